@@ -1,0 +1,233 @@
+//! The device-information frame (`9B 4C 01 01`, 77 bytes) an idle ESC sends after each data frame.
+//!
+//! ```text
+//!  0    1    2    3    4 ..= 75                                   76
+//!  9B   4C   01   01   72 ASCII bytes, space-padded fixed fields    check = low byte of sum(0..=75)
+//! ```
+//!
+//! The 72 text bytes seen on an XRotor v4 Pro HV 80A are five fixed-width fields:
+//! 16 blanks, `XR_FOC_ESC` (16), `HW577_KZ1_V1.1` (16), `XR-01.0.00` (16), `01040443` (8).
+//! The vendor document does not describe this frame; only one distinct frame has been seen, so
+//! the check byte rule is likely rather than certain, and the text is also exposed whole.
+
+use core::fmt;
+
+use crate::frame::{FrameError, SYNC, VERSION, checksum};
+
+/// Length byte of a device-information frame: bytes before the check byte.
+pub const INFO_LENGTH_BYTE: u8 = 0x4C;
+/// Command byte of a device-information frame.
+pub const CMD_INFO: u8 = 0x01;
+/// Total length of a device-information frame on the wire.
+pub const INFO_FRAME_LEN: usize = 77;
+/// Number of text bytes carried by a device-information frame.
+pub const INFO_TEXT_LEN: usize = 72;
+
+/// Widths of the fixed fields of the text, in order: blank, product, hardware, firmware, id.
+const FIELDS: [(usize, usize); 5] = [(0, 16), (16, 32), (32, 48), (48, 64), (64, 72)];
+/// Names of the four visible fields, as used in [`InfoFieldError`].
+const FIELD_NAMES: [&str; 4] = ["product", "hardware", "firmware", "id"];
+
+/// Why [`InfoFrame::new`] refused a field.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum InfoFieldError {
+    /// The text does not fit its fixed-width field.
+    TooLong {
+        /// Which field: `product`, `hardware`, `firmware` or `id`.
+        field: &'static str,
+        /// Bytes the field holds.
+        max: usize,
+        /// Bytes given.
+        len: usize,
+    },
+    /// The text is not ASCII.
+    NotAscii {
+        /// Which field.
+        field: &'static str,
+    },
+}
+
+impl fmt::Display for InfoFieldError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match *self {
+            InfoFieldError::TooLong { field, max, len } => {
+                write!(f, "{field} is {len} bytes long; the field holds {max}")
+            }
+            InfoFieldError::NotAscii { field } => write!(f, "{field} is not ASCII text"),
+        }
+    }
+}
+
+impl core::error::Error for InfoFieldError {}
+
+/// A device-information frame: 72 bytes of space-padded ASCII text.
+///
+/// ```
+/// use hwfoc::InfoFrame;
+///
+/// let info = InfoFrame::new("XR_FOC_ESC", "HW577_KZ1_V1.1", "XR-01.0.00", "01040443")?;
+/// let bytes = info.encode();
+/// assert_eq!(&bytes[..4], &[0x9B, 0x4C, 0x01, 0x01]);
+/// assert_eq!(bytes[76], 0x34); // the check byte of the real frame
+/// let back = InfoFrame::parse(&bytes)?;
+/// assert_eq!(back.product(), "XR_FOC_ESC");
+/// assert_eq!(back.firmware(), "XR-01.0.00");
+/// # Ok::<(), Box<dyn core::error::Error>>(())
+/// ```
+#[derive(Clone, Copy, PartialEq, Eq, Hash)]
+pub struct InfoFrame {
+    text: [u8; INFO_TEXT_LEN],
+}
+
+impl InfoFrame {
+    /// Builds a frame from its four visible fields (the leading 16-byte field is left blank).
+    ///
+    /// The first three fields take at most 16 ASCII bytes, `id` at most 8; each is padded with
+    /// spaces.
+    pub fn new(
+        product: &str,
+        hardware: &str,
+        firmware: &str,
+        id: &str,
+    ) -> Result<Self, InfoFieldError> {
+        let mut text = [b' '; INFO_TEXT_LEN];
+        let fields = [product, hardware, firmware, id];
+        for ((value, &(start, end)), &field) in fields.iter().zip(&FIELDS[1..]).zip(&FIELD_NAMES) {
+            let max = end - start;
+            if !value.is_ascii() {
+                return Err(InfoFieldError::NotAscii { field });
+            }
+            if value.len() > max {
+                return Err(InfoFieldError::TooLong {
+                    field,
+                    max,
+                    len: value.len(),
+                });
+            }
+            text[start..start + value.len()].copy_from_slice(value.as_bytes());
+        }
+        Ok(InfoFrame { text })
+    }
+
+    /// Builds a frame carrying exactly these 72 text bytes.
+    pub const fn from_text(text: [u8; INFO_TEXT_LEN]) -> Self {
+        InfoFrame { text }
+    }
+
+    /// Decodes a device-information frame from the first 77 bytes of `bytes`.
+    pub fn parse(bytes: &[u8]) -> Result<Self, FrameError> {
+        let Some(frame) = bytes.first_chunk::<INFO_FRAME_LEN>() else {
+            return Err(FrameError::Truncated {
+                needed: INFO_FRAME_LEN,
+                got: bytes.len(),
+            });
+        };
+        if frame[0] != SYNC {
+            return Err(FrameError::NoSync { found: frame[0] });
+        }
+        if frame[1] != INFO_LENGTH_BYTE {
+            return Err(FrameError::UnknownLength { found: frame[1] });
+        }
+        Self::parse_exact(frame)
+    }
+
+    /// Checks and decodes a 77-byte candidate whose sync and length bytes already matched.
+    #[inline]
+    pub(crate) fn parse_exact(f: &[u8; INFO_FRAME_LEN]) -> Result<Self, FrameError> {
+        let expected = checksum(&f[..76]) & 0xFF;
+        let found = u16::from(f[76]);
+        if expected != found {
+            return Err(FrameError::Checksum { expected, found });
+        }
+        if f[2] != VERSION || f[3] != CMD_INFO {
+            return Err(FrameError::UnknownCommand {
+                version: f[2],
+                command: f[3],
+            });
+        }
+        let mut text = [0u8; INFO_TEXT_LEN];
+        text.copy_from_slice(&f[4..76]);
+        Ok(InfoFrame { text })
+    }
+
+    /// Encodes the frame as the 77 bytes an ESC sends.
+    pub fn encode(&self) -> [u8; INFO_FRAME_LEN] {
+        let mut f = [0u8; INFO_FRAME_LEN];
+        f[..4].copy_from_slice(&[SYNC, INFO_LENGTH_BYTE, VERSION, CMD_INFO]);
+        f[4..76].copy_from_slice(&self.text);
+        f[76] = checksum(&f[..76]) as u8;
+        f
+    }
+
+    /// The 72 text bytes exactly as received.
+    pub fn text(&self) -> &[u8; INFO_TEXT_LEN] {
+        &self.text
+    }
+
+    /// The fixed-width field `index` (0..5) with its padding removed; non-ASCII bytes make it `"?"`.
+    fn field(&self, index: usize) -> &str {
+        let (start, end) = FIELDS[index];
+        let raw = &self.text[start..end];
+        match core::str::from_utf8(raw) {
+            Ok(s) if raw.is_ascii() => s.trim_matches(|c: char| c == ' ' || c == '\0'),
+            _ => "?",
+        }
+    }
+
+    /// Product name (text bytes 16..32), e.g. `XR_FOC_ESC`.
+    pub fn product(&self) -> &str {
+        self.field(1)
+    }
+
+    /// Hardware version (text bytes 32..48), e.g. `HW577_KZ1_V1.1`.
+    pub fn hardware(&self) -> &str {
+        self.field(2)
+    }
+
+    /// Firmware version (text bytes 48..64), e.g. `XR-01.0.00`.
+    pub fn firmware(&self) -> &str {
+        self.field(3)
+    }
+
+    /// The trailing 8-character identifier (text bytes 64..72), e.g. `01040443`. Its meaning
+    /// (serial or build number) is not documented by the vendor.
+    pub fn id(&self) -> &str {
+        self.field(4)
+    }
+
+    /// The whitespace-separated words of the text, in order: robust to a layout other than the
+    /// one seen so far. Words that are not ASCII are given as `"?"`.
+    pub fn words(&self) -> impl Iterator<Item = &str> + '_ {
+        self.text
+            .split(|&b| b == b' ' || b == 0)
+            .filter(|w| !w.is_empty())
+            .map(|w| match core::str::from_utf8(w) {
+                Ok(s) if w.is_ascii() => s,
+                _ => "?",
+            })
+    }
+}
+
+impl fmt::Debug for InfoFrame {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.debug_struct("InfoFrame")
+            .field("product", &self.product())
+            .field("hardware", &self.hardware())
+            .field("firmware", &self.firmware())
+            .field("id", &self.id())
+            .finish()
+    }
+}
+
+impl fmt::Display for InfoFrame {
+    /// The words of the text joined by single spaces.
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        for (i, w) in self.words().enumerate() {
+            if i > 0 {
+                f.write_str(" ")?;
+            }
+            f.write_str(w)?;
+        }
+        Ok(())
+    }
+}

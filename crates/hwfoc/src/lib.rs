@@ -1,0 +1,18 @@
+#![doc = include_str!("../README.md")]
+#![no_std]
+#![forbid(unsafe_code)]
+#![warn(missing_docs)]
+
+pub mod decoder;
+pub mod frame;
+pub mod info;
+pub mod stats;
+pub mod status;
+pub mod units;
+
+pub use decoder::{Decoded, Decoder, Frames, frames};
+pub use frame::{DataFrame, Frame, FrameError, Parsed, parse};
+pub use info::{InfoFieldError, InfoFrame};
+pub use stats::LinkStats;
+pub use status::{Fault, Faults, Status};
+pub use units::{Settings, SettingsError, Temperature};

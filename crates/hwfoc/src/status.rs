@@ -1,0 +1,237 @@
+//! The 16-bit status word: named fault flags.
+//!
+//! Bytes 20 (high) and 21 (low) of a data frame. Bit 0 is the least significant bit of the low
+//! byte, bit 8 of the high byte. Names are those of `PROTOCOL-NOTES.md` and are stable across every
+//! output of the project.
+
+use core::fmt;
+
+/// One bit of the status word.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+#[repr(u8)]
+pub enum Fault {
+    /// Bit 0: input voltage is too high.
+    InputVoltageHigh = 0,
+    /// Bit 1: input voltage is too low.
+    InputVoltageLow = 1,
+    /// Bit 2: over current.
+    OverCurrent = 2,
+    /// Bit 3: not assigned by the vendor.
+    Reserved3 = 3,
+    /// Bit 4: the throttle signal is lost.
+    ThrottleSignalLost = 4,
+    /// Bit 5: the throttle is not returned to zero.
+    ThrottleNotZeroed = 5,
+    /// Bit 6: MOSFET overheat.
+    MosOverheat = 6,
+    /// Bit 7: capacitor overheat.
+    CapOverheat = 7,
+    /// Bit 8: motor is blocked.
+    MotorBlocked = 8,
+    /// Bit 9: open circuit of the upper bridge (MOSFET).
+    UpperBridgeOpen = 9,
+    /// Bit 10: MOSFET short circuit.
+    MosShort = 10,
+    /// Bit 11: open circuit of the lower bridge (MOSFET).
+    LowerBridgeOpen = 11,
+    /// Bit 12: operational amplifier abnormal, phase C.
+    OpampPhaseC = 12,
+    /// Bit 13: operational amplifier abnormal, phase B.
+    OpampPhaseB = 13,
+    /// Bit 14: operational amplifier abnormal, phase A.
+    OpampPhaseA = 14,
+    /// Bit 15: not assigned by the vendor.
+    Reserved15 = 15,
+}
+
+impl Fault {
+    /// All sixteen flags in bit order.
+    pub const ALL: [Fault; 16] = [
+        Fault::InputVoltageHigh,
+        Fault::InputVoltageLow,
+        Fault::OverCurrent,
+        Fault::Reserved3,
+        Fault::ThrottleSignalLost,
+        Fault::ThrottleNotZeroed,
+        Fault::MosOverheat,
+        Fault::CapOverheat,
+        Fault::MotorBlocked,
+        Fault::UpperBridgeOpen,
+        Fault::MosShort,
+        Fault::LowerBridgeOpen,
+        Fault::OpampPhaseC,
+        Fault::OpampPhaseB,
+        Fault::OpampPhaseA,
+        Fault::Reserved15,
+    ];
+
+    /// The bit number, 0..=15.
+    pub const fn bit(self) -> u8 {
+        self as u8
+    }
+
+    /// The flag's mask in the status word.
+    pub const fn mask(self) -> u16 {
+        1 << (self as u8)
+    }
+
+    /// The flag for bit `bit`, or `None` above 15.
+    pub const fn from_bit(bit: u8) -> Option<Fault> {
+        if bit < 16 {
+            Some(Self::ALL[bit as usize])
+        } else {
+            None
+        }
+    }
+
+    /// The stable machine name used in every output, e.g. `mos_overheat`.
+    pub const fn name(self) -> &'static str {
+        match self {
+            Fault::InputVoltageHigh => "input_voltage_high",
+            Fault::InputVoltageLow => "input_voltage_low",
+            Fault::OverCurrent => "over_current",
+            Fault::Reserved3 => "reserved_3",
+            Fault::ThrottleSignalLost => "throttle_signal_lost",
+            Fault::ThrottleNotZeroed => "throttle_not_zeroed",
+            Fault::MosOverheat => "mos_overheat",
+            Fault::CapOverheat => "cap_overheat",
+            Fault::MotorBlocked => "motor_blocked",
+            Fault::UpperBridgeOpen => "upper_bridge_open",
+            Fault::MosShort => "mos_short",
+            Fault::LowerBridgeOpen => "lower_bridge_open",
+            Fault::OpampPhaseC => "opamp_phase_c",
+            Fault::OpampPhaseB => "opamp_phase_b",
+            Fault::OpampPhaseA => "opamp_phase_a",
+            Fault::Reserved15 => "reserved_15",
+        }
+    }
+
+    /// The flag whose [`Fault::name`] is `name`.
+    pub fn from_name(name: &str) -> Option<Fault> {
+        Self::ALL.into_iter().find(|f| f.name() == name)
+    }
+
+    /// A short English description, e.g. "MOSFET overheat".
+    pub const fn description(self) -> &'static str {
+        match self {
+            Fault::InputVoltageHigh => "input voltage is too high",
+            Fault::InputVoltageLow => "input voltage is too low",
+            Fault::OverCurrent => "over current",
+            Fault::Reserved3 => "not assigned (bit 3)",
+            Fault::ThrottleSignalLost => "the throttle signal is lost",
+            Fault::ThrottleNotZeroed => "the throttle is not returned to zero",
+            Fault::MosOverheat => "MOSFET overheat",
+            Fault::CapOverheat => "capacitor overheat",
+            Fault::MotorBlocked => "motor is blocked",
+            Fault::UpperBridgeOpen => "open circuit of upper bridge (MOSFET)",
+            Fault::MosShort => "MOSFET short circuit",
+            Fault::LowerBridgeOpen => "open circuit of lower bridge (MOSFET)",
+            Fault::OpampPhaseC => "operational amplifier abnormal, phase C",
+            Fault::OpampPhaseB => "operational amplifier abnormal, phase B",
+            Fault::OpampPhaseA => "operational amplifier abnormal, phase A",
+            Fault::Reserved15 => "not assigned (bit 15)",
+        }
+    }
+}
+
+impl fmt::Display for Fault {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// The raw status word with named access to its flags.
+///
+/// ```
+/// use hwfoc::{Fault, Status};
+///
+/// let status = Status(0x1000 | 0x0040);
+/// assert!(status.contains(Fault::MosOverheat));
+/// let names: Vec<&str> = status.faults().map(|f| f.name()).collect();
+/// assert_eq!(names, ["mos_overheat", "opamp_phase_c"]);
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+pub struct Status(pub u16);
+
+impl Status {
+    /// No flag set.
+    pub const OK: Status = Status(0);
+
+    /// Whether `fault` is set.
+    pub const fn contains(self, fault: Fault) -> bool {
+        self.0 & fault.mask() != 0
+    }
+
+    /// Whether no flag is set.
+    pub const fn is_ok(self) -> bool {
+        self.0 == 0
+    }
+
+    /// The word with `fault` set as well.
+    #[must_use]
+    pub const fn with(self, fault: Fault) -> Status {
+        Status(self.0 | fault.mask())
+    }
+
+    /// The set flags, in bit order (bit 0 first).
+    pub fn faults(self) -> Faults {
+        Faults(self.0)
+    }
+}
+
+impl From<u16> for Status {
+    fn from(word: u16) -> Self {
+        Status(word)
+    }
+}
+
+impl FromIterator<Fault> for Status {
+    fn from_iter<I: IntoIterator<Item = Fault>>(iter: I) -> Self {
+        Status(iter.into_iter().fold(0, |w, f| w | f.mask()))
+    }
+}
+
+impl IntoIterator for Status {
+    type Item = Fault;
+    type IntoIter = Faults;
+    fn into_iter(self) -> Faults {
+        self.faults()
+    }
+}
+
+impl fmt::Display for Status {
+    /// The set flags' names joined by `|` (the CSV form), or nothing when no flag is set.
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        for (i, fault) in self.faults().enumerate() {
+            if i > 0 {
+                f.write_str("|")?;
+            }
+            f.write_str(fault.name())?;
+        }
+        Ok(())
+    }
+}
+
+/// Iterator over the flags set in a status word, in bit order.
+#[derive(Debug, Clone)]
+pub struct Faults(u16);
+
+impl Iterator for Faults {
+    type Item = Fault;
+
+    fn next(&mut self) -> Option<Fault> {
+        if self.0 == 0 {
+            return None;
+        }
+        let bit = self.0.trailing_zeros() as u8;
+        self.0 &= self.0 - 1;
+        Fault::from_bit(bit)
+    }
+
+    fn size_hint(&self) -> (usize, Option<usize>) {
+        let n = self.0.count_ones() as usize;
+        (n, Some(n))
+    }
+}
+
+impl ExactSizeIterator for Faults {}
