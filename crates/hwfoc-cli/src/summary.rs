@@ -1,0 +1,461 @@
+//! `hwfoc summary`: what a stream holds and how good the link was.
+//!
+//! Statistics are gathered on the raw integers (min, max and sum per field, a histogram of each
+//! temperature's ADC codes) and converted to physical units once, at the end: every conversion
+//! is monotonic, so this is exact, and it keeps the per-frame cost to a few integer operations.
+
+use std::fmt::Write as _;
+
+use hwfoc::{DataFrame, Fault, Frame, InfoFrame, LinkStats, Settings, Temperature};
+use serde_json::{Value, json};
+
+use crate::SummaryArgs;
+use crate::error::CliError;
+use crate::input::Format;
+use crate::output::Output;
+use crate::stream::Stream;
+
+/// What to tell a user whose input has bytes but no frame.
+pub const NO_FRAMES: &str = "no valid HW-FOC frames: check the baud rate (19200) and the wiring";
+
+pub fn run(args: &SummaryArgs) -> Result<(), CliError> {
+    let settings = args.settings.settings()?;
+    let mut input = args.input.open()?;
+    let mut stream = Stream::new();
+    let mut acc = Accumulator::default();
+    while let Some(batch) = input.next_batch()? {
+        stream.feed(batch, |t, d| acc.add(t, &d.frame));
+    }
+    stream.finish(|t, d| acc.add(t, &d.frame));
+    let report = Report {
+        input: input.name(),
+        format: input.format(),
+        flagged_bytes: input.flagged_bytes(),
+        stats: stream.stats(),
+        settings: &settings,
+        acc: &acc,
+    };
+    let mut text = if args.json {
+        let mut s = serde_json::to_string_pretty(&report.json()).unwrap_or_default();
+        s.push('\n');
+        s
+    } else {
+        report.text()
+    };
+    let mut out = Output::create(None)?;
+    let mut buf = std::mem::take(&mut text).into_bytes();
+    out.write(&mut buf)?;
+    out.flush()
+}
+
+/// Min, max and sum of one raw integer field.
+#[derive(Debug, Clone, Copy)]
+struct Range {
+    min: i32,
+    max: i32,
+    sum: i64,
+}
+
+impl Default for Range {
+    fn default() -> Self {
+        Range {
+            min: i32::MAX,
+            max: i32::MIN,
+            sum: 0,
+        }
+    }
+}
+
+impl Range {
+    #[inline]
+    fn add(&mut self, v: i32) {
+        self.min = self.min.min(v);
+        self.max = self.max.max(v);
+        self.sum += i64::from(v);
+    }
+
+    /// Min, max and mean after applying a monotonic increasing conversion.
+    fn convert(&self, n: u64, f: impl Fn(f64) -> f64) -> Option<[f64; 3]> {
+        (n > 0).then(|| {
+            [
+                f(f64::from(self.min)),
+                f(f64::from(self.max)),
+                f(self.sum as f64 / n as f64),
+            ]
+        })
+    }
+}
+
+/// Everything the summary needs from the frames, gathered as they are decoded.
+#[derive(Debug)]
+struct Accumulator {
+    frames: u64,
+    throttle_in: Range,
+    throttle_out: Range,
+    erpm: Range,
+    voltage: Range,
+    current: Range,
+    phase_current: Range,
+    mos_codes: [u64; 256],
+    cap_codes: [u64; 256],
+    fault_frames: [u64; 16],
+    first_t: Option<f64>,
+    last_t: Option<f64>,
+    infos: Vec<(InfoFrame, u64)>,
+}
+
+impl Default for Accumulator {
+    fn default() -> Self {
+        Accumulator {
+            frames: 0,
+            throttle_in: Range::default(),
+            throttle_out: Range::default(),
+            erpm: Range::default(),
+            voltage: Range::default(),
+            current: Range::default(),
+            phase_current: Range::default(),
+            mos_codes: [0; 256],
+            cap_codes: [0; 256],
+            fault_frames: [0; 16],
+            first_t: None,
+            last_t: None,
+            infos: Vec::new(),
+        }
+    }
+}
+
+impl Accumulator {
+    #[inline]
+    fn add(&mut self, t: Option<f64>, frame: &Frame) {
+        match frame {
+            Frame::Data(f) => self.add_data(t, f),
+            Frame::Info(info) => match self.infos.iter_mut().find(|(i, _)| i == info) {
+                Some((_, n)) => *n += 1,
+                None => self.infos.push((*info, 1)),
+            },
+        }
+    }
+
+    #[inline]
+    fn add_data(&mut self, t: Option<f64>, f: &DataFrame) {
+        self.frames += 1;
+        self.throttle_in.add(i32::from(f.throttle_in_raw));
+        self.throttle_out.add(i32::from(f.throttle_out_raw));
+        self.erpm.add(i32::from(f.erpm_raw));
+        self.voltage.add(i32::from(f.voltage_raw));
+        self.current.add(i32::from(f.current_raw));
+        self.phase_current.add(i32::from(f.phase_current_raw));
+        self.mos_codes[usize::from(f.mos_adc)] += 1;
+        self.cap_codes[usize::from(f.cap_adc)] += 1;
+        if !f.status.is_ok() {
+            for fault in f.status.faults() {
+                self.fault_frames[usize::from(fault.bit())] += 1;
+            }
+        }
+        if let Some(t) = t {
+            self.first_t.get_or_insert(t);
+            self.last_t = Some(t);
+        }
+    }
+}
+
+/// Temperature statistics from a histogram of ADC codes.
+#[derive(Debug, Default, PartialEq)]
+struct TempStats {
+    range: Option<[f64; 3]>,
+    below: u64,
+    above: u64,
+}
+
+fn temp_stats(codes: &[u64; 256]) -> TempStats {
+    let mut s = TempStats::default();
+    let (mut min, mut max, mut sum, mut n) = (f64::MAX, f64::MIN, 0.0, 0u64);
+    for (code, &count) in codes.iter().enumerate() {
+        if count == 0 {
+            continue;
+        }
+        match Temperature::from_adc(code as u8) {
+            Temperature::Celsius(c) => {
+                let c = f64::from(c);
+                min = min.min(c);
+                max = max.max(c);
+                sum += c * count as f64;
+                n += count;
+            }
+            Temperature::BelowRange => s.below += count,
+            Temperature::AboveRange => s.above += count,
+        }
+    }
+    if n > 0 {
+        s.range = Some([min, max, sum / n as f64]);
+    }
+    s
+}
+
+/// The summary, ready to be printed.
+struct Report<'a> {
+    input: &'a str,
+    format: Format,
+    flagged_bytes: u64,
+    stats: &'a LinkStats,
+    settings: &'a Settings,
+    acc: &'a Accumulator,
+}
+
+/// One row of the field table: name, unit, and min/max/mean if there were frames.
+type FieldRow = (&'static str, &'static str, Option<[f64; 3]>);
+
+impl Report<'_> {
+    fn duration(&self) -> Option<f64> {
+        Some(self.acc.last_t? - self.acc.first_t?)
+    }
+
+    /// Data frames per second between the first and the last frame.
+    fn frame_rate(&self) -> Option<f64> {
+        let d = self.duration()?;
+        (d > 0.0).then(|| (self.acc.frames - 1) as f64 / d)
+    }
+
+    fn fields(&self) -> Vec<FieldRow> {
+        let a = self.acc;
+        let n = a.frames;
+        let s = *self.settings;
+        let pct = |x: f64| x * 100.0 / 1024.0;
+        let amps = move |x: f64| x / f64::from(s.current_scale);
+        let rpm = move |x: f64| x * 10.0 / (f64::from(s.gear_ratio) * f64::from(s.pole_pairs));
+        vec![
+            ("throttle_in_pct", "%", a.throttle_in.convert(n, pct)),
+            ("throttle_out_pct", "%", a.throttle_out.convert(n, pct)),
+            ("erpm", "rev/min", a.erpm.convert(n, |x| x * 10.0)),
+            ("rpm", "rev/min", a.erpm.convert(n, rpm)),
+            ("voltage_v", "V", a.voltage.convert(n, |x| x / 10.0)),
+            ("current_a", "A", a.current.convert(n, amps)),
+            ("phase_current_a", "A", a.phase_current.convert(n, amps)),
+            ("mos_temp_c", "degC", temp_stats(&a.mos_codes).range),
+            ("cap_temp_c", "degC", temp_stats(&a.cap_codes).range),
+        ]
+    }
+
+    fn faults(&self) -> impl Iterator<Item = (Fault, u64)> + '_ {
+        Fault::ALL
+            .into_iter()
+            .map(|f| (f, self.acc.fault_frames[usize::from(f.bit())]))
+            .filter(|&(_, n)| n > 0)
+    }
+
+    fn text(&self) -> String {
+        let st = self.stats;
+        let mut o = String::new();
+        // Writing to a String cannot fail; the results are ignored below for that reason.
+        let _ = writeln!(
+            o,
+            "input        {} ({}, {} bytes)",
+            self.input,
+            self.format,
+            st.bytes()
+        );
+        if self.flagged_bytes > 0 {
+            let _ = writeln!(
+                o,
+                "             {} bytes flagged with parity or framing errors by the analyser",
+                self.flagged_bytes
+            );
+        }
+        let _ = writeln!(
+            o,
+            "settings     current scale {}, pole pairs {}, gear ratio {}",
+            self.settings.current_scale, self.settings.pole_pairs, self.settings.gear_ratio
+        );
+        if st.frames() == 0 && st.info_frames() == 0 {
+            let _ = writeln!(o, "frames       none: {NO_FRAMES}");
+            let _ = writeln!(o, "skipped      {} bytes", st.bytes_skipped());
+            return o;
+        }
+        let _ = write!(
+            o,
+            "frames       {} data, {} info",
+            st.frames(),
+            st.info_frames()
+        );
+        if let (Some(d), Some(rate)) = (self.duration(), self.frame_rate()) {
+            let _ = write!(o, " over {d:.3} s ({rate:.1} data frames/s)");
+        }
+        o.push('\n');
+        if let (Some(first), Some(last)) = (self.acc.first_t, self.acc.last_t) {
+            let _ = writeln!(o, "time         {first} .. {last} s");
+        }
+        let _ = writeln!(
+            o,
+            "link         {} checksum failures, {} lost packets, {} duplicate packets, {} bytes skipped ({:.2} %)",
+            st.checksum_failures(),
+            st.lost_packets(),
+            st.duplicate_packets(),
+            st.bytes_skipped(),
+            percent(st.bytes_skipped(), st.bytes())
+        );
+        if let Some(ratio) = st.delivery_ratio() {
+            let _ = writeln!(o, "delivery     {:.2} % of data frames", ratio * 100.0);
+        }
+        if st.frames() == 0 {
+            let _ = writeln!(o, "             no data frames: {NO_FRAMES}");
+        }
+        for (info, n) in &self.acc.infos {
+            let _ = writeln!(o, "device       {info}  ({n} info frames)");
+        }
+        if self.acc.frames > 0 {
+            let _ = writeln!(
+                o,
+                "\n{:<18} {:>12} {:>12} {:>12}  unit",
+                "field", "min", "max", "mean"
+            );
+            for (name, unit, range) in self.fields() {
+                match range {
+                    Some([min, max, mean]) => {
+                        let _ =
+                            writeln!(o, "{name:<18} {min:>12.3} {max:>12.3} {mean:>12.3}  {unit}");
+                    }
+                    None => {
+                        let _ =
+                            writeln!(o, "{name:<18} {:>12} {:>12} {:>12}  {unit}", "-", "-", "-");
+                    }
+                }
+            }
+            for (name, t) in [
+                ("mos_temp_c", temp_stats(&self.acc.mos_codes)),
+                ("cap_temp_c", temp_stats(&self.acc.cap_codes)),
+            ] {
+                if t.below + t.above > 0 {
+                    let _ = writeln!(
+                        o,
+                        "{name:<18} out of the table's range in {} frames (below 0 degC: {}, above 129 degC: {})",
+                        t.below + t.above,
+                        t.below,
+                        t.above
+                    );
+                }
+            }
+            o.push('\n');
+            let mut any = false;
+            for (fault, n) in self.faults() {
+                any = true;
+                let _ = writeln!(
+                    o,
+                    "fault        {:<22} in {n} frames ({})",
+                    fault.name(),
+                    fault.description()
+                );
+            }
+            if !any {
+                let _ = writeln!(o, "faults       none");
+            }
+        }
+        o
+    }
+
+    fn json(&self) -> Value {
+        let st = self.stats;
+        let fields: serde_json::Map<String, Value> = self
+            .fields()
+            .into_iter()
+            .map(|(name, unit, range)| {
+                let v = match range {
+                    Some([min, max, mean]) => {
+                        json!({"min": min, "max": max, "mean": mean, "unit": unit})
+                    }
+                    None => json!({"min": null, "max": null, "mean": null, "unit": unit}),
+                };
+                (name.to_string(), v)
+            })
+            .collect();
+        let faults: serde_json::Map<String, Value> = self
+            .faults()
+            .map(|(f, n)| (f.name().to_string(), json!(n)))
+            .collect();
+        let infos: Vec<Value> = self
+            .acc
+            .infos
+            .iter()
+            .map(|(i, n)| {
+                json!({
+                    "product": i.product(),
+                    "hardware": i.hardware(),
+                    "firmware": i.firmware(),
+                    "id": i.id(),
+                    "text": i.to_string(),
+                    "frames": n,
+                })
+            })
+            .collect();
+        let temps = |t: TempStats| json!({"below_range": t.below, "above_range": t.above});
+        json!({
+            "input": self.input,
+            "format": match self.format { Format::Raw => "raw", Format::AnalyzerCsv => "csv" },
+            "bytes": st.bytes(),
+            "flagged_bytes": self.flagged_bytes,
+            "settings": {
+                "current_scale": self.settings.current_scale,
+                "pole_pairs": self.settings.pole_pairs,
+                "gear_ratio": self.settings.gear_ratio,
+            },
+            "frames": st.frames(),
+            "info_frames": st.info_frames(),
+            "first_t_s": self.acc.first_t,
+            "last_t_s": self.acc.last_t,
+            "duration_s": self.duration(),
+            "frame_rate_hz": self.frame_rate(),
+            "link": {
+                "checksum_failures": st.checksum_failures(),
+                "lost_packets": st.lost_packets(),
+                "duplicate_packets": st.duplicate_packets(),
+                "bytes_skipped": st.bytes_skipped(),
+                "delivery_ratio": st.delivery_ratio(),
+            },
+            "info": infos,
+            "fields": fields,
+            "temperature_out_of_range": {
+                "mos_temp_c": temps(temp_stats(&self.acc.mos_codes)),
+                "cap_temp_c": temps(temp_stats(&self.acc.cap_codes)),
+            },
+            "faults": faults,
+            "warning": (st.frames() == 0).then_some(NO_FRAMES),
+        })
+    }
+}
+
+fn percent(part: u64, whole: u64) -> f64 {
+    if whole == 0 {
+        0.0
+    } else {
+        part as f64 * 100.0 / whole as f64
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn temperature_stats_come_from_the_histogram() {
+        let mut codes = [0u64; 256];
+        codes[206] = 3; // 28 degC
+        codes[183] = 1; // 40 degC
+        codes[250] = 2; // below range
+        codes[10] = 1; // above range
+        let t = temp_stats(&codes);
+        assert_eq!(t.range, Some([28.0, 40.0, (3.0 * 28.0 + 40.0) / 4.0]));
+        assert_eq!((t.below, t.above), (2, 1));
+    }
+
+    #[test]
+    fn ranges_convert_monotonically() {
+        let mut r = Range::default();
+        for v in [-64, 128, 0] {
+            r.add(v);
+        }
+        assert_eq!(
+            r.convert(3, |x| x / 64.0),
+            Some([-1.0, 2.0, 64.0 / 3.0 / 64.0])
+        );
+        assert_eq!(Range::default().convert(0, |x| x), None);
+    }
+}
