@@ -64,14 +64,20 @@ fn decode_all(
     text: &mut Vec<u8>,
     emit: &mut impl FnMut(Option<f64>, hwfoc::Decoded, &mut Vec<u8>),
 ) -> Result<(), CliError> {
-    while let Some(batch) = input.next_batch()? {
+    let result = loop {
+        let batch = match input.next_batch() {
+            Ok(Some(batch)) => batch,
+            Ok(None) => break Ok(()),
+            Err(e) => break Err(e),
+        };
         stream.feed(batch, |t, d| emit(t, d, text));
         // Small batches come from a live stream: pass them on at once.
         if text.len() >= FLUSH_AT || batch.bytes.len() < 4096 {
             out.write(text)?;
             out.flush()?;
         }
-    }
+    };
+    // Even after an input error, frames already received are decoded.
     stream.finish(|t, d| emit(t, d, text));
-    Ok(())
+    result
 }

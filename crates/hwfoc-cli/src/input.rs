@@ -45,17 +45,20 @@ pub struct Batch<'a> {
 }
 
 enum Source {
-    Raw {
-        reader: Box<dyn Read>,
-    },
-    Csv {
-        reader: BufReader<Box<dyn Read>>,
-        value_col: usize,
-        error_cols: Vec<usize>,
-        /// Number of the last line read (1-based).
-        line: u64,
-        row: Vec<u8>,
-    },
+    Raw { reader: Box<dyn Read> },
+    Csv(CsvRows),
+}
+
+/// The rows of a logic-analyser CSV after its header line.
+struct CsvRows {
+    reader: BufReader<Box<dyn Read>>,
+    value_col: usize,
+    error_cols: Vec<usize>,
+    /// Number of the last line read (1-based; the header is line 1).
+    line: u64,
+    row: Vec<u8>,
+    /// Rows flagged with a parity or framing error.
+    flagged: u64,
 }
 
 /// One opened input.
@@ -67,9 +70,11 @@ pub struct Input {
     times: Vec<f64>,
     /// Bytes read during format detection, handed out first (raw inputs only).
     pending: Vec<u8>,
-    flagged: u64,
     seen_any: bool,
     done: bool,
+    /// An error met after some bytes of a batch: reported on the next call, so that the bytes
+    /// before it are decoded first.
+    deferred: Option<CliError>,
 }
 
 impl Input {
@@ -143,13 +148,14 @@ impl Input {
                 .filter(|(_, c)| c.contains("error"))
                 .map(|(i, _)| i)
                 .collect();
-            let source = Source::Csv {
+            let source = Source::Csv(CsvRows {
                 reader,
                 value_col,
                 error_cols,
                 line: 1,
                 row: Vec::new(),
-            };
+                flagged: 0,
+            });
             (Format::AnalyzerCsv, source, Vec::new())
         } else {
             (Format::Raw, Source::Raw { reader }, head)
@@ -161,9 +167,9 @@ impl Input {
             bytes: Vec::new(),
             times: Vec::new(),
             pending,
-            flagged: 0,
             seen_any: false,
             done: false,
+            deferred: None,
         })
     }
 
@@ -180,11 +186,18 @@ impl Input {
     /// Bytes the logic analyser flagged with a parity or framing error (passed on all the same:
     /// the frame checksum decides).
     pub fn flagged_bytes(&self) -> u64 {
-        self.flagged
+        match &self.source {
+            Source::Csv(rows) => rows.flagged,
+            Source::Raw { .. } => 0,
+        }
     }
 
     /// The next batch of bytes, or `None` at the end of the input.
     pub fn next_batch(&mut self) -> Result<Option<Batch<'_>>, CliError> {
+        if let Some(e) = self.deferred.take() {
+            self.done = true;
+            return Err(e);
+        }
         if self.done {
             return Ok(None);
         }
@@ -204,55 +217,13 @@ impl Input {
                     self.bytes.truncate(n);
                 }
             }
-            Source::Csv {
-                reader,
-                value_col,
-                error_cols,
-                line,
-                row,
-            } => {
-                while self.bytes.len() < CSV_BATCH_ROWS {
-                    row.clear();
-                    let n = reader
-                        .read_until(b'\n', row)
-                        .map_err(|source| CliError::Read {
-                            input: self.name.clone(),
-                            source,
-                        })?;
-                    if n == 0 {
-                        break;
+            Source::Csv(rows) => {
+                if let Err(e) = rows.read(&self.name, &mut self.bytes, &mut self.times) {
+                    if self.bytes.is_empty() {
+                        self.done = true;
+                        return Err(e);
                     }
-                    *line += 1;
-                    let bad = |message: String| CliError::Csv {
-                        input: self.name.clone(),
-                        line: *line,
-                        message,
-                    };
-                    let text = std::str::from_utf8(row)
-                        .map_err(|_| bad("not valid UTF-8 text".to_string()))?
-                        .trim_end_matches(['\n', '\r']);
-                    if text.trim().is_empty() {
-                        continue; // a blank line
-                    }
-                    let field = |i: usize| text.split(',').nth(i).map(unquote);
-                    let time = field(0)
-                        .and_then(|t| t.parse::<f64>().ok())
-                        .filter(|t| t.is_finite())
-                        .ok_or_else(|| bad(format!("bad time {}", field_text(field(0)))))?;
-                    let value = field(*value_col).and_then(parse_byte).ok_or_else(|| {
-                        bad(format!(
-                            "bad byte value {} (expected 0x00..0xFF or 0..255)",
-                            field_text(field(*value_col))
-                        ))
-                    })?;
-                    if error_cols
-                        .iter()
-                        .any(|&c| field(c).is_some_and(|f| !f.is_empty()))
-                    {
-                        self.flagged += 1;
-                    }
-                    self.bytes.push(value);
-                    self.times.push(time);
+                    self.deferred = Some(e);
                 }
             }
         }
@@ -274,6 +245,71 @@ impl Input {
             bytes: &self.bytes,
             times,
         }))
+    }
+}
+
+impl CsvRows {
+    /// Reads rows into `bytes` and `times` until a batch is full or the input ends. On an error,
+    /// the rows before it stay in `bytes` and `times`.
+    fn read(
+        &mut self,
+        name: &str,
+        bytes: &mut Vec<u8>,
+        times: &mut Vec<f64>,
+    ) -> Result<(), CliError> {
+        let CsvRows {
+            reader,
+            value_col,
+            error_cols,
+            line,
+            row,
+            flagged,
+        } = self;
+        let value_col = *value_col;
+        while bytes.len() < CSV_BATCH_ROWS {
+            row.clear();
+            let n = reader
+                .read_until(b'\n', row)
+                .map_err(|source| CliError::Read {
+                    input: name.to_string(),
+                    source,
+                })?;
+            if n == 0 {
+                break;
+            }
+            *line += 1;
+            let bad = |message: String| CliError::Csv {
+                input: name.to_string(),
+                line: *line,
+                message,
+            };
+            let text = std::str::from_utf8(row)
+                .map_err(|_| bad("not valid UTF-8 text".to_string()))?
+                .trim_end_matches(['\n', '\r']);
+            if text.trim().is_empty() {
+                continue; // a blank line
+            }
+            let field = |i: usize| text.split(',').nth(i).map(unquote);
+            let time = field(0)
+                .and_then(|t| t.parse::<f64>().ok())
+                .filter(|t| t.is_finite())
+                .ok_or_else(|| bad(format!("bad time {}", field_text(field(0)))))?;
+            let value = field(value_col).and_then(parse_byte).ok_or_else(|| {
+                bad(format!(
+                    "bad byte value {} (expected 0x00..0xFF or 0..255)",
+                    field_text(field(value_col))
+                ))
+            })?;
+            if error_cols
+                .iter()
+                .any(|&c| field(c).is_some_and(|f| !f.is_empty()))
+            {
+                *flagged += 1;
+            }
+            bytes.push(value);
+            times.push(time);
+        }
+        Ok(())
     }
 }
 
