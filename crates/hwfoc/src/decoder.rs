@@ -190,10 +190,23 @@ impl Decoder {
         let mut data = data;
         let mut base = start;
         if self.len > 0 {
+            let held = usize::from(self.len);
+            // Common byte-at-a-time case: the held candidate still cannot be decided with these
+            // bytes (a frame's length is known from its second byte), so just keep them.
+            let needed = match self.buf[..held] {
+                [_] => 2,
+                [_, DATA_LENGTH_BYTE, ..] => DATA_FRAME_LEN,
+                [_, INFO_LENGTH_BYTE, ..] => INFO_FRAME_LEN,
+                _ => 0,
+            };
+            if held + data.len() < needed {
+                self.buf[held..held + data.len()].copy_from_slice(data);
+                self.len += data.len() as u8;
+                return;
+            }
             // Finish the held candidate with the first bytes of `data`. A candidate starting in
             // the held bytes needs at most MAX_FRAME_LEN bytes from its start, so appending that
             // many decides every one of them whenever `data` is long enough.
-            let held = usize::from(self.len);
             let take = data.len().min(MAX_FRAME_LEN);
             let mut tmp = [0u8; 2 * MAX_FRAME_LEN - 1];
             tmp[..held].copy_from_slice(&self.buf[..held]);

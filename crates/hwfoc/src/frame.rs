@@ -332,6 +332,14 @@ pub enum FrameError {
         /// Command byte (byte 3).
         command: u8,
     },
+    /// A device-information candidate whose text holds a byte that is not ASCII: not a real
+    /// frame (typically a cut one with another frame behind it).
+    NotText {
+        /// Offset of the first such byte in the frame.
+        offset: usize,
+        /// The byte.
+        found: u8,
+    },
 }
 
 impl fmt::Display for FrameError {
@@ -354,6 +362,10 @@ impl fmt::Display for FrameError {
             FrameError::UnknownCommand { version, command } => write!(
                 f,
                 "unknown version 0x{version:02X} / command 0x{command:02X}"
+            ),
+            FrameError::NotText { offset, found } => write!(
+                f,
+                "device-information text holds byte 0x{found:02X} at offset {offset}, which is not ASCII"
             ),
         }
     }

@@ -9,6 +9,11 @@
 //! 16 blanks, `XR_FOC_ESC` (16), `HW577_KZ1_V1.1` (16), `XR-01.0.00` (16), `01040443` (8).
 //! The vendor document does not describe this frame; only one distinct frame has been seen, so
 //! the check byte rule is likely rather than certain, and the text is also exposed whole.
+//!
+//! The check byte is only 8 bits: a frame cut short and followed by other frames passes it by
+//! chance once in 256 times, and would swallow the data frames behind it. So a candidate is also
+//! required to carry ASCII text (every byte below 0x80): a data frame inside the 77-byte window
+//! always brings its `0x9B` sync byte into the text and is never hidden.
 
 use core::fmt;
 
@@ -109,9 +114,13 @@ impl InfoFrame {
         Ok(InfoFrame { text })
     }
 
-    /// Builds a frame carrying exactly these 72 text bytes.
-    pub const fn from_text(text: [u8; INFO_TEXT_LEN]) -> Self {
-        InfoFrame { text }
+    /// Builds a frame carrying exactly these 72 text bytes, which must be ASCII (as every
+    /// frame the decoder accepts is).
+    pub fn from_text(text: [u8; INFO_TEXT_LEN]) -> Result<Self, InfoFieldError> {
+        if !text.is_ascii() {
+            return Err(InfoFieldError::NotAscii { field: "text" });
+        }
+        Ok(InfoFrame { text })
     }
 
     /// Decodes a device-information frame from the first 77 bytes of `bytes`.
@@ -145,6 +154,12 @@ impl InfoFrame {
                 command: f[3],
             });
         }
+        if let Some(at) = f[4..76].iter().position(|b| !b.is_ascii()) {
+            return Err(FrameError::NotText {
+                offset: 4 + at,
+                found: f[4 + at],
+            });
+        }
         let mut text = [0u8; INFO_TEXT_LEN];
         text.copy_from_slice(&f[4..76]);
         Ok(InfoFrame { text })
@@ -164,14 +179,10 @@ impl InfoFrame {
         &self.text
     }
 
-    /// The fixed-width field `index` (0..5) with its padding removed; non-ASCII bytes make it `"?"`.
+    /// The fixed-width field `index` (0..5) with its padding removed.
     fn field(&self, index: usize) -> &str {
         let (start, end) = FIELDS[index];
-        let raw = &self.text[start..end];
-        match core::str::from_utf8(raw) {
-            Ok(s) if raw.is_ascii() => s.trim_matches(|c: char| c == ' ' || c == '\0'),
-            _ => "?",
-        }
+        ascii(&self.text[start..end]).trim_matches(|c: char| c == ' ' || c == '\0')
     }
 
     /// Product name (text bytes 16..32), e.g. `XR_FOC_ESC`.
@@ -196,16 +207,18 @@ impl InfoFrame {
     }
 
     /// The whitespace-separated words of the text, in order: robust to a layout other than the
-    /// one seen so far. Words that are not ASCII are given as `"?"`.
+    /// one seen so far.
     pub fn words(&self) -> impl Iterator<Item = &str> + '_ {
         self.text
             .split(|&b| b == b' ' || b == 0)
             .filter(|w| !w.is_empty())
-            .map(|w| match core::str::from_utf8(w) {
-                Ok(s) if w.is_ascii() => s,
-                _ => "?",
-            })
+            .map(ascii)
     }
+}
+
+/// ASCII bytes as text (an `InfoFrame` holds nothing else; `"?"` would mark a broken invariant).
+fn ascii(bytes: &[u8]) -> &str {
+    core::str::from_utf8(bytes).unwrap_or("?")
 }
 
 impl fmt::Debug for InfoFrame {

@@ -59,7 +59,9 @@ impl LinkStats {
     }
 
     /// Candidate frames (0x9B followed by a known length byte, long enough) that were rejected:
-    /// checksum mismatch, or a correct checksum with an unknown version or command.
+    /// checksum mismatch, or a correct checksum with an unknown version or command, or a
+    /// device-information candidate whose text is not ASCII. Corrupted and cut frames, and fake
+    /// headers in noise, all count here; a frame cut off by the end of the stream does not.
     pub const fn checksum_failures(&self) -> u32 {
         self.checksum_failures
     }

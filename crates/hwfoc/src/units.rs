@@ -133,20 +133,21 @@ const fn build_celsius() -> [f32; 256] {
         out[code as usize] = (t + end) as f32 / 2.0;
         t = end + 1;
     }
-    // Codes between two entries: linear between their temperatures.
+    // Codes between two entries: linear between the temperatures of the nearest exact codes.
+    let exact = out;
     let mut code = ADC_MIN as usize;
     while code <= ADC_MAX as usize {
-        if out[code].is_nan() {
-            let mut lo = code - 1; // hotter neighbour (lower code), always exact
-            while out[lo].is_nan() {
+        if exact[code].is_nan() {
+            let mut lo = code - 1; // hotter neighbour (lower code)
+            while exact[lo].is_nan() {
                 lo -= 1;
             }
             let mut hi = code + 1; // colder neighbour (higher code)
-            while out[hi].is_nan() {
+            while exact[hi].is_nan() {
                 hi += 1;
             }
             let frac = (code - lo) as f32 / (hi - lo) as f32;
-            out[code] = out[lo] + (out[hi] - out[lo]) * frac;
+            out[code] = exact[lo] + (exact[hi] - exact[lo]) * frac;
         }
         code += 1;
     }
