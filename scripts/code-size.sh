@@ -1,0 +1,94 @@
+#!/usr/bin/env bash
+# Release code size of the hwfoc streaming decoder on a Cortex-M4F (thumbv7em-none-eabihf).
+#
+# Builds crates/hwfoc/size-probe, a no_std staticlib (opt-level "s", fat LTO, one codegen unit,
+# panic = abort), twice: with the entry point `hwfoc_probe_push` only (Decoder::push, a few raw
+# fields of the last data frame), then with `hwfoc_probe_push_units` as well (feature `units`:
+# voltage, currents and RPM under caller settings, temperatures from the ADC table).
+#
+# After LTO the probe's own object in the archive holds exactly the code those entry points reach.
+# Counted, from that object: its .text* sections (entry points, hwfoc code, core's panic stubs;
+# literal pools are inside .text), its .rodata* sections (the 1 KiB f32 temperature table) and its
+# .data*/.bss* sections (static RAM; the decoder state itself is the caller's, reported apart).
+# Not counted: the compiler-builtins memory helpers it calls (memcpy, memclr: listed, as any
+# firmware links them anyway) and .ARM.exidx (unwind index entries, 8 bytes per function, which
+# embedded linker scripts usually discard).
+#
+# Tools: llvm-size/-nm/-ar from the rustup component llvm-tools (added if missing), else the same
+# on PATH, else arm-none-eabi-size/-nm/-ar (binutils-arm-none-eabi, installed with apt-get when
+# running as root). Figures depend on the compiler version, printed first.
+set -euo pipefail
+
+target=thumbv7em-none-eabihf
+probe=$(cd "$(dirname "${BASH_SOURCE[0]}")/../crates/hwfoc/size-probe" && pwd)
+cd "$probe"
+
+if command -v rustup >/dev/null && ! rustup target list --installed | grep -qx "$target"; then
+    rustup target add "$target" >&2
+fi
+
+# Size and symbol tools that read ARM ELF objects.
+host=$(rustc -vV | sed -n 's/^host: //p')
+llvm_bin=$(rustc --print sysroot)/lib/rustlib/$host/bin
+if [[ ! -x $llvm_bin/llvm-size ]] && command -v rustup >/dev/null; then
+    rustup component add llvm-tools >&2 || echo "code-size: could not add llvm-tools" >&2
+fi
+if [[ -x $llvm_bin/llvm-size && -x $llvm_bin/llvm-nm && -x $llvm_bin/llvm-ar ]]; then
+    size=$llvm_bin/llvm-size nm=$llvm_bin/llvm-nm
+elif command -v llvm-size >/dev/null && command -v llvm-nm >/dev/null \
+    && command -v llvm-ar >/dev/null; then
+    size=llvm-size nm=llvm-nm
+else
+    if ! command -v arm-none-eabi-size >/dev/null && [[ $(id -u) == 0 ]] \
+        && command -v apt-get >/dev/null; then
+        apt-get update -qq >&2
+        DEBIAN_FRONTEND=noninteractive apt-get install -y -qq binutils-arm-none-eabi >&2
+    fi
+    size=arm-none-eabi-size nm=arm-none-eabi-nm
+    command -v "$size" >/dev/null || {
+        echo "code-size: need llvm-size (rustup component add llvm-tools) or arm-none-eabi-size" >&2
+        exit 1
+    }
+fi
+
+lib=$probe/target/$target/release/libhwfoc_size_probe.a
+ar=${size%size}ar # llvm-ar or arm-none-eabi-ar, next to the size tool
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+
+# Builds the probe with the given cargo arguments, extracts its own object from the archive to
+# $tmp/probe.o (the other members are compiler-builtins, some holding bitcode that older tools
+# cannot read) and prints "<label>: sizes" for it.
+measure() {
+    local label=$1
+    shift
+    cargo build --release --target "$target" --target-dir target "$@" >&2
+    local member
+    member=$("$ar" t "$lib" | grep '^hwfoc_size_probe-' || true)
+    if [[ -z $member || $member == *$'\n'* ]]; then
+        echo "code-size: expected one hwfoc_size_probe object in $lib" >&2
+        exit 1
+    fi
+    (cd "$tmp" && "$ar" x "$lib" "$member" && mv "$member" probe.o)
+    # `size -A`: one "<section> <size> <addr>" line per section.
+    "$size" -A "$tmp/probe.o" | awk -v label="$label" '
+        $1 ~ /^\.text/ { text += $2 }
+        $1 ~ /^\.rodata/ { ro += $2 }
+        $1 ~ /^\.(data|bss)/ { ram += $2 }
+        END {
+            if (text == 0) { print "code-size: no .text in the probe object" > "/dev/stderr"; exit 1 }
+            printf "%s: %d bytes .text, %d bytes .rodata, %d bytes .data/.bss\n", label, text, ro, ram
+        }'
+}
+
+echo "hwfoc release code size on $target ($(rustc -V); opt-level \"s\", LTO, panic = abort)"
+measure "decoder (push + frame fields)"
+measure "decoder + units (conversions, ADC table)" --features units
+
+# The build asserts size_of::<Decoder>() == DECODER_STATE_BYTES for the target.
+state=$(sed -n 's/^pub const DECODER_STATE_BYTES: usize = \([0-9]*\);.*/\1/p' src/lib.rs)
+echo "decoder state: ${state:?} bytes (size_of::<Decoder>(), owned by the caller)"
+
+# Symbols the probe object takes from outside (last build, a superset of the first).
+helpers=$("$nm" -u "$tmp/probe.o" | awk '{ print $NF }' | sort -u | tr '\n' ' ')
+echo "not counted: ${helpers:-nothing }(compiler-builtins helpers), .ARM.exidx unwind index"
