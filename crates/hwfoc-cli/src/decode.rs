@@ -5,7 +5,7 @@ use hwfoc::Frame;
 use crate::error::CliError;
 use crate::input::Input;
 use crate::output::Output;
-use crate::record::Record;
+use crate::schema::Record;
 use crate::stream::Stream;
 use crate::{DecodeArgs, RecordFormat};
 

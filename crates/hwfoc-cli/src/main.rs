@@ -8,7 +8,7 @@ mod demo;
 mod error;
 mod input;
 mod output;
-mod record;
+mod schema;
 mod stream;
 mod summary;
 
