@@ -10,9 +10,10 @@
 //! a cut frame or a run of garbage never hides a following intact frame.
 
 use crate::frame::{
-    DATA_FRAME_LEN, DATA_LENGTH_BYTE, DataFrame, Frame, MAX_FRAME_LEN, SYNC, check_data,
+    CMD_DATA, DATA_FRAME_LEN, DATA_LENGTH_BYTE, DataFrame, Frame, MAX_FRAME_LEN, SYNC, VERSION,
+    check_data, checksum,
 };
-use crate::info::{INFO_FRAME_LEN, INFO_LENGTH_BYTE, InfoFrame};
+use crate::info::{CMD_INFO, INFO_FRAME_LEN, INFO_LENGTH_BYTE, InfoFrame};
 use crate::stats::LinkStats;
 
 /// A frame and where it started in the stream.
@@ -25,56 +26,82 @@ pub struct Decoded {
     pub frame: Frame,
 }
 
-/// Offset of the first sync byte in `hay`.
+/// Whether `b` is the length byte of a known frame.
+#[inline(always)]
+fn is_length_byte(b: u8) -> bool {
+    b == DATA_LENGTH_BYTE || b == INFO_LENGTH_BYTE
+}
+
+/// Offset of the first place in `hay` where a frame may start: a sync byte followed by a known
+/// length byte, or a sync byte that is the last byte of `hay` (undecided until more bytes come).
+///
+/// A sync byte followed by any other byte can never start a frame, so the scanner passes over it
+/// like any other skipped byte, without stopping there.
 #[inline]
-fn find_sync(hay: &[u8]) -> Option<usize> {
-    const LO: u64 = 0x0101_0101_0101_0101;
-    const HI: u64 = 0x8080_8080_8080_8080;
-    const PAT: u64 = LO * SYNC as u64;
-    // After a frame the next byte is usually the next frame's sync byte.
-    if hay.first() == Some(&SYNC) {
+fn find_header(hay: &[u8]) -> Option<usize> {
+    const LOW7: u64 = 0x7F7F_7F7F_7F7F_7F7F;
+    const ONES: u64 = 0x0101_0101_0101_0101;
+    /// 0x80 in every byte of `x` that is zero, 0 elsewhere (exact: no carry crosses bytes).
+    #[inline(always)]
+    fn zero_bytes(x: u64) -> u64 {
+        !(((x & LOW7).wrapping_add(LOW7)) | x | LOW7)
+    }
+    // After a frame the next bytes are usually the next frame's header.
+    if let [SYNC, l, ..] = *hay
+        && is_length_byte(l)
+    {
         return Some(0);
     }
-    let mut chunks = hay.chunks_exact(16);
     let mut base = 0;
-    for chunk in &mut chunks {
-        let (a, b) = chunk.split_at(8);
-        // A byte equal to SYNC becomes zero after the XOR; the classic "has zero byte" test
-        // marks the first such byte exactly (later marks may be false, the first never is).
-        let a = u64::from_le_bytes(a.try_into().unwrap_or([0; 8])) ^ PAT;
-        let b = u64::from_le_bytes(b.try_into().unwrap_or([0; 8])) ^ PAT;
-        let za = a.wrapping_sub(LO) & !a & HI;
-        let zb = b.wrapping_sub(LO) & !b & HI;
-        if za | zb != 0 {
-            return Some(if za != 0 {
-                base + (za.trailing_zeros() / 8) as usize
-            } else {
-                base + 8 + (zb.trailing_zeros() / 8) as usize
-            });
+    // Eight positions at a time: the word at `base` for the sync bytes and the word one byte
+    // later for the length bytes that follow them.
+    while let Some(w) = hay.get(base..base + 9) {
+        let word = |at: usize| u64::from_le_bytes(w[at..at + 8].try_into().unwrap_or([0; 8]));
+        let (s, l) = (word(0), word(1));
+        let hits = zero_bytes(s ^ (ONES * SYNC as u64))
+            & (zero_bytes(l ^ (ONES * DATA_LENGTH_BYTE as u64))
+                | zero_bytes(l ^ (ONES * INFO_LENGTH_BYTE as u64)));
+        if hits != 0 {
+            return Some(base + (hits.trailing_zeros() / 8) as usize);
         }
-        base += 16;
+        base += 8;
     }
-    chunks
-        .remainder()
-        .iter()
-        .position(|&b| b == SYNC)
-        .map(|i| base + i)
+    let tail = &hay[base..];
+    (0..tail.len())
+        .find(|&j| tail[j] == SYNC && tail.get(j + 1).is_none_or(|&l| is_length_byte(l)))
+        .map(|j| base + j)
 }
+
+/// The first four bytes of a data frame, as a little-endian `u32`.
+const DATA_HEADER: u32 = u32::from_le_bytes([SYNC, DATA_LENGTH_BYTE, VERSION, CMD_DATA]);
+/// The first four bytes of a device-information frame, as a little-endian `u32`.
+const INFO_HEADER: u32 = u32::from_le_bytes([SYNC, INFO_LENGTH_BYTE, VERSION, CMD_INFO]);
 
 /// Finds the next frame in `data` from `*pos`, counting what it passes over in `stats`.
 ///
 /// Returns the frame and its start offset, with `*pos` just after it. Returns `None` when no
 /// further frame can be decided: `*pos` is then `data.len()`, or, unless `at_end`, the start of
 /// a candidate frame that needs more bytes (nothing of it has been counted yet).
-#[inline]
+#[inline(always)]
 fn scan_next(
     data: &[u8],
     pos: &mut usize,
     stats: &mut LinkStats,
     at_end: bool,
 ) -> Option<(usize, Frame)> {
+    // Back-to-back frames, the usual case: a data frame starts right here.
+    if let Some(d) = data[*pos..].first_chunk::<DATA_FRAME_LEN>()
+        && u32::from_le_bytes([d[0], d[1], d[2], d[3]]) == DATA_HEADER
+        && checksum(&d[..22]) == u16::from_le_bytes([d[22], d[23]])
+    {
+        let i = *pos;
+        let d = DataFrame::from_verified(d);
+        stats.data_frame(d.packet);
+        *pos = i + DATA_FRAME_LEN;
+        return Some((i, Frame::Data(d)));
+    }
     loop {
-        let Some(k) = find_sync(&data[*pos..]) else {
+        let Some(k) = find_header(&data[*pos..]) else {
             stats.skip(data.len() - *pos);
             *pos = data.len();
             return None;
@@ -83,6 +110,43 @@ fn scan_next(
         let i = *pos + k;
         *pos = i;
         let rest = &data[i..];
+        // Fast path, whenever a whole data frame's worth of bytes is left: one branch decides
+        // "valid data frame", one "valid info frame"; both are predictable (false all through
+        // line noise, the first true all through a run of frames), unlike a branch on the length
+        // byte. Same verdicts as the general path below.
+        if let Some(d) = rest.first_chunk::<DATA_FRAME_LEN>() {
+            let header = u32::from_le_bytes([d[0], d[1], d[2], d[3]]);
+            let sum = u32::from(checksum(&d[..22]));
+            let found = u32::from(u16::from_le_bytes([d[22], d[23]]));
+            if (sum ^ found) | (header ^ DATA_HEADER) == 0 {
+                let d = DataFrame::from_verified(d);
+                stats.data_frame(d.packet);
+                *pos = i + DATA_FRAME_LEN;
+                return Some((i, Frame::Data(d)));
+            }
+            if header == INFO_HEADER
+                && let Some(f) = rest.first_chunk::<INFO_FRAME_LEN>()
+                && let Ok(info) = InfoFrame::parse_exact(f)
+            {
+                stats.info_frame();
+                *pos = i + INFO_FRAME_LEN;
+                return Some((i, Frame::Info(info)));
+            }
+            // `find_header` stops only at a known length byte.
+            let needed = if d[1] == DATA_LENGTH_BYTE {
+                DATA_FRAME_LEN
+            } else {
+                INFO_FRAME_LEN
+            };
+            if rest.len() >= needed {
+                stats.checksum_failure();
+            } else if !at_end {
+                return None;
+            }
+            stats.skip(1);
+            *pos = i + 1;
+            continue;
+        }
         let complete = match rest.get(1) {
             Some(&DATA_LENGTH_BYTE) => match rest.first_chunk::<DATA_FRAME_LEN>() {
                 Some(f) => {
@@ -355,28 +419,29 @@ mod tests {
     use super::*;
 
     #[test]
-    fn find_sync_matches_a_plain_search() {
-        let mut hay = [0u8; 70];
-        for (i, b) in hay.iter_mut().enumerate() {
-            *b = (i as u8).wrapping_mul(37) | 1;
-            if *b == SYNC {
-                *b = 0;
-            }
+    fn find_header_matches_a_plain_search() {
+        fn plain(h: &[u8]) -> Option<usize> {
+            (0..h.len())
+                .find(|&j| h[j] == SYNC && h.get(j + 1).is_none_or(|&l| l == 0x16 || l == 0x4C))
         }
-        assert_eq!(find_sync(&hay), None);
-        for at in 0..hay.len() {
-            let mut h = hay;
-            h[at] = SYNC;
-            // Bytes just above and below the pattern must not confuse the bit trick.
-            if at + 1 < h.len() {
-                h[at + 1] = SYNC + 1;
+        let mut x = 0x1234_5678_9abc_def0u64;
+        let mut hay = [0u8; 150];
+        for round in 0..20_000 {
+            let density = round % 7;
+            for b in hay.iter_mut() {
+                x ^= x << 13;
+                x ^= x >> 7;
+                x ^= x << 17;
+                *b = match (x >> 60) as usize % (density + 2) {
+                    0 => SYNC,
+                    1 => [0x16, 0x4C, 0x9A, 0x9C, 0x15, 0x17][(x >> 8) as usize % 6],
+                    _ => x as u8,
+                };
             }
-            if at > 0 {
-                h[at - 1] = SYNC - 1;
-            }
-            assert_eq!(find_sync(&h), Some(at), "sync at {at}");
-            for start in 0..=at {
-                assert_eq!(find_sync(&h[start..]), Some(at - start));
+            let len = (x >> 16) as usize % (hay.len() + 1);
+            for start in [0, 1, 5, 31, 33].into_iter().filter(|&s| s <= len) {
+                let h = &hay[start..len];
+                assert_eq!(find_header(h), plain(h), "{h:02X?}");
             }
         }
     }

@@ -1,0 +1,43 @@
+//! The bulk `frames` iterator over the whole input, checked against `Decoder` fed the same
+//! bytes in one chunk, one byte at a time, and through `decode_all`.
+//!
+//! Checked: the whole-stream invariants of `check_stream`, the iterator staying exhausted, and
+//! exact equality (frames and statistics) of all four ways of decoding.
+
+#![no_main]
+
+use hwfoc::{Decoder, frames};
+use hwfoc_fuzz::check_stream;
+use libfuzzer_sys::fuzz_target;
+
+fuzz_target!(|data: &[u8]| {
+    let mut it = frames(data);
+    let bulk: Vec<_> = it.by_ref().collect();
+    assert_eq!(it.next(), None, "frames() is fused");
+    let stats = *it.stats();
+    check_stream(data, &bulk, &stats);
+
+    let mut one = Decoder::new();
+    let mut got = Vec::new();
+    one.feed(data, |d| got.push(d));
+    assert!(one.buffered() < 77);
+    one.flush(|d| got.push(d));
+    assert_eq!(got, bulk, "one-chunk Decoder and frames() disagree");
+    assert_eq!(*one.stats(), stats);
+
+    let mut bytewise = Decoder::new();
+    got.clear();
+    for &b in data {
+        bytewise.push(b, |d| got.push(d));
+        assert!(bytewise.buffered() < 77);
+    }
+    bytewise.flush(|d| got.push(d));
+    assert_eq!(got, bulk, "byte-at-a-time Decoder and frames() disagree");
+    assert_eq!(*bytewise.stats(), stats);
+
+    let mut all = Decoder::new();
+    got.clear();
+    all.decode_all(data, |d| got.push(d));
+    assert_eq!(got, bulk, "decode_all and frames() disagree");
+    assert_eq!(*all.stats(), stats);
+});
