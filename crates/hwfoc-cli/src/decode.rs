@@ -1,83 +1,171 @@
-//! `hwfoc decode`: one record per data frame, as JSON Lines or CSV.
+//! `hwfoc decode`: one record per data frame, as JSON Lines, CSV or Parquet.
+//!
+//! Inputs are read one after another ([`Sources`]); records can be limited to some ESCs
+//! (`--esc`) and to a window of receive times (`--from` inclusive, `--to` exclusive, so that
+//! consecutive windows never share a frame). A time window needs inputs with receive times:
+//! raw bytes have none, and are refused rather than silently giving no records.
 
-use hwfoc::Frame;
+use hwfoc::{Decoded, Frame};
+use serde_json::json;
 
 use crate::error::CliError;
-use crate::input::Input;
-use crate::output::Output;
-use crate::schema::Record;
-use crate::stream::Stream;
+use crate::export::{Export, Format, Provenance};
+use crate::sources::{Handler, Sources};
 use crate::{DecodeArgs, RecordFormat};
-
-/// Output is handed to the sink once this much text has built up (and after every input batch).
-const FLUSH_AT: usize = 1 << 20;
 
 pub fn run(args: &DecodeArgs) -> Result<(), CliError> {
     let settings = args.settings.settings()?;
-    let mut input = args.input.open()?;
-    let mut out = Output::create(args.output.as_deref())?;
-    let mut text = Vec::with_capacity(2 * FLUSH_AT);
-    if args.format == RecordFormat::Csv {
-        if args.settings_comment {
-            text.extend_from_slice(
-                format!(
-                    "# hwfoc decode: current_scale={} pole_pairs={} gear_ratio={} input={}\n",
-                    settings.current_scale,
-                    settings.pole_pairs,
-                    settings.gear_ratio,
-                    input.name()
-                )
-                .as_bytes(),
-            );
-        }
-        Record::write_csv_header(&mut text);
+    let window = Window::new(args.from, args.to)?;
+    let mut sources = Sources::new(args.input.open_all()?);
+    if window.is_limited() {
+        sources.require_timing()?;
     }
-    let mut stream = Stream::new();
-    let mut emit = |t_s: Option<f64>, d: hwfoc::Decoded, text: &mut Vec<u8>| {
-        if let Frame::Data(frame) = d.frame {
-            let record = Record::new(t_s, 0, &frame, &settings);
-            match args.format {
-                RecordFormat::Jsonl => record.write_json(text),
-                RecordFormat::Csv => record.write_csv(text),
-            }
-        }
+    let mut escs = [args.esc.is_empty(); 256];
+    for &esc in &args.esc {
+        escs[usize::from(esc)] = true;
+    }
+    let provenance = Provenance {
+        settings,
+        inputs: sources.names().to_vec(),
+        filter: filter_text(args),
+        csv_comment: args.settings_comment,
     };
-    let result = decode_all(&mut input, &mut stream, &mut out, &mut text, &mut emit);
+    let format = match args.format {
+        RecordFormat::Jsonl => Format::Jsonl,
+        RecordFormat::Csv => Format::Csv,
+        RecordFormat::Parquet => Format::Parquet,
+    };
+    let export = Export::create(format, args.output.as_deref(), provenance)?;
+    let mut records = Records {
+        export,
+        escs,
+        window,
+    };
+    let result = sources.run(&mut records);
     // Whatever was decoded before an input error is still written out.
-    let written = out.write(&mut text).and_then(|()| out.flush());
+    let metadata = vec![("escs".to_string(), escs_json(&sources))];
+    let finished = records.export.finish(metadata);
     result?;
-    written?;
-    if stream.stats().frames() == 0 {
-        eprintln!(
-            "hwfoc: warning: {}: {}",
-            input.name(),
-            crate::summary::NO_FRAMES
-        );
-    }
+    finished?;
+    warn(&sources, &args.esc);
     Ok(())
 }
 
-fn decode_all(
-    input: &mut Input,
-    stream: &mut Stream,
-    out: &mut Output,
-    text: &mut Vec<u8>,
-    emit: &mut impl FnMut(Option<f64>, hwfoc::Decoded, &mut Vec<u8>),
-) -> Result<(), CliError> {
-    let result = loop {
-        let batch = match input.next_batch() {
-            Ok(Some(batch)) => batch,
-            Ok(None) => break Ok(()),
-            Err(e) => break Err(e),
-        };
-        stream.feed(batch, |t, d| emit(t, d, text));
-        // Small batches come from a live stream: pass them on at once.
-        if text.len() >= FLUSH_AT || batch.bytes.len() < 4096 {
-            out.write(text)?;
-            out.flush()?;
+/// The frames that make records: data frames of the chosen ESCs in the time window.
+struct Records {
+    export: Export,
+    escs: [bool; 256],
+    window: Window,
+}
+
+impl Handler for Records {
+    #[inline]
+    fn frame(&mut self, esc: u8, t: Option<f64>, decoded: Decoded) {
+        if let Frame::Data(frame) = decoded.frame
+            && self.escs[usize::from(esc)]
+            && self.window.contains(t)
+        {
+            self.export.push(esc, t, &frame);
         }
-    };
-    // Even after an input error, frames already received are decoded.
-    stream.finish(|t, d| emit(t, d, text));
-    result
+    }
+
+    fn end_batch(&mut self, live: bool) -> Result<(), CliError> {
+        self.export.end_batch(live)
+    }
+}
+
+/// A window of receive times: `from <= t_s < to`, each end optional.
+#[derive(Debug, Clone, Copy)]
+struct Window {
+    from: f64,
+    to: f64,
+}
+
+impl Window {
+    fn new(from: Option<f64>, to: Option<f64>) -> Result<Window, CliError> {
+        let window = Window {
+            from: from.unwrap_or(f64::NEG_INFINITY),
+            to: to.unwrap_or(f64::INFINITY),
+        };
+        // NaN and an empty window select nothing: say so rather than export nothing.
+        if window.from.is_nan() || window.to.is_nan() || window.from >= window.to {
+            return Err(CliError::EmptyWindow {
+                from: window.from,
+                to: window.to,
+            });
+        }
+        Ok(window)
+    }
+
+    fn is_limited(&self) -> bool {
+        self.from > f64::NEG_INFINITY || self.to < f64::INFINITY
+    }
+
+    #[inline]
+    fn contains(&self, t: Option<f64>) -> bool {
+        match t {
+            Some(t) => t >= self.from && t < self.to,
+            None => !self.is_limited(),
+        }
+    }
+}
+
+/// The filters, as recorded with the output: `esc=0,2 from=1.5 to=3`, or empty.
+fn filter_text(args: &DecodeArgs) -> String {
+    let mut parts = Vec::new();
+    if !args.esc.is_empty() {
+        let escs: Vec<String> = args.esc.iter().map(u8::to_string).collect();
+        parts.push(format!("esc={}", escs.join(",")));
+    }
+    if let Some(from) = args.from {
+        parts.push(format!("from={from}"));
+    }
+    if let Some(to) = args.to {
+        parts.push(format!("to={to}"));
+    }
+    parts.join(" ")
+}
+
+/// Which ESC is which: `[{"esc": 0, "input": "a.pcapng", "stream": "/dev/ttyUSB0"}, ...]`.
+fn escs_json(sources: &Sources) -> String {
+    let escs: Vec<serde_json::Value> = sources
+        .escs()
+        .iter()
+        .enumerate()
+        .map(|(i, esc)| {
+            json!({
+                "esc": i,
+                "input": sources.names()[esc.input],
+                "stream": esc.name,
+            })
+        })
+        .collect();
+    serde_json::Value::from(escs).to_string()
+}
+
+/// Warnings on standard error: ESCs whose bytes held no frame, ESCs asked for but not found.
+fn warn(sources: &Sources, wanted: &[u8]) {
+    for (i, esc) in sources.escs().iter().enumerate() {
+        let stats = esc.stream.stats();
+        if stats.bytes() > 0 && stats.frames() == 0 {
+            eprintln!(
+                "hwfoc: warning: {}: {}",
+                crate::summary::esc_label(sources, i),
+                crate::summary::NO_FRAMES
+            );
+        }
+    }
+    let found = sources.escs().len();
+    for &esc in wanted {
+        if usize::from(esc) >= found {
+            eprintln!(
+                "hwfoc: warning: --esc {esc}: the inputs have {}",
+                match found {
+                    0 => "no ESC".to_string(),
+                    1 => "only ESC 0".to_string(),
+                    n => format!("only ESCs 0 to {}", n - 1),
+                }
+            );
+        }
+    }
 }

@@ -6,9 +6,15 @@
 mod decode;
 mod demo;
 mod error;
+mod export;
 mod input;
 mod output;
+mod pcapng;
+mod record;
 mod schema;
+mod serial;
+mod simulate;
+mod sources;
 mod stream;
 mod summary;
 
@@ -30,28 +36,56 @@ struct Cli {
 
 #[derive(Debug, Subcommand)]
 enum Command {
-    /// Decode telemetry into one record per data frame (JSON Lines or CSV).
+    /// Decode telemetry into one record per data frame (JSON Lines, CSV or Parquet).
     Decode(DecodeArgs),
     /// Summarise a stream: frames, link quality, device information, min/max/mean of each field.
     Summary(SummaryArgs),
+    /// Record serial ports losslessly, with nanosecond receive times, to pcapng (Wireshark opens it).
+    Record(record::Args),
+    /// Virtual ESCs: the protocol from a physical model, to a pty, serial port, file or stdout.
+    Simulate(Box<simulate::Args>),
 }
 
 /// Where telemetry comes from.
 #[derive(Debug, Args)]
 struct InputArgs {
-    /// Raw bytes from the wire or a logic-analyser CSV export (detected); `-` reads standard input.
-    #[arg(value_name = "FILE|-", required_unless_present = "demo")]
-    input: Option<String>,
+    /// Serial ports (`/dev/ttyUSB0`, `COM3`; one ESC each, in the order given), recordings
+    /// (pcapng), raw bytes from the wire or logic-analyser CSV exports (detected); `-` reads
+    /// standard input. Files are read one after another.
+    #[arg(value_name = "FILE|PORT|-", required_unless_present = "demo", num_args = 1..)]
+    inputs: Vec<String>,
+    /// Baud rate of serial ports (8N1).
+    #[arg(long, value_name = "N", default_value_t = serial::DEFAULT_BAUD,
+          value_parser = clap::value_parser!(u32).range(1..))]
+    baud: u32,
     /// Use the built-in demo capture of a virtual ESC instead of FILE.
-    #[arg(long, conflicts_with = "input")]
+    #[arg(long, conflicts_with = "inputs")]
     demo: bool,
 }
 
 impl InputArgs {
-    fn open(&self) -> Result<Input, CliError> {
-        match &self.input {
-            Some(path) if !self.demo => Input::open(path),
-            _ => Input::from_memory("demo capture", demo::capture_csv()),
+    /// Opens every input, in the order given: each file (or standard input) as one [`Input`],
+    /// all serial ports together as one [`Input`] with a stream per port. Ports and files
+    /// cannot be mixed.
+    fn open_all(&self) -> Result<Vec<Input>, CliError> {
+        if self.demo || self.inputs.is_empty() {
+            return Ok(vec![Input::from_memory(
+                "demo capture",
+                demo::capture_csv(),
+            )?]);
+        }
+        let (ports, files): (Vec<&String>, Vec<&String>) =
+            self.inputs.iter().partition(|spec| serial::is_port(spec));
+        match (ports.first(), files.first()) {
+            (Some(port), Some(file)) => Err(CliError::MixedInputs {
+                port: port.to_string(),
+                file: file.to_string(),
+            }),
+            (Some(_), None) => {
+                let ports: Vec<String> = ports.into_iter().cloned().collect();
+                Ok(vec![Input::open_ports(&ports, self.baud)?])
+            }
+            _ => files.into_iter().map(|f| Input::open(f)).collect(),
         }
     }
 }
@@ -77,13 +111,15 @@ impl SettingsArgs {
     }
 }
 
-/// Record text formats.
+/// Record output formats.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
 enum RecordFormat {
     /// One JSON object per line, with exactly the schema's keys.
     Jsonl,
     /// Comma-separated, with a header row; faults joined by `|`, nulls empty.
     Csv,
+    /// Apache Parquet (needs -o): typed columns, units and settings in the metadata.
+    Parquet,
 }
 
 #[derive(Debug, Args)]
@@ -99,8 +135,17 @@ struct DecodeArgs {
     #[arg(long)]
     settings_comment: bool,
     /// Write to FILE instead of standard output.
-    #[arg(short, long, value_name = "FILE")]
+    #[arg(short, long, value_name = "FILE", required_if_eq("format", "parquet"))]
     output: Option<String>,
+    /// Keep only these ESCs (indices as in the `esc` column; repeat or separate with commas).
+    #[arg(long, value_name = "N", value_delimiter = ',')]
+    esc: Vec<u8>,
+    /// Keep only frames received at or after S seconds (`t_s`; needs inputs with receive times).
+    #[arg(long, value_name = "S", allow_negative_numbers = true)]
+    from: Option<f64>,
+    /// Keep only frames received before S seconds (`t_s`; needs inputs with receive times).
+    #[arg(long, value_name = "S", allow_negative_numbers = true)]
+    to: Option<f64>,
 }
 
 #[derive(Debug, Args)]
@@ -119,6 +164,8 @@ fn main() -> ExitCode {
     let result = match &cli.command {
         Command::Decode(args) => decode::run(args),
         Command::Summary(args) => summary::run(args),
+        Command::Record(args) => record::run(args),
+        Command::Simulate(args) => simulate::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -100,6 +100,7 @@ mod tests {
                     Batch {
                         bytes: b,
                         times: Some(t),
+                        stream: 0,
                     },
                     |t, _| got.push(t.unwrap()),
                 );

@@ -1,41 +1,47 @@
-//! `hwfoc summary`: what a stream holds and how good the link was.
+//! `hwfoc summary`: what the inputs hold, ESC by ESC, and how good each link was.
 //!
 //! Statistics are gathered on the raw integers (min, max and sum per field, a histogram of each
 //! temperature's ADC codes) and converted to physical units once, at the end: every conversion
 //! is monotonic, so this is exact, and it keeps the per-frame cost to a few integer operations.
+//!
+//! A fault episode is a maximal run of consecutive data frames of one ESC whose status word is
+//! not zero; it is reported with its first and last frame (times where the input has them,
+//! frame indices and packet numbers always) and the fault bits seen during it.
 
 use std::fmt::Write as _;
 
-use hwfoc::{DataFrame, Fault, Frame, InfoFrame, LinkStats, Settings, Temperature};
+use hwfoc::{
+    DataFrame, Decoded, Fault, Frame, InfoFrame, LinkStats, Settings, Status, Temperature,
+};
 use serde_json::{Value, json};
 
 use crate::SummaryArgs;
 use crate::error::CliError;
 use crate::input::Format;
 use crate::output::Output;
-use crate::stream::Stream;
+use crate::sources::{Handler, InputInfo, Sources};
 
 /// What to tell a user whose input has bytes but no frame.
 pub const NO_FRAMES: &str = "no valid HW-FOC frames: check the baud rate (19200) and the wiring";
 
+/// Fault episodes kept per ESC in detail (all are counted).
+const MAX_EPISODES: usize = 10_000;
+
+/// Fault episodes listed per ESC in the text output (`--json` lists all those kept).
+const TEXT_EPISODES: usize = 20;
+
 pub fn run(args: &SummaryArgs) -> Result<(), CliError> {
     let settings = args.settings.settings()?;
-    let mut input = args.input.open()?;
-    let mut stream = Stream::new();
-    let mut acc = Accumulator::default();
-    while let Some(batch) = input.next_batch()? {
-        stream.feed(batch, |t, d| acc.add(t, &d.frame));
-    }
-    stream.finish(|t, d| acc.add(t, &d.frame));
+    let mut sources = Sources::new(args.input.open_all()?);
+    let mut escs = Escs::default();
+    // On an input error, what was read before it is summarised, then the error reported.
+    let result = sources.run(&mut escs);
     let report = Report {
-        input: input.name(),
-        format: input.format(),
-        flagged_bytes: input.flagged_bytes(),
-        stats: stream.stats(),
+        sources: &sources,
         settings: &settings,
-        acc: &acc,
+        accs: &escs.0,
     };
-    let mut text = if args.json {
+    let text = if args.json {
         let mut s = serde_json::to_string_pretty(&report.json()).unwrap_or_default();
         s.push('\n');
         s
@@ -43,9 +49,40 @@ pub fn run(args: &SummaryArgs) -> Result<(), CliError> {
         report.text()
     };
     let mut out = Output::create(None)?;
-    let mut buf = std::mem::take(&mut text).into_bytes();
+    let mut buf = text.into_bytes();
     out.write(&mut buf)?;
-    out.flush()
+    out.flush()?;
+    result
+}
+
+/// How an ESC is named in messages: its input, and its stream when the input has several.
+pub fn esc_label(sources: &Sources, esc: usize) -> String {
+    let e = &sources.escs()[esc];
+    let input = &sources.names()[e.input];
+    let single = sources
+        .inputs()
+        .get(e.input)
+        .is_none_or(|info| info.escs.len() == 1);
+    if single && e.name == *input {
+        input.clone()
+    } else {
+        format!("{input}: {} (ESC {esc})", e.name)
+    }
+}
+
+/// One accumulator per ESC.
+#[derive(Default)]
+struct Escs(Vec<Accumulator>);
+
+impl Handler for Escs {
+    #[inline]
+    fn frame(&mut self, esc: u8, t: Option<f64>, decoded: Decoded) {
+        let esc = usize::from(esc);
+        if self.0.len() <= esc {
+            self.0.resize_with(esc + 1, Accumulator::default);
+        }
+        self.0[esc].add(t, &decoded.frame);
+    }
 }
 
 /// Min, max and sum of one raw integer field.
@@ -86,7 +123,30 @@ impl Range {
     }
 }
 
-/// Everything the summary needs from the frames, gathered as they are decoded.
+/// One end of a fault episode: a data frame.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Mark {
+    /// Receive time, if the input has timing.
+    t: Option<f64>,
+    /// Index of the data frame among the ESC's data frames (0-based).
+    frame: u64,
+    /// Its packet number.
+    packet: u16,
+}
+
+/// A maximal run of consecutive data frames with a non-zero status word.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Episode {
+    first: Mark,
+    last: Mark,
+    frames: u64,
+    /// Every status bit seen during the episode.
+    bits: Status,
+    /// Still going on at the end of the input.
+    ongoing: bool,
+}
+
+/// Everything the summary needs from the frames of one ESC, gathered as they are decoded.
 #[derive(Debug)]
 struct Accumulator {
     frames: u64,
@@ -102,6 +162,9 @@ struct Accumulator {
     first_t: Option<f64>,
     last_t: Option<f64>,
     infos: Vec<(InfoFrame, u64)>,
+    episode: Option<Episode>,
+    episodes: Vec<Episode>,
+    episode_count: u64,
 }
 
 impl Default for Accumulator {
@@ -120,6 +183,9 @@ impl Default for Accumulator {
             first_t: None,
             last_t: None,
             infos: Vec::new(),
+            episode: None,
+            episodes: Vec::new(),
+            episode_count: 0,
         }
     }
 }
@@ -138,6 +204,7 @@ impl Accumulator {
 
     #[inline]
     fn add_data(&mut self, t: Option<f64>, f: &DataFrame) {
+        let index = self.frames;
         self.frames += 1;
         self.throttle_in.add(i32::from(f.throttle_in_raw));
         self.throttle_out.add(i32::from(f.throttle_out_raw));
@@ -147,14 +214,49 @@ impl Accumulator {
         self.phase_current.add(i32::from(f.phase_current_raw));
         self.mos_codes[usize::from(f.mos_adc)] += 1;
         self.cap_codes[usize::from(f.cap_adc)] += 1;
-        if !f.status.is_ok() {
-            for fault in f.status.faults() {
-                self.fault_frames[usize::from(fault.bit())] += 1;
-            }
-        }
         if let Some(t) = t {
             self.first_t.get_or_insert(t);
             self.last_t = Some(t);
+        }
+        if f.status.is_ok() {
+            if self.episode.is_some() {
+                self.end_episode(false);
+            }
+            return;
+        }
+        for fault in f.status.faults() {
+            self.fault_frames[usize::from(fault.bit())] += 1;
+        }
+        let mark = Mark {
+            t,
+            frame: index,
+            packet: f.packet,
+        };
+        match &mut self.episode {
+            Some(e) => {
+                e.last = mark;
+                e.frames += 1;
+                e.bits = Status(e.bits.0 | f.status.0);
+            }
+            None => {
+                self.episode = Some(Episode {
+                    first: mark,
+                    last: mark,
+                    frames: 1,
+                    bits: f.status,
+                    ongoing: false,
+                })
+            }
+        }
+    }
+
+    fn end_episode(&mut self, ongoing: bool) {
+        if let Some(mut e) = self.episode.take() {
+            e.ongoing = ongoing;
+            self.episode_count += 1;
+            if self.episodes.len() < MAX_EPISODES {
+                self.episodes.push(e);
+            }
         }
     }
 }
@@ -194,18 +296,145 @@ fn temp_stats(codes: &[u64; 256]) -> TempStats {
 
 /// The summary, ready to be printed.
 struct Report<'a> {
-    input: &'a str,
-    format: Format,
-    flagged_bytes: u64,
-    stats: &'a LinkStats,
+    sources: &'a Sources,
     settings: &'a Settings,
-    acc: &'a Accumulator,
+    accs: &'a [Accumulator],
 }
 
 /// One row of the field table: name, unit, and min/max/mean if there were frames.
 type FieldRow = (&'static str, &'static str, Option<[f64; 3]>);
 
-impl Report<'_> {
+/// One ESC's part of the report.
+struct EscReport<'a> {
+    index: usize,
+    label: String,
+    stream: &'a str,
+    input: &'a str,
+    stats: &'a LinkStats,
+    settings: Settings,
+    acc: &'a Accumulator,
+    /// The episode still open at the end, closed for the report.
+    episodes: Vec<Episode>,
+    episode_count: u64,
+}
+
+/// The short name of a format in `--json`.
+fn format_name(format: Format) -> &'static str {
+    match format {
+        Format::Raw => "raw",
+        Format::AnalyzerCsv => "csv",
+        Format::Recording => "pcapng",
+        Format::Serial => "serial",
+    }
+}
+
+impl<'a> Report<'a> {
+    fn escs(&self) -> Vec<EscReport<'a>> {
+        static EMPTY: std::sync::OnceLock<Accumulator> = std::sync::OnceLock::new();
+        let empty = EMPTY.get_or_init(Accumulator::default);
+        self.sources
+            .escs()
+            .iter()
+            .enumerate()
+            .map(|(i, esc)| {
+                let acc = self.accs.get(i).unwrap_or(empty);
+                let mut episodes = acc.episodes.clone();
+                let mut episode_count = acc.episode_count;
+                if let Some(mut open) = acc.episode {
+                    open.ongoing = true;
+                    episode_count += 1;
+                    if episodes.len() < MAX_EPISODES {
+                        episodes.push(open);
+                    }
+                }
+                EscReport {
+                    index: i,
+                    label: esc_label(self.sources, i),
+                    stream: &esc.name,
+                    input: &self.sources.names()[esc.input],
+                    stats: esc.stream.stats(),
+                    settings: *self.settings,
+                    acc,
+                    episodes,
+                    episode_count,
+                }
+            })
+            .collect()
+    }
+
+    /// Bytes read from an input: the sum over its streams.
+    fn input_bytes(&self, info: &InputInfo) -> u64 {
+        self.sources.escs()[info.escs.clone()]
+            .iter()
+            .map(|e| e.stream.stats().bytes())
+            .sum()
+    }
+
+    fn text(&self) -> String {
+        let mut o = String::new();
+        // Writing to a String cannot fail; the results are ignored below for that reason.
+        let _ = writeln!(
+            o,
+            "settings     current scale {}, pole pairs {}, gear ratio {}",
+            self.settings.current_scale, self.settings.pole_pairs, self.settings.gear_ratio
+        );
+        for info in self.sources.inputs() {
+            let escs = match info.escs.len() {
+                0 => "no ESC".to_string(),
+                1 => format!("ESC {}", info.escs.start),
+                _ => format!("ESCs {} to {}", info.escs.start, info.escs.end - 1),
+            };
+            let _ = writeln!(
+                o,
+                "input        {} ({}, {} bytes, {escs})",
+                info.name,
+                info.format,
+                self.input_bytes(info)
+            );
+            if info.flagged_bytes > 0 {
+                let _ = writeln!(
+                    o,
+                    "             {} bytes flagged with parity or framing errors by the analyser",
+                    info.flagged_bytes
+                );
+            }
+        }
+        for esc in self.escs() {
+            o.push('\n');
+            esc.text(&mut o);
+        }
+        o
+    }
+
+    fn json(&self) -> Value {
+        let inputs: Vec<Value> = self
+            .sources
+            .inputs()
+            .iter()
+            .map(|info| {
+                json!({
+                    "input": info.name,
+                    "format": format_name(info.format),
+                    "bytes": self.input_bytes(info),
+                    "flagged_bytes": info.flagged_bytes,
+                    "escs": info.escs.clone().collect::<Vec<usize>>(),
+                })
+            })
+            .collect();
+        let escs: Vec<Value> = self.escs().iter().map(EscReport::json).collect();
+        json!({
+            "settings": {
+                "current_scale": self.settings.current_scale,
+                "pole_pairs": self.settings.pole_pairs,
+                "gear_ratio": self.settings.gear_ratio,
+            },
+            "inputs": inputs,
+            "escs": escs,
+        })
+    }
+}
+
+impl EscReport<'_> {
     fn duration(&self) -> Option<f64> {
         Some(self.acc.last_t? - self.acc.first_t?)
     }
@@ -219,7 +448,7 @@ impl Report<'_> {
     fn fields(&self) -> Vec<FieldRow> {
         let a = self.acc;
         let n = a.frames;
-        let s = *self.settings;
+        let s = self.settings;
         let pct = |x: f64| x * 100.0 / 1024.0;
         let amps = move |x: f64| x / f64::from(s.current_scale);
         let rpm = move |x: f64| x * 10.0 / (f64::from(s.gear_ratio) * f64::from(s.pole_pairs));
@@ -243,33 +472,17 @@ impl Report<'_> {
             .filter(|&(_, n)| n > 0)
     }
 
-    fn text(&self) -> String {
+    fn text(&self, o: &mut String) {
         let st = self.stats;
-        let mut o = String::new();
-        // Writing to a String cannot fail; the results are ignored below for that reason.
-        let _ = writeln!(
-            o,
-            "input        {} ({}, {} bytes)",
-            self.input,
-            self.format,
-            st.bytes()
-        );
-        if self.flagged_bytes > 0 {
-            let _ = writeln!(
-                o,
-                "             {} bytes flagged with parity or framing errors by the analyser",
-                self.flagged_bytes
-            );
+        let _ = writeln!(o, "ESC {:<8} {}", self.index, self.label);
+        if st.bytes() == 0 {
+            let _ = writeln!(o, "frames       none: no bytes from this stream");
+            return;
         }
-        let _ = writeln!(
-            o,
-            "settings     current scale {}, pole pairs {}, gear ratio {}",
-            self.settings.current_scale, self.settings.pole_pairs, self.settings.gear_ratio
-        );
         if st.frames() == 0 && st.info_frames() == 0 {
             let _ = writeln!(o, "frames       none: {NO_FRAMES}");
             let _ = writeln!(o, "skipped      {} bytes", st.bytes_skipped());
-            return o;
+            return;
         }
         let _ = write!(
             o,
@@ -302,54 +515,63 @@ impl Report<'_> {
         for (info, n) in &self.acc.infos {
             let _ = writeln!(o, "device       {info}  ({n} info frames)");
         }
-        if self.acc.frames > 0 {
-            let _ = writeln!(
-                o,
-                "\n{:<18} {:>12} {:>12} {:>12}  unit",
-                "field", "min", "max", "mean"
-            );
-            for (name, unit, range) in self.fields() {
-                match range {
-                    Some([min, max, mean]) => {
-                        let _ =
-                            writeln!(o, "{name:<18} {min:>12.3} {max:>12.3} {mean:>12.3}  {unit}");
-                    }
-                    None => {
-                        let _ =
-                            writeln!(o, "{name:<18} {:>12} {:>12} {:>12}  {unit}", "-", "-", "-");
-                    }
+        if self.acc.frames == 0 {
+            return;
+        }
+        let _ = writeln!(
+            o,
+            "\n{:<18} {:>12} {:>12} {:>12}  unit",
+            "field", "min", "max", "mean"
+        );
+        for (name, unit, range) in self.fields() {
+            match range {
+                Some([min, max, mean]) => {
+                    let _ = writeln!(o, "{name:<18} {min:>12.3} {max:>12.3} {mean:>12.3}  {unit}");
                 }
-            }
-            for (name, t) in [
-                ("mos_temp_c", temp_stats(&self.acc.mos_codes)),
-                ("cap_temp_c", temp_stats(&self.acc.cap_codes)),
-            ] {
-                if t.below + t.above > 0 {
-                    let _ = writeln!(
-                        o,
-                        "{name:<18} out of the table's range in {} frames (below 0 degC: {}, above 129 degC: {})",
-                        t.below + t.above,
-                        t.below,
-                        t.above
-                    );
+                None => {
+                    let _ = writeln!(o, "{name:<18} {:>12} {:>12} {:>12}  {unit}", "-", "-", "-");
                 }
-            }
-            o.push('\n');
-            let mut any = false;
-            for (fault, n) in self.faults() {
-                any = true;
-                let _ = writeln!(
-                    o,
-                    "fault        {:<22} in {n} frames ({})",
-                    fault.name(),
-                    fault.description()
-                );
-            }
-            if !any {
-                let _ = writeln!(o, "faults       none");
             }
         }
-        o
+        for (name, t) in [
+            ("mos_temp_c", temp_stats(&self.acc.mos_codes)),
+            ("cap_temp_c", temp_stats(&self.acc.cap_codes)),
+        ] {
+            if t.below + t.above > 0 {
+                let _ = writeln!(
+                    o,
+                    "{name:<18} out of the table's range in {} frames (below 0 degC: {}, above 129 degC: {})",
+                    t.below + t.above,
+                    t.below,
+                    t.above
+                );
+            }
+        }
+        o.push('\n');
+        if self.episode_count == 0 {
+            let _ = writeln!(o, "faults       none");
+            return;
+        }
+        for (fault, n) in self.faults() {
+            let _ = writeln!(
+                o,
+                "fault        {:<22} in {n} frames ({})",
+                fault.name(),
+                fault.description()
+            );
+        }
+        let _ = writeln!(
+            o,
+            "episodes     {} (runs of consecutive frames with faults)",
+            self.episode_count
+        );
+        for (i, e) in self.episodes.iter().take(TEXT_EPISODES).enumerate() {
+            let _ = writeln!(o, "  {:>4}  {}", i + 1, episode_text(e));
+        }
+        let more = self.episode_count - self.episodes.len().min(TEXT_EPISODES) as u64;
+        if more > 0 {
+            let _ = writeln!(o, "        ... and {more} more (all listed with --json)");
+        }
     }
 
     fn json(&self) -> Value {
@@ -386,17 +608,18 @@ impl Report<'_> {
                 })
             })
             .collect();
+        let episodes: Vec<Value> = self.episodes.iter().map(episode_json).collect();
         let temps = |t: TempStats| json!({"below_range": t.below, "above_range": t.above});
+        let warning = if st.bytes() == 0 {
+            Some("no bytes from this stream")
+        } else {
+            (st.frames() == 0).then_some(NO_FRAMES)
+        };
         json!({
+            "esc": self.index,
             "input": self.input,
-            "format": match self.format { Format::Raw => "raw", Format::AnalyzerCsv => "csv" },
+            "stream": self.stream,
             "bytes": st.bytes(),
-            "flagged_bytes": self.flagged_bytes,
-            "settings": {
-                "current_scale": self.settings.current_scale,
-                "pole_pairs": self.settings.pole_pairs,
-                "gear_ratio": self.settings.gear_ratio,
-            },
             "frames": st.frames(),
             "info_frames": st.info_frames(),
             "first_t_s": self.acc.first_t,
@@ -417,9 +640,56 @@ impl Report<'_> {
                 "cap_temp_c": temps(temp_stats(&self.acc.cap_codes)),
             },
             "faults": faults,
-            "warning": (st.frames() == 0).then_some(NO_FRAMES),
+            "fault_episode_count": self.episode_count,
+            "fault_episodes": episodes,
+            "warning": warning,
         })
     }
+}
+
+/// An episode in one line: when, how long, which faults.
+fn episode_text(e: &Episode) -> String {
+    let mut s = String::new();
+    match (e.first.t, e.last.t) {
+        (Some(a), Some(b)) => {
+            let _ = write!(s, "{a:.3} .. {b:.3} s ({:.3} s, ", b - a);
+        }
+        _ => {
+            let _ = write!(s, "frames {} .. {} (", e.first.frame, e.last.frame);
+        }
+    }
+    let _ = write!(
+        s,
+        "{} frames, packets {} .. {})  {}",
+        e.frames,
+        e.first.packet,
+        e.last.packet,
+        fault_names(e.bits).join(", ")
+    );
+    if e.ongoing {
+        s.push_str("  (still on at the end)");
+    }
+    s
+}
+
+fn episode_json(e: &Episode) -> Value {
+    json!({
+        "start_t_s": e.first.t,
+        "end_t_s": e.last.t,
+        "duration_s": e.first.t.zip(e.last.t).map(|(a, b)| b - a),
+        "start_frame": e.first.frame,
+        "end_frame": e.last.frame,
+        "start_packet": e.first.packet,
+        "end_packet": e.last.packet,
+        "frames": e.frames,
+        "status": e.bits.0,
+        "faults": fault_names(e.bits),
+        "ongoing": e.ongoing,
+    })
+}
+
+fn fault_names(status: Status) -> Vec<&'static str> {
+    status.faults().map(Fault::name).collect()
 }
 
 fn percent(part: u64, whole: u64) -> f64 {
@@ -457,5 +727,38 @@ mod tests {
             Some([-1.0, 2.0, 64.0 / 3.0 / 64.0])
         );
         assert_eq!(Range::default().convert(0, |x| x), None);
+    }
+
+    #[test]
+    fn episodes_are_maximal_runs_of_faulty_frames() {
+        let mut acc = Accumulator::default();
+        let statuses = [
+            0u16, 0x0001, 0x0040, 0x0001, 0, 0, 0x8000, 0, 0x0002, 0x0002,
+        ];
+        for (i, &s) in statuses.iter().enumerate() {
+            let frame = DataFrame {
+                packet: 100 + i as u16,
+                status: Status(s),
+                ..Default::default()
+            };
+            acc.add(Some(i as f64 * 0.05), &Frame::Data(frame));
+        }
+        assert_eq!(acc.episode_count, 2);
+        let first = acc.episodes[0];
+        assert_eq!(
+            (first.first.frame, first.last.frame, first.frames),
+            (1, 3, 3)
+        );
+        assert_eq!((first.first.packet, first.last.packet), (101, 103));
+        assert_eq!(first.first.t, Some(0.05));
+        assert_eq!(
+            fault_names(first.bits),
+            ["input_voltage_high", "mos_overheat"]
+        );
+        assert!(!first.ongoing);
+        assert_eq!(acc.episodes[1].frames, 1);
+        // The last run is still open at the end of the stream.
+        let open = acc.episode.unwrap();
+        assert_eq!((open.first.frame, open.last.frame, open.frames), (8, 9, 2));
     }
 }

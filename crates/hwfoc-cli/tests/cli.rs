@@ -157,7 +157,12 @@ fn summary_of_real_capture() {
         "--json",
         capture(XROTOR).to_str().unwrap(),
     ]));
-    let v: Value = serde_json::from_str(&out).unwrap();
+    let top: Value = serde_json::from_str(&out).unwrap();
+    assert_eq!(top["inputs"][0]["bytes"], 7002);
+    assert_eq!(top["inputs"][0]["escs"], serde_json::json!([0]));
+    assert_eq!(top["escs"].as_array().unwrap().len(), 1);
+    let v = &top["escs"][0];
+    assert_eq!(v["esc"], 0);
     assert_eq!(v["frames"], 248);
     assert_eq!(v["info_frames"], 12);
     assert_eq!(v["bytes"], 7002);
@@ -175,6 +180,7 @@ fn summary_of_real_capture() {
     assert_eq!(v["first_t_s"], 0.22798);
     assert_eq!(v["warning"], Value::Null);
     assert_eq!(v["faults"], serde_json::json!({}));
+    assert_eq!(v["fault_episode_count"], 0);
     // The input is named as given on the command line, which differs between checkouts.
     let portable = out.replace(
         &serde_json::to_string(capture(XROTOR).to_str().unwrap()).unwrap(),
@@ -202,6 +208,7 @@ fn other_protocols_give_no_frames_and_say_so() {
         assert!(err.contains("no valid HW-FOC frames"), "{err}");
 
         let v: Value = serde_json::from_str(&stdout(&run(&["summary", "--json", path]))).unwrap();
+        let v = &v["escs"][0];
         assert_eq!(v["frames"], 0, "{name}");
         assert_eq!(v["info_frames"], 0, "{name}");
         assert_eq!(
@@ -355,6 +362,7 @@ fn info_frames_are_summarised_not_recorded() {
     let p = path.to_str().unwrap();
     assert_eq!(stdout(&run(&["decode", p])).lines().count(), 1);
     let v: Value = serde_json::from_str(&stdout(&run(&["summary", "--json", p]))).unwrap();
+    let v = &v["escs"][0];
     assert_eq!(v["info"][0]["text"], "X8_FOC HW1 FW2 42");
     assert_eq!(v["link"]["checksum_failures"], 0);
 }

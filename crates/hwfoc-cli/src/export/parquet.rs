@@ -1,0 +1,452 @@
+//! The Parquet writer: the record schema as an Apache Parquet file, with the Arrow schema
+//! embedded so that Arrow readers (pyarrow, arrow-rs, polars, DuckDB) see the exact types.
+//!
+//! Columns, types and units are those of `RECORD-SCHEMA.md`; each Arrow field carries its unit
+//! in its metadata (key `unit`, `-` for a number without unit). The file's key-value metadata
+//! holds `hwfoc_version`, the settings (`current_scale`, `pole_pairs`, `gear_ratio`), `inputs`
+//! (a JSON array of the input names), `escs` (a JSON array of `{"esc", "input", "stream"}`)
+//! and, when records were filtered, `filter`.
+//!
+//! Speed (figures from `scripts/bench-export.sh`): the decoding thread only collects frames,
+//! a row group's worth at a time; the writer thread converts, encodes and compresses the
+//! columns of each row group in memory together with a helper thread (each takes the next
+//! column not yet done), then writes them in schema order. Encodings are chosen to keep up
+//! with decoding:
+//! - data pages of format version 2 (values compressed on their own, levels not, no copy of
+//!   the values before compression; a page that does not compress is stored as it is);
+//! - plain values compressed with LZ4 (`LZ4_RAW`: faster than Snappy here, and smaller);
+//! - `packet` and `erpm` as bit-packed differences (`DELTA_BINARY_PACKED`, not compressed):
+//!   they count up or drift, and plain they hardly compress;
+//! - no dictionaries, except for the fault names;
+//! - minimum and maximum per row group for `t_s`, `esc` and `status` only (what a reader needs
+//!   to skip row groups by time, ESC or fault).
+//!
+//! Row groups hold about [`ROW_GROUP_ROWS`] rows, so that memory stays small.
+
+use std::collections::HashMap;
+use std::io;
+use std::sync::Arc;
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::mpsc::{Receiver, SyncSender};
+
+use arrow_schema::{DataType, Field, FieldRef, Schema};
+use bytes::Bytes;
+use hwfoc::{DataFrame, Fault, Settings, Temperature};
+use parquet::arrow::{ArrowSchemaConverter, add_encoded_arrow_schema_to_metadata};
+use parquet::basic::{Compression, Encoding};
+use parquet::column::writer::{ColumnCloseResult, get_column_writer, get_typed_column_writer};
+use parquet::data_type::{
+    ByteArray, ByteArrayType, DataType as ParquetType, DoubleType, FloatType, Int32Type,
+};
+use parquet::errors::ParquetError;
+use parquet::file::metadata::KeyValue;
+use parquet::file::properties::WriterPropertiesPtr;
+use parquet::file::properties::{EnabledStatistics, WriterProperties, WriterVersion};
+use parquet::file::writer::{
+    SerializedFileWriter, SerializedPageWriter, SerializedRowGroupWriter, TrackedWrite,
+};
+use parquet::schema::types::{ColumnDescPtr, ColumnPath, SchemaDescriptor};
+
+use crate::error::CliError;
+use crate::schema::{COLUMNS, UNITS};
+
+use super::{Chunk, Msg, Provenance, Sink};
+
+/// Rows per row group, at least (a row group is written once this many rows are collected).
+pub const ROW_GROUP_ROWS: usize = 1 << 17;
+
+/// Name of the `faults` list's item field (Arrow's default).
+const ITEM: &str = "item";
+
+/// The Arrow schema of the records: names, types, nullability and units of RECORD-SCHEMA.md.
+pub fn schema() -> Schema {
+    let types = [
+        (DataType::Float64, true),
+        (DataType::UInt8, false),
+        (DataType::UInt16, false),
+        (DataType::Float32, false),
+        (DataType::Float32, false),
+        (DataType::UInt32, false),
+        (DataType::Float32, false),
+        (DataType::Float32, false),
+        (DataType::Float32, false),
+        (DataType::Float32, false),
+        (DataType::Float32, true),
+        (DataType::Float32, true),
+        (DataType::UInt16, false),
+        (DataType::List(fault_item()), false),
+    ];
+    let fields: Vec<Field> = COLUMNS
+        .iter()
+        .zip(UNITS)
+        .zip(types)
+        .map(|((name, unit), (data_type, nullable))| {
+            let metadata = HashMap::from([("unit".to_string(), unit.to_string())]);
+            Field::new(*name, data_type, nullable).with_metadata(metadata)
+        })
+        .collect();
+    Schema::new(fields)
+}
+
+/// The item field of the `faults` list: a fault name, never null.
+fn fault_item() -> FieldRef {
+    Arc::new(Field::new(ITEM, DataType::Utf8, false))
+}
+
+/// The writer's properties: fast encodings, the settings and the Arrow schema in the key-value
+/// metadata.
+fn properties(schema: &Schema, provenance: &Provenance) -> WriterProperties {
+    let s = provenance.settings;
+    let mut kv = vec![
+        KeyValue::new(
+            "hwfoc_version".to_string(),
+            env!("CARGO_PKG_VERSION").to_string(),
+        ),
+        KeyValue::new("current_scale".to_string(), s.current_scale.to_string()),
+        KeyValue::new("pole_pairs".to_string(), s.pole_pairs.to_string()),
+        KeyValue::new("gear_ratio".to_string(), s.gear_ratio.to_string()),
+        KeyValue::new(
+            "inputs".to_string(),
+            serde_json::Value::from(provenance.inputs.clone()).to_string(),
+        ),
+    ];
+    if !provenance.filter.is_empty() {
+        kv.push(KeyValue::new(
+            "filter".to_string(),
+            provenance.filter.clone(),
+        ));
+    }
+    let mut builder = WriterProperties::builder()
+        .set_writer_version(WriterVersion::PARQUET_2_0)
+        .set_compression(Compression::LZ4_RAW)
+        .set_dictionary_enabled(false)
+        .set_encoding(Encoding::PLAIN)
+        .set_column_dictionary_enabled(
+            ColumnPath::from(vec![
+                "faults".to_string(),
+                "list".to_string(),
+                ITEM.to_string(),
+            ]),
+            true,
+        )
+        .set_statistics_enabled(EnabledStatistics::None)
+        .set_key_value_metadata(Some(kv));
+    // Packet numbers count up, eRPM drifts: their differences pack into a few bits, smaller
+    // and cheaper than compressing the plain values (which barely compress).
+    for column in ["packet", "erpm"] {
+        builder = builder
+            .set_column_encoding(ColumnPath::from(column), Encoding::DELTA_BINARY_PACKED)
+            .set_column_compression(ColumnPath::from(column), Compression::UNCOMPRESSED);
+    }
+    for column in ["t_s", "esc", "status"] {
+        builder = builder
+            .set_column_statistics_enabled(ColumnPath::from(column), EnabledStatistics::Chunk);
+    }
+    let mut props = builder.build();
+    add_encoded_arrow_schema_to_metadata(schema, &mut props);
+    props
+}
+
+/// Converts frames to Parquet columns under fixed settings and encodes them.
+pub struct Converter {
+    settings: Settings,
+    /// The temperature of each ADC code, and whether it is in the table's range.
+    celsius: [(f32, bool); 256],
+    /// Each fault's name, ready to be stored.
+    names: [ByteArray; 16],
+}
+
+/// A column's values (nulls left out) and its definition levels, if it has nulls.
+type Nullable<T> = (Vec<T>, Vec<i16>);
+
+impl Converter {
+    /// A converter for `settings`.
+    pub fn new(settings: Settings) -> Converter {
+        Converter {
+            settings,
+            celsius: std::array::from_fn(|code| {
+                match Temperature::from_adc(code as u8).celsius() {
+                    Some(c) => (c, true),
+                    None => (0.0, false),
+                }
+            }),
+            names: std::array::from_fn(|bit| {
+                let name = Fault::from_bit(bit as u8).map_or("", Fault::name);
+                ByteArray::from(name)
+            }),
+        }
+    }
+
+    /// Receive times, with a definition level each (0 for no time).
+    fn times(&self, rows: &Chunk) -> Nullable<f64> {
+        let n = rows.len();
+        let timed = rows.t.iter().filter(|t| !t.is_nan()).count();
+        if timed == n {
+            (rows.t.clone(), vec![1; n])
+        } else if timed == 0 {
+            (Vec::new(), vec![0; n])
+        } else {
+            let values = rows.t.iter().copied().filter(|t| !t.is_nan()).collect();
+            let def = rows.t.iter().map(|t| i16::from(!t.is_nan())).collect();
+            (values, def)
+        }
+    }
+
+    /// Temperatures from ADC codes: the values in range, and a definition level each.
+    fn temperatures(&self, codes: impl Iterator<Item = u8>) -> Nullable<f32> {
+        let mut values = Vec::new();
+        let def = codes
+            .map(|code| {
+                let (c, valid) = self.celsius[usize::from(code)];
+                if valid {
+                    values.push(c);
+                }
+                i16::from(valid)
+            })
+            .collect();
+        (values, def)
+    }
+
+    /// The fault names of each row, with definition and repetition levels (an empty list is
+    /// one level pair and no value).
+    fn faults(&self, rows: &Chunk) -> (Vec<ByteArray>, Vec<i16>, Vec<i16>) {
+        let n = rows.len();
+        if rows.frames.iter().all(|f| f.status.is_ok()) {
+            return (Vec::new(), vec![0; n], vec![0; n]);
+        }
+        let (mut values, mut def, mut rep) =
+            (Vec::new(), Vec::with_capacity(n), Vec::with_capacity(n));
+        for f in &rows.frames {
+            if f.status.is_ok() {
+                def.push(0);
+                rep.push(0);
+                continue;
+            }
+            for (i, fault) in f.status.faults().enumerate() {
+                values.push(self.names[usize::from(fault.bit())].clone());
+                def.push(1);
+                rep.push(i16::from(i > 0));
+            }
+        }
+        (values, def, rep)
+    }
+
+    /// Converts and encodes column `index` (in schema order) of `rows` into memory: the
+    /// column chunk's bytes and the metadata that goes with them.
+    fn encode(
+        &self,
+        index: usize,
+        rows: &Chunk,
+        descr: &SchemaDescriptor,
+        props: &WriterPropertiesPtr,
+    ) -> Encoded {
+        let frames = &rows.frames;
+        let s = &self.settings;
+        let descr = descr.column(index);
+        let f32s =
+            |values: Vec<f32>| encode::<FloatType>(descr.clone(), props, &values, None, None);
+        let i32s =
+            |values: Vec<i32>| encode::<Int32Type>(descr.clone(), props, &values, None, None);
+        match index {
+            0 => {
+                let (values, def) = self.times(rows);
+                encode::<DoubleType>(descr, props, &values, Some(&def), None)
+            }
+            1 => i32s(rows.esc.iter().map(|&e| i32::from(e)).collect()),
+            2 => i32s(column(frames, |f| i32::from(f.packet))),
+            3 => f32s(column(frames, |f| f.throttle_in_pct())),
+            4 => f32s(column(frames, |f| f.throttle_out_pct())),
+            // UINT_32 is stored in an INT32 column with the same bits.
+            5 => i32s(column(frames, |f| f.erpm() as i32)),
+            6 => f32s(column(frames, |f| f.rpm(s))),
+            7 => f32s(column(frames, |f| f.voltage_v())),
+            8 => f32s(column(frames, |f| f.current_a(s))),
+            9 => f32s(column(frames, |f| f.phase_current_a(s))),
+            10 | 11 => {
+                let (values, def) = if index == 10 {
+                    self.temperatures(frames.iter().map(|f| f.mos_adc))
+                } else {
+                    self.temperatures(frames.iter().map(|f| f.cap_adc))
+                };
+                encode::<FloatType>(descr, props, &values, Some(&def), None)
+            }
+            12 => i32s(column(frames, |f| i32::from(f.status.0))),
+            _ => {
+                let (values, def, rep) = self.faults(rows);
+                encode::<ByteArrayType>(descr, props, &values, Some(&def), Some(&rep))
+            }
+        }
+    }
+
+    /// Writes `rows` as one row group. The columns are converted, encoded and compressed in
+    /// memory by this thread and a helper, each taking the next column not yet taken (on two
+    /// cores, the decoding thread leaves time to spare), then written in schema order.
+    fn write<W: io::Write + Send>(
+        &self,
+        rows: &Chunk,
+        descr: &SchemaDescriptor,
+        props: &WriterPropertiesPtr,
+        rg: &mut SerializedRowGroupWriter<'_, W>,
+    ) -> Result<(), ParquetError> {
+        let leaves = descr.num_columns();
+        let next = AtomicUsize::new(0);
+        let work = || {
+            let mut done = Vec::new();
+            loop {
+                let index = next.fetch_add(1, Ordering::Relaxed);
+                if index >= leaves {
+                    return done;
+                }
+                done.push((index, self.encode(index, rows, descr, props)));
+            }
+        };
+        let mut chunks = std::thread::scope(|s| {
+            let helper = s.spawn(work);
+            let mut mine = work();
+            // A helper that panicked has encoded nothing more: its columns are missing below.
+            mine.extend(helper.join().unwrap_or_default());
+            mine
+        });
+        chunks.sort_by_key(|(index, _)| *index);
+        if chunks.len() != leaves {
+            return Err(ParquetError::General(
+                "a column could not be encoded".to_string(),
+            ));
+        }
+        for (_, chunk) in chunks {
+            let (bytes, close) = chunk?;
+            rg.append_column(&bytes, close)?;
+        }
+        Ok(())
+    }
+}
+
+/// One value per frame.
+#[inline]
+fn column<T>(frames: &[DataFrame], value: impl Fn(&DataFrame) -> T) -> Vec<T> {
+    frames.iter().map(value).collect()
+}
+
+/// A column chunk encoded in memory, or why it could not be.
+type Encoded = Result<(Bytes, ColumnCloseResult), ParquetError>;
+
+/// Encodes one column chunk into memory.
+fn encode<T: ParquetType>(
+    descr: ColumnDescPtr,
+    props: &WriterPropertiesPtr,
+    values: &[T::T],
+    def: Option<&[i16]>,
+    rep: Option<&[i16]>,
+) -> Encoded {
+    let mut buf = TrackedWrite::new(Vec::new());
+    let close = {
+        let pages = SerializedPageWriter::new(&mut buf);
+        let mut writer =
+            get_typed_column_writer::<T>(get_column_writer(descr, props.clone(), Box::new(pages)));
+        writer.write_batch(values, def, rep)?;
+        writer.close()?
+    };
+    Ok((Bytes::from(buf.into_inner()?), close))
+}
+
+/// A Parquet error as a write error naming the output (an I/O error as itself).
+fn write_error(output: &str, e: ParquetError) -> CliError {
+    let source = match e {
+        ParquetError::External(inner) => match inner.downcast::<io::Error>() {
+            Ok(io) => *io,
+            Err(other) => io::Error::other(other.to_string()),
+        },
+        other => io::Error::other(other.to_string()),
+    };
+    CliError::Write {
+        output: output.to_string(),
+        source,
+    }
+}
+
+/// Writes the rows received on `rx` as one Parquet file, a row group per message, and returns
+/// them on `spare` for reuse. At the end message, or when the sender goes away, the
+/// file is closed properly: footer and metadata, so it is readable.
+pub(super) fn write(
+    sink: Sink,
+    provenance: &Provenance,
+    rx: Receiver<Msg>,
+    spare: SyncSender<Chunk>,
+) -> Result<(), CliError> {
+    let schema = schema();
+    let name = sink.name;
+    let fail = |e| write_error(&name, e);
+    let parquet_schema = ArrowSchemaConverter::new().convert(&schema).map_err(fail)?;
+    let props = Arc::new(properties(&schema, provenance));
+    let mut writer =
+        SerializedFileWriter::new(sink.writer, parquet_schema.root_schema_ptr(), props.clone())
+            .map_err(fail)?;
+    let converter = Converter::new(provenance.settings);
+    for msg in rx {
+        match msg {
+            Msg::Rows(rows) => {
+                let mut rg = writer.next_row_group().map_err(fail)?;
+                converter
+                    .write(&rows, &parquet_schema, &props, &mut rg)
+                    .map_err(fail)?;
+                rg.close().map_err(fail)?;
+                // The command may have stopped listening; the rows are then dropped.
+                let _ = spare.try_send(rows);
+            }
+            Msg::End(metadata) => {
+                for (key, value) in metadata {
+                    writer.append_key_value_metadata(KeyValue::new(key, value));
+                }
+                break;
+            }
+        }
+    }
+    writer.close().map_err(fail)?;
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use parquet::basic::Type as PhysicalType;
+
+    /// The Parquet leaf columns that `Converter::encode` fills, in order, with their levels.
+    #[test]
+    fn parquet_schema_matches_the_columns_written() {
+        let descr = ArrowSchemaConverter::new().convert(&schema()).unwrap();
+        let leaves: Vec<(String, PhysicalType, i16, i16)> = descr
+            .columns()
+            .iter()
+            .map(|c| {
+                (
+                    c.path().string(),
+                    c.physical_type(),
+                    c.max_def_level(),
+                    c.max_rep_level(),
+                )
+            })
+            .collect();
+        use PhysicalType::*;
+        let expected = [
+            ("t_s", DOUBLE, 1, 0),
+            ("esc", INT32, 0, 0),
+            ("packet", INT32, 0, 0),
+            ("throttle_in_pct", FLOAT, 0, 0),
+            ("throttle_out_pct", FLOAT, 0, 0),
+            ("erpm", INT32, 0, 0),
+            ("rpm", FLOAT, 0, 0),
+            ("voltage_v", FLOAT, 0, 0),
+            ("current_a", FLOAT, 0, 0),
+            ("phase_current_a", FLOAT, 0, 0),
+            ("mos_temp_c", FLOAT, 1, 0),
+            ("cap_temp_c", FLOAT, 1, 0),
+            ("status", INT32, 0, 0),
+            ("faults.list.item", BYTE_ARRAY, 1, 1),
+        ];
+        let expected: Vec<(String, PhysicalType, i16, i16)> = expected
+            .into_iter()
+            .map(|(p, t, d, r)| (p.to_string(), t, d, r))
+            .collect();
+        assert_eq!(leaves, expected);
+    }
+}

@@ -1,0 +1,164 @@
+//! The text writer: JSON Lines or CSV, through the encodings of [`crate::schema`].
+//!
+//! Formatting numbers is most of the work, so two threads format, each a slice of rows at a
+//! time, and a third writes their text in order: this thread hands the slices out in turn to
+//! the formatters and the writer takes their text in the same turn, so the output is in input
+//! order without any sorting. Queues between them hold one slice each, so memory stays bounded
+//! (a slice of [`SLICE_ROWS`] rows is about 2 MB of JSON).
+
+use std::sync::mpsc::{Receiver, SyncSender, sync_channel};
+
+use crate::error::CliError;
+use crate::schema::{Record, TextEncoder};
+
+use super::{Chunk, Msg, Provenance, Sink};
+
+/// Rows formatted at a time by one formatter.
+const SLICE_ROWS: usize = 8192;
+
+/// Text smaller than this is gathered before it is written.
+const GATHER: usize = 1 << 16;
+
+/// Number of formatting threads.
+const FORMATTERS: usize = 2;
+
+/// What a formatter hands to the writer: the text of a slice, and whether to flush after it.
+type Text = (Vec<u8>, bool);
+
+/// Writes the chunks received on `rx` as CSV (`csv`) or JSON Lines, returning each chunk on
+/// `spare` for reuse. Returns at the end message, or when the sender goes away, with everything
+/// written and flushed; or at the first write error.
+pub(super) fn write(
+    csv: bool,
+    sink: Sink,
+    provenance: &Provenance,
+    rx: Receiver<Msg>,
+    spare: SyncSender<Chunk>,
+) -> Result<(), CliError> {
+    let header = header(csv, provenance);
+    let settings = provenance.settings;
+    std::thread::scope(|s| {
+        let mut slices = Vec::new();
+        let mut texts = Vec::new();
+        for _ in 0..FORMATTERS {
+            let (slice_tx, slice_rx) = sync_channel::<Chunk>(1);
+            let (text_tx, text_rx) = sync_channel::<Text>(1);
+            slices.push(slice_tx);
+            texts.push(text_rx);
+            s.spawn(move || {
+                let mut encoder = TextEncoder::cached();
+                for slice in slice_rx {
+                    let mut text = Vec::with_capacity(slice.len() * if csv { 110 } else { 260 });
+                    for ((&t, &esc), frame) in slice.t.iter().zip(&slice.esc).zip(&slice.frames) {
+                        let record = Record::new((!t.is_nan()).then_some(t), esc, frame, &settings);
+                        if csv {
+                            encoder.csv_frame(&record, frame, &mut text);
+                        } else {
+                            encoder.json_frame(&record, frame, &mut text);
+                        }
+                    }
+                    if text_tx.send((text, slice.flush)).is_err() {
+                        // The writer has stopped (a write error): nothing more to do.
+                        return;
+                    }
+                }
+            });
+        }
+        let writer = s.spawn(move || write_in_turn(sink, header, texts));
+        // Hand out the rows in slices, to the formatters in turn.
+        let mut turn = 0;
+        'rows: for msg in rx {
+            let mut chunk = match msg {
+                Msg::Rows(chunk) => chunk,
+                Msg::End(_) => break,
+            };
+            let n = chunk.len();
+            let mut start = 0;
+            while start < n || (n == 0 && chunk.flush) {
+                let end = n.min(start + SLICE_ROWS);
+                let slice = Chunk {
+                    t: chunk.t[start..end].to_vec(),
+                    esc: chunk.esc[start..end].to_vec(),
+                    frames: chunk.frames[start..end].to_vec(),
+                    flush: chunk.flush && end == n,
+                };
+                if slices[turn].send(slice).is_err() {
+                    break 'rows;
+                }
+                turn = (turn + 1) % FORMATTERS;
+                if end == n {
+                    break;
+                }
+                start = end;
+            }
+            chunk.clear();
+            // The command may have stopped listening; the chunk is then simply dropped.
+            let _ = spare.try_send(chunk);
+        }
+        // No more slices: the formatters finish theirs and stop, and so does the writer.
+        drop(slices);
+        writer.join().unwrap_or_else(|_| {
+            Err(CliError::Write {
+                output: "the output".to_string(),
+                source: std::io::Error::other("the writer thread failed"),
+            })
+        })
+    })
+}
+
+/// The CSV header row (after the settings comment when asked for), or nothing for JSON Lines.
+fn header(csv: bool, provenance: &Provenance) -> Vec<u8> {
+    let mut text = Vec::new();
+    if !csv {
+        return text;
+    }
+    if provenance.csv_comment {
+        let settings = provenance.settings;
+        let filter = if provenance.filter.is_empty() {
+            String::new()
+        } else {
+            format!(" filter={}", provenance.filter)
+        };
+        text.extend_from_slice(
+            format!(
+                "# hwfoc decode: current_scale={} pole_pairs={} gear_ratio={} input={}{filter}\n",
+                settings.current_scale,
+                settings.pole_pairs,
+                settings.gear_ratio,
+                provenance.inputs.join(" "),
+            )
+            .as_bytes(),
+        );
+    }
+    Record::write_csv_header(&mut text);
+    text
+}
+
+/// Writes the header, then the formatters' text, taking from each formatter in turn (the
+/// order the slices were handed out in), until the formatter whose turn it is has stopped.
+fn write_in_turn(
+    mut sink: Sink,
+    header: Vec<u8>,
+    texts: Vec<Receiver<Text>>,
+) -> Result<(), CliError> {
+    let mut pending = header;
+    let mut turn = 0;
+    while let Ok((text, flush)) = texts[turn].recv() {
+        turn = (turn + 1) % texts.len();
+        if pending.is_empty() && text.len() >= GATHER {
+            sink.writer.write_all(&text).map_err(|e| sink.error(e))?;
+        } else {
+            // Small pieces (live input, the header) are gathered into bigger writes.
+            pending.extend_from_slice(&text);
+            if flush || pending.len() >= GATHER {
+                sink.writer.write_all(&pending).map_err(|e| sink.error(e))?;
+                pending.clear();
+            }
+        }
+        if flush {
+            sink.writer.flush().map_err(|e| sink.error(e))?;
+        }
+    }
+    sink.writer.write_all(&pending).map_err(|e| sink.error(e))?;
+    sink.writer.flush().map_err(|e| sink.error(e))
+}

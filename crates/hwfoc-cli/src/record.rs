@@ -1,0 +1,522 @@
+//! `hwfoc record PORT... -o FILE`: lossless, timestamped capture of serial ports to pcapng.
+//!
+//! Every byte received is stored, in chunks as the reads returned them, each chunk timestamped
+//! with the Unix time of its first byte in nanoseconds; one pcapng interface per port, in the
+//! order given (see [`crate::pcapng`]). The recording is meant to survive the worst:
+//! - crash safety: blocks go from a small buffer to the file at least every [`FLUSH_EVERY`],
+//!   so after `kill -9` (or a crash) the file reads up to its last complete block and at most
+//!   that much data is lost; the file is also synced to the disk every [`SYNC_EVERY`];
+//! - a port that disappears (USB unplugged) is noted in the recording as a gap, with a comment,
+//!   and recording goes on: the port is tried again every 0.5 s and resumes when it is back;
+//! - Ctrl-C or SIGTERM (or `--duration`) ends the recording cleanly;
+//! - with `--rotate-size` or `--rotate-time` the recording is a series of numbered files
+//!   (`out-0001.pcapng`, `out-0002.pcapng`, …), each complete on its own.
+//!
+//! Frames are decoded on the fly, only to count them and to warn when a port sends bytes but
+//! no valid frame (a wrong baud rate or swapped wires) or nothing at all.
+
+use std::fs::File;
+use std::io::BufWriter;
+use std::path::Path;
+use std::sync::atomic::Ordering;
+use std::time::{Duration, Instant};
+
+use hwfoc::Decoder;
+
+use crate::error::CliError;
+use crate::pcapng;
+use crate::serial::{self, PortEvent, PortSet};
+
+/// Longest time a received byte stays in this process before it is written to the file.
+pub const FLUSH_EVERY: Duration = Duration::from_millis(50);
+/// How often the file is synced to the disk (against power loss; a process crash loses only
+/// what is not yet written).
+pub const SYNC_EVERY: Duration = Duration::from_secs(1);
+/// How long bytes may arrive without a valid frame before the warning.
+pub const NO_FRAMES_AFTER: Duration = Duration::from_secs(3);
+/// How long a port may stay silent before the warning.
+pub const SILENT_AFTER: Duration = Duration::from_secs(5);
+/// The size of the buffer in front of the file: far more than 50 ms of any number of ports.
+const BUFFER: usize = 1 << 16;
+
+/// Arguments of `hwfoc record`.
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    /// Serial ports to record (`/dev/ttyUSB0`, `/dev/serial/by-id/…`, `COM3`): one pcapng
+    /// interface each, in the order given.
+    #[arg(value_name = "PORT", required = true, num_args = 1..)]
+    pub ports: Vec<String>,
+    /// The recording to write (pcapng; Wireshark and tshark open it). With rotation, files are
+    /// numbered: FILE `out.pcapng` gives `out-0001.pcapng`, `out-0002.pcapng`, …
+    #[arg(short, long, value_name = "FILE")]
+    pub output: String,
+    /// Baud rate of the ports (8N1).
+    #[arg(long, value_name = "N", default_value_t = serial::DEFAULT_BAUD,
+          value_parser = clap::value_parser!(u32).range(1..))]
+    pub baud: u32,
+    /// Start a new file before one would grow past BYTES (suffixes k, M, G, or KiB, MiB, GiB).
+    #[arg(long, value_name = "BYTES", value_parser = parse_size, conflicts_with = "rotate_time")]
+    pub rotate_size: Option<u64>,
+    /// Start a new file every SECONDS.
+    #[arg(long, value_name = "SECONDS", value_parser = parse_seconds)]
+    pub rotate_time: Option<f64>,
+    /// Stop after S seconds (otherwise on Ctrl-C or SIGTERM).
+    #[arg(long, value_name = "S", value_parser = parse_seconds)]
+    pub duration: Option<f64>,
+}
+
+/// A size in bytes: `1000000`, `500k`, `100M`, `2G` (powers of 1000) or `64KiB`, `1MiB`, `1GiB`.
+fn parse_size(text: &str) -> Result<u64, String> {
+    let t = text.trim();
+    let split = t.find(|c: char| !c.is_ascii_digit()).unwrap_or(t.len());
+    let (number, unit) = t.split_at(split);
+    let unit_bytes: u64 = match unit.trim() {
+        "" | "B" => 1,
+        "k" | "K" | "kB" | "KB" => 1000,
+        "M" | "MB" => 1_000_000,
+        "G" | "GB" => 1_000_000_000,
+        "KiB" => 1 << 10,
+        "MiB" => 1 << 20,
+        "GiB" => 1 << 30,
+        other => {
+            return Err(format!(
+                "unknown unit {other:?} (use k, M, G, KiB, MiB or GiB)"
+            ));
+        }
+    };
+    let n: u64 = number
+        .parse()
+        .map_err(|_| format!("{text:?} is not a size in bytes"))?;
+    n.checked_mul(unit_bytes)
+        .filter(|&b| b >= 1024)
+        .ok_or_else(|| format!("{text:?}: the size must be at least 1 KiB"))
+}
+
+/// A positive, finite number of seconds.
+fn parse_seconds(text: &str) -> Result<f64, String> {
+    text.trim()
+        .parse::<f64>()
+        .ok()
+        .filter(|s| s.is_finite() && *s > 0.0)
+        .ok_or_else(|| format!("{text:?} is not a positive number of seconds"))
+}
+
+/// The name of file number `n` of a rotated recording: `out.pcapng` → `out-0001.pcapng`.
+pub fn numbered(path: &str, n: u32) -> String {
+    let p = Path::new(path);
+    let stem = p
+        .file_stem()
+        .map_or_else(String::new, |s| s.to_string_lossy().into_owned());
+    let name = match p.extension() {
+        Some(ext) => format!("{stem}-{n:04}.{}", ext.to_string_lossy()),
+        None => format!("{stem}-{n:04}"),
+    };
+    match p.parent() {
+        Some(dir) if !dir.as_os_str().is_empty() => dir.join(name).to_string_lossy().into_owned(),
+        _ => name,
+    }
+}
+
+/// What is known about one port during the recording.
+struct PortState {
+    name: String,
+    decoder: Decoder,
+    /// When the first byte not yet followed by a valid frame arrived, and how many bytes since.
+    unframed_since: Option<Instant>,
+    unframed_bytes: u64,
+    warned_unframed: bool,
+    /// When the port was opened (or came back) with no byte since; `None` once bytes came.
+    silent_since: Option<Instant>,
+    /// Unix time (ns) at which the port was lost, while it is.
+    lost_at: Option<u64>,
+}
+
+impl PortState {
+    fn frames(&self) -> u64 {
+        let stats = self.decoder.stats();
+        u64::from(stats.frames()) + u64::from(stats.info_frames())
+    }
+}
+
+/// The file being written and the rotation state.
+struct Recorder {
+    base: String,
+    rotate_size: Option<u64>,
+    rotate_time: Option<Duration>,
+    baud: u32,
+    /// Files written, the current one last.
+    files: Vec<String>,
+    /// The file being written; `None` after a rotation until there is something to write, so
+    /// that a recording never ends with a file holding nothing.
+    writer: Option<pcapng::Writer<BufWriter<File>>>,
+    /// Whether the current file holds any packet yet.
+    file_has_packets: bool,
+    file_started: Instant,
+    last_flush: Instant,
+    last_sync: Instant,
+    /// The clock of the ports' timestamps.
+    clock: serial::Clock,
+    ports: Vec<PortState>,
+}
+
+/// Runs `hwfoc record`.
+pub fn run(args: &Args) -> Result<(), CliError> {
+    // Install the Ctrl-C / SIGTERM handler first, so that no signal is lost once ports are open.
+    let interrupted = serial::interrupted();
+    let set = PortSet::open(&args.ports, args.baud)?;
+    let started = Instant::now();
+    let mut recorder = Recorder::new(args, set.names(), set.clock())?;
+    eprintln!(
+        "hwfoc: recording {} at {} baud to {}; Ctrl-C stops",
+        set.names().join(", "),
+        args.baud,
+        recorder.current()
+    );
+    let stop_at = args.duration.map(|s| started + Duration::from_secs_f64(s));
+    let result = (|| {
+        loop {
+            let now = Instant::now();
+            if interrupted.load(Ordering::Relaxed) || stop_at.is_some_and(|t| now >= t) {
+                return Ok(());
+            }
+            let mut wait = FLUSH_EVERY.saturating_sub(recorder.last_flush.elapsed());
+            if let Some(t) = stop_at {
+                wait = wait.min(t.saturating_duration_since(now));
+            }
+            if let Some(event) = set.next_event(wait) {
+                recorder.handle(event)?;
+                while let Some(event) = set.try_event() {
+                    recorder.handle(event)?;
+                }
+            }
+            recorder.tick()?;
+        }
+    })();
+    // Stop the readers and keep what they received up to the end, even after an error.
+    let last = set.close();
+    let result = result.and_then(|()| {
+        for event in last {
+            recorder.handle(event)?;
+        }
+        recorder.close()
+    });
+    eprintln!("hwfoc: {}", recorder.status(started.elapsed()));
+    result
+}
+
+impl Recorder {
+    fn new(args: &Args, ports: &[String], clock: serial::Clock) -> Result<Recorder, CliError> {
+        let rotating = args.rotate_size.is_some() || args.rotate_time.is_some();
+        let first = if rotating {
+            numbered(&args.output, 1)
+        } else {
+            args.output.clone()
+        };
+        let writer = create(&first, ports, args.baud)?;
+        let now = Instant::now();
+        Ok(Recorder {
+            base: args.output.clone(),
+            rotate_size: args.rotate_size,
+            rotate_time: args.rotate_time.map(Duration::from_secs_f64),
+            baud: args.baud,
+            files: vec![first],
+            writer: Some(writer),
+            file_has_packets: false,
+            file_started: now,
+            last_flush: now,
+            last_sync: now,
+            clock,
+            ports: ports
+                .iter()
+                .map(|name| PortState {
+                    name: name.clone(),
+                    decoder: Decoder::new(),
+                    unframed_since: None,
+                    unframed_bytes: 0,
+                    warned_unframed: false,
+                    silent_since: Some(now),
+                    lost_at: None,
+                })
+                .collect(),
+        })
+    }
+
+    /// The file being written.
+    fn current(&self) -> &str {
+        self.files.last().map_or("", String::as_str)
+    }
+
+    fn write_error(&self, source: std::io::Error) -> CliError {
+        CliError::Write {
+            output: self.current().to_string(),
+            source,
+        }
+    }
+
+    fn handle(&mut self, event: PortEvent) -> Result<(), CliError> {
+        match event {
+            PortEvent::Data { port, t_ns, bytes } => {
+                if let (Some(limit), Some(writer)) = (self.rotate_size, &self.writer) {
+                    let block = 32 + bytes.len().next_multiple_of(4) as u64;
+                    if self.file_has_packets && writer.bytes_written() + block > limit {
+                        self.rotate()?;
+                    }
+                }
+                let written = self.writer()?.write(port as u32, t_ns, &bytes);
+                written.map_err(|e| self.write_error(e))?;
+                self.file_has_packets = true;
+                self.decode(port, &bytes);
+            }
+            PortEvent::Lost { port, t_ns, reason } => {
+                let state = &mut self.ports[port];
+                state.lost_at = Some(t_ns);
+                state.silent_since = None;
+                state.unframed_since = None;
+                let note = format!(
+                    "gap: {} lost ({reason}); retrying every {} ms",
+                    state.name,
+                    serial::RETRY_EVERY.as_millis()
+                );
+                eprintln!("hwfoc: warning: {note}; the recording goes on");
+                self.note(port, t_ns, &note)?;
+            }
+            PortEvent::Back { port, t_ns } => {
+                let state = &mut self.ports[port];
+                let gap = state
+                    .lost_at
+                    .take()
+                    .map_or(0.0, |lost| t_ns.saturating_sub(lost) as f64 * 1e-9);
+                state.silent_since = Some(Instant::now());
+                let note = format!("resumed: {} is back after a gap of {gap:.1} s", state.name);
+                eprintln!("hwfoc: {note}");
+                self.note(port, t_ns, &note)?;
+            }
+        }
+        Ok(())
+    }
+
+    fn note(&mut self, port: usize, t_ns: u64, text: &str) -> Result<(), CliError> {
+        let written = self.writer()?.comment(port as u32, t_ns, text);
+        written.map_err(|e| self.write_error(e))?;
+        self.file_has_packets = true;
+        // A note is rare and worth having on disk at once.
+        self.flush()
+    }
+
+    /// Decodes a chunk to count frames and to notice a port that sends no valid frame.
+    fn decode(&mut self, port: usize, bytes: &[u8]) {
+        let state = &mut self.ports[port];
+        let before = state.frames();
+        state.decoder.feed(bytes, |_| {});
+        state.silent_since = None;
+        if state.frames() > before {
+            state.unframed_since = None;
+            state.unframed_bytes = 0;
+            state.warned_unframed = false;
+        } else {
+            state.unframed_since.get_or_insert_with(Instant::now);
+            state.unframed_bytes += bytes.len() as u64;
+        }
+    }
+
+    /// Periodic work: flushing, syncing, rotating by time, warnings.
+    fn tick(&mut self) -> Result<(), CliError> {
+        if self.last_flush.elapsed() >= FLUSH_EVERY {
+            self.flush()?;
+        }
+        if self.last_sync.elapsed() >= SYNC_EVERY {
+            self.last_sync = Instant::now();
+            if let Some(writer) = &self.writer {
+                let synced = writer.get_ref().get_ref().sync_data();
+                synced.map_err(|e| self.write_error(e))?;
+            }
+        }
+        if self.writer.is_some()
+            && self
+                .rotate_time
+                .is_some_and(|every| self.file_started.elapsed() >= every)
+        {
+            self.rotate()?;
+        }
+        let baud = self.baud;
+        for state in &mut self.ports {
+            if !state.warned_unframed
+                && state
+                    .unframed_since
+                    .is_some_and(|t| t.elapsed() >= NO_FRAMES_AFTER)
+                && state.unframed_bytes >= 64
+            {
+                state.warned_unframed = true;
+                eprintln!(
+                    "hwfoc: warning: {}: {} bytes in {} s but no valid HW-FOC frame: likely a \
+                     wrong baud rate (read at {baud}; HW-FOC telemetry is 19200, see --baud) or \
+                     swapped TX/RX wires (the adapter's RX must be on the ESC's telemetry wire)",
+                    state.name,
+                    state.unframed_bytes,
+                    NO_FRAMES_AFTER.as_secs()
+                );
+            }
+            if state
+                .silent_since
+                .is_some_and(|t| t.elapsed() >= SILENT_AFTER)
+            {
+                state.silent_since = None;
+                eprintln!(
+                    "hwfoc: warning: {}: nothing received in {} s: is the ESC powered, and its \
+                     telemetry wire on the adapter's RX pin (not TX)?",
+                    state.name,
+                    SILENT_AFTER.as_secs()
+                );
+            }
+        }
+        Ok(())
+    }
+
+    fn flush(&mut self) -> Result<(), CliError> {
+        self.last_flush = Instant::now();
+        match &mut self.writer {
+            Some(writer) => {
+                let flushed = writer.flush();
+                flushed.map_err(|e| self.write_error(e))
+            }
+            None => Ok(()),
+        }
+    }
+
+    /// The file to write to, starting the next file of a rotated recording if need be.
+    fn writer(&mut self) -> Result<&mut pcapng::Writer<BufWriter<File>>, CliError> {
+        let writer = match self.writer.take() {
+            Some(writer) => writer,
+            None => self.next_file()?,
+        };
+        Ok(self.writer.insert(writer))
+    }
+
+    /// Creates the next file of a rotated recording, with the headers again and a note for
+    /// each port that is lost at the moment.
+    fn next_file(&mut self) -> Result<pcapng::Writer<BufWriter<File>>, CliError> {
+        let next = numbered(&self.base, self.files.len() as u32 + 1);
+        let names: Vec<String> = self.ports.iter().map(|p| p.name.clone()).collect();
+        let mut writer = create(&next, &names, self.baud)?;
+        self.files.push(next);
+        self.file_started = Instant::now();
+        self.file_has_packets = false;
+        let now_ns = self.clock.now_ns();
+        for (port, state) in self.ports.iter().enumerate() {
+            if let Some(since) = state.lost_at {
+                let text = format!(
+                    "gap: {} is still lost (since {:.1} s before this file began)",
+                    state.name,
+                    now_ns.saturating_sub(since) as f64 * 1e-9
+                );
+                writer
+                    .comment(port as u32, now_ns, &text)
+                    .map_err(|e| self.write_error(e))?;
+                self.file_has_packets = true;
+            }
+        }
+        Ok(writer)
+    }
+
+    /// Closes the current file; the next one starts with the next thing to write.
+    fn rotate(&mut self) -> Result<(), CliError> {
+        if let Some(old) = self.writer.take() {
+            finish(old).map_err(|e| self.write_error(e))?;
+        }
+        Ok(())
+    }
+
+    /// Writes everything out and syncs the file.
+    fn close(&mut self) -> Result<(), CliError> {
+        self.rotate()
+    }
+
+    /// One line: how long, where, and bytes and frames per port.
+    fn status(&self, elapsed: Duration) -> String {
+        let files = match self.files.as_slice() {
+            [one] => one.clone(),
+            [first, .., last] => format!("{first} … {last} ({} files)", self.files.len()),
+            [] => String::new(),
+        };
+        let ports: Vec<String> = self
+            .ports
+            .iter()
+            .map(|p| {
+                format!(
+                    "{} {} bytes, {} frames",
+                    p.name,
+                    p.decoder.stats().bytes(),
+                    p.frames()
+                )
+            })
+            .collect();
+        format!(
+            "recorded {:.1} s to {files}: {}",
+            elapsed.as_secs_f64(),
+            ports.join("; ")
+        )
+    }
+}
+
+/// Creates a recording file with its headers, one interface per port.
+fn create(
+    path: &str,
+    ports: &[String],
+    baud: u32,
+) -> Result<pcapng::Writer<BufWriter<File>>, CliError> {
+    let err = |source| CliError::Write {
+        output: path.to_string(),
+        source,
+    };
+    let file = File::create(path).map_err(err)?;
+    let mut writer = pcapng::Writer::new(BufWriter::with_capacity(BUFFER, file)).map_err(err)?;
+    for port in ports {
+        writer.add_interface(port, baud).map_err(err)?;
+    }
+    writer.flush().map_err(err)?;
+    Ok(writer)
+}
+
+/// Flushes and syncs a finished file.
+fn finish(writer: pcapng::Writer<BufWriter<File>>) -> std::io::Result<()> {
+    let buffered = writer.into_inner()?;
+    let file = buffered.into_inner().map_err(|e| e.into_error())?;
+    file.sync_all()?;
+    drop(file);
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn sizes() {
+        assert_eq!(parse_size("100000"), Ok(100_000));
+        assert_eq!(parse_size("100M"), Ok(100_000_000));
+        assert_eq!(parse_size("64KiB"), Ok(65_536));
+        assert_eq!(parse_size("2G"), Ok(2_000_000_000));
+        assert!(parse_size("10").is_err());
+        assert!(parse_size("x").is_err());
+        assert!(parse_size("5 parsecs").is_err());
+        assert!(parse_size("99999999999999999999G").is_err());
+    }
+
+    #[test]
+    fn seconds() {
+        assert_eq!(parse_seconds("2.5"), Ok(2.5));
+        assert!(parse_seconds("0").is_err());
+        assert!(parse_seconds("-1").is_err());
+        assert!(parse_seconds("inf").is_err());
+    }
+
+    #[test]
+    fn numbered_names() {
+        assert_eq!(numbered("out.pcapng", 1), "out-0001.pcapng");
+        assert_eq!(
+            numbered("/tmp/a.b/run.pcapng", 12),
+            "/tmp/a.b/run-0012.pcapng"
+        );
+        assert_eq!(numbered("capture", 3), "capture-0003");
+    }
+}

@@ -1,0 +1,507 @@
+//! Serial ports: telling them from files, opening them with errors that say what to do, and
+//! reading several at once, each in its own thread, surviving a port that is unplugged.
+//!
+//! A [`PortSet`] owns one reader thread per port. Each thread hands over every chunk of bytes
+//! as soon as a read returns, with the Unix time of its first byte, as a [`PortEvent`] on a
+//! channel; a port that fails mid-read (USB unplugged: `EIO`, a hang-up, end of file) becomes a
+//! [`PortEvent::Lost`], after which the thread tries to reopen the same path every
+//! [`RETRY_EVERY`] and reports [`PortEvent::Back`] when the device has returned.
+
+use std::io::{self, Read};
+use std::path::Path;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::mpsc::{self, Receiver, Sender};
+use std::sync::{Arc, OnceLock};
+use std::thread::{self, JoinHandle};
+use std::time::{Duration, Instant, SystemTime, UNIX_EPOCH};
+
+use serialport::{DataBits, FlowControl, Parity, SerialPort, StopBits};
+
+use crate::error::CliError;
+
+/// The HW-FOC telemetry rate.
+pub const DEFAULT_BAUD: u32 = 19_200;
+
+/// How long a read waits for bytes before the thread checks whether it should stop.
+const READ_TIMEOUT: Duration = Duration::from_millis(50);
+
+/// How often a lost port is tried again.
+pub const RETRY_EVERY: Duration = Duration::from_millis(500);
+
+/// Bytes asked for per read (at 19200 baud a read rarely returns more than a frame).
+const READ_SIZE: usize = 4096;
+
+/// Whether `spec`, an input named on the command line, is a serial port rather than a file:
+/// `COM3` (or `\\.\COM12`); a character device that is a terminal; or a path under `/dev` that
+/// looks like a serial device (`/dev/ttyUSB0`, `/dev/ttyACM0`, `/dev/cu.usbserial-1`,
+/// `/dev/serial/by-id/…`, `/dev/pts/3`), even when it does not exist, so that a missing adapter
+/// is reported as a missing port.
+pub fn is_port(spec: &str) -> bool {
+    let upper = spec.to_ascii_uppercase();
+    let com = upper.strip_prefix(r"\\.\").unwrap_or(&upper);
+    if com
+        .strip_prefix("COM")
+        .is_some_and(|n| !n.is_empty() && n.bytes().all(|b| b.is_ascii_digit()))
+    {
+        return true;
+    }
+    if ["/dev/stdin", "/dev/tty", "/dev/console"].contains(&spec)
+        || spec.starts_with("/dev/fd/")
+        || spec.starts_with("/proc/")
+    {
+        return false;
+    }
+    #[cfg(unix)]
+    if let Ok(meta) = std::fs::metadata(spec) {
+        use std::os::unix::fs::FileTypeExt;
+        return meta.file_type().is_char_device() && is_terminal(spec);
+    }
+    [
+        "/dev/tty",
+        "/dev/cu.",
+        "/dev/serial/",
+        "/dev/pts/",
+        "/dev/rfcomm",
+    ]
+    .iter()
+    .any(|prefix| spec.starts_with(prefix))
+}
+
+/// Whether the character device at `path` is a terminal (opened without waiting for a carrier
+/// and without becoming our controlling terminal).
+#[cfg(unix)]
+fn is_terminal(path: &str) -> bool {
+    use std::io::IsTerminal;
+    use std::os::unix::fs::OpenOptionsExt;
+    let flags = nix::fcntl::OFlag::O_NONBLOCK | nix::fcntl::OFlag::O_NOCTTY;
+    match std::fs::OpenOptions::new()
+        .read(true)
+        .custom_flags(flags.bits())
+        .open(path)
+    {
+        Ok(file) => file.is_terminal(),
+        // Not allowed to open it: say so when it is opened as a port.
+        Err(e) => e.kind() == io::ErrorKind::PermissionDenied,
+    }
+}
+
+/// Opens `port` at `baud`, 8N1, no flow control, for exclusive use.
+pub fn open(port: &str, baud: u32) -> Result<Box<dyn SerialPort>, CliError> {
+    if cfg!(unix) {
+        match std::fs::metadata(port) {
+            Err(_) => return Err(no_such_port(port)),
+            Ok(meta) if meta.is_file() || meta.is_dir() => {
+                return Err(CliError::Port {
+                    port: port.to_string(),
+                    message: format!(
+                        "it is a {}, not a serial port (to read a capture file, use `hwfoc \
+                         decode {port}`)",
+                        if meta.is_dir() { "directory" } else { "file" }
+                    ),
+                });
+            }
+            Ok(_) => {}
+        }
+    }
+    serialport::new(port, baud)
+        .data_bits(DataBits::Eight)
+        .parity(Parity::None)
+        .stop_bits(StopBits::One)
+        .flow_control(FlowControl::None)
+        .timeout(READ_TIMEOUT)
+        .open()
+        .map_err(|e| open_error(port, e))
+}
+
+fn no_such_port(port: &str) -> CliError {
+    CliError::NoSuchPort {
+        port: port.to_string(),
+        available: available_ports(),
+    }
+}
+
+/// The serial ports the system knows of, with the USB adapter's product name where known.
+pub fn available_ports() -> Vec<String> {
+    // The sysfs scan of `serialport` panics when /sys/class/tty is missing (some containers).
+    if cfg!(target_os = "linux") && !Path::new("/sys/class/tty").is_dir() {
+        return Vec::new();
+    }
+    let mut ports: Vec<String> = serialport::available_ports()
+        .unwrap_or_default()
+        .into_iter()
+        .map(|p| match p.port_type {
+            serialport::SerialPortType::UsbPort(usb) => match usb.product {
+                Some(product) => format!("{} ({product})", p.port_name),
+                None => format!("{} (USB {:04x}:{:04x})", p.port_name, usb.vid, usb.pid),
+            },
+            _ => p.port_name,
+        })
+        .collect();
+    ports.sort();
+    ports
+}
+
+fn open_error(port: &str, e: serialport::Error) -> CliError {
+    use serialport::ErrorKind as K;
+    match e.kind() {
+        K::Io(io::ErrorKind::NotFound) => no_such_port(port),
+        K::Io(io::ErrorKind::PermissionDenied) => CliError::PortPermission {
+            port: port.to_string(),
+            group: owner_group(port),
+        },
+        // EBUSY from TIOCEXCL, or the lock another program holds.
+        K::NoDevice => CliError::PortBusy {
+            port: port.to_string(),
+        },
+        _ => CliError::Port {
+            port: port.to_string(),
+            message: e.to_string(),
+        },
+    }
+}
+
+/// The name of the group owning the device file, if it can be found.
+#[cfg(unix)]
+fn owner_group(port: &str) -> Option<String> {
+    use std::os::unix::fs::MetadataExt;
+    let gid = std::fs::metadata(port).ok()?.gid();
+    let group = nix::unistd::Group::from_gid(nix::unistd::Gid::from_raw(gid)).ok()??;
+    Some(group.name)
+}
+
+#[cfg(not(unix))]
+fn owner_group(_port: &str) -> Option<String> {
+    None
+}
+
+/// The process-wide flag set by Ctrl-C (SIGINT) or SIGTERM. The first call installs the
+/// handlers; from then on those signals no longer end the process at once but ask the command
+/// to stop cleanly, except that a second signal while the flag is set ends it immediately.
+/// If the handlers cannot be installed, the signals keep their default action.
+pub fn interrupted() -> Arc<AtomicBool> {
+    static FLAG: OnceLock<Arc<AtomicBool>> = OnceLock::new();
+    FLAG.get_or_init(|| {
+        let flag = Arc::new(AtomicBool::new(false));
+        for signal in [signal_hook::consts::SIGINT, signal_hook::consts::SIGTERM] {
+            // Order matters: the conditional shutdown sees the flag as it was before this signal.
+            let _ =
+                signal_hook::flag::register_conditional_shutdown(signal, 130, Arc::clone(&flag));
+            let _ = signal_hook::flag::register(signal, Arc::clone(&flag));
+        }
+        flag
+    })
+    .clone()
+}
+
+/// Unix time in nanoseconds that never goes backwards: the wall clock when the clock was made,
+/// advanced by a monotonic clock (so that a clock step during a recording does not reorder it).
+#[derive(Debug, Clone, Copy)]
+pub struct Clock {
+    wall_ns: u64,
+    start: Instant,
+}
+
+impl Clock {
+    /// A clock anchored at the wall-clock time now.
+    pub fn new() -> Clock {
+        let wall_ns = SystemTime::now()
+            .duration_since(UNIX_EPOCH)
+            .map_or(0, |d| d.as_nanos() as u64);
+        Clock {
+            wall_ns,
+            start: Instant::now(),
+        }
+    }
+
+    /// Unix time now, in nanoseconds.
+    pub fn now_ns(&self) -> u64 {
+        self.wall_ns + self.start.elapsed().as_nanos() as u64
+    }
+}
+
+impl Default for Clock {
+    fn default() -> Self {
+        Clock::new()
+    }
+}
+
+/// What a port's reader thread reports.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum PortEvent {
+    /// Bytes received.
+    Data {
+        /// Index of the port in the set.
+        port: usize,
+        /// Unix time in nanoseconds of the first byte: the time the read returned less the
+        /// wire time of the bytes after the first, never earlier than just after the previous
+        /// chunk's last byte.
+        t_ns: u64,
+        /// The bytes.
+        bytes: Vec<u8>,
+    },
+    /// The port failed mid-read (unplugged); the thread now tries to reopen it.
+    Lost {
+        /// Index of the port in the set.
+        port: usize,
+        /// Unix time in nanoseconds when the failure was seen.
+        t_ns: u64,
+        /// What the operating system said.
+        reason: String,
+    },
+    /// A lost port was reopened.
+    Back {
+        /// Index of the port in the set.
+        port: usize,
+        /// Unix time in nanoseconds when it was reopened.
+        t_ns: u64,
+    },
+}
+
+/// Several serial ports read at once, one thread per port, events on one channel.
+pub struct PortSet {
+    names: Vec<String>,
+    baud: u32,
+    clock: Clock,
+    events: Receiver<PortEvent>,
+    stop: Arc<AtomicBool>,
+    threads: Vec<JoinHandle<()>>,
+}
+
+impl PortSet {
+    /// Opens every port (all of them, before any reading starts, so that a bad name is
+    /// reported at once) and starts their reader threads.
+    pub fn open(names: &[String], baud: u32) -> Result<PortSet, CliError> {
+        if let Some((i, name)) = names
+            .iter()
+            .enumerate()
+            .find(|(i, name)| names[..*i].contains(name))
+        {
+            return Err(CliError::Port {
+                port: name.clone(),
+                message: format!(
+                    "it is named twice (as port {} and port {})",
+                    names.iter().position(|n| n == name).unwrap_or(0) + 1,
+                    i + 1
+                ),
+            });
+        }
+        let ports = names
+            .iter()
+            .map(|name| open(name, baud))
+            .collect::<Result<Vec<_>, _>>()?;
+        let clock = Clock::new();
+        let stop = Arc::new(AtomicBool::new(false));
+        let (tx, events) = mpsc::channel();
+        let threads = ports
+            .into_iter()
+            .enumerate()
+            .map(|(index, port)| {
+                let reader = PortReader {
+                    index,
+                    name: names[index].clone(),
+                    baud,
+                    clock,
+                    stop: Arc::clone(&stop),
+                    tx: tx.clone(),
+                    last_ns: None,
+                };
+                thread::Builder::new()
+                    .name(format!("read {}", names[index]))
+                    .spawn(move || reader.run(port))
+                    .map_err(|e| CliError::Port {
+                        port: names[index].clone(),
+                        message: format!("cannot start its reader thread: {e}"),
+                    })
+            })
+            .collect::<Result<Vec<_>, _>>()?;
+        Ok(PortSet {
+            names: names.to_vec(),
+            baud,
+            clock,
+            events,
+            stop,
+            threads,
+        })
+    }
+
+    /// The ports, in the order given.
+    pub fn names(&self) -> &[String] {
+        &self.names
+    }
+
+    /// The baud rate of every port.
+    pub fn baud(&self) -> u32 {
+        self.baud
+    }
+
+    /// The clock the events' times come from.
+    pub fn clock(&self) -> Clock {
+        self.clock
+    }
+
+    /// The next event, waiting at most `timeout`; `None` if none came.
+    pub fn next_event(&self, timeout: Duration) -> Option<PortEvent> {
+        self.events.recv_timeout(timeout).ok()
+    }
+
+    /// The next event if one is waiting.
+    pub fn try_event(&self) -> Option<PortEvent> {
+        self.events.try_recv().ok()
+    }
+
+    /// Stops the reader threads, waits for them, and returns the events they sent before
+    /// stopping (bytes received up to the end are not lost).
+    pub fn close(mut self) -> Vec<PortEvent> {
+        self.shut_down();
+        self.events.try_iter().collect()
+    }
+
+    fn shut_down(&mut self) {
+        self.stop.store(true, Ordering::Relaxed);
+        for thread in self.threads.drain(..) {
+            let _ = thread.join();
+        }
+    }
+}
+
+impl Drop for PortSet {
+    fn drop(&mut self) {
+        self.shut_down();
+    }
+}
+
+/// One port's reader thread.
+struct PortReader {
+    index: usize,
+    name: String,
+    baud: u32,
+    clock: Clock,
+    stop: Arc<AtomicBool>,
+    tx: Sender<PortEvent>,
+    /// Time of the previous chunk's last byte.
+    last_ns: Option<u64>,
+}
+
+impl PortReader {
+    fn run(mut self, port: Box<dyn SerialPort>) {
+        let mut port = Some(port);
+        let mut buf = vec![0u8; READ_SIZE];
+        while !self.stop.load(Ordering::Relaxed) {
+            let Some(p) = port.as_mut() else {
+                port = self.reopen();
+                continue;
+            };
+            let failure = match p.read(&mut buf) {
+                Ok(0) => Some("the device reported end of file".to_string()),
+                Ok(n) => {
+                    self.received(&buf[..n]);
+                    None
+                }
+                Err(e)
+                    if matches!(
+                        e.kind(),
+                        io::ErrorKind::TimedOut
+                            | io::ErrorKind::WouldBlock
+                            | io::ErrorKind::Interrupted
+                    ) =>
+                {
+                    None
+                }
+                Err(e) => Some(e.to_string()),
+            };
+            if let Some(reason) = failure {
+                port = None;
+                let event = PortEvent::Lost {
+                    port: self.index,
+                    t_ns: self.clock.now_ns(),
+                    reason,
+                };
+                if self.tx.send(event).is_err() {
+                    return;
+                }
+            }
+        }
+    }
+
+    fn received(&mut self, bytes: &[u8]) {
+        let per_byte = crate::pcapng::byte_ns(self.baud);
+        let now = self.clock.now_ns();
+        let span = ((bytes.len() - 1) as f64 * per_byte) as u64;
+        let mut t_ns = now.saturating_sub(span);
+        if let Some(last) = self.last_ns {
+            t_ns = t_ns.max(last + per_byte as u64);
+        }
+        self.last_ns = Some(t_ns + span);
+        let _ = self.tx.send(PortEvent::Data {
+            port: self.index,
+            t_ns,
+            bytes: bytes.to_vec(),
+        });
+    }
+
+    /// Waits [`RETRY_EVERY`] (or until asked to stop) and tries to open the port again.
+    fn reopen(&mut self) -> Option<Box<dyn SerialPort>> {
+        let until = Instant::now() + RETRY_EVERY;
+        while Instant::now() < until {
+            if self.stop.load(Ordering::Relaxed) {
+                return None;
+            }
+            thread::sleep(Duration::from_millis(20));
+        }
+        let port = open(&self.name, self.baud).ok()?;
+        let event = PortEvent::Back {
+            port: self.index,
+            t_ns: self.clock.now_ns(),
+        };
+        self.tx.send(event).ok()?;
+        Some(port)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn port_names() {
+        for port in [
+            "COM3",
+            "com12",
+            r"\\.\COM10",
+            "/dev/ttyUSB9",
+            "/dev/serial/by-id/x",
+        ] {
+            assert!(is_port(port), "{port}");
+        }
+        for file in [
+            "COM",
+            "COMX",
+            "capture.bin",
+            "-",
+            "/dev/null",
+            "/dev/stdin",
+            "/tmp",
+        ] {
+            assert!(!is_port(file), "{file}");
+        }
+    }
+
+    #[test]
+    fn missing_port_is_named() {
+        let e = open("/dev/ttyUSB_hwfoc_test_missing", 19200).err().unwrap();
+        assert!(
+            e.to_string()
+                .starts_with("no such port /dev/ttyUSB_hwfoc_test_missing"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn clock_is_unix_time_and_monotonic() {
+        let clock = Clock::new();
+        let a = clock.now_ns();
+        let b = clock.now_ns();
+        assert!(b >= a);
+        assert!(a > 1_600_000_000_000_000_000);
+    }
+}

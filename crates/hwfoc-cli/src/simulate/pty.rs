@@ -1,0 +1,229 @@
+//! Pseudo-terminals that behave like the far end of a serial cable, and stable symlinks to them.
+//!
+//! Each virtual ESC gets a pty pair; programs open the slave side (`/dev/pts/N`) exactly like a
+//! serial port. The slave is put in raw mode once, at creation (so even `cat` reads the bytes
+//! unchanged; programs that set their own modes are welcome to), and then closed: we keep only
+//! the master.
+//!
+//! A real ESC's bytes are lost when no one listens on the wire, and a port that is opened gets
+//! what arrives from then on. The pty does the same: the kernel reports a hang-up on the master
+//! while no process has the slave open, and bytes are then counted as undelivered instead of
+//! piling up in the terminal's buffer (where the next reader would find seconds of stale
+//! frames). The master is non-blocking: a reader that has the port open but stops reading
+//! fills the kernel's buffer (a few KiB), after which bytes are dropped and counted, never
+//! blocking the simulation. A reader may close and reopen the port at any time. Anything a
+//! reader writes to the port is read and discarded.
+
+use std::fs::File;
+use std::io::{self, Read, Write};
+use std::os::fd::AsFd;
+use std::path::{Path, PathBuf};
+
+use nix::fcntl::{FcntlArg, OFlag, fcntl};
+use nix::poll::{PollFd, PollFlags, PollTimeout, poll};
+use nix::pty::openpty;
+use nix::sys::termios::{SetArg, cfmakeraw, tcgetattr, tcsetattr};
+
+use crate::error::CliError;
+
+/// One pseudo-terminal: our master side and the path of the slave.
+pub struct Pty {
+    master: File,
+    path: PathBuf,
+    undelivered: u64,
+}
+
+impl Pty {
+    /// Creates a pty in raw mode.
+    pub fn open() -> Result<Pty, CliError> {
+        let err = |e: nix::Error| CliError::Pty {
+            source: io::Error::from(e),
+        };
+        let pair = openpty(None, None).map_err(err)?;
+        let mut mode = tcgetattr(&pair.slave).map_err(err)?;
+        cfmakeraw(&mut mode);
+        tcsetattr(&pair.slave, SetArg::TCSANOW, &mode).map_err(err)?;
+        let path = nix::unistd::ttyname(&pair.slave).map_err(err)?;
+        drop(pair.slave);
+        let flags = fcntl(&pair.master, FcntlArg::F_GETFL).map_err(err)?;
+        let flags = OFlag::from_bits_truncate(flags) | OFlag::O_NONBLOCK;
+        fcntl(&pair.master, FcntlArg::F_SETFL(flags)).map_err(err)?;
+        Ok(Pty {
+            master: File::from(pair.master),
+            path,
+            undelivered: 0,
+        })
+    }
+
+    /// The slave's path, to open like a serial port.
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
+
+    /// Bytes that found no reader (or a full buffer) so far.
+    pub fn undelivered(&self) -> u64 {
+        self.undelivered
+    }
+
+    /// Whether some process has the slave side open.
+    pub fn has_reader(&self) -> bool {
+        let mut fds = [PollFd::new(self.master.as_fd(), PollFlags::POLLOUT)];
+        match poll(&mut fds, PollTimeout::ZERO) {
+            Ok(_) => !fds[0]
+                .revents()
+                .is_some_and(|r| r.contains(PollFlags::POLLHUP)),
+            Err(_) => false,
+        }
+    }
+
+    /// Writes `bytes` if a reader has the port open and room in its buffer; whether all went.
+    pub fn write(&mut self, bytes: &[u8]) -> bool {
+        self.discard_input();
+        let sent = if self.has_reader() {
+            // An error is EAGAIN (buffer full) or EIO (the reader went away just now).
+            self.master.write(bytes).unwrap_or_default()
+        } else {
+            0
+        };
+        self.undelivered += (bytes.len() - sent) as u64;
+        sent == bytes.len()
+    }
+
+    /// Reads and throws away what the reader wrote to the port, so that it never blocks.
+    fn discard_input(&mut self) {
+        let mut buf = [0u8; 512];
+        for _ in 0..16 {
+            match self.master.read(&mut buf) {
+                Ok(n) if n > 0 => continue,
+                _ => break,
+            }
+        }
+    }
+}
+
+/// Symlinks to the ptys at stable paths, removed again when dropped (also on an error or
+/// Ctrl-C) if they still point at our pty.
+#[derive(Default)]
+pub struct Links {
+    made: Vec<(PathBuf, PathBuf)>,
+}
+
+impl Links {
+    /// Makes `link` point at `target`. A symlink already there (left by an earlier run that was
+    /// killed) is replaced; anything else is an error.
+    pub fn add(&mut self, link: &Path, target: &Path) -> Result<(), CliError> {
+        let err = |source: io::Error| CliError::Link {
+            path: link.display().to_string(),
+            source,
+        };
+        if let Ok(meta) = std::fs::symlink_metadata(link) {
+            if !meta.file_type().is_symlink() {
+                return Err(err(io::Error::new(
+                    io::ErrorKind::AlreadyExists,
+                    "it exists and is not a symbolic link",
+                )));
+            }
+            std::fs::remove_file(link).map_err(err)?;
+        }
+        std::os::unix::fs::symlink(target, link).map_err(err)?;
+        self.made.push((link.to_path_buf(), target.to_path_buf()));
+        Ok(())
+    }
+}
+
+impl Drop for Links {
+    fn drop(&mut self) {
+        for (link, target) in &self.made {
+            if std::fs::read_link(link).is_ok_and(|t| t == *target) {
+                let _ = std::fs::remove_file(link);
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::os::unix::fs::OpenOptionsExt;
+
+    fn open_reader(path: &Path) -> File {
+        std::fs::OpenOptions::new()
+            .read(true)
+            .write(true)
+            .custom_flags(libc_flags())
+            .open(path)
+            .unwrap()
+    }
+
+    fn libc_flags() -> i32 {
+        (OFlag::O_NOCTTY | OFlag::O_NONBLOCK).bits()
+    }
+
+    fn read_now(f: &mut File) -> Vec<u8> {
+        let mut out = Vec::new();
+        let mut buf = [0u8; 4096];
+        while let Ok(n) = f.read(&mut buf) {
+            if n == 0 {
+                break;
+            }
+            out.extend_from_slice(&buf[..n]);
+        }
+        out
+    }
+
+    #[test]
+    fn bytes_reach_a_reader_only_while_it_listens() {
+        let mut pty = Pty::open().unwrap();
+        assert!(pty.path().starts_with("/dev/"));
+        assert!(!pty.has_reader());
+        // Nobody listening: nothing blocks, nothing piles up.
+        for _ in 0..2000 {
+            assert!(!pty.write(&[0x9B; 24]));
+        }
+        assert_eq!(pty.undelivered(), 48_000);
+        let mut reader = open_reader(pty.path());
+        assert!(pty.has_reader());
+        // Raw mode: every byte value passes unchanged, no echo, no line buffering.
+        let all: Vec<u8> = (0..=255).collect();
+        assert!(pty.write(&all));
+        reader.write_all(b"ignored\n").unwrap();
+        std::thread::sleep(std::time::Duration::from_millis(20));
+        assert_eq!(read_now(&mut reader), all);
+        assert!(pty.write(b"x"));
+        // Reader closes and reopens: it gets what comes from then on.
+        drop(reader);
+        assert!(!pty.write(b"lost"));
+        let mut reader = open_reader(pty.path());
+        assert!(pty.write(b"again"));
+        std::thread::sleep(std::time::Duration::from_millis(20));
+        let got = read_now(&mut reader);
+        assert!(got.ends_with(b"again") && !got.windows(4).any(|w| w == b"lost"));
+        // A reader that stops reading: the buffer fills, then bytes are dropped, never blocking.
+        let before = pty.undelivered();
+        for _ in 0..10_000 {
+            pty.write(&[0x55; 24]);
+        }
+        assert!(pty.undelivered() > before);
+    }
+
+    #[test]
+    fn links_replace_stale_ones_and_go_away() {
+        let dir = tempfile::tempdir().unwrap();
+        let link = dir.path().join("esc0");
+        std::os::unix::fs::symlink("/nonexistent", &link).unwrap();
+        let file = dir.path().join("file");
+        std::fs::write(&file, b"keep").unwrap();
+        {
+            let mut links = Links::default();
+            links.add(&link, Path::new("/dev/null")).unwrap();
+            assert_eq!(std::fs::read_link(&link).unwrap(), Path::new("/dev/null"));
+            let e = links.add(&file, Path::new("/dev/null")).unwrap_err();
+            assert!(
+                e.to_string().contains("exists and is not a symbolic link"),
+                "{e}"
+            );
+        }
+        assert!(std::fs::symlink_metadata(&link).is_err());
+        assert_eq!(std::fs::read(&file).unwrap(), b"keep");
+    }
+}

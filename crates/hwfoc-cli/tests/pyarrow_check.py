@@ -1,0 +1,102 @@
+#!/usr/bin/env python3
+"""Checks `hwfoc decode --format parquet` with pyarrow, as a data scientist would read the file.
+
+Usage: pyarrow_check.py HWFOC [WORKDIR]
+
+HWFOC is the path of the hwfoc binary. The script exports the built-in demo capture twice, as
+Parquet and as JSON Lines, under non-default settings, then asserts with pyarrow: the column names,
+types and nullability of RECORD-SCHEMA.md, the unit of each column in the field metadata, the
+settings, version, inputs and ESCs in the file's key-value metadata, and every value equal to the
+JSON Lines record of the same row. Needs pyarrow only (no numpy, no pandas). Exits non-zero with a
+message on the first difference; prints "1 passed, 0 failed" when all is well.
+"""
+
+import json
+import os
+import struct
+import subprocess
+import sys
+import tempfile
+
+import pyarrow as pa
+import pyarrow.parquet as pq
+
+SCHEMA = [
+    ("t_s", pa.float64(), True, "s"),
+    ("esc", pa.uint8(), False, "-"),
+    ("packet", pa.uint16(), False, "-"),
+    ("throttle_in_pct", pa.float32(), False, "%"),
+    ("throttle_out_pct", pa.float32(), False, "%"),
+    ("erpm", pa.uint32(), False, "rev/min"),
+    ("rpm", pa.float32(), False, "rev/min"),
+    ("voltage_v", pa.float32(), False, "V"),
+    ("current_a", pa.float32(), False, "A"),
+    ("phase_current_a", pa.float32(), False, "A"),
+    ("mos_temp_c", pa.float32(), True, "degC"),
+    ("cap_temp_c", pa.float32(), True, "degC"),
+    ("status", pa.uint16(), False, "-"),
+    ("faults", pa.list_(pa.field("item", pa.string(), nullable=False)), False, "-"),
+]
+
+SETTINGS = {"current_scale": "100", "pole_pairs": "14", "gear_ratio": "2.5"}
+
+
+def f32(x):
+    """The float32 nearest to a JSON number (the JSON text is the shortest text of a float32)."""
+    return struct.unpack("<f", struct.pack("<f", x))[0]
+
+
+def check(cond, message):
+    if not cond:
+        sys.exit(f"pyarrow_check: {message}")
+
+
+def main():
+    if len(sys.argv) not in (2, 3):
+        sys.exit(__doc__.split("\n\n")[1])
+    hwfoc = sys.argv[1]
+    work = sys.argv[2] if len(sys.argv) == 3 else tempfile.mkdtemp(prefix="hwfoc-pyarrow-")
+    os.makedirs(work, exist_ok=True)
+    parquet_path = os.path.join(work, "demo.parquet")
+    settings = [arg for k, v in SETTINGS.items() for arg in (f"--{k.replace('_', '-')}", v)]
+    base = [hwfoc, "decode", "--demo", *settings]
+    subprocess.run([*base, "--format", "parquet", "-o", parquet_path], check=True)
+    lines = subprocess.run(base, check=True, capture_output=True, text=True).stdout.splitlines()
+    records = [json.loads(line) for line in lines]
+    check(len(records) > 100, f"only {len(records)} JSON records")
+
+    schema = pq.read_schema(parquet_path)
+    check(schema.names == [name for name, *_ in SCHEMA], f"column names {schema.names}")
+    for field, (name, typ, nullable, unit) in zip(schema, SCHEMA):
+        check(field.type == typ, f"{name}: type {field.type}, expected {typ}")
+        check(field.nullable == nullable, f"{name}: nullable {field.nullable}")
+        meta = field.metadata or {}
+        check(meta.get(b"unit") == unit.encode(), f"{name}: unit {meta.get(b'unit')!r}, expected {unit!r}")
+
+    kv = pq.ParquetFile(parquet_path).metadata.metadata
+    for key, value in SETTINGS.items():
+        check(kv.get(key.encode()) == value.encode(), f"metadata {key}: {kv.get(key.encode())!r}")
+    check(kv.get(b"hwfoc_version", b"") != b"", "no hwfoc_version in the metadata")
+    check(json.loads(kv[b"inputs"]) == ["demo capture"], f"inputs {kv[b'inputs']!r}")
+    escs = json.loads(kv[b"escs"])
+    check(escs == [{"esc": 0, "input": "demo capture", "stream": "demo capture"}], f"escs {escs}")
+
+    table = pq.read_table(parquet_path)
+    check(table.num_rows == len(records), f"{table.num_rows} rows, {len(records)} JSON records")
+    rows = table.to_pylist()
+    floats = {name for name, typ, *_ in SCHEMA if typ == pa.float32()}
+    for i, (row, record) in enumerate(zip(rows, records)):
+        check(list(row) == list(record), f"row {i}: keys {list(row)}")
+        for name, value in record.items():
+            got = row[name]
+            if name in floats and value is not None:
+                value = f32(value)
+            check(got == value, f"row {i} {name}: parquet {got!r}, JSON {value!r}")
+    # The demo has a fault episode: the list column holds names, not just empty lists.
+    check(any(r["faults"] for r in rows), "no faults in the demo's records")
+    print("pyarrow_check: %d rows, schema, units and metadata as RECORD-SCHEMA.md" % len(rows))
+    print("1 passed, 0 failed")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,469 @@
+//! End-to-end tests of `hwfoc simulate`: what the virtual ESCs send decodes (with `hwfoc decode`
+//! or the codec) to exactly the ground truth they write, with and without link faults; the
+//! same seed gives the same bytes; frame timing; pseudo-terminals; errors.
+
+#![cfg(unix)]
+
+use std::io::{BufRead, BufReader, Read};
+use std::os::unix::fs::OpenOptionsExt;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output, Stdio};
+use std::time::{Duration, Instant};
+
+use hwfoc::{Decoder, Frame};
+use serde_json::Value;
+
+fn hwfoc() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_hwfoc"))
+}
+
+fn run(args: &[&str]) -> Output {
+    hwfoc().args(args).output().expect("run hwfoc")
+}
+
+fn ok(o: Output) -> Output {
+    assert!(
+        o.status.success(),
+        "hwfoc failed: {}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    o
+}
+
+/// Asserts a failure with one line on stderr containing `needle`, and no panic.
+fn assert_fails_with(o: &Output, needle: &str) {
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "stderr: {err}");
+    assert!(err.contains(needle), "{needle:?} not in {err:?}");
+    assert_eq!(err.lines().count(), 1, "one line expected: {err:?}");
+    assert!(err.starts_with("hwfoc: "), "{err}");
+}
+
+fn jsonl(text: &[u8]) -> Vec<Value> {
+    std::str::from_utf8(text)
+        .unwrap()
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap())
+        .collect()
+}
+
+fn read_jsonl(path: &Path) -> Vec<Value> {
+    jsonl(&std::fs::read(path).unwrap())
+}
+
+fn decode(path: &Path) -> Vec<Value> {
+    jsonl(&ok(run(&["decode", path.to_str().unwrap()])).stdout)
+}
+
+fn without(mut records: Vec<Value>, keys: &[&str]) -> Vec<Value> {
+    for r in &mut records {
+        for k in keys {
+            r.as_object_mut().unwrap().remove(*k);
+        }
+    }
+    records
+}
+
+struct Dir(tempfile::TempDir);
+
+impl Dir {
+    fn new() -> Dir {
+        Dir(tempfile::tempdir().unwrap())
+    }
+    fn path(&self, name: &str) -> PathBuf {
+        self.0.path().join(name)
+    }
+    fn arg(&self, name: &str) -> String {
+        self.path(name).to_str().unwrap().to_string()
+    }
+}
+
+const FAULTY: [&str; 8] = [
+    "--bit-error-rate",
+    "5e-4",
+    "--drop-rate",
+    "0.03",
+    "--cut-rate",
+    "0.03",
+    "--garbage-rate",
+    "0.1",
+];
+
+#[test]
+fn raw_file_decodes_to_the_truth() {
+    let dir = Dir::new();
+    for faulty in [false, true] {
+        let mut args = vec![
+            "simulate".to_string(),
+            "-o".into(),
+            dir.arg("run.bin"),
+            "--truth".into(),
+            dir.arg("truth.jsonl"),
+            "--fault".into(),
+            "mos_overheat@3-4".into(),
+            "--quiet".into(),
+        ];
+        if faulty {
+            args.extend(FAULTY.iter().map(|s| s.to_string()));
+        }
+        let o = ok(hwfoc().args(&args).output().unwrap());
+        assert!(o.stderr.is_empty());
+        let truth = read_jsonl(&dir.path("truth.jsonl"));
+        let decoded = decode(&dir.path("run.bin"));
+        // Default: lead-in 2 s + 7 steps of 2 s + 2 s = 18 s.
+        assert!(
+            truth.len() > if faulty { 180 } else { 220 },
+            "{}",
+            truth.len()
+        );
+        // Raw bytes carry no time; the truth has the simulated time.
+        assert!(decoded.iter().all(|r| r["t_s"].is_null()));
+        let t: Vec<f64> = truth.iter().map(|r| r["t_s"].as_f64().unwrap()).collect();
+        assert!(t[0] >= 0.0 && t[0] < 1.0, "{}", t[0]);
+        assert!(*t.last().unwrap() < 18.0);
+        assert!(t.windows(2).all(|w| w[1] > w[0]));
+        let untimed: Vec<Value> = truth
+            .iter()
+            .cloned()
+            .map(|mut r| {
+                r["t_s"] = Value::Null;
+                r
+            })
+            .collect();
+        assert_eq!(decoded, untimed);
+        // The injected fault is there, and the model's values move.
+        assert!(
+            truth
+                .iter()
+                .any(|r| r["faults"] == serde_json::json!(["mos_overheat"]))
+        );
+        assert!(
+            truth
+                .iter()
+                .any(|r| r["current_a"].as_f64().unwrap() < -1.0)
+        );
+        assert!(truth.iter().any(|r| r["rpm"].as_f64().unwrap() > 8000.0));
+    }
+}
+
+#[test]
+fn recording_decodes_to_the_truth_with_times() {
+    let dir = Dir::new();
+    let mut args = vec![
+        "simulate",
+        "--escs",
+        "3",
+        "--seed",
+        "9",
+        "--start-time",
+        "1700000000.25",
+        "--start-packet",
+        "65530",
+        "--quiet",
+    ];
+    args.extend(FAULTY);
+    // One recording with an interface per ESC, and one recording per ESC.
+    let all = dir.arg("all.pcapng");
+    let each = dir.arg("esc{esc}.pcapng");
+    let truth = dir.arg("truth.jsonl");
+    ok(hwfoc()
+        .args(&args)
+        .args(["-o", &all, "--truth", &truth])
+        .output()
+        .unwrap());
+    let truth = read_jsonl(&dir.path("truth.jsonl"));
+    let first = truth[0]["t_s"].as_f64().unwrap();
+    assert!((1_700_000_000.25..1_700_000_000.31).contains(&first));
+    // Each interface is one ESC: the records match in every field, esc and t_s included.
+    let key = |r: &Value| (r["t_s"].as_f64().unwrap().to_bits(), r["esc"].as_u64());
+    let mut decoded = decode(&dir.path("all.pcapng"));
+    let mut expected = truth.clone();
+    decoded.sort_by_key(key);
+    expected.sort_by_key(key);
+    assert_eq!(decoded, expected);
+
+    ok(hwfoc().args(&args).args(["-o", &each]).output().unwrap());
+    for esc in 0..3u64 {
+        let decoded = without(decode(&dir.path(&format!("esc{esc}.pcapng"))), &["esc"]);
+        let expected: Vec<Value> = truth.iter().filter(|r| r["esc"] == esc).cloned().collect();
+        assert_eq!(decoded, without(expected, &["esc"]), "esc {esc}");
+        // Packet numbers wrap.
+        let packets: Vec<u64> = decoded
+            .iter()
+            .map(|r| r["packet"].as_u64().unwrap())
+            .collect();
+        assert!(
+            packets[0] >= 65530 && packets.iter().any(|&p| p < 100),
+            "{packets:?}"
+        );
+    }
+}
+
+#[test]
+fn frame_timing_from_a_recording() {
+    let dir = Dir::new();
+    let file = dir.arg("t.pcapng");
+    // Idle 2 s, 50 % for 2 s, idle 3 s.
+    std::fs::write(
+        dir.path("p.csv"),
+        "time_s,throttle_percent\n0,0\n2,0\n2,50\n4,50\n4,0\n",
+    )
+    .unwrap();
+    let profile = format!("csv:{}", dir.arg("p.csv"));
+    ok(run(&[
+        "simulate",
+        "-o",
+        &file,
+        "--profile",
+        &profile,
+        "--duration",
+        "7",
+        "--start-time",
+        "0",
+        "--quiet",
+    ]));
+    let records = decode(&dir.path("t.pcapng"));
+    let idle = |r: &Value| r["erpm"] == 0 && r["throttle_out_pct"] == 0.0;
+    let (mut runs, mut idles) = (0, 0);
+    for w in records.windows(2) {
+        let gap_ms = (w[1]["t_s"].as_f64().unwrap() - w[0]["t_s"].as_f64().unwrap()) * 1e3;
+        match (idle(&w[0]), idle(&w[1])) {
+            (false, false) => {
+                assert!((gap_ms - 50.0).abs() < 1e-3, "{gap_ms}");
+                runs += 1;
+            }
+            (_, true) => {
+                assert!((gap_ms - 364.0).abs() < 1e-3, "{gap_ms}");
+                idles += 1;
+            }
+            (true, false) => assert!(gap_ms < 364.0),
+        }
+    }
+    assert!(runs >= 40 && idles >= 10, "{runs} {idles}");
+
+    // Device information: 40 ms after each idle data frame, straight from the recording's bytes.
+    let bytes = std::fs::read(dir.path("t.pcapng")).unwrap();
+    let mut info = 0;
+    Decoder::new().decode_all(&bytes, |d| {
+        if matches!(d.frame, Frame::Info(_)) {
+            info += 1;
+        }
+    });
+    let idle_times: Vec<f64> = records
+        .iter()
+        .filter(|r| idle(r))
+        .map(|r| r["t_s"].as_f64().unwrap())
+        .collect();
+    let cut_off = usize::from(idle_times.last().unwrap() + 0.040 >= 7.0);
+    assert_eq!(info, idle_times.len() - cut_off, "one per idle data frame");
+}
+
+#[test]
+fn same_seed_same_bytes() {
+    let dir = Dir::new();
+    let go = |seed: &str, name: &str| {
+        let mut args = vec![
+            "simulate",
+            "--escs",
+            "2",
+            "--seed",
+            seed,
+            "--duration",
+            "6",
+            "--start-time",
+            "1",
+            "--quiet",
+        ];
+        args.extend(FAULTY);
+        let out = dir.arg(name);
+        ok(hwfoc().args(&args).args(["-o", &out]).output().unwrap());
+        std::fs::read(dir.path(name)).unwrap()
+    };
+    let a = go("7", "a.pcapng");
+    assert!(a.len() > 5000);
+    assert_eq!(a, go("7", "b.pcapng"));
+    assert_ne!(a, go("8", "c.pcapng"));
+    // Standard output carries the same raw bytes as a file.
+    let file = dir.arg("one.bin");
+    ok(run(&[
+        "simulate",
+        "--duration",
+        "3",
+        "-o",
+        &file,
+        "--quiet",
+    ]));
+    let piped = ok(run(&["simulate", "--duration", "3", "--quiet"])).stdout;
+    assert_eq!(piped, std::fs::read(dir.path("one.bin")).unwrap());
+}
+
+/// Reads what arrives on `path` until `until`, without blocking.
+fn read_for(path: &str, until: Instant) -> Vec<u8> {
+    let mut port = std::fs::OpenOptions::new()
+        .read(true)
+        .custom_flags((nix::fcntl::OFlag::O_NOCTTY | nix::fcntl::OFlag::O_NONBLOCK).bits())
+        .open(path)
+        .expect("open the pty");
+    let mut got = Vec::new();
+    let mut buf = [0u8; 4096];
+    while Instant::now() < until {
+        match port.read(&mut buf) {
+            Ok(n) if n > 0 => got.extend_from_slice(&buf[..n]),
+            Ok(_) => break,
+            Err(e) if e.kind() == std::io::ErrorKind::WouldBlock => {
+                std::thread::sleep(Duration::from_millis(10))
+            }
+            Err(_) => break,
+        }
+    }
+    got
+}
+
+#[test]
+fn pseudo_terminals_carry_the_frames_in_real_time() {
+    let dir = Dir::new();
+    let links = dir.path("links");
+    let truth = dir.arg("truth.jsonl");
+    let started = Instant::now();
+    let mut child = hwfoc()
+        .args([
+            "simulate",
+            "--pty",
+            "--escs",
+            "2",
+            "--seed",
+            "3",
+            "--start-packet",
+            "100",
+        ])
+        .args([
+            "--lead-in",
+            "0.5",
+            "--levels",
+            "30,60",
+            "--truth",
+            &truth,
+            "--link-dir",
+        ])
+        .arg(&links)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut lines = BufReader::new(child.stdout.take().unwrap()).lines();
+    let mut paths = Vec::new();
+    for esc in 0..2 {
+        let line = lines.next().unwrap().unwrap();
+        let path = line
+            .strip_prefix(&format!("esc {esc}: "))
+            .unwrap_or_else(|| panic!("{line:?}"));
+        assert!(path.starts_with("/dev/"), "{path}");
+        assert_eq!(
+            std::fs::read_link(links.join(format!("esc{esc}"))).unwrap(),
+            Path::new(path)
+        );
+        paths.push(path.to_string());
+    }
+    // ESC 1 through its link, ESC 0 by its path; both while the simulation runs.
+    let link1 = links.join("esc1").to_str().unwrap().to_string();
+    let until = started + Duration::from_millis(2500);
+    let reader1 = std::thread::spawn(move || read_for(&link1, until));
+    let got0 = read_for(&paths[0], until);
+    let got1 = reader1.join().unwrap();
+    // Ctrl-C: a clean stop that removes the links.
+    nix::sys::signal::kill(
+        nix::unistd::Pid::from_raw(child.id() as i32),
+        nix::sys::signal::Signal::SIGINT,
+    )
+    .unwrap();
+    let status = child.wait().unwrap();
+    assert!(status.success());
+    assert!(!links.join("esc0").exists() && !links.join("esc1").exists());
+    let elapsed = started.elapsed();
+    assert!(elapsed < Duration::from_secs(5), "{elapsed:?}");
+
+    let truth = read_jsonl(&dir.path("truth.jsonl"));
+    for (esc, got) in [got0, got1].iter().enumerate() {
+        let mut frames = Vec::new();
+        Decoder::new().decode_all(got, |d| {
+            if let Frame::Data(f) = d.frame {
+                frames.push(f);
+            }
+        });
+        // About 2.4 s: idle frames, then 50 ms frames once the steps start at 0.5 s.
+        assert!(frames.len() >= 25, "esc {esc}: {} frames", frames.len());
+        // Every frame received is in the truth with the same values, and frames arrived in
+        // real time: the run took as long as the frames say.
+        for f in &frames {
+            let r = truth
+                .iter()
+                .find(|r| r["esc"] == esc && r["packet"] == f.packet)
+                .unwrap_or_else(|| panic!("esc {esc} packet {} not in the truth", f.packet));
+            assert_eq!(r["erpm"], f.erpm());
+            assert_eq!(r["voltage_v"].as_f64().unwrap() as f32, f.voltage_v());
+        }
+        let first = truth.iter().find(|r| r["esc"] == esc).unwrap();
+        let last = truth.iter().rev().find(|r| r["esc"] == esc).unwrap();
+        let span = last["t_s"].as_f64().unwrap() - first["t_s"].as_f64().unwrap();
+        assert!((1.8..3.0).contains(&span), "{span}");
+    }
+}
+
+#[test]
+fn errors_name_what_is_wrong() {
+    let dir = Dir::new();
+    assert_fails_with(
+        &run(&["simulate", "-o", "/nonexistent/dir/x.bin"]),
+        "cannot write /nonexistent/dir/x.bin",
+    );
+    assert_fails_with(
+        &run(&[
+            "simulate",
+            "-o",
+            &dir.arg("x.bin"),
+            "--truth",
+            "/nonexistent/t.jsonl",
+        ]),
+        "cannot write /nonexistent/t.jsonl",
+    );
+    assert_fails_with(
+        &run(&["simulate", "--port", "/dev/ttyUSB-hwfoc-missing"]),
+        "no such port /dev/ttyUSB-hwfoc-missing",
+    );
+    std::fs::write(dir.path("p.csv"), "time,throttle\n0,0\n1,50\n2,lots\n").unwrap();
+    let profile = format!("csv:{}", dir.arg("p.csv"));
+    assert_fails_with(
+        &run(&["simulate", "--profile", &profile, "-o", &dir.arg("x.bin")]),
+        &format!("{}:4: bad throttle \"lots\"", dir.arg("p.csv")),
+    );
+    assert_fails_with(
+        &run(&[
+            "simulate",
+            "--profile",
+            "csv:/nonexistent.csv",
+            "-o",
+            &dir.arg("x.bin"),
+        ]),
+        "cannot open /nonexistent.csv",
+    );
+    assert_fails_with(
+        &run(&["simulate", "--escs", "2", "-o", &dir.arg("x.bin")]),
+        "put {esc} in the name",
+    );
+    assert_fails_with(
+        &run(&[
+            "simulate",
+            "--escs",
+            "2",
+            "--fault",
+            "2:mos_short@1",
+            "-o",
+            &dir.arg("{esc}"),
+        ]),
+        "ESC 2 does not exist",
+    );
+    // Usage errors from the argument parser.
+    let o = run(&["simulate", "--fault", "overheat@1"]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("the names are input_voltage_high"));
+}
