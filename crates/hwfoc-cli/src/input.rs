@@ -502,7 +502,7 @@ impl Recording {
 /// Appends the receive times, in Unix seconds, of `n` bytes the first of which arrived at
 /// `t_ns` and each next one `per_byte` ns later.
 fn append_times(t_ns: u64, per_byte: f64, n: usize, times: &mut Vec<f64>) {
-    times.extend((0..n).map(|i| (t_ns as f64 + i as f64 * per_byte) * 1e-9));
+    times.extend((0..n).map(|i| pcapng::byte_time_s(t_ns, i, per_byte)));
 }
 
 impl Ports {

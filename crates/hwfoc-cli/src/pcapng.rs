@@ -28,6 +28,13 @@ use std::ops::Range;
 /// `LINKTYPE_USER0`: raw HW-FOC UART bytes (the user range 147..=162 is for private use).
 pub const LINKTYPE: u32 = 147;
 
+/// Receive time in Unix seconds of byte `i` of a chunk whose first byte arrived at `t_ns`, the
+/// bytes `per_byte_ns` apart. The one conversion from recording timestamps to `t_s`: the
+/// simulator's ground truth uses it too, so that the two agree to the last bit.
+pub fn byte_time_s(t_ns: u64, i: usize, per_byte_ns: f64) -> f64 {
+    (t_ns as f64 + i as f64 * per_byte_ns) * 1e-9
+}
+
 /// The first four bytes of every pcapng file (the section header block's type; the same in
 /// both byte orders).
 pub const MAGIC: [u8; 4] = [0x0A, 0x0D, 0x0D, 0x0A];

@@ -204,9 +204,9 @@ pub fn run(
             && let Some(truth) = truth.as_deref_mut()
         {
             // Seconds exactly as the recording's reader computes them for a packet's first
-            // byte (`t_ns as f64 * 1e-9`), so that decoding a recording gives the same `t_s`.
+            // byte, so that decoding a recording gives the same `t_s`.
             let t_ns = clock.origin_ns + lane.burst.t_ns;
-            truth.record(t_ns as f64 * 1e-9, index, frame)?;
+            truth.record(crate::pcapng::byte_time_s(t_ns, 0, 0.0), index, frame)?;
         }
         lane.burst = lane.esc.next_burst();
         lane.written = 0;
