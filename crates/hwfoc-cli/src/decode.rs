@@ -40,6 +40,8 @@ pub fn run(args: &DecodeArgs) -> Result<(), CliError> {
         export,
         escs,
         window,
+        kept: 0,
+        times: None,
     };
     let result = sources.run(&mut records);
     // Whatever was decoded before an input error is still written out.
@@ -48,6 +50,15 @@ pub fn run(args: &DecodeArgs) -> Result<(), CliError> {
     result?;
     finished?;
     warn(&sources, &args.esc);
+    if let (true, 0, Some((first, last))) =
+        (records.window.is_limited(), records.kept, records.times)
+    {
+        eprintln!(
+            "hwfoc: warning: no frame in the time window ({}): the frames' t_s run from {first} \
+             to {last} s (recordings and serial ports give Unix time)",
+            filter_text(args)
+        );
+    }
     Ok(())
 }
 
@@ -56,6 +67,10 @@ struct Records {
     export: Export,
     escs: [bool; 256],
     window: Window,
+    /// Records written.
+    kept: u64,
+    /// Earliest and latest `t_s` of the chosen ESCs' data frames, to explain an empty window.
+    times: Option<(f64, f64)>,
 }
 
 impl Handler for Records {
@@ -63,9 +78,16 @@ impl Handler for Records {
     fn frame(&mut self, esc: u8, t: Option<f64>, decoded: Decoded) {
         if let Frame::Data(frame) = decoded.frame
             && self.escs[usize::from(esc)]
-            && self.window.contains(t)
         {
-            self.export.push(esc, t, &frame);
+            if let Some(t) = t {
+                let (first, last) = self.times.get_or_insert((t, t));
+                *first = first.min(t);
+                *last = last.max(t);
+            }
+            if self.window.contains(t) {
+                self.export.push(esc, t, &frame);
+                self.kept += 1;
+            }
         }
     }
 

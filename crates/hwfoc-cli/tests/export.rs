@@ -521,6 +521,17 @@ fn esc_and_time_filters() {
         &run(&["decode", s(&a), "--from", "2", "--to", "1"]),
         "--from 2 is not before --to 1",
     );
+    // A window that holds no frame (say, seconds from the start given for a recording whose
+    // t_s are Unix times): no records, and a warning giving the times the frames have.
+    let o = run(&["decode", s(&a), "--from", "1000", "--to", "1001"]);
+    assert!(stdout(&o).is_empty());
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        err.contains(
+            "no frame in the time window (from=1000 to=1001): the frames' t_s run from 0.077 to"
+        ),
+        "{err}"
+    );
     // An ESC that is not there: no records, and a warning.
     let o = run(&["decode", s(&a), "--esc", "3"]);
     assert!(stdout(&o).is_empty());
