@@ -161,26 +161,15 @@ impl Profile {
                 lead_in_s,
                 period_s,
                 max_pct,
-            } => {
-                if t < *lead_in_s {
-                    0.0
-                } else {
-                    let phase = ((t - lead_in_s) / period_s).fract();
-                    max_pct * (1.0 - (2.0 * phase - 1.0).abs())
-                }
-            }
+            } => phase(t, *lead_in_s, *period_s)
+                .map_or(0.0, |phase| max_pct * (1.0 - (2.0 * phase - 1.0).abs())),
             Profile::Sine {
                 lead_in_s,
                 period_s,
                 max_pct,
-            } => {
-                if t < *lead_in_s {
-                    0.0
-                } else {
-                    let phase = ((t - lead_in_s) / period_s).fract();
-                    max_pct * (1.0 - (std::f64::consts::TAU * phase).cos()) / 2.0
-                }
-            }
+            } => phase(t, *lead_in_s, *period_s).map_or(0.0, |phase| {
+                max_pct * (1.0 - (std::f64::consts::TAU * phase).cos()) / 2.0
+            }),
             Profile::Points(points) => interpolate(points, t),
         };
         pct.clamp(0.0, 100.0)
@@ -207,6 +196,12 @@ impl Profile {
             Profile::Points(points) => points.last().map_or(0.0, |p| p.0),
         }
     }
+}
+
+/// Where `t` is in a cycle of `period_s` seconds that starts after `lead_in_s` (0..1), or
+/// `None` during the lead-in.
+fn phase(t: f64, lead_in_s: f64, period_s: f64) -> Option<f64> {
+    (t >= lead_in_s).then(|| ((t - lead_in_s) / period_s).fract())
 }
 
 /// Linear interpolation between points sorted by time; constant outside them.
