@@ -561,13 +561,9 @@ impl<R: Read> Reader<R> {
             });
         }
         let p = self.pos;
-        let raw_type = u32::from_le_bytes([
-            self.buf[p],
-            self.buf[p + 1],
-            self.buf[p + 2],
-            self.buf[p + 3],
-        ]);
-        if raw_type == SHB {
+        // A section header's type reads the same in either byte order, so the current order
+        // (perhaps that of the previous section) recognises it.
+        if self.u32_at(p) == SHB {
             if !self.fill(12)? {
                 return Ok(Step::Bad(cut_off(self.buf.len() - self.pos, None)));
             }
@@ -768,13 +764,7 @@ impl<R: Read> Reader<R> {
     /// consuming it or changing any state).
     fn plausible_block(&mut self) -> io::Result<bool> {
         let p = self.pos;
-        let raw_type = u32::from_le_bytes([
-            self.buf[p],
-            self.buf[p + 1],
-            self.buf[p + 2],
-            self.buf[p + 3],
-        ]);
-        if raw_type == SHB {
+        if self.u32_at(p) == SHB {
             return Ok(matches!(
                 self.buf[p + 8..p + 12],
                 [0x4D, 0x3C, 0x2B, 0x1A] | [0x1A, 0x2B, 0x3C, 0x4D]
