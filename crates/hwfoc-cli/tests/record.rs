@@ -4,80 +4,19 @@
 
 #![cfg(unix)]
 
-use std::io::{BufRead, BufReader, Write};
-use std::os::fd::{AsFd, OwnedFd};
-use std::path::{Path, PathBuf};
-use std::process::{Child, Command, Output, Stdio};
-use std::sync::mpsc::{self, Receiver};
-use std::sync::{Arc, Mutex};
-use std::thread;
-use std::time::{Duration, Instant, SystemTime, UNIX_EPOCH};
+mod common;
 
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Stdio};
+use std::thread;
+use std::time::{Duration, Instant};
+
+use common::{OutputLocked, Pty, Running, SPAWN, hwfoc, pty, run, spawn, unix_now};
 use hwfoc::{DataFrame, InfoFrame};
-use nix::fcntl::{FcntlArg, FdFlag, fcntl};
-use nix::pty::openpty;
 use nix::sys::signal::{Signal, kill};
-use nix::sys::termios::{SetArg, cfmakeraw, tcgetattr, tcsetattr};
 use nix::unistd::Pid;
 use serde_json::Value;
-
-fn hwfoc() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_hwfoc"))
-}
-
-/// Held while a pty is opened and while a process is started: a process started by another
-/// test in between would inherit the pty's descriptors (before they are made close-on-exec)
-/// and keep it alive after the test closes it.
-static SPAWN: Mutex<()> = Mutex::new(());
-
-fn spawn(cmd: &mut Command) -> Child {
-    let _guard = SPAWN.lock().unwrap_or_else(|e| e.into_inner());
-    cmd.stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .expect("spawn")
-}
-
-fn run(cmd: &mut Command) -> Output {
-    spawn(cmd).wait_with_output().expect("wait")
-}
-
-/// [`Command::output`] with the process started under [`SPAWN`].
-trait OutputLocked {
-    fn output_locked(&mut self) -> Output;
-}
-
-impl OutputLocked for Command {
-    fn output_locked(&mut self) -> Output {
-        run(self)
-    }
-}
-
-/// A pseudo-terminal: the master side the test writes to, and the path of the slave side that
-/// `hwfoc` opens like a serial port.
-struct Pty {
-    master: std::fs::File,
-    path: PathBuf,
-    _slave: OwnedFd,
-}
-
-fn pty() -> Pty {
-    let _guard = SPAWN.lock().unwrap_or_else(|e| e.into_inner());
-    let pair = openpty(None, None).expect("openpty");
-    for fd in [&pair.master, &pair.slave] {
-        fcntl(fd.as_fd(), FcntlArg::F_SETFD(FdFlag::FD_CLOEXEC)).unwrap();
-    }
-    // Raw, so that nothing is echoed or translated before `hwfoc` opens the port.
-    let mut termios = tcgetattr(pair.slave.as_fd()).unwrap();
-    cfmakeraw(&mut termios);
-    tcsetattr(pair.slave.as_fd(), SetArg::TCSANOW, &termios).unwrap();
-    let path = nix::unistd::ttyname(pair.slave.as_fd()).expect("ttyname");
-    Pty {
-        master: std::fs::File::from(pair.master),
-        path,
-        _slave: pair.slave,
-    }
-}
 
 /// Data frame number `k` of a test: packet 1000 + k, voltage 20.0 V + k/10.
 fn frame(k: u16) -> [u8; 24] {
@@ -91,93 +30,6 @@ fn frame(k: u16) -> [u8; 24] {
         ..Default::default()
     }
     .encode()
-}
-
-fn unix_now() -> f64 {
-    SystemTime::now()
-        .duration_since(UNIX_EPOCH)
-        .unwrap()
-        .as_secs_f64()
-}
-
-/// A running `hwfoc` whose standard error is collected line by line.
-struct Running {
-    child: Child,
-    lines: Receiver<String>,
-    stderr: Arc<Mutex<Vec<String>>>,
-}
-
-impl Running {
-    fn start(args: &[&str]) -> Running {
-        let mut child = spawn(hwfoc().args(args));
-        let stderr = Arc::new(Mutex::new(Vec::new()));
-        let (tx, lines) = mpsc::channel();
-        let pipe = child.stderr.take().unwrap();
-        let all = Arc::clone(&stderr);
-        thread::spawn(move || {
-            for line in BufReader::new(pipe).lines() {
-                let Ok(line) = line else { break };
-                all.lock().unwrap().push(line.clone());
-                let _ = tx.send(line);
-            }
-        });
-        Running {
-            child,
-            lines,
-            stderr,
-        }
-    }
-
-    /// Waits for a line of standard error containing `text`.
-    fn wait_for(&self, text: &str, timeout: Duration) -> String {
-        let until = Instant::now() + timeout;
-        loop {
-            let left = until.saturating_duration_since(Instant::now());
-            match self.lines.recv_timeout(left) {
-                Ok(line) if line.contains(text) => return line,
-                Ok(_) => {}
-                Err(_) => panic!(
-                    "no {text:?} on hwfoc's standard error within {timeout:?}; got:\n{}",
-                    self.stderr()
-                ),
-            }
-        }
-    }
-
-    fn stderr(&self) -> String {
-        self.stderr.lock().unwrap().join("\n")
-    }
-
-    fn signal(&self, signal: Signal) {
-        kill(Pid::from_raw(self.child.id() as i32), signal).unwrap();
-    }
-
-    /// Waits for the process to end (at most `timeout`); returns whether it succeeded.
-    fn wait(&mut self, timeout: Duration) -> bool {
-        let until = Instant::now() + timeout;
-        loop {
-            if let Some(status) = self.child.try_wait().unwrap() {
-                // Let the stderr thread take the last lines.
-                thread::sleep(Duration::from_millis(50));
-                return status.success();
-            }
-            if Instant::now() > until {
-                let _ = self.child.kill();
-                panic!("hwfoc did not end within {timeout:?}:\n{}", self.stderr());
-            }
-            thread::sleep(Duration::from_millis(20));
-        }
-    }
-}
-
-impl Drop for Running {
-    /// A test that fails half-way leaves no `hwfoc` running behind it.
-    fn drop(&mut self) {
-        if self.child.try_wait().ok().flatten().is_none() {
-            let _ = self.child.kill();
-            let _ = self.child.wait();
-        }
-    }
 }
 
 /// Writes data frames `ks` to the pty, one every `every`; returns the Unix time of each write.
