@@ -133,6 +133,18 @@ pub enum CliError {
         /// Why.
         source: io::Error,
     },
+    /// `hwfoc plot`: the inputs hold nothing to plot.
+    NothingToPlot {
+        /// What is missing, and where.
+        message: String,
+    },
+    /// `hwfoc plot`: the image could not be drawn.
+    Render {
+        /// The image file.
+        output: String,
+        /// Why.
+        message: String,
+    },
 }
 
 impl CliError {
@@ -246,6 +258,8 @@ impl fmt::Display for CliError {
             } => write!(f, "{file}:{line}: {message}"),
             CliError::Pty { source } => write!(f, "cannot create a pseudo-terminal: {source}"),
             CliError::Link { path, source } => write!(f, "cannot create the link {path}: {source}"),
+            CliError::NothingToPlot { message } => write!(f, "nothing to plot: {message}"),
+            CliError::Render { output, message } => write!(f, "cannot draw {output}: {message}"),
         }
     }
 }

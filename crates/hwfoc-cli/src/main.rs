@@ -10,6 +10,7 @@ mod export;
 mod input;
 mod output;
 mod pcapng;
+mod plot;
 mod record;
 mod schema;
 mod serial;
@@ -40,6 +41,8 @@ enum Command {
     Decode(DecodeArgs),
     /// Summarise a stream: frames, link quality, device information, min/max/mean of each field.
     Summary(SummaryArgs),
+    /// Plot each ESC's throttle, speed, currents, voltage and temperatures, faults marked (PNG, SVG).
+    Plot(plot::Args),
     /// Record serial ports losslessly, with nanosecond receive times, to pcapng (Wireshark opens it).
     Record(record::Args),
     /// Virtual ESCs: the protocol from a physical model, to a pty, serial port, file or stdout.
@@ -155,6 +158,9 @@ struct SummaryArgs {
     /// Print one JSON object instead of text.
     #[arg(long)]
     json: bool,
+    /// Also plot the inputs to FILE (.png or .svg), as `hwfoc plot` does.
+    #[arg(long, value_name = "FILE")]
+    plot: Option<String>,
     #[command(flatten)]
     settings: SettingsArgs,
 }
@@ -166,6 +172,7 @@ fn main() -> ExitCode {
         Command::Summary(args) => summary::run(args),
         Command::Record(args) => record::run(args),
         Command::Simulate(args) => simulate::run(args),
+        Command::Plot(args) => plot::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -19,6 +19,7 @@ use crate::SummaryArgs;
 use crate::error::CliError;
 use crate::input::Format;
 use crate::output::Output;
+use crate::plot;
 use crate::sources::{Handler, InputInfo, Sources};
 
 /// What to tell a user whose input has bytes but no frame.
@@ -32,10 +33,18 @@ const TEXT_EPISODES: usize = 20;
 
 pub fn run(args: &SummaryArgs) -> Result<(), CliError> {
     let settings = args.settings.settings()?;
+    // The plot's file is opened first: a wrong name is reported before the inputs are read.
+    let mut plot = match &args.plot {
+        Some(path) => Some(plot::Alongside::open(path, settings)?),
+        None => None,
+    };
     let mut sources = Sources::new(args.input.open_all()?);
     let mut escs = Escs::default();
     // On an input error, what was read before it is summarised, then the error reported.
-    let result = sources.run(&mut escs);
+    let result = match &mut plot {
+        Some(plot) => sources.run(&mut plot::Both(&mut escs, plot)),
+        None => sources.run(&mut escs),
+    };
     let report = Report {
         sources: &sources,
         settings: &settings,
@@ -52,6 +61,9 @@ pub fn run(args: &SummaryArgs) -> Result<(), CliError> {
     let mut buf = text.into_bytes();
     out.write(&mut buf)?;
     out.flush()?;
+    if let Some(plot) = plot {
+        plot.finish(&sources)?;
+    }
     result
 }
 
@@ -125,25 +137,57 @@ impl Range {
 
 /// One end of a fault episode: a data frame.
 #[derive(Debug, Clone, Copy, PartialEq)]
-struct Mark {
+pub struct Mark {
     /// Receive time, if the input has timing.
-    t: Option<f64>,
+    pub t: Option<f64>,
     /// Index of the data frame among the ESC's data frames (0-based).
-    frame: u64,
+    pub frame: u64,
     /// Its packet number.
-    packet: u16,
+    pub packet: u16,
 }
 
 /// A maximal run of consecutive data frames with a non-zero status word.
 #[derive(Debug, Clone, Copy, PartialEq)]
-struct Episode {
-    first: Mark,
-    last: Mark,
-    frames: u64,
+pub struct Episode {
+    /// Its first frame.
+    pub first: Mark,
+    /// Its last frame.
+    pub last: Mark,
+    /// How many frames it lasted.
+    pub frames: u64,
     /// Every status bit seen during the episode.
-    bits: Status,
+    pub bits: Status,
     /// Still going on at the end of the input.
-    ongoing: bool,
+    pub ongoing: bool,
+}
+
+impl Episode {
+    /// Follows the fault episodes of one ESC through its data frames, in order: a frame with a
+    /// non-zero status word starts the open episode `open` or extends it, a clean frame ends
+    /// it. Returns the episode the frame ended, if any.
+    #[inline]
+    pub fn track(open: &mut Option<Episode>, mark: Mark, status: Status) -> Option<Episode> {
+        if status.is_ok() {
+            return open.take();
+        }
+        match open {
+            Some(e) => {
+                e.last = mark;
+                e.frames += 1;
+                e.bits = Status(e.bits.0 | status.0);
+            }
+            None => {
+                *open = Some(Episode {
+                    first: mark,
+                    last: mark,
+                    frames: 1,
+                    bits: status,
+                    ongoing: false,
+                })
+            }
+        }
+        None
+    }
 }
 
 /// Everything the summary needs from the frames of one ESC, gathered as they are decoded.
@@ -218,12 +262,6 @@ impl Accumulator {
             self.first_t.get_or_insert(t);
             self.last_t = Some(t);
         }
-        if f.status.is_ok() {
-            if self.episode.is_some() {
-                self.end_episode(false);
-            }
-            return;
-        }
         for fault in f.status.faults() {
             self.fault_frames[usize::from(fault.bit())] += 1;
         }
@@ -232,30 +270,10 @@ impl Accumulator {
             frame: index,
             packet: f.packet,
         };
-        match &mut self.episode {
-            Some(e) => {
-                e.last = mark;
-                e.frames += 1;
-                e.bits = Status(e.bits.0 | f.status.0);
-            }
-            None => {
-                self.episode = Some(Episode {
-                    first: mark,
-                    last: mark,
-                    frames: 1,
-                    bits: f.status,
-                    ongoing: false,
-                })
-            }
-        }
-    }
-
-    fn end_episode(&mut self, ongoing: bool) {
-        if let Some(mut e) = self.episode.take() {
-            e.ongoing = ongoing;
+        if let Some(ended) = Episode::track(&mut self.episode, mark, f.status) {
             self.episode_count += 1;
             if self.episodes.len() < MAX_EPISODES {
-                self.episodes.push(e);
+                self.episodes.push(ended);
             }
         }
     }

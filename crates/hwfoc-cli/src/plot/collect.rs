@@ -1,0 +1,706 @@
+//! The frames of a plot, gathered as they are decoded, in bounded memory.
+//!
+//! Each ESC has a fixed number of time buckets. A bucket holds, for each plotted quantity, the
+//! first, lowest, highest and last value of its frames: drawn as a line through first, low,
+//! high and last, a column of pixels shows exactly what a line through every frame would
+//! (the "M4" reduction). When a frame falls past the last bucket, neighbouring buckets are
+//! merged in pairs and each covers twice the time: the buckets always span the ESC's frames,
+//! at least half of them in use, whatever the length of the recording.
+//!
+//! Buckets hold the frames' raw integers, converted to physical units only when drawn: every
+//! conversion is monotonic (temperature falls as its ADC code rises), so this is exact, and it
+//! keeps the cost per frame to a few integer comparisons.
+//!
+//! Frames are placed on a clock: their receive time, or for inputs without receive times the
+//! data frame's index times the nominal frame period (50 ms).
+
+use hwfoc::{DataFrame, Decoded, Frame, InfoFrame, Settings, Status, Temperature};
+
+use crate::error::CliError;
+use crate::sources::{Handler, Sources};
+use crate::summary::{Episode, Mark};
+
+use super::{Options, Target};
+
+/// The nominal time between two data frames of a running ESC, s: the clock of inputs without
+/// receive times, and the width given to a fault episode's last frame.
+pub const FRAME_PERIOD: f64 = 0.05;
+
+/// A pause longer than this between two data frames of an ESC (idle frames come every
+/// ~364 ms) is a gap in the recording: lines are not drawn across it.
+pub const GAP_S: f64 = 1.0;
+
+/// The width of a bucket before any merging, s.
+const FIRST_WIDTH: f64 = 0.001;
+
+/// Fault spans kept per ESC; beyond this, each new one is merged into the last.
+const MAX_SPANS: usize = 10_000;
+
+/// The plotted quantities, in the order of a bucket's arrays.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Quantity {
+    /// Input throttle, %.
+    ThrottleIn,
+    /// Output throttle, %.
+    ThrottleOut,
+    /// Motor (or output shaft) speed, rev/min.
+    Rpm,
+    /// Input current, A.
+    Current,
+    /// Phase current, A.
+    PhaseCurrent,
+    /// Input voltage, V.
+    Voltage,
+    /// MOSFET temperature, degC.
+    MosTemp,
+    /// Capacitor temperature, degC.
+    CapTemp,
+}
+
+impl Quantity {
+    /// Its value in physical units for a raw value of its field (as [`DataFrame`] converts
+    /// it); NaN for a temperature code out of the table's range.
+    pub fn convert(self, raw: i32, settings: &Settings) -> f64 {
+        let d = DataFrame::default();
+        let v = match self {
+            Quantity::ThrottleIn => DataFrame {
+                throttle_in_raw: raw as u16,
+                ..d
+            }
+            .throttle_in_pct(),
+            Quantity::ThrottleOut => DataFrame {
+                throttle_out_raw: raw as u16,
+                ..d
+            }
+            .throttle_out_pct(),
+            Quantity::Rpm => DataFrame {
+                erpm_raw: raw as u16,
+                ..d
+            }
+            .rpm(settings),
+            Quantity::Current => DataFrame {
+                current_raw: raw as i16,
+                ..d
+            }
+            .current_a(settings),
+            Quantity::PhaseCurrent => DataFrame {
+                phase_current_raw: raw as i16,
+                ..d
+            }
+            .phase_current_a(settings),
+            Quantity::Voltage => DataFrame {
+                voltage_raw: raw as u16,
+                ..d
+            }
+            .voltage_v(),
+            Quantity::MosTemp | Quantity::CapTemp => Temperature::from_adc(raw as u8)
+                .celsius()
+                .unwrap_or(f32::NAN),
+        };
+        f64::from(v)
+    }
+
+    /// Whether the physical value falls as the raw one rises (temperatures).
+    fn falls(self) -> bool {
+        matches!(self, Quantity::MosTemp | Quantity::CapTemp)
+    }
+}
+
+/// How many quantities a bucket holds.
+pub const QUANTITIES: usize = 8;
+
+/// The first of the quantities that may have no value (the temperatures).
+const OPTIONAL: usize = Quantity::MosTemp as usize;
+
+/// No value: a temperature code out of the table's range.
+const NONE: i32 = i32::MIN;
+
+/// The raw values of one frame, by [`Quantity`].
+pub(super) type Raw = [i32; QUANTITIES];
+
+/// The raw values of a data frame.
+#[inline]
+pub(super) fn raw(f: &DataFrame) -> Raw {
+    let temp = |code: u8| match Temperature::from_adc(code) {
+        Temperature::Celsius(_) => i32::from(code),
+        _ => NONE,
+    };
+    [
+        i32::from(f.throttle_in_raw),
+        i32::from(f.throttle_out_raw),
+        i32::from(f.erpm_raw),
+        i32::from(f.current_raw),
+        i32::from(f.phase_current_raw),
+        i32::from(f.voltage_raw),
+        temp(f.mos_adc),
+        temp(f.cap_adc),
+    ]
+}
+
+/// The frames of one stretch of time: per quantity the first, lowest, highest and last raw
+/// value (for a temperature with no reading: first and last [`NONE`], lowest above highest).
+#[derive(Debug, Clone, Copy)]
+pub struct Bucket {
+    /// Data frames in it.
+    pub frames: u32,
+    /// Its first frame came after a gap ([`GAP_S`]) or is the first of its ESC.
+    pub gap_before: bool,
+    first: Raw,
+    min: Raw,
+    max: Raw,
+    last: Raw,
+}
+
+impl Bucket {
+    /// A bucket without frames.
+    pub const EMPTY: Bucket = Bucket {
+        frames: 0,
+        gap_before: false,
+        first: [NONE; QUANTITIES],
+        min: [i32::MAX; QUANTITIES],
+        max: [i32::MIN; QUANTITIES],
+        last: [NONE; QUANTITIES],
+    };
+
+    /// Adds a frame's raw values.
+    #[inline]
+    pub(super) fn add(&mut self, v: &Raw, gap: bool) {
+        if self.frames == 0 {
+            self.gap_before = gap;
+            self.first = *v;
+        }
+        self.frames = self.frames.saturating_add(1);
+        for (q, &x) in v.iter().enumerate().take(OPTIONAL) {
+            self.last[q] = x;
+            self.min[q] = self.min[q].min(x);
+            self.max[q] = self.max[q].max(x);
+        }
+        for (q, &x) in v.iter().enumerate().skip(OPTIONAL) {
+            if x != NONE {
+                if self.first[q] == NONE {
+                    self.first[q] = x;
+                }
+                self.last[q] = x;
+                self.min[q] = self.min[q].min(x);
+                self.max[q] = self.max[q].max(x);
+            }
+        }
+    }
+
+    /// Adds the frames of `later`, which all came after this bucket's.
+    pub fn merge(&mut self, later: &Bucket) {
+        if later.frames == 0 {
+            return;
+        }
+        if self.frames == 0 {
+            *self = *later;
+            return;
+        }
+        self.frames = self.frames.saturating_add(later.frames);
+        for q in 0..QUANTITIES {
+            if self.first[q] == NONE {
+                self.first[q] = later.first[q];
+            }
+            if later.last[q] != NONE {
+                self.last[q] = later.last[q];
+            }
+            self.min[q] = self.min[q].min(later.min[q]);
+            self.max[q] = self.max[q].max(later.max[q]);
+        }
+    }
+
+    /// First, lowest, highest and last value of quantity `q` in physical units, if any of
+    /// the frames had one.
+    pub fn values(&self, q: Quantity, settings: &Settings) -> Option<[f64; 4]> {
+        let i = q as usize;
+        if self.frames == 0 || self.min[i] > self.max[i] {
+            return None;
+        }
+        let f = |raw| q.convert(raw, settings);
+        let (lo, hi) = if q.falls() {
+            (f(self.max[i]), f(self.min[i]))
+        } else {
+            (f(self.min[i]), f(self.max[i]))
+        };
+        Some([f(self.first[i]), lo, hi, f(self.last[i])])
+    }
+}
+
+/// A fixed number of buckets of equal width from the clock value of an ESC's first frame.
+#[derive(Debug)]
+pub struct Buckets {
+    /// Clock value where bucket 0 starts.
+    pub origin: f64,
+    /// Width of a bucket, s.
+    pub width: f64,
+    /// Its inverse: buckets per second.
+    per_width: f64,
+    /// The buckets; those past the last frame are empty.
+    pub cells: Vec<Bucket>,
+}
+
+impl Buckets {
+    fn new(count: usize) -> Buckets {
+        Buckets {
+            origin: f64::NAN,
+            width: FIRST_WIDTH,
+            per_width: 1.0 / FIRST_WIDTH,
+            cells: vec![Bucket::EMPTY; count],
+        }
+    }
+
+    /// Adds a frame at clock value `c`.
+    #[inline]
+    fn add(&mut self, c: f64, v: &Raw, gap: bool) {
+        if self.origin.is_nan() {
+            self.origin = c;
+        }
+        // A clock that went back (the next file of the same stream) counts from the start.
+        let mut i = ((c - self.origin) * self.per_width).max(0.0);
+        while i >= self.cells.len() as f64 {
+            self.halve();
+            i = ((c - self.origin) * self.per_width).max(0.0);
+        }
+        self.cells[i as usize].add(v, gap);
+    }
+
+    /// Merges the buckets in pairs: twice the time each, the second half left empty.
+    fn halve(&mut self) {
+        let n = self.cells.len();
+        for i in 0..n / 2 {
+            let mut b = self.cells[2 * i];
+            b.merge(&self.cells[2 * i + 1]);
+            self.cells[i] = b;
+        }
+        for cell in &mut self.cells[n / 2..] {
+            *cell = Bucket::EMPTY;
+        }
+        self.width *= 2.0;
+        self.per_width = 1.0 / self.width;
+    }
+}
+
+/// A stretch of time with faults: one fault episode, or several too close to tell apart.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Span {
+    /// Clock value of its first faulty frame.
+    pub start: f64,
+    /// Clock value of its last faulty frame plus one frame period.
+    pub end: f64,
+    /// Every status bit seen in it.
+    pub bits: Status,
+    /// Fault episodes in it.
+    pub episodes: u64,
+    /// Still going on at the end of the input.
+    pub ongoing: bool,
+}
+
+/// Everything plotted of one ESC.
+#[derive(Debug)]
+pub struct EscData {
+    /// Data frames read (in the time window or not).
+    pub frames: u64,
+    /// Data frames plotted.
+    pub plotted: u64,
+    /// Whether its frames have receive times.
+    pub timed: bool,
+    /// Earliest and latest receive time of its data frames, in the window or not.
+    pub times: Option<(f64, f64)>,
+    /// Clock value of its first and last plotted frame.
+    pub clock: Option<(f64, f64)>,
+    /// Its first device-information frame.
+    pub info: Option<InfoFrame>,
+    /// Its plotted frames.
+    pub buckets: Buckets,
+    /// Its fault spans, in time order.
+    pub spans: Vec<Span>,
+    /// Fault episodes seen.
+    pub episodes: u64,
+    /// The fault episode going on.
+    open: Option<Episode>,
+}
+
+impl EscData {
+    fn new(buckets: usize) -> EscData {
+        EscData {
+            frames: 0,
+            plotted: 0,
+            timed: false,
+            times: None,
+            clock: None,
+            info: None,
+            buckets: Buckets::new(buckets),
+            spans: Vec::new(),
+            episodes: 0,
+            open: None,
+        }
+    }
+
+    #[inline]
+    fn add(&mut self, t: Option<f64>, f: &DataFrame, window: &Window) {
+        let index = self.frames;
+        self.frames += 1;
+        if let Some(t) = t {
+            let (first, last) = self.times.get_or_insert((t, t));
+            *first = first.min(t);
+            *last = last.max(t);
+        }
+        if !window.contains(t) {
+            return;
+        }
+        let c = clock(t, index);
+        if !c.is_finite() {
+            return;
+        }
+        self.timed = t.is_some();
+        self.plotted += 1;
+        let gap = match &mut self.clock {
+            Some((_, last)) => {
+                let gap = (c - *last).abs() > GAP_S;
+                *last = c;
+                gap
+            }
+            None => {
+                self.clock = Some((c, c));
+                true
+            }
+        };
+        self.buckets.add(c, &raw(f), gap);
+        let mark = Mark {
+            t,
+            frame: index,
+            packet: f.packet,
+        };
+        if let Some(ended) = Episode::track(&mut self.open, mark, f.status) {
+            self.keep(&ended);
+        }
+    }
+
+    /// Adds an ended fault episode to the spans, merged into the last one when the plot could
+    /// not show the space between them (less than a bucket).
+    fn keep(&mut self, e: &Episode) {
+        self.episodes += 1;
+        let span = Span {
+            start: clock(e.first.t, e.first.frame),
+            end: clock(e.last.t, e.last.frame) + FRAME_PERIOD,
+            bits: e.bits,
+            episodes: 1,
+            ongoing: e.ongoing,
+        };
+        let full = self.spans.len() >= MAX_SPANS;
+        match self.spans.last_mut() {
+            Some(last) if full || span.start - last.end < self.buckets.width => {
+                last.end = last.end.max(span.end);
+                last.bits = Status(last.bits.0 | span.bits.0);
+                last.episodes += 1;
+                last.ongoing = span.ongoing;
+            }
+            _ => self.spans.push(span),
+        }
+    }
+
+    /// Closes the episode still going on at the end of the input.
+    fn finish(&mut self) {
+        if let Some(mut open) = self.open.take() {
+            open.ongoing = true;
+            self.keep(&open);
+        }
+    }
+}
+
+/// The clock value of a data frame: its receive time, or its index times the frame period.
+fn clock(t: Option<f64>, index: u64) -> f64 {
+    t.unwrap_or(index as f64 * FRAME_PERIOD)
+}
+
+/// A window of receive times, as `hwfoc decode` takes it: `from <= t_s < to`, each end
+/// optional.
+#[derive(Debug, Clone, Copy)]
+pub struct Window {
+    /// Start, s (inclusive).
+    pub from: f64,
+    /// End, s (exclusive).
+    pub to: f64,
+}
+
+impl Window {
+    /// The window from `--from` and `--to`; an empty one is an error.
+    pub fn new(from: Option<f64>, to: Option<f64>) -> Result<Window, CliError> {
+        let window = Window {
+            from: from.unwrap_or(f64::NEG_INFINITY),
+            to: to.unwrap_or(f64::INFINITY),
+        };
+        if window.from.is_nan() || window.to.is_nan() || window.from >= window.to {
+            return Err(CliError::EmptyWindow {
+                from: window.from,
+                to: window.to,
+            });
+        }
+        Ok(window)
+    }
+
+    /// No window at all: every frame.
+    pub const ALL: Window = Window {
+        from: f64::NEG_INFINITY,
+        to: f64::INFINITY,
+    };
+
+    /// Whether either end is given.
+    pub fn is_limited(&self) -> bool {
+        self.from > f64::NEG_INFINITY || self.to < f64::INFINITY
+    }
+
+    #[inline]
+    fn contains(&self, t: Option<f64>) -> bool {
+        match t {
+            Some(t) => t >= self.from && t < self.to,
+            None => !self.is_limited(),
+        }
+    }
+}
+
+/// The [`Handler`] of a plot: the frames of the chosen ESCs, by ESC.
+#[derive(Debug)]
+pub struct Collector {
+    settings: Settings,
+    window: Window,
+    wanted: [bool; 256],
+    buckets: usize,
+    escs: Vec<EscData>,
+}
+
+impl Collector {
+    /// A collector for an image `width` pixels wide, of the ESCs in `escs` (empty: all).
+    pub fn new(settings: Settings, window: Window, escs: &[u8], width: u32) -> Collector {
+        let mut wanted = [escs.is_empty(); 256];
+        for &esc in escs {
+            wanted[usize::from(esc)] = true;
+        }
+        Collector {
+            settings,
+            window,
+            wanted,
+            buckets: super::draw::buckets_for(width),
+            escs: Vec::new(),
+        }
+    }
+
+    /// The settings values were converted with.
+    pub fn settings(&self) -> &Settings {
+        &self.settings
+    }
+
+    /// The window frames were chosen by.
+    pub fn window(&self) -> &Window {
+        &self.window
+    }
+
+    /// Whether ESC `esc` was asked for.
+    pub fn wanted(&self, esc: usize) -> bool {
+        self.wanted.get(esc).copied().unwrap_or(false)
+    }
+
+    /// The data of ESC `esc`, if it had any frame.
+    pub fn esc(&self, esc: usize) -> Option<&EscData> {
+        self.escs.get(esc)
+    }
+
+    /// Draws the plot of what was read from `sources` and writes it to `target`.
+    pub fn write(
+        &mut self,
+        sources: &Sources,
+        options: &Options,
+        target: &mut Target,
+    ) -> Result<(), CliError> {
+        for esc in &mut self.escs {
+            esc.finish();
+        }
+        let image = super::draw::render(self, sources, options, target)?;
+        target.write(&image)
+    }
+}
+
+impl Handler for Collector {
+    #[inline]
+    fn frame(&mut self, esc: u8, t: Option<f64>, decoded: Decoded) {
+        let i = usize::from(esc);
+        if !self.wanted[i] {
+            return;
+        }
+        if self.escs.len() <= i {
+            let buckets = self.buckets;
+            self.escs.resize_with(i + 1, || EscData::new(buckets));
+        }
+        let esc = &mut self.escs[i];
+        match decoded.frame {
+            Frame::Data(f) => esc.add(t, &f, &self.window),
+            Frame::Info(info) => {
+                esc.info.get_or_insert(info);
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn frame(throttle: u16, status: u16) -> DataFrame {
+        DataFrame {
+            throttle_in_raw: throttle,
+            status: Status(status),
+            ..Default::default()
+        }
+    }
+
+    fn raw_of(x: i32) -> Raw {
+        [x, x, x, x, x, x, 100, 100]
+    }
+
+    #[test]
+    fn buckets_keep_first_min_max_last_and_halve_to_fit() {
+        let settings = Settings::DEFAULT;
+        let mut b = Buckets::new(4);
+        b.add(0.0, &raw_of(512), true);
+        b.add(0.0005, &raw_of(256), false);
+        b.add(0.0009, &raw_of(768), false);
+        assert_eq!(b.cells[0].frames, 3);
+        assert_eq!(
+            b.cells[0].values(Quantity::ThrottleIn, &settings),
+            Some([50.0, 25.0, 75.0, 75.0])
+        );
+        assert!(b.cells[0].gap_before);
+        // 10 ms is past 4 buckets of 1 ms: two halvings make them 4 ms wide.
+        b.add(0.010, &raw_of(1024), false);
+        assert_eq!(b.width, 0.004);
+        assert_eq!(b.cells[0].frames, 3);
+        assert_eq!(
+            b.cells[0].values(Quantity::ThrottleIn, &settings),
+            Some([50.0, 25.0, 75.0, 75.0])
+        );
+        assert_eq!(b.cells[2].frames, 1);
+        assert_eq!(
+            b.cells[2].values(Quantity::Voltage, &settings),
+            Some([f64::from(102.4f32); 4])
+        );
+        assert!(!b.cells[2].gap_before);
+        assert_eq!(b.cells[1].frames + b.cells[3].frames, 0);
+        assert_eq!(b.cells[1].values(Quantity::Rpm, &settings), None);
+    }
+
+    #[test]
+    fn values_convert_as_the_record_does() {
+        let s = Settings::new(100.0, 7, 2.0).unwrap();
+        let f = DataFrame {
+            throttle_in_raw: 300,
+            throttle_out_raw: 280,
+            erpm_raw: 1234,
+            voltage_raw: 251,
+            current_raw: -150,
+            phase_current_raw: 420,
+            mos_adc: 206,
+            cap_adc: 183,
+            ..Default::default()
+        };
+        let mut b = Bucket::EMPTY;
+        b.add(&raw(&f), false);
+        let v = |q| b.values(q, &s).unwrap()[0];
+        assert_eq!(v(Quantity::ThrottleIn), f64::from(f.throttle_in_pct()));
+        assert_eq!(v(Quantity::ThrottleOut), f64::from(f.throttle_out_pct()));
+        assert_eq!(v(Quantity::Rpm), f64::from(f.rpm(&s)));
+        assert_eq!(v(Quantity::Voltage), f64::from(f.voltage_v()));
+        assert_eq!(v(Quantity::Current), f64::from(f.current_a(&s)));
+        assert_eq!(v(Quantity::PhaseCurrent), f64::from(f.phase_current_a(&s)));
+        assert_eq!(v(Quantity::MosTemp), 28.0);
+        assert_eq!(v(Quantity::CapTemp), 40.0);
+    }
+
+    #[test]
+    fn temperatures_fall_as_codes_rise_and_out_of_range_codes_are_no_value() {
+        // The table is monotonic, which makes min/max of codes exact.
+        let temps: Vec<f32> = (0..=255u8)
+            .filter_map(|c| Temperature::from_adc(c).celsius())
+            .collect();
+        assert!(temps.windows(2).all(|w| w[0] >= w[1]), "{temps:?}");
+        let settings = Settings::DEFAULT;
+        let mut b = Bucket::EMPTY;
+        let with = |mos: u8| {
+            raw(&DataFrame {
+                mos_adc: mos,
+                ..Default::default()
+            })
+        };
+        b.add(&with(250), false); // below range: no value
+        assert_eq!(b.values(Quantity::MosTemp, &settings), None);
+        b.add(&with(206), false); // 28 degC
+        b.add(&with(183), false); // 40 degC
+        b.add(&with(10), false); // above range: no value
+        assert_eq!(
+            b.values(Quantity::MosTemp, &settings),
+            Some([28.0, 28.0, 40.0, 40.0])
+        );
+        let mut later = Bucket::EMPTY;
+        later.add(&with(250), false);
+        b.merge(&later);
+        assert_eq!(b.frames, 5);
+        assert_eq!(b.values(Quantity::MosTemp, &settings).unwrap()[3], 40.0);
+    }
+
+    #[test]
+    fn episodes_become_spans_and_gaps_are_found() {
+        let mut esc = EscData::new(1024);
+        let statuses = [0u16, 0x40, 0x40, 0, 0, 0x1, 0];
+        for (i, &s) in statuses.iter().enumerate() {
+            esc.add(Some(100.0 + i as f64 * 0.05), &frame(0, s), &Window::ALL);
+        }
+        // A pause of 5 s, then a fault to the end.
+        esc.add(Some(105.3), &frame(0, 0x2), &Window::ALL);
+        esc.finish();
+        assert_eq!(esc.episodes, 3);
+        let s: Vec<(f64, f64, u16, bool)> = esc
+            .spans
+            .iter()
+            .map(|s| (s.start, s.end, s.bits.0, s.ongoing))
+            .collect();
+        assert_eq!(s.len(), 3, "{s:?}");
+        assert!((s[0].0 - 100.05).abs() < 1e-9 && (s[0].1 - 100.15).abs() < 1e-9);
+        assert_eq!((s[0].2, s[1].2, s[2].2), (0x40, 0x1, 0x2));
+        assert!(s[2].3 && !s[1].3);
+        let gaps: Vec<bool> = esc
+            .buckets
+            .cells
+            .iter()
+            .filter(|b| b.frames > 0)
+            .map(|b| b.gap_before)
+            .collect();
+        assert_eq!(gaps.iter().filter(|&&g| g).count(), 2, "{gaps:?}");
+        assert!(gaps[0] && *gaps.last().unwrap());
+    }
+
+    #[test]
+    fn episodes_closer_than_a_bucket_share_a_span() {
+        let mut esc = EscData::new(4);
+        // 4 buckets over 20 s of frames: 8.192 s each; faults every other frame.
+        for i in 0..400u16 {
+            esc.add(Some(f64::from(i) * 0.05), &frame(0, i % 2), &Window::ALL);
+        }
+        esc.finish();
+        assert_eq!(esc.episodes, 200);
+        assert!(esc.spans.len() <= 4, "{:?}", esc.spans.len());
+        assert_eq!(esc.spans.iter().map(|s| s.episodes).sum::<u64>(), 200);
+    }
+
+    #[test]
+    fn frames_outside_the_window_are_not_plotted() {
+        let window = Window::new(Some(1.0), Some(2.0)).unwrap();
+        let mut esc = EscData::new(64);
+        for i in 0..60 {
+            esc.add(Some(i as f64 * 0.05), &frame(100, 0), &window);
+        }
+        assert_eq!((esc.frames, esc.plotted), (60, 20));
+        assert_eq!(esc.times, Some((0.0, 59.0 * 0.05)));
+        let (first, last) = esc.clock.unwrap();
+        assert!((first - 1.0).abs() < 1e-9 && (last - 1.95).abs() < 1e-9);
+        assert!(Window::new(Some(2.0), Some(2.0)).is_err());
+    }
+}

@@ -1,0 +1,154 @@
+//! `hwfoc plot`: one row of time-series panels per ESC (throttle, RPM, currents, voltage,
+//! temperatures), fault episodes shaded, as PNG or SVG.
+//!
+//! Frames are gathered as they are decoded into a fixed number of time buckets per ESC holding
+//! the first, lowest, highest and last value of each quantity ([`collect`]): memory stays
+//! bounded however long the recording, and drawing one column of pixels from its buckets shows
+//! every spike a line through all the frames would. The image is drawn with plotters ([`draw`])
+//! and its text with a font compiled into the program, so no system font is needed.
+
+mod collect;
+mod draw;
+mod target;
+mod text;
+
+use hwfoc::{Decoded, Settings};
+
+use crate::error::CliError;
+use crate::sources::{Handler, Sources};
+use crate::{InputArgs, SettingsArgs};
+
+use collect::{Collector, Window};
+use target::Target;
+
+/// The narrowest and widest image, and the lowest and highest, in pixels.
+const MIN_SIZE: u32 = 320;
+/// See [`MIN_SIZE`]: 10000 x 10000 pixels are 300 MB of RGB.
+const MAX_SIZE: u32 = 10_000;
+
+/// Arguments of `hwfoc plot`.
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    #[command(flatten)]
+    input: InputArgs,
+    /// The image to write: a name ending in .png or .svg gives the format.
+    #[arg(short, long, value_name = "FILE")]
+    output: String,
+    /// Width of the image in pixels.
+    #[arg(long, value_name = "PX", default_value_t = draw::DEFAULT_WIDTH,
+          value_parser = clap::value_parser!(u32).range(i64::from(MIN_SIZE)..=i64::from(MAX_SIZE)))]
+    width: u32,
+    /// Height of the image in pixels. Default: room for a row of panels per ESC.
+    #[arg(long, value_name = "PX",
+          value_parser = clap::value_parser!(u32).range(i64::from(MIN_SIZE)..=i64::from(MAX_SIZE)))]
+    height: Option<u32>,
+    /// Title on top of the image. Default: the inputs' names.
+    #[arg(long, value_name = "TEXT")]
+    title: Option<String>,
+    /// Plot only these ESCs (indices as in `hwfoc decode`; repeat or separate with commas).
+    #[arg(long, value_name = "N", value_delimiter = ',')]
+    esc: Vec<u8>,
+    /// Plot only frames received at or after S seconds (`t_s`, as in `hwfoc decode`; needs
+    /// inputs with receive times).
+    #[arg(long, value_name = "S", allow_negative_numbers = true)]
+    from: Option<f64>,
+    /// Plot only frames received before S seconds (`t_s`, as in `hwfoc decode`; needs inputs
+    /// with receive times).
+    #[arg(long, value_name = "S", allow_negative_numbers = true)]
+    to: Option<f64>,
+    #[command(flatten)]
+    settings: SettingsArgs,
+}
+
+/// What the image shows besides the frames.
+#[derive(Debug, Clone, Default)]
+pub struct Options {
+    /// Width in pixels.
+    pub width: u32,
+    /// Height in pixels; `None`: room for every ESC.
+    pub height: Option<u32>,
+    /// Title; `None`: made from the inputs' names.
+    pub title: Option<String>,
+    /// The ESCs asked for with `--esc` (empty: all).
+    pub escs: Vec<u8>,
+}
+
+/// `hwfoc plot`: reads the inputs and writes the image.
+pub fn run(args: &Args) -> Result<(), CliError> {
+    let settings = args.settings.settings()?;
+    let window = Window::new(args.from, args.to)?;
+    // Opened first, so that a wrong name is reported before the inputs are read; a file
+    // created here is removed again if the plot is not written.
+    let mut target = Target::open(&args.output)?;
+    let options = Options {
+        width: args.width,
+        height: args.height,
+        title: args.title.clone(),
+        escs: args.esc.clone(),
+    };
+    let mut sources = Sources::new(args.input.open_all()?);
+    if window.is_limited() {
+        sources.require_timing()?;
+    }
+    let mut collector = Collector::new(settings, window, &options.escs, options.width);
+    let result = sources.run(&mut collector);
+    // On an input error, what was read before it is still plotted, then the error reported.
+    let written = collector.write(&sources, &options, &mut target);
+    result?;
+    written
+}
+
+/// `hwfoc summary --plot FILE`: a plot with the defaults of `hwfoc plot`, of the frames the
+/// summary reads.
+pub struct Alongside {
+    target: Target,
+    options: Options,
+    collector: Collector,
+}
+
+impl Alongside {
+    /// Opens the image file (see [`Target::open`]).
+    pub fn open(path: &str, settings: Settings) -> Result<Alongside, CliError> {
+        let target = Target::open(path)?;
+        let options = Options {
+            width: draw::DEFAULT_WIDTH,
+            ..Options::default()
+        };
+        let collector = Collector::new(settings, Window::ALL, &[], options.width);
+        Ok(Alongside {
+            target,
+            options,
+            collector,
+        })
+    }
+
+    /// Draws the plot of what was read from `sources` and writes it.
+    pub fn finish(mut self, sources: &Sources) -> Result<(), CliError> {
+        self.collector
+            .write(sources, &self.options, &mut self.target)
+    }
+}
+
+impl Handler for Alongside {
+    #[inline]
+    fn frame(&mut self, esc: u8, t: Option<f64>, decoded: Decoded) {
+        self.collector.frame(esc, t, decoded);
+    }
+}
+
+/// Hands every frame to two handlers: `hwfoc summary --plot` summarises and plots in one
+/// reading of the inputs.
+pub struct Both<'a, A, B>(pub &'a mut A, pub &'a mut B);
+
+impl<A: Handler, B: Handler> Handler for Both<'_, A, B> {
+    #[inline]
+    fn frame(&mut self, esc: u8, t: Option<f64>, decoded: Decoded) {
+        self.0.frame(esc, t, decoded);
+        self.1.frame(esc, t, decoded);
+    }
+
+    fn end_batch(&mut self, live: bool) -> Result<(), CliError> {
+        self.0.end_batch(live)?;
+        self.1.end_batch(live)
+    }
+}
