@@ -112,6 +112,20 @@ pub enum CliError {
         /// What is wrong and what to do.
         message: String,
     },
+    /// A configuration file could not be read.
+    Config {
+        /// The file.
+        path: String,
+        /// 1-based line of the mistake, where known.
+        line: Option<usize>,
+        /// What is wrong.
+        message: String,
+    },
+    /// The terminal could not be set up or drawn on.
+    Terminal {
+        /// Why.
+        source: io::Error,
+    },
     /// A row of a throttle profile CSV could not be read.
     Profile {
         /// The file as named on the command line.
@@ -246,6 +260,17 @@ impl fmt::Display for CliError {
                  ports with `hwfoc record`, then read the recording with the files"
             ),
             CliError::Usage { option, message } => write!(f, "{option}: {message}"),
+            CliError::Config {
+                path,
+                line: Some(line),
+                message,
+            } => write!(f, "{path} line {line}: {message}"),
+            CliError::Config {
+                path,
+                line: None,
+                message,
+            } => write!(f, "{path}: {message}"),
+            CliError::Terminal { source } => write!(f, "terminal: {source}"),
             CliError::Profile {
                 file,
                 line: 0,
@@ -272,6 +297,7 @@ impl std::error::Error for CliError {
             | CliError::Write { source, .. }
             | CliError::Create { source, .. }
             | CliError::Pty { source }
+            | CliError::Terminal { source }
             | CliError::Link { source, .. } => Some(source),
             CliError::Settings(e) => Some(e),
             _ => None,

@@ -8,6 +8,7 @@ mod demo;
 mod error;
 mod export;
 mod input;
+mod monitor;
 mod output;
 mod pcapng;
 mod plot;
@@ -37,11 +38,14 @@ struct Cli {
 
 #[derive(Debug, Subcommand)]
 enum Command {
+    /// Watch ESCs live: a dashboard of every ESC with alarms, charts and recording (or lines
+    /// of text with --plain/--json).
+    Monitor(Box<monitor::Args>),
     /// Decode telemetry into one record per data frame (JSON Lines, CSV or Parquet).
     Decode(DecodeArgs),
     /// Summarise a stream: frames, link quality, device information, min/max/mean of each field.
     Summary(SummaryArgs),
-    /// Plot each ESC's throttle, speed, currents, voltage and temperatures, faults marked (PNG, SVG).
+    /// Plot each ESC's telemetry over time, fault episodes marked (PNG or SVG).
     Plot(plot::Args),
     /// Record serial ports losslessly, with nanosecond receive times, to pcapng (Wireshark opens it).
     Record(record::Args),
@@ -168,6 +172,7 @@ struct SummaryArgs {
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match &cli.command {
+        Command::Monitor(args) => monitor::run(args),
         Command::Decode(args) => decode::run(args),
         Command::Summary(args) => summary::run(args),
         Command::Record(args) => record::run(args),

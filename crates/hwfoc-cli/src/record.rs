@@ -138,8 +138,24 @@ impl PortState {
     }
 }
 
-/// The file being written and the rotation state.
-struct Recorder {
+/// Where and how a recording is written.
+#[derive(Debug, Clone)]
+pub struct Plan {
+    /// The file (with rotation, the base of the numbered names).
+    pub output: String,
+    /// Rotate before a file would grow past this many bytes.
+    pub rotate_size: Option<u64>,
+    /// Rotate after this long.
+    pub rotate_time: Option<Duration>,
+    /// Baud rate of the ports (in each interface's description).
+    pub baud: u32,
+    /// Print gaps and link warnings on standard error (not under a full-screen display).
+    pub warn: bool,
+}
+
+/// A recording being written: the file, its rotation, and what is known of each port.
+pub struct Recorder {
+    warn: bool,
     base: String,
     rotate_size: Option<u64>,
     rotate_time: Option<Duration>,
@@ -165,7 +181,14 @@ pub fn run(args: &Args) -> Result<(), CliError> {
     let interrupted = serial::interrupted();
     let set = PortSet::open(&args.ports, args.baud)?;
     let started = Instant::now();
-    let mut recorder = Recorder::new(args, set.names(), set.clock())?;
+    let plan = Plan {
+        output: args.output.clone(),
+        rotate_size: args.rotate_size,
+        rotate_time: args.rotate_time.map(Duration::from_secs_f64),
+        baud: args.baud,
+        warn: true,
+    };
+    let mut recorder = Recorder::new(plan, set.names(), set.clock())?;
     eprintln!(
         "hwfoc: recording {} at {} baud to {}; Ctrl-C stops",
         set.names().join(", "),
@@ -205,20 +228,22 @@ pub fn run(args: &Args) -> Result<(), CliError> {
 }
 
 impl Recorder {
-    fn new(args: &Args, ports: &[String], clock: serial::Clock) -> Result<Recorder, CliError> {
-        let rotating = args.rotate_size.is_some() || args.rotate_time.is_some();
+    /// Creates the (first) file, with one interface per port, timestamps from `clock`.
+    pub fn new(plan: Plan, ports: &[String], clock: serial::Clock) -> Result<Recorder, CliError> {
+        let rotating = plan.rotate_size.is_some() || plan.rotate_time.is_some();
         let first = if rotating {
-            numbered(&args.output, 1)
+            numbered(&plan.output, 1)
         } else {
-            args.output.clone()
+            plan.output.clone()
         };
-        let writer = create(&first, ports, args.baud)?;
+        let writer = create(&first, ports, plan.baud)?;
         let now = Instant::now();
         Ok(Recorder {
-            base: args.output.clone(),
-            rotate_size: args.rotate_size,
-            rotate_time: args.rotate_time.map(Duration::from_secs_f64),
-            baud: args.baud,
+            warn: plan.warn,
+            base: plan.output,
+            rotate_size: plan.rotate_size,
+            rotate_time: plan.rotate_time,
+            baud: plan.baud,
             files: vec![first],
             writer: Some(writer),
             file_has_packets: false,
@@ -242,7 +267,7 @@ impl Recorder {
     }
 
     /// The file being written.
-    fn current(&self) -> &str {
+    pub fn current(&self) -> &str {
         self.files.last().map_or("", String::as_str)
     }
 
@@ -253,7 +278,8 @@ impl Recorder {
         }
     }
 
-    fn handle(&mut self, event: PortEvent) -> Result<(), CliError> {
+    /// Writes what a port reported: bytes as a packet, a loss or return as a note.
+    pub fn handle(&mut self, event: PortEvent) -> Result<(), CliError> {
         match event {
             PortEvent::Data { port, t_ns, bytes } => {
                 if let (Some(limit), Some(writer)) = (self.rotate_size, &self.writer) {
@@ -277,7 +303,9 @@ impl Recorder {
                     state.name,
                     serial::RETRY_EVERY.as_millis()
                 );
-                eprintln!("hwfoc: warning: {note}; the recording goes on");
+                if self.warn {
+                    eprintln!("hwfoc: warning: {note}; the recording goes on");
+                }
                 self.note(port, t_ns, &note)?;
             }
             PortEvent::Back { port, t_ns } => {
@@ -288,7 +316,9 @@ impl Recorder {
                     .map_or(0.0, |lost| t_ns.saturating_sub(lost) as f64 * 1e-9);
                 state.silent_since = Some(Instant::now());
                 let note = format!("resumed: {} is back after a gap of {gap:.1} s", state.name);
-                eprintln!("hwfoc: {note}");
+                if self.warn {
+                    eprintln!("hwfoc: {note}");
+                }
                 self.note(port, t_ns, &note)?;
             }
         }
@@ -319,8 +349,9 @@ impl Recorder {
         }
     }
 
-    /// Periodic work: flushing, syncing, rotating by time, warnings.
-    fn tick(&mut self) -> Result<(), CliError> {
+    /// Periodic work: flushing, syncing, rotating by time, warnings. Call it at least every
+    /// [`FLUSH_EVERY`].
+    pub fn tick(&mut self) -> Result<(), CliError> {
         if self.last_flush.elapsed() >= FLUSH_EVERY {
             self.flush()?;
         }
@@ -337,6 +368,9 @@ impl Recorder {
                 .is_some_and(|every| self.file_started.elapsed() >= every)
         {
             self.rotate()?;
+        }
+        if !self.warn {
+            return Ok(());
         }
         let baud = self.baud;
         for state in &mut self.ports {
@@ -427,12 +461,12 @@ impl Recorder {
     }
 
     /// Writes everything out and syncs the file.
-    fn close(&mut self) -> Result<(), CliError> {
+    pub fn close(&mut self) -> Result<(), CliError> {
         self.rotate()
     }
 
     /// One line: how long, where, and bytes and frames per port.
-    fn status(&self, elapsed: Duration) -> String {
+    pub fn status(&self, elapsed: Duration) -> String {
         let files = match self.files.as_slice() {
             [one] => one.clone(),
             [first, .., last] => format!("{first} … {last} ({} files)", self.files.len()),

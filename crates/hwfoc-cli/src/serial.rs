@@ -259,18 +259,29 @@ pub enum PortEvent {
 
 /// Several serial ports read at once, one thread per port, events on one channel.
 pub struct PortSet {
+    readers: Readers,
+    events: Receiver<PortEvent>,
+}
+
+/// The reader threads of several ports, sending their events into a channel of the caller's
+/// (wrapped in the caller's message type); dropping it stops them.
+pub struct Readers {
     names: Vec<String>,
     baud: u32,
     clock: Clock,
-    events: Receiver<PortEvent>,
     stop: Arc<AtomicBool>,
     threads: Vec<JoinHandle<()>>,
 }
 
-impl PortSet {
+impl Readers {
     /// Opens every port (all of them, before any reading starts, so that a bad name is
-    /// reported at once) and starts their reader threads.
-    pub fn open(names: &[String], baud: u32) -> Result<PortSet, CliError> {
+    /// reported at once) and starts their reader threads, which send `wrap(event)` on `tx`.
+    pub fn start<M: Send + 'static>(
+        names: &[String],
+        baud: u32,
+        tx: Sender<M>,
+        wrap: fn(PortEvent) -> M,
+    ) -> Result<Readers, CliError> {
         if let Some((i, name)) = names
             .iter()
             .enumerate()
@@ -291,7 +302,6 @@ impl PortSet {
             .collect::<Result<Vec<_>, _>>()?;
         let clock = Clock::new();
         let stop = Arc::new(AtomicBool::new(false));
-        let (tx, events) = mpsc::channel();
         let threads = ports
             .into_iter()
             .enumerate()
@@ -303,6 +313,7 @@ impl PortSet {
                     clock,
                     stop: Arc::clone(&stop),
                     tx: tx.clone(),
+                    wrap,
                     last_ns: None,
                 };
                 thread::Builder::new()
@@ -314,11 +325,10 @@ impl PortSet {
                     })
             })
             .collect::<Result<Vec<_>, _>>()?;
-        Ok(PortSet {
+        Ok(Readers {
             names: names.to_vec(),
             baud,
             clock,
-            events,
             stop,
             threads,
         })
@@ -329,14 +339,47 @@ impl PortSet {
         &self.names
     }
 
+    /// The clock the events' times come from.
+    pub fn clock(&self) -> Clock {
+        self.clock
+    }
+
+    fn shut_down(&mut self) {
+        self.stop.store(true, Ordering::Relaxed);
+        for thread in self.threads.drain(..) {
+            let _ = thread.join();
+        }
+    }
+}
+
+impl Drop for Readers {
+    fn drop(&mut self) {
+        self.shut_down();
+    }
+}
+
+impl PortSet {
+    /// Opens every port (all of them, before any reading starts, so that a bad name is
+    /// reported at once) and starts their reader threads.
+    pub fn open(names: &[String], baud: u32) -> Result<PortSet, CliError> {
+        let (tx, events) = mpsc::channel();
+        let readers = Readers::start(names, baud, tx, |event| event)?;
+        Ok(PortSet { readers, events })
+    }
+
+    /// The ports, in the order given.
+    pub fn names(&self) -> &[String] {
+        self.readers.names()
+    }
+
     /// The baud rate of every port.
     pub fn baud(&self) -> u32 {
-        self.baud
+        self.readers.baud
     }
 
     /// The clock the events' times come from.
     pub fn clock(&self) -> Clock {
-        self.clock
+        self.readers.clock()
     }
 
     /// The next event, waiting at most `timeout`; `None` if none came.
@@ -352,37 +395,25 @@ impl PortSet {
     /// Stops the reader threads, waits for them, and returns the events they sent before
     /// stopping (bytes received up to the end are not lost).
     pub fn close(mut self) -> Vec<PortEvent> {
-        self.shut_down();
+        self.readers.shut_down();
         self.events.try_iter().collect()
-    }
-
-    fn shut_down(&mut self) {
-        self.stop.store(true, Ordering::Relaxed);
-        for thread in self.threads.drain(..) {
-            let _ = thread.join();
-        }
-    }
-}
-
-impl Drop for PortSet {
-    fn drop(&mut self) {
-        self.shut_down();
     }
 }
 
 /// One port's reader thread.
-struct PortReader {
+struct PortReader<M> {
     index: usize,
     name: String,
     baud: u32,
     clock: Clock,
     stop: Arc<AtomicBool>,
-    tx: Sender<PortEvent>,
+    tx: Sender<M>,
+    wrap: fn(PortEvent) -> M,
     /// Time of the previous chunk's last byte.
     last_ns: Option<u64>,
 }
 
-impl PortReader {
+impl<M> PortReader<M> {
     fn run(mut self, port: Box<dyn SerialPort>) {
         let mut port = Some(port);
         let mut buf = vec![0u8; READ_SIZE];
@@ -416,7 +447,7 @@ impl PortReader {
                     t_ns: self.clock.now_ns(),
                     reason,
                 };
-                if self.tx.send(event).is_err() {
+                if self.tx.send((self.wrap)(event)).is_err() {
                     return;
                 }
             }
@@ -432,11 +463,11 @@ impl PortReader {
             t_ns = t_ns.max(last + per_byte as u64);
         }
         self.last_ns = Some(t_ns + span);
-        let _ = self.tx.send(PortEvent::Data {
+        let _ = self.tx.send((self.wrap)(PortEvent::Data {
             port: self.index,
             t_ns,
             bytes: bytes.to_vec(),
-        });
+        }));
     }
 
     /// Waits [`RETRY_EVERY`] (or until asked to stop) and tries to open the port again.
@@ -453,7 +484,7 @@ impl PortReader {
             port: self.index,
             t_ns: self.clock.now_ns(),
         };
-        self.tx.send(event).ok()?;
+        self.tx.send((self.wrap)(event)).ok()?;
         Some(port)
     }
 }

@@ -23,7 +23,7 @@ mod profile;
 mod pty;
 mod rng;
 mod schedule;
-mod sink;
+pub mod sink;
 
 use std::io::IsTerminal;
 use std::rc::Rc;
@@ -74,9 +74,6 @@ pub struct Args {
     /// Number of virtual ESCs (esc 0..N-1). With --port: one per port.
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u16).range(1..=256))]
     escs: Option<u16>,
-    /// Seed of every random choice: the same seed and options give the same bytes.
-    #[arg(long, value_name = "N", default_value_t = 1)]
-    seed: u64,
     /// Seconds of simulated time. Default: one run of the profile plus 2 s for files and
     /// standard output; until Ctrl-C in real time.
     #[arg(long, value_name = "S", value_parser = positive)]
@@ -85,6 +82,62 @@ pub struct Args {
     #[arg(long, value_name = "BAUD", default_value_t = 19_200,
           value_parser = clap::value_parser!(u32).range(9_600..=4_000_000))]
     baud: u32,
+    /// The virtual ESCs: random seed, throttle profile, physical model, faults.
+    #[command(flatten)]
+    pub model: ModelArgs,
+    /// How the ESC scales currents and which pole pairs it has; the ground truth is converted
+    /// with the same settings (and the gear ratio).
+    #[command(flatten, next_help_heading = "Model")]
+    settings: SettingsArgs,
+
+    /// A pseudo-terminal per ESC: prints `esc N: PATH` per line, then runs in real time.
+    #[arg(long, conflicts_with_all = ["port", "output"], help_heading = "Output")]
+    pty: bool,
+    /// With --pty: a symlink to each ESC's pty (one PATH per ESC, or one with `{esc}` in it),
+    /// removed on exit.
+    #[arg(long, value_name = "PATH", requires = "pty", help_heading = "Output")]
+    link: Vec<String>,
+    /// With --pty: symlinks DIR/esc0, DIR/esc1, ... (DIR is created), removed on exit.
+    #[arg(
+        long,
+        value_name = "DIR",
+        requires = "pty",
+        conflicts_with = "link",
+        help_heading = "Output"
+    )]
+    link_dir: Option<String>,
+    /// Real serial ports, one per ESC, in real time.
+    #[arg(long, value_name = "PORT", num_args = 1.., conflicts_with = "output",
+          help_heading = "Output")]
+    port: Vec<String>,
+    /// Write to FILE as fast as possible (`{esc}` in the name: one file per ESC). Default:
+    /// standard output.
+    #[arg(short, long, value_name = "FILE", help_heading = "Output")]
+    output: Option<String>,
+    /// File format. Default: pcapng for a name ending in .pcapng, raw otherwise.
+    #[arg(long, value_enum, help_heading = "Output")]
+    format: Option<FileFormat>,
+    /// Write the file or standard output at the real rate instead of as fast as possible.
+    #[arg(long, help_heading = "Output")]
+    realtime: bool,
+    /// Write the ground truth: one JSON Lines record per data frame delivered intact.
+    #[arg(long, value_name = "FILE", help_heading = "Output")]
+    truth: Option<String>,
+    /// Unix time (seconds) of the start, for recordings and the truth of file outputs.
+    /// Default: now for pcapng, 0 for raw bytes.
+    #[arg(long, value_name = "UNIX_S", value_parser = non_negative, help_heading = "Output")]
+    start_time: Option<f64>,
+    /// No per-ESC report on standard error at the end.
+    #[arg(short, long, help_heading = "Output")]
+    quiet: bool,
+}
+
+/// What the virtual ESCs do, shared by `hwfoc simulate` and `hwfoc monitor --sim`.
+#[derive(Debug, Clone, clap::Args)]
+pub struct ModelArgs {
+    /// Seed of every random choice: the same seed and options give the same bytes.
+    #[arg(long, value_name = "N", default_value_t = 1)]
+    seed: u64,
     /// First packet number of every ESC (e.g. 65500 to see the wrap soon). Default: random
     /// per ESC, from the seed.
     #[arg(long, value_name = "N")]
@@ -143,11 +196,6 @@ pub struct Args {
     #[arg(long, value_name = "DEGC", default_value_t = 25.0, value_parser = ambient,
           help_heading = "Model")]
     ambient: f64,
-    /// How the ESC scales currents and which pole pairs it has; the ground truth is converted
-    /// with the same settings (and the gear ratio).
-    #[command(flatten, next_help_heading = "Model")]
-    settings: SettingsArgs,
-
     /// Raise a status bit from START to END seconds (to the end without END), on every ESC or
     /// on ESC number ESC. Repeatable.
     #[arg(
@@ -172,47 +220,106 @@ pub struct Args {
     #[arg(long, value_name = "P", default_value_t = 0.0, value_parser = probability,
           help_heading = "Faults")]
     garbage_rate: f64,
+}
 
-    /// A pseudo-terminal per ESC: prints `esc N: PATH` per line, then runs in real time.
-    #[arg(long, conflicts_with_all = ["port", "output"], help_heading = "Output")]
-    pty: bool,
-    /// With --pty: a symlink to each ESC's pty (one PATH per ESC, or one with `{esc}` in it),
-    /// removed on exit.
-    #[arg(long, value_name = "PATH", requires = "pty", help_heading = "Output")]
-    link: Vec<String>,
-    /// With --pty: symlinks DIR/esc0, DIR/esc1, ... (DIR is created), removed on exit.
-    #[arg(
-        long,
-        value_name = "DIR",
-        requires = "pty",
-        conflicts_with = "link",
-        help_heading = "Output"
-    )]
-    link_dir: Option<String>,
-    /// Real serial ports, one per ESC, in real time.
-    #[arg(long, value_name = "PORT", num_args = 1.., conflicts_with = "output",
-          help_heading = "Output")]
-    port: Vec<String>,
-    /// Write to FILE as fast as possible (`{esc}` in the name: one file per ESC). Default:
-    /// standard output.
-    #[arg(short, long, value_name = "FILE", help_heading = "Output")]
-    output: Option<String>,
-    /// File format. Default: pcapng for a name ending in .pcapng, raw otherwise.
-    #[arg(long, value_enum, help_heading = "Output")]
-    format: Option<FileFormat>,
-    /// Write the file or standard output at the real rate instead of as fast as possible.
-    #[arg(long, help_heading = "Output")]
-    realtime: bool,
-    /// Write the ground truth: one JSON Lines record per data frame delivered intact.
-    #[arg(long, value_name = "FILE", help_heading = "Output")]
-    truth: Option<String>,
-    /// Unix time (seconds) of the start, for recordings and the truth of file outputs.
-    /// Default: now for pcapng, 0 for raw bytes.
-    #[arg(long, value_name = "UNIX_S", value_parser = non_negative, help_heading = "Output")]
-    start_time: Option<f64>,
-    /// No per-ESC report on standard error at the end.
-    #[arg(short, long, help_heading = "Output")]
-    quiet: bool,
+impl ModelArgs {
+    /// The `n` virtual ESCs these arguments describe, at `baud`, their currents and RPM scaled
+    /// by `settings`: checked (fault ESC numbers, the profile file) but not started.
+    pub fn fleet(
+        &self,
+        n: usize,
+        baud: u32,
+        settings: &hwfoc::Settings,
+    ) -> Result<Fleet, CliError> {
+        if let Some(bad) = self.faults.iter().find(|f| f.esc.is_some_and(|e| e >= n)) {
+            return Err(usage(
+                "--fault",
+                format!(
+                    "ESC {} does not exist: there are {n} (0..{})",
+                    bad.esc.unwrap_or(0),
+                    n - 1
+                ),
+            ));
+        }
+        let shape = Shape {
+            lead_in_s: self.lead_in,
+            levels: self.levels.clone(),
+            hold_s: self.hold,
+            period_s: self.period,
+            max_pct: self.max_throttle,
+        };
+        Ok(Fleet {
+            n,
+            seed: self.seed,
+            baud,
+            start_packet: self.start_packet,
+            profile: Profile::load(&self.profile, &shape)?,
+            config: model::Config {
+                kv: self.kv,
+                pole_pairs: settings.pole_pairs,
+                full_current_a: self.full_current,
+                cells: self.cells,
+                battery_r_ohm: self.battery_r,
+                capacity_mah: self.capacity,
+                ambient_c: self.ambient,
+                current_scale: settings.current_scale,
+            },
+            faults: self.faults.clone(),
+            link: LinkRates {
+                bit_error: self.bit_error_rate,
+                drop: self.drop_rate,
+                cut: self.cut_rate,
+                garbage: self.garbage_rate,
+            },
+        })
+    }
+}
+
+/// Virtual ESCs described and checked, not yet started; it can be moved to another thread.
+#[derive(Debug)]
+pub struct Fleet {
+    n: usize,
+    seed: u64,
+    baud: u32,
+    start_packet: Option<u16>,
+    profile: Profile,
+    config: model::Config,
+    faults: Vec<FaultSpec>,
+    link: LinkRates,
+}
+
+impl Fleet {
+    /// The ESCs, at rest at time zero.
+    fn escs(self) -> Vec<VirtualEsc> {
+        let profile = Rc::new(self.profile);
+        (0..self.n)
+            .map(|index| {
+                VirtualEsc::new(Setup {
+                    index,
+                    seed: self.seed,
+                    baud: self.baud,
+                    start_packet: self.start_packet,
+                    model: self.config,
+                    profile: Rc::clone(&profile),
+                    faults: FaultSchedule::for_esc(&self.faults, index),
+                    link: self.link,
+                })
+            })
+            .collect()
+    }
+
+    /// Runs the ESCs in real time from now until `stop` is set, each burst handed whole to
+    /// `sink` when its first byte is due (Unix time in ns), as a UART's reader would get it.
+    pub fn run_live(self, sink: &mut dyn Sink, stop: &AtomicBool) -> Result<(), CliError> {
+        let origin_ns = SystemTime::now()
+            .duration_since(UNIX_EPOCH)
+            .map_or(0, |d| d.as_nanos() as u64);
+        let clock = Clock {
+            origin_ns,
+            real: Some(Instant::now()),
+        };
+        schedule::run(self.escs(), sink, None, Pace::Whole, clock, None, stop).map(|_| ())
+    }
 }
 
 fn number(s: &str) -> Result<f64, String> {
@@ -295,16 +402,6 @@ pub fn run(args: &Args) -> Result<(), CliError> {
     if n > 256 {
         return Err(usage("--port", "at most 256 ESCs"));
     }
-    if let Some(bad) = args.faults.iter().find(|f| f.esc.is_some_and(|e| e >= n)) {
-        return Err(usage(
-            "--fault",
-            format!(
-                "ESC {} does not exist: there are {n} (0..{})",
-                bad.esc.unwrap_or(0),
-                n - 1
-            ),
-        ));
-    }
     let target = if args.pty {
         Target::Pty
     } else if !args.port.is_empty() {
@@ -360,49 +457,13 @@ pub fn run(args: &Args) -> Result<(), CliError> {
         _ => {}
     }
 
-    let shape = Shape {
-        lead_in_s: args.lead_in,
-        levels: args.levels.clone(),
-        hold_s: args.hold,
-        period_s: args.period,
-        max_pct: args.max_throttle,
-    };
-    let profile = Rc::new(Profile::load(&args.profile, &shape)?);
+    let fleet = args.model.fleet(n, args.baud, &settings)?;
     let duration_s = match args.duration {
         Some(d) => Some(d),
         None if realtime => None,
-        None => Some(profile.natural_length_s() + TAIL_S),
+        None => Some(fleet.profile.natural_length_s() + TAIL_S),
     };
-    let config = model::Config {
-        kv: args.kv,
-        pole_pairs: settings.pole_pairs,
-        full_current_a: args.full_current,
-        cells: args.cells,
-        battery_r_ohm: args.battery_r,
-        capacity_mah: args.capacity,
-        ambient_c: args.ambient,
-        current_scale: settings.current_scale,
-    };
-    let link = LinkRates {
-        bit_error: args.bit_error_rate,
-        drop: args.drop_rate,
-        cut: args.cut_rate,
-        garbage: args.garbage_rate,
-    };
-    let escs: Vec<VirtualEsc> = (0..n)
-        .map(|index| {
-            VirtualEsc::new(Setup {
-                index,
-                seed: args.seed,
-                baud: args.baud,
-                start_packet: args.start_packet,
-                model: config,
-                profile: Rc::clone(&profile),
-                faults: FaultSchedule::for_esc(&args.faults, index),
-                link,
-            })
-        })
-        .collect();
+    let escs = fleet.escs();
 
     // The truth file is opened before the outputs, so that a path that cannot be written is
     // reported before any pseudo-terminal is announced.

@@ -1,0 +1,613 @@
+//! The full-screen dashboard (ratatui over crossterm).
+//!
+//! From top to bottom: a title line (time, recording, pause), one row per ESC with live values
+//! and peaks, then the selected ESC's charts of the last minute beside the alarm log, and a line
+//! of keys. Warning cells are yellow, critical ones red. It redraws at most every
+//! [`FRAME_EVERY`] while frames arrive (so a frame is on the screen well within 100 ms) and
+//! every [`IDLE_EVERY`] otherwise (ages tick on). The terminal is restored however it ends:
+//! `q`, Ctrl-C, SIGTERM, `--duration`, an error, or a panic (ratatui's hook).
+
+use std::collections::VecDeque;
+use std::thread;
+use std::time::{Duration, Instant};
+
+use ratatui::DefaultTerminal;
+use ratatui::Frame;
+use ratatui::crossterm::event::{self, Event, KeyCode, KeyEvent, KeyEventKind, KeyModifiers};
+use ratatui::layout::{Alignment, Constraint, Layout, Rect};
+use ratatui::style::{Color, Modifier, Style, Stylize};
+use ratatui::symbols::Marker;
+use ratatui::text::{Line, Span};
+use ratatui::widgets::{
+    Axis, Block, Borders, Cell, Chart, Clear, Dataset, GraphType, List, ListItem, Paragraph, Row,
+    Table, TableState,
+};
+
+use super::alarms::{Change, Level};
+use super::feed::Msg;
+use super::fleet::{EscView, HISTORY_S, Link, LogEntry};
+use super::{Session, number};
+use crate::error::CliError;
+
+/// Shortest time between redraws while frames arrive.
+const FRAME_EVERY: Duration = Duration::from_millis(50);
+/// Redraw at least this often.
+const IDLE_EVERY: Duration = Duration::from_millis(250);
+
+/// What the screen shows: live, or a copy frozen by `p`.
+#[derive(Clone, Copy)]
+struct View<'a> {
+    escs: &'a [EscView],
+    log: &'a VecDeque<LogEntry>,
+    now: f64,
+}
+
+/// The copy the display shows while paused.
+struct Frozen {
+    escs: Vec<EscView>,
+    log: VecDeque<LogEntry>,
+    now: f64,
+}
+
+/// The dashboard's own state.
+struct Ui {
+    selected: usize,
+    frozen: Option<Frozen>,
+    help: bool,
+    quit: bool,
+}
+
+/// Runs the dashboard until `q`, Ctrl-C, SIGTERM or the end of `--duration`.
+pub fn run(session: &mut Session) -> Result<(), CliError> {
+    let mut terminal = ratatui::try_init().map_err(|source| CliError::Terminal { source })?;
+    let result = main_loop(session, &mut terminal);
+    let restored = ratatui::try_restore().map_err(|source| CliError::Terminal { source });
+    result.and(restored)
+}
+
+fn main_loop(session: &mut Session, terminal: &mut DefaultTerminal) -> Result<(), CliError> {
+    let tx = session.sender();
+    // Keys, resizes: read in a thread of their own, delivered with the telemetry.
+    thread::Builder::new()
+        .name("keyboard".into())
+        .spawn(move || {
+            while let Ok(event) = event::read() {
+                if tx.send(Msg::Term(event)).is_err() {
+                    break;
+                }
+            }
+        })
+        .map_err(|source| CliError::Terminal { source })?;
+    let mut ui = Ui {
+        selected: 0,
+        frozen: None,
+        help: false,
+        quit: false,
+    };
+    let mut last_draw: Option<Instant> = None;
+    let mut dirty = true;
+    while !ui.quit && !session.should_stop() {
+        let now = Instant::now();
+        let due = match last_draw {
+            None => now,
+            Some(t) if dirty || session.perf.has_pending() => t + FRAME_EVERY,
+            Some(t) => t + IDLE_EVERY,
+        };
+        for event in session.pump(due.saturating_duration_since(now))? {
+            dirty |= handle(&mut ui, session, event);
+        }
+        let now = Instant::now();
+        let due = match last_draw {
+            None => now,
+            Some(t) if dirty || session.perf.has_pending() => t + FRAME_EVERY,
+            Some(t) => t + IDLE_EVERY,
+        };
+        if now >= due && !ui.quit {
+            let view = match &ui.frozen {
+                Some(f) => View {
+                    escs: &f.escs,
+                    log: &f.log,
+                    now: f.now,
+                },
+                None => View {
+                    escs: &session.fleet.escs,
+                    log: &session.fleet.log,
+                    now: session.now(),
+                },
+            };
+            let started = Instant::now();
+            terminal
+                .draw(|frame| draw(frame, session, &ui, view))
+                .map_err(|source| CliError::Terminal { source })?;
+            session.perf.drawn(started, Instant::now());
+            last_draw = Some(started);
+            dirty = false;
+        }
+    }
+    Ok(())
+}
+
+/// Acts on a key or a resize; returns whether the screen should be redrawn soon.
+fn handle(ui: &mut Ui, session: &mut Session, event: Event) -> bool {
+    let Event::Key(KeyEvent {
+        code,
+        modifiers,
+        kind,
+        ..
+    }) = event
+    else {
+        // A resize (or focus, paste): redraw.
+        return true;
+    };
+    if kind == KeyEventKind::Release {
+        return false;
+    }
+    let n = session.fleet.escs.len();
+    match code {
+        KeyCode::Char('c') if modifiers.contains(KeyModifiers::CONTROL) => ui.quit = true,
+        KeyCode::Char('q') => ui.quit = true,
+        KeyCode::Esc if ui.help => ui.help = false,
+        KeyCode::Esc => ui.quit = true,
+        KeyCode::Char('?') | KeyCode::Char('h') | KeyCode::F(1) => ui.help = !ui.help,
+        KeyCode::Up | KeyCode::Char('k') | KeyCode::BackTab => {
+            ui.selected = (ui.selected + n - 1) % n.max(1);
+        }
+        KeyCode::Down | KeyCode::Char('j') | KeyCode::Tab => {
+            ui.selected = (ui.selected + 1) % n.max(1);
+        }
+        KeyCode::Home => ui.selected = 0,
+        KeyCode::End => ui.selected = n.saturating_sub(1),
+        KeyCode::Char(d @ '0'..='9') => {
+            let i = d as usize - '0' as usize;
+            if i < n {
+                ui.selected = i;
+            }
+        }
+        KeyCode::Char('p') | KeyCode::Char(' ') => {
+            ui.frozen = match ui.frozen {
+                Some(_) => None,
+                None => Some(Frozen {
+                    escs: session.fleet.escs.clone(),
+                    log: session.fleet.log.clone(),
+                    now: session.now(),
+                }),
+            };
+        }
+        KeyCode::Char('c') => {
+            session.fleet.reset_peaks();
+            session.notice = Some("peaks reset".into());
+        }
+        KeyCode::Char('r') => session.toggle_recording(),
+        _ => return false,
+    }
+    true
+}
+
+fn draw(frame: &mut Frame, session: &Session, ui: &Ui, view: View<'_>) {
+    let n = view.escs.len();
+    let table_height = (n as u16 + 3).min(frame.area().height.saturating_sub(6).max(4));
+    let [title, table, bottom, keys] = Layout::vertical([
+        Constraint::Length(1),
+        Constraint::Length(table_height),
+        Constraint::Min(0),
+        Constraint::Length(1),
+    ])
+    .areas(frame.area());
+    draw_title(frame, title, session, ui, view);
+    draw_table(frame, table, ui, view);
+    let [detail, log] =
+        Layout::horizontal([Constraint::Percentage(68), Constraint::Percentage(32)]).areas(bottom);
+    if let Some(esc) = view.escs.get(ui.selected) {
+        draw_detail(frame, detail, ui.selected, esc, view.now);
+    }
+    draw_log(frame, log, view);
+    frame.render_widget(
+        Paragraph::new(Line::from(vec![
+            " ↑↓ ".bold(),
+            "select  ".into(),
+            "p ".bold(),
+            "pause  ".into(),
+            "c ".bold(),
+            "reset peaks  ".into(),
+            "r ".bold(),
+            "record  ".into(),
+            "? ".bold(),
+            "help  ".into(),
+            "q ".bold(),
+            "quit".into(),
+        ]))
+        .style(Style::new().fg(Color::Gray)),
+        keys,
+    );
+    if ui.help {
+        draw_help(frame, session);
+    }
+}
+
+fn draw_title(frame: &mut Frame, area: Rect, session: &Session, ui: &Ui, view: View<'_>) {
+    let n = view.escs.len();
+    let mut spans = vec![
+        " hwfoc monitor ".bold().reversed(),
+        format!(
+            "  {n} ESC{}{}  ",
+            if n == 1 { "" } else { "s" },
+            if session.simulated { " (virtual)" } else { "" }
+        )
+        .into(),
+        super::local_time(view.now, "%H:%M:%S").into(),
+        format!("  {} frames", session.fleet.frames).dark_gray(),
+    ];
+    if let Some(recorder) = &session.recorder {
+        spans.push("  ● REC ".red().bold());
+        spans.push(recorder.current().to_string().into());
+    }
+    if ui.frozen.is_some() {
+        spans.push("  PAUSED (p resumes)".yellow().bold());
+    }
+    if let Some(notice) = &session.notice {
+        spans.push(format!("  {notice}").cyan());
+    }
+    frame.render_widget(Paragraph::new(Line::from(spans)), area);
+}
+
+/// Style of a cell at an alarm level.
+fn level_style(level: Option<Level>) -> Style {
+    match level {
+        Some(Level::Critical) => Style::new().fg(Color::White).bg(Color::Red).bold(),
+        Some(Level::Warning) => Style::new().fg(Color::Black).bg(Color::Yellow),
+        None => Style::new(),
+    }
+}
+
+/// A live value with its peak beside it, dimmed: `20.3 ↑25.1`.
+fn with_peak(live: String, arrow: &str, peak: Option<f32>, decimals: usize) -> Line<'static> {
+    let mut spans = vec![Span::raw(live)];
+    if let Some(p) = peak {
+        spans.push(Span::styled(
+            format!(" {arrow}{}", number(p, decimals)),
+            Style::new().fg(Color::DarkGray),
+        ));
+    }
+    Line::from(spans)
+}
+
+fn draw_table(frame: &mut Frame, area: Rect, ui: &Ui, view: View<'_>) {
+    let header = Row::new([
+        "ESC",
+        "Name",
+        "Thr in/out %",
+        "RPM  ↑max",
+        "V  ↓min",
+        "A  ↑max",
+        "Phase A ↑max",
+        "MOS °C ↑max",
+        "CAP °C ↑max",
+        "fr/s",
+        "lost dup crc",
+        "age s",
+        "Faults and alarms",
+    ])
+    .style(Style::new().bold().underlined());
+    let rows = view.escs.iter().enumerate().map(|(i, esc)| {
+        let a = &esc.alarms;
+        let p = &esc.peaks;
+        let name = Cell::from(esc.title().to_string());
+        let (values, faults): (Vec<Cell>, Cell) = match (&esc.link, &esc.last) {
+            (Link::Down { since, .. }, _) => (
+                vec![Cell::from(""); 6],
+                Cell::from(format!("disconnected {:.0} s", view.now - since))
+                    .style(level_style(Some(Level::Critical))),
+            ),
+            (Link::Up, None) => (vec![Cell::from(""); 6], Cell::from("no frames yet")),
+            (Link::Up, Some(r)) => {
+                let temp = |t: Option<f32>| t.map_or("-".to_string(), |t| number(t, 0));
+                (
+                    vec![
+                        Cell::from(format!(
+                            "{}/{}",
+                            number(r.throttle_in_pct, 0),
+                            number(r.throttle_out_pct, 0)
+                        )),
+                        Cell::from(with_peak(number(r.rpm, 0), "↑", p.rpm, 0)),
+                        Cell::from(with_peak(number(r.voltage_v, 1), "↓", p.min_voltage_v, 1))
+                            .style(level_style(a.voltage.level())),
+                        Cell::from(with_peak(number(r.current_a, 1), "↑", p.current_a, 1)),
+                        Cell::from(with_peak(
+                            number(r.phase_current_a, 1),
+                            "↑",
+                            p.phase_current_a,
+                            1,
+                        )),
+                        Cell::from(with_peak(temp(r.mos_temp_c), "↑", p.mos_temp_c, 0))
+                            .style(level_style(a.mos.level())),
+                    ],
+                    alarm_cell(esc),
+                )
+            }
+        };
+        let cap = match &esc.last {
+            Some(r) if esc.link == Link::Up => Cell::from(with_peak(
+                r.cap_temp_c.map_or("-".into(), |t| number(t, 0)),
+                "↑",
+                p.cap_temp_c,
+                0,
+            ))
+            .style(level_style(a.cap.level())),
+            _ => Cell::from(""),
+        };
+        let stats = &esc.stats;
+        let link = format!(
+            "{} {} {}",
+            stats.lost_packets(),
+            stats.duplicate_packets(),
+            stats.checksum_failures()
+        );
+        let age = esc
+            .age(view.now)
+            .map_or("-".to_string(), |a| format!("{a:.1}"));
+        let mut cells = vec![Cell::from(format!("{i}")), name];
+        cells.extend(values);
+        cells.push(cap);
+        cells.push(Cell::from(format!("{:.1}", esc.frame_rate(view.now))));
+        cells.push(Cell::from(link));
+        cells.push(Cell::from(age).style(level_style(a.stale.level())));
+        cells.push(faults);
+        Row::new(cells)
+    });
+    let widths = [
+        Constraint::Length(3),
+        Constraint::Min(8),
+        Constraint::Length(12),
+        Constraint::Length(12),
+        Constraint::Length(11),
+        Constraint::Length(11),
+        Constraint::Length(12),
+        Constraint::Length(11),
+        Constraint::Length(11),
+        Constraint::Length(5),
+        Constraint::Length(12),
+        Constraint::Length(5),
+        Constraint::Fill(2),
+    ];
+    let table = Table::new(rows, widths)
+        .header(header)
+        .block(Block::new().borders(Borders::TOP | Borders::BOTTOM))
+        .row_highlight_style(Style::new().bg(Color::DarkGray))
+        .highlight_symbol("▶")
+        .column_spacing(1);
+    let mut state = TableState::default().with_selected(Some(ui.selected));
+    frame.render_stateful_widget(table, area, &mut state);
+}
+
+/// The active faults and alarms of an ESC by name, coloured by level.
+fn alarm_cell(esc: &EscView) -> Cell<'static> {
+    let active = esc.alarms.active();
+    if active.is_empty() {
+        return Cell::from("ok".green());
+    }
+    let worst = active.first().map(|(_, l)| *l);
+    let names: Vec<&str> = active.iter().map(|(k, _)| k.name()).collect();
+    Cell::from(names.join(" ")).style(level_style(worst))
+}
+
+fn draw_detail(frame: &mut Frame, area: Rect, index: usize, esc: &EscView, now: f64) {
+    let info = match &esc.info {
+        Some(info) => format!(
+            "{} · hw {} · fw {} · id {}",
+            info.product(),
+            info.hardware(),
+            info.firmware(),
+            info.id()
+        ),
+        None => "no device information yet (sent while idle)".to_string(),
+    };
+    let cells = match (esc.cells, esc.cells_detected) {
+        (Some(c), true) => format!("{c}S battery (detected; set --battery-cells)"),
+        (Some(c), false) => format!("{c}S battery"),
+        (None, _) => "battery cells unknown".to_string(),
+    };
+    let stats = &esc.stats;
+    let block = Block::bordered().title(Line::from(vec![
+        format!(" esc{index} ").bold(),
+        format!("{} ", esc.title()).into(),
+    ]));
+    let inner = block.inner(area);
+    frame.render_widget(block, area);
+    let [text, charts] = Layout::vertical([Constraint::Length(2), Constraint::Min(0)]).areas(inner);
+    frame.render_widget(
+        Paragraph::new(vec![
+            Line::from(info),
+            Line::from(format!(
+                "{cells} · {} frames · {} bytes, {} skipped · {} checksum failures",
+                stats.frames(),
+                stats.bytes(),
+                stats.bytes_skipped(),
+                stats.checksum_failures()
+            ))
+            .dark_gray(),
+        ]),
+        text,
+    );
+    let [top, low] = Layout::vertical([Constraint::Fill(1); 2]).areas(charts);
+    let [rpm_area, current_area] = Layout::horizontal([Constraint::Fill(1); 2]).areas(top);
+    let [volt_area, temp_area] = Layout::horizontal([Constraint::Fill(1); 2]).areas(low);
+    let series = |f: &dyn Fn(&super::fleet::Sample) -> Option<f32>| -> Vec<(f64, f64)> {
+        esc.history
+            .iter()
+            .filter_map(|s| f(s).map(|v| (s.t - now, f64::from(v))))
+            .collect()
+    };
+    let rpm = series(&|s| Some(s.rpm));
+    let current = series(&|s| Some(s.current_a));
+    let phase = series(&|s| Some(s.phase_current_a));
+    let volt = series(&|s| Some(s.voltage_v));
+    let mos = series(&|s| s.mos_temp_c);
+    let cap = series(&|s| s.cap_temp_c);
+    chart(frame, rpm_area, "RPM", &[("rpm", Color::Cyan, &rpm)], true);
+    chart(
+        frame,
+        current_area,
+        "Current A",
+        &[
+            ("input", Color::Yellow, &current),
+            ("phase", Color::Magenta, &phase),
+        ],
+        true,
+    );
+    chart(
+        frame,
+        volt_area,
+        "Voltage V",
+        &[("input", Color::Green, &volt)],
+        false,
+    );
+    chart(
+        frame,
+        temp_area,
+        "Temperature °C",
+        &[("MOS", Color::Red, &mos), ("CAP", Color::LightBlue, &cap)],
+        false,
+    );
+}
+
+/// One line of a chart: its name, colour and points (seconds before now, value).
+type Series<'a> = (&'a str, Color, &'a [(f64, f64)]);
+
+/// One chart of the last minute: x from -60 s to now, y fitted to the data.
+fn chart(frame: &mut Frame, area: Rect, title: &str, lines: &[Series<'_>], from_zero: bool) {
+    let values = lines.iter().flat_map(|(_, _, d)| d.iter().map(|p| p.1));
+    let (lo, hi) = values.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
+        (lo.min(v), hi.max(v))
+    });
+    let (lo, hi) = if lo.is_finite() {
+        let lo = if from_zero { lo.min(0.0) } else { lo };
+        let pad = ((hi - lo) * 0.1).max(if from_zero { 1.0 } else { 0.5 });
+        (
+            if from_zero && lo >= 0.0 {
+                0.0
+            } else {
+                lo - pad
+            },
+            hi + pad,
+        )
+    } else {
+        (0.0, 1.0)
+    };
+    let decimals = if hi - lo < 10.0 { 1 } else { 0 };
+    let label = |v: f64| Span::raw(format!("{v:.decimals$}"));
+    let datasets = lines
+        .iter()
+        .map(|(name, color, data)| {
+            Dataset::default()
+                .name(*name)
+                .marker(Marker::Braille)
+                .graph_type(GraphType::Line)
+                .style(Style::new().fg(*color))
+                .data(data)
+        })
+        .collect();
+    // The legend goes in the title, where it hides no data.
+    let mut heading = vec![Span::raw(title.to_string()).bold()];
+    if lines.len() > 1 {
+        for (name, color, _) in lines {
+            heading.push(Span::styled(format!("  ━ {name}"), Style::new().fg(*color)));
+        }
+    }
+    let chart = Chart::new(datasets)
+        .block(Block::new().title(Line::from(heading)))
+        .x_axis(
+            Axis::default()
+                .bounds([-HISTORY_S, 0.0])
+                .labels(["-60 s", "-30 s", "now"])
+                .style(Style::new().fg(Color::DarkGray)),
+        )
+        .y_axis(
+            Axis::default()
+                .bounds([lo, hi])
+                .labels([label(lo), label((lo + hi) / 2.0), label(hi)])
+                .style(Style::new().fg(Color::DarkGray)),
+        )
+        .legend_position(None);
+    frame.render_widget(chart, area);
+}
+
+fn draw_log(frame: &mut Frame, area: Rect, view: View<'_>) {
+    let height = area.height.saturating_sub(2) as usize;
+    let items: Vec<ListItem> = view
+        .log
+        .iter()
+        .rev()
+        .take(height)
+        .map(|e| {
+            let style = match (e.change, e.level) {
+                (Change::Cleared { .. }, _) => Style::new().fg(Color::Green),
+                (_, Level::Critical) => Style::new().fg(Color::Red).add_modifier(Modifier::BOLD),
+                (_, Level::Warning) => Style::new().fg(Color::Yellow),
+            };
+            let name = view.escs.get(e.esc).map_or("", |esc| esc.title());
+            ListItem::new(Line::from(vec![
+                Span::styled(
+                    super::local_time(e.t, "%H:%M:%S "),
+                    Style::new().fg(Color::DarkGray),
+                ),
+                Span::raw(format!("esc{} ", e.esc)),
+                Span::styled(e.text(), style),
+                Span::styled(format!("  {name}"), Style::new().fg(Color::DarkGray)),
+            ]))
+        })
+        .collect();
+    let title = format!(" Alarms ({}) ", view.log.len());
+    let list = if items.is_empty() {
+        List::new([ListItem::new("no alarms".green())])
+    } else {
+        List::new(items)
+    };
+    frame.render_widget(list.block(Block::bordered().title(title)), area);
+}
+
+fn draw_help(frame: &mut Frame, session: &Session) {
+    let limits = session.fleet.limits();
+    let lines = vec![
+        Line::from("Keys".bold()),
+        Line::from("  ↑ ↓  j k  Tab   select an ESC (0-9 jump to one)"),
+        Line::from("  p  space        pause / resume the display (data keeps coming)"),
+        Line::from("  c               reset the peaks (↑max, ↓min) of every ESC"),
+        Line::from("  r               start / stop recording everything to pcapng"),
+        Line::from("  ?  h            this help (Esc closes it)"),
+        Line::from("  q  Esc  Ctrl-C  quit"),
+        Line::from(""),
+        Line::from("Alarms".bold()),
+        Line::from(format!(
+            "  MOSFET ≥ {} °C warning, ≥ {} °C critical; capacitor ≥ {} / {} °C",
+            limits.mos.warning, limits.mos.critical, limits.cap.warning, limits.cap.critical
+        )),
+        Line::from(format!(
+            "  battery ≤ {} V/cell warning, ≤ {} V/cell critical",
+            limits.cell.warning, limits.cell.critical
+        )),
+        Line::from(format!(
+            "  stale after {} s without a frame; status bits by name (PROTOCOL-NOTES.md)",
+            limits.stale_after_s
+        )),
+        Line::from("  yellow: warning, red: critical; each alarm is logged once per episode"),
+        Line::from(match &session.config_file {
+            Some(path) => format!("  settings from {}", path.display()),
+            None => "  no configuration file (see hwfoc monitor --help)".to_string(),
+        }),
+    ];
+    let width = 76.min(frame.area().width);
+    let height = (lines.len() as u16 + 2).min(frame.area().height);
+    let area = Rect {
+        x: frame.area().width.saturating_sub(width) / 2,
+        y: frame.area().height.saturating_sub(height) / 2,
+        width,
+        height,
+    };
+    frame.render_widget(Clear, area);
+    frame.render_widget(
+        Paragraph::new(lines)
+            .alignment(Alignment::Left)
+            .block(Block::bordered().title(" help ")),
+        area,
+    );
+}

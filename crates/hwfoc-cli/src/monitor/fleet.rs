@@ -1,0 +1,700 @@
+//! What the monitor knows about each ESC: the latest frame, peaks, the last minute, the link,
+//! alarms and the alarm log. No terminal here: the dashboard and the headless printers only
+//! read it.
+
+use std::collections::VecDeque;
+
+use hwfoc::{Fault, Frame, InfoFrame, LinkStats, Settings};
+
+use super::alarms::{Change, Kind, Latch, Level, Threshold};
+use super::config::Limits;
+use crate::input::Batch;
+use crate::pcapng;
+use crate::schema::Record;
+use crate::serial::PortEvent;
+use crate::stream::Stream;
+
+/// Seconds of history kept for the charts.
+pub const HISTORY_S: f64 = 60.0;
+/// At most this many samples per ESC (a minute at 20 frames/s is 1200).
+const HISTORY_MAX: usize = 2048;
+/// Alarm log entries kept (the oldest go first).
+const LOG_MAX: usize = 1000;
+/// The window over which the frame rate is measured, seconds.
+const RATE_WINDOW_S: f64 = 2.0;
+/// Highest plausible voltage of one LiPo cell, for detecting the number of cells.
+const FULL_CELL_V: f64 = 4.35;
+
+/// One point of an ESC's history.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Sample {
+    /// Receive time, Unix seconds.
+    pub t: f64,
+    /// Mechanical RPM.
+    pub rpm: f32,
+    /// Input current, A.
+    pub current_a: f32,
+    /// Phase current, A.
+    pub phase_current_a: f32,
+    /// Input voltage, V.
+    pub voltage_v: f32,
+    /// MOSFET temperature, degC.
+    pub mos_temp_c: Option<f32>,
+    /// Capacitor temperature, degC.
+    pub cap_temp_c: Option<f32>,
+}
+
+/// Extremes since the start or the last reset.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Peaks {
+    /// Highest mechanical RPM.
+    pub rpm: Option<f32>,
+    /// Highest input current, A.
+    pub current_a: Option<f32>,
+    /// Highest phase current, A.
+    pub phase_current_a: Option<f32>,
+    /// Lowest input voltage, V.
+    pub min_voltage_v: Option<f32>,
+    /// Highest MOSFET temperature, degC.
+    pub mos_temp_c: Option<f32>,
+    /// Highest capacitor temperature, degC.
+    pub cap_temp_c: Option<f32>,
+}
+
+impl Peaks {
+    fn add(&mut self, r: &Record) {
+        fn max(slot: &mut Option<f32>, v: Option<f32>) {
+            if let Some(v) = v {
+                *slot = Some(slot.map_or(v, |s| s.max(v)));
+            }
+        }
+        max(&mut self.rpm, Some(r.rpm));
+        max(&mut self.current_a, Some(r.current_a));
+        max(&mut self.phase_current_a, Some(r.phase_current_a));
+        max(&mut self.mos_temp_c, r.mos_temp_c);
+        max(&mut self.cap_temp_c, r.cap_temp_c);
+        self.min_voltage_v = Some(
+            self.min_voltage_v
+                .map_or(r.voltage_v, |s| s.min(r.voltage_v)),
+        );
+    }
+}
+
+/// Whether the port of an ESC is there.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Link {
+    /// Open (frames may or may not be coming).
+    Up,
+    /// Gone since this Unix time; the reason the system gave.
+    Down {
+        /// Unix seconds.
+        since: f64,
+        /// What the operating system said.
+        reason: String,
+    },
+}
+
+/// The alarms of one ESC.
+#[derive(Debug, Clone, Default)]
+pub struct Alarms {
+    /// One per status bit, in bit order.
+    pub faults: [Latch; 16],
+    /// MOSFET temperature.
+    pub mos: Latch,
+    /// Capacitor temperature.
+    pub cap: Latch,
+    /// Low voltage.
+    pub voltage: Latch,
+    /// No frames.
+    pub stale: Latch,
+    /// Port gone.
+    pub disconnected: Latch,
+}
+
+impl Alarms {
+    /// The latch of `kind`.
+    pub fn latch(&self, kind: Kind) -> &Latch {
+        match kind {
+            Kind::Fault(f) => &self.faults[usize::from(f.bit())],
+            Kind::MosTemp => &self.mos,
+            Kind::CapTemp => &self.cap,
+            Kind::LowVoltage => &self.voltage,
+            Kind::Stale => &self.stale,
+            Kind::Disconnected => &self.disconnected,
+        }
+    }
+
+    /// The active alarms, worst first.
+    pub fn active(&self) -> Vec<(Kind, Level)> {
+        let mut all: Vec<(Kind, Level)> = Fault::ALL
+            .iter()
+            .map(|&f| Kind::Fault(f))
+            .chain([
+                Kind::Disconnected,
+                Kind::Stale,
+                Kind::MosTemp,
+                Kind::CapTemp,
+                Kind::LowVoltage,
+            ])
+            .filter_map(|k| self.latch(k).level().map(|l| (k, l)))
+            .collect();
+        all.sort_by_key(|&(_, level)| std::cmp::Reverse(level));
+        all
+    }
+}
+
+/// What the monitor shows of one ESC.
+#[derive(Debug, Clone)]
+pub struct EscView {
+    /// Its port (or `sim:escN`).
+    pub name: String,
+    /// Its label from the configuration, if any.
+    pub label: Option<String>,
+    /// Whether the port is there.
+    pub link: Link,
+    /// The latest data frame.
+    pub last: Option<Record>,
+    /// Receive time of the latest frame of any kind, Unix seconds.
+    pub last_frame_t: Option<f64>,
+    /// Extremes since the start or the last reset.
+    pub peaks: Peaks,
+    /// The last minute.
+    pub history: VecDeque<Sample>,
+    /// The latest device-information frame.
+    pub info: Option<InfoFrame>,
+    /// Link statistics of its decoder.
+    pub stats: LinkStats,
+    /// Battery cells: configured, or detected from the first voltage.
+    pub cells: Option<u8>,
+    /// Whether `cells` was detected rather than configured.
+    pub cells_detected: bool,
+    /// Its alarms.
+    pub alarms: Alarms,
+    /// Receive times of the frames of the last [`RATE_WINDOW_S`].
+    recent: VecDeque<f64>,
+    /// When watching started (for an ESC that never sends: stale from then on).
+    started: f64,
+}
+
+impl EscView {
+    /// Data frames per second over the last two seconds at time `now`.
+    pub fn frame_rate(&self, now: f64) -> f64 {
+        let n = self
+            .recent
+            .iter()
+            .filter(|&&t| t > now - RATE_WINDOW_S)
+            .count();
+        n as f64 / RATE_WINDOW_S
+    }
+
+    /// Seconds since the latest frame, at `now`.
+    pub fn age(&self, now: f64) -> Option<f64> {
+        self.last_frame_t.map(|t| (now - t).max(0.0))
+    }
+
+    /// The name to show: the label, or the port.
+    pub fn title(&self) -> &str {
+        self.label.as_deref().unwrap_or(&self.name)
+    }
+}
+
+/// One line of the alarm log.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LogEntry {
+    /// Unix seconds.
+    pub t: f64,
+    /// ESC index.
+    pub esc: usize,
+    /// The alarm.
+    pub kind: Kind,
+    /// What happened.
+    pub change: Change,
+    /// The alarm's level after the change (the level it had, for a clear).
+    pub level: Level,
+    /// The value that raised it (temperature, voltage), if any.
+    pub value: Option<f64>,
+}
+
+impl LogEntry {
+    /// What happened, in words: `mos_temp warning raised at 91.0 degC`,
+    /// `mos_overheat critical raised`, `low_voltage escalated to critical at 19.7 V`,
+    /// `stale cleared after 3.2 s`.
+    pub fn text(&self) -> String {
+        let name = self.kind.name();
+        let unit = match self.kind {
+            Kind::MosTemp | Kind::CapTemp => " degC",
+            Kind::LowVoltage => " V",
+            _ => "",
+        };
+        let at = |v: Option<f64>| v.map_or(String::new(), |v| format!(" at {v:.1}{unit}"));
+        match self.change {
+            Change::Raised(level) => format!("{name} {level} raised{}", at(self.value)),
+            Change::Escalated => format!("{name} escalated to critical{}", at(self.value)),
+            Change::Cleared { duration_s, worst } => {
+                let worst = match (worst, self.kind) {
+                    (Some(w), Kind::LowVoltage) => format!(" (lowest {w:.1}{unit})"),
+                    (Some(w), _) => format!(" (highest {w:.1}{unit})"),
+                    (None, _) => String::new(),
+                };
+                format!("{name} cleared after {duration_s:.1} s{worst}")
+            }
+        }
+    }
+
+    /// `raised`, `escalated` or `cleared`.
+    pub fn event(&self) -> &'static str {
+        match self.change {
+            Change::Raised(_) => "raised",
+            Change::Escalated => "escalated",
+            Change::Cleared { .. } => "cleared",
+        }
+    }
+}
+
+/// Every ESC watched, their decoders and the alarm log.
+pub struct Fleet {
+    /// What is shown of each ESC.
+    pub escs: Vec<EscView>,
+    /// The alarm log, oldest first.
+    pub log: VecDeque<LogEntry>,
+    /// How many entries were ever logged (the log keeps the last [`LOG_MAX`]).
+    pub logged: u64,
+    /// Data frames decoded in all.
+    pub frames: u64,
+    streams: Vec<Stream>,
+    settings: Settings,
+    limits: Limits,
+    byte_ns: f64,
+    times: Vec<f64>,
+}
+
+impl Fleet {
+    /// ESCs named `names` (labels beside them), watched from Unix time `now`, their bytes
+    /// arriving at `baud`.
+    pub fn new(
+        names: Vec<(String, Option<String>)>,
+        settings: Settings,
+        limits: Limits,
+        baud: u32,
+        now: f64,
+    ) -> Fleet {
+        let escs = names
+            .into_iter()
+            .map(|(name, label)| EscView {
+                name,
+                label,
+                link: Link::Up,
+                last: None,
+                last_frame_t: None,
+                peaks: Peaks::default(),
+                history: VecDeque::new(),
+                info: None,
+                stats: LinkStats::default(),
+                cells: limits.cells,
+                cells_detected: false,
+                alarms: Alarms::default(),
+                recent: VecDeque::new(),
+                started: now,
+            })
+            .collect::<Vec<_>>();
+        Fleet {
+            streams: escs.iter().map(|_| Stream::new()).collect(),
+            escs,
+            log: VecDeque::new(),
+            logged: 0,
+            frames: 0,
+            settings,
+            limits,
+            byte_ns: pcapng::byte_ns(baud),
+            times: Vec::new(),
+        }
+    }
+
+    /// The alarm levels in force.
+    pub fn limits(&self) -> &Limits {
+        &self.limits
+    }
+
+    /// The conversion settings.
+    pub fn settings(&self) -> &Settings {
+        &self.settings
+    }
+
+    /// Takes in what a port (or a virtual ESC) reported; returns the number of data frames it
+    /// completed.
+    pub fn on_event(&mut self, event: &PortEvent) -> usize {
+        match event {
+            PortEvent::Data { port, t_ns, bytes } => {
+                let Some(stream) = self.streams.get_mut(*port) else {
+                    return 0;
+                };
+                self.times.clear();
+                self.times
+                    .extend((0..bytes.len()).map(|i| pcapng::byte_time_s(*t_ns, i, self.byte_ns)));
+                let mut frames = Vec::new();
+                stream.feed(
+                    Batch {
+                        bytes,
+                        times: Some(&self.times),
+                        stream: *port,
+                    },
+                    |t, d| frames.push((t.unwrap_or(0.0), d.frame)),
+                );
+                let stats = *stream.stats();
+                let mut data = 0;
+                for (t, frame) in frames {
+                    match frame {
+                        Frame::Data(f) => {
+                            let record = Record::new(Some(t), *port as u8, &f, &self.settings);
+                            self.on_data(*port, t, record);
+                            data += 1;
+                        }
+                        Frame::Info(info) => {
+                            let esc = &mut self.escs[*port];
+                            esc.info = Some(info);
+                            esc.last_frame_t = Some(t);
+                        }
+                    }
+                }
+                self.escs[*port].stats = stats;
+                self.frames += data as u64;
+                data
+            }
+            PortEvent::Lost { port, t_ns, reason } => {
+                let t = *t_ns as f64 / 1e9;
+                if let Some(esc) = self.escs.get_mut(*port) {
+                    esc.link = Link::Down {
+                        since: t,
+                        reason: reason.clone(),
+                    };
+                    let change = esc.alarms.stale.clear(t);
+                    self.note(*port, Kind::Stale, change, t, None);
+                    let change =
+                        self.escs[*port]
+                            .alarms
+                            .disconnected
+                            .set(true, Level::Critical, 0.0, t);
+                    self.note(*port, Kind::Disconnected, change, t, None);
+                }
+                0
+            }
+            PortEvent::Back { port, t_ns } => {
+                let t = *t_ns as f64 / 1e9;
+                if let Some(esc) = self.escs.get_mut(*port) {
+                    esc.link = Link::Up;
+                    // Stale counts again from now: the ESC has a second to speak.
+                    esc.started = t;
+                    esc.last_frame_t = None;
+                    let change = esc.alarms.disconnected.clear(t);
+                    self.note(*port, Kind::Disconnected, change, t, None);
+                }
+                0
+            }
+        }
+    }
+
+    fn on_data(&mut self, i: usize, t: f64, r: Record) {
+        let limits = self.limits.clone();
+        let esc = &mut self.escs[i];
+        esc.last = Some(r);
+        esc.last_frame_t = Some(t);
+        esc.peaks.add(&r);
+        esc.recent.push_back(t);
+        while esc.recent.front().is_some_and(|&f| f <= t - RATE_WINDOW_S) {
+            esc.recent.pop_front();
+        }
+        esc.history.push_back(Sample {
+            t,
+            rpm: r.rpm,
+            current_a: r.current_a,
+            phase_current_a: r.phase_current_a,
+            voltage_v: r.voltage_v,
+            mos_temp_c: r.mos_temp_c,
+            cap_temp_c: r.cap_temp_c,
+        });
+        while esc.history.len() > HISTORY_MAX
+            || esc.history.front().is_some_and(|s| s.t < t - HISTORY_S)
+        {
+            esc.history.pop_front();
+        }
+        if esc.cells.is_none() && r.voltage_v > 2.0 {
+            esc.cells = Some(
+                (f64::from(r.voltage_v) / FULL_CELL_V)
+                    .ceil()
+                    .clamp(1.0, 255.0) as u8,
+            );
+            esc.cells_detected = true;
+        }
+
+        let mut changes: Vec<(Kind, Option<Change>, Option<f64>)> = Vec::with_capacity(4);
+        let a = &mut esc.alarms;
+        changes.push((
+            Kind::Stale,
+            a.stale.set(false, Level::Warning, 0.0, t),
+            None,
+        ));
+        for fault in Fault::ALL {
+            let on = r.status.contains(fault);
+            let latch = &mut a.faults[usize::from(fault.bit())];
+            if on || latch.level().is_some() {
+                let change = latch.set(on, Kind::fault_level(fault), limits.fault_hold_s, t);
+                changes.push((Kind::Fault(fault), change, None));
+            }
+        }
+        let mut threshold = |kind, latch: &mut Latch, th: &Threshold, v: Option<f32>| {
+            if let Some(v) = v {
+                let v = f64::from(v);
+                changes.push((kind, latch.update(th, v, t), Some(v)));
+            }
+        };
+        threshold(Kind::MosTemp, &mut a.mos, &limits.mos, r.mos_temp_c);
+        threshold(Kind::CapTemp, &mut a.cap, &limits.cap, r.cap_temp_c);
+        if let Some(cells) = esc.cells {
+            let th = limits.voltage(cells);
+            threshold(Kind::LowVoltage, &mut a.voltage, &th, Some(r.voltage_v));
+        }
+        for (kind, change, value) in changes {
+            self.note(i, kind, change, t, value);
+        }
+    }
+
+    /// Checks the clocks at Unix time `now`: ESCs that went silent become stale.
+    pub fn tick(&mut self, now: f64) {
+        let stale_after = self.limits.stale_after_s;
+        for i in 0..self.escs.len() {
+            let esc = &mut self.escs[i];
+            if esc.link != Link::Up {
+                continue;
+            }
+            let since = esc.last_frame_t.unwrap_or(esc.started);
+            if now - since > stale_after {
+                let change = esc.alarms.stale.set(true, Level::Warning, 0.0, now);
+                self.note(i, Kind::Stale, change, now, None);
+            }
+        }
+    }
+
+    /// Forgets the peaks of every ESC.
+    pub fn reset_peaks(&mut self) {
+        for esc in &mut self.escs {
+            esc.peaks = Peaks::default();
+            if let Some(r) = &esc.last {
+                esc.peaks.add(r);
+            }
+        }
+    }
+
+    fn note(&mut self, esc: usize, kind: Kind, change: Option<Change>, t: f64, value: Option<f64>) {
+        let Some(change) = change else { return };
+        let latch = self.escs[esc].alarms.latch(kind);
+        let level = match change {
+            Change::Raised(level) => level,
+            Change::Escalated => Level::Critical,
+            Change::Cleared { .. } => latch.level().unwrap_or(Level::Warning),
+        };
+        if self.log.len() == LOG_MAX {
+            self.log.pop_front();
+        }
+        self.log.push_back(LogEntry {
+            t,
+            esc,
+            kind,
+            change,
+            level,
+            value,
+        });
+        self.logged += 1;
+    }
+
+    /// The log entries after the first `seen` ever logged (those still kept).
+    pub fn log_since(&self, seen: u64) -> impl Iterator<Item = &LogEntry> {
+        let first_kept = self.logged - self.log.len() as u64;
+        let skip = seen.saturating_sub(first_kept) as usize;
+        self.log.iter().skip(skip)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::monitor::config::{Config, Overrides};
+    use hwfoc::{DataFrame, Status};
+
+    fn fleet(n: usize) -> Fleet {
+        let config = Config::load(&Overrides {
+            no_config: true,
+            ..Overrides::default()
+        })
+        .unwrap();
+        let names = (0..n).map(|i| (format!("esc{i}"), None)).collect();
+        Fleet::new(names, config.settings, config.limits, 19_200, 1000.0)
+    }
+
+    fn frame(packet: u16, status: Status, mos_code: u8, volt_raw: u16) -> Vec<u8> {
+        DataFrame {
+            packet,
+            status,
+            mos_adc: mos_code,
+            cap_adc: hwfoc::units::ADC_TABLE[30],
+            voltage_raw: volt_raw,
+            ..Default::default()
+        }
+        .encode()
+        .to_vec()
+    }
+
+    fn data(port: usize, t: f64, bytes: Vec<u8>) -> PortEvent {
+        PortEvent::Data {
+            port,
+            t_ns: (t * 1e9) as u64,
+            bytes,
+        }
+    }
+
+    fn names(fleet: &Fleet) -> Vec<String> {
+        fleet
+            .log
+            .iter()
+            .map(|e| {
+                let what = match e.change {
+                    Change::Raised(l) => format!("raised {l}"),
+                    Change::Escalated => "escalated".to_string(),
+                    Change::Cleared { .. } => "cleared".to_string(),
+                };
+                format!("esc{} {} {what}", e.esc, e.kind.name())
+            })
+            .collect()
+    }
+
+    #[test]
+    fn frames_update_the_view_peaks_and_rate() {
+        let mut f = fleet(2);
+        let cool = hwfoc::units::ADC_TABLE[40];
+        for k in 0..40u16 {
+            let t = 1000.0 + f64::from(k) * 0.05;
+            // 25.2 V is raw 252 (0.1 V units).
+            assert_eq!(f.on_event(&data(1, t, frame(k, Status::OK, cool, 252))), 1);
+        }
+        let esc = &f.escs[1];
+        assert_eq!(esc.last.unwrap().packet, 39);
+        assert_eq!(esc.cells, Some(6));
+        assert!(esc.cells_detected);
+        assert!((esc.frame_rate(1001.95) - 20.0).abs() < 0.6);
+        assert_eq!(esc.peaks.mos_temp_c, Some(40.0));
+        assert_eq!(esc.history.len(), 40);
+        assert!(f.escs[0].last.is_none());
+        assert_eq!(f.frames, 40);
+        assert!(f.log.is_empty(), "{:?}", names(&f));
+    }
+
+    #[test]
+    fn a_fault_bit_is_logged_once_by_name_and_clears_after_the_hold() {
+        let mut f = fleet(1);
+        let cool = hwfoc::units::ADC_TABLE[40];
+        let hot = Status::OK.with(Fault::MosOverheat);
+        for k in 0..60u16 {
+            let t = 1000.0 + f64::from(k) * 0.05;
+            // On for frames 10..30, flickering off on every third.
+            let status = if (10..30).contains(&k) && k % 3 != 0 {
+                hot
+            } else {
+                Status::OK
+            };
+            f.on_event(&data(0, t, frame(k, status, cool, 252)));
+        }
+        assert_eq!(
+            names(&f),
+            [
+                "esc0 mos_overheat raised critical",
+                "esc0 mos_overheat cleared"
+            ]
+        );
+        // On from frame 10 (0.5 s), last on at frame 29 (1.45 s), cleared 0.5 s later.
+        match f.log[1].change {
+            Change::Cleared { duration_s, .. } => assert!((duration_s - 1.45).abs() < 1e-6),
+            other => panic!("{other:?}"),
+        }
+    }
+
+    #[test]
+    fn temperature_and_voltage_thresholds_raise_alarms() {
+        let mut f = fleet(1);
+        let temps = [40u8, 95, 110, 96, 80];
+        for (k, &c) in temps.iter().enumerate() {
+            let code = hwfoc::units::ADC_TABLE[usize::from(c)];
+            // Voltage drops to 3.2 V per cell on the last frame (6S: 19.2 V).
+            let volt = if k == 4 { 192 } else { 252 };
+            f.on_event(&data(
+                0,
+                1000.0 + k as f64 * 0.05,
+                frame(k as u16, Status::OK, code, volt),
+            ));
+        }
+        assert_eq!(
+            names(&f),
+            [
+                "esc0 mos_temp raised warning",
+                "esc0 mos_temp escalated",
+                "esc0 mos_temp cleared",
+                "esc0 low_voltage raised critical"
+            ]
+        );
+        assert_eq!(f.log[0].value, Some(95.0));
+    }
+
+    #[test]
+    fn silence_makes_an_esc_stale_and_a_lost_port_disconnected() {
+        let mut f = fleet(2);
+        let cool = hwfoc::units::ADC_TABLE[40];
+        f.on_event(&data(0, 1000.1, frame(0, Status::OK, cool, 252)));
+        f.tick(1000.9);
+        assert!(f.log.is_empty());
+        f.tick(1001.2);
+        // ESC 1 never sent anything: stale a second after the start; ESC 0 at 1.1 s.
+        assert_eq!(
+            names(&f),
+            ["esc0 stale raised warning", "esc1 stale raised warning"]
+        );
+        f.tick(1001.5);
+        assert_eq!(f.log.len(), 2, "stale is logged once");
+        f.on_event(&data(0, 1001.6, frame(1, Status::OK, cool, 252)));
+        assert_eq!(names(&f)[2], "esc0 stale cleared");
+
+        f.on_event(&PortEvent::Lost {
+            port: 1,
+            t_ns: 1_002_000_000_000,
+            reason: "EIO".into(),
+        });
+        assert!(matches!(f.escs[1].link, Link::Down { .. }));
+        f.tick(1005.0);
+        f.on_event(&PortEvent::Back {
+            port: 1,
+            t_ns: 1_006_000_000_000,
+        });
+        // Meanwhile ESC 0 went silent too (its last frame was at 1001.6).
+        assert_eq!(
+            names(&f)[3..],
+            [
+                "esc1 stale cleared",
+                "esc1 disconnected raised critical",
+                "esc0 stale raised warning",
+                "esc1 disconnected cleared"
+            ]
+        );
+        assert_eq!(f.escs[1].link, Link::Up);
+        assert_eq!(f.log_since(5).count(), 2);
+        assert_eq!(f.log_since(0).count(), 7);
+    }
+
+    #[test]
+    fn reset_peaks_keeps_only_the_latest_frame() {
+        let mut f = fleet(1);
+        let code = |c: usize| hwfoc::units::ADC_TABLE[c];
+        f.on_event(&data(0, 1000.0, frame(0, Status::OK, code(70), 252)));
+        f.on_event(&data(0, 1000.05, frame(1, Status::OK, code(50), 240)));
+        assert_eq!(f.escs[0].peaks.mos_temp_c, Some(70.0));
+        assert_eq!(f.escs[0].peaks.min_voltage_v, Some(24.0));
+        f.reset_peaks();
+        assert_eq!(f.escs[0].peaks.mos_temp_c, Some(50.0));
+    }
+}

@@ -1,0 +1,211 @@
+//! `--plain` and `--json`: the monitor without a screen, for a Raspberry Pi on a drone or a test
+//! bench. One line per ESC per interval, and every alarm the moment it is raised, escalated or
+//! cleared. Memory stays bounded, so it can run for days; each batch of lines is flushed at once,
+//! so `tail -f` and pipes see it live.
+
+use std::io::{self, Write};
+use std::time::{Duration, Instant};
+
+use serde_json::{Value, json};
+
+use super::fleet::{EscView, Fleet, Link, LogEntry};
+use super::{Session, number};
+use crate::error::CliError;
+use crate::schema::Record;
+
+/// Runs the headless monitor until it is stopped.
+pub fn run(session: &mut Session, json: bool, interval_s: f64) -> Result<(), CliError> {
+    let interval = Duration::from_secs_f64(interval_s);
+    let mut out = io::stdout().lock();
+    let mut seen = 0;
+    let mut next_status = Instant::now() + interval;
+    let mut text = Vec::new();
+    while !session.should_stop() {
+        let wait = next_status.saturating_duration_since(Instant::now());
+        session.pump(wait)?;
+        let now = session.now();
+        for entry in session.fleet.log_since(seen) {
+            let esc = &session.fleet.escs[entry.esc];
+            if json {
+                writeln!(text, "{}", alarm_json(entry, esc)).ok();
+            } else {
+                writeln!(text, "{}", alarm_line(entry, esc)).ok();
+            }
+        }
+        seen = session.fleet.logged;
+        if Instant::now() >= next_status {
+            for (i, esc) in session.fleet.escs.iter().enumerate() {
+                if json {
+                    writeln!(text, "{}", status_json(&session.fleet, i, esc, now)).ok();
+                } else {
+                    writeln!(text, "{}", status_line(i, esc, now)).ok();
+                }
+            }
+            // Skip intervals missed (a suspended machine) rather than printing a burst.
+            while next_status <= Instant::now() {
+                next_status += interval;
+            }
+        }
+        if let Some(notice) = session.notice.take() {
+            eprintln!("hwfoc: {notice}");
+        }
+        if !text.is_empty() {
+            out.write_all(&text)
+                .and_then(|()| out.flush())
+                .map_err(|source| CliError::Write {
+                    output: "standard output".into(),
+                    source,
+                })?;
+            text.clear();
+        }
+    }
+    Ok(())
+}
+
+/// Local time with its UTC offset and milliseconds: `2026-11-22T14:03:22.150+01:00`.
+pub fn timestamp(t: f64) -> String {
+    super::local_time(t, "%Y-%m-%dT%H:%M:%S%.3f%:z")
+}
+
+/// `2026-… esc0 /dev/ttyUSB0: thr 50.0/48.2 % 12000 rpm 24.1 V 20.3 A (phase 35.1 A) mos 45.0C
+/// cap 40.0C | 20.0 fr/s lost 0 dup 0 crc 0 | age 0.03 s | ok`
+fn status_line(i: usize, esc: &EscView, now: f64) -> String {
+    let mut line = format!("{} esc{i} {}: ", timestamp(now), esc.title());
+    match (&esc.link, &esc.last) {
+        (Link::Down { since, reason }, _) => {
+            line.push_str(&format!("disconnected for {:.1} s ({reason})", now - since));
+        }
+        (Link::Up, None) => line.push_str("no frames yet"),
+        (Link::Up, Some(r)) => {
+            let temp = |t: Option<f32>| t.map_or("-".to_string(), |t| format!("{}C", number(t, 1)));
+            line.push_str(&format!(
+                "thr {}/{} % {} rpm {} V {} A (phase {} A) mos {} cap {} | {:.1} fr/s lost {} \
+                 dup {} crc {} | age {:.2} s",
+                number(r.throttle_in_pct, 1),
+                number(r.throttle_out_pct, 1),
+                number(r.rpm, 0),
+                number(r.voltage_v, 1),
+                number(r.current_a, 1),
+                number(r.phase_current_a, 1),
+                temp(r.mos_temp_c),
+                temp(r.cap_temp_c),
+                esc.frame_rate(now),
+                esc.stats.lost_packets(),
+                esc.stats.duplicate_packets(),
+                esc.stats.checksum_failures(),
+                esc.age(now).unwrap_or(0.0),
+            ));
+        }
+    }
+    let active = esc.alarms.active();
+    if active.is_empty() {
+        line.push_str(" | ok");
+    } else {
+        let names: Vec<String> = active
+            .iter()
+            .map(|(kind, level)| format!("{}({level})", kind.name()))
+            .collect();
+        line.push_str(&format!(" | ALARM {}", names.join(" ")));
+    }
+    line
+}
+
+/// `2026-… ALARM esc1 sim:esc1 mos_overheat critical raised`
+fn alarm_line(entry: &LogEntry, esc: &EscView) -> String {
+    let tag = match entry.event() {
+        "cleared" => "CLEARED",
+        _ => "ALARM",
+    };
+    format!(
+        "{} {tag} esc{} {}: {}",
+        timestamp(entry.t),
+        entry.esc,
+        esc.title(),
+        entry.text()
+    )
+}
+
+fn alarm_json(entry: &LogEntry, esc: &EscView) -> Value {
+    let (duration_s, worst) = match entry.change {
+        super::alarms::Change::Cleared { duration_s, worst } => (Some(duration_s), worst),
+        _ => (None, None),
+    };
+    json!({
+        "type": "alarm",
+        "time": timestamp(entry.t),
+        "t_s": entry.t,
+        "esc": entry.esc,
+        "name": esc.name,
+        "label": esc.label,
+        "alarm": entry.kind.name(),
+        "level": entry.level.name(),
+        "event": entry.event(),
+        "value": entry.value,
+        "duration_s": duration_s,
+        "worst": worst,
+        "text": entry.text(),
+    })
+}
+
+fn status_json(fleet: &Fleet, i: usize, esc: &EscView, now: f64) -> Value {
+    let record = esc.last.as_ref().map(record_json);
+    let (link, down_since, reason) = match &esc.link {
+        Link::Up => ("up", None, None),
+        Link::Down { since, reason } => ("down", Some(*since), Some(reason.clone())),
+    };
+    let p = &esc.peaks;
+    let alarms: Vec<Value> = esc
+        .alarms
+        .active()
+        .into_iter()
+        .map(|(kind, level)| json!({"alarm": kind.name(), "level": level.name()}))
+        .collect();
+    json!({
+        "type": "status",
+        "time": timestamp(now),
+        "t_s": now,
+        "esc": i,
+        "name": esc.name,
+        "label": esc.label,
+        "link": link,
+        "down_since_s": down_since,
+        "down_reason": reason,
+        "age_s": esc.age(now),
+        "frame_rate_hz": esc.frame_rate(now),
+        "frames": esc.stats.frames(),
+        "lost": esc.stats.lost_packets(),
+        "duplicates": esc.stats.duplicate_packets(),
+        "checksum_failures": esc.stats.checksum_failures(),
+        "bytes": esc.stats.bytes(),
+        "bytes_skipped": esc.stats.bytes_skipped(),
+        "record": record,
+        "peaks": {
+            "rpm": p.rpm,
+            "current_a": p.current_a,
+            "phase_current_a": p.phase_current_a,
+            "min_voltage_v": p.min_voltage_v,
+            "mos_temp_c": p.mos_temp_c,
+            "cap_temp_c": p.cap_temp_c,
+        },
+        "battery_cells": esc.cells,
+        "info": esc.info.as_ref().map(|info| json!({
+            "product": info.product(),
+            "hardware": info.hardware(),
+            "firmware": info.firmware(),
+            "id": info.id(),
+        })),
+        "alarms": alarms,
+        "settings": {
+            "current_scale": fleet.settings().current_scale,
+            "pole_pairs": fleet.settings().pole_pairs,
+            "gear_ratio": fleet.settings().gear_ratio,
+        },
+    })
+}
+
+/// The record exactly as `hwfoc decode` writes it (RECORD-SCHEMA.md).
+fn record_json(r: &Record) -> Value {
+    let mut text = Vec::new();
+    r.write_json(&mut text);
+    serde_json::from_slice(&text).unwrap_or(Value::Null)
+}

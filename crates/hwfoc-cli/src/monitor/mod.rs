@@ -1,0 +1,404 @@
+//! `hwfoc monitor`: live telemetry of one to sixteen ESCs (or more), as a full-screen dashboard
+//! ([`dashboard`]) or as lines for a machine without a screen ([`headless`]).
+//!
+//! Bytes come from serial ports or from virtual ESCs running in this process ([`feed`]); the
+//! state of every ESC, its alarms and the alarm log live in [`fleet`] (alarm logic in
+//! [`alarms`]); settings come from flags over an optional TOML file ([`config`]). Everything
+//! received can be recorded to pcapng as `hwfoc record` does, from the start (`--record`) or
+//! with a key.
+
+mod alarms;
+mod config;
+mod dashboard;
+mod feed;
+mod fleet;
+mod headless;
+mod perf;
+
+use std::path::PathBuf;
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::mpsc::{self, Receiver, RecvTimeoutError};
+use std::time::{Duration, Instant};
+
+use self::config::{AlarmKeys, Config, Overrides};
+use self::feed::{Feed, Msg};
+use self::fleet::Fleet;
+use self::perf::Perf;
+use crate::error::CliError;
+use crate::record::{self, Recorder};
+use crate::serial::{self, PortEvent};
+use crate::simulate::ModelArgs;
+
+/// The most virtual ESCs `--sim` runs.
+const MAX_SIM: u16 = 64;
+
+const EXAMPLES: &str = "\
+Examples:
+  hwfoc monitor --sim 4                           # four virtual ESCs, nothing to plug in
+  hwfoc monitor /dev/ttyUSB0 /dev/ttyUSB1         # two ESCs on USB-UART adapters
+  hwfoc monitor --sim 4 --fault 1:mos_overheat@20-25
+  hwfoc monitor /dev/ttyUSB0 --plain              # one line per second, alarms as they happen
+  hwfoc monitor /dev/ttyUSB0 --json --record flight.pcapng
+
+Keys: up/down (or j/k, 0-9) select an ESC, p pause, c reset peaks, r start/stop recording,
+? help, q quit.";
+
+/// Arguments of `hwfoc monitor`.
+#[derive(Debug, clap::Args)]
+#[command(after_help = EXAMPLES)]
+pub struct Args {
+    /// Serial ports to watch, one ESC each, in this order. Default: the ports listed in the
+    /// configuration file.
+    #[arg(value_name = "PORT", conflicts_with = "sim")]
+    ports: Vec<String>,
+    /// Watch N virtual ESCs running in this process (see the Throttle, Model and Faults options).
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u16).range(1..=MAX_SIM as i64))]
+    sim: Option<u16>,
+    /// No dashboard: print one line per ESC per interval and every alarm as it happens.
+    #[arg(long, conflicts_with = "json")]
+    plain: bool,
+    /// No dashboard: as --plain, in JSON Lines.
+    #[arg(long)]
+    json: bool,
+    /// Seconds between the status lines of --plain and --json.
+    #[arg(long, value_name = "S", default_value_t = 1.0, value_parser = seconds)]
+    interval: f64,
+    /// Stop after S seconds (otherwise on q, Ctrl-C or SIGTERM).
+    #[arg(long, value_name = "S", value_parser = seconds)]
+    duration: Option<f64>,
+    /// Record everything received to FILE from the start (pcapng, as `hwfoc record` writes).
+    #[arg(long, value_name = "FILE")]
+    record: Option<String>,
+    /// Where the r key puts its recordings (hwfoc-DATE-TIME.pcapng) [default: .].
+    #[arg(long, value_name = "DIR")]
+    record_dir: Option<PathBuf>,
+    /// A name for each ESC, in order (repeat the option).
+    #[arg(long = "label", value_name = "TEXT")]
+    labels: Vec<String>,
+    /// Configuration file [default: hwfoc/monitor.toml in the user's configuration directory,
+    /// if it exists].
+    #[arg(long, value_name = "FILE")]
+    config: Option<PathBuf>,
+    /// Read no configuration file.
+    #[arg(long, conflicts_with = "config")]
+    no_config: bool,
+    /// Baud rate of the ports (8N1) [default: 19200].
+    #[arg(long, value_name = "N")]
+    baud: Option<u32>,
+    /// Raw current units per ampere [default: 64].
+    #[arg(long, value_name = "N")]
+    current_scale: Option<f32>,
+    /// Motor pole pairs, for RPM [default: 7].
+    #[arg(long, value_name = "N")]
+    pole_pairs: Option<u16>,
+    /// Gear ratio between motor and output shaft, for RPM [default: 1].
+    #[arg(long, value_name = "X")]
+    gear_ratio: Option<f32>,
+    /// Alarm levels.
+    #[command(flatten)]
+    alarms: AlarmKeys,
+    /// On exit, print on standard error how the monitor performed: frames, redraws, the delay
+    /// from bytes received to the screen, CPU time.
+    #[arg(long)]
+    stats: bool,
+    /// The virtual ESCs of --sim.
+    #[command(flatten)]
+    model: ModelArgs,
+}
+
+fn seconds(text: &str) -> Result<f64, String> {
+    text.trim()
+        .parse::<f64>()
+        .ok()
+        .filter(|s| s.is_finite() && *s > 0.0)
+        .ok_or_else(|| format!("{text:?} is not a positive number of seconds"))
+}
+
+/// Runs `hwfoc monitor`.
+pub fn run(args: &Args) -> Result<(), CliError> {
+    let config = Config::load(&Overrides {
+        config: args.config.clone(),
+        no_config: args.no_config,
+        baud: args.baud,
+        current_scale: args.current_scale,
+        pole_pairs: args.pole_pairs,
+        gear_ratio: args.gear_ratio,
+        record_dir: args.record_dir.clone(),
+        alarms: args.alarms.clone(),
+    })?;
+    let mut session = Session::start(args, config)?;
+    let headless = args.plain || args.json;
+    if !headless && !std::io::IsTerminal::is_terminal(&std::io::stdout()) {
+        return Err(CliError::Usage {
+            option: "monitor".into(),
+            message: "standard output is not a terminal: use --plain or --json for lines of text"
+                .into(),
+        });
+    }
+    let result = if headless {
+        headless::run(&mut session, args.json, args.interval)
+    } else {
+        dashboard::run(&mut session)
+    };
+    let closed = session.close();
+    if args.stats {
+        eprintln!("hwfoc: {}", session.perf.report(session.fleet.frames));
+    }
+    result.and(closed)
+}
+
+/// A running monitor: its source, what it knows, its recording.
+pub struct Session {
+    /// Every ESC watched.
+    pub fleet: Fleet,
+    /// The recording being written, if any.
+    pub recorder: Option<Recorder>,
+    /// The last recording problem or success, for the status line.
+    pub notice: Option<String>,
+    /// How the monitor itself is doing.
+    pub perf: Perf,
+    /// Whether the source is virtual.
+    pub simulated: bool,
+    /// The configuration file read, if any.
+    pub config_file: Option<PathBuf>,
+    rx: Receiver<Msg>,
+    tx: mpsc::Sender<Msg>,
+    feed: Option<Feed>,
+    clock: serial::Clock,
+    names: Vec<String>,
+    baud: u32,
+    record_dir: PathBuf,
+    interrupted: Arc<AtomicBool>,
+    stop_at: Option<Instant>,
+}
+
+impl Session {
+    fn start(args: &Args, config: Config) -> Result<Session, CliError> {
+        let interrupted = serial::interrupted();
+        let (tx, rx) = mpsc::channel();
+        let ports: Vec<String> = if args.ports.is_empty() {
+            config.ports.clone()
+        } else {
+            args.ports.clone()
+        };
+        let (names, feed) = match args.sim {
+            Some(n) => {
+                let feed = Feed::simulated(
+                    &args.model,
+                    usize::from(n),
+                    config.baud,
+                    &config.settings,
+                    tx.clone(),
+                )?;
+                let names = (0..n).map(|i| format!("sim:esc{i}")).collect();
+                (names, feed)
+            }
+            None if ports.is_empty() => {
+                return Err(CliError::Usage {
+                    option: "monitor".into(),
+                    message: format!(
+                        "no ports to watch: name them (e.g. `hwfoc monitor /dev/ttyUSB0`), list \
+                         them in {}, or try the virtual ESCs: `hwfoc monitor --sim 4`",
+                        config::default_path()
+                            .map_or("the configuration file".into(), |p| p.display().to_string())
+                    ),
+                });
+            }
+            None => {
+                let feed = Feed::ports(&ports, config.baud, tx.clone())?;
+                (ports, feed)
+            }
+        };
+        let labelled = names
+            .iter()
+            .enumerate()
+            .map(|(i, name)| {
+                let label = args
+                    .labels
+                    .get(i)
+                    .cloned()
+                    .or_else(|| config.label(name).map(str::to_string));
+                (name.clone(), label)
+            })
+            .collect();
+        // The ports' own clock, so that ages and recordings agree with their timestamps.
+        let clock = match &feed {
+            Feed::Ports(readers) => readers.clock(),
+            Feed::Simulated { .. } => serial::Clock::new(),
+        };
+        let now = clock.now_ns() as f64 / 1e9;
+        let fleet = Fleet::new(
+            labelled,
+            config.settings,
+            config.limits.clone(),
+            config.baud,
+            now,
+        );
+        let mut session = Session {
+            fleet,
+            recorder: None,
+            notice: None,
+            perf: Perf::new(),
+            simulated: args.sim.is_some(),
+            config_file: config.file.clone(),
+            rx,
+            tx,
+            feed: Some(feed),
+            clock,
+            names,
+            baud: config.baud,
+            record_dir: config.record_dir,
+            interrupted,
+            stop_at: args
+                .duration
+                .map(|s| Instant::now() + Duration::from_secs_f64(s)),
+        };
+        if let Some(path) = &args.record {
+            session.start_recording(path.clone())?;
+        }
+        Ok(session)
+    }
+
+    /// Unix time now, seconds.
+    pub fn now(&self) -> f64 {
+        self.clock.now_ns() as f64 / 1e9
+    }
+
+    /// A sender for terminal events (the dashboard's keyboard thread).
+    pub fn sender(&self) -> mpsc::Sender<Msg> {
+        self.tx.clone()
+    }
+
+    /// Whether it is time to stop: Ctrl-C or SIGTERM, or the end of `--duration`.
+    pub fn should_stop(&self) -> bool {
+        self.interrupted.load(Ordering::Relaxed)
+            || self.stop_at.is_some_and(|t| Instant::now() >= t)
+    }
+
+    /// Waits at most `timeout` for something to happen and takes in all that came; returns the
+    /// terminal events among it. Stale ESCs are checked and the recording flushed.
+    pub fn pump(
+        &mut self,
+        timeout: Duration,
+    ) -> Result<Vec<ratatui::crossterm::event::Event>, CliError> {
+        let timeout = match self.stop_at {
+            Some(t) => timeout.min(t.saturating_duration_since(Instant::now())),
+            None => timeout,
+        };
+        let mut terminal = Vec::new();
+        let first = match self.rx.recv_timeout(timeout) {
+            Ok(msg) => Some(msg),
+            Err(RecvTimeoutError::Timeout) => None,
+            Err(RecvTimeoutError::Disconnected) => None,
+        };
+        let mut next = first;
+        while let Some(msg) = next {
+            match msg {
+                Msg::Port(event) => self.take(event),
+                Msg::Term(event) => terminal.push(event),
+                Msg::Failed(e) => return Err(e),
+            }
+            next = self.rx.try_recv().ok();
+        }
+        let now = self.now();
+        self.fleet.tick(now);
+        if let Some(recorder) = &mut self.recorder
+            && let Err(e) = recorder.tick()
+        {
+            self.recording_failed(e);
+        }
+        Ok(terminal)
+    }
+
+    fn take(&mut self, event: PortEvent) {
+        if self.fleet.on_event(&event) > 0 {
+            self.perf.arrived(Instant::now());
+        }
+        if let Some(recorder) = &mut self.recorder
+            && let Err(e) = recorder.handle(event)
+        {
+            self.recording_failed(e);
+        }
+    }
+
+    /// A recording that cannot go on is closed with what it has; the monitor goes on.
+    fn recording_failed(&mut self, e: CliError) {
+        if let Some(mut recorder) = self.recorder.take() {
+            let _ = recorder.close();
+        }
+        self.notice = Some(format!("recording stopped: {e}"));
+    }
+
+    /// Starts recording to `path`.
+    pub fn start_recording(&mut self, path: String) -> Result<(), CliError> {
+        let plan = record::Plan {
+            output: path.clone(),
+            rotate_size: None,
+            rotate_time: None,
+            baud: self.baud,
+            warn: false,
+        };
+        self.recorder = Some(Recorder::new(plan, &self.names, self.clock)?);
+        self.notice = Some(format!("recording to {path}"));
+        Ok(())
+    }
+
+    /// Starts a recording in the recording directory, or stops the one running. Problems go
+    /// to the status line.
+    pub fn toggle_recording(&mut self) {
+        if let Some(mut recorder) = self.recorder.take() {
+            let file = recorder.current().to_string();
+            self.notice = Some(match recorder.close() {
+                Ok(()) => format!("recorded to {file}"),
+                Err(e) => format!("recording stopped: {e}"),
+            });
+            return;
+        }
+        let stamp = jiff::Zoned::now().strftime("%Y%m%d-%H%M%S").to_string();
+        let path = self.record_dir.join(format!("hwfoc-{stamp}.pcapng"));
+        let path = path.display().to_string();
+        if let Err(e) = self.start_recording(path) {
+            self.notice = Some(format!("cannot record: {e}"));
+        }
+    }
+
+    /// Stops the source and closes the recording with everything received.
+    fn close(&mut self) -> Result<(), CliError> {
+        self.feed.take();
+        while let Ok(msg) = self.rx.try_recv() {
+            if let Msg::Port(event) = msg {
+                self.take(event);
+            }
+        }
+        match self.recorder.take() {
+            Some(mut recorder) => {
+                let file = recorder.current().to_string();
+                recorder.close()?;
+                eprintln!("hwfoc: recorded to {file}");
+                Ok(())
+            }
+            None => Ok(()),
+        }
+    }
+}
+
+/// Unix time `t` (seconds) as local time, formatted with the strftime `pattern`.
+pub fn local_time(t: f64, pattern: &str) -> String {
+    match jiff::Timestamp::from_nanosecond((t * 1e9) as i128) {
+        Ok(ts) => ts
+            .to_zoned(jiff::tz::TimeZone::system())
+            .strftime(pattern)
+            .to_string(),
+        Err(_) => format!("{t:.3}"),
+    }
+}
+
+/// `v` with `decimals` decimals, without the sign of a value that rounds to zero (`-0.0`).
+pub fn number(v: f32, decimals: usize) -> String {
+    let text = format!("{v:.decimals$}");
+    match text.strip_prefix('-') {
+        Some(rest) if rest.bytes().all(|b| b == b'0' || b == b'.') => rest.to_string(),
+        _ => text,
+    }
+}

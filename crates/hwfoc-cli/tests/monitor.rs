@@ -1,0 +1,511 @@
+//! `hwfoc monitor`: the dashboard driven through tmux, the headless modes, a port that goes away
+//! and comes back, recording while watching, and the errors a person meets.
+
+#![cfg(unix)]
+
+mod common;
+
+use std::process::Command;
+use std::thread;
+use std::time::{Duration, Instant};
+
+use common::{OutputLocked, Running, hwfoc};
+use nix::sys::signal::Signal;
+use serde_json::Value;
+
+/// The columns of RECORD-SCHEMA.md, in order.
+const SCHEMA: [&str; 14] = [
+    "t_s",
+    "esc",
+    "packet",
+    "throttle_in_pct",
+    "throttle_out_pct",
+    "erpm",
+    "rpm",
+    "voltage_v",
+    "current_a",
+    "phase_current_a",
+    "mos_temp_c",
+    "cap_temp_c",
+    "status",
+    "faults",
+];
+
+fn lines(out: &[u8]) -> Vec<String> {
+    String::from_utf8_lossy(out)
+        .lines()
+        .map(str::to_string)
+        .collect()
+}
+
+#[test]
+fn plain_prints_each_esc_every_interval_and_alarms_by_name() {
+    let out = hwfoc()
+        .args([
+            "monitor",
+            "--sim",
+            "2",
+            "--plain",
+            "--no-config",
+            "--interval",
+            "1",
+            "--duration",
+            "7.5",
+            "--fault",
+            "1:mos_overheat@3-4",
+        ])
+        .output_locked();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    let lines = lines(&out.stdout);
+    for esc in 0..2 {
+        let status: Vec<&String> = lines
+            .iter()
+            .filter(|l| l.contains(&format!(" esc{esc} sim:esc{esc}: ")))
+            .filter(|l| !l.contains(" ALARM esc") && !l.contains(" CLEARED esc"))
+            .collect();
+        assert!((6..=8).contains(&status.len()), "{lines:#?}");
+        // The first line comes after a second: the idle ESC has sent frames by then.
+        assert!(
+            status[0].contains(" V ") && status[0].contains("fr/s"),
+            "{lines:#?}"
+        );
+    }
+    // Throttle steps start after the 2 s lead-in: the last lines show the motor turning.
+    let last = lines.iter().rev().find(|l| l.contains(" esc0 ")).unwrap();
+    let rpm: f64 = last
+        .split(" rpm")
+        .next()
+        .and_then(|s| s.rsplit(' ').next())
+        .and_then(|s| s.parse().ok())
+        .unwrap_or_else(|| panic!("no rpm in {last}"));
+    assert!(rpm > 1000.0, "{last}");
+
+    let alarms: Vec<&String> = lines
+        .iter()
+        .filter(|l| l.contains(" ALARM esc") || l.contains(" CLEARED esc"))
+        .collect();
+    assert_eq!(alarms.len(), 2, "{lines:#?}");
+    assert!(
+        alarms[0].ends_with("ALARM esc1 sim:esc1: mos_overheat critical raised"),
+        "{}",
+        alarms[0]
+    );
+    // Cleared once the bit has been off for half a second: idle frames come every 364 ms, so
+    // the episode lasts from 0.5 s (on for one frame) to 1.4 s (on for the whole second).
+    let after: f64 = alarms[1]
+        .split("cleared after ")
+        .nth(1)
+        .and_then(|s| s.strip_suffix(" s"))
+        .and_then(|s| s.parse().ok())
+        .unwrap_or_else(|| panic!("{}", alarms[1]));
+    assert!(
+        alarms[1].contains("CLEARED esc1 sim:esc1: mos_overheat"),
+        "{}",
+        alarms[1]
+    );
+    assert!((0.5..=1.5).contains(&after), "{}", alarms[1]);
+    // The status line shows the fault while it is on (at 3..4 s; a line at about 3.5 s).
+    assert!(
+        lines
+            .iter()
+            .any(|l| l.contains(" esc1 ") && l.ends_with("| ALARM mos_overheat(critical)")),
+        "{lines:#?}"
+    );
+    assert!(
+        lines
+            .iter()
+            .filter(|l| l.contains(" esc0 "))
+            .all(|l| l.ends_with("| ok")),
+        "{lines:#?}"
+    );
+}
+
+#[test]
+fn json_lines_carry_the_schema_record_link_and_alarms() {
+    let out = hwfoc()
+        .args([
+            "monitor",
+            "--sim",
+            "1",
+            "--json",
+            "--no-config",
+            "--interval",
+            "0.5",
+            "--duration",
+            "3.2",
+            "--fault",
+            "throttle_signal_lost@1-1.2",
+        ])
+        .output_locked();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let values: Vec<Value> = lines(&out.stdout)
+        .iter()
+        .map(|l| serde_json::from_str(l).unwrap_or_else(|e| panic!("{e}: {l}")))
+        .collect();
+    let status: Vec<&Value> = values.iter().filter(|v| v["type"] == "status").collect();
+    assert!((5..=7).contains(&status.len()), "{values:#?}");
+    let last = status.last().unwrap();
+    assert_eq!(last["name"], "sim:esc0");
+    assert_eq!(last["link"], "up");
+    let record = last["record"].as_object().expect("a record");
+    let keys: Vec<&str> = record.keys().map(String::as_str).collect();
+    assert_eq!(keys, SCHEMA);
+    assert!(last["info"]["product"].is_string(), "{last}");
+    assert_eq!(last["battery_cells"], 6);
+    assert!(last["frame_rate_hz"].as_f64().unwrap() > 1.0);
+    // Timestamps: RFC 3339 with an offset, and Unix seconds.
+    let time = last["time"].as_str().unwrap();
+    assert!(time.len() >= 29 && time.as_bytes()[10] == b'T', "{time}");
+    assert!(last["t_s"].as_f64().unwrap() > 1.7e9);
+
+    let alarms: Vec<&Value> = values.iter().filter(|v| v["type"] == "alarm").collect();
+    assert_eq!(alarms.len(), 2, "{alarms:#?}");
+    assert_eq!(alarms[0]["alarm"], "throttle_signal_lost");
+    assert_eq!(alarms[0]["level"], "warning");
+    assert_eq!(alarms[0]["event"], "raised");
+    assert_eq!(alarms[1]["event"], "cleared");
+    assert!(alarms[1]["duration_s"].as_f64().unwrap() >= 0.5);
+}
+
+#[test]
+fn a_port_that_goes_away_shows_disconnected_and_resumes() {
+    let dir = tempfile::tempdir().unwrap();
+    let link = dir.path().join("esc0");
+    let link = link.to_str().unwrap();
+    let start_sim = || {
+        let sim = Running::start(&["simulate", "--pty", "--link", link, "--quiet"]);
+        sim.wait_for_stdout("esc 0:", Duration::from_secs(10));
+        sim
+    };
+    let mut first = start_sim();
+    let mut monitor = Running::start(&[
+        "monitor",
+        link,
+        "--plain",
+        "--no-config",
+        "--interval",
+        "0.25",
+    ]);
+    monitor.wait_for_stdout(" V ", Duration::from_secs(10));
+
+    // The ESC's pty goes away: SIGTERM ends the simulator, which closes it and removes the link.
+    first.signal(Signal::SIGTERM);
+    assert!(first.wait(Duration::from_secs(5)));
+    monitor.wait_for_stdout("disconnected critical raised", Duration::from_secs(5));
+    monitor.wait_for_stdout(": disconnected for", Duration::from_secs(5));
+    thread::sleep(Duration::from_millis(1000));
+    assert!(
+        monitor.child.try_wait().unwrap().is_none(),
+        "the monitor ended when its port went away:\n{}",
+        monitor.stderr()
+    );
+
+    // A new pty appears at the same path.
+    let mut second = start_sim();
+    let cleared = monitor.wait_for_stdout("disconnected cleared after", Duration::from_secs(5));
+    assert!(cleared.contains("CLEARED esc0"), "{cleared}");
+    // Frames again, and the ESC's line is back to normal.
+    monitor.wait_for_stdout("| ok", Duration::from_secs(5));
+    monitor.signal(Signal::SIGTERM);
+    assert!(monitor.wait(Duration::from_secs(5)), "{}", monitor.stderr());
+    second.signal(Signal::SIGTERM);
+    assert!(second.wait(Duration::from_secs(5)));
+    // A single disconnection episode, raised once and cleared once.
+    let out = monitor.stdout();
+    assert_eq!(
+        out.matches("disconnected critical raised").count(),
+        1,
+        "{out}"
+    );
+    assert_eq!(out.matches("disconnected cleared").count(), 1, "{out}");
+}
+
+#[test]
+fn record_while_monitoring_writes_a_recording_that_decodes() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("watch.pcapng");
+    let out = hwfoc()
+        .args(["monitor", "--sim", "2", "--plain", "--no-config"])
+        .args(["--duration", "2.5", "--record"])
+        .arg(&path)
+        .output_locked();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    assert!(stderr.contains("recorded to"), "{stderr}");
+    let decoded = hwfoc().arg("decode").arg(&path).output_locked();
+    assert!(decoded.status.success());
+    let records: Vec<Value> = lines(&decoded.stdout)
+        .iter()
+        .map(|l| serde_json::from_str(l).unwrap())
+        .collect();
+    for esc in 0..2 {
+        let n = records.iter().filter(|r| r["esc"] == esc).count();
+        // 2.5 s idle: a frame every 364 ms.
+        assert!((4..=9).contains(&n), "esc {esc}: {n} frames");
+    }
+}
+
+#[test]
+fn errors_say_what_to_do() {
+    let dir = tempfile::tempdir().unwrap();
+    let check = |args: &[&str], expected: &str| {
+        let out = hwfoc().arg("monitor").args(args).output_locked();
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success(), "{args:?} succeeded");
+        assert!(stderr.contains(expected), "{args:?}: {stderr}");
+        assert_eq!(stderr.trim_end().lines().count(), 1, "{args:?}: {stderr}");
+    };
+    check(&["--no-config"], "hwfoc monitor --sim 4");
+    check(&["--sim", "2", "--no-config"], "use --plain or --json");
+    check(
+        &["/dev/ttyNOPE7", "--plain", "--no-config"],
+        "no such port /dev/ttyNOPE7",
+    );
+    check(
+        &[
+            "--sim",
+            "2",
+            "--plain",
+            "--no-config",
+            "--fault",
+            "5:mos_overheat@1",
+        ],
+        "ESC 5 does not exist",
+    );
+    check(
+        &[
+            "--sim",
+            "1",
+            "--plain",
+            "--no-config",
+            "--record",
+            "/nonexistent/x.pcapng",
+        ],
+        "cannot write /nonexistent/x.pcapng",
+    );
+    check(
+        &[
+            "--sim",
+            "1",
+            "--plain",
+            "--no-config",
+            "--mos-warning-c",
+            "110",
+        ],
+        "must be above the warning level",
+    );
+    let config = dir.path().join("monitor.toml");
+    std::fs::write(&config, "baud = 19200\n\n[alarms]\nmos_warn_c = 80\n").unwrap();
+    check(
+        &[
+            "--sim",
+            "1",
+            "--plain",
+            "--config",
+            config.to_str().unwrap(),
+        ],
+        "monitor.toml line 4: unknown field `mos_warn_c`",
+    );
+}
+
+#[test]
+fn a_configuration_file_sets_labels_and_levels() {
+    let dir = tempfile::tempdir().unwrap();
+    let config = dir.path().join("monitor.toml");
+    // A MOSFET warning level under the simulator's ambient temperature: raised at once.
+    std::fs::write(
+        &config,
+        "[alarms]\nmos_warning_c = 10\nmos_critical_c = 120\n\n[[esc]]\nport = \"sim:esc0\"\n\
+         label = \"front left\"\n",
+    )
+    .unwrap();
+    let out = hwfoc()
+        .args(["monitor", "--sim", "1", "--plain", "--duration", "1.5"])
+        .arg("--config")
+        .arg(&config)
+        .output_locked();
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(
+        stdout.contains("ALARM esc0 front left: mos_temp warning raised at"),
+        "{stdout}"
+    );
+    assert!(stdout.contains(" esc0 front left: thr "), "{stdout}");
+}
+
+/// A tmux server of the test's own, killed when dropped.
+struct Tmux {
+    socket: String,
+}
+
+impl Tmux {
+    fn start(width: u16, height: u16) -> Tmux {
+        let tmux = Tmux {
+            socket: format!("hwfoc-test-{}", std::process::id()),
+        };
+        let ok = tmux
+            .cmd()
+            .args(["new-session", "-d", "-s", "t", "-x", &width.to_string()])
+            .args(["-y", &height.to_string(), "bash --norc --noprofile"])
+            .env("TERM", "xterm-256color")
+            .status()
+            .unwrap_or_else(|e| panic!("tmux is needed for this test (apt install tmux): {e}"));
+        assert!(ok.success());
+        tmux
+    }
+
+    fn cmd(&self) -> Command {
+        let mut cmd = Command::new("tmux");
+        cmd.args(["-L", &self.socket]);
+        cmd
+    }
+
+    fn keys(&self, keys: &[&str]) {
+        let ok = self
+            .cmd()
+            .args(["send-keys", "-t", "t"])
+            .args(keys)
+            .status()
+            .unwrap();
+        assert!(ok.success());
+    }
+
+    fn pane(&self) -> String {
+        let out = self
+            .cmd()
+            .args(["capture-pane", "-p", "-t", "t"])
+            .output()
+            .unwrap();
+        String::from_utf8_lossy(&out.stdout).into_owned()
+    }
+
+    /// Waits until the pane shows what `test` looks for; returns the pane.
+    fn wait(&self, what: &str, timeout: Duration, test: impl Fn(&str) -> bool) -> String {
+        let until = Instant::now() + timeout;
+        loop {
+            let pane = self.pane();
+            if test(&pane) {
+                return pane;
+            }
+            if Instant::now() > until {
+                panic!("the pane never showed {what} within {timeout:?}:\n{pane}");
+            }
+            thread::sleep(Duration::from_millis(100));
+        }
+    }
+}
+
+impl Drop for Tmux {
+    fn drop(&mut self) {
+        let _ = self.cmd().arg("kill-server").status();
+    }
+}
+
+/// The row of ESC `esc` in the dashboard's table.
+fn row(pane: &str, esc: usize) -> Option<&str> {
+    let name = format!("sim:esc{esc} ");
+    pane.lines()
+        .find(|l| l.contains(&name) && !l.contains('┌') && !l.contains('│'))
+}
+
+/// The numbers in a row, in order (live values and peaks).
+fn numbers(row: &str) -> Vec<f64> {
+    row.split(|c: char| !(c.is_ascii_digit() || c == '.' || c == '-'))
+        .filter_map(|s| s.parse().ok())
+        .collect()
+}
+
+#[test]
+fn the_dashboard_in_tmux() {
+    let tmux = Tmux::start(160, 45);
+    let command = format!(
+        "{} monitor --sim 4 --no-config --fault 2:mos_overheat@3-60; echo MONITOR-EXIT=$?",
+        env!("CARGO_BIN_EXE_hwfoc")
+    );
+    tmux.keys(&[&command, "Enter"]);
+
+    // One row per ESC, with plausible values: voltage of a 6S pack, temperatures near ambient.
+    let pane = tmux.wait("four rows with values", Duration::from_secs(15), |p| {
+        (0..4).all(|i| row(p, i).is_some_and(|r| r.contains('/')))
+    });
+    assert!(
+        pane.contains("hwfoc monitor") && pane.contains("4 ESCs (virtual)"),
+        "{pane}"
+    );
+    for esc in 0..4 {
+        let r = row(&pane, esc).unwrap();
+        let n = numbers(r);
+        // esc, the N of "sim:escN", throttle in/out, rpm and its peak, volt and its minimum, current
+        // and peak, phase current and peak, MOSFET temperature and peak, ...
+        assert_eq!(n[0], esc as f64, "{r}");
+        let volt = n[6];
+        assert!(
+            (20.0..=25.5).contains(&volt),
+            "voltage {volt} in {r}\n{pane}"
+        );
+        let mos = n[12];
+        assert!((15.0..=60.0).contains(&mos), "MOSFET {mos} in {r}\n{pane}");
+    }
+    // The first ESC is selected: its detail pane, charts and device information.
+    assert!(pane.contains("┌ esc0 sim:esc0"), "{pane}");
+    assert!(
+        pane.contains("RPM") && pane.contains("Temperature °C"),
+        "{pane}"
+    );
+
+    // Selecting the next ESC changes the detail pane.
+    tmux.keys(&["Down"]);
+    tmux.wait("esc1's detail pane", Duration::from_secs(3), |p| {
+        p.contains("┌ esc1 sim:esc1")
+    });
+    tmux.keys(&["3"]);
+    tmux.wait("esc3's detail pane", Duration::from_secs(3), |p| {
+        p.contains("┌ esc3 sim:esc3")
+    });
+
+    // The injected fault reaches the log by name, and the ESC's row.
+    let pane = tmux.wait("the fault in the log", Duration::from_secs(10), |p| {
+        p.contains("esc2 mos_overheat critical raised")
+    });
+    assert!(row(&pane, 2).unwrap().contains("mos_overheat"), "{pane}");
+    assert!(!row(&pane, 1).unwrap().contains("mos_overheat"), "{pane}");
+
+    // Help opens and closes.
+    tmux.keys(&["?"]);
+    tmux.wait("the help", Duration::from_secs(3), |p| {
+        p.contains("reset the peaks")
+    });
+    tmux.keys(&["Escape"]);
+    tmux.wait("the help closed", Duration::from_secs(3), |p| {
+        !p.contains("reset the peaks") && p.contains("sim:esc0")
+    });
+
+    // q quits with success and gives the terminal back as it was.
+    tmux.keys(&["q"]);
+    let pane = tmux.wait("the exit", Duration::from_secs(5), |p| {
+        p.contains("MONITOR-EXIT=0")
+    });
+    assert!(
+        !pane.contains("Alarms ("),
+        "the dashboard is still on screen:\n{pane}"
+    );
+    tmux.keys(&[
+        // The marker is computed, so that the command line itself does not match it.
+        "stty -a | tr ' ;' '\\n\\n' | grep -x -e icanon -e echo | tr '\\n' ' '; echo STTY-$((6*7))",
+        "Enter",
+    ]);
+    let pane = tmux.wait("stty's answer", Duration::from_secs(5), |p| {
+        p.lines().any(|l| l.ends_with("STTY-42"))
+    });
+    let answer = pane.lines().find(|l| l.ends_with("STTY-42")).unwrap();
+    assert_eq!(answer.trim(), "icanon echo STTY-42", "{pane}");
+}
