@@ -314,6 +314,43 @@ fn errors_say_what_to_do() {
 }
 
 #[test]
+fn the_configuration_file_is_found_in_the_user_configuration_directory() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::create_dir(dir.path().join("hwfoc")).unwrap();
+    std::fs::write(
+        dir.path().join("hwfoc/monitor.toml"),
+        "[[esc]]\nport = \"sim:esc0\"\nlabel = \"tail rotor\"\n",
+    )
+    .unwrap();
+    let out = hwfoc()
+        .args(["monitor", "--sim", "1", "--plain", "--duration", "1.2"])
+        .env("XDG_CONFIG_HOME", dir.path())
+        .output_locked();
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(stdout.contains(" esc0 tail rotor: "), "{stdout}");
+    // --no-config leaves it out.
+    let out = hwfoc()
+        .args([
+            "monitor",
+            "--sim",
+            "1",
+            "--plain",
+            "--duration",
+            "1.2",
+            "--no-config",
+        ])
+        .env("XDG_CONFIG_HOME", dir.path())
+        .output_locked();
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(stdout.contains(" esc0 sim:esc0: "), "{stdout}");
+}
+
+#[test]
 fn a_configuration_file_sets_labels_and_levels() {
     let dir = tempfile::tempdir().unwrap();
     let config = dir.path().join("monitor.toml");
@@ -426,10 +463,13 @@ fn numbers(row: &str) -> Vec<f64> {
 
 #[test]
 fn the_dashboard_in_tmux() {
+    let dir = tempfile::tempdir().unwrap();
     let tmux = Tmux::start(160, 45);
     let command = format!(
-        "{} monitor --sim 4 --no-config --fault 2:mos_overheat@3-60; echo MONITOR-EXIT=$?",
-        env!("CARGO_BIN_EXE_hwfoc")
+        "{} monitor --sim 4 --no-config --fault 2:mos_overheat@3-60 --record-dir {}; \
+         echo MONITOR-EXIT=$?",
+        env!("CARGO_BIN_EXE_hwfoc"),
+        dir.path().display()
     );
     tmux.keys(&[&command, "Enter"]);
 
@@ -478,6 +518,58 @@ fn the_dashboard_in_tmux() {
     });
     assert!(row(&pane, 2).unwrap().contains("mos_overheat"), "{pane}");
     assert!(!row(&pane, 1).unwrap().contains("mos_overheat"), "{pane}");
+
+    // Pause freezes the display; the peaks can be reset.
+    tmux.keys(&["p"]);
+    tmux.wait("PAUSED", Duration::from_secs(3), |p| p.contains("PAUSED"));
+    tmux.keys(&["p"]);
+    tmux.wait("live again", Duration::from_secs(3), |p| {
+        !p.contains("PAUSED")
+    });
+    tmux.keys(&["c"]);
+    tmux.wait("the peaks reset", Duration::from_secs(3), |p| {
+        p.contains("peaks reset")
+    });
+
+    // r starts a recording in --record-dir and stops it; it decodes.
+    tmux.keys(&["r"]);
+    tmux.wait("recording", Duration::from_secs(3), |p| p.contains("● REC"));
+    thread::sleep(Duration::from_millis(1500));
+    tmux.keys(&["r"]);
+    tmux.wait("recorded", Duration::from_secs(3), |p| {
+        p.contains("recorded to") && !p.contains("● REC")
+    });
+    let files: Vec<_> = std::fs::read_dir(dir.path())
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .collect();
+    assert_eq!(files.len(), 1, "{files:?}");
+    let name = files[0].file_name().unwrap().to_string_lossy().into_owned();
+    assert!(
+        name.starts_with("hwfoc-") && name.ends_with(".pcapng"),
+        "{name}"
+    );
+    let decoded = hwfoc().arg("decode").arg(&files[0]).output_locked();
+    assert!(decoded.status.success());
+    assert!(
+        lines(&decoded.stdout).len() >= 4 * 10,
+        "{}",
+        lines(&decoded.stdout).len()
+    );
+
+    // A smaller terminal: the dashboard redraws to fit.
+    let ok = tmux
+        .cmd()
+        .args(["resize-window", "-t", "t", "-x", "110", "-y", "30"])
+        .status()
+        .unwrap();
+    assert!(ok.success());
+    tmux.wait("the table at 110 columns", Duration::from_secs(3), |p| {
+        p.lines().all(|l| l.chars().count() <= 110)
+            && (0..4).all(|i| row(p, i).is_some())
+            && p.lines().count() <= 30
+            && p.contains("┌ esc3")
+    });
 
     // Help opens and closes.
     tmux.keys(&["?"]);
