@@ -33,6 +33,8 @@ use crate::error::CliError;
 const FRAME_EVERY: Duration = Duration::from_millis(50);
 /// Redraw at least this often.
 const IDLE_EVERY: Duration = Duration::from_millis(250);
+/// Terminals at least this wide show peaks beside the live values and the log beside the charts.
+const WIDE: u16 = 140;
 
 /// What the screen shows: live, or a copy frozen by `p`.
 #[derive(Clone, Copy)]
@@ -195,8 +197,12 @@ fn draw(frame: &mut Frame, session: &Session, ui: &Ui, view: View<'_>) {
     .areas(frame.area());
     draw_title(frame, title, session, ui, view);
     draw_table(frame, table, ui, view);
-    let [detail, log] =
-        Layout::horizontal([Constraint::Percentage(68), Constraint::Percentage(32)]).areas(bottom);
+    // Side by side on a wide terminal; the log under the charts on a narrow one.
+    let [detail, log] = if frame.area().width >= WIDE {
+        Layout::horizontal([Constraint::Percentage(68), Constraint::Percentage(32)]).areas(bottom)
+    } else {
+        Layout::vertical([Constraint::Percentage(65), Constraint::Percentage(35)]).areas(bottom)
+    };
     if let Some(esc) = view.escs.get(ui.selected) {
         draw_detail(frame, detail, ui.selected, esc, view.now);
     }
@@ -259,10 +265,16 @@ fn level_style(level: Option<Level>) -> Style {
     }
 }
 
-/// A live value with its peak beside it, dimmed: `20.3 ↑25.1`.
-fn with_peak(live: String, arrow: &str, peak: Option<f32>, decimals: usize) -> Line<'static> {
+/// A live value with its peak beside it, dimmed: `20.3 ↑25.1` (the value alone when `compact`).
+fn with_peak(
+    live: String,
+    arrow: &str,
+    peak: Option<f32>,
+    decimals: usize,
+    compact: bool,
+) -> Line<'static> {
     let mut spans = vec![Span::raw(live)];
-    if let Some(p) = peak {
+    if let Some(p) = peak.filter(|_| !compact) {
         spans.push(Span::styled(
             format!(" {arrow}{}", number(p, decimals)),
             Style::new().fg(Color::DarkGray),
@@ -272,22 +284,31 @@ fn with_peak(live: String, arrow: &str, peak: Option<f32>, decimals: usize) -> L
 }
 
 fn draw_table(frame: &mut Frame, area: Rect, ui: &Ui, view: View<'_>) {
-    let header = Row::new([
-        "ESC",
-        "Name",
-        "Thr in/out %",
-        "RPM  ↑max",
-        "V  ↓min",
-        "A  ↑max",
-        "Phase A ↑max",
-        "MOS °C ↑max",
-        "CAP °C ↑max",
-        "fr/s",
-        "lost dup crc",
-        "age s",
-        "Faults and alarms",
-    ])
-    .style(Style::new().bold().underlined());
+    let compact = area.width < WIDE;
+    let titles = if compact {
+        [
+            "ESC", "Name", "Thr %", "RPM", "V", "A", "Ph A", "MOS", "CAP", "fr/s", "l/d/crc",
+            "age", "Faults",
+        ]
+    } else {
+        [
+            "ESC",
+            "Name",
+            "Thr in/out %",
+            "RPM  ↑max",
+            "V  ↓min",
+            "A  ↑max",
+            "Phase A ↑max",
+            "MOS °C ↑max",
+            "CAP °C ↑max",
+            "fr/s",
+            "lost dup crc",
+            "age s",
+            "Faults and alarms",
+        ]
+    };
+    let header = Row::new(titles).style(Style::new().bold().underlined());
+    let with_peak = |live, arrow, peak, decimals| with_peak(live, arrow, peak, decimals, compact);
     let rows = view.escs.iter().enumerate().map(|(i, esc)| {
         let a = &esc.alarms;
         let p = &esc.peaks;
@@ -336,8 +357,9 @@ fn draw_table(frame: &mut Frame, area: Rect, ui: &Ui, view: View<'_>) {
             _ => Cell::from(""),
         };
         let stats = &esc.stats;
+        let sep = if compact { "/" } else { " " };
         let link = format!(
-            "{} {} {}",
+            "{}{sep}{}{sep}{}",
             stats.lost_packets(),
             stats.duplicate_packets(),
             stats.checksum_failures()
@@ -354,21 +376,15 @@ fn draw_table(frame: &mut Frame, area: Rect, ui: &Ui, view: View<'_>) {
         cells.push(faults);
         Row::new(cells)
     });
-    let widths = [
-        Constraint::Length(3),
-        Constraint::Min(8),
-        Constraint::Length(12),
-        Constraint::Length(12),
-        Constraint::Length(11),
-        Constraint::Length(11),
-        Constraint::Length(12),
-        Constraint::Length(11),
-        Constraint::Length(11),
-        Constraint::Length(5),
-        Constraint::Length(12),
-        Constraint::Length(5),
-        Constraint::Fill(2),
-    ];
+    let widths: [u16; 11] = if compact {
+        [7, 6, 5, 5, 5, 3, 3, 4, 7, 4, 0]
+    } else {
+        [12, 12, 11, 11, 12, 11, 11, 5, 12, 5, 0]
+    };
+    let widths = [Constraint::Length(3), Constraint::Min(8)]
+        .into_iter()
+        .chain(widths[..10].iter().map(|&w| Constraint::Length(w)))
+        .chain([Constraint::Fill(2)]);
     let table = Table::new(rows, widths)
         .header(header)
         .block(Block::new().borders(Borders::TOP | Borders::BOTTOM))
