@@ -1,15 +1,14 @@
 //! End-to-end tests of the `hwfoc` binary: real captures, golden outputs, stdin, errors.
 
+mod common;
+
 use std::io::{Read, Write};
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output, Stdio};
+use std::process::{Output, Stdio};
 
+use common::{SCHEMA, assert_fails_with, hwfoc};
 use hwfoc::{DataFrame, Fault, InfoFrame, Status};
 use serde_json::Value;
-
-fn hwfoc() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_hwfoc"))
-}
 
 fn capture(name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -61,16 +60,6 @@ fn stdout(o: &Output) -> String {
     String::from_utf8(o.stdout.clone()).unwrap()
 }
 
-/// Asserts a failure with exactly one line on stderr containing `needle`, and no panic.
-fn assert_fails_with(o: &Output, needle: &str) {
-    let err = String::from_utf8_lossy(&o.stderr);
-    assert_eq!(o.status.code(), Some(1), "stderr: {err}");
-    assert!(err.contains(needle), "{needle:?} not in {err:?}");
-    assert_eq!(err.lines().count(), 1, "one line expected: {err:?}");
-    assert!(!err.contains("panicked"), "{err}");
-    assert!(err.starts_with("hwfoc: "), "{err}");
-}
-
 /// Compares with a golden file; `UPDATE_GOLDEN=1` rewrites it instead.
 fn check_golden(name: &str, actual: &str) {
     let path = golden(name);
@@ -97,23 +86,6 @@ fn csv_bytes(path: &Path) -> Vec<u8> {
         .collect()
 }
 
-const KEYS: [&str; 14] = [
-    "t_s",
-    "esc",
-    "packet",
-    "throttle_in_pct",
-    "throttle_out_pct",
-    "erpm",
-    "rpm",
-    "voltage_v",
-    "current_a",
-    "phase_current_a",
-    "mos_temp_c",
-    "cap_temp_c",
-    "status",
-    "faults",
-];
-
 #[test]
 fn decode_real_capture_matches_schema_and_golden() {
     let out = stdout(&run(&["decode", capture(XROTOR).to_str().unwrap()]));
@@ -130,14 +102,14 @@ fn decode_real_capture_matches_schema_and_golden() {
     for line in &lines {
         // Exactly the schema's keys, in the schema's order.
         let mut at = 0;
-        for key in KEYS {
+        for key in SCHEMA {
             let pos = line[at..]
                 .find(&format!("\"{key}\":"))
                 .unwrap_or_else(|| panic!("{key} missing or out of order in {line}"));
             at += pos;
         }
         let v: Value = serde_json::from_str(line).unwrap();
-        assert_eq!(v.as_object().unwrap().len(), KEYS.len());
+        assert_eq!(v.as_object().unwrap().len(), SCHEMA.len());
         let t = v["t_s"].as_f64().unwrap();
         assert!(t > last_t, "timestamps increase");
         last_t = t;
@@ -292,7 +264,7 @@ fn csv_output_has_header_and_joined_faults() {
     ]));
     let lines: Vec<&str> = out.lines().collect();
     assert!(lines[0].starts_with("# hwfoc decode: current_scale=100 pole_pairs=7 gear_ratio=1"));
-    assert_eq!(lines[1], KEYS.join(","));
+    assert_eq!(lines[1], SCHEMA.join(","));
     assert_eq!(lines.len(), 5);
     // No time in a raw file; MOSFET code 250 is below the table's range, capacitor code 0 above.
     assert_eq!(

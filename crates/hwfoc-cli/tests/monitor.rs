@@ -9,27 +9,9 @@ use std::process::Command;
 use std::thread;
 use std::time::{Duration, Instant};
 
-use common::{OutputLocked, Running, hwfoc};
+use common::{OutputLocked, Running, SCHEMA, hwfoc};
 use nix::sys::signal::Signal;
 use serde_json::Value;
-
-/// The columns of RECORD-SCHEMA.md, in order.
-const SCHEMA: [&str; 14] = [
-    "t_s",
-    "esc",
-    "packet",
-    "throttle_in_pct",
-    "throttle_out_pct",
-    "erpm",
-    "rpm",
-    "voltage_v",
-    "current_a",
-    "phase_current_a",
-    "mos_temp_c",
-    "cap_temp_c",
-    "status",
-    "faults",
-];
 
 fn lines(out: &[u8]) -> Vec<String> {
     String::from_utf8_lossy(out)

@@ -2,37 +2,18 @@
 //! images checked as images: PNG size and pixels (a row of panels per ESC, fault spans where
 //! the faults were), SVG as XML (panels, unit labels, fault names); errors.
 
+mod common;
+
 use std::collections::BTreeMap;
 use std::fs::File;
 use std::io::BufReader;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::process::Output;
 
-fn hwfoc() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_hwfoc"))
-}
+use common::{assert_fails_with, hwfoc, ok};
 
 fn run(args: &[&str]) -> Output {
     hwfoc().args(args).output().expect("run hwfoc")
-}
-
-fn ok(o: Output) -> Output {
-    assert!(
-        o.status.success(),
-        "hwfoc failed: {}",
-        String::from_utf8_lossy(&o.stderr)
-    );
-    o
-}
-
-/// Asserts a failure with one line on stderr containing `needle`, and no panic.
-fn assert_fails_with(o: &Output, needle: &str) {
-    let err = String::from_utf8_lossy(&o.stderr);
-    assert_eq!(o.status.code(), Some(1), "stderr: {err}");
-    assert!(err.contains(needle), "{needle:?} not in {err:?}");
-    assert_eq!(err.lines().count(), 1, "one line expected: {err:?}");
-    assert!(!err.contains("panicked"), "{err}");
-    assert!(err.starts_with("hwfoc: "), "{err}");
 }
 
 struct Dir(tempfile::TempDir);

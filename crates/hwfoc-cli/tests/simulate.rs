@@ -4,39 +4,21 @@
 
 #![cfg(unix)]
 
+mod common;
+
 use std::io::{BufRead, BufReader, Read};
 use std::os::unix::fs::OpenOptionsExt;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output, Stdio};
+use std::process::{Output, Stdio};
 use std::time::{Duration, Instant};
+
+use common::{assert_fails_with, hwfoc, ok};
 
 use hwfoc::{Decoder, Frame};
 use serde_json::Value;
 
-fn hwfoc() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_hwfoc"))
-}
-
 fn run(args: &[&str]) -> Output {
     hwfoc().args(args).output().expect("run hwfoc")
-}
-
-fn ok(o: Output) -> Output {
-    assert!(
-        o.status.success(),
-        "hwfoc failed: {}",
-        String::from_utf8_lossy(&o.stderr)
-    );
-    o
-}
-
-/// Asserts a failure with one line on stderr containing `needle`, and no panic.
-fn assert_fails_with(o: &Output, needle: &str) {
-    let err = String::from_utf8_lossy(&o.stderr);
-    assert_eq!(o.status.code(), Some(1), "stderr: {err}");
-    assert!(err.contains(needle), "{needle:?} not in {err:?}");
-    assert_eq!(err.lines().count(), 1, "one line expected: {err:?}");
-    assert!(err.starts_with("hwfoc: "), "{err}");
 }
 
 fn jsonl(text: &[u8]) -> Vec<Value> {

@@ -4,20 +4,53 @@
 
 #![allow(dead_code)]
 
-use std::io::{BufRead, BufReader, Read};
-use std::os::fd::{AsFd, OwnedFd};
-use std::path::PathBuf;
 use std::process::{Child, Command, Output, Stdio};
-use std::sync::mpsc::{self, Receiver, Sender};
-use std::sync::{Arc, Mutex};
-use std::thread;
-use std::time::{Duration, Instant, SystemTime, UNIX_EPOCH};
+use std::sync::Mutex;
+use std::time::{SystemTime, UNIX_EPOCH};
 
-use nix::fcntl::{FcntlArg, FdFlag, fcntl};
-use nix::pty::openpty;
-use nix::sys::signal::{Signal, kill};
-use nix::sys::termios::{SetArg, cfmakeraw, tcgetattr, tcsetattr};
-use nix::unistd::Pid;
+#[cfg(unix)]
+#[allow(unused_imports)]
+pub use self::unix::*;
+
+/// The columns of RECORD-SCHEMA.md, in order (written out here, not taken from the code under
+/// test).
+pub const SCHEMA: [&str; 14] = [
+    "t_s",
+    "esc",
+    "packet",
+    "throttle_in_pct",
+    "throttle_out_pct",
+    "erpm",
+    "rpm",
+    "voltage_v",
+    "current_a",
+    "phase_current_a",
+    "mos_temp_c",
+    "cap_temp_c",
+    "status",
+    "faults",
+];
+
+/// Asserts success (showing standard error otherwise) and hands the output on.
+pub fn ok(o: Output) -> Output {
+    assert!(
+        o.status.success(),
+        "hwfoc failed: {}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    o
+}
+
+/// Asserts a failure with exactly one line on standard error, `hwfoc: ` and then a message
+/// containing `needle`, and no panic.
+pub fn assert_fails_with(o: &Output, needle: &str) {
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "stderr: {err}");
+    assert!(err.contains(needle), "{needle:?} not in {err:?}");
+    assert_eq!(err.lines().count(), 1, "one line expected: {err:?}");
+    assert!(!err.contains("panicked"), "{err}");
+    assert!(err.starts_with("hwfoc: "), "{err}");
+}
 
 pub fn hwfoc() -> Command {
     Command::new(env!("CARGO_BIN_EXE_hwfoc"))
@@ -51,32 +84,6 @@ impl OutputLocked for Command {
     }
 }
 
-/// A pseudo-terminal: the master side the test writes to, and the path of the slave side that
-/// `hwfoc` opens like a serial port.
-pub struct Pty {
-    pub master: std::fs::File,
-    pub path: PathBuf,
-    _slave: OwnedFd,
-}
-
-pub fn pty() -> Pty {
-    let _guard = SPAWN.lock().unwrap_or_else(|e| e.into_inner());
-    let pair = openpty(None, None).expect("openpty");
-    for fd in [&pair.master, &pair.slave] {
-        fcntl(fd.as_fd(), FcntlArg::F_SETFD(FdFlag::FD_CLOEXEC)).unwrap();
-    }
-    // Raw, so that nothing is echoed or translated before `hwfoc` opens the port.
-    let mut termios = tcgetattr(pair.slave.as_fd()).unwrap();
-    cfmakeraw(&mut termios);
-    tcsetattr(pair.slave.as_fd(), SetArg::TCSANOW, &termios).unwrap();
-    let path = nix::unistd::ttyname(pair.slave.as_fd()).expect("ttyname");
-    Pty {
-        master: std::fs::File::from(pair.master),
-        path,
-        _slave: pair.slave,
-    }
-}
-
 pub fn unix_now() -> f64 {
     SystemTime::now()
         .duration_since(UNIX_EPOCH)
@@ -84,113 +91,160 @@ pub fn unix_now() -> f64 {
         .as_secs_f64()
 }
 
-/// A running `hwfoc` whose standard output and standard error are collected line by line.
-pub struct Running {
-    pub child: Child,
-    err_lines: Receiver<String>,
-    out_lines: Receiver<String>,
-    stderr: Arc<Mutex<Vec<String>>>,
-    stdout: Arc<Mutex<Vec<String>>>,
-}
+/// Pseudo-terminals and running processes (Unix only).
+#[cfg(unix)]
+mod unix {
+    use std::io::{BufRead, BufReader, Read};
+    use std::os::fd::{AsFd, OwnedFd};
+    use std::path::PathBuf;
+    use std::process::Child;
+    use std::sync::mpsc::{self, Receiver, Sender};
+    use std::sync::{Arc, Mutex};
+    use std::thread;
+    use std::time::{Duration, Instant};
 
-/// Collects the lines of `pipe` into `all` and sends each on `tx`.
-fn collect(pipe: impl Read + Send + 'static, all: Arc<Mutex<Vec<String>>>, tx: Sender<String>) {
-    thread::spawn(move || {
-        for line in BufReader::new(pipe).lines() {
-            let Ok(line) = line else { break };
-            all.lock().unwrap().push(line.clone());
-            let _ = tx.send(line);
+    use nix::fcntl::{FcntlArg, FdFlag, fcntl};
+    use nix::pty::openpty;
+    use nix::sys::signal::{Signal, kill};
+    use nix::sys::termios::{SetArg, cfmakeraw, tcgetattr, tcsetattr};
+    use nix::unistd::Pid;
+
+    use super::{SPAWN, hwfoc, spawn};
+
+    /// A pseudo-terminal: the master side the test writes to, and the path of the slave side that
+    /// `hwfoc` opens like a serial port.
+    pub struct Pty {
+        pub master: std::fs::File,
+        pub path: PathBuf,
+        _slave: OwnedFd,
+    }
+
+    pub fn pty() -> Pty {
+        let _guard = SPAWN.lock().unwrap_or_else(|e| e.into_inner());
+        let pair = openpty(None, None).expect("openpty");
+        for fd in [&pair.master, &pair.slave] {
+            fcntl(fd.as_fd(), FcntlArg::F_SETFD(FdFlag::FD_CLOEXEC)).unwrap();
         }
-    });
-}
-
-impl Running {
-    pub fn start(args: &[&str]) -> Running {
-        let mut child = spawn(hwfoc().args(args));
-        let stderr = Arc::new(Mutex::new(Vec::new()));
-        let stdout = Arc::new(Mutex::new(Vec::new()));
-        let (tx, err_lines) = mpsc::channel();
-        collect(child.stderr.take().unwrap(), Arc::clone(&stderr), tx);
-        let (tx, out_lines) = mpsc::channel();
-        collect(child.stdout.take().unwrap(), Arc::clone(&stdout), tx);
-        Running {
-            child,
-            err_lines,
-            out_lines,
-            stderr,
-            stdout,
+        // Raw, so that nothing is echoed or translated before `hwfoc` opens the port.
+        let mut termios = tcgetattr(pair.slave.as_fd()).unwrap();
+        cfmakeraw(&mut termios);
+        tcsetattr(pair.slave.as_fd(), SetArg::TCSANOW, &termios).unwrap();
+        let path = nix::unistd::ttyname(pair.slave.as_fd()).expect("ttyname");
+        Pty {
+            master: std::fs::File::from(pair.master),
+            path,
+            _slave: pair.slave,
         }
     }
 
-    fn wait_on(
-        &self,
-        lines: &Receiver<String>,
-        what: &str,
-        text: &str,
-        timeout: Duration,
-    ) -> String {
-        let until = Instant::now() + timeout;
-        loop {
-            let left = until.saturating_duration_since(Instant::now());
-            match lines.recv_timeout(left) {
-                Ok(line) if line.contains(text) => return line,
-                Ok(_) => {}
-                Err(_) => panic!(
-                    "no {text:?} on hwfoc's {what} within {timeout:?}; standard output:\n{}\n\
-                     standard error:\n{}",
-                    self.stdout(),
-                    self.stderr()
-                ),
+    /// A running `hwfoc` whose standard output and standard error are collected line by line.
+    pub struct Running {
+        pub child: Child,
+        err_lines: Receiver<String>,
+        out_lines: Receiver<String>,
+        stderr: Arc<Mutex<Vec<String>>>,
+        stdout: Arc<Mutex<Vec<String>>>,
+    }
+
+    /// Collects the lines of `pipe` into `all` and sends each on `tx`.
+    fn collect(pipe: impl Read + Send + 'static, all: Arc<Mutex<Vec<String>>>, tx: Sender<String>) {
+        thread::spawn(move || {
+            for line in BufReader::new(pipe).lines() {
+                let Ok(line) = line else { break };
+                all.lock().unwrap().push(line.clone());
+                let _ = tx.send(line);
+            }
+        });
+    }
+
+    impl Running {
+        pub fn start(args: &[&str]) -> Running {
+            let mut child = spawn(hwfoc().args(args));
+            let stderr = Arc::new(Mutex::new(Vec::new()));
+            let stdout = Arc::new(Mutex::new(Vec::new()));
+            let (tx, err_lines) = mpsc::channel();
+            collect(child.stderr.take().unwrap(), Arc::clone(&stderr), tx);
+            let (tx, out_lines) = mpsc::channel();
+            collect(child.stdout.take().unwrap(), Arc::clone(&stdout), tx);
+            Running {
+                child,
+                err_lines,
+                out_lines,
+                stderr,
+                stdout,
+            }
+        }
+
+        fn wait_on(
+            &self,
+            lines: &Receiver<String>,
+            what: &str,
+            text: &str,
+            timeout: Duration,
+        ) -> String {
+            let until = Instant::now() + timeout;
+            loop {
+                let left = until.saturating_duration_since(Instant::now());
+                match lines.recv_timeout(left) {
+                    Ok(line) if line.contains(text) => return line,
+                    Ok(_) => {}
+                    Err(_) => panic!(
+                        "no {text:?} on hwfoc's {what} within {timeout:?}; standard output:\n{}\n\
+                         standard error:\n{}",
+                        self.stdout(),
+                        self.stderr()
+                    ),
+                }
+            }
+        }
+
+        /// Waits for a line of standard error containing `text`.
+        pub fn wait_for(&self, text: &str, timeout: Duration) -> String {
+            self.wait_on(&self.err_lines, "standard error", text, timeout)
+        }
+
+        /// Waits for a line of standard output containing `text` (lines before it are passed over).
+        pub fn wait_for_stdout(&self, text: &str, timeout: Duration) -> String {
+            self.wait_on(&self.out_lines, "standard output", text, timeout)
+        }
+
+        pub fn stderr(&self) -> String {
+            self.stderr.lock().unwrap().join("\n")
+        }
+
+        pub fn stdout(&self) -> String {
+            self.stdout.lock().unwrap().join("\n")
+        }
+
+        pub fn signal(&self, signal: Signal) {
+            kill(Pid::from_raw(self.child.id() as i32), signal).unwrap();
+        }
+
+        /// Waits for the process to end (at most `timeout`); returns whether it succeeded.
+        pub fn wait(&mut self, timeout: Duration) -> bool {
+            let until = Instant::now() + timeout;
+            loop {
+                if let Some(status) = self.child.try_wait().unwrap() {
+                    // Let the reader threads take the last lines.
+                    thread::sleep(Duration::from_millis(50));
+                    return status.success();
+                }
+                if Instant::now() > until {
+                    let _ = self.child.kill();
+                    panic!("hwfoc did not end within {timeout:?}:\n{}", self.stderr());
+                }
+                thread::sleep(Duration::from_millis(20));
             }
         }
     }
 
-    /// Waits for a line of standard error containing `text`.
-    pub fn wait_for(&self, text: &str, timeout: Duration) -> String {
-        self.wait_on(&self.err_lines, "standard error", text, timeout)
-    }
-
-    /// Waits for a line of standard output containing `text` (lines before it are passed over).
-    pub fn wait_for_stdout(&self, text: &str, timeout: Duration) -> String {
-        self.wait_on(&self.out_lines, "standard output", text, timeout)
-    }
-
-    pub fn stderr(&self) -> String {
-        self.stderr.lock().unwrap().join("\n")
-    }
-
-    pub fn stdout(&self) -> String {
-        self.stdout.lock().unwrap().join("\n")
-    }
-
-    pub fn signal(&self, signal: Signal) {
-        kill(Pid::from_raw(self.child.id() as i32), signal).unwrap();
-    }
-
-    /// Waits for the process to end (at most `timeout`); returns whether it succeeded.
-    pub fn wait(&mut self, timeout: Duration) -> bool {
-        let until = Instant::now() + timeout;
-        loop {
-            if let Some(status) = self.child.try_wait().unwrap() {
-                // Let the reader threads take the last lines.
-                thread::sleep(Duration::from_millis(50));
-                return status.success();
-            }
-            if Instant::now() > until {
+    impl Drop for Running {
+        /// A test that fails half-way leaves no `hwfoc` running behind it.
+        fn drop(&mut self) {
+            if self.child.try_wait().ok().flatten().is_none() {
                 let _ = self.child.kill();
-                panic!("hwfoc did not end within {timeout:?}:\n{}", self.stderr());
+                let _ = self.child.wait();
             }
-            thread::sleep(Duration::from_millis(20));
-        }
-    }
-}
-
-impl Drop for Running {
-    /// A test that fails half-way leaves no `hwfoc` running behind it.
-    fn drop(&mut self) {
-        if self.child.try_wait().ok().flatten().is_none() {
-            let _ = self.child.kill();
-            let _ = self.child.wait();
         }
     }
 }
