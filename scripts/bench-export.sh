@@ -13,6 +13,9 @@
 # is about 9.5 times the size of the input, CSV 3 times, Parquet a third). Prints MB/s of input
 # (MB = 10^6 bytes) for each run and the best run per format. Other heavy processes on the
 # machine skew the figures: the script prints the load average first; run it on a quiet machine.
+# An output file past its first 16 MiB is written with direct I/O (see
+# crates/hwfoc-cli/src/export/file.rs), so disk figures include the disk's own throughput; compare
+# variants by user + sys CPU time when the load average is not near zero.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 size_mb=${1:-2048}
