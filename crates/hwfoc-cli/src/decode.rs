@@ -11,6 +11,7 @@ use serde_json::json;
 use crate::error::CliError;
 use crate::export::{Export, Format, Provenance};
 use crate::sources::{Handler, Sources};
+use crate::window::Window;
 use crate::{DecodeArgs, RecordFormat};
 
 pub fn run(args: &DecodeArgs) -> Result<(), CliError> {
@@ -93,42 +94,6 @@ impl Handler for Records {
 
     fn end_batch(&mut self, live: bool) -> Result<(), CliError> {
         self.export.end_batch(live)
-    }
-}
-
-/// A window of receive times: `from <= t_s < to`, each end optional.
-#[derive(Debug, Clone, Copy)]
-struct Window {
-    from: f64,
-    to: f64,
-}
-
-impl Window {
-    fn new(from: Option<f64>, to: Option<f64>) -> Result<Window, CliError> {
-        let window = Window {
-            from: from.unwrap_or(f64::NEG_INFINITY),
-            to: to.unwrap_or(f64::INFINITY),
-        };
-        // NaN and an empty window select nothing: say so rather than export nothing.
-        if window.from.is_nan() || window.to.is_nan() || window.from >= window.to {
-            return Err(CliError::EmptyWindow {
-                from: window.from,
-                to: window.to,
-            });
-        }
-        Ok(window)
-    }
-
-    fn is_limited(&self) -> bool {
-        self.from > f64::NEG_INFINITY || self.to < f64::INFINITY
-    }
-
-    #[inline]
-    fn contains(&self, t: Option<f64>) -> bool {
-        match t {
-            Some(t) => t >= self.from && t < self.to,
-            None => !self.is_limited(),
-        }
     }
 }
 

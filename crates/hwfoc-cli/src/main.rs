@@ -19,6 +19,7 @@ mod simulate;
 mod sources;
 mod stream;
 mod summary;
+mod window;
 
 use std::process::ExitCode;
 

@@ -19,6 +19,7 @@ use hwfoc::{DataFrame, Decoded, Frame, InfoFrame, Settings, Status, Temperature}
 use crate::error::CliError;
 use crate::sources::{Handler, Sources};
 use crate::summary::{Episode, Mark};
+use crate::window::Window;
 
 use super::{Options, Target};
 
@@ -411,52 +412,6 @@ impl EscData {
 /// The clock value of a data frame: its receive time, or its index times the frame period.
 fn clock(t: Option<f64>, index: u64) -> f64 {
     t.unwrap_or(index as f64 * FRAME_PERIOD)
-}
-
-/// A window of receive times, as `hwfoc decode` takes it: `from <= t_s < to`, each end
-/// optional.
-#[derive(Debug, Clone, Copy)]
-pub struct Window {
-    /// Start, s (inclusive).
-    pub from: f64,
-    /// End, s (exclusive).
-    pub to: f64,
-}
-
-impl Window {
-    /// The window from `--from` and `--to`; an empty one is an error.
-    pub fn new(from: Option<f64>, to: Option<f64>) -> Result<Window, CliError> {
-        let window = Window {
-            from: from.unwrap_or(f64::NEG_INFINITY),
-            to: to.unwrap_or(f64::INFINITY),
-        };
-        if window.from.is_nan() || window.to.is_nan() || window.from >= window.to {
-            return Err(CliError::EmptyWindow {
-                from: window.from,
-                to: window.to,
-            });
-        }
-        Ok(window)
-    }
-
-    /// No window at all: every frame.
-    pub const ALL: Window = Window {
-        from: f64::NEG_INFINITY,
-        to: f64::INFINITY,
-    };
-
-    /// Whether either end is given.
-    pub fn is_limited(&self) -> bool {
-        self.from > f64::NEG_INFINITY || self.to < f64::INFINITY
-    }
-
-    #[inline]
-    fn contains(&self, t: Option<f64>) -> bool {
-        match t {
-            Some(t) => t >= self.from && t < self.to,
-            None => !self.is_limited(),
-        }
-    }
 }
 
 /// The [`Handler`] of a plot: the frames of the chosen ESCs, by ESC.

@@ -18,7 +18,8 @@ use crate::error::CliError;
 use crate::sources::{Handler, Sources};
 use crate::{InputArgs, SettingsArgs};
 
-use collect::{Collector, Window};
+use crate::window::Window;
+use collect::Collector;
 use target::Target;
 
 /// The narrowest and widest image, and the lowest and highest, in pixels.
