@@ -95,7 +95,17 @@ fn main_loop(session: &mut Session, terminal: &mut DefaultTerminal) -> Result<()
             Some(t) if dirty || session.perf.has_pending() => t + FRAME_EVERY,
             Some(t) => t + IDLE_EVERY,
         };
-        for event in session.pump(due.saturating_duration_since(now))? {
+        let wait = due.saturating_duration_since(now);
+        let events = if session.perf.has_pending() {
+            // Frames are waiting for the next redraw anyway: take in everything that comes
+            // until then in one go, rather than waking for every chunk of every port (a key
+            // waits at most one redraw interval).
+            std::thread::sleep(wait);
+            session.pump(Duration::ZERO)?
+        } else {
+            session.pump(wait)?
+        };
+        for event in events {
             dirty |= handle(&mut ui, session, event);
         }
         let now = Instant::now();
@@ -447,11 +457,16 @@ fn draw_detail(frame: &mut Frame, area: Rect, index: usize, esc: &EscView, now: 
     let [top, low] = Layout::vertical([Constraint::Fill(1); 2]).areas(charts);
     let [rpm_area, current_area] = Layout::horizontal([Constraint::Fill(1); 2]).areas(top);
     let [volt_area, temp_area] = Layout::horizontal([Constraint::Fill(1); 2]).areas(low);
+    // Two braille dots per cell across: more points than that cannot show, so each column of
+    // dots gets the lowest and highest value that fell in it (spikes stay visible).
+    let columns = usize::from(rpm_area.width).max(1) * 2;
     let series = |f: &dyn Fn(&super::fleet::Sample) -> Option<f32>| -> Vec<(f64, f64)> {
-        esc.history
-            .iter()
-            .filter_map(|s| f(s).map(|v| (s.t - now, f64::from(v))))
-            .collect()
+        envelope(
+            esc.history
+                .iter()
+                .filter_map(|s| f(s).map(|v| (s.t - now, f64::from(v)))),
+            columns,
+        )
     };
     let rpm = series(&|s| Some(s.rpm));
     let current = series(&|s| Some(s.current_a));
@@ -484,6 +499,49 @@ fn draw_detail(frame: &mut Frame, area: Rect, index: usize, esc: &EscView, now: 
         &[("MOS", Color::Red, &mos), ("CAP", Color::LightBlue, &cap)],
         false,
     );
+}
+
+/// `points` (seconds before now, value; in time order) reduced to at most two per column of a
+/// chart `columns` wide over the last [`HISTORY_S`]: the lowest and the highest of each column,
+/// in the order they came.
+fn envelope(points: impl Iterator<Item = (f64, f64)>, columns: usize) -> Vec<(f64, f64)> {
+    let width = HISTORY_S / columns as f64;
+    let mut out: Vec<(f64, f64)> = Vec::with_capacity(2 * columns + 2);
+    let mut column = None;
+    // Indices in `out` of the current column's lowest and highest point.
+    let (mut lo, mut hi) = (0, 0);
+    for p in points {
+        let c = ((p.0 + HISTORY_S) / width).floor() as i64;
+        if column != Some(c) {
+            column = Some(c);
+            out.push(p);
+            lo = out.len() - 1;
+            hi = lo;
+            continue;
+        }
+        if lo == hi {
+            // One point so far in this column: the second becomes the other extreme.
+            out.push(p);
+            if p.1 < out[lo].1 {
+                lo = out.len() - 1;
+            } else {
+                hi = out.len() - 1;
+            }
+        } else {
+            if p.1 < out[lo].1 {
+                out[lo] = p;
+            } else if p.1 > out[hi].1 {
+                out[hi] = p;
+            }
+            // Keep the column's two points in time order.
+            let (first, second) = (lo.min(hi), lo.max(hi));
+            if out[first].0 > out[second].0 {
+                out.swap(first, second);
+                std::mem::swap(&mut lo, &mut hi);
+            }
+        }
+    }
+    out
 }
 
 /// One line of a chart: its name, colour and points (seconds before now, value).
@@ -626,4 +684,37 @@ fn draw_help(frame: &mut Frame, session: &Session) {
             .block(Block::bordered().title(" help ")),
         area,
     );
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_envelope_keeps_each_columns_extremes_in_time_order() {
+        // 1200 points over a minute, a spike at -30 s, into 60 columns of a second.
+        let points: Vec<(f64, f64)> = (0..1200)
+            .map(|i| {
+                let t = -60.0 + f64::from(i) * 0.05;
+                let v = if i == 600 { 100.0 } else { f64::from(i % 7) };
+                (t, v)
+            })
+            .collect();
+        let out = envelope(points.iter().copied(), 60);
+        assert!(out.len() <= 120, "{}", out.len());
+        assert!(out.windows(2).all(|w| w[0].0 <= w[1].0), "time order");
+        assert!(out.contains(&(-30.0, 100.0)), "the spike survives");
+        // Each column keeps its lowest and highest value.
+        let second: Vec<f64> = out
+            .iter()
+            .filter(|p| (-59.0..-58.0).contains(&p.0))
+            .map(|p| p.1)
+            .collect();
+        assert_eq!(second.len(), 2);
+        assert_eq!(second.iter().cloned().fold(f64::INFINITY, f64::min), 0.0);
+        assert_eq!(second.iter().cloned().fold(0.0, f64::max), 6.0);
+        // Fewer points than columns pass through unchanged.
+        let few = [(-10.0, 1.0), (-5.0, 2.0)];
+        assert_eq!(envelope(few.iter().copied(), 60), few);
+    }
 }

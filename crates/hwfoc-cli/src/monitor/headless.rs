@@ -13,6 +13,9 @@ use super::{Session, number};
 use crate::error::CliError;
 use crate::schema::Record;
 
+/// The longest an alarm waits before it is printed.
+const BATCH: Duration = Duration::from_millis(100);
+
 /// Runs the headless monitor until it is stopped.
 pub fn run(session: &mut Session, json: bool, interval_s: f64) -> Result<(), CliError> {
     let interval = Duration::from_secs_f64(interval_s);
@@ -21,8 +24,11 @@ pub fn run(session: &mut Session, json: bool, interval_s: f64) -> Result<(), Cli
     let mut next_status = Instant::now() + interval;
     let mut text = Vec::new();
     while !session.should_stop() {
+        // Wake a few times a second and take in everything that came, rather than for every
+        // chunk of every port: an alarm is printed at most that much later.
         let wait = next_status.saturating_duration_since(Instant::now());
-        session.pump(wait)?;
+        std::thread::sleep(wait.min(BATCH));
+        session.pump(Duration::ZERO)?;
         let now = session.now();
         for entry in session.fleet.log_since(seen) {
             let esc = &session.fleet.escs[entry.esc];

@@ -312,14 +312,33 @@ impl Session {
     }
 
     fn take(&mut self, event: PortEvent) {
+        let received = self.received_at(&event);
         if self.fleet.on_event(&event) > 0 {
-            self.perf.arrived(Instant::now());
+            self.perf.arrived(received);
         }
         if let Some(recorder) = &mut self.recorder
             && let Err(e) = recorder.handle(event)
         {
             self.recording_failed(e);
         }
+    }
+
+    /// When the bytes of `event` were handed over: the end of the read that returned them (its
+    /// first byte's time plus the wire time of the rest), or for a virtual ESC the moment it
+    /// sent them (a whole burst at once). Events may wait in the channel until the next redraw;
+    /// the screen's delay is counted from here.
+    fn received_at(&self, event: &PortEvent) -> Instant {
+        let now = Instant::now();
+        let PortEvent::Data { t_ns, bytes, .. } = event else {
+            return now;
+        };
+        let span = if self.simulated {
+            0
+        } else {
+            (bytes.len().saturating_sub(1) as f64 * crate::pcapng::byte_ns(self.baud)) as u64
+        };
+        let ago = self.clock.now_ns().saturating_sub(t_ns + span);
+        now.checked_sub(Duration::from_nanos(ago)).unwrap_or(now)
     }
 
     /// A recording that cannot go on is closed with what it has; the monitor goes on.
