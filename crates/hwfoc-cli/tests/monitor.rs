@@ -245,6 +245,16 @@ fn errors_say_what_to_do() {
     check(&["--no-config"], "hwfoc monitor --sim 4");
     check(&["--sim", "2", "--no-config"], "use --plain or --json");
     check(
+        &[
+            "/dev/ttyUSB0",
+            "--plain",
+            "--no-config",
+            "--fault",
+            "mos_overheat@1",
+        ],
+        "add --sim N",
+    );
+    check(
         &["/dev/ttyNOPE7", "--plain", "--no-config"],
         "no such port /dev/ttyNOPE7",
     );

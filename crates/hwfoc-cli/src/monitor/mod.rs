@@ -127,6 +127,14 @@ pub fn run(args: &Args) -> Result<(), CliError> {
         record_dir: args.record_dir.clone(),
         alarms: args.alarms.clone(),
     })?;
+    if args.sim.is_none() && !args.model.is_default() {
+        return Err(CliError::Usage {
+            option: "monitor".into(),
+            message: "the Throttle, Model and Faults options drive virtual ESCs: add --sim N, or \
+                      leave them out to watch ports"
+                .into(),
+        });
+    }
     let mut session = Session::start(args, config)?;
     let headless = args.plain || args.json;
     if !headless && !std::io::IsTerminal::is_terminal(&std::io::stdout()) {

@@ -133,7 +133,7 @@ pub struct Args {
 }
 
 /// What the virtual ESCs do, shared by `hwfoc simulate` and `hwfoc monitor --sim`.
-#[derive(Debug, Clone, clap::Args)]
+#[derive(Debug, Clone, PartialEq, clap::Args)]
 pub struct ModelArgs {
     /// Seed of every random choice: the same seed and options give the same bytes.
     #[arg(long, value_name = "N", default_value_t = 1)]
@@ -223,6 +223,18 @@ pub struct ModelArgs {
 }
 
 impl ModelArgs {
+    /// Whether any option differs from its default (so that `monitor` can refuse them
+    /// without `--sim`).
+    pub fn is_default(&self) -> bool {
+        use clap::{Args, FromArgMatches};
+        let command = ModelArgs::augment_args(clap::Command::new("defaults"));
+        command
+            .try_get_matches_from(["defaults"])
+            .ok()
+            .and_then(|m| ModelArgs::from_arg_matches(&m).ok())
+            .is_some_and(|defaults| defaults == *self)
+    }
+
     /// The `n` virtual ESCs these arguments describe, at `baud`, their currents and RPM scaled
     /// by `settings`: checked (fault ESC numbers, the profile file) but not started.
     pub fn fleet(
