@@ -136,11 +136,11 @@ pub struct Args {
 #[derive(Debug, Clone, PartialEq, clap::Args)]
 pub struct ModelArgs {
     /// Seed of every random choice: the same seed and options give the same bytes.
-    #[arg(long, value_name = "N", default_value_t = 1)]
+    #[arg(long, value_name = "N", default_value_t = 1, help_heading = "Model")]
     seed: u64,
     /// First packet number of every ESC (e.g. 65500 to see the wrap soon). Default: random
     /// per ESC, from the seed.
-    #[arg(long, value_name = "N")]
+    #[arg(long, value_name = "N", help_heading = "Model")]
     start_packet: Option<u16>,
 
     /// Throttle profile: steps, ramp, sine, or csv:FILE with rows time_s,throttle_percent.
