@@ -592,4 +592,28 @@ fn the_dashboard_in_tmux() {
     });
     let answer = pane.lines().find(|l| l.ends_with("STTY-42")).unwrap();
     assert_eq!(answer.trim(), "icanon echo STTY-42", "{pane}");
+
+    // Ctrl-C quits as cleanly.
+    tmux.keys(&["clear", "Enter"]);
+    let command = format!(
+        "{} monitor --sim 1 --no-config; echo CTRL-C-EXIT=$?",
+        env!("CARGO_BIN_EXE_hwfoc")
+    );
+    tmux.keys(&[&command, "Enter"]);
+    tmux.wait("the dashboard again", Duration::from_secs(10), |p| {
+        row(p, 0).is_some()
+    });
+    tmux.keys(&["C-c"]);
+    tmux.wait("the exit", Duration::from_secs(5), |p| {
+        p.contains("CTRL-C-EXIT=0")
+    });
+    tmux.keys(&[
+        "stty -a | tr ' ;' '\\n\\n' | grep -x -e icanon -e echo | tr '\\n' ' '; echo STTY-$((7*7))",
+        "Enter",
+    ]);
+    let pane = tmux.wait("stty's answer", Duration::from_secs(5), |p| {
+        p.lines().any(|l| l.ends_with("STTY-49"))
+    });
+    let answer = pane.lines().find(|l| l.ends_with("STTY-49")).unwrap();
+    assert_eq!(answer.trim(), "icanon echo STTY-49", "{pane}");
 }
