@@ -439,6 +439,23 @@ impl Drop for Tmux {
     }
 }
 
+/// Asserts that the shell's terminal is back in line mode with echo (no raw mode left behind),
+/// by asking `stty`; `n` makes the answer's marker unique.
+fn assert_terminal_usable(tmux: &Tmux, n: u32) {
+    // The marker is computed, so that the command line itself does not match it.
+    let command = format!(
+        "stty -a | tr ' ;' '\\n\\n' | grep -x -e icanon -e echo | tr '\\n' ' '; \
+         echo STTY-$(({n}*7))"
+    );
+    tmux.keys(&[&command, "Enter"]);
+    let marker = format!("STTY-{}", n * 7);
+    let pane = tmux.wait("stty's answer", Duration::from_secs(5), |p| {
+        p.lines().any(|l| l.ends_with(&marker))
+    });
+    let answer = pane.lines().find(|l| l.ends_with(&marker)).unwrap();
+    assert_eq!(answer.trim(), format!("icanon echo {marker}"), "{pane}");
+}
+
 /// The row of ESC `esc` in the dashboard's table.
 fn row(pane: &str, esc: usize) -> Option<&str> {
     let name = format!("sim:esc{esc} ");
@@ -582,16 +599,7 @@ fn the_dashboard_in_tmux() {
         !pane.contains("Alarms ("),
         "the dashboard is still on screen:\n{pane}"
     );
-    tmux.keys(&[
-        // The marker is computed, so that the command line itself does not match it.
-        "stty -a | tr ' ;' '\\n\\n' | grep -x -e icanon -e echo | tr '\\n' ' '; echo STTY-$((6*7))",
-        "Enter",
-    ]);
-    let pane = tmux.wait("stty's answer", Duration::from_secs(5), |p| {
-        p.lines().any(|l| l.ends_with("STTY-42"))
-    });
-    let answer = pane.lines().find(|l| l.ends_with("STTY-42")).unwrap();
-    assert_eq!(answer.trim(), "icanon echo STTY-42", "{pane}");
+    assert_terminal_usable(&tmux, 6);
 
     // Ctrl-C quits as cleanly.
     tmux.keys(&["clear", "Enter"]);
@@ -607,13 +615,5 @@ fn the_dashboard_in_tmux() {
     tmux.wait("the exit", Duration::from_secs(5), |p| {
         p.contains("CTRL-C-EXIT=0")
     });
-    tmux.keys(&[
-        "stty -a | tr ' ;' '\\n\\n' | grep -x -e icanon -e echo | tr '\\n' ' '; echo STTY-$((7*7))",
-        "Enter",
-    ]);
-    let pane = tmux.wait("stty's answer", Duration::from_secs(5), |p| {
-        p.lines().any(|l| l.ends_with("STTY-49"))
-    });
-    let answer = pane.lines().find(|l| l.ends_with("STTY-49")).unwrap();
-    assert_eq!(answer.trim(), "icanon echo STTY-49", "{pane}");
+    assert_terminal_usable(&tmux, 7);
 }

@@ -7,27 +7,13 @@ mod common;
 use std::collections::BTreeMap;
 use std::fs::File;
 use std::io::BufReader;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::Output;
 
-use common::{assert_fails_with, hwfoc, ok};
+use common::{Dir, assert_fails_with, hwfoc, ok};
 
 fn run(args: &[&str]) -> Output {
     hwfoc().args(args).output().expect("run hwfoc")
-}
-
-struct Dir(tempfile::TempDir);
-
-impl Dir {
-    fn new() -> Dir {
-        Dir(tempfile::tempdir().unwrap())
-    }
-    fn path(&self, name: &str) -> PathBuf {
-        self.0.path().join(name)
-    }
-    fn arg(&self, name: &str) -> String {
-        self.path(name).to_str().unwrap().to_string()
-    }
 }
 
 /// Three virtual ESCs recorded for 20 s (Unix time from 1000 s), ESC 1 overheating from 5 to

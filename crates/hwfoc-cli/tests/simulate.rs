@@ -8,11 +8,11 @@ mod common;
 
 use std::io::{BufRead, BufReader, Read};
 use std::os::unix::fs::OpenOptionsExt;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::{Output, Stdio};
 use std::time::{Duration, Instant};
 
-use common::{assert_fails_with, hwfoc, ok};
+use common::{Dir, assert_fails_with, hwfoc, ok};
 
 use hwfoc::{Decoder, Frame};
 use serde_json::Value;
@@ -44,20 +44,6 @@ fn without(mut records: Vec<Value>, keys: &[&str]) -> Vec<Value> {
         }
     }
     records
-}
-
-struct Dir(tempfile::TempDir);
-
-impl Dir {
-    fn new() -> Dir {
-        Dir(tempfile::tempdir().unwrap())
-    }
-    fn path(&self, name: &str) -> PathBuf {
-        self.0.path().join(name)
-    }
-    fn arg(&self, name: &str) -> String {
-        self.path(name).to_str().unwrap().to_string()
-    }
 }
 
 const FAULTY: [&str; 8] = [
