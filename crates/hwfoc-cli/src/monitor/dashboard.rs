@@ -154,7 +154,7 @@ fn handle(ui: &mut Ui, session: &mut Session, event: Event) -> bool {
     if kind == KeyEventKind::Release {
         return false;
     }
-    let n = session.fleet.escs.len();
+    let n = session.fleet.escs.len().max(1);
     match code {
         KeyCode::Char('c') if modifiers.contains(KeyModifiers::CONTROL) => ui.quit = true,
         KeyCode::Char('q') => ui.quit = true,
@@ -162,10 +162,10 @@ fn handle(ui: &mut Ui, session: &mut Session, event: Event) -> bool {
         KeyCode::Esc => ui.quit = true,
         KeyCode::Char('?') | KeyCode::Char('h') | KeyCode::F(1) => ui.help = !ui.help,
         KeyCode::Up | KeyCode::Char('k') | KeyCode::BackTab => {
-            ui.selected = (ui.selected + n - 1) % n.max(1);
+            ui.selected = (ui.selected + n - 1) % n;
         }
         KeyCode::Down | KeyCode::Char('j') | KeyCode::Tab => {
-            ui.selected = (ui.selected + 1) % n.max(1);
+            ui.selected = (ui.selected + 1) % n;
         }
         KeyCode::Home => ui.selected = 0,
         KeyCode::End => ui.selected = n.saturating_sub(1),
@@ -329,7 +329,7 @@ fn draw_table(frame: &mut Frame, area: Rect, ui: &Ui, view: View<'_>) {
                 Cell::from(format!("disconnected {:.0} s", view.now - since))
                     .style(level_style(Some(Level::Critical))),
             ),
-            (Link::Up, None) => (vec![Cell::from(""); 6], Cell::from("no frames yet")),
+            (Link::Up, None) => (vec![Cell::from(""); 6], Cell::from(esc.waiting())),
             (Link::Up, Some(r)) => {
                 let temp = |t: Option<f32>| t.map_or("-".to_string(), |t| number(t, 0));
                 (

@@ -192,6 +192,17 @@ impl EscView {
         self.last_frame_t.map(|t| (now - t).max(0.0))
     }
 
+    /// What to show for an ESC that has sent no data frame yet: nothing at all (is it powered,
+    /// is the wire on RX?), bytes that never make a frame (baud rate? swapped wires?), or just
+    /// not yet.
+    pub fn waiting(&self) -> &'static str {
+        match (self.stats.bytes(), self.stats.frames()) {
+            (0, _) => "no bytes yet: ESC powered? telemetry wire on RX?",
+            (bytes, 0) if bytes >= 64 => "bytes but no valid frame: baud rate? swapped wires?",
+            _ => "no frames yet",
+        }
+    }
+
     /// The name to show: the label, or the port.
     pub fn title(&self) -> &str {
         self.label.as_deref().unwrap_or(&self.name)
@@ -684,6 +695,21 @@ mod tests {
         assert_eq!(f.escs[1].link, Link::Up);
         assert_eq!(f.log_since(5).count(), 2);
         assert_eq!(f.log_since(0).count(), 7);
+    }
+
+    #[test]
+    fn an_esc_without_frames_says_why() {
+        let mut f = fleet(2);
+        assert!(f.escs[0].waiting().starts_with("no bytes yet"));
+        // What a wrong baud rate gives: bytes, never a frame.
+        f.on_event(&data(0, 1000.0, vec![0x55; 100]));
+        assert!(
+            f.escs[0].waiting().contains("baud rate"),
+            "{}",
+            f.escs[0].waiting()
+        );
+        f.on_event(&data(1, 1000.0, vec![0x55; 10]));
+        assert_eq!(f.escs[1].waiting(), "no frames yet");
     }
 
     #[test]

@@ -81,7 +81,7 @@ fn status_line(i: usize, esc: &EscView, now: f64) -> String {
         (Link::Down { since, reason }, _) => {
             line.push_str(&format!("disconnected for {:.1} s ({reason})", now - since));
         }
-        (Link::Up, None) => line.push_str("no frames yet"),
+        (Link::Up, None) => line.push_str(esc.waiting()),
         (Link::Up, Some(r)) => {
             let temp = |t: Option<f32>| t.map_or("-".to_string(), |t| format!("{}C", number(t, 1)));
             line.push_str(&format!(
