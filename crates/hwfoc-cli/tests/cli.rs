@@ -6,23 +6,15 @@ use std::io::{Read, Write};
 use std::path::{Path, PathBuf};
 use std::process::{Output, Stdio};
 
-use common::{SCHEMA, assert_fails_with, hwfoc};
+use common::{SCHEMA, XROTOR, assert_fails_with, capture, hwfoc, stdout};
 use hwfoc::{DataFrame, Fault, InfoFrame, Status};
 use serde_json::Value;
-
-fn capture(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../../shared/captures")
-        .join(name)
-}
 
 fn golden(name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("tests/golden")
         .join(name)
 }
-
-const XROTOR: &str = "xrotor-v4-pro-hv-80A.csv";
 
 fn run(args: &[&str]) -> Output {
     hwfoc().args(args).output().expect("run hwfoc")
@@ -49,15 +41,6 @@ fn run_stdin(args: &[&str], stdin: &[u8]) -> Output {
     let out = child.wait_with_output().expect("wait hwfoc");
     writer.join().unwrap();
     out
-}
-
-fn stdout(o: &Output) -> String {
-    assert!(
-        o.status.success(),
-        "hwfoc failed: {}",
-        String::from_utf8_lossy(&o.stderr)
-    );
-    String::from_utf8(o.stdout.clone()).unwrap()
 }
 
 /// Compares with a golden file; `UPDATE_GOLDEN=1` rewrites it instead.

@@ -1,10 +1,14 @@
 //! End-to-end tests of exports (Parquet, CSV, JSON Lines), filters, several inputs, the per-ESC
 //! summary with fault episodes, and output errors.
 
+mod common;
+
 use std::fs::File;
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output, Stdio};
+use std::path::Path;
+use std::process::{Output, Stdio};
 use std::sync::Arc;
+
+use common::{XROTOR, assert_fails_with, capture, hwfoc, stdout};
 
 use arrow_array::cast::AsArray;
 use arrow_array::types::{Float32Type, Float64Type, UInt8Type, UInt16Type, UInt32Type};
@@ -14,40 +18,9 @@ use hwfoc::{DataFrame, Fault, InfoFrame, Status};
 use parquet::arrow::arrow_reader::ParquetRecordBatchReaderBuilder;
 use serde_json::{Value, json};
 
-fn hwfoc() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_hwfoc"))
-}
-
 fn run(args: &[&str]) -> Output {
     hwfoc().args(args).output().expect("run hwfoc")
 }
-
-fn stdout(o: &Output) -> String {
-    assert!(
-        o.status.success(),
-        "hwfoc failed: {}",
-        String::from_utf8_lossy(&o.stderr)
-    );
-    String::from_utf8(o.stdout.clone()).unwrap()
-}
-
-/// Asserts a failure with exactly one line on stderr containing `needle`, and no panic.
-fn assert_fails_with(o: &Output, needle: &str) {
-    let err = String::from_utf8_lossy(&o.stderr);
-    assert_eq!(o.status.code(), Some(1), "stderr: {err}");
-    assert!(err.contains(needle), "{needle:?} not in {err:?}");
-    assert_eq!(err.lines().count(), 1, "one line expected: {err:?}");
-    assert!(!err.contains("panicked"), "{err}");
-    assert!(err.starts_with("hwfoc: "), "{err}");
-}
-
-fn capture(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../../shared/captures")
-        .join(name)
-}
-
-const XROTOR: &str = "xrotor-v4-pro-hv-80A.csv";
 
 fn s(p: &Path) -> &str {
     p.to_str().unwrap()

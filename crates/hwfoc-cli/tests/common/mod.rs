@@ -32,6 +32,21 @@ pub const SCHEMA: [&str; 14] = [
     "faults",
 ];
 
+/// The real capture of an XRotor ESC in `shared/captures`.
+pub const XROTOR: &str = "xrotor-v4-pro-hv-80A.csv";
+
+/// The path of a capture in `shared/captures` (beside the repository).
+pub fn capture(name: &str) -> PathBuf {
+    std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../../shared/captures")
+        .join(name)
+}
+
+/// Standard output of a run that must have succeeded (standard error shown otherwise).
+pub fn stdout(o: &Output) -> String {
+    String::from_utf8(ok(o.clone()).stdout).unwrap()
+}
+
 /// A temporary directory, removed at the end of the test.
 pub struct Dir(pub tempfile::TempDir);
 
