@@ -88,14 +88,17 @@ fn main_loop(session: &mut Session, terminal: &mut DefaultTerminal) -> Result<()
     };
     let mut last_draw: Option<Instant> = None;
     let mut dirty = true;
+    // When the next redraw is due: soon after the last one while something changed or frames
+    // wait to be shown, otherwise only to let ages tick on.
+    let due = |last_draw: Option<Instant>, busy: bool| match last_draw {
+        None => Instant::now(),
+        Some(t) if busy => t + FRAME_EVERY,
+        Some(t) => t + IDLE_EVERY,
+    };
     while !ui.quit && !session.should_stop() {
         let now = Instant::now();
-        let due = match last_draw {
-            None => now,
-            Some(t) if dirty || session.perf.has_pending() => t + FRAME_EVERY,
-            Some(t) => t + IDLE_EVERY,
-        };
-        let wait = due.saturating_duration_since(now);
+        let due_at = due(last_draw, dirty || session.perf.has_pending());
+        let wait = due_at.saturating_duration_since(now);
         let events = if session.perf.has_pending() {
             // Frames are waiting for the next redraw anyway: take in everything that comes
             // until then in one go, rather than waking for every chunk of every port (a key
@@ -108,13 +111,8 @@ fn main_loop(session: &mut Session, terminal: &mut DefaultTerminal) -> Result<()
         for event in events {
             dirty |= handle(&mut ui, session, event);
         }
-        let now = Instant::now();
-        let due = match last_draw {
-            None => now,
-            Some(t) if dirty || session.perf.has_pending() => t + FRAME_EVERY,
-            Some(t) => t + IDLE_EVERY,
-        };
-        if now >= due && !ui.quit {
+        let due_at = due(last_draw, dirty || session.perf.has_pending());
+        if Instant::now() >= due_at && !ui.quit {
             let view = match &ui.frozen {
                 Some(f) => View {
                     escs: &f.escs,

@@ -405,7 +405,7 @@ impl Fleet {
     }
 
     fn on_data(&mut self, i: usize, t: f64, r: Record) {
-        let limits = self.limits.clone();
+        let limits = &self.limits;
         let esc = &mut self.escs[i];
         esc.last = Some(r);
         esc.last_frame_t = Some(t);
