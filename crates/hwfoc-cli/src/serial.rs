@@ -193,6 +193,13 @@ pub fn interrupted() -> Arc<AtomicBool> {
     .clone()
 }
 
+/// The wall clock now, Unix time in nanoseconds (0 for a clock set before 1970).
+pub fn unix_now_ns() -> u64 {
+    SystemTime::now()
+        .duration_since(UNIX_EPOCH)
+        .map_or(0, |d| d.as_nanos() as u64)
+}
+
 /// Unix time in nanoseconds that never goes backwards: the wall clock when the clock was made,
 /// advanced by a monotonic clock (so that a clock step during a recording does not reorder it).
 #[derive(Debug, Clone, Copy)]
@@ -204,9 +211,7 @@ pub struct Clock {
 impl Clock {
     /// A clock anchored at the wall-clock time now.
     pub fn new() -> Clock {
-        let wall_ns = SystemTime::now()
-            .duration_since(UNIX_EPOCH)
-            .map_or(0, |d| d.as_nanos() as u64);
+        let wall_ns = unix_now_ns();
         Clock {
             wall_ns,
             start: Instant::now(),

@@ -28,7 +28,7 @@ pub mod sink;
 use std::io::IsTerminal;
 use std::rc::Rc;
 use std::sync::atomic::AtomicBool;
-use std::time::{Instant, SystemTime, UNIX_EPOCH};
+use std::time::Instant;
 
 use clap::ValueEnum;
 
@@ -39,6 +39,7 @@ use self::schedule::{Clock, Pace, Tally};
 use self::sink::{PcapngSink, PortSink, RawSink, Sink, Truth};
 use crate::SettingsArgs;
 use crate::error::CliError;
+use crate::serial::unix_now_ns;
 
 /// Extra seconds after one run of the profile, for file outputs without `--duration`: the
 /// motor stops and the idle frames and device information show.
@@ -323,11 +324,8 @@ impl Fleet {
     /// Runs the ESCs in real time from now until `stop` is set, each burst handed whole to
     /// `sink` when its first byte is due (Unix time in ns), as a UART's reader would get it.
     pub fn run_live(self, sink: &mut dyn Sink, stop: &AtomicBool) -> Result<(), CliError> {
-        let origin_ns = SystemTime::now()
-            .duration_since(UNIX_EPOCH)
-            .map_or(0, |d| d.as_nanos() as u64);
         let clock = Clock {
-            origin_ns,
+            origin_ns: unix_now_ns(),
             real: Some(Instant::now()),
         };
         schedule::run(self.escs(), sink, None, Pace::Whole, clock, None, stop).map(|_| ())
@@ -486,15 +484,10 @@ pub fn run(args: &Args) -> Result<(), CliError> {
         }
         None => None,
     };
-    let now_ns = || {
-        SystemTime::now()
-            .duration_since(UNIX_EPOCH)
-            .map_or(0, |d| d.as_nanos() as u64)
-    };
     let start_ns = args.start_time.map(|s| (s * 1e9).round() as u64);
     let origin_ns = match (realtime, format) {
-        (true, _) => now_ns(),
-        (false, FileFormat::Pcapng) => start_ns.unwrap_or_else(now_ns),
+        (true, _) => unix_now_ns(),
+        (false, FileFormat::Pcapng) => start_ns.unwrap_or_else(unix_now_ns),
         (false, FileFormat::Raw) => start_ns.unwrap_or(0),
     };
     let pieces = Pace::Pieces((PIECE_S * f64::from(args.baud) / 10.0).round().max(1.0) as usize);
