@@ -335,14 +335,16 @@ impl Input {
         if self.done {
             return Ok(None);
         }
-        self.bytes.clear();
         self.times.clear();
         self.stream = 0;
         match &mut self.source {
             Source::Raw { reader } => {
                 if !self.pending.is_empty() {
                     std::mem::swap(&mut self.bytes, &mut self.pending);
+                    self.pending.clear();
                 } else {
+                    // The buffer keeps its length from the last read: only bytes never read
+                    // into are zeroed here (zeroing all of it every time cost more than the read).
                     self.bytes.resize(BATCH, 0);
                     let n =
                         read_some(reader, &mut self.bytes).map_err(|source| CliError::Read {
@@ -353,6 +355,7 @@ impl Input {
                 }
             }
             Source::Csv(rows) => {
+                self.bytes.clear();
                 if let Err(e) = rows.read(&self.name, &mut self.bytes, &mut self.times) {
                     if self.bytes.is_empty() {
                         self.done = true;
@@ -362,6 +365,7 @@ impl Input {
                 }
             }
             Source::Recording(rec) => {
+                self.bytes.clear();
                 match rec.read(&self.name, &mut self.bytes, &mut self.times) {
                     Ok(stream) => self.stream = stream,
                     Err(e) if self.bytes.is_empty() => {
@@ -372,6 +376,7 @@ impl Input {
                 }
             }
             Source::Ports(ports) => {
+                self.bytes.clear();
                 self.stream = ports.read(&mut self.bytes, &mut self.times);
                 if self.bytes.is_empty() {
                     // Interrupted: the end of a live input, not an error even with no bytes.

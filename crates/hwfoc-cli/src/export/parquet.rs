@@ -10,16 +10,21 @@
 //! Speed (figures from `scripts/bench-export.sh`): the decoding thread only collects frames,
 //! a row group's worth at a time; the writer thread converts, encodes and compresses the
 //! columns of each row group in memory together with a helper thread (each takes the next
-//! column not yet done), then writes them in schema order. Encodings are chosen to keep up
+//! column not yet done, costliest first, so that both end together), and writes the previous
+//! row group to the file while the helper starts on the next. Encodings are chosen to keep up
 //! with decoding:
 //! - data pages of format version 2 (values compressed on their own, levels not, no copy of
 //!   the values before compression; a page that does not compress is stored as it is);
 //! - plain values compressed with LZ4 (`LZ4_RAW`: faster than Snappy here, and smaller);
 //! - `packet` and `erpm` as bit-packed differences (`DELTA_BINARY_PACKED`, not compressed):
-//!   they count up or drift, and plain they hardly compress;
-//! - throttles and currents with their bytes split into streams (`BYTE_STREAM_SPLIT`) before
-//!   compression: slowly varying values then compress to a half or a third (as fast), where
-//!   `rpm` and `voltage_v` gain little or compress more slowly;
+//!   they count up or drift, and plain they hardly compress. (Their bytes split into streams
+//!   and compressed would be smaller and cheaper still, but integer columns in that encoding
+//!   came with Parquet 2.11, in 2024: Spark 3.5 (parquet-java 1.13) and DuckDB releases
+//!   before mid-2026 cannot read them; the floats' byte-stream split is older and read
+//!   everywhere.)
+//! - throttles, `rpm` and currents with their bytes split into streams (`BYTE_STREAM_SPLIT`)
+//!   before compression: slowly varying values then compress to a half or a third (as fast),
+//!   where `voltage_v` and the temperatures, which repeat, compress better plain;
 //! - values handed to the column writers [`WRITE_BATCH`] at a time, so pages hold up to a
 //!   row group (fewer, larger pages: less work per value, better compression);
 //! - no dictionaries, except for the fault names;
@@ -47,9 +52,7 @@ use parquet::errors::ParquetError;
 use parquet::file::metadata::KeyValue;
 use parquet::file::properties::WriterPropertiesPtr;
 use parquet::file::properties::{EnabledStatistics, WriterProperties, WriterVersion};
-use parquet::file::writer::{
-    SerializedFileWriter, SerializedPageWriter, SerializedRowGroupWriter, TrackedWrite,
-};
+use parquet::file::writer::{SerializedFileWriter, SerializedPageWriter, TrackedWrite};
 use parquet::schema::types::{ColumnDescPtr, ColumnPath, SchemaDescriptor};
 
 use crate::error::CliError;
@@ -152,6 +155,7 @@ fn properties(schema: &Schema, provenance: &Provenance) -> WriterProperties {
     for column in [
         "throttle_in_pct",
         "throttle_out_pct",
+        "rpm",
         "current_a",
         "phase_current_a",
     ] {
@@ -298,48 +302,62 @@ impl Converter {
         }
     }
 
-    /// Writes `rows` as one row group. The columns are converted, encoded and compressed in
-    /// memory by this thread and a helper, each taking the next column not yet taken (on two
-    /// cores, the decoding thread leaves time to spare), then written in schema order.
-    fn write<W: io::Write + Send>(
+    /// Converts, encodes and compresses the columns of `rows` in memory, by this thread and a
+    /// helper, each taking the next column not yet taken (on two cores, the decoding thread
+    /// leaves time to spare). `meanwhile` runs on this thread first, while the helper starts
+    /// on the columns: writing the previous row group to the file overlaps with encoding this
+    /// one. Returns the column chunks in schema order, and what `meanwhile` returned.
+    fn encode_row_group<R>(
         &self,
         rows: &Chunk,
         descr: &SchemaDescriptor,
         props: &WriterPropertiesPtr,
-        rg: &mut SerializedRowGroupWriter<'_, W>,
-    ) -> Result<(), ParquetError> {
+        meanwhile: impl FnOnce() -> R,
+    ) -> (Result<Vec<EncodedColumn>, ParquetError>, R) {
         let leaves = descr.num_columns();
         let next = AtomicUsize::new(0);
         let work = || {
             let mut done = Vec::new();
-            loop {
-                let index = next.fetch_add(1, Ordering::Relaxed);
-                if index >= leaves {
-                    return done;
-                }
+            while let Some(&index) = BY_COST.get(next.fetch_add(1, Ordering::Relaxed)) {
                 done.push((index, self.encode(index, rows, descr, props)));
             }
+            done
         };
-        let mut chunks = std::thread::scope(|s| {
+        let (mut chunks, other) = std::thread::scope(|s| {
             let helper = s.spawn(work);
+            let other = meanwhile();
             let mut mine = work();
             // A helper that panicked has encoded nothing more: its columns are missing below.
             mine.extend(helper.join().unwrap_or_default());
-            mine
+            (mine, other)
         });
-        chunks.sort_by_key(|(index, _)| *index);
         if chunks.len() != leaves {
-            return Err(ParquetError::General(
-                "a column could not be encoded".to_string(),
-            ));
+            let e = ParquetError::General("a column could not be encoded".to_string());
+            return (Err(e), other);
         }
-        for (_, chunk) in chunks {
-            let (bytes, close) = chunk?;
-            rg.append_column(&bytes, close)?;
-        }
-        Ok(())
+        chunks.sort_by_key(|(index, _)| *index);
+        (chunks.into_iter().map(|(_, chunk)| chunk).collect(), other)
     }
 }
+
+/// Writes encoded columns to the file as its next row group.
+fn append_row_group<W: io::Write + Send>(
+    writer: &mut SerializedFileWriter<W>,
+    columns: Vec<EncodedColumn>,
+) -> Result<(), ParquetError> {
+    let mut rg = writer.next_row_group()?;
+    for (bytes, close) in columns {
+        rg.append_column(&bytes, close)?;
+    }
+    rg.close()?;
+    Ok(())
+}
+
+/// The columns (schema indices), costliest to encode first: the two threads then end a row
+/// group together, give or take one of the cheap columns at the end (measured on
+/// `scripts/bench-export.sh` input: delta-encoded `packet` and `erpm`, then the byte-stream-split
+/// and compressed floats, down to `esc`, `status` and `t_s`, which compress to nearly nothing).
+const BY_COST: [usize; 14] = [2, 5, 6, 8, 9, 3, 4, 10, 11, 13, 7, 1, 12, 0];
 
 /// One value per frame.
 #[inline]
@@ -347,8 +365,11 @@ fn column<T>(frames: &[DataFrame], value: impl Fn(&DataFrame) -> T) -> Vec<T> {
     frames.iter().map(value).collect()
 }
 
+/// A column chunk encoded in memory: its bytes and the metadata that goes with them.
+type EncodedColumn = (Bytes, ColumnCloseResult);
+
 /// A column chunk encoded in memory, or why it could not be.
-type Encoded = Result<(Bytes, ColumnCloseResult), ParquetError>;
+type Encoded = Result<EncodedColumn, ParquetError>;
 
 /// Encodes one column chunk into memory.
 fn encode<T: ParquetType>(
@@ -402,14 +423,19 @@ pub(super) fn write(
         SerializedFileWriter::new(sink.writer, parquet_schema.root_schema_ptr(), props.clone())
             .map_err(fail)?;
     let converter = Converter::new(provenance.settings);
+    // The row group encoded last, written to the file while the next one is encoded.
+    let mut previous: Option<Vec<EncodedColumn>> = None;
     for msg in rx {
         match msg {
             Msg::Rows(rows) => {
-                let mut rg = writer.next_row_group().map_err(fail)?;
-                converter
-                    .write(&rows, &parquet_schema, &props, &mut rg)
-                    .map_err(fail)?;
-                rg.close().map_err(fail)?;
+                let (encoded, written) =
+                    converter.encode_row_group(&rows, &parquet_schema, &props, || {
+                        previous
+                            .take()
+                            .map_or(Ok(()), |columns| append_row_group(&mut writer, columns))
+                    });
+                written.map_err(fail)?;
+                previous = Some(encoded.map_err(fail)?);
                 // The command may have stopped listening; the rows are then dropped.
                 let _ = spare.try_send(rows);
             }
@@ -421,6 +447,9 @@ pub(super) fn write(
             }
         }
     }
+    if let Some(columns) = previous {
+        append_row_group(&mut writer, columns).map_err(fail)?;
+    }
     writer.close().map_err(fail)?;
     Ok(())
 }
@@ -429,6 +458,18 @@ pub(super) fn write(
 mod tests {
     use super::*;
     use parquet::basic::Type as PhysicalType;
+
+    /// Every column is encoded, once.
+    #[test]
+    fn the_cost_order_names_every_column_once() {
+        let mut order = BY_COST.to_vec();
+        order.sort_unstable();
+        let leaves = ArrowSchemaConverter::new()
+            .convert(&schema())
+            .unwrap()
+            .num_columns();
+        assert_eq!(order, (0..leaves).collect::<Vec<_>>());
+    }
 
     /// The Parquet leaf columns that `Converter::encode` fills, in order, with their levels.
     #[test]
