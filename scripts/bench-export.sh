@@ -10,8 +10,9 @@
 # "parquet csv jsonl"), RUNS times each (default 3), with /usr/bin/time -v for the peak
 # resident memory. The output goes to a file in OUT_DIR (default target/bench/), deleted before
 # each run, or with `null` to /dev/null, which leaves the disk out of the figures (JSON Lines
-# is about 9.5 times the size of the input, CSV 3 times, Parquet a third). Prints MB/s of input
-# (MB = 10^6 bytes) for each run and the best run per format. Other heavy processes on the
+# is about 9.5 times the size of the input, CSV 3 times, Parquet an eighth). Prints MB/s of input
+# (MB = 10^6 bytes) for each run, with the share of the machine's CPU time that was idle or stolen
+# by the hypervisor during it, and the best and median run per format. Other heavy processes on the
 # machine skew the figures: the script prints the load average first; run it on a quiet machine.
 # An output file past its first 16 MiB is written with direct I/O (see
 # crates/hwfoc-cli/src/export/file.rs), so disk figures include the disk's own throughput; compare
@@ -37,11 +38,13 @@ echo "input: $input, $bytes bytes; $(nproc) cores ($(grep -m1 'model name' /proc
 cat "$input" > /dev/null
 for format in $formats; do
   if [ "$out_dir" = null ]; then out=/dev/null; else out=$out_dir/out.$format; fi
-  best=
+  all=
   for run in $(seq "$runs"); do
     [ "$out" = /dev/null ] || rm -f "$out"
     log=$(mktemp)
+    cpu_before=$(head -1 /proc/stat)
     /usr/bin/time -v "$bin" decode --format "$format" "$input" -o "$out" 2> "$log"
+    cpu_after=$(head -1 /proc/stat)
     wall=$(grep 'Elapsed (wall clock)' "$log" | awk '{print $NF}')
     rss_kb=$(grep 'Maximum resident set size' "$log" | awk '{print $NF}')
     user=$(grep 'User time' "$log" | awk '{print $NF}')
@@ -50,10 +53,23 @@ for format in $formats; do
     secs=$(echo "$wall" | awk -F: '{ s = 0; for (i = 1; i <= NF; i++) s = s * 60 + $i; print s }')
     mbps=$(awk -v b="$bytes" -v s="$secs" 'BEGIN { printf "%.0f", b / 1e6 / s }')
     if [ "$out" = /dev/null ]; then out_mb=-; else out_mb=$(($(stat -c %s "$out") / 1000000)); fi
-    printf '%-8s run %d: %6.2f s wall (%s s user, %s s sys), %5s MB/s, peak RSS %d MB, output %s MB\n' \
-      "$format" "$run" "$secs" "$user" "$sys" "$mbps" $((rss_kb / 1024)) "$out_mb"
-    if [ -z "$best" ] || [ "$mbps" -gt "$best" ]; then best=$mbps; fi
+    # Of the machine's CPU time during the run: idle (no thread of ours ready, or waiting for
+    # the disk) and stolen (taken by the hypervisor for other guests: a noisy host).
+    share=$(printf '%s\n%s\n' "$cpu_before" "$cpu_after" | awk '
+      { for (i = 2; i <= 9; i++) v[NR, i] = $i }
+      END {
+        for (i = 2; i <= 9; i++) { d[i] = v[2, i] - v[1, i]; t += d[i] }
+        printf "idle %.0f %%, stolen %.0f %%", 100 * (d[5] + d[6]) / t, 100 * d[9] / t
+      }')
+    printf '%-8s run %d: %6.2f s wall (%s s user, %s s sys; %s), %5s MB/s, peak RSS %d MB, output %s MB\n' \
+      "$format" "$run" "$secs" "$user" "$sys" "$share" "$mbps" $((rss_kb / 1024)) "$out_mb"
+    all="$all $mbps"
   done
-  echo "$format: best $best MB/s"
+  echo "$format:$all" | awk '{
+    n = NF - 1; for (i = 2; i <= NF; i++) v[i - 1] = $i
+    for (i = 1; i <= n; i++) for (j = i + 1; j <= n; j++) if (v[j] > v[i]) { t = v[i]; v[i] = v[j]; v[j] = t }
+    m = (n % 2) ? v[(n + 1) / 2] : (v[n / 2] + v[n / 2 + 1]) / 2
+    printf "%s best %d MB/s, median %d MB/s (%d runs)\n", $1, v[1], m, n
+  }'
   [ "$out" = /dev/null ] || rm -f "$out"
 done
