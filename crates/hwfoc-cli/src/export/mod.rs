@@ -5,11 +5,11 @@
 //! by side (text: two formatting threads and a writing one, see `text.rs`; Parquet: a writer
 //! thread that encodes the columns of each row group with a helper, see `parquet.rs`). Queues
 //! between the threads are short ([`QUEUE`] chunks of about [`CHUNK_ROWS`] rows for text, one
-//! row group for Parquet), so memory stays bounded whatever the size of the input: about 40 MB
-//! at most (with the output file's 4 MiB block).
+//! row group for Parquet), so memory stays bounded whatever the size of the input: about 45 MB
+//! at most (with the output file's two 4 MiB blocks).
 //!
-//! An output file of more than a few megabytes is written with direct I/O, bypassing the page
-//! cache (see `file.rs`).
+//! An output file is written by a thread of its own, a block at a time, and past its first
+//! megabytes with direct I/O, bypassing the page cache (see `file.rs`).
 //!
 //! Nothing already produced is lost to an error: on an input error the command finishes the
 //! export normally (text flushed, the Parquet file closed with its footer, so it is readable)
