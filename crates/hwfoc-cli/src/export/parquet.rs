@@ -280,25 +280,24 @@ impl Converter {
         let frames = &rows.frames;
         let s = &self.settings;
         let descr = descr.column(index);
-        let f32s =
-            |values: Vec<f32>| encode::<FloatType>(descr.clone(), props, &values, None, None);
-        let i32s =
-            |values: Vec<i32>| encode::<Int32Type>(descr.clone(), props, &values, None, None);
         match index {
             0 => {
                 let (values, def) = self.times(rows);
                 encode::<DoubleType>(descr, props, &values, Some(&def), None)
             }
-            1 => i32s(rows.esc.iter().map(|&e| i32::from(e)).collect()),
-            2 => i32s(column(frames, |f| i32::from(f.packet))),
-            3 => f32s(column(frames, |f| f.throttle_in_pct())),
-            4 => f32s(column(frames, |f| f.throttle_out_pct())),
+            1 => {
+                let esc: Vec<i32> = rows.esc.iter().map(|&e| i32::from(e)).collect();
+                encode::<Int32Type>(descr, props, &esc, None, None)
+            }
+            2 => encode_converted::<Int32Type>(descr, props, frames, |f| i32::from(f.packet)),
+            3 => encode_converted::<FloatType>(descr, props, frames, DataFrame::throttle_in_pct),
+            4 => encode_converted::<FloatType>(descr, props, frames, DataFrame::throttle_out_pct),
             // UINT_32 is stored in an INT32 column with the same bits.
-            5 => i32s(column(frames, |f| f.erpm() as i32)),
-            6 => f32s(column(frames, |f| f.rpm(s))),
-            7 => f32s(column(frames, |f| f.voltage_v())),
-            8 => f32s(column(frames, |f| f.current_a(s))),
-            9 => f32s(column(frames, |f| f.phase_current_a(s))),
+            5 => encode_converted::<Int32Type>(descr, props, frames, |f| f.erpm() as i32),
+            6 => encode_converted::<FloatType>(descr, props, frames, |f| f.rpm(s)),
+            7 => encode_converted::<FloatType>(descr, props, frames, DataFrame::voltage_v),
+            8 => encode_converted::<FloatType>(descr, props, frames, |f| f.current_a(s)),
+            9 => encode_converted::<FloatType>(descr, props, frames, |f| f.phase_current_a(s)),
             10 | 11 => {
                 let (values, def) = if index == 10 {
                     self.temperatures(frames.iter().map(|f| f.mos_adc))
@@ -307,7 +306,7 @@ impl Converter {
                 };
                 encode::<FloatType>(descr, props, &values, Some(&def), None)
             }
-            12 => i32s(column(frames, |f| i32::from(f.status.0))),
+            12 => encode_converted::<Int32Type>(descr, props, frames, |f| i32::from(f.status.0)),
             _ => {
                 let (values, def, rep) = self.faults(rows);
                 encode::<ByteArrayType>(descr, props, &values, Some(&def), Some(&rep))
@@ -372,10 +371,31 @@ fn append_row_group<W: io::Write + Send>(
 /// and compressed floats, down to `esc`, `status` and `t_s`, which compress to nearly nothing).
 const BY_COST: [usize; 14] = [2, 5, 6, 8, 9, 3, 4, 10, 11, 13, 7, 1, 12, 0];
 
-/// One value per frame.
-#[inline]
-fn column<T>(frames: &[DataFrame], value: impl Fn(&DataFrame) -> T) -> Vec<T> {
-    frames.iter().map(value).collect()
+/// Values converted at a time by [`encode_converted`]: they are still in the processor's
+/// first-level cache when the column writer copies them.
+const BLOCK: usize = 4096;
+
+/// Encodes one column chunk into memory: `value` of each frame, converted a block at a time.
+fn encode_converted<T: ParquetType>(
+    descr: ColumnDescPtr,
+    props: &WriterPropertiesPtr,
+    frames: &[DataFrame],
+    value: impl Fn(&DataFrame) -> T::T,
+) -> Encoded {
+    let mut buf = TrackedWrite::new(Vec::new());
+    let close = {
+        let pages = SerializedPageWriter::new(&mut buf);
+        let mut writer =
+            get_typed_column_writer::<T>(get_column_writer(descr, props.clone(), Box::new(pages)));
+        let mut block = Vec::with_capacity(BLOCK);
+        for frames in frames.chunks(BLOCK) {
+            block.clear();
+            block.extend(frames.iter().map(&value));
+            writer.write_batch(&block, None, None)?;
+        }
+        writer.close()?
+    };
+    Ok((Bytes::from(buf.into_inner()?), close))
 }
 
 /// A column chunk encoded in memory: its bytes and the metadata that goes with them.
