@@ -193,9 +193,6 @@ pub struct Converter {
     names: [ByteArray; 16],
 }
 
-/// A column's values (nulls left out) and its definition levels, if it has nulls.
-type Nullable<T> = (Vec<T>, Vec<i16>);
-
 impl Converter {
     /// A converter for `settings`.
     pub fn new(settings: Settings) -> Converter {
@@ -212,36 +209,6 @@ impl Converter {
                 ByteArray::from(name)
             }),
         }
-    }
-
-    /// Receive times, with a definition level each (0 for no time).
-    fn times(&self, rows: &Chunk) -> Nullable<f64> {
-        let n = rows.len();
-        let timed = rows.t.iter().filter(|t| !t.is_nan()).count();
-        if timed == n {
-            (rows.t.clone(), vec![1; n])
-        } else if timed == 0 {
-            (Vec::new(), vec![0; n])
-        } else {
-            let values = rows.t.iter().copied().filter(|t| !t.is_nan()).collect();
-            let def = rows.t.iter().map(|t| i16::from(!t.is_nan())).collect();
-            (values, def)
-        }
-    }
-
-    /// Temperatures from ADC codes: the values in range, and a definition level each.
-    fn temperatures(&self, codes: impl Iterator<Item = u8>) -> Nullable<f32> {
-        let mut values = Vec::new();
-        let def = codes
-            .map(|code| {
-                let (c, valid) = self.celsius[usize::from(code)];
-                if valid {
-                    values.push(c);
-                }
-                i16::from(valid)
-            })
-            .collect();
-        (values, def)
     }
 
     /// The fault names of each row, with definition and repetition levels (an empty list is
@@ -281,32 +248,45 @@ impl Converter {
         let s = &self.settings;
         let descr = descr.column(index);
         match index {
-            0 => {
-                let (values, def) = self.times(rows);
-                encode::<DoubleType>(descr, props, &values, Some(&def), None)
+            // A receive time where there is one, null where not (NaN in the chunk).
+            0 => encode_blocks::<DoubleType, _>(descr, props, &rows.t, |block, values, def| {
+                for &t in block {
+                    if !t.is_nan() {
+                        values.push(t);
+                    }
+                    def.push(i16::from(!t.is_nan()));
+                }
+            }),
+            1 => encode_converted::<Int32Type, _>(descr, props, &rows.esc, |&e| i32::from(e)),
+            2 => encode_converted::<Int32Type, _>(descr, props, frames, |f| i32::from(f.packet)),
+            3 => encode_converted::<FloatType, _>(descr, props, frames, DataFrame::throttle_in_pct),
+            4 => {
+                encode_converted::<FloatType, _>(descr, props, frames, DataFrame::throttle_out_pct)
             }
-            1 => {
-                let esc: Vec<i32> = rows.esc.iter().map(|&e| i32::from(e)).collect();
-                encode::<Int32Type>(descr, props, &esc, None, None)
-            }
-            2 => encode_converted::<Int32Type>(descr, props, frames, |f| i32::from(f.packet)),
-            3 => encode_converted::<FloatType>(descr, props, frames, DataFrame::throttle_in_pct),
-            4 => encode_converted::<FloatType>(descr, props, frames, DataFrame::throttle_out_pct),
             // UINT_32 is stored in an INT32 column with the same bits.
-            5 => encode_converted::<Int32Type>(descr, props, frames, |f| f.erpm() as i32),
-            6 => encode_converted::<FloatType>(descr, props, frames, |f| f.rpm(s)),
-            7 => encode_converted::<FloatType>(descr, props, frames, DataFrame::voltage_v),
-            8 => encode_converted::<FloatType>(descr, props, frames, |f| f.current_a(s)),
-            9 => encode_converted::<FloatType>(descr, props, frames, |f| f.phase_current_a(s)),
+            5 => encode_converted::<Int32Type, _>(descr, props, frames, |f| f.erpm() as i32),
+            6 => encode_converted::<FloatType, _>(descr, props, frames, |f| f.rpm(s)),
+            7 => encode_converted::<FloatType, _>(descr, props, frames, DataFrame::voltage_v),
+            8 => encode_converted::<FloatType, _>(descr, props, frames, |f| f.current_a(s)),
+            9 => encode_converted::<FloatType, _>(descr, props, frames, |f| f.phase_current_a(s)),
+            // Temperatures from ADC codes: null where a code is outside the table.
             10 | 11 => {
-                let (values, def) = if index == 10 {
-                    self.temperatures(frames.iter().map(|f| f.mos_adc))
+                let code = if index == 10 {
+                    |f: &DataFrame| f.mos_adc
                 } else {
-                    self.temperatures(frames.iter().map(|f| f.cap_adc))
+                    |f: &DataFrame| f.cap_adc
                 };
-                encode::<FloatType>(descr, props, &values, Some(&def), None)
+                encode_blocks::<FloatType, _>(descr, props, frames, |block, values, def| {
+                    for f in block {
+                        let (c, valid) = self.celsius[usize::from(code(f))];
+                        if valid {
+                            values.push(c);
+                        }
+                        def.push(i16::from(valid));
+                    }
+                })
             }
-            12 => encode_converted::<Int32Type>(descr, props, frames, |f| i32::from(f.status.0)),
+            12 => encode_converted::<Int32Type, _>(descr, props, frames, |f| i32::from(f.status.0)),
             _ => {
                 let (values, def, rep) = self.faults(rows);
                 encode::<ByteArrayType>(descr, props, &values, Some(&def), Some(&rep))
@@ -371,31 +351,47 @@ fn append_row_group<W: io::Write + Send>(
 /// and compressed floats, down to `esc`, `status` and `t_s`, which compress to nearly nothing).
 const BY_COST: [usize; 14] = [2, 5, 6, 8, 9, 3, 4, 10, 11, 13, 7, 1, 12, 0];
 
-/// Values converted at a time by [`encode_converted`]: they are still in the processor's
+/// Rows converted at a time by [`encode_blocks`]: their values are still in the processor's
 /// first-level cache when the column writer copies them.
 const BLOCK: usize = 4096;
 
-/// Encodes one column chunk into memory: `value` of each frame, converted a block at a time.
-fn encode_converted<T: ParquetType>(
+/// Encodes one column chunk into memory, [`BLOCK`] rows at a time: `fill` appends the values
+/// (nulls left out) and, for a nullable column, the definition levels of a block of rows to
+/// the empty buffers it is given.
+fn encode_blocks<T: ParquetType, R>(
     descr: ColumnDescPtr,
     props: &WriterPropertiesPtr,
-    frames: &[DataFrame],
-    value: impl Fn(&DataFrame) -> T::T,
+    rows: &[R],
+    fill: impl Fn(&[R], &mut Vec<T::T>, &mut Vec<i16>),
 ) -> Encoded {
+    let nullable = descr.max_def_level() > 0;
     let mut buf = TrackedWrite::new(Vec::new());
     let close = {
         let pages = SerializedPageWriter::new(&mut buf);
         let mut writer =
             get_typed_column_writer::<T>(get_column_writer(descr, props.clone(), Box::new(pages)));
-        let mut block = Vec::with_capacity(BLOCK);
-        for frames in frames.chunks(BLOCK) {
-            block.clear();
-            block.extend(frames.iter().map(&value));
-            writer.write_batch(&block, None, None)?;
+        let (mut values, mut def) = (Vec::with_capacity(BLOCK), Vec::with_capacity(BLOCK));
+        for block in rows.chunks(BLOCK) {
+            values.clear();
+            def.clear();
+            fill(block, &mut values, &mut def);
+            writer.write_batch(&values, nullable.then_some(&def[..]), None)?;
         }
         writer.close()?
     };
     Ok((Bytes::from(buf.into_inner()?), close))
+}
+
+/// Encodes one column chunk of values that are never null: `value` of each row.
+fn encode_converted<T: ParquetType, R>(
+    descr: ColumnDescPtr,
+    props: &WriterPropertiesPtr,
+    rows: &[R],
+    value: impl Fn(&R) -> T::T,
+) -> Encoded {
+    encode_blocks::<T, R>(descr, props, rows, |block, values, _| {
+        values.extend(block.iter().map(&value))
+    })
 }
 
 /// A column chunk encoded in memory: its bytes and the metadata that goes with them.
