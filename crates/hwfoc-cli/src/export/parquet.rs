@@ -211,30 +211,6 @@ impl Converter {
         }
     }
 
-    /// The fault names of each row, with definition and repetition levels (an empty list is
-    /// one level pair and no value).
-    fn faults(&self, rows: &Chunk) -> (Vec<ByteArray>, Vec<i16>, Vec<i16>) {
-        let n = rows.len();
-        if rows.frames.iter().all(|f| f.status.is_ok()) {
-            return (Vec::new(), vec![0; n], vec![0; n]);
-        }
-        let (mut values, mut def, mut rep) =
-            (Vec::new(), Vec::with_capacity(n), Vec::with_capacity(n));
-        for f in &rows.frames {
-            if f.status.is_ok() {
-                def.push(0);
-                rep.push(0);
-                continue;
-            }
-            for (i, fault) in f.status.faults().enumerate() {
-                values.push(self.names[usize::from(fault.bit())].clone());
-                def.push(1);
-                rep.push(i16::from(i > 0));
-            }
-        }
-        (values, def, rep)
-    }
-
     /// Converts and encodes column `index` (in schema order) of `rows` into memory: the
     /// column chunk's bytes and the metadata that goes with them.
     fn encode(
@@ -249,12 +225,12 @@ impl Converter {
         let descr = descr.column(index);
         match index {
             // A receive time where there is one, null where not (NaN in the chunk).
-            0 => encode_blocks::<DoubleType, _>(descr, props, &rows.t, |block, values, def| {
+            0 => encode_blocks::<DoubleType, _>(descr, props, &rows.t, |block, levels| {
                 for &t in block {
                     if !t.is_nan() {
-                        values.push(t);
+                        levels.values.push(t);
                     }
-                    def.push(i16::from(!t.is_nan()));
+                    levels.def.push(i16::from(!t.is_nan()));
                 }
             }),
             1 => encode_converted::<Int32Type, _>(descr, props, &rows.esc, |&e| i32::from(e)),
@@ -276,21 +252,33 @@ impl Converter {
                 } else {
                     |f: &DataFrame| f.cap_adc
                 };
-                encode_blocks::<FloatType, _>(descr, props, frames, |block, values, def| {
+                encode_blocks::<FloatType, _>(descr, props, frames, |block, levels| {
                     for f in block {
                         let (c, valid) = self.celsius[usize::from(code(f))];
                         if valid {
-                            values.push(c);
+                            levels.values.push(c);
                         }
-                        def.push(i16::from(valid));
+                        levels.def.push(i16::from(valid));
                     }
                 })
             }
             12 => encode_converted::<Int32Type, _>(descr, props, frames, |f| i32::from(f.status.0)),
-            _ => {
-                let (values, def, rep) = self.faults(rows);
-                encode::<ByteArrayType>(descr, props, &values, Some(&def), Some(&rep))
-            }
+            // The fault names of each row: a list, so each name has a repetition level (0 for
+            // a row's first) and an empty list is one level pair and no value.
+            _ => encode_blocks::<ByteArrayType, _>(descr, props, frames, |block, levels| {
+                for f in block {
+                    if f.status.is_ok() {
+                        levels.push(0, 0);
+                        continue;
+                    }
+                    for (i, fault) in f.status.faults().enumerate() {
+                        levels
+                            .values
+                            .push(self.names[usize::from(fault.bit())].clone());
+                        levels.push(1, i16::from(i > 0));
+                    }
+                }
+            }),
         }
     }
 
@@ -355,27 +343,53 @@ const BY_COST: [usize; 14] = [2, 5, 6, 8, 9, 3, 4, 10, 11, 13, 7, 1, 12, 0];
 /// first-level cache when the column writer copies them.
 const BLOCK: usize = 4096;
 
-/// Encodes one column chunk into memory, [`BLOCK`] rows at a time: `fill` appends the values
-/// (nulls left out) and, for a nullable column, the definition levels of a block of rows to
-/// the empty buffers it is given.
+/// A block's values (nulls left out) and, for a column that has them, its definition and
+/// repetition levels.
+struct Levels<T> {
+    values: Vec<T>,
+    def: Vec<i16>,
+    rep: Vec<i16>,
+}
+
+impl<T> Levels<T> {
+    /// Adds a level pair: `def` 0 for a null or an empty list, the column's maximum for a
+    /// value; `rep` 0 for a row's first value (columns that repeat only).
+    fn push(&mut self, def: i16, rep: i16) {
+        self.def.push(def);
+        self.rep.push(rep);
+    }
+}
+
+/// Encodes one column chunk into memory, [`BLOCK`] rows at a time: `fill` appends the values,
+/// and the levels if the column has them, of a block of rows to the empty buffers it is given.
 fn encode_blocks<T: ParquetType, R>(
     descr: ColumnDescPtr,
     props: &WriterPropertiesPtr,
     rows: &[R],
-    fill: impl Fn(&[R], &mut Vec<T::T>, &mut Vec<i16>),
+    fill: impl Fn(&[R], &mut Levels<T::T>),
 ) -> Encoded {
     let nullable = descr.max_def_level() > 0;
+    let repeated = descr.max_rep_level() > 0;
     let mut buf = TrackedWrite::new(Vec::new());
     let close = {
         let pages = SerializedPageWriter::new(&mut buf);
         let mut writer =
             get_typed_column_writer::<T>(get_column_writer(descr, props.clone(), Box::new(pages)));
-        let (mut values, mut def) = (Vec::with_capacity(BLOCK), Vec::with_capacity(BLOCK));
-        for block in rows.chunks(BLOCK) {
-            values.clear();
-            def.clear();
-            fill(block, &mut values, &mut def);
-            writer.write_batch(&values, nullable.then_some(&def[..]), None)?;
+        let mut block = Levels {
+            values: Vec::with_capacity(BLOCK),
+            def: Vec::with_capacity(BLOCK),
+            rep: Vec::with_capacity(BLOCK),
+        };
+        for rows in rows.chunks(BLOCK) {
+            block.values.clear();
+            block.def.clear();
+            block.rep.clear();
+            fill(rows, &mut block);
+            writer.write_batch(
+                &block.values,
+                nullable.then_some(&block.def[..]),
+                repeated.then_some(&block.rep[..]),
+            )?;
         }
         writer.close()?
     };
@@ -389,8 +403,8 @@ fn encode_converted<T: ParquetType, R>(
     rows: &[R],
     value: impl Fn(&R) -> T::T,
 ) -> Encoded {
-    encode_blocks::<T, R>(descr, props, rows, |block, values, _| {
-        values.extend(block.iter().map(&value))
+    encode_blocks::<T, R>(descr, props, rows, |block, levels| {
+        levels.values.extend(block.iter().map(&value))
     })
 }
 
@@ -399,25 +413,6 @@ type EncodedColumn = (Bytes, ColumnCloseResult);
 
 /// A column chunk encoded in memory, or why it could not be.
 type Encoded = Result<EncodedColumn, ParquetError>;
-
-/// Encodes one column chunk into memory.
-fn encode<T: ParquetType>(
-    descr: ColumnDescPtr,
-    props: &WriterPropertiesPtr,
-    values: &[T::T],
-    def: Option<&[i16]>,
-    rep: Option<&[i16]>,
-) -> Encoded {
-    let mut buf = TrackedWrite::new(Vec::new());
-    let close = {
-        let pages = SerializedPageWriter::new(&mut buf);
-        let mut writer =
-            get_typed_column_writer::<T>(get_column_writer(descr, props.clone(), Box::new(pages)));
-        writer.write_batch(values, def, rep)?;
-        writer.close()?
-    };
-    Ok((Bytes::from(buf.into_inner()?), close))
-}
 
 /// A Parquet error as a write error naming the output (an I/O error as itself).
 fn write_error(output: &str, e: ParquetError) -> CliError {
