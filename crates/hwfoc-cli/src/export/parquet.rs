@@ -265,20 +265,34 @@ impl Converter {
             12 => encode_converted::<Int32Type, _>(descr, props, frames, |f| i32::from(f.status.0)),
             // The fault names of each row: a list, so each name has a repetition level (0 for
             // a row's first) and an empty list is one level pair and no value.
-            _ => encode_blocks::<ByteArrayType, _>(descr, props, frames, |block, levels| {
-                for f in block {
-                    if f.status.is_ok() {
-                        levels.push(0, 0);
-                        continue;
+            // Mostly levels and few values: one block for the row group (the column writer's
+            // work per call is the larger cost here).
+            _ => encode_in::<ByteArrayType, _>(
+                frames.len(),
+                descr,
+                props,
+                frames,
+                |block, levels| {
+                    if block.iter().all(|f| f.status.is_ok()) {
+                        // The usual row group: no fault at all.
+                        levels.def.resize(block.len(), 0);
+                        levels.rep.resize(block.len(), 0);
+                        return;
                     }
-                    for (i, fault) in f.status.faults().enumerate() {
-                        levels
-                            .values
-                            .push(self.names[usize::from(fault.bit())].clone());
-                        levels.push(1, i16::from(i > 0));
+                    for f in block {
+                        if f.status.is_ok() {
+                            levels.push(0, 0);
+                            continue;
+                        }
+                        for (i, fault) in f.status.faults().enumerate() {
+                            levels
+                                .values
+                                .push(self.names[usize::from(fault.bit())].clone());
+                            levels.push(1, i16::from(i > 0));
+                        }
                     }
-                }
-            }),
+                },
+            ),
         }
     }
 
@@ -368,6 +382,17 @@ fn encode_blocks<T: ParquetType, R>(
     rows: &[R],
     fill: impl Fn(&[R], &mut Levels<T::T>),
 ) -> Encoded {
+    encode_in::<T, R>(BLOCK, descr, props, rows, fill)
+}
+
+/// [`encode_blocks`] with blocks of `block_rows` rows.
+fn encode_in<T: ParquetType, R>(
+    block_rows: usize,
+    descr: ColumnDescPtr,
+    props: &WriterPropertiesPtr,
+    rows: &[R],
+    fill: impl Fn(&[R], &mut Levels<T::T>),
+) -> Encoded {
     let nullable = descr.max_def_level() > 0;
     let repeated = descr.max_rep_level() > 0;
     let mut buf = TrackedWrite::new(Vec::new());
@@ -376,11 +401,11 @@ fn encode_blocks<T: ParquetType, R>(
         let mut writer =
             get_typed_column_writer::<T>(get_column_writer(descr, props.clone(), Box::new(pages)));
         let mut block = Levels {
-            values: Vec::with_capacity(BLOCK),
-            def: Vec::with_capacity(BLOCK),
-            rep: Vec::with_capacity(BLOCK),
+            values: Vec::with_capacity(block_rows),
+            def: Vec::with_capacity(block_rows),
+            rep: Vec::with_capacity(block_rows),
         };
-        for rows in rows.chunks(BLOCK) {
+        for rows in rows.chunks(block_rows.max(1)) {
             block.values.clear();
             block.def.clear();
             block.rep.clear();
