@@ -292,6 +292,34 @@ fn parquet_has_the_schema_units_and_metadata_and_the_jsonl_values() {
     assert!(batch.column_by_name("t_s").unwrap().null_count() == 1500);
 }
 
+/// A long recording of healthy ESCs: blocks of rows that all have times and temperatures in
+/// range (the writer's fast paths), then a raw stream of the same ESCs without times.
+#[test]
+fn parquet_of_long_runs_matches_jsonl() {
+    let dir = tempfile::tempdir().unwrap();
+    let rec = dir.path().join("run.pcapng");
+    let raw = dir.path().join("run.bin");
+    let sim = ["simulate", "--duration", "300"];
+    stdout(&run(&[&sim[..], &["--escs", "2", "-o", s(&rec)]].concat()));
+    stdout(&run(&[&sim[..], &["--escs", "1", "-o", s(&raw)]].concat()));
+    let pq = dir.path().join("out.parquet");
+    let inputs = ["decode", s(&rec), s(&raw)];
+    stdout(&run(
+        &[&inputs[..], &["--format", "parquet", "-o", s(&pq)]].concat()
+    ));
+    let records = jsonl(&stdout(&run(&inputs)));
+    assert!(records.len() > 12_000, "{} records", records.len());
+    assert!(records.iter().all(|r| !r["mos_temp_c"].is_null()));
+    let (_, _, batch) = read_parquet(&pq);
+    assert_same_records(&batch, &records);
+    let t = batch.column_by_name("t_s").unwrap();
+    assert_eq!(
+        t.null_count(),
+        records.iter().filter(|r| r["t_s"].is_null()).count()
+    );
+    assert!(t.null_count() > 4000 && t.null_count() < records.len());
+}
+
 #[test]
 fn parquet_row_groups_and_standard_input() {
     let dir = tempfile::tempdir().unwrap();

@@ -226,11 +226,19 @@ impl Converter {
         match index {
             // A receive time where there is one, null where not (NaN in the chunk).
             0 => encode_blocks::<DoubleType, _>(descr, props, &rows.t, |block, levels| {
-                for &t in block {
-                    if !t.is_nan() {
-                        levels.values.push(t);
+                let timed = block.iter().filter(|t| !t.is_nan()).count();
+                if timed == block.len() {
+                    levels.values.extend_from_slice(block);
+                    levels.def.resize(block.len(), 1);
+                } else if timed == 0 {
+                    levels.def.resize(block.len(), 0);
+                } else {
+                    for &t in block {
+                        if !t.is_nan() {
+                            levels.values.push(t);
+                        }
+                        levels.def.push(i16::from(!t.is_nan()));
                     }
-                    levels.def.push(i16::from(!t.is_nan()));
                 }
             }),
             1 => encode_converted::<Int32Type, _>(descr, props, &rows.esc, |&e| i32::from(e)),
@@ -253,6 +261,18 @@ impl Converter {
                     |f: &DataFrame| f.cap_adc
                 };
                 encode_blocks::<FloatType, _>(descr, props, frames, |block, levels| {
+                    // Usually every code is in the table: no branch per row then.
+                    let mut all_valid = true;
+                    levels.values.extend(block.iter().map(|f| {
+                        let (c, valid) = self.celsius[usize::from(code(f))];
+                        all_valid &= valid;
+                        c
+                    }));
+                    if all_valid {
+                        levels.def.resize(block.len(), 1);
+                        return;
+                    }
+                    levels.values.clear();
                     for f in block {
                         let (c, valid) = self.celsius[usize::from(code(f))];
                         if valid {
