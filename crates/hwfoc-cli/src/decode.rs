@@ -16,13 +16,13 @@ use crate::{DecodeArgs, RecordFormat};
 
 pub fn run(args: &DecodeArgs) -> Result<(), CliError> {
     let settings = args.settings.settings()?;
-    let window = Window::new(args.from, args.to)?;
+    let window = args.select.window()?;
     let mut sources = Sources::new(args.input.open_all()?);
     if window.is_limited() {
         sources.require_timing()?;
     }
-    let mut escs = [args.esc.is_empty(); 256];
-    for &esc in &args.esc {
+    let mut escs = [args.select.esc.is_empty(); 256];
+    for &esc in &args.select.esc {
         escs[usize::from(esc)] = true;
     }
     let provenance = Provenance {
@@ -50,7 +50,7 @@ pub fn run(args: &DecodeArgs) -> Result<(), CliError> {
     let finished = records.export.finish(metadata);
     result?;
     finished?;
-    warn(&sources, &args.esc);
+    warn(&sources, &args.select.esc);
     if let (true, 0, Some((first, last))) =
         (records.window.is_limited(), records.kept, records.times)
     {
@@ -100,14 +100,14 @@ impl Handler for Records {
 /// The filters, as recorded with the output: `esc=0,2 from=1.5 to=3`, or empty.
 fn filter_text(args: &DecodeArgs) -> String {
     let mut parts = Vec::new();
-    if !args.esc.is_empty() {
-        let escs: Vec<String> = args.esc.iter().map(u8::to_string).collect();
+    if !args.select.esc.is_empty() {
+        let escs: Vec<String> = args.select.esc.iter().map(u8::to_string).collect();
         parts.push(format!("esc={}", escs.join(",")));
     }
-    if let Some(from) = args.from {
+    if let Some(from) = args.select.from {
         parts.push(format!("from={from}"));
     }
-    if let Some(to) = args.to {
+    if let Some(to) = args.select.to {
         parts.push(format!("to={to}"));
     }
     parts.join(" ")

@@ -145,15 +145,8 @@ struct DecodeArgs {
     /// Write to FILE instead of standard output.
     #[arg(short, long, value_name = "FILE", required_if_eq("format", "parquet"))]
     output: Option<String>,
-    /// Keep only these ESCs (indices as in the `esc` column; repeat or separate with commas).
-    #[arg(long, value_name = "N", value_delimiter = ',')]
-    esc: Vec<u8>,
-    /// Keep only frames received at or after S seconds (`t_s`; needs inputs with receive times).
-    #[arg(long, value_name = "S", allow_negative_numbers = true)]
-    from: Option<f64>,
-    /// Keep only frames received before S seconds (`t_s`; needs inputs with receive times).
-    #[arg(long, value_name = "S", allow_negative_numbers = true)]
-    to: Option<f64>,
+    #[command(flatten)]
+    select: window::SelectArgs,
 }
 
 #[derive(Debug, Args)]

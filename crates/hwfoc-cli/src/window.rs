@@ -1,6 +1,28 @@
-//! A window of receive times (`--from`, `--to`), as `decode` and `plot` select frames by it.
+//! Which frames `decode` and `plot` keep: some ESCs (`--esc`) and a window of receive times
+//! (`--from`, `--to`).
 
 use crate::error::CliError;
+
+/// The selection options that `decode` and `plot` share.
+#[derive(Debug, clap::Args)]
+pub struct SelectArgs {
+    /// Only these ESCs (indices as in the `esc` column; repeat or separate with commas).
+    #[arg(long, value_name = "N", value_delimiter = ',')]
+    pub esc: Vec<u8>,
+    /// Only frames received at or after S seconds (`t_s`; needs inputs with receive times).
+    #[arg(long, value_name = "S", allow_negative_numbers = true)]
+    pub from: Option<f64>,
+    /// Only frames received before S seconds (`t_s`; needs inputs with receive times).
+    #[arg(long, value_name = "S", allow_negative_numbers = true)]
+    pub to: Option<f64>,
+}
+
+impl SelectArgs {
+    /// The window of receive times; an empty one is an error.
+    pub fn window(&self) -> Result<Window, CliError> {
+        Window::new(self.from, self.to)
+    }
+}
 
 /// A window of receive times: `from <= t_s < to`, each end optional (`--to` is exclusive, so
 /// that consecutive windows never share a frame).

@@ -18,7 +18,7 @@ use crate::error::CliError;
 use crate::sources::{Handler, Sources};
 use crate::{InputArgs, SettingsArgs};
 
-use crate::window::Window;
+use crate::window::{SelectArgs, Window};
 use collect::Collector;
 use target::Target;
 
@@ -46,17 +46,8 @@ pub struct Args {
     /// Title on top of the image. Default: the inputs' names.
     #[arg(long, value_name = "TEXT")]
     title: Option<String>,
-    /// Plot only these ESCs (indices as in `hwfoc decode`; repeat or separate with commas).
-    #[arg(long, value_name = "N", value_delimiter = ',')]
-    esc: Vec<u8>,
-    /// Plot only frames received at or after S seconds (`t_s`, as in `hwfoc decode`; needs
-    /// inputs with receive times).
-    #[arg(long, value_name = "S", allow_negative_numbers = true)]
-    from: Option<f64>,
-    /// Plot only frames received before S seconds (`t_s`, as in `hwfoc decode`; needs inputs
-    /// with receive times).
-    #[arg(long, value_name = "S", allow_negative_numbers = true)]
-    to: Option<f64>,
+    #[command(flatten)]
+    select: SelectArgs,
     #[command(flatten)]
     settings: SettingsArgs,
 }
@@ -77,7 +68,7 @@ pub struct Options {
 /// `hwfoc plot`: reads the inputs and writes the image.
 pub fn run(args: &Args) -> Result<(), CliError> {
     let settings = args.settings.settings()?;
-    let window = Window::new(args.from, args.to)?;
+    let window = args.select.window()?;
     // Opened first, so that a wrong name is reported before the inputs are read; a file
     // created here is removed again if the plot is not written.
     let mut target = Target::open(&args.output)?;
@@ -85,7 +76,7 @@ pub fn run(args: &Args) -> Result<(), CliError> {
         width: args.width,
         height: args.height,
         title: args.title.clone(),
-        escs: args.esc.clone(),
+        escs: args.select.esc.clone(),
     };
     let mut sources = Sources::new(args.input.open_all()?);
     if window.is_limited() {
