@@ -9,7 +9,7 @@ use std::process::Command;
 use std::thread;
 use std::time::{Duration, Instant};
 
-use common::{OutputLocked, Running, SCHEMA, hwfoc};
+use common::{OutputLocked, Running, SCHEMA, hwfoc, ok, stdout};
 use nix::sys::signal::Signal;
 use serde_json::Value;
 
@@ -120,11 +120,7 @@ fn json_lines_carry_the_schema_record_link_and_alarms() {
             "throttle_signal_lost@1-1.2",
         ])
         .output_locked();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    let out = ok(out);
     let values: Vec<Value> = lines(&out.stdout)
         .iter()
         .map(|l| serde_json::from_str(l).unwrap_or_else(|e| panic!("{e}: {l}")))
@@ -318,13 +314,8 @@ fn the_configuration_file_is_found_in_the_user_configuration_directory() {
         .args(["monitor", "--sim", "1", "--plain", "--duration", "1.2"])
         .env("XDG_CONFIG_HOME", dir.path())
         .output_locked();
-    let stdout = String::from_utf8_lossy(&out.stdout);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    assert!(stdout.contains(" esc0 tail rotor: "), "{stdout}");
+    let text = stdout(&out);
+    assert!(text.contains(" esc0 tail rotor: "), "{text}");
     // --no-config leaves it out.
     let out = hwfoc()
         .args([
@@ -338,8 +329,8 @@ fn the_configuration_file_is_found_in_the_user_configuration_directory() {
         ])
         .env("XDG_CONFIG_HOME", dir.path())
         .output_locked();
-    let stdout = String::from_utf8_lossy(&out.stdout);
-    assert!(stdout.contains(" esc0 sim:esc0: "), "{stdout}");
+    let text = stdout(&out);
+    assert!(text.contains(" esc0 sim:esc0: "), "{text}");
 }
 
 #[test]
@@ -358,12 +349,7 @@ fn a_configuration_file_sets_labels_and_levels() {
         .arg("--config")
         .arg(&config)
         .output_locked();
-    let stdout = String::from_utf8_lossy(&out.stdout);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    let stdout = stdout(&out);
     assert!(
         stdout.contains("ALARM esc0 front left: mos_temp warning raised at"),
         "{stdout}"
