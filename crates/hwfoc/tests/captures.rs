@@ -1,11 +1,10 @@
-//! Golden tests on the three real logic-analyser captures in `shared/captures/`.
-//!
-//! The captures live beside the repository (`../shared/captures` from the workspace root, as on
-//! CI), so they are located relative to this crate's manifest.
+//! Golden tests on the three real logic-analyser captures in `testdata/captures/` (copies of
+//! `shared/captures/`, kept in the repository so that a clone alone passes; see
+//! `testdata/README.md` for their source).
 
 use hwfoc::{DataFrame, Decoded, Decoder, Frame, InfoFrame, LinkStats, Settings, frames};
 
-const CAPTURES: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../../shared/captures/");
+const CAPTURES: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../testdata/captures/");
 const XROTOR: &str = "xrotor-v4-pro-hv-80A.csv";
 const PLATINUM_V4: &str = "platinum-v4.csv";
 const PLATINUM_PRO_V3: &str = "platinum-pro-v3.csv";

@@ -32,13 +32,13 @@ pub const SCHEMA: [&str; 14] = [
     "faults",
 ];
 
-/// The real capture of an XRotor ESC in `shared/captures`.
+/// The real capture of an XRotor ESC in `testdata/captures`.
 pub const XROTOR: &str = "xrotor-v4-pro-hv-80A.csv";
 
-/// The path of a capture in `shared/captures` (beside the repository).
+/// The path of a real capture in the repository's `testdata/captures` (see its README).
 pub fn capture(name: &str) -> PathBuf {
     std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../../shared/captures")
+        .join("../../testdata/captures")
         .join(name)
 }
 
