@@ -9,10 +9,10 @@ use hwfoc::{Decoded, Frame};
 use serde_json::json;
 
 use crate::error::CliError;
-use crate::export::{Export, Format, Provenance};
-use crate::sources::{Handler, Sources};
 use crate::window::Window;
 use crate::{DecodeArgs, RecordFormat};
+use hwfoc_io::sources::{Handler, Sources};
+use hwfoc_io::write::{Export, OutputFormat, Provenance};
 
 pub fn run(args: &DecodeArgs) -> Result<(), CliError> {
     let settings = args.settings.settings()?;
@@ -32,10 +32,11 @@ pub fn run(args: &DecodeArgs) -> Result<(), CliError> {
         csv_comment: args.settings_comment,
     };
     let format = match args.format {
-        RecordFormat::Jsonl => Format::Jsonl,
-        RecordFormat::Csv => Format::Csv,
-        RecordFormat::Parquet => Format::Parquet,
+        RecordFormat::Jsonl => OutputFormat::Jsonl,
+        RecordFormat::Csv => OutputFormat::Csv,
+        RecordFormat::Parquet => OutputFormat::Parquet,
     };
+    keep_freed_memory();
     let export = Export::create(format, args.output.as_deref(), provenance)?;
     let mut records = Records {
         export,
@@ -75,6 +76,8 @@ struct Records {
 }
 
 impl Handler for Records {
+    type Error = CliError;
+
     #[inline]
     fn frame(&mut self, esc: u8, t: Option<f64>, decoded: Decoded) {
         if let Frame::Data(frame) = decoded.frame
@@ -93,7 +96,7 @@ impl Handler for Records {
     }
 
     fn end_batch(&mut self, live: bool) -> Result<(), CliError> {
-        self.export.end_batch(live)
+        Ok(self.export.end_batch(live)?)
     }
 }
 
@@ -156,3 +159,23 @@ fn warn(sources: &Sources, wanted: &[u8]) {
         }
     }
 }
+
+/// Asks the C library's allocator to keep freed memory for reuse rather than hand it back to
+/// the operating system at once. Encoding allocates and frees large buffers all the time (a
+/// compressed page, a row group's columns); by default glibc unmaps or trims them on every
+/// free, and faulting the pages in again took more time than compressing them. The export's
+/// memory is bounded (see `hwfoc_io::write`), so keeping it costs nothing. A process-wide
+/// setting: the command's to make, not the library's.
+#[cfg(all(target_os = "linux", target_env = "gnu"))]
+fn keep_freed_memory() {
+    // SAFETY: mallopt only changes allocator tuning parameters; it is called before the writer
+    // threads start, and glibc serialises it with allocations in any case.
+    unsafe {
+        libc::mallopt(libc::M_MMAP_THRESHOLD, 32 << 20);
+        libc::mallopt(libc::M_TRIM_THRESHOLD, 256 << 20);
+    }
+}
+
+/// Other C libraries keep their defaults.
+#[cfg(not(all(target_os = "linux", target_env = "gnu")))]
+fn keep_freed_memory() {}

@@ -99,9 +99,9 @@ pub fn capture_csv() -> Vec<u8> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::input::Input;
-    use crate::stream::Stream;
     use hwfoc::Frame;
+    use hwfoc_io::input::Input;
+    use hwfoc_io::stream::Stream;
 
     #[test]
     fn demo_decodes_as_designed() {

@@ -1,63 +1,25 @@
 //! The command's errors: each one names what went wrong and where, in one line.
+//!
+//! The library's errors (inputs, ports, outputs) are wrapped as they are, so their messages are
+//! the library's; the variants of its own are the command line's: options, configuration files,
+//! the terminal, pseudo-terminals, plots.
 
 use std::fmt;
 use std::io;
 
+use hwfoc_io::InputError;
+use hwfoc_io::serial::PortError;
+use hwfoc_io::write::WriteError;
+
 /// Everything that makes a command fail. Printed once, by `main`, as `hwfoc: <message>`.
 #[derive(Debug)]
 pub enum CliError {
-    /// An input could not be opened.
-    Open {
-        /// The input as named on the command line.
-        input: String,
-        /// Why.
-        source: io::Error,
-    },
-    /// An input is a directory.
-    IsDirectory {
-        /// The input as named on the command line.
-        input: String,
-    },
-    /// Reading an input failed part-way.
-    Read {
-        /// The input as named on the command line.
-        input: String,
-        /// Why.
-        source: io::Error,
-    },
-    /// An input has no bytes at all.
-    Empty {
-        /// The input as named on the command line.
-        input: String,
-    },
-    /// A row of a logic-analyser CSV could not be read.
-    Csv {
-        /// The input as named on the command line.
-        input: String,
-        /// 1-based line number in the file.
-        line: u64,
-        /// What is wrong with it.
-        message: String,
-    },
-    /// Writing the output failed.
-    Write {
-        /// Where the output was going.
-        output: String,
-        /// Why.
-        source: io::Error,
-    },
-    /// An output file could not be created.
-    Create {
-        /// The file as named on the command line.
-        output: String,
-        /// Why.
-        source: io::Error,
-    },
-    /// `--from`/`--to` given for an input that has no receive times.
-    NoTiming {
-        /// The input as named on the command line.
-        input: String,
-    },
+    /// An input could not be opened or read.
+    Input(InputError),
+    /// A serial port could not be opened.
+    Port(PortError),
+    /// An output could not be created or written.
+    Write(WriteError),
     /// `--from` is not before `--to`.
     EmptyWindow {
         /// Start of the window, s.
@@ -65,39 +27,8 @@ pub enum CliError {
         /// End of the window, s.
         to: f64,
     },
-    /// More streams than the record's `esc` column can number (0..=255).
-    TooManyEscs {
-        /// The input whose stream would be ESC 256 or more.
-        input: String,
-    },
     /// A conversion setting is out of range.
     Settings(hwfoc::SettingsError),
-    /// A serial port that does not exist.
-    NoSuchPort {
-        /// The port as named on the command line.
-        port: String,
-        /// The ports the system does have.
-        available: Vec<String>,
-    },
-    /// A serial port we may not open.
-    PortPermission {
-        /// The port as named on the command line.
-        port: String,
-        /// The group owning the device file, if known.
-        group: Option<String>,
-    },
-    /// A serial port another program has open.
-    PortBusy {
-        /// The port as named on the command line.
-        port: String,
-    },
-    /// A serial port that could not be opened or set up for another reason.
-    Port {
-        /// The port as named on the command line.
-        port: String,
-        /// Why.
-        message: String,
-    },
     /// Serial ports and files named together as inputs.
     MixedInputs {
         /// The first port named.
@@ -105,7 +36,7 @@ pub enum CliError {
         /// The first file named.
         file: String,
     },
-    /// Options that do not go together (`hwfoc simulate`).
+    /// Options that do not go together.
     Usage {
         /// The option at fault.
         option: String,
@@ -165,95 +96,44 @@ impl CliError {
     /// Whether this is the reader of our output going away (`hwfoc decode … | head`): not an
     /// error worth reporting.
     pub fn is_broken_pipe(&self) -> bool {
-        matches!(self, CliError::Write { source, .. } if source.kind() == io::ErrorKind::BrokenPipe)
+        matches!(self, CliError::Write(e) if e.is_broken_pipe())
+    }
+}
+
+impl From<InputError> for CliError {
+    fn from(e: InputError) -> Self {
+        match e {
+            InputError::Port(e) => CliError::Port(e),
+            e => CliError::Input(e),
+        }
+    }
+}
+
+impl From<PortError> for CliError {
+    fn from(e: PortError) -> Self {
+        CliError::Port(e)
+    }
+}
+
+impl From<WriteError> for CliError {
+    fn from(e: WriteError) -> Self {
+        CliError::Write(e)
     }
 }
 
 impl fmt::Display for CliError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
-            CliError::Open { input, source } => write!(f, "cannot open {input}: {source}"),
-            CliError::IsDirectory { input } => {
-                write!(f, "{input} is a directory, not a capture file")
-            }
-            CliError::Read { input, source } => write!(f, "cannot read {input}: {source}"),
-            CliError::Empty { input } => write!(f, "{input} is empty: there is nothing to decode"),
-            CliError::Csv {
-                input,
-                line,
-                message,
-            } => write!(f, "{input}:{line}: {message}"),
-            CliError::Write { output, source } => write!(f, "cannot write {output}: {source}"),
-            CliError::Create { output, source } => match source.kind() {
-                io::ErrorKind::NotFound => {
-                    let dir = std::path::Path::new(output)
-                        .parent()
-                        .map(|d| d.display().to_string())
-                        .filter(|d| !d.is_empty())
-                        .unwrap_or_else(|| ".".to_string());
-                    write!(
-                        f,
-                        "cannot write {output}: the directory {dir} does not exist"
-                    )
-                }
-                io::ErrorKind::PermissionDenied => write!(
-                    f,
-                    "cannot write {output}: permission denied (choose another place with -o)"
-                ),
-                io::ErrorKind::IsADirectory => {
-                    write!(f, "cannot write {output}: it is a directory, not a file")
-                }
-                _ => write!(f, "cannot write {output}: {source}"),
-            },
-            CliError::NoTiming { input } => write!(
-                f,
-                "--from/--to select frames by time, but {input} is raw bytes without receive \
-                 times: use a recording (`hwfoc record`) or a logic-analyser CSV, or leave out \
-                 --from/--to"
-            ),
+            CliError::Input(e) => e.fmt(f),
+            CliError::Port(e) => e.fmt(f),
+            CliError::Write(e) => e.fmt(f),
             CliError::EmptyWindow { from, to } => {
                 write!(
                     f,
                     "--from {from} is not before --to {to}: no frame can be selected"
                 )
             }
-            CliError::TooManyEscs { input } => write!(
-                f,
-                "{input}: too many streams: records number ESCs 0 to 255; read fewer inputs at once"
-            ),
             CliError::Settings(e) => write!(f, "invalid setting: {e}"),
-            CliError::NoSuchPort { port, available } => {
-                write!(f, "no such port {port}")?;
-                if available.is_empty() {
-                    write!(f, " (no serial ports found: is the adapter plugged in?)")
-                } else {
-                    write!(f, " (serial ports found: {})", available.join(", "))
-                }
-            }
-            CliError::PortPermission { port, group } => {
-                // A device of group root is not meant for users: give the usual groups.
-                let group = group.as_deref().filter(|g| *g != "root");
-                let owner = match group {
-                    Some(g) => format!(" (owned by group {g})"),
-                    None => String::new(),
-                };
-                let command = match group {
-                    Some(g) => format!("`sudo usermod -aG {g} $USER`"),
-                    None => "`sudo usermod -aG dialout $USER` on Debian/Ubuntu, `uucp` on Arch"
-                        .to_string(),
-                };
-                write!(
-                    f,
-                    "permission denied on {port}{owner}: join the group that may use serial \
-                     ports ({command}), then log out and in again"
-                )
-            }
-            CliError::PortBusy { port } => write!(
-                f,
-                "{port} is busy: another program has it open (a serial monitor, another hwfoc, \
-                 ModemManager); close it and try again"
-            ),
-            CliError::Port { port, message } => write!(f, "cannot open port {port}: {message}"),
             CliError::MixedInputs { port, file } => write!(
                 f,
                 "cannot read the serial port {port} and the file {file} together: record the \
@@ -292,11 +172,10 @@ impl fmt::Display for CliError {
 impl std::error::Error for CliError {
     fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
         match self {
-            CliError::Open { source, .. }
-            | CliError::Read { source, .. }
-            | CliError::Write { source, .. }
-            | CliError::Create { source, .. }
-            | CliError::Pty { source }
+            CliError::Input(e) => Some(e),
+            CliError::Port(e) => Some(e),
+            CliError::Write(e) => Some(e),
+            CliError::Pty { source }
             | CliError::Terminal { source }
             | CliError::Link { source, .. } => Some(source),
             CliError::Settings(e) => Some(e),

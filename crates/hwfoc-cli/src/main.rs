@@ -6,18 +6,11 @@
 mod decode;
 mod demo;
 mod error;
-mod export;
-mod input;
 mod monitor;
 mod output;
-mod pcapng;
 mod plot;
 mod record;
-mod schema;
-mod serial;
 mod simulate;
-mod sources;
-mod stream;
 mod summary;
 mod window;
 
@@ -27,7 +20,8 @@ use clap::{Args, Parser, Subcommand, ValueEnum};
 use hwfoc::Settings;
 
 use crate::error::CliError;
-use crate::input::Input;
+use hwfoc_io::Input;
+use hwfoc_io::serial;
 
 /// Decode and analyse the telemetry of Hobbywing FOC ESCs (HW-FOC protocol, 19200 baud).
 #[derive(Debug, Parser)]
@@ -93,7 +87,10 @@ impl InputArgs {
                 let ports: Vec<String> = ports.into_iter().cloned().collect();
                 Ok(vec![Input::open_ports(&ports, self.baud)?])
             }
-            _ => files.into_iter().map(|f| Input::open(f)).collect(),
+            _ => Ok(files
+                .into_iter()
+                .map(|f| Input::open(f))
+                .collect::<Result<_, _>>()?),
         }
     }
 }

@@ -4,6 +4,7 @@ use std::fs::File;
 use std::io::{self, Write};
 
 use crate::error::CliError;
+use hwfoc_io::write::WriteError;
 
 /// An output sink. Text is handed over in whole buffers, so nothing is lost to a later error:
 /// whatever was produced before it is written and flushed first.
@@ -21,7 +22,7 @@ impl Output {
                 sink: Box::new(io::stdout().lock()),
             }),
             Some(path) => {
-                let file = File::create(path).map_err(|source| CliError::Write {
+                let file = File::create(path).map_err(|source| WriteError::Write {
                     output: path.to_string(),
                     source,
                 })?;
@@ -46,9 +47,10 @@ impl Output {
     }
 
     fn error(&self, source: io::Error) -> CliError {
-        CliError::Write {
+        WriteError::Write {
             output: self.name.clone(),
             source,
         }
+        .into()
     }
 }

@@ -2,7 +2,7 @@
 //!
 //! Every byte received is stored, in chunks as the reads returned them, each chunk timestamped
 //! with the Unix time of its first byte in nanoseconds; one pcapng interface per port, in the
-//! order given (see [`crate::pcapng`]). The recording is meant to survive the worst:
+//! order given (see [`hwfoc_io::pcapng`]). The recording is meant to survive the worst:
 //! - crash safety: blocks go from a small buffer to the file at least every [`FLUSH_EVERY`],
 //!   so after `kill -9` (or a crash) the file reads up to its last complete block and at most
 //!   that much data is lost; the file is also synced to the disk every [`SYNC_EVERY`];
@@ -24,8 +24,9 @@ use std::time::{Duration, Instant};
 use hwfoc::Decoder;
 
 use crate::error::CliError;
-use crate::pcapng;
-use crate::serial::{self, PortEvent, PortSet};
+use hwfoc_io::pcapng;
+use hwfoc_io::serial::{self, PortEvent, PortSet};
+use hwfoc_io::write::WriteError;
 
 /// Longest time a received byte stays in this process before it is written to the file.
 pub const FLUSH_EVERY: Duration = Duration::from_millis(50);
@@ -272,10 +273,11 @@ impl Recorder {
     }
 
     fn write_error(&self, source: std::io::Error) -> CliError {
-        CliError::Write {
+        WriteError::Write {
             output: self.current().to_string(),
             source,
         }
+        .into()
     }
 
     /// Writes what a port reported: bytes as a packet, a loss or return as a note.
@@ -498,7 +500,7 @@ fn create(
     ports: &[String],
     baud: u32,
 ) -> Result<pcapng::Writer<BufWriter<File>>, CliError> {
-    let err = |source| CliError::Write {
+    let err = |source| WriteError::Write {
         output: path.to_string(),
         source,
     };

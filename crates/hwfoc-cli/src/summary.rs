@@ -17,10 +17,10 @@ use serde_json::{Value, json};
 
 use crate::SummaryArgs;
 use crate::error::CliError;
-use crate::input::Format;
 use crate::output::Output;
 use crate::plot;
-use crate::sources::{Handler, InputInfo, Sources};
+use hwfoc_io::InputFormat;
+use hwfoc_io::sources::{Handler, InputInfo, Sources};
 
 /// What to tell a user whose input has bytes but no frame.
 pub const NO_FRAMES: &str = "no valid HW-FOC frames: check the baud rate (19200) and the wiring";
@@ -87,6 +87,8 @@ pub fn esc_label(sources: &Sources, esc: usize) -> String {
 struct Escs(Vec<Accumulator>);
 
 impl Handler for Escs {
+    type Error = CliError;
+
     #[inline]
     fn frame(&mut self, esc: u8, t: Option<f64>, decoded: Decoded) {
         let esc = usize::from(esc);
@@ -337,12 +339,12 @@ struct EscReport<'a> {
 }
 
 /// The short name of a format in `--json`.
-fn format_name(format: Format) -> &'static str {
+fn format_name(format: InputFormat) -> &'static str {
     match format {
-        Format::Raw => "raw",
-        Format::AnalyzerCsv => "csv",
-        Format::Recording => "pcapng",
-        Format::Serial => "serial",
+        InputFormat::Raw => "raw",
+        InputFormat::AnalyzerCsv => "csv",
+        InputFormat::Recording => "pcapng",
+        InputFormat::Serial => "serial",
     }
 }
 

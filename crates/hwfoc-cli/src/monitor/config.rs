@@ -41,7 +41,8 @@ use serde::Deserialize;
 
 use super::alarms::Threshold;
 use crate::error::CliError;
-use crate::serial;
+use hwfoc_io::InputError;
+use hwfoc_io::serial;
 
 /// The file's layout.
 #[derive(Debug, Default, Deserialize)]
@@ -325,7 +326,7 @@ fn invalid(origin: String, message: impl Into<String>) -> CliError {
 
 /// Reads and parses a configuration file; errors name the file and the line.
 fn read_file(path: &Path) -> Result<File, CliError> {
-    let text = std::fs::read_to_string(path).map_err(|source| CliError::Open {
+    let text = std::fs::read_to_string(path).map_err(|source| InputError::Open {
         input: path.display().to_string(),
         source,
     })?;

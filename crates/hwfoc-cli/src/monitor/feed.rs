@@ -12,9 +12,9 @@ use std::thread::{self, JoinHandle};
 use hwfoc::Settings;
 
 use crate::error::CliError;
-use crate::serial::{PortEvent, Readers};
 use crate::simulate::sink::Sink;
 use crate::simulate::{Fleet, ModelArgs};
+use hwfoc_io::serial::{PortEvent, Readers};
 
 /// What the monitor's loop receives.
 #[derive(Debug)]

@@ -8,11 +8,11 @@ use hwfoc::{Fault, Frame, InfoFrame, LinkStats, Settings};
 
 use super::alarms::{Change, Kind, Latch, Level, Threshold};
 use super::config::Limits;
-use crate::input::Batch;
-use crate::pcapng;
-use crate::schema::Record;
-use crate::serial::PortEvent;
-use crate::stream::Stream;
+use hwfoc_io::input::Batch;
+use hwfoc_io::pcapng;
+use hwfoc_io::record::Record;
+use hwfoc_io::serial::PortEvent;
+use hwfoc_io::stream::Stream;
 
 /// Seconds of history kept for the charts.
 pub const HISTORY_S: f64 = 60.0;

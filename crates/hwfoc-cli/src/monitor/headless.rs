@@ -11,7 +11,8 @@ use serde_json::{Value, json};
 use super::fleet::{EscView, Fleet, Link, LogEntry};
 use super::{Session, number};
 use crate::error::CliError;
-use crate::schema::Record;
+use hwfoc_io::record::Record;
+use hwfoc_io::write::WriteError;
 
 /// The longest an alarm waits before it is printed.
 const BATCH: Duration = Duration::from_millis(100);
@@ -58,7 +59,7 @@ pub fn run(session: &mut Session, json: bool, interval_s: f64) -> Result<(), Cli
         if !text.is_empty() {
             out.write_all(&text)
                 .and_then(|()| out.flush())
-                .map_err(|source| CliError::Write {
+                .map_err(|source| WriteError::Write {
                     output: "standard output".into(),
                     source,
                 })?;

@@ -27,8 +27,8 @@ use self::fleet::Fleet;
 use self::perf::Perf;
 use crate::error::CliError;
 use crate::record::{self, Recorder};
-use crate::serial::{self, PortEvent};
 use crate::simulate::ModelArgs;
+use hwfoc_io::serial::{self, PortEvent};
 
 /// The most virtual ESCs `--sim` runs.
 const MAX_SIM: u16 = 64;
@@ -343,7 +343,7 @@ impl Session {
         let span = if self.simulated {
             0
         } else {
-            (bytes.len().saturating_sub(1) as f64 * crate::pcapng::byte_ns(self.baud)) as u64
+            (bytes.len().saturating_sub(1) as f64 * hwfoc_io::pcapng::byte_ns(self.baud)) as u64
         };
         let ago = self.clock.now_ns().saturating_sub(t_ns + span);
         now.checked_sub(Duration::from_nanos(ago)).unwrap_or(now)

@@ -17,9 +17,9 @@
 use hwfoc::{DataFrame, Decoded, Frame, InfoFrame, Settings, Status, Temperature};
 
 use crate::error::CliError;
-use crate::sources::{Handler, Sources};
 use crate::summary::{Episode, Mark};
 use crate::window::Window;
+use hwfoc_io::sources::{Handler, Sources};
 
 use super::{Options, Target};
 
@@ -476,6 +476,8 @@ impl Collector {
 }
 
 impl Handler for Collector {
+    type Error = CliError;
+
     #[inline]
     fn frame(&mut self, esc: u8, t: Option<f64>, decoded: Decoded) {
         let i = usize::from(esc);

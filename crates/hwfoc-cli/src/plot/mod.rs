@@ -15,8 +15,8 @@ mod text;
 use hwfoc::{Decoded, Settings};
 
 use crate::error::CliError;
-use crate::sources::{Handler, Sources};
 use crate::{InputArgs, SettingsArgs};
+use hwfoc_io::sources::{Handler, Sources};
 
 use crate::window::{SelectArgs, Window};
 use collect::Collector;
@@ -122,6 +122,8 @@ impl Alongside {
 }
 
 impl Handler for Alongside {
+    type Error = CliError;
+
     #[inline]
     fn frame(&mut self, esc: u8, t: Option<f64>, decoded: Decoded) {
         self.collector.frame(esc, t, decoded);
@@ -132,7 +134,9 @@ impl Handler for Alongside {
 /// reading of the inputs.
 pub struct Both<'a, A, B>(pub &'a mut A, pub &'a mut B);
 
-impl<A: Handler, B: Handler> Handler for Both<'_, A, B> {
+impl<A: Handler<Error = CliError>, B: Handler<Error = CliError>> Handler for Both<'_, A, B> {
+    type Error = CliError;
+
     #[inline]
     fn frame(&mut self, esc: u8, t: Option<f64>, decoded: Decoded) {
         self.0.frame(esc, t, decoded);

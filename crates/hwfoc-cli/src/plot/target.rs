@@ -6,6 +6,7 @@ use std::io::{self, Write};
 use std::path::Path;
 
 use crate::error::CliError;
+use hwfoc_io::write::WriteError;
 
 /// What the image is written as.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -49,7 +50,7 @@ impl Target {
             message: "the image format follows the file name: use a name ending in .png or .svg"
                 .to_string(),
         })?;
-        let create = |source| CliError::Create {
+        let create = |source| WriteError::Create {
             output: path.to_string(),
             source,
         };
@@ -59,7 +60,7 @@ impl Target {
                 OpenOptions::new().write(true).open(path).map_err(create)?,
                 false,
             ),
-            Err(e) => return Err(create(e)),
+            Err(e) => return Err(create(e).into()),
         };
         Ok(Target {
             path: path.to_string(),
@@ -87,7 +88,7 @@ impl Target {
             .set_len(0)
             .and_then(|()| self.file.write_all(bytes))
             .and_then(|()| self.file.flush());
-        result.map_err(|source| CliError::Write {
+        result.map_err(|source| WriteError::Write {
             output: self.path.clone(),
             source,
         })?;

@@ -39,7 +39,8 @@ use self::schedule::{Clock, Pace, Tally};
 use self::sink::{PcapngSink, PortSink, RawSink, Sink, Truth};
 use crate::SettingsArgs;
 use crate::error::CliError;
-use crate::serial::unix_now_ns;
+use hwfoc_io::serial::unix_now_ns;
+use hwfoc_io::write::WriteError;
 
 /// Extra seconds after one run of the profile, for file outputs without `--duration`: the
 /// motor stops and the idle frames and device information show.
@@ -537,7 +538,7 @@ pub fn run(args: &Args) -> Result<(), CliError> {
     };
 
     let infos: Vec<hwfoc::InfoFrame> = escs.iter().map(|e| *e.info()).collect();
-    let stop: std::sync::Arc<AtomicBool> = crate::serial::interrupted();
+    let stop: std::sync::Arc<AtomicBool> = hwfoc_io::serial::interrupted();
     let clock = Clock {
         origin_ns,
         real: realtime.then(Instant::now),
@@ -619,7 +620,7 @@ fn open_ptys(
     for (i, name) in names.iter().enumerate() {
         writeln!(stdout, "esc {i}: {name}")
             .and_then(|()| stdout.flush())
-            .map_err(|source| CliError::Write {
+            .map_err(|source| WriteError::Write {
                 output: "standard output".to_string(),
                 source,
             })?;

@@ -14,6 +14,7 @@ use std::fmt;
 use std::str::FromStr;
 
 use crate::error::CliError;
+use hwfoc_io::InputError;
 
 /// A profile as named on the command line, before any file is read.
 #[derive(Debug, Clone, PartialEq)]
@@ -133,7 +134,7 @@ impl Profile {
                 max_pct,
             },
             ProfileSpec::Csv(path) => {
-                let text = std::fs::read(path).map_err(|source| CliError::Open {
+                let text = std::fs::read(path).map_err(|source| InputError::Open {
                     input: path.clone(),
                     source,
                 })?;

@@ -6,8 +6,10 @@ use std::io::{self, BufWriter, Write};
 use hwfoc::{DataFrame, Settings};
 
 use crate::error::CliError;
-use crate::pcapng;
-use crate::schema::Record;
+use hwfoc_io::pcapng;
+use hwfoc_io::record::Record;
+use hwfoc_io::serial::PortError;
+use hwfoc_io::write::WriteError;
 
 /// The outputs of a simulation, one stream per ESC.
 pub trait Sink {
@@ -27,7 +29,7 @@ pub fn create(path: &str) -> Result<(String, Box<dyn Write>), CliError> {
     if path == "-" {
         return Ok(("standard output".to_string(), Box::new(io::stdout())));
     }
-    let file = File::create(path).map_err(|source| CliError::Write {
+    let file = File::create(path).map_err(|source| WriteError::Write {
         output: path.to_string(),
         source,
     })?;
@@ -40,9 +42,12 @@ pub fn expand(template: &str, esc: usize) -> String {
 }
 
 fn write_error(name: &str) -> impl FnOnce(io::Error) -> CliError + '_ {
-    move |source| CliError::Write {
-        output: name.to_string(),
-        source,
+    move |source| {
+        WriteError::Write {
+            output: name.to_string(),
+            source,
+        }
+        .into()
     }
 }
 
@@ -146,10 +151,10 @@ impl PortSink {
     pub fn open(names: &[String], baud: u32) -> Result<PortSink, CliError> {
         let mut ports = Vec::with_capacity(names.len());
         for name in names {
-            let mut port = crate::serial::open(name, baud)?;
+            let mut port = hwfoc_io::serial::open(name, baud)?;
             // A write waits at most this long for room in the driver's buffer.
             port.set_timeout(std::time::Duration::from_millis(500))
-                .map_err(|e| CliError::Port {
+                .map_err(|e| PortError::Other {
                     port: name.clone(),
                     message: e.to_string(),
                 })?;
@@ -171,10 +176,11 @@ impl Sink for PortSink {
                 self.undelivered[esc] += bytes.len() as u64;
                 Ok(false)
             }
-            Err(source) => Err(CliError::Write {
+            Err(source) => Err(WriteError::Write {
                 output: name.clone(),
                 source,
-            }),
+            }
+            .into()),
         }
     }
 

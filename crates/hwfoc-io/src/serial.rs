@@ -17,9 +17,9 @@ use std::time::{Duration, Instant, SystemTime, UNIX_EPOCH};
 
 use serialport::{DataBits, FlowControl, Parity, SerialPort, StopBits};
 
-use crate::error::CliError;
+use std::fmt;
 
-/// The HW-FOC telemetry rate.
+/// The HW-FOC telemetry rate, the default of every serial input.
 pub const DEFAULT_BAUD: u32 = 19_200;
 
 /// How long a read waits for bytes before the thread checks whether it should stop.
@@ -30,6 +30,78 @@ pub const RETRY_EVERY: Duration = Duration::from_millis(500);
 
 /// Bytes asked for per read (at 19200 baud a read rarely returns more than a frame).
 const READ_SIZE: usize = 4096;
+
+/// Why a serial port could not be opened or read. Each names the port as the user gave it.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum PortError {
+    /// A serial port that does not exist.
+    NoSuchPort {
+        /// The port as named on the command line.
+        port: String,
+        /// The ports the system does have.
+        available: Vec<String>,
+    },
+    /// A serial port we may not open.
+    Permission {
+        /// The port as named on the command line.
+        port: String,
+        /// The group owning the device file, if known.
+        group: Option<String>,
+    },
+    /// A serial port another program has open.
+    Busy {
+        /// The port as named on the command line.
+        port: String,
+    },
+    /// A serial port that could not be opened or set up for another reason.
+    Other {
+        /// The port as named on the command line.
+        port: String,
+        /// Why.
+        message: String,
+    },
+}
+
+impl fmt::Display for PortError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            PortError::NoSuchPort { port, available } => {
+                write!(f, "no such port {port}")?;
+                if available.is_empty() {
+                    write!(f, " (no serial ports found: is the adapter plugged in?)")
+                } else {
+                    write!(f, " (serial ports found: {})", available.join(", "))
+                }
+            }
+            PortError::Permission { port, group } => {
+                // A device of group root is not meant for users: give the usual groups.
+                let group = group.as_deref().filter(|g| *g != "root");
+                let owner = match group {
+                    Some(g) => format!(" (owned by group {g})"),
+                    None => String::new(),
+                };
+                let command = match group {
+                    Some(g) => format!("`sudo usermod -aG {g} $USER`"),
+                    None => "`sudo usermod -aG dialout $USER` on Debian/Ubuntu, `uucp` on Arch"
+                        .to_string(),
+                };
+                write!(
+                    f,
+                    "permission denied on {port}{owner}: join the group that may use serial \
+                     ports ({command}), then log out and in again"
+                )
+            }
+            PortError::Busy { port } => write!(
+                f,
+                "{port} is busy: another program has it open (a serial monitor, another hwfoc, \
+                 ModemManager); close it and try again"
+            ),
+            PortError::Other { port, message } => write!(f, "cannot open port {port}: {message}"),
+        }
+    }
+}
+
+impl std::error::Error for PortError {}
 
 /// Whether `spec`, an input named on the command line, is a serial port rather than a file:
 /// `COM3` (or `\\.\COM12`); a character device that is a terminal; or a path under `/dev` that
@@ -86,12 +158,12 @@ fn is_terminal(path: &str) -> bool {
 }
 
 /// Opens `port` at `baud`, 8N1, no flow control, for exclusive use.
-pub fn open(port: &str, baud: u32) -> Result<Box<dyn SerialPort>, CliError> {
+pub fn open(port: &str, baud: u32) -> Result<Box<dyn SerialPort>, PortError> {
     if cfg!(unix) {
         match std::fs::metadata(port) {
             Err(_) => return Err(no_such_port(port)),
             Ok(meta) if meta.is_file() || meta.is_dir() => {
-                return Err(CliError::Port {
+                return Err(PortError::Other {
                     port: port.to_string(),
                     message: format!(
                         "it is a {}, not a serial port (to read a capture file, use `hwfoc \
@@ -113,8 +185,8 @@ pub fn open(port: &str, baud: u32) -> Result<Box<dyn SerialPort>, CliError> {
         .map_err(|e| open_error(port, e))
 }
 
-fn no_such_port(port: &str) -> CliError {
-    CliError::NoSuchPort {
+fn no_such_port(port: &str) -> PortError {
+    PortError::NoSuchPort {
         port: port.to_string(),
         available: available_ports(),
     }
@@ -141,19 +213,19 @@ pub fn available_ports() -> Vec<String> {
     ports
 }
 
-fn open_error(port: &str, e: serialport::Error) -> CliError {
+fn open_error(port: &str, e: serialport::Error) -> PortError {
     use serialport::ErrorKind as K;
     match e.kind() {
         K::Io(io::ErrorKind::NotFound) => no_such_port(port),
-        K::Io(io::ErrorKind::PermissionDenied) => CliError::PortPermission {
+        K::Io(io::ErrorKind::PermissionDenied) => PortError::Permission {
             port: port.to_string(),
             group: owner_group(port),
         },
         // EBUSY from TIOCEXCL, or the lock another program holds.
-        K::NoDevice => CliError::PortBusy {
+        K::NoDevice => PortError::Busy {
             port: port.to_string(),
         },
-        _ => CliError::Port {
+        _ => PortError::Other {
             port: port.to_string(),
             message: e.to_string(),
         },
@@ -286,13 +358,13 @@ impl Readers {
         baud: u32,
         tx: Sender<M>,
         wrap: fn(PortEvent) -> M,
-    ) -> Result<Readers, CliError> {
+    ) -> Result<Readers, PortError> {
         if let Some((i, name)) = names
             .iter()
             .enumerate()
             .find(|(i, name)| names[..*i].contains(name))
         {
-            return Err(CliError::Port {
+            return Err(PortError::Other {
                 port: name.clone(),
                 message: format!(
                     "it is named twice (as port {} and port {})",
@@ -324,7 +396,7 @@ impl Readers {
                 thread::Builder::new()
                     .name(format!("read {}", names[index]))
                     .spawn(move || reader.run(port))
-                    .map_err(|e| CliError::Port {
+                    .map_err(|e| PortError::Other {
                         port: names[index].clone(),
                         message: format!("cannot start its reader thread: {e}"),
                     })
@@ -366,7 +438,7 @@ impl Drop for Readers {
 impl PortSet {
     /// Opens every port (all of them, before any reading starts, so that a bad name is
     /// reported at once) and starts their reader threads.
-    pub fn open(names: &[String], baud: u32) -> Result<PortSet, CliError> {
+    pub fn open(names: &[String], baud: u32) -> Result<PortSet, PortError> {
         let (tx, events) = mpsc::channel();
         let readers = Readers::start(names, baud, tx, |event| event)?;
         Ok(PortSet { readers, events })

@@ -34,13 +34,12 @@
 //!
 //! Row groups hold about [`ROW_GROUP_ROWS`] rows, so that memory stays small.
 
-use std::collections::HashMap;
 use std::io;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::mpsc::{Receiver, SyncSender};
 
-use arrow_schema::{DataType, Field, FieldRef, Schema};
+use arrow_schema::Schema;
 use bytes::Bytes;
 use hwfoc::{DataFrame, Fault, Settings, Temperature};
 use parquet::arrow::{ArrowSchemaConverter, add_encoded_arrow_schema_to_metadata};
@@ -58,10 +57,9 @@ use parquet::file::properties::{
 use parquet::file::writer::{SerializedFileWriter, SerializedPageWriter, TrackedWrite};
 use parquet::schema::types::{ColumnDescPtr, ColumnPath, SchemaDescriptor};
 
-use crate::error::CliError;
-use crate::schema::{COLUMNS, UNITS};
+use super::arrow::{ITEM, schema};
 
-use super::{Chunk, Msg, Provenance, Sink};
+use super::{Chunk, Destination, Provenance, ToWriter, WriteError};
 
 /// Rows per row group, at least (a row group is written once this many rows are collected).
 pub const ROW_GROUP_ROWS: usize = 1 << 17;
@@ -69,44 +67,6 @@ pub const ROW_GROUP_ROWS: usize = 1 << 17;
 /// Values handed to a column writer at a time (the crate's default, 1024, spends more time per
 /// value and makes pages of 1 MB at most).
 const WRITE_BATCH: usize = 1 << 16;
-
-/// Name of the `faults` list's item field (Arrow's default).
-const ITEM: &str = "item";
-
-/// The Arrow schema of the records: names, types, nullability and units of RECORD-SCHEMA.md.
-pub fn schema() -> Schema {
-    let types = [
-        (DataType::Float64, true),
-        (DataType::UInt8, false),
-        (DataType::UInt16, false),
-        (DataType::Float32, false),
-        (DataType::Float32, false),
-        (DataType::UInt32, false),
-        (DataType::Float32, false),
-        (DataType::Float32, false),
-        (DataType::Float32, false),
-        (DataType::Float32, false),
-        (DataType::Float32, true),
-        (DataType::Float32, true),
-        (DataType::UInt16, false),
-        (DataType::List(fault_item()), false),
-    ];
-    let fields: Vec<Field> = COLUMNS
-        .iter()
-        .zip(UNITS)
-        .zip(types)
-        .map(|((name, unit), (data_type, nullable))| {
-            let metadata = HashMap::from([("unit".to_string(), unit.to_string())]);
-            Field::new(*name, data_type, nullable).with_metadata(metadata)
-        })
-        .collect();
-    Schema::new(fields)
-}
-
-/// The item field of the `faults` list: a fault name, never null.
-fn fault_item() -> FieldRef {
-    Arc::new(Field::new(ITEM, DataType::Utf8, false))
-}
 
 /// The writer's properties: fast encodings, the settings and the Arrow schema in the key-value
 /// metadata.
@@ -460,7 +420,7 @@ type EncodedColumn = (Bytes, ColumnCloseResult);
 type Encoded = Result<EncodedColumn, ParquetError>;
 
 /// A Parquet error as a write error naming the output (an I/O error as itself).
-fn write_error(output: &str, e: ParquetError) -> CliError {
+fn write_error(output: &str, e: ParquetError) -> WriteError {
     let source = match e {
         ParquetError::External(inner) => match inner.downcast::<io::Error>() {
             Ok(io) => *io,
@@ -468,7 +428,7 @@ fn write_error(output: &str, e: ParquetError) -> CliError {
         },
         other => io::Error::other(other.to_string()),
     };
-    CliError::Write {
+    WriteError::Write {
         output: output.to_string(),
         source,
     }
@@ -478,11 +438,11 @@ fn write_error(output: &str, e: ParquetError) -> CliError {
 /// them on `spare` for reuse. At the end message, or when the sender goes away, the
 /// file is closed properly: footer and metadata, so it is readable.
 pub(super) fn write(
-    sink: Sink,
+    sink: Destination,
     provenance: &Provenance,
-    rx: Receiver<Msg>,
+    rx: Receiver<ToWriter>,
     spare: SyncSender<Chunk>,
-) -> Result<(), CliError> {
+) -> Result<(), WriteError> {
     let schema = schema();
     let name = sink.name;
     let fail = |e| write_error(&name, e);
@@ -496,7 +456,7 @@ pub(super) fn write(
     let mut previous: Option<Vec<EncodedColumn>> = None;
     for msg in rx {
         match msg {
-            Msg::Rows(rows) => {
+            ToWriter::Rows(rows) => {
                 let (encoded, written) =
                     converter.encode_row_group(&rows, &parquet_schema, &props, || {
                         previous
@@ -508,7 +468,7 @@ pub(super) fn write(
                 // The command may have stopped listening; the rows are then dropped.
                 let _ = spare.try_send(rows);
             }
-            Msg::End(metadata) => {
+            ToWriter::End(metadata) => {
                 for (key, value) in metadata {
                     writer.append_key_value_metadata(KeyValue::new(key, value));
                 }

@@ -1,4 +1,4 @@
-//! The text writer: JSON Lines or CSV, through the encodings of [`crate::schema`].
+//! The text writer: JSON Lines or CSV, through the encodings of [`crate::record`].
 //!
 //! Formatting numbers is most of the work, so two threads format, each a slice of rows at a
 //! time, and a third writes their text in order: this thread hands the slices out in turn to
@@ -8,10 +8,9 @@
 
 use std::sync::mpsc::{Receiver, SyncSender, sync_channel};
 
-use crate::error::CliError;
-use crate::schema::{Record, TextEncoder};
+use crate::record::{Record, TextEncoder};
 
-use super::{Chunk, Msg, Provenance, Sink};
+use super::{Chunk, Destination, Provenance, ToWriter, WriteError};
 
 /// Rows formatted at a time by one formatter.
 const SLICE_ROWS: usize = 8192;
@@ -30,11 +29,11 @@ type Text = (Vec<u8>, bool);
 /// written and flushed; or at the first write error.
 pub(super) fn write(
     csv: bool,
-    sink: Sink,
+    sink: Destination,
     provenance: &Provenance,
-    rx: Receiver<Msg>,
+    rx: Receiver<ToWriter>,
     spare: SyncSender<Chunk>,
-) -> Result<(), CliError> {
+) -> Result<(), WriteError> {
     let header = header(csv, provenance);
     let settings = provenance.settings;
     std::thread::scope(|s| {
@@ -69,8 +68,8 @@ pub(super) fn write(
         let mut turn = 0;
         'rows: for msg in rx {
             let mut chunk = match msg {
-                Msg::Rows(chunk) => chunk,
-                Msg::End(_) => break,
+                ToWriter::Rows(chunk) => chunk,
+                ToWriter::End(_) => break,
             };
             let n = chunk.len();
             let mut start = 0;
@@ -98,7 +97,7 @@ pub(super) fn write(
         // No more slices: the formatters finish theirs and stop, and so does the writer.
         drop(slices);
         writer.join().unwrap_or_else(|_| {
-            Err(CliError::Write {
+            Err(WriteError::Write {
                 output: "the output".to_string(),
                 source: std::io::Error::other("the writer thread failed"),
             })
@@ -137,10 +136,10 @@ fn header(csv: bool, provenance: &Provenance) -> Vec<u8> {
 /// Writes the header, then the formatters' text, taking from each formatter in turn (the
 /// order the slices were handed out in), until the formatter whose turn it is has stopped.
 fn write_in_turn(
-    mut sink: Sink,
+    mut sink: Destination,
     header: Vec<u8>,
     texts: Vec<Receiver<Text>>,
-) -> Result<(), CliError> {
+) -> Result<(), WriteError> {
     let mut pending = header;
     let mut turn = 0;
     while let Ok((text, flush)) = texts[turn].recv() {

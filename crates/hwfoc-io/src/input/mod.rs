@@ -20,9 +20,8 @@ use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Duration;
 
-use crate::error::CliError;
 use crate::pcapng;
-use crate::serial::{self, PortEvent, PortSet};
+use crate::serial::{self, PortError, PortEvent, PortSet};
 
 /// How many bytes a raw read asks for: small enough that what the kernel copies in is still in
 /// the L2 cache when the decoder reads it (1 MiB reads made `summary` 1.6x slower), large enough
@@ -36,7 +35,7 @@ const PORT_POLL: Duration = Duration::from_millis(100);
 
 /// The detected format of an input.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Format {
+pub enum InputFormat {
     /// Raw bytes from the wire.
     Raw,
     /// A logic-analyser CSV export, one row per byte.
@@ -47,13 +46,13 @@ pub enum Format {
     Serial,
 }
 
-impl fmt::Display for Format {
+impl fmt::Display for InputFormat {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         f.write_str(match self {
-            Format::Raw => "raw bytes",
-            Format::AnalyzerCsv => "logic-analyser CSV",
-            Format::Recording => "pcapng recording",
-            Format::Serial => "serial port",
+            InputFormat::Raw => "raw bytes",
+            InputFormat::AnalyzerCsv => "logic-analyser CSV",
+            InputFormat::Recording => "pcapng recording",
+            InputFormat::Serial => "serial port",
         })
     }
 }
@@ -95,7 +94,7 @@ struct Recording {
     window_start: Option<u64>,
     /// The file is read to its end (or to a read error, kept in `error`).
     ended: bool,
-    error: Option<CliError>,
+    error: Option<InputError>,
     /// Interfaces whose link type is not telemetry, already warned about.
     skipped: Vec<u32>,
 }
@@ -128,7 +127,7 @@ struct CsvRows {
 /// One opened input.
 pub struct Input {
     name: String,
-    format: Format,
+    format: InputFormat,
     source: Source,
     bytes: Vec<u8>,
     times: Vec<f64>,
@@ -140,25 +139,25 @@ pub struct Input {
     done: bool,
     /// An error met after some bytes of a batch: reported on the next call, so that the bytes
     /// before it are decoded first.
-    deferred: Option<CliError>,
+    deferred: Option<InputError>,
 }
 
 impl Input {
     /// Opens a file, or standard input for `-`, and detects its format.
-    pub fn open(spec: &str) -> Result<Input, CliError> {
+    pub fn open(spec: &str) -> Result<Input, InputError> {
         if spec == "-" {
             return Input::from_reader("standard input", Box::new(io::stdin().lock()));
         }
-        let file = File::open(spec).map_err(|source| CliError::Open {
+        let file = File::open(spec).map_err(|source| InputError::Open {
             input: spec.to_string(),
             source,
         })?;
-        let meta = file.metadata().map_err(|source| CliError::Open {
+        let meta = file.metadata().map_err(|source| InputError::Open {
             input: spec.to_string(),
             source,
         })?;
         if meta.is_dir() {
-            return Err(CliError::IsDirectory {
+            return Err(InputError::IsDirectory {
                 input: spec.to_string(),
             });
         }
@@ -168,25 +167,25 @@ impl Input {
     /// Opens serial ports at `baud` (8N1) as one input with one stream per port, in the order
     /// given. Reading ends on Ctrl-C or SIGTERM (the signals stop the input rather than the
     /// process); a port that is unplugged is waited for, with a warning.
-    pub fn open_ports(names: &[String], baud: u32) -> Result<Input, CliError> {
+    pub fn open_ports(names: &[String], baud: u32) -> Result<Input, InputError> {
         let interrupted = serial::interrupted();
         let set = PortSet::open(names, baud)?;
         Ok(Input::new(
             &names.join(", "),
-            Format::Serial,
+            InputFormat::Serial,
             Source::Ports(Ports { set, interrupted }),
             Vec::new(),
         ))
     }
 
     /// An input over bytes already in memory (the built-in demo stream).
-    pub fn from_memory(name: &str, data: Vec<u8>) -> Result<Input, CliError> {
+    pub fn from_memory(name: &str, data: Vec<u8>) -> Result<Input, InputError> {
         Input::from_reader(name, Box::new(Cursor::new(data)))
     }
 
     /// Detects the format from the first bytes of `reader`.
-    pub fn from_reader(name: &str, mut reader: Box<dyn Read>) -> Result<Input, CliError> {
-        let read_err = |source| CliError::Read {
+    pub fn from_reader(name: &str, mut reader: Box<dyn Read>) -> Result<Input, InputError> {
+        let read_err = |source| InputError::Read {
             input: name.to_string(),
             source,
         };
@@ -206,7 +205,7 @@ impl Input {
             }
         }
         if head.is_empty() {
-            return Err(CliError::Empty {
+            return Err(InputError::Empty {
                 input: name.to_string(),
             });
         }
@@ -236,7 +235,7 @@ impl Input {
                 error: None,
                 skipped: Vec::new(),
             }));
-            return Ok(Input::new(name, Format::Recording, source, Vec::new()));
+            return Ok(Input::new(name, InputFormat::Recording, source, Vec::new()));
         }
         let is_csv = {
             let text = String::from_utf8_lossy(&head);
@@ -264,14 +263,14 @@ impl Input {
                 row: Vec::new(),
                 flagged: 0,
             });
-            (Format::AnalyzerCsv, source, Vec::new())
+            (InputFormat::AnalyzerCsv, source, Vec::new())
         } else {
-            (Format::Raw, Source::Raw { reader }, head)
+            (InputFormat::Raw, Source::Raw { reader }, head)
         };
         Ok(Input::new(name, format, source, pending))
     }
 
-    fn new(name: &str, format: Format, source: Source, pending: Vec<u8>) -> Input {
+    fn new(name: &str, format: InputFormat, source: Source, pending: Vec<u8>) -> Input {
         Input {
             name: name.to_string(),
             format,
@@ -292,7 +291,7 @@ impl Input {
     }
 
     /// The detected format.
-    pub fn format(&self) -> Format {
+    pub fn format(&self) -> InputFormat {
         self.format
     }
 
@@ -327,7 +326,7 @@ impl Input {
     }
 
     /// The next batch of bytes, or `None` at the end of the input.
-    pub fn next_batch(&mut self) -> Result<Option<Batch<'_>>, CliError> {
+    pub fn next_batch(&mut self) -> Result<Option<Batch<'_>>, InputError> {
         if let Some(e) = self.deferred.take() {
             self.done = true;
             return Err(e);
@@ -347,7 +346,7 @@ impl Input {
                     // into are zeroed here (zeroing all of it every time cost more than the read).
                     self.bytes.resize(BATCH, 0);
                     let n =
-                        read_some(reader, &mut self.bytes).map_err(|source| CliError::Read {
+                        read_some(reader, &mut self.bytes).map_err(|source| InputError::Read {
                             input: self.name.clone(),
                             source,
                         })?;
@@ -388,7 +387,7 @@ impl Input {
         if self.bytes.is_empty() {
             self.done = true;
             if !self.seen_any {
-                return Err(CliError::Empty {
+                return Err(InputError::Empty {
                     input: self.name.clone(),
                 });
             }
@@ -396,8 +395,10 @@ impl Input {
         }
         self.seen_any = true;
         let times = match self.format {
-            Format::AnalyzerCsv | Format::Recording | Format::Serial => Some(&self.times[..]),
-            Format::Raw => None,
+            InputFormat::AnalyzerCsv | InputFormat::Recording | InputFormat::Serial => {
+                Some(&self.times[..])
+            }
+            InputFormat::Raw => None,
         };
         Ok(Some(Batch {
             bytes: &self.bytes,
@@ -418,7 +419,7 @@ impl Recording {
         name: &str,
         bytes: &mut Vec<u8>,
         times: &mut Vec<f64>,
-    ) -> Result<usize, CliError> {
+    ) -> Result<usize, InputError> {
         loop {
             if let Some(from) = self.draining {
                 if let Some(i) = (from..self.pending.len()).find(|&i| !self.pending[i].0.is_empty())
@@ -443,13 +444,16 @@ impl Recording {
 
     /// Reads packets into the per-interface buffers until the window is over, a buffer is
     /// full, or the file ends.
-    fn read_window(&mut self, name: &str) -> Result<(), CliError> {
+    fn read_window(&mut self, name: &str) -> Result<(), InputError> {
         self.window_start = None;
         loop {
-            let packet = self.reader.next_packet().map_err(|source| CliError::Read {
-                input: name.to_string(),
-                source,
-            });
+            let packet = self
+                .reader
+                .next_packet()
+                .map_err(|source| InputError::Read {
+                    input: name.to_string(),
+                    source,
+                });
             let packet = match packet {
                 Ok(Some(p)) => p,
                 Ok(None) => {
@@ -549,7 +553,7 @@ impl CsvRows {
         name: &str,
         bytes: &mut Vec<u8>,
         times: &mut Vec<f64>,
-    ) -> Result<(), CliError> {
+    ) -> Result<(), InputError> {
         let CsvRows {
             reader,
             value_col,
@@ -563,7 +567,7 @@ impl CsvRows {
             row.clear();
             let n = reader
                 .read_until(b'\n', row)
-                .map_err(|source| CliError::Read {
+                .map_err(|source| InputError::Read {
                     input: name.to_string(),
                     source,
                 })?;
@@ -571,7 +575,7 @@ impl CsvRows {
                 break;
             }
             *line += 1;
-            let bad = |message: String| CliError::Csv {
+            let bad = |message: String| InputError::Csv {
                 input: name.to_string(),
                 line: *line,
                 message,
@@ -662,6 +666,103 @@ fn field_text(field: Option<&str>) -> String {
     }
 }
 
+/// Why an input could not be read. Each names the input as the user gave it.
+#[derive(Debug)]
+pub enum InputError {
+    /// An input could not be opened.
+    Open {
+        /// The input as named on the command line.
+        input: String,
+        /// Why.
+        source: io::Error,
+    },
+    /// An input is a directory.
+    IsDirectory {
+        /// The input as named on the command line.
+        input: String,
+    },
+    /// Reading an input failed part-way.
+    Read {
+        /// The input as named on the command line.
+        input: String,
+        /// Why.
+        source: io::Error,
+    },
+    /// An input has no bytes at all.
+    Empty {
+        /// The input as named on the command line.
+        input: String,
+    },
+    /// A row of a logic-analyser CSV could not be read.
+    Csv {
+        /// The input as named on the command line.
+        input: String,
+        /// 1-based line number in the file.
+        line: u64,
+        /// What is wrong with it.
+        message: String,
+    },
+    /// Frames were to be selected by time, but the input has no receive times.
+    NoTiming {
+        /// The input as named on the command line.
+        input: String,
+    },
+    /// More streams than the record's `esc` column can number (0..=255).
+    TooManyEscs {
+        /// The input whose stream would be ESC 256 or more.
+        input: String,
+    },
+    /// A serial port could not be opened.
+    Port(PortError),
+}
+
+impl From<PortError> for InputError {
+    fn from(e: PortError) -> Self {
+        InputError::Port(e)
+    }
+}
+
+impl fmt::Display for InputError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            InputError::Open { input, source } => write!(f, "cannot open {input}: {source}"),
+            InputError::IsDirectory { input } => {
+                write!(f, "{input} is a directory, not a capture file")
+            }
+            InputError::Read { input, source } => write!(f, "cannot read {input}: {source}"),
+            InputError::Empty { input } => {
+                write!(f, "{input} is empty: there is nothing to decode")
+            }
+            InputError::Csv {
+                input,
+                line,
+                message,
+            } => write!(f, "{input}:{line}: {message}"),
+            InputError::NoTiming { input } => write!(
+                f,
+                "--from/--to select frames by time, but {input} is raw bytes without receive \
+                 times: use a recording (`hwfoc record`) or a logic-analyser CSV, or leave out \
+                 --from/--to"
+            ),
+            InputError::TooManyEscs { input } => write!(
+                f,
+                "{input}: too many streams: records number ESCs 0 to 255; read fewer inputs at once"
+            ),
+            InputError::Port(e) => e.fmt(f),
+        }
+    }
+}
+
+impl std::error::Error for InputError {
+    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
+        match self {
+            InputError::Open { source, .. } | InputError::Read { source, .. } => Some(source),
+            InputError::Port(e) => Some(e),
+            _ => None,
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -692,7 +793,7 @@ mod tests {
     fn detects_csv_and_raw() {
         let csv = b"Time [s],Value,Parity Error,Framing Error\n0.5,0x9B,,\n0.75,0x16,,x\n".to_vec();
         let mut input = Input::from_memory("a.csv", csv).unwrap();
-        assert_eq!(input.format(), Format::AnalyzerCsv);
+        assert_eq!(input.format(), InputFormat::AnalyzerCsv);
         assert_eq!(
             read_all(&mut input),
             (vec![0x9B, 0x16], Some(vec![0.5, 0.75]))
@@ -701,12 +802,12 @@ mod tests {
 
         let raw = b"\x9B\x16\x01Time".to_vec();
         let mut input = Input::from_memory("a.bin", raw.clone()).unwrap();
-        assert_eq!(input.format(), Format::Raw);
+        assert_eq!(input.format(), InputFormat::Raw);
         assert_eq!(read_all(&mut input), (raw, None));
 
         // Text that is not a logic-analyser export is raw bytes too.
         let input = Input::from_memory("t", b"Tea,time\n".to_vec()).unwrap();
-        assert_eq!(input.format(), Format::Raw);
+        assert_eq!(input.format(), InputFormat::Raw);
     }
 
     #[test]
@@ -731,7 +832,7 @@ mod tests {
         let e = Input::from_memory("x", Vec::new()).err().unwrap();
         assert_eq!(e.to_string(), "x is empty: there is nothing to decode");
         let mut input = Input::from_memory("h.csv", b"Time [s],Value\n".to_vec()).unwrap();
-        assert!(matches!(input.next_batch(), Err(CliError::Empty { .. })));
+        assert!(matches!(input.next_batch(), Err(InputError::Empty { .. })));
     }
 
     /// Batches as (stream, bytes, times), owned.
@@ -759,7 +860,7 @@ mod tests {
 
         // Whatever the name: the content decides.
         let mut input = Input::from_memory("capture.bin", file).unwrap();
-        assert_eq!(input.format(), Format::Recording);
+        assert_eq!(input.format(), InputFormat::Recording);
         let got = batches(&mut input);
         assert_eq!(input.streams(), 2);
         assert_eq!(input.stream_name(1), "/dev/ttyUSB1");
@@ -806,7 +907,7 @@ mod tests {
     fn raw_bytes_starting_like_a_recording_stay_raw() {
         let raw = vec![0x0A, 0x0D, 0x0D, 0x0A, 0, 0, 0, 0, 1, 2, 3, 4, 0x9B];
         let mut input = Input::from_memory("odd.bin", raw.clone()).unwrap();
-        assert_eq!(input.format(), Format::Raw);
+        assert_eq!(input.format(), InputFormat::Raw);
         assert_eq!(read_all(&mut input), (raw, None));
         let raw = vec![0x0A, 0x9B, 0x16];
         let mut input = Input::from_memory("nl.bin", raw.clone()).unwrap();
@@ -829,7 +930,7 @@ mod tests {
             })
             .collect();
         let mut input = Input::open_ports(&names, 19200).unwrap();
-        assert_eq!(input.format(), Format::Serial);
+        assert_eq!(input.format(), InputFormat::Serial);
         assert_eq!(input.streams(), 2);
         assert_eq!(input.stream_name(1), names[1]);
         let mut master = std::fs::File::from(ptys[1].master.try_clone().unwrap());

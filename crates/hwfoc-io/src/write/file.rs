@@ -35,7 +35,7 @@ const ALIGN: usize = 4096;
 
 /// How the file is being written.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum Mode {
+enum IoMode {
     /// The usual way for now; direct I/O once [`BUFFERED`] bytes are written.
     Soon,
     /// Direct I/O.
@@ -102,9 +102,9 @@ impl OutputFile {
             file,
             written: 0,
             mode: if regular && cfg!(target_os = "linux") {
-                Mode::Soon
+                IoMode::Soon
             } else {
-                Mode::Buffered
+                IoMode::Buffered
             },
         };
         let (jobs, rx) = sync_channel::<Job>(1);
@@ -226,7 +226,7 @@ struct Disk {
     file: File,
     /// Bytes written to the file so far.
     written: u64,
-    mode: Mode,
+    mode: IoMode,
 }
 
 impl Disk {
@@ -237,11 +237,11 @@ impl Disk {
             // Direct writes must be whole blocks of the disk: the rest goes the usual way.
             self.end_direct()?;
         }
-        if self.mode == Mode::Soon && self.written >= BUFFERED {
+        if self.mode == IoMode::Soon && self.written >= BUFFERED {
             self.mode = if set_direct(&self.file, true).is_ok() {
-                Mode::Direct
+                IoMode::Direct
             } else {
-                Mode::Buffered
+                IoMode::Buffered
             };
         }
         let mut done = 0;
@@ -252,7 +252,7 @@ impl Disk {
                 Err(e) if e.kind() == io::ErrorKind::Interrupted => {}
                 // The file system refuses this direct write (alignment, or no direct I/O at
                 // all): write the usual way from here on.
-                Err(e) if self.mode == Mode::Direct && e.raw_os_error() == Some(libc::EINVAL) => {
+                Err(e) if self.mode == IoMode::Direct && e.raw_os_error() == Some(libc::EINVAL) => {
                     self.end_direct()?;
                 }
                 Err(e) => return Err(e),
@@ -266,10 +266,10 @@ impl Disk {
     }
 
     fn end_direct(&mut self) -> io::Result<()> {
-        if self.mode == Mode::Direct {
+        if self.mode == IoMode::Direct {
             set_direct(&self.file, false)?;
         }
-        self.mode = Mode::Buffered;
+        self.mode = IoMode::Buffered;
         Ok(())
     }
 }

@@ -15,18 +15,19 @@
 //! export normally (text flushed, the Parquet file closed with its footer, so it is readable)
 //! before reporting it; on an output error the writers stop and the error names the output.
 
+pub mod arrow;
 mod file;
+#[cfg(feature = "parquet")]
 mod parquet;
 mod text;
 
+use std::fmt;
 use std::fs::File;
 use std::io::{self, Write};
 use std::sync::mpsc::{Receiver, SyncSender, sync_channel};
 use std::thread::JoinHandle;
 
 use hwfoc::{DataFrame, Settings};
-
-use crate::error::CliError;
 
 /// Rows per chunk handed to the writer thread (a chunk may exceed it by one input batch).
 pub const CHUNK_ROWS: usize = 1 << 16;
@@ -44,7 +45,7 @@ const PARQUET_ROWS: usize = parquet::ROW_GROUP_ROWS + CHUNK_ROWS;
 
 /// Output formats.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Format {
+pub enum OutputFormat {
     /// JSON Lines.
     Jsonl,
     /// CSV with a header row.
@@ -109,7 +110,7 @@ impl Chunk {
 }
 
 /// A message to the writer thread.
-enum Msg {
+enum ToWriter {
     /// Rows to write: some text, or a Parquet row group.
     Rows(Chunk),
     /// The end: metadata known only now (the ESCs found), as key-value pairs.
@@ -119,13 +120,13 @@ enum Msg {
 /// An export in progress.
 pub struct Export {
     chunk: Chunk,
-    tx: Option<SyncSender<Msg>>,
-    worker: Option<JoinHandle<Result<(), CliError>>>,
-    mode: Mode,
+    tx: Option<SyncSender<ToWriter>>,
+    worker: Option<JoinHandle<Result<(), WriteError>>>,
+    mode: Pipeline,
 }
 
 /// What the decoding thread prepares for the writer.
-enum Mode {
+enum Pipeline {
     /// Text: chunks of frames, formatted by the writer. Chunks it is done with come back.
     Text { spare: Receiver<Chunk> },
     /// Parquet: a row group's frames at a time, converted, encoded and written by the writer.
@@ -134,26 +135,26 @@ enum Mode {
 }
 
 /// Where the output goes.
-pub(crate) struct Sink {
+pub(crate) struct Destination {
     /// The output as named on the command line, or "standard output".
     pub name: String,
     /// The open file or standard output.
     pub writer: Box<dyn Write + Send>,
 }
 
-impl Sink {
-    fn open(path: Option<&str>) -> Result<Sink, CliError> {
+impl Destination {
+    fn open(path: Option<&str>) -> Result<Destination, WriteError> {
         match path {
-            None | Some("-") => Ok(Sink {
+            None | Some("-") => Ok(Destination {
                 name: "standard output".to_string(),
                 writer: Box::new(io::stdout()),
             }),
             Some(path) => {
-                let file = File::create(path).map_err(|source| CliError::Create {
+                let file = File::create(path).map_err(|source| WriteError::Create {
                     output: path.to_string(),
                     source,
                 })?;
-                Ok(Sink {
+                Ok(Destination {
                     name: path.to_string(),
                     writer: Box::new(file::OutputFile::new(file)),
                 })
@@ -162,8 +163,8 @@ impl Sink {
     }
 
     /// A write error, naming the output.
-    pub fn error(&self, source: io::Error) -> CliError {
-        CliError::Write {
+    pub fn error(&self, source: io::Error) -> WriteError {
+        WriteError::Write {
             output: self.name.clone(),
             source,
         }
@@ -173,30 +174,29 @@ impl Sink {
 impl Export {
     /// Creates the output (standard output for `None` or `-`) and starts the writer thread.
     pub fn create(
-        format: Format,
+        format: OutputFormat,
         path: Option<&str>,
         provenance: Provenance,
-    ) -> Result<Export, CliError> {
-        let sink = Sink::open(path)?;
-        keep_freed_memory();
-        type Work = Box<dyn FnOnce() -> Result<(), CliError> + Send>;
-        let (tx, mode, work): (SyncSender<Msg>, Mode, Work) = match format {
-            Format::Jsonl | Format::Csv => {
-                let (tx, rx) = sync_channel::<Msg>(QUEUE);
+    ) -> Result<Export, WriteError> {
+        let sink = Destination::open(path)?;
+        type Work = Box<dyn FnOnce() -> Result<(), WriteError> + Send>;
+        let (tx, mode, work): (SyncSender<ToWriter>, Pipeline, Work) = match format {
+            OutputFormat::Jsonl | OutputFormat::Csv => {
+                let (tx, rx) = sync_channel::<ToWriter>(QUEUE);
                 let (spare_tx, spare) = sync_channel::<Chunk>(QUEUE + 2);
-                let csv = format == Format::Csv;
+                let csv = format == OutputFormat::Csv;
                 (
                     tx,
-                    Mode::Text { spare },
+                    Pipeline::Text { spare },
                     Box::new(move || text::write(csv, sink, &provenance, rx, spare_tx)),
                 )
             }
-            Format::Parquet => {
-                let (tx, rx) = sync_channel::<Msg>(PARQUET_QUEUE);
+            OutputFormat::Parquet => {
+                let (tx, rx) = sync_channel::<ToWriter>(PARQUET_QUEUE);
                 let (spare_tx, spare) = sync_channel::<Chunk>(PARQUET_QUEUE + 2);
                 (
                     tx,
-                    Mode::Parquet { spare },
+                    Pipeline::Parquet { spare },
                     Box::new(move || parquet::write(sink, &provenance, rx, spare_tx)),
                 )
             }
@@ -204,13 +204,13 @@ impl Export {
         let worker = std::thread::Builder::new()
             .name("hwfoc-writer".to_string())
             .spawn(work)
-            .map_err(|source| CliError::Write {
+            .map_err(|source| WriteError::Write {
                 output: path.unwrap_or("standard output").to_string(),
                 source,
             })?;
         let rows = match mode {
-            Mode::Text { .. } => CHUNK_ROWS,
-            Mode::Parquet { .. } => PARQUET_ROWS,
+            Pipeline::Text { .. } => CHUNK_ROWS,
+            Pipeline::Parquet { .. } => PARQUET_ROWS,
         };
         Ok(Export {
             chunk: Chunk::with_capacity(rows),
@@ -230,7 +230,7 @@ impl Export {
 
     /// Hands the rows collected so far to the writer once there are enough of them, or at once
     /// when `live` (the rows are then written and flushed without waiting for more).
-    pub fn end_batch(&mut self, live: bool) -> Result<(), CliError> {
+    pub fn end_batch(&mut self, live: bool) -> Result<(), WriteError> {
         if self.chunk.len() >= CHUNK_ROWS || (live && !self.chunk.is_empty()) {
             self.send(live, false)?;
         }
@@ -239,9 +239,9 @@ impl Export {
 
     /// Hands the current chunk on; `flush`: text is to reach the output at once; `last`: the
     /// end of the export.
-    fn send(&mut self, flush: bool, last: bool) -> Result<(), CliError> {
+    fn send(&mut self, flush: bool, last: bool) -> Result<(), WriteError> {
         let msg = match &mut self.mode {
-            Mode::Text { spare } => {
+            Pipeline::Text { spare } => {
                 let next = match spare.try_recv() {
                     Ok(mut c) => {
                         c.clear();
@@ -251,9 +251,9 @@ impl Export {
                 };
                 let mut chunk = std::mem::replace(&mut self.chunk, next);
                 chunk.flush = flush;
-                Msg::Rows(chunk)
+                ToWriter::Rows(chunk)
             }
-            Mode::Parquet { spare } => {
+            Pipeline::Parquet { spare } => {
                 // A Parquet file is readable only once closed (its footer comes last), so live
                 // input gains nothing from early writes: rows gather into full row groups.
                 if self.chunk.is_empty() || (self.chunk.len() < parquet::ROW_GROUP_ROWS && !last) {
@@ -266,20 +266,20 @@ impl Export {
                     }
                     Err(_) => Chunk::with_capacity(PARQUET_ROWS),
                 };
-                Msg::Rows(std::mem::replace(&mut self.chunk, next))
+                ToWriter::Rows(std::mem::replace(&mut self.chunk, next))
             }
         };
         self.post(msg)
     }
 
-    fn post(&mut self, msg: Msg) -> Result<(), CliError> {
+    fn post(&mut self, msg: ToWriter) -> Result<(), WriteError> {
         let sent = self.tx.as_ref().is_some_and(|tx| tx.send(msg).is_ok());
         if sent {
             Ok(())
         } else {
             // The writer has stopped: its error says why.
             self.tx = None;
-            Err(self.join().err().unwrap_or_else(|| CliError::Write {
+            Err(self.join().err().unwrap_or_else(|| WriteError::Write {
                 output: "the output".to_string(),
                 source: io::Error::other("the writer stopped"),
             }))
@@ -288,17 +288,17 @@ impl Export {
 
     /// Writes the remaining rows and ends the output: flushes text, closes a Parquet file
     /// (adding `metadata` to its key-value metadata).
-    pub fn finish(mut self, metadata: Vec<(String, String)>) -> Result<(), CliError> {
+    pub fn finish(mut self, metadata: Vec<(String, String)>) -> Result<(), WriteError> {
         self.send(true, true)?;
-        self.post(Msg::End(metadata))?;
+        self.post(ToWriter::End(metadata))?;
         self.tx = None;
         self.join()
     }
 
-    fn join(&mut self) -> Result<(), CliError> {
+    fn join(&mut self) -> Result<(), WriteError> {
         match self.worker.take() {
             Some(worker) => worker.join().unwrap_or_else(|_| {
-                Err(CliError::Write {
+                Err(WriteError::Write {
                     output: "the output".to_string(),
                     source: io::Error::other("the writer thread failed"),
                 })
@@ -316,21 +316,66 @@ impl Drop for Export {
     }
 }
 
-/// Asks the C library's allocator to keep freed memory for reuse rather than hand it back to
-/// the operating system at once. Encoding allocates and frees large buffers all the time (a
-/// compressed page, a row group's columns); by default glibc unmaps or trims them on every
-/// free, and faulting the pages in again took more time than compressing them. The export's
-/// memory is bounded (see the module documentation), so keeping it costs nothing.
-#[cfg(all(target_os = "linux", target_env = "gnu"))]
-fn keep_freed_memory() {
-    // SAFETY: mallopt only changes allocator tuning parameters; it is called before the writer
-    // thread starts, and glibc serialises it with allocations in any case.
-    unsafe {
-        libc::mallopt(libc::M_MMAP_THRESHOLD, 32 << 20);
-        libc::mallopt(libc::M_TRIM_THRESHOLD, 256 << 20);
+/// Why records could not be written. Each names the output.
+#[derive(Debug)]
+pub enum WriteError {
+    /// Writing the output failed.
+    Write {
+        /// Where the output was going.
+        output: String,
+        /// Why.
+        source: io::Error,
+    },
+    /// An output file could not be created.
+    Create {
+        /// The file as named on the command line.
+        output: String,
+        /// Why.
+        source: io::Error,
+    },
+}
+
+impl WriteError {
+    /// Whether this is the reader of the output going away (`hwfoc decode … | head`): not an
+    /// error worth reporting.
+    pub fn is_broken_pipe(&self) -> bool {
+        matches!(self, WriteError::Write { source, .. } if source.kind() == io::ErrorKind::BrokenPipe)
     }
 }
 
-/// Other C libraries keep their defaults.
-#[cfg(not(all(target_os = "linux", target_env = "gnu")))]
-fn keep_freed_memory() {}
+impl fmt::Display for WriteError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            WriteError::Write { output, source } => write!(f, "cannot write {output}: {source}"),
+            WriteError::Create { output, source } => match source.kind() {
+                io::ErrorKind::NotFound => {
+                    let dir = std::path::Path::new(output)
+                        .parent()
+                        .map(|d| d.display().to_string())
+                        .filter(|d| !d.is_empty())
+                        .unwrap_or_else(|| ".".to_string());
+                    write!(
+                        f,
+                        "cannot write {output}: the directory {dir} does not exist"
+                    )
+                }
+                io::ErrorKind::PermissionDenied => write!(
+                    f,
+                    "cannot write {output}: permission denied (choose another place with -o)"
+                ),
+                io::ErrorKind::IsADirectory => {
+                    write!(f, "cannot write {output}: it is a directory, not a file")
+                }
+                _ => write!(f, "cannot write {output}: {source}"),
+            },
+        }
+    }
+}
+
+impl std::error::Error for WriteError {
+    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
+        match self {
+            WriteError::Write { source, .. } | WriteError::Create { source, .. } => Some(source),
+        }
+    }
+}

@@ -69,9 +69,6 @@ const MAX_RESYNC_BLOCK: usize = MAX_CHUNK + 4096;
 /// Bytes asked of the source per read.
 const READ_SIZE: usize = 1 << 16;
 
-/// The baud rate assumed for byte timing when a recording does not say.
-pub const DEFAULT_BAUD: u32 = 19_200;
-
 /// Nanoseconds one byte takes on the wire at `baud`, 8N1 (ten bits: start, eight data, stop).
 pub fn byte_ns(baud: u32) -> f64 {
     10e9 / f64::from(baud.max(1))
@@ -295,9 +292,9 @@ pub struct Interface {
 }
 
 impl Interface {
-    /// Nanoseconds per byte on this interface (at [`DEFAULT_BAUD`] when the baud is unknown).
+    /// Nanoseconds per byte on this interface (at [`crate::serial::DEFAULT_BAUD`], the HW-FOC rate, when the baud is unknown).
     pub fn byte_ns(&self) -> f64 {
-        byte_ns(self.baud.unwrap_or(DEFAULT_BAUD))
+        byte_ns(self.baud.unwrap_or(crate::serial::DEFAULT_BAUD))
     }
 
     /// Whether the link type is in the user range (147..=162), where HW-FOC bytes are stored.

@@ -9,8 +9,7 @@ use std::ops::Range;
 
 use hwfoc::Decoded;
 
-use crate::error::CliError;
-use crate::input::{Format, Input};
+use crate::input::{Input, InputError, InputFormat};
 use crate::stream::Stream;
 
 /// Batches shorter than this come from a live source: what they produce is passed on at once.
@@ -19,14 +18,21 @@ const LIVE_BATCH: usize = 4096;
 /// How many ESCs the record's `esc` column (a `u8`) can number.
 const MAX_ESCS: usize = 256;
 
-/// What a command does with the frames of [`Sources::run`].
+/// What a command does with the frames of [`Sources::run`]: the seam between reading and
+/// presenting, as `Sink` is in ripgrep.
+///
+/// Its error type carries the handler's own failures (an output that cannot be written) and
+/// the input errors [`Sources::run`] meets, so that a command sees one error type.
 pub trait Handler {
+    /// The handler's error: its own, or an input's (hence `From<InputError>`).
+    type Error: From<InputError>;
+
     /// A frame of ESC `esc`, with the receive time of its first byte where the input has one.
     fn frame(&mut self, esc: u8, t: Option<f64>, decoded: Decoded);
 
     /// The end of a batch of bytes; `live` when it was small, as from a serial port (what it
     /// produced should be passed on at once). An error stops the run.
-    fn end_batch(&mut self, live: bool) -> Result<(), CliError> {
+    fn end_batch(&mut self, live: bool) -> Result<(), Self::Error> {
         let _ = live;
         Ok(())
     }
@@ -49,7 +55,7 @@ pub struct InputInfo {
     /// The input as named on the command line.
     pub name: String,
     /// Its detected format.
-    pub format: Format,
+    pub format: InputFormat,
     /// Bytes a logic analyser flagged with a parity or framing error.
     pub flagged_bytes: u64,
     /// The ESC indices of its streams.
@@ -77,13 +83,13 @@ impl Sources {
         }
     }
 
-    /// Makes an input without receive times an error ([`CliError::NoTiming`]): raw-byte inputs
+    /// Makes an input without receive times an error ([`InputError::NoTiming`]): raw-byte inputs
     /// are refused at once, before anything is read, and any other source as soon as it hands
     /// out bytes without times.
-    pub fn require_timing(&mut self) -> Result<(), CliError> {
+    pub fn require_timing(&mut self) -> Result<(), InputError> {
         self.need_timing = true;
-        match self.pending.iter().find(|i| i.format() == Format::Raw) {
-            Some(raw) => Err(CliError::NoTiming {
+        match self.pending.iter().find(|i| i.format() == InputFormat::Raw) {
+            Some(raw) => Err(InputError::NoTiming {
                 input: raw.name().to_string(),
             }),
             None => Ok(()),
@@ -110,7 +116,7 @@ impl Sources {
     ///
     /// On an input error, the frames of the bytes before it are still decoded (each stream of
     /// that input is finished), and the error is returned without reading further inputs.
-    pub fn run(&mut self, handler: &mut impl Handler) -> Result<(), CliError> {
+    pub fn run<H: Handler>(&mut self, handler: &mut H) -> Result<(), H::Error> {
         let inputs = std::mem::take(&mut self.pending);
         for mut input in inputs {
             let base = self.escs.len();
@@ -146,12 +152,12 @@ impl Sources {
         Ok(())
     }
 
-    fn read_input(
+    fn read_input<H: Handler>(
         &mut self,
         input: &mut Input,
         index: usize,
-        handler: &mut impl Handler,
-    ) -> Result<(), CliError> {
+        handler: &mut H,
+    ) -> Result<(), H::Error> {
         let base = self.escs.len();
         loop {
             let batch = match input.next_batch()? {
@@ -159,15 +165,17 @@ impl Sources {
                 None => return Ok(()),
             };
             if self.need_timing && batch.times.is_none() {
-                return Err(CliError::NoTiming {
+                return Err(InputError::NoTiming {
                     input: self.names[index].clone(),
-                });
+                }
+                .into());
             }
             let stream = batch.stream;
             let Ok(id) = u8::try_from(base + stream) else {
-                return Err(CliError::TooManyEscs {
+                return Err(InputError::TooManyEscs {
                     input: self.names[index].clone(),
-                });
+                }
+                .into());
             };
             while self.escs.len() <= base + stream {
                 self.escs.push(Esc {

@@ -1,0 +1,35 @@
+//! Everything between the bytes on an ESC's telemetry wire and the records every output shows.
+//!
+//! The codec (`hwfoc`) turns bytes into frames; this library does what lies around it, for every
+//! front end alike (the `hwfoc` command, bridges, bindings):
+//!
+//! - [`input`]: where bytes come from (raw files, logic-analyser CSV exports, pcapng recordings,
+//!   serial ports, standard input), the format detected from the content, each byte with its
+//!   receive time where the source has a clock;
+//! - [`stream`] and [`sources`]: the one path from timed bytes to frames, a decoding stream per
+//!   ESC, and the [`sources::Handler`] seam through which frames reach a command;
+//! - [`record`]: the record of `RECORD-SCHEMA.md` (one row per data frame, physical units) and
+//!   its text encodings;
+//! - [`write`]: writers of records (JSON Lines, CSV, Parquet with the `parquet` feature), each on
+//!   a thread of its own;
+//! - [`pcapng`]: the recording format (writer and truncation-tolerant reader);
+//! - [`serial`]: serial ports that survive being unplugged, and the process's stop signal.
+//!
+//! Each module has its own error type, an enum carrying what went wrong and where, whose
+//! `Display` is the one-line message a person reads.
+
+#![forbid(unsafe_op_in_unsafe_fn)]
+#![warn(missing_docs)]
+
+pub mod input;
+pub mod pcapng;
+pub mod record;
+pub mod serial;
+pub mod sources;
+pub mod stream;
+pub mod write;
+
+pub use input::{Batch, Input, InputError, InputFormat};
+pub use record::Record;
+pub use sources::{Handler, Sources};
+pub use stream::Stream;
