@@ -21,12 +21,14 @@
 #![forbid(unsafe_op_in_unsafe_fn)]
 #![warn(missing_docs)]
 
+pub mod episode;
 pub mod input;
 pub mod pcapng;
 pub mod record;
 pub mod serial;
 pub mod sources;
 pub mod stream;
+pub mod summary;
 pub mod write;
 
 pub use input::{Batch, Input, InputError, InputFormat};

@@ -1,8 +1,22 @@
-//! One telemetry stream: the codec's streaming decoder plus the receive time of each frame.
+//! Timed decoding: the codec's streaming decoder plus the receive time of each frame.
+//!
+//! [`Stream`] is one ESC's stream: every command's frames come out of one (through
+//! [`crate::sources::Sources`] for inputs read to their end, through [`PortStreams`] for live
+//! port events). [`byte_times`] is the one place where a chunk's receive time becomes the time
+//! of each of its bytes.
 
 use hwfoc::{Decoded, Decoder, LinkStats};
 
 use crate::input::Batch;
+use crate::pcapng;
+use crate::serial::PortEvent;
+
+/// Appends to `times` the receive times, in Unix seconds, of `n` bytes the first of which
+/// arrived at `t_ns` (Unix ns) and each next one `per_byte_ns` later (a byte time at the line's
+/// baud rate: bytes of one read arrived back to back).
+pub fn byte_times(t_ns: u64, per_byte_ns: f64, n: usize, times: &mut Vec<f64>) {
+    times.extend((0..n).map(|i| pcapng::byte_time_s(t_ns, i, per_byte_ns)));
+}
 
 /// How many receive times to keep from earlier batches: a frame still arriving is shorter than
 /// the longest frame (77 bytes), so its first byte is never further back than this.
@@ -59,6 +73,59 @@ impl Stream {
     /// The link statistics so far.
     pub fn stats(&self) -> &LinkStats {
         self.decoder.stats()
+    }
+}
+
+/// A [`Stream`] per port, fed by [`PortEvent`]s: the path from live bytes to timed frames of
+/// `monitor`, `record` and the bridges (and of [`crate::Input::open_ports`], through
+/// [`byte_times`]).
+#[derive(Debug)]
+pub struct PortStreams {
+    streams: Vec<Stream>,
+    per_byte_ns: f64,
+    times: Vec<f64>,
+}
+
+impl PortStreams {
+    /// `ports` streams, their bytes arriving at `baud` (8N1).
+    pub fn new(ports: usize, baud: u32) -> PortStreams {
+        PortStreams {
+            streams: (0..ports).map(|_| Stream::new()).collect(),
+            per_byte_ns: pcapng::byte_ns(baud),
+            times: Vec::new(),
+        }
+    }
+
+    /// Decodes the bytes of a [`PortEvent::Data`]; `on_frame` gets each frame completed with
+    /// its port and the receive time of its first byte (Unix seconds). Other events and ports
+    /// beyond those made are ignored. Returns the port's link statistics after the bytes, or
+    /// `None` when there were no bytes for a known port.
+    pub fn feed(
+        &mut self,
+        event: &PortEvent,
+        mut on_frame: impl FnMut(usize, f64, Decoded),
+    ) -> Option<&LinkStats> {
+        let PortEvent::Data { port, t_ns, bytes } = event else {
+            return None;
+        };
+        let stream = self.streams.get_mut(*port)?;
+        self.times.clear();
+        byte_times(*t_ns, self.per_byte_ns, bytes.len(), &mut self.times);
+        stream.feed(
+            Batch {
+                bytes,
+                times: Some(&self.times),
+                stream: *port,
+            },
+            // Every byte of a port event has a time.
+            |t, d| on_frame(*port, t.unwrap_or(0.0), d),
+        );
+        Some(stream.stats())
+    }
+
+    /// The link statistics of `port`'s stream.
+    pub fn stats(&self, port: usize) -> Option<&LinkStats> {
+        self.streams.get(port).map(Stream::stats)
     }
 }
 

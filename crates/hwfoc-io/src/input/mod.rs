@@ -22,6 +22,7 @@ use std::time::Duration;
 
 use crate::pcapng;
 use crate::serial::{self, PortError, PortEvent, PortSet};
+use crate::stream::byte_times;
 
 /// How many bytes a raw read asks for: small enough that what the kernel copies in is still in
 /// the L2 cache when the decoder reads it (1 MiB reads made `summary` 1.6x slower), large enough
@@ -72,7 +73,7 @@ pub struct Batch<'a> {
 enum Source {
     Raw { reader: Box<dyn Read> },
     Csv(CsvRows),
-    Recording(Box<Recording>),
+    Recording(Box<RecordingReader>),
     Ports(Ports),
 }
 
@@ -84,7 +85,7 @@ enum Source {
 /// batch, in port order: so batches are kilobytes rather than a frame (decoding an 8-port
 /// recording is ten times faster), and records of different ports stay in time order to
 /// within the window (those of one port are always in order).
-struct Recording {
+struct RecordingReader {
     reader: pcapng::Reader<Box<dyn Read>>,
     /// Bytes and receive times gathered in the current window, by interface.
     pending: Vec<(Vec<u8>, Vec<f64>)>,
@@ -226,7 +227,7 @@ impl Input {
                 ))
         {
             let reader: Box<dyn Read> = Box::new(Cursor::new(head).chain(reader));
-            let source = Source::Recording(Box::new(Recording {
+            let source = Source::Recording(Box::new(RecordingReader {
                 reader: pcapng::Reader::new(reader),
                 pending: Vec::new(),
                 draining: None,
@@ -408,7 +409,7 @@ impl Input {
     }
 }
 
-impl Recording {
+impl RecordingReader {
     /// Hands out the next batch of the current window into `bytes` and `times` (which are
     /// empty) and returns its interface, reading the next window when this one is done;
     /// leaves `bytes` empty at the end of the file. A read error is returned after the
@@ -488,7 +489,7 @@ impl Recording {
                     self.pending.resize_with(i + 1, Default::default);
                 }
                 let (bytes, times) = &mut self.pending[i];
-                append_times(t_ns, interface.byte_ns(), packet.data.len(), times);
+                byte_times(t_ns, interface.byte_ns(), packet.data.len(), times);
                 bytes.extend_from_slice(packet.data);
                 let start = *self.window_start.get_or_insert(t_ns);
                 full = bytes.len() >= RECORDING_BATCH
@@ -508,12 +509,6 @@ impl Recording {
     }
 }
 
-/// Appends the receive times, in Unix seconds, of `n` bytes the first of which arrived at
-/// `t_ns` and each next one `per_byte` ns later.
-fn append_times(t_ns: u64, per_byte: f64, n: usize, times: &mut Vec<f64>) {
-    times.extend((0..n).map(|i| pcapng::byte_time_s(t_ns, i, per_byte)));
-}
-
 impl Ports {
     /// Waits for the next chunk of bytes and puts it, with its receive times, in `bytes` and
     /// `times`; returns its port. Returns with nothing once interrupted. Ports that are lost
@@ -527,7 +522,7 @@ impl Ports {
                     t_ns,
                     bytes: data,
                 }) => {
-                    append_times(t_ns, per_byte, data.len(), times);
+                    byte_times(t_ns, per_byte, data.len(), times);
                     bytes.extend_from_slice(&data);
                     return port;
                 }

@@ -1,4 +1,8 @@
-//! `hwfoc summary`: what the inputs hold, ESC by ESC, and how good each link was.
+//! The summary of a run of inputs: what they hold, ESC by ESC, and how good each link was,
+//! as text for a person or as JSON (`hwfoc summary`, `--json`).
+//!
+//! [`Summary`] is a [`Handler`]: give it to [`Sources::run`], then ask it for the
+//! [`Summary::report`].
 //!
 //! Statistics are gathered on the raw integers (min, max and sum per field, a histogram of each
 //! temperature's ADC codes) and converted to physical units once, at the end: every conversion
@@ -15,12 +19,9 @@ use hwfoc::{
 };
 use serde_json::{Value, json};
 
-use crate::SummaryArgs;
-use crate::error::CliError;
-use crate::output::Output;
-use crate::plot;
-use hwfoc_io::InputFormat;
-use hwfoc_io::sources::{Handler, InputInfo, Sources};
+pub use crate::episode::{Episode, Mark};
+use crate::input::{InputError, InputFormat};
+use crate::sources::{Handler, InputInfo, Sources};
 
 /// What to tell a user whose input has bytes but no frame.
 pub const NO_FRAMES: &str = "no valid HW-FOC frames: check the baud rate (19200) and the wiring";
@@ -30,42 +31,6 @@ const MAX_EPISODES: usize = 10_000;
 
 /// Fault episodes listed per ESC in the text output (`--json` lists all those kept).
 const TEXT_EPISODES: usize = 20;
-
-pub fn run(args: &SummaryArgs) -> Result<(), CliError> {
-    let settings = args.settings.settings()?;
-    // The plot's file is opened first: a wrong name is reported before the inputs are read.
-    let mut plot = match &args.plot {
-        Some(path) => Some(plot::Alongside::open(path, settings)?),
-        None => None,
-    };
-    let mut sources = Sources::new(args.input.open_all()?);
-    let mut escs = Escs::default();
-    // On an input error, what was read before it is summarised, then the error reported.
-    let result = match &mut plot {
-        Some(plot) => sources.run(&mut plot::Both(&mut escs, plot)),
-        None => sources.run(&mut escs),
-    };
-    let report = Report {
-        sources: &sources,
-        settings: &settings,
-        accs: &escs.0,
-    };
-    let text = if args.json {
-        let mut s = serde_json::to_string_pretty(&report.json()).unwrap_or_default();
-        s.push('\n');
-        s
-    } else {
-        report.text()
-    };
-    let mut out = Output::create(None)?;
-    let mut buf = text.into_bytes();
-    out.write(&mut buf)?;
-    out.flush()?;
-    if let Some(plot) = plot {
-        plot.finish(&sources)?;
-    }
-    result
-}
 
 /// How an ESC is named in messages: its input, and its stream when the input has several.
 pub fn esc_label(sources: &Sources, esc: usize) -> String {
@@ -82,12 +47,29 @@ pub fn esc_label(sources: &Sources, esc: usize) -> String {
     }
 }
 
-/// One accumulator per ESC.
+/// What the summary gathers from the frames: one accumulator per ESC.
 #[derive(Default)]
-struct Escs(Vec<Accumulator>);
+pub struct Summary(Vec<Accumulator>);
 
-impl Handler for Escs {
-    type Error = CliError;
+impl Summary {
+    /// Nothing gathered yet.
+    pub fn new() -> Summary {
+        Summary::default()
+    }
+
+    /// The report on what was gathered from `sources` (after [`Sources::run`]), converted under
+    /// `settings`.
+    pub fn report<'a>(&'a self, sources: &'a Sources, settings: &'a Settings) -> Report<'a> {
+        Report {
+            sources,
+            settings,
+            accs: &self.0,
+        }
+    }
+}
+
+impl Handler for Summary {
+    type Error = InputError;
 
     #[inline]
     fn frame(&mut self, esc: u8, t: Option<f64>, decoded: Decoded) {
@@ -134,61 +116,6 @@ impl Range {
                 f(self.sum as f64 / n as f64),
             ]
         })
-    }
-}
-
-/// One end of a fault episode: a data frame.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Mark {
-    /// Receive time, if the input has timing.
-    pub t: Option<f64>,
-    /// Index of the data frame among the ESC's data frames (0-based).
-    pub frame: u64,
-    /// Its packet number.
-    pub packet: u16,
-}
-
-/// A maximal run of consecutive data frames with a non-zero status word.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Episode {
-    /// Its first frame.
-    pub first: Mark,
-    /// Its last frame.
-    pub last: Mark,
-    /// How many frames it lasted.
-    pub frames: u64,
-    /// Every status bit seen during the episode.
-    pub bits: Status,
-    /// Still going on at the end of the input.
-    pub ongoing: bool,
-}
-
-impl Episode {
-    /// Follows the fault episodes of one ESC through its data frames, in order: a frame with a
-    /// non-zero status word starts the open episode `open` or extends it, a clean frame ends
-    /// it. Returns the episode the frame ended, if any.
-    #[inline]
-    pub fn track(open: &mut Option<Episode>, mark: Mark, status: Status) -> Option<Episode> {
-        if status.is_ok() {
-            return open.take();
-        }
-        match open {
-            Some(e) => {
-                e.last = mark;
-                e.frames += 1;
-                e.bits = Status(e.bits.0 | status.0);
-            }
-            None => {
-                *open = Some(Episode {
-                    first: mark,
-                    last: mark,
-                    frames: 1,
-                    bits: status,
-                    ongoing: false,
-                })
-            }
-        }
-        None
     }
 }
 
@@ -314,8 +241,8 @@ fn temp_stats(codes: &[u64; 256]) -> TempStats {
     s
 }
 
-/// The summary, ready to be printed.
-struct Report<'a> {
+/// The summary, ready to be printed: [`Report::text`] or [`Report::json`].
+pub struct Report<'a> {
     sources: &'a Sources,
     settings: &'a Settings,
     accs: &'a [Accumulator],
@@ -390,7 +317,8 @@ impl<'a> Report<'a> {
             .sum()
     }
 
-    fn text(&self) -> String {
+    /// The summary as text, as `hwfoc summary` prints it.
+    pub fn text(&self) -> String {
         let mut o = String::new();
         // Writing to a String cannot fail; the results are ignored below for that reason.
         let _ = writeln!(
@@ -426,7 +354,8 @@ impl<'a> Report<'a> {
         o
     }
 
-    fn json(&self) -> Value {
+    /// The summary as one JSON object, as `hwfoc summary --json` prints it.
+    pub fn json(&self) -> Value {
         let inputs: Vec<Value> = self
             .sources
             .inputs()

@@ -25,9 +25,9 @@ use self::config::{AlarmKeys, Config, Overrides};
 use self::feed::{Feed, Msg};
 use self::fleet::Fleet;
 use self::perf::Perf;
+use super::capture::{self, Recorder};
+use crate::commands::simulate::ModelArgs;
 use crate::error::CliError;
-use crate::record::{self, Recorder};
-use crate::simulate::ModelArgs;
 use hwfoc_io::serial::{self, PortEvent};
 
 /// The most virtual ESCs `--sim` runs.
@@ -47,7 +47,7 @@ Keys: up/down (or j/k, 0-9) select an ESC, p pause, c reset peaks, r start/stop 
 /// Arguments of `hwfoc monitor`.
 #[derive(Debug, clap::Args)]
 #[command(after_help = EXAMPLES)]
-pub struct Args {
+pub struct MonitorArgs {
     /// Serial ports to watch, one ESC each, in this order. Default: the ports listed in the
     /// configuration file.
     #[arg(value_name = "PORT", conflicts_with = "sim")]
@@ -116,7 +116,7 @@ fn seconds(text: &str) -> Result<f64, String> {
 }
 
 /// Runs `hwfoc monitor`.
-pub fn run(args: &Args) -> Result<(), CliError> {
+pub fn run(args: &MonitorArgs) -> Result<(), CliError> {
     let config = Config::load(&Overrides {
         config: args.config.clone(),
         no_config: args.no_config,
@@ -182,7 +182,7 @@ pub struct Session {
 }
 
 impl Session {
-    fn start(args: &Args, config: Config) -> Result<Session, CliError> {
+    fn start(args: &MonitorArgs, config: Config) -> Result<Session, CliError> {
         let interrupted = serial::interrupted();
         let (tx, rx) = mpsc::channel();
         let ports: Vec<String> = if args.ports.is_empty() {
@@ -359,7 +359,7 @@ impl Session {
 
     /// Starts recording to `path`.
     pub fn start_recording(&mut self, path: String) -> Result<(), CliError> {
-        let plan = record::Plan {
+        let plan = capture::Plan {
             output: path.clone(),
             rotate_size: None,
             rotate_time: None,

@@ -74,7 +74,7 @@ const DERATED_PCT: f64 = 50.0;
 
 /// The user's settings for the motor, battery and ESC.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Config {
+pub struct ModelConfig {
     /// Motor KV, RPM per volt.
     pub kv: f64,
     /// Motor pole pairs (for eRPM).
@@ -140,7 +140,7 @@ pub struct Model {
 impl Model {
     /// A model at rest (disarmed, motor stopped, at ambient temperature), with this ESC's
     /// tolerances drawn from `rng`.
-    pub fn new(config: &Config, rng: &mut Rng) -> Model {
+    pub fn new(config: &ModelConfig, rng: &mut Rng) -> Model {
         let vary = |rng: &mut Rng, spread: f64| 1.0 + spread * rng.signed();
         let kv = config.kv * vary(rng, 0.02);
         let full_current_a = config.full_current_a * vary(rng, 0.03);
@@ -406,8 +406,8 @@ pub(crate) mod tests {
     use hwfoc::{Settings, Temperature};
 
     /// The command line's defaults.
-    pub(crate) fn config() -> Config {
-        Config {
+    pub(crate) fn config() -> ModelConfig {
+        ModelConfig {
             kv: 500.0,
             pole_pairs: 7,
             full_current_a: 60.0,
@@ -549,7 +549,7 @@ pub(crate) mod tests {
     #[test]
     fn overheat_is_raised_and_derates() {
         let mut m = Model::new(
-            &Config {
+            &ModelConfig {
                 ambient_c: 60.0,
                 full_current_a: 110.0,
                 ..config()

@@ -21,11 +21,12 @@ use std::path::Path;
 use std::sync::atomic::Ordering;
 use std::time::{Duration, Instant};
 
-use hwfoc::Decoder;
+use hwfoc::LinkStats;
 
 use crate::error::CliError;
 use hwfoc_io::pcapng;
 use hwfoc_io::serial::{self, PortEvent, PortSet};
+use hwfoc_io::stream::PortStreams;
 use hwfoc_io::write::WriteError;
 
 /// Longest time a received byte stays in this process before it is written to the file.
@@ -42,7 +43,7 @@ const BUFFER: usize = 1 << 16;
 
 /// Arguments of `hwfoc record`.
 #[derive(Debug, clap::Args)]
-pub struct Args {
+pub struct RecordArgs {
     /// Serial ports to record (`/dev/ttyUSB0`, `/dev/serial/by-id/…`, `COM3`): one pcapng
     /// interface each, in the order given.
     #[arg(value_name = "PORT", required = true, num_args = 1..)]
@@ -121,7 +122,6 @@ pub fn numbered(path: &str, n: u32) -> String {
 /// What is known about one port during the recording.
 struct PortState {
     name: String,
-    decoder: Decoder,
     /// When the first byte not yet followed by a valid frame arrived, and how many bytes since.
     unframed_since: Option<Instant>,
     unframed_bytes: u64,
@@ -132,11 +132,9 @@ struct PortState {
     lost_at: Option<u64>,
 }
 
-impl PortState {
-    fn frames(&self) -> u64 {
-        let stats = self.decoder.stats();
-        u64::from(stats.frames()) + u64::from(stats.info_frames())
-    }
+/// Frames of either kind a port's stream has decoded.
+fn frames(stats: &LinkStats) -> u64 {
+    u64::from(stats.frames()) + u64::from(stats.info_frames())
 }
 
 /// Where and how a recording is written.
@@ -174,10 +172,12 @@ pub struct Recorder {
     /// The clock of the ports' timestamps.
     clock: serial::Clock,
     ports: Vec<PortState>,
+    /// The ports' decoding streams (frames are counted, not kept).
+    streams: PortStreams,
 }
 
 /// Runs `hwfoc record`.
-pub fn run(args: &Args) -> Result<(), CliError> {
+pub fn run(args: &RecordArgs) -> Result<(), CliError> {
     // Install the Ctrl-C / SIGTERM handler first, so that no signal is lost once ports are open.
     let interrupted = serial::interrupted();
     let set = PortSet::open(&args.ports, args.baud)?;
@@ -252,11 +252,11 @@ impl Recorder {
             last_flush: now,
             last_sync: now,
             clock,
+            streams: PortStreams::new(ports.len(), plan.baud),
             ports: ports
                 .iter()
                 .map(|name| PortState {
                     name: name.clone(),
-                    decoder: Decoder::new(),
                     unframed_since: None,
                     unframed_bytes: 0,
                     warned_unframed: false,
@@ -282,6 +282,9 @@ impl Recorder {
 
     /// Writes what a port reported: bytes as a packet, a loss or return as a note.
     pub fn handle(&mut self, event: PortEvent) -> Result<(), CliError> {
+        if let PortEvent::Data { port, .. } = event {
+            self.decode(port, &event);
+        }
         match event {
             PortEvent::Data { port, t_ns, bytes } => {
                 if let (Some(limit), Some(writer)) = (self.rotate_size, &self.writer) {
@@ -293,7 +296,6 @@ impl Recorder {
                 let written = self.writer()?.write(port as u32, t_ns, &bytes);
                 written.map_err(|e| self.write_error(e))?;
                 self.file_has_packets = true;
-                self.decode(port, &bytes);
             }
             PortEvent::Lost { port, t_ns, reason } => {
                 let state = &mut self.ports[port];
@@ -336,18 +338,22 @@ impl Recorder {
     }
 
     /// Decodes a chunk to count frames and to notice a port that sends no valid frame.
-    fn decode(&mut self, port: usize, bytes: &[u8]) {
+    fn decode(&mut self, port: usize, event: &PortEvent) {
+        let before = self.streams.stats(port).map_or(0, frames);
+        let after = self.streams.feed(event, |_, _, _| {}).map_or(0, frames);
+        let bytes = match event {
+            PortEvent::Data { bytes, .. } => bytes.len(),
+            _ => 0,
+        };
         let state = &mut self.ports[port];
-        let before = state.frames();
-        state.decoder.feed(bytes, |_| {});
         state.silent_since = None;
-        if state.frames() > before {
+        if after > before {
             state.unframed_since = None;
             state.unframed_bytes = 0;
             state.warned_unframed = false;
         } else {
             state.unframed_since.get_or_insert_with(Instant::now);
-            state.unframed_bytes += bytes.len() as u64;
+            state.unframed_bytes += bytes as u64;
         }
     }
 
@@ -477,12 +483,14 @@ impl Recorder {
         let ports: Vec<String> = self
             .ports
             .iter()
-            .map(|p| {
+            .enumerate()
+            .map(|(i, p)| {
+                let stats = self.streams.stats(i).copied().unwrap_or_default();
                 format!(
                     "{} {} bytes, {} frames",
                     p.name,
-                    p.decoder.stats().bytes(),
-                    p.frames()
+                    stats.bytes(),
+                    frames(&stats)
                 )
             })
             .collect();

@@ -35,9 +35,9 @@ use clap::ValueEnum;
 use self::esc::{Setup, VirtualEsc};
 use self::faults::{FaultSchedule, FaultSpec, LinkRates};
 use self::profile::{Profile, ProfileSpec, Shape};
-use self::schedule::{Clock, Pace, Tally};
+use self::schedule::{Pace, SimClock, Tally};
 use self::sink::{PcapngSink, PortSink, RawSink, Sink, Truth};
-use crate::SettingsArgs;
+use crate::args::SettingsArgs;
 use crate::error::CliError;
 use hwfoc_io::serial::unix_now_ns;
 use hwfoc_io::write::WriteError;
@@ -47,7 +47,7 @@ use hwfoc_io::write::WriteError;
 const TAIL_S: f64 = 2.0;
 /// How long the ptys stay open after the last write.
 const PTY_LINGER: std::time::Duration = std::time::Duration::from_millis(300);
-/// Target duration of one piece written to a pseudo-terminal, seconds.
+/// Outlet duration of one piece written to a pseudo-terminal, seconds.
 const PIECE_S: f64 = 0.004;
 
 /// File formats of `-o`.
@@ -72,7 +72,7 @@ Examples:
 /// Arguments of `hwfoc simulate`.
 #[derive(Debug, clap::Args)]
 #[command(after_help = EXAMPLES)]
-pub struct Args {
+pub struct SimulateArgs {
     /// Number of virtual ESCs (esc 0..N-1). With --port: one per port.
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u16).range(1..=256))]
     escs: Option<u16>,
@@ -244,7 +244,7 @@ impl ModelArgs {
         n: usize,
         baud: u32,
         settings: &hwfoc::Settings,
-    ) -> Result<Fleet, CliError> {
+    ) -> Result<VirtualFleet, CliError> {
         if let Some(bad) = self.faults.iter().find(|f| f.esc.is_some_and(|e| e >= n)) {
             return Err(usage(
                 "--fault",
@@ -262,13 +262,13 @@ impl ModelArgs {
             period_s: self.period,
             max_pct: self.max_throttle,
         };
-        Ok(Fleet {
+        Ok(VirtualFleet {
             n,
             seed: self.seed,
             baud,
             start_packet: self.start_packet,
             profile: Profile::load(&self.profile, &shape)?,
-            config: model::Config {
+            config: model::ModelConfig {
                 kv: self.kv,
                 pole_pairs: settings.pole_pairs,
                 full_current_a: self.full_current,
@@ -291,18 +291,18 @@ impl ModelArgs {
 
 /// Virtual ESCs described and checked, not yet started; it can be moved to another thread.
 #[derive(Debug)]
-pub struct Fleet {
+pub struct VirtualFleet {
     n: usize,
     seed: u64,
     baud: u32,
     start_packet: Option<u16>,
     profile: Profile,
-    config: model::Config,
+    config: model::ModelConfig,
     faults: Vec<FaultSpec>,
     link: LinkRates,
 }
 
-impl Fleet {
+impl VirtualFleet {
     /// The ESCs, at rest at time zero.
     fn escs(self) -> Vec<VirtualEsc> {
         let profile = Rc::new(self.profile);
@@ -325,7 +325,7 @@ impl Fleet {
     /// Runs the ESCs in real time from now until `stop` is set, each burst handed whole to
     /// `sink` when its first byte is due (Unix time in ns), as a UART's reader would get it.
     pub fn run_live(self, sink: &mut dyn Sink, stop: &AtomicBool) -> Result<(), CliError> {
-        let clock = Clock {
+        let clock = SimClock {
             origin_ns: unix_now_ns(),
             real: Some(Instant::now()),
         };
@@ -381,7 +381,7 @@ fn ambient(s: &str) -> Result<f64, String> {
 }
 
 /// Where the bytes go.
-enum Target {
+enum Outlet {
     Stdout,
     File(String),
     Pty,
@@ -396,7 +396,7 @@ fn usage(option: &str, message: impl Into<String>) -> CliError {
 }
 
 /// Runs `hwfoc simulate`.
-pub fn run(args: &Args) -> Result<(), CliError> {
+pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
     let settings = args.settings.settings()?;
     let n = match (args.escs, args.port.len()) {
         (Some(n), 0) => usize::from(n),
@@ -414,27 +414,27 @@ pub fn run(args: &Args) -> Result<(), CliError> {
         return Err(usage("--port", "at most 256 ESCs"));
     }
     let target = if args.pty {
-        Target::Pty
+        Outlet::Pty
     } else if !args.port.is_empty() {
-        Target::Ports
+        Outlet::Ports
     } else {
         match args.output.as_deref() {
-            None | Some("-") => Target::Stdout,
-            Some(path) => Target::File(path.to_string()),
+            None | Some("-") => Outlet::Stdout,
+            Some(path) => Outlet::File(path.to_string()),
         }
     };
     let format = match (&target, args.format) {
-        (Target::Pty | Target::Ports, Some(_)) => {
+        (Outlet::Pty | Outlet::Ports, Some(_)) => {
             return Err(usage(
                 "--format",
                 "only for -o FILE or standard output: ptys and ports carry raw bytes",
             ));
         }
         (_, Some(format)) => format,
-        (Target::File(path), None) if path.ends_with(".pcapng") => FileFormat::Pcapng,
+        (Outlet::File(path), None) if path.ends_with(".pcapng") => FileFormat::Pcapng,
         _ => FileFormat::Raw,
     };
-    let realtime = args.realtime || matches!(target, Target::Pty | Target::Ports);
+    let realtime = args.realtime || matches!(target, Outlet::Pty | Outlet::Ports);
     if realtime && args.start_time.is_some() {
         return Err(usage(
             "--start-time",
@@ -442,21 +442,21 @@ pub fn run(args: &Args) -> Result<(), CliError> {
         ));
     }
     match &target {
-        Target::Stdout if format == FileFormat::Raw && n > 1 => {
+        Outlet::Stdout if format == FileFormat::Raw && n > 1 => {
             return Err(usage(
                 "--escs",
                 "raw bytes on standard output can carry only one ESC: use --format pcapng, \
                  or -o FILE with {esc} in the name",
             ));
         }
-        Target::Stdout if std::io::stdout().is_terminal() => {
+        Outlet::Stdout if std::io::stdout().is_terminal() => {
             return Err(usage(
                 "-o",
                 "not writing binary telemetry to a terminal: give -o FILE or --pty, or pipe \
                  the output (e.g. into `hwfoc decode -`)",
             ));
         }
-        Target::File(path) if format == FileFormat::Raw && n > 1 && !path.contains("{esc}") => {
+        Outlet::File(path) if format == FileFormat::Raw && n > 1 && !path.contains("{esc}") => {
             return Err(usage(
                 "-o",
                 format!(
@@ -496,7 +496,7 @@ pub fn run(args: &Args) -> Result<(), CliError> {
     #[cfg(unix)]
     let mut _links = pty::Links::default();
     let (mut out, pace, names): (Box<dyn Sink>, Pace, Vec<String>) = match &target {
-        Target::Pty => {
+        Outlet::Pty => {
             #[cfg(unix)]
             {
                 let (sink, names) = open_ptys(args, n, &mut _links)?;
@@ -505,18 +505,18 @@ pub fn run(args: &Args) -> Result<(), CliError> {
             #[cfg(not(unix))]
             return Err(usage("--pty", "pseudo-terminals need a Unix system"));
         }
-        Target::Ports => (
+        Outlet::Ports => (
             Box::new(PortSink::open(&args.port, args.baud)?),
             Pace::Whole,
             args.port.clone(),
         ),
-        Target::Stdout | Target::File(_) => {
+        Outlet::Stdout | Outlet::File(_) => {
             let (paths, file_of): (Vec<String>, Vec<usize>) = match &target {
-                Target::File(path) if path.contains("{esc}") => (
+                Outlet::File(path) if path.contains("{esc}") => (
                     (0..n).map(|i| sink::expand(path, i)).collect(),
                     (0..n).collect(),
                 ),
-                Target::File(path) => (vec![path.clone()], vec![0; n]),
+                Outlet::File(path) => (vec![path.clone()], vec![0; n]),
                 _ => (vec!["-".to_string()], vec![0; n]),
             };
             let mut outs = Vec::with_capacity(paths.len());
@@ -530,7 +530,7 @@ pub fn run(args: &Args) -> Result<(), CliError> {
             };
             let pace = match (&target, realtime) {
                 (_, false) => Pace::Fast,
-                (Target::Stdout, true) => pieces,
+                (Outlet::Stdout, true) => pieces,
                 (_, true) => Pace::Whole,
             };
             (sink, pace, names)
@@ -539,7 +539,7 @@ pub fn run(args: &Args) -> Result<(), CliError> {
 
     let infos: Vec<hwfoc::InfoFrame> = escs.iter().map(|e| *e.info()).collect();
     let stop: std::sync::Arc<AtomicBool> = hwfoc_io::serial::interrupted();
-    let clock = Clock {
+    let clock = SimClock {
         origin_ns,
         real: realtime.then(Instant::now),
     };
@@ -553,7 +553,7 @@ pub fn run(args: &Args) -> Result<(), CliError> {
         duration_ns,
         &stop,
     )?;
-    if matches!(target, Target::Pty) {
+    if matches!(target, Outlet::Pty) {
         // Closing a pty's master hangs up the reader and discards what it has not read yet:
         // give readers a moment to take the last frames, which the truth lists as delivered.
         std::thread::sleep(PTY_LINGER);
@@ -573,7 +573,7 @@ pub fn run(args: &Args) -> Result<(), CliError> {
 /// Creates a pty per ESC, prints their paths and makes the links asked for.
 #[cfg(unix)]
 fn open_ptys(
-    args: &Args,
+    args: &SimulateArgs,
     n: usize,
     links: &mut pty::Links,
 ) -> Result<(sink::PtySink, Vec<String>), CliError> {

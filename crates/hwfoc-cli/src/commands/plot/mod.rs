@@ -14,8 +14,8 @@ mod text;
 
 use hwfoc::{Decoded, Settings};
 
+use crate::args::{InputArgs, SettingsArgs};
 use crate::error::CliError;
-use crate::{InputArgs, SettingsArgs};
 use hwfoc_io::sources::{Handler, Sources};
 
 use crate::window::{SelectArgs, Window};
@@ -29,7 +29,7 @@ const MAX_SIZE: u32 = 10_000;
 
 /// Arguments of `hwfoc plot`.
 #[derive(Debug, clap::Args)]
-pub struct Args {
+pub struct PlotArgs {
     #[command(flatten)]
     input: InputArgs,
     /// The image to write: a name ending in .png or .svg gives the format.
@@ -66,7 +66,7 @@ pub struct Options {
 }
 
 /// `hwfoc plot`: reads the inputs and writes the image.
-pub fn run(args: &Args) -> Result<(), CliError> {
+pub fn run(args: &PlotArgs) -> Result<(), CliError> {
     let settings = args.settings.settings()?;
     let window = args.select.window()?;
     // Opened first, so that a wrong name is reported before the inputs are read; a file
@@ -134,7 +134,10 @@ impl Handler for Alongside {
 /// reading of the inputs.
 pub struct Both<'a, A, B>(pub &'a mut A, pub &'a mut B);
 
-impl<A: Handler<Error = CliError>, B: Handler<Error = CliError>> Handler for Both<'_, A, B> {
+impl<A: Handler, B: Handler> Handler for Both<'_, A, B>
+where
+    CliError: From<A::Error> + From<B::Error>,
+{
     type Error = CliError;
 
     #[inline]
@@ -145,6 +148,6 @@ impl<A: Handler<Error = CliError>, B: Handler<Error = CliError>> Handler for Bot
 
     fn end_batch(&mut self, live: bool) -> Result<(), CliError> {
         self.0.end_batch(live)?;
-        self.1.end_batch(live)
+        Ok(self.1.end_batch(live)?)
     }
 }

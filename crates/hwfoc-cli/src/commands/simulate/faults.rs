@@ -127,18 +127,18 @@ pub enum Fate {
 
 /// The link's random decisions, from one [`Rng`] stream.
 #[derive(Debug, Clone)]
-pub struct Link {
+pub struct LineFaults {
     rates: LinkRates,
     rng: Rng,
     /// Bits still to go before the next bit error (geometric), if bit errors are on.
     next_error: Option<u64>,
 }
 
-impl Link {
+impl LineFaults {
     /// A link with these rates.
-    pub fn new(rates: LinkRates, mut rng: Rng) -> Link {
+    pub fn new(rates: LinkRates, mut rng: Rng) -> LineFaults {
         let next_error = geometric(&mut rng, rates.bit_error);
-        Link {
+        LineFaults {
             rates,
             rng,
             next_error,
@@ -280,7 +280,7 @@ mod tests {
             bit_error: 1e-3,
             ..Default::default()
         };
-        let mut link = Link::new(rates, Rng::for_esc(3, 0, Purpose::Link));
+        let mut link = LineFaults::new(rates, Rng::for_esc(3, 0, Purpose::Link));
         let mut flips = 0u32;
         for _ in 0..10_000 {
             let mut frame = [0u8; 24];
@@ -299,7 +299,7 @@ mod tests {
             garbage: 0.5,
             ..Default::default()
         };
-        let mut link = Link::new(rates, Rng::for_esc(3, 0, Purpose::Link));
+        let mut link = LineFaults::new(rates, Rng::for_esc(3, 0, Purpose::Link));
         let (mut dropped, mut cut, mut intact, mut bursts) = (0, 0, 0, 0);
         for _ in 0..4000 {
             let mut bytes = vec![0x55; 24];

@@ -15,8 +15,8 @@ use plotters::style::{FontStyle, register_font};
 use hwfoc::Settings;
 
 use crate::error::CliError;
-use crate::summary::NO_FRAMES;
 use hwfoc_io::sources::Sources;
+use hwfoc_io::summary::NO_FRAMES;
 
 use super::collect::{Bucket, Collector, EscData, FRAME_PERIOD, Quantity, Span};
 use super::target::{ImageFormat, Target};

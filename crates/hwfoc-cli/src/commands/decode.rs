@@ -5,15 +5,47 @@
 //! consecutive windows never share a frame). A time window needs inputs with receive times:
 //! raw bytes have none, and are refused rather than silently giving no records.
 
+use clap::{Args, ValueEnum};
 use hwfoc::{Decoded, Frame};
 use serde_json::json;
 
+use crate::args::{InputArgs, SettingsArgs};
 use crate::error::CliError;
-use crate::window::Window;
-use crate::{DecodeArgs, RecordFormat};
+use crate::window::{SelectArgs, Window};
 use hwfoc_io::sources::{Handler, Sources};
 use hwfoc_io::write::{Export, OutputFormat, Provenance};
 
+/// Record output formats.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum RecordFormat {
+    /// One JSON object per line, with exactly the schema's keys.
+    Jsonl,
+    /// Comma-separated, with a header row; faults joined by `|`, nulls empty.
+    Csv,
+    /// Apache Parquet (needs -o): typed columns, units and settings in the metadata.
+    Parquet,
+}
+
+#[derive(Debug, Args)]
+pub struct DecodeArgs {
+    #[command(flatten)]
+    pub input: InputArgs,
+    /// Output format.
+    #[arg(long, value_enum, default_value_t = RecordFormat::Jsonl)]
+    pub format: RecordFormat,
+    #[command(flatten)]
+    pub settings: SettingsArgs,
+    /// CSV only: start with a `#` comment line giving the settings used.
+    #[arg(long)]
+    pub settings_comment: bool,
+    /// Write to FILE instead of standard output.
+    #[arg(short, long, value_name = "FILE", required_if_eq("format", "parquet"))]
+    pub output: Option<String>,
+    #[command(flatten)]
+    pub select: SelectArgs,
+}
+
+/// Runs `hwfoc decode`.
 pub fn run(args: &DecodeArgs) -> Result<(), CliError> {
     let settings = args.settings.settings()?;
     let window = args.select.window()?;
@@ -140,8 +172,8 @@ fn warn(sources: &Sources, wanted: &[u8]) {
         if stats.bytes() > 0 && stats.frames() == 0 {
             eprintln!(
                 "hwfoc: warning: {}: {}",
-                crate::summary::esc_label(sources, i),
-                crate::summary::NO_FRAMES
+                hwfoc_io::summary::esc_label(sources, i),
+                hwfoc_io::summary::NO_FRAMES
             );
         }
     }

@@ -23,8 +23,8 @@ use std::rc::Rc;
 
 use hwfoc::{DataFrame, Decoder, Fault, Frame, InfoFrame};
 
-use super::faults::{Fate, FaultSchedule, Link, LinkRates};
-use super::model::{Config, Model};
+use super::faults::{Fate, FaultSchedule, LineFaults, LinkRates};
+use super::model::{Model, ModelConfig};
 use super::profile::Profile;
 use super::rng::{Purpose, Rng};
 
@@ -101,7 +101,7 @@ pub struct Setup {
     /// First packet number; random from the seed if `None`.
     pub start_packet: Option<u16>,
     /// Motor, battery, ESC.
-    pub model: Config,
+    pub model: ModelConfig,
     /// The throttle command.
     pub profile: Rc<Profile>,
     /// Injected status bits.
@@ -119,7 +119,7 @@ pub struct VirtualEsc {
     /// Simulated time the model has reached, ns.
     model_ns: u64,
     noise: Rng,
-    link: Link,
+    link: LineFaults,
     packet: u16,
     info: InfoFrame,
     /// Next 50 ms check.
@@ -155,7 +155,7 @@ impl VirtualEsc {
             model,
             model_ns: 0,
             noise: Rng::for_esc(setup.seed, setup.index, Purpose::Noise),
-            link: Link::new(
+            link: LineFaults::new(
                 setup.link,
                 Rng::for_esc(setup.seed, setup.index, Purpose::Link),
             ),

@@ -8,11 +8,9 @@ use hwfoc::{Fault, Frame, InfoFrame, LinkStats, Settings};
 
 use super::alarms::{Change, Kind, Latch, Level, Threshold};
 use super::config::Limits;
-use hwfoc_io::input::Batch;
-use hwfoc_io::pcapng;
 use hwfoc_io::record::Record;
 use hwfoc_io::serial::PortEvent;
-use hwfoc_io::stream::Stream;
+use hwfoc_io::stream::PortStreams;
 
 /// Seconds of history kept for the charts.
 pub const HISTORY_S: f64 = 60.0;
@@ -272,11 +270,9 @@ pub struct Fleet {
     pub logged: u64,
     /// Data frames decoded in all.
     pub frames: u64,
-    streams: Vec<Stream>,
+    streams: PortStreams,
     settings: Settings,
     limits: Limits,
-    byte_ns: f64,
-    times: Vec<f64>,
 }
 
 impl Fleet {
@@ -309,15 +305,13 @@ impl Fleet {
             })
             .collect::<Vec<_>>();
         Fleet {
-            streams: escs.iter().map(|_| Stream::new()).collect(),
+            streams: PortStreams::new(escs.len(), baud),
             escs,
             log: VecDeque::new(),
             logged: 0,
             frames: 0,
             settings,
             limits,
-            byte_ns: pcapng::byte_ns(baud),
-            times: Vec::new(),
         }
     }
 
@@ -335,23 +329,14 @@ impl Fleet {
     /// completed.
     pub fn on_event(&mut self, event: &PortEvent) -> usize {
         match event {
-            PortEvent::Data { port, t_ns, bytes } => {
-                let Some(stream) = self.streams.get_mut(*port) else {
+            PortEvent::Data { port, .. } => {
+                let mut frames = Vec::new();
+                let Some(&stats) = self
+                    .streams
+                    .feed(event, |_, t, d| frames.push((t, d.frame)))
+                else {
                     return 0;
                 };
-                self.times.clear();
-                self.times
-                    .extend((0..bytes.len()).map(|i| pcapng::byte_time_s(*t_ns, i, self.byte_ns)));
-                let mut frames = Vec::new();
-                stream.feed(
-                    Batch {
-                        bytes,
-                        times: Some(&self.times),
-                        stream: *port,
-                    },
-                    |t, d| frames.push((t.unwrap_or(0.0), d.frame)),
-                );
-                let stats = *stream.stats();
                 let mut data = 0;
                 for (t, frame) in frames {
                     match frame {
@@ -528,7 +513,7 @@ impl Fleet {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::monitor::config::{Config, Overrides};
+    use crate::commands::monitor::config::{Config, Overrides};
     use hwfoc::{DataFrame, Status};
 
     fn fleet(n: usize) -> Fleet {

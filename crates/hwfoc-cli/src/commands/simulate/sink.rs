@@ -84,13 +84,13 @@ impl Sink for RawSink {
 }
 
 /// A pcapng writer over a buffered output.
-type Recording = pcapng::Writer<BufWriter<Box<dyn Write>>>;
+type RecordingWriter = pcapng::Writer<BufWriter<Box<dyn Write>>>;
 
 /// pcapng recordings: one interface per ESC, in one file or one file per ESC. Each burst of
 /// bytes is one packet, timestamped at its first byte, so a frame always starts a packet and
 /// its `t_s` read back is exactly the packet's time.
 pub struct PcapngSink {
-    files: Vec<(String, Recording)>,
+    files: Vec<(String, RecordingWriter)>,
     /// For each ESC: its file and interface.
     route: Vec<(usize, u32)>,
 }

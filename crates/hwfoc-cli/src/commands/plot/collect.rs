@@ -17,8 +17,8 @@
 use hwfoc::{DataFrame, Decoded, Frame, InfoFrame, Settings, Status, Temperature};
 
 use crate::error::CliError;
-use crate::summary::{Episode, Mark};
 use crate::window::Window;
+use hwfoc_io::episode::{Episode, Mark};
 use hwfoc_io::sources::{Handler, Sources};
 
 use super::{Options, Target};

@@ -100,7 +100,7 @@ impl Tally {
 
 /// The clock of a run.
 #[derive(Debug, Clone, Copy)]
-pub struct Clock {
+pub struct SimClock {
     /// The output clock's reading at simulated time zero, ns (Unix time, or a chosen start).
     pub origin_ns: u64,
     /// In real time: the instant of simulated time zero.
@@ -125,7 +125,7 @@ pub fn run(
     sink: &mut dyn Sink,
     mut truth: Option<&mut Truth>,
     pace: Pace,
-    clock: Clock,
+    clock: SimClock,
     duration_ns: Option<u64>,
     stop: &AtomicBool,
 ) -> Result<Vec<Tally>, CliError> {
@@ -277,7 +277,7 @@ mod tests {
             garbage: 0.2,
         };
         let origin_ns = 1_000_000_000_000;
-        let clock = Clock {
+        let clock = SimClock {
             origin_ns,
             real: None,
         };
@@ -339,7 +339,7 @@ mod tests {
         };
         let start = sink.start;
         let stop = AtomicBool::new(false);
-        let clock = Clock {
+        let clock = SimClock {
             origin_ns: 0,
             real: Some(start),
         };
@@ -381,7 +381,7 @@ mod tests {
             start: Instant::now(),
         };
         let stop = AtomicBool::new(true);
-        let clock = Clock {
+        let clock = SimClock {
             origin_ns: 0,
             real: Some(Instant::now()),
         };

@@ -11,9 +11,9 @@ use std::thread::{self, JoinHandle};
 
 use hwfoc::Settings;
 
+use crate::commands::simulate::sink::Sink;
+use crate::commands::simulate::{ModelArgs, VirtualFleet};
 use crate::error::CliError;
-use crate::simulate::sink::Sink;
-use crate::simulate::{Fleet, ModelArgs};
 use hwfoc_io::serial::{PortEvent, Readers};
 
 /// What the monitor's loop receives.
@@ -67,7 +67,7 @@ impl Feed {
         settings: &Settings,
         tx: Sender<Msg>,
     ) -> Result<Feed, CliError> {
-        let fleet: Fleet = model.fleet(n, baud, settings)?;
+        let fleet: VirtualFleet = model.fleet(n, baud, settings)?;
         let stop = Arc::new(AtomicBool::new(false));
         let flag = Arc::clone(&stop);
         let thread = thread::Builder::new()

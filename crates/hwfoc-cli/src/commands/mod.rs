@@ -1,0 +1,8 @@
+//! One module per subcommand: its options (a clap `Args` struct) and its `run`.
+
+pub mod capture;
+pub mod decode;
+pub mod monitor;
+pub mod plot;
+pub mod simulate;
+pub mod summary;

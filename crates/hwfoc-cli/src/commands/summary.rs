@@ -1,0 +1,58 @@
+//! `hwfoc summary`: what the inputs hold, ESC by ESC, and how good each link was (the report
+//! itself is `hwfoc_io::summary`'s), optionally plotted alongside.
+
+use clap::Args;
+use hwfoc_io::sources::Sources;
+use hwfoc_io::summary::Summary;
+
+use super::plot;
+use crate::args::{InputArgs, SettingsArgs};
+use crate::error::CliError;
+use crate::output::Output;
+
+#[derive(Debug, Args)]
+pub struct SummaryArgs {
+    #[command(flatten)]
+    pub input: InputArgs,
+    /// Print one JSON object instead of text.
+    #[arg(long)]
+    pub json: bool,
+    /// Also plot the inputs to FILE (.png or .svg), as `hwfoc plot` does.
+    #[arg(long, value_name = "FILE")]
+    pub plot: Option<String>,
+    #[command(flatten)]
+    pub settings: SettingsArgs,
+}
+
+/// Runs `hwfoc summary`.
+pub fn run(args: &SummaryArgs) -> Result<(), CliError> {
+    let settings = args.settings.settings()?;
+    // The plot's file is opened first: a wrong name is reported before the inputs are read.
+    let mut plot = match &args.plot {
+        Some(path) => Some(plot::Alongside::open(path, settings)?),
+        None => None,
+    };
+    let mut sources = Sources::new(args.input.open_all()?);
+    let mut summary = Summary::new();
+    // On an input error, what was read before it is summarised, then the error reported.
+    let result = match &mut plot {
+        Some(plot) => sources.run(&mut plot::Both(&mut summary, plot)),
+        None => sources.run(&mut summary).map_err(CliError::from),
+    };
+    let report = summary.report(&sources, &settings);
+    let text = if args.json {
+        let mut s = serde_json::to_string_pretty(&report.json()).unwrap_or_default();
+        s.push('\n');
+        s
+    } else {
+        report.text()
+    };
+    let mut out = Output::create(None)?;
+    let mut buf = text.into_bytes();
+    out.write(&mut buf)?;
+    out.flush()?;
+    if let Some(plot) = plot {
+        plot.finish(&sources)?;
+    }
+    result
+}

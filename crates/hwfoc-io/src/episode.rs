@@ -1,0 +1,59 @@
+//! Fault episodes: maximal runs of consecutive data frames of one ESC whose status word is not
+//! zero, as the summary reports them and the plots shade them.
+
+use hwfoc::Status;
+
+/// One end of a fault episode: a data frame.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Mark {
+    /// Receive time, if the input has timing.
+    pub t: Option<f64>,
+    /// Index of the data frame among the ESC's data frames (0-based).
+    pub frame: u64,
+    /// Its packet number.
+    pub packet: u16,
+}
+
+/// A maximal run of consecutive data frames with a non-zero status word.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Episode {
+    /// Its first frame.
+    pub first: Mark,
+    /// Its last frame.
+    pub last: Mark,
+    /// How many frames it lasted.
+    pub frames: u64,
+    /// Every status bit seen during the episode.
+    pub bits: Status,
+    /// Still going on at the end of the input.
+    pub ongoing: bool,
+}
+
+impl Episode {
+    /// Follows the fault episodes of one ESC through its data frames, in order: a frame with a
+    /// non-zero status word starts the open episode `open` or extends it, a clean frame ends
+    /// it. Returns the episode the frame ended, if any.
+    #[inline]
+    pub fn track(open: &mut Option<Episode>, mark: Mark, status: Status) -> Option<Episode> {
+        if status.is_ok() {
+            return open.take();
+        }
+        match open {
+            Some(e) => {
+                e.last = mark;
+                e.frames += 1;
+                e.bits = Status(e.bits.0 | status.0);
+            }
+            None => {
+                *open = Some(Episode {
+                    first: mark,
+                    last: mark,
+                    frames: 1,
+                    bits: status,
+                    ongoing: false,
+                })
+            }
+        }
+        None
+    }
+}
