@@ -10,10 +10,11 @@
 //!   ESC, and the [`sources::Handler`] seam through which frames reach a command;
 //! - [`record`]: the record of `RECORD-SCHEMA.md` (one row per data frame, physical units) and
 //!   its text encodings;
-//! - [`write`]: writers of records (JSON Lines, CSV, Parquet with the `parquet` feature), each on
+//! - [`write`](mod@write): writers of records (JSON Lines, CSV, Parquet with the `parquet` feature), each on
 //!   a thread of its own;
 //! - [`pcapng`]: the recording format (writer and truncation-tolerant reader);
-//! - [`serial`]: serial ports that survive being unplugged, and the process's stop signal.
+//! - [`serial`]: serial ports that survive being unplugged; [`clock`]: receive times;
+//!   [`stop`]: Ctrl-C and SIGTERM as a request to stop that every loop honours.
 //!
 //! Each module has its own error type, an enum carrying what went wrong and where, whose
 //! `Display` is the one-line message a person reads.
@@ -21,12 +22,14 @@
 #![forbid(unsafe_op_in_unsafe_fn)]
 #![warn(missing_docs)]
 
+pub mod clock;
 pub mod episode;
 pub mod input;
 pub mod pcapng;
 pub mod record;
 pub mod serial;
 pub mod sources;
+pub mod stop;
 pub mod stream;
 pub mod summary;
 pub mod write;

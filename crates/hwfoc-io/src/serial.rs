@@ -9,11 +9,13 @@
 
 use std::io::{self, Read};
 use std::path::Path;
+use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc::{self, Receiver, Sender};
-use std::sync::{Arc, OnceLock};
 use std::thread::{self, JoinHandle};
-use std::time::{Duration, Instant, SystemTime, UNIX_EPOCH};
+use std::time::{Duration, Instant};
+
+use crate::clock::Clock;
 
 use serialport::{DataBits, FlowControl, Parity, SerialPort, StopBits};
 
@@ -244,62 +246,6 @@ fn owner_group(port: &str) -> Option<String> {
 #[cfg(not(unix))]
 fn owner_group(_port: &str) -> Option<String> {
     None
-}
-
-/// The process-wide flag set by Ctrl-C (SIGINT) or SIGTERM. The first call installs the
-/// handlers; from then on those signals no longer end the process at once but ask the command
-/// to stop cleanly, except that a second signal while the flag is set ends it immediately.
-/// If the handlers cannot be installed, the signals keep their default action.
-pub fn interrupted() -> Arc<AtomicBool> {
-    static FLAG: OnceLock<Arc<AtomicBool>> = OnceLock::new();
-    FLAG.get_or_init(|| {
-        let flag = Arc::new(AtomicBool::new(false));
-        for signal in [signal_hook::consts::SIGINT, signal_hook::consts::SIGTERM] {
-            // Order matters: the conditional shutdown sees the flag as it was before this signal.
-            let _ =
-                signal_hook::flag::register_conditional_shutdown(signal, 130, Arc::clone(&flag));
-            let _ = signal_hook::flag::register(signal, Arc::clone(&flag));
-        }
-        flag
-    })
-    .clone()
-}
-
-/// The wall clock now, Unix time in nanoseconds (0 for a clock set before 1970).
-pub fn unix_now_ns() -> u64 {
-    SystemTime::now()
-        .duration_since(UNIX_EPOCH)
-        .map_or(0, |d| d.as_nanos() as u64)
-}
-
-/// Unix time in nanoseconds that never goes backwards: the wall clock when the clock was made,
-/// advanced by a monotonic clock (so that a clock step during a recording does not reorder it).
-#[derive(Debug, Clone, Copy)]
-pub struct Clock {
-    wall_ns: u64,
-    start: Instant,
-}
-
-impl Clock {
-    /// A clock anchored at the wall-clock time now.
-    pub fn new() -> Clock {
-        let wall_ns = unix_now_ns();
-        Clock {
-            wall_ns,
-            start: Instant::now(),
-        }
-    }
-
-    /// Unix time now, in nanoseconds.
-    pub fn now_ns(&self) -> u64 {
-        self.wall_ns + self.start.elapsed().as_nanos() as u64
-    }
-}
-
-impl Default for Clock {
-    fn default() -> Self {
-        Clock::new()
-    }
 }
 
 /// What a port's reader thread reports.

@@ -170,7 +170,7 @@ pub struct Recorder {
     last_flush: Instant,
     last_sync: Instant,
     /// The clock of the ports' timestamps.
-    clock: serial::Clock,
+    clock: hwfoc_io::clock::Clock,
     ports: Vec<PortState>,
     /// The ports' decoding streams (frames are counted, not kept).
     streams: PortStreams,
@@ -179,7 +179,7 @@ pub struct Recorder {
 /// Runs `hwfoc record`.
 pub fn run(args: &RecordArgs) -> Result<(), CliError> {
     // Install the Ctrl-C / SIGTERM handler first, so that no signal is lost once ports are open.
-    let interrupted = serial::interrupted();
+    let interrupted = hwfoc_io::stop::interrupted();
     let set = PortSet::open(&args.ports, args.baud)?;
     let started = Instant::now();
     let plan = Plan {
@@ -230,7 +230,11 @@ pub fn run(args: &RecordArgs) -> Result<(), CliError> {
 
 impl Recorder {
     /// Creates the (first) file, with one interface per port, timestamps from `clock`.
-    pub fn new(plan: Plan, ports: &[String], clock: serial::Clock) -> Result<Recorder, CliError> {
+    pub fn new(
+        plan: Plan,
+        ports: &[String],
+        clock: hwfoc_io::clock::Clock,
+    ) -> Result<Recorder, CliError> {
         let rotating = plan.rotate_size.is_some() || plan.rotate_time.is_some();
         let first = if rotating {
             numbered(&plan.output, 1)

@@ -21,7 +21,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Duration;
 
 use crate::pcapng;
-use crate::serial::{self, PortError, PortEvent, PortSet};
+use crate::serial::{PortError, PortEvent, PortSet};
 use crate::stream::byte_times;
 
 /// How many bytes a raw read asks for: small enough that what the kernel copies in is still in
@@ -169,7 +169,7 @@ impl Input {
     /// given. Reading ends on Ctrl-C or SIGTERM (the signals stop the input rather than the
     /// process); a port that is unplugged is waited for, with a warning.
     pub fn open_ports(names: &[String], baud: u32) -> Result<Input, InputError> {
-        let interrupted = serial::interrupted();
+        let interrupted = crate::stop::interrupted();
         let set = PortSet::open(names, baud)?;
         Ok(Input::new(
             &names.join(", "),
@@ -929,7 +929,7 @@ mod tests {
         assert_eq!(input.streams(), 2);
         assert_eq!(input.stream_name(1), names[1]);
         let mut master = std::fs::File::from(ptys[1].master.try_clone().unwrap());
-        let sent = serial::Clock::new().now_ns() as f64 * 1e-9;
+        let sent = crate::clock::Clock::new().now_ns() as f64 * 1e-9;
         master.write_all(&[0x9B, 0x16, 0x01]).unwrap();
         let mut got = Vec::new();
         let mut times = Vec::new();

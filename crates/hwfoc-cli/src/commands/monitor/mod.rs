@@ -28,7 +28,7 @@ use self::perf::Perf;
 use super::capture::{self, Recorder};
 use crate::commands::simulate::ModelArgs;
 use crate::error::CliError;
-use hwfoc_io::serial::{self, PortEvent};
+use hwfoc_io::serial::PortEvent;
 
 /// The most virtual ESCs `--sim` runs.
 const MAX_SIM: u16 = 64;
@@ -173,7 +173,7 @@ pub struct Session {
     rx: Receiver<Msg>,
     tx: mpsc::Sender<Msg>,
     feed: Option<Feed>,
-    clock: serial::Clock,
+    clock: hwfoc_io::clock::Clock,
     names: Vec<String>,
     baud: u32,
     record_dir: PathBuf,
@@ -183,7 +183,7 @@ pub struct Session {
 
 impl Session {
     fn start(args: &MonitorArgs, config: Config) -> Result<Session, CliError> {
-        let interrupted = serial::interrupted();
+        let interrupted = hwfoc_io::stop::interrupted();
         let (tx, rx) = mpsc::channel();
         let ports: Vec<String> = if args.ports.is_empty() {
             config.ports.clone()
@@ -233,7 +233,7 @@ impl Session {
         // The ports' own clock, so that ages and recordings agree with their timestamps.
         let clock = match &feed {
             Feed::Ports(readers) => readers.clock(),
-            Feed::Simulated { .. } => serial::Clock::new(),
+            Feed::Simulated { .. } => hwfoc_io::clock::Clock::new(),
         };
         let now = clock.now_ns() as f64 / 1e9;
         let fleet = Fleet::new(

@@ -39,7 +39,7 @@ use self::schedule::{Pace, SimClock, Tally};
 use self::sink::{PcapngSink, PortSink, RawSink, Sink, Truth};
 use crate::args::SettingsArgs;
 use crate::error::CliError;
-use hwfoc_io::serial::unix_now_ns;
+use hwfoc_io::clock::unix_now_ns;
 use hwfoc_io::write::WriteError;
 
 /// Extra seconds after one run of the profile, for file outputs without `--duration`: the
@@ -538,7 +538,7 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
     };
 
     let infos: Vec<hwfoc::InfoFrame> = escs.iter().map(|e| *e.info()).collect();
-    let stop: std::sync::Arc<AtomicBool> = hwfoc_io::serial::interrupted();
+    let stop: std::sync::Arc<AtomicBool> = hwfoc_io::stop::interrupted();
     let clock = SimClock {
         origin_ns,
         real: realtime.then(Instant::now),
