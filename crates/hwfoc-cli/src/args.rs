@@ -1,8 +1,9 @@
-//! Option groups that several commands share: where telemetry comes from, and the conversion
-//! settings the frames do not carry.
+//! Option groups that several commands share: where telemetry comes from, the conversion
+//! settings the frames do not carry, and which frames to keep.
 
 use clap::Args;
 use hwfoc::Settings;
+use hwfoc_io::select::{Selection, Window};
 use hwfoc_io::serial;
 use hwfoc_io::{Input, InputError};
 
@@ -74,5 +75,43 @@ impl SettingsArgs {
     pub fn settings(&self) -> Result<Settings, CliError> {
         Settings::new(self.current_scale, self.pole_pairs, self.gear_ratio)
             .map_err(CliError::Settings)
+    }
+}
+
+/// The selection options that `decode` and `plot` share.
+#[derive(Debug, Args)]
+pub struct SelectArgs {
+    /// Only these ESCs (indices as in the `esc` column; repeat or separate with commas).
+    #[arg(long, value_name = "N", value_delimiter = ',')]
+    pub esc: Vec<u8>,
+    /// Only frames received at or after S seconds (`t_s`; needs inputs with receive times).
+    #[arg(long, value_name = "S", allow_negative_numbers = true)]
+    pub from: Option<f64>,
+    /// Only frames received before S seconds (`t_s`; needs inputs with receive times).
+    #[arg(long, value_name = "S", allow_negative_numbers = true)]
+    pub to: Option<f64>,
+}
+
+impl SelectArgs {
+    /// The ESCs and the window of receive times; an empty window is an error.
+    pub fn selection(&self) -> Result<Selection, CliError> {
+        let window = Window::new(self.from, self.to).map_err(CliError::Window)?;
+        Ok(Selection::new(&self.esc, window))
+    }
+
+    /// The filters, as recorded with an output: `esc=0,2 from=1.5 to=3`, or empty.
+    pub fn text(&self) -> String {
+        let mut parts = Vec::new();
+        if !self.esc.is_empty() {
+            let escs: Vec<String> = self.esc.iter().map(u8::to_string).collect();
+            parts.push(format!("esc={}", escs.join(",")));
+        }
+        if let Some(from) = self.from {
+            parts.push(format!("from={from}"));
+        }
+        if let Some(to) = self.to {
+            parts.push(format!("to={to}"));
+        }
+        parts.join(" ")
     }
 }

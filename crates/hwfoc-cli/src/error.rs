@@ -8,8 +8,9 @@ use std::fmt;
 use std::io;
 
 use hwfoc_io::InputError;
+use hwfoc_io::select::EmptyWindow;
 use hwfoc_io::serial::PortError;
-use hwfoc_io::write::WriteError;
+use hwfoc_io::write::{ExportError, WriteError};
 
 /// Everything that makes a command fail. Printed once, by `main`, as `hwfoc: <message>`.
 #[derive(Debug)]
@@ -21,12 +22,7 @@ pub enum CliError {
     /// An output could not be created or written.
     Write(WriteError),
     /// `--from` is not before `--to`.
-    EmptyWindow {
-        /// Start of the window, s.
-        from: f64,
-        /// End of the window, s.
-        to: f64,
-    },
+    Window(EmptyWindow),
     /// A conversion setting is out of range.
     Settings(hwfoc::SettingsError),
     /// Serial ports and files named together as inputs.
@@ -109,6 +105,15 @@ impl From<InputError> for CliError {
     }
 }
 
+impl From<ExportError> for CliError {
+    fn from(e: ExportError) -> Self {
+        match e {
+            ExportError::Input(e) => e.into(),
+            ExportError::Write(e) => CliError::Write(e),
+        }
+    }
+}
+
 impl From<PortError> for CliError {
     fn from(e: PortError) -> Self {
         CliError::Port(e)
@@ -127,12 +132,7 @@ impl fmt::Display for CliError {
             CliError::Input(e) => e.fmt(f),
             CliError::Port(e) => e.fmt(f),
             CliError::Write(e) => e.fmt(f),
-            CliError::EmptyWindow { from, to } => {
-                write!(
-                    f,
-                    "--from {from} is not before --to {to}: no frame can be selected"
-                )
-            }
+            CliError::Window(e) => e.fmt(f),
             CliError::Settings(e) => write!(f, "invalid setting: {e}"),
             CliError::MixedInputs { port, file } => write!(
                 f,
@@ -175,6 +175,7 @@ impl std::error::Error for CliError {
             CliError::Input(e) => Some(e),
             CliError::Port(e) => Some(e),
             CliError::Write(e) => Some(e),
+            CliError::Window(e) => Some(e),
             CliError::Pty { source }
             | CliError::Terminal { source }
             | CliError::Link { source, .. } => Some(source),

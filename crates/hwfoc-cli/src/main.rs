@@ -9,7 +9,6 @@ mod commands;
 mod demo;
 mod error;
 mod output;
-mod window;
 
 use std::process::ExitCode;
 

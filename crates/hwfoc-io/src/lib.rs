@@ -7,7 +7,7 @@
 //!   serial ports, standard input), the format detected from the content, each byte with its
 //!   receive time where the source has a clock;
 //! - [`stream`] and [`sources`]: the one path from timed bytes to frames, a decoding stream per
-//!   ESC, and the [`sources::Handler`] seam through which frames reach a command;
+//!   ESC; [`handler`]: the [`Handler`] seam through which records reach a front end;
 //! - [`record`]: the record of `RECORD-SCHEMA.md` (one row per data frame, physical units) and
 //!   its text encodings;
 //! - [`write`](mod@write): writers of records (JSON Lines, CSV, Parquet with the `parquet` feature), each on
@@ -24,9 +24,11 @@
 
 pub mod clock;
 pub mod episode;
+pub mod handler;
 pub mod input;
 pub mod pcapng;
 pub mod record;
+pub mod select;
 pub mod serial;
 pub mod sources;
 pub mod stop;
@@ -34,7 +36,8 @@ pub mod stream;
 pub mod summary;
 pub mod write;
 
+pub use handler::Handler;
 pub use input::{Batch, Input, InputError, InputFormat};
 pub use record::Record;
-pub use sources::{Handler, Sources};
+pub use sources::Sources;
 pub use stream::Stream;

@@ -7,8 +7,9 @@
 
 use std::ops::Range;
 
-use hwfoc::Decoded;
+use hwfoc::Settings;
 
+pub use crate::handler::Handler;
 use crate::input::{Input, InputError, InputFormat};
 use crate::stream::Stream;
 
@@ -17,26 +18,6 @@ const LIVE_BATCH: usize = 4096;
 
 /// How many ESCs the record's `esc` column (a `u8`) can number.
 const MAX_ESCS: usize = 256;
-
-/// What a command does with the frames of [`Sources::run`]: the seam between reading and
-/// presenting, as `Sink` is in ripgrep.
-///
-/// Its error type carries the handler's own failures (an output that cannot be written) and
-/// the input errors [`Sources::run`] meets, so that a command sees one error type.
-pub trait Handler {
-    /// The handler's error: its own, or an input's (hence `From<InputError>`).
-    type Error: From<InputError>;
-
-    /// A frame of ESC `esc`, with the receive time of its first byte where the input has one.
-    fn frame(&mut self, esc: u8, t: Option<f64>, decoded: Decoded);
-
-    /// The end of a batch of bytes; `live` when it was small, as from a serial port (what it
-    /// produced should be passed on at once). An error stops the run.
-    fn end_batch(&mut self, live: bool) -> Result<(), Self::Error> {
-        let _ = live;
-        Ok(())
-    }
-}
 
 /// One ESC: a stream of one input.
 #[derive(Debug)]
@@ -64,6 +45,7 @@ pub struct InputInfo {
 
 /// The inputs of a command and the ESCs found in them.
 pub struct Sources {
+    settings: Settings,
     pending: Vec<Input>,
     names: Vec<String>,
     read: Vec<InputInfo>,
@@ -72,9 +54,11 @@ pub struct Sources {
 }
 
 impl Sources {
-    /// The inputs, opened, in command-line order.
-    pub fn new(inputs: Vec<Input>) -> Sources {
+    /// The inputs, opened, in command-line order; data frames become records under
+    /// `settings`.
+    pub fn new(inputs: Vec<Input>, settings: Settings) -> Sources {
         Sources {
+            settings,
             names: inputs.iter().map(|i| i.name().to_string()).collect(),
             pending: inputs,
             read: Vec::new(),
@@ -94,6 +78,11 @@ impl Sources {
             }),
             None => Ok(()),
         }
+    }
+
+    /// The conversion settings of the records.
+    pub fn settings(&self) -> &Settings {
+        &self.settings
     }
 
     /// The names of all inputs, in command-line order.
@@ -138,7 +127,8 @@ impl Sources {
                 }
                 // Every stream with bytes has an index below 256 (checked when first seen).
                 let id = u8::try_from(i).unwrap_or(u8::MAX);
-                esc.stream.finish(|t, d| handler.frame(id, t, d));
+                esc.stream
+                    .finish(|t, d| handler.frame(id, t, d, &self.settings));
             }
             self.read.push(InputInfo {
                 name: input.name().to_string(),
@@ -186,7 +176,9 @@ impl Sources {
             }
             let live = batch.bytes.len() < LIVE_BATCH;
             let esc = &mut self.escs[base + stream];
-            esc.stream.feed(batch, |t, d| handler.frame(id, t, d));
+            let settings = &self.settings;
+            esc.stream
+                .feed(batch, |t, d| handler.frame(id, t, d, settings));
             if esc.name.is_empty() {
                 esc.name = input.stream_name(stream);
             }

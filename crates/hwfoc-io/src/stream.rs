@@ -5,7 +5,9 @@
 //! port events). [`byte_times`] is the one place where a chunk's receive time becomes the time
 //! of each of its bytes.
 
-use hwfoc::{Decoded, Decoder, LinkStats};
+use hwfoc::{Decoded, Decoder, LinkStats, Settings};
+
+use crate::handler::Handler;
 
 use crate::input::Batch;
 use crate::pcapng;
@@ -84,41 +86,45 @@ pub struct PortStreams {
     streams: Vec<Stream>,
     per_byte_ns: f64,
     times: Vec<f64>,
+    settings: Settings,
 }
 
 impl PortStreams {
-    /// `ports` streams, their bytes arriving at `baud` (8N1).
-    pub fn new(ports: usize, baud: u32) -> PortStreams {
+    /// `ports` streams, their bytes arriving at `baud` (8N1), their data frames made records
+    /// under `settings`.
+    pub fn new(ports: usize, baud: u32, settings: Settings) -> PortStreams {
         PortStreams {
             streams: (0..ports).map(|_| Stream::new()).collect(),
             per_byte_ns: pcapng::byte_ns(baud),
             times: Vec::new(),
+            settings,
         }
     }
 
-    /// Decodes the bytes of a [`PortEvent::Data`]; `on_frame` gets each frame completed with
-    /// its port and the receive time of its first byte (Unix seconds). Other events and ports
-    /// beyond those made are ignored. Returns the port's link statistics after the bytes, or
-    /// `None` when there were no bytes for a known port.
-    pub fn feed(
-        &mut self,
-        event: &PortEvent,
-        mut on_frame: impl FnMut(usize, f64, Decoded),
-    ) -> Option<&LinkStats> {
+    /// Decodes the bytes of a [`PortEvent::Data`], handing each frame completed to `handler`
+    /// as ESC number `port` (records of ports past 255 are not made: the `esc` column numbers
+    /// 256). Other events, and ports beyond those made, are ignored. Returns the port's link
+    /// statistics after the bytes, or `None` when there were no bytes for a known port.
+    pub fn feed<H: Handler>(&mut self, event: &PortEvent, handler: &mut H) -> Option<&LinkStats> {
         let PortEvent::Data { port, t_ns, bytes } = event else {
             return None;
         };
         let stream = self.streams.get_mut(*port)?;
         self.times.clear();
         byte_times(*t_ns, self.per_byte_ns, bytes.len(), &mut self.times);
+        let esc = u8::try_from(*port).ok();
+        let settings = &self.settings;
         stream.feed(
             Batch {
                 bytes,
                 times: Some(&self.times),
                 stream: *port,
             },
-            // Every byte of a port event has a time.
-            |t, d| on_frame(*port, t.unwrap_or(0.0), d),
+            |t, d| {
+                if let Some(esc) = esc {
+                    handler.frame(esc, t, d, settings);
+                }
+            },
         );
         Some(stream.stats())
     }

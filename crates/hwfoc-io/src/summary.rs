@@ -71,8 +71,10 @@ impl Summary {
 impl Handler for Summary {
     type Error = InputError;
 
+    /// Takes frames as decoded: statistics are kept on the raw integers (see the module
+    /// documentation), converted once at the end.
     #[inline]
-    fn frame(&mut self, esc: u8, t: Option<f64>, decoded: Decoded) {
+    fn frame(&mut self, esc: u8, t: Option<f64>, decoded: Decoded, _: &Settings) {
         let esc = usize::from(esc);
         if self.0.len() <= esc {
             self.0.resize_with(esc + 1, Accumulator::default);

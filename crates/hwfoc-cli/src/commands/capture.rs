@@ -256,7 +256,8 @@ impl Recorder {
             last_flush: now,
             last_sync: now,
             clock,
-            streams: PortStreams::new(ports.len(), plan.baud),
+            // Frames are only counted: the conversion settings do not matter.
+            streams: PortStreams::new(ports.len(), plan.baud, hwfoc::Settings::DEFAULT),
             ports: ports
                 .iter()
                 .map(|name| PortState {
@@ -344,7 +345,7 @@ impl Recorder {
     /// Decodes a chunk to count frames and to notice a port that sends no valid frame.
     fn decode(&mut self, port: usize, event: &PortEvent) {
         let before = self.streams.stats(port).map_or(0, frames);
-        let after = self.streams.feed(event, |_, _, _| {}).map_or(0, frames);
+        let after = self.streams.feed(event, &mut ()).map_or(0, frames);
         let bytes = match event {
             PortEvent::Data { bytes, .. } => bytes.len(),
             _ => 0,

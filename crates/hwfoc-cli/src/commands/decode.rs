@@ -6,13 +6,11 @@
 //! raw bytes have none, and are refused rather than silently giving no records.
 
 use clap::{Args, ValueEnum};
-use hwfoc::{Decoded, Frame};
 use serde_json::json;
 
-use crate::args::{InputArgs, SettingsArgs};
+use crate::args::{InputArgs, SelectArgs, SettingsArgs};
 use crate::error::CliError;
-use crate::window::{SelectArgs, Window};
-use hwfoc_io::sources::{Handler, Sources};
+use hwfoc_io::sources::Sources;
 use hwfoc_io::write::{Export, OutputFormat, Provenance};
 
 /// Record output formats.
@@ -48,19 +46,15 @@ pub struct DecodeArgs {
 /// Runs `hwfoc decode`.
 pub fn run(args: &DecodeArgs) -> Result<(), CliError> {
     let settings = args.settings.settings()?;
-    let window = args.select.window()?;
-    let mut sources = Sources::new(args.input.open_all()?);
-    if window.is_limited() {
+    let selection = args.select.selection()?;
+    let mut sources = Sources::new(args.input.open_all()?, settings);
+    if selection.window.is_limited() {
         sources.require_timing()?;
-    }
-    let mut escs = [args.select.esc.is_empty(); 256];
-    for &esc in &args.select.esc {
-        escs[usize::from(esc)] = true;
     }
     let provenance = Provenance {
         settings,
         inputs: sources.names().to_vec(),
-        filter: filter_text(args),
+        filter: args.select.text(),
         csv_comment: args.settings_comment,
     };
     let format = match args.format {
@@ -69,83 +63,24 @@ pub fn run(args: &DecodeArgs) -> Result<(), CliError> {
         RecordFormat::Parquet => OutputFormat::Parquet,
     };
     keep_freed_memory();
-    let export = Export::create(format, args.output.as_deref(), provenance)?;
-    let mut records = Records {
-        export,
-        escs,
-        window,
-        kept: 0,
-        times: None,
-    };
-    let result = sources.run(&mut records);
+    let mut export =
+        Export::create(format, args.output.as_deref(), provenance)?.select(selection.clone());
+    let result = sources.run(&mut export);
+    let (kept, span) = (export.kept(), export.span());
     // Whatever was decoded before an input error is still written out.
     let metadata = vec![("escs".to_string(), escs_json(&sources))];
-    let finished = records.export.finish(metadata);
+    let finished = export.finish(metadata);
     result?;
     finished?;
     warn(&sources, &args.select.esc);
-    if let (true, 0, Some((first, last))) =
-        (records.window.is_limited(), records.kept, records.times)
-    {
+    if let (true, 0, Some((first, last))) = (selection.window.is_limited(), kept, span) {
         eprintln!(
             "hwfoc: warning: no frame in the time window ({}): the frames' t_s run from {first} \
              to {last} s (recordings and serial ports give Unix time)",
-            filter_text(args)
+            args.select.text()
         );
     }
     Ok(())
-}
-
-/// The frames that make records: data frames of the chosen ESCs in the time window.
-struct Records {
-    export: Export,
-    escs: [bool; 256],
-    window: Window,
-    /// Records written.
-    kept: u64,
-    /// Earliest and latest `t_s` of the chosen ESCs' data frames, to explain an empty window.
-    times: Option<(f64, f64)>,
-}
-
-impl Handler for Records {
-    type Error = CliError;
-
-    #[inline]
-    fn frame(&mut self, esc: u8, t: Option<f64>, decoded: Decoded) {
-        if let Frame::Data(frame) = decoded.frame
-            && self.escs[usize::from(esc)]
-        {
-            if let Some(t) = t {
-                let (first, last) = self.times.get_or_insert((t, t));
-                *first = first.min(t);
-                *last = last.max(t);
-            }
-            if self.window.contains(t) {
-                self.export.push(esc, t, &frame);
-                self.kept += 1;
-            }
-        }
-    }
-
-    fn end_batch(&mut self, live: bool) -> Result<(), CliError> {
-        Ok(self.export.end_batch(live)?)
-    }
-}
-
-/// The filters, as recorded with the output: `esc=0,2 from=1.5 to=3`, or empty.
-fn filter_text(args: &DecodeArgs) -> String {
-    let mut parts = Vec::new();
-    if !args.select.esc.is_empty() {
-        let escs: Vec<String> = args.select.esc.iter().map(u8::to_string).collect();
-        parts.push(format!("esc={}", escs.join(",")));
-    }
-    if let Some(from) = args.select.from {
-        parts.push(format!("from={from}"));
-    }
-    if let Some(to) = args.select.to {
-        parts.push(format!("to={to}"));
-    }
-    parts.join(" ")
 }
 
 /// Which ESC is which: `[{"esc": 0, "input": "a.pcapng", "stream": "/dev/ttyUSB0"}, ...]`.

@@ -2,6 +2,7 @@
 //! itself is `hwfoc_io::summary`'s), optionally plotted alongside.
 
 use clap::Args;
+use hwfoc_io::handler::Both;
 use hwfoc_io::sources::Sources;
 use hwfoc_io::summary::Summary;
 
@@ -32,11 +33,11 @@ pub fn run(args: &SummaryArgs) -> Result<(), CliError> {
         Some(path) => Some(plot::Alongside::open(path, settings)?),
         None => None,
     };
-    let mut sources = Sources::new(args.input.open_all()?);
+    let mut sources = Sources::new(args.input.open_all()?, settings);
     let mut summary = Summary::new();
     // On an input error, what was read before it is summarised, then the error reported.
     let result = match &mut plot {
-        Some(plot) => sources.run(&mut plot::Both(&mut summary, plot)),
+        Some(plot) => sources.run(&mut Both(&mut summary, plot)),
         None => sources.run(&mut summary).map_err(CliError::from),
     };
     let report = summary.report(&sources, &settings);

@@ -27,7 +27,11 @@ use std::io::{self, Write};
 use std::sync::mpsc::{Receiver, SyncSender, sync_channel};
 use std::thread::JoinHandle;
 
-use hwfoc::{DataFrame, Settings};
+use hwfoc::{DataFrame, Decoded, Frame, Settings};
+
+use crate::handler::Handler;
+use crate::input::InputError;
+use crate::select::Selection;
 
 /// Rows per chunk handed to the writer thread (a chunk may exceed it by one input batch).
 pub const CHUNK_ROWS: usize = 1 << 16;
@@ -123,6 +127,11 @@ pub struct Export {
     tx: Option<SyncSender<ToWriter>>,
     worker: Option<JoinHandle<Result<(), WriteError>>>,
     mode: Pipeline,
+    selection: Selection,
+    /// Records written.
+    kept: u64,
+    /// Earliest and latest `t_s` of the selected ESCs' data frames, in the window or not.
+    span: Option<(f64, f64)>,
 }
 
 /// What the decoding thread prepares for the writer.
@@ -217,7 +226,29 @@ impl Export {
             tx: Some(tx),
             worker: Some(worker),
             mode,
+            selection: Selection::default(),
+            kept: 0,
+            span: None,
         })
+    }
+
+    /// Keeps only the records of `selection` when the export is a [`Handler`] (every record
+    /// otherwise).
+    pub fn select(mut self, selection: Selection) -> Export {
+        self.selection = selection;
+        self
+    }
+
+    /// Records written so far.
+    pub fn kept(&self) -> u64 {
+        self.kept
+    }
+
+    /// The earliest and latest receive time of the selected ESCs' data frames, whether in the
+    /// selection's time window or not (to tell a user whose window held no frame what times
+    /// the frames have).
+    pub fn span(&self) -> Option<(f64, f64)> {
+        self.span
     }
 
     /// Adds a record: a data frame, its ESC and its receive time.
@@ -304,6 +335,72 @@ impl Export {
                 })
             }),
             None => Ok(()),
+        }
+    }
+}
+
+/// An export is what `hwfoc decode` hands the frames to: it takes them as decoded, and its
+/// writers convert them a block at a time on their own threads.
+impl Handler for Export {
+    type Error = ExportError;
+
+    #[inline]
+    fn frame(&mut self, esc: u8, t: Option<f64>, decoded: Decoded, _: &Settings) {
+        if let Frame::Data(frame) = decoded.frame
+            && self.selection.esc(esc)
+        {
+            if let Some(t) = t {
+                let (first, last) = self.span.get_or_insert((t, t));
+                *first = first.min(t);
+                *last = last.max(t);
+            }
+            if self.selection.window.contains(t) {
+                self.push(esc, t, &frame);
+                self.kept += 1;
+            }
+        }
+    }
+
+    fn end_batch(&mut self, live: bool) -> Result<(), ExportError> {
+        Ok(Export::end_batch(self, live)?)
+    }
+}
+
+/// Why an export stopped: an input it was reading, or its output.
+#[derive(Debug)]
+pub enum ExportError {
+    /// An input could not be read.
+    Input(InputError),
+    /// The output could not be written.
+    Write(WriteError),
+}
+
+impl From<InputError> for ExportError {
+    fn from(e: InputError) -> Self {
+        ExportError::Input(e)
+    }
+}
+
+impl From<WriteError> for ExportError {
+    fn from(e: WriteError) -> Self {
+        ExportError::Write(e)
+    }
+}
+
+impl fmt::Display for ExportError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            ExportError::Input(e) => e.fmt(f),
+            ExportError::Write(e) => e.fmt(f),
+        }
+    }
+}
+
+impl std::error::Error for ExportError {
+    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
+        match self {
+            ExportError::Input(e) => Some(e),
+            ExportError::Write(e) => Some(e),
         }
     }
 }

@@ -4,10 +4,12 @@
 
 use std::collections::VecDeque;
 
-use hwfoc::{Fault, Frame, InfoFrame, LinkStats, Settings};
+use hwfoc::{Fault, InfoFrame, LinkStats, Settings};
 
 use super::alarms::{Change, Kind, Latch, Level, Threshold};
 use super::config::Limits;
+use hwfoc_io::InputError;
+use hwfoc_io::handler::Handler;
 use hwfoc_io::record::Record;
 use hwfoc_io::serial::PortEvent;
 use hwfoc_io::stream::PortStreams;
@@ -75,6 +77,27 @@ impl Peaks {
             self.min_voltage_v
                 .map_or(r.voltage_v, |s| s.min(r.voltage_v)),
         );
+    }
+}
+
+/// What one port event brought, in order.
+#[derive(Default)]
+struct Received(Vec<Item>);
+
+enum Item {
+    Record(Record),
+    Info(Option<f64>, InfoFrame),
+}
+
+impl Handler for Received {
+    type Error = InputError;
+
+    fn record(&mut self, record: &Record) {
+        self.0.push(Item::Record(*record));
+    }
+
+    fn info(&mut self, _: u8, t: Option<f64>, info: &InfoFrame) {
+        self.0.push(Item::Info(t, *info));
     }
 }
 
@@ -305,7 +328,7 @@ impl Fleet {
             })
             .collect::<Vec<_>>();
         Fleet {
-            streams: PortStreams::new(escs.len(), baud),
+            streams: PortStreams::new(escs.len(), baud, settings),
             escs,
             log: VecDeque::new(),
             logged: 0,
@@ -330,25 +353,22 @@ impl Fleet {
     pub fn on_event(&mut self, event: &PortEvent) -> usize {
         match event {
             PortEvent::Data { port, .. } => {
-                let mut frames = Vec::new();
-                let Some(&stats) = self
-                    .streams
-                    .feed(event, |_, t, d| frames.push((t, d.frame)))
-                else {
+                let mut got = Received::default();
+                let Some(&stats) = self.streams.feed(event, &mut got) else {
                     return 0;
                 };
                 let mut data = 0;
-                for (t, frame) in frames {
-                    match frame {
-                        Frame::Data(f) => {
-                            let record = Record::new(Some(t), *port as u8, &f, &self.settings);
-                            self.on_data(*port, t, record);
+                for item in got.0 {
+                    match item {
+                        Item::Record(r) => {
+                            // Every frame of a port event has its receive time.
+                            self.on_data(*port, r.t_s.unwrap_or(0.0), r);
                             data += 1;
                         }
-                        Frame::Info(info) => {
+                        Item::Info(t, info) => {
                             let esc = &mut self.escs[*port];
                             esc.info = Some(info);
-                            esc.last_frame_t = Some(t);
+                            esc.last_frame_t = t;
                         }
                     }
                 }

@@ -12,8 +12,6 @@ use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 use plotters::style::{FontStyle, register_font};
 
-use hwfoc::Settings;
-
 use crate::error::CliError;
 use hwfoc_io::sources::Sources;
 use hwfoc_io::summary::NO_FRAMES;
@@ -242,7 +240,6 @@ struct Scene<'a> {
     time: TimeAxis,
     /// Value axis of each panel column.
     ranges: [(f64, f64); 5],
-    settings: Settings,
 }
 
 impl<'a> Scene<'a> {
@@ -325,7 +322,7 @@ impl<'a> Scene<'a> {
             time.hi = time.lo + 1.0;
         }
         let settings = *collector.settings();
-        let ranges = std::array::from_fn(|p| value_range(&PANELS[p], &rows, &settings));
+        let ranges = std::array::from_fn(|p| value_range(&PANELS[p], &rows));
         let timed = rows.iter().any(|r| r.data.is_some_and(|d| d.timed));
         let untimed = rows.iter().any(|r| r.data.is_some_and(|d| !d.timed));
         let title = options.title.clone().unwrap_or_else(|| {
@@ -374,7 +371,6 @@ impl<'a> Scene<'a> {
             rows,
             time,
             ranges,
-            settings,
         })
     }
 
@@ -529,7 +525,7 @@ impl<'a> Scene<'a> {
                 2
             };
             let style = colour.stroke_width(width);
-            for path in paths(&columns, quantity, &self.settings) {
+            for path in paths(&columns, quantity) {
                 if path.len() == 1 {
                     chart.draw_series(std::iter::once(Circle::new(path[0], 2, colour.filled())))?;
                 } else {
@@ -709,13 +705,13 @@ fn number_format(range: std::ops::Range<f64>) -> impl Fn(&f64) -> String {
 }
 
 /// The value range of a panel over every row, padded.
-fn value_range(panel: &Panel, rows: &[Row], settings: &Settings) -> (f64, f64) {
+fn value_range(panel: &Panel, rows: &[Row]) -> (f64, f64) {
     let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
     for row in rows {
         let Some(data) = row.data else { continue };
         for cell in &data.buckets.cells {
             for &(q, _, _) in panel.lines {
-                if let Some([_, a, b, _]) = cell.values(q, settings) {
+                if let Some([_, a, b, _]) = cell.values(q) {
                     lo = lo.min(a);
                     hi = hi.max(b);
                 }
@@ -786,11 +782,11 @@ fn columns(data: &EscData, offset: f64, time: TimeAxis, plot_w: u32) -> Vec<(f64
 
 /// The lines of one quantity through the columns: first, lowest, highest and last value of
 /// each, broken at gaps and where the quantity has no value.
-fn paths(columns: &[(f64, Bucket)], q: Quantity, settings: &Settings) -> Vec<Vec<(f64, f64)>> {
+fn paths(columns: &[(f64, Bucket)], q: Quantity) -> Vec<Vec<(f64, f64)>> {
     let mut paths = Vec::new();
     let mut path: Vec<(f64, f64)> = Vec::new();
     for (x, b) in columns {
-        let values = b.values(q, settings);
+        let values = b.values(q);
         if (b.gap_before || values.is_none()) && !path.is_empty() {
             paths.push(std::mem::take(&mut path));
         }
@@ -890,13 +886,18 @@ mod tests {
 
     #[test]
     fn paths_break_at_gaps_and_missing_values() {
-        let settings = Settings::DEFAULT;
         let frame = |throttle: u16, mos: u8| {
-            super::super::collect::raw(&hwfoc::DataFrame {
+            let f = hwfoc::DataFrame {
                 throttle_in_raw: throttle,
                 mos_adc: mos,
                 ..Default::default()
-            })
+            };
+            super::super::collect::values(&hwfoc_io::record::Record::new(
+                None,
+                0,
+                &f,
+                &hwfoc::Settings::DEFAULT,
+            ))
         };
         let mut a = Bucket::EMPTY;
         for t in [512, 0, 1024, 512] {
@@ -908,7 +909,7 @@ mod tests {
         missing.add(&frame(512, 250), false);
         let cols = [(0.0, a), (1.0, a), (2.0, gap), (3.0, missing), (4.0, a)];
         // Throttle: broken at the gap only; its points are first, min, max, last.
-        let p = paths(&cols, Quantity::ThrottleIn, &settings);
+        let p = paths(&cols, Quantity::ThrottleIn);
         assert_eq!(p.len(), 2);
         assert_eq!(
             p[0],
@@ -925,7 +926,7 @@ mod tests {
         );
         assert_eq!(p[1][0], (2.0, 50.0));
         // Temperature: broken at the gap and where out of range.
-        let p = paths(&cols, Quantity::MosTemp, &settings);
+        let p = paths(&cols, Quantity::MosTemp);
         assert_eq!(p.len(), 3);
         assert_eq!(p[2], [(4.0, 28.0)]);
     }

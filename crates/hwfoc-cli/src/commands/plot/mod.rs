@@ -12,13 +12,14 @@ mod draw;
 mod target;
 mod text;
 
-use hwfoc::{Decoded, Settings};
+use hwfoc::{InfoFrame, Settings};
 
-use crate::args::{InputArgs, SettingsArgs};
+use crate::args::{InputArgs, SelectArgs, SettingsArgs};
 use crate::error::CliError;
+use hwfoc_io::record::Record;
+use hwfoc_io::select::Selection;
 use hwfoc_io::sources::{Handler, Sources};
 
-use crate::window::{SelectArgs, Window};
 use collect::Collector;
 use target::Target;
 
@@ -68,7 +69,7 @@ pub struct Options {
 /// `hwfoc plot`: reads the inputs and writes the image.
 pub fn run(args: &PlotArgs) -> Result<(), CliError> {
     let settings = args.settings.settings()?;
-    let window = args.select.window()?;
+    let selection = args.select.selection()?;
     // Opened first, so that a wrong name is reported before the inputs are read; a file
     // created here is removed again if the plot is not written.
     let mut target = Target::open(&args.output)?;
@@ -78,11 +79,11 @@ pub fn run(args: &PlotArgs) -> Result<(), CliError> {
         title: args.title.clone(),
         escs: args.select.esc.clone(),
     };
-    let mut sources = Sources::new(args.input.open_all()?);
-    if window.is_limited() {
+    let mut sources = Sources::new(args.input.open_all()?, settings);
+    if selection.window.is_limited() {
         sources.require_timing()?;
     }
-    let mut collector = Collector::new(settings, window, &options.escs, options.width);
+    let mut collector = Collector::new(settings, selection, options.width);
     let result = sources.run(&mut collector);
     // On an input error, what was read before it is still plotted, then the error reported.
     let written = collector.write(&sources, &options, &mut target);
@@ -106,7 +107,7 @@ impl Alongside {
             width: draw::DEFAULT_WIDTH,
             ..Options::default()
         };
-        let collector = Collector::new(settings, Window::ALL, &[], options.width);
+        let collector = Collector::new(settings, Selection::default(), options.width);
         Ok(Alongside {
             target,
             options,
@@ -125,29 +126,11 @@ impl Handler for Alongside {
     type Error = CliError;
 
     #[inline]
-    fn frame(&mut self, esc: u8, t: Option<f64>, decoded: Decoded) {
-        self.collector.frame(esc, t, decoded);
-    }
-}
-
-/// Hands every frame to two handlers: `hwfoc summary --plot` summarises and plots in one
-/// reading of the inputs.
-pub struct Both<'a, A, B>(pub &'a mut A, pub &'a mut B);
-
-impl<A: Handler, B: Handler> Handler for Both<'_, A, B>
-where
-    CliError: From<A::Error> + From<B::Error>,
-{
-    type Error = CliError;
-
-    #[inline]
-    fn frame(&mut self, esc: u8, t: Option<f64>, decoded: Decoded) {
-        self.0.frame(esc, t, decoded);
-        self.1.frame(esc, t, decoded);
+    fn record(&mut self, r: &Record) {
+        self.collector.record(r);
     }
 
-    fn end_batch(&mut self, live: bool) -> Result<(), CliError> {
-        self.0.end_batch(live)?;
-        Ok(self.1.end_batch(live)?)
+    fn info(&mut self, esc: u8, t: Option<f64>, info: &InfoFrame) {
+        self.collector.info(esc, t, info);
     }
 }

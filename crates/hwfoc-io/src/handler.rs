@@ -1,0 +1,85 @@
+//! The seam between reading telemetry and doing something with it, as `Sink` is in ripgrep.
+//!
+//! [`crate::sources::Sources::run`] (inputs read to their end) and
+//! [`crate::stream::PortStreams::feed`] (live port events) hand every frame to a [`Handler`].
+//! A front end (a command, a bridge, a binding) implements [`Handler::record`] and
+//! [`Handler::info`]: it sees records in physical units, the same whatever protocol the bytes
+//! were in, never the codec's frames. The library's own handlers (the writers, the summary)
+//! take the frames as decoded through [`Handler::frame`], to convert a block at a time on
+//! their own threads or to keep raw integers for exact means.
+
+use hwfoc::{Decoded, Frame, InfoFrame, Settings};
+
+use crate::input::InputError;
+use crate::record::Record;
+
+/// What is done with the frames of a run of inputs or of live ports.
+///
+/// Its error type carries the handler's own failures (an output that cannot be written) and
+/// the input errors met while reading, so that a front end sees one error type.
+pub trait Handler {
+    /// The handler's error: its own, or an input's (hence `From<InputError>`).
+    type Error: From<InputError>;
+
+    /// A data frame, as the record every output shows.
+    #[inline]
+    fn record(&mut self, record: &Record) {
+        let _ = record;
+    }
+
+    /// A device-information frame of ESC `esc`, with the receive time of its first byte where
+    /// the input has one.
+    #[inline]
+    fn info(&mut self, esc: u8, t: Option<f64>, info: &InfoFrame) {
+        let _ = (esc, t, info);
+    }
+
+    /// A frame of ESC `esc` as the codec decoded it, with the receive time of its first byte
+    /// where the input has one. The default converts a data frame under `settings` and hands
+    /// it to [`Handler::record`], and a device-information frame to [`Handler::info`].
+    #[inline]
+    fn frame(&mut self, esc: u8, t: Option<f64>, decoded: Decoded, settings: &Settings) {
+        match decoded.frame {
+            Frame::Data(f) => self.record(&Record::new(t, esc, &f, settings)),
+            Frame::Info(info) => self.info(esc, t, &info),
+        }
+    }
+
+    /// The end of a batch of bytes; `live` when it was small, as from a serial port (what it
+    /// produced should be passed on at once). An error stops the run.
+    fn end_batch(&mut self, live: bool) -> Result<(), Self::Error> {
+        let _ = live;
+        Ok(())
+    }
+}
+
+/// No handler: the frames are decoded (for their link statistics) and dropped.
+impl Handler for () {
+    type Error = InputError;
+
+    #[inline]
+    fn frame(&mut self, _: u8, _: Option<f64>, _: Decoded, _: &Settings) {}
+}
+
+/// Hands every frame to two handlers, each taking it its own way (as decoded, or as a record):
+/// `hwfoc summary --plot` summarises and plots in one reading of the inputs. Its error is the
+/// second handler's, which must take in the first's.
+pub struct Both<'a, A, B>(pub &'a mut A, pub &'a mut B);
+
+impl<A: Handler, B: Handler> Handler for Both<'_, A, B>
+where
+    B::Error: From<A::Error>,
+{
+    type Error = B::Error;
+
+    #[inline]
+    fn frame(&mut self, esc: u8, t: Option<f64>, decoded: Decoded, settings: &Settings) {
+        self.0.frame(esc, t, decoded, settings);
+        self.1.frame(esc, t, decoded, settings);
+    }
+
+    fn end_batch(&mut self, live: bool) -> Result<(), B::Error> {
+        self.0.end_batch(live)?;
+        self.1.end_batch(live)
+    }
+}
