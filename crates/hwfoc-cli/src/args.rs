@@ -28,6 +28,13 @@ pub struct InputArgs {
 }
 
 impl InputArgs {
+    /// Refuses an output file that is one of the inputs (see
+    /// [`hwfoc_io::write::refuse_input`]): call it before the output is opened.
+    pub fn refuse_output(&self, output: &str) -> Result<(), CliError> {
+        let inputs = self.inputs.iter().map(String::as_str);
+        Ok(hwfoc_io::write::refuse_input(output, inputs)?)
+    }
+
     /// Opens every input, in the order given: each file (or standard input) as one [`Input`],
     /// all serial ports together as one [`Input`] with a stream per port. Ports and files
     /// cannot be mixed.

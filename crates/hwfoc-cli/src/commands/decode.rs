@@ -47,6 +47,9 @@ pub struct DecodeArgs {
 pub fn run(args: &DecodeArgs) -> Result<(), CliError> {
     let settings = args.settings.settings()?;
     let selection = args.select.selection()?;
+    if let Some(output) = &args.output {
+        args.input.refuse_output(output)?;
+    }
     let mut sources = Sources::new(args.input.open_all()?, settings);
     if selection.window.is_limited() {
         sources.require_timing()?;

@@ -30,7 +30,10 @@ pub fn run(args: &SummaryArgs) -> Result<(), CliError> {
     let settings = args.settings.settings()?;
     // The plot's file is opened first: a wrong name is reported before the inputs are read.
     let mut plot = match &args.plot {
-        Some(path) => Some(plot::Alongside::open(path, settings)?),
+        Some(path) => {
+            args.input.refuse_output(path)?;
+            Some(plot::Alongside::open(path, settings)?)
+        }
         None => None,
     };
     let mut sources = Sources::new(args.input.open_all()?, settings);

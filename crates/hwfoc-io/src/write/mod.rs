@@ -24,6 +24,7 @@ mod text;
 use std::fmt;
 use std::fs::File;
 use std::io::{self, Write};
+use std::path::{Path, PathBuf};
 use std::sync::mpsc::{Receiver, SyncSender, sync_channel};
 use std::thread::JoinHandle;
 
@@ -132,6 +133,8 @@ pub struct Export {
     kept: u64,
     /// Earliest and latest `t_s` of the selected ESCs' data frames, in the window or not.
     span: Option<(f64, f64)>,
+    /// The output file while it is written under its partial name.
+    staged: Option<Staged>,
 }
 
 /// What the decoding thread prepares for the writer.
@@ -151,24 +154,66 @@ pub(crate) struct Destination {
     pub writer: Box<dyn Write + Send>,
 }
 
+/// A file written under a temporary name beside its final one, renamed into place when
+/// complete: an export cut short (killed, or the machine lost) leaves the earlier file at the
+/// path untouched, and at most the clearly named partial file.
+#[derive(Debug, Clone)]
+struct Staged {
+    partial: PathBuf,
+    path: PathBuf,
+}
+
+/// The suffix of an export's file while it is being written.
+pub const PARTIAL_SUFFIX: &str = ".partial";
+
 impl Destination {
-    fn open(path: Option<&str>) -> Result<Destination, WriteError> {
-        match path {
-            None | Some("-") => Ok(Destination {
+    /// Opens the output: standard output for `None` or `-`; a new or regular file under its
+    /// partial name (returned, to be renamed once complete); anything else (a device such as
+    /// `/dev/null`, a pipe) as it is.
+    fn open(path: Option<&str>) -> Result<(Destination, Option<Staged>), WriteError> {
+        let Some(path) = path.filter(|&p| p != "-") else {
+            let stdout = Destination {
                 name: "standard output".to_string(),
                 writer: Box::new(io::stdout()),
-            }),
-            Some(path) => {
-                let file = File::create(path).map_err(|source| WriteError::Create {
+            };
+            return Ok((stdout, None));
+        };
+        let create = |target: &Path| {
+            File::create(target).map_err(|source| WriteError::Create {
+                output: path.to_string(),
+                source,
+            })
+        };
+        let special = std::fs::metadata(path).is_ok_and(|m| !m.is_file() && !m.is_dir());
+        let (file, staged) = if special {
+            (create(Path::new(path))?, None)
+        } else {
+            if Path::new(path).is_dir() {
+                return Err(WriteError::Create {
                     output: path.to_string(),
-                    source,
-                })?;
-                Ok(Destination {
-                    name: path.to_string(),
-                    writer: Box::new(file::OutputFile::new(file)),
-                })
+                    source: io::ErrorKind::IsADirectory.into(),
+                });
             }
-        }
+            // Through a link, the file it points to is replaced, not the link.
+            let target = match std::fs::symlink_metadata(path) {
+                Ok(m) if m.file_type().is_symlink() => {
+                    std::fs::canonicalize(path).unwrap_or_else(|_| PathBuf::from(path))
+                }
+                _ => PathBuf::from(path),
+            };
+            let mut partial = target.clone().into_os_string();
+            partial.push(PARTIAL_SUFFIX);
+            let staged = Staged {
+                partial: PathBuf::from(partial),
+                path: target,
+            };
+            (create(&staged.partial)?, Some(staged))
+        };
+        let destination = Destination {
+            name: path.to_string(),
+            writer: Box::new(file::OutputFile::new(file)),
+        };
+        Ok((destination, staged))
     }
 
     /// A write error, naming the output.
@@ -187,7 +232,7 @@ impl Export {
         path: Option<&str>,
         provenance: Provenance,
     ) -> Result<Export, WriteError> {
-        let sink = Destination::open(path)?;
+        let (sink, staged) = Destination::open(path)?;
         type Work = Box<dyn FnOnce() -> Result<(), WriteError> + Send>;
         let (tx, mode, work): (SyncSender<ToWriter>, Pipeline, Work) = match format {
             OutputFormat::Jsonl | OutputFormat::Csv => {
@@ -229,6 +274,7 @@ impl Export {
             selection: Selection::default(),
             kept: 0,
             span: None,
+            staged,
         })
     }
 
@@ -318,12 +364,27 @@ impl Export {
     }
 
     /// Writes the remaining rows and ends the output: flushes text, closes a Parquet file
-    /// (adding `metadata` to its key-value metadata).
+    /// (adding `metadata` to its key-value metadata), and renames a file written under its
+    /// partial name into place. On a write error the partial file is removed.
     pub fn finish(mut self, metadata: Vec<(String, String)>) -> Result<(), WriteError> {
-        self.send(true, true)?;
-        self.post(ToWriter::End(metadata))?;
-        self.tx = None;
-        self.join()
+        let written = self
+            .send(true, true)
+            .and_then(|()| self.post(ToWriter::End(metadata)))
+            .and_then(|()| {
+                self.tx = None;
+                self.join()
+            });
+        let Some(staged) = self.staged.take() else {
+            return written;
+        };
+        if written.is_err() {
+            let _ = std::fs::remove_file(&staged.partial);
+            return written;
+        }
+        std::fs::rename(&staged.partial, &staged.path).map_err(|source| WriteError::Write {
+            output: staged.path.display().to_string(),
+            source,
+        })
     }
 
     fn join(&mut self) -> Result<(), WriteError> {
@@ -430,6 +491,52 @@ pub enum WriteError {
         /// Why.
         source: io::Error,
     },
+    /// The output is one of the inputs (the same file, by whatever path): writing it would
+    /// destroy the input.
+    IsInput {
+        /// The output as named on the command line.
+        output: String,
+        /// The input it is, as named on the command line.
+        input: String,
+    },
+}
+
+/// Refuses an output file that is one of `inputs` (the same file, by device and inode: the
+/// same path, `./` before it, a link to it), before anything is opened for writing.
+pub fn refuse_input<'a>(
+    output: &str,
+    inputs: impl IntoIterator<Item = &'a str>,
+) -> Result<(), WriteError> {
+    if output == "-" {
+        return Ok(());
+    }
+    match inputs.into_iter().find(|&input| same_file(output, input)) {
+        Some(input) => Err(WriteError::IsInput {
+            output: output.to_string(),
+            input: input.to_string(),
+        }),
+        None => Ok(()),
+    }
+}
+
+/// Whether two paths name one existing file.
+fn same_file(a: &str, b: &str) -> bool {
+    let (Ok(ma), Ok(mb)) = (std::fs::metadata(a), std::fs::metadata(b)) else {
+        return false;
+    };
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::MetadataExt;
+        ma.dev() == mb.dev() && ma.ino() == mb.ino()
+    }
+    #[cfg(not(unix))]
+    {
+        let _ = (ma, mb);
+        matches!(
+            (std::fs::canonicalize(a), std::fs::canonicalize(b)),
+            (Ok(x), Ok(y)) if x == y
+        )
+    }
 }
 
 impl WriteError {
@@ -444,6 +551,11 @@ impl fmt::Display for WriteError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
             WriteError::Write { output, source } => write!(f, "cannot write {output}: {source}"),
+            WriteError::IsInput { output, input } => write!(
+                f,
+                "cannot write {output}: it is the input {input}, which would be destroyed; \
+                 choose another output file"
+            ),
             WriteError::Create { output, source } => match source.kind() {
                 io::ErrorKind::NotFound => {
                     let dir = std::path::Path::new(output)
@@ -473,6 +585,7 @@ impl std::error::Error for WriteError {
     fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
         match self {
             WriteError::Write { source, .. } | WriteError::Create { source, .. } => Some(source),
+            WriteError::IsInput { .. } => None,
         }
     }
 }

@@ -72,6 +72,7 @@ pub fn run(args: &PlotArgs) -> Result<(), CliError> {
     let selection = args.select.selection()?;
     // Opened first, so that a wrong name is reported before the inputs are read; a file
     // created here is removed again if the plot is not written.
+    args.input.refuse_output(&args.output)?;
     let mut target = Target::open(&args.output)?;
     let options = Options {
         width: args.width,

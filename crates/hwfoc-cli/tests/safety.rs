@@ -1,0 +1,169 @@
+//! Nothing a user has is destroyed: an output that is an input is refused, an export is written
+//! under a partial name and renamed into place when complete, so that a killed export leaves the
+//! earlier file as it was.
+
+mod common;
+
+use std::io::Write;
+use std::process::Stdio;
+use std::time::{Duration, Instant};
+
+use common::{Dir, XROTOR, assert_fails_with, capture, hwfoc, ok, run, spawn};
+
+/// The bytes of the real capture, as a raw file and as a CSV file in `dir`.
+fn inputs(dir: &Dir) -> (String, String) {
+    let csv = dir.arg("cap.csv");
+    std::fs::copy(capture(XROTOR), &csv).unwrap();
+    let raw = dir.arg("cap.bin");
+    let out = ok(run(hwfoc().args([
+        "simulate",
+        "-o",
+        &raw,
+        "--duration",
+        "3",
+    ])));
+    assert!(out.status.success());
+    (csv, raw)
+}
+
+#[test]
+fn an_output_that_is_an_input_is_refused_and_the_input_kept() {
+    let dir = Dir::new();
+    let (csv, raw) = inputs(&dir);
+    let before_csv = std::fs::read(&csv).unwrap();
+    let before_raw = std::fs::read(&raw).unwrap();
+    #[cfg(unix)]
+    std::os::unix::fs::symlink(&raw, dir.path("link.bin")).unwrap();
+    let dot = format!("{}/./cap.bin", dir.0.path().display());
+    let mut cases: Vec<(Vec<String>, &str)> = vec![
+        (
+            vec!["decode".into(), csv.clone(), "-o".into(), csv.clone()],
+            &csv,
+        ),
+        (
+            vec![
+                "decode".into(),
+                "--format".into(),
+                "parquet".into(),
+                raw.clone(),
+                "-o".into(),
+                dot.clone(),
+            ],
+            &raw,
+        ),
+        (
+            vec![
+                "decode".into(),
+                "--format".into(),
+                "csv".into(),
+                csv.clone(),
+                raw.clone(),
+                "-o".into(),
+                raw.clone(),
+            ],
+            &raw,
+        ),
+        (
+            vec!["plot".into(), csv.clone(), "-o".into(), csv.clone()],
+            &csv,
+        ),
+        (
+            vec!["summary".into(), raw.clone(), "--plot".into(), raw.clone()],
+            &raw,
+        ),
+    ];
+    #[cfg(unix)]
+    cases.push((
+        vec![
+            "decode".into(),
+            raw.clone(),
+            "-o".into(),
+            dir.arg("link.bin"),
+        ],
+        &raw,
+    ));
+    for (args, input) in &cases {
+        let out = run(hwfoc().args(args));
+        assert_fails_with(
+            &out,
+            &format!("it is the input {input}, which would be destroyed"),
+        );
+        assert!(!dir.path("cap.bin.partial").exists(), "{args:?}");
+    }
+    assert_eq!(std::fs::read(&csv).unwrap(), before_csv);
+    assert_eq!(std::fs::read(&raw).unwrap(), before_raw);
+}
+
+#[test]
+fn a_finished_export_replaces_the_file_and_leaves_no_partial_file() {
+    let dir = Dir::new();
+    let (csv, _) = inputs(&dir);
+    let out = dir.arg("out.jsonl");
+    std::fs::write(&out, "an earlier export\n").unwrap();
+    ok(run(hwfoc().args(["decode", &csv, "-o", &out])));
+    let text = std::fs::read_to_string(&out).unwrap();
+    assert_eq!(text.lines().count(), 248);
+    assert!(!dir.path("out.jsonl.partial").exists());
+    // Through a link, the file it points to is replaced and the link stays.
+    #[cfg(unix)]
+    {
+        let link = dir.path("link.jsonl");
+        std::os::unix::fs::symlink(&out, &link).unwrap();
+        std::fs::write(&out, "old\n").unwrap();
+        ok(run(hwfoc().args([
+            "decode",
+            &csv,
+            "-o",
+            link.to_str().unwrap(),
+        ])));
+        assert!(
+            std::fs::symlink_metadata(&link)
+                .unwrap()
+                .file_type()
+                .is_symlink()
+        );
+        assert_eq!(std::fs::read_to_string(&out).unwrap(), text);
+    }
+    // A device is written as it is (no partial file beside /dev/null).
+    ok(run(hwfoc().args(["decode", &csv, "-o", "/dev/null"])));
+}
+
+/// An export killed part-way (here: its input still arriving on standard input) has not
+/// touched the earlier file at the path; what it wrote is in the partial file.
+#[cfg(unix)]
+#[test]
+fn a_killed_export_leaves_the_earlier_file() {
+    let dir = Dir::new();
+    let (_, raw) = inputs(&dir);
+    let bytes = std::fs::read(&raw).unwrap();
+    for format in ["parquet", "csv"] {
+        let out = dir.arg(&format!("out.{format}"));
+        std::fs::write(&out, "the earlier export").unwrap();
+        let mut child = spawn(
+            hwfoc()
+                .args(["decode", "--format", format, "-", "-o", &out])
+                .stdin(Stdio::piped()),
+        );
+        let mut stdin = child.stdin.take().unwrap();
+        stdin.write_all(&bytes).unwrap();
+        stdin.flush().unwrap();
+        let partial = dir.path(&format!("out.{format}.partial"));
+        let start = Instant::now();
+        while !partial.exists() && start.elapsed() < Duration::from_secs(30) {
+            std::thread::sleep(Duration::from_millis(20));
+        }
+        assert!(partial.exists(), "no partial file for {format}");
+        child.kill().unwrap();
+        child.wait().unwrap();
+        assert_eq!(std::fs::read_to_string(&out).unwrap(), "the earlier export");
+        drop(stdin);
+    }
+}
+
+#[test]
+fn a_directory_as_output_is_refused() {
+    let dir = Dir::new();
+    let (csv, _) = inputs(&dir);
+    let out = run(hwfoc().args(["decode", &csv, "-o", &dir.arg("")]));
+    assert_fails_with(&out, "it is a directory, not a file");
+}
