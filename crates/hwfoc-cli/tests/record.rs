@@ -539,7 +539,9 @@ fn errors_name_the_port_or_file() {
     assert!(!o.status.success());
     let e = String::from_utf8_lossy(&o.stderr);
     assert!(
-        e.starts_with("hwfoc: cannot write /nonexistent-dir/x.pcapng: No such file or directory"),
+        e.starts_with(
+            "hwfoc: cannot write /nonexistent-dir/x.pcapng: the directory /nonexistent-dir does not exist"
+        ),
         "{e}"
     );
 

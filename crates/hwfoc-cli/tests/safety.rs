@@ -167,3 +167,81 @@ fn a_directory_as_output_is_refused() {
     let out = run(hwfoc().args(["decode", &csv, "-o", &dir.arg("")]));
     assert_fails_with(&out, "it is a directory, not a file");
 }
+
+/// `hwfoc record` of a pty for `seconds`, with `extra` options; its output.
+#[cfg(unix)]
+fn record(port: &str, out: &str, extra: &[&str]) -> std::process::Output {
+    let mut args = vec!["record", port, "-o", out, "--duration", "0.3"];
+    args.extend_from_slice(extra);
+    run(hwfoc().args(&args))
+}
+
+#[cfg(unix)]
+#[test]
+fn a_recording_is_never_overwritten_unasked() {
+    let dir = Dir::new();
+    let port = common::pty();
+    let port = port.path.to_str().unwrap().to_string();
+    let out = dir.arg("rec.pcapng");
+    ok(record(&port, &out, &[]));
+    let first = std::fs::read(&out).unwrap();
+    let again = record(&port, &out, &[]);
+    assert_fails_with(&again, "a recording of that name exists");
+    assert_eq!(std::fs::read(&out).unwrap(), first);
+    std::fs::write(&out, "stale").unwrap();
+    ok(record(&port, &out, &["--overwrite"]));
+    assert!(
+        std::fs::read(&out)
+            .unwrap()
+            .starts_with(&[0x0A, 0x0D, 0x0D, 0x0A])
+    );
+
+    // A rotated series: a second run is refused while any file of the first is there; with
+    // --overwrite the earlier series goes first, so no series mixes two runs.
+    let base = dir.arg("run.pcapng");
+    ok(record(&port, &base, &["--rotate-time", "10"]));
+    assert!(dir.path("run-0001.pcapng").exists());
+    std::fs::rename(dir.path("run-0001.pcapng"), dir.path("run-0003.pcapng")).unwrap();
+    std::fs::write(dir.path("run-notes.txt"), "mine").unwrap();
+    assert_fails_with(
+        &record(&port, &base, &["--rotate-time", "10"]),
+        "run-0003.pcapng: a recording of that name exists",
+    );
+    ok(record(
+        &port,
+        &base,
+        &["--rotate-time", "10", "--overwrite"],
+    ));
+    assert!(dir.path("run-0001.pcapng").exists());
+    assert!(!dir.path("run-0003.pcapng").exists());
+    assert_eq!(
+        std::fs::read_to_string(dir.path("run-notes.txt")).unwrap(),
+        "mine"
+    );
+
+    // The monitor's --record likewise.
+    let monitor = |extra: &[&str]| {
+        let mut args = vec![
+            "monitor",
+            "--sim",
+            "1",
+            "--plain",
+            "--no-config",
+            "--duration",
+            "0.3",
+        ];
+        args.extend_from_slice(&["--record", &out]);
+        args.extend_from_slice(extra);
+        run(hwfoc().args(&args))
+    };
+    let before = std::fs::read(&out).unwrap();
+    assert_fails_with(&monitor(&[]), "a recording of that name exists");
+    assert_eq!(std::fs::read(&out).unwrap(), before);
+    std::fs::write(&out, "stale").unwrap();
+    ok(monitor(&["--overwrite"]));
+    assert!(
+        std::fs::read(&out)
+            .unwrap()
+            .starts_with(&[0x0A, 0x0D, 0x0D, 0x0A])
+    );
+}

@@ -17,7 +17,7 @@
 
 use std::fs::File;
 use std::io::BufWriter;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::sync::atomic::Ordering;
 use std::time::{Duration, Instant};
 
@@ -65,6 +65,10 @@ pub struct RecordArgs {
     /// Stop after S seconds (otherwise on Ctrl-C or SIGTERM).
     #[arg(long, value_name = "S", value_parser = parse_seconds)]
     pub duration: Option<f64>,
+    /// Replace an existing recording of that name (with rotation: remove every file of the
+    /// earlier series first). Without it, an existing recording is never touched.
+    #[arg(long)]
+    pub overwrite: bool,
 }
 
 /// A size in bytes: `1000000`, `500k`, `100M`, `2G` (powers of 1000) or `64KiB`, `1MiB`, `1GiB`.
@@ -150,6 +154,8 @@ pub struct Plan {
     pub baud: u32,
     /// Print gaps and link warnings on standard error (not under a full-screen display).
     pub warn: bool,
+    /// Replace an existing recording (and, with rotation, the earlier series' files).
+    pub overwrite: bool,
 }
 
 /// A recording being written: the file, its rotation, and what is known of each port.
@@ -188,6 +194,7 @@ pub fn run(args: &RecordArgs) -> Result<(), CliError> {
         rotate_time: args.rotate_time.map(Duration::from_secs_f64),
         baud: args.baud,
         warn: true,
+        overwrite: args.overwrite,
     };
     let mut recorder = Recorder::new(plan, set.names(), set.clock())?;
     eprintln!(
@@ -241,7 +248,23 @@ impl Recorder {
         } else {
             plan.output.clone()
         };
-        let writer = create(&first, ports, plan.baud)?;
+        if rotating {
+            // Never a series mixing two runs: the files of an earlier one are refused, or with
+            // --overwrite removed, before the first file is written.
+            let earlier = series(&plan.output);
+            match earlier.first() {
+                Some(file) if !plan.overwrite => return Err(exists(file)),
+                _ => {
+                    for file in &earlier {
+                        std::fs::remove_file(file).map_err(|source| WriteError::Write {
+                            output: file.clone(),
+                            source,
+                        })?;
+                    }
+                }
+            }
+        }
+        let writer = create(&first, ports, plan.baud, plan.overwrite)?;
         let now = Instant::now();
         Ok(Recorder {
             warn: plan.warn,
@@ -444,7 +467,8 @@ impl Recorder {
     fn next_file(&mut self) -> Result<pcapng::Writer<BufWriter<File>>, CliError> {
         let next = numbered(&self.base, self.files.len() as u32 + 1);
         let names: Vec<String> = self.ports.iter().map(|p| p.name.clone()).collect();
-        let mut writer = create(&next, &names, self.baud)?;
+        // The series' files were checked at the start: one there now is another program's.
+        let mut writer = create(&next, &names, self.baud, false)?;
         self.files.push(next);
         self.file_started = Instant::now();
         self.file_has_packets = false;
@@ -507,23 +531,88 @@ impl Recorder {
     }
 }
 
-/// Creates a recording file with its headers, one interface per port.
+/// Creates a recording file with its headers, one interface per port. An existing file is an
+/// error unless `overwrite`.
 fn create(
     path: &str,
     ports: &[String],
     baud: u32,
+    overwrite: bool,
 ) -> Result<pcapng::Writer<BufWriter<File>>, CliError> {
     let err = |source| WriteError::Write {
         output: path.to_string(),
         source,
     };
-    let file = File::create(path).map_err(err)?;
+    let file = std::fs::OpenOptions::new()
+        .write(true)
+        .create(true)
+        .truncate(true)
+        .create_new(!overwrite)
+        .open(path)
+        .map_err(|source| match source.kind() {
+            std::io::ErrorKind::AlreadyExists => exists(path),
+            _ => CliError::from(WriteError::Create {
+                output: path.to_string(),
+                source,
+            }),
+        })?;
     let mut writer = pcapng::Writer::new(BufWriter::with_capacity(BUFFER, file)).map_err(err)?;
     for port in ports {
         writer.add_interface(port, baud).map_err(err)?;
     }
     writer.flush().map_err(err)?;
     Ok(writer)
+}
+
+/// The error for a recording already at `path`.
+fn exists(path: &str) -> CliError {
+    CliError::Usage {
+        option: format!("-o {path}"),
+        message: "a recording of that name exists and is never overwritten unasked: choose \
+                  another name, or pass --overwrite"
+            .to_string(),
+    }
+}
+
+/// The existing files of the rotated series `base` (`out.pcapng`: `out-0001.pcapng`, ...), in
+/// order.
+fn series(base: &str) -> Vec<String> {
+    let first = PathBuf::from(numbered(base, 1));
+    let dir = match first.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
+        _ => PathBuf::from("."),
+    };
+    let Ok(entries) = std::fs::read_dir(&dir) else {
+        return Vec::new();
+    };
+    // A file is of the series when its name is `numbered(base, n)` for its own number n.
+    let mut files: Vec<(u32, String)> = entries
+        .filter_map(Result::ok)
+        .filter_map(|e| {
+            let name = e.file_name().to_string_lossy().into_owned();
+            let n = series_number(base, &name)?;
+            let path = numbered(base, n);
+            (Path::new(&path).file_name() == Some(e.file_name().as_os_str())).then_some((n, path))
+        })
+        .collect();
+    files.sort();
+    files.into_iter().map(|(_, path)| path).collect()
+}
+
+/// The number `n` of a file name that may be `numbered(base, n)`: the digits before the
+/// extension, after the last `-`.
+fn series_number(base: &str, name: &str) -> Option<u32> {
+    let ext = Path::new(base)
+        .extension()
+        .map(|e| e.to_string_lossy().into_owned());
+    let body = match &ext {
+        Some(ext) => name.strip_suffix(&format!(".{ext}"))?,
+        None => name,
+    };
+    let digits = body.rsplit_once('-')?.1;
+    (digits.len() >= 4 && digits.bytes().all(|b| b.is_ascii_digit()))
+        .then(|| digits.parse().ok())
+        .flatten()
 }
 
 /// Flushes and syncs a finished file.

@@ -70,6 +70,9 @@ pub struct MonitorArgs {
     /// Record everything received to FILE from the start (pcapng, as `hwfoc record` writes).
     #[arg(long, value_name = "FILE")]
     record: Option<String>,
+    /// Let --record replace an existing file of that name (never done unasked).
+    #[arg(long, requires = "record")]
+    overwrite: bool,
     /// Where the r key puts its recordings (hwfoc-DATE-TIME.pcapng) [default: .].
     #[arg(long, value_name = "DIR")]
     record_dir: Option<PathBuf>,
@@ -177,6 +180,8 @@ pub struct Session {
     names: Vec<String>,
     baud: u32,
     record_dir: PathBuf,
+    /// Whether `--record` may replace an existing file.
+    overwrite: bool,
     interrupted: Arc<AtomicBool>,
     stop_at: Option<Instant>,
 }
@@ -257,6 +262,7 @@ impl Session {
             names,
             baud: config.baud,
             record_dir: config.record_dir,
+            overwrite: args.overwrite,
             interrupted,
             stop_at: args
                 .duration
@@ -365,6 +371,7 @@ impl Session {
             rotate_time: None,
             baud: self.baud,
             warn: false,
+            overwrite: self.overwrite,
         };
         self.recorder = Some(Recorder::new(plan, &self.names, self.clock)?);
         self.notice = Some(format!("recording to {path}"));
@@ -383,7 +390,10 @@ impl Session {
             return;
         }
         let stamp = jiff::Zoned::now().strftime("%Y%m%d-%H%M%S").to_string();
-        let path = self.record_dir.join(format!("hwfoc-{stamp}.pcapng"));
+        let Some(path) = free_name(&self.record_dir, &stamp) else {
+            self.notice = Some("cannot record: no free file name".to_string());
+            return;
+        };
         let path = path.display().to_string();
         if let Err(e) = self.start_recording(path) {
             self.notice = Some(format!("cannot record: {e}"));
@@ -410,6 +420,18 @@ impl Session {
     }
 }
 
+/// A name for a recording started at `stamp` in `dir` that no file has: `hwfoc-STAMP.pcapng`,
+/// or for a second one within the same second `hwfoc-STAMP-2.pcapng`, and so on.
+fn free_name(dir: &std::path::Path, stamp: &str) -> Option<PathBuf> {
+    let name = |n: u32| match n {
+        1 => format!("hwfoc-{stamp}.pcapng"),
+        n => format!("hwfoc-{stamp}-{n}.pcapng"),
+    };
+    (1..1000)
+        .map(|n| dir.join(name(n)))
+        .find(|p| std::fs::symlink_metadata(p).is_err())
+}
+
 /// Unix time `t` (seconds) as local time, formatted with the strftime `pattern`.
 pub fn local_time(t: f64, pattern: &str) -> String {
     match jiff::Timestamp::from_nanosecond((t * 1e9) as i128) {
@@ -427,5 +449,23 @@ pub fn number(v: f32, decimals: usize) -> String {
     match text.strip_prefix('-') {
         Some(rest) if rest.bytes().all(|b| b == b'0' || b == b'.') => rest.to_string(),
         _ => text,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn recordings_started_within_a_second_get_their_own_names() {
+        let dir = tempfile::tempdir().unwrap();
+        let first = free_name(dir.path(), "20261123-140322").unwrap();
+        assert_eq!(first, dir.path().join("hwfoc-20261123-140322.pcapng"));
+        std::fs::write(&first, "a recording").unwrap();
+        let second = free_name(dir.path(), "20261123-140322").unwrap();
+        assert_eq!(second, dir.path().join("hwfoc-20261123-140322-2.pcapng"));
+        std::fs::write(&second, "another").unwrap();
+        let third = free_name(dir.path(), "20261123-140322").unwrap();
+        assert_eq!(third, dir.path().join("hwfoc-20261123-140322-3.pcapng"));
     }
 }
