@@ -1,11 +1,13 @@
 //! Several inputs read one after another, one decoding [`Stream`] per ESC.
 //!
 //! Inputs given together on the command line are read in the order given. Each stream of each
-//! input is one ESC: its `esc` index is the number of streams of the earlier inputs plus the
-//! stream's index within its input (0 for a file, the interface of a recording, the port's
-//! position in a set of serial ports).
+//! input is one ESC, numbered in the order the streams are first seen (a file has one stream,
+//! a recording one per interface, a set of serial ports one per port), with one exception:
+//! recordings name the port of each interface, and the interfaces of recordings given together
+//! that name the same port are one ESC, one continuous stream (the files of a rotated recording
+//! decode exactly as their bytes concatenated: a frame split between two files is whole).
 
-use std::ops::Range;
+use std::collections::HashMap;
 
 use hwfoc::Settings;
 
@@ -39,8 +41,10 @@ pub struct InputInfo {
     pub format: InputFormat,
     /// Bytes a logic analyser flagged with a parity or framing error.
     pub flagged_bytes: u64,
-    /// The ESC indices of its streams.
-    pub escs: Range<usize>,
+    /// Bytes read from it.
+    pub bytes: u64,
+    /// The ESC index of each of its streams, in stream order.
+    pub escs: Vec<usize>,
 }
 
 /// The inputs of a command and the ESCs found in them.
@@ -51,6 +55,8 @@ pub struct Sources {
     read: Vec<InputInfo>,
     escs: Vec<Esc>,
     need_timing: bool,
+    /// The ESC of each port named by a recording's interface so far.
+    ports: HashMap<String, usize>,
 }
 
 impl Sources {
@@ -64,6 +70,7 @@ impl Sources {
             read: Vec::new(),
             escs: Vec::new(),
             need_timing: false,
+            ports: HashMap::new(),
         }
     }
 
@@ -103,56 +110,119 @@ impl Sources {
     /// Reads every input to its end, in order, handing each frame and the end of each batch
     /// to `handler`.
     ///
-    /// On an input error, the frames of the bytes before it are still decoded (each stream of
-    /// that input is finished), and the error is returned without reading further inputs.
+    /// On an input error, the frames of the bytes before it are still decoded (every stream is
+    /// finished), and the error is returned without reading further inputs.
     pub fn run<H: Handler>(&mut self, handler: &mut H) -> Result<(), H::Error> {
         let inputs = std::mem::take(&mut self.pending);
+        let mut result = Ok(());
         for mut input in inputs {
-            let base = self.escs.len();
             let index = self.read.len();
-            let result = self.read_input(&mut input, index, handler);
+            let mut escs = Vec::new();
+            let mut bytes = 0;
+            result = self.read_input(&mut input, index, &mut escs, &mut bytes, handler);
             // Streams declared but never heard from are ESCs all the same (as far as an `esc`
             // index can number them: they have no frames).
-            let streams = input.streams().min(MAX_ESCS - base.min(MAX_ESCS));
-            while self.escs.len() < base + streams {
-                self.escs.push(Esc {
-                    input: index,
-                    name: String::new(),
-                    stream: Stream::new(),
-                });
-            }
-            for (i, esc) in self.escs.iter_mut().enumerate().skip(base) {
-                if esc.name.is_empty() {
-                    esc.name = input.stream_name(i - base);
+            for stream in 0..input.streams() {
+                if self.esc_of(&input, index, stream, &mut escs).is_err() {
+                    break;
                 }
-                // Every stream with bytes has an index below 256 (checked when first seen).
-                let id = u8::try_from(i).unwrap_or(u8::MAX);
-                esc.stream
-                    .finish(|t, d| handler.frame(id, t, d, &self.settings));
+            }
+            // A recorded port's stream may go on in the next recording: it is finished at the
+            // end of the run. Other streams end with their input.
+            if input.format() != InputFormat::Recording {
+                for &esc in escs.iter().flatten() {
+                    self.finish(esc, handler);
+                }
             }
             self.read.push(InputInfo {
                 name: input.name().to_string(),
                 format: input.format(),
                 flagged_bytes: input.flagged_bytes(),
-                escs: base..self.escs.len(),
+                bytes,
+                escs: escs.into_iter().flatten().collect(),
             });
-            result?;
-            handler.end_batch(false)?;
+            if result.is_err() {
+                break;
+            }
+            result = handler.end_batch(false);
+            if result.is_err() {
+                break;
+            }
         }
-        Ok(())
+        for esc in 0..self.escs.len() {
+            self.finish(esc, handler);
+        }
+        result?;
+        handler.end_batch(false)
+    }
+
+    /// Ends the stream of ESC `esc`: a frame cut off at the end is dropped, frames inside it
+    /// are still found. Harmless on a stream already finished.
+    fn finish<H: Handler>(&mut self, esc: usize, handler: &mut H) {
+        // Every stream has an index below 256 (checked when it was made).
+        let id = u8::try_from(esc).unwrap_or(u8::MAX);
+        let settings = &self.settings;
+        self.escs[esc]
+            .stream
+            .finish(|t, d| handler.frame(id, t, d, settings));
+    }
+
+    /// The ESC of stream `stream` of `input` (number `index`), made when first seen; `escs`
+    /// holds the ESCs of the input's streams so far.
+    fn esc_of(
+        &mut self,
+        input: &Input,
+        index: usize,
+        stream: usize,
+        escs: &mut Vec<Option<usize>>,
+    ) -> Result<usize, InputError> {
+        if let Some(&Some(esc)) = escs.get(stream) {
+            return Ok(esc);
+        }
+        let name = input.stream_name(stream);
+        let recorded = input.format() == InputFormat::Recording;
+        let earlier = self
+            .ports
+            .get(&name)
+            .copied()
+            .filter(|e| recorded && !escs.contains(&Some(*e)));
+        let esc = match earlier {
+            Some(esc) => esc,
+            None => {
+                if self.escs.len() >= MAX_ESCS {
+                    return Err(InputError::TooManyEscs {
+                        input: self.names[index].clone(),
+                    });
+                }
+                if recorded {
+                    self.ports.insert(name.clone(), self.escs.len());
+                }
+                self.escs.push(Esc {
+                    input: index,
+                    name,
+                    stream: Stream::new(),
+                });
+                self.escs.len() - 1
+            }
+        };
+        if escs.len() <= stream {
+            escs.resize(stream + 1, None);
+        }
+        escs[stream] = Some(esc);
+        Ok(esc)
     }
 
     fn read_input<H: Handler>(
         &mut self,
         input: &mut Input,
         index: usize,
+        escs: &mut Vec<Option<usize>>,
+        bytes: &mut u64,
         handler: &mut H,
     ) -> Result<(), H::Error> {
-        let base = self.escs.len();
         loop {
-            let batch = match input.next_batch()? {
-                Some(batch) => batch,
-                None => return Ok(()),
+            let Some(batch) = input.next_batch()? else {
+                return Ok(());
             };
             if self.need_timing && batch.times.is_none() {
                 return Err(InputError::NoTiming {
@@ -160,29 +230,148 @@ impl Sources {
                 }
                 .into());
             }
-            let stream = batch.stream;
-            let Ok(id) = u8::try_from(base + stream) else {
-                return Err(InputError::TooManyEscs {
-                    input: self.names[index].clone(),
-                }
-                .into());
+            let (stream, len) = (batch.stream, batch.bytes.len());
+            *bytes += len as u64;
+            // The batch borrows the input: its stream's ESC is found first, by a second look.
+            let _ = batch;
+            let esc = self.esc_of(input, index, stream, escs)?;
+            let Some(batch) = input.current_batch() else {
+                continue;
             };
-            while self.escs.len() <= base + stream {
-                self.escs.push(Esc {
-                    input: index,
-                    name: String::new(),
-                    stream: Stream::new(),
-                });
-            }
-            let live = batch.bytes.len() < LIVE_BATCH;
-            let esc = &mut self.escs[base + stream];
+            let id = u8::try_from(esc).unwrap_or(u8::MAX);
             let settings = &self.settings;
-            esc.stream
+            self.escs[esc]
+                .stream
                 .feed(batch, |t, d| handler.frame(id, t, d, settings));
-            if esc.name.is_empty() {
-                esc.name = input.stream_name(stream);
-            }
-            handler.end_batch(live)?;
+            handler.end_batch(len < LIVE_BATCH)?;
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::pcapng;
+    use crate::record::Record;
+    use hwfoc::DataFrame;
+
+    /// Collects the records, by ESC.
+    #[derive(Default)]
+    struct ByEsc(Vec<Vec<(u16, f64)>>);
+
+    impl Handler for ByEsc {
+        type Error = InputError;
+
+        fn record(&mut self, r: &Record) {
+            let esc = usize::from(r.esc);
+            if self.0.len() <= esc {
+                self.0.resize(esc + 1, Vec::new());
+            }
+            self.0[esc].push((r.packet, r.t_s.unwrap_or(f64::NAN)));
+        }
+    }
+
+    /// The bytes of data frames `packets`.
+    fn wire(packets: std::ops::Range<u16>) -> Vec<u8> {
+        packets
+            .flat_map(|packet| {
+                DataFrame {
+                    packet,
+                    ..Default::default()
+                }
+                .encode()
+            })
+            .collect()
+    }
+
+    /// A recording with one interface per `(port, bytes, first byte's time in ns)`, in the
+    /// order given; each port's bytes in packets of 7 bytes, 1 ms apart.
+    fn recording(ports: &[(&str, &[u8], u64)]) -> Vec<u8> {
+        let mut w = pcapng::Writer::new(Vec::new()).unwrap();
+        for (port, _, _) in ports {
+            w.add_interface(port, 19200).unwrap();
+        }
+        for (i, (_, bytes, t0)) in ports.iter().enumerate() {
+            for (k, piece) in bytes.chunks(7).enumerate() {
+                w.write(i as u32, t0 + k as u64 * 1_000_000, piece).unwrap();
+            }
+        }
+        w.into_inner().unwrap()
+    }
+
+    fn run(inputs: Vec<Vec<u8>>) -> (ByEsc, Sources) {
+        let inputs = inputs
+            .into_iter()
+            .enumerate()
+            .map(|(i, bytes)| Input::from_memory(&format!("rec-{i}.pcapng"), bytes).unwrap())
+            .collect();
+        let mut sources = Sources::new(inputs, Settings::DEFAULT);
+        let mut got = ByEsc::default();
+        sources.run(&mut got).unwrap();
+        (got, sources)
+    }
+
+    /// The files of a rotated recording are one stream per port: a frame split between two
+    /// files is decoded whole, the ports keep their ESC numbers whatever the order of the
+    /// interfaces in each file, and the records are those of one recording holding every byte.
+    #[test]
+    fn recordings_of_the_same_ports_continue_one_stream_each() {
+        let (a, b) = (wire(0..30), wire(100..130));
+        let t = 1_700_000_000_000_000_000u64;
+        // Cut each port's bytes in the middle of a frame, at different places.
+        let (a1, a2) = a.split_at(24 * 10 + 5);
+        let (b1, b2) = b.split_at(24 * 20 + 17);
+        let ms = 1_000_000;
+        let whole = recording(&[("/dev/ttyUSB0", &a, t), ("/dev/ttyUSB1", &b, t)]);
+        let first = recording(&[("/dev/ttyUSB0", a1, t), ("/dev/ttyUSB1", b1, t)]);
+        let a2_t = t + a1.len().div_ceil(7) as u64 * ms;
+        let b2_t = t + b1.len().div_ceil(7) as u64 * ms;
+        // The second file declares the ports in the other order.
+        let second = recording(&[("/dev/ttyUSB1", b2, b2_t), ("/dev/ttyUSB0", a2, a2_t)]);
+        let (one, _) = run(vec![whole]);
+        let (split, sources) = run(vec![first, second]);
+        assert_eq!(sources.escs().len(), 2);
+        assert_eq!(split.0[0].len(), 30);
+        assert_eq!(split.0[1].len(), 30);
+        let packets: Vec<u16> = split.0[1].iter().map(|r| r.0).collect();
+        assert_eq!(packets, (100..130).collect::<Vec<_>>());
+        // Times are those of the bytes (the split pieces were timed as in the whole file).
+        assert_eq!(split.0[0].len(), one.0[0].len());
+        assert_eq!(sources.inputs()[1].escs, [1, 0]);
+        assert_eq!(
+            sources.inputs()[0].bytes + sources.inputs()[1].bytes,
+            (a.len() + b.len()) as u64
+        );
+        for esc in &sources.escs()[..2] {
+            assert_eq!(esc.stream.stats().checksum_failures(), 0);
+            assert_eq!(esc.stream.stats().bytes_skipped(), 0);
+        }
+    }
+
+    /// Hundreds of files of one rotated recording are still one ESC per port.
+    #[test]
+    fn a_long_rotated_series_is_not_too_many_escs() {
+        let t = 1_700_000_000_000_000_000u64;
+        let files: Vec<Vec<u8>> = (0..300u16)
+            .map(|k| {
+                let bytes = wire(2 * k..2 * k + 2);
+                recording(&[("/dev/ttyACM0", &bytes, t + u64::from(k) * 1_000_000_000)])
+            })
+            .collect();
+        let (got, sources) = run(files);
+        assert_eq!(sources.escs().len(), 1);
+        assert_eq!(got.0[0].len(), 600);
+        assert_eq!(sources.escs()[0].stream.stats().lost_packets(), 0);
+    }
+
+    /// Files other than recordings are one ESC each, as before.
+    #[test]
+    fn files_without_port_names_are_one_esc_each() {
+        let raw = |p| Input::from_memory("a.bin", wire(p)).unwrap();
+        let mut sources = Sources::new(vec![raw(0..3), raw(0..3)], Settings::DEFAULT);
+        let mut got = ByEsc::default();
+        sources.run(&mut got).unwrap();
+        assert_eq!(sources.escs().len(), 2);
+        assert_eq!((got.0[0].len(), got.0[1].len()), (3, 3));
     }
 }

@@ -21,7 +21,7 @@ use serde_json::{Value, json};
 
 pub use crate::episode::{Episode, Mark};
 use crate::input::{InputError, InputFormat};
-use crate::sources::{Handler, InputInfo, Sources};
+use crate::sources::{Handler, Sources};
 
 /// What to tell a user whose input has bytes but no frame.
 pub const NO_FRAMES: &str = "no valid HW-FOC frames: check the baud rate (19200) and the wiring";
@@ -311,14 +311,6 @@ impl<'a> Report<'a> {
             .collect()
     }
 
-    /// Bytes read from an input: the sum over its streams.
-    fn input_bytes(&self, info: &InputInfo) -> u64 {
-        self.sources.escs()[info.escs.clone()]
-            .iter()
-            .map(|e| e.stream.stats().bytes())
-            .sum()
-    }
-
     /// The summary as text, as `hwfoc summary` prints it.
     pub fn text(&self) -> String {
         let mut o = String::new();
@@ -329,17 +321,21 @@ impl<'a> Report<'a> {
             self.settings.current_scale, self.settings.pole_pairs, self.settings.gear_ratio
         );
         for info in self.sources.inputs() {
-            let escs = match info.escs.len() {
-                0 => "no ESC".to_string(),
-                1 => format!("ESC {}", info.escs.start),
-                _ => format!("ESCs {} to {}", info.escs.start, info.escs.end - 1),
+            let escs = match info.escs.as_slice() {
+                [] => "no ESC".to_string(),
+                [one] => format!("ESC {one}"),
+                [first, .., last] if last - first + 1 == info.escs.len() => {
+                    format!("ESCs {first} to {last}")
+                }
+                many => {
+                    let list: Vec<String> = many.iter().map(usize::to_string).collect();
+                    format!("ESCs {}", list.join(", "))
+                }
             };
             let _ = writeln!(
                 o,
                 "input        {} ({}, {} bytes, {escs})",
-                info.name,
-                info.format,
-                self.input_bytes(info)
+                info.name, info.format, info.bytes
             );
             if info.flagged_bytes > 0 {
                 let _ = writeln!(
@@ -366,9 +362,9 @@ impl<'a> Report<'a> {
                 json!({
                     "input": info.name,
                     "format": format_name(info.format),
-                    "bytes": self.input_bytes(info),
+                    "bytes": info.bytes,
                     "flagged_bytes": info.flagged_bytes,
-                    "escs": info.escs.clone().collect::<Vec<usize>>(),
+                    "escs": info.escs,
                 })
             })
             .collect();

@@ -395,17 +395,26 @@ impl Input {
             return Ok(None);
         }
         self.seen_any = true;
+        Ok(self.current_batch())
+    }
+
+    /// The batch [`Input::next_batch`] returned last, again (`None` before the first and at
+    /// the end).
+    pub fn current_batch(&self) -> Option<Batch<'_>> {
+        if self.bytes.is_empty() || self.done {
+            return None;
+        }
         let times = match self.format {
             InputFormat::AnalyzerCsv | InputFormat::Recording | InputFormat::Serial => {
                 Some(&self.times[..])
             }
             InputFormat::Raw => None,
         };
-        Ok(Some(Batch {
+        Some(Batch {
             bytes: &self.bytes,
             times,
             stream: self.stream,
-        }))
+        })
     }
 }
 
