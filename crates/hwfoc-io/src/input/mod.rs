@@ -97,7 +97,7 @@ struct RecordingReader {
     ended: bool,
     error: Option<InputError>,
     /// Interfaces whose link type is not telemetry, already warned about.
-    skipped: Vec<u32>,
+    skipped: std::collections::HashSet<u32>,
 }
 
 /// Recording time gathered per port before its bytes are handed out (10 s: 4.8 kB of frames
@@ -117,7 +117,8 @@ struct Ports {
 struct CsvRows {
     reader: BufReader<Box<dyn Read>>,
     value_col: usize,
-    error_cols: Vec<usize>,
+    /// Whether each column is a parity or framing error flag.
+    error_cols: Vec<bool>,
     /// Number of the last line read (1-based; the header is line 1).
     line: u64,
     row: Vec<u8>,
@@ -234,7 +235,7 @@ impl Input {
                 window_start: None,
                 ended: false,
                 error: None,
-                skipped: Vec::new(),
+                skipped: Default::default(),
             }));
             return Ok(Input::new(name, InputFormat::Recording, source, Vec::new()));
         }
@@ -246,16 +247,21 @@ impl Input {
         let (format, source, pending) = if is_csv {
             let mut reader = BufReader::with_capacity(BATCH, reader);
             if head.last() != Some(&b'\n') {
-                reader.read_until(b'\n', &mut head).map_err(read_err)?;
+                read_line(&mut reader, &mut head).map_err(read_err)?;
+                if head.last() != Some(&b'\n') && head.len() > MAX_LINE {
+                    return Err(InputError::Csv {
+                        input: name.to_string(),
+                        line: 1,
+                        message: format!(
+                            "the header line is longer than {MAX_LINE} bytes: not a \
+                             logic-analyser export"
+                        ),
+                    });
+                }
             }
             let header = header_columns(&String::from_utf8_lossy(&head));
             let value_col = header.iter().position(|c| c == "value").unwrap_or(1);
-            let error_cols = header
-                .iter()
-                .enumerate()
-                .filter(|(_, c)| c.contains("error"))
-                .map(|(i, _)| i)
-                .collect();
+            let error_cols = header.iter().map(|c| c.contains("error")).collect();
             let source = Source::Csv(CsvRows {
                 reader,
                 value_col,
@@ -484,13 +490,12 @@ impl RecordingReader {
             if packet.data.is_empty() {
                 // A note only.
             } else if !interface.is_user_link_type() {
-                if !self.skipped.contains(&iface) {
+                if self.skipped.insert(iface) {
                     eprintln!(
                         "hwfoc: warning: {name}: interface {} has link type {}, not serial \
                          bytes: its packets are skipped",
                         interface.name, interface.link_type
                     );
-                    self.skipped.push(iface);
                 }
             } else {
                 let i = iface as usize;
@@ -569,12 +574,10 @@ impl CsvRows {
         let value_col = *value_col;
         while bytes.len() < CSV_BATCH_ROWS {
             row.clear();
-            let n = reader
-                .read_until(b'\n', row)
-                .map_err(|source| InputError::Read {
-                    input: name.to_string(),
-                    source,
-                })?;
+            let n = read_line(reader, row).map_err(|source| InputError::Read {
+                input: name.to_string(),
+                source,
+            })?;
             if n == 0 {
                 break;
             }
@@ -584,27 +587,40 @@ impl CsvRows {
                 line: *line,
                 message,
             };
+            if row.last() != Some(&b'\n') && row.len() > MAX_LINE {
+                return Err(bad(format!(
+                    "the line is longer than {MAX_LINE} bytes: not a logic-analyser export"
+                )));
+            }
             let text = std::str::from_utf8(row)
                 .map_err(|_| bad("not valid UTF-8 text".to_string()))?
                 .trim_end_matches(['\n', '\r']);
             if text.trim().is_empty() {
                 continue; // a blank line
             }
-            let field = |i: usize| text.split(',').nth(i).map(unquote);
-            let time = field(0)
+            // One pass over the fields, whatever their number.
+            let (mut time, mut value, mut flag) = (None, None, false);
+            for (i, field) in text.split(',').enumerate() {
+                let field = unquote(field);
+                if i == 0 {
+                    time = Some(field);
+                }
+                if i == value_col {
+                    value = Some(field);
+                }
+                flag |= !field.is_empty() && error_cols.get(i).copied().unwrap_or(false);
+            }
+            let time = time
                 .and_then(|t| t.parse::<f64>().ok())
                 .filter(|t| t.is_finite())
-                .ok_or_else(|| bad(format!("bad time {}", field_text(field(0)))))?;
-            let value = field(value_col).and_then(parse_byte).ok_or_else(|| {
+                .ok_or_else(|| bad(format!("bad time {}", field_text(time))))?;
+            let value = value.and_then(parse_byte).ok_or_else(|| {
                 bad(format!(
                     "bad byte value {} (expected 0x00..0xFF or 0..255)",
-                    field_text(field(value_col))
+                    field_text(value)
                 ))
             })?;
-            if error_cols
-                .iter()
-                .any(|&c| field(c).is_some_and(|f| !f.is_empty()))
-            {
+            if flag {
                 *flagged += 1;
             }
             bytes.push(value);
@@ -662,12 +678,29 @@ fn parse_byte(text: &str) -> Option<u8> {
     }
 }
 
-/// A CSV field quoted for an error message.
+/// A CSV field quoted for an error message, cut after [`QUOTED`] characters.
 fn field_text(field: Option<&str>) -> String {
     match field {
         None => "(missing)".to_string(),
+        Some(f) if f.chars().count() > QUOTED => {
+            let cut: String = f.chars().take(QUOTED).collect();
+            format!("{cut:?}... ({} bytes)", f.len())
+        }
         Some(f) => format!("{f:?}"),
     }
+}
+
+/// Characters of a field quoted in an error message, at most.
+const QUOTED: usize = 40;
+
+/// Longest line of a logic-analyser CSV (a real one is under 100 bytes): a longer one is an
+/// error rather than memory for whatever the file holds.
+const MAX_LINE: usize = 64 << 10;
+
+/// Reads a line into `row` (which is empty), newline included, but no more than
+/// [`MAX_LINE`] + 1 bytes: a longer line is left cut, without its newline.
+fn read_line(reader: &mut impl BufRead, row: &mut Vec<u8>) -> io::Result<usize> {
+    reader.take(MAX_LINE as u64 + 1).read_until(b'\n', row)
 }
 
 /// Why an input could not be read. Each names the input as the user gave it.
@@ -951,5 +984,92 @@ mod tests {
         assert_eq!(got, [0x9B, 0x16, 0x01]);
         assert!((times[0] - sent).abs() < 0.5, "{times:?} vs {sent}");
         assert!(times.windows(2).all(|w| w[1] > w[0]));
+    }
+
+    /// The first error of reading `input` to its end.
+    fn first_error(mut input: Input) -> InputError {
+        loop {
+            match input.next_batch() {
+                Ok(Some(_)) => {}
+                Ok(None) => panic!("no error"),
+                Err(e) => break e,
+            }
+        }
+    }
+
+    #[test]
+    fn an_endless_line_is_an_error_not_memory_and_messages_quote_little() {
+        let mut csv = b"Time [s],Value\n0.5,0x9B\n".to_vec();
+        csv.extend(std::iter::repeat_n(b'7', 10 << 20));
+        let e = first_error(Input::from_memory("big.csv", csv).unwrap());
+        assert_eq!(
+            e.to_string(),
+            "big.csv:3: the line is longer than 65536 bytes: not a logic-analyser export"
+        );
+        let mut csv = b"Time [s],Value\n0.5,".to_vec();
+        csv.extend(std::iter::repeat_n(b'x', 5000));
+        csv.push(b'\n');
+        let e = first_error(Input::from_memory("long.csv", csv).unwrap()).to_string();
+        assert!(e.starts_with("long.csv:2: bad byte value \"xxxx"), "{e}");
+        assert!(
+            e.ends_with("\"... (5000 bytes) (expected 0x00..0xFF or 0..255)"),
+            "{e}"
+        );
+        assert!(e.len() < 150, "{e}");
+        let mut header = b"Time [s],Value,".to_vec();
+        header.extend(std::iter::repeat_n(b'x', 200 << 10));
+        let e = Input::from_memory("h.csv", header).err().unwrap();
+        assert!(
+            e.to_string()
+                .starts_with("h.csv:1: the header line is longer"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn thousands_of_error_columns_are_read_in_one_pass() {
+        let columns = 4000;
+        let mut csv = "Time [s],Value".to_string();
+        for i in 0..columns {
+            csv.push_str(&format!(",Error {i}"));
+        }
+        csv.push('\n');
+        for row in 0..50 {
+            csv.push_str(&format!("{}.0,0x{:02X}", row, row));
+            for i in 0..columns {
+                // Row 7 has a flag in its last column only.
+                csv.push_str(if row == 7 && i == columns - 1 {
+                    ",x"
+                } else {
+                    ","
+                });
+            }
+            csv.push('\n');
+        }
+        let mut input = Input::from_memory("wide.csv", csv.into_bytes()).unwrap();
+        let (bytes, times) = read_all(&mut input);
+        assert_eq!(bytes, (0..50u8).collect::<Vec<_>>());
+        assert_eq!(times.unwrap()[49], 49.0);
+        assert_eq!(input.flagged_bytes(), 1);
+    }
+
+    /// A recording of 50 000 interface blocks for the same two ports, as concatenated
+    /// sections give: the ports are found once each. (Interfaces are looked up by port, so
+    /// that any number of interface blocks is read in linear time.)
+    #[test]
+    fn many_interface_blocks_name_few_ports() {
+        let mut file = Vec::new();
+        for section in 0..25_000u64 {
+            let mut w = pcapng::Writer::new(Vec::new()).unwrap();
+            w.add_interface("/dev/ttyUSB0", 19200).unwrap();
+            w.add_interface("/dev/ttyUSB1", 19200).unwrap();
+            w.write(1, 1_700_000_000_000_000_000 + section, &[0x55])
+                .unwrap();
+            file.extend(w.into_inner().unwrap());
+        }
+        let mut input = Input::from_memory("many.pcapng", file).unwrap();
+        let (bytes, _) = read_all(&mut input);
+        assert_eq!(bytes.len(), 25_000);
+        assert_eq!(input.streams(), 2);
     }
 }
