@@ -112,3 +112,51 @@ impl VirtualFleet {
         Ok(())
     }
 }
+
+#[cfg(test)]
+pub(crate) mod tests {
+    use super::*;
+    use crate::model::tests::config;
+
+    /// `n` ESCs with the command line's model, a short steps profile, no faults.
+    pub(crate) fn spec(n: usize) -> FleetSpec {
+        FleetSpec {
+            n,
+            seed: 1,
+            baud: 19200,
+            start_packet: None,
+            profile: ProfileSpec::Steps,
+            shape: Shape {
+                lead_in_s: 0.5,
+                levels: vec![0.0, 50.0],
+                hold_s: 1.0,
+                period_s: 10.0,
+                max_pct: 80.0,
+            },
+            model: config(),
+            faults: Vec::new(),
+            link: LinkRates::default(),
+        }
+    }
+
+    #[test]
+    fn building_checks_the_esc_numbers() {
+        let mut s = spec(2);
+        s.faults = vec!["2:mos_short@1".parse().unwrap()];
+        assert_eq!(
+            s.build().unwrap_err().to_string(),
+            "--fault: ESC 2 does not exist: there are 2 (0..1)"
+        );
+        assert!(matches!(
+            spec(MAX_ESCS + 1).build(),
+            Err(SimError::TooManyEscs { n: 257 })
+        ));
+        let fleet = spec(3).build().unwrap();
+        assert_eq!(fleet.profile().natural_length_s(), 2.5);
+        let escs = fleet.escs();
+        assert_eq!(
+            escs.iter().map(VirtualEsc::index).collect::<Vec<_>>(),
+            [0, 1, 2]
+        );
+    }
+}

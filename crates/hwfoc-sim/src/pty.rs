@@ -271,6 +271,29 @@ mod tests {
     }
 
     #[test]
+    fn link_paths() {
+        let paths = |links: PtyLinks, n| links.paths(n).map_err(|e| e.to_string());
+        assert_eq!(paths(PtyLinks::default(), 3), Ok(Vec::new()));
+        assert_eq!(
+            paths(PtyLinks::Paths(vec!["/x/e{esc}".into()]), 2),
+            Ok(vec![PathBuf::from("/x/e0"), PathBuf::from("/x/e1")])
+        );
+        assert_eq!(
+            paths(PtyLinks::Paths(vec!["/x/a".into()]), 1),
+            Ok(vec![PathBuf::from("/x/a")])
+        );
+        assert_eq!(
+            paths(PtyLinks::Paths(vec!["a".into(), "b".into()]), 3),
+            Err("--link: 2 links for 3 ESCs: give one per ESC, or one with {esc} in it".into())
+        );
+        let dir = tempfile::tempdir().unwrap();
+        let sub = dir.path().join("escs");
+        let made = paths(PtyLinks::Dir(sub.display().to_string()), 2).unwrap();
+        assert_eq!(made, [sub.join("esc0"), sub.join("esc1")]);
+        assert!(sub.is_dir());
+    }
+
+    #[test]
     fn links_replace_stale_ones_and_go_away() {
         let dir = tempfile::tempdir().unwrap();
         let link = dir.path().join("esc0");

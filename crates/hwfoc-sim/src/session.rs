@@ -170,3 +170,66 @@ impl Session {
             .collect())
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::fleet::tests::spec;
+
+    #[test]
+    fn a_recording_is_the_same_every_time_and_its_truth_matches_the_report() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = |name: &str| dir.path().join(name).display().to_string();
+        let run = |name: &str| {
+            let plan = Plan {
+                outlet: Outlet::File {
+                    path: path(name),
+                    format: FileFormat::for_path(name),
+                },
+                realtime: false,
+                start_s: Some(1.7e9),
+                duration_s: None,
+                truth: Some(path(&format!("{name}.jsonl"))),
+                settings: Settings::default(),
+            };
+            let session = Session::open(spec(2).build().unwrap(), &plan).unwrap();
+            assert_eq!(session.outputs(), [path(name), path(name)]);
+            let reports = session.run(&AtomicBool::new(false)).unwrap();
+            let truth = std::fs::read_to_string(path(&format!("{name}.jsonl"))).unwrap();
+            (std::fs::read(path(name)).unwrap(), reports, truth)
+        };
+        let (a, reports, truth) = run("a.pcapng");
+        let (b, again, _) = run("b.pcapng");
+        assert_eq!(a, b);
+        let tallies = |r: &[EscReport]| -> Vec<(String, Tally)> {
+            r.iter().map(|r| (r.id.clone(), r.tally.clone())).collect()
+        };
+        assert_eq!(tallies(&reports), tallies(&again));
+        let intact: u64 = reports.iter().map(|r| r.tally.intact).sum();
+        assert_eq!(truth.lines().count() as u64, intact);
+        // The profile's 2.5 s and 2 s more: idle, then running at 50 %.
+        assert!(reports.iter().all(|r| (40..90).contains(&r.tally.data)));
+        let first: serde_json::Value = serde_json::from_str(truth.lines().next().unwrap()).unwrap();
+        assert!((1.7e9..1.7e9 + 0.05).contains(&first["t_s"].as_f64().unwrap()));
+    }
+
+    #[test]
+    fn raw_bytes_of_several_escs_need_a_file_each() {
+        let dir = tempfile::tempdir().unwrap();
+        let plan = Plan {
+            outlet: Outlet::File {
+                path: dir.path().join("x.bin").display().to_string(),
+                format: FileFormat::Raw,
+            },
+            realtime: false,
+            start_s: None,
+            duration_s: Some(1.0),
+            truth: None,
+            settings: Settings::default(),
+        };
+        let e = Session::open(spec(2).build().unwrap(), &plan)
+            .err()
+            .unwrap();
+        assert!(matches!(e, SimError::SharedRaw { n: 2 }), "{e}");
+    }
+}
