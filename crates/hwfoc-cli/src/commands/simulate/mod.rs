@@ -8,6 +8,7 @@
 use std::io::{IsTerminal, Write};
 
 use clap::ValueEnum;
+use hwfoc::Settings;
 
 use crate::args::SettingsArgs;
 use crate::error::CliError;
@@ -218,7 +219,7 @@ impl ModelArgs {
 
     /// The `n` virtual ESCs these arguments describe, at `baud`, their currents and RPM scaled
     /// by `settings`.
-    pub fn spec(&self, n: usize, baud: u32, settings: &hwfoc::Settings) -> FleetSpec {
+    pub fn spec(&self, n: usize, baud: u32, settings: &Settings) -> FleetSpec {
         FleetSpec {
             n,
             seed: self.seed,
@@ -258,7 +259,7 @@ impl ModelArgs {
         &self,
         n: usize,
         baud: u32,
-        settings: &hwfoc::Settings,
+        settings: &Settings,
     ) -> Result<VirtualFleet, CliError> {
         Ok(self.spec(n, baud, settings).build()?)
     }
@@ -321,6 +322,24 @@ fn usage(option: &str, message: impl Into<String>) -> CliError {
 /// Runs `hwfoc simulate`.
 pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
     let settings = args.settings.settings()?;
+    let n = count_escs(args)?;
+    let plan = plan(args, n, settings)?;
+    let fleet = args.model.fleet(n, args.baud, &settings)?;
+    let session = Session::open(fleet, &plan)?;
+    if args.pty {
+        announce(session.outputs())?;
+    }
+    let reports = session.run(&hwfoc_io::stop::interrupted())?;
+    if !args.quiet {
+        for (esc, r) in reports.iter().enumerate() {
+            eprintln!("{}", report(esc, r));
+        }
+    }
+    Ok(())
+}
+
+/// How many ESCs: `--escs`, or one per `--port`.
+fn count_escs(args: &SimulateArgs) -> Result<usize, CliError> {
     let n = match (args.escs, args.port.len()) {
         (Some(n), 0) => usize::from(n),
         (None, 0) => 1,
@@ -336,6 +355,11 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
     if n > MAX_ESCS {
         return Err(usage("--port", format!("at most {MAX_ESCS} ESCs")));
     }
+    Ok(n)
+}
+
+/// The run the options describe for `n` ESCs, refusing options that do not go together.
+fn plan(args: &SimulateArgs, n: usize, settings: Settings) -> Result<Plan, CliError> {
     if (args.pty || !args.port.is_empty()) && args.format.is_some() {
         return Err(usage(
             "--format",
@@ -407,19 +431,7 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
         }
         _ => {}
     }
-
-    let fleet = args.model.fleet(n, args.baud, &settings)?;
-    let session = Session::open(fleet, &plan)?;
-    if args.pty {
-        announce(session.outputs())?;
-    }
-    let reports = session.run(&hwfoc_io::stop::interrupted())?;
-    if !args.quiet {
-        for (esc, r) in reports.iter().enumerate() {
-            eprintln!("{}", report(esc, r));
-        }
-    }
-    Ok(())
+    Ok(plan)
 }
 
 /// Prints `esc N: PATH` for each pseudo-terminal.
