@@ -1,8 +1,8 @@
 //! The command's errors: each one names what went wrong and where, in one line.
 //!
-//! The library's errors (inputs, ports, outputs) are wrapped as they are, so their messages are
-//! the library's; the variants of its own are the command line's: options, configuration files,
-//! the terminal, pseudo-terminals, plots.
+//! The libraries' errors (inputs, ports, outputs, the simulator) are wrapped as they are, so their
+//! messages are the libraries'; the variants of its own are the command line's: options,
+//! configuration files, the terminal, plots.
 
 use std::fmt;
 use std::io;
@@ -11,6 +11,7 @@ use hwfoc_io::InputError;
 use hwfoc_io::select::EmptyWindow;
 use hwfoc_io::serial::PortError;
 use hwfoc_io::write::{ExportError, WriteError};
+use hwfoc_sim::SimError;
 
 /// Everything that makes a command fail. Printed once, by `main`, as `hwfoc: <message>`.
 #[derive(Debug)]
@@ -21,6 +22,8 @@ pub enum CliError {
     Port(PortError),
     /// An output could not be created or written.
     Write(WriteError),
+    /// The virtual ESCs could not be set up or run (`hwfoc simulate`, `hwfoc monitor --sim`).
+    Sim(SimError),
     /// `--from` is not before `--to`.
     Window(EmptyWindow),
     /// A conversion setting is out of range.
@@ -50,27 +53,6 @@ pub enum CliError {
     },
     /// The terminal could not be set up or drawn on.
     Terminal {
-        /// Why.
-        source: io::Error,
-    },
-    /// A row of a throttle profile CSV could not be read.
-    Profile {
-        /// The file as named on the command line.
-        file: String,
-        /// 1-based line number, or 0 for the file as a whole.
-        line: u64,
-        /// What is wrong with it.
-        message: String,
-    },
-    /// A pseudo-terminal could not be created.
-    Pty {
-        /// Why.
-        source: io::Error,
-    },
-    /// A symlink to a pseudo-terminal could not be made.
-    Link {
-        /// The link's path.
-        path: String,
         /// Why.
         source: io::Error,
     },
@@ -126,12 +108,25 @@ impl From<WriteError> for CliError {
     }
 }
 
+/// Output and port errors of the simulator are the command's own kinds, as those of inputs are
+/// (so that a reader of standard output going away is not reported, whoever wrote to it).
+impl From<SimError> for CliError {
+    fn from(e: SimError) -> Self {
+        match e {
+            SimError::Write(e) => CliError::Write(e),
+            SimError::Port(e) => CliError::Port(e),
+            e => CliError::Sim(e),
+        }
+    }
+}
+
 impl fmt::Display for CliError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
             CliError::Input(e) => e.fmt(f),
             CliError::Port(e) => e.fmt(f),
             CliError::Write(e) => e.fmt(f),
+            CliError::Sim(e) => e.fmt(f),
             CliError::Window(e) => e.fmt(f),
             CliError::Settings(e) => write!(f, "invalid setting: {e}"),
             CliError::MixedInputs { port, file } => write!(
@@ -151,18 +146,6 @@ impl fmt::Display for CliError {
                 message,
             } => write!(f, "{path}: {message}"),
             CliError::Terminal { source } => write!(f, "terminal: {source}"),
-            CliError::Profile {
-                file,
-                line: 0,
-                message,
-            } => write!(f, "{file}: {message}"),
-            CliError::Profile {
-                file,
-                line,
-                message,
-            } => write!(f, "{file}:{line}: {message}"),
-            CliError::Pty { source } => write!(f, "cannot create a pseudo-terminal: {source}"),
-            CliError::Link { path, source } => write!(f, "cannot create the link {path}: {source}"),
             CliError::NothingToPlot { message } => write!(f, "nothing to plot: {message}"),
             CliError::Render { output, message } => write!(f, "cannot draw {output}: {message}"),
         }
@@ -175,10 +158,9 @@ impl std::error::Error for CliError {
             CliError::Input(e) => Some(e),
             CliError::Port(e) => Some(e),
             CliError::Write(e) => Some(e),
+            CliError::Sim(e) => Some(e),
             CliError::Window(e) => Some(e),
-            CliError::Pty { source }
-            | CliError::Terminal { source }
-            | CliError::Link { source, .. } => Some(source),
+            CliError::Terminal { source } => Some(source),
             CliError::Settings(e) => Some(e),
             _ => None,
         }

@@ -11,10 +11,11 @@ use std::thread::{self, JoinHandle};
 
 use hwfoc::Settings;
 
-use crate::commands::simulate::sink::Sink;
-use crate::commands::simulate::{ModelArgs, VirtualFleet};
+use crate::commands::simulate::ModelArgs;
 use crate::error::CliError;
 use hwfoc_io::serial::{PortEvent, Readers};
+use hwfoc_io::write::WriteError;
+use hwfoc_sim::{Sink, VirtualFleet};
 
 /// What the monitor's loop receives.
 #[derive(Debug)]
@@ -77,7 +78,7 @@ impl Feed {
                 if let Err(e) = fleet.run_live(&mut sink, &flag)
                     && !flag.load(Ordering::Relaxed)
                 {
-                    let _ = tx.send(Msg::Failed(e));
+                    let _ = tx.send(Msg::Failed(e.into()));
                 }
             })
             .map_err(|e| CliError::Usage {
@@ -97,7 +98,7 @@ struct ChannelSink {
 }
 
 impl Sink for ChannelSink {
-    fn write(&mut self, esc: usize, t_ns: u64, bytes: &[u8]) -> Result<bool, CliError> {
+    fn write(&mut self, esc: usize, t_ns: u64, bytes: &[u8]) -> Result<bool, WriteError> {
         let event = PortEvent::Data {
             port: esc,
             t_ns,
@@ -107,7 +108,7 @@ impl Sink for ChannelSink {
         Ok(self.tx.send(Msg::Port(event)).is_ok())
     }
 
-    fn flush(&mut self) -> Result<(), CliError> {
+    fn flush(&mut self) -> Result<(), WriteError> {
         Ok(())
     }
 }

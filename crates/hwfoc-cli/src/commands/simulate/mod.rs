@@ -1,63 +1,43 @@
 //! `hwfoc simulate`: virtual HW-FOC ESCs that speak the protocol as real ones do.
 //!
-//! Each ESC runs a small physical model ([`model`]) driven by a throttle profile ([`profile`]),
-//! sends its frames on the real schedule ([`esc`]) through a link that can misbehave
-//! ([`faults`]), into pseudo-terminals, serial ports, files or standard output ([`sink`],
-//! [`pty`]), paced in real time or as fast as possible ([`schedule`]). Every random choice comes
-//! from `--seed` ([`rng`]): the same seed and options give the same bytes.
-//!
-//! The ground truth (`--truth FILE`) has one record per data frame delivered intact, `t_s` being
-//! the time its first byte started on the wire, in the clock of the output:
-//! - real-time outputs (pseudo-terminals, serial ports, `--realtime`): Unix time;
-//! - a pcapng recording: the recording's own timestamps, which start at `--start-time` (Unix
-//!   seconds; default now), so that decoding the recording gives exactly the truth's `t_s`;
-//! - raw bytes (a file or standard output): raw bytes carry no time, so decoding them gives a
-//!   null `t_s`; the truth still has the simulated time, seconds from the start of the run plus
-//!   `--start-time` (default 0).
+//! The simulator is the `hwfoc_sim` library; this command turns its options into the library's
+//! description of a run (a [`FleetSpec`] and a [`Plan`]), refuses options that do not go
+//! together, announces the pseudo-terminals and reports on each ESC at the end. The ground
+//! truth's clock is described in [`hwfoc_sim::session`].
 
-mod esc;
-mod faults;
-mod model;
-mod profile;
-#[cfg(unix)]
-mod pty;
-mod rng;
-mod schedule;
-pub mod sink;
-
-use std::io::IsTerminal;
-use std::rc::Rc;
-use std::sync::atomic::AtomicBool;
-use std::time::Instant;
+use std::io::{IsTerminal, Write};
 
 use clap::ValueEnum;
+use hwfoc::Settings;
 
-use self::esc::{Setup, VirtualEsc};
-use self::faults::{FaultSchedule, FaultSpec, LinkRates};
-use self::profile::{Profile, ProfileSpec, Shape};
-use self::schedule::{Pace, SimClock, Tally};
-use self::sink::{PcapngSink, PortSink, RawSink, Sink, Truth};
 use crate::args::SettingsArgs;
 use crate::error::CliError;
-use hwfoc_io::clock::unix_now_ns;
 use hwfoc_io::write::WriteError;
-
-/// Extra seconds after one run of the profile, for file outputs without `--duration`: the
-/// motor stops and the idle frames and device information show.
-const TAIL_S: f64 = 2.0;
-/// How long the ptys stay open after the last write.
-const PTY_LINGER: std::time::Duration = std::time::Duration::from_millis(300);
-/// Outlet duration of one piece written to a pseudo-terminal, seconds.
-const PIECE_S: f64 = 0.004;
+use hwfoc_sim::faults::{FaultSpec, LinkRates};
+use hwfoc_sim::fleet::MAX_ESCS;
+use hwfoc_sim::model::ModelConfig;
+use hwfoc_sim::profile::{ProfileSpec, Shape};
+#[cfg(unix)]
+use hwfoc_sim::pty::PtyLinks;
+use hwfoc_sim::{EscReport, FileFormat, FleetSpec, Outlet, Plan, Session, VirtualFleet};
 
 /// File formats of `-o`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
-pub enum FileFormat {
+pub enum Format {
     /// The bytes as they were on the wire.
     Raw,
     /// A pcapng recording (one interface per ESC, nanosecond timestamps), as `hwfoc record`
     /// writes.
     Pcapng,
+}
+
+impl From<Format> for FileFormat {
+    fn from(format: Format) -> FileFormat {
+        match format {
+            Format::Raw => FileFormat::Raw,
+            Format::Pcapng => FileFormat::Pcapng,
+        }
+    }
 }
 
 const EXAMPLES: &str = "\
@@ -118,7 +98,7 @@ pub struct SimulateArgs {
     output: Option<String>,
     /// File format. Default: pcapng for a name ending in .pcapng, raw otherwise.
     #[arg(long, value_enum, help_heading = "Output")]
-    format: Option<FileFormat>,
+    format: Option<Format>,
     /// Write the file or standard output at the real rate instead of as fast as possible.
     #[arg(long, help_heading = "Output")]
     realtime: bool,
@@ -238,37 +218,22 @@ impl ModelArgs {
     }
 
     /// The `n` virtual ESCs these arguments describe, at `baud`, their currents and RPM scaled
-    /// by `settings`: checked (fault ESC numbers, the profile file) but not started.
-    pub fn fleet(
-        &self,
-        n: usize,
-        baud: u32,
-        settings: &hwfoc::Settings,
-    ) -> Result<VirtualFleet, CliError> {
-        if let Some(bad) = self.faults.iter().find(|f| f.esc.is_some_and(|e| e >= n)) {
-            return Err(usage(
-                "--fault",
-                format!(
-                    "ESC {} does not exist: there are {n} (0..{})",
-                    bad.esc.unwrap_or(0),
-                    n - 1
-                ),
-            ));
-        }
-        let shape = Shape {
-            lead_in_s: self.lead_in,
-            levels: self.levels.clone(),
-            hold_s: self.hold,
-            period_s: self.period,
-            max_pct: self.max_throttle,
-        };
-        Ok(VirtualFleet {
+    /// by `settings`.
+    pub fn spec(&self, n: usize, baud: u32, settings: &Settings) -> FleetSpec {
+        FleetSpec {
             n,
             seed: self.seed,
             baud,
             start_packet: self.start_packet,
-            profile: Profile::load(&self.profile, &shape)?,
-            config: model::ModelConfig {
+            profile: self.profile.clone(),
+            shape: Shape {
+                lead_in_s: self.lead_in,
+                levels: self.levels.clone(),
+                hold_s: self.hold,
+                period_s: self.period,
+                max_pct: self.max_throttle,
+            },
+            model: ModelConfig {
                 kv: self.kv,
                 pole_pairs: settings.pole_pairs,
                 full_current_a: self.full_current,
@@ -285,51 +250,18 @@ impl ModelArgs {
                 cut: self.cut_rate,
                 garbage: self.garbage_rate,
             },
-        })
-    }
-}
-
-/// Virtual ESCs described and checked, not yet started; it can be moved to another thread.
-#[derive(Debug)]
-pub struct VirtualFleet {
-    n: usize,
-    seed: u64,
-    baud: u32,
-    start_packet: Option<u16>,
-    profile: Profile,
-    config: model::ModelConfig,
-    faults: Vec<FaultSpec>,
-    link: LinkRates,
-}
-
-impl VirtualFleet {
-    /// The ESCs, at rest at time zero.
-    fn escs(self) -> Vec<VirtualEsc> {
-        let profile = Rc::new(self.profile);
-        (0..self.n)
-            .map(|index| {
-                VirtualEsc::new(Setup {
-                    index,
-                    seed: self.seed,
-                    baud: self.baud,
-                    start_packet: self.start_packet,
-                    model: self.config,
-                    profile: Rc::clone(&profile),
-                    faults: FaultSchedule::for_esc(&self.faults, index),
-                    link: self.link,
-                })
-            })
-            .collect()
+        }
     }
 
-    /// Runs the ESCs in real time from now until `stop` is set, each burst handed whole to
-    /// `sink` when its first byte is due (Unix time in ns), as a UART's reader would get it.
-    pub fn run_live(self, sink: &mut dyn Sink, stop: &AtomicBool) -> Result<(), CliError> {
-        let clock = SimClock {
-            origin_ns: unix_now_ns(),
-            real: Some(Instant::now()),
-        };
-        schedule::run(self.escs(), sink, None, Pace::Whole, clock, None, stop).map(|_| ())
+    /// The fleet of [`ModelArgs::spec`], checked (fault ESC numbers, the profile file) but not
+    /// started.
+    pub fn fleet(
+        &self,
+        n: usize,
+        baud: u32,
+        settings: &Settings,
+    ) -> Result<VirtualFleet, CliError> {
+        Ok(self.spec(n, baud, settings).build()?)
     }
 }
 
@@ -380,14 +312,6 @@ fn ambient(s: &str) -> Result<f64, String> {
     Ok(v)
 }
 
-/// Where the bytes go.
-enum Outlet {
-    Stdout,
-    File(String),
-    Pty,
-    Ports,
-}
-
 fn usage(option: &str, message: impl Into<String>) -> CliError {
     CliError::Usage {
         option: option.to_string(),
@@ -398,6 +322,24 @@ fn usage(option: &str, message: impl Into<String>) -> CliError {
 /// Runs `hwfoc simulate`.
 pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
     let settings = args.settings.settings()?;
+    let n = count_escs(args)?;
+    let plan = plan(args, n, settings)?;
+    let fleet = args.model.fleet(n, args.baud, &settings)?;
+    let session = Session::open(fleet, &plan)?;
+    if args.pty {
+        announce(session.outputs())?;
+    }
+    let reports = session.run(&hwfoc_io::stop::interrupted())?;
+    if !args.quiet {
+        for (esc, r) in reports.iter().enumerate() {
+            eprintln!("{}", report(esc, r));
+        }
+    }
+    Ok(())
+}
+
+/// How many ESCs: `--escs`, or one per `--port`.
+fn count_escs(args: &SimulateArgs) -> Result<usize, CliError> {
     let n = match (args.escs, args.port.len()) {
         (Some(n), 0) => usize::from(n),
         (None, 0) => 1,
@@ -410,53 +352,75 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
             ));
         }
     };
-    if n > 256 {
-        return Err(usage("--port", "at most 256 ESCs"));
+    if n > MAX_ESCS {
+        return Err(usage("--port", format!("at most {MAX_ESCS} ESCs")));
     }
-    let target = if args.pty {
-        Outlet::Pty
+    Ok(n)
+}
+
+/// The run the options describe for `n` ESCs, refusing options that do not go together.
+fn plan(args: &SimulateArgs, n: usize, settings: Settings) -> Result<Plan, CliError> {
+    if (args.pty || !args.port.is_empty()) && args.format.is_some() {
+        return Err(usage(
+            "--format",
+            "only for -o FILE or standard output: ptys and ports carry raw bytes",
+        ));
+    }
+    let outlet = if args.pty {
+        #[cfg(unix)]
+        {
+            Outlet::Ptys(match &args.link_dir {
+                Some(dir) => PtyLinks::Dir(dir.clone()),
+                None => PtyLinks::Paths(args.link.clone()),
+            })
+        }
+        #[cfg(not(unix))]
+        return Err(usage("--pty", "pseudo-terminals need a Unix system"));
     } else if !args.port.is_empty() {
-        Outlet::Ports
+        Outlet::Ports(args.port.clone())
     } else {
+        let format = args.format.map(FileFormat::from);
         match args.output.as_deref() {
-            None | Some("-") => Outlet::Stdout,
-            Some(path) => Outlet::File(path.to_string()),
+            None | Some("-") => Outlet::Stdout(format.unwrap_or(FileFormat::Raw)),
+            Some(path) => Outlet::File {
+                path: path.to_string(),
+                format: format.unwrap_or_else(|| FileFormat::for_path(path)),
+            },
         }
     };
-    let format = match (&target, args.format) {
-        (Outlet::Pty | Outlet::Ports, Some(_)) => {
-            return Err(usage(
-                "--format",
-                "only for -o FILE or standard output: ptys and ports carry raw bytes",
-            ));
-        }
-        (_, Some(format)) => format,
-        (Outlet::File(path), None) if path.ends_with(".pcapng") => FileFormat::Pcapng,
-        _ => FileFormat::Raw,
+    let plan = Plan {
+        outlet,
+        realtime: args.realtime,
+        start_s: args.start_time,
+        duration_s: args.duration,
+        truth: args.truth.clone(),
+        settings,
     };
-    let realtime = args.realtime || matches!(target, Outlet::Pty | Outlet::Ports);
-    if realtime && args.start_time.is_some() {
+    if plan.is_realtime() && args.start_time.is_some() {
         return Err(usage(
             "--start-time",
             "real-time outputs use the time now; --start-time is for files written at once",
         ));
     }
-    match &target {
-        Outlet::Stdout if format == FileFormat::Raw && n > 1 => {
+    match &plan.outlet {
+        Outlet::Stdout(FileFormat::Raw) if n > 1 => {
             return Err(usage(
                 "--escs",
                 "raw bytes on standard output can carry only one ESC: use --format pcapng, \
                  or -o FILE with {esc} in the name",
             ));
         }
-        Outlet::Stdout if std::io::stdout().is_terminal() => {
+        Outlet::Stdout(_) if std::io::stdout().is_terminal() => {
             return Err(usage(
                 "-o",
                 "not writing binary telemetry to a terminal: give -o FILE or --pty, or pipe \
                  the output (e.g. into `hwfoc decode -`)",
             ));
         }
-        Outlet::File(path) if format == FileFormat::Raw && n > 1 && !path.contains("{esc}") => {
+        Outlet::File {
+            path,
+            format: FileFormat::Raw,
+        } if n > 1 && !path.contains("{esc}") => {
             return Err(usage(
                 "-o",
                 format!(
@@ -467,172 +431,29 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
         }
         _ => {}
     }
-
-    let fleet = args.model.fleet(n, args.baud, &settings)?;
-    let duration_s = match args.duration {
-        Some(d) => Some(d),
-        None if realtime => None,
-        None => Some(fleet.profile.natural_length_s() + TAIL_S),
-    };
-    let escs = fleet.escs();
-
-    // The truth file is opened before the outputs, so that a path that cannot be written is
-    // reported before any pseudo-terminal is announced.
-    let mut truth = match &args.truth {
-        Some(path) => {
-            let (name, out) = sink::create(path)?;
-            Some(Truth::new(name, out, settings))
-        }
-        None => None,
-    };
-    let start_ns = args.start_time.map(|s| (s * 1e9).round() as u64);
-    let origin_ns = match (realtime, format) {
-        (true, _) => unix_now_ns(),
-        (false, FileFormat::Pcapng) => start_ns.unwrap_or_else(unix_now_ns),
-        (false, FileFormat::Raw) => start_ns.unwrap_or(0),
-    };
-    let pieces = Pace::Pieces((PIECE_S * f64::from(args.baud) / 10.0).round().max(1.0) as usize);
-
-    #[cfg(unix)]
-    let mut _links = pty::Links::default();
-    let (mut out, pace, names): (Box<dyn Sink>, Pace, Vec<String>) = match &target {
-        Outlet::Pty => {
-            #[cfg(unix)]
-            {
-                let (sink, names) = open_ptys(args, n, &mut _links)?;
-                (Box::new(sink), pieces, names)
-            }
-            #[cfg(not(unix))]
-            return Err(usage("--pty", "pseudo-terminals need a Unix system"));
-        }
-        Outlet::Ports => (
-            Box::new(PortSink::open(&args.port, args.baud)?),
-            Pace::Whole,
-            args.port.clone(),
-        ),
-        Outlet::Stdout | Outlet::File(_) => {
-            let (paths, file_of): (Vec<String>, Vec<usize>) = match &target {
-                Outlet::File(path) if path.contains("{esc}") => (
-                    (0..n).map(|i| sink::expand(path, i)).collect(),
-                    (0..n).collect(),
-                ),
-                Outlet::File(path) => (vec![path.clone()], vec![0; n]),
-                _ => (vec!["-".to_string()], vec![0; n]),
-            };
-            let mut outs = Vec::with_capacity(paths.len());
-            for path in &paths {
-                outs.push(sink::create(path)?);
-            }
-            let names = file_of.iter().map(|&f| outs[f].0.clone()).collect();
-            let sink: Box<dyn Sink> = match format {
-                FileFormat::Raw => Box::new(RawSink::new(outs)),
-                FileFormat::Pcapng => Box::new(PcapngSink::new(outs, &file_of, args.baud)?),
-            };
-            let pace = match (&target, realtime) {
-                (_, false) => Pace::Fast,
-                (Outlet::Stdout, true) => pieces,
-                (_, true) => Pace::Whole,
-            };
-            (sink, pace, names)
-        }
-    };
-
-    let infos: Vec<hwfoc::InfoFrame> = escs.iter().map(|e| *e.info()).collect();
-    let stop: std::sync::Arc<AtomicBool> = hwfoc_io::stop::interrupted();
-    let clock = SimClock {
-        origin_ns,
-        real: realtime.then(Instant::now),
-    };
-    let duration_ns = duration_s.map(|s| (s * 1e9).round() as u64);
-    let tallies = schedule::run(
-        escs,
-        out.as_mut(),
-        truth.as_mut(),
-        pace,
-        clock,
-        duration_ns,
-        &stop,
-    )?;
-    if matches!(target, Outlet::Pty) {
-        // Closing a pty's master hangs up the reader and discards what it has not read yet:
-        // give readers a moment to take the last frames, which the truth lists as delivered.
-        std::thread::sleep(PTY_LINGER);
-    }
-    if !args.quiet {
-        for (esc, tally) in tallies.iter().enumerate() {
-            let id = infos[esc].id();
-            eprintln!(
-                "{}",
-                report(esc, &names[esc], id, tally, out.undelivered(esc))
-            );
-        }
-    }
-    Ok(())
+    Ok(plan)
 }
 
-/// Creates a pty per ESC, prints their paths and makes the links asked for.
-#[cfg(unix)]
-fn open_ptys(
-    args: &SimulateArgs,
-    n: usize,
-    links: &mut pty::Links,
-) -> Result<(sink::PtySink, Vec<String>), CliError> {
-    use std::io::Write;
-    use std::path::PathBuf;
-
-    let link_paths: Vec<PathBuf> = match (&args.link_dir, args.link.as_slice()) {
-        (Some(dir), _) => {
-            std::fs::create_dir_all(dir).map_err(|source| CliError::Link {
-                path: dir.clone(),
-                source,
-            })?;
-            (0..n)
-                .map(|i| PathBuf::from(dir).join(format!("esc{i}")))
-                .collect()
-        }
-        (None, []) => Vec::new(),
-        (None, [one]) if n == 1 || one.contains("{esc}") => (0..n)
-            .map(|i| PathBuf::from(sink::expand(one, i)))
-            .collect(),
-        (None, many) if many.len() == n => many.iter().map(PathBuf::from).collect(),
-        (None, many) => {
-            return Err(usage(
-                "--link",
-                format!(
-                    "{} links for {n} ESCs: give one per ESC, or one with {{esc}} in it",
-                    many.len()
-                ),
-            ));
-        }
-    };
-    let mut ptys = Vec::with_capacity(n);
-    for _ in 0..n {
-        ptys.push(pty::Pty::open()?);
-    }
-    for (link, p) in link_paths.iter().zip(&ptys) {
-        links.add(link, p.path())?;
-    }
-    let names: Vec<String> = ptys
-        .iter()
-        .map(|p| p.path().display().to_string())
-        .collect();
+/// Prints `esc N: PATH` for each pseudo-terminal.
+fn announce(paths: &[String]) -> Result<(), CliError> {
     let mut stdout = std::io::stdout().lock();
-    for (i, name) in names.iter().enumerate() {
-        writeln!(stdout, "esc {i}: {name}")
+    for (i, path) in paths.iter().enumerate() {
+        writeln!(stdout, "esc {i}: {path}")
             .and_then(|()| stdout.flush())
             .map_err(|source| WriteError::Write {
                 output: "standard output".to_string(),
                 source,
             })?;
     }
-    Ok((sink::PtySink::new(ptys), names))
+    Ok(())
 }
 
 /// The end-of-run line for one ESC.
-fn report(esc: usize, name: &str, id: &str, t: &Tally, undelivered_bytes: u64) -> String {
+fn report(esc: usize, r: &EscReport) -> String {
+    let t = &r.tally;
     let mut line = format!(
-        "esc {esc} ({name}, id {id}): {} data frames, {} intact",
-        t.data, t.intact
+        "esc {esc} ({}, id {}): {} data frames, {} intact",
+        r.output, r.id, t.data, t.intact
     );
     for (count, what) in [
         (t.dropped, "dropped"),
@@ -650,10 +471,10 @@ fn report(esc: usize, name: &str, id: &str, t: &Tally, undelivered_bytes: u64) -
     if t.glitches > 0 {
         line.push_str(&format!("; {} glitches", t.glitches));
     }
-    if undelivered_bytes > 0 {
+    if r.undelivered_bytes > 0 {
         line.push_str(&format!(
-            "; {undelivered_bytes} bytes ({} intact data frames) not delivered: no reader",
-            t.undelivered
+            "; {} bytes ({} intact data frames) not delivered: no reader",
+            r.undelivered_bytes, t.undelivered
         ));
     }
     line

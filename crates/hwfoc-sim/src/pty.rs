@@ -24,9 +24,11 @@ use nix::poll::{PollFd, PollFlags, PollTimeout, poll};
 use nix::pty::openpty;
 use nix::sys::termios::{SetArg, cfmakeraw, tcgetattr, tcsetattr};
 
-use crate::error::CliError;
+use crate::error::SimError;
+use crate::sink::expand;
 
 /// One pseudo-terminal: our master side and the path of the slave.
+#[derive(Debug)]
 pub struct Pty {
     master: File,
     path: PathBuf,
@@ -35,8 +37,8 @@ pub struct Pty {
 
 impl Pty {
     /// Creates a pty in raw mode.
-    pub fn open() -> Result<Pty, CliError> {
-        let err = |e: nix::Error| CliError::Pty {
+    pub fn open() -> Result<Pty, SimError> {
+        let err = |e: nix::Error| SimError::Pty {
             source: io::Error::from(e),
         };
         let pair = openpty(None, None).map_err(err)?;
@@ -101,9 +103,71 @@ impl Pty {
     }
 }
 
+/// Where the symlinks to a run's pseudo-terminals go.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum PtyLinks {
+    /// `DIR/esc0`, `DIR/esc1`, ... (the directory is created if need be).
+    Dir(String),
+    /// One path per ESC, or one with `{esc}` in it (just one path for a single ESC); none for
+    /// no links.
+    Paths(Vec<String>),
+}
+
+impl Default for PtyLinks {
+    fn default() -> Self {
+        PtyLinks::Paths(Vec::new())
+    }
+}
+
+impl PtyLinks {
+    /// The link of each of `n` ESCs (none at all, or one each), creating the directory of
+    /// [`PtyLinks::Dir`].
+    pub fn paths(&self, n: usize) -> Result<Vec<PathBuf>, SimError> {
+        Ok(match self {
+            PtyLinks::Dir(dir) => {
+                std::fs::create_dir_all(dir).map_err(|source| SimError::Link {
+                    path: dir.clone(),
+                    source,
+                })?;
+                (0..n)
+                    .map(|i| PathBuf::from(dir).join(format!("esc{i}")))
+                    .collect()
+            }
+            PtyLinks::Paths(paths) => match paths.as_slice() {
+                [] => Vec::new(),
+                [one] if n == 1 || one.contains("{esc}") => {
+                    (0..n).map(|i| PathBuf::from(expand(one, i))).collect()
+                }
+                many if many.len() == n => many.iter().map(PathBuf::from).collect(),
+                many => {
+                    return Err(SimError::LinkCount {
+                        links: many.len(),
+                        n,
+                    });
+                }
+            },
+        })
+    }
+}
+
+/// Creates a pty per ESC, `n` in all, and the links to them that `links` asks for (kept while
+/// the returned [`Links`] lives).
+pub fn open_all(n: usize, links: &PtyLinks) -> Result<(Vec<Pty>, Links), SimError> {
+    let paths = links.paths(n)?;
+    let mut ptys = Vec::with_capacity(n);
+    for _ in 0..n {
+        ptys.push(Pty::open()?);
+    }
+    let mut made = Links::default();
+    for (link, pty) in paths.iter().zip(&ptys) {
+        made.add(link, pty.path())?;
+    }
+    Ok((ptys, made))
+}
+
 /// Symlinks to the ptys at stable paths, removed again when dropped (also on an error or
 /// Ctrl-C) if they still point at our pty.
-#[derive(Default)]
+#[derive(Debug, Default)]
 pub struct Links {
     made: Vec<(PathBuf, PathBuf)>,
 }
@@ -111,8 +175,8 @@ pub struct Links {
 impl Links {
     /// Makes `link` point at `target`. A symlink already there (left by an earlier run that was
     /// killed) is replaced; anything else is an error.
-    pub fn add(&mut self, link: &Path, target: &Path) -> Result<(), CliError> {
-        let err = |source: io::Error| CliError::Link {
+    pub fn add(&mut self, link: &Path, target: &Path) -> Result<(), SimError> {
+        let err = |source: io::Error| SimError::Link {
             path: link.display().to_string(),
             source,
         };
@@ -204,6 +268,29 @@ mod tests {
             pty.write(&[0x55; 24]);
         }
         assert!(pty.undelivered() > before);
+    }
+
+    #[test]
+    fn link_paths() {
+        let paths = |links: PtyLinks, n| links.paths(n).map_err(|e| e.to_string());
+        assert_eq!(paths(PtyLinks::default(), 3), Ok(Vec::new()));
+        assert_eq!(
+            paths(PtyLinks::Paths(vec!["/x/e{esc}".into()]), 2),
+            Ok(vec![PathBuf::from("/x/e0"), PathBuf::from("/x/e1")])
+        );
+        assert_eq!(
+            paths(PtyLinks::Paths(vec!["/x/a".into()]), 1),
+            Ok(vec![PathBuf::from("/x/a")])
+        );
+        assert_eq!(
+            paths(PtyLinks::Paths(vec!["a".into(), "b".into()]), 3),
+            Err("--link: 2 links for 3 ESCs: give one per ESC, or one with {esc} in it".into())
+        );
+        let dir = tempfile::tempdir().unwrap();
+        let sub = dir.path().join("escs");
+        let made = paths(PtyLinks::Dir(sub.display().to_string()), 2).unwrap();
+        assert_eq!(made, [sub.join("esc0"), sub.join("esc1")]);
+        assert!(sub.is_dir());
     }
 
     #[test]

@@ -5,10 +5,11 @@ use std::str::FromStr;
 
 use hwfoc::{Fault, Status};
 
-use super::rng::Rng;
+use crate::rng::Rng;
 
-/// One `--fault [ESC:]NAME@START[-END]`: a status bit set from START (inclusive) to END
-/// (exclusive; to the end of the run without END), on one ESC or on all of them.
+/// One fault, written `[ESC:]NAME@START[-END]` (`hwfoc simulate --fault`): a status bit set
+/// from START (inclusive) to END (exclusive; to the end of the run without END), on one ESC or
+/// on all of them.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct FaultSpec {
     /// The ESC index, or `None` for every ESC.
@@ -217,8 +218,8 @@ fn geometric(rng: &mut Rng, p: f64) -> Option<u64> {
 
 #[cfg(test)]
 mod tests {
-    use super::super::rng::Purpose;
     use super::*;
+    use crate::rng::Purpose;
 
     #[test]
     fn fault_specs() {

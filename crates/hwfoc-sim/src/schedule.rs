@@ -2,17 +2,17 @@
 //! rate, and keeping count of what went out.
 //!
 //! One loop serves every ESC: it always handles the earliest pending write over all of them and,
-//! in real time, sleeps until it is due (sleeping in slices of at most 100 ms to notice Ctrl-C;
-//! no busy waiting). Buffered output and the ground truth are flushed whenever the loop is about
-//! to sleep, so a reader sees each frame as soon as it is written.
+//! in real time, sleeps until it is due (sleeping in slices of at most 100 ms to notice a stop
+//! request; no busy waiting). Buffered output and the ground truth are flushed whenever the loop
+//! is about to sleep, so a reader sees each frame as soon as it is written.
 
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 
-use super::esc::{Burst, VirtualEsc, What};
-use super::faults::Fate;
-use super::sink::{Sink, Truth};
-use crate::error::CliError;
+use crate::esc::{Burst, VirtualEsc, What};
+use crate::faults::Fate;
+use crate::sink::{Sink, Truth};
+use hwfoc_io::write::WriteError;
 
 /// Longest single sleep, so that a stop request is seen promptly.
 const SLEEP_SLICE: Duration = Duration::from_millis(100);
@@ -128,7 +128,7 @@ pub fn run(
     clock: SimClock,
     duration_ns: Option<u64>,
     stop: &AtomicBool,
-) -> Result<Vec<Tally>, CliError> {
+) -> Result<Vec<Tally>, WriteError> {
     let byte_ns = escs.first().map_or(1.0, VirtualEsc::byte_ns);
     let mut lanes: Vec<Lane> = escs
         .into_iter()
@@ -222,11 +222,11 @@ pub fn run(
 
 #[cfg(test)]
 mod tests {
-    use super::super::esc::VirtualEsc;
-    use super::super::esc::tests::{decode, setup};
-    use super::super::faults::LinkRates;
-    use super::super::profile::Profile;
     use super::*;
+    use crate::esc::VirtualEsc;
+    use crate::esc::tests::{decode, setup};
+    use crate::faults::LinkRates;
+    use crate::profile::Profile;
     use hwfoc::Settings;
 
     /// Keeps every write with the time it was made.
@@ -236,13 +236,13 @@ mod tests {
     }
 
     impl Sink for Memory {
-        fn write(&mut self, esc: usize, t_ns: u64, bytes: &[u8]) -> Result<bool, CliError> {
+        fn write(&mut self, esc: usize, t_ns: u64, bytes: &[u8]) -> Result<bool, WriteError> {
             let at = self.start.elapsed();
             self.writes.push((esc, t_ns, bytes.to_vec(), at));
             Ok(true)
         }
 
-        fn flush(&mut self) -> Result<(), CliError> {
+        fn flush(&mut self) -> Result<(), WriteError> {
             Ok(())
         }
     }

@@ -25,7 +25,7 @@
 use hwfoc::units::ADC_TABLE;
 use hwfoc::{DataFrame, Fault, Status};
 
-use super::rng::Rng;
+use crate::rng::Rng;
 
 /// Loaded RPM at full throttle as a fraction of `kv * volts` (the propeller's load).
 const LOADED: f64 = 0.85;
@@ -401,8 +401,8 @@ pub fn adc_code(celsius: f64) -> u8 {
 
 #[cfg(test)]
 pub(crate) mod tests {
-    use super::super::rng::Purpose;
     use super::*;
+    use crate::rng::Purpose;
     use hwfoc::{Settings, Temperature};
 
     /// The command line's defaults.

@@ -5,7 +5,6 @@ use std::io::{self, BufWriter, Write};
 
 use hwfoc::{DataFrame, Settings};
 
-use crate::error::CliError;
 use hwfoc_io::pcapng;
 use hwfoc_io::record::Record;
 use hwfoc_io::serial::PortError;
@@ -15,9 +14,9 @@ use hwfoc_io::write::WriteError;
 pub trait Sink {
     /// Writes bytes of ESC `esc`; `t_ns` is the time the first of them started on the wire, in
     /// the output's clock (ns). Returns whether they were all delivered.
-    fn write(&mut self, esc: usize, t_ns: u64, bytes: &[u8]) -> Result<bool, CliError>;
+    fn write(&mut self, esc: usize, t_ns: u64, bytes: &[u8]) -> Result<bool, WriteError>;
     /// Hands buffered bytes to the operating system.
-    fn flush(&mut self) -> Result<(), CliError>;
+    fn flush(&mut self) -> Result<(), WriteError>;
     /// Bytes of ESC `esc` that could not be delivered (no reader on a pseudo-terminal).
     fn undelivered(&self, _esc: usize) -> u64 {
         0
@@ -25,7 +24,7 @@ pub trait Sink {
 }
 
 /// Opens `path` for writing (or standard output for `-`), with errors naming it.
-pub fn create(path: &str) -> Result<(String, Box<dyn Write>), CliError> {
+pub fn create(path: &str) -> Result<(String, Box<dyn Write>), WriteError> {
     if path == "-" {
         return Ok(("standard output".to_string(), Box::new(io::stdout())));
     }
@@ -41,13 +40,10 @@ pub fn expand(template: &str, esc: usize) -> String {
     template.replace("{esc}", &esc.to_string())
 }
 
-fn write_error(name: &str) -> impl FnOnce(io::Error) -> CliError + '_ {
-    move |source| {
-        WriteError::Write {
-            output: name.to_string(),
-            source,
-        }
-        .into()
+fn write_error(name: &str) -> impl FnOnce(io::Error) -> WriteError + '_ {
+    move |source| WriteError::Write {
+        output: name.to_string(),
+        source,
     }
 }
 
@@ -69,13 +65,13 @@ impl RawSink {
 }
 
 impl Sink for RawSink {
-    fn write(&mut self, esc: usize, _t_ns: u64, bytes: &[u8]) -> Result<bool, CliError> {
+    fn write(&mut self, esc: usize, _t_ns: u64, bytes: &[u8]) -> Result<bool, WriteError> {
         let (name, out) = &mut self.outs[esc];
         out.write_all(bytes).map_err(write_error(name))?;
         Ok(true)
     }
 
-    fn flush(&mut self) -> Result<(), CliError> {
+    fn flush(&mut self) -> Result<(), WriteError> {
         for (name, out) in &mut self.outs {
             out.flush().map_err(write_error(name))?;
         }
@@ -102,7 +98,7 @@ impl PcapngSink {
         outs: Vec<(String, Box<dyn Write>)>,
         file_of: &[usize],
         baud: u32,
-    ) -> Result<PcapngSink, CliError> {
+    ) -> Result<PcapngSink, WriteError> {
         let mut files = Vec::with_capacity(outs.len());
         for (name, w) in outs {
             let writer = pcapng::Writer::new(BufWriter::with_capacity(1 << 16, w))
@@ -122,7 +118,7 @@ impl PcapngSink {
 }
 
 impl Sink for PcapngSink {
-    fn write(&mut self, esc: usize, t_ns: u64, bytes: &[u8]) -> Result<bool, CliError> {
+    fn write(&mut self, esc: usize, t_ns: u64, bytes: &[u8]) -> Result<bool, WriteError> {
         let (file, iface) = self.route[esc];
         let (name, writer) = &mut self.files[file];
         writer
@@ -131,7 +127,7 @@ impl Sink for PcapngSink {
         Ok(true)
     }
 
-    fn flush(&mut self) -> Result<(), CliError> {
+    fn flush(&mut self) -> Result<(), WriteError> {
         for (name, writer) in &mut self.files {
             writer.flush().map_err(write_error(name))?;
         }
@@ -148,7 +144,7 @@ pub struct PortSink {
 
 impl PortSink {
     /// Opens each port at `baud`, 8N1.
-    pub fn open(names: &[String], baud: u32) -> Result<PortSink, CliError> {
+    pub fn open(names: &[String], baud: u32) -> Result<PortSink, PortError> {
         let mut ports = Vec::with_capacity(names.len());
         for name in names {
             let mut port = hwfoc_io::serial::open(name, baud)?;
@@ -168,7 +164,7 @@ impl PortSink {
 }
 
 impl Sink for PortSink {
-    fn write(&mut self, esc: usize, _t_ns: u64, bytes: &[u8]) -> Result<bool, CliError> {
+    fn write(&mut self, esc: usize, _t_ns: u64, bytes: &[u8]) -> Result<bool, WriteError> {
         let (name, port) = &mut self.ports[esc];
         match port.write_all(bytes) {
             Ok(()) => Ok(true),
@@ -179,12 +175,11 @@ impl Sink for PortSink {
             Err(source) => Err(WriteError::Write {
                 output: name.clone(),
                 source,
-            }
-            .into()),
+            }),
         }
     }
 
-    fn flush(&mut self) -> Result<(), CliError> {
+    fn flush(&mut self) -> Result<(), WriteError> {
         Ok(())
     }
 
@@ -196,24 +191,24 @@ impl Sink for PortSink {
 /// Pseudo-terminals, one per ESC.
 #[cfg(unix)]
 pub struct PtySink {
-    ptys: Vec<super::pty::Pty>,
+    ptys: Vec<crate::pty::Pty>,
 }
 
 #[cfg(unix)]
 impl PtySink {
     /// Over created ptys, the `i`-th for ESC `i`.
-    pub fn new(ptys: Vec<super::pty::Pty>) -> PtySink {
+    pub fn new(ptys: Vec<crate::pty::Pty>) -> PtySink {
         PtySink { ptys }
     }
 }
 
 #[cfg(unix)]
 impl Sink for PtySink {
-    fn write(&mut self, esc: usize, _t_ns: u64, bytes: &[u8]) -> Result<bool, CliError> {
+    fn write(&mut self, esc: usize, _t_ns: u64, bytes: &[u8]) -> Result<bool, WriteError> {
         Ok(self.ptys[esc].write(bytes))
     }
 
-    fn flush(&mut self) -> Result<(), CliError> {
+    fn flush(&mut self) -> Result<(), WriteError> {
         Ok(())
     }
 
@@ -242,9 +237,9 @@ impl Truth {
     }
 
     /// Records `frame` of ESC `esc`, whose first byte started at `t_s`.
-    pub fn record(&mut self, t_s: f64, esc: usize, frame: &DataFrame) -> Result<(), CliError> {
+    pub fn record(&mut self, t_s: f64, esc: usize, frame: &DataFrame) -> Result<(), WriteError> {
         self.line.clear();
-        // ESC indices are below 256 (checked with the options).
+        // ESC indices are below 256 (checked when the fleet is built).
         Record::new(Some(t_s), esc as u8, frame, &self.settings).write_json(&mut self.line);
         self.out
             .write_all(&self.line)
@@ -252,7 +247,7 @@ impl Truth {
     }
 
     /// Hands buffered records to the operating system.
-    pub fn flush(&mut self) -> Result<(), CliError> {
+    pub fn flush(&mut self) -> Result<(), WriteError> {
         self.out.flush().map_err(write_error(&self.name))
     }
 }

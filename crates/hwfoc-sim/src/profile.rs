@@ -13,10 +13,9 @@
 use std::fmt;
 use std::str::FromStr;
 
-use crate::error::CliError;
-use hwfoc_io::InputError;
+use crate::error::SimError;
 
-/// A profile as named on the command line, before any file is read.
+/// A profile as named (`steps`, `ramp`, `sine`, `csv:FILE`), before any file is read.
 #[derive(Debug, Clone, PartialEq)]
 pub enum ProfileSpec {
     /// Hold each level for a while.
@@ -109,7 +108,7 @@ pub enum Profile {
 
 impl Profile {
     /// The profile `spec` with parameters `shape`, reading a CSV file if named.
-    pub fn load(spec: &ProfileSpec, shape: &Shape) -> Result<Profile, CliError> {
+    pub fn load(spec: &ProfileSpec, shape: &Shape) -> Result<Profile, SimError> {
         let Shape {
             lead_in_s,
             hold_s,
@@ -134,8 +133,8 @@ impl Profile {
                 max_pct,
             },
             ProfileSpec::Csv(path) => {
-                let text = std::fs::read(path).map_err(|source| InputError::Open {
-                    input: path.clone(),
+                let text = std::fs::read(path).map_err(|source| SimError::ProfileRead {
+                    file: path.clone(),
                     source,
                 })?;
                 Profile::Points(parse_csv(path, &text)?)
@@ -219,8 +218,8 @@ fn interpolate(points: &[(f64, f64)], t: f64) -> f64 {
 
 /// Reads CSV rows `time_s,throttle_percent`. A first line that is not two numbers is a header;
 /// blank lines and lines starting with `#` are skipped.
-pub fn parse_csv(name: &str, text: &[u8]) -> Result<Vec<(f64, f64)>, CliError> {
-    let bad = |line: u64, message: String| CliError::Profile {
+pub fn parse_csv(name: &str, text: &[u8]) -> Result<Vec<(f64, f64)>, SimError> {
+    let bad = |line: u64, message: String| SimError::Profile {
         file: name.to_string(),
         line,
         message,
@@ -284,7 +283,7 @@ pub fn parse_csv(name: &str, text: &[u8]) -> Result<Vec<(f64, f64)>, CliError> {
         points.push((time, pct));
     }
     if points.is_empty() {
-        return Err(CliError::Profile {
+        return Err(SimError::Profile {
             file: name.to_string(),
             line: 0,
             message: "no rows: expected lines of time_s,throttle_percent".to_string(),

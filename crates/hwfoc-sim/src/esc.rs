@@ -23,10 +23,10 @@ use std::rc::Rc;
 
 use hwfoc::{DataFrame, Decoder, Fault, Frame, InfoFrame};
 
-use super::faults::{Fate, FaultSchedule, LineFaults, LinkRates};
-use super::model::{Model, ModelConfig};
-use super::profile::Profile;
-use super::rng::{Purpose, Rng};
+use crate::faults::{Fate, FaultSchedule, LineFaults, LinkRates};
+use crate::model::{Model, ModelConfig};
+use crate::profile::Profile;
+use crate::rng::{Purpose, Rng};
 
 /// Data frame interval while the motor turns, ns.
 pub const RUN_INTERVAL_NS: u64 = 50_000_000;
@@ -339,8 +339,8 @@ fn seconds(t_ns: u64) -> f64 {
 
 #[cfg(test)]
 pub(crate) mod tests {
-    use super::super::model::tests::config;
     use super::*;
+    use crate::model::tests::config;
     use hwfoc::Status;
 
     /// ESC 0 with the default model, seed 42, starting at packet 65530.

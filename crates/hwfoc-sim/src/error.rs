@@ -1,0 +1,141 @@
+//! The simulator's errors: each one names what went wrong and where, in one line.
+//!
+//! Outputs and serial ports fail with the I/O library's own errors, wrapped as they are; the
+//! rest are the simulator's: a throttle profile that cannot be read, a fault or a link for an
+//! ESC that does not exist, a pseudo-terminal or a link to one that cannot be made. Where a
+//! mistake is in how the simulation was described, the message names the `hwfoc simulate`
+//! option that describes it (`--fault`, `--link`), as every front end so far spells them.
+
+use std::fmt;
+use std::io;
+
+use hwfoc_io::serial::PortError;
+use hwfoc_io::write::WriteError;
+
+/// Everything that makes a simulation fail to start or stop early.
+#[derive(Debug)]
+pub enum SimError {
+    /// An output (a file, standard output, the ground truth) could not be created or written.
+    Write(WriteError),
+    /// A serial port could not be opened or set up.
+    Port(PortError),
+    /// A throttle profile CSV file could not be read.
+    ProfileRead {
+        /// The file as named.
+        file: String,
+        /// Why.
+        source: io::Error,
+    },
+    /// A row of a throttle profile CSV could not be read.
+    Profile {
+        /// The file as named.
+        file: String,
+        /// 1-based line number, or 0 for the file as a whole.
+        line: u64,
+        /// What is wrong with it.
+        message: String,
+    },
+    /// More ESCs than a fleet can have ([`MAX_ESCS`](crate::fleet::MAX_ESCS)).
+    TooManyEscs {
+        /// How many were asked for.
+        n: usize,
+    },
+    /// A fault was scheduled on an ESC the fleet does not have.
+    NoSuchEsc {
+        /// The ESC named.
+        esc: usize,
+        /// How many ESCs there are.
+        n: usize,
+    },
+    /// Raw bytes of several ESCs sent to one file or standard output (the front ends refuse
+    /// this with messages of their own before starting anything).
+    SharedRaw {
+        /// How many ESCs there are.
+        n: usize,
+    },
+    /// Symlinks to pseudo-terminals, neither one per ESC nor one template.
+    LinkCount {
+        /// How many links were given.
+        links: usize,
+        /// How many ESCs there are.
+        n: usize,
+    },
+    /// A pseudo-terminal could not be created.
+    Pty {
+        /// Why.
+        source: io::Error,
+    },
+    /// A symlink to a pseudo-terminal (or its directory) could not be made.
+    Link {
+        /// The link's path.
+        path: String,
+        /// Why.
+        source: io::Error,
+    },
+}
+
+impl From<WriteError> for SimError {
+    fn from(e: WriteError) -> Self {
+        SimError::Write(e)
+    }
+}
+
+impl From<PortError> for SimError {
+    fn from(e: PortError) -> Self {
+        SimError::Port(e)
+    }
+}
+
+impl fmt::Display for SimError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            SimError::Write(e) => e.fmt(f),
+            SimError::Port(e) => e.fmt(f),
+            SimError::ProfileRead { file, source } => write!(f, "cannot open {file}: {source}"),
+            SimError::Profile {
+                file,
+                line: 0,
+                message,
+            } => write!(f, "{file}: {message}"),
+            SimError::Profile {
+                file,
+                line,
+                message,
+            } => write!(f, "{file}:{line}: {message}"),
+            SimError::TooManyEscs { n } => write!(
+                f,
+                "{n} ESCs: at most {} (an ESC's number is a byte)",
+                crate::fleet::MAX_ESCS
+            ),
+            SimError::NoSuchEsc { esc, n } => write!(
+                f,
+                "--fault: ESC {esc} does not exist: there are {n} (0..{})",
+                n.saturating_sub(1)
+            ),
+            SimError::SharedRaw { n } => write!(
+                f,
+                "raw bytes of {n} ESCs cannot share one output: give each its own file \
+                 ({{esc}} in the name) or write a recording (pcapng)"
+            ),
+            SimError::LinkCount { links, n } => write!(
+                f,
+                "--link: {links} links for {n} ESCs: give one per ESC, or one with {{esc}} in it"
+            ),
+            SimError::Pty { source } => write!(f, "cannot create a pseudo-terminal: {source}"),
+            SimError::Link { path, source } => write!(f, "cannot create the link {path}: {source}"),
+        }
+    }
+}
+
+impl std::error::Error for SimError {
+    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
+        match self {
+            SimError::Write(e) => Some(e),
+            SimError::Port(e) => Some(e),
+            SimError::ProfileRead { source, .. }
+            | SimError::Pty { source }
+            | SimError::Link { source, .. } => Some(source),
+            _ => None,
+        }
+    }
+}

@@ -1,0 +1,162 @@
+//! A fleet of virtual ESCs: described in plain data ([`FleetSpec`]), then checked and made ready
+//! to run ([`VirtualFleet`]).
+
+use std::rc::Rc;
+use std::sync::atomic::AtomicBool;
+use std::time::Instant;
+
+use hwfoc_io::clock::unix_now_ns;
+
+use crate::error::SimError;
+use crate::esc::{Setup, VirtualEsc};
+use crate::faults::{FaultSchedule, FaultSpec, LinkRates};
+use crate::model::ModelConfig;
+use crate::profile::{Profile, ProfileSpec, Shape};
+use crate::schedule::{self, Pace, SimClock};
+use crate::sink::Sink;
+
+/// The most ESCs a fleet can have: a record's ESC number is a byte.
+pub const MAX_ESCS: usize = 256;
+
+/// Everything the virtual ESCs of a run are made from, as plain data.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FleetSpec {
+    /// Number of ESCs (ESC 0 to `n - 1`), at most [`MAX_ESCS`].
+    pub n: usize,
+    /// Seed of every random choice: the same seed and description give the same bytes.
+    pub seed: u64,
+    /// Line rate, baud (8N1).
+    pub baud: u32,
+    /// First packet number of every ESC; random per ESC (from the seed) if `None`.
+    pub start_packet: Option<u16>,
+    /// The throttle profile.
+    pub profile: ProfileSpec,
+    /// The parameters of the built-in profiles.
+    pub shape: Shape,
+    /// Motor, battery, ESC.
+    pub model: ModelConfig,
+    /// Status bits raised at given times.
+    pub faults: Vec<FaultSpec>,
+    /// How often the link misbehaves.
+    pub link: LinkRates,
+}
+
+impl FleetSpec {
+    /// The fleet, checked (at most [`MAX_ESCS`] ESCs, every fault's ESC exists) and its profile loaded (a CSV file read),
+    /// but not started.
+    pub fn build(self) -> Result<VirtualFleet, SimError> {
+        if self.n > MAX_ESCS {
+            return Err(SimError::TooManyEscs { n: self.n });
+        }
+        if let Some(esc) = self
+            .faults
+            .iter()
+            .find_map(|f| f.esc.filter(|&e| e >= self.n))
+        {
+            return Err(SimError::NoSuchEsc { esc, n: self.n });
+        }
+        let profile = Profile::load(&self.profile, &self.shape)?;
+        Ok(VirtualFleet {
+            spec: self,
+            profile,
+        })
+    }
+}
+
+/// Virtual ESCs described and checked, not yet started; it can be moved to another thread.
+#[derive(Debug)]
+pub struct VirtualFleet {
+    spec: FleetSpec,
+    profile: Profile,
+}
+
+impl VirtualFleet {
+    /// What the fleet was built from.
+    pub fn spec(&self) -> &FleetSpec {
+        &self.spec
+    }
+
+    /// The throttle profile, loaded.
+    pub fn profile(&self) -> &Profile {
+        &self.profile
+    }
+
+    /// The ESCs, at rest at time zero.
+    pub fn escs(self) -> Vec<VirtualEsc> {
+        let spec = self.spec;
+        let profile = Rc::new(self.profile);
+        (0..spec.n)
+            .map(|index| {
+                VirtualEsc::new(Setup {
+                    index,
+                    seed: spec.seed,
+                    baud: spec.baud,
+                    start_packet: spec.start_packet,
+                    model: spec.model,
+                    profile: Rc::clone(&profile),
+                    faults: FaultSchedule::for_esc(&spec.faults, index),
+                    link: spec.link,
+                })
+            })
+            .collect()
+    }
+
+    /// Runs the ESCs in real time from now until `stop` is set, each burst handed whole to
+    /// `sink` when its first byte is due (Unix time in ns), as a UART's reader would get it.
+    pub fn run_live(self, sink: &mut dyn Sink, stop: &AtomicBool) -> Result<(), SimError> {
+        let clock = SimClock {
+            origin_ns: unix_now_ns(),
+            real: Some(Instant::now()),
+        };
+        schedule::run(self.escs(), sink, None, Pace::Whole, clock, None, stop)?;
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+pub(crate) mod tests {
+    use super::*;
+    use crate::model::tests::config;
+
+    /// `n` ESCs with the command line's model, a short steps profile, no faults.
+    pub(crate) fn spec(n: usize) -> FleetSpec {
+        FleetSpec {
+            n,
+            seed: 1,
+            baud: 19200,
+            start_packet: None,
+            profile: ProfileSpec::Steps,
+            shape: Shape {
+                lead_in_s: 0.5,
+                levels: vec![0.0, 50.0],
+                hold_s: 1.0,
+                period_s: 10.0,
+                max_pct: 80.0,
+            },
+            model: config(),
+            faults: Vec::new(),
+            link: LinkRates::default(),
+        }
+    }
+
+    #[test]
+    fn building_checks_the_esc_numbers() {
+        let mut s = spec(2);
+        s.faults = vec!["2:mos_short@1".parse().unwrap()];
+        assert_eq!(
+            s.build().unwrap_err().to_string(),
+            "--fault: ESC 2 does not exist: there are 2 (0..1)"
+        );
+        assert!(matches!(
+            spec(MAX_ESCS + 1).build(),
+            Err(SimError::TooManyEscs { n: 257 })
+        ));
+        let fleet = spec(3).build().unwrap();
+        assert_eq!(fleet.profile().natural_length_s(), 2.5);
+        let escs = fleet.escs();
+        assert_eq!(
+            escs.iter().map(VirtualEsc::index).collect::<Vec<_>>(),
+            [0, 1, 2]
+        );
+    }
+}

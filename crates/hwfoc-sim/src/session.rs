@@ -1,0 +1,235 @@
+//! A whole run: a fleet, its outlet, the ground truth, the clock and how long it lasts
+//! ([`Plan`]), opened ([`Session::open`]) and run ([`Session::run`]) to a report per ESC.
+//!
+//! The ground truth has one record per data frame delivered intact, `t_s` being the time its
+//! first byte started on the wire, in the clock of the output:
+//! - real-time outputs (pseudo-terminals, serial ports, [`Plan::realtime`]): Unix time;
+//! - a pcapng recording: the recording's own timestamps, which start at [`Plan::start_s`]
+//!   (Unix seconds; default now), so that decoding the recording gives exactly the truth's
+//!   `t_s`;
+//! - raw bytes (a file or standard output): raw bytes carry no time, so decoding them gives a
+//!   null `t_s`; the truth still has the simulated time, seconds from the start of the run plus
+//!   [`Plan::start_s`] (default 0).
+
+use std::sync::atomic::AtomicBool;
+use std::time::{Duration, Instant};
+
+use hwfoc::Settings;
+use hwfoc_io::clock::unix_now_ns;
+
+use crate::error::SimError;
+use crate::esc::VirtualEsc;
+use crate::fleet::VirtualFleet;
+use crate::outlet::{FileFormat, Opened, Outlet};
+use crate::schedule::{self, Pace, SimClock, Tally};
+use crate::sink::{self, Truth};
+
+/// Extra seconds after one run of the profile, for runs written at once without a duration:
+/// the motor stops and the idle frames and device information show.
+const TAIL_S: f64 = 2.0;
+/// How long the ptys stay open after the last write.
+const PTY_LINGER: Duration = Duration::from_millis(300);
+
+/// How a fleet is run: where its bytes go, at what rate, from when, for how long, and where
+/// the ground truth goes.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Plan {
+    /// Where the bytes go.
+    pub outlet: Outlet,
+    /// Write a file or standard output at the real rate instead of as fast as possible (live
+    /// outlets always are).
+    pub realtime: bool,
+    /// Unix time (seconds) of the start, for runs written at once: the recording's clock and
+    /// the truth's. Default: now for pcapng, 0 for raw bytes. Real-time runs use the time now.
+    pub start_s: Option<f64>,
+    /// Seconds of simulated time. Default: one run of the profile plus 2 s for runs written at
+    /// once; until stopped in real time.
+    pub duration_s: Option<f64>,
+    /// The ground truth's file (`-`: standard output), if wanted.
+    pub truth: Option<String>,
+    /// How the truth's records are converted (the ESCs' current scale and pole pairs should
+    /// match the fleet's).
+    pub settings: Settings,
+}
+
+impl Plan {
+    /// Whether the run goes at the real rate.
+    pub fn is_realtime(&self) -> bool {
+        self.realtime || self.outlet.is_live()
+    }
+}
+
+/// What one ESC sent, at the end of a run.
+#[derive(Debug, Clone, PartialEq)]
+pub struct EscReport {
+    /// Its output, as a person would name it (a path, a port, standard output).
+    pub output: String,
+    /// The id in its device information.
+    pub id: String,
+    /// What it sent.
+    pub tally: Tally,
+    /// Bytes that could not be delivered (no reader on a pseudo-terminal, a port that would
+    /// not take them).
+    pub undelivered_bytes: u64,
+}
+
+/// A run with its outputs open, ready to start.
+pub struct Session {
+    escs: Vec<VirtualEsc>,
+    opened: Opened,
+    truth: Option<Truth>,
+    pace: Pace,
+    origin_ns: u64,
+    realtime: bool,
+    duration_ns: Option<u64>,
+}
+
+impl Session {
+    /// Opens what `plan` asks for `fleet`: the ground truth first (so that a path that cannot
+    /// be written is reported before any pseudo-terminal exists), then the outlet.
+    pub fn open(fleet: VirtualFleet, plan: &Plan) -> Result<Session, SimError> {
+        let realtime = plan.is_realtime();
+        let n = fleet.spec().n;
+        let baud = fleet.spec().baud;
+        let duration_s = match plan.duration_s {
+            Some(d) => Some(d),
+            None if realtime => None,
+            None => Some(fleet.profile().natural_length_s() + TAIL_S),
+        };
+        let escs = fleet.escs();
+        let truth = match &plan.truth {
+            Some(path) => {
+                let (name, out) = sink::create(path)?;
+                Some(Truth::new(name, out, plan.settings))
+            }
+            None => None,
+        };
+        let start_ns = plan.start_s.map(|s| (s * 1e9).round() as u64);
+        let origin_ns = match (realtime, plan.outlet.file_format()) {
+            (false, Some(FileFormat::Pcapng)) => start_ns.unwrap_or_else(unix_now_ns),
+            (false, Some(FileFormat::Raw)) => start_ns.unwrap_or(0),
+            _ => unix_now_ns(),
+        };
+        Ok(Session {
+            opened: plan.outlet.open(n, baud)?,
+            escs,
+            truth,
+            pace: plan.outlet.pace(realtime, baud),
+            origin_ns,
+            realtime,
+            duration_ns: duration_s.map(|s| (s * 1e9).round() as u64),
+        })
+    }
+
+    /// Each ESC's output, as a person would name it: for pseudo-terminals, the path to open.
+    pub fn outputs(&self) -> &[String] {
+        &self.opened.names
+    }
+
+    /// Runs to the end (of the duration, or until `stop` is set) and reports on each ESC.
+    pub fn run(self, stop: &AtomicBool) -> Result<Vec<EscReport>, SimError> {
+        let Session {
+            escs,
+            mut opened,
+            mut truth,
+            pace,
+            origin_ns,
+            realtime,
+            duration_ns,
+        } = self;
+        let ids: Vec<String> = escs.iter().map(|e| e.info().id().to_string()).collect();
+        let clock = SimClock {
+            origin_ns,
+            real: realtime.then(Instant::now),
+        };
+        let tallies = schedule::run(
+            escs,
+            opened.sink.as_mut(),
+            truth.as_mut(),
+            pace,
+            clock,
+            duration_ns,
+            stop,
+        )?;
+        if opened.linger {
+            // Closing a pty's master hangs up the reader and discards what it has not read
+            // yet: give readers a moment to take the last frames, which the truth lists as
+            // delivered.
+            std::thread::sleep(PTY_LINGER);
+        }
+        Ok(tallies
+            .into_iter()
+            .zip(ids)
+            .enumerate()
+            .map(|(esc, (tally, id))| EscReport {
+                output: opened.names[esc].clone(),
+                id,
+                tally,
+                undelivered_bytes: opened.sink.undelivered(esc),
+            })
+            .collect())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::fleet::tests::spec;
+
+    #[test]
+    fn a_recording_is_the_same_every_time_and_its_truth_matches_the_report() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = |name: &str| dir.path().join(name).display().to_string();
+        let run = |name: &str| {
+            let plan = Plan {
+                outlet: Outlet::File {
+                    path: path(name),
+                    format: FileFormat::for_path(name),
+                },
+                realtime: false,
+                start_s: Some(1.7e9),
+                duration_s: None,
+                truth: Some(path(&format!("{name}.jsonl"))),
+                settings: Settings::default(),
+            };
+            let session = Session::open(spec(2).build().unwrap(), &plan).unwrap();
+            assert_eq!(session.outputs(), [path(name), path(name)]);
+            let reports = session.run(&AtomicBool::new(false)).unwrap();
+            let truth = std::fs::read_to_string(path(&format!("{name}.jsonl"))).unwrap();
+            (std::fs::read(path(name)).unwrap(), reports, truth)
+        };
+        let (a, reports, truth) = run("a.pcapng");
+        let (b, again, _) = run("b.pcapng");
+        assert_eq!(a, b);
+        let tallies = |r: &[EscReport]| -> Vec<(String, Tally)> {
+            r.iter().map(|r| (r.id.clone(), r.tally.clone())).collect()
+        };
+        assert_eq!(tallies(&reports), tallies(&again));
+        let intact: u64 = reports.iter().map(|r| r.tally.intact).sum();
+        assert_eq!(truth.lines().count() as u64, intact);
+        // The profile's 2.5 s and 2 s more: idle, then running at 50 %.
+        assert!(reports.iter().all(|r| (40..90).contains(&r.tally.data)));
+        let first: serde_json::Value = serde_json::from_str(truth.lines().next().unwrap()).unwrap();
+        assert!((1.7e9..1.7e9 + 0.05).contains(&first["t_s"].as_f64().unwrap()));
+    }
+
+    #[test]
+    fn raw_bytes_of_several_escs_need_a_file_each() {
+        let dir = tempfile::tempdir().unwrap();
+        let plan = Plan {
+            outlet: Outlet::File {
+                path: dir.path().join("x.bin").display().to_string(),
+                format: FileFormat::Raw,
+            },
+            realtime: false,
+            start_s: None,
+            duration_s: Some(1.0),
+            truth: None,
+            settings: Settings::default(),
+        };
+        let e = Session::open(spec(2).build().unwrap(), &plan)
+            .err()
+            .unwrap();
+        assert!(matches!(e, SimError::SharedRaw { n: 2 }), "{e}");
+    }
+}
