@@ -245,3 +245,29 @@ fn a_recording_is_never_overwritten_unasked() {
             .starts_with(&[0x0A, 0x0D, 0x0D, 0x0A])
     );
 }
+
+#[test]
+fn the_ground_truth_never_lands_on_the_recording() {
+    let dir = Dir::new();
+    let out = dir.arg("run.pcapng");
+    std::fs::write(&out, "keep me").unwrap();
+    let o = run(hwfoc().args(["simulate", "-o", &out, "--truth", &out]));
+    assert_fails_with(&o, "is also the output -o");
+    assert_eq!(std::fs::read_to_string(&out).unwrap(), "keep me");
+    // Through another path to the same file, and with one file per ESC.
+    let dot = format!("{}/./run.pcapng", dir.0.path().display());
+    let o = run(hwfoc().args(["simulate", "-o", &dot, "--truth", &out]));
+    assert_fails_with(&o, "is also the output -o");
+    let per_esc = dir.arg("esc{esc}.bin");
+    let o = run(hwfoc().args([
+        "simulate",
+        "--escs",
+        "3",
+        "-o",
+        &per_esc,
+        "--truth",
+        &dir.arg("esc2.bin"),
+    ]));
+    assert_fails_with(&o, "is also the output -o");
+    assert_eq!(std::fs::read_to_string(&out).unwrap(), "keep me");
+}

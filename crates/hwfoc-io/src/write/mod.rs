@@ -519,8 +519,8 @@ pub fn refuse_input<'a>(
     }
 }
 
-/// Whether two paths name one existing file.
-fn same_file(a: &str, b: &str) -> bool {
+/// Whether two paths name one existing file (by device and inode, on Unix).
+pub fn same_file(a: &str, b: &str) -> bool {
     let (Ok(ma), Ok(mb)) = (std::fs::metadata(a), std::fs::metadata(b)) else {
         return false;
     };

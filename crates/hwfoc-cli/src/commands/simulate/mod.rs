@@ -19,6 +19,7 @@ use hwfoc_sim::model::ModelConfig;
 use hwfoc_sim::profile::{ProfileSpec, Shape};
 #[cfg(unix)]
 use hwfoc_sim::pty::PtyLinks;
+use hwfoc_sim::sink::expand;
 use hwfoc_sim::{EscReport, FileFormat, FleetSpec, Outlet, Plan, Session, VirtualFleet};
 
 /// File formats of `-o`.
@@ -388,6 +389,18 @@ fn plan(args: &SimulateArgs, n: usize, settings: Settings) -> Result<Plan, CliEr
             },
         }
     };
+    if let (Outlet::File { path, .. }, Some(truth)) = (&outlet, &args.truth) {
+        // The ground truth must not land on (and destroy) one of the recordings, or they on it.
+        let clash = (0..n)
+            .map(|esc| expand(path, esc))
+            .find(|out| out == truth || hwfoc_io::write::same_file(out, truth));
+        if let Some(out) = clash {
+            return Err(usage(
+                "--truth",
+                format!("{truth} is also the output -o {out}: choose another file for either"),
+            ));
+        }
+    }
     let plan = Plan {
         outlet,
         realtime: args.realtime,
