@@ -122,3 +122,21 @@ impl SelectArgs {
         parts.join(" ")
     }
 }
+
+/// The longest time any option takes, s (about 31 years): longer would overflow the clocks.
+pub const MAX_SECONDS: f64 = 1e9;
+
+/// A positive, finite number of seconds, at most [`MAX_SECONDS`] (`--duration`, `--interval`,
+/// `--rotate-time`).
+pub fn seconds(text: &str) -> Result<f64, String> {
+    let s = text
+        .trim()
+        .parse::<f64>()
+        .ok()
+        .filter(|s| s.is_finite() && *s > 0.0)
+        .ok_or_else(|| format!("{text:?} is not a positive number of seconds"))?;
+    if s > MAX_SECONDS {
+        return Err(format!("{text:?}: at most {MAX_SECONDS} seconds"));
+    }
+    Ok(s)
+}

@@ -94,17 +94,13 @@ fn parse_size(text: &str) -> Result<u64, String> {
         .parse()
         .map_err(|_| format!("{text:?} is not a size in bytes"))?;
     n.checked_mul(unit_bytes)
-        .filter(|&b| b >= 1024)
-        .ok_or_else(|| format!("{text:?}: the size must be at least 1 KiB"))
+        .filter(|&b| b >= 1000)
+        .ok_or_else(|| format!("{text:?}: the size must be at least 1k (1000 bytes)"))
 }
 
-/// A positive, finite number of seconds.
+/// A positive number of seconds (see [`crate::args::seconds`]).
 fn parse_seconds(text: &str) -> Result<f64, String> {
-    text.trim()
-        .parse::<f64>()
-        .ok()
-        .filter(|s| s.is_finite() && *s > 0.0)
-        .ok_or_else(|| format!("{text:?} is not a positive number of seconds"))
+    crate::args::seconds(text)
 }
 
 /// The name of file number `n` of a rotated recording: `out.pcapng` → `out-0001.pcapng`.
@@ -635,6 +631,8 @@ mod tests {
         assert_eq!(parse_size("64KiB"), Ok(65_536));
         assert_eq!(parse_size("2G"), Ok(2_000_000_000));
         assert!(parse_size("10").is_err());
+        assert_eq!(parse_size("1k"), Ok(1000));
+        assert!(parse_size("999").is_err());
         assert!(parse_size("x").is_err());
         assert!(parse_size("5 parsecs").is_err());
         assert!(parse_size("99999999999999999999G").is_err());
@@ -646,6 +644,7 @@ mod tests {
         assert!(parse_seconds("0").is_err());
         assert!(parse_seconds("-1").is_err());
         assert!(parse_seconds("inf").is_err());
+        assert!(parse_seconds("1e300").is_err());
     }
 
     #[test]

@@ -48,10 +48,11 @@ pub fn run(session: &mut Session, json: bool, interval_s: f64) -> Result<(), Cli
                     writeln!(text, "{}", status_line(i, esc, now)).ok();
                 }
             }
-            // Skip intervals missed (a suspended machine) rather than printing a burst.
-            while next_status <= Instant::now() {
-                next_status += interval;
-            }
+            // Skip intervals missed (a suspended machine) rather than printing a burst: the next
+            // status is due one interval after the last one due, counted without a loop.
+            let late = Instant::now().saturating_duration_since(next_status);
+            let missed = (late.as_secs_f64() / interval.as_secs_f64()).floor();
+            next_status += interval.mul_f64(missed + 1.0);
         }
         if let Some(notice) = session.notice.take() {
             eprintln!("hwfoc: {notice}");

@@ -61,8 +61,9 @@ pub struct MonitorArgs {
     /// No dashboard: as --plain, in JSON Lines.
     #[arg(long)]
     json: bool,
-    /// Seconds between the status lines of --plain and --json.
-    #[arg(long, value_name = "S", default_value_t = 1.0, value_parser = seconds)]
+    /// Seconds between the status lines of --plain and --json (0.05 to 86400: an ESC sends a
+    /// frame every 50 ms).
+    #[arg(long, value_name = "S", default_value_t = 1.0, value_parser = interval)]
     interval: f64,
     /// Stop after S seconds (otherwise on q, Ctrl-C or SIGTERM).
     #[arg(long, value_name = "S", value_parser = seconds)]
@@ -111,12 +112,22 @@ pub struct MonitorArgs {
 }
 
 fn seconds(text: &str) -> Result<f64, String> {
-    text.trim()
-        .parse::<f64>()
-        .ok()
-        .filter(|s| s.is_finite() && *s > 0.0)
-        .ok_or_else(|| format!("{text:?} is not a positive number of seconds"))
+    crate::args::seconds(text)
 }
+
+/// Seconds between status lines: from [`MIN_INTERVAL_S`] to a day.
+fn interval(text: &str) -> Result<f64, String> {
+    let s = seconds(text)?;
+    if !(MIN_INTERVAL_S..=86_400.0).contains(&s) {
+        return Err(format!(
+            "{text:?}: the interval must be from {MIN_INTERVAL_S} to 86400 seconds"
+        ));
+    }
+    Ok(s)
+}
+
+/// The shortest interval between status lines: the period of an ESC's frames.
+const MIN_INTERVAL_S: f64 = 0.05;
 
 /// Runs `hwfoc monitor`.
 pub fn run(args: &MonitorArgs) -> Result<(), CliError> {

@@ -1,0 +1,93 @@
+//! Values that cannot be represented are refused with their valid range, and nothing spins:
+//! every loop ends on time, on --duration and on SIGTERM.
+
+mod common;
+
+use std::time::{Duration, Instant};
+
+use common::{hwfoc, ok, run};
+
+/// A clap refusal: exit code 2, the option's name and the reason on standard error.
+fn refused(args: &[&str], needle: &str) {
+    let o = run(hwfoc().args(args));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{args:?}: {err}");
+    assert!(err.contains(needle), "{args:?}: {needle:?} not in {err}");
+}
+
+#[test]
+fn intervals_and_durations_have_a_range() {
+    refused(
+        &["monitor", "--sim", "1", "--plain", "--interval", "1e-8"],
+        "the interval must be from 0.05 to 86400 seconds",
+    );
+    refused(
+        &["monitor", "--sim", "1", "--plain", "--duration", "1e300"],
+        "at most 1000000000 seconds",
+    );
+    refused(
+        &[
+            "record",
+            "/dev/ttyUSB9",
+            "-o",
+            "x.pcapng",
+            "--duration",
+            "1e300",
+        ],
+        "at most",
+    );
+    refused(
+        &[
+            "record",
+            "/dev/ttyUSB9",
+            "-o",
+            "x.pcapng",
+            "--rotate-time",
+            "inf",
+        ],
+        "not a positive",
+    );
+}
+
+/// The shortest interval prints a line per ESC about every 50 ms and stops on --duration.
+#[test]
+fn the_shortest_interval_stops_on_time() {
+    let start = Instant::now();
+    let o = ok(run(hwfoc().args([
+        "monitor",
+        "--sim",
+        "1",
+        "--plain",
+        "--no-config",
+        "--interval",
+        "0.05",
+        "--duration",
+        "1",
+    ])));
+    assert!(start.elapsed() < Duration::from_secs(20));
+    let lines = String::from_utf8_lossy(&o.stdout).lines().count();
+    assert!((5..=25).contains(&lines), "{lines} lines");
+}
+
+/// SIGTERM ends the headless monitor at its shortest interval, with the usual exit.
+#[cfg(unix)]
+#[test]
+fn sigterm_stops_the_shortest_interval() {
+    use nix::sys::signal::Signal;
+    let mut m = common::Running::start(&[
+        "monitor",
+        "--sim",
+        "2",
+        "--plain",
+        "--no-config",
+        "--interval",
+        "0.05",
+    ]);
+    m.wait_for_stdout("esc1", Duration::from_secs(20));
+    m.signal(Signal::SIGTERM);
+    assert!(
+        m.wait(Duration::from_secs(10)),
+        "still running: {}",
+        m.stderr()
+    );
+}
