@@ -91,3 +91,16 @@ fn sigterm_stops_the_shortest_interval() {
         m.stderr()
     );
 }
+
+/// A configuration file or a throttle profile of any size (here an endless one) is an error,
+/// not all the memory there is.
+#[cfg(unix)]
+#[test]
+fn endless_files_are_refused() {
+    let dir = common::Dir::new();
+    let o = run(hwfoc().args(["monitor", "--sim", "1", "--plain", "--config", "/dev/zero"]));
+    common::assert_fails_with(&o, "cannot open /dev/zero: it is larger than 1024 KiB");
+    let out = dir.arg("x.bin");
+    let o = run(hwfoc().args(["simulate", "--profile", "csv:/dev/zero", "-o", &out]));
+    common::assert_fails_with(&o, "cannot open /dev/zero: it is larger than 65536 KiB");
+}

@@ -13,7 +13,13 @@
 use std::fmt;
 use std::str::FromStr;
 
+use hwfoc_io::input::read_small_file;
+
 use crate::error::SimError;
+
+/// The largest throttle profile read (a point per line, a few tens of bytes each: a day of
+/// points every 10 ms fits).
+const MAX_PROFILE: u64 = 64 << 20;
 
 /// A profile as named (`steps`, `ramp`, `sine`, `csv:FILE`), before any file is read.
 #[derive(Debug, Clone, PartialEq)]
@@ -133,10 +139,11 @@ impl Profile {
                 max_pct,
             },
             ProfileSpec::Csv(path) => {
-                let text = std::fs::read(path).map_err(|source| SimError::ProfileRead {
-                    file: path.clone(),
-                    source,
-                })?;
+                let text =
+                    read_small_file(path, MAX_PROFILE).map_err(|source| SimError::ProfileRead {
+                        file: path.clone(),
+                        source,
+                    })?;
                 Profile::Points(parse_csv(path, &text)?)
             }
         })

@@ -630,6 +630,24 @@ impl CsvRows {
     }
 }
 
+/// Reads a small file whole (a configuration file, a throttle profile): at most `limit` bytes;
+/// a larger file (or an endless one such as `/dev/zero`) is an error of kind `InvalidData`
+/// saying so, rather than memory for whatever it holds.
+pub fn read_small_file(path: impl AsRef<std::path::Path>, limit: u64) -> io::Result<Vec<u8>> {
+    let mut bytes = Vec::new();
+    File::open(path)?.take(limit + 1).read_to_end(&mut bytes)?;
+    if bytes.len() as u64 > limit {
+        return Err(io::Error::new(
+            io::ErrorKind::InvalidData,
+            format!(
+                "it is larger than {} KiB, more than such a file holds",
+                limit >> 10
+            ),
+        ));
+    }
+    Ok(bytes)
+}
+
 /// Whether `head`, the first bytes of an input, can still be the start of a CSV header line
 /// (which begins with "Time", possibly after a UTF-8 byte-order mark).
 fn may_be_header(head: &[u8]) -> bool {

@@ -42,6 +42,7 @@ use serde::Deserialize;
 use super::alarms::Threshold;
 use crate::error::CliError;
 use hwfoc_io::InputError;
+use hwfoc_io::input::read_small_file;
 use hwfoc_io::serial;
 
 /// The file's layout.
@@ -324,11 +325,21 @@ fn invalid(origin: String, message: impl Into<String>) -> CliError {
     }
 }
 
+/// The largest configuration file read (a real one is a few hundred bytes).
+const MAX_CONFIG: u64 = 1 << 20;
+
 /// Reads and parses a configuration file; errors name the file and the line.
 fn read_file(path: &Path) -> Result<File, CliError> {
-    let text = std::fs::read_to_string(path).map_err(|source| InputError::Open {
+    let open_error = |source| InputError::Open {
         input: path.display().to_string(),
         source,
+    };
+    let bytes = read_small_file(path, MAX_CONFIG).map_err(open_error)?;
+    let text = String::from_utf8(bytes).map_err(|_| {
+        open_error(std::io::Error::new(
+            std::io::ErrorKind::InvalidData,
+            "it is not UTF-8 text",
+        ))
     })?;
     toml::from_str(&text).map_err(|e| {
         let line = e.span().map(|span| {
