@@ -49,6 +49,36 @@ fn intervals_and_durations_have_a_range() {
     );
 }
 
+#[test]
+fn simulated_times_fit_the_recording_clock() {
+    let dir = common::Dir::new();
+    let out = dir.arg("x.pcapng");
+    refused(
+        &["simulate", "-o", &out, "--start-time", "1e11"],
+        "the start time must be from 0 to 10000000000 Unix seconds",
+    );
+    refused(&["simulate", "-o", &out, "--duration", "1e300"], "at most");
+    // The latest start and a long run still give increasing, exact times.
+    ok(run(hwfoc().args([
+        "simulate",
+        "-o",
+        &out,
+        "--start-time",
+        "1e10",
+        "--duration",
+        "3",
+    ])));
+    let o = ok(run(hwfoc().args(["decode", &out, "--format", "csv"])));
+    let text = String::from_utf8_lossy(&o.stdout);
+    let t: Vec<f64> = text
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').next().unwrap().parse().unwrap())
+        .collect();
+    assert!(t.len() > 5 && t.windows(2).all(|w| w[1] > w[0]), "{t:?}");
+    assert!(t[0] >= 1e10 && t[t.len() - 1] < 1e10 + 3.0, "{t:?}");
+}
+
 /// The shortest interval prints a line per ESC about every 50 ms and stops on --duration.
 #[test]
 fn the_shortest_interval_stops_on_time() {

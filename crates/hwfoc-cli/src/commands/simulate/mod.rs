@@ -59,10 +59,10 @@ pub struct SimulateArgs {
     escs: Option<u16>,
     /// Seconds of simulated time. Default: one run of the profile plus 2 s for files and
     /// standard output; until Ctrl-C in real time.
-    #[arg(long, value_name = "S", value_parser = positive)]
+    #[arg(long, value_name = "S", value_parser = crate::args::seconds)]
     duration: Option<f64>,
     /// Line rate in baud (8N1).
-    #[arg(long, value_name = "BAUD", default_value_t = 19_200,
+    #[arg(long, value_name = "BAUD", default_value_t = hwfoc_io::serial::DEFAULT_BAUD,
           value_parser = clap::value_parser!(u32).range(9_600..=4_000_000))]
     baud: u32,
     /// The virtual ESCs: random seed, throttle profile, physical model, faults.
@@ -108,7 +108,7 @@ pub struct SimulateArgs {
     truth: Option<String>,
     /// Unix time (seconds) of the start, for recordings and the truth of file outputs.
     /// Default: now for pcapng, 0 for raw bytes.
-    #[arg(long, value_name = "UNIX_S", value_parser = non_negative, help_heading = "Output")]
+    #[arg(long, value_name = "UNIX_S", value_parser = start_time, help_heading = "Output")]
     start_time: Option<f64>,
     /// No per-ESC report on standard error at the end.
     #[arg(short, long, help_heading = "Output")]
@@ -277,6 +277,20 @@ fn positive(s: &str) -> Result<f64, String> {
     let v = number(s)?;
     if v <= 0.0 {
         return Err(format!("{s} must be more than 0"));
+    }
+    Ok(v)
+}
+
+/// The latest start time, Unix seconds (the year 2286): timestamps are nanoseconds in a
+/// `u64`, which this and the longest run (`crate::args::MAX_SECONDS`) leave room for.
+const MAX_START_S: f64 = 1e10;
+
+fn start_time(s: &str) -> Result<f64, String> {
+    let v = non_negative(s)?;
+    if v > MAX_START_S {
+        return Err(format!(
+            "{s}: the start time must be from 0 to {MAX_START_S} Unix seconds (the year 2286)"
+        ));
     }
     Ok(v)
 }
