@@ -125,10 +125,16 @@ impl PtyLinks {
     pub fn paths(&self, n: usize) -> Result<Vec<PathBuf>, SimError> {
         Ok(match self {
             PtyLinks::Dir(dir) => {
-                std::fs::create_dir_all(dir).map_err(|source| SimError::Link {
-                    path: dir.clone(),
-                    source,
-                })?;
+                // A directory made here is the user's alone (mode 0700).
+                use std::os::unix::fs::DirBuilderExt;
+                std::fs::DirBuilder::new()
+                    .recursive(true)
+                    .mode(0o700)
+                    .create(dir)
+                    .map_err(|source| SimError::Link {
+                        path: dir.clone(),
+                        source,
+                    })?;
                 (0..n)
                     .map(|i| PathBuf::from(dir).join(format!("esc{i}")))
                     .collect()
@@ -165,26 +171,31 @@ pub fn open_all(n: usize, links: &PtyLinks) -> Result<(Vec<Pty>, Links), SimErro
     Ok((ptys, made))
 }
 
-/// Symlinks to the ptys at stable paths, removed again when dropped (also on an error or
-/// Ctrl-C) if they still point at our pty.
+/// Symlinks to the ptys at stable paths, made by this process and removed again when dropped
+/// (also on an error or Ctrl-C) if they still point at our pty. Nothing else is touched.
 #[derive(Debug, Default)]
 pub struct Links {
     made: Vec<(PathBuf, PathBuf)>,
 }
 
 impl Links {
-    /// Makes `link` point at `target`. A symlink already there (left by an earlier run that was
-    /// killed) is replaced; anything else is an error.
+    /// Makes `link` point at `target`, atomically: the link is created only where there is
+    /// nothing (the system refuses to create it over anything, so no other program's file can
+    /// be replaced between a check and the creation). The one thing removed first is a dangling
+    /// symlink, such as an earlier run that was killed leaves (its pseudo-terminal is gone);
+    /// anything else there is an error.
     pub fn add(&mut self, link: &Path, target: &Path) -> Result<(), SimError> {
         let err = |source: io::Error| SimError::Link {
             path: link.display().to_string(),
             source,
         };
         if let Ok(meta) = std::fs::symlink_metadata(link) {
-            if !meta.file_type().is_symlink() {
+            let dangling = meta.file_type().is_symlink() && std::fs::metadata(link).is_err();
+            if !dangling {
                 return Err(err(io::Error::new(
                     io::ErrorKind::AlreadyExists,
-                    "it exists and is not a symbolic link",
+                    "something is there already (not a link left by an earlier run): \
+                     choose another path, or a directory of your own with --link-dir",
                 )));
             }
             std::fs::remove_file(link).map_err(err)?;
@@ -291,6 +302,9 @@ mod tests {
         let made = paths(PtyLinks::Dir(sub.display().to_string()), 2).unwrap();
         assert_eq!(made, [sub.join("esc0"), sub.join("esc1")]);
         assert!(sub.is_dir());
+        use std::os::unix::fs::PermissionsExt;
+        let mode = std::fs::metadata(&sub).unwrap().permissions().mode();
+        assert_eq!(mode & 0o777, 0o700, "{mode:o}");
     }
 
     #[test]
@@ -300,17 +314,20 @@ mod tests {
         std::os::unix::fs::symlink("/nonexistent", &link).unwrap();
         let file = dir.path().join("file");
         std::fs::write(&file, b"keep").unwrap();
+        let mine = dir.path().join("mine");
+        std::os::unix::fs::symlink(&file, &mine).unwrap();
         {
             let mut links = Links::default();
             links.add(&link, Path::new("/dev/null")).unwrap();
             assert_eq!(std::fs::read_link(&link).unwrap(), Path::new("/dev/null"));
             let e = links.add(&file, Path::new("/dev/null")).unwrap_err();
-            assert!(
-                e.to_string().contains("exists and is not a symbolic link"),
-                "{e}"
-            );
+            assert!(e.to_string().contains("something is there already"), "{e}");
+            // A user's own link (to something that exists) is neither replaced nor removed.
+            let e = links.add(&mine, Path::new("/dev/null")).unwrap_err();
+            assert!(e.to_string().contains("something is there already"), "{e}");
         }
         assert!(std::fs::symlink_metadata(&link).is_err());
         assert_eq!(std::fs::read(&file).unwrap(), b"keep");
+        assert_eq!(std::fs::read_link(&mine).unwrap(), file);
     }
 }

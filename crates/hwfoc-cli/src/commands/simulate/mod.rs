@@ -44,7 +44,7 @@ impl From<Format> for FileFormat {
 const EXAMPLES: &str = "\
 Examples:
   hwfoc simulate --pty                                # one ESC on a pseudo-terminal, until Ctrl-C
-  hwfoc simulate --escs 8 --pty --link-dir /tmp/escs  # /tmp/escs/esc0 .. esc7
+  hwfoc simulate --escs 8 --pty --link-dir ~/escs     # ~/escs/esc0 .. esc7 (a directory of your own)
   hwfoc simulate -o run.bin --truth truth.jsonl       # raw bytes, 18 s simulated, at once
   hwfoc simulate --escs 4 -o run.pcapng --profile sine --duration 60
   hwfoc simulate --drop-rate 0.02 --bit-error-rate 1e-4 --fault mos_overheat@5-7 | hwfoc decode -
