@@ -271,3 +271,28 @@ fn the_ground_truth_never_lands_on_the_recording() {
     assert_fails_with(&o, "is also the output -o");
     assert_eq!(std::fs::read_to_string(&out).unwrap(), "keep me");
 }
+
+#[test]
+fn a_plot_is_written_whole_to_a_file_and_not_to_a_device() {
+    let dir = Dir::new();
+    let (csv, _) = inputs(&dir);
+    let png = dir.arg("p.png");
+    std::fs::write(&png, "an earlier plot").unwrap();
+    ok(run(hwfoc().args(["plot", &csv, "-o", &png])));
+    assert!(std::fs::read(&png).unwrap().starts_with(b"\x89PNG"));
+    assert!(!dir.path("p.png.partial").exists());
+    #[cfg(unix)]
+    {
+        let link = dir.path("dev.svg");
+        std::os::unix::fs::symlink("/dev/null", &link).unwrap();
+        let o = run(hwfoc().args(["plot", &csv, "-o", link.to_str().unwrap()]));
+        assert_fails_with(&o, "it is a device or a pipe, not a file");
+    }
+    // A plot that fails (nothing to plot) leaves the earlier file and no partial file.
+    let empty = dir.arg("empty.bin");
+    std::fs::write(&empty, [0u8; 100]).unwrap();
+    let o = run(hwfoc().args(["plot", &empty, "-o", &png]));
+    assert!(!o.status.success());
+    assert!(std::fs::read(&png).unwrap().starts_with(b"\x89PNG"));
+    assert!(!dir.path("p.png.partial").exists());
+}

@@ -28,6 +28,15 @@ use crate::stream::byte_times;
 /// the L2 cache when the decoder reads it (1 MiB reads made `summary` 1.6x slower), large enough
 /// that system calls cost nothing. Also the read buffer of a CSV input.
 const BATCH: usize = 64 << 10;
+/// The magic numbers of a classic libpcap file, as its first four bytes: microsecond and
+/// nanosecond timestamps, either byte order.
+const CLASSIC_PCAP: [[u8; 4]; 4] = [
+    [0xD4, 0xC3, 0xB2, 0xA1],
+    [0xA1, 0xB2, 0xC3, 0xD4],
+    [0x4D, 0x3C, 0xB2, 0xA1],
+    [0xA1, 0xB2, 0x3C, 0x4D],
+];
+
 /// How many CSV rows make one batch.
 const CSV_BATCH_ROWS: usize = 1 << 16;
 
@@ -208,6 +217,19 @@ impl Input {
         }
         if head.is_empty() {
             return Err(InputError::Empty {
+                input: name.to_string(),
+            });
+        }
+        // A classic libpcap file (Wireshark's older format) starts with its magic number.
+        while head.len() < 4 && CLASSIC_PCAP.iter().any(|m| m.starts_with(&head)) {
+            let n = read_some(&mut reader, &mut byte).map_err(read_err)?;
+            if n == 0 {
+                break;
+            }
+            head.push(byte[0]);
+        }
+        if CLASSIC_PCAP.iter().any(|m| head.starts_with(m)) {
+            return Err(InputError::ClassicPcap {
                 input: name.to_string(),
             });
         }
@@ -767,6 +789,11 @@ pub enum InputError {
         /// The input whose stream would be ESC 256 or more.
         input: String,
     },
+    /// A classic libpcap file: recordings are read in pcapng.
+    ClassicPcap {
+        /// The input as named on the command line.
+        input: String,
+    },
     /// A serial port could not be opened.
     Port(PortError),
 }
@@ -803,6 +830,17 @@ impl fmt::Display for InputError {
                 f,
                 "{input}: too many streams: records number ESCs 0 to 255; read fewer inputs at once"
             ),
+            InputError::ClassicPcap { input } => {
+                let converted = match input.strip_suffix(".pcap") {
+                    Some(stem) => format!("{stem}.pcapng"),
+                    None => format!("{input}.pcapng"),
+                };
+                write!(
+                    f,
+                    "{input} is a classic libpcap file, not pcapng: convert it with \
+                     `editcap -F pcapng {input} {converted}`, then decode that"
+                )
+            }
             InputError::Port(e) => e.fmt(f),
         }
     }
@@ -1089,5 +1127,23 @@ mod tests {
         let (bytes, _) = read_all(&mut input);
         assert_eq!(bytes.len(), 25_000);
         assert_eq!(input.streams(), 2);
+    }
+
+    #[test]
+    fn classic_pcap_files_are_named_as_such() {
+        for magic in CLASSIC_PCAP {
+            let mut file = magic.to_vec();
+            file.extend_from_slice(&[2, 0, 4, 0, 0, 0, 0, 0]);
+            let e = Input::from_memory("old.pcap", file).err().unwrap();
+            assert_eq!(
+                e.to_string(),
+                "old.pcap is a classic libpcap file, not pcapng: convert it with \
+                 `editcap -F pcapng old.pcap old.pcapng`, then decode that"
+            );
+        }
+        // Raw bytes that merely start like one stay raw.
+        let raw = vec![0xD4, 0xC3, 0x9B, 0x16];
+        let mut input = Input::from_memory("r.bin", raw.clone()).unwrap();
+        assert_eq!(read_all(&mut input), (raw, None));
     }
 }

@@ -1,9 +1,9 @@
 //! The image file of a plot: its format from its name, opened before any input is read so that
 //! a wrong name or an unwritable place is reported at once, not after minutes of decoding.
 
-use std::fs::{self, File, OpenOptions};
+use std::fs::{self, File};
 use std::io::{self, Write};
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use crate::error::CliError;
 use hwfoc_io::write::WriteError;
@@ -31,19 +31,23 @@ impl ImageFormat {
     }
 }
 
-/// The image file, open for writing but not yet truncated: an existing file stays as it was
-/// until the image is ready, and a file this command created is removed if nothing is written.
+/// The image file: written under its partial name (`FILE.partial`, made when the target is
+/// opened, so that an unwritable place is reported at once) and renamed into place once the
+/// image is complete. An existing file stays as it was until then; the partial file is removed
+/// if nothing is written.
 #[derive(Debug)]
 pub struct Target {
     path: String,
     format: ImageFormat,
-    file: File,
-    created: bool,
-    written: bool,
+    /// The file replaced: the path, or the file a link at the path points to.
+    target: PathBuf,
+    partial: PathBuf,
+    file: Option<File>,
 }
 
 impl Target {
-    /// Checks the name's format and opens (or creates) the file.
+    /// Checks the name's format, refuses anything but a (new or) regular file, and creates the
+    /// partial file.
     pub fn open(path: &str) -> Result<Target, CliError> {
         let format = ImageFormat::from_name(path).ok_or_else(|| CliError::Usage {
             option: format!("-o {path}"),
@@ -54,20 +58,30 @@ impl Target {
             output: path.to_string(),
             source,
         };
-        let (file, created) = match OpenOptions::new().write(true).create_new(true).open(path) {
-            Ok(file) => (file, true),
-            Err(e) if e.kind() == io::ErrorKind::AlreadyExists => (
-                OpenOptions::new().write(true).open(path).map_err(create)?,
-                false,
-            ),
-            Err(e) => return Err(create(e).into()),
-        };
+        match fs::metadata(path) {
+            Ok(m) if m.is_dir() => return Err(create(io::ErrorKind::IsADirectory.into()).into()),
+            Ok(m) if !m.is_file() => {
+                return Err(CliError::Usage {
+                    option: format!("-o {path}"),
+                    message: "it is a device or a pipe, not a file: a plot is written to a \
+                              .png or .svg file"
+                        .to_string(),
+                });
+            }
+            _ => {}
+        }
+        // Through a link, the file it points to is replaced, not the link.
+        let target = fs::canonicalize(path).unwrap_or_else(|_| PathBuf::from(path));
+        let mut partial = target.clone().into_os_string();
+        partial.push(hwfoc_io::write::PARTIAL_SUFFIX);
+        let partial = PathBuf::from(partial);
+        let file = File::create(&partial).map_err(create)?;
         Ok(Target {
             path: path.to_string(),
             format,
-            file,
-            created,
-            written: false,
+            target,
+            partial,
+            file: Some(file),
         })
     }
 
@@ -81,27 +95,29 @@ impl Target {
         self.format
     }
 
-    /// Replaces the file's content with `bytes`.
+    /// Writes `bytes` as the file's content: to the partial file, then renamed into place.
     pub fn write(&mut self, bytes: &[u8]) -> Result<(), CliError> {
-        let result = self
-            .file
-            .set_len(0)
-            .and_then(|()| self.file.write_all(bytes))
-            .and_then(|()| self.file.flush());
-        result.map_err(|source| WriteError::Write {
+        let error = |source| WriteError::Write {
             output: self.path.clone(),
             source,
-        })?;
-        self.written = true;
+        };
+        let Some(mut file) = self.file.take() else {
+            return Err(error(io::Error::other("the image was written already")).into());
+        };
+        file.write_all(bytes)
+            .and_then(|()| file.flush())
+            .map_err(error)?;
+        drop(file);
+        fs::rename(&self.partial, &self.target).map_err(error)?;
         Ok(())
     }
 }
 
 impl Drop for Target {
-    /// Removes the file if this command created it and wrote nothing to it.
+    /// Removes the partial file if the image was not written.
     fn drop(&mut self) {
-        if self.created && !self.written {
-            let _ = fs::remove_file(&self.path);
+        if self.file.is_some() {
+            let _ = fs::remove_file(&self.partial);
         }
     }
 }
