@@ -46,7 +46,8 @@ fn plain_prints_each_esc_every_interval_and_alarms_by_name() {
             .filter(|l| l.contains(&format!(" esc{esc} sim:esc{esc}: ")))
             .filter(|l| !l.contains(" ALARM esc") && !l.contains(" CLEARED esc"))
             .collect();
-        assert!((6..=8).contains(&status.len()), "{lines:#?}");
+        // 7 on an idle machine; a busy one may wake late and skip a line (never add one).
+        assert!((4..=8).contains(&status.len()), "{lines:#?}");
         // The first line comes after a second: the idle ESC has sent frames by then.
         assert!(
             status[0].contains(" V ") && status[0].contains("fr/s"),

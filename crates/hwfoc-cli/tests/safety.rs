@@ -296,3 +296,26 @@ fn a_plot_is_written_whole_to_a_file_and_not_to_a_device() {
     assert!(std::fs::read(&png).unwrap().starts_with(b"\x89PNG"));
     assert!(!dir.path("p.png.partial").exists());
 }
+
+/// A directory the user may not write: the error says so and where to write instead. As root
+/// (CI), the command runs as `nobody`, who may not write there either.
+#[cfg(unix)]
+#[test]
+fn permission_denied_on_an_output_says_so() {
+    use std::os::unix::fs::PermissionsExt;
+    let dir = Dir::new();
+    // The directory must be reachable by `nobody`, and not writable.
+    std::fs::set_permissions(dir.0.path(), std::fs::Permissions::from_mode(0o755)).unwrap();
+    let locked = dir.path("locked");
+    std::fs::create_dir(&locked).unwrap();
+    std::fs::set_permissions(&locked, std::fs::Permissions::from_mode(0o555)).unwrap();
+    let target = locked.join("out.csv");
+    let target = target.to_str().unwrap();
+    let o = common::run(
+        common::hwfoc_unprivileged().args(["decode", "--demo", "--format", "csv", "-o", target]),
+    );
+    assert_fails_with(
+        &o,
+        &format!("cannot write {target}: permission denied (choose another place with -o)"),
+    );
+}

@@ -283,3 +283,29 @@ mod unix {
         }
     }
 }
+
+/// Whether a check that needs `what` (a tool, another user) can run here. Where it cannot: in
+/// CI (the environment variable `CI` is set, and `.ci/run` installs every tool), the test fails
+/// loudly; elsewhere it says on standard error that the check is skipped.
+pub fn can_check(available: bool, what: &str) -> bool {
+    if !available {
+        assert!(
+            std::env::var_os("CI").is_none(),
+            "{what}: required in CI, where .ci/run provides it"
+        );
+        eprintln!("NOTICE: {what}: this check is skipped here");
+    }
+    available
+}
+
+/// `hwfoc` as the user `nobody` when the tests run as root (root may write and open anything,
+/// so permission errors can only be seen as another user); as the user itself otherwise.
+#[cfg(unix)]
+pub fn hwfoc_unprivileged() -> Command {
+    use std::os::unix::process::CommandExt;
+    let mut cmd = hwfoc();
+    if nix::unistd::geteuid().is_root() {
+        cmd.uid(65534).gid(65534);
+    }
+    cmd
+}
