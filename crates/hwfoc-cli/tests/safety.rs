@@ -319,3 +319,39 @@ fn permission_denied_on_an_output_says_so() {
         &format!("cannot write {target}: permission denied (choose another place with -o)"),
     );
 }
+
+/// Every command words a missing output directory the same way.
+#[test]
+fn a_missing_output_directory_is_worded_once() {
+    let csv = capture(XROTOR);
+    let csv = csv.to_str().unwrap();
+    let cases: [&[&str]; 7] = [
+        &["decode", csv, "-o", "/nonexistent-hwfoc/x.csv"],
+        &[
+            "decode",
+            "--format",
+            "parquet",
+            csv,
+            "-o",
+            "/nonexistent-hwfoc/x.csv",
+        ],
+        &["plot", csv, "-o", "/nonexistent-hwfoc/x.png"],
+        &["summary", csv, "--plot", "/nonexistent-hwfoc/x.svg"],
+        &["simulate", "-o", "/nonexistent-hwfoc/x.csv"],
+        &["simulate", "-o", "-", "--truth", "/nonexistent-hwfoc/x.csv"],
+        &[
+            "monitor",
+            "--sim",
+            "1",
+            "--plain",
+            "--duration",
+            "1",
+            "--record",
+            "/nonexistent-hwfoc/x.csv",
+        ],
+    ];
+    for args in cases {
+        let o = run(hwfoc().args(args).stdout(Stdio::null()));
+        assert_fails_with(&o, "the directory /nonexistent-hwfoc does not exist");
+    }
+}

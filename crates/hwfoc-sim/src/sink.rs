@@ -28,7 +28,7 @@ pub fn create(path: &str) -> Result<(String, Box<dyn Write>), WriteError> {
     if path == "-" {
         return Ok(("standard output".to_string(), Box::new(io::stdout())));
     }
-    let file = File::create(path).map_err(|source| WriteError::Write {
+    let file = File::create(path).map_err(|source| WriteError::Create {
         output: path.to_string(),
         source,
     })?;
