@@ -13,16 +13,22 @@
 //! Serial ports are opened with [`Input::open_ports`]: one input with one stream per port,
 //! times being the Unix time each byte was received.
 
+mod csv;
+mod error;
+mod ports;
+mod recording;
+
 use std::fmt;
 use std::fs::File;
-use std::io::{self, BufRead, BufReader, Cursor, Read};
-use std::sync::Arc;
-use std::sync::atomic::{AtomicBool, Ordering};
-use std::time::Duration;
+use std::io::{self, BufReader, Cursor, Read};
 
 use crate::pcapng;
-use crate::serial::{PortError, PortEvent, PortSet};
-use crate::stream::byte_times;
+use crate::serial::PortSet;
+
+use self::csv::{CsvRows, may_be_header};
+pub use self::error::InputError;
+use self::ports::Ports;
+use self::recording::RecordingReader;
 
 /// How many bytes a raw read asks for: small enough that what the kernel copies in is still in
 /// the L2 cache when the decoder reads it (1 MiB reads made `summary` 1.6x slower), large enough
@@ -36,12 +42,6 @@ const CLASSIC_PCAP: [[u8; 4]; 4] = [
     [0x4D, 0x3C, 0xB2, 0xA1],
     [0xA1, 0xB2, 0x3C, 0x4D],
 ];
-
-/// How many CSV rows make one batch.
-const CSV_BATCH_ROWS: usize = 1 << 16;
-
-/// How long a serial input waits for bytes before checking for Ctrl-C.
-const PORT_POLL: Duration = Duration::from_millis(100);
 
 /// The detected format of an input.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -84,55 +84,6 @@ enum Source {
     Csv(CsvRows),
     Recording(Box<RecordingReader>),
     Ports(Ports),
-}
-
-/// A pcapng recording being read.
-///
-/// Packets of the ports of a recording interleave, a few bytes each. They are gathered per
-/// port over a window of [`RECORDING_WINDOW_NS`] of recording time (or until a port has
-/// [`RECORDING_BATCH`] bytes), and each port's bytes of the window are handed out as one
-/// batch, in port order: so batches are kilobytes rather than a frame (decoding an 8-port
-/// recording is ten times faster), and records of different ports stay in time order to
-/// within the window (those of one port are always in order).
-struct RecordingReader {
-    reader: pcapng::Reader<Box<dyn Read>>,
-    /// Bytes and receive times gathered in the current window, by interface.
-    pending: Vec<(Vec<u8>, Vec<f64>)>,
-    /// While handing out the window's batches: the next interface to look at.
-    draining: Option<usize>,
-    /// Time of the first packet of the current window.
-    window_start: Option<u64>,
-    /// The file is read to its end (or to a read error, kept in `error`).
-    ended: bool,
-    error: Option<InputError>,
-    /// Interfaces whose link type is not telemetry, already warned about.
-    skipped: std::collections::HashSet<u32>,
-}
-
-/// Recording time gathered per port before its bytes are handed out (10 s: 4.8 kB of frames
-/// per port at 20 frames a second).
-const RECORDING_WINDOW_NS: u64 = 10_000_000_000;
-/// Most bytes gathered for one port before the window's batches are handed out.
-const RECORDING_BATCH: usize = 1 << 18;
-
-/// Live serial ports.
-struct Ports {
-    set: PortSet,
-    /// Set by Ctrl-C or SIGTERM: the input ends.
-    interrupted: Arc<AtomicBool>,
-}
-
-/// The rows of a logic-analyser CSV after its header line.
-struct CsvRows {
-    reader: BufReader<Box<dyn Read>>,
-    value_col: usize,
-    /// Whether each column is a parity or framing error flag.
-    error_cols: Vec<bool>,
-    /// Number of the last line read (1-based; the header is line 1).
-    line: u64,
-    row: Vec<u8>,
-    /// Rows flagged with a parity or framing error.
-    flagged: u64,
 }
 
 /// One opened input.
@@ -184,7 +135,7 @@ impl Input {
         Ok(Input::new(
             &names.join(", "),
             InputFormat::Serial,
-            Source::Ports(Ports { set, interrupted }),
+            Source::Ports(Ports::new(set, interrupted)),
             Vec::new(),
         ))
     }
@@ -250,49 +201,13 @@ impl Input {
                 ))
         {
             let reader: Box<dyn Read> = Box::new(Cursor::new(head).chain(reader));
-            let source = Source::Recording(Box::new(RecordingReader {
-                reader: pcapng::Reader::new(reader),
-                pending: Vec::new(),
-                draining: None,
-                window_start: None,
-                ended: false,
-                error: None,
-                skipped: Default::default(),
-            }));
+            let source = Source::Recording(Box::new(RecordingReader::new(reader)));
             return Ok(Input::new(name, InputFormat::Recording, source, Vec::new()));
         }
-        let is_csv = {
-            let text = String::from_utf8_lossy(&head);
-            let first = header_columns(&text);
-            first[0].starts_with("time") && first.iter().any(|c| c == "value")
-        };
-        let (format, source, pending) = if is_csv {
-            let mut reader = BufReader::with_capacity(BATCH, reader);
-            if head.last() != Some(&b'\n') {
-                read_line(&mut reader, &mut head).map_err(read_err)?;
-                if head.last() != Some(&b'\n') && head.len() > MAX_LINE {
-                    return Err(InputError::Csv {
-                        input: name.to_string(),
-                        line: 1,
-                        message: format!(
-                            "the header line is longer than {MAX_LINE} bytes: not a \
-                             logic-analyser export"
-                        ),
-                    });
-                }
-            }
-            let header = header_columns(&String::from_utf8_lossy(&head));
-            let value_col = header.iter().position(|c| c == "value").unwrap_or(1);
-            let error_cols = header.iter().map(|c| c.contains("error")).collect();
-            let source = Source::Csv(CsvRows {
-                reader,
-                value_col,
-                error_cols,
-                line: 1,
-                row: Vec::new(),
-                flagged: 0,
-            });
-            (InputFormat::AnalyzerCsv, source, Vec::new())
+        let (format, source, pending) = if csv::is_header(&head) {
+            let reader = BufReader::with_capacity(BATCH, reader);
+            let rows = CsvRows::open(name, reader, head)?;
+            (InputFormat::AnalyzerCsv, Source::Csv(rows), Vec::new())
         } else {
             (InputFormat::Raw, Source::Raw { reader }, head)
         };
@@ -328,7 +243,7 @@ impl Input {
     /// the frame checksum decides).
     pub fn flagged_bytes(&self) -> u64 {
         match &self.source {
-            Source::Csv(rows) => rows.flagged,
+            Source::Csv(rows) => rows.flagged(),
             _ => 0,
         }
     }
@@ -338,8 +253,8 @@ impl Input {
     pub fn streams(&self) -> usize {
         match &self.source {
             Source::Raw { .. } | Source::Csv(_) => 1,
-            Source::Recording(rec) => rec.reader.interfaces().len(),
-            Source::Ports(ports) => ports.set.names().len(),
+            Source::Recording(rec) => rec.interfaces().len(),
+            Source::Ports(ports) => ports.names().len(),
         }
     }
 
@@ -347,8 +262,8 @@ impl Input {
     /// was recorded from), or the input's name for a single-stream input.
     pub fn stream_name(&self, i: usize) -> String {
         let name = match &self.source {
-            Source::Recording(rec) => rec.reader.interfaces().get(i).map(|f| f.name.clone()),
-            Source::Ports(ports) => ports.set.names().get(i).cloned(),
+            Source::Recording(rec) => rec.interfaces().get(i).map(|f| f.name.clone()),
+            Source::Ports(ports) => ports.names().get(i).cloned(),
             Source::Raw { .. } | Source::Csv(_) => None,
         };
         name.unwrap_or_else(|| self.name.clone())
@@ -446,212 +361,6 @@ impl Input {
     }
 }
 
-impl RecordingReader {
-    /// Hands out the next batch of the current window into `bytes` and `times` (which are
-    /// empty) and returns its interface, reading the next window when this one is done;
-    /// leaves `bytes` empty at the end of the file. A read error is returned after the
-    /// bytes before it. Damage and notes in the file are reported on standard error as they
-    /// are met.
-    fn read(
-        &mut self,
-        name: &str,
-        bytes: &mut Vec<u8>,
-        times: &mut Vec<f64>,
-    ) -> Result<usize, InputError> {
-        loop {
-            if let Some(from) = self.draining {
-                if let Some(i) = (from..self.pending.len()).find(|&i| !self.pending[i].0.is_empty())
-                {
-                    std::mem::swap(bytes, &mut self.pending[i].0);
-                    std::mem::swap(times, &mut self.pending[i].1);
-                    self.draining = Some(i + 1);
-                    return Ok(i);
-                }
-                self.draining = None;
-            }
-            if self.ended {
-                return self.error.take().map_or(Ok(0), Err);
-            }
-            if let Err(e) = self.read_window(name) {
-                self.error = Some(e);
-                self.ended = true;
-            }
-            self.draining = Some(0);
-        }
-    }
-
-    /// Reads packets into the per-interface buffers until the window is over, a buffer is
-    /// full, or the file ends.
-    fn read_window(&mut self, name: &str) -> Result<(), InputError> {
-        self.window_start = None;
-        loop {
-            let packet = self
-                .reader
-                .next_packet()
-                .map_err(|source| InputError::Read {
-                    input: name.to_string(),
-                    source,
-                });
-            let packet = match packet {
-                Ok(Some(p)) => p,
-                Ok(None) => {
-                    self.ended = true;
-                    self.report_damage(name);
-                    return Ok(());
-                }
-                Err(e) => {
-                    self.report_damage(name);
-                    return Err(e);
-                }
-            };
-            let (iface, t_ns, interface) = (packet.iface, packet.t_ns, packet.interface);
-            if let Some(text) = packet.comment {
-                eprintln!("hwfoc: note: {name}: {}: {text}", interface.name);
-            }
-            let mut full = false;
-            if packet.data.is_empty() {
-                // A note only.
-            } else if !interface.is_user_link_type() {
-                if self.skipped.insert(iface) {
-                    eprintln!(
-                        "hwfoc: warning: {name}: interface {} has link type {}, not serial \
-                         bytes: its packets are skipped",
-                        interface.name, interface.link_type
-                    );
-                }
-            } else {
-                let i = iface as usize;
-                if self.pending.len() <= i {
-                    self.pending.resize_with(i + 1, Default::default);
-                }
-                let (bytes, times) = &mut self.pending[i];
-                byte_times(t_ns, interface.byte_ns(), packet.data.len(), times);
-                bytes.extend_from_slice(packet.data);
-                let start = *self.window_start.get_or_insert(t_ns);
-                full = bytes.len() >= RECORDING_BATCH
-                    || t_ns.saturating_sub(start) >= RECORDING_WINDOW_NS;
-            }
-            self.report_damage(name);
-            if full {
-                return Ok(());
-            }
-        }
-    }
-
-    fn report_damage(&mut self, name: &str) {
-        for damage in self.reader.take_damage() {
-            eprintln!("hwfoc: warning: {name}: {damage}");
-        }
-    }
-}
-
-impl Ports {
-    /// Waits for the next chunk of bytes and puts it, with its receive times, in `bytes` and
-    /// `times`; returns its port. Returns with nothing once interrupted. Ports that are lost
-    /// or come back are reported on standard error.
-    fn read(&mut self, bytes: &mut Vec<u8>, times: &mut Vec<f64>) -> usize {
-        let per_byte = pcapng::byte_ns(self.set.baud());
-        while !self.interrupted.load(Ordering::Relaxed) {
-            match self.set.next_event(PORT_POLL) {
-                Some(PortEvent::Data {
-                    port,
-                    t_ns,
-                    bytes: data,
-                }) => {
-                    byte_times(t_ns, per_byte, data.len(), times);
-                    bytes.extend_from_slice(&data);
-                    return port;
-                }
-                Some(PortEvent::Lost { port, reason, .. }) => eprintln!(
-                    "hwfoc: warning: {} lost ({reason}); waiting for it to come back",
-                    self.set.names()[port]
-                ),
-                Some(PortEvent::Back { port, .. }) => {
-                    eprintln!("hwfoc: {} is back", self.set.names()[port]);
-                }
-                None => {}
-            }
-        }
-        0
-    }
-}
-
-impl CsvRows {
-    /// Reads rows into `bytes` and `times` until a batch is full or the input ends. On an error,
-    /// the rows before it stay in `bytes` and `times`.
-    fn read(
-        &mut self,
-        name: &str,
-        bytes: &mut Vec<u8>,
-        times: &mut Vec<f64>,
-    ) -> Result<(), InputError> {
-        let CsvRows {
-            reader,
-            value_col,
-            error_cols,
-            line,
-            row,
-            flagged,
-        } = self;
-        let value_col = *value_col;
-        while bytes.len() < CSV_BATCH_ROWS {
-            row.clear();
-            let n = read_line(reader, row).map_err(|source| InputError::Read {
-                input: name.to_string(),
-                source,
-            })?;
-            if n == 0 {
-                break;
-            }
-            *line += 1;
-            let bad = |message: String| InputError::Csv {
-                input: name.to_string(),
-                line: *line,
-                message,
-            };
-            if row.last() != Some(&b'\n') && row.len() > MAX_LINE {
-                return Err(bad(format!(
-                    "the line is longer than {MAX_LINE} bytes: not a logic-analyser export"
-                )));
-            }
-            let text = std::str::from_utf8(row)
-                .map_err(|_| bad("not valid UTF-8 text".to_string()))?
-                .trim_end_matches(['\n', '\r']);
-            if text.trim().is_empty() {
-                continue; // a blank line
-            }
-            // One pass over the fields, whatever their number.
-            let (mut time, mut value, mut flag) = (None, None, false);
-            for (i, field) in text.split(',').enumerate() {
-                let field = unquote(field);
-                if i == 0 {
-                    time = Some(field);
-                }
-                if i == value_col {
-                    value = Some(field);
-                }
-                flag |= !field.is_empty() && error_cols.get(i).copied().unwrap_or(false);
-            }
-            let time = time
-                .and_then(|t| t.parse::<f64>().ok())
-                .filter(|t| t.is_finite())
-                .ok_or_else(|| bad(format!("bad time {}", field_text(time))))?;
-            let value = value.and_then(parse_byte).ok_or_else(|| {
-                bad(format!(
-                    "bad byte value {} (expected 0x00..0xFF or 0..255)",
-                    field_text(value)
-                ))
-            })?;
-            if flag {
-                *flagged += 1;
-            }
-            bytes.push(value);
-            times.push(time);
-        }
-        Ok(())
-    }
-}
-
 /// Reads a small file whole (a configuration file, a throttle profile): at most `limit` bytes;
 /// a larger file (or an endless one such as `/dev/zero`) is an error of kind `InvalidData`
 /// saying so, rather than memory for whatever it holds.
@@ -670,17 +379,6 @@ pub fn read_small_file(path: impl AsRef<std::path::Path>, limit: u64) -> io::Res
     Ok(bytes)
 }
 
-/// Whether `head`, the first bytes of an input, can still be the start of a CSV header line
-/// (which begins with "Time", possibly after a UTF-8 byte-order mark).
-fn may_be_header(head: &[u8]) -> bool {
-    const BOM: &[u8] = b"\xEF\xBB\xBF";
-    if head.len() < BOM.len() && BOM.starts_with(head) {
-        return true;
-    }
-    let body = head.strip_prefix(BOM).unwrap_or(head);
-    body.first().is_none_or(|b| b.eq_ignore_ascii_case(&b'T'))
-}
-
 /// `read` that retries when interrupted by a signal.
 fn read_some(reader: &mut dyn Read, buf: &mut [u8]) -> io::Result<usize> {
     loop {
@@ -691,185 +389,10 @@ fn read_some(reader: &mut dyn Read, buf: &mut [u8]) -> io::Result<usize> {
     }
 }
 
-/// The lower-cased, trimmed column names of a CSV header line.
-fn header_columns(line: &str) -> Vec<String> {
-    line.trim_start_matches('\u{FEFF}')
-        .trim_end()
-        .split(',')
-        .map(|c| unquote(c).to_ascii_lowercase())
-        .collect()
-}
-
-/// A CSV field without surrounding blanks and quotes.
-fn unquote(field: &str) -> &str {
-    let f = field.trim();
-    f.strip_prefix('"')
-        .and_then(|f| f.strip_suffix('"'))
-        .unwrap_or(f)
-        .trim()
-}
-
-/// A byte value as a logic analyser exports it: `0x9B`, `0X9b` or `155`.
-fn parse_byte(text: &str) -> Option<u8> {
-    match text.strip_prefix("0x").or_else(|| text.strip_prefix("0X")) {
-        Some(hex) if !hex.is_empty() && hex.len() <= 2 => u8::from_str_radix(hex, 16).ok(),
-        Some(_) => None,
-        None => text.parse().ok(),
-    }
-}
-
-/// A CSV field quoted for an error message, cut after [`QUOTED`] characters.
-fn field_text(field: Option<&str>) -> String {
-    match field {
-        None => "(missing)".to_string(),
-        Some(f) if f.chars().count() > QUOTED => {
-            let cut: String = f.chars().take(QUOTED).collect();
-            format!("{cut:?}... ({} bytes)", f.len())
-        }
-        Some(f) => format!("{f:?}"),
-    }
-}
-
-/// Characters of a field quoted in an error message, at most.
-const QUOTED: usize = 40;
-
-/// Longest line of a logic-analyser CSV (a real one is under 100 bytes): a longer one is an
-/// error rather than memory for whatever the file holds.
-const MAX_LINE: usize = 64 << 10;
-
-/// Reads a line into `row` (which is empty), newline included, but no more than
-/// [`MAX_LINE`] + 1 bytes: a longer line is left cut, without its newline.
-fn read_line(reader: &mut impl BufRead, row: &mut Vec<u8>) -> io::Result<usize> {
-    reader.take(MAX_LINE as u64 + 1).read_until(b'\n', row)
-}
-
-/// Why an input could not be read. Each names the input as the user gave it.
-#[derive(Debug)]
-pub enum InputError {
-    /// An input could not be opened.
-    Open {
-        /// The input as named on the command line.
-        input: String,
-        /// Why.
-        source: io::Error,
-    },
-    /// An input is a directory.
-    IsDirectory {
-        /// The input as named on the command line.
-        input: String,
-    },
-    /// Reading an input failed part-way.
-    Read {
-        /// The input as named on the command line.
-        input: String,
-        /// Why.
-        source: io::Error,
-    },
-    /// An input has no bytes at all.
-    Empty {
-        /// The input as named on the command line.
-        input: String,
-    },
-    /// A row of a logic-analyser CSV could not be read.
-    Csv {
-        /// The input as named on the command line.
-        input: String,
-        /// 1-based line number in the file.
-        line: u64,
-        /// What is wrong with it.
-        message: String,
-    },
-    /// Frames were to be selected by time, but the input has no receive times.
-    NoTiming {
-        /// The input as named on the command line.
-        input: String,
-    },
-    /// More streams than the record's `esc` column can number (0..=255).
-    TooManyEscs {
-        /// The input whose stream would be ESC 256 or more.
-        input: String,
-    },
-    /// A classic libpcap file: recordings are read in pcapng.
-    ClassicPcap {
-        /// The input as named on the command line.
-        input: String,
-    },
-    /// A serial port could not be opened.
-    Port(PortError),
-}
-
-impl From<PortError> for InputError {
-    fn from(e: PortError) -> Self {
-        InputError::Port(e)
-    }
-}
-
-impl fmt::Display for InputError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            InputError::Open { input, source } => write!(f, "cannot open {input}: {source}"),
-            InputError::IsDirectory { input } => {
-                write!(f, "{input} is a directory, not a capture file")
-            }
-            InputError::Read { input, source } => write!(f, "cannot read {input}: {source}"),
-            InputError::Empty { input } => {
-                write!(f, "{input} is empty: there is nothing to decode")
-            }
-            InputError::Csv {
-                input,
-                line,
-                message,
-            } => write!(f, "{input}:{line}: {message}"),
-            InputError::NoTiming { input } => write!(
-                f,
-                "--from/--to select frames by time, but {input} is raw bytes without receive \
-                 times: use a recording (`hwfoc record`) or a logic-analyser CSV, or leave out \
-                 --from/--to"
-            ),
-            InputError::TooManyEscs { input } => write!(
-                f,
-                "{input}: too many streams: records number ESCs 0 to 255; read fewer inputs at once"
-            ),
-            InputError::ClassicPcap { input } => {
-                let converted = match input.strip_suffix(".pcap") {
-                    Some(stem) => format!("{stem}.pcapng"),
-                    None => format!("{input}.pcapng"),
-                };
-                write!(
-                    f,
-                    "{input} is a classic libpcap file, not pcapng: convert it with \
-                     `editcap -F pcapng {input} {converted}`, then decode that"
-                )
-            }
-            InputError::Port(e) => e.fmt(f),
-        }
-    }
-}
-
-impl std::error::Error for InputError {
-    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
-        match self {
-            InputError::Open { source, .. } | InputError::Read { source, .. } => Some(source),
-            InputError::Port(e) => Some(e),
-            _ => None,
-        }
-    }
-}
-
 #[cfg(test)]
 mod tests {
+    use super::recording::RECORDING_WINDOW_NS;
     use super::*;
-
-    #[test]
-    fn byte_values_in_hex_and_decimal() {
-        assert_eq!(parse_byte("0x9B"), Some(0x9B));
-        assert_eq!(parse_byte("0X0a"), Some(0x0A));
-        assert_eq!(parse_byte("155"), Some(155));
-        assert_eq!(parse_byte("0x"), None);
-        assert_eq!(parse_byte("0x100"), None);
-        assert_eq!(parse_byte("256"), None);
-        assert_eq!(parse_byte("zz"), None);
-    }
 
     fn read_all(input: &mut Input) -> (Vec<u8>, Option<Vec<f64>>) {
         let (mut bytes, mut times) = (Vec::new(), None::<Vec<f64>>);

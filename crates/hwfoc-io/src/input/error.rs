@@ -1,0 +1,119 @@
+//! Why an input could not be read.
+
+use std::fmt;
+use std::io;
+
+use crate::serial::PortError;
+
+/// Why an input could not be read. Each names the input as the user gave it.
+#[derive(Debug)]
+pub enum InputError {
+    /// An input could not be opened.
+    Open {
+        /// The input as named on the command line.
+        input: String,
+        /// Why.
+        source: io::Error,
+    },
+    /// An input is a directory.
+    IsDirectory {
+        /// The input as named on the command line.
+        input: String,
+    },
+    /// Reading an input failed part-way.
+    Read {
+        /// The input as named on the command line.
+        input: String,
+        /// Why.
+        source: io::Error,
+    },
+    /// An input has no bytes at all.
+    Empty {
+        /// The input as named on the command line.
+        input: String,
+    },
+    /// A row of a logic-analyser CSV could not be read.
+    Csv {
+        /// The input as named on the command line.
+        input: String,
+        /// 1-based line number in the file.
+        line: u64,
+        /// What is wrong with it.
+        message: String,
+    },
+    /// Frames were to be selected by time, but the input has no receive times.
+    NoTiming {
+        /// The input as named on the command line.
+        input: String,
+    },
+    /// More streams than the record's `esc` column can number (0..=255).
+    TooManyEscs {
+        /// The input whose stream would be ESC 256 or more.
+        input: String,
+    },
+    /// A classic libpcap file: recordings are read in pcapng.
+    ClassicPcap {
+        /// The input as named on the command line.
+        input: String,
+    },
+    /// A serial port could not be opened.
+    Port(PortError),
+}
+
+impl From<PortError> for InputError {
+    fn from(e: PortError) -> Self {
+        InputError::Port(e)
+    }
+}
+
+impl fmt::Display for InputError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            InputError::Open { input, source } => write!(f, "cannot open {input}: {source}"),
+            InputError::IsDirectory { input } => {
+                write!(f, "{input} is a directory, not a capture file")
+            }
+            InputError::Read { input, source } => write!(f, "cannot read {input}: {source}"),
+            InputError::Empty { input } => {
+                write!(f, "{input} is empty: there is nothing to decode")
+            }
+            InputError::Csv {
+                input,
+                line,
+                message,
+            } => write!(f, "{input}:{line}: {message}"),
+            InputError::NoTiming { input } => write!(
+                f,
+                "--from/--to select frames by time, but {input} is raw bytes without receive \
+                 times: use a recording (`hwfoc record`) or a logic-analyser CSV, or leave out \
+                 --from/--to"
+            ),
+            InputError::TooManyEscs { input } => write!(
+                f,
+                "{input}: too many streams: records number ESCs 0 to 255; read fewer inputs at once"
+            ),
+            InputError::ClassicPcap { input } => {
+                let converted = match input.strip_suffix(".pcap") {
+                    Some(stem) => format!("{stem}.pcapng"),
+                    None => format!("{input}.pcapng"),
+                };
+                write!(
+                    f,
+                    "{input} is a classic libpcap file, not pcapng: convert it with \
+                     `editcap -F pcapng {input} {converted}`, then decode that"
+                )
+            }
+            InputError::Port(e) => e.fmt(f),
+        }
+    }
+}
+
+impl std::error::Error for InputError {
+    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
+        match self {
+            InputError::Open { source, .. } | InputError::Read { source, .. } => Some(source),
+            InputError::Port(e) => Some(e),
+            _ => None,
+        }
+    }
+}

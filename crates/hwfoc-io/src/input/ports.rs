@@ -1,0 +1,60 @@
+//! Live serial ports as an input.
+
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::Duration;
+
+use crate::pcapng;
+use crate::serial::{PortEvent, PortSet};
+use crate::stream::byte_times;
+
+/// How long a serial input waits for bytes before checking for Ctrl-C.
+const PORT_POLL: Duration = Duration::from_millis(100);
+
+/// Live serial ports.
+pub(super) struct Ports {
+    set: PortSet,
+    /// Set by Ctrl-C or SIGTERM: the input ends.
+    interrupted: Arc<AtomicBool>,
+}
+
+impl Ports {
+    /// Reads `set` until `interrupted` is set.
+    pub(super) fn new(set: PortSet, interrupted: Arc<AtomicBool>) -> Ports {
+        Ports { set, interrupted }
+    }
+
+    /// The ports' names, in order.
+    pub(super) fn names(&self) -> &[String] {
+        self.set.names()
+    }
+
+    /// Waits for the next chunk of bytes and puts it, with its receive times, in `bytes` and
+    /// `times`; returns its port. Returns with nothing once interrupted. Ports that are lost
+    /// or come back are reported on standard error.
+    pub(super) fn read(&mut self, bytes: &mut Vec<u8>, times: &mut Vec<f64>) -> usize {
+        let per_byte = pcapng::byte_ns(self.set.baud());
+        while !self.interrupted.load(Ordering::Relaxed) {
+            match self.set.next_event(PORT_POLL) {
+                Some(PortEvent::Data {
+                    port,
+                    t_ns,
+                    bytes: data,
+                }) => {
+                    byte_times(t_ns, per_byte, data.len(), times);
+                    bytes.extend_from_slice(&data);
+                    return port;
+                }
+                Some(PortEvent::Lost { port, reason, .. }) => eprintln!(
+                    "hwfoc: warning: {} lost ({reason}); waiting for it to come back",
+                    self.set.names()[port]
+                ),
+                Some(PortEvent::Back { port, .. }) => {
+                    eprintln!("hwfoc: {} is back", self.set.names()[port]);
+                }
+                None => {}
+            }
+        }
+        0
+    }
+}
