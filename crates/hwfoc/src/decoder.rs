@@ -10,11 +10,11 @@
 //! a cut frame or a run of garbage never hides a following intact frame.
 
 use crate::frame::{
-    CMD_DATA, DATA_FRAME_LEN, DATA_LENGTH_BYTE, DataFrame, Frame, MAX_FRAME_LEN, SYNC, VERSION,
-    check_data, checksum,
+    CMD_DATA, DATA_FRAME_LEN, DATA_LENGTH_BYTE, DataFrame, Frame, MAX_FRAME_LEN, check_data,
 };
 use crate::info::{CMD_INFO, INFO_FRAME_LEN, INFO_LENGTH_BYTE, InfoFrame};
 use crate::stats::LinkStats;
+use crate::wire::{SYNC, VERSION, sum16};
 
 /// A frame and where it started in the stream.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -92,7 +92,7 @@ fn scan_next(
     // Back-to-back frames, the usual case: a data frame starts right here.
     if let Some(d) = data[*pos..].first_chunk::<DATA_FRAME_LEN>()
         && u32::from_le_bytes([d[0], d[1], d[2], d[3]]) == DATA_HEADER
-        && checksum(&d[..22]) == u16::from_le_bytes([d[22], d[23]])
+        && sum16(&d[..22]) == u16::from_le_bytes([d[22], d[23]])
     {
         let i = *pos;
         let d = DataFrame::from_verified(d);
@@ -116,7 +116,7 @@ fn scan_next(
         // byte. Same verdicts as the general path below.
         if let Some(d) = rest.first_chunk::<DATA_FRAME_LEN>() {
             let header = u32::from_le_bytes([d[0], d[1], d[2], d[3]]);
-            let sum = u32::from(checksum(&d[..22]));
+            let sum = u32::from(sum16(&d[..22]));
             let found = u32::from(u16::from_le_bytes([d[22], d[23]]));
             if (sum ^ found) | (header ^ DATA_HEADER) == 0 {
                 let d = DataFrame::from_verified(d);

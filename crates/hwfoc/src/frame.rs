@@ -13,11 +13,7 @@ use core::fmt;
 use crate::info::{INFO_FRAME_LEN, INFO_LENGTH_BYTE, InfoFrame};
 use crate::status::Status;
 use crate::units::{Settings, Temperature};
-
-/// First byte of every HW-FOC frame.
-pub const SYNC: u8 = 0x9B;
-/// Protocol version byte (byte 2) of every frame seen on real ESCs.
-pub const VERSION: u8 = 0x01;
+use crate::wire::{Checksum, SYNC, VERSION};
 /// Command byte of a real-time data frame.
 pub const CMD_DATA: u8 = 0x02;
 /// Length byte of a data frame: the number of bytes before the two checksum bytes.
@@ -26,25 +22,6 @@ pub const DATA_LENGTH_BYTE: u8 = 0x16;
 pub const DATA_FRAME_LEN: usize = 24;
 /// Length of the longest frame on the wire (the device-information frame).
 pub const MAX_FRAME_LEN: usize = INFO_FRAME_LEN;
-
-/// The 16-bit wrapping sum of `bytes`, the checksum of a data frame.
-///
-/// ```
-/// // The first frame of the XRotor capture: sum 0x080D, sent as `0D 08`.
-/// let frame = [0x9B, 0x16, 0x01, 0x02, 0x05, 0xC2, 0, 0, 0, 0, 0, 0, 0x00, 0xF7,
-///              0xFF, 0xFF, 0xFF, 0xFF, 0xCE, 0xD1, 0x00, 0x00];
-/// assert_eq!(hwfoc::frame::checksum(&frame), 0x080D);
-/// ```
-#[inline]
-pub fn checksum(bytes: &[u8]) -> u16 {
-    // Summing into a u32 first lets the compiler vectorise; the wrap to 16 bits is exact because
-    // no realistic slice (< 16 MiB) overflows a u32.
-    let mut sum = 0u32;
-    for &b in bytes {
-        sum += u32::from(b);
-    }
-    sum as u16
-}
 
 /// One real-time telemetry frame (command 0x02), every field as the raw integer sent on the wire.
 ///
@@ -145,8 +122,7 @@ impl DataFrame {
         f[18] = self.mos_adc;
         f[19] = self.cap_adc;
         f[20..22].copy_from_slice(&self.status.0.to_be_bytes());
-        let sum = checksum(&f[..22]);
-        f[22..24].copy_from_slice(&sum.to_le_bytes());
+        Checksum::Sum16Le.seal(&mut f);
         f
     }
 
@@ -200,11 +176,7 @@ impl DataFrame {
 /// already matched).
 #[inline]
 pub(crate) fn check_data(f: &[u8; DATA_FRAME_LEN]) -> Result<(), FrameError> {
-    let expected = checksum(&f[..22]);
-    let found = u16::from_le_bytes([f[22], f[23]]);
-    if expected != found {
-        return Err(FrameError::Checksum { expected, found });
-    }
+    Checksum::Sum16Le.verify(f)?;
     if f[2] != VERSION || f[3] != CMD_DATA {
         return Err(FrameError::UnknownCommand {
             version: f[2],

@@ -17,7 +17,8 @@
 
 use core::fmt;
 
-use crate::frame::{FrameError, SYNC, VERSION, checksum};
+use crate::frame::FrameError;
+use crate::wire::{Checksum, SYNC, VERSION};
 
 /// Length byte of a device-information frame: bytes before the check byte.
 pub const INFO_LENGTH_BYTE: u8 = 0x4C;
@@ -143,11 +144,7 @@ impl InfoFrame {
     /// Checks and decodes a 77-byte candidate whose sync and length bytes already matched.
     #[inline]
     pub(crate) fn parse_exact(f: &[u8; INFO_FRAME_LEN]) -> Result<Self, FrameError> {
-        let expected = checksum(&f[..76]) & 0xFF;
-        let found = u16::from(f[76]);
-        if expected != found {
-            return Err(FrameError::Checksum { expected, found });
-        }
+        Checksum::Sum8.verify(f)?;
         if f[2] != VERSION || f[3] != CMD_INFO {
             return Err(FrameError::UnknownCommand {
                 version: f[2],
@@ -170,7 +167,7 @@ impl InfoFrame {
         let mut f = [0u8; INFO_FRAME_LEN];
         f[..4].copy_from_slice(&[SYNC, INFO_LENGTH_BYTE, VERSION, CMD_INFO]);
         f[4..76].copy_from_slice(&self.text);
-        f[76] = checksum(&f[..76]) as u8;
+        Checksum::Sum8.seal(&mut f);
         f
     }
 

@@ -9,6 +9,7 @@ pub mod info;
 pub mod stats;
 pub mod status;
 pub mod units;
+pub mod wire;
 
 pub use decoder::{Decoded, Decoder, Frames, frames};
 pub use frame::{DataFrame, Frame, FrameError, Parsed, parse};

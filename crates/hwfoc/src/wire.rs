@@ -1,0 +1,196 @@
+//! What every HW-FOC frame shares on the wire: the line settings, the sync and version bytes and
+//! the kinds of check bytes.
+//!
+//! Every HW-FOC frame has the same outline:
+//!
+//! ```text
+//!  0      1             2        3        4 ..              LEN - w .. LEN
+//!  9B     length byte   version  command  payload           check bytes (w = 1 or 2)
+//! ```
+//!
+//! The length byte counts the bytes before the check bytes (`LEN - w`) and is what tells the
+//! kinds apart; version and command are then checked against the kind (see `PROTOCOL-NOTES.md`).
+
+use crate::frame::FrameError;
+
+/// Baud rate of the HW-FOC telemetry wire (8 data bits, no parity, 1 stop bit: 8N1).
+pub const BAUD_RATE: u32 = 19_200;
+
+/// Bits on the wire per byte on an 8N1 line: start bit, 8 data bits, stop bit.
+pub const BITS_PER_BYTE: u32 = 10;
+
+/// Duration of one byte on an 8N1 wire at `baud` (a baud rate of 0 is taken as 1), in
+/// nanoseconds: `10e9 / baud`, about 520 833.3 ns at [`BAUD_RATE`].
+///
+/// The one definition of byte timing: recorders and simulators that place bytes in time use it,
+/// so that their timestamps agree to the last bit.
+///
+/// ```
+/// use hwfoc::wire::{BAUD_RATE, byte_ns};
+///
+/// assert_eq!(byte_ns(BAUD_RATE), 1e10 / 19200.0);
+/// assert!((24.0 * byte_ns(BAUD_RATE) - 12.5e6).abs() < 1e-3); // a data frame lasts 12.5 ms
+/// ```
+#[inline]
+pub const fn byte_ns(baud: u32) -> f64 {
+    // 10e9 is BITS_PER_BYTE * 1e9, written as one exact constant.
+    10e9 / (if baud == 0 { 1 } else { baud }) as f64
+}
+
+/// First byte of every HW-FOC frame.
+pub const SYNC: u8 = 0x9B;
+/// Protocol version byte (byte 2) of every frame seen on real ESCs.
+pub const VERSION: u8 = 0x01;
+
+/// The 16-bit wrapping sum of `bytes`: the checksum of a data frame, and (its low byte) the check
+/// byte of a device-information frame.
+///
+/// ```
+/// // The first frame of the XRotor capture: sum 0x080D, sent as `0D 08`.
+/// let frame = [0x9B, 0x16, 0x01, 0x02, 0x05, 0xC2, 0, 0, 0, 0, 0, 0, 0x00, 0xF7,
+///              0xFF, 0xFF, 0xFF, 0xFF, 0xCE, 0xD1, 0x00, 0x00];
+/// assert_eq!(hwfoc::wire::sum16(&frame), 0x080D);
+/// ```
+#[inline]
+pub fn sum16(bytes: &[u8]) -> u16 {
+    // Summing into a u32 first lets the compiler vectorise; the wrap to 16 bits is exact because
+    // no realistic slice (< 16 MiB) overflows a u32.
+    let mut sum = 0u32;
+    for &b in bytes {
+        sum += u32::from(b);
+    }
+    sum as u16
+}
+
+/// How a frame kind protects its bytes: the check bytes at the end of the frame.
+///
+/// A new kind of check (DataLink V2's CRC-16/XMODEM, say) is one more arm here and in the
+/// methods below.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[non_exhaustive]
+pub enum Checksum {
+    /// The 16-bit wrapping sum of every byte before the check bytes, sent low byte first
+    /// (2 check bytes): data frames. Real frames do not match the CRC-16/MODBUS that one revision
+    /// of the vendor document names; the sum does (`PROTOCOL-NOTES.md`).
+    Sum16Le,
+    /// The low byte of that sum (1 check byte): device-information frames.
+    Sum8,
+}
+
+impl Checksum {
+    /// Number of check bytes at the end of the frame.
+    #[inline]
+    pub const fn width(self) -> usize {
+        match self {
+            Checksum::Sum16Le => 2,
+            Checksum::Sum8 => 1,
+        }
+    }
+
+    /// The check value of `covered`, the bytes of a frame before its check bytes.
+    #[inline]
+    pub fn compute(self, covered: &[u8]) -> u16 {
+        match self {
+            Checksum::Sum16Le => sum16(covered),
+            Checksum::Sum8 => sum16(covered) & 0xFF,
+        }
+    }
+
+    /// The check value carried by `check`, the check bytes of a frame ([`Checksum::width`] of
+    /// them; `None` if fewer are given).
+    #[inline]
+    pub fn carried(self, check: &[u8]) -> Option<u16> {
+        match self {
+            Checksum::Sum16Le => check.first_chunk().map(|&b| u16::from_le_bytes(b)),
+            Checksum::Sum8 => check.first().map(|&b| u16::from(b)),
+        }
+    }
+
+    /// Checks the check bytes at the end of `frame` (a whole frame, nothing after it).
+    ///
+    /// The error carries the value computed over the bytes (`expected`) and the one the frame
+    /// carries (`found`); a slice shorter than the check bytes is [`FrameError::Truncated`].
+    #[inline]
+    pub fn verify(self, frame: &[u8]) -> Result<(), FrameError> {
+        let truncated = FrameError::Truncated {
+            needed: self.width(),
+            got: frame.len(),
+        };
+        let Some((covered, check)) = frame
+            .len()
+            .checked_sub(self.width())
+            .and_then(|at| frame.split_at_checked(at))
+        else {
+            return Err(truncated);
+        };
+        let expected = self.compute(covered);
+        let found = self.carried(check).ok_or(truncated)?;
+        if expected != found {
+            return Err(FrameError::Checksum { expected, found });
+        }
+        Ok(())
+    }
+
+    /// Writes the check bytes at the end of `frame` (a whole frame) over the bytes before them.
+    #[inline]
+    pub fn seal(self, frame: &mut [u8]) {
+        let Some(at) = frame.len().checked_sub(self.width()) else {
+            return;
+        };
+        let (covered, check) = frame.split_at_mut(at);
+        let value = self.compute(covered);
+        match self {
+            Checksum::Sum16Le => check.copy_from_slice(&value.to_le_bytes()),
+            Checksum::Sum8 => check[0] = value as u8,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn byte_ns_is_the_recorders_formula() {
+        // The formula the CLI's recorder and simulator used before this definition existed.
+        let old = |baud: u32| 10e9 / f64::from(baud.max(1));
+        for baud in (0..=1_000_000)
+            .step_by(7)
+            .chain([19_200, 115_200, 19_332, u32::MAX])
+        {
+            assert_eq!(byte_ns(baud).to_bits(), old(baud).to_bits(), "{baud}");
+        }
+        assert_eq!(byte_ns(BAUD_RATE), 10.0e9 / 19200.0);
+    }
+
+    #[test]
+    fn checksum_kinds() {
+        let mut frame = [0u8; 24];
+        frame[..4].copy_from_slice(&[SYNC, 0x16, VERSION, 0x02]);
+        frame[4..22].fill(0xFF);
+        Checksum::Sum16Le.seal(&mut frame);
+        let sum = 0x9B + 0x16 + 0x01 + 0x02 + 18 * 0xFF;
+        assert_eq!(frame[22..], [sum as u8, (sum >> 8) as u8]);
+        assert_eq!(Checksum::Sum16Le.verify(&frame), Ok(()));
+        frame[5] ^= 1;
+        assert_eq!(
+            Checksum::Sum16Le.verify(&frame),
+            Err(FrameError::Checksum {
+                expected: sum - 1,
+                found: sum
+            })
+        );
+        let mut short = [0x9B, 0x4C, 0];
+        Checksum::Sum8.seal(&mut short);
+        assert_eq!(short[2], 0xE7);
+        assert_eq!(Checksum::Sum8.verify(&short), Ok(()));
+        assert_eq!(
+            Checksum::Sum16Le.verify(&[1]),
+            Err(FrameError::Truncated { needed: 2, got: 1 })
+        );
+        assert_eq!(
+            Checksum::Sum8.verify(&[]),
+            Err(FrameError::Truncated { needed: 1, got: 0 })
+        );
+    }
+}
