@@ -8,13 +8,15 @@
 //! mistaken for a frame start). A rejected candidate (wrong length byte, bad checksum) costs one
 //! byte: scanning resumes at the byte after the rejected `0x9B`, so a lone `0x9B`, a fake header,
 //! a cut frame or a run of garbage never hides a following intact frame.
+//!
+//! The scanner names no frame kind: it asks the list of kinds in [`crate::frame`] whether a frame
+//! starts at a candidate, and how long a candidate with a given length byte is. Those calls are
+//! inlined with every kind's constants, so the loops below are what they were when they were
+//! written for the data and device-information frames by hand.
 
-use crate::frame::{
-    CMD_DATA, DATA_FRAME_LEN, DATA_LENGTH_BYTE, DataFrame, Frame, MAX_FRAME_LEN, check_data,
-};
-use crate::info::{CMD_INFO, INFO_FRAME_LEN, INFO_LENGTH_BYTE, InfoFrame};
+use crate::frame::{Frame, MAX_FRAME_LEN, or_length_bytes, wire_len_of};
 use crate::stats::LinkStats;
-use crate::wire::{SYNC, VERSION, sum16};
+use crate::wire::SYNC;
 
 /// A frame and where it started in the stream.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -26,10 +28,10 @@ pub struct Decoded {
     pub frame: Frame,
 }
 
-/// Whether `b` is the length byte of a known frame.
+/// Whether `b` is the length byte of a known frame kind.
 #[inline(always)]
 fn is_length_byte(b: u8) -> bool {
-    b == DATA_LENGTH_BYTE || b == INFO_LENGTH_BYTE
+    wire_len_of(b).is_some()
 }
 
 /// Offset of the first place in `hay` where a frame may start: a sync byte followed by a known
@@ -58,9 +60,8 @@ fn find_header(hay: &[u8]) -> Option<usize> {
     while let Some(w) = hay.get(base..base + 9) {
         let word = |at: usize| u64::from_le_bytes(w[at..at + 8].try_into().unwrap_or([0; 8]));
         let (s, l) = (word(0), word(1));
-        let hits = zero_bytes(s ^ (ONES * SYNC as u64))
-            & (zero_bytes(l ^ (ONES * DATA_LENGTH_BYTE as u64))
-                | zero_bytes(l ^ (ONES * INFO_LENGTH_BYTE as u64)));
+        let lengths = or_length_bytes(|b| zero_bytes(l ^ (ONES * b as u64)));
+        let hits = zero_bytes(s ^ (ONES * SYNC as u64)) & lengths;
         if hits != 0 {
             return Some(base + (hits.trailing_zeros() / 8) as usize);
         }
@@ -71,11 +72,6 @@ fn find_header(hay: &[u8]) -> Option<usize> {
         .find(|&j| tail[j] == SYNC && tail.get(j + 1).is_none_or(|&l| is_length_byte(l)))
         .map(|j| base + j)
 }
-
-/// The first four bytes of a data frame, as a little-endian `u32`.
-const DATA_HEADER: u32 = u32::from_le_bytes([SYNC, DATA_LENGTH_BYTE, VERSION, CMD_DATA]);
-/// The first four bytes of a device-information frame, as a little-endian `u32`.
-const INFO_HEADER: u32 = u32::from_le_bytes([SYNC, INFO_LENGTH_BYTE, VERSION, CMD_INFO]);
 
 /// Finds the next frame in `data` from `*pos`, counting what it passes over in `stats`.
 ///
@@ -89,16 +85,9 @@ fn scan_next(
     stats: &mut LinkStats,
     at_end: bool,
 ) -> Option<(usize, Frame)> {
-    // Back-to-back frames, the usual case: a data frame starts right here.
-    if let Some(d) = data[*pos..].first_chunk::<DATA_FRAME_LEN>()
-        && u32::from_le_bytes([d[0], d[1], d[2], d[3]]) == DATA_HEADER
-        && sum16(&d[..22]) == u16::from_le_bytes([d[22], d[23]])
-    {
-        let i = *pos;
-        let d = DataFrame::from_verified(d);
-        stats.data_frame(d.packet);
-        *pos = i + DATA_FRAME_LEN;
-        return Some((i, Frame::Data(d)));
+    // Back-to-back frames, the usual case: a frame of the most frequent kind starts right here.
+    if let Some(found) = Frame::take_first(data, pos, stats) {
+        return Some(found);
     }
     loop {
         let Some(k) = find_header(&data[*pos..]) else {
@@ -109,77 +98,27 @@ fn scan_next(
         stats.skip(k);
         let i = *pos + k;
         *pos = i;
-        let rest = &data[i..];
-        // Fast path, whenever a whole data frame's worth of bytes is left: one branch decides
-        // "valid data frame", one "valid info frame"; both are predictable (false all through
-        // line noise, the first true all through a run of frames), unlike a branch on the length
-        // byte. Same verdicts as the general path below.
-        if let Some(d) = rest.first_chunk::<DATA_FRAME_LEN>() {
-            let header = u32::from_le_bytes([d[0], d[1], d[2], d[3]]);
-            let sum = u32::from(sum16(&d[..22]));
-            let found = u32::from(u16::from_le_bytes([d[22], d[23]]));
-            if (sum ^ found) | (header ^ DATA_HEADER) == 0 {
-                let d = DataFrame::from_verified(d);
-                stats.data_frame(d.packet);
-                *pos = i + DATA_FRAME_LEN;
-                return Some((i, Frame::Data(d)));
-            }
-            if header == INFO_HEADER
-                && let Some(f) = rest.first_chunk::<INFO_FRAME_LEN>()
-                && let Ok(info) = InfoFrame::parse_exact(f)
-            {
-                stats.info_frame();
-                *pos = i + INFO_FRAME_LEN;
-                return Some((i, Frame::Info(info)));
-            }
-            // `find_header` stops only at a known length byte.
-            let needed = if d[1] == DATA_LENGTH_BYTE {
-                DATA_FRAME_LEN
-            } else {
-                INFO_FRAME_LEN
-            };
-            if rest.len() >= needed {
-                stats.checksum_failure();
-            } else if !at_end {
-                return None;
-            }
-            stats.skip(1);
-            *pos = i + 1;
-            continue;
+        // Each kind decides "valid frame of mine" with as few, as predictable, branches as it can
+        // (false all through line noise, true all through a run of frames).
+        if let Some(found) = Frame::take(data, pos, stats) {
+            return Some(found);
         }
-        let complete = match rest.get(1) {
-            Some(&DATA_LENGTH_BYTE) => match rest.first_chunk::<DATA_FRAME_LEN>() {
-                Some(f) => {
-                    if check_data(f).is_ok() {
-                        let d = DataFrame::from_verified(f);
-                        stats.data_frame(d.packet);
-                        *pos = i + DATA_FRAME_LEN;
-                        return Some((i, Frame::Data(d)));
-                    }
-                    true
+        let rest = &data[i..];
+        // Rejected, or undecided: the length byte says how many bytes decide the candidate.
+        let needed = match rest.get(1) {
+            Some(&l) => match wire_len_of(l) {
+                Some(len) => len,
+                // Not a frame header (`find_header` stops only at a known length byte): skip
+                // the sync byte without calling it a failure.
+                None => {
+                    stats.skip(1);
+                    *pos = i + 1;
+                    continue;
                 }
-                None => false,
             },
-            Some(&INFO_LENGTH_BYTE) => match rest.first_chunk::<INFO_FRAME_LEN>() {
-                Some(f) => {
-                    if let Ok(info) = InfoFrame::parse_exact(f) {
-                        stats.info_frame();
-                        *pos = i + INFO_FRAME_LEN;
-                        return Some((i, Frame::Info(info)));
-                    }
-                    true
-                }
-                None => false,
-            },
-            // Not a frame header: skip the sync byte without calling it a failure.
-            Some(_) => {
-                stats.skip(1);
-                *pos = i + 1;
-                continue;
-            }
-            None => false,
+            None => 2,
         };
-        if complete {
+        if rest.len() >= needed {
             stats.checksum_failure();
         } else if !at_end {
             return None;
@@ -259,8 +198,7 @@ impl Decoder {
             // bytes (a frame's length is known from its second byte), so just keep them.
             let needed = match self.buf[..held] {
                 [_] => 2,
-                [_, DATA_LENGTH_BYTE, ..] => DATA_FRAME_LEN,
-                [_, INFO_LENGTH_BYTE, ..] => INFO_FRAME_LEN,
+                [_, l, ..] => wire_len_of(l).unwrap_or(0),
                 _ => 0,
             };
             if held + data.len() < needed {
@@ -417,6 +355,7 @@ impl core::iter::FusedIterator for Frames<'_> {}
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::DataFrame;
 
     #[test]
     fn find_header_matches_a_plain_search() {

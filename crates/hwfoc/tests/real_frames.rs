@@ -5,8 +5,8 @@
 //! Every stream test decodes twice, with the bulk iterator and with the streaming decoder fed one
 //! byte at a time, and checks that both agree (frames and statistics) before checking values.
 
-use hwfoc::frame::DATA_FRAME_LEN;
-use hwfoc::info::INFO_FRAME_LEN;
+use hwfoc::kinds::data::DATA_FRAME_LEN;
+use hwfoc::kinds::info::INFO_FRAME_LEN;
 use hwfoc::units::{ADC_MAX, ADC_MIN, ADC_TABLE};
 use hwfoc::wire::sum16;
 use hwfoc::{
@@ -1208,4 +1208,48 @@ fn info_candidate_with_non_ascii_text_is_refused() {
     assert!(decoded.is_empty());
     assert_eq!(stats.checksum_failures(), 1);
     assert_eq!(stats.info_frames(), 0);
+}
+
+#[test]
+fn frame_error_messages() {
+    // The texts as they were before the frame kinds got a module each; the unknown-length one is
+    // now built from the list of kinds.
+    let cases = [
+        (
+            FrameError::NoSync { found: 0x00 },
+            "frame starts with 0x00, not the sync byte 0x9B",
+        ),
+        (
+            FrameError::UnknownLength { found: 0x42 },
+            "unknown length byte 0x42 (expected 0x16 or 0x4C)",
+        ),
+        (
+            FrameError::Truncated { needed: 24, got: 3 },
+            "truncated frame: 3 of 24 bytes",
+        ),
+        (
+            FrameError::Checksum {
+                expected: 0x080D,
+                found: 0x090D,
+            },
+            "checksum mismatch: bytes sum to 0x080D, frame carries 0x090D",
+        ),
+        (
+            FrameError::UnknownCommand {
+                version: 0x01,
+                command: 0x0A,
+            },
+            "unknown version 0x01 / command 0x0A",
+        ),
+        (
+            FrameError::NotText {
+                offset: 9,
+                found: 0x9B,
+            },
+            "device-information text holds byte 0x9B at offset 9, which is not ASCII",
+        ),
+    ];
+    for (error, text) in cases {
+        assert_eq!(error.to_string(), text);
+    }
 }

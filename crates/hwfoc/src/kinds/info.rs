@@ -14,11 +14,13 @@
 //! chance once in 256 times, and would swallow the data frames behind it. So a candidate is also
 //! required to carry ASCII text (every byte below 0x80): a data frame inside the 77-byte window
 //! always brings its `0x9B` sync byte into the text and is never hidden.
+//!
+//! The check byte is [`Checksum::Sum8`]: the low byte of the 16-bit sum of bytes 0..=75.
 
 use core::fmt;
 
-use crate::frame::FrameError;
-use crate::wire::{Checksum, SYNC, VERSION};
+use crate::stats::LinkStats;
+use crate::wire::{Checksum, FrameError, FrameKind, VERSION, sealed};
 
 /// Length byte of a device-information frame: bytes before the check byte.
 pub const INFO_LENGTH_BYTE: u8 = 0x4C;
@@ -126,48 +128,13 @@ impl InfoFrame {
 
     /// Decodes a device-information frame from the first 77 bytes of `bytes`.
     pub fn parse(bytes: &[u8]) -> Result<Self, FrameError> {
-        let Some(frame) = bytes.first_chunk::<INFO_FRAME_LEN>() else {
-            return Err(FrameError::Truncated {
-                needed: INFO_FRAME_LEN,
-                got: bytes.len(),
-            });
-        };
-        if frame[0] != SYNC {
-            return Err(FrameError::NoSync { found: frame[0] });
-        }
-        if frame[1] != INFO_LENGTH_BYTE {
-            return Err(FrameError::UnknownLength { found: frame[1] });
-        }
-        Self::parse_exact(frame)
-    }
-
-    /// Checks and decodes a 77-byte candidate whose sync and length bytes already matched.
-    #[inline]
-    pub(crate) fn parse_exact(f: &[u8; INFO_FRAME_LEN]) -> Result<Self, FrameError> {
-        Checksum::Sum8.verify(f)?;
-        if f[2] != VERSION || f[3] != CMD_INFO {
-            return Err(FrameError::UnknownCommand {
-                version: f[2],
-                command: f[3],
-            });
-        }
-        if let Some(at) = f[4..76].iter().position(|b| !b.is_ascii()) {
-            return Err(FrameError::NotText {
-                offset: 4 + at,
-                found: f[4 + at],
-            });
-        }
-        let mut text = [0u8; INFO_TEXT_LEN];
-        text.copy_from_slice(&f[4..76]);
-        Ok(InfoFrame { text })
+        <Self as FrameKind>::parse(bytes)
     }
 
     /// Encodes the frame as the 77 bytes an ESC sends.
     pub fn encode(&self) -> [u8; INFO_FRAME_LEN] {
         let mut f = [0u8; INFO_FRAME_LEN];
-        f[..4].copy_from_slice(&[SYNC, INFO_LENGTH_BYTE, VERSION, CMD_INFO]);
-        f[4..76].copy_from_slice(&self.text);
-        Checksum::Sum8.seal(&mut f);
+        self.encode_into(&mut f);
         f
     }
 
@@ -210,6 +177,44 @@ impl InfoFrame {
             .split(|&b| b == b' ' || b == 0)
             .filter(|w| !w.is_empty())
             .map(ascii)
+    }
+}
+
+impl FrameKind for InfoFrame {
+    const LENGTH_BYTE: u8 = INFO_LENGTH_BYTE;
+    const VERSION: u8 = VERSION;
+    const COMMAND: u8 = CMD_INFO;
+    const LEN: usize = INFO_FRAME_LEN;
+    const CHECKSUM: Checksum = Checksum::Sum8;
+}
+
+impl sealed::Sealed for InfoFrame {
+    #[inline]
+    fn read(frame: &[u8]) -> Result<Self, FrameError> {
+        let Some(f) = frame.first_chunk::<INFO_FRAME_LEN>() else {
+            return Err(FrameError::Truncated {
+                needed: INFO_FRAME_LEN,
+                got: frame.len(),
+            });
+        };
+        if let Some(at) = f[4..76].iter().position(|b| !b.is_ascii()) {
+            return Err(FrameError::NotText {
+                offset: 4 + at,
+                found: f[4 + at],
+            });
+        }
+        let mut text = [0u8; INFO_TEXT_LEN];
+        text.copy_from_slice(&f[4..76]);
+        Ok(InfoFrame { text })
+    }
+
+    fn write(&self, payload: &mut [u8]) {
+        payload.copy_from_slice(&self.text);
+    }
+
+    #[inline(always)]
+    fn count(&self, stats: &mut LinkStats) {
+        stats.info_frame();
     }
 }
 
