@@ -11,8 +11,8 @@
 //!
 //! The scanner names no frame kind: it asks the list of kinds in [`crate::frame`] whether a frame
 //! starts at a candidate, and how long a candidate with a given length byte is. Those calls are
-//! inlined with every kind's constants, so the loops below are what they were when they were
-//! written for the data and device-information frames by hand.
+//! inlined with every kind's constants: no dynamic dispatch, no function pointer, and no loop over
+//! the kinds is left in the scanner.
 
 use crate::frame::{Frame, MAX_FRAME_LEN, or_length_bytes, wire_len_of};
 use crate::stats::LinkStats;
@@ -128,6 +128,29 @@ fn scan_next(
     }
 }
 
+/// Runs the scanner over `data`, whose first byte is at stream offset `base`, giving every frame
+/// to `on_frame`; returns where it stopped (as [`scan_next`] leaves `pos`).
+///
+/// Out of line, so that [`Decoder::feed`] (which scans its held candidate, then the new bytes)
+/// and [`Decoder::flush`] each have one copy of the scanner, not one per loop: a fixed layout,
+/// whose speed does not hang on the compiler's inlining choices.
+#[inline(never)]
+fn scan_all<const AT_END: bool>(
+    data: &[u8],
+    base: u64,
+    stats: &mut LinkStats,
+    on_frame: &mut impl FnMut(Decoded),
+) -> usize {
+    let mut pos = 0;
+    while let Some((at, frame)) = scan_next(data, &mut pos, stats, AT_END) {
+        on_frame(Decoded {
+            offset: base + at as u64,
+            frame,
+        });
+    }
+    pos
+}
+
 /// A streaming decoder: feed it bytes in any chunking, get every frame once.
 ///
 /// Its whole state is a 76-byte buffer for a frame still arriving plus the [`LinkStats`]:
@@ -215,13 +238,7 @@ impl Decoder {
             tmp[held..held + take].copy_from_slice(&data[..take]);
             let n = held + take;
             let tmp_base = start - held as u64;
-            let mut pos = 0;
-            while let Some((at, frame)) = scan_next(&tmp[..n], &mut pos, &mut self.stats, false) {
-                on_frame(Decoded {
-                    offset: tmp_base + at as u64,
-                    frame,
-                });
-            }
+            let pos = scan_all::<false>(&tmp[..n], tmp_base, &mut self.stats, &mut on_frame);
             if pos < held {
                 // `data` ran out before the held candidate was decided.
                 self.hold(&tmp[pos..n]);
@@ -230,13 +247,7 @@ impl Decoder {
             data = &data[pos - held..];
             base += (pos - held) as u64;
         }
-        let mut pos = 0;
-        while let Some((at, frame)) = scan_next(data, &mut pos, &mut self.stats, false) {
-            on_frame(Decoded {
-                offset: base + at as u64,
-                frame,
-            });
-        }
+        let pos = scan_all::<false>(data, base, &mut self.stats, &mut on_frame);
         self.hold(&data[pos..]);
     }
 
@@ -256,14 +267,7 @@ impl Decoder {
     pub fn flush(&mut self, mut on_frame: impl FnMut(Decoded)) {
         let held = usize::from(self.len);
         let base = self.stats.bytes() - held as u64;
-        let mut pos = 0;
-        while let Some((at, frame)) = scan_next(&self.buf[..held], &mut pos, &mut self.stats, true)
-        {
-            on_frame(Decoded {
-                offset: base + at as u64,
-                frame,
-            });
-        }
+        scan_all::<true>(&self.buf[..held], base, &mut self.stats, &mut on_frame);
         self.len = 0;
     }
 

@@ -55,12 +55,14 @@ pub const VERSION: u8 = 0x01;
 /// assert_eq!(hwfoc::wire::sum16(&frame), 0x080D);
 /// ```
 #[inline]
-pub fn sum16(bytes: &[u8]) -> u16 {
+pub const fn sum16(bytes: &[u8]) -> u16 {
     // Summing into a u32 first lets the compiler vectorise; the wrap to 16 bits is exact because
     // no realistic slice (< 16 MiB) overflows a u32.
     let mut sum = 0u32;
-    for &b in bytes {
-        sum += u32::from(b);
+    let mut i = 0;
+    while i < bytes.len() {
+        sum += bytes[i] as u32;
+        i += 1;
     }
     sum as u16
 }
@@ -92,7 +94,7 @@ impl Checksum {
     }
 
     /// The check value of `covered`, the bytes of a frame before its check bytes.
-    #[inline]
+    #[inline(always)]
     pub fn compute(self, covered: &[u8]) -> u16 {
         match self {
             Checksum::Sum16Le => sum16(covered),
@@ -102,7 +104,7 @@ impl Checksum {
 
     /// The check value carried by `check`, the check bytes of a frame ([`Checksum::width`] of
     /// them; `None` if fewer are given).
-    #[inline]
+    #[inline(always)]
     pub fn carried(self, check: &[u8]) -> Option<u16> {
         match self {
             Checksum::Sum16Le => check.first_chunk().map(|&b| u16::from_le_bytes(b)),
@@ -114,7 +116,7 @@ impl Checksum {
     ///
     /// The error carries the value computed over the bytes (`expected`) and the one the frame
     /// carries (`found`); a slice shorter than the check bytes is [`FrameError::Truncated`].
-    #[inline]
+    #[inline(always)]
     pub fn verify(self, frame: &[u8]) -> Result<(), FrameError> {
         let truncated = FrameError::Truncated {
             needed: self.width(),
@@ -189,7 +191,7 @@ pub trait FrameKind: Sized + Copy + sealed::Sealed {
     /// Checks and decodes a candidate whose sync and length bytes already matched, from its
     /// first [`FrameKind::LEN`] bytes: check bytes first, then version and command, then the
     /// kind's own rules (a device-information frame's text must be ASCII).
-    #[inline]
+    #[inline(always)]
     fn verify(candidate: &[u8]) -> Result<Self, FrameError> {
         let Some(frame) = candidate.get(..Self::LEN) else {
             return Err(FrameError::Truncated {

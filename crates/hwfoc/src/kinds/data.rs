@@ -72,11 +72,14 @@ impl FrameKind for DataFrame {
     /// One branch decides "valid data frame": the header and the checksum are compared at once,
     /// which stays predictable in line noise (always false) and in a run of frames (always true),
     /// where comparing the header first would branch on every fake `9B 16` header.
+    ///
+    /// The sum of the header bytes is taken as that of [`FrameKind::HEADER`]: a frame with
+    /// another header is rejected whatever its sum, so only the 18 payload bytes are summed.
     #[inline(always)]
     fn accept(candidate: &[u8]) -> Option<Self> {
         let d = candidate.first_chunk::<DATA_FRAME_LEN>()?;
         let header = u32::from_le_bytes([d[0], d[1], d[2], d[3]]);
-        let sum = u32::from(sum16(&d[..22]));
+        let sum = u32::from(HEADER_SUM.wrapping_add(sum16(&d[4..22])));
         let found = u32::from(u16::from_le_bytes([d[22], d[23]]));
         if (sum ^ found) | (header ^ Self::HEADER_WORD) == 0 {
             Some(Self::from_verified(d))
@@ -85,6 +88,9 @@ impl FrameKind for DataFrame {
         }
     }
 }
+
+/// The sum of a data frame's header bytes.
+const HEADER_SUM: u16 = sum16(&<DataFrame as FrameKind>::HEADER);
 
 impl sealed::Sealed for DataFrame {
     #[inline]

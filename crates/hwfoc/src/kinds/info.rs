@@ -197,10 +197,10 @@ impl sealed::Sealed for InfoFrame {
                 got: frame.len(),
             });
         };
-        if let Some(at) = f[4..76].iter().position(|b| !b.is_ascii()) {
+        if let Some((at, found)) = first_non_ascii(&f[4..76]) {
             return Err(FrameError::NotText {
                 offset: 4 + at,
-                found: f[4 + at],
+                found,
             });
         }
         let mut text = [0u8; INFO_TEXT_LEN];
@@ -216,6 +216,25 @@ impl sealed::Sealed for InfoFrame {
     fn count(&self, stats: &mut LinkStats) {
         stats.info_frame();
     }
+}
+
+/// Offset and value of the first byte of `text` that is not ASCII, looked for a machine word at
+/// a time (4 bytes on a Cortex-M, 8 on a PC: 18 or 9 steps for the 72 text bytes, one loop).
+#[inline]
+fn first_non_ascii(text: &[u8]) -> Option<(usize, u8)> {
+    const WORD: usize = size_of::<usize>();
+    const HIGH: usize = usize::from_ne_bytes([0x80; WORD]);
+    let mut words = text.chunks_exact(WORD);
+    for (i, w) in words.by_ref().enumerate() {
+        let word = usize::from_le_bytes(w.try_into().unwrap_or([0; WORD]));
+        if word & HIGH != 0 {
+            let bit = (word & HIGH).trailing_zeros() & !7;
+            return Some((i * WORD + bit as usize / 8, (word >> bit) as u8));
+        }
+    }
+    let rest = words.remainder();
+    let at = rest.iter().position(|b| !b.is_ascii())?;
+    Some((text.len() - rest.len() + at, rest[at]))
 }
 
 /// ASCII bytes as text (an `InfoFrame` holds nothing else; `"?"` would mark a broken invariant).
@@ -244,5 +263,38 @@ impl fmt::Display for InfoFrame {
             f.write_str(w)?;
         }
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn first_non_ascii_matches_a_plain_search() {
+        let plain = |t: &[u8]| t.iter().position(|b| !b.is_ascii()).map(|at| (at, t[at]));
+        let mut text = [b' '; INFO_TEXT_LEN];
+        assert_eq!(first_non_ascii(&text), None);
+        for at in 0..INFO_TEXT_LEN {
+            for bad in [0x80, 0x9B, 0xFF] {
+                text[at] = bad;
+                assert_eq!(first_non_ascii(&text), Some((at, bad)));
+                if at + 3 < INFO_TEXT_LEN {
+                    text[at + 3] = 0xC0; // a later one changes nothing
+                    assert_eq!(first_non_ascii(&text), Some((at, bad)));
+                    text[at + 3] = b'x';
+                }
+                text[at] = 0x7F;
+                assert_eq!(first_non_ascii(&text), plain(&text));
+            }
+        }
+        // Lengths that leave a remainder after whole words.
+        for len in 0..20 {
+            let mut t = [b'a'; 20];
+            if len > 0 {
+                t[len - 1] = 0xA5;
+            }
+            assert_eq!(first_non_ascii(&t[..len]), plain(&t[..len]), "{len}");
+        }
     }
 }
