@@ -17,5 +17,5 @@ pub use kinds::data::DataFrame;
 pub use kinds::info::{InfoFieldError, InfoFrame};
 pub use stats::LinkStats;
 pub use status::{Fault, Faults, Status};
-pub use units::{Settings, SettingsError, Temperature};
+pub use units::{Quantity, Settings, SettingsError, Temperature};
 pub use wire::{FrameError, FrameKind};

@@ -10,7 +10,7 @@
 //! CRC-16/MODBUS, the sum does).
 
 use crate::status::Status;
-use crate::units::{Settings, Temperature};
+use crate::units::{ERPM_PER_RAW, Linear, Quantity, Settings, Temperature};
 use crate::wire::{Checksum, FrameError, FrameKind, VERSION, sealed, sum16};
 
 /// Command byte of a real-time data frame.
@@ -163,27 +163,27 @@ impl DataFrame {
 
     /// Input throttle in percent (raw * 100 / 1024).
     pub fn throttle_in_pct(&self) -> f32 {
-        f32::from(self.throttle_in_raw) * 100.0 / 1024.0
+        Linear::THROTTLE_PCT.to_f32(f32::from(self.throttle_in_raw))
     }
 
     /// Output throttle in percent (raw * 100 / 1024).
     pub fn throttle_out_pct(&self) -> f32 {
-        f32::from(self.throttle_out_raw) * 100.0 / 1024.0
+        Linear::THROTTLE_PCT.to_f32(f32::from(self.throttle_out_raw))
     }
 
     /// Electrical RPM (raw * 10).
     pub fn erpm(&self) -> u32 {
-        u32::from(self.erpm_raw) * 10
+        u32::from(self.erpm_raw) * u32::from(ERPM_PER_RAW)
     }
 
     /// Motor (or, with a gear ratio, output shaft) RPM: raw * 10 / (gear ratio * pole pairs).
     pub fn rpm(&self, settings: &Settings) -> f32 {
-        settings.rpm_from_erpm(self.erpm())
+        settings.rpm_linear().to_f32(f32::from(self.erpm_raw))
     }
 
     /// Input voltage in volts (raw / 10).
     pub fn voltage_v(&self) -> f32 {
-        f32::from(self.voltage_raw) / 10.0
+        Linear::VOLTS.to_f32(f32::from(self.voltage_raw))
     }
 
     /// Input current in amperes (raw / current scale); negative while braking regeneratively.
@@ -194,6 +194,25 @@ impl DataFrame {
     /// Phase current in amperes (raw / current scale).
     pub fn phase_current_a(&self, settings: &Settings) -> f32 {
         settings.amps(self.phase_current_raw)
+    }
+
+    /// The raw field that `quantity` is converted from (for statistics of raw values, converted
+    /// once with [`Linear::to_f64`]).
+    pub fn raw(&self, quantity: Quantity) -> i32 {
+        match quantity {
+            Quantity::ThrottleIn => i32::from(self.throttle_in_raw),
+            Quantity::ThrottleOut => i32::from(self.throttle_out_raw),
+            Quantity::Erpm | Quantity::Rpm => i32::from(self.erpm_raw),
+            Quantity::Voltage => i32::from(self.voltage_raw),
+            Quantity::Current => i32::from(self.current_raw),
+            Quantity::PhaseCurrent => i32::from(self.phase_current_raw),
+        }
+    }
+
+    /// `quantity` in its unit under `settings`: the same value as the method of that name
+    /// (`throttle_in_pct`, `rpm`, ...; eRPM as an `f32`, exact).
+    pub fn value(&self, quantity: Quantity, settings: &Settings) -> f32 {
+        quantity.linear(settings).to_f32(self.raw(quantity) as f32)
     }
 
     /// MOSFET temperature from the ADC table.
