@@ -36,8 +36,8 @@ pub const BITS_PER_BYTE: u32 = 10;
 /// ```
 #[inline]
 pub const fn byte_ns(baud: u32) -> f64 {
-    // 10e9 is BITS_PER_BYTE * 1e9, written as one exact constant.
-    10e9 / (if baud == 0 { 1 } else { baud }) as f64
+    // BITS_PER_BYTE * 1e9 is exactly 10e9, the constant the CLI's recorder divided.
+    BITS_PER_BYTE as f64 * 1e9 / (if baud == 0 { 1 } else { baud }) as f64
 }
 
 /// First byte of every HW-FOC frame.
@@ -172,8 +172,9 @@ impl Checksum {
 /// # Ok::<(), Box<dyn core::error::Error>>(())
 /// ```
 pub trait FrameKind: Sized + Copy + sealed::Sealed {
-    /// Byte 1: the number of bytes before the check bytes (`LEN - CHECKSUM.width()`). It tells
-    /// the kinds apart, so no two kinds share one.
+    /// Byte 1: the number of bytes before the check bytes (`LEN - CHECKSUM.width()`), from
+    /// which the scanner knows a candidate's length. Kinds are told apart by their whole
+    /// [`FrameKind::HEADER`]: two may share a length byte if they share a length.
     const LENGTH_BYTE: u8;
     /// Byte 2: the protocol version.
     const VERSION: u8;
