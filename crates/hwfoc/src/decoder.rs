@@ -104,21 +104,16 @@ fn scan_next(
             return Some(found);
         }
         let rest = &data[i..];
-        // Rejected, or undecided: the length byte says how many bytes decide the candidate.
-        let needed = match rest.get(1) {
-            Some(&l) => match wire_len_of(l) {
-                Some(len) => len,
-                // Not a frame header (`find_header` stops only at a known length byte): skip
-                // the sync byte without calling it a failure.
-                None => {
-                    stats.skip(1);
-                    *pos = i + 1;
-                    continue;
-                }
-            },
-            None => 2,
-        };
-        if rest.len() >= needed {
+        // Rejected, or undecided: a candidate is rejected once all its bytes are there. With
+        // MAX_FRAME_LEN bytes they are, whatever its length byte, which is then not even read
+        // (in line noise, which length byte a fake header carries is unpredictable). Short of
+        // that, its length byte (a known one: `find_header` stops at no other) tells.
+        let complete = rest.len() >= MAX_FRAME_LEN
+            || match *rest {
+                [_, l, ..] => rest.len() >= wire_len_of(l).unwrap_or(0),
+                _ => false,
+            };
+        if complete {
             stats.checksum_failure();
         } else if !at_end {
             return None;
