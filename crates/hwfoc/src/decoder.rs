@@ -104,6 +104,10 @@ fn scan_next(
             return Some(found);
         }
         let rest = &data[i..];
+        debug_assert!(
+            rest.len() == 1 || is_length_byte(rest[1]),
+            "find_header's contract"
+        );
         // Rejected, or undecided: a candidate is rejected once all its bytes are there. With
         // MAX_FRAME_LEN bytes they are, whatever its length byte, which is then not even read
         // (in line noise, which length byte a fake header carries is unpredictable). Short of
