@@ -8,13 +8,15 @@
 //! mistaken for a frame start). A rejected candidate (wrong length byte, bad checksum) costs one
 //! byte: scanning resumes at the byte after the rejected `0x9B`, so a lone `0x9B`, a fake header,
 //! a cut frame or a run of garbage never hides a following intact frame.
+//!
+//! The scanner names no frame kind: it asks the list of kinds in [`crate::frame`] whether a frame
+//! starts at a candidate, and how long a candidate with a given length byte is. Those calls are
+//! inlined with every kind's constants: no dynamic dispatch, no function pointer, and no loop over
+//! the kinds is left in the scanner.
 
-use crate::frame::{
-    CMD_DATA, DATA_FRAME_LEN, DATA_LENGTH_BYTE, DataFrame, Frame, MAX_FRAME_LEN, SYNC, VERSION,
-    check_data, checksum,
-};
-use crate::info::{CMD_INFO, INFO_FRAME_LEN, INFO_LENGTH_BYTE, InfoFrame};
+use crate::frame::{Frame, MAX_FRAME_LEN, or_length_bytes, wire_len_of};
 use crate::stats::LinkStats;
+use crate::wire::SYNC;
 
 /// A frame and where it started in the stream.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -26,10 +28,10 @@ pub struct Decoded {
     pub frame: Frame,
 }
 
-/// Whether `b` is the length byte of a known frame.
+/// Whether `b` is the length byte of a known frame kind.
 #[inline(always)]
 fn is_length_byte(b: u8) -> bool {
-    b == DATA_LENGTH_BYTE || b == INFO_LENGTH_BYTE
+    wire_len_of(b).is_some()
 }
 
 /// Offset of the first place in `hay` where a frame may start: a sync byte followed by a known
@@ -58,9 +60,8 @@ fn find_header(hay: &[u8]) -> Option<usize> {
     while let Some(w) = hay.get(base..base + 9) {
         let word = |at: usize| u64::from_le_bytes(w[at..at + 8].try_into().unwrap_or([0; 8]));
         let (s, l) = (word(0), word(1));
-        let hits = zero_bytes(s ^ (ONES * SYNC as u64))
-            & (zero_bytes(l ^ (ONES * DATA_LENGTH_BYTE as u64))
-                | zero_bytes(l ^ (ONES * INFO_LENGTH_BYTE as u64)));
+        let lengths = or_length_bytes(|b| zero_bytes(l ^ (ONES * b as u64)));
+        let hits = zero_bytes(s ^ (ONES * SYNC as u64)) & lengths;
         if hits != 0 {
             return Some(base + (hits.trailing_zeros() / 8) as usize);
         }
@@ -71,11 +72,6 @@ fn find_header(hay: &[u8]) -> Option<usize> {
         .find(|&j| tail[j] == SYNC && tail.get(j + 1).is_none_or(|&l| is_length_byte(l)))
         .map(|j| base + j)
 }
-
-/// The first four bytes of a data frame, as a little-endian `u32`.
-const DATA_HEADER: u32 = u32::from_le_bytes([SYNC, DATA_LENGTH_BYTE, VERSION, CMD_DATA]);
-/// The first four bytes of a device-information frame, as a little-endian `u32`.
-const INFO_HEADER: u32 = u32::from_le_bytes([SYNC, INFO_LENGTH_BYTE, VERSION, CMD_INFO]);
 
 /// Finds the next frame in `data` from `*pos`, counting what it passes over in `stats`.
 ///
@@ -89,16 +85,9 @@ fn scan_next(
     stats: &mut LinkStats,
     at_end: bool,
 ) -> Option<(usize, Frame)> {
-    // Back-to-back frames, the usual case: a data frame starts right here.
-    if let Some(d) = data[*pos..].first_chunk::<DATA_FRAME_LEN>()
-        && u32::from_le_bytes([d[0], d[1], d[2], d[3]]) == DATA_HEADER
-        && checksum(&d[..22]) == u16::from_le_bytes([d[22], d[23]])
-    {
-        let i = *pos;
-        let d = DataFrame::from_verified(d);
-        stats.data_frame(d.packet);
-        *pos = i + DATA_FRAME_LEN;
-        return Some((i, Frame::Data(d)));
+    // Back-to-back frames, the usual case: a frame of the most frequent kind starts right here.
+    if let Some(found) = Frame::take_first(data, pos, stats) {
+        return Some(found);
     }
     loop {
         let Some(k) = find_header(&data[*pos..]) else {
@@ -109,76 +98,25 @@ fn scan_next(
         stats.skip(k);
         let i = *pos + k;
         *pos = i;
-        let rest = &data[i..];
-        // Fast path, whenever a whole data frame's worth of bytes is left: one branch decides
-        // "valid data frame", one "valid info frame"; both are predictable (false all through
-        // line noise, the first true all through a run of frames), unlike a branch on the length
-        // byte. Same verdicts as the general path below.
-        if let Some(d) = rest.first_chunk::<DATA_FRAME_LEN>() {
-            let header = u32::from_le_bytes([d[0], d[1], d[2], d[3]]);
-            let sum = u32::from(checksum(&d[..22]));
-            let found = u32::from(u16::from_le_bytes([d[22], d[23]]));
-            if (sum ^ found) | (header ^ DATA_HEADER) == 0 {
-                let d = DataFrame::from_verified(d);
-                stats.data_frame(d.packet);
-                *pos = i + DATA_FRAME_LEN;
-                return Some((i, Frame::Data(d)));
-            }
-            if header == INFO_HEADER
-                && let Some(f) = rest.first_chunk::<INFO_FRAME_LEN>()
-                && let Ok(info) = InfoFrame::parse_exact(f)
-            {
-                stats.info_frame();
-                *pos = i + INFO_FRAME_LEN;
-                return Some((i, Frame::Info(info)));
-            }
-            // `find_header` stops only at a known length byte.
-            let needed = if d[1] == DATA_LENGTH_BYTE {
-                DATA_FRAME_LEN
-            } else {
-                INFO_FRAME_LEN
-            };
-            if rest.len() >= needed {
-                stats.checksum_failure();
-            } else if !at_end {
-                return None;
-            }
-            stats.skip(1);
-            *pos = i + 1;
-            continue;
+        // Each kind decides "valid frame of mine" with as few, as predictable, branches as it can
+        // (false all through line noise, true all through a run of frames).
+        if let Some(found) = Frame::take(data, pos, stats) {
+            return Some(found);
         }
-        let complete = match rest.get(1) {
-            Some(&DATA_LENGTH_BYTE) => match rest.first_chunk::<DATA_FRAME_LEN>() {
-                Some(f) => {
-                    if check_data(f).is_ok() {
-                        let d = DataFrame::from_verified(f);
-                        stats.data_frame(d.packet);
-                        *pos = i + DATA_FRAME_LEN;
-                        return Some((i, Frame::Data(d)));
-                    }
-                    true
-                }
-                None => false,
-            },
-            Some(&INFO_LENGTH_BYTE) => match rest.first_chunk::<INFO_FRAME_LEN>() {
-                Some(f) => {
-                    if let Ok(info) = InfoFrame::parse_exact(f) {
-                        stats.info_frame();
-                        *pos = i + INFO_FRAME_LEN;
-                        return Some((i, Frame::Info(info)));
-                    }
-                    true
-                }
-                None => false,
-            },
-            // Not a frame header: skip the sync byte without calling it a failure.
-            Some(_) => {
-                stats.skip(1);
-                *pos = i + 1;
-                continue;
-            }
-            None => false,
-        };
+        let rest = &data[i..];
+        debug_assert!(
+            rest.len() == 1 || is_length_byte(rest[1]),
+            "find_header's contract"
+        );
+        // Rejected, or undecided: a candidate is rejected once all its bytes are there. With
+        // MAX_FRAME_LEN bytes they are, whatever its length byte, which is then not even read
+        // (in line noise, which length byte a fake header carries is unpredictable). Short of
+        // that, its length byte (a known one: `find_header` stops at no other) tells.
+        let complete = rest.len() >= MAX_FRAME_LEN
+            || match *rest {
+                [_, l, ..] => rest.len() >= wire_len_of(l).unwrap_or(0),
+                _ => false,
+            };
         if complete {
             stats.checksum_failure();
         } else if !at_end {
@@ -187,6 +125,29 @@ fn scan_next(
         stats.skip(1);
         *pos = i + 1;
     }
+}
+
+/// Runs the scanner over `data`, whose first byte is at stream offset `base`, giving every frame
+/// to `on_frame`; returns where it stopped (as [`scan_next`] leaves `pos`).
+///
+/// Out of line, so that [`Decoder::feed`] (which scans its held candidate, then the new bytes)
+/// and [`Decoder::flush`] each have one copy of the scanner, not one per loop: a fixed layout,
+/// whose speed does not hang on the compiler's inlining choices.
+#[inline(never)]
+fn scan_all<const AT_END: bool>(
+    data: &[u8],
+    base: u64,
+    stats: &mut LinkStats,
+    on_frame: &mut impl FnMut(Decoded),
+) -> usize {
+    let mut pos = 0;
+    while let Some((at, frame)) = scan_next(data, &mut pos, stats, AT_END) {
+        on_frame(Decoded {
+            offset: base + at as u64,
+            frame,
+        });
+    }
+    pos
 }
 
 /// A streaming decoder: feed it bytes in any chunking, get every frame once.
@@ -259,8 +220,7 @@ impl Decoder {
             // bytes (a frame's length is known from its second byte), so just keep them.
             let needed = match self.buf[..held] {
                 [_] => 2,
-                [_, DATA_LENGTH_BYTE, ..] => DATA_FRAME_LEN,
-                [_, INFO_LENGTH_BYTE, ..] => INFO_FRAME_LEN,
+                [_, l, ..] => wire_len_of(l).unwrap_or(0),
                 _ => 0,
             };
             if held + data.len() < needed {
@@ -277,13 +237,7 @@ impl Decoder {
             tmp[held..held + take].copy_from_slice(&data[..take]);
             let n = held + take;
             let tmp_base = start - held as u64;
-            let mut pos = 0;
-            while let Some((at, frame)) = scan_next(&tmp[..n], &mut pos, &mut self.stats, false) {
-                on_frame(Decoded {
-                    offset: tmp_base + at as u64,
-                    frame,
-                });
-            }
+            let pos = scan_all::<false>(&tmp[..n], tmp_base, &mut self.stats, &mut on_frame);
             if pos < held {
                 // `data` ran out before the held candidate was decided.
                 self.hold(&tmp[pos..n]);
@@ -292,13 +246,7 @@ impl Decoder {
             data = &data[pos - held..];
             base += (pos - held) as u64;
         }
-        let mut pos = 0;
-        while let Some((at, frame)) = scan_next(data, &mut pos, &mut self.stats, false) {
-            on_frame(Decoded {
-                offset: base + at as u64,
-                frame,
-            });
-        }
+        let pos = scan_all::<false>(data, base, &mut self.stats, &mut on_frame);
         self.hold(&data[pos..]);
     }
 
@@ -318,14 +266,7 @@ impl Decoder {
     pub fn flush(&mut self, mut on_frame: impl FnMut(Decoded)) {
         let held = usize::from(self.len);
         let base = self.stats.bytes() - held as u64;
-        let mut pos = 0;
-        while let Some((at, frame)) = scan_next(&self.buf[..held], &mut pos, &mut self.stats, true)
-        {
-            on_frame(Decoded {
-                offset: base + at as u64,
-                frame,
-            });
-        }
+        scan_all::<true>(&self.buf[..held], base, &mut self.stats, &mut on_frame);
         self.len = 0;
     }
 
@@ -417,6 +358,7 @@ impl core::iter::FusedIterator for Frames<'_> {}
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::DataFrame;
 
     #[test]
     fn find_header_matches_a_plain_search() {

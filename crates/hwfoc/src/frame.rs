@@ -1,248 +1,288 @@
-//! The 0x02 real-time data frame: layout, checksum, parsing and encoding.
+//! The list of frame kinds, and what is built from it: [`Frame`] (one arm per kind),
+//! [`MAX_FRAME_LEN`], [`parse`] and the dispatch the scanner of [`crate::decoder`] uses.
 //!
-//! ```text
-//!  0    1    2    3    4..5   6..7      8..9       10..11  12..13  14..15    16..17     18   19   20..21   22     23
-//!  9B   16   01   02   PN     thr_in    thr_out    erpm    volt    i_in      i_phase    MOS  CAP  status   SUM_L  SUM_H
-//! ```
+//! The layers of the codec, each knowing only those below it:
 //!
-//! Payload fields are big-endian; the checksum is the 16-bit wrapping sum of bytes 0..=21, sent low
-//! byte first (see `PROTOCOL-NOTES.md`: real frames do not match CRC-16/MODBUS, the sum does).
+//! | module | holds |
+//! |---|---|
+//! | [`crate::wire`] | line settings ([`BAUD_RATE`](crate::wire::BAUD_RATE), [`byte_ns`](crate::wire::byte_ns)), sync byte, [`Checksum`](crate::wire::Checksum) kinds, [`FrameError`], the [`FrameKind`] trait |
+//! | [`crate::kinds`] | one module per kind: [`DataFrame`], [`InfoFrame`] |
+//! | `frame` (here) | the list of kinds: [`Frame`], [`MAX_FRAME_LEN`], [`parse`], [`Parsed`] |
+//! | [`crate::decoder`] | the scanner: [`Decoder`](crate::Decoder), [`frames`](crate::frames) |
+//!
+//! The scanner never names a kind: right after a frame it asks the first kind of the list
+//! whether another starts there; otherwise it finds a sync byte followed by a known length byte,
+//! asks each kind in turn whether a frame starts there ([`FrameKind::accept`]), and otherwise learns
+//! from the length byte how many bytes the candidate needs before it can be rejected. Every
+//! constant of every kind is known at compile time, so this dispatch compiles to the same
+//! compares a hand-written scanner for these two kinds would make.
+//!
+//! # Adding a frame kind
+//!
+//! A new HW-FOC frame kind (another command, or the older XRotor-Pro `9B 16 03` frame of
+//! `OLDER-PROTOCOLS.md` that should be recognised and reported as unsupported) is:
+//!
+//! 1. **One new file**, `src/kinds/<name>.rs` (plus its `pub mod` line in `src/kinds/mod.rs`):
+//!    the type, with `impl FrameKind` (length byte, version, command, length,
+//!    [`Checksum`](crate::wire::Checksum) kind, and optionally a faster [`FrameKind::accept`]) and
+//!    `impl Sealed` (read the payload of a verified frame, write it, count the frame in
+//!    [`LinkStats`]).
+//! 2. **One arm** in the `frame_kinds!` list below: `Name(Type)` with its doc comment. That arm
+//!    makes the [`Frame`] variant, a `From` conversion, its place in [`Frame::wire_len`],
+//!    [`Frame::encode_into`], [`parse`], the scanner's dispatch, the known length bytes of
+//!    [`FrameError::UnknownLength`] and [`MAX_FRAME_LEN`]. Arms are tried in order, and only the
+//!    first is tried right after a frame: keep the most frequent kind first.
+//! 3. If the kind should be counted apart, a counter in [`LinkStats`]
+//!    (`stats.rs`) for its `count` to call.
+//!
+//! Compile-time checks below reject a kind whose length byte is not its length minus its check
+//! bytes, two kinds with the same header, and two kinds sharing a length byte but not a length
+//! (two kinds *may* share a length byte: the `9B 16 03` frame would share the data frame's).
+//! A kind longer than 77 bytes raises [`MAX_FRAME_LEN`], and with it the [`Decoder`](crate::Decoder)'s
+//! state (`MAX_FRAME_LEN - 1` bytes of buffer) and the size of [`Frame`]: the decoder's
+//! `state_is_under_128_bytes` test and the size probe's `DECODER_STATE_BYTES` check catch it.
+//!
+//! # Another protocol
+//!
+//! - **DataLink V2** (the hub's aggregate frame, `PROTOCOL-NOTES.md`): `9B 9E 01 02`, 160 bytes,
+//!   a frame counter and 8 ESC records, CRC-16/XMODEM of bytes 0..=157, low byte first, on a
+//!   115200-baud wire. Its frame fits this outline exactly (0x9E = 160 - 2), so it is one new
+//!   arm of [`Checksum`](crate::wire::Checksum) (`Crc16Xmodem`: its `width`, `compute`,
+//!   `carried`, `seal`), one new file `kinds/datalink.rs`, and one arm here. Its baud rate would
+//!   be a constant of that file ([`byte_ns`](crate::wire::byte_ns) takes any rate). The price:
+//!   [`MAX_FRAME_LEN`] becomes 160, so every [`Decoder`](crate::Decoder) grows from 120 to 200
+//!   bytes and [`Frame`] to the size of 8 records (from 74 to about 170 bytes), also in firmware
+//!   that reads one ESC's own wire, where a hub frame never comes. If that matters, the scanner
+//!   can be made generic over the list of kinds (from here it uses only `Frame::take_first`,
+//!   `Frame::take`, `wire_len_of`, `or_length_bytes` and `MAX_FRAME_LEN`), with one list per
+//!   wire: this file's for an ESC's wire, a one-arm list for a hub's.
+//! - **Hobbywing V3/V4** (`OLDER-PROTOCOLS.md`): same sync byte and baud rate, but no length
+//!   byte and no checksum. Frames are recognised by fixed bytes, by chaining (the next header
+//!   exactly where the previous frame ended) and by the packet counter, which needs state across
+//!   frames. That is a different scanner, not a kind: a module of its own beside
+//!   [`crate::decoder`], using [`SYNC`], [`BAUD_RATE`](crate::wire::BAUD_RATE)
+//!   and [`byte_ns`](crate::wire::byte_ns) from [`crate::wire`] and its own frame types (only
+//!   their conversions, not their layout, resemble [`DataFrame`]'s). Auto-detection would sit
+//!   above both scanners.
 
 use core::fmt;
 
-use crate::info::{INFO_FRAME_LEN, INFO_LENGTH_BYTE, InfoFrame};
-use crate::status::Status;
-use crate::units::{Settings, Temperature};
+use crate::kinds::data::DataFrame;
+use crate::kinds::info::InfoFrame;
+use crate::stats::LinkStats;
+use crate::wire::sealed::Sealed;
+use crate::wire::{FrameError, FrameKind, SYNC};
 
-/// First byte of every HW-FOC frame.
-pub const SYNC: u8 = 0x9B;
-/// Protocol version byte (byte 2) of every frame seen on real ESCs.
-pub const VERSION: u8 = 0x01;
-/// Command byte of a real-time data frame.
-pub const CMD_DATA: u8 = 0x02;
-/// Length byte of a data frame: the number of bytes before the two checksum bytes.
-pub const DATA_LENGTH_BYTE: u8 = 0x16;
-/// Total length of a data frame on the wire, checksum included.
-pub const DATA_FRAME_LEN: usize = 24;
-/// Length of the longest frame on the wire (the device-information frame).
-pub const MAX_FRAME_LEN: usize = INFO_FRAME_LEN;
+/// Declares the frame kinds: one arm per kind, `Variant(Type)`, in the order the scanner tries
+/// them. Everything that lists the kinds is generated from this one list.
+macro_rules! frame_kinds {
+    (
+        $(#[$first_attr:meta])* $first_arm:ident($first_kind:ty)
+        $(, $(#[$attr:meta])* $arm:ident($kind:ty))* $(,)?
+    ) => {
+        frame_kinds!(@expand $first_arm($first_kind);
+            [$(#[$first_attr])* $first_arm($first_kind)] $([$(#[$attr])* $arm($kind)])*);
+    };
+    (@expand $first_arm:ident($first_kind:ty); $([$(#[$attr:meta])* $arm:ident($kind:ty)])+) => {
+        /// A frame of any kind found on the telemetry wire: one arm per [`FrameKind`].
+        #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+        pub enum Frame {
+            $( $(#[$attr])* $arm($kind), )+
+        }
 
-/// The 16-bit wrapping sum of `bytes`, the checksum of a data frame.
-///
-/// ```
-/// // The first frame of the XRotor capture: sum 0x080D, sent as `0D 08`.
-/// let frame = [0x9B, 0x16, 0x01, 0x02, 0x05, 0xC2, 0, 0, 0, 0, 0, 0, 0x00, 0xF7,
-///              0xFF, 0xFF, 0xFF, 0xFF, 0xCE, 0xD1, 0x00, 0x00];
-/// assert_eq!(hwfoc::frame::checksum(&frame), 0x080D);
-/// ```
-#[inline]
-pub fn checksum(bytes: &[u8]) -> u16 {
-    // Summing into a u32 first lets the compiler vectorise; the wrap to 16 bits is exact because
-    // no realistic slice (< 16 MiB) overflows a u32.
-    let mut sum = 0u32;
-    for &b in bytes {
-        sum += u32::from(b);
-    }
-    sum as u16
+        $(
+            impl From<$kind> for Frame {
+                #[inline]
+                fn from(frame: $kind) -> Frame {
+                    Frame::$arm(frame)
+                }
+            }
+        )+
+
+        /// What the compile-time checks and [`MAX_FRAME_LEN`] need of every kind, in list order.
+        const KINDS: &[Kind] = &[$(Kind::of::<$kind>()),+];
+
+        /// The length byte of every kind, in list order.
+        const LENGTH_BYTES: [u8; KINDS.len()] = [$(<$kind as FrameKind>::LENGTH_BYTE),+];
+
+        /// `f` of every kind's length byte, ORed: one expression with constants, never a loop
+        /// (which LLVM does not always unroll).
+        #[inline(always)]
+        pub(crate) fn or_length_bytes(f: impl Fn(u8) -> u64) -> u64 {
+            0 $( | f(<$kind as FrameKind>::LENGTH_BYTE) )+
+        }
+
+        /// The wire length of a frame whose length byte is `length_byte`, or `None` when no kind
+        /// has that length byte.
+        #[inline(always)]
+        pub(crate) fn wire_len_of(length_byte: u8) -> Option<usize> {
+            $(
+                if length_byte == <$kind as FrameKind>::LENGTH_BYTE {
+                    return Some(<$kind as FrameKind>::LEN);
+                }
+            )+
+            None
+        }
+
+        impl Frame {
+            /// The frame's length on the wire.
+            pub fn wire_len(&self) -> usize {
+                match self {
+                    $( Frame::$arm(_) => <$kind as FrameKind>::LEN, )+
+                }
+            }
+
+            /// Encodes the frame into the start of `out` and returns the number of bytes written,
+            /// or `None` when `out` is shorter than [`Frame::wire_len`].
+            pub fn encode_into(&self, out: &mut [u8]) -> Option<usize> {
+                match self {
+                    $( Frame::$arm(frame) => frame.encode_into(out), )+
+                }
+            }
+
+            /// The frame at `data[*pos..]`, if it is of the first (most frequent) kind: the
+            /// scanner's first guess, right after a frame. A frame is counted in `stats` and
+            /// returned with its offset, `*pos` moved past it.
+            #[inline(always)]
+            pub(crate) fn take_first(
+                data: &[u8],
+                pos: &mut usize,
+                stats: &mut LinkStats,
+            ) -> Option<(usize, Frame)> {
+                let at = *pos;
+                let frame = <$first_kind as FrameKind>::accept(&data[at..])?;
+                frame.count(stats);
+                *pos = at + <$first_kind as FrameKind>::LEN;
+                Some((at, Frame::$first_arm(frame)))
+            }
+
+            /// The frame at `data[*pos..]` (a sync byte and a known length byte), if a kind
+            /// accepts it: counted and returned as by [`Frame::take_first`].
+            #[inline(always)]
+            pub(crate) fn take(
+                data: &[u8],
+                pos: &mut usize,
+                stats: &mut LinkStats,
+            ) -> Option<(usize, Frame)> {
+                let at = *pos;
+                $(
+                    if let Some(frame) = <$kind as FrameKind>::accept(&data[at..]) {
+                        frame.count(stats);
+                        *pos = at + <$kind as FrameKind>::LEN;
+                        return Some((at, Frame::$arm(frame)));
+                    }
+                )+
+                None
+            }
+
+            /// Checks and decodes `candidate`, at least as long as the kinds with its length
+            /// byte `length_byte`: as the kind whose header it carries, else as the first kind
+            /// with that length byte (whose error then says what is wrong).
+            fn verify(candidate: &[u8], length_byte: u8) -> Result<Frame, FrameError> {
+                let header = candidate.first_chunk::<4>();
+                $(
+                    if header == Some(&<$kind as FrameKind>::HEADER) {
+                        return <$kind as FrameKind>::verify(candidate).map(Frame::$arm);
+                    }
+                )+
+                $(
+                    if length_byte == <$kind as FrameKind>::LENGTH_BYTE {
+                        return <$kind as FrameKind>::verify(candidate).map(Frame::$arm);
+                    }
+                )+
+                Err(FrameError::UnknownLength { found: length_byte })
+            }
+        }
+    };
 }
 
-/// One real-time telemetry frame (command 0x02), every field as the raw integer sent on the wire.
-///
-/// Physical values come from the conversion methods, which take the user's [`Settings`] where a
-/// conversion depends on them (current scale, pole pairs, gear ratio).
-///
-/// ```
-/// use hwfoc::{DataFrame, Settings};
-///
-/// let bytes = [0x9B, 0x16, 0x01, 0x02, 0x05, 0xC2, 0, 0, 0, 0, 0, 0, 0x00, 0xF7,
-///              0xFF, 0xFF, 0xFF, 0xFF, 0xCE, 0xD1, 0x00, 0x00, 0x0D, 0x08];
-/// let frame = DataFrame::parse(&bytes)?;
-/// assert_eq!(frame.packet, 1474);
-/// assert_eq!(frame.voltage_v(), 24.7);
-/// assert_eq!(frame.current_a(&Settings::default()), -0.015625);
-/// assert_eq!(frame.mos_temp().celsius(), Some(28.0));
-/// assert_eq!(frame.encode(), bytes);
-/// # Ok::<(), hwfoc::FrameError>(())
-/// ```
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
-pub struct DataFrame {
-    /// Packet number, +1 per data frame, wrapping 65535 -> 0.
-    pub packet: u16,
-    /// Input throttle, 0..=1024 (percent = raw * 100 / 1024).
-    pub throttle_in_raw: u16,
-    /// Output throttle, 0..=1024 (percent = raw * 100 / 1024).
-    pub throttle_out_raw: u16,
-    /// Electrical RPM divided by 10.
-    pub erpm_raw: u16,
-    /// Input voltage in units of 0.1 V.
-    pub voltage_raw: u16,
-    /// Input current, two's complement, in units of 1 / current scale A.
-    pub current_raw: i16,
-    /// Phase current, two's complement, in units of 1 / current scale A.
-    pub phase_current_raw: i16,
-    /// MOSFET temperature as an ADC code (see [`Temperature::from_adc`]).
-    pub mos_adc: u8,
-    /// Capacitor temperature as an ADC code (see [`Temperature::from_adc`]).
-    pub cap_adc: u8,
-    /// Status word: sixteen fault bits.
-    pub status: Status,
-}
-
-impl DataFrame {
-    /// Decodes a data frame from the first [`DATA_FRAME_LEN`] bytes of `bytes`, checking the
-    /// header and the checksum. Bytes after the frame are ignored.
-    pub fn parse(bytes: &[u8]) -> Result<DataFrame, FrameError> {
-        let Some(frame) = bytes.first_chunk::<DATA_FRAME_LEN>() else {
-            return Err(FrameError::Truncated {
-                needed: DATA_FRAME_LEN,
-                got: bytes.len(),
-            });
-        };
-        if frame[0] != SYNC {
-            return Err(FrameError::NoSync { found: frame[0] });
-        }
-        if frame[1] != DATA_LENGTH_BYTE {
-            return Err(FrameError::UnknownLength { found: frame[1] });
-        }
-        check_data(frame)?;
-        Ok(Self::from_verified(frame))
-    }
-
-    /// Reads the fields of a frame whose header and checksum were already verified.
-    #[inline]
-    pub(crate) fn from_verified(f: &[u8; DATA_FRAME_LEN]) -> DataFrame {
-        let be = |i: usize| u16::from_be_bytes([f[i], f[i + 1]]);
-        DataFrame {
-            packet: be(4),
-            throttle_in_raw: be(6),
-            throttle_out_raw: be(8),
-            erpm_raw: be(10),
-            voltage_raw: be(12),
-            current_raw: be(14) as i16,
-            phase_current_raw: be(16) as i16,
-            mos_adc: f[18],
-            cap_adc: f[19],
-            status: Status(be(20)),
-        }
-    }
-
-    /// Encodes the frame as the 24 bytes an ESC sends, header and checksum included.
-    pub fn encode(&self) -> [u8; DATA_FRAME_LEN] {
-        let mut f = [0u8; DATA_FRAME_LEN];
-        f[..4].copy_from_slice(&[SYNC, DATA_LENGTH_BYTE, VERSION, CMD_DATA]);
-        let words = [
-            self.packet,
-            self.throttle_in_raw,
-            self.throttle_out_raw,
-            self.erpm_raw,
-            self.voltage_raw,
-            self.current_raw as u16,
-            self.phase_current_raw as u16,
-        ];
-        for (i, w) in words.iter().enumerate() {
-            f[4 + 2 * i..6 + 2 * i].copy_from_slice(&w.to_be_bytes());
-        }
-        f[18] = self.mos_adc;
-        f[19] = self.cap_adc;
-        f[20..22].copy_from_slice(&self.status.0.to_be_bytes());
-        let sum = checksum(&f[..22]);
-        f[22..24].copy_from_slice(&sum.to_le_bytes());
-        f
-    }
-
-    /// Input throttle in percent (raw * 100 / 1024).
-    pub fn throttle_in_pct(&self) -> f32 {
-        f32::from(self.throttle_in_raw) * 100.0 / 1024.0
-    }
-
-    /// Output throttle in percent (raw * 100 / 1024).
-    pub fn throttle_out_pct(&self) -> f32 {
-        f32::from(self.throttle_out_raw) * 100.0 / 1024.0
-    }
-
-    /// Electrical RPM (raw * 10).
-    pub fn erpm(&self) -> u32 {
-        u32::from(self.erpm_raw) * 10
-    }
-
-    /// Motor (or, with a gear ratio, output shaft) RPM: raw * 10 / (gear ratio * pole pairs).
-    pub fn rpm(&self, settings: &Settings) -> f32 {
-        settings.rpm_from_erpm(self.erpm())
-    }
-
-    /// Input voltage in volts (raw / 10).
-    pub fn voltage_v(&self) -> f32 {
-        f32::from(self.voltage_raw) / 10.0
-    }
-
-    /// Input current in amperes (raw / current scale); negative while braking regeneratively.
-    pub fn current_a(&self, settings: &Settings) -> f32 {
-        settings.amps(self.current_raw)
-    }
-
-    /// Phase current in amperes (raw / current scale).
-    pub fn phase_current_a(&self, settings: &Settings) -> f32 {
-        settings.amps(self.phase_current_raw)
-    }
-
-    /// MOSFET temperature from the ADC table.
-    pub fn mos_temp(&self) -> Temperature {
-        Temperature::from_adc(self.mos_adc)
-    }
-
-    /// Capacitor temperature from the ADC table.
-    pub fn cap_temp(&self) -> Temperature {
-        Temperature::from_adc(self.cap_adc)
-    }
-}
-
-/// Verifies the checksum, version and command of a candidate data frame (sync and length byte
-/// already matched).
-#[inline]
-pub(crate) fn check_data(f: &[u8; DATA_FRAME_LEN]) -> Result<(), FrameError> {
-    let expected = checksum(&f[..22]);
-    let found = u16::from_le_bytes([f[22], f[23]]);
-    if expected != found {
-        return Err(FrameError::Checksum { expected, found });
-    }
-    if f[2] != VERSION || f[3] != CMD_DATA {
-        return Err(FrameError::UnknownCommand {
-            version: f[2],
-            command: f[3],
-        });
-    }
-    Ok(())
-}
-
-/// A frame of either kind found on the telemetry wire.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-pub enum Frame {
+frame_kinds! {
     /// A real-time data frame (command 0x02, 24 bytes).
     Data(DataFrame),
     /// A device-information frame (command 0x01, 77 bytes).
     Info(InfoFrame),
 }
 
-impl Frame {
-    /// The frame's length on the wire.
-    pub fn wire_len(&self) -> usize {
-        match self {
-            Frame::Data(_) => DATA_FRAME_LEN,
-            Frame::Info(_) => INFO_FRAME_LEN,
+/// Length of the longest frame on the wire (the device-information frame).
+pub const MAX_FRAME_LEN: usize = {
+    let mut max = 0;
+    let mut i = 0;
+    while i < KINDS.len() {
+        if KINDS[i].len > max {
+            max = KINDS[i].len;
         }
+        i += 1;
     }
+    max
+};
 
-    /// Encodes the frame into the start of `out` and returns the number of bytes written, or
-    /// `None` when `out` is shorter than [`Frame::wire_len`].
-    pub fn encode_into(&self, out: &mut [u8]) -> Option<usize> {
-        let n = self.wire_len();
-        let dst = out.get_mut(..n)?;
-        match self {
-            Frame::Data(d) => dst.copy_from_slice(&d.encode()),
-            Frame::Info(i) => dst.copy_from_slice(&i.encode()),
+/// The constants of one kind, for the compile-time checks.
+struct Kind {
+    header: [u8; 4],
+    len: usize,
+    check_bytes: usize,
+}
+
+impl Kind {
+    const fn of<K: FrameKind>() -> Kind {
+        Kind {
+            header: K::HEADER,
+            len: K::LEN,
+            check_bytes: K::CHECKSUM.width(),
         }
-        Some(n)
     }
+}
+
+// Every kind follows the HW-FOC outline, and the length byte decides a candidate's length.
+const _: () = {
+    let mut i = 0;
+    while i < KINDS.len() {
+        let k = &KINDS[i];
+        assert!(k.header[0] == SYNC);
+        assert!(
+            k.len > 4 + k.check_bytes,
+            "a frame holds a header, payload and check bytes"
+        );
+        assert!(
+            k.header[1] as usize == k.len - k.check_bytes,
+            "the length byte counts the bytes before the check bytes"
+        );
+        let mut j = i + 1;
+        while j < KINDS.len() {
+            let o = &KINDS[j];
+            assert!(
+                !(o.header[0] == k.header[0]
+                    && o.header[1] == k.header[1]
+                    && o.header[2] == k.header[2]
+                    && o.header[3] == k.header[3]),
+                "two kinds with the same header"
+            );
+            assert!(
+                o.header[1] != k.header[1] || o.len == k.len,
+                "kinds sharing a length byte must share a length"
+            );
+            j += 1;
+        }
+        i += 1;
+    }
+};
+
+/// Writes the known length bytes, each once, as "0x16 or 0x4C" (for [`FrameError`]'s message).
+fn write_length_bytes(f: &mut fmt::Formatter<'_>) -> fmt::Result {
+    let distinct = |i: usize| !LENGTH_BYTES[..i].contains(&LENGTH_BYTES[i]);
+    let count = (0..LENGTH_BYTES.len()).filter(|&i| distinct(i)).count();
+    let mut written = 0;
+    for (i, b) in LENGTH_BYTES.iter().enumerate() {
+        if !distinct(i) {
+            continue;
+        }
+        if written > 0 {
+            f.write_str(if written + 1 == count { " or " } else { ", " })?;
+        }
+        write!(f, "0x{b:02X}")?;
+        written += 1;
+    }
+    Ok(())
 }
 
 /// The outcome of [`parse`]: a whole frame, or the start of one that needs more bytes.
@@ -273,73 +313,16 @@ pub fn parse(bytes: &[u8]) -> Result<Parsed, FrameError> {
     if first != SYNC {
         return Err(FrameError::NoSync { found: first });
     }
-    let Some(&len_byte) = bytes.get(1) else {
+    let Some(&length_byte) = bytes.get(1) else {
         return Ok(Parsed::Partial(2));
     };
-    match len_byte {
-        DATA_LENGTH_BYTE => match bytes.first_chunk::<DATA_FRAME_LEN>() {
-            Some(f) => {
-                check_data(f)?;
-                Ok(Parsed::Complete(
-                    Frame::Data(DataFrame::from_verified(f)),
-                    DATA_FRAME_LEN,
-                ))
-            }
-            None => Ok(Parsed::Partial(DATA_FRAME_LEN)),
-        },
-        INFO_LENGTH_BYTE => match bytes.first_chunk::<INFO_FRAME_LEN>() {
-            Some(f) => Ok(Parsed::Complete(
-                Frame::Info(InfoFrame::parse_exact(f)?),
-                INFO_FRAME_LEN,
-            )),
-            None => Ok(Parsed::Partial(INFO_FRAME_LEN)),
-        },
-        found => Err(FrameError::UnknownLength { found }),
+    let Some(len) = wire_len_of(length_byte) else {
+        return Err(FrameError::UnknownLength { found: length_byte });
+    };
+    if bytes.len() < len {
+        return Ok(Parsed::Partial(len));
     }
-}
-
-/// Why bytes are not a valid frame.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-pub enum FrameError {
-    /// The first byte is not the sync byte 0x9B.
-    NoSync {
-        /// The byte found instead.
-        found: u8,
-    },
-    /// The length byte is neither 0x16 (data) nor 0x4C (device information).
-    UnknownLength {
-        /// The length byte found.
-        found: u8,
-    },
-    /// Fewer bytes than a whole frame.
-    Truncated {
-        /// Bytes a whole frame has.
-        needed: usize,
-        /// Bytes given.
-        got: usize,
-    },
-    /// The checksum does not match the bytes: the frame was corrupted on the wire.
-    Checksum {
-        /// Checksum computed over the received bytes.
-        expected: u16,
-        /// Checksum carried by the frame.
-        found: u16,
-    },
-    /// Checksum correct, but a version or command this decoder does not know.
-    UnknownCommand {
-        /// Version byte (byte 2).
-        version: u8,
-        /// Command byte (byte 3).
-        command: u8,
-    },
-    /// A device-information candidate whose text holds a byte that is not ASCII: not a real
-    /// frame (typically a cut one with another frame behind it).
-    NotText {
-        /// Offset of the first such byte in the frame.
-        offset: usize,
-        /// The byte.
-        found: u8,
-    },
+    Ok(Parsed::Complete(Frame::verify(bytes, length_byte)?, len))
 }
 
 impl fmt::Display for FrameError {
@@ -348,10 +331,11 @@ impl fmt::Display for FrameError {
             FrameError::NoSync { found } => {
                 write!(f, "frame starts with 0x{found:02X}, not the sync byte 0x9B")
             }
-            FrameError::UnknownLength { found } => write!(
-                f,
-                "unknown length byte 0x{found:02X} (expected 0x16 or 0x4C)"
-            ),
+            FrameError::UnknownLength { found } => {
+                write!(f, "unknown length byte 0x{found:02X} (expected ")?;
+                write_length_bytes(f)?;
+                f.write_str(")")
+            }
             FrameError::Truncated { needed, got } => {
                 write!(f, "truncated frame: {got} of {needed} bytes")
             }

@@ -5,14 +5,17 @@
 
 pub mod decoder;
 pub mod frame;
-pub mod info;
+pub mod kinds;
 pub mod stats;
 pub mod status;
 pub mod units;
+pub mod wire;
 
 pub use decoder::{Decoded, Decoder, Frames, frames};
-pub use frame::{DataFrame, Frame, FrameError, Parsed, parse};
-pub use info::{InfoFieldError, InfoFrame};
+pub use frame::{Frame, Parsed, parse};
+pub use kinds::data::DataFrame;
+pub use kinds::info::{InfoFieldError, InfoFrame};
 pub use stats::LinkStats;
 pub use status::{Fault, Faults, Status};
-pub use units::{Settings, SettingsError, Temperature};
+pub use units::{Quantity, Settings, SettingsError, Temperature};
+pub use wire::{FrameError, FrameKind};

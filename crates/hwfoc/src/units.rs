@@ -1,6 +1,138 @@
-//! Physical units: the user's conversion settings and the ADC-to-temperature table.
+//! Physical units: every conversion from a raw field to a physical value, written once, the
+//! user's conversion settings, and the ADC-to-temperature table.
+//!
+//! Every HW-FOC conversion but temperature is linear: a [`Linear`] (`raw * mul / div`), named by
+//! a [`Quantity`]. The same definition converts a raw field to `f32` (what [`DataFrame`]'s
+//! methods return) and a statistic of raw values (a minimum, a mean) to `f64`, each bit for bit
+//! as the formulas written out by hand did:
+//!
+//! ```
+//! use hwfoc::{DataFrame, Quantity, Settings};
+//!
+//! let settings = Settings::default(); // current scale 64, 7 pole pairs, gear ratio 1
+//! let frame = DataFrame { erpm_raw: 350, current_raw: -1, ..Default::default() };
+//! assert_eq!(frame.rpm(&settings), 500.0);
+//! assert_eq!(Quantity::Rpm.linear(&settings).to_f32(350.0), 500.0);
+//! assert_eq!(Quantity::Current.linear(&settings).to_f64(-1.5), -1.5 / 64.0);
+//! assert_eq!((Quantity::Current.name(), Quantity::Current.unit()), ("current_a", "A"));
+//! ```
+//!
+//! [`DataFrame`]: crate::DataFrame
 
 use core::fmt;
+
+/// Electrical RPM per unit of a data frame's raw eRPM field.
+pub const ERPM_PER_RAW: u16 = 10;
+
+/// A linear conversion from a raw value to a physical one: `raw * mul / (div * div2)`, computed
+/// in that order, in the precision of the result.
+///
+/// The divisor is kept as two factors because the RPM divisor, gear ratio times pole pairs, is
+/// formed in the result's precision: rounded to `f32` for an `f32` result (as the frame's
+/// methods always did), exact for an `f64` one. For the other conversions the second factor is 1
+/// and the multiplier often 1, both exact, so e.g. a current is `raw / current_scale`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Linear {
+    mul: f32,
+    div: f32,
+    div2: f32,
+}
+
+impl Linear {
+    /// Throttle in percent: `raw * 100 / 1024`.
+    pub const THROTTLE_PCT: Linear = Linear::new(100.0, 1024.0, 1.0);
+    /// Electrical RPM: `raw * 10`.
+    pub const ERPM: Linear = Linear::new(ERPM_PER_RAW as f32, 1.0, 1.0);
+    /// Input voltage in volts: `raw / 10`.
+    pub const VOLTS: Linear = Linear::new(1.0, 10.0, 1.0);
+
+    /// The conversion `raw * mul / (div * div2)`.
+    pub const fn new(mul: f32, div: f32, div2: f32) -> Linear {
+        Linear { mul, div, div2 }
+    }
+
+    /// The value of `raw` as an `f32`: `raw * mul / (div * div2)`, all in `f32`.
+    #[inline]
+    pub fn to_f32(self, raw: f32) -> f32 {
+        raw * self.mul / (self.div * self.div2)
+    }
+
+    /// The value of `raw` (a raw value or a statistic of raw values, such as a mean) as an `f64`:
+    /// `raw * mul / (div * div2)`, all in `f64`.
+    #[inline]
+    pub fn to_f64(self, raw: f64) -> f64 {
+        raw * f64::from(self.mul) / (f64::from(self.div) * f64::from(self.div2))
+    }
+}
+
+/// A quantity of a data frame that converts linearly from its raw field, with its name and unit
+/// in every output of the project (`RECORD-SCHEMA.md`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Quantity {
+    /// Input throttle, % (`throttle_in_pct`).
+    ThrottleIn,
+    /// Output throttle, % (`throttle_out_pct`).
+    ThrottleOut,
+    /// Electrical RPM (`erpm`).
+    Erpm,
+    /// Motor (or geared output) RPM (`rpm`).
+    Rpm,
+    /// Input voltage, V (`voltage_v`).
+    Voltage,
+    /// Input current, A (`current_a`).
+    Current,
+    /// Phase current, A (`phase_current_a`).
+    PhaseCurrent,
+}
+
+impl Quantity {
+    /// Every quantity, in the order of the telemetry record.
+    pub const ALL: [Quantity; 7] = [
+        Quantity::ThrottleIn,
+        Quantity::ThrottleOut,
+        Quantity::Erpm,
+        Quantity::Rpm,
+        Quantity::Voltage,
+        Quantity::Current,
+        Quantity::PhaseCurrent,
+    ];
+
+    /// The column name in every output, e.g. `voltage_v`.
+    pub const fn name(self) -> &'static str {
+        match self {
+            Quantity::ThrottleIn => "throttle_in_pct",
+            Quantity::ThrottleOut => "throttle_out_pct",
+            Quantity::Erpm => "erpm",
+            Quantity::Rpm => "rpm",
+            Quantity::Voltage => "voltage_v",
+            Quantity::Current => "current_a",
+            Quantity::PhaseCurrent => "phase_current_a",
+        }
+    }
+
+    /// The unit: `%`, `rev/min`, `V` or `A`.
+    pub const fn unit(self) -> &'static str {
+        match self {
+            Quantity::ThrottleIn | Quantity::ThrottleOut => "%",
+            Quantity::Erpm | Quantity::Rpm => "rev/min",
+            Quantity::Voltage => "V",
+            Quantity::Current | Quantity::PhaseCurrent => "A",
+        }
+    }
+
+    /// The conversion from the raw field under `settings` (which only RPM and the currents
+    /// depend on).
+    #[inline]
+    pub fn linear(self, settings: &Settings) -> Linear {
+        match self {
+            Quantity::ThrottleIn | Quantity::ThrottleOut => Linear::THROTTLE_PCT,
+            Quantity::Erpm => Linear::ERPM,
+            Quantity::Rpm => settings.rpm_linear(),
+            Quantity::Voltage => Linear::VOLTS,
+            Quantity::Current | Quantity::PhaseCurrent => settings.amps_linear(),
+        }
+    }
+}
 
 /// Conversion settings that the frame itself does not carry.
 ///
@@ -54,16 +186,39 @@ impl Settings {
         })
     }
 
-    /// Amperes for a raw current value.
+    /// Amperes for a raw current value (input or phase): `raw / current scale`.
     #[inline]
     pub fn amps(&self, raw: i16) -> f32 {
-        f32::from(raw) / self.current_scale
+        self.amps_linear().to_f32(f32::from(raw))
     }
 
-    /// Mechanical RPM for an electrical RPM: erpm / (gear ratio * pole pairs).
+    /// Mechanical RPM for an electrical RPM: `erpm / (gear ratio * pole pairs)`.
     #[inline]
     pub fn rpm_from_erpm(&self, erpm: u32) -> f32 {
-        erpm as f32 / (self.gear_ratio * f32::from(self.pole_pairs))
+        self.erpm_to_rpm().to_f32(erpm as f32)
+    }
+
+    /// The conversion of a raw current (input or phase) to amperes: `raw / current scale`.
+    #[inline]
+    pub const fn amps_linear(&self) -> Linear {
+        Linear::new(1.0, self.current_scale, 1.0)
+    }
+
+    /// The conversion of an electrical RPM to mechanical RPM: `erpm / (gear ratio * pole pairs)`.
+    #[inline]
+    pub const fn erpm_to_rpm(&self) -> Linear {
+        Linear::new(1.0, self.gear_ratio, self.pole_pairs as f32)
+    }
+
+    /// The conversion of a raw eRPM field to mechanical RPM:
+    /// `raw * 10 / (gear ratio * pole pairs)`, [`Linear::ERPM`] and
+    /// [`Settings::erpm_to_rpm`] in one step (exact: `raw * 10` is an integer below 2^24).
+    #[inline]
+    pub const fn rpm_linear(&self) -> Linear {
+        Linear {
+            mul: Linear::ERPM.mul,
+            ..self.erpm_to_rpm()
+        }
     }
 }
 

@@ -4,8 +4,8 @@
 //!
 //! Case counts are kept modest so that the whole file runs in a few seconds in debug mode.
 
-use hwfoc::frame::DATA_FRAME_LEN;
-use hwfoc::info::INFO_FRAME_LEN;
+use hwfoc::kinds::data::DATA_FRAME_LEN;
+use hwfoc::kinds::info::INFO_FRAME_LEN;
 use hwfoc::{
     DataFrame, Decoded, Decoder, Frame, FrameError, InfoFrame, LinkStats, Parsed, Status, frames,
     parse,

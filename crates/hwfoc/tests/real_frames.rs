@@ -5,9 +5,10 @@
 //! Every stream test decodes twice, with the bulk iterator and with the streaming decoder fed one
 //! byte at a time, and checks that both agree (frames and statistics) before checking values.
 
-use hwfoc::frame::{DATA_FRAME_LEN, checksum};
-use hwfoc::info::INFO_FRAME_LEN;
+use hwfoc::kinds::data::DATA_FRAME_LEN;
+use hwfoc::kinds::info::INFO_FRAME_LEN;
 use hwfoc::units::{ADC_MAX, ADC_MIN, ADC_TABLE};
+use hwfoc::wire::sum16;
 use hwfoc::{
     DataFrame, Decoded, Decoder, Fault, Frame, FrameError, InfoFieldError, InfoFrame, LinkStats,
     Parsed, Settings, SettingsError, Status, Temperature, frames, parse,
@@ -328,7 +329,7 @@ fn example_frame_physical_values_under_default_settings() {
 
 #[test]
 fn example_frame_checksum_is_a_16_bit_sum_sent_low_byte_first() {
-    assert_eq!(checksum(&EXAMPLE[..22]), 0x080D);
+    assert_eq!(sum16(&EXAMPLE[..22]), 0x080D);
     assert_eq!(EXAMPLE[22..], [0x0D, 0x08]);
     let manual: u32 = EXAMPLE[..22].iter().map(|&b| u32::from(b)).sum();
     assert_eq!(manual, 0x080D);
@@ -490,7 +491,7 @@ fn corrupted_frames_in_a_stream_count_as_failures_and_lost_packets() {
 fn correct_checksum_with_unknown_command_is_refused() {
     // Re-sum the corrupted-command frame: the checksum now matches but command 0x0A is unknown.
     let mut f = CORRUPT_COMMAND;
-    let sum = checksum(&f[..22]).to_le_bytes();
+    let sum = sum16(&f[..22]).to_le_bytes();
     f[22..].copy_from_slice(&sum);
     assert_eq!(
         DataFrame::parse(&f),
@@ -579,7 +580,7 @@ fn real_info_frame_fields() {
 #[test]
 fn real_info_frame_check_byte_and_reencoding() {
     let bytes = info_bytes();
-    assert_eq!(checksum(&bytes[..76]) & 0xFF, 0x34);
+    assert_eq!(sum16(&bytes[..76]) & 0xFF, 0x34);
     let info = InfoFrame::parse(&bytes).unwrap();
     assert_eq!(info.encode(), bytes);
     assert_eq!(InfoFrame::from_text(*INFO_TEXT), Ok(info));
@@ -1195,7 +1196,7 @@ fn settings_new_accepts_sensible_values() {
 fn info_candidate_with_non_ascii_text_is_refused() {
     let mut bytes = info_bytes();
     bytes[30] = 0x9B;
-    bytes[76] = checksum(&bytes[..76]) as u8;
+    bytes[76] = sum16(&bytes[..76]) as u8;
     assert_eq!(
         InfoFrame::parse(&bytes),
         Err(FrameError::NotText {
@@ -1207,4 +1208,48 @@ fn info_candidate_with_non_ascii_text_is_refused() {
     assert!(decoded.is_empty());
     assert_eq!(stats.checksum_failures(), 1);
     assert_eq!(stats.info_frames(), 0);
+}
+
+#[test]
+fn frame_error_messages() {
+    // The texts as they were before the frame kinds got a module each; the unknown-length one is
+    // now built from the list of kinds.
+    let cases = [
+        (
+            FrameError::NoSync { found: 0x00 },
+            "frame starts with 0x00, not the sync byte 0x9B",
+        ),
+        (
+            FrameError::UnknownLength { found: 0x42 },
+            "unknown length byte 0x42 (expected 0x16 or 0x4C)",
+        ),
+        (
+            FrameError::Truncated { needed: 24, got: 3 },
+            "truncated frame: 3 of 24 bytes",
+        ),
+        (
+            FrameError::Checksum {
+                expected: 0x080D,
+                found: 0x090D,
+            },
+            "checksum mismatch: bytes sum to 0x080D, frame carries 0x090D",
+        ),
+        (
+            FrameError::UnknownCommand {
+                version: 0x01,
+                command: 0x0A,
+            },
+            "unknown version 0x01 / command 0x0A",
+        ),
+        (
+            FrameError::NotText {
+                offset: 9,
+                found: 0x9B,
+            },
+            "device-information text holds byte 0x9B at offset 9, which is not ASCII",
+        ),
+    ];
+    for (error, text) in cases {
+        assert_eq!(error.to_string(), text);
+    }
 }

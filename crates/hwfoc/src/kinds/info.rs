@@ -14,10 +14,13 @@
 //! chance once in 256 times, and would swallow the data frames behind it. So a candidate is also
 //! required to carry ASCII text (every byte below 0x80): a data frame inside the 77-byte window
 //! always brings its `0x9B` sync byte into the text and is never hidden.
+//!
+//! The check byte is [`Checksum::Sum8`]: the low byte of the 16-bit sum of bytes 0..=75.
 
 use core::fmt;
 
-use crate::frame::{FrameError, SYNC, VERSION, checksum};
+use crate::stats::LinkStats;
+use crate::wire::{Checksum, FrameError, FrameKind, VERSION, sealed};
 
 /// Length byte of a device-information frame: bytes before the check byte.
 pub const INFO_LENGTH_BYTE: u8 = 0x4C;
@@ -125,52 +128,13 @@ impl InfoFrame {
 
     /// Decodes a device-information frame from the first 77 bytes of `bytes`.
     pub fn parse(bytes: &[u8]) -> Result<Self, FrameError> {
-        let Some(frame) = bytes.first_chunk::<INFO_FRAME_LEN>() else {
-            return Err(FrameError::Truncated {
-                needed: INFO_FRAME_LEN,
-                got: bytes.len(),
-            });
-        };
-        if frame[0] != SYNC {
-            return Err(FrameError::NoSync { found: frame[0] });
-        }
-        if frame[1] != INFO_LENGTH_BYTE {
-            return Err(FrameError::UnknownLength { found: frame[1] });
-        }
-        Self::parse_exact(frame)
-    }
-
-    /// Checks and decodes a 77-byte candidate whose sync and length bytes already matched.
-    #[inline]
-    pub(crate) fn parse_exact(f: &[u8; INFO_FRAME_LEN]) -> Result<Self, FrameError> {
-        let expected = checksum(&f[..76]) & 0xFF;
-        let found = u16::from(f[76]);
-        if expected != found {
-            return Err(FrameError::Checksum { expected, found });
-        }
-        if f[2] != VERSION || f[3] != CMD_INFO {
-            return Err(FrameError::UnknownCommand {
-                version: f[2],
-                command: f[3],
-            });
-        }
-        if let Some(at) = f[4..76].iter().position(|b| !b.is_ascii()) {
-            return Err(FrameError::NotText {
-                offset: 4 + at,
-                found: f[4 + at],
-            });
-        }
-        let mut text = [0u8; INFO_TEXT_LEN];
-        text.copy_from_slice(&f[4..76]);
-        Ok(InfoFrame { text })
+        <Self as FrameKind>::parse(bytes)
     }
 
     /// Encodes the frame as the 77 bytes an ESC sends.
     pub fn encode(&self) -> [u8; INFO_FRAME_LEN] {
         let mut f = [0u8; INFO_FRAME_LEN];
-        f[..4].copy_from_slice(&[SYNC, INFO_LENGTH_BYTE, VERSION, CMD_INFO]);
-        f[4..76].copy_from_slice(&self.text);
-        f[76] = checksum(&f[..76]) as u8;
+        self.encode_into(&mut f);
         f
     }
 
@@ -216,6 +180,63 @@ impl InfoFrame {
     }
 }
 
+impl FrameKind for InfoFrame {
+    const LENGTH_BYTE: u8 = INFO_LENGTH_BYTE;
+    const VERSION: u8 = VERSION;
+    const COMMAND: u8 = CMD_INFO;
+    const LEN: usize = INFO_FRAME_LEN;
+    const CHECKSUM: Checksum = Checksum::Sum8;
+}
+
+impl sealed::Sealed for InfoFrame {
+    #[inline]
+    fn read(frame: &[u8]) -> Result<Self, FrameError> {
+        let Some(f) = frame.first_chunk::<INFO_FRAME_LEN>() else {
+            return Err(FrameError::Truncated {
+                needed: INFO_FRAME_LEN,
+                got: frame.len(),
+            });
+        };
+        if let Some((at, found)) = first_non_ascii(&f[4..76]) {
+            return Err(FrameError::NotText {
+                offset: 4 + at,
+                found,
+            });
+        }
+        let mut text = [0u8; INFO_TEXT_LEN];
+        text.copy_from_slice(&f[4..76]);
+        Ok(InfoFrame { text })
+    }
+
+    fn write(&self, payload: &mut [u8]) {
+        payload.copy_from_slice(&self.text);
+    }
+
+    #[inline(always)]
+    fn count(&self, stats: &mut LinkStats) {
+        stats.info_frame();
+    }
+}
+
+/// Offset and value of the first byte of `text` that is not ASCII, looked for a machine word at
+/// a time (4 bytes on a Cortex-M, 8 on a PC: 18 or 9 steps for the 72 text bytes, one loop).
+#[inline]
+fn first_non_ascii(text: &[u8]) -> Option<(usize, u8)> {
+    const WORD: usize = size_of::<usize>();
+    const HIGH: usize = usize::from_ne_bytes([0x80; WORD]);
+    let mut words = text.chunks_exact(WORD);
+    for (i, w) in words.by_ref().enumerate() {
+        let word = usize::from_le_bytes(w.try_into().unwrap_or([0; WORD]));
+        if word & HIGH != 0 {
+            let bit = (word & HIGH).trailing_zeros() & !7;
+            return Some((i * WORD + bit as usize / 8, (word >> bit) as u8));
+        }
+    }
+    let rest = words.remainder();
+    let at = rest.iter().position(|b| !b.is_ascii())?;
+    Some((text.len() - rest.len() + at, rest[at]))
+}
+
 /// ASCII bytes as text (an `InfoFrame` holds nothing else; `"?"` would mark a broken invariant).
 fn ascii(bytes: &[u8]) -> &str {
     core::str::from_utf8(bytes).unwrap_or("?")
@@ -242,5 +263,38 @@ impl fmt::Display for InfoFrame {
             f.write_str(w)?;
         }
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn first_non_ascii_matches_a_plain_search() {
+        let plain = |t: &[u8]| t.iter().position(|b| !b.is_ascii()).map(|at| (at, t[at]));
+        let mut text = [b' '; INFO_TEXT_LEN];
+        assert_eq!(first_non_ascii(&text), None);
+        for at in 0..INFO_TEXT_LEN {
+            for bad in [0x80, 0x9B, 0xFF] {
+                text[at] = bad;
+                assert_eq!(first_non_ascii(&text), Some((at, bad)));
+                if at + 3 < INFO_TEXT_LEN {
+                    text[at + 3] = 0xC0; // a later one changes nothing
+                    assert_eq!(first_non_ascii(&text), Some((at, bad)));
+                    text[at + 3] = b'x';
+                }
+                text[at] = 0x7F;
+                assert_eq!(first_non_ascii(&text), plain(&text));
+            }
+        }
+        // Lengths that leave a remainder after whole words.
+        for len in 0..20 {
+            let mut t = [b'a'; 20];
+            if len > 0 {
+                t[len - 1] = 0xA5;
+            }
+            assert_eq!(first_non_ascii(&t[..len]), plain(&t[..len]), "{len}");
+        }
     }
 }
