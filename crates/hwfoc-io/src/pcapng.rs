@@ -70,11 +70,6 @@ const MAX_RESYNC_BLOCK: usize = MAX_CHUNK + 4096;
 /// Bytes asked of the source per read.
 const READ_SIZE: usize = 1 << 16;
 
-/// Nanoseconds one byte takes on the wire at `baud`, 8N1 (ten bits: start, eight data, stop).
-pub fn byte_ns(baud: u32) -> f64 {
-    10e9 / f64::from(baud.max(1))
-}
-
 /// Writes a pcapng recording: the section header on creation, then interfaces, chunks and notes.
 ///
 /// Each block is handed to `W` in a single `write_all`; the writer keeps nothing itself, so with
@@ -146,7 +141,7 @@ impl<W: Write> Writer<W> {
     /// than [`MAX_CHUNK`] becomes several packets.
     pub fn write(&mut self, iface: u32, t_ns: u64, data: &[u8]) -> io::Result<()> {
         let baud = self.baud(iface)?;
-        let per_byte = byte_ns(baud);
+        let per_byte = hwfoc::wire::byte_ns(baud);
         for (k, piece) in data.chunks(MAX_CHUNK).enumerate() {
             let offset = (k * MAX_CHUNK) as f64 * per_byte;
             self.packet(
@@ -295,7 +290,7 @@ pub struct Interface {
 impl Interface {
     /// Nanoseconds per byte on this interface (at [`crate::serial::DEFAULT_BAUD`], the HW-FOC rate, when the baud is unknown).
     pub fn byte_ns(&self) -> f64 {
-        byte_ns(self.baud.unwrap_or(crate::serial::DEFAULT_BAUD))
+        hwfoc::wire::byte_ns(self.baud.unwrap_or(crate::serial::DEFAULT_BAUD))
     }
 
     /// Whether the link type is in the user range (147..=162), where HW-FOC bytes are stored.

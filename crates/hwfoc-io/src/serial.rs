@@ -22,7 +22,7 @@ use serialport::{DataBits, FlowControl, Parity, SerialPort, StopBits};
 use std::fmt;
 
 /// The HW-FOC telemetry rate, the default of every serial input.
-pub const DEFAULT_BAUD: u32 = 19_200;
+pub const DEFAULT_BAUD: u32 = hwfoc::wire::BAUD_RATE;
 
 /// How long a read waits for bytes before the thread checks whether it should stop.
 const READ_TIMEOUT: Duration = Duration::from_millis(50);
@@ -478,7 +478,7 @@ impl<M> PortReader<M> {
     }
 
     fn received(&mut self, bytes: &[u8]) {
-        let per_byte = crate::pcapng::byte_ns(self.baud);
+        let per_byte = hwfoc::wire::byte_ns(self.baud);
         let now = self.clock.now_ns();
         let span = ((bytes.len() - 1) as f64 * per_byte) as u64;
         let mut t_ns = now.saturating_sub(span);

@@ -95,7 +95,7 @@ impl PortStreams {
     pub fn new(ports: usize, baud: u32, settings: Settings) -> PortStreams {
         PortStreams {
             streams: (0..ports).map(|_| Stream::new()).collect(),
-            per_byte_ns: pcapng::byte_ns(baud),
+            per_byte_ns: hwfoc::wire::byte_ns(baud),
             times: Vec::new(),
             settings,
         }

@@ -15,7 +15,7 @@
 use std::fmt::Write as _;
 
 use hwfoc::{
-    DataFrame, Decoded, Fault, Frame, InfoFrame, LinkStats, Settings, Status, Temperature,
+    DataFrame, Decoded, Fault, Frame, InfoFrame, LinkStats, Quantity, Settings, Status, Temperature,
 };
 use serde_json::{Value, json};
 
@@ -24,7 +24,12 @@ use crate::input::{InputError, InputFormat};
 use crate::sources::{Handler, Sources};
 
 /// What to tell a user whose input has bytes but no frame.
-pub const NO_FRAMES: &str = "no valid HW-FOC frames: check the baud rate (19200) and the wiring";
+pub static NO_FRAMES: std::sync::LazyLock<String> = std::sync::LazyLock::new(|| {
+    format!(
+        "no valid HW-FOC frames: check the baud rate ({}) and the wiring",
+        hwfoc::wire::BAUD_RATE
+    )
+});
 
 /// Fault episodes kept per ESC in detail (all are counted).
 const MAX_EPISODES: usize = 10_000;
@@ -396,17 +401,19 @@ impl EscReport<'_> {
         let a = self.acc;
         let n = a.frames;
         let s = self.settings;
-        let pct = |x: f64| x * 100.0 / 1024.0;
-        let amps = move |x: f64| x / f64::from(s.current_scale);
-        let rpm = move |x: f64| x * 10.0 / (f64::from(s.gear_ratio) * f64::from(s.pole_pairs));
+        // The conversions of the codec, applied to the raw min, max and mean.
+        let field = |q: Quantity, range: &Range| {
+            let linear = q.linear(&s);
+            (q.name(), q.unit(), range.convert(n, |x| linear.to_f64(x)))
+        };
         vec![
-            ("throttle_in_pct", "%", a.throttle_in.convert(n, pct)),
-            ("throttle_out_pct", "%", a.throttle_out.convert(n, pct)),
-            ("erpm", "rev/min", a.erpm.convert(n, |x| x * 10.0)),
-            ("rpm", "rev/min", a.erpm.convert(n, rpm)),
-            ("voltage_v", "V", a.voltage.convert(n, |x| x / 10.0)),
-            ("current_a", "A", a.current.convert(n, amps)),
-            ("phase_current_a", "A", a.phase_current.convert(n, amps)),
+            field(Quantity::ThrottleIn, &a.throttle_in),
+            field(Quantity::ThrottleOut, &a.throttle_out),
+            field(Quantity::Erpm, &a.erpm),
+            field(Quantity::Rpm, &a.erpm),
+            field(Quantity::Voltage, &a.voltage),
+            field(Quantity::Current, &a.current),
+            field(Quantity::PhaseCurrent, &a.phase_current),
             ("mos_temp_c", "degC", temp_stats(&a.mos_codes).range),
             ("cap_temp_c", "degC", temp_stats(&a.cap_codes).range),
         ]
@@ -427,7 +434,7 @@ impl EscReport<'_> {
             return;
         }
         if st.frames() == 0 && st.info_frames() == 0 {
-            let _ = writeln!(o, "frames       none: {NO_FRAMES}");
+            let _ = writeln!(o, "frames       none: {}", *NO_FRAMES);
             let _ = writeln!(o, "skipped      {} bytes", st.bytes_skipped());
             return;
         }
@@ -457,7 +464,7 @@ impl EscReport<'_> {
             let _ = writeln!(o, "delivery     {:.2} % of data frames", ratio * 100.0);
         }
         if st.frames() == 0 {
-            let _ = writeln!(o, "             no data frames: {NO_FRAMES}");
+            let _ = writeln!(o, "             no data frames: {}", *NO_FRAMES);
         }
         for (info, n) in &self.acc.infos {
             let _ = writeln!(o, "device       {info}  ({n} info frames)");
@@ -560,7 +567,7 @@ impl EscReport<'_> {
         let warning = if st.bytes() == 0 {
             Some("no bytes from this stream")
         } else {
-            (st.frames() == 0).then_some(NO_FRAMES)
+            (st.frames() == 0).then_some(NO_FRAMES.as_str())
         };
         json!({
             "esc": self.index,

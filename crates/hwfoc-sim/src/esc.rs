@@ -151,7 +151,7 @@ impl VirtualEsc {
         let info = InfoFrame::new(PRODUCT, HARDWARE, FIRMWARE, &format!("{id:08}"))
             .expect("valid device information");
         VirtualEsc {
-            byte_ns: 10.0e9 / f64::from(setup.baud),
+            byte_ns: hwfoc::wire::byte_ns(setup.baud),
             model,
             model_ns: 0,
             noise: Rng::for_esc(setup.seed, setup.index, Purpose::Noise),

@@ -415,11 +415,12 @@ impl Recorder {
                 state.warned_unframed = true;
                 eprintln!(
                     "hwfoc: warning: {}: {} bytes in {} s but no valid HW-FOC frame: likely a \
-                     wrong baud rate (read at {baud}; HW-FOC telemetry is 19200, see --baud) or \
+                     wrong baud rate (read at {baud}; HW-FOC telemetry is {}, see --baud) or \
                      swapped TX/RX wires (the adapter's RX must be on the ESC's telemetry wire)",
                     state.name,
                     state.unframed_bytes,
-                    NO_FRAMES_AFTER.as_secs()
+                    NO_FRAMES_AFTER.as_secs(),
+                    hwfoc::wire::BAUD_RATE
                 );
             }
             if state

@@ -111,7 +111,7 @@ fn warn(sources: &Sources, wanted: &[u8]) {
             eprintln!(
                 "hwfoc: warning: {}: {}",
                 hwfoc_io::summary::esc_label(sources, i),
-                hwfoc_io::summary::NO_FRAMES
+                *hwfoc_io::summary::NO_FRAMES
             );
         }
     }

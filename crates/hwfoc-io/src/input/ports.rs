@@ -4,7 +4,6 @@ use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Duration;
 
-use crate::pcapng;
 use crate::serial::{PortEvent, PortSet};
 use crate::stream::byte_times;
 
@@ -33,7 +32,7 @@ impl Ports {
     /// `times`; returns its port. Returns with nothing once interrupted. Ports that are lost
     /// or come back are reported on standard error.
     pub(super) fn read(&mut self, bytes: &mut Vec<u8>, times: &mut Vec<f64>) -> usize {
-        let per_byte = pcapng::byte_ns(self.set.baud());
+        let per_byte = hwfoc::wire::byte_ns(self.set.baud());
         while !self.interrupted.load(Ordering::Relaxed) {
             match self.set.next_event(PORT_POLL) {
                 Some(PortEvent::Data {

@@ -360,7 +360,7 @@ impl Session {
         let span = if self.simulated {
             0
         } else {
-            (bytes.len().saturating_sub(1) as f64 * hwfoc_io::pcapng::byte_ns(self.baud)) as u64
+            (bytes.len().saturating_sub(1) as f64 * hwfoc::wire::byte_ns(self.baud)) as u64
         };
         let ago = self.clock.now_ns().saturating_sub(t_ns + span);
         now.checked_sub(Duration::from_nanos(ago)).unwrap_or(now)

@@ -286,7 +286,7 @@ impl<'a> Scene<'a> {
                     Some(d) if d.plotted > 0 => None,
                     Some(d) if d.frames > 0 => Some("no data frame in the time window"),
                     _ if stats.bytes() == 0 => Some("no bytes from this stream"),
-                    _ if stats.frames() == 0 => Some(NO_FRAMES),
+                    _ if stats.frames() == 0 => Some(NO_FRAMES.as_str()),
                     _ => Some("no data frames"),
                 };
                 Row {
@@ -868,7 +868,7 @@ fn nothing_message(collector: &Collector, sources: &Sources, shown: &[usize]) ->
     {
         format!("{names}: no data frames")
     } else {
-        format!("{names}: {NO_FRAMES}")
+        format!("{names}: {}", *NO_FRAMES)
     }
 }
 
