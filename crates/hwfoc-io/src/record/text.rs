@@ -1,100 +1,21 @@
-//! The telemetry record of `RECORD-SCHEMA.md` and its text encodings (JSON Lines and CSV).
+//! The text encodings of the records: JSON Lines and CSV.
 //!
 //! Numbers are written as `itoa`/`ryu` write them (the shortest text that reads back to the same
-//! value, as `serde_json` writes them), with no allocation per record; see [`TextEncoder`].
+//! value, as `serde_json` writes them), with no allocation per record; see [`TextEncoder`]. A
+//! row is the columns of the table in order, each written as its value type says
+//! ([`TextValue`]): through [`columns::visit`], with no dispatch per value.
 
-use hwfoc::{DataFrame, Settings, Status};
+use std::marker::PhantomData;
 
-/// Column names in schema order.
-pub const COLUMNS: [&str; 14] = [
-    "t_s",
-    "esc",
-    "packet",
-    "throttle_in_pct",
-    "throttle_out_pct",
-    "erpm",
-    "rpm",
-    "voltage_v",
-    "current_a",
-    "phase_current_a",
-    "mos_temp_c",
-    "cap_temp_c",
-    "status",
-    "faults",
-];
+use hwfoc::{DataFrame, Fault, Status};
 
-/// Unit of each column, in schema order (`-` for a number without unit).
-pub const UNITS: [&str; 14] = [
-    "s", "-", "-", "%", "%", "rev/min", "rev/min", "V", "A", "A", "degC", "degC", "-", "-",
-];
-
-/// One decoded data frame in physical units, as every output presents it.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Record {
-    /// Receive time of the frame's first byte, in seconds, if the source has timing.
-    pub t_s: Option<f64>,
-    /// Index of the input the frame came from.
-    pub esc: u8,
-    /// Packet number.
-    pub packet: u16,
-    /// Input throttle, %.
-    pub throttle_in_pct: f32,
-    /// Output throttle, %.
-    pub throttle_out_pct: f32,
-    /// Electrical RPM.
-    pub erpm: u32,
-    /// Mechanical RPM under the settings.
-    pub rpm: f32,
-    /// Input voltage, V.
-    pub voltage_v: f32,
-    /// Input current, A.
-    pub current_a: f32,
-    /// Phase current, A.
-    pub phase_current_a: f32,
-    /// MOSFET temperature, degC, if in the table's range.
-    pub mos_temp_c: Option<f32>,
-    /// Capacitor temperature, degC, if in the table's range.
-    pub cap_temp_c: Option<f32>,
-    /// Raw status word (the `faults` column is derived from it).
-    pub status: Status,
-}
-
-impl Record {
-    /// Converts a frame under `settings`.
-    pub fn new(t_s: Option<f64>, esc: u8, f: &DataFrame, settings: &Settings) -> Record {
-        Record {
-            t_s,
-            esc,
-            packet: f.packet,
-            throttle_in_pct: f.throttle_in_pct(),
-            throttle_out_pct: f.throttle_out_pct(),
-            erpm: f.erpm(),
-            rpm: f.rpm(settings),
-            voltage_v: f.voltage_v(),
-            current_a: f.current_a(settings),
-            phase_current_a: f.phase_current_a(settings),
-            mos_temp_c: f.mos_temp().celsius(),
-            cap_temp_c: f.cap_temp().celsius(),
-            status: f.status,
-        }
-    }
-
-    /// Appends the record as one JSON object and a newline.
-    ///
-    /// For many records, [`TextEncoder`] is faster: it remembers the text of recent numbers.
-    pub fn write_json(&self, out: &mut Vec<u8>) {
-        TextEncoder::new().json(self, out);
-    }
-
-    /// Appends the CSV header row.
-    pub fn write_csv_header(out: &mut Vec<u8>) {
-        out.extend_from_slice(COLUMNS.join(",").as_bytes());
-        out.push(b'\n');
-    }
-}
+use super::Record;
+use super::column::{Column, FaultList, Visitor};
+use super::columns::{self, COUNT};
 
 /// Longest text of one record: the keys (about 200 bytes), thirteen numbers of at most 24
-/// characters and sixteen fault names, with room to spare for the fixed-size copies below.
+/// characters and sixteen fault names, with room to spare for the fixed-size copies below
+/// (checked by a test against the columns' [`TextValue::TEXT_MAX`]).
 const ROW_MAX: usize = 2048;
 
 /// Entries of each number cache (a power of two).
@@ -115,21 +36,13 @@ pub struct TextEncoder {
     row: [u8; ROW_MAX],
     pos: usize,
     float: ryu::Buffer,
-    cache: Option<Box<[FloatCache; FLOAT_COLUMNS]>>,
+    /// A cache per column, by column index (empty for the columns without text key).
+    cache: Option<Box<[FloatCache; COUNT]>>,
 }
-
-/// The `f32` columns, each with its own cache, and the raw integer each comes from.
-const FLOAT_COLUMNS: usize = 7;
-const C_THROTTLE_IN: usize = 0;
-const C_THROTTLE_OUT: usize = 1;
-const C_RPM: usize = 2;
-const C_VOLTAGE: usize = 3;
-const C_CURRENT: usize = 4;
-const C_PHASE_CURRENT: usize = 5;
-const C_TEMP: usize = 6;
 
 /// A direct-mapped cache from a raw integer (the low bits index it) to the text of the value
 /// converted from it. Neighbouring raw values share cache lines.
+#[derive(Default)]
 struct FloatCache {
     entries: Vec<CacheEntry>,
 }
@@ -163,21 +76,167 @@ impl Default for TextEncoder {
     }
 }
 
-/// The raw keys of a record's `f32` columns, in the order of the `C_*` indices (temperatures:
-/// MOSFET, then capacitor).
-type RawKeys = [u32; 8];
+/// A text format: what differs between JSON and CSV.
+pub trait Format {
+    /// JSON (keys, lists in brackets) rather than CSV (commas, lists joined by `|`).
+    const JSON: bool;
+    /// The text of a null.
+    const NULL: &'static [u8];
+}
 
-fn raw_keys(f: &DataFrame) -> RawKeys {
-    [
-        u32::from(f.throttle_in_raw),
-        u32::from(f.throttle_out_raw),
-        u32::from(f.erpm_raw),
-        u32::from(f.voltage_raw),
-        u32::from(f.current_raw as u16),
-        u32::from(f.phase_current_raw as u16),
-        u32::from(f.mos_adc),
-        u32::from(f.cap_adc),
-    ]
+/// JSON Lines.
+pub enum Json {}
+
+/// CSV.
+pub enum Csv {}
+
+impl Format for Json {
+    const JSON: bool = true;
+    const NULL: &'static [u8] = b"null";
+}
+
+impl Format for Csv {
+    const JSON: bool = false;
+    const NULL: &'static [u8] = b"";
+}
+
+/// How a value type is written as text, in JSON and in CSV.
+pub trait TextValue: Copy {
+    /// Bytes a value may take in the row buffer while it is written (fixed-size copies
+    /// included).
+    const TEXT_MAX: usize;
+
+    /// Appends the value's text in format `F`; `cache`: the column's index and the raw integer
+    /// the value was converted from, for a column with a text key.
+    fn text<F: Format>(self, e: &mut TextEncoder, cache: Option<(usize, u32)>);
+}
+
+impl TextValue for f32 {
+    const TEXT_MAX: usize = 27;
+
+    #[inline(always)]
+    fn text<F: Format>(self, e: &mut TextEncoder, cache: Option<(usize, u32)>) {
+        e.f32(self, cache);
+    }
+}
+
+impl TextValue for f64 {
+    const TEXT_MAX: usize = 24;
+
+    #[inline(always)]
+    fn text<F: Format>(self, e: &mut TextEncoder, _: Option<(usize, u32)>) {
+        e.f64(self);
+    }
+}
+
+impl<T: TextValue> TextValue for Option<T> {
+    const TEXT_MAX: usize = if T::TEXT_MAX > 4 { T::TEXT_MAX } else { 4 };
+
+    #[inline(always)]
+    fn text<F: Format>(self, e: &mut TextEncoder, cache: Option<(usize, u32)>) {
+        match self {
+            Some(v) => v.text::<F>(e, cache),
+            None => e.lit(F::NULL),
+        }
+    }
+}
+
+macro_rules! unsigned_text {
+    ($($t:ty),*) => {$(
+        impl TextValue for $t {
+            const TEXT_MAX: usize = 10;
+
+            #[inline(always)]
+            fn text<F: Format>(self, e: &mut TextEncoder, _: Option<(usize, u32)>) {
+                e.uint(u32::from(self));
+            }
+        }
+    )*};
+}
+
+unsigned_text!(u8, u16, u32);
+
+impl TextValue for Status {
+    const TEXT_MAX: usize = 5;
+
+    #[inline(always)]
+    fn text<F: Format>(self, e: &mut TextEncoder, _: Option<(usize, u32)>) {
+        e.uint(u32::from(self.0));
+    }
+}
+
+impl TextValue for FaultList {
+    // Every name quoted, with a comma, and the brackets.
+    const TEXT_MAX: usize = {
+        let mut n = 2;
+        let mut i = 0;
+        while i < Fault::ALL.len() {
+            n += Fault::ALL[i].name().len() + 3;
+            i += 1;
+        }
+        n
+    };
+
+    #[inline(always)]
+    fn text<F: Format>(self, e: &mut TextEncoder, _: Option<(usize, u32)>) {
+        if F::JSON {
+            e.lit(b"[");
+        }
+        if !self.0.is_ok() {
+            for (i, name) in self.names().enumerate() {
+                if i > 0 {
+                    e.lit(if F::JSON { b"," } else { b"|" });
+                }
+                if F::JSON {
+                    // Fault names are plain ASCII identifiers: nothing to escape.
+                    e.lit(b"\"");
+                    e.lit(name.as_bytes());
+                    e.lit(b"\"");
+                } else {
+                    e.lit(name.as_bytes());
+                }
+            }
+        }
+        if F::JSON {
+            e.lit(b"]");
+        }
+    }
+}
+
+/// Writes the columns of one record in format `F`: the visitor of [`TextEncoder::row`].
+struct Row<'a, F> {
+    e: &'a mut TextEncoder,
+    record: &'a Record,
+    /// The frame the record was converted from, for the caches' keys.
+    frame: Option<&'a DataFrame>,
+    format: PhantomData<F>,
+}
+
+impl<F: Format> Visitor for Row<'_, F> {
+    #[inline(always)]
+    fn column<C: Column>(&mut self) {
+        if F::JSON {
+            self.e.lit(C::JSON_KEY.as_bytes());
+        } else if C::INDEX > 0 {
+            self.e.lit(b",");
+        }
+        let cache = match self.frame {
+            Some(frame) if C::TEXT_CACHED => Some((C::INDEX, C::text_key(frame))),
+            _ => None,
+        };
+        C::from_record(self.record).text::<F>(self.e, cache);
+    }
+}
+
+/// Marks the columns with a text key: the visitor of [`TextEncoder::cached`].
+struct MakeCaches<'a>(&'a mut [FloatCache; COUNT]);
+
+impl Visitor for MakeCaches<'_> {
+    fn column<C: Column>(&mut self) {
+        if C::TEXT_CACHED {
+            self.0[C::INDEX] = FloatCache::new();
+        }
+    }
 }
 
 impl TextEncoder {
@@ -194,121 +253,55 @@ impl TextEncoder {
     /// An encoder with number caches (about 1 MB), for long runs of records converted under
     /// one set of settings: the caches hold the text of converted values.
     pub fn cached() -> TextEncoder {
+        let mut caches: Box<[FloatCache; COUNT]> = Box::default();
+        columns::visit(&mut MakeCaches(&mut caches));
         TextEncoder {
-            cache: Some(Box::new(std::array::from_fn(|_| FloatCache::new()))),
+            cache: Some(caches),
             ..TextEncoder::new()
         }
     }
 
     /// Appends `r` as one JSON object and a newline, with exactly the schema's keys in order.
     pub fn json(&mut self, r: &Record, out: &mut Vec<u8>) {
-        self.json_impl(r, None, out);
+        self.row::<Json>(r, None, out);
     }
 
     /// Appends `r`, the record of `frame`, as [`TextEncoder::json`] does; a cached encoder
     /// takes the text of numbers from its caches. Every record given to one cached encoder
     /// must be converted under the same settings.
     pub fn json_frame(&mut self, r: &Record, frame: &DataFrame, out: &mut Vec<u8>) {
-        self.json_impl(r, Some(raw_keys(frame)), out);
+        self.row::<Json>(r, Some(frame), out);
     }
 
-    /// Appends `r`, the record of `frame`, as one CSV row (the columns of [`COLUMNS`]): empty
-    /// fields for nulls, faults joined by `|`. A cached encoder takes the text of numbers from
-    /// its caches, as [`TextEncoder::json_frame`] does.
+    /// Appends `r` as one CSV row (the columns of [`COLUMNS`](super::COLUMNS)): empty fields
+    /// for nulls, faults joined by `|`.
+    pub fn csv(&mut self, r: &Record, out: &mut Vec<u8>) {
+        self.row::<Csv>(r, None, out);
+    }
+
+    /// Appends `r`, the record of `frame`, as [`TextEncoder::csv`] does. A cached encoder takes
+    /// the text of numbers from its caches, as [`TextEncoder::json_frame`] does.
     pub fn csv_frame(&mut self, r: &Record, frame: &DataFrame, out: &mut Vec<u8>) {
-        self.csv_impl(r, Some(raw_keys(frame)), out);
+        self.row::<Csv>(r, Some(frame), out);
     }
 
+    /// Assembles the row of `r` in format `F` and appends it to `out`.
     #[inline]
-    fn json_impl(&mut self, r: &Record, k: Option<RawKeys>, out: &mut Vec<u8>) {
-        let key = |i: usize| k.map(|k| k[i]);
+    fn row<F: Format>(&mut self, r: &Record, frame: Option<&DataFrame>, out: &mut Vec<u8>) {
         self.pos = 0;
-        self.lit(b"{\"t_s\":");
-        match r.t_s {
-            Some(t) => self.f64(t),
-            None => self.lit(b"null"),
+        columns::visit(&mut Row::<F> {
+            e: self,
+            record: r,
+            frame,
+            format: PhantomData,
+        });
+        if F::JSON {
+            // The first key's comma opens the object.
+            self.row[0] = b'{';
+            self.lit(b"}\n");
+        } else {
+            self.lit(b"\n");
         }
-        self.lit(b",\"esc\":");
-        self.uint(u32::from(r.esc));
-        self.lit(b",\"packet\":");
-        self.uint(u32::from(r.packet));
-        self.lit(b",\"throttle_in_pct\":");
-        self.f32(C_THROTTLE_IN, r.throttle_in_pct, key(0));
-        self.lit(b",\"throttle_out_pct\":");
-        self.f32(C_THROTTLE_OUT, r.throttle_out_pct, key(1));
-        self.lit(b",\"erpm\":");
-        self.uint(r.erpm);
-        self.lit(b",\"rpm\":");
-        self.f32(C_RPM, r.rpm, key(2));
-        self.lit(b",\"voltage_v\":");
-        self.f32(C_VOLTAGE, r.voltage_v, key(3));
-        self.lit(b",\"current_a\":");
-        self.f32(C_CURRENT, r.current_a, key(4));
-        self.lit(b",\"phase_current_a\":");
-        self.f32(C_PHASE_CURRENT, r.phase_current_a, key(5));
-        self.lit(b",\"mos_temp_c\":");
-        self.opt_f32(r.mos_temp_c, key(6), b"null");
-        self.lit(b",\"cap_temp_c\":");
-        self.opt_f32(r.cap_temp_c, key(7), b"null");
-        self.lit(b",\"status\":");
-        self.uint(u32::from(r.status.0));
-        self.lit(b",\"faults\":[");
-        if !r.status.is_ok() {
-            for (i, fault) in r.status.faults().enumerate() {
-                if i > 0 {
-                    self.lit(b",");
-                }
-                // Fault names are plain ASCII identifiers: nothing to escape.
-                self.lit(b"\"");
-                self.lit(fault.name().as_bytes());
-                self.lit(b"\"");
-            }
-        }
-        self.lit(b"]}\n");
-        out.extend_from_slice(&self.row[..self.pos]);
-    }
-
-    #[inline]
-    fn csv_impl(&mut self, r: &Record, k: Option<RawKeys>, out: &mut Vec<u8>) {
-        let key = |i: usize| k.map(|k| k[i]);
-        self.pos = 0;
-        if let Some(t) = r.t_s {
-            self.f64(t);
-        }
-        self.lit(b",");
-        self.uint(u32::from(r.esc));
-        self.lit(b",");
-        self.uint(u32::from(r.packet));
-        self.lit(b",");
-        self.f32(C_THROTTLE_IN, r.throttle_in_pct, key(0));
-        self.lit(b",");
-        self.f32(C_THROTTLE_OUT, r.throttle_out_pct, key(1));
-        self.lit(b",");
-        self.uint(r.erpm);
-        self.lit(b",");
-        self.f32(C_RPM, r.rpm, key(2));
-        self.lit(b",");
-        self.f32(C_VOLTAGE, r.voltage_v, key(3));
-        self.lit(b",");
-        self.f32(C_CURRENT, r.current_a, key(4));
-        self.lit(b",");
-        self.f32(C_PHASE_CURRENT, r.phase_current_a, key(5));
-        self.lit(b",");
-        self.opt_f32(r.mos_temp_c, key(6), b"");
-        self.lit(b",");
-        self.opt_f32(r.cap_temp_c, key(7), b"");
-        self.lit(b",");
-        self.uint(u32::from(r.status.0));
-        self.lit(b",");
-        if !r.status.is_ok() {
-            for (i, fault) in r.status.faults().enumerate() {
-                if i > 0 {
-                    self.lit(b"|");
-                }
-                self.lit(fault.name().as_bytes());
-            }
-        }
-        self.lit(b"\n");
         out.extend_from_slice(&self.row[..self.pos]);
     }
 
@@ -335,15 +328,16 @@ impl TextEncoder {
         self.pos = end;
     }
 
-    /// The text of `v`, converted from the raw integer `key`, in column `column`'s cache.
-    /// Finite values only: every value written is computed from integers by a finite factor.
+    /// The text of `v`; `cache`: the column whose cache keeps it and the raw integer `v` was
+    /// converted from. Finite values only: every value written is computed from integers by
+    /// a finite factor.
     #[inline(always)]
-    fn f32(&mut self, column: usize, v: f32, key: Option<u32>) {
-        let (Some(cache), Some(key)) = (self.cache.as_mut(), key) else {
+    fn f32(&mut self, v: f32, cache: Option<(usize, u32)>) {
+        let (Some(caches), Some((column, key))) = (self.cache.as_mut(), cache) else {
             self.f32_uncached(v);
             return;
         };
-        let entry = &mut cache[column].entries[key as usize & ((1 << CACHE_BITS) - 1)];
+        let entry = &mut caches[column].entries[key as usize & ((1 << CACHE_BITS) - 1)];
         if entry.len == 0 || entry.key != key {
             let text = self.float.format_finite(v).as_bytes();
             if text.len() > entry.text.len() {
@@ -374,19 +368,33 @@ impl TextEncoder {
         self.row[self.pos..self.pos + 24].copy_from_slice(&fixed);
         self.pos += text.len();
     }
-
-    #[inline]
-    fn opt_f32(&mut self, v: Option<f32>, key: Option<u32>, null: &[u8]) {
-        match v {
-            Some(v) => self.f32(C_TEMP, v, key),
-            None => self.lit(null),
-        }
-    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::record::COLUMNS;
+    use hwfoc::Settings;
+
+    /// The longest row of the table fits the row buffer, fixed-size copies included.
+    #[test]
+    fn the_longest_row_fits() {
+        struct Longest(usize);
+        impl Visitor for Longest {
+            fn column<C: Column>(&mut self) {
+                self.0 += C::JSON_KEY.len() + <C::Value as TextValue>::TEXT_MAX;
+            }
+        }
+        let mut longest = Longest("}\n".len());
+        columns::visit(&mut longest);
+        assert!(longest.0 <= ROW_MAX, "{} bytes", longest.0);
+        // Every fault set: the longest list.
+        let mut e = TextEncoder::new();
+        e.pos = 0;
+        FaultList(Status(0xFFFF)).text::<Json>(&mut e, None);
+        // Sixteen names and fifteen commas between them: room for one more comma.
+        assert_eq!(e.pos + 1, FaultList::TEXT_MAX);
+    }
 
     /// The first frame of the XRotor capture and the JSON line RECORD-SCHEMA.md gives for it.
     #[test]
