@@ -4,7 +4,7 @@
 //! threads turn them into the output format and write them, so decoding and encoding run side
 //! by side (text: two formatting threads and a writing one, see `text.rs`; Parquet: a writer
 //! thread that encodes the columns of each row group with a helper, see `parquet.rs`). Queues
-//! between the threads are short ([`QUEUE`] chunks of about [`CHUNK_ROWS`] rows for text, one
+//! between the threads are short (`QUEUE` chunks of about [`CHUNK_ROWS`] rows for text, one
 //! row group for Parquet), so memory stays bounded whatever the size of the input: about 45 MB
 //! at most (with the output file's two 4 MiB blocks).
 //!
