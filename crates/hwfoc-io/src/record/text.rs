@@ -285,8 +285,9 @@ impl TextEncoder {
         self.row::<Csv>(r, Some(frame), out);
     }
 
-    /// Assembles the row of `r` in format `F` and appends it to `out`.
-    #[inline]
+    /// Assembles the row of `r` in format `F` and appends it to `out`. Inlined into each
+    /// caller, so that whether there is a frame (cache keys) is known at compile time.
+    #[inline(always)]
     fn row<F: Format>(&mut self, r: &Record, frame: Option<&DataFrame>, out: &mut Vec<u8>) {
         self.pos = 0;
         columns::visit(&mut Row::<F> {
