@@ -3,26 +3,28 @@
 //! Each entry gives the column's name, the type of its values (which fixes its Arrow type, its
 //! nullability, its text and its Parquet storage: see [`Value`](super::Value)), its unit, and
 //! how it is computed from a data frame received at `t_s` from ESC `esc` under the settings.
-//! Optionally: the raw integer of the frame the value is a function of (`text key`: text
-//! encoders then keep the text of each value instead of formatting it again), and, for a
-//! column that is not a field of [`Record`], how it is read from a record.
+//! Optionally: the raw integer of the frame the value is a function of (`text key`, for `f32`
+//! values: text encoders then keep the text of each value instead of formatting it again), and,
+//! for a column that is not a field of [`Record`], how it is read from a record.
 //!
-//! From this table come the [`Record`] struct and `Record::new`,
-//! [`COLUMNS`], [`UNITS`] and a zero-sized type per column
-//! implementing [`Column`](super::Column) (named as the column), through which the writers
-//! derive everything by name: JSON Lines keys and CSV header, the Arrow schema and record
-//! batches, the Parquet columns.
+//! From this table come the [`Record`] struct and `Record::new`, [`COLUMNS`], [`UNITS`] and a
+//! zero-sized type per column implementing [`Column`](super::Column) (named as the column),
+//! through which the writers derive everything by name: JSON Lines keys and CSV header, the
+//! Arrow schema and record batches, the Parquet columns.
 //!
 //! # Adding a column
 //!
-//! 1. An entry here, where the column goes in the schema (and the row in `RECORD-SCHEMA.md`).
-//! 2. Its row in the copy of that table in `tests/schema.rs`, the test of the schema's order,
-//!    types and units.
+//! 1. An entry here, at its place in the schema (and its row in `RECORD-SCHEMA.md`).
+//! 2. Its row in the copy of that table in hwfoc-io's `tests/schema.rs` (and the example line
+//!    there, which has every column), the test of the schema's order, types and units.
 //!
-//! Nothing else: the writers follow. Only a column with a value type that no column had before
-//! (a new [`Value`](super::Value)) needs that type's text, Arrow and Parquet encodings (the
-//! compiler names what is missing). A Parquet column gets the default encoding (plain values,
-//! LZ4); choosing another, or statistics, is a line in `write/parquet.rs`, by name.
+//! That is all the code: the writers and the other tests follow the table. A column with a
+//! value type that no column had before (a new [`Value`](super::Value)) also needs that type's
+//! text, Arrow and Parquet encodings (the compiler names what is missing). A Parquet column
+//! gets the defaults (plain values, LZ4, no statistics, encoded last); choosing otherwise is a
+//! line in `write/parquet.rs`, by name. What changes with a column is the output: the `hwfoc`
+//! command's golden outputs (`crates/hwfoc-cli/tests/golden/`, the lines written out in
+//! `tests/cli.rs`) and the column list of `tests/pyarrow_check.py` follow it.
 
 use hwfoc::Status;
 
