@@ -8,10 +8,10 @@
 //!   receive time where the source has a clock;
 //! - [`stream`] and [`sources`]: the one path from timed bytes to frames, a decoding stream per
 //!   ESC; [`handler`]: the [`Handler`] seam through which records reach a front end;
-//! - [`record`]: the record of `RECORD-SCHEMA.md` (one row per data frame, physical units) and
-//!   its text encodings;
-//! - [`write`](mod@write): writers of records (JSON Lines, CSV, Parquet with the `parquet` feature), each on
-//!   a thread of its own;
+//! - [`record`]: the record of `RECORD-SCHEMA.md` (one row per data frame, physical units), its
+//!   columns declared once in one table, and its text encodings;
+//! - [`write`](mod@write): writers of records (JSON Lines, CSV, Parquet with the `parquet`
+//!   feature), each on a thread of its own, and Arrow record batches;
 //! - [`pcapng`]: the recording format (writer and truncation-tolerant reader);
 //! - [`serial`]: serial ports that survive being unplugged; [`clock`]: receive times;
 //!   [`stop`]: Ctrl-C and SIGTERM as a request to stop that every loop honours.

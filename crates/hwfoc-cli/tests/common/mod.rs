@@ -13,24 +13,10 @@ use std::time::{SystemTime, UNIX_EPOCH};
 #[allow(unused_imports)]
 pub use self::unix::*;
 
-/// The columns of RECORD-SCHEMA.md, in order (written out here, not taken from the code under
-/// test).
-pub const SCHEMA: [&str; 14] = [
-    "t_s",
-    "esc",
-    "packet",
-    "throttle_in_pct",
-    "throttle_out_pct",
-    "erpm",
-    "rpm",
-    "voltage_v",
-    "current_a",
-    "phase_current_a",
-    "mos_temp_c",
-    "cap_temp_c",
-    "status",
-    "faults",
-];
+/// The columns of RECORD-SCHEMA.md, in order: those of the column table, which hwfoc-io's
+/// `tests/schema.rs` checks against a copy of the specification's table.
+#[allow(unused_imports)]
+pub use hwfoc_io::record::COLUMNS as SCHEMA;
 
 /// The real capture of an XRotor ESC in `testdata/captures`.
 pub const XROTOR: &str = "xrotor-v4-pro-hv-80A.csv";

@@ -1,47 +1,236 @@
-//! The Arrow schema of the records: the names, types, nullability and units of
-//! `RECORD-SCHEMA.md`, for the Parquet writer and for Arrow consumers.
+//! The records in Apache Arrow: the schema (the names, types, nullability and units of
+//! `RECORD-SCHEMA.md`, for the Parquet writer and for Arrow consumers) and record batches.
+//!
+//! Both are derived from the column table ([`crate::record::columns`]): a column's Arrow type
+//! and nullability are those of its value type ([`ArrowValue`]), its unit goes in its field's
+//! metadata (key `unit`). A [`RecordBatchBuilder`] makes batches with exactly [`schema`]: each
+//! column's array is built at once, from all the rows, by code generic over the column.
 
 use std::collections::HashMap;
 use std::sync::Arc;
 
-use arrow_schema::{DataType, Field, FieldRef, Schema};
+use arrow_array::builder::{ListBuilder, StringBuilder};
+use arrow_array::types::{Float32Type, Float64Type, UInt8Type, UInt16Type, UInt32Type};
+use arrow_array::{ArrayRef, PrimitiveArray, RecordBatch};
+use arrow_schema::{DataType, Field, FieldRef, Schema, SchemaRef};
+use hwfoc::{DataFrame, Settings, Status};
 
-use crate::record::{COLUMNS, UNITS};
+use crate::record::{Column, FaultList, Record, Visitor, columns};
 
 /// Name of the `faults` list's item field (Arrow's default).
 pub(crate) const ITEM: &str = "item";
 
-/// The Arrow schema of the records: names, types, nullability and units of RECORD-SCHEMA.md.
-pub fn schema() -> Schema {
-    let types = [
-        (DataType::Float64, true),
-        (DataType::UInt8, false),
-        (DataType::UInt16, false),
-        (DataType::Float32, false),
-        (DataType::Float32, false),
-        (DataType::UInt32, false),
-        (DataType::Float32, false),
-        (DataType::Float32, false),
-        (DataType::Float32, false),
-        (DataType::Float32, false),
-        (DataType::Float32, true),
-        (DataType::Float32, true),
-        (DataType::UInt16, false),
-        (DataType::List(fault_item()), false),
-    ];
-    let fields: Vec<Field> = COLUMNS
-        .iter()
-        .zip(UNITS)
-        .zip(types)
-        .map(|((name, unit), (data_type, nullable))| {
-            let metadata = HashMap::from([("unit".to_string(), unit.to_string())]);
-            Field::new(*name, data_type, nullable).with_metadata(metadata)
-        })
-        .collect();
-    Schema::new(fields)
+/// How a value type is stored in Arrow: its type, whether it may be null, and an array of
+/// values.
+pub trait ArrowValue: Sized {
+    /// Whether values may be null (an `Option`).
+    const NULLABLE: bool;
+
+    /// The Arrow type.
+    fn data_type() -> DataType;
+
+    /// An array of `values`, of type [`ArrowValue::data_type`].
+    fn array(values: impl ExactSizeIterator<Item = Self>) -> ArrayRef;
+}
+
+/// Value types stored as an Arrow primitive, never null, and as one, nullable, in an `Option`.
+macro_rules! primitive {
+    ($($value:ty => $arrow:ty, $data_type:expr;)*) => {$(
+        impl ArrowValue for $value {
+            const NULLABLE: bool = false;
+
+            fn data_type() -> DataType {
+                $data_type
+            }
+
+            fn array(values: impl ExactSizeIterator<Item = Self>) -> ArrayRef {
+                Arc::new(PrimitiveArray::<$arrow>::from_iter_values(values))
+            }
+        }
+
+        impl ArrowValue for Option<$value> {
+            const NULLABLE: bool = true;
+
+            fn data_type() -> DataType {
+                $data_type
+            }
+
+            fn array(values: impl ExactSizeIterator<Item = Self>) -> ArrayRef {
+                Arc::new(values.collect::<PrimitiveArray<$arrow>>())
+            }
+        }
+    )*};
+}
+
+primitive! {
+    f32 => Float32Type, DataType::Float32;
+    f64 => Float64Type, DataType::Float64;
+    u8 => UInt8Type, DataType::UInt8;
+    u16 => UInt16Type, DataType::UInt16;
+    u32 => UInt32Type, DataType::UInt32;
+}
+
+impl ArrowValue for Status {
+    const NULLABLE: bool = false;
+
+    fn data_type() -> DataType {
+        DataType::UInt16
+    }
+
+    fn array(values: impl ExactSizeIterator<Item = Self>) -> ArrayRef {
+        u16::array(values.map(|s| s.0))
+    }
+}
+
+impl ArrowValue for FaultList {
+    const NULLABLE: bool = false;
+
+    fn data_type() -> DataType {
+        DataType::List(fault_item())
+    }
+
+    fn array(values: impl ExactSizeIterator<Item = Self>) -> ArrayRef {
+        let mut lists =
+            ListBuilder::with_capacity(StringBuilder::new(), values.len()).with_field(fault_item());
+        for faults in values {
+            for name in faults.names() {
+                lists.values().append_value(name);
+            }
+            lists.append(true);
+        }
+        Arc::new(lists.finish())
+    }
 }
 
 /// The item field of the `faults` list: a fault name, never null.
 fn fault_item() -> FieldRef {
     Arc::new(Field::new(ITEM, DataType::Utf8, false))
+}
+
+/// The Arrow field of column `C`: name, type, nullability, and the unit in the metadata.
+pub fn field<C: Column>() -> Field {
+    let metadata = HashMap::from([("unit".to_string(), C::UNIT.to_string())]);
+    Field::new(C::NAME, <C::Value as ArrowValue>::data_type(), C::NULLABLE).with_metadata(metadata)
+}
+
+/// The Arrow schema of the records: names, types, nullability and units of RECORD-SCHEMA.md.
+pub fn schema() -> Schema {
+    struct Fields(Vec<Field>);
+    impl Visitor for Fields {
+        fn column<C: Column>(&mut self) {
+            self.0.push(field::<C>());
+        }
+    }
+    let mut fields = Fields(Vec::with_capacity(columns::COUNT));
+    columns::visit(&mut fields);
+    Schema::new(fields.0)
+}
+
+/// The Arrow record batch of `records`, with exactly the schema of [`schema`] (a
+/// [`RecordBatchBuilder`] keeps the schema from batch to batch).
+pub fn record_batch(records: &[Record]) -> RecordBatch {
+    batch(Arc::new(schema()), records)
+}
+
+/// Makes each column's array from all of `records`, one column at a time.
+fn batch(schema: SchemaRef, records: &[Record]) -> RecordBatch {
+    struct Arrays<'a> {
+        records: &'a [Record],
+        arrays: Vec<ArrayRef>,
+    }
+    impl Visitor for Arrays<'_> {
+        fn column<C: Column>(&mut self) {
+            let values = self.records.iter().map(C::from_record);
+            self.arrays.push(<C::Value as ArrowValue>::array(values));
+        }
+    }
+    let mut arrays = Arrays {
+        records,
+        arrays: Vec::with_capacity(columns::COUNT),
+    };
+    columns::visit(&mut arrays);
+    // Each array has its field's type (both come from the column's value type), the same
+    // length, and nulls only where the field is nullable.
+    RecordBatch::try_new(schema, arrays.arrays).expect("the arrays follow the schema")
+}
+
+/// Gathers records, or frames converted to records, and makes Arrow record batches of them
+/// with exactly the schema of [`schema`] (units in the fields' metadata).
+///
+/// ```
+/// use hwfoc::{DataFrame, Settings};
+/// use hwfoc_io::write::arrow::RecordBatchBuilder;
+///
+/// let mut builder = RecordBatchBuilder::new();
+/// let frame = DataFrame { packet: 1, voltage_raw: 247, ..Default::default() };
+/// builder.push_frame(Some(0.5), 0, &frame, &Settings::default());
+/// let batch = builder.finish();
+/// assert_eq!(batch.num_rows(), 1);
+/// assert_eq!(batch.schema().field(0).name(), "t_s");
+/// assert!(builder.is_empty());
+/// ```
+#[derive(Debug, Clone)]
+pub struct RecordBatchBuilder {
+    schema: SchemaRef,
+    records: Vec<Record>,
+}
+
+impl Default for RecordBatchBuilder {
+    fn default() -> Self {
+        RecordBatchBuilder::new()
+    }
+}
+
+impl RecordBatchBuilder {
+    /// An empty builder.
+    pub fn new() -> RecordBatchBuilder {
+        RecordBatchBuilder::with_capacity(0)
+    }
+
+    /// An empty builder with room for `rows` records.
+    pub fn with_capacity(rows: usize) -> RecordBatchBuilder {
+        RecordBatchBuilder {
+            schema: Arc::new(schema()),
+            records: Vec::with_capacity(rows),
+        }
+    }
+
+    /// Adds a record.
+    pub fn push(&mut self, record: Record) {
+        self.records.push(record);
+    }
+
+    /// Adds the record of a data frame received at `t_s` (if the source has timing) from ESC
+    /// `esc`, converted under `settings`.
+    pub fn push_frame(
+        &mut self,
+        t_s: Option<f64>,
+        esc: u8,
+        frame: &DataFrame,
+        settings: &Settings,
+    ) {
+        self.records.push(Record::new(t_s, esc, frame, settings));
+    }
+
+    /// Number of records gathered.
+    pub fn len(&self) -> usize {
+        self.records.len()
+    }
+
+    /// Whether no record is gathered.
+    pub fn is_empty(&self) -> bool {
+        self.records.is_empty()
+    }
+
+    /// The schema of the batches.
+    pub fn schema(&self) -> SchemaRef {
+        self.schema.clone()
+    }
+
+    /// The record batch of the records gathered since the last one; the builder is then empty.
+    pub fn finish(&mut self) -> RecordBatch {
+        let rows = batch(self.schema.clone(), &self.records);
+        self.records.clear();
+        rows
+    }
 }

@@ -17,8 +17,7 @@
 
 pub mod arrow;
 mod file;
-#[cfg(feature = "parquet")]
-mod parquet;
+pub(crate) mod parquet;
 mod text;
 
 use std::fmt;
@@ -119,7 +118,7 @@ enum ToWriter {
     /// Rows to write: some text, or a Parquet row group.
     Rows(Chunk),
     /// The end: metadata known only now (the ESCs found), as key-value pairs.
-    End(Vec<(String, String)>),
+    End(#[cfg_attr(not(feature = "parquet"), allow(dead_code))] Vec<(String, String)>),
 }
 
 /// An export in progress.

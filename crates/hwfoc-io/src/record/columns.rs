@@ -1,0 +1,74 @@
+//! The column table: every column of `RECORD-SCHEMA.md`, declared once, in schema order.
+//!
+//! Each entry gives the column's name, the type of its values (which fixes its Arrow type, its
+//! nullability, its text and its Parquet storage: see [`Value`](super::Value)), its unit, and
+//! how it is computed from a data frame received at `t_s` from ESC `esc` under the settings.
+//! Optionally: the raw integer of the frame the value is a function of (`text key`, for `f32`
+//! values: text encoders then keep the text of each value instead of formatting it again), and,
+//! for a column that is not a field of [`Record`], how it is read from a record.
+//!
+//! From this table come the [`Record`] struct and `Record::new`, [`COLUMNS`], [`UNITS`] and a
+//! zero-sized type per column implementing [`Column`](super::Column) (named as the column),
+//! through which the writers derive everything by name: JSON Lines keys and CSV header, the
+//! Arrow schema and record batches, the Parquet columns.
+//!
+//! # Adding a column
+//!
+//! 1. An entry here, at its place in the schema (and its row in `RECORD-SCHEMA.md`).
+//! 2. Its row in the copy of that table in hwfoc-io's `tests/schema.rs` (and the example line
+//!    there, which has every column), the test of the schema's order, types and units.
+//!
+//! That is all the code: the writers and the other tests follow the table. A column with a
+//! value type that no column had before (a new [`Value`](super::Value)) also needs that type's
+//! text, Arrow and Parquet encodings (the compiler names what is missing). A Parquet column
+//! gets the defaults (plain values, LZ4, no statistics, encoded last); choosing otherwise is a
+//! line in `write/parquet.rs`, by name. What changes with a column is the output: the `hwfoc`
+//! command's golden outputs (`crates/hwfoc-cli/tests/golden/`, the lines written out in
+//! `tests/cli.rs`) and the column list of `tests/pyarrow_check.py` follow it.
+
+use hwfoc::Status;
+
+use super::FaultList;
+
+columns! {
+    /// Receive time of the frame's first byte, in seconds: the source's own clock where it has
+    /// one (a logic-analyser CSV's or a pcapng capture's timestamps), Unix time for live input;
+    /// null where the source has no timing (a raw byte file).
+    t_s: Option<f64>, "s", |t_s, _, _, _| t_s;
+    /// Which ESC: the index of the input port or stream the frame came from (0-based).
+    esc: u8, "-", |_, esc, _, _| esc;
+    /// Packet number from the frame.
+    packet: u16, "-", |_, _, f, _| f.packet;
+    /// Input throttle, %: raw * 100 / 1024.
+    throttle_in_pct: f32, "%", |_, _, f, _| f.throttle_in_pct(),
+        text key |f| f.throttle_in_raw;
+    /// Output throttle, %: raw * 100 / 1024.
+    throttle_out_pct: f32, "%", |_, _, f, _| f.throttle_out_pct(),
+        text key |f| f.throttle_out_raw;
+    /// Electrical RPM: raw * 10.
+    erpm: u32, "rev/min", |_, _, f, _| f.erpm();
+    /// Motor (or geared output) RPM under the settings: raw * 10 / (gear ratio * pole pairs).
+    rpm: f32, "rev/min", |_, _, f, s| f.rpm(s),
+        text key |f| f.erpm_raw;
+    /// Input voltage, V: raw / 10.
+    voltage_v: f32, "V", |_, _, f, _| f.voltage_v(),
+        text key |f| f.voltage_raw;
+    /// Input current, A: raw (signed) / current scale; negative while braking regeneratively.
+    current_a: f32, "A", |_, _, f, s| f.current_a(s),
+        text key |f| f.current_raw as u16;
+    /// Phase current, A: raw (signed) / current scale.
+    phase_current_a: f32, "A", |_, _, f, s| f.phase_current_a(s),
+        text key |f| f.phase_current_raw as u16;
+    /// MOSFET temperature, degC, from the ADC table; null when out of the table's range.
+    mos_temp_c: Option<f32>, "degC", |_, _, f, _| f.mos_temp().celsius(),
+        text key |f| f.mos_adc;
+    /// Capacitor temperature, degC, from the ADC table; null when out of the table's range.
+    cap_temp_c: Option<f32>, "degC", |_, _, f, _| f.cap_temp().celsius(),
+        text key |f| f.cap_adc;
+    /// The raw status word (an unsigned 16-bit integer).
+    status: Status, "-", |_, _, f, _| f.status;
+    /// Names of the set status bits, in bit order (from `PROTOCOL-NOTES.md`); derived from
+    /// `status`, not a field of the record.
+    faults: FaultList, "-", |_, _, f, _| FaultList(f.status),
+        record |r| FaultList(r.status);
+}

@@ -1,0 +1,111 @@
+//! The telemetry record of `RECORD-SCHEMA.md`: one row per data frame, in physical units, the
+//! same columns in every output.
+//!
+//! The columns are declared once, in the table of [`columns`] (name, unit, value type, how the
+//! value is computed from a frame under the settings); everything else is derived from it by
+//! name, at compile time:
+//!
+//! - [`Record`], [`Record::new`], [`COLUMNS`] and [`UNITS`];
+//! - a zero-sized type per column implementing [`Column`], and [`columns::visit`], which calls
+//!   a [`Visitor`] with each column's type in schema order: writers are generic over the
+//!   column, monomorphised and inlined, with no dispatch per row;
+//! - the text encodings (JSON Lines and CSV, [`TextEncoder`]), the Arrow schema and record
+//!   batches ([`crate::write::arrow`]), the Parquet columns (the `parquet` feature): each
+//!   format stores a column as its [`Value`] type says.
+//!
+//! How to add a column: see [`columns`].
+
+#[macro_use]
+mod column;
+pub mod columns;
+mod text;
+
+pub use column::{Column, FaultList, Value, Visitor};
+pub use columns::{COLUMNS, Record, UNITS};
+pub use text::TextEncoder;
+
+impl Record {
+    /// Appends the record as one JSON object and a newline.
+    ///
+    /// For many records, [`TextEncoder`] is faster: it remembers the text of recent numbers.
+    pub fn write_json(&self, out: &mut Vec<u8>) {
+        TextEncoder::new().json(self, out);
+    }
+
+    /// Appends the CSV header row: the column names, joined by commas.
+    pub fn write_csv_header(out: &mut Vec<u8>) {
+        out.extend_from_slice(COLUMNS.join(",").as_bytes());
+        out.push(b'\n');
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use hwfoc::{DataFrame, Settings, Status};
+
+    /// Reading a column from the record gives what computing it from the frame gives.
+    #[test]
+    fn record_fields_are_the_columns_of_the_frame() {
+        struct Check<'a> {
+            t: Option<f64>,
+            esc: u8,
+            frame: &'a DataFrame,
+            settings: &'a Settings,
+            record: Record,
+        }
+        impl Visitor for Check<'_> {
+            fn column<C: Column>(&mut self) {
+                let from_frame = C::from_frame(self.t, self.esc, self.frame, self.settings);
+                // NaN never occurs in a record: equality is the right test.
+                assert_eq!(C::from_record(&self.record), from_frame, "{}", C::NAME);
+            }
+        }
+        let settings = Settings::new(100.0, 14, 2.5).unwrap();
+        for (i, status) in [0u16, 0x0041, 0xFFFF].into_iter().enumerate() {
+            let frame = DataFrame {
+                packet: 7 + i as u16,
+                throttle_in_raw: 512,
+                throttle_out_raw: 300,
+                erpm_raw: 12_345,
+                voltage_raw: 247,
+                current_raw: -5,
+                phase_current_raw: 1000,
+                mos_adc: [206, 250, 20][i],
+                cap_adc: 210,
+                status: Status(status),
+            };
+            let t = [Some(1.5), None, Some(1.7e9)][i];
+            let record = Record::new(t, i as u8, &frame, &settings);
+            columns::visit(&mut Check {
+                t,
+                esc: i as u8,
+                frame: &frame,
+                settings: &settings,
+                record,
+            });
+        }
+    }
+
+    /// The zero-sized types know their places, names and units, as the lists have them.
+    #[test]
+    fn column_types_follow_the_lists() {
+        struct Names(Vec<(usize, &'static str, &'static str)>);
+        impl Visitor for Names {
+            fn column<C: Column>(&mut self) {
+                self.0.push((C::INDEX, C::NAME, C::UNIT));
+                assert_eq!(C::JSON_KEY, format!(",\"{}\":", C::NAME));
+            }
+        }
+        let mut names = Names(Vec::new());
+        columns::visit(&mut names);
+        let expected: Vec<_> = COLUMNS
+            .into_iter()
+            .zip(UNITS)
+            .enumerate()
+            .map(|(i, (name, unit))| (i, name, unit))
+            .collect();
+        assert_eq!(names.0, expected);
+        assert_eq!(columns::COUNT, COLUMNS.len());
+    }
+}
