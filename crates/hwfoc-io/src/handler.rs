@@ -38,10 +38,10 @@ pub trait Handler {
     /// where the input has one. The default converts a data frame under `settings` and hands
     /// it to [`Handler::record`], and a device-information frame to [`Handler::info`].
     #[inline]
-    fn frame(&mut self, esc: u8, t: Option<f64>, decoded: Decoded, settings: &Settings) {
-        match decoded.frame {
-            Frame::Data(f) => self.record(&Record::new(t, esc, &f, settings)),
-            Frame::Info(info) => self.info(esc, t, &info),
+    fn frame(&mut self, esc: u8, t: Option<f64>, decoded: &Decoded, settings: &Settings) {
+        match &decoded.frame {
+            Frame::Data(f) => self.record(&Record::new(t, esc, f, settings)),
+            Frame::Info(info) => self.info(esc, t, info),
         }
     }
 
@@ -58,7 +58,7 @@ impl Handler for () {
     type Error = InputError;
 
     #[inline]
-    fn frame(&mut self, _: u8, _: Option<f64>, _: Decoded, _: &Settings) {}
+    fn frame(&mut self, _: u8, _: Option<f64>, _: &Decoded, _: &Settings) {}
 }
 
 /// Hands every frame to two handlers, each taking it its own way (as decoded, or as a record):
@@ -73,7 +73,7 @@ where
     type Error = B::Error;
 
     #[inline]
-    fn frame(&mut self, esc: u8, t: Option<f64>, decoded: Decoded, settings: &Settings) {
+    fn frame(&mut self, esc: u8, t: Option<f64>, decoded: &Decoded, settings: &Settings) {
         self.0.frame(esc, t, decoded, settings);
         self.1.frame(esc, t, decoded, settings);
     }

@@ -39,17 +39,17 @@ impl Stream {
     }
 
     /// Decodes a batch; `on_frame` gets each frame with its time (`None` without timing).
-    pub fn feed(&mut self, batch: Batch<'_>, mut on_frame: impl FnMut(Option<f64>, Decoded)) {
+    pub fn feed(&mut self, batch: Batch<'_>, mut on_frame: impl FnMut(Option<f64>, &Decoded)) {
         let start = self.decoder.stats().bytes();
         match batch.times {
             None => {
                 self.history.clear();
-                self.decoder.feed(batch.bytes, |d| on_frame(None, d));
+                self.decoder.feed(batch.bytes, |d| on_frame(None, &d));
             }
             Some(times) => {
                 let history = &self.history;
                 self.decoder.feed(batch.bytes, |d| {
-                    on_frame(Some(time_at(history, times, start, d.offset)), d)
+                    on_frame(Some(time_at(history, times, start, d.offset)), &d)
                 });
                 let keep = TIME_HISTORY.min(self.history.len() + times.len());
                 let from_times = keep.min(times.len());
@@ -62,13 +62,13 @@ impl Stream {
     }
 
     /// Ends the stream: a frame cut off at the end is dropped, frames inside it are still found.
-    pub fn finish(&mut self, mut on_frame: impl FnMut(Option<f64>, Decoded)) {
+    pub fn finish(&mut self, mut on_frame: impl FnMut(Option<f64>, &Decoded)) {
         let end = self.decoder.stats().bytes();
         let history = &self.history;
         let timed = !history.is_empty();
         self.decoder.flush(|d| {
             let t = timed.then(|| time_at(history, &[], end, d.offset));
-            on_frame(t, d)
+            on_frame(t, &d)
         });
     }
 

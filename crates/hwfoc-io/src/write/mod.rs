@@ -405,7 +405,7 @@ impl Handler for Export {
     type Error = ExportError;
 
     #[inline]
-    fn frame(&mut self, esc: u8, t: Option<f64>, decoded: Decoded, _: &Settings) {
+    fn frame(&mut self, esc: u8, t: Option<f64>, decoded: &Decoded, _: &Settings) {
         if let Frame::Data(frame) = decoded.frame
             && self.selection.esc(esc)
         {
