@@ -7,6 +7,7 @@
 
 use hwfoc::kinds::data::DATA_FRAME_LEN;
 use hwfoc::kinds::info::INFO_FRAME_LEN;
+use hwfoc::stats::MAX_PACKET_GAP;
 use hwfoc::units::{ADC_MAX, ADC_MIN, ADC_TABLE};
 use hwfoc::wire::sum16;
 use hwfoc::{
@@ -1117,18 +1118,214 @@ fn duplicates_are_not_losses() {
 }
 
 #[test]
-fn backwards_jump_is_neither_loss_nor_duplicate() {
+fn backwards_jump_is_a_restart() {
     let (_, s) = decode(&packets(&[1000, 999]));
-    assert_eq!((s.lost_packets(), s.duplicate_packets()), (0, 0));
+    assert_eq!(
+        (s.lost_packets(), s.duplicate_packets(), s.restarts()),
+        (0, 0, 1)
+    );
     let (_, s) = decode(&packets(&[1000, 5, 6]));
-    assert_eq!((s.lost_packets(), s.duplicate_packets()), (0, 0));
-    // The boundary: a step of 32768 is a loss of 32767, a step of 32769 goes backwards.
+    assert_eq!(
+        (s.lost_packets(), s.duplicate_packets(), s.restarts()),
+        (0, 0, 1)
+    );
+    // Half the counter forwards is still far beyond any loss; one more step goes backwards.
     let (_, s) = decode(&packets(&[0, 0x8000]));
-    assert_eq!(s.lost_packets(), 0x7FFF);
+    assert_eq!((s.lost_packets(), s.restarts()), (0, 1));
     let (_, s) = decode(&packets(&[0, 0x8001]));
-    assert_eq!(s.lost_packets(), 0);
-    assert_eq!(s.duplicate_packets(), 0);
+    assert_eq!(
+        (s.lost_packets(), s.duplicate_packets(), s.restarts()),
+        (0, 0, 1)
+    );
     assert_eq!(s.last_packet(), Some(0x8001));
+}
+
+/// The issue's report: a simulator restarted on the same port after 110 frames, its numbers
+/// starting again where a fresh run of it starts, counted 25727 lost packets (delivery 2.14 %
+/// over the 12 frames, and worse with every restart).
+#[test]
+fn restarted_sequence_is_a_restart_not_a_loss() {
+    let mut numbers: Vec<u16> = (100..=110).collect();
+    numbers.extend(25838..25848);
+    let (_, s) = decode(&packets(&numbers));
+    assert_eq!(s.frames(), 21);
+    assert_eq!(s.restarts(), 1);
+    assert_eq!(s.lost_packets(), 0);
+    assert_eq!(s.delivery_ratio(), Some(1.0));
+    // The sequence continues from the new number: a loss after the restart is counted.
+    numbers.extend([25849, 25850]);
+    let (_, s) = decode(&packets(&numbers));
+    assert_eq!((s.restarts(), s.lost_packets()), (1, 1));
+}
+
+#[test]
+fn largest_gap_counted_as_loss_is_max_packet_gap() {
+    let gap = MAX_PACKET_GAP;
+    let (_, s) = decode(&packets(&[7, 8 + gap]));
+    assert_eq!((s.lost_packets(), s.restarts()), (u32::from(gap), 0));
+    let (_, s) = decode(&packets(&[7, 9 + gap]));
+    assert_eq!((s.lost_packets(), s.restarts()), (0, 1));
+    // Across the wrap of the counter alike.
+    let (_, s) = decode(&packets(&[65535 - 3, gap - 3]));
+    assert_eq!((s.lost_packets(), s.restarts()), (u32::from(gap), 0));
+    let (_, s) = decode(&packets(&[65535 - 3, gap - 2]));
+    assert_eq!((s.lost_packets(), s.restarts()), (0, 1));
+}
+
+/// Two ESCs' sequences on one wire (or a recording replayed into a live one): each switch from
+/// one to the other is a restart. Counted as losses, every switch forwards added thousands and
+/// the count ran up to 4294967295.
+#[test]
+fn interleaved_sequences_count_restarts_not_losses() {
+    let numbers: Vec<u16> = (0..2000u16)
+        .map(|i| {
+            if i % 2 == 0 {
+                100 + i / 2
+            } else {
+                20000 + i / 2
+            }
+        })
+        .collect();
+    let (_, s) = decode(&packets(&numbers));
+    assert_eq!(s.frames(), 2000);
+    assert_eq!(s.lost_packets(), 0);
+    assert_eq!(s.restarts(), 1999);
+    assert_eq!(s.delivery_ratio(), Some(1.0));
+}
+
+/// Decodes `parts` one byte at a time and in whole parts, telling the decoder before each part
+/// but the first that the line was silent for `silences[i]` frames; both ways must agree.
+fn decode_with_silences(parts: &[Vec<u8>], silences: &[u32]) -> (Vec<Decoded>, LinkStats) {
+    let mut results = Vec::new();
+    for bytewise in [false, true] {
+        let mut d = Decoder::new();
+        let mut out = Vec::new();
+        for (i, part) in parts.iter().enumerate() {
+            if i > 0 {
+                d.line_silent(silences[i - 1], |x| out.push(x));
+            }
+            if bytewise {
+                for &b in part {
+                    d.push(b, |x| out.push(x));
+                }
+            } else {
+                d.feed(part, |x| out.push(x));
+            }
+        }
+        d.flush(|x| out.push(x));
+        results.push((out, *d.stats()));
+    }
+    assert_eq!(results[0], results[1], "bulk and bytewise differ");
+    results.pop().unwrap()
+}
+
+/// The issue's case on a timed source: an ESC rebooted within a second and came back 536 packet
+/// numbers on. Without the silence the step is a plausible loss of 535; with it, a restart.
+#[test]
+fn silence_turns_an_implausible_gap_into_a_restart() {
+    let before = packets(&[65000, 65001]);
+    let after = packets(&[1, 2, 5]);
+    let (_, s) = decode(&[before.clone(), after.clone()].concat());
+    assert_eq!((s.lost_packets(), s.restarts()), (535 + 2, 0));
+    // 1.5 s of silence: at most 120 frames (24 byte times each) could have been sent.
+    let (decoded, s) = decode_with_silences(&[before.clone(), after.clone()], &[120]);
+    assert_eq!(decoded.len(), 5);
+    assert_eq!((s.lost_packets(), s.restarts()), (2, 1));
+    // The allowance is exact: a step of max_frames + 1 is a loss, one more a restart.
+    let (_, s) = decode_with_silences(&[before.clone(), after.clone()], &[534]);
+    assert_eq!((s.lost_packets(), s.restarts()), (2, 1));
+    let (_, s) = decode_with_silences(&[before.clone(), after.clone()], &[535]);
+    assert_eq!((s.lost_packets(), s.restarts()), (535 + 2, 0));
+    // A silence longer than MAX_PACKET_GAP frames makes a longer gap a loss (a link unplugged
+    // for two minutes), but never a step backwards.
+    let far = packets(&[(65001 + 2400) as u16]);
+    let (_, s) = decode_with_silences(&[before.clone(), far.clone()], &[9600]);
+    assert_eq!((s.lost_packets(), s.restarts()), (2399, 0));
+    let (_, s) = decode(&[before.clone(), far].concat());
+    assert_eq!((s.lost_packets(), s.restarts()), (0, 1));
+    let back = packets(&[65001 - 10]);
+    let (_, s) = decode_with_silences(&[before.clone(), back], &[u32::MAX]);
+    assert_eq!((s.lost_packets(), s.restarts()), (0, 1));
+    // The largest allowance: 32767 lost frames; a step of 32769 goes backwards.
+    let half = packets(&[65001u16.wrapping_add(0x8000)]);
+    let (_, s) = decode_with_silences(&[before.clone(), half], &[u32::MAX]);
+    assert_eq!((s.lost_packets(), s.restarts()), (0x7FFF, 0));
+    let past = packets(&[65001u16.wrapping_add(0x8001)]);
+    let (_, s) = decode_with_silences(&[before.clone(), past], &[u32::MAX]);
+    assert_eq!((s.lost_packets(), s.restarts()), (0, 1));
+}
+
+#[test]
+fn silence_allows_only_the_next_data_frame() {
+    let info = info_bytes();
+    // No frame at all in the silence: the next frame's step must be 1.
+    let (_, s) = decode_with_silences(&[packets(&[10]), packets(&[11, 13])], &[0]);
+    assert_eq!((s.lost_packets(), s.restarts()), (1, 0));
+    let (_, s) = decode_with_silences(&[packets(&[10]), packets(&[12, 14])], &[0]);
+    assert_eq!((s.lost_packets(), s.restarts()), (1, 1));
+    // A duplicate after the silence is still a duplicate, and uses up the allowance.
+    let (_, s) = decode_with_silences(&[packets(&[10]), packets(&[10, 1000])], &[0]);
+    assert_eq!(
+        (s.duplicate_packets(), s.lost_packets(), s.restarts()),
+        (1, 989, 0)
+    );
+    // Info frames, noise and corrupted frames in between do not use it up.
+    let second = cat(&[
+        &info,
+        &[0x00, 0x9B, 0x16],
+        &CORRUPT_STATUS,
+        &packets(&[300]),
+    ]);
+    let (_, s) = decode_with_silences(&[packets(&[10]), second.clone()], &[5]);
+    assert_eq!((s.lost_packets(), s.restarts(), s.info_frames()), (0, 1, 1));
+    // Silences before one data frame add up: 3 + 4 + 0 frames allow a step of 8.
+    let parts = [
+        packets(&[10]),
+        info.to_vec(),
+        info.to_vec(),
+        packets(&[18, 30]),
+    ];
+    let (_, s) = decode_with_silences(&parts, &[3, 4, 0]);
+    assert_eq!((s.lost_packets(), s.restarts()), (7 + 11, 0));
+    let parts = [
+        packets(&[10]),
+        info.to_vec(),
+        info.to_vec(),
+        packets(&[19, 30]),
+    ];
+    let (_, s) = decode_with_silences(&parts, &[3, 4, 0]);
+    assert_eq!((s.lost_packets(), s.restarts()), (10, 1));
+    // Before the first data frame there is no step to judge.
+    let (_, s) = decode_with_silences(&[info.to_vec(), packets(&[40000, 40002])], &[0]);
+    assert_eq!((s.lost_packets(), s.restarts(), s.frames()), (1, 0, 2));
+}
+
+/// A silence ends the frame that was arriving: its bytes are decided at once (a cut data frame
+/// is dropped), and the frames an unfinished device-information candidate hid are given before
+/// the allowance is used, so that it goes to the first frame after the silence.
+#[test]
+fn silence_decides_the_held_bytes_first() {
+    let frame = packets(&[10]);
+    // A cut frame, then the silence: later bytes do not finish it.
+    let parts = [frame[..10].to_vec(), frame[10..].to_vec()];
+    let (decoded, s) = decode_with_silences(&parts, &[0]);
+    assert!(decoded.is_empty());
+    assert_eq!(s.bytes_skipped(), 24);
+    // A fake info header holds a whole data frame until 77 bytes are there; the silence gives it
+    // before the allowance applies, so 11 is the next frame, and 2000 (step 1989) a restart.
+    let first = cat(&[&[0x9B, 0x4C], &packets(&[10, 11])]);
+    let (decoded, s) = decode_with_silences(&[first, packets(&[2000])], &[0]);
+    assert_eq!(data_frames(&decoded), [(2, 10), (26, 11), (50, 2000)]);
+    assert_eq!(
+        (s.lost_packets(), s.restarts(), s.checksum_failures()),
+        (0, 1, 0)
+    );
+    let mut d = Decoder::new();
+    let mut got = Vec::new();
+    d.feed(&cat(&[&[0x9B, 0x4C], &packets(&[10, 11])]), |x| got.push(x));
+    assert_eq!((got.len(), d.buffered()), (0, 50));
+    d.line_silent(7, |x| got.push(x));
+    assert_eq!((got.len(), d.buffered()), (2, 0));
 }
 
 #[test]
@@ -1252,4 +1449,22 @@ fn frame_error_messages() {
     for (error, text) in cases {
         assert_eq!(error.to_string(), text);
     }
+}
+
+#[test]
+fn link_stats_display_names_every_counter() {
+    let info = info_bytes();
+    let stream = cat(&[
+        &[0x00],
+        &packets(&[10, 10, 13]),
+        &info,
+        &CORRUPT_STATUS,
+        &packets(&[5000, 5001]),
+    ]);
+    let (_, s) = decode(&stream);
+    assert_eq!(
+        s.to_string(),
+        "222 bytes, 5 frames, 1 info frames, 1 checksum failures, 25 bytes skipped, \
+         2 lost packets, 1 duplicate packets, 1 restarts"
+    );
 }
