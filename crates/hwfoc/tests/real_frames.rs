@@ -1371,7 +1371,88 @@ fn settings_new_rejects_zero_negative_and_non_finite() {
         Err(SettingsError::GearRatio(v)) if v.is_nan()
     ));
     assert_eq!(Settings::new(64.0, 0, 1.0), Err(SettingsError::PolePairs));
-    assert!(!SettingsError::PolePairs.to_string().is_empty());
+}
+
+/// The issue: `--current-scale 1e-38` made every current infinite. Values whose conversions
+/// cannot be represented are refused, up to the bounds and not one step beyond.
+#[test]
+fn settings_new_refuses_values_that_cannot_be_represented() {
+    let (scale_min, scale_max) = (Settings::CURRENT_SCALE_MIN, Settings::CURRENT_SCALE_MAX);
+    let (ratio_min, ratio_max) = (Settings::GEAR_RATIO_MIN, Settings::GEAR_RATIO_MAX);
+    assert_eq!(
+        (scale_min, scale_max, ratio_min, ratio_max),
+        (1e-34, 1e37, 1e-28, 1e33)
+    );
+    for bad in [
+        1e-38,
+        f32::MIN_POSITIVE,
+        f32::MAX,
+        scale_min.next_down(),
+        scale_max.next_up(),
+    ] {
+        assert_eq!(
+            Settings::new(bad, 7, 1.0),
+            Err(SettingsError::CurrentScale(bad))
+        );
+    }
+    for bad in [3e-38, f32::MAX, ratio_min.next_down(), ratio_max.next_up()] {
+        assert_eq!(
+            Settings::new(64.0, 7, bad),
+            Err(SettingsError::GearRatio(bad))
+        );
+    }
+    for scale in [scale_min, scale_max] {
+        for ratio in [ratio_min, ratio_max] {
+            for poles in [1, u16::MAX] {
+                let s = Settings::new(scale, poles, ratio).unwrap();
+                assert_eq!(
+                    (s.current_scale, s.pole_pairs, s.gear_ratio),
+                    (scale, poles, ratio)
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn settings_error_messages_give_the_range() {
+    let message = |scale, poles, ratio| Settings::new(scale, poles, ratio).unwrap_err().to_string();
+    assert_eq!(
+        message(1e-38, 7, 1.0),
+        "current scale must be from 1e-34 to 1e37, not 1e-38"
+    );
+    assert_eq!(
+        message(-64.0, 7, 1.0),
+        "current scale must be from 1e-34 to 1e37, not -64"
+    );
+    assert_eq!(
+        message(f32::INFINITY, 7, 1.0),
+        "current scale must be from 1e-34 to 1e37, not inf"
+    );
+    assert_eq!(
+        message(f32::NAN, 7, 1.0),
+        "current scale must be from 1e-34 to 1e37, not NaN"
+    );
+    assert_eq!(
+        message(64.0, 0, 1.0),
+        "pole pairs must be at least 1, not 0"
+    );
+    assert_eq!(
+        message(64.0, 7, 0.0),
+        "gear ratio must be from 1e-28 to 1e33, not 0"
+    );
+    assert_eq!(
+        message(64.0, 7, 2e33),
+        "gear ratio must be from 1e-28 to 1e33, not 2e33"
+    );
+    assert_eq!(
+        message(64.0, 7, -0.0001),
+        "gear ratio must be from 1e-28 to 1e33, not -0.0001"
+    );
+    assert_eq!(
+        message(64.0, 7, -2.5),
+        "gear ratio must be from 1e-28 to 1e33, not -2.5"
+    );
 }
 
 #[test]
@@ -1384,7 +1465,6 @@ fn settings_new_accepts_sensible_values() {
     assert_eq!(s.gear_ratio, 0.5);
     assert_eq!(s.amps(-250), -2.5);
     assert_eq!(s.rpm_from_erpm(60000), 10000.0);
-    assert!(Settings::new(f32::MIN_POSITIVE, 1, f32::MAX).is_ok());
 }
 
 /// A device-information candidate with a correct check byte but a byte that is not ASCII in its
