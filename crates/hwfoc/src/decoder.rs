@@ -14,7 +14,7 @@
 //! inlined with every kind's constants: no dynamic dispatch, no function pointer, and no loop over
 //! the kinds is left in the scanner.
 
-use crate::frame::{Frame, MAX_FRAME_LEN, or_length_bytes, wire_len_of};
+use crate::frame::{Frame, MAX_FRAME_LEN, candidate_len, or_length_bytes, wire_len_of};
 use crate::stats::LinkStats;
 use crate::wire::SYNC;
 
@@ -112,11 +112,7 @@ fn scan_next(
         // MAX_FRAME_LEN bytes they are, whatever its length byte, which is then not even read
         // (in line noise, which length byte a fake header carries is unpredictable). Short of
         // that, its length byte (a known one: `find_header` stops at no other) tells.
-        let complete = rest.len() >= MAX_FRAME_LEN
-            || match *rest {
-                [_, l, ..] => rest.len() >= wire_len_of(l).unwrap_or(0),
-                _ => false,
-            };
+        let complete = rest.len() >= MAX_FRAME_LEN || rest.len() >= candidate_len(rest);
         if complete {
             stats.checksum_failure();
         } else if !at_end {
@@ -218,12 +214,7 @@ impl Decoder {
             let held = usize::from(self.len);
             // Common byte-at-a-time case: the held candidate still cannot be decided with these
             // bytes (a frame's length is known from its second byte), so just keep them.
-            let needed = match self.buf[..held] {
-                [_] => 2,
-                [_, l, ..] => wire_len_of(l).unwrap_or(0),
-                _ => 0,
-            };
-            if held + data.len() < needed {
+            if held + data.len() < candidate_len(&self.buf[..held]) {
                 self.buf[held..held + data.len()].copy_from_slice(data);
                 self.len += data.len() as u8;
                 return;

@@ -1548,3 +1548,213 @@ fn link_stats_display_names_every_counter() {
          2 lost packets, 1 duplicate packets, 1 restarts"
     );
 }
+
+// ---------------------------------------------------------------------------------------------
+// Behaviour that mutation testing found untested
+// ---------------------------------------------------------------------------------------------
+
+/// `bytes` with its check bytes rewritten to match (a 24-byte data frame or a 77-byte info frame).
+fn resealed(mut bytes: Vec<u8>) -> Vec<u8> {
+    let n = bytes.len();
+    if n == DATA_FRAME_LEN {
+        let sum = sum16(&bytes[..22]).to_le_bytes();
+        bytes[22..].copy_from_slice(&sum);
+    } else {
+        bytes[76] = sum16(&bytes[..76]) as u8;
+    }
+    bytes
+}
+
+/// A frame whose check bytes are right but whose version or command is not its kind's is refused
+/// by every path (`parse`, the kind's own `parse`, the scanner), whichever of the two is wrong.
+#[test]
+fn valid_check_bytes_with_another_version_or_command_are_refused() {
+    for (version, command) in [
+        (0x02, 0x01),
+        (0x00, 0x01),
+        (0x01, 0x02),
+        (0x01, 0x81),
+        (0x02, 0x02),
+    ] {
+        let mut bytes = info_bytes().to_vec();
+        bytes[2] = version;
+        bytes[3] = command;
+        let bytes = resealed(bytes);
+        let error = FrameError::UnknownCommand { version, command };
+        assert_eq!(
+            InfoFrame::parse(&bytes),
+            Err(error),
+            "info {version:02X} {command:02X}"
+        );
+        assert_eq!(parse(&bytes), Err(error));
+        let (decoded, stats) = decode(&bytes);
+        assert!(decoded.is_empty());
+        assert_eq!(stats.checksum_failures(), 1);
+    }
+    for (version, command) in [
+        (0x02, 0x02),
+        (0x00, 0x02),
+        (0x01, 0x01),
+        (0x01, 0x0A),
+        (0x03, 0x03),
+    ] {
+        let mut bytes = EXAMPLE.to_vec();
+        bytes[2] = version;
+        bytes[3] = command;
+        let bytes = resealed(bytes);
+        let error = FrameError::UnknownCommand { version, command };
+        assert_eq!(
+            DataFrame::parse(&bytes),
+            Err(error),
+            "data {version:02X} {command:02X}"
+        );
+        assert_eq!(parse(&bytes), Err(error));
+        let (decoded, stats) = decode(&bytes);
+        assert!(decoded.is_empty());
+        assert_eq!(stats.checksum_failures(), 1);
+    }
+}
+
+/// The data frame's one-branch check compares the header and the sum at once; a candidate whose
+/// sync or length byte differs from the data frame's by some bits, and whose carried sum differs
+/// from the payload's by the same bits, must still be refused (XOR-ing the two differences
+/// would cancel them out). The scanner meets such candidates at every `9B 4C` (its length byte
+/// differs from the data frame's by 0x5A) and, right after a frame, at any byte.
+#[test]
+fn header_and_sum_differing_by_the_same_bits_are_refused() {
+    let payload = &EXAMPLE[4..22];
+    let header_sum = sum16(&EXAMPLE[..4]);
+    let payload_sum = sum16(payload);
+    let frame = DataFrame::parse(&EXAMPLE).unwrap();
+    for (at, right) in [(0, 0x9B), (1, 0x16)] {
+        for b in (0..=255u8).filter(|&b| b != right) {
+            let mut header = [0x9B, 0x16, 0x01, 0x02];
+            header[at] = b;
+            let diff = u16::from(b ^ right) << (8 * at);
+            let carried = (header_sum.wrapping_add(payload_sum) ^ diff).to_le_bytes();
+            let candidate = cat(&[&header, payload, &carried]);
+            assert!(
+                !matches!(parse(&candidate), Ok(Parsed::Complete(..))),
+                "{candidate:02X?}"
+            );
+            assert!(DataFrame::parse(&candidate).is_err());
+            // Alone (the candidate is found only at a `9B 16` or `9B 4C`)...
+            let (decoded, _) = decode(&candidate);
+            assert!(decoded.is_empty(), "{candidate:02X?}");
+            // ... and right after a frame, where the scanner tries a data frame first.
+            let (decoded, _) = decode(&cat(&[&EXAMPLE, &candidate]));
+            assert_eq!(decoded.len(), 1, "{candidate:02X?}");
+            assert_eq!(decoded[0].frame, Frame::Data(frame));
+        }
+    }
+}
+
+/// A flag set twice is set (not toggled back off), by `with` and by collecting.
+#[test]
+fn a_flag_set_twice_stays_set() {
+    for fault in Fault::ALL {
+        let once = Status::OK.with(fault);
+        assert_eq!(once.with(fault), once);
+        assert_eq!([fault, fault].into_iter().collect::<Status>(), once);
+        assert_eq!([fault, fault, fault].into_iter().collect::<Status>(), once);
+        let other = Fault::from_bit((fault.bit() + 5) % 16).unwrap();
+        let both = Status(fault.mask() | other.mask());
+        assert_eq!(both.with(fault), both);
+        assert_eq!([fault, other, fault].into_iter().collect::<Status>(), both);
+        assert_eq!(both.faults().len(), 2);
+        assert_eq!(both.into_iter().count(), 2);
+    }
+    assert_eq!(std::iter::empty::<Fault>().collect::<Status>(), Status::OK);
+    assert!(Status::OK.is_ok());
+    assert_eq!(Status::from(0x1040), Status(0x1040));
+}
+
+/// Throttle percentages of a running frame, input and output told apart.
+#[test]
+fn throttle_percentages_of_a_running_frame() {
+    let f = DataFrame::parse(&BRAKING).unwrap();
+    assert_eq!((f.throttle_in_raw, f.throttle_out_raw), (167, 167));
+    assert_eq!(f.throttle_in_pct(), 16.308594);
+    assert_eq!(f.throttle_out_pct(), 16.308594);
+    assert_eq!(f.erpm(), 25630);
+    let f = DataFrame {
+        throttle_in_raw: 1024,
+        throttle_out_raw: 512,
+        ..Default::default()
+    };
+    assert_eq!((f.throttle_in_pct(), f.throttle_out_pct()), (100.0, 50.0));
+    let f = DataFrame {
+        throttle_in_raw: 1,
+        throttle_out_raw: 256,
+        ..Default::default()
+    };
+    assert_eq!(
+        (f.throttle_in_pct(), f.throttle_out_pct()),
+        (0.09765625, 25.0)
+    );
+}
+
+/// Every flag's description, as in PROTOCOL-NOTES.md's status table.
+#[test]
+fn fault_descriptions() {
+    let descriptions: Vec<&str> = Fault::ALL.iter().map(|f| f.description()).collect();
+    assert_eq!(
+        descriptions,
+        [
+            "input voltage is too high",
+            "input voltage is too low",
+            "over current",
+            "not assigned (bit 3)",
+            "the throttle signal is lost",
+            "the throttle is not returned to zero",
+            "MOSFET overheat",
+            "capacitor overheat",
+            "motor is blocked",
+            "open circuit of upper bridge (MOSFET)",
+            "MOSFET short circuit",
+            "open circuit of lower bridge (MOSFET)",
+            "operational amplifier abnormal, phase C",
+            "operational amplifier abnormal, phase B",
+            "operational amplifier abnormal, phase A",
+            "not assigned (bit 15)",
+        ]
+    );
+}
+
+#[test]
+fn display_texts() {
+    assert_eq!(Temperature::from_adc(0xCE).to_string(), "28 degC");
+    assert_eq!(Temperature::from_adc(225).to_string(), "15.5 degC");
+    assert_eq!(
+        Temperature::BelowRange.to_string(),
+        "below 0 degC (out of range)"
+    );
+    assert_eq!(
+        Temperature::AboveRange.to_string(),
+        "above 129 degC (out of range)"
+    );
+    assert_eq!(
+        InfoFieldError::TooLong {
+            field: "product",
+            max: 16,
+            len: 17
+        }
+        .to_string(),
+        "product is 17 bytes long; the field holds 16"
+    );
+    assert_eq!(
+        InfoFieldError::NotAscii { field: "firmware" }.to_string(),
+        "firmware is not ASCII text"
+    );
+    let info = InfoFrame::parse(&info_bytes()).unwrap();
+    assert_eq!(
+        format!("{info:?}"),
+        "InfoFrame { product: \"XR_FOC_ESC\", hardware: \"HW577_KZ1_V1.1\", \
+         firmware: \"XR-01.0.00\", id: \"01040443\" }"
+    );
+    assert_eq!(InfoFrame::new("", "", "", "").unwrap().to_string(), "");
+    assert_eq!(
+        InfoFrame::new("A", "", "B", "C").unwrap().to_string(),
+        "A B C"
+    );
+}
