@@ -14,7 +14,7 @@
 //! inlined with every kind's constants: no dynamic dispatch, no function pointer, and no loop over
 //! the kinds is left in the scanner.
 
-use crate::frame::{Frame, MAX_FRAME_LEN, or_length_bytes, wire_len_of};
+use crate::frame::{Frame, MAX_FRAME_LEN, candidate_len, or_length_bytes, wire_len_of};
 use crate::stats::LinkStats;
 use crate::wire::SYNC;
 
@@ -112,11 +112,7 @@ fn scan_next(
         // MAX_FRAME_LEN bytes they are, whatever its length byte, which is then not even read
         // (in line noise, which length byte a fake header carries is unpredictable). Short of
         // that, its length byte (a known one: `find_header` stops at no other) tells.
-        let complete = rest.len() >= MAX_FRAME_LEN
-            || match *rest {
-                [_, l, ..] => rest.len() >= wire_len_of(l).unwrap_or(0),
-                _ => false,
-            };
+        let complete = rest.len() >= MAX_FRAME_LEN || rest.len() >= candidate_len(rest);
         if complete {
             stats.checksum_failure();
         } else if !at_end {
@@ -218,12 +214,7 @@ impl Decoder {
             let held = usize::from(self.len);
             // Common byte-at-a-time case: the held candidate still cannot be decided with these
             // bytes (a frame's length is known from its second byte), so just keep them.
-            let needed = match self.buf[..held] {
-                [_] => 2,
-                [_, l, ..] => wire_len_of(l).unwrap_or(0),
-                _ => 0,
-            };
-            if held + data.len() < needed {
+            if held + data.len() < candidate_len(&self.buf[..held]) {
                 self.buf[held..held + data.len()].copy_from_slice(data);
                 self.len += data.len() as u8;
                 return;
@@ -261,13 +252,62 @@ impl Decoder {
     ///
     /// Call it at the end of a stream. A caller that sees the line fall silent for longer than a
     /// few byte times (a "gap": real ESCs send each frame back to back) may call it then too, so
-    /// that a cut frame is settled at once rather than when the next bytes arrive. Statistics and
-    /// packet tracking carry on across the call.
+    /// that a cut frame is settled at once rather than when the next bytes arrive
+    /// ([`Decoder::line_silent`] does, and also tells the packet counting how long the silence
+    /// was). Statistics and packet tracking carry on across the call.
     pub fn flush(&mut self, mut on_frame: impl FnMut(Decoded)) {
         let held = usize::from(self.len);
         let base = self.stats.bytes() - held as u64;
         scan_all::<true>(&self.buf[..held], base, &mut self.stats, &mut on_frame);
         self.len = 0;
+    }
+
+    /// Tells the decoder that the line has just been silent for a time in which at most
+    /// `max_frames` data frames could have been sent; `on_frame` gets any frame the held bytes
+    /// still held.
+    ///
+    /// It does two things:
+    ///
+    /// 1. The silence ends whatever frame was arriving (an ESC sends a frame's bytes back to
+    ///    back), so the held bytes are decided at once, exactly as by [`Decoder::flush`].
+    /// 2. The next data frame (the first one after the silence, whatever its bytes' chunking)
+    ///    counts as a loss of `step - 1` packets only if its packet-number step is from 2 to
+    ///    `max_frames + 1`; a larger step is a [restart](LinkStats::restarts). A step of 0 is
+    ///    still a duplicate and 1 the next frame. The rule replaces the
+    ///    [`MAX_PACKET_GAP`](crate::stats::MAX_PACKET_GAP) rule for that one frame, then the
+    ///    default returns. Several calls before that frame add up (their silences could each
+    ///    have hidden frames); a step beyond 32768 is a step backwards, a restart whatever
+    ///    `max_frames` says. Before the first data frame there is no step, and the call only
+    ///    decides the held bytes.
+    ///
+    /// So an ESC that rebooted within a second and a half is seen restarting even when its new
+    /// packet number happens to lie a few hundred past the old one, while a frame lost in a
+    /// short silence is still a loss. `max_frames` is the caller's bound from the time that
+    /// passed: the line carries a data frame in at most 24 byte times (12.5 ms at 19200 baud),
+    /// and real ESCs send one every 50 ms at most. Frames hidden in bytes that arrived but were
+    /// rejected (corrupted) are not the silence's: do not count them in `max_frames`. Host-side
+    /// read latency is not a silence of the line; call this only for gaps longer than the
+    /// receiving path can introduce.
+    ///
+    /// ```
+    /// use hwfoc::wire::{BAUD_RATE, byte_ns};
+    /// use hwfoc::{DataFrame, Decoder};
+    ///
+    /// let frame = |packet| DataFrame { packet, ..Default::default() }.encode();
+    /// let mut decoder = Decoder::new();
+    /// decoder.feed(&frame(65000), |_| {});
+    /// // 1.5 s without a byte: at most 1.5 s / 24 byte times = 120 frames could have been sent.
+    /// let max_frames = (1.5e9 / (24.0 * byte_ns(BAUD_RATE))) as u32;
+    /// assert_eq!(max_frames, 120);
+    /// decoder.line_silent(max_frames, |_| {});
+    /// decoder.feed(&frame(0), |_| {}); // a step of 536: the ESC restarted
+    /// decoder.feed(&frame(3), |_| {}); // no silence: 2 frames lost
+    /// assert_eq!(decoder.stats().restarts(), 1);
+    /// assert_eq!(decoder.stats().lost_packets(), 2);
+    /// ```
+    pub fn line_silent(&mut self, max_frames: u32, on_frame: impl FnMut(Decoded)) {
+        self.flush(on_frame);
+        self.stats.line_silent(max_frames);
     }
 
     /// Feeds a whole stream and flushes it: the bulk path for a buffer in memory.

@@ -54,8 +54,8 @@
 //!   bytes and [`Frame`] to the size of 8 records (from 74 to about 170 bytes), also in firmware
 //!   that reads one ESC's own wire, where a hub frame never comes. If that matters, the scanner
 //!   can be made generic over the list of kinds (from here it uses only `Frame::take_first`,
-//!   `Frame::take`, `wire_len_of`, `or_length_bytes` and `MAX_FRAME_LEN`), with one list per
-//!   wire: this file's for an ESC's wire, a one-arm list for a hub's.
+//!   `Frame::take`, `wire_len_of`, `candidate_len`, `or_length_bytes` and `MAX_FRAME_LEN`), with
+//!   one list per wire: this file's for an ESC's wire, a one-arm list for a hub's.
 //! - **Hobbywing V3/V4** (`OLDER-PROTOCOLS.md`): same sync byte and baud rate, but no length
 //!   byte and no checksum. Frames are recognised by fixed bytes, by chaining (the next header
 //!   exactly where the previous frame ended) and by the packet counter, which needs state across
@@ -122,6 +122,26 @@ macro_rules! frame_kinds {
                 }
             )+
             None
+        }
+
+        /// How many bytes a candidate needs before it can be decided: 2 while it is only its
+        /// sync byte, else the wire length of its length byte's kind.
+        ///
+        /// The scanner's candidates start with a sync byte followed, if there is a second byte,
+        /// by a known length byte (`find_header` stops at no other), so there is no "unknown"
+        /// answer: a byte no kind has gives [`MAX_FRAME_LEN`], the length after which any
+        /// candidate is decided.
+        #[inline(always)]
+        pub(crate) fn candidate_len(candidate: &[u8]) -> usize {
+            let Some(&length_byte) = candidate.get(1) else {
+                return 2;
+            };
+            $(
+                if length_byte == <$kind as FrameKind>::LENGTH_BYTE {
+                    return <$kind as FrameKind>::LEN;
+                }
+            )+
+            MAX_FRAME_LEN
         }
 
         impl Frame {

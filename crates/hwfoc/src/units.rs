@@ -163,20 +163,54 @@ impl Settings {
         gear_ratio: 1.0,
     };
 
-    /// Settings checked for values that would make every conversion meaningless
-    /// (a zero, negative or non-finite scale or ratio, zero pole pairs).
+    /// The smallest current scale [`Settings::new`] accepts, `1e-34`: the largest current,
+    /// `i16::MIN / scale`, must be a finite `f32` (below `f32::MAX`, about 3.4e38), so the scale
+    /// must exceed `32768 / f32::MAX`, about 9.6e-35. (At `1e-35` that current is infinite.)
+    pub const CURRENT_SCALE_MIN: f32 = 1e-34;
+    /// The largest current scale [`Settings::new`] accepts, `1e37`: the smallest current,
+    /// `1 / scale`, must be a normal `f32` (at least `f32::MIN_POSITIVE`, about 1.2e-38: below
+    /// it an `f32` keeps fewer digits, down to none at 0), so the scale must be at most about
+    /// 8.5e37. (At `1e38` that current has lost precision.)
+    pub const CURRENT_SCALE_MAX: f32 = 1e37;
+    /// The smallest gear ratio [`Settings::new`] accepts, `1e-28`: the largest RPM, of the largest
+    /// eRPM [`Settings::rpm_from_erpm`] takes (`u32::MAX`, about 4.3e9) with one pole pair, must
+    /// be finite, so the ratio must exceed `u32::MAX / f32::MAX`, about 1.3e-29. (At `1e-29`
+    /// that RPM is infinite.) A frame's largest eRPM, 655350, needs far less.
+    pub const GEAR_RATIO_MIN: f32 = 1e-28;
+    /// The largest gear ratio [`Settings::new`] accepts, `1e33`: the divisor of the RPM,
+    /// `gear ratio * pole pairs`, must be finite with 65535 pole pairs, and the smallest RPM,
+    /// `1 / divisor`, a normal `f32`, so the ratio must be at most about
+    /// `1 / (f32::MIN_POSITIVE * 65535)`, 1.3e33. (At `1e34` the divisor is infinite and every
+    /// RPM 0.)
+    pub const GEAR_RATIO_MAX: f32 = 1e33;
+
+    /// Settings checked so that every conversion they make is a finite number, a nonzero raw
+    /// value giving a nonzero (and normal, full-precision) one: the current scale must be from
+    /// [`Settings::CURRENT_SCALE_MIN`] to [`Settings::CURRENT_SCALE_MAX`] (`1e-34` to `1e37`),
+    /// pole pairs at least 1 (any `u16` but 0), the gear ratio from
+    /// [`Settings::GEAR_RATIO_MIN`] to [`Settings::GEAR_RATIO_MAX`] (`1e-28` to `1e33`).
+    /// NaN is refused. The bounds are the arithmetic's (see each), rounded inwards to a power of
+    /// ten: real scales and ratios lie far inside them.
+    ///
+    /// ```
+    /// use hwfoc::Settings;
+    ///
+    /// assert!(Settings::new(100.0, 14, 2.5).is_ok());
+    /// let error = Settings::new(1e-38, 7, 1.0).unwrap_err();
+    /// assert_eq!(error.to_string(), "current scale must be from 1e-34 to 1e37, not 1e-38");
+    /// ```
     pub fn new(
         current_scale: f32,
         pole_pairs: u16,
         gear_ratio: f32,
     ) -> Result<Self, SettingsError> {
-        if !(current_scale.is_finite() && current_scale > 0.0) {
+        if !(Self::CURRENT_SCALE_MIN..=Self::CURRENT_SCALE_MAX).contains(&current_scale) {
             return Err(SettingsError::CurrentScale(current_scale));
         }
         if pole_pairs == 0 {
             return Err(SettingsError::PolePairs);
         }
-        if !(gear_ratio.is_finite() && gear_ratio > 0.0) {
+        if !(Self::GEAR_RATIO_MIN..=Self::GEAR_RATIO_MAX).contains(&gear_ratio) {
             return Err(SettingsError::GearRatio(gear_ratio));
         }
         Ok(Settings {
@@ -222,27 +256,52 @@ impl Settings {
     }
 }
 
-/// A setting that [`Settings::new`] refuses.
+/// A setting that [`Settings::new`] refuses; its message gives the range accepted.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum SettingsError {
-    /// The current scale must be a positive finite number.
+    /// The current scale is not from [`Settings::CURRENT_SCALE_MIN`] to
+    /// [`Settings::CURRENT_SCALE_MAX`] (or is NaN).
     CurrentScale(f32),
     /// Pole pairs must be at least 1.
     PolePairs,
-    /// The gear ratio must be a positive finite number.
+    /// The gear ratio is not from [`Settings::GEAR_RATIO_MIN`] to [`Settings::GEAR_RATIO_MAX`]
+    /// (or is NaN).
     GearRatio(f32),
 }
 
 impl fmt::Display for SettingsError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            SettingsError::CurrentScale(v) => {
-                write!(f, "current scale must be a positive number, not {v}")
-            }
-            SettingsError::PolePairs => f.write_str("pole pairs must be at least 1"),
-            SettingsError::GearRatio(v) => {
-                write!(f, "gear ratio must be a positive number, not {v}")
-            }
+        match *self {
+            SettingsError::CurrentScale(v) => write!(
+                f,
+                "current scale must be from {:e} to {:e}, not {}",
+                Settings::CURRENT_SCALE_MIN,
+                Settings::CURRENT_SCALE_MAX,
+                Number(v)
+            ),
+            SettingsError::PolePairs => f.write_str("pole pairs must be at least 1, not 0"),
+            SettingsError::GearRatio(v) => write!(
+                f,
+                "gear ratio must be from {:e} to {:e}, not {}",
+                Settings::GEAR_RATIO_MIN,
+                Settings::GEAR_RATIO_MAX,
+                Number(v)
+            ),
+        }
+    }
+}
+
+/// A number as a user would write it: `64`, `0.5`, but `1e-38` and `3.4028235e38` rather than
+/// forty digits.
+struct Number(f32);
+
+impl fmt::Display for Number {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let v = self.0;
+        if v == 0.0 || !v.is_finite() || (1e-4..1e16).contains(&v.abs()) {
+            write!(f, "{v}")
+        } else {
+            write!(f, "{v:e}")
         }
     }
 }

@@ -6,6 +6,7 @@
 
 use hwfoc::kinds::data::DATA_FRAME_LEN;
 use hwfoc::kinds::info::INFO_FRAME_LEN;
+use hwfoc::stats::MAX_PACKET_GAP;
 use hwfoc::{
     DataFrame, Decoded, Decoder, Frame, FrameError, InfoFrame, LinkStats, Parsed, Status, frames,
     parse,
@@ -195,7 +196,10 @@ struct RefStats {
     checksum_failures: u32,
     lost_packets: u32,
     duplicate_packets: u32,
+    restarts: u32,
     last_packet: Option<u16>,
+    /// Frames the silences since the last data frame could have hidden, if there was one.
+    silent_frames: Option<u64>,
 }
 
 impl From<&LinkStats> for RefStats {
@@ -208,8 +212,35 @@ impl From<&LinkStats> for RefStats {
             checksum_failures: s.checksum_failures(),
             lost_packets: s.lost_packets(),
             duplicate_packets: s.duplicate_packets(),
+            restarts: s.restarts(),
             last_packet: s.last_packet(),
+            silent_frames: None,
         }
+    }
+}
+
+impl RefStats {
+    /// Counts a data frame's packet number by the rule of the issue: a step of 0 is a duplicate,
+    /// 1 the next frame, 2 up to the limit a loss of `step - 1`, anything else (a jump forwards
+    /// beyond the limit, or backwards: past half the counter) a restart. The limit is
+    /// `MAX_PACKET_GAP + 1`, or after silences `1 +` the frames they could have hidden.
+    fn packet(&mut self, packet: u16) {
+        if let Some(last) = self.last_packet {
+            let step = u64::from(packet.wrapping_sub(last));
+            let limit = match self.silent_frames {
+                Some(frames) => 1 + frames,
+                None => u64::from(MAX_PACKET_GAP) + 1,
+            };
+            match step {
+                0 => self.duplicate_packets += 1,
+                1 => {}
+                _ if step <= limit && step <= 32768 => self.lost_packets += step as u32 - 1,
+                _ => self.restarts += 1,
+            }
+        }
+        self.silent_frames = None;
+        self.last_packet = Some(packet);
+        self.frames += 1;
     }
 }
 
@@ -218,10 +249,32 @@ impl From<&LinkStats> for RefStats {
 /// version and command; take a valid frame whole, otherwise move on by one byte.
 fn reference(bytes: &[u8]) -> (Vec<Decoded>, RefStats) {
     let mut out = Vec::new();
-    let mut s = RefStats {
-        bytes: bytes.len() as u64,
-        ..Default::default()
-    };
+    let mut s = RefStats::default();
+    reference_scan(bytes, 0, &mut s, &mut out);
+    (out, s)
+}
+
+/// [`reference`] over stretches of bytes separated by silences: a silence of `silences[i]`
+/// frames between `parts[i]` and `parts[i + 1]` ends the stream of frames (no frame spans it)
+/// and widens or narrows what the next data frame's step may lose.
+fn reference_with_silences(parts: &[Vec<u8>], silences: &[u32]) -> (Vec<Decoded>, RefStats) {
+    let mut out = Vec::new();
+    let mut s = RefStats::default();
+    let mut base = 0;
+    for (i, part) in parts.iter().enumerate() {
+        if i > 0 {
+            let before = s.silent_frames.unwrap_or(0);
+            s.silent_frames = Some(before + u64::from(silences[i - 1]));
+        }
+        reference_scan(part, base, &mut s, &mut out);
+        base += part.len() as u64;
+    }
+    (out, s)
+}
+
+/// Scans `bytes`, whose first byte is at stream offset `base`, to their end.
+fn reference_scan(bytes: &[u8], base: u64, s: &mut RefStats, out: &mut Vec<Decoded>) {
+    s.bytes += bytes.len() as u64;
     let mut i = 0;
     while i < bytes.len() {
         let rest = &bytes[i..];
@@ -270,27 +323,18 @@ fn reference(bytes: &[u8]) -> (Vec<Decoded>, RefStats) {
                 cap_adc: f[19],
                 status: Status(u16::from_be_bytes([f[20], f[21]])),
             };
-            if let Some(last) = s.last_packet {
-                match d.packet.wrapping_sub(last) {
-                    0 => s.duplicate_packets += 1,
-                    step @ 1..=32768 => s.lost_packets += u32::from(step) - 1,
-                    _ => {}
-                }
-            }
-            s.last_packet = Some(d.packet);
-            s.frames += 1;
+            s.packet(d.packet);
             Frame::Data(d)
         } else {
             s.info_frames += 1;
             Frame::Info(InfoFrame::from_text(f[4..76].try_into().unwrap()).unwrap())
         };
         out.push(Decoded {
-            offset: i as u64,
+            offset: base + i as u64,
             frame,
         });
         i += len;
     }
-    (out, s)
 }
 
 /// Whether some candidate that is not an intact frame's own start is itself a valid frame
@@ -528,8 +572,9 @@ proptest! {
         prop_assert_eq!(RefStats::from(&stats), ref_stats);
     }
 
-    /// Packet accounting over arbitrary packet sequences matches the rule of `LinkStats`
-    /// (steps modulo 65536; 0 is a duplicate, 2..=32768 a loss of step - 1, larger is backwards).
+    /// Packet accounting over arbitrary packet sequences matches the rule of `LinkStats` (steps
+    /// modulo 65536: 0 is a duplicate, 2..=MAX_PACKET_GAP + 1 a loss of step - 1, anything else
+    /// but 1 a restart), and every step is counted as exactly one event.
     #[test]
     fn packet_accounting(packet_numbers in vec(any::<u16>(), 1..40), start in any::<u16>()) {
         // Half of the numbers are small steps from the previous one, to exercise the counting.
@@ -542,23 +587,245 @@ proptest! {
                 last
             })
             .collect();
-        let wire: Vec<u8> = numbers
-            .iter()
-            .flat_map(|&packet| DataFrame { packet, ..Default::default() }.encode())
-            .collect();
-        let (_, stats) = bulk(&wire);
-        let (mut lost, mut dup) = (0u32, 0u32);
+        let (_, stats) = bulk(&packet_wire(&numbers));
+        let mut expected = RefStats::default();
+        let (mut next, mut counted) = (0u32, 0u64);
         for w in numbers.windows(2) {
             let step = u32::from(w[1].wrapping_sub(w[0]));
-            if step == 0 {
-                dup += 1;
-            } else if step <= 32768 {
-                lost += step - 1;
+            match step {
+                0 => {}
+                1 => next += 1,
+                _ if step <= u32::from(MAX_PACKET_GAP) + 1 => counted += u64::from(step - 1),
+                _ => {}
             }
         }
+        for &n in &numbers {
+            expected.packet(n);
+        }
         prop_assert_eq!(stats.frames() as usize, numbers.len());
-        prop_assert_eq!(stats.lost_packets(), lost);
-        prop_assert_eq!(stats.duplicate_packets(), dup);
+        prop_assert_eq!(stats.lost_packets(), expected.lost_packets);
+        prop_assert_eq!(u64::from(stats.lost_packets()), counted);
+        prop_assert_eq!(stats.duplicate_packets(), expected.duplicate_packets);
+        prop_assert_eq!(stats.restarts(), expected.restarts);
         prop_assert_eq!(stats.last_packet(), numbers.last().copied());
+        // Each step after the first frame is one event: next, duplicate, loss or restart.
+        let steps = stats.frames() - 1;
+        let lossy_steps = steps - next - stats.duplicate_packets() - stats.restarts();
+        prop_assert!(stats.lost_packets() >= lossy_steps);
+        prop_assert!(stats.lost_packets() <= u32::from(MAX_PACKET_GAP) * lossy_steps);
     }
+
+    /// A sequence that only loses frames (never more than MAX_PACKET_GAP in a row) is counted
+    /// exactly: no restart, no duplicate, and `frames + lost` is the span of its numbers.
+    #[test]
+    fn lossy_sequence_counts_its_true_loss(
+        start in any::<u16>(),
+        gaps in vec(prop_oneof![4 => Just(0u16), 2 => 0u16..5, 1 => 0..=MAX_PACKET_GAP], 0..60),
+    ) {
+        let numbers = run(start, &gaps);
+        let (_, stats) = bulk(&packet_wire(&numbers));
+        let true_loss: u32 = gaps.iter().map(|&g| u32::from(g)).sum();
+        prop_assert_eq!(stats.restarts(), 0);
+        prop_assert_eq!(stats.duplicate_packets(), 0);
+        prop_assert_eq!(stats.lost_packets(), true_loss);
+        prop_assert_eq!(u64::from(stats.frames()) + u64::from(stats.lost_packets()),
+            1 + gaps.iter().map(|&g| 1 + u64::from(g)).sum::<u64>());
+    }
+
+    /// A sequence restarted in the middle (a new one from any number, with or without a silence
+    /// before it, whatever the chunking) counts exactly one restart and the true loss of both
+    /// runs, unless the new number plausibly continues the old run: then it is what it looks
+    /// like (a duplicate, the next frame, or a loss within the limit).
+    #[test]
+    fn restart_in_the_middle_counts_one_restart(
+        start in any::<u16>(),
+        gaps_a in vec(prop_oneof![3 => Just(0u16), 1 => 0u16..50], 1..20),
+        restart in prop_oneof![3 => any::<u16>(), 1 => (0u16..1100).prop_map(|d| d.wrapping_sub(50))],
+        gaps_b in vec(prop_oneof![3 => Just(0u16), 1 => 0u16..50], 0..20),
+        silence in prop_oneof![Just(None), (0u32..2000).prop_map(Some), any::<u32>().prop_map(Some)],
+        picks in vec(any::<Index>(), 0..10),
+    ) {
+        let a = run(start, &gaps_a);
+        let b_start = a.last().unwrap().wrapping_add(restart);
+        let b = run(b_start, &gaps_b);
+        let loss_a: u32 = gaps_a.iter().map(|&g| u32::from(g)).sum();
+        let loss_b: u32 = gaps_b.iter().map(|&g| u32::from(g)).sum();
+        let parts = [packet_wire(&a), packet_wire(&b)];
+        let silences = [silence.unwrap_or(0)];
+
+        let stats = match silence {
+            None => bulk(&parts.concat()).1,
+            Some(_) => {
+                let (decoded, stats) = streamed_with_silences(&parts, &silences, Chunks::At(&picks));
+                prop_assert_eq!(decoded.len(), a.len() + b.len());
+                stats
+            }
+        };
+        let limit = match silence {
+            None => u32::from(MAX_PACKET_GAP) + 1,
+            Some(frames) => frames.saturating_add(1).min(32768),
+        };
+        let step = u32::from(restart);
+        let (lost, duplicates, restarts) = match step {
+            0 => (0, 1, 0),
+            1 => (0, 0, 0),
+            _ if step <= limit => (step - 1, 0, 0),
+            _ => (0, 0, 1),
+        };
+        prop_assert_eq!(stats.restarts(), restarts);
+        prop_assert_eq!(stats.duplicate_packets(), duplicates);
+        prop_assert_eq!(stats.lost_packets(), loss_a + loss_b + lost);
+        prop_assert_eq!(stats.frames() as usize, a.len() + b.len());
+    }
+
+    /// Two sequences interleaved in any order, their numbers far apart (as two ESCs' are, or a
+    /// replayed recording's and a live one's): every switch from one to the other is a restart,
+    /// and the loss counted never exceeds the true loss of the two sequences.
+    #[test]
+    fn interleaved_sequences_never_count_more_than_the_true_loss(
+        start in any::<u16>(),
+        apart in 0x2000u16..=0xE000,
+        gaps_a in vec(prop_oneof![3 => Just(0u16), 1 => 0u16..50], 1..40),
+        gaps_b in vec(prop_oneof![3 => Just(0u16), 1 => 0u16..50], 1..40),
+        order in vec(any::<bool>(), 2..80),
+    ) {
+        // Each run spans at most 40 * 50 = 2000 < 0x1000 numbers, so the two stay apart by at
+        // least 0x1000 either way round the counter: no step between them looks like a loss.
+        let a = run(start, &gaps_a);
+        let b = run(start.wrapping_add(apart), &gaps_b);
+        let (mut ia, mut ib) = (0, 0);
+        let mut numbers = Vec::new();
+        let mut from = Vec::new();
+        for &take_a in &order {
+            if take_a && ia < a.len() {
+                numbers.push(a[ia]);
+                from.push(true);
+                ia += 1;
+            } else if ib < b.len() {
+                numbers.push(b[ib]);
+                from.push(false);
+                ib += 1;
+            }
+        }
+        prop_assume!(!numbers.is_empty());
+        let (_, stats) = bulk(&packet_wire(&numbers));
+        let switches = from.windows(2).filter(|w| w[0] != w[1]).count() as u32;
+        let true_loss: u32 = gaps_a[..ia.saturating_sub(1)]
+            .iter()
+            .chain(&gaps_b[..ib.saturating_sub(1)])
+            .map(|&g| u32::from(g))
+            .sum();
+        prop_assert_eq!(stats.restarts(), switches);
+        prop_assert_eq!(stats.duplicate_packets(), 0);
+        prop_assert!(stats.lost_packets() <= true_loss);
+        if switches == 0 {
+            prop_assert_eq!(stats.lost_packets(), true_loss);
+        }
+    }
+
+    /// Silences anywhere in a stream of frames, noise and cut frames, told to the decoder between
+    /// chunks: the same frames and statistics whatever the chunking in between (byte at a time,
+    /// whole stretches, random cuts), and the same as the reference scanner's.
+    #[test]
+    fn line_silent_in_any_chunking(
+        stretches in vec((pieces(6), any::<u32>()), 1..6),
+        steps in vec(prop_oneof![4 => Just(1u16), 2 => 0u16..4, 1 => any::<u16>()], 40),
+        start in any::<u16>(),
+        picks in vec(any::<Index>(), 0..20),
+    ) {
+        // Data frames numbered as a sequence with drops, duplicates and jumps.
+        let mut packet = start;
+        let mut steps = steps.iter().cycle();
+        let mut parts = Vec::new();
+        let mut silences = Vec::new();
+        for (ps, silence) in &stretches {
+            let ps: Vec<Piece> = ps
+                .iter()
+                .cloned()
+                .map(|p| match p {
+                    Piece::Intact(Frame::Data(d)) => {
+                        packet = packet.wrapping_add(*steps.next().unwrap());
+                        Piece::Intact(Frame::Data(DataFrame { packet, ..d }))
+                    }
+                    p => p,
+                })
+                .collect();
+            parts.push(build(&ps).bytes);
+            // Small silences mostly, so that they decide something.
+            silences.push(silence % 8);
+        }
+        silences.pop();
+        let whole = streamed_with_silences(&parts, &silences, Chunks::Whole);
+        let chunked = streamed_with_silences(&parts, &silences, Chunks::At(&picks));
+        prop_assert_eq!(&chunked, &whole);
+        let bytewise = streamed_with_silences(&parts, &silences, Chunks::Bytewise);
+        prop_assert_eq!(&bytewise, &whole);
+        let (ref_decoded, mut ref_stats) = reference_with_silences(&parts, &silences);
+        ref_stats.silent_frames = None;
+        prop_assert_eq!(&whole.0, &ref_decoded);
+        prop_assert_eq!(RefStats::from(&whole.1), ref_stats);
+    }
+}
+
+/// Packet numbers from `start` on, each the previous plus 1 plus the next of `gaps` (frames lost).
+fn run(start: u16, gaps: &[u16]) -> Vec<u16> {
+    let mut n = start;
+    let mut out = vec![n];
+    for &g in gaps {
+        n = n.wrapping_add(1).wrapping_add(g);
+        out.push(n);
+    }
+    out
+}
+
+/// A wire of data frames with these packet numbers.
+fn packet_wire(numbers: &[u16]) -> Vec<u8> {
+    numbers
+        .iter()
+        .flat_map(|&packet| {
+            DataFrame {
+                packet,
+                ..Default::default()
+            }
+            .encode()
+        })
+        .collect()
+}
+
+/// How [`streamed_with_silences`] cuts each part into chunks.
+#[derive(Clone, Copy)]
+enum Chunks<'a> {
+    /// The part in one chunk.
+    Whole,
+    /// One byte at a time.
+    Bytewise,
+    /// Cut at these picks (as [`cut_points`]).
+    At(&'a [Index]),
+}
+
+/// Streams `parts` into a decoder, telling it before each part but the first that the line was
+/// silent (`silences[i - 1]` frames), each part cut into chunks as `chunks` says.
+fn streamed_with_silences(
+    parts: &[Vec<u8>],
+    silences: &[u32],
+    chunks: Chunks<'_>,
+) -> (Vec<Decoded>, LinkStats) {
+    let mut d = Decoder::new();
+    let mut out = Vec::new();
+    for (i, part) in parts.iter().enumerate() {
+        if i > 0 {
+            d.line_silent(silences[i - 1], |x| out.push(x));
+            assert_eq!(d.buffered(), 0);
+        }
+        let cuts: Vec<usize> = match chunks {
+            Chunks::Whole => vec![0, part.len()],
+            Chunks::Bytewise => (0..=part.len()).collect(),
+            Chunks::At(picks) => cut_points(part.len(), picks),
+        };
+        for w in cuts.windows(2) {
+            d.feed(&part[w[0]..w[1]], |x| out.push(x));
+        }
+    }
+    d.flush(|x| out.push(x));
+    (out, *d.stats())
 }

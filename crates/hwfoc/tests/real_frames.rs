@@ -7,6 +7,7 @@
 
 use hwfoc::kinds::data::DATA_FRAME_LEN;
 use hwfoc::kinds::info::INFO_FRAME_LEN;
+use hwfoc::stats::MAX_PACKET_GAP;
 use hwfoc::units::{ADC_MAX, ADC_MIN, ADC_TABLE};
 use hwfoc::wire::sum16;
 use hwfoc::{
@@ -1117,18 +1118,214 @@ fn duplicates_are_not_losses() {
 }
 
 #[test]
-fn backwards_jump_is_neither_loss_nor_duplicate() {
+fn backwards_jump_is_a_restart() {
     let (_, s) = decode(&packets(&[1000, 999]));
-    assert_eq!((s.lost_packets(), s.duplicate_packets()), (0, 0));
+    assert_eq!(
+        (s.lost_packets(), s.duplicate_packets(), s.restarts()),
+        (0, 0, 1)
+    );
     let (_, s) = decode(&packets(&[1000, 5, 6]));
-    assert_eq!((s.lost_packets(), s.duplicate_packets()), (0, 0));
-    // The boundary: a step of 32768 is a loss of 32767, a step of 32769 goes backwards.
+    assert_eq!(
+        (s.lost_packets(), s.duplicate_packets(), s.restarts()),
+        (0, 0, 1)
+    );
+    // Half the counter forwards is still far beyond any loss; one more step goes backwards.
     let (_, s) = decode(&packets(&[0, 0x8000]));
-    assert_eq!(s.lost_packets(), 0x7FFF);
+    assert_eq!((s.lost_packets(), s.restarts()), (0, 1));
     let (_, s) = decode(&packets(&[0, 0x8001]));
-    assert_eq!(s.lost_packets(), 0);
-    assert_eq!(s.duplicate_packets(), 0);
+    assert_eq!(
+        (s.lost_packets(), s.duplicate_packets(), s.restarts()),
+        (0, 0, 1)
+    );
     assert_eq!(s.last_packet(), Some(0x8001));
+}
+
+/// The issue's report: a simulator restarted on the same port after 110 frames, its numbers
+/// starting again where a fresh run of it starts, counted 25727 lost packets (delivery 2.14 %
+/// over the 12 frames, and worse with every restart).
+#[test]
+fn restarted_sequence_is_a_restart_not_a_loss() {
+    let mut numbers: Vec<u16> = (100..=110).collect();
+    numbers.extend(25838..25848);
+    let (_, s) = decode(&packets(&numbers));
+    assert_eq!(s.frames(), 21);
+    assert_eq!(s.restarts(), 1);
+    assert_eq!(s.lost_packets(), 0);
+    assert_eq!(s.delivery_ratio(), Some(1.0));
+    // The sequence continues from the new number: a loss after the restart is counted.
+    numbers.extend([25849, 25850]);
+    let (_, s) = decode(&packets(&numbers));
+    assert_eq!((s.restarts(), s.lost_packets()), (1, 1));
+}
+
+#[test]
+fn largest_gap_counted_as_loss_is_max_packet_gap() {
+    let gap = MAX_PACKET_GAP;
+    let (_, s) = decode(&packets(&[7, 8 + gap]));
+    assert_eq!((s.lost_packets(), s.restarts()), (u32::from(gap), 0));
+    let (_, s) = decode(&packets(&[7, 9 + gap]));
+    assert_eq!((s.lost_packets(), s.restarts()), (0, 1));
+    // Across the wrap of the counter alike.
+    let (_, s) = decode(&packets(&[65535 - 3, gap - 3]));
+    assert_eq!((s.lost_packets(), s.restarts()), (u32::from(gap), 0));
+    let (_, s) = decode(&packets(&[65535 - 3, gap - 2]));
+    assert_eq!((s.lost_packets(), s.restarts()), (0, 1));
+}
+
+/// Two ESCs' sequences on one wire (or a recording replayed into a live one): each switch from
+/// one to the other is a restart. Counted as losses, every switch forwards added thousands and
+/// the count ran up to 4294967295.
+#[test]
+fn interleaved_sequences_count_restarts_not_losses() {
+    let numbers: Vec<u16> = (0..2000u16)
+        .map(|i| {
+            if i % 2 == 0 {
+                100 + i / 2
+            } else {
+                20000 + i / 2
+            }
+        })
+        .collect();
+    let (_, s) = decode(&packets(&numbers));
+    assert_eq!(s.frames(), 2000);
+    assert_eq!(s.lost_packets(), 0);
+    assert_eq!(s.restarts(), 1999);
+    assert_eq!(s.delivery_ratio(), Some(1.0));
+}
+
+/// Decodes `parts` one byte at a time and in whole parts, telling the decoder before each part
+/// but the first that the line was silent for `silences[i]` frames; both ways must agree.
+fn decode_with_silences(parts: &[Vec<u8>], silences: &[u32]) -> (Vec<Decoded>, LinkStats) {
+    let mut results = Vec::new();
+    for bytewise in [false, true] {
+        let mut d = Decoder::new();
+        let mut out = Vec::new();
+        for (i, part) in parts.iter().enumerate() {
+            if i > 0 {
+                d.line_silent(silences[i - 1], |x| out.push(x));
+            }
+            if bytewise {
+                for &b in part {
+                    d.push(b, |x| out.push(x));
+                }
+            } else {
+                d.feed(part, |x| out.push(x));
+            }
+        }
+        d.flush(|x| out.push(x));
+        results.push((out, *d.stats()));
+    }
+    assert_eq!(results[0], results[1], "bulk and bytewise differ");
+    results.pop().unwrap()
+}
+
+/// The issue's case on a timed source: an ESC rebooted within a second and came back 536 packet
+/// numbers on. Without the silence the step is a plausible loss of 535; with it, a restart.
+#[test]
+fn silence_turns_an_implausible_gap_into_a_restart() {
+    let before = packets(&[65000, 65001]);
+    let after = packets(&[1, 2, 5]);
+    let (_, s) = decode(&[before.clone(), after.clone()].concat());
+    assert_eq!((s.lost_packets(), s.restarts()), (535 + 2, 0));
+    // 1.5 s of silence: at most 120 frames (24 byte times each) could have been sent.
+    let (decoded, s) = decode_with_silences(&[before.clone(), after.clone()], &[120]);
+    assert_eq!(decoded.len(), 5);
+    assert_eq!((s.lost_packets(), s.restarts()), (2, 1));
+    // The allowance is exact: a step of max_frames + 1 is a loss, one more a restart.
+    let (_, s) = decode_with_silences(&[before.clone(), after.clone()], &[534]);
+    assert_eq!((s.lost_packets(), s.restarts()), (2, 1));
+    let (_, s) = decode_with_silences(&[before.clone(), after.clone()], &[535]);
+    assert_eq!((s.lost_packets(), s.restarts()), (535 + 2, 0));
+    // A silence longer than MAX_PACKET_GAP frames makes a longer gap a loss (a link unplugged
+    // for two minutes), but never a step backwards.
+    let far = packets(&[(65001 + 2400) as u16]);
+    let (_, s) = decode_with_silences(&[before.clone(), far.clone()], &[9600]);
+    assert_eq!((s.lost_packets(), s.restarts()), (2399, 0));
+    let (_, s) = decode(&[before.clone(), far].concat());
+    assert_eq!((s.lost_packets(), s.restarts()), (0, 1));
+    let back = packets(&[65001 - 10]);
+    let (_, s) = decode_with_silences(&[before.clone(), back], &[u32::MAX]);
+    assert_eq!((s.lost_packets(), s.restarts()), (0, 1));
+    // The largest allowance: 32767 lost frames; a step of 32769 goes backwards.
+    let half = packets(&[65001u16.wrapping_add(0x8000)]);
+    let (_, s) = decode_with_silences(&[before.clone(), half], &[u32::MAX]);
+    assert_eq!((s.lost_packets(), s.restarts()), (0x7FFF, 0));
+    let past = packets(&[65001u16.wrapping_add(0x8001)]);
+    let (_, s) = decode_with_silences(&[before.clone(), past], &[u32::MAX]);
+    assert_eq!((s.lost_packets(), s.restarts()), (0, 1));
+}
+
+#[test]
+fn silence_allows_only_the_next_data_frame() {
+    let info = info_bytes();
+    // No frame at all in the silence: the next frame's step must be 1.
+    let (_, s) = decode_with_silences(&[packets(&[10]), packets(&[11, 13])], &[0]);
+    assert_eq!((s.lost_packets(), s.restarts()), (1, 0));
+    let (_, s) = decode_with_silences(&[packets(&[10]), packets(&[12, 14])], &[0]);
+    assert_eq!((s.lost_packets(), s.restarts()), (1, 1));
+    // A duplicate after the silence is still a duplicate, and uses up the allowance.
+    let (_, s) = decode_with_silences(&[packets(&[10]), packets(&[10, 1000])], &[0]);
+    assert_eq!(
+        (s.duplicate_packets(), s.lost_packets(), s.restarts()),
+        (1, 989, 0)
+    );
+    // Info frames, noise and corrupted frames in between do not use it up.
+    let second = cat(&[
+        &info,
+        &[0x00, 0x9B, 0x16],
+        &CORRUPT_STATUS,
+        &packets(&[300]),
+    ]);
+    let (_, s) = decode_with_silences(&[packets(&[10]), second.clone()], &[5]);
+    assert_eq!((s.lost_packets(), s.restarts(), s.info_frames()), (0, 1, 1));
+    // Silences before one data frame add up: 3 + 4 + 0 frames allow a step of 8.
+    let parts = [
+        packets(&[10]),
+        info.to_vec(),
+        info.to_vec(),
+        packets(&[18, 30]),
+    ];
+    let (_, s) = decode_with_silences(&parts, &[3, 4, 0]);
+    assert_eq!((s.lost_packets(), s.restarts()), (7 + 11, 0));
+    let parts = [
+        packets(&[10]),
+        info.to_vec(),
+        info.to_vec(),
+        packets(&[19, 30]),
+    ];
+    let (_, s) = decode_with_silences(&parts, &[3, 4, 0]);
+    assert_eq!((s.lost_packets(), s.restarts()), (10, 1));
+    // Before the first data frame there is no step to judge.
+    let (_, s) = decode_with_silences(&[info.to_vec(), packets(&[40000, 40002])], &[0]);
+    assert_eq!((s.lost_packets(), s.restarts(), s.frames()), (1, 0, 2));
+}
+
+/// A silence ends the frame that was arriving: its bytes are decided at once (a cut data frame
+/// is dropped), and the frames an unfinished device-information candidate hid are given before
+/// the allowance is used, so that it goes to the first frame after the silence.
+#[test]
+fn silence_decides_the_held_bytes_first() {
+    let frame = packets(&[10]);
+    // A cut frame, then the silence: later bytes do not finish it.
+    let parts = [frame[..10].to_vec(), frame[10..].to_vec()];
+    let (decoded, s) = decode_with_silences(&parts, &[0]);
+    assert!(decoded.is_empty());
+    assert_eq!(s.bytes_skipped(), 24);
+    // A fake info header holds a whole data frame until 77 bytes are there; the silence gives it
+    // before the allowance applies, so 11 is the next frame, and 2000 (step 1989) a restart.
+    let first = cat(&[&[0x9B, 0x4C], &packets(&[10, 11])]);
+    let (decoded, s) = decode_with_silences(&[first, packets(&[2000])], &[0]);
+    assert_eq!(data_frames(&decoded), [(2, 10), (26, 11), (50, 2000)]);
+    assert_eq!(
+        (s.lost_packets(), s.restarts(), s.checksum_failures()),
+        (0, 1, 0)
+    );
+    let mut d = Decoder::new();
+    let mut got = Vec::new();
+    d.feed(&cat(&[&[0x9B, 0x4C], &packets(&[10, 11])]), |x| got.push(x));
+    assert_eq!((got.len(), d.buffered()), (0, 50));
+    d.line_silent(7, |x| got.push(x));
+    assert_eq!((got.len(), d.buffered()), (2, 0));
 }
 
 #[test]
@@ -1174,7 +1371,88 @@ fn settings_new_rejects_zero_negative_and_non_finite() {
         Err(SettingsError::GearRatio(v)) if v.is_nan()
     ));
     assert_eq!(Settings::new(64.0, 0, 1.0), Err(SettingsError::PolePairs));
-    assert!(!SettingsError::PolePairs.to_string().is_empty());
+}
+
+/// The issue: `--current-scale 1e-38` made every current infinite. Values whose conversions
+/// cannot be represented are refused, up to the bounds and not one step beyond.
+#[test]
+fn settings_new_refuses_values_that_cannot_be_represented() {
+    let (scale_min, scale_max) = (Settings::CURRENT_SCALE_MIN, Settings::CURRENT_SCALE_MAX);
+    let (ratio_min, ratio_max) = (Settings::GEAR_RATIO_MIN, Settings::GEAR_RATIO_MAX);
+    assert_eq!(
+        (scale_min, scale_max, ratio_min, ratio_max),
+        (1e-34, 1e37, 1e-28, 1e33)
+    );
+    for bad in [
+        1e-38,
+        f32::MIN_POSITIVE,
+        f32::MAX,
+        scale_min.next_down(),
+        scale_max.next_up(),
+    ] {
+        assert_eq!(
+            Settings::new(bad, 7, 1.0),
+            Err(SettingsError::CurrentScale(bad))
+        );
+    }
+    for bad in [3e-38, f32::MAX, ratio_min.next_down(), ratio_max.next_up()] {
+        assert_eq!(
+            Settings::new(64.0, 7, bad),
+            Err(SettingsError::GearRatio(bad))
+        );
+    }
+    for scale in [scale_min, scale_max] {
+        for ratio in [ratio_min, ratio_max] {
+            for poles in [1, u16::MAX] {
+                let s = Settings::new(scale, poles, ratio).unwrap();
+                assert_eq!(
+                    (s.current_scale, s.pole_pairs, s.gear_ratio),
+                    (scale, poles, ratio)
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn settings_error_messages_give_the_range() {
+    let message = |scale, poles, ratio| Settings::new(scale, poles, ratio).unwrap_err().to_string();
+    assert_eq!(
+        message(1e-38, 7, 1.0),
+        "current scale must be from 1e-34 to 1e37, not 1e-38"
+    );
+    assert_eq!(
+        message(-64.0, 7, 1.0),
+        "current scale must be from 1e-34 to 1e37, not -64"
+    );
+    assert_eq!(
+        message(f32::INFINITY, 7, 1.0),
+        "current scale must be from 1e-34 to 1e37, not inf"
+    );
+    assert_eq!(
+        message(f32::NAN, 7, 1.0),
+        "current scale must be from 1e-34 to 1e37, not NaN"
+    );
+    assert_eq!(
+        message(64.0, 0, 1.0),
+        "pole pairs must be at least 1, not 0"
+    );
+    assert_eq!(
+        message(64.0, 7, 0.0),
+        "gear ratio must be from 1e-28 to 1e33, not 0"
+    );
+    assert_eq!(
+        message(64.0, 7, 2e33),
+        "gear ratio must be from 1e-28 to 1e33, not 2e33"
+    );
+    assert_eq!(
+        message(64.0, 7, -0.0001),
+        "gear ratio must be from 1e-28 to 1e33, not -0.0001"
+    );
+    assert_eq!(
+        message(64.0, 7, -2.5),
+        "gear ratio must be from 1e-28 to 1e33, not -2.5"
+    );
 }
 
 #[test]
@@ -1187,7 +1465,6 @@ fn settings_new_accepts_sensible_values() {
     assert_eq!(s.gear_ratio, 0.5);
     assert_eq!(s.amps(-250), -2.5);
     assert_eq!(s.rpm_from_erpm(60000), 10000.0);
-    assert!(Settings::new(f32::MIN_POSITIVE, 1, f32::MAX).is_ok());
 }
 
 /// A device-information candidate with a correct check byte but a byte that is not ASCII in its
@@ -1252,4 +1529,232 @@ fn frame_error_messages() {
     for (error, text) in cases {
         assert_eq!(error.to_string(), text);
     }
+}
+
+#[test]
+fn link_stats_display_names_every_counter() {
+    let info = info_bytes();
+    let stream = cat(&[
+        &[0x00],
+        &packets(&[10, 10, 13]),
+        &info,
+        &CORRUPT_STATUS,
+        &packets(&[5000, 5001]),
+    ]);
+    let (_, s) = decode(&stream);
+    assert_eq!(
+        s.to_string(),
+        "222 bytes, 5 frames, 1 info frames, 1 checksum failures, 25 bytes skipped, \
+         2 lost packets, 1 duplicate packets, 1 restarts"
+    );
+}
+
+// ---------------------------------------------------------------------------------------------
+// Behaviour that mutation testing found untested
+// ---------------------------------------------------------------------------------------------
+
+/// `bytes` with its check bytes rewritten to match (a 24-byte data frame or a 77-byte info frame).
+fn resealed(mut bytes: Vec<u8>) -> Vec<u8> {
+    let n = bytes.len();
+    if n == DATA_FRAME_LEN {
+        let sum = sum16(&bytes[..22]).to_le_bytes();
+        bytes[22..].copy_from_slice(&sum);
+    } else {
+        bytes[76] = sum16(&bytes[..76]) as u8;
+    }
+    bytes
+}
+
+/// A frame whose check bytes are right but whose version or command is not its kind's is refused
+/// by every path (`parse`, the kind's own `parse`, the scanner), whichever of the two is wrong.
+#[test]
+fn valid_check_bytes_with_another_version_or_command_are_refused() {
+    for (version, command) in [
+        (0x02, 0x01),
+        (0x00, 0x01),
+        (0x01, 0x02),
+        (0x01, 0x81),
+        (0x02, 0x02),
+    ] {
+        let mut bytes = info_bytes().to_vec();
+        bytes[2] = version;
+        bytes[3] = command;
+        let bytes = resealed(bytes);
+        let error = FrameError::UnknownCommand { version, command };
+        assert_eq!(
+            InfoFrame::parse(&bytes),
+            Err(error),
+            "info {version:02X} {command:02X}"
+        );
+        assert_eq!(parse(&bytes), Err(error));
+        let (decoded, stats) = decode(&bytes);
+        assert!(decoded.is_empty());
+        assert_eq!(stats.checksum_failures(), 1);
+    }
+    for (version, command) in [
+        (0x02, 0x02),
+        (0x00, 0x02),
+        (0x01, 0x01),
+        (0x01, 0x0A),
+        (0x03, 0x03),
+    ] {
+        let mut bytes = EXAMPLE.to_vec();
+        bytes[2] = version;
+        bytes[3] = command;
+        let bytes = resealed(bytes);
+        let error = FrameError::UnknownCommand { version, command };
+        assert_eq!(
+            DataFrame::parse(&bytes),
+            Err(error),
+            "data {version:02X} {command:02X}"
+        );
+        assert_eq!(parse(&bytes), Err(error));
+        let (decoded, stats) = decode(&bytes);
+        assert!(decoded.is_empty());
+        assert_eq!(stats.checksum_failures(), 1);
+    }
+}
+
+/// The data frame's one-branch check compares the header and the sum at once; a candidate whose
+/// sync or length byte differs from the data frame's by some bits, and whose carried sum differs
+/// from the payload's by the same bits, must still be refused (XOR-ing the two differences
+/// would cancel them out). The scanner meets such candidates at every `9B 4C` (its length byte
+/// differs from the data frame's by 0x5A) and, right after a frame, at any byte.
+#[test]
+fn header_and_sum_differing_by_the_same_bits_are_refused() {
+    let payload = &EXAMPLE[4..22];
+    let header_sum = sum16(&EXAMPLE[..4]);
+    let payload_sum = sum16(payload);
+    let frame = DataFrame::parse(&EXAMPLE).unwrap();
+    for (at, right) in [(0, 0x9B), (1, 0x16)] {
+        for b in (0..=255u8).filter(|&b| b != right) {
+            let mut header = [0x9B, 0x16, 0x01, 0x02];
+            header[at] = b;
+            let diff = u16::from(b ^ right) << (8 * at);
+            let carried = (header_sum.wrapping_add(payload_sum) ^ diff).to_le_bytes();
+            let candidate = cat(&[&header, payload, &carried]);
+            assert!(
+                !matches!(parse(&candidate), Ok(Parsed::Complete(..))),
+                "{candidate:02X?}"
+            );
+            assert!(DataFrame::parse(&candidate).is_err());
+            // Alone (the candidate is found only at a `9B 16` or `9B 4C`)...
+            let (decoded, _) = decode(&candidate);
+            assert!(decoded.is_empty(), "{candidate:02X?}");
+            // ... and right after a frame, where the scanner tries a data frame first.
+            let (decoded, _) = decode(&cat(&[&EXAMPLE, &candidate]));
+            assert_eq!(decoded.len(), 1, "{candidate:02X?}");
+            assert_eq!(decoded[0].frame, Frame::Data(frame));
+        }
+    }
+}
+
+/// A flag set twice is set (not toggled back off), by `with` and by collecting.
+#[test]
+fn a_flag_set_twice_stays_set() {
+    for fault in Fault::ALL {
+        let once = Status::OK.with(fault);
+        assert_eq!(once.with(fault), once);
+        assert_eq!([fault, fault].into_iter().collect::<Status>(), once);
+        assert_eq!([fault, fault, fault].into_iter().collect::<Status>(), once);
+        let other = Fault::from_bit((fault.bit() + 5) % 16).unwrap();
+        let both = Status(fault.mask() | other.mask());
+        assert_eq!(both.with(fault), both);
+        assert_eq!([fault, other, fault].into_iter().collect::<Status>(), both);
+        assert_eq!(both.faults().len(), 2);
+        assert_eq!(both.into_iter().count(), 2);
+    }
+    assert_eq!(std::iter::empty::<Fault>().collect::<Status>(), Status::OK);
+    assert!(Status::OK.is_ok());
+    assert_eq!(Status::from(0x1040), Status(0x1040));
+}
+
+/// Throttle percentages of a running frame, input and output told apart.
+#[test]
+fn throttle_percentages_of_a_running_frame() {
+    let f = DataFrame::parse(&BRAKING).unwrap();
+    assert_eq!((f.throttle_in_raw, f.throttle_out_raw), (167, 167));
+    assert_eq!(f.throttle_in_pct(), 16.308594);
+    assert_eq!(f.throttle_out_pct(), 16.308594);
+    assert_eq!(f.erpm(), 25630);
+    let f = DataFrame {
+        throttle_in_raw: 1024,
+        throttle_out_raw: 512,
+        ..Default::default()
+    };
+    assert_eq!((f.throttle_in_pct(), f.throttle_out_pct()), (100.0, 50.0));
+    let f = DataFrame {
+        throttle_in_raw: 1,
+        throttle_out_raw: 256,
+        ..Default::default()
+    };
+    assert_eq!(
+        (f.throttle_in_pct(), f.throttle_out_pct()),
+        (0.09765625, 25.0)
+    );
+}
+
+/// Every flag's description, as in PROTOCOL-NOTES.md's status table.
+#[test]
+fn fault_descriptions() {
+    let descriptions: Vec<&str> = Fault::ALL.iter().map(|f| f.description()).collect();
+    assert_eq!(
+        descriptions,
+        [
+            "input voltage is too high",
+            "input voltage is too low",
+            "over current",
+            "not assigned (bit 3)",
+            "the throttle signal is lost",
+            "the throttle is not returned to zero",
+            "MOSFET overheat",
+            "capacitor overheat",
+            "motor is blocked",
+            "open circuit of upper bridge (MOSFET)",
+            "MOSFET short circuit",
+            "open circuit of lower bridge (MOSFET)",
+            "operational amplifier abnormal, phase C",
+            "operational amplifier abnormal, phase B",
+            "operational amplifier abnormal, phase A",
+            "not assigned (bit 15)",
+        ]
+    );
+}
+
+#[test]
+fn display_texts() {
+    assert_eq!(Temperature::from_adc(0xCE).to_string(), "28 degC");
+    assert_eq!(Temperature::from_adc(225).to_string(), "15.5 degC");
+    assert_eq!(
+        Temperature::BelowRange.to_string(),
+        "below 0 degC (out of range)"
+    );
+    assert_eq!(
+        Temperature::AboveRange.to_string(),
+        "above 129 degC (out of range)"
+    );
+    assert_eq!(
+        InfoFieldError::TooLong {
+            field: "product",
+            max: 16,
+            len: 17
+        }
+        .to_string(),
+        "product is 17 bytes long; the field holds 16"
+    );
+    assert_eq!(
+        InfoFieldError::NotAscii { field: "firmware" }.to_string(),
+        "firmware is not ASCII text"
+    );
+    let info = InfoFrame::parse(&info_bytes()).unwrap();
+    assert_eq!(
+        format!("{info:?}"),
+        "InfoFrame { product: \"XR_FOC_ESC\", hardware: \"HW577_KZ1_V1.1\", \
+         firmware: \"XR-01.0.00\", id: \"01040443\" }"
+    );
+    assert_eq!(InfoFrame::new("", "", "", "").unwrap().to_string(), "");
+    assert_eq!(
+        InfoFrame::new("A", "", "B", "C").unwrap().to_string(),
+        "A B C"
+    );
 }

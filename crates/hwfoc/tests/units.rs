@@ -14,7 +14,19 @@ fn settings() -> Vec<Settings> {
         (17.3, 3, 0.37),
         (1e-3, 65_535, 1e3),
         (12_345.678, 1, 1e-7),
-        (f32::MAX, 2, 3.0e-38),
+        // The bounds of Settings::new, both ways round.
+        (Settings::CURRENT_SCALE_MIN, 1, Settings::GEAR_RATIO_MIN),
+        (
+            Settings::CURRENT_SCALE_MAX,
+            65_535,
+            Settings::GEAR_RATIO_MAX,
+        ),
+        (
+            Settings::CURRENT_SCALE_MIN,
+            65_535,
+            Settings::GEAR_RATIO_MAX,
+        ),
+        (Settings::CURRENT_SCALE_MAX, 1, Settings::GEAR_RATIO_MIN),
     ]
     .into_iter()
     .map(|(scale, poles, gear)| Settings::new(scale, poles, gear).unwrap())
@@ -132,5 +144,94 @@ fn names_and_units_are_the_record_schema() {
             ("current_a", "A"),
             ("phase_current_a", "A"),
         ]
+    );
+}
+
+/// A finite value, nonzero (and normal: full precision) unless `raw` is 0.
+fn representable(value: f32, raw: f64) -> bool {
+    value.is_finite() && (raw == 0.0) == (value == 0.0) && (raw == 0.0 || value.is_normal())
+}
+
+/// The issue: `--current-scale 1e-38` made currents infinite. Under the settings at the bounds
+/// of `Settings::new` (each combination of the extremes), every raw value of every field converts
+/// to a finite number, nonzero and normal when the raw value is, in `f32` and in `f64`.
+#[test]
+fn every_raw_value_is_representable_at_the_bounds() {
+    let scales = [Settings::CURRENT_SCALE_MIN, Settings::CURRENT_SCALE_MAX];
+    let ratios = [Settings::GEAR_RATIO_MIN, Settings::GEAR_RATIO_MAX];
+    for scale in scales {
+        for ratio in ratios {
+            for poles in [1, 2, 7, 1000, 65_535] {
+                let s = Settings::new(scale, poles, ratio).unwrap();
+                for q in Quantity::ALL {
+                    for bits in 0..=u16::MAX {
+                        let f = frame_with(q, bits);
+                        let raw = f.raw(q);
+                        let value = f.value(q, &s);
+                        assert!(
+                            representable(value, raw.into()),
+                            "{q:?} {raw} {s:?}: {value}"
+                        );
+                        let wide = q.linear(&s).to_f64(raw.into());
+                        assert!(
+                            wide.is_finite() && (raw == 0) == (wide == 0.0),
+                            "{q:?} {raw}"
+                        );
+                    }
+                }
+                // rpm_from_erpm takes any u32 eRPM: its extremes.
+                for erpm in [1, 655_350, u32::MAX] {
+                    let rpm = s.rpm_from_erpm(erpm);
+                    assert!(representable(rpm, erpm.into()), "{erpm} {s:?}: {rpm}");
+                }
+            }
+            // Every number of pole pairs, at the extreme raw values (the RPM is monotonic in
+            // both the raw value and the divisor).
+            for poles in 1..=u16::MAX {
+                let s = Settings::new(scale, poles, ratio).unwrap();
+                for erpm_raw in [1, u16::MAX] {
+                    let f = DataFrame {
+                        erpm_raw,
+                        ..Default::default()
+                    };
+                    assert!(
+                        representable(f.rpm(&s), erpm_raw.into()),
+                        "{erpm_raw} {s:?}"
+                    );
+                }
+                for erpm in [1, u32::MAX] {
+                    assert!(
+                        representable(s.rpm_from_erpm(erpm), erpm.into()),
+                        "{erpm} {s:?}"
+                    );
+                }
+            }
+        }
+    }
+}
+
+/// The bounds are the tightest powers of ten: ten times further out, some raw value converts to
+/// infinity or loses its precision (or becomes 0).
+#[test]
+fn bounds_are_the_tightest_powers_of_ten() {
+    let unchecked = |current_scale, pole_pairs, gear_ratio| Settings {
+        current_scale,
+        pole_pairs,
+        gear_ratio,
+    };
+    let s = unchecked(Settings::CURRENT_SCALE_MIN / 10.0, 7, 1.0);
+    assert_eq!(s.amps(i16::MIN), f32::NEG_INFINITY);
+    let s = unchecked(Settings::CURRENT_SCALE_MAX * 10.0, 7, 1.0);
+    assert!(!s.amps(1).is_normal());
+    let s = unchecked(64.0, 1, Settings::GEAR_RATIO_MIN / 10.0);
+    assert_eq!(s.rpm_from_erpm(u32::MAX), f32::INFINITY);
+    let s = unchecked(64.0, u16::MAX, Settings::GEAR_RATIO_MAX * 10.0);
+    assert_eq!(
+        DataFrame {
+            erpm_raw: u16::MAX,
+            ..Default::default()
+        }
+        .rpm(&s),
+        0.0
     );
 }
