@@ -24,6 +24,18 @@ pub fn byte_times(t_ns: u64, per_byte_ns: f64, n: usize, times: &mut Vec<f64>) {
 /// the longest frame (77 bytes), so its first byte is never further back than this.
 const TIME_HISTORY: usize = hwfoc::frame::MAX_FRAME_LEN;
 
+/// A silence of the line longer than this, between two bytes, may hide a restart of the ESC:
+/// the decoder is told of it (see [`hwfoc::Decoder::line_silent`]). Real ESCs send a frame at
+/// least every 364 ms (idle), and a read may return a little late.
+pub const SILENCE_S: f64 = 1.0;
+
+/// The most data frames a silence of `seconds` can have hidden: one per 24 byte times, the
+/// fastest the line carries them (real ESCs send one every 50 ms at most).
+fn frames_in(seconds: f64) -> u32 {
+    let frame_s = 24.0 * hwfoc::wire::byte_ns(hwfoc::wire::BAUD_RATE) * 1e-9;
+    (seconds / frame_s).ceil().min(f64::from(u32::MAX)) as u32
+}
+
 /// A [`Decoder`] that also gives each frame the receive time of its first byte.
 #[derive(Debug, Default)]
 pub struct Stream {
@@ -48,7 +60,27 @@ impl Stream {
             }
             Some(times) => {
                 let history = &self.history;
-                self.decoder.feed(batch.bytes, |d| {
+                let decoder = &mut self.decoder;
+                // The batch in pieces at each silence of the line: the decoder is told how many
+                // frames the silence could have hidden, so that an ESC that restarted in it is
+                // counted as a restart, not as thousands of lost packets.
+                let mut from = 0;
+                let mut last = history.last().copied();
+                for (i, &t) in times.iter().enumerate() {
+                    if let Some(before) = last
+                        && t - before > SILENCE_S
+                    {
+                        decoder.feed(&batch.bytes[from..i], |d| {
+                            on_frame(Some(time_at(history, times, start, d.offset)), &d)
+                        });
+                        decoder.line_silent(frames_in(t - before), |d| {
+                            on_frame(Some(time_at(history, times, start, d.offset)), &d)
+                        });
+                        from = i;
+                    }
+                    last = Some(t);
+                }
+                decoder.feed(&batch.bytes[from..], |d| {
                     on_frame(Some(time_at(history, times, start, d.offset)), &d)
                 });
                 let keep = TIME_HISTORY.min(self.history.len() + times.len());
@@ -181,5 +213,62 @@ mod tests {
             stream.finish(|t, _| got.push(t.unwrap()));
             assert_eq!(got, expected, "batches of {batch}");
         }
+    }
+
+    /// Frames `packets`, each 50 ms after the last from `t0`, their bytes timed as on the wire.
+    fn timed(packets: &[u16], t0: f64) -> (Vec<u8>, Vec<f64>) {
+        let (mut bytes, mut times) = (Vec::new(), Vec::new());
+        for (k, &packet) in packets.iter().enumerate() {
+            let f = DataFrame {
+                packet,
+                ..Default::default()
+            }
+            .encode();
+            for (j, &b) in f.iter().enumerate() {
+                bytes.push(b);
+                times.push(t0 + k as f64 * 0.05 + j as f64 / 1920.0);
+            }
+        }
+        (bytes, times)
+    }
+
+    /// The statistics of a stream fed `parts`, each a batch, in batches of `chunk` bytes.
+    fn run(parts: &[(Vec<u8>, Vec<f64>)], chunk: usize) -> LinkStats {
+        let mut stream = Stream::new();
+        for (bytes, times) in parts {
+            for (b, t) in bytes.chunks(chunk).zip(times.chunks(chunk)) {
+                let batch = Batch {
+                    bytes: b,
+                    times: Some(t),
+                    stream: 0,
+                };
+                stream.feed(batch, |_, _| {});
+            }
+        }
+        stream.finish(|_, _| {});
+        *stream.stats()
+    }
+
+    /// An ESC that restarts after a silence counts a restart, not the packets its new numbers
+    /// skip; a silence that only hid frames counts them as lost.
+    #[test]
+    fn a_silence_tells_a_restart_from_a_loss() {
+        let before = timed(&[64_990, 64_991, 64_992], 10.0);
+        // 1.5 s later the ESC counts again 536 numbers on (wrapping): a restart, as at most 120
+        // frames fit in the silence.
+        let restarted = timed(&[65_528, 65_529], 11.6);
+        // 2 s later, 30 numbers on: frames lost in the silence.
+        let resumed = timed(&[23, 24], 13.7);
+        for chunk in [1, 7, 24, 100, 10_000] {
+            let s = run(&[before.clone(), restarted.clone(), resumed.clone()], chunk);
+            assert_eq!(s.frames(), 7, "chunk {chunk}");
+            assert_eq!(s.restarts(), 1, "chunk {chunk}");
+            assert_eq!(s.lost_packets(), 29, "chunk {chunk}");
+        }
+        // The same numbers without the silence: a step of 536 is a loss (the rule for raw
+        // bytes), so the silence is what told the restart.
+        let close = timed(&[65_528, 65_529], 10.2);
+        let s = run(&[before, close], 24);
+        assert_eq!((s.restarts(), s.lost_packets()), (0, 535));
     }
 }

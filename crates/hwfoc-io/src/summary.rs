@@ -479,10 +479,11 @@ impl EscReport<'_> {
         }
         let _ = writeln!(
             o,
-            "link         {} checksum failures, {} lost packets, {} duplicate packets, {} bytes skipped ({:.2} %)",
+            "link         {} checksum failures, {} lost packets, {} duplicate packets, {} restarts, {} bytes skipped ({:.2} %)",
             st.checksum_failures(),
             st.lost_packets(),
             st.duplicate_packets(),
+            st.restarts(),
             st.bytes_skipped(),
             percent(st.bytes_skipped(), st.bytes())
         );
@@ -610,6 +611,7 @@ impl EscReport<'_> {
                 "checksum_failures": st.checksum_failures(),
                 "lost_packets": st.lost_packets(),
                 "duplicate_packets": st.duplicate_packets(),
+                "restarts": st.restarts(),
                 "bytes_skipped": st.bytes_skipped(),
                 "delivery_ratio": st.delivery_ratio(),
             },

@@ -442,11 +442,12 @@ fn draw_detail(frame: &mut Frame, area: Rect, index: usize, esc: &EscView, now: 
         Paragraph::new(vec![
             Line::from(info),
             Line::from(format!(
-                "{cells} · {} frames · {} bytes, {} skipped · {} checksum failures",
+                "{cells} · {} frames · {} bytes, {} skipped · {} checksum failures · {} restarts",
                 stats.frames(),
                 stats.bytes(),
                 stats.bytes_skipped(),
-                stats.checksum_failures()
+                stats.checksum_failures(),
+                stats.restarts()
             ))
             .dark_gray(),
         ]),

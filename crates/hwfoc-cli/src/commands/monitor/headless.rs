@@ -88,7 +88,7 @@ fn status_line(i: usize, esc: &EscView, now: f64) -> String {
             let temp = |t: Option<f32>| t.map_or("-".to_string(), |t| format!("{}C", number(t, 1)));
             line.push_str(&format!(
                 "thr {}/{} % {} rpm {} V {} A (phase {} A) mos {} cap {} | {:.1} fr/s lost {} \
-                 dup {} crc {} | age {:.2} s",
+                 dup {} crc {} restarts {} | age {:.2} s",
                 number(r.throttle_in_pct, 1),
                 number(r.throttle_out_pct, 1),
                 number(r.rpm, 0),
@@ -101,6 +101,7 @@ fn status_line(i: usize, esc: &EscView, now: f64) -> String {
                 esc.stats.lost_packets(),
                 esc.stats.duplicate_packets(),
                 esc.stats.checksum_failures(),
+                esc.stats.restarts(),
                 esc.age(now).unwrap_or(0.0),
             ));
         }
@@ -183,6 +184,7 @@ fn status_json(fleet: &Fleet, i: usize, esc: &EscView, now: f64) -> Value {
         "frames": esc.stats.frames(),
         "lost": esc.stats.lost_packets(),
         "duplicates": esc.stats.duplicate_packets(),
+        "restarts": esc.stats.restarts(),
         "checksum_failures": esc.stats.checksum_failures(),
         "bytes": esc.stats.bytes(),
         "bytes_skipped": esc.stats.bytes_skipped(),
