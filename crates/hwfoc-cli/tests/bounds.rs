@@ -134,3 +134,19 @@ fn endless_files_are_refused() {
     let o = run(hwfoc().args(["simulate", "--profile", "csv:/dev/zero", "-o", &out]));
     common::assert_fails_with(&o, "cannot open /dev/zero: it is larger than 65536 KiB");
 }
+
+/// Settings whose conversions cannot be represented are refused with their range, by every
+/// command that converts.
+#[test]
+fn settings_out_of_range_are_refused_with_the_range() {
+    for args in [
+        &["simulate", "--current-scale", "1e-38", "-o", "-"][..],
+        &["decode", "--demo", "--current-scale", "1e-38"],
+        &["summary", "--demo", "--gear-ratio", "1e-30"],
+    ] {
+        let o = run(hwfoc().args(args));
+        common::assert_fails_with(&o, "invalid setting:");
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(err.contains(" from ") && err.contains(" to "), "{err}");
+    }
+}
