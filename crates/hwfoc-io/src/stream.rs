@@ -44,13 +44,19 @@ impl Stream {
         match batch.times {
             None => {
                 self.history.clear();
-                self.decoder.feed(batch.bytes, |d| on_frame(None, &d));
+                self.decoder.feed(
+                    batch.bytes,
+                    #[inline(always)]
+                    |d| on_frame(None, &d),
+                );
             }
             Some(times) => {
                 let history = &self.history;
-                self.decoder.feed(batch.bytes, |d| {
-                    on_frame(Some(time_at(history, times, start, d.offset)), &d)
-                });
+                self.decoder.feed(
+                    batch.bytes,
+                    #[inline(always)]
+                    |d| on_frame(Some(time_at(history, times, start, d.offset)), &d),
+                );
                 let keep = TIME_HISTORY.min(self.history.len() + times.len());
                 let from_times = keep.min(times.len());
                 let from_history = keep - from_times;
@@ -66,10 +72,13 @@ impl Stream {
         let end = self.decoder.stats().bytes();
         let history = &self.history;
         let timed = !history.is_empty();
-        self.decoder.flush(|d| {
-            let t = timed.then(|| time_at(history, &[], end, d.offset));
-            on_frame(t, &d)
-        });
+        self.decoder.flush(
+            #[inline(always)]
+            |d| {
+                let t = timed.then(|| time_at(history, &[], end, d.offset));
+                on_frame(t, &d)
+            },
+        );
     }
 
     /// The link statistics so far.
