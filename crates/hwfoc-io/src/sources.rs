@@ -162,9 +162,10 @@ impl Sources {
         // Every stream has an index below 256 (checked when it was made).
         let id = u8::try_from(esc).unwrap_or(u8::MAX);
         let settings = &self.settings;
-        self.escs[esc]
-            .stream
-            .finish(|t, d| handler.frame(id, t, d, settings));
+        self.escs[esc].stream.finish(
+            #[inline(always)]
+            |t, d| handler.frame(id, t, d, settings),
+        );
     }
 
     /// The ESC of stream `stream` of `input` (number `index`), made when first seen; `escs`
@@ -240,9 +241,13 @@ impl Sources {
             };
             let id = u8::try_from(esc).unwrap_or(u8::MAX);
             let settings = &self.settings;
-            self.escs[esc]
-                .stream
-                .feed(batch, |t, d| handler.frame(id, t, d, settings));
+            // Inlined into the decoder's loop, so that the handler may be too: a frame's fields
+            // then reach it in registers, not through a `Decoded` stored and loaded back.
+            self.escs[esc].stream.feed(
+                batch,
+                #[inline(always)]
+                |t, d| handler.frame(id, t, d, settings),
+            );
             handler.end_batch(len < LIVE_BATCH)?;
         }
     }

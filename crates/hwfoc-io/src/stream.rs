@@ -56,7 +56,11 @@ impl Stream {
         match batch.times {
             None => {
                 self.history.clear();
-                self.decoder.feed(batch.bytes, |d| on_frame(None, &d));
+                self.decoder.feed(
+                    batch.bytes,
+                    #[inline(always)]
+                    |d| on_frame(None, &d),
+                );
             }
             Some(times) => {
                 let history = &self.history;
@@ -70,9 +74,11 @@ impl Stream {
                     if let Some(before) = last
                         && t - before > SILENCE_S
                     {
-                        decoder.feed(&batch.bytes[from..i], |d| {
-                            on_frame(Some(time_at(history, times, start, d.offset)), &d)
-                        });
+                        decoder.feed(
+                            &batch.bytes[from..i],
+                            #[inline(always)]
+                            |d| on_frame(Some(time_at(history, times, start, d.offset)), &d),
+                        );
                         decoder.line_silent(frames_in(t - before), |d| {
                             on_frame(Some(time_at(history, times, start, d.offset)), &d)
                         });
@@ -80,9 +86,11 @@ impl Stream {
                     }
                     last = Some(t);
                 }
-                decoder.feed(&batch.bytes[from..], |d| {
-                    on_frame(Some(time_at(history, times, start, d.offset)), &d)
-                });
+                decoder.feed(
+                    &batch.bytes[from..],
+                    #[inline(always)]
+                    |d| on_frame(Some(time_at(history, times, start, d.offset)), &d),
+                );
                 let keep = TIME_HISTORY.min(self.history.len() + times.len());
                 let from_times = keep.min(times.len());
                 let from_history = keep - from_times;
@@ -98,10 +106,13 @@ impl Stream {
         let end = self.decoder.stats().bytes();
         let history = &self.history;
         let timed = !history.is_empty();
-        self.decoder.flush(|d| {
-            let t = timed.then(|| time_at(history, &[], end, d.offset));
-            on_frame(t, &d)
-        });
+        self.decoder.flush(
+            #[inline(always)]
+            |d| {
+                let t = timed.then(|| time_at(history, &[], end, d.offset));
+                on_frame(t, &d)
+            },
+        );
     }
 
     /// The link statistics so far.

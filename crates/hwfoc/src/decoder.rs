@@ -74,6 +74,8 @@ fn find_header(hay: &[u8]) -> Option<usize> {
 }
 
 /// Finds the next frame in `data` from `*pos`, counting what it passes over in `stats`.
+/// Unless `first_guess` is false (the caller has just tried it), it first tries a frame of the
+/// first kind right at `*pos`.
 ///
 /// Returns the frame and its start offset, with `*pos` just after it. Returns `None` when no
 /// further frame can be decided: `*pos` is then `data.len()`, or, unless `at_end`, the start of
@@ -84,9 +86,10 @@ fn scan_next(
     pos: &mut usize,
     stats: &mut LinkStats,
     at_end: bool,
+    first_guess: bool,
 ) -> Option<(usize, Frame)> {
     // Back-to-back frames, the usual case: a frame of the most frequent kind starts right here.
-    if let Some(found) = Frame::take_first(data, pos, stats) {
+    if first_guess && let Some(found) = Frame::take_first(data, pos, stats) {
         return Some(found);
     }
     loop {
@@ -137,13 +140,24 @@ fn scan_all<const AT_END: bool>(
     on_frame: &mut impl FnMut(Decoded),
 ) -> usize {
     let mut pos = 0;
-    while let Some((at, frame)) = scan_next(data, &mut pos, stats, AT_END) {
+    loop {
+        // Back-to-back frames of the first kind have a call site of their own, where the frame
+        // built is known to be of that kind: only its fields are written, not the bytes of the
+        // largest kind that a merged call site would copy for every frame.
+        while let Some((at, frame)) = Frame::take_first(data, &mut pos, stats) {
+            on_frame(Decoded {
+                offset: base + at as u64,
+                frame,
+            });
+        }
+        let Some((at, frame)) = scan_next(data, &mut pos, stats, AT_END, false) else {
+            return pos;
+        };
         on_frame(Decoded {
             offset: base + at as u64,
             frame,
         });
     }
-    pos
 }
 
 /// A streaming decoder: feed it bytes in any chunking, get every frame once.
@@ -386,9 +400,11 @@ impl Iterator for Frames<'_> {
 
     #[inline]
     fn next(&mut self) -> Option<Decoded> {
-        scan_next(self.data, &mut self.pos, &mut self.stats, true).map(|(at, frame)| Decoded {
-            offset: at as u64,
-            frame,
+        scan_next(self.data, &mut self.pos, &mut self.stats, true, true).map(|(at, frame)| {
+            Decoded {
+                offset: at as u64,
+                frame,
+            }
         })
     }
 }
