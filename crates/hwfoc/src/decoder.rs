@@ -235,9 +235,10 @@ impl Decoder {
             }
             // Finish the held candidate with the first bytes of `data`. A candidate starting in
             // the held bytes needs at most MAX_FRAME_LEN bytes from its start, so appending that
-            // many decides every one of them whenever `data` is long enough.
+            // many decides every one of them whenever `data` is long enough. (The held bytes
+            // are fewer than MAX_FRAME_LEN: one byte of `tmp` is never used.)
             let take = data.len().min(MAX_FRAME_LEN);
-            let mut tmp = [0u8; 2 * MAX_FRAME_LEN - 1];
+            let mut tmp = [0u8; 2 * MAX_FRAME_LEN];
             tmp[..held].copy_from_slice(&self.buf[..held]);
             tmp[held..held + take].copy_from_slice(&data[..take]);
             let n = held + take;

@@ -58,7 +58,7 @@ enum Bytes {
 
 impl ByteCounts {
     const fn get(&self, which: Bytes) -> u64 {
-        self.low[which as usize] as u64 | (self.high[which as usize] as u64) << 32
+        self.low[which as usize] as u64 + ((self.high[which as usize] as u64) << 32)
     }
 
     #[inline]
@@ -237,7 +237,7 @@ impl LinkStats {
             };
             match packet.wrapping_sub(self.last_packet) {
                 0 => self.duplicate_packets = self.duplicate_packets.saturating_add(1),
-                1 => {}
+                // The next frame (a step of 1) loses nothing; the limit is at least 1.
                 step if step <= limit => {
                     self.lost_packets = self.lost_packets.saturating_add(u32::from(step - 1));
                 }

@@ -352,11 +352,12 @@ const fn build_celsius() -> [f32; 256] {
     let mut code = ADC_MIN as usize;
     while code <= ADC_MAX as usize {
         if exact[code].is_nan() {
-            let mut lo = code - 1; // hotter neighbour (lower code)
+            // From `code` itself, which has no temperature: the nearest that have.
+            let mut lo = code; // hotter neighbour (lower code)
             while exact[lo].is_nan() {
                 lo -= 1;
             }
-            let mut hi = code + 1; // colder neighbour (higher code)
+            let mut hi = code; // colder neighbour (higher code)
             while exact[hi].is_nan() {
                 hi += 1;
             }

@@ -337,6 +337,33 @@ fn reference_scan(bytes: &[u8], base: u64, s: &mut RefStats, out: &mut Vec<Decod
     }
 }
 
+/// How many bytes at the end of `bytes` a streaming decoder fed them (and not flushed) still
+/// holds: from the first candidate (a `9B` that is the last byte, or a `9B` and a known length
+/// byte) that has fewer bytes than its frame, once the frames before it are taken.
+fn reference_held(bytes: &[u8]) -> usize {
+    let mut i = 0;
+    while i < bytes.len() {
+        let rest = &bytes[i..];
+        let len = match rest {
+            [0x9B] => return rest.len(),
+            [0x9B, 0x16, ..] => DATA_FRAME_LEN,
+            [0x9B, 0x4C, ..] => INFO_FRAME_LEN,
+            _ => {
+                i += 1;
+                continue;
+            }
+        };
+        if rest.len() < len {
+            return rest.len();
+        }
+        i += match parse(rest) {
+            Ok(Parsed::Complete(_, n)) => n,
+            _ => 1,
+        };
+    }
+    0
+}
+
 /// Whether some candidate that is not an intact frame's own start is itself a valid frame
 /// overlapping an intact frame. Such a wire is ambiguous: the checksums cannot tell the
 /// candidate from the intact frame, and a decoder that trusts them takes the first one.
@@ -441,6 +468,36 @@ proptest! {
         prop_assert_eq!(&chunked.0, &whole.0);
         prop_assert_eq!(&chunked.1, &whole.1);
         prop_assert_eq!(&streamed_bytewise(&wire.bytes), &whole);
+    }
+
+    /// (b) The streaming decoder holds back only an undecided candidate: after every chunk, the
+    /// bytes it holds are those from the first candidate still short of its frame's length, and
+    /// every other byte is already in a frame or counted as skipped.
+    #[test]
+    fn only_an_undecided_candidate_is_held(
+        ps in pieces(16),
+        picks in vec(any::<Index>(), 0..30),
+        bytewise in any::<bool>(),
+    ) {
+        let wire = build(&ps);
+        let cuts = if bytewise {
+            (0..=wire.bytes.len()).collect()
+        } else {
+            cut_points(wire.bytes.len(), &picks)
+        };
+        let mut d = Decoder::new();
+        for w in cuts.windows(2) {
+            d.feed(&wire.bytes[w[0]..w[1]], |_| {});
+            prop_assert_eq!(d.buffered(), reference_held(&wire.bytes[..w[1]]), "after {}", w[1]);
+            let s = d.stats();
+            prop_assert_eq!(
+                s.bytes(),
+                24 * u64::from(s.frames())
+                    + 77 * u64::from(s.info_frames())
+                    + s.bytes_skipped()
+                    + d.buffered() as u64
+            );
+        }
     }
 
     /// (c) Garbage, cut frames and fake headers between frames never lose an intact frame:
