@@ -244,13 +244,14 @@ impl Decoder {
             let n = held + take;
             let tmp_base = start - held as u64;
             let pos = scan_all::<false>(&tmp[..n], tmp_base, &mut self.stats, &mut on_frame);
-            if pos < held {
+            let Some(used) = pos.checked_sub(held) else {
                 // `data` ran out before the held candidate was decided.
                 self.hold(&tmp[pos..n]);
                 return;
-            }
-            data = &data[pos - held..];
-            base += (pos - held) as u64;
+            };
+            // The scan stopped in `data`, after `used` of its bytes: go on from there.
+            data = &data[used..];
+            base += used as u64;
         }
         let pos = scan_all::<false>(data, base, &mut self.stats, &mut on_frame);
         self.hold(&data[pos..]);
@@ -278,8 +279,8 @@ impl Decoder {
     }
 
     /// Tells the decoder that the line has just been silent for a time in which at most
-    /// `max_frames` data frames could have been sent; `on_frame` gets any frame the held bytes
-    /// still held.
+    /// `max_frames` data frames could have been sent; `on_frame` gets the frames still found in
+    /// the bytes held back before the silence.
     ///
     /// It does two things:
     ///
@@ -298,8 +299,8 @@ impl Decoder {
     /// So an ESC that rebooted within a second and a half is seen restarting even when its new
     /// packet number happens to lie a few hundred past the old one, while a frame lost in a
     /// short silence is still a loss. `max_frames` is the caller's bound from the time that
-    /// passed: the line carries a data frame in at most 24 byte times (12.5 ms at 19200 baud),
-    /// and real ESCs send one every 50 ms at most. Frames hidden in bytes that arrived but were
+    /// passed: a data frame takes 24 byte times on the line (12.5 ms at 19200 baud), and a real
+    /// ESC sends one every 50 ms or more. Frames hidden in bytes that arrived but were
     /// rejected (corrupted) are not the silence's: do not count them in `max_frames`. Host-side
     /// read latency is not a silence of the line; call this only for gaps longer than the
     /// receiving path can introduce.
