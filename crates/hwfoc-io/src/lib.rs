@@ -23,6 +23,7 @@
 #![warn(missing_docs)]
 
 pub mod clock;
+pub mod energy;
 pub mod episode;
 pub mod handler;
 pub mod input;

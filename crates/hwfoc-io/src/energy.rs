@@ -1,0 +1,207 @@
+//! Charge and energy drawn by an ESC, integrated over the times of its frames: the one place
+//! where `summary`, the monitor, the plots and the MAVLink bridge's "mAh consumed" come from.
+//!
+//! Each frame's input current and voltage are taken to hold until the ESC's next frame (a
+//! left Riemann sum over the frame times: an ESC measures, then sends). The step from one frame
+//! to the next counts at most [`MAX_STEP_S`]: a silence longer than that (a cut line, an ESC
+//! that rebooted, a pause between recordings) is not filled with the last current seen. For an
+//! input without times (raw bytes), every step is [`NOMINAL_PERIOD_S`], the protocol's frame
+//! period, and [`Energy::nominal`] says so.
+//!
+//! Regenerative braking (negative input current) gives charge back: the charge and energy are
+//! net figures, as a battery sees them.
+
+/// The protocol's frame period of a running ESC: 50 ms. The step between two frames of an input
+/// without times.
+pub const NOMINAL_PERIOD_S: f64 = 0.05;
+
+/// The longest step between two frames that is integrated: a longer silence counts only this
+/// much (an idle ESC sends a frame every ~364 ms; a longer silence is a cut line, and the
+/// stream tells the decoder of it from [`crate::stream::SILENCE_S`], the same second).
+pub const MAX_STEP_S: f64 = crate::stream::SILENCE_S;
+
+/// Charge, energy and power of one ESC (or the sum of several: [`Energy::merge`]).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Energy {
+    /// The last frame: time (s, `None` on an untimed input), volts, amps.
+    last: Option<(Option<f64>, f64, f64)>,
+    /// Ampere-seconds.
+    charge_as: f64,
+    /// Joules.
+    energy_j: f64,
+    /// Seconds integrated.
+    seconds: f64,
+    /// Largest electrical input power of a frame, W.
+    peak_w: Option<f64>,
+    /// Whether some step used [`NOMINAL_PERIOD_S`] for want of times.
+    nominal: bool,
+}
+
+impl Energy {
+    /// Nothing integrated yet.
+    pub const fn new() -> Energy {
+        Energy {
+            last: None,
+            charge_as: 0.0,
+            energy_j: 0.0,
+            seconds: 0.0,
+            peak_w: None,
+            nominal: false,
+        }
+    }
+
+    /// Adds a frame received at `t_s` (`None` without timing) carrying `voltage_v` and input
+    /// `current_a`. Frames must come in time order; a step back in time counts as zero.
+    pub fn add(&mut self, t_s: Option<f64>, voltage_v: f64, current_a: f64) {
+        if let Some((last_t, v, i)) = self.last {
+            let step = match (last_t, t_s) {
+                (Some(a), Some(b)) => (b - a).clamp(0.0, MAX_STEP_S),
+                _ => {
+                    self.nominal = true;
+                    NOMINAL_PERIOD_S
+                }
+            };
+            self.charge_as += i * step;
+            self.energy_j += v * i * step;
+            self.seconds += step;
+        }
+        let power = voltage_v * current_a;
+        self.peak_w = Some(self.peak_w.map_or(power, |p| p.max(power)));
+        self.last = Some((t_s, voltage_v, current_a));
+    }
+
+    /// Forgets the last frame, so that the next one starts a new integration (the charge and
+    /// energy so far are kept): for a stream known to have been cut.
+    pub fn break_here(&mut self) {
+        self.last = None;
+    }
+
+    /// Consumed charge, mAh.
+    pub fn charge_mah(&self) -> f64 {
+        self.charge_as / 3.6
+    }
+
+    /// Consumed energy, Wh.
+    pub fn energy_wh(&self) -> f64 {
+        self.energy_j / 3600.0
+    }
+
+    /// Seconds integrated.
+    pub fn seconds(&self) -> f64 {
+        self.seconds
+    }
+
+    /// Mean electrical input power over the time integrated, W (`None` before two frames).
+    pub fn mean_w(&self) -> Option<f64> {
+        (self.seconds > 0.0).then(|| self.energy_j / self.seconds)
+    }
+
+    /// Largest electrical input power of a single frame, W (`None` before a frame).
+    pub fn peak_w(&self) -> Option<f64> {
+        self.peak_w
+    }
+
+    /// Whether steps were taken as [`NOMINAL_PERIOD_S`] for want of receive times.
+    pub fn nominal(&self) -> bool {
+        self.nominal
+    }
+
+    /// Adds another ESC's figures to these, for a total over ESCs that ran at the same time:
+    /// charges and energies add, the time integrated is the longer of the two (so the mean
+    /// power is the total energy over it), the peak is the largest single-ESC peak (peaks of
+    /// different ESCs need not be simultaneous). The last frames are not combined.
+    pub fn merge(&mut self, other: &Energy) {
+        self.charge_as += other.charge_as;
+        self.energy_j += other.energy_j;
+        self.seconds = self.seconds.max(other.seconds);
+        self.peak_w = match (self.peak_w, other.peak_w) {
+            (Some(a), Some(b)) => Some(a.max(b)),
+            (a, b) => a.or(b),
+        };
+        self.nominal |= other.nominal;
+        self.last = None;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn constant_draw_integrates_exactly() {
+        let mut e = Energy::new();
+        // 10 A at 20 V for 3.6 s, a frame every 50 ms: 10 mAh, 0.2 Wh.
+        for k in 0..=72 {
+            e.add(Some(100.0 + k as f64 * 0.05), 20.0, 10.0);
+        }
+        assert!((e.charge_mah() - 10.0).abs() < 1e-9, "{}", e.charge_mah());
+        assert!((e.energy_wh() - 0.2).abs() < 1e-9);
+        assert!((e.seconds() - 3.6).abs() < 1e-9);
+        assert_eq!(e.peak_w(), Some(200.0));
+        assert!((e.mean_w().unwrap() - 200.0).abs() < 1e-9);
+        assert!(!e.nominal());
+    }
+
+    #[test]
+    fn each_current_holds_until_the_next_frame() {
+        let mut e = Energy::new();
+        e.add(Some(0.0), 10.0, 36.0); // 36 A for 0.1 s = 1 mAh
+        e.add(Some(0.1), 10.0, 0.0); // then nothing for 0.2 s
+        e.add(Some(0.3), 10.0, 72.0); // the last frame's current has no step yet
+        assert!((e.charge_mah() - 1.0).abs() < 1e-12);
+        assert_eq!(e.peak_w(), Some(720.0));
+    }
+
+    #[test]
+    fn a_silence_is_not_filled_with_the_last_current() {
+        let mut e = Energy::new();
+        e.add(Some(0.0), 10.0, 3.6);
+        e.add(Some(60.0), 10.0, 3.6); // a minute of silence counts one second
+        assert!((e.charge_mah() - 1.0).abs() < 1e-12);
+        assert!((e.seconds() - MAX_STEP_S).abs() < 1e-12);
+        let mut back = Energy::new();
+        back.add(Some(5.0), 10.0, 3.6);
+        back.add(Some(4.0), 10.0, 3.6); // a step back in time adds nothing
+        assert_eq!(back.charge_mah(), 0.0);
+    }
+
+    #[test]
+    fn untimed_frames_step_the_nominal_period_and_say_so() {
+        let mut e = Energy::new();
+        for _ in 0..=20 {
+            e.add(None, 10.0, 36.0);
+        }
+        // 20 steps of 50 ms at 36 A: 10 mAh.
+        assert!((e.charge_mah() - 10.0).abs() < 1e-9);
+        assert!(e.nominal());
+    }
+
+    #[test]
+    fn regenerative_current_gives_charge_back() {
+        let mut e = Energy::new();
+        e.add(Some(0.0), 10.0, 36.0);
+        e.add(Some(0.1), 10.0, -36.0);
+        e.add(Some(0.2), 10.0, 0.0);
+        assert!(e.charge_mah().abs() < 1e-12);
+        assert_eq!(e.peak_w(), Some(360.0));
+    }
+
+    #[test]
+    fn a_total_adds_charges_and_means() {
+        let mut a = Energy::new();
+        let mut b = Energy::new();
+        for k in 0..=20 {
+            a.add(Some(k as f64 * 0.05), 20.0, 10.0); // 200 W for 1 s
+            b.add(Some(k as f64 * 0.05), 20.0, 5.0); // 100 W for 1 s
+        }
+        let mut total = Energy::new();
+        total.merge(&a);
+        total.merge(&b);
+        assert!((total.charge_mah() - (a.charge_mah() + b.charge_mah())).abs() < 1e-9);
+        assert!((total.mean_w().unwrap() - 300.0).abs() < 1e-9);
+        assert!((total.energy_wh() - 300.0 / 3600.0).abs() < 1e-12);
+        assert_eq!(total.peak_w(), Some(200.0));
+        let empty = Energy::new();
+        assert_eq!((empty.mean_w(), empty.peak_w()), (None, None));
+    }
+}
