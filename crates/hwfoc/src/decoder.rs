@@ -41,27 +41,45 @@ fn is_length_byte(b: u8) -> bool {
 /// like any other skipped byte, without stopping there.
 #[inline]
 fn find_header(hay: &[u8]) -> Option<usize> {
+    find_sync_then(hay, is_length_byte, |l| {
+        or_length_bytes(|b| bytes_equal(l, b))
+    })
+}
+
+/// 0x80 in every byte of `word` that equals `b`, 0 elsewhere (exact: no carry crosses bytes).
+#[inline(always)]
+pub(crate) fn bytes_equal(word: u64, b: u8) -> u64 {
     const LOW7: u64 = 0x7F7F_7F7F_7F7F_7F7F;
     const ONES: u64 = 0x0101_0101_0101_0101;
-    /// 0x80 in every byte of `x` that is zero, 0 elsewhere (exact: no carry crosses bytes).
-    #[inline(always)]
-    fn zero_bytes(x: u64) -> u64 {
-        !(((x & LOW7).wrapping_add(LOW7)) | x | LOW7)
-    }
+    let x = word ^ (ONES * b as u64);
+    !(((x & LOW7).wrapping_add(LOW7)) | x | LOW7)
+}
+
+/// Offset of the first sync byte in `hay` followed by a byte that `is_second` accepts, or of a
+/// sync byte that is the last byte of `hay`: where a scanner's candidate may start.
+/// `seconds(word)` is `is_second` on the eight bytes of a word at once (0x80 in each accepted
+/// byte, 0 elsewhere, as [`bytes_equal`] gives), a constant expression after inlining.
+///
+/// The scanner of [`crate::datalink`] shares it, with its own second bytes.
+#[inline(always)]
+pub(crate) fn find_sync_then(
+    hay: &[u8],
+    is_second: impl Fn(u8) -> bool,
+    seconds: impl Fn(u64) -> u64,
+) -> Option<usize> {
     // After a frame the next bytes are usually the next frame's header.
     if let [SYNC, l, ..] = *hay
-        && is_length_byte(l)
+        && is_second(l)
     {
         return Some(0);
     }
     let mut base = 0;
     // Eight positions at a time: the word at `base` for the sync bytes and the word one byte
-    // later for the length bytes that follow them.
+    // later for the second bytes that follow them.
     while let Some(w) = hay.get(base..base + 9) {
         let word = |at: usize| u64::from_le_bytes(w[at..at + 8].try_into().unwrap_or([0; 8]));
         let (s, l) = (word(0), word(1));
-        let lengths = or_length_bytes(|b| zero_bytes(l ^ (ONES * b as u64)));
-        let hits = zero_bytes(s ^ (ONES * SYNC as u64)) & lengths;
+        let hits = bytes_equal(s, SYNC) & seconds(l);
         if hits != 0 {
             return Some(base + (hits.trailing_zeros() / 8) as usize);
         }
@@ -69,7 +87,7 @@ fn find_header(hay: &[u8]) -> Option<usize> {
     }
     let tail = &hay[base..];
     (0..tail.len())
-        .find(|&j| tail[j] == SYNC && tail.get(j + 1).is_none_or(|&l| is_length_byte(l)))
+        .find(|&j| tail[j] == SYNC && tail.get(j + 1).is_none_or(|&l| is_second(l)))
         .map(|j| base + j)
 }
 

@@ -10,6 +10,9 @@
 //! | `frame` (here) | the list of kinds: [`Frame`], [`MAX_FRAME_LEN`], [`parse`], [`Parsed`] |
 //! | [`crate::decoder`] | the scanner: [`Decoder`](crate::Decoder), [`frames`](crate::frames) |
 //!
+//! Beside them, [`crate::datalink`] holds the DataLink V2 hub's frame, scanner and statistics,
+//! built on [`crate::wire`], [`DataFrame`]'s payload and the scanner's sync-pair search.
+//!
 //! The scanner never names a kind: right after a frame it asks the first kind of the list
 //! whether another starts there; otherwise it finds a sync byte followed by a known length byte,
 //! asks each kind in turn whether a frame starts there ([`FrameKind::accept`]), and otherwise learns
@@ -44,18 +47,20 @@
 //!
 //! # Another protocol
 //!
-//! - **DataLink V2** (the hub's aggregate frame, `PROTOCOL-NOTES.md`): `9B 9E 01 02`, 160 bytes,
-//!   a frame counter and 8 ESC records, CRC-16/XMODEM of bytes 0..=157, low byte first, on a
-//!   115200-baud wire. Its frame fits this outline exactly (0x9E = 160 - 2), so it is one new
-//!   arm of [`Checksum`](crate::wire::Checksum) (`Crc16Xmodem`: its `width`, `compute`,
-//!   `carried`, `seal`), one new file `kinds/datalink.rs`, and one arm here. Its baud rate would
-//!   be a constant of that file ([`byte_ns`](crate::wire::byte_ns) takes any rate). The price:
-//!   [`MAX_FRAME_LEN`] becomes 160, so every [`Decoder`](crate::Decoder) grows from 120 to 200
-//!   bytes and [`Frame`] to the size of 8 records (from 74 to about 170 bytes), also in firmware
-//!   that reads one ESC's own wire, where a hub frame never comes. If that matters, the scanner
-//!   can be made generic over the list of kinds (from here it uses only `Frame::take_first`,
-//!   `Frame::take`, `wire_len_of`, `candidate_len`, `or_length_bytes` and `MAX_FRAME_LEN`), with
-//!   one list per wire: this file's for an ESC's wire, a one-arm list for a hub's.
+//! - **DataLink V2** (the hub's aggregate frame, `PROTOCOL-NOTES.md`): `9B 9E 01 02` (or a
+//!   length byte 0xA0, which some drivers write), 160 bytes, a frame counter and 8 ESC records,
+//!   CRC-16/XMODEM of bytes 0..=157, low byte first, on a 115200-baud wire. It is **not** a kind
+//!   of this list but a module family of its own, [`crate::datalink`], with its own scanner
+//!   ([`DatalinkDecoder`](crate::DatalinkDecoder), [`datalink::frames`](crate::datalink::frames))
+//!   and statistics ([`DatalinkStats`](crate::DatalinkStats)): as a kind it would have made
+//!   [`MAX_FRAME_LEN`] 160, every [`Decoder`](crate::Decoder) 200 bytes instead of 120 and
+//!   [`Frame`] the size of 8 records, also in firmware that reads one ESC's own wire, where a
+//!   hub frame never comes; and its two length bytes for one length break this list's rule that
+//!   the length byte is the length minus the check bytes. What it shares is shared, not copied:
+//!   the [`Checksum::Crc16Xmodem`](crate::wire::Checksum::Crc16Xmodem) arm, [`SYNC`] and the
+//!   version byte, [`byte_ns`](crate::wire::byte_ns), the data frame's payload layout (a record
+//!   is a channel byte and those 18 bytes), the scanner's sync-pair search, and the following of
+//!   a counter ([`PacketSequence`](crate::PacketSequence)).
 //! - **Hobbywing V3/V4** (`OLDER-PROTOCOLS.md`): same sync byte and baud rate, but no length
 //!   byte and no checksum. Frames are recognised by fixed bytes, by chaining (the next header
 //!   exactly where the previous frame ended) and by the packet counter, which needs state across

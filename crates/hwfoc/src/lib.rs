@@ -3,6 +3,7 @@
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]
 
+pub mod datalink;
 pub mod decoder;
 pub mod frame;
 pub mod kinds;
@@ -11,11 +12,14 @@ pub mod status;
 pub mod units;
 pub mod wire;
 
+pub use datalink::{
+    DatalinkDecoded, DatalinkDecoder, DatalinkError, DatalinkFrame, DatalinkFrames, DatalinkStats,
+};
 pub use decoder::{Decoded, Decoder, Frames, frames};
 pub use frame::{Frame, Parsed, parse};
 pub use kinds::data::DataFrame;
 pub use kinds::info::{InfoFieldError, InfoFrame};
-pub use stats::LinkStats;
+pub use stats::{LinkStats, PacketSequence};
 pub use status::{Fault, Faults, Status};
 pub use units::{Quantity, Settings, SettingsError, Temperature};
 pub use wire::{FrameError, FrameKind};

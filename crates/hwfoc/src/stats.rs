@@ -1,7 +1,8 @@
-//! Link statistics for one telemetry stream.
+//! Link statistics for one telemetry stream, and the following of a packet counter they share
+//! with the DataLink statistics ([`crate::datalink::DatalinkStats`]).
 //!
 //! Besides counting bytes and frames, [`LinkStats`] follows the packet numbers of the data frames
-//! and sorts every step from one to the next into one of four events: the next number (nothing to
+//! (a [`PacketSequence`]) and sorts every step from one to the next into one of four events: the next number (nothing to
 //! count), the same number again (a [duplicate](LinkStats::duplicate_packets)), a small gap
 //! forward ([lost packets](LinkStats::lost_packets): the numbers in between), or a jump that no
 //! lost frames explain: a step backwards, or forwards by more than [`MAX_PACKET_GAP`] + 1. Such a
@@ -42,14 +43,14 @@ const MAX_FORWARD_STEP: u16 = 0x8000;
 ///
 /// [`Decoder`]: crate::Decoder
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
-struct ByteCounts {
+pub(crate) struct ByteCounts {
     low: [u32; 2],
     high: [u16; 2],
 }
 
 /// Which of the [`ByteCounts`].
 #[derive(Clone, Copy)]
-enum Bytes {
+pub(crate) enum Bytes {
     /// Bytes fed.
     Fed = 0,
     /// Bytes skipped.
@@ -57,15 +58,136 @@ enum Bytes {
 }
 
 impl ByteCounts {
-    const fn get(&self, which: Bytes) -> u64 {
+    pub(crate) const fn new() -> Self {
+        ByteCounts {
+            low: [0; 2],
+            high: [0; 2],
+        }
+    }
+
+    pub(crate) const fn get(&self, which: Bytes) -> u64 {
         self.low[which as usize] as u64 + ((self.high[which as usize] as u64) << 32)
     }
 
     #[inline]
-    fn add(&mut self, which: Bytes, n: usize) {
+    pub(crate) fn add(&mut self, which: Bytes, n: usize) {
         let sum = self.get(which).wrapping_add(n as u64);
         self.low[which as usize] = sum as u32;
         self.high[which as usize] = (sum >> 32) as u16;
+    }
+}
+
+/// The numbers of one counter (an ESC's packet numbers, a DataLink hub's frame counter),
+/// followed step by step: each number after the first is sorted into exactly one of the next
+/// number, a [duplicate](PacketSequence::duplicates), a gap of [lost](PacketSequence::lost)
+/// numbers, or a [restart](PacketSequence::restarts), by the rule of the [module](self)
+/// documentation ([`MAX_PACKET_GAP`], and the tighter limit after a silence of the line).
+///
+/// [`LinkStats`] keeps one for the data frames' packet numbers;
+/// [`DatalinkStats`](crate::DatalinkStats) one for the hub's frame counter and one per ESC
+/// channel. Counters are `u32` and saturate; 20 bytes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+pub struct PacketSequence {
+    count: u32,
+    lost: u32,
+    duplicates: u32,
+    restarts: u32,
+    last: u16,
+    /// The largest step to the next number that counts as a loss, as set by
+    /// [`PacketSequence::line_silent`]; 0 (no silence since the last number) means
+    /// `MAX_PACKET_GAP + 1`.
+    gap_limit: u16,
+}
+
+impl PacketSequence {
+    /// No number seen yet.
+    pub const fn new() -> Self {
+        PacketSequence {
+            count: 0,
+            lost: 0,
+            duplicates: 0,
+            restarts: 0,
+            last: 0,
+            gap_limit: 0,
+        }
+    }
+
+    /// Numbers seen (frames or records counted).
+    pub const fn count(&self) -> u32 {
+        self.count
+    }
+
+    /// Numbers missing between consecutive numbers of one sequence: a step of
+    /// `d = (next - last) mod 65536` counts `d - 1` when `2 <= d <= MAX_PACKET_GAP + 1`
+    /// (after a silence, the limit it set); a larger step is a restart and loses nothing.
+    pub const fn lost(&self) -> u32 {
+        self.lost
+    }
+
+    /// Numbers equal to the one before (not a loss).
+    pub const fn duplicates(&self) -> u32 {
+        self.duplicates
+    }
+
+    /// Numbers that start a new sequence: a step backwards (`d > 32768` modulo 65536) or
+    /// forwards beyond the gap limit. A restart counts no loss and no duplicate.
+    pub const fn restarts(&self) -> u32 {
+        self.restarts
+    }
+
+    /// The last number seen, if any.
+    pub const fn last(&self) -> Option<u16> {
+        if self.count == 0 {
+            None
+        } else {
+            Some(self.last)
+        }
+    }
+
+    /// Fraction of expected numbers that arrived: `count / (count + lost)`, or `None` before
+    /// the first. Restarts expect nothing.
+    pub fn delivery_ratio(&self) -> Option<f64> {
+        if self.count == 0 {
+            return None;
+        }
+        let count = f64::from(self.count);
+        Some(count / (count + f64::from(self.lost)))
+    }
+
+    /// The line was silent for a time in which at most `max_frames` numbers could have been
+    /// sent: the next step counts as a loss only up to `max_frames + 1` (at most 32768).
+    /// Silences before one number add up.
+    pub(crate) fn line_silent(&mut self, max_frames: u32) {
+        let limit = if self.gap_limit == 0 {
+            1
+        } else {
+            u32::from(self.gap_limit)
+        };
+        let limit = limit.saturating_add(max_frames);
+        self.gap_limit = limit.min(u32::from(MAX_FORWARD_STEP)) as u16;
+    }
+
+    /// Takes the next number and classifies its step from the last one.
+    #[inline]
+    pub(crate) fn next(&mut self, number: u16) {
+        if self.count != 0 {
+            let limit = if self.gap_limit == 0 {
+                MAX_PACKET_GAP + 1
+            } else {
+                self.gap_limit
+            };
+            match number.wrapping_sub(self.last) {
+                0 => self.duplicates = self.duplicates.saturating_add(1),
+                // The next number (a step of 1) loses nothing; the limit is at least 1.
+                step if step <= limit => {
+                    self.lost = self.lost.saturating_add(u32::from(step - 1));
+                }
+                _ => self.restarts = self.restarts.saturating_add(1),
+            }
+        }
+        self.gap_limit = 0;
+        self.count = self.count.saturating_add(1);
+        self.last = number;
     }
 }
 
@@ -78,43 +200,27 @@ impl ByteCounts {
 /// Every byte fed ends up either in an accepted frame or in [`LinkStats::bytes_skipped`]: after
 /// [`crate::Decoder::flush`], `bytes == 24 * frames + 77 * info_frames + bytes_skipped`.
 ///
-/// Every data frame but the first is one step of the packet numbers, counted as exactly one of:
-/// the next number, a [duplicate](LinkStats::duplicate_packets), a gap of
-/// [lost packets](LinkStats::lost_packets), or a [restart](LinkStats::restarts); so
+/// Every data frame but the first is one step of the packet numbers (a [`PacketSequence`]),
+/// counted as exactly one of: the next number, a [duplicate](LinkStats::duplicate_packets), a
+/// gap of [lost packets](LinkStats::lost_packets), or a [restart](LinkStats::restarts); so
 /// `duplicates + restarts <= frames - 1` (while no counter saturates), and the loss counted in
 /// one step is at most [`MAX_PACKET_GAP`] (or what [`crate::Decoder::line_silent`] allowed).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
 pub struct LinkStats {
     bytes: ByteCounts,
-    frames: u32,
     info_frames: u32,
     checksum_failures: u32,
-    lost_packets: u32,
-    duplicate_packets: u32,
-    restarts: u32,
-    last_packet: u16,
-    /// The largest step to the next data frame's packet number that counts as a loss, as set by
-    /// [`LinkStats::line_silent`]; 0 (no silence since the last data frame) means
-    /// `MAX_PACKET_GAP + 1`.
-    gap_limit: u16,
+    packets: PacketSequence,
 }
 
 impl LinkStats {
     /// All counters zero.
     pub const fn new() -> Self {
         LinkStats {
-            bytes: ByteCounts {
-                low: [0; 2],
-                high: [0; 2],
-            },
-            frames: 0,
+            bytes: ByteCounts::new(),
             info_frames: 0,
             checksum_failures: 0,
-            lost_packets: 0,
-            duplicate_packets: 0,
-            restarts: 0,
-            last_packet: 0,
-            gap_limit: 0,
+            packets: PacketSequence::new(),
         }
     }
 
@@ -131,7 +237,7 @@ impl LinkStats {
 
     /// Data frames (command 0x02) decoded.
     pub const fn frames(&self) -> u32 {
-        self.frames
+        self.packets.count()
     }
 
     /// Device-information frames decoded. They are never counted as errors.
@@ -155,12 +261,12 @@ impl LinkStats {
     /// [`crate::Decoder::line_silent`], the limit it set); a larger step, forwards or backwards,
     /// is a [restart](LinkStats::restarts) and loses nothing.
     pub const fn lost_packets(&self) -> u32 {
-        self.lost_packets
+        self.packets.lost()
     }
 
     /// Data frames whose packet number equals the previous frame's (seen on real ESCs; not a loss).
     pub const fn duplicate_packets(&self) -> u32 {
-        self.duplicate_packets
+        self.packets.duplicates()
     }
 
     /// Data frames whose packet number does not continue the sequence, but starts a new one: a
@@ -171,27 +277,24 @@ impl LinkStats {
     ///
     /// A restart counts no loss and no duplicate; the sequence continues from its number.
     pub const fn restarts(&self) -> u32 {
-        self.restarts
+        self.packets.restarts()
     }
 
     /// Packet number of the last data frame, if any.
     pub const fn last_packet(&self) -> Option<u16> {
-        if self.frames == 0 {
-            None
-        } else {
-            Some(self.last_packet)
-        }
+        self.packets.last()
     }
 
     /// Fraction of expected data frames that arrived: `frames / (frames + lost)`, or `None`
     /// before the first frame. Restarts expect nothing: the frames a restarted ESC did not send
     /// are not missing.
     pub fn delivery_ratio(&self) -> Option<f64> {
-        if self.frames == 0 {
-            return None;
-        }
-        let frames = f64::from(self.frames);
-        Some(frames / (frames + f64::from(self.lost_packets)))
+        self.packets.delivery_ratio()
+    }
+
+    /// The data frames' packet numbers, followed step by step.
+    pub const fn packets(&self) -> &PacketSequence {
+        &self.packets
     }
 
     #[inline]
@@ -218,35 +321,12 @@ impl LinkStats {
     /// sent: the next data frame's step counts as a loss only up to `max_frames + 1` (at most
     /// 32768). Silences before one data frame add up.
     pub(crate) fn line_silent(&mut self, max_frames: u32) {
-        let limit = if self.gap_limit == 0 {
-            1
-        } else {
-            u32::from(self.gap_limit)
-        };
-        let limit = limit.saturating_add(max_frames);
-        self.gap_limit = limit.min(u32::from(MAX_FORWARD_STEP)) as u16;
+        self.packets.line_silent(max_frames);
     }
 
     #[inline]
     pub(crate) fn data_frame(&mut self, packet: u16) {
-        if self.frames != 0 {
-            let limit = if self.gap_limit == 0 {
-                MAX_PACKET_GAP + 1
-            } else {
-                self.gap_limit
-            };
-            match packet.wrapping_sub(self.last_packet) {
-                0 => self.duplicate_packets = self.duplicate_packets.saturating_add(1),
-                // The next frame (a step of 1) loses nothing; the limit is at least 1.
-                step if step <= limit => {
-                    self.lost_packets = self.lost_packets.saturating_add(u32::from(step - 1));
-                }
-                _ => self.restarts = self.restarts.saturating_add(1),
-            }
-        }
-        self.gap_limit = 0;
-        self.frames = self.frames.saturating_add(1);
-        self.last_packet = packet;
+        self.packets.next(packet);
     }
 }
 
@@ -257,13 +337,13 @@ impl fmt::Display for LinkStats {
             "{} bytes, {} frames, {} info frames, {} checksum failures, {} bytes skipped, \
              {} lost packets, {} duplicate packets, {} restarts",
             self.bytes(),
-            self.frames,
+            self.frames(),
             self.info_frames,
             self.checksum_failures,
             self.bytes_skipped(),
-            self.lost_packets,
-            self.duplicate_packets,
-            self.restarts
+            self.lost_packets(),
+            self.duplicate_packets(),
+            self.restarts()
         )
     }
 }
@@ -297,6 +377,7 @@ mod tests {
     #[test]
     fn every_counter_fits_in_40_bytes() {
         assert_eq!(size_of::<LinkStats>(), 40);
+        assert_eq!(size_of::<PacketSequence>(), 20);
     }
 
     /// Two interleaved sequences far apart for a million frames: the loss that used to run up to
@@ -320,10 +401,13 @@ mod tests {
     #[test]
     fn counters_saturate() {
         let mut s = LinkStats {
-            frames: u32::MAX,
-            lost_packets: u32::MAX - 1,
-            duplicate_packets: u32::MAX,
-            restarts: u32::MAX,
+            packets: PacketSequence {
+                count: u32::MAX,
+                lost: u32::MAX - 1,
+                duplicates: u32::MAX,
+                restarts: u32::MAX,
+                ..PacketSequence::new()
+            },
             info_frames: u32::MAX,
             checksum_failures: u32::MAX,
             ..LinkStats::new()
@@ -347,15 +431,15 @@ mod tests {
     fn silences_add_up_to_at_most_half_the_counter() {
         let mut s = LinkStats::new();
         s.line_silent(0);
-        assert_eq!(s.gap_limit, 1);
+        assert_eq!(s.packets.gap_limit, 1);
         s.line_silent(9);
         s.line_silent(20);
-        assert_eq!(s.gap_limit, 30);
+        assert_eq!(s.packets.gap_limit, 30);
         s.line_silent(u32::MAX);
-        assert_eq!(s.gap_limit, 0x8000);
+        assert_eq!(s.packets.gap_limit, 0x8000);
         s.data_frame(1);
-        assert_eq!(s.gap_limit, 0);
+        assert_eq!(s.packets.gap_limit, 0);
         s.line_silent(u32::MAX - 1);
-        assert_eq!(s.gap_limit, 0x8000);
+        assert_eq!(s.packets.gap_limit, 0x8000);
     }
 }

@@ -67,11 +67,55 @@ pub const fn sum16(bytes: &[u8]) -> u16 {
     sum as u16
 }
 
+/// The CRC-16/XMODEM lookup table (polynomial 0x1021): entry `i` is the CRC register after
+/// shifting the byte `i` through a zero register. Built at compile time; 512 bytes.
+const CRC16_XMODEM_TABLE: [u16; 256] = {
+    let mut table = [0u16; 256];
+    let mut i = 0;
+    while i < 256 {
+        let mut crc = (i as u16) << 8;
+        let mut bit = 0;
+        while bit < 8 {
+            crc = if crc & 0x8000 != 0 {
+                (crc << 1) ^ CRC16_XMODEM_POLY
+            } else {
+                crc << 1
+            };
+            bit += 1;
+        }
+        table[i] = crc;
+        i += 1;
+    }
+    table
+};
+
+/// The generator polynomial of CRC-16/XMODEM (x^16 + x^12 + x^5 + 1, the CCITT polynomial).
+const CRC16_XMODEM_POLY: u16 = 0x1021;
+
+/// The CRC-16/XMODEM of `bytes`: polynomial 0x1021, initial value 0, no reflection, no final
+/// XOR (check value 0x31C3 for `"123456789"`). The check of a DataLink V2 frame
+/// ([`crate::datalink`]), table-driven, one byte per step.
+///
+/// ```
+/// assert_eq!(hwfoc::wire::crc16_xmodem(b"123456789"), 0x31C3);
+/// assert_eq!(hwfoc::wire::crc16_xmodem(&[]), 0);
+/// ```
+#[inline]
+pub const fn crc16_xmodem(bytes: &[u8]) -> u16 {
+    let mut crc = 0u16;
+    let mut i = 0;
+    while i < bytes.len() {
+        crc = (crc << 8) ^ CRC16_XMODEM_TABLE[((crc >> 8) as u8 ^ bytes[i]) as usize];
+        i += 1;
+    }
+    crc
+}
+
 /// How a frame kind protects its bytes: the check bytes at the end of the frame.
 ///
-/// Each kind names one in [`FrameKind::CHECKSUM`]; the shared code computes, verifies and writes
-/// it. A new kind of check (DataLink V2's CRC-16/XMODEM, say) is one more arm here and in the
-/// methods below.
+/// Each kind names one in [`FrameKind::CHECKSUM`] (and the DataLink frame of
+/// [`crate::datalink`] uses [`Checksum::Crc16Xmodem`]); the shared code computes, verifies and
+/// writes it. A new kind of check is one more arm here and in the methods below.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 #[non_exhaustive]
 pub enum Checksum {
@@ -81,6 +125,9 @@ pub enum Checksum {
     Sum16Le,
     /// The low byte of that sum (1 check byte): device-information frames.
     Sum8,
+    /// The CRC-16/XMODEM ([`crc16_xmodem`]) of every byte before the check bytes, sent low byte
+    /// first (2 check bytes): DataLink V2 hub frames ([`crate::datalink`]).
+    Crc16Xmodem,
 }
 
 impl Checksum {
@@ -88,7 +135,7 @@ impl Checksum {
     #[inline]
     pub const fn width(self) -> usize {
         match self {
-            Checksum::Sum16Le => 2,
+            Checksum::Sum16Le | Checksum::Crc16Xmodem => 2,
             Checksum::Sum8 => 1,
         }
     }
@@ -99,6 +146,7 @@ impl Checksum {
         match self {
             Checksum::Sum16Le => sum16(covered),
             Checksum::Sum8 => sum16(covered) & 0xFF,
+            Checksum::Crc16Xmodem => crc16_xmodem(covered),
         }
     }
 
@@ -107,7 +155,9 @@ impl Checksum {
     #[inline(always)]
     pub fn carried(self, check: &[u8]) -> Option<u16> {
         match self {
-            Checksum::Sum16Le => check.first_chunk().map(|&b| u16::from_le_bytes(b)),
+            Checksum::Sum16Le | Checksum::Crc16Xmodem => {
+                check.first_chunk().map(|&b| u16::from_le_bytes(b))
+            }
             Checksum::Sum8 => check.first().map(|&b| u16::from(b)),
         }
     }
@@ -146,7 +196,9 @@ impl Checksum {
         let (covered, check) = frame.split_at_mut(at);
         let value = self.compute(covered);
         match self {
-            Checksum::Sum16Le => check.copy_from_slice(&value.to_le_bytes()),
+            Checksum::Sum16Le | Checksum::Crc16Xmodem => {
+                check.copy_from_slice(&value.to_le_bytes())
+            }
             Checksum::Sum8 => check[0] = value as u8,
         }
     }
@@ -340,6 +392,64 @@ mod tests {
             assert_eq!(byte_ns(baud).to_bits(), old(baud).to_bits(), "{baud}");
         }
         assert_eq!(byte_ns(BAUD_RATE), 10.0e9 / 19200.0);
+    }
+
+    /// CRC-16/XMODEM one bit at a time, straight from its definition.
+    fn crc16_bitwise(bytes: &[u8]) -> u16 {
+        let mut crc = 0u16;
+        for &b in bytes {
+            for bit in (0..8).rev() {
+                let feedback = ((crc >> 15) ^ u16::from(b >> bit)) & 1;
+                crc <<= 1;
+                if feedback != 0 {
+                    crc ^= 0x1021;
+                }
+            }
+        }
+        crc
+    }
+
+    #[test]
+    fn crc16_xmodem_check_value_and_bitwise_reference() {
+        assert_eq!(crc16_xmodem(b"123456789"), 0x31C3);
+        assert_eq!(crc16_bitwise(b"123456789"), 0x31C3);
+        assert_eq!(CRC16_XMODEM_TABLE[1], 0x1021);
+        assert_eq!(CRC16_XMODEM_TABLE[255], 0x1EF0);
+        let mut x = 0x2545_F491_4F6C_DD1Du64;
+        let mut buf = [0u8; 200];
+        for len in 0..buf.len() {
+            for b in buf.iter_mut() {
+                x ^= x << 13;
+                x ^= x >> 7;
+                x ^= x << 17;
+                *b = x as u8;
+            }
+            assert_eq!(
+                crc16_xmodem(&buf[..len]),
+                crc16_bitwise(&buf[..len]),
+                "{len}"
+            );
+        }
+        for b in 0..=255u8 {
+            assert_eq!(crc16_xmodem(&[b]), crc16_bitwise(&[b]));
+        }
+    }
+
+    #[test]
+    fn crc16_xmodem_checksum_arm() {
+        let mut frame = *b"123456789\0\0";
+        Checksum::Crc16Xmodem.seal(&mut frame);
+        assert_eq!(frame[9..], [0xC3, 0x31], "low byte first");
+        assert_eq!(Checksum::Crc16Xmodem.width(), 2);
+        assert_eq!(Checksum::Crc16Xmodem.verify(&frame), Ok(()));
+        frame[0] ^= 0x80;
+        assert_eq!(
+            Checksum::Crc16Xmodem.verify(&frame),
+            Err(FrameError::Checksum {
+                expected: crc16_xmodem(&frame[..9]),
+                found: 0x31C3
+            })
+        );
     }
 
     #[test]

@@ -19,6 +19,11 @@ pub const CMD_DATA: u8 = 0x02;
 pub const DATA_LENGTH_BYTE: u8 = 0x16;
 /// Total length of a data frame on the wire, checksum included.
 pub const DATA_FRAME_LEN: usize = 24;
+/// Length of a data frame's payload, the fields from the packet number to the status word
+/// (bytes 4..22). A DataLink V2 record carries the same bytes after its channel byte.
+pub const DATA_PAYLOAD_LEN: usize = 18;
+
+const _: () = assert!(DATA_FRAME_LEN == 4 + DATA_PAYLOAD_LEN + 2);
 
 /// One real-time telemetry frame (command 0x02), every field as the raw integer sent on the wire.
 ///
@@ -105,22 +110,10 @@ impl sealed::Sealed for DataFrame {
     }
 
     fn write(&self, payload: &mut [u8]) {
-        let words = [
-            self.packet,
-            self.throttle_in_raw,
-            self.throttle_out_raw,
-            self.erpm_raw,
-            self.voltage_raw,
-            self.current_raw as u16,
-            self.phase_current_raw as u16,
-        ];
         // `payload` is bytes 4..22 of the frame.
-        for (i, w) in words.iter().enumerate() {
-            payload[2 * i..2 * i + 2].copy_from_slice(&w.to_be_bytes());
+        if let Ok(payload) = <&mut [u8; DATA_PAYLOAD_LEN]>::try_from(payload) {
+            self.write_payload(payload);
         }
-        payload[14] = self.mos_adc;
-        payload[15] = self.cap_adc;
-        payload[16..18].copy_from_slice(&self.status.0.to_be_bytes());
     }
 
     #[inline(always)]
@@ -139,19 +132,47 @@ impl DataFrame {
     /// Reads the fields of a frame whose header and checksum were already verified.
     #[inline]
     fn from_verified(f: &[u8; DATA_FRAME_LEN]) -> DataFrame {
-        let be = |i: usize| u16::from_be_bytes([f[i], f[i + 1]]);
+        let payload = f[4..4 + DATA_PAYLOAD_LEN].try_into();
+        // Always `Ok`: 18 bytes of a 24-byte array (the `Err` arm is compiled away).
+        Self::read_payload(payload.unwrap_or(&[0; DATA_PAYLOAD_LEN]))
+    }
+
+    /// Reads the fields from a payload (the packet number to the status word, big-endian):
+    /// bytes 4..22 of a data frame, or a DataLink record after its channel byte.
+    #[inline]
+    pub(crate) fn read_payload(p: &[u8; DATA_PAYLOAD_LEN]) -> DataFrame {
+        let be = |i: usize| u16::from_be_bytes([p[i], p[i + 1]]);
         DataFrame {
-            packet: be(4),
-            throttle_in_raw: be(6),
-            throttle_out_raw: be(8),
-            erpm_raw: be(10),
-            voltage_raw: be(12),
-            current_raw: be(14) as i16,
-            phase_current_raw: be(16) as i16,
-            mos_adc: f[18],
-            cap_adc: f[19],
-            status: Status(be(20)),
+            packet: be(0),
+            throttle_in_raw: be(2),
+            throttle_out_raw: be(4),
+            erpm_raw: be(6),
+            voltage_raw: be(8),
+            current_raw: be(10) as i16,
+            phase_current_raw: be(12) as i16,
+            mos_adc: p[14],
+            cap_adc: p[15],
+            status: Status(be(16)),
         }
+    }
+
+    /// Writes the fields as a payload, the inverse of [`DataFrame::read_payload`].
+    pub(crate) fn write_payload(&self, payload: &mut [u8; DATA_PAYLOAD_LEN]) {
+        let words = [
+            self.packet,
+            self.throttle_in_raw,
+            self.throttle_out_raw,
+            self.erpm_raw,
+            self.voltage_raw,
+            self.current_raw as u16,
+            self.phase_current_raw as u16,
+        ];
+        for (i, w) in words.iter().enumerate() {
+            payload[2 * i..2 * i + 2].copy_from_slice(&w.to_be_bytes());
+        }
+        payload[14] = self.mos_adc;
+        payload[15] = self.cap_adc;
+        payload[16..18].copy_from_slice(&self.status.0.to_be_bytes());
     }
 
     /// Encodes the frame as the 24 bytes an ESC sends, header and checksum included.

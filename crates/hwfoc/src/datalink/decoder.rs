@@ -1,0 +1,437 @@
+//! Finding DataLink V2 frames in a byte stream: the streaming [`DatalinkDecoder`] and the bulk
+//! [`frames`] iterator, with the guarantees of the HW-FOC scanner ([`crate::decoder`]).
+//!
+//! The scanner is content-based: a candidate is a `9B` followed by a length byte 0x9E or 0xA0.
+//! It is rejected as soon as its version and command bytes are not `01 02` (a
+//! [bad header](DatalinkStats::bad_headers)), or once its 160 bytes are there and the CRC does
+//! not match (a [CRC failure](DatalinkStats::crc_failures)); a rejected candidate costs one
+//! byte: scanning resumes at the byte after its `9B`, so a lone `9B`, a fake header, a cut frame
+//! or garbage never hides a following intact frame. A verified frame is taken whole. Both
+//! decoders run the same scanner, so they give the same frames and statistics for the same
+//! bytes however the stream is cut into chunks.
+
+use crate::decoder::{bytes_equal, find_sync_then};
+
+use super::frame::{DatalinkFrame, FrameReport};
+use super::layout::{FRAME_LEN, LengthByte, is_version_and_command};
+use super::stats::DatalinkStats;
+
+/// A DataLink frame, where it started in the stream, and what reading its records found.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub struct DatalinkDecoded {
+    /// Offset of the frame's first byte, counting every byte given to the decoder since it was
+    /// created (or, for [`frames`], from the start of the slice).
+    pub offset: u64,
+    /// The frame.
+    pub frame: DatalinkFrame,
+    /// Its length byte, and its empty, bad-channel and duplicate-channel records.
+    pub report: FrameReport,
+}
+
+/// Offset of the first candidate in `hay`: a `9B` followed by 0x9E or 0xA0, or a `9B` that is
+/// the last byte of `hay`.
+#[inline]
+fn find_header(hay: &[u8]) -> Option<usize> {
+    find_sync_then(
+        hay,
+        |b| LengthByte::from_byte(b).is_some(),
+        |word| {
+            bytes_equal(word, LengthByte::Covered.byte())
+                | bytes_equal(word, LengthByte::Total.byte())
+        },
+    )
+}
+
+/// How many bytes of a candidate decide it: 2 while it is only its `9B` (does a length byte
+/// follow?), 4 until its version and command are known, then the whole frame.
+#[inline(always)]
+fn candidate_len(held: usize) -> usize {
+    match held {
+        0 | 1 => 2,
+        2 | 3 => 4,
+        _ => FRAME_LEN,
+    }
+}
+
+/// What a candidate (a `9B` and a length byte, or a `9B` alone at the end) is.
+enum Verdict {
+    Frame(DatalinkFrame, FrameReport),
+    BadHeader,
+    BadCrc,
+    /// More bytes are needed.
+    Undecided,
+}
+
+#[inline(always)]
+fn judge(candidate: &[u8]) -> Verdict {
+    let (Some(&length_byte), Some(&version), Some(&command)) =
+        (candidate.get(1), candidate.get(2), candidate.get(3))
+    else {
+        return Verdict::Undecided;
+    };
+    if !is_version_and_command(version, command) {
+        return Verdict::BadHeader;
+    }
+    let Some(frame) = candidate.first_chunk::<FRAME_LEN>() else {
+        return Verdict::Undecided;
+    };
+    if !DatalinkFrame::crc_ok(frame) {
+        return Verdict::BadCrc;
+    }
+    match LengthByte::from_byte(length_byte) {
+        Some(length_byte) => {
+            let (frame, report) = DatalinkFrame::read(frame, length_byte);
+            Verdict::Frame(frame, report)
+        }
+        // `find_header` stops at no other length byte.
+        None => Verdict::BadHeader,
+    }
+}
+
+/// Finds the next frame in `data` from `*pos`, counting what it passes over in `stats`.
+///
+/// Returns the frame and its start offset, with `*pos` just after it. Returns `None` when no
+/// further frame can be decided: `*pos` is then `data.len()`, or, unless `at_end`, the start of
+/// a candidate that needs more bytes (nothing of it counted yet).
+#[inline(always)]
+fn scan_next(
+    data: &[u8],
+    pos: &mut usize,
+    stats: &mut DatalinkStats,
+    at_end: bool,
+) -> Option<(usize, DatalinkFrame, FrameReport)> {
+    loop {
+        let Some(k) = find_header(&data[*pos..]) else {
+            stats.skip(data.len() - *pos);
+            *pos = data.len();
+            return None;
+        };
+        stats.skip(k);
+        let i = *pos + k;
+        *pos = i;
+        match judge(&data[i..]) {
+            Verdict::Frame(frame, report) => {
+                stats.frame(&frame, &report);
+                *pos = i + FRAME_LEN;
+                return Some((i, frame, report));
+            }
+            Verdict::BadHeader => stats.bad_header(),
+            Verdict::BadCrc => stats.crc_failure(),
+            Verdict::Undecided if !at_end => return None,
+            // Cut off by the end of the stream: skipped, not counted as an error.
+            Verdict::Undecided => {}
+        }
+        stats.skip(1);
+        *pos = i + 1;
+    }
+}
+
+/// Runs the scanner over `data`, whose first byte is at stream offset `base`, giving every frame
+/// to `on_frame`; returns where it stopped (as [`scan_next`] leaves `pos`).
+#[inline(never)]
+fn scan_all<const AT_END: bool>(
+    data: &[u8],
+    base: u64,
+    stats: &mut DatalinkStats,
+    on_frame: &mut impl FnMut(DatalinkDecoded),
+) -> usize {
+    let mut pos = 0;
+    while let Some((at, frame, report)) = scan_next(data, &mut pos, stats, AT_END) {
+        on_frame(DatalinkDecoded {
+            offset: base + at as u64,
+            frame,
+            report,
+        });
+    }
+    pos
+}
+
+/// A streaming DataLink V2 decoder: feed it bytes in any chunking, get every frame once.
+///
+/// Its state is a 159-byte buffer for a frame still arriving plus the [`DatalinkStats`]:
+/// 380 bytes (`size_of::<DatalinkDecoder>()`, checked by a test), no allocation, no timing.
+/// Large chunks are scanned in place; only an unfinished tail is copied.
+///
+/// ```
+/// use hwfoc::datalink::{DatalinkDecoder, DatalinkFrame, LengthByte};
+/// use hwfoc::DataFrame;
+///
+/// let mut frame = DatalinkFrame::new(7);
+/// frame.slots[1] = Some(DataFrame { packet: 300, voltage_raw: 252, ..Default::default() });
+/// let mut wire = vec![0x00, 0x9B, 0x9E]; // noise and a fake header
+/// wire.extend_from_slice(&frame.encode_as(LengthByte::Total));
+///
+/// let mut decoder = DatalinkDecoder::new();
+/// let mut got = Vec::new();
+/// for &byte in &wire {
+///     decoder.push(byte, |d| got.push(d));
+/// }
+/// decoder.flush(|d| got.push(d));
+/// assert_eq!(got.len(), 1);
+/// assert_eq!((got[0].offset, got[0].frame), (3, frame));
+/// let stats = decoder.stats();
+/// assert_eq!((stats.bytes_skipped(), stats.bad_headers()), (3, 1));
+/// assert_eq!(stats.frames_with_length_byte(LengthByte::Total), 1);
+/// assert_eq!(stats.channel(1).unwrap().last(), Some(300));
+/// ```
+#[derive(Debug, Clone)]
+pub struct DatalinkDecoder {
+    buf: [u8; FRAME_LEN - 1],
+    len: u8,
+    stats: DatalinkStats,
+}
+
+impl Default for DatalinkDecoder {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl DatalinkDecoder {
+    /// A decoder with an empty buffer and zero statistics.
+    pub const fn new() -> Self {
+        DatalinkDecoder {
+            buf: [0; FRAME_LEN - 1],
+            len: 0,
+            stats: DatalinkStats::new(),
+        }
+    }
+
+    /// Feeds one byte; `on_frame` is called for each frame it completes (at most one).
+    #[inline]
+    pub fn push(&mut self, byte: u8, on_frame: impl FnMut(DatalinkDecoded)) {
+        self.feed(&[byte], on_frame);
+    }
+
+    /// Feeds a chunk of bytes; `on_frame` is called for each frame found, in stream order.
+    pub fn feed(&mut self, data: &[u8], mut on_frame: impl FnMut(DatalinkDecoded)) {
+        if data.is_empty() {
+            return;
+        }
+        let start = self.stats.bytes();
+        self.stats.add_bytes(data.len());
+        let mut data = data;
+        let mut base = start;
+        if self.len > 0 {
+            let held = usize::from(self.len);
+            // The held candidate cannot be decided with these bytes yet: just keep them.
+            if held + data.len() < candidate_len(held) {
+                self.buf[held..held + data.len()].copy_from_slice(data);
+                self.len += data.len() as u8;
+                return;
+            }
+            // Finish the held candidate with the first bytes of `data`: a candidate starting in
+            // the held bytes is decided by at most FRAME_LEN bytes from its start, so appending
+            // that many decides every one of them whenever `data` is long enough.
+            let take = data.len().min(FRAME_LEN);
+            let mut tmp = [0u8; 2 * FRAME_LEN];
+            tmp[..held].copy_from_slice(&self.buf[..held]);
+            tmp[held..held + take].copy_from_slice(&data[..take]);
+            let n = held + take;
+            let tmp_base = start - held as u64;
+            let pos = scan_all::<false>(&tmp[..n], tmp_base, &mut self.stats, &mut on_frame);
+            let Some(used) = pos.checked_sub(held) else {
+                // `data` ran out before the held candidate was decided.
+                self.hold(&tmp[pos..n]);
+                return;
+            };
+            data = &data[used..];
+            base += used as u64;
+        }
+        let pos = scan_all::<false>(data, base, &mut self.stats, &mut on_frame);
+        self.hold(&data[pos..]);
+    }
+
+    /// Keeps an undecided candidate (always shorter than a whole frame) for the next call.
+    fn hold(&mut self, tail: &[u8]) {
+        self.buf[..tail.len()].copy_from_slice(tail);
+        self.len = tail.len() as u8;
+    }
+
+    /// Decides the held bytes now, as if the stream ended here: a frame cut short is dropped
+    /// (its bytes counted as skipped) and any frame inside it is still found. Call it at the end
+    /// of a stream, or when the line falls silent ([`DatalinkDecoder::line_silent`] does).
+    /// Statistics and counter tracking carry on across the call.
+    pub fn flush(&mut self, mut on_frame: impl FnMut(DatalinkDecoded)) {
+        let held = usize::from(self.len);
+        let base = self.stats.bytes() - held as u64;
+        scan_all::<true>(&self.buf[..held], base, &mut self.stats, &mut on_frame);
+        self.len = 0;
+    }
+
+    /// Tells the decoder that the line has just been silent for a time in which at most
+    /// `max_frames` DataLink frames could have been sent (160 byte times each at
+    /// [`BAUD_RATE`](super::BAUD_RATE), about 13.9 ms); `on_frame` gets the frames still found in
+    /// the bytes held back before the silence.
+    ///
+    /// As [`Decoder::line_silent`](crate::Decoder::line_silent): the held bytes are decided at
+    /// once ([`DatalinkDecoder::flush`]), and the next frame's counter step counts as a loss only
+    /// up to `max_frames + 1` (a larger step is a restart). Each channel's next packet-number
+    /// step counts as a loss only up to [`esc_frames_in`](super::esc_frames_in)`(max_frames) + 1`,
+    /// the most frames that ESC could have sent on its own 19200-baud wire in that time.
+    ///
+    /// ```
+    /// use hwfoc::datalink::{BAUD_RATE, DatalinkDecoder, DatalinkFrame, FRAME_LEN};
+    /// use hwfoc::wire::byte_ns;
+    ///
+    /// let mut decoder = DatalinkDecoder::new();
+    /// decoder.feed(&DatalinkFrame::new(1000).encode(), |_| {});
+    /// // 1 s without a byte: at most 1 s / 160 byte times = 72 frames could have been sent.
+    /// let max_frames = (1e9 / (FRAME_LEN as f64 * byte_ns(BAUD_RATE))) as u32;
+    /// assert_eq!(max_frames, 72);
+    /// decoder.line_silent(max_frames, |_| {});
+    /// decoder.feed(&DatalinkFrame::new(1200).encode(), |_| {}); // the hub restarted
+    /// decoder.feed(&DatalinkFrame::new(1203).encode(), |_| {}); // 2 frames lost
+    /// assert_eq!(decoder.stats().restarts(), 1);
+    /// assert_eq!(decoder.stats().lost_frames(), 2);
+    /// ```
+    pub fn line_silent(&mut self, max_frames: u32, on_frame: impl FnMut(DatalinkDecoded)) {
+        self.flush(on_frame);
+        self.stats.line_silent(max_frames);
+    }
+
+    /// Feeds a whole stream and flushes it: the bulk path for a buffer in memory.
+    pub fn decode_all(&mut self, data: &[u8], mut on_frame: impl FnMut(DatalinkDecoded)) {
+        self.feed(data, &mut on_frame);
+        self.flush(on_frame);
+    }
+
+    /// Bytes held for a frame that has not finished arriving (always fewer than 160).
+    pub fn buffered(&self) -> usize {
+        usize::from(self.len)
+    }
+
+    /// The statistics so far.
+    pub fn stats(&self) -> &DatalinkStats {
+        &self.stats
+    }
+
+    /// Forgets held bytes and statistics, as new.
+    pub fn reset(&mut self) {
+        *self = Self::new();
+    }
+}
+
+/// Decodes every DataLink frame in a complete buffer, in place: the bulk path.
+///
+/// The iterator borrows the slice and allocates nothing; a frame cut off by the end of the
+/// slice is skipped. It yields exactly what a [`DatalinkDecoder`] fed the same bytes and then
+/// flushed would, with the same statistics.
+///
+/// ```
+/// use hwfoc::datalink::{self, DatalinkFrame};
+///
+/// let mut wire = Vec::new();
+/// for counter in 0..3u16 {
+///     wire.extend_from_slice(&DatalinkFrame::new(counter).encode());
+/// }
+/// wire[200] ^= 0x04; // corrupt the second frame
+/// let mut it = datalink::frames(&wire);
+/// let counters: Vec<u16> = it.by_ref().map(|d| d.frame.counter).collect();
+/// assert_eq!(counters, [0, 2]);
+/// assert_eq!(it.stats().crc_failures(), 1);
+/// assert_eq!(it.stats().lost_frames(), 1);
+/// ```
+pub fn frames(data: &[u8]) -> DatalinkFrames<'_> {
+    let mut stats = DatalinkStats::new();
+    stats.add_bytes(data.len());
+    DatalinkFrames {
+        data,
+        pos: 0,
+        stats,
+    }
+}
+
+/// Iterator returned by [`frames`].
+#[derive(Debug, Clone)]
+pub struct DatalinkFrames<'a> {
+    data: &'a [u8],
+    pos: usize,
+    stats: DatalinkStats,
+}
+
+impl DatalinkFrames<'_> {
+    /// Statistics of the bytes scanned so far (complete once the iterator has returned `None`;
+    /// [`DatalinkStats::bytes`] is the whole slice from the start).
+    pub fn stats(&self) -> &DatalinkStats {
+        &self.stats
+    }
+}
+
+impl Iterator for DatalinkFrames<'_> {
+    type Item = DatalinkDecoded;
+
+    #[inline]
+    fn next(&mut self) -> Option<DatalinkDecoded> {
+        scan_next(self.data, &mut self.pos, &mut self.stats, true).map(|(at, frame, report)| {
+            DatalinkDecoded {
+                offset: at as u64,
+                frame,
+                report,
+            }
+        })
+    }
+}
+
+impl core::iter::FusedIterator for DatalinkFrames<'_> {}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::wire::SYNC;
+
+    #[test]
+    fn find_header_matches_a_plain_search() {
+        fn plain(h: &[u8]) -> Option<usize> {
+            (0..h.len())
+                .find(|&j| h[j] == SYNC && h.get(j + 1).is_none_or(|&l| l == 0x9E || l == 0xA0))
+        }
+        let mut x = 0x1234_5678_9abc_def0u64;
+        let mut hay = [0u8; 150];
+        for round in 0..20_000 {
+            let density = round % 7;
+            for b in hay.iter_mut() {
+                x ^= x << 13;
+                x ^= x >> 7;
+                x ^= x << 17;
+                *b = match (x >> 60) as usize % (density + 2) {
+                    0 => SYNC,
+                    1 => [0x9E, 0xA0, 0x9D, 0x9F, 0xA1, 0x16][(x >> 8) as usize % 6],
+                    _ => x as u8,
+                };
+            }
+            let len = (x >> 16) as usize % (hay.len() + 1);
+            for start in [0, 1, 5, 31, 33].into_iter().filter(|&s| s <= len) {
+                let h = &hay[start..len];
+                assert_eq!(find_header(h), plain(h), "{h:02X?}");
+            }
+        }
+    }
+
+    #[test]
+    fn state_size() {
+        assert_eq!(size_of::<DatalinkDecoder>(), 380);
+        assert!(size_of::<DatalinkDecoder>() <= 384);
+    }
+
+    #[test]
+    fn held_candidate_resolves_across_calls() {
+        let f = DatalinkFrame::new(9).encode();
+        let mut d = DatalinkDecoder::new();
+        let mut n = 0;
+        for (i, chunk) in [&f[..1], &f[1..3], &f[3..4], &f[4..159]].iter().enumerate() {
+            d.feed(chunk, |_| n += 1);
+            assert_eq!((n, d.buffered()), (0, [1, 3, 4, 159][i]));
+        }
+        d.feed(&f[159..], |x| {
+            assert_eq!(x.offset, 0);
+            n += 1
+        });
+        assert_eq!((n, d.buffered()), (1, 0));
+        // A bad header is decided on its fourth byte, without waiting for 160 bytes.
+        d.feed(&[SYNC, 0x9E, 0x01], |_| n += 1);
+        assert_eq!(d.buffered(), 3);
+        d.feed(&[0x03], |_| n += 1);
+        assert_eq!((d.buffered(), d.stats().bad_headers()), (0, 1));
+    }
+}
