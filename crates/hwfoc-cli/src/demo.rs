@@ -108,7 +108,7 @@ mod tests {
         let mut input = Input::from_memory("demo", capture_csv()).unwrap();
         let mut stream = Stream::new();
         let (mut data, mut info, mut faulted, mut braking) = (0, 0, 0, 0);
-        let mut on_frame = |t: Option<f64>, d: &hwfoc::Decoded| {
+        let mut on_frame = |t: Option<f64>, _channel: Option<u8>, d: &hwfoc::Decoded| {
             assert!(t.is_some());
             match d.frame {
                 Frame::Data(f) => {

@@ -9,11 +9,12 @@
 
 use std::collections::HashMap;
 
-use hwfoc::Settings;
+use hwfoc::datalink::{CHANNELS, DatalinkStats};
+use hwfoc::{Decoded, Settings};
 
 pub use crate::handler::Handler;
 use crate::input::{Input, InputError, InputFormat};
-use crate::stream::Stream;
+use crate::stream::{EscLink, Stream};
 
 /// Batches shorter than this come from a live source: what they produce is passed on at once.
 const LIVE_BATCH: usize = 4096;
@@ -28,8 +29,11 @@ pub struct Esc {
     pub input: usize,
     /// Name of the stream: the port it was recorded from, or the input's name.
     pub name: String,
-    /// Its decoder and receive times; its link statistics.
+    /// Its decoder and receive times; its link statistics. (Behind a DataLink hub, the hub's
+    /// stream is that of the ESC on channel 0; the others' is never fed: see [`Sources::link`].)
     pub stream: Stream,
+    /// Behind a DataLink hub: the ESC whose stream carries this one's frames, and its channel.
+    pub hub: Option<(usize, u8)>,
 }
 
 /// What is known about an input once it has been read.
@@ -57,6 +61,9 @@ pub struct Sources {
     need_timing: bool,
     /// The ESC of each port named by a recording's interface so far.
     ports: HashMap<String, usize>,
+    /// The ESC of each channel of each stream found to come from a DataLink hub, by the ESC
+    /// of its stream.
+    hubs: HashMap<usize, [usize; CHANNELS]>,
 }
 
 impl Sources {
@@ -71,6 +78,7 @@ impl Sources {
             escs: Vec::new(),
             need_timing: false,
             ports: HashMap::new(),
+            hubs: HashMap::new(),
         }
     }
 
@@ -105,6 +113,30 @@ impl Sources {
     /// The ESCs found so far, by index.
     pub fn escs(&self) -> &[Esc] {
         &self.escs
+    }
+
+    /// The DataLink hubs found: the ESC whose stream each came in (its channel 0), and the
+    /// hub link's statistics.
+    pub fn hubs(&self) -> impl Iterator<Item = (usize, DatalinkStats)> + '_ {
+        let mut owners: Vec<usize> = self.hubs.keys().copied().collect();
+        owners.sort_unstable();
+        owners
+            .into_iter()
+            .filter_map(|esc| Some((esc, *self.escs[esc].stream.hub()?)))
+    }
+
+    /// Whether ESC `esc` is a channel of a DataLink hub.
+    pub fn is_hub(&self, esc: usize) -> bool {
+        self.escs[esc].hub.is_some() || self.hubs.contains_key(&esc)
+    }
+
+    /// The link statistics of ESC `esc` (behind a DataLink hub, its channel's and the hub
+    /// link's).
+    pub fn link(&self, esc: usize) -> EscLink {
+        match self.escs[esc].hub {
+            Some((owner, channel)) => self.escs[owner].stream.link(channel),
+            None => self.escs[esc].stream.stats(),
+        }
     }
 
     /// Reads every input to its end, in order, handing each frame and the end of each batch
@@ -152,6 +184,14 @@ impl Sources {
         for esc in 0..self.escs.len() {
             self.finish(esc, handler);
         }
+        // A hub's channels that carried an ESC are ESCs of its input.
+        for esc in 0..self.escs.len() {
+            if self.escs[esc].hub.is_some() && self.link(esc).frames() > 0 {
+                let escs = &mut self.read[self.escs[esc].input].escs;
+                escs.push(esc);
+                escs.sort_unstable();
+            }
+        }
         result?;
         handler.end_batch(false)
     }
@@ -162,10 +202,50 @@ impl Sources {
         // Every stream has an index below 256 (checked when it was made).
         let id = u8::try_from(esc).unwrap_or(u8::MAX);
         let settings = &self.settings;
+        let hub = self.hubs.get(&esc).copied();
+        let mut pending = Vec::new();
         self.escs[esc].stream.finish(
             #[inline(always)]
-            |t, d| handler.frame(id, t, d, settings),
+            |t, channel, d| route(id, hub, t, channel, d, settings, handler, &mut pending),
         );
+        self.deliver(esc, pending, handler);
+    }
+
+    /// Hands on the frames of a stream just found to come from a DataLink hub, once its
+    /// channels have ESCs (made here, in channel order: channel 0 is the stream's own ESC).
+    fn deliver<H: Handler>(&mut self, esc: usize, pending: Vec<Pending>, handler: &mut H) {
+        if pending.is_empty() {
+            return;
+        }
+        let channels = match self.hubs.get(&esc) {
+            Some(&channels) => channels,
+            None => {
+                let mut channels = [esc; CHANNELS];
+                let name = self.escs[esc].name.clone();
+                self.escs[esc].name = format!("{name} channel 0");
+                for (channel, slot) in channels.iter_mut().enumerate().skip(1) {
+                    if self.escs.len() >= MAX_ESCS {
+                        // Not numbered: the `esc` column cannot tell it from another.
+                        *slot = usize::MAX;
+                        continue;
+                    }
+                    *slot = self.escs.len();
+                    self.escs.push(Esc {
+                        input: self.escs[esc].input,
+                        name: format!("{name} channel {channel}"),
+                        stream: Stream::new(),
+                        hub: Some((esc, channel as u8)),
+                    });
+                }
+                self.hubs.insert(esc, channels);
+                channels
+            }
+        };
+        for (t, channel, d) in pending {
+            if let Ok(id) = u8::try_from(channels[usize::from(channel)]) {
+                handler.frame(id, t, &d, &self.settings);
+            }
+        }
     }
 
     /// The ESC of stream `stream` of `input` (number `index`), made when first seen; `escs`
@@ -202,6 +282,7 @@ impl Sources {
                     input: index,
                     name,
                     stream: Stream::new(),
+                    hub: None,
                 });
                 self.escs.len() - 1
             }
@@ -241,15 +322,46 @@ impl Sources {
             };
             let id = u8::try_from(esc).unwrap_or(u8::MAX);
             let settings = &self.settings;
+            let hub = self.hubs.get(&esc).copied();
+            let mut pending = Vec::new();
             // Inlined into the decoder's loop, so that the handler may be too: a frame's fields
             // then reach it in registers, not through a `Decoded` stored and loaded back.
             self.escs[esc].stream.feed(
                 batch,
                 #[inline(always)]
-                |t, d| handler.frame(id, t, d, settings),
+                |t, channel, d| route(id, hub, t, channel, d, settings, handler, &mut pending),
             );
+            self.deliver(esc, pending, handler);
             handler.end_batch(len < LIVE_BATCH)?;
         }
+    }
+}
+
+/// A frame of a DataLink channel that has no ESC yet: its time, channel and frame.
+type Pending = (Option<f64>, u8, Decoded);
+
+/// Hands a frame of the stream of ESC `id` to `handler`: as that ESC's on its own wire, as its
+/// channel's ESC behind a hub whose channels are numbered (`hub`), or else into `pending`.
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+fn route<H: Handler>(
+    id: u8,
+    hub: Option<[usize; CHANNELS]>,
+    t: Option<f64>,
+    channel: Option<u8>,
+    d: &Decoded,
+    settings: &Settings,
+    handler: &mut H,
+    pending: &mut Vec<Pending>,
+) {
+    match (channel, hub) {
+        (None, _) => handler.frame(id, t, d, settings),
+        (Some(c), Some(channels)) => {
+            if let Ok(esc) = u8::try_from(channels[usize::from(c)]) {
+                handler.frame(esc, t, d, settings);
+            }
+        }
+        (Some(c), None) => pending.push((t, c, *d)),
     }
 }
 

@@ -5,7 +5,9 @@
 //! port events). [`byte_times`] is the one place where a chunk's receive time becomes the time
 //! of each of its bytes.
 
-use hwfoc::{Decoded, Decoder, LinkStats, Settings};
+use hwfoc::datalink::{self, DatalinkDecoded, DatalinkDecoder, DatalinkStats};
+use hwfoc::stats::PacketSequence;
+use hwfoc::{Decoded, Decoder, Frame, LinkStats, Settings};
 
 use crate::handler::Handler;
 
@@ -21,8 +23,13 @@ pub fn byte_times(t_ns: u64, per_byte_ns: f64, n: usize, times: &mut Vec<f64>) {
 }
 
 /// How many receive times to keep from earlier batches: a frame still arriving is shorter than
-/// the longest frame (77 bytes), so its first byte is never further back than this.
-const TIME_HISTORY: usize = hwfoc::frame::MAX_FRAME_LEN;
+/// the longest frame (a DataLink frame, 160 bytes), so its first byte is never further back
+/// than this.
+const TIME_HISTORY: usize = if hwfoc::frame::MAX_FRAME_LEN > datalink::FRAME_LEN {
+    hwfoc::frame::MAX_FRAME_LEN
+} else {
+    datalink::FRAME_LEN
+};
 
 /// A silence of the line longer than this, between two bytes, may hide a restart of the ESC:
 /// the decoder is told of it (see [`hwfoc::Decoder::line_silent`]). Real ESCs send a frame at
@@ -36,10 +43,234 @@ fn frames_in(seconds: f64) -> u32 {
     (seconds / frame_s).ceil().min(f64::from(u32::MAX)) as u32
 }
 
-/// A [`Decoder`] that also gives each frame the receive time of its first byte.
+/// The most DataLink frames a silence of `seconds` can have hidden: one per 160 byte times at
+/// the hub's 115200 baud.
+fn hub_frames_in(seconds: f64) -> u32 {
+    let frame_s = datalink::FRAME_LEN as f64 * hwfoc::wire::byte_ns(datalink::BAUD_RATE) * 1e-9;
+    (seconds / frame_s).ceil().min(f64::from(u32::MAX)) as u32
+}
+
+/// Which protocol a stream speaks, known from its first verified frame.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum WireKind {
+    /// No frame yet: the bytes go to both decoders.
+    Unknown,
+    /// One ESC's own wire: HW-FOC frames at 19200 baud.
+    Esc,
+    /// A Hobbywing DataLink V2 hub: frames of up to eight ESCs at 115200 baud.
+    Hub,
+}
+
+/// The decoder(s) of a stream.
+#[derive(Debug, Clone)]
+enum Wire {
+    /// Before the first frame: both decoders see every byte, and the first to find a frame
+    /// decides (a HW-FOC frame and a DataLink frame each carry a checksum over their bytes, so a
+    /// stream of one protocol does not pass for the other).
+    Detecting(Box<(Decoder, DatalinkDecoder)>),
+    Esc(Decoder),
+    Hub(Box<DatalinkDecoder>),
+}
+
+impl Default for Wire {
+    fn default() -> Self {
+        Wire::Detecting(Box::default())
+    }
+}
+
+/// A frame found while detecting, kept until the batch is done.
+enum Found {
+    Esc(Decoded),
+    Hub(DatalinkDecoded),
+}
+
+/// Hands each ESC frame of a hub frame on as `(channel, decoded)`, at the hub frame's offset.
+#[inline]
+fn hub_records(d: &DatalinkDecoded, emit: &mut impl FnMut(Option<u8>, &Decoded)) {
+    for (channel, frame) in d.frame.escs() {
+        let decoded = Decoded {
+            offset: d.offset,
+            frame: Frame::Data(*frame),
+        };
+        emit(Some(channel as u8), &decoded);
+    }
+}
+
+impl Wire {
+    /// Decodes `data` (ending with a silence of the line of `silence_s` seconds when given):
+    /// `emit(channel, decoded)` gets each ESC frame with its DataLink channel (`None` on an
+    /// ESC's own wire).
+    #[inline(always)]
+    fn feed(
+        &mut self,
+        data: &[u8],
+        silence_s: Option<f64>,
+        emit: &mut impl FnMut(Option<u8>, &Decoded),
+    ) {
+        match self {
+            Wire::Esc(decoder) => {
+                decoder.feed(data, |d| emit(None, &d));
+                if let Some(s) = silence_s {
+                    decoder.line_silent(frames_in(s), |d| emit(None, &d));
+                }
+            }
+            Wire::Hub(decoder) => {
+                decoder.feed(data, |d| hub_records(&d, emit));
+                if let Some(s) = silence_s {
+                    decoder.line_silent(hub_frames_in(s), |d| hub_records(&d, emit));
+                }
+            }
+            Wire::Detecting(both) => {
+                let (esc, hub) = &mut **both;
+                let mut found = Vec::new();
+                esc.feed(data, |d| found.push(Found::Esc(d)));
+                hub.feed(data, |d| found.push(Found::Hub(d)));
+                if let Some(s) = silence_s {
+                    esc.line_silent(frames_in(s), |d| found.push(Found::Esc(d)));
+                    hub.line_silent(hub_frames_in(s), |d| found.push(Found::Hub(d)));
+                }
+                self.decide(found, emit);
+            }
+        }
+    }
+
+    /// Settles the bytes held, as at the end of the stream.
+    fn flush(&mut self, emit: &mut impl FnMut(Option<u8>, &Decoded)) {
+        match self {
+            Wire::Esc(decoder) => decoder.flush(|d| emit(None, &d)),
+            Wire::Hub(decoder) => decoder.flush(|d| hub_records(&d, emit)),
+            Wire::Detecting(both) => {
+                let (esc, hub) = &mut **both;
+                let mut found = Vec::new();
+                esc.flush(|d| found.push(Found::Esc(d)));
+                hub.flush(|d| found.push(Found::Hub(d)));
+                self.decide(found, emit);
+            }
+        }
+    }
+
+    /// Keeps the decoder that found a frame (a hub frame wins: its 160 bytes and CRC-16 make
+    /// it the stronger evidence) and hands on its frames.
+    fn decide(&mut self, found: Vec<Found>, emit: &mut impl FnMut(Option<u8>, &Decoded)) {
+        let Wire::Detecting(both) = self else {
+            return;
+        };
+        let hub = found.iter().any(|f| matches!(f, Found::Hub(_)));
+        if hub {
+            *self = Wire::Hub(Box::new(both.1.clone()));
+        } else if !found.is_empty() {
+            *self = Wire::Esc(both.0.clone());
+        }
+        for f in &found {
+            match f {
+                Found::Hub(d) if hub => hub_records(d, emit),
+                Found::Esc(d) if !hub => emit(None, d),
+                _ => {}
+            }
+        }
+    }
+
+    fn bytes(&self) -> u64 {
+        match self {
+            Wire::Esc(d) => d.stats().bytes(),
+            Wire::Hub(d) => d.stats().bytes(),
+            Wire::Detecting(both) => both.0.stats().bytes(),
+        }
+    }
+}
+
+/// The link statistics of one ESC: those of its own wire, or of its channel of a DataLink hub
+/// (whose bytes, skipped bytes and CRC failures are the hub link's, shared by its channels).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum EscLink {
+    /// An ESC on its own wire (or a stream whose protocol is not known yet).
+    Wire(LinkStats),
+    /// Channel `channel` of a DataLink hub.
+    Hub {
+        /// The hub link's statistics.
+        hub: DatalinkStats,
+        /// The ESC's channel.
+        channel: usize,
+    },
+}
+
+impl Default for EscLink {
+    fn default() -> Self {
+        EscLink::Wire(LinkStats::new())
+    }
+}
+
+impl EscLink {
+    fn channel(&self) -> Option<&PacketSequence> {
+        match self {
+            EscLink::Wire(s) => Some(s.packets()),
+            EscLink::Hub { hub, channel } => hub.channel(*channel),
+        }
+    }
+
+    /// Bytes of the stream the ESC's frames came in.
+    pub fn bytes(&self) -> u64 {
+        match self {
+            EscLink::Wire(s) => s.bytes(),
+            EscLink::Hub { hub, .. } => hub.bytes(),
+        }
+    }
+
+    /// Bytes of that stream that were in no accepted frame.
+    pub fn bytes_skipped(&self) -> u64 {
+        match self {
+            EscLink::Wire(s) => s.bytes_skipped(),
+            EscLink::Hub { hub, .. } => hub.bytes_skipped(),
+        }
+    }
+
+    /// Data frames of the ESC (records of its channel, behind a hub).
+    pub fn frames(&self) -> u32 {
+        self.channel().map_or(0, PacketSequence::count)
+    }
+
+    /// Device-information frames (a hub forwards none).
+    pub fn info_frames(&self) -> u32 {
+        match self {
+            EscLink::Wire(s) => s.info_frames(),
+            EscLink::Hub { .. } => 0,
+        }
+    }
+
+    /// Frames rejected by their checksum (behind a hub: the hub frames' CRC failures).
+    pub fn checksum_failures(&self) -> u32 {
+        match self {
+            EscLink::Wire(s) => s.checksum_failures(),
+            EscLink::Hub { hub, .. } => hub.crc_failures(),
+        }
+    }
+
+    /// Packet numbers skipped.
+    pub fn lost_packets(&self) -> u32 {
+        self.channel().map_or(0, PacketSequence::lost)
+    }
+
+    /// Packet numbers received twice in a row.
+    pub fn duplicate_packets(&self) -> u32 {
+        self.channel().map_or(0, PacketSequence::duplicates)
+    }
+
+    /// Jumps of the packet numbers that no loss explains.
+    pub fn restarts(&self) -> u32 {
+        self.channel().map_or(0, PacketSequence::restarts)
+    }
+
+    /// Frames received over frames sent, from the packet numbers.
+    pub fn delivery_ratio(&self) -> Option<f64> {
+        self.channel().and_then(PacketSequence::delivery_ratio)
+    }
+}
+
+/// A decoder that also gives each frame the receive time of its first byte, and finds out
+/// from the bytes whether they come from one ESC or from a DataLink hub.
 #[derive(Debug, Default)]
 pub struct Stream {
-    decoder: Decoder,
+    wire: Wire,
     /// Receive times of the last bytes of earlier batches, oldest first.
     history: Vec<f64>,
 }
@@ -50,21 +281,27 @@ impl Stream {
         Stream::default()
     }
 
-    /// Decodes a batch; `on_frame` gets each frame with its time (`None` without timing).
-    pub fn feed(&mut self, batch: Batch<'_>, mut on_frame: impl FnMut(Option<f64>, &Decoded)) {
-        let start = self.decoder.stats().bytes();
+    /// Decodes a batch; `on_frame(t, channel, decoded)` gets each ESC frame with its time
+    /// (`None` without timing) and its DataLink channel (`None` on an ESC's own wire).
+    #[inline(always)]
+    pub fn feed(
+        &mut self,
+        batch: Batch<'_>,
+        mut on_frame: impl FnMut(Option<f64>, Option<u8>, &Decoded),
+    ) {
+        let start = self.wire.bytes();
         match batch.times {
             None => {
                 self.history.clear();
-                self.decoder.feed(
-                    batch.bytes,
-                    #[inline(always)]
-                    |d| on_frame(None, &d),
-                );
+                self.wire.feed(batch.bytes, None, &mut |channel, d| {
+                    on_frame(None, channel, d)
+                });
             }
             Some(times) => {
                 let history = &self.history;
-                let decoder = &mut self.decoder;
+                let mut emit = |channel: Option<u8>, d: &Decoded| {
+                    on_frame(Some(time_at(history, times, start, d.offset)), channel, d)
+                };
                 // The batch in pieces at each silence of the line: the decoder is told how many
                 // frames the silence could have hidden, so that an ESC that restarted in it is
                 // counted as a restart, not as thousands of lost packets.
@@ -74,23 +311,13 @@ impl Stream {
                     if let Some(before) = last
                         && t - before > SILENCE_S
                     {
-                        decoder.feed(
-                            &batch.bytes[from..i],
-                            #[inline(always)]
-                            |d| on_frame(Some(time_at(history, times, start, d.offset)), &d),
-                        );
-                        decoder.line_silent(frames_in(t - before), |d| {
-                            on_frame(Some(time_at(history, times, start, d.offset)), &d)
-                        });
+                        self.wire
+                            .feed(&batch.bytes[from..i], Some(t - before), &mut emit);
                         from = i;
                     }
                     last = Some(t);
                 }
-                decoder.feed(
-                    &batch.bytes[from..],
-                    #[inline(always)]
-                    |d| on_frame(Some(time_at(history, times, start, d.offset)), &d),
-                );
+                self.wire.feed(&batch.bytes[from..], None, &mut emit);
                 let keep = TIME_HISTORY.min(self.history.len() + times.len());
                 let from_times = keep.min(times.len());
                 let from_history = keep - from_times;
@@ -102,22 +329,48 @@ impl Stream {
     }
 
     /// Ends the stream: a frame cut off at the end is dropped, frames inside it are still found.
-    pub fn finish(&mut self, mut on_frame: impl FnMut(Option<f64>, &Decoded)) {
-        let end = self.decoder.stats().bytes();
+    pub fn finish(&mut self, mut on_frame: impl FnMut(Option<f64>, Option<u8>, &Decoded)) {
+        let end = self.wire.bytes();
         let history = &self.history;
         let timed = !history.is_empty();
-        self.decoder.flush(
-            #[inline(always)]
-            |d| {
-                let t = timed.then(|| time_at(history, &[], end, d.offset));
-                on_frame(t, &d)
-            },
-        );
+        self.wire.flush(&mut |channel, d| {
+            let t = timed.then(|| time_at(history, &[], end, d.offset));
+            on_frame(t, channel, d)
+        });
     }
 
-    /// The link statistics so far.
-    pub fn stats(&self) -> &LinkStats {
-        self.decoder.stats()
+    /// What the stream turned out to be.
+    pub fn kind(&self) -> WireKind {
+        match self.wire {
+            Wire::Detecting(_) => WireKind::Unknown,
+            Wire::Esc(_) => WireKind::Esc,
+            Wire::Hub(_) => WireKind::Hub,
+        }
+    }
+
+    /// The link statistics of the stream's ESC (its channel 0, from a DataLink hub).
+    pub fn stats(&self) -> EscLink {
+        self.link(0)
+    }
+
+    /// The link statistics of the stream's ESC on `channel` (any channel on an ESC's own wire).
+    pub fn link(&self, channel: u8) -> EscLink {
+        match &self.wire {
+            Wire::Esc(d) => EscLink::Wire(*d.stats()),
+            Wire::Detecting(both) => EscLink::Wire(*both.0.stats()),
+            Wire::Hub(d) => EscLink::Hub {
+                hub: *d.stats(),
+                channel: usize::from(channel),
+            },
+        }
+    }
+
+    /// The DataLink hub's statistics, when the stream is one.
+    pub fn hub(&self) -> Option<&DatalinkStats> {
+        match &self.wire {
+            Wire::Hub(d) => Some(d.stats()),
+            _ => None,
+        }
     }
 }
 
@@ -145,26 +398,29 @@ impl PortStreams {
     }
 
     /// Decodes the bytes of a [`PortEvent::Data`], handing each frame completed to `handler`
-    /// as ESC number `port` (records of ports past 255 are not made: the `esc` column numbers
-    /// 256). Other events, and ports beyond those made, are ignored. Returns the port's link
-    /// statistics after the bytes, or `None` when there were no bytes for a known port.
-    pub fn feed<H: Handler>(&mut self, event: &PortEvent, handler: &mut H) -> Option<&LinkStats> {
+    /// as ESC number `port`, or, from a DataLink hub, as ESC `8 * port + channel` (so a hub
+    /// read alone numbers its ESCs by channel; records numbered past 255 are not made: the
+    /// `esc` column numbers 256). Other events, and ports beyond those made, are ignored.
+    /// Returns the port's link statistics after the bytes (of its channel 0, from a hub), or
+    /// `None` when there were no bytes for a known port.
+    pub fn feed<H: Handler>(&mut self, event: &PortEvent, handler: &mut H) -> Option<EscLink> {
         let PortEvent::Data { port, t_ns, bytes } = event else {
             return None;
         };
         let stream = self.streams.get_mut(*port)?;
         self.times.clear();
         byte_times(*t_ns, self.per_byte_ns, bytes.len(), &mut self.times);
-        let esc = u8::try_from(*port).ok();
         let settings = &self.settings;
+        let hub_base = port.saturating_mul(datalink::CHANNELS);
         stream.feed(
             Batch {
                 bytes,
                 times: Some(&self.times),
                 stream: *port,
             },
-            |t, d| {
-                if let Some(esc) = esc {
+            |t, channel, d| {
+                let esc = channel.map_or(*port, |c| hub_base + usize::from(c));
+                if let Ok(esc) = u8::try_from(esc) {
                     handler.frame(esc, t, d, settings);
                 }
             },
@@ -172,9 +428,14 @@ impl PortStreams {
         Some(stream.stats())
     }
 
-    /// The link statistics of `port`'s stream.
-    pub fn stats(&self, port: usize) -> Option<&LinkStats> {
+    /// The link statistics of `port`'s stream (of its channel 0, from a hub).
+    pub fn stats(&self, port: usize) -> Option<EscLink> {
         self.streams.get(port).map(Stream::stats)
+    }
+
+    /// The stream of `port`.
+    pub fn stream(&self, port: usize) -> Option<&Stream> {
+        self.streams.get(port)
     }
 }
 
@@ -218,10 +479,10 @@ mod tests {
                         times: Some(t),
                         stream: 0,
                     },
-                    |t, _| got.push(t.unwrap()),
+                    |t, _, _| got.push(t.unwrap()),
                 );
             }
-            stream.finish(|t, _| got.push(t.unwrap()));
+            stream.finish(|t, _, _| got.push(t.unwrap()));
             assert_eq!(got, expected, "batches of {batch}");
         }
     }
@@ -244,7 +505,7 @@ mod tests {
     }
 
     /// The statistics of a stream fed `parts`, each a batch, in batches of `chunk` bytes.
-    fn run(parts: &[(Vec<u8>, Vec<f64>)], chunk: usize) -> LinkStats {
+    fn run(parts: &[(Vec<u8>, Vec<f64>)], chunk: usize) -> EscLink {
         let mut stream = Stream::new();
         for (bytes, times) in parts {
             for (b, t) in bytes.chunks(chunk).zip(times.chunks(chunk)) {
@@ -253,11 +514,11 @@ mod tests {
                     times: Some(t),
                     stream: 0,
                 };
-                stream.feed(batch, |_, _| {});
+                stream.feed(batch, |_, _, _| {});
             }
         }
-        stream.finish(|_, _| {});
-        *stream.stats()
+        stream.finish(|_, _, _| {});
+        stream.stats()
     }
 
     /// An ESC that restarts after a silence counts a restart, not the packets its new numbers

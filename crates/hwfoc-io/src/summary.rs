@@ -14,14 +14,14 @@
 
 use std::fmt::Write as _;
 
-use hwfoc::{
-    DataFrame, Decoded, Fault, Frame, InfoFrame, LinkStats, Quantity, Settings, Status, Temperature,
-};
+use hwfoc::{DataFrame, Decoded, Fault, Frame, InfoFrame, Quantity, Settings, Status, Temperature};
 use serde_json::{Value, json};
 
 pub use crate::episode::{Episode, Mark};
 use crate::input::{InputError, InputFormat};
 use crate::sources::{Handler, Sources};
+use crate::stream::EscLink;
+use hwfoc::datalink::LengthByte;
 
 /// What to tell a user whose input has bytes but no frame.
 pub static NO_FRAMES: std::sync::LazyLock<String> = std::sync::LazyLock::new(|| {
@@ -325,7 +325,7 @@ struct EscReport<'a> {
     label: String,
     stream: &'a str,
     input: &'a str,
-    stats: &'a LinkStats,
+    stats: EscLink,
     settings: Settings,
     acc: &'a Accumulator,
     /// The episode still open at the end, closed for the report.
@@ -351,6 +351,8 @@ impl<'a> Report<'a> {
             .escs()
             .iter()
             .enumerate()
+            // A hub's channels that carried no ESC are not ESCs.
+            .filter(|&(i, _)| !self.sources.is_hub(i) || self.sources.link(i).frames() > 0)
             .map(|(i, esc)| {
                 let acc = self.accs.get(i).unwrap_or(empty);
                 let mut episodes = acc.episodes.clone();
@@ -367,7 +369,7 @@ impl<'a> Report<'a> {
                     label: esc_label(self.sources, i),
                     stream: &esc.name,
                     input: &self.sources.names()[esc.input],
-                    stats: esc.stream.stats(),
+                    stats: self.sources.link(i),
                     settings: *self.settings,
                     acc,
                     episodes,
@@ -411,6 +413,13 @@ impl<'a> Report<'a> {
                 );
             }
         }
+        for (esc, hub) in self.sources.hubs() {
+            let _ = writeln!(
+                o,
+                "hub          {}: DataLink V2, {hub}",
+                self.sources.escs()[esc].name
+            );
+        }
         for esc in self.escs() {
             o.push('\n');
             esc.text(&mut o);
@@ -435,6 +444,28 @@ impl<'a> Report<'a> {
             })
             .collect();
         let escs: Vec<Value> = self.escs().iter().map(EscReport::json).collect();
+        let hubs: Vec<Value> = self
+            .sources
+            .hubs()
+            .map(|(esc, h)| {
+                json!({
+                    "stream": self.sources.escs()[esc].name,
+                    "bytes": h.bytes(),
+                    "bytes_skipped": h.bytes_skipped(),
+                    "frames": h.frames(),
+                    "frames_length_byte_158": h.frames_with_length_byte(LengthByte::Covered),
+                    "frames_length_byte_160": h.frames_with_length_byte(LengthByte::Total),
+                    "crc_failures": h.crc_failures(),
+                    "bad_headers": h.bad_headers(),
+                    "lost_frames": h.lost_frames(),
+                    "duplicate_frames": h.duplicate_frames(),
+                    "restarts": h.restarts(),
+                    "empty_slots": h.empty_slots(),
+                    "bad_channels": h.bad_channels(),
+                    "duplicate_channels": h.duplicate_channels(),
+                })
+            })
+            .collect();
         json!({
             "settings": {
                 "current_scale": self.settings.current_scale,
@@ -442,6 +473,7 @@ impl<'a> Report<'a> {
                 "gear_ratio": self.settings.gear_ratio,
             },
             "inputs": inputs,
+            "hubs": hubs,
             "escs": escs,
         })
     }

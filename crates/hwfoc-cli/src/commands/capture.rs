@@ -21,7 +21,7 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::Ordering;
 use std::time::{Duration, Instant};
 
-use hwfoc::LinkStats;
+use hwfoc_io::stream::EscLink;
 
 use crate::error::CliError;
 use hwfoc_io::pcapng;
@@ -133,7 +133,7 @@ struct PortState {
 }
 
 /// Frames of either kind a port's stream has decoded.
-fn frames(stats: &LinkStats) -> u64 {
+fn frames(stats: EscLink) -> u64 {
     u64::from(stats.frames()) + u64::from(stats.info_frames())
 }
 
@@ -511,12 +511,12 @@ impl Recorder {
             .iter()
             .enumerate()
             .map(|(i, p)| {
-                let stats = self.streams.stats(i).copied().unwrap_or_default();
+                let stats = self.streams.stats(i).unwrap_or_default();
                 format!(
                     "{} {} bytes, {} frames",
                     p.name,
                     stats.bytes(),
-                    frames(&stats)
+                    frames(stats)
                 )
             })
             .collect();

@@ -105,9 +105,9 @@ fn escs_json(sources: &Sources) -> String {
 
 /// Warnings on standard error: ESCs whose bytes held no frame, ESCs asked for but not found.
 fn warn(sources: &Sources, wanted: &[u8]) {
-    for (i, esc) in sources.escs().iter().enumerate() {
-        let stats = esc.stream.stats();
-        if stats.bytes() > 0 && stats.frames() == 0 {
+    for i in 0..sources.escs().len() {
+        let stats = sources.link(i);
+        if stats.bytes() > 0 && stats.frames() == 0 && !sources.is_hub(i) {
             eprintln!(
                 "hwfoc: warning: {}: {}",
                 hwfoc_io::summary::esc_label(sources, i),

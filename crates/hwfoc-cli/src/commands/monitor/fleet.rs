@@ -4,7 +4,8 @@
 
 use std::collections::VecDeque;
 
-use hwfoc::{Fault, InfoFrame, LinkStats, Settings};
+use hwfoc::{Fault, InfoFrame, Settings};
+use hwfoc_io::stream::EscLink;
 
 use super::alarms::{Change, Kind, Latch, Level, Threshold};
 use super::config::Limits;
@@ -184,7 +185,7 @@ pub struct EscView {
     /// The latest device-information frame.
     pub info: Option<InfoFrame>,
     /// Link statistics of its decoder.
-    pub stats: LinkStats,
+    pub stats: EscLink,
     /// Battery cells: configured, or detected from the first voltage.
     pub cells: Option<u8>,
     /// Whether `cells` was detected rather than configured.
@@ -319,7 +320,7 @@ impl Fleet {
                 peaks: Peaks::default(),
                 history: VecDeque::new(),
                 info: None,
-                stats: LinkStats::default(),
+                stats: EscLink::default(),
                 cells: limits.cells,
                 cells_detected: false,
                 alarms: Alarms::default(),
@@ -354,7 +355,7 @@ impl Fleet {
         match event {
             PortEvent::Data { port, .. } => {
                 let mut got = Received::default();
-                let Some(&stats) = self.streams.feed(event, &mut got) else {
+                let Some(stats) = self.streams.feed(event, &mut got) else {
                     return 0;
                 };
                 let mut data = 0;

@@ -279,9 +279,8 @@ impl<'a> Scene<'a> {
         let rows: Vec<Row> = shown
             .iter()
             .map(|&i| {
-                let esc = &sources.escs()[i];
                 let data = plotted(i);
-                let stats = esc.stream.stats();
+                let stats = sources.link(i);
                 let empty = match collector.esc(i) {
                     Some(d) if d.plotted > 0 => None,
                     Some(d) if d.frames > 0 => Some("no data frame in the time window"),
