@@ -10,8 +10,11 @@
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]
 
+pub mod datalink;
+pub mod fanout;
 pub mod latency;
 pub mod output;
+pub mod replay;
 
 pub use latency::Latency;
 pub use output::{Output, OutputError, OutputStats, SILENT_AFTER, Update};

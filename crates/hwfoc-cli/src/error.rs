@@ -22,6 +22,8 @@ pub enum CliError {
     Port(PortError),
     /// An output could not be created or written.
     Write(WriteError),
+    /// A bridge output could not be opened.
+    Output(hwfoc_bridge::OutputError),
     /// The virtual ESCs could not be set up or run (`hwfoc simulate`, `hwfoc monitor --sim`).
     Sim(SimError),
     /// `--from` is not before `--to`.
@@ -127,6 +129,7 @@ impl fmt::Display for CliError {
             CliError::Port(e) => e.fmt(f),
             CliError::Write(e) => e.fmt(f),
             CliError::Sim(e) => e.fmt(f),
+            CliError::Output(e) => e.fmt(f),
             CliError::Window(e) => e.fmt(f),
             CliError::Settings(e) => write!(f, "invalid setting: {e}"),
             CliError::MixedInputs { port, file } => write!(
@@ -159,6 +162,7 @@ impl std::error::Error for CliError {
             CliError::Port(e) => Some(e),
             CliError::Write(e) => Some(e),
             CliError::Sim(e) => Some(e),
+            CliError::Output(e) => Some(e),
             CliError::Window(e) => Some(e),
             CliError::Terminal { source } => Some(source),
             CliError::Settings(e) => Some(e),

@@ -14,7 +14,7 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 
-use crate::commands::{capture, decode, monitor, plot, simulate, summary};
+use crate::commands::{bridge, capture, decode, monitor, plot, simulate, summary};
 use crate::error::CliError;
 
 /// Decode and analyse the telemetry of Hobbywing FOC ESCs (HW-FOC protocol, 19200 baud).
@@ -40,6 +40,9 @@ enum Command {
     Record(capture::RecordArgs),
     /// Virtual ESCs: the protocol from a physical model, to a pty, serial port, file or stdout.
     Simulate(Box<simulate::SimulateArgs>),
+    /// Bridge ESC telemetry (ports, recordings, virtual ESCs) to flight controllers and ground
+    /// stations: DataLink V2 frames, MAVLink, DroneCAN.
+    Bridge(Box<bridge::BridgeArgs>),
 }
 
 fn main() -> ExitCode {
@@ -51,6 +54,7 @@ fn main() -> ExitCode {
         Command::Record(args) => capture::run(args),
         Command::Simulate(args) => simulate::run(args),
         Command::Plot(args) => plot::run(args),
+        Command::Bridge(args) => bridge::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

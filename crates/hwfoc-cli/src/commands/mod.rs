@@ -1,5 +1,6 @@
 //! One module per subcommand: its options (a clap `Args` struct) and its `run`.
 
+pub mod bridge;
 pub mod capture;
 pub mod decode;
 pub mod monitor;

@@ -10,7 +10,7 @@
 mod alarms;
 mod config;
 mod dashboard;
-mod feed;
+pub(crate) mod feed;
 mod fleet;
 mod headless;
 mod perf;

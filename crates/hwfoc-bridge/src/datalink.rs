@@ -1,0 +1,257 @@
+//! The DataLink role: up to eight ESCs merged into DataLink V2 frames on a 115200-baud serial
+//! port, as the Hobbywing hub sends them to a flight controller.
+//!
+//! # When a frame is sent
+//!
+//! Each ESC has a slot, filled by its newest frame; a DataLink frame carries the slots filled
+//! since the previous one and empties them (a slot without a new frame is sent empty: no stale
+//! value is repeated, and an ESC that went silent stops being sent, which is how the DataLink
+//! protocol says it). A frame is sent when something is waiting and [`Pacing::period`] has
+//! passed since the previous frame (at once, after a pause), or earlier when an ESC's next frame
+//! arrives while its slot is still full, as long as [`Pacing::min_gap`] has passed (otherwise
+//! the older frame is superseded, and counted as such). So every frame of ESCs sending at the
+//! protocol's 50 ms period gets through, at about the ESCs' own rate.
+//!
+//! The gap matters to receivers: ArduPilot's DataLink driver reads only when exactly one
+//! frame (160 bytes) is waiting, polling every 10 ms; frames sent back to back would be
+//! discarded. [`Pacing::default`] keeps at least 10 ms of silence between frames.
+
+use std::io::Write;
+use std::time::{Duration, Instant};
+
+use hwfoc::DataFrame;
+use hwfoc::datalink::{self, DatalinkFrame};
+
+use crate::output::{Output, OutputError, OutputStats, Update};
+
+/// When DataLink frames are sent (see the module documentation).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Pacing {
+    /// The usual time from one frame to the next: the ESCs' own frame period.
+    pub period: Duration,
+    /// The shortest time from one frame's start to the next one's: the frame's own time on the
+    /// line (160 bytes at 115200 baud, 13.9 ms) plus a silence receivers can see.
+    pub min_gap: Duration,
+}
+
+impl Default for Pacing {
+    fn default() -> Self {
+        let frame_ns = datalink::FRAME_LEN as f64 * hwfoc::wire::byte_ns(datalink::BAUD_RATE);
+        Pacing {
+            period: Duration::from_millis(50),
+            min_gap: Duration::from_nanos(frame_ns as u64) + Duration::from_millis(10),
+        }
+    }
+}
+
+/// How long a lost port waits before it is reopened.
+const REOPEN_AFTER: Duration = Duration::from_secs(1);
+
+/// Where the frames go.
+enum Line {
+    /// A serial port (or a pty), reopened when lost.
+    Port {
+        path: String,
+        port: Option<Box<dyn serialport::SerialPort>>,
+        retry_at: Instant,
+    },
+    /// Any writer (tests, files).
+    Writer(Box<dyn Write + Send>),
+}
+
+/// One ESC's slot: its newest frame and when it arrived.
+#[derive(Clone, Copy)]
+struct Slot {
+    frame: DataFrame,
+    arrived: Instant,
+}
+
+/// DataLink V2 frames of up to eight ESCs (ESC `n` in channel `n`; ESCs past 7 are not carried
+/// and are counted in [`DatalinkOutput::escs_not_carried`]).
+pub struct DatalinkOutput {
+    name: String,
+    line: Line,
+    pacing: Pacing,
+    slots: [Option<Slot>; datalink::CHANNELS],
+    counter: u16,
+    last_sent: Option<Instant>,
+    not_carried: u64,
+    stats: OutputStats,
+}
+
+impl DatalinkOutput {
+    /// DataLink frames on serial port `path` at 115200 baud, 8N1.
+    pub fn open(path: &str, pacing: Pacing) -> Result<DatalinkOutput, OutputError> {
+        let name = format!("datalink {path}");
+        let port =
+            hwfoc_io::serial::open(path, datalink::BAUD_RATE).map_err(|e| OutputError::Open {
+                output: name.clone(),
+                reason: e.to_string(),
+            })?;
+        Ok(DatalinkOutput::with_line(
+            name,
+            Line::Port {
+                path: path.to_string(),
+                port: Some(port),
+                retry_at: Instant::now(),
+            },
+            pacing,
+        ))
+    }
+
+    /// DataLink frames written to `writer`, named `name` in messages.
+    pub fn to_writer(name: &str, writer: Box<dyn Write + Send>, pacing: Pacing) -> Self {
+        DatalinkOutput::with_line(name.to_string(), Line::Writer(writer), pacing)
+    }
+
+    fn with_line(name: String, line: Line, pacing: Pacing) -> DatalinkOutput {
+        DatalinkOutput {
+            name,
+            line,
+            pacing,
+            slots: [None; datalink::CHANNELS],
+            counter: 0,
+            last_sent: None,
+            not_carried: 0,
+            stats: OutputStats::default(),
+        }
+    }
+
+    /// Frames of ESCs numbered 8 or more, which a DataLink frame has no channel for.
+    pub fn escs_not_carried(&self) -> u64 {
+        self.not_carried
+    }
+
+    /// Whether the gap since the last frame is at least `gap`.
+    fn waited(&self, now: Instant, gap: Duration) -> bool {
+        self.last_sent
+            .is_none_or(|last| now.saturating_duration_since(last) >= gap)
+    }
+
+    /// Sends the filled slots as one frame and empties them.
+    fn send(&mut self, now: Instant) -> Result<(), OutputError> {
+        let mut frame = DatalinkFrame {
+            counter: self.counter,
+            slots: [None; datalink::CHANNELS],
+        };
+        for (slot, out) in self.slots.iter().zip(frame.slots.iter_mut()) {
+            *out = slot.map(|s| s.frame);
+        }
+        let bytes = frame.encode();
+        // The frame is taken whether or not it gets out: a frame that could not be written is
+        // lost, as on a real line, and the next one carries the next frames.
+        let carried = std::mem::replace(&mut self.slots, [None; datalink::CHANNELS]);
+        self.last_sent = Some(now);
+        self.counter = self.counter.wrapping_add(1);
+        self.write(&bytes, now)?;
+        let written = Instant::now();
+        self.stats.messages += 1;
+        self.stats.bytes += bytes.len() as u64;
+        for slot in carried.iter().flatten() {
+            self.stats
+                .latency
+                .add(written.saturating_duration_since(slot.arrived));
+        }
+        Ok(())
+    }
+
+    fn write(&mut self, bytes: &[u8], now: Instant) -> Result<(), OutputError> {
+        let name = &self.name;
+        let failed = |reason: String| OutputError::Send {
+            output: name.clone(),
+            reason,
+        };
+        match &mut self.line {
+            Line::Writer(w) => w
+                .write_all(bytes)
+                .and_then(|()| w.flush())
+                .map_err(|e| failed(e.to_string())),
+            Line::Port {
+                path,
+                port,
+                retry_at,
+            } => {
+                if port.is_none() {
+                    if now < *retry_at {
+                        return Err(failed("the port is being reopened".into()));
+                    }
+                    match hwfoc_io::serial::open(path, datalink::BAUD_RATE) {
+                        Ok(p) => *port = Some(p),
+                        Err(e) => {
+                            *retry_at = now + REOPEN_AFTER;
+                            return Err(OutputError::Lost {
+                                output: name.clone(),
+                                reason: e.to_string(),
+                            });
+                        }
+                    }
+                }
+                let Some(p) = port else {
+                    unreachable!("opened above")
+                };
+                match p.write_all(bytes).and_then(|()| p.flush()) {
+                    Ok(()) => Ok(()),
+                    Err(e) if e.kind() == std::io::ErrorKind::TimedOut => {
+                        Err(failed("the port did not take the frame in time".into()))
+                    }
+                    Err(e) => {
+                        *port = None;
+                        *retry_at = now + REOPEN_AFTER;
+                        Err(OutputError::Lost {
+                            output: name.clone(),
+                            reason: e.to_string(),
+                        })
+                    }
+                }
+            }
+        }
+    }
+
+    /// Counts a failure of `result`.
+    fn count(&mut self, result: Result<(), OutputError>) -> Result<(), OutputError> {
+        if result.is_err() {
+            self.stats.errors += 1;
+        }
+        result
+    }
+}
+
+impl Output for DatalinkOutput {
+    fn name(&self) -> &str {
+        &self.name
+    }
+
+    fn update(&mut self, update: &Update<'_>) {
+        let Some(index) = Some(usize::from(update.esc)).filter(|&e| e < datalink::CHANNELS) else {
+            self.not_carried += 1;
+            return;
+        };
+        if self.slots[index].is_some() {
+            // The ESC's previous frame is still waiting: send it now if the line allows,
+            // else the newer frame takes its place. (A failure here is counted; poll reports
+            // the state of the line at its next call.)
+            if self.waited(update.arrived.max(Instant::now()), self.pacing.min_gap) {
+                let result = self.send(Instant::now());
+                let _ = self.count(result);
+            } else {
+                self.stats.superseded += 1;
+            }
+        }
+        self.slots[index] = Some(Slot {
+            frame: *update.frame,
+            arrived: update.arrived,
+        });
+    }
+
+    fn poll(&mut self, now: Instant) -> Result<(), OutputError> {
+        if self.slots.iter().any(Option::is_some) && self.waited(now, self.pacing.period) {
+            let result = self.send(now);
+            return self.count(result);
+        }
+        Ok(())
+    }
+
+    fn stats(&self) -> &OutputStats {
+        &self.stats
+    }
+}

@@ -1,0 +1,82 @@
+//! Every frame of every ESC to every output: the bridge's [`Handler`].
+
+use std::time::Instant;
+
+use hwfoc::{Decoded, Frame, Settings};
+use hwfoc_io::{Handler, InputError, Record};
+
+use crate::output::{Output, OutputError, Update};
+
+/// The outputs of a bridge, fed by [`hwfoc_io::stream::PortStreams::feed`] (live ports, virtual
+/// ESCs) or [`hwfoc_io::Sources::run`] (recordings, through [`crate::replay::Replay`]).
+pub struct Fanout {
+    outputs: Vec<Box<dyn Output>>,
+    arrived: Instant,
+    frames: u64,
+    /// The highest ESC number seen, plus one.
+    escs: usize,
+}
+
+impl Fanout {
+    /// Hands frames to `outputs`.
+    pub fn new(outputs: Vec<Box<dyn Output>>) -> Fanout {
+        Fanout {
+            outputs,
+            arrived: Instant::now(),
+            frames: 0,
+            escs: 0,
+        }
+    }
+
+    /// The frames fed next were completed by a read that returned at `arrived`.
+    pub fn arrived(&mut self, arrived: Instant) {
+        self.arrived = arrived;
+    }
+
+    /// Asks every output to send what is due at `now`; `on_error` gets each output's failure
+    /// (the others are polled all the same).
+    pub fn poll(&mut self, now: Instant, mut on_error: impl FnMut(OutputError)) {
+        for output in &mut self.outputs {
+            if let Err(e) = output.poll(now) {
+                on_error(e);
+            }
+        }
+    }
+
+    /// The outputs, for their names and counters.
+    pub fn outputs(&self) -> &[Box<dyn Output>] {
+        &self.outputs
+    }
+
+    /// Data frames handed on.
+    pub fn frames(&self) -> u64 {
+        self.frames
+    }
+
+    /// How many ESCs were heard (the highest ESC number plus one).
+    pub fn escs(&self) -> usize {
+        self.escs
+    }
+}
+
+impl Handler for Fanout {
+    type Error = InputError;
+
+    fn frame(&mut self, esc: u8, t: Option<f64>, decoded: &Decoded, settings: &Settings) {
+        let Frame::Data(frame) = &decoded.frame else {
+            return;
+        };
+        let record = Record::new(t, esc, frame, settings);
+        let update = Update {
+            esc,
+            frame,
+            record: &record,
+            arrived: self.arrived,
+        };
+        for output in &mut self.outputs {
+            output.update(&update);
+        }
+        self.frames += 1;
+        self.escs = self.escs.max(usize::from(esc) + 1);
+    }
+}

@@ -1,0 +1,259 @@
+//! `hwfoc bridge`: telemetry from any input to the protocols flight controllers and ground
+//! stations read (DataLink V2 frames, MAVLink, DroneCAN), several at once.
+//!
+//! The outputs are `hwfoc_bridge` [`Output`]s behind one [`Fanout`]; this module opens them
+//! from the options, feeds them from live ports or virtual ESCs (as the monitor reads them) or
+//! from recordings replayed in real time, reports their failures as they happen (without
+//! stopping) and their counters at the end.
+
+mod report;
+
+use std::sync::atomic::Ordering;
+use std::sync::mpsc::{self, RecvTimeoutError};
+use std::time::{Duration, Instant};
+
+use clap::Args;
+use hwfoc_bridge::Output;
+use hwfoc_bridge::datalink::{DatalinkOutput, Pacing};
+use hwfoc_bridge::fanout::Fanout;
+use hwfoc_bridge::replay::{POLL, Replay, ReplayError};
+use hwfoc_io::Sources;
+use hwfoc_io::serial::{self, PortEvent};
+use hwfoc_io::stream::PortStreams;
+
+use crate::args::{SettingsArgs, seconds};
+use crate::commands::monitor::feed::{Feed, Msg};
+use crate::commands::simulate::ModelArgs;
+use crate::error::CliError;
+
+use report::Errors;
+
+/// The most virtual ESCs `--sim` runs.
+const MAX_SIM: u16 = 64;
+
+const EXAMPLES: &str = "\
+Examples:
+  hwfoc bridge --sim 4 --mavlink udp:127.0.0.1:14550     # four virtual ESCs to a ground station
+  hwfoc bridge /dev/ttyUSB0 /dev/ttyUSB1 --datalink /dev/ttyAMA0
+  hwfoc bridge flight.pcapng --mavlink udp:192.168.1.20:14550 --dronecan slcan:/dev/ttyACM0";
+
+/// Arguments of `hwfoc bridge`.
+#[derive(Debug, Args)]
+#[command(after_help = EXAMPLES)]
+pub struct BridgeArgs {
+    /// Serial ports (read live, one ESC each, or eight from a DataLink hub) or recordings and
+    /// other inputs (replayed in real time).
+    #[arg(
+        value_name = "PORT|FILE",
+        required_unless_present = "sim",
+        conflicts_with = "sim"
+    )]
+    inputs: Vec<String>,
+    /// Run N virtual ESCs instead of reading inputs (the Throttle, Model and Faults options of
+    /// `hwfoc simulate` shape them).
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u16).range(1..=MAX_SIM as i64))]
+    sim: Option<u16>,
+    /// Baud rate of the input ports (8N1).
+    #[arg(long, value_name = "N", default_value_t = serial::DEFAULT_BAUD,
+          value_parser = clap::value_parser!(u32).range(1..))]
+    baud: u32,
+
+    /// DataLink V2 frames (115200 baud) of ESCs 0 to 7 on this serial port: hwfoc as the
+    /// DataLink box a flight controller reads.
+    #[arg(long, value_name = "PORT", help_heading = "Outputs")]
+    datalink: Option<String>,
+    /// Milliseconds from one DataLink frame to the next (the ESCs' own period; an ESC's next
+    /// frame arriving sooner is sent sooner).
+    #[arg(long, value_name = "MS", default_value_t = 50, help_heading = "Outputs",
+          value_parser = clap::value_parser!(u64).range(20..=1000))]
+    datalink_period: u64,
+
+    /// How long to run, in seconds (default: until Ctrl-C, or the end of the recordings).
+    #[arg(long, value_name = "S", value_parser = seconds)]
+    duration: Option<f64>,
+    /// No messages of output failures while running (they are still counted in the report).
+    #[arg(long, short)]
+    quiet: bool,
+
+    #[command(flatten)]
+    settings: SettingsArgs,
+    #[command(flatten)]
+    model: ModelArgs,
+}
+
+/// Runs `hwfoc bridge`.
+pub fn run(args: &BridgeArgs) -> Result<(), CliError> {
+    if args.sim.is_none() && !args.model.is_default() {
+        return Err(CliError::Usage {
+            option: "bridge".into(),
+            message: "the Throttle, Model and Faults options drive virtual ESCs: add --sim N"
+                .into(),
+        });
+    }
+    let settings = args.settings.settings()?;
+    let outputs = open_outputs(args)?;
+    let mut fanout = Fanout::new(outputs);
+    let mut errors = Errors::new(args.quiet);
+    let started = Instant::now();
+    let deadline = args.duration.map(|s| started + Duration::from_secs_f64(s));
+
+    let (ports, files): (Vec<&String>, Vec<&String>) =
+        args.inputs.iter().partition(|spec| serial::is_port(spec));
+    if let (Some(port), Some(file)) = (ports.first(), files.first()) {
+        return Err(CliError::MixedInputs {
+            port: port.to_string(),
+            file: file.to_string(),
+        });
+    }
+    let result = if ports.is_empty() && args.sim.is_none() {
+        replay(&files, settings, deadline, &mut fanout, &mut errors)
+    } else {
+        let (tx, rx) = mpsc::channel();
+        let (names, feed) = match args.sim {
+            Some(n) => {
+                let feed = Feed::simulated(&args.model, usize::from(n), args.baud, &settings, tx)?;
+                ((0..n).map(|i| format!("sim:esc{i}")).collect(), feed)
+            }
+            None => {
+                let names: Vec<String> = ports.iter().map(|p| p.to_string()).collect();
+                let feed = Feed::ports(&names, args.baud, tx)?;
+                (names, feed)
+            }
+        };
+        let mut streams = PortStreams::new(names.len(), args.baud, settings);
+        let per_byte_ns = hwfoc::wire::byte_ns(args.baud);
+        let result = live(
+            &rx,
+            &names,
+            &mut streams,
+            per_byte_ns,
+            deadline,
+            &mut fanout,
+            &mut errors,
+        );
+        drop(feed);
+        result
+    };
+    // What is still waiting goes out.
+    fanout.poll(Instant::now(), |e| errors.report(&e));
+    report::print(&fanout, &errors, started.elapsed());
+    result
+}
+
+/// Opens every output named; at least one.
+fn open_outputs(args: &BridgeArgs) -> Result<Vec<Box<dyn Output>>, CliError> {
+    let mut outputs: Vec<Box<dyn Output>> = Vec::new();
+    if let Some(port) = &args.datalink {
+        let pacing = Pacing {
+            period: Duration::from_millis(args.datalink_period),
+            ..Pacing::default()
+        };
+        outputs.push(Box::new(
+            DatalinkOutput::open(port, pacing).map_err(CliError::Output)?,
+        ));
+    }
+    if outputs.is_empty() {
+        return Err(CliError::Usage {
+            option: "bridge".into(),
+            message: "name an output: --datalink PORT, --mavlink udp:127.0.0.1:14550 or \
+                      --dronecan slcan:PORT"
+                .into(),
+        });
+    }
+    Ok(outputs)
+}
+
+/// Live ports or virtual ESCs: their events through the monitor's decoding path.
+fn live(
+    rx: &mpsc::Receiver<Msg>,
+    names: &[String],
+    streams: &mut PortStreams,
+    per_byte_ns: f64,
+    deadline: Option<Instant>,
+    fanout: &mut Fanout,
+    errors: &mut Errors,
+) -> Result<(), CliError> {
+    let stop = hwfoc_io::stop::interrupted();
+    let clock = hwfoc_io::clock::Clock::new();
+    while !stop.load(Ordering::Relaxed) && deadline.is_none_or(|d| Instant::now() < d) {
+        let mut msg = match rx.recv_timeout(POLL) {
+            Ok(msg) => Some(msg),
+            Err(RecvTimeoutError::Timeout) => None,
+            Err(RecvTimeoutError::Disconnected) => break,
+        };
+        // Everything that has arrived, then the outputs.
+        while let Some(m) = msg {
+            match m {
+                Msg::Port(event) => take(&event, names, streams, per_byte_ns, &clock, fanout),
+                Msg::Failed(e) => return Err(e),
+                Msg::Term(_) => {}
+            }
+            msg = rx.try_recv().ok();
+        }
+        fanout.poll(Instant::now(), |e| errors.report(&e));
+    }
+    Ok(())
+}
+
+/// Decodes a port's event into the outputs.
+fn take(
+    event: &PortEvent,
+    names: &[String],
+    streams: &mut PortStreams,
+    per_byte_ns: f64,
+    clock: &hwfoc_io::clock::Clock,
+    fanout: &mut Fanout,
+) {
+    match event {
+        PortEvent::Data { t_ns, bytes, .. } => {
+            // The read that completed these bytes returned when the last of them arrived.
+            let last_ns = *t_ns as f64 + per_byte_ns * bytes.len().saturating_sub(1) as f64;
+            let ago_ns = (clock.now_ns() as f64 - last_ns).max(0.0);
+            let now = Instant::now();
+            fanout.arrived(
+                now.checked_sub(Duration::from_nanos(ago_ns as u64))
+                    .unwrap_or(now),
+            );
+            streams.feed(event, fanout);
+        }
+        PortEvent::Lost { port, reason, .. } => {
+            eprintln!("hwfoc: port {} lost ({reason}); reopening", names[*port]);
+        }
+        PortEvent::Back { port, .. } => eprintln!("hwfoc: port {} is back", names[*port]),
+    }
+}
+
+/// Recordings and other inputs, replayed in real time.
+fn replay(
+    files: &[&String],
+    settings: hwfoc::Settings,
+    deadline: Option<Instant>,
+    fanout: &mut Fanout,
+    errors: &mut Errors,
+) -> Result<(), CliError> {
+    let inputs = files
+        .iter()
+        .map(|f| hwfoc_io::Input::open(f))
+        .collect::<Result<Vec<_>, _>>()?;
+    let mut sources = Sources::new(inputs, settings);
+    let stop = hwfoc_io::stop::interrupted();
+    // The deadline stops the replay as Ctrl-C would.
+    let timer = deadline.map(|d| {
+        let stop = std::sync::Arc::clone(&stop);
+        std::thread::spawn(move || {
+            while Instant::now() < d && !stop.load(Ordering::Relaxed) {
+                std::thread::sleep(POLL);
+            }
+            stop.store(true, Ordering::Relaxed);
+        })
+    });
+    let result = sources.run(&mut Replay::new(fanout, &stop, |e| errors.report(&e)));
+    stop.store(true, Ordering::Relaxed);
+    if let Some(timer) = timer {
+        let _ = timer.join();
+    }
+    match result {
+        Ok(()) | Err(ReplayError::Stopped) => Ok(()),
+        Err(ReplayError::Input(e)) => Err(e.into()),
+    }
+}
