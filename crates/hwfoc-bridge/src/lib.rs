@@ -11,6 +11,7 @@
 #![warn(missing_docs)]
 
 pub mod latency;
+pub mod mavlink;
 pub mod output;
 
 pub use latency::Latency;
