@@ -13,6 +13,7 @@
 pub mod datalink;
 pub mod fanout;
 pub mod latency;
+pub mod mavlink;
 pub mod output;
 pub mod replay;
 

@@ -1,0 +1,146 @@
+//! Where the MAVLink frames go: a UDP socket of our own (non-blocking) or a serial port
+//! (writes with a timeout, reopened when it disappears).
+
+use std::io::{self, Write};
+use std::net::{Ipv4Addr, Ipv6Addr, SocketAddr, UdpSocket};
+use std::time::Instant;
+
+use serialport::SerialPort;
+
+/// Why a frame was not written.
+#[derive(Debug)]
+pub(crate) enum LinkError {
+    /// The write failed; the link stays (the next frame is tried).
+    Send(String),
+    /// The write failed and the rest of this poll's frames should not be tried (a full buffer, a
+    /// serial write that timed out: each would wait or fail the same way).
+    Stalled(String),
+    /// The serial port is gone; it is reopened from a later poll.
+    Lost(String),
+    /// The serial port is still gone: nothing was written (already reported as lost).
+    Down,
+}
+
+/// A UDP destination or a serial port.
+pub(crate) enum Link {
+    Udp {
+        socket: UdpSocket,
+        dest: SocketAddr,
+        /// Whether `connect` succeeded (a connected socket hears ICMP errors: a refused port
+        /// becomes `ECONNREFUSED` on a later send). Retried before each send until it does.
+        connected: bool,
+    },
+    Serial {
+        port: String,
+        baud: u32,
+        open: Option<Box<dyn SerialPort>>,
+        /// When to try to reopen a lost port.
+        retry_at: Instant,
+    },
+}
+
+impl Link {
+    /// A non-blocking UDP socket sending to `dest`, bound to an ephemeral port of the
+    /// unspecified address of `dest`'s family.
+    pub(crate) fn udp(dest: SocketAddr) -> io::Result<Link> {
+        let local: SocketAddr = if dest.is_ipv4() {
+            (Ipv4Addr::UNSPECIFIED, 0).into()
+        } else {
+            (Ipv6Addr::UNSPECIFIED, 0).into()
+        };
+        let socket = UdpSocket::bind(local)?;
+        socket.set_nonblocking(true)?;
+        // A destination without a route fails here; the sends retry it.
+        let connected = socket.connect(dest).is_ok();
+        Ok(Link::Udp {
+            socket,
+            dest,
+            connected,
+        })
+    }
+
+    /// The serial port `port` at `baud` (8N1; `hwfoc_io::serial::open`, whose timeout of 50 ms
+    /// bounds each write).
+    pub(crate) fn serial(port: &str, baud: u32) -> Result<Link, hwfoc_io::serial::PortError> {
+        let open = hwfoc_io::serial::open(port, baud)?;
+        Ok(Link::Serial {
+            port: port.to_string(),
+            baud,
+            open: Some(open),
+            retry_at: Instant::now(),
+        })
+    }
+
+    /// Writes one frame.
+    pub(crate) fn send(&mut self, frame: &[u8], now: Instant) -> Result<(), LinkError> {
+        match self {
+            Link::Udp {
+                socket,
+                dest,
+                connected,
+            } => {
+                if !*connected {
+                    socket
+                        .connect(*dest)
+                        .map_err(|e| LinkError::Send(e.to_string()))?;
+                    *connected = true;
+                }
+                match socket.send(frame) {
+                    Ok(n) if n == frame.len() => Ok(()),
+                    Ok(n) => Err(LinkError::Send(format!(
+                        "short datagram ({n} of {} bytes)",
+                        frame.len()
+                    ))),
+                    Err(e) if e.kind() == io::ErrorKind::WouldBlock => Err(LinkError::Stalled(
+                        "the socket's send buffer is full".to_string(),
+                    )),
+                    Err(e) => Err(LinkError::Send(e.to_string())),
+                }
+            }
+            Link::Serial {
+                port,
+                baud,
+                open,
+                retry_at,
+            } => {
+                if open.is_none() {
+                    if now < *retry_at {
+                        return Err(LinkError::Down);
+                    }
+                    match hwfoc_io::serial::open(port, *baud) {
+                        Ok(p) => *open = Some(p),
+                        Err(_) => {
+                            *retry_at = now + hwfoc_io::serial::RETRY_EVERY;
+                            return Err(LinkError::Down);
+                        }
+                    }
+                }
+                let Some(p) = open.as_mut() else {
+                    return Err(LinkError::Down);
+                };
+                match p.write_all(frame) {
+                    Ok(()) => Ok(()),
+                    Err(e) if e.kind() == io::ErrorKind::TimedOut => Err(LinkError::Stalled(
+                        "write timed out (is the other end reading?)".to_string(),
+                    )),
+                    Err(e) if e.kind() == io::ErrorKind::Interrupted => {
+                        Err(LinkError::Send(e.to_string()))
+                    }
+                    Err(e) => {
+                        *open = None;
+                        *retry_at = now + hwfoc_io::serial::RETRY_EVERY;
+                        Err(LinkError::Lost(e.to_string()))
+                    }
+                }
+            }
+        }
+    }
+
+    /// The local address of a UDP link.
+    pub(crate) fn local_addr(&self) -> Option<SocketAddr> {
+        match self {
+            Link::Udp { socket, .. } => socket.local_addr().ok(),
+            Link::Serial { .. } => None,
+        }
+    }
+}

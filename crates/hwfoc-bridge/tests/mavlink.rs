@@ -1,0 +1,528 @@
+//! The MAVLink output, end to end over a loopback UDP socket: every datagram is decoded by the
+//! `mavlink` crate's own parser and its fields compared with the records sent.
+
+use std::net::{SocketAddr, UdpSocket};
+use std::time::{Duration, Instant};
+
+use hwfoc::{DataFrame, Fault, Settings, Status};
+use hwfoc_bridge::mavlink::{
+    MAV_COMP_ID_PERIPHERAL, MavlinkOptions, MavlinkOutput, MavlinkTarget, messages,
+};
+use hwfoc_bridge::{Output, OutputError, SILENT_AFTER, Update};
+use hwfoc_io::Record;
+use mavlink::dialects::ardupilotmega::{MavAutopilot, MavMessage, MavType};
+use mavlink::{MavHeader, MavlinkReader, MavlinkVersion};
+
+/// A frame with distinct values: 24.7 V, 12.5 A, 3000 eRPM raw (motor RPM 30000/7), MOS 40 degC.
+fn frame(packet: u16, status: Status) -> DataFrame {
+    DataFrame {
+        packet,
+        throttle_in_raw: 512,
+        throttle_out_raw: 500,
+        erpm_raw: 3000,
+        voltage_raw: 247,
+        current_raw: 800,
+        phase_current_raw: 1600,
+        mos_adc: 150,
+        cap_adc: 160,
+        status,
+    }
+}
+
+struct Rig {
+    rx: UdpSocket,
+    out: MavlinkOutput,
+}
+
+impl Rig {
+    fn new(options: MavlinkOptions) -> Rig {
+        let rx = UdpSocket::bind("127.0.0.1:0").unwrap();
+        let out =
+            MavlinkOutput::open(MavlinkTarget::Udp(rx.local_addr().unwrap()), options).unwrap();
+        Rig { rx, out }
+    }
+
+    fn update(&mut self, esc: u8, t_s: Option<f64>, frame: &DataFrame, arrived: Instant) -> Record {
+        let record = Record::new(t_s, esc, frame, &Settings::default());
+        self.out.update(&Update {
+            esc,
+            frame,
+            record: &record,
+            arrived,
+        });
+        record
+    }
+
+    /// Every message received so far, decoded by the mavlink crate, with its header (a
+    /// datagram to 127.0.0.1 is in the receiver's queue when `send` returns).
+    fn received(&self) -> Vec<(MavHeader, MavMessage)> {
+        let mut got = Vec::new();
+        let mut buf = [0u8; 512];
+        self.rx.set_nonblocking(true).unwrap();
+        while let Ok(n) = self.rx.recv(&mut buf) {
+            let mut reader = MavlinkReader::new(&buf[..n]);
+            let (header, message) = reader
+                .read_message::<MavMessage>(MavlinkVersion::V2)
+                .expect("a valid MAVLink 2 frame");
+            assert_eq!(buf[0], 0xFD, "MAVLink 2 framing");
+            got.push((header, message));
+        }
+        got
+    }
+}
+
+fn names(messages: &[(MavHeader, MavMessage)]) -> Vec<String> {
+    use mavlink::Message;
+    messages
+        .iter()
+        .map(|(_, m)| match m {
+            MavMessage::ESC_INFO(d) => format!("ESC_INFO[{}]", d.index),
+            MavMessage::ESC_STATUS(d) => format!("ESC_STATUS[{}]", d.index),
+            m => m.message_name().to_string(),
+        })
+        .collect()
+}
+
+#[test]
+fn one_esc_decodes_with_its_values_in_the_messages_units() {
+    let mut rig = Rig::new(MavlinkOptions::default());
+    let now = Instant::now();
+    let status = Status::OK.with(Fault::OverCurrent).with(Fault::MosOverheat);
+    let record = rig.update(0, Some(100.0), &frame(1, status), now);
+    rig.out.poll(now).unwrap();
+    let got = rig.received();
+    assert_eq!(
+        names(&got),
+        [
+            "HEARTBEAT",
+            "ESC_TELEMETRY_1_TO_4",
+            "ESC_STATUS[0]",
+            "ESC_INFO[0]"
+        ]
+    );
+    for (i, (h, _)) in got.iter().enumerate() {
+        assert_eq!((h.system_id, h.component_id), (1, MAV_COMP_ID_PERIPHERAL));
+        assert_eq!(h.sequence, i as u8, "sequence numbers increment");
+    }
+    let MavMessage::HEARTBEAT(hb) = &got[0].1 else {
+        panic!()
+    };
+    assert_eq!(hb.mavtype, MavType::MAV_TYPE_ONBOARD_CONTROLLER);
+    assert_eq!(hb.autopilot, MavAutopilot::MAV_AUTOPILOT_INVALID);
+
+    let MavMessage::ESC_TELEMETRY_1_TO_4(t) = &got[1].1 else {
+        panic!()
+    };
+    let temp = record.mos_temp_c.unwrap().max(record.cap_temp_c.unwrap());
+    assert_eq!(t.voltage, [2470, 0, 0, 0]);
+    assert_eq!(t.current, [1250, 0, 0, 0]);
+    assert_eq!(t.rpm, [(30000.0f64 / 7.0).round() as u16, 0, 0, 0]);
+    assert_eq!(t.temperature, [temp.round() as u8, 0, 0, 0]);
+    assert_eq!(t.totalcurrent, [0; 4], "one frame: nothing integrated yet");
+    assert_eq!(t.count, [1, 0, 0, 0]);
+
+    let MavMessage::ESC_STATUS(s) = &got[2].1 else {
+        panic!()
+    };
+    assert_eq!(s.index, 0);
+    assert_eq!(s.voltage, [record.voltage_v, 0.0, 0.0, 0.0]);
+    assert_eq!(s.current, [12.5, 0.0, 0.0, 0.0]);
+    assert_eq!(s.rpm, [4286, 0, 0, 0]);
+    assert!(
+        s.time_usec > 1_600_000_000_000_000,
+        "Unix time in microseconds"
+    );
+
+    let MavMessage::ESC_INFO(info) = &got[3].1 else {
+        panic!()
+    };
+    assert_eq!(
+        (info.index, info.count, info.info, info.counter),
+        (0, 1, 0b1, 1)
+    );
+    assert_eq!(info.failure_flags, [1 | 4, 0, 0, 0]);
+    assert_eq!(info.error_count, [2, 0, 0, 0]);
+    assert_eq!(
+        info.temperature,
+        [(temp * 100.0).round() as i16, i16::MAX, i16::MAX, i16::MAX]
+    );
+    assert_eq!(
+        info.connection_type,
+        mavlink::dialects::ardupilotmega::EscConnectionType::ESC_CONNECTION_TYPE_SERIAL
+    );
+    assert_eq!(rig.out.stats().messages, 4);
+    assert_eq!(
+        rig.out.stats().latency.count(),
+        2,
+        "one frame carried by two messages"
+    );
+}
+
+#[test]
+fn total_current_is_the_charge_consumed() {
+    let mut rig = Rig::new(MavlinkOptions::default());
+    let start = Instant::now();
+    // 12.5 A for 0.05 s steps: 36 s of steps = 125 mAh... 72 frames 50 ms apart: 3.55 s.
+    let mut last = start;
+    for k in 0..=72u16 {
+        last = start + Duration::from_millis(50 * u64::from(k));
+        rig.update(
+            0,
+            Some(1000.0 + f64::from(k) * 0.05),
+            &frame(k, Status::OK),
+            last,
+        );
+    }
+    rig.out.poll(last).unwrap();
+    let got = rig.received();
+    let t = got
+        .iter()
+        .find_map(|(_, m)| match m {
+            MavMessage::ESC_TELEMETRY_1_TO_4(t) => Some(t.clone()),
+            _ => None,
+        })
+        .unwrap();
+    // 12.5 A * 3.6 s = 45 As = 12.5 mAh.
+    assert_eq!(t.totalcurrent[0], 13);
+    assert_eq!(t.count[0], 73);
+    assert_eq!(rig.out.stats().superseded, 72, "coalesced into one message");
+
+    // Without times, the arrival instants are integrated.
+    let mut untimed = Rig::new(MavlinkOptions::default());
+    for k in 0..=72u16 {
+        let at = start + Duration::from_millis(100 * u64::from(k));
+        untimed.update(0, None, &frame(k, Status::OK), at);
+    }
+    untimed
+        .out
+        .poll(start + Duration::from_millis(7200))
+        .unwrap();
+    let t = untimed
+        .received()
+        .iter()
+        .find_map(|(_, m)| match m {
+            MavMessage::ESC_TELEMETRY_1_TO_4(t) => Some(t.clone()),
+            _ => None,
+        })
+        .unwrap();
+    // 12.5 A * 7.2 s = 25 mAh.
+    assert_eq!(t.totalcurrent[0], 25);
+}
+
+#[test]
+fn groups_follow_the_number_of_escs() {
+    for (escs, expected) in [
+        (
+            1,
+            vec!["ESC_TELEMETRY_1_TO_4", "ESC_STATUS[0]", "ESC_INFO[0]"],
+        ),
+        (
+            4,
+            vec!["ESC_TELEMETRY_1_TO_4", "ESC_STATUS[0]", "ESC_INFO[0]"],
+        ),
+        (
+            5,
+            vec![
+                "ESC_TELEMETRY_1_TO_4",
+                "ESC_STATUS[0]",
+                "ESC_INFO[0]",
+                "ESC_TELEMETRY_5_TO_8",
+                "ESC_STATUS[4]",
+                "ESC_INFO[4]",
+            ],
+        ),
+        (
+            16,
+            vec![
+                "ESC_TELEMETRY_1_TO_4",
+                "ESC_STATUS[0]",
+                "ESC_INFO[0]",
+                "ESC_TELEMETRY_5_TO_8",
+                "ESC_STATUS[4]",
+                "ESC_INFO[4]",
+                "ESC_TELEMETRY_9_TO_12",
+                "ESC_STATUS[8]",
+                "ESC_INFO[8]",
+                "ESC_TELEMETRY_13_TO_16",
+                "ESC_STATUS[12]",
+                "ESC_INFO[12]",
+            ],
+        ),
+    ] {
+        let mut rig = Rig::new(MavlinkOptions::default());
+        let now = Instant::now();
+        for esc in 0..escs {
+            rig.update(esc, None, &frame(u16::from(esc), Status::OK), now);
+        }
+        rig.out.poll(now).unwrap();
+        let got = rig.received();
+        assert_eq!(names(&got)[1..], expected, "{escs} ESCs");
+        for (_, m) in &got {
+            if let MavMessage::ESC_INFO(info) = m {
+                assert_eq!(info.count, escs);
+                let in_group = (escs - info.index).min(4);
+                assert_eq!(info.info, (1u8 << in_group) - 1);
+            }
+        }
+        // Only the group with a new frame is sent again.
+        rig.update(escs - 1, None, &frame(99, Status::OK), now);
+        rig.out.poll(now + Duration::from_millis(20)).unwrap();
+        let again = names(&rig.received());
+        let index = (escs - 1) / 4 * 4;
+        assert_eq!(again.len(), 2, "{again:?}");
+        assert_eq!(again[1], format!("ESC_STATUS[{index}]"));
+    }
+}
+
+#[test]
+fn a_silent_esc_is_zeros_offline_and_then_not_sent() {
+    let mut rig = Rig::new(MavlinkOptions::default());
+    let t0 = Instant::now();
+    rig.update(0, None, &frame(1, Status::OK), t0);
+    rig.update(1, None, &frame(1, Status::OK.with(Fault::MotorBlocked)), t0);
+    rig.out.poll(t0).unwrap();
+    rig.received();
+    // ESC 1 goes silent; ESC 0 goes on.
+    let t1 = t0 + SILENT_AFTER + Duration::from_millis(100);
+    rig.update(0, None, &frame(2, Status::OK), t1);
+    rig.out.poll(t1).unwrap();
+    let got = rig.received();
+    assert_eq!(
+        names(&got),
+        [
+            "HEARTBEAT",
+            "ESC_TELEMETRY_1_TO_4",
+            "ESC_STATUS[0]",
+            "ESC_INFO[0]"
+        ]
+    );
+    let MavMessage::ESC_TELEMETRY_1_TO_4(t) = &got[1].1 else {
+        panic!()
+    };
+    assert_eq!(t.voltage, [2470, 0, 0, 0], "the silent ESC is zeros");
+    assert_eq!(t.count, [2, 0, 0, 0]);
+    let MavMessage::ESC_INFO(info) = &got[3].1 else {
+        panic!()
+    };
+    assert_eq!(info.info, 0b01, "offline");
+    assert_eq!(info.failure_flags, [0; 4]);
+    assert_eq!(info.error_count[1], 1, "its fault onset is still counted");
+    assert_eq!(info.temperature[1], i16::MAX);
+
+    // Both silent: one last ESC_INFO saying so, then nothing but heartbeats.
+    let t2 = t1 + SILENT_AFTER + Duration::from_millis(100);
+    rig.out.poll(t2).unwrap();
+    let got = rig.received();
+    assert_eq!(names(&got), ["HEARTBEAT", "ESC_INFO[0]"]);
+    let MavMessage::ESC_INFO(info) = &got[1].1 else {
+        panic!()
+    };
+    assert_eq!(info.info, 0);
+    rig.out.poll(t2 + Duration::from_secs(5)).unwrap();
+    assert_eq!(names(&rig.received()), ["HEARTBEAT"]);
+}
+
+#[test]
+fn esc_info_is_periodic_and_immediate_on_a_new_failure() {
+    let mut rig = Rig::new(MavlinkOptions::default());
+    let t0 = Instant::now();
+    rig.update(0, None, &frame(1, Status::OK), t0);
+    rig.out.poll(t0).unwrap();
+    rig.received();
+    // A new frame 100 ms later, same state: no ESC_INFO, no heartbeat.
+    let t1 = t0 + Duration::from_millis(100);
+    rig.update(0, None, &frame(2, Status::OK), t1);
+    rig.out.poll(t1).unwrap();
+    assert_eq!(
+        names(&rig.received()),
+        ["ESC_TELEMETRY_1_TO_4", "ESC_STATUS[0]"]
+    );
+    // A failure: ESC_INFO at once.
+    let t2 = t0 + Duration::from_millis(200);
+    rig.update(
+        0,
+        None,
+        &frame(3, Status::OK.with(Fault::InputVoltageHigh)),
+        t2,
+    );
+    rig.out.poll(t2).unwrap();
+    let got = rig.received();
+    assert_eq!(
+        names(&got),
+        ["ESC_TELEMETRY_1_TO_4", "ESC_STATUS[0]", "ESC_INFO[0]"]
+    );
+    let MavMessage::ESC_INFO(info) = &got[2].1 else {
+        panic!()
+    };
+    assert_eq!(info.failure_flags[0], 2);
+    // No new frame, a second later: heartbeat and the periodic ESC_INFO only.
+    let t3 = t2 + Duration::from_millis(1000);
+    rig.out.poll(t3).unwrap();
+    assert_eq!(names(&rig.received()), ["HEARTBEAT", "ESC_INFO[0]"]);
+}
+
+#[test]
+fn sequence_numbers_wrap() {
+    let mut rig = Rig::new(MavlinkOptions {
+        system_id: 42,
+        component_id: 1,
+        ..MavlinkOptions::default()
+    });
+    let t0 = Instant::now();
+    let mut seqs = Vec::new();
+    for k in 0..150u16 {
+        let at = t0 + Duration::from_millis(u64::from(k) * 10);
+        rig.update(0, None, &frame(k, Status::OK), at);
+        rig.out.poll(at).unwrap();
+        for (h, m) in rig.received() {
+            assert_eq!((h.system_id, h.component_id), (42, 1));
+            if let MavMessage::HEARTBEAT(hb) = m {
+                assert_eq!(
+                    hb.mavtype,
+                    MavType::MAV_TYPE_GENERIC,
+                    "component 1: a stand-in vehicle"
+                );
+                assert_eq!(hb.autopilot, MavAutopilot::MAV_AUTOPILOT_GENERIC);
+            }
+            seqs.push(h.sequence);
+        }
+    }
+    assert!(seqs.len() > 256);
+    for w in seqs.windows(2) {
+        assert_eq!(w[1], w[0].wrapping_add(1));
+    }
+}
+
+#[test]
+fn an_unreachable_destination_is_counted_and_survived() {
+    // A port nobody listens on: the kernel answers with ICMP port unreachable, which the
+    // connected socket reports as ECONNREFUSED on a later send.
+    let dead = UdpSocket::bind("127.0.0.1:0").unwrap();
+    let addr: SocketAddr = dead.local_addr().unwrap();
+    drop(dead);
+    let mut out = MavlinkOutput::open(MavlinkTarget::Udp(addr), MavlinkOptions::default()).unwrap();
+    let t0 = Instant::now();
+    let mut errors = Vec::new();
+    for k in 0..20u16 {
+        let at = t0 + Duration::from_millis(u64::from(k) * 50);
+        let f = frame(k, Status::OK);
+        let record = Record::new(None, 0, &f, &Settings::default());
+        out.update(&Update {
+            esc: 0,
+            frame: &f,
+            record: &record,
+            arrived: at,
+        });
+        if let Err(e) = out.poll(at) {
+            errors.push(e);
+        }
+    }
+    assert!(!errors.is_empty());
+    assert!(
+        errors.iter().all(|e| matches!(e, OutputError::Send { .. })),
+        "{errors:?}"
+    );
+    assert!(
+        errors[0]
+            .to_string()
+            .starts_with(&format!("mavlink udp:{addr}: cannot send"))
+    );
+    assert!(out.stats().errors >= errors.len() as u64);
+    assert!(
+        out.stats().messages > 0,
+        "sends between the refusals went out"
+    );
+    // Someone listens now: the output carries on.
+    let Ok(rx) = UdpSocket::bind(addr) else {
+        return; // the port was taken meanwhile
+    };
+    rx.set_read_timeout(Some(Duration::from_secs(1))).unwrap();
+    let at = t0 + Duration::from_secs(5);
+    let f = frame(100, Status::OK);
+    let record = Record::new(None, 0, &f, &Settings::default());
+    out.update(&Update {
+        esc: 0,
+        frame: &f,
+        record: &record,
+        arrived: at,
+    });
+    out.poll(at).unwrap();
+    let mut buf = [0u8; 512];
+    assert!(rx.recv(&mut buf).unwrap() > 0);
+}
+
+#[test]
+fn a_network_without_a_route_is_a_send_error() {
+    // The documentation range 192.0.2.0/24 has no route in a sandbox without a default route;
+    // where there is one, the datagram goes out to nobody (only in that case is nothing
+    // checked): either way nothing blocks or panics.
+    let target = MavlinkTarget::parse("udp:192.0.2.1:14550").unwrap();
+    let mut out = MavlinkOutput::open(target, MavlinkOptions::default()).unwrap();
+    let start = Instant::now();
+    let result = out.poll(start);
+    assert!(start.elapsed() < Duration::from_millis(500));
+    if let Err(e) = result {
+        assert!(matches!(e, OutputError::Send { .. }), "{e}");
+        assert_eq!(out.stats().errors, 1);
+    }
+}
+
+#[test]
+fn targets_parse() {
+    let udp = |s: &str| match MavlinkTarget::parse(s).unwrap() {
+        MavlinkTarget::Udp(a) => a.to_string(),
+        other => panic!("{other:?}"),
+    };
+    assert_eq!(udp("udp"), "127.0.0.1:14550");
+    assert_eq!(udp("UDP:14551"), "127.0.0.1:14551");
+    assert_eq!(udp("udp:192.168.1.10:14550"), "192.168.1.10:14550");
+    assert_eq!(udp("udp:[::1]:14550"), "[::1]:14550");
+    assert_eq!(udp("udp:localhost:14555"), "127.0.0.1:14555");
+    assert_eq!(
+        MavlinkTarget::parse("serial:/dev/ttyACM0").unwrap(),
+        MavlinkTarget::Serial {
+            port: "/dev/ttyACM0".into(),
+            baud: 57600
+        }
+    );
+    assert_eq!(
+        MavlinkTarget::parse("serial:COM3:921600")
+            .unwrap()
+            .to_string(),
+        "serial:COM3:921600"
+    );
+    for bad in [
+        "udp:host",
+        "udp:1.2.3.4:99999",
+        "serial",
+        "serial:",
+        "tcp:1.2.3.4:1",
+        "serial:/dev/x:0",
+    ] {
+        let e = MavlinkTarget::parse(bad).unwrap_err();
+        assert!(matches!(e, OutputError::Open { .. }), "{bad}");
+        assert!(
+            e.to_string()
+                .starts_with(&format!("mavlink {bad}: cannot open")),
+            "{e}"
+        );
+    }
+    let missing = MavlinkOutput::open(
+        MavlinkTarget::parse("serial:/dev/ttyUSB_no_such_port").unwrap(),
+        MavlinkOptions::default(),
+    )
+    .unwrap_err();
+    assert!(matches!(missing, OutputError::Open { .. }), "{missing}");
+}
+
+#[test]
+fn failure_flags_of_every_fault() {
+    assert_eq!(
+        messages::failure_flags(Status::OK.with(Fault::OverCurrent)),
+        1
+    );
+    assert_eq!(
+        messages::failure_flags(Status::OK.with(Fault::MotorBlocked)),
+        32
+    );
+}
