@@ -42,8 +42,8 @@
 //!
 //! The crates.io crates were read first: `dronecan` 0.2.0 (MPL-2.0) only
 //! reassembles received transfers and parses CAN IDs: no transmit-side splitting, no DSDL
-//! types. The GitHub `David-OConnor/dronecan` (not that crate) is tied to STM32's FD-CAN
-//! peripheral and has no `esc.Status`. `slcan` 0.1.3 (2020) is built on the unmaintained
+//! types. `David-OConnor/dronecan` on GitHub (0.1.0, same name) is tied to STM32's
+//! FD-CAN peripheral and has no `esc.Status`. `slcan` 0.1.3 (2020) is built on the unmaintained
 //! `serial` crate and `mini-slcan` / `serial-can` are codecs of a few lines of what
 //! [`slcan::push_extended`] does. `canadensis` is Cyphal (UAVCAN v1), another transport.
 //! The transport here is a hundred lines ([`transport`]), tested against pydronecan's bytes,
