@@ -11,6 +11,7 @@
 #![warn(missing_docs)]
 
 pub mod datalink;
+pub mod dronecan;
 pub mod fanout;
 pub mod latency;
 pub mod mavlink;

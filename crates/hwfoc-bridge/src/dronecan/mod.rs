@@ -1,0 +1,511 @@
+//! The DroneCAN output: a DroneCAN node on a CAN bus, reached through an SLCAN serial adapter,
+//! broadcasting `uavcan.equipment.esc.Status` for each ESC and its own
+//! `uavcan.protocol.NodeStatus`: what ArduPilot, PX4 and the DroneCAN GUI tool read from CAN
+//! ESCs.
+//!
+//! `hwfoc bridge --dronecan slcan:PORT[:BITRATE]` ([`SlcanTarget`]), with [`DronecanOptions`].
+//!
+//! # What is sent
+//!
+//! - **esc.Status** (data type 1034, priority [`PRIORITY`]): one per new frame of an ESC, at
+//!   the next [`Output::poll`]; frames of the same ESC between two polls are coalesced (the
+//!   older counted in [`OutputStats::superseded`]). Nothing is invented: an ESC is sent only
+//!   when it sent, and a silent one ([`SILENT_AFTER`]) is not sent. Fields:
+//!   `esc_index` = the bridge's ESC number (ESCs 32 and above, which `uint5` cannot hold, are
+//!   not sent); `voltage` V and `current` A as recorded (float16); `temperature` = MOSFET
+//!   temperature + 273.15 K, NaN when the ADC code is out of the table (the DSDL's "unknown");
+//!   `rpm` = motor RPM under the bridge's settings, rounded, saturated to `int18`;
+//!   `power_rating_pct` = output throttle %, rounded, 0..=127; `error_count` = how many frames
+//!   of that ESC had a fault bit set in their status word since the bridge started (the
+//!   decoder's checksum failures are not handed to outputs, so they are not in it).
+//! - **NodeStatus** (341), every second from the first poll: `uptime_sec` since the output was
+//!   opened; `mode` OPERATIONAL; `health` OK, or WARNING while an ESC that was heard is silent
+//!   or the last frame of a live ESC had a fault bit set; `vendor_specific_status_code` = bit
+//!   `i` set while ESC `i` (0..=15) is live.
+//!
+//! Both are broadcasts from the node id of [`DronecanOptions::node_id`] (default
+//! [`DEFAULT_NODE_ID`]), each message type with its own transfer id counter.
+//!
+//! # The adapter
+//!
+//! Opened with [`hwfoc_io::serial::open`] (ptys too) at [`DronecanOptions::baud`] (default
+//! [`DEFAULT_BAUD`]; adapters on USB CDC such as CANable ignore it, an adapter on a real UART
+//! needs its own: at 115200 baud a link carries about 140 esc.Status a second), then set up
+//! with `C`, `S<code>`, `O` (see [`slcan`]). What the adapter answers is read and ignored
+//! (refusals, BEL, counted in [`DronecanOutput::refusals`]). A write that fails because the
+//! port is gone is [`OutputError::Lost`]; the port is reopened (and set up again) at a later
+//! poll, after 0.25 s, doubling to at most 4 s while it stays away. A write that times out
+//! (the adapter does not take bytes) is [`OutputError::Send`] and the port is kept. Every error
+//! returned is also counted in [`OutputStats::errors`].
+//!
+//! # Why by hand
+//!
+//! The crates.io crates were read first: `dronecan` 0.2.0 (MPL-2.0) only
+//! reassembles received transfers and parses CAN IDs: no transmit-side splitting, no DSDL
+//! types. `David-OConnor/dronecan` on GitHub (0.1.0, same name) is tied to STM32's
+//! FD-CAN peripheral and has no `esc.Status`. `slcan` 0.1.3 (2020) is built on the unmaintained
+//! `serial` crate and `mini-slcan` / `serial-can` are codecs of a few lines of what
+//! [`slcan::push_extended`] does. `canadensis` is Cyphal (UAVCAN v1), another transport.
+//! The transport here is a hundred lines ([`transport`]), tested against pydronecan's bytes,
+//! and float16 is the `half` crate's.
+
+pub mod dsdl;
+pub mod slcan;
+pub mod transport;
+
+use std::io::{self, Read, Write};
+use std::time::{Duration, Instant};
+
+use serialport::SerialPort;
+
+use crate::output::{Output, OutputError, OutputStats, SILENT_AFTER, Update};
+use dsdl::{EscStatus, Health, NodeStatus};
+
+/// The default node id: outside the usual flight controller's (10) and the allocator's range
+/// of dynamically allocated peripherals (125 down), below the tools' 126 and 127.
+pub const DEFAULT_NODE_ID: u8 = 100;
+/// The default CAN bitrate, bit/s: what ArduPilot and PX4 use.
+pub const DEFAULT_BITRATE: u32 = 1_000_000;
+/// The default serial speed of the adapter, baud (ignored by USB CDC adapters).
+pub const DEFAULT_BAUD: u32 = 115_200;
+/// The transfer priority of every message: 16, DroneCAN's "medium" (0 highest, 31 lowest).
+pub const PRIORITY: u8 = 16;
+/// How often NodeStatus is sent.
+pub const NODE_STATUS_EVERY: Duration = Duration::from_secs(1);
+/// The most ESCs `esc_index` (uint5) can number.
+pub const MAX_ESCS: usize = 32;
+
+/// The first wait before reopening a lost adapter, doubled after each failure up to
+/// [`REOPEN_MAX`].
+const REOPEN_FIRST: Duration = Duration::from_millis(250);
+/// The longest wait between two attempts at reopening.
+const REOPEN_MAX: Duration = Duration::from_secs(4);
+
+/// The node's settings.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct DronecanOptions {
+    /// The node id, 1..=127 (default [`DEFAULT_NODE_ID`]).
+    pub node_id: u8,
+    /// The serial speed of the adapter (default [`DEFAULT_BAUD`]).
+    pub baud: u32,
+}
+
+impl Default for DronecanOptions {
+    fn default() -> Self {
+        DronecanOptions {
+            node_id: DEFAULT_NODE_ID,
+            baud: DEFAULT_BAUD,
+        }
+    }
+}
+
+/// Where the node's CAN frames go: an SLCAN adapter's serial port, and the bus's bitrate.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct SlcanTarget {
+    /// The serial port (`/dev/ttyACM0`, `COM5`, `/dev/pts/3`).
+    pub port: String,
+    /// The CAN bitrate, bit/s: one of [`slcan::BITRATES`].
+    pub bitrate: u32,
+}
+
+impl SlcanTarget {
+    /// Parses `slcan:PORT[:BITRATE]`; BITRATE in bit/s (`500000`), or with `k` or `M`
+    /// (`500k`, `1M`); default [`DEFAULT_BITRATE`]. A bitrate SLCAN has no code for is an error
+    /// naming those it has.
+    pub fn parse(spec: &str) -> Result<SlcanTarget, OutputError> {
+        let err = |reason: String| OutputError::Open {
+            output: spec.to_string(),
+            reason,
+        };
+        let rest = spec.strip_prefix("slcan:").ok_or_else(|| {
+            err("expected slcan:PORT[:BITRATE] (an SLCAN serial CAN adapter)".to_string())
+        })?;
+        let (port, bitrate) = match rest.rsplit_once(':') {
+            Some((port, bitrate)) => (port, parse_bitrate(bitrate).map_err(err)?),
+            None => (rest, DEFAULT_BITRATE),
+        };
+        if port.is_empty() {
+            return Err(err("no port: expected slcan:PORT[:BITRATE]".to_string()));
+        }
+        Ok(SlcanTarget {
+            port: port.to_string(),
+            bitrate,
+        })
+    }
+}
+
+impl std::fmt::Display for SlcanTarget {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "slcan:{}:{}", self.port, self.bitrate)
+    }
+}
+
+/// A CAN bitrate with an SLCAN code, from `1000000`, `1000k` or `1M`.
+fn parse_bitrate(text: &str) -> Result<u32, String> {
+    let (digits, unit) = match text.as_bytes().last() {
+        Some(b'k' | b'K') => (&text[..text.len() - 1], 1_000),
+        Some(b'M' | b'm') => (&text[..text.len() - 1], 1_000_000),
+        _ => (text, 1),
+    };
+    let supported = || {
+        slcan::BITRATES
+            .iter()
+            .map(u32::to_string)
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    let bitrate = digits
+        .parse::<u32>()
+        .ok()
+        .and_then(|n| n.checked_mul(unit))
+        .ok_or_else(|| {
+            format!(
+                "bad CAN bitrate {text:?}: SLCAN takes {} bit/s",
+                supported()
+            )
+        })?;
+    match slcan::bitrate_code(bitrate) {
+        Some(_) => Ok(bitrate),
+        None => Err(format!(
+            "CAN bitrate {bitrate} bit/s has no SLCAN code: SLCAN takes {} bit/s",
+            supported()
+        )),
+    }
+}
+
+/// One ESC as the node knows it.
+#[derive(Debug, Clone, Default)]
+struct Esc {
+    /// When its last frame arrived.
+    heard: Option<Instant>,
+    /// Its last frame had a fault bit set.
+    fault: bool,
+    /// Frames with a fault bit set so far.
+    error_count: u32,
+    /// The esc.Status to send at the next poll, and when its frame arrived.
+    pending: Option<(EscStatus, Instant)>,
+}
+
+/// The DroneCAN output (see the [module documentation](self)).
+pub struct DronecanOutput {
+    name: String,
+    target: SlcanTarget,
+    options: DronecanOptions,
+    code: u8,
+    port: Option<Box<dyn SerialPort>>,
+    opened: Instant,
+    next_node_status: Option<Instant>,
+    reopen_at: Instant,
+    reopen_wait: Duration,
+    escs: Vec<Esc>,
+    esc_transfer_id: u8,
+    node_transfer_id: u8,
+    stats: OutputStats,
+    frames: u64,
+    reopens: u64,
+    refusals: u64,
+    not_sent: u64,
+    out: Vec<u8>,
+}
+
+impl std::fmt::Debug for DronecanOutput {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("DronecanOutput")
+            .field("name", &self.name)
+            .field("options", &self.options)
+            .field("connected", &self.port.is_some())
+            .finish_non_exhaustive()
+    }
+}
+
+impl DronecanOutput {
+    /// Opens the adapter and sets it up. An error if the node id is not 1..=127 or the port
+    /// cannot be opened now ([`OutputError::Open`]); later losses are reopened.
+    pub fn open(
+        target: SlcanTarget,
+        options: DronecanOptions,
+    ) -> Result<DronecanOutput, OutputError> {
+        let name = format!("dronecan {target}");
+        let open_err = |reason: String| OutputError::Open {
+            output: target.to_string(),
+            reason,
+        };
+        if !(1..=127).contains(&options.node_id) {
+            return Err(open_err(format!(
+                "node id {} out of range: a DroneCAN node id is 1 to 127",
+                options.node_id
+            )));
+        }
+        let code = slcan::bitrate_code(target.bitrate).ok_or_else(|| {
+            open_err(format!(
+                "CAN bitrate {} bit/s has no SLCAN code",
+                target.bitrate
+            ))
+        })?;
+        let port = open_adapter(&target.port, options.baud, code).map_err(open_err)?;
+        let now = Instant::now();
+        Ok(DronecanOutput {
+            name,
+            target,
+            options,
+            code,
+            port: Some(port),
+            opened: now,
+            next_node_status: None,
+            reopen_at: now,
+            reopen_wait: REOPEN_FIRST,
+            escs: vec![Esc::default(); MAX_ESCS],
+            esc_transfer_id: 0,
+            node_transfer_id: 0,
+            stats: OutputStats::default(),
+            frames: 0,
+            reopens: 0,
+            refusals: 0,
+            not_sent: 0,
+            out: Vec::with_capacity(256),
+        })
+    }
+
+    /// The adapter as given.
+    pub fn target(&self) -> &SlcanTarget {
+        &self.target
+    }
+
+    /// Whether the adapter is open now (false between a loss and its reopening).
+    pub fn connected(&self) -> bool {
+        self.port.is_some()
+    }
+
+    /// CAN frames written so far ([`OutputStats::messages`] counts transfers: an esc.Status is
+    /// three frames, a NodeStatus one).
+    pub fn frames(&self) -> u64 {
+        self.frames
+    }
+
+    /// How many times a lost adapter was opened again.
+    pub fn reopens(&self) -> u64 {
+        self.reopens
+    }
+
+    /// Commands the adapter refused (BEL answers), e.g. frames it could not send on the bus.
+    pub fn refusals(&self) -> u64 {
+        self.refusals
+    }
+
+    /// ESC frames not sent: their ESC number is 32 or more, or they were still waiting when the
+    /// adapter was lost and too old ([`SILENT_AFTER`]) once it was back.
+    pub fn not_sent(&self) -> u64 {
+        self.not_sent
+    }
+
+    /// The NodeStatus at `now`.
+    fn node_status(&self, now: Instant) -> NodeStatus {
+        let mut live_mask = 0u16;
+        let mut warning = false;
+        for (i, esc) in self.escs.iter().enumerate() {
+            let Some(heard) = esc.heard else { continue };
+            let live = now.saturating_duration_since(heard) < SILENT_AFTER;
+            if live {
+                if i < 16 {
+                    live_mask |= 1 << i;
+                }
+                warning |= esc.fault;
+            } else {
+                warning = true;
+            }
+        }
+        NodeStatus {
+            uptime_sec: u32::try_from(now.saturating_duration_since(self.opened).as_secs())
+                .unwrap_or(u32::MAX),
+            health: if warning { Health::Warning } else { Health::Ok },
+            mode: dsdl::MODE_OPERATIONAL,
+            sub_mode: 0,
+            vendor_specific_status_code: live_mask,
+        }
+    }
+
+    /// Writes `self.out` (the lines of whole transfers); an error makes the port lost or not.
+    fn write_out(&mut self, now: Instant) -> Result<(), OutputError> {
+        let Some(port) = self.port.as_mut() else {
+            return Ok(());
+        };
+        match port.write_all(&self.out).and_then(|()| port.flush()) {
+            Ok(()) => {
+                self.stats.bytes += self.out.len() as u64;
+                Ok(())
+            }
+            Err(e) => {
+                self.stats.errors += 1;
+                let reason = e.to_string();
+                if matches!(
+                    e.kind(),
+                    io::ErrorKind::TimedOut
+                        | io::ErrorKind::WouldBlock
+                        | io::ErrorKind::Interrupted
+                ) {
+                    Err(OutputError::Send {
+                        output: self.name.clone(),
+                        reason,
+                    })
+                } else {
+                    self.port = None;
+                    self.reopen_at = now + self.reopen_wait;
+                    Err(OutputError::Lost {
+                        output: self.name.clone(),
+                        reason,
+                    })
+                }
+            }
+        }
+    }
+
+    /// Appends one transfer's SLCAN lines to `self.out`.
+    fn push_transfer(&mut self, data_type: u16, signature: u64, transfer_id: u8, payload: &[u8]) {
+        let id = transport::message_id(PRIORITY, data_type, self.options.node_id);
+        for frame in transport::frames(id, signature, transfer_id, payload) {
+            slcan::push_extended(&mut self.out, frame.id, frame.data());
+            self.frames += 1;
+        }
+    }
+
+    /// Reads and drops what the adapter answered, counting refusals.
+    fn drain(&mut self) {
+        let Some(port) = self.port.as_mut() else {
+            return;
+        };
+        let mut buf = [0u8; 256];
+        for _ in 0..16 {
+            let waiting = port.bytes_to_read().unwrap_or(0) as usize;
+            if waiting == 0 {
+                break;
+            }
+            let n = waiting.min(buf.len());
+            match port.read(&mut buf[..n]) {
+                Ok(n) if n > 0 => {
+                    self.refusals += buf[..n].iter().filter(|&&b| b == slcan::BEL).count() as u64
+                }
+                _ => break,
+            }
+        }
+    }
+
+    /// Tries to reopen a lost adapter if it is time.
+    fn reopen(&mut self, now: Instant) {
+        if now < self.reopen_at {
+            return;
+        }
+        match open_adapter(&self.target.port, self.options.baud, self.code) {
+            Ok(port) => {
+                self.port = Some(port);
+                self.reopens += 1;
+                self.reopen_wait = REOPEN_FIRST;
+                // A NodeStatus straight away: the bus learns the node is back.
+                self.next_node_status = Some(now);
+            }
+            Err(_) => {
+                self.reopen_wait = (self.reopen_wait * 2).min(REOPEN_MAX);
+                self.reopen_at = now + self.reopen_wait;
+            }
+        }
+    }
+}
+
+/// Opens an SLCAN adapter and sends its setup.
+fn open_adapter(port: &str, baud: u32, code: u8) -> Result<Box<dyn SerialPort>, String> {
+    let mut p = hwfoc_io::serial::open(port, baud).map_err(|e| e.to_string())?;
+    // Whatever was waiting is from before us.
+    let _ = p.clear(serialport::ClearBuffer::Input);
+    p.write_all(&slcan::setup(code))
+        .and_then(|()| p.flush())
+        .map_err(|e| format!("cannot set the SLCAN adapter up: {e}"))?;
+    Ok(p)
+}
+
+impl Output for DronecanOutput {
+    fn name(&self) -> &str {
+        &self.name
+    }
+
+    fn update(&mut self, update: &Update<'_>) {
+        let Some(esc) = self.escs.get_mut(usize::from(update.esc)) else {
+            self.not_sent += 1;
+            return;
+        };
+        let r = update.record;
+        let fault = r.status.0 != 0;
+        esc.heard = Some(update.arrived);
+        esc.fault = fault;
+        if fault {
+            esc.error_count = esc.error_count.wrapping_add(1);
+        }
+        let status = EscStatus {
+            error_count: esc.error_count,
+            voltage: r.voltage_v,
+            current: r.current_a,
+            temperature: r.mos_temp_c.map_or(f32::NAN, |c| c + 273.15),
+            rpm: r.rpm.round() as i32,
+            power_rating_pct: r.throttle_out_pct.round().clamp(0.0, 127.0) as u8,
+            esc_index: update.esc,
+        };
+        if esc.pending.replace((status, update.arrived)).is_some() {
+            self.stats.superseded += 1;
+        }
+    }
+
+    fn poll(&mut self, now: Instant) -> Result<(), OutputError> {
+        if self.port.is_none() {
+            self.reopen(now);
+            if self.port.is_none() {
+                return Ok(());
+            }
+        }
+        self.drain();
+        for i in 0..self.escs.len() {
+            let Some((status, arrived)) = self.escs[i].pending.take() else {
+                continue;
+            };
+            if now.saturating_duration_since(arrived) >= SILENT_AFTER {
+                self.not_sent += 1;
+                continue;
+            }
+            self.out.clear();
+            let tid = self.esc_transfer_id;
+            self.esc_transfer_id = (tid + 1) & 0x1F;
+            self.push_transfer(
+                dsdl::ESC_STATUS_ID,
+                dsdl::ESC_STATUS_SIGNATURE,
+                tid,
+                &status.serialize(),
+            );
+            self.write_out(now)?;
+            self.stats.messages += 1;
+            self.stats.latency.add(Instant::now() - arrived);
+        }
+        if self.next_node_status.is_none_or(|t| now >= t) {
+            let payload = self.node_status(now).serialize();
+            self.out.clear();
+            let tid = self.node_transfer_id;
+            self.node_transfer_id = (tid + 1) & 0x1F;
+            self.push_transfer(
+                dsdl::NODE_STATUS_ID,
+                dsdl::NODE_STATUS_SIGNATURE,
+                tid,
+                &payload,
+            );
+            // A second after this one was due; a second after now if far behind.
+            let next = self.next_node_status.unwrap_or(now) + NODE_STATUS_EVERY;
+            self.next_node_status = Some(if next <= now {
+                now + NODE_STATUS_EVERY
+            } else {
+                next
+            });
+            self.write_out(now)?;
+            self.stats.messages += 1;
+        }
+        Ok(())
+    }
+
+    fn stats(&self) -> &OutputStats {
+        &self.stats
+    }
+}
