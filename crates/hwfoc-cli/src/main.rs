@@ -40,6 +40,8 @@ enum Command {
     Record(capture::RecordArgs),
     /// Virtual ESCs: the protocol from a physical model, to a pty, serial port, file or stdout.
     Simulate(Box<simulate::SimulateArgs>),
+    /// The Wireshark dissector for recordings: install it, print where it goes, or print it.
+    Wireshark(commands::wireshark::WiresharkArgs),
 }
 
 fn main() -> ExitCode {
@@ -51,6 +53,7 @@ fn main() -> ExitCode {
         Command::Record(args) => capture::run(args),
         Command::Simulate(args) => simulate::run(args),
         Command::Plot(args) => plot::run(args),
+        Command::Wireshark(args) => commands::wireshark::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

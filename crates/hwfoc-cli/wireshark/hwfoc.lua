@@ -127,7 +127,7 @@ local f = {
     cap_adc = ProtoField.uint8("hwfoc.cap_adc", "Capacitor temperature (ADC code)"),
     cap_temp = ProtoField.double("hwfoc.cap_temp_c", "Capacitor temperature"),
     status = ProtoField.uint16("hwfoc.status", "Status", base.HEX),
-    faults = ProtoField.string("hwfoc.faults", "Faults"),
+    faults = ProtoField.string("hwfoc.faults", "Faults (status bits set, by name, or none)"),
     info_text = ProtoField.string("hwfoc.info.text", "Text"),
     info_product = ProtoField.string("hwfoc.info.product", "Product"),
     info_hardware = ProtoField.string("hwfoc.info.hardware", "Hardware"),
@@ -348,7 +348,7 @@ local function data_frame(r, tree)
         end
     end
     local faults = table.concat(names, ",")
-    tree:add(f.faults, r(20, 2), faults)
+    tree:add(f.faults, r(20, 2), #names > 0 and faults or "none")
     if #names > 0 then
         status_item:append_text(" (" .. faults .. ")")
         status_item:add_proto_expert_info(ef.fault, "ESC fault: " .. faults)
@@ -472,7 +472,9 @@ function hwfoc.dissector(tvb, pinfo, tree)
     -- passes use what the first one kept). A silence of over a second ends such a frame, as it
     -- does in hwfoc's decoder.
     local epoch = f_epoch().value
-    local carry = { bytes = "", epoch = epoch, k = 0 }
+    -- Carried bytes: where each packet they came from begins in them (`at`), that packet's
+    -- time and how many of its bytes came before (`k`).
+    local carry = { bytes = "", segs = {} }
     if not pinfo.visited then
         local p = pending[iface]
         if p and now - p.t_end <= 1.0 then carry = p end
@@ -481,37 +483,47 @@ function hwfoc.dissector(tvb, pinfo, tree)
         carry = carry_of[number] or carry
     end
     local s = carry.bytes .. tvb:raw()
+    local c = #carry.bytes
+    local segs = {}
+    for _, seg in ipairs(carry.segs) do segs[#segs + 1] = seg end
+    segs[#segs + 1] = { at = c, epoch = epoch, k = 0 }
+    -- The time of byte `i` of `s`, as {epoch, k}: k bytes after the first byte of a packet.
+    local function when_of(i)
+        local seg = segs[1]
+        for _, candidate_seg in ipairs(segs) do
+            if candidate_seg.at <= i then seg = candidate_seg end
+        end
+        return { epoch = seg.epoch, k = seg.k + i - seg.at, byte_s = byte_s }
+    end
     local items = scan(s)
     if not pinfo.visited then
         local last = items[#items]
         if last and last.what == "partial" and last.to - last.from < INFO_LEN then
-            local from_here = last.from - #carry.bytes
-            pending[iface] = {
-                bytes = s:sub(last.from + 1),
-                -- Its first byte: in this packet, or in the packet it was carried from.
-                epoch = from_here >= 0 and epoch or carry.epoch,
-                k = from_here >= 0 and from_here or carry.k + last.from,
-                t_end = now + n * byte_s,
-            }
+            local first = when_of(last.from)
+            local kept = { { at = 0, epoch = first.epoch, k = first.k } }
+            for _, seg in ipairs(segs) do
+                if seg.at > last.from then
+                    kept[#kept + 1] = { at = seg.at - last.from, epoch = seg.epoch, k = seg.k }
+                end
+            end
+            pending[iface] = { bytes = s:sub(last.from + 1), segs = kept, t_end = now + n * byte_s }
         else
             pending[iface] = nil
         end
     end
 
     local root = tree:add(hwfoc, tvb(), "HW-FOC telemetry")
-    local c = #carry.bytes
     local infos = {}
     local joined = nil
     for _, item in ipairs(items) do
         if item.to > c then
-            local when = { epoch = epoch, k = item.from - c, byte_s = byte_s }
+            local when = when_of(item.from)
             local range
             if item.from >= c then
                 range = tvb(item.from - c, item.to - item.from)
             else
                 joined = joined or ByteArray.new(s, true):tvb("Reassembled HW-FOC frame")
                 range = joined(item.from, item.to - item.from)
-                when = { epoch = carry.epoch, k = carry.k + item.from, byte_s = byte_s }
             end
             if item.what == "noise" then
                 local it = root:add(f.noise, range)
