@@ -343,7 +343,8 @@ local function data_frame(r, tree)
     local names = {}
     for bit, fault in ipairs(FAULTS) do
         status_item:add(status_bits[bit], r(20, 2))
-        if bit32.band(status, 2 ^ (bit - 1)) ~= 0 then
+        -- (arithmetic rather than bit32, which Lua 5.3 and later lack)
+        if math.floor(status / 2 ^ (bit - 1)) % 2 == 1 then
             names[#names + 1] = fault[1]
         end
     end
