@@ -43,6 +43,8 @@ enum Command {
     /// Bridge ESC telemetry (ports, recordings, virtual ESCs) to flight controllers and ground
     /// stations: DataLink V2 frames, MAVLink, DroneCAN.
     Bridge(Box<bridge::BridgeArgs>),
+    /// The Wireshark dissector for recordings: install it, print where it goes, or print it.
+    Wireshark(commands::wireshark::WiresharkArgs),
 }
 
 fn main() -> ExitCode {
@@ -55,6 +57,7 @@ fn main() -> ExitCode {
         Command::Simulate(args) => simulate::run(args),
         Command::Plot(args) => plot::run(args),
         Command::Bridge(args) => bridge::run(args),
+        Command::Wireshark(args) => commands::wireshark::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -1,8 +1,11 @@
 //! `hwfoc record PORT... -o FILE`: lossless, timestamped capture of serial ports to pcapng.
 //!
-//! Every byte received is stored, in chunks as the reads returned them, each chunk timestamped
-//! with the Unix time of its first byte in nanoseconds; one pcapng interface per port, in the
-//! order given (see [`hwfoc_io::pcapng`]). The recording is meant to survive the worst:
+//! Every byte received is stored, cut at frame boundaries: one packet per frame, timestamped with
+//! the Unix time of its first byte in nanoseconds, and the bytes between frames in packets of
+//! their own; one pcapng interface per port, in the order given (see [`hwfoc_io::pcapng`]). The
+//! bytes of a frame still arriving are held until it completes, or until the port has been
+//! silent for [`SETTLE_AFTER`], and are written at the end of every file. The recording is
+//! meant to survive the worst:
 //! - crash safety: blocks go from a small buffer to the file at least every [`FLUSH_EVERY`],
 //!   so after `kill -9` (or a crash) the file reads up to its last complete block and at most
 //!   that much data is lost; the file is also synced to the disk every [`SYNC_EVERY`];
@@ -31,6 +34,9 @@ use hwfoc_io::write::WriteError;
 
 /// Longest time a received byte stays in this process before it is written to the file.
 pub const FLUSH_EVERY: Duration = Duration::from_millis(50);
+/// How long a port must be silent before the bytes of a frame that has not completed are written
+/// as they are (a frame's bytes come back to back: 77 bytes take 40 ms at 19200 baud).
+pub const SETTLE_AFTER: Duration = Duration::from_millis(200);
 /// How often the file is synced to the disk (against power loss; a process crash loses only
 /// what is not yet written).
 pub const SYNC_EVERY: Duration = Duration::from_secs(1);
@@ -312,8 +318,11 @@ impl Recorder {
         match event {
             PortEvent::Data { port, t_ns, bytes } => {
                 if let (Some(limit), Some(writer)) = (self.rotate_size, &self.writer) {
-                    let block = 32 + bytes.len().next_multiple_of(4) as u64;
-                    if self.file_has_packets && writer.bytes_written() + block > limit {
+                    // What the file would be were it closed after these bytes (held bytes
+                    // included): so every file, closed at any moment, stays under the limit.
+                    let cost = writer.cost(port as u32, &bytes);
+                    let cost = cost.map_err(|e| self.write_error(e))?;
+                    if self.file_has_packets && writer.bytes_written() + cost > limit {
                         self.rotate()?;
                     }
                 }
@@ -439,11 +448,16 @@ impl Recorder {
         Ok(())
     }
 
+    /// Writes the bytes held for ports silent for [`SETTLE_AFTER`] and flushes the file; the
+    /// bytes of frames still arriving stay held, so that no frame is cut in two by a flush.
     fn flush(&mut self) -> Result<(), CliError> {
         self.last_flush = Instant::now();
+        let now_ns = self.clock.now_ns();
         match &mut self.writer {
             Some(writer) => {
-                let flushed = writer.flush();
+                let flushed = writer
+                    .settle(now_ns, SETTLE_AFTER.as_nanos() as u64)
+                    .and_then(|()| writer.flush_written());
                 flushed.map_err(|e| self.write_error(e))
             }
             None => Ok(()),

@@ -7,3 +7,4 @@ pub mod monitor;
 pub mod plot;
 pub mod simulate;
 pub mod summary;
+pub mod wireshark;

@@ -1,16 +1,29 @@
 //! Recordings in pcapng, the capture format of Wireshark and tshark.
 //!
 //! A recording holds the bytes received on one or more serial ports exactly as they arrived,
-//! each chunk with the receive time of its first byte in nanoseconds:
-//! - a section header block (SHB) naming the writing application;
+//! every byte in order, with its receive time:
+//! - a section header block (SHB) naming the writing application (`shb_userappl` = `hwfoc` and
+//!   its version);
 //! - one interface description block (IDB) per port: link type [`LINKTYPE`] (`LINKTYPE_USER0`,
 //!   raw HW-FOC UART bytes), `if_name` = the port, `if_description` = "HW-FOC telemetry, 19200
 //!   baud 8N1", `if_speed` = the baud rate, `if_tsresol` = 9 (nanoseconds);
-//! - one enhanced packet block (EPB) per chunk of received bytes, timestamped with the Unix time
-//!   in nanoseconds of the chunk's first byte; byte `i` of a chunk arrived at
-//!   `t_ns + i * 10e9 / baud` ns (8N1: ten bits per byte);
+//! - one enhanced packet block (EPB) per frame, holding exactly the frame's bytes, timestamped
+//!   with the Unix time in nanoseconds of its first byte; the bytes between frames (line noise,
+//!   frames that fail their checksum) in packets of their own, one per read of the port they
+//!   came in, each timestamped with its first byte's time. Byte `i` of a packet arrived at
+//!   `t_ns + i * 10e9 / baud` ns (8N1: ten bits per byte). The EPBs carry no options: 32 bytes
+//!   of block around the frame (a data frame of 24 bytes takes 56 bytes of file);
 //! - notes such as a gap while a port was unplugged are an EPB with no bytes and an
 //!   `opt_comment` (Wireshark shows them as a 0-byte packet carrying the comment).
+//!
+//! The cut at frames ([`Writer::write`]; the frames are found by the codec's decoder, module
+//! `cut`) makes each packet one frame in Wireshark (with the dissector `hwfoc wireshark install`
+//! puts in place) and the file small: about 2.4 times the bytes on the wire, where the earlier
+//! layout (one packet per read of the port, cut anywhere in the frames) took 4.8. A reader needs
+//! no change for either: the bytes of each port, concatenated in file order, are the stream, and
+//! every frame's first byte has the same time in both (to a nanosecond's rounding). Files of the
+//! earlier layout read exactly as before. Packets of different ports may be a frame's length out
+//! of time order in the file, since a frame is written when it is complete.
 //!
 //! The blocks are written and read here by hand rather than with the `pcap-file` crate (2.0):
 //! its EPB reader takes the raw timestamp as nanoseconds whatever the interface's `if_tsresol`
@@ -21,10 +34,14 @@
 //! reports each place it could not read, with its byte offset, as [`Damage`]. The three block
 //! types the writer needs are a few lines each.
 
+mod cut;
+
 use std::collections::HashMap;
 use std::fmt;
 use std::io::{self, Read, Write};
 use std::ops::Range;
+
+use cut::{Cutter, Emit};
 
 /// `LINKTYPE_USER0`: raw HW-FOC UART bytes (the user range 147..=162 is for private use).
 pub const LINKTYPE: u32 = 147;
@@ -40,8 +57,8 @@ pub fn byte_time_s(t_ns: u64, i: usize, per_byte_ns: f64) -> f64 {
 /// both byte orders).
 pub const MAGIC: [u8; 4] = [0x0A, 0x0D, 0x0D, 0x0A];
 
-/// Longest chunk written as one packet: longer writes are split (Wireshark refuses packets over
-/// 256 KiB), each piece timestamped at its own first byte.
+/// Longest run of bytes written as one packet: longer runs between frames are split (Wireshark
+/// refuses packets over 256 KiB), each piece timestamped at its own first byte.
 pub const MAX_CHUNK: usize = 1 << 16;
 
 const SHB: u32 = 0x0A0D_0D0A;
@@ -70,17 +87,50 @@ const MAX_RESYNC_BLOCK: usize = MAX_CHUNK + 4096;
 /// Bytes asked of the source per read.
 const READ_SIZE: usize = 1 << 16;
 
-/// Writes a pcapng recording: the section header on creation, then interfaces, chunks and notes.
+/// Writes a pcapng recording: the section header on creation, then interfaces, frames and notes.
 ///
-/// Each block is handed to `W` in a single `write_all`; the writer keeps nothing itself, so with
-/// an unbuffered `W` every block is in the file when the call returns, and with a buffered one
-/// after [`Writer::flush`].
+/// Each block is handed to `W` in a single `write_all`. The bytes of a frame still arriving
+/// (fewer than 77 per port) are held by the writer until the frame completes, until
+/// [`Writer::settle`] finds its port silent, or until [`Writer::flush`] or [`Writer::into_inner`];
+/// every other byte is handed to `W` by the [`Writer::write`] that brought it. With an unbuffered
+/// `W` a block is in the file when the call returns, with a buffered one after a flush.
 pub struct Writer<W: Write> {
     inner: W,
-    /// Baud rate of each interface, by id.
-    bauds: Vec<u32>,
+    /// Baud rate and cutter of each interface, by id.
+    ports: Vec<(u32, Cutter)>,
     block: Vec<u8>,
     written: u64,
+}
+
+/// Bytes of file an EPB without options takes for `len` bytes of packet.
+fn epb_size(len: usize) -> u64 {
+    32 + len.next_multiple_of(4) as u64
+}
+
+/// The pieces of a cutter written as packets of one interface.
+struct Packets<'a, W: Write> {
+    writer: &'a mut Writer<W>,
+    iface: u32,
+}
+
+impl<W: Write> Emit for Packets<'_, W> {
+    type Error = io::Error;
+    fn piece(&mut self, t_ns: u64, bytes: &[u8]) -> io::Result<()> {
+        self.writer.chunk(self.iface, t_ns, bytes)
+    }
+}
+
+/// The pieces of a cutter counted as file bytes.
+struct Cost(u64);
+
+impl Emit for Cost {
+    type Error = std::convert::Infallible;
+    fn piece(&mut self, _: u64, bytes: &[u8]) -> Result<(), Self::Error> {
+        let whole = (bytes.len() / MAX_CHUNK) as u64 * epb_size(MAX_CHUNK);
+        let rest = bytes.len() % MAX_CHUNK;
+        self.0 += whole + if rest > 0 { epb_size(rest) } else { 0 };
+        Ok(())
+    }
 }
 
 impl<W: Write> Writer<W> {
@@ -89,7 +139,7 @@ impl<W: Write> Writer<W> {
     pub fn new(w: W) -> io::Result<Self> {
         let mut writer = Writer {
             inner: w,
-            bauds: Vec::new(),
+            ports: Vec::new(),
             block: Vec::with_capacity(256),
             written: 0,
         };
@@ -117,7 +167,7 @@ impl<W: Write> Writer<W> {
                 "a baud rate of 0 is not valid",
             ));
         }
-        let id = u32::try_from(self.bauds.len())
+        let id = u32::try_from(self.ports.len())
             .map_err(|_| io::Error::new(io::ErrorKind::InvalidInput, "too many interfaces"))?;
         self.begin(IDB);
         self.put_u16(LINKTYPE as u16);
@@ -132,43 +182,97 @@ impl<W: Write> Writer<W> {
         self.option(IF_TSRESOL, &[9]);
         self.end_options();
         self.finish()?;
-        self.bauds.push(baud);
+        self.ports
+            .push((baud, Cutter::new(hwfoc::wire::byte_ns(baud))));
         Ok(id)
     }
 
-    /// Writes a chunk of received bytes on interface `iface`; `t_ns` is the Unix time in
-    /// nanoseconds of the chunk's first byte. An empty chunk writes nothing; a chunk longer
-    /// than [`MAX_CHUNK`] becomes several packets.
+    /// Writes bytes received on interface `iface`, `t_ns` the Unix time in nanoseconds of the
+    /// first of them (the bytes of one read of a port, back to back): each frame they complete
+    /// becomes a packet, timestamped with its first byte's time, and the bytes between frames
+    /// packets of their own (see the module documentation). The bytes of a frame still arriving
+    /// are held for the next call. An empty `data` writes nothing.
     pub fn write(&mut self, iface: u32, t_ns: u64, data: &[u8]) -> io::Result<()> {
-        let baud = self.baud(iface)?;
-        let per_byte = hwfoc::wire::byte_ns(baud);
-        for (k, piece) in data.chunks(MAX_CHUNK).enumerate() {
-            let offset = (k * MAX_CHUNK) as f64 * per_byte;
-            self.packet(
+        self.baud(iface)?;
+        let mut cutter = self.take_cutter(iface);
+        let result = cutter.feed(
+            t_ns,
+            data,
+            &mut Packets {
+                writer: self,
                 iface,
-                t_ns.saturating_add(offset.round() as u64),
-                piece,
-                None,
-            )?;
+            },
+        );
+        self.ports[iface as usize].1 = cutter;
+        result
+    }
+
+    /// Writes `data` as it is, as one packet on interface `iface` (several if longer than
+    /// [`MAX_CHUNK`], each timestamped at its own first byte), after the bytes held for that
+    /// interface. For bytes that are not a port's stream; [`Writer::write`] is for those.
+    pub fn write_packet(&mut self, iface: u32, t_ns: u64, data: &[u8]) -> io::Result<()> {
+        self.settle_port(iface)?;
+        self.chunk(iface, t_ns, data)
+    }
+
+    /// Writes out the bytes held for every port whose last byte was received `quiet_ns` or more
+    /// before `now_ns`: a frame that has not completed in that time never will (an ESC sends a
+    /// frame's bytes back to back, 77 bytes at most), and its bytes are written as bytes between
+    /// frames. Call it now and then (the recorder does every 50 ms with a 200 ms silence).
+    pub fn settle(&mut self, now_ns: u64, quiet_ns: u64) -> io::Result<()> {
+        for iface in 0..self.ports.len() as u32 {
+            let cutter = &self.ports[iface as usize].1;
+            if cutter.holds() && now_ns.saturating_sub(cutter.last_ns()) >= quiet_ns {
+                self.settle_port(iface)?;
+            }
         }
         Ok(())
     }
 
-    /// Writes a note about interface `iface` at Unix time `t_ns` (for example a gap while the
-    /// port was unplugged): a packet with no bytes and the text as its comment.
-    pub fn comment(&mut self, iface: u32, t_ns: u64, text: &str) -> io::Result<()> {
+    /// How many bytes the file would grow by if `data` were written on `iface` at this moment
+    /// and the recording then ended (every held byte written): a bound for rotating by size.
+    pub fn cost(&self, iface: u32, data: &[u8]) -> io::Result<u64> {
         self.baud(iface)?;
+        let mut cost = Cost(0);
+        for (i, (_, cutter)) in self.ports.iter().enumerate() {
+            if i != iface as usize && !cutter.holds() {
+                continue;
+            }
+            let mut cutter = cutter.clone();
+            if i == iface as usize {
+                let Ok(()) = cutter.feed(0, data, &mut cost);
+            }
+            let Ok(()) = cutter.settle(&mut cost);
+        }
+        Ok(cost.0)
+    }
+
+    /// Writes a note about interface `iface` at Unix time `t_ns` (for example a gap while the
+    /// port was unplugged): a packet with no bytes and the text as its comment, after the bytes
+    /// held for that interface.
+    pub fn comment(&mut self, iface: u32, t_ns: u64, text: &str) -> io::Result<()> {
+        self.settle_port(iface)?;
         self.packet(iface, t_ns, &[], Some(text))
     }
 
-    /// Flushes `W`.
+    /// Writes out every held byte (a frame still arriving is written as bytes between frames)
+    /// and flushes `W`: everything given to the writer is then in `W`.
     pub fn flush(&mut self) -> io::Result<()> {
+        for iface in 0..self.ports.len() as u32 {
+            self.settle_port(iface)?;
+        }
         self.inner.flush()
     }
 
-    /// Flushes `W` and returns it.
+    /// Flushes `W` with every block written so far, holding back the bytes of frames still
+    /// arriving (the periodic flush of a recording, which must not cut frames in two).
+    pub fn flush_written(&mut self) -> io::Result<()> {
+        self.inner.flush()
+    }
+
+    /// Writes out every held byte, flushes `W` and returns it.
     pub fn into_inner(mut self) -> io::Result<W> {
-        self.inner.flush()?;
+        self.flush()?;
         Ok(self.inner)
     }
 
@@ -183,12 +287,50 @@ impl<W: Write> Writer<W> {
     }
 
     fn baud(&self, iface: u32) -> io::Result<u32> {
-        self.bauds.get(iface as usize).copied().ok_or_else(|| {
+        self.ports.get(iface as usize).map(|p| p.0).ok_or_else(|| {
             io::Error::new(
                 io::ErrorKind::InvalidInput,
                 format!("interface {iface} was never added to the recording"),
             )
         })
+    }
+
+    /// The cutter of `iface` (which exists), leaving a fresh one in its place for the moment.
+    fn take_cutter(&mut self, iface: u32) -> Cutter {
+        let (baud, cutter) = &mut self.ports[iface as usize];
+        std::mem::replace(cutter, Cutter::new(hwfoc::wire::byte_ns(*baud)))
+    }
+
+    /// Writes out the bytes held for `iface`.
+    fn settle_port(&mut self, iface: u32) -> io::Result<()> {
+        self.baud(iface)?;
+        if !self.ports[iface as usize].1.holds() {
+            return Ok(());
+        }
+        let mut cutter = self.take_cutter(iface);
+        let result = cutter.settle(&mut Packets {
+            writer: self,
+            iface,
+        });
+        self.ports[iface as usize].1 = cutter;
+        result
+    }
+
+    /// Writes `data` as packets of at most [`MAX_CHUNK`] bytes, each timestamped at its first
+    /// byte.
+    fn chunk(&mut self, iface: u32, t_ns: u64, data: &[u8]) -> io::Result<()> {
+        let baud = self.baud(iface)?;
+        let per_byte = hwfoc::wire::byte_ns(baud);
+        for (k, piece) in data.chunks(MAX_CHUNK).enumerate() {
+            let offset = (k * MAX_CHUNK) as f64 * per_byte;
+            self.packet(
+                iface,
+                t_ns.saturating_add(offset.round() as u64),
+                piece,
+                None,
+            )?;
+        }
+        Ok(())
     }
 
     fn packet(
@@ -868,7 +1010,7 @@ mod tests {
             let iface = u32::from(k % 2);
             let data: Vec<u8> = (0..k * 3 + 1).map(|i| i.wrapping_mul(37) ^ k).collect();
             let t_ns = t0 + u64::from(k) * 50_000_001;
-            w.write(iface, t_ns, &data).unwrap();
+            w.write_packet(iface, t_ns, &data).unwrap();
             expected.push(Owned {
                 iface,
                 t_ns,
@@ -910,6 +1052,116 @@ mod tests {
                     link_type: 147,
                 },
             ]
+        );
+    }
+
+    /// A port's stream: frames (data, information, one failing its checksum), noise and a frame
+    /// cut by the end, read in chunks of 7 bytes 3 ms apart.
+    fn port_stream() -> (Vec<u8>, Vec<(u64, Vec<u8>)>) {
+        use hwfoc::{DataFrame, InfoFrame};
+        let mut wire = Vec::new();
+        for packet in 0..20u16 {
+            wire.extend_from_slice(
+                &DataFrame {
+                    packet,
+                    voltage_raw: 240 + packet,
+                    ..Default::default()
+                }
+                .encode(),
+            );
+            if packet % 5 == 0 {
+                let info = InfoFrame::new("XR_FOC_ESC", "HW577_KZ1_V1.1", "XR-01.0.00", "1");
+                wire.extend_from_slice(&info.unwrap().encode());
+            }
+            if packet % 7 == 3 {
+                wire.extend_from_slice(&[0x9B, 0x16, 0x55, 0x00, 0x9B]);
+            }
+        }
+        wire[100] ^= 0x01; // a frame fails its checksum
+        wire.extend_from_slice(&DataFrame::default().encode()[..11]);
+        let reads = wire
+            .chunks(7)
+            .enumerate()
+            .map(|(k, c)| (1_754_000_000_000_000_000 + k as u64 * 3_000_000, c.to_vec()))
+            .collect();
+        (wire, reads)
+    }
+
+    #[test]
+    fn writes_a_packet_per_frame_and_every_byte_with_its_time() {
+        let (wire, reads) = port_stream();
+        let mut w = Writer::new(Vec::new()).unwrap();
+        w.add_interface("p", 19200).unwrap();
+        let mut predicted = w.bytes_written();
+        for (t, bytes) in &reads {
+            // The cost of a write, were the recording to end after it, is exact.
+            predicted = w.bytes_written() + w.cost(0, bytes).unwrap();
+            w.write(0, *t, bytes).unwrap();
+        }
+        let file = w.into_inner().unwrap();
+        assert_eq!(file.len() as u64, predicted);
+        let (packets, _, damage) = read_all(&file);
+        assert!(damage.is_empty());
+        let joined: Vec<u8> = packets.iter().flat_map(|p| p.data.clone()).collect();
+        assert_eq!(joined, wire);
+        // Every frame the decoder finds is one packet, at its first byte's time in the reads.
+        let per_byte = hwfoc::wire::byte_ns(19200);
+        let time_of = |offset: usize| {
+            let (t, _) = reads[offset / 7];
+            t + ((offset % 7) as f64 * per_byte).round() as u64
+        };
+        let mut starts = Vec::new();
+        let mut at = 0;
+        for p in &packets {
+            starts.push(at);
+            at += p.data.len();
+        }
+        let mut found = 0;
+        hwfoc::Decoder::new().decode_all(&wire, |d| {
+            let offset = d.offset as usize;
+            let k = starts
+                .iter()
+                .position(|&s| s == offset)
+                .expect("a frame starts a packet");
+            assert_eq!(packets[k].data.len(), d.frame.wire_len());
+            assert_eq!(packets[k].t_ns, time_of(offset));
+            found += 1;
+        });
+        assert_eq!(found, 23); // 20 data and 4 information frames, one failing its checksum
+        // The bytes between frames keep their times too.
+        for (k, p) in packets.iter().enumerate() {
+            assert_eq!(p.t_ns, time_of(starts[k]), "packet {k}");
+        }
+    }
+
+    #[test]
+    fn held_bytes_are_written_by_settle_comment_and_flush() {
+        let frame = hwfoc::DataFrame::default().encode();
+        let mut w = Writer::new(Vec::new()).unwrap();
+        w.add_interface("a", 19200).unwrap();
+        w.add_interface("b", 19200).unwrap();
+        let headers = w.bytes_written();
+        w.write(0, 1_000, &frame[..5]).unwrap();
+        w.write(1, 2_000, &frame[..9]).unwrap();
+        w.flush_written().unwrap();
+        assert_eq!(w.bytes_written(), headers, "a frame still arriving is held");
+        // Port a's last byte came at 1000 + 4 byte times (~2.1 ms): settled 200 ms later.
+        w.settle(100_000_000, 200_000_000).unwrap();
+        assert_eq!(w.bytes_written(), headers);
+        w.settle(202_084_333, 200_000_000).unwrap();
+        assert_eq!(w.bytes_written(), headers + epb_size(5));
+        w.comment(1, 3_000, "gap").unwrap();
+        assert_eq!(w.bytes_written(), headers + epb_size(5) + epb_size(9) + 44);
+        w.write(0, 5_000, &frame[..3]).unwrap();
+        w.flush().unwrap();
+        let (packets, _, _) = read_all(&w.into_inner().unwrap());
+        let got: Vec<(u32, u64, usize)> = packets
+            .iter()
+            .map(|p| (p.iface, p.t_ns, p.data.len()))
+            .collect();
+        assert_eq!(
+            got,
+            [(0, 1_000, 5), (1, 2_000, 9), (1, 3_000, 0), (0, 5_000, 3)]
         );
     }
 

@@ -1,0 +1,578 @@
+//! The Wireshark dissector (`hwfoc wireshark`), run by tshark on recordings: every frame it shows
+//! as valid has exactly the values `hwfoc decode` gives (data frames) and the codec reads (device
+//! information), with the same time, in recordings of the compact layout and of the earlier
+//! read-chunk layout; bad checksums show as bad, faults by name; `install` puts it where tshark
+//! loads it and never replaces another file unasked.
+
+#![cfg(unix)]
+
+mod common;
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+use common::{hwfoc, run};
+use hwfoc::{DataFrame, Frame, InfoFrame};
+use hwfoc_io::pcapng;
+use serde_json::Value;
+
+fn dissector() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("wireshark/hwfoc.lua")
+}
+
+fn old_recording() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../testdata/recordings/chunked-2esc.pcapng")
+}
+
+fn tshark_found() -> bool {
+    let found = Command::new("tshark")
+        .arg("--version")
+        .output()
+        .is_ok_and(|o| o.status.success());
+    common::can_check(found, "tshark (running the Wireshark dissector)")
+}
+
+const FIELDS: [&str; 22] = [
+    "frame.interface_id",
+    "hwfoc.kind",
+    "hwfoc.checksum.status",
+    "hwfoc.time_epoch",
+    "hwfoc.packet",
+    "hwfoc.throttle_in_pct",
+    "hwfoc.throttle_out_pct",
+    "hwfoc.erpm",
+    "hwfoc.rpm",
+    "hwfoc.voltage_v",
+    "hwfoc.current_a",
+    "hwfoc.phase_current_a",
+    "hwfoc.mos_temp_c",
+    "hwfoc.cap_temp_c",
+    "hwfoc.status",
+    "hwfoc.faults",
+    "hwfoc.info.product",
+    "hwfoc.info.hardware",
+    "hwfoc.info.firmware",
+    "hwfoc.info.id",
+    "hwfoc.checksum",
+    "hwfoc.checksum.computed",
+];
+
+/// One frame as tshark shows it: field name -> value ("" when absent).
+type Shown = std::collections::BTreeMap<&'static str, String>;
+
+/// Every frame the dissector shows, in file order. Frames of one packet are its fields'
+/// occurrences (tshark aggregates them with `;`); fields a frame lacks (a temperature out of
+/// range) are told apart by the frame's own count of fields.
+fn tshark(file: &Path, options: &[&str], with_script: bool) -> Vec<Shown> {
+    let mut cmd = Command::new("tshark");
+    if with_script {
+        cmd.arg("-X")
+            .arg(format!("lua_script:{}", dissector().display()));
+    }
+    cmd.args(options).arg("-r").arg(file).args(["-T", "fields"]);
+    cmd.args([
+        "-E",
+        "occurrence=a",
+        "-E",
+        "aggregator=;",
+        "-E",
+        "separator=/t",
+    ]);
+    for f in FIELDS {
+        cmd.args(["-e", f]);
+    }
+    let out = cmd.output().expect("tshark");
+    assert!(
+        out.status.success(),
+        "tshark: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = String::from_utf8(out.stdout).unwrap();
+    let mut frames = Vec::new();
+    for line in text.lines() {
+        let cols: Vec<&str> = line.split('\t').collect();
+        assert_eq!(cols.len(), FIELDS.len(), "{line}");
+        let kinds: Vec<&str> = cols[1].split(';').filter(|k| !k.is_empty()).collect();
+        // Fields every frame of a kind has, split per frame (a data frame's temperatures may be
+        // absent: they are read only for packets of one frame).
+        let mut per_field: Vec<std::collections::VecDeque<&str>> = cols
+            .iter()
+            .map(|c| c.split(';').filter(|v| !v.is_empty()).collect())
+            .collect();
+        for kind in &kinds {
+            let mut shown = Shown::new();
+            shown.insert("frame.interface_id", cols[0].to_string());
+            for (i, f) in FIELDS.iter().enumerate().skip(1) {
+                let applies = match (*kind, *f) {
+                    (_, "hwfoc.kind" | "hwfoc.checksum.status" | "hwfoc.time_epoch") => true,
+                    (_, "hwfoc.checksum" | "hwfoc.checksum.computed") => true,
+                    ("info", f) => f.starts_with("hwfoc.info."),
+                    ("data", f) => !f.starts_with("hwfoc.info."),
+                    _ => false,
+                };
+                let optional = matches!(*f, "hwfoc.mos_temp_c" | "hwfoc.cap_temp_c");
+                if applies && !optional {
+                    let v = per_field[i]
+                        .pop_front()
+                        .unwrap_or_else(|| panic!("{f} in {line}"));
+                    shown.insert(f, v.to_string());
+                } else {
+                    shown.insert(f, String::new());
+                }
+            }
+            frames.push(shown);
+        }
+        // Optional temperatures are only checked for packets of one frame.
+        if kinds.len() == 1 {
+            let shown = frames.last_mut().unwrap();
+            for f in ["hwfoc.mos_temp_c", "hwfoc.cap_temp_c"] {
+                let i = FIELDS.iter().position(|x| *x == f).unwrap();
+                shown.insert(f, cols[i].to_string());
+            }
+        } else {
+            for shown in frames.iter_mut().rev().take(kinds.len()) {
+                shown.insert("hwfoc.mos_temp_c", "?".into());
+                shown.insert("hwfoc.cap_temp_c", "?".into());
+            }
+        }
+    }
+    frames
+}
+
+fn records(out: &[u8]) -> Vec<Value> {
+    String::from_utf8(out.to_vec())
+        .unwrap()
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap())
+        .collect()
+}
+
+fn decode(file: &Path, options: &[&str]) -> Vec<Value> {
+    let out = run(hwfoc().arg("decode").args(options).arg(file));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    records(&out.stdout)
+}
+
+fn as_f32(text: &str) -> f32 {
+    text.parse::<f64>()
+        .unwrap_or_else(|_| panic!("a number: {text:?}")) as f32
+}
+
+fn uint(text: &str) -> u64 {
+    match text.strip_prefix("0x") {
+        Some(hex) => u64::from_str_radix(hex, 16).unwrap(),
+        None => text.parse().unwrap(),
+    }
+}
+
+/// tshark's valid data frames are `hwfoc decode`'s records, value for value (numbers compared
+/// as the f32 they are), in order per ESC, with the same time.
+fn same_data_frames(shown: &[Shown], decoded: &[Value]) -> usize {
+    let good: Vec<&Shown> = shown
+        .iter()
+        .filter(|s| s["hwfoc.kind"] == "data" && s["hwfoc.checksum.status"] == "1")
+        .collect();
+    assert_eq!(good.len(), decoded.len(), "valid data frames");
+    let mut by_esc: std::collections::BTreeMap<u64, Vec<&Shown>> = Default::default();
+    for s in &good {
+        by_esc
+            .entry(uint(&s["frame.interface_id"]))
+            .or_default()
+            .push(s);
+    }
+    let mut next: std::collections::BTreeMap<u64, usize> = Default::default();
+    for r in decoded {
+        let esc = r["esc"].as_u64().unwrap();
+        let k = next.entry(esc).or_default();
+        let s = by_esc[&esc][*k];
+        *k += 1;
+        let what = format!("esc {esc} packet {}", r["packet"]);
+        assert_eq!(
+            uint(&s["hwfoc.packet"]),
+            r["packet"].as_u64().unwrap(),
+            "{what}"
+        );
+        assert_eq!(
+            uint(&s["hwfoc.erpm"]),
+            r["erpm"].as_u64().unwrap(),
+            "{what}"
+        );
+        assert_eq!(
+            uint(&s["hwfoc.status"]),
+            r["status"].as_u64().unwrap(),
+            "{what}"
+        );
+        for (field, column) in [
+            ("hwfoc.throttle_in_pct", "throttle_in_pct"),
+            ("hwfoc.throttle_out_pct", "throttle_out_pct"),
+            ("hwfoc.rpm", "rpm"),
+            ("hwfoc.voltage_v", "voltage_v"),
+            ("hwfoc.current_a", "current_a"),
+            ("hwfoc.phase_current_a", "phase_current_a"),
+            ("hwfoc.mos_temp_c", "mos_temp_c"),
+            ("hwfoc.cap_temp_c", "cap_temp_c"),
+        ] {
+            let want = &r[column];
+            let got = &s[field];
+            if got == "?" {
+                continue;
+            }
+            if want.is_null() {
+                assert_eq!(got, "", "{what}: {column} is out of range");
+            } else {
+                assert_eq!(
+                    as_f32(got),
+                    want.as_f64().unwrap() as f32,
+                    "{what}: {column}"
+                );
+            }
+        }
+        let faults: Vec<&str> = r["faults"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|f| f.as_str().unwrap())
+            .collect();
+        let faults = if faults.is_empty() {
+            "none".to_string()
+        } else {
+            faults.join(",")
+        };
+        assert_eq!(s["hwfoc.faults"], faults, "{what}");
+        let ns = s["hwfoc.time_epoch"].replace('.', "");
+        let t = ns.parse::<u64>().unwrap() as f64 * 1e-9;
+        let dt = (t - r["t_s"].as_f64().unwrap()).abs();
+        assert!(dt < 1e-6, "{what}: time differs by {dt} s");
+    }
+    good.len()
+}
+
+/// The information frames of each port, read with the codec from the recording's bytes.
+fn info_frames(file: &Path) -> Vec<(u32, InfoFrame)> {
+    let bytes = std::fs::read(file).unwrap();
+    let mut reader = pcapng::Reader::new(&bytes[..]);
+    let mut streams: Vec<Vec<u8>> = Vec::new();
+    while let Some(p) = reader.next_packet().unwrap() {
+        let i = p.iface as usize;
+        if streams.len() <= i {
+            streams.resize(i + 1, Vec::new());
+        }
+        streams[i].extend_from_slice(p.data);
+    }
+    let mut out = Vec::new();
+    for (i, s) in streams.iter().enumerate() {
+        hwfoc::Decoder::new().decode_all(s, |d| {
+            if let Frame::Info(info) = d.frame {
+                out.push((i as u32, info));
+            }
+        });
+    }
+    out
+}
+
+fn same_info_frames(shown: &[Shown], file: &Path) -> usize {
+    let mut got: Vec<(u32, [String; 4])> = shown
+        .iter()
+        .filter(|s| s["hwfoc.kind"] == "info" && s["hwfoc.checksum.status"] == "1")
+        .map(|s| {
+            let f = |k: &str| s[k].clone();
+            (
+                uint(&s["frame.interface_id"]) as u32,
+                [
+                    f("hwfoc.info.product"),
+                    f("hwfoc.info.hardware"),
+                    f("hwfoc.info.firmware"),
+                    f("hwfoc.info.id"),
+                ],
+            )
+        })
+        .collect();
+    let mut want: Vec<(u32, [String; 4])> = info_frames(file)
+        .into_iter()
+        .map(|(i, info)| {
+            let fields = [info.product(), info.hardware(), info.firmware(), info.id()];
+            (i, fields.map(str::to_string))
+        })
+        .collect();
+    got.sort_by_key(|g| g.0);
+    want.sort_by_key(|w| w.0);
+    assert_eq!(got, want, "device-information frames");
+    got.len()
+}
+
+/// Every frame shown: a good checksum equals the one computed, a bad one differs.
+fn checksums_are_honest(shown: &[Shown]) -> usize {
+    let mut bad = 0;
+    for s in shown {
+        let (carried, computed) = (&s["hwfoc.checksum"], &s["hwfoc.checksum.computed"]);
+        match s["hwfoc.checksum.status"].as_str() {
+            "1" => assert_eq!(uint(carried), uint(computed)),
+            "0" => {
+                assert_ne!(uint(carried), uint(computed));
+                bad += 1;
+            }
+            other => panic!("checksum status {other:?}"),
+        }
+    }
+    bad
+}
+
+#[test]
+fn a_simulated_recording_dissects_as_decode_reads_it() {
+    if !tshark_found() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("sim.pcapng");
+    let sim = run(hwfoc()
+        .args(["simulate", "--escs", "3", "--seed", "5", "--duration", "12"])
+        .args(["--start-time", "1754000000.25", "--lead-in", "3"])
+        .args([
+            "--garbage-rate",
+            "0.05",
+            "--bit-error-rate",
+            "3e-4",
+            "--cut-rate",
+            "0.02",
+        ])
+        .args([
+            "--fault",
+            "1:mos_overheat@4-5",
+            "--fault",
+            "over_current@6-6.5",
+        ])
+        .arg("-o")
+        .arg(&file)
+        .arg("-q"));
+    assert!(
+        sim.status.success(),
+        "{}",
+        String::from_utf8_lossy(&sim.stderr)
+    );
+
+    let shown = tshark(&file, &[], true);
+    let decoded = decode(&file, &[]);
+    let data = same_data_frames(&shown, &decoded);
+    let info = same_info_frames(&shown, &file);
+    let bad = checksums_are_honest(&shown);
+    assert!(
+        data > 300 && info >= 6,
+        "{data} data, {info} information frames"
+    );
+    assert!(bad > 0, "no corrupted frame shown as bad");
+    let faults: Vec<&Shown> = shown
+        .iter()
+        .filter(|s| s["hwfoc.faults"].contains("mos_overheat"))
+        .collect();
+    assert!(!faults.is_empty() && faults.iter().all(|s| s["frame.interface_id"] == "1"));
+    assert!(shown.iter().any(|s| s["hwfoc.faults"] == "over_current"));
+    // The compact layout: every frame is alone in its packet.
+    assert!(shown.iter().all(|s| s["hwfoc.mos_temp_c"] != "?"));
+    // Noise is shown as such, and a bad frame has its expert info.
+    let expert = Command::new("tshark")
+        .arg("-X")
+        .arg(format!("lua_script:{}", dissector().display()))
+        .arg("-r")
+        .arg(&file)
+        .args(["-Y", "hwfoc.noise", "-T", "fields", "-e", "frame.number"])
+        .output()
+        .unwrap();
+    assert!(!expert.stdout.is_empty(), "no noise shown");
+    let bad_expert = Command::new("tshark")
+        .arg("-X")
+        .arg(format!("lua_script:{}", dissector().display()))
+        .arg("-r")
+        .arg(&file)
+        .args([
+            "-Y",
+            "hwfoc.checksum.bad && hwfoc.fault.expert || hwfoc.checksum.bad",
+        ])
+        .output()
+        .unwrap();
+    assert_eq!(
+        String::from_utf8_lossy(&bad_expert.stdout).lines().count(),
+        bad,
+        "expert info for each bad checksum"
+    );
+}
+
+#[test]
+fn the_old_chunked_recording_decodes_as_before_and_dissects_alike() {
+    let file = old_recording();
+    let golden = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/golden/chunked-2esc.jsonl");
+    let out = run(hwfoc().arg("decode").arg(&file));
+    assert!(out.status.success());
+    assert_eq!(
+        String::from_utf8(out.stdout).unwrap(),
+        std::fs::read_to_string(&golden).unwrap(),
+        "an old recording must decode exactly as before"
+    );
+    if !tshark_found() {
+        return;
+    }
+    let shown = tshark(&file, &[], true);
+    let decoded = records(&std::fs::read(&golden).unwrap());
+    // Frames cut across packets (reads) are reassembled: every frame is there.
+    assert_eq!(same_data_frames(&shown, &decoded), 114);
+    assert_eq!(same_info_frames(&shown, &file), 9);
+    assert!(checksums_are_honest(&shown) > 0);
+}
+
+/// A recording of frames with every temperature code, extreme currents and every status bit,
+/// written with the library's writer.
+fn every_code(file: &Path) {
+    let mut w = pcapng::Writer::new(std::fs::File::create(file).unwrap()).unwrap();
+    w.add_interface("/dev/ttyUSB0", 19200).unwrap();
+    let mut t = 1_754_000_000_000_000_000u64;
+    for code in 0..=255u8 {
+        let frame = DataFrame {
+            packet: u16::from(code) * 251,
+            throttle_in_raw: u16::from(code) * 4,
+            throttle_out_raw: 1024 - u16::from(code),
+            erpm_raw: u16::from(code) * 257,
+            voltage_raw: u16::from(code) * 3 + 1,
+            current_raw: (i16::from(code) - 128) * 255,
+            phase_current_raw: i16::MIN + i16::from(code),
+            mos_adc: code,
+            cap_adc: 255 - code,
+            status: hwfoc::Status(1u16 << (code % 16)),
+        };
+        w.write(0, t, &frame.encode()).unwrap();
+        t += 50_000_000;
+    }
+    let info = InfoFrame::new("XR_FOC_ESC", "HW577_KZ1_V1.1", "XR-01.0.00", "01040443").unwrap();
+    w.write(0, t, &info.encode()).unwrap();
+    w.into_inner().unwrap();
+}
+
+#[test]
+fn every_temperature_code_and_the_conversion_preferences() {
+    if !tshark_found() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("codes.pcapng");
+    every_code(&file);
+    let shown = tshark(&file, &[], true);
+    let decoded = decode(&file, &[]);
+    assert_eq!(same_data_frames(&shown, &decoded), 256);
+    assert_eq!(same_info_frames(&shown, &file), 1);
+    assert_eq!(checksums_are_honest(&shown), 0);
+
+    let prefs = [
+        "-o",
+        "hwfoc.pole_pairs:14",
+        "-o",
+        "hwfoc.current_scale:100",
+        "-o",
+        "hwfoc.gear_ratio:2.5",
+    ];
+    let shown = tshark(&file, &prefs, true);
+    let decoded = decode(
+        &file,
+        &[
+            "--pole-pairs",
+            "14",
+            "--current-scale",
+            "100",
+            "--gear-ratio",
+            "2.5",
+        ],
+    );
+    assert_eq!(same_data_frames(&shown, &decoded), 256);
+}
+
+#[test]
+fn other_user0_files_are_left_alone_unless_asked() {
+    if !tshark_found() {
+        return;
+    }
+    // USER0 bytes from another tool: an interface hwfoc did not describe.
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("other.pcapng");
+    let frame = DataFrame {
+        packet: 77,
+        ..Default::default()
+    }
+    .encode();
+    let mut raw = pcapng::Writer::new(Vec::new()).unwrap();
+    raw.add_interface("x", 19200).unwrap();
+    raw.write(0, 1_000_000_000, &frame).unwrap();
+    let mut file_bytes = raw.into_inner().unwrap();
+    // Rewrite the description ("HW-FOC telemetry, …") into something else of the same length.
+    let at = file_bytes.windows(6).position(|w| w == b"HW-FOC").unwrap();
+    file_bytes[at..at + 6].copy_from_slice(b"OTHER ");
+    std::fs::write(&file, &file_bytes).unwrap();
+    let shown = tshark(&file, &[], true);
+    assert!(shown.is_empty(), "claimed another tool's USER0 packets");
+    let shown = tshark(&file, &["-o", "hwfoc.all_user0:TRUE"], true);
+    assert_eq!(shown.len(), 1);
+    assert_eq!(shown[0]["hwfoc.packet"], "77");
+}
+
+#[test]
+fn install_path_and_print() {
+    let dir = tempfile::tempdir().unwrap();
+    let home = dir.path();
+    let target = home.join(".local/lib/wireshark/plugins/hwfoc.lua");
+    let cmd = |args: &[&str]| run(hwfoc().arg("wireshark").args(args).env("HOME", home));
+
+    let path = cmd(&["path"]);
+    assert!(path.status.success());
+    assert_eq!(
+        String::from_utf8_lossy(&path.stdout).trim(),
+        target.to_str().unwrap()
+    );
+
+    let print = cmd(&["print"]);
+    assert_eq!(print.stdout, std::fs::read(dissector()).unwrap());
+
+    let install = cmd(&["install"]);
+    assert!(
+        install.status.success(),
+        "{}",
+        String::from_utf8_lossy(&install.stderr)
+    );
+    assert!(String::from_utf8_lossy(&install.stdout).contains(target.to_str().unwrap()));
+    assert_eq!(std::fs::read(&target).unwrap(), print.stdout);
+    let again = cmd(&["install"]);
+    assert!(again.status.success());
+    assert!(String::from_utf8_lossy(&again.stdout).contains("already"));
+
+    // Wireshark loads it from there: tshark dissects without -X.
+    if tshark_found() {
+        let file = home.join("codes.pcapng");
+        every_code(&file);
+        let out = Command::new("tshark")
+            .env("HOME", home)
+            .arg("-r")
+            .arg(&file)
+            .args(["-T", "fields", "-e", "hwfoc.packet"])
+            .output()
+            .unwrap();
+        let text = String::from_utf8_lossy(&out.stdout);
+        assert_eq!(
+            text.lines().filter(|l| !l.is_empty()).count(),
+            256,
+            "{text}"
+        );
+    }
+
+    // A file of one's own is never replaced unasked.
+    std::fs::write(&target, "-- my edits\n").unwrap();
+    let refused = cmd(&["install"]);
+    assert!(!refused.status.success());
+    assert!(String::from_utf8_lossy(&refused.stderr).contains("--force"));
+    assert_eq!(std::fs::read_to_string(&target).unwrap(), "-- my edits\n");
+    let forced = cmd(&["install", "--force"]);
+    assert!(forced.status.success());
+    assert_eq!(std::fs::read(&target).unwrap(), print.stdout);
+    let left: Vec<_> = std::fs::read_dir(target.parent().unwrap())
+        .unwrap()
+        .collect();
+    assert_eq!(left.len(), 1, "a temporary file was left behind");
+}
