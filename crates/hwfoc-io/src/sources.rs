@@ -13,6 +13,7 @@ use hwfoc::Settings;
 
 pub use crate::handler::Handler;
 use crate::input::{Input, InputError, InputFormat};
+use crate::settings::SettingsMap;
 use crate::stream::Stream;
 
 /// Batches shorter than this come from a live source: what they produce is passed on at once.
@@ -49,7 +50,7 @@ pub struct InputInfo {
 
 /// The inputs of a command and the ESCs found in them.
 pub struct Sources {
-    settings: Settings,
+    settings: SettingsMap,
     pending: Vec<Input>,
     names: Vec<String>,
     read: Vec<InputInfo>,
@@ -61,10 +62,10 @@ pub struct Sources {
 
 impl Sources {
     /// The inputs, opened, in command-line order; data frames become records under
-    /// `settings`.
-    pub fn new(inputs: Vec<Input>, settings: Settings) -> Sources {
+    /// `settings`: one [`Settings`] for every ESC, or a [`SettingsMap`] by ESC and port.
+    pub fn new(inputs: Vec<Input>, settings: impl Into<SettingsMap>) -> Sources {
         Sources {
-            settings,
+            settings: settings.into(),
             names: inputs.iter().map(|i| i.name().to_string()).collect(),
             pending: inputs,
             read: Vec::new(),
@@ -87,9 +88,15 @@ impl Sources {
         }
     }
 
-    /// The conversion settings of the records.
+    /// The conversion settings of the records of ESCs without settings of their own.
     pub fn settings(&self) -> &Settings {
-        &self.settings
+        self.settings.default_settings()
+    }
+
+    /// The conversion settings of ESC `esc` (default settings for an ESC not found yet).
+    pub fn esc_settings(&self, esc: usize) -> Settings {
+        let name = self.escs.get(esc).map_or("", |e| e.name.as_str());
+        self.settings.get(esc, name)
     }
 
     /// The names of all inputs, in command-line order.
@@ -161,7 +168,7 @@ impl Sources {
     fn finish<H: Handler>(&mut self, esc: usize, handler: &mut H) {
         // Every stream has an index below 256 (checked when it was made).
         let id = u8::try_from(esc).unwrap_or(u8::MAX);
-        let settings = &self.settings;
+        let settings = &self.esc_settings(esc);
         self.escs[esc].stream.finish(
             #[inline(always)]
             |t, d| handler.frame(id, t, d, settings),
@@ -240,7 +247,7 @@ impl Sources {
                 continue;
             };
             let id = u8::try_from(esc).unwrap_or(u8::MAX);
-            let settings = &self.settings;
+            let settings = &self.esc_settings(esc);
             // Inlined into the decoder's loop, so that the handler may be too: a frame's fields
             // then reach it in registers, not through a `Decoded` stored and loaded back.
             self.escs[esc].stream.feed(
