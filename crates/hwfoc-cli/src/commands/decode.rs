@@ -45,12 +45,13 @@ pub struct DecodeArgs {
 
 /// Runs `hwfoc decode`.
 pub fn run(args: &DecodeArgs) -> Result<(), CliError> {
-    let settings = args.settings.settings()?;
+    let (_, settings_map) = args.settings.settings_map()?;
+    let settings = *settings_map.default_settings();
     let selection = args.select.selection()?;
     if let Some(output) = &args.output {
         args.input.refuse_output(output)?;
     }
-    let mut sources = Sources::new(args.input.open_all()?, settings);
+    let mut sources = Sources::new(args.input.open_all()?, settings_map);
     if selection.window.is_limited() {
         sources.require_timing()?;
     }

@@ -9,6 +9,7 @@ use hwfoc::{Fault, InfoFrame, LinkStats, Settings};
 use super::alarms::{Change, Kind, Latch, Level, Threshold};
 use super::config::Limits;
 use hwfoc_io::InputError;
+use hwfoc_io::energy::Energy;
 use hwfoc_io::handler::Handler;
 use hwfoc_io::record::Record;
 use hwfoc_io::serial::PortEvent;
@@ -171,6 +172,8 @@ pub struct EscView {
     pub name: String,
     /// Its label from the configuration, if any.
     pub label: Option<String>,
+    /// The settings its frames are converted under.
+    pub settings: Settings,
     /// Whether the port is there.
     pub link: Link,
     /// The latest data frame.
@@ -179,6 +182,8 @@ pub struct EscView {
     pub last_frame_t: Option<f64>,
     /// Extremes since the start or the last reset.
     pub peaks: Peaks,
+    /// Charge, energy and peak power since the start or the last reset.
+    pub energy: Energy,
     /// The last minute.
     pub history: VecDeque<Sample>,
     /// The latest device-information frame.
@@ -206,6 +211,13 @@ impl EscView {
             .filter(|&&t| t > now - RATE_WINDOW_S)
             .count();
         n as f64 / RATE_WINDOW_S
+    }
+
+    /// Electrical input power of the latest frame, W.
+    pub fn power_w(&self) -> Option<f64> {
+        self.last
+            .as_ref()
+            .map(|r| f64::from(r.voltage_v) * f64::from(r.current_a))
     }
 
     /// Seconds since the latest frame, at `now`.
@@ -250,7 +262,7 @@ pub struct LogEntry {
 impl LogEntry {
     /// What happened, in words: `mos_temp warning raised at 91.0 degC`,
     /// `mos_overheat critical raised`, `low_voltage escalated to critical at 19.7 V`,
-    /// `stale cleared after 3.2 s`.
+    /// `stale warning cleared after 3.2 s` (a clear names the highest level of its episode).
     pub fn text(&self) -> String {
         let name = self.kind.name();
         let unit = match self.kind {
@@ -262,13 +274,17 @@ impl LogEntry {
         match self.change {
             Change::Raised(level) => format!("{name} {level} raised{}", at(self.value)),
             Change::Escalated => format!("{name} escalated to critical{}", at(self.value)),
-            Change::Cleared { duration_s, worst } => {
+            Change::Cleared {
+                level,
+                duration_s,
+                worst,
+            } => {
                 let worst = match (worst, self.kind) {
                     (Some(w), Kind::LowVoltage) => format!(" (lowest {w:.1}{unit})"),
                     (Some(w), _) => format!(" (highest {w:.1}{unit})"),
                     (None, _) => String::new(),
                 };
-                format!("{name} cleared after {duration_s:.1} s{worst}")
+                format!("{name} {level} cleared after {duration_s:.1} s{worst}")
             }
         }
     }
@@ -294,29 +310,29 @@ pub struct Fleet {
     /// Data frames decoded in all.
     pub frames: u64,
     streams: PortStreams,
-    settings: Settings,
     limits: Limits,
 }
 
 impl Fleet {
-    /// ESCs named `names` (labels beside them), watched from Unix time `now`, their bytes
-    /// arriving at `baud`.
+    /// ESCs named `names` (labels and conversion settings beside them), watched from Unix time
+    /// `now`, their bytes arriving at `baud`.
     pub fn new(
-        names: Vec<(String, Option<String>)>,
-        settings: Settings,
+        names: Vec<(String, Option<String>, Settings)>,
         limits: Limits,
         baud: u32,
         now: f64,
     ) -> Fleet {
         let escs = names
             .into_iter()
-            .map(|(name, label)| EscView {
+            .map(|(name, label, settings)| EscView {
                 name,
                 label,
+                settings,
                 link: Link::Up,
                 last: None,
                 last_frame_t: None,
                 peaks: Peaks::default(),
+                energy: Energy::new(),
                 history: VecDeque::new(),
                 info: None,
                 stats: LinkStats::default(),
@@ -328,12 +344,11 @@ impl Fleet {
             })
             .collect::<Vec<_>>();
         Fleet {
-            streams: PortStreams::new(escs.len(), baud, settings),
+            streams: PortStreams::with_settings(baud, escs.iter().map(|e| e.settings).collect()),
             escs,
             log: VecDeque::new(),
             logged: 0,
             frames: 0,
-            settings,
             limits,
         }
     }
@@ -341,11 +356,6 @@ impl Fleet {
     /// The alarm levels in force.
     pub fn limits(&self) -> &Limits {
         &self.limits
-    }
-
-    /// The conversion settings.
-    pub fn settings(&self) -> &Settings {
-        &self.settings
     }
 
     /// Takes in what a port (or a virtual ESC) reported; returns the number of data frames it
@@ -379,6 +389,8 @@ impl Fleet {
             PortEvent::Lost { port, t_ns, reason } => {
                 let t = *t_ns as f64 / 1e9;
                 if let Some(esc) = self.escs.get_mut(*port) {
+                    // No current is assumed over the time the port was away.
+                    esc.energy.break_here();
                     esc.link = Link::Down {
                         since: t,
                         reason: reason.clone(),
@@ -415,6 +427,8 @@ impl Fleet {
         esc.last = Some(r);
         esc.last_frame_t = Some(t);
         esc.peaks.add(&r);
+        esc.energy
+            .add(Some(t), f64::from(r.voltage_v), f64::from(r.current_a));
         esc.recent.push_back(t);
         while esc.recent.front().is_some_and(|&f| f <= t - RATE_WINDOW_S) {
             esc.recent.pop_front();
@@ -490,23 +504,46 @@ impl Fleet {
         }
     }
 
-    /// Forgets the peaks of every ESC.
+    /// Forgets the peaks, the charge and the energy of every ESC (counting starts again from
+    /// the latest frame).
     pub fn reset_peaks(&mut self) {
         for esc in &mut self.escs {
             esc.peaks = Peaks::default();
+            esc.energy = Energy::new();
             if let Some(r) = &esc.last {
                 esc.peaks.add(r);
+                let t = esc.last_frame_t.or(r.t_s);
+                esc.energy
+                    .add(t, f64::from(r.voltage_v), f64::from(r.current_a));
             }
         }
     }
 
+    /// Charge and energy of all ESCs together, and their peak power (the largest of one ESC).
+    pub fn total_energy(&self) -> Energy {
+        let mut total = Energy::new();
+        for esc in &self.escs {
+            total.merge(&esc.energy);
+        }
+        total
+    }
+
+    /// Electrical input power of all ESCs now, W: the sum of each one's latest frame (`None`
+    /// before any frame).
+    pub fn total_power_w(&self) -> Option<f64> {
+        self.escs
+            .iter()
+            .filter(|e| e.link == Link::Up)
+            .filter_map(EscView::power_w)
+            .fold(None, |sum, p| Some(sum.unwrap_or(0.0) + p))
+    }
+
     fn note(&mut self, esc: usize, kind: Kind, change: Option<Change>, t: f64, value: Option<f64>) {
         let Some(change) = change else { return };
-        let latch = self.escs[esc].alarms.latch(kind);
         let level = match change {
             Change::Raised(level) => level,
             Change::Escalated => Level::Critical,
-            Change::Cleared { .. } => latch.level().unwrap_or(Level::Warning),
+            Change::Cleared { level, .. } => level,
         };
         if self.log.len() == LOG_MAX {
             self.log.pop_front();
@@ -538,12 +575,17 @@ mod tests {
 
     fn fleet(n: usize) -> Fleet {
         let config = Config::load(&Overrides {
-            no_config: true,
+            settings: crate::args::SettingsArgs {
+                no_config: true,
+                ..Default::default()
+            },
             ..Overrides::default()
         })
         .unwrap();
-        let names = (0..n).map(|i| (format!("esc{i}"), None)).collect();
-        Fleet::new(names, config.settings, config.limits, 19_200, 1000.0)
+        let names = (0..n)
+            .map(|i| (format!("esc{i}"), None, Settings::DEFAULT))
+            .collect();
+        Fleet::new(names, config.limits, 19_200, 1000.0)
     }
 
     fn frame(packet: u16, status: Status, mos_code: u8, volt_raw: u16) -> Vec<u8> {
@@ -624,6 +666,15 @@ mod tests {
                 "esc0 mos_overheat raised critical",
                 "esc0 mos_overheat cleared"
             ]
+        );
+        // The clear names the level the alarm had (it was once logged as a warning).
+        assert_eq!(f.log[1].level, Level::Critical);
+        assert!(
+            f.log[1]
+                .text()
+                .starts_with("mos_overheat critical cleared after 1.4"),
+            "{}",
+            f.log[1].text()
         );
         // On from frame 10 (0.5 s), last on at frame 29 (1.45 s), cleared 0.5 s later.
         match f.log[1].change {

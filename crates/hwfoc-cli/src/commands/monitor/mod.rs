@@ -26,6 +26,7 @@ use self::feed::{Feed, Msg};
 use self::fleet::Fleet;
 use self::perf::Perf;
 use super::capture::{self, Recorder};
+use crate::args::SettingsArgs;
 use crate::commands::simulate::ModelArgs;
 use crate::error::CliError;
 use hwfoc_io::serial::PortEvent;
@@ -74,31 +75,20 @@ pub struct MonitorArgs {
     /// Let --record replace an existing file of that name (never done unasked).
     #[arg(long, requires = "record")]
     overwrite: bool,
-    /// Where the r key puts its recordings (hwfoc-DATE-TIME.pcapng) [default: .].
+    /// Where the r key puts its recordings (hwfoc-DATE-TIME.pcapng), made if need be (mode 0700)
+    /// [default: from the configuration file, else hwfoc/recordings in the user's data
+    /// directory: ~/.local/share/hwfoc/recordings].
     #[arg(long, value_name = "DIR")]
     record_dir: Option<PathBuf>,
     /// A name for each ESC, in order (repeat the option).
     #[arg(long = "label", value_name = "TEXT")]
     labels: Vec<String>,
-    /// Configuration file [default: hwfoc/monitor.toml in the user's configuration directory,
-    /// if it exists].
-    #[arg(long, value_name = "FILE")]
-    config: Option<PathBuf>,
-    /// Read no configuration file.
-    #[arg(long, conflicts_with = "config")]
-    no_config: bool,
-    /// Baud rate of the ports (8N1) [default: 19200].
+    /// Baud rate of the ports (8N1) [default: from the configuration file, else 19200].
     #[arg(long, value_name = "N")]
     baud: Option<u32>,
-    /// Raw current units per ampere [default: 64].
-    #[arg(long, value_name = "N")]
-    current_scale: Option<f32>,
-    /// Motor pole pairs, for RPM [default: 7].
-    #[arg(long, value_name = "N")]
-    pole_pairs: Option<u16>,
-    /// Gear ratio between motor and output shaft, for RPM [default: 1].
-    #[arg(long, value_name = "X")]
-    gear_ratio: Option<f32>,
+    /// Conversion settings and the configuration file.
+    #[command(flatten)]
+    settings: SettingsArgs,
     /// Alarm levels.
     #[command(flatten)]
     alarms: AlarmKeys,
@@ -132,12 +122,8 @@ const MIN_INTERVAL_S: f64 = 0.05;
 /// Runs `hwfoc monitor`.
 pub fn run(args: &MonitorArgs) -> Result<(), CliError> {
     let config = Config::load(&Overrides {
-        config: args.config.clone(),
-        no_config: args.no_config,
+        settings: args.settings.clone(),
         baud: args.baud,
-        current_scale: args.current_scale,
-        pole_pairs: args.pole_pairs,
-        gear_ratio: args.gear_ratio,
         record_dir: args.record_dir.clone(),
         alarms: args.alarms.clone(),
     })?;
@@ -212,7 +198,7 @@ impl Session {
                     &args.model,
                     usize::from(n),
                     config.baud,
-                    &config.settings,
+                    config.settings.default_settings(),
                     tx.clone(),
                 )?;
                 let names = (0..n).map(|i| format!("sim:esc{i}")).collect();
@@ -224,7 +210,7 @@ impl Session {
                     message: format!(
                         "no ports to watch: name them (e.g. `hwfoc monitor /dev/ttyUSB0`), list \
                          them in {}, or try the virtual ESCs: `hwfoc monitor --sim 4`",
-                        config::default_path()
+                        crate::config::default_path()
                             .map_or("the configuration file".into(), |p| p.display().to_string())
                     ),
                 });
@@ -242,8 +228,8 @@ impl Session {
                     .labels
                     .get(i)
                     .cloned()
-                    .or_else(|| config.label(name).map(str::to_string));
-                (name.clone(), label)
+                    .or_else(|| config.label(i, name).map(str::to_string));
+                (name.clone(), label, config.settings_of(i, name))
             })
             .collect();
         // The ports' own clock, so that ages and recordings agree with their timestamps.
@@ -252,13 +238,7 @@ impl Session {
             Feed::Simulated { .. } => hwfoc_io::clock::Clock::new(),
         };
         let now = clock.now_ns() as f64 / 1e9;
-        let fleet = Fleet::new(
-            labelled,
-            config.settings,
-            config.limits.clone(),
-            config.baud,
-            now,
-        );
+        let fleet = Fleet::new(labelled, config.limits.clone(), config.baud, now);
         let mut session = Session {
             fleet,
             recorder: None,
@@ -441,6 +421,20 @@ fn free_name(dir: &std::path::Path, stamp: &str) -> Option<PathBuf> {
     (1..1000)
         .map(|n| dir.join(name(n)))
         .find(|p| std::fs::symlink_metadata(p).is_err())
+}
+
+/// Unix time `t` (seconds) as ISO 8601 local time with its UTC offset:
+/// `2026-11-22T14:03:22+01:00`, or with milliseconds `2026-11-22T14:03:22.150+01:00`.
+///
+/// The one place the monitor writes a date and time (with `jiff`); when `hwfoc_io` formats
+/// times itself, this calls it.
+pub fn iso8601(t: f64, millis: bool) -> String {
+    let pattern = if millis {
+        "%Y-%m-%dT%H:%M:%S%.3f%:z"
+    } else {
+        "%Y-%m-%dT%H:%M:%S%:z"
+    };
+    local_time(t, pattern)
 }
 
 /// Unix time `t` (seconds) as local time, formatted with the strftime `pattern`.
