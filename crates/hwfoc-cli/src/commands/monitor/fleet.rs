@@ -299,6 +299,24 @@ impl LogEntry {
     }
 }
 
+/// Charge and energy of `escs` together (and the largest peak power of one of them).
+pub fn total_energy(escs: &[EscView]) -> Energy {
+    let mut total = Energy::new();
+    for esc in escs {
+        total.merge(&esc.energy);
+    }
+    total
+}
+
+/// Electrical input power of the connected ones of `escs` together now, W: the sum of their
+/// latest frames (`None` before any frame).
+pub fn total_power_w(escs: &[EscView]) -> Option<f64> {
+    escs.iter()
+        .filter(|e| e.link == Link::Up)
+        .filter_map(EscView::power_w)
+        .fold(None, |sum, p| Some(sum.unwrap_or(0.0) + p))
+}
+
 /// Every ESC watched, their decoders and the alarm log.
 pub struct Fleet {
     /// What is shown of each ESC.
@@ -309,6 +327,9 @@ pub struct Fleet {
     pub logged: u64,
     /// Data frames decoded in all.
     pub frames: u64,
+    /// Highest power of all ESCs together (the sum of their latest frames), W, since the start
+    /// or the last reset.
+    pub peak_total_w: Option<f64>,
     streams: PortStreams,
     limits: Limits,
 }
@@ -349,6 +370,7 @@ impl Fleet {
             log: VecDeque::new(),
             logged: 0,
             frames: 0,
+            peak_total_w: None,
             limits,
         }
     }
@@ -384,6 +406,9 @@ impl Fleet {
                 }
                 self.escs[*port].stats = stats;
                 self.frames += data as u64;
+                if data > 0 {
+                    self.note_total_power();
+                }
                 data
             }
             PortEvent::Lost { port, t_ns, reason } => {
@@ -504,9 +529,16 @@ impl Fleet {
         }
     }
 
+    fn note_total_power(&mut self) {
+        if let Some(p) = self.total_power_w() {
+            self.peak_total_w = Some(self.peak_total_w.map_or(p, |peak| peak.max(p)));
+        }
+    }
+
     /// Forgets the peaks, the charge and the energy of every ESC (counting starts again from
     /// the latest frame).
     pub fn reset_peaks(&mut self) {
+        self.peak_total_w = None;
         for esc in &mut self.escs {
             esc.peaks = Peaks::default();
             esc.energy = Energy::new();
@@ -517,25 +549,18 @@ impl Fleet {
                     .add(t, f64::from(r.voltage_v), f64::from(r.current_a));
             }
         }
+        self.note_total_power();
     }
 
-    /// Charge and energy of all ESCs together, and their peak power (the largest of one ESC).
+    /// Charge and energy of all ESCs together.
     pub fn total_energy(&self) -> Energy {
-        let mut total = Energy::new();
-        for esc in &self.escs {
-            total.merge(&esc.energy);
-        }
-        total
+        total_energy(&self.escs)
     }
 
     /// Electrical input power of all ESCs now, W: the sum of each one's latest frame (`None`
     /// before any frame).
     pub fn total_power_w(&self) -> Option<f64> {
-        self.escs
-            .iter()
-            .filter(|e| e.link == Link::Up)
-            .filter_map(EscView::power_w)
-            .fold(None, |sum, p| Some(sum.unwrap_or(0.0) + p))
+        total_power_w(&self.escs)
     }
 
     fn note(&mut self, esc: usize, kind: Kind, change: Option<Change>, t: f64, value: Option<f64>) {
@@ -766,6 +791,68 @@ mod tests {
         );
         f.on_event(&data(1, 1000.0, vec![0x55; 10]));
         assert_eq!(f.escs[1].waiting(), "no frames yet");
+    }
+
+    #[test]
+    fn charge_energy_and_power_per_esc_and_in_total_reset_with_the_peaks() {
+        let mut f = fleet(2);
+        // 12.8 A (raw 819 at scale 64) at 25.0 V on ESC 0, half that on ESC 1, for 3.6 s.
+        let frame = |packet: u16, amps_raw: i16| {
+            DataFrame {
+                packet,
+                current_raw: amps_raw,
+                voltage_raw: 250,
+                ..Default::default()
+            }
+            .encode()
+            .to_vec()
+        };
+        for k in 0..=72u16 {
+            let t = 1000.0 + f64::from(k) * 0.05;
+            f.on_event(&data(0, t, frame(k, 819)));
+            f.on_event(&data(1, t + 0.01, frame(k, 410)));
+        }
+        let amps0 = 819.0 / 64.0;
+        let amps1 = 410.0 / 64.0;
+        let e0 = &f.escs[0].energy;
+        assert!(
+            (e0.charge_mah() - amps0 * 1000.0 / 1000.0).abs() < 0.01,
+            "{}",
+            e0.charge_mah()
+        );
+        assert!((e0.energy_wh() - amps0 * 25.0 * 3.6 / 3600.0).abs() < 1e-3);
+        let p0 = f.escs[0].power_w().unwrap();
+        assert!((p0 - amps0 * 25.0).abs() < 0.01, "{p0}");
+        let total = f.total_energy();
+        assert!(
+            (total.charge_mah() - (amps0 + amps1)).abs() < 0.02,
+            "{}",
+            total.charge_mah()
+        );
+        let sum = f.total_power_w().unwrap();
+        assert!((sum - (amps0 + amps1) * 25.0).abs() < 0.1, "{sum}");
+        assert!((f.peak_total_w.unwrap() - sum).abs() < 0.1);
+        // A burst on ESC 0 raises the total's peak; reset forgets it, and the charge.
+        f.on_event(&data(0, 1003.65, frame(73, 3276)));
+        let peak = f.peak_total_w.unwrap();
+        // 51.2 A at 25 V plus ESC 1's 160 W.
+        assert!(
+            (peak - (3276.0 / 64.0 + amps1) * 25.0).abs() < 0.1,
+            "{peak}"
+        );
+        f.on_event(&data(0, 1003.70, frame(74, 819)));
+        assert_eq!(f.peak_total_w, Some(peak));
+        f.reset_peaks();
+        assert_eq!(f.escs[0].energy.charge_mah(), 0.0);
+        assert!((f.peak_total_w.unwrap() - sum).abs() < 0.1);
+        assert_eq!(f.escs[0].energy.peak_w(), f.escs[0].power_w());
+        // A port that goes away adds nothing for the time it was away, nor counts in the total.
+        f.on_event(&PortEvent::Lost {
+            port: 1,
+            t_ns: 1_004_000_000_000,
+            reason: "unplugged".into(),
+        });
+        assert_eq!(f.total_power_w(), f.escs[0].power_w());
     }
 
     #[test]

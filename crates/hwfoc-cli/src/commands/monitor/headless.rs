@@ -84,33 +84,37 @@ pub fn timestamp(t: f64) -> String {
 
 /// `power 480 W (peak 1210 W) used 312.5 mAh 7.41 Wh`: power now (`-` without a frame), the
 /// peak, charge and energy since the start or the last reset.
-fn energy_text(power_w: Option<f64>, energy: &Energy) -> String {
+fn energy_text(power_w: Option<f64>, peak_w: Option<f64>, energy: &Energy) -> String {
     let w = |p: Option<f64>| p.map_or("-".to_string(), |p| format!("{p:.0} W"));
     format!(
         "power {} (peak {}) used {:.1} mAh {:.2} Wh",
         w(power_w),
-        w(energy.peak_w()),
+        w(peak_w),
         energy.charge_mah(),
         energy.energy_wh()
     )
 }
 
-fn energy_json(power_w: Option<f64>, energy: &Energy) -> Value {
+fn energy_json(power_w: Option<f64>, peak_w: Option<f64>, energy: &Energy) -> Value {
     json!({
         "power_w": power_w,
-        "peak_power_w": energy.peak_w(),
+        "peak_power_w": peak_w,
         "charge_mah": energy.charge_mah(),
         "energy_wh": energy.energy_wh(),
     })
 }
 
 /// `2026-… total: power 960 W (peak 1210 W) used 625.0 mAh 14.82 Wh`: all ESCs together (the
-/// peak is the largest of one ESC's).
+/// peak is the highest sum of their powers).
 fn total_line(fleet: &Fleet, now: f64) -> String {
     format!(
         "{} total: {}",
         timestamp(now),
-        energy_text(fleet.total_power_w(), &fleet.total_energy())
+        energy_text(
+            fleet.total_power_w(),
+            fleet.peak_total_w,
+            &fleet.total_energy()
+        )
     )
 }
 
@@ -120,7 +124,7 @@ fn total_json(fleet: &Fleet, now: f64) -> Value {
         "time": timestamp(now),
         "t_s": now,
         "escs": fleet.escs.len(),
-        "energy": energy_json(fleet.total_power_w(), &fleet.total_energy()),
+        "energy": energy_json(fleet.total_power_w(), fleet.peak_total_w, &fleet.total_energy()),
     })
 }
 
@@ -155,7 +159,11 @@ fn status_line(i: usize, esc: &EscView, now: f64) -> String {
                 esc.age(now).unwrap_or(0.0),
             ));
             line.push_str(" | ");
-            line.push_str(&energy_text(esc.power_w(), &esc.energy));
+            line.push_str(&energy_text(
+                esc.power_w(),
+                esc.energy.peak_w(),
+                &esc.energy,
+            ));
         }
     }
     let active = esc.alarms.active();
@@ -251,7 +259,7 @@ fn status_json(i: usize, esc: &EscView, now: f64) -> Value {
             "mos_temp_c": p.mos_temp_c,
             "cap_temp_c": p.cap_temp_c,
         },
-        "energy": energy_json(esc.power_w(), &esc.energy),
+        "energy": energy_json(esc.power_w(), esc.energy.peak_w(), &esc.energy),
         "battery_cells": esc.cells,
         "info": esc.info.as_ref().map(|info| json!({
             "product": info.product(),

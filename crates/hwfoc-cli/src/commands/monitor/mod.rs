@@ -179,6 +179,8 @@ pub struct Session {
     record_dir: PathBuf,
     /// Whether `--record` may replace an existing file.
     overwrite: bool,
+    /// The recordings finished so far, to name on exit.
+    recorded: Vec<String>,
     interrupted: Arc<AtomicBool>,
     stop_at: Option<Instant>,
 }
@@ -254,6 +256,7 @@ impl Session {
             baud: config.baud,
             record_dir: config.record_dir,
             overwrite: args.overwrite,
+            recorded: Vec::new(),
             interrupted,
             stop_at: args
                 .duration
@@ -365,7 +368,7 @@ impl Session {
             overwrite: self.overwrite,
         };
         self.recorder = Some(Recorder::new(plan, &self.names, self.clock)?);
-        self.notice = Some(format!("recording to {path}"));
+        self.notice = None;
         Ok(())
     }
 
@@ -375,9 +378,17 @@ impl Session {
         if let Some(mut recorder) = self.recorder.take() {
             let file = recorder.current().to_string();
             self.notice = Some(match recorder.close() {
-                Ok(()) => format!("recorded to {file}"),
+                Ok(()) => format!("recorded to {}", display_path(&file)),
                 Err(e) => format!("recording stopped: {e}"),
             });
+            self.recorded.push(file);
+            return;
+        }
+        if let Err(e) = make_private_dir(&self.record_dir) {
+            self.notice = Some(format!(
+                "cannot record: cannot make {}: {e}",
+                display_path(&self.record_dir.display().to_string())
+            ));
             return;
         }
         let stamp = jiff::Zoned::now().strftime("%Y%m%d-%H%M%S").to_string();
@@ -399,15 +410,39 @@ impl Session {
                 self.take(event);
             }
         }
-        match self.recorder.take() {
+        let closed = match self.recorder.take() {
             Some(mut recorder) => {
                 let file = recorder.current().to_string();
-                recorder.close()?;
-                eprintln!("hwfoc: recorded to {file}");
-                Ok(())
+                let closed = recorder.close();
+                self.recorded.push(file);
+                closed
             }
             None => Ok(()),
+        };
+        for file in &self.recorded {
+            eprintln!("hwfoc: recorded to {file}");
         }
+        closed
+    }
+}
+
+/// Makes `dir` and its missing parents, readable by the user alone (mode 0700 on Unix: a
+/// recording may say where and when a vehicle flew); a directory already there is left as it is.
+fn make_private_dir(dir: &std::path::Path) -> std::io::Result<()> {
+    let mut builder = std::fs::DirBuilder::new();
+    builder.recursive(true);
+    #[cfg(unix)]
+    std::os::unix::fs::DirBuilderExt::mode(&mut builder, 0o700);
+    builder.create(dir)
+}
+
+/// `path` with the user's home directory written `~`, for a line that has little room.
+pub fn display_path(path: &str) -> String {
+    match dirs::home_dir().and_then(|h| h.to_str().map(str::to_string)) {
+        Some(home) if home.len() > 1 && path.starts_with(&format!("{home}/")) => {
+            format!("~{}", &path[home.len()..])
+        }
+        _ => path.to_string(),
     }
 }
 
@@ -460,6 +495,41 @@ pub fn number(v: f32, decimals: usize) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_recording_directory_is_made_private_on_demand() {
+        let dir = tempfile::tempdir().unwrap();
+        let deep = dir.path().join("share/hwfoc/recordings");
+        make_private_dir(&deep).unwrap();
+        assert!(deep.is_dir());
+        #[cfg(unix)]
+        {
+            use std::os::unix::fs::PermissionsExt;
+            let mode = std::fs::metadata(&deep).unwrap().permissions().mode();
+            assert_eq!(mode & 0o777, 0o700, "{mode:o}");
+        }
+        // Again: nothing changes, nothing fails.
+        std::fs::write(deep.join("kept.pcapng"), "a recording").unwrap();
+        make_private_dir(&deep).unwrap();
+        assert!(deep.join("kept.pcapng").is_file());
+        // A file in the way is an error, not replaced.
+        let file = dir.path().join("file");
+        std::fs::write(&file, "x").unwrap();
+        assert!(make_private_dir(&file).is_err());
+        assert_eq!(std::fs::read(&file).unwrap(), b"x");
+    }
+
+    #[test]
+    fn paths_under_home_are_shown_short() {
+        let Some(home) = dirs::home_dir() else { return };
+        let home = home.display().to_string();
+        if home.len() <= 1 {
+            return;
+        }
+        assert_eq!(display_path(&format!("{home}/a/b.pcapng")), "~/a/b.pcapng");
+        assert_eq!(display_path("/elsewhere/b.pcapng"), "/elsewhere/b.pcapng");
+        assert_eq!(display_path(&format!("{home}x/b")), format!("{home}x/b"));
+    }
 
     #[test]
     fn recordings_started_within_a_second_get_their_own_names() {
