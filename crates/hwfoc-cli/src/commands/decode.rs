@@ -45,13 +45,12 @@ pub struct DecodeArgs {
 
 /// Runs `hwfoc decode`.
 pub fn run(args: &DecodeArgs) -> Result<(), CliError> {
-    let (_, settings_map) = args.settings.settings_map()?;
-    let settings = *settings_map.default_settings();
+    let settings = args.settings.uniform_settings("decode")?;
     let selection = args.select.selection()?;
     if let Some(output) = &args.output {
         args.input.refuse_output(output)?;
     }
-    let mut sources = Sources::new(args.input.open_all()?, settings_map);
+    let mut sources = Sources::new(args.input.open_all()?, settings);
     if selection.window.is_limited() {
         sources.require_timing()?;
     }

@@ -27,8 +27,7 @@ pub struct SummaryArgs {
 
 /// Runs `hwfoc summary`.
 pub fn run(args: &SummaryArgs) -> Result<(), CliError> {
-    let (_, settings_map) = args.settings.settings_map()?;
-    let settings = *settings_map.default_settings();
+    let settings = args.settings.uniform_settings("summary")?;
     // The plot's file is opened first: a wrong name is reported before the inputs are read.
     let mut plot = match &args.plot {
         Some(path) => {
@@ -37,7 +36,7 @@ pub fn run(args: &SummaryArgs) -> Result<(), CliError> {
         }
         None => None,
     };
-    let mut sources = Sources::new(args.input.open_all()?, settings_map);
+    let mut sources = Sources::new(args.input.open_all()?, settings);
     let mut summary = Summary::new();
     // On an input error, what was read before it is summarised, then the error reported.
     let result = match &mut plot {
