@@ -6,6 +6,7 @@
 mod common;
 
 use std::process::Command;
+use std::str::FromStr;
 use std::thread;
 use std::time::{Duration, Instant};
 
@@ -603,4 +604,95 @@ fn the_dashboard_in_tmux() {
         p.contains("CTRL-C-EXIT=0")
     });
     assert_terminal_usable(&tmux, 7);
+}
+
+/// Whether `c` is a braille dot pattern (what the charts draw with).
+fn braille(c: char) -> bool {
+    ('\u{2801}'..='\u{28FF}').contains(&c)
+}
+
+#[test]
+fn the_dashboard_at_80_by_24_is_readable() {
+    let dir = tempfile::tempdir().unwrap();
+    let data = dir.path().join("data");
+    let tmux = Tmux::start(80, 24);
+    // The recording directory left to its default: under XDG_DATA_HOME, made on demand.
+    let command = format!(
+        "XDG_DATA_HOME={} {} monitor --sim 4 --no-config; echo MONITOR-EXIT=$?",
+        data.display(),
+        env!("CARGO_BIN_EXE_hwfoc")
+    );
+    tmux.keys(&[&command, "Enter"]);
+    let pane = tmux.wait("four rows and sparklines", Duration::from_secs(15), |p| {
+        (0..4).all(|i| row(p, i).is_some_and(|r| r.contains('/')))
+            && p.lines()
+                .filter(|l| l.contains("▁") || l.contains("█"))
+                .count()
+                >= 3
+    });
+    // No chart squeezed into a row or two: sparklines instead, one per quantity, labelled.
+    assert!(!pane.chars().any(braille), "{pane}");
+    for name in ["RPM", "Current", "Voltage", "MOS temp"] {
+        let line = pane
+            .lines()
+            .find(|l| l.contains(&format!("│{name} ")))
+            .unwrap_or_else(|| panic!("no {name} sparkline:\n{pane}"));
+        assert!(line.chars().count() <= 80, "{line}");
+    }
+    assert!(pane.lines().count() <= 24 && pane.lines().all(|l| l.chars().count() <= 80));
+    // Energy of the selected ESC and of all of them, and the time as ISO 8601.
+    assert!(
+        pane.contains("this ESC") && pane.contains("all ESCs"),
+        "{pane}"
+    );
+    assert!(pane.contains(" mAh") && pane.contains(" Wh"), "{pane}");
+    let title = pane.lines().next().unwrap();
+    let iso = title
+        .split_whitespace()
+        .find(|w| w.len() >= 25 && w.as_bytes()[10] == b'T')
+        .unwrap_or_else(|| panic!("no ISO 8601 time in {title}"));
+    assert!(jiff::Timestamp::from_str(iso).is_ok(), "{iso}");
+
+    // r records into the data directory, made private, and says where.
+    tmux.keys(&["r"]);
+    tmux.wait("recording", Duration::from_secs(3), |p| p.contains("● REC"));
+    thread::sleep(Duration::from_millis(800));
+    tmux.keys(&["r"]);
+    tmux.wait("recorded", Duration::from_secs(3), |p| {
+        p.contains("recorded to")
+    });
+    let recordings = data.join("hwfoc/recordings");
+    let files: Vec<_> = std::fs::read_dir(&recordings).unwrap().collect();
+    assert_eq!(files.len(), 1);
+    {
+        use std::os::unix::fs::PermissionsExt;
+        let mode = std::fs::metadata(&recordings).unwrap().permissions().mode();
+        assert_eq!(mode & 0o777, 0o700, "{mode:o}");
+    }
+
+    // Wide enough for charts: their axis labels never run together.
+    let ok = tmux
+        .cmd()
+        .args(["resize-window", "-t", "t", "-x", "160", "-y", "50"])
+        .status()
+        .unwrap();
+    assert!(ok.success());
+    let pane = tmux.wait("the charts", Duration::from_secs(5), |p| {
+        p.chars().filter(|&c| braille(c)).count() > 10 && p.contains("-30 s")
+    });
+    assert!(!pane.contains("now-60"), "{pane}");
+    let labels = pane
+        .lines()
+        .find(|l| l.contains("now") && l.contains("-60 s") && l.contains("-30 s"))
+        .unwrap_or_else(|| panic!("no axis labels:\n{pane}"));
+    let gap = labels.split("now").nth(1).unwrap();
+    assert!(gap.starts_with("   "), "labels too close: {labels}");
+
+    tmux.keys(&["q"]);
+    let pane = tmux.wait("the exit", Duration::from_secs(5), |p| {
+        p.contains("MONITOR-EXIT=0")
+    });
+    // Where the recording went is said on exit too.
+    assert!(pane.contains("hwfoc: recorded to"), "{pane}");
+    assert!(pane.contains("hwfoc/recordings/hwfoc-"), "{pane}");
 }
