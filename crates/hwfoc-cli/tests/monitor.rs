@@ -187,7 +187,11 @@ fn a_port_that_goes_away_shows_disconnected_and_resumes() {
 
     // A new pty appears at the same path.
     let mut second = start_sim();
-    let cleared = monitor.wait_for_stdout("disconnected cleared after", Duration::from_secs(5));
+    // The clear names the level the alarm had.
+    let cleared = monitor.wait_for_stdout(
+        "disconnected critical cleared after",
+        Duration::from_secs(5),
+    );
     assert!(cleared.contains("CLEARED esc0"), "{cleared}");
     // Frames again, and the ESC's line is back to normal.
     monitor.wait_for_stdout("| ok", Duration::from_secs(5));
@@ -202,7 +206,11 @@ fn a_port_that_goes_away_shows_disconnected_and_resumes() {
         1,
         "{out}"
     );
-    assert_eq!(out.matches("disconnected cleared").count(), 1, "{out}");
+    assert_eq!(
+        out.matches("disconnected critical cleared").count(),
+        1,
+        "{out}"
+    );
 }
 
 #[test]
@@ -366,8 +374,11 @@ struct Tmux {
 
 impl Tmux {
     fn start(width: u16, height: u16) -> Tmux {
+        // A server per test: tests run in parallel.
+        static NEXT: std::sync::atomic::AtomicU32 = std::sync::atomic::AtomicU32::new(0);
+        let n = NEXT.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
         let tmux = Tmux {
-            socket: format!("hwfoc-test-{}", std::process::id()),
+            socket: format!("hwfoc-test-{}-{n}", std::process::id()),
         };
         let ok = tmux
             .cmd()
