@@ -55,6 +55,39 @@ fn plain_prints_each_esc_every_interval_and_alarms_by_name() {
             "{lines:#?}"
         );
     }
+    // Each ESC's power, charge and energy, and all of them together once per interval.
+    let totals: Vec<&String> = lines
+        .iter()
+        .filter(|l| l.contains(" total: power "))
+        .collect();
+    assert!((4..=8).contains(&totals.len()), "{lines:#?}");
+    let last_total = totals.last().unwrap();
+    assert!(
+        last_total.contains(" mAh ")
+            && last_total.ends_with(" Wh")
+            && last_total.contains("(peak "),
+        "{last_total}"
+    );
+    let used = |l: &str| -> f64 {
+        l.split("used ")
+            .nth(1)
+            .and_then(|s| s.split(" mAh").next())
+            .and_then(|s| s.parse().ok())
+            .unwrap_or_else(|| panic!("no charge in {l}"))
+    };
+    assert!(used(last_total) > 0.0, "{last_total}");
+    let last_esc = |esc: usize| {
+        lines
+            .iter()
+            .rev()
+            .find(|l| l.contains(&format!(" esc{esc} sim:esc{esc}: thr ")))
+            .unwrap()
+    };
+    let sum = used(last_esc(0)) + used(last_esc(1));
+    assert!(
+        (used(last_total) - sum).abs() < 0.3,
+        "{last_total} vs {sum}"
+    );
     // Throttle steps start after the 2 s lead-in: the last lines show the motor turning.
     let last = lines.iter().rev().find(|l| l.contains(" esc0 ")).unwrap();
     let rpm: f64 = last

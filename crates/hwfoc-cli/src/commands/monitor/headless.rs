@@ -49,11 +49,15 @@ pub fn run(session: &mut Session, json: bool, interval_s: f64) -> Result<(), Cli
                     writeln!(text, "{}", status_line(i, esc, now)).ok();
                 }
             }
+            // All ESCs together, when there are several.
             let fleet = &session.fleet;
-            if json {
-                writeln!(text, "{}", total_json(fleet, now)).ok();
-            } else {
-                writeln!(text, "{}", total_line(fleet, now)).ok();
+            let total = match (fleet.escs.len() > 1, json) {
+                (false, _) => None,
+                (true, true) => Some(total_json(fleet, now).to_string()),
+                (true, false) => Some(total_line(fleet, now)),
+            };
+            if let Some(total) = total {
+                writeln!(text, "{total}").ok();
             }
             // Skip intervals missed (a suspended machine) rather than printing a burst: the next
             // status is due one interval after the last one due, counted without a loop.
