@@ -1,12 +1,15 @@
 //! Option groups that several commands share: where telemetry comes from, the conversion
 //! settings the frames do not carry, and which frames to keep.
 
+use std::path::PathBuf;
+
 use clap::Args;
-use hwfoc::Settings;
 use hwfoc_io::select::{Selection, Window};
 use hwfoc_io::serial;
+use hwfoc_io::settings::{SettingsMap, SettingsPatch};
 use hwfoc_io::{Input, InputError};
 
+use crate::config::Config;
 use crate::demo;
 use crate::error::CliError;
 
@@ -64,24 +67,83 @@ impl InputArgs {
     }
 }
 
-/// Conversion settings the frames do not carry.
-#[derive(Debug, Args)]
+/// How the configuration file and the flags combine, for `--help`.
+pub const SETTINGS_HELP: &str = "\
+Configuration file (TOML). Settings come from, first to last (field by field): these flags; the ESC's [esc.N] entry in the
+configuration file; its port's [port.\"NAME\"] entry; the file's [settings]; the defaults (current
+scale 64, 7 pole pairs, gear ratio 1). The file: --config FILE, else $HWFOC_CONFIG, else
+hwfoc/config.toml in the user's configuration directory ($XDG_CONFIG_HOME or ~/.config) if it
+exists; --no-config reads none. See the README (Configuration).";
+
+/// Conversion settings the frames do not carry, and the configuration file that sets them.
+#[derive(Debug, Default, Clone, Args)]
 pub struct SettingsArgs {
-    /// Raw current units per ampere (the vendor document says 64; some drivers use 100).
-    #[arg(long, value_name = "N", default_value_t = Settings::DEFAULT.current_scale)]
-    pub current_scale: f32,
-    /// Motor pole pairs (magnets / 2), for `rpm`.
-    #[arg(long, value_name = "N", default_value_t = Settings::DEFAULT.pole_pairs)]
-    pub pole_pairs: u16,
-    /// Gear ratio between motor and output shaft, for `rpm`.
-    #[arg(long, value_name = "X", default_value_t = Settings::DEFAULT.gear_ratio)]
-    pub gear_ratio: f32,
+    /// Raw current units per ampere, for every ESC (the vendor document says 64; some drivers
+    /// use 100) [default: from the configuration file, else 64].
+    #[arg(long, value_name = "N", help_heading = "Settings")]
+    pub current_scale: Option<f32>,
+    /// Motor pole pairs (magnets / 2), for `rpm`, for every ESC [default: from the
+    /// configuration file, else 7].
+    #[arg(long, value_name = "N", help_heading = "Settings")]
+    pub pole_pairs: Option<u16>,
+    /// Gear ratio between motor and output shaft, for `rpm`, for every ESC [default: from the
+    /// configuration file, else 1].
+    #[arg(long, value_name = "X", help_heading = "Settings")]
+    pub gear_ratio: Option<f32>,
+    /// Configuration file (TOML) [default: $HWFOC_CONFIG, else hwfoc/config.toml in the user's
+    /// configuration directory, if it exists].
+    #[arg(long, value_name = "FILE", help_heading = "Settings", long_help = SETTINGS_HELP)]
+    pub config: Option<PathBuf>,
+    /// Read no configuration file.
+    #[arg(long, conflicts_with = "config", help_heading = "Settings")]
+    pub no_config: bool,
 }
 
 impl SettingsArgs {
-    pub fn settings(&self) -> Result<Settings, CliError> {
-        Settings::new(self.current_scale, self.pole_pairs, self.gear_ratio)
-            .map_err(CliError::Settings)
+    /// The configuration file these flags point to, read (see [`Config::load`]).
+    pub fn config(&self) -> Result<Config, CliError> {
+        Config::load(self, false)
+    }
+
+    /// The settings of ESCs that no entry of the configuration file names: the flags over the
+    /// file's `[settings]` over the defaults.
+    pub fn settings(&self) -> Result<hwfoc::Settings, CliError> {
+        self.config()?.settings(self)
+    }
+
+    /// The settings set by flags.
+    pub fn patch(&self) -> SettingsPatch {
+        SettingsPatch {
+            current_scale: self.current_scale,
+            pole_pairs: self.pole_pairs,
+            gear_ratio: self.gear_ratio,
+        }
+    }
+
+    /// The settings of every ESC for a command that converts all ESCs alike (`decode`'s writers
+    /// and `summary`'s statistics convert under one [`hwfoc::Settings`]): the flags over the
+    /// file's `[settings]`. Entries by ESC or port in the file are not applied there: a warning on
+    /// standard error says so, rather than leaving the user to believe they were.
+    pub fn uniform_settings(&self, command: &str) -> Result<hwfoc::Settings, CliError> {
+        let (config, map) = self.settings_map()?;
+        if !map.is_uniform()
+            && let Some(path) = &config.path
+        {
+            eprintln!(
+                "hwfoc: warning: {command} converts every ESC under [settings]: the [esc.N] and \
+                 [port] settings of {} are not applied (hwfoc plot and hwfoc monitor apply them)",
+                path.display()
+            );
+        }
+        Ok(*map.default_settings())
+    }
+
+    /// The configuration file read and every ESC's settings: the file's, and the flags over
+    /// them.
+    pub fn settings_map(&self) -> Result<(Config, SettingsMap), CliError> {
+        let config = self.config()?;
+        let map = config.settings_map(self)?;
+        Ok((config, map))
     }
 }
 

@@ -6,6 +6,7 @@
 mod common;
 
 use std::process::Command;
+use std::str::FromStr;
 use std::thread;
 use std::time::{Duration, Instant};
 
@@ -54,6 +55,39 @@ fn plain_prints_each_esc_every_interval_and_alarms_by_name() {
             "{lines:#?}"
         );
     }
+    // Each ESC's power, charge and energy, and all of them together once per interval.
+    let totals: Vec<&String> = lines
+        .iter()
+        .filter(|l| l.contains(" total: power "))
+        .collect();
+    assert!((4..=8).contains(&totals.len()), "{lines:#?}");
+    let last_total = totals.last().unwrap();
+    assert!(
+        last_total.contains(" mAh ")
+            && last_total.ends_with(" Wh")
+            && last_total.contains("(peak "),
+        "{last_total}"
+    );
+    let used = |l: &str| -> f64 {
+        l.split("used ")
+            .nth(1)
+            .and_then(|s| s.split(" mAh").next())
+            .and_then(|s| s.parse().ok())
+            .unwrap_or_else(|| panic!("no charge in {l}"))
+    };
+    assert!(used(last_total) > 0.0, "{last_total}");
+    let last_esc = |esc: usize| {
+        lines
+            .iter()
+            .rev()
+            .find(|l| l.contains(&format!(" esc{esc} sim:esc{esc}: thr ")))
+            .unwrap()
+    };
+    let sum = used(last_esc(0)) + used(last_esc(1));
+    assert!(
+        (used(last_total) - sum).abs() < 0.3,
+        "{last_total} vs {sum}"
+    );
     // Throttle steps start after the 2 s lead-in: the last lines show the motor turning.
     let last = lines.iter().rev().find(|l| l.contains(" esc0 ")).unwrap();
     let rpm: f64 = last
@@ -186,7 +220,11 @@ fn a_port_that_goes_away_shows_disconnected_and_resumes() {
 
     // A new pty appears at the same path.
     let mut second = start_sim();
-    let cleared = monitor.wait_for_stdout("disconnected cleared after", Duration::from_secs(5));
+    // The clear names the level the alarm had.
+    let cleared = monitor.wait_for_stdout(
+        "disconnected critical cleared after",
+        Duration::from_secs(5),
+    );
     assert!(cleared.contains("CLEARED esc0"), "{cleared}");
     // Frames again, and the ESC's line is back to normal.
     monitor.wait_for_stdout("| ok", Duration::from_secs(5));
@@ -201,7 +239,11 @@ fn a_port_that_goes_away_shows_disconnected_and_resumes() {
         1,
         "{out}"
     );
-    assert_eq!(out.matches("disconnected cleared").count(), 1, "{out}");
+    assert_eq!(
+        out.matches("disconnected critical cleared").count(),
+        1,
+        "{out}"
+    );
 }
 
 #[test]
@@ -365,8 +407,11 @@ struct Tmux {
 
 impl Tmux {
     fn start(width: u16, height: u16) -> Tmux {
+        // A server per test: tests run in parallel.
+        static NEXT: std::sync::atomic::AtomicU32 = std::sync::atomic::AtomicU32::new(0);
+        let n = NEXT.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
         let tmux = Tmux {
-            socket: format!("hwfoc-test-{}", std::process::id()),
+            socket: format!("hwfoc-test-{}-{n}", std::process::id()),
         };
         let ok = tmux
             .cmd()
@@ -603,4 +648,95 @@ fn the_dashboard_in_tmux() {
         p.contains("CTRL-C-EXIT=0")
     });
     assert_terminal_usable(&tmux, 7);
+}
+
+/// Whether `c` is a braille dot pattern (what the charts draw with).
+fn braille(c: char) -> bool {
+    ('\u{2801}'..='\u{28FF}').contains(&c)
+}
+
+#[test]
+fn the_dashboard_at_80_by_24_is_readable() {
+    let dir = tempfile::tempdir().unwrap();
+    let data = dir.path().join("data");
+    let tmux = Tmux::start(80, 24);
+    // The recording directory left to its default: under XDG_DATA_HOME, made on demand.
+    let command = format!(
+        "XDG_DATA_HOME={} {} monitor --sim 4 --no-config; echo MONITOR-EXIT=$?",
+        data.display(),
+        env!("CARGO_BIN_EXE_hwfoc")
+    );
+    tmux.keys(&[&command, "Enter"]);
+    let pane = tmux.wait("four rows and sparklines", Duration::from_secs(15), |p| {
+        (0..4).all(|i| row(p, i).is_some_and(|r| r.contains('/')))
+            && p.lines()
+                .filter(|l| l.contains("▁") || l.contains("█"))
+                .count()
+                >= 3
+    });
+    // No chart squeezed into a row or two: sparklines instead, one per quantity, labelled.
+    assert!(!pane.chars().any(braille), "{pane}");
+    for name in ["RPM", "Current", "Voltage", "MOS temp"] {
+        let line = pane
+            .lines()
+            .find(|l| l.contains(&format!("│{name} ")))
+            .unwrap_or_else(|| panic!("no {name} sparkline:\n{pane}"));
+        assert!(line.chars().count() <= 80, "{line}");
+    }
+    assert!(pane.lines().count() <= 24 && pane.lines().all(|l| l.chars().count() <= 80));
+    // Energy of the selected ESC and of all of them, and the time as ISO 8601.
+    assert!(
+        pane.contains("this ESC") && pane.contains("all ESCs"),
+        "{pane}"
+    );
+    assert!(pane.contains(" mAh") && pane.contains(" Wh"), "{pane}");
+    let title = pane.lines().next().unwrap();
+    let iso = title
+        .split_whitespace()
+        .find(|w| w.len() >= 25 && w.as_bytes()[10] == b'T')
+        .unwrap_or_else(|| panic!("no ISO 8601 time in {title}"));
+    assert!(jiff::Timestamp::from_str(iso).is_ok(), "{iso}");
+
+    // r records into the data directory, made private, and says where.
+    tmux.keys(&["r"]);
+    tmux.wait("recording", Duration::from_secs(3), |p| p.contains("● REC"));
+    thread::sleep(Duration::from_millis(800));
+    tmux.keys(&["r"]);
+    tmux.wait("recorded", Duration::from_secs(3), |p| {
+        p.contains("recorded to")
+    });
+    let recordings = data.join("hwfoc/recordings");
+    let files: Vec<_> = std::fs::read_dir(&recordings).unwrap().collect();
+    assert_eq!(files.len(), 1);
+    {
+        use std::os::unix::fs::PermissionsExt;
+        let mode = std::fs::metadata(&recordings).unwrap().permissions().mode();
+        assert_eq!(mode & 0o777, 0o700, "{mode:o}");
+    }
+
+    // Wide enough for charts: their axis labels never run together.
+    let ok = tmux
+        .cmd()
+        .args(["resize-window", "-t", "t", "-x", "160", "-y", "50"])
+        .status()
+        .unwrap();
+    assert!(ok.success());
+    let pane = tmux.wait("the charts", Duration::from_secs(5), |p| {
+        p.chars().filter(|&c| braille(c)).count() > 10 && p.contains("-30 s")
+    });
+    assert!(!pane.contains("now-60"), "{pane}");
+    let labels = pane
+        .lines()
+        .find(|l| l.contains("now") && l.contains("-60 s") && l.contains("-30 s"))
+        .unwrap_or_else(|| panic!("no axis labels:\n{pane}"));
+    let gap = labels.split("now").nth(1).unwrap();
+    assert!(gap.starts_with("   "), "labels too close: {labels}");
+
+    tmux.keys(&["q"]);
+    let pane = tmux.wait("the exit", Duration::from_secs(5), |p| {
+        p.contains("MONITOR-EXIT=0")
+    });
+    // Where the recording went is said on exit too.
+    assert!(pane.contains("hwfoc: recorded to"), "{pane}");
+    assert!(pane.contains("hwfoc/recordings/hwfoc-"), "{pane}");
 }

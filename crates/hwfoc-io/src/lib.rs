@@ -7,7 +7,7 @@
 //!   serial ports, standard input), the format detected from the content, each byte with its
 //!   receive time where the source has a clock;
 //! - [`stream`] and [`sources`]: the one path from timed bytes to frames, a decoding stream per
-//!   ESC; [`handler`]: the [`Handler`] seam through which records reach a front end;
+//!   ESC, each converted under its own [`settings`]; [`handler`]: the [`Handler`] seam through which records reach a front end;
 //! - [`record`]: the record of `RECORD-SCHEMA.md` (one row per data frame, physical units), its
 //!   columns declared once in one table, and its text encodings;
 //! - [`write`](mod@write): writers of records (JSON Lines, CSV, Parquet with the `parquet`
@@ -31,6 +31,7 @@ pub mod pcapng;
 pub mod record;
 pub mod select;
 pub mod serial;
+pub mod settings;
 pub mod sources;
 pub mod stop;
 pub mod stream;

@@ -14,6 +14,7 @@ use hwfoc::{Decoded, Settings};
 
 pub use crate::handler::Handler;
 use crate::input::{Input, InputError, InputFormat};
+use crate::settings::SettingsMap;
 use crate::stream::{EscLink, Stream};
 
 /// Batches shorter than this come from a live source: what they produce is passed on at once.
@@ -53,7 +54,7 @@ pub struct InputInfo {
 
 /// The inputs of a command and the ESCs found in them.
 pub struct Sources {
-    settings: Settings,
+    settings: SettingsMap,
     pending: Vec<Input>,
     names: Vec<String>,
     read: Vec<InputInfo>,
@@ -63,15 +64,15 @@ pub struct Sources {
     ports: HashMap<String, usize>,
     /// The ESC of each channel of each stream found to come from a DataLink hub, by the ESC
     /// of its stream.
-    hubs: HashMap<usize, [usize; CHANNELS]>,
+    hubs: HashMap<usize, Hub>,
 }
 
 impl Sources {
     /// The inputs, opened, in command-line order; data frames become records under
-    /// `settings`.
-    pub fn new(inputs: Vec<Input>, settings: Settings) -> Sources {
+    /// `settings`: one [`Settings`] for every ESC, or a [`SettingsMap`] by ESC and port.
+    pub fn new(inputs: Vec<Input>, settings: impl Into<SettingsMap>) -> Sources {
         Sources {
-            settings,
+            settings: settings.into(),
             names: inputs.iter().map(|i| i.name().to_string()).collect(),
             pending: inputs,
             read: Vec::new(),
@@ -95,9 +96,15 @@ impl Sources {
         }
     }
 
-    /// The conversion settings of the records.
+    /// The conversion settings of the records of ESCs without settings of their own.
     pub fn settings(&self) -> &Settings {
-        &self.settings
+        self.settings.default_settings()
+    }
+
+    /// The conversion settings of ESC `esc` (default settings for an ESC not found yet).
+    pub fn esc_settings(&self, esc: usize) -> Settings {
+        let name = self.escs.get(esc).map_or("", |e| e.name.as_str());
+        self.settings.get(esc, name)
     }
 
     /// The names of all inputs, in command-line order.
@@ -201,8 +208,8 @@ impl Sources {
     fn finish<H: Handler>(&mut self, esc: usize, handler: &mut H) {
         // Every stream has an index below 256 (checked when it was made).
         let id = u8::try_from(esc).unwrap_or(u8::MAX);
-        let settings = &self.settings;
-        let hub = self.hubs.get(&esc).copied();
+        let settings = &self.esc_settings(esc);
+        let hub = self.hubs.get(&esc);
         let mut pending = Vec::new();
         self.escs[esc].stream.finish(
             #[inline(always)]
@@ -217,13 +224,11 @@ impl Sources {
         if pending.is_empty() {
             return;
         }
-        let channels = match self.hubs.get(&esc) {
-            Some(&channels) => channels,
+        let hub = match self.hubs.get(&esc) {
+            Some(&hub) => hub,
             None => {
-                let mut channels = [esc; CHANNELS];
-                let name = self.escs[esc].name.clone();
-                self.escs[esc].name = format!("{name} channel 0");
-                for (channel, slot) in channels.iter_mut().enumerate().skip(1) {
+                let mut escs = [esc; CHANNELS];
+                for (channel, slot) in escs.iter_mut().enumerate().skip(1) {
                     if self.escs.len() >= MAX_ESCS {
                         // Not numbered: the `esc` column cannot tell it from another.
                         *slot = usize::MAX;
@@ -232,18 +237,21 @@ impl Sources {
                     *slot = self.escs.len();
                     self.escs.push(Esc {
                         input: self.escs[esc].input,
-                        name: format!("{name} channel {channel}"),
+                        name: self.escs[esc].name.clone(),
                         stream: Stream::new(),
                         hub: Some((esc, channel as u8)),
                     });
                 }
-                self.hubs.insert(esc, channels);
-                channels
+                let settings = escs.map(|e| self.esc_settings(e));
+                let hub = Hub { escs, settings };
+                self.hubs.insert(esc, hub);
+                hub
             }
         };
         for (t, channel, d) in pending {
-            if let Ok(id) = u8::try_from(channels[usize::from(channel)]) {
-                handler.frame(id, t, &d, &self.settings);
+            let c = usize::from(channel);
+            if let Ok(id) = u8::try_from(hub.escs[c]) {
+                handler.frame(id, t, &d, &hub.settings[c]);
             }
         }
     }
@@ -321,8 +329,8 @@ impl Sources {
                 continue;
             };
             let id = u8::try_from(esc).unwrap_or(u8::MAX);
-            let settings = &self.settings;
-            let hub = self.hubs.get(&esc).copied();
+            let settings = &self.esc_settings(esc);
+            let hub = self.hubs.get(&esc);
             let mut pending = Vec::new();
             // Inlined into the decoder's loop, so that the handler may be too: a frame's fields
             // then reach it in registers, not through a `Decoded` stored and loaded back.
@@ -337,6 +345,13 @@ impl Sources {
     }
 }
 
+/// The ESCs of a DataLink hub's channels, and their settings.
+#[derive(Debug, Clone, Copy)]
+struct Hub {
+    escs: [usize; CHANNELS],
+    settings: [Settings; CHANNELS],
+}
+
 /// A frame of a DataLink channel that has no ESC yet: its time, channel and frame.
 type Pending = (Option<f64>, u8, Decoded);
 
@@ -346,7 +361,7 @@ type Pending = (Option<f64>, u8, Decoded);
 #[allow(clippy::too_many_arguments)]
 fn route<H: Handler>(
     id: u8,
-    hub: Option<[usize; CHANNELS]>,
+    hub: Option<&Hub>,
     t: Option<f64>,
     channel: Option<u8>,
     d: &Decoded,
@@ -356,9 +371,10 @@ fn route<H: Handler>(
 ) {
     match (channel, hub) {
         (None, _) => handler.frame(id, t, d, settings),
-        (Some(c), Some(channels)) => {
-            if let Ok(esc) = u8::try_from(channels[usize::from(c)]) {
-                handler.frame(esc, t, d, settings);
+        (Some(c), Some(hub)) => {
+            let c = usize::from(c);
+            if let Ok(esc) = u8::try_from(hub.escs[c]) {
+                handler.frame(esc, t, d, &hub.settings[c]);
             }
         }
         (Some(c), None) => pending.push((t, c, *d)),

@@ -382,15 +382,22 @@ pub struct PortStreams {
     streams: Vec<Stream>,
     per_byte_ns: f64,
     times: Vec<f64>,
-    settings: Settings,
+    /// The settings of each port's records.
+    settings: Vec<Settings>,
 }
 
 impl PortStreams {
     /// `ports` streams, their bytes arriving at `baud` (8N1), their data frames made records
     /// under `settings`.
     pub fn new(ports: usize, baud: u32, settings: Settings) -> PortStreams {
+        PortStreams::with_settings(baud, vec![settings; ports])
+    }
+
+    /// A stream per entry of `settings`, their bytes arriving at `baud` (8N1), the data frames
+    /// of port `i` made records under `settings[i]` (see [`crate::settings::SettingsMap`]).
+    pub fn with_settings(baud: u32, settings: Vec<Settings>) -> PortStreams {
         PortStreams {
-            streams: (0..ports).map(|_| Stream::new()).collect(),
+            streams: settings.iter().map(|_| Stream::new()).collect(),
             per_byte_ns: hwfoc::wire::byte_ns(baud),
             times: Vec::new(),
             settings,
@@ -410,7 +417,7 @@ impl PortStreams {
         let stream = self.streams.get_mut(*port)?;
         self.times.clear();
         byte_times(*t_ns, self.per_byte_ns, bytes.len(), &mut self.times);
-        let settings = &self.settings;
+        let settings = &self.settings[*port];
         let hub_base = port.saturating_mul(datalink::CHANNELS);
         stream.feed(
             Batch {

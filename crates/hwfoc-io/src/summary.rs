@@ -45,10 +45,17 @@ pub fn esc_label(sources: &Sources, esc: usize) -> String {
         .inputs()
         .get(e.input)
         .is_none_or(|info| info.escs.len() == 1);
-    if single && e.name == *input {
+    let channel = match e.hub {
+        Some((_, channel)) => format!(" channel {channel}"),
+        None if sources.is_hub(esc) => " channel 0".to_string(),
+        None => String::new(),
+    };
+    if single && e.name == *input && channel.is_empty() {
         input.clone()
+    } else if e.name == *input {
+        format!("{input}{channel} (ESC {esc})")
     } else {
-        format!("{input}: {} (ESC {esc})", e.name)
+        format!("{input}: {}{channel} (ESC {esc})", e.name)
     }
 }
 

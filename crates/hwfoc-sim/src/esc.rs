@@ -6,7 +6,8 @@
 //! 77-byte device-information frame. The ESC checks its state every 50 ms, so a motor starting
 //! gets its first running frame within 50 ms. Frames never overlap on the wire: one that is due
 //! while the previous is still being sent waits for it. The first frame comes at a random phase
-//! within the first 50 ms, so several ESCs are not in lockstep.
+//! within the first 50 ms, and every ESC but the first runs the throttle profile a little behind
+//! and at a load of its own ([`spread`]), so that several ESCs are not in lockstep.
 //!
 //! The ESC's output is an endless series of [`Burst`]s, bytes sent back to back, in time
 //! order: frames, and the garbage and glitches the link adds between them.
@@ -104,6 +105,12 @@ pub struct Setup {
     pub model: ModelConfig,
     /// The throttle command.
     pub profile: Rc<Profile>,
+    /// How far this ESC runs behind the profile, seconds: it sees the throttle of `t - lag_s`
+    /// (see [`spread`]).
+    pub lag_s: f64,
+    /// This ESC's share of the propeller load, times the model's `full_current_a` (see
+    /// [`spread`]).
+    pub load: f64,
     /// Injected status bits.
     pub faults: FaultSchedule,
     /// Link fault rates.
@@ -139,7 +146,9 @@ impl VirtualEsc {
     /// An ESC at rest at time zero.
     pub fn new(setup: Setup) -> VirtualEsc {
         let mut params = Rng::for_esc(setup.seed, setup.index, Purpose::Params);
-        let model = Model::new(&setup.model, &mut params);
+        let mut config = setup.model;
+        config.full_current_a *= setup.load;
+        let model = Model::new(&config, &mut params);
         let packet = setup
             .start_packet
             .unwrap_or_else(|| params.below(1 << 16) as u16);
@@ -239,8 +248,8 @@ impl VirtualEsc {
                 .faults
                 .status_at(now)
                 .contains(Fault::ThrottleSignalLost);
-            self.model
-                .step(dt as f64 * 1e-9, self.setup.profile.throttle(now), lost);
+            let throttle = self.setup.profile.throttle(now - self.setup.lag_s);
+            self.model.step(dt as f64 * 1e-9, throttle, lost);
             self.model_ns += dt;
         }
     }
@@ -332,6 +341,31 @@ impl VirtualEsc {
     }
 }
 
+/// The longest an ESC runs behind the profile, seconds (see [`spread`]).
+pub const MAX_LAG_S: f64 = 1.0;
+/// How far an ESC's load is from the model's, as a fraction (see [`spread`]).
+pub const LOAD_SPREAD: f64 = 0.15;
+
+/// The lag (seconds) and load factor of ESC `index` of a run seeded `seed`, so that the ESCs of
+/// one run are not in lockstep: ESC 0 runs the profile as given at the model's load (a run of one
+/// ESC is as it always was); every other one lags it by a lag from 0 to [`MAX_LAG_S`] and draws
+/// a load from `1 - LOAD_SPREAD` to `1 + LOAD_SPREAD` of the model's (its propeller, its motor's
+/// share of the aircraft's weight), both drawn from the seed and the index alone: the same seed
+/// gives the same run.
+pub fn spread(seed: u64, index: usize) -> (f64, f64) {
+    if index == 0 {
+        return (0.0, 1.0);
+    }
+    // A stream of its own (the seed turned), so that no other draw of the ESC moves with it.
+    let mut rng = Rng::for_esc(seed.rotate_left(17) ^ SPREAD_SALT, index, Purpose::Params);
+    let lag_s = MAX_LAG_S * rng.unit();
+    let load = 1.0 + LOAD_SPREAD * rng.signed();
+    (lag_s, load)
+}
+
+/// Turns the seed for [`spread`]'s draws.
+const SPREAD_SALT: u64 = 0x5350_5245_4144_2d31;
+
 /// Simulated seconds for simulated nanoseconds.
 fn seconds(t_ns: u64) -> f64 {
     t_ns as f64 * 1e-9
@@ -352,9 +386,58 @@ pub(crate) mod tests {
             start_packet: Some(65530),
             model: config(),
             profile: Rc::new(profile),
+            lag_s: 0.0,
+            load: 1.0,
             faults: FaultSchedule::default(),
             link,
         }
+    }
+
+    #[test]
+    fn escs_other_than_the_first_lag_the_profile_and_carry_their_own_load() {
+        assert_eq!(spread(42, 0), (0.0, 1.0));
+        let all: Vec<(f64, f64)> = (1..16).map(|i| spread(42, i)).collect();
+        assert_eq!(all, (1..16).map(|i| spread(42, i)).collect::<Vec<_>>());
+        for &(lag, load) in &all {
+            assert!((0.0..MAX_LAG_S).contains(&lag), "{lag}");
+            assert!(
+                (1.0 - LOAD_SPREAD..1.0 + LOAD_SPREAD).contains(&load),
+                "{load}"
+            );
+        }
+        // Not in lockstep: the lags differ, and so do the loads.
+        let lags: Vec<u64> = all.iter().map(|p| (p.0 * 1e6) as u64).collect();
+        assert!(lags.windows(2).all(|w| w[0] != w[1]), "{lags:?}");
+        assert_ne!(spread(42, 1), spread(43, 1));
+
+        // An ESC lagging by a second starts its motor a second later, and a heavier load draws
+        // more current at the same throttle.
+        let steps = || Profile::Points(vec![(0.0, 0.0), (1.0, 0.0), (1.0, 60.0), (9.0, 60.0)]);
+        let first_spin = |lag_s: f64, load: f64| {
+            let mut s = setup(steps(), LinkRates::default());
+            (s.lag_s, s.load) = (lag_s, load);
+            let mut esc = VirtualEsc::new(s);
+            let mut spin = None;
+            let mut amps = 0.0;
+            for _ in 0..400 {
+                let burst = esc.next_burst();
+                if let Some(f) = burst.intact_frame() {
+                    if spin.is_none() && f.erpm_raw > 0 {
+                        spin = Some(burst.t_ns as f64 * 1e-9);
+                    }
+                    if burst.t_ns > 6_000_000_000 {
+                        amps = f64::from(f.current_raw) / 64.0;
+                        break;
+                    }
+                }
+            }
+            (spin.unwrap(), amps)
+        };
+        let (t0, a0) = first_spin(0.0, 1.0);
+        let (t1, _) = first_spin(1.0, 1.0);
+        assert!((t1 - t0 - 1.0).abs() < 0.1, "{t0} {t1}");
+        let (_, heavy) = first_spin(0.0, 1.15);
+        assert!(heavy > a0 * 1.08, "{a0} A, heavier {heavy} A");
     }
 
     /// Idle for 2 s, then 40 % for 2 s, then idle.

@@ -8,7 +8,7 @@ use std::time::Instant;
 use hwfoc_io::clock::unix_now_ns;
 
 use crate::error::SimError;
-use crate::esc::{Setup, VirtualEsc};
+use crate::esc::{Setup, VirtualEsc, spread};
 use crate::faults::{FaultSchedule, FaultSpec, LinkRates};
 use crate::model::ModelConfig;
 use crate::profile::{Profile, ProfileSpec, Shape};
@@ -81,12 +81,14 @@ impl VirtualFleet {
         &self.profile
     }
 
-    /// The ESCs, at rest at time zero.
+    /// The ESCs, at rest at time zero. Each but the first runs behind the profile and at a
+    /// load of its own ([`spread`]), so that they are not in lockstep.
     pub fn escs(self) -> Vec<VirtualEsc> {
         let spec = self.spec;
         let profile = Rc::new(self.profile);
         (0..spec.n)
             .map(|index| {
+                let (lag_s, load) = spread(spec.seed, index);
                 VirtualEsc::new(Setup {
                     index,
                     seed: spec.seed,
@@ -94,6 +96,8 @@ impl VirtualFleet {
                     start_packet: spec.start_packet,
                     model: spec.model,
                     profile: Rc::clone(&profile),
+                    lag_s,
+                    load,
                     faults: FaultSchedule::for_esc(&spec.faults, index),
                     link: spec.link,
                 })

@@ -45,7 +45,7 @@ pub struct DecodeArgs {
 
 /// Runs `hwfoc decode`.
 pub fn run(args: &DecodeArgs) -> Result<(), CliError> {
-    let settings = args.settings.settings()?;
+    let settings = args.settings.uniform_settings("decode")?;
     let selection = args.select.selection()?;
     if let Some(output) = &args.output {
         args.input.refuse_output(output)?;

@@ -27,7 +27,7 @@ pub struct SummaryArgs {
 
 /// Runs `hwfoc summary`.
 pub fn run(args: &SummaryArgs) -> Result<(), CliError> {
-    let settings = args.settings.settings()?;
+    let settings = args.settings.uniform_settings("summary")?;
     // The plot's file is opened first: a wrong name is reported before the inputs are read.
     let mut plot = match &args.plot {
         Some(path) => {

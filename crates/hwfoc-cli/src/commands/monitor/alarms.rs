@@ -97,6 +97,8 @@ pub enum Change {
     /// The episode is over after this many seconds; `worst` is the extreme value it saw
     /// (for thresholds; `None` for bits).
     Cleared {
+        /// The highest level the episode reached (what it is cleared from).
+        level: Level,
         /// Seconds from raised to cleared.
         duration_s: f64,
         /// The highest (or, for low voltage, lowest) value of the episode.
@@ -240,10 +242,11 @@ impl Latch {
                 self.reported = Some(Level::Critical);
                 Some(Change::Escalated)
             }
-            (Some(_), None) => {
+            (Some(level), None) => {
                 self.reported = None;
                 let worst = self.worst.take();
                 Some(Change::Cleared {
+                    level,
                     duration_s: (t - self.since).max(0.0),
                     worst,
                 })
@@ -282,6 +285,7 @@ mod tests {
                 (
                     9,
                     Change::Cleared {
+                        level: Level::Warning,
                         duration_s: 7.0,
                         worst: Some(91.0)
                     }
@@ -305,6 +309,7 @@ mod tests {
                 (
                     7,
                     Change::Cleared {
+                        level: Level::Critical,
                         duration_s: 7.0,
                         worst: Some(106.0)
                     }
@@ -360,6 +365,7 @@ mod tests {
                 (
                     7,
                     Change::Cleared {
+                        level: Level::Critical,
                         duration_s: 6.0,
                         worst: Some(19.7)
                     }
@@ -387,12 +393,61 @@ mod tests {
         assert_eq!(changes[0], (0, Change::Raised(Level::Critical)));
         // Last on at frame 18 (0.9 s): cleared at the first frame 0.5 s later, frame 28.
         match changes[1] {
-            (28, Change::Cleared { duration_s, worst }) => {
+            (
+                28,
+                Change::Cleared {
+                    level: Level::Critical,
+                    duration_s,
+                    worst,
+                },
+            ) => {
                 assert!((duration_s - 1.4).abs() < 1e-9);
                 assert_eq!(worst, None);
             }
             other => panic!("{other:?}"),
         }
+    }
+
+    #[test]
+    fn a_clear_names_the_highest_level_of_its_episode() {
+        let th = Threshold::high(90.0, 105.0, 5.0);
+        // Raised critical, eased to warning, then cleared: cleared from critical.
+        let mut latch = Latch::default();
+        let changes = run(&mut latch, &th, &[110.0, 95.0, 80.0]);
+        assert_eq!(changes[0], (0, Change::Raised(Level::Critical)));
+        assert!(
+            matches!(
+                changes[1],
+                (
+                    2,
+                    Change::Cleared {
+                        level: Level::Critical,
+                        ..
+                    }
+                )
+            ),
+            "{changes:?}"
+        );
+        // A bit raised critical and cleared by `clear` (the ESC went silent).
+        let mut latch = Latch::default();
+        latch.set(true, Level::Critical, 0.5, 0.0);
+        assert!(matches!(
+            latch.clear(1.0),
+            Some(Change::Cleared {
+                level: Level::Critical,
+                ..
+            })
+        ));
+        // A warning stays a warning.
+        let mut latch = Latch::default();
+        let changes = run(&mut latch, &th, &[95.0, 80.0]);
+        assert!(matches!(
+            changes[1].1,
+            Change::Cleared {
+                level: Level::Warning,
+                ..
+            }
+        ));
     }
 
     #[test]

@@ -1,17 +1,18 @@
-//! The monitor's settings: built-in defaults, overridden by an optional TOML file, overridden by
-//! flags.
+//! The monitor's settings: built-in defaults, overridden by the configuration file
+//! ([`crate::config`]: `[settings]`, `[port."NAME"]`, `[esc.N]`, `[monitor]`, `[alarms]`),
+//! overridden by flags.
 //!
-//! The file is `hwfoc/monitor.toml` in the user's configuration directory
-//! (`~/.config/hwfoc/monitor.toml` on Linux, `~/Library/Application Support/hwfoc/monitor.toml`
-//! on macOS, `%APPDATA%\hwfoc\monitor.toml` on Windows), or the one named by `--config`. Every
-//! key is optional; unknown keys are errors (a misspelt threshold must not be silently ignored):
+//! The older `hwfoc/monitor.toml` is still read when there is no `hwfoc/config.toml` (its keys
+//! at the top and its `[[esc]]` list of ports and labels: see [`crate::config::File`]):
 //!
 //! ```toml
+//! [monitor]
+//! ports = ["/dev/ttyUSB0"]   # watched when none are named on the command line
 //! baud = 19200
-//! current_scale = 64.0
-//! pole_pairs = 7
-//! gear_ratio = 1.0
 //! record_dir = "/home/pi/recordings"
+//!
+//! [port."/dev/ttyUSB0"]
+//! label = "front left"
 //!
 //! [alarms]
 //! mos_warning_c = 90
@@ -25,88 +26,18 @@
 //! cell_hysteresis_v = 0.1
 //! stale_after_s = 1.0
 //! fault_hold_s = 0.5
-//!
-//! [[esc]]
-//! port = "/dev/serial/by-id/usb-FTDI_FT232R_USB_UART_A50285BI-if00-port0"
-//! label = "front left"
 //! ```
-//!
-//! Ports listed under `[[esc]]` are watched when none are named on the command line; a label
-//! belongs to its port wherever that port is named.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use hwfoc::Settings;
-use serde::Deserialize;
+use hwfoc_io::serial;
+use hwfoc_io::settings::SettingsMap;
 
 use super::alarms::Threshold;
+use crate::args::SettingsArgs;
+pub use crate::config::AlarmKeys;
 use crate::error::CliError;
-use hwfoc_io::InputError;
-use hwfoc_io::input::read_small_file;
-use hwfoc_io::serial;
-
-/// The file's layout.
-#[derive(Debug, Default, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct File {
-    baud: Option<u32>,
-    current_scale: Option<f32>,
-    pole_pairs: Option<u16>,
-    gear_ratio: Option<f32>,
-    record_dir: Option<PathBuf>,
-    #[serde(default)]
-    alarms: AlarmKeys,
-    #[serde(default)]
-    esc: Vec<EscEntry>,
-}
-
-/// The `[alarms]` table (and the matching flags).
-#[derive(Debug, Default, Clone, Deserialize, clap::Args)]
-#[serde(deny_unknown_fields)]
-pub struct AlarmKeys {
-    /// MOSFET temperature warning level, degC [default: 90].
-    #[arg(long, value_name = "DEGC", help_heading = "Alarms")]
-    pub mos_warning_c: Option<f64>,
-    /// MOSFET temperature critical level, degC [default: 105].
-    #[arg(long, value_name = "DEGC", help_heading = "Alarms")]
-    pub mos_critical_c: Option<f64>,
-    /// Capacitor temperature warning level, degC [default: 85].
-    #[arg(long, value_name = "DEGC", help_heading = "Alarms")]
-    pub cap_warning_c: Option<f64>,
-    /// Capacitor temperature critical level, degC [default: 100].
-    #[arg(long, value_name = "DEGC", help_heading = "Alarms")]
-    pub cap_critical_c: Option<f64>,
-    /// How far a temperature must fall below a level to leave it, degC [default: 5].
-    #[arg(long, value_name = "DEGC", help_heading = "Alarms")]
-    pub temp_hysteresis_c: Option<f64>,
-    /// Battery cells in series, for the low-voltage levels [default: detected from the first
-    /// voltage seen, as a full LiPo].
-    #[arg(long, value_name = "N", help_heading = "Alarms")]
-    pub battery_cells: Option<u8>,
-    /// Low-voltage warning level per cell, V [default: 3.5].
-    #[arg(long, value_name = "V", help_heading = "Alarms")]
-    pub cell_warning_v: Option<f64>,
-    /// Low-voltage critical level per cell, V [default: 3.3].
-    #[arg(long, value_name = "V", help_heading = "Alarms")]
-    pub cell_critical_v: Option<f64>,
-    /// How far the voltage must rise above a level to leave it, V per cell [default: 0.1].
-    #[arg(long, value_name = "V", help_heading = "Alarms")]
-    pub cell_hysteresis_v: Option<f64>,
-    /// An ESC is stale after this long without a frame, seconds [default: 1].
-    #[arg(long, value_name = "S", help_heading = "Alarms")]
-    pub stale_after_s: Option<f64>,
-    /// A status-bit alarm clears after the bit has been off this long, seconds [default: 0.5].
-    #[arg(long, value_name = "S", help_heading = "Alarms")]
-    pub fault_hold_s: Option<f64>,
-}
-
-/// One `[[esc]]` entry.
-#[derive(Debug, Clone, Deserialize)]
-#[serde(deny_unknown_fields)]
-struct EscEntry {
-    port: String,
-    label: Option<String>,
-}
 
 /// The alarm levels in force.
 #[derive(Debug, Clone, PartialEq)]
@@ -138,92 +69,68 @@ impl Limits {
 }
 
 /// Everything the monitor is set to.
-#[derive(Debug, Clone)]
+#[derive(Debug)]
 pub struct Config {
     /// Where the configuration file was read from, if one was.
     pub file: Option<PathBuf>,
-    /// Conversion settings.
-    pub settings: Settings,
+    /// Conversion settings, by ESC and port.
+    pub settings: SettingsMap,
     /// Baud rate of the ports.
     pub baud: u32,
     /// Ports from the file, when none are named on the command line.
     pub ports: Vec<String>,
-    /// Labels by port name, from the file.
-    labels: Vec<(String, String)>,
     /// Where recordings started with the `r` key go.
     pub record_dir: PathBuf,
     /// Alarm levels.
     pub limits: Limits,
+    /// The file, for labels.
+    general: crate::config::Config,
 }
 
 /// What the command line says (each `None` leaves the file's value or the default).
 #[derive(Debug, Default, Clone)]
 pub struct Overrides {
-    /// `--config FILE`.
-    pub config: Option<PathBuf>,
-    /// `--no-config`.
-    pub no_config: bool,
+    /// `--config`, `--no-config` and the conversion settings.
+    pub settings: SettingsArgs,
     /// `--baud`.
     pub baud: Option<u32>,
-    /// `--current-scale`.
-    pub current_scale: Option<f32>,
-    /// `--pole-pairs`.
-    pub pole_pairs: Option<u16>,
-    /// `--gear-ratio`.
-    pub gear_ratio: Option<f32>,
     /// `--record-dir`.
     pub record_dir: Option<PathBuf>,
     /// The alarm flags.
     pub alarms: AlarmKeys,
 }
 
-/// The per-user configuration file, whether or not it exists.
-pub fn default_path() -> Option<PathBuf> {
-    dirs::config_dir().map(|d| d.join("hwfoc").join("monitor.toml"))
+/// Where recordings go unless told otherwise: `hwfoc/recordings` in the user's data directory
+/// (`~/.local/share/hwfoc/recordings` on Linux), or the current directory if there is none.
+pub fn default_record_dir() -> PathBuf {
+    dirs::data_local_dir()
+        .map(|d| d.join("hwfoc").join("recordings"))
+        .unwrap_or_else(|| PathBuf::from("."))
 }
 
 impl Config {
     /// Reads the configuration file (the one named, or the per-user one if it exists) and
     /// applies the flags over it.
     pub fn load(flags: &Overrides) -> Result<Config, CliError> {
-        let path = match (&flags.config, flags.no_config) {
-            (_, true) => None,
-            (Some(path), false) => Some(path.clone()),
-            (None, false) => default_path().filter(|p| p.is_file()),
-        };
-        let file = match &path {
-            Some(path) => read_file(path)?,
-            None => File::default(),
-        };
-        Config::merge(path, file, flags)
+        let general = crate::config::Config::load(&flags.settings, true)?;
+        Config::merge(general, flags)
     }
 
-    fn merge(path: Option<PathBuf>, file: File, flags: &Overrides) -> Result<Config, CliError> {
-        let origin = |key: &str| match &path {
+    fn merge(general: crate::config::Config, flags: &Overrides) -> Result<Config, CliError> {
+        let origin = |key: &str| match &general.path {
             Some(p) => format!("{} ({key})", p.display()),
             None => format!("--{}", key.replace('_', "-")),
         };
-        let settings = Settings::new(
-            flags
-                .current_scale
-                .or(file.current_scale)
-                .unwrap_or(Settings::DEFAULT.current_scale),
-            flags
-                .pole_pairs
-                .or(file.pole_pairs)
-                .unwrap_or(Settings::DEFAULT.pole_pairs),
-            flags
-                .gear_ratio
-                .or(file.gear_ratio)
-                .unwrap_or(Settings::DEFAULT.gear_ratio),
-        )
-        .map_err(CliError::Settings)?;
-        let baud = flags.baud.or(file.baud).unwrap_or(serial::DEFAULT_BAUD);
+        let settings = general.settings_map(&flags.settings)?;
+        let baud = flags
+            .baud
+            .or(general.baud())
+            .unwrap_or(serial::DEFAULT_BAUD);
         if baud == 0 {
             return Err(invalid(origin("baud"), "the baud rate must be more than 0"));
         }
         let a = &flags.alarms;
-        let f = &file.alarms;
+        let f = &general.file.alarms;
         let pick =
             |flag: Option<f64>, file: Option<f64>, default: f64| flag.or(file).unwrap_or(default);
         let mos = Threshold::high(
@@ -291,30 +198,28 @@ impl Config {
             ));
         }
         Ok(Config {
-            file: path,
+            file: general.path.clone(),
             settings,
             baud,
-            ports: file.esc.iter().map(|e| e.port.clone()).collect(),
-            labels: file
-                .esc
-                .into_iter()
-                .filter_map(|e| Some((e.port, e.label?)))
-                .collect(),
+            ports: general.ports(),
             record_dir: flags
                 .record_dir
                 .clone()
-                .or(file.record_dir)
-                .unwrap_or_else(|| PathBuf::from(".")),
+                .or_else(|| general.record_dir())
+                .unwrap_or_else(default_record_dir),
             limits,
+            general,
         })
     }
 
-    /// The label the file gives `port`, if any.
-    pub fn label(&self, port: &str) -> Option<&str> {
-        self.labels
-            .iter()
-            .find(|(p, _)| p == port)
-            .map(|(_, l)| l.as_str())
+    /// The settings of ESC `esc`, read from `port`.
+    pub fn settings_of(&self, esc: usize, port: &str) -> Settings {
+        self.settings.get(esc, port)
+    }
+
+    /// The label the file gives ESC `esc` read from `port`, if any.
+    pub fn label(&self, esc: usize, port: &str) -> Option<&str> {
+        self.general.label(esc, port)
     }
 }
 
@@ -323,38 +228,6 @@ fn invalid(origin: String, message: impl Into<String>) -> CliError {
         option: origin,
         message: message.into(),
     }
-}
-
-/// The largest configuration file read (a real one is a few hundred bytes).
-const MAX_CONFIG: u64 = 1 << 20;
-
-/// Reads and parses a configuration file; errors name the file and the line.
-fn read_file(path: &Path) -> Result<File, CliError> {
-    let open_error = |source| InputError::Open {
-        input: path.display().to_string(),
-        source,
-    };
-    let bytes = read_small_file(path, MAX_CONFIG).map_err(open_error)?;
-    let text = String::from_utf8(bytes).map_err(|_| {
-        open_error(std::io::Error::new(
-            std::io::ErrorKind::InvalidData,
-            "it is not UTF-8 text",
-        ))
-    })?;
-    toml::from_str(&text).map_err(|e| {
-        let line = e.span().map(|span| {
-            text.as_bytes()[..span.start.min(text.len())]
-                .iter()
-                .filter(|&&b| b == b'\n')
-                .count()
-                + 1
-        });
-        CliError::Config {
-            path: path.display().to_string(),
-            line,
-            message: e.message().trim().replace('\n', " "),
-        }
-    })
 }
 
 #[cfg(test)]
@@ -366,7 +239,10 @@ mod tests {
         let path = dir.path().join("monitor.toml");
         std::fs::write(&path, text).unwrap();
         Config::load(&Overrides {
-            config: Some(path),
+            settings: SettingsArgs {
+                config: Some(path),
+                ..SettingsArgs::default()
+            },
             ..Overrides::default()
         })
     }
@@ -374,7 +250,10 @@ mod tests {
     #[test]
     fn defaults_without_a_file() {
         let config = Config::load(&Overrides {
-            no_config: true,
+            settings: SettingsArgs {
+                no_config: true,
+                ..SettingsArgs::default()
+            },
             ..Overrides::default()
         })
         .unwrap();
@@ -384,8 +263,10 @@ mod tests {
         assert_eq!((six.warning, six.hysteresis), (3.5 * 6.0, 0.1 * 6.0));
         assert!((six.critical - 19.8).abs() < 1e-9 && six.low_is_bad);
         assert_eq!(config.baud, 19_200);
-        assert_eq!(config.settings, Settings::DEFAULT);
+        assert_eq!(config.settings, SettingsMap::from(Settings::DEFAULT));
         assert!(config.ports.is_empty());
+        assert_eq!(config.record_dir, default_record_dir());
+        assert!(config.record_dir.ends_with("hwfoc/recordings"));
     }
 
     #[test]
@@ -395,18 +276,21 @@ mod tests {
                     label = \"front left\"\n[[esc]]\nport = \"/dev/ttyUSB1\"\n";
         let config = parse(text).unwrap();
         assert_eq!(config.baud, 115_200);
-        assert_eq!(config.settings.pole_pairs, 14);
+        assert_eq!(config.settings_of(0, "/dev/ttyUSB0").pole_pairs, 14);
         assert_eq!(config.limits.mos.warning, 80.0);
         assert_eq!(config.limits.cells, Some(12));
         assert_eq!(config.ports, ["/dev/ttyUSB0", "/dev/ttyUSB1"]);
-        assert_eq!(config.label("/dev/ttyUSB0"), Some("front left"));
-        assert_eq!(config.label("/dev/ttyUSB1"), None);
+        assert_eq!(config.label(0, "/dev/ttyUSB0"), Some("front left"));
+        assert_eq!(config.label(1, "/dev/ttyUSB1"), None);
 
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("m.toml");
         std::fs::write(&path, text).unwrap();
         let mut flags = Overrides {
-            config: Some(path),
+            settings: SettingsArgs {
+                config: Some(path),
+                ..SettingsArgs::default()
+            },
             baud: Some(9600),
             ..Overrides::default()
         };
@@ -439,7 +323,10 @@ mod tests {
     #[test]
     fn a_missing_named_file_is_an_error() {
         let err = Config::load(&Overrides {
-            config: Some(PathBuf::from("/nonexistent/monitor.toml")),
+            settings: SettingsArgs {
+                config: Some(PathBuf::from("/nonexistent/monitor.toml")),
+                ..SettingsArgs::default()
+            },
             ..Overrides::default()
         })
         .unwrap_err()

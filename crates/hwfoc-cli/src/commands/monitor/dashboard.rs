@@ -25,9 +25,10 @@ use ratatui::widgets::{
 
 use super::alarms::{Change, Level};
 use super::feed::Msg;
-use super::fleet::{EscView, HISTORY_S, Link, LogEntry};
+use super::fleet::{EscView, HISTORY_S, Link, LogEntry, total_energy, total_power_w};
 use super::{Session, number};
 use crate::error::CliError;
+use hwfoc_io::energy::Energy;
 
 /// Shortest time between redraws while frames arrive.
 const FRAME_EVERY: Duration = Duration::from_millis(50);
@@ -42,6 +43,8 @@ struct View<'a> {
     escs: &'a [EscView],
     log: &'a VecDeque<LogEntry>,
     now: f64,
+    /// Highest power of all ESCs together, W.
+    peak_total_w: Option<f64>,
 }
 
 /// The copy the display shows while paused.
@@ -49,6 +52,7 @@ struct Frozen {
     escs: Vec<EscView>,
     log: VecDeque<LogEntry>,
     now: f64,
+    peak_total_w: Option<f64>,
 }
 
 /// The dashboard's own state.
@@ -118,11 +122,13 @@ fn main_loop(session: &mut Session, terminal: &mut DefaultTerminal) -> Result<()
                     escs: &f.escs,
                     log: &f.log,
                     now: f.now,
+                    peak_total_w: f.peak_total_w,
                 },
                 None => View {
                     escs: &session.fleet.escs,
                     log: &session.fleet.log,
                     now: session.now(),
+                    peak_total_w: session.fleet.peak_total_w,
                 },
             };
             let started = Instant::now();
@@ -180,6 +186,7 @@ fn handle(ui: &mut Ui, session: &mut Session, event: Event) -> bool {
                     escs: session.fleet.escs.clone(),
                     log: session.fleet.log.clone(),
                     now: session.now(),
+                    peak_total_w: session.fleet.peak_total_w,
                 }),
             };
         }
@@ -240,20 +247,11 @@ fn draw(frame: &mut Frame, session: &Session, ui: &Ui, view: View<'_>) {
 
 fn draw_title(frame: &mut Frame, area: Rect, session: &Session, ui: &Ui, view: View<'_>) {
     let n = view.escs.len();
-    let mut spans = vec![
-        " hwfoc monitor ".bold().reversed(),
-        format!(
-            "  {n} ESC{}{}  ",
-            if n == 1 { "" } else { "s" },
-            if session.simulated { " (virtual)" } else { "" }
-        )
-        .into(),
-        super::local_time(view.now, "%H:%M:%S").into(),
-        format!("  {} frames", session.fleet.frames).dark_gray(),
-    ];
+    // What matters most first: a narrow terminal cuts the line on the right.
+    let mut spans = vec![" hwfoc monitor ".bold().reversed()];
     if let Some(recorder) = &session.recorder {
         spans.push("  ● REC ".red().bold());
-        spans.push(recorder.current().to_string().into());
+        spans.push(super::display_path(recorder.current()).into());
     }
     if ui.frozen.is_some() {
         spans.push("  PAUSED (p resumes)".yellow().bold());
@@ -261,6 +259,16 @@ fn draw_title(frame: &mut Frame, area: Rect, session: &Session, ui: &Ui, view: V
     if let Some(notice) = &session.notice {
         spans.push(format!("  {notice}").cyan());
     }
+    spans.push(
+        format!(
+            "  {n} ESC{}{}  ",
+            if n == 1 { "" } else { "s" },
+            if session.simulated { " (virtual)" } else { "" }
+        )
+        .into(),
+    );
+    spans.push(super::iso8601(view.now, false).into());
+    spans.push(format!("  {} frames", session.fleet.frames).dark_gray());
     frame.render_widget(Paragraph::new(Line::from(spans)), area);
 }
 
@@ -292,6 +300,8 @@ fn with_peak(
 }
 
 fn draw_table(frame: &mut Frame, area: Rect, ui: &Ui, view: View<'_>) {
+    let total_energy = total_energy(view.escs);
+    let total_power = total_power_w(view.escs);
     let compact = area.width < WIDE;
     let titles = if compact {
         [
@@ -393,9 +403,14 @@ fn draw_table(frame: &mut Frame, area: Rect, ui: &Ui, view: View<'_>) {
         .into_iter()
         .chain(widths[..10].iter().map(|&w| Constraint::Length(w)))
         .chain([Constraint::Fill(2)]);
+    let total = energy_line(total_power, view.peak_total_w, &total_energy, "all ESCs");
     let table = Table::new(rows, widths)
         .header(header)
-        .block(Block::new().borders(Borders::TOP | Borders::BOTTOM))
+        .block(
+            Block::new()
+                .borders(Borders::TOP | Borders::BOTTOM)
+                .title_bottom(total),
+        )
         .row_highlight_style(Style::new().bg(Color::DarkGray))
         .highlight_symbol("▶")
         .column_spacing(1);
@@ -437,9 +452,10 @@ fn draw_detail(frame: &mut Frame, area: Rect, index: usize, esc: &EscView, now: 
     ]));
     let inner = block.inner(area);
     frame.render_widget(block, area);
-    let [text, charts] = Layout::vertical([Constraint::Length(2), Constraint::Min(0)]).areas(inner);
+    let [text, charts] = Layout::vertical([Constraint::Length(3), Constraint::Min(0)]).areas(inner);
     frame.render_widget(
         Paragraph::new(vec![
+            energy_line(esc.power_w(), esc.energy.peak_w(), &esc.energy, "this ESC"),
             Line::from(info),
             Line::from(format!(
                 "{cells} · {} frames · {} bytes, {} skipped · {} checksum failures · {} restarts",
@@ -453,9 +469,20 @@ fn draw_detail(frame: &mut Frame, area: Rect, index: usize, esc: &EscView, now: 
         ]),
         text,
     );
+    if charts.height < 2 * MIN_CHART_HEIGHT {
+        draw_sparklines(frame, charts, esc, now);
+        return;
+    }
     let [top, low] = Layout::vertical([Constraint::Fill(1); 2]).areas(charts);
-    let [rpm_area, current_area] = Layout::horizontal([Constraint::Fill(1); 2]).areas(top);
-    let [volt_area, temp_area] = Layout::horizontal([Constraint::Fill(1); 2]).areas(low);
+    // Room between the charts side by side, so that one's last x label ("now") and the next
+    // one's y labels never run together.
+    let beside = |area| {
+        Layout::horizontal([Constraint::Fill(1); 2])
+            .spacing(CHART_GAP)
+            .areas(area)
+    };
+    let [rpm_area, current_area] = beside(top);
+    let [volt_area, temp_area] = beside(low);
     // Two braille dots per cell across: more points than that cannot show, so each column of
     // dots gets the lowest and highest value that fell in it (spikes stay visible).
     let columns = usize::from(rpm_area.width).max(1) * 2;
@@ -498,6 +525,121 @@ fn draw_detail(frame: &mut Frame, area: Rect, index: usize, esc: &EscView, now: 
         &[("MOS", Color::Red, &mos), ("CAP", Color::LightBlue, &cap)],
         false,
     );
+}
+
+/// `power 480 W (peak 1210 W) · used 312.5 mAh · 7.41 Wh`, and what it is of.
+fn energy_line(
+    power_w: Option<f64>,
+    peak_w: Option<f64>,
+    energy: &Energy,
+    of: &str,
+) -> Line<'static> {
+    let w = |p: Option<f64>| p.map_or("-".to_string(), |p| format!("{p:.0} W"));
+    Line::from(vec![
+        "power ".dark_gray(),
+        w(power_w).bold(),
+        format!(" (peak {})", w(peak_w)).dark_gray(),
+        " · used ".dark_gray(),
+        format!("{:.1} mAh", energy.charge_mah()).bold(),
+        " · ".dark_gray(),
+        format!("{:.2} Wh", energy.energy_wh()).bold(),
+        format!("  {of}, since start or c").dark_gray(),
+    ])
+}
+
+/// The rows of a chart at the least: its title, three rows of data, the x axis and its labels.
+const MIN_CHART_HEIGHT: u16 = 6;
+/// Columns between two charts side by side.
+const CHART_GAP: u16 = 3;
+/// The eight heights of a sparkline column.
+const BARS: [char; 8] = ['▁', '▂', '▃', '▄', '▅', '▆', '▇', '█'];
+
+/// The last minute of `points` (seconds before now, value) as `width` characters of a
+/// sparkline: each column the highest value that fell in it, scaled from the lowest to the
+/// highest of all (from zero when `from_zero`); a column without data is a space.
+fn sparkline(points: &[(f64, f64)], width: usize, from_zero: bool) -> String {
+    if width == 0 {
+        return String::new();
+    }
+    let mut columns: Vec<Option<f64>> = vec![None; width];
+    for &(t, v) in points {
+        if !v.is_finite() {
+            continue;
+        }
+        let c = ((t + HISTORY_S) / HISTORY_S * width as f64).floor();
+        if c >= 0.0 {
+            let slot = &mut columns[(c as usize).min(width - 1)];
+            *slot = Some(slot.map_or(v, |s: f64| s.max(v)));
+        }
+    }
+    let values = columns.iter().flatten();
+    let lo = values.clone().fold(f64::INFINITY, |a, &b| a.min(b));
+    let hi = values.fold(f64::NEG_INFINITY, |a, &b| a.max(b));
+    let lo = if from_zero { lo.min(0.0) } else { lo };
+    columns
+        .iter()
+        .map(|c| match c {
+            None => ' ',
+            Some(v) if hi > lo => {
+                let i = ((v - lo) / (hi - lo) * 7.0).round() as usize;
+                BARS[i.min(7)]
+            }
+            Some(_) => BARS[0],
+        })
+        .collect()
+}
+
+/// Where the charts do not fit (a terminal of 24 rows): one sparkline row per quantity, as many
+/// as there is room for, each with its latest value.
+fn draw_sparklines(frame: &mut Frame, area: Rect, esc: &EscView, now: f64) {
+    type Pick = fn(&super::fleet::Sample) -> Option<f32>;
+    let rows: [(&str, Color, Pick, usize, &str, bool); 4] = [
+        ("RPM", Color::Cyan, |s| Some(s.rpm), 0, "", true),
+        (
+            "Current",
+            Color::Yellow,
+            |s| Some(s.current_a),
+            1,
+            " A",
+            true,
+        ),
+        (
+            "Voltage",
+            Color::Green,
+            |s| Some(s.voltage_v),
+            1,
+            " V",
+            false,
+        ),
+        ("MOS temp", Color::Red, |s| s.mos_temp_c, 0, " °C", false),
+    ];
+    let label_width = 9;
+    let value_width = 10;
+    let width = usize::from(area.width).saturating_sub(label_width + value_width + 1);
+    let lines: Vec<Line> = rows
+        .iter()
+        .take(usize::from(area.height))
+        .map(|&(name, color, pick, decimals, unit, from_zero)| {
+            let points: Vec<(f64, f64)> = esc
+                .history
+                .iter()
+                .filter_map(|s| pick(s).map(|v| (s.t - now, f64::from(v))))
+                .collect();
+            let latest = esc
+                .history
+                .back()
+                .and_then(pick)
+                .map_or("-".to_string(), |v| {
+                    format!("{}{unit}", number(v, decimals))
+                });
+            Line::from(vec![
+                Span::raw(format!("{name:<label_width$}")).bold(),
+                Span::styled(sparkline(&points, width, from_zero), Style::new().fg(color)),
+                Span::raw(format!(" {latest:>value_width$}")),
+            ])
+        })
+        .collect();
+    frame.render_widget(Paragraph::new(lines), area);
 }
 
 /// `points` (seconds before now, value; in time order) reduced to at most two per column of a
@@ -620,7 +762,13 @@ fn draw_log(frame: &mut Frame, area: Rect, view: View<'_>) {
             let name = view.escs.get(e.esc).map_or("", |esc| esc.title());
             ListItem::new(Line::from(vec![
                 Span::styled(
-                    super::local_time(e.t, "%H:%M:%S "),
+                    // ISO 8601: the date and time where there is room, the time of day where
+                    // there is not.
+                    if area.width >= WIDE / 2 + 20 {
+                        format!("{} ", super::iso8601(e.t, false))
+                    } else {
+                        super::local_time(e.t, "%H:%M:%S ")
+                    },
                     Style::new().fg(Color::DarkGray),
                 ),
                 Span::raw(format!("esc{} ", e.esc)),

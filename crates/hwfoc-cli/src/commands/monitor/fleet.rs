@@ -10,6 +10,7 @@ use hwfoc_io::stream::EscLink;
 use super::alarms::{Change, Kind, Latch, Level, Threshold};
 use super::config::Limits;
 use hwfoc_io::InputError;
+use hwfoc_io::energy::Energy;
 use hwfoc_io::handler::Handler;
 use hwfoc_io::record::Record;
 use hwfoc_io::serial::PortEvent;
@@ -172,6 +173,8 @@ pub struct EscView {
     pub name: String,
     /// Its label from the configuration, if any.
     pub label: Option<String>,
+    /// The settings its frames are converted under.
+    pub settings: Settings,
     /// Whether the port is there.
     pub link: Link,
     /// The latest data frame.
@@ -180,6 +183,8 @@ pub struct EscView {
     pub last_frame_t: Option<f64>,
     /// Extremes since the start or the last reset.
     pub peaks: Peaks,
+    /// Charge, energy and peak power since the start or the last reset.
+    pub energy: Energy,
     /// The last minute.
     pub history: VecDeque<Sample>,
     /// The latest device-information frame.
@@ -207,6 +212,13 @@ impl EscView {
             .filter(|&&t| t > now - RATE_WINDOW_S)
             .count();
         n as f64 / RATE_WINDOW_S
+    }
+
+    /// Electrical input power of the latest frame, W.
+    pub fn power_w(&self) -> Option<f64> {
+        self.last
+            .as_ref()
+            .map(|r| f64::from(r.voltage_v) * f64::from(r.current_a))
     }
 
     /// Seconds since the latest frame, at `now`.
@@ -251,7 +263,7 @@ pub struct LogEntry {
 impl LogEntry {
     /// What happened, in words: `mos_temp warning raised at 91.0 degC`,
     /// `mos_overheat critical raised`, `low_voltage escalated to critical at 19.7 V`,
-    /// `stale cleared after 3.2 s`.
+    /// `stale warning cleared after 3.2 s` (a clear names the highest level of its episode).
     pub fn text(&self) -> String {
         let name = self.kind.name();
         let unit = match self.kind {
@@ -263,13 +275,17 @@ impl LogEntry {
         match self.change {
             Change::Raised(level) => format!("{name} {level} raised{}", at(self.value)),
             Change::Escalated => format!("{name} escalated to critical{}", at(self.value)),
-            Change::Cleared { duration_s, worst } => {
+            Change::Cleared {
+                level,
+                duration_s,
+                worst,
+            } => {
                 let worst = match (worst, self.kind) {
                     (Some(w), Kind::LowVoltage) => format!(" (lowest {w:.1}{unit})"),
                     (Some(w), _) => format!(" (highest {w:.1}{unit})"),
                     (None, _) => String::new(),
                 };
-                format!("{name} cleared after {duration_s:.1} s{worst}")
+                format!("{name} {level} cleared after {duration_s:.1} s{worst}")
             }
         }
     }
@@ -284,6 +300,24 @@ impl LogEntry {
     }
 }
 
+/// Charge and energy of `escs` together (and the largest peak power of one of them).
+pub fn total_energy(escs: &[EscView]) -> Energy {
+    let mut total = Energy::new();
+    for esc in escs {
+        total.merge(&esc.energy);
+    }
+    total
+}
+
+/// Electrical input power of the connected ones of `escs` together now, W: the sum of their
+/// latest frames (`None` before any frame).
+pub fn total_power_w(escs: &[EscView]) -> Option<f64> {
+    escs.iter()
+        .filter(|e| e.link == Link::Up)
+        .filter_map(EscView::power_w)
+        .fold(None, |sum, p| Some(sum.unwrap_or(0.0) + p))
+}
+
 /// Every ESC watched, their decoders and the alarm log.
 pub struct Fleet {
     /// What is shown of each ESC.
@@ -294,30 +328,33 @@ pub struct Fleet {
     pub logged: u64,
     /// Data frames decoded in all.
     pub frames: u64,
+    /// Highest power of all ESCs together (the sum of their latest frames), W, since the start
+    /// or the last reset.
+    pub peak_total_w: Option<f64>,
     streams: PortStreams,
-    settings: Settings,
     limits: Limits,
 }
 
 impl Fleet {
-    /// ESCs named `names` (labels beside them), watched from Unix time `now`, their bytes
-    /// arriving at `baud`.
+    /// ESCs named `names` (labels and conversion settings beside them), watched from Unix time
+    /// `now`, their bytes arriving at `baud`.
     pub fn new(
-        names: Vec<(String, Option<String>)>,
-        settings: Settings,
+        names: Vec<(String, Option<String>, Settings)>,
         limits: Limits,
         baud: u32,
         now: f64,
     ) -> Fleet {
         let escs = names
             .into_iter()
-            .map(|(name, label)| EscView {
+            .map(|(name, label, settings)| EscView {
                 name,
                 label,
+                settings,
                 link: Link::Up,
                 last: None,
                 last_frame_t: None,
                 peaks: Peaks::default(),
+                energy: Energy::new(),
                 history: VecDeque::new(),
                 info: None,
                 stats: EscLink::default(),
@@ -329,12 +366,12 @@ impl Fleet {
             })
             .collect::<Vec<_>>();
         Fleet {
-            streams: PortStreams::new(escs.len(), baud, settings),
+            streams: PortStreams::with_settings(baud, escs.iter().map(|e| e.settings).collect()),
             escs,
             log: VecDeque::new(),
             logged: 0,
             frames: 0,
-            settings,
+            peak_total_w: None,
             limits,
         }
     }
@@ -342,11 +379,6 @@ impl Fleet {
     /// The alarm levels in force.
     pub fn limits(&self) -> &Limits {
         &self.limits
-    }
-
-    /// The conversion settings.
-    pub fn settings(&self) -> &Settings {
-        &self.settings
     }
 
     /// Takes in what a port (or a virtual ESC) reported; returns the number of data frames it
@@ -375,11 +407,16 @@ impl Fleet {
                 }
                 self.escs[*port].stats = stats;
                 self.frames += data as u64;
+                if data > 0 {
+                    self.note_total_power();
+                }
                 data
             }
             PortEvent::Lost { port, t_ns, reason } => {
                 let t = *t_ns as f64 / 1e9;
                 if let Some(esc) = self.escs.get_mut(*port) {
+                    // No current is assumed over the time the port was away.
+                    esc.energy.break_here();
                     esc.link = Link::Down {
                         since: t,
                         reason: reason.clone(),
@@ -416,6 +453,8 @@ impl Fleet {
         esc.last = Some(r);
         esc.last_frame_t = Some(t);
         esc.peaks.add(&r);
+        esc.energy
+            .add(Some(t), f64::from(r.voltage_v), f64::from(r.current_a));
         esc.recent.push_back(t);
         while esc.recent.front().is_some_and(|&f| f <= t - RATE_WINDOW_S) {
             esc.recent.pop_front();
@@ -491,23 +530,46 @@ impl Fleet {
         }
     }
 
-    /// Forgets the peaks of every ESC.
+    fn note_total_power(&mut self) {
+        if let Some(p) = self.total_power_w() {
+            self.peak_total_w = Some(self.peak_total_w.map_or(p, |peak| peak.max(p)));
+        }
+    }
+
+    /// Forgets the peaks, the charge and the energy of every ESC (counting starts again from
+    /// the latest frame).
     pub fn reset_peaks(&mut self) {
+        self.peak_total_w = None;
         for esc in &mut self.escs {
             esc.peaks = Peaks::default();
+            esc.energy = Energy::new();
             if let Some(r) = &esc.last {
                 esc.peaks.add(r);
+                let t = esc.last_frame_t.or(r.t_s);
+                esc.energy
+                    .add(t, f64::from(r.voltage_v), f64::from(r.current_a));
             }
         }
+        self.note_total_power();
+    }
+
+    /// Charge and energy of all ESCs together.
+    pub fn total_energy(&self) -> Energy {
+        total_energy(&self.escs)
+    }
+
+    /// Electrical input power of all ESCs now, W: the sum of each one's latest frame (`None`
+    /// before any frame).
+    pub fn total_power_w(&self) -> Option<f64> {
+        total_power_w(&self.escs)
     }
 
     fn note(&mut self, esc: usize, kind: Kind, change: Option<Change>, t: f64, value: Option<f64>) {
         let Some(change) = change else { return };
-        let latch = self.escs[esc].alarms.latch(kind);
         let level = match change {
             Change::Raised(level) => level,
             Change::Escalated => Level::Critical,
-            Change::Cleared { .. } => latch.level().unwrap_or(Level::Warning),
+            Change::Cleared { level, .. } => level,
         };
         if self.log.len() == LOG_MAX {
             self.log.pop_front();
@@ -539,12 +601,17 @@ mod tests {
 
     fn fleet(n: usize) -> Fleet {
         let config = Config::load(&Overrides {
-            no_config: true,
+            settings: crate::args::SettingsArgs {
+                no_config: true,
+                ..Default::default()
+            },
             ..Overrides::default()
         })
         .unwrap();
-        let names = (0..n).map(|i| (format!("esc{i}"), None)).collect();
-        Fleet::new(names, config.settings, config.limits, 19_200, 1000.0)
+        let names = (0..n)
+            .map(|i| (format!("esc{i}"), None, Settings::DEFAULT))
+            .collect();
+        Fleet::new(names, config.limits, 19_200, 1000.0)
     }
 
     fn frame(packet: u16, status: Status, mos_code: u8, volt_raw: u16) -> Vec<u8> {
@@ -625,6 +692,15 @@ mod tests {
                 "esc0 mos_overheat raised critical",
                 "esc0 mos_overheat cleared"
             ]
+        );
+        // The clear names the level the alarm had (it was once logged as a warning).
+        assert_eq!(f.log[1].level, Level::Critical);
+        assert!(
+            f.log[1]
+                .text()
+                .starts_with("mos_overheat critical cleared after 1.4"),
+            "{}",
+            f.log[1].text()
         );
         // On from frame 10 (0.5 s), last on at frame 29 (1.45 s), cleared 0.5 s later.
         match f.log[1].change {
@@ -716,6 +792,68 @@ mod tests {
         );
         f.on_event(&data(1, 1000.0, vec![0x55; 10]));
         assert_eq!(f.escs[1].waiting(), "no frames yet");
+    }
+
+    #[test]
+    fn charge_energy_and_power_per_esc_and_in_total_reset_with_the_peaks() {
+        let mut f = fleet(2);
+        // 12.8 A (raw 819 at scale 64) at 25.0 V on ESC 0, half that on ESC 1, for 3.6 s.
+        let frame = |packet: u16, amps_raw: i16| {
+            DataFrame {
+                packet,
+                current_raw: amps_raw,
+                voltage_raw: 250,
+                ..Default::default()
+            }
+            .encode()
+            .to_vec()
+        };
+        for k in 0..=72u16 {
+            let t = 1000.0 + f64::from(k) * 0.05;
+            f.on_event(&data(0, t, frame(k, 819)));
+            f.on_event(&data(1, t + 0.01, frame(k, 410)));
+        }
+        let amps0 = 819.0 / 64.0;
+        let amps1 = 410.0 / 64.0;
+        let e0 = &f.escs[0].energy;
+        assert!(
+            (e0.charge_mah() - amps0 * 1000.0 / 1000.0).abs() < 0.01,
+            "{}",
+            e0.charge_mah()
+        );
+        assert!((e0.energy_wh() - amps0 * 25.0 * 3.6 / 3600.0).abs() < 1e-3);
+        let p0 = f.escs[0].power_w().unwrap();
+        assert!((p0 - amps0 * 25.0).abs() < 0.01, "{p0}");
+        let total = f.total_energy();
+        assert!(
+            (total.charge_mah() - (amps0 + amps1)).abs() < 0.02,
+            "{}",
+            total.charge_mah()
+        );
+        let sum = f.total_power_w().unwrap();
+        assert!((sum - (amps0 + amps1) * 25.0).abs() < 0.1, "{sum}");
+        assert!((f.peak_total_w.unwrap() - sum).abs() < 0.1);
+        // A burst on ESC 0 raises the total's peak; reset forgets it, and the charge.
+        f.on_event(&data(0, 1003.65, frame(73, 3276)));
+        let peak = f.peak_total_w.unwrap();
+        // 51.2 A at 25 V plus ESC 1's 160 W.
+        assert!(
+            (peak - (3276.0 / 64.0 + amps1) * 25.0).abs() < 0.1,
+            "{peak}"
+        );
+        f.on_event(&data(0, 1003.70, frame(74, 819)));
+        assert_eq!(f.peak_total_w, Some(peak));
+        f.reset_peaks();
+        assert_eq!(f.escs[0].energy.charge_mah(), 0.0);
+        assert!((f.peak_total_w.unwrap() - sum).abs() < 0.1);
+        assert_eq!(f.escs[0].energy.peak_w(), f.escs[0].power_w());
+        // A port that goes away adds nothing for the time it was away, nor counts in the total.
+        f.on_event(&PortEvent::Lost {
+            port: 1,
+            t_ns: 1_004_000_000_000,
+            reason: "unplugged".into(),
+        });
+        assert_eq!(f.total_power_w(), f.escs[0].power_w());
     }
 
     #[test]

@@ -11,6 +11,7 @@ use serde_json::{Value, json};
 use super::fleet::{EscView, Fleet, Link, LogEntry};
 use super::{Session, number};
 use crate::error::CliError;
+use hwfoc_io::energy::Energy;
 use hwfoc_io::record::Record;
 use hwfoc_io::write::WriteError;
 
@@ -43,10 +44,20 @@ pub fn run(session: &mut Session, json: bool, interval_s: f64) -> Result<(), Cli
         if Instant::now() >= next_status {
             for (i, esc) in session.fleet.escs.iter().enumerate() {
                 if json {
-                    writeln!(text, "{}", status_json(&session.fleet, i, esc, now)).ok();
+                    writeln!(text, "{}", status_json(i, esc, now)).ok();
                 } else {
                     writeln!(text, "{}", status_line(i, esc, now)).ok();
                 }
+            }
+            // All ESCs together, when there are several.
+            let fleet = &session.fleet;
+            let total = match (fleet.escs.len() > 1, json) {
+                (false, _) => None,
+                (true, true) => Some(total_json(fleet, now).to_string()),
+                (true, false) => Some(total_line(fleet, now)),
+            };
+            if let Some(total) = total {
+                writeln!(text, "{total}").ok();
             }
             // Skip intervals missed (a suspended machine) rather than printing a burst: the next
             // status is due one interval after the last one due, counted without a loop.
@@ -72,11 +83,58 @@ pub fn run(session: &mut Session, json: bool, interval_s: f64) -> Result<(), Cli
 
 /// Local time with its UTC offset and milliseconds: `2026-11-22T14:03:22.150+01:00`.
 pub fn timestamp(t: f64) -> String {
-    super::local_time(t, "%Y-%m-%dT%H:%M:%S%.3f%:z")
+    super::iso8601(t, true)
+}
+
+/// `power 480 W (peak 1210 W) used 312.5 mAh 7.41 Wh`: power now (`-` without a frame), the
+/// peak, charge and energy since the start or the last reset.
+fn energy_text(power_w: Option<f64>, peak_w: Option<f64>, energy: &Energy) -> String {
+    let w = |p: Option<f64>| p.map_or("-".to_string(), |p| format!("{p:.0} W"));
+    format!(
+        "power {} (peak {}) used {:.1} mAh {:.2} Wh",
+        w(power_w),
+        w(peak_w),
+        energy.charge_mah(),
+        energy.energy_wh()
+    )
+}
+
+fn energy_json(power_w: Option<f64>, peak_w: Option<f64>, energy: &Energy) -> Value {
+    json!({
+        "power_w": power_w,
+        "peak_power_w": peak_w,
+        "charge_mah": energy.charge_mah(),
+        "energy_wh": energy.energy_wh(),
+    })
+}
+
+/// `2026-… total: power 960 W (peak 1210 W) used 625.0 mAh 14.82 Wh`: all ESCs together (the
+/// peak is the highest sum of their powers).
+fn total_line(fleet: &Fleet, now: f64) -> String {
+    format!(
+        "{} total: {}",
+        timestamp(now),
+        energy_text(
+            fleet.total_power_w(),
+            fleet.peak_total_w,
+            &fleet.total_energy()
+        )
+    )
+}
+
+fn total_json(fleet: &Fleet, now: f64) -> Value {
+    json!({
+        "type": "total",
+        "time": timestamp(now),
+        "t_s": now,
+        "escs": fleet.escs.len(),
+        "energy": energy_json(fleet.total_power_w(), fleet.peak_total_w, &fleet.total_energy()),
+    })
 }
 
 /// `2026-… esc0 /dev/ttyUSB0: thr 50.0/48.2 % 12000 rpm 24.1 V 20.3 A (phase 35.1 A) mos 45.0C
-/// cap 40.0C | 20.0 fr/s lost 0 dup 0 crc 0 | age 0.03 s | ok`
+/// cap 40.0C | 20.0 fr/s lost 0 dup 0 crc 0 | age 0.03 s | power 489 W (peak 520 W) used
+/// 12.5 mAh 0.30 Wh | ok`
 fn status_line(i: usize, esc: &EscView, now: f64) -> String {
     let mut line = format!("{} esc{i} {}: ", timestamp(now), esc.title());
     match (&esc.link, &esc.last) {
@@ -103,6 +161,12 @@ fn status_line(i: usize, esc: &EscView, now: f64) -> String {
                 esc.stats.checksum_failures(),
                 esc.stats.restarts(),
                 esc.age(now).unwrap_or(0.0),
+            ));
+            line.push_str(" | ");
+            line.push_str(&energy_text(
+                esc.power_w(),
+                esc.energy.peak_w(),
+                &esc.energy,
             ));
         }
     }
@@ -136,7 +200,9 @@ fn alarm_line(entry: &LogEntry, esc: &EscView) -> String {
 
 fn alarm_json(entry: &LogEntry, esc: &EscView) -> Value {
     let (duration_s, worst) = match entry.change {
-        super::alarms::Change::Cleared { duration_s, worst } => (Some(duration_s), worst),
+        super::alarms::Change::Cleared {
+            duration_s, worst, ..
+        } => (Some(duration_s), worst),
         _ => (None, None),
     };
     json!({
@@ -156,7 +222,7 @@ fn alarm_json(entry: &LogEntry, esc: &EscView) -> Value {
     })
 }
 
-fn status_json(fleet: &Fleet, i: usize, esc: &EscView, now: f64) -> Value {
+fn status_json(i: usize, esc: &EscView, now: f64) -> Value {
     let record = esc.last.as_ref().map(record_json);
     let (link, down_since, reason) = match &esc.link {
         Link::Up => ("up", None, None),
@@ -197,6 +263,7 @@ fn status_json(fleet: &Fleet, i: usize, esc: &EscView, now: f64) -> Value {
             "mos_temp_c": p.mos_temp_c,
             "cap_temp_c": p.cap_temp_c,
         },
+        "energy": energy_json(esc.power_w(), esc.energy.peak_w(), &esc.energy),
         "battery_cells": esc.cells,
         "info": esc.info.as_ref().map(|info| json!({
             "product": info.product(),
@@ -206,9 +273,9 @@ fn status_json(fleet: &Fleet, i: usize, esc: &EscView, now: f64) -> Value {
         })),
         "alarms": alarms,
         "settings": {
-            "current_scale": fleet.settings().current_scale,
-            "pole_pairs": fleet.settings().pole_pairs,
-            "gear_ratio": fleet.settings().gear_ratio,
+            "current_scale": esc.settings.current_scale,
+            "pole_pairs": esc.settings.pole_pairs,
+            "gear_ratio": esc.settings.gear_ratio,
         },
     })
 }

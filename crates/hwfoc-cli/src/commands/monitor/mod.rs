@@ -26,6 +26,7 @@ use self::feed::{Feed, Msg};
 use self::fleet::Fleet;
 use self::perf::Perf;
 use super::capture::{self, Recorder};
+use crate::args::SettingsArgs;
 use crate::commands::simulate::ModelArgs;
 use crate::error::CliError;
 use hwfoc_io::serial::PortEvent;
@@ -74,31 +75,20 @@ pub struct MonitorArgs {
     /// Let --record replace an existing file of that name (never done unasked).
     #[arg(long, requires = "record")]
     overwrite: bool,
-    /// Where the r key puts its recordings (hwfoc-DATE-TIME.pcapng) [default: .].
+    /// Where the r key puts its recordings (hwfoc-DATE-TIME.pcapng), made if need be (mode 0700)
+    /// [default: from the configuration file, else hwfoc/recordings in the user's data
+    /// directory: ~/.local/share/hwfoc/recordings].
     #[arg(long, value_name = "DIR")]
     record_dir: Option<PathBuf>,
     /// A name for each ESC, in order (repeat the option).
     #[arg(long = "label", value_name = "TEXT")]
     labels: Vec<String>,
-    /// Configuration file [default: hwfoc/monitor.toml in the user's configuration directory,
-    /// if it exists].
-    #[arg(long, value_name = "FILE")]
-    config: Option<PathBuf>,
-    /// Read no configuration file.
-    #[arg(long, conflicts_with = "config")]
-    no_config: bool,
-    /// Baud rate of the ports (8N1) [default: 19200].
+    /// Baud rate of the ports (8N1) [default: from the configuration file, else 19200].
     #[arg(long, value_name = "N")]
     baud: Option<u32>,
-    /// Raw current units per ampere [default: 64].
-    #[arg(long, value_name = "N")]
-    current_scale: Option<f32>,
-    /// Motor pole pairs, for RPM [default: 7].
-    #[arg(long, value_name = "N")]
-    pole_pairs: Option<u16>,
-    /// Gear ratio between motor and output shaft, for RPM [default: 1].
-    #[arg(long, value_name = "X")]
-    gear_ratio: Option<f32>,
+    /// Conversion settings and the configuration file.
+    #[command(flatten)]
+    settings: SettingsArgs,
     /// Alarm levels.
     #[command(flatten)]
     alarms: AlarmKeys,
@@ -132,12 +122,8 @@ const MIN_INTERVAL_S: f64 = 0.05;
 /// Runs `hwfoc monitor`.
 pub fn run(args: &MonitorArgs) -> Result<(), CliError> {
     let config = Config::load(&Overrides {
-        config: args.config.clone(),
-        no_config: args.no_config,
+        settings: args.settings.clone(),
         baud: args.baud,
-        current_scale: args.current_scale,
-        pole_pairs: args.pole_pairs,
-        gear_ratio: args.gear_ratio,
         record_dir: args.record_dir.clone(),
         alarms: args.alarms.clone(),
     })?;
@@ -193,6 +179,8 @@ pub struct Session {
     record_dir: PathBuf,
     /// Whether `--record` may replace an existing file.
     overwrite: bool,
+    /// The recordings finished so far, to name on exit.
+    recorded: Vec<String>,
     interrupted: Arc<AtomicBool>,
     stop_at: Option<Instant>,
 }
@@ -212,7 +200,7 @@ impl Session {
                     &args.model,
                     usize::from(n),
                     config.baud,
-                    &config.settings,
+                    config.settings.default_settings(),
                     tx.clone(),
                 )?;
                 let names = (0..n).map(|i| format!("sim:esc{i}")).collect();
@@ -224,7 +212,7 @@ impl Session {
                     message: format!(
                         "no ports to watch: name them (e.g. `hwfoc monitor /dev/ttyUSB0`), list \
                          them in {}, or try the virtual ESCs: `hwfoc monitor --sim 4`",
-                        config::default_path()
+                        crate::config::default_path()
                             .map_or("the configuration file".into(), |p| p.display().to_string())
                     ),
                 });
@@ -242,8 +230,8 @@ impl Session {
                     .labels
                     .get(i)
                     .cloned()
-                    .or_else(|| config.label(name).map(str::to_string));
-                (name.clone(), label)
+                    .or_else(|| config.label(i, name).map(str::to_string));
+                (name.clone(), label, config.settings_of(i, name))
             })
             .collect();
         // The ports' own clock, so that ages and recordings agree with their timestamps.
@@ -252,13 +240,7 @@ impl Session {
             Feed::Simulated { .. } => hwfoc_io::clock::Clock::new(),
         };
         let now = clock.now_ns() as f64 / 1e9;
-        let fleet = Fleet::new(
-            labelled,
-            config.settings,
-            config.limits.clone(),
-            config.baud,
-            now,
-        );
+        let fleet = Fleet::new(labelled, config.limits.clone(), config.baud, now);
         let mut session = Session {
             fleet,
             recorder: None,
@@ -274,6 +256,7 @@ impl Session {
             baud: config.baud,
             record_dir: config.record_dir,
             overwrite: args.overwrite,
+            recorded: Vec::new(),
             interrupted,
             stop_at: args
                 .duration
@@ -385,7 +368,7 @@ impl Session {
             overwrite: self.overwrite,
         };
         self.recorder = Some(Recorder::new(plan, &self.names, self.clock)?);
-        self.notice = Some(format!("recording to {path}"));
+        self.notice = None;
         Ok(())
     }
 
@@ -395,9 +378,17 @@ impl Session {
         if let Some(mut recorder) = self.recorder.take() {
             let file = recorder.current().to_string();
             self.notice = Some(match recorder.close() {
-                Ok(()) => format!("recorded to {file}"),
+                Ok(()) => format!("recorded to {}", display_path(&file)),
                 Err(e) => format!("recording stopped: {e}"),
             });
+            self.recorded.push(file);
+            return;
+        }
+        if let Err(e) = make_private_dir(&self.record_dir) {
+            self.notice = Some(format!(
+                "cannot record: cannot make {}: {e}",
+                display_path(&self.record_dir.display().to_string())
+            ));
             return;
         }
         let stamp = jiff::Zoned::now().strftime("%Y%m%d-%H%M%S").to_string();
@@ -419,15 +410,39 @@ impl Session {
                 self.take(event);
             }
         }
-        match self.recorder.take() {
+        let closed = match self.recorder.take() {
             Some(mut recorder) => {
                 let file = recorder.current().to_string();
-                recorder.close()?;
-                eprintln!("hwfoc: recorded to {file}");
-                Ok(())
+                let closed = recorder.close();
+                self.recorded.push(file);
+                closed
             }
             None => Ok(()),
+        };
+        for file in &self.recorded {
+            eprintln!("hwfoc: recorded to {file}");
         }
+        closed
+    }
+}
+
+/// Makes `dir` and its missing parents, readable by the user alone (mode 0700 on Unix: a
+/// recording may say where and when a vehicle flew); a directory already there is left as it is.
+fn make_private_dir(dir: &std::path::Path) -> std::io::Result<()> {
+    let mut builder = std::fs::DirBuilder::new();
+    builder.recursive(true);
+    #[cfg(unix)]
+    std::os::unix::fs::DirBuilderExt::mode(&mut builder, 0o700);
+    builder.create(dir)
+}
+
+/// `path` with the user's home directory written `~`, for a line that has little room.
+pub fn display_path(path: &str) -> String {
+    match dirs::home_dir().and_then(|h| h.to_str().map(str::to_string)) {
+        Some(home) if home.len() > 1 && path.starts_with(&format!("{home}/")) => {
+            format!("~{}", &path[home.len()..])
+        }
+        _ => path.to_string(),
     }
 }
 
@@ -441,6 +456,20 @@ fn free_name(dir: &std::path::Path, stamp: &str) -> Option<PathBuf> {
     (1..1000)
         .map(|n| dir.join(name(n)))
         .find(|p| std::fs::symlink_metadata(p).is_err())
+}
+
+/// Unix time `t` (seconds) as ISO 8601 local time with its UTC offset:
+/// `2026-11-22T14:03:22+01:00`, or with milliseconds `2026-11-22T14:03:22.150+01:00`.
+///
+/// The one place the monitor writes a date and time (with `jiff`); when `hwfoc_io` formats
+/// times itself, this calls it.
+pub fn iso8601(t: f64, millis: bool) -> String {
+    let pattern = if millis {
+        "%Y-%m-%dT%H:%M:%S%.3f%:z"
+    } else {
+        "%Y-%m-%dT%H:%M:%S%:z"
+    };
+    local_time(t, pattern)
 }
 
 /// Unix time `t` (seconds) as local time, formatted with the strftime `pattern`.
@@ -466,6 +495,41 @@ pub fn number(v: f32, decimals: usize) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_recording_directory_is_made_private_on_demand() {
+        let dir = tempfile::tempdir().unwrap();
+        let deep = dir.path().join("share/hwfoc/recordings");
+        make_private_dir(&deep).unwrap();
+        assert!(deep.is_dir());
+        #[cfg(unix)]
+        {
+            use std::os::unix::fs::PermissionsExt;
+            let mode = std::fs::metadata(&deep).unwrap().permissions().mode();
+            assert_eq!(mode & 0o777, 0o700, "{mode:o}");
+        }
+        // Again: nothing changes, nothing fails.
+        std::fs::write(deep.join("kept.pcapng"), "a recording").unwrap();
+        make_private_dir(&deep).unwrap();
+        assert!(deep.join("kept.pcapng").is_file());
+        // A file in the way is an error, not replaced.
+        let file = dir.path().join("file");
+        std::fs::write(&file, "x").unwrap();
+        assert!(make_private_dir(&file).is_err());
+        assert_eq!(std::fs::read(&file).unwrap(), b"x");
+    }
+
+    #[test]
+    fn paths_under_home_are_shown_short() {
+        let Some(home) = dirs::home_dir() else { return };
+        let home = home.display().to_string();
+        if home.len() <= 1 {
+            return;
+        }
+        assert_eq!(display_path(&format!("{home}/a/b.pcapng")), "~/a/b.pcapng");
+        assert_eq!(display_path("/elsewhere/b.pcapng"), "/elsewhere/b.pcapng");
+        assert_eq!(display_path(&format!("{home}x/b")), format!("{home}x/b"));
+    }
 
     #[test]
     fn recordings_started_within_a_second_get_their_own_names() {

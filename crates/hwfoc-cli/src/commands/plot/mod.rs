@@ -68,7 +68,8 @@ pub struct Options {
 
 /// `hwfoc plot`: reads the inputs and writes the image.
 pub fn run(args: &PlotArgs) -> Result<(), CliError> {
-    let settings = args.settings.settings()?;
+    let (_, settings_map) = args.settings.settings_map()?;
+    let settings = *settings_map.default_settings();
     let selection = args.select.selection()?;
     // Opened first, so that a wrong name is reported before the inputs are read; a file
     // created here is removed again if the plot is not written.
@@ -80,7 +81,7 @@ pub fn run(args: &PlotArgs) -> Result<(), CliError> {
         title: args.title.clone(),
         escs: args.select.esc.clone(),
     };
-    let mut sources = Sources::new(args.input.open_all()?, settings);
+    let mut sources = Sources::new(args.input.open_all()?, settings_map);
     if selection.window.is_limited() {
         sources.require_timing()?;
     }

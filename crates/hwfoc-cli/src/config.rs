@@ -1,0 +1,553 @@
+//! The configuration file: the settings every command would otherwise be told again and again
+//! (current scale, pole pairs, gear ratio: per ESC and per port as well as for all), the
+//! monitor's alarm levels, ports and labels.
+//!
+//! Where it is: `--config FILE`, else the file named by the `HWFOC_CONFIG` environment variable,
+//! else `hwfoc/config.toml` in the user's configuration directory (`$XDG_CONFIG_HOME`, by default
+//! `~/.config`, on Linux; `~/Library/Application Support` on macOS; `%APPDATA%` on Windows) if it
+//! exists. `--no-config` reads none. `hwfoc monitor` also reads the older `hwfoc/monitor.toml`
+//! there when there is no `config.toml` (its layout is read as before: see [`File`]).
+//!
+//! ```toml
+//! [settings]              # every ESC, unless said otherwise below
+//! current_scale = 64.0
+//! pole_pairs = 7
+//! gear_ratio = 1.0
+//!
+//! [port."/dev/ttyUSB1"]   # the ESC read from this port (a serial port, or a port named in a
+//! pole_pairs = 14         # recording); `label` names it in the monitor
+//! label = "tail"
+//!
+//! [esc.2]                 # ESC 2 (the `esc` column), whatever it is read from
+//! current_scale = 100.0
+//!
+//! [monitor]
+//! ports = ["/dev/ttyUSB0", "/dev/ttyUSB1"]   # watched when none are named
+//! baud = 19200
+//! record_dir = "/home/pi/recordings"
+//!
+//! [alarms]                # the monitor's levels: see `hwfoc monitor --help`
+//! mos_warning_c = 90
+//! ```
+//!
+//! Precedence, field by field: a command-line flag, then the ESC's `[esc.N]` entry, then its
+//! port's `[port."NAME"]` entry, then `[settings]`, then the built-in defaults. Unknown keys are
+//! errors naming the file, the line and the key.
+
+use std::collections::BTreeMap;
+use std::fmt;
+use std::path::{Path, PathBuf};
+
+use hwfoc::Settings;
+use hwfoc_io::InputError;
+use hwfoc_io::input::read_small_file;
+use hwfoc_io::settings::{SettingsMap, SettingsPatch};
+use serde::Deserialize;
+use serde::de::{self, Deserializer, MapAccess, SeqAccess, Visitor};
+
+use crate::args::SettingsArgs;
+use crate::error::CliError;
+
+/// The environment variable that names a configuration file (`--config` wins over it).
+pub const ENV: &str = "HWFOC_CONFIG";
+
+/// The file's layout. Every key is optional.
+///
+/// The older `monitor.toml` layout is read too: `baud`, `current_scale`, `pole_pairs`,
+/// `gear_ratio` and `record_dir` at the top (today in `[settings]` and `[monitor]`), and
+/// `[[esc]]` entries each naming a `port` (a port to watch and its label).
+#[derive(Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct File {
+    /// Settings of every ESC.
+    #[serde(default)]
+    settings: Entry,
+    /// Entries by port name.
+    #[serde(default)]
+    port: BTreeMap<String, Entry>,
+    /// `[esc.N]` entries, or the older `[[esc]]` list.
+    #[serde(default)]
+    esc: EscSection,
+    /// The monitor's own keys.
+    #[serde(default)]
+    pub monitor: MonitorKeys,
+    /// The monitor's alarm levels.
+    #[serde(default)]
+    pub alarms: AlarmKeys,
+    // The older layout's top-level keys.
+    baud: Option<u32>,
+    current_scale: Option<f32>,
+    pole_pairs: Option<u16>,
+    gear_ratio: Option<f32>,
+    record_dir: Option<PathBuf>,
+}
+
+/// Settings of every ESC, of a port's or of one ESC.
+#[derive(Debug, Default, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct Entry {
+    current_scale: Option<f32>,
+    pole_pairs: Option<u16>,
+    gear_ratio: Option<f32>,
+    /// A name shown by the monitor (not in `[settings]`).
+    label: Option<String>,
+}
+
+impl Entry {
+    fn patch(&self) -> SettingsPatch {
+        SettingsPatch {
+            current_scale: self.current_scale,
+            pole_pairs: self.pole_pairs,
+            gear_ratio: self.gear_ratio,
+        }
+    }
+}
+
+/// An entry of the older `[[esc]]` list: a port, and settings for it.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct PortEntry {
+    port: String,
+    current_scale: Option<f32>,
+    pole_pairs: Option<u16>,
+    gear_ratio: Option<f32>,
+    label: Option<String>,
+}
+
+impl PortEntry {
+    fn entry(&self) -> Entry {
+        Entry {
+            current_scale: self.current_scale,
+            pole_pairs: self.pole_pairs,
+            gear_ratio: self.gear_ratio,
+            label: self.label.clone(),
+        }
+    }
+}
+
+/// `esc`: a table of ESC indices (`[esc.3]`), or the older list of ports (`[[esc]]`).
+#[derive(Debug, Default)]
+enum EscSection {
+    #[default]
+    None,
+    ByIndex(BTreeMap<u8, Entry>),
+    Ports(Vec<PortEntry>),
+}
+
+impl<'de> Deserialize<'de> for EscSection {
+    fn deserialize<D: Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+        struct V;
+        impl<'de> Visitor<'de> for V {
+            type Value = EscSection;
+
+            fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
+                f.write_str("tables [esc.N] by ESC index (or a list [[esc]] of ports)")
+            }
+
+            fn visit_seq<A: SeqAccess<'de>>(self, mut seq: A) -> Result<EscSection, A::Error> {
+                let mut list = Vec::new();
+                while let Some(entry) = seq.next_element::<PortEntry>()? {
+                    list.push(entry);
+                }
+                Ok(EscSection::Ports(list))
+            }
+
+            fn visit_map<A: MapAccess<'de>>(self, mut map: A) -> Result<EscSection, A::Error> {
+                let mut by_index = BTreeMap::new();
+                while let Some(key) = map.next_key::<String>()? {
+                    let index: u8 = key.parse().map_err(|_| {
+                        de::Error::custom(format!(
+                            "esc.{key}: an ESC is named by its index, 0 to 255 (as in the `esc` \
+                             column)"
+                        ))
+                    })?;
+                    by_index.insert(index, map.next_value::<Entry>()?);
+                }
+                Ok(EscSection::ByIndex(by_index))
+            }
+        }
+        deserializer.deserialize_any(V)
+    }
+}
+
+/// The `[monitor]` table.
+#[derive(Debug, Default, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MonitorKeys {
+    /// Ports watched when none are named on the command line.
+    #[serde(default)]
+    pub ports: Vec<String>,
+    /// Baud rate of the ports.
+    pub baud: Option<u32>,
+    /// Where the `r` key puts its recordings.
+    pub record_dir: Option<PathBuf>,
+}
+
+/// The `[alarms]` table (and the monitor's matching flags).
+#[derive(Debug, Default, Clone, Deserialize, clap::Args)]
+#[serde(deny_unknown_fields)]
+pub struct AlarmKeys {
+    /// MOSFET temperature warning level, degC [default: 90].
+    #[arg(long, value_name = "DEGC", help_heading = "Alarms")]
+    pub mos_warning_c: Option<f64>,
+    /// MOSFET temperature critical level, degC [default: 105].
+    #[arg(long, value_name = "DEGC", help_heading = "Alarms")]
+    pub mos_critical_c: Option<f64>,
+    /// Capacitor temperature warning level, degC [default: 85].
+    #[arg(long, value_name = "DEGC", help_heading = "Alarms")]
+    pub cap_warning_c: Option<f64>,
+    /// Capacitor temperature critical level, degC [default: 100].
+    #[arg(long, value_name = "DEGC", help_heading = "Alarms")]
+    pub cap_critical_c: Option<f64>,
+    /// How far a temperature must fall below a level to leave it, degC [default: 5].
+    #[arg(long, value_name = "DEGC", help_heading = "Alarms")]
+    pub temp_hysteresis_c: Option<f64>,
+    /// Battery cells in series, for the low-voltage levels [default: detected from the first
+    /// voltage seen, as a full LiPo].
+    #[arg(long, value_name = "N", help_heading = "Alarms")]
+    pub battery_cells: Option<u8>,
+    /// Low-voltage warning level per cell, V [default: 3.5].
+    #[arg(long, value_name = "V", help_heading = "Alarms")]
+    pub cell_warning_v: Option<f64>,
+    /// Low-voltage critical level per cell, V [default: 3.3].
+    #[arg(long, value_name = "V", help_heading = "Alarms")]
+    pub cell_critical_v: Option<f64>,
+    /// How far the voltage must rise above a level to leave it, V per cell [default: 0.1].
+    #[arg(long, value_name = "V", help_heading = "Alarms")]
+    pub cell_hysteresis_v: Option<f64>,
+    /// An ESC is stale after this long without a frame, seconds [default: 1].
+    #[arg(long, value_name = "S", help_heading = "Alarms")]
+    pub stale_after_s: Option<f64>,
+    /// A status-bit alarm clears after the bit has been off this long, seconds [default: 0.5].
+    #[arg(long, value_name = "S", help_heading = "Alarms")]
+    pub fault_hold_s: Option<f64>,
+}
+
+/// The configuration file read (or none), and what it says.
+#[derive(Debug, Default)]
+pub struct Config {
+    /// Where it was read from; `None` when no file was read.
+    pub path: Option<PathBuf>,
+    /// What it says (all empty without a file).
+    pub file: File,
+}
+
+/// The per-user configuration file, whether or not it exists.
+pub fn default_path() -> Option<PathBuf> {
+    dirs::config_dir().map(|d| d.join("hwfoc").join("config.toml"))
+}
+
+/// The older per-user file of `hwfoc monitor`, read by it when there is no [`default_path`].
+pub fn legacy_monitor_path() -> Option<PathBuf> {
+    dirs::config_dir().map(|d| d.join("hwfoc").join("monitor.toml"))
+}
+
+impl Config {
+    /// Reads the configuration file `args` point to (see the module documentation); `monitor`
+    /// also looks for the older `monitor.toml`.
+    pub fn load(args: &SettingsArgs, monitor: bool) -> Result<Config, CliError> {
+        let named = args.config.clone().or_else(|| {
+            std::env::var_os(ENV)
+                .filter(|v| !v.is_empty())
+                .map(PathBuf::from)
+        });
+        let path = match (args.no_config, named) {
+            (true, _) => None,
+            (false, Some(path)) => Some(path),
+            (false, None) => default_path()
+                .filter(|p| p.is_file())
+                .or_else(|| legacy_monitor_path().filter(|p| monitor && p.is_file())),
+        };
+        let file = match &path {
+            Some(path) => read_file(path)?,
+            None => File::default(),
+        };
+        Ok(Config { path, file })
+    }
+
+    /// Where this file's values came from, for an error: `FILE ([esc.2])`.
+    pub fn origin(&self, what: &str) -> String {
+        match &self.path {
+            Some(p) => format!("{} ({what})", p.display()),
+            None => what.to_string(),
+        }
+    }
+
+    /// The settings of ESCs that no entry names: the flags over `[settings]` over the defaults.
+    pub fn settings(&self, flags: &SettingsArgs) -> Result<Settings, CliError> {
+        let file = self.defaults_patch();
+        let flag = flags.patch();
+        flag.apply(
+            &file
+                .apply(&Settings::DEFAULT)
+                .map_err(|e| CliError::Usage {
+                    option: self.origin("[settings]"),
+                    message: e.to_string(),
+                })?,
+        )
+        .map_err(CliError::Settings)
+    }
+
+    /// Every ESC's settings: [`Config::settings`] for all, the entries by port and by ESC over
+    /// them, the flags over everything.
+    pub fn settings_map(&self, flags: &SettingsArgs) -> Result<SettingsMap, CliError> {
+        let mut map = SettingsMap::new(self.settings(flags)?);
+        let flag = flags.patch();
+        let bad = |what: String, e: hwfoc::SettingsError| CliError::Usage {
+            option: self.origin(&what),
+            message: e.to_string(),
+        };
+        for (port, entry) in &self.port_entries() {
+            map.set_port(*port, flag.over(&entry.patch()))
+                .map_err(|e| bad(format!("port {port:?}"), e))?;
+        }
+        if let EscSection::ByIndex(escs) = &self.file.esc {
+            for (&esc, entry) in escs {
+                map.set_esc(usize::from(esc), flag.over(&entry.patch()))
+                    .map_err(|e| bad(format!("[esc.{esc}]"), e))?;
+            }
+        }
+        Ok(map)
+    }
+
+    /// `[settings]`, with the older layout's top-level keys where it has none.
+    fn defaults_patch(&self) -> SettingsPatch {
+        let f = &self.file;
+        f.settings.patch().over(&SettingsPatch {
+            current_scale: f.current_scale,
+            pole_pairs: f.pole_pairs,
+            gear_ratio: f.gear_ratio,
+        })
+    }
+
+    /// The entries by port: `[port."NAME"]`, then the older `[[esc]]` list.
+    fn port_entries(&self) -> Vec<(&str, Entry)> {
+        let list = match &self.file.esc {
+            EscSection::Ports(list) => list.as_slice(),
+            _ => &[],
+        };
+        self.file
+            .port
+            .iter()
+            .map(|(p, e)| (p.as_str(), e.clone()))
+            .chain(list.iter().map(|e| (e.port.as_str(), e.entry())))
+            .collect()
+    }
+
+    /// The label of ESC `esc` read from `port`: its `[esc.N]` label, else its port's.
+    pub fn label(&self, esc: usize, port: &str) -> Option<&str> {
+        let by_index = match &self.file.esc {
+            EscSection::ByIndex(escs) => u8::try_from(esc)
+                .ok()
+                .and_then(|i| escs.get(&i))
+                .and_then(|e| e.label.as_deref()),
+            _ => None,
+        };
+        let by_port = || {
+            let from_table = self.file.port.get(port).and_then(|e| e.label.as_deref());
+            let from_list = match &self.file.esc {
+                EscSection::Ports(list) => list
+                    .iter()
+                    .filter(|e| e.port == port)
+                    .find_map(|e| e.label.as_deref()),
+                _ => None,
+            };
+            from_table.or(from_list)
+        };
+        by_index.or_else(by_port)
+    }
+
+    /// The ports to watch when none are named: `[monitor] ports`, then those of the older
+    /// `[[esc]]` list.
+    pub fn ports(&self) -> Vec<String> {
+        let mut ports = self.file.monitor.ports.clone();
+        if let EscSection::Ports(list) = &self.file.esc {
+            ports.extend(list.iter().map(|e| e.port.clone()));
+        }
+        ports
+    }
+
+    /// The monitor's baud rate: `[monitor] baud`, or the older top-level `baud`.
+    pub fn baud(&self) -> Option<u32> {
+        self.file.monitor.baud.or(self.file.baud)
+    }
+
+    /// The monitor's recording directory: `[monitor] record_dir`, or the older top-level key.
+    pub fn record_dir(&self) -> Option<PathBuf> {
+        let f = &self.file;
+        f.monitor
+            .record_dir
+            .clone()
+            .or_else(|| f.record_dir.clone())
+    }
+}
+
+/// The largest configuration file read (a real one is a few hundred bytes).
+const MAX_CONFIG: u64 = 1 << 20;
+
+/// Reads and parses a configuration file; errors name the file and the line.
+fn read_file(path: &Path) -> Result<File, CliError> {
+    let open_error = |source| InputError::Open {
+        input: path.display().to_string(),
+        source,
+    };
+    let bytes = read_small_file(path, MAX_CONFIG).map_err(open_error)?;
+    let text = String::from_utf8(bytes).map_err(|_| {
+        open_error(std::io::Error::new(
+            std::io::ErrorKind::InvalidData,
+            "it is not UTF-8 text",
+        ))
+    })?;
+    toml::from_str(&text).map_err(|e| {
+        let line = e.span().map(|span| {
+            text.as_bytes()[..span.start.min(text.len())]
+                .iter()
+                .filter(|&&b| b == b'\n')
+                .count()
+                + 1
+        });
+        CliError::Config {
+            path: path.display().to_string(),
+            line,
+            message: e.message().trim().replace('\n', " "),
+        }
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The flags of a command line, without a file of the user's.
+    fn flags(config: Option<&Path>) -> SettingsArgs {
+        SettingsArgs {
+            current_scale: None,
+            pole_pairs: None,
+            gear_ratio: None,
+            config: config.map(Path::to_path_buf),
+            no_config: config.is_none(),
+        }
+    }
+
+    fn load(text: &str) -> (tempfile::TempDir, Result<Config, CliError>) {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("config.toml");
+        std::fs::write(&path, text).unwrap();
+        let config = Config::load(&flags(Some(&path)), false);
+        (dir, config)
+    }
+
+    const FILE: &str = "[settings]\ncurrent_scale = 100\npole_pairs = 12\n\n\
+                        [port.\"/dev/ttyUSB1\"]\npole_pairs = 14\nlabel = \"tail\"\n\n\
+                        [esc.1]\ngear_ratio = 2.5\n\n[esc.3]\nlabel = \"rear\"\ncurrent_scale = 64\n";
+
+    #[test]
+    fn flags_beat_entries_beat_settings_beat_defaults() {
+        let (_dir, config) = load(FILE);
+        let config = config.unwrap();
+        let map = config.settings_map(&flags(None)).unwrap();
+        let s = |esc, port| {
+            let s = map.get(esc, port);
+            (s.current_scale, s.pole_pairs, s.gear_ratio)
+        };
+        assert_eq!(s(0, "/dev/ttyUSB0"), (100.0, 12, 1.0));
+        assert_eq!(s(0, "/dev/ttyUSB1"), (100.0, 14, 1.0));
+        assert_eq!(s(1, "/dev/ttyUSB1"), (100.0, 14, 2.5));
+        assert_eq!(s(3, "/dev/ttyUSB1"), (64.0, 14, 1.0));
+        assert_eq!(config.label(1, "/dev/ttyUSB1"), Some("tail"));
+        assert_eq!(config.label(3, "/dev/ttyUSB1"), Some("rear"));
+        assert_eq!(config.label(0, "/dev/ttyUSB0"), None);
+
+        let mut flag = flags(None);
+        flag.pole_pairs = Some(2);
+        let map = config.settings_map(&flag).unwrap();
+        for (esc, port) in [(0, "x"), (1, "/dev/ttyUSB1"), (3, "/dev/ttyUSB1")] {
+            assert_eq!(map.get(esc, port).pole_pairs, 2, "esc {esc}");
+        }
+        // The fields no flag sets still come from the entries.
+        assert_eq!(map.get(1, "/dev/ttyUSB1").gear_ratio, 2.5);
+        assert_eq!(map.get(3, "/dev/ttyUSB1").current_scale, 64.0);
+        assert_eq!(config.settings(&flag).unwrap().current_scale, 100.0);
+
+        let none = Config::load(&flags(None), false).unwrap();
+        assert_eq!(none.path, None);
+        assert_eq!(none.settings(&flags(None)).unwrap(), Settings::DEFAULT);
+    }
+
+    #[test]
+    fn the_older_monitor_layout_is_read_as_before() {
+        let (_dir, config) = load(
+            "baud = 115200\npole_pairs = 14\nrecord_dir = \"/tmp/r\"\n[alarms]\n\
+             mos_warning_c = 80\n[[esc]]\nport = \"/dev/ttyUSB0\"\nlabel = \"front left\"\n\
+             [[esc]]\nport = \"/dev/ttyUSB1\"\ncurrent_scale = 100\n",
+        );
+        let config = config.unwrap();
+        assert_eq!(config.baud(), Some(115_200));
+        assert_eq!(config.record_dir(), Some(PathBuf::from("/tmp/r")));
+        assert_eq!(config.ports(), ["/dev/ttyUSB0", "/dev/ttyUSB1"]);
+        assert_eq!(config.label(0, "/dev/ttyUSB0"), Some("front left"));
+        assert_eq!(config.file.alarms.mos_warning_c, Some(80.0));
+        let map = config.settings_map(&flags(None)).unwrap();
+        assert_eq!(map.get(0, "/dev/ttyUSB0").pole_pairs, 14);
+        assert_eq!(map.get(1, "/dev/ttyUSB1").current_scale, 100.0);
+        assert_eq!(map.get(1, "/dev/ttyUSB1").pole_pairs, 14);
+    }
+
+    #[test]
+    fn errors_name_the_file_line_and_key() {
+        let cases = [
+            (
+                "[settings]\npole_pairs = 7\npole_pair = 7\n",
+                3,
+                "pole_pair",
+            ),
+            (
+                "[esc.2]\nlabel = \"x\"\ncurrent_sale = 1\n",
+                3,
+                "current_sale",
+            ),
+            ("[port.\"a\"]\n\n\nlable = \"x\"\n", 4, "lable"),
+            ("[[esc]]\nport = \"a\"\nlabels = \"x\"\n", 3, "labels"),
+            ("[monitor]\nport = []\n", 2, "port"),
+            ("[esc.front]\nlabel = \"x\"\n", 1, "esc.front"),
+            ("[settings]\n\npole_pairs = \"seven\"\n", 3, "string"),
+            ("speed = 3\n", 1, "speed"),
+        ];
+        for (text, line, key) in cases {
+            let (_dir, config) = load(text);
+            let err = config.unwrap_err().to_string();
+            assert!(
+                err.contains(&format!("config.toml line {line}")),
+                "{text}: {err}"
+            );
+            assert!(err.contains(key), "{text}: {err}");
+            assert!(!err.contains('\n'), "{err}");
+        }
+        // Values out of range name the file and the entry.
+        let (_dir, config) = load("[esc.4]\npole_pairs = 0\n");
+        let err = config
+            .unwrap()
+            .settings_map(&flags(None))
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("config.toml ([esc.4])"), "{err}");
+        let (_dir, config) = load("[settings]\ncurrent_scale = -1\n");
+        let err = config
+            .unwrap()
+            .settings(&flags(None))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.contains("([settings])") && err.contains("current scale"),
+            "{err}"
+        );
+    }
+
+    #[test]
+    fn a_missing_named_file_is_an_error() {
+        let err = Config::load(&flags(Some(Path::new("/nonexistent/c.toml"))), false)
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("/nonexistent/c.toml"), "{err}");
+    }
+}

@@ -1,0 +1,247 @@
+//! Conversion settings per ESC: the ESCs of one aircraft can drive different motors (pole pairs,
+//! gearing) or measure current differently (scale), so each ESC's frames are converted under
+//! its own [`Settings`].
+//!
+//! A [`SettingsMap`] holds the settings of every ESC not named otherwise, and partial settings
+//! ([`SettingsPatch`]) by port name (the stream an ESC is read from: a serial port, a port named
+//! in a recording, a file) and by ESC index. An ESC's settings are, field by field: its index's
+//! patch, then its port's patch, then the defaults. A map made `From` one [`Settings`] gives
+//! every ESC those.
+//!
+//! ```
+//! use hwfoc::Settings;
+//! use hwfoc_io::settings::{SettingsMap, SettingsPatch};
+//!
+//! let mut map = SettingsMap::from(Settings::DEFAULT);
+//! map.set_port("/dev/ttyUSB1", SettingsPatch { current_scale: Some(100.0), ..Default::default() });
+//! map.set_esc(1, SettingsPatch { pole_pairs: Some(14), ..Default::default() });
+//! let one = map.get(1, "/dev/ttyUSB1");
+//! assert_eq!((one.current_scale, one.pole_pairs), (100.0, 14));
+//! assert_eq!(map.get(0, "/dev/ttyUSB0"), Settings::DEFAULT);
+//! ```
+
+use std::collections::BTreeMap;
+
+use hwfoc::{Settings, SettingsError};
+
+/// Some of the fields of [`Settings`]; `None` leaves a field to the next level.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct SettingsPatch {
+    /// Raw current units per ampere.
+    pub current_scale: Option<f32>,
+    /// Motor pole pairs.
+    pub pole_pairs: Option<u16>,
+    /// Gear ratio between motor and output shaft.
+    pub gear_ratio: Option<f32>,
+}
+
+impl SettingsPatch {
+    /// The fields of `self` that are set, the others from `under`.
+    pub fn over(&self, under: &SettingsPatch) -> SettingsPatch {
+        SettingsPatch {
+            current_scale: self.current_scale.or(under.current_scale),
+            pole_pairs: self.pole_pairs.or(under.pole_pairs),
+            gear_ratio: self.gear_ratio.or(under.gear_ratio),
+        }
+    }
+
+    /// `base` with the fields of `self` that are set, checked as [`Settings::new`] does.
+    pub fn apply(&self, base: &Settings) -> Result<Settings, SettingsError> {
+        Settings::new(
+            self.current_scale.unwrap_or(base.current_scale),
+            self.pole_pairs.unwrap_or(base.pole_pairs),
+            self.gear_ratio.unwrap_or(base.gear_ratio),
+        )
+    }
+
+    /// Whether no field is set.
+    pub fn is_empty(&self) -> bool {
+        *self == SettingsPatch::default()
+    }
+}
+
+/// The settings of every ESC: defaults, and patches by port name and by ESC index.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SettingsMap {
+    default: Settings,
+    ports: BTreeMap<String, (SettingsPatch, Settings)>,
+    escs: BTreeMap<usize, SettingsPatch>,
+}
+
+impl From<Settings> for SettingsMap {
+    fn from(default: Settings) -> SettingsMap {
+        SettingsMap {
+            default,
+            ports: BTreeMap::new(),
+            escs: BTreeMap::new(),
+        }
+    }
+}
+
+impl SettingsMap {
+    /// Every ESC under `default`, until patches are set.
+    pub fn new(default: Settings) -> SettingsMap {
+        SettingsMap::from(default)
+    }
+
+    /// The settings of ESCs that no patch names.
+    pub fn default_settings(&self) -> &Settings {
+        &self.default
+    }
+
+    /// Sets the patch of the ESCs read from port `name`. A patch that [`Settings::new`]
+    /// refuses over the defaults is an error (and not set).
+    pub fn set_port(
+        &mut self,
+        name: impl Into<String>,
+        patch: SettingsPatch,
+    ) -> Result<(), SettingsError> {
+        let settings = patch.apply(&self.default)?;
+        self.ports.insert(name.into(), (patch, settings));
+        Ok(())
+    }
+
+    /// Sets the patch of ESC `esc`. A patch that [`Settings::new`] refuses over the defaults is
+    /// an error (and not set).
+    pub fn set_esc(&mut self, esc: usize, patch: SettingsPatch) -> Result<(), SettingsError> {
+        patch.apply(&self.default)?;
+        self.escs.insert(esc, patch);
+        Ok(())
+    }
+
+    /// The settings of ESC `esc`, read from port (or stream) `name`: field by field, the ESC's
+    /// patch, the port's patch, the defaults.
+    pub fn get(&self, esc: usize, name: &str) -> Settings {
+        let port = self.ports.get(name);
+        match (self.escs.get(&esc), port) {
+            (None, None) => self.default,
+            (None, Some((_, settings))) => *settings,
+            (Some(patch), port) => {
+                let under = port.map(|(p, _)| *p).unwrap_or_default();
+                // Each field was checked on its own, and the checks are field by field.
+                patch
+                    .over(&under)
+                    .apply(&self.default)
+                    .unwrap_or(self.default)
+            }
+        }
+    }
+
+    /// Whether every ESC has the defaults.
+    pub fn is_uniform(&self) -> bool {
+        self.ports.is_empty() && self.escs.is_empty()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn patch(scale: Option<f32>, pairs: Option<u16>, ratio: Option<f32>) -> SettingsPatch {
+        SettingsPatch {
+            current_scale: scale,
+            pole_pairs: pairs,
+            gear_ratio: ratio,
+        }
+    }
+
+    #[test]
+    fn the_esc_beats_the_port_beats_the_defaults_field_by_field() {
+        let base = Settings::new(64.0, 7, 1.0).unwrap();
+        let mut map = SettingsMap::new(base);
+        assert!(map.is_uniform());
+        map.set_port("a", patch(Some(100.0), Some(12), None))
+            .unwrap();
+        map.set_esc(2, patch(None, Some(14), Some(2.0))).unwrap();
+        assert!(!map.is_uniform());
+        assert_eq!(map.get(0, "b"), base);
+        assert_eq!(map.get(0, "a"), Settings::new(100.0, 12, 1.0).unwrap());
+        assert_eq!(map.get(2, "a"), Settings::new(100.0, 14, 2.0).unwrap());
+        assert_eq!(map.get(2, "b"), Settings::new(64.0, 14, 2.0).unwrap());
+        assert_eq!(map.default_settings(), &base);
+    }
+
+    /// Collects (esc, rpm, current) of each record.
+    #[derive(Default)]
+    struct Rows(Vec<(u8, f32, f32)>);
+
+    impl crate::Handler for Rows {
+        type Error = crate::InputError;
+
+        fn record(&mut self, r: &crate::Record) {
+            self.0.push((r.esc, r.rpm, r.current_a));
+        }
+    }
+
+    /// Three frames of 700 eRPM (raw 70, in 10 eRPM units) and 12.8 A at scale 64 (raw 819).
+    fn wire() -> Vec<u8> {
+        (0..3u16)
+            .flat_map(|packet| {
+                hwfoc::DataFrame {
+                    packet,
+                    erpm_raw: 70,
+                    current_raw: 819,
+                    ..Default::default()
+                }
+                .encode()
+            })
+            .collect()
+    }
+
+    #[test]
+    fn sources_convert_each_escs_frames_under_its_own_settings() {
+        let inputs = ["front", "rear", "tail"]
+            .map(|name| crate::Input::from_memory(name, wire()).unwrap())
+            .into();
+        let mut map = SettingsMap::from(Settings::DEFAULT);
+        map.set_esc(1, patch(None, Some(14), None)).unwrap();
+        map.set_port("tail", patch(Some(100.0), None, None))
+            .unwrap();
+        let mut sources = crate::Sources::new(inputs, map);
+        let mut rows = Rows::default();
+        sources.run(&mut rows).unwrap();
+        let first = |esc: u8| *rows.0.iter().find(|r| r.0 == esc).unwrap();
+        let (_, rpm0, amps0) = first(0);
+        let (_, rpm1, amps1) = first(1);
+        let (_, rpm2, amps2) = first(2);
+        assert_eq!(rpm0, 100.0);
+        assert_eq!(rpm1, 50.0);
+        assert_eq!(rpm2, 100.0);
+        assert!((amps0 - 819.0 / 64.0).abs() < 1e-4 && amps1 == amps0);
+        assert!((amps2 - 8.19).abs() < 1e-4);
+        assert_eq!(rows.0.len(), 9);
+        assert_eq!(sources.esc_settings(2).current_scale, 100.0);
+        assert_eq!(sources.settings(), &Settings::DEFAULT);
+    }
+
+    #[test]
+    fn port_streams_convert_each_port_under_its_settings() {
+        let other = Settings::new(64.0, 14, 1.0).unwrap();
+        let mut streams =
+            crate::stream::PortStreams::with_settings(19_200, vec![Settings::DEFAULT, other]);
+        let mut rows = Rows::default();
+        for port in 0..2 {
+            let event = crate::serial::PortEvent::Data {
+                port,
+                t_ns: 1_000_000_000,
+                bytes: wire(),
+            };
+            assert!(streams.feed(&event, &mut rows).is_some());
+        }
+        let rpm: Vec<(u8, f32)> = rows.0.iter().map(|r| (r.0, r.1)).collect();
+        assert!(
+            rpm.contains(&(0, 100.0)) && rpm.contains(&(1, 50.0)),
+            "{rpm:?}"
+        );
+        assert!(!rpm.contains(&(1, 100.0)), "{rpm:?}");
+    }
+
+    #[test]
+    fn a_patch_that_makes_bad_settings_is_refused() {
+        let mut map = SettingsMap::from(Settings::DEFAULT);
+        assert!(map.set_esc(0, patch(None, Some(0), None)).is_err());
+        assert!(map.set_port("p", patch(Some(-1.0), None, None)).is_err());
+        assert!(map.is_uniform());
+        assert!(patch(None, None, None).is_empty());
+    }
+}
