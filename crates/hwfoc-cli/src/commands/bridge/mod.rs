@@ -15,6 +15,8 @@ use std::time::{Duration, Instant};
 use clap::Args;
 use hwfoc_bridge::Output;
 use hwfoc_bridge::datalink::{DatalinkOutput, Pacing};
+use hwfoc_bridge::dronecan::{self, DronecanOptions, DronecanOutput, SlcanTarget};
+use hwfoc_bridge::mavlink::{self, MavlinkOptions, MavlinkOutput, MavlinkTarget};
 use hwfoc_bridge::fanout::Fanout;
 use hwfoc_bridge::replay::{POLL, Replay, ReplayError};
 use hwfoc_io::Sources;
@@ -67,6 +69,35 @@ pub struct BridgeArgs {
     #[arg(long, value_name = "MS", default_value_t = 50, help_heading = "Outputs",
           value_parser = clap::value_parser!(u64).range(20..=1000))]
     datalink_period: u64,
+
+    /// MAVLink 2 to a ground station or flight controller: `udp:HOST:PORT` (`udp` alone is
+    /// 127.0.0.1:14550, where ground stations listen) or `serial:PORT[:BAUD]`. HEARTBEAT,
+    /// ESC_TELEMETRY_1_TO_4.. (Mission Planner), ESC_STATUS and ESC_INFO (QGroundControl, PX4).
+    /// Repeat for several destinations.
+    #[arg(long, value_name = "SPEC", help_heading = "Outputs")]
+    mavlink: Vec<String>,
+    /// MAVLink system id of the messages (1: the vehicle's, as ground stations expect).
+    #[arg(long, value_name = "N", default_value_t = 1, help_heading = "Outputs",
+          value_parser = clap::value_parser!(u8).range(1..=255))]
+    mavlink_system: u8,
+    /// MAVLink component id: 158 (peripheral) beside a flight controller; 1 (autopilot) on a
+    /// bench without one, so that the ground station takes hwfoc for the vehicle.
+    #[arg(long, value_name = "N", default_value_t = mavlink::MAV_COMP_ID_PERIPHERAL,
+          help_heading = "Outputs", value_parser = clap::value_parser!(u8).range(1..=255))]
+    mavlink_component: u8,
+
+    /// A DroneCAN node on an SLCAN adapter, `slcan:PORT[:BITRATE]` (default 1000000 bit/s):
+    /// uavcan.equipment.esc.Status for each ESC, and NodeStatus.
+    #[arg(long, value_name = "SPEC", help_heading = "Outputs")]
+    dronecan: Option<String>,
+    /// DroneCAN node id (1 to 127).
+    #[arg(long, value_name = "N", default_value_t = dronecan::DEFAULT_NODE_ID,
+          help_heading = "Outputs", value_parser = clap::value_parser!(u8).range(1..=127))]
+    dronecan_node: u8,
+    /// Baud rate of the SLCAN adapter's serial port (USB adapters ignore it).
+    #[arg(long, value_name = "N", default_value_t = dronecan::DEFAULT_BAUD,
+          help_heading = "Outputs", value_parser = clap::value_parser!(u32).range(1..))]
+    dronecan_baud: u32,
 
     /// How long to run, in seconds (default: until Ctrl-C, or the end of the recordings).
     #[arg(long, value_name = "S", value_parser = seconds)]
@@ -150,6 +181,27 @@ fn open_outputs(args: &BridgeArgs) -> Result<Vec<Box<dyn Output>>, CliError> {
         };
         outputs.push(Box::new(
             DatalinkOutput::open(port, pacing).map_err(CliError::Output)?,
+        ));
+    }
+    for spec in &args.mavlink {
+        let target = MavlinkTarget::parse(spec).map_err(CliError::Output)?;
+        let options = MavlinkOptions {
+            system_id: args.mavlink_system,
+            component_id: args.mavlink_component,
+            ..MavlinkOptions::default()
+        };
+        outputs.push(Box::new(
+            MavlinkOutput::open(target, options).map_err(CliError::Output)?,
+        ));
+    }
+    if let Some(spec) = &args.dronecan {
+        let target = SlcanTarget::parse(spec).map_err(CliError::Output)?;
+        let options = DronecanOptions {
+            node_id: args.dronecan_node,
+            baud: args.dronecan_baud,
+        };
+        outputs.push(Box::new(
+            DronecanOutput::open(target, options).map_err(CliError::Output)?,
         ));
     }
     if outputs.is_empty() {
