@@ -673,13 +673,13 @@ proptest! {
         let mut bytes = Vec::new();
         let mut sent = 0u32;
         let mut dropped_inside = 0u32;
-        for i in 0..n {
+        for (i, &corrupt) in corrupt.iter().enumerate().take(n) {
             let mut f = DatalinkFrame::new(start.wrapping_add(i as u16));
             for (ch, &p) in packets.iter().enumerate() {
                 f.slots[2 * ch] = Some(DataFrame { packet: p.wrapping_add(i as u16), voltage_raw: 1, ..Default::default() });
             }
             let mut b = f.encode();
-            if corrupt[i] && i != 0 && i != n - 1 {
+            if corrupt && i != 0 && i != n - 1 {
                 b[100] ^= 0x10;
                 dropped_inside += 1;
             } else {
