@@ -219,7 +219,12 @@ fn streamed_at(bytes: &[u8], cuts: &[usize]) -> (Vec<DatalinkDecoded>, DatalinkS
     let mut out = Vec::new();
     for w in cuts.windows(2) {
         d.feed(&bytes[w[0]..w[1]], |x| out.push(x));
-        assert!(d.buffered() < FRAME_LEN);
+        assert_eq!(
+            d.buffered(),
+            reference_held(&bytes[..w[1]]),
+            "after {}",
+            w[1]
+        );
         let s = d.stats();
         assert_eq!(
             s.bytes(),
@@ -298,17 +303,36 @@ struct RefStats {
 /// there is a frame if its CRC matches (its records read by channel byte, one at a time), else
 /// rejected; a rejected or cut candidate costs one byte.
 fn reference(bytes: &[u8]) -> (Vec<DatalinkDecoded>, RefStats) {
+    let (out, s, _) = reference_scan(bytes, true);
+    (out, s)
+}
+
+/// How many bytes a streaming decoder fed `bytes` holds back: those from the first candidate
+/// that more bytes could still decide (a `9B` last, `9B` and a length byte short of 4 bytes, or
+/// a good header short of 160).
+fn reference_held(bytes: &[u8]) -> usize {
+    reference_scan(bytes, false).2
+}
+
+/// The reference scanner over `bytes`; unless `at_end`, it stops at the first undecided
+/// candidate and also returns how many bytes are left from there.
+fn reference_scan(bytes: &[u8], at_end: bool) -> (Vec<DatalinkDecoded>, RefStats, usize) {
     let mut s = RefStats::default();
     let mut out = Vec::new();
     let mut i = 0;
     while i < bytes.len() {
-        let is_candidate = bytes[i] == 0x9B && matches!(bytes.get(i + 1), Some(0x9E | 0xA0));
-        if !is_candidate {
+        let is_candidate = bytes[i] == 0x9B && matches!(bytes.get(i + 1), Some(0x9E | 0xA0) | None);
+        let rest = bytes.len() - i;
+        let bad_header = rest >= 4 && bytes[i + 2..i + 4] != [0x01, 0x02];
+        if is_candidate && !at_end && rest < FRAME_LEN && !bad_header {
+            return (out, s, rest);
+        }
+        if !is_candidate || rest < 2 {
             s.bytes_skipped += 1;
             i += 1;
             continue;
         }
-        if bytes.len() >= i + 4 && bytes[i + 2..i + 4] != [0x01, 0x02] {
+        if bad_header {
             s.bad_headers += 1;
         } else if bytes.len() >= i + FRAME_LEN {
             let f = &bytes[i..i + FRAME_LEN];
@@ -327,7 +351,7 @@ fn reference(bytes: &[u8]) -> (Vec<DatalinkDecoded>, RefStats) {
         s.bytes_skipped += 1;
         i += 1;
     }
-    (out, s)
+    (out, s, 0)
 }
 
 fn reference_read(f: &[u8], s: &mut RefStats) -> (DatalinkFrame, FrameReport) {
@@ -635,6 +659,23 @@ proptest! {
         decode_checked(&wire.bytes, &picks);
     }
 
+    /// The streaming decoder holds back only an undecided candidate, after every chunk and after
+    /// every byte pushed: the bytes from the first candidate that more bytes could decide.
+    #[test]
+    fn only_an_undecided_candidate_is_held(
+        ps in pieces(8),
+        picks in vec(any::<Index>(), 0..30),
+        bytewise in any::<bool>(),
+    ) {
+        let wire = build(&ps);
+        let cuts = if bytewise {
+            (0..=wire.bytes.len()).collect()
+        } else {
+            cut_points(wire.bytes.len(), &picks)
+        };
+        streamed_at(&wire.bytes, &cuts);
+    }
+
     /// Garbage, cut and corrupted frames and fake headers around and between frames never lose
     /// an intact frame: every one is decoded, in order, at its offset, with its length byte;
     /// any extra frame (formed by chance) lies wholly outside them.
@@ -732,6 +773,22 @@ fn both_length_bytes_are_counted() {
     assert_eq!(stats.frames_with_length_byte(LengthByte::Total), 3);
     assert_eq!(decoded[1].report.length_byte, LengthByte::Total);
     assert_eq!(stats.lost_frames(), 0);
+}
+
+/// A record is empty only when all 18 bytes after its channel byte are zero: one non-zero byte
+/// anywhere makes it an ESC's.
+#[test]
+fn one_non_zero_byte_makes_a_record() {
+    for at in 0..18 {
+        let mut b = DatalinkFrame::new(5).encode();
+        b[RECORDS_AT + 2 * RECORD_LEN + 1 + at] = 0x80;
+        Checksum::Crc16Xmodem.seal(&mut b);
+        let (frame, report) = DatalinkFrame::parse_with_report(&b).unwrap();
+        assert!(frame.slots[2].is_some(), "{at}");
+        assert_eq!(frame.escs().count(), 1);
+        assert_eq!(report.empty_slots, 7);
+        assert_eq!(decode_checked(&b, &[]).1.records(), 1);
+    }
 }
 
 /// Any other length byte is not a DataLink frame, even with a correct CRC.
