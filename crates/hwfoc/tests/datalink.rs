@@ -751,6 +751,32 @@ proptest! {
 // Unit tests on encoder-made bytes
 // ---------------------------------------------------------------------------------------------
 
+/// The frame of `fuzz/run.sh`'s seeds: the first data frame of the XRotor capture in slot 0,
+/// every other slot empty. Its CRCs come from Python's `binascii.crc_hqx(frame[:158], 0)`
+/// (CRC-16/XMODEM), not from this crate.
+#[test]
+fn encoder_matches_an_independent_crc() {
+    let esc = DataFrame::parse(&[
+        0x9B, 0x16, 0x01, 0x02, 0x05, 0xC2, 0, 0, 0, 0, 0, 0, 0x00, 0xF7, 0xFF, 0xFF, 0xFF, 0xFF,
+        0xCE, 0xD1, 0x00, 0x00, 0x0D, 0x08,
+    ])
+    .unwrap();
+    let mut f = DatalinkFrame::new(1);
+    f.slots[0] = Some(esc);
+    let b = f.encode();
+    assert_eq!(b[..7], [0x9B, 0x9E, 0x01, 0x02, 0x00, 0x01, 0x00]);
+    assert_eq!(
+        b[7..25],
+        [
+            0x05, 0xC2, 0, 0, 0, 0, 0, 0, 0x00, 0xF7, 0xFF, 0xFF, 0xFF, 0xFF, 0xCE, 0xD1, 0x00,
+            0x00
+        ]
+    );
+    assert_eq!(b[158..], [0x61, 0x34]);
+    f.counter = 2;
+    assert_eq!(f.encode_as(LengthByte::Total)[158..], [0xC9, 0x15]);
+}
+
 /// A stream with both length bytes: each frame counted under its own.
 #[test]
 fn both_length_bytes_are_counted() {
