@@ -1,10 +1,12 @@
 #!/usr/bin/env bash
-# Release code size of the hwfoc streaming decoder on a Cortex-M4F (thumbv7em-none-eabihf).
+# Release code size of the hwfoc streaming decoders on a Cortex-M4F (thumbv7em-none-eabihf).
 #
 # Builds crates/hwfoc/size-probe, a no_std staticlib (opt-level "s", fat LTO, one codegen unit,
-# panic = abort), twice: with the entry point `hwfoc_probe_push` only (Decoder::push, a few raw
-# fields of the last data frame), then with `hwfoc_probe_push_units` as well (feature `units`:
-# voltage, currents and RPM under caller settings, temperatures from the ADC table).
+# panic = abort), three times: with the entry point `hwfoc_probe_push` only (Decoder::push, a few
+# raw fields of the last data frame), then with `hwfoc_probe_push_units` as well (feature `units`:
+# voltage, currents and RPM under caller settings, temperatures from the ADC table), then with
+# `hwfoc_probe_datalink_push` alone (feature `datalink` without the default `esc`:
+# DatalinkDecoder::push, the counter and a few raw fields of each ESC of the last hub frame).
 #
 # After LTO the probe's own object in the archive holds exactly the code those entry points reach.
 # Counted, from that object: its .text* sections (entry points, hwfoc code, core's panic stubs;
@@ -70,6 +72,7 @@ measure() {
         exit 1
     fi
     (cd "$tmp" && "$ar" x "$lib" "$member" && mv "$member" probe.o)
+    "$nm" -u "$tmp/probe.o" | awk '{ print $NF }' >>"$tmp/helpers"
     # `size -A`: one "<section> <size> <addr>" line per section.
     "$size" -A "$tmp/probe.o" | awk -v label="$label" '
         $1 ~ /^\.text/ { text += $2 }
@@ -84,11 +87,15 @@ measure() {
 echo "hwfoc release code size on $target ($(rustc -V); opt-level \"s\", LTO, panic = abort)"
 measure "decoder (push + frame fields)"
 measure "decoder + units (conversions, ADC table)" --features units
+measure "DataLink decoder alone (push + frame fields)" --no-default-features --features datalink
 
-# The build asserts size_of::<Decoder>() == DECODER_STATE_BYTES for the target.
+# The build asserts size_of::<Decoder>() == DECODER_STATE_BYTES for the target, and the same of
+# the DataLink decoder.
 state=$(sed -n 's/^pub const DECODER_STATE_BYTES: usize = \([0-9]*\);.*/\1/p' src/lib.rs)
 echo "decoder state: ${state:?} bytes (size_of::<Decoder>(), owned by the caller)"
+dl_state=$(sed -n 's/^pub const DATALINK_DECODER_STATE_BYTES: usize = \([0-9]*\);.*/\1/p' src/lib.rs)
+echo "DataLink decoder state: ${dl_state:?} bytes (size_of::<DatalinkDecoder>(), owned by the caller)"
 
-# Symbols the probe object takes from outside (last build, a superset of the first).
-helpers=$("$nm" -u "$tmp/probe.o" | awk '{ print $NF }' | sort -u | tr '\n' ' ')
+# Symbols the probe objects take from outside (all three builds).
+helpers=$(sort -u "$tmp/helpers" | tr '\n' ' ')
 echo "not counted: ${helpers:-nothing }(compiler-builtins helpers), .ARM.exidx unwind index"

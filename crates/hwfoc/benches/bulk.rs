@@ -9,6 +9,10 @@
 //!   line noise (where a header-like `9B 16` comes once in 65 536 random byte pairs): a worst
 //!   case for the scanner.
 //!
+//! - `datalink_clean`, `datalink_noisy`: the DataLink V2 decoder on ~8 MiB of back-to-back hub
+//!   frames (160 bytes, 6 of 8 slots filled from 6 independent ESC profiles, counter +1), then the
+//!   same frames with garbage runs as in `noisy` before ~35% of frames, ~2% flipped and ~2% cut.
+//!
 //! Each stream is measured three ways: the `frames` iterator over the whole buffer, a `Decoder`
 //! fed 64 KiB chunks then flushed, and a `Decoder` pushed one byte at a time (the
 //! microcontroller path; on a 256 KiB slice only, as it is much slower).
@@ -21,6 +25,7 @@ use std::hint::black_box;
 use std::time::Duration;
 
 use criterion::{BenchmarkGroup, Criterion, Throughput, criterion_group, criterion_main};
+use hwfoc::datalink::{self, DatalinkDecoded, DatalinkDecoder, DatalinkFrame, FRAME_LEN};
 use hwfoc::{DataFrame, Decoded, Decoder, Frame, InfoFrame, Status, frames};
 
 /// Size of each generated stream.
@@ -95,6 +100,13 @@ impl Telemetry {
             return false;
         }
         self.data_since_info += 1;
+        let frame = self.next_data();
+        out.extend_from_slice(&frame.encode());
+        true
+    }
+
+    /// The next data frame's fields.
+    fn next_data(&mut self) -> DataFrame {
         let r = &mut self.rng;
         // Throttle random-walks between idle and full; the other fields follow it loosely.
         self.throttle = (self.throttle + r.range(0, 80) as i32 - 40).clamp(0, 1024);
@@ -126,8 +138,7 @@ impl Telemetry {
         if !r.chance(1) {
             self.packet = self.packet.wrapping_add(1);
         }
-        out.extend_from_slice(&frame.encode());
-        true
+        frame
     }
 }
 
@@ -316,7 +327,127 @@ fn bench_stream(g: &mut BenchmarkGroup<'_, criterion::measurement::WallTime>, bu
     });
 }
 
+/// A DataLink stream: back-to-back hub frames of 6 ESCs, or with noise as in [`noisy_stream`].
+fn datalink_stream(noisy: bool) -> (Vec<u8>, Expected) {
+    let mut escs: Vec<Telemetry> = (0..6u64)
+        .map(|i| Telemetry::new(0x9B9E_0102_0000_0001 + i * 0x1111))
+        .collect();
+    let mut rng = Rng(0xDA7A_11E4_0000_5EED);
+    let mut buf = Vec::with_capacity(STREAM_LEN + 512);
+    let mut e = Expected::default();
+    let mut counter = 0u16;
+    while buf.len() < STREAM_LEN {
+        if noisy && rng.chance(350) {
+            e.garbage_bytes += garbage(&mut rng, &mut buf, false);
+        }
+        let mut frame = DatalinkFrame::new(counter);
+        counter = counter.wrapping_add(1);
+        for (slot, esc) in frame.slots.iter_mut().zip(&mut escs) {
+            *slot = Some(esc.next_data());
+        }
+        let mut bytes = frame.encode();
+        if noisy && rng.chance(20) {
+            let bit = rng.range(0, FRAME_LEN as u32 * 8 - 1) as usize;
+            bytes[bit / 8] ^= 1 << (bit % 8);
+            e.flipped_frames += 1;
+            buf.extend_from_slice(&bytes);
+        } else if noisy && rng.chance(20) {
+            let keep = rng.range(1, FRAME_LEN as u32 - 1) as usize;
+            e.cut_frames += 1;
+            buf.extend_from_slice(&bytes[..keep]);
+        } else {
+            e.offsets.push(buf.len() as u64);
+            e.data_frames += 1;
+            buf.extend_from_slice(&bytes);
+        }
+    }
+    (buf, e)
+}
+
+/// Something from every DataLink frame, so that no decoding work can be optimised away.
+#[inline(always)]
+fn fold_datalink(acc: u64, d: &DatalinkDecoded) -> u64 {
+    let v = d.frame.slots[5].map_or(0, |e| u64::from(e.packet) ^ u64::from(e.status.0) << 16);
+    acc.wrapping_mul(31)
+        .wrapping_add(v ^ d.offset ^ u64::from(d.frame.counter))
+}
+
+/// Decodes a DataLink stream once and checks it: every intact frame found, no chance frame,
+/// the streaming decoder in agreement.
+fn check_datalink(name: &str, buf: &[u8], e: &Expected) {
+    let mut it = datalink::frames(buf);
+    let decoded: Vec<DatalinkDecoded> = it.by_ref().collect();
+    let s = *it.stats();
+    let offsets: Vec<u64> = decoded.iter().map(|d| d.offset).collect();
+    assert_eq!(offsets, e.offsets, "{name}: exactly the intact frames");
+    assert!(decoded.iter().all(|d| d.frame.escs().count() == 6));
+    eprintln!(
+        "{name}: {} bytes, {} frames, {} garbage bytes ({:.1}%), {} flipped-bit frames, {} cut \
+         frames\n  decoder: {s}",
+        buf.len(),
+        e.data_frames,
+        e.garbage_bytes,
+        100.0 * e.garbage_bytes as f64 / buf.len() as f64,
+        e.flipped_frames,
+        e.cut_frames,
+    );
+    let mut dec = DatalinkDecoder::new();
+    let mut all = Vec::with_capacity(decoded.len());
+    dec.decode_all(buf, |d| all.push(d));
+    assert_eq!(
+        all, decoded,
+        "{name}: DatalinkDecoder and frames() disagree"
+    );
+    assert_eq!(*dec.stats(), s, "{name}: statistics disagree");
+}
+
+fn bench_datalink(g: &mut BenchmarkGroup<'_, criterion::measurement::WallTime>, buf: &[u8]) {
+    g.throughput(Throughput::Bytes(buf.len() as u64));
+    g.bench_function("frames", |b| {
+        b.iter(|| {
+            let mut acc = 0u64;
+            for d in datalink::frames(black_box(buf)) {
+                acc = fold_datalink(acc, &d);
+            }
+            black_box(acc)
+        })
+    });
+    g.bench_function("feed_64k", |b| {
+        b.iter(|| {
+            let mut acc = 0u64;
+            let mut dec = DatalinkDecoder::new();
+            for chunk in black_box(buf).chunks(CHUNK) {
+                dec.feed(chunk, |d| acc = fold_datalink(acc, &d));
+            }
+            dec.flush(|d| acc = fold_datalink(acc, &d));
+            black_box(dec.stats().bytes_skipped());
+            black_box(acc)
+        })
+    });
+    let small = &buf[..PUSH_LEN];
+    g.throughput(Throughput::Bytes(small.len() as u64));
+    g.bench_function("push_256k", |b| {
+        b.iter(|| {
+            let mut acc = 0u64;
+            let mut dec = DatalinkDecoder::new();
+            for &byte in black_box(small) {
+                dec.push(byte, |d| acc = fold_datalink(acc, &d));
+            }
+            dec.flush(|d| acc = fold_datalink(acc, &d));
+            black_box(dec.stats().bytes_skipped());
+            black_box(acc)
+        })
+    });
+}
+
 fn bulk(c: &mut Criterion) {
+    for (name, noisy) in [("datalink_clean", false), ("datalink_noisy", true)] {
+        let (buf, expected) = datalink_stream(noisy);
+        check_datalink(name, &buf, &expected);
+        let mut g = c.benchmark_group(name);
+        bench_datalink(&mut g, &buf);
+        g.finish();
+    }
     let streams = [
         ("clean", clean_stream()),
         ("noisy", noisy_stream(false)),

@@ -46,6 +46,26 @@ info_text="$(printf '%-16s%-16s%-16s%-16s%-8s' '' XR_FOC_ESC HW577_KZ1_V1.1 XR-0
 info_frame="\\x9b\\x4c\\x01\\x01${info_text}\\x34"
 seed_stream="\\x00\\x9b\\x13${data_frame}${info_frame}\\x9b\\x16\\x01\\x02${data_frame}"
 
+# DataLink V2 seeds: a hub frame whose slot 0 holds that data frame's payload and whose other
+# slots are empty, with length byte 0x9E (counter 1) and 0xA0 (counter 2); CRC-16/XMODEM from
+# Python's binascii.crc_hqx(frame[:158], 0), as pinned in tests/datalink.rs.
+zero18='\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00'
+dl_records='\x00\x05\xc2\x00\x00\x00\x00\x00\x00\x00\xf7\xff\xff\xff\xff\xce\xd1\x00\x00'
+for ch in 1 2 3 4 5 6 7; do dl_records+="\\x0${ch}${zero18}"; done
+datalink_frame="\\x9b\\x9e\\x01\\x02\\x00\\x01${dl_records}\\x61\\x34"
+datalink_frame_a0="\\x9b\\xa0\\x01\\x02\\x00\\x02${dl_records}\\xc9\\x15"
+datalink_stream="\\x00\\x9b\\x13\\x9b\\x9e\\x01\\x02${datalink_frame}\\x9b${datalink_frame_a0}"
+
+seed_datalink() { # seed_datalink TARGET PREFIX: as seed, with DataLink frames
+    local dir="$fuzz_dir/corpus/$1"
+    mkdir -p "$dir"
+    if [ -z "$(ls -A "$dir")" ]; then
+        printf "$2${datalink_frame}" >"$dir/seed-datalink-frame"
+        printf "$2${datalink_frame_a0}" >"$dir/seed-datalink-frame-a0"
+        printf "$2${datalink_stream}" >"$dir/seed-datalink-stream"
+    fi
+}
+
 seed() { # seed TARGET PREFIX: write seeds unless the corpus already has inputs
     local dir="$fuzz_dir/corpus/$1"
     mkdir -p "$dir"
@@ -61,6 +81,8 @@ for target in $(cargo "${toolchain[@]}" fuzz list); do
     case "$target" in
     # stream: byte 0 picks one schedule byte, 0x07 = feed 7 bytes at a time.
     stream) seed "$target" '\x00\x07' ;;
+    # datalink: the same schedule layout as stream.
+    datalink) seed_datalink "$target" '\x00\x07' ;;
     *) seed "$target" '' ;;
     esac
     echo "=== fuzz target $target: ${duration} s" >&2

@@ -1,6 +1,9 @@
 //! Invariant checks shared by the fuzz targets in `fuzz_targets/`.
 
-use hwfoc::{Decoded, Frame, LinkStats, Parsed, parse};
+use hwfoc::datalink::LengthByte;
+use hwfoc::{
+    DatalinkDecoded, DatalinkFrame, DatalinkStats, Decoded, Frame, LinkStats, Parsed, parse,
+};
 
 /// Panics unless `decoded` and `stats` are a consistent decoding of `input`, a whole stream
 /// (a flushed `Decoder`, or an exhausted `frames` iterator):
@@ -64,6 +67,82 @@ pub fn check_stream(input: &[u8], decoded: &[Decoded], stats: &LinkStats) {
             Ok(Parsed::Complete(d.frame, n)),
             "parse disagrees at {start}"
         );
+        next_free = end as u64;
+    }
+}
+
+/// Panics unless `decoded` and `stats` are a consistent DataLink decoding of `input`, a whole
+/// stream (a flushed `DatalinkDecoder`, or an exhausted `datalink::frames` iterator):
+///
+/// - every byte is accounted for: `bytes == input.len() == 160*frames + skipped`, and every
+///   frame counted under one length byte;
+/// - every record of every frame counted once (a channel's, empty, bad or duplicate channel),
+///   and each channel's record count matches the frames given;
+/// - offsets strictly increase and frames never overlap;
+/// - `DatalinkFrame::parse_with_report` reads the same frame and report at each offset, and
+///   the frame re-encodes to the input bytes when nothing of it was dropped (no bad or
+///   duplicate channel, the length byte 0x9E, every channel byte its position).
+pub fn check_datalink_stream(input: &[u8], decoded: &[DatalinkDecoded], stats: &DatalinkStats) {
+    assert_eq!(stats.bytes(), input.len() as u64, "bytes counted");
+    assert_eq!(
+        stats.bytes(),
+        160 * u64::from(stats.frames()) + stats.bytes_skipped(),
+        "bytes == 160*frames + skipped: {stats}"
+    );
+    assert_eq!(decoded.len() as u64, u64::from(stats.frames()), "frames");
+    assert_eq!(
+        u64::from(stats.frames()),
+        u64::from(stats.frames_with_length_byte(LengthByte::Covered))
+            + u64::from(stats.frames_with_length_byte(LengthByte::Total)),
+        "frames by length byte"
+    );
+    assert_eq!(
+        8 * u64::from(stats.frames()),
+        stats.records()
+            + u64::from(stats.empty_slots())
+            + u64::from(stats.bad_channels())
+            + u64::from(stats.duplicate_channels()),
+        "every record counted once: {stats}"
+    );
+    for ch in 0..8 {
+        let n = decoded
+            .iter()
+            .filter(|d| d.frame.slots[ch].is_some())
+            .count();
+        assert_eq!(
+            n as u64,
+            u64::from(stats.channel(ch).unwrap().count()),
+            "channel {ch}"
+        );
+    }
+    let mut next_free = 0u64;
+    for d in decoded {
+        assert!(
+            d.offset >= next_free,
+            "frame at {} overlaps the one before",
+            d.offset
+        );
+        let start = usize::try_from(d.offset).expect("offset fits usize");
+        let end = start + 160;
+        assert!(end <= input.len(), "frame at {start} runs past the input");
+        assert_eq!(
+            DatalinkFrame::parse_with_report(&input[start..]),
+            Ok((d.frame, d.report)),
+            "parse disagrees at {start}"
+        );
+        let r = &d.report;
+        let in_place = (0..8).all(|ch| input[start + 6 + 19 * ch] == ch as u8);
+        if r.bad_channels == 0
+            && r.duplicate_channels == 0
+            && r.length_byte == LengthByte::Covered
+            && in_place
+        {
+            assert_eq!(
+                &d.frame.encode()[..],
+                &input[start..end],
+                "frame at {start} does not re-encode to its bytes"
+            );
+        }
         next_free = end as u64;
     }
 }

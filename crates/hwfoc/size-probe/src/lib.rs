@@ -5,17 +5,26 @@
 //! - `hwfoc_probe_push`: one byte into a [`Decoder`], a few raw fields of the last data frame out.
 //! - `hwfoc_probe_push_units` (feature `units`): the same, then physical values (voltage,
 //!   currents and RPM under the caller's settings, temperatures from the ADC table).
+//! - `hwfoc_probe_datalink_push` (feature `datalink`): one byte into a [`DatalinkDecoder`], the
+//!   frame counter and a few raw fields of each ESC of the last DataLink frame out.
+//!
+//! The HW-FOC entry points are behind the default feature `esc`, so that
+//! `--no-default-features --features datalink` measures the DataLink decoder alone.
 //!
 //! The only `unsafe` is the `no_mangle` attribute; the decoder state is the caller's
 //! (`&mut Decoder`, opaque to C), so there is no mutable static.
 
 #![no_std]
 
-use hwfoc::{Decoder, Frame};
+use hwfoc::{DatalinkDecoder, Decoder};
 
 /// `size_of::<Decoder>()` on the target; the build fails if it changes (the script reports it).
 pub const DECODER_STATE_BYTES: usize = 120;
 const _: () = assert!(core::mem::size_of::<Decoder>() == DECODER_STATE_BYTES);
+
+/// `size_of::<DatalinkDecoder>()` on the target, checked as [`DECODER_STATE_BYTES`] is.
+pub const DATALINK_DECODER_STATE_BYTES: usize = 380;
+const _: () = assert!(core::mem::size_of::<DatalinkDecoder>() == DATALINK_DECODER_STATE_BYTES);
 
 /// Raw fields of a data frame, as firmware might copy them out.
 #[repr(C)]
@@ -41,29 +50,43 @@ pub struct ProbeFrame {
     pub cap_adc: u8,
 }
 
-/// Pushes one byte into `state`; returns true and fills `out` when the byte completes at least
-/// one data frame (the last one if it completes several). Info frames are decoded but not copied.
-#[unsafe(no_mangle)]
-#[inline(never)] // called from `hwfoc_probe_push_units` too: keep one copy of the decoder
-pub extern "C" fn hwfoc_probe_push(state: &mut Decoder, byte: u8, out: &mut ProbeFrame) -> bool {
-    let mut got = false;
-    state.push(byte, |d| {
-        if let Frame::Data(f) = d.frame {
-            *out = ProbeFrame {
-                offset: d.offset,
-                packet: f.packet,
-                voltage_raw: f.voltage_raw,
-                current_raw: f.current_raw,
-                phase_current_raw: f.phase_current_raw,
-                erpm_raw: f.erpm_raw,
-                status: f.status.0,
-                mos_adc: f.mos_adc,
-                cap_adc: f.cap_adc,
-            };
-            got = true;
-        }
-    });
-    got
+#[cfg(feature = "esc")]
+pub use esc::*;
+
+#[cfg(feature = "esc")]
+mod esc {
+    use hwfoc::{Decoder, Frame};
+
+    use crate::ProbeFrame;
+
+    /// Pushes one byte into `state`; returns true and fills `out` when the byte completes at least
+    /// one data frame (the last one if it completes several). Info frames are decoded but not copied.
+    #[unsafe(no_mangle)]
+    #[inline(never)] // called from `hwfoc_probe_push_units` too: keep one copy of the decoder
+    pub extern "C" fn hwfoc_probe_push(
+        state: &mut Decoder,
+        byte: u8,
+        out: &mut ProbeFrame,
+    ) -> bool {
+        let mut got = false;
+        state.push(byte, |d| {
+            if let Frame::Data(f) = d.frame {
+                *out = ProbeFrame {
+                    offset: d.offset,
+                    packet: f.packet,
+                    voltage_raw: f.voltage_raw,
+                    current_raw: f.current_raw,
+                    phase_current_raw: f.phase_current_raw,
+                    erpm_raw: f.erpm_raw,
+                    status: f.status.0,
+                    mos_adc: f.mos_adc,
+                    cap_adc: f.cap_adc,
+                };
+                got = true;
+            }
+        });
+        got
+    }
 }
 
 #[cfg(feature = "units")]
@@ -142,6 +165,75 @@ mod units {
         out.mos_c = frame.mos_temp().celsius().unwrap_or(f32::NAN);
         out.cap_c = frame.cap_temp().celsius().unwrap_or(f32::NAN);
         true
+    }
+}
+
+#[cfg(feature = "datalink")]
+pub use datalink::*;
+
+#[cfg(feature = "datalink")]
+mod datalink {
+    use hwfoc::DatalinkDecoder;
+    use hwfoc::datalink::CHANNELS;
+
+    /// Raw fields of one ESC of a DataLink frame.
+    #[repr(C)]
+    #[derive(Debug, Clone, Copy, Default)]
+    pub struct ProbeEsc {
+        /// Packet number.
+        pub packet: u16,
+        /// Input voltage, 0.1 V units.
+        pub voltage_raw: u16,
+        /// Input current, raw.
+        pub current_raw: i16,
+        /// Electrical RPM / 10.
+        pub erpm_raw: u16,
+        /// Status word (fault bits).
+        pub status: u16,
+        /// 1 when the slot holds an ESC, else 0.
+        pub present: u8,
+    }
+
+    /// A DataLink frame as firmware might copy it out.
+    #[repr(C)]
+    #[derive(Debug, Clone, Copy, Default)]
+    pub struct ProbeDatalink {
+        /// Stream offset of the frame's first byte.
+        pub offset: u64,
+        /// The hub's frame counter.
+        pub counter: u16,
+        /// The ESCs by channel.
+        pub escs: [ProbeEsc; CHANNELS],
+    }
+
+    /// Pushes one byte into `state`; returns true and fills `out` when the byte completes a
+    /// DataLink frame.
+    #[unsafe(no_mangle)]
+    pub extern "C" fn hwfoc_probe_datalink_push(
+        state: &mut DatalinkDecoder,
+        byte: u8,
+        out: &mut ProbeDatalink,
+    ) -> bool {
+        let mut got = false;
+        state.push(byte, |d| {
+            out.offset = d.offset;
+            out.counter = d.frame.counter;
+            for (o, slot) in out.escs.iter_mut().zip(&d.frame.slots) {
+                *o = match slot {
+                    Some(e) => ProbeEsc {
+                        packet: e.packet,
+                        voltage_raw: e.voltage_raw,
+                        current_raw: e.current_raw,
+                        erpm_raw: e.erpm_raw,
+                        status: e.status.0,
+                        present: 1,
+                    },
+                    None => ProbeEsc::default(),
+                };
+            }
+            got = true;
+        });
+        got
     }
 }
 

@@ -228,7 +228,7 @@ impl DatalinkDecoder {
             tmp[..held].copy_from_slice(&self.buf[..held]);
             tmp[held..held + take].copy_from_slice(&data[..take]);
             let n = held + take;
-            let tmp_base = start - held as u64;
+            let tmp_base = start.wrapping_sub(held as u64);
             let pos = scan_all::<false>(&tmp[..n], tmp_base, &mut self.stats, &mut on_frame);
             let Some(used) = pos.checked_sub(held) else {
                 // `data` ran out before the held candidate was decided.
@@ -254,7 +254,7 @@ impl DatalinkDecoder {
     /// Statistics and counter tracking carry on across the call.
     pub fn flush(&mut self, mut on_frame: impl FnMut(DatalinkDecoded)) {
         let held = usize::from(self.len);
-        let base = self.stats.bytes() - held as u64;
+        let base = self.stats.bytes().wrapping_sub(held as u64);
         scan_all::<true>(&self.buf[..held], base, &mut self.stats, &mut on_frame);
         self.len = 0;
     }
