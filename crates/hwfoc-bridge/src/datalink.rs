@@ -3,19 +3,21 @@
 //!
 //! # When a frame is sent
 //!
-//! Each ESC has a slot, filled by its newest frame; a DataLink frame carries the slots filled
-//! since the previous one and empties them (a slot without a new frame is sent empty: no stale
-//! value is repeated, and an ESC that went silent stops being sent, which is how the DataLink
-//! protocol says it). A frame is sent when something is waiting and [`Pacing::period`] has
-//! passed since the previous frame (at once, after a pause), or earlier when an ESC's next frame
-//! arrives while its slot is still full, as long as [`Pacing::min_gap`] has passed (otherwise
-//! the older frame is superseded, and counted as such). So every frame of ESCs sending at the
-//! protocol's 50 ms period gets through, at about the ESCs' own rate.
+//! Each ESC has a slot: a short queue of its frames not yet sent. A DataLink frame carries the
+//! oldest waiting frame of each ESC (an ESC with none waiting is sent empty: no stale value is
+//! repeated, and an ESC that went silent stops being sent, which is how the DataLink protocol
+//! says it). A frame is sent when something is waiting and [`Pacing::period`] has passed since
+//! the previous frame (at once, after a pause), or earlier, as soon as [`Pacing::min_gap`] has
+//! passed, while some ESC has a second frame waiting. So every frame of ESCs sending at the
+//! protocol's 50 ms period gets through, at about the ESCs' own rate, even when a read brings
+//! two frames of one ESC at once; only an ESC more than [`QUEUE`] frames ahead of the line
+//! loses its oldest (counted as superseded).
 //!
 //! The gap matters to receivers: ArduPilot's DataLink driver reads only when exactly one
 //! frame (160 bytes) is waiting, polling every 10 ms; frames sent back to back would be
 //! discarded. [`Pacing::default`] keeps at least 10 ms of silence between frames.
 
+use std::collections::VecDeque;
 use std::io::Write;
 use std::time::{Duration, Instant};
 
@@ -44,6 +46,9 @@ impl Default for Pacing {
     }
 }
 
+/// The most frames of one ESC waiting to be sent.
+pub const QUEUE: usize = 4;
+
 /// How long a lost port waits before it is reopened.
 const REOPEN_AFTER: Duration = Duration::from_secs(1);
 
@@ -60,7 +65,7 @@ enum Line {
 }
 
 /// One ESC's slot: its newest frame and when it arrived.
-#[derive(Clone, Copy)]
+#[derive(Debug, Clone, Copy)]
 struct Slot {
     frame: DataFrame,
     arrived: Instant,
@@ -72,7 +77,7 @@ pub struct DatalinkOutput {
     name: String,
     line: Line,
     pacing: Pacing,
-    slots: [Option<Slot>; datalink::CHANNELS],
+    slots: [VecDeque<Slot>; datalink::CHANNELS],
     counter: u16,
     last_sent: Option<Instant>,
     not_carried: u64,
@@ -109,7 +114,7 @@ impl DatalinkOutput {
             name,
             line,
             pacing,
-            slots: [None; datalink::CHANNELS],
+            slots: Default::default(),
             counter: 0,
             last_sent: None,
             not_carried: 0,
@@ -128,19 +133,17 @@ impl DatalinkOutput {
             .is_none_or(|last| now.saturating_duration_since(last) >= gap)
     }
 
-    /// Sends the filled slots as one frame and empties them.
+    /// Sends the oldest waiting frame of each ESC as one DataLink frame.
     fn send(&mut self, now: Instant) -> Result<(), OutputError> {
-        let mut frame = DatalinkFrame {
+        // The frames are taken whether or not they get out: a frame that could not be written
+        // is lost, as on a real line, and the next one carries the next frames.
+        let carried: [Option<Slot>; datalink::CHANNELS] =
+            std::array::from_fn(|i| self.slots[i].pop_front());
+        let frame = DatalinkFrame {
             counter: self.counter,
-            slots: [None; datalink::CHANNELS],
+            slots: carried.map(|slot| slot.map(|s| s.frame)),
         };
-        for (slot, out) in self.slots.iter().zip(frame.slots.iter_mut()) {
-            *out = slot.map(|s| s.frame);
-        }
         let bytes = frame.encode();
-        // The frame is taken whether or not it gets out: a frame that could not be written is
-        // lost, as on a real line, and the next one carries the next frames.
-        let carried = std::mem::replace(&mut self.slots, [None; datalink::CHANNELS]);
         self.last_sent = Some(now);
         self.counter = self.counter.wrapping_add(1);
         self.write(&bytes, now)?;
@@ -226,25 +229,31 @@ impl Output for DatalinkOutput {
             self.not_carried += 1;
             return;
         };
-        if self.slots[index].is_some() {
-            // The ESC's previous frame is still waiting: send it now if the line allows,
-            // else the newer frame takes its place. (A failure here is counted; poll reports
-            // the state of the line at its next call.)
-            if self.waited(update.arrived.max(Instant::now()), self.pacing.min_gap) {
-                let result = self.send(Instant::now());
-                let _ = self.count(result);
-            } else {
-                self.stats.superseded += 1;
-            }
+        let queue = &mut self.slots[index];
+        if queue.len() == QUEUE {
+            queue.pop_front();
+            self.stats.superseded += 1;
         }
-        self.slots[index] = Some(Slot {
+        queue.push_back(Slot {
             frame: *update.frame,
             arrived: update.arrived,
         });
+        // A second frame of this ESC is waiting: send as soon as the line allows. (A failure
+        // here is counted; poll reports the state of the line at its next call.)
+        if queue.len() >= 2 && self.waited(Instant::now(), self.pacing.min_gap) {
+            let result = self.send(Instant::now());
+            let _ = self.count(result);
+        }
     }
 
     fn poll(&mut self, now: Instant) -> Result<(), OutputError> {
-        if self.slots.iter().any(Option::is_some) && self.waited(now, self.pacing.period) {
+        let waiting = self.slots.iter().map(VecDeque::len).max().unwrap_or(0);
+        let due = match waiting {
+            0 => false,
+            1 => self.waited(now, self.pacing.period),
+            _ => self.waited(now, self.pacing.min_gap),
+        };
+        if due {
             let result = self.send(now);
             return self.count(result);
         }
