@@ -25,3 +25,15 @@ HWFOC_PYMAVLINK="$venv/bin/python" cargo test -p hwfoc-bridge --test mavlink_pym
 grep -q "pymavlink decoded and checked" "${TMPDIR:-/tmp}/hwfoc-ci-mavlink.log" \
   || { echo "the pymavlink test did not run" >&2; exit 1; }
 echo "::: mavlink-pymavlink: ok ($((SECONDS - start)) s)"
+
+# The bridge end to end: a recording replayed by `hwfoc bridge --mavlink`, received by pymavlink,
+# with the values `hwfoc decode` gives for the same recording.
+start=$SECONDS
+echo "::: mavlink-bridge: cargo test -p hwfoc-cli --test bridge pymavlink"
+HWFOC_PYMAVLINK="$venv/bin/python" cargo test -p hwfoc-cli --test bridge pymavlink -- --nocapture 2>&1 \
+  | tee "${TMPDIR:-/tmp}/hwfoc-ci-mavlink-bridge.log"
+grep -q "skipped" "${TMPDIR:-/tmp}/hwfoc-ci-mavlink-bridge.log" \
+  && { echo "the bridge's pymavlink test did not run" >&2; exit 1; }
+grep -q "1 passed" "${TMPDIR:-/tmp}/hwfoc-ci-mavlink-bridge.log" \
+  || { echo "the bridge's pymavlink test did not pass" >&2; exit 1; }
+echo "::: mavlink-bridge: ok ($((SECONDS - start)) s)"
