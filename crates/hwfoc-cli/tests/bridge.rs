@@ -456,3 +456,55 @@ fn pymavlink_reads_a_replayed_recording_with_the_values_decode_gives() {
         assert!(messages.iter().any(|m| m["name"] == name), "no {name}");
     }
 }
+
+#[test]
+fn the_monitor_shows_a_datalink_port_as_its_escs() {
+    let hub = pty();
+    let mut writer = hub.master.try_clone().unwrap();
+    let stop = Arc::new(AtomicBool::new(false));
+    let writing = Arc::clone(&stop);
+    thread::spawn(move || {
+        let mut k = 0u16;
+        while !writing.load(Ordering::Relaxed) {
+            let mut frame = DatalinkFrame::new(k);
+            for channel in [0usize, 1, 5] {
+                frame.slots[channel] = Some(DataFrame {
+                    packet: k,
+                    voltage_raw: 240 + channel as u16,
+                    ..Default::default()
+                });
+            }
+            if writer.write_all(&frame.encode()).is_err() {
+                break;
+            }
+            k = k.wrapping_add(1);
+            thread::sleep(Duration::from_millis(50));
+        }
+    });
+    let mut monitor = Running::start(&[
+        "monitor",
+        &hub.path.to_string_lossy(),
+        "--baud",
+        "115200",
+        "--plain",
+        "--no-config",
+        "--interval",
+        "0.5",
+    ]);
+    let line = monitor.wait_for_stdout("channel 5", Duration::from_secs(10));
+    assert!(line.contains("24.5 V"), "{line}");
+    monitor.wait_for_stdout("channel 1", Duration::from_secs(5));
+    monitor.signal(Signal::SIGINT);
+    assert!(
+        monitor.wait(Duration::from_secs(10)),
+        "{}",
+        monitor.stderr()
+    );
+    stop.store(true, Ordering::Relaxed);
+    let out = monitor.stdout();
+    assert!(out.contains("channel 0"), "{out}");
+    assert!(
+        !out.contains("channel 2"),
+        "an empty slot is not an ESC: {out}"
+    );
+}

@@ -2,10 +2,11 @@
 //! alarms and the alarm log. No terminal here: the dashboard and the headless printers only
 //! read it.
 
-use std::collections::VecDeque;
+use std::collections::{HashMap, VecDeque};
 
+use hwfoc::datalink;
 use hwfoc::{Fault, InfoFrame, Settings};
-use hwfoc_io::stream::EscLink;
+use hwfoc_io::stream::{EscLink, WireKind};
 
 use super::alarms::{Change, Kind, Latch, Level, Threshold};
 use super::config::Limits;
@@ -333,6 +334,10 @@ pub struct Fleet {
     pub peak_total_w: Option<f64>,
     streams: PortStreams,
     limits: Limits,
+    /// The port each ESC is read from (a DataLink hub's port has an ESC per channel heard).
+    ports: Vec<usize>,
+    /// The ESC shown for each channel heard of each port that turned out to be a DataLink hub.
+    channels: HashMap<(usize, usize), usize>,
 }
 
 impl Fleet {
@@ -367,6 +372,8 @@ impl Fleet {
             .collect::<Vec<_>>();
         Fleet {
             streams: PortStreams::with_settings(baud, escs.iter().map(|e| e.settings).collect()),
+            ports: (0..escs.len()).collect(),
+            channels: HashMap::new(),
             escs,
             log: VecDeque::new(),
             logged: 0,
@@ -386,26 +393,47 @@ impl Fleet {
     pub fn on_event(&mut self, event: &PortEvent) -> usize {
         match event {
             PortEvent::Data { port, .. } => {
+                let port = *port;
                 let mut got = Received::default();
                 let Some(stats) = self.streams.feed(event, &mut got) else {
                     return 0;
                 };
+                let hub = self
+                    .streams
+                    .stream(port)
+                    .is_some_and(|s| s.kind() == WireKind::Hub);
                 let mut data = 0;
                 for item in got.0 {
                     match item {
                         Item::Record(r) => {
+                            let i = if hub {
+                                let channel = usize::from(r.esc) - port * datalink::CHANNELS;
+                                self.channel_view(port, channel)
+                            } else {
+                                port
+                            };
                             // Every frame of a port event has its receive time.
-                            self.on_data(*port, r.t_s.unwrap_or(0.0), r);
+                            self.on_data(i, r.t_s.unwrap_or(0.0), r);
                             data += 1;
                         }
                         Item::Info(t, info) => {
-                            let esc = &mut self.escs[*port];
+                            let esc = &mut self.escs[port];
                             esc.info = Some(info);
                             esc.last_frame_t = t;
                         }
                     }
                 }
-                self.escs[*port].stats = stats;
+                if hub {
+                    if let Some(stream) = self.streams.stream(port) {
+                        for (&(p, channel), &i) in &self.channels {
+                            if p == port {
+                                self.escs[i].stats = stream.link(channel as u8);
+                            }
+                        }
+                    }
+                } else {
+                    self.escs[port].stats = stats;
+                }
                 self.frames += data as u64;
                 if data > 0 {
                     self.note_total_power();
@@ -414,7 +442,11 @@ impl Fleet {
             }
             PortEvent::Lost { port, t_ns, reason } => {
                 let t = *t_ns as f64 / 1e9;
-                if let Some(esc) = self.escs.get_mut(*port) {
+                for port in self.views_of(*port) {
+                    let port = &port;
+                    let Some(esc) = self.escs.get_mut(*port) else {
+                        continue;
+                    };
                     // No current is assumed over the time the port was away.
                     esc.energy.break_here();
                     esc.link = Link::Down {
@@ -434,7 +466,11 @@ impl Fleet {
             }
             PortEvent::Back { port, t_ns } => {
                 let t = *t_ns as f64 / 1e9;
-                if let Some(esc) = self.escs.get_mut(*port) {
+                for port in self.views_of(*port) {
+                    let port = &port;
+                    let Some(esc) = self.escs.get_mut(*port) else {
+                        continue;
+                    };
                     esc.link = Link::Up;
                     // Stale counts again from now: the ESC has a second to speak.
                     esc.started = t;
@@ -445,6 +481,48 @@ impl Fleet {
                 0
             }
         }
+    }
+
+    /// The ESCs shown for port `port`: the port's own, and one per DataLink channel heard.
+    fn views_of(&self, port: usize) -> Vec<usize> {
+        (0..self.escs.len())
+            .filter(|&i| self.ports[i] == port)
+            .collect()
+    }
+
+    /// The ESC shown for channel `channel` of the DataLink hub on `port`: the port's own ESC for
+    /// the first channel heard, a new one (after all others) for each next channel.
+    fn channel_view(&mut self, port: usize, channel: usize) -> usize {
+        if let Some(&i) = self.channels.get(&(port, channel)) {
+            return i;
+        }
+        let taken = self.channels.keys().any(|&(p, _)| p == port);
+        let name = self.escs[port]
+            .name
+            .split(" channel ")
+            .next()
+            .unwrap_or_default()
+            .to_string();
+        let i = if taken {
+            let mut view = self.escs[port].clone();
+            view.last = None;
+            view.last_frame_t = None;
+            view.peaks = Peaks::default();
+            view.energy = Energy::new();
+            view.history.clear();
+            view.info = None;
+            view.alarms = Alarms::default();
+            view.recent.clear();
+            view.label = None;
+            self.escs.push(view);
+            self.ports.push(port);
+            self.escs.len() - 1
+        } else {
+            port
+        };
+        self.escs[i].name = format!("{name} channel {channel}");
+        self.channels.insert((port, channel), i);
+        i
     }
 
     fn on_data(&mut self, i: usize, t: f64, r: Record) {
