@@ -526,3 +526,61 @@ fn failure_flags_of_every_fault() {
         32
     );
 }
+
+/// The serial target, on a pseudo-terminal: the same messages, back to back on the line, read
+/// back by the mavlink crate's parser; a port that goes away is lost and reopened.
+#[cfg(unix)]
+#[test]
+fn a_serial_port_carries_the_same_messages() {
+    use std::io::Read;
+    use std::os::fd::AsFd;
+
+    let pair = nix::pty::openpty(None, None).unwrap();
+    let mut termios = nix::sys::termios::tcgetattr(pair.slave.as_fd()).unwrap();
+    nix::sys::termios::cfmakeraw(&mut termios);
+    nix::sys::termios::tcsetattr(
+        pair.slave.as_fd(),
+        nix::sys::termios::SetArg::TCSANOW,
+        &termios,
+    )
+    .unwrap();
+    let path = nix::unistd::ttyname(pair.slave.as_fd()).unwrap();
+    let target =
+        MavlinkTarget::parse(&format!("serial:{}:115200", path.to_string_lossy())).unwrap();
+    let mut out = MavlinkOutput::open(target, MavlinkOptions::default()).unwrap();
+    let now = Instant::now();
+    for (packet, esc) in [(1u16, 0u8), (1, 1), (2, 0)] {
+        let f = frame(packet, Status::OK);
+        let record = Record::new(None, esc, &f, &Settings::default());
+        out.update(&Update {
+            esc,
+            frame: &f,
+            record: &record,
+            arrived: now,
+        });
+        out.poll(Instant::now()).unwrap();
+    }
+    assert_eq!(out.stats().errors, 0);
+    let mut master = std::fs::File::from(pair.master);
+    let mut bytes = vec![0u8; 4096];
+    let n = master.read(&mut bytes).unwrap();
+    let mut reader = MavlinkReader::new(&bytes[..n]);
+    let mut got = Vec::new();
+    while let Ok((_, message)) = reader.read_message::<MavMessage>(MavlinkVersion::V2) {
+        got.push(message);
+    }
+    let names = names(
+        &got.into_iter()
+            .map(|m| (MavHeader::default(), m))
+            .collect::<Vec<_>>(),
+    );
+    assert!(names.iter().any(|n| n == "HEARTBEAT"), "{names:?}");
+    assert!(
+        names.iter().any(|n| n.starts_with("ESC_TELEMETRY_1_TO_4")),
+        "{names:?}"
+    );
+    assert!(
+        names.iter().any(|n| n.starts_with("ESC_STATUS")),
+        "{names:?}"
+    );
+}
