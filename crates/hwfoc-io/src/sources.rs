@@ -152,6 +152,16 @@ impl Sources {
         &self.read
     }
 
+    /// The clock of the inputs read so far, if they all have the same one (see
+    /// [`crate::time::Clock`]): whether their times can be shown as dates.
+    pub fn clock(&self) -> Option<Clock> {
+        let first = self.read.first()?.format.clock();
+        self.read
+            .iter()
+            .all(|i| i.format.clock() == first)
+            .then_some(first)
+    }
+
     /// The ESCs found so far, by index.
     pub fn escs(&self) -> &[Esc] {
         &self.escs

@@ -101,17 +101,6 @@ pub enum TimeError {
         /// What is wrong, as `jiff` says it.
         reason: String,
     },
-    /// A date-time given for an input whose clock is not a wall clock.
-    NoWallClock {
-        /// The option (`--from`).
-        option: &'static str,
-        /// The time as given.
-        time: String,
-        /// The input.
-        input: String,
-        /// Its format.
-        format: InputFormat,
-    },
 }
 
 impl fmt::Display for TimeError {
@@ -131,16 +120,6 @@ impl fmt::Display for TimeError {
             TimeError::BadDate { text, reason } => {
                 write!(f, "{text:?} is not a valid date-time: {reason}")
             }
-            TimeError::NoWallClock {
-                option,
-                time,
-                input,
-                format,
-            } => write!(
-                f,
-                "{option} {time}: {input} ({format}) has no wall clock, its times count from \
-                 the start of its capture: give seconds of its clock or +S from the first frame"
-            ),
         }
     }
 }
@@ -252,6 +231,21 @@ pub fn iso8601_in(t_s: f64, zone: &TimeZone) -> String {
             .strftime("%Y-%m-%dT%H:%M:%S%.3f%:z")
             .to_string(),
         None => iso8601(t_s),
+    }
+}
+
+/// The receive times of some frames, from `first` to `last`, as a person reads them: as
+/// dates too where the clock is a wall clock (`wall`), for a message about a window that
+/// held no frame.
+pub fn span_text(first: f64, last: f64, wall: bool) -> String {
+    if wall {
+        format!(
+            "the frames' t_s run from {first} to {last} s ({} to {})",
+            iso8601(first),
+            iso8601(last)
+        )
+    } else {
+        format!("the frames' t_s run from {first} to {last} s (the source's own clock)")
     }
 }
 
@@ -397,6 +391,19 @@ mod tests {
             "2026-11-23T14:03:00.250Z"
         );
         assert_eq!(Time::FromFirst(90.0).to_string(), "+90");
+    }
+
+    #[test]
+    fn spans_show_dates_on_a_wall_clock() {
+        assert_eq!(
+            span_text(1_795_442_580.0, 1_795_442_581.5, true),
+            "the frames' t_s run from 1795442580 to 1795442581.5 s \
+             (2026-11-23T14:03:00.000Z to 2026-11-23T14:03:01.500Z)"
+        );
+        assert_eq!(
+            span_text(0.5, 2.0, false),
+            "the frames' t_s run from 0.5 to 2 s (the source's own clock)"
+        );
     }
 
     #[test]
