@@ -726,7 +726,7 @@ impl EscReport<'_> {
                 );
             }
         }
-        let _ = writeln!(o, "energy       {}", energy_text(&self.energy()));
+        let _ = writeln!(o, "\nenergy       {}", energy_text(&self.energy()));
         o.push('\n');
         if self.episode_count == 0 {
             let _ = writeln!(o, "faults       none");
