@@ -268,6 +268,36 @@ mod tests {
         *stream.stats()
     }
 
+    /// The first byte held of a frame still arriving bounds the time of any frame to come.
+    #[test]
+    fn held_bytes_give_their_first_time() {
+        let (bytes, times) = timed(&[7, 8], 100.0);
+        let mut stream = Stream::new();
+        assert_eq!(stream.held_since(), None);
+        // The first frame whole and 10 bytes of the second: those 10 are held.
+        let cut = 24 + 10;
+        stream.feed(
+            Batch {
+                bytes: &bytes[..cut],
+                times: Some(&times[..cut]),
+                stream: 0,
+            },
+            |_, _| {},
+        );
+        assert_eq!(stream.held_since(), Some(times[24]));
+        let mut got = Vec::new();
+        stream.feed(
+            Batch {
+                bytes: &bytes[cut..],
+                times: Some(&times[cut..]),
+                stream: 0,
+            },
+            |t, _| got.push(t.unwrap()),
+        );
+        assert_eq!(got, [times[24]]);
+        assert_eq!(stream.held_since(), None);
+    }
+
     /// An ESC that restarts after a silence counts a restart, not the packets its new numbers
     /// skip; a silence that only hid frames counts them as lost.
     #[test]
