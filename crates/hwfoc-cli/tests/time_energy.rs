@@ -86,7 +86,9 @@ fn assert_time_order(rows: &[(u64, f64)]) {
 }
 
 fn decode(input: &str, window: &[&str]) -> Vec<Value> {
-    jsonl(&stdout(&ok(run(&[&["decode", input][..], window].concat()))))
+    jsonl(&stdout(&ok(
+        run(&[&["decode", input][..], window].concat()),
+    )))
 }
 
 #[test]
@@ -106,7 +108,11 @@ fn times_after_the_first_frame_select_exactly_their_frames() {
     assert_eq!(rows.iter().filter(|r| r.0 == 1).count(), 100);
     // The same window written every other way.
     let same = |from: &str, to: &str| {
-        assert_eq!(decode(&input, &["--from", from, "--to", to]), window, "{from} {to}");
+        assert_eq!(
+            decode(&input, &["--from", from, "--to", to]),
+            window,
+            "{from} {to}"
+        );
     };
     same("+5s", "+10000ms");
     same("+PT5S", "+PT10S");
@@ -131,8 +137,16 @@ fn local_times_are_read_in_the_zone_of_tz() {
     let input = two_escs(&dir);
     let expected = decode(&input, &["--from", "+5", "--to", "+10"]);
     for (zone, from, to) in [
-        ("Europe/Berlin", "2026-11-23 15:03:05", "2026-11-23T15:03:10"),
-        ("America/New_York", "2026-11-23T09:03:05", "2026-11-23 09:03:10.000"),
+        (
+            "Europe/Berlin",
+            "2026-11-23 15:03:05",
+            "2026-11-23T15:03:10",
+        ),
+        (
+            "America/New_York",
+            "2026-11-23T09:03:05",
+            "2026-11-23 09:03:10.000",
+        ),
         ("UTC", "2026-11-23T14:03:05", "2026-11-23 14:03:10"),
     ] {
         let o = ok(hwfoc()
@@ -174,11 +188,13 @@ fn bad_times_are_one_line_naming_the_option_and_the_value() {
     );
     // A date for an input without a wall clock could select nothing: refused.
     let csv = capture("xrotor-v4-pro-hv-80A.csv");
-    let o = run(&["decode", csv.to_str().unwrap(), "--from", "2026-11-23T14:03:00Z"]);
-    assert_fails_with(
-        &o,
-        "--from 2026-11-23T14:03:00.000Z: ",
-    );
+    let o = run(&[
+        "decode",
+        csv.to_str().unwrap(),
+        "--from",
+        "2026-11-23T14:03:00Z",
+    ]);
+    assert_fails_with(&o, "--from 2026-11-23T14:03:00.000Z: ");
     assert_fails_with(&o, "(logic-analyser CSV) has no wall clock");
     // Seconds after the first frame, and the analyser's own seconds, work on it.
     let csv = csv.to_str().unwrap();
@@ -234,7 +250,14 @@ fn records_of_several_escs_come_in_time_order_in_every_format() {
     assert_eq!(csv_rows, jsonl_rows);
 
     let pq = dir.path("two.parquet");
-    ok(run(&["decode", "--format", "parquet", "-o", pq.to_str().unwrap(), &input]));
+    ok(run(&[
+        "decode",
+        "--format",
+        "parquet",
+        "-o",
+        pq.to_str().unwrap(),
+        &input,
+    ]));
     assert_eq!(parquet_esc_times(&pq), jsonl_rows);
 
     // Several recordings, of other ports, merged by time: the one given first starts later.
@@ -329,8 +352,10 @@ fn summary_gives_charge_energy_and_power_per_esc_and_in_total() {
     assert_eq!(top["energy_total"], Value::Null);
     let text = stdout(&ok(run(&["summary", raw])));
     assert!(
-        text.contains("199.500 mAh, 4.9875 Wh consumed; input power peak 900.0 W, mean 900.0 W \
-             over 19.950 s (no receive times: each frame counted as 50 ms)"),
+        text.contains(
+            "199.500 mAh, 4.9875 Wh consumed; input power peak 900.0 W, mean 900.0 W \
+             over 19.950 s (no receive times: each frame counted as 50 ms)"
+        ),
         "{text}"
     );
 }
@@ -341,7 +366,9 @@ fn dates_are_shown_where_the_source_has_a_wall_clock() {
     let input = two_escs(&dir);
     let text = stdout(&ok(run(&["summary", &input])));
     assert!(
-        text.contains("time         2026-11-23T14:03:00.000Z .. 2026-11-23T14:03:19.950Z (19.950 s)\n"),
+        text.contains(
+            "time         2026-11-23T14:03:00.000Z .. 2026-11-23T14:03:19.950Z (19.950 s)\n"
+        ),
         "{text}"
     );
     let top: Value =
@@ -367,9 +394,9 @@ fn dates_are_shown_where_the_source_has_a_wall_clock() {
     let svg = std::fs::read_to_string(&svg).unwrap();
     let texts = plot_texts(&svg);
     assert!(
-        texts.iter().any(|t| t.contains(
-            "time in seconds from the first frame, 2026-11-23T14:03:00.000Z"
-        )),
+        texts
+            .iter()
+            .any(|t| t.contains("time in seconds from the first frame, 2026-11-23T14:03:00.000Z")),
         "{texts:?}"
     );
     for needle in ["Power", "power (W)"] {
@@ -384,12 +411,16 @@ fn dates_are_shown_where_the_source_has_a_wall_clock() {
         "{texts:?}"
     );
     let svg = dir.path("csv.svg");
-    ok(run(&["plot", csv.to_str().unwrap(), "-o", svg.to_str().unwrap()]));
+    ok(run(&[
+        "plot",
+        csv.to_str().unwrap(),
+        "-o",
+        svg.to_str().unwrap(),
+    ]));
     let texts = plot_texts(&std::fs::read_to_string(&svg).unwrap());
     assert!(
-        texts.iter().any(|t| t.contains(
-            "time in seconds from the first frame (t_s = 0.228, the source's clock)"
-        )),
+        texts.iter().any(|t| t
+            .contains("time in seconds from the first frame (t_s = 0.228, the source's clock)")),
         "{texts:?}"
     );
     assert!(!texts.iter().any(|t| t.contains("1970-")), "{texts:?}");
@@ -416,7 +447,10 @@ fn a_plot_window_after_the_first_frame_keeps_its_seconds() {
         .iter()
         .find(|t| t.starts_with("2 ESCs · "))
         .unwrap_or_else(|| panic!("no subtitle in {texts:?}"));
-    assert!(subtitle.contains("window from +5.000 s to +10.000 s"), "{subtitle}");
+    assert!(
+        subtitle.contains("window from +5.000 s to +10.000 s"),
+        "{subtitle}"
+    );
     // The time axis is labelled in seconds from the first frame: 5 to 10, not 0 to 5.
     let ticks = |from: usize| -> Vec<String> { (from..from + 6).map(|s| s.to_string()).collect() };
     let has = |ticks: &[String]| texts.windows(6).filter(|w| w == &ticks).count();
