@@ -7,6 +7,8 @@ use clap::Args;
 use hwfoc_io::select::{Selection, Window};
 use hwfoc_io::serial;
 use hwfoc_io::settings::{SettingsMap, SettingsPatch};
+use hwfoc_io::sources::Sources;
+use hwfoc_io::time::{Clock, Time, TimeError};
 use hwfoc_io::{Input, InputError};
 
 use crate::config::Config;
@@ -153,22 +155,52 @@ pub struct SelectArgs {
     /// Only these ESCs (indices as in the `esc` column; repeat or separate with commas).
     #[arg(long, value_name = "N", value_delimiter = ',')]
     pub esc: Vec<u8>,
-    /// Only frames received at or after S seconds (`t_s`; needs inputs with receive times).
-    #[arg(long, value_name = "S", allow_negative_numbers = true)]
-    pub from: Option<f64>,
-    /// Only frames received before S seconds (`t_s`; needs inputs with receive times).
-    #[arg(long, value_name = "S", allow_negative_numbers = true)]
-    pub to: Option<f64>,
+    /// Only frames received at or after TIME: +S after the first frame (+5, +2m, +1h30m,
+    /// +250ms), seconds of the inputs' clock (Unix time for recordings and serial ports, the
+    /// analyser's clock for a CSV export), or an ISO 8601 date-time (2026-11-23T14:03:00Z,
+    /// 2026-11-23T14:03:00.250+01:00; without an offset, local time: 2026-11-23 14:03).
+    /// Needs inputs with receive times.
+    #[arg(long, value_name = "TIME", allow_negative_numbers = true, value_parser = time)]
+    pub from: Option<Time>,
+    /// Only frames received before TIME (as for --from).
+    #[arg(long, value_name = "TIME", allow_negative_numbers = true, value_parser = time)]
+    pub to: Option<Time>,
+}
+
+/// A `--from`/`--to` time (see [`hwfoc_io::time`] for the grammar).
+fn time(text: &str) -> Result<Time, TimeError> {
+    hwfoc_io::time::parse(text)
 }
 
 impl SelectArgs {
     /// The ESCs and the window of receive times; an empty window is an error.
     pub fn selection(&self) -> Result<Selection, CliError> {
-        let window = Window::new(self.from, self.to).map_err(CliError::Window)?;
+        let window = Window::from_times(self.from, self.to).map_err(CliError::Window)?;
         Ok(Selection::new(&self.esc, window))
     }
 
-    /// The filters, as recorded with an output: `esc=0,2 from=1.5 to=3`, or empty.
+    /// Refuses a date-time for inputs without a wall clock (a logic-analyser CSV counts from
+    /// the start of its capture): it could select nothing. Call it before reading.
+    pub fn check_clocks(&self, sources: &Sources) -> Result<(), CliError> {
+        for (option, time) in [("--from", self.from), ("--to", self.to)] {
+            let Some(time) = time.filter(Time::is_date) else {
+                continue;
+            };
+            if let Some((input, format)) = sources.formats().find(|(_, f)| f.clock() != Clock::Wall)
+            {
+                return Err(CliError::Usage {
+                    option: format!("{option} {time}"),
+                    message: format!(
+                        "{input} ({format}) has no wall clock, its times count from the start \
+                         of its capture: give seconds of its clock or +S after the first frame"
+                    ),
+                });
+            }
+        }
+        Ok(())
+    }
+
+    /// The filters, as recorded with an output: `esc=0,2 from=+1.5 to=1795442580`, or empty.
     pub fn text(&self) -> String {
         let mut parts = Vec::new();
         if !self.esc.is_empty() {

@@ -20,6 +20,13 @@ pub const NOMINAL_PERIOD_S: f64 = 0.05;
 /// stream tells the decoder of it from [`crate::stream::SILENCE_S`], the same second).
 pub const MAX_STEP_S: f64 = crate::stream::SILENCE_S;
 
+/// Electrical input power, W, of a frame's input voltage and current: the one definition the
+/// summary, the plots and [`Energy`] use.
+#[inline]
+pub fn power_w(voltage_v: f64, current_a: f64) -> f64 {
+    voltage_v * current_a
+}
+
 /// Charge, energy and power of one ESC (or the sum of several: [`Energy::merge`]).
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct Energy {
@@ -62,12 +69,38 @@ impl Energy {
                 }
             };
             self.charge_as += i * step;
-            self.energy_j += v * i * step;
+            self.energy_j += power_w(v, i) * step;
             self.seconds += step;
         }
-        let power = voltage_v * current_a;
+        let power = power_w(voltage_v, current_a);
         self.peak_w = Some(self.peak_w.map_or(power, |p| p.max(power)));
         self.last = Some((t_s, voltage_v, current_a));
+    }
+
+    /// The figures [`Energy::add`] gives for `frames` frames without receive times, from sums
+    /// a caller keeps anyway (the summary's raw lanes): `current_sum` and `power_sum` over
+    /// every frame, `last` the last frame's volts and amps, `peak_w` the largest power. Each
+    /// frame but the last holds for [`NOMINAL_PERIOD_S`].
+    pub fn untimed(
+        frames: u64,
+        current_sum: f64,
+        power_sum: f64,
+        last: (f64, f64),
+        peak_w: Option<f64>,
+    ) -> Energy {
+        if frames == 0 {
+            return Energy::new();
+        }
+        let steps = (frames - 1) as f64 * NOMINAL_PERIOD_S;
+        let (v, i) = last;
+        Energy {
+            last: Some((None, v, i)),
+            charge_as: (current_sum - i) * NOMINAL_PERIOD_S,
+            energy_j: (power_sum - power_w(v, i)) * NOMINAL_PERIOD_S,
+            seconds: steps,
+            peak_w,
+            nominal: frames > 1,
+        }
     }
 
     /// Forgets the last frame, so that the next one starts a new integration (the charge and
@@ -104,6 +137,21 @@ impl Energy {
     /// Whether steps were taken as [`NOMINAL_PERIOD_S`] for want of receive times.
     pub fn nominal(&self) -> bool {
         self.nominal
+    }
+
+    /// These figures with every voltage multiplied by `volts` and every current by `amps`
+    /// (both positive): for an integration over raw integers, converted once at the end, as
+    /// the summary does (the conversions are linear, so this is what integrating the converted
+    /// values gives).
+    pub fn scaled(&self, volts: f64, amps: f64) -> Energy {
+        Energy {
+            last: self.last.map(|(t, v, i)| (t, v * volts, i * amps)),
+            charge_as: self.charge_as * amps,
+            energy_j: self.energy_j * volts * amps,
+            seconds: self.seconds,
+            peak_w: self.peak_w.map(|p| p * volts * amps),
+            nominal: self.nominal,
+        }
     }
 
     /// Adds another ESC's figures to these, for a total over ESCs that ran at the same time:
@@ -177,6 +225,37 @@ mod tests {
     }
 
     #[test]
+    fn sums_give_what_adding_untimed_frames_gives() {
+        let frames = [(25.0, 10.0), (24.5, -2.0), (24.0, 30.5), (24.8, 7.25)];
+        let mut added = Energy::new();
+        for &(v, i) in &frames {
+            added.add(None, v, i);
+        }
+        let sum = |f: fn(&(f64, f64)) -> f64| frames.iter().map(f).sum::<f64>();
+        let from_sums = Energy::untimed(
+            4,
+            sum(|&(_, i)| i),
+            sum(|&(v, i)| power_w(v, i)),
+            (24.8, 7.25),
+            Some(24.0 * 30.5),
+        );
+        assert!((from_sums.charge_mah() - added.charge_mah()).abs() < 1e-12);
+        assert!((from_sums.energy_wh() - added.energy_wh()).abs() < 1e-12);
+        assert!((from_sums.seconds() - added.seconds()).abs() < 1e-12);
+        assert_eq!(from_sums.peak_w(), added.peak_w());
+        assert!(from_sums.nominal() && added.nominal());
+        assert_eq!(
+            Energy::untimed(0, 0.0, 0.0, (0.0, 0.0), None),
+            Energy::new()
+        );
+        let one = Energy::untimed(1, 5.0, 50.0, (10.0, 5.0), Some(50.0));
+        assert_eq!(
+            (one.seconds(), one.charge_mah(), one.nominal()),
+            (0.0, 0.0, false)
+        );
+    }
+
+    #[test]
     fn regenerative_current_gives_charge_back() {
         let mut e = Energy::new();
         e.add(Some(0.0), 10.0, 36.0);
@@ -184,6 +263,25 @@ mod tests {
         e.add(Some(0.2), 10.0, 0.0);
         assert!(e.charge_mah().abs() < 1e-12);
         assert_eq!(e.peak_w(), Some(360.0));
+    }
+
+    #[test]
+    fn raw_figures_scale_to_physical_ones() {
+        let (mut raw, mut physical) = (Energy::new(), Energy::new());
+        for (k, (v, i)) in [(251, 640), (250, -64), (249, 1280), (252, 0)]
+            .iter()
+            .enumerate()
+        {
+            let t = Some(k as f64 * 0.05);
+            raw.add(t, f64::from(*v), f64::from(*i));
+            physical.add(t, f64::from(*v) / 10.0, f64::from(*i) / 64.0);
+        }
+        let scaled = raw.scaled(0.1, 1.0 / 64.0);
+        assert!((scaled.charge_mah() - physical.charge_mah()).abs() < 1e-12);
+        assert!((scaled.energy_wh() - physical.energy_wh()).abs() < 1e-12);
+        assert!((scaled.peak_w().unwrap() - physical.peak_w().unwrap()).abs() < 1e-9);
+        assert!((scaled.mean_w().unwrap() - physical.mean_w().unwrap()).abs() < 1e-9);
+        assert_eq!(scaled.seconds(), physical.seconds());
     }
 
     #[test]

@@ -13,6 +13,8 @@
 //! - [`write`](mod@write): writers of records (JSON Lines, CSV, Parquet with the `parquet`
 //!   feature), each on a thread of its own, and Arrow record batches;
 //! - [`pcapng`]: the recording format (writer and truncation-tolerant reader);
+//! - [`time`]: times as people write them (`--from +5`, ISO 8601) and dates shown where the
+//!   source has a wall clock; [`energy`]: charge and energy integrated over frame times;
 //! - [`serial`]: serial ports that survive being unplugged; [`clock`]: receive times;
 //!   [`stop`]: Ctrl-C and SIGTERM as a request to stop that every loop honours.
 //!
@@ -36,6 +38,7 @@ pub mod sources;
 pub mod stop;
 pub mod stream;
 pub mod summary;
+pub mod time;
 pub mod write;
 
 pub use handler::Handler;

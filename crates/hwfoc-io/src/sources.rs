@@ -1,13 +1,38 @@
-//! Several inputs read one after another, one decoding [`Stream`] per ESC.
+//! Several inputs, one decoding [`Stream`] per ESC, their records handed on in time order.
 //!
-//! Inputs given together on the command line are read in the order given. Each stream of each
-//! input is one ESC, numbered in the order the streams are first seen (a file has one stream,
-//! a recording one per interface, a set of serial ports one per port), with one exception:
-//! recordings name the port of each interface, and the interfaces of recordings given together
-//! that name the same port are one ESC, one continuous stream (the files of a rotated recording
-//! decode exactly as their bytes concatenated: a frame split between two files is whole).
+//! Each stream of each input is one ESC, numbered input by input in the order given (a file
+//! has one stream, a recording one per interface, a set of serial ports one per port; an
+//! input's streams are numbered when its first batch is read, all the interfaces it has
+//! declared by then in their order, any declared later when they first appear), with one
+//! exception: recordings name the port of each interface, and the interfaces of recordings
+//! given together that name the same port are one ESC, one continuous stream (the files of a
+//! rotated recording decode exactly as their bytes concatenated: a frame split between two
+//! files is whole).
+//!
+//! # Time order
+//!
+//! Inputs given one after another whose clocks are alike (see [`crate::time::Clock`]:
+//! recordings, or logic-analyser CSV exports) are read together, and their records of every
+//! ESC are handed on in time order (`t_s`, then ESC number for equal times): a two-ESC
+//! recording gives its ESCs' records interleaved, several recordings are merged by time. Each
+//! ESC's own records always keep their stream's order. Raw byte files (no times) and serial
+//! ports (live: records are handed on as they arrive, which is their order) are read alone, in
+//! the order given, as is each run of inputs of one clock after another run.
+//!
+//! How, in bounded memory: each input holds one batch read ahead (an input's batches come in
+//! order of their first byte's time: a recording hands out each window's ports in that order);
+//! the input whose batch is earliest is decoded next, and its frames wait in a queue per ESC.
+//! A frame is handed on once no input can still give an earlier one: once it is earlier than
+//! every input's batch read ahead and than the first byte any decoder holds of a frame still
+//! arriving. So the queue holds about one batch of each input: a recording's batch is at most
+//! 10 s of its ports (200 frames per port), a CSV export's 64 KiB of rows. Should the queue
+//! grow past [`MAX_QUEUED`] frames (times that go backwards, recordings of one port that
+//! overlap), its earliest frame is handed on at once, so memory stays bounded whatever the
+//! inputs hold; order is then kept as far as the queue allows. Recordings that continue one
+//! another's ports are read one after another, in the order given.
 
-use std::collections::HashMap;
+use std::cmp::Ordering;
+use std::collections::{BinaryHeap, HashMap, VecDeque};
 
 use hwfoc::datalink::{CHANNELS, DatalinkStats};
 use hwfoc::{Decoded, Settings};
@@ -16,12 +41,17 @@ pub use crate::handler::Handler;
 use crate::input::{Input, InputError, InputFormat};
 use crate::settings::SettingsMap;
 use crate::stream::{EscLink, Stream};
+use crate::time::Clock;
 
 /// Batches shorter than this come from a live source: what they produce is passed on at once.
 const LIVE_BATCH: usize = 4096;
 
 /// How many ESCs the record's `esc` column (a `u8`) can number.
 const MAX_ESCS: usize = 256;
+
+/// The most frames waiting in the time-order queue: past it, the earliest is handed on at once
+/// (about 7 MB of frames; a recording of 256 ports needs at most 51 200).
+pub const MAX_QUEUED: usize = 1 << 16;
 
 /// One ESC: a stream of one input.
 #[derive(Debug)]
@@ -55,6 +85,8 @@ pub struct InputInfo {
 /// The inputs of a command and the ESCs found in them.
 pub struct Sources {
     settings: SettingsMap,
+    /// The settings of each ESC found, looked up once.
+    esc_settings: Vec<Settings>,
     pending: Vec<Input>,
     names: Vec<String>,
     read: Vec<InputInfo>,
@@ -65,6 +97,19 @@ pub struct Sources {
     /// The ESC of each channel of each stream found to come from a DataLink hub, by the ESC
     /// of its stream.
     hubs: HashMap<usize, Hub>,
+    queue: Queue,
+}
+
+/// An input being read in a run of inputs read together.
+struct Reading {
+    input: Input,
+    /// Its index among all inputs.
+    index: usize,
+    /// The ESC of each of its streams seen so far.
+    escs: Vec<Option<usize>>,
+    bytes: u64,
+    /// Its batch read ahead: the first byte's time and the ESC; `None` once at its end.
+    ahead: Option<(f64, usize)>,
 }
 
 impl Sources {
@@ -80,6 +125,8 @@ impl Sources {
             need_timing: false,
             ports: HashMap::new(),
             hubs: HashMap::new(),
+            esc_settings: Vec::new(),
+            queue: Queue::default(),
         }
     }
 
@@ -103,8 +150,13 @@ impl Sources {
 
     /// The conversion settings of ESC `esc` (default settings for an ESC not found yet).
     pub fn esc_settings(&self, esc: usize) -> Settings {
-        let name = self.escs.get(esc).map_or("", |e| e.name.as_str());
-        self.settings.get(esc, name)
+        match self.esc_settings.get(esc) {
+            Some(settings) => *settings,
+            None => {
+                let name = self.escs.get(esc).map_or("", |e| e.name.as_str());
+                self.settings.get(esc, name)
+            }
+        }
     }
 
     /// The names of all inputs, in command-line order.
@@ -112,9 +164,25 @@ impl Sources {
         &self.names
     }
 
-    /// The inputs read so far.
+    /// The formats of the inputs not read yet (before [`Sources::run`]: all of them), in
+    /// command-line order.
+    pub fn formats(&self) -> impl Iterator<Item = (&str, InputFormat)> {
+        self.pending.iter().map(|i| (i.name(), i.format()))
+    }
+
+    /// The inputs read so far, in command-line order.
     pub fn inputs(&self) -> &[InputInfo] {
         &self.read
+    }
+
+    /// The clock of the inputs read so far, if they all have the same one (see
+    /// [`crate::time::Clock`]): whether their times can be shown as dates.
+    pub fn clock(&self) -> Option<Clock> {
+        let first = self.read.first()?.format.clock();
+        self.read
+            .iter()
+            .all(|i| i.format.clock() == first)
+            .then_some(first)
     }
 
     /// The ESCs found so far, by index.
@@ -146,51 +214,48 @@ impl Sources {
         }
     }
 
-    /// Reads every input to its end, in order, handing each frame and the end of each batch
-    /// to `handler`.
+    /// The most frames that waited at once in the time-order queue (at most [`MAX_QUEUED`]).
+    pub fn peak_queued(&self) -> usize {
+        self.queue.peak
+    }
+
+    /// Reads every input to its end, handing each frame (in time order, see the module
+    /// documentation) and the end of each batch to `handler`.
     ///
     /// On an input error, the frames of the bytes before it are still decoded (every stream is
-    /// finished), and the error is returned without reading further inputs.
+    /// finished), and the error is returned without reading further.
     pub fn run<H: Handler>(&mut self, handler: &mut H) -> Result<(), H::Error> {
-        let inputs = std::mem::take(&mut self.pending);
+        let mut inputs: VecDeque<Input> = std::mem::take(&mut self.pending).into();
         let mut result = Ok(());
-        for mut input in inputs {
-            let index = self.read.len();
-            let mut escs = Vec::new();
-            let mut bytes = 0;
-            result = self.read_input(&mut input, index, &mut escs, &mut bytes, handler);
-            // Streams declared but never heard from are ESCs all the same (as far as an `esc`
-            // index can number them: they have no frames).
-            for stream in 0..input.streams() {
-                if self.esc_of(&input, index, stream, &mut escs).is_err() {
-                    break;
-                }
-            }
-            // A recorded port's stream may go on in the next recording: it is finished at the
-            // end of the run. Other streams end with their input.
-            if input.format() != InputFormat::Recording {
-                for &esc in escs.iter().flatten() {
-                    self.finish(esc, handler);
-                }
-            }
-            self.read.push(InputInfo {
-                name: input.name().to_string(),
-                format: input.format(),
-                flagged_bytes: input.flagged_bytes(),
-                bytes,
-                escs: escs.into_iter().flatten().collect(),
-            });
-            if result.is_err() {
-                break;
-            }
-            result = handler.end_batch(false);
+        while let Some(first) = inputs.front() {
+            let clock = first.format().clock();
+            let merged = first.format() != InputFormat::Serial && clock != Clock::None;
+            let n = if merged {
+                inputs
+                    .iter()
+                    .take_while(|i| {
+                        i.format().clock() == clock && i.format() != InputFormat::Serial
+                    })
+                    .count()
+            } else {
+                1
+            };
+            let run: Vec<Input> = inputs.drain(..n).collect();
+            let more_recordings = inputs.iter().any(|i| i.format() == InputFormat::Recording);
+            result = if merged {
+                self.read_together(run, more_recordings, handler)
+            } else {
+                run.into_iter()
+                    .try_for_each(|input| self.read_alone(input, handler))
+            };
             if result.is_err() {
                 break;
             }
         }
         for esc in 0..self.escs.len() {
-            self.finish(esc, handler);
+            self.finish(esc);
         }
+        self.release(f64::INFINITY, handler);
         // A hub's channels that carried an ESC are ESCs of its input.
         for esc in 0..self.escs.len() {
             if self.escs[esc].hub.is_some() && self.link(esc).frames() > 0 {
@@ -203,24 +268,32 @@ impl Sources {
         handler.end_batch(false)
     }
 
-    /// Ends the stream of ESC `esc`: a frame cut off at the end is dropped, frames inside it
-    /// are still found. Harmless on a stream already finished.
-    fn finish<H: Handler>(&mut self, esc: usize, handler: &mut H) {
-        // Every stream has an index below 256 (checked when it was made).
-        let id = u8::try_from(esc).unwrap_or(u8::MAX);
-        let settings = &self.esc_settings(esc);
+    /// Ends the stream of ESC `esc`, its last frames to the queue: a frame cut off at the end
+    /// is dropped, frames inside it are still found. Harmless on a stream already finished.
+    fn finish(&mut self, esc: usize) {
+        let queue = &mut self.queue;
         let hub = self.hubs.get(&esc);
         let mut pending = Vec::new();
-        self.escs[esc].stream.finish(
-            #[inline(always)]
-            |t, channel, d| route(id, hub, t, channel, d, settings, handler, &mut pending),
-        );
-        self.deliver(esc, pending, handler);
+        self.escs[esc]
+            .stream
+            .finish(|t, channel, d| queue_frame(esc, hub, t, channel, d, queue, &mut pending));
+        self.deliver(esc, pending, &mut Deliver::<()>::Queue);
+    }
+
+    /// Hands on the queued frames earlier than `bound` (all of them for infinity), and the
+    /// earliest ones beyond the queue's bound, in time order.
+    fn release<H: Handler>(&mut self, bound: f64, handler: &mut H) {
+        while let Some((esc, t, d)) = self.queue.pop_before(bound) {
+            let id = u8::try_from(esc).unwrap_or(u8::MAX);
+            let settings = self.esc_settings(esc);
+            handler.frame(id, t, &d, &settings);
+        }
     }
 
     /// Hands on the frames of a stream just found to come from a DataLink hub, once its
-    /// channels have ESCs (made here, in channel order: channel 0 is the stream's own ESC).
-    fn deliver<H: Handler>(&mut self, esc: usize, pending: Vec<Pending>, handler: &mut H) {
+    /// channels have ESCs (made here, in channel order: channel 0 is the stream's own ESC): to
+    /// a handler, or to the time-order queue.
+    fn deliver<H: Handler>(&mut self, esc: usize, pending: Vec<Pending>, to: &mut Deliver<'_, H>) {
         if pending.is_empty() {
             return;
         }
@@ -235,12 +308,13 @@ impl Sources {
                         continue;
                     }
                     *slot = self.escs.len();
-                    self.escs.push(Esc {
+                    let esc = Esc {
                         input: self.escs[esc].input,
                         name: self.escs[esc].name.clone(),
                         stream: Stream::new(),
                         hub: Some((esc, channel as u8)),
-                    });
+                    };
+                    self.push_esc(esc);
                 }
                 let settings = escs.map(|e| self.esc_settings(e));
                 let hub = Hub { escs, settings };
@@ -250,10 +324,23 @@ impl Sources {
         };
         for (t, channel, d) in pending {
             let c = usize::from(channel);
-            if let Ok(id) = u8::try_from(hub.escs[c]) {
-                handler.frame(id, t, &d, &hub.settings[c]);
+            let Some(&id) = hub.escs.get(c).filter(|&&e| e != usize::MAX) else {
+                continue;
+            };
+            match to {
+                Deliver::Handler(handler) => {
+                    handler.frame(id as u8, t, &d, &hub.settings[c]);
+                }
+                Deliver::Queue => self.queue.push(id, t, &d),
             }
         }
+    }
+
+    /// A new ESC, its settings looked up once.
+    fn push_esc(&mut self, esc: Esc) {
+        let settings = self.settings.get(self.escs.len(), &esc.name);
+        self.escs.push(esc);
+        self.esc_settings.push(settings);
     }
 
     /// The ESC of stream `stream` of `input` (number `index`), made when first seen; `escs`
@@ -286,7 +373,7 @@ impl Sources {
                 if recorded {
                     self.ports.insert(name.clone(), self.escs.len());
                 }
-                self.escs.push(Esc {
+                self.push_esc(Esc {
                     input: index,
                     name,
                     stream: Stream::new(),
@@ -300,6 +387,61 @@ impl Sources {
         }
         escs[stream] = Some(esc);
         Ok(esc)
+    }
+
+    /// Numbers every stream `input` has declared so far (streams declared but never heard
+    /// from are ESCs all the same, as far as an `esc` index can number them).
+    fn number_streams(&mut self, input: &Input, index: usize, escs: &mut Vec<Option<usize>>) {
+        for stream in 0..input.streams() {
+            if self.esc_of(input, index, stream, escs).is_err() {
+                break;
+            }
+        }
+    }
+
+    /// Notes what is known of an input at its end.
+    fn close(&mut self, input: &Input, index: usize, escs: &[Option<usize>], bytes: u64) {
+        let info = &mut self.read[index];
+        info.flagged_bytes = input.flagged_bytes();
+        info.bytes = bytes;
+        info.escs = escs.iter().flatten().copied().collect();
+    }
+
+    /// Notes an input as begun, in command-line order.
+    fn open(&mut self, input: &Input) -> usize {
+        self.read.push(InputInfo {
+            name: input.name().to_string(),
+            format: input.format(),
+            flagged_bytes: 0,
+            bytes: 0,
+            escs: Vec::new(),
+        });
+        self.read.len() - 1
+    }
+
+    /// Reads an input without times (or a live one) to its end, its frames handed on as they
+    /// are decoded: the path of `summary` on a raw file, kept to the decoder's loop.
+    fn read_alone<H: Handler>(
+        &mut self,
+        mut input: Input,
+        handler: &mut H,
+    ) -> Result<(), H::Error> {
+        let index = self.open(&input);
+        let mut escs = Vec::new();
+        let mut bytes = 0;
+        let result = self.read_input(&mut input, index, &mut escs, &mut bytes, handler);
+        self.number_streams(&input, index, &mut escs);
+        // A recorded port's stream may go on in the next recording: it is finished at the
+        // end of the run. Other streams end with their input.
+        if input.format() != InputFormat::Recording {
+            for &esc in escs.iter().flatten() {
+                self.finish(esc);
+            }
+        }
+        self.release(f64::INFINITY, handler);
+        self.close(&input, index, &escs, bytes);
+        result?;
+        handler.end_batch(false)
     }
 
     fn read_input<H: Handler>(
@@ -339,9 +481,238 @@ impl Sources {
                 #[inline(always)]
                 |t, channel, d| route(id, hub, t, channel, d, settings, handler, &mut pending),
             );
-            self.deliver(esc, pending, handler);
+            self.deliver(esc, pending, &mut Deliver::Handler(handler));
             handler.end_batch(len < LIVE_BATCH)?;
         }
+    }
+
+    /// Reads inputs with times together, their frames handed on in time order (see the module
+    /// documentation). `more_recordings`: recordings follow, which may go on with the ports of
+    /// these.
+    fn read_together<H: Handler>(
+        &mut self,
+        inputs: Vec<Input>,
+        more_recordings: bool,
+        handler: &mut H,
+    ) -> Result<(), H::Error> {
+        let mut run: Vec<Reading> = Vec::with_capacity(inputs.len());
+        // Every input's first batch, in the order given: its streams are numbered then. After
+        // an error, the inputs not begun are not read.
+        let mut result = Ok(());
+        for input in inputs {
+            let index = self.open(&input);
+            run.push(Reading {
+                input,
+                index,
+                escs: Vec::new(),
+                bytes: 0,
+                ahead: Some((f64::NEG_INFINITY, 0)),
+            });
+            let k = run.len() - 1;
+            result = self.read_ahead(&mut run, k, more_recordings);
+            if result.is_err() {
+                break;
+            }
+        }
+        let mut live = false;
+        while result.is_ok() {
+            // Frames no input can precede any more are handed on.
+            self.release(self.bound(&run), handler);
+            handler.end_batch(live)?;
+            let Some(k) = next_to_decode(&run) else {
+                break;
+            };
+            let reading = &mut run[k];
+            let Some((_, esc)) = reading.ahead else {
+                break;
+            };
+            if let Some(batch) = reading.input.current_batch() {
+                live = batch.bytes.len() < LIVE_BATCH;
+                let queue = &mut self.queue;
+                let hub = self.hubs.get(&esc);
+                let mut pending = Vec::new();
+                self.escs[esc].stream.feed(batch, |t, channel, d| {
+                    queue_frame(esc, hub, t, channel, d, queue, &mut pending)
+                });
+                self.deliver(esc, pending, &mut Deliver::<H>::Queue);
+            }
+            result = self.read_ahead(&mut run, k, more_recordings);
+        }
+        // On an error, the inputs not at their end stop here: their streams are finished too.
+        for k in 0..run.len() {
+            if run[k].ahead.is_some() {
+                run[k].ahead = None;
+                self.end_of(&mut run, k, more_recordings);
+            }
+        }
+        self.release(f64::INFINITY, handler);
+        Ok(result?)
+    }
+
+    /// Reads input `k`'s next batch ahead (numbering its streams after its first), or notes
+    /// its end.
+    fn read_ahead(
+        &mut self,
+        run: &mut [Reading],
+        k: usize,
+        more_recordings: bool,
+    ) -> Result<(), InputError> {
+        let first = run[k].ahead.is_some_and(|(t, _)| t == f64::NEG_INFINITY);
+        let reading = &mut run[k];
+        let batch = match reading.input.next_batch() {
+            Ok(Some(batch)) => batch,
+            Ok(None) => {
+                reading.ahead = None;
+                self.end_of(run, k, more_recordings);
+                return Ok(());
+            }
+            Err(e) => return Err(e),
+        };
+        let Some(times) = batch.times else {
+            return Err(InputError::NoTiming {
+                input: self.names[reading.index].clone(),
+            });
+        };
+        let t = times.first().copied().unwrap_or(f64::NEG_INFINITY);
+        let stream = batch.stream;
+        reading.bytes += batch.bytes.len() as u64;
+        let (input, index, escs) = (&reading.input, reading.index, &mut reading.escs);
+        if first {
+            self.number_streams(input, index, escs);
+        }
+        let esc = self.esc_of(input, index, stream, escs)?;
+        reading.ahead = Some((t, esc));
+        Ok(())
+    }
+
+    /// Input `k` is at its end: its streams are numbered and noted; those no other input can
+    /// go on with are finished.
+    fn end_of(&mut self, run: &mut [Reading], k: usize, more_recordings: bool) {
+        let reading = &mut run[k];
+        let (input, index) = (&reading.input, reading.index);
+        let mut escs = std::mem::take(&mut reading.escs);
+        self.number_streams(input, index, &mut escs);
+        self.close(input, index, &escs, reading.bytes);
+        let recorded = input.format() == InputFormat::Recording;
+        run[k].escs = escs;
+        for &esc in run[k].escs.clone().iter().flatten() {
+            let shared = run
+                .iter()
+                .enumerate()
+                .any(|(j, r)| j != k && r.ahead.is_some() && r.escs.contains(&Some(esc)));
+            if !(shared || (recorded && more_recordings)) {
+                self.finish(esc);
+            }
+        }
+    }
+
+    /// The time before which no input of `run` can give a frame any more: the earliest batch
+    /// read ahead, and the earliest byte a decoder holds of a frame still arriving.
+    fn bound(&self, run: &[Reading]) -> f64 {
+        let mut bound = f64::INFINITY;
+        for (k, r) in run.iter().enumerate() {
+            if let Some((t, _)) = r.ahead
+                && !blocked(run, k)
+            {
+                bound = bound.min(t);
+            }
+            if r.ahead.is_some() {
+                for &esc in r.escs.iter().flatten() {
+                    if let Some(t) = self.escs[esc].stream.held_since() {
+                        bound = bound.min(t);
+                    }
+                }
+            }
+        }
+        bound
+    }
+}
+
+/// Whether input `k` of `run` must wait for an earlier input (in the order given) that goes
+/// on with the same ESC: recordings of one port are read one after another.
+fn blocked(run: &[Reading], k: usize) -> bool {
+    let Some((_, esc)) = run[k].ahead else {
+        return false;
+    };
+    run[..k]
+        .iter()
+        .any(|r| r.ahead.is_some() && r.escs.contains(&Some(esc)))
+}
+
+/// The input whose batch read ahead is the earliest, of those not waiting for another.
+fn next_to_decode(run: &[Reading]) -> Option<usize> {
+    (0..run.len())
+        .filter(|&k| !blocked(run, k))
+        .filter_map(|k| run[k].ahead.map(|(t, _)| (t, k)))
+        .min_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)))
+        .map(|(_, k)| k)
+}
+
+/// Decoded frames waiting to be handed on in time order: a queue per ESC (each in its
+/// stream's order) and a heap of their first frames.
+#[derive(Default)]
+struct Queue {
+    escs: Vec<VecDeque<(Option<f64>, Decoded)>>,
+    fronts: BinaryHeap<Front>,
+    len: usize,
+    peak: usize,
+}
+
+/// The first frame waiting of an ESC: the earliest time first, then the lowest ESC.
+#[derive(Debug, PartialEq)]
+struct Front {
+    t: f64,
+    esc: usize,
+}
+
+impl Eq for Front {}
+
+impl Ord for Front {
+    fn cmp(&self, other: &Self) -> Ordering {
+        // Reversed: the heap's greatest is the earliest.
+        other.t.total_cmp(&self.t).then(other.esc.cmp(&self.esc))
+    }
+}
+
+impl PartialOrd for Front {
+    fn partial_cmp(&self, other: &Self) -> Option<Ordering> {
+        Some(self.cmp(other))
+    }
+}
+
+/// The time a frame is ordered by: one without a time goes first.
+fn key(t: Option<f64>) -> f64 {
+    t.unwrap_or(f64::NEG_INFINITY)
+}
+
+impl Queue {
+    fn push(&mut self, esc: usize, t: Option<f64>, d: &Decoded) {
+        if self.escs.len() <= esc {
+            self.escs.resize_with(esc + 1, VecDeque::new);
+        }
+        let queue = &mut self.escs[esc];
+        if queue.is_empty() {
+            self.fronts.push(Front { t: key(t), esc });
+        }
+        queue.push_back((t, *d));
+        self.len += 1;
+        self.peak = self.peak.max(self.len);
+    }
+
+    /// The earliest frame, if it is earlier than `bound` or the queue is over its bound.
+    fn pop_before(&mut self, bound: f64) -> Option<(usize, Option<f64>, Decoded)> {
+        let front = self.fronts.peek()?;
+        if front.t >= bound && self.len <= MAX_QUEUED {
+            return None;
+        }
+        let esc = self.fronts.pop()?.esc;
+        let queue = &mut self.escs[esc];
+        let (t, d) = queue.pop_front()?;
+        if let Some(&(next, _)) = queue.front() {
+            self.fronts.push(Front { t: key(next), esc });
+        }
+        self.len -= 1;
+        Some((esc, t, d))
     }
 }
 
@@ -375,6 +746,35 @@ fn route<H: Handler>(
             let c = usize::from(c);
             if let Ok(esc) = u8::try_from(hub.escs[c]) {
                 handler.frame(esc, t, d, &hub.settings[c]);
+            }
+        }
+        (Some(c), None) => pending.push((t, c, *d)),
+    }
+}
+
+/// Where [`Sources::deliver`] hands frames: a handler, or the time-order queue.
+enum Deliver<'a, H> {
+    Handler(&'a mut H),
+    Queue,
+}
+
+/// Puts a frame of the stream of ESC `esc` in the time-order queue: as that ESC's on its own
+/// wire, as its channel's ESC behind a hub whose channels are numbered (`hub`), or else into
+/// `pending`.
+fn queue_frame(
+    esc: usize,
+    hub: Option<&Hub>,
+    t: Option<f64>,
+    channel: Option<u8>,
+    d: &Decoded,
+    queue: &mut Queue,
+    pending: &mut Vec<Pending>,
+) {
+    match (channel, hub) {
+        (None, _) => queue.push(esc, t, d),
+        (Some(c), Some(hub)) => {
+            if let Some(&esc) = hub.escs.get(usize::from(c)).filter(|&&e| e != usize::MAX) {
+                queue.push(esc, t, d);
             }
         }
         (Some(c), None) => pending.push((t, c, *d)),
@@ -506,5 +906,167 @@ mod tests {
         sources.run(&mut got).unwrap();
         assert_eq!(sources.escs().len(), 2);
         assert_eq!((got.0[0].len(), got.0[1].len()), (3, 3));
+    }
+
+    /// Collects the records in the order handed on: ESC, packet, time.
+    #[derive(Default)]
+    struct InOrder(Vec<(u8, u16, f64)>);
+
+    impl Handler for InOrder {
+        type Error = InputError;
+
+        fn record(&mut self, r: &Record) {
+            self.0.push((r.esc, r.packet, r.t_s.unwrap_or(f64::NAN)));
+        }
+    }
+
+    /// A recording as `hwfoc record` writes one: packets of every port in time order, a data
+    /// frame per packet every 50 ms per port from `t0` (ns), port `p` `p` ms after port 0.
+    fn live_recording(ports: &[&str], first_packet: u16, frames: u16, t0: u64) -> Vec<u8> {
+        let mut w = pcapng::Writer::new(Vec::new()).unwrap();
+        for port in ports {
+            w.add_interface(port, 19200).unwrap();
+        }
+        for k in 0..frames {
+            for p in 0..ports.len() {
+                let t = t0 + u64::from(k) * 50_000_000 + p as u64 * 1_000_000;
+                let packet = first_packet.wrapping_add(k);
+                w.write(p as u32, t, &wire(packet..packet + 1)).unwrap();
+            }
+        }
+        w.into_inner().unwrap()
+    }
+
+    fn in_order(inputs: Vec<Vec<u8>>) -> (InOrder, Sources) {
+        let inputs = inputs
+            .into_iter()
+            .enumerate()
+            .map(|(i, bytes)| Input::from_memory(&format!("rec-{i}.pcapng"), bytes).unwrap())
+            .collect();
+        let mut sources = Sources::new(inputs, Settings::DEFAULT);
+        let mut got = InOrder::default();
+        sources.run(&mut got).unwrap();
+        (got, sources)
+    }
+
+    fn assert_time_order(records: &[(u8, u16, f64)]) {
+        for w in records.windows(2) {
+            assert!(
+                (w[0].2, w[0].0) < (w[1].2, w[1].0),
+                "out of order: {:?} then {:?}",
+                w[0],
+                w[1]
+            );
+        }
+    }
+
+    /// A two-ESC recording gives its ESCs' records interleaved in time order, not a window of
+    /// one ESC then a window of the other.
+    #[test]
+    fn the_records_of_a_recording_come_in_time_order() {
+        let t0 = 1_795_442_580_000_000_000;
+        let rec = live_recording(&["/dev/ttyUSB0", "/dev/ttyUSB1"], 0, 400, t0);
+        let (got, sources) = in_order(vec![rec]);
+        assert_eq!(got.0.len(), 800);
+        assert_time_order(&got.0);
+        let escs: Vec<u8> = got.0.iter().take(6).map(|r| r.0).collect();
+        assert_eq!(escs, [0, 1, 0, 1, 0, 1]);
+        assert!(
+            sources.peak_queued() <= 2 * 201,
+            "{}",
+            sources.peak_queued()
+        );
+    }
+
+    /// Recordings of different ports that overlap in time are merged by time; their ESCs are
+    /// numbered in the order given, whatever their times.
+    #[test]
+    fn several_recordings_are_merged_by_time() {
+        let s = 1_000_000_000u64;
+        let t0 = 1_795_442_580 * s;
+        let late = live_recording(&["/dev/ttyUSB1"], 500, 300, t0 + 5 * s);
+        let early = live_recording(&["/dev/ttyUSB0", "/dev/ttyUSB2"], 0, 300, t0);
+        let (got, sources) = in_order(vec![late, early]);
+        assert_eq!(got.0.len(), 900);
+        assert_time_order(&got.0);
+        // The later file was given first: its port is ESC 0.
+        assert_eq!(sources.escs()[0].name, "/dev/ttyUSB1");
+        assert_eq!(sources.inputs()[1].escs, [1, 2]);
+        assert_eq!(got.0[0].0, 1);
+        let first_of_late = got.0.iter().position(|r| r.0 == 0).unwrap();
+        assert!((got.0[first_of_late].2 - got.0[0].2 - 5.0).abs() < 1e-6);
+        // The files of a rotated recording, as in the test above, also come in time order.
+        let t = 1_700_000_000_000_000_000u64;
+        let whole = live_recording(&["/dev/ttyUSB0", "/dev/ttyUSB1"], 0, 100, t);
+        let next = live_recording(&["/dev/ttyUSB1", "/dev/ttyUSB0"], 100, 100, t + 5 * s);
+        let (got, sources) = in_order(vec![whole, next]);
+        assert_eq!(sources.escs().len(), 2);
+        assert_eq!(got.0.len(), 400);
+        assert_time_order(&got.0);
+    }
+
+    /// Half an hour of two ESCs: the queue holds about one window of the recording, not the file.
+    #[test]
+    fn a_long_recording_is_merged_in_bounded_memory() {
+        let frames = 20 * 1800;
+        let rec = live_recording(&["/dev/ttyUSB0", "/dev/ttyUSB1"], 0, frames, 1 << 60);
+        let (got, sources) = in_order(vec![rec]);
+        assert_eq!(got.0.len(), 2 * usize::from(frames));
+        assert_time_order(&got.0);
+        // A 10 s window of two ports at 20 frames a second, and a frame or two more.
+        assert!(
+            sources.peak_queued() <= 2 * 201,
+            "{}",
+            sources.peak_queued()
+        );
+        assert!(sources.peak_queued() >= 200, "{}", sources.peak_queued());
+    }
+
+    /// Recordings of one port given out of time order are one stream in the order given (as
+    /// their bytes concatenated), and the queue stays within its bound.
+    #[test]
+    fn overlapping_recordings_of_one_port_are_read_one_after_another() {
+        let s = 1_000_000_000u64;
+        let later = live_recording(&["/dev/ttyUSB0"], 100, 100, 1_700_000_000 * s + 5 * s);
+        let earlier = live_recording(&["/dev/ttyUSB0"], 0, 100, 1_700_000_000 * s);
+        let (got, sources) = in_order(vec![later, earlier]);
+        assert_eq!(sources.escs().len(), 1);
+        let packets: Vec<u16> = got.0.iter().map(|r| r.1).collect();
+        let expected: Vec<u16> = (100..200).chain(0..100).collect();
+        assert_eq!(packets, expected);
+        assert!(sources.peak_queued() <= MAX_QUEUED);
+    }
+
+    /// Raw files (no times) keep the order given, around recordings merged by time.
+    #[test]
+    fn untimed_inputs_keep_their_place() {
+        let t0 = 1_795_442_580_000_000_000;
+        let inputs = vec![
+            Input::from_memory("a.bin", wire(0..3)).unwrap(),
+            Input::from_memory(
+                "r.pcapng",
+                live_recording(&["/dev/ttyUSB0", "/dev/ttyUSB1"], 10, 2, t0),
+            )
+            .unwrap(),
+            Input::from_memory("b.bin", wire(20..22)).unwrap(),
+        ];
+        let mut sources = Sources::new(inputs, Settings::DEFAULT);
+        let mut got = InOrder::default();
+        sources.run(&mut got).unwrap();
+        let order: Vec<(u8, u16)> = got.0.iter().map(|r| (r.0, r.1)).collect();
+        assert_eq!(
+            order,
+            [
+                (0, 0),
+                (0, 1),
+                (0, 2),
+                (1, 10),
+                (2, 10),
+                (1, 11),
+                (2, 11),
+                (3, 20),
+                (3, 21)
+            ]
+        );
     }
 }

@@ -170,6 +170,15 @@ impl Wire {
         }
     }
 
+    /// Bytes held for a frame still arriving (the most either decoder holds, while detecting).
+    fn buffered(&self) -> usize {
+        match self {
+            Wire::Esc(d) => d.buffered(),
+            Wire::Hub(d) => d.buffered(),
+            Wire::Detecting(both) => both.0.buffered().max(both.1.buffered()),
+        }
+    }
+
     fn bytes(&self) -> u64 {
         match self {
             Wire::Esc(d) => d.stats().bytes(),
@@ -372,6 +381,14 @@ impl Stream {
             _ => None,
         }
     }
+
+    /// The receive time of the first byte the decoder holds for a frame still arriving, if it
+    /// holds any: no frame completed later can be older (later bytes are no older than the
+    /// held ones). `None` when nothing is held or the stream has no times.
+    pub fn held_since(&self) -> Option<f64> {
+        let held = self.wire.buffered();
+        (held > 0 && held <= self.history.len()).then(|| self.history[self.history.len() - held])
+    }
 }
 
 /// A [`Stream`] per port, fed by [`PortEvent`]s: the path from live bytes to timed frames of
@@ -526,6 +543,36 @@ mod tests {
         }
         stream.finish(|_, _, _| {});
         stream.stats()
+    }
+
+    /// The first byte held of a frame still arriving bounds the time of any frame to come.
+    #[test]
+    fn held_bytes_give_their_first_time() {
+        let (bytes, times) = timed(&[7, 8], 100.0);
+        let mut stream = Stream::new();
+        assert_eq!(stream.held_since(), None);
+        // The first frame whole and 10 bytes of the second: those 10 are held.
+        let cut = 24 + 10;
+        stream.feed(
+            Batch {
+                bytes: &bytes[..cut],
+                times: Some(&times[..cut]),
+                stream: 0,
+            },
+            |_, _, _| {},
+        );
+        assert_eq!(stream.held_since(), Some(times[24]));
+        let mut got = Vec::new();
+        stream.feed(
+            Batch {
+                bytes: &bytes[cut..],
+                times: Some(&times[cut..]),
+                stream: 0,
+            },
+            |t, _, _| got.push(t.unwrap()),
+        );
+        assert_eq!(got, [times[24]]);
+        assert_eq!(stream.held_since(), None);
     }
 
     /// An ESC that restarts after a silence counts a restart, not the packets its new numbers

@@ -1,9 +1,11 @@
 //! `hwfoc decode`: one record per data frame, as JSON Lines, CSV or Parquet.
 //!
-//! Inputs are read one after another ([`Sources`]); records can be limited to some ESCs
-//! (`--esc`) and to a window of receive times (`--from` inclusive, `--to` exclusive, so that
-//! consecutive windows never share a frame). A time window needs inputs with receive times:
-//! raw bytes have none, and are refused rather than silently giving no records.
+//! Inputs are read by [`Sources`], records of inputs with times in time order; records can be
+//! limited to some ESCs (`--esc`) and to a window of receive times (`--from` inclusive, `--to`
+//! exclusive, so that consecutive windows never share a frame; times as `hwfoc_io::time`
+//! reads them: after the first frame, seconds of the source's clock, or dates). A time window
+//! needs inputs with receive times: raw bytes have none, and are refused rather than silently
+//! giving no records; a date for an input without a wall clock is refused likewise.
 
 use clap::{Args, ValueEnum};
 use serde_json::json;
@@ -11,6 +13,7 @@ use serde_json::json;
 use crate::args::{InputArgs, SelectArgs, SettingsArgs};
 use crate::error::CliError;
 use hwfoc_io::sources::Sources;
+use hwfoc_io::time::Clock;
 use hwfoc_io::write::{Export, OutputFormat, Provenance};
 
 /// Record output formats.
@@ -53,6 +56,7 @@ pub fn run(args: &DecodeArgs) -> Result<(), CliError> {
     let mut sources = Sources::new(args.input.open_all()?, settings);
     if selection.window.is_limited() {
         sources.require_timing()?;
+        args.select.check_clocks(&sources)?;
     }
     let provenance = Provenance {
         settings,
@@ -78,9 +82,9 @@ pub fn run(args: &DecodeArgs) -> Result<(), CliError> {
     warn(&sources, &args.select.esc);
     if let (true, 0, Some((first, last))) = (selection.window.is_limited(), kept, span) {
         eprintln!(
-            "hwfoc: warning: no frame in the time window ({}): the frames' t_s run from {first} \
-             to {last} s (recordings and serial ports give Unix time)",
-            args.select.text()
+            "hwfoc: warning: no frame in the time window ({}): {}",
+            args.select.text(),
+            hwfoc_io::time::span_text(first, last, sources.clock() == Some(Clock::Wall))
         );
     }
     Ok(())

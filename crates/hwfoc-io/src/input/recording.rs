@@ -11,15 +11,16 @@ use crate::stream::byte_times;
 /// Packets of the ports of a recording interleave, a few bytes each. They are gathered per
 /// port over a window of [`RECORDING_WINDOW_NS`] of recording time (or until a port has
 /// [`RECORDING_BATCH`] bytes), and each port's bytes of the window are handed out as one
-/// batch, in port order: so batches are kilobytes rather than a frame (decoding an 8-port
-/// recording is ten times faster), and records of different ports stay in time order to
-/// within the window (those of one port are always in order).
+/// batch, in the order of their first byte's time: so batches are kilobytes rather than a
+/// frame (decoding an 8-port recording is ten times faster), and come in order of their first
+/// byte's time (packets of a recording are in time order), which is what
+/// [`crate::sources::Sources`] needs to hand records of every port on in time order.
 pub(super) struct RecordingReader {
     reader: pcapng::Reader<Box<dyn Read>>,
     /// Bytes and receive times gathered in the current window, by interface.
     pending: Vec<(Vec<u8>, Vec<f64>)>,
-    /// While handing out the window's batches: the next interface to look at.
-    draining: Option<usize>,
+    /// Whether the window's batches are being handed out.
+    draining: bool,
     /// Time of the first packet of the current window.
     window_start: Option<u64>,
     /// The file is read to its end (or to a read error, kept in `error`).
@@ -41,7 +42,7 @@ impl RecordingReader {
         RecordingReader {
             reader: pcapng::Reader::new(reader),
             pending: Vec::new(),
-            draining: None,
+            draining: false,
             window_start: None,
             ended: false,
             error: None,
@@ -66,15 +67,20 @@ impl RecordingReader {
         times: &mut Vec<f64>,
     ) -> Result<usize, InputError> {
         loop {
-            if let Some(from) = self.draining {
-                if let Some(i) = (from..self.pending.len()).find(|&i| !self.pending[i].0.is_empty())
-                {
+            if self.draining {
+                // The window's ports in the order of their first byte: batches of a recording
+                // come in order of their first byte's time (what `Sources` merges by).
+                let next = (0..self.pending.len())
+                    .filter(|&i| !self.pending[i].0.is_empty())
+                    .min_by(|&a, &b| self.pending[a].1[0].total_cmp(&self.pending[b].1[0]));
+                if let Some(i) = next {
                     std::mem::swap(bytes, &mut self.pending[i].0);
                     std::mem::swap(times, &mut self.pending[i].1);
-                    self.draining = Some(i + 1);
+                    self.pending[i].0.clear();
+                    self.pending[i].1.clear();
                     return Ok(i);
                 }
-                self.draining = None;
+                self.draining = false;
             }
             if self.ended {
                 return self.error.take().map_or(Ok(0), Err);
@@ -83,7 +89,7 @@ impl RecordingReader {
                 self.error = Some(e);
                 self.ended = true;
             }
-            self.draining = Some(0);
+            self.draining = true;
         }
     }
 

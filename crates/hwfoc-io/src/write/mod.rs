@@ -406,9 +406,12 @@ impl Handler for Export {
 
     #[inline]
     fn frame(&mut self, esc: u8, t: Option<f64>, decoded: &Decoded, _: &Settings) {
-        if let Frame::Data(frame) = decoded.frame
-            && self.selection.esc(esc)
-        {
+        if let Frame::Data(frame) = decoded.frame {
+            // The first frame of any ESC resolves a window given after the first frame.
+            self.selection.window.observe(t);
+            if !self.selection.esc(esc) {
+                return;
+            }
             if let Some(t) = t {
                 let (first, last) = self.span.get_or_insert((t, t));
                 *first = first.min(t);

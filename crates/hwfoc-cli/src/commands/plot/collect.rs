@@ -16,6 +16,7 @@
 use hwfoc::{InfoFrame, Settings, Status};
 
 use crate::error::CliError;
+use hwfoc_io::energy::{self, Energy};
 use hwfoc_io::episode::{Episode, Mark};
 use hwfoc_io::record::Record;
 use hwfoc_io::select::{Selection, Window};
@@ -25,7 +26,7 @@ use super::{Options, Target};
 
 /// The nominal time between two data frames of a running ESC, s: the clock of inputs without
 /// receive times, and the width given to a fault episode's last frame.
-pub const FRAME_PERIOD: f64 = 0.05;
+pub const FRAME_PERIOD: f64 = energy::NOMINAL_PERIOD_S;
 
 /// A pause longer than this between two data frames of an ESC (idle frames come every
 /// ~364 ms) is a gap in the recording: lines are not drawn across it.
@@ -52,6 +53,8 @@ pub enum Quantity {
     PhaseCurrent,
     /// Input voltage, V.
     Voltage,
+    /// Electrical input power, W: voltage times input current.
+    Power,
     /// MOSFET temperature, degC.
     MosTemp,
     /// Capacitor temperature, degC.
@@ -69,6 +72,9 @@ impl Quantity {
             Quantity::Current => r.current_a,
             Quantity::PhaseCurrent => r.phase_current_a,
             Quantity::Voltage => r.voltage_v,
+            Quantity::Power => {
+                energy::power_w(f64::from(r.voltage_v), f64::from(r.current_a)) as f32
+            }
             Quantity::MosTemp => r.mos_temp_c.unwrap_or(f32::NAN),
             Quantity::CapTemp => r.cap_temp_c.unwrap_or(f32::NAN),
         }
@@ -76,7 +82,7 @@ impl Quantity {
 }
 
 /// How many quantities a bucket holds.
-pub const QUANTITIES: usize = 8;
+pub const QUANTITIES: usize = 9;
 
 /// The values of one frame, by [`Quantity`] (NaN: no value).
 pub(super) type Values = [f32; QUANTITIES];
@@ -95,6 +101,7 @@ const ALL: [Quantity; QUANTITIES] = [
     Quantity::Current,
     Quantity::PhaseCurrent,
     Quantity::Voltage,
+    Quantity::Power,
     Quantity::MosTemp,
     Quantity::CapTemp,
 ];
@@ -265,6 +272,8 @@ pub struct EscData {
     pub spans: Vec<Span>,
     /// Fault episodes seen.
     pub episodes: u64,
+    /// Charge and energy of its plotted frames.
+    pub energy: Energy,
     /// The fault episode going on.
     open: Option<Episode>,
 }
@@ -281,12 +290,13 @@ impl EscData {
             buckets: Buckets::new(buckets),
             spans: Vec::new(),
             episodes: 0,
+            energy: Energy::new(),
             open: None,
         }
     }
 
     #[inline]
-    fn add(&mut self, r: &Record, selection: &Selection) {
+    fn add(&mut self, r: &Record, window: &mut Window) {
         let t = r.t_s;
         let index = self.frames;
         self.frames += 1;
@@ -295,7 +305,7 @@ impl EscData {
             *first = first.min(t);
             *last = last.max(t);
         }
-        if !selection.window.contains(t) {
+        if !window.contains(t) {
             return;
         }
         let c = clock(t, index);
@@ -316,6 +326,8 @@ impl EscData {
             }
         };
         self.buckets.add(c, &values(r), gap);
+        self.energy
+            .add(t, f64::from(r.voltage_v), f64::from(r.current_a));
         let mark = Mark {
             t,
             frame: index,
@@ -394,6 +406,12 @@ impl Collector {
         &self.selection.window
     }
 
+    /// The receive time of the first data frame with one, of any ESC: the time axis counts
+    /// from it, as `--from +S` does.
+    pub fn origin(&self) -> Option<f64> {
+        self.selection.window.origin()
+    }
+
     /// Whether ESC `esc` was asked for.
     pub fn wanted(&self, esc: usize) -> bool {
         u8::try_from(esc).is_ok_and(|e| self.selection.esc(e))
@@ -424,8 +442,10 @@ impl Handler for Collector {
 
     #[inline]
     fn record(&mut self, r: &Record) {
+        // Every ESC's first frame counts for the window and the time axis.
+        self.selection.window.observe(r.t_s);
         if let Some(esc) = esc_data(&mut self.escs, self.buckets, &self.selection, r.esc) {
-            esc.add(r, &self.selection);
+            esc.add(r, &mut self.selection.window);
         }
     }
 
@@ -474,11 +494,11 @@ mod tests {
     /// Every quantity at the value of a throttle of `raw` (temperatures 79.0 degC).
     fn values_of(raw: u16) -> Values {
         let pct = raw as f32 * 100.0 / 1024.0;
-        [pct, pct, pct, pct, pct, pct, 79.0, 79.0]
+        [pct, pct, pct, pct, pct, pct, pct, 79.0, 79.0]
     }
 
-    fn all() -> Selection {
-        Selection::default()
+    fn all() -> Window {
+        Window::ALL
     }
 
     #[test]
@@ -529,6 +549,12 @@ mod tests {
         assert_eq!(v(Quantity::ThrottleOut), f64::from(f.throttle_out_pct()));
         assert_eq!(v(Quantity::Rpm), f64::from(f.rpm(&s)));
         assert_eq!(v(Quantity::Voltage), f64::from(f.voltage_v()));
+        // 25.1 V times -1.5 A.
+        assert!(
+            (v(Quantity::Power) - 25.1 * -1.5).abs() < 1e-4,
+            "{}",
+            v(Quantity::Power)
+        );
         assert_eq!(v(Quantity::Current), f64::from(f.current_a(&s)));
         assert_eq!(v(Quantity::PhaseCurrent), f64::from(f.phase_current_a(&s)));
         assert_eq!(v(Quantity::MosTemp), 28.0);
@@ -564,10 +590,10 @@ mod tests {
         let mut esc = EscData::new(1024);
         let statuses = [0u16, 0x40, 0x40, 0, 0, 0x1, 0];
         for (i, &s) in statuses.iter().enumerate() {
-            esc.add(&frame(100.0 + i as f64 * 0.05, 0, s), &all());
+            esc.add(&frame(100.0 + i as f64 * 0.05, 0, s), &mut all());
         }
         // A pause of 5 s, then a fault to the end.
-        esc.add(&frame(105.3, 0, 0x2), &all());
+        esc.add(&frame(105.3, 0, 0x2), &mut all());
         esc.finish();
         assert_eq!(esc.episodes, 3);
         let s: Vec<(f64, f64, u16, bool)> = esc
@@ -595,7 +621,7 @@ mod tests {
         let mut esc = EscData::new(4);
         // 4 buckets over 20 s of frames: 8.192 s each; faults every other frame.
         for i in 0..400u16 {
-            esc.add(&frame(f64::from(i) * 0.05, 0, i % 2), &all());
+            esc.add(&frame(f64::from(i) * 0.05, 0, i % 2), &mut all());
         }
         esc.finish();
         assert_eq!(esc.episodes, 200);
@@ -605,10 +631,10 @@ mod tests {
 
     #[test]
     fn frames_outside_the_window_are_not_plotted() {
-        let selection = Selection::new(&[], Window::new(Some(1.0), Some(2.0)).unwrap());
+        let mut window = Window::new(Some(1.0), Some(2.0)).unwrap();
         let mut esc = EscData::new(64);
         for i in 0..60 {
-            esc.add(&frame(i as f64 * 0.05, 100, 0), &selection);
+            esc.add(&frame(i as f64 * 0.05, 100, 0), &mut window);
         }
         assert_eq!((esc.frames, esc.plotted), (60, 20));
         assert_eq!(esc.times, Some((0.0, 59.0 * 0.05)));

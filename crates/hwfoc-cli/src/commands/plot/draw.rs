@@ -15,6 +15,7 @@ use plotters::style::{FontStyle, register_font};
 use crate::error::CliError;
 use hwfoc_io::sources::Sources;
 use hwfoc_io::summary::NO_FRAMES;
+use hwfoc_io::time::{self, Clock};
 
 use super::collect::{Bucket, Collector, EscData, FRAME_PERIOD, Quantity, Span};
 use super::target::{ImageFormat, Target};
@@ -87,7 +88,7 @@ struct Panel {
 }
 
 /// The panels of a row, left to right.
-const PANELS: [Panel; 5] = [
+const PANELS: [Panel; 6] = [
     Panel {
         title: "Throttle",
         axis: "throttle (%)",
@@ -110,6 +111,12 @@ const PANELS: [Panel; 5] = [
             (Quantity::Current, "input", BLUE),
             (Quantity::PhaseCurrent, "phase", ORANGE),
         ],
+        scale: Scale::FromZero,
+    },
+    Panel {
+        title: "Power",
+        axis: "power (W)",
+        lines: &[(Quantity::Power, "input", GREEN)],
         scale: Scale::FromZero,
     },
     Panel {
@@ -239,7 +246,7 @@ struct Scene<'a> {
     rows: Vec<Row<'a>>,
     time: TimeAxis,
     /// Value axis of each panel column.
-    ranges: [(f64, f64); 5],
+    ranges: [(f64, f64); PANELS.len()],
 }
 
 impl<'a> Scene<'a> {
@@ -270,12 +277,14 @@ impl<'a> Scene<'a> {
                 message: nothing_message(collector, sources, &shown),
             });
         }
-        // Timed ESCs count from the earliest plotted frame; the others from their frame 0.
-        let t0 = shown
+        // Timed ESCs count from the first frame of the inputs (as `--from +S` does); the
+        // others from their frame 0.
+        let earliest = shown
             .iter()
             .filter_map(|&i| plotted(i).filter(|d| d.timed))
             .filter_map(|d| d.clock.map(|c| c.0))
             .fold(f64::INFINITY, f64::min);
+        let t0 = collector.origin().unwrap_or(earliest);
         let rows: Vec<Row> = shown
             .iter()
             .map(|&i| {
@@ -315,8 +324,6 @@ impl<'a> Scene<'a> {
                 time.hi = time.hi.max(last - row.offset + FRAME_PERIOD);
             }
         }
-        // The earliest row starts at 0 (its first frame, or frame 0).
-        time.lo = time.lo.min(0.0);
         if time.hi - time.lo < 1.0 {
             time.hi = time.lo + 1.0;
         }
@@ -339,10 +346,28 @@ impl<'a> Scene<'a> {
             },
             time.hi - time.lo
         );
+        // Dates where every plotted timed ESC's input has a wall clock.
+        let wall = rows
+            .iter()
+            .filter(|r| r.data.is_some_and(|d| d.timed))
+            .all(|r| {
+                let input = sources.escs()[r.esc].input;
+                sources
+                    .inputs()
+                    .get(input)
+                    .is_some_and(|i| i.format.clock() == Clock::Wall)
+            });
         if timed {
-            subtitle.push_str(&format!(
-                " · time in seconds from the first frame (t_s = {t0:.3})"
-            ));
+            if wall {
+                subtitle.push_str(&format!(
+                    " · time in seconds from the first frame, {}",
+                    time::iso8601(t0)
+                ));
+            } else {
+                subtitle.push_str(&format!(
+                    " · time in seconds from the first frame (t_s = {t0:.3}, the source's clock)"
+                ));
+            }
         }
         if untimed {
             subtitle.push_str(&format!(
@@ -351,13 +376,13 @@ impl<'a> Scene<'a> {
             ));
         }
         let window = collector.window();
-        if window.is_limited() {
+        if window.is_limited() && timed {
             subtitle.push_str(" · window");
             if window.from > f64::NEG_INFINITY {
-                subtitle.push_str(&format!(" from t_s {}", window.from));
+                subtitle.push_str(&format!(" from {:+.3} s", window.from - t0));
             }
             if window.to < f64::INFINITY {
-                subtitle.push_str(&format!(" to t_s {}", window.to));
+                subtitle.push_str(&format!(" to {:+.3} s", window.to - t0));
             }
         }
         subtitle.push_str(&format!(
@@ -422,6 +447,24 @@ impl<'a> Scene<'a> {
         header.draw_text(&faults, &right, (width, 10))?;
         let right_w = header.estimate_text_size(&faults, &right)?.0 as i32;
         let mut about = row.source.clone();
+        if let Some(data) = row.data
+            && data.energy.seconds() > 0.0
+        {
+            let e = &data.energy;
+            about.push_str(&format!(
+                "  ·  {:.1} mAh, {:.2} Wh{}",
+                e.charge_mah(),
+                e.energy_wh(),
+                if e.nominal() {
+                    format!(
+                        " (each frame counted as {} ms)",
+                        hwfoc_io::energy::NOMINAL_PERIOD_S * 1000.0
+                    )
+                } else {
+                    String::new()
+                }
+            ));
+        }
         if let Some(info) = &row.info {
             about.push_str("  ·  ");
             about.push_str(info);
@@ -856,8 +899,8 @@ fn nothing_message(collector: &Collector, sources: &Sources, shown: &[usize]) ->
         });
     if let (true, Some((first, last))) = (window.is_limited(), times) {
         return format!(
-            "no frame in the time window: the frames' t_s run from {first} to {last} s \
-             (recordings and serial ports give Unix time)"
+            "no frame in the time window: {}",
+            time::span_text(first, last, sources.clock() == Some(Clock::Wall))
         );
     }
     let names = sources.names().join(", ");

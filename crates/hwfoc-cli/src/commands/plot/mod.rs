@@ -84,6 +84,7 @@ pub fn run(args: &PlotArgs) -> Result<(), CliError> {
     let mut sources = Sources::new(args.input.open_all()?, settings_map);
     if selection.window.is_limited() {
         sources.require_timing()?;
+        args.select.check_clocks(&sources)?;
     }
     let mut collector = Collector::new(settings, selection, options.width);
     let result = sources.run(&mut collector);
