@@ -409,7 +409,8 @@ fn the_old_chunked_recording_decodes_as_before_and_dissects_alike() {
     assert_eq!(
         String::from_utf8(out.stdout).unwrap(),
         std::fs::read_to_string(&golden).unwrap(),
-        "an old recording must decode exactly as before"
+        "an old recording must decode exactly as before (the same records as the old writer's \
+         reader gave, now in time order across its two ports)"
     );
     if !tshark_found() {
         return;
