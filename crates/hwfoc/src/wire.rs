@@ -102,7 +102,21 @@ const CRC16_XMODEM_POLY: u16 = 0x1021;
 /// ```
 #[inline]
 pub const fn crc16_xmodem(bytes: &[u8]) -> u16 {
-    let mut crc = 0u16;
+    crc16_ccitt(0, bytes)
+}
+
+/// The CRC of `bytes` with the CCITT polynomial 0x1021, unreflected, without a final XOR, from
+/// the running value `crc`: 0 starts CRC-16/XMODEM ([`crc16_xmodem`]), 0xFFFF
+/// CRC-16/CCITT-FALSE (DroneCAN's transfer CRC; check value 0x29B1), and a value returned
+/// goes on over more bytes.
+///
+/// ```
+/// use hwfoc::wire::crc16_ccitt;
+/// assert_eq!(crc16_ccitt(0xFFFF, b"123456789"), 0x29B1);
+/// assert_eq!(crc16_ccitt(crc16_ccitt(0xFFFF, b"1234"), b"56789"), 0x29B1);
+/// ```
+#[inline]
+pub const fn crc16_ccitt(mut crc: u16, bytes: &[u8]) -> u16 {
     let mut i = 0;
     while i < bytes.len() {
         crc = (crc << 8) ^ CRC16_XMODEM_TABLE[((crc >> 8) as u8 ^ bytes[i]) as usize];

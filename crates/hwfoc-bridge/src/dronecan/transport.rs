@@ -38,24 +38,8 @@ pub fn message_id(priority: u8, data_type_id: u16, source_node: u8) -> u32 {
 
 /// The transfer CRC of a multi-frame transfer of `payload` of a data type with `signature`.
 pub fn transfer_crc(signature: u64, payload: &[u8]) -> u16 {
-    let mut crc = 0xFFFF;
-    for &b in signature.to_le_bytes().iter().chain(payload) {
-        crc = crc16_step(crc, b);
-    }
-    crc
-}
-
-/// CRC-16-CCITT-FALSE, one byte.
-fn crc16_step(crc: u16, byte: u8) -> u16 {
-    let mut crc = crc ^ (u16::from(byte) << 8);
-    for _ in 0..8 {
-        crc = if crc & 0x8000 != 0 {
-            (crc << 1) ^ 0x1021
-        } else {
-            crc << 1
-        };
-    }
-    crc
+    let seeded = hwfoc::wire::crc16_ccitt(0xFFFF, &signature.to_le_bytes());
+    hwfoc::wire::crc16_ccitt(seeded, payload)
 }
 
 /// The tail byte.
@@ -128,9 +112,15 @@ mod tests {
 
     #[test]
     fn crc_check_value() {
-        // CRC-16-CCITT-FALSE of "123456789" is 0x29B1: fed without a signature.
-        let crc = b"123456789".iter().fold(0xFFFF, |c, &b| crc16_step(c, b));
-        assert_eq!(crc, 0x29B1);
+        // CRC-16-CCITT-FALSE of "123456789" is 0x29B1; the signature goes first, low byte first.
+        assert_eq!(hwfoc::wire::crc16_ccitt(0xFFFF, b"123456789"), 0x29B1);
+        let signature = 0x0102_0304_0506_0708_u64;
+        let mut all = signature.to_le_bytes().to_vec();
+        all.extend_from_slice(b"abc");
+        assert_eq!(
+            transfer_crc(signature, b"abc"),
+            hwfoc::wire::crc16_ccitt(0xFFFF, &all)
+        );
     }
 
     #[test]
