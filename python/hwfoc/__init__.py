@@ -25,6 +25,7 @@ Polars and pandas take the table as it is::
 from ._hwfoc import (
     Decoder,
     HwfocError,
+    HwfocWarning,
     InputError,
     PortError,
     PortWarning,
@@ -43,6 +44,7 @@ from ._hwfoc import (
 __all__ = [
     "Decoder",
     "HwfocError",
+    "HwfocWarning",
     "InputError",
     "PortError",
     "PortWarning",

@@ -32,7 +32,11 @@ class SelectionError(HwfocError):
 class SettingsError(HwfocError):
     """A conversion setting out of range (current scale, pole pairs, gear ratio)."""
 
-class PortWarning(UserWarning):
+class HwfocWarning(UserWarning):
+    """What the hwfoc command prints as ``hwfoc: warning: ...``: an input whose bytes hold no
+    frame (:func:`read`)."""
+
+class PortWarning(HwfocWarning):
     """A serial port was lost (unplugged: it is retried) or is back."""
 
 def read(

@@ -64,7 +64,24 @@ pub fn settings(e: hwfoc::SettingsError) -> PyErr {
 
 create_exception!(
     hwfoc,
-    PortWarning,
+    HwfocWarning,
     pyo3::exceptions::PyUserWarning,
+    "What the hwfoc command prints as `hwfoc: warning: ...`: an input whose bytes hold no frame."
+);
+create_exception!(
+    hwfoc,
+    PortWarning,
+    HwfocWarning,
     "A serial port was lost (unplugged: it is retried) or is back."
 );
+
+/// Issues `message` as a Python warning of `category` (which the caller's filters may make an
+/// error).
+pub fn warn(
+    py: pyo3::Python<'_>,
+    category: &pyo3::Bound<'_, pyo3::types::PyType>,
+    message: &str,
+) -> pyo3::PyResult<()> {
+    let text = std::ffi::CString::new(message.replace('\0', " "))?;
+    PyErr::warn(py, category.as_any(), &text, 1)
+}

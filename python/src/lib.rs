@@ -18,7 +18,7 @@ use arrow_pyarrow::{IntoPyArrow, Table};
 use hwfoc::Settings;
 use hwfoc_io::select::{Selection, Window};
 use hwfoc_io::sources::Sources;
-use hwfoc_io::summary::Summary;
+use hwfoc_io::summary::{NO_FRAMES, Summary, esc_label};
 use hwfoc_io::write::arrow::schema;
 use hwfoc_io::{Input, InputError};
 use pyo3::exceptions::{PyTypeError, PyValueError};
@@ -113,9 +113,27 @@ pub(crate) fn open_all(specs: Vec<Spec>) -> Result<Vec<Input>, InputError> {
     specs.into_iter().map(Spec::open).collect()
 }
 
-/// Decodes `specs` whole: the record batches (with the schema without metadata) and the ESCs
-/// found, as JSON. Decoding runs on this thread, converting on worker threads.
-fn decode_all(specs: Vec<Spec>, options: &Options) -> Result<(Vec<RecordBatch>, String), Stop> {
+/// What `read` made: the record batches (with the schema without metadata), the ESCs found as
+/// JSON, and the command's warnings.
+struct Decoded {
+    batches: Vec<RecordBatch>,
+    escs: String,
+    warnings: Vec<String>,
+}
+
+/// The warnings `hwfoc decode` prints for ESCs whose bytes held no frame.
+pub(crate) fn no_frames(sources: &Sources) -> Vec<String> {
+    (0..sources.escs().len())
+        .filter(|&i| {
+            let stats = sources.escs()[i].stream.stats();
+            stats.bytes() > 0 && stats.frames() == 0
+        })
+        .map(|i| format!("{}: {}", esc_label(sources, i), *NO_FRAMES))
+        .collect()
+}
+
+/// Decodes `specs` whole. Decoding runs on this thread, converting on worker threads.
+fn decode_all(specs: Vec<Spec>, options: &Options) -> Result<Decoded, Stop> {
     let mut sources = Sources::new(open_all(specs)?, options.settings);
     if options.selection.window.is_limited() {
         sources.require_timing()?;
@@ -161,10 +179,11 @@ fn decode_all(specs: Vec<Spec>, options: &Options) -> Result<(Vec<RecordBatch>, 
     result?;
     let mut batches: Vec<(usize, RecordBatch)> = done_rx.into_iter().collect();
     batches.sort_unstable_by_key(|(i, _)| *i);
-    Ok((
-        batches.into_iter().map(|(_, b)| b).collect(),
-        escs_json(&sources),
-    ))
+    Ok(Decoded {
+        batches: batches.into_iter().map(|(_, b)| b).collect(),
+        escs: escs_json(&sources),
+        warnings: no_frames(&sources),
+    })
 }
 
 /// The exception of a run that stopped.
@@ -194,11 +213,15 @@ fn read<'py>(
     let options = Options::new(esc, start, end, current_scale, pole_pairs, gear_ratio)?;
     let specs = source::specs(source)?;
     let provenance = options.provenance(&specs);
-    let (batches, escs) = py
+    let decoded = py
         .detach(|| decode_all(specs, &options))
         .map_err(stop_error)?;
-    let schema = provenance.schema(Some(escs));
-    let batches = batches
+    for warning in &decoded.warnings {
+        errors::warn(py, &py.get_type::<errors::HwfocWarning>(), warning)?;
+    }
+    let schema = provenance.schema(Some(decoded.escs));
+    let batches = decoded
+        .batches
         .into_iter()
         .map(|b| b.with_schema(schema.clone()))
         .collect::<Result<Vec<_>, _>>()
@@ -275,6 +298,7 @@ fn _hwfoc(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("PortError", py.get_type::<errors::PortError>())?;
     m.add("SelectionError", py.get_type::<errors::SelectionError>())?;
     m.add("SettingsError", py.get_type::<errors::SettingsError>())?;
+    m.add("HwfocWarning", py.get_type::<errors::HwfocWarning>())?;
     m.add("PortWarning", py.get_type::<errors::PortWarning>())?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())

@@ -315,8 +315,7 @@ impl Ports {
             _ => None,
         };
         if let Some(note) = note {
-            let category = py.get_type::<errors::PortWarning>();
-            PyErr::warn(py, category.as_any(), &std::ffi::CString::new(note)?, 1)?;
+            errors::warn(py, &py.get_type::<errors::PortWarning>(), &note)?;
         }
         if event.is_none() {
             py.check_signals()?;
