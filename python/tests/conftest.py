@@ -89,7 +89,7 @@ def sim_dir(tmp_path_factory, cli):
     simulate(cli, d / "three.pcapng", "--escs", "3", "--seed", "7", "--duration", "12",
              "--start-time", "1700000000", "--fault", "1:mos_overheat@3-5", "--fault", "over_current@8-8.5",
              "--drop-rate", "0.01", "--bit-error-rate", "1e-4", "--garbage-rate", "0.02")
-    simulate(cli, d / "one.bin", "--seed", "3", "--duration", "8", "--fault", "input_voltage_low@2-3",
+    simulate(cli, d / "one.bin", "--seed", "3", "--duration", "40", "--fault", "input_voltage_low@2-3",
              "--cut-rate", "0.01")
     return d
 

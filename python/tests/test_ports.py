@@ -20,30 +20,43 @@ def _pty():
     return master, slave, os.ttyname(slave)
 
 
+def _close_after(ports, seconds):
+    """Closes the ports after `seconds` (the iterator then ends), so that a test waiting for
+    records that never come fails instead of hanging."""
+    timer = threading.Timer(seconds, ports.close)
+    timer.daemon = True
+    timer.start()
+    return timer
+
+
 def test_records_arrive_from_ports(sim_dir):
-    data = (sim_dir / "one.bin").read_bytes()[:24 * 120]
+    data = (sim_dir / "one.bin").read_bytes()[: 24 * 120]
     expected = hwfoc.read(data).to_pylist()
+    expected1 = hwfoc.read(data[: 24 * 20]).to_pylist()
+    assert len(expected) > 60 and len(expected1) >= 5
     m0, s0, name0 = _pty()
     m1, s1, name1 = _pty()
     try:
         with hwfoc.open_ports([name0, name1]) as ports:
+            timer = _close_after(ports, 30)
             assert ports.ports == [name0, name1]
             os.write(m0, data)
-            os.write(m1, data[: 24 * 10])
+            os.write(m1, data[: 24 * 20])
             got = []
             t0 = time.time()
             for record in ports:
                 got.append(record)
-                if len(got) == len(expected) + 10:
+                if len(got) == len(expected) + len(expected1):
                     break
+            timer.cancel()
             stats = ports.stats
-        by_esc = {0: [r for r in got if r["esc"] == 0], 1: [r for r in got if r["esc"] == 1]}
+        by_esc = {e: [r for r in got if r["esc"] == e] for e in (0, 1)}
         assert [r["packet"] for r in by_esc[0]] == [r["packet"] for r in expected]
-        assert len(by_esc[1]) == 10
+        assert [r["packet"] for r in by_esc[1]] == [r["packet"] for r in expected1]
         assert all(abs(r["t_s"] - t0) < 30 for r in got)
         for g, e in zip(by_esc[0], expected):
             assert {k: v for k, v in g.items() if k != "t_s"} == {k: v for k, v in e.items() if k != "t_s"}
-        assert stats[0]["frames"] >= len(expected) and stats[1]["bytes"] == 240
+        assert stats[0]["frames"] == len(expected) and stats[1]["bytes"] == 24 * 20
         # Closed: the iterator ends.
         assert list(ports) == []
     finally:

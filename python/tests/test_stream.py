@@ -18,9 +18,9 @@ def test_scan_gives_reads_records_in_bounded_batches(sim_dir):
     for name in ("three.pcapng", "one.bin"):
         path = sim_dir / name
         whole = hwfoc.read(path)
-        batches = list(hwfoc.scan(path, batch_rows=1000))
+        batches = list(hwfoc.scan(path, batch_rows=50))
         assert len(batches) > 2
-        assert all(b.num_rows <= 1000 for b in batches)
+        assert all(b.num_rows <= 50 for b in batches)
         table = pa.Table.from_batches(batches)
         assert table.equals(whole)
         meta = batches[0].schema.metadata
