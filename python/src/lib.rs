@@ -143,10 +143,13 @@ fn decode_all(specs: Vec<Spec>, options: &Options) -> Result<Decoded, Stop> {
     let (tx, rx) = sync_channel::<(usize, Frames)>(READ_QUEUE);
     let rx = Mutex::new(rx);
     let (done_tx, done_rx) = mpsc::channel::<(usize, RecordBatch)>();
+    // Blocks converted go back to the decoding thread, to be filled again.
+    let (spare_tx, spare_rx) = mpsc::channel::<Frames>();
     let settings = options.settings;
     let result = std::thread::scope(|s| {
         for _ in 0..workers {
             let done = done_tx.clone();
+            let spare = spare_tx.clone();
             let (rx, schema) = (&rx, schema.clone());
             s.spawn(move || {
                 loop {
@@ -155,12 +158,11 @@ fn decode_all(specs: Vec<Spec>, options: &Options) -> Result<Decoded, Stop> {
                         Err(_) => break,
                     };
                     let Ok((index, frames)) = job else { break };
-                    if done
-                        .send((index, frames.to_batch(schema.clone(), &settings)))
-                        .is_err()
-                    {
+                    let batch = frames.to_batch(schema.clone(), &settings);
+                    if done.send((index, batch)).is_err() {
                         break;
                     }
+                    let _ = spare.send(frames);
                 }
             });
         }
@@ -169,7 +171,8 @@ fn decode_all(specs: Vec<Spec>, options: &Options) -> Result<Decoded, Stop> {
             tx.send((next, frames)).map_err(|_| Stop::Abandoned)?;
             next += 1;
             Ok(())
-        });
+        })
+        .reuse(spare_rx);
         let result = sources.run(&mut collect).and_then(|()| collect.flush());
         drop(collect);
         drop(tx);

@@ -5,7 +5,7 @@
 use std::collections::HashMap;
 use std::sync::Arc;
 
-use arrow_array::RecordBatch;
+use arrow_array::{RecordBatch, new_null_array};
 use arrow_schema::{Schema, SchemaRef};
 use hwfoc::{DataFrame, Decoded, Frame, Settings};
 use hwfoc_io::InputError;
@@ -18,8 +18,11 @@ use hwfoc_io::write::arrow::{ArrowValue, schema};
 /// Data frames as received, column by column: what a batch is made from.
 #[derive(Debug, Default)]
 pub struct Frames {
-    /// Receive time of each frame's first byte, if the input has times.
-    pub t: Vec<Option<f64>>,
+    /// Receive time of each frame's first byte; NaN where the input has no times (a receive
+    /// time is never NaN).
+    pub t: Vec<f64>,
+    /// Whether any frame has a time.
+    pub timed: bool,
     /// ESC of each frame.
     pub esc: Vec<u8>,
     /// The frames.
@@ -31,6 +34,7 @@ impl Frames {
     pub fn with_capacity(n: usize) -> Frames {
         Frames {
             t: Vec::with_capacity(n),
+            timed: false,
             esc: Vec::with_capacity(n),
             frames: Vec::with_capacity(n),
         }
@@ -39,9 +43,18 @@ impl Frames {
     /// Adds a frame.
     #[inline]
     pub fn push(&mut self, t: Option<f64>, esc: u8, frame: &DataFrame) {
-        self.t.push(t);
+        self.timed |= t.is_some();
+        self.t.push(t.unwrap_or(f64::NAN));
         self.esc.push(esc);
         self.frames.push(*frame);
+    }
+
+    /// Empties it, keeping its room (a buffer used again is not faulted in again).
+    pub fn clear(&mut self) {
+        self.t.clear();
+        self.esc.clear();
+        self.frames.clear();
+        self.timed = false;
     }
 
     /// Number of frames.
@@ -78,10 +91,19 @@ impl Frames {
             fn column<C: Column>(&mut self) {
                 let f = self.frames;
                 let s = self.settings;
-                let values = self
-                    .rows
-                    .clone()
-                    .map(|i| C::from_frame(f.t[i], f.esc[i], &f.frames[i], s));
+                let rows = self.rows.clone();
+                // Without times `t_s` is all null: an array of nulls is zeroed memory the
+                // allocator hands out untouched, not a value written per row.
+                if C::NAME == "t_s" && !f.timed {
+                    let nulls = new_null_array(&<C::Value as ArrowValue>::data_type(), rows.len());
+                    self.arrays.push(nulls);
+                    return;
+                }
+                let (t, esc, frames) = (&f.t[rows.clone()], &f.esc[rows.clone()], &f.frames[rows]);
+                let values = t.iter().zip(esc).zip(frames).map(|((&t, &esc), frame)| {
+                    let t = (!t.is_nan()).then_some(t);
+                    C::from_frame(t, esc, frame, s)
+                });
                 self.arrays.push(<C::Value as ArrowValue>::array(values));
             }
         }
@@ -196,13 +218,22 @@ impl From<InputError> for Stop {
     }
 }
 
+/// Room for a block of `rows` frames: a block is handed on at the end of the input batch that
+/// fills it, so one batch more (a 64 KiB read holds at most 2731 data frames; a recording's
+/// packet or a CSV block, less) fits without the vectors growing (a copy of all of it).
+pub fn block_capacity(rows: usize) -> usize {
+    rows.min(1 << 20) + (64 << 10)
+}
+
 /// A [`Handler`] gathering the selected data frames in blocks of `rows` frames, handing each
-/// full block to `full` (at the end of an input batch, as the export does).
+/// full block to `full` (at the end of an input batch, as the export does). A block comes from
+/// `spare` when one is there (blocks handed back once converted), else it is new.
 pub struct Collect<F> {
     selection: Selection,
     rows: usize,
     frames: Frames,
     full: F,
+    spare: Option<std::sync::mpsc::Receiver<Frames>>,
 }
 
 impl<F: FnMut(Frames) -> Result<(), Stop>> Collect<F> {
@@ -211,9 +242,16 @@ impl<F: FnMut(Frames) -> Result<(), Stop>> Collect<F> {
         Collect {
             selection,
             rows,
-            frames: Frames::with_capacity(rows.min(1 << 20)),
+            frames: Frames::with_capacity(block_capacity(rows)),
             full,
+            spare: None,
         }
+    }
+
+    /// Takes the blocks for the next frames from `spare` when there are some.
+    pub fn reuse(mut self, spare: std::sync::mpsc::Receiver<Frames>) -> Self {
+        self.spare = Some(spare);
+        self
     }
 
     /// Hands on the frames gathered so far, if any.
@@ -221,7 +259,14 @@ impl<F: FnMut(Frames) -> Result<(), Stop>> Collect<F> {
         if self.frames.is_empty() {
             return Ok(());
         }
-        let next = Frames::with_capacity(self.rows.min(1 << 20));
+        let reused = self.spare.as_ref().and_then(|s| s.try_recv().ok());
+        let next = match reused {
+            Some(mut frames) => {
+                frames.clear();
+                frames
+            }
+            None => Frames::with_capacity(block_capacity(self.rows)),
+        };
         let frames = std::mem::replace(&mut self.frames, next);
         (self.full)(frames)
     }

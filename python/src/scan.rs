@@ -65,6 +65,8 @@ fn produce(
         return;
     }
     let settings = options.settings;
+    // A block converted is filled again (its memory is not faulted in again).
+    let (spare_tx, spare_rx) = std::sync::mpsc::channel();
     let mut collect = Collect::new(options.selection.clone(), rows, |frames| {
         let mut from = 0;
         while from < frames.len() {
@@ -73,8 +75,10 @@ fn produce(
             tx.send(Msg::Batch(batch)).map_err(|_| Stop::Abandoned)?;
             from = to;
         }
+        let _ = spare_tx.send(frames);
         Ok(())
-    });
+    })
+    .reuse(spare_rx);
     // On an input error the frames decoded before it are still handed over, then the error.
     let result = sources.run(&mut collect);
     let flushed = collect.flush();
