@@ -199,7 +199,11 @@ pub(crate) fn stop_error(stop: Stop) -> PyErr {
 
 /// Reads telemetry whole into a `pyarrow.Table` of RECORD-SCHEMA.md's records.
 ///
-/// See `hwfoc.read` (`__init__.pyi`) for the arguments.
+/// `source`: a path (raw bytes, logic-analyser CSV or pcapng recording, detected from the
+/// content), bytes, a binary file object, or a list of these read one after another. `esc`,
+/// `start`, `end` select as the command's `--esc`, `--from`, `--to`; the settings convert
+/// currents and RPM. The schema metadata is that of `hwfoc decode --format parquet`. Raises
+/// InputError, SelectionError, SettingsError; warns HwfocWarning for inputs without frames.
 #[pyfunction]
 #[pyo3(signature = (source, *, esc=None, start=None, end=None, current_scale=64.0, pole_pairs=7, gear_ratio=1.0))]
 #[allow(clippy::too_many_arguments)]
@@ -242,9 +246,9 @@ fn summary_json(specs: Vec<Spec>, settings: Settings) -> Result<String, InputErr
     Ok(summary.report(&sources, &settings).json().to_string())
 }
 
-/// What `hwfoc summary --json` prints, as Python objects.
-///
-/// See `hwfoc.summary` (`__init__.pyi`).
+/// What `hwfoc summary --json` prints for `source` (as `read` takes it), as Python objects:
+/// settings, inputs, and per ESC its link statistics, field ranges, faults and fault episodes.
+/// Raises InputError.
 #[pyfunction]
 #[pyo3(signature = (source, *, current_scale=64.0, pole_pairs=7, gear_ratio=1.0))]
 fn summary<'py>(

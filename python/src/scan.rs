@@ -88,7 +88,10 @@ fn produce(
     }
 }
 
-/// Starts the decoding thread of `hwfoc.scan`.
+/// The records of `sources` (as `read` takes them) as `pyarrow.RecordBatch`es of at most
+/// `batch_rows` rows, in bounded memory: read and decoded on a thread of its own, at most two
+/// batches ahead. Errors opening the inputs are raised at once, later ones by the iterator after
+/// the batches before them.
 #[pyfunction]
 #[pyo3(signature = (sources, *, batch_rows=65536, esc=None, start=None, end=None, current_scale=64.0, pole_pairs=7, gear_ratio=1.0))]
 #[allow(clippy::too_many_arguments)]
