@@ -1,0 +1,61 @@
+"""Hobbywing HW-FOC ESC telemetry as Arrow tables.
+
+The records are those of RECORD-SCHEMA.md (the same names, types and units as every output of
+the ``hwfoc`` command): one row per data frame, in physical units.
+
+- :func:`read`: inputs read whole into a ``pyarrow.Table`` (raw bytes from the wire,
+  logic-analyser CSV exports, pcapng recordings; paths, ``bytes`` or binary file objects);
+- :func:`scan`: the same records as ``pyarrow.RecordBatch`` es, in bounded memory, for inputs
+  larger than memory;
+- :func:`summary`: what ``hwfoc summary --json`` prints, as Python objects;
+- :class:`Decoder`: a streaming decoder for live bytes; :func:`open_ports`: live records from
+  serial ports, as ``hwfoc monitor`` reads them;
+- :mod:`hwfoc.dask` and :mod:`hwfoc.spark`: fleets of recordings on Dask and Spark.
+
+Errors are raised as :class:`HwfocError` subclasses whose message is the one the ``hwfoc``
+command prints after ``hwfoc:``.
+
+Polars and pandas take the table as it is::
+
+    import hwfoc, polars as pl
+    table = hwfoc.read("flight.pcapng")
+    df = pl.from_arrow(table)      # or table.to_pandas()
+"""
+
+from ._hwfoc import (
+    Decoder,
+    HwfocError,
+    HwfocWarning,
+    InputError,
+    PortError,
+    PortWarning,
+    Ports,
+    Scan,
+    SelectionError,
+    SettingsError,
+    __version__,
+    open_ports,
+    read,
+    record_schema,
+    scan,
+    summary,
+)
+
+__all__ = [
+    "Decoder",
+    "HwfocError",
+    "HwfocWarning",
+    "InputError",
+    "PortError",
+    "PortWarning",
+    "Ports",
+    "Scan",
+    "SelectionError",
+    "SettingsError",
+    "__version__",
+    "open_ports",
+    "read",
+    "record_schema",
+    "scan",
+    "summary",
+]

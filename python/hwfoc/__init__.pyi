@@ -1,0 +1,186 @@
+"""Type stubs of ``hwfoc`` (the functions and classes of its extension module, ``hwfoc._hwfoc``)."""
+
+import datetime
+import os
+from types import TracebackType
+from typing import IO, Any, Dict, Iterator, List, Optional, Sequence, Union
+
+import pyarrow as pa
+
+__version__: str
+
+#: One input: a path, bytes in memory, or a binary file object.
+Source = Union[str, "os.PathLike[str]", bytes, bytearray, memoryview, IO[bytes]]
+#: Inputs read one after another, as the command reads the inputs named together.
+Sources = Union[Source, Sequence[Source]]
+#: A time as ``t_s`` has it (seconds; Unix time for recordings), or a datetime.
+Time = Union[float, int, datetime.datetime]
+
+class HwfocError(Exception):
+    """Base class of the errors hwfoc raises; the message is the one the hwfoc command prints."""
+
+class InputError(HwfocError):
+    """An input could not be opened or read (missing file, directory, empty input, bad CSV row,
+    classic pcap, raw bytes where times are needed, too many streams)."""
+
+class PortError(HwfocError):
+    """A serial port could not be opened (missing, permission denied, busy, not a port)."""
+
+class SelectionError(HwfocError):
+    """A selection that cannot hold any frame: ``start`` not before ``end``."""
+
+class SettingsError(HwfocError):
+    """A conversion setting out of range (current scale, pole pairs, gear ratio)."""
+
+class HwfocWarning(UserWarning):
+    """What the hwfoc command prints as ``hwfoc: warning: ...``: an input whose bytes hold no
+    frame (:func:`read`)."""
+
+class PortWarning(HwfocWarning):
+    """A serial port was lost (unplugged: it is retried) or is back."""
+
+def read(
+    source: Sources,
+    *,
+    esc: Union[int, Sequence[int], None] = None,
+    start: Optional[Time] = None,
+    end: Optional[Time] = None,
+    current_scale: float = 64,
+    pole_pairs: int = 7,
+    gear_ratio: float = 1,
+) -> pa.Table:
+    """Reads telemetry whole into a ``pyarrow.Table`` of RECORD-SCHEMA.md's records.
+
+    ``source``: a path (raw bytes from the wire, a logic-analyser CSV export or a pcapng
+    recording: the format is detected from the content), ``bytes``/``bytearray``/``memoryview``,
+    a binary file object, or a list of these read one after another (the files of a rotated
+    recording continue each port's stream). ``esc``, ``start`` and ``end`` select as the
+    command's ``--esc``, ``--from`` (inclusive) and ``--to`` (exclusive); a time window needs
+    inputs with receive times. The settings convert currents and RPM.
+
+    The schema's metadata holds what ``hwfoc decode --format parquet`` writes in its file:
+    ``hwfoc_version``, ``current_scale``, ``pole_pairs``, ``gear_ratio``, ``inputs`` and
+    ``escs`` (JSON) and ``filter`` when records were selected; each field has its ``unit``.
+
+    Raises InputError, SelectionError, SettingsError; TypeError for a source of another type.
+    """
+
+def scan(
+    sources: Sources,
+    *,
+    batch_rows: int = 65536,
+    esc: Union[int, Sequence[int], None] = None,
+    start: Optional[Time] = None,
+    end: Optional[Time] = None,
+    current_scale: float = 64,
+    pole_pairs: int = 7,
+    gear_ratio: float = 1,
+) -> "Scan":
+    """The records of ``sources`` as ``pyarrow.RecordBatch``es of at most ``batch_rows`` rows,
+    in bounded memory whatever the size of the inputs (read a block at a time on a thread of
+    its own, at most two batches ahead).
+
+    Arguments as :func:`read`. Errors opening the inputs are raised by ``scan`` itself; an
+    error part-way is raised by the iterator after the batches of the records before it. The
+    batches' schema metadata is :func:`read`'s without ``escs`` (known only at the end).
+    """
+
+class Scan(Iterator[pa.RecordBatch]):
+    """An iterator of ``pyarrow.RecordBatch``: see :func:`scan`."""
+
+    def __iter__(self) -> "Scan": ...
+    def __next__(self) -> pa.RecordBatch: ...
+    def close(self) -> None:
+        """Stops the decoding thread; the iterator then ends."""
+
+def summary(
+    source: Sources,
+    *,
+    current_scale: float = 64,
+    pole_pairs: int = 7,
+    gear_ratio: float = 1,
+) -> Dict[str, Any]:
+    """What ``hwfoc summary --json`` prints for ``source``, as Python objects: the settings,
+    the inputs (format, bytes, ESCs) and per ESC its link statistics, field ranges, faults and
+    fault episodes. Raises InputError as :func:`read`."""
+
+def record_schema(
+    *, current_scale: float = 64, pole_pairs: int = 7, gear_ratio: float = 1
+) -> pa.Schema:
+    """The Arrow schema of the records (units in the fields' metadata, settings in the
+    schema's)."""
+
+class Decoder:
+    """A streaming decoder of one ESC's bytes as they arrive (a frame split between two
+    ``feed`` calls is decoded whole)."""
+
+    def __init__(
+        self,
+        *,
+        esc: int = 0,
+        baud: int = 19200,
+        current_scale: float = 64,
+        pole_pairs: int = 7,
+        gear_ratio: float = 1,
+    ) -> None:
+        """``esc``: the ``esc`` column of the records; ``baud``: the line's rate, for the time of
+        each byte."""
+
+    def feed(
+        self, data: Union[bytes, bytearray, memoryview], t: Optional[float] = None
+    ) -> pa.RecordBatch:
+        """Decodes the next bytes; ``t``: Unix time (s) the first was received (the others
+        follow at the baud rate), or None for no ``t_s``. Returns the records of the data
+        frames completed (``.to_pylist()`` gives dicts)."""
+
+    def finish(self) -> pa.RecordBatch:
+        """Ends the stream: records of frames still held (a frame cut off is dropped)."""
+
+    @property
+    def stats(self) -> Dict[str, Any]:
+        """Link statistics: ``bytes``, ``bytes_skipped``, ``frames``, ``info_frames``,
+        ``checksum_failures``, ``lost_packets``, ``duplicate_packets``, ``restarts``,
+        ``last_packet``, ``delivery_ratio``."""
+
+    @property
+    def schema(self) -> pa.Schema:
+        """The schema of the batches."""
+
+def open_ports(
+    ports: Sequence[str],
+    *,
+    baud: int = 19200,
+    current_scale: float = 64,
+    pole_pairs: int = 7,
+    gear_ratio: float = 1,
+) -> "Ports":
+    """Opens serial ports (8N1), one ESC each in the order given, read as ``hwfoc monitor``
+    reads them: a reader thread per port, a port that is unplugged retried (a
+    :class:`PortWarning` says so). Iterate for the records, as dicts with the schema's keys
+    (``t_s`` is Unix time); Ctrl-C raises KeyboardInterrupt and closes the ports. Raises
+    PortError."""
+
+class Ports(Iterator[Dict[str, Any]]):
+    """Live records of serial ports: see :func:`open_ports`. A context manager that closes
+    the ports."""
+
+    def __iter__(self) -> "Ports": ...
+    def __next__(self) -> Dict[str, Any]: ...
+    @property
+    def ports(self) -> List[str]:
+        """The ports, in the order given (the ``esc`` of their records)."""
+
+    @property
+    def stats(self) -> List[Dict[str, Any]]:
+        """Each port's link statistics so far (as :attr:`Decoder.stats`)."""
+
+    def close(self) -> None:
+        """Stops reading and closes the ports; the iterator then ends."""
+
+    def __enter__(self) -> "Ports": ...
+    def __exit__(
+        self,
+        exc_type: Optional[type],
+        exc: Optional[BaseException],
+        tb: Optional[TracebackType],
+    ) -> bool: ...

@@ -1,0 +1,87 @@
+//! The module's exceptions: one per error type of the libraries, all under `HwfocError`, each
+//! with the message the `hwfoc` command prints after `hwfoc: ` (the error's `Display`).
+
+use hwfoc_io::select::EmptyWindow;
+use pyo3::PyErr;
+use pyo3::create_exception;
+use pyo3::exceptions::PyException;
+
+create_exception!(
+    hwfoc,
+    HwfocError,
+    PyException,
+    "Base class of the errors hwfoc raises; the message is the one the hwfoc command prints."
+);
+create_exception!(
+    hwfoc,
+    InputError,
+    HwfocError,
+    "An input could not be opened or read (missing file, directory, empty input, bad CSV row, \
+     classic pcap, raw bytes where times are needed, too many streams)."
+);
+create_exception!(
+    hwfoc,
+    PortError,
+    HwfocError,
+    "A serial port could not be opened (missing, permission denied, busy, not a port)."
+);
+create_exception!(
+    hwfoc,
+    SelectionError,
+    HwfocError,
+    "A selection that cannot hold any frame: start not before end."
+);
+create_exception!(
+    hwfoc,
+    SettingsError,
+    HwfocError,
+    "A conversion setting out of range (current scale, pole pairs, gear ratio)."
+);
+
+/// The Python exception of an input error: a port's is a `PortError`, as the command tells
+/// them apart.
+pub fn input(e: hwfoc_io::InputError) -> PyErr {
+    match e {
+        hwfoc_io::InputError::Port(e) => port(e),
+        e => InputError::new_err(e.to_string()),
+    }
+}
+
+/// The Python exception of a port error.
+pub fn port(e: hwfoc_io::serial::PortError) -> PyErr {
+    PortError::new_err(e.to_string())
+}
+
+/// The Python exception of an empty time window.
+pub fn window(e: EmptyWindow) -> PyErr {
+    SelectionError::new_err(e.to_string())
+}
+
+/// The Python exception of a setting out of range, worded as the command words it.
+pub fn settings(e: hwfoc::SettingsError) -> PyErr {
+    SettingsError::new_err(format!("invalid setting: {e}"))
+}
+
+create_exception!(
+    hwfoc,
+    HwfocWarning,
+    pyo3::exceptions::PyUserWarning,
+    "What the hwfoc command prints as `hwfoc: warning: ...`: an input whose bytes hold no frame."
+);
+create_exception!(
+    hwfoc,
+    PortWarning,
+    HwfocWarning,
+    "A serial port was lost (unplugged: it is retried) or is back."
+);
+
+/// Issues `message` as a Python warning of `category` (which the caller's filters may make an
+/// error).
+pub fn warn(
+    py: pyo3::Python<'_>,
+    category: &pyo3::Bound<'_, pyo3::types::PyType>,
+    message: &str,
+) -> pyo3::PyResult<()> {
+    let text = std::ffi::CString::new(message.replace('\0', " "))?;
+    PyErr::warn(py, category.as_any(), &text, 1)
+}

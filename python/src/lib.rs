@@ -1,0 +1,312 @@
+//! `hwfoc._hwfoc`, the extension module of the `hwfoc` Python package: the project's library
+//! crates (`hwfoc`, `hwfoc-io`) behind a few functions and classes. Records reach Python as
+//! Arrow record batches through the Arrow C Data Interface (`arrow-pyarrow`): no Python object
+//! per row. Decoding runs with the interpreter's lock released; every error becomes an
+//! exception of `hwfoc` (see `errors.rs`) whose message is the one the `hwfoc` command prints.
+
+mod errors;
+mod live;
+mod records;
+mod scan;
+mod source;
+
+use std::sync::mpsc::{self, sync_channel};
+use std::sync::{Arc, Mutex};
+
+use arrow_array::RecordBatch;
+use arrow_pyarrow::{IntoPyArrow, Table};
+use hwfoc::Settings;
+use hwfoc_io::select::{Selection, Window};
+use hwfoc_io::sources::Sources;
+use hwfoc_io::summary::{NO_FRAMES, Summary, esc_label};
+use hwfoc_io::write::arrow::schema;
+use hwfoc_io::{Input, InputError};
+use pyo3::exceptions::{PyTypeError, PyValueError};
+use pyo3::prelude::*;
+
+use records::{Collect, Frames, Provenance, Stop, escs_json, filter_text};
+use source::Spec;
+
+/// Rows per record batch of `read`'s table: blocks converted side by side on the workers.
+const READ_ROWS: usize = 1 << 18;
+
+/// Blocks of frames waiting for a worker, at most (bounds the frames held before conversion).
+const READ_QUEUE: usize = 4;
+
+/// What the caller asked for, checked: settings, the selection, and its text for the metadata.
+#[derive(Debug, Clone)]
+pub(crate) struct Options {
+    pub settings: Settings,
+    pub selection: Selection,
+    pub filter: String,
+}
+
+impl Options {
+    pub fn new(
+        esc: Option<&Bound<'_, PyAny>>,
+        start: Option<&Bound<'_, PyAny>>,
+        end: Option<&Bound<'_, PyAny>>,
+        current_scale: f32,
+        pole_pairs: u16,
+        gear_ratio: f32,
+    ) -> PyResult<Options> {
+        let settings =
+            Settings::new(current_scale, pole_pairs, gear_ratio).map_err(errors::settings)?;
+        let escs = escs_arg(esc)?;
+        let from = time_arg(start)?;
+        let to = time_arg(end)?;
+        let window = Window::new(from, to).map_err(errors::window)?;
+        Ok(Options {
+            settings,
+            selection: Selection::new(&escs, window),
+            filter: filter_text(&escs, from, to),
+        })
+    }
+
+    fn provenance(&self, specs: &[Spec]) -> Provenance {
+        Provenance {
+            settings: self.settings,
+            inputs: specs.iter().map(|s| s.name().to_string()).collect(),
+            filter: self.filter.clone(),
+        }
+    }
+}
+
+/// `esc=`: an ESC index or a list of them.
+fn escs_arg(esc: Option<&Bound<'_, PyAny>>) -> PyResult<Vec<u8>> {
+    let Some(esc) = esc.filter(|e| !e.is_none()) else {
+        return Ok(Vec::new());
+    };
+    let escs: Vec<i64> = match esc.extract::<i64>() {
+        Ok(one) => vec![one],
+        Err(_) => esc.extract::<Vec<i64>>().map_err(|_| {
+            PyTypeError::new_err("esc: give an ESC index (0 to 255) or a list of them")
+        })?,
+    };
+    escs.into_iter()
+        .map(|e| {
+            u8::try_from(e).map_err(|_| {
+                PyValueError::new_err(format!("esc: {e} is not an ESC index (0 to 255)"))
+            })
+        })
+        .collect()
+}
+
+/// `start=`/`end=`: seconds as `t_s` has them (a number), or a `datetime` (its Unix time).
+fn time_arg(t: Option<&Bound<'_, PyAny>>) -> PyResult<Option<f64>> {
+    let Some(t) = t.filter(|t| !t.is_none()) else {
+        return Ok(None);
+    };
+    if let Ok(s) = t.extract::<f64>() {
+        return Ok(Some(s));
+    }
+    if t.hasattr("timestamp")? {
+        return Ok(Some(t.call_method0("timestamp")?.extract::<f64>()?));
+    }
+    Err(PyTypeError::new_err(
+        "start/end: give seconds (a number, as in t_s) or a datetime",
+    ))
+}
+
+/// Opens every input, in order (all before any is read, as the command does).
+pub(crate) fn open_all(specs: Vec<Spec>) -> Result<Vec<Input>, InputError> {
+    specs.into_iter().map(Spec::open).collect()
+}
+
+/// What `read` made: the record batches (with the schema without metadata), the ESCs found as
+/// JSON, and the command's warnings.
+struct Decoded {
+    batches: Vec<RecordBatch>,
+    escs: String,
+    warnings: Vec<String>,
+}
+
+/// The warnings `hwfoc decode` prints for ESCs whose bytes held no frame.
+pub(crate) fn no_frames(sources: &Sources) -> Vec<String> {
+    (0..sources.escs().len())
+        .filter(|&i| {
+            let stats = sources.escs()[i].stream.stats();
+            stats.bytes() > 0 && stats.frames() == 0
+        })
+        .map(|i| format!("{}: {}", esc_label(sources, i), *NO_FRAMES))
+        .collect()
+}
+
+/// Decodes `specs` whole. Decoding runs on this thread, converting on worker threads.
+fn decode_all(specs: Vec<Spec>, options: &Options) -> Result<Decoded, Stop> {
+    let mut sources = Sources::new(open_all(specs)?, options.settings);
+    if options.selection.window.is_limited() {
+        sources.require_timing()?;
+    }
+    let schema = Arc::new(schema());
+    let workers = std::thread::available_parallelism().map_or(1, |n| n.get().clamp(1, 4));
+    let (tx, rx) = sync_channel::<(usize, Frames)>(READ_QUEUE);
+    let rx = Mutex::new(rx);
+    let (done_tx, done_rx) = mpsc::channel::<(usize, RecordBatch)>();
+    // Blocks converted go back to the decoding thread, to be filled again.
+    let (spare_tx, spare_rx) = mpsc::channel::<Frames>();
+    let settings = options.settings;
+    let result = std::thread::scope(|s| {
+        for _ in 0..workers {
+            let done = done_tx.clone();
+            let spare = spare_tx.clone();
+            let (rx, schema) = (&rx, schema.clone());
+            s.spawn(move || {
+                loop {
+                    let job = match rx.lock() {
+                        Ok(rx) => rx.recv(),
+                        Err(_) => break,
+                    };
+                    let Ok((index, frames)) = job else { break };
+                    let batch = frames.to_batch(schema.clone(), &settings);
+                    if done.send((index, batch)).is_err() {
+                        break;
+                    }
+                    let _ = spare.send(frames);
+                }
+            });
+        }
+        let mut next = 0;
+        let mut collect = Collect::new(options.selection.clone(), READ_ROWS, |frames| {
+            tx.send((next, frames)).map_err(|_| Stop::Abandoned)?;
+            next += 1;
+            Ok(())
+        })
+        .reuse(spare_rx);
+        let result = sources.run(&mut collect).and_then(|()| collect.flush());
+        drop(collect);
+        drop(tx);
+        result
+    });
+    drop(done_tx);
+    result?;
+    let mut batches: Vec<(usize, RecordBatch)> = done_rx.into_iter().collect();
+    batches.sort_unstable_by_key(|(i, _)| *i);
+    Ok(Decoded {
+        batches: batches.into_iter().map(|(_, b)| b).collect(),
+        escs: escs_json(&sources),
+        warnings: no_frames(&sources),
+    })
+}
+
+/// The exception of a run that stopped.
+pub(crate) fn stop_error(stop: Stop) -> PyErr {
+    match stop {
+        Stop::Input(e) => errors::input(e),
+        Stop::Abandoned => errors::HwfocError::new_err("the decoding stopped unexpectedly"),
+    }
+}
+
+/// Reads telemetry whole into a `pyarrow.Table` of RECORD-SCHEMA.md's records.
+///
+/// `source`: a path (raw bytes, logic-analyser CSV or pcapng recording, detected from the
+/// content), bytes, a binary file object, or a list of these read one after another. `esc`,
+/// `start`, `end` select as the command's `--esc`, `--from`, `--to`; the settings convert
+/// currents and RPM. The schema metadata is that of `hwfoc decode --format parquet`. Raises
+/// InputError, SelectionError, SettingsError; warns HwfocWarning for inputs without frames.
+#[pyfunction]
+#[pyo3(signature = (source, *, esc=None, start=None, end=None, current_scale=64.0, pole_pairs=7, gear_ratio=1.0))]
+#[allow(clippy::too_many_arguments)]
+fn read<'py>(
+    py: Python<'py>,
+    source: &Bound<'py, PyAny>,
+    esc: Option<&Bound<'py, PyAny>>,
+    start: Option<&Bound<'py, PyAny>>,
+    end: Option<&Bound<'py, PyAny>>,
+    current_scale: f32,
+    pole_pairs: u16,
+    gear_ratio: f32,
+) -> PyResult<Bound<'py, PyAny>> {
+    let options = Options::new(esc, start, end, current_scale, pole_pairs, gear_ratio)?;
+    let specs = source::specs(source)?;
+    let provenance = options.provenance(&specs);
+    let decoded = py
+        .detach(|| decode_all(specs, &options))
+        .map_err(stop_error)?;
+    for warning in &decoded.warnings {
+        errors::warn(py, &py.get_type::<errors::HwfocWarning>(), warning)?;
+    }
+    let schema = provenance.schema(Some(decoded.escs));
+    let batches = decoded
+        .batches
+        .into_iter()
+        .map(|b| b.with_schema(schema.clone()))
+        .collect::<Result<Vec<_>, _>>()
+        .map_err(|e| errors::HwfocError::new_err(e.to_string()))?;
+    let table =
+        Table::try_new(batches, schema).map_err(|e| errors::HwfocError::new_err(e.to_string()))?;
+    table.into_pyarrow(py)
+}
+
+/// The summary of `hwfoc summary --json`, as one JSON text.
+fn summary_json(specs: Vec<Spec>, settings: Settings) -> Result<String, InputError> {
+    let mut sources = Sources::new(open_all(specs)?, settings);
+    let mut summary = Summary::new();
+    sources.run(&mut summary)?;
+    Ok(summary.report(&sources, &settings).json().to_string())
+}
+
+/// What `hwfoc summary --json` prints for `source` (as `read` takes it), as Python objects:
+/// settings, inputs, and per ESC its link statistics, field ranges, faults and fault episodes.
+/// Raises InputError.
+#[pyfunction]
+#[pyo3(signature = (source, *, current_scale=64.0, pole_pairs=7, gear_ratio=1.0))]
+fn summary<'py>(
+    py: Python<'py>,
+    source: &Bound<'py, PyAny>,
+    current_scale: f32,
+    pole_pairs: u16,
+    gear_ratio: f32,
+) -> PyResult<Bound<'py, PyAny>> {
+    let settings =
+        Settings::new(current_scale, pole_pairs, gear_ratio).map_err(errors::settings)?;
+    let specs = source::specs(source)?;
+    let json = py
+        .detach(|| summary_json(specs, settings))
+        .map_err(errors::input)?;
+    py.import("json")?.call_method1("loads", (json,))
+}
+
+/// The Arrow schema of the records (names, types, nullability, units in the fields' metadata),
+/// with the settings in its metadata.
+#[pyfunction]
+#[pyo3(signature = (*, current_scale=64.0, pole_pairs=7, gear_ratio=1.0))]
+fn record_schema(
+    py: Python<'_>,
+    current_scale: f32,
+    pole_pairs: u16,
+    gear_ratio: f32,
+) -> PyResult<Bound<'_, PyAny>> {
+    let settings =
+        Settings::new(current_scale, pole_pairs, gear_ratio).map_err(errors::settings)?;
+    let provenance = Provenance {
+        settings,
+        inputs: Vec::new(),
+        filter: String::new(),
+    };
+    let schema = provenance.schema(None);
+    arrow_pyarrow::ToPyArrow::to_pyarrow(schema.as_ref(), py)
+}
+
+/// The extension module.
+#[pymodule]
+fn _hwfoc(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    let py = m.py();
+    m.add_function(wrap_pyfunction!(read, m)?)?;
+    m.add_function(wrap_pyfunction!(scan::scan, m)?)?;
+    m.add_function(wrap_pyfunction!(summary, m)?)?;
+    m.add_function(wrap_pyfunction!(record_schema, m)?)?;
+    m.add_function(wrap_pyfunction!(live::open_ports, m)?)?;
+    m.add_class::<scan::Scan>()?;
+    m.add_class::<live::Decoder>()?;
+    m.add_class::<live::Ports>()?;
+    m.add("HwfocError", py.get_type::<errors::HwfocError>())?;
+    m.add("InputError", py.get_type::<errors::InputError>())?;
+    m.add("PortError", py.get_type::<errors::PortError>())?;
+    m.add("SelectionError", py.get_type::<errors::SelectionError>())?;
+    m.add("SettingsError", py.get_type::<errors::SettingsError>())?;
+    m.add("HwfocWarning", py.get_type::<errors::HwfocWarning>())?;
+    m.add("PortWarning", py.get_type::<errors::PortWarning>())?;
+    m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    Ok(())
+}

@@ -1,0 +1,392 @@
+//! Live telemetry: [`Decoder`], a streaming decoder fed bytes as they arrive, and [`Ports`],
+//! serial ports read as `hwfoc monitor` reads them (`PortSet`: a reader thread per port that
+//! survives unplugging; `PortStreams`: a timed decoding stream per port).
+
+use std::collections::VecDeque;
+use std::sync::Mutex;
+use std::time::Duration;
+
+use arrow_array::RecordBatch;
+use arrow_pyarrow::ToPyArrow;
+use arrow_schema::SchemaRef;
+use hwfoc::{Decoded, Frame, LinkStats, Settings};
+use hwfoc_io::InputError;
+use hwfoc_io::handler::Handler;
+use hwfoc_io::input::Batch;
+use hwfoc_io::serial::{DEFAULT_BAUD, PortEvent, PortSet};
+use hwfoc_io::stream::{PortStreams, Stream, byte_times};
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+use pyo3::types::{PyByteArray, PyBytes, PyDict, PyMemoryView};
+
+use crate::errors;
+use crate::records::{Frames, Provenance};
+
+/// How long a wait for port events lasts before looking for Ctrl-C.
+const POLL: Duration = Duration::from_millis(100);
+
+/// A handler gathering the data frames it is given.
+#[derive(Default)]
+struct Gather(Frames);
+
+impl Handler for Gather {
+    type Error = InputError;
+
+    fn frame(&mut self, esc: u8, t: Option<f64>, decoded: &Decoded, _: &Settings) {
+        if let Frame::Data(f) = &decoded.frame {
+            self.0.push(t, esc, f);
+        }
+    }
+}
+
+/// The link statistics as a dict.
+fn stats_dict<'py>(py: Python<'py>, s: &LinkStats) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    d.set_item("bytes", s.bytes())?;
+    d.set_item("bytes_skipped", s.bytes_skipped())?;
+    d.set_item("frames", s.frames())?;
+    d.set_item("info_frames", s.info_frames())?;
+    d.set_item("checksum_failures", s.checksum_failures())?;
+    d.set_item("lost_packets", s.lost_packets())?;
+    d.set_item("duplicate_packets", s.duplicate_packets())?;
+    d.set_item("restarts", s.restarts())?;
+    d.set_item("last_packet", s.last_packet())?;
+    d.set_item("delivery_ratio", s.delivery_ratio())?;
+    Ok(d)
+}
+
+/// The bytes of a `bytes`, `bytearray` or `memoryview`.
+fn bytes_of(data: &Bound<'_, PyAny>) -> PyResult<Vec<u8>> {
+    if let Ok(b) = data.cast::<PyBytes>() {
+        return Ok(b.as_bytes().to_vec());
+    }
+    if let Ok(b) = data.cast::<PyByteArray>() {
+        return Ok(b.to_vec());
+    }
+    if data.is_instance_of::<PyMemoryView>() {
+        let b = data.call_method0("tobytes")?;
+        return Ok(b.cast::<PyBytes>()?.as_bytes().to_vec());
+    }
+    Err(pyo3::exceptions::PyTypeError::new_err(format!(
+        "feed() takes bytes, bytearray or memoryview, not {}",
+        data.get_type().name()?
+    )))
+}
+
+/// The record schema with `settings` in its metadata.
+fn live_schema(settings: Settings, inputs: Vec<String>) -> SchemaRef {
+    Provenance {
+        settings,
+        inputs,
+        filter: String::new(),
+    }
+    .schema(None)
+}
+
+struct DecoderState {
+    stream: Stream,
+    times: Vec<f64>,
+    /// Whether the bytes fed so far came with times (`None` before the first feed): a stream
+    /// is timed throughout or not at all (a frame's time is its first byte's).
+    timed: Option<bool>,
+}
+
+/// A streaming decoder of one ESC's bytes: see `hwfoc.Decoder`.
+#[pyclass(module = "hwfoc")]
+pub struct Decoder {
+    state: Mutex<DecoderState>,
+    esc: u8,
+    settings: Settings,
+    per_byte_ns: f64,
+    schema: SchemaRef,
+}
+
+impl Decoder {
+    fn batch(&self, py: Python<'_>, frames: &Frames) -> PyResult<Py<PyAny>> {
+        Ok(frames
+            .to_batch(self.schema.clone(), &self.settings)
+            .to_pyarrow(py)?
+            .unbind())
+    }
+
+    fn lock(&self) -> PyResult<std::sync::MutexGuard<'_, DecoderState>> {
+        self.state
+            .lock()
+            .map_err(|_| errors::HwfocError::new_err("the decoder failed earlier"))
+    }
+}
+
+#[pymethods]
+impl Decoder {
+    #[new]
+    #[pyo3(signature = (*, esc=0, baud=DEFAULT_BAUD, current_scale=64.0, pole_pairs=7, gear_ratio=1.0))]
+    fn new(
+        esc: u8,
+        baud: u32,
+        current_scale: f32,
+        pole_pairs: u16,
+        gear_ratio: f32,
+    ) -> PyResult<Self> {
+        let settings =
+            Settings::new(current_scale, pole_pairs, gear_ratio).map_err(errors::settings)?;
+        if baud == 0 {
+            return Err(PyValueError::new_err("baud must be at least 1"));
+        }
+        Ok(Decoder {
+            state: Mutex::new(DecoderState {
+                stream: Stream::new(),
+                times: Vec::new(),
+                timed: None,
+            }),
+            esc,
+            settings,
+            per_byte_ns: hwfoc::wire::byte_ns(baud),
+            schema: live_schema(settings, Vec::new()),
+        })
+    }
+
+    /// Decodes `data`, the next bytes of the stream; `t`: Unix time (s) the first of them was
+    /// received, the others following at the baud rate's byte time. Returns the records of
+    /// the data frames completed, as a `pyarrow.RecordBatch`.
+    #[pyo3(signature = (data, t=None))]
+    fn feed(&self, py: Python<'_>, data: &Bound<'_, PyAny>, t: Option<f64>) -> PyResult<Py<PyAny>> {
+        let bytes = bytes_of(data)?;
+        if let Some(t) = t
+            && !(t.is_finite() && t >= 0.0)
+        {
+            return Err(PyValueError::new_err(format!(
+                "t: {t} is not a time in seconds since 1970"
+            )));
+        }
+        let esc = self.esc;
+        let per_byte_ns = self.per_byte_ns;
+        let frames = py.detach(|| {
+            let mut state = self.state.lock().ok()?;
+            let DecoderState {
+                stream,
+                times,
+                timed,
+            } = &mut *state;
+            if *timed.get_or_insert(t.is_some()) != t.is_some() {
+                return Some(Err(()));
+            }
+            let mut gather = Gather::default();
+            times.clear();
+            if let Some(t) = t {
+                byte_times((t * 1e9).round() as u64, per_byte_ns, bytes.len(), times);
+            }
+            let batch = Batch {
+                bytes: &bytes,
+                times: t.map(|_| times.as_slice()),
+                stream: 0,
+            };
+            stream.feed(batch, |t, d| {
+                if let Frame::Data(f) = &d.frame {
+                    gather.0.push(t, esc, f);
+                }
+            });
+            Some(Ok(gather.0))
+        });
+        let frames = frames
+            .ok_or_else(|| errors::HwfocError::new_err("the decoder failed earlier"))?
+            .map_err(|()| {
+                PyValueError::new_err(
+                    "t: give a receive time with every feed() or with none (a stream is timed \
+                     throughout or not at all)",
+                )
+            })?;
+        self.batch(py, &frames)
+    }
+
+    /// Ends the stream: the records of frames still held (a frame cut off at the end is
+    /// dropped), as a `pyarrow.RecordBatch`.
+    fn finish(&self, py: Python<'_>) -> PyResult<Py<PyAny>> {
+        let mut gather = Gather::default();
+        let esc = self.esc;
+        self.lock()?.stream.finish(|t, d| {
+            if let Frame::Data(f) = &d.frame {
+                gather.0.push(t, esc, f);
+            }
+        });
+        self.batch(py, &gather.0)
+    }
+
+    /// The link statistics so far (bytes, frames, checksum failures, lost packets,
+    /// duplicates, restarts...).
+    #[getter]
+    fn stats<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let stats = *self.lock()?.stream.stats();
+        stats_dict(py, &stats)
+    }
+
+    /// The Arrow schema of the batches `feed` returns.
+    #[getter]
+    fn schema<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        self.schema.as_ref().to_pyarrow(py)
+    }
+}
+
+struct PortsState {
+    set: PortSet,
+    streams: PortStreams,
+}
+
+/// Serial ports being read: an iterator of records (dicts): see `hwfoc.open_ports`.
+#[pyclass(module = "hwfoc")]
+pub struct Ports {
+    state: Mutex<Option<PortsState>>,
+    pending: Mutex<VecDeque<Py<PyAny>>>,
+    names: Vec<String>,
+    settings: Settings,
+    schema: SchemaRef,
+}
+
+/// Opens serial ports: see `hwfoc.open_ports`.
+#[pyfunction]
+#[pyo3(signature = (ports, *, baud=DEFAULT_BAUD, current_scale=64.0, pole_pairs=7, gear_ratio=1.0))]
+pub fn open_ports(
+    py: Python<'_>,
+    ports: Vec<String>,
+    baud: u32,
+    current_scale: f32,
+    pole_pairs: u16,
+    gear_ratio: f32,
+) -> PyResult<Ports> {
+    let settings =
+        Settings::new(current_scale, pole_pairs, gear_ratio).map_err(errors::settings)?;
+    if ports.is_empty() {
+        return Err(PyValueError::new_err("no port given"));
+    }
+    if baud == 0 {
+        return Err(PyValueError::new_err("baud must be at least 1"));
+    }
+    let set = py
+        .detach(|| PortSet::open(&ports, baud))
+        .map_err(errors::port)?;
+    let streams = PortStreams::new(ports.len(), baud, settings);
+    Ok(Ports {
+        state: Mutex::new(Some(PortsState { set, streams })),
+        pending: Mutex::new(VecDeque::new()),
+        schema: live_schema(settings, ports.clone()),
+        names: ports,
+        settings,
+    })
+}
+
+impl Ports {
+    fn take_pending(&self) -> Option<Py<PyAny>> {
+        self.pending.lock().ok()?.pop_front()
+    }
+
+    /// Waits for the next port event and handles it: records become pending dicts, a port
+    /// lost or back becomes a warning. `Ok(false)` once the ports are closed.
+    fn step(&self, py: Python<'_>) -> PyResult<bool> {
+        let got = py.detach(|| {
+            let mut guard = self.state.lock().ok()?;
+            let state = guard.as_mut()?;
+            let event = state.set.next_event(POLL);
+            let mut gather = Gather::default();
+            if let Some(event) = &event {
+                state.streams.feed(event, &mut gather);
+            }
+            Some((event, gather.0))
+        });
+        let Some((event, frames)) = got else {
+            return Ok(false);
+        };
+        if !frames.is_empty() {
+            let batch: RecordBatch = frames.to_batch(self.schema.clone(), &self.settings);
+            let rows = batch.to_pyarrow(py)?.call_method0("to_pylist")?;
+            let mut pending = self
+                .pending
+                .lock()
+                .map_err(|_| errors::HwfocError::new_err("the ports failed earlier"))?;
+            for row in rows.try_iter()? {
+                pending.push_back(row?.unbind());
+            }
+        }
+        let note = match &event {
+            Some(PortEvent::Lost { port, reason, .. }) => Some(format!(
+                "{} lost ({reason}); retrying every {} ms",
+                self.names[*port],
+                hwfoc_io::serial::RETRY_EVERY.as_millis()
+            )),
+            Some(PortEvent::Back { port, .. }) => Some(format!("{} is back", self.names[*port])),
+            _ => None,
+        };
+        if let Some(note) = note {
+            errors::warn(py, &py.get_type::<errors::PortWarning>(), &note)?;
+        }
+        if event.is_none() {
+            py.check_signals()?;
+        }
+        Ok(true)
+    }
+
+    fn shut(&self, py: Python<'_>) {
+        // Joining the reader threads takes up to a read timeout: without the lock.
+        py.detach(|| {
+            let state = self.state.lock().ok().and_then(|mut s| s.take());
+            drop(state);
+        });
+    }
+}
+
+#[pymethods]
+impl Ports {
+    fn __iter__(slf: PyRef<'_, Self>) -> PyRef<'_, Self> {
+        slf
+    }
+
+    fn __next__(&self, py: Python<'_>) -> PyResult<Option<Py<PyAny>>> {
+        loop {
+            if let Some(record) = self.take_pending() {
+                return Ok(Some(record));
+            }
+            match self.step(py) {
+                Ok(true) => {}
+                Ok(false) => return Ok(None),
+                Err(e) => {
+                    // Ctrl-C (or a warning made an error): the ports are closed.
+                    if e.is_instance_of::<pyo3::exceptions::PyKeyboardInterrupt>(py) {
+                        self.shut(py);
+                    }
+                    return Err(e);
+                }
+            }
+        }
+    }
+
+    /// The ports, in the order given (the `esc` of their records).
+    #[getter]
+    fn ports(&self) -> Vec<String> {
+        self.names.clone()
+    }
+
+    /// The link statistics of each port so far, in port order.
+    #[getter]
+    fn stats<'py>(&self, py: Python<'py>) -> PyResult<Vec<Bound<'py, PyDict>>> {
+        let all: Vec<LinkStats> = match self.state.lock().ok().as_ref().and_then(|s| s.as_ref()) {
+            Some(state) => (0..self.names.len())
+                .filter_map(|p| state.streams.stats(p).copied())
+                .collect(),
+            None => Vec::new(),
+        };
+        all.iter().map(|s| stats_dict(py, s)).collect()
+    }
+
+    /// Stops reading and closes the ports; the iterator then ends.
+    fn close(&self, py: Python<'_>) {
+        self.shut(py);
+    }
+
+    fn __enter__(slf: PyRef<'_, Self>) -> PyRef<'_, Self> {
+        slf
+    }
+
+    #[pyo3(signature = (*_args))]
+    fn __exit__(&self, py: Python<'_>, _args: &Bound<'_, pyo3::types::PyTuple>) -> bool {
+        self.shut(py);
+        false
+    }
+}

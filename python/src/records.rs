@@ -1,0 +1,293 @@
+//! Frames to Arrow record batches: the schema of `hwfoc_io::write::arrow` (names, types,
+//! nullability, units of RECORD-SCHEMA.md, from the column table), each column's array made at
+//! once from a block of frames, and the key-value metadata of the Parquet export.
+
+use std::collections::HashMap;
+use std::sync::Arc;
+
+use arrow_array::{RecordBatch, new_null_array};
+use arrow_schema::{Schema, SchemaRef};
+use hwfoc::{DataFrame, Decoded, Frame, Settings};
+use hwfoc_io::InputError;
+use hwfoc_io::handler::Handler;
+use hwfoc_io::record::{Column, Visitor, columns};
+use hwfoc_io::select::Selection;
+use hwfoc_io::sources::Sources;
+use hwfoc_io::write::arrow::{ArrowValue, schema};
+
+/// Data frames as received, column by column: what a batch is made from.
+#[derive(Debug, Default)]
+pub struct Frames {
+    /// Receive time of each frame's first byte; NaN where the input has no times (a receive
+    /// time is never NaN).
+    pub t: Vec<f64>,
+    /// Whether any frame has a time.
+    pub timed: bool,
+    /// ESC of each frame.
+    pub esc: Vec<u8>,
+    /// The frames.
+    pub frames: Vec<DataFrame>,
+}
+
+impl Frames {
+    /// Room for `n` frames.
+    pub fn with_capacity(n: usize) -> Frames {
+        Frames {
+            t: Vec::with_capacity(n),
+            timed: false,
+            esc: Vec::with_capacity(n),
+            frames: Vec::with_capacity(n),
+        }
+    }
+
+    /// Adds a frame.
+    #[inline]
+    pub fn push(&mut self, t: Option<f64>, esc: u8, frame: &DataFrame) {
+        self.timed |= t.is_some();
+        self.t.push(t.unwrap_or(f64::NAN));
+        self.esc.push(esc);
+        self.frames.push(*frame);
+    }
+
+    /// Empties it, keeping its room (a buffer used again is not faulted in again).
+    pub fn clear(&mut self) {
+        self.t.clear();
+        self.esc.clear();
+        self.frames.clear();
+        self.timed = false;
+    }
+
+    /// Number of frames.
+    pub fn len(&self) -> usize {
+        self.frames.len()
+    }
+
+    /// Whether there are none.
+    pub fn is_empty(&self) -> bool {
+        self.frames.is_empty()
+    }
+
+    /// The record batch of these frames under `settings`, with schema `schema` (the record
+    /// schema, with or without key-value metadata): each column's array from all the frames,
+    /// by code generic over the column, as the library's writers make theirs.
+    pub fn to_batch(&self, schema: SchemaRef, settings: &Settings) -> RecordBatch {
+        self.slice_to_batch(0..self.len(), schema, settings)
+    }
+
+    /// The record batch of frames `rows` (a range within `0..len()`), as [`Frames::to_batch`].
+    pub fn slice_to_batch(
+        &self,
+        rows: std::ops::Range<usize>,
+        schema: SchemaRef,
+        settings: &Settings,
+    ) -> RecordBatch {
+        struct Arrays<'a> {
+            frames: &'a Frames,
+            rows: std::ops::Range<usize>,
+            settings: &'a Settings,
+            arrays: Vec<arrow_array::ArrayRef>,
+        }
+        impl Visitor for Arrays<'_> {
+            fn column<C: Column>(&mut self) {
+                let f = self.frames;
+                let s = self.settings;
+                let rows = self.rows.clone();
+                // Without times `t_s` is all null: an array of nulls is zeroed memory the
+                // allocator hands out untouched, not a value written per row.
+                if C::NAME == "t_s" && !f.timed {
+                    let nulls = new_null_array(&<C::Value as ArrowValue>::data_type(), rows.len());
+                    self.arrays.push(nulls);
+                    return;
+                }
+                let (t, esc, frames) = (&f.t[rows.clone()], &f.esc[rows.clone()], &f.frames[rows]);
+                let values = t.iter().zip(esc).zip(frames).map(|((&t, &esc), frame)| {
+                    let t = (!t.is_nan()).then_some(t);
+                    C::from_frame(t, esc, frame, s)
+                });
+                self.arrays.push(<C::Value as ArrowValue>::array(values));
+            }
+        }
+        let mut arrays = Arrays {
+            frames: self,
+            rows,
+            settings,
+            arrays: Vec::with_capacity(columns::COUNT),
+        };
+        columns::visit(&mut arrays);
+        // Each array has its field's type and nullability (both come from the column's value
+        // type, as in `hwfoc_io::write::arrow`), and all have the same length.
+        RecordBatch::try_new(schema, arrays.arrays).expect("the arrays follow the schema")
+    }
+}
+
+/// What the records were made from: the Parquet export's key-value metadata (`hwfoc decode
+/// --format parquet`): `hwfoc_version`, the settings, `inputs`, `filter` when records were
+/// selected, and `escs` when known (after the whole run).
+#[derive(Debug, Clone)]
+pub struct Provenance {
+    /// The conversion settings.
+    pub settings: Settings,
+    /// The inputs' names.
+    pub inputs: Vec<String>,
+    /// The selection as the command writes it (`esc=0,2 from=1.5 to=3`), or empty.
+    pub filter: String,
+}
+
+impl Provenance {
+    /// The key-value metadata, with `escs` (a JSON array of `{"esc", "input", "stream"}`) when
+    /// given.
+    pub fn metadata(&self, escs: Option<String>) -> HashMap<String, String> {
+        let s = &self.settings;
+        let mut kv = HashMap::from([
+            (
+                "hwfoc_version".to_string(),
+                env!("CARGO_PKG_VERSION").to_string(),
+            ),
+            ("current_scale".to_string(), s.current_scale.to_string()),
+            ("pole_pairs".to_string(), s.pole_pairs.to_string()),
+            ("gear_ratio".to_string(), s.gear_ratio.to_string()),
+            (
+                "inputs".to_string(),
+                serde_json::Value::from(self.inputs.clone()).to_string(),
+            ),
+        ]);
+        if !self.filter.is_empty() {
+            kv.insert("filter".to_string(), self.filter.clone());
+        }
+        if let Some(escs) = escs {
+            kv.insert("escs".to_string(), escs);
+        }
+        kv
+    }
+
+    /// The record schema with the metadata.
+    pub fn schema(&self, escs: Option<String>) -> SchemaRef {
+        Arc::new(Schema::new_with_metadata(
+            schema().fields().clone(),
+            self.metadata(escs),
+        ))
+    }
+}
+
+/// The selection as `hwfoc decode` records it: `esc=0,2 from=1.5 to=3`, or empty.
+pub fn filter_text(escs: &[u8], from: Option<f64>, to: Option<f64>) -> String {
+    let mut parts = Vec::new();
+    if !escs.is_empty() {
+        let escs: Vec<String> = escs.iter().map(u8::to_string).collect();
+        parts.push(format!("esc={}", escs.join(",")));
+    }
+    if let Some(from) = from {
+        parts.push(format!("from={from}"));
+    }
+    if let Some(to) = to {
+        parts.push(format!("to={to}"));
+    }
+    parts.join(" ")
+}
+
+/// Which ESC is which, as the Parquet export's `escs`:
+/// `[{"esc": 0, "input": "a.pcapng", "stream": "/dev/ttyUSB0"}, ...]`.
+pub fn escs_json(sources: &Sources) -> String {
+    let escs: Vec<serde_json::Value> = sources
+        .escs()
+        .iter()
+        .enumerate()
+        .map(|(i, esc)| {
+            serde_json::json!({
+                "esc": i,
+                "input": sources.names()[esc.input],
+                "stream": esc.name,
+            })
+        })
+        .collect();
+    serde_json::Value::from(escs).to_string()
+}
+
+/// Why a run of inputs stopped: an input, or the reader of the batches having gone away.
+#[derive(Debug)]
+pub enum Stop {
+    /// An input could not be read.
+    Input(InputError),
+    /// Nobody wants the records any more (the iterator was dropped).
+    Abandoned,
+}
+
+impl From<InputError> for Stop {
+    fn from(e: InputError) -> Self {
+        Stop::Input(e)
+    }
+}
+
+/// Room for a block of `rows` frames: a block is handed on at the end of the input batch that
+/// fills it, so one batch more (a 64 KiB read holds at most 2731 data frames; a recording's
+/// packet or a CSV block, less) fits without the vectors growing (a copy of all of it).
+pub fn block_capacity(rows: usize) -> usize {
+    rows.min(1 << 20) + (64 << 10)
+}
+
+/// A [`Handler`] gathering the selected data frames in blocks of `rows` frames, handing each
+/// full block to `full` (at the end of an input batch, as the export does). A block comes from
+/// `spare` when one is there (blocks handed back once converted), else it is new.
+pub struct Collect<F> {
+    selection: Selection,
+    rows: usize,
+    frames: Frames,
+    full: F,
+    spare: Option<std::sync::mpsc::Receiver<Frames>>,
+}
+
+impl<F: FnMut(Frames) -> Result<(), Stop>> Collect<F> {
+    /// Gathers the frames of `selection` in blocks of about `rows`.
+    pub fn new(selection: Selection, rows: usize, full: F) -> Self {
+        Collect {
+            selection,
+            rows,
+            frames: Frames::with_capacity(block_capacity(rows)),
+            full,
+            spare: None,
+        }
+    }
+
+    /// Takes the blocks for the next frames from `spare` when there are some.
+    pub fn reuse(mut self, spare: std::sync::mpsc::Receiver<Frames>) -> Self {
+        self.spare = Some(spare);
+        self
+    }
+
+    /// Hands on the frames gathered so far, if any.
+    pub fn flush(&mut self) -> Result<(), Stop> {
+        if self.frames.is_empty() {
+            return Ok(());
+        }
+        let reused = self.spare.as_ref().and_then(|s| s.try_recv().ok());
+        let next = match reused {
+            Some(mut frames) => {
+                frames.clear();
+                frames
+            }
+            None => Frames::with_capacity(block_capacity(self.rows)),
+        };
+        let frames = std::mem::replace(&mut self.frames, next);
+        (self.full)(frames)
+    }
+}
+
+impl<F: FnMut(Frames) -> Result<(), Stop>> Handler for Collect<F> {
+    type Error = Stop;
+
+    #[inline]
+    fn frame(&mut self, esc: u8, t: Option<f64>, decoded: &Decoded, _: &Settings) {
+        if let Frame::Data(frame) = &decoded.frame
+            && self.selection.contains(esc, t)
+        {
+            self.frames.push(t, esc, frame);
+        }
+    }
+
+    fn end_batch(&mut self, _live: bool) -> Result<(), Stop> {
+        if self.frames.len() >= self.rows {
+            self.flush()?;
+        }
+        Ok(())
+    }
+}

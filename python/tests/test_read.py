@@ -1,0 +1,252 @@
+"""hwfoc.read: the same records as `hwfoc decode`, the schema and metadata of its Parquet
+output, every kind of source, selections and settings, and errors with the command's
+messages."""
+
+import io
+import json
+import os
+import subprocess
+import sys
+import warnings
+from pathlib import Path
+
+import numpy as np
+import pyarrow as pa
+import pyarrow.parquet as pq
+import pytest
+
+import hwfoc
+from conftest import CAPTURES, assert_same_records, cli_error, cli_records, run_cli
+
+
+@pytest.mark.parametrize("capture", CAPTURES, ids=lambda p: p.name)
+def test_real_captures_equal_decode(cli, capture):
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", hwfoc.HwfocWarning)
+        table = hwfoc.read(str(capture))
+    records = cli_records(cli, capture)
+    assert_same_records(table, records)
+
+
+def test_the_real_captures_hold_frames():
+    # The comparison above is not empty: the X-Rotor capture has HW-FOC data frames (the
+    # Platinum captures are another protocol: no frame, a warning, as the command says).
+    sizes = []
+    for c in CAPTURES:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", hwfoc.HwfocWarning)
+            sizes.append(hwfoc.read(str(c)).num_rows)
+    assert sizes == [0, 0, 248], sizes
+
+
+@pytest.mark.parametrize("name", ["three.pcapng", "one.bin"])
+def test_simulated_recordings_equal_decode(cli, sim_dir, name):
+    path = sim_dir / name
+    table = hwfoc.read(path)
+    records = cli_records(cli, path)
+    assert len(records) > 100
+    assert any(r["faults"] for r in records)
+    assert_same_records(table, records)
+
+
+def test_schema_and_metadata_are_the_parquet_exports(cli, sim_dir, tmp_path):
+    path = str(sim_dir / "three.pcapng")
+    out = tmp_path / "x.parquet"
+    run_cli(cli, "decode", "--format", "parquet", "-o", out, path, "--esc", "0,2", "--from", "1700000002")
+    table = hwfoc.read(path, esc=[0, 2], start=1700000002)
+    exported = pq.read_table(out)
+    assert table.schema.equals(exported.schema, check_metadata=False)
+    # Field by field, with the units.
+    for got, want in zip(table.schema, exported.schema):
+        assert got.name == want.name and got.type == want.type and got.nullable == want.nullable
+        assert got.metadata == want.metadata
+    file_meta = pq.read_metadata(out).metadata
+    for key, value in table.schema.metadata.items():
+        assert file_meta[key] == value, key
+    assert set(table.schema.metadata) == {k for k in file_meta if k != b"ARROW:schema"}
+    assert table.schema.metadata[b"filter"] == b"esc=0,2 from=1700000002"
+    assert table.equals(exported)
+
+
+def test_settings_change_values_and_metadata(cli, sim_dir):
+    path = sim_dir / "one.bin"
+    table = hwfoc.read(path, current_scale=100, pole_pairs=14, gear_ratio=2.5)
+    records = cli_records(cli, path, "--current-scale", "100", "--pole-pairs", "14", "--gear-ratio", "2.5")
+    assert_same_records(table, records)
+    meta = table.schema.metadata
+    assert (meta[b"current_scale"], meta[b"pole_pairs"], meta[b"gear_ratio"]) == (b"100", b"14", b"2.5")
+    assert table.column("rpm") != hwfoc.read(path).column("rpm")
+
+
+@pytest.mark.parametrize("esc,start,end", [(1, None, None), ([0, 2], 1700000003.5, None), (None, None, 1700000004), (2, 1700000002, 1700000006)])
+def test_selection_is_the_commands(cli, sim_dir, esc, start, end):
+    path = sim_dir / "three.pcapng"
+    args = []
+    if esc is not None:
+        args += ["--esc", ",".join(map(str, esc if isinstance(esc, list) else [esc]))]
+    if start is not None:
+        args += ["--from", start]
+    if end is not None:
+        args += ["--to", end]
+    table = hwfoc.read(path, esc=esc, start=start, end=end)
+    records = cli_records(cli, path, *args)
+    assert 0 < len(records) < hwfoc.read(path).num_rows
+    assert_same_records(table, records)
+
+
+def test_a_datetime_selects_as_its_unix_time(sim_dir):
+    import datetime
+
+    path = sim_dir / "three.pcapng"
+    when = datetime.datetime.fromtimestamp(1700000004, tz=datetime.timezone.utc)
+    assert hwfoc.read(path, start=when).equals(hwfoc.read(path, start=1700000004))
+
+
+def test_bytes_and_file_objects_read_as_the_file(sim_dir):
+    path = sim_dir / "three.pcapng"
+    whole = hwfoc.read(path)
+    data = path.read_bytes()
+    for source in (data, bytearray(data), memoryview(data), io.BytesIO(data)):
+        got = hwfoc.read(source)
+        assert got.equals(whole)
+    with open(path, "rb") as f:
+        got = hwfoc.read(f)
+    assert got.equals(whole)
+    assert json.loads(got.schema.metadata[b"inputs"]) == [str(path)]
+    assert json.loads(hwfoc.read(data).schema.metadata[b"inputs"]) == ["<bytes>"]
+
+
+def test_inputs_given_together(cli, sim_dir):
+    a, b = sim_dir / "one.bin", sim_dir / "three.pcapng"
+    table = hwfoc.read([a, str(b)])
+    assert_same_records(table, cli_records(cli, a, b))
+    escs = json.loads(table.schema.metadata[b"escs"])
+    assert [e["esc"] for e in escs] == [0, 1, 2, 3]
+    assert set(table.column("esc").to_pylist()) == {0, 1, 2, 3}
+
+
+def test_empty_window_and_bad_settings_raise_the_commands_errors(cli, sim_dir):
+    path = sim_dir / "three.pcapng"
+    with pytest.raises(hwfoc.SelectionError) as e:
+        hwfoc.read(path, start=5, end=5)
+    assert str(e.value) == cli_error(cli, "decode", path, "--from", "5", "--to", "5")
+    with pytest.raises(hwfoc.SettingsError) as e:
+        hwfoc.read(path, current_scale=0)
+    assert str(e.value) == cli_error(cli, "decode", path, "--current-scale", "0")
+    with pytest.raises(hwfoc.SettingsError) as e:
+        hwfoc.read(path, pole_pairs=0)
+    assert str(e.value) == cli_error(cli, "decode", path, "--pole-pairs", "0")
+    with pytest.raises(ValueError):
+        hwfoc.read(path, esc=256)
+    with pytest.raises(TypeError):
+        hwfoc.read(path, esc="zero")
+    with pytest.raises(TypeError):
+        hwfoc.read(path, start="yesterday")
+
+
+def test_a_window_on_raw_bytes_is_refused(cli, sim_dir):
+    path = sim_dir / "one.bin"
+    with pytest.raises(hwfoc.InputError) as e:
+        hwfoc.read(path, start=1)
+    assert str(e.value) == cli_error(cli, "decode", path, "--from", "1")
+
+
+def test_bad_inputs_raise_the_commands_errors(cli, tmp_path):
+    missing = tmp_path / "missing.bin"
+    empty = tmp_path / "empty.bin"
+    empty.write_bytes(b"")
+    classic = tmp_path / "old.pcap"
+    classic.write_bytes(bytes([0xD4, 0xC3, 0xB2, 0xA1]) + bytes(20))
+    bad_csv = tmp_path / "bad.csv"
+    bad_csv.write_text("Time [s],Value,Parity Error,Framing Error\n0.1,0x9B,,\n0.2,zz,,\n")
+    for path in (missing, empty, classic, tmp_path, bad_csv):
+        with pytest.raises(hwfoc.InputError) as e:
+            hwfoc.read(path)
+        assert str(e.value) == cli_error(cli, "decode", path), path
+        assert isinstance(e.value, hwfoc.HwfocError)
+    with pytest.raises(hwfoc.InputError) as e:
+        hwfoc.summary(missing)
+    assert str(e.value) == cli_error(cli, "summary", missing)
+
+
+def test_text_mode_file_objects_and_other_types_are_refused(sim_dir):
+    with pytest.raises(hwfoc.InputError, match="binary mode"):
+        hwfoc.read(io.StringIO("not bytes"))
+    with pytest.raises(TypeError, match="cannot read a int"):
+        hwfoc.read(3)
+    with pytest.raises(TypeError):
+        hwfoc.read([])
+
+
+def test_garbage_and_other_protocols_warn_as_the_command_does(cli, tmp_path):
+    rng = np.random.default_rng(5)
+    garbage = tmp_path / "garbage.bin"
+    garbage.write_bytes(rng.integers(0, 256, 20000, dtype=np.uint8).tobytes())
+    # A DataLink-like stream (another protocol): 0x9B headers that never make a HW-FOC frame.
+    other = tmp_path / "other.bin"
+    other.write_bytes(bytes([0x9B, 0x30, 0x01, 0x22] + list(range(40))) * 200)
+    for path in (garbage, other):
+        with pytest.warns(hwfoc.HwfocWarning) as caught:
+            table = hwfoc.read(path)
+        assert table.num_rows == 0
+        _, err, _ = run_cli(cli, "decode", path)
+        assert [f"hwfoc: warning: {w.message}" for w in caught] == err.splitlines()
+
+
+def test_truncated_recording_reads_what_is_there(cli, sim_dir, tmp_path, capfd):
+    data = (sim_dir / "three.pcapng").read_bytes()
+    cut = tmp_path / "cut.pcapng"
+    cut.write_bytes(data[: len(data) * 2 // 3 + 5])
+    table = hwfoc.read(cut)
+    assert "stopped at byte" in capfd.readouterr().err
+    records = cli_records(cli, cut)
+    assert 0 < len(records)
+    assert_same_records(table, records)
+
+
+def test_random_bytes_never_crash_the_interpreter(tmp_path):
+    # In a child process, so that a crash would show as its exit status, not end the tests.
+    script = r"""
+import io, sys, warnings
+import numpy as np
+import hwfoc
+warnings.simplefilter("ignore")
+rng = np.random.default_rng(11)
+header = bytes.fromhex("0a0d0d0a")
+for k in range(300):
+    n = int(rng.integers(1, 3000))
+    data = rng.integers(0, 256, n, dtype=np.uint8).tobytes()
+    if k % 3 == 0:
+        data = header + data
+    if k % 3 == 1:
+        data = b"Time [s],Value,Parity Error,Framing Error\n" + data
+    for call in (lambda: hwfoc.read(data), lambda: hwfoc.summary(data), lambda: list(hwfoc.scan(data))):
+        try:
+            call()
+        except hwfoc.HwfocError:
+            pass
+    d = hwfoc.Decoder()
+    d.feed(data)
+    d.finish()
+print("ok")
+"""
+    p = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=600)
+    assert p.returncode == 0, p.stderr[-3000:]
+    assert p.stdout.strip() == "ok"
+    assert "panicked" not in p.stderr
+
+
+def test_polars_and_pandas_take_the_table(sim_dir):
+    import pandas as pd
+    import polars as pl
+
+    table = hwfoc.read(sim_dir / "three.pcapng")
+    df = pl.from_arrow(table)
+    assert df.height == table.num_rows
+    assert df.schema["esc"] == pl.UInt8 and df.schema["faults"] == pl.List(pl.String)
+    hot = df.group_by("esc").agg(pl.col("mos_temp_c").max()).sort("esc")
+    assert hot.height == 3
+    pdf = table.to_pandas()
+    assert str(pdf["packet"].dtype) == "uint16"
+    assert pdf["mos_temp_c"].max() == pytest.approx(float(pa.compute.max(table.column("mos_temp_c")).as_py()))
+    assert isinstance(pdf, pd.DataFrame)
