@@ -9,11 +9,12 @@ use std::time::Duration;
 use arrow_array::RecordBatch;
 use arrow_pyarrow::ToPyArrow;
 use arrow_schema::SchemaRef;
-use hwfoc::{Decoded, Frame, LinkStats, Settings};
+use hwfoc::{Decoded, Frame, Settings};
 use hwfoc_io::InputError;
 use hwfoc_io::handler::Handler;
 use hwfoc_io::input::Batch;
 use hwfoc_io::serial::{DEFAULT_BAUD, PortEvent, PortSet};
+use hwfoc_io::stream::EscLink;
 use hwfoc_io::stream::{PortStreams, Stream, byte_times};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
@@ -40,7 +41,7 @@ impl Handler for Gather {
 }
 
 /// The link statistics as a dict.
-fn stats_dict<'py>(py: Python<'py>, s: &LinkStats) -> PyResult<Bound<'py, PyDict>> {
+fn stats_dict<'py>(py: Python<'py>, s: &EscLink) -> PyResult<Bound<'py, PyDict>> {
     let d = PyDict::new(py);
     d.set_item("bytes", s.bytes())?;
     d.set_item("bytes_skipped", s.bytes_skipped())?;
@@ -180,9 +181,12 @@ impl Decoder {
                 times: t.map(|_| times.as_slice()),
                 stream: 0,
             };
-            stream.feed(batch, |t, d| {
+            // From a DataLink hub, channel `c` is ESC `esc + c`.
+            stream.feed(batch, |t, channel, d| {
                 if let Frame::Data(f) = &d.frame {
-                    gather.0.push(t, esc, f);
+                    gather
+                        .0
+                        .push(t, channel.map_or(esc, |c| esc.saturating_add(c)), f);
                 }
             });
             Some(Ok(gather.0))
@@ -203,9 +207,11 @@ impl Decoder {
     fn finish(&self, py: Python<'_>) -> PyResult<Py<PyAny>> {
         let mut gather = Gather::default();
         let esc = self.esc;
-        self.lock()?.stream.finish(|t, d| {
+        self.lock()?.stream.finish(|t, channel, d| {
             if let Frame::Data(f) = &d.frame {
-                gather.0.push(t, esc, f);
+                gather
+                    .0
+                    .push(t, channel.map_or(esc, |c| esc.saturating_add(c)), f);
             }
         });
         self.batch(py, &gather.0)
@@ -215,7 +221,7 @@ impl Decoder {
     /// duplicates, restarts...).
     #[getter]
     fn stats<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
-        let stats = *self.lock()?.stream.stats();
+        let stats = self.lock()?.stream.stats();
         stats_dict(py, &stats)
     }
 
@@ -366,9 +372,9 @@ impl Ports {
     /// The link statistics of each port so far, in port order.
     #[getter]
     fn stats<'py>(&self, py: Python<'py>) -> PyResult<Vec<Bound<'py, PyDict>>> {
-        let all: Vec<LinkStats> = match self.state.lock().ok().as_ref().and_then(|s| s.as_ref()) {
+        let all: Vec<EscLink> = match self.state.lock().ok().as_ref().and_then(|s| s.as_ref()) {
             Some(state) => (0..self.names.len())
-                .filter_map(|p| state.streams.stats(p).copied())
+                .filter_map(|p| state.streams.stats(p))
                 .collect(),
             None => Vec::new(),
         };

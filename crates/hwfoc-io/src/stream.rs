@@ -269,6 +269,11 @@ impl EscLink {
         self.channel().map_or(0, PacketSequence::restarts)
     }
 
+    /// The last packet number received.
+    pub fn last_packet(&self) -> Option<u16> {
+        self.channel().and_then(PacketSequence::last)
+    }
+
     /// Frames received over frames sent, from the packet numbers.
     pub fn delivery_ratio(&self) -> Option<f64> {
         self.channel().and_then(PacketSequence::delivery_ratio)
