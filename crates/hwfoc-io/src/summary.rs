@@ -436,6 +436,7 @@ impl<'a> Report<'a> {
             .collect();
         let escs: Vec<Value> = self.escs().iter().map(EscReport::json).collect();
         json!({
+            "schema_version": crate::JSON_SCHEMA_VERSION,
             "settings": {
                 "current_scale": self.settings.current_scale,
                 "pole_pairs": self.settings.pole_pairs,
