@@ -12,14 +12,14 @@ mod output;
 
 use std::process::ExitCode;
 
-use clap::{Parser, Subcommand};
+use clap::{CommandFactory, Parser, Subcommand};
 
-use crate::commands::{capture, decode, monitor, plot, simulate, summary};
+use crate::commands::{capture, completions, decode, man, monitor, plot, simulate, summary};
 use crate::error::CliError;
 
 /// Decode and analyse the telemetry of Hobbywing FOC ESCs (HW-FOC protocol, 19200 baud).
 #[derive(Debug, Parser)]
-#[command(name = "hwfoc", version, about, propagate_version = true)]
+#[command(name = "hwfoc", version = env!("HWFOC_VERSION"), about, propagate_version = true)]
 struct Cli {
     #[command(subcommand)]
     command: Command,
@@ -40,6 +40,10 @@ enum Command {
     Record(capture::RecordArgs),
     /// Virtual ESCs: the protocol from a physical model, to a pty, serial port, file or stdout.
     Simulate(Box<simulate::SimulateArgs>),
+    /// Print the completion script for a shell (bash, zsh, fish, powershell, elvish).
+    Completions(completions::CompletionsArgs),
+    /// Write the manual pages (hwfoc.1 and one per subcommand), or print hwfoc.1.
+    Man(man::ManArgs),
 }
 
 fn main() -> ExitCode {
@@ -51,6 +55,8 @@ fn main() -> ExitCode {
         Command::Record(args) => capture::run(args),
         Command::Simulate(args) => simulate::run(args),
         Command::Plot(args) => plot::run(args),
+        Command::Completions(args) => completions::run(args, Cli::command()),
+        Command::Man(args) => man::run(args, Cli::command()),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

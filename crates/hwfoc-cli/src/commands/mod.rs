@@ -1,7 +1,9 @@
 //! One module per subcommand: its options (a clap `Args` struct) and its `run`.
 
 pub mod capture;
+pub mod completions;
 pub mod decode;
+pub mod man;
 pub mod monitor;
 pub mod plot;
 pub mod simulate;
