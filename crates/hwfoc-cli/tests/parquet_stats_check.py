@@ -5,7 +5,8 @@ Usage: parquet_stats_check.py HWFOC [WORKDIR]
 
 HWFOC is the path of the hwfoc binary. The script simulates a recording whose values change
 over time (16 virtual ESCs for 70 minutes, the throttle climbing from idle to full, so the
-MOSFETs warm up row group after row group; pcapng, so `t_s` is Unix time), exports it as
+MOSFETs warm up row group after row group; two fault episodes; pcapng, so `t_s` is Unix
+time), exports it as
 Parquet (10 row groups or more), then:
 
 - pyarrow: every column chunk of every row group has statistics: a null count, and a minimum
@@ -69,7 +70,9 @@ def export(hwfoc, work):
         f.write("time_s,throttle_percent\n0,0\n60,5\n%d,100\n" % DURATION_S)
     recording = os.path.join(work, "climb.pcapng")
     run(hwfoc, "simulate", "--escs", str(ESCS), "--duration", str(DURATION_S), "--seed", "7",
-        "--profile", f"csv:{profile}", "--start-time", str(START), "--quiet", "-o", recording)
+        "--profile", f"csv:{profile}", "--start-time", str(START), "--quiet", "-o", recording,
+        # Fault names in some row groups only: the list column's statistics then vary too.
+        "--fault", "3:mos_overheat@600-660", "--fault", "5:throttle_signal_lost@1800-1830")
     parquet = os.path.join(work, "climb.parquet")
     run(hwfoc, "decode", "--format", "parquet", "-o", parquet, recording)
     return parquet
@@ -224,6 +227,8 @@ def main():
     os.makedirs(work, exist_ok=True)
     path = export(hwfoc, work)
     groups = check_pyarrow_statistics(path)
+    with_names = sum(1 for g in groups if g["faults.list.item"][0] is not None)
+    check(0 < with_names < len(groups), f"{with_names} row groups with fault names")
     check_duckdb_metadata(path, groups)
     # Hot MOSFETs: above the middle of the row groups' maxima (a float32 column).
     maxima = sorted(g["mos_temp_c"][1] for g in groups)
