@@ -13,14 +13,16 @@ mod output;
 
 use std::process::ExitCode;
 
-use clap::{Parser, Subcommand};
+use clap::{CommandFactory, Parser, Subcommand};
 
-use crate::commands::{bridge, capture, decode, monitor, plot, simulate, summary};
+use crate::commands::{
+    bridge, capture, completions, decode, man, monitor, plot, simulate, summary,
+};
 use crate::error::CliError;
 
 /// Decode and analyse the telemetry of Hobbywing FOC ESCs (HW-FOC protocol, 19200 baud).
 #[derive(Debug, Parser)]
-#[command(name = "hwfoc", version, about, propagate_version = true)]
+#[command(name = "hwfoc", version = env!("HWFOC_VERSION"), about, propagate_version = true)]
 struct Cli {
     #[command(subcommand)]
     command: Command,
@@ -46,6 +48,10 @@ enum Command {
     Bridge(Box<bridge::BridgeArgs>),
     /// The Wireshark dissector for recordings: install it, print where it goes, or print it.
     Wireshark(commands::wireshark::WiresharkArgs),
+    /// Print the completion script for a shell (bash, zsh, fish, powershell, elvish).
+    Completions(completions::CompletionsArgs),
+    /// Write the manual pages (hwfoc.1 and one per subcommand), or print hwfoc.1.
+    Man(man::ManArgs),
 }
 
 fn main() -> ExitCode {
@@ -59,6 +65,8 @@ fn main() -> ExitCode {
         Command::Plot(args) => plot::run(args),
         Command::Bridge(args) => bridge::run(args),
         Command::Wireshark(args) => commands::wireshark::run(args),
+        Command::Completions(args) => completions::run(args, Cli::command()),
+        Command::Man(args) => man::run(args, Cli::command()),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

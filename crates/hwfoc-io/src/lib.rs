@@ -41,6 +41,13 @@ pub mod summary;
 pub mod time;
 pub mod write;
 
+/// The version of the layout of the JSON objects the project prints (`hwfoc summary --json`,
+/// the status and alarm lines of `hwfoc monitor --json`), as their `"schema_version"` key: it
+/// goes up when a key is renamed or removed or its meaning or unit changes, not when a key is
+/// added. The records of `RECORD-SCHEMA.md` (JSON Lines) carry no such key: they have exactly
+/// the schema's keys.
+pub const JSON_SCHEMA_VERSION: u32 = 1;
+
 pub use handler::Handler;
 pub use input::{Batch, Input, InputError, InputFormat};
 pub use record::Record;

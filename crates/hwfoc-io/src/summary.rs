@@ -553,6 +553,7 @@ impl<'a> Report<'a> {
             })
             .collect();
         json!({
+            "schema_version": crate::JSON_SCHEMA_VERSION,
             "settings": {
                 "current_scale": self.settings.current_scale,
                 "pole_pairs": self.settings.pole_pairs,

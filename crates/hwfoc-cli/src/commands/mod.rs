@@ -2,7 +2,9 @@
 
 pub mod bridge;
 pub mod capture;
+pub mod completions;
 pub mod decode;
+pub mod man;
 pub mod monitor;
 pub mod plot;
 pub mod simulate;

@@ -206,6 +206,7 @@ fn alarm_json(entry: &LogEntry, esc: &EscView) -> Value {
         _ => (None, None),
     };
     json!({
+        "schema_version": hwfoc_io::JSON_SCHEMA_VERSION,
         "type": "alarm",
         "time": timestamp(entry.t),
         "t_s": entry.t,
@@ -236,6 +237,7 @@ fn status_json(i: usize, esc: &EscView, now: f64) -> Value {
         .map(|(kind, level)| json!({"alarm": kind.name(), "level": level.name()}))
         .collect();
     json!({
+        "schema_version": hwfoc_io::JSON_SCHEMA_VERSION,
         "type": "status",
         "time": timestamp(now),
         "t_s": now,
