@@ -160,8 +160,20 @@ pub struct Export {
     default: Settings,
     /// The settings of each ESC, once one ESC's differ from `default`.
     table: Option<Arc<EscTable>>,
-    /// The ESCs whose settings were looked at (at their first selected frame).
-    known: [bool; 256],
+    /// Each ESC: not selected, or selected and whether its settings were taken yet (at its
+    /// first frame). One look per frame tells both.
+    escs: [EscState; 256],
+}
+
+/// What an export knows of an ESC.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum EscState {
+    /// Selected; no frame of it seen yet.
+    New,
+    /// Selected, its settings taken.
+    Known,
+    /// Not selected.
+    Skipped,
 }
 
 /// What the decoding thread prepares for the writer.
@@ -305,13 +317,20 @@ impl Export {
             staged,
             default,
             table: None,
-            known: [false; 256],
+            escs: [EscState::New; 256],
         })
     }
 
     /// Keeps only the records of `selection` when the export is a [`Handler`] (every record
     /// otherwise).
     pub fn select(mut self, selection: Selection) -> Export {
+        for (esc, state) in (0..=u8::MAX).zip(self.escs.iter_mut()) {
+            *state = match (selection.esc(esc), *state) {
+                (false, _) => EscState::Skipped,
+                (true, EscState::Known) => EscState::Known,
+                (true, _) => EscState::New,
+            };
+        }
         self.selection = selection;
         self
     }
@@ -332,7 +351,10 @@ impl Export {
     /// default settings until set; an ESC's settings are meant to stay the same for the whole
     /// export: rows already pushed but not yet handed to the writer convert under these too).
     pub fn set_esc_settings(&mut self, esc: u8, settings: &Settings) {
-        self.known[usize::from(esc)] = true;
+        let state = &mut self.escs[usize::from(esc)];
+        if *state == EscState::New {
+            *state = EscState::Known;
+        }
         let current = match &self.table {
             Some(table) => &table[usize::from(esc)],
             None => &self.default,
@@ -484,12 +506,12 @@ impl Handler for Export {
         if let Frame::Data(frame) = decoded.frame {
             // The first frame of any ESC resolves a window given after the first frame.
             self.selection.window.observe(t);
-            if !self.selection.esc(esc) {
-                return;
-            }
-            if !self.known[usize::from(esc)] {
-                // An ESC's settings are looked up once by `Sources`: its first frame says them.
-                self.set_esc_settings(esc, settings);
+            let state = self.escs[usize::from(esc)];
+            if state != EscState::Known {
+                if state == EscState::Skipped {
+                    return;
+                }
+                self.learn(esc, settings);
             }
             if let Some(t) = t {
                 let (first, last) = self.span.get_or_insert((t, t));
@@ -505,6 +527,16 @@ impl Handler for Export {
 
     fn end_batch(&mut self, live: bool) -> Result<(), ExportError> {
         Ok(Export::end_batch(self, live)?)
+    }
+}
+
+impl Export {
+    /// Takes the settings of an ESC at its first frame (`Sources` looks them up once per ESC).
+    /// Out of line: the usual frame only checks that its ESC is known.
+    #[cold]
+    #[inline(never)]
+    fn learn(&mut self, esc: u8, settings: &Settings) {
+        self.set_esc_settings(esc, settings);
     }
 }
 
@@ -887,6 +919,63 @@ mod tests {
             }
         }
         check_rows(&rows, ports, frames);
+    }
+
+    /// Only the selected ESCs' settings are taken: a skipped ESC under settings of its own is
+    /// neither written nor named among the ESCs with their own settings.
+    #[test]
+    fn skipped_escs_settings_are_not_taken() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("some.jsonl");
+        let mut map = SettingsMap::from(Settings::DEFAULT);
+        for esc in [1, 2] {
+            let patch = SettingsPatch {
+                pole_pairs: Some(settings_of(esc).pole_pairs),
+                current_scale: Some(settings_of(esc).current_scale),
+                gear_ratio: None,
+            };
+            map.set_port(format!("p{esc}"), patch).unwrap();
+        }
+        let provenance = Provenance {
+            settings: Settings::DEFAULT,
+            overrides: Vec::new(),
+            inputs: Vec::new(),
+            filter: String::new(),
+            csv_comment: false,
+        };
+        let selection = Selection::new(&[0, 2], crate::select::Window::ALL);
+        let mut export = Export::create(OutputFormat::Jsonl, path.to_str(), provenance)
+            .unwrap()
+            .select(selection);
+        Sources::new(inputs(3, 100), map).run(&mut export).unwrap();
+        assert_eq!(export.esc_settings(), [(2, settings_of(2))]);
+        assert_eq!(export.kept(), 200);
+        export.finish(Vec::new()).unwrap();
+        let rows: Vec<(u8, f32, f32)> = std::fs::read_to_string(&path)
+            .unwrap()
+            .lines()
+            .map(|line| {
+                let v: serde_json::Value = serde_json::from_str(line).unwrap();
+                let f = |k: &str| v[k].as_f64().unwrap() as f32;
+                (v["esc"].as_u64().unwrap() as u8, f("rpm"), f("current_a"))
+            })
+            .collect();
+        assert_eq!(rows.len(), 200);
+        assert!(rows.iter().all(|r| r.0 != 1));
+        let frame = DataFrame {
+            erpm_raw: 70,
+            current_raw: 819,
+            ..Default::default()
+        };
+        for &(esc, rpm, amps) in &rows {
+            let s = settings_of(usize::from(esc));
+            assert_eq!(
+                (rpm, amps),
+                (frame.rpm(&s), frame.current_a(&s)),
+                "ESC {esc}"
+            );
+        }
+        assert!(rows.iter().any(|r| r.0 == 2));
     }
 
     /// An export whose ESCs all have the default settings carries no table and no

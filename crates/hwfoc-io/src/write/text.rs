@@ -47,22 +47,23 @@ pub(super) fn write(
             slices.push(slice_tx);
             texts.push(text_rx);
             s.spawn(move || {
-                let mut encoders = Encoders::new(settings);
+                // Rows under the export's settings (the usual case: all of them).
+                let mut encoder = TextEncoder::cached();
+                // Rows under their ESC's settings, once a slice carries a table of them.
+                let mut by_settings: Option<Encoders> = None;
                 for slice in slice_rx {
                     let mut text = Vec::with_capacity(slice.len() * if csv { 110 } else { 260 });
                     let rows = slice.t.iter().zip(&slice.esc).zip(&slice.frames);
                     match slice.settings.as_deref() {
-                        // Every row under the export's settings: one cached encoder.
                         None => {
-                            let encoder = &mut encoders.list[0].1;
                             for ((&t, &esc), frame) in rows {
                                 let t = (!t.is_nan()).then_some(t);
                                 let record = Record::new(t, esc, frame, &settings);
-                                encode(encoder, csv, &record, frame, &mut text);
+                                encode(&mut encoder, csv, &record, frame, &mut text);
                             }
                         }
-                        // Each row under its ESC's settings, with the encoder of those.
                         Some(table) => {
+                            let encoders = by_settings.get_or_insert_with(Encoders::default);
                             let slots = encoders.slots(table);
                             for ((&t, &esc), frame) in rows {
                                 let t = (!t.is_nan()).then_some(t);
@@ -143,21 +144,16 @@ fn encode(
 /// ESCs under further sets are written by an encoder without caches (the same text, slower).
 pub(super) const CACHED_SETTINGS: usize = 8;
 
-/// A formatter's text encoders: a cached one per set of settings (a cache holds the text of
-/// values converted under one set), the export's default first, and one without caches.
+/// A formatter's text encoders for rows under their ESC's settings: a cached one per set of
+/// settings (a cache holds the text of values converted under one set), made as sets are
+/// met, and one without caches.
+#[derive(Default)]
 struct Encoders {
     list: Vec<(Settings, TextEncoder)>,
     plain: TextEncoder,
 }
 
 impl Encoders {
-    fn new(default: Settings) -> Encoders {
-        Encoders {
-            list: vec![(default, TextEncoder::cached())],
-            plain: TextEncoder::new(),
-        }
-    }
-
     /// Which encoder writes the rows of each ESC under `table`: an index in `list`, or
     /// `usize::MAX` for the plain encoder. Encoders are made for settings first seen here.
     fn slots(&mut self, table: &EscTable) -> [usize; 256] {
