@@ -122,24 +122,6 @@ impl SettingsArgs {
         }
     }
 
-    /// The settings of every ESC for a command that converts all ESCs alike (`decode`'s writers
-    /// and `summary`'s statistics convert under one [`hwfoc::Settings`]): the flags over the
-    /// file's `[settings]`. Entries by ESC or port in the file are not applied there: a warning on
-    /// standard error says so, rather than leaving the user to believe they were.
-    pub fn uniform_settings(&self, command: &str) -> Result<hwfoc::Settings, CliError> {
-        let (config, map) = self.settings_map()?;
-        if !map.is_uniform()
-            && let Some(path) = &config.path
-        {
-            eprintln!(
-                "hwfoc: warning: {command} converts every ESC under [settings]: the [esc.N] and \
-                 [port] settings of {} are not applied (hwfoc plot and hwfoc monitor apply them)",
-                path.display()
-            );
-        }
-        Ok(*map.default_settings())
-    }
-
     /// The configuration file read and every ESC's settings: the file's, and the flags over
     /// them.
     pub fn settings_map(&self) -> Result<(Config, SettingsMap), CliError> {

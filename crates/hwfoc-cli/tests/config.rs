@@ -183,30 +183,266 @@ fn flags_beat_the_file_and_the_file_beats_the_defaults() {
     );
 }
 
+/// A record's (esc, rpm, current_a).
+type Row = (u64, f32, f32);
+
+/// (esc, rpm, current_a) of each record, in order.
+fn values(records: &[Value]) -> Vec<Row> {
+    records
+        .iter()
+        .map(|r| {
+            let f = |k: &str| r[k].as_f64().unwrap() as f32;
+            (r["esc"].as_u64().unwrap(), f("rpm"), f("current_a"))
+        })
+        .collect()
+}
+
+/// Checks that `changed` is `plain` (the same records under the defaults) with only ESC 1's
+/// values changed: its rpm multiplied by `rpm` and its current by `current` (powers of two,
+/// so exact in `f32`), ESC 0's the same.
+fn only_esc1_changed(plain: &[Row], changed: &[Row], rpm: f32, current: f32) {
+    assert_eq!(plain.len(), changed.len());
+    let mut seen = [false; 2];
+    for (p, c) in plain.iter().zip(changed) {
+        assert_eq!(p.0, c.0, "records in another order");
+        let (k_rpm, k_current) = if p.0 == 1 { (rpm, current) } else { (1.0, 1.0) };
+        assert_eq!((c.1, c.2), (p.1 * k_rpm, p.2 * k_current), "{p:?} {c:?}");
+        // Rows where the change shows.
+        seen[p.0 as usize] |= p.1 != 0.0 && p.2 != 0.0;
+    }
+    assert_eq!(seen, [true, true], "no ESC turning with current");
+}
+
+/// The configuration of ESC 1 (twice the pole pairs, twice the current scale): its records
+/// have half the rpm and half the current, ESC 0's are the defaults'.
+const ESC1: &str = "[settings]\npole_pairs = 7\n[esc.1]\npole_pairs = 14\ncurrent_scale = 128\n";
+
 #[test]
-fn decode_says_when_it_cannot_apply_per_esc_settings() {
+fn decode_converts_each_esc_under_its_own_settings() {
     let dir = Dir::new();
     let input = recording(&dir);
-    let home = user_config(
-        &dir,
-        "[settings]\npole_pairs = 14\n[esc.1]\npole_pairs = 2\n",
-    );
-    let out = ok(clean(&home).args(["decode", &input]).output_locked());
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert!(stderr.contains("[esc.N] and [port] settings"), "{stderr}");
-    assert!(
-        turning(&jsonl(&out))
-            .iter()
-            .all(|r| (r.1 / r.2 - 14.0).abs() < 1e-3)
-    );
-    // Without such entries, nothing is said.
-    let home = user_config(&dir, "[settings]\npole_pairs = 14\n");
-    let out = ok(clean(&home).args(["decode", &input]).output_locked());
+    let none = dir.path("none");
+    let plain = |args: &[&str]| ok(clean(&none).arg("decode").args(args).output_locked());
+    let home = user_config(&dir, ESC1);
+    let configured = |args: &[&str]| ok(clean(&home).arg("decode").args(args).output_locked());
+
+    // JSON Lines, and nothing said on standard error.
+    let defaults = values(&jsonl(&plain(&[&input])));
+    let out = configured(&[&input]);
     assert!(
         out.stderr.is_empty(),
         "{}",
         String::from_utf8_lossy(&out.stderr)
     );
+    only_esc1_changed(&defaults, &values(&jsonl(&out)), 0.5, 0.5);
+
+    // CSV, the settings comment naming ESC 1's.
+    let out = configured(&["--format", "csv", "--settings-comment", &input]);
+    let text = String::from_utf8(out.stdout).unwrap();
+    let mut lines = text.lines();
+    let comment = lines.next().unwrap();
+    assert!(
+        comment.starts_with(
+            "# hwfoc decode: current_scale=64 pole_pairs=7 gear_ratio=1 \
+             esc.1.current_scale=128 esc.1.pole_pairs=14 input="
+        ),
+        "{comment}"
+    );
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let col = |name: &str| header.iter().position(|&c| c == name).unwrap();
+    let (esc, rpm, current) = (col("esc"), col("rpm"), col("current_a"));
+    let csv: Vec<Row> = lines
+        .map(|line| {
+            let f: Vec<&str> = line.split(',').collect();
+            (
+                f[esc].parse().unwrap(),
+                f[rpm].parse().unwrap(),
+                f[current].parse().unwrap(),
+            )
+        })
+        .collect();
+    only_esc1_changed(&defaults, &csv, 0.5, 0.5);
+
+    // Parquet, ESC 1's settings in the metadata.
+    let pq = dir.arg("out.parquet");
+    configured(&["--format", "parquet", "-o", &pq, &input]);
+    let (parquet, metadata) = read_parquet(&pq);
+    only_esc1_changed(&defaults, &parquet, 0.5, 0.5);
+    assert_eq!(metadata("pole_pairs").as_deref(), Some("7"));
+    let escs: Value = serde_json::from_str(&metadata("esc_settings").unwrap()).unwrap();
+    assert_eq!(
+        escs,
+        serde_json::json!({"1": {"current_scale": 128.0, "pole_pairs": 14, "gear_ratio": 1.0}})
+    );
+    // Without settings of an ESC's own, no such key.
+    let pq = dir.arg("plain.parquet");
+    plain(&["--format", "parquet", "-o", &pq, &input]);
+    let (same, metadata) = read_parquet(&pq);
+    assert_eq!(same, defaults);
+    assert_eq!(metadata("esc_settings"), None);
+}
+
+/// (esc, rpm, current_a) of each row of a Parquet file, and its key-value metadata by key.
+fn read_parquet(path: &str) -> (Vec<Row>, impl Fn(&str) -> Option<String>) {
+    use arrow_array::cast::AsArray;
+    use arrow_array::types::{Float32Type, UInt8Type};
+    use parquet::arrow::arrow_reader::ParquetRecordBatchReaderBuilder;
+
+    let reader =
+        ParquetRecordBatchReaderBuilder::try_new(std::fs::File::open(path).unwrap()).unwrap();
+    let kv = reader
+        .metadata()
+        .file_metadata()
+        .key_value_metadata()
+        .cloned()
+        .unwrap_or_default();
+    let mut rows = Vec::new();
+    for batch in reader.build().unwrap() {
+        let batch = batch.unwrap();
+        let column = |name: &str| batch.column(batch.schema().index_of(name).unwrap()).clone();
+        let (esc, rpm, current) = (column("esc"), column("rpm"), column("current_a"));
+        let (esc, rpm, current) = (
+            esc.as_primitive::<UInt8Type>(),
+            rpm.as_primitive::<Float32Type>(),
+            current.as_primitive::<Float32Type>(),
+        );
+        for i in 0..batch.num_rows() {
+            rows.push((u64::from(esc.value(i)), rpm.value(i), current.value(i)));
+        }
+    }
+    let metadata = move |key: &str| {
+        kv.iter()
+            .find(|e| e.key == key)
+            .and_then(|e| e.value.clone())
+    };
+    (rows, metadata)
+}
+
+#[test]
+fn a_ports_settings_apply_in_decode_to_the_esc_read_from_it() {
+    let dir = Dir::new();
+    let input = recording(&dir);
+    // The recording names its ports esc-0 and esc-1.
+    let out = ok(clean(&dir.path("none"))
+        .args(["summary", "--json", &input])
+        .output_locked());
+    let report: Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(report["escs"][1]["stream"], "esc-1", "{report}");
+    let defaults = values(&jsonl(&ok(clean(&dir.path("none"))
+        .args(["decode", &input])
+        .output_locked())));
+    let home = user_config(
+        &dir,
+        "[port.\"esc-1\"]\ngear_ratio = 2\ncurrent_scale = 32\n",
+    );
+    let out = ok(clean(&home).args(["decode", &input]).output_locked());
+    only_esc1_changed(&defaults, &values(&jsonl(&out)), 0.5, 2.0);
+}
+
+#[test]
+fn summary_converts_each_esc_under_its_own_settings() {
+    let dir = Dir::new();
+    let input = recording(&dir);
+    let none = dir.path("none");
+    let home = user_config(&dir, ESC1);
+    let json = |home: &Path| -> Value {
+        let out = ok(clean(home)
+            .args(["summary", "--json", &input])
+            .output_locked());
+        assert!(
+            out.stderr.is_empty(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        serde_json::from_slice(&out.stdout).unwrap()
+    };
+    let (plain, configured) = (json(&none), json(&home));
+    let field = |report: &Value, esc: usize, name: &str, stat: &str| {
+        report["escs"][esc]["fields"][name][stat].as_f64().unwrap()
+    };
+    for stat in ["min", "max", "mean"] {
+        for name in ["rpm", "current_a", "phase_current_a"] {
+            assert_eq!(
+                field(&configured, 0, name, stat),
+                field(&plain, 0, name, stat)
+            );
+            assert_eq!(
+                field(&configured, 1, name, stat),
+                field(&plain, 1, name, stat) / 2.0,
+                "{name} {stat}"
+            );
+        }
+        // What does not depend on the settings is the same.
+        for esc in 0..2 {
+            let name = "erpm";
+            assert_eq!(
+                field(&configured, esc, name, stat),
+                field(&plain, esc, name, stat)
+            );
+        }
+    }
+    assert!(field(&plain, 1, "rpm", "max") > 0.0 && field(&plain, 1, "current_a", "max") > 0.0);
+    // Charge and energy follow the current.
+    let energy = |report: &Value, esc: usize, key: &str| {
+        report["escs"][esc]["energy"][key].as_f64().unwrap()
+    };
+    for key in ["charge_mah", "energy_wh"] {
+        assert_eq!(energy(&configured, 0, key), energy(&plain, 0, key));
+        let (half, whole) = (energy(&configured, 1, key), energy(&plain, 1, key));
+        assert!(
+            whole > 0.0 && (half * 2.0 - whole).abs() <= whole * 1e-12,
+            "{key}"
+        );
+    }
+    // ESC 1's settings in its object; the others' are the report's.
+    assert_eq!(
+        configured["escs"][1]["settings"],
+        serde_json::json!({"current_scale": 128.0, "pole_pairs": 14, "gear_ratio": 1.0})
+    );
+    assert!(configured["escs"][0].get("settings").is_none());
+    assert!(plain["escs"][1].get("settings").is_none());
+    assert_eq!(configured["settings"], plain["settings"]);
+
+    // The text: the settings line names ESC 1's, the figures are converted under them.
+    let text = |home: &Path| {
+        let out = ok(clean(home).args(["summary", &input]).output_locked());
+        assert!(
+            out.stderr.is_empty(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        String::from_utf8(out.stdout).unwrap()
+    };
+    let (plain_text, configured_text) = (text(&none), text(&home));
+    assert_eq!(
+        configured_text.lines().next(),
+        Some(
+            "settings     current scale 64, pole pairs 7, gear ratio 1; \
+             ESC 1: current scale 128, pole pairs 14"
+        )
+    );
+    assert_eq!(
+        plain_text.lines().next(),
+        Some("settings     current scale 64, pole pairs 7, gear ratio 1")
+    );
+    // ESC 0's part is the same; ESC 1's differs (its rpm and currents).
+    let part = |text: &str, esc: usize| -> String {
+        let start = text.find(&format!("\nESC {esc} ")).unwrap();
+        let rest = &text[start + 1..];
+        let end = rest.find("\nESC ").map_or(rest.len(), |e| e + 1);
+        rest[..end].to_string()
+    };
+    assert_eq!(part(&configured_text, 0), part(&plain_text, 0));
+    assert_ne!(part(&configured_text, 1), part(&plain_text, 1));
+    let row = |text: &str, name: &str| -> String {
+        part(text, 1)
+            .lines()
+            .find(|l| l.starts_with(&format!("{name} ")))
+            .unwrap_or_else(|| panic!("no {name} in {text}"))
+            .to_string()
+    };
+    assert_ne!(row(&configured_text, "rpm"), row(&plain_text, "rpm"));
+    assert_eq!(row(&configured_text, "erpm"), row(&plain_text, "erpm"));
 }
 
 #[test]

@@ -127,6 +127,18 @@ impl SettingsMap {
         }
     }
 
+    /// The patches by port name, in name order.
+    pub fn port_patches(&self) -> impl Iterator<Item = (&str, &SettingsPatch)> {
+        self.ports
+            .iter()
+            .map(|(name, (patch, _))| (name.as_str(), patch))
+    }
+
+    /// The patches by ESC index, in index order.
+    pub fn esc_patches(&self) -> impl Iterator<Item = (usize, &SettingsPatch)> {
+        self.escs.iter().map(|(&esc, patch)| (esc, patch))
+    }
+
     /// Whether every ESC has the defaults.
     pub fn is_uniform(&self) -> bool {
         self.ports.is_empty() && self.escs.is_empty()
@@ -159,6 +171,10 @@ mod tests {
         assert_eq!(map.get(2, "a"), Settings::new(100.0, 14, 2.0).unwrap());
         assert_eq!(map.get(2, "b"), Settings::new(64.0, 14, 2.0).unwrap());
         assert_eq!(map.default_settings(), &base);
+        let ports: Vec<_> = map.port_patches().map(|(n, p)| (n, p.pole_pairs)).collect();
+        assert_eq!(ports, [("a", Some(12))]);
+        let escs: Vec<_> = map.esc_patches().map(|(e, p)| (e, p.gear_ratio)).collect();
+        assert_eq!(escs, [(2, Some(2.0))]);
     }
 
     /// Collects (esc, rpm, current) of each record.

@@ -29,6 +29,7 @@ use crate::input::{InputError, InputFormat};
 use crate::sources::{Handler, Sources};
 use crate::stream::EscLink;
 use crate::time::{self, Clock};
+use crate::write::settings_json;
 use hwfoc::datalink::LengthByte;
 
 /// What to tell a user whose input has bytes but no frame.
@@ -77,12 +78,12 @@ impl Summary {
         Summary::default()
     }
 
-    /// The report on what was gathered from `sources` (after [`Sources::run`]), converted under
-    /// `settings`.
-    pub fn report<'a>(&'a self, sources: &'a Sources, settings: &'a Settings) -> Report<'a> {
+    /// The report on what was gathered from `sources` (after [`Sources::run`]): each ESC's
+    /// figures converted under its own settings ([`Sources::esc_settings`]).
+    pub fn report<'a>(&'a self, sources: &'a Sources) -> Report<'a> {
         Report {
             sources,
-            settings,
+            settings: sources.settings(),
             accs: &self.0,
         }
     }
@@ -375,6 +376,7 @@ fn temp_stats(codes: &[u64; 256]) -> TempStats {
 /// The summary, ready to be printed: [`Report::text`] or [`Report::json`].
 pub struct Report<'a> {
     sources: &'a Sources,
+    /// The settings of ESCs without settings of their own.
     settings: &'a Settings,
     accs: &'a [Accumulator],
 }
@@ -441,7 +443,7 @@ impl<'a> Report<'a> {
                     stream: &esc.name,
                     input: &self.sources.names()[esc.input],
                     stats: self.sources.link(i),
-                    settings: *self.settings,
+                    settings: self.sources.esc_settings(i),
                     acc,
                     episodes,
                     episode_count,
@@ -454,11 +456,19 @@ impl<'a> Report<'a> {
     pub fn text(&self) -> String {
         let mut o = String::new();
         // Writing to a String cannot fail; the results are ignored below for that reason.
-        let _ = writeln!(
+        let escs = self.escs();
+        let _ = write!(
             o,
             "settings     current scale {}, pole pairs {}, gear ratio {}",
             self.settings.current_scale, self.settings.pole_pairs, self.settings.gear_ratio
         );
+        for esc in &escs {
+            let differing = settings_differing(&esc.settings, self.settings);
+            if !differing.is_empty() {
+                let _ = write!(o, "; ESC {}: {}", esc.index, differing.join(", "));
+            }
+        }
+        o.push('\n');
         for info in self.sources.inputs() {
             let escs = match info.escs.as_slice() {
                 [] => "no ESC".to_string(),
@@ -491,7 +501,6 @@ impl<'a> Report<'a> {
                 self.sources.escs()[esc].name
             );
         }
-        let escs = self.escs();
         for esc in &escs {
             o.push('\n');
             esc.text(&mut o);
@@ -529,7 +538,19 @@ impl<'a> Report<'a> {
             })
             .collect();
         let reports = self.escs();
-        let escs: Vec<Value> = reports.iter().map(EscReport::json).collect();
+        let escs: Vec<Value> = reports
+            .iter()
+            .map(|esc| {
+                let mut v = esc.json();
+                // An ESC's own settings, where they differ from the report's.
+                if esc.settings != *self.settings
+                    && let Some(object) = v.as_object_mut()
+                {
+                    object.insert("settings".to_string(), settings_json(&esc.settings));
+                }
+                v
+            })
+            .collect();
         let hubs: Vec<Value> = self
             .sources
             .hubs()
@@ -554,17 +575,29 @@ impl<'a> Report<'a> {
             .collect();
         json!({
             "schema_version": crate::JSON_SCHEMA_VERSION,
-            "settings": {
-                "current_scale": self.settings.current_scale,
-                "pole_pairs": self.settings.pole_pairs,
-                "gear_ratio": self.settings.gear_ratio,
-            },
+            "settings": settings_json(self.settings),
             "inputs": inputs,
             "hubs": hubs,
             "escs": escs,
             "energy_total": total_energy(&reports).as_ref().map(energy_json),
         })
     }
+}
+
+/// The fields of `settings` that differ from `default`, as the summary names them
+/// (`pole pairs 14`).
+fn settings_differing(settings: &Settings, default: &Settings) -> Vec<String> {
+    let mut fields = Vec::new();
+    if settings.current_scale != default.current_scale {
+        fields.push(format!("current scale {}", settings.current_scale));
+    }
+    if settings.pole_pairs != default.pole_pairs {
+        fields.push(format!("pole pairs {}", settings.pole_pairs));
+    }
+    if settings.gear_ratio != default.gear_ratio {
+        fields.push(format!("gear ratio {}", settings.gear_ratio));
+    }
+    fields
 }
 
 /// The figures of every ESC with data frames added, when there are two or more.

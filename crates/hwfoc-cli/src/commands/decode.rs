@@ -12,6 +12,7 @@ use serde_json::json;
 
 use crate::args::{InputArgs, SelectArgs, SettingsArgs};
 use crate::error::CliError;
+use hwfoc_io::settings::{SettingsMap, SettingsPatch};
 use hwfoc_io::sources::Sources;
 use hwfoc_io::time::Clock;
 use hwfoc_io::write::{Export, OutputFormat, Provenance};
@@ -48,18 +49,21 @@ pub struct DecodeArgs {
 
 /// Runs `hwfoc decode`.
 pub fn run(args: &DecodeArgs) -> Result<(), CliError> {
-    let settings = args.settings.uniform_settings("decode")?;
+    let (_, settings_map) = args.settings.settings_map()?;
+    let settings = *settings_map.default_settings();
+    let overrides = overrides(&settings_map);
     let selection = args.select.selection()?;
     if let Some(output) = &args.output {
         args.input.refuse_output(output)?;
     }
-    let mut sources = Sources::new(args.input.open_all()?, settings);
+    let mut sources = Sources::new(args.input.open_all()?, settings_map);
     if selection.window.is_limited() {
         sources.require_timing()?;
         args.select.check_clocks(&sources)?;
     }
     let provenance = Provenance {
         settings,
+        overrides,
         inputs: sources.names().to_vec(),
         filter: args.select.text(),
         csv_comment: args.settings_comment,
@@ -88,6 +92,26 @@ pub fn run(args: &DecodeArgs) -> Result<(), CliError> {
         );
     }
     Ok(())
+}
+
+/// The entries by port and by ESC of `map`, named as in the configuration file (`port."NAME"`,
+/// `esc.2`), with the fields that differ from the default settings (entries without any left
+/// out).
+fn overrides(map: &SettingsMap) -> Vec<(String, SettingsPatch)> {
+    let default = map.default_settings();
+    let differing = |p: &SettingsPatch| SettingsPatch {
+        current_scale: p.current_scale.filter(|&v| v != default.current_scale),
+        pole_pairs: p.pole_pairs.filter(|&v| v != default.pole_pairs),
+        gear_ratio: p.gear_ratio.filter(|&v| v != default.gear_ratio),
+    };
+    let ports = map.port_patches().map(|(name, p)| {
+        let quoted = serde_json::Value::from(name).to_string();
+        (format!("port.{quoted}"), differing(p))
+    });
+    let escs = map
+        .esc_patches()
+        .map(|(esc, p)| (format!("esc.{esc}"), differing(p)));
+    ports.chain(escs).filter(|(_, p)| !p.is_empty()).collect()
 }
 
 /// Which ESC is which: `[{"esc": 0, "input": "a.pcapng", "stream": "/dev/ttyUSB0"}, ...]`.

@@ -27,7 +27,8 @@ pub struct SummaryArgs {
 
 /// Runs `hwfoc summary`.
 pub fn run(args: &SummaryArgs) -> Result<(), CliError> {
-    let settings = args.settings.uniform_settings("summary")?;
+    let (_, settings_map) = args.settings.settings_map()?;
+    let settings = *settings_map.default_settings();
     // The plot's file is opened first: a wrong name is reported before the inputs are read.
     let mut plot = match &args.plot {
         Some(path) => {
@@ -36,14 +37,14 @@ pub fn run(args: &SummaryArgs) -> Result<(), CliError> {
         }
         None => None,
     };
-    let mut sources = Sources::new(args.input.open_all()?, settings);
+    let mut sources = Sources::new(args.input.open_all()?, settings_map);
     let mut summary = Summary::new();
     // On an input error, what was read before it is summarised, then the error reported.
     let result = match &mut plot {
         Some(plot) => sources.run(&mut Both(&mut summary, plot)),
         None => sources.run(&mut summary).map_err(CliError::from),
     };
-    let report = summary.report(&sources, &settings);
+    let report = summary.report(&sources);
     let text = if args.json {
         let mut s = serde_json::to_string_pretty(&report.json()).unwrap_or_default();
         s.push('\n');

@@ -8,6 +8,12 @@
 //! row group for Parquet), so memory stays bounded whatever the size of the input: about 45 MB
 //! at most (with the output file's two 4 MiB blocks).
 //!
+//! Each row is converted under its ESC's settings, those that [`Sources`](crate::sources::Sources)
+//! hands to [`Handler::frame`] with its frames: the export learns them at an ESC's first
+//! frame, and a chunk carries a table of them ([`EscTable`]) only when some ESC's settings
+//! differ from [`Provenance::settings`]; otherwise (the usual case) every row of the chunk is
+//! converted under those, as before.
+//!
 //! An output file is written by a thread of its own, a block at a time, and past its first
 //! megabytes with direct I/O, bypassing the page cache (see `file.rs`).
 //!
@@ -24,6 +30,7 @@ use std::fmt;
 use std::fs::File;
 use std::io::{self, Write};
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 use std::sync::mpsc::{Receiver, SyncSender, sync_channel};
 use std::thread::JoinHandle;
 
@@ -32,6 +39,7 @@ use hwfoc::{DataFrame, Decoded, Frame, Settings};
 use crate::handler::Handler;
 use crate::input::InputError;
 use crate::select::Selection;
+use crate::settings::SettingsPatch;
 
 /// Rows per chunk handed to the writer thread (a chunk may exceed it by one input batch).
 pub const CHUNK_ROWS: usize = 1 << 16;
@@ -61,8 +69,13 @@ pub enum OutputFormat {
 /// What an export records about how it was made (Parquet key-value metadata, the CSV comment).
 #[derive(Debug, Clone)]
 pub struct Provenance {
-    /// The conversion settings.
+    /// The conversion settings of every ESC without settings of its own.
     pub settings: Settings,
+    /// The settings configured by port or by ESC, where they differ from `settings`: each
+    /// entry's name as the configuration file writes it (`esc.2`, `port."/dev/ttyUSB1"`) and the
+    /// fields it sets. For the CSV comment, written before any ESC is found; the settings each
+    /// ESC's rows were converted under are in the Parquet metadata (`esc_settings`).
+    pub overrides: Vec<(String, SettingsPatch)>,
     /// The inputs, as named on the command line.
     pub inputs: Vec<String>,
     /// The filters applied, as text (`esc=0,2 from=1.5`), empty for none.
@@ -83,7 +96,14 @@ pub struct Chunk {
     /// Whether the writer should push everything to the operating system after this chunk
     /// (live input: records appear as frames arrive).
     pub flush: bool,
+    /// The settings of each ESC, by index, when some ESC's differ from
+    /// [`Provenance::settings`]; `None`: every row is converted under those.
+    pub settings: Option<Arc<EscTable>>,
 }
+
+/// The conversion settings of each ESC index (every `u8`), for an export in which some ESC's
+/// settings differ from the others'.
+pub type EscTable = [Settings; 256];
 
 impl Chunk {
     fn with_capacity(n: usize) -> Chunk {
@@ -92,6 +112,7 @@ impl Chunk {
             esc: Vec::with_capacity(n),
             frames: Vec::with_capacity(n),
             flush: false,
+            settings: None,
         }
     }
 
@@ -110,6 +131,7 @@ impl Chunk {
         self.esc.clear();
         self.frames.clear();
         self.flush = false;
+        self.settings = None;
     }
 }
 
@@ -134,6 +156,24 @@ pub struct Export {
     span: Option<(f64, f64)>,
     /// The output file while it is written under its partial name.
     staged: Option<Staged>,
+    /// The settings of ESCs without settings of their own ([`Provenance::settings`]).
+    default: Settings,
+    /// The settings of each ESC, once one ESC's differ from `default`.
+    table: Option<Arc<EscTable>>,
+    /// Each ESC: not selected, or selected and whether its settings were taken yet (at its
+    /// first frame). One look per frame tells both.
+    escs: [EscState; 256],
+}
+
+/// What an export knows of an ESC.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum EscState {
+    /// Selected; no frame of it seen yet.
+    New,
+    /// Selected, its settings taken.
+    Known,
+    /// Not selected.
+    Skipped,
 }
 
 /// What the decoding thread prepares for the writer.
@@ -232,6 +272,7 @@ impl Export {
         provenance: Provenance,
     ) -> Result<Export, WriteError> {
         let (sink, staged) = Destination::open(path)?;
+        let default = provenance.settings;
         type Work = Box<dyn FnOnce() -> Result<(), WriteError> + Send>;
         let (tx, mode, work): (SyncSender<ToWriter>, Pipeline, Work) = match format {
             OutputFormat::Jsonl | OutputFormat::Csv => {
@@ -274,12 +315,22 @@ impl Export {
             kept: 0,
             span: None,
             staged,
+            default,
+            table: None,
+            escs: [EscState::New; 256],
         })
     }
 
     /// Keeps only the records of `selection` when the export is a [`Handler`] (every record
     /// otherwise).
     pub fn select(mut self, selection: Selection) -> Export {
+        for (esc, state) in (0..=u8::MAX).zip(self.escs.iter_mut()) {
+            *state = match (selection.esc(esc), *state) {
+                (false, _) => EscState::Skipped,
+                (true, EscState::Known) => EscState::Known,
+                (true, _) => EscState::New,
+            };
+        }
         self.selection = selection;
         self
     }
@@ -294,6 +345,42 @@ impl Export {
     /// the frames have).
     pub fn span(&self) -> Option<(f64, f64)> {
         self.span
+    }
+
+    /// The settings that the rows of ESC `esc` are converted under from now on (the export's
+    /// default settings until set; an ESC's settings are meant to stay the same for the whole
+    /// export: rows already pushed but not yet handed to the writer convert under these too).
+    pub fn set_esc_settings(&mut self, esc: u8, settings: &Settings) {
+        let state = &mut self.escs[usize::from(esc)];
+        if *state == EscState::New {
+            *state = EscState::Known;
+        }
+        let current = match &self.table {
+            Some(table) => &table[usize::from(esc)],
+            None => &self.default,
+        };
+        if current == settings {
+            return;
+        }
+        let mut table = match &self.table {
+            Some(table) => **table,
+            None => [self.default; 256],
+        };
+        table[usize::from(esc)] = *settings;
+        self.table = Some(Arc::new(table));
+    }
+
+    /// The ESCs whose rows are converted under settings other than the export's default, with
+    /// those settings, by index.
+    pub fn esc_settings(&self) -> Vec<(u8, Settings)> {
+        let Some(table) = &self.table else {
+            return Vec::new();
+        };
+        (0..=u8::MAX)
+            .zip(table.iter())
+            .filter(|(_, s)| **s != self.default)
+            .map(|(esc, s)| (esc, *s))
+            .collect()
     }
 
     /// Adds a record: a data frame, its ESC and its receive time.
@@ -327,6 +414,7 @@ impl Export {
                 };
                 let mut chunk = std::mem::replace(&mut self.chunk, next);
                 chunk.flush = flush;
+                chunk.settings = self.table.clone();
                 ToWriter::Rows(chunk)
             }
             Pipeline::Parquet { spare } => {
@@ -342,7 +430,9 @@ impl Export {
                     }
                     Err(_) => Chunk::with_capacity(PARQUET_ROWS),
                 };
-                ToWriter::Rows(std::mem::replace(&mut self.chunk, next))
+                let mut chunk = std::mem::replace(&mut self.chunk, next);
+                chunk.settings = self.table.clone();
+                ToWriter::Rows(chunk)
             }
         };
         self.post(msg)
@@ -363,9 +453,15 @@ impl Export {
     }
 
     /// Writes the remaining rows and ends the output: flushes text, closes a Parquet file
-    /// (adding `metadata` to its key-value metadata), and renames a file written under its
-    /// partial name into place. On a write error the partial file is removed.
-    pub fn finish(mut self, metadata: Vec<(String, String)>) -> Result<(), WriteError> {
+    /// (adding `metadata` to its key-value metadata, and `esc_settings` when some ESC's rows
+    /// were converted under settings of their own: see [`esc_settings_json`]), and renames a
+    /// file written under its partial name into place. On a write error the partial file is
+    /// removed.
+    pub fn finish(mut self, mut metadata: Vec<(String, String)>) -> Result<(), WriteError> {
+        let escs = self.esc_settings();
+        if !escs.is_empty() {
+            metadata.push(("esc_settings".to_string(), esc_settings_json(&escs)));
+        }
         let written = self
             .send(true, true)
             .and_then(|()| self.post(ToWriter::End(metadata)))
@@ -400,17 +496,22 @@ impl Export {
 }
 
 /// An export is what `hwfoc decode` hands the frames to: it takes them as decoded, and its
-/// writers convert them a block at a time on their own threads.
+/// writers convert them a block at a time on their own threads, each under the settings given
+/// with its ESC's first frame (see [`Export::set_esc_settings`]).
 impl Handler for Export {
     type Error = ExportError;
 
     #[inline]
-    fn frame(&mut self, esc: u8, t: Option<f64>, decoded: &Decoded, _: &Settings) {
+    fn frame(&mut self, esc: u8, t: Option<f64>, decoded: &Decoded, settings: &Settings) {
         if let Frame::Data(frame) = decoded.frame {
             // The first frame of any ESC resolves a window given after the first frame.
             self.selection.window.observe(t);
-            if !self.selection.esc(esc) {
-                return;
+            let state = self.escs[usize::from(esc)];
+            if state != EscState::Known {
+                if state == EscState::Skipped {
+                    return;
+                }
+                self.learn(esc, settings);
             }
             if let Some(t) = t {
                 let (first, last) = self.span.get_or_insert((t, t));
@@ -427,6 +528,36 @@ impl Handler for Export {
     fn end_batch(&mut self, live: bool) -> Result<(), ExportError> {
         Ok(Export::end_batch(self, live)?)
     }
+}
+
+impl Export {
+    /// Takes the settings of an ESC at its first frame (`Sources` looks them up once per ESC).
+    /// Out of line: the usual frame only checks that its ESC is known.
+    #[cold]
+    #[inline(never)]
+    fn learn(&mut self, esc: u8, settings: &Settings) {
+        self.set_esc_settings(esc, settings);
+    }
+}
+
+/// The settings of some ESCs as one JSON object by ESC index:
+/// `{"2": {"current_scale": 100.0, "pole_pairs": 14, "gear_ratio": 1.0}}` (the Parquet
+/// metadata key `esc_settings`).
+pub fn esc_settings_json(escs: &[(u8, Settings)]) -> String {
+    let map: serde_json::Map<String, serde_json::Value> = escs
+        .iter()
+        .map(|(esc, s)| (esc.to_string(), settings_json(s)))
+        .collect();
+    serde_json::Value::Object(map).to_string()
+}
+
+/// Settings as a JSON object: `{"current_scale": 64.0, "pole_pairs": 7, "gear_ratio": 1.0}`.
+pub fn settings_json(s: &Settings) -> serde_json::Value {
+    serde_json::json!({
+        "current_scale": s.current_scale,
+        "pole_pairs": s.pole_pairs,
+        "gear_ratio": s.gear_ratio,
+    })
 }
 
 /// Why an export stopped: an input it was reading, or its output.
@@ -589,5 +720,284 @@ impl std::error::Error for WriteError {
             WriteError::Write { source, .. } | WriteError::Create { source, .. } => Some(source),
             WriteError::IsInput { .. } => None,
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::input::Input;
+    use crate::settings::SettingsMap;
+    use crate::sources::Sources;
+
+    /// Ports named `p0`, `p1`, ...: frames of raw eRPM 70 (700 eRPM) and raw current 819 each.
+    fn inputs(ports: usize, frames: u16) -> Vec<Input> {
+        (0..ports)
+            .map(|port| {
+                let wire: Vec<u8> = (0..frames)
+                    .flat_map(|packet| {
+                        DataFrame {
+                            packet,
+                            erpm_raw: 70,
+                            current_raw: 819,
+                            ..Default::default()
+                        }
+                        .encode()
+                    })
+                    .collect();
+                Input::from_memory(&format!("p{port}"), wire).unwrap()
+            })
+            .collect()
+    }
+
+    /// The settings of ESC `esc` in [`exported`]: every third ESC under the defaults, the
+    /// others each under a current scale and pole pairs of its own.
+    fn settings_of(esc: usize) -> Settings {
+        if esc.is_multiple_of(3) {
+            Settings::DEFAULT
+        } else {
+            Settings::new(10.0 + esc as f32, 2 + esc as u16, 1.0).unwrap()
+        }
+    }
+
+    /// Exports `ports` ports of `frames` frames each in `format`, each port's ESC under
+    /// [`settings_of`] (set by port); returns the output file's path.
+    fn exported(dir: &Path, format: OutputFormat, ports: usize, frames: u16) -> PathBuf {
+        let mut map = SettingsMap::from(Settings::DEFAULT);
+        for esc in (0..ports).filter(|esc| !esc.is_multiple_of(3)) {
+            let s = settings_of(esc);
+            let patch = SettingsPatch {
+                current_scale: Some(s.current_scale),
+                pole_pairs: Some(s.pole_pairs),
+                gear_ratio: None,
+            };
+            map.set_port(format!("p{esc}"), patch).unwrap();
+        }
+        let path = dir.join(format!("out.{format:?}"));
+        let provenance = Provenance {
+            settings: Settings::DEFAULT,
+            overrides: vec![(
+                "esc.1".to_string(),
+                SettingsPatch {
+                    pole_pairs: Some(3),
+                    ..Default::default()
+                },
+            )],
+            inputs: vec!["p0".to_string()],
+            filter: String::new(),
+            csv_comment: true,
+        };
+        let mut export = Export::create(format, path.to_str(), provenance).unwrap();
+        Sources::new(inputs(ports, frames), map)
+            .run(&mut export)
+            .unwrap();
+        let expected: Vec<(u8, Settings)> = (0..ports)
+            .filter(|esc| !esc.is_multiple_of(3))
+            .map(|esc| (esc as u8, settings_of(esc)))
+            .collect();
+        assert_eq!(export.esc_settings(), expected);
+        export.finish(Vec::new()).unwrap();
+        path
+    }
+
+    /// Checks (esc, rpm, current_a) of every row: each under its ESC's settings.
+    fn check_rows(rows: &[(u8, f32, f32)], ports: usize, frames: u16) {
+        assert_eq!(rows.len(), ports * usize::from(frames));
+        for &(esc, rpm, amps) in rows {
+            let s = settings_of(usize::from(esc));
+            let frame = DataFrame {
+                erpm_raw: 70,
+                current_raw: 819,
+                ..Default::default()
+            };
+            assert_eq!(
+                (rpm, amps),
+                (frame.rpm(&s), frame.current_a(&s)),
+                "ESC {esc}"
+            );
+        }
+        for esc in 0..ports as u8 {
+            assert!(rows.iter().any(|r| r.0 == esc), "no row of ESC {esc}");
+        }
+    }
+
+    /// Rows of many ESCs under many settings (more sets than a formatter keeps cached encoders
+    /// for), in more than one chunk: each row under its ESC's, in JSON Lines and CSV.
+    #[test]
+    fn text_rows_are_converted_under_their_escs_settings() {
+        let dir = tempfile::tempdir().unwrap();
+        let (ports, frames) = (14, 12_000);
+        assert!(ports - ports / 3 > super::text::CACHED_SETTINGS);
+        let jsonl =
+            std::fs::read_to_string(exported(dir.path(), OutputFormat::Jsonl, ports, frames))
+                .unwrap();
+        let rows: Vec<(u8, f32, f32)> = jsonl
+            .lines()
+            .map(|line| {
+                let v: serde_json::Value = serde_json::from_str(line).unwrap();
+                let f = |k: &str| v[k].as_f64().unwrap() as f32;
+                (v["esc"].as_u64().unwrap() as u8, f("rpm"), f("current_a"))
+            })
+            .collect();
+        check_rows(&rows, ports, frames);
+
+        let csv = std::fs::read_to_string(exported(dir.path(), OutputFormat::Csv, ports, frames))
+            .unwrap();
+        let mut lines = csv.lines();
+        let comment = lines.next().unwrap();
+        assert!(
+            comment.starts_with(
+                "# hwfoc decode: current_scale=64 pole_pairs=7 gear_ratio=1 esc.1.pole_pairs=3 \
+                 input=p0"
+            ),
+            "{comment}"
+        );
+        let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+        let col = |name: &str| header.iter().position(|&c| c == name).unwrap();
+        let (esc, rpm, amps) = (col("esc"), col("rpm"), col("current_a"));
+        let rows: Vec<(u8, f32, f32)> = lines
+            .map(|line| {
+                let fields: Vec<&str> = line.split(',').collect();
+                (
+                    fields[esc].parse().unwrap(),
+                    fields[rpm].parse().unwrap(),
+                    fields[amps].parse().unwrap(),
+                )
+            })
+            .collect();
+        check_rows(&rows, ports, frames);
+    }
+
+    /// The same in Parquet, with the settings of each ESC that has its own in the metadata.
+    #[cfg(feature = "parquet")]
+    #[test]
+    fn parquet_rows_are_converted_under_their_escs_settings() {
+        use ::parquet::arrow::arrow_reader::ParquetRecordBatchReaderBuilder;
+        use arrow_array::cast::AsArray;
+        use arrow_array::types::{Float32Type, UInt8Type};
+
+        let dir = tempfile::tempdir().unwrap();
+        // Two row groups at least, each with ESCs under settings of their own.
+        let (ports, frames) = (5, 40_000);
+        let path = exported(dir.path(), OutputFormat::Parquet, ports, frames);
+        let reader = ParquetRecordBatchReaderBuilder::try_new(File::open(&path).unwrap()).unwrap();
+        let kv = reader
+            .metadata()
+            .file_metadata()
+            .key_value_metadata()
+            .unwrap()
+            .clone();
+        assert!(reader.metadata().num_row_groups() >= 2);
+        let value = |key: &str| {
+            kv.iter()
+                .find(|e| e.key == key)
+                .and_then(|e| e.value.clone())
+        };
+        assert_eq!(value("pole_pairs").as_deref(), Some("7"));
+        let escs: serde_json::Value =
+            serde_json::from_str(&value("esc_settings").unwrap()).unwrap();
+        assert_eq!(
+            escs,
+            serde_json::json!({
+                "1": {"current_scale": 11.0, "pole_pairs": 3, "gear_ratio": 1.0},
+                "2": {"current_scale": 12.0, "pole_pairs": 4, "gear_ratio": 1.0},
+                "4": {"current_scale": 14.0, "pole_pairs": 6, "gear_ratio": 1.0},
+            })
+        );
+        let mut rows = Vec::new();
+        for batch in reader.build().unwrap() {
+            let batch = batch.unwrap();
+            let column = |name: &str| batch.column(batch.schema().index_of(name).unwrap()).clone();
+            let (esc, rpm, amps) = (column("esc"), column("rpm"), column("current_a"));
+            let (esc, rpm, amps) = (
+                esc.as_primitive::<UInt8Type>(),
+                rpm.as_primitive::<Float32Type>(),
+                amps.as_primitive::<Float32Type>(),
+            );
+            for i in 0..batch.num_rows() {
+                rows.push((esc.value(i), rpm.value(i), amps.value(i)));
+            }
+        }
+        check_rows(&rows, ports, frames);
+    }
+
+    /// Only the selected ESCs' settings are taken: a skipped ESC under settings of its own is
+    /// neither written nor named among the ESCs with their own settings.
+    #[test]
+    fn skipped_escs_settings_are_not_taken() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("some.jsonl");
+        let mut map = SettingsMap::from(Settings::DEFAULT);
+        for esc in [1, 2] {
+            let patch = SettingsPatch {
+                pole_pairs: Some(settings_of(esc).pole_pairs),
+                current_scale: Some(settings_of(esc).current_scale),
+                gear_ratio: None,
+            };
+            map.set_port(format!("p{esc}"), patch).unwrap();
+        }
+        let provenance = Provenance {
+            settings: Settings::DEFAULT,
+            overrides: Vec::new(),
+            inputs: Vec::new(),
+            filter: String::new(),
+            csv_comment: false,
+        };
+        let selection = Selection::new(&[0, 2], crate::select::Window::ALL);
+        let mut export = Export::create(OutputFormat::Jsonl, path.to_str(), provenance)
+            .unwrap()
+            .select(selection);
+        Sources::new(inputs(3, 100), map).run(&mut export).unwrap();
+        assert_eq!(export.esc_settings(), [(2, settings_of(2))]);
+        assert_eq!(export.kept(), 200);
+        export.finish(Vec::new()).unwrap();
+        let rows: Vec<(u8, f32, f32)> = std::fs::read_to_string(&path)
+            .unwrap()
+            .lines()
+            .map(|line| {
+                let v: serde_json::Value = serde_json::from_str(line).unwrap();
+                let f = |k: &str| v[k].as_f64().unwrap() as f32;
+                (v["esc"].as_u64().unwrap() as u8, f("rpm"), f("current_a"))
+            })
+            .collect();
+        assert_eq!(rows.len(), 200);
+        assert!(rows.iter().all(|r| r.0 != 1));
+        let frame = DataFrame {
+            erpm_raw: 70,
+            current_raw: 819,
+            ..Default::default()
+        };
+        for &(esc, rpm, amps) in &rows {
+            let s = settings_of(usize::from(esc));
+            assert_eq!(
+                (rpm, amps),
+                (frame.rpm(&s), frame.current_a(&s)),
+                "ESC {esc}"
+            );
+        }
+        assert!(rows.iter().any(|r| r.0 == 2));
+    }
+
+    /// An export whose ESCs all have the default settings carries no table and no
+    /// `esc_settings`; settings equal to the default, said for an ESC, change nothing.
+    #[test]
+    fn uniform_settings_carry_no_table() {
+        let provenance = Provenance {
+            settings: Settings::DEFAULT,
+            overrides: Vec::new(),
+            inputs: Vec::new(),
+            filter: String::new(),
+            csv_comment: false,
+        };
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("x.jsonl");
+        let mut export = Export::create(OutputFormat::Jsonl, path.to_str(), provenance).unwrap();
+        export.set_esc_settings(3, &Settings::DEFAULT);
+        assert!(export.table.is_none() && export.esc_settings().is_empty());
+        let other = Settings::new(100.0, 7, 1.0).unwrap();
+        export.set_esc_settings(3, &other);
+        export.set_esc_settings(5, &Settings::DEFAULT);
+        assert_eq!(export.esc_settings(), [(3, other)]);
+        export.finish(Vec::new()).unwrap();
     }
 }

@@ -5,8 +5,9 @@
 //! ([`crate::record::columns`]); each Arrow field carries its unit in its metadata (key `unit`,
 //! `-` for a number without unit). The file's key-value metadata holds `hwfoc_version`, the
 //! settings (`current_scale`, `pole_pairs`, `gear_ratio`), `inputs` (a JSON array of the input
-//! names), `escs` (a JSON array of `{"esc", "input", "stream"}`) and, when records were
-//! filtered, `filter`.
+//! names), `escs` (a JSON array of `{"esc", "input", "stream"}`), when some ESCs' records were
+//! converted under settings of their own `esc_settings` (a JSON object of their settings by ESC
+//! index, see [`super::esc_settings_json`]) and, when records were filtered, `filter`.
 //!
 //! Each column is one Parquet leaf column, encoded by code generic over the column: its values
 //! computed from the frames, a block of rows at a time, and stored as its value type says
@@ -445,21 +446,38 @@ mod encode {
     }
 
     /// Converts and encodes column `C` of `rows` into memory: the column chunk's bytes and the
-    /// metadata that goes with them.
+    /// metadata that goes with them. Rows are converted under `settings`, or under their ESC's
+    /// where the rows carry a table of settings by ESC.
     fn encode_column<C: Column>(
         rows: &Chunk,
         descr: ColumnDescPtr,
         props: &WriterPropertiesPtr,
         settings: &Settings,
     ) -> Encoded {
+        match rows.settings.as_deref() {
+            None => encode_column_by::<C>(rows, descr, props, |_| settings),
+            Some(table) => {
+                encode_column_by::<C>(rows, descr, props, |esc| &table[usize::from(esc)])
+            }
+        }
+    }
+
+    /// [`encode_column`] with the settings of each row's ESC given by `settings`.
+    fn encode_column_by<'s, C: Column>(
+        rows: &Chunk,
+        descr: ColumnDescPtr,
+        props: &WriterPropertiesPtr,
+        settings: impl Fn(u8) -> &'s Settings + Copy,
+    ) -> Encoded {
         let n = rows.len();
         let value = |i: usize| {
             let t = rows.t[i];
+            let esc = rows.esc[i];
             C::from_frame(
                 (!t.is_nan()).then_some(t),
-                rows.esc[i],
+                esc,
                 &rows.frames[i],
-                settings,
+                settings(esc),
             )
         };
         let block_rows =
@@ -476,7 +494,7 @@ mod encode {
                 .zip(&rows.esc[block.clone()])
                 .zip(&rows.frames[block])
                 .map(|((&t, &esc), frame)| {
-                    C::from_frame((!t.is_nan()).then_some(t), esc, frame, settings)
+                    C::from_frame((!t.is_nan()).then_some(t), esc, frame, settings(esc))
                 });
             <C::Value as ParquetValue>::fill(values, levels);
         })

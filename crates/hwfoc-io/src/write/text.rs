@@ -8,9 +8,11 @@
 
 use std::sync::mpsc::{Receiver, SyncSender, sync_channel};
 
+use hwfoc::{DataFrame, Settings};
+
 use crate::record::{Record, TextEncoder};
 
-use super::{Chunk, Destination, Provenance, ToWriter, WriteError};
+use super::{Chunk, Destination, EscTable, Provenance, ToWriter, WriteError};
 
 /// Rows formatted at a time by one formatter.
 const SLICE_ROWS: usize = 8192;
@@ -45,15 +47,31 @@ pub(super) fn write(
             slices.push(slice_tx);
             texts.push(text_rx);
             s.spawn(move || {
+                // Rows under the export's settings (the usual case: all of them).
                 let mut encoder = TextEncoder::cached();
+                // Rows under their ESC's settings, once a slice carries a table of them.
+                let mut by_settings: Option<Encoders> = None;
                 for slice in slice_rx {
                     let mut text = Vec::with_capacity(slice.len() * if csv { 110 } else { 260 });
-                    for ((&t, &esc), frame) in slice.t.iter().zip(&slice.esc).zip(&slice.frames) {
-                        let record = Record::new((!t.is_nan()).then_some(t), esc, frame, &settings);
-                        if csv {
-                            encoder.csv_frame(&record, frame, &mut text);
-                        } else {
-                            encoder.json_frame(&record, frame, &mut text);
+                    let rows = slice.t.iter().zip(&slice.esc).zip(&slice.frames);
+                    match slice.settings.as_deref() {
+                        None => {
+                            for ((&t, &esc), frame) in rows {
+                                let t = (!t.is_nan()).then_some(t);
+                                let record = Record::new(t, esc, frame, &settings);
+                                encode(&mut encoder, csv, &record, frame, &mut text);
+                            }
+                        }
+                        Some(table) => {
+                            let encoders = by_settings.get_or_insert_with(Encoders::default);
+                            let slots = encoders.slots(table);
+                            for ((&t, &esc), frame) in rows {
+                                let t = (!t.is_nan()).then_some(t);
+                                let settings = &table[usize::from(esc)];
+                                let record = Record::new(t, esc, frame, settings);
+                                let encoder = encoders.get(slots[usize::from(esc)]);
+                                encode(encoder, csv, &record, frame, &mut text);
+                            }
                         }
                     }
                     if text_tx.send((text, slice.flush)).is_err() {
@@ -80,6 +98,7 @@ pub(super) fn write(
                     esc: chunk.esc[start..end].to_vec(),
                     frames: chunk.frames[start..end].to_vec(),
                     flush: chunk.flush && end == n,
+                    settings: chunk.settings.clone(),
                 };
                 if slices[turn].send(slice).is_err() {
                     break 'rows;
@@ -105,7 +124,65 @@ pub(super) fn write(
     })
 }
 
-/// The CSV header row (after the settings comment when asked for), or nothing for JSON Lines.
+/// Appends the text of `record`, the record of `frame`, as CSV (`csv`) or JSON.
+#[inline(always)]
+fn encode(
+    encoder: &mut TextEncoder,
+    csv: bool,
+    record: &Record,
+    frame: &DataFrame,
+    out: &mut Vec<u8>,
+) {
+    if csv {
+        encoder.csv_frame(record, frame, out);
+    } else {
+        encoder.json_frame(record, frame, out);
+    }
+}
+
+/// The most sets of settings a formatter keeps cached encoders for (about 1 MB each); rows of
+/// ESCs under further sets are written by an encoder without caches (the same text, slower).
+pub(super) const CACHED_SETTINGS: usize = 8;
+
+/// A formatter's text encoders for rows under their ESC's settings: a cached one per set of
+/// settings (a cache holds the text of values converted under one set), made as sets are
+/// met, and one without caches.
+#[derive(Default)]
+struct Encoders {
+    list: Vec<(Settings, TextEncoder)>,
+    plain: TextEncoder,
+}
+
+impl Encoders {
+    /// Which encoder writes the rows of each ESC under `table`: an index in `list`, or
+    /// `usize::MAX` for the plain encoder. Encoders are made for settings first seen here.
+    fn slots(&mut self, table: &EscTable) -> [usize; 256] {
+        let mut slots = [usize::MAX; 256];
+        for (slot, settings) in slots.iter_mut().zip(table) {
+            *slot = match self.list.iter().position(|(s, _)| s == settings) {
+                Some(i) => i,
+                None if self.list.len() < CACHED_SETTINGS => {
+                    self.list.push((*settings, TextEncoder::cached()));
+                    self.list.len() - 1
+                }
+                None => usize::MAX,
+            };
+        }
+        slots
+    }
+
+    /// The encoder in `slot` (see [`Encoders::slots`]).
+    #[inline]
+    fn get(&mut self, slot: usize) -> &mut TextEncoder {
+        match self.list.get_mut(slot) {
+            Some((_, encoder)) => encoder,
+            None => &mut self.plain,
+        }
+    }
+}
+
+/// The CSV header row (after the settings comment when asked for: the default settings, then
+/// those set by port or ESC, as `esc.2.pole_pairs=14`), or nothing for JSON Lines.
 fn header(csv: bool, provenance: &Provenance) -> Vec<u8> {
     let mut text = Vec::new();
     if !csv {
@@ -118,9 +195,22 @@ fn header(csv: bool, provenance: &Provenance) -> Vec<u8> {
         } else {
             format!(" filter={}", provenance.filter)
         };
+        let mut overrides = String::new();
+        for (name, patch) in &provenance.overrides {
+            if let Some(scale) = patch.current_scale {
+                overrides.push_str(&format!(" {name}.current_scale={scale}"));
+            }
+            if let Some(pairs) = patch.pole_pairs {
+                overrides.push_str(&format!(" {name}.pole_pairs={pairs}"));
+            }
+            if let Some(ratio) = patch.gear_ratio {
+                overrides.push_str(&format!(" {name}.gear_ratio={ratio}"));
+            }
+        }
         text.extend_from_slice(
             format!(
-                "# hwfoc decode: current_scale={} pole_pairs={} gear_ratio={} input={}{filter}\n",
+                "# hwfoc decode: current_scale={} pole_pairs={} gear_ratio={}{overrides} \
+                 input={}{filter}\n",
                 settings.current_scale,
                 settings.pole_pairs,
                 settings.gear_ratio,
