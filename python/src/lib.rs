@@ -27,8 +27,10 @@ use pyo3::prelude::*;
 use records::{Collect, Frames, Provenance, Stop, escs_json, filter_text};
 use source::Spec;
 
-/// Rows per record batch of `read`'s table: blocks converted side by side on the workers.
-const READ_ROWS: usize = 1 << 18;
+/// Rows per record batch of `read`'s table: blocks converted side by side on the workers. A
+/// block of frames this size (under 2 MiB: 29 bytes a frame) stays in a core's L2 cache while
+/// each column is made from it: with 2^18 rows a call took 20 % more CPU time.
+const READ_ROWS: usize = 1 << 16;
 
 /// Blocks of frames waiting for a worker, at most (bounds the frames held before conversion).
 const READ_QUEUE: usize = 4;

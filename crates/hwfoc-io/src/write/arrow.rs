@@ -9,9 +9,9 @@
 use std::collections::HashMap;
 use std::sync::Arc;
 
-use arrow_array::builder::{ListBuilder, StringBuilder};
+use arrow_array::builder::OffsetBufferBuilder;
 use arrow_array::types::{Float32Type, Float64Type, UInt8Type, UInt16Type, UInt32Type};
-use arrow_array::{ArrayRef, PrimitiveArray, RecordBatch};
+use arrow_array::{ArrayRef, ListArray, PrimitiveArray, RecordBatch, StringArray};
 use arrow_schema::{DataType, Field, FieldRef, Schema, SchemaRef};
 use hwfoc::{DataFrame, Settings, Status};
 
@@ -89,16 +89,30 @@ impl ArrowValue for FaultList {
         DataType::List(fault_item())
     }
 
+    /// The offsets of the lists and the names' offsets and bytes go straight into their
+    /// buffers, without a builder call per row: most rows have no fault, an empty list, which
+    /// is only its offset repeated.
     fn array(values: impl ExactSizeIterator<Item = Self>) -> ArrayRef {
-        let mut lists =
-            ListBuilder::with_capacity(StringBuilder::new(), values.len()).with_field(fault_item());
+        let mut lists = OffsetBufferBuilder::<i32>::new(values.len());
+        let mut names = OffsetBufferBuilder::<i32>::new(0);
+        let mut bytes: Vec<u8> = Vec::new();
         for faults in values {
-            for name in faults.names() {
-                lists.values().append_value(name);
+            let count = faults.0.0.count_ones() as usize;
+            if count != 0 {
+                for name in faults.names() {
+                    bytes.extend_from_slice(name.as_bytes());
+                    names.push_length(name.len());
+                }
             }
-            lists.append(true);
+            lists.push_length(count);
         }
-        Arc::new(lists.finish())
+        let names = StringArray::new(names.finish(), bytes.into(), None);
+        Arc::new(ListArray::new(
+            fault_item(),
+            lists.finish(),
+            Arc::new(names),
+            None,
+        ))
     }
 }
 
