@@ -245,7 +245,7 @@ fn summary_json(specs: Vec<Spec>, settings: Settings) -> Result<String, InputErr
     let mut sources = Sources::new(open_all(specs)?, settings);
     let mut summary = Summary::new();
     sources.run(&mut summary)?;
-    Ok(summary.report(&sources, &settings).json().to_string())
+    Ok(summary.report(&sources).json().to_string())
 }
 
 /// What `hwfoc summary --json` prints for `source` (as `read` takes it), as Python objects:
