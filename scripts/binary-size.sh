@@ -5,8 +5,8 @@
 #   scripts/binary-size.sh BINARY [LIMIT_BYTES]
 #
 # BINARY is a release build (target/release/hwfoc, or target/TRIPLE/release/hwfoc): the release
-# profile builds it without debug information (the workspace's Cargo.toml), so it keeps only its
-# symbol table, for names in backtraces. LIMIT_BYTES (default 10000000, 10 MB) applies to the
+# profile builds it without debug information or symbols (the workspace's Cargo.toml).
+# LIMIT_BYTES (default 10000000, 10 MB) applies to the
 # binary as built (what `cargo install` installs: debug information creeping back into the
 # release profile fails here) and to a copy stripped of every symbol, made with `strip` (or
 # aarch64-linux-gnu-strip for an AArch64 binary) in a temporary file. Prints both sizes; exits 1
