@@ -470,11 +470,22 @@ impl PortStreams {
 
 /// Receive time of stream offset `offset`, where `times` holds the times of the bytes from
 /// offset `start` on and `history` those just before `start`.
+///
+/// A frame that began in bytes fed without times (a stream that became timed mid-frame) has no
+/// time of its own: it gets the earliest time known.
 fn time_at(history: &[f64], times: &[f64], start: u64, offset: u64) -> f64 {
     if offset >= start {
         times[(offset - start) as usize]
     } else {
-        history[history.len() - (start - offset) as usize]
+        let back = (start - offset) as usize;
+        match history.len().checked_sub(back) {
+            Some(i) => history[i],
+            None => history
+                .first()
+                .or(times.first())
+                .copied()
+                .unwrap_or(f64::NAN),
+        }
     }
 }
 
@@ -548,6 +559,32 @@ mod tests {
         }
         stream.finish(|_, _, _| {});
         stream.stats()
+    }
+
+    /// A frame begun in bytes without times and ended in timed ones takes the earliest time
+    /// known (this panicked before).
+    #[test]
+    fn a_stream_that_becomes_timed_mid_frame() {
+        let (bytes, times) = timed(&[7], 100.0);
+        let mut stream = Stream::new();
+        stream.feed(
+            Batch {
+                bytes: &bytes[..10],
+                times: None,
+                stream: 0,
+            },
+            |_, _, _| panic!("no frame yet"),
+        );
+        let mut got = Vec::new();
+        stream.feed(
+            Batch {
+                bytes: &bytes[10..],
+                times: Some(&times[10..]),
+                stream: 0,
+            },
+            |t, _, _| got.push(t),
+        );
+        assert_eq!(got, [Some(times[10])]);
     }
 
     /// The first byte held of a frame still arriving bounds the time of any frame to come.
