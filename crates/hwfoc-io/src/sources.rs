@@ -274,9 +274,11 @@ impl Sources {
         let queue = &mut self.queue;
         let hub = self.hubs.get(&esc);
         let mut pending = Vec::new();
-        self.escs[esc]
-            .stream
-            .finish(|t, channel, d| queue_frame(esc, hub, t, channel, d, queue, &mut pending));
+        self.escs[esc].stream.finish(|t, channel, d| {
+            if let Some((esc, _)) = route(esc, hub, t, channel, d, &mut pending) {
+                queue.push(esc, t, d);
+            }
+        });
         self.deliver(esc, pending, &mut Deliver::<()>::Queue);
     }
 
@@ -479,7 +481,15 @@ impl Sources {
             self.escs[esc].stream.feed(
                 batch,
                 #[inline(always)]
-                |t, channel, d| route(id, hub, t, channel, d, settings, handler, &mut pending),
+                |t, channel, d| match route(esc, hub, t, channel, d, &mut pending) {
+                    Some((_, None)) => handler.frame(id, t, d, settings),
+                    Some((esc, Some(settings))) => {
+                        if let Ok(esc) = u8::try_from(esc) {
+                            handler.frame(esc, t, d, settings);
+                        }
+                    }
+                    None => {}
+                },
             );
             self.deliver(esc, pending, &mut Deliver::Handler(handler));
             handler.end_batch(len < LIVE_BATCH)?;
@@ -532,7 +542,9 @@ impl Sources {
                 let hub = self.hubs.get(&esc);
                 let mut pending = Vec::new();
                 self.escs[esc].stream.feed(batch, |t, channel, d| {
-                    queue_frame(esc, hub, t, channel, d, queue, &mut pending)
+                    if let Some((esc, _)) = route(esc, hub, t, channel, d, &mut pending) {
+                        queue.push(esc, t, d);
+                    }
                 });
                 self.deliver(esc, pending, &mut Deliver::<H>::Queue);
             }
@@ -726,29 +738,29 @@ struct Hub {
 /// A frame of a DataLink channel that has no ESC yet: its time, channel and frame.
 type Pending = (Option<f64>, u8, Decoded);
 
-/// Hands a frame of the stream of ESC `id` to `handler`: as that ESC's on its own wire, as its
-/// channel's ESC behind a hub whose channels are numbered (`hub`), or else into `pending`.
+/// The ESC a frame of the stream of ESC `own` belongs to: `own` on its own wire; behind a hub
+/// whose channels are numbered (`hub`), its channel's ESC with that ESC's settings; `None` for a
+/// channel the `esc` column cannot number, or when the hub's channels are not numbered yet (the
+/// frame then waits in `pending`).
 #[inline(always)]
-#[allow(clippy::too_many_arguments)]
-fn route<H: Handler>(
-    id: u8,
-    hub: Option<&Hub>,
+fn route<'h>(
+    own: usize,
+    hub: Option<&'h Hub>,
     t: Option<f64>,
     channel: Option<u8>,
     d: &Decoded,
-    settings: &Settings,
-    handler: &mut H,
     pending: &mut Vec<Pending>,
-) {
+) -> Option<(usize, Option<&'h Settings>)> {
     match (channel, hub) {
-        (None, _) => handler.frame(id, t, d, settings),
+        (None, _) => Some((own, None)),
         (Some(c), Some(hub)) => {
             let c = usize::from(c);
-            if let Ok(esc) = u8::try_from(hub.escs[c]) {
-                handler.frame(esc, t, d, &hub.settings[c]);
-            }
+            (hub.escs[c] != usize::MAX).then(|| (hub.escs[c], Some(&hub.settings[c])))
         }
-        (Some(c), None) => pending.push((t, c, *d)),
+        (Some(c), None) => {
+            pending.push((t, c, *d));
+            None
+        }
     }
 }
 
@@ -756,29 +768,6 @@ fn route<H: Handler>(
 enum Deliver<'a, H> {
     Handler(&'a mut H),
     Queue,
-}
-
-/// Puts a frame of the stream of ESC `esc` in the time-order queue: as that ESC's on its own
-/// wire, as its channel's ESC behind a hub whose channels are numbered (`hub`), or else into
-/// `pending`.
-fn queue_frame(
-    esc: usize,
-    hub: Option<&Hub>,
-    t: Option<f64>,
-    channel: Option<u8>,
-    d: &Decoded,
-    queue: &mut Queue,
-    pending: &mut Vec<Pending>,
-) {
-    match (channel, hub) {
-        (None, _) => queue.push(esc, t, d),
-        (Some(c), Some(hub)) => {
-            if let Some(&esc) = hub.escs.get(usize::from(c)).filter(|&&e| e != usize::MAX) {
-                queue.push(esc, t, d);
-            }
-        }
-        (Some(c), None) => pending.push((t, c, *d)),
-    }
 }
 
 #[cfg(test)]
