@@ -273,6 +273,58 @@ fn the_ground_truth_never_lands_on_the_recording() {
 }
 
 #[test]
+fn a_simulated_recording_never_overwrites_a_file_unasked() {
+    let dir = Dir::new();
+    let out = dir.arg("run.pcapng");
+    std::fs::write(&out, "keep me").unwrap();
+    let o = run(hwfoc().args(["simulate", "-o", &out, "--duration", "1"]));
+    assert_fails_with(&o, "run.pcapng exists and is never overwritten unasked");
+    assert_eq!(std::fs::read_to_string(&out).unwrap(), "keep me");
+    // One file per ESC: the third exists, so none is written (nor the truth).
+    let per_esc = dir.arg("esc{esc}.bin");
+    std::fs::write(dir.path("esc2.bin"), "keep me too").unwrap();
+    let truth = dir.arg("truth.jsonl");
+    let args = [
+        "simulate",
+        "--escs",
+        "3",
+        "-o",
+        &per_esc,
+        "--truth",
+        &truth,
+        "--duration",
+        "1",
+    ];
+    let o = run(hwfoc().args(args));
+    assert_fails_with(&o, "esc2.bin exists and is never overwritten unasked");
+    assert_eq!(
+        std::fs::read_to_string(dir.path("esc2.bin")).unwrap(),
+        "keep me too"
+    );
+    assert!(!dir.path("esc0.bin").exists() && !dir.path("truth.jsonl").exists());
+    // Asked: written over.
+    ok(run(hwfoc().args(args).arg("--overwrite")));
+    let bytes = std::fs::read(dir.path("esc2.bin")).unwrap();
+    assert!(
+        bytes.len() >= 24 && !bytes.starts_with(b"keep me"),
+        "{bytes:?}"
+    );
+    ok(run(hwfoc().args([
+        "simulate",
+        "-o",
+        &out,
+        "--duration",
+        "1",
+        "--overwrite",
+    ])));
+    assert!(
+        std::fs::read(&out)
+            .unwrap()
+            .starts_with(&[0x0A, 0x0D, 0x0D, 0x0A])
+    );
+}
+
+#[test]
 fn a_plot_is_written_whole_to_a_file_and_not_to_a_device() {
     let dir = Dir::new();
     let (csv, _) = inputs(&dir);

@@ -70,6 +70,8 @@ fn raw_file_decodes_to_the_truth() {
             "--fault".into(),
             "mos_overheat@3-4".into(),
             "--quiet".into(),
+            // The second run replaces the first's files.
+            "--overwrite".into(),
         ];
         if faulty {
             args.extend(FAULTY.iter().map(|s| s.to_string()));

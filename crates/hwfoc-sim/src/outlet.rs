@@ -101,8 +101,22 @@ impl Outlet {
         }
     }
 
-    /// Opens the outlet for `n` ESCs at `baud`.
-    pub(crate) fn open(&self, n: usize, baud: u32) -> Result<Opened, SimError> {
+    /// The files `n` ESCs are written to (`-` for standard output): one, or one per ESC with
+    /// `{esc}` in the name; none for live outlets.
+    pub fn files(&self, n: usize) -> Vec<String> {
+        match self {
+            Outlet::File { path, .. } if path.contains("{esc}") => {
+                (0..n).map(|i| sink::expand(path, i)).collect()
+            }
+            Outlet::File { path, .. } => vec![path.clone()],
+            Outlet::Stdout(_) => vec!["-".to_string()],
+            _ => Vec::new(),
+        }
+    }
+
+    /// Opens the outlet for `n` ESCs at `baud`; existing files are replaced only if
+    /// `overwrite`.
+    pub(crate) fn open(&self, n: usize, baud: u32, overwrite: bool) -> Result<Opened, SimError> {
         #[cfg(unix)]
         let mut links = pty::Links::default();
         let (sink, names, linger): (Box<dyn Sink>, Vec<String>, bool) = match self {
@@ -118,20 +132,18 @@ impl Outlet {
             }
             Outlet::Ports(ports) => (Box::new(PortSink::open(ports, baud)?), ports.clone(), false),
             Outlet::Stdout(format) | Outlet::File { format, .. } => {
-                let (paths, file_of): (Vec<String>, Vec<usize>) = match self {
-                    Outlet::File { path, .. } if path.contains("{esc}") => (
-                        (0..n).map(|i| sink::expand(path, i)).collect(),
-                        (0..n).collect(),
-                    ),
-                    Outlet::File { path, .. } => (vec![path.clone()], vec![0; n]),
-                    _ => (vec!["-".to_string()], vec![0; n]),
+                let paths = self.files(n);
+                let file_of: Vec<usize> = match paths.len() {
+                    1 => vec![0; n],
+                    _ => (0..n).collect(),
                 };
                 if *format == FileFormat::Raw && paths.len() < n {
                     return Err(SimError::SharedRaw { n });
                 }
+                sink::check_new(paths.iter().map(String::as_str), overwrite)?;
                 let mut outs = Vec::with_capacity(paths.len());
                 for path in &paths {
-                    outs.push(sink::create(path)?);
+                    outs.push(sink::create(path, overwrite)?);
                 }
                 let names = file_of.iter().map(|&f| outs[f].0.clone()).collect();
                 let sink: Box<dyn Sink> = match format {

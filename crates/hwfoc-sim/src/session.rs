@@ -50,6 +50,9 @@ pub struct Plan {
     /// How the truth's records are converted (the ESCs' current scale and pole pairs should
     /// match the fleet's).
     pub settings: Settings,
+    /// Replace output files (recordings, raw files, the truth) that exist. Without it, an
+    /// existing file is an error ([`SimError::Exists`]) and nothing is written.
+    pub overwrite: bool,
 }
 
 impl Plan {
@@ -97,9 +100,13 @@ impl Session {
             None => Some(fleet.profile().natural_length_s() + TAIL_S),
         };
         let escs = fleet.escs();
+        // Every file is checked before any is created: a run fails whole or starts whole.
+        let outlet_files = plan.outlet.files(n);
+        let files = plan.truth.iter().chain(&outlet_files);
+        sink::check_new(files.map(String::as_str), plan.overwrite)?;
         let truth = match &plan.truth {
             Some(path) => {
-                let (name, out) = sink::create(path)?;
+                let (name, out) = sink::create(path, plan.overwrite)?;
                 Some(Truth::new(name, out, plan.settings))
             }
             None => None,
@@ -111,7 +118,7 @@ impl Session {
             _ => unix_now_ns(),
         };
         Ok(Session {
-            opened: plan.outlet.open(n, baud)?,
+            opened: plan.outlet.open(n, baud, plan.overwrite)?,
             escs,
             truth,
             pace: plan.outlet.pace(realtime, baud),
@@ -191,6 +198,7 @@ mod tests {
                 duration_s: None,
                 truth: Some(path(&format!("{name}.jsonl"))),
                 settings: Settings::default(),
+                overwrite: false,
             };
             let session = Session::open(spec(2).build().unwrap(), &plan).unwrap();
             assert_eq!(session.outputs(), [path(name), path(name)]);
@@ -214,6 +222,61 @@ mod tests {
     }
 
     #[test]
+    fn an_existing_file_is_never_written_over_unasked() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = |name: &str| dir.path().join(name).display().to_string();
+        // ESC 1's file exists (an earlier run's); ESC 0's and the truth do not.
+        std::fs::write(path("esc1.bin"), b"an earlier recording").unwrap();
+        let plan = |overwrite| Plan {
+            outlet: Outlet::File {
+                path: path("esc{esc}.bin"),
+                format: FileFormat::Raw,
+            },
+            realtime: false,
+            start_s: None,
+            duration_s: Some(1.0),
+            truth: Some(path("truth.jsonl")),
+            settings: Settings::default(),
+            overwrite,
+        };
+        let e = Session::open(spec(2).build().unwrap(), &plan(false))
+            .err()
+            .unwrap();
+        assert!(
+            matches!(&e, SimError::Exists { file } if *file == path("esc1.bin")),
+            "{e}"
+        );
+        assert!(e.to_string().contains("--overwrite"), "{e}");
+        // Nothing was created or touched: the run failed whole.
+        assert_eq!(
+            std::fs::read(path("esc1.bin")).unwrap(),
+            b"an earlier recording"
+        );
+        assert!(!std::path::Path::new(&path("esc0.bin")).exists());
+        assert!(!std::path::Path::new(&path("truth.jsonl")).exists());
+
+        // The truth alone existing is refused as well.
+        std::fs::remove_file(path("esc1.bin")).unwrap();
+        std::fs::write(path("truth.jsonl"), b"{}\n").unwrap();
+        let e = Session::open(spec(2).build().unwrap(), &plan(false))
+            .err()
+            .unwrap();
+        assert!(matches!(&e, SimError::Exists { file } if *file == path("truth.jsonl")));
+        assert_eq!(std::fs::read(path("truth.jsonl")).unwrap(), b"{}\n");
+
+        // Asked: replaced.
+        std::fs::write(path("esc1.bin"), b"an earlier recording").unwrap();
+        let session = Session::open(spec(2).build().unwrap(), &plan(true)).unwrap();
+        session.run(&AtomicBool::new(false)).unwrap();
+        let bytes = std::fs::read(path("esc1.bin")).unwrap();
+        assert!(
+            bytes.len() >= 24 && !bytes.starts_with(b"an earlier"),
+            "{bytes:?}"
+        );
+        assert_ne!(std::fs::read(path("truth.jsonl")).unwrap(), b"{}\n");
+    }
+
+    #[test]
     fn raw_bytes_of_several_escs_need_a_file_each() {
         let dir = tempfile::tempdir().unwrap();
         let plan = Plan {
@@ -226,6 +289,7 @@ mod tests {
             duration_s: Some(1.0),
             truth: None,
             settings: Settings::default(),
+            overwrite: false,
         };
         let e = Session::open(spec(2).build().unwrap(), &plan)
             .err()

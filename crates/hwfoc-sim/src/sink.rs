@@ -1,6 +1,6 @@
 //! Where the virtual ESCs' bytes go, and the ground truth of what they sent.
 
-use std::fs::File;
+use std::fs::OpenOptions;
 use std::io::{self, BufWriter, Write};
 
 use hwfoc::{DataFrame, Settings};
@@ -9,6 +9,8 @@ use hwfoc_io::pcapng;
 use hwfoc_io::record::Record;
 use hwfoc_io::serial::PortError;
 use hwfoc_io::write::WriteError;
+
+use crate::error::SimError;
 
 /// The outputs of a simulation, one stream per ESC.
 pub trait Sink {
@@ -23,16 +25,50 @@ pub trait Sink {
     }
 }
 
-/// Opens `path` for writing (or standard output for `-`), with errors naming it.
-pub fn create(path: &str) -> Result<(String, Box<dyn Write>), WriteError> {
+/// Opens `path` for writing (or standard output for `-`), with errors naming it. An existing
+/// file is [`SimError::Exists`] unless `overwrite`: a recording is never written over unasked
+/// (the check and the creation are one step, so no file can appear between them).
+pub fn create(path: &str, overwrite: bool) -> Result<(String, Box<dyn Write>), SimError> {
     if path == "-" {
         return Ok(("standard output".to_string(), Box::new(io::stdout())));
     }
-    let file = File::create(path).map_err(|source| WriteError::Create {
-        output: path.to_string(),
-        source,
-    })?;
+    let file = OpenOptions::new()
+        .write(true)
+        .create(true)
+        .truncate(true)
+        .create_new(!overwrite)
+        .open(path)
+        .map_err(|source| match source.kind() {
+            io::ErrorKind::AlreadyExists => SimError::Exists {
+                file: path.to_string(),
+            },
+            _ => WriteError::Create {
+                output: path.to_string(),
+                source,
+            }
+            .into(),
+        })?;
     Ok((path.to_string(), Box::new(file)))
+}
+
+/// Refuses, before anything is created, a file of `paths` that exists (unless `overwrite`), so
+/// that a run with several outputs fails whole rather than after writing some of them.
+pub fn check_new<'a>(
+    paths: impl IntoIterator<Item = &'a str>,
+    overwrite: bool,
+) -> Result<(), SimError> {
+    if overwrite {
+        return Ok(());
+    }
+    match paths
+        .into_iter()
+        .find(|p| *p != "-" && std::fs::symlink_metadata(p).is_ok())
+    {
+        Some(file) => Err(SimError::Exists {
+            file: file.to_string(),
+        }),
+        None => Ok(()),
+    }
 }
 
 /// `template` with `{esc}` replaced by the ESC's index.

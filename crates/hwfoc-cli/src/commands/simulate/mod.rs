@@ -110,6 +110,10 @@ pub struct SimulateArgs {
     /// Default: now for pcapng, 0 for raw bytes.
     #[arg(long, value_name = "UNIX_S", value_parser = start_time, help_heading = "Output")]
     start_time: Option<f64>,
+    /// Replace output files (-o, --truth) that exist. Without it, an existing file is an error
+    /// and nothing is written.
+    #[arg(long, help_heading = "Output")]
+    overwrite: bool,
     /// No per-ESC report on standard error at the end.
     #[arg(short, long, help_heading = "Output")]
     quiet: bool,
@@ -422,6 +426,7 @@ fn plan(args: &SimulateArgs, n: usize, settings: Settings) -> Result<Plan, CliEr
         duration_s: args.duration,
         truth: args.truth.clone(),
         settings,
+        overwrite: args.overwrite,
     };
     if plan.is_realtime() && args.start_time.is_some() {
         return Err(usage(
