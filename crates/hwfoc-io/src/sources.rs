@@ -1058,4 +1058,94 @@ mod tests {
             ]
         );
     }
+
+    /// Hubs and ESCs plugged in together never share an ESC number: a hub's channel 0 is its
+    /// port's number, its other channels the next numbers after all ports', hub by hub in the
+    /// order they are found. Live ports ([`PortStreams`](crate::stream::PortStreams)) and a
+    /// recording of them number them alike.
+    #[test]
+    fn hubs_and_escs_together_number_every_esc_once_live_and_recorded() {
+        // Ports 0 and 2 are hubs with all 8 channels (packet = 1000 + 100 * port + channel:
+        // an all-zero record would be an empty slot), port 1 an ESC of its own.
+        let hub = |port: u16| -> Vec<u8> {
+            (0..3)
+                .flat_map(|counter| {
+                    let mut frame = hwfoc::datalink::DatalinkFrame {
+                        counter,
+                        slots: [None; CHANNELS],
+                    };
+                    for (c, slot) in frame.slots.iter_mut().enumerate() {
+                        *slot = Some(DataFrame {
+                            packet: 1000 + 100 * port + c as u16,
+                            ..Default::default()
+                        });
+                    }
+                    frame.encode()
+                })
+                .collect()
+        };
+        // Bytes as they arrived: port 2's first, then port 1's, then port 0's.
+        let t = 1_700_000_000_000_000_000u64;
+        let arrivals = [(2usize, hub(2)), (1, wire(100..103)), (0, hub(0))];
+        let by_esc = |records: Vec<(u8, u16)>| {
+            let mut m = std::collections::BTreeMap::<u8, Vec<u16>>::new();
+            for (esc, packet) in records {
+                m.entry(esc).or_default().push(packet);
+            }
+            m
+        };
+        // Port 2, found a hub first, takes 3..=9 for its channels 1..7; port 0 then 10..=16.
+        let mut expected = std::collections::BTreeMap::new();
+        expected.insert(1, vec![100, 101, 102]);
+        for c in 0..8u16 {
+            let (esc2, esc0) = if c == 0 {
+                (2, 0)
+            } else {
+                (2 + c as u8, 9 + c as u8)
+            };
+            expected.insert(esc2, vec![1200 + c; 3]);
+            expected.insert(esc0, vec![1000 + c; 3]);
+        }
+
+        struct Escs(Vec<(u8, u16)>);
+        impl Handler for Escs {
+            type Error = InputError;
+            fn record(&mut self, r: &Record) {
+                self.0.push((r.esc, r.packet));
+            }
+        }
+        let mut streams = crate::stream::PortStreams::new(3, 115_200, Settings::DEFAULT);
+        let mut live = Escs(Vec::new());
+        for (k, (port, bytes)) in arrivals.iter().enumerate() {
+            let event = crate::serial::PortEvent::Data {
+                port: *port,
+                t_ns: t + k as u64 * 100_000_000,
+                bytes: bytes.clone(),
+            };
+            assert!(streams.feed(&event, &mut live).is_some());
+        }
+        assert_eq!(by_esc(live.0), expected);
+        assert_eq!(streams.channel_of(2, 9), Some(7));
+        assert_eq!(streams.channel_of(0, 0), Some(0));
+        assert_eq!(streams.channel_of(0, 10), Some(1));
+        assert_eq!(streams.channel_of(1, 1), None);
+        assert_eq!(streams.channel_of(0, 3), None);
+
+        // The recording `hwfoc record` makes of those ports: an interface per port, packets
+        // in the order the bytes arrived.
+        let mut w = pcapng::Writer::new(Vec::new()).unwrap();
+        for port in 0..3 {
+            w.add_interface(&format!("/dev/ttyUSB{port}"), 115_200)
+                .unwrap();
+        }
+        for (k, (port, bytes)) in arrivals.iter().enumerate() {
+            w.write(*port as u32, t + k as u64 * 100_000_000, bytes)
+                .unwrap();
+        }
+        let input = Input::from_memory("rec.pcapng", w.into_inner().unwrap()).unwrap();
+        let mut sources = Sources::new(vec![input], Settings::DEFAULT);
+        let mut recorded = Escs(Vec::new());
+        sources.run(&mut recorded).unwrap();
+        assert_eq!(by_esc(recorded.0), expected);
+    }
 }

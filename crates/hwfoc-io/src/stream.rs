@@ -399,6 +399,12 @@ impl Stream {
 /// A [`Stream`] per port, fed by [`PortEvent`]s: the path from live bytes to timed frames of
 /// `monitor`, `record` and the bridges (and of [`crate::Input::open_ports`], through
 /// [`byte_times`]).
+///
+/// ESC numbers are those [`crate::sources::Sources`] gives a recording of the same ports: port
+/// `i` is ESC `i`; a port found to carry a DataLink hub has its channel 0 as that ESC and its
+/// channels 1 to 7 as the next numbers after all ports' (in the order the hubs are found), so
+/// that a hub read alone numbers its ESCs 0 to 7 by channel and no two ESCs share a number
+/// whatever mix of hubs and ESCs is plugged in.
 #[derive(Debug)]
 pub struct PortStreams {
     streams: Vec<Stream>,
@@ -406,6 +412,10 @@ pub struct PortStreams {
     times: Vec<f64>,
     /// The settings of each port's records.
     settings: Vec<Settings>,
+    /// The ESC number of each channel of each port found to be a hub.
+    hubs: Vec<Option<[usize; datalink::CHANNELS]>>,
+    /// The number the next hub's channel 1 gets.
+    next_esc: usize,
 }
 
 impl PortStreams {
@@ -422,13 +432,14 @@ impl PortStreams {
             streams: settings.iter().map(|_| Stream::new()).collect(),
             per_byte_ns: hwfoc::wire::byte_ns(baud),
             times: Vec::new(),
+            hubs: vec![None; settings.len()],
+            next_esc: settings.len(),
             settings,
         }
     }
 
     /// Decodes the bytes of a [`PortEvent::Data`], handing each frame completed to `handler`
-    /// as ESC number `port`, or, from a DataLink hub, as ESC `8 * port + channel` (so a hub
-    /// read alone numbers its ESCs by channel; records numbered past 255 are not made: the
+    /// with its ESC number (see [`PortStreams`]; records numbered past 255 are not made: the
     /// `esc` column numbers 256). Other events, and ports beyond those made, are ignored.
     /// Returns the port's link statistics after the bytes (of its channel 0, from a hub), or
     /// `None` when there were no bytes for a known port.
@@ -436,19 +447,37 @@ impl PortStreams {
         let PortEvent::Data { port, t_ns, bytes } = event else {
             return None;
         };
-        let stream = self.streams.get_mut(*port)?;
-        self.times.clear();
-        byte_times(*t_ns, self.per_byte_ns, bytes.len(), &mut self.times);
-        let settings = &self.settings[*port];
-        let hub_base = port.saturating_mul(datalink::CHANNELS);
+        let PortStreams {
+            streams,
+            per_byte_ns,
+            times,
+            settings,
+            hubs,
+            next_esc,
+        } = self;
+        let stream = streams.get_mut(*port)?;
+        times.clear();
+        byte_times(*t_ns, *per_byte_ns, bytes.len(), times);
+        let settings = &settings[*port];
+        let hub = &mut hubs[*port];
         stream.feed(
             Batch {
                 bytes,
-                times: Some(&self.times),
+                times: Some(&times[..]),
                 stream: *port,
             },
             |t, channel, d| {
-                let esc = channel.map_or(*port, |c| hub_base + usize::from(c));
+                let esc = match channel {
+                    None => *port,
+                    Some(c) => hub.get_or_insert_with(|| {
+                        let mut escs = [*port; datalink::CHANNELS];
+                        for e in &mut escs[1..] {
+                            *e = *next_esc;
+                            *next_esc += 1;
+                        }
+                        escs
+                    })[usize::from(c)],
+                };
                 if let Ok(esc) = u8::try_from(esc) {
                     handler.frame(esc, t, d, settings);
                 }
@@ -465,6 +494,14 @@ impl PortStreams {
     /// The stream of `port`.
     pub fn stream(&self, port: usize) -> Option<&Stream> {
         self.streams.get(port)
+    }
+
+    /// The DataLink channel that ESC `esc` is on, if `port` is a hub that has handed on
+    /// frames and `esc` is one of its channels' numbers.
+    pub fn channel_of(&self, port: usize, esc: u8) -> Option<u8> {
+        let escs = self.hubs.get(port)?.as_ref()?;
+        let channel = escs.iter().position(|&e| e == usize::from(esc))?;
+        u8::try_from(channel).ok()
     }
 }
 

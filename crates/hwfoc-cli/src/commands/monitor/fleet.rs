@@ -4,7 +4,6 @@
 
 use std::collections::{HashMap, VecDeque};
 
-use hwfoc::datalink;
 use hwfoc::{Fault, InfoFrame, Settings};
 use hwfoc_io::stream::{EscLink, WireKind};
 
@@ -407,8 +406,8 @@ impl Fleet {
                     match item {
                         Item::Record(r) => {
                             let i = if hub {
-                                let channel = usize::from(r.esc) - port * datalink::CHANNELS;
-                                self.channel_view(port, channel)
+                                let channel = self.streams.channel_of(port, r.esc).unwrap_or(0);
+                                self.channel_view(port, usize::from(channel))
                             } else {
                                 port
                             };
