@@ -363,6 +363,8 @@ fn telemetry_of(record: &Value) -> (u64, u64, u64) {
     (cv, ca, rpm)
 }
 
+/// Also: the bridge converts each ESC under its own settings of the configuration file, as
+/// `decode` does (ESC 2's motor has 14 pole pairs and its current another scale).
 #[test]
 fn pymavlink_reads_a_replayed_recording_with_the_values_decode_gives() {
     let Ok(python) = std::env::var("HWFOC_PYMAVLINK") else {
@@ -381,11 +383,27 @@ fn pymavlink_reads_a_replayed_recording_with_the_values_decode_gives() {
             "--lead-in",
             "0.5",
         ])
-        .args(["--profile", "sine", "-o"])
+        .args(["--profile", "sine", "--no-config", "-o"])
         .arg(&recording)));
-    let decoded =
-        records(&String::from_utf8(ok(run(hwfoc().arg("decode").arg(&recording))).stdout).unwrap());
+    let config = dir.path("config.toml");
+    std::fs::write(&config, "[esc.2]\npole_pairs = 14\ncurrent_scale = 100\n").unwrap();
+    let decoded = records(
+        &String::from_utf8(
+            ok(run(hwfoc()
+                .arg("decode")
+                .arg("--config")
+                .arg(&config)
+                .arg(&recording)))
+            .stdout,
+        )
+        .unwrap(),
+    );
     let per_esc = by_esc(&decoded);
+    // ESC 2's records are under its own settings (half the rpm of the same erpm at 7 pairs).
+    let turning = per_esc[&2].iter().find(|r| r["erpm"].as_f64().unwrap() > 0.0);
+    let r = turning.expect("ESC 2 turns");
+    let (rpm, erpm) = (r["rpm"].as_f64().unwrap(), r["erpm"].as_f64().unwrap());
+    assert!((rpm - erpm / 14.0).abs() < 1e-3 * erpm, "{r}");
 
     let xml = Path::new(env!("CARGO_MANIFEST_DIR")).join("../hwfoc-bridge/tests/mavlink-xml");
     let script =
@@ -407,6 +425,8 @@ fn pymavlink_reads_a_replayed_recording_with_the_values_decode_gives() {
 
     let bridge = run(hwfoc()
         .arg("bridge")
+        .arg("--config")
+        .arg(&config)
         .arg(&recording)
         .args(["--mavlink", &format!("udp:127.0.0.1:{port}")]));
     assert!(

@@ -232,9 +232,11 @@ mod tests {
 
     #[test]
     fn port_streams_convert_each_port_under_its_settings() {
-        let other = Settings::new(64.0, 14, 1.0).unwrap();
-        let mut streams =
-            crate::stream::PortStreams::with_settings(19_200, vec![Settings::DEFAULT, other]);
+        let mut map = SettingsMap::from(Settings::DEFAULT);
+        map.set_port("/dev/ttyUSB1", patch(None, Some(14), None))
+            .unwrap();
+        let names = vec!["/dev/ttyUSB0".to_string(), "/dev/ttyUSB1".to_string()];
+        let mut streams = crate::stream::PortStreams::with_map(19_200, names, map);
         let mut rows = Rows::default();
         for port in 0..2 {
             let event = crate::serial::PortEvent::Data {

@@ -1062,7 +1062,7 @@ mod tests {
     /// Hubs and ESCs plugged in together never share an ESC number: a hub's channel 0 is its
     /// port's number, its other channels the next numbers after all ports', hub by hub in the
     /// order they are found. Live ports ([`PortStreams`](crate::stream::PortStreams)) and a
-    /// recording of them number them alike.
+    /// recording of them number them alike, and convert each under its own settings.
     #[test]
     fn hubs_and_escs_together_number_every_esc_once_live_and_recorded() {
         // Ports 0 and 2 are hubs with all 8 channels (packet = 1000 + 100 * port + channel:
@@ -1113,8 +1113,34 @@ mod tests {
             fn record(&mut self, r: &Record) {
                 self.0.push((r.esc, r.packet));
             }
+            fn frame(&mut self, esc: u8, t: Option<f64>, d: &Decoded, settings: &Settings) {
+                // ESC 12 (port 0's channel 2) has settings of its own; port 2's channels
+                // follow the port's.
+                let poles = match esc {
+                    12 => 7,
+                    2..=9 => 14,
+                    _ => Settings::DEFAULT.pole_pairs,
+                };
+                let scale = if esc == 12 { 100.0 } else { 64.0 };
+                assert_eq!(
+                    (settings.pole_pairs, settings.current_scale),
+                    (poles, scale)
+                );
+                if let hwfoc::Frame::Data(f) = &d.frame {
+                    self.record(&Record::new(t, esc, f, settings));
+                }
+            }
         }
-        let mut streams = crate::stream::PortStreams::new(3, 115_200, Settings::DEFAULT);
+        let names: Vec<String> = (0..3).map(|p| format!("/dev/ttyUSB{p}")).collect();
+        let mut map = crate::settings::SettingsMap::from(Settings::DEFAULT);
+        let patch = |scale, poles| crate::settings::SettingsPatch {
+            current_scale: scale,
+            pole_pairs: poles,
+            gear_ratio: None,
+        };
+        map.set_port(&names[2], patch(None, Some(14))).unwrap();
+        map.set_esc(12, patch(Some(100.0), None)).unwrap();
+        let mut streams = crate::stream::PortStreams::with_map(115_200, names.clone(), map.clone());
         let mut live = Escs(Vec::new());
         for (k, (port, bytes)) in arrivals.iter().enumerate() {
             let event = crate::serial::PortEvent::Data {
@@ -1134,16 +1160,15 @@ mod tests {
         // The recording `hwfoc record` makes of those ports: an interface per port, packets
         // in the order the bytes arrived.
         let mut w = pcapng::Writer::new(Vec::new()).unwrap();
-        for port in 0..3 {
-            w.add_interface(&format!("/dev/ttyUSB{port}"), 115_200)
-                .unwrap();
+        for name in &names {
+            w.add_interface(name, 115_200).unwrap();
         }
         for (k, (port, bytes)) in arrivals.iter().enumerate() {
             w.write(*port as u32, t + k as u64 * 100_000_000, bytes)
                 .unwrap();
         }
         let input = Input::from_memory("rec.pcapng", w.into_inner().unwrap()).unwrap();
-        let mut sources = Sources::new(vec![input], Settings::DEFAULT);
+        let mut sources = Sources::new(vec![input], map);
         let mut recorded = Escs(Vec::new());
         sources.run(&mut recorded).unwrap();
         assert_eq!(by_esc(recorded.0), expected);

@@ -14,6 +14,7 @@ use crate::handler::Handler;
 use crate::input::Batch;
 use crate::pcapng;
 use crate::serial::PortEvent;
+use crate::settings::SettingsMap;
 
 /// Appends to `times` the receive times, in Unix seconds, of `n` bytes the first of which
 /// arrived at `t_ns` (Unix ns) and each next one `per_byte_ns` later (a byte time at the line's
@@ -410,31 +411,44 @@ pub struct PortStreams {
     streams: Vec<Stream>,
     per_byte_ns: f64,
     times: Vec<f64>,
-    /// The settings of each port's records.
-    settings: Vec<Settings>,
+    /// Each port's name, as the settings know it.
+    names: Vec<String>,
+    /// The settings by port name and ESC number.
+    map: SettingsMap,
+    /// The settings of each ESC number given so far (the ports', then hubs' channels): its
+    /// length is the next number to give.
+    esc_settings: Vec<Settings>,
     /// The ESC number of each channel of each port found to be a hub.
     hubs: Vec<Option<[usize; datalink::CHANNELS]>>,
-    /// The number the next hub's channel 1 gets.
-    next_esc: usize,
 }
 
 impl PortStreams {
     /// `ports` streams, their bytes arriving at `baud` (8N1), their data frames made records
     /// under `settings`.
     pub fn new(ports: usize, baud: u32, settings: Settings) -> PortStreams {
-        PortStreams::with_settings(baud, vec![settings; ports])
+        PortStreams::with_map(
+            baud,
+            vec![String::new(); ports],
+            SettingsMap::from(settings),
+        )
     }
 
-    /// A stream per entry of `settings`, their bytes arriving at `baud` (8N1), the data frames
-    /// of port `i` made records under `settings[i]` (see [`crate::settings::SettingsMap`]).
-    pub fn with_settings(baud: u32, settings: Vec<Settings>) -> PortStreams {
+    /// A stream per port of `names`, their bytes arriving at `baud` (8N1), the data frames of
+    /// each ESC made records under its settings in `map` (by its number and its port's name,
+    /// a hub's channels included).
+    pub fn with_map(baud: u32, names: Vec<String>, map: SettingsMap) -> PortStreams {
         PortStreams {
-            streams: settings.iter().map(|_| Stream::new()).collect(),
+            streams: names.iter().map(|_| Stream::new()).collect(),
             per_byte_ns: hwfoc::wire::byte_ns(baud),
             times: Vec::new(),
-            hubs: vec![None; settings.len()],
-            next_esc: settings.len(),
-            settings,
+            esc_settings: names
+                .iter()
+                .enumerate()
+                .map(|(esc, name)| map.get(esc, name))
+                .collect(),
+            hubs: vec![None; names.len()],
+            names,
+            map,
         }
     }
 
@@ -451,14 +465,14 @@ impl PortStreams {
             streams,
             per_byte_ns,
             times,
-            settings,
+            names,
+            map,
+            esc_settings,
             hubs,
-            next_esc,
         } = self;
         let stream = streams.get_mut(*port)?;
         times.clear();
         byte_times(*t_ns, *per_byte_ns, bytes.len(), times);
-        let settings = &settings[*port];
         let hub = &mut hubs[*port];
         stream.feed(
             Batch {
@@ -472,14 +486,14 @@ impl PortStreams {
                     Some(c) => hub.get_or_insert_with(|| {
                         let mut escs = [*port; datalink::CHANNELS];
                         for e in &mut escs[1..] {
-                            *e = *next_esc;
-                            *next_esc += 1;
+                            *e = esc_settings.len();
+                            esc_settings.push(map.get(*e, &names[*port]));
                         }
                         escs
                     })[usize::from(c)],
                 };
-                if let Ok(esc) = u8::try_from(esc) {
-                    handler.frame(esc, t, d, settings);
+                if let Ok(id) = u8::try_from(esc) {
+                    handler.frame(id, t, d, &esc_settings[esc]);
                 }
             },
         );
@@ -494,6 +508,11 @@ impl PortStreams {
     /// The stream of `port`.
     pub fn stream(&self, port: usize) -> Option<&Stream> {
         self.streams.get(port)
+    }
+
+    /// The settings the records of ESC `esc` are made under, once it has a number.
+    pub fn settings_of(&self, esc: u8) -> Option<&Settings> {
+        self.esc_settings.get(usize::from(esc))
     }
 
     /// The DataLink channel that ESC `esc` is on, if `port` is a hub that has handed on

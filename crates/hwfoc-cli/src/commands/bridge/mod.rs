@@ -21,6 +21,7 @@ use hwfoc_bridge::mavlink::{self, MavlinkOptions, MavlinkOutput, MavlinkTarget};
 use hwfoc_bridge::replay::{POLL, Replay, ReplayError};
 use hwfoc_io::Sources;
 use hwfoc_io::serial::{self, PortEvent};
+use hwfoc_io::settings::SettingsMap;
 use hwfoc_io::stream::PortStreams;
 
 use crate::args::{SettingsArgs, seconds};
@@ -121,7 +122,8 @@ pub fn run(args: &BridgeArgs) -> Result<(), CliError> {
                 .into(),
         });
     }
-    let settings = args.settings.settings()?;
+    // Every ESC's settings, from the configuration file (per port, per ESC) and the flags.
+    let (_, settings) = args.settings.settings_map()?;
     let outputs = open_outputs(args)?;
     let mut fanout = Fanout::new(outputs);
     let mut errors = Errors::new(args.quiet);
@@ -142,7 +144,13 @@ pub fn run(args: &BridgeArgs) -> Result<(), CliError> {
         let (tx, rx) = mpsc::channel();
         let (names, feed) = match args.sim {
             Some(n) => {
-                let feed = Feed::simulated(&args.model, usize::from(n), args.baud, &settings, tx)?;
+                let feed = Feed::simulated(
+                    &args.model,
+                    usize::from(n),
+                    args.baud,
+                    settings.default_settings(),
+                    tx,
+                )?;
                 ((0..n).map(|i| format!("sim:esc{i}")).collect(), feed)
             }
             None => {
@@ -151,7 +159,7 @@ pub fn run(args: &BridgeArgs) -> Result<(), CliError> {
                 (names, feed)
             }
         };
-        let mut streams = PortStreams::new(names.len(), args.baud, settings);
+        let mut streams = PortStreams::with_map(args.baud, names.clone(), settings);
         let per_byte_ns = hwfoc::wire::byte_ns(args.baud);
         let result = live(
             &rx,
@@ -278,7 +286,7 @@ fn take(
 /// Recordings and other inputs, replayed in real time.
 fn replay(
     files: &[&String],
-    settings: hwfoc::Settings,
+    settings: SettingsMap,
     deadline: Option<Instant>,
     fanout: &mut Fanout,
     errors: &mut Errors,

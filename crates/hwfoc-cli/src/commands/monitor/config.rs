@@ -30,7 +30,6 @@
 
 use std::path::PathBuf;
 
-use hwfoc::Settings;
 use hwfoc_io::serial;
 use hwfoc_io::settings::SettingsMap;
 
@@ -212,11 +211,6 @@ impl Config {
         })
     }
 
-    /// The settings of ESC `esc`, read from `port`.
-    pub fn settings_of(&self, esc: usize, port: &str) -> Settings {
-        self.settings.get(esc, port)
-    }
-
     /// The label the file gives ESC `esc` read from `port`, if any.
     pub fn label(&self, esc: usize, port: &str) -> Option<&str> {
         self.general.label(esc, port)
@@ -233,6 +227,7 @@ fn invalid(origin: String, message: impl Into<String>) -> CliError {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use hwfoc::Settings;
 
     fn parse(text: &str) -> Result<Config, CliError> {
         let dir = tempfile::tempdir().unwrap();
@@ -276,7 +271,7 @@ mod tests {
                     label = \"front left\"\n[[esc]]\nport = \"/dev/ttyUSB1\"\n";
         let config = parse(text).unwrap();
         assert_eq!(config.baud, 115_200);
-        assert_eq!(config.settings_of(0, "/dev/ttyUSB0").pole_pairs, 14);
+        assert_eq!(config.settings.get(0, "/dev/ttyUSB0").pole_pairs, 14);
         assert_eq!(config.limits.mos.warning, 80.0);
         assert_eq!(config.limits.cells, Some(12));
         assert_eq!(config.ports, ["/dev/ttyUSB0", "/dev/ttyUSB1"]);

@@ -14,6 +14,7 @@ use hwfoc_io::energy::Energy;
 use hwfoc_io::handler::Handler;
 use hwfoc_io::record::Record;
 use hwfoc_io::serial::PortEvent;
+use hwfoc_io::settings::SettingsMap;
 use hwfoc_io::stream::PortStreams;
 
 /// Seconds of history kept for the charts.
@@ -340,20 +341,32 @@ pub struct Fleet {
 }
 
 impl Fleet {
-    /// ESCs named `names` (labels and conversion settings beside them), watched from Unix time
-    /// `now`, their bytes arriving at `baud`.
+    /// ESCs read from the ports `names` (labels beside them), their frames converted under
+    /// `settings` (by port name and ESC number, a hub's channels included), watched from Unix
+    /// time `now`, their bytes arriving at `baud`.
     pub fn new(
-        names: Vec<(String, Option<String>, Settings)>,
+        names: Vec<(String, Option<String>)>,
+        settings: SettingsMap,
         limits: Limits,
         baud: u32,
         now: f64,
     ) -> Fleet {
+        let streams = PortStreams::with_map(
+            baud,
+            names.iter().map(|(name, _)| name.clone()).collect(),
+            settings,
+        );
         let escs = names
             .into_iter()
-            .map(|(name, label, settings)| EscView {
+            .enumerate()
+            .map(|(i, (name, label))| EscView {
                 name,
                 label,
-                settings,
+                settings: u8::try_from(i)
+                    .ok()
+                    .and_then(|i| streams.settings_of(i))
+                    .copied()
+                    .unwrap_or(Settings::DEFAULT),
                 link: Link::Up,
                 last: None,
                 last_frame_t: None,
@@ -370,7 +383,7 @@ impl Fleet {
             })
             .collect::<Vec<_>>();
         Fleet {
-            streams: PortStreams::with_settings(baud, escs.iter().map(|e| e.settings).collect()),
+            streams,
             ports: (0..escs.len()).collect(),
             channels: HashMap::new(),
             escs,
@@ -407,7 +420,11 @@ impl Fleet {
                         Item::Record(r) => {
                             let i = if hub {
                                 let channel = self.streams.channel_of(port, r.esc).unwrap_or(0);
-                                self.channel_view(port, usize::from(channel))
+                                let i = self.channel_view(port, usize::from(channel));
+                                if let Some(settings) = self.streams.settings_of(r.esc) {
+                                    self.escs[i].settings = *settings;
+                                }
+                                i
                             } else {
                                 port
                             };
@@ -685,10 +702,8 @@ mod tests {
             ..Overrides::default()
         })
         .unwrap();
-        let names = (0..n)
-            .map(|i| (format!("esc{i}"), None, Settings::DEFAULT))
-            .collect();
-        Fleet::new(names, config.limits, 19_200, 1000.0)
+        let names = (0..n).map(|i| (format!("esc{i}"), None)).collect();
+        Fleet::new(names, config.settings, config.limits, 19_200, 1000.0)
     }
 
     fn frame(packet: u16, status: Status, mos_code: u8, volt_raw: u16) -> Vec<u8> {

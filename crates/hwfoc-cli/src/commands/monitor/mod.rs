@@ -231,7 +231,7 @@ impl Session {
                     .get(i)
                     .cloned()
                     .or_else(|| config.label(i, name).map(str::to_string));
-                (name.clone(), label, config.settings_of(i, name))
+                (name.clone(), label)
             })
             .collect();
         // The ports' own clock, so that ages and recordings agree with their timestamps.
@@ -240,7 +240,13 @@ impl Session {
             Feed::Simulated { .. } => hwfoc_io::clock::Clock::new(),
         };
         let now = clock.now_ns() as f64 / 1e9;
-        let fleet = Fleet::new(labelled, config.limits.clone(), config.baud, now);
+        let fleet = Fleet::new(
+            labelled,
+            config.settings.clone(),
+            config.limits.clone(),
+            config.baud,
+            now,
+        );
         let mut session = Session {
             fleet,
             recorder: None,
