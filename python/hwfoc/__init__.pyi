@@ -33,8 +33,10 @@ class SettingsError(HwfocError):
     """A conversion setting out of range (current scale, pole pairs, gear ratio)."""
 
 class HwfocWarning(UserWarning):
-    """What the hwfoc command prints as ``hwfoc: warning: ...``: an input whose bytes hold no
-    frame (:func:`read`)."""
+    """What the hwfoc command prints as ``hwfoc: warning: ...`` (or ``note: ...``): an input whose
+    bytes hold no frame (:func:`read`), a damaged or foreign part of a recording skipped, a note
+    written in a recording (:func:`read`, :func:`scan`, :func:`summary`). The message is the
+    command's text after that prefix."""
 
 class PortWarning(HwfocWarning):
     """A serial port was lost (unplugged: it is retried) or is back."""

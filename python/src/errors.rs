@@ -66,7 +66,9 @@ create_exception!(
     hwfoc,
     HwfocWarning,
     pyo3::exceptions::PyUserWarning,
-    "What the hwfoc command prints as `hwfoc: warning: ...`: an input whose bytes hold no frame."
+    "What the hwfoc command prints as `hwfoc: warning: ...` (or `note: `): an input whose bytes \
+     hold no frame, a damaged or foreign part of a recording skipped, a note written in a \
+     recording."
 );
 create_exception!(
     hwfoc,

@@ -16,6 +16,7 @@ use std::sync::{Arc, Mutex};
 use arrow_array::RecordBatch;
 use arrow_pyarrow::{IntoPyArrow, Table};
 use hwfoc::Settings;
+use hwfoc_io::notice::Notice;
 use hwfoc_io::select::{Selection, Window};
 use hwfoc_io::sources::Sources;
 use hwfoc_io::summary::{NO_FRAMES, Summary, esc_label};
@@ -111,8 +112,44 @@ fn time_arg(t: Option<&Bound<'_, PyAny>>) -> PyResult<Option<f64>> {
 }
 
 /// Opens every input, in order (all before any is read, as the command does).
-pub(crate) fn open_all(specs: Vec<Spec>) -> Result<Vec<Input>, InputError> {
-    specs.into_iter().map(Spec::open).collect()
+pub(crate) fn open_all(specs: Vec<Spec>, notes: &Notes) -> Result<Vec<Input>, InputError> {
+    specs
+        .into_iter()
+        .map(|spec| {
+            let mut input = spec.open()?;
+            let notes = Arc::clone(notes);
+            input.set_notices(move |n| {
+                if let Ok(mut notes) = notes.lock() {
+                    notes.push(n);
+                }
+            });
+            Ok(input)
+        })
+        .collect()
+}
+
+/// The notices of the inputs being read (damage and notes in a recording, a port lost), kept
+/// for the thread holding the interpreter to issue as warnings: the command prints them on
+/// standard error, which a Python caller cannot catch or filter.
+pub(crate) type Notes = Arc<Mutex<Vec<Notice>>>;
+
+/// Issues the notices gathered so far as warnings (`PortWarning` for ports, `HwfocWarning`
+/// for the rest), with the command's text after `hwfoc: warning: ` (or `note: `).
+pub(crate) fn warn_notices(py: Python<'_>, notes: &Notes) -> PyResult<()> {
+    let taken = match notes.lock() {
+        Ok(mut notes) => std::mem::take(&mut *notes),
+        Err(_) => return Ok(()),
+    };
+    for notice in taken {
+        let text = notice.to_string();
+        match notice {
+            Notice::PortLost { .. } | Notice::PortBack { .. } => {
+                errors::warn(py, &py.get_type::<errors::PortWarning>(), &text)?
+            }
+            _ => errors::warn(py, &py.get_type::<errors::HwfocWarning>(), &text)?,
+        }
+    }
+    Ok(())
 }
 
 /// What `read` made: the record batches (with the schema without metadata), the ESCs found as
@@ -135,8 +172,8 @@ pub(crate) fn no_frames(sources: &Sources) -> Vec<String> {
 }
 
 /// Decodes `specs` whole. Decoding runs on this thread, converting on worker threads.
-fn decode_all(specs: Vec<Spec>, options: &Options) -> Result<Decoded, Stop> {
-    let mut sources = Sources::new(open_all(specs)?, options.settings);
+fn decode_all(specs: Vec<Spec>, options: &Options, notes: &Notes) -> Result<Decoded, Stop> {
+    let mut sources = Sources::new(open_all(specs, notes)?, options.settings);
     if options.selection.window.is_limited() {
         sources.require_timing()?;
     }
@@ -205,7 +242,8 @@ pub(crate) fn stop_error(stop: Stop) -> PyErr {
 /// content), bytes, a binary file object, or a list of these read one after another. `esc`,
 /// `start`, `end` select as the command's `--esc`, `--from`, `--to`; the settings convert
 /// currents and RPM. The schema metadata is that of `hwfoc decode --format parquet`. Raises
-/// InputError, SelectionError, SettingsError; warns HwfocWarning for inputs without frames.
+/// InputError, SelectionError, SettingsError; warns HwfocWarning for inputs without frames and
+/// for damage or notes in a recording.
 #[pyfunction]
 #[pyo3(signature = (source, *, esc=None, start=None, end=None, current_scale=64.0, pole_pairs=7, gear_ratio=1.0))]
 #[allow(clippy::too_many_arguments)]
@@ -222,9 +260,11 @@ fn read<'py>(
     let options = Options::new(esc, start, end, current_scale, pole_pairs, gear_ratio)?;
     let specs = source::specs(source)?;
     let provenance = options.provenance(&specs);
-    let decoded = py
-        .detach(|| decode_all(specs, &options))
-        .map_err(stop_error)?;
+    let notes = Notes::default();
+    let decoded = py.detach(|| decode_all(specs, &options, &notes));
+    // What the inputs told comes first, as the command prints it while reading.
+    warn_notices(py, &notes)?;
+    let decoded = decoded.map_err(stop_error)?;
     for warning in &decoded.warnings {
         errors::warn(py, &py.get_type::<errors::HwfocWarning>(), warning)?;
     }
@@ -241,8 +281,8 @@ fn read<'py>(
 }
 
 /// The summary of `hwfoc summary --json`, as one JSON text.
-fn summary_json(specs: Vec<Spec>, settings: Settings) -> Result<String, InputError> {
-    let mut sources = Sources::new(open_all(specs)?, settings);
+fn summary_json(specs: Vec<Spec>, settings: Settings, notes: &Notes) -> Result<String, InputError> {
+    let mut sources = Sources::new(open_all(specs, notes)?, settings);
     let mut summary = Summary::new();
     sources.run(&mut summary)?;
     Ok(summary.report(&sources).json().to_string())
@@ -263,9 +303,10 @@ fn summary<'py>(
     let settings =
         Settings::new(current_scale, pole_pairs, gear_ratio).map_err(errors::settings)?;
     let specs = source::specs(source)?;
-    let json = py
-        .detach(|| summary_json(specs, settings))
-        .map_err(errors::input)?;
+    let notes = Notes::default();
+    let json = py.detach(|| summary_json(specs, settings, &notes));
+    warn_notices(py, &notes)?;
+    let json = json.map_err(errors::input)?;
     py.import("json")?.call_method1("loads", (json,))
 }
 

@@ -15,7 +15,7 @@ use pyo3::prelude::*;
 
 use crate::records::{Collect, Stop};
 use crate::source::Spec;
-use crate::{Options, errors, open_all, stop_error};
+use crate::{Notes, Options, errors, open_all, stop_error, warn_notices};
 
 /// Record batches made but not yet taken, at most.
 const QUEUE: usize = 2;
@@ -37,6 +37,8 @@ enum Msg {
 #[pyclass(module = "hwfoc")]
 pub struct Scan {
     rx: Mutex<Option<Receiver<Msg>>>,
+    /// The inputs' notices, issued as warnings before the batch or error that follows them.
+    notes: Notes,
 }
 
 /// Reads and decodes `specs` on this thread, sending batches of at most `rows` records.
@@ -46,8 +48,9 @@ fn produce(
     schema: arrow_schema::SchemaRef,
     rows: usize,
     tx: std::sync::mpsc::SyncSender<Msg>,
+    notes: Notes,
 ) {
-    let inputs = match open_all(specs) {
+    let inputs = match open_all(specs, &notes) {
         Ok(inputs) => inputs,
         Err(e) => {
             let _ = tx.send(Msg::Failed(Stop::Input(e)));
@@ -114,17 +117,22 @@ pub fn scan(
     // The batches' metadata: the ESCs are known only at the end, so `escs` is not in it.
     let schema = options.provenance(&specs).schema(None);
     let (tx, rx) = sync_channel(QUEUE);
+    let notes = Notes::default();
+    let thread_notes = Notes::clone(&notes);
     std::thread::Builder::new()
         .name("hwfoc scan".to_string())
-        .spawn(move || produce(specs, options, schema, batch_rows, tx))
+        .spawn(move || produce(specs, options, schema, batch_rows, tx, thread_notes))
         .map_err(|e| {
             errors::HwfocError::new_err(format!("cannot start the decoding thread: {e}"))
         })?;
     let scan = Scan {
         rx: Mutex::new(Some(rx)),
+        notes,
     };
     // Errors opening the inputs are raised here, as `read` raises them.
-    match scan.wait(py)? {
+    let msg = scan.wait(py);
+    warn_notices(py, &scan.notes)?;
+    match msg? {
         Some(Msg::Opened) | None => Ok(scan),
         Some(Msg::Failed(stop)) => Err(stop_error(stop)),
         Some(Msg::Batch(_)) => Err(errors::HwfocError::new_err(
@@ -170,7 +178,9 @@ impl Scan {
 
     fn __next__(&self, py: Python<'_>) -> PyResult<Option<Py<PyAny>>> {
         loop {
-            match self.wait(py) {
+            let msg = self.wait(py);
+            warn_notices(py, &self.notes)?;
+            match msg {
                 Ok(None) => return Ok(None),
                 Ok(Some(Msg::Batch(batch))) => return Ok(Some(batch.to_pyarrow(py)?.unbind())),
                 Ok(Some(Msg::Opened)) => continue,

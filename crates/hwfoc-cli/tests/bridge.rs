@@ -400,7 +400,9 @@ fn pymavlink_reads_a_replayed_recording_with_the_values_decode_gives() {
     );
     let per_esc = by_esc(&decoded);
     // ESC 2's records are under its own settings (half the rpm of the same erpm at 7 pairs).
-    let turning = per_esc[&2].iter().find(|r| r["erpm"].as_f64().unwrap() > 0.0);
+    let turning = per_esc[&2]
+        .iter()
+        .find(|r| r["erpm"].as_f64().unwrap() > 0.0);
     let r = turning.expect("ESC 2 turns");
     let (rpm, erpm) = (r["rpm"].as_f64().unwrap(), r["erpm"].as_f64().unwrap());
     assert!((rpm - erpm / 14.0).abs() < 1e-3 * erpm, "{r}");

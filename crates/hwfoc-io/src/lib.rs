@@ -29,6 +29,7 @@ pub mod energy;
 pub mod episode;
 pub mod handler;
 pub mod input;
+pub mod notice;
 pub mod pcapng;
 pub mod record;
 pub mod select;

@@ -22,6 +22,7 @@ use std::fmt;
 use std::fs::File;
 use std::io::{self, BufReader, Cursor, Read};
 
+use crate::notice::{self, Notice, NoticeSink};
 use crate::pcapng;
 use crate::serial::PortSet;
 
@@ -102,6 +103,8 @@ pub struct Input {
     /// An error met after some bytes of a batch: reported on the next call, so that the bytes
     /// before it are decoded first.
     deferred: Option<InputError>,
+    /// Where notices go ([`crate::notice`]).
+    notices: NoticeSink,
 }
 
 impl Input {
@@ -226,7 +229,14 @@ impl Input {
             seen_any: false,
             done: false,
             deferred: None,
+            notices: notice::to_stderr(),
         }
+    }
+
+    /// Hands the input's notices (a port lost or back, a recording's notes and skipped parts)
+    /// to `sink` as they are met, instead of standard error.
+    pub fn set_notices(&mut self, sink: impl FnMut(Notice) + Send + 'static) {
+        self.notices = Box::new(sink);
     }
 
     /// The input's name as the user gave it.
@@ -309,7 +319,12 @@ impl Input {
             }
             Source::Recording(rec) => {
                 self.bytes.clear();
-                match rec.read(&self.name, &mut self.bytes, &mut self.times) {
+                match rec.read(
+                    &self.name,
+                    &mut self.bytes,
+                    &mut self.times,
+                    &mut self.notices,
+                ) {
                     Ok(stream) => self.stream = stream,
                     Err(e) if self.bytes.is_empty() => {
                         self.done = true;
@@ -320,7 +335,7 @@ impl Input {
             }
             Source::Ports(ports) => {
                 self.bytes.clear();
-                self.stream = ports.read(&mut self.bytes, &mut self.times);
+                self.stream = ports.read(&mut self.bytes, &mut self.times, &mut self.notices);
                 if self.bytes.is_empty() {
                     // Interrupted: the end of a live input, not an error even with no bytes.
                     self.done = true;
@@ -493,6 +508,46 @@ mod tests {
         assert!(close(got[0].2[2], t + 0.010));
         assert!(close(got[0].2[3], t + 0.030));
         assert!(close(got[1].2[1], t + 0.020 + 1.0 / 960.0));
+    }
+
+    /// A recording's notes and damage go to the input's notice sink (a front end's own
+    /// channel), not to standard error, and do not stop reading.
+    #[test]
+    fn notices_go_to_the_sink_set() {
+        let mut w = pcapng::Writer::new(Vec::new()).unwrap();
+        w.add_interface("/dev/ttyUSB0", 19200).unwrap();
+        let t0 = 1_700_000_000_000_000_000u64;
+        w.write(0, t0, &[1, 2]).unwrap();
+        w.comment(0, t0 + 1, "gap: 3 bytes lost").unwrap();
+        w.write(0, t0 + 2, &[3]).unwrap();
+        let mut file = w.into_inner().unwrap();
+        let end = file.len() as u64;
+        file.extend_from_slice(&[0xEE; 40]);
+        let mut input = Input::from_memory("cut.pcapng", file).unwrap();
+        let seen = std::sync::Arc::new(std::sync::Mutex::new(Vec::new()));
+        let sink = std::sync::Arc::clone(&seen);
+        input.set_notices(move |n| sink.lock().unwrap().push(n));
+        assert_eq!(read_all(&mut input).0, [1, 2, 3]);
+        let seen = seen.lock().unwrap();
+        assert_eq!(seen.len(), 2, "{seen:?}");
+        assert_eq!(
+            seen[0],
+            Notice::Comment {
+                input: "cut.pcapng".into(),
+                interface: "/dev/ttyUSB0".into(),
+                text: "gap: 3 bytes lost".into(),
+            }
+        );
+        assert!(
+            matches!(&seen[1], Notice::Damage { input, damage }
+                if input == "cut.pcapng" && damage.offset == end),
+            "{seen:?}"
+        );
+        assert!(
+            seen[1]
+                .line()
+                .starts_with("hwfoc: warning: cut.pcapng: stopped at byte")
+        );
     }
 
     #[test]

@@ -4,6 +4,7 @@ use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Duration;
 
+use crate::notice::{Notice, NoticeSink};
 use crate::serial::{PortEvent, PortSet};
 use crate::stream::byte_times;
 
@@ -30,8 +31,13 @@ impl Ports {
 
     /// Waits for the next chunk of bytes and puts it, with its receive times, in `bytes` and
     /// `times`; returns its port. Returns with nothing once interrupted. Ports that are lost
-    /// or come back are reported on standard error.
-    pub(super) fn read(&mut self, bytes: &mut Vec<u8>, times: &mut Vec<f64>) -> usize {
+    /// or come back are told to `notices`.
+    pub(super) fn read(
+        &mut self,
+        bytes: &mut Vec<u8>,
+        times: &mut Vec<f64>,
+        notices: &mut NoticeSink,
+    ) -> usize {
         let per_byte = hwfoc::wire::byte_ns(self.set.baud());
         while !self.interrupted.load(Ordering::Relaxed) {
             match self.set.next_event(PORT_POLL) {
@@ -44,13 +50,13 @@ impl Ports {
                     bytes.extend_from_slice(&data);
                     return port;
                 }
-                Some(PortEvent::Lost { port, reason, .. }) => eprintln!(
-                    "hwfoc: warning: {} lost ({reason}); waiting for it to come back",
-                    self.set.names()[port]
-                ),
-                Some(PortEvent::Back { port, .. }) => {
-                    eprintln!("hwfoc: {} is back", self.set.names()[port]);
-                }
+                Some(PortEvent::Lost { port, reason, .. }) => notices(Notice::PortLost {
+                    port: self.set.names()[port].clone(),
+                    reason,
+                }),
+                Some(PortEvent::Back { port, .. }) => notices(Notice::PortBack {
+                    port: self.set.names()[port].clone(),
+                }),
                 None => {}
             }
         }

@@ -3,6 +3,7 @@
 use std::io::Read;
 
 use super::InputError;
+use crate::notice::{Notice, NoticeSink};
 use crate::pcapng;
 use crate::stream::byte_times;
 
@@ -58,13 +59,13 @@ impl RecordingReader {
     /// Hands out the next batch of the current window into `bytes` and `times` (which are
     /// empty) and returns its interface, reading the next window when this one is done;
     /// leaves `bytes` empty at the end of the file. A read error is returned after the
-    /// bytes before it. Damage and notes in the file are reported on standard error as they
-    /// are met.
+    /// bytes before it. Damage and notes in the file are told to `notices` as they are met.
     pub(super) fn read(
         &mut self,
         name: &str,
         bytes: &mut Vec<u8>,
         times: &mut Vec<f64>,
+        notices: &mut NoticeSink,
     ) -> Result<usize, InputError> {
         loop {
             if self.draining {
@@ -85,7 +86,7 @@ impl RecordingReader {
             if self.ended {
                 return self.error.take().map_or(Ok(0), Err);
             }
-            if let Err(e) = self.read_window(name) {
+            if let Err(e) = self.read_window(name, notices) {
                 self.error = Some(e);
                 self.ended = true;
             }
@@ -95,7 +96,7 @@ impl RecordingReader {
 
     /// Reads packets into the per-interface buffers until the window is over, a buffer is
     /// full, or the file ends.
-    fn read_window(&mut self, name: &str) -> Result<(), InputError> {
+    fn read_window(&mut self, name: &str, notices: &mut NoticeSink) -> Result<(), InputError> {
         self.window_start = None;
         loop {
             let packet = self
@@ -109,28 +110,32 @@ impl RecordingReader {
                 Ok(Some(p)) => p,
                 Ok(None) => {
                     self.ended = true;
-                    self.report_damage(name);
+                    self.report_damage(name, notices);
                     return Ok(());
                 }
                 Err(e) => {
-                    self.report_damage(name);
+                    self.report_damage(name, notices);
                     return Err(e);
                 }
             };
             let (iface, t_ns, interface) = (packet.iface, packet.t_ns, packet.interface);
             if let Some(text) = packet.comment {
-                eprintln!("hwfoc: note: {name}: {}: {text}", interface.name);
+                notices(Notice::Comment {
+                    input: name.to_string(),
+                    interface: interface.name.clone(),
+                    text: text.to_string(),
+                });
             }
             let mut full = false;
             if packet.data.is_empty() {
                 // A note only.
             } else if !interface.is_user_link_type() {
                 if self.skipped.insert(iface) {
-                    eprintln!(
-                        "hwfoc: warning: {name}: interface {} has link type {}, not serial \
-                         bytes: its packets are skipped",
-                        interface.name, interface.link_type
-                    );
+                    notices(Notice::ForeignInterface {
+                        input: name.to_string(),
+                        interface: interface.name.clone(),
+                        link_type: interface.link_type,
+                    });
                 }
             } else {
                 let i = iface as usize;
@@ -144,16 +149,19 @@ impl RecordingReader {
                 full = bytes.len() >= RECORDING_BATCH
                     || t_ns.saturating_sub(start) >= RECORDING_WINDOW_NS;
             }
-            self.report_damage(name);
+            self.report_damage(name, notices);
             if full {
                 return Ok(());
             }
         }
     }
 
-    fn report_damage(&mut self, name: &str) {
+    fn report_damage(&mut self, name: &str, notices: &mut NoticeSink) {
         for damage in self.reader.take_damage() {
-            eprintln!("hwfoc: warning: {name}: {damage}");
+            notices(Notice::Damage {
+                input: name.to_string(),
+                damage,
+            });
         }
     }
 }

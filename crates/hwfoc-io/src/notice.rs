@@ -1,0 +1,137 @@
+//! What an input has to tell besides its bytes: a serial port lost or back, a note written in a
+//! recording, a part of a recording that is damaged or not serial bytes and was skipped.
+//!
+//! None of these stops reading, so none is an [`InputError`](crate::InputError). An
+//! [`Input`](crate::Input) hands each to its notice sink as it is met: by default
+//! [`to_stderr`], which writes the line the `hwfoc` command prints; a front end that has a
+//! channel of its own for them (Python's `warnings`, a dashboard's log) sets another with
+//! [`Input::set_notices`](crate::Input::set_notices).
+
+use std::fmt;
+
+use crate::pcapng::Damage;
+
+/// Something an input met that the reader should know.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Notice {
+    /// A serial port disappeared (unplugged); it is reopened when it comes back.
+    PortLost {
+        /// The port as named.
+        port: String,
+        /// Why reading failed.
+        reason: String,
+    },
+    /// A lost serial port is open again.
+    PortBack {
+        /// The port as named.
+        port: String,
+    },
+    /// A comment written in a recording (`hwfoc record` notes gaps and restarts there).
+    Comment {
+        /// The input as named.
+        input: String,
+        /// The interface (port) the comment is attached to.
+        interface: String,
+        /// The comment.
+        text: String,
+    },
+    /// An interface of a recording that does not carry serial bytes: its packets are skipped.
+    ForeignInterface {
+        /// The input as named.
+        input: String,
+        /// The interface's name.
+        interface: String,
+        /// Its pcapng link type.
+        link_type: u16,
+    },
+    /// A damaged place in a recording, skipped.
+    Damage {
+        /// The input as named.
+        input: String,
+        /// Where and what.
+        damage: Damage,
+    },
+}
+
+impl Notice {
+    /// Whether it warns of something lost or skipped (rather than only informing).
+    pub fn is_warning(&self) -> bool {
+        matches!(
+            self,
+            Notice::PortLost { .. } | Notice::ForeignInterface { .. } | Notice::Damage { .. }
+        )
+    }
+
+    /// The line the `hwfoc` command prints for it: `hwfoc: warning: ...`, `hwfoc: note: ...`
+    /// or `hwfoc: ...`.
+    pub fn line(&self) -> String {
+        let level = match self {
+            _ if self.is_warning() => "warning: ",
+            Notice::Comment { .. } => "note: ",
+            _ => "",
+        };
+        format!("hwfoc: {level}{self}")
+    }
+}
+
+impl fmt::Display for Notice {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Notice::PortLost { port, reason } => {
+                write!(f, "{port} lost ({reason}); waiting for it to come back")
+            }
+            Notice::PortBack { port } => write!(f, "{port} is back"),
+            Notice::Comment {
+                input,
+                interface,
+                text,
+            } => write!(f, "{input}: {interface}: {text}"),
+            Notice::ForeignInterface {
+                input,
+                interface,
+                link_type,
+            } => write!(
+                f,
+                "{input}: interface {interface} has link type {link_type}, not serial bytes: its \
+                 packets are skipped"
+            ),
+            Notice::Damage { input, damage } => write!(f, "{input}: {damage}"),
+        }
+    }
+}
+
+/// Where an input's notices go.
+pub type NoticeSink = Box<dyn FnMut(Notice) + Send>;
+
+/// The default sink: each notice's [`Notice::line`] on standard error.
+pub fn to_stderr() -> NoticeSink {
+    Box::new(|notice| eprintln!("{}", notice.line()))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn lines_are_those_the_command_printed() {
+        let lost = Notice::PortLost {
+            port: "/dev/ttyUSB0".into(),
+            reason: "No such device".into(),
+        };
+        assert_eq!(
+            lost.line(),
+            "hwfoc: warning: /dev/ttyUSB0 lost (No such device); waiting for it to come back"
+        );
+        let back = Notice::PortBack {
+            port: "/dev/ttyUSB0".into(),
+        };
+        assert_eq!(back.line(), "hwfoc: /dev/ttyUSB0 is back");
+        let note = Notice::Comment {
+            input: "a.pcapng".into(),
+            interface: "/dev/ttyUSB1".into(),
+            text: "gap".into(),
+        };
+        assert_eq!(note.line(), "hwfoc: note: a.pcapng: /dev/ttyUSB1: gap");
+        assert!(lost.is_warning() && !back.is_warning() && !note.is_warning());
+    }
+}
