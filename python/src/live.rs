@@ -13,6 +13,7 @@ use hwfoc::{Decoded, Frame, Settings};
 use hwfoc_io::InputError;
 use hwfoc_io::handler::Handler;
 use hwfoc_io::input::Batch;
+use hwfoc_io::notice::Notice;
 use hwfoc_io::serial::{DEFAULT_BAUD, PortEvent, PortSet};
 use hwfoc_io::stream::EscLink;
 use hwfoc_io::stream::{PortStreams, Stream, byte_times};
@@ -311,17 +312,22 @@ impl Ports {
                 pending.push_back(row?.unbind());
             }
         }
-        let note = match &event {
-            Some(PortEvent::Lost { port, reason, .. }) => Some(format!(
-                "{} lost ({reason}); retrying every {} ms",
-                self.names[*port],
-                hwfoc_io::serial::RETRY_EVERY.as_millis()
-            )),
-            Some(PortEvent::Back { port, .. }) => Some(format!("{} is back", self.names[*port])),
+        let notice = match &event {
+            Some(PortEvent::Lost { port, reason, .. }) => Some(Notice::PortLost {
+                port: self.names[*port].clone(),
+                reason: reason.clone(),
+            }),
+            Some(PortEvent::Back { port, .. }) => Some(Notice::PortBack {
+                port: self.names[*port].clone(),
+            }),
             _ => None,
         };
-        if let Some(note) = note {
-            errors::warn(py, &py.get_type::<errors::PortWarning>(), &note)?;
+        if let Some(notice) = notice {
+            errors::warn(
+                py,
+                &py.get_type::<errors::PortWarning>(),
+                &notice.to_string(),
+            )?;
         }
         if event.is_none() {
             py.check_signals()?;

@@ -77,9 +77,11 @@ impl Notice {
 impl fmt::Display for Notice {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
-            Notice::PortLost { port, reason } => {
-                write!(f, "{port} lost ({reason}); waiting for it to come back")
-            }
+            Notice::PortLost { port, reason } => write!(
+                f,
+                "{port} lost ({reason}); retrying every {} ms",
+                crate::serial::RETRY_EVERY.as_millis()
+            ),
             Notice::PortBack { port } => write!(f, "{port} is back"),
             Notice::Comment {
                 input,
@@ -120,7 +122,7 @@ mod tests {
         };
         assert_eq!(
             lost.line(),
-            "hwfoc: warning: /dev/ttyUSB0 lost (No such device); waiting for it to come back"
+            "hwfoc: warning: /dev/ttyUSB0 lost (No such device); retrying every 500 ms"
         );
         let back = Notice::PortBack {
             port: "/dev/ttyUSB0".into(),

@@ -27,6 +27,7 @@ use std::time::{Duration, Instant};
 use hwfoc_io::stream::EscLink;
 
 use crate::error::CliError;
+use hwfoc_io::notice::Notice;
 use hwfoc_io::pcapng;
 use hwfoc_io::serial::{self, PortEvent, PortSet};
 use hwfoc_io::stream::PortStreams;
@@ -335,11 +336,11 @@ impl Recorder {
                 state.lost_at = Some(t_ns);
                 state.silent_since = None;
                 state.unframed_since = None;
-                let note = format!(
-                    "gap: {} lost ({reason}); retrying every {} ms",
-                    state.name,
-                    serial::RETRY_EVERY.as_millis()
-                );
+                let lost = Notice::PortLost {
+                    port: state.name.clone(),
+                    reason,
+                };
+                let note = format!("gap: {lost}");
                 if self.warn {
                     eprintln!("hwfoc: warning: {note}; the recording goes on");
                 }

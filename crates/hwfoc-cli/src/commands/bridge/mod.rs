@@ -20,6 +20,7 @@ use hwfoc_bridge::fanout::Fanout;
 use hwfoc_bridge::mavlink::{self, MavlinkOptions, MavlinkOutput, MavlinkTarget};
 use hwfoc_bridge::replay::{POLL, Replay, ReplayError};
 use hwfoc_io::Sources;
+use hwfoc_io::notice::Notice;
 use hwfoc_io::serial::{self, PortEvent};
 use hwfoc_io::settings::SettingsMap;
 use hwfoc_io::stream::PortStreams;
@@ -277,9 +278,18 @@ fn take(
             streams.feed(event, fanout);
         }
         PortEvent::Lost { port, reason, .. } => {
-            eprintln!("hwfoc: port {} lost ({reason}); reopening", names[*port]);
+            let notice = Notice::PortLost {
+                port: names[*port].clone(),
+                reason: reason.clone(),
+            };
+            eprintln!("{}", notice.line());
         }
-        PortEvent::Back { port, .. } => eprintln!("hwfoc: port {} is back", names[*port]),
+        PortEvent::Back { port, .. } => {
+            let notice = Notice::PortBack {
+                port: names[*port].clone(),
+            };
+            eprintln!("{}", notice.line());
+        }
     }
 }
 
