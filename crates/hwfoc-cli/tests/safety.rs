@@ -186,7 +186,7 @@ fn a_recording_is_never_overwritten_unasked() {
     ok(record(&port, &out, &[]));
     let first = std::fs::read(&out).unwrap();
     let again = record(&port, &out, &[]);
-    assert_fails_with(&again, "a recording of that name exists");
+    assert_fails_with(&again, "rec.pcapng exists and is never overwritten unasked");
     assert_eq!(std::fs::read(&out).unwrap(), first);
     std::fs::write(&out, "stale").unwrap();
     ok(record(&port, &out, &["--overwrite"]));
@@ -205,7 +205,7 @@ fn a_recording_is_never_overwritten_unasked() {
     std::fs::write(dir.path("run-notes.txt"), "mine").unwrap();
     assert_fails_with(
         &record(&port, &base, &["--rotate-time", "10"]),
-        "run-0003.pcapng: a recording of that name exists",
+        "run-0003.pcapng exists and is never overwritten unasked",
     );
     ok(record(
         &port,
@@ -235,7 +235,10 @@ fn a_recording_is_never_overwritten_unasked() {
         run(hwfoc().args(&args))
     };
     let before = std::fs::read(&out).unwrap();
-    assert_fails_with(&monitor(&[]), "a recording of that name exists");
+    assert_fails_with(
+        &monitor(&[]),
+        "rec.pcapng exists and is never overwritten unasked",
+    );
     assert_eq!(std::fs::read(&out).unwrap(), before);
     std::fs::write(&out, "stale").unwrap();
     ok(monitor(&["--overwrite"]));

@@ -60,11 +60,6 @@ pub enum SimError {
         /// How many ESCs there are.
         n: usize,
     },
-    /// An output file exists and overwriting was not asked for.
-    Exists {
-        /// The file as named.
-        file: String,
-    },
     /// A pseudo-terminal could not be created.
     Pty {
         /// Why.
@@ -125,11 +120,6 @@ impl fmt::Display for SimError {
             SimError::LinkCount { links, n } => write!(
                 f,
                 "--link: {links} links for {n} ESCs: give one per ESC, or one with {{esc}} in it"
-            ),
-            SimError::Exists { file } => write!(
-                f,
-                "{file} exists and is never overwritten unasked: choose another name, or pass \
-                 --overwrite"
             ),
             SimError::Pty { source } => write!(f, "cannot create a pseudo-terminal: {source}"),
             SimError::Link { path, source } => write!(f, "cannot create the link {path}: {source}"),

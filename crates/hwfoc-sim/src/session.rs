@@ -51,7 +51,8 @@ pub struct Plan {
     /// match the fleet's).
     pub settings: Settings,
     /// Replace output files (recordings, raw files, the truth) that exist. Without it, an
-    /// existing file is an error ([`SimError::Exists`]) and nothing is written.
+    /// existing file is an error ([`WriteError::Exists`](hwfoc_io::write::WriteError)) and
+    /// nothing is written.
     pub overwrite: bool,
 }
 
@@ -182,6 +183,7 @@ impl Session {
 mod tests {
     use super::*;
     use crate::fleet::tests::spec;
+    use hwfoc_io::write::WriteError;
 
     #[test]
     fn a_recording_is_the_same_every_time_and_its_truth_matches_the_report() {
@@ -243,7 +245,7 @@ mod tests {
             .err()
             .unwrap();
         assert!(
-            matches!(&e, SimError::Exists { file } if *file == path("esc1.bin")),
+            matches!(&e, SimError::Write(WriteError::Exists { output }) if *output == path("esc1.bin")),
             "{e}"
         );
         assert!(e.to_string().contains("--overwrite"), "{e}");
@@ -261,7 +263,9 @@ mod tests {
         let e = Session::open(spec(2).build().unwrap(), &plan(false))
             .err()
             .unwrap();
-        assert!(matches!(&e, SimError::Exists { file } if *file == path("truth.jsonl")));
+        assert!(
+            matches!(&e, SimError::Write(WriteError::Exists { output }) if *output == path("truth.jsonl"))
+        );
         assert_eq!(std::fs::read(path("truth.jsonl")).unwrap(), b"{}\n");
 
         // Asked: replaced.

@@ -1,6 +1,5 @@
 //! Where the virtual ESCs' bytes go, and the ground truth of what they sent.
 
-use std::fs::OpenOptions;
 use std::io::{self, BufWriter, Write};
 
 use hwfoc::{DataFrame, Settings};
@@ -8,9 +7,7 @@ use hwfoc::{DataFrame, Settings};
 use hwfoc_io::pcapng;
 use hwfoc_io::record::Record;
 use hwfoc_io::serial::PortError;
-use hwfoc_io::write::WriteError;
-
-use crate::error::SimError;
+use hwfoc_io::write::{self, WriteError};
 
 /// The outputs of a simulation, one stream per ESC.
 pub trait Sink {
@@ -26,28 +23,12 @@ pub trait Sink {
 }
 
 /// Opens `path` for writing (or standard output for `-`), with errors naming it. An existing
-/// file is [`SimError::Exists`] unless `overwrite`: a recording is never written over unasked
-/// (the check and the creation are one step, so no file can appear between them).
-pub fn create(path: &str, overwrite: bool) -> Result<(String, Box<dyn Write>), SimError> {
+/// file is [`WriteError::Exists`] unless `overwrite` (see [`write::create_file`]).
+pub fn create(path: &str, overwrite: bool) -> Result<(String, Box<dyn Write>), WriteError> {
     if path == "-" {
         return Ok(("standard output".to_string(), Box::new(io::stdout())));
     }
-    let file = OpenOptions::new()
-        .write(true)
-        .create(true)
-        .truncate(true)
-        .create_new(!overwrite)
-        .open(path)
-        .map_err(|source| match source.kind() {
-            io::ErrorKind::AlreadyExists => SimError::Exists {
-                file: path.to_string(),
-            },
-            _ => WriteError::Create {
-                output: path.to_string(),
-                source,
-            }
-            .into(),
-        })?;
+    let file = write::create_file(path, overwrite)?;
     Ok((path.to_string(), Box::new(file)))
 }
 
@@ -56,7 +37,7 @@ pub fn create(path: &str, overwrite: bool) -> Result<(String, Box<dyn Write>), S
 pub fn check_new<'a>(
     paths: impl IntoIterator<Item = &'a str>,
     overwrite: bool,
-) -> Result<(), SimError> {
+) -> Result<(), WriteError> {
     if overwrite {
         return Ok(());
     }
@@ -64,8 +45,8 @@ pub fn check_new<'a>(
         .into_iter()
         .find(|p| *p != "-" && std::fs::symlink_metadata(p).is_ok())
     {
-        Some(file) => Err(SimError::Exists {
-            file: file.to_string(),
+        Some(file) => Err(WriteError::Exists {
+            output: file.to_string(),
         }),
         None => Ok(()),
     }

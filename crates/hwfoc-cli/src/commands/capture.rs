@@ -256,7 +256,12 @@ impl Recorder {
             // --overwrite removed, before the first file is written.
             let earlier = series(&plan.output);
             match earlier.first() {
-                Some(file) if !plan.overwrite => return Err(exists(file)),
+                Some(file) if !plan.overwrite => {
+                    return Err(WriteError::Exists {
+                        output: file.clone(),
+                    }
+                    .into());
+                }
                 _ => {
                     for file in &earlier {
                         std::fs::remove_file(file).map_err(|source| WriteError::Write {
@@ -555,35 +560,13 @@ fn create(
         output: path.to_string(),
         source,
     };
-    let file = std::fs::OpenOptions::new()
-        .write(true)
-        .create(true)
-        .truncate(true)
-        .create_new(!overwrite)
-        .open(path)
-        .map_err(|source| match source.kind() {
-            std::io::ErrorKind::AlreadyExists => exists(path),
-            _ => CliError::from(WriteError::Create {
-                output: path.to_string(),
-                source,
-            }),
-        })?;
+    let file = hwfoc_io::write::create_file(path, overwrite)?;
     let mut writer = pcapng::Writer::new(BufWriter::with_capacity(BUFFER, file)).map_err(err)?;
     for port in ports {
         writer.add_interface(port, baud).map_err(err)?;
     }
     writer.flush().map_err(err)?;
     Ok(writer)
-}
-
-/// The error for a recording already at `path`.
-fn exists(path: &str) -> CliError {
-    CliError::Usage {
-        option: format!("-o {path}"),
-        message: "a recording of that name exists and is never overwritten unasked: choose \
-                  another name, or pass --overwrite"
-            .to_string(),
-    }
 }
 
 /// The existing files of the rotated series `base` (`out.pcapng`: `out-0001.pcapng`, ...), in

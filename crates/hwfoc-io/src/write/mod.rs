@@ -624,6 +624,11 @@ pub enum WriteError {
         /// Why.
         source: io::Error,
     },
+    /// A file of that name exists, and replacing it was not asked for (`--overwrite`).
+    Exists {
+        /// The file as named.
+        output: String,
+    },
     /// The output is one of the inputs (the same file, by whatever path): writing it would
     /// destroy the input.
     IsInput {
@@ -650,6 +655,28 @@ pub fn refuse_input<'a>(
         }),
         None => Ok(()),
     }
+}
+
+/// Creates the file `path` for writing, empty. An existing file is [`WriteError::Exists`]
+/// unless `overwrite` (then it is truncated): recordings and simulated files are never written
+/// over unasked. The check and the creation are one step, so no file can appear between them.
+/// (Exports do not come here: they are written under a partial name and renamed into place.)
+pub fn create_file(path: &str, overwrite: bool) -> Result<File, WriteError> {
+    std::fs::OpenOptions::new()
+        .write(true)
+        .create(true)
+        .truncate(true)
+        .create_new(!overwrite)
+        .open(path)
+        .map_err(|source| match source.kind() {
+            io::ErrorKind::AlreadyExists => WriteError::Exists {
+                output: path.to_string(),
+            },
+            _ => WriteError::Create {
+                output: path.to_string(),
+                source,
+            },
+        })
 }
 
 /// Whether two paths name one existing file (by device and inode, on Unix).
@@ -684,6 +711,11 @@ impl fmt::Display for WriteError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
             WriteError::Write { output, source } => write!(f, "cannot write {output}: {source}"),
+            WriteError::Exists { output } => write!(
+                f,
+                "{output} exists and is never overwritten unasked: choose another name, or pass \
+                 --overwrite"
+            ),
             WriteError::IsInput { output, input } => write!(
                 f,
                 "cannot write {output}: it is the input {input}, which would be destroyed; \
@@ -718,7 +750,7 @@ impl std::error::Error for WriteError {
     fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
         match self {
             WriteError::Write { source, .. } | WriteError::Create { source, .. } => Some(source),
-            WriteError::IsInput { .. } => None,
+            WriteError::IsInput { .. } | WriteError::Exists { .. } => None,
         }
     }
 }
