@@ -15,6 +15,7 @@
 //! the kinds is left in the scanner.
 
 use crate::frame::{Frame, MAX_FRAME_LEN, candidate_len, or_length_bytes, wire_len_of};
+use crate::scan::{Scan, Scanner, Stats, StreamDecoder};
 use crate::stats::LinkStats;
 use crate::wire::SYNC;
 
@@ -147,8 +148,8 @@ fn scan_next(
 /// Runs the scanner over `data`, whose first byte is at stream offset `base`, giving every frame
 /// to `on_frame`; returns where it stopped (as [`scan_next`] leaves `pos`).
 ///
-/// Out of line, so that [`Decoder::feed`] (which scans its held candidate, then the new bytes)
-/// and [`Decoder::flush`] each have one copy of the scanner, not one per loop: a fixed layout,
+/// Out of line, so that [`StreamDecoder::feed`] (which scans its held candidate, then the new
+/// bytes) and [`StreamDecoder::flush`] each have one copy of the scanner, not one per loop: a fixed layout,
 /// whose speed does not hang on the compiler's inlining choices.
 #[inline(never)]
 fn scan_all<const AT_END: bool>(
@@ -178,11 +179,73 @@ fn scan_all<const AT_END: bool>(
     }
 }
 
-/// A streaming decoder: feed it bytes in any chunking, get every frame once.
+/// The HW-FOC scanner, as the streaming layer ([`crate::scan`]) runs it: [`Decoder`] and
+/// [`Frames`] are it under [`StreamDecoder`] and [`Scan`].
+#[derive(Debug, Clone, Copy, Default)]
+pub struct HwFocScanner;
+
+impl crate::scan::sealed::Sealed for HwFocScanner {}
+impl crate::scan::sealed::Sealed for LinkStats {}
+
+impl Stats for LinkStats {
+    const NEW: Self = LinkStats::new();
+
+    #[inline]
+    fn bytes(&self) -> u64 {
+        LinkStats::bytes(self)
+    }
+
+    #[inline]
+    fn add_bytes(&mut self, n: usize) {
+        LinkStats::add_bytes(self, n);
+    }
+
+    fn line_silent(&mut self, max_frames: u32) {
+        LinkStats::line_silent(self, max_frames);
+    }
+}
+
+impl Scanner for HwFocScanner {
+    type Item = Decoded;
+    type Stats = LinkStats;
+    type Held = [u8; MAX_FRAME_LEN - 1];
+    type Pair = [u8; 2 * MAX_FRAME_LEN];
+    const HELD: Self::Held = [0; MAX_FRAME_LEN - 1];
+    const PAIR: Self::Pair = [0; 2 * MAX_FRAME_LEN];
+    const MAX_LEN: usize = MAX_FRAME_LEN;
+
+    #[inline(always)]
+    fn candidate_len(held: &[u8]) -> usize {
+        candidate_len(held)
+    }
+
+    #[inline(always)]
+    fn scan_all<const AT_END: bool>(
+        data: &[u8],
+        base: u64,
+        stats: &mut LinkStats,
+        on_frame: &mut impl FnMut(Decoded),
+    ) -> usize {
+        scan_all::<AT_END>(data, base, stats, on_frame)
+    }
+
+    #[inline(always)]
+    fn scan_next(data: &[u8], pos: &mut usize, stats: &mut LinkStats) -> Option<Decoded> {
+        scan_next(data, pos, stats, true, true).map(|(at, frame)| Decoded {
+            offset: at as u64,
+            frame,
+        })
+    }
+}
+
+/// A streaming decoder of the ESC wire: feed it bytes in any chunking, get every frame once
+/// (the streaming layer's [`StreamDecoder`] over the HW-FOC scanner).
 ///
 /// Its whole state is a 76-byte buffer for a frame still arriving plus the [`LinkStats`]:
 /// 120 bytes (`size_of::<Decoder>()`, checked by a test), no allocation, no timing.
-/// Large chunks are scanned in place (the bulk path); only the unfinished tail is copied.
+/// Large chunks are scanned in place (the bulk path); only the unfinished tail is copied. One
+/// byte pushed completes at most three frames (when a rejected device-information candidate
+/// turns out to hold data frames).
 ///
 /// ```
 /// use hwfoc::{Decoder, DataFrame, Frame};
@@ -203,168 +266,46 @@ fn scan_all<const AT_END: bool>(
 /// assert_eq!(got[0].frame, Frame::Data(frame));
 /// assert_eq!(decoder.stats().bytes_skipped(), 3);
 /// ```
-#[derive(Debug, Clone)]
-pub struct Decoder {
-    buf: [u8; MAX_FRAME_LEN - 1],
-    len: u8,
-    stats: LinkStats,
-}
-
-impl Default for Decoder {
-    fn default() -> Self {
-        Self::new()
-    }
-}
-
-impl Decoder {
-    /// A decoder with an empty buffer and zero statistics.
-    pub const fn new() -> Self {
-        Decoder {
-            buf: [0; MAX_FRAME_LEN - 1],
-            len: 0,
-            stats: LinkStats::new(),
-        }
-    }
-
-    /// Feeds one byte; `on_frame` is called for each frame it completes (at most three, when
-    /// a rejected device-information candidate turns out to hold data frames).
-    #[inline]
-    pub fn push(&mut self, byte: u8, on_frame: impl FnMut(Decoded)) {
-        self.feed(&[byte], on_frame);
-    }
-
-    /// Feeds a chunk of bytes; `on_frame` is called for each frame found, in stream order.
-    pub fn feed(&mut self, data: &[u8], mut on_frame: impl FnMut(Decoded)) {
-        if data.is_empty() {
-            return;
-        }
-        let start = self.stats.bytes();
-        self.stats.add_bytes(data.len());
-        let mut data = data;
-        let mut base = start;
-        if self.len > 0 {
-            let held = usize::from(self.len);
-            // Common byte-at-a-time case: the held candidate still cannot be decided with these
-            // bytes (a frame's length is known from its second byte), so just keep them.
-            if held + data.len() < candidate_len(&self.buf[..held]) {
-                self.buf[held..held + data.len()].copy_from_slice(data);
-                self.len += data.len() as u8;
-                return;
-            }
-            // Finish the held candidate with the first bytes of `data`. A candidate starting in
-            // the held bytes needs at most MAX_FRAME_LEN bytes from its start, so appending that
-            // many decides every one of them whenever `data` is long enough. (The held bytes
-            // are fewer than MAX_FRAME_LEN: one byte of `tmp` is never used.)
-            let take = data.len().min(MAX_FRAME_LEN);
-            let mut tmp = [0u8; 2 * MAX_FRAME_LEN];
-            tmp[..held].copy_from_slice(&self.buf[..held]);
-            tmp[held..held + take].copy_from_slice(&data[..take]);
-            let n = held + take;
-            let tmp_base = start - held as u64;
-            let pos = scan_all::<false>(&tmp[..n], tmp_base, &mut self.stats, &mut on_frame);
-            let Some(used) = pos.checked_sub(held) else {
-                // `data` ran out before the held candidate was decided.
-                self.hold(&tmp[pos..n]);
-                return;
-            };
-            // The scan stopped in `data`, after `used` of its bytes: go on from there.
-            data = &data[used..];
-            base += used as u64;
-        }
-        let pos = scan_all::<false>(data, base, &mut self.stats, &mut on_frame);
-        self.hold(&data[pos..]);
-    }
-
-    /// Keeps an undecided candidate (always shorter than a whole frame) for the next call.
-    fn hold(&mut self, tail: &[u8]) {
-        self.buf[..tail.len()].copy_from_slice(tail);
-        self.len = tail.len() as u8;
-    }
-
-    /// Decides the held bytes now, as if the stream ended here: a frame cut short is dropped
-    /// (its bytes counted as skipped) and any frame inside it is still found.
-    ///
-    /// Call it at the end of a stream. A caller that sees the line fall silent for longer than a
-    /// few byte times (a "gap": real ESCs send each frame back to back) may call it then too, so
-    /// that a cut frame is settled at once rather than when the next bytes arrive
-    /// ([`Decoder::line_silent`] does, and also tells the packet counting how long the silence
-    /// was). Statistics and packet tracking carry on across the call.
-    pub fn flush(&mut self, mut on_frame: impl FnMut(Decoded)) {
-        let held = usize::from(self.len);
-        let base = self.stats.bytes() - held as u64;
-        scan_all::<true>(&self.buf[..held], base, &mut self.stats, &mut on_frame);
-        self.len = 0;
-    }
-
-    /// Tells the decoder that the line has just been silent for a time in which at most
-    /// `max_frames` data frames could have been sent; `on_frame` gets the frames still found in
-    /// the bytes held back before the silence.
-    ///
-    /// It does two things:
-    ///
-    /// 1. The silence ends whatever frame was arriving (an ESC sends a frame's bytes back to
-    ///    back), so the held bytes are decided at once, exactly as by [`Decoder::flush`].
-    /// 2. The next data frame (the first one after the silence, whatever its bytes' chunking)
-    ///    counts as a loss of `step - 1` packets only if its packet-number step is from 2 to
-    ///    `max_frames + 1`; a larger step is a [restart](LinkStats::restarts). A step of 0 is
-    ///    still a duplicate and 1 the next frame. The rule replaces the
-    ///    [`MAX_PACKET_GAP`](crate::stats::MAX_PACKET_GAP) rule for that one frame, then the
-    ///    default returns. Several calls before that frame add up (their silences could each
-    ///    have hidden frames); a step beyond 32768 is a step backwards, a restart whatever
-    ///    `max_frames` says. Before the first data frame there is no step, and the call only
-    ///    decides the held bytes.
-    ///
-    /// So an ESC that rebooted within a second and a half is seen restarting even when its new
-    /// packet number happens to lie a few hundred past the old one, while a frame lost in a
-    /// short silence is still a loss. `max_frames` is the caller's bound from the time that
-    /// passed: a data frame takes 24 byte times on the line (12.5 ms at 19200 baud), and a real
-    /// ESC sends one every 50 ms or more. Frames hidden in bytes that arrived but were
-    /// rejected (corrupted) are not the silence's: do not count them in `max_frames`. Host-side
-    /// read latency is not a silence of the line; call this only for gaps longer than the
-    /// receiving path can introduce.
-    ///
-    /// ```
-    /// use hwfoc::wire::{BAUD_RATE, byte_ns};
-    /// use hwfoc::{DataFrame, Decoder};
-    ///
-    /// let frame = |packet| DataFrame { packet, ..Default::default() }.encode();
-    /// let mut decoder = Decoder::new();
-    /// decoder.feed(&frame(65000), |_| {});
-    /// // 1.5 s without a byte: at most 1.5 s / 24 byte times = 120 frames could have been sent.
-    /// let max_frames = (1.5e9 / (24.0 * byte_ns(BAUD_RATE))) as u32;
-    /// assert_eq!(max_frames, 120);
-    /// decoder.line_silent(max_frames, |_| {});
-    /// decoder.feed(&frame(0), |_| {}); // a step of 536: the ESC restarted
-    /// decoder.feed(&frame(3), |_| {}); // no silence: 2 frames lost
-    /// assert_eq!(decoder.stats().restarts(), 1);
-    /// assert_eq!(decoder.stats().lost_packets(), 2);
-    /// ```
-    pub fn line_silent(&mut self, max_frames: u32, on_frame: impl FnMut(Decoded)) {
-        self.flush(on_frame);
-        self.stats.line_silent(max_frames);
-    }
-
-    /// Feeds a whole stream and flushes it: the bulk path for a buffer in memory.
-    pub fn decode_all(&mut self, data: &[u8], mut on_frame: impl FnMut(Decoded)) {
-        self.feed(data, &mut on_frame);
-        self.flush(on_frame);
-    }
-
-    /// Bytes held for a frame that has not finished arriving (always fewer than 77).
-    pub fn buffered(&self) -> usize {
-        usize::from(self.len)
-    }
-
-    /// The link statistics so far.
-    pub fn stats(&self) -> &LinkStats {
-        &self.stats
-    }
-
-    /// Forgets held bytes and statistics, as new.
-    pub fn reset(&mut self) {
-        *self = Self::new();
-    }
-}
+///
+/// # Silences
+///
+/// [`line_silent`](StreamDecoder::line_silent)`(max_frames, ..)` tells the decoder that the
+/// line has just been silent for a time in which at most `max_frames` data frames could have
+/// been sent. The held bytes are decided at once, and the next data frame (the first one after
+/// the silence, whatever its bytes' chunking) counts as a loss of `step - 1` packets only if
+/// its packet-number step is from 2 to `max_frames + 1`; a larger step is a
+/// [restart](LinkStats::restarts). A step of 0 is still a duplicate and 1 the next frame. The
+/// rule replaces the [`MAX_PACKET_GAP`](crate::stats::MAX_PACKET_GAP) rule for that one frame,
+/// then the default returns. Several calls before that frame add up (their silences could each
+/// have hidden frames); a step beyond 32768 is a step backwards, a restart whatever
+/// `max_frames` says. Before the first data frame there is no step, and the call only decides
+/// the held bytes.
+///
+/// So an ESC that rebooted within a second and a half is seen restarting even when its new
+/// packet number happens to lie a few hundred past the old one, while a frame lost in a short
+/// silence is still a loss. `max_frames` is the caller's bound from the time that passed: a
+/// data frame takes 24 byte times on the line (12.5 ms at 19200 baud), and a real ESC sends one
+/// every 50 ms or more. Frames hidden in bytes that arrived but were rejected (corrupted) are
+/// not the silence's: do not count them in `max_frames`. Host-side read latency is not a
+/// silence of the line; call it only for gaps longer than the receiving path can introduce.
+///
+/// ```
+/// use hwfoc::wire::{BAUD_RATE, byte_ns};
+/// use hwfoc::{DataFrame, Decoder};
+///
+/// let frame = |packet| DataFrame { packet, ..Default::default() }.encode();
+/// let mut decoder = Decoder::new();
+/// decoder.feed(&frame(65000), |_| {});
+/// // 1.5 s without a byte: at most 1.5 s / 24 byte times = 120 frames could have been sent.
+/// let max_frames = (1.5e9 / (24.0 * byte_ns(BAUD_RATE))) as u32;
+/// assert_eq!(max_frames, 120);
+/// decoder.line_silent(max_frames, |_| {});
+/// decoder.feed(&frame(0), |_| {}); // a step of 536: the ESC restarted
+/// decoder.feed(&frame(3), |_| {}); // no silence: 2 frames lost
+/// assert_eq!(decoder.stats().restarts(), 1);
+/// assert_eq!(decoder.stats().lost_packets(), 2);
+/// ```
+pub type Decoder = StreamDecoder<HwFocScanner>;
 
 /// Decodes every frame in a complete buffer, in place: the bulk path.
 ///
@@ -390,46 +331,11 @@ impl Decoder {
 /// assert_eq!(it.stats().lost_packets(), 1);
 /// ```
 pub fn frames(data: &[u8]) -> Frames<'_> {
-    let mut stats = LinkStats::new();
-    stats.add_bytes(data.len());
-    Frames {
-        data,
-        pos: 0,
-        stats,
-    }
+    Scan::new(data)
 }
 
 /// Iterator returned by [`frames`].
-#[derive(Debug, Clone)]
-pub struct Frames<'a> {
-    data: &'a [u8],
-    pos: usize,
-    stats: LinkStats,
-}
-
-impl Frames<'_> {
-    /// Statistics of the bytes scanned so far (complete once the iterator has returned `None`;
-    /// [`LinkStats::bytes`] is the whole slice from the start).
-    pub fn stats(&self) -> &LinkStats {
-        &self.stats
-    }
-}
-
-impl Iterator for Frames<'_> {
-    type Item = Decoded;
-
-    #[inline]
-    fn next(&mut self) -> Option<Decoded> {
-        scan_next(self.data, &mut self.pos, &mut self.stats, true, true).map(|(at, frame)| {
-            Decoded {
-                offset: at as u64,
-                frame,
-            }
-        })
-    }
-}
-
-impl core::iter::FusedIterator for Frames<'_> {}
+pub type Frames<'a> = Scan<'a, HwFocScanner>;
 
 #[cfg(test)]
 mod tests {

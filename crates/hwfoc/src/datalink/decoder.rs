@@ -11,6 +11,7 @@
 //! bytes however the stream is cut into chunks.
 
 use crate::decoder::{bytes_equal, find_sync_then};
+use crate::scan::{Scan, Scanner, Stats, StreamDecoder};
 
 use super::frame::{DatalinkFrame, FrameReport};
 use super::layout::{FRAME_LEN, LengthByte, is_version_and_command};
@@ -146,11 +147,77 @@ fn scan_all<const AT_END: bool>(
     pos
 }
 
-/// A streaming DataLink V2 decoder: feed it bytes in any chunking, get every frame once.
+/// The DataLink V2 scanner, as the streaming layer ([`crate::scan`]) runs it:
+/// [`DatalinkDecoder`] and [`DatalinkFrames`] are it under [`StreamDecoder`] and [`Scan`].
+#[derive(Debug, Clone, Copy, Default)]
+pub struct DatalinkScanner;
+
+impl crate::scan::sealed::Sealed for DatalinkScanner {}
+impl crate::scan::sealed::Sealed for DatalinkStats {}
+
+impl Stats for DatalinkStats {
+    const NEW: Self = DatalinkStats::new();
+
+    #[inline]
+    fn bytes(&self) -> u64 {
+        DatalinkStats::bytes(self)
+    }
+
+    #[inline]
+    fn add_bytes(&mut self, n: usize) {
+        DatalinkStats::add_bytes(self, n);
+    }
+
+    fn line_silent(&mut self, max_frames: u32) {
+        DatalinkStats::line_silent(self, max_frames);
+    }
+}
+
+impl Scanner for DatalinkScanner {
+    type Item = DatalinkDecoded;
+    type Stats = DatalinkStats;
+    type Held = [u8; FRAME_LEN - 1];
+    type Pair = [u8; 2 * FRAME_LEN];
+    const HELD: Self::Held = [0; FRAME_LEN - 1];
+    const PAIR: Self::Pair = [0; 2 * FRAME_LEN];
+    const MAX_LEN: usize = FRAME_LEN;
+
+    #[inline(always)]
+    fn candidate_len(held: &[u8]) -> usize {
+        candidate_len(held.len())
+    }
+
+    #[inline(always)]
+    fn scan_all<const AT_END: bool>(
+        data: &[u8],
+        base: u64,
+        stats: &mut DatalinkStats,
+        on_frame: &mut impl FnMut(DatalinkDecoded),
+    ) -> usize {
+        scan_all::<AT_END>(data, base, stats, on_frame)
+    }
+
+    #[inline]
+    fn scan_next(
+        data: &[u8],
+        pos: &mut usize,
+        stats: &mut DatalinkStats,
+    ) -> Option<DatalinkDecoded> {
+        scan_next(data, pos, stats, true).map(|(at, frame, report)| DatalinkDecoded {
+            offset: at as u64,
+            frame,
+            report,
+        })
+    }
+}
+
+/// A streaming DataLink V2 decoder: feed it bytes in any chunking, get every frame once (the
+/// streaming layer's [`StreamDecoder`] over the DataLink scanner).
 ///
 /// Its state is a 159-byte buffer for a frame still arriving plus the [`DatalinkStats`]:
 /// 380 bytes (`size_of::<DatalinkDecoder>()`, checked by a test), no allocation, no timing.
-/// Large chunks are scanned in place; only an unfinished tail is copied.
+/// Large chunks are scanned in place; only an unfinished tail is copied. One byte pushed
+/// completes at most one frame.
 ///
 /// ```
 /// use hwfoc::datalink::{DatalinkDecoder, DatalinkFrame, LengthByte};
@@ -174,143 +241,33 @@ fn scan_all<const AT_END: bool>(
 /// assert_eq!(stats.frames_with_length_byte(LengthByte::Total), 1);
 /// assert_eq!(stats.channel(1).unwrap().last(), Some(300));
 /// ```
-#[derive(Debug, Clone)]
-pub struct DatalinkDecoder {
-    buf: [u8; FRAME_LEN - 1],
-    len: u8,
-    stats: DatalinkStats,
-}
-
-impl Default for DatalinkDecoder {
-    fn default() -> Self {
-        Self::new()
-    }
-}
-
-impl DatalinkDecoder {
-    /// A decoder with an empty buffer and zero statistics.
-    pub const fn new() -> Self {
-        DatalinkDecoder {
-            buf: [0; FRAME_LEN - 1],
-            len: 0,
-            stats: DatalinkStats::new(),
-        }
-    }
-
-    /// Feeds one byte; `on_frame` is called for each frame it completes (at most one).
-    #[inline]
-    pub fn push(&mut self, byte: u8, on_frame: impl FnMut(DatalinkDecoded)) {
-        self.feed(&[byte], on_frame);
-    }
-
-    /// Feeds a chunk of bytes; `on_frame` is called for each frame found, in stream order.
-    pub fn feed(&mut self, data: &[u8], mut on_frame: impl FnMut(DatalinkDecoded)) {
-        if data.is_empty() {
-            return;
-        }
-        let start = self.stats.bytes();
-        self.stats.add_bytes(data.len());
-        let mut data = data;
-        let mut base = start;
-        if self.len > 0 {
-            let held = usize::from(self.len);
-            // The held candidate cannot be decided with these bytes yet: just keep them.
-            if held + data.len() < candidate_len(held) {
-                self.buf[held..held + data.len()].copy_from_slice(data);
-                self.len += data.len() as u8;
-                return;
-            }
-            // Finish the held candidate with the first bytes of `data`: a candidate starting in
-            // the held bytes is decided by at most FRAME_LEN bytes from its start, so appending
-            // that many decides every one of them whenever `data` is long enough.
-            let take = data.len().min(FRAME_LEN);
-            let mut tmp = [0u8; 2 * FRAME_LEN];
-            tmp[..held].copy_from_slice(&self.buf[..held]);
-            tmp[held..held + take].copy_from_slice(&data[..take]);
-            let n = held + take;
-            let tmp_base = start.wrapping_sub(held as u64);
-            let pos = scan_all::<false>(&tmp[..n], tmp_base, &mut self.stats, &mut on_frame);
-            let Some(used) = pos.checked_sub(held) else {
-                // `data` ran out before the held candidate was decided.
-                self.hold(&tmp[pos..n]);
-                return;
-            };
-            data = &data[used..];
-            base += used as u64;
-        }
-        let pos = scan_all::<false>(data, base, &mut self.stats, &mut on_frame);
-        self.hold(&data[pos..]);
-    }
-
-    /// Keeps an undecided candidate (always shorter than a whole frame) for the next call.
-    fn hold(&mut self, tail: &[u8]) {
-        self.buf[..tail.len()].copy_from_slice(tail);
-        self.len = tail.len() as u8;
-    }
-
-    /// Decides the held bytes now, as if the stream ended here: a frame cut short is dropped
-    /// (its bytes counted as skipped) and any frame inside it is still found. Call it at the end
-    /// of a stream, or when the line falls silent ([`DatalinkDecoder::line_silent`] does).
-    /// Statistics and counter tracking carry on across the call.
-    pub fn flush(&mut self, mut on_frame: impl FnMut(DatalinkDecoded)) {
-        let held = usize::from(self.len);
-        let base = self.stats.bytes().wrapping_sub(held as u64);
-        scan_all::<true>(&self.buf[..held], base, &mut self.stats, &mut on_frame);
-        self.len = 0;
-    }
-
-    /// Tells the decoder that the line has just been silent for a time in which at most
-    /// `max_frames` DataLink frames could have been sent (160 byte times each at
-    /// [`BAUD_RATE`](super::BAUD_RATE), about 13.9 ms); `on_frame` gets the frames still found in
-    /// the bytes held back before the silence.
-    ///
-    /// As [`Decoder::line_silent`](crate::Decoder::line_silent): the held bytes are decided at
-    /// once ([`DatalinkDecoder::flush`]), and the next frame's counter step counts as a loss only
-    /// up to `max_frames + 1` (a larger step is a restart). Each channel's next packet-number
-    /// step counts as a loss only up to [`esc_frames_in`](super::esc_frames_in)`(max_frames) + 1`,
-    /// the most frames that ESC could have sent on its own 19200-baud wire in that time.
-    ///
-    /// ```
-    /// use hwfoc::datalink::{BAUD_RATE, DatalinkDecoder, DatalinkFrame, FRAME_LEN};
-    /// use hwfoc::wire::byte_ns;
-    ///
-    /// let mut decoder = DatalinkDecoder::new();
-    /// decoder.feed(&DatalinkFrame::new(1000).encode(), |_| {});
-    /// // 1 s without a byte: at most 1 s / 160 byte times = 72 frames could have been sent.
-    /// let max_frames = (1e9 / (FRAME_LEN as f64 * byte_ns(BAUD_RATE))) as u32;
-    /// assert_eq!(max_frames, 72);
-    /// decoder.line_silent(max_frames, |_| {});
-    /// decoder.feed(&DatalinkFrame::new(1200).encode(), |_| {}); // the hub restarted
-    /// decoder.feed(&DatalinkFrame::new(1203).encode(), |_| {}); // 2 frames lost
-    /// assert_eq!(decoder.stats().restarts(), 1);
-    /// assert_eq!(decoder.stats().lost_frames(), 2);
-    /// ```
-    pub fn line_silent(&mut self, max_frames: u32, on_frame: impl FnMut(DatalinkDecoded)) {
-        self.flush(on_frame);
-        self.stats.line_silent(max_frames);
-    }
-
-    /// Feeds a whole stream and flushes it: the bulk path for a buffer in memory.
-    pub fn decode_all(&mut self, data: &[u8], mut on_frame: impl FnMut(DatalinkDecoded)) {
-        self.feed(data, &mut on_frame);
-        self.flush(on_frame);
-    }
-
-    /// Bytes held for a frame that has not finished arriving (always fewer than 160).
-    pub fn buffered(&self) -> usize {
-        usize::from(self.len)
-    }
-
-    /// The statistics so far.
-    pub fn stats(&self) -> &DatalinkStats {
-        &self.stats
-    }
-
-    /// Forgets held bytes and statistics, as new.
-    pub fn reset(&mut self) {
-        *self = Self::new();
-    }
-}
+///
+/// # Silences
+///
+/// [`line_silent`](StreamDecoder::line_silent)`(max_frames, ..)`: at most `max_frames`
+/// DataLink frames could have been sent in the silence (160 byte times each at
+/// [`BAUD_RATE`](super::BAUD_RATE), about 13.9 ms). As for the ESC [`Decoder`](crate::Decoder),
+/// the held bytes are decided at once and the next frame's counter step counts as a loss only
+/// up to `max_frames + 1` (a larger step is a restart). Each channel's next packet-number step
+/// counts as a loss only up to [`esc_frames_in`](super::esc_frames_in)`(max_frames) + 1`, the
+/// most frames that ESC could have sent on its own 19200-baud wire in that time.
+///
+/// ```
+/// use hwfoc::datalink::{BAUD_RATE, DatalinkDecoder, DatalinkFrame, FRAME_LEN};
+/// use hwfoc::wire::byte_ns;
+///
+/// let mut decoder = DatalinkDecoder::new();
+/// decoder.feed(&DatalinkFrame::new(1000).encode(), |_| {});
+/// // 1 s without a byte: at most 1 s / 160 byte times = 72 frames could have been sent.
+/// let max_frames = (1e9 / (FRAME_LEN as f64 * byte_ns(BAUD_RATE))) as u32;
+/// assert_eq!(max_frames, 72);
+/// decoder.line_silent(max_frames, |_| {});
+/// decoder.feed(&DatalinkFrame::new(1200).encode(), |_| {}); // the hub restarted
+/// decoder.feed(&DatalinkFrame::new(1203).encode(), |_| {}); // 2 frames lost
+/// assert_eq!(decoder.stats().restarts(), 1);
+/// assert_eq!(decoder.stats().lost_frames(), 2);
+/// ```
+pub type DatalinkDecoder = StreamDecoder<DatalinkScanner>;
 
 /// Decodes every DataLink frame in a complete buffer, in place: the bulk path.
 ///
@@ -333,47 +290,11 @@ impl DatalinkDecoder {
 /// assert_eq!(it.stats().lost_frames(), 1);
 /// ```
 pub fn frames(data: &[u8]) -> DatalinkFrames<'_> {
-    let mut stats = DatalinkStats::new();
-    stats.add_bytes(data.len());
-    DatalinkFrames {
-        data,
-        pos: 0,
-        stats,
-    }
+    Scan::new(data)
 }
 
 /// Iterator returned by [`frames`].
-#[derive(Debug, Clone)]
-pub struct DatalinkFrames<'a> {
-    data: &'a [u8],
-    pos: usize,
-    stats: DatalinkStats,
-}
-
-impl DatalinkFrames<'_> {
-    /// Statistics of the bytes scanned so far (complete once the iterator has returned `None`;
-    /// [`DatalinkStats::bytes`] is the whole slice from the start).
-    pub fn stats(&self) -> &DatalinkStats {
-        &self.stats
-    }
-}
-
-impl Iterator for DatalinkFrames<'_> {
-    type Item = DatalinkDecoded;
-
-    #[inline]
-    fn next(&mut self) -> Option<DatalinkDecoded> {
-        scan_next(self.data, &mut self.pos, &mut self.stats, true).map(|(at, frame, report)| {
-            DatalinkDecoded {
-                offset: at as u64,
-                frame,
-                report,
-            }
-        })
-    }
-}
-
-impl core::iter::FusedIterator for DatalinkFrames<'_> {}
+pub type DatalinkFrames<'a> = Scan<'a, DatalinkScanner>;
 
 #[cfg(test)]
 mod tests {

@@ -47,7 +47,7 @@ mod frame;
 mod layout;
 mod stats;
 
-pub use decoder::{DatalinkDecoded, DatalinkDecoder, DatalinkFrames, frames};
+pub use decoder::{DatalinkDecoded, DatalinkDecoder, DatalinkFrames, DatalinkScanner, frames};
 pub use error::DatalinkError;
 pub use frame::{DatalinkFrame, FrameReport};
 pub use layout::{
