@@ -561,10 +561,23 @@ fn a_serial_port_carries_the_same_messages() {
         out.poll(Instant::now()).unwrap();
     }
     assert_eq!(out.stats().errors, 0);
-    let mut master = std::fs::File::from(pair.master);
-    let mut bytes = vec![0u8; 4096];
-    let n = master.read(&mut bytes).unwrap();
-    let mut reader = MavlinkReader::new(&bytes[..n]);
+    // The messages may come through the pseudo-terminal in several reads: read until the line
+    // has been quiet for 200 ms (the messages were all written above).
+    let master = std::fs::File::from(pair.master);
+    let mut bytes = Vec::new();
+    let mut chunk = [0u8; 4096];
+    loop {
+        let mut fds = [nix::poll::PollFd::new(
+            master.as_fd(),
+            nix::poll::PollFlags::POLLIN,
+        )];
+        if nix::poll::poll(&mut fds, nix::poll::PollTimeout::from(200u16)).unwrap() == 0 {
+            break;
+        }
+        let n = (&master).read(&mut chunk).unwrap();
+        bytes.extend_from_slice(&chunk[..n]);
+    }
+    let mut reader = MavlinkReader::new(&bytes[..]);
     let mut got = Vec::new();
     while let Ok((_, message)) = reader.read_message::<MavMessage>(MavlinkVersion::V2) {
         got.push(message);
