@@ -145,40 +145,6 @@ fn scan_next(
     }
 }
 
-/// Runs the scanner over `data`, whose first byte is at stream offset `base`, giving every frame
-/// to `on_frame`; returns where it stopped (as [`scan_next`] leaves `pos`).
-///
-/// Out of line, so that [`StreamDecoder::feed`] (which scans its held candidate, then the new
-/// bytes) and [`StreamDecoder::flush`] each have one copy of the scanner, not one per loop: a fixed layout,
-/// whose speed does not hang on the compiler's inlining choices.
-#[inline(never)]
-fn scan_all<const AT_END: bool>(
-    data: &[u8],
-    base: u64,
-    stats: &mut LinkStats,
-    on_frame: &mut impl FnMut(Decoded),
-) -> usize {
-    let mut pos = 0;
-    loop {
-        // Back-to-back frames of the first kind have a call site of their own, where the frame
-        // built is known to be of that kind: only its fields are written, not the bytes of the
-        // largest kind that a merged call site would copy for every frame.
-        while let Some((at, frame)) = Frame::take_first(data, &mut pos, stats) {
-            on_frame(Decoded {
-                offset: base + at as u64,
-                frame,
-            });
-        }
-        let Some((at, frame)) = scan_next(data, &mut pos, stats, AT_END, false) else {
-            return pos;
-        };
-        on_frame(Decoded {
-            offset: base + at as u64,
-            frame,
-        });
-    }
-}
-
 /// The HW-FOC scanner, as the streaming layer ([`crate::scan`]) runs it: [`Decoder`] and
 /// [`Frames`] are it under [`StreamDecoder`] and [`Scan`].
 #[derive(Debug, Clone, Copy, Default)]
@@ -219,14 +185,38 @@ impl Scanner for HwFocScanner {
         candidate_len(held)
     }
 
-    #[inline(always)]
+    /// Runs the scanner over `data`, whose first byte is at stream offset `base`, giving every
+    /// frame to `on_frame`; returns where it stopped (as the scanner's `scan_next` leaves `pos`).
+    ///
+    /// Out of line, so that [`StreamDecoder::feed`] (which scans its held candidate, then the
+    /// new bytes) and [`StreamDecoder::flush`] each have one copy of the scanner, not one per
+    /// loop: a fixed layout, whose speed does not hang on the compiler's inlining choices.
+    #[inline(never)]
     fn scan_all<const AT_END: bool>(
         data: &[u8],
         base: u64,
         stats: &mut LinkStats,
         on_frame: &mut impl FnMut(Decoded),
     ) -> usize {
-        scan_all::<AT_END>(data, base, stats, on_frame)
+        let mut pos = 0;
+        loop {
+            // Back-to-back frames of the first kind have a call site of their own, where the frame
+            // built is known to be of that kind: only its fields are written, not the bytes of the
+            // largest kind that a merged call site would copy for every frame.
+            while let Some((at, frame)) = Frame::take_first(data, &mut pos, stats) {
+                on_frame(Decoded {
+                    offset: base + at as u64,
+                    frame,
+                });
+            }
+            let Some((at, frame)) = scan_next(data, &mut pos, stats, AT_END, false) else {
+                return pos;
+            };
+            on_frame(Decoded {
+                offset: base + at as u64,
+                frame,
+            });
+        }
     }
 
     #[inline(always)]

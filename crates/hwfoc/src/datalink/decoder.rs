@@ -127,26 +127,6 @@ fn scan_next(
     }
 }
 
-/// Runs the scanner over `data`, whose first byte is at stream offset `base`, giving every frame
-/// to `on_frame`; returns where it stopped (as [`scan_next`] leaves `pos`).
-#[inline(never)]
-fn scan_all<const AT_END: bool>(
-    data: &[u8],
-    base: u64,
-    stats: &mut DatalinkStats,
-    on_frame: &mut impl FnMut(DatalinkDecoded),
-) -> usize {
-    let mut pos = 0;
-    while let Some((at, frame, report)) = scan_next(data, &mut pos, stats, AT_END) {
-        on_frame(DatalinkDecoded {
-            offset: base + at as u64,
-            frame,
-            report,
-        });
-    }
-    pos
-}
-
 /// The DataLink V2 scanner, as the streaming layer ([`crate::scan`]) runs it:
 /// [`DatalinkDecoder`] and [`DatalinkFrames`] are it under [`StreamDecoder`] and [`Scan`].
 #[derive(Debug, Clone, Copy, Default)]
@@ -187,14 +167,24 @@ impl Scanner for DatalinkScanner {
         candidate_len(held.len())
     }
 
-    #[inline(always)]
+    /// Runs the scanner over `data`, whose first byte is at stream offset `base`, giving every
+    /// frame to `on_frame`; returns where it stopped (as the scanner's `scan_next` leaves `pos`).
+    #[inline(never)]
     fn scan_all<const AT_END: bool>(
         data: &[u8],
         base: u64,
         stats: &mut DatalinkStats,
         on_frame: &mut impl FnMut(DatalinkDecoded),
     ) -> usize {
-        scan_all::<AT_END>(data, base, stats, on_frame)
+        let mut pos = 0;
+        while let Some((at, frame, report)) = scan_next(data, &mut pos, stats, AT_END) {
+            on_frame(DatalinkDecoded {
+                offset: base + at as u64,
+                frame,
+                report,
+            });
+        }
+        pos
     }
 
     #[inline]
