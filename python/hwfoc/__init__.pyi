@@ -114,7 +114,8 @@ def record_schema(
 
 class Decoder:
     """A streaming decoder of one ESC's bytes as they arrive (a frame split between two
-    ``feed`` calls is decoded whole)."""
+    ``feed`` calls is decoded whole), or of a DataLink hub's (told from the content, at
+    ``baud=115200``): then channel ``c`` is ESC ``esc + c``."""
 
     def __init__(
         self,
