@@ -64,7 +64,9 @@ def read(
     ``hwfoc_version``, ``current_scale``, ``pole_pairs``, ``gear_ratio``, ``inputs`` and
     ``escs`` (JSON) and ``filter`` when records were selected; each field has its ``unit``.
 
-    Raises InputError, SelectionError, SettingsError; TypeError for a source of another type.
+    Raises InputError (also for a serial port's path: read ports with :func:`open_ports`),
+    SelectionError, SettingsError; TypeError for a source of another type. Warns HwfocWarning
+    for inputs without frames and for a recording's damage and notes.
     """
 
 def scan(
@@ -85,6 +87,8 @@ def scan(
     Arguments as :func:`read`. Errors opening the inputs are raised by ``scan`` itself; an
     error part-way is raised by the iterator after the batches of the records before it. The
     batches' schema metadata is :func:`read`'s without ``escs`` (known only at the end).
+    Warnings as :func:`read`'s: a recording's damage and notes as they are met, inputs without
+    frames once all are read.
     """
 
 class Scan(Iterator[pa.RecordBatch]):

@@ -31,6 +31,8 @@ enum Msg {
     Batch(RecordBatch),
     /// An input failed; the batches of what came before it were sent first.
     Failed(Stop),
+    /// The inputs are read: the warnings `read` gives too (an ESC whose bytes held no frame).
+    Warnings(Vec<String>),
 }
 
 /// An iterator of `pyarrow.RecordBatch`: see `hwfoc.scan`.
@@ -86,8 +88,13 @@ fn produce(
     let result = sources.run(&mut collect);
     let flushed = collect.flush();
     drop(collect);
-    if let Err(stop) = result.and(flushed) {
-        let _ = tx.send(Msg::Failed(stop));
+    match result.and(flushed) {
+        Err(stop) => {
+            let _ = tx.send(Msg::Failed(stop));
+        }
+        Ok(()) => {
+            let _ = tx.send(Msg::Warnings(crate::no_frames(&sources)));
+        }
     }
 }
 
@@ -135,8 +142,8 @@ pub fn scan(
     match msg? {
         Some(Msg::Opened) | None => Ok(scan),
         Some(Msg::Failed(stop)) => Err(stop_error(stop)),
-        Some(Msg::Batch(_)) => Err(errors::HwfocError::new_err(
-            "the decoding thread sent a batch before opening the inputs",
+        Some(Msg::Batch(_) | Msg::Warnings(_)) => Err(errors::HwfocError::new_err(
+            "the decoding thread sent records before opening the inputs",
         )),
     }
 }
@@ -184,6 +191,12 @@ impl Scan {
                 Ok(None) => return Ok(None),
                 Ok(Some(Msg::Batch(batch))) => return Ok(Some(batch.to_pyarrow(py)?.unbind())),
                 Ok(Some(Msg::Opened)) => continue,
+                Ok(Some(Msg::Warnings(warnings))) => {
+                    for warning in &warnings {
+                        errors::warn(py, &py.get_type::<errors::HwfocWarning>(), warning)?;
+                    }
+                    continue;
+                }
                 Ok(Some(Msg::Failed(stop))) => {
                     self.drop_channel();
                     return Err(stop_error(stop));

@@ -67,11 +67,22 @@ pub fn specs(source: &Bound<'_, PyAny>) -> PyResult<Vec<Spec>> {
     Ok(vec![spec(source)?])
 }
 
+/// A path, unless it names a serial port: reading one as a file would wait for its bytes
+/// forever, without receive times.
+fn path_spec(path: String) -> PyResult<Spec> {
+    if hwfoc_io::serial::is_port(&path) {
+        return Err(crate::errors::InputError::new_err(format!(
+            "{path} is a serial port: read it live with hwfoc.open_ports([\"{path}\"])"
+        )));
+    }
+    Ok(Spec::Path(path))
+}
+
 /// One input.
 pub fn spec(source: &Bound<'_, PyAny>) -> PyResult<Spec> {
     let py = source.py();
     if let Ok(s) = source.cast::<PyString>() {
-        return Ok(Spec::Path(s.to_cow()?.into_owned()));
+        return path_spec(s.to_cow()?.into_owned());
     }
     if let Ok(b) = source.cast::<PyBytes>() {
         return Ok(bytes(b.as_bytes().to_vec()));
@@ -86,7 +97,7 @@ pub fn spec(source: &Bound<'_, PyAny>) -> PyResult<Spec> {
     if source.hasattr("__fspath__")? {
         let path = py.import("os")?.call_method1("fspath", (source,))?;
         return match path.cast::<PyString>() {
-            Ok(s) => Ok(Spec::Path(s.to_cow()?.into_owned())),
+            Ok(s) => path_spec(s.to_cow()?.into_owned()),
             Err(_) => Err(PyTypeError::new_err(
                 "a path given as bytes is not supported: give it as str",
             )),

@@ -128,3 +128,15 @@ def test_port_errors_are_the_commands(cli, tmp_path):
         os.close(s)
     with pytest.raises(ValueError):
         hwfoc.open_ports([])
+
+
+def test_reading_a_port_as_a_file_is_refused():
+    # `read` and `scan` would wait for the port's bytes forever, without receive times.
+    master, slave, name = _pty()
+    try:
+        for call in (hwfoc.read, hwfoc.scan, hwfoc.summary):
+            with pytest.raises(hwfoc.InputError, match="is a serial port: read it live with hwfoc.open_ports"):
+                call(name)
+    finally:
+        os.close(master)
+        os.close(slave)

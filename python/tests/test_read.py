@@ -191,6 +191,10 @@ def test_garbage_and_other_protocols_warn_as_the_command_does(cli, tmp_path):
         assert table.num_rows == 0
         _, err, _ = run_cli(cli, "decode", path)
         assert [f"hwfoc: warning: {w.message}" for w in caught] == err.splitlines()
+        # scan warns alike, once its inputs are read.
+        with pytest.warns(hwfoc.HwfocWarning) as scanned:
+            assert sum(b.num_rows for b in hwfoc.scan(path)) == 0
+        assert [str(w.message) for w in scanned] == [str(w.message) for w in caught]
 
 
 def test_truncated_recording_reads_what_is_there(cli, sim_dir, tmp_path, capfd):
