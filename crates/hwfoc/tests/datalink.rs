@@ -3,9 +3,12 @@
 //! garbage, single-bit error detection, and bulk == streaming, checked against a naive reference
 //! scanner written here from the protocol description.
 
+mod common;
+
+use common::{cut_points, data_frame, streamed_bytewise};
 use hwfoc::datalink::{
-    self, CHANNELS, DatalinkDecoded, DatalinkDecoder, DatalinkError, DatalinkFrame, DatalinkStats,
-    FRAME_LEN, FrameReport, LengthByte, RECORD_LEN, RECORDS_AT,
+    self, CHANNELS, DatalinkDecoded, DatalinkDecoder, DatalinkError, DatalinkFrame,
+    DatalinkScanner, DatalinkStats, FRAME_LEN, FrameReport, LengthByte, RECORD_LEN, RECORDS_AT,
 };
 use hwfoc::stats::MAX_PACKET_GAP;
 use hwfoc::wire::{Checksum, crc16_xmodem};
@@ -17,32 +20,6 @@ use proptest::sample::Index;
 // ---------------------------------------------------------------------------------------------
 // Generators
 // ---------------------------------------------------------------------------------------------
-
-fn data_frame() -> impl Strategy<Value = DataFrame> {
-    (
-        (any::<u16>(), any::<u16>(), any::<u16>(), any::<u16>()),
-        (any::<u16>(), any::<i16>(), any::<i16>()),
-        (any::<u8>(), any::<u8>(), any::<u16>()),
-    )
-        .prop_map(
-            |(
-                (packet, throttle_in_raw, throttle_out_raw, erpm_raw),
-                (voltage_raw, current_raw, phase_current_raw),
-                (mos_adc, cap_adc, status),
-            )| DataFrame {
-                packet,
-                throttle_in_raw,
-                throttle_out_raw,
-                erpm_raw,
-                voltage_raw,
-                current_raw,
-                phase_current_raw,
-                mos_adc,
-                cap_adc,
-                status: Status(status),
-            },
-        )
-}
 
 /// A slot: empty, an ESC, or (rarely) an ESC whose every field is zero, which the wire cannot
 /// tell from an empty slot.
@@ -177,16 +154,6 @@ fn build(pieces: &[Piece]) -> Wire {
     wire
 }
 
-/// Cut points for `len` bytes from arbitrary indices: sorted, deduplicated, inside 0..=len.
-fn cut_points(len: usize, picks: &[Index]) -> Vec<usize> {
-    let mut cuts: Vec<usize> = picks.iter().map(|i| i.index(len + 1)).collect();
-    cuts.push(0);
-    cuts.push(len);
-    cuts.sort_unstable();
-    cuts.dedup();
-    cuts
-}
-
 /// Whether a valid frame, formed by chance, starts outside the intact frames and overlaps one:
 /// a CRC matching by chance (about 1 in 65536 per candidate running into an intact frame). The
 /// CRC cannot settle such a wire; the tests that need every intact frame found discard it.
@@ -233,16 +200,6 @@ fn streamed_at(bytes: &[u8], cuts: &[usize]) -> (Vec<DatalinkDecoded>, DatalinkS
     }
     d.flush(|x| out.push(x));
     assert_eq!(d.buffered(), 0);
-    (out, *d.stats())
-}
-
-fn streamed_bytewise(bytes: &[u8]) -> (Vec<DatalinkDecoded>, DatalinkStats) {
-    let mut d = DatalinkDecoder::new();
-    let mut out = Vec::new();
-    for &b in bytes {
-        d.push(b, |x| out.push(x));
-    }
-    d.flush(|x| out.push(x));
     (out, *d.stats())
 }
 
@@ -464,7 +421,7 @@ fn decode_checked(bytes: &[u8], picks: &[Index]) -> (Vec<DatalinkDecoded>, Datal
         "chunked"
     );
     assert_eq!(
-        streamed_bytewise(bytes),
+        streamed_bytewise::<DatalinkScanner>(bytes),
         (frames.clone(), stats),
         "bytewise"
     );

@@ -4,6 +4,10 @@
 //!
 //! Case counts are kept modest so that the whole file runs in a few seconds in debug mode.
 
+mod common;
+
+use common::{cut_points, data_frame, streamed_bytewise};
+use hwfoc::decoder::HwFocScanner;
 use hwfoc::kinds::data::DATA_FRAME_LEN;
 use hwfoc::kinds::info::INFO_FRAME_LEN;
 use hwfoc::stats::MAX_PACKET_GAP;
@@ -22,32 +26,6 @@ use proptest::sample::Index;
 /// The real device-information text (XRotor v4 Pro HV 80A).
 const REAL_INFO_TEXT: &[u8; 72] =
     b"                XR_FOC_ESC      HW577_KZ1_V1.1  XR-01.0.00      01040443";
-
-fn data_frame() -> impl Strategy<Value = DataFrame> {
-    (
-        (any::<u16>(), any::<u16>(), any::<u16>(), any::<u16>()),
-        (any::<u16>(), any::<i16>(), any::<i16>()),
-        (any::<u8>(), any::<u8>(), any::<u16>()),
-    )
-        .prop_map(
-            |(
-                (packet, throttle_in_raw, throttle_out_raw, erpm_raw),
-                (voltage_raw, current_raw, phase_current_raw),
-                (mos_adc, cap_adc, status),
-            )| DataFrame {
-                packet,
-                throttle_in_raw,
-                throttle_out_raw,
-                erpm_raw,
-                voltage_raw,
-                current_raw,
-                phase_current_raw,
-                mos_adc,
-                cap_adc,
-                status: Status(status),
-            },
-        )
-}
 
 /// Any ASCII text (the protocol's text is ASCII; the decoder refuses anything else).
 fn info_text() -> impl Strategy<Value = [u8; 72]> {
@@ -144,16 +122,6 @@ fn build(pieces: &[Piece]) -> Wire {
     wire
 }
 
-/// Cut points for `len` bytes from arbitrary indices: sorted, deduplicated, inside 0..=len.
-fn cut_points(len: usize, picks: &[Index]) -> Vec<usize> {
-    let mut cuts: Vec<usize> = picks.iter().map(|i| i.index(len + 1)).collect();
-    cuts.push(0);
-    cuts.push(len);
-    cuts.sort_unstable();
-    cuts.dedup();
-    cuts
-}
-
 // ---------------------------------------------------------------------------------------------
 // Decoding paths
 // ---------------------------------------------------------------------------------------------
@@ -173,16 +141,6 @@ fn streamed_at(bytes: &[u8], cuts: &[usize]) -> (Vec<Decoded>, LinkStats) {
     }
     d.flush(|x| out.push(x));
     assert_eq!(d.buffered(), 0);
-    (out, *d.stats())
-}
-
-fn streamed_bytewise(bytes: &[u8]) -> (Vec<Decoded>, LinkStats) {
-    let mut d = Decoder::new();
-    let mut out = Vec::new();
-    for &b in bytes {
-        d.push(b, |x| out.push(x));
-    }
-    d.flush(|x| out.push(x));
     (out, *d.stats())
 }
 
@@ -467,7 +425,7 @@ proptest! {
         let chunked = streamed_at(&wire.bytes, &cuts);
         prop_assert_eq!(&chunked.0, &whole.0);
         prop_assert_eq!(&chunked.1, &whole.1);
-        prop_assert_eq!(&streamed_bytewise(&wire.bytes), &whole);
+        prop_assert_eq!(&streamed_bytewise::<HwFocScanner>(&wire.bytes), &whole);
     }
 
     /// (b) The streaming decoder holds back only an undecided candidate: after every chunk, the
@@ -545,7 +503,7 @@ proptest! {
                 + 77 * u64::from(stats.info_frames())
                 + stats.bytes_skipped()
         );
-        prop_assert_eq!(&streamed_bytewise(&wire.bytes), &(decoded, stats));
+        prop_assert_eq!(&streamed_bytewise::<HwFocScanner>(&wire.bytes), &(decoded, stats));
     }
 
     /// (d) One flipped bit anywhere in a frame is always caught, whatever surrounds it.
@@ -618,7 +576,7 @@ proptest! {
         let streamed = streamed_at(&wire.bytes, &cuts);
         prop_assert_eq!(&streamed.0, &decoded);
         prop_assert_eq!(&streamed.1, &stats);
-        prop_assert_eq!(&streamed_bytewise(&wire.bytes), &(decoded.clone(), stats));
+        prop_assert_eq!(&streamed_bytewise::<HwFocScanner>(&wire.bytes), &(decoded.clone(), stats));
         let mut all = Decoder::new();
         let mut out = Vec::new();
         all.decode_all(&wire.bytes, |d| out.push(d));
