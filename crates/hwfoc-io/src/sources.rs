@@ -821,16 +821,24 @@ mod tests {
         w.into_inner().unwrap()
     }
 
-    fn run(inputs: Vec<Vec<u8>>) -> (ByEsc, Sources) {
+    /// Runs recordings `inputs` (named `rec-0.pcapng`, ...) into a new `H`.
+    fn run_into<H: Handler + Default>(inputs: Vec<Vec<u8>>) -> (H, Sources)
+    where
+        H::Error: std::fmt::Debug,
+    {
         let inputs = inputs
             .into_iter()
             .enumerate()
             .map(|(i, bytes)| Input::from_memory(&format!("rec-{i}.pcapng"), bytes).unwrap())
             .collect();
         let mut sources = Sources::new(inputs, Settings::DEFAULT);
-        let mut got = ByEsc::default();
+        let mut got = H::default();
         sources.run(&mut got).unwrap();
         (got, sources)
+    }
+
+    fn run(inputs: Vec<Vec<u8>>) -> (ByEsc, Sources) {
+        run_into(inputs)
     }
 
     /// The files of a rotated recording are one stream per port: a frame split between two
@@ -927,15 +935,7 @@ mod tests {
     }
 
     fn in_order(inputs: Vec<Vec<u8>>) -> (InOrder, Sources) {
-        let inputs = inputs
-            .into_iter()
-            .enumerate()
-            .map(|(i, bytes)| Input::from_memory(&format!("rec-{i}.pcapng"), bytes).unwrap())
-            .collect();
-        let mut sources = Sources::new(inputs, Settings::DEFAULT);
-        let mut got = InOrder::default();
-        sources.run(&mut got).unwrap();
-        (got, sources)
+        run_into(inputs)
     }
 
     fn assert_time_order(records: &[(u8, u16, f64)]) {
