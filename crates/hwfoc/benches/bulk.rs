@@ -25,7 +25,11 @@ use std::hint::black_box;
 use std::time::Duration;
 
 use criterion::{BenchmarkGroup, Criterion, Throughput, criterion_group, criterion_main};
-use hwfoc::datalink::{self, DatalinkDecoded, DatalinkDecoder, DatalinkFrame, FRAME_LEN};
+use hwfoc::datalink::{
+    self, DatalinkDecoded, DatalinkDecoder, DatalinkFrame, DatalinkScanner, FRAME_LEN,
+};
+use hwfoc::decoder::HwFocScanner;
+use hwfoc::scan::{Scan, Scanner, StreamDecoder};
 use hwfoc::{DataFrame, Decoded, Decoder, Frame, InfoFrame, Status, frames};
 
 /// Size of each generated stream.
@@ -288,12 +292,19 @@ fn check(name: &str, buf: &[u8], e: &Expected) {
     );
 }
 
-fn bench_stream(g: &mut BenchmarkGroup<'_, criterion::measurement::WallTime>, buf: &[u8]) {
+/// The three decoding paths of scanner `S` over `buf`, each decoded frame folded by `fold` (so
+/// that nothing is optimised away): `frames` (bulk), `feed_64k` (the streaming decoder fed
+/// 64 KiB chunks) and `push_256k` (a byte at a time, over the first 256 KiB).
+fn bench_decoder<S: Scanner>(
+    g: &mut BenchmarkGroup<'_, criterion::measurement::WallTime>,
+    buf: &[u8],
+    fold: impl Fn(u64, &S::Item) -> u64 + Copy,
+) {
     g.throughput(Throughput::Bytes(buf.len() as u64));
     g.bench_function("frames", |b| {
         b.iter(|| {
             let mut acc = 0u64;
-            for d in frames(black_box(buf)) {
+            for d in Scan::<S>::new(black_box(buf)) {
                 acc = fold(acc, &d);
             }
             black_box(acc)
@@ -302,12 +313,12 @@ fn bench_stream(g: &mut BenchmarkGroup<'_, criterion::measurement::WallTime>, bu
     g.bench_function("feed_64k", |b| {
         b.iter(|| {
             let mut acc = 0u64;
-            let mut dec = Decoder::new();
+            let mut dec = StreamDecoder::<S>::new();
             for chunk in black_box(buf).chunks(CHUNK) {
                 dec.feed(chunk, |d| acc = fold(acc, &d));
             }
             dec.flush(|d| acc = fold(acc, &d));
-            black_box(dec.stats().bytes_skipped());
+            black_box(dec.stats());
             black_box(acc)
         })
     });
@@ -316,12 +327,12 @@ fn bench_stream(g: &mut BenchmarkGroup<'_, criterion::measurement::WallTime>, bu
     g.bench_function("push_256k", |b| {
         b.iter(|| {
             let mut acc = 0u64;
-            let mut dec = Decoder::new();
+            let mut dec = StreamDecoder::<S>::new();
             for &byte in black_box(small) {
                 dec.push(byte, |d| acc = fold(acc, &d));
             }
             dec.flush(|d| acc = fold(acc, &d));
-            black_box(dec.stats().bytes_skipped());
+            black_box(dec.stats());
             black_box(acc)
         })
     });
@@ -401,51 +412,12 @@ fn check_datalink(name: &str, buf: &[u8], e: &Expected) {
     assert_eq!(*dec.stats(), s, "{name}: statistics disagree");
 }
 
-fn bench_datalink(g: &mut BenchmarkGroup<'_, criterion::measurement::WallTime>, buf: &[u8]) {
-    g.throughput(Throughput::Bytes(buf.len() as u64));
-    g.bench_function("frames", |b| {
-        b.iter(|| {
-            let mut acc = 0u64;
-            for d in datalink::frames(black_box(buf)) {
-                acc = fold_datalink(acc, &d);
-            }
-            black_box(acc)
-        })
-    });
-    g.bench_function("feed_64k", |b| {
-        b.iter(|| {
-            let mut acc = 0u64;
-            let mut dec = DatalinkDecoder::new();
-            for chunk in black_box(buf).chunks(CHUNK) {
-                dec.feed(chunk, |d| acc = fold_datalink(acc, &d));
-            }
-            dec.flush(|d| acc = fold_datalink(acc, &d));
-            black_box(dec.stats().bytes_skipped());
-            black_box(acc)
-        })
-    });
-    let small = &buf[..PUSH_LEN];
-    g.throughput(Throughput::Bytes(small.len() as u64));
-    g.bench_function("push_256k", |b| {
-        b.iter(|| {
-            let mut acc = 0u64;
-            let mut dec = DatalinkDecoder::new();
-            for &byte in black_box(small) {
-                dec.push(byte, |d| acc = fold_datalink(acc, &d));
-            }
-            dec.flush(|d| acc = fold_datalink(acc, &d));
-            black_box(dec.stats().bytes_skipped());
-            black_box(acc)
-        })
-    });
-}
-
 fn bulk(c: &mut Criterion) {
     for (name, noisy) in [("datalink_clean", false), ("datalink_noisy", true)] {
         let (buf, expected) = datalink_stream(noisy);
         check_datalink(name, &buf, &expected);
         let mut g = c.benchmark_group(name);
-        bench_datalink(&mut g, &buf);
+        bench_decoder::<DatalinkScanner>(&mut g, &buf, fold_datalink);
         g.finish();
     }
     let streams = [
@@ -456,7 +428,7 @@ fn bulk(c: &mut Criterion) {
     for (name, (buf, expected)) in streams {
         check(name, &buf, &expected);
         let mut g = c.benchmark_group(name);
-        bench_stream(&mut g, &buf);
+        bench_decoder::<HwFocScanner>(&mut g, &buf, fold);
         g.finish();
     }
 }
