@@ -115,7 +115,8 @@ impl Outlet {
     }
 
     /// Opens the outlet for `n` ESCs at `baud`; existing files are replaced only if
-    /// `overwrite`.
+    /// `overwrite` ([`Session::open`](crate::Session::open) has refused them all before any
+    /// is created; each creation still refuses a file that appeared since).
     pub(crate) fn open(&self, n: usize, baud: u32, overwrite: bool) -> Result<Opened, SimError> {
         #[cfg(unix)]
         let mut links = pty::Links::default();
@@ -140,7 +141,6 @@ impl Outlet {
                 if *format == FileFormat::Raw && paths.len() < n {
                     return Err(SimError::SharedRaw { n });
                 }
-                sink::check_new(paths.iter().map(String::as_str), overwrite)?;
                 let mut outs = Vec::with_capacity(paths.len());
                 for path in &paths {
                     outs.push(sink::create(path, overwrite)?);
