@@ -420,11 +420,7 @@ impl Fleet {
                         Item::Record(r) => {
                             let i = if hub {
                                 let channel = self.streams.channel_of(port, r.esc).unwrap_or(0);
-                                let i = self.channel_view(port, usize::from(channel));
-                                if let Some(settings) = self.streams.settings_of(r.esc) {
-                                    self.escs[i].settings = *settings;
-                                }
-                                i
+                                self.channel_view(port, usize::from(channel), r.esc)
                             } else {
                                 port
                             };
@@ -506,9 +502,10 @@ impl Fleet {
             .collect()
     }
 
-    /// The ESC shown for channel `channel` of the DataLink hub on `port`: the port's own ESC for
-    /// the first channel heard, a new one (after all others) for each next channel.
-    fn channel_view(&mut self, port: usize, channel: usize) -> usize {
+    /// The ESC shown for channel `channel` (ESC number `esc`) of the DataLink hub on `port`:
+    /// the port's own ESC for the first channel heard, a new one (after all others) for each
+    /// next channel; made with that ESC's settings.
+    fn channel_view(&mut self, port: usize, channel: usize, esc: u8) -> usize {
         if let Some(&i) = self.channels.get(&(port, channel)) {
             return i;
         }
@@ -537,6 +534,9 @@ impl Fleet {
             port
         };
         self.escs[i].name = format!("{name} channel {channel}");
+        if let Some(settings) = self.streams.settings_of(esc) {
+            self.escs[i].settings = *settings;
+        }
         self.channels.insert((port, channel), i);
         i
     }
