@@ -18,9 +18,9 @@ use hwfoc_bridge::dronecan::transport::transfer_crc;
 use hwfoc_bridge::dronecan::{DronecanOptions, DronecanOutput, SlcanTarget};
 use hwfoc_bridge::{Output, OutputError, SILENT_AFTER, Update};
 use hwfoc_io::Record;
+use hwfoc_sim::pty::RawPair;
 use nix::fcntl::{FcntlArg, OFlag, fcntl};
 use nix::poll::{PollFd, PollFlags, PollTimeout, poll};
-use nix::sys::termios::{SetArg, cfmakeraw, tcgetattr, tcsetattr};
 
 /// A pty pair: the test holds the master (the adapter's side) and keeps the slave open (so
 /// that the master never sees a hang-up while the program under test reopens it).
@@ -32,17 +32,15 @@ struct Pty {
 
 impl Pty {
     fn open() -> Pty {
-        let pair = nix::pty::openpty(None, None).unwrap();
-        let mut mode = tcgetattr(&pair.slave).unwrap();
-        cfmakeraw(&mut mode);
-        tcsetattr(&pair.slave, SetArg::TCSANOW, &mode).unwrap();
-        let path = nix::unistd::ttyname(&pair.slave).unwrap();
+        // Close-on-exec: pydronecan's Python, started by a test beside this one, must not
+        // hold the master open (the slave would never hang up when a test drops it).
+        let pair = RawPair::open().unwrap();
         let flags = OFlag::from_bits_truncate(fcntl(&pair.master, FcntlArg::F_GETFL).unwrap());
         fcntl(&pair.master, FcntlArg::F_SETFL(flags | OFlag::O_NONBLOCK)).unwrap();
         Pty {
-            master: File::from(pair.master),
+            master: pair.master,
             _slave: pair.slave,
-            path,
+            path: pair.path,
         }
     }
 

@@ -535,16 +535,9 @@ fn a_serial_port_carries_the_same_messages() {
     use std::io::Read;
     use std::os::fd::AsFd;
 
-    let pair = nix::pty::openpty(None, None).unwrap();
-    let mut termios = nix::sys::termios::tcgetattr(pair.slave.as_fd()).unwrap();
-    nix::sys::termios::cfmakeraw(&mut termios);
-    nix::sys::termios::tcsetattr(
-        pair.slave.as_fd(),
-        nix::sys::termios::SetArg::TCSANOW,
-        &termios,
-    )
-    .unwrap();
-    let path = nix::unistd::ttyname(pair.slave.as_fd()).unwrap();
+    // Close-on-exec: pymavlink's Python, started by a test beside this one, must not hold it.
+    let pair = hwfoc_sim::pty::RawPair::open().unwrap();
+    let path = pair.path;
     let target =
         MavlinkTarget::parse(&format!("serial:{}:115200", path.to_string_lossy())).unwrap();
     let mut out = MavlinkOutput::open(target, MavlinkOptions::default()).unwrap();
@@ -563,7 +556,7 @@ fn a_serial_port_carries_the_same_messages() {
     assert_eq!(out.stats().errors, 0);
     // The messages may come through the pseudo-terminal in several reads: read until the line
     // has been quiet for 200 ms (the messages were all written above).
-    let master = std::fs::File::from(pair.master);
+    let master = pair.master;
     let mut bytes = Vec::new();
     let mut chunk = [0u8; 4096];
     loop {

@@ -7,7 +7,7 @@ mod common;
 use std::path::Path;
 use std::process::{Command, Output};
 
-use common::{Dir, OutputLocked, assert_fails_with, hwfoc, ok};
+use common::{Dir, assert_fails_with, hwfoc, ok};
 use serde_json::Value;
 
 /// `hwfoc` with no configuration of the user's: an empty configuration directory, no
@@ -32,7 +32,8 @@ fn recording(dir: &Dir) -> String {
     ok(clean(&dir.path("none"))
         .args(["simulate", "--escs", "2", "--seed", "5", "--duration", "6"])
         .args(["--quiet", "--no-config", "-o", &path])
-        .output_locked());
+        .output()
+        .expect("spawn"));
     path
 }
 
@@ -75,7 +76,8 @@ fn monitor_settings(home: &Path, extra: &[&str]) -> Vec<(u64, f64, f64, f64, f64
             "2.7",
         ])
         .args(extra)
-        .output_locked());
+        .output()
+        .expect("spawn"));
     let values = jsonl(&out);
     let last = |esc: u64| {
         values
@@ -158,7 +160,12 @@ fn flags_beat_the_file_and_the_file_beats_the_defaults() {
     let input = recording(&dir);
     let home = user_config(&dir, "[settings]\npole_pairs = 14\n");
     let ratio = |cmd: &mut Command, args: &[&str]| -> Vec<f64> {
-        let out = ok(cmd.arg("decode").args(args).arg(&input).output_locked());
+        let out = ok(cmd
+            .arg("decode")
+            .args(args)
+            .arg(&input)
+            .output()
+            .expect("spawn"));
         let mut seen: Vec<f64> = turning(&jsonl(&out))
             .iter()
             .map(|r| (r.1 / r.2 * 1000.0).round() / 1000.0)
@@ -222,9 +229,21 @@ fn decode_converts_each_esc_under_its_own_settings() {
     let dir = Dir::new();
     let input = recording(&dir);
     let none = dir.path("none");
-    let plain = |args: &[&str]| ok(clean(&none).arg("decode").args(args).output_locked());
+    let plain = |args: &[&str]| {
+        ok(clean(&none)
+            .arg("decode")
+            .args(args)
+            .output()
+            .expect("spawn"))
+    };
     let home = user_config(&dir, ESC1);
-    let configured = |args: &[&str]| ok(clean(&home).arg("decode").args(args).output_locked());
+    let configured = |args: &[&str]| {
+        ok(clean(&home)
+            .arg("decode")
+            .args(args)
+            .output()
+            .expect("spawn"))
+    };
 
     // JSON Lines, and nothing said on standard error.
     let defaults = values(&jsonl(&plain(&[&input])));
@@ -325,17 +344,22 @@ fn a_ports_settings_apply_in_decode_to_the_esc_read_from_it() {
     // The recording names its ports esc-0 and esc-1.
     let out = ok(clean(&dir.path("none"))
         .args(["summary", "--json", &input])
-        .output_locked());
+        .output()
+        .expect("spawn"));
     let report: Value = serde_json::from_slice(&out.stdout).unwrap();
     assert_eq!(report["escs"][1]["stream"], "esc-1", "{report}");
     let defaults = values(&jsonl(&ok(clean(&dir.path("none"))
         .args(["decode", &input])
-        .output_locked())));
+        .output()
+        .expect("spawn"))));
     let home = user_config(
         &dir,
         "[port.\"esc-1\"]\ngear_ratio = 2\ncurrent_scale = 32\n",
     );
-    let out = ok(clean(&home).args(["decode", &input]).output_locked());
+    let out = ok(clean(&home)
+        .args(["decode", &input])
+        .output()
+        .expect("spawn"));
     only_esc1_changed(&defaults, &values(&jsonl(&out)), 0.5, 2.0);
 }
 
@@ -348,7 +372,8 @@ fn summary_converts_each_esc_under_its_own_settings() {
     let json = |home: &Path| -> Value {
         let out = ok(clean(home)
             .args(["summary", "--json", &input])
-            .output_locked());
+            .output()
+            .expect("spawn"));
         assert!(
             out.stderr.is_empty(),
             "{}",
@@ -405,7 +430,10 @@ fn summary_converts_each_esc_under_its_own_settings() {
 
     // The text: the settings line names ESC 1's, the figures are converted under them.
     let text = |home: &Path| {
-        let out = ok(clean(home).args(["summary", &input]).output_locked());
+        let out = ok(clean(home)
+            .args(["summary", &input])
+            .output()
+            .expect("spawn"));
         assert!(
             out.stderr.is_empty(),
             "{}",
@@ -453,7 +481,8 @@ fn summary_plot_and_simulate_read_it_too() {
     // summary reports the settings it used.
     let out = ok(clean(&home)
         .args(["summary", "--json", &input])
-        .output_locked());
+        .output()
+        .expect("spawn"));
     let report: Value = serde_json::from_slice(&out.stdout).unwrap();
     assert_eq!(report["settings"]["pole_pairs"], 14, "{report}");
     assert_eq!(report["settings"]["current_scale"], 100.0, "{report}");
@@ -461,7 +490,8 @@ fn summary_plot_and_simulate_read_it_too() {
     let svg = dir.arg("plot.svg");
     ok(clean(&home)
         .args(["plot", &input, "-o", &svg])
-        .output_locked());
+        .output()
+        .expect("spawn"));
     let text = std::fs::read_to_string(&svg).unwrap();
     assert!(text.contains("14 pole pairs"), "no settings in the plot");
     // simulate encodes under them: its frames decode to its truth under the same file, and to
@@ -479,19 +509,24 @@ fn summary_plot_and_simulate_read_it_too() {
             "--truth",
             &truth,
         ])
-        .output_locked());
+        .output()
+        .expect("spawn"));
     let truth: Vec<Value> = std::fs::read_to_string(&truth)
         .unwrap()
         .lines()
         .map(|l| serde_json::from_str(l).unwrap())
         .collect();
-    let with = jsonl(&ok(clean(&home).args(["decode", &raw]).output_locked()));
+    let with = jsonl(&ok(clean(&home)
+        .args(["decode", &raw])
+        .output()
+        .expect("spawn")));
     let rpm = |v: &[Value]| -> Vec<f64> { v.iter().map(|r| r["rpm"].as_f64().unwrap()).collect() };
     assert_eq!(rpm(&with), rpm(&truth));
     assert!(rpm(&truth).iter().any(|&r| r > 100.0));
     let without = jsonl(&ok(clean(&home)
         .args(["decode", "--no-config", &raw])
-        .output_locked()));
+        .output()
+        .expect("spawn")));
     for (a, b) in rpm(&without).iter().zip(rpm(&truth)) {
         assert!((a - 2.0 * b).abs() < 0.01, "{a} {b}");
     }
@@ -515,7 +550,8 @@ fn the_monitor_converts_each_esc_under_its_own_settings() {
             "--duration",
             "3.2",
         ])
-        .output_locked());
+        .output()
+        .expect("spawn"));
     let values = jsonl(&out);
     let status = |esc: u64| -> Vec<&Value> {
         values
@@ -557,7 +593,8 @@ fn the_older_monitor_file_is_still_read_by_the_monitor() {
             "--duration",
             "1.6",
         ])
-        .output_locked());
+        .output()
+        .expect("spawn"));
     let values = jsonl(&out);
     let status = values.iter().find(|v| v["type"] == "status").unwrap();
     assert_eq!(status["label"], "tail rotor");
@@ -585,7 +622,8 @@ fn the_older_monitor_file_is_still_read_by_the_monitor() {
             "--duration",
             "1.2",
         ])
-        .output_locked());
+        .output()
+        .expect("spawn"));
     let values = jsonl(&out);
     let status = values.iter().find(|v| v["type"] == "status").unwrap();
     assert_eq!(status["settings"]["pole_pairs"], 3);
@@ -606,24 +644,29 @@ fn a_bad_file_is_an_error_naming_its_line_and_key() {
         &["simulate", "--duration", "1", "-o", &dir.arg("s.bin")],
         &["monitor", "--sim", "1", "--plain", "--duration", "1"],
     ] {
-        let out = clean(&home).args(args).output_locked();
+        let out = clean(&home).args(args).output().expect("spawn");
         assert_fails_with(&out, "config.toml line 6: unknown field `curent_scale`");
     }
     // Out of range: the entry is named.
     let home = user_config(&dir, "[esc.3]\npole_pairs = 0\n");
-    let out = clean(&home).args(["decode", "--demo"]).output_locked();
+    let out = clean(&home)
+        .args(["decode", "--demo"])
+        .output()
+        .expect("spawn");
     assert_fails_with(&out, "config.toml ([esc.3])");
     // A file named and missing.
     let out = clean(&home)
         .args(["decode", "--demo", "--config", "/nonexistent/hwfoc.toml"])
-        .output_locked();
+        .output()
+        .expect("spawn");
     assert_fails_with(&out, "/nonexistent/hwfoc.toml");
     // --no-config reads none of it.
     ok(clean(&home)
         .args(["decode", "--demo", "--no-config"])
-        .output_locked());
+        .output()
+        .expect("spawn"));
     // The help says how settings are found.
-    let help = ok(hwfoc().args(["decode", "--help"]).output_locked());
+    let help = ok(hwfoc().args(["decode", "--help"]).output().expect("spawn"));
     let help = String::from_utf8_lossy(&help.stdout);
     assert!(
         help.contains("[esc.N]") && help.contains("HWFOC_CONFIG"),

@@ -4,7 +4,7 @@
 
 mod common;
 
-use common::{OutputLocked, SCHEMA, XROTOR, capture, hwfoc, ok, stdout};
+use common::{SCHEMA, XROTOR, capture, hwfoc, ok, stdout};
 use serde_json::Value;
 
 /// The first key of `v` and its value.
@@ -48,7 +48,8 @@ fn monitor_json_status_and_alarm_lines_carry_the_schema_version() {
             "--fault",
             "throttle_signal_lost@1-1.2",
         ])
-        .output_locked());
+        .output()
+        .expect("spawn"));
     let lines: Vec<Value> = String::from_utf8(out.stdout)
         .unwrap()
         .lines()

@@ -10,7 +10,7 @@ use std::str::FromStr;
 use std::thread;
 use std::time::{Duration, Instant};
 
-use common::{OutputLocked, Running, SCHEMA, hwfoc, ok, stdout};
+use common::{Running, SCHEMA, hwfoc, ok, stdout};
 use nix::sys::signal::Signal;
 use serde_json::Value;
 
@@ -37,7 +37,8 @@ fn plain_prints_each_esc_every_interval_and_alarms_by_name() {
             "--fault",
             "1:mos_overheat@3-4",
         ])
-        .output_locked();
+        .output()
+        .expect("spawn");
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(out.status.success(), "{stderr}");
     let lines = lines(&out.stdout);
@@ -154,7 +155,8 @@ fn json_lines_carry_the_schema_record_link_and_alarms() {
             "--fault",
             "throttle_signal_lost@1-1.2",
         ])
-        .output_locked();
+        .output()
+        .expect("spawn");
     let out = ok(out);
     let values: Vec<Value> = lines(&out.stdout)
         .iter()
@@ -254,11 +256,12 @@ fn record_while_monitoring_writes_a_recording_that_decodes() {
         .args(["monitor", "--sim", "2", "--plain", "--no-config"])
         .args(["--duration", "2.5", "--record"])
         .arg(&path)
-        .output_locked();
+        .output()
+        .expect("spawn");
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(out.status.success(), "{stderr}");
     assert!(stderr.contains("recorded to"), "{stderr}");
-    let decoded = hwfoc().arg("decode").arg(&path).output_locked();
+    let decoded = hwfoc().arg("decode").arg(&path).output().expect("spawn");
     assert!(decoded.status.success());
     let records: Vec<Value> = lines(&decoded.stdout)
         .iter()
@@ -275,7 +278,7 @@ fn record_while_monitoring_writes_a_recording_that_decodes() {
 fn errors_say_what_to_do() {
     let dir = tempfile::tempdir().unwrap();
     let check = |args: &[&str], expected: &str| {
-        let out = hwfoc().arg("monitor").args(args).output_locked();
+        let out = hwfoc().arg("monitor").args(args).output().expect("spawn");
         let stderr = String::from_utf8_lossy(&out.stderr);
         assert!(!out.status.success(), "{args:?} succeeded");
         assert!(stderr.contains(expected), "{args:?}: {stderr}");
@@ -356,7 +359,8 @@ fn the_configuration_file_is_found_in_the_user_configuration_directory() {
     let out = hwfoc()
         .args(["monitor", "--sim", "1", "--plain", "--duration", "1.2"])
         .env("XDG_CONFIG_HOME", dir.path())
-        .output_locked();
+        .output()
+        .expect("spawn");
     let text = stdout(&out);
     assert!(text.contains(" esc0 tail rotor: "), "{text}");
     // --no-config leaves it out.
@@ -371,7 +375,8 @@ fn the_configuration_file_is_found_in_the_user_configuration_directory() {
             "--no-config",
         ])
         .env("XDG_CONFIG_HOME", dir.path())
-        .output_locked();
+        .output()
+        .expect("spawn");
     let text = stdout(&out);
     assert!(text.contains(" esc0 sim:esc0: "), "{text}");
 }
@@ -391,7 +396,8 @@ fn a_configuration_file_sets_labels_and_levels() {
         .args(["monitor", "--sim", "1", "--plain", "--duration", "1.5"])
         .arg("--config")
         .arg(&config)
-        .output_locked();
+        .output()
+        .expect("spawn");
     let stdout = stdout(&out);
     assert!(
         stdout.contains("ALARM esc0 front left: mos_temp warning raised at"),
@@ -590,7 +596,11 @@ fn the_dashboard_in_tmux() {
         name.starts_with("hwfoc-") && name.ends_with(".pcapng"),
         "{name}"
     );
-    let decoded = hwfoc().arg("decode").arg(&files[0]).output_locked();
+    let decoded = hwfoc()
+        .arg("decode")
+        .arg(&files[0])
+        .output()
+        .expect("spawn");
     assert!(decoded.status.success());
     assert!(
         lines(&decoded.stdout).len() >= 4 * 10,

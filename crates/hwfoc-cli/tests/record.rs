@@ -12,7 +12,7 @@ use std::process::{Command, Stdio};
 use std::thread;
 use std::time::{Duration, Instant};
 
-use common::{OutputLocked, Pty, Running, SPAWN, hwfoc, pty, run, spawn, unix_now};
+use common::{Pty, Running, hwfoc, pty, run, spawn, unix_now};
 use hwfoc::{DataFrame, InfoFrame};
 use nix::sys::signal::{Signal, kill};
 use nix::unistd::Pid;
@@ -100,11 +100,10 @@ fn packet_blocks(file: &[u8]) -> Vec<(u32, u64, Vec<u8>)> {
 }
 
 fn tshark_available() -> bool {
-    let found = {
-        let _guard = SPAWN.lock().unwrap_or_else(|e| e.into_inner());
-        Command::new("tshark").arg("--version").output()
-    }
-    .is_ok_and(|o| o.status.success());
+    let found = Command::new("tshark")
+        .arg("--version")
+        .output()
+        .is_ok_and(|o| o.status.success());
     common::can_check(found, "tshark (reading recordings with standard tools)")
 }
 
@@ -197,7 +196,8 @@ fn records_a_pty_exactly() {
                 "-e",
                 "frame.len",
             ])
-            .output_locked();
+            .output()
+            .expect("spawn");
         assert!(
             out.status.success(),
             "{}",
@@ -499,7 +499,8 @@ fn errors_name_the_port_or_file() {
     let o = hwfoc()
         .args(["record", "/dev/ttyUSB_hwfoc_missing", "-o"])
         .arg(&out)
-        .output_locked();
+        .output()
+        .expect("spawn");
     assert!(!o.status.success());
     let e = String::from_utf8_lossy(&o.stderr);
     assert!(
@@ -511,7 +512,8 @@ fn errors_name_the_port_or_file() {
     // Decoding a missing port says the same.
     let o = hwfoc()
         .args(["decode", "/dev/ttyUSB_hwfoc_missing"])
-        .output_locked();
+        .output()
+        .expect("spawn");
     assert!(!o.status.success());
     assert!(String::from_utf8_lossy(&o.stderr).contains("no such port"));
 
@@ -523,7 +525,8 @@ fn errors_name_the_port_or_file() {
         .arg(&file)
         .arg("-o")
         .arg(&out)
-        .output_locked();
+        .output()
+        .expect("spawn");
     assert!(!o.status.success());
     assert!(String::from_utf8_lossy(&o.stderr).contains("not a serial port"));
 
@@ -540,7 +543,8 @@ fn errors_name_the_port_or_file() {
             "--duration",
             "1",
         ])
-        .output_locked();
+        .output()
+        .expect("spawn");
     assert!(!o.status.success());
     let e = String::from_utf8_lossy(&o.stderr);
     assert!(
@@ -556,7 +560,8 @@ fn errors_name_the_port_or_file() {
     let o = hwfoc()
         .args(["record", &port, "-o"])
         .arg(dir.path().join("y.pcapng"))
-        .output_locked();
+        .output()
+        .expect("spawn");
     holder.signal(Signal::SIGINT);
     assert!(holder.wait(Duration::from_secs(5)));
     assert!(!o.status.success());
@@ -564,7 +569,12 @@ fn errors_name_the_port_or_file() {
     assert!(e.contains(&format!("{port} is busy")), "{e}");
 
     // Ports and files cannot be mixed.
-    let o = hwfoc().arg("decode").arg(&port).arg(&file).output_locked();
+    let o = hwfoc()
+        .arg("decode")
+        .arg(&port)
+        .arg(&file)
+        .output()
+        .expect("spawn");
     assert!(!o.status.success());
     assert!(String::from_utf8_lossy(&o.stderr).contains("cannot read the serial port"));
 }
@@ -583,10 +593,7 @@ fn permission_denied_says_which_group_to_join() {
     } else {
         std::fs::set_permissions(&pty.path, std::fs::Permissions::from_mode(0o000)).unwrap();
     }
-    let child = {
-        let _guard = SPAWN.lock().unwrap_or_else(|e| e.into_inner());
-        cmd.stdout(Stdio::piped()).stderr(Stdio::piped()).spawn()
-    };
+    let child = cmd.stdout(Stdio::piped()).stderr(Stdio::piped()).spawn();
     let child = match child {
         Ok(child) => child,
         Err(e) if !common::can_check(false, &format!("starting hwfoc as another user ({e})")) => {

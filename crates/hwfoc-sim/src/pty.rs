@@ -13,19 +13,78 @@
 //! fills the kernel's buffer (a few KiB), after which bytes are dropped and counted, never
 //! blocking the simulation. A reader may close and reopen the port at any time. Anything a
 //! reader writes to the port is read and discarded.
+//!
+//! Both sides are opened close-on-exec ([`RawPair::open`]): a program started by this process
+//! (a ground station, a test's Python) must not inherit the master, or the slave would never
+//! see the hang-up when we close it.
 
 use std::fs::File;
 use std::io::{self, Read, Write};
-use std::os::fd::AsFd;
+use std::os::fd::{AsFd, OwnedFd};
 use std::path::{Path, PathBuf};
 
 use nix::fcntl::{FcntlArg, OFlag, fcntl};
 use nix::poll::{PollFd, PollFlags, PollTimeout, poll};
-use nix::pty::openpty;
 use nix::sys::termios::{SetArg, cfmakeraw, tcgetattr, tcsetattr};
 
 use crate::error::SimError;
 use crate::sink::expand;
+
+/// A pseudo-terminal pair in raw mode, both sides close-on-exec from the moment they exist.
+///
+/// `nix::pty::openpty` (glibc's `openpty`) opens both sides inheritable, and setting
+/// `FD_CLOEXEC` afterwards leaves a window in which a thread that starts a program hands it the
+/// master; the program then holds the terminal open after we close it. On Linux the master is
+/// opened with `O_CLOEXEC` and the slave by its name, so there is no window.
+#[derive(Debug)]
+pub struct RawPair {
+    /// The master side (blocking).
+    pub master: File,
+    /// The slave side.
+    pub slave: OwnedFd,
+    /// The slave's path, to open like a serial port.
+    pub path: PathBuf,
+}
+
+impl RawPair {
+    /// Opens a pair and puts the slave in raw mode (nothing echoed or translated).
+    pub fn open() -> io::Result<RawPair> {
+        let (master, slave) = open_cloexec()?;
+        let mut mode = tcgetattr(&slave)?;
+        cfmakeraw(&mut mode);
+        tcsetattr(&slave, SetArg::TCSANOW, &mode)?;
+        let path = nix::unistd::ttyname(&slave)?;
+        Ok(RawPair {
+            master: File::from(master),
+            slave,
+            path,
+        })
+    }
+}
+
+#[cfg(any(target_os = "linux", target_os = "android"))]
+fn open_cloexec() -> nix::Result<(OwnedFd, OwnedFd)> {
+    use nix::pty::{grantpt, posix_openpt, ptsname_r, unlockpt};
+    let flags = OFlag::O_RDWR | OFlag::O_NOCTTY | OFlag::O_CLOEXEC;
+    let master = posix_openpt(flags)?;
+    grantpt(&master)?;
+    unlockpt(&master)?;
+    let name = ptsname_r(&master)?;
+    let slave = nix::fcntl::open(name.as_str(), flags, nix::sys::stat::Mode::empty())?;
+    Ok((master.into(), slave))
+}
+
+/// Elsewhere `posix_openpt` may refuse `O_CLOEXEC` and `ptsname_r` is missing: `openpty`, then
+/// close-on-exec at once (the window described on [`RawPair`] remains).
+#[cfg(not(any(target_os = "linux", target_os = "android")))]
+fn open_cloexec() -> nix::Result<(OwnedFd, OwnedFd)> {
+    use nix::fcntl::FdFlag;
+    let pair = nix::pty::openpty(None, None)?;
+    for fd in [&pair.master, &pair.slave] {
+        fcntl(fd, FcntlArg::F_SETFD(FdFlag::FD_CLOEXEC))?;
+    }
+    Ok((pair.master, pair.slave))
+}
 
 /// One pseudo-terminal: our master side and the path of the slave.
 #[derive(Debug)]
@@ -38,21 +97,17 @@ pub struct Pty {
 impl Pty {
     /// Creates a pty in raw mode.
     pub fn open() -> Result<Pty, SimError> {
-        let err = |e: nix::Error| SimError::Pty {
-            source: io::Error::from(e),
-        };
-        let pair = openpty(None, None).map_err(err)?;
-        let mut mode = tcgetattr(&pair.slave).map_err(err)?;
-        cfmakeraw(&mut mode);
-        tcsetattr(&pair.slave, SetArg::TCSANOW, &mode).map_err(err)?;
-        let path = nix::unistd::ttyname(&pair.slave).map_err(err)?;
+        let err = |source: io::Error| SimError::Pty { source };
+        let pair = RawPair::open().map_err(err)?;
         drop(pair.slave);
-        let flags = fcntl(&pair.master, FcntlArg::F_GETFL).map_err(err)?;
-        let flags = OFlag::from_bits_truncate(flags) | OFlag::O_NONBLOCK;
-        fcntl(&pair.master, FcntlArg::F_SETFL(flags)).map_err(err)?;
+        let flags = fcntl(&pair.master, FcntlArg::F_GETFL).map_err(io::Error::from);
+        let flags = OFlag::from_bits_truncate(flags.map_err(err)?) | OFlag::O_NONBLOCK;
+        fcntl(&pair.master, FcntlArg::F_SETFL(flags))
+            .map_err(io::Error::from)
+            .map_err(err)?;
         Ok(Pty {
-            master: File::from(pair.master),
-            path,
+            master: pair.master,
+            path: pair.path,
             undelivered: 0,
         })
     }

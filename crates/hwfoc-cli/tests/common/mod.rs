@@ -6,7 +6,6 @@
 
 use std::path::PathBuf;
 use std::process::{Child, Command, Output, Stdio};
-use std::sync::Mutex;
 use std::time::{SystemTime, UNIX_EPOCH};
 
 #[cfg(unix)]
@@ -77,13 +76,7 @@ pub fn hwfoc() -> Command {
     Command::new(env!("CARGO_BIN_EXE_hwfoc"))
 }
 
-/// Held while a pty is opened and while a process is started: a process started by another
-/// test in between would inherit the pty's descriptors (before they are made close-on-exec)
-/// and keep it alive after the test closes it.
-pub static SPAWN: Mutex<()> = Mutex::new(());
-
 pub fn spawn(cmd: &mut Command) -> Child {
-    let _guard = SPAWN.lock().unwrap_or_else(|e| e.into_inner());
     cmd.stdout(Stdio::piped())
         .stderr(Stdio::piped())
         .spawn()
@@ -92,17 +85,6 @@ pub fn spawn(cmd: &mut Command) -> Child {
 
 pub fn run(cmd: &mut Command) -> Output {
     spawn(cmd).wait_with_output().expect("wait")
-}
-
-/// [`Command::output`] with the process started under [`SPAWN`].
-pub trait OutputLocked {
-    fn output_locked(&mut self) -> Output;
-}
-
-impl OutputLocked for Command {
-    fn output_locked(&mut self) -> Output {
-        run(self)
-    }
 }
 
 pub fn unix_now() -> f64 {
@@ -116,7 +98,7 @@ pub fn unix_now() -> f64 {
 #[cfg(unix)]
 mod unix {
     use std::io::{BufRead, BufReader, Read};
-    use std::os::fd::{AsFd, OwnedFd};
+    use std::os::fd::OwnedFd;
     use std::path::PathBuf;
     use std::process::Child;
     use std::sync::mpsc::{self, Receiver, Sender};
@@ -124,13 +106,12 @@ mod unix {
     use std::thread;
     use std::time::{Duration, Instant};
 
-    use nix::fcntl::{FcntlArg, FdFlag, fcntl};
-    use nix::pty::openpty;
     use nix::sys::signal::{Signal, kill};
-    use nix::sys::termios::{SetArg, cfmakeraw, tcgetattr, tcsetattr};
     use nix::unistd::Pid;
 
-    use super::{SPAWN, hwfoc, spawn};
+    use hwfoc_sim::pty::RawPair;
+
+    use super::{hwfoc, spawn};
 
     /// A pseudo-terminal: the master side the test writes to, and the path of the slave side that
     /// `hwfoc` opens like a serial port.
@@ -141,19 +122,13 @@ mod unix {
     }
 
     pub fn pty() -> Pty {
-        let _guard = SPAWN.lock().unwrap_or_else(|e| e.into_inner());
-        let pair = openpty(None, None).expect("openpty");
-        for fd in [&pair.master, &pair.slave] {
-            fcntl(fd.as_fd(), FcntlArg::F_SETFD(FdFlag::FD_CLOEXEC)).unwrap();
-        }
-        // Raw, so that nothing is echoed or translated before `hwfoc` opens the port.
-        let mut termios = tcgetattr(pair.slave.as_fd()).unwrap();
-        cfmakeraw(&mut termios);
-        tcsetattr(pair.slave.as_fd(), SetArg::TCSANOW, &termios).unwrap();
-        let path = nix::unistd::ttyname(pair.slave.as_fd()).expect("ttyname");
+        // Raw, so that nothing is echoed or translated before `hwfoc` opens the port; both sides
+        // close-on-exec from the start, so that an `hwfoc` started by another test meanwhile
+        // does not keep the terminal alive after this test closes it.
+        let pair = RawPair::open().expect("pty");
         Pty {
-            master: std::fs::File::from(pair.master),
-            path,
+            master: pair.master,
+            path: pair.path,
             _slave: pair.slave,
         }
     }
