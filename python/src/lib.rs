@@ -141,15 +141,21 @@ pub(crate) fn warn_notices(py: Python<'_>, notes: &Notes) -> PyResult<()> {
         Err(_) => return Ok(()),
     };
     for notice in taken {
-        let text = notice.to_string();
-        match notice {
-            Notice::PortLost { .. } | Notice::PortBack { .. } => {
-                errors::warn(py, &py.get_type::<errors::PortWarning>(), &text)?
-            }
-            _ => errors::warn(py, &py.get_type::<errors::HwfocWarning>(), &text)?,
-        }
+        warn_notice(py, notice)?;
     }
     Ok(())
+}
+
+/// Issues one notice as a warning: `PortWarning` for a port lost or back, `HwfocWarning` for
+/// the rest.
+pub(crate) fn warn_notice(py: Python<'_>, notice: Notice) -> PyResult<()> {
+    let text = notice.to_string();
+    match notice {
+        Notice::PortLost { .. } | Notice::PortBack { .. } => {
+            errors::warn(py, &py.get_type::<errors::PortWarning>(), &text)
+        }
+        _ => errors::warn(py, &py.get_type::<errors::HwfocWarning>(), &text),
+    }
 }
 
 /// What `read` made: the record batches (with the schema without metadata), the ESCs found as

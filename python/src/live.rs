@@ -14,7 +14,7 @@ use hwfoc_io::InputError;
 use hwfoc_io::handler::Handler;
 use hwfoc_io::input::Batch;
 use hwfoc_io::notice::Notice;
-use hwfoc_io::serial::{DEFAULT_BAUD, PortEvent, PortSet};
+use hwfoc_io::serial::{DEFAULT_BAUD, PortSet};
 use hwfoc_io::stream::EscLink;
 use hwfoc_io::stream::{PortStreams, Stream, byte_times};
 use pyo3::exceptions::PyValueError;
@@ -312,22 +312,11 @@ impl Ports {
                 pending.push_back(row?.unbind());
             }
         }
-        let notice = match &event {
-            Some(PortEvent::Lost { port, reason, .. }) => Some(Notice::PortLost {
-                port: self.names[*port].clone(),
-                reason: reason.clone(),
-            }),
-            Some(PortEvent::Back { port, .. }) => Some(Notice::PortBack {
-                port: self.names[*port].clone(),
-            }),
-            _ => None,
-        };
-        if let Some(notice) = notice {
-            errors::warn(
-                py,
-                &py.get_type::<errors::PortWarning>(),
-                &notice.to_string(),
-            )?;
+        if let Some(notice) = event
+            .as_ref()
+            .and_then(|e| Notice::of_port_event(e, &self.names))
+        {
+            crate::warn_notice(py, notice)?;
         }
         if event.is_none() {
             py.check_signals()?;

@@ -10,6 +10,7 @@
 use std::fmt;
 
 use crate::pcapng::Damage;
+use crate::serial::PortEvent;
 
 /// Something an input met that the reader should know.
 #[derive(Debug, Clone, PartialEq)]
@@ -54,6 +55,21 @@ pub enum Notice {
 }
 
 impl Notice {
+    /// The notice of a port's [`PortEvent::Lost`] or [`PortEvent::Back`], the port named as in
+    /// `names` (the set's names); `None` for bytes, or a port `names` does not hold.
+    pub fn of_port_event(event: &PortEvent, names: &[String]) -> Option<Notice> {
+        match event {
+            PortEvent::Data { .. } => None,
+            PortEvent::Lost { port, reason, .. } => Some(Notice::PortLost {
+                port: names.get(*port)?.clone(),
+                reason: reason.clone(),
+            }),
+            PortEvent::Back { port, .. } => Some(Notice::PortBack {
+                port: names.get(*port)?.clone(),
+            }),
+        }
+    }
+
     /// Whether it warns of something lost or skipped (rather than only informing).
     pub fn is_warning(&self) -> bool {
         matches!(
@@ -135,5 +151,21 @@ mod tests {
         };
         assert_eq!(note.line(), "hwfoc: note: a.pcapng: /dev/ttyUSB1: gap");
         assert!(lost.is_warning() && !back.is_warning() && !note.is_warning());
+        let names = ["/dev/ttyUSB0".to_string()];
+        let event = |port| PortEvent::Lost {
+            port,
+            t_ns: 0,
+            reason: "No such device".into(),
+        };
+        assert_eq!(Notice::of_port_event(&event(0), &names), Some(lost));
+        assert_eq!(Notice::of_port_event(&event(1), &names), None);
+        let event = PortEvent::Back { port: 0, t_ns: 0 };
+        assert_eq!(Notice::of_port_event(&event, &names), Some(back));
+        let event = PortEvent::Data {
+            port: 0,
+            t_ns: 0,
+            bytes: vec![1],
+        };
+        assert_eq!(Notice::of_port_event(&event, &names), None);
     }
 }

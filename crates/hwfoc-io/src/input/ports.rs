@@ -50,13 +50,11 @@ impl Ports {
                     bytes.extend_from_slice(&data);
                     return port;
                 }
-                Some(PortEvent::Lost { port, reason, .. }) => notices(Notice::PortLost {
-                    port: self.set.names()[port].clone(),
-                    reason,
-                }),
-                Some(PortEvent::Back { port, .. }) => notices(Notice::PortBack {
-                    port: self.set.names()[port].clone(),
-                }),
+                Some(event) => {
+                    if let Some(notice) = Notice::of_port_event(&event, self.set.names()) {
+                        notices(notice);
+                    }
+                }
                 None => {}
             }
         }

@@ -277,18 +277,10 @@ fn take(
             );
             streams.feed(event, fanout);
         }
-        PortEvent::Lost { port, reason, .. } => {
-            let notice = Notice::PortLost {
-                port: names[*port].clone(),
-                reason: reason.clone(),
-            };
-            eprintln!("{}", notice.line());
-        }
-        PortEvent::Back { port, .. } => {
-            let notice = Notice::PortBack {
-                port: names[*port].clone(),
-            };
-            eprintln!("{}", notice.line());
+        PortEvent::Lost { .. } | PortEvent::Back { .. } => {
+            if let Some(notice) = Notice::of_port_event(event, names) {
+                eprintln!("{}", notice.line());
+            }
         }
     }
 }
