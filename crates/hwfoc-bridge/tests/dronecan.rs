@@ -19,7 +19,6 @@ use hwfoc_bridge::dronecan::{DronecanOptions, DronecanOutput, SlcanTarget};
 use hwfoc_bridge::{Output, OutputError, SILENT_AFTER, Update};
 use hwfoc_io::Record;
 use hwfoc_sim::pty::RawPair;
-use nix::fcntl::{FcntlArg, OFlag, fcntl};
 use nix::poll::{PollFd, PollFlags, PollTimeout, poll};
 
 /// A pty pair: the test holds the master (the adapter's side) and keeps the slave open (so
@@ -35,8 +34,7 @@ impl Pty {
         // Close-on-exec: pydronecan's Python, started by a test beside this one, must not
         // hold the master open (the slave would never hang up when a test drops it).
         let pair = RawPair::open().unwrap();
-        let flags = OFlag::from_bits_truncate(fcntl(&pair.master, FcntlArg::F_GETFL).unwrap());
-        fcntl(&pair.master, FcntlArg::F_SETFL(flags | OFlag::O_NONBLOCK)).unwrap();
+        pair.master_nonblocking().unwrap();
         Pty {
             master: pair.master,
             _slave: pair.slave,

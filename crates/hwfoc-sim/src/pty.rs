@@ -60,6 +60,13 @@ impl RawPair {
             path,
         })
     }
+
+    /// Makes reads and writes of the master return at once (`WouldBlock`) instead of waiting.
+    pub fn master_nonblocking(&self) -> io::Result<()> {
+        let flags = OFlag::from_bits_truncate(fcntl(&self.master, FcntlArg::F_GETFL)?);
+        fcntl(&self.master, FcntlArg::F_SETFL(flags | OFlag::O_NONBLOCK))?;
+        Ok(())
+    }
 }
 
 #[cfg(any(target_os = "linux", target_os = "android"))]
@@ -99,12 +106,8 @@ impl Pty {
     pub fn open() -> Result<Pty, SimError> {
         let err = |source: io::Error| SimError::Pty { source };
         let pair = RawPair::open().map_err(err)?;
+        pair.master_nonblocking().map_err(err)?;
         drop(pair.slave);
-        let flags = fcntl(&pair.master, FcntlArg::F_GETFL).map_err(io::Error::from);
-        let flags = OFlag::from_bits_truncate(flags.map_err(err)?) | OFlag::O_NONBLOCK;
-        fcntl(&pair.master, FcntlArg::F_SETFL(flags))
-            .map_err(io::Error::from)
-            .map_err(err)?;
         Ok(Pty {
             master: pair.master,
             path: pair.path,
