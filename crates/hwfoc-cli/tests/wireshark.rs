@@ -341,6 +341,21 @@ fn checksums_are_honest(shown: &[Shown]) -> usize {
     bad
 }
 
+/// Runs `hwfoc simulate ARGS -o FILE -q` (`args` separated by spaces), which must succeed.
+fn simulate(file: &Path, args: &str) {
+    let sim = run(hwfoc()
+        .arg("simulate")
+        .args(args.split_whitespace())
+        .arg("-o")
+        .arg(file)
+        .arg("-q"));
+    assert!(
+        sim.status.success(),
+        "{}",
+        String::from_utf8_lossy(&sim.stderr)
+    );
+}
+
 #[test]
 fn a_simulated_recording_dissects_as_decode_reads_it() {
     if !tshark_found() {
@@ -348,30 +363,11 @@ fn a_simulated_recording_dissects_as_decode_reads_it() {
     }
     let dir = tempfile::tempdir().unwrap();
     let file = dir.path().join("sim.pcapng");
-    let sim = run(hwfoc()
-        .args(["simulate", "--escs", "3", "--seed", "5", "--duration", "12"])
-        .args(["--start-time", "1754000000.25", "--lead-in", "3"])
-        .args([
-            "--garbage-rate",
-            "0.05",
-            "--bit-error-rate",
-            "3e-4",
-            "--cut-rate",
-            "0.02",
-        ])
-        .args([
-            "--fault",
-            "1:mos_overheat@4-5",
-            "--fault",
-            "over_current@6-6.5",
-        ])
-        .arg("-o")
-        .arg(&file)
-        .arg("-q"));
-    assert!(
-        sim.status.success(),
-        "{}",
-        String::from_utf8_lossy(&sim.stderr)
+    simulate(
+        &file,
+        "--escs 3 --seed 5 --duration 12 --start-time 1754000000.25 --lead-in 3 \
+         --garbage-rate 0.05 --bit-error-rate 3e-4 --cut-rate 0.02 \
+         --fault 1:mos_overheat@4-5 --fault over_current@6-6.5",
     );
 
     let shown = tshark(&file, &[], true);
@@ -671,27 +667,13 @@ fn noisy_recordings_dissect_frame_for_frame_as_decode_reads_them() {
     ];
     for (seed, garbage, bits, cuts, drops) in runs {
         let file = dir.path().join(format!("noisy-{seed}.pcapng"));
-        let sim = run(hwfoc()
-            .args(["simulate", "--escs", "2", "--duration", "20", "--seed"])
-            .arg(seed.to_string())
-            .args([
-                "--start-time",
-                "1754000000",
-                "--lead-in",
-                "3",
-                "--hold",
-                "3",
-            ])
-            .args(["--levels", "0,40,0,80"])
-            .args(["--garbage-rate", garbage, "--bit-error-rate", bits])
-            .args(["--cut-rate", cuts, "--drop-rate", drops])
-            .arg("-o")
-            .arg(&file)
-            .arg("-q"));
-        assert!(
-            sim.status.success(),
-            "{}",
-            String::from_utf8_lossy(&sim.stderr)
+        simulate(
+            &file,
+            &format!(
+                "--escs 2 --duration 20 --seed {seed} --start-time 1754000000 --lead-in 3 \
+                 --hold 3 --levels 0,40,0,80 --garbage-rate {garbage} --bit-error-rate {bits} \
+                 --cut-rate {cuts} --drop-rate {drops}"
+            ),
         );
         let (_, decoded) = same_frames_as_decode(&file, &format!("seed {seed}"));
         let n: Vec<usize> = decoded.values().map(Vec::len).collect();
