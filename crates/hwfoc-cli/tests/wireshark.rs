@@ -675,8 +675,25 @@ fn noisy_recordings_dissect_frame_for_frame_as_decode_reads_them() {
                  --cut-rate {cuts} --drop-rate {drops}"
             ),
         );
-        let (_, decoded) = same_frames_as_decode(&file, &format!("seed {seed}"));
+        let (shown, decoded) = same_frames_as_decode(&file, &format!("seed {seed}"));
         let n: Vec<usize> = decoded.values().map(Vec::len).collect();
+        // The device-information frames too (counted per port: a frame that fails its checks
+        // may hold any byte in its text, which tshark's fields do not escape).
+        let mut infos = [0, 0];
+        for s in &shown {
+            if s["hwfoc.kind"] == "info" && s["hwfoc.checksum.status"] == "1" {
+                infos[uint(&s["frame.interface_id"]) as usize] += 1;
+            }
+        }
+        let mut want = [0, 0];
+        for (port, _) in info_frames(&file) {
+            want[port as usize] += 1;
+        }
+        assert_eq!(
+            infos, want,
+            "seed {seed}: device-information frames per port"
+        );
+        assert!(want.iter().all(|&n| n > 10), "seed {seed}: {want:?}");
         assert!(
             n.len() == 2 && n.iter().all(|&n| n > 150),
             "seed {seed}: {n:?} frames"
