@@ -64,6 +64,26 @@ type Shown = std::collections::BTreeMap<&'static str, String>;
 /// occurrences (tshark aggregates them with `;`); fields a frame lacks (a temperature out of
 /// range) are told apart by the frame's own count of fields.
 fn tshark(file: &Path, options: &[&str], with_script: bool) -> Vec<Shown> {
+    tshark_fields(file, options, with_script, &FIELDS)
+}
+
+/// [`tshark`] without the device-information text, which in a frame that fails its checks
+/// may hold any byte (the aggregator `;` among them).
+fn tshark_without_text(file: &Path) -> Vec<Shown> {
+    let fields: Vec<&'static str> = FIELDS
+        .into_iter()
+        .filter(|f| !f.starts_with("hwfoc.info."))
+        .collect();
+    tshark_fields(file, &[], true, &fields)
+}
+
+/// [`tshark`] with the fields `fields`, a selection of [`FIELDS`] in its order.
+fn tshark_fields(
+    file: &Path,
+    options: &[&str],
+    with_script: bool,
+    fields: &[&'static str],
+) -> Vec<Shown> {
     let mut cmd = Command::new("tshark");
     if with_script {
         cmd.arg("-X")
@@ -78,7 +98,7 @@ fn tshark(file: &Path, options: &[&str], with_script: bool) -> Vec<Shown> {
         "-E",
         "separator=/t",
     ]);
-    for f in FIELDS {
+    for f in fields {
         cmd.args(["-e", f]);
     }
     let out = cmd.output().expect("tshark");
@@ -91,7 +111,7 @@ fn tshark(file: &Path, options: &[&str], with_script: bool) -> Vec<Shown> {
     let mut frames = Vec::new();
     for line in text.lines() {
         let cols: Vec<&str> = line.split('\t').collect();
-        assert_eq!(cols.len(), FIELDS.len(), "{line}");
+        assert_eq!(cols.len(), fields.len(), "{line}");
         let kinds: Vec<&str> = cols[1].split(';').filter(|k| !k.is_empty()).collect();
         // Fields every frame of a kind has, split per frame (a data frame's temperatures may be
         // absent: they are read only for packets of one frame).
@@ -102,7 +122,7 @@ fn tshark(file: &Path, options: &[&str], with_script: bool) -> Vec<Shown> {
         for kind in &kinds {
             let mut shown = Shown::new();
             shown.insert("frame.interface_id", cols[0].to_string());
-            for (i, f) in FIELDS.iter().enumerate().skip(1) {
+            for (i, f) in fields.iter().enumerate().skip(1) {
                 let applies = match (*kind, *f) {
                     (_, "hwfoc.kind" | "hwfoc.checksum.status" | "hwfoc.time_epoch") => true,
                     (_, "hwfoc.checksum" | "hwfoc.checksum.computed") => true,
@@ -126,7 +146,7 @@ fn tshark(file: &Path, options: &[&str], with_script: bool) -> Vec<Shown> {
         if kinds.len() == 1 {
             let shown = frames.last_mut().unwrap();
             for f in ["hwfoc.mos_temp_c", "hwfoc.cap_temp_c"] {
-                let i = FIELDS.iter().position(|x| *x == f).unwrap();
+                let i = fields.iter().position(|x| *x == f).unwrap();
                 shown.insert(f, cols[i].to_string());
             }
         } else {
@@ -321,6 +341,21 @@ fn checksums_are_honest(shown: &[Shown]) -> usize {
     bad
 }
 
+/// Runs `hwfoc simulate ARGS -o FILE -q` (`args` separated by spaces), which must succeed.
+fn simulate(file: &Path, args: &str) {
+    let sim = run(hwfoc()
+        .arg("simulate")
+        .args(args.split_whitespace())
+        .arg("-o")
+        .arg(file)
+        .arg("-q"));
+    assert!(
+        sim.status.success(),
+        "{}",
+        String::from_utf8_lossy(&sim.stderr)
+    );
+}
+
 #[test]
 fn a_simulated_recording_dissects_as_decode_reads_it() {
     if !tshark_found() {
@@ -328,30 +363,11 @@ fn a_simulated_recording_dissects_as_decode_reads_it() {
     }
     let dir = tempfile::tempdir().unwrap();
     let file = dir.path().join("sim.pcapng");
-    let sim = run(hwfoc()
-        .args(["simulate", "--escs", "3", "--seed", "5", "--duration", "12"])
-        .args(["--start-time", "1754000000.25", "--lead-in", "3"])
-        .args([
-            "--garbage-rate",
-            "0.05",
-            "--bit-error-rate",
-            "3e-4",
-            "--cut-rate",
-            "0.02",
-        ])
-        .args([
-            "--fault",
-            "1:mos_overheat@4-5",
-            "--fault",
-            "over_current@6-6.5",
-        ])
-        .arg("-o")
-        .arg(&file)
-        .arg("-q"));
-    assert!(
-        sim.status.success(),
-        "{}",
-        String::from_utf8_lossy(&sim.stderr)
+    simulate(
+        &file,
+        "--escs 3 --seed 5 --duration 12 --start-time 1754000000.25 --lead-in 3 \
+         --garbage-rate 0.05 --bit-error-rate 3e-4 --cut-rate 0.02 \
+         --fault 1:mos_overheat@4-5 --fault over_current@6-6.5",
     );
 
     let shown = tshark(&file, &[], true);
@@ -576,4 +592,338 @@ fn install_path_and_print() {
         .unwrap()
         .collect();
     assert_eq!(left.len(), 1, "a temporary file was left behind");
+}
+
+/// Each ESC's valid data frames, as (interface or ESC) -> packet numbers in order.
+type PacketsByEsc = std::collections::BTreeMap<u64, Vec<u64>>;
+
+fn packets_shown(shown: &[Shown]) -> PacketsByEsc {
+    let mut by_esc = PacketsByEsc::new();
+    for s in shown
+        .iter()
+        .filter(|s| s["hwfoc.kind"] == "data" && s["hwfoc.checksum.status"] == "1")
+    {
+        by_esc
+            .entry(uint(&s["frame.interface_id"]))
+            .or_default()
+            .push(uint(&s["hwfoc.packet"]));
+    }
+    by_esc
+}
+
+fn packets_decoded(decoded: &[Value]) -> PacketsByEsc {
+    let mut by_esc = PacketsByEsc::new();
+    for r in decoded {
+        by_esc
+            .entry(r["esc"].as_u64().unwrap())
+            .or_default()
+            .push(r["packet"].as_u64().unwrap());
+    }
+    by_esc
+}
+
+/// tshark shows, frame for frame, the data frames `hwfoc decode` reads from `file` (each ESC's
+/// packet numbers in order; the first difference is named), then the same values and times.
+/// Returns the frames tshark shows and `hwfoc decode`'s packet numbers.
+fn same_frames_as_decode(file: &Path, what: &str) -> (Vec<Shown>, PacketsByEsc) {
+    let shown = tshark_without_text(file);
+    let decoded = decode(file, &[]);
+    let (got, want) = (packets_shown(&shown), packets_decoded(&decoded));
+    let escs: std::collections::BTreeSet<u64> = got.keys().chain(want.keys()).copied().collect();
+    let of = |by_esc: &PacketsByEsc, esc| by_esc.get(&esc).cloned().unwrap_or_default();
+    for esc in escs {
+        let (shown, read) = (of(&got, esc), of(&want, esc));
+        if let Some(at) = (0..shown.len().max(read.len())).find(|&k| shown.get(k) != read.get(k)) {
+            let around =
+                |v: &[u64]| v[at.saturating_sub(2).min(v.len())..(at + 3).min(v.len())].to_vec();
+            panic!(
+                "{what}: ESC {esc}, valid data frame {at}: tshark shows packets {:?}, hwfoc \
+                 decode reads {:?} ({} and {} frames in all)",
+                around(&shown),
+                around(&read),
+                shown.len(),
+                read.len()
+            );
+        }
+    }
+    same_data_frames(&shown, &decoded);
+    (shown, want)
+}
+
+/// Noisy recordings of two ESCs (garbage, bit errors, cut and dropped frames, long idle spells
+/// with their device-information frames, some of them cut): tshark finds exactly the frames
+/// `hwfoc decode` finds, for several seeds and noise levels.
+#[test]
+fn noisy_recordings_dissect_frame_for_frame_as_decode_reads_them() {
+    if !tshark_found() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    // (seed, garbage, bit errors, cuts, drops)
+    let runs = [
+        (3, "0.1", "2e-4", "0.1", "0.02"),
+        (11, "0.3", "1e-3", "0.05", "0"),
+        (29, "0.02", "0", "0.25", "0.05"),
+    ];
+    for (seed, garbage, bits, cuts, drops) in runs {
+        let file = dir.path().join(format!("noisy-{seed}.pcapng"));
+        simulate(
+            &file,
+            &format!(
+                "--escs 2 --duration 20 --seed {seed} --start-time 1754000000 --lead-in 3 \
+                 --hold 3 --levels 0,40,0,80 --garbage-rate {garbage} --bit-error-rate {bits} \
+                 --cut-rate {cuts} --drop-rate {drops}"
+            ),
+        );
+        let (shown, decoded) = same_frames_as_decode(&file, &format!("seed {seed}"));
+        let n: Vec<usize> = decoded.values().map(Vec::len).collect();
+        // The device-information frames too (counted per port: a frame that fails its checks
+        // may hold any byte in its text, which tshark's fields do not escape).
+        let mut infos = [0, 0];
+        for s in &shown {
+            if s["hwfoc.kind"] == "info" && s["hwfoc.checksum.status"] == "1" {
+                infos[uint(&s["frame.interface_id"]) as usize] += 1;
+            }
+        }
+        let mut want = [0, 0];
+        for (port, _) in info_frames(&file) {
+            want[port as usize] += 1;
+        }
+        assert_eq!(
+            infos, want,
+            "seed {seed}: device-information frames per port"
+        );
+        assert!(want.iter().all(|&n| n > 10), "seed {seed}: {want:?}");
+        assert!(
+            n.len() == 2 && n.iter().all(|&n| n > 150),
+            "seed {seed}: {n:?} frames"
+        );
+    }
+}
+
+/// Nanoseconds per byte at 19200 baud, 8N1.
+const BYTE_NS: f64 = 1e10 / 19200.0;
+
+/// One port of a crafted recording: packets of chosen bytes at chosen times.
+struct Port {
+    t_ns: u64,
+    packets: Vec<(u64, Vec<u8>)>,
+}
+
+impl Port {
+    fn new(t_ns: u64) -> Port {
+        Port {
+            t_ns,
+            packets: Vec::new(),
+        }
+    }
+
+    /// A packet of `bytes` now; the clock moves on by their byte times.
+    fn send(&mut self, bytes: &[u8]) {
+        self.packets.push((self.t_ns, bytes.to_vec()));
+        self.t_ns += (bytes.len() as f64 * BYTE_NS).round() as u64;
+    }
+
+    /// The line is silent for `s` seconds (after the last byte's byte time).
+    fn wait(&mut self, s: f64) {
+        self.t_ns += (s * 1e9).round() as u64;
+    }
+}
+
+/// Writes the ports' packets as they are (one interface each), in time order.
+fn write_ports(file: &Path, ports: &[Port]) {
+    let mut w = pcapng::Writer::new(std::fs::File::create(file).unwrap()).unwrap();
+    let mut all = Vec::new();
+    for (i, port) in ports.iter().enumerate() {
+        let iface = w.add_interface(&format!("/dev/ttyUSB{i}"), 19200).unwrap();
+        all.extend(port.packets.iter().map(|(t, b)| (*t, iface, b)));
+    }
+    all.sort_by_key(|&(t, iface, _)| (t, iface));
+    for (t, iface, bytes) in all {
+        w.write_packet(iface, t, bytes).unwrap();
+    }
+    w.into_inner().unwrap();
+}
+
+/// Data frames numbered from 1, with values drawn from a seeded generator.
+struct Frames {
+    packet: u16,
+    rng: hwfoc_sim::rng::Rng,
+}
+
+impl Frames {
+    fn next(&mut self) -> (u16, [u8; 24]) {
+        self.packet += 1;
+        let rng = &mut self.rng;
+        let frame = DataFrame {
+            packet: self.packet,
+            throttle_in_raw: rng.below(1025) as u16,
+            erpm_raw: rng.below(5000) as u16,
+            voltage_raw: 220 + rng.below(30) as u16,
+            current_raw: rng.below(3000) as i16,
+            mos_adc: 40 + rng.below(200) as u8,
+            cap_adc: 40 + rng.below(200) as u8,
+            ..Default::default()
+        };
+        (self.packet, frame.encode())
+    }
+
+    /// `n` data frames on `port`, a packet each, 50 ms apart; their numbers go into `whole`.
+    fn send(&mut self, port: &mut Port, n: usize, whole: &mut Vec<u64>) {
+        for _ in 0..n {
+            let (packet, bytes) = self.next();
+            port.send(&bytes);
+            port.wait(0.0375);
+            whole.push(packet.into());
+        }
+    }
+}
+
+/// Every way a candidate frame can end up in a recording's packets, on port 0 one case after
+/// another and on port 1 a random stream of frames, cut frames, fake headers and noise cut
+/// into packets anywhere, with silences: the dissector gives up a candidate exactly where the
+/// decoder does (a header whose version, command or text show it is no frame hides none of
+/// the frames after it, however many packets it takes to tell), reassembles what the decoder
+/// reassembles, and no more across a silence of over a second.
+#[test]
+fn a_candidate_that_fails_is_given_up_where_the_decoder_gives_it_up() {
+    if !tshark_found() {
+        return;
+    }
+    let rng = hwfoc_sim::rng::Rng::for_esc(7, 0, hwfoc_sim::rng::Purpose::Link);
+    let mut frames = Frames { packet: 0, rng };
+    let info = InfoFrame::new("XR_FOC_ESC", "HW577_KZ1_V1.1", "XR-01.0.00", "01040443")
+        .unwrap()
+        .encode();
+    // Port 0, and the data frames hwfoc decode finds in it.
+    let mut a = Port::new(1_754_000_000_000_000_000);
+    let mut want = Vec::new();
+    frames.send(&mut a, 3, &mut want);
+    // 15 bytes of noise that begin like a device-information frame, then frames.
+    a.send(&[
+        0x9B, 0x4C, 0x33, 0xA7, 0x10, 0x9B, 0x16, 0x55, 0xE0, 0x02, 0x9B, 0x4C, 0x01, 0xFF, 0x42,
+    ]);
+    frames.send(&mut a, 4, &mut want);
+    // A device-information frame cut after 33 bytes (its text so far is ASCII), then frames.
+    a.send(&info[..33]);
+    frames.send(&mut a, 4, &mut want);
+    // The same over three packets: the text goes on, plain ASCII, until a frame's sync byte.
+    a.send(&info[..20]);
+    a.send(b"ABCDEFGHIJKLMNOPQRSTUVWXYZ0123");
+    frames.send(&mut a, 3, &mut want);
+    // A data frame cut after 10 bytes, then frames.
+    a.send(&frames.next().1[..10]);
+    frames.send(&mut a, 2, &mut want);
+    // A sync byte at the end of a packet, then a frame.
+    a.send(&[0x00, 0x9B]);
+    frames.send(&mut a, 2, &mut want);
+    // A data frame in three packets, then a device-information frame in four.
+    let (packet, f) = frames.next();
+    a.send(&f[..8]);
+    a.send(&f[8..16]);
+    a.send(&f[16..]);
+    want.push(packet.into());
+    a.wait(0.02);
+    for piece in info.chunks(20) {
+        a.send(piece);
+    }
+    a.wait(0.02);
+    frames.send(&mut a, 2, &mut want);
+    // A device-information frame whose two halves are 2 s apart: a silence ends a frame.
+    a.send(&info[..40]);
+    a.wait(2.0);
+    a.send(&info[40..]);
+    frames.send(&mut a, 2, &mut want);
+    // A data frame whose halves are just over a second apart (from the last byte of one to the
+    // first of the other): not reassembled; just under a second: reassembled.
+    for gap in [1.0002, 0.9998] {
+        let (packet, f) = frames.next();
+        a.send(&f[..12]);
+        a.wait(gap - BYTE_NS * 1e-9);
+        a.send(&f[12..]);
+        if gap < 1.0 {
+            want.push(packet.into());
+        }
+        frames.send(&mut a, 2, &mut want);
+    }
+    // Port 1: a random stream cut anywhere.
+    let mut rng = hwfoc_sim::rng::Rng::for_esc(7, 1, hwfoc_sim::rng::Purpose::Link);
+    let mut stream = Vec::new();
+    for _ in 0..600 {
+        match rng.below(100) {
+            0..=54 => {
+                let mut f = frames.next().1.to_vec();
+                if rng.chance(0.15) {
+                    f.truncate(1 + rng.below(23) as usize);
+                } else if rng.chance(0.1) {
+                    let at = rng.below(24) as usize;
+                    f[at] ^= 1 << rng.below(8);
+                }
+                stream.extend_from_slice(&f);
+            }
+            55..=62 => {
+                let cut = if rng.chance(0.5) {
+                    1 + rng.below(76) as usize
+                } else {
+                    77
+                };
+                stream.extend_from_slice(&info[..cut]);
+            }
+            63..=74 => {
+                // A fake header: a device-information header and text, or a data header.
+                if rng.chance(0.5) {
+                    stream.extend_from_slice(&[0x9B, 0x4C, 0x01, 0x01]);
+                    for _ in 0..rng.below(90) {
+                        stream.push(0x20 + rng.below(0x5F) as u8);
+                    }
+                } else {
+                    stream.extend_from_slice(&[0x9B, 0x16, 0x01, 0x02]);
+                }
+            }
+            _ => {
+                const DENSE: [u8; 6] = [0x9B, 0x16, 0x4C, 0x01, 0x02, 0x20];
+                for _ in 0..1 + rng.below(40) {
+                    let b = if rng.chance(0.5) {
+                        DENSE[rng.below(6) as usize]
+                    } else {
+                        rng.below(256) as u8
+                    };
+                    stream.push(b);
+                }
+            }
+        }
+    }
+    let mut b = Port::new(1_754_000_000_003_000_000);
+    let mut rest = &stream[..];
+    while !rest.is_empty() {
+        let n = (1 + rng.below(90) as usize).min(rest.len());
+        b.send(&rest[..n]);
+        rest = &rest[n..];
+        b.wait(match rng.below(100) {
+            0 => 1.5,
+            1 => 0.9,
+            _ => rng.below(30) as f64 * 1e-3,
+        });
+    }
+
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("crafted.pcapng");
+    write_ports(&file, &[a, b]);
+    let (shown, decoded) = same_frames_as_decode(&file, "crafted");
+    assert_eq!(
+        decoded[&0], want,
+        "the data frames of port 0 hwfoc decode finds"
+    );
+    assert!(
+        decoded[&1].len() > 200,
+        "{} frames on port 1",
+        decoded[&1].len()
+    );
+    // Port 0's one whole device-information frame is the one in four packets.
+    let infos = shown
+        .iter()
+        .filter(|s| s["hwfoc.kind"] == "info" && s["hwfoc.checksum.status"] == "1")
+        .filter(|s| s["frame.interface_id"] == "0")
+        .count();
+    assert_eq!(infos, 1, "device-information frames of port 0");
 }

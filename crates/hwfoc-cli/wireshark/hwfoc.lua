@@ -11,6 +11,9 @@
 -- computed). Bytes that are no frame are shown as line noise. In an old recording a frame cut
 -- across packets is shown as a partial frame at the end of the first packet and reassembled in
 -- the packet that completes it (the bytes of one port are a stream, as hwfoc decodes them).
+-- The valid frames shown are exactly those `hwfoc decode` finds, on noisy lines too: a candidate
+-- frame is given up as soon as a byte shows it is none (the frames after it are shown in their
+-- own packets), and a silence of over a second ends a frame still arriving.
 --
 -- USER0 is a link type for private use: other tools write other things with it. The dissector
 -- only takes packets of interfaces hwfoc described ("HW-FOC telemetry" in the interface
@@ -32,6 +35,9 @@ local hwfoc = Proto("hwfoc", "Hobbywing HW-FOC ESC telemetry")
 
 local SYNC = 0x9B
 local DATA_LEN, INFO_LEN = 24, 77
+-- A silence of the line longer than this (seconds, between two bytes) ends a frame still
+-- arriving (hwfoc's SILENCE_S).
+local SILENCE_S = 1.0
 -- Frame kinds by length byte.
 local KINDS = {
     [0x16] = { len = DATA_LEN, command = 0x02, name = "Data frame" },
@@ -216,24 +222,37 @@ local function sum(s, from, to) -- bytes from..to-1 (0-based)
     return total
 end
 
--- Whether a frame may start at `i` of `s` (n bytes): returns the kind and "good" or "bad", or
--- "undecided" when the bytes end first, or nil when no frame starts there (exactly the hwfoc
--- decoder's rule: a sync byte, a known length byte, then version, command, checksum and, for
--- the information frame, ASCII text).
+-- Whether a frame may start at `i` of `s` (n bytes): returns the kind and "good" or "bad" once
+-- its bytes decide, "undecided" while the bytes there begin a frame the bytes still to come may
+-- complete, or nil when no frame starts there. The rule is the hwfoc decoder's: a sync byte, a
+-- known length byte, then version, command, checksum and, for the information frame, ASCII
+-- text. A candidate is "bad" as soon as a byte there shows it is no frame (a version, command
+-- or text byte no frame has), before all its bytes are there: the decoder waits for them before
+-- it gives the candidate up, but, giving up a candidate at the cost of its first byte whenever
+-- that is, finds the same frames. So a candidate carried into the next packet is always the
+-- start of a frame, and holds no other frame (an information frame's text has no sync byte,
+-- and a frame that begins in a data frame's first 23 bytes ends after them): a silence or the
+-- end of the file that ends it hides nothing the decoder would find.
 local function candidate(s, n, i)
     if s:byte(i + 1) ~= SYNC then return nil end
     if i + 1 >= n then return nil, "undecided" end
     local kind = KINDS[s:byte(i + 2)]
     if not kind then return nil end
-    if n - i < kind.len then return kind, "undecided" end
-    local good = s:byte(i + 3) == 0x01 and s:byte(i + 4) == kind.command
-    if kind.len == DATA_LEN then
-        good = good and sum(s, i, i + 22) % 65536 == s:byte(i + 23) + s:byte(i + 24) * 256
-    else
-        good = good and sum(s, i, i + 76) % 256 == s:byte(i + 77)
-        for k = i + 5, i + 76 do
-            if s:byte(k) >= 0x80 then good = false end
+    local have = math.min(n - i, kind.len) -- bytes of the candidate there
+    if (have >= 3 and s:byte(i + 3) ~= 0x01) or (have >= 4 and s:byte(i + 4) ~= kind.command) then
+        return kind, "bad"
+    end
+    if kind.len == INFO_LEN then
+        for k = i + 5, i + math.min(have, INFO_LEN - 1) do
+            if s:byte(k) >= 0x80 then return kind, "bad" end
         end
+    end
+    if have < kind.len then return kind, "undecided" end
+    local good
+    if kind.len == DATA_LEN then
+        good = sum(s, i, i + 22) % 65536 == s:byte(i + 23) + s:byte(i + 24) * 256
+    else
+        good = sum(s, i, i + 76) % 256 == s:byte(i + 77)
     end
     return kind, good and "good" or "bad"
 end
@@ -263,11 +282,11 @@ local function scan(s)
             items[#items + 1] = { kind = kind, from = i, to = i + kind.len, what = "good" }
             i = i + kind.len
         elseif state == "bad" then
-            noise_to(i)
             -- The decoder goes on at the next byte: a valid (or still arriving) frame that starts
             -- inside this one ends it.
+            local whole = n - i >= kind.len
             local cut = nil
-            for j = i + 1, i + kind.len - 1 do
+            for j = i + 1, math.min(i + kind.len, n) - 1 do
                 local _, inner = candidate(s, n, j)
                 if inner == "good" or inner == "undecided" then
                     cut = j
@@ -275,11 +294,17 @@ local function scan(s)
                 end
             end
             if cut then
+                noise_to(i)
                 items[#items + 1] = { kind = kind, from = i, to = cut, what = "cut" }
                 i = cut
-            else
+            elseif whole then
+                noise_to(i)
                 items[#items + 1] = { kind = kind, from = i, to = i + kind.len, what = "bad" }
                 i = i + kind.len
+            else
+                -- Given up before its end, with no frame after it in `s`: line noise.
+                noise_from = noise_from or i
+                i = n
             end
         else
             noise_from = noise_from or i
@@ -467,18 +492,24 @@ function hwfoc.dissector(tvb, pinfo, tree)
     local number = pinfo.number
     local baud = desc and tonumber(tostring(desc.value):match("(%d+) baud")) or 19200
     local byte_s = 10 / baud
-    local now = pinfo.abs_ts
+    local byte_ns = 10 * 1e9 / baud
+    local epoch = f_epoch().value
+    -- The receive time in seconds of byte `i` of this packet, computed as hwfoc computes it
+    -- (`(t_ns + i * ns per byte) * 1e-9` in doubles), so that the silences of over a second are
+    -- the ones hwfoc finds.
+    local function byte_time(i)
+        return ((epoch.secs * 1e9 + epoch.nsecs) + i * byte_ns) * 1e-9
+    end
 
     -- The bytes of a frame begun in the previous packet of this port (first pass only; later
-    -- passes use what the first one kept). A silence of over a second ends such a frame, as it
-    -- does in hwfoc's decoder.
-    local epoch = f_epoch().value
+    -- passes use what the first one kept). A silence of over a second between that packet's
+    -- last byte and this one's first ends such a frame, as it does in hwfoc's decoder.
     -- Carried bytes: where each packet they came from begins in them (`at`), that packet's
     -- time and how many of its bytes came before (`k`).
     local carry = { bytes = "", segs = {} }
     if not pinfo.visited then
         local p = pending[iface]
-        if p and now - p.t_end <= 1.0 then carry = p end
+        if p and byte_time(0) - p.t_last <= SILENCE_S then carry = p end
         carry_of[number] = carry
     else
         carry = carry_of[number] or carry
@@ -507,7 +538,7 @@ function hwfoc.dissector(tvb, pinfo, tree)
                     kept[#kept + 1] = { at = seg.at - last.from, epoch = seg.epoch, k = seg.k }
                 end
             end
-            pending[iface] = { bytes = s:sub(last.from + 1), segs = kept, t_end = now + n * byte_s }
+            pending[iface] = { bytes = s:sub(last.from + 1), segs = kept, t_last = byte_time(n - 1) }
         else
             pending[iface] = nil
         end
