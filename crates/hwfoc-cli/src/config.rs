@@ -254,9 +254,11 @@ impl Config {
         let path = match (args.no_config, named) {
             (true, _) => None,
             (false, Some(path)) => Some(path),
+            // Whatever is there is read: one that is not a regular file (a FIFO, a directory)
+            // is an error naming it, not a configuration silently ignored.
             (false, None) => default_path()
-                .filter(|p| p.is_file())
-                .or_else(|| legacy_monitor_path().filter(|p| monitor && p.is_file())),
+                .filter(|p| is_there(p))
+                .or_else(|| legacy_monitor_path().filter(|p| monitor && is_there(p))),
         };
         let file = match &path {
             Some(path) => read_file(path)?,
@@ -380,6 +382,11 @@ impl Config {
             .clone()
             .or_else(|| f.record_dir.clone())
     }
+}
+
+/// Whether anything (a file, a directory, a FIFO, a link even to nothing) is at `path`.
+fn is_there(path: &Path) -> bool {
+    std::fs::symlink_metadata(path).is_ok()
 }
 
 /// The largest configuration file read (a real one is a few hundred bytes).
