@@ -647,6 +647,19 @@ fn a_bad_file_is_an_error_naming_its_line_and_key() {
         let out = clean(&home).args(args).output().expect("spawn");
         assert_fails_with(&out, "config.toml line 6: unknown field `curent_scale`");
     }
+    // Two entries of one ESC: both lines are named.
+    let home = user_config(
+        &dir,
+        "[esc.1]\npole_pairs = 14\n\n[esc.01]\npole_pairs = 7\n",
+    );
+    let out = clean(&home)
+        .args(["summary", "--demo"])
+        .output()
+        .expect("spawn");
+    assert_fails_with(
+        &out,
+        "config.toml line 4: [esc.01] names the same ESC as [esc.1] on line 1",
+    );
     // Out of range: the entry is named.
     let home = user_config(&dir, "[esc.3]\npole_pairs = 0\n");
     let out = clean(&home)
