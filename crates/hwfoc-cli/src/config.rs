@@ -32,7 +32,9 @@
 //!
 //! Precedence, field by field: a command-line flag, then the ESC's `[esc.N]` entry, then its
 //! port's `[port."NAME"]` entry, then `[settings]`, then the built-in defaults. Unknown keys are
-//! errors naming the file, the line and the key.
+//! errors naming the file, the line and the key; so are two entries of one ESC (`[esc.1]` and
+//! `[esc.01]`), of one port (`[port."/dev/ttyUSB0"]` and an older `[[esc]]` entry of that port)
+//! and a setting both in its table and at the top (the older layout), naming both lines.
 
 use std::collections::BTreeMap;
 use std::fmt;
@@ -44,6 +46,8 @@ use hwfoc_io::input::read_small_file;
 use hwfoc_io::settings::{SettingsMap, SettingsPatch};
 use serde::Deserialize;
 use serde::de::{self, Deserializer, MapAccess, SeqAccess, Visitor};
+use toml::Spanned;
+use toml::de::{DeString, DeTable, DeValue};
 
 use crate::args::SettingsArgs;
 use crate::error::CliError;
@@ -254,9 +258,11 @@ impl Config {
         let path = match (args.no_config, named) {
             (true, _) => None,
             (false, Some(path)) => Some(path),
+            // Whatever is there is read: one that is not a regular file (a FIFO, a directory)
+            // is an error naming it, not a configuration silently ignored.
             (false, None) => default_path()
-                .filter(|p| p.is_file())
-                .or_else(|| legacy_monitor_path().filter(|p| monitor && p.is_file())),
+                .filter(|p| is_there(p))
+                .or_else(|| legacy_monitor_path().filter(|p| monitor && is_there(p))),
         };
         let file = match &path {
             Some(path) => read_file(path)?,
@@ -382,6 +388,11 @@ impl Config {
     }
 }
 
+/// Whether anything (a file, a directory, a FIFO, a link even to nothing) is at `path`.
+fn is_there(path: &Path) -> bool {
+    std::fs::symlink_metadata(path).is_ok()
+}
+
 /// The largest configuration file read (a real one is a few hundred bytes).
 const MAX_CONFIG: u64 = 1 << 20;
 
@@ -398,20 +409,175 @@ fn read_file(path: &Path) -> Result<File, CliError> {
             "it is not UTF-8 text",
         ))
     })?;
-    toml::from_str(&text).map_err(|e| {
-        let line = e.span().map(|span| {
-            text.as_bytes()[..span.start.min(text.len())]
-                .iter()
-                .filter(|&&b| b == b'\n')
-                .count()
-                + 1
+    let config_error = |line, message| CliError::Config {
+        path: path.display().to_string(),
+        line,
+        message,
+    };
+    let toml_error = |e: toml::de::Error| {
+        let line = e.span().map(|span| line_of(&text, span.start));
+        config_error(line, e.message().trim().replace('\n', " "))
+    };
+    let doc = DeTable::parse(&text).map_err(toml_error)?;
+    if let Some((line, message)) = same_names(doc.get_ref(), &text) {
+        return Err(config_error(Some(line), message));
+    }
+    File::deserialize(toml::de::Deserializer::from(doc)).map_err(toml_error)
+}
+
+/// The 1-based line of byte `offset` of `text`.
+fn line_of(text: &str, offset: usize) -> usize {
+    let end = offset.min(text.len());
+    text.as_bytes()[..end]
+        .iter()
+        .filter(|&&b| b == b'\n')
+        .count()
+        + 1
+}
+
+/// One name of an ESC, a port or a setting in the file: where it is, how it is written, and
+/// what it names (the same `key` for two names is one ESC, port or setting).
+#[derive(Clone)]
+struct Name<K> {
+    offset: usize,
+    shown: String,
+    key: K,
+}
+
+/// The first name (in the file's order) that names what an earlier one does, as the line of the
+/// later one and a message naming both: TOML refuses a key written twice, but `[esc.1]` and
+/// `[esc.01]`, or `[port."/dev/ttyUSB0"]` and an older `[[esc]]` entry of that port, are
+/// different keys naming one ESC or port, and one entry would be silently ignored.
+fn same_names(doc: &DeTable, text: &str) -> Option<(usize, String)> {
+    let name = |key: &Spanned<DeString>, shown: String| (key.span().start, shown);
+    let esc = doc.get("esc").map(|v| v.get_ref());
+
+    // [esc.N]: keys that are one index.
+    let escs = esc.and_then(DeValue::as_table).into_iter().flatten();
+    let escs = escs.filter_map(|(key, _)| {
+        let index = key.get_ref().parse::<u8>().ok()?;
+        let (offset, shown) = name(key, format!("[esc.{}]", &text[key.span()]));
+        Some(Name {
+            offset,
+            shown,
+            key: index,
+        })
+    });
+    let mut found = first_twice(escs.collect(), text, "names the same ESC as");
+
+    // Ports: [port."NAME"] and the older [[esc]] entries give settings; [monitor] ports and
+    // those entries are the ports watched.
+    let list_ports: Vec<Name<PathBuf>> = esc
+        .and_then(DeValue::as_array)
+        .into_iter()
+        .flat_map(|list| list.iter())
+        .filter_map(|entry| {
+            let port = entry.get_ref().as_table()?.get("port")?;
+            let named = port.get_ref().as_str()?;
+            Some(Name {
+                offset: port.span().start,
+                shown: format!("[[esc]] port = {named:?}"),
+                key: port_key(named),
+            })
+        })
+        .collect();
+    let table_ports = table(doc.get("port"))
+        .into_iter()
+        .flatten()
+        .map(|(key, _)| {
+            let (offset, shown) = name(key, format!("[port.{}]", &text[key.span()]));
+            Name {
+                offset,
+                shown,
+                key: port_key(key.get_ref()),
+            }
         });
-        CliError::Config {
-            path: path.display().to_string(),
-            line,
-            message: e.message().trim().replace('\n', " "),
+    let watched = table(doc.get("monitor"))
+        .and_then(|m| m.get("ports"))
+        .and_then(|p| p.get_ref().as_array())
+        .into_iter()
+        .flat_map(|list| list.iter())
+        .filter_map(|port| {
+            let named = port.get_ref().as_str()?;
+            Some(Name {
+                offset: port.span().start,
+                shown: format!("[monitor] ports {named:?}"),
+                key: port_key(named),
+            })
+        });
+    let settings_by_port = table_ports.chain(list_ports.iter().cloned()).collect();
+    let watched = watched.chain(list_ports.iter().cloned()).collect();
+    found = found
+        .or_else(|| first_twice(settings_by_port, text, "names the same port as"))
+        .or_else(|| first_twice(watched, text, "names the same port to watch as"));
+
+    // The older layout's top-level keys and the tables that hold them today.
+    for (key, now) in [
+        ("current_scale", "settings"),
+        ("pole_pairs", "settings"),
+        ("gear_ratio", "settings"),
+        ("baud", "monitor"),
+        ("record_dir", "monitor"),
+    ] {
+        let old = doc.get_key_value(key);
+        let new = table(doc.get(now)).and_then(|t| t.get_key_value(key));
+        if found.is_none()
+            && let (Some((old, _)), Some((new, _))) = (old, new)
+        {
+            let names = vec![
+                Name {
+                    offset: old.span().start,
+                    shown: format!("{key} (the older layout's, at the top)"),
+                    key: (),
+                },
+                Name {
+                    offset: new.span().start,
+                    shown: format!("[{now}] {key}"),
+                    key: (),
+                },
+            ];
+            found = first_twice(names, text, "is the same setting as");
         }
+    }
+    found
+}
+
+/// The table `value` holds, if it is one.
+fn table<'a, 'i>(value: Option<&'a Spanned<DeValue<'i>>>) -> Option<&'a DeTable<'i>> {
+    value.and_then(|v| v.get_ref().as_table())
+}
+
+/// The later of the first two `names` with one key, as its line and "`A` `says` `B` on line
+/// N: keep one".
+fn first_twice<K: PartialEq>(
+    mut names: Vec<Name<K>>,
+    text: &str,
+    says: &str,
+) -> Option<(usize, String)> {
+    names.sort_by_key(|n| n.offset);
+    names.iter().enumerate().find_map(|(i, later)| {
+        let earlier = names[..i].iter().find(|n| n.key == later.key)?;
+        Some((
+            line_of(text, later.offset),
+            format!(
+                "{} {says} {} on line {}: keep one (one of them would be ignored)",
+                later.shown,
+                earlier.shown,
+                line_of(text, earlier.offset)
+            ),
+        ))
     })
+}
+
+/// A port name as compared for sameness: its path's components (`/dev//ttyUSB0` and
+/// `/dev/./ttyUSB0` are `/dev/ttyUSB0`), without regard to case on Windows (`com3` is `COM3`).
+fn port_key(name: &str) -> PathBuf {
+    let path: PathBuf = Path::new(name).components().collect();
+    if cfg!(windows) {
+        PathBuf::from(path.to_string_lossy().to_lowercase())
+    } else {
+        path
+    }
 }
 
 #[cfg(test)]
@@ -541,6 +707,100 @@ mod tests {
             err.contains("([settings])") && err.contains("current scale"),
             "{err}"
         );
+    }
+
+    #[test]
+    fn two_names_of_one_esc_port_or_setting_are_an_error_naming_both_lines() {
+        let cases = [
+            (
+                "[esc.1]\npole_pairs = 7\n\n[esc.01]\npole_pairs = 14\n",
+                4,
+                "[esc.01]",
+                1,
+                "[esc.1]",
+            ),
+            (
+                "[esc.\"+2\"]\nlabel = \"a\"\n[esc.2]\nlabel = \"b\"\n",
+                3,
+                "[esc.2]",
+                1,
+                "[esc.\"+2\"]",
+            ),
+            (
+                "esc.1.pole_pairs = 3\n[esc.001]\n",
+                2,
+                "[esc.001]",
+                1,
+                "[esc.1]",
+            ),
+            (
+                "[port.\"/dev/ttyUSB1\"]\npole_pairs = 14\n[[esc]]\nport = \"/dev/ttyUSB1\"\n",
+                4,
+                "[[esc]] port = \"/dev/ttyUSB1\"",
+                1,
+                "[port.\"/dev/ttyUSB1\"]",
+            ),
+            (
+                "[port.\"/dev/ttyUSB1\"]\nlabel = \"a\"\n[port.\"/dev//ttyUSB1\"]\nlabel = \"b\"\n",
+                3,
+                "[port.\"/dev//ttyUSB1\"]",
+                1,
+                "[port.\"/dev/ttyUSB1\"]",
+            ),
+            (
+                "[[esc]]\nport = \"a\"\n[[esc]]\nport = \"a\"\nlabel = \"b\"\n",
+                4,
+                "[[esc]] port = \"a\"",
+                2,
+                "[[esc]] port = \"a\"",
+            ),
+            (
+                "[monitor]\nports = [\"a\"]\n[[esc]]\nport = \"a\"\n",
+                4,
+                "[[esc]] port = \"a\"",
+                2,
+                "[monitor] ports \"a\"",
+            ),
+            (
+                "pole_pairs = 7\n[settings]\npole_pairs = 14\n",
+                3,
+                "[settings] pole_pairs",
+                1,
+                "pole_pairs (the older layout's",
+            ),
+            ("[monitor]\nbaud = 9600\n", 0, "", 0, ""),
+            (
+                "record_dir = \"/a\"\n[monitor]\nrecord_dir = \"/b\"\n",
+                3,
+                "[monitor] record_dir",
+                1,
+                "record_dir (the older",
+            ),
+        ];
+        for (text, line, later, earlier_line, earlier) in cases {
+            let (_dir, config) = load(text);
+            if line == 0 {
+                assert!(config.is_ok(), "{text}");
+                continue;
+            }
+            let err = config.unwrap_err().to_string();
+            assert!(
+                err.contains(&format!("config.toml line {line}: {later} ")),
+                "{text}: {err}"
+            );
+            assert!(
+                err.contains(&format!("as {earlier}"))
+                    && err.contains(&format!("on line {earlier_line}:")),
+                "{text}: {err}"
+            );
+            assert!(!err.contains('\n'), "{err}");
+        }
+        // Two ports or ESCs that differ are two entries.
+        let (_dir, config) = load(
+            "[esc.1]\n[esc.10]\n[port.\"/dev/ttyUSB1\"]\n[port.\"/dev/ttyUSB10\"]\n\
+             [monitor]\nports = [\"/dev/ttyUSB1\"]\n",
+        );
+        config.unwrap();
     }
 
     #[test]

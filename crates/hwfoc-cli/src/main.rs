@@ -72,7 +72,8 @@ fn main() -> ExitCode {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) if e.is_broken_pipe() => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("hwfoc: {e}");
+            // Errors quote file content (a key, a name): shown escaped, and on one line.
+            eprintln!("hwfoc: {}", hwfoc_io::escape::Escaped(&e));
             ExitCode::FAILURE
         }
     }

@@ -122,17 +122,30 @@ fn sigterm_stops_the_shortest_interval() {
     );
 }
 
-/// A configuration file or a throttle profile of any size (here an endless one) is an error,
-/// not all the memory there is.
+/// A configuration file or a throttle profile that is endless (a device) or too large is an
+/// error, not all the memory there is.
 #[cfg(unix)]
 #[test]
 fn endless_files_are_refused() {
     let dir = common::Dir::new();
     let o = run(hwfoc().args(["monitor", "--sim", "1", "--plain", "--config", "/dev/zero"]));
-    common::assert_fails_with(&o, "cannot open /dev/zero: it is larger than 1024 KiB");
+    common::assert_fails_with(
+        &o,
+        "cannot open /dev/zero: it is a device, not a regular file",
+    );
     let out = dir.arg("x.bin");
     let o = run(hwfoc().args(["simulate", "--profile", "csv:/dev/zero", "-o", &out]));
-    common::assert_fails_with(&o, "cannot open /dev/zero: it is larger than 65536 KiB");
+    common::assert_fails_with(
+        &o,
+        "cannot open /dev/zero: it is a device, not a regular file",
+    );
+    // A regular file larger than such a file is (sparse: nothing is written).
+    let big = dir.path("big.toml");
+    std::fs::File::create(&big)
+        .and_then(|f| f.set_len((1 << 20) + 1))
+        .unwrap();
+    let o = run(hwfoc().args(["summary", "--demo", "--config", big.to_str().unwrap()]));
+    common::assert_fails_with(&o, "big.toml: it is larger than 1024 KiB");
 }
 
 /// Settings whose conversions cannot be represented are refused with their range, by every

@@ -647,6 +647,19 @@ fn a_bad_file_is_an_error_naming_its_line_and_key() {
         let out = clean(&home).args(args).output().expect("spawn");
         assert_fails_with(&out, "config.toml line 6: unknown field `curent_scale`");
     }
+    // Two entries of one ESC: both lines are named.
+    let home = user_config(
+        &dir,
+        "[esc.1]\npole_pairs = 14\n\n[esc.01]\npole_pairs = 7\n",
+    );
+    let out = clean(&home)
+        .args(["summary", "--demo"])
+        .output()
+        .expect("spawn");
+    assert_fails_with(
+        &out,
+        "config.toml line 4: [esc.01] names the same ESC as [esc.1] on line 1",
+    );
     // Out of range: the entry is named.
     let home = user_config(&dir, "[esc.3]\npole_pairs = 0\n");
     let out = clean(&home)
@@ -672,4 +685,63 @@ fn a_bad_file_is_an_error_naming_its_line_and_key() {
         help.contains("[esc.N]") && help.contains("HWFOC_CONFIG"),
         "{help}"
     );
+}
+
+/// The output of `cmd`, which must end within 20 s (it is killed and the test fails otherwise).
+#[cfg(unix)]
+fn within_deadline(cmd: &mut Command) -> Output {
+    let mut child = common::spawn(cmd);
+    let deadline = std::time::Instant::now() + std::time::Duration::from_secs(20);
+    while child.try_wait().expect("wait").is_none() {
+        if std::time::Instant::now() > deadline {
+            child.kill().ok();
+            child.wait().ok();
+            panic!("hwfoc still running after 20 s: {cmd:?}");
+        }
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    child.wait_with_output().expect("wait")
+}
+
+#[cfg(unix)]
+#[test]
+fn a_configuration_that_is_not_a_regular_file_is_an_error_naming_it() {
+    use nix::sys::stat::Mode;
+    let dir = Dir::new();
+    let fifo = dir.path("fifo.toml");
+    nix::unistd::mkfifo(&fifo, Mode::S_IRUSR | Mode::S_IWUSR).unwrap();
+    let fifo_arg = fifo.to_str().unwrap();
+    let none = dir.path("none");
+    // Named with --config, and with HWFOC_CONFIG: nothing ever writes to the FIFO.
+    let out = within_deadline(clean(&none).args(["summary", "--demo", "--config", fifo_arg]));
+    assert_fails_with(
+        &out,
+        &format!("{fifo_arg}: it is a FIFO, not a regular file"),
+    );
+    let out = within_deadline(
+        clean(&none)
+            .env("HWFOC_CONFIG", &fifo)
+            .args(["decode", "--demo"]),
+    );
+    assert_fails_with(&out, &format!("{fifo_arg}: it is a FIFO"));
+    // At the default place: a FIFO, then a directory, are errors too (not a file skipped).
+    let home = dir.path("xdg");
+    std::fs::create_dir_all(home.join("hwfoc")).unwrap();
+    let default = home.join("hwfoc/config.toml");
+    nix::unistd::mkfifo(&default, Mode::S_IRUSR | Mode::S_IWUSR).unwrap();
+    let out = within_deadline(clean(&home).args(["summary", "--demo"]));
+    assert_fails_with(
+        &out,
+        &format!("{}: it is a FIFO", default.to_str().unwrap()),
+    );
+    std::fs::remove_file(&default).unwrap();
+    std::fs::create_dir(&default).unwrap();
+    let out = within_deadline(clean(&home).args(["summary", "--demo"]));
+    assert_fails_with(&out, "config.toml: it is a directory, not a regular file");
+    // --no-config reads nothing there.
+    ok(within_deadline(clean(&home).args([
+        "summary",
+        "--demo",
+        "--no-config",
+    ])));
 }

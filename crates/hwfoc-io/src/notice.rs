@@ -9,6 +9,7 @@
 
 use std::fmt;
 
+use crate::escape::Escaped;
 use crate::pcapng::Damage;
 use crate::serial::PortEvent;
 
@@ -91,29 +92,40 @@ impl Notice {
 }
 
 impl fmt::Display for Notice {
+    /// The notice for a person: its names and texts (a recording's, a port's) [`Escaped`].
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
             Notice::PortLost { port, reason } => write!(
                 f,
-                "{port} lost ({reason}); retrying every {} ms",
+                "{} lost ({}); retrying every {} ms",
+                Escaped(port),
+                Escaped(reason),
                 crate::serial::RETRY_EVERY.as_millis()
             ),
-            Notice::PortBack { port } => write!(f, "{port} is back"),
+            Notice::PortBack { port } => write!(f, "{} is back", Escaped(port)),
             Notice::Comment {
                 input,
                 interface,
                 text,
-            } => write!(f, "{input}: {interface}: {text}"),
+            } => write!(
+                f,
+                "{}: {}: {}",
+                Escaped(input),
+                Escaped(interface),
+                Escaped(text)
+            ),
             Notice::ForeignInterface {
                 input,
                 interface,
                 link_type,
             } => write!(
                 f,
-                "{input}: interface {interface} has link type {link_type}, not serial bytes: its \
-                 packets are skipped"
+                "{}: interface {} has link type {link_type}, not serial bytes: its packets are \
+                 skipped",
+                Escaped(input),
+                Escaped(interface)
             ),
-            Notice::Damage { input, damage } => write!(f, "{input}: {damage}"),
+            Notice::Damage { input, damage } => write!(f, "{}: {damage}", Escaped(input)),
         }
     }
 }
@@ -150,6 +162,15 @@ mod tests {
             text: "gap".into(),
         };
         assert_eq!(note.line(), "hwfoc: note: a.pcapng: /dev/ttyUSB1: gap");
+        let crafted = Notice::Comment {
+            input: "a.pcapng".into(),
+            interface: "\x1b]0;title\x07".into(),
+            text: "gap\r\x1b[2Jhwfoc: fake".into(),
+        };
+        assert_eq!(
+            crafted.line(),
+            "hwfoc: note: a.pcapng: \\x1b]0;title\\x07: gap\\r\\x1b[2Jhwfoc: fake"
+        );
         assert!(lost.is_warning() && !back.is_warning() && !note.is_warning());
         let names = ["/dev/ttyUSB0".to_string()];
         let event = |port| PortEvent::Lost {

@@ -25,6 +25,7 @@ use serde_json::{Value, json};
 
 use crate::energy::{Energy, NOMINAL_PERIOD_S};
 pub use crate::episode::{Episode, Mark};
+use crate::escape::Escaped;
 use crate::input::{InputError, InputFormat};
 use crate::sources::{Handler, Sources};
 use crate::stream::EscLink;
@@ -46,7 +47,8 @@ const MAX_EPISODES: usize = 10_000;
 /// Fault episodes listed per ESC in the text output (`--json` lists all those kept).
 const TEXT_EPISODES: usize = 20;
 
-/// How an ESC is named in messages: its input, and its stream when the input has several.
+/// How an ESC is named in messages: its input, and its stream when the input has several
+/// (names from a recording [`Escaped`]).
 pub fn esc_label(sources: &Sources, esc: usize) -> String {
     let e = &sources.escs()[esc];
     let input = &sources.names()[e.input];
@@ -59,12 +61,13 @@ pub fn esc_label(sources: &Sources, esc: usize) -> String {
         None if sources.is_hub(esc) => " channel 0".to_string(),
         None => String::new(),
     };
-    if single && e.name == *input && channel.is_empty() {
-        input.clone()
-    } else if e.name == *input {
+    let input = Escaped(input);
+    if single && e.name == *input.0 && channel.is_empty() {
+        input.to_string()
+    } else if e.name == *input.0 {
         format!("{input}{channel} (ESC {esc})")
     } else {
-        format!("{input}: {}{channel} (ESC {esc})", e.name)
+        format!("{input}: {}{channel} (ESC {esc})", Escaped(&e.name))
     }
 }
 
@@ -484,7 +487,9 @@ impl<'a> Report<'a> {
             let _ = writeln!(
                 o,
                 "input        {} ({}, {} bytes, {escs})",
-                info.name, info.format, info.bytes
+                Escaped(&info.name),
+                info.format,
+                info.bytes
             );
             if info.flagged_bytes > 0 {
                 let _ = writeln!(
@@ -498,7 +503,7 @@ impl<'a> Report<'a> {
             let _ = writeln!(
                 o,
                 "hub          {}: DataLink V2, {hub}",
-                self.sources.escs()[esc].name
+                Escaped(&self.sources.escs()[esc].name)
             );
         }
         for esc in &escs {
@@ -765,7 +770,7 @@ impl EscReport<'_> {
             let _ = writeln!(o, "             no data frames: {}", *NO_FRAMES);
         }
         for (info, n) in &self.acc.infos {
-            let _ = writeln!(o, "device       {info}  ({n} info frames)");
+            let _ = writeln!(o, "device       {}  ({n} info frames)", Escaped(info));
         }
         if self.acc.frames == 0 {
             return;

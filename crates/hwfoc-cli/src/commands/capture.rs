@@ -27,6 +27,7 @@ use std::time::{Duration, Instant};
 use hwfoc_io::stream::EscLink;
 
 use crate::error::CliError;
+use hwfoc_io::escape::Escaped;
 use hwfoc_io::notice::Notice;
 use hwfoc_io::pcapng;
 use hwfoc_io::serial::{self, PortEvent, PortSet};
@@ -202,7 +203,7 @@ pub fn run(args: &RecordArgs) -> Result<(), CliError> {
     let mut recorder = Recorder::new(plan, set.names(), set.clock())?;
     eprintln!(
         "hwfoc: recording {} at {} baud to {}; Ctrl-C stops",
-        set.names().join(", "),
+        Escaped(set.names().join(", ")),
         args.baud,
         recorder.current()
     );
@@ -234,7 +235,7 @@ pub fn run(args: &RecordArgs) -> Result<(), CliError> {
         }
         recorder.close()
     });
-    eprintln!("hwfoc: {}", recorder.status(started.elapsed()));
+    eprintln!("hwfoc: {}", Escaped(recorder.status(started.elapsed())));
     result
 }
 
@@ -347,7 +348,7 @@ impl Recorder {
                 };
                 let note = format!("gap: {lost}");
                 if self.warn {
-                    eprintln!("hwfoc: warning: {note}; the recording goes on");
+                    eprintln!("hwfoc: warning: {}; the recording goes on", Escaped(&note));
                 }
                 self.note(port, t_ns, &note)?;
             }
@@ -360,7 +361,7 @@ impl Recorder {
                 state.silent_since = Some(Instant::now());
                 let note = format!("resumed: {} is back after a gap of {gap:.1} s", state.name);
                 if self.warn {
-                    eprintln!("hwfoc: {note}");
+                    eprintln!("hwfoc: {}", Escaped(&note));
                 }
                 self.note(port, t_ns, &note)?;
             }
@@ -432,7 +433,7 @@ impl Recorder {
                     "hwfoc: warning: {}: {} bytes in {} s but no valid HW-FOC frame: likely a \
                      wrong baud rate (read at {baud}; HW-FOC telemetry is {}, see --baud) or \
                      swapped TX/RX wires (the adapter's RX must be on the ESC's telemetry wire)",
-                    state.name,
+                    Escaped(&state.name),
                     state.unframed_bytes,
                     NO_FRAMES_AFTER.as_secs(),
                     hwfoc::wire::BAUD_RATE
@@ -446,7 +447,7 @@ impl Recorder {
                 eprintln!(
                     "hwfoc: warning: {}: nothing received in {} s: is the ESC powered, and its \
                      telemetry wire on the adapter's RX pin (not TX)?",
-                    state.name,
+                    Escaped(&state.name),
                     SILENT_AFTER.as_secs()
                 );
             }

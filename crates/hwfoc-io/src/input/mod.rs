@@ -378,10 +378,28 @@ impl Input {
 
 /// Reads a small file whole (a configuration file, a throttle profile): at most `limit` bytes;
 /// a larger file (or an endless one such as `/dev/zero`) is an error of kind `InvalidData`
-/// saying so, rather than memory for whatever it holds.
+/// saying so, rather than memory for whatever it holds. Anything but a regular file (a FIFO, a
+/// device, a directory) is an error of kind `InvalidInput` naming what it is: opening a FIFO
+/// waits for a writer, so it is opened without waiting and refused.
 pub fn read_small_file(path: impl AsRef<std::path::Path>, limit: u64) -> io::Result<Vec<u8>> {
+    let mut options = std::fs::OpenOptions::new();
+    options.read(true);
+    // O_NONBLOCK: the open of a FIFO returns at once; reads of a regular file never wait anyway.
+    #[cfg(unix)]
+    std::os::unix::fs::OpenOptionsExt::custom_flags(&mut options, libc::O_NONBLOCK);
+    let file = options.open(path)?;
+    let kind = file.metadata()?.file_type();
+    if !kind.is_file() {
+        return Err(io::Error::new(
+            io::ErrorKind::InvalidInput,
+            match file_kind(&kind) {
+                Some(what) => format!("it is {what}, not a regular file"),
+                None => "it is not a regular file".to_string(),
+            },
+        ));
+    }
     let mut bytes = Vec::new();
-    File::open(path)?.take(limit + 1).read_to_end(&mut bytes)?;
+    file.take(limit + 1).read_to_end(&mut bytes)?;
     if bytes.len() as u64 > limit {
         return Err(io::Error::new(
             io::ErrorKind::InvalidData,
@@ -392,6 +410,24 @@ pub fn read_small_file(path: impl AsRef<std::path::Path>, limit: u64) -> io::Res
         ));
     }
     Ok(bytes)
+}
+
+/// What a file that is not a regular file is, for an error: "a FIFO", "a directory".
+fn file_kind(kind: &std::fs::FileType) -> Option<&'static str> {
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::FileTypeExt;
+        if kind.is_fifo() {
+            return Some("a FIFO");
+        }
+        if kind.is_char_device() || kind.is_block_device() {
+            return Some("a device");
+        }
+        if kind.is_socket() {
+            return Some("a socket");
+        }
+    }
+    kind.is_dir().then_some("a directory")
 }
 
 /// `read` that retries when interrupted by a signal.

@@ -7,6 +7,7 @@ use std::time::{Duration, Instant};
 
 use hwfoc_bridge::OutputError;
 use hwfoc_bridge::fanout::Fanout;
+use hwfoc_io::escape::Escaped;
 
 /// How long the same failure message is not repeated.
 const REPEAT_AFTER: Duration = Duration::from_secs(10);
@@ -32,7 +33,7 @@ impl Errors {
     /// A failure: printed unless the same message was printed in the last ten seconds.
     pub fn report(&mut self, error: &OutputError) {
         self.total += 1;
-        let message = error.to_string();
+        let message = Escaped(error).to_string();
         let now = Instant::now();
         let entry = self.seen.entry(message.clone()).or_insert((now, 0));
         let first = entry.1 == 0;
@@ -79,7 +80,7 @@ pub fn print(fanout: &Fanout, errors: &Errors, ran: Duration) {
         };
         eprintln!(
             "  {}: {} messages, {} bytes, {} failed, {} superseded, latency median {}, p99 {}",
-            output.name(),
+            Escaped(output.name()),
             s.messages,
             s.bytes,
             s.errors,

@@ -29,6 +29,7 @@ use super::fleet::{EscView, HISTORY_S, Link, LogEntry, total_energy, total_power
 use super::{Session, number};
 use crate::error::CliError;
 use hwfoc_io::energy::Energy;
+use hwfoc_io::escape::Escaped;
 
 /// Shortest time between redraws while frames arrive.
 const FRAME_EVERY: Duration = Duration::from_millis(50);
@@ -257,7 +258,7 @@ fn draw_title(frame: &mut Frame, area: Rect, session: &Session, ui: &Ui, view: V
         spans.push("  PAUSED (p resumes)".yellow().bold());
     }
     if let Some(notice) = &session.notice {
-        spans.push(format!("  {notice}").cyan());
+        spans.push(format!("  {}", Escaped(notice)).cyan());
     }
     spans.push(
         format!(
@@ -330,7 +331,7 @@ fn draw_table(frame: &mut Frame, area: Rect, ui: &Ui, view: View<'_>) {
     let rows = view.escs.iter().enumerate().map(|(i, esc)| {
         let a = &esc.alarms;
         let p = &esc.peaks;
-        let name = Cell::from(esc.title().to_string());
+        let name = Cell::from(Escaped(esc.title()).to_string());
         let (values, faults): (Vec<Cell>, Cell) = match (&esc.link, &esc.last) {
             (Link::Down { since, .. }, _) => (
                 vec![Cell::from(""); 6],
@@ -431,13 +432,14 @@ fn alarm_cell(esc: &EscView) -> Cell<'static> {
 
 fn draw_detail(frame: &mut Frame, area: Rect, index: usize, esc: &EscView, now: f64) {
     let info = match &esc.info {
-        Some(info) => format!(
+        Some(info) => Escaped(format_args!(
             "{} · hw {} · fw {} · id {}",
             info.product(),
             info.hardware(),
             info.firmware(),
             info.id()
-        ),
+        ))
+        .to_string(),
         None => "no device information yet (sent while idle)".to_string(),
     };
     let cells = match (esc.cells, esc.cells_detected) {
@@ -448,7 +450,7 @@ fn draw_detail(frame: &mut Frame, area: Rect, index: usize, esc: &EscView, now: 
     let stats = &esc.stats;
     let block = Block::bordered().title(Line::from(vec![
         format!(" esc{index} ").bold(),
-        format!("{} ", esc.title()).into(),
+        format!("{} ", Escaped(esc.title())).into(),
     ]));
     let inner = block.inner(area);
     frame.render_widget(block, area);
@@ -759,7 +761,7 @@ fn draw_log(frame: &mut Frame, area: Rect, view: View<'_>) {
                 (_, Level::Critical) => Style::new().fg(Color::Red).add_modifier(Modifier::BOLD),
                 (_, Level::Warning) => Style::new().fg(Color::Yellow),
             };
-            let name = view.escs.get(e.esc).map_or("", |esc| esc.title());
+            let name = Escaped(view.escs.get(e.esc).map_or("", |esc| esc.title()));
             ListItem::new(Line::from(vec![
                 Span::styled(
                     // ISO 8601: the date and time where there is room, the time of day where

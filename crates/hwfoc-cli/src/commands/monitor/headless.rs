@@ -12,6 +12,7 @@ use super::fleet::{EscView, Fleet, Link, LogEntry};
 use super::{Session, number};
 use crate::error::CliError;
 use hwfoc_io::energy::Energy;
+use hwfoc_io::escape::Escaped;
 use hwfoc_io::record::Record;
 use hwfoc_io::write::WriteError;
 
@@ -66,7 +67,7 @@ pub fn run(session: &mut Session, json: bool, interval_s: f64) -> Result<(), Cli
             next_status += interval.mul_f64(missed + 1.0);
         }
         if let Some(notice) = session.notice.take() {
-            eprintln!("hwfoc: {notice}");
+            eprintln!("hwfoc: {}", Escaped(&notice));
         }
         if !text.is_empty() {
             out.write_all(&text)
@@ -136,7 +137,7 @@ fn total_json(fleet: &Fleet, now: f64) -> Value {
 /// cap 40.0C | 20.0 fr/s lost 0 dup 0 crc 0 | age 0.03 s | power 489 W (peak 520 W) used
 /// 12.5 mAh 0.30 Wh | ok`
 fn status_line(i: usize, esc: &EscView, now: f64) -> String {
-    let mut line = format!("{} esc{i} {}: ", timestamp(now), esc.title());
+    let mut line = format!("{} esc{i} {}: ", timestamp(now), Escaped(esc.title()));
     match (&esc.link, &esc.last) {
         (Link::Down { since, reason }, _) => {
             line.push_str(&format!("disconnected for {:.1} s ({reason})", now - since));
@@ -193,7 +194,7 @@ fn alarm_line(entry: &LogEntry, esc: &EscView) -> String {
         "{} {tag} esc{} {}: {}",
         timestamp(entry.t),
         entry.esc,
-        esc.title(),
+        Escaped(esc.title()),
         entry.text()
     )
 }

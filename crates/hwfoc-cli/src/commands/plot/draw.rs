@@ -13,6 +13,7 @@ use plotters::style::text_anchor::{HPos, Pos, VPos};
 use plotters::style::{FontStyle, register_font};
 
 use crate::error::CliError;
+use hwfoc_io::escape::Escaped;
 use hwfoc_io::sources::Sources;
 use hwfoc_io::summary::NO_FRAMES;
 use hwfoc_io::time::{self, Clock};
@@ -305,11 +306,11 @@ impl<'a> Scene<'a> {
                     } else {
                         0.0
                     },
-                    source: source_name(sources, i),
+                    source: Escaped(source_name(sources, i)).to_string(),
                     info: collector
                         .esc(i)
                         .and_then(|d| d.info)
-                        .map(|info| info.to_string()),
+                        .map(|info| Escaped(info).to_string()),
                     empty,
                 }
             })
@@ -332,7 +333,11 @@ impl<'a> Scene<'a> {
         let timed = rows.iter().any(|r| r.data.is_some_and(|d| d.timed));
         let untimed = rows.iter().any(|r| r.data.is_some_and(|d| !d.timed));
         let title = options.title.clone().unwrap_or_else(|| {
-            let names = sources.names();
+            let names: Vec<String> = sources
+                .names()
+                .iter()
+                .map(|n| Escaped(n).to_string())
+                .collect();
             match names.len() {
                 0..=3 => names.join(", "),
                 n => format!("{}, … ({n} inputs)", names[..2].join(", ")),
