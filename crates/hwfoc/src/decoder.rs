@@ -31,7 +31,7 @@ pub struct Decoded {
 
 /// Whether `b` is the length byte of a known frame kind.
 #[inline(always)]
-fn is_length_byte(b: u8) -> bool {
+pub(crate) fn is_length_byte(b: u8) -> bool {
     wire_len_of(b).is_some()
 }
 

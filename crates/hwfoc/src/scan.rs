@@ -13,7 +13,9 @@
 //! [`Decoder`](crate::Decoder), [`frames`](crate::frames)) and
 //! [`DatalinkScanner`](crate::datalink::DatalinkScanner) (the DataLink hub:
 //! [`DatalinkDecoder`](crate::datalink::DatalinkDecoder),
-//! [`datalink::frames`](crate::datalink::frames)). A new protocol is a module with its scanner
+//! [`datalink::frames`](crate::datalink::frames)); [`MixedScanner`](crate::mixed::MixedScanner)
+//! reads both at once ([`MixedDecoder`](crate::mixed::MixedDecoder)), for a stream that may
+//! carry either. A new protocol is a module with its scanner
 //! and one `impl Scanner`; the trait is sealed (its scanners live in this crate).
 
 use core::fmt;
@@ -244,6 +246,12 @@ impl<S: Scanner> StreamDecoder<S> {
     /// The statistics so far.
     pub fn stats(&self) -> &S::Stats {
         &self.stats
+    }
+
+    /// The statistics, for a protocol's own silence rule (see
+    /// [`MixedDecoder`](crate::mixed::MixedDecoder)).
+    pub(crate) fn stats_mut(&mut self) -> &mut S::Stats {
+        &mut self.stats
     }
 
     /// Forgets held bytes and statistics, as new.

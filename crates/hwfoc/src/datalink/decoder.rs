@@ -46,7 +46,7 @@ fn find_header(hay: &[u8]) -> Option<usize> {
 /// How many bytes of a candidate decide it: 2 while it is only its `9B` (does a length byte
 /// follow?), 4 until its version and command are known, then the whole frame.
 #[inline(always)]
-fn candidate_len(held: usize) -> usize {
+pub(crate) fn candidate_len(held: usize) -> usize {
     match held {
         0 | 1 => 2,
         2 | 3 => 4,
@@ -55,7 +55,7 @@ fn candidate_len(held: usize) -> usize {
 }
 
 /// What a candidate (a `9B` and a length byte, or a `9B` alone at the end) is.
-enum Verdict {
+pub(crate) enum Verdict {
     Frame(DatalinkFrame, FrameReport),
     BadHeader,
     BadCrc,
@@ -63,8 +63,9 @@ enum Verdict {
     Undecided,
 }
 
+/// Judges a candidate: a `9B` and a DataLink length byte (or a `9B` alone at the end).
 #[inline(always)]
-fn judge(candidate: &[u8]) -> Verdict {
+pub(crate) fn judge(candidate: &[u8]) -> Verdict {
     let (Some(&length_byte), Some(&version), Some(&command)) =
         (candidate.get(1), candidate.get(2), candidate.get(3))
     else {
