@@ -383,17 +383,26 @@ mod tests {
         );
     }
 
-    /// Streams that change protocol, with a little noise between: every frame of both is
-    /// found, in byte order, whatever the chunking, and no byte of a frame of one protocol
-    /// counts as skipped or as a failed candidate of the other.
+    /// Streams that change protocol, with a frame of each cut short where it changes and a
+    /// lone sync byte: every intact frame of both is found, in byte order, whatever the
+    /// chunking, and no byte of a frame of one protocol counts as skipped or as a failed
+    /// candidate of the other.
     #[test]
     fn every_frame_of_both_protocols_whatever_the_chunking() {
         let mut wire = [0u8; 12_000];
         let mut n = 0;
         hub(0..3, &mut wire, &mut n);
+        // The first 100 bytes of a hub frame: a CRC failure once 160 bytes are there.
+        let mut cut = [0u8; FRAME_LEN];
+        hub(99..100, &mut cut, &mut 0);
+        wire[n..n + 100].copy_from_slice(&cut[..100]);
+        n += 100;
         esc(0..40, &mut wire, &mut n);
         wire[n] = 0x9B; // a lone sync byte
         n += 1;
+        // The first 10 bytes of an ESC frame: a checksum failure.
+        esc(500..501, &mut wire, &mut n);
+        n -= 14;
         hub(3..6, &mut wire, &mut n);
         esc(40..80, &mut wire, &mut n);
         let wire = &wire[..n];
@@ -422,9 +431,9 @@ mod tests {
             assert_eq!(k, 86, "chunk {chunk}");
             assert!(offsets.windows(2).all(|w| w[0] < w[1]), "byte order");
             let s = d.stats();
-            assert_eq!((s.esc.bytes_skipped(), s.hub.bytes_skipped()), (1, 1));
-            assert_eq!((s.esc.checksum_failures(), s.esc.lost_packets()), (0, 0));
-            assert_eq!((s.hub.crc_failures(), s.hub.bad_headers()), (0, 0));
+            assert_eq!((s.esc.bytes_skipped(), s.hub.bytes_skipped()), (111, 111));
+            assert_eq!((s.esc.checksum_failures(), s.esc.lost_packets()), (1, 0));
+            assert_eq!((s.hub.crc_failures(), s.hub.bad_headers()), (1, 0));
             assert_eq!((s.esc.packets().count(), s.hub.frames()), (80, 6));
             assert_eq!(s.hub.lost_frames(), 0);
         }
