@@ -802,7 +802,7 @@ enum Deliver<'a, H> {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use crate::pcapng;
     use crate::record::Record;
@@ -825,7 +825,7 @@ mod tests {
     }
 
     /// The bytes of data frames `packets`.
-    fn wire(packets: std::ops::Range<u16>) -> Vec<u8> {
+    pub(crate) fn wire(packets: std::ops::Range<u16>) -> Vec<u8> {
         packets
             .flat_map(|packet| {
                 DataFrame {
@@ -1205,9 +1205,10 @@ mod tests {
         assert_eq!(by_esc(recorded.0), expected);
     }
 
-    /// Hub frames `0..3` whose `channels` carry an ESC (packet = 1000 + 100 * `id` + channel).
-    fn hub_wire(id: u16, channels: &[usize]) -> Vec<u8> {
-        (0..3)
+    /// Hub frames `counters` whose `channels` carry an ESC (packet = 1000 + 100 * `id` +
+    /// channel: an all-zero record would be an empty slot).
+    pub(crate) fn hub_wire(id: u16, counters: std::ops::Range<u16>, channels: &[usize]) -> Vec<u8> {
+        counters
             .flat_map(|counter| {
                 let mut frame = hwfoc::datalink::DatalinkFrame::new(counter);
                 for &c in channels {
@@ -1229,7 +1230,11 @@ mod tests {
     #[test]
     fn files_a_recording_and_ports_number_hubs_alike() {
         let all: Vec<usize> = (0..CHANNELS).collect();
-        let inputs = [hub_wire(0, &all), hub_wire(1, &[5]), wire(100..103)];
+        let inputs = [
+            hub_wire(0, 0..3, &all),
+            hub_wire(1, 0..3, &[5]),
+            wire(100..103),
+        ];
         let mut expected = std::collections::BTreeMap::<u8, Vec<u16>>::new();
         expected.insert(0, vec![1000; 3]);
         for c in 1..8u16 {

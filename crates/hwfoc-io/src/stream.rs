@@ -635,38 +635,11 @@ mod tests {
 #[cfg(test)]
 mod mixed_tests {
     use super::*;
-    use hwfoc::DataFrame;
-    use hwfoc::datalink::DatalinkFrame;
+    use crate::sources::tests::{hub_wire, wire as esc};
 
-    /// ESC data frames `packets`.
-    fn esc(packets: std::ops::Range<u16>) -> Vec<u8> {
-        packets
-            .flat_map(|packet| {
-                DataFrame {
-                    packet,
-                    voltage_raw: 250,
-                    ..Default::default()
-                }
-                .encode()
-            })
-            .collect()
-    }
-
-    /// Hub frames `counters`, each with all eight channels (packet numbers from 1000: an
-    /// all-zero record is an empty slot).
+    /// Hub frames `counters`, each with all eight channels.
     fn hub(counters: std::ops::Range<u16>) -> Vec<u8> {
-        counters
-            .flat_map(|counter| {
-                let mut frame = DatalinkFrame::new(counter);
-                for (c, slot) in frame.slots.iter_mut().enumerate() {
-                    *slot = Some(DataFrame {
-                        packet: 1000 + counter * 8 + c as u16,
-                        ..Default::default()
-                    });
-                }
-                frame.encode()
-            })
-            .collect()
+        hub_wire(0, counters, &[0, 1, 2, 3, 4, 5, 6, 7])
     }
 
     /// The records of `wire` fed to one stream in batches of `chunk` bytes, as `(channel,

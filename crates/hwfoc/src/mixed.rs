@@ -19,11 +19,10 @@
 //! frames is read as fast as by the [`Decoder`](crate::Decoder); the search over bytes in no
 //! frame compares each word with four second bytes instead of two.
 
-use crate::datalink::decoder::{Verdict, judge};
 use crate::datalink::{DatalinkDecoded, DatalinkStats, FRAME_LEN, LengthByte};
-use crate::decoder::{Decoded, bytes_equal, find_sync_then, is_length_byte};
+use crate::decoder::{Decoded, bytes_equal, find_sync_then, is_length_byte, take_candidate};
 use crate::frame::{Frame, MAX_FRAME_LEN, or_length_bytes};
-use crate::scan::{Scan, Scanner, Stats, StreamDecoder};
+use crate::scan::{Candidate, Scan, Scanner, Stats, StreamDecoder};
 use crate::stats::LinkStats;
 
 /// The longest candidate of either protocol.
@@ -169,43 +168,30 @@ fn scan_next(
         stats.skip(k);
         let i = *pos + k;
         *pos = i;
-        let rest = &data[i..];
-        match rest.get(1) {
-            Some(&b) if is_hub_length_byte(b) => match judge(rest) {
-                Verdict::Frame(frame, report) => {
-                    stats.hub.frame(&frame, &report);
-                    *pos = i + FRAME_LEN;
-                    return Some((
-                        i,
-                        MixedFrame::Hub(DatalinkDecoded {
+        // The length byte tells the protocol (their length bytes differ): that protocol
+        // decides the candidate (a sync byte that ends `data` is the ESC wire's to decide).
+        let decided = match data.get(i + 1) {
+            Some(&b) if is_hub_length_byte(b) => {
+                match crate::datalink::decoder::take_candidate(data, pos, &mut stats.hub, at_end) {
+                    Candidate::Frame((at, frame, report)) => {
+                        // Its stream offset is set by `MixedFrame::at`.
+                        let hub = DatalinkDecoded {
                             offset: 0,
                             frame,
                             report,
-                        }),
-                    ));
-                }
-                Verdict::BadHeader => stats.hub.bad_header(),
-                Verdict::BadCrc => stats.hub.crc_failure(),
-                Verdict::Undecided if !at_end => return None,
-                // Cut off by the end of the stream: skipped, not counted as an error.
-                Verdict::Undecided => {}
-            },
-            Some(_) => {
-                if let Some((at, frame)) = Frame::take(data, pos, &mut stats.esc) {
-                    return Some((at, MixedFrame::Esc(frame)));
-                }
-                // As the HW-FOC scanner decides a rejected or undecided candidate.
-                let complete =
-                    rest.len() >= MAX_FRAME_LEN || rest.len() >= crate::frame::candidate_len(rest);
-                if complete {
-                    stats.esc.checksum_failure();
-                } else if !at_end {
-                    return None;
+                        };
+                        return Some((at, MixedFrame::Hub(hub)));
+                    }
+                    other => other.is_decided(),
                 }
             }
-            // A sync byte that is the last byte: more bytes decide it.
-            None if !at_end => return None,
-            None => {}
+            _ => match take_candidate(data, pos, &mut stats.esc, at_end) {
+                Candidate::Frame((at, frame)) => return Some((at, MixedFrame::Esc(frame))),
+                other => other.is_decided(),
+            },
+        };
+        if !decided {
+            return None;
         }
         stats.skip(1);
         *pos = i + 1;

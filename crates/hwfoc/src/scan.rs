@@ -80,6 +80,26 @@ pub trait Stats: sealed::Sealed + Clone + fmt::Debug {
     fn line_silent(&mut self, max_frames: u32);
 }
 
+/// What a protocol's candidate (where its search for a header stopped) comes to, counted in
+/// its statistics: each protocol decides its own candidates, for its scanner and for
+/// [`MixedScanner`](crate::mixed::MixedScanner).
+pub(crate) enum Candidate<T> {
+    /// A verified frame, taken whole.
+    Frame(T),
+    /// Rejected, or cut off by the end of the stream: it costs one byte.
+    Rejected,
+    /// More bytes are needed.
+    Undecided,
+}
+
+impl<T> Candidate<T> {
+    /// Whether the candidate is decided (a frame, or rejected).
+    #[inline(always)]
+    pub(crate) fn is_decided(&self) -> bool {
+        !matches!(self, Candidate::Undecided)
+    }
+}
+
 pub(crate) mod sealed {
     /// Keeps [`Scanner`](super::Scanner) and [`Stats`](super::Stats) to this crate.
     pub trait Sealed {}

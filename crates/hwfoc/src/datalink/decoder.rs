@@ -11,7 +11,7 @@
 //! bytes however the stream is cut into chunks.
 
 use crate::decoder::{bytes_equal, find_sync_then};
-use crate::scan::{Scan, Scanner, Stats, StreamDecoder};
+use crate::scan::{Candidate, Scan, Scanner, Stats, StreamDecoder};
 
 use super::frame::{DatalinkFrame, FrameReport};
 use super::layout::{FRAME_LEN, LengthByte, is_version_and_command};
@@ -55,7 +55,7 @@ pub(crate) fn candidate_len(held: usize) -> usize {
 }
 
 /// What a candidate (a `9B` and a length byte, or a `9B` alone at the end) is.
-pub(crate) enum Verdict {
+enum Verdict {
     Frame(DatalinkFrame, FrameReport),
     BadHeader,
     BadCrc,
@@ -63,9 +63,8 @@ pub(crate) enum Verdict {
     Undecided,
 }
 
-/// Judges a candidate: a `9B` and a DataLink length byte (or a `9B` alone at the end).
 #[inline(always)]
-pub(crate) fn judge(candidate: &[u8]) -> Verdict {
+fn judge(candidate: &[u8]) -> Verdict {
     let (Some(&length_byte), Some(&version), Some(&command)) =
         (candidate.get(1), candidate.get(2), candidate.get(3))
     else {
@@ -111,20 +110,44 @@ fn scan_next(
         stats.skip(k);
         let i = *pos + k;
         *pos = i;
-        match judge(&data[i..]) {
-            Verdict::Frame(frame, report) => {
-                stats.frame(&frame, &report);
-                *pos = i + FRAME_LEN;
-                return Some((i, frame, report));
-            }
-            Verdict::BadHeader => stats.bad_header(),
-            Verdict::BadCrc => stats.crc_failure(),
-            Verdict::Undecided if !at_end => return None,
-            // Cut off by the end of the stream: skipped, not counted as an error.
-            Verdict::Undecided => {}
+        match take_candidate(data, pos, stats, at_end) {
+            Candidate::Frame(found) => return Some(found),
+            Candidate::Undecided => return None,
+            Candidate::Rejected => {}
         }
         stats.skip(1);
         *pos = i + 1;
+    }
+}
+
+/// Decides the candidate at `*pos` (a `9B` and a DataLink length byte, or a `9B` that ends
+/// `data`): a frame is counted and taken, `*pos` just after it; a bad header or CRC is
+/// counted. Nothing is skipped here, and `*pos` moves only past a frame.
+#[inline(always)]
+pub(crate) fn take_candidate(
+    data: &[u8],
+    pos: &mut usize,
+    stats: &mut DatalinkStats,
+    at_end: bool,
+) -> Candidate<(usize, DatalinkFrame, FrameReport)> {
+    let i = *pos;
+    match judge(&data[i..]) {
+        Verdict::Frame(frame, report) => {
+            stats.frame(&frame, &report);
+            *pos = i + FRAME_LEN;
+            Candidate::Frame((i, frame, report))
+        }
+        Verdict::BadHeader => {
+            stats.bad_header();
+            Candidate::Rejected
+        }
+        Verdict::BadCrc => {
+            stats.crc_failure();
+            Candidate::Rejected
+        }
+        Verdict::Undecided if !at_end => Candidate::Undecided,
+        // Cut off by the end of the stream: skipped, not counted as an error.
+        Verdict::Undecided => Candidate::Rejected,
     }
 }
 
