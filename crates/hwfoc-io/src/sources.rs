@@ -97,6 +97,8 @@ pub struct Sources {
     /// The ESC of each channel of each stream found to come from a DataLink hub, by the ESC
     /// of its stream.
     hubs: HashMap<usize, Hub>,
+    /// The ESCs of each input's streams numbered before it is read, by input.
+    numbered: Vec<Vec<Option<usize>>>,
     queue: Queue,
 }
 
@@ -125,6 +127,7 @@ impl Sources {
             need_timing: false,
             ports: HashMap::new(),
             hubs: HashMap::new(),
+            numbered: Vec::new(),
             esc_settings: Vec::new(),
             queue: Queue::default(),
         }
@@ -226,6 +229,7 @@ impl Sources {
     /// finished), and the error is returned without reading further.
     pub fn run<H: Handler>(&mut self, handler: &mut H) -> Result<(), H::Error> {
         let mut inputs: VecDeque<Input> = std::mem::take(&mut self.pending).into();
+        self.number_inputs(&inputs);
         let mut result = Ok(());
         while let Some(first) = inputs.front() {
             let clock = first.format().clock();
@@ -401,6 +405,32 @@ impl Sources {
         }
     }
 
+    /// Numbers the streams of the inputs before they are read (one for a file or standard
+    /// input, one per port), in the order given up to the first recording (which declares its
+    /// ports as it is read: they and the inputs after them are numbered as they are read): the
+    /// channels of a DataLink hub, found later in any of them, take numbers after all of these,
+    /// as they do live (see [`PortStreams`](crate::stream::PortStreams)).
+    fn number_inputs(&mut self, inputs: &VecDeque<Input>) {
+        let base = self.read.len();
+        self.numbered.resize(base, Vec::new());
+        for (k, input) in inputs.iter().enumerate() {
+            if input.format() == InputFormat::Recording {
+                break;
+            }
+            let mut escs = Vec::new();
+            self.number_streams(input, base + k, &mut escs);
+            self.numbered.push(escs);
+        }
+    }
+
+    /// The ESCs of input `index`'s streams numbered before it was read.
+    fn numbered(&mut self, index: usize) -> Vec<Option<usize>> {
+        self.numbered
+            .get_mut(index)
+            .map(std::mem::take)
+            .unwrap_or_default()
+    }
+
     /// Notes what is known of an input at its end.
     fn close(&mut self, input: &Input, index: usize, escs: &[Option<usize>], bytes: u64) {
         let info = &mut self.read[index];
@@ -429,7 +459,7 @@ impl Sources {
         handler: &mut H,
     ) -> Result<(), H::Error> {
         let index = self.open(&input);
-        let mut escs = Vec::new();
+        let mut escs = self.numbered(index);
         let mut bytes = 0;
         let result = self.read_input(&mut input, index, &mut escs, &mut bytes, handler);
         self.number_streams(&input, index, &mut escs);
@@ -511,10 +541,11 @@ impl Sources {
         let mut result = Ok(());
         for input in inputs {
             let index = self.open(&input);
+            let escs = self.numbered(index);
             run.push(Reading {
                 input,
                 index,
-                escs: Vec::new(),
+                escs,
                 bytes: 0,
                 ahead: Some((f64::NEG_INFINITY, 0)),
             });
@@ -771,7 +802,7 @@ enum Deliver<'a, H> {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use crate::pcapng;
     use crate::record::Record;
@@ -794,7 +825,7 @@ mod tests {
     }
 
     /// The bytes of data frames `packets`.
-    fn wire(packets: std::ops::Range<u16>) -> Vec<u8> {
+    pub(crate) fn wire(packets: std::ops::Range<u16>) -> Vec<u8> {
         packets
             .flat_map(|packet| {
                 DataFrame {
@@ -1172,5 +1203,96 @@ mod tests {
         let mut recorded = Escs(Vec::new());
         sources.run(&mut recorded).unwrap();
         assert_eq!(by_esc(recorded.0), expected);
+    }
+
+    /// Hub frames `counters` whose `channels` carry an ESC (packet = 1000 + 100 * `id` +
+    /// channel: an all-zero record would be an empty slot).
+    pub(crate) fn hub_wire(id: u16, counters: std::ops::Range<u16>, channels: &[usize]) -> Vec<u8> {
+        counters
+            .flat_map(|counter| {
+                let mut frame = hwfoc::datalink::DatalinkFrame::new(counter);
+                for &c in channels {
+                    frame.slots[c] = Some(DataFrame {
+                        packet: 1000 + 100 * id + c as u16,
+                        ..Default::default()
+                    });
+                }
+                frame.encode()
+            })
+            .collect()
+    }
+
+    /// The README's one rule, alike for files, a recording and live ports: each input (or
+    /// port) is numbered in the order given, a hub's channel 0 keeps its input's number, and
+    /// its channels 1 to 7 take the next numbers after all inputs', hub by hub as found. So in
+    /// `summary dl_clean.bin dl_ch5.bin raw.bin` the raw file is ESC 2 (it was 16: each hub's
+    /// channels were numbered before the next file).
+    #[test]
+    fn files_a_recording_and_ports_number_hubs_alike() {
+        let all: Vec<usize> = (0..CHANNELS).collect();
+        let inputs = [
+            hub_wire(0, 0..3, &all),
+            hub_wire(1, 0..3, &[5]),
+            wire(100..103),
+        ];
+        let mut expected = std::collections::BTreeMap::<u8, Vec<u16>>::new();
+        expected.insert(0, vec![1000; 3]);
+        for c in 1..8u16 {
+            expected.insert(2 + c as u8, vec![1000 + c; 3]);
+        }
+        expected.insert(14, vec![1105; 3]);
+        expected.insert(2, vec![100, 101, 102]);
+
+        #[derive(Default)]
+        struct Escs(std::collections::BTreeMap<u8, Vec<u16>>);
+        impl Handler for Escs {
+            type Error = InputError;
+            fn record(&mut self, r: &Record) {
+                self.0.entry(r.esc).or_default().push(r.packet);
+            }
+        }
+
+        // Files, read one after another.
+        let files = inputs
+            .iter()
+            .zip(["dl_clean.bin", "dl_ch5.bin", "raw.bin"])
+            .map(|(bytes, name)| Input::from_memory(name, bytes.clone()).unwrap())
+            .collect();
+        let mut sources = Sources::new(files, Settings::DEFAULT);
+        let mut got = Escs::default();
+        sources.run(&mut got).unwrap();
+        assert_eq!(got.0, expected, "files");
+        assert_eq!(sources.inputs()[2].escs, [2]);
+
+        // Live ports, their bytes arriving in the same order.
+        let names: Vec<String> = (0..3).map(|p| format!("/dev/ttyUSB{p}")).collect();
+        let t = 1_700_000_000_000_000_000u64;
+        let mut streams = crate::stream::PortStreams::with_map(
+            115_200,
+            names.clone(),
+            SettingsMap::from(Settings::DEFAULT),
+        );
+        let mut live = Escs::default();
+        for (port, bytes) in inputs.iter().enumerate() {
+            let event = crate::serial::PortEvent::Data {
+                port,
+                t_ns: t + port as u64 * 100_000_000,
+                bytes: bytes.clone(),
+            };
+            streams.feed(&event, &mut live);
+        }
+        assert_eq!(live.0, expected, "ports");
+
+        // The recording of those ports.
+        let mut w = pcapng::Writer::new(Vec::new()).unwrap();
+        for name in &names {
+            w.add_interface(name, 115_200).unwrap();
+        }
+        for (port, bytes) in inputs.iter().enumerate() {
+            w.write(port as u32, t + port as u64 * 100_000_000, bytes)
+                .unwrap();
+        }
+        let (recorded, _) = run_into::<Escs>(vec![w.into_inner().unwrap()]);
+        assert_eq!(recorded.0, expected, "recording");
     }
 }

@@ -5,9 +5,10 @@
 //! port events). [`byte_times`] is the one place where a chunk's receive time becomes the time
 //! of each of its bytes.
 
-use hwfoc::datalink::{self, DatalinkDecoded, DatalinkDecoder, DatalinkStats};
+use hwfoc::datalink::{self, DatalinkDecoded, DatalinkStats};
+use hwfoc::mixed::{MixedDecoded, MixedDecoder};
 use hwfoc::stats::PacketSequence;
-use hwfoc::{Decoded, Decoder, Frame, LinkStats, Settings};
+use hwfoc::{Decoded, Frame, LinkStats, Settings};
 
 use crate::handler::Handler;
 
@@ -51,38 +52,17 @@ fn hub_frames_in(seconds: f64) -> u32 {
     (seconds / frame_s).ceil().min(f64::from(u32::MAX)) as u32
 }
 
-/// Which protocol a stream speaks, known from its first verified frame.
+/// Which protocols a stream has been heard speaking, from the frames found so far.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum WireKind {
-    /// No frame yet: the bytes go to both decoders.
+    /// No frame yet.
     Unknown,
     /// One ESC's own wire: HW-FOC frames at 19200 baud.
     Esc,
     /// A Hobbywing DataLink V2 hub: frames of up to eight ESCs at 115200 baud.
     Hub,
-}
-
-/// The decoder(s) of a stream.
-#[derive(Debug, Clone)]
-enum Wire {
-    /// Before the first frame: both decoders see every byte, and the first to find a frame
-    /// decides (a HW-FOC frame and a DataLink frame each carry a checksum over their bytes, so a
-    /// stream of one protocol does not pass for the other).
-    Detecting(Box<(Decoder, DatalinkDecoder)>),
-    Esc(Decoder),
-    Hub(Box<DatalinkDecoder>),
-}
-
-impl Default for Wire {
-    fn default() -> Self {
-        Wire::Detecting(Box::default())
-    }
-}
-
-/// A frame found while detecting, kept until the batch is done.
-enum Found {
-    Esc(Decoded),
-    Hub(DatalinkDecoded),
+    /// Both, one after the other (an adapter moved between an ESC and a hub).
+    Mixed,
 }
 
 /// Hands each ESC frame of a hub frame on as `(channel, decoded)`, at the hub frame's offset.
@@ -97,95 +77,13 @@ fn hub_records(d: &DatalinkDecoded, emit: &mut impl FnMut(Option<u8>, &Decoded))
     }
 }
 
-impl Wire {
-    /// Decodes `data` (ending with a silence of the line of `silence_s` seconds when given):
-    /// `emit(channel, decoded)` gets each ESC frame with its DataLink channel (`None` on an
-    /// ESC's own wire).
-    #[inline(always)]
-    fn feed(
-        &mut self,
-        data: &[u8],
-        silence_s: Option<f64>,
-        emit: &mut impl FnMut(Option<u8>, &Decoded),
-    ) {
-        match self {
-            Wire::Esc(decoder) => {
-                decoder.feed(data, |d| emit(None, &d));
-                if let Some(s) = silence_s {
-                    decoder.line_silent(frames_in(s), |d| emit(None, &d));
-                }
-            }
-            Wire::Hub(decoder) => {
-                decoder.feed(data, |d| hub_records(&d, emit));
-                if let Some(s) = silence_s {
-                    decoder.line_silent(hub_frames_in(s), |d| hub_records(&d, emit));
-                }
-            }
-            Wire::Detecting(both) => {
-                let (esc, hub) = &mut **both;
-                let mut found = Vec::new();
-                esc.feed(data, |d| found.push(Found::Esc(d)));
-                hub.feed(data, |d| found.push(Found::Hub(d)));
-                if let Some(s) = silence_s {
-                    esc.line_silent(frames_in(s), |d| found.push(Found::Esc(d)));
-                    hub.line_silent(hub_frames_in(s), |d| found.push(Found::Hub(d)));
-                }
-                self.decide(found, emit);
-            }
-        }
-    }
-
-    /// Settles the bytes held, as at the end of the stream.
-    fn flush(&mut self, emit: &mut impl FnMut(Option<u8>, &Decoded)) {
-        match self {
-            Wire::Esc(decoder) => decoder.flush(|d| emit(None, &d)),
-            Wire::Hub(decoder) => decoder.flush(|d| hub_records(&d, emit)),
-            Wire::Detecting(both) => {
-                let (esc, hub) = &mut **both;
-                let mut found = Vec::new();
-                esc.flush(|d| found.push(Found::Esc(d)));
-                hub.flush(|d| found.push(Found::Hub(d)));
-                self.decide(found, emit);
-            }
-        }
-    }
-
-    /// Keeps the decoder that found a frame (a hub frame wins: its 160 bytes and CRC-16 make
-    /// it the stronger evidence) and hands on its frames.
-    fn decide(&mut self, found: Vec<Found>, emit: &mut impl FnMut(Option<u8>, &Decoded)) {
-        let Wire::Detecting(both) = self else {
-            return;
-        };
-        let hub = found.iter().any(|f| matches!(f, Found::Hub(_)));
-        if hub {
-            *self = Wire::Hub(Box::new(both.1.clone()));
-        } else if !found.is_empty() {
-            *self = Wire::Esc(both.0.clone());
-        }
-        for f in &found {
-            match f {
-                Found::Hub(d) if hub => hub_records(d, emit),
-                Found::Esc(d) if !hub => emit(None, d),
-                _ => {}
-            }
-        }
-    }
-
-    /// Bytes held for a frame still arriving (the most either decoder holds, while detecting).
-    fn buffered(&self) -> usize {
-        match self {
-            Wire::Esc(d) => d.buffered(),
-            Wire::Hub(d) => d.buffered(),
-            Wire::Detecting(both) => both.0.buffered().max(both.1.buffered()),
-        }
-    }
-
-    fn bytes(&self) -> u64 {
-        match self {
-            Wire::Esc(d) => d.stats().bytes(),
-            Wire::Hub(d) => d.stats().bytes(),
-            Wire::Detecting(both) => both.0.stats().bytes(),
-        }
+/// Hands on a frame of either protocol: `emit(channel, decoded)` gets each ESC frame with its
+/// DataLink channel (`None` on an ESC's own wire).
+#[inline(always)]
+fn emit_mixed(d: MixedDecoded, emit: &mut impl FnMut(Option<u8>, &Decoded)) {
+    match d {
+        MixedDecoded::Esc(d) => emit(None, &d),
+        MixedDecoded::Hub(d) => hub_records(&d, emit),
     }
 }
 
@@ -281,11 +179,14 @@ impl EscLink {
     }
 }
 
-/// A decoder that also gives each frame the receive time of its first byte, and finds out
-/// from the bytes whether they come from one ESC or from a DataLink hub.
+/// A decoder that also gives each frame the receive time of its first byte.
+///
+/// It reads both protocols at once ([`MixedDecoder`]): the frames of an ESC's own wire and of
+/// a DataLink hub, in byte order, whatever the chunking, also when the stream changes from one
+/// to the other; bytes in a frame of either are not skipped bytes of the other.
 #[derive(Debug, Default)]
 pub struct Stream {
-    wire: Wire,
+    wire: MixedDecoder,
     /// Receive times of the last bytes of earlier batches, oldest first.
     history: Vec<f64>,
 }
@@ -304,11 +205,11 @@ impl Stream {
         batch: Batch<'_>,
         mut on_frame: impl FnMut(Option<f64>, Option<u8>, &Decoded),
     ) {
-        let start = self.wire.bytes();
+        let start = self.wire.stats().bytes();
         match batch.times {
             None => {
                 self.history.clear();
-                self.wire.feed(batch.bytes, None, &mut |channel, d| {
+                feed(&mut self.wire, batch.bytes, None, &mut |channel, d| {
                     on_frame(None, channel, d)
                 });
             }
@@ -326,13 +227,17 @@ impl Stream {
                     if let Some(before) = last
                         && t - before > SILENCE_S
                     {
-                        self.wire
-                            .feed(&batch.bytes[from..i], Some(t - before), &mut emit);
+                        feed(
+                            &mut self.wire,
+                            &batch.bytes[from..i],
+                            Some(t - before),
+                            &mut emit,
+                        );
                         from = i;
                     }
                     last = Some(t);
                 }
-                self.wire.feed(&batch.bytes[from..], None, &mut emit);
+                feed(&mut self.wire, &batch.bytes[from..], None, &mut emit);
                 let keep = TIME_HISTORY.min(self.history.len() + times.len());
                 let from_times = keep.min(times.len());
                 let from_history = keep - from_times;
@@ -345,47 +250,61 @@ impl Stream {
 
     /// Ends the stream: a frame cut off at the end is dropped, frames inside it are still found.
     pub fn finish(&mut self, mut on_frame: impl FnMut(Option<f64>, Option<u8>, &Decoded)) {
-        let end = self.wire.bytes();
+        let end = self.wire.stats().bytes();
         let history = &self.history;
         let timed = !history.is_empty();
-        self.wire.flush(&mut |channel, d| {
+        let mut emit = |channel: Option<u8>, d: &Decoded| {
             let t = timed.then(|| time_at(history, &[], end, d.offset));
             on_frame(t, channel, d)
-        });
+        };
+        self.wire.flush(|d| emit_mixed(d, &mut emit));
     }
 
-    /// What the stream turned out to be.
+    /// Which protocols the stream has been heard speaking.
     pub fn kind(&self) -> WireKind {
-        match self.wire {
-            Wire::Detecting(_) => WireKind::Unknown,
-            Wire::Esc(_) => WireKind::Esc,
-            Wire::Hub(_) => WireKind::Hub,
+        match (self.esc_frames(), self.hub_frames()) {
+            (false, false) => WireKind::Unknown,
+            (true, false) => WireKind::Esc,
+            (false, true) => WireKind::Hub,
+            (true, true) => WireKind::Mixed,
         }
     }
 
-    /// The link statistics of the stream's ESC (its channel 0, from a DataLink hub).
+    /// Whether an ESC frame (data or device information) has been found.
+    fn esc_frames(&self) -> bool {
+        let s = &self.wire.stats().esc;
+        s.packets().count() > 0 || s.info_frames() > 0
+    }
+
+    /// Whether a DataLink frame has been found.
+    fn hub_frames(&self) -> bool {
+        self.wire.stats().hub.frames() > 0
+    }
+
+    /// The link statistics of the stream's ESC: of its own wire, or of the hub's channel 0
+    /// when the stream has carried hub frames and no ESC frame of its own.
     pub fn stats(&self) -> EscLink {
         self.link(0)
     }
 
-    /// The link statistics of the stream's ESC on `channel` (any channel on an ESC's own wire).
+    /// The link statistics of the stream's ESC on `channel`: the hub's channel once hub frames
+    /// were found (channel 0: unless the stream also carried ESC frames of its own, whose
+    /// statistics are then given), else the ESC's own wire (any channel).
     pub fn link(&self, channel: u8) -> EscLink {
-        match &self.wire {
-            Wire::Esc(d) => EscLink::Wire(*d.stats()),
-            Wire::Detecting(both) => EscLink::Wire(*both.0.stats()),
-            Wire::Hub(d) => EscLink::Hub {
-                hub: *d.stats(),
+        let stats = self.wire.stats();
+        if self.hub_frames() && (channel != 0 || !self.esc_frames()) {
+            EscLink::Hub {
+                hub: stats.hub,
                 channel: usize::from(channel),
-            },
+            }
+        } else {
+            EscLink::Wire(stats.esc)
         }
     }
 
-    /// The DataLink hub's statistics, when the stream is one.
+    /// The DataLink hub's statistics, once the stream has carried a hub frame.
     pub fn hub(&self) -> Option<&DatalinkStats> {
-        match &self.wire {
-            Wire::Hub(d) => Some(d.stats()),
-            _ => None,
-        }
+        self.hub_frames().then_some(&self.wire.stats().hub)
     }
 
     /// The receive time of the first byte the decoder holds for a frame still arriving, if it
@@ -394,6 +313,22 @@ impl Stream {
     pub fn held_since(&self) -> Option<f64> {
         let held = self.wire.buffered();
         (held > 0 && held <= self.history.len()).then(|| self.history[self.history.len() - held])
+    }
+}
+
+/// Decodes `data` (ending with a silence of the line of `silence_s` seconds when given):
+/// `emit(channel, decoded)` gets each ESC frame with its DataLink channel (`None` on an ESC's
+/// own wire).
+#[inline(always)]
+fn feed(
+    decoder: &mut MixedDecoder,
+    data: &[u8],
+    silence_s: Option<f64>,
+    emit: &mut impl FnMut(Option<u8>, &Decoded),
+) {
+    decoder.feed(data, |d| emit_mixed(d, emit));
+    if let Some(s) = silence_s {
+        decoder.line_silent_each(frames_in(s), hub_frames_in(s), |d| emit_mixed(d, emit));
     }
 }
 
@@ -694,5 +629,87 @@ mod tests {
         let close = timed(&[65_528, 65_529], 10.2);
         let s = run(&[before, close], 24);
         assert_eq!((s.restarts(), s.lost_packets()), (0, 535));
+    }
+}
+
+#[cfg(test)]
+mod mixed_tests {
+    use super::*;
+    use crate::sources::tests::{hub_wire, wire as esc};
+
+    /// Hub frames `counters`, each with all eight channels.
+    fn hub(counters: std::ops::Range<u16>) -> Vec<u8> {
+        hub_wire(0, counters, &[0, 1, 2, 3, 4, 5, 6, 7])
+    }
+
+    /// The records of `wire` fed to one stream in batches of `chunk` bytes, as `(channel,
+    /// packet)`, and the stream.
+    fn decode(wire: &[u8], chunk: usize) -> (Vec<(Option<u8>, u16)>, Stream) {
+        let mut stream = Stream::new();
+        let mut got = Vec::new();
+        let mut on = |_: Option<f64>, channel: Option<u8>, d: &Decoded| {
+            if let Frame::Data(f) = d.frame {
+                got.push((channel, f.packet));
+            }
+        };
+        for b in wire.chunks(chunk) {
+            let batch = Batch {
+                bytes: b,
+                times: None,
+                stream: 0,
+            };
+            stream.feed(batch, &mut on);
+        }
+        stream.finish(&mut on);
+        (got, stream)
+    }
+
+    /// One hub frame and then 2000 ESC frames: every frame is decoded, in byte order, and no
+    /// byte is skipped (the first frame once decided the protocol: 8 records, 48 000 bytes
+    /// skipped).
+    #[test]
+    fn a_hub_frame_then_esc_frames_are_all_decoded() {
+        let mut wire = hub(0..1);
+        wire.extend(esc(0..2000));
+        let mut expected: Vec<(Option<u8>, u16)> =
+            (0..8).map(|c| (Some(c), 1000 + u16::from(c))).collect();
+        expected.extend((0..2000).map(|p| (None, p)));
+        for chunk in [1, 7, 24, 100, 160, 4096, wire.len()] {
+            let (got, stream) = decode(&wire, chunk);
+            assert_eq!(got, expected, "chunk {chunk}");
+            assert_eq!(stream.kind(), WireKind::Mixed);
+            assert_eq!(stream.stats().bytes_skipped(), 0, "chunk {chunk}");
+            assert_eq!(stream.stats().frames(), 2000);
+            assert_eq!(stream.link(3).frames(), 1);
+            assert_eq!(stream.hub().map(|h| h.bytes_skipped()), Some(0));
+        }
+    }
+
+    /// ESC frames, then hub frames (an adapter moved from an ESC to a hub), then ESC frames
+    /// again: none is lost whatever the chunking, and each protocol's packet and frame
+    /// numbers run on without a loss.
+    #[test]
+    fn a_stream_that_changes_protocol_loses_no_frame() {
+        let mut wire = esc(0..200);
+        wire.extend(hub(0..200));
+        wire.extend(esc(200..210));
+        for chunk in [1, 5, 24, 159, 161, 1000, 4800, wire.len()] {
+            let (got, stream) = decode(&wire, chunk);
+            assert_eq!(got.len(), 200 + 200 * 8 + 10, "chunk {chunk}");
+            assert_eq!(got[199], (None, 199));
+            assert_eq!(got[200], (Some(0), 1000));
+            assert_eq!(got[200 + 1600], (None, 200));
+            let s = stream.stats();
+            assert_eq!(
+                (s.frames(), s.lost_packets(), s.bytes_skipped()),
+                (210, 0, 0)
+            );
+            let hub = stream.hub().unwrap();
+            assert_eq!(
+                (hub.frames(), hub.lost_frames(), hub.crc_failures()),
+                (200, 0, 0)
+            );
+            assert_eq!(s.checksum_failures(), 0);
+        }
     }
 }

@@ -15,7 +15,7 @@
 //! the kinds is left in the scanner.
 
 use crate::frame::{Frame, MAX_FRAME_LEN, candidate_len, or_length_bytes, wire_len_of};
-use crate::scan::{Scan, Scanner, Stats, StreamDecoder};
+use crate::scan::{Candidate, Scan, Scanner, Stats, StreamDecoder};
 use crate::stats::LinkStats;
 use crate::wire::SYNC;
 
@@ -31,7 +31,7 @@ pub struct Decoded {
 
 /// Whether `b` is the length byte of a known frame kind.
 #[inline(always)]
-fn is_length_byte(b: u8) -> bool {
+pub(crate) fn is_length_byte(b: u8) -> bool {
     wire_len_of(b).is_some()
 }
 
@@ -120,28 +120,50 @@ fn scan_next(
         stats.skip(k);
         let i = *pos + k;
         *pos = i;
-        // Each kind decides "valid frame of mine" with as few, as predictable, branches as it can
-        // (false all through line noise, true all through a run of frames).
-        if let Some(found) = Frame::take(data, pos, stats) {
-            return Some(found);
-        }
-        let rest = &data[i..];
-        debug_assert!(
-            rest.len() == 1 || is_length_byte(rest[1]),
-            "find_header's contract"
-        );
-        // Rejected, or undecided: a candidate is rejected once all its bytes are there. With
-        // MAX_FRAME_LEN bytes they are, whatever its length byte, which is then not even read
-        // (in line noise, which length byte a fake header carries is unpredictable). Short of
-        // that, its length byte (a known one: `find_header` stops at no other) tells.
-        let complete = rest.len() >= MAX_FRAME_LEN || rest.len() >= candidate_len(rest);
-        if complete {
-            stats.checksum_failure();
-        } else if !at_end {
-            return None;
+        match take_candidate(data, pos, stats, at_end) {
+            Candidate::Frame(found) => return Some(found),
+            Candidate::Undecided => return None,
+            Candidate::Rejected => {}
         }
         stats.skip(1);
         *pos = i + 1;
+    }
+}
+
+/// Decides the candidate at `*pos` (a sync byte and a known length byte, or a sync byte that
+/// ends `data`): a frame is counted and taken, `*pos` just after it; a candidate whose bytes
+/// are all there and that is no frame is a checksum failure. Nothing is skipped here, and
+/// `*pos` moves only past a frame.
+#[inline(always)]
+pub(crate) fn take_candidate(
+    data: &[u8],
+    pos: &mut usize,
+    stats: &mut LinkStats,
+    at_end: bool,
+) -> Candidate<(usize, Frame)> {
+    let i = *pos;
+    // Each kind decides "valid frame of mine" with as few, as predictable, branches as it can
+    // (false all through line noise, true all through a run of frames).
+    if let Some(found) = Frame::take(data, pos, stats) {
+        return Candidate::Frame(found);
+    }
+    let rest = &data[i..];
+    debug_assert!(
+        rest.len() == 1 || is_length_byte(rest[1]),
+        "find_header's contract"
+    );
+    // Rejected, or undecided: a candidate is rejected once all its bytes are there. With
+    // MAX_FRAME_LEN bytes they are, whatever its length byte, which is then not even read
+    // (in line noise, which length byte a fake header carries is unpredictable). Short of
+    // that, its length byte (a known one: `find_header` stops at no other) tells.
+    let complete = rest.len() >= MAX_FRAME_LEN || rest.len() >= candidate_len(rest);
+    if complete {
+        stats.checksum_failure();
+        Candidate::Rejected
+    } else if at_end {
+        Candidate::Rejected
+    } else {
+        Candidate::Undecided
     }
 }
 

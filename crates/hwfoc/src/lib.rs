@@ -7,6 +7,7 @@ pub mod datalink;
 pub mod decoder;
 pub mod frame;
 pub mod kinds;
+pub mod mixed;
 pub mod scan;
 pub mod stats;
 pub mod status;

@@ -13,7 +13,9 @@
 //! [`Decoder`](crate::Decoder), [`frames`](crate::frames)) and
 //! [`DatalinkScanner`](crate::datalink::DatalinkScanner) (the DataLink hub:
 //! [`DatalinkDecoder`](crate::datalink::DatalinkDecoder),
-//! [`datalink::frames`](crate::datalink::frames)). A new protocol is a module with its scanner
+//! [`datalink::frames`](crate::datalink::frames)); [`MixedScanner`](crate::mixed::MixedScanner)
+//! reads both at once ([`MixedDecoder`](crate::mixed::MixedDecoder)), for a stream that may
+//! carry either. A new protocol is a module with its scanner
 //! and one `impl Scanner`; the trait is sealed (its scanners live in this crate).
 
 use core::fmt;
@@ -76,6 +78,26 @@ pub trait Stats: sealed::Sealed + Clone + fmt::Debug {
     /// sent (see [`StreamDecoder::line_silent`]).
     #[doc(hidden)]
     fn line_silent(&mut self, max_frames: u32);
+}
+
+/// What a protocol's candidate (where its search for a header stopped) comes to, counted in
+/// its statistics: each protocol decides its own candidates, for its scanner and for
+/// [`MixedScanner`](crate::mixed::MixedScanner).
+pub(crate) enum Candidate<T> {
+    /// A verified frame, taken whole.
+    Frame(T),
+    /// Rejected, or cut off by the end of the stream: it costs one byte.
+    Rejected,
+    /// More bytes are needed.
+    Undecided,
+}
+
+impl<T> Candidate<T> {
+    /// Whether the candidate is decided (a frame, or rejected).
+    #[inline(always)]
+    pub(crate) fn is_decided(&self) -> bool {
+        !matches!(self, Candidate::Undecided)
+    }
 }
 
 pub(crate) mod sealed {
@@ -244,6 +266,12 @@ impl<S: Scanner> StreamDecoder<S> {
     /// The statistics so far.
     pub fn stats(&self) -> &S::Stats {
         &self.stats
+    }
+
+    /// The statistics, for a protocol's own silence rule (see
+    /// [`MixedDecoder`](crate::mixed::MixedDecoder)).
+    pub(crate) fn stats_mut(&mut self) -> &mut S::Stats {
+        &mut self.stats
     }
 
     /// Forgets held bytes and statistics, as new.

@@ -11,7 +11,7 @@
 //! bytes however the stream is cut into chunks.
 
 use crate::decoder::{bytes_equal, find_sync_then};
-use crate::scan::{Scan, Scanner, Stats, StreamDecoder};
+use crate::scan::{Candidate, Scan, Scanner, Stats, StreamDecoder};
 
 use super::frame::{DatalinkFrame, FrameReport};
 use super::layout::{FRAME_LEN, LengthByte, is_version_and_command};
@@ -46,7 +46,7 @@ fn find_header(hay: &[u8]) -> Option<usize> {
 /// How many bytes of a candidate decide it: 2 while it is only its `9B` (does a length byte
 /// follow?), 4 until its version and command are known, then the whole frame.
 #[inline(always)]
-fn candidate_len(held: usize) -> usize {
+pub(crate) fn candidate_len(held: usize) -> usize {
     match held {
         0 | 1 => 2,
         2 | 3 => 4,
@@ -110,20 +110,44 @@ fn scan_next(
         stats.skip(k);
         let i = *pos + k;
         *pos = i;
-        match judge(&data[i..]) {
-            Verdict::Frame(frame, report) => {
-                stats.frame(&frame, &report);
-                *pos = i + FRAME_LEN;
-                return Some((i, frame, report));
-            }
-            Verdict::BadHeader => stats.bad_header(),
-            Verdict::BadCrc => stats.crc_failure(),
-            Verdict::Undecided if !at_end => return None,
-            // Cut off by the end of the stream: skipped, not counted as an error.
-            Verdict::Undecided => {}
+        match take_candidate(data, pos, stats, at_end) {
+            Candidate::Frame(found) => return Some(found),
+            Candidate::Undecided => return None,
+            Candidate::Rejected => {}
         }
         stats.skip(1);
         *pos = i + 1;
+    }
+}
+
+/// Decides the candidate at `*pos` (a `9B` and a DataLink length byte, or a `9B` that ends
+/// `data`): a frame is counted and taken, `*pos` just after it; a bad header or CRC is
+/// counted. Nothing is skipped here, and `*pos` moves only past a frame.
+#[inline(always)]
+pub(crate) fn take_candidate(
+    data: &[u8],
+    pos: &mut usize,
+    stats: &mut DatalinkStats,
+    at_end: bool,
+) -> Candidate<(usize, DatalinkFrame, FrameReport)> {
+    let i = *pos;
+    match judge(&data[i..]) {
+        Verdict::Frame(frame, report) => {
+            stats.frame(&frame, &report);
+            *pos = i + FRAME_LEN;
+            Candidate::Frame((i, frame, report))
+        }
+        Verdict::BadHeader => {
+            stats.bad_header();
+            Candidate::Rejected
+        }
+        Verdict::BadCrc => {
+            stats.crc_failure();
+            Candidate::Rejected
+        }
+        Verdict::Undecided if !at_end => Candidate::Undecided,
+        // Cut off by the end of the stream: skipped, not counted as an error.
+        Verdict::Undecided => Candidate::Rejected,
     }
 }
 

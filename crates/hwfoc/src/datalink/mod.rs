@@ -41,7 +41,7 @@
 //! assert_eq!(decoded[0].report.empty_slots, 6);
 //! ```
 
-mod decoder;
+pub(crate) mod decoder;
 mod error;
 mod frame;
 mod layout;

@@ -413,7 +413,7 @@ impl Fleet {
                 let hub = self
                     .streams
                     .stream(port)
-                    .is_some_and(|s| s.kind() == WireKind::Hub);
+                    .is_some_and(|s| matches!(s.kind(), WireKind::Hub | WireKind::Mixed));
                 let mut data = 0;
                 for item in got.0 {
                     match item {

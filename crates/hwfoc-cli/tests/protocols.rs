@@ -1,0 +1,211 @@
+//! Streams of both protocols (ESC wire and DataLink hub): every intact frame of either is
+//! decoded whatever the chunking, and ESCs are numbered by one rule for files, recordings and
+//! live ports.
+
+mod common;
+
+use std::collections::BTreeMap;
+use std::io::Write;
+use std::process::Stdio;
+use std::thread;
+use std::time::Duration;
+
+use common::{Dir, hwfoc, stdout};
+use hwfoc::DataFrame;
+use hwfoc::datalink::DatalinkFrame;
+use serde_json::Value;
+
+/// ESC data frames `packets`.
+fn esc(packets: std::ops::Range<u16>) -> Vec<u8> {
+    packets
+        .flat_map(|packet| {
+            DataFrame {
+                packet,
+                voltage_raw: 250,
+                ..Default::default()
+            }
+            .encode()
+        })
+        .collect()
+}
+
+/// Hub frames `counters` whose `channels` carry an ESC (packet = 1000 + 100 * `id` + channel:
+/// an all-zero record would be an empty slot).
+fn hub(id: u16, counters: std::ops::Range<u16>, channels: &[usize]) -> Vec<u8> {
+    counters
+        .flat_map(|counter| {
+            let mut frame = DatalinkFrame::new(counter);
+            for &c in channels {
+                frame.slots[c] = Some(DataFrame {
+                    packet: 1000 + 100 * id + c as u16,
+                    ..Default::default()
+                });
+            }
+            frame.encode()
+        })
+        .collect()
+}
+
+/// The packets of JSON Lines records, by ESC.
+fn by_esc(jsonl: &str) -> BTreeMap<u64, Vec<u64>> {
+    let mut m = BTreeMap::<u64, Vec<u64>>::new();
+    for line in jsonl.lines() {
+        let r: Value = serde_json::from_str(line).unwrap();
+        m.entry(r["esc"].as_u64().unwrap())
+            .or_default()
+            .push(r["packet"].as_u64().unwrap());
+    }
+    m
+}
+
+/// Every `bytes_skipped` figure in `v`.
+fn skipped_bytes(v: &Value, out: &mut Vec<u64>) {
+    match v {
+        Value::Object(m) => {
+            for (k, v) in m {
+                match v.as_u64() {
+                    Some(n) if k == "bytes_skipped" => out.push(n),
+                    _ => skipped_bytes(v, out),
+                }
+            }
+        }
+        Value::Array(a) => a.iter().for_each(|v| skipped_bytes(v, out)),
+        _ => {}
+    }
+}
+
+/// 200 ESC frames and then 200 hub frames of seven ESCs (an adapter moved from an ESC to a
+/// hub): 1600 records from the file, and the same from standard input in two pieces half a
+/// second apart (the first piece once decided the protocol: 200 records).
+#[test]
+fn a_stream_that_changes_protocol_decodes_alike_from_a_file_and_from_stdin() {
+    let dir = Dir::new();
+    let part1 = esc(0..200);
+    let part2 = hub(0, 0..200, &[0, 1, 2, 3, 4, 5, 6]);
+    let path = dir.path("moved.bin");
+    std::fs::write(&path, [&part1[..], &part2[..]].concat()).unwrap();
+    let from_file = stdout(
+        &hwfoc()
+            .args(["decode", &dir.arg("moved.bin")])
+            .output()
+            .unwrap(),
+    );
+    assert_eq!(from_file.lines().count(), 1600);
+    let escs = by_esc(&from_file);
+    assert_eq!(escs.len(), 7);
+    assert_eq!(
+        escs[&0].len(),
+        400,
+        "the ESC and the hub's channel 0 keep ESC 0"
+    );
+    assert_eq!(escs[&6], vec![1006; 200]);
+
+    let mut child = hwfoc()
+        .args(["decode", "-"])
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut pipe = child.stdin.take().unwrap();
+    pipe.write_all(&part1).unwrap();
+    pipe.flush().unwrap();
+    thread::sleep(Duration::from_millis(500));
+    pipe.write_all(&part2).unwrap();
+    drop(pipe);
+    let from_stdin = stdout(&child.wait_with_output().unwrap());
+    assert!(
+        from_stdin == from_file,
+        "standard input decodes as the file does"
+    );
+
+    // One hub frame, then 2000 ESC frames: no byte is skipped.
+    std::fs::write(
+        dir.path("hub-first.bin"),
+        [hub(0, 0..1, &[0]), esc(0..2000)].concat(),
+    )
+    .unwrap();
+    let summary = stdout(
+        &hwfoc()
+            .args(["summary", "--json", &dir.arg("hub-first.bin")])
+            .output()
+            .unwrap(),
+    );
+    let summary: Value = serde_json::from_str(&summary).unwrap();
+    let mut skipped = Vec::new();
+    skipped_bytes(&summary, &mut skipped);
+    assert!(!skipped.is_empty(), "{summary}");
+    assert!(skipped.iter().all(|&n| n == 0), "{summary}");
+    let decoded = stdout(
+        &hwfoc()
+            .args(["decode", &dir.arg("hub-first.bin")])
+            .output()
+            .unwrap(),
+    );
+    assert_eq!(decoded.lines().count(), 2001);
+}
+
+/// `dl_clean.bin dl_ch5.bin raw.bin`: the raw file is ESC 2, the first hub's channels 1 to 7
+/// are ESCs 3 to 9, the second hub's channel 5 is ESC 14; alike from files, from live ports
+/// (ptys) and from a recording of those ports.
+#[cfg(unix)]
+#[test]
+fn files_a_recording_and_ports_number_hubs_alike() {
+    use common::{Running, pty};
+    use nix::sys::signal::Signal;
+
+    let dir = Dir::new();
+    let all: Vec<usize> = (0..8).collect();
+    let inputs = [hub(0, 0..3, &all), hub(1, 0..3, &[5]), esc(100..103)];
+    let mut expected = BTreeMap::<u64, Vec<u64>>::new();
+    expected.insert(0, vec![1000; 3]);
+    for c in 1..8u64 {
+        expected.insert(2 + c, vec![1000 + c; 3]);
+    }
+    expected.insert(14, vec![1105; 3]);
+    expected.insert(2, vec![100, 101, 102]);
+
+    let names = ["dl_clean.bin", "dl_ch5.bin", "raw.bin"];
+    for (name, bytes) in names.iter().zip(&inputs) {
+        std::fs::write(dir.path(name), bytes).unwrap();
+    }
+    let files: Vec<String> = names.iter().map(|n| dir.arg(n)).collect();
+    let decoded = stdout(&hwfoc().arg("decode").args(&files).output().unwrap());
+    assert_eq!(by_esc(&decoded), expected, "files");
+
+    // Live: the three ports' bytes arrive in that order, a little apart; the same bytes again
+    // to `hwfoc record`, whose recording is then decoded.
+    let live = |args: &[&str]| {
+        let ports: Vec<_> = (0..3).map(|_| pty()).collect();
+        let paths: Vec<String> = ports
+            .iter()
+            .map(|p| p.path.to_string_lossy().into_owned())
+            .collect();
+        let mut all: Vec<&str> = args.to_vec();
+        all.extend(paths.iter().map(String::as_str));
+        all.extend(["--baud", "115200"]);
+        let mut running = Running::start(&all);
+        thread::sleep(Duration::from_millis(500));
+        for (mut port, bytes) in ports.iter().map(|p| &p.master).zip(&inputs) {
+            port.write_all(bytes).unwrap();
+            port.flush().unwrap();
+            thread::sleep(Duration::from_millis(300));
+        }
+        thread::sleep(Duration::from_millis(300));
+        running.signal(Signal::SIGINT);
+        assert!(
+            running.wait(Duration::from_secs(10)),
+            "{}",
+            running.stderr()
+        );
+    };
+    let out = dir.arg("live.jsonl");
+    live(&["decode", "-o", &out]);
+    let from_ports = std::fs::read_to_string(&out).unwrap();
+    assert_eq!(by_esc(&from_ports), expected, "live ports");
+
+    let rec = dir.arg("ports.pcapng");
+    live(&["record", "-o", &rec]);
+    let recorded = stdout(&hwfoc().args(["decode", &rec]).output().unwrap());
+    assert_eq!(by_esc(&recorded), expected, "recording");
+}

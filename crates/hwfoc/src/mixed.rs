@@ -1,0 +1,435 @@
+//! Streams that may carry either protocol, or both one after the other: the [`MixedDecoder`]
+//! reads HW-FOC frames (an ESC's own wire) and DataLink V2 frames (a hub) at once, in byte
+//! order.
+//!
+//! One scanner looks for both: at each `9B` followed by a length byte of either protocol it
+//! tries a frame of the protocol that length byte belongs to (the two sets of length bytes are
+//! disjoint, so a candidate is of one protocol only). A verified frame of either is taken whole
+//! and scanning resumes after it, so the bytes of an intact frame of one protocol are never read
+//! as a candidate of the other (a `9B 16` inside a hub frame's records is not a false ESC frame,
+//! nor counted as a checksum failure). A rejected candidate costs one byte, as in each
+//! protocol's own scanner. So whatever the chunking, and however often a stream changes
+//! protocol (an adapter moved from an ESC to a hub), every intact frame of both is found.
+//!
+//! The statistics ([`MixedStats`]) are each protocol's: [`LinkStats`] for the ESC frames,
+//! [`DatalinkStats`] for the hub frames. Both count every byte of the stream, and both count as
+//! skipped only the bytes in no frame of either protocol.
+//!
+//! Back-to-back ESC data frames take the HW-FOC scanner's own first guess, so a stream of ESC
+//! frames is read as fast as by the [`Decoder`](crate::Decoder); the search over bytes in no
+//! frame compares each word with four second bytes instead of two.
+
+use crate::datalink::{DatalinkDecoded, DatalinkStats, FRAME_LEN, LengthByte};
+use crate::decoder::{Decoded, bytes_equal, find_sync_then, is_length_byte, take_candidate};
+use crate::frame::{Frame, MAX_FRAME_LEN, or_length_bytes};
+use crate::scan::{Candidate, Scan, Scanner, Stats, StreamDecoder};
+use crate::stats::LinkStats;
+
+/// The longest candidate of either protocol.
+const MAX_LEN: usize = if MAX_FRAME_LEN > FRAME_LEN {
+    MAX_FRAME_LEN
+} else {
+    FRAME_LEN
+};
+
+/// A frame of either protocol, with its stream offset.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum MixedDecoded {
+    /// A HW-FOC frame (an ESC's own wire).
+    Esc(Decoded),
+    /// A DataLink V2 hub frame.
+    Hub(DatalinkDecoded),
+}
+
+impl MixedDecoded {
+    /// Offset of the frame's first byte in the stream.
+    pub fn offset(&self) -> u64 {
+        match self {
+            MixedDecoded::Esc(d) => d.offset,
+            MixedDecoded::Hub(d) => d.offset,
+        }
+    }
+}
+
+/// The statistics of a stream read by the [`MixedDecoder`]: each protocol's.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct MixedStats {
+    /// The HW-FOC frames' statistics (its bytes and skipped bytes are the stream's).
+    pub esc: LinkStats,
+    /// The DataLink frames' statistics (its bytes and skipped bytes are the stream's).
+    pub hub: DatalinkStats,
+}
+
+impl MixedStats {
+    /// No bytes seen.
+    pub const fn new() -> Self {
+        MixedStats {
+            esc: LinkStats::new(),
+            hub: DatalinkStats::new(),
+        }
+    }
+
+    /// Every byte given to the decoder so far.
+    #[inline]
+    pub const fn bytes(&self) -> u64 {
+        self.esc.bytes()
+    }
+
+    #[inline(always)]
+    fn skip(&mut self, n: usize) {
+        self.esc.skip(n);
+        self.hub.skip(n);
+    }
+}
+
+impl Default for MixedStats {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl crate::scan::sealed::Sealed for MixedStats {}
+
+impl Stats for MixedStats {
+    const NEW: Self = MixedStats::new();
+
+    #[inline]
+    fn bytes(&self) -> u64 {
+        MixedStats::bytes(self)
+    }
+
+    #[inline]
+    fn add_bytes(&mut self, n: usize) {
+        self.esc.add_bytes(n);
+        self.hub.add_bytes(n);
+    }
+
+    /// `max_frames` ESC data frames (24 byte times at 19200 baud each) could have been sent:
+    /// as many hub frames fit in nine tenths of that time (160 byte times at 115200 baud).
+    fn line_silent(&mut self, max_frames: u32) {
+        let hub_frames = (u64::from(max_frames) * 9).div_ceil(10);
+        self.esc.line_silent(max_frames);
+        self.hub
+            .line_silent(u32::try_from(hub_frames).unwrap_or(u32::MAX));
+    }
+}
+
+/// Whether `b` is a DataLink length byte.
+#[inline(always)]
+fn is_hub_length_byte(b: u8) -> bool {
+    LengthByte::from_byte(b).is_some()
+}
+
+/// Offset of the first candidate of either protocol in `hay`: a sync byte followed by a length
+/// byte of either, or a sync byte that is the last byte of `hay`.
+#[inline]
+fn find_header(hay: &[u8]) -> Option<usize> {
+    find_sync_then(
+        hay,
+        |b| is_length_byte(b) || is_hub_length_byte(b),
+        |word| {
+            or_length_bytes(|b| bytes_equal(word, b))
+                | bytes_equal(word, LengthByte::Covered.byte())
+                | bytes_equal(word, LengthByte::Total.byte())
+        },
+    )
+}
+
+/// How many bytes decide the candidate whose first bytes are `held`.
+#[inline(always)]
+fn candidate_len(held: &[u8]) -> usize {
+    match held.get(1) {
+        Some(&b) if is_hub_length_byte(b) => crate::datalink::decoder::candidate_len(held.len()),
+        Some(_) => crate::frame::candidate_len(held),
+        None => 2,
+    }
+}
+
+/// Finds the next frame of either protocol in `data` from `*pos`, counting what it passes over
+/// in `stats`; unless `first_guess` is false, it first tries an ESC data frame right at `*pos`.
+/// Returns as the HW-FOC scanner's `scan_next` does.
+#[inline(always)]
+fn scan_next(
+    data: &[u8],
+    pos: &mut usize,
+    stats: &mut MixedStats,
+    at_end: bool,
+    first_guess: bool,
+) -> Option<(usize, MixedFrame)> {
+    if first_guess && let Some((at, frame)) = Frame::take_first(data, pos, &mut stats.esc) {
+        return Some((at, MixedFrame::Esc(frame)));
+    }
+    loop {
+        let Some(k) = find_header(&data[*pos..]) else {
+            stats.skip(data.len() - *pos);
+            *pos = data.len();
+            return None;
+        };
+        stats.skip(k);
+        let i = *pos + k;
+        *pos = i;
+        // The length byte tells the protocol (their length bytes differ): that protocol
+        // decides the candidate (a sync byte that ends `data` is the ESC wire's to decide).
+        let decided = match data.get(i + 1) {
+            Some(&b) if is_hub_length_byte(b) => {
+                match crate::datalink::decoder::take_candidate(data, pos, &mut stats.hub, at_end) {
+                    Candidate::Frame((at, frame, report)) => {
+                        // Its stream offset is set by `MixedFrame::at`.
+                        let hub = DatalinkDecoded {
+                            offset: 0,
+                            frame,
+                            report,
+                        };
+                        return Some((at, MixedFrame::Hub(hub)));
+                    }
+                    other => other.is_decided(),
+                }
+            }
+            _ => match take_candidate(data, pos, &mut stats.esc, at_end) {
+                Candidate::Frame((at, frame)) => return Some((at, MixedFrame::Esc(frame))),
+                other => other.is_decided(),
+            },
+        };
+        if !decided {
+            return None;
+        }
+        stats.skip(1);
+        *pos = i + 1;
+    }
+}
+
+/// A frame found, its offset given apart.
+enum MixedFrame {
+    Esc(Frame),
+    Hub(DatalinkDecoded),
+}
+
+impl MixedFrame {
+    #[inline(always)]
+    fn at(self, offset: u64) -> MixedDecoded {
+        match self {
+            MixedFrame::Esc(frame) => MixedDecoded::Esc(Decoded { offset, frame }),
+            MixedFrame::Hub(mut d) => {
+                d.offset = offset;
+                MixedDecoded::Hub(d)
+            }
+        }
+    }
+}
+
+/// The scanner of both protocols, as the streaming layer ([`crate::scan`]) runs it:
+/// [`MixedDecoder`] and [`MixedFrames`] are it under [`StreamDecoder`] and [`Scan`].
+#[derive(Debug, Clone, Copy, Default)]
+pub struct MixedScanner;
+
+impl crate::scan::sealed::Sealed for MixedScanner {}
+
+impl Scanner for MixedScanner {
+    type Item = MixedDecoded;
+    type Stats = MixedStats;
+    type Held = [u8; MAX_LEN - 1];
+    type Pair = [u8; 2 * MAX_LEN];
+    const HELD: Self::Held = [0; MAX_LEN - 1];
+    const PAIR: Self::Pair = [0; 2 * MAX_LEN];
+    const MAX_LEN: usize = MAX_LEN;
+
+    #[inline(always)]
+    fn candidate_len(held: &[u8]) -> usize {
+        candidate_len(held)
+    }
+
+    /// Out of line, as the HW-FOC scanner's: one copy of the scanner per caller.
+    #[inline(never)]
+    fn scan_all<const AT_END: bool>(
+        data: &[u8],
+        base: u64,
+        stats: &mut MixedStats,
+        on_frame: &mut impl FnMut(MixedDecoded),
+    ) -> usize {
+        let mut pos = 0;
+        loop {
+            // Back-to-back ESC data frames: the HW-FOC scanner's first guess.
+            while let Some((at, frame)) = Frame::take_first(data, &mut pos, &mut stats.esc) {
+                on_frame(MixedDecoded::Esc(Decoded {
+                    offset: base + at as u64,
+                    frame,
+                }));
+            }
+            let Some((at, frame)) = scan_next(data, &mut pos, stats, AT_END, false) else {
+                return pos;
+            };
+            on_frame(frame.at(base + at as u64));
+        }
+    }
+
+    #[inline]
+    fn scan_next(data: &[u8], pos: &mut usize, stats: &mut MixedStats) -> Option<MixedDecoded> {
+        scan_next(data, pos, stats, true, true).map(|(at, frame)| frame.at(at as u64))
+    }
+}
+
+/// A streaming decoder of both protocols (see the [module documentation](self)): feed it bytes
+/// in any chunking, get every HW-FOC and DataLink frame once, in byte order.
+///
+/// ```
+/// use hwfoc::datalink::DatalinkFrame;
+/// use hwfoc::mixed::{MixedDecoded, MixedDecoder};
+/// use hwfoc::DataFrame;
+///
+/// // An adapter on an ESC, then moved to a hub.
+/// let mut wire = DataFrame { packet: 7, ..Default::default() }.encode().to_vec();
+/// wire.extend_from_slice(&DatalinkFrame::new(1).encode());
+/// let mut decoder = MixedDecoder::new();
+/// let mut got = Vec::new();
+/// for chunk in wire.chunks(5) {
+///     decoder.feed(chunk, |d| got.push(d));
+/// }
+/// decoder.flush(|d| got.push(d));
+/// assert!(matches!(got[..], [MixedDecoded::Esc(_), MixedDecoded::Hub(_)]));
+/// assert_eq!(decoder.stats().esc.bytes_skipped(), 0);
+/// assert_eq!(decoder.stats().hub.bytes_skipped(), 0);
+/// ```
+///
+/// # Silences
+///
+/// [`line_silent_each`](StreamDecoder::line_silent_each) tells it how many frames of each
+/// protocol a silence could have hidden (see [`Decoder`](crate::Decoder) and
+/// [`DatalinkDecoder`](crate::datalink::DatalinkDecoder));
+/// [`line_silent`](StreamDecoder::line_silent) takes ESC data frames and counts nine tenths of
+/// them (rounded up) as hub frames, the hub frames that fit in the same time.
+pub type MixedDecoder = StreamDecoder<MixedScanner>;
+
+impl StreamDecoder<MixedScanner> {
+    /// The line was silent for a time in which at most `esc_frames` ESC data frames, or
+    /// `hub_frames` DataLink frames, could have been sent: the held bytes are decided at once,
+    /// and each protocol's next number step is judged as its own decoder's `line_silent` says.
+    pub fn line_silent_each(
+        &mut self,
+        esc_frames: u32,
+        hub_frames: u32,
+        on_frame: impl FnMut(MixedDecoded),
+    ) {
+        self.flush(on_frame);
+        let stats = self.stats_mut();
+        stats.esc.line_silent(esc_frames);
+        stats.hub.line_silent(hub_frames);
+    }
+}
+
+/// Decodes every frame of both protocols in a complete buffer, in place: the bulk path. It
+/// yields exactly what a [`MixedDecoder`] fed the same bytes and then flushed would.
+pub fn frames(data: &[u8]) -> MixedFrames<'_> {
+    Scan::new(data)
+}
+
+/// Iterator returned by [`frames`].
+pub type MixedFrames<'a> = Scan<'a, MixedScanner>;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::datalink::DatalinkFrame;
+    use crate::{DataFrame, DatalinkDecoder, Decoder};
+
+    fn esc(packets: core::ops::Range<u16>, out: &mut [u8], at: &mut usize) {
+        for packet in packets {
+            let f = DataFrame {
+                packet,
+                voltage_raw: 250,
+                ..Default::default()
+            }
+            .encode();
+            out[*at..*at + f.len()].copy_from_slice(&f);
+            *at += f.len();
+        }
+    }
+
+    fn hub(counters: core::ops::Range<u16>, out: &mut [u8], at: &mut usize) {
+        for counter in counters {
+            let mut frame = DatalinkFrame::new(counter);
+            for (c, slot) in frame.slots.iter_mut().enumerate() {
+                *slot = Some(DataFrame {
+                    packet: 1000 + counter * 8 + c as u16,
+                    ..Default::default()
+                });
+            }
+            let f = frame.encode();
+            out[*at..*at + f.len()].copy_from_slice(&f);
+            *at += f.len();
+        }
+    }
+
+    #[test]
+    fn find_header_matches_a_plain_search() {
+        let near = [0x16, 0x4C, 0x9E, 0xA0, 0x9F, 0x17];
+        crate::decoder::tests::assert_matches_a_plain_search(
+            find_header,
+            &[0x16, 0x4C, 0x9E, 0xA0],
+            near,
+        );
+    }
+
+    /// Streams that change protocol, with a frame of each cut short where it changes and a
+    /// lone sync byte: every intact frame of both is found, in byte order, whatever the
+    /// chunking, and no byte of a frame of one protocol counts as skipped or as a failed
+    /// candidate of the other.
+    #[test]
+    fn every_frame_of_both_protocols_whatever_the_chunking() {
+        let mut wire = [0u8; 12_000];
+        let mut n = 0;
+        hub(0..3, &mut wire, &mut n);
+        // The first 100 bytes of a hub frame: a CRC failure once 160 bytes are there.
+        let mut cut = [0u8; FRAME_LEN];
+        hub(99..100, &mut cut, &mut 0);
+        wire[n..n + 100].copy_from_slice(&cut[..100]);
+        n += 100;
+        esc(0..40, &mut wire, &mut n);
+        wire[n] = 0x9B; // a lone sync byte
+        n += 1;
+        // The first 10 bytes of an ESC frame: a checksum failure.
+        esc(500..501, &mut wire, &mut n);
+        n -= 14;
+        hub(3..6, &mut wire, &mut n);
+        esc(40..80, &mut wire, &mut n);
+        let wire = &wire[..n];
+        let (mut escs, mut hubs) = (0, 0);
+        let bulk: usize = frames(wire)
+            .map(|d| match d {
+                MixedDecoded::Esc(_) => escs += 1,
+                MixedDecoded::Hub(_) => hubs += 1,
+            })
+            .count();
+        assert_eq!((bulk, escs, hubs), (86, 80, 6));
+        for chunk in [1, 2, 3, 5, 24, 77, 159, 160, 161, 1000, n] {
+            let mut d = MixedDecoder::new();
+            let mut offsets = [0u64; 86];
+            let mut k = 0;
+            for c in wire.chunks(chunk) {
+                d.feed(c, |f| {
+                    offsets[k] = f.offset();
+                    k += 1;
+                });
+            }
+            d.flush(|f| {
+                offsets[k] = f.offset();
+                k += 1;
+            });
+            assert_eq!(k, 86, "chunk {chunk}");
+            assert!(offsets.windows(2).all(|w| w[0] < w[1]), "byte order");
+            let s = d.stats();
+            assert_eq!((s.esc.bytes_skipped(), s.hub.bytes_skipped()), (111, 111));
+            assert_eq!((s.esc.checksum_failures(), s.esc.lost_packets()), (1, 0));
+            assert_eq!((s.hub.crc_failures(), s.hub.bad_headers()), (1, 0));
+            assert_eq!((s.esc.packets().count(), s.hub.frames()), (80, 6));
+            assert_eq!(s.hub.lost_frames(), 0);
+        }
+        // Each protocol's own decoder sees only its own frames in the same bytes.
+        let mut own = Decoder::new();
+        let mut n_esc = 0;
+        own.decode_all(wire, |_| n_esc += 1);
+        let mut own_hub = DatalinkDecoder::new();
+        let mut n_hub = 0;
+        own_hub.decode_all(wire, |_| n_hub += 1);
+        assert_eq!((n_esc, n_hub), (80, 6));
+    }
+}
