@@ -139,3 +139,41 @@ fn a_replay_goes_on_past_a_packet_stamped_in_2226() {
         bridge.stderr()
     );
 }
+
+#[test]
+fn ctrl_c_ends_a_replay_past_a_jump() {
+    use nix::sys::signal::Signal;
+    let dir = Dir::new();
+    // Ten minutes of frames; the 21st stamped in 2226.
+    let path = recording(&dir, "long.pcapng", 12_000, |k| match k {
+        20 => 8_000_000_000 * NS,
+        _ => T0 * NS + k * 50_000_000,
+    });
+    let sink = std::net::UdpSocket::bind("127.0.0.1:0").unwrap();
+    let port = sink.local_addr().unwrap().port();
+    let mut bridge = Running::start(&[
+        "bridge",
+        &path,
+        "--mavlink",
+        &format!("udp:127.0.0.1:{port}"),
+    ]);
+    // 50 ms a frame: three seconds: past the jump at 1 s, frames keep coming.
+    std::thread::sleep(Duration::from_secs(3));
+    bridge.signal(Signal::SIGINT);
+    assert!(bridge.wait(Duration::from_secs(10)), "{}", bridge.stderr());
+    let err = bridge.stderr();
+    let line = err
+        .lines()
+        .find(|l| l.starts_with("hwfoc bridge: "))
+        .unwrap_or_else(|| panic!("{err}"));
+    let frames: u64 = line
+        .split(", ")
+        .nth(1)
+        .unwrap()
+        .split(' ')
+        .next()
+        .unwrap()
+        .parse()
+        .unwrap();
+    assert!(frames > 40, "{line}");
+}
