@@ -2,7 +2,9 @@
 //! the first frame as passed between them on the wire. A discontinuity of an ESC's receive
 //! clock ([`Step`]: a step back, or a jump forward its packet numbers do not explain, such as
 //! a computer that booted in 1970 and then synced) is replayed as one frame period: the replay
-//! never waits for a clock that jumped years ahead.
+//! never waits for a clock that jumped years ahead. An ESC's first frame is measured from the
+//! frame before it of any ESC: more than a second after it (every ESC silent, or a jump) is
+//! one frame period.
 
 use std::fmt;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -60,6 +62,10 @@ pub struct Replay<'a, E> {
     /// Per ESC, its last timed frame: receive time, packet number (of a data frame), and
     /// seconds after the origin's instant it was due.
     last: Vec<Option<(f64, Option<u16>, f64)>>,
+    /// The last timed frame of any ESC, as in `last`: what an ESC's first frame is measured
+    /// from (without a packet number in common, a step over [`hwfoc_io::clock::MAX_STEP_S`]
+    /// is a jump).
+    latest: Option<(f64, Option<u16>, f64)>,
     /// When the replay started, for untimed frames.
     start: Instant,
     /// Untimed frames handed on so far, per ESC.
@@ -76,6 +82,7 @@ impl<'a, E: FnMut(OutputError)> Replay<'a, E> {
             on_error,
             origin: None,
             last: Vec::new(),
+            latest: None,
             start: Instant::now(),
             untimed: Vec::new(),
         }
@@ -90,7 +97,11 @@ impl<'a, E: FnMut(OutputError)> Replay<'a, E> {
                     self.last.resize(esc + 1, None);
                 }
                 let (mut t0, at) = *self.origin.get_or_insert((t, Instant::now()));
-                if let Some((last_t, last_packet, last_due)) = self.last[esc] {
+                let before = match self.last[esc] {
+                    Some(own) => Some(own),
+                    None => self.latest.map(|(t, _, due)| (t, None, due)),
+                };
+                if let Some((last_t, last_packet, last_due)) = before {
                     let packets = last_packet.zip(packet).map(|(a, b)| b.wrapping_sub(a));
                     if Step::between(last_t, t, packets).is_discontinuity() {
                         // One frame period after the ESC's frame before.
@@ -100,6 +111,7 @@ impl<'a, E: FnMut(OutputError)> Replay<'a, E> {
                 }
                 let after = (t - t0).clamp(0.0, 1e9);
                 self.last[esc] = Some((t, packet, after));
+                self.latest = self.last[esc];
                 at + Duration::from_secs_f64(after)
             }
             None => {
@@ -182,5 +194,30 @@ mod tests {
                 "frame {k} due {after} s after the first"
             );
         }
+    }
+
+    #[test]
+    fn a_new_esc_after_a_jump_waits_one_frame_period() {
+        let mut fanout = Fanout::new(Vec::new());
+        let stop = AtomicBool::new(false);
+        let mut replay = Replay::new(&mut fanout, &stop, |_| {});
+        let start = 1_795_442_580.0;
+        let first = replay.due(0, Some(start), Some(0));
+        let then = replay.due(0, Some(start + 0.05), Some(1));
+        // ESC 1's first frame, stamped in 2226.
+        let late = replay.due(1, Some(8_000_000_000.0), Some(0));
+        let after = |due: Instant, first| due.duration_since(first).as_secs_f64();
+        assert!((after(then, first) - 0.05).abs() < 1e-6);
+        assert!(
+            (after(late, first) - 0.1).abs() < 1e-6,
+            "{}",
+            after(late, first)
+        );
+        // ESC 1 heard half a second after ESC 0: its own time.
+        let mut fanout = Fanout::new(Vec::new());
+        let mut replay = Replay::new(&mut fanout, &stop, |_| {});
+        let first = replay.due(0, Some(start), Some(0));
+        let other = replay.due(1, Some(start + 0.5), Some(9));
+        assert!((after(other, first) - 0.5).abs() < 1e-6);
     }
 }
