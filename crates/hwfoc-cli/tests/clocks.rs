@@ -116,21 +116,28 @@ fn plots_of_a_clock_that_steps_back_or_jumps_are_drawn() {
     assert!(help.contains("steps back"), "{help}");
 }
 
-#[test]
-fn a_replay_goes_on_past_a_packet_stamped_in_2226() {
-    let dir = Dir::new();
-    let path = recording(&dir, "replay.pcapng", 60, |k| match k {
-        30 => 8_000_000_000 * NS,
+/// `hwfoc bridge` replaying `frames` frames 50 ms apart, frame `late` stamped in 2226, to
+/// MAVLink on a local UDP socket (returned, so that it stays open).
+fn replay_jumped(dir: &Dir, frames: u64, late: u64) -> (Running, std::net::UdpSocket) {
+    let path = recording(dir, "replay.pcapng", frames, |k| match k {
+        k if k == late => 8_000_000_000 * NS,
         _ => T0 * NS + k * 50_000_000,
     });
     let sink = std::net::UdpSocket::bind("127.0.0.1:0").unwrap();
     let port = sink.local_addr().unwrap().port();
-    let mut bridge = Running::start(&[
+    let bridge = Running::start(&[
         "bridge",
         &path,
         "--mavlink",
         &format!("udp:127.0.0.1:{port}"),
     ]);
+    (bridge, sink)
+}
+
+#[test]
+fn a_replay_goes_on_past_a_packet_stamped_in_2226() {
+    let dir = Dir::new();
+    let (mut bridge, _sink) = replay_jumped(&dir, 60, 30);
     // 60 frames 50 ms apart: 3 s.
     assert!(bridge.wait(Duration::from_secs(30)), "{}", bridge.stderr());
     assert!(
@@ -145,18 +152,7 @@ fn ctrl_c_ends_a_replay_past_a_jump() {
     use nix::sys::signal::Signal;
     let dir = Dir::new();
     // Ten minutes of frames; the 21st stamped in 2226.
-    let path = recording(&dir, "long.pcapng", 12_000, |k| match k {
-        20 => 8_000_000_000 * NS,
-        _ => T0 * NS + k * 50_000_000,
-    });
-    let sink = std::net::UdpSocket::bind("127.0.0.1:0").unwrap();
-    let port = sink.local_addr().unwrap().port();
-    let mut bridge = Running::start(&[
-        "bridge",
-        &path,
-        "--mavlink",
-        &format!("udp:127.0.0.1:{port}"),
-    ]);
+    let (mut bridge, _sink) = replay_jumped(&dir, 12_000, 20);
     // 50 ms a frame: three seconds: past the jump at 1 s, frames keep coming.
     std::thread::sleep(Duration::from_secs(3));
     bridge.signal(Signal::SIGINT);
