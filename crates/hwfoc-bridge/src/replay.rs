@@ -1,11 +1,17 @@
 //! Recordings replayed in real time: each frame is handed on when as much time has passed since
-//! the first frame as passed between them on the wire.
+//! the first frame as passed between them on the wire. A discontinuity of an ESC's receive
+//! clock ([`Step`]: a step back, or a jump forward its packet numbers do not explain, such as
+//! a computer that booted in 1970 and then synced) is replayed as one frame period: the replay
+//! never waits for a clock that jumped years ahead. An ESC's first frame is measured from the
+//! frame before it of any ESC: more than a second after it (every ESC silent, or a jump) is
+//! one frame period.
 
 use std::fmt;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 
-use hwfoc::{Decoded, Settings};
+use hwfoc::{Decoded, Frame, Settings};
+use hwfoc_io::clock::Step;
 use hwfoc_io::energy::NOMINAL_PERIOD_S;
 use hwfoc_io::{Handler, InputError};
 
@@ -50,8 +56,16 @@ pub struct Replay<'a, E> {
     fanout: &'a mut Fanout,
     stop: &'a AtomicBool,
     on_error: E,
-    /// The first timed frame's time and when it was handed on.
+    /// The receive time replayed at an instant, and that instant: a frame at `t` is due
+    /// `t - origin.0` seconds after `origin.1`. It moves at each discontinuity.
     origin: Option<(f64, Instant)>,
+    /// Per ESC, its last timed frame: receive time, packet number (of a data frame), and
+    /// seconds after the origin's instant it was due.
+    last: Vec<Option<(f64, Option<u16>, f64)>>,
+    /// The last timed frame of any ESC, as in `last`: what an ESC's first frame is measured
+    /// from (without a packet number in common, a step over [`hwfoc_io::clock::MAX_STEP_S`]
+    /// is a jump).
+    latest: Option<(f64, Option<u16>, f64)>,
     /// When the replay started, for untimed frames.
     start: Instant,
     /// Untimed frames handed on so far, per ESC.
@@ -67,17 +81,38 @@ impl<'a, E: FnMut(OutputError)> Replay<'a, E> {
             stop,
             on_error,
             origin: None,
+            last: Vec::new(),
+            latest: None,
             start: Instant::now(),
             untimed: Vec::new(),
         }
     }
 
-    /// When a frame of `esc` received at `t` is due.
-    fn due(&mut self, esc: u8, t: Option<f64>) -> Instant {
+    /// When a frame of `esc` received at `t` is due; `packet` is a data frame's packet number.
+    fn due(&mut self, esc: u8, t: Option<f64>, packet: Option<u16>) -> Instant {
         match t {
             Some(t) => {
-                let (t0, at) = *self.origin.get_or_insert((t, Instant::now()));
-                at + Duration::from_secs_f64((t - t0).clamp(0.0, 1e9))
+                let esc = usize::from(esc);
+                if self.last.len() <= esc {
+                    self.last.resize(esc + 1, None);
+                }
+                let (mut t0, at) = *self.origin.get_or_insert((t, Instant::now()));
+                let before = match self.last[esc] {
+                    Some(own) => Some(own),
+                    None => self.latest.map(|(t, _, due)| (t, None, due)),
+                };
+                if let Some((last_t, last_packet, last_due)) = before {
+                    let packets = last_packet.zip(packet).map(|(a, b)| b.wrapping_sub(a));
+                    if Step::between(last_t, t, packets).is_discontinuity() {
+                        // One frame period after the ESC's frame before.
+                        t0 = t - (last_due + NOMINAL_PERIOD_S);
+                        self.origin = Some((t0, at));
+                    }
+                }
+                let after = (t - t0).clamp(0.0, 1e9);
+                self.last[esc] = Some((t, packet, after));
+                self.latest = self.last[esc];
+                at + Duration::from_secs_f64(after)
             }
             None => {
                 let esc = usize::from(esc);
@@ -111,7 +146,11 @@ impl<E: FnMut(OutputError)> Handler for Replay<'_, E> {
         if self.stop.load(Ordering::Relaxed) {
             return;
         }
-        let due = self.due(esc, t);
+        let packet = match &decoded.frame {
+            Frame::Data(f) => Some(f.packet),
+            Frame::Info(_) => None,
+        };
+        let due = self.due(esc, t, packet);
         self.wait(due);
         self.fanout.arrived(Instant::now());
         self.fanout.frame(esc, t, decoded, settings);
@@ -123,5 +162,62 @@ impl<E: FnMut(OutputError)> Handler for Replay<'_, E> {
             return Err(ReplayError::Stopped);
         }
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_jumped_clock_replays_as_one_frame_period() {
+        let mut fanout = Fanout::new(Vec::new());
+        let stop = AtomicBool::new(false);
+        let mut replay = Replay::new(&mut fanout, &stop, |_| {});
+        // 101 frames from 2026, one stamped in 2226, 98 more in 2026, then the clock set back
+        // an hour (NTP): every frame comes a frame period after the one before.
+        let start = 1_795_442_580.0;
+        let mut times: Vec<f64> = (0..101).map(|k| start + f64::from(k) * 0.05).collect();
+        times.push(8_000_000_000.0);
+        times.extend((102..200).map(|k| start + f64::from(k) * 0.05));
+        times.push(start - 3600.0);
+        let dues: Vec<Instant> = times
+            .iter()
+            .enumerate()
+            .map(|(k, &t)| replay.due(0, Some(t), Some(k as u16)))
+            .collect();
+        let first = dues[0];
+        for (k, due) in dues.iter().enumerate() {
+            let after = due.duration_since(first).as_secs_f64();
+            assert!(
+                (after - k as f64 * NOMINAL_PERIOD_S).abs() < 1e-6,
+                "frame {k} due {after} s after the first"
+            );
+        }
+    }
+
+    #[test]
+    fn a_new_esc_after_a_jump_waits_one_frame_period() {
+        let mut fanout = Fanout::new(Vec::new());
+        let stop = AtomicBool::new(false);
+        let mut replay = Replay::new(&mut fanout, &stop, |_| {});
+        let start = 1_795_442_580.0;
+        let first = replay.due(0, Some(start), Some(0));
+        let then = replay.due(0, Some(start + 0.05), Some(1));
+        // ESC 1's first frame, stamped in 2226.
+        let late = replay.due(1, Some(8_000_000_000.0), Some(0));
+        let after = |due: Instant, first| due.duration_since(first).as_secs_f64();
+        assert!((after(then, first) - 0.05).abs() < 1e-6);
+        assert!(
+            (after(late, first) - 0.1).abs() < 1e-6,
+            "{}",
+            after(late, first)
+        );
+        // ESC 1 heard half a second after ESC 0: its own time.
+        let mut fanout = Fanout::new(Vec::new());
+        let mut replay = Replay::new(&mut fanout, &stop, |_| {});
+        let first = replay.due(0, Some(start), Some(0));
+        let other = replay.due(1, Some(start + 0.5), Some(9));
+        assert!((after(other, first) - 0.5).abs() < 1e-6);
     }
 }

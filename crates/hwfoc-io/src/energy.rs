@@ -2,23 +2,22 @@
 //! where `summary`, the monitor, the plots and the MAVLink bridge's "mAh consumed" come from.
 //!
 //! Each frame's input current and voltage are taken to hold until the ESC's next frame (a
-//! left Riemann sum over the frame times: an ESC measures, then sends). The step from one frame
-//! to the next counts at most [`MAX_STEP_S`]: a silence longer than that (a cut line, an ESC
-//! that rebooted, a pause between recordings) is not filled with the last current seen. For an
-//! input without times (raw bytes), every step is [`NOMINAL_PERIOD_S`], the protocol's frame
-//! period, and [`Energy::nominal`] says so.
+//! left Riemann sum over the frame times: an ESC measures, then sends). Only a step that is
+//! [`Step::Continuous`] is integrated (at most [`crate::clock::MAX_STEP_S`], not back): a longer
+//! silence (a cut line, an ESC that rebooted, a pause between recordings) is not filled with
+//! the last current seen, and nothing is integrated across a clock that stepped back or
+//! jumped; [`Energy::seconds`] is the sum of the steps integrated. For an input without times
+//! (raw bytes), every step is [`NOMINAL_PERIOD_S`], the protocol's frame period, and
+//! [`Energy::nominal`] says so.
 //!
 //! Regenerative braking (negative input current) gives charge back: the charge and energy are
 //! net figures, as a battery sees them.
 
+use crate::clock::Step;
+
 /// The protocol's frame period of a running ESC: 50 ms. The step between two frames of an input
 /// without times.
 pub const NOMINAL_PERIOD_S: f64 = 0.05;
-
-/// The longest step between two frames that is integrated: a longer silence counts only this
-/// much (an idle ESC sends a frame every ~364 ms; a longer silence is a cut line, and the
-/// stream tells the decoder of it from [`crate::stream::SILENCE_S`], the same second).
-pub const MAX_STEP_S: f64 = crate::stream::SILENCE_S;
 
 /// Electrical input power, W, of a frame's input voltage and current: the one definition the
 /// summary, the plots and [`Energy`] use.
@@ -58,11 +57,15 @@ impl Energy {
     }
 
     /// Adds a frame received at `t_s` (`None` without timing) carrying `voltage_v` and input
-    /// `current_a`. Frames must come in time order; a step back in time counts as zero.
+    /// `current_a`. A step that is not [`Step::Continuous`] (a silence, a step back, a jump)
+    /// adds nothing.
     pub fn add(&mut self, t_s: Option<f64>, voltage_v: f64, current_a: f64) {
         if let Some((last_t, v, i)) = self.last {
             let step = match (last_t, t_s) {
-                (Some(a), Some(b)) => (b - a).clamp(0.0, MAX_STEP_S),
+                (Some(a), Some(b)) => match Step::between(a, b, None) {
+                    Step::Continuous(dt) => dt,
+                    _ => 0.0,
+                },
                 _ => {
                     self.nominal = true;
                     NOMINAL_PERIOD_S
@@ -204,13 +207,27 @@ mod tests {
     fn a_silence_is_not_filled_with_the_last_current() {
         let mut e = Energy::new();
         e.add(Some(0.0), 10.0, 3.6);
-        e.add(Some(60.0), 10.0, 3.6); // a minute of silence counts one second
+        e.add(Some(60.0), 10.0, 3.6); // a minute of silence counts nothing
+        e.add(Some(61.0), 10.0, 3.6); // one second at 3.6 A
         assert!((e.charge_mah() - 1.0).abs() < 1e-12);
-        assert!((e.seconds() - MAX_STEP_S).abs() < 1e-12);
+        assert!((e.seconds() - crate::clock::MAX_STEP_S).abs() < 1e-12);
         let mut back = Energy::new();
         back.add(Some(5.0), 10.0, 3.6);
         back.add(Some(4.0), 10.0, 3.6); // a step back in time adds nothing
         assert_eq!(back.charge_mah(), 0.0);
+    }
+
+    #[test]
+    fn nothing_is_integrated_across_a_jumped_timestamp() {
+        // 9.95 s of frames, one of them stamped an hour late: 9.85 s integrated (the steps
+        // to and from the late frame are discontinuities), never more than the recording.
+        let mut e = Energy::new();
+        for k in 0..200 {
+            let t = k as f64 * 0.05 + if k == 100 { 3600.0 } else { 0.0 };
+            e.add(Some(t), 10.0, 3.6);
+        }
+        assert!((e.seconds() - 9.85).abs() < 1e-9, "{}", e.seconds());
+        assert!((e.charge_mah() - 9.85).abs() < 1e-9);
     }
 
     #[test]

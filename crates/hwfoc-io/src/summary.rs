@@ -11,7 +11,9 @@
 //! Charge, energy and power ([`Energy`]) are integrated per ESC over its data frames' times
 //! (each frame's current holding until the next), on the raw voltage and current, converted
 //! once at the end; an input without times counts each frame as the nominal period, and the
-//! report says so. Times of sources with a wall clock (recordings, serial ports) are shown as
+//! report says so. The duration of an ESC's frames is the time that passed between them: a
+//! clock that steps back or jumps forward ([`Step`]) adds nothing, and the report counts such
+//! discontinuities. Times of sources with a wall clock (recordings, serial ports) are shown as
 //! ISO 8601 dates in UTC; other sources' times as their seconds.
 //!
 //! A fault episode is a maximal run of consecutive data frames of one ESC whose status word is
@@ -23,6 +25,7 @@ use std::fmt::Write as _;
 use hwfoc::{DataFrame, Decoded, Fault, Frame, InfoFrame, Quantity, Settings, Status, Temperature};
 use serde_json::{Value, json};
 
+use crate::clock::Step;
 use crate::energy::{Energy, NOMINAL_PERIOD_S};
 pub use crate::episode::{Episode, Mark};
 use crate::escape::Escaped;
@@ -216,6 +219,14 @@ struct Accumulator {
     fault_frames: [u64; 16],
     first_t: Option<f64>,
     last_t: Option<f64>,
+    /// The last timed data frame's packet number.
+    last_packet: u16,
+    /// Seconds that passed between the timed data frames: the sum of the steps that are not
+    /// clock discontinuities.
+    elapsed: f64,
+    /// Clock discontinuities between timed data frames: steps back, jumps forward.
+    steps_back: u64,
+    jumps: u64,
     /// Charge and energy of timed frames in raw units (voltage and current as sent); frames
     /// without times are integrated from the lanes' sums at the end (see [`Self::energy`]).
     energy: Energy,
@@ -241,6 +252,10 @@ impl Default for Accumulator {
             fault_frames: [0; 16],
             first_t: None,
             last_t: None,
+            last_packet: 0,
+            elapsed: 0.0,
+            steps_back: 0,
+            jumps: 0,
             energy: Energy::new(),
             last: (0, 0),
             power_sum: 0,
@@ -298,8 +313,16 @@ impl Accumulator {
     fn timed(&mut self, t: f64, f: &DataFrame) {
         self.energy
             .add(Some(t), f64::from(f.voltage_raw), f64::from(f.current_raw));
+        if let Some(last) = self.last_t {
+            match Step::between(last, t, Some(f.packet.wrapping_sub(self.last_packet))) {
+                Step::Back => self.steps_back += 1,
+                Step::Jump => self.jumps += 1,
+                step => self.elapsed += step.elapsed().unwrap_or(0.0),
+            }
+        }
         self.first_t.get_or_insert(t);
         self.last_t = Some(t);
+        self.last_packet = f.packet;
     }
 
     #[inline]
@@ -678,8 +701,34 @@ impl EscReport<'_> {
         t.filter(|_| self.clock == Clock::Wall).map(time::iso8601)
     }
 
+    /// Seconds that passed between the first and the last timed data frame, not counting
+    /// across clock discontinuities.
     fn duration(&self) -> Option<f64> {
-        Some(self.acc.last_t? - self.acc.first_t?)
+        self.acc.first_t.map(|_| self.acc.elapsed)
+    }
+
+    /// The clock's discontinuities in words, if there were any.
+    fn discontinuities(&self) -> Option<String> {
+        let (back, jumps) = (self.acc.steps_back, self.acc.jumps);
+        let times = |n: u64| {
+            if n == 1 {
+                "once".to_string()
+            } else {
+                format!("{n} times")
+            }
+        };
+        let text = match (back, jumps) {
+            (0, 0) => return None,
+            (b, 0) => format!("the clock steps back {}", times(b)),
+            (0, j) => format!("the clock jumps forward {}", times(j)),
+            (b, j) => format!(
+                "the clock steps back {} and jumps forward {}",
+                times(b),
+                times(j)
+            ),
+        };
+        let across = if back + jumps == 1 { "it" } else { "them" };
+        Some(format!("{text}: no time counted across {across}"))
     }
 
     /// Data frames per second between the first and the last frame.
@@ -747,10 +796,13 @@ impl EscReport<'_> {
                     "time         {} .. {} ({:.3} s)",
                     time::iso8601(first),
                     time::iso8601(last),
-                    last - first
+                    self.acc.elapsed
                 );
             } else {
                 let _ = writeln!(o, "time         {first} .. {last} s (the source's clock)");
+            }
+            if let Some(text) = self.discontinuities() {
+                let _ = writeln!(o, "clock        {text}");
             }
         }
         let _ = writeln!(
@@ -890,6 +942,8 @@ impl EscReport<'_> {
             "first_time": self.date(self.acc.first_t),
             "last_time": self.date(self.acc.last_t),
             "duration_s": self.duration(),
+            "clock_steps_back": self.acc.steps_back,
+            "clock_jumps": self.acc.jumps,
             "frame_rate_hz": self.frame_rate(),
             "link": {
                 "checksum_failures": st.checksum_failures(),

@@ -13,7 +13,10 @@
 //! | `+5`, `+2.5`, `+250ms`, `+2m`, `+1h30m`, `+1m30.5s`, `+PT1H30M` | from the first frame: `+` then seconds, or a duration (`h`, `m`, `s`, `ms`, `us`, `ns` and the longer words, as the `jiff` crate reads them, or ISO 8601) |
 //! | `1795470439.16`, `-3`, `12` | seconds of the source's own clock: Unix time for recordings and serial ports, seconds from the capture's start for an analyser CSV |
 //! | `2026-11-23T14:03:00Z`, `2026-11-23T14:03:00.250+01:00` | an ISO 8601 (RFC 3339) date-time with its offset |
-//! | `2026-11-23 14:03:00`, `2026-11-23T14:03`, `2026-11-23` | a date-time without offset: local time, in the zone of `TZ` or the system's (a time a clock change skips or repeats is read as the `jiff` crate's "compatible" choice: the later of a gap, the earlier of a fold) |
+//! | `2026-11-23 14:03:00`, `2026-11-23T14:03`, `2026-11-23` | a date-time without offset: local time, in the zone of `TZ` or the system's; a time a clock change repeats (`2026-10-25 02:30` in Europe/Berlin) or skips is refused, naming the offsets to give |
+//!
+//! Dates are those from `-009999-01-02T01:59:59Z` to `9999-12-30T22:00:00Z` (what the `jiff`
+//! crate holds); a date beyond is refused in a line of its own.
 //!
 //! "The first frame" is the first data frame with a receive time among the inputs given
 //! together (their records come in time order, so it is the earliest one): see
@@ -22,7 +25,8 @@
 use std::fmt;
 
 use jiff::civil::DateTime;
-use jiff::tz::TimeZone;
+use jiff::fmt::temporal::Pieces;
+use jiff::tz::{AmbiguousOffset, Offset, TimeZone};
 use jiff::{SignedDuration, Timestamp};
 
 use crate::input::InputFormat;
@@ -101,6 +105,25 @@ pub enum TimeError {
         /// What is wrong, as `jiff` says it.
         reason: String,
     },
+    /// A date-time beyond the dates the `jiff` crate holds.
+    OutOfRange {
+        /// The text given.
+        text: String,
+    },
+    /// A local date-time that the zone's clocks show twice (they are put back) or skip (they
+    /// are put forward): which instant is meant needs an offset.
+    AmbiguousLocal {
+        /// The text given.
+        text: String,
+        /// The zone's name.
+        zone: String,
+        /// Whether the clocks skip it (else they show it twice).
+        skipped: bool,
+        /// The zone's offsets before and after the change: `+02:00`.
+        before: String,
+        /// See `before`.
+        after: String,
+    },
 }
 
 impl fmt::Display for TimeError {
@@ -120,6 +143,34 @@ impl fmt::Display for TimeError {
             TimeError::BadDate { text, reason } => {
                 write!(f, "{text:?} is not a valid date-time: {reason}")
             }
+            TimeError::OutOfRange { text } => write!(
+                f,
+                "{text:?} is beyond the dates hwfoc reads ({:.0} to {:.0})",
+                Timestamp::MIN,
+                Timestamp::MAX
+            ),
+            TimeError::AmbiguousLocal {
+                text,
+                zone,
+                skipped: false,
+                before,
+                after,
+            } => write!(
+                f,
+                "{text:?} happens twice in {zone} (the clocks go back): give its offset, \
+                 {text}{before} or {text}{after}"
+            ),
+            TimeError::AmbiguousLocal {
+                text,
+                zone,
+                skipped: true,
+                before,
+                after,
+            } => write!(
+                f,
+                "{text:?} does not happen in {zone} (the clocks go forward over it): give an \
+                 offset, {text}{before} or {text}{after}"
+            ),
         }
     }
 }
@@ -153,9 +204,16 @@ pub fn parse_in(text: &str, zone: &TimeZone) -> Result<Time, TimeError> {
             text: text.to_string(),
         });
     }
-    let bad = |e: jiff::Error| TimeError::BadDate {
-        text: text.to_string(),
-        reason: e.to_string(),
+    // A date that reads but names no instant jiff holds is beyond its range: said in a line
+    // of our own (jiff's message names its internal limits).
+    let bad = |e: jiff::Error| match Pieces::parse(s) {
+        Ok(_) => TimeError::OutOfRange {
+            text: text.to_string(),
+        },
+        Err(_) => TimeError::BadDate {
+            text: text.to_string(),
+            reason: e.to_string(),
+        },
     };
     let has_offset =
         s.ends_with(['Z', 'z']) || s.get(10..).is_some_and(|time| time.contains(['+', '-']));
@@ -163,7 +221,30 @@ pub fn parse_in(text: &str, zone: &TimeZone) -> Result<Time, TimeError> {
         s.parse::<Timestamp>().map_err(bad)?
     } else {
         let civil = s.parse::<DateTime>().map_err(bad)?;
-        zone.to_zoned(civil).map_err(bad)?.timestamp()
+        let local = zone.to_ambiguous_zoned(civil);
+        let (skipped, before, after) = match local.offset() {
+            AmbiguousOffset::Unambiguous { .. } => (false, None, None),
+            AmbiguousOffset::Gap { before, after } => (true, Some(before), Some(after)),
+            AmbiguousOffset::Fold { before, after } => (false, Some(before), Some(after)),
+        };
+        if let (Some(before), Some(after)) = (before, after) {
+            return Err(TimeError::AmbiguousLocal {
+                text: text.trim().to_string(),
+                zone: zone
+                    .iana_name()
+                    .unwrap_or("the local time zone")
+                    .to_string(),
+                skipped,
+                before: offset_text(before),
+                after: offset_text(after),
+            });
+        }
+        local
+            .compatible()
+            .map_err(|_| TimeError::OutOfRange {
+                text: text.to_string(),
+            })?
+            .timestamp()
     };
     Ok(Time::Date(unix_seconds(instant)))
 }
@@ -188,6 +269,14 @@ fn after_first(rest: &str) -> Option<f64> {
         None => rest.parse::<SignedDuration>().ok()?.as_secs_f64(),
     };
     (seconds >= 0.0 && seconds.is_finite()).then_some(seconds)
+}
+
+/// An offset as RFC 3339 writes it, `+02:00` (jiff's `Display` leaves out zero minutes:
+/// `+02`, which RFC 3339 does not read).
+fn offset_text(offset: Offset) -> String {
+    let s = offset.seconds();
+    let (sign, s) = if s < 0 { ('-', -s) } else { ('+', s) };
+    format!("{sign}{:02}:{:02}", s / 3600, s / 60 % 60)
 }
 
 /// Unix seconds of an instant.
@@ -368,6 +457,44 @@ mod tests {
         );
         // An offset given wins over the zone.
         assert_eq!(local("2026-11-23T14:03:00Z"), Ok(Time::Date(t)));
+    }
+
+    #[test]
+    fn local_times_a_clock_change_repeats_or_skips_ask_for_an_offset() {
+        let berlin = TimeZone::get("Europe/Berlin").unwrap();
+        let twice = parse_in("2026-10-25 02:30", &berlin).unwrap_err();
+        assert_eq!(
+            twice.to_string(),
+            "\"2026-10-25 02:30\" happens twice in Europe/Berlin (the clocks go back): give its \
+             offset, 2026-10-25 02:30+02:00 or 2026-10-25 02:30+01:00"
+        );
+        let skipped = parse_in("2026-03-29T02:30", &berlin).unwrap_err();
+        assert!(
+            matches!(skipped, TimeError::AmbiguousLocal { skipped: true, .. }),
+            "{skipped:?}"
+        );
+        // Each offset suggested reads, as the instant it says.
+        for (text, utc_text) in [
+            ("2026-10-25 02:30+02:00", "2026-10-25T00:30Z"),
+            ("2026-10-25 02:30+01:00", "2026-10-25T01:30Z"),
+        ] {
+            let want = unix_seconds(utc_text.parse().unwrap());
+            assert_eq!(parse_in(text, &berlin), Ok(Time::Date(want)), "{text}");
+        }
+    }
+
+    #[test]
+    fn dates_beyond_the_range_are_refused_in_our_words() {
+        for text in ["9999-12-31T23:59:59Z", "9999-12-31 23:59:59"] {
+            let e = utc(text).unwrap_err();
+            assert_eq!(
+                e.to_string(),
+                format!(
+                    "{text:?} is beyond the dates hwfoc reads \
+                     (-009999-01-02T01:59:59Z to 9999-12-30T22:00:00Z)"
+                )
+            );
+        }
     }
 
     #[test]

@@ -176,7 +176,7 @@ pub fn run(args: &BridgeArgs) -> Result<(), CliError> {
     };
     // What is still waiting goes out.
     fanout.poll(Instant::now(), |e| errors.report(&e));
-    report::print(&fanout, &errors, started.elapsed());
+    report::print(&fanout, started.elapsed());
     result
 }
 

@@ -17,7 +17,6 @@ pub struct Errors {
     quiet: bool,
     /// When each message was last printed, and how often it happened since.
     seen: HashMap<String, (Instant, u64)>,
-    total: u64,
 }
 
 impl Errors {
@@ -26,13 +25,11 @@ impl Errors {
         Errors {
             quiet,
             seen: HashMap::new(),
-            total: 0,
         }
     }
 
     /// A failure: printed unless the same message was printed in the last ten seconds.
     pub fn report(&mut self, error: &OutputError) {
-        self.total += 1;
         let message = Escaped(error).to_string();
         let now = Instant::now();
         let entry = self.seen.entry(message.clone()).or_insert((now, 0));
@@ -52,24 +49,26 @@ impl Errors {
             *entry = (now, 1);
         }
     }
-
-    /// Failures in all.
-    pub fn total(&self) -> u64 {
-        self.total
-    }
 }
 
 /// Prints the counters of every output (standard error: standard output may be a pipe to
 /// something else).
-pub fn print(fanout: &Fanout, errors: &Errors, ran: Duration) {
-    eprintln!(
-        "hwfoc bridge: {:.1} s, {} frames of {} ESC{}, {} output failure{}",
+pub fn print(fanout: &Fanout, ran: Duration) {
+    eprint!("{}", counters(fanout, ran));
+}
+
+/// The counters of every output, and their total failures: the sum of what each output
+/// counts ([`hwfoc_bridge::output::OutputStats::errors`]).
+fn counters(fanout: &Fanout, ran: Duration) -> String {
+    let failures: u64 = fanout.outputs().iter().map(|o| o.stats().errors).sum();
+    let mut text = format!(
+        "hwfoc bridge: {:.1} s, {} frames of {} ESC{}, {} output failure{}\n",
         ran.as_secs_f64(),
         fanout.frames(),
         fanout.escs(),
         if fanout.escs() == 1 { "" } else { "s" },
-        errors.total(),
-        if errors.total() == 1 { "" } else { "s" },
+        failures,
+        if failures == 1 { "" } else { "s" },
     );
     for output in fanout.outputs() {
         let s = output.stats();
@@ -78,8 +77,8 @@ pub fn print(fanout: &Fanout, errors: &Errors, ran: Duration) {
                 format!("{:.2} ms", d.as_secs_f64() * 1e3)
             })
         };
-        eprintln!(
-            "  {}: {} messages, {} bytes, {} failed, {} superseded, latency median {}, p99 {}",
+        text += &format!(
+            "  {}: {} messages, {} bytes, {} failed, {} superseded, latency median {}, p99 {}\n",
             Escaped(output.name()),
             s.messages,
             s.bytes,
@@ -88,5 +87,53 @@ pub fn print(fanout: &Fanout, errors: &Errors, ran: Duration) {
             ms(50.0),
             ms(99.0),
         );
+    }
+    text
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    use hwfoc_bridge::output::{Output, OutputError, OutputStats, Update};
+
+    /// An output whose sends all failed, `failed` times, of which poll reported one.
+    struct Failing {
+        stats: OutputStats,
+    }
+
+    impl Output for Failing {
+        fn name(&self) -> &str {
+            "failing"
+        }
+        fn update(&mut self, _: &Update<'_>) {}
+        fn poll(&mut self, _: Instant) -> Result<(), OutputError> {
+            Err(OutputError::Send {
+                output: "failing".into(),
+                reason: "refused".into(),
+            })
+        }
+        fn stats(&self) -> &OutputStats {
+            &self.stats
+        }
+    }
+
+    #[test]
+    fn the_total_is_the_sum_of_the_outputs_failures() {
+        let failing = |errors| -> Box<dyn Output> {
+            Box::new(Failing {
+                stats: OutputStats {
+                    errors,
+                    ..OutputStats::default()
+                },
+            })
+        };
+        let mut fanout = Fanout::new(vec![failing(5951), failing(11903)]);
+        let mut errors = Errors::new(true);
+        fanout.poll(Instant::now(), |e| errors.report(&e));
+        let text = counters(&fanout, Duration::from_secs(10));
+        let first = text.lines().next().unwrap();
+        assert!(first.ends_with(", 17854 output failures"), "{text}");
+        assert!(text.contains(" 5951 failed") && text.contains(" 11903 failed"));
     }
 }

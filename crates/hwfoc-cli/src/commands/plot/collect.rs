@@ -11,11 +11,15 @@
 //! `hwfoc decode` gives.
 //!
 //! Frames are placed on a clock: their receive time, or for inputs without receive times the
-//! data frame's index times the nominal frame period (50 ms).
+//! data frame's index times the nominal frame period (50 ms). The clock of an ESC never goes
+//! back: at a discontinuity of its receive times (a step back, or a jump forward its packet
+//! numbers do not explain: [`Step`]) it goes on one frame period after the frame before, and
+//! the lines break there; the plot's subtitle counts the discontinuities.
 
 use hwfoc::{InfoFrame, Settings, Status};
 
 use crate::error::CliError;
+use hwfoc_io::clock::Step;
 use hwfoc_io::energy::{self, Energy};
 use hwfoc_io::episode::{Episode, Mark};
 use hwfoc_io::record::Record;
@@ -211,7 +215,8 @@ impl Buckets {
         if self.origin.is_nan() {
             self.origin = c;
         }
-        // A clock that went back (the next file of the same stream) counts from the start.
+        // An ESC's clock never goes back (see the module documentation); a frame before the
+        // origin would be a frame of the first bucket.
         let mut i = ((c - self.origin) * self.per_width).max(0.0);
         while i >= self.cells.len() as f64 {
             self.halve();
@@ -274,6 +279,13 @@ pub struct EscData {
     pub episodes: u64,
     /// Charge and energy of its plotted frames.
     pub energy: Energy,
+    /// Discontinuities of its receive times ([`Step`]): the clock goes on across them.
+    pub discontinuities: u64,
+    /// The last timed data frame's receive time and packet number.
+    last_timed: Option<(f64, u16)>,
+    /// What is added to a receive time to place it on the clock: it changes at each
+    /// discontinuity, so that the clock goes on one frame period after the frame before.
+    shift: f64,
     /// The fault episode going on.
     open: Option<Episode>,
 }
@@ -291,6 +303,9 @@ impl EscData {
             spans: Vec::new(),
             episodes: 0,
             energy: Energy::new(),
+            discontinuities: 0,
+            last_timed: None,
+            shift: 0.0,
             open: None,
         }
     }
@@ -300,15 +315,25 @@ impl EscData {
         let t = r.t_s;
         let index = self.frames;
         self.frames += 1;
+        let mut jumped = false;
         if let Some(t) = t {
             let (first, last) = self.times.get_or_insert((t, t));
             *first = first.min(t);
             *last = last.max(t);
+            if let Some((last_t, last_packet)) = self.last_timed {
+                let packets = r.packet.wrapping_sub(last_packet);
+                if Step::between(last_t, t, Some(packets)).is_discontinuity() {
+                    self.discontinuities += 1;
+                    self.shift = last_t + self.shift + FRAME_PERIOD - t;
+                    jumped = true;
+                }
+            }
+            self.last_timed = Some((t, r.packet));
         }
         if !window.contains(t) {
             return;
         }
-        let c = clock(t, index);
+        let c = t.map_or_else(|| clock(None, index), |t| t + self.shift);
         if !c.is_finite() {
             return;
         }
@@ -316,7 +341,7 @@ impl EscData {
         self.plotted += 1;
         let gap = match &mut self.clock {
             Some((_, last)) => {
-                let gap = (c - *last).abs() > GAP_S;
+                let gap = jumped || c - *last > GAP_S;
                 *last = c;
                 gap
             }
@@ -328,8 +353,9 @@ impl EscData {
         self.buckets.add(c, &values(r), gap);
         self.energy
             .add(t, f64::from(r.voltage_v), f64::from(r.current_a));
+        // Episodes are placed on the clock too.
         let mark = Mark {
-            t,
+            t: t.map(|_| c),
             frame: index,
             packet: r.packet,
         };
@@ -484,6 +510,7 @@ mod tests {
     /// The record of a frame at `t` with this throttle and status word.
     fn frame(t: f64, throttle: u16, status: u16) -> Record {
         let f = DataFrame {
+            packet: (t / FRAME_PERIOD).round() as u16,
             throttle_in_raw: throttle,
             status: Status(status),
             ..Default::default()
@@ -627,6 +654,35 @@ mod tests {
         assert_eq!(esc.episodes, 200);
         assert!(esc.spans.len() <= 4, "{:?}", esc.spans.len());
         assert_eq!(esc.spans.iter().map(|s| s.episodes).sum::<u64>(), 200);
+    }
+
+    #[test]
+    fn the_clock_goes_on_across_a_step_back_and_a_jump() {
+        let mut esc = EscData::new(1024);
+        // 2 s of frames, an NTP step back of an hour, 2 s more, a jump to the year 2226
+        // (packet numbers go on by one), 2 s more back in 2026.
+        let start = 1_795_442_580.0;
+        let mut times: Vec<f64> = (0..40).map(|k| start + k as f64 * 0.05).collect();
+        times.extend((0..40).map(|k| start - 3600.0 + k as f64 * 0.05));
+        times.push(8_000_000_000.0);
+        times.extend((0..40).map(|k| start - 3598.0 + k as f64 * 0.05));
+        for (k, &t) in times.iter().enumerate() {
+            let mut r = frame(t, 0, 0);
+            r.packet = k as u16;
+            esc.add(&r, &mut all());
+        }
+        assert_eq!(esc.discontinuities, 3);
+        let (first, last) = esc.clock.unwrap();
+        // 121 frames a frame period apart.
+        assert!(
+            (last - first - 120.0 * FRAME_PERIOD).abs() < 1e-6,
+            "{first} .. {last}"
+        );
+        let gaps = esc.buckets.cells.iter().filter(|b| b.gap_before).count();
+        assert_eq!(
+            gaps, 4,
+            "the first frame and each discontinuity start a line"
+        );
     }
 
     #[test]

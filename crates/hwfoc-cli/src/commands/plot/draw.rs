@@ -380,6 +380,19 @@ impl<'a> Scene<'a> {
                 if timed { "" } else { "time: " }
             ));
         }
+        let jumps: u64 = rows
+            .iter()
+            .filter_map(|r| r.data)
+            .map(|d| d.discontinuities)
+            .sum();
+        if jumps > 0 {
+            subtitle.push_str(&format!(
+                " · {jumps} clock discontinuit{} (a step back or a jump): the time axis goes on \
+                 across {}, lines break there",
+                if jumps == 1 { "y" } else { "ies" },
+                if jumps == 1 { "it" } else { "them" }
+            ));
+        }
         let window = collector.window();
         if window.is_limited() && timed {
             subtitle.push_str(" · window");

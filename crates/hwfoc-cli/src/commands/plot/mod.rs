@@ -23,6 +23,12 @@ use hwfoc_io::sources::{Handler, Sources};
 use collect::Collector;
 use target::Target;
 
+/// What the time axis does with a clock that steps back or jumps (`hwfoc plot --help`).
+const CLOCK_HELP: &str = "Time axis: seconds from the first frame. Where an ESC's receive clock \
+steps back (NTP) or jumps forward further than its packet numbers explain, its time goes on one \
+frame period after the frame before and its lines break there; the subtitle counts such \
+discontinuities. A silence that the packet numbers explain (a cut line) stays on the axis.";
+
 /// The narrowest and widest image, and the lowest and highest, in pixels.
 const MIN_SIZE: u32 = 320;
 /// See [`MIN_SIZE`]: 10000 x 10000 pixels are 300 MB of RGB.
@@ -30,6 +36,7 @@ const MAX_SIZE: u32 = 10_000;
 
 /// Arguments of `hwfoc plot`.
 #[derive(Debug, clap::Args)]
+#[command(after_help = CLOCK_HELP)]
 pub struct PlotArgs {
     #[command(flatten)]
     input: InputArgs,
