@@ -12,6 +12,7 @@ use serde_json::json;
 
 use crate::args::{InputArgs, SelectArgs, SettingsArgs};
 use crate::error::CliError;
+use hwfoc_io::InputFormat;
 use hwfoc_io::settings::{SettingsMap, SettingsPatch};
 use hwfoc_io::sources::Sources;
 use hwfoc_io::time::Clock;
@@ -49,14 +50,19 @@ pub struct DecodeArgs {
 
 /// Runs `hwfoc decode`.
 pub fn run(args: &DecodeArgs) -> Result<(), CliError> {
-    let (_, settings_map) = args.settings.settings_map()?;
+    let (config, settings_map) = args.settings.settings_map()?;
     let settings = *settings_map.default_settings();
     let overrides = overrides(&settings_map);
     let selection = args.select.selection()?;
-    if let Some(output) = &args.output {
-        args.input.refuse_output(output)?;
-    }
-    let mut sources = Sources::new(args.input.open_all()?, settings_map);
+    args.input
+        .refuse_output(args.output.as_deref().unwrap_or("-"), &config)?;
+    // Ctrl-C and SIGTERM abandon an export of inputs read to their end, leaving any earlier
+    // file at the output as it was; live ports end their input on them instead, and what they
+    // gave is written.
+    let stop = hwfoc_io::stop::interrupted();
+    let inputs = args.input.open_all()?;
+    let live = inputs.iter().any(|i| i.format() == InputFormat::Serial);
+    let mut sources = Sources::new(inputs, settings_map);
     if selection.window.is_limited() {
         sources.require_timing()?;
         args.select.check_clocks(&sources)?;
@@ -76,6 +82,9 @@ pub fn run(args: &DecodeArgs) -> Result<(), CliError> {
     keep_freed_memory();
     let mut export =
         Export::create(format, args.output.as_deref(), provenance)?.select(selection.clone());
+    if !live {
+        export = export.stop_on(stop);
+    }
     let result = sources.run(&mut export);
     let (kept, span) = (export.kept(), export.span());
     // Whatever was decoded before an input error is still written out.
