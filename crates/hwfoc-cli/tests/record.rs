@@ -652,3 +652,61 @@ fn rotation_by_size_keeps_files_under_the_limit() {
         (1000..1060).collect::<Vec<u16>>()
     );
 }
+
+/// A file that appears at a later name of a rotating recording (another program's) is left
+/// alone: the recording goes on under the next free name, says so once, and loses nothing.
+#[test]
+fn rotation_skips_a_name_taken_meanwhile() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("x.pcapng");
+    let mut pty = pty();
+    let port = pty.path.to_str().unwrap().to_string();
+    let mut rec = Running::start(&[
+        "record",
+        &port,
+        "-o",
+        out.to_str().unwrap(),
+        "--rotate-size",
+        "1k",
+        "--duration",
+        "2",
+    ]);
+    rec.wait_for("recording", Duration::from_secs(10));
+    let taken = dir.path().join("x-0003.pcapng");
+    std::fs::write(&taken, "another program's").unwrap();
+    feed(&mut pty, 0..60, Duration::from_millis(25));
+    assert!(rec.wait(Duration::from_secs(10)), "{}", rec.stderr());
+    assert_eq!(
+        std::fs::read_to_string(&taken).unwrap(),
+        "another program's"
+    );
+    let stderr = rec.stderr();
+    let said: Vec<&str> = stderr
+        .lines()
+        .filter(|l| l.contains("x-0003.pcapng"))
+        .collect();
+    assert_eq!(said.len(), 1, "{stderr}");
+    assert!(
+        said[0].starts_with("hwfoc: warning: ") && said[0].contains("x-0004.pcapng"),
+        "{stderr}"
+    );
+    let mut all = Vec::new();
+    let mut n = 0;
+    for number in 1.. {
+        let f = dir.path().join(format!("x-{number:04}.pcapng"));
+        if !f.exists() {
+            break;
+        }
+        if f != taken {
+            all.extend(std::fs::read(&f).unwrap());
+            n += 1;
+        }
+    }
+    assert!(n >= 3, "{n} files");
+    let joined = dir.path().join("joined.pcapng");
+    std::fs::write(&joined, all).unwrap();
+    assert_eq!(
+        packets(&decode(&joined).0),
+        (1000..1060).collect::<Vec<u16>>()
+    );
+}
