@@ -12,7 +12,6 @@ use serde_json::json;
 
 use crate::args::{InputArgs, SelectArgs, SettingsArgs};
 use crate::error::CliError;
-use hwfoc_io::InputFormat;
 use hwfoc_io::settings::{SettingsMap, SettingsPatch};
 use hwfoc_io::sources::Sources;
 use hwfoc_io::time::Clock;
@@ -56,12 +55,12 @@ pub fn run(args: &DecodeArgs) -> Result<(), CliError> {
     let selection = args.select.selection()?;
     args.input
         .refuse_output(args.output.as_deref().unwrap_or("-"), &config)?;
-    // Ctrl-C and SIGTERM abandon an export of inputs read to their end, leaving any earlier
-    // file at the output as it was; live ports end their input on them instead, and what they
-    // gave is written.
-    let stop = hwfoc_io::stop::interrupted();
+    // Ctrl-C and SIGTERM abandon an export of files read to their end, leaving any earlier
+    // file at the output as it was. Live inputs keep the signals' usual meaning: serial ports
+    // end their input on them, and what they gave is written; a pipe or a terminal on standard
+    // input ends the process (its export stays in the temporary file).
+    let stop = read_to_end(&args.input).then(hwfoc_io::stop::interrupted);
     let inputs = args.input.open_all()?;
-    let live = inputs.iter().any(|i| i.format() == InputFormat::Serial);
     let mut sources = Sources::new(inputs, settings_map);
     if selection.window.is_limited() {
         sources.require_timing()?;
@@ -82,7 +81,7 @@ pub fn run(args: &DecodeArgs) -> Result<(), CliError> {
     keep_freed_memory();
     let mut export =
         Export::create(format, args.output.as_deref(), provenance)?.select(selection.clone());
-    if !live {
+    if let Some(stop) = stop {
         export = export.stop_on(stop);
     }
     let result = sources.run(&mut export);
@@ -101,6 +100,33 @@ pub fn run(args: &DecodeArgs) -> Result<(), CliError> {
         );
     }
     Ok(())
+}
+
+/// Whether every input is read to its end: regular files (standard input included), or the
+/// demo; not serial ports, pipes or terminals.
+fn read_to_end(input: &InputArgs) -> bool {
+    input.inputs.iter().all(|spec| {
+        let meta = if spec == "-" {
+            stdin_metadata()
+        } else {
+            std::fs::metadata(spec).ok()
+        };
+        meta.is_some_and(|m| m.is_file())
+    })
+}
+
+/// What standard input is.
+#[cfg(unix)]
+fn stdin_metadata() -> Option<std::fs::Metadata> {
+    use std::os::fd::AsFd;
+    let fd = std::io::stdin().as_fd().try_clone_to_owned().ok()?;
+    std::fs::File::from(fd).metadata().ok()
+}
+
+/// What standard input is (not looked at elsewhere: taken as live).
+#[cfg(not(unix))]
+fn stdin_metadata() -> Option<std::fs::Metadata> {
+    None
 }
 
 /// The entries by port and by ESC of `map`, named as in the configuration file (`port."NAME"`,
