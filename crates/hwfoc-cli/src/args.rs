@@ -1,7 +1,7 @@
 //! Option groups that several commands share: where telemetry comes from, the conversion
 //! settings the frames do not carry, and which frames to keep.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use clap::Args;
 use hwfoc_io::select::{Selection, Window};
@@ -33,11 +33,16 @@ pub struct InputArgs {
 }
 
 impl InputArgs {
-    /// Refuses an output file that is one of the inputs (see
-    /// [`hwfoc_io::write::refuse_input`]): call it before the output is opened.
-    pub fn refuse_output(&self, output: &str) -> Result<(), CliError> {
-        let inputs = self.inputs.iter().map(String::as_str);
-        Ok(hwfoc_io::write::refuse_input(output, inputs)?)
+    /// Refuses an output (`-`: standard output) that is a file the command reads: one of the
+    /// inputs (`-`: whatever is behind standard input) or the configuration file read (see
+    /// [`hwfoc_io::write::refuse_input`]). Call it before the output is opened.
+    pub fn refuse_output(&self, output: &str, config: &Config) -> Result<(), CliError> {
+        let config = config_read(config);
+        let inputs = self.inputs.iter().map(Path::new);
+        Ok(hwfoc_io::write::refuse_input(
+            output,
+            inputs.chain(config.as_deref()),
+        )?)
     }
 
     /// Opens every input, in the order given: each file (or standard input) as one [`Input`],
@@ -67,6 +72,17 @@ impl InputArgs {
                 .collect::<Result<_, InputError>>()?),
         }
     }
+}
+
+/// The configuration file `config` was read from, as [`hwfoc_io::write::refuse_input`] takes a
+/// file read (to which `-` is standard input; a configuration file named `-` is a file).
+pub fn config_read(config: &Config) -> Option<PathBuf> {
+    let path = config.path.as_ref()?;
+    Some(if path.as_os_str() == "-" {
+        Path::new(".").join(path)
+    } else {
+        path.clone()
+    })
 }
 
 /// How the configuration file and the flags combine, for `--help`.
@@ -105,12 +121,6 @@ impl SettingsArgs {
     /// The configuration file these flags point to, read (see [`Config::load`]).
     pub fn config(&self) -> Result<Config, CliError> {
         Config::load(self, false)
-    }
-
-    /// The settings of ESCs that no entry of the configuration file names: the flags over the
-    /// file's `[settings]` over the defaults.
-    pub fn settings(&self) -> Result<hwfoc::Settings, CliError> {
-        self.config()?.settings(self)
     }
 
     /// The settings set by flags.

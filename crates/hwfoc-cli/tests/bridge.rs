@@ -355,6 +355,28 @@ fn a_bridge_needs_an_output_and_refuses_bad_ones_in_one_line() {
     common::assert_fails_with(&o, "/dev/ttyNOPE-hwfoc");
 }
 
+/// Port 0 and the unspecified address are nowhere to send to: refused, not silently accepted.
+#[test]
+fn a_udp_destination_needs_a_port_and_an_address() {
+    for (spec, needle) in [
+        ("udp:1.2.3.4:0", "port 0 is no destination"),
+        ("udp:0", "port 0 is no destination"),
+        ("udp:0.0.0.0:14550", "0.0.0.0 is no destination address"),
+        ("udp:[::]:14550", ":: is no destination address"),
+    ] {
+        let o = run(hwfoc().args([
+            "bridge",
+            "--sim",
+            "1",
+            "--duration",
+            "0.2",
+            "--mavlink",
+            spec,
+        ]));
+        common::assert_fails_with(&o, &format!("mavlink {spec}: cannot open: {needle}"));
+    }
+}
+
 /// The MAVLink fields of ESC_TELEMETRY that carry a record's values, in the message's units.
 fn telemetry_of(record: &Value) -> (u64, u64, u64) {
     let cv = (record["voltage_v"].as_f64().unwrap() * 100.0).round() as u64;

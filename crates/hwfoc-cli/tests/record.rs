@@ -614,10 +614,16 @@ fn permission_denied_says_which_group_to_join() {
     );
 }
 
-#[test]
-fn rotation_by_size_keeps_files_under_the_limit() {
-    let dir = tempfile::tempdir().unwrap();
-    let out = dir.path().join("sized.pcapng");
+/// `hwfoc record` of a pty to `dir/NAME.pcapng` rotated at 1 KiB for 2 s, fed 60 frames once
+/// `meanwhile` has run; its standard error, and the files of the series
+/// (`NAME-0001.pcapng`, ... while they exist) but `skip`.
+fn record_rotating_by_size(
+    dir: &Path,
+    name: &str,
+    meanwhile: impl FnOnce(),
+    skip: &Path,
+) -> (String, Vec<PathBuf>) {
+    let out = dir.join(format!("{name}.pcapng"));
     let mut pty = pty();
     let port = pty.path.to_str().unwrap().to_string();
     let mut rec = Running::start(&[
@@ -631,24 +637,68 @@ fn rotation_by_size_keeps_files_under_the_limit() {
         "2",
     ]);
     rec.wait_for("recording", Duration::from_secs(10));
+    meanwhile();
     feed(&mut pty, 0..60, Duration::from_millis(25));
     assert!(rec.wait(Duration::from_secs(10)), "{}", rec.stderr());
     let files: Vec<PathBuf> = (1..)
-        .map(|n| dir.path().join(format!("sized-{n:04}.pcapng")))
+        .map(|n| dir.join(format!("{name}-{n:04}.pcapng")))
         .take_while(|p| p.exists())
+        .filter(|p| p != skip)
         .collect();
     assert!(files.len() >= 3, "{files:?}");
+    (rec.stderr(), files)
+}
+
+/// The packets of the recordings `files`, one after another, as one recording decodes.
+fn packets_of_series(dir: &Path, files: &[PathBuf]) -> Vec<u16> {
     let mut all = Vec::new();
+    for f in files {
+        all.extend(std::fs::read(f).unwrap());
+    }
+    let joined = dir.join("joined.pcapng");
+    std::fs::write(&joined, all).unwrap();
+    packets(&decode(&joined).0)
+}
+
+#[test]
+fn rotation_by_size_keeps_files_under_the_limit() {
+    let dir = tempfile::tempdir().unwrap();
+    let (_, files) = record_rotating_by_size(dir.path(), "sized", || {}, Path::new(""));
     for f in &files {
         let file = std::fs::read(f).unwrap();
         assert!(file.len() <= 1024, "{f:?}: {} bytes", file.len());
         assert_eq!(blocks(&file)[0].0, 0x0A0D_0D0A);
-        all.extend(file);
     }
-    let joined = dir.path().join("joined.pcapng");
-    std::fs::write(&joined, all).unwrap();
     assert_eq!(
-        packets(&decode(&joined).0),
+        packets_of_series(dir.path(), &files),
+        (1000..1060).collect::<Vec<u16>>()
+    );
+}
+
+/// A file that appears at a later name of a rotating recording (another program's) is left
+/// alone: the recording goes on under the next free name, says so once, and loses nothing.
+#[test]
+fn rotation_skips_a_name_taken_meanwhile() {
+    let dir = tempfile::tempdir().unwrap();
+    let taken = dir.path().join("x-0003.pcapng");
+    let make = || std::fs::write(&taken, "another program's").unwrap();
+    let (stderr, files) = record_rotating_by_size(dir.path(), "x", make, &taken);
+    assert_eq!(
+        std::fs::read_to_string(&taken).unwrap(),
+        "another program's"
+    );
+    let said: Vec<&str> = stderr
+        .lines()
+        .filter(|l| l.contains("x-0003.pcapng"))
+        .collect();
+    assert_eq!(said.len(), 1, "{stderr}");
+    assert!(
+        said[0].starts_with("hwfoc: warning: ") && said[0].contains("x-0004.pcapng"),
+        "{stderr}"
+    );
+    assert!(files.contains(&dir.path().join("x-0004.pcapng")));
+    assert_eq!(
+        packets_of_series(dir.path(), &files),
         (1000..1060).collect::<Vec<u16>>()
     );
 }

@@ -8,7 +8,7 @@ use std::io::Write;
 use std::process::Stdio;
 use std::time::{Duration, Instant};
 
-use common::{Dir, XROTOR, assert_fails_with, capture, hwfoc, ok, run, spawn};
+use common::{Dir, XROTOR, assert_fails_with, capture, hwfoc, ok, run, spawn, stdout};
 
 /// The bytes of the real capture, as a raw file and as a CSV file in `dir`.
 fn inputs(dir: &Dir) -> (String, String) {
@@ -88,7 +88,7 @@ fn an_output_that_is_an_input_is_refused_and_the_input_kept() {
             &out,
             &format!("it is the input {input}, which would be destroyed"),
         );
-        assert!(!dir.path("cap.bin.partial").exists(), "{args:?}");
+        assert!(partials(&dir).is_empty(), "{args:?}");
     }
     assert_eq!(std::fs::read(&csv).unwrap(), before_csv);
     assert_eq!(std::fs::read(&raw).unwrap(), before_raw);
@@ -103,7 +103,7 @@ fn a_finished_export_replaces_the_file_and_leaves_no_partial_file() {
     ok(run(hwfoc().args(["decode", &csv, "-o", &out])));
     let text = std::fs::read_to_string(&out).unwrap();
     assert_eq!(text.lines().count(), 248);
-    assert!(!dir.path("out.jsonl.partial").exists());
+    assert!(partials(&dir).is_empty());
     // Through a link, the file it points to is replaced and the link stays.
     #[cfg(unix)]
     {
@@ -147,17 +147,212 @@ fn a_killed_export_leaves_the_earlier_file() {
         let mut stdin = child.stdin.take().unwrap();
         stdin.write_all(&bytes).unwrap();
         stdin.flush().unwrap();
-        let partial = dir.path(&format!("out.{format}.partial"));
         let start = Instant::now();
-        while !partial.exists() && start.elapsed() < Duration::from_secs(30) {
+        while partials(&dir).is_empty() && start.elapsed() < Duration::from_secs(30) {
             std::thread::sleep(Duration::from_millis(20));
         }
-        assert!(partial.exists(), "no partial file for {format}");
+        let partial = partials(&dir);
+        assert!(
+            partial.len() == 1 && partial[0].starts_with(&format!("out.{format}.")),
+            "no partial file for {format}: {partial:?}"
+        );
         child.kill().unwrap();
         child.wait().unwrap();
         assert_eq!(std::fs::read_to_string(&out).unwrap(), "the earlier export");
         drop(stdin);
+        for name in partial {
+            std::fs::remove_file(dir.path(&name)).unwrap();
+        }
     }
+}
+
+/// The names of the temporary files of exports in `dir` (`NAME.XXXXXX.partial`).
+fn partials(dir: &Dir) -> Vec<String> {
+    let mut names: Vec<String> = std::fs::read_dir(dir.0.path())
+        .unwrap()
+        .filter_map(|e| e.ok()?.file_name().into_string().ok())
+        .filter(|name| name.ends_with(".partial"))
+        .collect();
+    names.sort();
+    names
+}
+
+/// SIGTERM during a long export ends it with a message, removes its temporary file, and leaves
+/// the earlier file at the path as it was.
+#[cfg(unix)]
+#[test]
+fn sigterm_during_an_export_removes_the_temporary_file() {
+    use nix::sys::signal::{Signal, kill};
+    use nix::unistd::Pid;
+    let dir = Dir::new();
+    let one = dir.arg("one.bin");
+    ok(run(hwfoc().args([
+        "simulate",
+        "-o",
+        &one,
+        "--duration",
+        "3000",
+        "--quiet",
+    ])));
+    // About 50 MB of telemetry: some tens of seconds of CSV export, a debug build or not.
+    let bytes = std::fs::read(&one).unwrap();
+    let big = dir.arg("big.bin");
+    let mut file = std::fs::File::create(&big).unwrap();
+    for _ in 0..40 {
+        file.write_all(&bytes).unwrap();
+    }
+    drop(file);
+    let out = dir.arg("out.csv");
+    std::fs::write(&out, "the earlier export").unwrap();
+    let mut child = spawn(hwfoc().args(["decode", "--format", "csv", &big, "-o", &out]));
+    // Signalled once the export has written something to its temporary file.
+    let start = Instant::now();
+    let written = || {
+        partials(&dir)
+            .first()
+            .and_then(|name| std::fs::metadata(dir.path(name)).ok())
+            .is_some_and(|m| m.len() > 0)
+    };
+    while !written() && start.elapsed() < Duration::from_secs(60) {
+        std::thread::sleep(Duration::from_millis(10));
+    }
+    assert!(written(), "no temporary file: {:?}", partials(&dir));
+    assert!(
+        child.try_wait().unwrap().is_none(),
+        "the export ended before the signal: make the input larger"
+    );
+    kill(Pid::from_raw(child.id() as i32), Signal::SIGTERM).unwrap();
+    let start = Instant::now();
+    while child.try_wait().unwrap().is_none() && start.elapsed() < Duration::from_secs(30) {
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    let status = child.try_wait().unwrap();
+    if status.is_none() {
+        child.kill().unwrap();
+    }
+    let o = child.wait_with_output().unwrap();
+    assert!(status.is_some(), "SIGTERM did not end the export");
+    assert_fails_with(&o, "interrupted: ");
+    assert!(partials(&dir).is_empty(), "{:?}", partials(&dir));
+    assert_eq!(std::fs::read_to_string(&out).unwrap(), "the earlier export");
+}
+
+/// Standard input and the configuration file are inputs too: an output that is the file
+/// behind standard input, or the configuration read, is refused and the file kept; so is
+/// standard output appended to an input.
+#[cfg(unix)]
+#[test]
+fn an_output_that_is_standard_input_or_the_configuration_is_refused() {
+    let dir = Dir::new();
+    let (csv, raw) = inputs(&dir);
+    let before = std::fs::read(&raw).unwrap();
+    let stdin = || std::fs::File::open(&raw).unwrap();
+    let o = run(hwfoc().args(["decode", "-o", &raw, "-"]).stdin(stdin()));
+    assert_fails_with(
+        &o,
+        &format!("cannot write {raw}: it is the input standard input"),
+    );
+    let append = std::fs::OpenOptions::new().append(true).open(&raw).unwrap();
+    let o = hwfoc()
+        .args(["decode", &raw])
+        .stdout(append)
+        .stderr(Stdio::piped())
+        .output()
+        .unwrap();
+    assert_fails_with(&o, "cannot write standard output: it is the input ");
+    assert_eq!(std::fs::read(&raw).unwrap(), before);
+
+    // A configuration file (valid TOML, whatever its name) as the output of every command
+    // that reads one.
+    let toml = "[settings]\npole_pairs = 7\n";
+    for (name, args) in [
+        (
+            "my.toml",
+            vec!["decode", "-o", "CONFIG", "--config", "CONFIG", &csv],
+        ),
+        (
+            "my.png",
+            vec!["plot", &csv, "-o", "CONFIG", "--config", "CONFIG"],
+        ),
+        (
+            "my.svg",
+            vec!["summary", &csv, "--plot", "CONFIG", "--config", "CONFIG"],
+        ),
+        (
+            "rec.toml",
+            vec![
+                "monitor",
+                "--sim",
+                "1",
+                "--plain",
+                "--duration",
+                "0.3",
+                "--record",
+                "CONFIG",
+                "--overwrite",
+                "--config",
+                "CONFIG",
+            ],
+        ),
+    ] {
+        let config = dir.arg(name);
+        std::fs::write(&config, toml).unwrap();
+        let args: Vec<&str> = args
+            .iter()
+            .map(|a| if *a == "CONFIG" { config.as_str() } else { a })
+            .collect();
+        let o = run(hwfoc().args(&args));
+        assert_fails_with(
+            &o,
+            &format!("it is the input {config}, which would be destroyed"),
+        );
+        assert_eq!(std::fs::read_to_string(&config).unwrap(), toml, "{args:?}");
+    }
+}
+
+/// The temporary file is a new file of its own: an input named like the old fixed partial
+/// name is read whole, a link placed at that name is not followed, and the replaced file keeps
+/// its mode.
+#[cfg(unix)]
+#[test]
+fn the_temporary_file_is_never_a_file_that_is_there() {
+    use std::os::unix::fs::PermissionsExt;
+    let dir = Dir::new();
+    let (csv, raw) = inputs(&dir);
+    let expected = stdout(&run(hwfoc().args(["decode", "--format", "csv", &raw])));
+    let out = dir.arg("out.csv");
+    let staged_input = dir.arg("out.csv.partial");
+    std::fs::copy(&raw, &staged_input).unwrap();
+    ok(run(hwfoc().args([
+        "decode",
+        "--format",
+        "csv",
+        "-o",
+        &out,
+        &staged_input,
+    ])));
+    assert_eq!(
+        std::fs::read(&staged_input).unwrap(),
+        std::fs::read(&raw).unwrap()
+    );
+    assert_eq!(std::fs::read_to_string(&out).unwrap(), expected);
+
+    std::fs::remove_file(&staged_input).unwrap();
+    let victim = dir.arg("victim.txt");
+    std::fs::write(&victim, "mine").unwrap();
+    std::os::unix::fs::symlink(&victim, &staged_input).unwrap();
+    std::fs::set_permissions(&out, std::fs::Permissions::from_mode(0o640)).unwrap();
+    ok(run(hwfoc().args(["decode", "-o", &out, &csv])));
+    assert_eq!(std::fs::read_to_string(&victim).unwrap(), "mine");
+    assert!(std::fs::read_to_string(&out).unwrap().starts_with("{"));
+    let mode = std::fs::metadata(&out).unwrap().permissions().mode() & 0o777;
+    assert_eq!(mode, 0o640);
+    // A plot likewise.
+    let png = dir.arg("p.png");
+    std::os::unix::fs::symlink(&victim, dir.path("p.png.partial")).unwrap();
+    ok(run(hwfoc().args(["plot", &csv, "-o", &png])));
+    assert_eq!(std::fs::read_to_string(&victim).unwrap(), "mine");
+    assert!(std::fs::read(&png).unwrap().starts_with(b"\x89PNG"));
 }
 
 #[test]
@@ -335,7 +530,7 @@ fn a_plot_is_written_whole_to_a_file_and_not_to_a_device() {
     std::fs::write(&png, "an earlier plot").unwrap();
     ok(run(hwfoc().args(["plot", &csv, "-o", &png])));
     assert!(std::fs::read(&png).unwrap().starts_with(b"\x89PNG"));
-    assert!(!dir.path("p.png.partial").exists());
+    assert!(partials(&dir).is_empty());
     #[cfg(unix)]
     {
         let link = dir.path("dev.svg");
@@ -349,7 +544,7 @@ fn a_plot_is_written_whole_to_a_file_and_not_to_a_device() {
     let o = run(hwfoc().args(["plot", &empty, "-o", &png]));
     assert!(!o.status.success());
     assert!(std::fs::read(&png).unwrap().starts_with(b"\x89PNG"));
-    assert!(!dir.path("p.png.partial").exists());
+    assert!(partials(&dir).is_empty());
 }
 
 /// A directory the user may not write: the error says so and where to write instead. As root
@@ -409,4 +604,74 @@ fn a_missing_output_directory_is_worded_once() {
         let o = run(hwfoc().args(args).stdout(Stdio::null()));
         assert_fails_with(&o, "the directory /nonexistent-hwfoc does not exist");
     }
+}
+
+/// `--overwrite` is for earlier outputs, never for what `simulate` reads: an output (by name,
+/// through a link, `--truth`, or an `{esc}` name expanding to it) that is the profile or the
+/// configuration is refused, and outputs that are one file (a link between two ESCs' names)
+/// are an error rather than one ESC's bytes lost.
+#[cfg(unix)]
+#[test]
+fn simulate_never_writes_over_what_it_reads_or_its_own_outputs() {
+    let dir = Dir::new();
+    let profile = dir.arg("prof.csv");
+    let rows = "time_s,throttle_percent\n0,0\n1,50\n2,0\n";
+    std::fs::write(&profile, rows).unwrap();
+    let link = dir.arg("link.csv");
+    std::os::unix::fs::symlink(&profile, &link).unwrap();
+    let config = dir.arg("my.toml");
+    let toml = "[settings]\npole_pairs = 7\n";
+    std::fs::write(&config, toml).unwrap();
+    let csv_profile = format!("csv:{profile}");
+    let esc_name = dir.arg("prof{esc}.csv");
+    std::fs::copy(&profile, dir.path("prof1.csv")).unwrap();
+    let prof1 = dir.arg("prof1.csv");
+    let profile1 = format!("csv:{prof1}");
+    let cases: [(&[&str], &str); 5] = [
+        (&["-o", &profile, "--profile", &csv_profile], &profile),
+        (&["-o", &link, "--profile", &csv_profile], &profile),
+        (
+            &["-o", "-", "--truth", &profile, "--profile", &csv_profile],
+            &profile,
+        ),
+        (
+            &["--escs", "2", "-o", &esc_name, "--profile", &profile1],
+            &prof1,
+        ),
+        (&["-o", &config, "--config", &config], &config),
+    ];
+    for (args, read) in cases {
+        let o = run(hwfoc()
+            .arg("simulate")
+            .args(args)
+            .args(["--overwrite", "--duration", "1"])
+            .stdout(Stdio::null()));
+        assert_fails_with(&o, &format!("it is the input {read}"));
+    }
+    assert_eq!(std::fs::read_to_string(&profile).unwrap(), rows);
+    assert_eq!(
+        std::fs::read_to_string(dir.path("prof1.csv")).unwrap(),
+        rows
+    );
+    assert_eq!(std::fs::read_to_string(&config).unwrap(), toml);
+
+    // o1.bin is a link to o0.bin: ESC 1's bytes would replace ESC 0's.
+    let o0 = dir.arg("o0.bin");
+    std::fs::write(&o0, "earlier").unwrap();
+    std::os::unix::fs::symlink(&o0, dir.path("o1.bin")).unwrap();
+    let o = run(hwfoc().args([
+        "simulate",
+        "--escs",
+        "2",
+        "-o",
+        &dir.arg("o{esc}.bin"),
+        "--overwrite",
+        "--duration",
+        "1",
+    ]));
+    assert_fails_with(
+        &o,
+        &format!("{o0} and {} are the same file", dir.arg("o1.bin")),
+    );
+    assert_eq!(std::fs::read_to_string(&o0).unwrap(), "earlier");
 }

@@ -437,3 +437,30 @@ fn errors_name_what_is_wrong() {
     assert_eq!(o.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&o.stderr).contains("the names are input_voltage_high"));
 }
+
+/// `--link-dir` replaces only a link a killed run left (to a pseudo-terminal that is gone): a
+/// user's dangling link is refused and kept, and the links made before it are removed.
+#[test]
+fn link_dir_never_replaces_a_users_link() {
+    let dir = Dir::new();
+    let links = dir.path("links");
+    std::fs::create_dir(&links).unwrap();
+    std::os::unix::fs::symlink("/nonexistent", links.join("esc2")).unwrap();
+    let o = run(&[
+        "simulate",
+        "--pty",
+        "--escs",
+        "3",
+        "--duration",
+        "1",
+        "--link-dir",
+        links.to_str().unwrap(),
+    ]);
+    assert_fails_with(&o, "a link of someone else's is there");
+    assert_eq!(
+        std::fs::read_link(links.join("esc2")).unwrap(),
+        Path::new("/nonexistent")
+    );
+    assert!(std::fs::symlink_metadata(links.join("esc0")).is_err());
+    assert!(std::fs::symlink_metadata(links.join("esc1")).is_err());
+}

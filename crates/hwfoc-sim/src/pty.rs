@@ -239,9 +239,10 @@ pub struct Links {
 impl Links {
     /// Makes `link` point at `target`, atomically: the link is created only where there is
     /// nothing (the system refuses to create it over anything, so no other program's file can
-    /// be replaced between a check and the creation). The one thing removed first is a dangling
-    /// symlink, such as an earlier run that was killed leaves (its pseudo-terminal is gone);
-    /// anything else there is an error.
+    /// be replaced between a check and the creation). The one thing removed first is a link
+    /// such as an earlier run that was killed leaves: dangling, to a pseudo-terminal (a path
+    /// like `target`'s, another number in the same place); anything else there, a dangling
+    /// link of the user's included, is an error.
     pub fn add(&mut self, link: &Path, target: &Path) -> Result<(), SimError> {
         let err = |source: io::Error| SimError::Link {
             path: link.display().to_string(),
@@ -249,11 +250,21 @@ impl Links {
         };
         if let Ok(meta) = std::fs::symlink_metadata(link) {
             let dangling = meta.file_type().is_symlink() && std::fs::metadata(link).is_err();
-            if !dangling {
+            let left_by_a_run =
+                dangling && std::fs::read_link(link).is_ok_and(|old| is_another_pty(&old, target));
+            if !left_by_a_run {
+                let what = if dangling {
+                    "a link of someone else's is there (not to a pseudo-terminal of an earlier \
+                     run)"
+                } else {
+                    "something is there already (not a link left by an earlier run)"
+                };
                 return Err(err(io::Error::new(
                     io::ErrorKind::AlreadyExists,
-                    "something is there already (not a link left by an earlier run): \
-                     choose another path, or a directory of your own with --link-dir",
+                    format!(
+                        "{what}: choose another path, or a directory of your own with \
+                         --link-dir"
+                    ),
                 )));
             }
             std::fs::remove_file(link).map_err(err)?;
@@ -262,6 +273,18 @@ impl Links {
         self.made.push((link.to_path_buf(), target.to_path_buf()));
         Ok(())
     }
+}
+
+/// Whether `old` names a pseudo-terminal the way `pty` does: in the same directory, the same
+/// name but for the number at its end (`/dev/pts/7` for `/dev/pts/3`, `/dev/ttys012` for
+/// `/dev/ttys004`).
+fn is_another_pty(old: &Path, pty: &Path) -> bool {
+    let split = |p: &Path| {
+        let name = p.file_name()?.to_str()?;
+        let stem = name.trim_end_matches(|c: char| c.is_ascii_digit());
+        (stem.len() < name.len()).then(|| (p.parent().map(Path::to_path_buf), stem.to_string()))
+    };
+    matches!((split(old), split(pty)), (Some(a), Some(b)) if a == b)
 }
 
 impl Drop for Links {
@@ -368,24 +391,54 @@ mod tests {
     #[test]
     fn links_replace_stale_ones_and_go_away() {
         let dir = tempfile::tempdir().unwrap();
+        // What a killed run leaves: a link to a pseudo-terminal that is gone.
         let link = dir.path().join("esc0");
-        std::os::unix::fs::symlink("/nonexistent", &link).unwrap();
+        std::os::unix::fs::symlink("/dev/pts/999999", &link).unwrap();
+        // A user's dangling link.
+        let theirs = dir.path().join("esc2");
+        std::os::unix::fs::symlink("/nonexistent", &theirs).unwrap();
         let file = dir.path().join("file");
         std::fs::write(&file, b"keep").unwrap();
         let mine = dir.path().join("mine");
         std::os::unix::fs::symlink(&file, &mine).unwrap();
+        let pty = Path::new("/dev/pts/3");
         {
             let mut links = Links::default();
-            links.add(&link, Path::new("/dev/null")).unwrap();
-            assert_eq!(std::fs::read_link(&link).unwrap(), Path::new("/dev/null"));
-            let e = links.add(&file, Path::new("/dev/null")).unwrap_err();
+            links.add(&link, pty).unwrap();
+            assert_eq!(std::fs::read_link(&link).unwrap(), pty);
+            let e = links.add(&file, pty).unwrap_err();
             assert!(e.to_string().contains("something is there already"), "{e}");
-            // A user's own link (to something that exists) is neither replaced nor removed.
-            let e = links.add(&mine, Path::new("/dev/null")).unwrap_err();
+            // A user's own link (to something that exists, or not) is neither replaced nor
+            // removed.
+            let e = links.add(&mine, pty).unwrap_err();
             assert!(e.to_string().contains("something is there already"), "{e}");
+            let e = links.add(&theirs, pty).unwrap_err();
+            assert!(e.to_string().contains("a link of someone else's"), "{e}");
         }
         assert!(std::fs::symlink_metadata(&link).is_err());
         assert_eq!(std::fs::read(&file).unwrap(), b"keep");
         assert_eq!(std::fs::read_link(&mine).unwrap(), file);
+        assert_eq!(
+            std::fs::read_link(&theirs).unwrap(),
+            Path::new("/nonexistent")
+        );
+    }
+
+    #[test]
+    fn pty_paths_are_told_by_their_place_and_stem() {
+        let yes = [("/dev/pts/7", "/dev/pts/3"), ("/dev/ttys012", "/dev/ttys4")];
+        for (old, pty) in yes {
+            assert!(is_another_pty(Path::new(old), Path::new(pty)), "{old}");
+        }
+        let no = [
+            ("/nonexistent", "/dev/pts/3"),
+            ("/dev/pts/x", "/dev/pts/3"),
+            ("/tmp/pts/7", "/dev/pts/3"),
+            ("/dev/ttyUSB0", "/dev/pts/3"),
+            ("esc", "/dev/pts/3"),
+        ];
+        for (old, pty) in no {
+            assert!(!is_another_pty(Path::new(old), Path::new(pty)), "{old}");
+        }
     }
 }

@@ -184,31 +184,22 @@ impl MavlinkTarget {
                 let Some(rest) = rest else {
                     return Ok(MavlinkTarget::Udp(DEFAULT_UDP));
                 };
-                if let Ok(port) = rest.parse::<u16>() {
-                    return Ok(MavlinkTarget::Udp(SocketAddr::new(
-                        Ipv4Addr::LOCALHOST.into(),
-                        port,
+                let addr = udp_address(rest, &bad)?;
+                if addr.port() == 0 {
+                    return Err(bad(
+                        "port 0 is no destination: give the port the ground station listens \
+                         on (14550 usually)"
+                            .to_string(),
+                    ));
+                }
+                if addr.ip().is_unspecified() {
+                    return Err(bad(format!(
+                        "{} is no destination address: give the ground station's address \
+                         (127.0.0.1 on this machine)",
+                        addr.ip()
                     )));
                 }
-                if let Ok(addr) = rest.parse::<SocketAddr>() {
-                    return Ok(MavlinkTarget::Udp(addr));
-                }
-                let Some((host, port)) = rest.rsplit_once(':') else {
-                    return Err(bad("expected udp:HOST:PORT".to_string()));
-                };
-                let port: u16 = port
-                    .parse()
-                    .map_err(|_| bad(format!("{port:?} is not a UDP port number")))?;
-                let addrs: Vec<SocketAddr> = (host, port)
-                    .to_socket_addrs()
-                    .map_err(|e| bad(format!("cannot resolve {host}: {e}")))?
-                    .collect();
-                addrs
-                    .iter()
-                    .find(|a| a.is_ipv4())
-                    .or(addrs.first())
-                    .map(|a| MavlinkTarget::Udp(*a))
-                    .ok_or_else(|| bad(format!("{host} has no address")))
+                Ok(MavlinkTarget::Udp(addr))
             }
             "serial" => {
                 let rest = rest
@@ -237,6 +228,36 @@ impl MavlinkTarget {
             )),
         }
     }
+}
+
+/// The address of `udp:REST`: `PORT` (on 127.0.0.1), `HOST:PORT` (a name resolved, IPv4
+/// preferred) or `[IPV6]:PORT`; `bad` makes the error.
+fn udp_address(
+    rest: &str,
+    bad: &impl Fn(String) -> OutputError,
+) -> Result<SocketAddr, OutputError> {
+    if let Ok(port) = rest.parse::<u16>() {
+        return Ok(SocketAddr::new(Ipv4Addr::LOCALHOST.into(), port));
+    }
+    if let Ok(addr) = rest.parse::<SocketAddr>() {
+        return Ok(addr);
+    }
+    let Some((host, port)) = rest.rsplit_once(':') else {
+        return Err(bad("expected udp:HOST:PORT".to_string()));
+    };
+    let port: u16 = port
+        .parse()
+        .map_err(|_| bad(format!("{port:?} is not a UDP port number")))?;
+    let addrs: Vec<SocketAddr> = (host, port)
+        .to_socket_addrs()
+        .map_err(|e| bad(format!("cannot resolve {host}: {e}")))?
+        .collect();
+    addrs
+        .iter()
+        .find(|a| a.is_ipv4())
+        .or(addrs.first())
+        .copied()
+        .ok_or_else(|| bad(format!("{host} has no address")))
 }
 
 impl fmt::Display for MavlinkTarget {

@@ -48,6 +48,9 @@ pub const NO_FRAMES_AFTER: Duration = Duration::from_secs(3);
 pub const SILENT_AFTER: Duration = Duration::from_secs(5);
 /// The size of the buffer in front of the file: far more than 50 ms of any number of ports.
 const BUFFER: usize = 1 << 16;
+/// How many names of a rotated series taken by other files are skipped at one rotation before
+/// the recording stops (something is making them as fast as they are tried).
+const MAX_TAKEN: usize = 1000;
 
 /// Arguments of `hwfoc record`.
 #[derive(Debug, clap::Args)]
@@ -171,6 +174,8 @@ pub struct Recorder {
     baud: u32,
     /// Files written, the current one last.
     files: Vec<String>,
+    /// The number of the next file of a rotated recording.
+    next_number: u32,
     /// The file being written; `None` after a rotation until there is something to write, so
     /// that a recording never ends with a file holding nothing.
     writer: Option<pcapng::Writer<BufWriter<File>>>,
@@ -282,6 +287,7 @@ impl Recorder {
             rotate_time: plan.rotate_time,
             baud: plan.baud,
             files: vec![first],
+            next_number: 2,
             writer: Some(writer),
             file_has_packets: false,
             file_started: now,
@@ -481,12 +487,31 @@ impl Recorder {
     }
 
     /// Creates the next file of a rotated recording, with the headers again and a note for
-    /// each port that is lost at the moment.
+    /// each port that is lost at the moment. A file of the next name that is there already
+    /// (the series' files were checked at the start: it is another program's) is left alone
+    /// and the recording goes on under the next free name, with a warning.
     fn next_file(&mut self) -> Result<pcapng::Writer<BufWriter<File>>, CliError> {
-        let next = numbered(&self.base, self.files.len() as u32 + 1);
         let names: Vec<String> = self.ports.iter().map(|p| p.name.clone()).collect();
-        // The series' files were checked at the start: one there now is another program's.
-        let mut writer = create(&next, &names, self.baud, false)?;
+        let mut taken = Vec::new();
+        let (next, mut writer) = loop {
+            let next = numbered(&self.base, self.next_number);
+            self.next_number += 1;
+            match create(&next, &names, self.baud, false) {
+                Ok(writer) => break (next, writer),
+                Err(CliError::Write(WriteError::Exists { .. })) if taken.len() < MAX_TAKEN => {
+                    taken.push(next);
+                }
+                Err(e) => return Err(e),
+            }
+        };
+        if !taken.is_empty() && self.warn {
+            eprintln!(
+                "hwfoc: warning: {} appeared meanwhile and {} left alone; the recording goes on \
+                 in {next}",
+                taken.join(", "),
+                if taken.len() == 1 { "is" } else { "are" }
+            );
+        }
         self.files.push(next);
         self.file_started = Instant::now();
         self.file_has_packets = false;

@@ -49,14 +49,19 @@ pub struct DecodeArgs {
 
 /// Runs `hwfoc decode`.
 pub fn run(args: &DecodeArgs) -> Result<(), CliError> {
-    let (_, settings_map) = args.settings.settings_map()?;
+    let (config, settings_map) = args.settings.settings_map()?;
     let settings = *settings_map.default_settings();
     let overrides = overrides(&settings_map);
     let selection = args.select.selection()?;
-    if let Some(output) = &args.output {
-        args.input.refuse_output(output)?;
-    }
-    let mut sources = Sources::new(args.input.open_all()?, settings_map);
+    args.input
+        .refuse_output(args.output.as_deref().unwrap_or("-"), &config)?;
+    // Ctrl-C and SIGTERM abandon an export of files read to their end, leaving any earlier
+    // file at the output as it was. Live inputs keep the signals' usual meaning: serial ports
+    // end their input on them, and what they gave is written; a pipe or a terminal on standard
+    // input ends the process (its export stays in the temporary file).
+    let stop = read_to_end(&args.input).then(hwfoc_io::stop::interrupted);
+    let inputs = args.input.open_all()?;
+    let mut sources = Sources::new(inputs, settings_map);
     if selection.window.is_limited() {
         sources.require_timing()?;
         args.select.check_clocks(&sources)?;
@@ -76,6 +81,9 @@ pub fn run(args: &DecodeArgs) -> Result<(), CliError> {
     keep_freed_memory();
     let mut export =
         Export::create(format, args.output.as_deref(), provenance)?.select(selection.clone());
+    if let Some(stop) = stop {
+        export = export.stop_on(stop);
+    }
     let result = sources.run(&mut export);
     let (kept, span) = (export.kept(), export.span());
     // Whatever was decoded before an input error is still written out.
@@ -92,6 +100,33 @@ pub fn run(args: &DecodeArgs) -> Result<(), CliError> {
         );
     }
     Ok(())
+}
+
+/// Whether every input is read to its end: regular files (standard input included), or the
+/// demo; not serial ports, pipes or terminals.
+fn read_to_end(input: &InputArgs) -> bool {
+    input.inputs.iter().all(|spec| {
+        let meta = if spec == "-" {
+            stdin_metadata()
+        } else {
+            std::fs::metadata(spec).ok()
+        };
+        meta.is_some_and(|m| m.is_file())
+    })
+}
+
+/// What standard input is.
+#[cfg(unix)]
+fn stdin_metadata() -> Option<std::fs::Metadata> {
+    use std::os::fd::AsFd;
+    let fd = std::io::stdin().as_fd().try_clone_to_owned().ok()?;
+    std::fs::File::from(fd).metadata().ok()
+}
+
+/// What standard input is (not looked at elsewhere: taken as live).
+#[cfg(not(unix))]
+fn stdin_metadata() -> Option<std::fs::Metadata> {
+    None
 }
 
 /// The entries by port and by ESC of `map`, named as in the configuration file (`port."NAME"`,

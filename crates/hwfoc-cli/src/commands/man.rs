@@ -3,11 +3,11 @@
 //! behind `--help`.
 
 use std::fs;
-use std::io;
+use std::io::{self, Write};
 use std::path::{Path, PathBuf};
 
 use clap::Args;
-use hwfoc_io::write::WriteError;
+use hwfoc_io::write::{Staging, WriteError};
 
 use crate::error::CliError;
 use crate::output::Output;
@@ -63,7 +63,8 @@ fn add_pages(command: &clap::Command, pages: &mut Vec<(String, Vec<u8>)>) -> io:
     Ok(())
 }
 
-/// Writes each page into `dir`, each file as `NAME.partial` renamed into place when complete.
+/// Writes each page into `dir`, each through a temporary file (a [`Staging`]) renamed into
+/// place when complete.
 fn write_pages(dir: &Path, pages: Vec<(String, Vec<u8>)>) -> Result<(), CliError> {
     let shown = dir.display().to_string();
     fs::create_dir_all(dir).map_err(|source| WriteError::Create {
@@ -72,14 +73,12 @@ fn write_pages(dir: &Path, pages: Vec<(String, Vec<u8>)>) -> Result<(), CliError
     })?;
     for (name, text) in pages {
         let path = dir.join(&name);
-        let partial = dir.join(format!("{name}.partial"));
-        let shown = path.display().to_string();
-        fs::write(&partial, text)
-            .and_then(|()| fs::rename(&partial, &path))
-            .map_err(|source| {
-                let _ = fs::remove_file(&partial);
-                write_error(&shown, source)
-            })?;
+        let written = Staging::create(&path).and_then(|(staging, mut file)| {
+            file.write_all(&text)?;
+            drop(file);
+            staging.commit()
+        });
+        written.map_err(|source| write_error(&path.display().to_string(), source))?;
     }
     Ok(())
 }
@@ -123,12 +122,22 @@ mod tests {
         assert!(decode.contains("The format."), "{decode}");
     }
 
-    /// The pages land in the directory, made if missing, with no partial file left over.
+    /// The pages land in the directory, made if missing, with no partial file left over; a
+    /// link at the name a partial file once had is not followed.
     #[test]
     fn pages_are_written_into_the_directory() {
         let dir = tempfile::tempdir().unwrap();
         let out = dir.path().join("man1");
         write_pages(&out, pages(tool()).unwrap()).unwrap();
+        #[cfg(unix)]
+        {
+            let victim = dir.path().join("victim");
+            fs::write(&victim, "mine").unwrap();
+            std::os::unix::fs::symlink(&victim, out.join("tool.1.partial")).unwrap();
+            write_pages(&out, pages(tool()).unwrap()).unwrap();
+            assert_eq!(fs::read_to_string(&victim).unwrap(), "mine");
+            fs::remove_file(out.join("tool.1.partial")).unwrap();
+        }
         let mut names: Vec<String> = fs::read_dir(&out)
             .unwrap()
             .map(|e| e.unwrap().file_name().into_string().unwrap())

@@ -27,12 +27,12 @@ pub struct SummaryArgs {
 
 /// Runs `hwfoc summary`.
 pub fn run(args: &SummaryArgs) -> Result<(), CliError> {
-    let (_, settings_map) = args.settings.settings_map()?;
+    let (config, settings_map) = args.settings.settings_map()?;
     let settings = *settings_map.default_settings();
     // The plot's file is opened first: a wrong name is reported before the inputs are read.
     let mut plot = match &args.plot {
         Some(path) => {
-            args.input.refuse_output(path)?;
+            args.input.refuse_output(path, &config)?;
             Some(plot::Alongside::open(path, settings)?)
         }
         None => None,

@@ -17,7 +17,7 @@ use std::path::{Path, PathBuf};
 use clap::{Args, Subcommand};
 
 use crate::error::CliError;
-use hwfoc_io::write::WriteError;
+use hwfoc_io::write::{Staging, WriteError};
 
 /// The dissector's source.
 pub const DISSECTOR: &str = include_str!("../../wireshark/hwfoc.lua");
@@ -143,7 +143,7 @@ pub enum Installed {
 }
 
 /// Installs `source` as `dir/hwfoc.lua`: creates `dir`, refuses to replace a different file
-/// unless `force`, writes through a temporary file renamed over the target.
+/// unless `force`, writes through a temporary file renamed over the target (a [`Staging`]).
 pub fn install(dir: &Path, source: &str, force: bool) -> Result<Installed, WiresharkError> {
     let target = dir.join(FILE_NAME);
     match std::fs::read(&target) {
@@ -156,22 +156,13 @@ pub fn install(dir: &Path, source: &str, force: bool) -> Result<Installed, Wires
         move |source| WiresharkError::Write { path, source }
     };
     std::fs::create_dir_all(dir).map_err(fail(dir))?;
-    let tmp = dir.join(format!(".{FILE_NAME}.{}.partial", std::process::id()));
-    let written = (|| {
-        let mut file = std::fs::OpenOptions::new()
-            .write(true)
-            .create_new(true)
-            .open(&tmp)?;
+    let written = Staging::create(&target).and_then(|(staging, mut file)| {
         file.write_all(source.as_bytes())?;
-        file.sync_all()
-    })();
-    if let Err(e) = written.and_then(|()| std::fs::rename(&tmp, &target)) {
-        let _ = std::fs::remove_file(&tmp);
-        return Err(WiresharkError::Write {
-            path: target,
-            source: e,
-        });
-    }
+        file.sync_all()?;
+        drop(file);
+        staging.commit()
+    });
+    written.map_err(fail(&target))?;
     Ok(Installed::Written)
 }
 

@@ -24,13 +24,17 @@
 pub mod arrow;
 mod file;
 pub(crate) mod parquet;
+mod staging;
 mod text;
+
+pub use staging::{PARTIAL_SUFFIX, Staging};
 
 use std::fmt;
 use std::fs::File;
 use std::io::{self, Write};
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc::{Receiver, SyncSender, sync_channel};
 use std::thread::JoinHandle;
 
@@ -154,8 +158,10 @@ pub struct Export {
     kept: u64,
     /// Earliest and latest `t_s` of the selected ESCs' data frames, in the window or not.
     span: Option<(f64, f64)>,
-    /// The output file while it is written under its partial name.
-    staged: Option<Staged>,
+    /// The output file while it is written under its temporary name.
+    staged: Option<Staging>,
+    /// When set (Ctrl-C, SIGTERM), the export is abandoned: see [`Export::stop_on`].
+    stop: Option<Arc<AtomicBool>>,
     /// The settings of ESCs without settings of their own ([`Provenance::settings`]).
     default: Settings,
     /// The settings of each ESC, once one ESC's differ from `default`.
@@ -193,23 +199,11 @@ pub(crate) struct Destination {
     pub writer: Box<dyn Write + Send>,
 }
 
-/// A file written under a temporary name beside its final one, renamed into place when
-/// complete: an export cut short (killed, or the machine lost) leaves the earlier file at the
-/// path untouched, and at most the clearly named partial file.
-#[derive(Debug, Clone)]
-struct Staged {
-    partial: PathBuf,
-    path: PathBuf,
-}
-
-/// The suffix of an export's file while it is being written.
-pub const PARTIAL_SUFFIX: &str = ".partial";
-
 impl Destination {
-    /// Opens the output: standard output for `None` or `-`; a new or regular file under its
-    /// partial name (returned, to be renamed once complete); anything else (a device such as
-    /// `/dev/null`, a pipe) as it is.
-    fn open(path: Option<&str>) -> Result<(Destination, Option<Staged>), WriteError> {
+    /// Opens the output: standard output for `None` or `-`; a new or regular file under a
+    /// temporary name (see [`Staging`]), renamed over it once complete; anything else (a device
+    /// such as `/dev/null`, a pipe) as it is.
+    fn open(path: Option<&str>) -> Result<(Destination, Option<Staging>), WriteError> {
         let Some(path) = path.filter(|&p| p != "-") else {
             let stdout = Destination {
                 name: "standard output".to_string(),
@@ -217,36 +211,19 @@ impl Destination {
             };
             return Ok((stdout, None));
         };
-        let create = |target: &Path| {
-            File::create(target).map_err(|source| WriteError::Create {
-                output: path.to_string(),
-                source,
-            })
+        let create_error = |source| WriteError::Create {
+            output: path.to_string(),
+            source,
         };
         let special = std::fs::metadata(path).is_ok_and(|m| !m.is_file() && !m.is_dir());
         let (file, staged) = if special {
-            (create(Path::new(path))?, None)
+            (File::create(path).map_err(create_error)?, None)
         } else {
             if Path::new(path).is_dir() {
-                return Err(WriteError::Create {
-                    output: path.to_string(),
-                    source: io::ErrorKind::IsADirectory.into(),
-                });
+                return Err(create_error(io::ErrorKind::IsADirectory.into()));
             }
-            // Through a link, the file it points to is replaced, not the link.
-            let target = match std::fs::symlink_metadata(path) {
-                Ok(m) if m.file_type().is_symlink() => {
-                    std::fs::canonicalize(path).unwrap_or_else(|_| PathBuf::from(path))
-                }
-                _ => PathBuf::from(path),
-            };
-            let mut partial = target.clone().into_os_string();
-            partial.push(PARTIAL_SUFFIX);
-            let staged = Staged {
-                partial: PathBuf::from(partial),
-                path: target,
-            };
-            (create(&staged.partial)?, Some(staged))
+            let (staging, file) = Staging::create(Path::new(path)).map_err(create_error)?;
+            (file, Some(staging))
         };
         let destination = Destination {
             name: path.to_string(),
@@ -315,6 +292,7 @@ impl Export {
             kept: 0,
             span: None,
             staged,
+            stop: None,
             default,
             table: None,
             escs: [EscState::New; 256],
@@ -333,6 +311,33 @@ impl Export {
         }
         self.selection = selection;
         self
+    }
+
+    /// Abandons the export once `flag` is set (by Ctrl-C or SIGTERM: see
+    /// [`crate::stop::interrupted`]): the next batch's end fails with
+    /// [`WriteError::Interrupted`], and [`Export::finish`] then removes the temporary file,
+    /// leaving any earlier file at the path as it was. For inputs that are read to their end;
+    /// live ports end their input on the signal, and what they gave is kept.
+    pub fn stop_on(mut self, flag: Arc<AtomicBool>) -> Export {
+        self.stop = Some(flag);
+        self
+    }
+
+    /// Whether the export was asked to stop (see [`Export::stop_on`]).
+    fn stopped(&self) -> bool {
+        self.stop
+            .as_ref()
+            .is_some_and(|f| f.load(Ordering::Relaxed))
+    }
+
+    /// The error of an abandoned export.
+    fn interrupted(&self) -> WriteError {
+        WriteError::Interrupted {
+            output: self
+                .staged
+                .as_ref()
+                .map(|s| s.target().display().to_string()),
+        }
     }
 
     /// Records written so far.
@@ -394,6 +399,9 @@ impl Export {
     /// Hands the rows collected so far to the writer once there are enough of them, or at once
     /// when `live` (the rows are then written and flushed without waiting for more).
     pub fn end_batch(&mut self, live: bool) -> Result<(), WriteError> {
+        if self.stopped() {
+            return Err(self.interrupted());
+        }
         if self.chunk.len() >= CHUNK_ROWS || (live && !self.chunk.is_empty()) {
             self.send(live, false)?;
         }
@@ -455,9 +463,12 @@ impl Export {
     /// Writes the remaining rows and ends the output: flushes text, closes a Parquet file
     /// (adding `metadata` to its key-value metadata, and `esc_settings` when some ESC's rows
     /// were converted under settings of their own: see [`esc_settings_json`]), and renames a
-    /// file written under its partial name into place. On a write error the partial file is
-    /// removed.
+    /// file written under its temporary name into place. On a write error, or when the export
+    /// was asked to stop ([`Export::stop_on`]), the temporary file is removed instead.
     pub fn finish(mut self, mut metadata: Vec<(String, String)>) -> Result<(), WriteError> {
+        if self.stopped() {
+            return Err(self.interrupted());
+        }
         let escs = self.esc_settings();
         if !escs.is_empty() {
             metadata.push(("esc_settings".to_string(), esc_settings_json(&escs)));
@@ -472,14 +483,14 @@ impl Export {
         let Some(staged) = self.staged.take() else {
             return written;
         };
-        if written.is_err() {
-            let _ = std::fs::remove_file(&staged.partial);
-            return written;
+        written?;
+        if self.stopped() {
+            return Err(self.interrupted());
         }
-        std::fs::rename(&staged.partial, &staged.path).map_err(|source| WriteError::Write {
-            output: staged.path.display().to_string(),
-            source,
-        })
+        let output = staged.target().display().to_string();
+        staged
+            .commit()
+            .map_err(|source| WriteError::Write { output, source })
     }
 
     fn join(&mut self) -> Result<(), WriteError> {
@@ -629,6 +640,11 @@ pub enum WriteError {
         /// The file as named.
         output: String,
     },
+    /// Ctrl-C or SIGTERM stopped the export before it was complete (see [`Export::stop_on`]).
+    Interrupted {
+        /// The file left as it was, if the output is one.
+        output: Option<String>,
+    },
     /// The output is one of the inputs (the same file, by whatever path): writing it would
     /// destroy the input.
     IsInput {
@@ -639,28 +655,91 @@ pub enum WriteError {
     },
 }
 
-/// Refuses an output file that is one of `inputs` (the same file, by device and inode: the
-/// same path, `./` before it, a link to it), before anything is opened for writing.
+/// Refuses an output that is one of `inputs`, every file the command reads (the same file, by
+/// device and inode: the same path, `./` before it, a link to it), before anything is opened
+/// for writing. An input `-` is standard input, whatever file is behind it (`< r1.bin`); the
+/// output `-` is standard output, refused when it is a regular file that is an input
+/// (`>> r1.bin`).
 pub fn refuse_input<'a>(
     output: &str,
-    inputs: impl IntoIterator<Item = &'a str>,
+    inputs: impl IntoIterator<Item = &'a Path>,
 ) -> Result<(), WriteError> {
-    if output == "-" {
+    let written = if output == "-" {
+        identity(Named::Stdout)
+    } else {
+        identity(Named::Path(Path::new(output)))
+    };
+    let Some(written) = written else {
         return Ok(());
-    }
-    match inputs.into_iter().find(|&input| same_file(output, input)) {
+    };
+    let clash = inputs.into_iter().find(|input| {
+        let read = match input.as_os_str().to_str() {
+            Some("-") => Named::Stdin,
+            _ => Named::Path(input),
+        };
+        identity(read) == Some(written)
+    });
+    match clash {
         Some(input) => Err(WriteError::IsInput {
-            output: output.to_string(),
-            input: input.to_string(),
+            output: match output {
+                "-" => "standard output".to_string(),
+                _ => output.to_string(),
+            },
+            input: match input.as_os_str().to_str() {
+                Some("-") => "standard input".to_string(),
+                _ => input.display().to_string(),
+            },
         }),
         None => Ok(()),
     }
 }
 
+/// A file by name, or a standard stream by its descriptor.
+#[derive(Clone, Copy)]
+enum Named<'a> {
+    Path(&'a Path),
+    Stdin,
+    Stdout,
+}
+
+/// What tells an existing file from any other: its device and inode (on Unix); `None` for a
+/// file that does not exist, and for standard output unless it is a regular file.
+#[cfg(unix)]
+fn identity(file: Named<'_>) -> Option<(u64, u64)> {
+    use std::os::fd::AsFd;
+    use std::os::unix::fs::MetadataExt;
+    let fstat = |fd: std::os::fd::BorrowedFd<'_>| {
+        let stat = nix::sys::stat::fstat(fd).ok()?;
+        Some((stat.st_dev as u64, stat.st_ino as u64, stat.st_mode))
+    };
+    match file {
+        Named::Path(path) => std::fs::metadata(path).ok().map(|m| (m.dev(), m.ino())),
+        Named::Stdin => fstat(io::stdin().as_fd()).map(|(dev, ino, _)| (dev, ino)),
+        Named::Stdout => fstat(io::stdout().as_fd())
+            .filter(|&(_, _, mode)| mode & libc::S_IFMT == libc::S_IFREG)
+            .map(|(dev, ino, _)| (dev, ino)),
+    }
+}
+
+/// Elsewhere, files by their canonical path; the standard streams are not compared.
+#[cfg(not(unix))]
+fn identity(file: Named<'_>) -> Option<std::path::PathBuf> {
+    match file {
+        Named::Path(path) => std::fs::canonicalize(path).ok(),
+        Named::Stdin | Named::Stdout => None,
+    }
+}
+
+/// Whether two paths name one existing file (by device and inode, on Unix).
+pub fn same_file(a: impl AsRef<Path>, b: impl AsRef<Path>) -> bool {
+    let a = identity(Named::Path(a.as_ref()));
+    a.is_some() && a == identity(Named::Path(b.as_ref()))
+}
+
 /// Creates the file `path` for writing, empty. An existing file is [`WriteError::Exists`]
 /// unless `overwrite` (then it is truncated): recordings and simulated files are never written
 /// over unasked. The check and the creation are one step, so no file can appear between them.
-/// (Exports do not come here: they are written under a partial name and renamed into place.)
+/// (Exports do not come here: they are written under a temporary name and renamed into place.)
 pub fn create_file(path: &str, overwrite: bool) -> Result<File, WriteError> {
     std::fs::OpenOptions::new()
         .write(true)
@@ -679,26 +758,6 @@ pub fn create_file(path: &str, overwrite: bool) -> Result<File, WriteError> {
         })
 }
 
-/// Whether two paths name one existing file (by device and inode, on Unix).
-pub fn same_file(a: &str, b: &str) -> bool {
-    let (Ok(ma), Ok(mb)) = (std::fs::metadata(a), std::fs::metadata(b)) else {
-        return false;
-    };
-    #[cfg(unix)]
-    {
-        use std::os::unix::fs::MetadataExt;
-        ma.dev() == mb.dev() && ma.ino() == mb.ino()
-    }
-    #[cfg(not(unix))]
-    {
-        let _ = (ma, mb);
-        matches!(
-            (std::fs::canonicalize(a), std::fs::canonicalize(b)),
-            (Ok(x), Ok(y)) if x == y
-        )
-    }
-}
-
 impl WriteError {
     /// Whether this is the reader of the output going away (`hwfoc decode … | head`): not an
     /// error worth reporting.
@@ -715,6 +774,13 @@ impl fmt::Display for WriteError {
                 f,
                 "{output} exists and is never overwritten unasked: choose another name, or pass \
                  --overwrite"
+            ),
+            WriteError::Interrupted { output: None } => write!(f, "interrupted"),
+            WriteError::Interrupted {
+                output: Some(output),
+            } => write!(
+                f,
+                "interrupted: {output} is left as it was (the incomplete export is removed)"
             ),
             WriteError::IsInput { output, input } => write!(
                 f,
@@ -750,7 +816,9 @@ impl std::error::Error for WriteError {
     fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
         match self {
             WriteError::Write { source, .. } | WriteError::Create { source, .. } => Some(source),
-            WriteError::IsInput { .. } | WriteError::Exists { .. } => None,
+            WriteError::IsInput { .. }
+            | WriteError::Exists { .. }
+            | WriteError::Interrupted { .. } => None,
         }
     }
 }
@@ -761,6 +829,7 @@ mod tests {
     use crate::input::Input;
     use crate::settings::SettingsMap;
     use crate::sources::Sources;
+    use std::path::PathBuf;
 
     /// Ports named `p0`, `p1`, ...: frames of raw eRPM 70 (700 eRPM) and raw current 819 each.
     fn inputs(ports: usize, frames: u16) -> Vec<Input> {

@@ -363,8 +363,10 @@ impl Session {
         self.notice = Some(format!("recording stopped: {e}"));
     }
 
-    /// Starts recording to `path`.
+    /// Starts recording to `path` (never the configuration file read, even with
+    /// `--overwrite`).
     pub fn start_recording(&mut self, path: String) -> Result<(), CliError> {
+        hwfoc_io::write::refuse_input(&path, self.config_file.as_deref())?;
         let plan = capture::Plan {
             output: path.clone(),
             rotate_size: None,

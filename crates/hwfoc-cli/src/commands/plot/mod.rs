@@ -75,12 +75,12 @@ pub struct Options {
 
 /// `hwfoc plot`: reads the inputs and writes the image.
 pub fn run(args: &PlotArgs) -> Result<(), CliError> {
-    let (_, settings_map) = args.settings.settings_map()?;
+    let (config, settings_map) = args.settings.settings_map()?;
     let settings = *settings_map.default_settings();
     let selection = args.select.selection()?;
     // Opened first, so that a wrong name is reported before the inputs are read; a file
     // created here is removed again if the plot is not written.
-    args.input.refuse_output(&args.output)?;
+    args.input.refuse_output(&args.output, &config)?;
     let mut target = Target::open(&args.output)?;
     let options = Options {
         width: args.width,

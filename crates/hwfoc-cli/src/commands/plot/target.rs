@@ -3,10 +3,10 @@
 
 use std::fs::{self, File};
 use std::io::{self, Write};
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use crate::error::CliError;
-use hwfoc_io::write::WriteError;
+use hwfoc_io::write::{Staging, WriteError};
 
 /// What the image is written as.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -31,23 +31,21 @@ impl ImageFormat {
     }
 }
 
-/// The image file: written under its partial name (`FILE.partial`, made when the target is
+/// The image file: written under a temporary name (a [`Staging`], made when the target is
 /// opened, so that an unwritable place is reported at once) and renamed into place once the
-/// image is complete. An existing file stays as it was until then; the partial file is removed
-/// if nothing is written.
+/// image is complete. An existing file stays as it was until then; the temporary file is
+/// removed if nothing is written.
 #[derive(Debug)]
 pub struct Target {
     path: String,
     format: ImageFormat,
-    /// The file replaced: the path, or the file a link at the path points to.
-    target: PathBuf,
-    partial: PathBuf,
-    file: Option<File>,
+    /// The temporary file, until the image is written.
+    staging: Option<(Staging, File)>,
 }
 
 impl Target {
     /// Checks the name's format, refuses anything but a (new or) regular file, and creates the
-    /// partial file.
+    /// temporary file.
     pub fn open(path: &str) -> Result<Target, CliError> {
         let format = ImageFormat::from_name(path).ok_or_else(|| CliError::Usage {
             option: format!("-o {path}"),
@@ -70,18 +68,11 @@ impl Target {
             }
             _ => {}
         }
-        // Through a link, the file it points to is replaced, not the link.
-        let target = fs::canonicalize(path).unwrap_or_else(|_| PathBuf::from(path));
-        let mut partial = target.clone().into_os_string();
-        partial.push(hwfoc_io::write::PARTIAL_SUFFIX);
-        let partial = PathBuf::from(partial);
-        let file = File::create(&partial).map_err(create)?;
+        let (staging, file) = Staging::create(Path::new(path)).map_err(create)?;
         Ok(Target {
             path: path.to_string(),
             format,
-            target,
-            partial,
-            file: Some(file),
+            staging: Some((staging, file)),
         })
     }
 
@@ -95,29 +86,20 @@ impl Target {
         self.format
     }
 
-    /// Writes `bytes` as the file's content: to the partial file, then renamed into place.
+    /// Writes `bytes` as the file's content: to the temporary file, then renamed into place.
     pub fn write(&mut self, bytes: &[u8]) -> Result<(), CliError> {
         let error = |source| WriteError::Write {
             output: self.path.clone(),
             source,
         };
-        let Some(mut file) = self.file.take() else {
+        let Some((staging, mut file)) = self.staging.take() else {
             return Err(error(io::Error::other("the image was written already")).into());
         };
         file.write_all(bytes)
             .and_then(|()| file.flush())
             .map_err(error)?;
         drop(file);
-        fs::rename(&self.partial, &self.target).map_err(error)?;
+        staging.commit().map_err(error)?;
         Ok(())
-    }
-}
-
-impl Drop for Target {
-    /// Removes the partial file if the image was not written.
-    fn drop(&mut self) {
-        if self.file.is_some() {
-            let _ = fs::remove_file(&self.partial);
-        }
     }
 }

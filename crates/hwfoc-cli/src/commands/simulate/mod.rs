@@ -340,9 +340,20 @@ fn usage(option: &str, message: impl Into<String>) -> CliError {
 
 /// Runs `hwfoc simulate`.
 pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
-    let settings = args.settings.settings()?;
+    let config = args.settings.config()?;
+    let settings = config.settings(&args.settings)?;
     let n = count_escs(args)?;
     let plan = plan(args, n, settings)?;
+    // The files read: the profile and the configuration.
+    let profile = match &args.model.profile {
+        ProfileSpec::Csv(path) => Some(std::path::PathBuf::from(path)),
+        _ => None,
+    };
+    let reads: Vec<std::path::PathBuf> = profile
+        .into_iter()
+        .chain(crate::args::config_read(&config))
+        .collect();
+    refuse_clashes(&plan, n, &reads)?;
     let fleet = args.model.fleet(n, args.baud, &settings)?;
     let session = Session::open(fleet, &plan)?;
     if args.pty {
@@ -407,18 +418,6 @@ fn plan(args: &SimulateArgs, n: usize, settings: Settings) -> Result<Plan, CliEr
             },
         }
     };
-    if let (Outlet::File { path, .. }, Some(truth)) = (&outlet, &args.truth) {
-        // The ground truth must not land on (and destroy) one of the recordings, or they on it.
-        let clash = (0..n)
-            .map(|esc| expand(path, esc))
-            .find(|out| out == truth || hwfoc_io::write::same_file(out, truth));
-        if let Some(out) = clash {
-            return Err(usage(
-                "--truth",
-                format!("{truth} is also the output -o {out}: choose another file for either"),
-            ));
-        }
-    }
     let plan = Plan {
         outlet,
         realtime: args.realtime,
@@ -464,6 +463,49 @@ fn plan(args: &SimulateArgs, n: usize, settings: Settings) -> Result<Plan, CliEr
         _ => {}
     }
     Ok(plan)
+}
+
+/// Refuses output files that would destroy a file read (`reads`: the profile, the
+/// configuration) or each other's data: `--overwrite` is for earlier outputs, never for
+/// inputs, and two outputs that are one file (the same name, or a link) would mix or lose
+/// an ESC's bytes.
+fn refuse_clashes(plan: &Plan, n: usize, reads: &[std::path::PathBuf]) -> Result<(), CliError> {
+    let mut outputs: Vec<(&str, String)> = Vec::new();
+    if let Outlet::File { path, .. } = &plan.outlet {
+        if path.contains("{esc}") {
+            outputs.extend((0..n).map(|esc| ("-o", expand(path, esc))));
+        } else {
+            outputs.push(("-o", path.clone()));
+        }
+    }
+    if let Some(truth) = &plan.truth {
+        outputs.push(("--truth", truth.clone()));
+    }
+    for (i, (option, out)) in outputs.iter().enumerate() {
+        hwfoc_io::write::refuse_input(out, reads.iter().map(std::path::PathBuf::as_path))?;
+        let earlier = outputs[..i]
+            .iter()
+            .find(|(_, o)| o == out || hwfoc_io::write::same_file(o, out));
+        match earlier {
+            // The ground truth must not land on (and destroy) one of the recordings.
+            Some((_, first)) if *option == "--truth" => {
+                return Err(usage(
+                    "--truth",
+                    format!("{out} is also the output -o {first}: choose another file for either"),
+                ));
+            }
+            Some((_, first)) => {
+                return Err(usage(
+                    "-o",
+                    format!(
+                        "{first} and {out} are the same file: each ESC needs a file of its own"
+                    ),
+                ));
+            }
+            None => {}
+        }
+    }
+    Ok(())
 }
 
 /// Prints `esc N: PATH` for each pseudo-terminal.
