@@ -750,3 +750,50 @@ fn the_dashboard_at_80_by_24_is_readable() {
     assert!(pane.contains("hwfoc: recorded to"), "{pane}");
     assert!(pane.contains("hwfoc/recordings/hwfoc-"), "{pane}");
 }
+
+/// An idle ESC's current sensor reads -1 LSB (the simulator's ESC 1 does, as a real XRotor
+/// does): its power is a few tenths of a watt below zero. The text shows `0 W`, `0.0 mAh` and
+/// `0.00 Wh`, never `-0`, and a peak of power drawn is never below zero.
+#[test]
+fn an_idle_esc_shows_no_negative_zero_and_no_negative_peak() {
+    let run = |mode: &str| {
+        ok(hwfoc()
+            .args([
+                "monitor",
+                "--sim",
+                "2",
+                mode,
+                "--no-config",
+                "--interval",
+                "0.5",
+                "--duration",
+                "2.2",
+            ])
+            .output()
+            .expect("spawn"))
+    };
+    let plain = String::from_utf8(run("--plain").stdout).unwrap();
+    assert!(plain.contains(" esc1 "), "{plain}");
+    for word in plain.split_whitespace() {
+        let digits = word.trim_start_matches('-');
+        assert!(
+            !(word.starts_with('-')
+                && !digits.is_empty()
+                && digits.bytes().all(|b| b == b'0' || b == b'.')),
+            "negative zero {word:?} in {plain}"
+        );
+    }
+    let json = String::from_utf8(run("--json").stdout).unwrap();
+    let mut negative_current = false;
+    for line in json.lines() {
+        let v: Value = serde_json::from_str(line).unwrap();
+        if let Some(i) = v["record"]["current_a"].as_f64() {
+            negative_current |= i < 0.0;
+        }
+        if let Some(peak) = v["energy"]["peak_power_w"].as_f64() {
+            assert!(peak >= 0.0, "{line}");
+        }
+    }
+    // The case the test is about: an ESC that reported a negative current.
+    assert!(negative_current, "{json}");
+}

@@ -27,6 +27,7 @@
 pub mod clock;
 pub mod energy;
 pub mod episode;
+pub mod fixed;
 pub mod handler;
 pub mod input;
 pub mod notice;
