@@ -61,11 +61,11 @@ def spark_schema(path_column: Optional[str] = None, frame_column: Optional[str] 
     return T.StructType(fields)
 
 
-def _records(batches: Iterator[pa.RecordBatch], column: str, path_column: Optional[str], frame_column: Optional[str], options: dict) -> Iterator[pa.RecordBatch]:
+def _records(batches: Iterator[pa.RecordBatch], column: str, name_column: str, path_column: Optional[str], frame_column: Optional[str], options: dict) -> Iterator[pa.RecordBatch]:
     schema = arrow_schema(path_column, frame_column, **_settings(options))
     for batch in batches:
-        for path in batch.column(column).to_pylist():
-            table = add_columns(hwfoc.read(path, **options), path, path_column, frame_column)
+        for path, name in zip(batch.column(column).to_pylist(), batch.column(name_column).to_pylist()):
+            table = add_columns(hwfoc.read(path, **options), name, path_column, frame_column)
             for b in table.cast(schema).to_batches(max_chunksize=1 << 16):
                 yield b
 
@@ -85,14 +85,19 @@ def read(
     """A Spark DataFrame of the records of recordings, one partition per file (a glob pattern
     is expanded on the driver, see :func:`hwfoc.dask.paths`). ``path_column``,
     ``frame_column`` and ``options`` as :func:`hwfoc.dask.read`. Errors surface when an action
-    runs, as the Python worker's :class:`hwfoc.HwfocError` with the command's message."""
-    files: List[str] = [os.path.abspath(p) for p in _paths(paths_or_glob)]
-    column = "_hwfoc_path"
-    listing = spark.createDataFrame([(p,) for p in files], f"{column} string").repartition(len(files), column)
+    runs, as the Python worker's :class:`hwfoc.HwfocError` with the command's message.
+    The workers read each file by its absolute path (they may run elsewhere than the
+    driver's working directory); ``path_column`` names it as given, as :func:`hwfoc.dask.read`
+    does."""
+    names: List[str] = _paths(paths_or_glob)
+    column, name_column = "_hwfoc_path", "_hwfoc_name"
+    listing = spark.createDataFrame(
+        [(os.path.abspath(p), p) for p in names], f"{column} string, {name_column} string"
+    ).repartition(len(names), column)
     schema = spark_schema(path_column, frame_column, **_settings(options))
 
     def records(batches: Iterator[pa.RecordBatch]) -> Iterator[pa.RecordBatch]:
-        return _records(batches, column, path_column, frame_column, options)
+        return _records(batches, column, name_column, path_column, frame_column, options)
 
     return listing.mapInArrow(records, schema)
 

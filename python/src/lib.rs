@@ -177,6 +177,19 @@ pub(crate) fn no_frames(sources: &Sources) -> Vec<String> {
         .collect()
 }
 
+/// The command's warning for a time window that held no frame, if `collect`'s did not.
+pub(crate) fn empty_window<F>(
+    collect: &Collect<F>,
+    options: &Options,
+    sources: &Sources,
+) -> Option<String>
+where
+    F: FnMut(records::Frames) -> Result<(), Stop>,
+{
+    let wall = sources.clock() == Some(hwfoc_io::time::Clock::Wall);
+    collect.empty_window(&options.filter, wall)
+}
+
 /// Decodes `specs` whole. Decoding runs on this thread, converting on worker threads.
 fn decode_all(specs: Vec<Spec>, options: &Options, notes: &Notes) -> Result<Decoded, Stop> {
     let mut sources = Sources::new(open_all(specs, notes)?, options.settings);
@@ -219,18 +232,19 @@ fn decode_all(specs: Vec<Spec>, options: &Options, notes: &Notes) -> Result<Deco
         })
         .reuse(spare_rx);
         let result = sources.run(&mut collect).and_then(|()| collect.flush());
+        let empty = empty_window(&collect, options, &sources);
         drop(collect);
         drop(tx);
-        result
+        result.map(|()| empty)
     });
     drop(done_tx);
-    result?;
+    let empty_window = result?;
     let mut batches: Vec<(usize, RecordBatch)> = done_rx.into_iter().collect();
     batches.sort_unstable_by_key(|(i, _)| *i);
     Ok(Decoded {
         batches: batches.into_iter().map(|(_, b)| b).collect(),
         escs: escs_json(&sources),
-        warnings: no_frames(&sources),
+        warnings: no_frames(&sources).into_iter().chain(empty_window).collect(),
     })
 }
 

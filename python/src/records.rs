@@ -230,6 +230,10 @@ pub fn block_capacity(rows: usize) -> usize {
 /// `spare` when one is there (blocks handed back once converted), else it is new.
 pub struct Collect<F> {
     selection: Selection,
+    /// Data frames selected, and the earliest and latest time of the selected ESCs' frames,
+    /// in the window or not (as the export counts them).
+    kept: u64,
+    span: Option<(f64, f64)>,
     rows: usize,
     frames: Frames,
     full: F,
@@ -241,6 +245,8 @@ impl<F: FnMut(Frames) -> Result<(), Stop>> Collect<F> {
     pub fn new(selection: Selection, rows: usize, full: F) -> Self {
         Collect {
             selection,
+            kept: 0,
+            span: None,
             rows,
             frames: Frames::with_capacity(block_capacity(rows)),
             full,
@@ -252,6 +258,18 @@ impl<F: FnMut(Frames) -> Result<(), Stop>> Collect<F> {
     pub fn reuse(mut self, spare: std::sync::mpsc::Receiver<Frames>) -> Self {
         self.spare = Some(spare);
         self
+    }
+
+    /// The warning for a time window that selected no frame though the selected ESCs had
+    /// some (the command's wording), with `filter` the selection's text and `wall` whether the
+    /// times are the wall clock's.
+    pub fn empty_window(&self, filter: &str, wall: bool) -> Option<String> {
+        match (self.selection.window.is_limited(), self.kept, self.span) {
+            (true, 0, Some((first, last))) => Some(hwfoc_io::select::no_frame_in_window(
+                filter, first, last, wall,
+            )),
+            _ => None,
+        }
     }
 
     /// Hands on the frames gathered so far, if any.
@@ -277,10 +295,16 @@ impl<F: FnMut(Frames) -> Result<(), Stop>> Handler for Collect<F> {
 
     #[inline]
     fn frame(&mut self, esc: u8, t: Option<f64>, decoded: &Decoded, _: &Settings) {
-        if let Frame::Data(frame) = &decoded.frame
-            && self.selection.contains(esc, t)
-        {
-            self.frames.push(t, esc, frame);
+        if let Frame::Data(frame) = &decoded.frame {
+            if let Some(t) = t.filter(|_| self.selection.esc(esc)) {
+                let (first, last) = self.span.get_or_insert((t, t));
+                *first = first.min(t);
+                *last = last.max(t);
+            }
+            if self.selection.contains(esc, t) {
+                self.frames.push(t, esc, frame);
+                self.kept += 1;
+            }
         }
     }
 

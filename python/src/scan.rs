@@ -87,13 +87,16 @@ fn produce(
     // On an input error the frames decoded before it are still handed over, then the error.
     let result = sources.run(&mut collect);
     let flushed = collect.flush();
+    let empty_window = crate::empty_window(&collect, &options, &sources);
     drop(collect);
     match result.and(flushed) {
         Err(stop) => {
             let _ = tx.send(Msg::Failed(stop));
         }
         Ok(()) => {
-            let _ = tx.send(Msg::Warnings(crate::no_frames(&sources)));
+            let mut warnings = crate::no_frames(&sources);
+            warnings.extend(empty_window);
+            let _ = tx.send(Msg::Warnings(warnings));
         }
     }
 }

@@ -139,6 +139,20 @@ def test_spark_local(spark, fleet, reference):
     assert row is not None and len(row["faults"]) >= 1
 
 
+def test_dask_and_spark_name_recordings_alike(spark, fleet, monkeypatch):
+    # Relative paths, as a user in the fleet's folder gives them: both readers name each
+    # recording as given (Spark's workers still read it by its absolute path).
+    import hwfoc.spark
+
+    folder = os.path.dirname(fleet[0])
+    monkeypatch.chdir(folder)
+    given = [os.path.basename(p) for p in fleet[:2]]
+    from_dask = set(hwfoc.dask.read(given, path_column="recording")["recording"].unique().compute())
+    spark_rows = hwfoc.spark.read(spark, given, path_column="recording").select("recording").distinct().collect()
+    from_spark = {r["recording"] for r in spark_rows}
+    assert from_dask == from_spark == set(given)
+
+
 def test_report_times():
     # Printed for the record (pytest -s); the figures are in the README's notes.
     for k, v in TIMES.items():

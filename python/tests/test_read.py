@@ -144,6 +144,19 @@ def test_empty_window_and_bad_settings_raise_the_commands_errors(cli, sim_dir):
         hwfoc.read(path, start="yesterday")
 
 
+def test_a_window_that_holds_no_frame_warns_as_the_command_does(cli, sim_dir):
+    path = sim_dir / "three.pcapng"
+    with pytest.warns(hwfoc.HwfocWarning) as caught:
+        table = hwfoc.read(path, start=100, end=200)
+    assert table.num_rows == 0
+    _, err, _ = run_cli(cli, "decode", path, "--from", "100", "--to", "200")
+    assert "no frame in the time window (from=100 to=200)" in err
+    assert [f"hwfoc: warning: {w.message}" for w in caught] == err.splitlines()
+    with pytest.warns(hwfoc.HwfocWarning) as scanned:
+        assert sum(b.num_rows for b in hwfoc.scan(path, start=100, end=200)) == 0
+    assert [str(w.message) for w in scanned] == [str(w.message) for w in caught]
+
+
 def test_a_window_on_raw_bytes_is_refused(cli, sim_dir):
     path = sim_dir / "one.bin"
     with pytest.raises(hwfoc.InputError) as e:

@@ -20,7 +20,9 @@ use crate::error::CliError;
 pub struct InputArgs {
     /// Serial ports (`/dev/ttyUSB0`, `COM3`; one ESC each, in the order given), recordings
     /// (pcapng), raw bytes from the wire or logic-analyser CSV exports (detected); `-` reads
-    /// standard input. Files are read one after another.
+    /// standard input. Recordings and analyser CSV exports given together are merged in time
+    /// order (the files of one port, such as a rotated recording, are one continuous stream);
+    /// raw files and standard input, which have no receive times, are read one after another.
     #[arg(value_name = "FILE|PORT|-", required_unless_present = "demo", num_args = 1..)]
     pub inputs: Vec<String>,
     /// Baud rate of serial ports (8N1).
@@ -86,12 +88,12 @@ pub fn config_read(config: &Config) -> Option<PathBuf> {
 }
 
 /// How the configuration file and the flags combine, for `--help`.
-pub const SETTINGS_HELP: &str = "\
-Configuration file (TOML). Settings come from, first to last (field by field): these flags; the ESC's [esc.N] entry in the
-configuration file; its port's [port.\"NAME\"] entry; the file's [settings]; the defaults (current
-scale 64, 7 pole pairs, gear ratio 1). The file: --config FILE, else $HWFOC_CONFIG, else
-hwfoc/config.toml in the user's configuration directory ($XDG_CONFIG_HOME or ~/.config) if it
-exists; --no-config reads none. See the README (Configuration).";
+pub const SETTINGS_HELP: &str = "Configuration file (TOML). Settings come from, first to last \
+(field by field): these flags; the ESC's [esc.N] entry in the configuration file; its port's \
+[port.\"NAME\"] entry; the file's [settings]; the defaults (current scale 64, 7 pole pairs, gear \
+ratio 1). The file: --config FILE, else $HWFOC_CONFIG, else hwfoc/config.toml in the user's \
+configuration directory ($XDG_CONFIG_HOME or ~/.config) if it exists; --no-config reads none. \
+See the README (Configuration).";
 
 /// Conversion settings the frames do not carry, and the configuration file that sets them.
 #[derive(Debug, Default, Clone, Args)]

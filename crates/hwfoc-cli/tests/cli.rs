@@ -428,3 +428,41 @@ fn a_closed_pipe_is_not_an_error() {
         String::from_utf8_lossy(&out.stderr)
     );
 }
+
+/// Every command's `--help` is wrapped by clap alone: a paragraph has no line broken short
+/// inside it (a hard line break in a help text gave `entry in the` / `(current` / `it` lines).
+#[test]
+fn help_paragraphs_have_no_broken_lines() {
+    let top = stdout(&run(&["--help"]));
+    let commands: Vec<&str> = top
+        .split("Commands:")
+        .nth(1)
+        .and_then(|s| s.split("Options:").next())
+        .expect("a command list")
+        .lines()
+        .filter_map(|l| l.strip_prefix("  "))
+        .filter(|l| !l.starts_with(' '))
+        .filter_map(|l| l.split_whitespace().next())
+        .filter(|c| *c != "help")
+        .collect();
+    assert!(commands.contains(&"decode"), "{top}");
+    let indent = |l: &str| l.len() - l.trim_start().len();
+    let listed = |l: &str| l.trim_start().starts_with(['-', '[']);
+    for command in commands {
+        let help = stdout(&run(&[command, "--help"]));
+        let lines: Vec<&str> = help.lines().collect();
+        for pair in lines.windows(2) {
+            let (a, b) = (pair[0], pair[1]);
+            let continued = indent(a) >= 10
+                && indent(a) == indent(b)
+                && !a.trim().is_empty()
+                && !b.trim().is_empty()
+                && !listed(a)
+                && !listed(b);
+            assert!(
+                !continued || a.len() >= 60,
+                "`hwfoc {command} --help` breaks a paragraph after {a:?}"
+            );
+        }
+    }
+}

@@ -33,12 +33,12 @@ fn summary_json_starts_with_the_schema_version() {
 }
 
 #[test]
-fn monitor_json_status_and_alarm_lines_carry_the_schema_version() {
+fn monitor_json_status_alarm_and_total_lines_carry_the_schema_version() {
     let out = ok(hwfoc()
         .args([
             "monitor",
             "--sim",
-            "1",
+            "2",
             "--json",
             "--no-config",
             "--interval",
@@ -57,7 +57,7 @@ fn monitor_json_status_and_alarm_lines_carry_the_schema_version() {
         .collect();
     let kinds: Vec<&str> = lines.iter().map(|v| v["type"].as_str().unwrap()).collect();
     assert!(
-        kinds.contains(&"status") && kinds.contains(&"alarm"),
+        kinds.contains(&"status") && kinds.contains(&"alarm") && kinds.contains(&"total"),
         "{kinds:?}"
     );
     for v in &lines {

@@ -99,9 +99,23 @@ fn plain_prints_each_esc_every_interval_and_alarms_by_name() {
         .unwrap_or_else(|| panic!("no rpm in {last}"));
     assert!(rpm > 1000.0, "{last}");
 
+    // The injected overheat comes with its temperature (above 110 degC), which raises the
+    // temperature alarm beside the fault's.
+    let alarm = |l: &&String| l.contains(" ALARM esc") || l.contains(" CLEARED esc");
+    let hot: Vec<&String> = lines
+        .iter()
+        .filter(alarm)
+        .filter(|l| l.contains(": mos_temp "))
+        .collect();
+    assert!(
+        hot.first()
+            .is_some_and(|l| l.contains("ALARM esc1 sim:esc1: mos_temp critical raised at 11")),
+        "{lines:#?}"
+    );
     let alarms: Vec<&String> = lines
         .iter()
-        .filter(|l| l.contains(" ALARM esc") || l.contains(" CLEARED esc"))
+        .filter(alarm)
+        .filter(|l| !l.contains(": mos_temp "))
         .collect();
     assert_eq!(alarms.len(), 2, "{lines:#?}");
     assert!(
@@ -127,7 +141,7 @@ fn plain_prints_each_esc_every_interval_and_alarms_by_name() {
     assert!(
         lines
             .iter()
-            .any(|l| l.contains(" esc1 ") && l.ends_with("| ALARM mos_overheat(critical)")),
+            .any(|l| l.contains(" esc1 ") && l.contains("| ALARM mos_overheat(critical)")),
         "{lines:#?}"
     );
     assert!(
@@ -749,4 +763,51 @@ fn the_dashboard_at_80_by_24_is_readable() {
     // Where the recording went is said on exit too.
     assert!(pane.contains("hwfoc: recorded to"), "{pane}");
     assert!(pane.contains("hwfoc/recordings/hwfoc-"), "{pane}");
+}
+
+/// An idle ESC's current sensor reads -1 LSB (the simulator's ESC 1 does, as a real XRotor
+/// does): its power is a few tenths of a watt below zero. The text shows `0 W`, `0.0 mAh` and
+/// `0.00 Wh`, never `-0`, and a peak of power drawn is never below zero.
+#[test]
+fn an_idle_esc_shows_no_negative_zero_and_no_negative_peak() {
+    let run = |mode: &str| {
+        ok(hwfoc()
+            .args([
+                "monitor",
+                "--sim",
+                "2",
+                mode,
+                "--no-config",
+                "--interval",
+                "0.5",
+                "--duration",
+                "2.2",
+            ])
+            .output()
+            .expect("spawn"))
+    };
+    let plain = String::from_utf8(run("--plain").stdout).unwrap();
+    assert!(plain.contains(" esc1 "), "{plain}");
+    for word in plain.split_whitespace() {
+        let digits = word.trim_start_matches('-');
+        assert!(
+            !(word.starts_with('-')
+                && !digits.is_empty()
+                && digits.bytes().all(|b| b == b'0' || b == b'.')),
+            "negative zero {word:?} in {plain}"
+        );
+    }
+    let json = String::from_utf8(run("--json").stdout).unwrap();
+    let mut negative_current = false;
+    for line in json.lines() {
+        let v: Value = serde_json::from_str(line).unwrap();
+        if let Some(i) = v["record"]["current_a"].as_f64() {
+            negative_current |= i < 0.0;
+        }
+        if let Some(peak) = v["energy"]["peak_power_w"].as_f64() {
+            assert!(peak >= 0.0, "{line}");
+        }
+    }
+    // The case the test is about: an ESC that reported a negative current.
+    assert!(negative_current, "{json}");
 }

@@ -6,7 +6,8 @@ Usage: pyarrow_check.py HWFOC [WORKDIR]
 HWFOC is the path of the hwfoc binary. The script exports the built-in demo capture twice, as
 Parquet and as JSON Lines, under non-default settings, then asserts with pyarrow: the column names,
 types and nullability of RECORD-SCHEMA.md, the unit of each column in the field metadata, the
-settings, version, inputs and ESCs in the file's key-value metadata, and every value equal to the
+settings, version, inputs and ESCs in the file's key-value metadata and in the table's schema
+metadata (what `read_table(f).schema.metadata` shows), and every value equal to the
 JSON Lines record of the same row. Needs pyarrow only (no numpy, no pandas). Exits non-zero with a
 message on the first difference; prints "1 passed, 0 failed" when all is well.
 """
@@ -83,6 +84,11 @@ def main():
 
     table = pq.read_table(parquet_path)
     check(table.num_rows == len(records), f"{table.num_rows} rows, {len(records)} JSON records")
+    # The same metadata where a reader of the table looks for it: the Arrow schema's.
+    table_meta = table.schema.metadata or {}
+    for key, value in kv.items():
+        if key != b"ARROW:schema":
+            check(table_meta.get(key) == value, f"read_table's schema metadata {key!r}: {table_meta.get(key)!r}")
     rows = table.to_pylist()
     floats = {name for name, typ, *_ in SCHEMA if typ == pa.float32()}
     for i, (row, record) in enumerate(zip(rows, records)):

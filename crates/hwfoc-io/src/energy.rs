@@ -26,6 +26,14 @@ pub fn power_w(voltage_v: f64, current_a: f64) -> f64 {
     voltage_v * current_a
 }
 
+/// Power drawn from the battery, W: `power_w` with a negative power (regeneration, or an idle
+/// ESC's current sensor reading -1 LSB, -0.016 A) counted as none. What a peak of power is
+/// taken over: a peak draw is never below 0 W.
+#[inline]
+pub fn drawn_w(power_w: f64) -> f64 {
+    power_w.max(0.0)
+}
+
 /// Charge, energy and power of one ESC (or the sum of several: [`Energy::merge`]).
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct Energy {
@@ -75,7 +83,7 @@ impl Energy {
             self.energy_j += power_w(v, i) * step;
             self.seconds += step;
         }
-        let power = power_w(voltage_v, current_a);
+        let power = drawn_w(power_w(voltage_v, current_a));
         self.peak_w = Some(self.peak_w.map_or(power, |p| p.max(power)));
         self.last = Some((t_s, voltage_v, current_a));
     }
@@ -101,7 +109,7 @@ impl Energy {
             charge_as: (current_sum - i) * NOMINAL_PERIOD_S,
             energy_j: (power_sum - power_w(v, i)) * NOMINAL_PERIOD_S,
             seconds: steps,
-            peak_w,
+            peak_w: peak_w.map(drawn_w),
             nominal: frames > 1,
         }
     }
@@ -132,7 +140,8 @@ impl Energy {
         (self.seconds > 0.0).then(|| self.energy_j / self.seconds)
     }
 
-    /// Largest electrical input power of a single frame, W (`None` before a frame).
+    /// Largest electrical input power drawn in a single frame, W ([`drawn_w`]: never below 0;
+    /// `None` before a frame).
     pub fn peak_w(&self) -> Option<f64> {
         self.peak_w
     }

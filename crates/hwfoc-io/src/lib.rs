@@ -28,6 +28,7 @@ pub mod clock;
 pub mod energy;
 pub mod episode;
 pub mod escape;
+pub mod fixed;
 pub mod handler;
 pub mod input;
 pub mod notice;

@@ -201,6 +201,17 @@ impl Selection {
     }
 }
 
+/// The warning for a time window that held no frame of the selected ESCs, naming the window
+/// as `filter` writes it (`from=100 to=200`) and the times the frames do have (`first` and
+/// `last`, seconds; `wall`: the source's clock is the wall clock). The one wording of the
+/// command's warning and of the Python package's `HwfocWarning`.
+pub fn no_frame_in_window(filter: &str, first: f64, last: f64, wall: bool) -> String {
+    format!(
+        "no frame in the time window ({filter}): {}",
+        crate::time::span_text(first, last, wall)
+    )
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -29,6 +29,7 @@ use crate::clock::Step;
 use crate::energy::{Energy, NOMINAL_PERIOD_S};
 pub use crate::episode::{Episode, Mark};
 use crate::escape::Escaped;
+use crate::fixed::Fixed;
 use crate::input::{InputError, InputFormat};
 use crate::sources::{Handler, Sources};
 use crate::stream::EscLink;
@@ -647,15 +648,15 @@ fn total_energy(escs: &[EscReport]) -> Option<Energy> {
 /// Charge, energy and power in one line.
 fn energy_text(e: &Energy) -> String {
     let mut s = format!(
-        "{:.3} mAh, {:.4} Wh consumed",
-        e.charge_mah(),
-        e.energy_wh()
+        "{} mAh, {} Wh consumed",
+        Fixed(e.charge_mah(), 3),
+        Fixed(e.energy_wh(), 4)
     );
     if let Some(peak) = e.peak_w() {
-        let _ = write!(s, "; input power peak {peak:.1} W");
+        let _ = write!(s, "; input power peak {} W", Fixed(peak, 1));
     }
     if let Some(mean) = e.mean_w() {
-        let _ = write!(s, ", mean {mean:.1} W over {:.3} s", e.seconds());
+        let _ = write!(s, ", mean {} W over {:.3} s", Fixed(mean, 1), e.seconds());
     }
     if e.nominal() {
         let _ = write!(

@@ -342,10 +342,27 @@ impl Model {
                 .clamp(0.0, 65535.0) as u16,
             current_raw,
             phase_current_raw,
-            mos_adc: adc_code(self.t_mos + noise.noise(0.15)),
-            cap_adc: adc_code(self.t_cap + noise.noise(0.15)),
+            mos_adc: adc_code(
+                overheated(self.t_mos, injected, Fault::MosOverheat, MOS_OVERHEAT_C)
+                    + noise.noise(0.15),
+            ),
+            cap_adc: adc_code(
+                overheated(self.t_cap, injected, Fault::CapOverheat, CAP_OVERHEAT_C)
+                    + noise.noise(0.15),
+            ),
             status: Status(self.status().0 | injected.0),
         }
+    }
+}
+
+/// The temperature an ESC reports with an injected overheat: an overheat bit comes with the
+/// temperature that raises it, so the sensor reads at least 2 degC above the threshold (`set`)
+/// while `fault` is injected; otherwise the model's `t_c`.
+fn overheated(t_c: f64, injected: Status, fault: Fault, (set, _clear): (f64, f64)) -> f64 {
+    if injected.contains(fault) {
+        t_c.max(set + 2.0)
+    } else {
+        t_c
     }
 }
 
@@ -590,6 +607,27 @@ pub(crate) mod tests {
         let mos = f.mos_temp().celsius().unwrap();
         assert!((f64::from(mos) - m.mos_temp_c()).abs() <= 1.0);
         assert!(f.status.contains(Fault::OverCurrent));
+    }
+
+    #[test]
+    fn an_injected_overheat_comes_with_its_temperature() {
+        let mut m = model();
+        let mut noise = Rng::for_esc(1, 0, Purpose::Noise);
+        run(&mut m, 0.5, 0.0);
+        let temps = |f: DataFrame| {
+            (
+                f.mos_temp().celsius().unwrap(),
+                f.cap_temp().celsius().unwrap(),
+            )
+        };
+        let (mos, cap) = temps(m.frame(1, Status::OK, &mut noise));
+        assert!(mos < 30.0 && cap < 30.0, "{mos} {cap}");
+        let f = m.frame(2, Status::OK.with(Fault::MosOverheat), &mut noise);
+        let (mos, cap) = temps(f);
+        assert!(mos > MOS_OVERHEAT_C.0 as f32 && cap < 30.0, "{mos} {cap}");
+        assert!(f.status.contains(Fault::MosOverheat));
+        let (mos, cap) = temps(m.frame(3, Status::OK.with(Fault::CapOverheat), &mut noise));
+        assert!(cap > CAP_OVERHEAT_C.0 as f32 && mos < 30.0, "{mos} {cap}");
     }
 
     #[test]

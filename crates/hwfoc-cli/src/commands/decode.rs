@@ -94,9 +94,13 @@ pub fn run(args: &DecodeArgs) -> Result<(), CliError> {
     warn(&sources, &args.select.esc);
     if let (true, 0, Some((first, last))) = (selection.window.is_limited(), kept, span) {
         eprintln!(
-            "hwfoc: warning: no frame in the time window ({}): {}",
-            args.select.text(),
-            hwfoc_io::time::span_text(first, last, sources.clock() == Some(Clock::Wall))
+            "hwfoc: warning: {}",
+            hwfoc_io::select::no_frame_in_window(
+                &args.select.text(),
+                first,
+                last,
+                sources.clock() == Some(Clock::Wall)
+            )
         );
     }
     Ok(())

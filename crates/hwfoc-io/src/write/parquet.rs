@@ -185,13 +185,9 @@ mod encode {
         named.iter().copied().chain(others).collect()
     }
 
-    /// The writer's properties: fast encodings, the settings and the Arrow schema in the
-    /// key-value metadata.
-    fn properties(
-        schema: &Schema,
-        descr: &SchemaDescriptor,
-        provenance: &Provenance,
-    ) -> WriterProperties {
+    /// The key-value metadata known before the first row: the version, the settings, the
+    /// inputs and the filter.
+    fn provenance_metadata(provenance: &Provenance) -> Vec<KeyValue> {
         let s = provenance.settings;
         let mut kv = vec![
             KeyValue::new(
@@ -212,6 +208,33 @@ mod encode {
                 provenance.filter.clone(),
             ));
         }
+        kv
+    }
+
+    /// The Arrow schema as the `ARROW:schema` key-value entry, its own metadata holding every
+    /// other key-value entry of the file: readers that rebuild the Arrow schema from it
+    /// (`pyarrow.parquet.read_table(f).schema.metadata`, arrow-rs) show the settings and
+    /// provenance there, as readers of the footer see them in its key-value metadata. The
+    /// parquet crate encodes the schema only into writer properties, so it is taken from there.
+    fn encoded_schema(schema: &Schema, metadata: &[KeyValue]) -> Option<KeyValue> {
+        let with_metadata = schema.clone().with_metadata(
+            metadata
+                .iter()
+                .filter_map(|kv| Some((kv.key.clone(), kv.value.clone()?)))
+                .collect::<std::collections::HashMap<_, _>>(),
+        );
+        let mut props = WriterProperties::builder().build();
+        add_encoded_arrow_schema_to_metadata(&with_metadata, &mut props);
+        props
+            .key_value_metadata()?
+            .iter()
+            .find(|kv| kv.key == parquet::arrow::ARROW_SCHEMA_META_KEY)
+            .cloned()
+    }
+
+    /// The writer's properties: fast encodings, and the settings and provenance in the
+    /// key-value metadata (the Arrow schema is added at the end, with all the metadata).
+    fn properties(descr: &SchemaDescriptor, kv: Vec<KeyValue>) -> WriterProperties {
         // The leaf column of each column named (`faults.list.item` for the list).
         let leaves = |names: &'static [&'static str]| {
             names
@@ -253,9 +276,7 @@ mod encode {
         for path in leaves(&SPLIT) {
             builder = builder.set_column_encoding(path, Encoding::BYTE_STREAM_SPLIT);
         }
-        let mut props = builder.build();
-        add_encoded_arrow_schema_to_metadata(schema, &mut props);
-        props
+        builder.build()
     }
 
     /// How a value type is stored in a Parquet leaf column: its physical type, its levels, and
@@ -690,7 +711,8 @@ mod encode {
         let name = sink.name;
         let fail = |e| write_error(&name, e);
         let parquet_schema = ArrowSchemaConverter::new().convert(&schema).map_err(fail)?;
-        let props = Arc::new(properties(&schema, &parquet_schema, provenance));
+        let mut metadata = provenance_metadata(provenance);
+        let props = Arc::new(properties(&parquet_schema, metadata.clone()));
         let mut writer = SerializedFileWriter::new(
             HoldFooter::new(sink.writer),
             parquet_schema.root_schema_ptr(),
@@ -714,9 +736,11 @@ mod encode {
                     // The command may have stopped listening; the rows are then dropped.
                     let _ = spare.try_send(rows);
                 }
-                ToWriter::End(metadata) => {
-                    for (key, value) in metadata {
-                        writer.append_key_value_metadata(KeyValue::new(key, value));
+                ToWriter::End(at_end) => {
+                    for (key, value) in at_end {
+                        let kv = KeyValue::new(key, value);
+                        metadata.push(kv.clone());
+                        writer.append_key_value_metadata(kv);
                     }
                     break;
                 }
@@ -724,6 +748,9 @@ mod encode {
         }
         if let Some(columns) = previous {
             append_row_group(&mut writer, columns).map_err(fail)?;
+        }
+        if let Some(kv) = encoded_schema(&schema, &metadata) {
+            writer.append_key_value_metadata(kv);
         }
         // The footer is held back, its float columns' order made the one every reader knows,
         // then written.

@@ -30,6 +30,7 @@ use super::{Session, number};
 use crate::error::CliError;
 use hwfoc_io::energy::Energy;
 use hwfoc_io::escape::Escaped;
+use hwfoc_io::fixed::Fixed;
 
 /// Shortest time between redraws while frames arrive.
 const FRAME_EVERY: Duration = Duration::from_millis(50);
@@ -536,15 +537,15 @@ fn energy_line(
     energy: &Energy,
     of: &str,
 ) -> Line<'static> {
-    let w = |p: Option<f64>| p.map_or("-".to_string(), |p| format!("{p:.0} W"));
+    let w = |p: Option<f64>| p.map_or("-".to_string(), |p| format!("{} W", Fixed(p, 0)));
     Line::from(vec![
         "power ".dark_gray(),
         w(power_w).bold(),
         format!(" (peak {})", w(peak_w)).dark_gray(),
         " · used ".dark_gray(),
-        format!("{:.1} mAh", energy.charge_mah()).bold(),
+        format!("{} mAh", Fixed(energy.charge_mah(), 1)).bold(),
         " · ".dark_gray(),
-        format!("{:.2} Wh", energy.energy_wh()).bold(),
+        format!("{} Wh", Fixed(energy.energy_wh(), 2)).bold(),
         format!("  {of}, since start or c").dark_gray(),
     ])
 }

@@ -625,7 +625,7 @@ impl Fleet {
     }
 
     fn note_total_power(&mut self) {
-        if let Some(p) = self.total_power_w() {
+        if let Some(p) = self.total_power_w().map(hwfoc_io::energy::drawn_w) {
             self.peak_total_w = Some(self.peak_total_w.map_or(p, |peak| peak.max(p)));
         }
     }

@@ -13,6 +13,7 @@ use super::{Session, number};
 use crate::error::CliError;
 use hwfoc_io::energy::Energy;
 use hwfoc_io::escape::Escaped;
+use hwfoc_io::fixed::Fixed;
 use hwfoc_io::record::Record;
 use hwfoc_io::write::WriteError;
 
@@ -90,13 +91,13 @@ pub fn timestamp(t: f64) -> String {
 /// `power 480 W (peak 1210 W) used 312.5 mAh 7.41 Wh`: power now (`-` without a frame), the
 /// peak, charge and energy since the start or the last reset.
 fn energy_text(power_w: Option<f64>, peak_w: Option<f64>, energy: &Energy) -> String {
-    let w = |p: Option<f64>| p.map_or("-".to_string(), |p| format!("{p:.0} W"));
+    let w = |p: Option<f64>| p.map_or("-".to_string(), |p| format!("{} W", Fixed(p, 0)));
     format!(
-        "power {} (peak {}) used {:.1} mAh {:.2} Wh",
+        "power {} (peak {}) used {} mAh {} Wh",
         w(power_w),
         w(peak_w),
-        energy.charge_mah(),
-        energy.energy_wh()
+        Fixed(energy.charge_mah(), 1),
+        Fixed(energy.energy_wh(), 2)
     )
 }
 
@@ -125,6 +126,7 @@ fn total_line(fleet: &Fleet, now: f64) -> String {
 
 fn total_json(fleet: &Fleet, now: f64) -> Value {
     json!({
+        "schema_version": hwfoc_io::JSON_SCHEMA_VERSION,
         "type": "total",
         "time": timestamp(now),
         "t_s": now,

@@ -14,6 +14,7 @@ use plotters::style::{FontStyle, register_font};
 
 use crate::error::CliError;
 use hwfoc_io::escape::Escaped;
+use hwfoc_io::fixed::Fixed;
 use hwfoc_io::sources::Sources;
 use hwfoc_io::summary::NO_FRAMES;
 use hwfoc_io::time::{self, Clock};
@@ -470,9 +471,9 @@ impl<'a> Scene<'a> {
         {
             let e = &data.energy;
             about.push_str(&format!(
-                "  ·  {:.1} mAh, {:.2} Wh{}",
-                e.charge_mah(),
-                e.energy_wh(),
+                "  ·  {} mAh, {} Wh{}",
+                Fixed(e.charge_mah(), 1),
+                Fixed(e.energy_wh(), 2),
                 if e.nominal() {
                     format!(
                         " (each frame counted as {} ms)",
