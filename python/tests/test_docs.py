@@ -46,7 +46,10 @@ def test_the_documents_have_python_examples():
 
 
 def _env(cli, home):
-    path = f"{Path(cli).resolve().parent}{os.pathsep}{os.environ.get('PATH', '')}"
+    # The interpreter's own directory first, as in an activated virtual environment (Spark's
+    # workers start `python3` from PATH).
+    path = os.pathsep.join([str(Path(cli).resolve().parent), str(Path(sys.executable).parent),
+                            os.environ.get("PATH", "")])
     env = dict(os.environ, PATH=path, HOME=str(home))
     env.pop("HWFOC_CONFIG", None)
     env.pop("XDG_CONFIG_HOME", None)
