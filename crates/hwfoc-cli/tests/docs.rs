@@ -402,3 +402,75 @@ fn every_example_runs() {
     eprintln!("ran the examples of: {}", ran.join(", "));
     assert!(failures.is_empty(), "{}", failures.join("\n\n"));
 }
+
+/// Every relative link of the documents (`[text](path#anchor)`), and every document of `docs/`
+/// the sources cite (a `.md` or `.txt` name after that folder's name), is a file of the
+/// repository.
+#[test]
+fn every_cited_document_exists() {
+    let mut missing = Vec::new();
+    let mut documents = documents();
+    documents.push(root().join("ARCHITECTURE.md"));
+    for doc in &documents {
+        let text = fs::read_to_string(doc).unwrap();
+        let name = doc
+            .strip_prefix(root())
+            .unwrap_or(doc)
+            .display()
+            .to_string();
+        for (_, rest) in text.match_indices("](").map(|(i, _)| ((), &text[i + 2..])) {
+            let Some(end) = rest.find(')') else { continue };
+            let target = rest[..end].split('#').next().unwrap();
+            if target.is_empty() || target.contains("://") {
+                continue;
+            }
+            if !doc.parent().unwrap().join(target).exists() {
+                missing.push(format!("{name}: link to {target}"));
+            }
+        }
+    }
+    // The sources: each crate's and the Python package's files that cite a document.
+    let mut sources = Vec::new();
+    let mut dirs = vec![
+        root().join("crates"),
+        root().join("python"),
+        root().join("testdata"),
+    ];
+    while let Some(dir) = dirs.pop() {
+        for entry in fs::read_dir(&dir).unwrap() {
+            let path = entry.unwrap().path();
+            let file_name = path.file_name().unwrap().to_string_lossy().into_owned();
+            if path.is_dir() {
+                if !["target", ".git", "captures", "recordings"].contains(&file_name.as_str()) {
+                    dirs.push(path);
+                }
+            } else if [".rs", ".py", ".pyi", ".lua", ".sh", ".md", ".toml"]
+                .iter()
+                .any(|ext| file_name.ends_with(ext))
+            {
+                sources.push(path);
+            }
+        }
+    }
+    for source in sources {
+        let Ok(text) = fs::read_to_string(&source) else {
+            continue;
+        };
+        for (i, _) in text.match_indices("docs/") {
+            let cited: String = text[i..]
+                .chars()
+                .take_while(|c| c.is_ascii_alphanumeric() || "/-_.".contains(*c))
+                .collect();
+            let cited = cited.trim_end_matches('.');
+            if (cited.ends_with(".md") || cited.ends_with(".txt")) && !root().join(cited).exists() {
+                let name = source.strip_prefix(root()).unwrap_or(&source).display();
+                missing.push(format!("{name}: {cited}"));
+            }
+        }
+    }
+    assert!(
+        missing.is_empty(),
+        "cited, but not in the repository:\n{}",
+        missing.join("\n")
+    );
+}
