@@ -1,6 +1,6 @@
 """Hobbywing HW-FOC ESC telemetry as Arrow tables.
 
-The records are those of RECORD-SCHEMA.md (the same names, types and units as every output of
+The records are those of docs/RECORD-SCHEMA.md (the same names, types and units as every output of
 the ``hwfoc`` command): one row per data frame, in physical units.
 
 - :func:`read`: inputs read whole into a ``pyarrow.Table`` (raw bytes from the wire,

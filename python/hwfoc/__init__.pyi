@@ -51,7 +51,7 @@ def read(
     pole_pairs: int = 7,
     gear_ratio: float = 1,
 ) -> pa.Table:
-    """Reads telemetry whole into a ``pyarrow.Table`` of RECORD-SCHEMA.md's records.
+    """Reads telemetry whole into a ``pyarrow.Table`` of docs/RECORD-SCHEMA.md's records.
 
     ``source``: a path (raw bytes from the wire, a logic-analyser CSV export or a pcapng
     recording: the format is detected from the content), ``bytes``/``bytearray``/``memoryview``,

@@ -256,7 +256,7 @@ pub(crate) fn stop_error(stop: Stop) -> PyErr {
     }
 }
 
-/// Reads telemetry whole into a `pyarrow.Table` of RECORD-SCHEMA.md's records.
+/// Reads telemetry whole into a `pyarrow.Table` of docs/RECORD-SCHEMA.md's records.
 ///
 /// `source`: a path (raw bytes, logic-analyser CSV or pcapng recording, detected from the
 /// content), bytes, a binary file object, or a list of these read one after another. `esc`,

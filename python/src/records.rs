@@ -1,5 +1,5 @@
 //! Frames to Arrow record batches: the schema of `hwfoc_io::write::arrow` (names, types,
-//! nullability, units of RECORD-SCHEMA.md, from the column table), each column's array made at
+//! nullability, units of docs/RECORD-SCHEMA.md, from the column table), each column's array made at
 //! once from a block of frames, and the key-value metadata of the Parquet export.
 
 use std::collections::HashMap;

@@ -196,7 +196,7 @@ fn parquet_has_the_schema_units_and_metadata_and_the_jsonl_values() {
     assert_eq!(records.len(), 248 + 1500);
 
     let (schema, meta, batch) = read_parquet(&pq);
-    // The schema of the column table (checked against RECORD-SCHEMA.md by hwfoc-io's tests),
+    // The schema of the column table (checked against docs/RECORD-SCHEMA.md by hwfoc-io's tests),
     // units in the fields' metadata.
     assert_eq!(schema.fields(), hwfoc_io::write::arrow::schema().fields());
     let names: Vec<&str> = schema.fields().iter().map(|f| f.name().as_str()).collect();

@@ -5,7 +5,7 @@ Usage: pyarrow_check.py HWFOC [WORKDIR]
 
 HWFOC is the path of the hwfoc binary. The script exports the built-in demo capture twice, as
 Parquet and as JSON Lines, under non-default settings, then asserts with pyarrow: the column names,
-types and nullability of RECORD-SCHEMA.md, the unit of each column in the field metadata, the
+types and nullability of docs/RECORD-SCHEMA.md, the unit of each column in the field metadata, the
 settings, version, inputs and ESCs in the file's key-value metadata and in the table's schema
 metadata (what `read_table(f).schema.metadata` shows), and every value equal to the
 JSON Lines record of the same row. Needs pyarrow only (no numpy, no pandas). Exits non-zero with a
@@ -100,7 +100,7 @@ def main():
             check(got == value, f"row {i} {name}: parquet {got!r}, JSON {value!r}")
     # The demo has a fault episode: the list column holds names, not just empty lists.
     check(any(r["faults"] for r in rows), "no faults in the demo's records")
-    print("pyarrow_check: %d rows, schema, units and metadata as RECORD-SCHEMA.md" % len(rows))
+    print("pyarrow_check: %d rows, schema, units and metadata as docs/RECORD-SCHEMA.md" % len(rows))
     print("1 passed, 0 failed")
 
 

@@ -44,7 +44,7 @@ local KINDS = {
     [0x4C] = { len = INFO_LEN, command = 0x01, name = "Device-information frame" },
 }
 
--- Status bits, bit 0 = least significant bit of the low byte (PROTOCOL-NOTES.md).
+-- Status bits, bit 0 = least significant bit of the low byte (docs/PROTOCOL-NOTES.md).
 local FAULTS = {
     { "input_voltage_high", "Input voltage too high" },
     { "input_voltage_low", "Input voltage too low" },

@@ -8,7 +8,7 @@
 //!   receive time where the source has a clock;
 //! - [`stream`] and [`sources`]: the one path from timed bytes to frames, a decoding stream per
 //!   ESC, each converted under its own [`settings`]; [`handler`]: the [`Handler`] seam through which records reach a front end;
-//! - [`record`]: the record of `RECORD-SCHEMA.md` (one row per data frame, physical units), its
+//! - [`record`]: the record of `docs/RECORD-SCHEMA.md` (one row per data frame, physical units), its
 //!   columns declared once in one table, and its text encodings;
 //! - [`write`](mod@write): writers of records (JSON Lines, CSV, Parquet with the `parquet`
 //!   feature), each on a thread of its own, and Arrow record batches;
@@ -47,7 +47,7 @@ pub mod write;
 /// The version of the layout of the JSON objects the project prints (`hwfoc summary --json`,
 /// the status and alarm lines of `hwfoc monitor --json`), as their `"schema_version"` key: it
 /// goes up when a key is renamed or removed or its meaning or unit changes, not when a key is
-/// added. The records of `RECORD-SCHEMA.md` (JSON Lines) carry no such key: they have exactly
+/// added. The records of `docs/RECORD-SCHEMA.md` (JSON Lines) carry no such key: they have exactly
 /// the schema's keys.
 pub const JSON_SCHEMA_VERSION: u32 = 1;
 

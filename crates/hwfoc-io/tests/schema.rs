@@ -1,8 +1,8 @@
 //! The column table against `RECORD-SCHEMA.md`: names in order, types, nullability and units,
 //! and every output's columns (JSON keys, CSV header, Arrow schema) in the table's order.
 //!
-//! The expected schema is a copy of RECORD-SCHEMA.md's table (the tests do not read the
-//! specification's directory): a new column is a row here as well as an entry in the table.
+//! The expected schema is read from `docs/RECORD-SCHEMA.md` at test time (the document itself,
+//! not a copy of it): a new column is a row of that table as well as an entry in the column table.
 
 use arrow_schema::{DataType, Field};
 use hwfoc::{DataFrame, Settings, Status};
@@ -10,28 +10,34 @@ use hwfoc_io::record::{COLUMNS, Record, TextEncoder, UNITS};
 use hwfoc_io::write::arrow::schema;
 use std::sync::Arc;
 
-/// The column table of RECORD-SCHEMA.md, as it is there.
-const RECORD_SCHEMA_MD: &str = "\
-| column | type | unit | value |
-|---|---|---|---|
-| `t_s` | float64, nullable | s | time of the frame's first byte: the source's own clock where it has one (a logic-analyser CSV's or a pcapng capture's timestamps, as they are in the file), Unix time for live input; null where the source has no timing (a raw byte file) |
-| `esc` | uint8 | - | which ESC: the index of the input port/stream it came from (0-based), or the DataLink channel |
-| `packet` | uint16 | - | packet number from the frame |
-| `throttle_in_pct` | float32 | % | input throttle, raw * 100 / 1024 |
-| `throttle_out_pct` | float32 | % | output throttle, raw * 100 / 1024 |
-| `erpm` | uint32 | rev/min | electrical RPM, raw * 10 |
-| `rpm` | float32 | rev/min | motor (or geared output) RPM, raw * 10 / (gear_ratio * pole_pairs) |
-| `voltage_v` | float32 | V | input voltage, raw / 10 |
-| `current_a` | float32 | A | input current, int16 raw / current scale (default 64) |
-| `phase_current_a` | float32 | A | phase current, int16 raw / current scale (default 64) |
-| `mos_temp_c` | float32, nullable | degC | MOSFET temperature from the ADC table; null when out of the table's range |
-| `cap_temp_c` | float32, nullable | degC | capacitor temperature, likewise |
-| `status` | uint16 | - | the raw status word |
-| `faults` | list of strings (CSV: `|`-joined) | - | names of the set status bits, from PROTOCOL-NOTES.md, in bit order |
-";
+/// The record schema document of the repository.
+const RECORD_SCHEMA_MD: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../docs/RECORD-SCHEMA.md");
 
-/// The example of RECORD-SCHEMA.md: the first frame of the XRotor capture, default settings.
-const EXAMPLE: &str = r#"{"t_s":0.22798,"esc":0,"packet":1474,"throttle_in_pct":0.0,"throttle_out_pct":0.0,"erpm":0,"rpm":0.0,"voltage_v":24.7,"current_a":-0.015625,"phase_current_a":-0.015625,"mos_temp_c":28.0,"cap_temp_c":26.0,"status":0,"faults":[]}"#;
+/// The text of `docs/RECORD-SCHEMA.md`.
+fn record_schema_md() -> String {
+    std::fs::read_to_string(RECORD_SCHEMA_MD).unwrap_or_else(|e| panic!("{RECORD_SCHEMA_MD}: {e}"))
+}
+
+/// The rows of the document's column table (below its header and separator line).
+fn table_rows(document: &str) -> Vec<&str> {
+    let mut lines = document.lines();
+    lines
+        .by_ref()
+        .find(|line| line.starts_with("| column | type | unit | value |"))
+        .unwrap_or_else(|| panic!("{RECORD_SCHEMA_MD}: no column table"));
+    lines
+        .skip(1)
+        .take_while(|line| line.starts_with('|'))
+        .collect()
+}
+
+/// The document's example record: the first frame of the XRotor capture, default settings.
+fn example(document: &str) -> &str {
+    document
+        .lines()
+        .find(|line| line.starts_with("{\"t_s\":"))
+        .unwrap_or_else(|| panic!("{RECORD_SCHEMA_MD}: no example record"))
+}
 
 /// A column of RECORD-SCHEMA.md: name, Arrow type, nullability, unit.
 struct Expected {
@@ -62,9 +68,8 @@ fn arrow_type(words: &str) -> (DataType, bool) {
 }
 
 fn expected() -> Vec<Expected> {
-    RECORD_SCHEMA_MD
-        .lines()
-        .skip(2)
+    table_rows(&record_schema_md())
+        .into_iter()
         .map(|row| {
             // Cells are separated by " | " (a `|` inside a cell has no spaces around it).
             let cells: Vec<&str> = row
@@ -107,7 +112,7 @@ fn the_table_is_record_schema_md() {
     }
 }
 
-/// The first frame of the XRotor capture gives RECORD-SCHEMA.md's example line.
+/// The first frame of the XRotor capture gives docs/RECORD-SCHEMA.md's example line.
 #[test]
 fn the_example_record() {
     let bytes = [
@@ -118,7 +123,11 @@ fn the_example_record() {
     let record = Record::new(Some(0.22798), 0, &frame, &Settings::default());
     let mut line = Vec::new();
     record.write_json(&mut line);
-    assert_eq!(String::from_utf8(line).unwrap(), format!("{EXAMPLE}\n"));
+    let document = record_schema_md();
+    assert_eq!(
+        String::from_utf8(line).unwrap(),
+        format!("{}\n", example(&document))
+    );
 }
 
 /// JSON keys and CSV header and fields in the table's order, nulls and faults included.

@@ -40,7 +40,7 @@ else
 fi
 
 # Seeds: the first data frame of the XRotor capture, the device-information frame seen after
-# idle frames, a lone sync byte and a fake header, as in PROTOCOL-NOTES.md.
+# idle frames, a lone sync byte and a fake header, as in docs/PROTOCOL-NOTES.md.
 data_frame='\x9b\x16\x01\x02\x05\xc2\x00\x00\x00\x00\x00\x00\x00\xf7\xff\xff\xff\xff\xce\xd1\x00\x00\x0d\x08'
 info_text="$(printf '%-16s%-16s%-16s%-16s%-8s' '' XR_FOC_ESC HW577_KZ1_V1.1 XR-01.0.00 01040443)"
 info_frame="\\x9b\\x4c\\x01\\x01${info_text}\\x34"

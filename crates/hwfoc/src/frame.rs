@@ -23,7 +23,7 @@
 //! # Adding a frame kind
 //!
 //! A new HW-FOC frame kind (another command, or the older XRotor-Pro `9B 16 03` frame of
-//! `OLDER-PROTOCOLS.md` that should be recognised and reported as unsupported) is:
+//! `docs/OLDER-PROTOCOLS.md` that should be recognised and reported as unsupported) is:
 //!
 //! 1. **One new file**, `src/kinds/<name>.rs` (plus its `pub mod` line in `src/kinds/mod.rs`):
 //!    the type, with `impl FrameKind` (length byte, version, command, length,
@@ -47,7 +47,7 @@
 //!
 //! # Another protocol
 //!
-//! - **DataLink V2** (the hub's aggregate frame, `PROTOCOL-NOTES.md`): `9B 9E 01 02` (or a
+//! - **DataLink V2** (the hub's aggregate frame, `docs/PROTOCOL-NOTES.md`): `9B 9E 01 02` (or a
 //!   length byte 0xA0, which some drivers write), 160 bytes, a frame counter and 8 ESC records,
 //!   CRC-16/XMODEM of bytes 0..=157, low byte first, on a 115200-baud wire. It is **not** a kind
 //!   of this list but a module family of its own, [`crate::datalink`], with its own scanner
@@ -61,7 +61,7 @@
 //!   version byte, [`byte_ns`](crate::wire::byte_ns), the data frame's payload layout (a record
 //!   is a channel byte and those 18 bytes), the scanner's sync-pair search, and the following of
 //!   a counter ([`PacketSequence`](crate::PacketSequence)).
-//! - **Hobbywing V3/V4** (`OLDER-PROTOCOLS.md`): same sync byte and baud rate, but no length
+//! - **Hobbywing V3/V4** (`docs/OLDER-PROTOCOLS.md`): same sync byte and baud rate, but no length
 //!   byte and no checksum. Frames are recognised by fixed bytes, by chaining (the next header
 //!   exactly where the previous frame ended) and by the packet counter, which needs state across
 //!   frames. That is a different scanner, not a kind: a module of its own beside

@@ -1,7 +1,7 @@
 //! The 16-bit status word: named fault flags.
 //!
 //! Bytes 20 (high) and 21 (low) of a data frame. Bit 0 is the least significant bit of the low
-//! byte, bit 8 of the high byte. Names are those of `PROTOCOL-NOTES.md` and are stable across every
+//! byte, bit 8 of the high byte. Names are those of `docs/PROTOCOL-NOTES.md` and are stable across every
 //! output of the project.
 
 use core::fmt;

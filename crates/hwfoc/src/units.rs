@@ -66,7 +66,7 @@ impl Linear {
 }
 
 /// A quantity of a data frame that converts linearly from its raw field, with its name and unit
-/// in every output of the project (`RECORD-SCHEMA.md`).
+/// in every output of the project (`docs/RECORD-SCHEMA.md`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum Quantity {
     /// Input throttle, % (`throttle_in_pct`).

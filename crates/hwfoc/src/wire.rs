@@ -14,7 +14,7 @@
 //! ```
 //!
 //! The length byte counts the bytes before the check bytes (`LEN - w`) and is what tells the
-//! kinds apart; version and command are then checked against the kind (see `PROTOCOL-NOTES.md`).
+//! kinds apart; version and command are then checked against the kind (see `docs/PROTOCOL-NOTES.md`).
 
 /// Baud rate of the HW-FOC telemetry wire (8 data bits, no parity, 1 stop bit: 8N1).
 pub const BAUD_RATE: u32 = 19_200;
@@ -135,7 +135,7 @@ pub const fn crc16_ccitt(mut crc: u16, bytes: &[u8]) -> u16 {
 pub enum Checksum {
     /// The 16-bit wrapping sum of every byte before the check bytes, sent low byte first
     /// (2 check bytes): data frames. Real frames do not match the CRC-16/MODBUS that one revision
-    /// of the vendor document names; the sum does (`PROTOCOL-NOTES.md`).
+    /// of the vendor document names; the sum does (`docs/PROTOCOL-NOTES.md`).
     Sum16Le,
     /// The low byte of that sum (1 check byte): device-information frames.
     Sum8,

@@ -1,5 +1,5 @@
-//! Unit tests built on real frames: the ones quoted in `shared/spec/PROTOCOL-NOTES.md` and the ones
-//! found in the XRotor capture (`shared/captures/xrotor-v4-pro-hv-80A.csv`, byte offsets given
+//! Unit tests built on real frames: the ones quoted in `docs/PROTOCOL-NOTES.md` and the ones
+//! found in the XRotor capture (`testdata/captures/xrotor-v4-pro-hv-80A.csv`, byte offsets given
 //! below are row indices of that capture, header excluded).
 //!
 //! Every stream test decodes twice, with the bulk iterator and with the streaming decoder fed one
@@ -19,7 +19,7 @@ use hwfoc::{
 // Real bytes
 // ---------------------------------------------------------------------------------------------
 
-/// The example frame of PROTOCOL-NOTES.md: the first frame of the XRotor capture (offset 0).
+/// The example frame of docs/PROTOCOL-NOTES.md: the first frame of the XRotor capture (offset 0).
 const EXAMPLE: [u8; 24] = [
     0x9B, 0x16, 0x01, 0x02, 0x05, 0xC2, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0xF7, 0xFF, 0xFF,
     0xFF, 0xFF, 0xCE, 0xD1, 0x00, 0x00, 0x0D, 0x08,
@@ -80,7 +80,7 @@ fn info_bytes() -> [u8; 77] {
     f
 }
 
-/// The sixteen status flag names of PROTOCOL-NOTES.md, bit 0 first.
+/// The sixteen status flag names of docs/PROTOCOL-NOTES.md, bit 0 first.
 const FLAG_NAMES: [&str; 16] = [
     "input_voltage_high",
     "input_voltage_low",
@@ -100,7 +100,7 @@ const FLAG_NAMES: [&str; 16] = [
     "reserved_15",
 ];
 
-/// The vendor's "ADC vs Temperature" table, transcribed from HW-FOC-protocol.txt: (code, degC).
+/// The vendor's "ADC vs Temperature" table, transcribed from docs/HW-FOC-protocol.txt: (code, degC).
 const SPEC_TABLE: [(u8, u8); 130] = [
     (241, 0),
     (240, 1),
@@ -1694,7 +1694,7 @@ fn throttle_percentages_of_a_running_frame() {
     );
 }
 
-/// Every flag's description, as in PROTOCOL-NOTES.md's status table.
+/// Every flag's description, as in docs/PROTOCOL-NOTES.md's status table.
 #[test]
 fn fault_descriptions() {
     let descriptions: Vec<&str> = Fault::ALL.iter().map(|f| f.description()).collect();

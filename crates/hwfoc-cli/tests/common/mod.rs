@@ -12,7 +12,7 @@ use std::time::{SystemTime, UNIX_EPOCH};
 #[allow(unused_imports)]
 pub use self::unix::*;
 
-/// The columns of RECORD-SCHEMA.md, in order: those of the column table, which hwfoc-io's
+/// The columns of docs/RECORD-SCHEMA.md, in order: those of the column table, which hwfoc-io's
 /// `tests/schema.rs` checks against a copy of the specification's table.
 #[allow(unused_imports)]
 pub use hwfoc_io::record::COLUMNS as SCHEMA;

@@ -1,4 +1,4 @@
-//! The column table: every column of `RECORD-SCHEMA.md`, declared once, in schema order.
+//! The column table: every column of `docs/RECORD-SCHEMA.md`, declared once, in schema order.
 //!
 //! Each entry gives the column's name, the type of its values (which fixes its Arrow type, its
 //! nullability, its text and its Parquet storage: see [`Value`](super::Value)), its unit, and
@@ -14,7 +14,7 @@
 //!
 //! # Adding a column
 //!
-//! 1. An entry here, at its place in the schema (and its row in `RECORD-SCHEMA.md`).
+//! 1. An entry here, at its place in the schema (and its row in `docs/RECORD-SCHEMA.md`).
 //! 2. Its row in the copy of that table in hwfoc-io's `tests/schema.rs` (and the example line
 //!    there, which has every column), the test of the schema's order, types and units.
 //!
@@ -67,7 +67,7 @@ columns! {
         text key |f| f.cap_adc;
     /// The raw status word (an unsigned 16-bit integer).
     status: Status, "-", |_, _, f, _| f.status;
-    /// Names of the set status bits, in bit order (from `PROTOCOL-NOTES.md`); derived from
+    /// Names of the set status bits, in bit order (from `docs/PROTOCOL-NOTES.md`); derived from
     /// `status`, not a field of the record.
     faults: FaultList, "-", |_, _, f, _| FaultList(f.status),
         record |r| FaultList(r.status);

@@ -1,4 +1,4 @@
-//! The telemetry record of `RECORD-SCHEMA.md`: one row per data frame, in physical units, the
+//! The telemetry record of `docs/RECORD-SCHEMA.md`: one row per data frame, in physical units, the
 //! same columns in every output.
 //!
 //! The columns are declared once, in the table of [`columns`] (name, unit, value type, how the

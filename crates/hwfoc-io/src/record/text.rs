@@ -397,7 +397,7 @@ mod tests {
         assert_eq!(e.pos + 1, FaultList::TEXT_MAX);
     }
 
-    /// Nulls, numbers and fault lists in JSON and in CSV (RECORD-SCHEMA.md's example line is
+    /// Nulls, numbers and fault lists in JSON and in CSV (docs/RECORD-SCHEMA.md's example line is
     /// in `tests/schema.rs`). Fields are found by name: a new column changes nothing here.
     #[test]
     fn nulls_faults_and_csv() {

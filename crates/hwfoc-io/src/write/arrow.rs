@@ -1,5 +1,5 @@
 //! The records in Apache Arrow: the schema (the names, types, nullability and units of
-//! `RECORD-SCHEMA.md`, for the Parquet writer and for Arrow consumers) and record batches.
+//! `docs/RECORD-SCHEMA.md`, for the Parquet writer and for Arrow consumers) and record batches.
 //!
 //! Both are derived from the column table ([`crate::record::columns`]): a column's Arrow type
 //! and nullability are those of its value type ([`ArrowValue`]), its unit goes in its field's
@@ -127,7 +127,7 @@ pub fn field<C: Column>() -> Field {
     Field::new(C::NAME, <C::Value as ArrowValue>::data_type(), C::NULLABLE).with_metadata(metadata)
 }
 
-/// The Arrow schema of the records: names, types, nullability and units of RECORD-SCHEMA.md.
+/// The Arrow schema of the records: names, types, nullability and units of docs/RECORD-SCHEMA.md.
 pub fn schema() -> Schema {
     struct Fields(Vec<Field>);
     impl Visitor for Fields {

@@ -1,7 +1,7 @@
 //! The Parquet writer: the record schema as an Apache Parquet file, with the Arrow schema
 //! embedded so that Arrow readers (pyarrow, arrow-rs, polars, DuckDB) see the exact types.
 //!
-//! Columns, types and units are those of `RECORD-SCHEMA.md`, from the column table
+//! Columns, types and units are those of `docs/RECORD-SCHEMA.md`, from the column table
 //! ([`crate::record::columns`]); each Arrow field carries its unit in its metadata (key `unit`,
 //! `-` for a number without unit). The file's key-value metadata holds `hwfoc_version`, the
 //! settings (`current_scale`, `pole_pairs`, `gear_ratio`), `inputs` (a JSON array of the input

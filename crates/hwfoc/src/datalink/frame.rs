@@ -199,7 +199,7 @@ mod tests {
         }
     }
 
-    /// The frame of `encode`, checked byte by byte against the layout of `PROTOCOL-NOTES.md`,
+    /// The frame of `encode`, checked byte by byte against the layout of `docs/PROTOCOL-NOTES.md`,
     /// and its CRC against Python's `binascii.crc_hqx(bytes[:158], 0)` (CRC-16/XMODEM).
     #[test]
     fn encode_writes_the_documented_layout() {

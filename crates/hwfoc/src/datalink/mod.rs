@@ -1,5 +1,5 @@
 //! Hobbywing DataLink V2: the hub that merges up to eight ESCs onto one 115200-baud wire, as one
-//! 160-byte frame (`PROTOCOL-NOTES.md`, "The DataLink side").
+//! 160-byte frame (`docs/PROTOCOL-NOTES.md`, "The DataLink side").
 //!
 //! A family of its own beside the HW-FOC decoder ([`crate::decoder`]), not a kind of
 //! [`crate::Frame`]: a hub's wire carries only these frames, an ESC's wire never does, so

@@ -6,7 +6,7 @@
 //! ```
 //!
 //! Payload fields are big-endian; the checksum is the 16-bit wrapping sum of bytes 0..=21, sent low
-//! byte first ([`Checksum::Sum16Le`]; see `PROTOCOL-NOTES.md`: real frames do not match
+//! byte first ([`Checksum::Sum16Le`]; see `docs/PROTOCOL-NOTES.md`: real frames do not match
 //! CRC-16/MODBUS, the sum does).
 
 use crate::status::Status;

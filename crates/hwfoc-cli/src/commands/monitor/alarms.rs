@@ -59,7 +59,7 @@ pub enum Kind {
 }
 
 impl Kind {
-    /// The alarm's name in logs and JSON: a status bit's name as in PROTOCOL-NOTES.md
+    /// The alarm's name in logs and JSON: a status bit's name as in docs/PROTOCOL-NOTES.md
     /// (`mos_overheat`), or `mos_temp`, `cap_temp`, `low_voltage`, `stale`, `disconnected`.
     pub fn name(self) -> &'static str {
         match self {

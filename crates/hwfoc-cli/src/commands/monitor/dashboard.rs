@@ -810,7 +810,7 @@ fn draw_help(frame: &mut Frame, session: &Session) {
             limits.cell.warning, limits.cell.critical
         )),
         Line::from(format!(
-            "  stale after {} s without a frame; status bits by name (PROTOCOL-NOTES.md)",
+            "  stale after {} s without a frame; bit names: docs/PROTOCOL-NOTES.md",
             limits.stale_after_s
         )),
         Line::from("  yellow: warning, red: critical; each alarm is logged once per episode"),

@@ -285,7 +285,7 @@ fn status_json(i: usize, esc: &EscView, now: f64) -> Value {
     })
 }
 
-/// The record exactly as `hwfoc decode` writes it (RECORD-SCHEMA.md).
+/// The record exactly as `hwfoc decode` writes it (docs/RECORD-SCHEMA.md).
 fn record_json(r: &Record) -> Value {
     let mut text = Vec::new();
     r.write_json(&mut text);
