@@ -1,7 +1,8 @@
 //! The DroneCAN output end to end: SLCAN written to a pseudo-terminal standing in for the
 //! adapter, read back and reassembled here; a pty whose far end goes away and comes back; and
-//! (with `HWFOC_DRONECAN_PY` naming a Python that has the `dronecan` package, as
-//! `.ci/dronecan.sh` sets) pydronecan's own SLCAN driver decoding what the output sends.
+//! (ignored unless asked for: it needs a Python with the `dronecan` package, `HWFOC_DRONECAN_PY`
+//! or `python3`; `.ci/dronecan.sh` makes one and runs it) pydronecan's own SLCAN driver decoding
+//! what the output sends.
 
 use std::fs::File;
 use std::io::{BufRead, BufReader, Read, Write};
@@ -20,6 +21,9 @@ use hwfoc_bridge::{Output, OutputError, SILENT_AFTER, Update};
 use hwfoc_io::Record;
 use hwfoc_sim::pty::RawPair;
 use nix::poll::{PollFd, PollFlags, PollTimeout, poll};
+
+#[path = "py/python.rs"]
+mod python;
 
 /// A pty pair: the test holds the master (the adapter's side) and keeps the slave open (so
 /// that the master never sees a hang-up while the program under test reopens it).
@@ -434,16 +438,11 @@ fn relay(a: Pty, b: Pty, stop: Arc<AtomicBool>, b_commands: Arc<Mutex<Vec<String
     }
 }
 
-/// pydronecan, the receiver people use, decodes what the output sends. Skipped unless
-/// `HWFOC_DRONECAN_PY` names a Python with the `dronecan` package (`.ci/dronecan.sh`).
+/// pydronecan, the receiver people use, decodes what the output sends.
 #[test]
+#[ignore = "needs a Python with dronecan (HWFOC_DRONECAN_PY or python3): .ci/dronecan.sh runs it"]
 fn pydronecan_decodes_esc_status_and_node_status() {
-    let Ok(python) = std::env::var("HWFOC_DRONECAN_PY") else {
-        eprintln!(
-            "skipped: set HWFOC_DRONECAN_PY to a Python with the dronecan package (.ci/dronecan.sh does)"
-        );
-        return;
-    };
+    let python = python::python_with("HWFOC_DRONECAN_PY", "dronecan", ".ci/dronecan.sh");
     let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/py/dronecan_check.py");
     let (a, b) = (Pty::open(), Pty::open());
     let (a_path, b_path) = (a.path().to_string(), b.path().to_string());
