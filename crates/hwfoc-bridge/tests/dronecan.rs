@@ -286,14 +286,20 @@ fn setup_then_one_transfer_per_esc_frame_and_node_status() {
     assert_eq!(transfers[0].payload, expected(&r0, 0).serialize());
     assert_eq!(transfers[1].id, 0x1004_0C2A);
     assert_eq!(transfers[1].transfer_id, 0);
-    assert_eq!(transfers[1].payload, expected_extended(&r0, &f0b).serialize());
+    assert_eq!(
+        transfers[1].payload,
+        expected_extended(&r0, &f0b).serialize()
+    );
     assert_eq!(transfers[2].transfer_id, 1);
     let s2 = expected(&r2, 1);
     assert!(s2.temperature.is_nan());
     assert_eq!(transfers[2].payload, s2.serialize());
     let x2 = expected_extended(&r2, &f2);
     assert_eq!((x2.status_flags, x2.input_pct), (0x0004, 59));
-    assert_eq!((transfers[3].transfer_id, data_type(&transfers[3])), (1, 1036));
+    assert_eq!(
+        (transfers[3].transfer_id, data_type(&transfers[3])),
+        (1, 1036)
+    );
     assert_eq!(transfers[3].payload, x2.serialize());
     let transfers = &transfers[2..];
     // NodeStatus: node 42, its own transfer id, WARNING (ESC 2's fault), ESCs 0 and 2 live.
@@ -332,7 +338,10 @@ fn setup_then_one_transfer_per_esc_frame_and_node_status() {
     assert_eq!(transfers.len(), 3, "{transfers:?}");
     assert_eq!(transfers[0].payload, expected(&r2, 1).serialize());
     assert_eq!(transfers[0].transfer_id, 3);
-    assert_eq!(transfers[1].payload, expected_extended(&r2, &f2).serialize());
+    assert_eq!(
+        transfers[1].payload,
+        expected_extended(&r2, &f2).serialize()
+    );
     assert_eq!(transfers[1].transfer_id, 2);
     let transfers = &transfers[1..];
     let node = NodeStatus {

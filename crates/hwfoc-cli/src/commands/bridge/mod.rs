@@ -73,7 +73,8 @@ pub struct BridgeArgs {
     datalink_period: u64,
 
     /// MAVLink 2 to a ground station or flight controller: `udp:HOST:PORT` (`udp` alone is
-    /// 127.0.0.1:14550, where ground stations listen) or `serial:PORT[:BAUD]`. HEARTBEAT,
+    /// 127.0.0.1:14550, where ground stations listen) or `serial:PORT[:BAUD]`; or `file:PATH`, a
+    /// telemetry log (.tlog, as Mission Planner writes and reads them). HEARTBEAT,
     /// ESC_TELEMETRY_1_TO_4.. (Mission Planner), ESC_STATUS and ESC_INFO (QGroundControl, PX4).
     /// Repeat for several destinations.
     #[arg(long, value_name = "SPEC", help_heading = "Outputs")]
@@ -82,6 +83,9 @@ pub struct BridgeArgs {
     #[arg(long, value_name = "N", default_value_t = 1, help_heading = "Outputs",
           value_parser = clap::value_parser!(u8).range(1..=255))]
     mavlink_system: u8,
+    /// A `--mavlink file:PATH` may replace an existing file (never one of the inputs).
+    #[arg(long, help_heading = "Outputs")]
+    overwrite: bool,
     /// MAVLink component id: 158 (peripheral) beside a flight controller; 1 (autopilot) on a
     /// bench without one, so that the ground station takes hwfoc for the vehicle.
     #[arg(long, value_name = "N", default_value_t = mavlink::MAV_COMP_ID_PERIPHERAL,
@@ -89,7 +93,7 @@ pub struct BridgeArgs {
     mavlink_component: u8,
 
     /// A DroneCAN node on an SLCAN adapter, `slcan:PORT[:BITRATE]` (default 1000000 bit/s):
-    /// uavcan.equipment.esc.Status for each ESC, and NodeStatus.
+    /// uavcan.equipment.esc.Status and StatusExtended for each ESC, and NodeStatus.
     #[arg(long, value_name = "SPEC", help_heading = "Outputs")]
     dronecan: Option<String>,
     /// DroneCAN node id (1 to 127).
@@ -194,9 +198,13 @@ fn open_outputs(args: &BridgeArgs) -> Result<Vec<Box<dyn Output>>, CliError> {
     }
     for spec in &args.mavlink {
         let target = MavlinkTarget::parse(spec).map_err(CliError::Output)?;
+        if let MavlinkTarget::File(path) = &target {
+            hwfoc_io::write::refuse_input(path, args.inputs.iter().map(String::as_str))?;
+        }
         let options = MavlinkOptions {
             system_id: args.mavlink_system,
             component_id: args.mavlink_component,
+            overwrite: args.overwrite,
             ..MavlinkOptions::default()
         };
         outputs.push(Box::new(
