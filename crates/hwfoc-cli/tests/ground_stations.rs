@@ -261,20 +261,8 @@ fn the_receiver_reads_a_telemetry_log_with_decodes_values_and_times() {
         );
         match kind.as_str() {
             "ESC_TELEMETRY_1_TO_4" | "ESC_TELEMETRY_5_TO_8" => {
-                let first = if kind == "ESC_TELEMETRY_1_TO_4" { 0 } else { 4 };
                 let mut newest = 0.0f64;
-                for i in 0..4 {
-                    let count = m["count"][i].as_u64().unwrap();
-                    let esc = (first + i) as u64;
-                    if count == 0 || !per_esc.contains_key(&esc) {
-                        continue;
-                    }
-                    // The count-th frame of this ESC is the one the message carries.
-                    let record = &per_esc[&esc][count as usize - 1];
-                    let (cv, ca, rpm) = telemetry_of(record);
-                    assert_eq!(m["voltage"][i].as_u64().unwrap(), cv, "{m} vs {record}");
-                    assert_eq!(m["current"][i].as_u64().unwrap(), ca, "{m} vs {record}");
-                    assert_eq!(m["rpm"][i].as_u64().unwrap(), rpm, "{m} vs {record}");
+                for record in telemetry_records(&kind, m, &per_esc) {
                     let t_s = record["t_s"].as_f64().unwrap();
                     assert!((0.0..1.0).contains(&(time - t_s)), "{m} vs {record}");
                     newest = newest.max(t_s);
@@ -368,8 +356,38 @@ fn telemetry_of(record: &Value) -> (u64, u64, u64) {
     (cv, ca, rpm)
 }
 
-/// Also: the bridge converts each ESC under its own settings of the configuration file, as
-/// `decode` does (ESC 2's motor has 14 pole pairs and its current another scale).
+/// The records an ESC_TELEMETRY_1_TO_4 or _5_TO_8 (`fields`, as pymavlink decodes them)
+/// carries, checked: each ESC's `count`-th record, with its voltage, current and rpm in the
+/// message's units.
+fn telemetry_records<'a>(
+    kind: &str,
+    fields: &Value,
+    per_esc: &'a BTreeMap<u64, Vec<Value>>,
+) -> Vec<&'a Value> {
+    let first = if kind == "ESC_TELEMETRY_1_TO_4" { 0 } else { 4 };
+    let mut carried = Vec::new();
+    for i in 0..4 {
+        let count = fields["count"][i].as_u64().unwrap();
+        let esc = (first + i) as u64;
+        if count == 0 || !per_esc.contains_key(&esc) {
+            continue;
+        }
+        // `count` frames of this ESC had been bridged: the message carries the count-th.
+        let record = &per_esc[&esc][count as usize - 1];
+        let (cv, ca, rpm) = telemetry_of(record);
+        let m = fields;
+        assert_eq!(m["voltage"][i].as_u64().unwrap(), cv, "{m} vs {record}");
+        assert_eq!(m["current"][i].as_u64().unwrap(), ca, "{m} vs {record}");
+        assert_eq!(m["rpm"][i].as_u64().unwrap(), rpm, "{m} vs {record}");
+        carried.push(record);
+    }
+    carried
+}
+
+/// A recording replayed to UDP, decoded by pymavlink (tests/py/mavlink_check.py of
+/// hwfoc-bridge) with the values `hwfoc decode` gives; the bridge converts each ESC under its
+/// own settings of the configuration file, as `decode` does (ESC 2's motor has 14 pole pairs
+/// and its current another scale).
 #[test]
 #[ignore = "needs a Python with pymavlink (HWFOC_PYMAVLINK or python3): .ci/mavlink.sh runs it"]
 fn pymavlink_reads_a_replayed_recording_with_the_values_decode_gives() {
@@ -448,28 +466,9 @@ fn pymavlink_reads_a_replayed_recording_with_the_values_decode_gives() {
     let mut telemetry = 0;
     for m in &messages {
         assert!(m.get("error").is_none(), "{m}");
-        if m["name"] != "ESC_TELEMETRY_1_TO_4" && m["name"] != "ESC_TELEMETRY_5_TO_8" {
-            continue;
-        }
-        let first = if m["name"] == "ESC_TELEMETRY_1_TO_4" {
-            0
-        } else {
-            4
-        };
-        let f = &m["fields"];
-        for i in 0..4 {
-            let count = f["count"][i].as_u64().unwrap();
-            let esc = (first + i) as u64;
-            if count == 0 || !per_esc.contains_key(&esc) {
-                continue;
-            }
-            // `count` frames of this ESC had been bridged: the message carries the count-th.
-            let record = &per_esc[&esc][count as usize - 1];
-            let (cv, ca, rpm) = telemetry_of(record);
-            assert_eq!(f["voltage"][i].as_u64().unwrap(), cv, "{m} vs {record}");
-            assert_eq!(f["current"][i].as_u64().unwrap(), ca, "{m} vs {record}");
-            assert_eq!(f["rpm"][i].as_u64().unwrap(), rpm, "{m} vs {record}");
-            telemetry += 1;
+        let kind = m["name"].as_str().unwrap();
+        if kind.starts_with("ESC_TELEMETRY_") {
+            telemetry += telemetry_records(kind, &m["fields"], &per_esc).len();
         }
     }
     let frames: usize = per_esc.values().map(Vec::len).sum();

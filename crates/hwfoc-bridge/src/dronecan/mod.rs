@@ -424,6 +424,13 @@ impl DronecanOutput {
     }
 }
 
+/// The transfer id to use from a message type's counter, which moves on (5 bits, wrapping).
+fn next_transfer_id(counter: &mut u8) -> u8 {
+    let tid = *counter;
+    *counter = (tid + 1) & 0x1F;
+    tid
+}
+
 /// Opens an SLCAN adapter and sends its setup.
 fn open_adapter(port: &str, baud: u32, code: u8) -> Result<Box<dyn SerialPort>, String> {
     let mut p = hwfoc_io::serial::open(port, baud).map_err(|e| e.to_string())?;
@@ -496,8 +503,7 @@ impl Output for DronecanOutput {
                 continue;
             }
             self.out.clear();
-            let tid = self.esc_transfer_id;
-            self.esc_transfer_id = (tid + 1) & 0x1F;
+            let tid = next_transfer_id(&mut self.esc_transfer_id);
             self.push_transfer(
                 dsdl::ESC_STATUS_ID,
                 dsdl::ESC_STATUS_SIGNATURE,
@@ -509,8 +515,7 @@ impl Output for DronecanOutput {
                 .is_none_or(|sent| arrived.saturating_duration_since(sent) >= EXTENDED_EVERY);
             if extended_due {
                 self.escs[i].extended_sent = Some(arrived);
-                let tid = self.extended_transfer_id;
-                self.extended_transfer_id = (tid + 1) & 0x1F;
+                let tid = next_transfer_id(&mut self.extended_transfer_id);
                 self.push_transfer(
                     dsdl::ESC_STATUS_EXTENDED_ID,
                     dsdl::ESC_STATUS_EXTENDED_SIGNATURE,
@@ -525,8 +530,7 @@ impl Output for DronecanOutput {
         if self.next_node_status.is_none_or(|t| now >= t) {
             let payload = self.node_status(now).serialize();
             self.out.clear();
-            let tid = self.node_transfer_id;
-            self.node_transfer_id = (tid + 1) & 0x1F;
+            let tid = next_transfer_id(&mut self.node_transfer_id);
             self.push_transfer(
                 dsdl::NODE_STATUS_ID,
                 dsdl::NODE_STATUS_SIGNATURE,
