@@ -39,7 +39,8 @@ const EXAMPLES: &str = "\
 Examples:
   hwfoc bridge --sim 4 --mavlink udp:127.0.0.1:14550     # four virtual ESCs to a ground station
   hwfoc bridge /dev/ttyUSB0 /dev/ttyUSB1 --datalink /dev/ttyAMA0
-  hwfoc bridge flight.pcapng --mavlink udp:192.168.1.20:14550 --dronecan slcan:/dev/ttyACM0";
+  hwfoc bridge flight.pcapng --mavlink udp:192.168.1.20:14550 --dronecan slcan:/dev/ttyACM0
+  hwfoc bridge flight.pcapng --mavlink file:flight.tlog   # a telemetry log, the flight's times";
 
 /// Arguments of `hwfoc bridge`.
 #[derive(Debug, Args)]
