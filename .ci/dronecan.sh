@@ -4,9 +4,17 @@
 # pseudo-terminals to crates/hwfoc-bridge/tests/py/dronecan_check.py and compares every
 # esc.Status it decodes with the records sent. Called by .ci/run; runs on its own too.
 set -euo pipefail
+export CARGO_TERM_COLOR=never
 cd "$(dirname "$0")/.."
 venv=${TMPDIR:-/tmp}/hwfoc-ci-dronecan-venv
 python3 -m venv "$venv"
 "$venv/bin/pip" install -q dronecan pyserial
 "$venv/bin/python" -c 'import dronecan, serial; print("dronecan", dronecan.__version__, "pyserial", serial.VERSION)'
-HWFOC_DRONECAN_PY="$venv/bin/python" cargo test -p hwfoc-bridge --test dronecan -- --nocapture
+# The pydronecan test is #[ignore]d in `cargo test`: here it runs (--include-ignored), and this
+# checks that every test of the file passed and none was left out.
+log=${TMPDIR:-/tmp}/hwfoc-ci-dronecan.log
+HWFOC_DRONECAN_PY="$venv/bin/python" cargo test -p hwfoc-bridge --test dronecan \
+  -- --include-ignored --nocapture 2>&1 | tee "$log"
+grep -Eq "^test result: ok\. [1-9][0-9]* passed; 0 failed; 0 ignored" "$log" \
+  || { echo "the DroneCAN tests did not all run and pass (see $log)" >&2; exit 1; }
+grep -q "pydronecan decoded" "$log" || { echo "the pydronecan test did not run" >&2; exit 1; }

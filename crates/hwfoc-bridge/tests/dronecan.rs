@@ -1,7 +1,8 @@
 //! The DroneCAN output end to end: SLCAN written to a pseudo-terminal standing in for the
 //! adapter, read back and reassembled here; a pty whose far end goes away and comes back; and
-//! (with `HWFOC_DRONECAN_PY` naming a Python that has the `dronecan` package, as
-//! `.ci/dronecan.sh` sets) pydronecan's own SLCAN driver decoding what the output sends.
+//! (ignored unless asked for: it needs a Python with the `dronecan` package, `HWFOC_DRONECAN_PY`
+//! or `python3`; `.ci/dronecan.sh` makes one and runs it) pydronecan's own SLCAN driver decoding
+//! what the output sends.
 
 use std::fs::File;
 use std::io::{BufRead, BufReader, Read, Write};
@@ -13,13 +14,18 @@ use std::thread;
 use std::time::{Duration, Instant};
 
 use hwfoc::{DataFrame, Settings, Status};
-use hwfoc_bridge::dronecan::dsdl::{self, EscStatus, Health, NodeStatus, f16_bits};
+use hwfoc_bridge::dronecan::dsdl::{
+    self, EscStatus, EscStatusExtended, Health, NodeStatus, f16_bits,
+};
 use hwfoc_bridge::dronecan::transport::transfer_crc;
 use hwfoc_bridge::dronecan::{DronecanOptions, DronecanOutput, SlcanTarget};
 use hwfoc_bridge::{Output, OutputError, SILENT_AFTER, Update};
 use hwfoc_io::Record;
 use hwfoc_sim::pty::RawPair;
 use nix::poll::{PollFd, PollFlags, PollTimeout, poll};
+
+#[path = "py/python.rs"]
+mod python;
 
 /// A pty pair: the test holds the master (the adapter's side) and keeps the slave open (so
 /// that the master never sees a hang-up while the program under test reopens it).
@@ -102,6 +108,23 @@ fn expected(r: &Record, error_count: u32) -> EscStatus {
         power_rating_pct: r.throttle_out_pct.round().clamp(0.0, 127.0) as u8,
         esc_index: r.esc,
     }
+}
+
+/// The esc.StatusExtended the output should send for `r` (frame `f`).
+fn expected_extended(r: &Record, f: &DataFrame) -> EscStatusExtended {
+    EscStatusExtended {
+        input_pct: r.throttle_in_pct.round() as u8,
+        output_pct: r.throttle_out_pct.round() as u8,
+        motor_temperature_deg_c: 0,
+        motor_angle: 0,
+        status_flags: u32::from(f.status.0),
+        esc_index: r.esc,
+    }
+}
+
+/// The data type of a transfer's CAN id.
+fn data_type(t: &Transfer) -> u32 {
+    t.id >> 8 & 0xFFFF
 }
 
 /// One reassembled transfer.
@@ -256,14 +279,29 @@ fn setup_then_one_transfer_per_esc_frame_and_node_status() {
     // The setup: an empty command, close, 1 Mbit/s, open.
     assert_eq!(commands[..4], ["", "C", "S8", "O"]);
     assert!(commands[4..].iter().all(String::is_empty), "{commands:?}");
-    assert_eq!(transfers.len(), 3, "{transfers:?}");
+    // Each ESC's esc.Status then (its first frame) its esc.StatusExtended, then NodeStatus.
+    assert_eq!(transfers.len(), 5, "{transfers:?}");
     assert_eq!(transfers[0].id, 0x1004_0A2A);
     assert_eq!(transfers[0].transfer_id, 0);
     assert_eq!(transfers[0].payload, expected(&r0, 0).serialize());
-    assert_eq!(transfers[1].transfer_id, 1);
+    assert_eq!(transfers[1].id, 0x1004_0C2A);
+    assert_eq!(transfers[1].transfer_id, 0);
+    assert_eq!(
+        transfers[1].payload,
+        expected_extended(&r0, &f0b).serialize()
+    );
+    assert_eq!(transfers[2].transfer_id, 1);
     let s2 = expected(&r2, 1);
     assert!(s2.temperature.is_nan());
-    assert_eq!(transfers[1].payload, s2.serialize());
+    assert_eq!(transfers[2].payload, s2.serialize());
+    let x2 = expected_extended(&r2, &f2);
+    assert_eq!((x2.status_flags, x2.input_pct), (0x0004, 59));
+    assert_eq!(
+        (transfers[3].transfer_id, data_type(&transfers[3])),
+        (1, 1036)
+    );
+    assert_eq!(transfers[3].payload, x2.serialize());
+    let transfers = &transfers[2..];
     // NodeStatus: node 42, its own transfer id, WARNING (ESC 2's fault), ESCs 0 and 2 live.
     assert_eq!(transfers[2].id, 0x1001_552A);
     assert_eq!(transfers[2].transfer_id, 0);
@@ -276,22 +314,36 @@ fn setup_then_one_transfer_per_esc_frame_and_node_status() {
     };
     assert_eq!(transfers[2].payload, node.serialize());
     let s = out.stats();
-    assert_eq!((s.messages, s.superseded, s.errors), (3, 1, 0));
+    assert_eq!((s.messages, s.superseded, s.errors), (5, 1, 0));
     assert_eq!(s.latency.count(), 2);
-    assert_eq!(out.frames(), 7);
+    assert_eq!(out.frames(), 9);
     // Nothing new: nothing sent, not even NodeStatus before its second.
     out.poll(t0 + Duration::from_millis(500)).unwrap();
     assert!(parse(&pty.read_now()).1.is_empty());
-    // A second later: NodeStatus, uptime 1; ESC 2 is fine now and ESC 0 silent (health
-    // WARNING: heard, then silent) and not sent.
-    let f2 = data_frame(8, 3000, 160, 100, 0);
+    // A frame of ESC 2 less than EXTENDED_EVERY after its first: esc.Status alone.
+    let f2 = data_frame(8, 2900, 160, 100, 0);
+    let r2 = update(&mut out, 2, &f2, t0 + Duration::from_millis(100));
+    out.poll(t0 + Duration::from_millis(600)).unwrap();
+    let (_, transfers) = parse(&pty.read_now());
+    assert_eq!(transfers.len(), 1, "{transfers:?}");
+    assert_eq!(transfers[0].payload, expected(&r2, 1).serialize());
+    // A second later: NodeStatus, uptime 1; ESC 2 is fine now (its esc.StatusExtended due
+    // again, with status flags 0) and ESC 0 silent (health WARNING: heard, then silent) and not
+    // sent.
+    let f2 = data_frame(9, 3000, 160, 100, 0);
     let r2 = update(&mut out, 2, &f2, t0 + Duration::from_millis(900));
     let later = t0 + SILENT_AFTER + Duration::from_millis(10);
     out.poll(later).unwrap();
     let (_, transfers) = parse(&pty.read_now());
-    assert_eq!(transfers.len(), 2);
+    assert_eq!(transfers.len(), 3, "{transfers:?}");
     assert_eq!(transfers[0].payload, expected(&r2, 1).serialize());
-    assert_eq!(transfers[0].transfer_id, 2);
+    assert_eq!(transfers[0].transfer_id, 3);
+    assert_eq!(
+        transfers[1].payload,
+        expected_extended(&r2, &f2).serialize()
+    );
+    assert_eq!(transfers[1].transfer_id, 2);
+    let transfers = &transfers[1..];
     let node = NodeStatus {
         uptime_sec: 1,
         health: Health::Warning,
@@ -316,7 +368,7 @@ fn transfer_ids_wrap_and_stale_or_unnumbered_escs_are_not_sent() {
         tids.extend(
             transfers
                 .iter()
-                .filter(|t| t.id >> 8 & 0xFFFF == 1034)
+                .filter(|t| data_type(t) == 1034)
                 .map(|t| t.transfer_id),
         );
     }
@@ -328,7 +380,7 @@ fn transfer_ids_wrap_and_stale_or_unnumbered_escs_are_not_sent() {
     out.poll(t0 + SILENT_AFTER).unwrap();
     let (_, transfers) = parse(&pty.read_now());
     assert!(
-        transfers.iter().all(|t| t.id >> 8 & 0xFFFF == 341),
+        transfers.iter().all(|t| data_type(t) == 341),
         "{transfers:?}"
     );
     assert_eq!(out.not_sent(), 2);
@@ -387,6 +439,7 @@ fn a_lost_adapter_is_reopened_and_set_up_again() {
     let (commands, transfers) = parse(&second.read_now());
     assert_eq!(commands[..4], ["", "C", "S6", "O"]);
     // The ESC frame of this poll and a NodeStatus straight away.
+    let transfers: Vec<_> = transfers.iter().filter(|t| data_type(t) != 1036).collect();
     assert_eq!(transfers.len(), 2, "{transfers:?}");
     assert_eq!(out.stats().errors, 1);
 }
@@ -434,16 +487,12 @@ fn relay(a: Pty, b: Pty, stop: Arc<AtomicBool>, b_commands: Arc<Mutex<Vec<String
     }
 }
 
-/// pydronecan, the receiver people use, decodes what the output sends. Skipped unless
-/// `HWFOC_DRONECAN_PY` names a Python with the `dronecan` package (`.ci/dronecan.sh`).
+/// pydronecan, the receiver people use, decodes what the output sends: esc.Status,
+/// esc.StatusExtended and NodeStatus.
 #[test]
-fn pydronecan_decodes_esc_status_and_node_status() {
-    let Ok(python) = std::env::var("HWFOC_DRONECAN_PY") else {
-        eprintln!(
-            "skipped: set HWFOC_DRONECAN_PY to a Python with the dronecan package (.ci/dronecan.sh does)"
-        );
-        return;
-    };
+#[ignore = "needs a Python with dronecan (HWFOC_DRONECAN_PY or python3): .ci/dronecan.sh runs it"]
+fn pydronecan_decodes_esc_status_extended_and_node_status() {
+    let python = python::python_with("HWFOC_DRONECAN_PY", "dronecan", ".ci/dronecan.sh");
     let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/py/dronecan_check.py");
     let (a, b) = (Pty::open(), Pty::open());
     let (a_path, b_path) = (a.path().to_string(), b.path().to_string());
@@ -491,7 +540,7 @@ fn pydronecan_decodes_esc_status_and_node_status() {
     }
     // Rounds of frames of four ESCs until pydronecan has what it wants. Each frame's rpm is
     // unique: a decoded esc.Status is matched to the record it came from by (esc, rpm).
-    let mut sent: Vec<(Record, u32)> = Vec::new();
+    let mut sent: Vec<(Record, u32, DataFrame)> = Vec::new();
     let mut faults = [0u32; 4];
     let mut round = 0u16;
     let mut done = false;
@@ -515,7 +564,7 @@ fn pydronecan_decodes_esc_status_and_node_status() {
                 faults[usize::from(esc)] += 1;
             }
             let r = update(&mut out, esc, &f, now);
-            sent.push((r, faults[usize::from(esc)]));
+            sent.push((r, faults[usize::from(esc)], f));
         }
         out.poll(now).unwrap();
         round += 1;
@@ -539,6 +588,7 @@ fn pydronecan_decodes_esc_status_and_node_status() {
         (!x.is_nan()).then_some(x)
     };
     let (mut escs, mut nodes) = (0, 0);
+    let mut extended = [0; 4];
     for line in &lines {
         let v: serde_json::Value = serde_json::from_str(line).unwrap_or_else(|_| panic!("{line}"));
         assert_eq!(v["source"], 100, "{line}");
@@ -546,9 +596,9 @@ fn pydronecan_decodes_esc_status_and_node_status() {
             "esc" => {
                 let esc = v["esc_index"].as_u64().unwrap() as u8;
                 let rpm = v["rpm"].as_i64().unwrap() as i32;
-                let (r, error_count) = sent
+                let (r, error_count, _) = sent
                     .iter()
-                    .find(|(r, _)| r.esc == esc && r.rpm.round() as i32 == rpm)
+                    .find(|(r, _, _)| r.esc == esc && r.rpm.round() as i32 == rpm)
                     .unwrap_or_else(|| panic!("decoded but never sent: {line}"));
                 let want = expected(r, *error_count);
                 assert_eq!(v["error_count"], want.error_count, "{line}");
@@ -566,6 +616,23 @@ fn pydronecan_decodes_esc_status_and_node_status() {
                 }
                 escs += 1;
             }
+            "ext" => {
+                let esc = v["esc_index"].as_u64().unwrap() as u8;
+                let decoded = EscStatusExtended {
+                    input_pct: v["input_pct"].as_u64().unwrap() as u8,
+                    output_pct: v["output_pct"].as_u64().unwrap() as u8,
+                    motor_temperature_deg_c: v["motor_temperature_degC"].as_i64().unwrap() as i16,
+                    motor_angle: v["motor_angle"].as_u64().unwrap() as u16,
+                    status_flags: v["status_flags"].as_u64().unwrap() as u32,
+                    esc_index: esc,
+                };
+                assert!(
+                    sent.iter()
+                        .any(|(r, _, f)| r.esc == esc && expected_extended(r, f) == decoded),
+                    "decoded but never sent: {line}"
+                );
+                extended[usize::from(esc)] += 1;
+            }
             "node" => {
                 assert_eq!(v["mode"], 0, "{line}");
                 assert!(v["health"] == 0 || v["health"] == 1, "{line}");
@@ -575,12 +642,12 @@ fn pydronecan_decodes_esc_status_and_node_status() {
         }
     }
     assert!(
-        escs >= WANT_ESC && nodes >= 2,
-        "{escs} esc.Status, {nodes} NodeStatus"
+        escs >= WANT_ESC && nodes >= 2 && extended.iter().all(|&n| n > 0),
+        "{escs} esc.Status, {extended:?} esc.StatusExtended, {nodes} NodeStatus"
     );
     eprintln!(
-        "pydronecan decoded {escs} esc.Status and {nodes} NodeStatus ({} rounds sent)",
-        round
+        "pydronecan decoded {escs} esc.Status, {extended:?} esc.StatusExtended and {nodes} \
+         NodeStatus ({round} rounds sent)"
     );
 }
 

@@ -498,6 +498,8 @@ fn targets_parse() {
         "serial:",
         "tcp:1.2.3.4:1",
         "serial:/dev/x:0",
+        "file",
+        "file:",
     ] {
         let e = MavlinkTarget::parse(bad).unwrap_err();
         assert!(matches!(e, OutputError::Open { .. }), "{bad}");
@@ -507,12 +509,129 @@ fn targets_parse() {
             "{e}"
         );
     }
+    assert_eq!(
+        MavlinkTarget::parse("file:logs/a b.tlog").unwrap(),
+        MavlinkTarget::File("logs/a b.tlog".into())
+    );
+    assert_eq!(
+        MavlinkTarget::File("x.tlog".into()).to_string(),
+        "file:x.tlog"
+    );
     let missing = MavlinkOutput::open(
         MavlinkTarget::parse("serial:/dev/ttyUSB_no_such_port").unwrap(),
         MavlinkOptions::default(),
     )
     .unwrap_err();
     assert!(matches!(missing, OutputError::Open { .. }), "{missing}");
+}
+
+/// A telemetry log's messages: each one's time (64-bit big-endian microseconds) and message.
+fn tlog(bytes: &[u8]) -> Vec<(u64, MavMessage)> {
+    let mut out = Vec::new();
+    let mut at = 0;
+    while at < bytes.len() {
+        let time = u64::from_be_bytes(bytes[at..at + 8].try_into().unwrap());
+        let frame = &bytes[at + 8..];
+        assert_eq!(frame[0], 0xFD, "a MAVLink 2 frame after each time");
+        let len = 12 + usize::from(frame[1]);
+        let mut reader = MavlinkReader::new(&frame[..len]);
+        let (_, message) = reader
+            .read_message::<MavMessage>(MavlinkVersion::V2)
+            .expect("a valid MAVLink 2 frame");
+        out.push((time, message));
+        at += 8 + len;
+    }
+    out
+}
+
+/// `file:PATH`: a telemetry log starting with the first frame, each message after the time of
+/// its data (the records' Unix times), never going back, ESC_STATUS's `time_usec` the same;
+/// records without a Unix time take the system clock; an existing file is refused unless
+/// `overwrite`.
+#[test]
+fn a_telemetry_log_has_each_message_after_the_time_of_its_data() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("flight.tlog");
+    let target = MavlinkTarget::File(path.to_str().unwrap().to_string());
+    let mut out = MavlinkOutput::open(target.clone(), MavlinkOptions::default()).unwrap();
+    let t0 = Instant::now();
+    out.poll(t0).unwrap();
+    assert_eq!(out.stats().messages, 0, "nothing before the first frame");
+    let unix0 = 1_700_000_000.0;
+    // Two ESCs, one frame each every 50 ms; ESC 1's frames arrive 10 ms late.
+    for k in 0..30u32 {
+        for esc in 0..2u8 {
+            let arrived = t0 + Duration::from_millis(u64::from(50 * k + 10 * u32::from(esc)));
+            let record = Record::new(
+                Some(unix0 + f64::from(k) * 0.05),
+                esc,
+                &frame(k as u16, Status::OK),
+                &Settings::default(),
+            );
+            out.update(&Update {
+                esc,
+                frame: &frame(k as u16, Status::OK),
+                record: &record,
+                arrived,
+            });
+            out.poll(arrived + Duration::from_millis(3)).unwrap();
+        }
+    }
+    drop(out);
+    let messages = tlog(&std::fs::read(&path).unwrap());
+    assert!(matches!(messages[0].1, MavMessage::HEARTBEAT(_)));
+    let usec = |s: f64| (s * 1e6).round() as u64;
+    // The first poll with a frame: its time plus the 3 ms since it arrived.
+    assert_eq!(messages[0].0, usec(unix0 + 0.003));
+    for w in messages.windows(2) {
+        assert!(w[0].0 <= w[1].0, "times never go back");
+    }
+    let last = messages.last().unwrap().0;
+    assert!(
+        (usec(unix0 + 1.45)..usec(unix0 + 1.47)).contains(&last),
+        "{last}"
+    );
+    let mut statuses = 0;
+    for (time, m) in &messages {
+        if let MavMessage::ESC_STATUS(d) = m {
+            assert_eq!(d.time_usec, *time);
+            statuses += 1;
+        }
+    }
+    assert_eq!(statuses, 60);
+
+    // An existing file: refused, unchanged; replaced when asked.
+    let before = std::fs::read(&path).unwrap();
+    let e = MavlinkOutput::open(target.clone(), MavlinkOptions::default()).unwrap_err();
+    assert!(matches!(e, OutputError::Open { .. }), "{e}");
+    assert!(e.to_string().contains("exists"), "{e}");
+    assert_eq!(std::fs::read(&path).unwrap(), before);
+    let options = MavlinkOptions {
+        overwrite: true,
+        ..MavlinkOptions::default()
+    };
+    let mut out = MavlinkOutput::open(target, options).unwrap();
+    assert!(std::fs::read(&path).unwrap().is_empty());
+    // Records without a Unix time (a capture's own clock): the system clock.
+    let now = Instant::now();
+    let record = Record::new(Some(12.5), 0, &frame(1, Status::OK), &Settings::default());
+    out.update(&Update {
+        esc: 0,
+        frame: &frame(1, Status::OK),
+        record: &record,
+        arrived: now,
+    });
+    out.poll(now).unwrap();
+    let unix_now = std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .unwrap()
+        .as_secs_f64();
+    for (time, _) in tlog(&std::fs::read(&path).unwrap()) {
+        assert!(
+            (usec(unix_now - 5.0)..=usec(unix_now)).contains(&time),
+            "{time}"
+        );
+    }
 }
 
 #[test]

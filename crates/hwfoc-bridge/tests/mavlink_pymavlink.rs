@@ -4,8 +4,8 @@
 //! it was made of, in the units of the message definitions, computed here independently of the
 //! encoder.
 //!
-//! Needs `HWFOC_PYMAVLINK`: a Python with pymavlink (`.ci/mavlink.sh` makes one and runs this
-//! test). Without it the test says it is skipped and passes.
+//! Needs a Python with pymavlink (`HWFOC_PYMAVLINK`, or `python3` if it has it): ignored unless
+//! asked for (`--include-ignored`); `.ci/mavlink.sh` makes one and runs this test.
 
 use std::io::{BufRead, BufReader};
 use std::net::SocketAddr;
@@ -18,6 +18,9 @@ use hwfoc_bridge::mavlink::{MavlinkOptions, MavlinkOutput, MavlinkTarget};
 use hwfoc_bridge::{Output, SILENT_AFTER, Update};
 use hwfoc_io::Record;
 use serde_json::Value;
+
+#[path = "py/python.rs"]
+mod python;
 
 const ESCS: usize = 5;
 /// ESC 3 sends only its first frames, then is silent.
@@ -117,13 +120,9 @@ struct Poll {
 }
 
 #[test]
+#[ignore = "needs a Python with pymavlink (HWFOC_PYMAVLINK or python3): .ci/mavlink.sh runs it"]
 fn pymavlink_decodes_every_message_with_the_records_values() {
-    let Ok(python) = std::env::var("HWFOC_PYMAVLINK") else {
-        eprintln!(
-            "skipped: HWFOC_PYMAVLINK is not set (a Python with pymavlink; .ci/mavlink.sh sets it)"
-        );
-        return;
-    };
+    let python = python::python_with("HWFOC_PYMAVLINK", "pymavlink", ".ci/mavlink.sh");
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests");
     let mut child = Command::new(&python)
         .arg(dir.join("py/mavlink_check.py"))

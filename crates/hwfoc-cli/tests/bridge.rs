@@ -1,25 +1,21 @@
 //! `hwfoc bridge` end to end, through real pseudo-terminals and sockets: virtual ESCs on ptys ->
 //! `hwfoc bridge --datalink` -> a pty read back by `hwfoc decode` (every frame of every ESC, in
 //! its channel); DataLink inputs with bad frames; outputs that fail (an unreachable UDP
-//! destination, an SLCAN adapter unplugged) while the others go on; and, where pymavlink is
-//! available (`HWFOC_PYMAVLINK`, set by `.ci/mavlink.sh`), a recording replayed to MAVLink and
-//! decoded by pymavlink with the values `hwfoc decode` gives for the same recording.
+//! destination, an SLCAN adapter unplugged) while the others go on. MAVLink as ground stations
+//! receive it is in `ground_stations.rs`.
 
 #![cfg(unix)]
 
 mod common;
 
-use std::collections::BTreeMap;
-use std::io::{BufRead, BufReader, Read, Write};
+use std::io::{Read, Write};
 use std::os::fd::AsFd;
-use std::path::Path;
-use std::process::{Command, Stdio};
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::thread;
 use std::time::{Duration, Instant};
 
-use common::{Dir, hwfoc, ok, run};
+use common::{Dir, by_esc, hwfoc, ok, records, run};
 use common::{Pty, Running, pty};
 use hwfoc::datalink::{DatalinkFrame, LengthByte};
 use hwfoc::{DataFrame, Status};
@@ -28,13 +24,6 @@ use nix::sys::signal::Signal;
 use serde_json::Value;
 
 const ESCS: usize = 8;
-
-fn records(jsonl: &str) -> Vec<Value> {
-    jsonl
-        .lines()
-        .map(|l| serde_json::from_str(l).expect("a JSON record"))
-        .collect()
-}
 
 /// Copies what arrives on `from`'s master to `to` (a pty's master, or a buffer) until `stop`.
 fn pump(mut from: std::fs::File, mut to: impl Write + Send + 'static, stop: Arc<AtomicBool>) {
@@ -67,17 +56,6 @@ fn drained() -> (Pty, Arc<AtomicBool>) {
         Arc::clone(&stop),
     );
     (pty, stop)
-}
-
-/// Frames sent by the simulator (its truth), by ESC, in order.
-fn by_esc(records: &[Value]) -> BTreeMap<u64, Vec<Value>> {
-    let mut out: BTreeMap<u64, Vec<Value>> = BTreeMap::new();
-    for r in records {
-        out.entry(r["esc"].as_u64().unwrap())
-            .or_default()
-            .push(r.clone());
-    }
-    out
 }
 
 #[test]
@@ -374,130 +352,6 @@ fn a_udp_destination_needs_a_port_and_an_address() {
             spec,
         ]));
         common::assert_fails_with(&o, &format!("mavlink {spec}: cannot open: {needle}"));
-    }
-}
-
-/// The MAVLink fields of ESC_TELEMETRY that carry a record's values, in the message's units.
-fn telemetry_of(record: &Value) -> (u64, u64, u64) {
-    let cv = (record["voltage_v"].as_f64().unwrap() * 100.0).round() as u64;
-    let ca = (record["current_a"].as_f64().unwrap().max(0.0) * 100.0).round() as u64;
-    let rpm = record["rpm"].as_f64().unwrap().round() as u64;
-    (cv, ca, rpm)
-}
-
-/// Also: the bridge converts each ESC under its own settings of the configuration file, as
-/// `decode` does (ESC 2's motor has 14 pole pairs and its current another scale).
-#[test]
-fn pymavlink_reads_a_replayed_recording_with_the_values_decode_gives() {
-    let Ok(python) = std::env::var("HWFOC_PYMAVLINK") else {
-        eprintln!("skipped: HWFOC_PYMAVLINK is not set (.ci/mavlink.sh sets it)");
-        return;
-    };
-    let dir = Dir::new();
-    let recording = dir.path("run.pcapng");
-    ok(run(hwfoc()
-        .args([
-            "simulate",
-            "--escs",
-            "5",
-            "--duration",
-            "4",
-            "--lead-in",
-            "0.5",
-        ])
-        .args(["--profile", "sine", "--no-config", "-o"])
-        .arg(&recording)));
-    let config = dir.path("config.toml");
-    std::fs::write(&config, "[esc.2]\npole_pairs = 14\ncurrent_scale = 100\n").unwrap();
-    let decoded = records(
-        &String::from_utf8(
-            ok(run(hwfoc()
-                .arg("decode")
-                .arg("--config")
-                .arg(&config)
-                .arg(&recording)))
-            .stdout,
-        )
-        .unwrap(),
-    );
-    let per_esc = by_esc(&decoded);
-    // ESC 2's records are under its own settings (half the rpm of the same erpm at 7 pairs).
-    let turning = per_esc[&2]
-        .iter()
-        .find(|r| r["erpm"].as_f64().unwrap() > 0.0);
-    let r = turning.expect("ESC 2 turns");
-    let (rpm, erpm) = (r["rpm"].as_f64().unwrap(), r["erpm"].as_f64().unwrap());
-    assert!((rpm - erpm / 14.0).abs() < 1e-3 * erpm, "{r}");
-
-    let xml = Path::new(env!("CARGO_MANIFEST_DIR")).join("../hwfoc-bridge/tests/mavlink-xml");
-    let script =
-        Path::new(env!("CARGO_MANIFEST_DIR")).join("../hwfoc-bridge/tests/py/mavlink_check.py");
-    let mut receiver = Command::new(python)
-        .arg(script)
-        .arg(xml)
-        .stdin(Stdio::piped())
-        .stdout(Stdio::piped())
-        .spawn()
-        .expect("start the pymavlink receiver");
-    let mut lines = BufReader::new(receiver.stdout.take().unwrap()).lines();
-    let ready = lines.next().unwrap().unwrap();
-    let port = ready
-        .strip_prefix("READY ")
-        .expect("READY line")
-        .trim()
-        .to_string();
-
-    let bridge = run(hwfoc()
-        .arg("bridge")
-        .arg("--config")
-        .arg(&config)
-        .arg(&recording)
-        .args(["--mavlink", &format!("udp:127.0.0.1:{port}")]));
-    assert!(
-        bridge.status.success(),
-        "{}",
-        String::from_utf8_lossy(&bridge.stderr)
-    );
-    drop(receiver.stdin.take());
-    let messages: Vec<Value> = lines
-        .map(|l| serde_json::from_str(&l.unwrap()).unwrap())
-        .collect();
-    receiver.wait().unwrap();
-
-    let mut telemetry = 0;
-    for m in &messages {
-        assert!(m.get("error").is_none(), "{m}");
-        if m["name"] != "ESC_TELEMETRY_1_TO_4" && m["name"] != "ESC_TELEMETRY_5_TO_8" {
-            continue;
-        }
-        let first = if m["name"] == "ESC_TELEMETRY_1_TO_4" {
-            0
-        } else {
-            4
-        };
-        let f = &m["fields"];
-        for i in 0..4 {
-            let count = f["count"][i].as_u64().unwrap();
-            let esc = (first + i) as u64;
-            if count == 0 || !per_esc.contains_key(&esc) {
-                continue;
-            }
-            // `count` frames of this ESC had been bridged: the message carries the count-th.
-            let record = &per_esc[&esc][count as usize - 1];
-            let (cv, ca, rpm) = telemetry_of(record);
-            assert_eq!(f["voltage"][i].as_u64().unwrap(), cv, "{m} vs {record}");
-            assert_eq!(f["current"][i].as_u64().unwrap(), ca, "{m} vs {record}");
-            assert_eq!(f["rpm"][i].as_u64().unwrap(), rpm, "{m} vs {record}");
-            telemetry += 1;
-        }
-    }
-    let frames: usize = per_esc.values().map(Vec::len).sum();
-    assert!(
-        telemetry >= frames * 9 / 10,
-        "{telemetry} ESC values in ESC_TELEMETRY for {frames} frames"
-    );
-    for name in ["HEARTBEAT", "ESC_STATUS", "ESC_INFO"] {
-        assert!(messages.iter().any(|m| m["name"] == name), "no {name}");
     }
 }
 

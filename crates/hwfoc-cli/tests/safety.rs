@@ -294,12 +294,28 @@ fn an_output_that_is_standard_input_or_the_configuration_is_refused() {
                 "CONFIG",
             ],
         ),
+        (
+            "log.toml",
+            vec![
+                "bridge",
+                &csv,
+                "--mavlink",
+                "file:CONFIG",
+                "--overwrite",
+                "--config",
+                "CONFIG",
+            ],
+        ),
     ] {
         let config = dir.arg(name);
         std::fs::write(&config, toml).unwrap();
-        let args: Vec<&str> = args
+        let args: Vec<String> = args
             .iter()
-            .map(|a| if *a == "CONFIG" { config.as_str() } else { a })
+            .map(|a| match *a {
+                "CONFIG" => config.clone(),
+                "file:CONFIG" => format!("file:{config}"),
+                a => a.to_string(),
+            })
             .collect();
         let o = run(hwfoc().args(&args));
         assert_fails_with(

@@ -1,6 +1,7 @@
-//! The two DSDL messages the node sends, serialised by hand: `uavcan.equipment.esc.Status`
-//! (1034) and `uavcan.protocol.NodeStatus` (341), from the definitions in
-//! <https://github.com/dronecan/DSDL> (`uavcan/equipment/esc/1034.Status.uavcan`,
+//! The DSDL messages the node sends, serialised by hand: `uavcan.equipment.esc.Status`
+//! (1034), `uavcan.equipment.esc.StatusExtended` (1036) and `uavcan.protocol.NodeStatus` (341),
+//! from the definitions in <https://github.com/dronecan/DSDL>
+//! (`uavcan/equipment/esc/1034.Status.uavcan`, `uavcan/equipment/esc/1036.StatusExtended.uavcan`,
 //! `uavcan/protocol/341.NodeStatus.uavcan`).
 //!
 //! DSDL bit packing: fields follow each other with no padding; a field of `n` bits is its value
@@ -9,8 +10,10 @@
 //! optimisation does not apply; a message that does not fill its last byte is padded with zero
 //! bits.
 //!
-//! The data type signatures are those pydronecan computes from the same definitions
-//! (`dronecan.uavcan.equipment.esc.Status.get_data_type_signature()`).
+//! The data type signatures are those pydronecan 1.0.27 computes from the same definitions
+//! (`dronecan.uavcan.equipment.esc.Status.get_data_type_signature()`). StatusExtended (7 bytes)
+//! and NodeStatus fit one CAN frame, whose transfer has no CRC: their signatures are not on the
+//! wire.
 
 /// `uavcan.equipment.esc.Status`: data type id.
 pub const ESC_STATUS_ID: u16 = 1034;
@@ -18,6 +21,13 @@ pub const ESC_STATUS_ID: u16 = 1034;
 pub const ESC_STATUS_SIGNATURE: u64 = 0xA9AF_28AE_A2FB_B254;
 /// `uavcan.equipment.esc.Status`: serialised length, bytes (110 bits).
 pub const ESC_STATUS_LEN: usize = 14;
+
+/// `uavcan.equipment.esc.StatusExtended`: data type id.
+pub const ESC_STATUS_EXTENDED_ID: u16 = 1036;
+/// `uavcan.equipment.esc.StatusExtended`: data type signature.
+pub const ESC_STATUS_EXTENDED_SIGNATURE: u64 = 0x02DC_203C_5096_0EDC;
+/// `uavcan.equipment.esc.StatusExtended`: serialised length, bytes (56 bits).
+pub const ESC_STATUS_EXTENDED_LEN: usize = 7;
 
 /// `uavcan.protocol.NodeStatus`: data type id.
 pub const NODE_STATUS_ID: u16 = 341;
@@ -60,6 +70,40 @@ impl EscStatus {
         let rpm = self.rpm.clamp(-(1 << 17), (1 << 17) - 1);
         w.put(u64::from(rpm as u32), 18);
         w.put(u64::from(self.power_rating_pct.min(127)), 7);
+        w.put(u64::from(self.esc_index), 5);
+        w.finish()
+    }
+}
+
+/// `uavcan.equipment.esc.StatusExtended`: what an ESC adds to its [`EscStatus`], at a lower
+/// rate.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct EscStatusExtended {
+    /// `uint7 input_pct`: the throttle command the ESC received, 0..=100 % (saturated to
+    /// 0..=127).
+    pub input_pct: u8,
+    /// `uint7 output_pct`: what the ESC drives the motor with, 0..=100 % (saturated to 0..=127).
+    pub output_pct: u8,
+    /// `int9 motor_temperature_degC`: saturated to -256..=255.
+    pub motor_temperature_deg_c: i16,
+    /// `uint9 motor_angle`, degrees: saturated to 0..=511.
+    pub motor_angle: u16,
+    /// `uint19 status_flags`: manufacturer-specific flags (the low 19 bits are sent).
+    pub status_flags: u32,
+    /// `uint5 esc_index`: 0..=31 (higher bits are dropped: the caller sends only 0..=31).
+    pub esc_index: u8,
+}
+
+impl EscStatusExtended {
+    /// The DSDL serialisation.
+    pub fn serialize(&self) -> [u8; ESC_STATUS_EXTENDED_LEN] {
+        let mut w = BitWriter::<ESC_STATUS_EXTENDED_LEN>::new();
+        w.put(u64::from(self.input_pct.min(127)), 7);
+        w.put(u64::from(self.output_pct.min(127)), 7);
+        let t = self.motor_temperature_deg_c.clamp(-256, 255);
+        w.put(u64::from(t as u16), 9);
+        w.put(u64::from(self.motor_angle.min(511)), 9);
+        w.put(u64::from(self.status_flags), 19);
         w.put(u64::from(self.esc_index), 5);
         w.finish()
     }
@@ -204,6 +248,22 @@ mod tests {
         // rpm 131071 = 0x1FFFF: FF FF then 0b01; power 127; index 31; two bits of padding
         // (pydronecan: 7F FC).
         assert_eq!(&b[10..], &[0xFF, 0xFF, 0x7F, 0xFC]);
+    }
+
+    /// pydronecan 1.0.27: StatusExtended(input_pct=55, output_pct=100, motor_temperature_degC=-40,
+    /// motor_angle=0, status_flags=0x5A5A5, esc_index=3) is 6f 93 62 00 a5 a5 a3 (the payload of
+    /// its single frame `6f936200a5a5a3c0`).
+    #[test]
+    fn esc_status_extended_bytes() {
+        let s = EscStatusExtended {
+            input_pct: 55,
+            output_pct: 100,
+            motor_temperature_deg_c: -40,
+            motor_angle: 0,
+            status_flags: 0x5A5A5,
+            esc_index: 3,
+        };
+        assert_eq!(s.serialize(), [0x6F, 0x93, 0x62, 0x00, 0xA5, 0xA5, 0xA3]);
     }
 
     /// pydronecan: NodeStatus(uptime_sec=123456, health=1, mode=0, sub_mode=0,

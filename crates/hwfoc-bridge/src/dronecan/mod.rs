@@ -1,7 +1,7 @@
 //! The DroneCAN output: a DroneCAN node on a CAN bus, reached through an SLCAN serial adapter,
-//! broadcasting `uavcan.equipment.esc.Status` for each ESC and its own
-//! `uavcan.protocol.NodeStatus`: what ArduPilot, PX4 and the DroneCAN GUI tool read from CAN
-//! ESCs.
+//! broadcasting `uavcan.equipment.esc.Status` and `uavcan.equipment.esc.StatusExtended` for each
+//! ESC and its own `uavcan.protocol.NodeStatus`: what ArduPilot, PX4 and the DroneCAN GUI tool
+//! read from CAN ESCs.
 //!
 //! `hwfoc bridge --dronecan slcan:PORT[:BITRATE]` ([`SlcanTarget`]), with [`DronecanOptions`].
 //!
@@ -18,6 +18,13 @@
 //!   `power_rating_pct` = output throttle %, rounded, 0..=127; `error_count` = how many frames
 //!   of that ESC had a fault bit set in their status word since the bridge started (the
 //!   decoder's checksum failures are not handed to outputs, so they are not in it).
+//! - **esc.StatusExtended** (1036), the lower-rate half: right after an ESC's esc.Status, for
+//!   its first frame and then for a frame that arrived [`EXTENDED_EVERY`] or more after the
+//!   frame of its last one (4 a second at the ESC's 20). Fields: `input_pct` and `output_pct` =
+//!   the input and output throttle %, rounded, 0..=100; `status_flags` = the frame's status word
+//!   as the ESC sent it (the fault bits of `hwfoc::Fault`); `esc_index` as in esc.Status;
+//!   `motor_temperature_degC` = 0 and `motor_angle` = 0: HW-FOC frames carry neither, and the
+//!   DSDL has no "unknown" for them (a receiver logging motor temperature logs 0 °C).
 //! - **NodeStatus** (341), every second from the first poll: `uptime_sec` since the output was
 //!   opened; `mode` OPERATIONAL; `health` OK, or WARNING while an ESC that was heard is silent
 //!   or the last frame of a live ESC had a fault bit set; `vendor_specific_status_code` = bit
@@ -59,7 +66,7 @@ use std::time::{Duration, Instant};
 use serialport::SerialPort;
 
 use crate::output::{Output, OutputError, OutputStats, SILENT_AFTER, Update};
-use dsdl::{EscStatus, Health, NodeStatus};
+use dsdl::{EscStatus, EscStatusExtended, Health, NodeStatus};
 
 /// The default node id: outside the usual flight controller's (10) and the allocator's range
 /// of dynamically allocated peripherals (125 down), below the tools' 126 and 127.
@@ -72,6 +79,8 @@ pub const DEFAULT_BAUD: u32 = 115_200;
 pub const PRIORITY: u8 = 16;
 /// How often NodeStatus is sent.
 pub const NODE_STATUS_EVERY: Duration = Duration::from_secs(1);
+/// The shortest time between the frames of two esc.StatusExtended of one ESC.
+pub const EXTENDED_EVERY: Duration = Duration::from_millis(250);
 /// The most ESCs `esc_index` (uint5) can number.
 pub const MAX_ESCS: usize = 32;
 
@@ -182,8 +191,11 @@ struct Esc {
     fault: bool,
     /// Frames with a fault bit set so far.
     error_count: u32,
-    /// The esc.Status to send at the next poll, and when its frame arrived.
-    pending: Option<(EscStatus, Instant)>,
+    /// The esc.Status and esc.StatusExtended of the frame to send at the next poll, and when
+    /// that frame arrived.
+    pending: Option<(EscStatus, EscStatusExtended, Instant)>,
+    /// The arrival of the frame of the last esc.StatusExtended sent.
+    extended_sent: Option<Instant>,
 }
 
 /// The DroneCAN output (see the [module documentation](self)).
@@ -199,6 +211,7 @@ pub struct DronecanOutput {
     reopen_wait: Duration,
     escs: Vec<Esc>,
     esc_transfer_id: u8,
+    extended_transfer_id: u8,
     node_transfer_id: u8,
     stats: OutputStats,
     frames: u64,
@@ -256,6 +269,7 @@ impl DronecanOutput {
             reopen_wait: REOPEN_FIRST,
             escs: vec![Esc::default(); MAX_ESCS],
             esc_transfer_id: 0,
+            extended_transfer_id: 0,
             node_transfer_id: 0,
             stats: OutputStats::default(),
             frames: 0,
@@ -277,7 +291,7 @@ impl DronecanOutput {
     }
 
     /// CAN frames written so far ([`OutputStats::messages`] counts transfers: an esc.Status is
-    /// three frames, a NodeStatus one).
+    /// three frames, an esc.StatusExtended and a NodeStatus one each).
     pub fn frames(&self) -> u64 {
         self.frames
     }
@@ -410,6 +424,13 @@ impl DronecanOutput {
     }
 }
 
+/// The transfer id to use from a message type's counter, which moves on (5 bits, wrapping).
+fn next_transfer_id(counter: &mut u8) -> u8 {
+    let tid = *counter;
+    *counter = (tid + 1) & 0x1F;
+    tid
+}
+
 /// Opens an SLCAN adapter and sends its setup.
 fn open_adapter(port: &str, baud: u32, code: u8) -> Result<Box<dyn SerialPort>, String> {
     let mut p = hwfoc_io::serial::open(port, baud).map_err(|e| e.to_string())?;
@@ -447,7 +468,20 @@ impl Output for DronecanOutput {
             power_rating_pct: r.throttle_out_pct.round().clamp(0.0, 127.0) as u8,
             esc_index: update.esc,
         };
-        if esc.pending.replace((status, update.arrived)).is_some() {
+        let percent = |pct: f32| pct.round().clamp(0.0, 100.0) as u8;
+        let extended = EscStatusExtended {
+            input_pct: percent(r.throttle_in_pct),
+            output_pct: percent(r.throttle_out_pct),
+            motor_temperature_deg_c: 0,
+            motor_angle: 0,
+            status_flags: u32::from(update.frame.status.0),
+            esc_index: update.esc,
+        };
+        if esc
+            .pending
+            .replace((status, extended, update.arrived))
+            .is_some()
+        {
             self.stats.superseded += 1;
         }
     }
@@ -461,7 +495,7 @@ impl Output for DronecanOutput {
         }
         self.drain();
         for i in 0..self.escs.len() {
-            let Some((status, arrived)) = self.escs[i].pending.take() else {
+            let Some((status, extended, arrived)) = self.escs[i].pending.take() else {
                 continue;
             };
             if now.saturating_duration_since(arrived) >= SILENT_AFTER {
@@ -469,23 +503,34 @@ impl Output for DronecanOutput {
                 continue;
             }
             self.out.clear();
-            let tid = self.esc_transfer_id;
-            self.esc_transfer_id = (tid + 1) & 0x1F;
+            let tid = next_transfer_id(&mut self.esc_transfer_id);
             self.push_transfer(
                 dsdl::ESC_STATUS_ID,
                 dsdl::ESC_STATUS_SIGNATURE,
                 tid,
                 &status.serialize(),
             );
+            let extended_due = self.escs[i]
+                .extended_sent
+                .is_none_or(|sent| arrived.saturating_duration_since(sent) >= EXTENDED_EVERY);
+            if extended_due {
+                self.escs[i].extended_sent = Some(arrived);
+                let tid = next_transfer_id(&mut self.extended_transfer_id);
+                self.push_transfer(
+                    dsdl::ESC_STATUS_EXTENDED_ID,
+                    dsdl::ESC_STATUS_EXTENDED_SIGNATURE,
+                    tid,
+                    &extended.serialize(),
+                );
+            }
             self.write_out(now)?;
-            self.stats.messages += 1;
+            self.stats.messages += 1 + u64::from(extended_due);
             self.stats.latency.add(Instant::now() - arrived);
         }
         if self.next_node_status.is_none_or(|t| now >= t) {
             let payload = self.node_status(now).serialize();
             self.out.clear();
-            let tid = self.node_transfer_id;
-            self.node_transfer_id = (tid + 1) & 0x1F;
+            let tid = next_transfer_id(&mut self.node_transfer_id);
             self.push_transfer(
                 dsdl::NODE_STATUS_ID,
                 dsdl::NODE_STATUS_SIGNATURE,

@@ -1,5 +1,5 @@
 //! The MAVLink output: MAVLink 2 frames to a ground station or a flight controller, over UDP or
-//! a serial port.
+//! a serial port, or into a telemetry log file.
 //!
 //! # Messages
 //!
@@ -22,6 +22,17 @@
 //! all offline is no longer sent. "mAh consumed" is integrated by [`hwfoc_io::energy::Energy`]
 //! over the records' times (`t_s`), or their arrival times when the input has none.
 //!
+//! # Times
+//!
+//! A message's time (`time_usec` of `ESC_STATUS` and `ESC_INFO`, and a telemetry log's
+//! timestamps) is the time of the data: the latest record's `t_s` plus the time since its frame
+//! arrived, where records have Unix times (live ports, virtual ESCs, recordings replayed: the
+//! flight's own times); the system clock where they have none or another clock (a raw byte file,
+//! a logic analyser's capture), told by magnitude as MAVLink's `time_usec` is (Unix times are
+//! after [`UNIX_TIME_FROM`]). Times never go back: a message is never older than the one
+//! before it. A telemetry log starts with the first ESC frame (no HEARTBEAT before it, whose
+//! time would be the system clock's rather than the data's).
+//!
 //! # Identity: system id, component id, heartbeat
 //!
 //! Ground stations show messages per system (and Mission Planner per system and component, the
@@ -41,7 +52,10 @@
 //!
 //! [`MavlinkTarget::parse`]: `udp` (127.0.0.1:14550, where ground stations listen),
 //! `udp:HOST:PORT`, `udp:PORT` (on 127.0.0.1), `udp:[V6ADDR]:PORT`; `serial:PORT` (57600 baud,
-//! ArduPilot's telemetry default), `serial:PORT:BAUD`.
+//! ArduPilot's telemetry default), `serial:PORT:BAUD`; `file:PATH`, a telemetry log as Mission
+//! Planner writes and reads it (`.tlog`: each message after its time, a 64-bit big-endian count of
+//! microseconds since the Unix epoch), which is never written over unless
+//! [`MavlinkOptions::overwrite`] (`hwfoc_io::write::create_file`).
 //!
 //! # Errors
 //!
@@ -86,6 +100,10 @@ pub const MAV_COMP_ID_AUTOPILOT1: u8 = 1;
 /// `MAV_COMP_ID_PERIPHERAL`: "generic autopilot peripheral component ID", hwfoc's default.
 pub const MAV_COMP_ID_PERIPHERAL: u8 = 158;
 
+/// Record times from this many seconds on (2001-09-09) are Unix times, and messages take their
+/// times from them (see [Times](self#times)); smaller ones are of another clock.
+pub const UNIX_TIME_FROM: f64 = 1.0e9;
+
 /// Who the messages come from, and how often the periodic ones are sent.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct MavlinkOptions {
@@ -99,6 +117,9 @@ pub struct MavlinkOptions {
     pub heartbeat_every: Duration,
     /// Period of each group's `ESC_INFO` while an ESC of it is online (default 1 s).
     pub info_every: Duration,
+    /// Whether a `file:` target may replace an existing file (default false: an existing file
+    /// is an error).
+    pub overwrite: bool,
 }
 
 impl Default for MavlinkOptions {
@@ -108,6 +129,7 @@ impl Default for MavlinkOptions {
             component_id: MAV_COMP_ID_PERIPHERAL,
             heartbeat_every: Duration::from_secs(1),
             info_every: Duration::from_secs(1),
+            overwrite: false,
         }
     }
 }
@@ -151,12 +173,15 @@ pub enum MavlinkTarget {
         /// Its baud rate.
         baud: u32,
     },
+    /// A telemetry log file (`.tlog`), created.
+    File(String),
 }
 
 impl MavlinkTarget {
     /// Reads a target as given on the command line: `udp` (= `udp:127.0.0.1:14550`),
     /// `udp:PORT` (on 127.0.0.1), `udp:HOST:PORT` (a name is resolved now, IPv4 preferred),
-    /// `udp:[IPV6]:PORT`; `serial:PORT` ([`DEFAULT_SERIAL_BAUD`]) or `serial:PORT:BAUD`.
+    /// `udp:[IPV6]:PORT`; `serial:PORT` ([`DEFAULT_SERIAL_BAUD`]) or `serial:PORT:BAUD`;
+    /// `file:PATH` (a telemetry log).
     ///
     /// ```
     /// use hwfoc_bridge::mavlink::MavlinkTarget;
@@ -166,6 +191,10 @@ impl MavlinkTarget {
     /// assert_eq!(
     ///     MavlinkTarget::parse("serial:/dev/ttyUSB0:115200")?,
     ///     MavlinkTarget::Serial { port: "/dev/ttyUSB0".into(), baud: 115200 }
+    /// );
+    /// assert_eq!(
+    ///     MavlinkTarget::parse("file:flight.tlog")?,
+    ///     MavlinkTarget::File("flight.tlog".into())
     /// );
     /// assert!(MavlinkTarget::parse("tcp:1.2.3.4:5760").is_err());
     /// # Ok::<(), hwfoc_bridge::OutputError>(())
@@ -223,8 +252,13 @@ impl MavlinkTarget {
                     baud,
                 })
             }
+            "file" => rest
+                .filter(|r| !r.is_empty())
+                .map(|path| MavlinkTarget::File(path.to_string()))
+                .ok_or_else(|| bad("expected file:PATH (a telemetry log, .tlog)".to_string())),
             _ => Err(bad(
-                "expected udp, udp:HOST:PORT, serial:PORT or serial:PORT:BAUD".to_string(),
+                "expected udp, udp:HOST:PORT, serial:PORT, serial:PORT:BAUD or file:PATH"
+                    .to_string(),
             )),
         }
     }
@@ -261,11 +295,12 @@ fn udp_address(
 }
 
 impl fmt::Display for MavlinkTarget {
-    /// The canonical spec: `udp:127.0.0.1:14550`, `serial:/dev/ttyUSB0:57600`.
+    /// The canonical spec: `udp:127.0.0.1:14550`, `serial:/dev/ttyUSB0:57600`, `file:x.tlog`.
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
             MavlinkTarget::Udp(addr) => write!(f, "udp:{addr}"),
             MavlinkTarget::Serial { port, baud } => write!(f, "serial:{port}:{baud}"),
+            MavlinkTarget::File(path) => write!(f, "file:{path}"),
         }
     }
 }
@@ -309,6 +344,10 @@ pub struct MavlinkOutput {
     next_heartbeat: Option<Instant>,
     /// The zero of arrival times, for the charge of inputs without times.
     opened: Instant,
+    /// The latest record with a Unix time: its `t_s` and its frame's arrival.
+    clock: Option<(f64, Instant)>,
+    /// The time of the last poll's messages.
+    last_usec: u64,
     frame: Vec<u8>,
 }
 
@@ -323,9 +362,10 @@ impl fmt::Debug for MavlinkOutput {
 }
 
 impl MavlinkOutput {
-    /// Opens the socket or the port. Fails ([`OutputError::Open`]) only when it cannot be
-    /// opened at all (no UDP socket, a serial port that does not exist or may not be opened): an
-    /// unreachable UDP destination is reported by the sends.
+    /// Opens the socket, the port or the file. Fails ([`OutputError::Open`]) only when it
+    /// cannot be opened at all (no UDP socket, a serial port that does not exist or may not be
+    /// opened, a file that exists or cannot be created): an unreachable UDP destination is
+    /// reported by the sends.
     pub fn open(
         target: MavlinkTarget,
         options: MavlinkOptions,
@@ -335,6 +375,9 @@ impl MavlinkOutput {
             MavlinkTarget::Udp(addr) => Link::udp(*addr).map_err(|e| e.to_string()),
             MavlinkTarget::Serial { port, baud } => {
                 Link::serial(port, *baud).map_err(|e| e.to_string())
+            }
+            MavlinkTarget::File(path) => {
+                Link::tlog(path, options.overwrite).map_err(|e| e.to_string())
             }
         }
         .map_err(|reason| OutputError::Open {
@@ -351,6 +394,8 @@ impl MavlinkOutput {
             infos: [InfoSent::default(); STATUS_GROUPS],
             next_heartbeat: None,
             opened: Instant::now(),
+            clock: None,
+            last_usec: 0,
             frame: Vec::with_capacity(280),
         })
     }
@@ -381,13 +426,28 @@ impl MavlinkOutput {
         })
     }
 
-    /// Encodes and writes one message; `carried` are the arrivals of the new frames it
-    /// carries (their latencies are added once written).
+    /// The time of messages sent at `now`, microseconds since the Unix epoch (see
+    /// [Times](self#times)), never before the last.
+    fn time_usec(&mut self, now: Instant) -> u64 {
+        let t = match self.clock {
+            Some((t_s, arrived)) => {
+                let t = t_s + now.saturating_duration_since(arrived).as_secs_f64();
+                (t * 1e6).round() as u64
+            }
+            None => unix_usec(),
+        };
+        self.last_usec = self.last_usec.max(t);
+        self.last_usec
+    }
+
+    /// Encodes and writes one message, of time `time_usec`; `carried` are the arrivals of the
+    /// new frames it carries (their latencies are added once written).
     fn send(
         &mut self,
         message: &MavMessage,
         carried: &[Instant],
         now: Instant,
+        time_usec: u64,
         first_error: &mut Option<OutputError>,
         stalled: &mut bool,
     ) {
@@ -413,7 +473,7 @@ impl MavlinkOutput {
             self.stats.errors += 1;
             return;
         }
-        match self.link.send(&self.frame, now) {
+        match self.link.send(&self.frame, now, time_usec) {
             Ok(()) => {
                 self.stats.messages += 1;
                 self.stats.bytes += self.frame.len() as u64;
@@ -491,19 +551,32 @@ impl Output for MavlinkOutput {
         esc.frames += 1;
         esc.latest = Some((*record, update.arrived));
         esc.fresh = Some(update.arrived);
+        if let Some(t_s) = record.t_s.filter(|t| *t >= UNIX_TIME_FROM) {
+            self.clock = Some((t_s, update.arrived));
+        }
     }
 
     fn poll(&mut self, now: Instant) -> Result<(), OutputError> {
+        if self.link.is_log() && self.escs.is_empty() {
+            return Ok(());
+        }
         let mut first_error = None;
         let mut stalled = false;
+        let time_usec = self.time_usec(now);
         if self.next_heartbeat.is_none_or(|due| now >= due) {
             self.next_heartbeat = Some(now + self.options.heartbeat_every);
             let heartbeat = self.options.heartbeat();
-            self.send(&heartbeat, &[], now, &mut first_error, &mut stalled);
+            self.send(
+                &heartbeat,
+                &[],
+                now,
+                time_usec,
+                &mut first_error,
+                &mut stalled,
+            );
         }
         let groups = self.escs.len().div_ceil(GROUP);
         let count = self.escs.len() as u8;
-        let time_usec = unix_usec();
         for group in 0..groups {
             let slots = self.slots(group, now);
             let mut carried = Vec::new();
@@ -516,10 +589,12 @@ impl Output for MavlinkOutput {
             }
             if !carried.is_empty() {
                 if let Some(telemetry) = messages::esc_telemetry(group, &slots) {
-                    self.send(&telemetry, &carried, now, &mut first_error, &mut stalled);
+                    let (t, e, s) = (time_usec, &mut first_error, &mut stalled);
+                    self.send(&telemetry, &carried, now, t, e, s);
                 }
                 let status = messages::esc_status(group, time_usec, &slots);
-                self.send(&status, &carried, now, &mut first_error, &mut stalled);
+                let (t, e, s) = (time_usec, &mut first_error, &mut stalled);
+                self.send(&status, &carried, now, t, e, s);
             }
             let state = messages::info_state(&slots);
             let sent = self.infos[group];
@@ -542,7 +617,8 @@ impl Output for MavlinkOutput {
                     state: Some(state),
                     due: Some(now + self.options.info_every),
                 };
-                self.send(&info, &[], now, &mut first_error, &mut stalled);
+                let (t, e, s) = (time_usec, &mut first_error, &mut stalled);
+                self.send(&info, &[], now, t, e, s);
             }
         }
         first_error.map_or(Ok(()), Err)

@@ -1,6 +1,7 @@
-//! Where the MAVLink frames go: a UDP socket of our own (non-blocking) or a serial port
-//! (writes with a timeout, reopened when it disappears).
+//! Where the MAVLink frames go: a UDP socket of our own (non-blocking), a serial port (writes
+//! with a timeout, reopened when it disappears) or a telemetry log file.
 
+use std::fs::File;
 use std::io::{self, Write};
 use std::net::{Ipv4Addr, Ipv6Addr, SocketAddr, UdpSocket};
 use std::time::Instant;
@@ -37,6 +38,13 @@ pub(crate) enum Link {
         /// When to try to reopen a lost port.
         retry_at: Instant,
     },
+    /// A telemetry log (`.tlog`): each frame after its time, microseconds since the Unix epoch
+    /// as a 64-bit big-endian integer, as Mission Planner writes and reads them.
+    Tlog {
+        file: File,
+        /// The time and the frame of one message, written by one call.
+        record: Vec<u8>,
+    },
 }
 
 impl Link {
@@ -71,9 +79,31 @@ impl Link {
         })
     }
 
-    /// Writes one frame.
-    pub(crate) fn send(&mut self, frame: &[u8], now: Instant) -> Result<(), LinkError> {
+    /// A new telemetry log at `path`; an existing file is replaced only if `overwrite`
+    /// (`hwfoc_io::write::create_file`).
+    pub(crate) fn tlog(path: &str, overwrite: bool) -> Result<Link, hwfoc_io::write::WriteError> {
+        let file = hwfoc_io::write::create_file(path, overwrite)?;
+        Ok(Link::Tlog {
+            file,
+            record: Vec::with_capacity(8 + 280),
+        })
+    }
+
+    /// Writes one frame; `unix_usec` is its time (the time a telemetry log gives it).
+    pub(crate) fn send(
+        &mut self,
+        frame: &[u8],
+        now: Instant,
+        unix_usec: u64,
+    ) -> Result<(), LinkError> {
         match self {
+            Link::Tlog { file, record } => {
+                record.clear();
+                record.extend_from_slice(&unix_usec.to_be_bytes());
+                record.extend_from_slice(frame);
+                file.write_all(record)
+                    .map_err(|e| LinkError::Send(e.to_string()))
+            }
             Link::Udp {
                 socket,
                 dest,
@@ -136,11 +166,16 @@ impl Link {
         }
     }
 
+    /// Whether it is a telemetry log.
+    pub(crate) fn is_log(&self) -> bool {
+        matches!(self, Link::Tlog { .. })
+    }
+
     /// The local address of a UDP link.
     pub(crate) fn local_addr(&self) -> Option<SocketAddr> {
         match self {
             Link::Udp { socket, .. } => socket.local_addr().ok(),
-            Link::Serial { .. } => None,
+            Link::Serial { .. } | Link::Tlog { .. } => None,
         }
     }
 }

@@ -1,10 +1,12 @@
 """Reads hwfoc's DroneCAN output as a ground station would: pydronecan's SLCAN driver on a
-serial port, decoding uavcan.equipment.esc.Status and uavcan.protocol.NodeStatus.
+serial port, decoding uavcan.equipment.esc.Status, uavcan.equipment.esc.StatusExtended and
+uavcan.protocol.NodeStatus.
 
     python dronecan_check.py PORT BITRATE ESC_STATUSES NODE_STATUSES TIMEOUT_S
 
 Prints READY once the driver has set the adapter up, then one JSON object per message
-decoded ({"type": "esc", ...} or {"type": "node", ...}; NaN as null), and exits when it has
+decoded ({"type": "esc", ...}, {"type": "ext", ...} or {"type": "node", ...}; NaN as null), and
+exits when it has
 seen ESC_STATUSES esc.Status and NODE_STATUSES NodeStatus, or after TIMEOUT_S (exit code 1).
 Run by crates/hwfoc-bridge/tests/dronecan.rs (through .ci/dronecan.sh).
 """
@@ -43,6 +45,19 @@ def main():
         }), flush=True)
         seen["esc"] += 1
 
+    def on_ext(event):
+        m = event.message
+        print(json.dumps({
+            "type": "ext",
+            "source": event.transfer.source_node_id,
+            "esc_index": m.esc_index,
+            "input_pct": m.input_pct,
+            "output_pct": m.output_pct,
+            "motor_temperature_degC": m.motor_temperature_degC,
+            "motor_angle": m.motor_angle,
+            "status_flags": m.status_flags,
+        }), flush=True)
+
     def on_node(event):
         m = event.message
         print(json.dumps({
@@ -57,6 +72,7 @@ def main():
         seen["node"] += 1
 
     node.add_handler(dronecan.uavcan.equipment.esc.Status, on_esc)
+    node.add_handler(dronecan.uavcan.equipment.esc.StatusExtended, on_ext)
     node.add_handler(dronecan.uavcan.protocol.NodeStatus, on_node)
     print("READY", flush=True)
     end = time.monotonic() + timeout

@@ -87,6 +87,27 @@ pub fn run(cmd: &mut Command) -> Output {
     spawn(cmd).wait_with_output().expect("wait")
 }
 
+/// The JSON lines of `jsonl` (`hwfoc decode`'s records, a receiver's messages).
+pub fn records(jsonl: &str) -> Vec<serde_json::Value> {
+    jsonl
+        .lines()
+        .map(|l| serde_json::from_str(l).expect("a JSON line"))
+        .collect()
+}
+
+/// Records by their `esc`, in order.
+pub fn by_esc(
+    records: &[serde_json::Value],
+) -> std::collections::BTreeMap<u64, Vec<serde_json::Value>> {
+    let mut out = std::collections::BTreeMap::<u64, Vec<serde_json::Value>>::new();
+    for r in records {
+        out.entry(r["esc"].as_u64().unwrap())
+            .or_default()
+            .push(r.clone());
+    }
+    out
+}
+
 pub fn unix_now() -> f64 {
     SystemTime::now()
         .duration_since(UNIX_EPOCH)

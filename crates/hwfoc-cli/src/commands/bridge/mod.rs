@@ -28,6 +28,7 @@ use hwfoc_io::stream::PortStreams;
 use crate::args::{SettingsArgs, seconds};
 use crate::commands::monitor::feed::{Feed, Msg};
 use crate::commands::simulate::ModelArgs;
+use crate::config::Config;
 use crate::error::CliError;
 
 use report::Errors;
@@ -39,7 +40,8 @@ const EXAMPLES: &str = "\
 Examples:
   hwfoc bridge --sim 4 --mavlink udp:127.0.0.1:14550     # four virtual ESCs to a ground station
   hwfoc bridge /dev/ttyUSB0 /dev/ttyUSB1 --datalink /dev/ttyAMA0
-  hwfoc bridge flight.pcapng --mavlink udp:192.168.1.20:14550 --dronecan slcan:/dev/ttyACM0";
+  hwfoc bridge flight.pcapng --mavlink udp:192.168.1.20:14550 --dronecan slcan:/dev/ttyACM0
+  hwfoc bridge flight.pcapng --mavlink file:flight.tlog   # a telemetry log, the flight's times";
 
 /// Arguments of `hwfoc bridge`.
 #[derive(Debug, Args)]
@@ -73,7 +75,8 @@ pub struct BridgeArgs {
     datalink_period: u64,
 
     /// MAVLink 2 to a ground station or flight controller: `udp:HOST:PORT` (`udp` alone is
-    /// 127.0.0.1:14550, where ground stations listen) or `serial:PORT[:BAUD]`. HEARTBEAT,
+    /// 127.0.0.1:14550, where ground stations listen) or `serial:PORT[:BAUD]`; or `file:PATH`, a
+    /// telemetry log (.tlog, as Mission Planner writes and reads them). HEARTBEAT,
     /// ESC_TELEMETRY_1_TO_4.. (Mission Planner), ESC_STATUS and ESC_INFO (QGroundControl, PX4).
     /// Repeat for several destinations.
     #[arg(long, value_name = "SPEC", help_heading = "Outputs")]
@@ -82,6 +85,9 @@ pub struct BridgeArgs {
     #[arg(long, value_name = "N", default_value_t = 1, help_heading = "Outputs",
           value_parser = clap::value_parser!(u8).range(1..=255))]
     mavlink_system: u8,
+    /// A `--mavlink file:PATH` may replace an existing file (never one of the inputs).
+    #[arg(long, help_heading = "Outputs")]
+    overwrite: bool,
     /// MAVLink component id: 158 (peripheral) beside a flight controller; 1 (autopilot) on a
     /// bench without one, so that the ground station takes hwfoc for the vehicle.
     #[arg(long, value_name = "N", default_value_t = mavlink::MAV_COMP_ID_PERIPHERAL,
@@ -89,7 +95,7 @@ pub struct BridgeArgs {
     mavlink_component: u8,
 
     /// A DroneCAN node on an SLCAN adapter, `slcan:PORT[:BITRATE]` (default 1000000 bit/s):
-    /// uavcan.equipment.esc.Status for each ESC, and NodeStatus.
+    /// uavcan.equipment.esc.Status and StatusExtended for each ESC, and NodeStatus.
     #[arg(long, value_name = "SPEC", help_heading = "Outputs")]
     dronecan: Option<String>,
     /// DroneCAN node id (1 to 127).
@@ -124,8 +130,8 @@ pub fn run(args: &BridgeArgs) -> Result<(), CliError> {
         });
     }
     // Every ESC's settings, from the configuration file (per port, per ESC) and the flags.
-    let (_, settings) = args.settings.settings_map()?;
-    let outputs = open_outputs(args)?;
+    let (config, settings) = args.settings.settings_map()?;
+    let outputs = open_outputs(args, &config)?;
     let mut fanout = Fanout::new(outputs);
     let mut errors = Errors::new(args.quiet);
     let started = Instant::now();
@@ -181,7 +187,14 @@ pub fn run(args: &BridgeArgs) -> Result<(), CliError> {
 }
 
 /// Opens every output named; at least one.
-fn open_outputs(args: &BridgeArgs) -> Result<Vec<Box<dyn Output>>, CliError> {
+fn open_outputs(args: &BridgeArgs, config: &Config) -> Result<Vec<Box<dyn Output>>, CliError> {
+    // What the bridge reads, which no output may be: its inputs and the configuration file.
+    let read: Vec<std::path::PathBuf> = args
+        .inputs
+        .iter()
+        .map(std::path::PathBuf::from)
+        .chain(crate::args::config_read(config))
+        .collect();
     let mut outputs: Vec<Box<dyn Output>> = Vec::new();
     if let Some(port) = &args.datalink {
         let pacing = Pacing {
@@ -194,9 +207,13 @@ fn open_outputs(args: &BridgeArgs) -> Result<Vec<Box<dyn Output>>, CliError> {
     }
     for spec in &args.mavlink {
         let target = MavlinkTarget::parse(spec).map_err(CliError::Output)?;
+        if let MavlinkTarget::File(path) = &target {
+            hwfoc_io::write::refuse_input(path, read.iter().map(std::path::PathBuf::as_path))?;
+        }
         let options = MavlinkOptions {
             system_id: args.mavlink_system,
             component_id: args.mavlink_component,
+            overwrite: args.overwrite,
             ..MavlinkOptions::default()
         };
         outputs.push(Box::new(
