@@ -52,6 +52,18 @@ pub enum Notice {
         /// Where and what.
         damage: Damage,
     },
+    /// Recordings of one port that overlap in time (the same recording given twice, say): the
+    /// later input's bytes of that time are left out, each moment decoded once.
+    Overlap {
+        /// The input as named whose bytes were left out.
+        input: String,
+        /// The port.
+        port: String,
+        /// The input that gave the port's bytes of that time.
+        earlier: String,
+        /// How long the overlap lasts, in seconds.
+        seconds: f64,
+    },
 }
 
 impl Notice {
@@ -74,7 +86,10 @@ impl Notice {
     pub fn is_warning(&self) -> bool {
         matches!(
             self,
-            Notice::PortLost { .. } | Notice::ForeignInterface { .. } | Notice::Damage { .. }
+            Notice::PortLost { .. }
+                | Notice::ForeignInterface { .. }
+                | Notice::Damage { .. }
+                | Notice::Overlap { .. }
         )
     }
 
@@ -114,6 +129,16 @@ impl fmt::Display for Notice {
                  packets are skipped"
             ),
             Notice::Damage { input, damage } => write!(f, "{input}: {damage}"),
+            Notice::Overlap {
+                input,
+                port,
+                earlier,
+                seconds,
+            } => write!(
+                f,
+                "{input}: {port} overlaps {earlier} by {seconds:.3} s (the same port at the same \
+                 time): its bytes of that time were decoded once, from {earlier}"
+            ),
         }
     }
 }
