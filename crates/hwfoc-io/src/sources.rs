@@ -5,9 +5,13 @@
 //! input's streams are numbered when its first batch is read, all the interfaces it has
 //! declared by then in their order, any declared later when they first appear), with one
 //! exception: recordings name the port of each interface, and the interfaces of recordings
-//! given together that name the same port are one ESC, one continuous stream (the files of a
-//! rotated recording decode exactly as their bytes concatenated: a frame split between two
-//! files is whole).
+//! given together that name the same port are one ESC, one continuous stream, its bytes in the
+//! order of their times whatever the order the files are given in (the files of a rotated
+//! recording decode exactly as their bytes concatenated in time order: a frame split between
+//! two files is whole). Where two inputs hold the same port's bytes of the same time (the same
+//! recording given twice, a recording and a copy of part of it), that time is decoded once,
+//! from the input that reached it first, and the other is told of it
+//! ([`crate::notice::Notice::Overlap`]).
 //!
 //! # Time order
 //!
@@ -19,17 +23,19 @@
 //! ports (live: records are handed on as they arrive, which is their order) are read alone, in
 //! the order given, as is each run of inputs of one clock after another run.
 //!
-//! How, in bounded memory: each input holds one batch read ahead (an input's batches come in
+//! How, in bounded memory: each input's first batch is read in the order given (its streams
+//! are numbered then); a file is then closed and read again from its start when its turn comes
+//! ([`Input::rewind`]), so that a year of rotated recordings holds a few files open, not
+//! thousands. Each input being read holds one batch read ahead (an input's batches come in
 //! order of their first byte's time: a recording hands out each window's ports in that order);
 //! the input whose batch is earliest is decoded next, and its frames wait in a queue per ESC.
 //! A frame is handed on once no input can still give an earlier one: once it is earlier than
 //! every input's batch read ahead and than the first byte any decoder holds of a frame still
-//! arriving. So the queue holds about one batch of each input: a recording's batch is at most
-//! 10 s of its ports (200 frames per port), a CSV export's 64 KiB of rows. Should the queue
-//! grow past [`MAX_QUEUED`] frames (times that go backwards, recordings of one port that
-//! overlap), its earliest frame is handed on at once, so memory stays bounded whatever the
-//! inputs hold; order is then kept as far as the queue allows. Recordings that continue one
-//! another's ports are read one after another, in the order given.
+//! arriving. So the queue holds about one batch of each input being read: a recording's batch
+//! is at most 10 s of its ports (200 frames per port), a CSV export's 64 KiB of rows. Should
+//! the queue grow past [`MAX_QUEUED`] frames (times that go backwards), its earliest frame is
+//! handed on at once, so memory stays bounded whatever the inputs hold; order is then kept as
+//! far as the queue allows.
 
 use std::cmp::Ordering;
 use std::collections::{BinaryHeap, HashMap, VecDeque};
@@ -571,7 +577,8 @@ impl Sources {
                 break;
             };
             if std::mem::take(&mut run[k].parked) {
-                result = self.read_again(&mut run, k, more_recordings);
+                // Its first batch again, its bytes counted already.
+                result = self.read_batch(&mut run, k, more_recordings, false, false);
                 if result.is_err() {
                     break;
                 }
@@ -666,17 +673,6 @@ impl Sources {
     ) -> Result<(), InputError> {
         let first = run[k].ahead.is_some_and(|(t, _)| t == f64::NEG_INFINITY);
         self.read_batch(run, k, more_recordings, first, true)
-    }
-
-    /// Reads input `k`'s first batch again, after the input was rewound (its bytes are counted
-    /// already).
-    fn read_again(
-        &mut self,
-        run: &mut [Reading],
-        k: usize,
-        more_recordings: bool,
-    ) -> Result<(), InputError> {
-        self.read_batch(run, k, more_recordings, false, false)
     }
 
     /// Reads input `k`'s next batch: `first`, its streams are numbered; `count`, its bytes are
@@ -1042,6 +1038,13 @@ mod tests {
         run_into(inputs)
     }
 
+    /// The queue held at most a 10 s window of two ports at 20 frames a second, and a frame or
+    /// two more.
+    fn assert_one_window_of_two_ports(sources: &Sources) {
+        let peak = sources.peak_queued();
+        assert!(peak <= 2 * 201, "{peak}");
+    }
+
     fn assert_time_order(records: &[(u8, u16, f64)]) {
         for w in records.windows(2) {
             assert!(
@@ -1064,11 +1067,7 @@ mod tests {
         assert_time_order(&got.0);
         let escs: Vec<u8> = got.0.iter().take(6).map(|r| r.0).collect();
         assert_eq!(escs, [0, 1, 0, 1, 0, 1]);
-        assert!(
-            sources.peak_queued() <= 2 * 201,
-            "{}",
-            sources.peak_queued()
-        );
+        assert_one_window_of_two_ports(&sources);
     }
 
     /// Recordings of different ports that overlap in time are merged by time; their ESCs are
@@ -1106,12 +1105,7 @@ mod tests {
         let (got, sources) = in_order(vec![rec]);
         assert_eq!(got.0.len(), 2 * usize::from(frames));
         assert_time_order(&got.0);
-        // A 10 s window of two ports at 20 frames a second, and a frame or two more.
-        assert!(
-            sources.peak_queued() <= 2 * 201,
-            "{}",
-            sources.peak_queued()
-        );
+        assert_one_window_of_two_ports(&sources);
         assert!(sources.peak_queued() >= 200, "{}", sources.peak_queued());
     }
 
@@ -1137,11 +1131,7 @@ mod tests {
             assert_eq!(esc.stream.stats().lost_packets(), 0);
             assert_eq!(esc.stream.stats().restarts(), 0);
         }
-        assert!(
-            sources.peak_queued() <= 2 * 201,
-            "{}",
-            sources.peak_queued()
-        );
+        assert_one_window_of_two_ports(&sources);
     }
 
     /// A recording given twice, and a file overlapping part of another of the same port, are

@@ -383,11 +383,11 @@ impl Input {
         if self.done {
             return Ok(None);
         }
-        if matches!(self.source, Source::Closed { .. }) {
-            if let Err(e) = self.reopen() {
-                self.done = true;
-                return Err(e);
-            }
+        if matches!(self.source, Source::Closed { .. })
+            && let Err(e) = self.reopen()
+        {
+            self.done = true;
+            return Err(e);
         }
         self.times.clear();
         self.stream = 0;
