@@ -90,8 +90,8 @@ enum Source {
     /// A file not open at the moment: not read yet, rewound, or at its end. What the closed
     /// source knew that is asked for after its end is kept.
     Closed {
-        /// The names of a recording's interfaces.
-        interfaces: Vec<String>,
+        /// A recording's interfaces.
+        interfaces: Vec<pcapng::Interface>,
         /// Bytes a logic analyser flagged.
         flagged: u64,
     },
@@ -180,15 +180,22 @@ impl Input {
     /// Closes the source, keeping what is asked of it after its end, and lets go of the
     /// buffers.
     fn close(&mut self) {
-        let interfaces = (0..self.streams())
-            .filter(|_| self.format == InputFormat::Recording)
-            .map(|i| self.stream_name(i))
-            .collect();
         let flagged = self.flagged_bytes();
-        self.source = Source::Closed {
-            interfaces,
+        let closed = Source::Closed {
+            interfaces: Vec::new(),
             flagged,
         };
+        let interfaces = match std::mem::replace(&mut self.source, closed) {
+            Source::Recording(rec) => rec.into_interfaces(),
+            Source::Closed { interfaces, .. } => interfaces,
+            _ => Vec::new(),
+        };
+        if let Source::Closed {
+            interfaces: kept, ..
+        } = &mut self.source
+        {
+            *kept = interfaces;
+        }
         self.pending = Vec::new();
         self.bytes = Vec::new();
         self.times = Vec::new();
@@ -368,7 +375,7 @@ impl Input {
         let name = match &self.source {
             Source::Recording(rec) => rec.interfaces().get(i).map(|f| f.name.clone()),
             Source::Ports(ports) => ports.names().get(i).cloned(),
-            Source::Closed { interfaces, .. } => interfaces.get(i).cloned(),
+            Source::Closed { interfaces, .. } => interfaces.get(i).map(|f| f.name.clone()),
             Source::Raw { .. } | Source::Csv(_) => None,
         };
         name.unwrap_or_else(|| self.name.clone())

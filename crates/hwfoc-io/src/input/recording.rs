@@ -75,6 +75,11 @@ impl RecordingReader {
         self.reader.interfaces()
     }
 
+    /// The interfaces declared so far, the file and buffers let go.
+    pub(super) fn into_interfaces(self) -> Vec<pcapng::Interface> {
+        self.reader.into_interfaces()
+    }
+
     /// Hands out the next batch of the current window into `bytes` and `times` (which are
     /// empty) and returns its interface, reading the next window when this one is done;
     /// leaves `bytes` empty at the end of the file. A read error is returned after the

@@ -521,11 +521,13 @@ impl TsUnit {
     }
 }
 
-/// An interface of the current section.
+/// An interface of the current section: its timestamps' `if_tsresol` and `if_tsoffset`, kept
+/// as given (16 bytes, where a [`TsUnit`] takes 48: a section may declare a million).
 #[derive(Debug, Clone, Copy)]
 struct Local {
     global: u32,
-    ts: TsUnit,
+    tsresol: u8,
+    tsoffset: i64,
 }
 
 /// The interfaces of one port (the same name, link type and baud), in the order declared, and
@@ -607,6 +609,11 @@ impl<R: Read> Reader<R> {
     /// The interfaces (ports) declared so far.
     pub fn interfaces(&self) -> &[Interface] {
         &self.interfaces
+    }
+
+    /// The interfaces declared so far, the reader let go.
+    pub fn into_interfaces(self) -> Vec<Interface> {
+        self.interfaces
     }
 
     /// The places that could not be read since the last call.
@@ -828,7 +835,8 @@ impl<R: Read> Reader<R> {
         same.used += 1;
         self.local.push(Local {
             global,
-            ts: TsUnit::new(tsresol, tsoffset),
+            tsresol,
+            tsoffset,
         });
         Ok(Step::Other)
     }
@@ -864,7 +872,7 @@ impl<R: Read> Reader<R> {
             .map(|(_, value)| value);
         Ok(Step::Packet(Found {
             iface: local.global,
-            t_ns: local.ts.to_ns(raw_t),
+            t_ns: TsUnit::new(local.tsresol, local.tsoffset).to_ns(raw_t),
             data,
             comment,
         }))
