@@ -852,6 +852,42 @@ mod tests {
         assert!(elapsed.as_secs() < 30, "{elapsed:?}");
     }
 
+    /// A file is open only while it is read, and read again from its start after a rewind,
+    /// without telling its notices twice; a file that is no longer of its format when it is
+    /// opened again is an error naming it.
+    #[test]
+    fn files_are_opened_when_read_and_can_be_read_again() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("r.pcapng");
+        let mut w = pcapng::Writer::new(Vec::new()).unwrap();
+        w.add_interface("/dev/ttyUSB0", 19200).unwrap();
+        w.comment(0, 1, "a note").unwrap();
+        w.write(0, 2, &[7, 8]).unwrap();
+        std::fs::write(&path, w.into_inner().unwrap()).unwrap();
+        let name = path.to_str().unwrap();
+        let mut input = Input::open(name).unwrap();
+        assert!(matches!(input.source, Source::Closed { .. }));
+        let seen = std::sync::Arc::new(std::sync::Mutex::new(0));
+        let count = std::sync::Arc::clone(&seen);
+        input.set_notices(move |_| *count.lock().unwrap() += 1);
+        assert_eq!(input.next_batch().unwrap().unwrap().bytes, [7, 8]);
+        assert!(input.rewind());
+        assert!(matches!(input.source, Source::Closed { .. }));
+        assert_eq!(read_all(&mut input).0, [7, 8]);
+        assert!(matches!(input.source, Source::Closed { .. }));
+        assert_eq!(input.stream_name(0), "/dev/ttyUSB0");
+        assert_eq!(*seen.lock().unwrap(), 1);
+        assert!(input.rewind());
+        std::fs::write(&path, b"raw bytes now").unwrap();
+        let e = input.next_batch().err().unwrap();
+        assert_eq!(
+            e.to_string(),
+            format!("{name} changed while it was being read: it is now raw bytes")
+        );
+        let mut memory = Input::from_memory("m.bin", vec![1]).unwrap();
+        assert!(!memory.rewind());
+    }
+
     #[test]
     fn classic_pcap_files_are_named_as_such() {
         for magic in CLASSIC_PCAP {
