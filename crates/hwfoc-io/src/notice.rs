@@ -53,6 +53,18 @@ pub enum Notice {
         /// Where and what.
         damage: Damage,
     },
+    /// Recordings of one port that overlap in time (the same recording given twice, say): the
+    /// later input's bytes of that time are left out, each moment decoded once.
+    Overlap {
+        /// The input as named whose bytes were left out.
+        input: String,
+        /// The port.
+        port: String,
+        /// The input that gave the port's bytes of that time.
+        earlier: String,
+        /// How long the overlap lasts, in seconds.
+        seconds: f64,
+    },
 }
 
 impl Notice {
@@ -75,7 +87,10 @@ impl Notice {
     pub fn is_warning(&self) -> bool {
         matches!(
             self,
-            Notice::PortLost { .. } | Notice::ForeignInterface { .. } | Notice::Damage { .. }
+            Notice::PortLost { .. }
+                | Notice::ForeignInterface { .. }
+                | Notice::Damage { .. }
+                | Notice::Overlap { .. }
         )
     }
 
@@ -126,6 +141,20 @@ impl fmt::Display for Notice {
                 Escaped(interface)
             ),
             Notice::Damage { input, damage } => write!(f, "{}: {damage}", Escaped(input)),
+            Notice::Overlap {
+                input,
+                port,
+                earlier,
+                seconds,
+            } => write!(
+                f,
+                "{}: {} overlaps {} by {seconds:.3} s (the same port at the same time): its \
+                 bytes of that time were decoded once, from {}",
+                Escaped(input),
+                Escaped(port),
+                Escaped(earlier),
+                Escaped(earlier)
+            ),
         }
     }
 }

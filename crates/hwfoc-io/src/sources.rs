@@ -5,9 +5,13 @@
 //! input's streams are numbered when its first batch is read, all the interfaces it has
 //! declared by then in their order, any declared later when they first appear), with one
 //! exception: recordings name the port of each interface, and the interfaces of recordings
-//! given together that name the same port are one ESC, one continuous stream (the files of a
-//! rotated recording decode exactly as their bytes concatenated: a frame split between two
-//! files is whole).
+//! given together that name the same port are one ESC, one continuous stream, its bytes in the
+//! order of their times whatever the order the files are given in (the files of a rotated
+//! recording decode exactly as their bytes concatenated in time order: a frame split between
+//! two files is whole). Where two inputs hold the same port's bytes of the same time (the same
+//! recording given twice, a recording and a copy of part of it), that time is decoded once,
+//! from the input that reached it first, and the other is told of it
+//! ([`crate::notice::Notice::Overlap`]).
 //!
 //! # Time order
 //!
@@ -19,17 +23,19 @@
 //! ports (live: records are handed on as they arrive, which is their order) are read alone, in
 //! the order given, as is each run of inputs of one clock after another run.
 //!
-//! How, in bounded memory: each input holds one batch read ahead (an input's batches come in
+//! How, in bounded memory: each input's first batch is read in the order given (its streams
+//! are numbered then); a file is then closed and read again from its start when its turn comes
+//! ([`Input::rewind`]), so that a year of rotated recordings holds a few files open, not
+//! thousands. Each input being read holds one batch read ahead (an input's batches come in
 //! order of their first byte's time: a recording hands out each window's ports in that order);
 //! the input whose batch is earliest is decoded next, and its frames wait in a queue per ESC.
 //! A frame is handed on once no input can still give an earlier one: once it is earlier than
 //! every input's batch read ahead and than the first byte any decoder holds of a frame still
-//! arriving. So the queue holds about one batch of each input: a recording's batch is at most
-//! 10 s of its ports (200 frames per port), a CSV export's 64 KiB of rows. Should the queue
-//! grow past [`MAX_QUEUED`] frames (times that go backwards, recordings of one port that
-//! overlap), its earliest frame is handed on at once, so memory stays bounded whatever the
-//! inputs hold; order is then kept as far as the queue allows. Recordings that continue one
-//! another's ports are read one after another, in the order given.
+//! arriving. So the queue holds about one batch of each input being read: a recording's batch
+//! is at most 10 s of its ports (200 frames per port), a CSV export's 64 KiB of rows. Should
+//! the queue grow past [`MAX_QUEUED`] frames (times that go backwards), its earliest frame is
+//! handed on at once, so memory stays bounded whatever the inputs hold; order is then kept as
+//! far as the queue allows.
 
 use std::cmp::Ordering;
 use std::collections::{BinaryHeap, HashMap, VecDeque};
@@ -38,7 +44,8 @@ use hwfoc::datalink::{CHANNELS, DatalinkStats};
 use hwfoc::{Decoded, Settings};
 
 pub use crate::handler::Handler;
-use crate::input::{Input, InputError, InputFormat};
+use crate::input::{Batch, Input, InputError, InputFormat};
+use crate::notice::Notice;
 use crate::settings::SettingsMap;
 use crate::stream::{EscLink, Stream};
 use crate::time::Clock;
@@ -100,6 +107,11 @@ pub struct Sources {
     /// The ESCs of each input's streams numbered before it is read, by input.
     numbered: Vec<Vec<Option<usize>>>,
     queue: Queue,
+    /// By ESC: how many inputs not at their end have a stream of it.
+    readers: Vec<u32>,
+    /// By ESC: the input (index) whose bytes its stream was fed last, and the time of the last
+    /// of them.
+    fed: Vec<Option<(usize, f64)>>,
 }
 
 /// An input being read in a run of inputs read together.
@@ -112,6 +124,21 @@ struct Reading {
     bytes: u64,
     /// Its batch read ahead: the first byte's time and the ESC; `None` once at its end.
     ahead: Option<(f64, usize)>,
+    /// The batch read ahead was let go with the file, to be read again when its turn comes
+    /// (see [`Input::rewind`]).
+    parked: bool,
+    /// Bytes not decoded because an earlier input gave the same port's bytes of that time.
+    overlaps: Vec<Overlap>,
+}
+
+/// Bytes of one ESC of an input that an earlier input of the same port gave already.
+struct Overlap {
+    esc: usize,
+    /// The input that gave them.
+    earlier: usize,
+    /// The time of the first and of the last.
+    from: f64,
+    to: f64,
 }
 
 impl Sources {
@@ -130,6 +157,8 @@ impl Sources {
             numbered: Vec::new(),
             esc_settings: Vec::new(),
             queue: Queue::default(),
+            readers: Vec::new(),
+            fed: Vec::new(),
         }
     }
 
@@ -347,6 +376,8 @@ impl Sources {
         let settings = self.settings.get(self.escs.len(), &esc.name);
         self.escs.push(esc);
         self.esc_settings.push(settings);
+        self.readers.push(0);
+        self.fed.push(None);
     }
 
     /// The ESC of stream `stream` of `input` (number `index`), made when first seen; `escs`
@@ -392,6 +423,7 @@ impl Sources {
             escs.resize(stream + 1, None);
         }
         escs[stream] = Some(esc);
+        self.readers[esc] += 1;
         Ok(esc)
     }
 
@@ -431,12 +463,15 @@ impl Sources {
             .unwrap_or_default()
     }
 
-    /// Notes what is known of an input at its end.
+    /// Notes what is known of an input at its end; its ESCs have one reader fewer.
     fn close(&mut self, input: &Input, index: usize, escs: &[Option<usize>], bytes: u64) {
         let info = &mut self.read[index];
         info.flagged_bytes = input.flagged_bytes();
         info.bytes = bytes;
         info.escs = escs.iter().flatten().copied().collect();
+        for &esc in escs.iter().flatten() {
+            self.readers[esc] -= 1;
+        }
     }
 
     /// Notes an input as begun, in command-line order.
@@ -536,8 +571,11 @@ impl Sources {
         handler: &mut H,
     ) -> Result<(), H::Error> {
         let mut run: Vec<Reading> = Vec::with_capacity(inputs.len());
-        // Every input's first batch, in the order given: its streams are numbered then. After
-        // an error, the inputs not begun are not read.
+        // The batches read ahead, earliest first.
+        let mut next = BinaryHeap::new();
+        // Every input's first batch, in the order given: its streams are numbered then, and a
+        // file is closed again until its turn comes. After an error, the inputs not begun are
+        // not read.
         let mut result = Ok(());
         for input in inputs {
             let index = self.open(&input);
@@ -548,27 +586,41 @@ impl Sources {
                 escs,
                 bytes: 0,
                 ahead: Some((f64::NEG_INFINITY, 0)),
+                parked: false,
+                overlaps: Vec::new(),
             });
             let k = run.len() - 1;
             result = self.read_ahead(&mut run, k, more_recordings);
             if result.is_err() {
                 break;
             }
+            if let Some((t, _)) = run[k].ahead {
+                run[k].parked = run[k].input.rewind();
+                next.push(Earliest { t, id: k });
+            }
         }
         let mut live = false;
         while result.is_ok() {
             // Frames no input can precede any more are handed on.
-            self.release(self.bound(&run), handler);
+            self.release(self.bound(&next), handler);
             handler.end_batch(live)?;
-            let Some(k) = next_to_decode(&run) else {
+            let Some(Earliest { id: k, .. }) = next.pop() else {
                 break;
+            };
+            if std::mem::take(&mut run[k].parked) {
+                // Its first batch again, its bytes counted already.
+                result = self.read_batch(&mut run, k, more_recordings, false, false);
+                if result.is_err() {
+                    break;
+                }
+            }
+            let Some((_, esc)) = run[k].ahead else {
+                continue;
             };
             let reading = &mut run[k];
-            let Some((_, esc)) = reading.ahead else {
-                break;
-            };
             if let Some(batch) = reading.input.current_batch() {
                 live = batch.bytes.len() < LIVE_BATCH;
+                let batch = self.unheard(reading.index, &mut reading.overlaps, esc, batch);
                 let queue = &mut self.queue;
                 let hub = self.hubs.get(&esc);
                 let mut pending = Vec::new();
@@ -580,6 +632,9 @@ impl Sources {
                 self.deliver(esc, pending, &mut Deliver::<H>::Queue);
             }
             result = self.read_ahead(&mut run, k, more_recordings);
+            if let Some((t, _)) = run[k].ahead {
+                next.push(Earliest { t, id: k });
+            }
         }
         // On an error, the inputs not at their end stop here: their streams are finished too.
         for k in 0..run.len() {
@@ -592,6 +647,53 @@ impl Sources {
         Ok(result?)
     }
 
+    /// The part of `batch` (of ESC `esc`, read from input `index`) that no other input gave: when
+    /// the ESC's stream was fed last from another input, the bytes up to the time of its last
+    /// byte are that input's again (the same recording given twice, or recordings of one port
+    /// that overlap), and are noted and left out, so that each moment of a port is decoded
+    /// once.
+    fn unheard<'b>(
+        &mut self,
+        index: usize,
+        overlaps: &mut Vec<Overlap>,
+        esc: usize,
+        batch: Batch<'b>,
+    ) -> Batch<'b> {
+        let Some(times) = batch.times else {
+            return batch;
+        };
+        let skip = match self.fed[esc] {
+            Some((earlier, last)) if earlier != index => {
+                let skip = times.iter().position(|&t| t > last).unwrap_or(times.len());
+                if skip > 0 {
+                    let (from, to) = (times[0], times[skip - 1]);
+                    match overlaps.iter_mut().find(|o| o.esc == esc) {
+                        Some(o) => {
+                            o.from = o.from.min(from);
+                            o.to = o.to.max(to);
+                        }
+                        None => overlaps.push(Overlap {
+                            esc,
+                            earlier,
+                            from,
+                            to,
+                        }),
+                    }
+                }
+                skip
+            }
+            _ => 0,
+        };
+        if let Some(&last) = times[skip..].last() {
+            self.fed[esc] = Some((index, last));
+        }
+        Batch {
+            bytes: &batch.bytes[skip..],
+            times: Some(&times[skip..]),
+            stream: batch.stream,
+        }
+    }
+
     /// Reads input `k`'s next batch ahead (numbering its streams after its first), or notes
     /// its end.
     fn read_ahead(
@@ -601,6 +703,19 @@ impl Sources {
         more_recordings: bool,
     ) -> Result<(), InputError> {
         let first = run[k].ahead.is_some_and(|(t, _)| t == f64::NEG_INFINITY);
+        self.read_batch(run, k, more_recordings, first, true)
+    }
+
+    /// Reads input `k`'s next batch: `first`, its streams are numbered; `count`, its bytes are
+    /// counted. At its end, notes the end.
+    fn read_batch(
+        &mut self,
+        run: &mut [Reading],
+        k: usize,
+        more_recordings: bool,
+        first: bool,
+        count: bool,
+    ) -> Result<(), InputError> {
         let reading = &mut run[k];
         let batch = match reading.input.next_batch() {
             Ok(Some(batch)) => batch,
@@ -618,7 +733,9 @@ impl Sources {
         };
         let t = times.first().copied().unwrap_or(f64::NEG_INFINITY);
         let stream = batch.stream;
-        reading.bytes += batch.bytes.len() as u64;
+        if count {
+            reading.bytes += batch.bytes.len() as u64;
+        }
         let (input, index, escs) = (&reading.input, reading.index, &mut reading.escs);
         if first {
             self.number_streams(input, index, escs);
@@ -629,66 +746,43 @@ impl Sources {
     }
 
     /// Input `k` is at its end: its streams are numbered and noted; those no other input can
-    /// go on with are finished.
+    /// go on with are finished. What it overlapped of earlier inputs is told.
     fn end_of(&mut self, run: &mut [Reading], k: usize, more_recordings: bool) {
         let reading = &mut run[k];
-        let (input, index) = (&reading.input, reading.index);
         let mut escs = std::mem::take(&mut reading.escs);
-        self.number_streams(input, index, &mut escs);
-        self.close(input, index, &escs, reading.bytes);
-        let recorded = input.format() == InputFormat::Recording;
-        run[k].escs = escs;
-        for &esc in run[k].escs.clone().iter().flatten() {
-            let shared = run
-                .iter()
-                .enumerate()
-                .any(|(j, r)| j != k && r.ahead.is_some() && r.escs.contains(&Some(esc)));
-            if !(shared || (recorded && more_recordings)) {
+        self.number_streams(&reading.input, reading.index, &mut escs);
+        self.close(&reading.input, reading.index, &escs, reading.bytes);
+        for o in std::mem::take(&mut reading.overlaps) {
+            reading.input.tell(Notice::Overlap {
+                input: self.names[reading.index].clone(),
+                port: self.escs[o.esc].name.clone(),
+                earlier: self.names[o.earlier].clone(),
+                seconds: o.to - o.from,
+            });
+        }
+        let recorded = reading.input.format() == InputFormat::Recording;
+        for &esc in escs.iter().flatten() {
+            if self.readers[esc] == 0 && !(recorded && more_recordings) {
                 self.finish(esc);
             }
         }
+        reading.escs = escs;
     }
 
-    /// The time before which no input of `run` can give a frame any more: the earliest batch
-    /// read ahead, and the earliest byte a decoder holds of a frame still arriving.
-    fn bound(&self, run: &[Reading]) -> f64 {
-        let mut bound = f64::INFINITY;
-        for (k, r) in run.iter().enumerate() {
-            if let Some((t, _)) = r.ahead
-                && !blocked(run, k)
+    /// The time before which no input being read can give a frame any more: the earliest
+    /// batch read ahead, and the earliest byte a decoder holds of a frame still arriving on a
+    /// stream an input not at its end goes on with.
+    fn bound(&self, next: &BinaryHeap<Earliest>) -> f64 {
+        let mut bound = next.peek().map_or(f64::INFINITY, |e| e.t);
+        for (esc, &readers) in self.readers.iter().enumerate() {
+            if readers > 0
+                && let Some(t) = self.escs[esc].stream.held_since()
             {
                 bound = bound.min(t);
-            }
-            if r.ahead.is_some() {
-                for &esc in r.escs.iter().flatten() {
-                    if let Some(t) = self.escs[esc].stream.held_since() {
-                        bound = bound.min(t);
-                    }
-                }
             }
         }
         bound
     }
-}
-
-/// Whether input `k` of `run` must wait for an earlier input (in the order given) that goes
-/// on with the same ESC: recordings of one port are read one after another.
-fn blocked(run: &[Reading], k: usize) -> bool {
-    let Some((_, esc)) = run[k].ahead else {
-        return false;
-    };
-    run[..k]
-        .iter()
-        .any(|r| r.ahead.is_some() && r.escs.contains(&Some(esc)))
-}
-
-/// The input whose batch read ahead is the earliest, of those not waiting for another.
-fn next_to_decode(run: &[Reading]) -> Option<usize> {
-    (0..run.len())
-        .filter(|&k| !blocked(run, k))
-        .filter_map(|k| run[k].ahead.map(|(t, _)| (t, k)))
-        .min_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)))
-        .map(|(_, k)| k)
 }
 
 /// Decoded frames waiting to be handed on in time order: a queue per ESC (each in its
@@ -696,28 +790,30 @@ fn next_to_decode(run: &[Reading]) -> Option<usize> {
 #[derive(Default)]
 struct Queue {
     escs: Vec<VecDeque<(Option<f64>, Decoded)>>,
-    fronts: BinaryHeap<Front>,
+    fronts: BinaryHeap<Earliest>,
     len: usize,
     peak: usize,
 }
 
-/// The first frame waiting of an ESC: the earliest time first, then the lowest ESC.
+/// A time and what it is of, ordered for a heap of the earliest: the first frame waiting of an
+/// ESC (`id` its number), or the batch an input read ahead (`id` its place in the run); the
+/// earliest time first, then the lowest `id`.
 #[derive(Debug, PartialEq)]
-struct Front {
+struct Earliest {
     t: f64,
-    esc: usize,
+    id: usize,
 }
 
-impl Eq for Front {}
+impl Eq for Earliest {}
 
-impl Ord for Front {
+impl Ord for Earliest {
     fn cmp(&self, other: &Self) -> Ordering {
         // Reversed: the heap's greatest is the earliest.
-        other.t.total_cmp(&self.t).then(other.esc.cmp(&self.esc))
+        other.t.total_cmp(&self.t).then(other.id.cmp(&self.id))
     }
 }
 
-impl PartialOrd for Front {
+impl PartialOrd for Earliest {
     fn partial_cmp(&self, other: &Self) -> Option<Ordering> {
         Some(self.cmp(other))
     }
@@ -735,7 +831,7 @@ impl Queue {
         }
         let queue = &mut self.escs[esc];
         if queue.is_empty() {
-            self.fronts.push(Front { t: key(t), esc });
+            self.fronts.push(Earliest { t: key(t), id: esc });
         }
         queue.push_back((t, *d));
         self.len += 1;
@@ -748,11 +844,14 @@ impl Queue {
         if front.t >= bound && self.len <= MAX_QUEUED {
             return None;
         }
-        let esc = self.fronts.pop()?.esc;
+        let esc = self.fronts.pop()?.id;
         let queue = &mut self.escs[esc];
         let (t, d) = queue.pop_front()?;
         if let Some(&(next, _)) = queue.front() {
-            self.fronts.push(Front { t: key(next), esc });
+            self.fronts.push(Earliest {
+                t: key(next),
+                id: esc,
+            });
         }
         self.len -= 1;
         Some((esc, t, d))
@@ -838,7 +937,8 @@ pub(crate) mod tests {
     }
 
     /// A recording with one interface per `(port, bytes, first byte's time in ns)`, in the
-    /// order given; each port's bytes in packets of 7 bytes, 1 ms apart.
+    /// order given; each port's bytes in packets of 7 bytes, 4 ms apart (7 bytes take 3.6 ms
+    /// at 19200 baud).
     fn recording(ports: &[(&str, &[u8], u64)]) -> Vec<u8> {
         let mut w = pcapng::Writer::new(Vec::new()).unwrap();
         for (port, _, _) in ports {
@@ -846,7 +946,7 @@ pub(crate) mod tests {
         }
         for (i, (_, bytes, t0)) in ports.iter().enumerate() {
             for (k, piece) in bytes.chunks(7).enumerate() {
-                w.write(i as u32, t0 + k as u64 * 1_000_000, piece).unwrap();
+                w.write(i as u32, t0 + k as u64 * 4_000_000, piece).unwrap();
             }
         }
         w.into_inner().unwrap()
@@ -882,7 +982,7 @@ pub(crate) mod tests {
         // Cut each port's bytes in the middle of a frame, at different places.
         let (a1, a2) = a.split_at(24 * 10 + 5);
         let (b1, b2) = b.split_at(24 * 20 + 17);
-        let ms = 1_000_000;
+        let ms = 4_000_000;
         let whole = recording(&[("/dev/ttyUSB0", &a, t), ("/dev/ttyUSB1", &b, t)]);
         let first = recording(&[("/dev/ttyUSB0", a1, t), ("/dev/ttyUSB1", b1, t)]);
         let a2_t = t + a1.len().div_ceil(7) as u64 * ms;
@@ -969,6 +1069,13 @@ pub(crate) mod tests {
         run_into(inputs)
     }
 
+    /// The queue held at most a 10 s window of two ports at 20 frames a second, and a frame or
+    /// two more.
+    fn assert_one_window_of_two_ports(sources: &Sources) {
+        let peak = sources.peak_queued();
+        assert!(peak <= 2 * 201, "{peak}");
+    }
+
     fn assert_time_order(records: &[(u8, u16, f64)]) {
         for w in records.windows(2) {
             assert!(
@@ -991,11 +1098,7 @@ pub(crate) mod tests {
         assert_time_order(&got.0);
         let escs: Vec<u8> = got.0.iter().take(6).map(|r| r.0).collect();
         assert_eq!(escs, [0, 1, 0, 1, 0, 1]);
-        assert!(
-            sources.peak_queued() <= 2 * 201,
-            "{}",
-            sources.peak_queued()
-        );
+        assert_one_window_of_two_ports(&sources);
     }
 
     /// Recordings of different ports that overlap in time are merged by time; their ESCs are
@@ -1033,28 +1136,87 @@ pub(crate) mod tests {
         let (got, sources) = in_order(vec![rec]);
         assert_eq!(got.0.len(), 2 * usize::from(frames));
         assert_time_order(&got.0);
-        // A 10 s window of two ports at 20 frames a second, and a frame or two more.
-        assert!(
-            sources.peak_queued() <= 2 * 201,
-            "{}",
-            sources.peak_queued()
-        );
+        assert_one_window_of_two_ports(&sources);
         assert!(sources.peak_queued() >= 200, "{}", sources.peak_queued());
     }
 
-    /// Recordings of one port given out of time order are one stream in the order given (as
-    /// their bytes concatenated), and the queue stays within its bound.
+    /// The files of a rotated recording of two ports, given in any order, are one stream per
+    /// port in time order: the records of the recording they were cut from.
     #[test]
-    fn overlapping_recordings_of_one_port_are_read_one_after_another() {
+    fn recordings_of_one_port_are_read_in_time_order_whatever_the_order_given() {
         let s = 1_000_000_000u64;
-        let later = live_recording(&["/dev/ttyUSB0"], 100, 100, 1_700_000_000 * s + 5 * s);
-        let earlier = live_recording(&["/dev/ttyUSB0"], 0, 100, 1_700_000_000 * s);
-        let (got, sources) = in_order(vec![later, earlier]);
-        assert_eq!(sources.escs().len(), 1);
-        let packets: Vec<u16> = got.0.iter().map(|r| r.1).collect();
-        let expected: Vec<u16> = (100..200).chain(0..100).collect();
-        assert_eq!(packets, expected);
-        assert!(sources.peak_queued() <= MAX_QUEUED);
+        let t0 = 1_700_000_000 * s;
+        let ports = ["/dev/ttyUSB0", "/dev/ttyUSB1"];
+        // Twelve files of 100 frames (5 s) per port, given 3, 10, 5, 0, 7, 2, 9, 4, 11, 6, 1, 8.
+        let files: Vec<Vec<u8>> = (0..12u16)
+            .map(|k| (k * 7 + 3) % 12)
+            .map(|k| live_recording(&ports, 100 * k, 100, t0 + u64::from(k) * 5 * s))
+            .collect();
+        let (got, sources) = in_order(files);
+        assert_eq!(sources.escs().len(), 2);
+        assert_eq!(got.0.len(), 2400);
+        assert_time_order(&got.0);
+        let packets: Vec<u16> = got.0.iter().step_by(2).map(|r| r.1).collect();
+        assert_eq!(packets, (0..1200).collect::<Vec<_>>());
+        for esc in sources.escs() {
+            assert_eq!(esc.stream.stats().lost_packets(), 0);
+            assert_eq!(esc.stream.stats().restarts(), 0);
+        }
+        assert_one_window_of_two_ports(&sources);
+    }
+
+    /// A recording given twice, and a file overlapping part of another of the same port, are
+    /// decoded once, with a notice saying so; a recording of another port at the same time is
+    /// not an overlap.
+    #[test]
+    fn a_moment_of_a_port_recorded_twice_is_decoded_once() {
+        let s = 1_000_000_000u64;
+        let t0 = 1_700_000_000 * s;
+        let rec = live_recording(&["/dev/ttyUSB0"], 0, 200, t0);
+        // Frames 150..250 of the same port: the first half overlaps `rec`.
+        let tail = live_recording(&["/dev/ttyUSB0"], 150, 100, t0 + 150 * s / 20);
+        let other = live_recording(&["/dev/ttyUSB1"], 0, 200, t0);
+        let named = [("a", &rec), ("a", &rec), ("b", &tail), ("c", &other)];
+        let seen = std::sync::Arc::new(std::sync::Mutex::new(Vec::new()));
+        let inputs = named
+            .iter()
+            .map(|(name, bytes)| {
+                let mut input = Input::from_memory(name, bytes.to_vec()).unwrap();
+                let sink = std::sync::Arc::clone(&seen);
+                input.set_notices(move |n| sink.lock().unwrap().push(n));
+                input
+            })
+            .collect();
+        let mut sources = Sources::new(inputs, Settings::DEFAULT);
+        let mut got = InOrder::default();
+        sources.run(&mut got).unwrap();
+        let port0: Vec<u16> = got.0.iter().filter(|r| r.0 == 0).map(|r| r.1).collect();
+        assert_eq!(port0, (0..250).collect::<Vec<_>>());
+        assert_eq!(got.0.iter().filter(|r| r.0 == 1).count(), 200);
+        assert_time_order(&got.0);
+        let stats = sources.escs()[0].stream.stats();
+        assert_eq!((stats.lost_packets(), stats.duplicate_packets()), (0, 0));
+        assert_eq!(stats.bytes_skipped(), 0);
+        let seen = seen.lock().unwrap();
+        let overlaps: Vec<(&str, &str, f64)> = seen
+            .iter()
+            .filter_map(|n| match n {
+                Notice::Overlap {
+                    input,
+                    earlier,
+                    seconds,
+                    port,
+                } if port == "/dev/ttyUSB0" => Some((input.as_str(), earlier.as_str(), *seconds)),
+                _ => None,
+            })
+            .collect();
+        assert_eq!(overlaps.len(), 2, "{seen:?}");
+        assert_eq!(overlaps[0].0, "a");
+        assert_eq!(overlaps[0].1, "a");
+        assert!((overlaps[0].2 - 9.962).abs() < 0.001, "{overlaps:?}");
+        assert_eq!((overlaps[1].0, overlaps[1].1), ("b", "a"));
+        assert!((overlaps[1].2 - 2.462).abs() < 0.001, "{overlaps:?}");
+        assert_eq!(seen.len(), 2, "{seen:?}");
     }
 
     /// Raw files (no times) keep the order given, around recordings merged by time.

@@ -56,6 +56,14 @@ pub enum InputError {
         /// The input as named on the command line.
         input: String,
     },
+    /// A file read in two goes (closed meanwhile: see [`Input::open`](crate::Input::open))
+    /// was no longer of the format it was first.
+    Changed {
+        /// The input as named on the command line.
+        input: String,
+        /// The format it has now.
+        format: crate::input::InputFormat,
+    },
     /// A serial port could not be opened.
     Port(PortError),
 }
@@ -103,6 +111,10 @@ impl fmt::Display for InputError {
                      `editcap -F pcapng {input} {converted}`, then decode that"
                 )
             }
+            InputError::Changed { input, format } => write!(
+                f,
+                "{input} changed while it was being read: it is now {format}"
+            ),
             InputError::Port(e) => e.fmt(f),
         }
     }

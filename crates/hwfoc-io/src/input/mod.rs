@@ -81,10 +81,20 @@ pub struct Batch<'a> {
 }
 
 enum Source {
-    Raw { reader: Box<dyn Read> },
+    Raw {
+        reader: Box<dyn Read>,
+    },
     Csv(CsvRows),
     Recording(Box<RecordingReader>),
     Ports(Ports),
+    /// A file not open at the moment: not read yet, rewound, or at its end. What the closed
+    /// source knew that is asked for after its end is kept.
+    Closed {
+        /// A recording's interfaces.
+        interfaces: Vec<pcapng::Interface>,
+        /// Bytes a logic analyser flagged.
+        flagged: u64,
+    },
 }
 
 /// One opened input.
@@ -105,10 +115,18 @@ pub struct Input {
     deferred: Option<InputError>,
     /// Where notices go ([`crate::notice`]).
     notices: NoticeSink,
+    /// A regular file opened by its path: open only while it is read (see [`Input::open`]).
+    path: Option<String>,
+    /// Notices given since the file was opened, and how many of them a reading before a
+    /// rewind already gave (those are not given again).
+    told: usize,
+    muted: usize,
 }
 
 impl Input {
-    /// Opens a file, or standard input for `-`, and detects its format.
+    /// Opens a file, or standard input for `-`, and detects its format. A regular file is
+    /// closed again once its format is known: it is open only while it is read, from its first
+    /// [`Input::next_batch`] to its end, so that any number of inputs can be given together.
     pub fn open(spec: &str) -> Result<Input, InputError> {
         if spec == "-" {
             return Input::from_reader("standard input", Box::new(io::stdin().lock()));
@@ -126,7 +144,82 @@ impl Input {
                 input: spec.to_string(),
             });
         }
-        Input::from_reader(spec, Box::new(file))
+        let mut input = Input::from_reader(spec, Box::new(file))?;
+        if meta.is_file() {
+            // Closed until read: a year of rotated recordings is thousands of inputs, more
+            // than a process may hold open. (A pipe or a device cannot be opened again.)
+            input.path = Some(spec.to_string());
+            input.close();
+        }
+        Ok(input)
+    }
+
+    /// Opens the file again (from its start) after [`Input::close`]; its format must not have
+    /// changed.
+    fn reopen(&mut self) -> Result<(), InputError> {
+        let Some(path) = &self.path else {
+            return Ok(());
+        };
+        let file = File::open(path).map_err(|source| InputError::Open {
+            input: self.name.clone(),
+            source,
+        })?;
+        let fresh = Input::from_reader(&self.name, Box::new(file))?;
+        if fresh.format != self.format {
+            return Err(InputError::Changed {
+                input: self.name.clone(),
+                format: fresh.format,
+            });
+        }
+        self.source = fresh.source;
+        self.pending = fresh.pending;
+        self.told = 0;
+        Ok(())
+    }
+
+    /// Closes the source, keeping what is asked of it after its end, and lets go of the
+    /// buffers.
+    fn close(&mut self) {
+        let flagged = self.flagged_bytes();
+        let closed = Source::Closed {
+            interfaces: Vec::new(),
+            flagged,
+        };
+        let interfaces = match std::mem::replace(&mut self.source, closed) {
+            Source::Recording(rec) => rec.into_interfaces(),
+            Source::Closed { interfaces, .. } => interfaces,
+            _ => Vec::new(),
+        };
+        if let Source::Closed {
+            interfaces: kept, ..
+        } = &mut self.source
+        {
+            *kept = interfaces;
+        }
+        self.pending = Vec::new();
+        self.bytes = Vec::new();
+        self.times = Vec::new();
+    }
+
+    /// Starts a file opened by its path again from its beginning, closing it until it is read:
+    /// what was read of it is read again, without its notices. False (and nothing changes) for
+    /// any other input, which cannot be read twice.
+    pub fn rewind(&mut self) -> bool {
+        if self.path.is_none() {
+            return false;
+        }
+        self.close();
+        self.stream = 0;
+        self.seen_any = false;
+        self.done = false;
+        self.deferred = None;
+        self.muted = self.told;
+        true
+    }
+
+    /// Hands `notice` to the input's notice sink.
+    pub(crate) fn tell(&mut self, notice: Notice) {
+        (self.notices)(notice);
     }
 
     /// Opens serial ports at `baud` (8N1) as one input with one stream per port, in the order
@@ -230,6 +323,9 @@ impl Input {
             done: false,
             deferred: None,
             notices: notice::to_stderr(),
+            path: None,
+            told: 0,
+            muted: 0,
         }
     }
 
@@ -254,6 +350,7 @@ impl Input {
     pub fn flagged_bytes(&self) -> u64 {
         match &self.source {
             Source::Csv(rows) => rows.flagged(),
+            Source::Closed { flagged, .. } => *flagged,
             _ => 0,
         }
     }
@@ -265,6 +362,10 @@ impl Input {
             Source::Raw { .. } | Source::Csv(_) => 1,
             Source::Recording(rec) => rec.interfaces().len(),
             Source::Ports(ports) => ports.names().len(),
+            Source::Closed { interfaces, .. } => match self.format {
+                InputFormat::Recording => interfaces.len(),
+                _ => 1,
+            },
         }
     }
 
@@ -274,6 +375,7 @@ impl Input {
         let name = match &self.source {
             Source::Recording(rec) => rec.interfaces().get(i).map(|f| f.name.clone()),
             Source::Ports(ports) => ports.names().get(i).cloned(),
+            Source::Closed { interfaces, .. } => interfaces.get(i).map(|f| f.name.clone()),
             Source::Raw { .. } | Source::Csv(_) => None,
         };
         name.unwrap_or_else(|| self.name.clone())
@@ -282,15 +384,30 @@ impl Input {
     /// The next batch of bytes, or `None` at the end of the input.
     pub fn next_batch(&mut self) -> Result<Option<Batch<'_>>, InputError> {
         if let Some(e) = self.deferred.take() {
-            self.done = true;
+            self.end();
             return Err(e);
         }
         if self.done {
             return Ok(None);
         }
+        if matches!(self.source, Source::Closed { .. })
+            && let Err(e) = self.reopen()
+        {
+            self.done = true;
+            return Err(e);
+        }
         self.times.clear();
         self.stream = 0;
+        // Notices are counted, and those a reading before a rewind gave are not given again.
+        let (sink, told, muted) = (&mut self.notices, &mut self.told, self.muted);
+        let mut notices = |notice: Notice| {
+            *told += 1;
+            if *told > muted {
+                sink(notice);
+            }
+        };
         match &mut self.source {
+            Source::Closed { .. } => {}
             Source::Raw { reader } => {
                 if !self.pending.is_empty() {
                     std::mem::swap(&mut self.bytes, &mut self.pending);
@@ -311,7 +428,7 @@ impl Input {
                 self.bytes.clear();
                 if let Err(e) = rows.read(&self.name, &mut self.bytes, &mut self.times) {
                     if self.bytes.is_empty() {
-                        self.done = true;
+                        self.end();
                         return Err(e);
                     }
                     self.deferred = Some(e);
@@ -319,15 +436,10 @@ impl Input {
             }
             Source::Recording(rec) => {
                 self.bytes.clear();
-                match rec.read(
-                    &self.name,
-                    &mut self.bytes,
-                    &mut self.times,
-                    &mut self.notices,
-                ) {
+                match rec.read(&self.name, &mut self.bytes, &mut self.times, &mut notices) {
                     Ok(stream) => self.stream = stream,
                     Err(e) if self.bytes.is_empty() => {
-                        self.done = true;
+                        self.end();
                         return Err(e);
                     }
                     Err(e) => self.deferred = Some(e),
@@ -335,7 +447,7 @@ impl Input {
             }
             Source::Ports(ports) => {
                 self.bytes.clear();
-                self.stream = ports.read(&mut self.bytes, &mut self.times, &mut self.notices);
+                self.stream = ports.read(&mut self.bytes, &mut self.times, &mut notices);
                 if self.bytes.is_empty() {
                     // Interrupted: the end of a live input, not an error even with no bytes.
                     self.done = true;
@@ -344,7 +456,7 @@ impl Input {
             }
         }
         if self.bytes.is_empty() {
-            self.done = true;
+            self.end();
             if !self.seen_any {
                 return Err(InputError::Empty {
                     input: self.name.clone(),
@@ -354,6 +466,14 @@ impl Input {
         }
         self.seen_any = true;
         Ok(self.current_batch())
+    }
+
+    /// At the end (or at an error): a file is closed, its buffers let go.
+    fn end(&mut self) {
+        self.done = true;
+        if self.path.is_some() {
+            self.close();
+        }
     }
 
     /// The batch [`Input::next_batch`] returned last, again (`None` before the first and at
@@ -741,6 +861,67 @@ mod tests {
         let (bytes, _) = read_all(&mut input);
         assert_eq!(bytes.len(), 25_000);
         assert_eq!(input.streams(), 2);
+    }
+
+    /// A section declaring one port in 200 000 interface blocks (each a stream of its own, as
+    /// a section's interfaces are), with bytes on the first and the last: read in linear time.
+    /// (A search of the port's interfaces for each block took minutes; the bound is generous
+    /// for a loaded machine and a debug build, where the linear read takes about a second.)
+    #[test]
+    fn one_section_of_many_interfaces_of_one_port_reads_in_linear_time() {
+        let n = 200_000u32;
+        let mut w = pcapng::Writer::new(Vec::new()).unwrap();
+        for _ in 0..n {
+            w.add_interface("/dev/ttyUSB0", 19200).unwrap();
+        }
+        let t = 1_700_000_000_000_000_000;
+        w.write(0, t, &[1]).unwrap();
+        w.write(n - 1, t + 1_000_000, &[2]).unwrap();
+        let file = w.into_inner().unwrap();
+        let started = std::time::Instant::now();
+        let mut input = Input::from_memory("many.pcapng", file).unwrap();
+        let got = batches(&mut input);
+        let elapsed = started.elapsed();
+        assert_eq!(input.streams(), n as usize);
+        let streams: Vec<(usize, Vec<u8>)> = got.into_iter().map(|b| (b.0, b.1)).collect();
+        assert_eq!(streams, [(0, vec![1]), (n as usize - 1, vec![2])]);
+        assert!(elapsed.as_secs() < 30, "{elapsed:?}");
+    }
+
+    /// A file is open only while it is read, and read again from its start after a rewind,
+    /// without telling its notices twice; a file that is no longer of its format when it is
+    /// opened again is an error naming it.
+    #[test]
+    fn files_are_opened_when_read_and_can_be_read_again() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("r.pcapng");
+        let mut w = pcapng::Writer::new(Vec::new()).unwrap();
+        w.add_interface("/dev/ttyUSB0", 19200).unwrap();
+        w.comment(0, 1, "a note").unwrap();
+        w.write(0, 2, &[7, 8]).unwrap();
+        std::fs::write(&path, w.into_inner().unwrap()).unwrap();
+        let name = path.to_str().unwrap();
+        let mut input = Input::open(name).unwrap();
+        assert!(matches!(input.source, Source::Closed { .. }));
+        let seen = std::sync::Arc::new(std::sync::Mutex::new(0));
+        let count = std::sync::Arc::clone(&seen);
+        input.set_notices(move |_| *count.lock().unwrap() += 1);
+        assert_eq!(input.next_batch().unwrap().unwrap().bytes, [7, 8]);
+        assert!(input.rewind());
+        assert!(matches!(input.source, Source::Closed { .. }));
+        assert_eq!(read_all(&mut input).0, [7, 8]);
+        assert!(matches!(input.source, Source::Closed { .. }));
+        assert_eq!(input.stream_name(0), "/dev/ttyUSB0");
+        assert_eq!(*seen.lock().unwrap(), 1);
+        assert!(input.rewind());
+        std::fs::write(&path, b"raw bytes now").unwrap();
+        let e = input.next_batch().err().unwrap();
+        assert_eq!(
+            e.to_string(),
+            format!("{name} changed while it was being read: it is now raw bytes")
+        );
+        let mut memory = Input::from_memory("m.bin", vec![1]).unwrap();
+        assert!(!memory.rewind());
     }
 
     #[test]

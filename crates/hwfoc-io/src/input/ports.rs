@@ -4,7 +4,7 @@ use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Duration;
 
-use crate::notice::{Notice, NoticeSink};
+use crate::notice::Notice;
 use crate::serial::{PortEvent, PortSet};
 use crate::stream::byte_times;
 
@@ -36,7 +36,7 @@ impl Ports {
         &mut self,
         bytes: &mut Vec<u8>,
         times: &mut Vec<f64>,
-        notices: &mut NoticeSink,
+        notices: &mut dyn FnMut(Notice),
     ) -> usize {
         let per_byte = hwfoc::wire::byte_ns(self.set.baud());
         while !self.interrupted.load(Ordering::Relaxed) {

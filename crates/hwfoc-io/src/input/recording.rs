@@ -3,7 +3,7 @@
 use std::io::Read;
 
 use super::InputError;
-use crate::notice::{Notice, NoticeSink};
+use crate::notice::Notice;
 use crate::pcapng;
 use crate::stream::byte_times;
 
@@ -18,8 +18,17 @@ use crate::stream::byte_times;
 /// [`crate::sources::Sources`] needs to hand records of every port on in time order.
 pub(super) struct RecordingReader {
     reader: pcapng::Reader<Box<dyn Read>>,
-    /// Bytes and receive times gathered in the current window, by interface.
-    pending: Vec<(Vec<u8>, Vec<f64>)>,
+    /// The interfaces with bytes in the current window, in the order of their first packet,
+    /// each with its bytes and their receive times; once the window is read, in the order of
+    /// their first byte's time, `handed` of them handed out.
+    pending: Vec<Gathered>,
+    /// The place in `pending` of each interface with bytes in the current window. (Only those:
+    /// a recording declaring a million interfaces costs nothing per window for the silent.)
+    slot: std::collections::HashMap<u32, usize>,
+    /// How many of `pending` were handed out.
+    handed: usize,
+    /// Buffers of earlier windows, to be filled again.
+    spare: Vec<(Vec<u8>, Vec<f64>)>,
     /// Whether the window's batches are being handed out.
     draining: bool,
     /// Time of the first packet of the current window.
@@ -29,6 +38,13 @@ pub(super) struct RecordingReader {
     error: Option<InputError>,
     /// Interfaces whose link type is not telemetry, already warned about.
     skipped: std::collections::HashSet<u32>,
+}
+
+/// One interface's bytes of a window.
+struct Gathered {
+    iface: u32,
+    bytes: Vec<u8>,
+    times: Vec<f64>,
 }
 
 /// Recording time gathered per port before its bytes are handed out (10 s: 4.8 kB of frames
@@ -43,6 +59,9 @@ impl RecordingReader {
         RecordingReader {
             reader: pcapng::Reader::new(reader),
             pending: Vec::new(),
+            slot: Default::default(),
+            handed: 0,
+            spare: Vec::new(),
             draining: false,
             window_start: None,
             ended: false,
@@ -56,6 +75,11 @@ impl RecordingReader {
         self.reader.interfaces()
     }
 
+    /// The interfaces declared so far, the file and buffers let go.
+    pub(super) fn into_interfaces(self) -> Vec<pcapng::Interface> {
+        self.reader.into_interfaces()
+    }
+
     /// Hands out the next batch of the current window into `bytes` and `times` (which are
     /// empty) and returns its interface, reading the next window when this one is done;
     /// leaves `bytes` empty at the end of the file. A read error is returned after the
@@ -65,38 +89,47 @@ impl RecordingReader {
         name: &str,
         bytes: &mut Vec<u8>,
         times: &mut Vec<f64>,
-        notices: &mut NoticeSink,
+        notices: &mut dyn FnMut(Notice),
     ) -> Result<usize, InputError> {
         loop {
             if self.draining {
                 // The window's ports in the order of their first byte: batches of a recording
                 // come in order of their first byte's time (what `Sources` merges by).
-                let next = (0..self.pending.len())
-                    .filter(|&i| !self.pending[i].0.is_empty())
-                    .min_by(|&a, &b| self.pending[a].1[0].total_cmp(&self.pending[b].1[0]));
-                if let Some(i) = next {
-                    std::mem::swap(bytes, &mut self.pending[i].0);
-                    std::mem::swap(times, &mut self.pending[i].1);
-                    self.pending[i].0.clear();
-                    self.pending[i].1.clear();
-                    return Ok(i);
+                if let Some(next) = self.pending.get_mut(self.handed) {
+                    self.handed += 1;
+                    std::mem::swap(bytes, &mut next.bytes);
+                    std::mem::swap(times, &mut next.times);
+                    return Ok(next.iface as usize);
                 }
                 self.draining = false;
             }
             if self.ended {
                 return self.error.take().map_or(Ok(0), Err);
             }
+            for mut done in self.pending.drain(..) {
+                done.bytes.clear();
+                done.times.clear();
+                self.spare.push((done.bytes, done.times));
+            }
+            self.slot.clear();
+            self.handed = 0;
             if let Err(e) = self.read_window(name, notices) {
                 self.error = Some(e);
                 self.ended = true;
             }
+            self.pending
+                .sort_by(|a, b| (a.times[0].total_cmp(&b.times[0])).then(a.iface.cmp(&b.iface)));
             self.draining = true;
         }
     }
 
     /// Reads packets into the per-interface buffers until the window is over, a buffer is
     /// full, or the file ends.
-    fn read_window(&mut self, name: &str, notices: &mut NoticeSink) -> Result<(), InputError> {
+    fn read_window(
+        &mut self,
+        name: &str,
+        notices: &mut dyn FnMut(Notice),
+    ) -> Result<(), InputError> {
         self.window_start = None;
         loop {
             let packet = self
@@ -138,11 +171,16 @@ impl RecordingReader {
                     });
                 }
             } else {
-                let i = iface as usize;
-                if self.pending.len() <= i {
-                    self.pending.resize_with(i + 1, Default::default);
-                }
-                let (bytes, times) = &mut self.pending[i];
+                let i = *self.slot.entry(iface).or_insert_with(|| {
+                    let (bytes, times) = self.spare.pop().unwrap_or_default();
+                    self.pending.push(Gathered {
+                        iface,
+                        bytes,
+                        times,
+                    });
+                    self.pending.len() - 1
+                });
+                let Gathered { bytes, times, .. } = &mut self.pending[i];
                 byte_times(t_ns, interface.byte_ns(), packet.data.len(), times);
                 bytes.extend_from_slice(packet.data);
                 let start = *self.window_start.get_or_insert(t_ns);
@@ -156,7 +194,7 @@ impl RecordingReader {
         }
     }
 
-    fn report_damage(&mut self, name: &str, notices: &mut NoticeSink) {
+    fn report_damage(&mut self, name: &str, notices: &mut dyn FnMut(Notice)) {
         for damage in self.reader.take_damage() {
             notices(Notice::Damage {
                 input: name.to_string(),
