@@ -10,7 +10,7 @@ use std::io::BufReader;
 use std::path::Path;
 use std::process::Output;
 
-use common::{Dir, assert_fails_with, hwfoc, ok};
+use common::{Dir, XROTOR, assert_fails_with, capture, hwfoc, ok};
 
 fn run(args: &[&str]) -> Output {
     hwfoc().args(args).output().expect("run hwfoc")
@@ -432,4 +432,49 @@ fn bad_outputs_and_empty_inputs_are_errors() {
     let o = run(&["plot", &dir.arg("absent.pcapng"), "-o", &dir.arg("y.svg")]);
     assert_fails_with(&o, "cannot open");
     assert!(!dir.path("y.svg").exists());
+}
+
+/// Lines stay inside their panels: on the real XRotor capture, one-frame spikes (phase current,
+/// power, voltage) turn straight back, and the PNG backend's mitred joins ran from them through
+/// the header text and the axis labels to the image's edge. The speed/power green and the
+/// voltage purple are only drawn between the top of the plotting areas (where the y axes
+/// start) and the x axes.
+#[test]
+fn lines_stay_inside_their_panels() {
+    let dir = Dir::new();
+    let out = dir.path("x.png");
+    let input = capture(XROTOR);
+    ok(run(&[
+        "plot",
+        input.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+        "--no-config",
+    ]));
+    let png = Png::read(&out);
+    const AXIS: (u8, u8, u8) = (120, 120, 120);
+    // The x axes: rows with a long run of the axis colour; the y axes: columns with one.
+    let x_axis = (0..png.height)
+        .filter(|&y| (0..png.width).filter(|&x| png.pixel(x, y) == AXIS).count() > 100)
+        .max()
+        .expect("an x axis");
+    let top = (0..png.width)
+        .filter_map(|x| {
+            let rows: Vec<u32> = (0..png.height)
+                .filter(|&y| png.pixel(x, y) == AXIS)
+                .collect();
+            (rows.len() > 100).then(|| rows[0])
+        })
+        .max()
+        .expect("a y axis");
+    let line = |p: (u8, u8, u8)| p == (44, 160, 44) || p == (148, 103, 189);
+    let rows = png.rows_with(line);
+    assert!(!rows.is_empty() && top > 60, "top {top}");
+    assert!(
+        rows.iter().all(|&y| (top..=x_axis).contains(&y)),
+        "line pixels in rows {:?}, outside the panels' rows {top}..={x_axis}",
+        rows.iter()
+            .filter(|&&y| !(top..=x_axis).contains(&y))
+            .collect::<Vec<_>>()
+    );
 }
