@@ -232,6 +232,8 @@ struct Row<'a> {
     info: Option<String>,
     /// Why nothing is drawn, when nothing is.
     empty: Option<&'static str>,
+    /// Whether its input's clock is the wall clock (its episode is given in dates).
+    wall: bool,
 }
 
 /// The time axis shared by all rows.
@@ -313,6 +315,10 @@ impl<'a> Scene<'a> {
                         .and_then(|d| d.info)
                         .map(|info| Escaped(info).to_string()),
                     empty,
+                    wall: sources
+                        .inputs()
+                        .get(sources.escs()[i].input)
+                        .is_some_and(|input| input.format.clock() == Clock::Wall),
                 }
             })
             .collect();
@@ -459,7 +465,7 @@ impl<'a> Scene<'a> {
         header.draw_text(&label, &name, (0, 9))?;
         let x = header.estimate_text_size(&label, &name)?.0 as i32 + 14;
         let (faults, colour) = match row.data {
-            Some(d) => fault_summary(d, row.offset),
+            Some(d) => fault_summary(d, row.wall),
             None => (String::new(), MUTED),
         };
         let right = text(14, colour).pos(Pos::new(HPos::Right, VPos::Top));
@@ -915,18 +921,18 @@ fn fault_names(status: hwfoc::Status) -> String {
         .join(", ")
 }
 
-/// The header's fault text, and its colour.
-fn fault_summary(data: &EscData, offset: f64) -> (String, RGBColor) {
-    let Some(first) = data.spans.first() else {
+/// The header's fault text, and its colour: an only episode with its times as the summary
+/// gives them ([`hwfoc_io::episode::Episode::when`]), several by their count.
+fn fault_summary(data: &EscData, wall: bool) -> (String, RGBColor) {
+    let Some(first) = data.first_episode.as_ref() else {
         return ("no faults".to_string(), OK_TEXT);
     };
     let bits = data.spans.iter().fold(0u16, |acc, s| acc | s.bits.0);
     let names = fault_names(hwfoc::Status(bits));
     let text = if data.episodes == 1 {
         format!(
-            "fault: {names}, {:.2} to {:.2} s{}",
-            first.start - offset,
-            first.end - offset,
+            "fault: {names}, {}{}",
+            first.when(wall),
             if first.ongoing { " (to the end)" } else { "" }
         )
     } else {
