@@ -10,7 +10,7 @@ use std::io::BufReader;
 use std::path::Path;
 use std::process::Output;
 
-use common::{Dir, assert_fails_with, hwfoc, ok};
+use common::{Dir, XROTOR, assert_fails_with, capture, hwfoc, ok};
 
 fn run(args: &[&str]) -> Output {
     hwfoc().args(args).output().expect("run hwfoc")
@@ -251,15 +251,15 @@ fn svg_is_xml_with_a_panel_set_per_esc_units_and_fault_names() {
         .keys()
         .find(|t| t.starts_with("fault: mos_overheat"))
         .unwrap_or_else(|| panic!("no fault header in {texts:?}"));
-    // 5 to 7 s of simulated time; the first frame comes a few ms after the start.
-    let times: Vec<f64> = header
+    // 5 to 7 s of simulated time from 1000 s after 1970 (the recording's wall clock), from
+    // the first faulty frame to the last, in dates, as the summary gives it.
+    let (start, end) = header
         .trim_start_matches("fault: mos_overheat, ")
-        .trim_end_matches(" s")
-        .split(" to ")
-        .map(|t| t.parse().unwrap())
-        .collect();
+        .split_once(" .. ")
+        .unwrap_or_else(|| panic!("{header}"));
+    assert!(start.starts_with("1970-01-01T00:16:45.0"), "{header}");
     assert!(
-        (times[0] - 5.0).abs() < 0.1 && (times[1] - 7.0).abs() < 0.15,
+        end.starts_with("1970-01-01T00:16:46.9") || end.starts_with("1970-01-01T00:16:47.0"),
         "{header}"
     );
     assert_eq!(count("no faults"), 2, "{texts:?}");
@@ -332,7 +332,10 @@ fn a_time_window_plots_only_its_frames() {
         .keys()
         .find(|t| t.starts_with("fault: mos_overheat, "))
         .unwrap_or_else(|| panic!("no fault header in {texts:?}"));
-    assert!(header.starts_with("fault: mos_overheat, 5.0"), "{header}");
+    assert!(
+        header.starts_with("fault: mos_overheat, 1970-01-01T00:16:45.0"),
+        "{header}"
+    );
     // A window that holds no frame says where the frames are.
     let o = run(&[
         "plot",
@@ -432,4 +435,96 @@ fn bad_outputs_and_empty_inputs_are_errors() {
     let o = run(&["plot", &dir.arg("absent.pcapng"), "-o", &dir.arg("y.svg")]);
     assert_fails_with(&o, "cannot open");
     assert!(!dir.path("y.svg").exists());
+}
+
+/// Lines stay inside their panels: on the real XRotor capture, one-frame spikes (phase current,
+/// power, voltage) turn straight back, and the PNG backend's mitred joins ran from them through
+/// the header text and the axis labels to the image's edge. The speed/power green and the
+/// voltage purple are only drawn between the top of the plotting areas (where the y axes
+/// start) and the x axes.
+#[test]
+fn lines_stay_inside_their_panels() {
+    let dir = Dir::new();
+    let out = dir.path("x.png");
+    let input = capture(XROTOR);
+    ok(run(&[
+        "plot",
+        input.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+        "--no-config",
+    ]));
+    let png = Png::read(&out);
+    const AXIS: (u8, u8, u8) = (120, 120, 120);
+    // The x axes: rows with a long run of the axis colour; the y axes: columns with one.
+    let x_axis = (0..png.height)
+        .filter(|&y| (0..png.width).filter(|&x| png.pixel(x, y) == AXIS).count() > 100)
+        .max()
+        .expect("an x axis");
+    let top = (0..png.width)
+        .filter_map(|x| {
+            let rows: Vec<u32> = (0..png.height)
+                .filter(|&y| png.pixel(x, y) == AXIS)
+                .collect();
+            (rows.len() > 100).then(|| rows[0])
+        })
+        .max()
+        .expect("a y axis");
+    let line = |p: (u8, u8, u8)| p == (44, 160, 44) || p == (148, 103, 189);
+    let rows = png.rows_with(line);
+    assert!(!rows.is_empty() && top > 60, "top {top}");
+    assert!(
+        rows.iter().all(|&y| (top..=x_axis).contains(&y)),
+        "line pixels in rows {:?}, outside the panels' rows {top}..={x_axis}",
+        rows.iter()
+            .filter(|&&y| !(top..=x_axis).contains(&y))
+            .collect::<Vec<_>>()
+    );
+}
+
+/// A fault episode has the same times in the plot's header as in the summary: from its first
+/// to its last faulty frame, on the source's clock (dates for a recording); the demo's
+/// throttle-signal-lost episode was "4.77 to 5.07 s" in one and "5.020 .. 5.270 s" in the other.
+#[test]
+fn a_fault_episode_has_the_same_times_in_the_plot_and_the_summary() {
+    let dir = Dir::new();
+    let recording = dir.path("rec.pcapng");
+    ok(run(&[
+        "simulate",
+        "--duration",
+        "6",
+        "--start-time",
+        "1700000000",
+        "--fault",
+        "mos_overheat@2-3",
+        "--no-config",
+        "-o",
+        recording.to_str().unwrap(),
+    ]));
+    for input in [vec!["--demo"], vec![recording.to_str().unwrap()]] {
+        let summary =
+            String::from_utf8(ok(run(&[&["summary"], &input[..]].concat())).stdout).unwrap();
+        // `     1  5.020 .. 5.270 s (0.250 s, ...` or `     1  2023-… .. 2023-… (1.0 s, ...`
+        let episode = summary
+            .lines()
+            .find(|l| l.trim_start().starts_with("1  "))
+            .unwrap_or_else(|| panic!("no episode in {summary}"));
+        let when = episode.trim_start()[3..]
+            .split(" (")
+            .next()
+            .unwrap()
+            .to_string();
+        let svg = dir.path("p.svg");
+        let mut args = vec!["plot"];
+        args.extend(&input);
+        args.extend(["-o", svg.to_str().unwrap()]);
+        let o = run(&args);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        let text = std::fs::read_to_string(&svg).unwrap();
+        assert!(
+            text.lines()
+                .any(|l| l.trim_end().ends_with(&format!(", {when}"))),
+            "the plot's header lacks {when:?} (summary: {episode})"
+        );
+    }
 }

@@ -30,6 +30,19 @@ pub struct Episode {
 }
 
 impl Episode {
+    /// When it was, from its first to its last faulty frame: `5.020 .. 5.270 s` on the
+    /// source's clock, dates on a wall clock (`wall`), `frames 12 .. 17` without receive
+    /// times. The one way the summary and the plot say it.
+    pub fn when(&self, wall: bool) -> String {
+        match (self.first.t, self.last.t) {
+            (Some(a), Some(b)) if wall => {
+                format!("{} .. {}", crate::time::iso8601(a), crate::time::iso8601(b))
+            }
+            (Some(a), Some(b)) => format!("{a:.3} .. {b:.3} s"),
+            _ => format!("frames {} .. {}", self.first.frame, self.last.frame),
+        }
+    }
+
     /// Follows the fault episodes of one ESC through its data frames, in order: a frame with a
     /// non-zero status word starts the open episode `open` or extends it, a clean frame ends
     /// it. Returns the episode the frame ended, if any.

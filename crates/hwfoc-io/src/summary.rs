@@ -971,23 +971,9 @@ impl EscReport<'_> {
 
 /// An episode in one line: when (dates on a wall clock), how long, which faults.
 fn episode_text(e: &Episode, clock: Clock) -> String {
-    let mut s = String::new();
-    match (e.first.t, e.last.t) {
-        (Some(a), Some(b)) if clock == Clock::Wall => {
-            let _ = write!(
-                s,
-                "{} .. {} ({:.3} s, ",
-                time::iso8601(a),
-                time::iso8601(b),
-                b - a
-            );
-        }
-        (Some(a), Some(b)) => {
-            let _ = write!(s, "{a:.3} .. {b:.3} s ({:.3} s, ", b - a);
-        }
-        _ => {
-            let _ = write!(s, "frames {} .. {} (", e.first.frame, e.last.frame);
-        }
+    let mut s = format!("{} (", e.when(clock == Clock::Wall));
+    if let (Some(a), Some(b)) = (e.first.t, e.last.t) {
+        let _ = write!(s, "{:.3} s, ", b - a);
     }
     let _ = write!(
         s,

@@ -288,6 +288,10 @@ pub struct EscData {
     shift: f64,
     /// The fault episode going on.
     open: Option<Episode>,
+    /// The first fault episode with the frames' own receive times (not the plot's clock),
+    /// for the header, and the one going on until it ends.
+    pub first_episode: Option<Episode>,
+    first_open: Option<Episode>,
 }
 
 impl EscData {
@@ -307,6 +311,8 @@ impl EscData {
             last_timed: None,
             shift: 0.0,
             open: None,
+            first_episode: None,
+            first_open: None,
         }
     }
 
@@ -362,6 +368,10 @@ impl EscData {
         if let Some(ended) = Episode::track(&mut self.open, mark, r.status) {
             self.keep(&ended);
         }
+        if self.first_episode.is_none() {
+            let own = Mark { t, ..mark };
+            self.first_episode = Episode::track(&mut self.first_open, own, r.status);
+        }
     }
 
     /// Adds an ended fault episode to the spans, merged into the last one when the plot could
@@ -392,6 +402,10 @@ impl EscData {
         if let Some(mut open) = self.open.take() {
             open.ongoing = true;
             self.keep(&open);
+        }
+        if let Some(mut open) = self.first_open.take() {
+            open.ongoing = true;
+            self.first_episode.get_or_insert(open);
         }
     }
 }

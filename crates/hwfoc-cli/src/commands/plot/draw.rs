@@ -232,6 +232,8 @@ struct Row<'a> {
     info: Option<String>,
     /// Why nothing is drawn, when nothing is.
     empty: Option<&'static str>,
+    /// Whether its input's clock is the wall clock (its episode is given in dates).
+    wall: bool,
 }
 
 /// The time axis shared by all rows.
@@ -313,6 +315,10 @@ impl<'a> Scene<'a> {
                         .and_then(|d| d.info)
                         .map(|info| Escaped(info).to_string()),
                     empty,
+                    wall: sources
+                        .inputs()
+                        .get(sources.escs()[i].input)
+                        .is_some_and(|input| input.format.clock() == Clock::Wall),
                 }
             })
             .collect();
@@ -459,7 +465,7 @@ impl<'a> Scene<'a> {
         header.draw_text(&label, &name, (0, 9))?;
         let x = header.estimate_text_size(&label, &name)?.0 as i32 + 14;
         let (faults, colour) = match row.data {
-            Some(d) => fault_summary(d, row.offset),
+            Some(d) => fault_summary(d, row.wall),
             None => (String::new(), MUTED),
         };
         let right = text(14, colour).pos(Pos::new(HPos::Right, VPos::Top));
@@ -586,7 +592,11 @@ impl<'a> Scene<'a> {
                 2
             };
             let style = colour.stroke_width(width);
-            for path in paths(&columns, quantity) {
+            let pieces = paths(&columns, quantity)
+                .into_iter()
+                .flat_map(|p| cut_at_sharp_turns(p, |v| chart.backend_coord(v)))
+                .collect::<Vec<_>>();
+            for path in pieces {
                 if path.len() == 1 {
                     chart.draw_series(std::iter::once(Circle::new(path[0], 2, colour.filled())))?;
                 } else {
@@ -867,6 +877,41 @@ fn paths(columns: &[(f64, Bucket)], q: Quantity) -> Vec<Vec<(f64, f64)>> {
     paths
 }
 
+/// `path` cut where it nearly turns back on itself on the image (`px` gives a point's pixel),
+/// each piece ending at the turn. plotters' bitmap backend joins the segments of a wide line
+/// by mitring without a limit, so at such a turn (a one-frame spike: up and straight down) the
+/// mitre ran far past the point, through the panel's header or axis labels to the image's edge;
+/// SVG renderers limit mitres to 4 line widths, the limit taken here: a turn whose inner angle
+/// is under 29 degrees (its cosine over 0.875).
+fn cut_at_sharp_turns(
+    path: Vec<(f64, f64)>,
+    px: impl Fn(&(f64, f64)) -> (i32, i32),
+) -> Vec<Vec<(f64, f64)>> {
+    if path.len() < 3 {
+        return vec![path];
+    }
+    let pixels: Vec<(f64, f64)> = path
+        .iter()
+        .map(|p| {
+            let (x, y) = px(p);
+            (f64::from(x), f64::from(y))
+        })
+        .collect();
+    let mut pieces = Vec::new();
+    let mut start = 0;
+    for i in 1..path.len() - 1 {
+        let (a, b, c) = (pixels[i - 1], pixels[i], pixels[i + 1]);
+        let (u, v) = ((b.0 - a.0, b.1 - a.1), (c.0 - b.0, c.1 - b.1));
+        let lengths = u.0.hypot(u.1) * v.0.hypot(v.1);
+        if lengths > 0.0 && (u.0 * v.0 + u.1 * v.1) / lengths < -0.875 {
+            pieces.push(path[start..=i].to_vec());
+            start = i;
+        }
+    }
+    pieces.push(path[start..].to_vec());
+    pieces
+}
+
 /// The fault names of a status word, joined.
 fn fault_names(status: hwfoc::Status) -> String {
     status
@@ -876,18 +921,18 @@ fn fault_names(status: hwfoc::Status) -> String {
         .join(", ")
 }
 
-/// The header's fault text, and its colour.
-fn fault_summary(data: &EscData, offset: f64) -> (String, RGBColor) {
-    let Some(first) = data.spans.first() else {
+/// The header's fault text, and its colour: an only episode with its times as the summary
+/// gives them ([`hwfoc_io::episode::Episode::when`]), several by their count.
+fn fault_summary(data: &EscData, wall: bool) -> (String, RGBColor) {
+    let Some(first) = data.first_episode.as_ref() else {
         return ("no faults".to_string(), OK_TEXT);
     };
     let bits = data.spans.iter().fold(0u16, |acc, s| acc | s.bits.0);
     let names = fault_names(hwfoc::Status(bits));
     let text = if data.episodes == 1 {
         format!(
-            "fault: {names}, {:.2} to {:.2} s{}",
-            first.start - offset,
-            first.end - offset,
+            "fault: {names}, {}{}",
+            first.when(wall),
             if first.ongoing { " (to the end)" } else { "" }
         )
     } else {
