@@ -19,7 +19,7 @@ use hwfoc::Settings;
 use hwfoc_io::notice::Notice;
 use hwfoc_io::select::{Selection, Window};
 use hwfoc_io::sources::Sources;
-use hwfoc_io::summary::{NO_FRAMES, Summary, esc_label};
+use hwfoc_io::summary::{Summary, esc_label, no_frames as no_frames_text};
 use hwfoc_io::write::arrow::schema;
 use hwfoc_io::{Input, InputError};
 use pyo3::exceptions::{PyTypeError, PyValueError};
@@ -173,7 +173,7 @@ pub(crate) fn no_frames(sources: &Sources) -> Vec<String> {
             let stats = sources.escs()[i].stream.stats();
             stats.bytes() > 0 && stats.frames() == 0
         })
-        .map(|i| format!("{}: {}", esc_label(sources, i), *NO_FRAMES))
+        .map(|i| format!("{}: {}", esc_label(sources, i), no_frames_text(sources, i)))
         .collect()
 }
 

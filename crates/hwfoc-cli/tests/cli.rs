@@ -158,11 +158,14 @@ fn other_protocols_give_no_frames_and_say_so() {
         let path = capture(name);
         let path = path.to_str().unwrap();
         let out = run(&["decode", path]);
-        assert!(stdout(&out).is_empty(), "{name}");
+        assert!(out.stdout.is_empty(), "{name}");
+        assert_eq!(out.status.code(), Some(1), "{name}");
         let err = String::from_utf8_lossy(&out.stderr);
         assert!(err.contains("no valid HW-FOC frames"), "{err}");
 
-        let v: Value = serde_json::from_str(&stdout(&run(&["summary", "--json", path]))).unwrap();
+        let out = run(&["summary", "--json", path]);
+        assert_eq!(out.status.code(), Some(1), "{name}");
+        let v: Value = serde_json::from_slice(&out.stdout).unwrap();
         let v = &v["escs"][0];
         assert_eq!(v["frames"], 0, "{name}");
         assert_eq!(v["info_frames"], 0, "{name}");
@@ -170,10 +173,65 @@ fn other_protocols_give_no_frames_and_say_so() {
             v["warning"],
             "no valid HW-FOC frames: check the baud rate (19200) and the wiring"
         );
-        let text = stdout(&run(&["summary", path]));
+        let text = String::from_utf8(run(&["summary", path]).stdout).unwrap();
         assert!(
             text.contains("no valid HW-FOC frames: check the baud rate (19200) and the wiring")
         );
+    }
+}
+
+/// A file that is not telemetry is named as such, not blamed on the baud rate and the wiring
+/// (advice for a wire, not for a README given by mistake); `decode`, `summary` and `plot` all
+/// fail (exit 1) when no input gave a data frame, and `decode -o` leaves an existing file as
+/// it was.
+#[test]
+fn files_that_are_not_telemetry_are_named_and_every_command_fails_alike() {
+    let dir = tempfile::tempdir().unwrap();
+    let readme = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../README.md");
+    let zeros = dir.path().join("zeros.bin");
+    std::fs::write(&zeros, [0u8; 5000]).unwrap();
+    let png = dir.path().join("image.png");
+    let mut png_bytes = b"\x89PNG\r\n\x1a\n".to_vec();
+    png_bytes.extend((0..3000u32).map(|i| (i * 7919 % 251) as u8));
+    std::fs::write(&png, png_bytes).unwrap();
+    let out_file = dir.path().join("out.csv");
+    for (input, reason) in [
+        (readme.as_path(), "text, not telemetry"),
+        (zeros.as_path(), "only zero bytes, not telemetry"),
+        (png.as_path(), "looks like a PNG image, not telemetry"),
+    ] {
+        let input = input.to_str().unwrap();
+        std::fs::write(&out_file, "earlier\n").unwrap();
+        let runs = [
+            run(&[
+                "decode",
+                "--format",
+                "csv",
+                input,
+                "-o",
+                out_file.to_str().unwrap(),
+            ]),
+            run(&["summary", input]),
+            run(&[
+                "plot",
+                input,
+                "-o",
+                dir.path().join("p.png").to_str().unwrap(),
+            ]),
+        ];
+        for out in &runs {
+            let err = String::from_utf8_lossy(&out.stderr);
+            assert_eq!(out.status.code(), Some(1), "{input}: {err}");
+            let said = err.to_string() + &String::from_utf8_lossy(&out.stdout);
+            assert!(said.contains(reason), "{input}: {said}");
+            assert!(!said.contains("baud rate"), "{input}: {said}");
+        }
+        assert!(
+            String::from_utf8_lossy(&runs[0].stderr).contains("no data frame in any input"),
+            "{input}"
+        );
+        assert_eq!(std::fs::read_to_string(&out_file).unwrap(), "earlier\n");
+        assert!(!dir.path().join("p.png").exists());
     }
 }
 

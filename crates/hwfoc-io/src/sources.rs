@@ -87,6 +87,9 @@ pub struct InputInfo {
     pub bytes: u64,
     /// The ESC index of each of its streams, in stream order.
     pub escs: Vec<usize>,
+    /// What its bytes look like, read to its end, when they are not telemetry (a raw input's:
+    /// text, zeros, another file format).
+    pub looks: Option<crate::input::Looks>,
 }
 
 /// The inputs of a command and the ESCs found in them.
@@ -244,6 +247,12 @@ impl Sources {
             Some((owner, channel)) => self.escs[owner].stream.link(channel),
             None => self.escs[esc].stream.stats(),
         }
+    }
+
+    /// Whether any ESC's bytes gave a data frame (`decode`, `summary` and `plot` fail alike
+    /// when none did).
+    pub fn any_data_frame(&self) -> bool {
+        (0..self.escs.len()).any(|esc| self.link(esc).frames() > 0)
     }
 
     /// The most frames that waited at once in the time-order queue (at most [`MAX_QUEUED`]).
@@ -468,6 +477,7 @@ impl Sources {
         let info = &mut self.read[index];
         info.flagged_bytes = input.flagged_bytes();
         info.bytes = bytes;
+        info.looks = input.looks();
         info.escs = escs.iter().flatten().copied().collect();
         for &esc in escs.iter().flatten() {
             self.readers[esc] -= 1;
@@ -482,6 +492,7 @@ impl Sources {
             flagged_bytes: 0,
             bytes: 0,
             escs: Vec::new(),
+            looks: None,
         });
         self.read.len() - 1
     }

@@ -37,13 +37,26 @@ use crate::time::{self, Clock};
 use crate::write::settings_json;
 use hwfoc::datalink::LengthByte;
 
-/// What to tell a user whose input has bytes but no frame.
+/// What to tell a user whose wire gave bytes but no frame.
 pub static NO_FRAMES: std::sync::LazyLock<String> = std::sync::LazyLock::new(|| {
     format!(
         "no valid HW-FOC frames: check the baud rate ({}) and the wiring",
         hwfoc::wire::BAUD_RATE
     )
 });
+
+/// Why ESC `esc`'s bytes gave no frame, as every output says it: what its input looks like
+/// when that is not telemetry (`text, not telemetry`, `looks like a PNG image, not telemetry`:
+/// a file given by mistake), else [`NO_FRAMES`], the advice for a wire (a port, a recording,
+/// a raw capture of bytes).
+pub fn no_frames(sources: &Sources, esc: usize) -> String {
+    sources
+        .escs()
+        .get(esc)
+        .and_then(|e| sources.inputs().get(e.input))
+        .and_then(|input| input.looks)
+        .map_or_else(|| NO_FRAMES.clone(), |looks| looks.to_string())
+}
 
 /// Fault episodes kept per ESC in detail (all are counted).
 const MAX_EPISODES: usize = 10_000;
@@ -425,6 +438,8 @@ struct EscReport<'a> {
     episode_count: u64,
     /// The clock of its input's times.
     clock: Clock,
+    /// Why its bytes gave no frame, if they gave none ([`no_frames`]).
+    no_frames: String,
 }
 
 /// The short name of a format in `--json`.
@@ -465,6 +480,7 @@ impl<'a> Report<'a> {
                     .map_or(Clock::None, |info| info.format.clock());
                 EscReport {
                     clock,
+                    no_frames: no_frames(self.sources, i),
                     index: i,
                     label: esc_label(self.sources, i),
                     stream: &esc.name,
@@ -776,7 +792,7 @@ impl EscReport<'_> {
             return;
         }
         if st.frames() == 0 && st.info_frames() == 0 {
-            let _ = writeln!(o, "frames       none: {}", *NO_FRAMES);
+            let _ = writeln!(o, "frames       none: {}", self.no_frames);
             let _ = writeln!(o, "skipped      {} bytes", st.bytes_skipped());
             return;
         }
@@ -820,7 +836,7 @@ impl EscReport<'_> {
             let _ = writeln!(o, "delivery     {:.2} % of data frames", ratio * 100.0);
         }
         if st.frames() == 0 {
-            let _ = writeln!(o, "             no data frames: {}", *NO_FRAMES);
+            let _ = writeln!(o, "             no data frames: {}", self.no_frames);
         }
         for (info, n) in &self.acc.infos {
             let _ = writeln!(o, "device       {}  ({n} info frames)", Escaped(info));
@@ -928,7 +944,7 @@ impl EscReport<'_> {
         let warning = if st.bytes() == 0 {
             Some("no bytes from this stream")
         } else {
-            (st.frames() == 0).then_some(NO_FRAMES.as_str())
+            (st.frames() == 0).then_some(self.no_frames.as_str())
         };
         json!({
             "esc": self.index,

@@ -85,6 +85,14 @@ pub fn run(args: &DecodeArgs) -> Result<(), CliError> {
         export = export.stop_on(stop);
     }
     let result = sources.run(&mut export);
+    if result.is_ok() && !sources.any_data_frame() {
+        // Nothing decoded: no output is written (a file of that name stays as it was).
+        drop(export);
+        warn(&sources, &args.select.esc);
+        return Err(CliError::NoDataFrames {
+            inputs: sources.names().join(", "),
+        });
+    }
     let (kept, span) = (export.kept(), export.span());
     // Whatever was decoded before an input error is still written out.
     let metadata = vec![("escs".to_string(), escs_json(&sources))];
@@ -178,7 +186,7 @@ fn warn(sources: &Sources, wanted: &[u8]) {
             eprintln!(
                 "hwfoc: warning: {}: {}",
                 hwfoc_io::summary::esc_label(sources, i),
-                *hwfoc_io::summary::NO_FRAMES
+                hwfoc_io::summary::no_frames(sources, i)
             );
         }
     }

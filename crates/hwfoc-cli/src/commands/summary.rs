@@ -56,6 +56,12 @@ pub fn run(args: &SummaryArgs) -> Result<(), CliError> {
     let mut buf = text.into_bytes();
     out.write(&mut buf)?;
     out.flush()?;
+    if result.is_ok() && !sources.any_data_frame() {
+        // The report says why, ESC by ESC; the exit says it failed, as decode and plot do.
+        return Err(CliError::NoDataFrames {
+            inputs: sources.names().join(", "),
+        });
+    }
     if let Some(plot) = plot {
         plot.finish(&sources)?;
     }

@@ -15,6 +15,7 @@
 
 mod csv;
 mod error;
+mod looks;
 mod ports;
 mod recording;
 
@@ -28,6 +29,7 @@ use crate::serial::PortSet;
 
 use self::csv::{CsvRows, may_be_header};
 pub use self::error::InputError;
+pub use self::looks::Looks;
 use self::ports::Ports;
 use self::recording::RecordingReader;
 
@@ -121,6 +123,9 @@ pub struct Input {
     /// rewind already gave (those are not given again).
     told: usize,
     muted: usize,
+    /// A raw input's first bytes (up to [`looks::SAMPLE`]), to say what they look like if they
+    /// hold no frame.
+    sample: Vec<u8>,
 }
 
 impl Input {
@@ -310,6 +315,12 @@ impl Input {
         Ok(Input::new(name, format, source, pending))
     }
 
+    /// What a raw input's first bytes look like when they are not telemetry (text, zeros, a
+    /// known file format); `None` for other inputs and for bytes that may be telemetry.
+    pub fn looks(&self) -> Option<Looks> {
+        Looks::of(&self.sample)
+    }
+
     fn new(name: &str, format: InputFormat, source: Source, pending: Vec<u8>) -> Input {
         Input {
             name: name.to_string(),
@@ -326,6 +337,7 @@ impl Input {
             path: None,
             told: 0,
             muted: 0,
+            sample: Vec::new(),
         }
     }
 
@@ -423,6 +435,9 @@ impl Input {
                         })?;
                     self.bytes.truncate(n);
                 }
+                let room = looks::SAMPLE.saturating_sub(self.sample.len());
+                self.sample
+                    .extend_from_slice(&self.bytes[..room.min(self.bytes.len())]);
             }
             Source::Csv(rows) => {
                 self.bytes.clear();

@@ -16,7 +16,7 @@ use crate::error::CliError;
 use hwfoc_io::escape::Escaped;
 use hwfoc_io::fixed::Fixed;
 use hwfoc_io::sources::Sources;
-use hwfoc_io::summary::NO_FRAMES;
+use hwfoc_io::summary::no_frames;
 use hwfoc_io::time::{self, Clock};
 
 use super::collect::{Bucket, Collector, EscData, FRAME_PERIOD, Quantity, Span};
@@ -231,7 +231,7 @@ struct Row<'a> {
     /// Its device information.
     info: Option<String>,
     /// Why nothing is drawn, when nothing is.
-    empty: Option<&'static str>,
+    empty: Option<String>,
     /// Whether its input's clock is the wall clock (its episode is given in dates).
     wall: bool,
 }
@@ -296,10 +296,10 @@ impl<'a> Scene<'a> {
                 let stats = sources.link(i);
                 let empty = match collector.esc(i) {
                     Some(d) if d.plotted > 0 => None,
-                    Some(d) if d.frames > 0 => Some("no data frame in the time window"),
-                    _ if stats.bytes() == 0 => Some("no bytes from this stream"),
-                    _ if stats.frames() == 0 => Some(NO_FRAMES.as_str()),
-                    _ => Some("no data frames"),
+                    Some(d) if d.frames > 0 => Some("no data frame in the time window".into()),
+                    _ if stats.bytes() == 0 => Some("no bytes from this stream".into()),
+                    _ if stats.frames() == 0 => Some(no_frames(sources, i)),
+                    _ => Some("no data frames".into()),
                 };
                 Row {
                     esc: i,
@@ -500,7 +500,7 @@ impl<'a> Scene<'a> {
         let Some(data) = row.data else {
             let (w, h) = body.dim_in_pixel();
             let style = text(15, MUTED).pos(Pos::new(HPos::Center, VPos::Center));
-            let message = row.empty.unwrap_or("no data frames");
+            let message = row.empty.as_deref().unwrap_or("no data frames");
             body.draw_text(message, &style, (w as i32 / 2, h as i32 / 2))?;
             return Ok(());
         };
@@ -974,7 +974,22 @@ fn nothing_message(collector: &Collector, sources: &Sources, shown: &[usize]) ->
     {
         format!("{names}: no data frames")
     } else {
-        format!("{names}: {}", *NO_FRAMES)
+        let mut reasons: Vec<String> = shown.iter().map(|&i| no_frames(sources, i)).collect();
+        reasons.dedup();
+        match reasons.as_slice() {
+            [one] => format!("{names}: {one}"),
+            _ => shown
+                .iter()
+                .map(|&i| {
+                    format!(
+                        "{}: {}",
+                        hwfoc_io::summary::esc_label(sources, i),
+                        no_frames(sources, i)
+                    )
+                })
+                .collect::<Vec<_>>()
+                .join("; "),
+        }
     }
 }
 

@@ -1,0 +1,143 @@
+//! What the bytes of a raw input look like, when they held no telemetry frame: a text file, a
+//! file of zeros, a file of a known format. Said instead of the advice about the baud rate and
+//! the wiring, which fits a capture of a wire, not a README given by mistake.
+
+use std::fmt;
+
+/// How many of an input's first bytes are looked at.
+pub const SAMPLE: usize = 4096;
+
+/// What a raw input that held no frame looks like.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Looks {
+    /// Printable text (UTF-8): a document, a CSV or JSON file, a configuration.
+    Text,
+    /// Nothing but zero bytes.
+    Zeros,
+    /// A file format known by its first bytes, named.
+    Format(&'static str),
+}
+
+/// Known formats by their first bytes: those a user is likely to give by mistake.
+const MAGIC: &[(&[u8], &str)] = &[
+    (b"\x89PNG\r\n\x1a\n", "a PNG image"),
+    (b"\xff\xd8\xff", "a JPEG image"),
+    (b"GIF8", "a GIF image"),
+    (b"%PDF", "a PDF document"),
+    (b"PK\x03\x04", "a ZIP archive (or an Office document)"),
+    (b"\x1f\x8b", "a gzip file"),
+    (b"BZh", "a bzip2 file"),
+    (b"\xfd7zXZ\x00", "an xz file"),
+    (b"\x28\xb5\x2f\xfd", "a zstd file"),
+    (b"\x7fELF", "an executable (ELF)"),
+    (b"PAR1", "a Parquet file"),
+    (b"SQLite format 3\x00", "an SQLite database"),
+    (b"ARROW1", "an Arrow file"),
+];
+
+impl Looks {
+    /// What `head`, an input's first bytes (up to [`SAMPLE`]), looks like, if it is something
+    /// other than telemetry; `None` for binary bytes (a capture at the wrong baud rate, say).
+    pub fn of(head: &[u8]) -> Option<Looks> {
+        if head.is_empty() {
+            return None;
+        }
+        if let Some(&(_, name)) = MAGIC.iter().find(|(magic, _)| head.starts_with(magic)) {
+            return Some(Looks::Format(name));
+        }
+        if head.iter().all(|&b| b == 0) {
+            return Some(Looks::Zeros);
+        }
+        // UTF-8, allowing a character cut at the end of the sample; printable but for tabs
+        // and line ends. HW-FOC frames start with 0x9B, never a byte of text.
+        let text = match std::str::from_utf8(head) {
+            Ok(t) => t,
+            Err(e) if e.error_len().is_none() => {
+                std::str::from_utf8(&head[..e.valid_up_to()]).unwrap_or_default()
+            }
+            Err(_) => return None,
+        };
+        let printable = text
+            .chars()
+            .filter(|c| !c.is_control() || matches!(c, '\t' | '\n' | '\r'))
+            .count();
+        let all = text.chars().count();
+        // Text has words: white space and more than a few different characters (a byte
+        // repeated, 0x55 "UUUU", is a line's pattern, not a document).
+        let mut distinct: Vec<char> = text.chars().take(512).collect();
+        distinct.sort_unstable();
+        distinct.dedup();
+        let words = text.chars().any(char::is_whitespace) && distinct.len() >= 4;
+        (all > 0 && words && printable * 100 >= all * 98).then_some(Looks::Text)
+    }
+}
+
+impl fmt::Display for Looks {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Looks::Text => f.write_str("text, not telemetry"),
+            Looks::Zeros => f.write_str("only zero bytes, not telemetry"),
+            Looks::Format(name) => write!(f, "looks like {name}, not telemetry"),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::Looks;
+
+    #[test]
+    fn text_zeros_and_formats_are_told_from_telemetry() {
+        assert_eq!(
+            Looks::of(b"# hwfoc\n\nThe open toolkit\n"),
+            Some(Looks::Text)
+        );
+        assert_eq!(
+            Looks::of("t_s,esc\n1.5,0\nnaïve °C".as_bytes()),
+            Some(Looks::Text)
+        );
+        // A character cut at the end of the sample is still text.
+        let cut = "mos temperature 25 °C".as_bytes();
+        assert_eq!(Looks::of(&cut[..cut.len() - 2]), Some(Looks::Text));
+        assert_eq!(Looks::of(&[0; 300]), Some(Looks::Zeros));
+        assert_eq!(
+            Looks::of(b"\x89PNG\r\n\x1a\n\0\0\0\rIHDR"),
+            Some(Looks::Format("a PNG image"))
+        );
+        assert_eq!(
+            Looks::of(b"PAR1\x15\x04"),
+            Some(Looks::Format("a Parquet file"))
+        );
+        assert_eq!(Looks::of(b""), None);
+    }
+
+    #[test]
+    fn telemetry_and_noise_look_like_nothing_else() {
+        // HW-FOC frames (0x9B lead byte), a capture at the wrong baud rate, random bytes.
+        let frames: Vec<u8> = (0..10)
+            .flat_map(|_| hwfoc::DataFrame::default().encode())
+            .collect();
+        assert_eq!(Looks::of(&frames), None);
+        let mut x: u32 = 12345;
+        let noise: Vec<u8> = (0..4096)
+            .map(|_| {
+                x = x.wrapping_mul(1_103_515_245).wrapping_add(12345);
+                (x >> 16) as u8
+            })
+            .collect();
+        assert_eq!(Looks::of(&noise), None);
+        // One byte repeated is a line's pattern, not text.
+        assert_eq!(Looks::of(&[0x55; 4096]), None);
+        // Text with a few control bytes in it is not text.
+        assert_eq!(Looks::of(b"abc\x01\x02\x03\x04def"), None);
+    }
+
+    #[test]
+    fn it_reads_as_a_reason() {
+        assert_eq!(Looks::Text.to_string(), "text, not telemetry");
+        assert_eq!(
+            Looks::Format("a PNG image").to_string(),
+            "looks like a PNG image, not telemetry"
+        );
+    }
+}
