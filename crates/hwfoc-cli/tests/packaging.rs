@@ -73,10 +73,12 @@ echo "values: ${COMPREPLY[*]}""#,
 }
 
 #[test]
+#[ignore = "needs zsh: .ci/run installs it and runs this with --ignored"]
 fn zsh_loads_the_completion() {
-    if !can_check(installed("zsh"), "zsh") {
-        return;
-    }
+    assert!(
+        installed("zsh"),
+        "needs zsh: install it (Debian: apt-get install zsh), as .ci/run does"
+    );
     let out = shell(
         "zsh",
         r#"autoload -U compinit && compinit -u -D
@@ -95,10 +97,12 @@ whence -w _hwfoc"#,
 }
 
 #[test]
+#[ignore = "needs fish: .ci/run installs it and runs this with --ignored"]
 fn fish_loads_the_completion_and_completes_subcommands() {
-    if !can_check(installed("fish"), "fish") {
-        return;
-    }
+    assert!(
+        installed("fish"),
+        "needs fish: install it (Debian: apt-get install fish), as .ci/run does"
+    );
     let out = shell(
         "fish",
         r#""$HWFOC" completions fish | source; or exit 1

@@ -32,6 +32,20 @@ fn tshark_found() -> bool {
     common::can_check(found, "tshark (running the Wireshark dissector)")
 }
 
+/// tshark, for a test that is tshark and nothing else (listed as ignored by a plain `cargo
+/// test`; `.ci/run` installs tshark and runs them with `--ignored`): a missing tshark fails
+/// it, saying so.
+fn need_tshark() {
+    let found = Command::new("tshark")
+        .arg("--version")
+        .output()
+        .is_ok_and(|o| o.status.success());
+    assert!(
+        found,
+        "needs tshark: install it (Debian: apt-get install tshark), as .ci/run does"
+    );
+}
+
 const FIELDS: [&str; 22] = [
     "frame.interface_id",
     "hwfoc.kind",
@@ -357,10 +371,9 @@ fn simulate(file: &Path, args: &str) {
 }
 
 #[test]
+#[ignore = "needs tshark: .ci/run installs it and runs these with --ignored"]
 fn a_simulated_recording_dissects_as_decode_reads_it() {
-    if !tshark_found() {
-        return;
-    }
+    need_tshark();
     let dir = tempfile::tempdir().unwrap();
     let file = dir.path().join("sim.pcapng");
     simulate(
@@ -467,10 +480,9 @@ fn every_code(file: &Path) {
 }
 
 #[test]
+#[ignore = "needs tshark: .ci/run installs it and runs these with --ignored"]
 fn every_temperature_code_and_the_conversion_preferences() {
-    if !tshark_found() {
-        return;
-    }
+    need_tshark();
     let dir = tempfile::tempdir().unwrap();
     let file = dir.path().join("codes.pcapng");
     every_code(&file);
@@ -504,10 +516,9 @@ fn every_temperature_code_and_the_conversion_preferences() {
 }
 
 #[test]
+#[ignore = "needs tshark: .ci/run installs it and runs these with --ignored"]
 fn other_user0_files_are_left_alone_unless_asked() {
-    if !tshark_found() {
-        return;
-    }
+    need_tshark();
     // USER0 bytes from another tool: an interface hwfoc did not describe.
     let dir = tempfile::tempdir().unwrap();
     let file = dir.path().join("other.pcapng");
@@ -654,10 +665,9 @@ fn same_frames_as_decode(file: &Path, what: &str) -> (Vec<Shown>, PacketsByEsc) 
 /// with their device-information frames, some of them cut): tshark finds exactly the frames
 /// `hwfoc decode` finds, for several seeds and noise levels.
 #[test]
+#[ignore = "needs tshark: .ci/run installs it and runs these with --ignored"]
 fn noisy_recordings_dissect_frame_for_frame_as_decode_reads_them() {
-    if !tshark_found() {
-        return;
-    }
+    need_tshark();
     let dir = tempfile::tempdir().unwrap();
     // (seed, garbage, bit errors, cuts, drops)
     let runs = [
@@ -786,10 +796,9 @@ impl Frames {
 /// the frames after it, however many packets it takes to tell), reassembles what the decoder
 /// reassembles, and no more across a silence of over a second.
 #[test]
+#[ignore = "needs tshark: .ci/run installs it and runs these with --ignored"]
 fn a_candidate_that_fails_is_given_up_where_the_decoder_gives_it_up() {
-    if !tshark_found() {
-        return;
-    }
+    need_tshark();
     let rng = hwfoc_sim::rng::Rng::for_esc(7, 0, hwfoc_sim::rng::Purpose::Link);
     let mut frames = Frames { packet: 0, rng };
     let info = InfoFrame::new("XR_FOC_ESC", "HW577_KZ1_V1.1", "XR-01.0.00", "01040443")
