@@ -47,6 +47,23 @@ impl InputArgs {
         )?)
     }
 
+    /// The flag Ctrl-C and SIGTERM set ([`hwfoc_io::stop::interrupted`], whose handlers it
+    /// installs), when every input is read to its end: an export or a plot of files is then
+    /// abandoned on the signal, its temporary file removed. `None` for serial ports, pipes and
+    /// terminals, which end their input on the signal instead (what they gave is kept), or
+    /// keep the signal's default action.
+    pub fn stop_if_read_to_end(&self) -> Option<std::sync::Arc<std::sync::atomic::AtomicBool>> {
+        let read_to_end = self.inputs.iter().all(|spec| {
+            let meta = if spec == "-" {
+                stdin_metadata()
+            } else {
+                std::fs::metadata(spec).ok()
+            };
+            meta.is_some_and(|m| m.is_file())
+        });
+        read_to_end.then(hwfoc_io::stop::interrupted)
+    }
+
     /// Opens every input, in the order given: each file (or standard input) as one [`Input`],
     /// all serial ports together as one [`Input`] with a stream per port. Ports and files
     /// cannot be mixed.
@@ -85,6 +102,20 @@ pub fn config_read(config: &Config) -> Option<PathBuf> {
     } else {
         path.clone()
     })
+}
+
+/// What standard input is.
+#[cfg(unix)]
+fn stdin_metadata() -> Option<std::fs::Metadata> {
+    use std::os::fd::AsFd;
+    let fd = std::io::stdin().as_fd().try_clone_to_owned().ok()?;
+    std::fs::File::from(fd).metadata().ok()
+}
+
+/// What standard input is (not looked at elsewhere: taken as live).
+#[cfg(not(unix))]
+fn stdin_metadata() -> Option<std::fs::Metadata> {
+    None
 }
 
 /// How the configuration file and the flags combine, for `--help`.

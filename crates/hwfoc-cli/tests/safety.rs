@@ -182,9 +182,39 @@ fn partials(dir: &Dir) -> Vec<String> {
 #[cfg(unix)]
 #[test]
 fn sigterm_during_an_export_removes_the_temporary_file() {
-    use nix::sys::signal::{Signal, kill};
-    use nix::unistd::Pid;
     let dir = Dir::new();
+    let big = big_input(&dir);
+    let out = dir.arg("out.csv");
+    std::fs::write(&out, "the earlier export").unwrap();
+    // Signalled once the export has written something to its temporary file.
+    let o = terminated(&dir, &["decode", "--format", "csv", &big, "-o", &out], true);
+    assert_fails_with(&o, "interrupted: ");
+    assert!(partials(&dir).is_empty(), "{:?}", partials(&dir));
+    assert_eq!(std::fs::read_to_string(&out).unwrap(), "the earlier export");
+}
+
+/// The same for a plot and a summary's plot: the image's temporary file (made before the
+/// inputs are read) goes away, the earlier image stays.
+#[cfg(unix)]
+#[test]
+fn sigterm_while_a_plot_reads_removes_its_temporary_file() {
+    let dir = Dir::new();
+    let big = big_input(&dir);
+    let image = dir.arg("old.png");
+    for args in [
+        vec!["plot", &big, "-o", &image],
+        vec!["summary", &big, "--plot", &image],
+    ] {
+        std::fs::write(&image, "the earlier plot").unwrap();
+        let o = terminated(&dir, &args, false);
+        assert_fails_with(&o, "interrupted: ");
+        assert!(partials(&dir).is_empty(), "{args:?}: {:?}", partials(&dir));
+        assert_eq!(std::fs::read_to_string(&image).unwrap(), "the earlier plot");
+    }
+}
+
+/// About 50 MB of telemetry: some tens of seconds of CSV export, a debug build or not.
+fn big_input(dir: &Dir) -> String {
     let one = dir.arg("one.bin");
     ok(run(hwfoc().args([
         "simulate",
@@ -194,32 +224,37 @@ fn sigterm_during_an_export_removes_the_temporary_file() {
         "3000",
         "--quiet",
     ])));
-    // About 50 MB of telemetry: some tens of seconds of CSV export, a debug build or not.
     let bytes = std::fs::read(&one).unwrap();
     let big = dir.arg("big.bin");
     let mut file = std::fs::File::create(&big).unwrap();
     for _ in 0..40 {
         file.write_all(&bytes).unwrap();
     }
-    drop(file);
-    let out = dir.arg("out.csv");
-    std::fs::write(&out, "the earlier export").unwrap();
-    let mut child = spawn(hwfoc().args(["decode", "--format", "csv", &big, "-o", &out]));
-    // Signalled once the export has written something to its temporary file.
+    big
+}
+
+/// `hwfoc ARGS`, sent SIGTERM once its temporary file is there (`written`: and holds
+/// something), and what it printed when it ended.
+fn terminated(dir: &Dir, args: &[&str], written: bool) -> std::process::Output {
+    use nix::sys::signal::{Signal, kill};
+    use nix::unistd::Pid;
+    let mut child = spawn(hwfoc().args(args));
     let start = Instant::now();
-    let written = || {
-        partials(&dir)
+    let staged = || {
+        partials(dir)
             .first()
             .and_then(|name| std::fs::metadata(dir.path(name)).ok())
-            .is_some_and(|m| m.len() > 0)
+            .is_some_and(|m| !written || m.len() > 0)
     };
-    while !written() && start.elapsed() < Duration::from_secs(60) {
+    while !staged() && start.elapsed() < Duration::from_secs(60) {
         std::thread::sleep(Duration::from_millis(10));
     }
-    assert!(written(), "no temporary file: {:?}", partials(&dir));
+    assert!(staged(), "no temporary file: {:?}", partials(dir));
+    // Into the reading.
+    std::thread::sleep(Duration::from_millis(300));
     assert!(
         child.try_wait().unwrap().is_none(),
-        "the export ended before the signal: make the input larger"
+        "{args:?} ended before the signal: make the input larger"
     );
     kill(Pid::from_raw(child.id() as i32), Signal::SIGTERM).unwrap();
     let start = Instant::now();
@@ -231,10 +266,8 @@ fn sigterm_during_an_export_removes_the_temporary_file() {
         child.kill().unwrap();
     }
     let o = child.wait_with_output().unwrap();
-    assert!(status.is_some(), "SIGTERM did not end the export");
-    assert_fails_with(&o, "interrupted: ");
-    assert!(partials(&dir).is_empty(), "{:?}", partials(&dir));
-    assert_eq!(std::fs::read_to_string(&out).unwrap(), "the earlier export");
+    assert!(status.is_some(), "SIGTERM did not end {args:?}");
+    o
 }
 
 /// Standard input and the configuration file are inputs too: an output that is the file

@@ -59,7 +59,7 @@ pub fn run(args: &DecodeArgs) -> Result<(), CliError> {
     // file at the output as it was. Live inputs keep the signals' usual meaning: serial ports
     // end their input on them, and what they gave is written; a pipe or a terminal on standard
     // input ends the process (its export stays in the temporary file).
-    let stop = read_to_end(&args.input).then(hwfoc_io::stop::interrupted);
+    let stop = args.input.stop_if_read_to_end();
     let inputs = args.input.open_all()?;
     let mut sources = Sources::new(inputs, settings_map);
     if selection.window.is_limited() {
@@ -112,33 +112,6 @@ pub fn run(args: &DecodeArgs) -> Result<(), CliError> {
         );
     }
     Ok(())
-}
-
-/// Whether every input is read to its end: regular files (standard input included), or the
-/// demo; not serial ports, pipes or terminals.
-fn read_to_end(input: &InputArgs) -> bool {
-    input.inputs.iter().all(|spec| {
-        let meta = if spec == "-" {
-            stdin_metadata()
-        } else {
-            std::fs::metadata(spec).ok()
-        };
-        meta.is_some_and(|m| m.is_file())
-    })
-}
-
-/// What standard input is.
-#[cfg(unix)]
-fn stdin_metadata() -> Option<std::fs::Metadata> {
-    use std::os::fd::AsFd;
-    let fd = std::io::stdin().as_fd().try_clone_to_owned().ok()?;
-    std::fs::File::from(fd).metadata().ok()
-}
-
-/// What standard input is (not looked at elsewhere: taken as live).
-#[cfg(not(unix))]
-fn stdin_metadata() -> Option<std::fs::Metadata> {
-    None
 }
 
 /// The entries by port and by ESC of `map`, named as in the configuration file (`port."NAME"`,

@@ -5,6 +5,7 @@ use clap::Args;
 use hwfoc_io::handler::Both;
 use hwfoc_io::sources::Sources;
 use hwfoc_io::summary::Summary;
+use hwfoc_io::write::WriteError;
 
 use super::plot;
 use crate::args::{InputArgs, SettingsArgs};
@@ -33,7 +34,11 @@ pub fn run(args: &SummaryArgs) -> Result<(), CliError> {
     let mut plot = match &args.plot {
         Some(path) => {
             args.input.refuse_output(path, &config)?;
-            Some(plot::Alongside::open(path, settings)?)
+            Some(plot::Alongside::open(
+                path,
+                settings,
+                args.input.stop_if_read_to_end(),
+            )?)
         }
         None => None,
     };
@@ -56,6 +61,10 @@ pub fn run(args: &SummaryArgs) -> Result<(), CliError> {
     let mut buf = text.into_bytes();
     out.write(&mut buf)?;
     out.flush()?;
+    if let Err(e @ CliError::Write(WriteError::Interrupted { .. })) = result {
+        // Stopped by a signal: the plot is not drawn (its temporary file goes away).
+        return Err(e);
+    }
     if result.is_ok() && !sources.any_data_frame() {
         // The report says why, ESC by ESC; the exit says it failed, as decode and plot do.
         return Err(CliError::NoDataFrames {

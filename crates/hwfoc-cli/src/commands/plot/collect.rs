@@ -16,6 +16,9 @@
 //! numbers do not explain: [`Step`]) it goes on one frame period after the frame before, and
 //! the lines break there; the plot's subtitle counts the discontinuities.
 
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
+
 use hwfoc::{InfoFrame, Settings, Status};
 
 use crate::error::CliError;
@@ -25,6 +28,7 @@ use hwfoc_io::episode::{Episode, Mark};
 use hwfoc_io::record::Record;
 use hwfoc_io::select::{Selection, Window};
 use hwfoc_io::sources::{Handler, Sources};
+use hwfoc_io::write::WriteError;
 
 use super::{Options, Target};
 
@@ -422,6 +426,9 @@ pub struct Collector {
     selection: Selection,
     buckets: usize,
     escs: Vec<EscData>,
+    /// When set (Ctrl-C, SIGTERM), reading ends with [`WriteError::Interrupted`] for the
+    /// image named: see [`Collector::stop_on`].
+    stop: Option<(Arc<AtomicBool>, String)>,
 }
 
 impl Collector {
@@ -433,7 +440,16 @@ impl Collector {
             selection,
             buckets: super::draw::buckets_for(width),
             escs: Vec::new(),
+            stop: None,
         }
+    }
+
+    /// Ends the reading at the next batch once `flag` is set (by Ctrl-C or SIGTERM: see
+    /// [`crate::args::InputArgs::stop_if_read_to_end`]), with an error saying that `image` is
+    /// left as it was: nothing is drawn, and the temporary file goes away with its target.
+    pub fn stop_on(mut self, flag: Option<Arc<AtomicBool>>, image: &str) -> Collector {
+        self.stop = flag.map(|f| (f, image.to_string()));
+        self
     }
 
     /// The settings values were converted with.
@@ -492,6 +508,17 @@ impl Handler for Collector {
     fn info(&mut self, esc: u8, _: Option<f64>, info: &InfoFrame) {
         if let Some(esc) = esc_data(&mut self.escs, self.buckets, &self.selection, esc) {
             esc.info.get_or_insert(*info);
+        }
+    }
+
+    fn end_batch(&mut self, _live: bool) -> Result<(), CliError> {
+        match &self.stop {
+            Some((flag, image)) if flag.load(Ordering::Relaxed) => {
+                Err(CliError::Write(WriteError::Interrupted {
+                    output: Some(image.clone()),
+                }))
+            }
+            _ => Ok(()),
         }
     }
 }

@@ -12,6 +12,9 @@ mod draw;
 mod target;
 mod text;
 
+use std::sync::Arc;
+use std::sync::atomic::AtomicBool;
+
 use hwfoc::{InfoFrame, Settings};
 
 use crate::args::{InputArgs, SelectArgs, SettingsArgs};
@@ -19,6 +22,7 @@ use crate::error::CliError;
 use hwfoc_io::record::Record;
 use hwfoc_io::select::Selection;
 use hwfoc_io::sources::{Handler, Sources};
+use hwfoc_io::write::WriteError;
 
 use collect::Collector;
 use target::Target;
@@ -93,8 +97,12 @@ pub fn run(args: &PlotArgs) -> Result<(), CliError> {
         sources.require_timing()?;
         args.select.check_clocks(&sources)?;
     }
-    let mut collector = Collector::new(settings, selection, options.width);
+    let mut collector = Collector::new(settings, selection, options.width)
+        .stop_on(args.input.stop_if_read_to_end(), &args.output);
     let result = sources.run(&mut collector);
+    if let Err(e @ CliError::Write(WriteError::Interrupted { .. })) = result {
+        return Err(e);
+    }
     // On an input error, what was read before it is still plotted, then the error reported.
     let written = collector.write(&sources, &options, &mut target);
     result?;
@@ -110,14 +118,19 @@ pub struct Alongside {
 }
 
 impl Alongside {
-    /// Opens the image file (see [`Target::open`]).
-    pub fn open(path: &str, settings: Settings) -> Result<Alongside, CliError> {
+    /// Opens the image file (see [`Target::open`]); `stop` as [`Collector::stop_on`].
+    pub fn open(
+        path: &str,
+        settings: Settings,
+        stop: Option<Arc<AtomicBool>>,
+    ) -> Result<Alongside, CliError> {
         let target = Target::open(path)?;
         let options = Options {
             width: draw::DEFAULT_WIDTH,
             ..Options::default()
         };
-        let collector = Collector::new(settings, Selection::default(), options.width);
+        let collector =
+            Collector::new(settings, Selection::default(), options.width).stop_on(stop, path);
         Ok(Alongside {
             target,
             options,
@@ -142,5 +155,9 @@ impl Handler for Alongside {
 
     fn info(&mut self, esc: u8, t: Option<f64>, info: &InfoFrame) {
         self.collector.info(esc, t, info);
+    }
+
+    fn end_batch(&mut self, live: bool) -> Result<(), CliError> {
+        self.collector.end_batch(live)
     }
 }
