@@ -5,7 +5,7 @@
 use std::fmt;
 
 /// How many of an input's first bytes are looked at.
-pub const SAMPLE: usize = 4096;
+pub(crate) const SAMPLE: usize = 4096;
 
 /// What a raw input that held no frame looks like.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -36,7 +36,7 @@ const MAGIC: &[(&[u8], &str)] = &[
 ];
 
 impl Looks {
-    /// What `head`, an input's first bytes (up to [`SAMPLE`]), looks like, if it is something
+    /// What `head`, an input's first bytes (up to its first 4096), looks like, if it is something
     /// other than telemetry; `None` for binary bytes (a capture at the wrong baud rate, say).
     pub fn of(head: &[u8]) -> Option<Looks> {
         if head.is_empty() {
