@@ -677,7 +677,7 @@ pub fn refuse_input<'a>(
             Some("-") => Named::Stdin,
             _ => Named::Path(input),
         };
-        identity(read) == Some(written)
+        identity(read).as_ref() == Some(&written)
     });
     match clash {
         Some(input) => Err(WriteError::IsInput {
