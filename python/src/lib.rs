@@ -244,7 +244,10 @@ fn decode_all(specs: Vec<Spec>, options: &Options, notes: &Notes) -> Result<Deco
     Ok(Decoded {
         batches: batches.into_iter().map(|(_, b)| b).collect(),
         escs: escs_json(&sources),
-        warnings: no_frames(&sources).into_iter().chain(empty_window).collect(),
+        warnings: no_frames(&sources)
+            .into_iter()
+            .chain(empty_window)
+            .collect(),
     })
 }
 
