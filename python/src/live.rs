@@ -9,7 +9,8 @@ use std::time::Duration;
 use arrow_array::RecordBatch;
 use arrow_pyarrow::ToPyArrow;
 use arrow_schema::SchemaRef;
-use hwfoc::{Decoded, Frame, Settings};
+use hwfoc::Settings;
+use hwfoc::telemetry::Frame;
 use hwfoc_io::InputError;
 use hwfoc_io::handler::Handler;
 use hwfoc_io::input::Batch;
@@ -34,8 +35,8 @@ struct Gather(Frames);
 impl Handler for Gather {
     type Error = InputError;
 
-    fn frame(&mut self, esc: u8, t: Option<f64>, decoded: &Decoded, _: &Settings) {
-        if let Frame::Data(f) = &decoded.frame {
+    fn frame(&mut self, esc: u8, t: Option<f64>, frame: &Frame, _: &Settings) {
+        if let Frame::Data(f) = frame {
             self.0.push(t, esc, f);
         }
     }
@@ -184,7 +185,7 @@ impl Decoder {
             };
             // From a DataLink hub, channel `c` is ESC `esc + c`.
             stream.feed(batch, |t, channel, d| {
-                if let Frame::Data(f) = &d.frame {
+                if let Frame::Data(f) = d {
                     gather
                         .0
                         .push(t, channel.map_or(esc, |c| esc.saturating_add(c)), f);
@@ -209,7 +210,7 @@ impl Decoder {
         let mut gather = Gather::default();
         let esc = self.esc;
         self.lock()?.stream.finish(|t, channel, d| {
-            if let Frame::Data(f) = &d.frame {
+            if let Frame::Data(f) = d {
                 gather
                     .0
                     .push(t, channel.map_or(esc, |c| esc.saturating_add(c)), f);

@@ -7,7 +7,8 @@ use std::sync::Arc;
 
 use arrow_array::{RecordBatch, new_null_array};
 use arrow_schema::{Schema, SchemaRef};
-use hwfoc::{DataFrame, Decoded, Frame, Settings};
+use hwfoc::Settings;
+use hwfoc::telemetry::{Data, Frame};
 use hwfoc_io::InputError;
 use hwfoc_io::handler::Handler;
 use hwfoc_io::record::{Column, Visitor, columns};
@@ -26,7 +27,7 @@ pub struct Frames {
     /// ESC of each frame.
     pub esc: Vec<u8>,
     /// The frames.
-    pub frames: Vec<DataFrame>,
+    pub frames: Vec<Data>,
 }
 
 impl Frames {
@@ -42,7 +43,7 @@ impl Frames {
 
     /// Adds a frame.
     #[inline]
-    pub fn push(&mut self, t: Option<f64>, esc: u8, frame: &DataFrame) {
+    pub fn push(&mut self, t: Option<f64>, esc: u8, frame: &Data) {
         self.timed |= t.is_some();
         self.t.push(t.unwrap_or(f64::NAN));
         self.esc.push(esc);
@@ -294,8 +295,8 @@ impl<F: FnMut(Frames) -> Result<(), Stop>> Handler for Collect<F> {
     type Error = Stop;
 
     #[inline]
-    fn frame(&mut self, esc: u8, t: Option<f64>, decoded: &Decoded, _: &Settings) {
-        if let Frame::Data(frame) = &decoded.frame {
+    fn frame(&mut self, esc: u8, t: Option<f64>, frame: &Frame, _: &Settings) {
+        if let Frame::Data(frame) = frame {
             if let Some(t) = t.filter(|_| self.selection.esc(esc)) {
                 let (first, last) = self.span.get_or_insert((t, t));
                 *first = first.min(t);

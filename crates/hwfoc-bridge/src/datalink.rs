@@ -235,7 +235,7 @@ impl Output for DatalinkOutput {
             self.stats.superseded += 1;
         }
         queue.push_back(Slot {
-            frame: *update.frame,
+            frame: update.frame.to_hwfoc(),
             arrived: update.arrived,
         });
         // A second frame of this ESC is waiting: send as soon as the line allows. (A failure

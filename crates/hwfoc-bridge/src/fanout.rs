@@ -2,7 +2,8 @@
 
 use std::time::Instant;
 
-use hwfoc::{Decoded, Frame, Settings};
+use hwfoc::Settings;
+use hwfoc::telemetry::Frame;
 use hwfoc_io::{Handler, InputError, Record};
 
 use crate::output::{Output, OutputError, Update};
@@ -62,8 +63,8 @@ impl Fanout {
 impl Handler for Fanout {
     type Error = InputError;
 
-    fn frame(&mut self, esc: u8, t: Option<f64>, decoded: &Decoded, settings: &Settings) {
-        let Frame::Data(frame) = &decoded.frame else {
+    fn frame(&mut self, esc: u8, t: Option<f64>, frame: &Frame, settings: &Settings) {
+        let Frame::Data(frame) = frame else {
             return;
         };
         let record = Record::new(t, esc, frame, settings);

@@ -3,7 +3,7 @@
 use std::fmt;
 use std::time::{Duration, Instant};
 
-use hwfoc::DataFrame;
+use hwfoc::telemetry::Data;
 use hwfoc_io::Record;
 
 use crate::latency::Latency;
@@ -17,9 +17,9 @@ pub const SILENT_AFTER: Duration = Duration::from_secs(1);
 pub struct Update<'a> {
     /// The ESC: the index of its input stream, or its DataLink channel.
     pub esc: u8,
-    /// The frame's raw values (an output re-encoding the protocol's own fields takes these:
-    /// no unit conversion to undo).
-    pub frame: &'a DataFrame,
+    /// The data frame as decoded, of any protocol, read through [`hwfoc::Telemetry`] (an output
+    /// re-encoding raw fields takes these: no unit conversion to undo).
+    pub frame: &'a Data,
     /// The frame in physical units, under the bridge's settings.
     pub record: &'a Record,
     /// When the read that completed the frame returned: where the bridge's latency starts.

@@ -10,7 +10,8 @@ use std::fmt;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 
-use hwfoc::{Decoded, Frame, Settings};
+use hwfoc::Settings;
+use hwfoc::telemetry::{Frame, Telemetry};
 use hwfoc_io::clock::Step;
 use hwfoc_io::energy::NOMINAL_PERIOD_S;
 use hwfoc_io::{Handler, InputError};
@@ -142,18 +143,18 @@ impl<'a, E: FnMut(OutputError)> Replay<'a, E> {
 impl<E: FnMut(OutputError)> Handler for Replay<'_, E> {
     type Error = ReplayError;
 
-    fn frame(&mut self, esc: u8, t: Option<f64>, decoded: &Decoded, settings: &Settings) {
+    fn frame(&mut self, esc: u8, t: Option<f64>, frame: &Frame, settings: &Settings) {
         if self.stop.load(Ordering::Relaxed) {
             return;
         }
-        let packet = match &decoded.frame {
-            Frame::Data(f) => Some(f.packet),
+        let packet = match frame {
+            Frame::Data(f) => f.packet(),
             Frame::Info(_) => None,
         };
         let due = self.due(esc, t, packet);
         self.wait(due);
         self.fanout.arrived(Instant::now());
-        self.fanout.frame(esc, t, decoded, settings);
+        self.fanout.frame(esc, t, frame, settings);
         self.fanout.poll(Instant::now(), &mut self.on_error);
     }
 

@@ -6,6 +6,7 @@ use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
 use hwfoc::datalink::{self, DatalinkFrame};
+use hwfoc::telemetry::Data;
 use hwfoc::{DataFrame, Settings, Status};
 use hwfoc_bridge::Output;
 use hwfoc_bridge::Update;
@@ -49,10 +50,10 @@ fn frame(esc: u8, packet: u16) -> DataFrame {
 
 fn update(out: &mut DatalinkOutput, esc: u8, packet: u16) {
     let f = frame(esc, packet);
-    let record = Record::new(None, esc, &f, &Settings::DEFAULT);
+    let record = Record::new(None, esc, &Data::from(f), &Settings::DEFAULT);
     out.update(&Update {
         esc,
-        frame: &f,
+        frame: &Data::from(f),
         record: &record,
         arrived: Instant::now(),
     });

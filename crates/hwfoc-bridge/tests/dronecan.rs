@@ -13,6 +13,7 @@ use std::sync::{Arc, Mutex, mpsc};
 use std::thread;
 use std::time::{Duration, Instant};
 
+use hwfoc::telemetry::Data;
 use hwfoc::{DataFrame, Settings, Status};
 use hwfoc_bridge::dronecan::dsdl::{
     self, EscStatus, EscStatusExtended, Health, NodeStatus, f16_bits,
@@ -83,14 +84,14 @@ fn data_frame(packet: u16, erpm_raw: u16, voltage_raw: u16, mos_adc: u8, status:
 }
 
 fn record(esc: u8, frame: &DataFrame) -> Record {
-    Record::new(Some(0.0), esc, frame, &Settings::default())
+    Record::new(Some(0.0), esc, &Data::from(*frame), &Settings::default())
 }
 
 fn update(out: &mut DronecanOutput, esc: u8, frame: &DataFrame, arrived: Instant) -> Record {
     let r = record(esc, frame);
     out.update(&Update {
         esc,
-        frame,
+        frame: &Data::from(*frame),
         record: &r,
         arrived,
     });

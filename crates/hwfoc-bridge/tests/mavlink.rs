@@ -4,6 +4,7 @@
 use std::net::{SocketAddr, UdpSocket};
 use std::time::{Duration, Instant};
 
+use hwfoc::telemetry::Data;
 use hwfoc::{DataFrame, Fault, Settings, Status};
 use hwfoc_bridge::mavlink::{
     MAV_COMP_ID_PERIPHERAL, MavlinkOptions, MavlinkOutput, MavlinkTarget, messages,
@@ -43,10 +44,10 @@ impl Rig {
     }
 
     fn update(&mut self, esc: u8, t_s: Option<f64>, frame: &DataFrame, arrived: Instant) -> Record {
-        let record = Record::new(t_s, esc, frame, &Settings::default());
+        let record = Record::new(t_s, esc, &Data::from(*frame), &Settings::default());
         self.out.update(&Update {
             esc,
-            frame,
+            frame: &Data::from(*frame),
             record: &record,
             arrived,
         });
@@ -406,10 +407,10 @@ fn an_unreachable_destination_is_counted_and_survived() {
     for k in 0..20u16 {
         let at = t0 + Duration::from_millis(u64::from(k) * 50);
         let f = frame(k, Status::OK);
-        let record = Record::new(None, 0, &f, &Settings::default());
+        let record = Record::new(None, 0, &Data::from(f), &Settings::default());
         out.update(&Update {
             esc: 0,
-            frame: &f,
+            frame: &Data::from(f),
             record: &record,
             arrived: at,
         });
@@ -439,10 +440,10 @@ fn an_unreachable_destination_is_counted_and_survived() {
     rx.set_read_timeout(Some(Duration::from_secs(1))).unwrap();
     let at = t0 + Duration::from_secs(5);
     let f = frame(100, Status::OK);
-    let record = Record::new(None, 0, &f, &Settings::default());
+    let record = Record::new(None, 0, &Data::from(f), &Settings::default());
     out.update(&Update {
         esc: 0,
-        frame: &f,
+        frame: &Data::from(f),
         record: &record,
         arrived: at,
     });
@@ -565,12 +566,12 @@ fn a_telemetry_log_has_each_message_after_the_time_of_its_data() {
             let record = Record::new(
                 Some(unix0 + f64::from(k) * 0.05),
                 esc,
-                &frame(k as u16, Status::OK),
+                &Data::from(frame(k as u16, Status::OK)),
                 &Settings::default(),
             );
             out.update(&Update {
                 esc,
-                frame: &frame(k as u16, Status::OK),
+                frame: &Data::from(frame(k as u16, Status::OK)),
                 record: &record,
                 arrived,
             });
@@ -614,10 +615,15 @@ fn a_telemetry_log_has_each_message_after_the_time_of_its_data() {
     assert!(std::fs::read(&path).unwrap().is_empty());
     // Records without a Unix time (a capture's own clock): the system clock.
     let now = Instant::now();
-    let record = Record::new(Some(12.5), 0, &frame(1, Status::OK), &Settings::default());
+    let record = Record::new(
+        Some(12.5),
+        0,
+        &Data::from(frame(1, Status::OK)),
+        &Settings::default(),
+    );
     out.update(&Update {
         esc: 0,
-        frame: &frame(1, Status::OK),
+        frame: &Data::from(frame(1, Status::OK)),
         record: &record,
         arrived: now,
     });
@@ -663,10 +669,10 @@ fn a_serial_port_carries_the_same_messages() {
     let now = Instant::now();
     for (packet, esc) in [(1u16, 0u8), (1, 1), (2, 0)] {
         let f = frame(packet, Status::OK);
-        let record = Record::new(None, esc, &f, &Settings::default());
+        let record = Record::new(None, esc, &Data::from(f), &Settings::default());
         out.update(&Update {
             esc,
-            frame: &f,
+            frame: &Data::from(f),
             record: &record,
             arrived: now,
         });

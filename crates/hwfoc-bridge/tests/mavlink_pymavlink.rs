@@ -13,6 +13,7 @@ use std::path::Path;
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
+use hwfoc::telemetry::Data;
 use hwfoc::{DataFrame, Fault, Settings, Status};
 use hwfoc_bridge::mavlink::{MavlinkOptions, MavlinkOutput, MavlinkTarget};
 use hwfoc_bridge::{Output, SILENT_AFTER, Update};
@@ -157,7 +158,7 @@ fn pymavlink_decodes_every_message_with_the_records_values() {
             let record = Record::new(
                 Some(1_700_000_000.0 + step as f64 * 0.05),
                 esc as u8,
-                &frame,
+                &Data::from(frame),
                 &Settings::default(),
             );
             let before = known.records.last().map_or(0, |(r, _)| r.status.0);
@@ -166,7 +167,7 @@ fn pymavlink_decodes_every_message_with_the_records_values() {
             fresh[esc / 4] = true;
             out.update(&Update {
                 esc: esc as u8,
-                frame: &frame,
+                frame: &Data::from(frame),
                 record: &record,
                 arrived: now,
             });

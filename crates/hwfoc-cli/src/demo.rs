@@ -99,7 +99,8 @@ pub fn capture_csv() -> Vec<u8> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use hwfoc::Frame;
+    use hwfoc::telemetry::Frame;
+    use hwfoc::{Quantity, Telemetry};
     use hwfoc_io::input::Input;
     use hwfoc_io::stream::Stream;
 
@@ -108,13 +109,14 @@ mod tests {
         let mut input = Input::from_memory("demo", capture_csv()).unwrap();
         let mut stream = Stream::new();
         let (mut data, mut info, mut faulted, mut braking) = (0, 0, 0, 0);
-        let mut on_frame = |t: Option<f64>, _channel: Option<u8>, d: &hwfoc::Decoded| {
+        let mut on_frame = |t: Option<f64>, _channel: Option<u8>, frame: &Frame| {
             assert!(t.is_some());
-            match d.frame {
+            match frame {
                 Frame::Data(f) => {
                     data += 1;
-                    faulted += usize::from(f.status.contains(Fault::ThrottleSignalLost));
-                    braking += usize::from(f.current_raw < 0);
+                    let status = f.status().unwrap();
+                    faulted += usize::from(status.contains(Fault::ThrottleSignalLost));
+                    braking += usize::from(f.raw(Quantity::Current).unwrap() < 0);
                 }
                 Frame::Info(i) => {
                     assert_eq!(i.product(), "XR_FOC_ESC");

@@ -10,8 +10,8 @@ pub struct Mark {
     pub t: Option<f64>,
     /// Index of the data frame among the ESC's data frames (0-based).
     pub frame: u64,
-    /// Its packet number.
-    pub packet: u16,
+    /// Its packet number, where its protocol sends one.
+    pub packet: Option<u16>,
 }
 
 /// A maximal run of consecutive data frames with a non-zero status word.

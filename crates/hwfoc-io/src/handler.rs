@@ -5,10 +5,12 @@
 //! A front end (a command, a bridge, a binding) implements [`Handler::record`] and
 //! [`Handler::info`]: it sees records in physical units, the same whatever protocol the bytes
 //! were in, never the codec's frames. The library's own handlers (the writers, the summary)
-//! take the frames as decoded through [`Handler::frame`], to convert a block at a time on
-//! their own threads or to keep raw integers for exact means.
+//! take the frames through [`Handler::frame`], as the protocol-neutral [`Frame`] read through
+//! [`hwfoc::Telemetry`], to convert a block at a time on their own threads or to keep raw
+//! integers for exact means; none of them names a protocol's frame type.
 
-use hwfoc::{Decoded, Frame, InfoFrame, Settings};
+use hwfoc::Settings;
+use hwfoc::telemetry::{Frame, Info};
 
 use crate::input::InputError;
 use crate::record::Record;
@@ -30,16 +32,16 @@ pub trait Handler {
     /// A device-information frame of ESC `esc`, with the receive time of its first byte where
     /// the input has one.
     #[inline]
-    fn info(&mut self, esc: u8, t: Option<f64>, info: &InfoFrame) {
+    fn info(&mut self, esc: u8, t: Option<f64>, info: &Info) {
         let _ = (esc, t, info);
     }
 
-    /// A frame of ESC `esc` as the codec decoded it, with the receive time of its first byte
-    /// where the input has one. The default converts a data frame under `settings` and hands
-    /// it to [`Handler::record`], and a device-information frame to [`Handler::info`].
+    /// A frame of ESC `esc`, of any protocol, with the receive time of its first byte where the
+    /// input has one. The default converts a data frame under `settings` and hands it to
+    /// [`Handler::record`], and a device-information frame to [`Handler::info`].
     #[inline]
-    fn frame(&mut self, esc: u8, t: Option<f64>, decoded: &Decoded, settings: &Settings) {
-        match &decoded.frame {
+    fn frame(&mut self, esc: u8, t: Option<f64>, frame: &Frame, settings: &Settings) {
+        match frame {
             Frame::Data(f) => self.record(&Record::new(t, esc, f, settings)),
             Frame::Info(info) => self.info(esc, t, info),
         }
@@ -58,7 +60,7 @@ impl Handler for () {
     type Error = InputError;
 
     #[inline]
-    fn frame(&mut self, _: u8, _: Option<f64>, _: &Decoded, _: &Settings) {}
+    fn frame(&mut self, _: u8, _: Option<f64>, _: &Frame, _: &Settings) {}
 }
 
 /// Hands every frame to two handlers, each taking it its own way (as decoded, or as a record):
@@ -73,9 +75,9 @@ where
     type Error = B::Error;
 
     #[inline]
-    fn frame(&mut self, esc: u8, t: Option<f64>, decoded: &Decoded, settings: &Settings) {
-        self.0.frame(esc, t, decoded, settings);
-        self.1.frame(esc, t, decoded, settings);
+    fn frame(&mut self, esc: u8, t: Option<f64>, frame: &Frame, settings: &Settings) {
+        self.0.frame(esc, t, frame, settings);
+        self.1.frame(esc, t, frame, settings);
     }
 
     fn end_batch(&mut self, live: bool) -> Result<(), B::Error> {

@@ -40,8 +40,9 @@
 use std::cmp::Ordering;
 use std::collections::{BinaryHeap, HashMap, VecDeque};
 
+use hwfoc::Settings;
 use hwfoc::datalink::{CHANNELS, DatalinkStats};
-use hwfoc::{Decoded, Settings};
+use hwfoc::telemetry::Frame;
 
 pub use crate::handler::Handler;
 use crate::input::{Batch, Input, InputError, InputFormat};
@@ -553,7 +554,7 @@ impl Sources {
             let hub = self.hubs.get(&esc);
             let mut pending = Vec::new();
             // Inlined into the decoder's loop, so that the handler may be too: a frame's fields
-            // then reach it in registers, not through a `Decoded` stored and loaded back.
+            // then reach it in registers, not through a `Frame` stored and loaded back.
             self.escs[esc].stream.feed(
                 batch,
                 #[inline(always)]
@@ -800,7 +801,7 @@ impl Sources {
 /// stream's order) and a heap of their first frames.
 #[derive(Default)]
 struct Queue {
-    escs: Vec<VecDeque<(Option<f64>, Decoded)>>,
+    escs: Vec<VecDeque<(Option<f64>, Frame)>>,
     fronts: BinaryHeap<Earliest>,
     len: usize,
     peak: usize,
@@ -836,7 +837,7 @@ fn key(t: Option<f64>) -> f64 {
 }
 
 impl Queue {
-    fn push(&mut self, esc: usize, t: Option<f64>, d: &Decoded) {
+    fn push(&mut self, esc: usize, t: Option<f64>, d: &Frame) {
         if self.escs.len() <= esc {
             self.escs.resize_with(esc + 1, VecDeque::new);
         }
@@ -850,7 +851,7 @@ impl Queue {
     }
 
     /// The earliest frame, if it is earlier than `bound` or the queue is over its bound.
-    fn pop_before(&mut self, bound: f64) -> Option<(usize, Option<f64>, Decoded)> {
+    fn pop_before(&mut self, bound: f64) -> Option<(usize, Option<f64>, Frame)> {
         let front = self.fronts.peek()?;
         if front.t >= bound && self.len <= MAX_QUEUED {
             return None;
@@ -877,7 +878,7 @@ struct Hub {
 }
 
 /// A frame of a DataLink channel that has no ESC yet: its time, channel and frame.
-type Pending = (Option<f64>, u8, Decoded);
+type Pending = (Option<f64>, u8, Frame);
 
 /// The ESC a frame of the stream of ESC `own` belongs to: `own` on its own wire; behind a hub
 /// whose channels are numbered (`hub`), its channel's ESC with that ESC's settings; `None` for a
@@ -889,7 +890,7 @@ fn route<'h>(
     hub: Option<&'h Hub>,
     t: Option<f64>,
     channel: Option<u8>,
-    d: &Decoded,
+    d: &Frame,
     pending: &mut Vec<Pending>,
 ) -> Option<(usize, Option<&'h Settings>)> {
     match (channel, hub) {
@@ -1317,7 +1318,7 @@ pub(crate) mod tests {
             fn record(&mut self, r: &Record) {
                 self.0.push((r.esc, r.packet));
             }
-            fn frame(&mut self, esc: u8, t: Option<f64>, d: &Decoded, settings: &Settings) {
+            fn frame(&mut self, esc: u8, t: Option<f64>, d: &Frame, settings: &Settings) {
                 // ESC 12 (port 0's channel 2) has settings of its own; port 2's channels
                 // follow the port's.
                 let poles = match esc {
@@ -1330,7 +1331,7 @@ pub(crate) mod tests {
                     (settings.pole_pairs, settings.current_scale),
                     (poles, scale)
                 );
-                if let hwfoc::Frame::Data(f) = &d.frame {
+                if let Frame::Data(f) = d {
                     self.record(&Record::new(t, esc, f, settings));
                 }
             }

@@ -8,7 +8,8 @@
 use hwfoc::datalink::{self, DatalinkDecoded, DatalinkStats};
 use hwfoc::mixed::{MixedDecoded, MixedDecoder};
 use hwfoc::stats::PacketSequence;
-use hwfoc::{Decoded, Frame, LinkStats, Settings};
+use hwfoc::telemetry::{Data, Frame};
+use hwfoc::{LinkStats, Settings};
 
 use crate::handler::Handler;
 
@@ -65,24 +66,27 @@ pub enum WireKind {
     Mixed,
 }
 
-/// Hands each ESC frame of a hub frame on as `(channel, decoded)`, at the hub frame's offset.
+/// Hands each ESC frame of a hub frame on as `(channel, offset, frame)`, at the hub frame's
+/// offset.
 #[inline]
-fn hub_records(d: &DatalinkDecoded, emit: &mut impl FnMut(Option<u8>, &Decoded)) {
+fn hub_records(d: &DatalinkDecoded, emit: &mut impl FnMut(Option<u8>, u64, &Frame)) {
     for (channel, frame) in d.frame.escs() {
-        let decoded = Decoded {
-            offset: d.offset,
-            frame: Frame::Data(*frame),
-        };
-        emit(Some(channel as u8), &decoded);
+        emit(
+            Some(channel as u8),
+            d.offset,
+            &Frame::Data(Data::from(*frame)),
+        );
     }
 }
 
-/// Hands on a frame of either protocol: `emit(channel, decoded)` gets each ESC frame with its
-/// DataLink channel (`None` on an ESC's own wire).
+/// Hands on a frame of any protocol as the protocol-neutral [`Frame`]: `emit(channel, offset,
+/// frame)` gets each ESC frame with its DataLink channel (`None` on an ESC's own wire) and the
+/// stream offset of its first byte. The one place where the codec's protocol frames become
+/// neutral frames.
 #[inline(always)]
-fn emit_mixed(d: MixedDecoded, emit: &mut impl FnMut(Option<u8>, &Decoded)) {
+fn emit_mixed(d: MixedDecoded, emit: &mut impl FnMut(Option<u8>, u64, &Frame)) {
     match d {
-        MixedDecoded::Esc(d) => emit(None, &d),
+        MixedDecoded::Esc(d) => emit(None, d.offset, &Frame::from(d.frame)),
         MixedDecoded::Hub(d) => hub_records(&d, emit),
     }
 }
@@ -197,26 +201,26 @@ impl Stream {
         Stream::default()
     }
 
-    /// Decodes a batch; `on_frame(t, channel, decoded)` gets each ESC frame with its time
+    /// Decodes a batch; `on_frame(t, channel, frame)` gets each ESC frame with its time
     /// (`None` without timing) and its DataLink channel (`None` on an ESC's own wire).
     #[inline(always)]
     pub fn feed(
         &mut self,
         batch: Batch<'_>,
-        mut on_frame: impl FnMut(Option<f64>, Option<u8>, &Decoded),
+        mut on_frame: impl FnMut(Option<f64>, Option<u8>, &Frame),
     ) {
         let start = self.wire.stats().bytes();
         match batch.times {
             None => {
                 self.history.clear();
-                feed(&mut self.wire, batch.bytes, None, &mut |channel, d| {
-                    on_frame(None, channel, d)
+                feed(&mut self.wire, batch.bytes, None, &mut |channel, _, f| {
+                    on_frame(None, channel, f)
                 });
             }
             Some(times) => {
                 let history = &self.history;
-                let mut emit = |channel: Option<u8>, d: &Decoded| {
-                    on_frame(Some(time_at(history, times, start, d.offset)), channel, d)
+                let mut emit = |channel: Option<u8>, offset: u64, f: &Frame| {
+                    on_frame(Some(time_at(history, times, start, offset)), channel, f)
                 };
                 // The batch in pieces at each silence of the line: the decoder is told how many
                 // frames the silence could have hidden, so that an ESC that restarted in it is
@@ -249,13 +253,13 @@ impl Stream {
     }
 
     /// Ends the stream: a frame cut off at the end is dropped, frames inside it are still found.
-    pub fn finish(&mut self, mut on_frame: impl FnMut(Option<f64>, Option<u8>, &Decoded)) {
+    pub fn finish(&mut self, mut on_frame: impl FnMut(Option<f64>, Option<u8>, &Frame)) {
         let end = self.wire.stats().bytes();
         let history = &self.history;
         let timed = !history.is_empty();
-        let mut emit = |channel: Option<u8>, d: &Decoded| {
-            let t = timed.then(|| time_at(history, &[], end, d.offset));
-            on_frame(t, channel, d)
+        let mut emit = |channel: Option<u8>, offset: u64, f: &Frame| {
+            let t = timed.then(|| time_at(history, &[], end, offset));
+            on_frame(t, channel, f)
         };
         self.wire.flush(|d| emit_mixed(d, &mut emit));
     }
@@ -317,14 +321,13 @@ impl Stream {
 }
 
 /// Decodes `data` (ending with a silence of the line of `silence_s` seconds when given):
-/// `emit(channel, decoded)` gets each ESC frame with its DataLink channel (`None` on an ESC's
-/// own wire).
+/// `emit(channel, offset, frame)` gets each ESC frame as [`emit_mixed`] hands it on.
 #[inline(always)]
 fn feed(
     decoder: &mut MixedDecoder,
     data: &[u8],
     silence_s: Option<f64>,
-    emit: &mut impl FnMut(Option<u8>, &Decoded),
+    emit: &mut impl FnMut(Option<u8>, u64, &Frame),
 ) {
     decoder.feed(data, |d| emit_mixed(d, emit));
     if let Some(s) = silence_s {
@@ -647,9 +650,9 @@ mod mixed_tests {
     fn decode(wire: &[u8], chunk: usize) -> (Vec<(Option<u8>, u16)>, Stream) {
         let mut stream = Stream::new();
         let mut got = Vec::new();
-        let mut on = |_: Option<f64>, channel: Option<u8>, d: &Decoded| {
-            if let Frame::Data(f) = d.frame {
-                got.push((channel, f.packet));
+        let mut on = |_: Option<f64>, channel: Option<u8>, frame: &Frame| {
+            if let Frame::Data(f) = frame {
+                got.push((channel, f.to_hwfoc().packet));
             }
         };
         for b in wire.chunks(chunk) {

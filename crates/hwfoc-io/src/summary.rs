@@ -4,9 +4,11 @@
 //! [`Summary`] is a [`Handler`]: give it to [`Sources::run`], then ask it for the
 //! [`Summary::report`].
 //!
-//! Statistics are gathered on the raw integers (min, max and sum per field, a histogram of each
-//! temperature's ADC codes) and converted to physical units once, at the end: every conversion
-//! is monotonic, so this is exact, and it keeps the per-frame cost to a few integer operations.
+//! Statistics are gathered on the raw integers of each quantity a frame carries
+//! ([`Telemetry::raw`]: min, max and sum per quantity, a histogram of each temperature's codes)
+//! and converted to physical units once, at the end, through the conversion the ESC's protocol
+//! gives under its settings ([`Telemetry::reading`] of a frame of the ESC): every conversion is
+//! monotonic, so this is exact, and it keeps the per-frame cost to a few integer operations.
 //!
 //! Charge, energy and power ([`Energy`]) are integrated per ESC over its data frames' times
 //! (each frame's current holding until the next), on the raw voltage and current, converted
@@ -22,7 +24,9 @@
 
 use std::fmt::Write as _;
 
-use hwfoc::{DataFrame, Decoded, Fault, Frame, InfoFrame, Quantity, Settings, Status, Temperature};
+use hwfoc::telemetry::{Conversion, Data, Frame, Info, Telemetry};
+use hwfoc::units::Linear;
+use hwfoc::{Fault, Quantity, Settings, Status, Temperature};
 use serde_json::{Value, json};
 
 use crate::clock::Step;
@@ -120,16 +124,16 @@ impl Handler for Summary {
     /// to the accumulator, not through a `Decoded` in memory); every other frame is taken out of
     /// line.
     #[inline(always)]
-    fn frame(&mut self, esc: u8, t: Option<f64>, decoded: &Decoded, _: &Settings) {
+    fn frame(&mut self, esc: u8, t: Option<f64>, frame: &Frame, _: &Settings) {
         let esc = usize::from(esc);
-        if let Frame::Data(f) = &decoded.frame
+        if let Frame::Data(f) = frame
             && let Some(acc) = self.0.get_mut(esc)
-            && f.status.is_ok()
-            && acc.episode.is_none()
+            && acc.fast
+            && f.status().is_none_or(Status::is_ok)
         {
             acc.add_clean(t, f);
         } else {
-            self.add(esc, t, &decoded.frame);
+            self.add(esc, t, frame);
         }
     }
 }
@@ -154,25 +158,49 @@ struct Range {
     sum: i64,
 }
 
-/// The raw integer fields with a [`Range`], in lanes: eight at once, so that a frame's six
-/// minima, maxima and sums are a few vector instructions (the summary's per-frame cost).
+/// The raw integers with a [`Range`], in lanes: eight at once, so that a frame's six minima,
+/// maxima and sums are a few vector instructions (the summary's per-frame cost).
 #[derive(Debug, Clone, Copy)]
 struct Ranges {
     min: [i32; LANES],
     max: [i32; LANES],
     sum: [i64; LANES],
+    /// Data frames that did not carry the lane's quantity (their protocol lacks it).
+    missing: [u64; LANES],
 }
 
-/// Lanes of [`Ranges`]: the six fields, and two unused (a seventh field, the raw power, made
-/// `summary` of a large file 40 % slower: it is summed apart, see [`Accumulator::count`]).
+/// Lanes of [`Ranges`]: six quantities, and two unused (a seventh, the raw power, made `summary`
+/// of a large file 40 % slower: it is summed apart, see [`Accumulator::count`]).
 const LANES: usize = 8;
-/// The lane of each field.
-const THROTTLE_IN: usize = 0;
-const THROTTLE_OUT: usize = 1;
+/// The quantity of each lane. RPM is eRPM's lane, converted otherwise.
+const LANE_QUANTITIES: [Quantity; 6] = [
+    Quantity::ThrottleIn,
+    Quantity::ThrottleOut,
+    Quantity::Erpm,
+    Quantity::Voltage,
+    Quantity::Current,
+    Quantity::PhaseCurrent,
+];
+/// The lane of each quantity of [`LANE_QUANTITIES`].
 const ERPM: usize = 2;
-const VOLTAGE: usize = 3;
 const CURRENT: usize = 4;
-const PHASE_CURRENT: usize = 5;
+
+/// The lane of `quantity`, if it has one.
+const fn lane(quantity: Quantity) -> Option<usize> {
+    match quantity {
+        Quantity::Rpm => Some(ERPM),
+        q => {
+            let mut i = 0;
+            while i < LANE_QUANTITIES.len() {
+                if LANE_QUANTITIES[i] as u8 == q as u8 {
+                    return Some(i);
+                }
+                i += 1;
+            }
+            None
+        }
+    }
+}
 
 impl Default for Ranges {
     fn default() -> Self {
@@ -180,33 +208,43 @@ impl Default for Ranges {
             min: [i32::MAX; LANES],
             max: [i32::MIN; LANES],
             sum: [0; LANES],
+            missing: [0; LANES],
         }
     }
 }
 
 impl Ranges {
-    /// Adds a frame's raw fields.
+    /// Adds a frame's raw integers. A quantity the frame does not carry leaves its lane's
+    /// minimum, maximum and sum as they are and is counted as missing (for a protocol that
+    /// carries every lane's quantity, the compiler removes that branch).
     #[inline(always)]
-    fn add(&mut self, f: &DataFrame) {
-        let mut v = [0i32; LANES];
-        v[THROTTLE_IN] = i32::from(f.throttle_in_raw);
-        v[THROTTLE_OUT] = i32::from(f.throttle_out_raw);
-        v[ERPM] = i32::from(f.erpm_raw);
-        v[VOLTAGE] = i32::from(f.voltage_raw);
-        v[CURRENT] = i32::from(f.current_raw);
-        v[PHASE_CURRENT] = i32::from(f.phase_current_raw);
-        self.min = std::array::from_fn(|i| self.min[i].min(v[i]));
-        self.max = std::array::from_fn(|i| self.max[i].max(v[i]));
-        self.sum = std::array::from_fn(|i| self.sum[i] + i64::from(v[i]));
+    fn add(&mut self, f: &impl Telemetry) {
+        let (mut low, mut high, mut add) = ([i32::MAX; LANES], [i32::MIN; LANES], [0i64; LANES]);
+        let mut take = |lane: usize| match f.raw(LANE_QUANTITIES[lane]) {
+            Some(raw) => (low[lane], high[lane], add[lane]) = (raw, raw, i64::from(raw)),
+            None => self.missing[lane] += 1,
+        };
+        // Written out, not a loop: each call is then a field read.
+        take(0);
+        take(1);
+        take(2);
+        take(3);
+        take(4);
+        take(5);
+        self.min = std::array::from_fn(|i| self.min[i].min(low[i]));
+        self.max = std::array::from_fn(|i| self.max[i].max(high[i]));
+        self.sum = std::array::from_fn(|i| self.sum[i] + add[i]);
     }
 
-    /// The range of the field in `lane`.
-    fn get(&self, lane: usize) -> Range {
-        Range {
+    /// The range of the quantity in `lane`, and the number of frames that carried it among
+    /// `frames`.
+    fn get(&self, lane: usize, frames: u64) -> (Range, u64) {
+        let range = Range {
             min: self.min[lane],
             max: self.max[lane],
             sum: self.sum[lane],
-        }
+        };
+        (range, frames - self.missing[lane])
     }
 }
 
@@ -227,14 +265,22 @@ impl Range {
 #[derive(Debug)]
 struct Accumulator {
     frames: u64,
+    /// A data frame of the ESC (its first), whose protocol's conversions the report uses.
+    sample: Option<Data>,
+    /// Whether the next data frame may take [`Accumulator::add_clean`]: the ESC's sample is
+    /// known and no fault episode is open.
+    fast: bool,
     ranges: Ranges,
+    /// Histograms of each temperature's raw codes (a table's codes, 0..=255), and the frames
+    /// whose temperature was not such a code or was not carried.
     mos_codes: [u64; 256],
     cap_codes: [u64; 256],
+    uncoded: [u64; 2],
     fault_frames: [u64; 16],
     first_t: Option<f64>,
     last_t: Option<f64>,
-    /// The last timed data frame's packet number.
-    last_packet: u16,
+    /// The last timed data frame's packet number, where its protocol sends one.
+    last_packet: Option<u16>,
     /// Seconds that passed between the timed data frames: the sum of the steps that are not
     /// clock discontinuities.
     elapsed: f64,
@@ -245,12 +291,12 @@ struct Accumulator {
     /// without times are integrated from the lanes' sums at the end (see [`Self::energy`]).
     energy: Energy,
     /// The last data frame's raw voltage and current.
-    last: (u16, i16),
-    /// Sum and largest of the raw power (voltage times current: at most 65535 x 32768 in
-    /// magnitude, within an `i32`) of every data frame.
+    last: (i32, i32),
+    /// Sum and largest of the raw power (voltage times current: for HW-FOC at most 65535 x
+    /// 32768 in magnitude, within an `i32`) of every data frame.
     power_sum: i64,
     power_max: i32,
-    infos: Vec<(InfoFrame, u64)>,
+    infos: Vec<(Info, u64)>,
     episode: Option<Episode>,
     episodes: Vec<Episode>,
     episode_count: u64,
@@ -260,13 +306,16 @@ impl Default for Accumulator {
     fn default() -> Self {
         Accumulator {
             frames: 0,
+            sample: None,
+            fast: false,
             ranges: Ranges::default(),
             mos_codes: [0; 256],
             cap_codes: [0; 256],
+            uncoded: [0; 2],
             fault_frames: [0; 16],
             first_t: None,
             last_t: None,
-            last_packet: 0,
+            last_packet: None,
             elapsed: 0.0,
             steps_back: 0,
             jumps: 0,
@@ -294,23 +343,33 @@ impl Accumulator {
         }
     }
 
-    /// A data frame whose status word is zero, outside a fault episode: what [`Self::add_data`]
-    /// does with it (no fault to count, no episode started or ended).
+    /// A data frame without faults, outside a fault episode, of an ESC whose sample is known:
+    /// what [`Self::add_data`] does with it (no fault to count, no episode started or ended).
     #[inline(always)]
-    fn add_clean(&mut self, t: Option<f64>, f: &DataFrame) {
-        debug_assert!(f.status.is_ok() && self.episode.is_none());
+    fn add_clean(&mut self, t: Option<f64>, f: &Data) {
+        debug_assert!(self.fast && self.sample.is_some() && self.episode.is_none());
         self.count(t, f);
     }
 
     /// What every data frame adds: its count, ranges, temperature codes and time.
     #[inline(always)]
-    fn count(&mut self, t: Option<f64>, f: &DataFrame) {
+    fn count(&mut self, t: Option<f64>, f: &Data) {
         self.frames += 1;
         self.ranges.add(f);
-        self.mos_codes[usize::from(f.mos_adc)] += 1;
-        self.cap_codes[usize::from(f.cap_adc)] += 1;
-        self.last = (f.voltage_raw, f.current_raw);
-        let power = i32::from(f.voltage_raw) * i32::from(f.current_raw);
+        let code = |quantity: Quantity, codes: &mut [u64; 256], uncoded: &mut u64| match f
+            .raw(quantity)
+            .and_then(|raw| u8::try_from(raw).ok())
+        {
+            Some(code) => codes[usize::from(code)] += 1,
+            None => *uncoded += 1,
+        };
+        code(Quantity::MosTemp, &mut self.mos_codes, &mut self.uncoded[0]);
+        code(Quantity::CapTemp, &mut self.cap_codes, &mut self.uncoded[1]);
+        let (Some(volts), Some(amps)) = (f.raw(Quantity::Voltage), f.raw(Quantity::Current)) else {
+            return self.untimed_power(t, f);
+        };
+        self.last = (volts, amps);
+        let power = volts * amps;
         self.power_sum += i64::from(power);
         // A branch rarely taken, not a chain of conditional moves from frame to frame.
         if power > self.power_max {
@@ -324,11 +383,19 @@ impl Accumulator {
     /// What a frame with a time adds: out of the decoder's loop, which stays as small as it
     /// was for inputs without times (the summary of a large raw file).
     #[inline(never)]
-    fn timed(&mut self, t: f64, f: &DataFrame) {
-        self.energy
-            .add(Some(t), f64::from(f.voltage_raw), f64::from(f.current_raw));
+    fn timed(&mut self, t: f64, f: &Data) {
+        let (volts, amps) = self.last;
+        self.energy.add(Some(t), f64::from(volts), f64::from(amps));
+        self.clock(t, f);
+    }
+
+    /// The time of a data frame: the duration and the clock's discontinuities.
+    #[inline]
+    fn clock(&mut self, t: f64, f: &Data) {
+        let packet = f.packet();
         if let Some(last) = self.last_t {
-            match Step::between(last, t, Some(f.packet.wrapping_sub(self.last_packet))) {
+            let counted = packet.zip(self.last_packet).map(|(p, l)| p.wrapping_sub(l));
+            match Step::between(last, t, counted) {
                 Step::Back => self.steps_back += 1,
                 Step::Jump => self.jumps += 1,
                 step => self.elapsed += step.elapsed().unwrap_or(0.0),
@@ -336,29 +403,41 @@ impl Accumulator {
         }
         self.first_t.get_or_insert(t);
         self.last_t = Some(t);
-        self.last_packet = f.packet;
+        self.last_packet = packet;
+    }
+
+    /// The rest of a data frame that does not carry both voltage and current: its time, and no
+    /// power (a protocol without them has no energy to integrate).
+    #[cold]
+    fn untimed_power(&mut self, t: Option<f64>, f: &Data) {
+        if let Some(t) = t {
+            self.clock(t, f);
+        }
     }
 
     #[inline]
-    fn add_data(&mut self, t: Option<f64>, f: &DataFrame) {
+    fn add_data(&mut self, t: Option<f64>, f: &Data) {
+        self.sample.get_or_insert(*f);
         let index = self.frames;
         self.count(t, f);
-        if !f.status.is_ok() {
-            for fault in f.status.faults() {
+        let status = f.status().unwrap_or_default();
+        if !status.is_ok() {
+            for fault in status.faults() {
                 self.fault_frames[usize::from(fault.bit())] += 1;
             }
         }
         let mark = Mark {
             t,
             frame: index,
-            packet: f.packet,
+            packet: f.packet(),
         };
-        if let Some(ended) = Episode::track(&mut self.episode, mark, f.status) {
+        if let Some(ended) = Episode::track(&mut self.episode, mark, status) {
             self.episode_count += 1;
             if self.episodes.len() < MAX_EPISODES {
                 self.episodes.push(ended);
             }
         }
+        self.fast = self.episode.is_none();
     }
 }
 
@@ -388,14 +467,20 @@ struct TempStats {
     above: u64,
 }
 
-fn temp_stats(codes: &[u64; 256]) -> TempStats {
+/// Temperature statistics from a histogram of codes read through `conversion`: a table's, whose
+/// codes outside it are counted below or above it, or a linear one.
+fn temp_stats(codes: &[u64; 256], conversion: Conversion) -> TempStats {
     let mut s = TempStats::default();
     let (mut min, mut max, mut sum, mut n) = (f64::MAX, f64::MIN, 0.0, 0u64);
     for (code, &count) in codes.iter().enumerate() {
         if count == 0 {
             continue;
         }
-        match Temperature::from_adc(code as u8) {
+        let temperature = match conversion {
+            Conversion::AdcTable => Temperature::from_adc(code as u8),
+            Conversion::Linear(linear) => Temperature::Celsius(linear.to_f32(code as f32)),
+        };
+        match temperature {
             Temperature::Celsius(c) => {
                 let c = f64::from(c);
                 min = min.min(c);
@@ -647,11 +732,7 @@ fn settings_differing(settings: &Settings, default: &Settings) -> Vec<String> {
 
 /// The figures of every ESC with data frames added, when there are two or more.
 fn total_energy(escs: &[EscReport]) -> Option<Energy> {
-    let with_frames: Vec<Energy> = escs
-        .iter()
-        .filter(|e| e.acc.frames > 0)
-        .map(EscReport::energy)
-        .collect();
+    let with_frames: Vec<Energy> = escs.iter().filter_map(EscReport::energy).collect();
     (with_frames.len() > 1).then(|| {
         let mut total = Energy::new();
         for e in &with_frames {
@@ -707,10 +788,23 @@ fn clock_name(clock: Clock) -> &'static str {
 
 impl EscReport<'_> {
     /// Charge, energy and power, converted from the raw units under the settings.
-    fn energy(&self) -> Energy {
-        let volts = Quantity::Voltage.linear(&self.settings).to_f64(1.0);
-        let amps = Quantity::Current.linear(&self.settings).to_f64(1.0);
-        self.acc.energy().scaled(volts, amps)
+    /// `None` for an ESC without data frames, or whose protocol sends no voltage or current.
+    fn energy(&self) -> Option<Energy> {
+        let volts = self.linear(Quantity::Voltage)?.to_f64(1.0);
+        let amps = self.linear(Quantity::Current)?.to_f64(1.0);
+        Some(self.acc.energy().scaled(volts, amps))
+    }
+
+    /// The conversion of `quantity` in this ESC's protocol under its settings, if the protocol
+    /// carries it (and the ESC gave a data frame): through which raw statistics are converted.
+    fn conversion(&self, quantity: Quantity) -> Option<Conversion> {
+        let sample = self.acc.sample?;
+        Some(sample.reading(quantity, &self.settings)?.conversion)
+    }
+
+    /// The linear conversion of `quantity` (see [`Self::conversion`]).
+    fn linear(&self, quantity: Quantity) -> Option<Linear> {
+        self.conversion(quantity)?.linear()
     }
 
     /// A time as shown: a date on a wall clock, else the source's seconds.
@@ -755,26 +849,34 @@ impl EscReport<'_> {
     }
 
     fn fields(&self) -> Vec<FieldRow> {
-        let a = self.acc;
-        let n = a.frames;
-        let s = self.settings;
-        // The conversions of the codec, applied to the raw min, max and mean.
-        let field = |q: Quantity, lane: usize| {
-            let linear = q.linear(&s);
-            let range = a.ranges.get(lane);
-            (q.name(), q.unit(), range.convert(n, |x| linear.to_f64(x)))
+        // The protocol's conversions, applied to the raw min, max and mean.
+        let field = |q: Quantity| {
+            let stats = match lane(q) {
+                Some(lane) => {
+                    let (range, n) = self.acc.ranges.get(lane, self.acc.frames);
+                    let linear = self.linear(q);
+                    linear.and_then(|linear| range.convert(n, |x| linear.to_f64(x)))
+                }
+                None => self.temperature(q).range,
+            };
+            (q.name(), q.unit(), stats)
         };
-        vec![
-            field(Quantity::ThrottleIn, THROTTLE_IN),
-            field(Quantity::ThrottleOut, THROTTLE_OUT),
-            field(Quantity::Erpm, ERPM),
-            field(Quantity::Rpm, ERPM),
-            field(Quantity::Voltage, VOLTAGE),
-            field(Quantity::Current, CURRENT),
-            field(Quantity::PhaseCurrent, PHASE_CURRENT),
-            ("mos_temp_c", "degC", temp_stats(&a.mos_codes).range),
-            ("cap_temp_c", "degC", temp_stats(&a.cap_codes).range),
-        ]
+        Quantity::ALL.into_iter().map(field).collect()
+    }
+
+    /// The statistics of temperature `quantity` (a histogram of its codes).
+    fn temperature(&self, quantity: Quantity) -> TempStats {
+        let (codes, uncoded) = match quantity {
+            Quantity::CapTemp => (&self.acc.cap_codes, self.acc.uncoded[1]),
+            _ => (&self.acc.mos_codes, self.acc.uncoded[0]),
+        };
+        match self.conversion(quantity) {
+            // Every data frame's temperature is in the histogram: its statistics are whole.
+            Some(conversion) if uncoded == 0 => temp_stats(codes, conversion),
+            // A protocol that does not send it, or not as a code of 0..=255: no statistics
+            // rather than those of some frames.
+            _ => TempStats::default(),
+        }
     }
 
     fn faults(&self) -> impl Iterator<Item = (Fault, u64)> + '_ {
@@ -860,8 +962,8 @@ impl EscReport<'_> {
             }
         }
         for (name, t) in [
-            ("mos_temp_c", temp_stats(&self.acc.mos_codes)),
-            ("cap_temp_c", temp_stats(&self.acc.cap_codes)),
+            ("mos_temp_c", self.temperature(Quantity::MosTemp)),
+            ("cap_temp_c", self.temperature(Quantity::CapTemp)),
         ] {
             if t.below + t.above > 0 {
                 let _ = writeln!(
@@ -873,7 +975,9 @@ impl EscReport<'_> {
                 );
             }
         }
-        let _ = writeln!(o, "\nenergy       {}", energy_text(&self.energy()));
+        if let Some(energy) = self.energy() {
+            let _ = writeln!(o, "\nenergy       {}", energy_text(&energy));
+        }
         o.push('\n');
         if self.episode_count == 0 {
             let _ = writeln!(o, "faults       none");
@@ -973,10 +1077,10 @@ impl EscReport<'_> {
             "info": infos,
             "fields": fields,
             "temperature_out_of_range": {
-                "mos_temp_c": temps(temp_stats(&self.acc.mos_codes)),
-                "cap_temp_c": temps(temp_stats(&self.acc.cap_codes)),
+                "mos_temp_c": temps(self.temperature(Quantity::MosTemp)),
+                "cap_temp_c": temps(self.temperature(Quantity::CapTemp)),
             },
-            "energy": (self.acc.frames > 0).then(|| energy_json(&self.energy())),
+            "energy": self.energy().map(|e| energy_json(&e)),
             "faults": faults,
             "fault_episode_count": self.episode_count,
             "fault_episodes": episodes,
@@ -991,14 +1095,11 @@ fn episode_text(e: &Episode, clock: Clock) -> String {
     if let (Some(a), Some(b)) = (e.first.t, e.last.t) {
         let _ = write!(s, "{:.3} s, ", b - a);
     }
-    let _ = write!(
-        s,
-        "{} frames, packets {} .. {})  {}",
-        e.frames,
-        e.first.packet,
-        e.last.packet,
-        fault_names(e.bits).join(", ")
-    );
+    let _ = write!(s, "{} frames", e.frames);
+    if let (Some(a), Some(b)) = (e.first.packet, e.last.packet) {
+        let _ = write!(s, ", packets {a} .. {b}");
+    }
+    let _ = write!(s, ")  {}", fault_names(e.bits).join(", "));
     if e.ongoing {
         s.push_str("  (still on at the end)");
     }
@@ -1039,6 +1140,7 @@ fn percent(part: u64, whole: u64) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use hwfoc::DataFrame;
 
     #[test]
     fn temperature_stats_come_from_the_histogram() {
@@ -1047,7 +1149,7 @@ mod tests {
         codes[183] = 1; // 40 degC
         codes[250] = 2; // below range
         codes[10] = 1; // above range
-        let t = temp_stats(&codes);
+        let t = temp_stats(&codes, Conversion::AdcTable);
         assert_eq!(t.range, Some([28.0, 40.0, (3.0 * 28.0 + 40.0) / 4.0]));
         assert_eq!((t.below, t.above), (2, 1));
     }
@@ -1062,15 +1164,18 @@ mod tests {
                 ..Default::default()
             });
         }
+        let voltage = lane(Quantity::Voltage).unwrap();
+        let (current, n) = r.get(CURRENT, 3);
+        assert_eq!(n, 3);
         assert_eq!(
-            r.get(CURRENT).convert(3, |x| x / 64.0),
+            current.convert(n, |x| x / 64.0),
             Some([-1.0, 2.0, 64.0 / 3.0 / 64.0])
         );
         assert_eq!(
-            r.get(VOLTAGE).convert(3, |x| x),
+            r.get(voltage, 3).0.convert(3, |x| x),
             Some([0.0, 192.0, 256.0 / 3.0])
         );
-        assert_eq!(Ranges::default().get(ERPM).convert(0, |x| x), None);
+        assert_eq!(Ranges::default().get(ERPM, 0).0.convert(0, |x| x), None);
     }
 
     #[test]
@@ -1085,7 +1190,7 @@ mod tests {
                 status: Status(s),
                 ..Default::default()
             };
-            acc.add(Some(i as f64 * 0.05), &Frame::Data(frame));
+            acc.add(Some(i as f64 * 0.05), &Frame::Data(frame.into()));
         }
         assert_eq!(acc.episode_count, 2);
         let first = acc.episodes[0];
@@ -1093,7 +1198,10 @@ mod tests {
             (first.first.frame, first.last.frame, first.frames),
             (1, 3, 3)
         );
-        assert_eq!((first.first.packet, first.last.packet), (101, 103));
+        assert_eq!(
+            (first.first.packet, first.last.packet),
+            (Some(101), Some(103))
+        );
         assert_eq!(first.first.t, Some(0.05));
         assert_eq!(
             fault_names(first.bits),

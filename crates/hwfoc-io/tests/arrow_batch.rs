@@ -98,10 +98,10 @@ fn a_batch_has_exactly_the_schema_and_the_records_values() {
     let mut builder = RecordBatchBuilder::new();
     let mut records = Vec::new();
     for (i, (t, esc, frame)) in frames().iter().enumerate() {
-        let record = Record::new(*t, *esc, frame, &settings);
+        let record = Record::new(*t, *esc, &hwfoc::telemetry::Data::from(*frame), &settings);
         // Frames and records alike.
         if i % 2 == 0 {
-            builder.push_frame(*t, *esc, frame, &settings);
+            builder.push_frame(*t, *esc, &hwfoc::telemetry::Data::from(*frame), &settings);
         } else {
             builder.push(record);
         }
@@ -138,7 +138,9 @@ fn the_record_fields_are_the_batch_columns() {
     let settings = Settings::default();
     let records: Vec<Record> = frames()
         .iter()
-        .map(|(t, esc, frame)| Record::new(*t, *esc, frame, &settings))
+        .map(|(t, esc, frame)| {
+            Record::new(*t, *esc, &hwfoc::telemetry::Data::from(*frame), &settings)
+        })
         .collect();
     let batch = record_batch(&records);
     let f32s = |name: &str| {
@@ -189,15 +191,25 @@ fn batches_one_after_another_and_empty() {
     let rows = frames();
     let mut records = Vec::new();
     for (t, esc, frame) in &rows[..10] {
-        builder.push_frame(*t, *esc, frame, &settings);
-        records.push(Record::new(*t, *esc, frame, &settings));
+        builder.push_frame(*t, *esc, &hwfoc::telemetry::Data::from(*frame), &settings);
+        records.push(Record::new(
+            *t,
+            *esc,
+            &hwfoc::telemetry::Data::from(*frame),
+            &settings,
+        ));
     }
     let first = builder.finish();
     assert_same(&first, &records);
     records.clear();
     for (t, esc, frame) in &rows[10..25] {
-        builder.push_frame(*t, *esc, frame, &settings);
-        records.push(Record::new(*t, *esc, frame, &settings));
+        builder.push_frame(*t, *esc, &hwfoc::telemetry::Data::from(*frame), &settings);
+        records.push(Record::new(
+            *t,
+            *esc,
+            &hwfoc::telemetry::Data::from(*frame),
+            &settings,
+        ));
     }
     let second = builder.finish();
     assert_same(&second, &records);

@@ -120,7 +120,12 @@ fn the_example_record() {
         0xCE, 0xD1, 0x00, 0x00, 0x0D, 0x08,
     ];
     let frame = DataFrame::parse(&bytes).unwrap();
-    let record = Record::new(Some(0.22798), 0, &frame, &Settings::default());
+    let record = Record::new(
+        Some(0.22798),
+        0,
+        &hwfoc::telemetry::Data::from(frame),
+        &Settings::default(),
+    );
     let mut line = Vec::new();
     record.write_json(&mut line);
     let document = record_schema_md();
@@ -140,10 +145,15 @@ fn text_follows_the_table() {
         status: Status(0x8001),
         ..Default::default()
     };
-    let record = Record::new(None, 3, &frame, &Settings::default());
+    let record = Record::new(
+        None,
+        3,
+        &hwfoc::telemetry::Data::from(frame),
+        &Settings::default(),
+    );
     let mut encoder = TextEncoder::cached();
     let mut json = Vec::new();
-    encoder.json_frame(&record, &frame, &mut json);
+    encoder.json_frame(&record, &hwfoc::telemetry::Data::from(frame), &mut json);
     let object: serde_json::Map<String, serde_json::Value> = serde_json::from_slice(&json).unwrap();
     // serde_json keeps the order of the keys (feature preserve_order).
     let keys: Vec<&str> = object.keys().map(String::as_str).collect();
@@ -151,7 +161,7 @@ fn text_follows_the_table() {
 
     let mut csv = Vec::new();
     Record::write_csv_header(&mut csv);
-    encoder.csv_frame(&record, &frame, &mut csv);
+    encoder.csv_frame(&record, &hwfoc::telemetry::Data::from(frame), &mut csv);
     let csv = String::from_utf8(csv).unwrap();
     let lines: Vec<&str> = csv.lines().collect();
     assert_eq!(lines[0], COLUMNS.join(","));

@@ -257,7 +257,8 @@ impl Truth {
     pub fn record(&mut self, t_s: f64, esc: usize, frame: &DataFrame) -> Result<(), WriteError> {
         self.line.clear();
         // ESC indices are below 256 (checked when the fleet is built).
-        Record::new(Some(t_s), esc as u8, frame, &self.settings).write_json(&mut self.line);
+        Record::new(Some(t_s), esc as u8, &(*frame).into(), &self.settings)
+            .write_json(&mut self.line);
         self.out
             .write_all(&self.line)
             .map_err(write_error(&self.name))

@@ -11,6 +11,7 @@ pub mod mixed;
 pub mod scan;
 pub mod stats;
 pub mod status;
+pub mod telemetry;
 pub mod units;
 pub mod wire;
 
@@ -24,5 +25,6 @@ pub use kinds::info::{InfoFieldError, InfoFrame};
 pub use scan::{Scan, StreamDecoder};
 pub use stats::{LinkStats, PacketSequence};
 pub use status::{Fault, Faults, Status};
+pub use telemetry::{Conversion, Reading, Telemetry};
 pub use units::{Quantity, Settings, SettingsError, Temperature};
 pub use wire::{FrameError, FrameKind};

@@ -1,19 +1,21 @@
 //! Physical units: every conversion from a raw field to a physical value, written once, the
 //! user's conversion settings, and the ADC-to-temperature table.
 //!
-//! Every HW-FOC conversion but temperature is linear: a [`Linear`] (`raw * mul / div`), named by
-//! a [`Quantity`]. The same definition converts a raw field to `f32` (what [`DataFrame`]'s
-//! methods return) and a statistic of raw values (a minimum, a mean) to `f64`, each bit for bit
-//! as the formulas written out by hand did:
+//! Every HW-FOC conversion but temperature is linear: a [`Linear`] (`raw * mul / div`), which a
+//! frame gives for each [`Quantity`] it carries
+//! ([`Telemetry::reading`](crate::Telemetry::reading)). The same definition converts a raw field
+//! to `f32` (what [`DataFrame`]'s methods return) and a statistic of raw values (a minimum, a
+//! mean) to `f64`, each bit for bit as the formulas written out by hand did:
 //!
 //! ```
-//! use hwfoc::{DataFrame, Quantity, Settings};
+//! use hwfoc::{DataFrame, Quantity, Settings, Telemetry};
 //!
 //! let settings = Settings::default(); // current scale 64, 7 pole pairs, gear ratio 1
 //! let frame = DataFrame { erpm_raw: 350, current_raw: -1, ..Default::default() };
 //! assert_eq!(frame.rpm(&settings), 500.0);
-//! assert_eq!(Quantity::Rpm.linear(&settings).to_f32(350.0), 500.0);
-//! assert_eq!(Quantity::Current.linear(&settings).to_f64(-1.5), -1.5 / 64.0);
+//! let linear = |q| frame.reading(q, &settings).unwrap().conversion.linear().unwrap();
+//! assert_eq!(linear(Quantity::Rpm).to_f32(350.0), 500.0);
+//! assert_eq!(linear(Quantity::Current).to_f64(-1.5), -1.5 / 64.0);
 //! assert_eq!((Quantity::Current.name(), Quantity::Current.unit()), ("current_a", "A"));
 //! ```
 //!
@@ -65,8 +67,9 @@ impl Linear {
     }
 }
 
-/// A quantity of a data frame that converts linearly from its raw field, with its name and unit
-/// in every output of the project (`docs/RECORD-SCHEMA.md`).
+/// A quantity a data frame may carry, with its name and unit in every output of the project
+/// (`docs/RECORD-SCHEMA.md`). Which protocol carries which, and how its raw integer converts, is
+/// said by each protocol's frame ([`Telemetry`](crate::telemetry::Telemetry)).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum Quantity {
     /// Input throttle, % (`throttle_in_pct`).
@@ -83,11 +86,15 @@ pub enum Quantity {
     Current,
     /// Phase current, A (`phase_current_a`).
     PhaseCurrent,
+    /// MOSFET temperature, degC (`mos_temp_c`).
+    MosTemp,
+    /// Capacitor temperature, degC (`cap_temp_c`).
+    CapTemp,
 }
 
 impl Quantity {
     /// Every quantity, in the order of the telemetry record.
-    pub const ALL: [Quantity; 7] = [
+    pub const ALL: [Quantity; 9] = [
         Quantity::ThrottleIn,
         Quantity::ThrottleOut,
         Quantity::Erpm,
@@ -95,6 +102,8 @@ impl Quantity {
         Quantity::Voltage,
         Quantity::Current,
         Quantity::PhaseCurrent,
+        Quantity::MosTemp,
+        Quantity::CapTemp,
     ];
 
     /// The column name in every output, e.g. `voltage_v`.
@@ -107,29 +116,19 @@ impl Quantity {
             Quantity::Voltage => "voltage_v",
             Quantity::Current => "current_a",
             Quantity::PhaseCurrent => "phase_current_a",
+            Quantity::MosTemp => "mos_temp_c",
+            Quantity::CapTemp => "cap_temp_c",
         }
     }
 
-    /// The unit: `%`, `rev/min`, `V` or `A`.
+    /// The unit: `%`, `rev/min`, `V`, `A` or `degC`.
     pub const fn unit(self) -> &'static str {
         match self {
             Quantity::ThrottleIn | Quantity::ThrottleOut => "%",
             Quantity::Erpm | Quantity::Rpm => "rev/min",
             Quantity::Voltage => "V",
             Quantity::Current | Quantity::PhaseCurrent => "A",
-        }
-    }
-
-    /// The conversion from the raw field under `settings` (which only RPM and the currents
-    /// depend on).
-    #[inline]
-    pub fn linear(self, settings: &Settings) -> Linear {
-        match self {
-            Quantity::ThrottleIn | Quantity::ThrottleOut => Linear::THROTTLE_PCT,
-            Quantity::Erpm => Linear::ERPM,
-            Quantity::Rpm => settings.rpm_linear(),
-            Quantity::Voltage => Linear::VOLTS,
-            Quantity::Current | Quantity::PhaseCurrent => settings.amps_linear(),
+            Quantity::MosTemp | Quantity::CapTemp => "degC",
         }
     }
 }

@@ -3,7 +3,18 @@
 //! maxima and means (f64). Every raw value of every field, under several settings.
 
 use hwfoc::units::{ERPM_PER_RAW, Linear};
-use hwfoc::{DataFrame, Quantity, Settings};
+use hwfoc::{DataFrame, Quantity, Settings, Telemetry, Temperature};
+
+/// The quantities an HW-FOC frame converts linearly (every one but the two temperatures).
+const LINEAR: [Quantity; 7] = [
+    Quantity::ThrottleIn,
+    Quantity::ThrottleOut,
+    Quantity::Erpm,
+    Quantity::Rpm,
+    Quantity::Voltage,
+    Quantity::Current,
+    Quantity::PhaseCurrent,
+];
 
 /// The settings tried: the default, the `x 0.01` current scale, and unusual ones.
 fn settings() -> Vec<Settings> {
@@ -43,6 +54,7 @@ fn old_f32(q: Quantity, raw: i32, s: &Settings) -> f32 {
         }
         Quantity::Voltage => f32::from(raw as u16) / 10.0,
         Quantity::Current | Quantity::PhaseCurrent => f32::from(raw as i16) / s.current_scale,
+        Quantity::MosTemp | Quantity::CapTemp => unreachable!("not linear"),
     }
 }
 
@@ -54,6 +66,7 @@ fn old_f64(q: Quantity, x: f64, s: &Settings) -> f64 {
         Quantity::Rpm => x * 10.0 / (f64::from(s.gear_ratio) * f64::from(s.pole_pairs)),
         Quantity::Voltage => x / 10.0,
         Quantity::Current | Quantity::PhaseCurrent => x / f64::from(s.current_scale),
+        Quantity::MosTemp | Quantity::CapTemp => unreachable!("not linear"),
     }
 }
 
@@ -67,6 +80,8 @@ fn method(f: &DataFrame, q: Quantity, s: &Settings) -> f32 {
         Quantity::Voltage => f.voltage_v(),
         Quantity::Current => f.current_a(s),
         Quantity::PhaseCurrent => f.phase_current_a(s),
+        Quantity::MosTemp => f.mos_temp().celsius().unwrap_or(f32::NAN),
+        Quantity::CapTemp => f.cap_temp().celsius().unwrap_or(f32::NAN),
     }
 }
 
@@ -80,6 +95,8 @@ fn frame_with(q: Quantity, bits: u16) -> DataFrame {
         Quantity::Voltage => f.voltage_raw = bits,
         Quantity::Current => f.current_raw = bits as i16,
         Quantity::PhaseCurrent => f.phase_current_raw = bits as i16,
+        Quantity::MosTemp => f.mos_adc = bits as u8,
+        Quantity::CapTemp => f.cap_adc = bits as u8,
     }
     f
 }
@@ -87,14 +104,14 @@ fn frame_with(q: Quantity, bits: u16) -> DataFrame {
 #[test]
 fn every_raw_value_converts_bit_for_bit_as_before() {
     for s in settings() {
-        for q in Quantity::ALL {
-            let linear = q.linear(&s);
+        for q in LINEAR {
             for bits in 0..=u16::MAX {
                 let f = frame_with(q, bits);
-                let raw = f.raw(q);
+                let reading = f.reading(q, &s).unwrap();
+                let (raw, linear) = (reading.raw, reading.conversion.linear().unwrap());
                 let old = old_f32(q, raw, &s).to_bits();
                 assert_eq!(method(&f, q, &s).to_bits(), old, "{q:?} {raw} {s:?}");
-                assert_eq!(f.value(q, &s).to_bits(), old, "{q:?} {raw} {s:?}");
+                assert_eq!(f.value(q, &s).unwrap().to_bits(), old, "{q:?} {raw} {s:?}");
                 assert_eq!(linear.to_f32(raw as f32).to_bits(), old, "{q:?} {raw}");
                 // A raw minimum or maximum, and means that are not whole numbers.
                 for x in [f64::from(raw), f64::from(raw) + 0.5, f64::from(raw) / 3.0] {
@@ -143,7 +160,43 @@ fn names_and_units_are_the_record_schema() {
             ("voltage_v", "V"),
             ("current_a", "A"),
             ("phase_current_a", "A"),
+            ("mos_temp_c", "degC"),
+            ("cap_temp_c", "degC"),
         ]
+    );
+}
+
+/// The temperatures of an HW-FOC frame are ADC codes read through the table: every code gives
+/// the table's temperature, and no value outside the table.
+#[test]
+fn every_temperature_code_reads_through_the_table() {
+    let s = Settings::default();
+    for q in [Quantity::MosTemp, Quantity::CapTemp] {
+        for code in 0..=u8::MAX {
+            let f = frame_with(q, code.into());
+            let reading = f.reading(q, &s).unwrap();
+            assert_eq!(reading.raw, i32::from(code));
+            assert_eq!(reading.conversion.linear(), None);
+            let expected = Temperature::from_adc(code).celsius();
+            assert_eq!(
+                reading.value().map(f32::to_bits),
+                expected.map(f32::to_bits),
+                "{code}"
+            );
+            assert_eq!(
+                method(&f, q, &s).to_bits(),
+                expected.unwrap_or(f32::NAN).to_bits()
+            );
+        }
+    }
+    // Points the table documents: code 206 is 28 degC; 250 is below the table.
+    assert_eq!(
+        frame_with(Quantity::MosTemp, 206).value(Quantity::MosTemp, &s),
+        Some(28.0)
+    );
+    assert_eq!(
+        frame_with(Quantity::CapTemp, 250).value(Quantity::CapTemp, &s),
+        None
     );
 }
 
@@ -163,16 +216,17 @@ fn every_raw_value_is_representable_at_the_bounds() {
         for ratio in ratios {
             for poles in [1, 2, 7, 1000, 65_535] {
                 let s = Settings::new(scale, poles, ratio).unwrap();
-                for q in Quantity::ALL {
+                for q in LINEAR {
                     for bits in 0..=u16::MAX {
                         let f = frame_with(q, bits);
-                        let raw = f.raw(q);
-                        let value = f.value(q, &s);
+                        let reading = f.reading(q, &s).unwrap();
+                        let raw = reading.raw;
+                        let value = reading.value().unwrap();
                         assert!(
                             representable(value, raw.into()),
                             "{q:?} {raw} {s:?}: {value}"
                         );
-                        let wide = q.linear(&s).to_f64(raw.into());
+                        let wide = reading.conversion.linear().unwrap().to_f64(raw.into());
                         assert!(
                             wide.is_finite() && (raw == 0) == (wide == 0.0),
                             "{q:?} {raw}"

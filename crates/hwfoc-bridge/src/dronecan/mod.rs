@@ -63,6 +63,7 @@ pub mod transport;
 use std::io::{self, Read, Write};
 use std::time::{Duration, Instant};
 
+use hwfoc::Telemetry;
 use serialport::SerialPort;
 
 use crate::output::{Output, OutputError, OutputStats, SILENT_AFTER, Update};
@@ -474,7 +475,7 @@ impl Output for DronecanOutput {
             output_pct: percent(r.throttle_out_pct),
             motor_temperature_deg_c: 0,
             motor_angle: 0,
-            status_flags: u32::from(update.frame.status.0),
+            status_flags: u32::from(update.frame.status().unwrap_or_default().0),
             esc_index: update.esc,
         };
         if esc

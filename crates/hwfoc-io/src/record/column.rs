@@ -2,7 +2,8 @@
 //! the columns ([`Visitor`]), and the `columns!` macro that turns the table of
 //! [`columns`](super::columns) into all of these.
 
-use hwfoc::{DataFrame, Settings, Status};
+use hwfoc::telemetry::Data;
+use hwfoc::{Settings, Status};
 
 use super::Record;
 use super::text::TextValue;
@@ -33,15 +34,16 @@ pub trait Column: 'static {
     type Value: Value;
 
     /// The value of a data frame received at `t_s` from ESC `esc`, under `settings`.
-    fn from_frame(t_s: Option<f64>, esc: u8, frame: &DataFrame, settings: &Settings)
-    -> Self::Value;
+    fn from_frame(t_s: Option<f64>, esc: u8, frame: &Data, settings: &Settings) -> Self::Value;
 
     /// The value in a record (a field of [`Record`], or derived from one).
     fn from_record(record: &Record) -> Self::Value;
 
     /// The raw integer of `frame` that the value is computed from, under fixed settings (the
-    /// text cache's key; meaningful only where [`Column::TEXT_CACHED`]).
-    fn text_key(frame: &DataFrame) -> u32;
+    /// text cache's key; meaningful only where [`Column::TEXT_CACHED`]). The key is the raw
+    /// integer alone: every supported protocol that carries the column's quantity converts it
+    /// alike under given settings (a protocol that converts one otherwise must key on it too).
+    fn text_key(frame: &Data) -> u32;
 }
 
 /// A type a column's values may have: `f32`, `Option<f32>`, `Option<f64>`, `u8`, `u16`, `u32`,
@@ -127,7 +129,7 @@ macro_rules! columns {
                 fn from_frame(
                     $t: Option<f64>,
                     $e: u8,
-                    $f: &hwfoc::DataFrame,
+                    $f: &hwfoc::telemetry::Data,
                     $s: &hwfoc::Settings,
                 ) -> $value {
                     $from
@@ -139,7 +141,7 @@ macro_rules! columns {
                 }
 
                 #[inline(always)]
-                fn text_key(frame: &hwfoc::DataFrame) -> u32 {
+                fn text_key(frame: &hwfoc::telemetry::Data) -> u32 {
                     columns!(@key frame $(, |$kf| $key)?)
                 }
             }
@@ -179,7 +181,7 @@ macro_rules! columns {
     }};
     (@key $frame:ident, |$kf:pat_param| $key:expr) => {{
         let $kf = $frame;
-        u32::from($key)
+        $key
     }};
 
     // The record's fields and their values from a frame, gathered entry by entry: a column
@@ -199,7 +201,7 @@ macro_rules! columns {
             pub fn new(
                 $t: Option<f64>,
                 $e: u8,
-                $f: &hwfoc::DataFrame,
+                $f: &hwfoc::telemetry::Data,
                 $s: &hwfoc::Settings,
             ) -> Record {
                 Record {

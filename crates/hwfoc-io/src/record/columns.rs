@@ -26,9 +26,23 @@
 //! command's golden outputs (`crates/hwfoc-cli/tests/golden/`, the lines written out in
 //! `tests/cli.rs`) and the column list of `tests/pyarrow_check.py` follow it.
 
-use hwfoc::Status;
+use hwfoc::telemetry::{Data, Telemetry};
+use hwfoc::{Quantity, Settings, Status};
 
 use super::FaultList;
+
+/// The value of `quantity`, a quantity of a column that is never null: every supported protocol
+/// carries it (`every_protocol_carries_the_columns_that_are_never_null` in `record/mod.rs`).
+#[inline(always)]
+fn carried(frame: &Data, quantity: Quantity, settings: &Settings) -> f32 {
+    frame.value(quantity, settings).unwrap_or(f32::NAN)
+}
+
+/// The raw integer of `quantity` (the text cache's key; 0 where it is not carried).
+#[inline(always)]
+fn raw(frame: &Data, quantity: Quantity) -> u32 {
+    frame.raw(quantity).map_or(0, |raw| raw as u32)
+}
 
 columns! {
     /// Receive time of the frame's first byte, in seconds: the source's own clock where it has
@@ -38,37 +52,37 @@ columns! {
     /// Which ESC: the index of the input port or stream the frame came from (0-based).
     esc: u8, "-", |_, esc, _, _| esc;
     /// Packet number from the frame.
-    packet: u16, "-", |_, _, f, _| f.packet;
+    packet: u16, "-", |_, _, f, _| f.packet().unwrap_or(0);
     /// Input throttle, %: raw * 100 / 1024.
-    throttle_in_pct: f32, "%", |_, _, f, _| f.throttle_in_pct(),
-        text key |f| f.throttle_in_raw;
+    throttle_in_pct: f32, "%", |_, _, f, s| carried(f, Quantity::ThrottleIn, s),
+        text key |f| raw(f, Quantity::ThrottleIn);
     /// Output throttle, %: raw * 100 / 1024.
-    throttle_out_pct: f32, "%", |_, _, f, _| f.throttle_out_pct(),
-        text key |f| f.throttle_out_raw;
+    throttle_out_pct: f32, "%", |_, _, f, s| carried(f, Quantity::ThrottleOut, s),
+        text key |f| raw(f, Quantity::ThrottleOut);
     /// Electrical RPM: raw * 10.
-    erpm: u32, "rev/min", |_, _, f, _| f.erpm();
+    erpm: u32, "rev/min", |_, _, f, s| carried(f, Quantity::Erpm, s) as u32;
     /// Motor (or geared output) RPM under the settings: raw * 10 / (gear ratio * pole pairs).
-    rpm: f32, "rev/min", |_, _, f, s| f.rpm(s),
-        text key |f| f.erpm_raw;
+    rpm: f32, "rev/min", |_, _, f, s| carried(f, Quantity::Rpm, s),
+        text key |f| raw(f, Quantity::Rpm);
     /// Input voltage, V: raw / 10.
-    voltage_v: f32, "V", |_, _, f, _| f.voltage_v(),
-        text key |f| f.voltage_raw;
+    voltage_v: f32, "V", |_, _, f, s| carried(f, Quantity::Voltage, s),
+        text key |f| raw(f, Quantity::Voltage);
     /// Input current, A: raw (signed) / current scale; negative while braking regeneratively.
-    current_a: f32, "A", |_, _, f, s| f.current_a(s),
-        text key |f| f.current_raw as u16;
+    current_a: f32, "A", |_, _, f, s| carried(f, Quantity::Current, s),
+        text key |f| raw(f, Quantity::Current);
     /// Phase current, A: raw (signed) / current scale.
-    phase_current_a: f32, "A", |_, _, f, s| f.phase_current_a(s),
-        text key |f| f.phase_current_raw as u16;
+    phase_current_a: f32, "A", |_, _, f, s| carried(f, Quantity::PhaseCurrent, s),
+        text key |f| raw(f, Quantity::PhaseCurrent);
     /// MOSFET temperature, degC, from the ADC table; null when out of the table's range.
-    mos_temp_c: Option<f32>, "degC", |_, _, f, _| f.mos_temp().celsius(),
-        text key |f| f.mos_adc;
+    mos_temp_c: Option<f32>, "degC", |_, _, f, s| f.value(Quantity::MosTemp, s),
+        text key |f| raw(f, Quantity::MosTemp);
     /// Capacitor temperature, degC, from the ADC table; null when out of the table's range.
-    cap_temp_c: Option<f32>, "degC", |_, _, f, _| f.cap_temp().celsius(),
-        text key |f| f.cap_adc;
+    cap_temp_c: Option<f32>, "degC", |_, _, f, s| f.value(Quantity::CapTemp, s),
+        text key |f| raw(f, Quantity::CapTemp);
     /// The raw status word (an unsigned 16-bit integer).
-    status: Status, "-", |_, _, f, _| f.status;
+    status: Status, "-", |_, _, f, _| f.status().unwrap_or(Status(0));
     /// Names of the set status bits, in bit order (from `docs/PROTOCOL-NOTES.md`); derived from
     /// `status`, not a field of the record.
-    faults: FaultList, "-", |_, _, f, _| FaultList(f.status),
+    faults: FaultList, "-", |_, _, f, _| FaultList(f.status().unwrap_or(Status(0))),
         record |r| FaultList(r.status);
 }

@@ -56,7 +56,12 @@ mod tests {
         }
         impl Visitor for Check<'_> {
             fn column<C: Column>(&mut self) {
-                let from_frame = C::from_frame(self.t, self.esc, self.frame, self.settings);
+                let from_frame = C::from_frame(
+                    self.t,
+                    self.esc,
+                    &hwfoc::telemetry::Data::from(*self.frame),
+                    self.settings,
+                );
                 // NaN never occurs in a record: equality is the right test.
                 assert_eq!(C::from_record(&self.record), from_frame, "{}", C::NAME);
             }
@@ -76,7 +81,7 @@ mod tests {
                 status: Status(status),
             };
             let t = [Some(1.5), None, Some(1.7e9)][i];
-            let record = Record::new(t, i as u8, &frame, &settings);
+            let record = Record::new(t, i as u8, &hwfoc::telemetry::Data::from(frame), &settings);
             columns::visit(&mut Check {
                 t,
                 esc: i as u8,
@@ -84,6 +89,61 @@ mod tests {
                 settings: &settings,
                 record,
             });
+        }
+    }
+
+    /// A column that is never null (the schema's non-nullable columns) holds a quantity every
+    /// supported protocol carries: for one frame of each protocol, each such column's quantity
+    /// is carried and has a value (a frame without it would have no true value to write). A
+    /// new protocol is a new arm of `Data`: the `match` below does not compile until it has a
+    /// sample here.
+    #[test]
+    fn every_protocol_carries_the_columns_that_are_never_null() {
+        use hwfoc::Quantity;
+        use hwfoc::telemetry::{Data, Telemetry};
+
+        struct NonNull(Vec<&'static str>);
+        impl Visitor for NonNull {
+            fn column<C: Column>(&mut self) {
+                if !C::NULLABLE {
+                    self.0.push(C::NAME);
+                }
+            }
+        }
+        let mut non_null = NonNull(Vec::new());
+        columns::visit(&mut non_null);
+        // Written out: the schema's table (docs/RECORD-SCHEMA.md) as it stands.
+        assert_eq!(
+            non_null.0,
+            [
+                "esc",
+                "packet",
+                "throttle_in_pct",
+                "throttle_out_pct",
+                "erpm",
+                "rpm",
+                "voltage_v",
+                "current_a",
+                "phase_current_a",
+                "status",
+                "faults"
+            ]
+        );
+        let samples = [Data::from(DataFrame {
+            mos_adc: 250,
+            ..DataFrame::default()
+        })];
+        for sample in samples {
+            match sample {
+                Data::HwFoc(_) => {}
+            }
+            let s = Settings::default();
+            for q in Quantity::ALL {
+                if non_null.0.contains(&q.name()) {
+                    assert!(sample.value(q, &s).is_some(), "{sample:?} {q:?}");
+                }
+            }
+            assert!(sample.packet().is_some() && sample.status().is_some());
         }
     }
 

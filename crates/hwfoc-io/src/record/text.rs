@@ -7,7 +7,8 @@
 
 use std::marker::PhantomData;
 
-use hwfoc::{DataFrame, Fault, Status};
+use hwfoc::telemetry::Data;
+use hwfoc::{Fault, Status};
 
 use super::Record;
 use super::column::{Column, FaultList, Visitor};
@@ -208,7 +209,7 @@ struct Row<'a, F> {
     e: &'a mut TextEncoder,
     record: &'a Record,
     /// The frame the record was converted from, for the caches' keys.
-    frame: Option<&'a DataFrame>,
+    frame: Option<&'a Data>,
     format: PhantomData<F>,
 }
 
@@ -269,7 +270,7 @@ impl TextEncoder {
     /// Appends `r`, the record of `frame`, as [`TextEncoder::json`] does; a cached encoder
     /// takes the text of numbers from its caches. Every record given to one cached encoder
     /// must be converted under the same settings.
-    pub fn json_frame(&mut self, r: &Record, frame: &DataFrame, out: &mut Vec<u8>) {
+    pub fn json_frame(&mut self, r: &Record, frame: &Data, out: &mut Vec<u8>) {
         self.row::<Json>(r, Some(frame), out);
     }
 
@@ -281,14 +282,14 @@ impl TextEncoder {
 
     /// Appends `r`, the record of `frame`, as [`TextEncoder::csv`] does. A cached encoder takes
     /// the text of numbers from its caches, as [`TextEncoder::json_frame`] does.
-    pub fn csv_frame(&mut self, r: &Record, frame: &DataFrame, out: &mut Vec<u8>) {
+    pub fn csv_frame(&mut self, r: &Record, frame: &Data, out: &mut Vec<u8>) {
         self.row::<Csv>(r, Some(frame), out);
     }
 
     /// Assembles the row of `r` in format `F` and appends it to `out`. Inlined into each
     /// caller, so that whether there is a frame (cache keys) is known at compile time.
     #[inline(always)]
-    fn row<F: Format>(&mut self, r: &Record, frame: Option<&DataFrame>, out: &mut Vec<u8>) {
+    fn row<F: Format>(&mut self, r: &Record, frame: Option<&Data>, out: &mut Vec<u8>) {
         self.pos = 0;
         columns::visit(&mut Row::<F> {
             e: self,
@@ -375,6 +376,7 @@ impl TextEncoder {
 mod tests {
     use super::*;
     use crate::record::COLUMNS;
+    use hwfoc::DataFrame;
     use hwfoc::Settings;
 
     /// The longest row of the table fits the row buffer, fixed-size copies included.
@@ -409,7 +411,12 @@ mod tests {
             status: Status(0x0041),
             ..Default::default()
         };
-        let record = Record::new(None, 2, &frame, &Settings::default());
+        let record = Record::new(
+            None,
+            2,
+            &hwfoc::telemetry::Data::from(frame),
+            &Settings::default(),
+        );
         let mut json = Vec::new();
         record.write_json(&mut json);
         let v: serde_json::Value = serde_json::from_slice(&json).unwrap();
@@ -426,7 +433,7 @@ mod tests {
 
         let mut csv = Vec::new();
         Record::write_csv_header(&mut csv);
-        TextEncoder::new().csv_frame(&record, &frame, &mut csv);
+        TextEncoder::new().csv_frame(&record, &hwfoc::telemetry::Data::from(frame), &mut csv);
         let csv = String::from_utf8(csv).unwrap();
         let lines: Vec<&str> = csv.lines().collect();
         assert_eq!(lines.len(), 2);
@@ -485,16 +492,21 @@ mod tests {
                 status: Status(if i % 7 == 0 { word(4) } else { 0 }),
             };
             let t = (i % 5 != 0).then_some(f64::from(i) * 0.05 + 1.7e9);
-            let record = Record::new(t, (i % 4) as u8, &frame, &settings);
+            let record = Record::new(
+                t,
+                (i % 4) as u8,
+                &hwfoc::telemetry::Data::from(frame),
+                &settings,
+            );
             a.clear();
             b.clear();
-            cached.json_frame(&record, &frame, &mut a);
+            cached.json_frame(&record, &hwfoc::telemetry::Data::from(frame), &mut a);
             plain.json(&record, &mut b);
             assert_eq!(a, b);
             a.clear();
             b.clear();
-            cached.csv_frame(&record, &frame, &mut a);
-            plain.csv_frame(&record, &frame, &mut b);
+            cached.csv_frame(&record, &hwfoc::telemetry::Data::from(frame), &mut a);
+            plain.csv_frame(&record, &hwfoc::telemetry::Data::from(frame), &mut b);
             assert_eq!(a, b);
             if i % 1000 == 0 {
                 // The text reads back to the record's values, as serde_json reads it.

@@ -13,7 +13,8 @@ use arrow_array::builder::OffsetBufferBuilder;
 use arrow_array::types::{Float32Type, Float64Type, UInt8Type, UInt16Type, UInt32Type};
 use arrow_array::{ArrayRef, ListArray, PrimitiveArray, RecordBatch, StringArray};
 use arrow_schema::{DataType, Field, FieldRef, Schema, SchemaRef};
-use hwfoc::{DataFrame, Settings, Status};
+use hwfoc::telemetry::Data;
+use hwfoc::{Settings, Status};
 
 use crate::record::{Column, FaultList, Record, Visitor, columns};
 
@@ -177,7 +178,7 @@ fn batch(schema: SchemaRef, records: &[Record]) -> RecordBatch {
 ///
 /// let mut builder = RecordBatchBuilder::new();
 /// let frame = DataFrame { packet: 1, voltage_raw: 247, ..Default::default() };
-/// builder.push_frame(Some(0.5), 0, &frame, &Settings::default());
+/// builder.push_frame(Some(0.5), 0, &frame.into(), &Settings::default());
 /// let batch = builder.finish();
 /// assert_eq!(batch.num_rows(), 1);
 /// assert_eq!(batch.schema().field(0).name(), "t_s");
@@ -216,13 +217,7 @@ impl RecordBatchBuilder {
 
     /// Adds the record of a data frame received at `t_s` (if the source has timing) from ESC
     /// `esc`, converted under `settings`.
-    pub fn push_frame(
-        &mut self,
-        t_s: Option<f64>,
-        esc: u8,
-        frame: &DataFrame,
-        settings: &Settings,
-    ) {
+    pub fn push_frame(&mut self, t_s: Option<f64>, esc: u8, frame: &Data, settings: &Settings) {
         self.records.push(Record::new(t_s, esc, frame, settings));
     }
 

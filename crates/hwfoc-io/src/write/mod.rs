@@ -38,7 +38,8 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc::{Receiver, SyncSender, sync_channel};
 use std::thread::JoinHandle;
 
-use hwfoc::{DataFrame, Decoded, Frame, Settings};
+use hwfoc::Settings;
+use hwfoc::telemetry::{Data, Frame};
 
 use crate::handler::Handler;
 use crate::input::InputError;
@@ -96,7 +97,7 @@ pub struct Chunk {
     /// ESC index of each frame.
     pub esc: Vec<u8>,
     /// The frames.
-    pub frames: Vec<DataFrame>,
+    pub frames: Vec<Data>,
     /// Whether the writer should push everything to the operating system after this chunk
     /// (live input: records appear as frames arrive).
     pub flush: bool,
@@ -390,7 +391,7 @@ impl Export {
 
     /// Adds a record: a data frame, its ESC and its receive time.
     #[inline]
-    pub fn push(&mut self, esc: u8, t: Option<f64>, frame: &DataFrame) {
+    pub fn push(&mut self, esc: u8, t: Option<f64>, frame: &Data) {
         self.chunk.t.push(t.unwrap_or(f64::NAN));
         self.chunk.esc.push(esc);
         self.chunk.frames.push(*frame);
@@ -513,8 +514,8 @@ impl Handler for Export {
     type Error = ExportError;
 
     #[inline]
-    fn frame(&mut self, esc: u8, t: Option<f64>, decoded: &Decoded, settings: &Settings) {
-        if let Frame::Data(frame) = decoded.frame {
+    fn frame(&mut self, esc: u8, t: Option<f64>, frame: &Frame, settings: &Settings) {
+        if let Frame::Data(frame) = *frame {
             // The first frame of any ESC resolves a window given after the first frame.
             self.selection.window.observe(t);
             let state = self.escs[usize::from(esc)];
@@ -829,6 +830,7 @@ mod tests {
     use crate::input::Input;
     use crate::settings::SettingsMap;
     use crate::sources::Sources;
+    use hwfoc::DataFrame;
     use std::path::PathBuf;
 
     /// Ports named `p0`, `p1`, ...: frames of raw eRPM 70 (700 eRPM) and raw current 819 each.

@@ -8,7 +8,8 @@
 
 use std::sync::mpsc::{Receiver, SyncSender, sync_channel};
 
-use hwfoc::{DataFrame, Settings};
+use hwfoc::Settings;
+use hwfoc::telemetry::Data;
 
 use crate::record::{Record, TextEncoder};
 
@@ -126,13 +127,7 @@ pub(super) fn write(
 
 /// Appends the text of `record`, the record of `frame`, as CSV (`csv`) or JSON.
 #[inline(always)]
-fn encode(
-    encoder: &mut TextEncoder,
-    csv: bool,
-    record: &Record,
-    frame: &DataFrame,
-    out: &mut Vec<u8>,
-) {
+fn encode(encoder: &mut TextEncoder, csv: bool, record: &Record, frame: &Data, out: &mut Vec<u8>) {
     if csv {
         encoder.csv_frame(record, frame, out);
     } else {

@@ -10,7 +10,7 @@
 //! CRC-16/MODBUS, the sum does).
 
 use crate::status::Status;
-use crate::units::{ERPM_PER_RAW, Linear, Quantity, Settings, Temperature};
+use crate::units::{ERPM_PER_RAW, Linear, Settings, Temperature};
 use crate::wire::{Checksum, FrameError, FrameKind, VERSION, sealed, sum16};
 
 /// Command byte of a real-time data frame.
@@ -215,25 +215,6 @@ impl DataFrame {
     /// Phase current in amperes (raw / current scale).
     pub fn phase_current_a(&self, settings: &Settings) -> f32 {
         settings.amps(self.phase_current_raw)
-    }
-
-    /// The raw field that `quantity` is converted from (for statistics of raw values, converted
-    /// once with [`Linear::to_f64`]).
-    pub fn raw(&self, quantity: Quantity) -> i32 {
-        match quantity {
-            Quantity::ThrottleIn => i32::from(self.throttle_in_raw),
-            Quantity::ThrottleOut => i32::from(self.throttle_out_raw),
-            Quantity::Erpm | Quantity::Rpm => i32::from(self.erpm_raw),
-            Quantity::Voltage => i32::from(self.voltage_raw),
-            Quantity::Current => i32::from(self.current_raw),
-            Quantity::PhaseCurrent => i32::from(self.phase_current_raw),
-        }
-    }
-
-    /// `quantity` in its unit under `settings`: the same value as the method of that name
-    /// (`throttle_in_pct`, `rpm`, ...; eRPM as an `f32`, exact).
-    pub fn value(&self, quantity: Quantity, settings: &Settings) -> f32 {
-        quantity.linear(settings).to_f32(self.raw(quantity) as f32)
     }
 
     /// MOSFET temperature from the ADC table.

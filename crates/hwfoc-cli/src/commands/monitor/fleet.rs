@@ -4,7 +4,8 @@
 
 use std::collections::{HashMap, VecDeque};
 
-use hwfoc::{Fault, InfoFrame, Settings};
+use hwfoc::telemetry::Info;
+use hwfoc::{Fault, Settings};
 use hwfoc_io::stream::{EscLink, WireKind};
 
 use super::alarms::{Change, Kind, Latch, Level, Threshold};
@@ -89,7 +90,7 @@ struct Received(Vec<Item>);
 
 enum Item {
     Record(Record),
-    Info(Option<f64>, InfoFrame),
+    Info(Option<f64>, Info),
 }
 
 impl Handler for Received {
@@ -99,7 +100,7 @@ impl Handler for Received {
         self.0.push(Item::Record(*record));
     }
 
-    fn info(&mut self, _: u8, t: Option<f64>, info: &InfoFrame) {
+    fn info(&mut self, _: u8, t: Option<f64>, info: &Info) {
         self.0.push(Item::Info(t, *info));
     }
 }
@@ -189,7 +190,7 @@ pub struct EscView {
     /// The last minute.
     pub history: VecDeque<Sample>,
     /// The latest device-information frame.
-    pub info: Option<InfoFrame>,
+    pub info: Option<Info>,
     /// Link statistics of its decoder.
     pub stats: EscLink,
     /// Battery cells: configured, or detected from the first voltage.

@@ -19,7 +19,8 @@
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 
-use hwfoc::{InfoFrame, Settings, Status};
+use hwfoc::telemetry::Info;
+use hwfoc::{Settings, Status};
 
 use crate::error::CliError;
 use hwfoc_io::clock::Step;
@@ -274,7 +275,7 @@ pub struct EscData {
     /// Clock value of its first and last plotted frame.
     pub clock: Option<(f64, f64)>,
     /// Its first device-information frame.
-    pub info: Option<InfoFrame>,
+    pub info: Option<Info>,
     /// Its plotted frames.
     pub buckets: Buckets,
     /// Its fault spans, in time order.
@@ -367,7 +368,7 @@ impl EscData {
         let mark = Mark {
             t: t.map(|_| c),
             frame: index,
-            packet: r.packet,
+            packet: Some(r.packet),
         };
         if let Some(ended) = Episode::track(&mut self.open, mark, r.status) {
             self.keep(&ended);
@@ -505,7 +506,7 @@ impl Handler for Collector {
         }
     }
 
-    fn info(&mut self, esc: u8, _: Option<f64>, info: &InfoFrame) {
+    fn info(&mut self, esc: u8, _: Option<f64>, info: &Info) {
         if let Some(esc) = esc_data(&mut self.escs, self.buckets, &self.selection, esc) {
             esc.info.get_or_insert(*info);
         }
@@ -556,7 +557,7 @@ mod tests {
             status: Status(status),
             ..Default::default()
         };
-        Record::new(Some(t), 0, &f, &Settings::DEFAULT)
+        Record::new(Some(t), 0, &f.into(), &Settings::DEFAULT)
     }
 
     /// Every quantity at the value of a throttle of `raw` (temperatures 79.0 degC).
@@ -611,7 +612,7 @@ mod tests {
             ..Default::default()
         };
         let mut b = Bucket::EMPTY;
-        b.add(&values(&Record::new(None, 0, &f, &s)), false);
+        b.add(&values(&Record::new(None, 0, &f.into(), &s)), false);
         let v = |q| b.values(q).unwrap()[0];
         assert_eq!(v(Quantity::ThrottleIn), f64::from(f.throttle_in_pct()));
         assert_eq!(v(Quantity::ThrottleOut), f64::from(f.throttle_out_pct()));
@@ -638,7 +639,7 @@ mod tests {
                 mos_adc: mos,
                 ..Default::default()
             };
-            values(&Record::new(None, 0, &f, &Settings::DEFAULT))
+            values(&Record::new(None, 0, &f.into(), &Settings::DEFAULT))
         };
         b.add(&with(250), false); // below range: no value
         assert_eq!(b.values(Quantity::MosTemp), None);

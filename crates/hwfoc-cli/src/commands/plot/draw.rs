@@ -1016,7 +1016,7 @@ mod tests {
             super::super::collect::values(&hwfoc_io::record::Record::new(
                 None,
                 0,
-                &f,
+                &f.into(),
                 &hwfoc::Settings::DEFAULT,
             ))
         };

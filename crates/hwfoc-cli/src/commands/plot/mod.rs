@@ -15,7 +15,8 @@ mod text;
 use std::sync::Arc;
 use std::sync::atomic::AtomicBool;
 
-use hwfoc::{InfoFrame, Settings};
+use hwfoc::Settings;
+use hwfoc::telemetry::Info;
 
 use crate::args::{InputArgs, SelectArgs, SettingsArgs};
 use crate::error::CliError;
@@ -153,7 +154,7 @@ impl Handler for Alongside {
         self.collector.record(r);
     }
 
-    fn info(&mut self, esc: u8, t: Option<f64>, info: &InfoFrame) {
+    fn info(&mut self, esc: u8, t: Option<f64>, info: &Info) {
         self.collector.info(esc, t, info);
     }
 

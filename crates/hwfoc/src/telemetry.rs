@@ -1,0 +1,279 @@
+//! The protocol-neutral reading of a frame: what every layer above the codec works through.
+//!
+//! Each protocol's data frame implements [`Telemetry`]: for every [`Quantity`] it says whether
+//! the frame carries it and, if so, its raw integer as sent and the exact [`Conversion`] of that
+//! integer to the quantity's unit (`docs/RECORD-SCHEMA.md`). Statistics are kept on the raw
+//! integers and converted once (exact means); records convert each value.
+//!
+//! [`Data`] is a data frame of any supported protocol and [`Info`] a device-information frame of
+//! any, each an enum with one arm per protocol; [`Frame`] is either, as decoders hand them to the
+//! layers above. A new protocol adds its arm to each (the compiler names every `match` that
+//! must learn it; none exists outside this module).
+//!
+//! ```
+//! use hwfoc::telemetry::{Data, Telemetry};
+//! use hwfoc::{Quantity, Settings};
+//!
+//! let bytes = [0x9B, 0x16, 0x01, 0x02, 0x05, 0xC2, 0, 0, 0, 0, 0, 0, 0x00, 0xF7,
+//!              0xFF, 0xFF, 0xFF, 0xFF, 0xCE, 0xD1, 0x00, 0x00, 0x0D, 0x08];
+//! let data = Data::from(hwfoc::DataFrame::parse(&bytes)?);
+//! let s = Settings::default();
+//! assert_eq!(data.packet(), Some(1474));
+//! assert_eq!(data.value(Quantity::Voltage, &s), Some(24.7));
+//! assert_eq!(data.reading(Quantity::Current, &s).map(|r| r.raw), Some(-1));
+//! assert_eq!(data.value(Quantity::MosTemp, &s), Some(28.0));
+//! # Ok::<(), hwfoc::FrameError>(())
+//! ```
+
+use crate::kinds::data::DataFrame;
+use crate::kinds::info::InfoFrame;
+use crate::status::Status;
+use crate::units::{Linear, Quantity, Settings, Temperature};
+
+/// How a quantity's raw integer becomes its value in the quantity's unit.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Conversion {
+    /// `raw * mul / (div * div2)` ([`Linear`]): every value is defined.
+    Linear(Linear),
+    /// An ADC code of the ESC's NTC thermistor, through the table of [`Temperature::from_adc`]:
+    /// degC inside the table, no value outside it.
+    AdcTable,
+}
+
+impl Conversion {
+    /// The value of `raw` as an `f32`, or `None` where the conversion has none (a temperature
+    /// code outside its table).
+    #[inline]
+    pub fn to_f32(self, raw: i32) -> Option<f32> {
+        match self {
+            Conversion::Linear(linear) => Some(linear.to_f32(raw as f32)),
+            Conversion::AdcTable => u8::try_from(raw)
+                .ok()
+                .and_then(|code| Temperature::from_adc(code).celsius()),
+        }
+    }
+
+    /// The linear conversion, if this is one (what statistics of raw values, such as a mean,
+    /// convert through: [`Linear::to_f64`]).
+    #[inline]
+    pub fn linear(self) -> Option<Linear> {
+        match self {
+            Conversion::Linear(linear) => Some(linear),
+            Conversion::AdcTable => None,
+        }
+    }
+}
+
+/// A quantity as a frame carries it: the raw integer sent, and its conversion.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Reading {
+    /// The integer on the wire (sign-extended where the field is signed).
+    pub raw: i32,
+    /// How `raw` becomes the quantity's value.
+    pub conversion: Conversion,
+}
+
+impl Reading {
+    /// The value in the quantity's unit, or `None` where the conversion has none.
+    #[inline]
+    pub fn value(self) -> Option<f32> {
+        self.conversion.to_f32(self.raw)
+    }
+}
+
+/// The protocol-neutral reading of a data frame: which quantities it carries, as sent and
+/// converted. Implemented by every protocol's data frame, and by [`Data`].
+pub trait Telemetry {
+    /// The frame's packet counter, where the protocol sends one.
+    fn packet(&self) -> Option<u16>;
+
+    /// The frame's status word (sixteen fault bits, [`Status`]), where the protocol sends one.
+    fn status(&self) -> Option<Status>;
+
+    /// `quantity` as this frame carries it under `settings` (which only conversions that depend
+    /// on the user's setup read: pole pairs, gear ratio, current scale), or `None` when the
+    /// frame's protocol does not carry it.
+    fn reading(&self, quantity: Quantity, settings: &Settings) -> Option<Reading>;
+
+    /// The raw integer of `quantity`, or `None` when the frame's protocol does not carry it. The
+    /// integer is what was sent: it does not depend on the settings (only its conversion may).
+    #[inline(always)]
+    fn raw(&self, quantity: Quantity) -> Option<i32> {
+        self.reading(quantity, &Settings::DEFAULT).map(|r| r.raw)
+    }
+
+    /// `quantity` in its unit, or `None` when it is not carried or has no value.
+    #[inline]
+    fn value(&self, quantity: Quantity, settings: &Settings) -> Option<f32> {
+        self.reading(quantity, settings).and_then(Reading::value)
+    }
+}
+
+impl Telemetry for DataFrame {
+    #[inline(always)]
+    fn packet(&self) -> Option<u16> {
+        Some(self.packet)
+    }
+
+    #[inline(always)]
+    fn status(&self) -> Option<Status> {
+        Some(self.status)
+    }
+
+    #[inline(always)]
+    fn reading(&self, quantity: Quantity, settings: &Settings) -> Option<Reading> {
+        let linear = |raw: i32, linear: Linear| Reading {
+            raw,
+            conversion: Conversion::Linear(linear),
+        };
+        let adc = |code: u8| Reading {
+            raw: i32::from(code),
+            conversion: Conversion::AdcTable,
+        };
+        Some(match quantity {
+            Quantity::ThrottleIn => linear(self.throttle_in_raw.into(), Linear::THROTTLE_PCT),
+            Quantity::ThrottleOut => linear(self.throttle_out_raw.into(), Linear::THROTTLE_PCT),
+            Quantity::Erpm => linear(self.erpm_raw.into(), Linear::ERPM),
+            Quantity::Rpm => linear(self.erpm_raw.into(), settings.rpm_linear()),
+            Quantity::Voltage => linear(self.voltage_raw.into(), Linear::VOLTS),
+            Quantity::Current => linear(self.current_raw.into(), settings.amps_linear()),
+            Quantity::PhaseCurrent => linear(self.phase_current_raw.into(), settings.amps_linear()),
+            Quantity::MosTemp => adc(self.mos_adc),
+            Quantity::CapTemp => adc(self.cap_adc),
+        })
+    }
+}
+
+/// Declares an enum with one arm per protocol and its `From` conversions.
+macro_rules! per_protocol {
+    (
+        $(#[$attr:meta])* pub enum $name:ident {
+            $( $(#[$arm_attr:meta])* $arm:ident($inner:ty), )+
+        }
+    ) => {
+        $(#[$attr])*
+        #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+        pub enum $name {
+            $( $(#[$arm_attr])* $arm($inner), )+
+        }
+
+        $(
+            impl From<$inner> for $name {
+                #[inline]
+                fn from(inner: $inner) -> $name {
+                    $name::$arm(inner)
+                }
+            }
+        )+
+    };
+}
+
+per_protocol! {
+    /// A data frame of any supported protocol.
+    pub enum Data {
+        /// An HW-FOC data frame (also a DataLink V2 record, which carries the same payload).
+        HwFoc(DataFrame),
+    }
+}
+
+impl Telemetry for Data {
+    #[inline(always)]
+    fn packet(&self) -> Option<u16> {
+        match self {
+            Data::HwFoc(f) => f.packet(),
+        }
+    }
+
+    #[inline(always)]
+    fn status(&self) -> Option<Status> {
+        match self {
+            Data::HwFoc(f) => Telemetry::status(f),
+        }
+    }
+
+    #[inline(always)]
+    fn reading(&self, quantity: Quantity, settings: &Settings) -> Option<Reading> {
+        match self {
+            Data::HwFoc(f) => f.reading(quantity, settings),
+        }
+    }
+}
+
+impl Data {
+    /// The HW-FOC data frame with this frame's readings: what a DataLink V2 hub record holds
+    /// (the hub forwards HW-FOC payloads), for outputs that speak HW-FOC. An HW-FOC frame is
+    /// itself.
+    #[inline]
+    pub fn to_hwfoc(&self) -> DataFrame {
+        match self {
+            Data::HwFoc(f) => *f,
+        }
+    }
+}
+
+per_protocol! {
+    /// A device-information frame of any supported protocol.
+    pub enum Info {
+        /// An HW-FOC device-information frame.
+        HwFoc(InfoFrame),
+    }
+}
+
+impl Info {
+    /// The product name, e.g. `X6`.
+    pub fn product(&self) -> &str {
+        match self {
+            Info::HwFoc(i) => i.product(),
+        }
+    }
+
+    /// The hardware version.
+    pub fn hardware(&self) -> &str {
+        match self {
+            Info::HwFoc(i) => i.hardware(),
+        }
+    }
+
+    /// The firmware version.
+    pub fn firmware(&self) -> &str {
+        match self {
+            Info::HwFoc(i) => i.firmware(),
+        }
+    }
+
+    /// The device's identifier.
+    pub fn id(&self) -> &str {
+        match self {
+            Info::HwFoc(i) => i.id(),
+        }
+    }
+}
+
+impl core::fmt::Display for Info {
+    /// The device's text as each protocol shows it (HW-FOC: its words joined by single spaces).
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match self {
+            Info::HwFoc(i) => i.fmt(f),
+        }
+    }
+}
+
+/// A frame of any supported protocol as the layers above the codec take it: data, or device
+/// information.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Frame {
+    /// A data frame.
+    Data(Data),
+    /// A device-information frame.
+    Info(Info),
+}
+
+impl From<crate::frame::Frame> for Frame {
+    #[inline(always)]
+    fn from(frame: crate::frame::Frame) -> Frame {
+        match frame {
+            crate::frame::Frame::Data(f) => Frame::Data(Data::HwFoc(f)),
+            crate::frame::Frame::Info(i) => Frame::Info(Info::HwFoc(i)),
+        }
+    }
+}
