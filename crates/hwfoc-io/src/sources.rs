@@ -170,7 +170,11 @@ impl Sources {
     /// out bytes without times.
     pub fn require_timing(&mut self) -> Result<(), InputError> {
         self.need_timing = true;
-        match self.pending.iter().find(|i| i.format() == InputFormat::Raw) {
+        match self
+            .pending
+            .iter()
+            .find(|i| i.format().clock() == Clock::None)
+        {
             Some(raw) => Err(InputError::NoTiming {
                 input: raw.name().to_string(),
             }),
@@ -271,19 +275,17 @@ impl Sources {
         let mut result = Ok(());
         while let Some(first) = inputs.front() {
             let clock = first.format().clock();
-            let merged = first.format() != InputFormat::Serial && clock != Clock::None;
+            let merged = first.format().is_merged_in_time();
             let n = if merged {
                 inputs
                     .iter()
-                    .take_while(|i| {
-                        i.format().clock() == clock && i.format() != InputFormat::Serial
-                    })
+                    .take_while(|i| i.format().is_merged_in_time() && i.format().clock() == clock)
                     .count()
             } else {
                 1
             };
             let run: Vec<Input> = inputs.drain(..n).collect();
-            let more_recordings = inputs.iter().any(|i| i.format() == InputFormat::Recording);
+            let more_recordings = inputs.iter().any(|i| i.format().has_recorded_ports());
             result = if merged {
                 self.read_together(run, more_recordings, handler)
             } else {
@@ -402,7 +404,7 @@ impl Sources {
             return Ok(esc);
         }
         let name = input.stream_name(stream);
-        let recorded = input.format() == InputFormat::Recording;
+        let recorded = input.format().has_recorded_ports();
         let earlier = self
             .ports
             .get(&name)
@@ -455,7 +457,7 @@ impl Sources {
         let base = self.read.len();
         self.numbered.resize(base, Vec::new());
         for (k, input) in inputs.iter().enumerate() {
-            if input.format() == InputFormat::Recording {
+            if input.format().has_recorded_ports() {
                 break;
             }
             let mut escs = Vec::new();
@@ -511,7 +513,7 @@ impl Sources {
         self.number_streams(&input, index, &mut escs);
         // A recorded port's stream may go on in the next recording: it is finished at the
         // end of the run. Other streams end with their input.
-        if input.format() != InputFormat::Recording {
+        if !input.format().has_recorded_ports() {
             for &esc in escs.iter().flatten() {
                 self.finish(esc);
             }
@@ -771,7 +773,7 @@ impl Sources {
                 seconds: o.to - o.from,
             });
         }
-        let recorded = reading.input.format() == InputFormat::Recording;
+        let recorded = reading.input.format().has_recorded_ports();
         for &esc in escs.iter().flatten() {
             if self.readers[esc] == 0 && !(recorded && more_recordings) {
                 self.finish(esc);

@@ -2,10 +2,11 @@
 
 use std::io::Read;
 
-use super::InputError;
+use super::{InputError, InputFormat, Looks, Source};
 use crate::notice::Notice;
 use crate::pcapng;
 use crate::stream::byte_times;
+use crate::time::Clock;
 
 /// A pcapng recording being read.
 ///
@@ -73,11 +74,6 @@ impl RecordingReader {
     /// The interfaces (ports) the recording has declared so far.
     pub(super) fn interfaces(&self) -> &[pcapng::Interface] {
         self.reader.interfaces()
-    }
-
-    /// The interfaces declared so far, the file and buffers let go.
-    pub(super) fn into_interfaces(self) -> Vec<pcapng::Interface> {
-        self.reader.into_interfaces()
     }
 
     /// Hands out the next batch of the current window into `bytes` and `times` (which are
@@ -201,5 +197,62 @@ impl RecordingReader {
                 damage,
             });
         }
+    }
+}
+
+impl InputFormat {
+    /// A pcapng recording: one stream per interface, each the port it names, times from the
+    /// packets' timestamps (Unix seconds).
+    pub const RECORDING: InputFormat = InputFormat {
+        name: "pcapng recording",
+        short_name: "pcapng",
+        clock: Clock::Wall,
+        live: false,
+        recorded_ports: true,
+    };
+}
+
+/// Whether `head`, an input's first bytes (12 of them, or all there are), starts a pcapng
+/// recording: the section header's type, 0A 0D 0D 0A, and its byte-order magic at bytes 8..12.
+pub(super) fn is_start(head: &[u8]) -> bool {
+    head.starts_with(&pcapng::MAGIC)
+        && (head.len() < 12
+            || matches!(
+                head[8..12],
+                [0x4D, 0x3C, 0x2B, 0x1A] | [0x1A, 0x2B, 0x3C, 0x4D]
+            ))
+}
+
+impl Source for RecordingReader {
+    fn format(&self) -> InputFormat {
+        InputFormat::RECORDING
+    }
+
+    fn fill(
+        &mut self,
+        name: &str,
+        bytes: &mut Vec<u8>,
+        times: &mut Vec<f64>,
+        notices: &mut dyn FnMut(Notice),
+    ) -> Result<usize, InputError> {
+        bytes.clear();
+        self.read(name, bytes, times, notices)
+    }
+
+    fn streams(&self) -> usize {
+        self.interfaces().len()
+    }
+
+    fn stream_name(&self, i: usize) -> Option<&str> {
+        self.interfaces().get(i).map(|f| f.name.as_str())
+    }
+
+    fn flagged_bytes(&self) -> u64 {
+        // A recording holds the bytes as read from the port, unflagged.
+        0
+    }
+
+    fn looks(&self) -> Option<Looks> {
+        None
     }
 }
