@@ -12,6 +12,12 @@
 //!
 //! Serial ports are opened with [`Input::open_ports`]: one input with one stream per port,
 //! times being the Unix time each byte was received.
+//!
+//! Each kind of input is a module (`raw.rs`, `csv.rs`, `recording.rs`, `ports.rs`) declaring
+//! its [`InputFormat`] (names, clock, whether live, whether its streams are recorded ports:
+//! what [`crate::sources::Sources`] and the summary ask of a format) and implementing `Source`
+//! (its reading, its streams, its flagged bytes). Standard input and files are read as their
+//! content says.
 
 mod csv;
 mod error;
@@ -51,8 +57,9 @@ const CLASSIC_PCAP: [[u8; 4]; 4] = [
 
 /// The format of an input, with what follows from it: its names, its clock, whether it is live,
 /// and how its streams are numbered. Each input kind's module declares its own (`raw.rs`,
-/// `csv.rs`, `recording.rs`, `ports.rs`), and its reader implements [`Source`]: adding an
-/// input format is a module declaring both, and its line in [`Input::from_reader`].
+/// `csv.rs`, `recording.rs`, `ports.rs`), and its reader implements the module's `Source`
+/// trait: adding an input format is a module declaring both, and its line in
+/// [`Input::from_reader`].
 ///
 /// Two formats are equal when their short names are.
 #[derive(Debug, Clone, Copy)]

@@ -76,49 +76,6 @@ impl RecordingReader {
         self.reader.interfaces()
     }
 
-    /// Hands out the next batch of the current window into `bytes` and `times` (which are
-    /// empty) and returns its interface, reading the next window when this one is done;
-    /// leaves `bytes` empty at the end of the file. A read error is returned after the
-    /// bytes before it. Damage and notes in the file are told to `notices` as they are met.
-    pub(super) fn read(
-        &mut self,
-        name: &str,
-        bytes: &mut Vec<u8>,
-        times: &mut Vec<f64>,
-        notices: &mut dyn FnMut(Notice),
-    ) -> Result<usize, InputError> {
-        loop {
-            if self.draining {
-                // The window's ports in the order of their first byte: batches of a recording
-                // come in order of their first byte's time (what `Sources` merges by).
-                if let Some(next) = self.pending.get_mut(self.handed) {
-                    self.handed += 1;
-                    std::mem::swap(bytes, &mut next.bytes);
-                    std::mem::swap(times, &mut next.times);
-                    return Ok(next.iface as usize);
-                }
-                self.draining = false;
-            }
-            if self.ended {
-                return self.error.take().map_or(Ok(0), Err);
-            }
-            for mut done in self.pending.drain(..) {
-                done.bytes.clear();
-                done.times.clear();
-                self.spare.push((done.bytes, done.times));
-            }
-            self.slot.clear();
-            self.handed = 0;
-            if let Err(e) = self.read_window(name, notices) {
-                self.error = Some(e);
-                self.ended = true;
-            }
-            self.pending
-                .sort_by(|a, b| (a.times[0].total_cmp(&b.times[0])).then(a.iface.cmp(&b.iface)));
-            self.draining = true;
-        }
-    }
-
     /// Reads packets into the per-interface buffers until the window is over, a buffer is
     /// full, or the file ends.
     fn read_window(
@@ -228,6 +185,10 @@ impl Source for RecordingReader {
         InputFormat::RECORDING
     }
 
+    /// Hands out the next batch of the current window into `bytes` and `times` and returns
+    /// its interface, reading the next window when this one is done;
+    /// leaves `bytes` empty at the end of the file. A read error is returned after the
+    /// bytes before it. Damage and notes in the file are told to `notices` as they are met.
     fn fill(
         &mut self,
         name: &str,
@@ -236,7 +197,36 @@ impl Source for RecordingReader {
         notices: &mut dyn FnMut(Notice),
     ) -> Result<usize, InputError> {
         bytes.clear();
-        self.read(name, bytes, times, notices)
+        loop {
+            if self.draining {
+                // The window's ports in the order of their first byte: batches of a recording
+                // come in order of their first byte's time (what `Sources` merges by).
+                if let Some(next) = self.pending.get_mut(self.handed) {
+                    self.handed += 1;
+                    std::mem::swap(bytes, &mut next.bytes);
+                    std::mem::swap(times, &mut next.times);
+                    return Ok(next.iface as usize);
+                }
+                self.draining = false;
+            }
+            if self.ended {
+                return self.error.take().map_or(Ok(0), Err);
+            }
+            for mut done in self.pending.drain(..) {
+                done.bytes.clear();
+                done.times.clear();
+                self.spare.push((done.bytes, done.times));
+            }
+            self.slot.clear();
+            self.handed = 0;
+            if let Err(e) = self.read_window(name, notices) {
+                self.error = Some(e);
+                self.ended = true;
+            }
+            self.pending
+                .sort_by(|a, b| (a.times[0].total_cmp(&b.times[0])).then(a.iface.cmp(&b.iface)));
+            self.draining = true;
+        }
     }
 
     fn streams(&self) -> usize {

@@ -24,9 +24,9 @@
 //! the order given, as is each run of inputs of one clock after another run.
 //!
 //! The files of this module: `numbering.rs` says which stream of which input is which ESC (a
-//! hub's channels by [`crate::esc_numbers`], as live ports number them); `merge.rs` hands
-//! frames on in time order (a heap of the batches read ahead, a queue per ESC, the bytes two
-//! inputs hold of one port left out once); `mod.rs` reads the inputs, alone or together.
+//! hub's channels by `esc_numbers.rs`, as live ports number them); `merge.rs` hands frames on
+//! in time order (a heap of the batches read ahead, a queue per ESC, the bytes two inputs hold
+//! of one port left out once); `mod.rs` reads the inputs, alone or together.
 
 mod merge;
 mod numbering;

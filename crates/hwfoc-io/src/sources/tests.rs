@@ -485,6 +485,18 @@ pub(crate) fn hub_wire(id: u16, counters: std::ops::Range<u16>, channels: &[usiz
         .collect()
 }
 
+/// Collects the packet numbers of the records, by ESC.
+#[derive(Default)]
+struct Packets(std::collections::BTreeMap<u8, Vec<u16>>);
+
+impl Handler for Packets {
+    type Error = InputError;
+
+    fn record(&mut self, r: &Record) {
+        self.0.entry(r.esc).or_default().push(r.packet);
+    }
+}
+
 /// The README's one rule, alike for files, a recording and live ports: each input (or
 /// port) is numbered in the order given, a hub's channel 0 keeps its input's number, and
 /// its channels 1 to 7 take the next numbers after all inputs', hub by hub as found. So in
@@ -506,15 +518,6 @@ fn files_a_recording_and_ports_number_hubs_alike() {
     expected.insert(14, vec![1105; 3]);
     expected.insert(2, vec![100, 101, 102]);
 
-    #[derive(Default)]
-    struct Escs(std::collections::BTreeMap<u8, Vec<u16>>);
-    impl Handler for Escs {
-        type Error = InputError;
-        fn record(&mut self, r: &Record) {
-            self.0.entry(r.esc).or_default().push(r.packet);
-        }
-    }
-
     // Files, read one after another.
     let files = inputs
         .iter()
@@ -522,7 +525,7 @@ fn files_a_recording_and_ports_number_hubs_alike() {
         .map(|(bytes, name)| Input::from_memory(name, bytes.clone()).unwrap())
         .collect();
     let mut sources = Sources::new(files, Settings::DEFAULT);
-    let mut got = Escs::default();
+    let mut got = Packets::default();
     sources.run(&mut got).unwrap();
     assert_eq!(got.0, expected, "files");
     assert_eq!(sources.inputs()[2].escs, [2]);
@@ -535,7 +538,7 @@ fn files_a_recording_and_ports_number_hubs_alike() {
         names.clone(),
         SettingsMap::from(Settings::DEFAULT),
     );
-    let mut live = Escs::default();
+    let mut live = Packets::default();
     for (port, bytes) in inputs.iter().enumerate() {
         let event = crate::serial::PortEvent::Data {
             port,
@@ -555,7 +558,7 @@ fn files_a_recording_and_ports_number_hubs_alike() {
         w.write(port as u32, t + port as u64 * 100_000_000, bytes)
             .unwrap();
     }
-    let (recorded, _) = run_into::<Escs>(vec![w.into_inner().unwrap()]);
+    let (recorded, _) = run_into::<Packets>(vec![w.into_inner().unwrap()]);
     assert_eq!(recorded.0, expected, "recording");
 }
 
@@ -576,22 +579,13 @@ fn files_and_ports_number_a_hub_alike_at_the_last_esc_number() {
         expected.insert(249 + c as u8, vec![1000 + c; 3]);
     }
 
-    #[derive(Default)]
-    struct Escs(std::collections::BTreeMap<u8, Vec<u16>>);
-    impl Handler for Escs {
-        type Error = InputError;
-        fn record(&mut self, r: &Record) {
-            self.0.entry(r.esc).or_default().push(r.packet);
-        }
-    }
-
     let files = inputs
         .iter()
         .enumerate()
         .map(|(k, bytes)| Input::from_memory(&format!("{k}.bin"), bytes.clone()).unwrap())
         .collect();
     let mut sources = Sources::new(files, Settings::DEFAULT);
-    let mut got = Escs::default();
+    let mut got = Packets::default();
     sources.run(&mut got).unwrap();
     assert_eq!(got.0, expected, "files");
     assert_eq!(sources.escs().len(), 256);
@@ -599,7 +593,7 @@ fn files_and_ports_number_a_hub_alike_at_the_last_esc_number() {
     let names: Vec<String> = (0..inputs.len()).map(|p| format!("port{p}")).collect();
     let mut streams =
         crate::stream::PortStreams::with_map(115_200, names, SettingsMap::from(Settings::DEFAULT));
-    let mut live = Escs::default();
+    let mut live = Packets::default();
     for (port, bytes) in inputs.iter().enumerate() {
         let event = crate::serial::PortEvent::Data {
             port,
