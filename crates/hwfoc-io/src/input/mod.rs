@@ -815,6 +815,32 @@ mod tests {
         assert_eq!(got, [(0, vec![1, 3]), (1, vec![2]), (1, vec![4, 5])]);
     }
 
+    /// A read error ends a raw input: it is returned once, naming the input, and no batch is
+    /// left behind it (not the read buffer, nor bytes the reader gives after the error).
+    #[test]
+    fn a_read_error_ends_a_raw_input_and_leaves_no_batch() {
+        /// One byte, then an error, then bytes again.
+        struct Flaky(u32);
+        impl Read for Flaky {
+            fn read(&mut self, buf: &mut [u8]) -> io::Result<usize> {
+                self.0 += 1;
+                match self.0 {
+                    2 => Err(io::Error::other("cable pulled")),
+                    _ => {
+                        buf[0] = 0x9B;
+                        Ok(1)
+                    }
+                }
+            }
+        }
+        let mut input = Input::from_reader("flaky", Box::new(Flaky(0))).unwrap();
+        assert_eq!(input.next_batch().unwrap().unwrap().bytes, [0x9B]);
+        let e = input.next_batch().err().unwrap();
+        assert_eq!(e.to_string(), "cannot read flaky: cable pulled");
+        assert!(input.current_batch().is_none());
+        assert!(input.next_batch().unwrap().is_none());
+    }
+
     #[test]
     fn raw_bytes_starting_like_a_recording_stay_raw() {
         let raw = vec![0x0A, 0x0D, 0x0D, 0x0A, 0, 0, 0, 0, 1, 2, 3, 4, 0x9B];
