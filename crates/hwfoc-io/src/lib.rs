@@ -27,6 +27,7 @@
 pub mod clock;
 pub mod energy;
 pub mod episode;
+mod esc_numbers;
 pub mod escape;
 pub mod fixed;
 pub mod handler;

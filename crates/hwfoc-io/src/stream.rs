@@ -11,6 +11,7 @@ use hwfoc::stats::PacketSequence;
 use hwfoc::telemetry::{Data, Frame};
 use hwfoc::{LinkStats, Settings};
 
+use crate::esc_numbers::UNNUMBERED;
 use crate::handler::Handler;
 
 use crate::input::Batch;
@@ -422,10 +423,9 @@ impl PortStreams {
                 let esc = match channel {
                     None => *port,
                     Some(c) => hub.get_or_insert_with(|| {
-                        let mut escs = [*port; datalink::CHANNELS];
-                        for e in &mut escs[1..] {
-                            *e = esc_settings.len();
-                            esc_settings.push(map.get(*e, &names[*port]));
+                        let escs = crate::esc_numbers::hub_channels(*port, esc_settings.len());
+                        for &e in escs[1..].iter().filter(|&&e| e != UNNUMBERED) {
+                            esc_settings.push(map.get(e, &names[*port]));
                         }
                         escs
                     })[usize::from(c)],

@@ -34,7 +34,7 @@ use crate::energy::{Energy, NOMINAL_PERIOD_S};
 pub use crate::episode::{Episode, Mark};
 use crate::escape::Escaped;
 use crate::fixed::Fixed;
-use crate::input::{InputError, InputFormat};
+use crate::input::InputError;
 use crate::sources::{Handler, Sources};
 use crate::stream::EscLink;
 use crate::time::{self, Clock};
@@ -527,16 +527,6 @@ struct EscReport<'a> {
     no_frames: String,
 }
 
-/// The short name of a format in `--json`.
-fn format_name(format: InputFormat) -> &'static str {
-    match format {
-        InputFormat::Raw => "raw",
-        InputFormat::AnalyzerCsv => "csv",
-        InputFormat::Recording => "pcapng",
-        InputFormat::Serial => "serial",
-    }
-}
-
 impl<'a> Report<'a> {
     fn escs(&self) -> Vec<EscReport<'a>> {
         static EMPTY: std::sync::OnceLock<Accumulator> = std::sync::OnceLock::new();
@@ -660,7 +650,7 @@ impl<'a> Report<'a> {
             .map(|info| {
                 json!({
                     "input": info.name,
-                    "format": format_name(info.format),
+                    "format": info.format.short_name(),
                     "bytes": info.bytes,
                     "flagged_bytes": info.flagged_bytes,
                     "escs": info.escs,

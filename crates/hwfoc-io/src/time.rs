@@ -1,7 +1,7 @@
 //! Times as people write and read them: the `--from`/`--to` grammar, and ISO 8601 display of
 //! receive times where the source has a wall clock.
 //!
-//! A source's clock ([`Clock`], from its [`InputFormat`]) says what its `t_s` numbers mean:
+//! A source's clock ([`Clock`], from its [`InputFormat`](crate::input::InputFormat)) says what its `t_s` numbers mean:
 //! Unix seconds for pcapng recordings and serial ports ([`Clock::Wall`]), seconds from the
 //! start of the capture for a logic-analyser CSV export ([`Clock::Capture`]), nothing for raw
 //! bytes ([`Clock::None`]). Only wall-clock times are shown as dates.
@@ -29,8 +29,6 @@ use jiff::fmt::temporal::Pieces;
 use jiff::tz::{AmbiguousOffset, Offset, TimeZone};
 use jiff::{SignedDuration, Timestamp};
 
-use crate::input::InputFormat;
-
 /// What a source's receive times (`t_s`) are.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Clock {
@@ -41,18 +39,6 @@ pub enum Clock {
     Capture,
     /// No receive times: raw bytes.
     None,
-}
-
-impl InputFormat {
-    /// What the receive times of an input of this format are: the one place that says which
-    /// sources have a wall clock.
-    pub fn clock(self) -> Clock {
-        match self {
-            InputFormat::Recording | InputFormat::Serial => Clock::Wall,
-            InputFormat::AnalyzerCsv => Clock::Capture,
-            InputFormat::Raw => Clock::None,
-        }
-    }
 }
 
 /// A time as given on the command line ([`parse`]).
@@ -531,13 +517,5 @@ mod tests {
             span_text(0.5, 2.0, false),
             "the frames' t_s run from 0.5 to 2 s (the source's own clock)"
         );
-    }
-
-    #[test]
-    fn clocks_of_formats() {
-        assert_eq!(InputFormat::Recording.clock(), Clock::Wall);
-        assert_eq!(InputFormat::Serial.clock(), Clock::Wall);
-        assert_eq!(InputFormat::AnalyzerCsv.clock(), Clock::Capture);
-        assert_eq!(InputFormat::Raw.clock(), Clock::None);
     }
 }

@@ -2,7 +2,9 @@
 
 use std::io::{self, BufRead, BufReader, Read};
 
-use super::InputError;
+use super::{InputError, InputFormat, Looks, Source};
+use crate::notice::Notice;
+use crate::time::Clock;
 
 /// How many CSV rows make one batch.
 pub(super) const CSV_BATCH_ROWS: usize = 1 << 16;
@@ -203,6 +205,50 @@ pub(super) const MAX_LINE: usize = 64 << 10;
 /// [`MAX_LINE`] + 1 bytes: a longer line is left cut, without its newline.
 pub(super) fn read_line(reader: &mut impl BufRead, row: &mut Vec<u8>) -> io::Result<usize> {
     reader.take(MAX_LINE as u64 + 1).read_until(b'\n', row)
+}
+
+impl InputFormat {
+    /// A logic-analyser CSV export, one row per byte: one stream, times of the capture's clock.
+    pub const ANALYZER_CSV: InputFormat = InputFormat {
+        name: "logic-analyser CSV",
+        short_name: "csv",
+        clock: Clock::Capture,
+        live: false,
+        recorded_ports: false,
+    };
+}
+
+impl Source for CsvRows {
+    fn format(&self) -> InputFormat {
+        InputFormat::ANALYZER_CSV
+    }
+
+    fn fill(
+        &mut self,
+        name: &str,
+        bytes: &mut Vec<u8>,
+        times: &mut Vec<f64>,
+        _notices: &mut dyn FnMut(Notice),
+    ) -> Result<usize, InputError> {
+        bytes.clear();
+        self.read(name, bytes, times).map(|()| 0)
+    }
+
+    fn streams(&self) -> usize {
+        1
+    }
+
+    fn stream_name(&self, _: usize) -> Option<&str> {
+        None
+    }
+
+    fn flagged_bytes(&self) -> u64 {
+        self.flagged()
+    }
+
+    fn looks(&self) -> Option<Looks> {
+        None
+    }
 }
 
 #[cfg(test)]

@@ -12,11 +12,18 @@
 //!
 //! Serial ports are opened with [`Input::open_ports`]: one input with one stream per port,
 //! times being the Unix time each byte was received.
+//!
+//! Each kind of input is a module (`raw.rs`, `csv.rs`, `recording.rs`, `ports.rs`) declaring
+//! its [`InputFormat`] (names, clock, whether live, whether its streams are recorded ports:
+//! what [`crate::sources::Sources`] and the summary ask of a format) and implementing `Source`
+//! (its reading, its streams, its flagged bytes). Standard input and files are read as their
+//! content says.
 
 mod csv;
 mod error;
 mod looks;
 mod ports;
+mod raw;
 mod recording;
 
 use std::fmt;
@@ -31,7 +38,9 @@ use self::csv::{CsvRows, may_be_header};
 pub use self::error::InputError;
 pub use self::looks::Looks;
 use self::ports::Ports;
+use self::raw::RawReader;
 use self::recording::RecordingReader;
+use crate::time::Clock;
 
 /// How many bytes a raw read asks for: small enough that what the kernel copies in is still in
 /// the L2 cache when the decoder reads it (1 MiB reads made `summary` 1.6x slower), large enough
@@ -46,27 +55,128 @@ const CLASSIC_PCAP: [[u8; 4]; 4] = [
     [0xA1, 0xB2, 0x3C, 0x4D],
 ];
 
-/// The detected format of an input.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum InputFormat {
-    /// Raw bytes from the wire.
-    Raw,
-    /// A logic-analyser CSV export, one row per byte.
-    AnalyzerCsv,
-    /// A pcapng recording, one stream per interface.
-    Recording,
-    /// Live serial ports, one stream per port.
-    Serial,
+/// The format of an input, with what follows from it: its names, its clock, whether it is live,
+/// and how its streams are numbered. Each input kind's module declares its own (`raw.rs`,
+/// `csv.rs`, `recording.rs`, `ports.rs`), and its reader implements the module's `Source`
+/// trait: adding an input format is a module declaring both, and its line in
+/// [`Input::from_reader`].
+///
+/// Two formats are equal when their short names are.
+#[derive(Debug, Clone, Copy)]
+pub struct InputFormat {
+    name: &'static str,
+    short_name: &'static str,
+    clock: Clock,
+    live: bool,
+    recorded_ports: bool,
 }
+
+impl InputFormat {
+    /// What a person reads: "raw bytes", "pcapng recording".
+    pub fn name(self) -> &'static str {
+        self.name
+    }
+
+    /// The short name of `summary --json` (`"format"`): "raw", "csv", "pcapng", "serial".
+    pub fn short_name(self) -> &'static str {
+        self.short_name
+    }
+
+    /// What the receive times of an input of this format are: the one place that says which
+    /// sources have a wall clock. Inputs of [`Clock::None`] hand out bytes without times.
+    pub fn clock(self) -> Clock {
+        self.clock
+    }
+
+    /// Whether the input is live (serial ports): read as it arrives, alone, its records handed
+    /// on in the order they come; its end (Ctrl-C) is not an error even with nothing read.
+    pub fn is_live(self) -> bool {
+        self.live
+    }
+
+    /// Whether each stream is a recorded port, named by the recording (pcapng): the streams
+    /// are declared as the input is read, and the streams of inputs read together that name
+    /// the same port are one ESC, one stream, its bytes merged in time order.
+    pub fn has_recorded_ports(self) -> bool {
+        self.recorded_ports
+    }
+
+    /// Whether inputs of this format are read together with those of the same clock given
+    /// next to them, their records handed on in time order: inputs with times that are not
+    /// live (recordings, analyser CSVs).
+    pub fn is_merged_in_time(self) -> bool {
+        !self.live && self.clock != Clock::None
+    }
+}
+
+impl PartialEq for InputFormat {
+    fn eq(&self, other: &Self) -> bool {
+        self.short_name == other.short_name
+    }
+}
+
+impl Eq for InputFormat {}
 
 impl fmt::Display for InputFormat {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(match self {
-            InputFormat::Raw => "raw bytes",
-            InputFormat::AnalyzerCsv => "logic-analyser CSV",
-            InputFormat::Recording => "pcapng recording",
-            InputFormat::Serial => "serial port",
-        })
+        f.write_str(self.name)
+    }
+}
+
+/// The reader of one input kind, behind [`Input`]: each kind's module implements it, holding
+/// its own policy (its [`InputFormat`], its streams, its flagged bytes).
+trait Source {
+    /// The format read.
+    fn format(&self) -> InputFormat;
+
+    /// Replaces `bytes` (the last batch, its buffer reused) by the next batch and appends
+    /// their receive times to `times` (empty; left empty by a format without a clock), and
+    /// returns the batch's stream; leaves `bytes` empty at the end. On an error, the bytes
+    /// read before it stay in `bytes` (they are handed out first). Notices (a recording's
+    /// notes, a port lost) go to `notices`; `name` is the input's, for errors.
+    fn fill(
+        &mut self,
+        name: &str,
+        bytes: &mut Vec<u8>,
+        times: &mut Vec<f64>,
+        notices: &mut dyn FnMut(Notice),
+    ) -> Result<usize, InputError>;
+
+    /// The number of streams known so far (see [`Input::streams`]).
+    fn streams(&self) -> usize;
+
+    /// The name of stream `i` where the input names its streams (a recording's interface, a
+    /// port); `None` for a single-stream input, which is named as the input.
+    fn stream_name(&self, i: usize) -> Option<&str>;
+
+    /// Bytes flagged with a parity or framing error by what captured them, so far.
+    fn flagged_bytes(&self) -> u64;
+
+    /// What the first bytes look like when they are not telemetry (raw bytes only).
+    fn looks(&self) -> Option<Looks>;
+}
+
+/// What a closed file's [`Source`] knew, asked for after its end.
+#[derive(Debug, Default)]
+struct Kept {
+    streams: usize,
+    /// The names of its streams, where it names them.
+    names: Vec<String>,
+    flagged: u64,
+    looks: Option<Looks>,
+}
+
+impl Kept {
+    fn of(source: &dyn Source) -> Kept {
+        let streams = source.streams();
+        Kept {
+            streams,
+            names: (0..streams)
+                .map_while(|i| source.stream_name(i).map(str::to_string))
+                .collect(),
+            flagged: source.flagged_bytes(),
+            looks: source.looks(),
+        }
     }
 }
 
@@ -82,32 +192,16 @@ pub struct Batch<'a> {
     pub stream: usize,
 }
 
-enum Source {
-    Raw {
-        reader: Box<dyn Read>,
-    },
-    Csv(CsvRows),
-    Recording(Box<RecordingReader>),
-    Ports(Ports),
-    /// A file not open at the moment: not read yet, rewound, or at its end. What the closed
-    /// source knew that is asked for after its end is kept.
-    Closed {
-        /// A recording's interfaces.
-        interfaces: Vec<pcapng::Interface>,
-        /// Bytes a logic analyser flagged.
-        flagged: u64,
-    },
-}
-
 /// One opened input.
 pub struct Input {
     name: String,
     format: InputFormat,
-    source: Source,
+    /// The reader; `None` for a file not open at the moment (not read yet, rewound, or at its
+    /// end), whose reader's answers are then in `kept`.
+    source: Option<Box<dyn Source>>,
+    kept: Kept,
     bytes: Vec<u8>,
     times: Vec<f64>,
-    /// Bytes read during format detection, handed out first (raw inputs only).
-    pending: Vec<u8>,
     /// The stream of the current batch.
     stream: usize,
     seen_any: bool,
@@ -123,9 +217,6 @@ pub struct Input {
     /// rewind already gave (those are not given again).
     told: usize,
     muted: usize,
-    /// A raw input's first bytes (up to [`looks::SAMPLE`]), to say what they look like if they
-    /// hold no frame.
-    sample: Vec<u8>,
 }
 
 impl Input {
@@ -177,7 +268,6 @@ impl Input {
             });
         }
         self.source = fresh.source;
-        self.pending = fresh.pending;
         self.told = 0;
         Ok(())
     }
@@ -185,23 +275,9 @@ impl Input {
     /// Closes the source, keeping what is asked of it after its end, and lets go of the
     /// buffers.
     fn close(&mut self) {
-        let flagged = self.flagged_bytes();
-        let closed = Source::Closed {
-            interfaces: Vec::new(),
-            flagged,
-        };
-        let interfaces = match std::mem::replace(&mut self.source, closed) {
-            Source::Recording(rec) => rec.into_interfaces(),
-            Source::Closed { interfaces, .. } => interfaces,
-            _ => Vec::new(),
-        };
-        if let Source::Closed {
-            interfaces: kept, ..
-        } = &mut self.source
-        {
-            *kept = interfaces;
+        if let Some(source) = self.source.take() {
+            self.kept = Kept::of(&*source);
         }
-        self.pending = Vec::new();
         self.bytes = Vec::new();
         self.times = Vec::new();
     }
@@ -235,9 +311,7 @@ impl Input {
         let set = PortSet::open(names, baud)?;
         Ok(Input::new(
             &names.join(", "),
-            InputFormat::Serial,
-            Source::Ports(Ports::new(set, interrupted)),
-            Vec::new(),
+            Box::new(Ports::new(set, interrupted)),
         ))
     }
 
@@ -246,7 +320,8 @@ impl Input {
         Input::from_reader(name, Box::new(Cursor::new(data)))
     }
 
-    /// Detects the format from the first bytes of `reader`.
+    /// Detects the format from the first bytes of `reader`: the one place formats are
+    /// detected, each format's reader made in a line of its own.
     pub fn from_reader(name: &str, mut reader: Box<dyn Read>) -> Result<Input, InputError> {
         let read_err = |source| InputError::Read {
             input: name.to_string(),
@@ -294,41 +369,32 @@ impl Input {
             }
             head.push(byte[0]);
         }
-        if head.starts_with(&pcapng::MAGIC)
-            && (head.len() < 12
-                || matches!(
-                    head[8..12],
-                    [0x4D, 0x3C, 0x2B, 0x1A] | [0x1A, 0x2B, 0x3C, 0x4D]
-                ))
-        {
-            let reader: Box<dyn Read> = Box::new(Cursor::new(head).chain(reader));
-            let source = Source::Recording(Box::new(RecordingReader::new(reader)));
-            return Ok(Input::new(name, InputFormat::Recording, source, Vec::new()));
-        }
-        let (format, source, pending) = if csv::is_header(&head) {
+        let source: Box<dyn Source> = if recording::is_start(&head) {
+            let reader = Box::new(Cursor::new(head).chain(reader));
+            Box::new(RecordingReader::new(reader))
+        } else if csv::is_header(&head) {
             let reader = BufReader::with_capacity(BATCH, reader);
-            let rows = CsvRows::open(name, reader, head)?;
-            (InputFormat::AnalyzerCsv, Source::Csv(rows), Vec::new())
+            Box::new(CsvRows::open(name, reader, head)?)
         } else {
-            (InputFormat::Raw, Source::Raw { reader }, head)
+            Box::new(RawReader::new(reader, head))
         };
-        Ok(Input::new(name, format, source, pending))
+        Ok(Input::new(name, source))
     }
 
     /// What a raw input's first bytes look like when they are not telemetry (text, zeros, a
     /// known file format); `None` for other inputs and for bytes that may be telemetry.
     pub fn looks(&self) -> Option<Looks> {
-        Looks::of(&self.sample)
+        self.source.as_ref().map_or(self.kept.looks, |s| s.looks())
     }
 
-    fn new(name: &str, format: InputFormat, source: Source, pending: Vec<u8>) -> Input {
+    fn new(name: &str, source: Box<dyn Source>) -> Input {
         Input {
             name: name.to_string(),
-            format,
-            source,
+            format: source.format(),
+            source: Some(source),
+            kept: Kept::default(),
             bytes: Vec::new(),
             times: Vec::new(),
-            pending,
             stream: 0,
             seen_any: false,
             done: false,
@@ -337,7 +403,6 @@ impl Input {
             path: None,
             told: 0,
             muted: 0,
-            sample: Vec::new(),
         }
     }
 
@@ -360,37 +425,27 @@ impl Input {
     /// Bytes the logic analyser flagged with a parity or framing error (passed on all the same:
     /// the frame checksum decides).
     pub fn flagged_bytes(&self) -> u64 {
-        match &self.source {
-            Source::Csv(rows) => rows.flagged(),
-            Source::Closed { flagged, .. } => *flagged,
-            _ => 0,
-        }
+        self.source
+            .as_ref()
+            .map_or(self.kept.flagged, |s| s.flagged_bytes())
     }
 
     /// The number of streams known so far: 1 for a raw or CSV file, the number of ports, or the
     /// number of interfaces a recording has declared up to the point read (it may grow).
     pub fn streams(&self) -> usize {
-        match &self.source {
-            Source::Raw { .. } | Source::Csv(_) => 1,
-            Source::Recording(rec) => rec.interfaces().len(),
-            Source::Ports(ports) => ports.names().len(),
-            Source::Closed { interfaces, .. } => match self.format {
-                InputFormat::Recording => interfaces.len(),
-                _ => 1,
-            },
-        }
+        self.source
+            .as_ref()
+            .map_or(self.kept.streams, |s| s.streams())
     }
 
     /// The name of stream `i`: the port (a recording's interface name, which is the port it
     /// was recorded from), or the input's name for a single-stream input.
     pub fn stream_name(&self, i: usize) -> String {
         let name = match &self.source {
-            Source::Recording(rec) => rec.interfaces().get(i).map(|f| f.name.clone()),
-            Source::Ports(ports) => ports.names().get(i).cloned(),
-            Source::Closed { interfaces, .. } => interfaces.get(i).map(|f| f.name.clone()),
-            Source::Raw { .. } | Source::Csv(_) => None,
+            Some(source) => source.stream_name(i),
+            None => self.kept.names.get(i).map(String::as_str),
         };
-        name.unwrap_or_else(|| self.name.clone())
+        name.unwrap_or(&self.name).to_string()
     }
 
     /// The next batch of bytes, or `None` at the end of the input.
@@ -402,7 +457,7 @@ impl Input {
         if self.done {
             return Ok(None);
         }
-        if matches!(self.source, Source::Closed { .. })
+        if self.source.is_none()
             && let Err(e) = self.reopen()
         {
             self.done = true;
@@ -418,61 +473,25 @@ impl Input {
                 sink(notice);
             }
         };
-        match &mut self.source {
-            Source::Closed { .. } => {}
-            Source::Raw { reader } => {
-                if !self.pending.is_empty() {
-                    std::mem::swap(&mut self.bytes, &mut self.pending);
-                    self.pending.clear();
-                } else {
-                    // The buffer keeps its length from the last read: only bytes never read
-                    // into are zeroed here (zeroing all of it every time cost more than the read).
-                    self.bytes.resize(BATCH, 0);
-                    let n =
-                        read_some(reader, &mut self.bytes).map_err(|source| InputError::Read {
-                            input: self.name.clone(),
-                            source,
-                        })?;
-                    self.bytes.truncate(n);
-                }
-                let room = looks::SAMPLE.saturating_sub(self.sample.len());
-                self.sample
-                    .extend_from_slice(&self.bytes[..room.min(self.bytes.len())]);
-            }
-            Source::Csv(rows) => {
+        let read = match &mut self.source {
+            Some(source) => source.fill(&self.name, &mut self.bytes, &mut self.times, &mut notices),
+            None => {
                 self.bytes.clear();
-                if let Err(e) = rows.read(&self.name, &mut self.bytes, &mut self.times) {
-                    if self.bytes.is_empty() {
-                        self.end();
-                        return Err(e);
-                    }
-                    self.deferred = Some(e);
-                }
+                Ok(0)
             }
-            Source::Recording(rec) => {
-                self.bytes.clear();
-                match rec.read(&self.name, &mut self.bytes, &mut self.times, &mut notices) {
-                    Ok(stream) => self.stream = stream,
-                    Err(e) if self.bytes.is_empty() => {
-                        self.end();
-                        return Err(e);
-                    }
-                    Err(e) => self.deferred = Some(e),
-                }
+        };
+        match read {
+            Ok(stream) => self.stream = stream,
+            Err(e) if self.bytes.is_empty() => {
+                self.end();
+                return Err(e);
             }
-            Source::Ports(ports) => {
-                self.bytes.clear();
-                self.stream = ports.read(&mut self.bytes, &mut self.times, &mut notices);
-                if self.bytes.is_empty() {
-                    // Interrupted: the end of a live input, not an error even with no bytes.
-                    self.done = true;
-                    return Ok(None);
-                }
-            }
+            Err(e) => self.deferred = Some(e),
         }
         if self.bytes.is_empty() {
             self.end();
-            if !self.seen_any {
+            // A live input ends when it is stopped: not an error even with no bytes.
+            if !self.seen_any && !self.format.is_live() {
                 return Err(InputError::Empty {
                     input: self.name.clone(),
                 });
@@ -497,15 +516,9 @@ impl Input {
         if self.bytes.is_empty() || self.done {
             return None;
         }
-        let times = match self.format {
-            InputFormat::AnalyzerCsv | InputFormat::Recording | InputFormat::Serial => {
-                Some(&self.times[..])
-            }
-            InputFormat::Raw => None,
-        };
         Some(Batch {
             bytes: &self.bytes,
-            times,
+            times: (self.format.clock() != Clock::None).then_some(&self.times[..]),
             stream: self.stream,
         })
     }
@@ -591,11 +604,68 @@ mod tests {
         (bytes, times)
     }
 
+    /// Each format's policy, as the summary, the `--from`/`--to` check and `Sources` read it:
+    /// names, clock, live, recorded ports, and so whether it is merged in time.
+    #[test]
+    fn every_format_says_its_own_policy() {
+        let table = [
+            (
+                InputFormat::RAW,
+                "raw bytes",
+                "raw",
+                Clock::None,
+                false,
+                false,
+                false,
+            ),
+            (
+                InputFormat::ANALYZER_CSV,
+                "logic-analyser CSV",
+                "csv",
+                Clock::Capture,
+                false,
+                false,
+                true,
+            ),
+            (
+                InputFormat::RECORDING,
+                "pcapng recording",
+                "pcapng",
+                Clock::Wall,
+                false,
+                true,
+                true,
+            ),
+            (
+                InputFormat::SERIAL,
+                "serial port",
+                "serial",
+                Clock::Wall,
+                true,
+                false,
+                false,
+            ),
+        ];
+        for (format, name, short, clock, live, ports, merged) in table {
+            assert_eq!(format.to_string(), name);
+            assert_eq!(format.short_name(), short);
+            assert_eq!(format.clock(), clock, "{name}");
+            assert_eq!(format.is_live(), live, "{name}");
+            assert_eq!(format.has_recorded_ports(), ports, "{name}");
+            assert_eq!(format.is_merged_in_time(), merged, "{name}");
+        }
+        for (i, a) in table.iter().enumerate() {
+            for (j, b) in table.iter().enumerate() {
+                assert_eq!(a.0 == b.0, i == j);
+            }
+        }
+    }
+
     #[test]
     fn detects_csv_and_raw() {
         let csv = b"Time [s],Value,Parity Error,Framing Error\n0.5,0x9B,,\n0.75,0x16,,x\n".to_vec();
         let mut input = Input::from_memory("a.csv", csv).unwrap();
-        assert_eq!(input.format(), InputFormat::AnalyzerCsv);
+        assert_eq!(input.format(), InputFormat::ANALYZER_CSV);
         assert_eq!(
             read_all(&mut input),
             (vec![0x9B, 0x16], Some(vec![0.5, 0.75]))
@@ -604,12 +674,12 @@ mod tests {
 
         let raw = b"\x9B\x16\x01Time".to_vec();
         let mut input = Input::from_memory("a.bin", raw.clone()).unwrap();
-        assert_eq!(input.format(), InputFormat::Raw);
+        assert_eq!(input.format(), InputFormat::RAW);
         assert_eq!(read_all(&mut input), (raw, None));
 
         // Text that is not a logic-analyser export is raw bytes too.
         let input = Input::from_memory("t", b"Tea,time\n".to_vec()).unwrap();
-        assert_eq!(input.format(), InputFormat::Raw);
+        assert_eq!(input.format(), InputFormat::RAW);
     }
 
     #[test]
@@ -662,7 +732,7 @@ mod tests {
 
         // Whatever the name: the content decides.
         let mut input = Input::from_memory("capture.bin", file).unwrap();
-        assert_eq!(input.format(), InputFormat::Recording);
+        assert_eq!(input.format(), InputFormat::RECORDING);
         let got = batches(&mut input);
         assert_eq!(input.streams(), 2);
         assert_eq!(input.stream_name(1), "/dev/ttyUSB1");
@@ -745,11 +815,37 @@ mod tests {
         assert_eq!(got, [(0, vec![1, 3]), (1, vec![2]), (1, vec![4, 5])]);
     }
 
+    /// A read error ends a raw input: it is returned once, naming the input, and no batch is
+    /// left behind it (not the read buffer, nor bytes the reader gives after the error).
+    #[test]
+    fn a_read_error_ends_a_raw_input_and_leaves_no_batch() {
+        /// One byte, then an error, then bytes again.
+        struct Flaky(u32);
+        impl Read for Flaky {
+            fn read(&mut self, buf: &mut [u8]) -> io::Result<usize> {
+                self.0 += 1;
+                match self.0 {
+                    2 => Err(io::Error::other("cable pulled")),
+                    _ => {
+                        buf[0] = 0x9B;
+                        Ok(1)
+                    }
+                }
+            }
+        }
+        let mut input = Input::from_reader("flaky", Box::new(Flaky(0))).unwrap();
+        assert_eq!(input.next_batch().unwrap().unwrap().bytes, [0x9B]);
+        let e = input.next_batch().err().unwrap();
+        assert_eq!(e.to_string(), "cannot read flaky: cable pulled");
+        assert!(input.current_batch().is_none());
+        assert!(input.next_batch().unwrap().is_none());
+    }
+
     #[test]
     fn raw_bytes_starting_like_a_recording_stay_raw() {
         let raw = vec![0x0A, 0x0D, 0x0D, 0x0A, 0, 0, 0, 0, 1, 2, 3, 4, 0x9B];
         let mut input = Input::from_memory("odd.bin", raw.clone()).unwrap();
-        assert_eq!(input.format(), InputFormat::Raw);
+        assert_eq!(input.format(), InputFormat::RAW);
         assert_eq!(read_all(&mut input), (raw, None));
         let raw = vec![0x0A, 0x9B, 0x16];
         let mut input = Input::from_memory("nl.bin", raw.clone()).unwrap();
@@ -772,7 +868,7 @@ mod tests {
             })
             .collect();
         let mut input = Input::open_ports(&names, 19200).unwrap();
-        assert_eq!(input.format(), InputFormat::Serial);
+        assert_eq!(input.format(), InputFormat::SERIAL);
         assert_eq!(input.streams(), 2);
         assert_eq!(input.stream_name(1), names[1]);
         let mut master = std::fs::File::from(ptys[1].master.try_clone().unwrap());
@@ -917,15 +1013,15 @@ mod tests {
         std::fs::write(&path, w.into_inner().unwrap()).unwrap();
         let name = path.to_str().unwrap();
         let mut input = Input::open(name).unwrap();
-        assert!(matches!(input.source, Source::Closed { .. }));
+        assert!(input.source.is_none());
         let seen = std::sync::Arc::new(std::sync::Mutex::new(0));
         let count = std::sync::Arc::clone(&seen);
         input.set_notices(move |_| *count.lock().unwrap() += 1);
         assert_eq!(input.next_batch().unwrap().unwrap().bytes, [7, 8]);
         assert!(input.rewind());
-        assert!(matches!(input.source, Source::Closed { .. }));
+        assert!(input.source.is_none());
         assert_eq!(read_all(&mut input).0, [7, 8]);
-        assert!(matches!(input.source, Source::Closed { .. }));
+        assert!(input.source.is_none());
         assert_eq!(input.stream_name(0), "/dev/ttyUSB0");
         assert_eq!(*seen.lock().unwrap(), 1);
         assert!(input.rewind());

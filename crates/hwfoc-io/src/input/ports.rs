@@ -7,6 +7,9 @@ use std::time::Duration;
 use crate::notice::Notice;
 use crate::serial::{PortEvent, PortSet};
 use crate::stream::byte_times;
+use crate::time::Clock;
+
+use super::{InputError, InputFormat, Looks, Source};
 
 /// How long a serial input waits for bytes before checking for Ctrl-C.
 const PORT_POLL: Duration = Duration::from_millis(100);
@@ -59,5 +62,51 @@ impl Ports {
             }
         }
         0
+    }
+}
+
+impl InputFormat {
+    /// Live serial ports: one stream per port, times of reception (Unix seconds), read as the
+    /// bytes arrive.
+    pub const SERIAL: InputFormat = InputFormat {
+        name: "serial port",
+        short_name: "serial",
+        clock: Clock::Wall,
+        live: true,
+        recorded_ports: false,
+    };
+}
+
+impl Source for Ports {
+    fn format(&self) -> InputFormat {
+        InputFormat::SERIAL
+    }
+
+    fn fill(
+        &mut self,
+        _name: &str,
+        bytes: &mut Vec<u8>,
+        times: &mut Vec<f64>,
+        notices: &mut dyn FnMut(Notice),
+    ) -> Result<usize, InputError> {
+        bytes.clear();
+        Ok(self.read(bytes, times, notices))
+    }
+
+    fn streams(&self) -> usize {
+        self.names().len()
+    }
+
+    fn stream_name(&self, i: usize) -> Option<&str> {
+        self.names().get(i).map(String::as_str)
+    }
+
+    fn flagged_bytes(&self) -> u64 {
+        // A UART's parity and framing errors do not reach the bytes read.
+        0
+    }
+
+    fn looks(&self) -> Option<Looks> {
+        None
     }
 }

@@ -2,10 +2,11 @@
 
 use std::io::Read;
 
-use super::InputError;
+use super::{InputError, InputFormat, Looks, Source};
 use crate::notice::Notice;
 use crate::pcapng;
 use crate::stream::byte_times;
+use crate::time::Clock;
 
 /// A pcapng recording being read.
 ///
@@ -73,54 +74,6 @@ impl RecordingReader {
     /// The interfaces (ports) the recording has declared so far.
     pub(super) fn interfaces(&self) -> &[pcapng::Interface] {
         self.reader.interfaces()
-    }
-
-    /// The interfaces declared so far, the file and buffers let go.
-    pub(super) fn into_interfaces(self) -> Vec<pcapng::Interface> {
-        self.reader.into_interfaces()
-    }
-
-    /// Hands out the next batch of the current window into `bytes` and `times` (which are
-    /// empty) and returns its interface, reading the next window when this one is done;
-    /// leaves `bytes` empty at the end of the file. A read error is returned after the
-    /// bytes before it. Damage and notes in the file are told to `notices` as they are met.
-    pub(super) fn read(
-        &mut self,
-        name: &str,
-        bytes: &mut Vec<u8>,
-        times: &mut Vec<f64>,
-        notices: &mut dyn FnMut(Notice),
-    ) -> Result<usize, InputError> {
-        loop {
-            if self.draining {
-                // The window's ports in the order of their first byte: batches of a recording
-                // come in order of their first byte's time (what `Sources` merges by).
-                if let Some(next) = self.pending.get_mut(self.handed) {
-                    self.handed += 1;
-                    std::mem::swap(bytes, &mut next.bytes);
-                    std::mem::swap(times, &mut next.times);
-                    return Ok(next.iface as usize);
-                }
-                self.draining = false;
-            }
-            if self.ended {
-                return self.error.take().map_or(Ok(0), Err);
-            }
-            for mut done in self.pending.drain(..) {
-                done.bytes.clear();
-                done.times.clear();
-                self.spare.push((done.bytes, done.times));
-            }
-            self.slot.clear();
-            self.handed = 0;
-            if let Err(e) = self.read_window(name, notices) {
-                self.error = Some(e);
-                self.ended = true;
-            }
-            self.pending
-                .sort_by(|a, b| (a.times[0].total_cmp(&b.times[0])).then(a.iface.cmp(&b.iface)));
-            self.draining = true;
-        }
     }
 
     /// Reads packets into the per-interface buffers until the window is over, a buffer is
@@ -201,5 +154,95 @@ impl RecordingReader {
                 damage,
             });
         }
+    }
+}
+
+impl InputFormat {
+    /// A pcapng recording: one stream per interface, each the port it names, times from the
+    /// packets' timestamps (Unix seconds).
+    pub const RECORDING: InputFormat = InputFormat {
+        name: "pcapng recording",
+        short_name: "pcapng",
+        clock: Clock::Wall,
+        live: false,
+        recorded_ports: true,
+    };
+}
+
+/// Whether `head`, an input's first bytes (12 of them, or all there are), starts a pcapng
+/// recording: the section header's type, 0A 0D 0D 0A, and its byte-order magic at bytes 8..12.
+pub(super) fn is_start(head: &[u8]) -> bool {
+    head.starts_with(&pcapng::MAGIC)
+        && (head.len() < 12
+            || matches!(
+                head[8..12],
+                [0x4D, 0x3C, 0x2B, 0x1A] | [0x1A, 0x2B, 0x3C, 0x4D]
+            ))
+}
+
+impl Source for RecordingReader {
+    fn format(&self) -> InputFormat {
+        InputFormat::RECORDING
+    }
+
+    /// Hands out the next batch of the current window into `bytes` and `times` and returns
+    /// its interface, reading the next window when this one is done;
+    /// leaves `bytes` empty at the end of the file. A read error is returned after the
+    /// bytes before it. Damage and notes in the file are told to `notices` as they are met.
+    fn fill(
+        &mut self,
+        name: &str,
+        bytes: &mut Vec<u8>,
+        times: &mut Vec<f64>,
+        notices: &mut dyn FnMut(Notice),
+    ) -> Result<usize, InputError> {
+        bytes.clear();
+        loop {
+            if self.draining {
+                // The window's ports in the order of their first byte: batches of a recording
+                // come in order of their first byte's time (what `Sources` merges by).
+                if let Some(next) = self.pending.get_mut(self.handed) {
+                    self.handed += 1;
+                    std::mem::swap(bytes, &mut next.bytes);
+                    std::mem::swap(times, &mut next.times);
+                    return Ok(next.iface as usize);
+                }
+                self.draining = false;
+            }
+            if self.ended {
+                return self.error.take().map_or(Ok(0), Err);
+            }
+            for mut done in self.pending.drain(..) {
+                done.bytes.clear();
+                done.times.clear();
+                self.spare.push((done.bytes, done.times));
+            }
+            self.slot.clear();
+            self.handed = 0;
+            if let Err(e) = self.read_window(name, notices) {
+                self.error = Some(e);
+                self.ended = true;
+            }
+            self.pending
+                .sort_by(|a, b| (a.times[0].total_cmp(&b.times[0])).then(a.iface.cmp(&b.iface)));
+            self.draining = true;
+        }
+    }
+
+    fn streams(&self) -> usize {
+        self.interfaces().len()
+    }
+
+    fn stream_name(&self, i: usize) -> Option<&str> {
+        self.interfaces().get(i).map(|f| f.name.as_str())
+    }
+
+    fn flagged_bytes(&self) -> u64 {
+        // A recording holds the bytes as read from the port, unflagged.
+        0
+    }
+
+    fn looks(&self) -> Option<Looks> {
+        None
     }
 }

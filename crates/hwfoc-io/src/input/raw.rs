@@ -1,0 +1,93 @@
+//! Raw bytes as they came off the wire: no timing, one stream.
+
+use std::io::Read;
+
+use super::{BATCH, InputError, InputFormat, Looks, Source, looks, read_some};
+use crate::notice::Notice;
+use crate::time::Clock;
+
+impl InputFormat {
+    /// Raw bytes from the wire: one stream, no receive times.
+    pub const RAW: InputFormat = InputFormat {
+        name: "raw bytes",
+        short_name: "raw",
+        clock: Clock::None,
+        live: false,
+        recorded_ports: false,
+    };
+}
+
+/// A raw input being read.
+pub(super) struct RawReader {
+    reader: Box<dyn Read>,
+    /// Bytes read during format detection, handed out first.
+    pending: Vec<u8>,
+    /// The first bytes (up to [`looks::SAMPLE`]), to say what they look like if they hold no
+    /// frame.
+    sample: Vec<u8>,
+}
+
+impl RawReader {
+    /// Reads `reader`, after `head`, the bytes format detection read of it.
+    pub(super) fn new(reader: Box<dyn Read>, head: Vec<u8>) -> RawReader {
+        RawReader {
+            reader,
+            pending: head,
+            sample: Vec::new(),
+        }
+    }
+}
+
+impl Source for RawReader {
+    fn format(&self) -> InputFormat {
+        InputFormat::RAW
+    }
+
+    fn fill(
+        &mut self,
+        name: &str,
+        bytes: &mut Vec<u8>,
+        _times: &mut Vec<f64>,
+        _notices: &mut dyn FnMut(Notice),
+    ) -> Result<usize, InputError> {
+        if !self.pending.is_empty() {
+            std::mem::swap(bytes, &mut self.pending);
+            self.pending.clear();
+        } else {
+            // The buffer keeps its length from the last read: only bytes never read into are
+            // zeroed here (zeroing all of it every time cost more than the read).
+            bytes.resize(BATCH, 0);
+            match read_some(&mut self.reader, bytes) {
+                Ok(n) => bytes.truncate(n),
+                Err(source) => {
+                    bytes.clear();
+                    return Err(InputError::Read {
+                        input: name.to_string(),
+                        source,
+                    });
+                }
+            }
+        }
+        let room = looks::SAMPLE.saturating_sub(self.sample.len());
+        self.sample
+            .extend_from_slice(&bytes[..room.min(bytes.len())]);
+        Ok(0)
+    }
+
+    fn streams(&self) -> usize {
+        1
+    }
+
+    fn stream_name(&self, _: usize) -> Option<&str> {
+        None
+    }
+
+    fn flagged_bytes(&self) -> u64 {
+        // Nothing between the wire and the file flags bytes.
+        0
+    }
+
+    fn looks(&self) -> Option<Looks> {
+        Looks::of(&self.sample)
+    }
+}

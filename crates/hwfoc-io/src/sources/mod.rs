@@ -1,0 +1,392 @@
+//! Several inputs, one decoding [`Stream`] per ESC, their records handed on in time order.
+//!
+//! Each stream of each input is one ESC, numbered input by input in the order given (a file
+//! has one stream, a recording one per interface, a set of serial ports one per port; an
+//! input's streams are numbered when its first batch is read, all the interfaces it has
+//! declared by then in their order, any declared later when they first appear), with one
+//! exception: recordings name the port of each interface, and the interfaces of recordings
+//! given together that name the same port are one ESC, one continuous stream, its bytes in the
+//! order of their times whatever the order the files are given in (the files of a rotated
+//! recording decode exactly as their bytes concatenated in time order: a frame split between
+//! two files is whole). Where two inputs hold the same port's bytes of the same time (the same
+//! recording given twice, a recording and a copy of part of it), that time is decoded once,
+//! from the input that reached it first, and the other is told of it
+//! ([`crate::notice::Notice::Overlap`]).
+//!
+//! # Time order
+//!
+//! Inputs given one after another whose clocks are alike (see [`crate::time::Clock`]:
+//! recordings, or logic-analyser CSV exports) are read together, and their records of every
+//! ESC are handed on in time order (`t_s`, then ESC number for equal times): a two-ESC
+//! recording gives its ESCs' records interleaved, several recordings are merged by time. Each
+//! ESC's own records always keep their stream's order. Raw byte files (no times) and serial
+//! ports (live: records are handed on as they arrive, which is their order) are read alone, in
+//! the order given, as is each run of inputs of one clock after another run.
+//!
+//! The files of this module: `numbering.rs` says which stream of which input is which ESC (a
+//! hub's channels by `esc_numbers.rs`, as live ports number them); `merge.rs` hands frames on
+//! in time order (a heap of the batches read ahead, a queue per ESC, the bytes two inputs hold
+//! of one port left out once); `mod.rs` reads the inputs, alone or together.
+
+mod merge;
+mod numbering;
+#[cfg(test)]
+pub(crate) mod tests;
+
+use std::collections::{HashMap, VecDeque};
+
+use hwfoc::Settings;
+use hwfoc::datalink::DatalinkStats;
+
+pub use crate::handler::Handler;
+use crate::input::{Input, InputError, InputFormat};
+use crate::settings::SettingsMap;
+use crate::stream::{EscLink, Stream};
+use crate::time::Clock;
+
+pub use self::merge::MAX_QUEUED;
+use self::merge::Queue;
+use self::numbering::{Deliver, Hub, route};
+
+/// Batches shorter than this come from a live source: what they produce is passed on at once.
+const LIVE_BATCH: usize = 4096;
+
+/// One ESC: a stream of one input.
+#[derive(Debug)]
+pub struct Esc {
+    /// Index of its input in [`Sources::inputs`].
+    pub input: usize,
+    /// Name of the stream: the port it was recorded from, or the input's name.
+    pub name: String,
+    /// Its decoder and receive times; its link statistics. (Behind a DataLink hub, the hub's
+    /// stream is that of the ESC on channel 0; the others' is never fed: see [`Sources::link`].)
+    pub stream: Stream,
+    /// Behind a DataLink hub: the ESC whose stream carries this one's frames, and its channel.
+    pub hub: Option<(usize, u8)>,
+}
+
+/// What is known about an input once it has been read.
+#[derive(Debug, Clone)]
+pub struct InputInfo {
+    /// The input as named on the command line.
+    pub name: String,
+    /// Its detected format.
+    pub format: InputFormat,
+    /// Bytes a logic analyser flagged with a parity or framing error.
+    pub flagged_bytes: u64,
+    /// Bytes read from it.
+    pub bytes: u64,
+    /// The ESC index of each of its streams, in stream order.
+    pub escs: Vec<usize>,
+    /// What its bytes look like, read to its end, when they are not telemetry (a raw input's:
+    /// text, zeros, another file format).
+    pub looks: Option<crate::input::Looks>,
+}
+
+/// The inputs of a command and the ESCs found in them.
+pub struct Sources {
+    settings: SettingsMap,
+    /// The settings of each ESC found, looked up once.
+    esc_settings: Vec<Settings>,
+    pending: Vec<Input>,
+    names: Vec<String>,
+    read: Vec<InputInfo>,
+    escs: Vec<Esc>,
+    need_timing: bool,
+    /// The ESC of each port named by a recording's interface so far.
+    ports: HashMap<String, usize>,
+    /// The ESC of each channel of each stream found to come from a DataLink hub, by the ESC
+    /// of its stream.
+    hubs: HashMap<usize, Hub>,
+    /// The ESCs of each input's streams numbered before it is read, by input.
+    numbered: Vec<Vec<Option<usize>>>,
+    queue: Queue,
+    /// By ESC: how many inputs not at their end have a stream of it.
+    readers: Vec<u32>,
+    /// By ESC: the input (index) whose bytes its stream was fed last, and the time of the last
+    /// of them.
+    fed: Vec<Option<(usize, f64)>>,
+}
+
+impl Sources {
+    /// The inputs, opened, in command-line order; data frames become records under
+    /// `settings`: one [`Settings`] for every ESC, or a [`SettingsMap`] by ESC and port.
+    pub fn new(inputs: Vec<Input>, settings: impl Into<SettingsMap>) -> Sources {
+        Sources {
+            settings: settings.into(),
+            names: inputs.iter().map(|i| i.name().to_string()).collect(),
+            pending: inputs,
+            read: Vec::new(),
+            escs: Vec::new(),
+            need_timing: false,
+            ports: HashMap::new(),
+            hubs: HashMap::new(),
+            numbered: Vec::new(),
+            esc_settings: Vec::new(),
+            queue: Queue::default(),
+            readers: Vec::new(),
+            fed: Vec::new(),
+        }
+    }
+
+    /// Makes an input without receive times an error ([`InputError::NoTiming`]): raw-byte inputs
+    /// are refused at once, before anything is read, and any other source as soon as it hands
+    /// out bytes without times.
+    pub fn require_timing(&mut self) -> Result<(), InputError> {
+        self.need_timing = true;
+        match self
+            .pending
+            .iter()
+            .find(|i| i.format().clock() == Clock::None)
+        {
+            Some(raw) => Err(InputError::NoTiming {
+                input: raw.name().to_string(),
+            }),
+            None => Ok(()),
+        }
+    }
+
+    /// The conversion settings of the records of ESCs without settings of their own.
+    pub fn settings(&self) -> &Settings {
+        self.settings.default_settings()
+    }
+
+    /// The conversion settings of ESC `esc` (default settings for an ESC not found yet).
+    pub fn esc_settings(&self, esc: usize) -> Settings {
+        match self.esc_settings.get(esc) {
+            Some(settings) => *settings,
+            None => {
+                let name = self.escs.get(esc).map_or("", |e| e.name.as_str());
+                self.settings.get(esc, name)
+            }
+        }
+    }
+
+    /// The names of all inputs, in command-line order.
+    pub fn names(&self) -> &[String] {
+        &self.names
+    }
+
+    /// The formats of the inputs not read yet (before [`Sources::run`]: all of them), in
+    /// command-line order.
+    pub fn formats(&self) -> impl Iterator<Item = (&str, InputFormat)> {
+        self.pending.iter().map(|i| (i.name(), i.format()))
+    }
+
+    /// The inputs read so far, in command-line order.
+    pub fn inputs(&self) -> &[InputInfo] {
+        &self.read
+    }
+
+    /// The clock of the inputs read so far, if they all have the same one (see
+    /// [`crate::time::Clock`]): whether their times can be shown as dates.
+    pub fn clock(&self) -> Option<Clock> {
+        let first = self.read.first()?.format.clock();
+        self.read
+            .iter()
+            .all(|i| i.format.clock() == first)
+            .then_some(first)
+    }
+
+    /// The ESCs found so far, by index.
+    pub fn escs(&self) -> &[Esc] {
+        &self.escs
+    }
+
+    /// The DataLink hubs found: the ESC whose stream each came in (its channel 0), and the
+    /// hub link's statistics.
+    pub fn hubs(&self) -> impl Iterator<Item = (usize, DatalinkStats)> + '_ {
+        let mut owners: Vec<usize> = self.hubs.keys().copied().collect();
+        owners.sort_unstable();
+        owners
+            .into_iter()
+            .filter_map(|esc| Some((esc, *self.escs[esc].stream.hub()?)))
+    }
+
+    /// Whether ESC `esc` is a channel of a DataLink hub.
+    pub fn is_hub(&self, esc: usize) -> bool {
+        self.escs[esc].hub.is_some() || self.hubs.contains_key(&esc)
+    }
+
+    /// The link statistics of ESC `esc` (behind a DataLink hub, its channel's and the hub
+    /// link's).
+    pub fn link(&self, esc: usize) -> EscLink {
+        match self.escs[esc].hub {
+            Some((owner, channel)) => self.escs[owner].stream.link(channel),
+            None => self.escs[esc].stream.stats(),
+        }
+    }
+
+    /// Whether any ESC's bytes gave a data frame (`decode`, `summary` and `plot` fail alike
+    /// when none did).
+    pub fn any_data_frame(&self) -> bool {
+        (0..self.escs.len()).any(|esc| self.link(esc).frames() > 0)
+    }
+
+    /// The most frames that waited at once in the time-order queue (at most [`MAX_QUEUED`]).
+    pub fn peak_queued(&self) -> usize {
+        self.queue.peak
+    }
+
+    /// Reads every input to its end, handing each frame (in time order, see the module
+    /// documentation) and the end of each batch to `handler`.
+    ///
+    /// On an input error, the frames of the bytes before it are still decoded (every stream is
+    /// finished), and the error is returned without reading further.
+    pub fn run<H: Handler>(&mut self, handler: &mut H) -> Result<(), H::Error> {
+        let mut inputs: VecDeque<Input> = std::mem::take(&mut self.pending).into();
+        self.number_inputs(&inputs);
+        let mut result = Ok(());
+        while let Some(first) = inputs.front() {
+            let clock = first.format().clock();
+            let merged = first.format().is_merged_in_time();
+            let n = if merged {
+                inputs
+                    .iter()
+                    .take_while(|i| i.format().is_merged_in_time() && i.format().clock() == clock)
+                    .count()
+            } else {
+                1
+            };
+            let run: Vec<Input> = inputs.drain(..n).collect();
+            let more_recordings = inputs.iter().any(|i| i.format().has_recorded_ports());
+            result = if merged {
+                self.read_together(run, more_recordings, handler)
+            } else {
+                run.into_iter()
+                    .try_for_each(|input| self.read_alone(input, handler))
+            };
+            if result.is_err() {
+                break;
+            }
+        }
+        for esc in 0..self.escs.len() {
+            self.finish(esc);
+        }
+        self.release(f64::INFINITY, handler);
+        // A hub's channels that carried an ESC are ESCs of its input.
+        for esc in 0..self.escs.len() {
+            if self.escs[esc].hub.is_some() && self.link(esc).frames() > 0 {
+                let escs = &mut self.read[self.escs[esc].input].escs;
+                escs.push(esc);
+                escs.sort_unstable();
+            }
+        }
+        result?;
+        handler.end_batch(false)
+    }
+
+    /// Ends the stream of ESC `esc`, its last frames to the queue: a frame cut off at the end
+    /// is dropped, frames inside it are still found. Harmless on a stream already finished.
+    fn finish(&mut self, esc: usize) {
+        let queue = &mut self.queue;
+        let hub = self.hubs.get(&esc);
+        let mut pending = Vec::new();
+        self.escs[esc].stream.finish(|t, channel, d| {
+            if let Some((esc, _)) = route(esc, hub, t, channel, d, &mut pending) {
+                queue.push(esc, t, d);
+            }
+        });
+        self.deliver(esc, pending, &mut Deliver::<()>::Queue);
+    }
+
+    /// Notes what is known of an input at its end; its ESCs have one reader fewer.
+    fn close(&mut self, input: &Input, index: usize, escs: &[Option<usize>], bytes: u64) {
+        let info = &mut self.read[index];
+        info.flagged_bytes = input.flagged_bytes();
+        info.bytes = bytes;
+        info.looks = input.looks();
+        info.escs = escs.iter().flatten().copied().collect();
+        for &esc in escs.iter().flatten() {
+            self.readers[esc] -= 1;
+        }
+    }
+
+    /// Notes an input as begun, in command-line order.
+    fn open(&mut self, input: &Input) -> usize {
+        self.read.push(InputInfo {
+            name: input.name().to_string(),
+            format: input.format(),
+            flagged_bytes: 0,
+            bytes: 0,
+            escs: Vec::new(),
+            looks: None,
+        });
+        self.read.len() - 1
+    }
+
+    /// Reads an input without times (or a live one) to its end, its frames handed on as they
+    /// are decoded: the path of `summary` on a raw file, kept to the decoder's loop.
+    fn read_alone<H: Handler>(
+        &mut self,
+        mut input: Input,
+        handler: &mut H,
+    ) -> Result<(), H::Error> {
+        let index = self.open(&input);
+        let mut escs = self.numbered(index);
+        let mut bytes = 0;
+        let result = self.read_input(&mut input, index, &mut escs, &mut bytes, handler);
+        self.number_streams(&input, index, &mut escs);
+        // A recorded port's stream may go on in the next recording: it is finished at the
+        // end of the run. Other streams end with their input.
+        if !input.format().has_recorded_ports() {
+            for &esc in escs.iter().flatten() {
+                self.finish(esc);
+            }
+        }
+        self.release(f64::INFINITY, handler);
+        self.close(&input, index, &escs, bytes);
+        result?;
+        handler.end_batch(false)
+    }
+
+    fn read_input<H: Handler>(
+        &mut self,
+        input: &mut Input,
+        index: usize,
+        escs: &mut Vec<Option<usize>>,
+        bytes: &mut u64,
+        handler: &mut H,
+    ) -> Result<(), H::Error> {
+        loop {
+            let Some(batch) = input.next_batch()? else {
+                return Ok(());
+            };
+            if self.need_timing && batch.times.is_none() {
+                return Err(InputError::NoTiming {
+                    input: self.names[index].clone(),
+                }
+                .into());
+            }
+            let (stream, len) = (batch.stream, batch.bytes.len());
+            *bytes += len as u64;
+            // The batch borrows the input: its stream's ESC is found first, by a second look.
+            let _ = batch;
+            let esc = self.esc_of(input, index, stream, escs)?;
+            let Some(batch) = input.current_batch() else {
+                continue;
+            };
+            let id = u8::try_from(esc).unwrap_or(u8::MAX);
+            let settings = &self.esc_settings(esc);
+            let hub = self.hubs.get(&esc);
+            let mut pending = Vec::new();
+            // Inlined into the decoder's loop, so that the handler may be too: a frame's fields
+            // then reach it in registers, not through a `Frame` stored and loaded back.
+            self.escs[esc].stream.feed(
+                batch,
+                #[inline(always)]
+                |t, channel, d| match route(esc, hub, t, channel, d, &mut pending) {
+                    Some((_, None)) => handler.frame(id, t, d, settings),
+                    Some((esc, Some(settings))) => {
+                        if let Ok(esc) = u8::try_from(esc) {
+                            handler.frame(esc, t, d, settings);
+                        }
+                    }
+                    None => {}
+                },
+            );
+            self.deliver(esc, pending, &mut Deliver::Handler(handler));
+            handler.end_batch(len < LIVE_BATCH)?;
+        }
+    }
+}

@@ -1,0 +1,202 @@
+//! Which stream of which input is which ESC: an input's streams in the order given, the
+//! recordings of one port one ESC, a hub's channels after all inputs' streams (see [`super`]).
+
+use std::collections::VecDeque;
+
+use hwfoc::Settings;
+use hwfoc::datalink::CHANNELS;
+use hwfoc::telemetry::Frame;
+
+use super::{Esc, Handler, Sources};
+use crate::esc_numbers::{MAX_ESCS, UNNUMBERED, hub_channels};
+use crate::input::{Input, InputError};
+use crate::stream::Stream;
+
+impl Sources {
+    /// Hands on the frames of a stream just found to come from a DataLink hub, once its
+    /// channels have ESCs (made here, in channel order: channel 0 is the stream's own ESC): to
+    /// a handler, or to the time-order queue.
+    pub(super) fn deliver<H: Handler>(
+        &mut self,
+        esc: usize,
+        pending: Vec<Pending>,
+        to: &mut Deliver<'_, H>,
+    ) {
+        if pending.is_empty() {
+            return;
+        }
+        let hub = match self.hubs.get(&esc) {
+            Some(&hub) => hub,
+            None => {
+                let escs = hub_channels(esc, self.escs.len());
+                for (channel, &number) in escs.iter().enumerate().skip(1) {
+                    if number == UNNUMBERED {
+                        continue;
+                    }
+                    debug_assert_eq!(number, self.escs.len());
+                    self.push_esc(Esc {
+                        input: self.escs[esc].input,
+                        name: self.escs[esc].name.clone(),
+                        stream: Stream::new(),
+                        hub: Some((esc, channel as u8)),
+                    });
+                }
+                let settings = escs.map(|e| self.esc_settings(e));
+                let hub = Hub { escs, settings };
+                self.hubs.insert(esc, hub);
+                hub
+            }
+        };
+        for (t, channel, d) in pending {
+            let c = usize::from(channel);
+            let Some(&id) = hub.escs.get(c).filter(|&&e| e != UNNUMBERED) else {
+                continue;
+            };
+            match to {
+                Deliver::Handler(handler) => {
+                    handler.frame(id as u8, t, &d, &hub.settings[c]);
+                }
+                Deliver::Queue => self.queue.push(id, t, &d),
+            }
+        }
+    }
+
+    /// A new ESC, its settings looked up once.
+    fn push_esc(&mut self, esc: Esc) {
+        let settings = self.settings.get(self.escs.len(), &esc.name);
+        self.escs.push(esc);
+        self.esc_settings.push(settings);
+        self.readers.push(0);
+        self.fed.push(None);
+    }
+
+    /// The ESC of stream `stream` of `input` (number `index`), made when first seen; `escs`
+    /// holds the ESCs of the input's streams so far.
+    pub(super) fn esc_of(
+        &mut self,
+        input: &Input,
+        index: usize,
+        stream: usize,
+        escs: &mut Vec<Option<usize>>,
+    ) -> Result<usize, InputError> {
+        if let Some(&Some(esc)) = escs.get(stream) {
+            return Ok(esc);
+        }
+        let name = input.stream_name(stream);
+        let recorded = input.format().has_recorded_ports();
+        let earlier = self
+            .ports
+            .get(&name)
+            .copied()
+            .filter(|e| recorded && !escs.contains(&Some(*e)));
+        let esc = match earlier {
+            Some(esc) => esc,
+            None => {
+                if self.escs.len() >= MAX_ESCS {
+                    return Err(InputError::TooManyEscs {
+                        input: self.names[index].clone(),
+                    });
+                }
+                if recorded {
+                    self.ports.insert(name.clone(), self.escs.len());
+                }
+                self.push_esc(Esc {
+                    input: index,
+                    name,
+                    stream: Stream::new(),
+                    hub: None,
+                });
+                self.escs.len() - 1
+            }
+        };
+        if escs.len() <= stream {
+            escs.resize(stream + 1, None);
+        }
+        escs[stream] = Some(esc);
+        self.readers[esc] += 1;
+        Ok(esc)
+    }
+
+    /// Numbers every stream `input` has declared so far (streams declared but never heard
+    /// from are ESCs all the same, as far as an `esc` index can number them).
+    pub(super) fn number_streams(
+        &mut self,
+        input: &Input,
+        index: usize,
+        escs: &mut Vec<Option<usize>>,
+    ) {
+        for stream in 0..input.streams() {
+            if self.esc_of(input, index, stream, escs).is_err() {
+                break;
+            }
+        }
+    }
+
+    /// Numbers the streams of the inputs before they are read (one for a file or standard
+    /// input, one per port), in the order given up to the first recording (which declares its
+    /// ports as it is read: they and the inputs after them are numbered as they are read): the
+    /// channels of a DataLink hub, found later in any of them, take numbers after all of these,
+    /// as they do live (see [`PortStreams`](crate::stream::PortStreams)).
+    pub(super) fn number_inputs(&mut self, inputs: &VecDeque<Input>) {
+        let base = self.read.len();
+        self.numbered.resize(base, Vec::new());
+        for (k, input) in inputs.iter().enumerate() {
+            if input.format().has_recorded_ports() {
+                break;
+            }
+            let mut escs = Vec::new();
+            self.number_streams(input, base + k, &mut escs);
+            self.numbered.push(escs);
+        }
+    }
+
+    /// The ESCs of input `index`'s streams numbered before it was read.
+    pub(super) fn numbered(&mut self, index: usize) -> Vec<Option<usize>> {
+        self.numbered
+            .get_mut(index)
+            .map(std::mem::take)
+            .unwrap_or_default()
+    }
+}
+
+/// The ESCs of a DataLink hub's channels, and their settings.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Hub {
+    escs: [usize; CHANNELS],
+    settings: [Settings; CHANNELS],
+}
+
+/// A frame of a DataLink channel that has no ESC yet: its time, channel and frame.
+pub(super) type Pending = (Option<f64>, u8, Frame);
+
+/// The ESC a frame of the stream of ESC `own` belongs to: `own` on its own wire; behind a hub
+/// whose channels are numbered (`hub`), its channel's ESC with that ESC's settings; `None` for a
+/// channel the `esc` column cannot number, or when the hub's channels are not numbered yet (the
+/// frame then waits in `pending`).
+#[inline(always)]
+pub(super) fn route<'h>(
+    own: usize,
+    hub: Option<&'h Hub>,
+    t: Option<f64>,
+    channel: Option<u8>,
+    d: &Frame,
+    pending: &mut Vec<Pending>,
+) -> Option<(usize, Option<&'h Settings>)> {
+    match (channel, hub) {
+        (None, _) => Some((own, None)),
+        (Some(c), Some(hub)) => {
+            let c = usize::from(c);
+            (hub.escs[c] != UNNUMBERED).then(|| (hub.escs[c], Some(&hub.settings[c])))
+        }
+        (Some(c), None) => {
+            pending.push((t, c, *d));
+            None
+        }
+    }
+}
+
+/// Where [`Sources::deliver`] hands frames: a handler, or the time-order queue.
+pub(super) enum Deliver<'a, H> {
+    Handler(&'a mut H),
+    Queue,
+}
