@@ -4,9 +4,9 @@ use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Duration;
 
+use crate::clock::byte_times;
 use crate::notice::Notice;
 use crate::serial::{PortEvent, PortSet};
-use crate::stream::byte_times;
 
 /// How long a serial input waits for bytes before checking for Ctrl-C.
 const PORT_POLL: Duration = Duration::from_millis(100);
