@@ -236,6 +236,21 @@ pub struct Config {
     pub file: File,
 }
 
+impl SettingsArgs {
+    /// The configuration file these flags point to, read (see [`Config::load`]).
+    pub fn config(&self) -> Result<Config, CliError> {
+        Config::load(self, false)
+    }
+
+    /// The configuration file read and every ESC's settings: the file's, and the flags over
+    /// them.
+    pub fn settings_map(&self) -> Result<(Config, SettingsMap), CliError> {
+        let config = self.config()?;
+        let map = config.settings_map(self)?;
+        Ok((config, map))
+    }
+}
+
 /// The per-user configuration file, whether or not it exists.
 pub fn default_path() -> Option<PathBuf> {
     dirs::config_dir().map(|d| d.join("hwfoc").join("config.toml"))

@@ -366,7 +366,7 @@ impl Session {
     /// Starts recording to `path` (never the configuration file read, even with
     /// `--overwrite`).
     pub fn start_recording(&mut self, path: String) -> Result<(), CliError> {
-        hwfoc_io::write::refuse_input(&path, self.config_file.as_deref())?;
+        crate::safety::refuse_input(&path, self.config_file.as_deref())?;
         let plan = capture::Plan {
             output: path.clone(),
             rotate_size: None,

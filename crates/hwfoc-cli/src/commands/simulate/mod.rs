@@ -351,7 +351,7 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
     };
     let reads: Vec<std::path::PathBuf> = profile
         .into_iter()
-        .chain(crate::args::config_read(&config))
+        .chain(crate::safety::config_read(&config))
         .collect();
     refuse_clashes(&plan, n, &reads)?;
     let fleet = args.model.fleet(n, args.baud, &settings)?;
@@ -482,7 +482,7 @@ fn refuse_clashes(plan: &Plan, n: usize, reads: &[std::path::PathBuf]) -> Result
         outputs.push(("--truth", truth.clone()));
     }
     for (i, (option, out)) in outputs.iter().enumerate() {
-        hwfoc_io::write::refuse_input(out, reads.iter().map(std::path::PathBuf::as_path))?;
+        crate::safety::refuse_input(out, reads.iter().map(std::path::PathBuf::as_path))?;
         let earlier = outputs[..i]
             .iter()
             .find(|(_, o)| o == out || hwfoc_io::write::same_file(o, out));
