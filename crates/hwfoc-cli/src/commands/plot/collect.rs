@@ -27,10 +27,8 @@ use hwfoc_io::energy::{self, Energy};
 use hwfoc_io::episode::{Episode, Mark};
 use hwfoc_io::record::Record;
 use hwfoc_io::select::{Selection, Window};
-use hwfoc_io::sources::{Handler, Sources};
+use hwfoc_io::sources::Handler;
 use hwfoc_io::write::WriteError;
-
-use super::{Options, Target};
 
 /// The nominal time between two data frames of a running ESC, s: the clock of inputs without
 /// receive times, and the width given to a fault episode's last frame.
@@ -431,6 +429,11 @@ pub struct Collector {
     stop: Option<(Arc<AtomicBool>, String)>,
 }
 
+/// Buckets per ESC for an image `width` pixels wide: at least two per pixel of a panel.
+pub fn buckets_for(width: u32) -> usize {
+    (width as usize / 2).max(256)
+}
+
 impl Collector {
     /// A collector for an image `width` pixels wide, of the frames in `selection`, whose
     /// records were converted under `settings`.
@@ -438,7 +441,7 @@ impl Collector {
         Collector {
             settings,
             selection,
-            buckets: super::draw::buckets_for(width),
+            buckets: buckets_for(width),
             escs: Vec::new(),
             stop: None,
         }
@@ -478,18 +481,11 @@ impl Collector {
         self.escs.get(esc)
     }
 
-    /// Draws the plot of what was read from `sources` and writes it to `target`.
-    pub fn write(
-        &mut self,
-        sources: &Sources,
-        options: &Options,
-        target: &mut Target,
-    ) -> Result<(), CliError> {
+    /// Ends every ESC's data: what was read is then ready to be drawn.
+    pub fn finish(&mut self) {
         for esc in &mut self.escs {
             esc.finish();
         }
-        let image = super::draw::render(self, sources, options, target)?;
-        target.write(&image)
     }
 }
 

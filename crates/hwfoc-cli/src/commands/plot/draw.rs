@@ -138,11 +138,6 @@ const PANELS: [Panel; 6] = [
     },
 ];
 
-/// Buckets per ESC for an image `width` pixels wide: at least two per pixel of a panel.
-pub fn buckets_for(width: u32) -> usize {
-    (width as usize / 2).max(256)
-}
-
 /// The height that gives every one of `rows` ESCs a full row.
 fn default_height(rows: usize) -> u32 {
     let h = TITLE_H as usize + rows * ROW_H as usize + BOTTOM_H as usize;
@@ -163,6 +158,20 @@ fn register_fonts() -> Result<(), CliError> {
             output: String::new(),
             message: "the embedded font could not be loaded".to_string(),
         })
+    }
+}
+
+impl Collector {
+    /// Draws the plot of what was read from `sources` and writes it to `target`.
+    pub fn write(
+        &mut self,
+        sources: &Sources,
+        options: &Options,
+        target: &mut Target,
+    ) -> Result<(), CliError> {
+        self.finish();
+        let image = render(self, sources, options, target)?;
+        target.write(&image)
     }
 }
 
