@@ -24,19 +24,21 @@ pub fn unix_now_ns() -> u64 {
         .map_or(0, |d| d.as_nanos() as u64)
 }
 
-/// Unix time in nanoseconds that never goes backwards: the wall clock when the clock was made,
-/// advanced by a monotonic clock (so that a clock step during a recording does not reorder it).
+/// The clock that stamps what is received (ports, the simulator, recordings): Unix time in
+/// nanoseconds that never goes backwards, the wall clock when the clock was made advanced by a
+/// monotonic clock (so that a clock step during a recording does not reorder it). Not to be
+/// confused with [`crate::time::Clock`], which says what a source's times mean.
 #[derive(Debug, Clone, Copy)]
-pub struct Clock {
+pub struct ReceiveClock {
     wall_ns: u64,
     start: Instant,
 }
 
-impl Clock {
+impl ReceiveClock {
     /// A clock anchored at the wall-clock time now.
-    pub fn new() -> Clock {
+    pub fn new() -> ReceiveClock {
         let wall_ns = unix_now_ns();
-        Clock {
+        ReceiveClock {
             wall_ns,
             start: Instant::now(),
         }
@@ -48,9 +50,9 @@ impl Clock {
     }
 }
 
-impl Default for Clock {
+impl Default for ReceiveClock {
     fn default() -> Self {
-        Clock::new()
+        ReceiveClock::new()
     }
 }
 

@@ -4,7 +4,8 @@
 //! A source's clock ([`Clock`], from its [`InputFormat`]) says what its `t_s` numbers mean:
 //! Unix seconds for pcapng recordings and serial ports ([`Clock::Wall`]), seconds from the
 //! start of the capture for a logic-analyser CSV export ([`Clock::Capture`]), nothing for raw
-//! bytes ([`Clock::None`]). Only wall-clock times are shown as dates.
+//! bytes ([`Clock::None`]). Only wall-clock times are shown as dates. (The clock that stamps
+//! what is received is [`crate::clock::ReceiveClock`].)
 //!
 //! # The grammar of a time ([`parse`])
 //!

@@ -252,7 +252,7 @@ fn live(
     errors: &mut Errors,
 ) -> Result<(), CliError> {
     let stop = hwfoc_io::stop::interrupted();
-    let clock = hwfoc_io::clock::Clock::new();
+    let clock = hwfoc_io::clock::ReceiveClock::new();
     while !stop.load(Ordering::Relaxed) && deadline.is_none_or(|d| Instant::now() < d) {
         let mut msg = match rx.recv_timeout(POLL) {
             Ok(msg) => Some(msg),
@@ -279,7 +279,7 @@ fn take(
     names: &[String],
     streams: &mut PortStreams,
     per_byte_ns: f64,
-    clock: &hwfoc_io::clock::Clock,
+    clock: &hwfoc_io::clock::ReceiveClock,
     fanout: &mut Fanout,
 ) {
     match event {

@@ -25,7 +25,7 @@ use self::config::{AlarmKeys, Config, Overrides};
 use self::feed::{Feed, Msg};
 use self::fleet::Fleet;
 use self::perf::Perf;
-use super::capture::{self, Recorder};
+use super::record::{self, Recorder};
 use crate::args::SettingsArgs;
 use crate::commands::simulate::ModelArgs;
 use crate::error::CliError;
@@ -173,7 +173,7 @@ pub struct Session {
     rx: Receiver<Msg>,
     tx: mpsc::Sender<Msg>,
     feed: Option<Feed>,
-    clock: hwfoc_io::clock::Clock,
+    clock: hwfoc_io::clock::ReceiveClock,
     names: Vec<String>,
     baud: u32,
     record_dir: PathBuf,
@@ -237,7 +237,7 @@ impl Session {
         // The ports' own clock, so that ages and recordings agree with their timestamps.
         let clock = match &feed {
             Feed::Ports(readers) => readers.clock(),
-            Feed::Simulated { .. } => hwfoc_io::clock::Clock::new(),
+            Feed::Simulated { .. } => hwfoc_io::clock::ReceiveClock::new(),
         };
         let now = clock.now_ns() as f64 / 1e9;
         let fleet = Fleet::new(
@@ -367,7 +367,7 @@ impl Session {
     /// `--overwrite`).
     pub fn start_recording(&mut self, path: String) -> Result<(), CliError> {
         crate::safety::refuse_input(&path, self.config_file.as_deref())?;
-        let plan = capture::Plan {
+        let plan = record::Plan {
             output: path.clone(),
             rotate_size: None,
             rotate_time: None,
