@@ -67,9 +67,10 @@ impl Limits {
     }
 }
 
-/// Everything the monitor is set to.
+/// Everything the monitor is set to: the configuration file read ([`crate::config::Config`])
+/// with the flags over it and the defaults under it.
 #[derive(Debug)]
-pub struct Config {
+pub struct Setup {
     /// Where the configuration file was read from, if one was.
     pub file: Option<PathBuf>,
     /// Conversion settings, by ESC and port.
@@ -107,15 +108,15 @@ pub fn default_record_dir() -> PathBuf {
         .unwrap_or_else(|| PathBuf::from("."))
 }
 
-impl Config {
+impl Setup {
     /// Reads the configuration file (the one named, or the per-user one if it exists) and
     /// applies the flags over it.
-    pub fn load(flags: &Overrides) -> Result<Config, CliError> {
+    pub fn load(flags: &Overrides) -> Result<Setup, CliError> {
         let general = crate::config::Config::load(&flags.settings, true)?;
-        Config::merge(general, flags)
+        Setup::merge(general, flags)
     }
 
-    fn merge(general: crate::config::Config, flags: &Overrides) -> Result<Config, CliError> {
+    fn merge(general: crate::config::Config, flags: &Overrides) -> Result<Setup, CliError> {
         let origin = |key: &str| match &general.path {
             Some(p) => format!("{} ({key})", p.display()),
             None => format!("--{}", key.replace('_', "-")),
@@ -196,7 +197,7 @@ impl Config {
                 "there must be at least one cell",
             ));
         }
-        Ok(Config {
+        Ok(Setup {
             file: general.path.clone(),
             settings,
             baud,
@@ -229,11 +230,11 @@ mod tests {
     use super::*;
     use hwfoc::Settings;
 
-    fn parse(text: &str) -> Result<Config, CliError> {
+    fn parse(text: &str) -> Result<Setup, CliError> {
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("monitor.toml");
         std::fs::write(&path, text).unwrap();
-        Config::load(&Overrides {
+        Setup::load(&Overrides {
             settings: SettingsArgs {
                 config: Some(path),
                 ..SettingsArgs::default()
@@ -244,7 +245,7 @@ mod tests {
 
     #[test]
     fn defaults_without_a_file() {
-        let config = Config::load(&Overrides {
+        let config = Setup::load(&Overrides {
             settings: SettingsArgs {
                 no_config: true,
                 ..SettingsArgs::default()
@@ -290,7 +291,7 @@ mod tests {
             ..Overrides::default()
         };
         flags.alarms.mos_warning_c = Some(70.0);
-        let config = Config::load(&flags).unwrap();
+        let config = Setup::load(&flags).unwrap();
         assert_eq!(config.baud, 9600);
         assert_eq!(config.limits.mos.warning, 70.0);
         assert_eq!(config.limits.mos.critical, 95.0);
@@ -317,7 +318,7 @@ mod tests {
 
     #[test]
     fn a_missing_named_file_is_an_error() {
-        let err = Config::load(&Overrides {
+        let err = Setup::load(&Overrides {
             settings: SettingsArgs {
                 config: Some(PathBuf::from("/nonexistent/monitor.toml")),
                 ..SettingsArgs::default()

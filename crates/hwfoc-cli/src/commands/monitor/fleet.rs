@@ -690,11 +690,11 @@ impl Fleet {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::commands::monitor::config::{Config, Overrides};
+    use crate::commands::monitor::config::{Overrides, Setup};
     use hwfoc::{DataFrame, Status};
 
     fn fleet(n: usize) -> Fleet {
-        let config = Config::load(&Overrides {
+        let config = Setup::load(&Overrides {
             settings: crate::args::SettingsArgs {
                 no_config: true,
                 ..Default::default()
