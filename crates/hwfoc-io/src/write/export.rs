@@ -135,21 +135,21 @@ enum Pipeline {
     Parquet { spare: Receiver<Chunk> },
 }
 
-/// Where the output goes.
-pub(crate) struct Destination {
+/// An opened output: its name, for errors, and its writer.
+pub(crate) struct Sink {
     /// The output as named on the command line, or "standard output".
     pub name: String,
     /// The open file or standard output.
     pub writer: Box<dyn Write + Send>,
 }
 
-impl Destination {
+impl Sink {
     /// Opens the output: standard output for `None` or `-`; a new or regular file under a
     /// temporary name (see [`Staging`]), renamed over it once complete; anything else (a device
     /// such as `/dev/null`, a pipe) as it is.
-    fn open(path: Option<&str>) -> Result<(Destination, Option<Staging>), WriteError> {
+    fn open(path: Option<&str>) -> Result<(Sink, Option<Staging>), WriteError> {
         let Some(path) = path.filter(|&p| p != "-") else {
-            let stdout = Destination {
+            let stdout = Sink {
                 name: "standard output".to_string(),
                 writer: Box::new(io::stdout()),
             };
@@ -169,11 +169,11 @@ impl Destination {
             let (staging, file) = Staging::create(Path::new(path)).map_err(create_error)?;
             (file, Some(staging))
         };
-        let destination = Destination {
+        let sink = Sink {
             name: path.to_string(),
             writer: Box::new(file::OutputFile::new(file)),
         };
-        Ok((destination, staged))
+        Ok((sink, staged))
     }
 
     /// A write error, naming the output.
@@ -192,7 +192,7 @@ impl Export {
         path: Option<&str>,
         provenance: Provenance,
     ) -> Result<Export, WriteError> {
-        let (sink, staged) = Destination::open(path)?;
+        let (sink, staged) = Sink::open(path)?;
         let default = provenance.settings;
         type Work = Box<dyn FnOnce() -> Result<(), WriteError> + Send>;
         let (tx, mode, work): (SyncSender<ToWriter>, Pipeline, Work) = match format {

@@ -36,7 +36,7 @@ mod staging;
 mod text;
 
 pub use export::Export;
-pub(crate) use export::{Chunk, Destination, EscTable, ToWriter};
+pub(crate) use export::{Chunk, EscTable, Sink, ToWriter};
 pub use json::{esc_settings_json, settings_json};
 pub use safety::{FileId, create_file, same_file};
 pub use staging::{PARTIAL_SUFFIX, Staging};

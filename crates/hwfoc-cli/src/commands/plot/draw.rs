@@ -20,7 +20,7 @@ use hwfoc_io::summary::no_frames;
 use hwfoc_io::time::{self, Clock};
 
 use super::collect::{Bucket, Collector, EscData, FRAME_PERIOD, Quantity, Span};
-use super::target::{ImageFormat, Target};
+use super::target::{ImageFile, ImageFormat};
 use super::text::Glyphs;
 use super::{MAX_SIZE, Options};
 
@@ -167,7 +167,7 @@ impl Collector {
         &mut self,
         sources: &Sources,
         options: &Options,
-        target: &mut Target,
+        target: &mut ImageFile,
     ) -> Result<(), CliError> {
         self.finish();
         let image = render(self, sources, options, target)?;
@@ -180,7 +180,7 @@ pub fn render(
     collector: &Collector,
     sources: &Sources,
     options: &Options,
-    target: &Target,
+    target: &ImageFile,
 ) -> Result<Vec<u8>, CliError> {
     let scene = Scene::new(collector, sources, options)?;
     register_fonts()?;
