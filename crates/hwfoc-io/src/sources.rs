@@ -1036,7 +1036,7 @@ pub(crate) mod tests {
         assert_eq!(sources.escs()[0].stream.stats().lost_packets(), 0);
     }
 
-    /// Files other than recordings are one ESC each, as before.
+    /// Files other than recordings are one ESC each.
     #[test]
     fn files_without_port_names_are_one_esc_each() {
         let raw = |p| Input::from_memory("a.bin", wire(p)).unwrap();

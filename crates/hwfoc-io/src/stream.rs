@@ -546,7 +546,7 @@ mod tests {
     }
 
     /// A frame begun in bytes without times and ended in timed ones takes the earliest time
-    /// known (this panicked before).
+    /// known, without a panic.
     #[test]
     fn a_stream_that_becomes_timed_mid_frame() {
         let (bytes, times) = timed(&[7], 100.0);

@@ -18,12 +18,12 @@
 //!
 //! The cut at frames ([`Writer::write`]; the frames are found by the codec's decoder, module
 //! `cut`) makes each packet one frame in Wireshark (with the dissector `hwfoc wireshark install`
-//! puts in place) and the file small: about 2.4 times the bytes on the wire, where the earlier
-//! layout (one packet per read of the port, cut anywhere in the frames) took 4.8. A reader needs
-//! no change for either: the bytes of each port, concatenated in file order, are the stream, and
-//! every frame's first byte has the same time in both (to a nanosecond's rounding). Files of the
-//! earlier layout read exactly as before. Packets of different ports may be a frame's length out
-//! of time order in the file, since a frame is written when it is complete.
+//! puts in place) and the file small: about 2.4 times the bytes on the wire, where the
+//! read-chunk layout (one packet per read of the port, cut anywhere in the frames) takes 4.8.
+//! [`Reader`] reads both alike: the bytes of each port, concatenated in file order, are the
+//! stream, and every frame's first byte has the same time in both (to a nanosecond's rounding).
+//! Packets of different ports may be a frame's length out of time order in the file, since a
+//! frame is written when it is complete.
 //!
 //! The blocks are written and read here by hand rather than with the `pcap-file` crate (2.0):
 //! its EPB reader takes the raw timestamp as nanoseconds whatever the interface's `if_tsresol`

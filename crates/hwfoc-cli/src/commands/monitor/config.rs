@@ -2,7 +2,7 @@
 //! ([`crate::config`]: `[settings]`, `[port."NAME"]`, `[esc.N]`, `[monitor]`, `[alarms]`),
 //! overridden by flags.
 //!
-//! The older `hwfoc/monitor.toml` is still read when there is no `hwfoc/config.toml` (its keys
+//! The older `hwfoc/monitor.toml` is read when there is no `hwfoc/config.toml` (its keys
 //! at the top and its `[[esc]]` list of ports and labels: see [`crate::config::File`]):
 //!
 //! ```toml

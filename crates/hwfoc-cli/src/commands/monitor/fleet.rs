@@ -785,7 +785,7 @@ mod tests {
                 "esc0 mos_overheat cleared"
             ]
         );
-        // The clear names the level the alarm had (it was once logged as a warning).
+        // The clear names the level the alarm had (critical), not a warning.
         assert_eq!(f.log[1].level, Level::Critical);
         assert!(
             f.log[1]
