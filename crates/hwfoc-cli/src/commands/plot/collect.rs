@@ -609,18 +609,26 @@ mod tests {
         let mut b = Bucket::EMPTY;
         b.add(&values(&Record::new(None, 0, &f, &s)), false);
         let v = |q| b.values(q).unwrap()[0];
-        assert_eq!(v(Quantity::ThrottleIn), f64::from(f.throttle_in_pct()));
-        assert_eq!(v(Quantity::ThrottleOut), f64::from(f.throttle_out_pct()));
-        assert_eq!(v(Quantity::Rpm), f64::from(f.rpm(&s)));
-        assert_eq!(v(Quantity::Voltage), f64::from(f.voltage_v()));
+        // docs/RECORD-SCHEMA.md's formulas, to f32's precision.
+        let near = |q, expected: f64| {
+            let got = v(q);
+            assert!(
+                (got - expected).abs() <= 1e-6 * expected.abs(),
+                "{q:?}: {got} {expected}"
+            );
+        };
+        near(Quantity::ThrottleIn, 300.0 * 100.0 / 1024.0);
+        near(Quantity::ThrottleOut, 280.0 * 100.0 / 1024.0);
+        near(Quantity::Rpm, 1234.0 * 10.0 / (2.0 * 7.0));
+        near(Quantity::Voltage, 25.1);
         // 25.1 V times -1.5 A.
         assert!(
             (v(Quantity::Power) - 25.1 * -1.5).abs() < 1e-4,
             "{}",
             v(Quantity::Power)
         );
-        assert_eq!(v(Quantity::Current), f64::from(f.current_a(&s)));
-        assert_eq!(v(Quantity::PhaseCurrent), f64::from(f.phase_current_a(&s)));
+        near(Quantity::Current, -150.0 / 100.0);
+        near(Quantity::PhaseCurrent, 420.0 / 100.0);
         assert_eq!(v(Quantity::MosTemp), 28.0);
         assert_eq!(v(Quantity::CapTemp), 40.0);
     }
