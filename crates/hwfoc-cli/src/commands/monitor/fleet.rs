@@ -690,11 +690,11 @@ impl Fleet {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::commands::monitor::config::{Overrides, Setup};
+    use crate::commands::monitor::config::{MonitorSetup, Overrides};
     use hwfoc::{DataFrame, Status};
 
     fn fleet(n: usize) -> Fleet {
-        let config = Setup::load(&Overrides {
+        let config = MonitorSetup::load(&Overrides {
             settings: crate::args::SettingsArgs {
                 no_config: true,
                 ..Default::default()

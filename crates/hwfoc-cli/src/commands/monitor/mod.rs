@@ -21,7 +21,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc::{self, Receiver, RecvTimeoutError};
 use std::time::{Duration, Instant};
 
-use self::config::{AlarmKeys, Overrides, Setup};
+use self::config::{AlarmKeys, MonitorSetup, Overrides};
 use self::feed::{Feed, Msg};
 use self::fleet::Fleet;
 use self::perf::Perf;
@@ -121,7 +121,7 @@ const MIN_INTERVAL_S: f64 = 0.05;
 
 /// Runs `hwfoc monitor`.
 pub fn run(args: &MonitorArgs) -> Result<(), CliError> {
-    let config = Setup::load(&Overrides {
+    let config = MonitorSetup::load(&Overrides {
         settings: args.settings.clone(),
         baud: args.baud,
         record_dir: args.record_dir.clone(),
@@ -186,7 +186,7 @@ pub struct Session {
 }
 
 impl Session {
-    fn start(args: &MonitorArgs, config: Setup) -> Result<Session, CliError> {
+    fn start(args: &MonitorArgs, config: MonitorSetup) -> Result<Session, CliError> {
         let interrupted = hwfoc_io::stop::interrupted();
         let (tx, rx) = mpsc::channel();
         let ports: Vec<String> = if args.ports.is_empty() {
