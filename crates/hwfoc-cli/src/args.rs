@@ -1,17 +1,16 @@
 //! Option groups that several commands share: where telemetry comes from, the conversion
 //! settings the frames do not carry, and which frames to keep.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use clap::Args;
 use hwfoc_io::select::{Selection, Window};
 use hwfoc_io::serial;
-use hwfoc_io::settings::{SettingsMap, SettingsPatch};
+use hwfoc_io::settings::SettingsPatch;
 use hwfoc_io::sources::Sources;
 use hwfoc_io::time::{Clock, Time, TimeError};
 use hwfoc_io::{Input, InputError};
 
-use crate::config::Config;
 use crate::demo;
 use crate::error::CliError;
 
@@ -35,18 +34,6 @@ pub struct InputArgs {
 }
 
 impl InputArgs {
-    /// Refuses an output (`-`: standard output) that is a file the command reads: one of the
-    /// inputs (`-`: whatever is behind standard input) or the configuration file read (see
-    /// [`hwfoc_io::write::refuse_input`]). Call it before the output is opened.
-    pub fn refuse_output(&self, output: &str, config: &Config) -> Result<(), CliError> {
-        let config = config_read(config);
-        let inputs = self.inputs.iter().map(Path::new);
-        Ok(hwfoc_io::write::refuse_input(
-            output,
-            inputs.chain(config.as_deref()),
-        )?)
-    }
-
     /// The flag Ctrl-C and SIGTERM set ([`hwfoc_io::stop::interrupted`], whose handlers it
     /// installs), when every input is read to its end: an export or a plot of files is then
     /// abandoned on the signal, its temporary file removed. `None` for serial ports, pipes and
@@ -91,17 +78,6 @@ impl InputArgs {
                 .collect::<Result<_, InputError>>()?),
         }
     }
-}
-
-/// The configuration file `config` was read from, as [`hwfoc_io::write::refuse_input`] takes a
-/// file read (to which `-` is standard input; a configuration file named `-` is a file).
-pub fn config_read(config: &Config) -> Option<PathBuf> {
-    let path = config.path.as_ref()?;
-    Some(if path.as_os_str() == "-" {
-        Path::new(".").join(path)
-    } else {
-        path.clone()
-    })
 }
 
 /// What standard input is.
@@ -151,11 +127,6 @@ pub struct SettingsArgs {
 }
 
 impl SettingsArgs {
-    /// The configuration file these flags point to, read (see [`Config::load`]).
-    pub fn config(&self) -> Result<Config, CliError> {
-        Config::load(self, false)
-    }
-
     /// The settings set by flags.
     pub fn patch(&self) -> SettingsPatch {
         SettingsPatch {
@@ -163,14 +134,6 @@ impl SettingsArgs {
             pole_pairs: self.pole_pairs,
             gear_ratio: self.gear_ratio,
         }
-    }
-
-    /// The configuration file read and every ESC's settings: the file's, and the flags over
-    /// them.
-    pub fn settings_map(&self) -> Result<(Config, SettingsMap), CliError> {
-        let config = self.config()?;
-        let map = config.settings_map(self)?;
-        Ok((config, map))
     }
 }
 

@@ -6,7 +6,7 @@
 //! else `hwfoc/config.toml` in the user's configuration directory (`$XDG_CONFIG_HOME`, by default
 //! `~/.config`, on Linux; `~/Library/Application Support` on macOS; `%APPDATA%` on Windows) if it
 //! exists. `--no-config` reads none. `hwfoc monitor` also reads the older `hwfoc/monitor.toml`
-//! there when there is no `config.toml` (its layout is read as before: see [`File`]).
+//! there when there is no `config.toml` (its layout too: see [`File`]).
 //!
 //! ```toml
 //! [settings]              # every ESC, unless said otherwise below
@@ -58,7 +58,7 @@ pub const ENV: &str = "HWFOC_CONFIG";
 /// The file's layout. Every key is optional.
 ///
 /// The older `monitor.toml` layout is read too: `baud`, `current_scale`, `pole_pairs`,
-/// `gear_ratio` and `record_dir` at the top (today in `[settings]` and `[monitor]`), and
+/// `gear_ratio` and `record_dir` at the top (in `config.toml`: `[settings]` and `[monitor]`), and
 /// `[[esc]]` entries each naming a `port` (a port to watch and its label).
 #[derive(Debug, Default, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -234,6 +234,21 @@ pub struct Config {
     pub path: Option<PathBuf>,
     /// What it says (all empty without a file).
     pub file: File,
+}
+
+impl SettingsArgs {
+    /// The configuration file these flags point to, read (see [`Config::load`]).
+    pub fn config(&self) -> Result<Config, CliError> {
+        Config::load(self, false)
+    }
+
+    /// The configuration file read and every ESC's settings: the file's, and the flags over
+    /// them.
+    pub fn settings_map(&self) -> Result<(Config, SettingsMap), CliError> {
+        let config = self.config()?;
+        let map = config.settings_map(self)?;
+        Ok((config, map))
+    }
 }
 
 /// The per-user configuration file, whether or not it exists.
@@ -511,7 +526,7 @@ fn same_names(doc: &DeTable, text: &str) -> Option<(usize, String)> {
         .or_else(|| first_twice(settings_by_port, text, "names the same port as"))
         .or_else(|| first_twice(watched, text, "names the same port to watch as"));
 
-    // The older layout's top-level keys and the tables that hold them today.
+    // The older layout's top-level keys and the tables that hold them in `config.toml`.
     for (key, now) in [
         ("current_scale", "settings"),
         ("pole_pairs", "settings"),

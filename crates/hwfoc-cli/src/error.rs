@@ -30,6 +30,14 @@ pub enum CliError {
     Window(EmptyWindow),
     /// A conversion setting is out of range.
     Settings(hwfoc::SettingsError),
+    /// The output is a file the command reads (the same file, by whatever path): writing it
+    /// would destroy it.
+    IsInput {
+        /// The output as named on the command line.
+        output: String,
+        /// The input it is, as named on the command line.
+        input: String,
+    },
     /// Serial ports and files named together as inputs.
     MixedInputs {
         /// The first port named.
@@ -138,6 +146,11 @@ impl fmt::Display for CliError {
             CliError::Output(e) => e.fmt(f),
             CliError::Window(e) => e.fmt(f),
             CliError::Settings(e) => write!(f, "invalid setting: {e}"),
+            CliError::IsInput { output, input } => write!(
+                f,
+                "cannot write {output}: it is the input {input}, which would be destroyed; \
+                 choose another output file"
+            ),
             CliError::MixedInputs { port, file } => write!(
                 f,
                 "cannot read the serial port {port} and the file {file} together: record the \

@@ -10,14 +10,13 @@ mod config;
 mod demo;
 mod error;
 mod output;
+mod safety;
 
 use std::process::ExitCode;
 
 use clap::{CommandFactory, Parser, Subcommand};
 
-use crate::commands::{
-    bridge, capture, completions, decode, man, monitor, plot, simulate, summary,
-};
+use crate::commands::{bridge, completions, decode, man, monitor, plot, record, simulate, summary};
 use crate::error::CliError;
 
 /// Decode and analyse the telemetry of Hobbywing FOC ESCs (HW-FOC protocol, 19200 baud).
@@ -40,7 +39,7 @@ enum Command {
     /// Plot each ESC's telemetry over time, fault episodes marked (PNG or SVG).
     Plot(plot::PlotArgs),
     /// Record serial ports losslessly, with nanosecond receive times, to pcapng (Wireshark opens it).
-    Record(capture::RecordArgs),
+    Record(record::RecordArgs),
     /// Virtual ESCs: the protocol from a physical model, to a pty, serial port, file or stdout.
     Simulate(Box<simulate::SimulateArgs>),
     /// Bridge ESC telemetry (ports, recordings, virtual ESCs) to flight controllers and ground
@@ -60,7 +59,7 @@ fn main() -> ExitCode {
         Command::Monitor(args) => monitor::run(args),
         Command::Decode(args) => decode::run(args),
         Command::Summary(args) => summary::run(args),
-        Command::Record(args) => capture::run(args),
+        Command::Record(args) => record::run(args),
         Command::Simulate(args) => simulate::run(args),
         Command::Plot(args) => plot::run(args),
         Command::Bridge(args) => bridge::run(args),

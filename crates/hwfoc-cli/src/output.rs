@@ -6,18 +6,19 @@ use std::io::{self, Write};
 use crate::error::CliError;
 use hwfoc_io::write::WriteError;
 
-/// An output sink. Text is handed over in whole buffers, so nothing is lost to a later error:
-/// whatever was produced before it is written and flushed first.
-pub struct Output {
+/// A text sink: standard output or a file, opened. Text is handed over in whole buffers, so
+/// nothing is lost to a later error: whatever was produced before it is written and flushed
+/// first.
+pub struct TextSink {
     name: String,
     sink: Box<dyn Write>,
 }
 
-impl Output {
+impl TextSink {
     /// Standard output, or the file at `path` (created or truncated).
-    pub fn create(path: Option<&str>) -> Result<Output, CliError> {
+    pub fn create(path: Option<&str>) -> Result<TextSink, CliError> {
         match path {
-            None | Some("-") => Ok(Output {
+            None | Some("-") => Ok(TextSink {
                 name: "standard output".to_string(),
                 sink: Box::new(io::stdout().lock()),
             }),
@@ -26,7 +27,7 @@ impl Output {
                     output: path.to_string(),
                     source,
                 })?;
-                Ok(Output {
+                Ok(TextSink {
                     name: path.to_string(),
                     sink: Box::new(file),
                 })

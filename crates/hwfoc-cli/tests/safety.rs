@@ -359,8 +359,8 @@ fn an_output_that_is_standard_input_or_the_configuration_is_refused() {
     }
 }
 
-/// The temporary file is a new file of its own: an input named like the old fixed partial
-/// name is read whole, a link placed at that name is not followed, and the replaced file keeps
+/// The temporary file is a new file of its own: an input named as the target plus `.partial`
+/// is read whole, a link placed at that name is not followed, and the replaced file keeps
 /// its mode.
 #[cfg(unix)]
 #[test]

@@ -1,6 +1,6 @@
 //! The Wireshark dissector (`hwfoc wireshark`), run by tshark on recordings: every frame it shows
 //! as valid has exactly the values `hwfoc decode` gives (data frames) and the codec reads (device
-//! information), with the same time, in recordings of the compact layout and of the earlier
+//! information), with the same time, in recordings of the compact layout and of the
 //! read-chunk layout; bad checksums show as bad, faults by name; `install` puts it where tshark
 //! loads it and never replaces another file unasked.
 

@@ -2,6 +2,21 @@
 
 use std::time::{Instant, SystemTime, UNIX_EPOCH};
 
+/// Receive time in Unix seconds of byte `i` of a chunk whose first byte arrived at `t_ns`, the
+/// bytes `per_byte_ns` apart. The one conversion from receive timestamps to `t_s`: the
+/// simulator's ground truth uses it too, so that the two agree to the last bit.
+pub fn byte_time_s(t_ns: u64, i: usize, per_byte_ns: f64) -> f64 {
+    (t_ns as f64 + i as f64 * per_byte_ns) * 1e-9
+}
+
+/// Appends to `times` the receive times, in Unix seconds, of `n` bytes the first of which
+/// arrived at `t_ns` (Unix ns) and each next one `per_byte_ns` later (a byte time at the line's
+/// baud rate: bytes of one read arrived back to back). The one place where a chunk's receive
+/// time becomes the time of each of its bytes.
+pub fn byte_times(t_ns: u64, per_byte_ns: f64, n: usize, times: &mut Vec<f64>) {
+    times.extend((0..n).map(|i| byte_time_s(t_ns, i, per_byte_ns)));
+}
+
 /// The wall clock now, Unix time in nanoseconds (0 for a clock set before 1970).
 pub fn unix_now_ns() -> u64 {
     SystemTime::now()
@@ -9,19 +24,21 @@ pub fn unix_now_ns() -> u64 {
         .map_or(0, |d| d.as_nanos() as u64)
 }
 
-/// Unix time in nanoseconds that never goes backwards: the wall clock when the clock was made,
-/// advanced by a monotonic clock (so that a clock step during a recording does not reorder it).
+/// The clock that stamps what is received (ports, the simulator, recordings): Unix time in
+/// nanoseconds that never goes backwards, the wall clock when the clock was made advanced by a
+/// monotonic clock (so that a clock step during a recording does not reorder it). Not to be
+/// confused with [`crate::time::Clock`], which says what a source's times mean.
 #[derive(Debug, Clone, Copy)]
-pub struct Clock {
+pub struct ReceiveClock {
     wall_ns: u64,
     start: Instant,
 }
 
-impl Clock {
+impl ReceiveClock {
     /// A clock anchored at the wall-clock time now.
-    pub fn new() -> Clock {
+    pub fn new() -> ReceiveClock {
         let wall_ns = unix_now_ns();
-        Clock {
+        ReceiveClock {
             wall_ns,
             start: Instant::now(),
         }
@@ -33,9 +50,9 @@ impl Clock {
     }
 }
 
-impl Default for Clock {
+impl Default for ReceiveClock {
     fn default() -> Self {
-        Clock::new()
+        ReceiveClock::new()
     }
 }
 
@@ -43,7 +60,7 @@ impl Default for Clock {
 /// rate: 20 frame periods (an idle ESC sends a frame every ~364 ms, a read may return a
 /// little late). The same second after which the stream tells the decoder of a silence
 /// ([`crate::stream::SILENCE_S`]).
-pub const MAX_STEP_S: f64 = crate::stream::SILENCE_S;
+pub const MAX_STEP_S: f64 = 1.0;
 
 /// The longest time an ESC takes per data frame it counts in its packet number, s: an idle
 /// ESC sends one every ~364 ms, a running one every ~56 ms.

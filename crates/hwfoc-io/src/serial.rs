@@ -15,7 +15,7 @@ use std::sync::mpsc::{self, Receiver, Sender};
 use std::thread::{self, JoinHandle};
 use std::time::{Duration, Instant};
 
-use crate::clock::Clock;
+use crate::clock::ReceiveClock;
 
 use serialport::{DataBits, FlowControl, Parity, SerialPort, StopBits};
 
@@ -291,7 +291,7 @@ pub struct PortSet {
 pub struct Readers {
     names: Vec<String>,
     baud: u32,
-    clock: Clock,
+    clock: ReceiveClock,
     stop: Arc<AtomicBool>,
     threads: Vec<JoinHandle<()>>,
 }
@@ -323,7 +323,7 @@ impl Readers {
             .iter()
             .map(|name| open(name, baud))
             .collect::<Result<Vec<_>, _>>()?;
-        let clock = Clock::new();
+        let clock = ReceiveClock::new();
         let stop = Arc::new(AtomicBool::new(false));
         let threads = ports
             .into_iter()
@@ -363,7 +363,7 @@ impl Readers {
     }
 
     /// The clock the events' times come from.
-    pub fn clock(&self) -> Clock {
+    pub fn clock(&self) -> ReceiveClock {
         self.clock
     }
 
@@ -401,7 +401,7 @@ impl PortSet {
     }
 
     /// The clock the events' times come from.
-    pub fn clock(&self) -> Clock {
+    pub fn clock(&self) -> ReceiveClock {
         self.readers.clock()
     }
 
@@ -428,7 +428,7 @@ struct PortReader<M> {
     index: usize,
     name: String,
     baud: u32,
-    clock: Clock,
+    clock: ReceiveClock,
     stop: Arc<AtomicBool>,
     tx: Sender<M>,
     wrap: fn(PortEvent) -> M,
@@ -552,7 +552,7 @@ mod tests {
 
     #[test]
     fn clock_is_unix_time_and_monotonic() {
-        let clock = Clock::new();
+        let clock = ReceiveClock::new();
         let a = clock.now_ns();
         let b = clock.now_ns();
         assert!(b >= a);

@@ -2,8 +2,8 @@
 //!
 //! [`Stream`] is one ESC's stream: every command's frames come out of one (through
 //! [`crate::sources::Sources`] for inputs read to their end, through [`PortStreams`] for live
-//! port events). [`byte_times`] is the one place where a chunk's receive time becomes the time
-//! of each of its bytes.
+//! port events). [`crate::clock::byte_times`] is the one place where a chunk's receive time
+//! becomes the time of each of its bytes.
 
 use hwfoc::datalink::{self, DatalinkDecoded, DatalinkStats};
 use hwfoc::mixed::{MixedDecoded, MixedDecoder};
@@ -11,20 +11,13 @@ use hwfoc::stats::PacketSequence;
 use hwfoc::telemetry::{Data, Frame};
 use hwfoc::{LinkStats, Settings};
 
+use crate::clock::byte_times;
 use crate::esc_numbers::UNNUMBERED;
 use crate::handler::Handler;
 
 use crate::input::Batch;
-use crate::pcapng;
 use crate::serial::PortEvent;
 use crate::settings::SettingsMap;
-
-/// Appends to `times` the receive times, in Unix seconds, of `n` bytes the first of which
-/// arrived at `t_ns` (Unix ns) and each next one `per_byte_ns` later (a byte time at the line's
-/// baud rate: bytes of one read arrived back to back).
-pub fn byte_times(t_ns: u64, per_byte_ns: f64, n: usize, times: &mut Vec<f64>) {
-    times.extend((0..n).map(|i| pcapng::byte_time_s(t_ns, i, per_byte_ns)));
-}
 
 /// How many receive times to keep from earlier batches: a frame still arriving is shorter than
 /// the longest frame (a DataLink frame, 160 bytes), so its first byte is never further back
@@ -38,7 +31,7 @@ const TIME_HISTORY: usize = if hwfoc::frame::MAX_FRAME_LEN > datalink::FRAME_LEN
 /// A silence of the line longer than this, between two bytes, may hide a restart of the ESC:
 /// the decoder is told of it (see [`hwfoc::Decoder::line_silent`]). Real ESCs send a frame at
 /// least every 364 ms (idle), and a read may return a little late.
-pub const SILENCE_S: f64 = 1.0;
+pub const SILENCE_S: f64 = crate::clock::MAX_STEP_S;
 
 /// The most data frames a silence of `seconds` can have hidden: one per 24 byte times, the
 /// fastest the line carries them (real ESCs send one every 50 ms at most).
@@ -556,7 +549,7 @@ mod tests {
     }
 
     /// A frame begun in bytes without times and ended in timed ones takes the earliest time
-    /// known (this panicked before).
+    /// known, without a panic.
     #[test]
     fn a_stream_that_becomes_timed_mid_frame() {
         let (bytes, times) = timed(&[7], 100.0);

@@ -4,7 +4,8 @@
 //! A source's clock ([`Clock`], from its [`InputFormat`](crate::input::InputFormat)) says what its `t_s` numbers mean:
 //! Unix seconds for pcapng recordings and serial ports ([`Clock::Wall`]), seconds from the
 //! start of the capture for a logic-analyser CSV export ([`Clock::Capture`]), nothing for raw
-//! bytes ([`Clock::None`]). Only wall-clock times are shown as dates.
+//! bytes ([`Clock::None`]). Only wall-clock times are shown as dates. (The clock that stamps
+//! what is received is [`crate::clock::ReceiveClock`].)
 //!
 //! # The grammar of a time ([`parse`])
 //!
@@ -517,5 +518,32 @@ mod tests {
             span_text(0.5, 2.0, false),
             "the frames' t_s run from 0.5 to 2 s (the source's own clock)"
         );
+    }
+
+    /// The clock each format says it has is what its input gives: a recording's Unix time of
+    /// receipt, an analyser export's seconds of its own capture, no time for raw bytes. (Serial
+    /// ports, which need a port, give the same Unix times as the recordings made of them.)
+    #[test]
+    fn the_clock_of_a_format_is_the_times_its_input_gives() {
+        use crate::input::Input;
+        let first_time = |name: &str, data: Vec<u8>| {
+            let mut input = Input::from_memory(name, data).unwrap();
+            let format = input.format();
+            let batch = input.next_batch().unwrap().unwrap();
+            (format.clock(), batch.times.map(|t| t[0]))
+        };
+        // 2026-11-23T14:03:00Z, as the recorder stamps it.
+        let t_ns = 1_795_442_580_000_000_000;
+        let mut recording = crate::pcapng::Writer::new(Vec::new()).unwrap();
+        recording.add_interface("/dev/ttyUSB0", 19200).unwrap();
+        recording.write_packet(0, t_ns, &[0x55; 8]).unwrap();
+        let recording = recording.into_inner().unwrap();
+        assert_eq!(
+            first_time("r.pcapng", recording),
+            (Clock::Wall, Some(1_795_442_580.0))
+        );
+        let csv = b"Time [s],Value\n0.5,0x55\n0.75,0x55\n".to_vec();
+        assert_eq!(first_time("a.csv", csv), (Clock::Capture, Some(0.5)));
+        assert_eq!(first_time("a.bin", vec![0x55; 8]), (Clock::None, None));
     }
 }

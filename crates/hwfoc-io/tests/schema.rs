@@ -6,7 +6,7 @@
 
 use arrow_schema::{DataType, Field};
 use hwfoc::{DataFrame, Settings, Status};
-use hwfoc_io::record::{COLUMNS, Record, TextEncoder, UNITS};
+use hwfoc_io::record::{COLUMNS, Column, Record, TextEncoder, UNITS, Visitor, columns};
 use hwfoc_io::write::arrow::schema;
 use std::sync::Arc;
 
@@ -109,6 +109,30 @@ fn the_table_is_record_schema_md() {
             column.name
         );
         assert_eq!(field.metadata().len(), 1, "{}: only the unit", column.name);
+    }
+}
+
+/// Each column's zero-sized type (what the writers are generic over) has the place, name and
+/// unit of its row of the table, and its JSON key is its name quoted.
+#[test]
+fn column_types_are_record_schema_md() {
+    struct Seen(Vec<(usize, &'static str, &'static str, &'static str)>);
+    impl Visitor for Seen {
+        fn column<C: Column>(&mut self) {
+            self.0.push((C::INDEX, C::NAME, C::UNIT, C::JSON_KEY));
+        }
+    }
+    let mut seen = Seen(Vec::new());
+    columns::visit(&mut seen);
+    let expected = expected();
+    assert_eq!(seen.0.len(), expected.len(), "one type per row");
+    assert_eq!(columns::COUNT, expected.len());
+    for (i, ((index, name, unit, json_key), row)) in seen.0.iter().zip(&expected).enumerate() {
+        assert_eq!(
+            (*index, *name, *unit),
+            (i, row.name.as_str(), row.unit.as_str())
+        );
+        assert_eq!(*json_key, format!(",\"{}\":", row.name), "{name}");
     }
 }
 

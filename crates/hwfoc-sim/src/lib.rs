@@ -4,7 +4,7 @@
 //!
 //! Each ESC runs a small physical model ([`model`]) driven by a throttle profile ([`profile`]),
 //! sends its frames on the real schedule ([`esc`]) through a link that can misbehave
-//! ([`faults`]), into pseudo-terminals, serial ports, files or standard output ([`outlet`],
+//! ([`faults`]), into pseudo-terminals, serial ports, files or standard output ([`destination`],
 //! [`sink`], `pty` on Unix), paced in real time or as fast as possible ([`schedule`]). Every
 //! random choice comes from the seed ([`rng`]): the same seed and description give the same
 //! bytes.
@@ -19,12 +19,12 @@
 #![forbid(unsafe_op_in_unsafe_fn)]
 #![warn(missing_docs)]
 
+pub mod destination;
 pub mod error;
 pub mod esc;
 pub mod faults;
 pub mod fleet;
 pub mod model;
-pub mod outlet;
 pub mod profile;
 #[cfg(unix)]
 pub mod pty;
@@ -33,8 +33,8 @@ pub mod schedule;
 pub mod session;
 pub mod sink;
 
+pub use destination::{Destination, FileFormat};
 pub use error::SimError;
 pub use fleet::{FleetSpec, VirtualFleet};
-pub use outlet::{FileFormat, Outlet};
 pub use session::{EscReport, Plan, Session};
 pub use sink::Sink;

@@ -1,4 +1,4 @@
-//! A whole run: a fleet, its outlet, the ground truth, the clock and how long it lasts
+//! A whole run: a fleet, its destination, the ground truth, the clock and how long it lasts
 //! ([`Plan`]), opened ([`Session::open`]) and run ([`Session::run`]) to a report per ESC.
 //!
 //! The ground truth has one record per data frame delivered intact, `t_s` being the time its
@@ -17,10 +17,10 @@ use std::time::{Duration, Instant};
 use hwfoc::Settings;
 use hwfoc_io::clock::unix_now_ns;
 
+use crate::destination::{Destination, FileFormat, Opened};
 use crate::error::SimError;
 use crate::esc::VirtualEsc;
 use crate::fleet::VirtualFleet;
-use crate::outlet::{FileFormat, Opened, Outlet};
 use crate::schedule::{self, Pace, SimClock, Tally};
 use crate::sink::{self, Truth};
 
@@ -35,9 +35,9 @@ const PTY_LINGER: Duration = Duration::from_millis(300);
 #[derive(Debug, Clone, PartialEq)]
 pub struct Plan {
     /// Where the bytes go.
-    pub outlet: Outlet,
+    pub destination: Destination,
     /// Write a file or standard output at the real rate instead of as fast as possible (live
-    /// outlets always are).
+    /// destinations always are).
     pub realtime: bool,
     /// Unix time (seconds) of the start, for runs written at once: the recording's clock and
     /// the truth's. Default: now for pcapng, 0 for raw bytes. Real-time runs use the time now.
@@ -59,7 +59,7 @@ pub struct Plan {
 impl Plan {
     /// Whether the run goes at the real rate.
     pub fn is_realtime(&self) -> bool {
-        self.realtime || self.outlet.is_live()
+        self.realtime || self.destination.is_live()
     }
 }
 
@@ -90,7 +90,7 @@ pub struct Session {
 
 impl Session {
     /// Opens what `plan` asks for `fleet`: the ground truth first (so that a path that cannot
-    /// be written is reported before any pseudo-terminal exists), then the outlet.
+    /// be written is reported before any pseudo-terminal exists), then the destination.
     pub fn open(fleet: VirtualFleet, plan: &Plan) -> Result<Session, SimError> {
         let realtime = plan.is_realtime();
         let n = fleet.spec().n;
@@ -102,8 +102,8 @@ impl Session {
         };
         let escs = fleet.escs();
         // Every file is checked before any is created: a run fails whole or starts whole.
-        let outlet_files = plan.outlet.files(n);
-        let files = plan.truth.iter().chain(&outlet_files);
+        let destination_files = plan.destination.files(n);
+        let files = plan.truth.iter().chain(&destination_files);
         sink::check_new(files.map(String::as_str), plan.overwrite)?;
         let truth = match &plan.truth {
             Some(path) => {
@@ -113,16 +113,16 @@ impl Session {
             None => None,
         };
         let start_ns = plan.start_s.map(|s| (s * 1e9).round() as u64);
-        let origin_ns = match (realtime, plan.outlet.file_format()) {
+        let origin_ns = match (realtime, plan.destination.file_format()) {
             (false, Some(FileFormat::Pcapng)) => start_ns.unwrap_or_else(unix_now_ns),
             (false, Some(FileFormat::Raw)) => start_ns.unwrap_or(0),
             _ => unix_now_ns(),
         };
         Ok(Session {
-            opened: plan.outlet.open(n, baud, plan.overwrite)?,
+            opened: plan.destination.open(n, baud, plan.overwrite)?,
             escs,
             truth,
-            pace: plan.outlet.pace(realtime, baud),
+            pace: plan.destination.pace(realtime, baud),
             origin_ns,
             realtime,
             duration_ns: duration_s.map(|s| (s * 1e9).round() as u64),
@@ -191,7 +191,7 @@ mod tests {
         let path = |name: &str| dir.path().join(name).display().to_string();
         let run = |name: &str| {
             let plan = Plan {
-                outlet: Outlet::File {
+                destination: Destination::File {
                     path: path(name),
                     format: FileFormat::for_path(name),
                 },
@@ -230,7 +230,7 @@ mod tests {
         // ESC 1's file exists (an earlier run's); ESC 0's and the truth do not.
         std::fs::write(path("esc1.bin"), b"an earlier recording").unwrap();
         let plan = |overwrite| Plan {
-            outlet: Outlet::File {
+            destination: Destination::File {
                 path: path("esc{esc}.bin"),
                 format: FileFormat::Raw,
             },
@@ -284,7 +284,7 @@ mod tests {
     fn raw_bytes_of_several_escs_need_a_file_each() {
         let dir = tempfile::tempdir().unwrap();
         let plan = Plan {
-            outlet: Outlet::File {
+            destination: Destination::File {
                 path: dir.path().join("x.bin").display().to_string(),
                 format: FileFormat::Raw,
             },

@@ -380,8 +380,8 @@ mod tests {
         assert_eq!(size_of::<PacketSequence>(), 20);
     }
 
-    /// Two interleaved sequences far apart for a million frames: the loss that used to run up to
-    /// 4294967295 stays at 0; every frame but the first is a restart.
+    /// Two interleaved sequences far apart for a million frames: the loss stays at 0 (it never
+    /// runs up to 4294967295); every frame but the first is a restart.
     #[test]
     fn interleaved_sequences_never_saturate_the_loss() {
         let mut s = LinkStats::new();

@@ -397,13 +397,17 @@ mod tests {
 
     #[test]
     fn byte_ns_is_the_recorders_formula() {
-        // The formula the CLI's recorder and simulator used before this definition existed.
-        let old = |baud: u32| 10e9 / f64::from(baud.max(1));
+        // Ten bits per byte (8N1) in nanoseconds, a baud rate of 0 taken as 1, written out.
+        let written_out = |baud: u32| 10e9 / f64::from(baud.max(1));
         for baud in (0..=1_000_000)
             .step_by(7)
             .chain([19_200, 115_200, 19_332, u32::MAX])
         {
-            assert_eq!(byte_ns(baud).to_bits(), old(baud).to_bits(), "{baud}");
+            assert_eq!(
+                byte_ns(baud).to_bits(),
+                written_out(baud).to_bits(),
+                "{baud}"
+            );
         }
         assert_eq!(byte_ns(BAUD_RATE), 10.0e9 / 19200.0);
     }

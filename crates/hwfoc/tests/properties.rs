@@ -469,7 +469,7 @@ proptest! {
     /// overlapping it brings a `9B` into that text; what remains is a cut info frame missing
     /// only its check byte with a frame behind it whose `9B` matches the check by chance. The
     /// checksums cannot settle such a wire, so the case is discarded by `prop_assume!` after an
-    /// exact check with `parse` at every candidate position (`ambiguous`); it is now so rare
+    /// exact check with `parse` at every candidate position (`ambiguous`); it is so rare
     /// that no case in a run is expected to be discarded. The real-byte tests
     /// `cut_info_frame_*` in `real_frames.rs` pin the behaviour down without any discarding.
     #[test]

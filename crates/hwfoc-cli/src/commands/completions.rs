@@ -5,7 +5,7 @@ use clap::Args;
 use clap_complete::Shell;
 
 use crate::error::CliError;
-use crate::output::Output;
+use crate::output::TextSink;
 
 const AFTER_HELP: &str = "\
 Load it for the running shell, or install it where the shell finds it:
@@ -28,7 +28,7 @@ pub struct CompletionsArgs {
 /// standard output.
 pub fn run(args: &CompletionsArgs, mut command: clap::Command) -> Result<(), CliError> {
     let mut buf = script(args.shell, &mut command);
-    let mut out = Output::create(None)?;
+    let mut out = TextSink::create(None)?;
     out.write(&mut buf)?;
     out.flush()
 }

@@ -10,7 +10,7 @@ use clap::Args;
 use hwfoc_io::write::{Staging, WriteError};
 
 use crate::error::CliError;
-use crate::output::Output;
+use crate::output::TextSink;
 
 const AFTER_HELP: &str = "\
 Examples:
@@ -33,7 +33,7 @@ pub fn run(args: &ManArgs, command: clap::Command) -> Result<(), CliError> {
     match &args.output {
         None => {
             let (_, mut page) = pages.into_iter().next().unwrap_or_default();
-            let mut out = Output::create(None)?;
+            let mut out = TextSink::create(None)?;
             out.write(&mut page)?;
             out.flush()
         }

@@ -10,7 +10,7 @@ use hwfoc_io::write::WriteError;
 use super::plot;
 use crate::args::{InputArgs, SettingsArgs};
 use crate::error::CliError;
-use crate::output::Output;
+use crate::output::TextSink;
 
 #[derive(Debug, Args)]
 pub struct SummaryArgs {
@@ -57,7 +57,7 @@ pub fn run(args: &SummaryArgs) -> Result<(), CliError> {
     } else {
         report.text()
     };
-    let mut out = Output::create(None)?;
+    let mut out = TextSink::create(None)?;
     let mut buf = text.into_bytes();
     out.write(&mut buf)?;
     out.flush()?;

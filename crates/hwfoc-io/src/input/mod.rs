@@ -872,7 +872,7 @@ mod tests {
         assert_eq!(input.streams(), 2);
         assert_eq!(input.stream_name(1), names[1]);
         let mut master = std::fs::File::from(ptys[1].master.try_clone().unwrap());
-        let sent = crate::clock::Clock::new().now_ns() as f64 * 1e-9;
+        let sent = crate::clock::ReceiveClock::new().now_ns() as f64 * 1e-9;
         master.write_all(&[0x9B, 0x16, 0x01]).unwrap();
         let mut got = Vec::new();
         let mut times = Vec::new();

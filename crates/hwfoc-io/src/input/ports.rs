@@ -4,9 +4,9 @@ use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Duration;
 
+use crate::clock::byte_times;
 use crate::notice::Notice;
 use crate::serial::{PortEvent, PortSet};
-use crate::stream::byte_times;
 use crate::time::Clock;
 
 use super::{InputError, InputFormat, Looks, Source};

@@ -3,9 +3,9 @@
 use std::io::Read;
 
 use super::{InputError, InputFormat, Looks, Source};
+use crate::clock::byte_times;
 use crate::notice::Notice;
 use crate::pcapng;
-use crate::stream::byte_times;
 use crate::time::Clock;
 
 /// A pcapng recording being read.

@@ -5,12 +5,12 @@
 //! - each frame the decoder finds, whole, timestamped with its first byte's time;
 //! - the bytes between frames (line noise, frames that fail their checksum, frames cut short),
 //!   timestamped with their first byte's time, cut wherever a read began (so each keeps the
-//!   time of its read, as the chunks of the earlier layout did);
+//!   time of its read, as the chunks of the read-chunk layout do);
 //! - nothing else: the bytes of a frame still arriving (the decoder's undecided candidate, fewer
 //!   than 77) are held until the frame completes, or until [`Cutter::settle`] decides them.
 //!
 //! The time of byte `k` of a read that began at `t_ns` is `t_ns + round(k * byte time)`, the
-//! rule of the earlier layout's splits of long reads; a reader that gives the bytes of a packet
+//! rule of the read-chunk layout's splits of long reads; a reader that gives the bytes of a packet
 //! times one byte time apart so finds every frame's first byte at the time it would have found
 //! it in the read chunk (to the rounding of a nanosecond).
 

@@ -73,7 +73,7 @@ mod off {
     use std::io;
     use std::sync::mpsc::{Receiver, SyncSender};
 
-    use super::super::{Chunk, Destination, Provenance, ToWriter, WriteError};
+    use super::super::{Chunk, Provenance, Sink, ToWriter, WriteError};
 
     /// How a value type is stored in Parquet: nothing to know without the `parquet` feature.
     pub trait ParquetValue {}
@@ -82,7 +82,7 @@ mod off {
 
     /// Reports that Parquet output is not built in.
     pub(in crate::write) fn write(
-        sink: Destination,
+        sink: Sink,
         _: &Provenance,
         _: Receiver<ToWriter>,
         _: SyncSender<Chunk>,
@@ -125,7 +125,7 @@ mod encode {
     use parquet::schema::types::{ColumnDescPtr, SchemaDescriptor};
 
     use super::super::arrow::schema;
-    use super::super::{Chunk, Destination, Provenance, ToWriter, WriteError};
+    use super::super::{Chunk, Provenance, Sink, ToWriter, WriteError};
     use crate::record::columns::{COLUMNS, COUNT, visit};
     use crate::record::{Column, FaultList, Visitor};
 
@@ -702,7 +702,7 @@ mod encode {
     /// returns them on `spare` for reuse. At the end message, or when the sender goes away,
     /// the file is closed properly: footer and metadata, so it is readable.
     pub(in crate::write) fn write(
-        sink: Destination,
+        sink: Sink,
         provenance: &Provenance,
         rx: Receiver<ToWriter>,
         spare: SyncSender<Chunk>,

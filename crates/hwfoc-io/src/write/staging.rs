@@ -92,7 +92,7 @@ mod tests {
     use std::io::Write;
 
     /// The temporary file is a new one beside the target, never a file that is there (a link
-    /// placed at a name the old scheme would have used is left alone), and goes when dropped.
+    /// placed at the target's name plus `.partial` is left alone), and goes when dropped.
     #[test]
     fn a_new_file_beside_the_target_removed_unless_committed() {
         let dir = tempfile::tempdir().unwrap();

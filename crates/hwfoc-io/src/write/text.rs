@@ -13,7 +13,7 @@ use hwfoc::telemetry::Data;
 
 use crate::record::{Record, TextEncoder};
 
-use super::{Chunk, Destination, EscTable, Provenance, ToWriter, WriteError};
+use super::{Chunk, EscTable, Provenance, Sink, ToWriter, WriteError};
 
 /// Rows formatted at a time by one formatter.
 const SLICE_ROWS: usize = 8192;
@@ -32,7 +32,7 @@ type Text = (Vec<u8>, bool);
 /// written and flushed; or at the first write error.
 pub(super) fn write(
     csv: bool,
-    sink: Destination,
+    sink: Sink,
     provenance: &Provenance,
     rx: Receiver<ToWriter>,
     spare: SyncSender<Chunk>,
@@ -221,7 +221,7 @@ fn header(csv: bool, provenance: &Provenance) -> Vec<u8> {
 /// Writes the header, then the formatters' text, taking from each formatter in turn (the
 /// order the slices were handed out in), until the formatter whose turn it is has stopped.
 fn write_in_turn(
-    mut sink: Destination,
+    mut sink: Sink,
     header: Vec<u8>,
     texts: Vec<Receiver<Text>>,
 ) -> Result<(), WriteError> {

@@ -193,7 +193,7 @@ fn open_outputs(args: &BridgeArgs, config: &Config) -> Result<Vec<Box<dyn Output
         .inputs
         .iter()
         .map(std::path::PathBuf::from)
-        .chain(crate::args::config_read(config))
+        .chain(crate::safety::config_read(config))
         .collect();
     let mut outputs: Vec<Box<dyn Output>> = Vec::new();
     if let Some(port) = &args.datalink {
@@ -208,7 +208,7 @@ fn open_outputs(args: &BridgeArgs, config: &Config) -> Result<Vec<Box<dyn Output
     for spec in &args.mavlink {
         let target = MavlinkTarget::parse(spec).map_err(CliError::Output)?;
         if let MavlinkTarget::File(path) = &target {
-            hwfoc_io::write::refuse_input(path, read.iter().map(std::path::PathBuf::as_path))?;
+            crate::safety::refuse_input(path, read.iter().map(std::path::PathBuf::as_path))?;
         }
         let options = MavlinkOptions {
             system_id: args.mavlink_system,
@@ -252,7 +252,7 @@ fn live(
     errors: &mut Errors,
 ) -> Result<(), CliError> {
     let stop = hwfoc_io::stop::interrupted();
-    let clock = hwfoc_io::clock::Clock::new();
+    let clock = hwfoc_io::clock::ReceiveClock::new();
     while !stop.load(Ordering::Relaxed) && deadline.is_none_or(|d| Instant::now() < d) {
         let mut msg = match rx.recv_timeout(POLL) {
             Ok(msg) => Some(msg),
@@ -279,7 +279,7 @@ fn take(
     names: &[String],
     streams: &mut PortStreams,
     per_byte_ns: f64,
-    clock: &hwfoc_io::clock::Clock,
+    clock: &hwfoc_io::clock::ReceiveClock,
     fanout: &mut Fanout,
 ) {
     match event {

@@ -2,7 +2,7 @@
 //! ([`crate::config`]: `[settings]`, `[port."NAME"]`, `[esc.N]`, `[monitor]`, `[alarms]`),
 //! overridden by flags.
 //!
-//! The older `hwfoc/monitor.toml` is still read when there is no `hwfoc/config.toml` (its keys
+//! The older `hwfoc/monitor.toml` is read when there is no `hwfoc/config.toml` (its keys
 //! at the top and its `[[esc]]` list of ports and labels: see [`crate::config::File`]):
 //!
 //! ```toml
@@ -67,9 +67,10 @@ impl Limits {
     }
 }
 
-/// Everything the monitor is set to.
+/// Everything the monitor is set to: the configuration file read ([`crate::config::Config`])
+/// with the flags over it and the defaults under it.
 #[derive(Debug)]
-pub struct Config {
+pub struct MonitorSetup {
     /// Where the configuration file was read from, if one was.
     pub file: Option<PathBuf>,
     /// Conversion settings, by ESC and port.
@@ -107,15 +108,15 @@ pub fn default_record_dir() -> PathBuf {
         .unwrap_or_else(|| PathBuf::from("."))
 }
 
-impl Config {
+impl MonitorSetup {
     /// Reads the configuration file (the one named, or the per-user one if it exists) and
     /// applies the flags over it.
-    pub fn load(flags: &Overrides) -> Result<Config, CliError> {
+    pub fn load(flags: &Overrides) -> Result<MonitorSetup, CliError> {
         let general = crate::config::Config::load(&flags.settings, true)?;
-        Config::merge(general, flags)
+        MonitorSetup::merge(general, flags)
     }
 
-    fn merge(general: crate::config::Config, flags: &Overrides) -> Result<Config, CliError> {
+    fn merge(general: crate::config::Config, flags: &Overrides) -> Result<MonitorSetup, CliError> {
         let origin = |key: &str| match &general.path {
             Some(p) => format!("{} ({key})", p.display()),
             None => format!("--{}", key.replace('_', "-")),
@@ -196,7 +197,7 @@ impl Config {
                 "there must be at least one cell",
             ));
         }
-        Ok(Config {
+        Ok(MonitorSetup {
             file: general.path.clone(),
             settings,
             baud,
@@ -229,11 +230,11 @@ mod tests {
     use super::*;
     use hwfoc::Settings;
 
-    fn parse(text: &str) -> Result<Config, CliError> {
+    fn parse(text: &str) -> Result<MonitorSetup, CliError> {
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("monitor.toml");
         std::fs::write(&path, text).unwrap();
-        Config::load(&Overrides {
+        MonitorSetup::load(&Overrides {
             settings: SettingsArgs {
                 config: Some(path),
                 ..SettingsArgs::default()
@@ -244,7 +245,7 @@ mod tests {
 
     #[test]
     fn defaults_without_a_file() {
-        let config = Config::load(&Overrides {
+        let config = MonitorSetup::load(&Overrides {
             settings: SettingsArgs {
                 no_config: true,
                 ..SettingsArgs::default()
@@ -290,7 +291,7 @@ mod tests {
             ..Overrides::default()
         };
         flags.alarms.mos_warning_c = Some(70.0);
-        let config = Config::load(&flags).unwrap();
+        let config = MonitorSetup::load(&flags).unwrap();
         assert_eq!(config.baud, 9600);
         assert_eq!(config.limits.mos.warning, 70.0);
         assert_eq!(config.limits.mos.critical, 95.0);
@@ -317,7 +318,7 @@ mod tests {
 
     #[test]
     fn a_missing_named_file_is_an_error() {
-        let err = Config::load(&Overrides {
+        let err = MonitorSetup::load(&Overrides {
             settings: SettingsArgs {
                 config: Some(PathBuf::from("/nonexistent/monitor.toml")),
                 ..SettingsArgs::default()

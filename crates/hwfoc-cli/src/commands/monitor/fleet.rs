@@ -691,11 +691,11 @@ impl Fleet {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::commands::monitor::config::{Config, Overrides};
+    use crate::commands::monitor::config::{MonitorSetup, Overrides};
     use hwfoc::{DataFrame, Status};
 
     fn fleet(n: usize) -> Fleet {
-        let config = Config::load(&Overrides {
+        let config = MonitorSetup::load(&Overrides {
             settings: crate::args::SettingsArgs {
                 no_config: true,
                 ..Default::default()
@@ -786,7 +786,7 @@ mod tests {
                 "esc0 mos_overheat cleared"
             ]
         );
-        // The clear names the level the alarm had (it was once logged as a warning).
+        // The clear names the level the alarm had (critical), not a warning.
         assert_eq!(f.log[1].level, Level::Critical);
         assert!(
             f.log[1]

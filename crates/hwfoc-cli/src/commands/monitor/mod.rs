@@ -21,11 +21,11 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc::{self, Receiver, RecvTimeoutError};
 use std::time::{Duration, Instant};
 
-use self::config::{AlarmKeys, Config, Overrides};
+use self::config::{AlarmKeys, MonitorSetup, Overrides};
 use self::feed::{Feed, Msg};
 use self::fleet::Fleet;
 use self::perf::Perf;
-use super::capture::{self, Recorder};
+use super::record::{self, Recorder};
 use crate::args::SettingsArgs;
 use crate::commands::simulate::ModelArgs;
 use crate::error::CliError;
@@ -121,7 +121,7 @@ const MIN_INTERVAL_S: f64 = 0.05;
 
 /// Runs `hwfoc monitor`.
 pub fn run(args: &MonitorArgs) -> Result<(), CliError> {
-    let config = Config::load(&Overrides {
+    let config = MonitorSetup::load(&Overrides {
         settings: args.settings.clone(),
         baud: args.baud,
         record_dir: args.record_dir.clone(),
@@ -173,7 +173,7 @@ pub struct Session {
     rx: Receiver<Msg>,
     tx: mpsc::Sender<Msg>,
     feed: Option<Feed>,
-    clock: hwfoc_io::clock::Clock,
+    clock: hwfoc_io::clock::ReceiveClock,
     names: Vec<String>,
     baud: u32,
     record_dir: PathBuf,
@@ -186,7 +186,7 @@ pub struct Session {
 }
 
 impl Session {
-    fn start(args: &MonitorArgs, config: Config) -> Result<Session, CliError> {
+    fn start(args: &MonitorArgs, config: MonitorSetup) -> Result<Session, CliError> {
         let interrupted = hwfoc_io::stop::interrupted();
         let (tx, rx) = mpsc::channel();
         let ports: Vec<String> = if args.ports.is_empty() {
@@ -237,7 +237,7 @@ impl Session {
         // The ports' own clock, so that ages and recordings agree with their timestamps.
         let clock = match &feed {
             Feed::Ports(readers) => readers.clock(),
-            Feed::Simulated { .. } => hwfoc_io::clock::Clock::new(),
+            Feed::Simulated { .. } => hwfoc_io::clock::ReceiveClock::new(),
         };
         let now = clock.now_ns() as f64 / 1e9;
         let fleet = Fleet::new(
@@ -366,8 +366,8 @@ impl Session {
     /// Starts recording to `path` (never the configuration file read, even with
     /// `--overwrite`).
     pub fn start_recording(&mut self, path: String) -> Result<(), CliError> {
-        hwfoc_io::write::refuse_input(&path, self.config_file.as_deref())?;
-        let plan = capture::Plan {
+        crate::safety::refuse_input(&path, self.config_file.as_deref())?;
+        let plan = record::Plan {
             output: path.clone(),
             rotate_size: None,
             rotate_time: None,

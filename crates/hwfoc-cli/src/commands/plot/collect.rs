@@ -28,10 +28,8 @@ use hwfoc_io::energy::{self, Energy};
 use hwfoc_io::episode::{Episode, Mark};
 use hwfoc_io::record::Record;
 use hwfoc_io::select::{Selection, Window};
-use hwfoc_io::sources::{Handler, Sources};
+use hwfoc_io::sources::Handler;
 use hwfoc_io::write::WriteError;
-
-use super::{Options, Target};
 
 /// The nominal time between two data frames of a running ESC, s: the clock of inputs without
 /// receive times, and the width given to a fault episode's last frame.
@@ -432,6 +430,11 @@ pub struct Collector {
     stop: Option<(Arc<AtomicBool>, String)>,
 }
 
+/// Buckets per ESC for an image `width` pixels wide: at least two per pixel of a panel.
+pub fn buckets_for(width: u32) -> usize {
+    (width as usize / 2).max(256)
+}
+
 impl Collector {
     /// A collector for an image `width` pixels wide, of the frames in `selection`, whose
     /// records were converted under `settings`.
@@ -439,7 +442,7 @@ impl Collector {
         Collector {
             settings,
             selection,
-            buckets: super::draw::buckets_for(width),
+            buckets: buckets_for(width),
             escs: Vec::new(),
             stop: None,
         }
@@ -479,18 +482,11 @@ impl Collector {
         self.escs.get(esc)
     }
 
-    /// Draws the plot of what was read from `sources` and writes it to `target`.
-    pub fn write(
-        &mut self,
-        sources: &Sources,
-        options: &Options,
-        target: &mut Target,
-    ) -> Result<(), CliError> {
+    /// Ends every ESC's data: what was read is then ready to be drawn.
+    pub fn finish(&mut self) {
         for esc in &mut self.escs {
             esc.finish();
         }
-        let image = super::draw::render(self, sources, options, target)?;
-        target.write(&image)
     }
 }
 
@@ -614,18 +610,26 @@ mod tests {
         let mut b = Bucket::EMPTY;
         b.add(&values(&Record::new(None, 0, &f.into(), &s)), false);
         let v = |q| b.values(q).unwrap()[0];
-        assert_eq!(v(Quantity::ThrottleIn), f64::from(f.throttle_in_pct()));
-        assert_eq!(v(Quantity::ThrottleOut), f64::from(f.throttle_out_pct()));
-        assert_eq!(v(Quantity::Rpm), f64::from(f.rpm(&s)));
-        assert_eq!(v(Quantity::Voltage), f64::from(f.voltage_v()));
+        // docs/RECORD-SCHEMA.md's formulas, to f32's precision.
+        let near = |q, expected: f64| {
+            let got = v(q);
+            assert!(
+                (got - expected).abs() <= 1e-6 * expected.abs(),
+                "{q:?}: {got} {expected}"
+            );
+        };
+        near(Quantity::ThrottleIn, 300.0 * 100.0 / 1024.0);
+        near(Quantity::ThrottleOut, 280.0 * 100.0 / 1024.0);
+        near(Quantity::Rpm, 1234.0 * 10.0 / (2.0 * 7.0));
+        near(Quantity::Voltage, 25.1);
         // 25.1 V times -1.5 A.
         assert!(
             (v(Quantity::Power) - 25.1 * -1.5).abs() < 1e-4,
             "{}",
             v(Quantity::Power)
         );
-        assert_eq!(v(Quantity::Current), f64::from(f.current_a(&s)));
-        assert_eq!(v(Quantity::PhaseCurrent), f64::from(f.phase_current_a(&s)));
+        near(Quantity::Current, -150.0 / 100.0);
+        near(Quantity::PhaseCurrent, 420.0 / 100.0);
         assert_eq!(v(Quantity::MosTemp), 28.0);
         assert_eq!(v(Quantity::CapTemp), 40.0);
     }

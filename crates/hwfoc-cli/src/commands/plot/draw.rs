@@ -20,7 +20,7 @@ use hwfoc_io::summary::no_frames;
 use hwfoc_io::time::{self, Clock};
 
 use super::collect::{Bucket, Collector, EscData, FRAME_PERIOD, Quantity, Span};
-use super::target::{ImageFormat, Target};
+use super::target::{ImageFile, ImageFormat};
 use super::text::Glyphs;
 use super::{MAX_SIZE, Options};
 
@@ -138,11 +138,6 @@ const PANELS: [Panel; 6] = [
     },
 ];
 
-/// Buckets per ESC for an image `width` pixels wide: at least two per pixel of a panel.
-pub fn buckets_for(width: u32) -> usize {
-    (width as usize / 2).max(256)
-}
-
 /// The height that gives every one of `rows` ESCs a full row.
 fn default_height(rows: usize) -> u32 {
     let h = TITLE_H as usize + rows * ROW_H as usize + BOTTOM_H as usize;
@@ -166,12 +161,26 @@ fn register_fonts() -> Result<(), CliError> {
     }
 }
 
+impl Collector {
+    /// Draws the plot of what was read from `sources` and writes it to `target`.
+    pub fn write(
+        &mut self,
+        sources: &Sources,
+        options: &Options,
+        target: &mut ImageFile,
+    ) -> Result<(), CliError> {
+        self.finish();
+        let image = render(self, sources, options, target)?;
+        target.write(&image)
+    }
+}
+
 /// Draws the plot and returns the file's bytes.
 pub fn render(
     collector: &Collector,
     sources: &Sources,
     options: &Options,
-    target: &Target,
+    target: &ImageFile,
 ) -> Result<Vec<u8>, CliError> {
     let scene = Scene::new(collector, sources, options)?;
     register_fonts()?;

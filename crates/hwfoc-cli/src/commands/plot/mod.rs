@@ -26,7 +26,7 @@ use hwfoc_io::sources::{Handler, Sources};
 use hwfoc_io::write::WriteError;
 
 use collect::Collector;
-use target::Target;
+use target::ImageFile;
 
 /// What the time axis does with a clock that steps back or jumps (`hwfoc plot --help`).
 const CLOCK_HELP: &str = "Time axis: seconds from the first frame. Where an ESC's receive clock \
@@ -86,7 +86,7 @@ pub fn run(args: &PlotArgs) -> Result<(), CliError> {
     // Opened first, so that a wrong name is reported before the inputs are read; a file
     // created here is removed again if the plot is not written.
     args.input.refuse_output(&args.output, &config)?;
-    let mut target = Target::open(&args.output)?;
+    let mut target = ImageFile::open(&args.output)?;
     let options = Options {
         width: args.width,
         height: args.height,
@@ -113,19 +113,19 @@ pub fn run(args: &PlotArgs) -> Result<(), CliError> {
 /// `hwfoc summary --plot FILE`: a plot with the defaults of `hwfoc plot`, of the frames the
 /// summary reads.
 pub struct Alongside {
-    target: Target,
+    target: ImageFile,
     options: Options,
     collector: Collector,
 }
 
 impl Alongside {
-    /// Opens the image file (see [`Target::open`]); `stop` as [`Collector::stop_on`].
+    /// Opens the image file (see [`ImageFile::open`]); `stop` as [`Collector::stop_on`].
     pub fn open(
         path: &str,
         settings: Settings,
         stop: Option<Arc<AtomicBool>>,
     ) -> Result<Alongside, CliError> {
-        let target = Target::open(path)?;
+        let target = ImageFile::open(path)?;
         let options = Options {
             width: draw::DEFAULT_WIDTH,
             ..Options::default()

@@ -36,17 +36,17 @@ impl ImageFormat {
 /// image is complete. An existing file stays as it was until then; the temporary file is
 /// removed if nothing is written.
 #[derive(Debug)]
-pub struct Target {
+pub struct ImageFile {
     path: String,
     format: ImageFormat,
     /// The temporary file, until the image is written.
     staging: Option<(Staging, File)>,
 }
 
-impl Target {
+impl ImageFile {
     /// Checks the name's format, refuses anything but a (new or) regular file, and creates the
     /// temporary file.
-    pub fn open(path: &str) -> Result<Target, CliError> {
+    pub fn open(path: &str) -> Result<ImageFile, CliError> {
         let format = ImageFormat::from_name(path).ok_or_else(|| CliError::Usage {
             option: format!("-o {path}"),
             message: "the image format follows the file name: use a name ending in .png or .svg"
@@ -69,7 +69,7 @@ impl Target {
             _ => {}
         }
         let (staging, file) = Staging::create(Path::new(path)).map_err(create)?;
-        Ok(Target {
+        Ok(ImageFile {
             path: path.to_string(),
             format,
             staging: Some((staging, file)),

@@ -20,7 +20,7 @@ use hwfoc_sim::profile::{ProfileSpec, Shape};
 #[cfg(unix)]
 use hwfoc_sim::pty::PtyLinks;
 use hwfoc_sim::sink::expand;
-use hwfoc_sim::{EscReport, FileFormat, FleetSpec, Outlet, Plan, Session, VirtualFleet};
+use hwfoc_sim::{Destination, EscReport, FileFormat, FleetSpec, Plan, Session, VirtualFleet};
 
 /// File formats of `-o`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
@@ -351,7 +351,7 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
     };
     let reads: Vec<std::path::PathBuf> = profile
         .into_iter()
-        .chain(crate::args::config_read(&config))
+        .chain(crate::safety::config_read(&config))
         .collect();
     refuse_clashes(&plan, n, &reads)?;
     let fleet = args.model.fleet(n, args.baud, &settings)?;
@@ -396,10 +396,10 @@ fn plan(args: &SimulateArgs, n: usize, settings: Settings) -> Result<Plan, CliEr
             "only for -o FILE or standard output: ptys and ports carry raw bytes",
         ));
     }
-    let outlet = if args.pty {
+    let destination = if args.pty {
         #[cfg(unix)]
         {
-            Outlet::Ptys(match &args.link_dir {
+            Destination::Ptys(match &args.link_dir {
                 Some(dir) => PtyLinks::Dir(dir.clone()),
                 None => PtyLinks::Paths(args.link.clone()),
             })
@@ -407,19 +407,19 @@ fn plan(args: &SimulateArgs, n: usize, settings: Settings) -> Result<Plan, CliEr
         #[cfg(not(unix))]
         return Err(usage("--pty", "pseudo-terminals need a Unix system"));
     } else if !args.port.is_empty() {
-        Outlet::Ports(args.port.clone())
+        Destination::Ports(args.port.clone())
     } else {
         let format = args.format.map(FileFormat::from);
         match args.output.as_deref() {
-            None | Some("-") => Outlet::Stdout(format.unwrap_or(FileFormat::Raw)),
-            Some(path) => Outlet::File {
+            None | Some("-") => Destination::Stdout(format.unwrap_or(FileFormat::Raw)),
+            Some(path) => Destination::File {
                 path: path.to_string(),
                 format: format.unwrap_or_else(|| FileFormat::for_path(path)),
             },
         }
     };
     let plan = Plan {
-        outlet,
+        destination,
         realtime: args.realtime,
         start_s: args.start_time,
         duration_s: args.duration,
@@ -433,22 +433,22 @@ fn plan(args: &SimulateArgs, n: usize, settings: Settings) -> Result<Plan, CliEr
             "real-time outputs use the time now; --start-time is for files written at once",
         ));
     }
-    match &plan.outlet {
-        Outlet::Stdout(FileFormat::Raw) if n > 1 => {
+    match &plan.destination {
+        Destination::Stdout(FileFormat::Raw) if n > 1 => {
             return Err(usage(
                 "--escs",
                 "raw bytes on standard output can carry only one ESC: use --format pcapng, \
                  or -o FILE with {esc} in the name",
             ));
         }
-        Outlet::Stdout(_) if std::io::stdout().is_terminal() => {
+        Destination::Stdout(_) if std::io::stdout().is_terminal() => {
             return Err(usage(
                 "-o",
                 "not writing binary telemetry to a terminal: give -o FILE or --pty, or pipe \
                  the output (e.g. into `hwfoc decode -`)",
             ));
         }
-        Outlet::File {
+        Destination::File {
             path,
             format: FileFormat::Raw,
         } if n > 1 && !path.contains("{esc}") => {
@@ -471,7 +471,7 @@ fn plan(args: &SimulateArgs, n: usize, settings: Settings) -> Result<Plan, CliEr
 /// an ESC's bytes.
 fn refuse_clashes(plan: &Plan, n: usize, reads: &[std::path::PathBuf]) -> Result<(), CliError> {
     let mut outputs: Vec<(&str, String)> = Vec::new();
-    if let Outlet::File { path, .. } = &plan.outlet {
+    if let Destination::File { path, .. } = &plan.destination {
         if path.contains("{esc}") {
             outputs.extend((0..n).map(|esc| ("-o", expand(path, esc))));
         } else {
@@ -482,7 +482,7 @@ fn refuse_clashes(plan: &Plan, n: usize, reads: &[std::path::PathBuf]) -> Result
         outputs.push(("--truth", truth.clone()));
     }
     for (i, (option, out)) in outputs.iter().enumerate() {
-        hwfoc_io::write::refuse_input(out, reads.iter().map(std::path::PathBuf::as_path))?;
+        crate::safety::refuse_input(out, reads.iter().map(std::path::PathBuf::as_path))?;
         let earlier = outputs[..i]
             .iter()
             .find(|(_, o)| o == out || hwfoc_io::write::same_file(o, out));

@@ -185,7 +185,7 @@ pub struct Recorder {
     last_flush: Instant,
     last_sync: Instant,
     /// The clock of the ports' timestamps.
-    clock: hwfoc_io::clock::Clock,
+    clock: hwfoc_io::clock::ReceiveClock,
     ports: Vec<PortState>,
     /// The ports' decoding streams (frames are counted, not kept).
     streams: PortStreams,
@@ -249,7 +249,7 @@ impl Recorder {
     pub fn new(
         plan: Plan,
         ports: &[String],
-        clock: hwfoc_io::clock::Clock,
+        clock: hwfoc_io::clock::ReceiveClock,
     ) -> Result<Recorder, CliError> {
         let rotating = plan.rotate_size.is_some() || plan.rotate_time.is_some();
         let first = if rotating {

@@ -7,7 +7,7 @@ use crate::pty::{self, PtyLinks};
 use crate::schedule::Pace;
 use crate::sink::{self, PcapngSink, PortSink, RawSink, Sink};
 
-/// Outlet duration of one piece written to a pseudo-terminal or a pipe in real time, seconds.
+/// Duration of one piece written to a pseudo-terminal or a pipe in real time, seconds.
 const PIECE_S: f64 = 0.004;
 
 /// Formats of files (and standard output).
@@ -33,7 +33,7 @@ impl FileFormat {
 
 /// Where a run's bytes go.
 #[derive(Debug, Clone, PartialEq)]
-pub enum Outlet {
+pub enum Destination {
     /// Standard output: raw bytes of a single ESC, or a recording of them all.
     Stdout(FileFormat),
     /// A file, or one per ESC with `{esc}` in the path (raw bytes of several ESCs need one
@@ -51,7 +51,7 @@ pub enum Outlet {
     Ports(Vec<String>),
 }
 
-/// An outlet opened: the sink, and what each ESC's output is called.
+/// A destination opened: the sink, and what each ESC's output is called.
 pub(crate) struct Opened {
     /// Where the bytes go.
     pub sink: Box<dyn Sink>,
@@ -66,55 +66,55 @@ pub(crate) struct Opened {
     pub _links: pty::Links,
 }
 
-impl Outlet {
-    /// Whether the outlet is a live one, always written in real time (pseudo-terminals and
+impl Destination {
+    /// Whether the destination is a live one, always written in real time (pseudo-terminals and
     /// serial ports).
     pub fn is_live(&self) -> bool {
         match self {
-            Outlet::Stdout(_) | Outlet::File { .. } => false,
+            Destination::Stdout(_) | Destination::File { .. } => false,
             #[cfg(unix)]
-            Outlet::Ptys(_) => true,
-            Outlet::Ports(_) => true,
+            Destination::Ptys(_) => true,
+            Destination::Ports(_) => true,
         }
     }
 
-    /// The format of a file or standard output; `None` for live outlets (raw bytes).
+    /// The format of a file or standard output; `None` for live destinations (raw bytes).
     pub fn file_format(&self) -> Option<FileFormat> {
         match self {
-            Outlet::Stdout(format) | Outlet::File { format, .. } => Some(*format),
+            Destination::Stdout(format) | Destination::File { format, .. } => Some(*format),
             _ => None,
         }
     }
 
-    /// How bytes are handed over at `baud`, in real time or not: live outlets and real-time
+    /// How bytes are handed over at `baud`, in real time or not: live destinations and real-time
     /// files get bursts whole at their start, pseudo-terminals and real-time standard output
     /// (a pipe) in pieces that never run ahead of the wire.
     pub(crate) fn pace(&self, realtime: bool, baud: u32) -> Pace {
         let pieces = Pace::Pieces((PIECE_S * f64::from(baud) / 10.0).round().max(1.0) as usize);
         match self {
             #[cfg(unix)]
-            Outlet::Ptys(_) => pieces,
-            Outlet::Ports(_) => Pace::Whole,
+            Destination::Ptys(_) => pieces,
+            Destination::Ports(_) => Pace::Whole,
             _ if !realtime => Pace::Fast,
-            Outlet::Stdout(_) => pieces,
-            Outlet::File { .. } => Pace::Whole,
+            Destination::Stdout(_) => pieces,
+            Destination::File { .. } => Pace::Whole,
         }
     }
 
     /// The files `n` ESCs are written to (`-` for standard output): one, or one per ESC with
-    /// `{esc}` in the name; none for live outlets.
+    /// `{esc}` in the name; none for live destinations.
     pub fn files(&self, n: usize) -> Vec<String> {
         match self {
-            Outlet::File { path, .. } if path.contains("{esc}") => {
+            Destination::File { path, .. } if path.contains("{esc}") => {
                 (0..n).map(|i| sink::expand(path, i)).collect()
             }
-            Outlet::File { path, .. } => vec![path.clone()],
-            Outlet::Stdout(_) => vec!["-".to_string()],
+            Destination::File { path, .. } => vec![path.clone()],
+            Destination::Stdout(_) => vec!["-".to_string()],
             _ => Vec::new(),
         }
     }
 
-    /// Opens the outlet for `n` ESCs at `baud`; existing files are replaced only if
+    /// Opens the destination for `n` ESCs at `baud`; existing files are replaced only if
     /// `overwrite` ([`Session::open`](crate::Session::open) has refused them all before any
     /// is created; each creation still refuses a file that appeared since).
     pub(crate) fn open(&self, n: usize, baud: u32, overwrite: bool) -> Result<Opened, SimError> {
@@ -122,7 +122,7 @@ impl Outlet {
         let mut links = pty::Links::default();
         let (sink, names, linger): (Box<dyn Sink>, Vec<String>, bool) = match self {
             #[cfg(unix)]
-            Outlet::Ptys(asked) => {
+            Destination::Ptys(asked) => {
                 let (ptys, made) = pty::open_all(n, asked)?;
                 links = made;
                 let names = ptys
@@ -131,8 +131,10 @@ impl Outlet {
                     .collect();
                 (Box::new(sink::PtySink::new(ptys)), names, true)
             }
-            Outlet::Ports(ports) => (Box::new(PortSink::open(ports, baud)?), ports.clone(), false),
-            Outlet::Stdout(format) | Outlet::File { format, .. } => {
+            Destination::Ports(ports) => {
+                (Box::new(PortSink::open(ports, baud)?), ports.clone(), false)
+            }
+            Destination::Stdout(format) | Destination::File { format, .. } => {
                 let paths = self.files(n);
                 let file_of: Vec<usize> = match paths.len() {
                     1 => vec![0; n],
