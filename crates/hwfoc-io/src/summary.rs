@@ -31,10 +31,10 @@ pub use crate::episode::{Episode, Mark};
 use crate::escape::Escaped;
 use crate::fixed::Fixed;
 use crate::input::{InputError, InputFormat};
+use crate::settings::settings_json;
 use crate::sources::{Handler, Sources};
 use crate::stream::EscLink;
 use crate::time::{self, Clock};
-use crate::write::settings_json;
 use hwfoc::datalink::LengthByte;
 
 /// What to tell a user whose wire gave bytes but no frame.

@@ -277,11 +277,7 @@ fn status_json(i: usize, esc: &EscView, now: f64) -> Value {
             "id": info.id(),
         })),
         "alarms": alarms,
-        "settings": {
-            "current_scale": esc.settings.current_scale,
-            "pole_pairs": esc.settings.pole_pairs,
-            "gear_ratio": esc.settings.gear_ratio,
-        },
+        "settings": hwfoc_io::settings::settings_json(&esc.settings),
     })
 }
 
