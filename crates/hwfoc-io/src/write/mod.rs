@@ -23,6 +23,7 @@
 
 pub mod arrow;
 mod file;
+pub mod metadata;
 pub(crate) mod parquet;
 mod staging;
 mod text;
@@ -471,7 +472,10 @@ impl Export {
         }
         let escs = self.esc_settings();
         if !escs.is_empty() {
-            metadata.push(("esc_settings".to_string(), esc_settings_json(&escs)));
+            metadata.push((
+                crate::write::metadata::ESC_SETTINGS.to_string(),
+                esc_settings_json(&escs),
+            ));
         }
         let written = self
             .send(true, true)
