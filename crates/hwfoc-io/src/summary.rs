@@ -925,14 +925,10 @@ impl EscReport<'_> {
             .infos
             .iter()
             .map(|(i, n)| {
-                json!({
-                    "product": i.product(),
-                    "hardware": i.hardware(),
-                    "firmware": i.firmware(),
-                    "id": i.id(),
-                    "text": i.to_string(),
-                    "frames": n,
-                })
+                let mut info = device_json(i);
+                info.insert("text".to_string(), json!(i.to_string()));
+                info.insert("frames".to_string(), json!(n));
+                Value::Object(info)
             })
             .collect();
         let episodes: Vec<Value> = self
@@ -983,6 +979,20 @@ impl EscReport<'_> {
             "warning": warning,
         })
     }
+}
+
+/// What an information frame says of the device, as every JSON output names it (`summary
+/// --json`, `monitor --json`): `{"product": ..., "hardware": ..., "firmware": ..., "id": ...}`.
+pub fn device_json(info: &InfoFrame) -> serde_json::Map<String, Value> {
+    [
+        ("product", info.product()),
+        ("hardware", info.hardware()),
+        ("firmware", info.firmware()),
+        ("id", info.id()),
+    ]
+    .into_iter()
+    .map(|(name, value)| (name.to_string(), json!(value)))
+    .collect()
 }
 
 /// An episode in one line: when (dates on a wall clock), how long, which faults.
@@ -1039,6 +1049,15 @@ fn percent(part: u64, whole: u64) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_device_is_named_field_by_field() {
+        let info = InfoFrame::new("HW1", "V2", "XR-01.0.00", "42").unwrap();
+        assert_eq!(
+            Value::Object(device_json(&info)).to_string(),
+            r#"{"product":"HW1","hardware":"V2","firmware":"XR-01.0.00","id":"42"}"#
+        );
+    }
 
     #[test]
     fn temperature_stats_come_from_the_histogram() {

@@ -270,12 +270,7 @@ fn status_json(i: usize, esc: &EscView, now: f64) -> Value {
         },
         "energy": energy_json(esc.power_w(), esc.energy.peak_w(), &esc.energy),
         "battery_cells": esc.cells,
-        "info": esc.info.as_ref().map(|info| json!({
-            "product": info.product(),
-            "hardware": info.hardware(),
-            "firmware": info.firmware(),
-            "id": info.id(),
-        })),
+        "info": esc.info.as_ref().map(hwfoc_io::summary::device_json),
         "alarms": alarms,
         "settings": hwfoc_io::settings::settings_json(&esc.settings),
     })
