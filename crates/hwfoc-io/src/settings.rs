@@ -65,6 +65,19 @@ pub fn fields(settings: &Settings) -> [(&'static str, SettingValue); 3] {
     ]
 }
 
+/// The fields of `settings` as people read them, each its name in words and its value:
+/// `["current scale 64", "pole pairs 7", "gear ratio 1"]` (`hwfoc summary`); with `default`,
+/// only those that differ from it.
+pub fn words(settings: &Settings, default: Option<&Settings>) -> Vec<String> {
+    let defaults = default.map(fields);
+    fields(settings)
+        .into_iter()
+        .enumerate()
+        .filter(|&(i, (_, value))| defaults.is_none_or(|d| d[i].1 != value))
+        .map(|(_, (name, value))| format!("{} {value}", name.replace('_', " ")))
+        .collect()
+}
+
 /// Settings as a JSON object, keyed as [`fields`] names them:
 /// `{"current_scale": 64.0, "pole_pairs": 7, "gear_ratio": 1.0}`.
 pub fn settings_json(settings: &Settings) -> serde_json::Value {
@@ -342,6 +355,13 @@ mod tests {
             .collect();
         assert_eq!(set, ["pole_pairs=3", "gear_ratio=0.5"]);
         assert_eq!(patch(None, None, None).fields().count(), 0);
+        assert_eq!(
+            words(&s, None),
+            ["current scale 100", "pole pairs 14", "gear ratio 2.5"]
+        );
+        let other = Settings::new(100.0, 7, 2.5).unwrap();
+        assert_eq!(words(&s, Some(&other)), ["pole pairs 14"]);
+        assert!(words(&s, Some(&s)).is_empty());
     }
 
     #[test]

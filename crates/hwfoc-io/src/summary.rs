@@ -31,7 +31,7 @@ pub use crate::episode::{Episode, Mark};
 use crate::escape::Escaped;
 use crate::fixed::Fixed;
 use crate::input::{InputError, InputFormat};
-use crate::settings::settings_json;
+use crate::settings::{self, settings_json};
 use crate::sources::{Handler, Sources};
 use crate::stream::EscLink;
 use crate::time::{self, Clock};
@@ -502,11 +502,11 @@ impl<'a> Report<'a> {
         let escs = self.escs();
         let _ = write!(
             o,
-            "settings     current scale {}, pole pairs {}, gear ratio {}",
-            self.settings.current_scale, self.settings.pole_pairs, self.settings.gear_ratio
+            "settings     {}",
+            settings::words(self.settings, None).join(", ")
         );
         for esc in &escs {
-            let differing = settings_differing(&esc.settings, self.settings);
+            let differing = settings::words(&esc.settings, Some(self.settings));
             if !differing.is_empty() {
                 let _ = write!(o, "; ESC {}: {}", esc.index, differing.join(", "));
             }
@@ -627,22 +627,6 @@ impl<'a> Report<'a> {
             "energy_total": total_energy(&reports).as_ref().map(energy_json),
         })
     }
-}
-
-/// The fields of `settings` that differ from `default`, as the summary names them
-/// (`pole pairs 14`).
-fn settings_differing(settings: &Settings, default: &Settings) -> Vec<String> {
-    let mut fields = Vec::new();
-    if settings.current_scale != default.current_scale {
-        fields.push(format!("current scale {}", settings.current_scale));
-    }
-    if settings.pole_pairs != default.pole_pairs {
-        fields.push(format!("pole pairs {}", settings.pole_pairs));
-    }
-    if settings.gear_ratio != default.gear_ratio {
-        fields.push(format!("gear ratio {}", settings.gear_ratio));
-    }
-    fields
 }
 
 /// The figures of every ESC with data frames added, when there are two or more.
