@@ -5,8 +5,10 @@
 //! units) but the electrical RPM (the plot and the monitor show the motor's), then the
 //! quantities no single linear field gives: the input power and the two temperatures. What a
 //! quantity measures ([`Measure`]: one plot panel, one dashboard chart) follows from its unit,
-//! so that a quantity the codec gains is drawn beside those of its unit without an edit here;
-//! its legend is its column name until [`Shown::legend`] gives it a word.
+//! so that a quantity the codec gains is listed, and drawn beside those of its unit, with one
+//! edit here: its value in a record ([`Shown::of`], a `match` the compiler points at). Its
+//! legend is its column name until [`Shown::legend`] gives it a word; a unit no measure has
+//! fails this module's test.
 
 use hwfoc::Quantity;
 use hwfoc_io::energy;
