@@ -51,7 +51,8 @@ FAULT_NAMES = [
 ]
 
 
-def python_decode(data: bytes, current_scale=64.0, pole_pairs=7, gear_ratio=1.0):
+def python_decode(data: bytes, current_scale=hwfoc.DEFAULT_CURRENT_SCALE, pole_pairs=hwfoc.DEFAULT_POLE_PAIRS,
+                  gear_ratio=hwfoc.DEFAULT_GEAR_RATIO):
     """Data frames of raw bytes, by `bytes.find` of the header and `struct`: the columns of
     the record (as lists)."""
     temps = celsius_table()

@@ -23,6 +23,9 @@ Polars and pandas take the table as it is::
 """
 
 from ._hwfoc import (
+    DEFAULT_CURRENT_SCALE,
+    DEFAULT_GEAR_RATIO,
+    DEFAULT_POLE_PAIRS,
     Decoder,
     HwfocError,
     HwfocWarning,
@@ -42,6 +45,9 @@ from ._hwfoc import (
 )
 
 __all__ = [
+    "DEFAULT_CURRENT_SCALE",
+    "DEFAULT_GEAR_RATIO",
+    "DEFAULT_POLE_PAIRS",
     "Decoder",
     "HwfocError",
     "HwfocWarning",

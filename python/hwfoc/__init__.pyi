@@ -9,6 +9,14 @@ import pyarrow as pa
 
 __version__: str
 
+#: The default of every ``current_scale`` argument: raw current units per ampere (the library's,
+#: as the ``hwfoc`` command's ``--current-scale``).
+DEFAULT_CURRENT_SCALE: float
+#: The default of every ``pole_pairs`` argument: the motor's pole pairs.
+DEFAULT_POLE_PAIRS: int
+#: The default of every ``gear_ratio`` argument: motor turns per output shaft turn.
+DEFAULT_GEAR_RATIO: float
+
 #: One input: a path, bytes in memory, or a binary file object.
 Source = Union[str, "os.PathLike[str]", bytes, bytearray, memoryview, IO[bytes]]
 #: Inputs read one after another, as the command reads the inputs named together.
@@ -47,9 +55,9 @@ def read(
     esc: Union[int, Sequence[int], None] = None,
     start: Optional[Time] = None,
     end: Optional[Time] = None,
-    current_scale: float = 64,
-    pole_pairs: int = 7,
-    gear_ratio: float = 1,
+    current_scale: float = ...,
+    pole_pairs: int = ...,
+    gear_ratio: float = ...,
 ) -> pa.Table:
     """Reads telemetry whole into a ``pyarrow.Table`` of docs/RECORD-SCHEMA.md's records.
 
@@ -76,9 +84,9 @@ def scan(
     esc: Union[int, Sequence[int], None] = None,
     start: Optional[Time] = None,
     end: Optional[Time] = None,
-    current_scale: float = 64,
-    pole_pairs: int = 7,
-    gear_ratio: float = 1,
+    current_scale: float = ...,
+    pole_pairs: int = ...,
+    gear_ratio: float = ...,
 ) -> "Scan":
     """The records of ``sources`` as ``pyarrow.RecordBatch``es of at most ``batch_rows`` rows,
     in bounded memory whatever the size of the inputs (read a block at a time on a thread of
@@ -102,16 +110,16 @@ class Scan(Iterator[pa.RecordBatch]):
 def summary(
     source: Sources,
     *,
-    current_scale: float = 64,
-    pole_pairs: int = 7,
-    gear_ratio: float = 1,
+    current_scale: float = ...,
+    pole_pairs: int = ...,
+    gear_ratio: float = ...,
 ) -> Dict[str, Any]:
     """What ``hwfoc summary --json`` prints for ``source``, as Python objects: the settings,
     the inputs (format, bytes, ESCs) and per ESC its link statistics, field ranges, faults and
     fault episodes. Raises InputError as :func:`read`."""
 
 def record_schema(
-    *, current_scale: float = 64, pole_pairs: int = 7, gear_ratio: float = 1
+    *, current_scale: float = ..., pole_pairs: int = ..., gear_ratio: float = ...
 ) -> pa.Schema:
     """The Arrow schema of the records (units in the fields' metadata, settings in the
     schema's)."""
@@ -126,9 +134,9 @@ class Decoder:
         *,
         esc: int = 0,
         baud: int = 19200,
-        current_scale: float = 64,
-        pole_pairs: int = 7,
-        gear_ratio: float = 1,
+        current_scale: float = ...,
+        pole_pairs: int = ...,
+        gear_ratio: float = ...,
     ) -> None:
         """``esc``: the ``esc`` column of the records; ``baud``: the line's rate, for the time of
         each byte."""
@@ -157,9 +165,9 @@ def open_ports(
     ports: Sequence[str],
     *,
     baud: int = 19200,
-    current_scale: float = 64,
-    pole_pairs: int = 7,
-    gear_ratio: float = 1,
+    current_scale: float = ...,
+    pole_pairs: int = ...,
+    gear_ratio: float = ...,
 ) -> "Ports":
     """Opens serial ports (8N1), one ESC each in the order given, read as ``hwfoc monitor``
     reads them: a reader thread per port, a port that is unplugged retried (a

@@ -17,16 +17,28 @@ use arrow_array::RecordBatch;
 use arrow_pyarrow::{IntoPyArrow, Table};
 use hwfoc::Settings;
 use hwfoc_io::notice::Notice;
-use hwfoc_io::select::{Selection, Window};
+use hwfoc_io::select::{Selection, Window, filter_text};
 use hwfoc_io::sources::Sources;
 use hwfoc_io::summary::{Summary, esc_label, no_frames as no_frames_text};
+use hwfoc_io::time::Time;
+use hwfoc_io::write::Provenance;
 use hwfoc_io::write::arrow::schema;
+use hwfoc_io::write::metadata::escs_json;
 use hwfoc_io::{Input, InputError};
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
 
-use records::{Collect, Frames, Provenance, Stop, escs_json, filter_text};
+use records::{Collect, Frames, Stop};
 use source::Spec;
+
+/// The defaults of every function's settings arguments (`current_scale`, `pole_pairs`,
+/// `gear_ratio`), those of the library: Python has them as `hwfoc.DEFAULT_CURRENT_SCALE`,
+/// `DEFAULT_POLE_PAIRS` and `DEFAULT_GEAR_RATIO`.
+pub(crate) const CURRENT_SCALE: f32 = Settings::DEFAULT.current_scale;
+/// See [`CURRENT_SCALE`].
+pub(crate) const POLE_PAIRS: u16 = Settings::DEFAULT.pole_pairs;
+/// See [`CURRENT_SCALE`].
+pub(crate) const GEAR_RATIO: f32 = Settings::DEFAULT.gear_ratio;
 
 /// Rows per record batch of `read`'s table: blocks converted side by side on the workers. A
 /// block of frames this size (under 2 MiB: 29 bytes a frame) stays in a core's L2 cache while
@@ -62,16 +74,16 @@ impl Options {
         Ok(Options {
             settings,
             selection: Selection::new(&escs, window),
-            filter: filter_text(&escs, from, to),
+            filter: filter_text(&escs, from.map(Time::Seconds), to.map(Time::Seconds)),
         })
     }
 
     fn provenance(&self, specs: &[Spec]) -> Provenance {
-        Provenance {
-            settings: self.settings,
-            inputs: specs.iter().map(|s| s.name().to_string()).collect(),
-            filter: self.filter.clone(),
-        }
+        Provenance::new(
+            self.settings,
+            specs.iter().map(|s| s.name().to_string()).collect(),
+            self.filter.clone(),
+        )
     }
 }
 
@@ -268,7 +280,7 @@ pub(crate) fn stop_error(stop: Stop) -> PyErr {
 /// InputError, SelectionError, SettingsError; warns HwfocWarning for inputs without frames and
 /// for damage or notes in a recording.
 #[pyfunction]
-#[pyo3(signature = (source, *, esc=None, start=None, end=None, current_scale=64.0, pole_pairs=7, gear_ratio=1.0))]
+#[pyo3(signature = (source, *, esc=None, start=None, end=None, current_scale=CURRENT_SCALE, pole_pairs=POLE_PAIRS, gear_ratio=GEAR_RATIO), text_signature = "(source, *, esc=None, start=None, end=None, current_scale=DEFAULT_CURRENT_SCALE, pole_pairs=DEFAULT_POLE_PAIRS, gear_ratio=DEFAULT_GEAR_RATIO)")]
 #[allow(clippy::too_many_arguments)]
 fn read<'py>(
     py: Python<'py>,
@@ -315,7 +327,7 @@ fn summary_json(specs: Vec<Spec>, settings: Settings, notes: &Notes) -> Result<S
 /// settings, inputs, and per ESC its link statistics, field ranges, faults and fault episodes.
 /// Raises InputError.
 #[pyfunction]
-#[pyo3(signature = (source, *, current_scale=64.0, pole_pairs=7, gear_ratio=1.0))]
+#[pyo3(signature = (source, *, current_scale=CURRENT_SCALE, pole_pairs=POLE_PAIRS, gear_ratio=GEAR_RATIO), text_signature = "(source, *, current_scale=DEFAULT_CURRENT_SCALE, pole_pairs=DEFAULT_POLE_PAIRS, gear_ratio=DEFAULT_GEAR_RATIO)")]
 fn summary<'py>(
     py: Python<'py>,
     source: &Bound<'py, PyAny>,
@@ -336,7 +348,7 @@ fn summary<'py>(
 /// The Arrow schema of the records (names, types, nullability, units in the fields' metadata),
 /// with the settings in its metadata.
 #[pyfunction]
-#[pyo3(signature = (*, current_scale=64.0, pole_pairs=7, gear_ratio=1.0))]
+#[pyo3(signature = (*, current_scale=CURRENT_SCALE, pole_pairs=POLE_PAIRS, gear_ratio=GEAR_RATIO), text_signature = "(*, current_scale=DEFAULT_CURRENT_SCALE, pole_pairs=DEFAULT_POLE_PAIRS, gear_ratio=DEFAULT_GEAR_RATIO)")]
 fn record_schema(
     py: Python<'_>,
     current_scale: f32,
@@ -345,11 +357,7 @@ fn record_schema(
 ) -> PyResult<Bound<'_, PyAny>> {
     let settings =
         Settings::new(current_scale, pole_pairs, gear_ratio).map_err(errors::settings)?;
-    let provenance = Provenance {
-        settings,
-        inputs: Vec::new(),
-        filter: String::new(),
-    };
+    let provenance = Provenance::new(settings, Vec::new(), String::new());
     let schema = provenance.schema(None);
     arrow_pyarrow::ToPyArrow::to_pyarrow(schema.as_ref(), py)
 }
@@ -374,5 +382,8 @@ fn _hwfoc(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("HwfocWarning", py.get_type::<errors::HwfocWarning>())?;
     m.add("PortWarning", py.get_type::<errors::PortWarning>())?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    m.add("DEFAULT_CURRENT_SCALE", CURRENT_SCALE)?;
+    m.add("DEFAULT_POLE_PAIRS", POLE_PAIRS)?;
+    m.add("DEFAULT_GEAR_RATIO", GEAR_RATIO)?;
     Ok(())
 }

@@ -2,6 +2,7 @@
 //! serial ports read as `hwfoc monitor` reads them (`PortSet`: a reader thread per port that
 //! survives unplugging; `PortStreams`: a timed decoding stream per port).
 
+use crate::{CURRENT_SCALE, GEAR_RATIO, POLE_PAIRS};
 use std::collections::VecDeque;
 use std::sync::Mutex;
 use std::time::Duration;
@@ -24,7 +25,8 @@ use pyo3::prelude::*;
 use pyo3::types::{PyByteArray, PyBytes, PyDict, PyMemoryView};
 
 use crate::errors;
-use crate::records::{Frames, Provenance};
+use crate::records::Frames;
+use hwfoc_io::write::Provenance;
 
 /// How long a wait for port events lasts before looking for Ctrl-C.
 const POLL: Duration = Duration::from_millis(100);
@@ -79,12 +81,7 @@ fn bytes_of(data: &Bound<'_, PyAny>) -> PyResult<Vec<u8>> {
 
 /// The record schema with `settings` in its metadata.
 fn live_schema(settings: Settings, inputs: Vec<String>) -> SchemaRef {
-    Provenance {
-        settings,
-        inputs,
-        filter: String::new(),
-    }
-    .schema(None)
+    Provenance::new(settings, inputs, String::new()).schema(None)
 }
 
 struct DecoderState {
@@ -123,7 +120,7 @@ impl Decoder {
 #[pymethods]
 impl Decoder {
     #[new]
-    #[pyo3(signature = (*, esc=0, baud=DEFAULT_BAUD, current_scale=64.0, pole_pairs=7, gear_ratio=1.0))]
+    #[pyo3(signature = (*, esc=0, baud=DEFAULT_BAUD, current_scale=CURRENT_SCALE, pole_pairs=POLE_PAIRS, gear_ratio=GEAR_RATIO), text_signature = "(*, esc=0, baud=..., current_scale=DEFAULT_CURRENT_SCALE, pole_pairs=DEFAULT_POLE_PAIRS, gear_ratio=DEFAULT_GEAR_RATIO)")]
     fn new(
         esc: u8,
         baud: u32,
@@ -252,7 +249,7 @@ pub struct Ports {
 
 /// Opens serial ports: see `hwfoc.open_ports`.
 #[pyfunction]
-#[pyo3(signature = (ports, *, baud=DEFAULT_BAUD, current_scale=64.0, pole_pairs=7, gear_ratio=1.0))]
+#[pyo3(signature = (ports, *, baud=DEFAULT_BAUD, current_scale=CURRENT_SCALE, pole_pairs=POLE_PAIRS, gear_ratio=GEAR_RATIO), text_signature = "(ports, *, baud=..., current_scale=DEFAULT_CURRENT_SCALE, pole_pairs=DEFAULT_POLE_PAIRS, gear_ratio=DEFAULT_GEAR_RATIO)")]
 pub fn open_ports(
     py: Python<'_>,
     ports: Vec<String>,

@@ -1,20 +1,16 @@
 //! Frames to Arrow record batches: the schema of `hwfoc_io::write::arrow` (names, types,
 //! nullability, units of docs/RECORD-SCHEMA.md, from the column table), each column's array made at
-//! once from a block of frames, and the key-value metadata of the Parquet export.
-
-use std::collections::HashMap;
-use std::sync::Arc;
+//! once from a block of frames.
 
 use arrow_array::{RecordBatch, new_null_array};
-use arrow_schema::{Schema, SchemaRef};
+use arrow_schema::SchemaRef;
 use hwfoc::Settings;
 use hwfoc::telemetry::{Data, Frame};
 use hwfoc_io::InputError;
 use hwfoc_io::handler::Handler;
 use hwfoc_io::record::{Column, Visitor, columns};
 use hwfoc_io::select::Selection;
-use hwfoc_io::sources::Sources;
-use hwfoc_io::write::arrow::{ArrowValue, schema};
+use hwfoc_io::write::arrow::ArrowValue;
 
 /// Data frames as received, column by column: what a batch is made from.
 #[derive(Debug, Default)]
@@ -119,89 +115,6 @@ impl Frames {
         // type, as in `hwfoc_io::write::arrow`), and all have the same length.
         RecordBatch::try_new(schema, arrays.arrays).expect("the arrays follow the schema")
     }
-}
-
-/// What the records were made from: the Parquet export's key-value metadata (`hwfoc decode
-/// --format parquet`): `hwfoc_version`, the settings, `inputs`, `filter` when records were
-/// selected, and `escs` when known (after the whole run).
-#[derive(Debug, Clone)]
-pub struct Provenance {
-    /// The conversion settings.
-    pub settings: Settings,
-    /// The inputs' names.
-    pub inputs: Vec<String>,
-    /// The selection as the command writes it (`esc=0,2 from=1.5 to=3`), or empty.
-    pub filter: String,
-}
-
-impl Provenance {
-    /// The key-value metadata, with `escs` (a JSON array of `{"esc", "input", "stream"}`) when
-    /// given.
-    pub fn metadata(&self, escs: Option<String>) -> HashMap<String, String> {
-        let s = &self.settings;
-        let mut kv = HashMap::from([
-            (
-                "hwfoc_version".to_string(),
-                env!("CARGO_PKG_VERSION").to_string(),
-            ),
-            ("current_scale".to_string(), s.current_scale.to_string()),
-            ("pole_pairs".to_string(), s.pole_pairs.to_string()),
-            ("gear_ratio".to_string(), s.gear_ratio.to_string()),
-            (
-                "inputs".to_string(),
-                serde_json::Value::from(self.inputs.clone()).to_string(),
-            ),
-        ]);
-        if !self.filter.is_empty() {
-            kv.insert("filter".to_string(), self.filter.clone());
-        }
-        if let Some(escs) = escs {
-            kv.insert("escs".to_string(), escs);
-        }
-        kv
-    }
-
-    /// The record schema with the metadata.
-    pub fn schema(&self, escs: Option<String>) -> SchemaRef {
-        Arc::new(Schema::new_with_metadata(
-            schema().fields().clone(),
-            self.metadata(escs),
-        ))
-    }
-}
-
-/// The selection as `hwfoc decode` records it: `esc=0,2 from=1.5 to=3`, or empty.
-pub fn filter_text(escs: &[u8], from: Option<f64>, to: Option<f64>) -> String {
-    let mut parts = Vec::new();
-    if !escs.is_empty() {
-        let escs: Vec<String> = escs.iter().map(u8::to_string).collect();
-        parts.push(format!("esc={}", escs.join(",")));
-    }
-    if let Some(from) = from {
-        parts.push(format!("from={from}"));
-    }
-    if let Some(to) = to {
-        parts.push(format!("to={to}"));
-    }
-    parts.join(" ")
-}
-
-/// Which ESC is which, as the Parquet export's `escs`:
-/// `[{"esc": 0, "input": "a.pcapng", "stream": "/dev/ttyUSB0"}, ...]`.
-pub fn escs_json(sources: &Sources) -> String {
-    let escs: Vec<serde_json::Value> = sources
-        .escs()
-        .iter()
-        .enumerate()
-        .map(|(i, esc)| {
-            serde_json::json!({
-                "esc": i,
-                "input": sources.names()[esc.input],
-                "stream": esc.name,
-            })
-        })
-        .collect();
-    serde_json::Value::from(escs).to_string()
 }
 
 /// Why a run of inputs stopped: an input, or the reader of the batches having gone away.

@@ -3,6 +3,7 @@
 //! and converts each block of frames into a record batch, handing them over a channel of
 //! `QUEUE` batches; the iterator waits for the next with the interpreter's lock released.
 
+use crate::{CURRENT_SCALE, GEAR_RATIO, POLE_PAIRS};
 use std::sync::Mutex;
 use std::sync::mpsc::{Receiver, RecvTimeoutError, sync_channel};
 use std::time::Duration;
@@ -106,7 +107,7 @@ fn produce(
 /// batches ahead. Errors opening the inputs are raised at once, later ones by the iterator after
 /// the batches before them.
 #[pyfunction]
-#[pyo3(signature = (sources, *, batch_rows=65536, esc=None, start=None, end=None, current_scale=64.0, pole_pairs=7, gear_ratio=1.0))]
+#[pyo3(signature = (sources, *, batch_rows=65536, esc=None, start=None, end=None, current_scale=CURRENT_SCALE, pole_pairs=POLE_PAIRS, gear_ratio=GEAR_RATIO), text_signature = "(sources, *, batch_rows=65536, esc=None, start=None, end=None, current_scale=DEFAULT_CURRENT_SCALE, pole_pairs=DEFAULT_POLE_PAIRS, gear_ratio=DEFAULT_GEAR_RATIO)")]
 #[allow(clippy::too_many_arguments)]
 pub fn scan(
     py: Python<'_>,

@@ -3,6 +3,7 @@ output, every kind of source, selections and settings, and errors with the comma
 messages."""
 
 import io
+import inspect
 import json
 import os
 import subprocess
@@ -76,6 +77,22 @@ def test_settings_change_values_and_metadata(cli, sim_dir):
     meta = table.schema.metadata
     assert (meta[b"current_scale"], meta[b"pole_pairs"], meta[b"gear_ratio"]) == (b"100", b"14", b"2.5")
     assert table.column("rpm") != hwfoc.read(path).column("rpm")
+
+
+def test_the_default_settings_are_the_librarys(sim_dir):
+    # docs/RECORD-SCHEMA.md: current scale 64, 7 pole pairs, gear ratio 1.
+    defaults = (hwfoc.DEFAULT_CURRENT_SCALE, hwfoc.DEFAULT_POLE_PAIRS, hwfoc.DEFAULT_GEAR_RATIO)
+    assert defaults == (64.0, 7, 1.0)
+    assert isinstance(hwfoc.DEFAULT_POLE_PAIRS, int)
+    meta = hwfoc.record_schema().metadata
+    assert (meta[b"current_scale"], meta[b"pole_pairs"], meta[b"gear_ratio"]) == (b"64", b"7", b"1")
+    for f in (hwfoc.read, hwfoc.scan, hwfoc.summary, hwfoc.record_schema, hwfoc.Decoder, hwfoc.open_ports):
+        params = inspect.signature(f).parameters
+        got = tuple(params[name].default for name in ("current_scale", "pole_pairs", "gear_ratio"))
+        assert got == defaults, f
+    path = sim_dir / "one.bin"
+    given = hwfoc.read(path, current_scale=defaults[0], pole_pairs=defaults[1], gear_ratio=defaults[2])
+    assert given.equals(hwfoc.read(path))
 
 
 @pytest.mark.parametrize("esc,start,end", [(1, None, None), ([0, 2], 1700000003.5, None), (None, None, 1700000004), (2, 1700000002, 1700000006)])

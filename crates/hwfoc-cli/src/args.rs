@@ -190,18 +190,7 @@ impl SelectArgs {
 
     /// The filters, as recorded with an output: `esc=0,2 from=+1.5 to=1795442580`, or empty.
     pub fn text(&self) -> String {
-        let mut parts = Vec::new();
-        if !self.esc.is_empty() {
-            let escs: Vec<String> = self.esc.iter().map(u8::to_string).collect();
-            parts.push(format!("esc={}", escs.join(",")));
-        }
-        if let Some(from) = self.from {
-            parts.push(format!("from={from}"));
-        }
-        if let Some(to) = self.to {
-            parts.push(format!("to={to}"));
-        }
-        parts.join(" ")
+        hwfoc_io::select::filter_text(&self.esc, self.from, self.to)
     }
 }
 

@@ -11,6 +11,7 @@ mod demo;
 mod error;
 mod output;
 mod safety;
+mod shown;
 
 use std::process::ExitCode;
 

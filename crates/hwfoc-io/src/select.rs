@@ -201,6 +201,24 @@ impl Selection {
     }
 }
 
+/// The selection as every output records it (the `filter` of the Parquet metadata and of the
+/// Python package's schema, the CSV comment, the empty window's warning): `esc=0,2 from=+1.5
+/// to=1795442580`, each part only when given (times as [`Time`] writes them), or empty.
+pub fn filter_text(escs: &[u8], from: Option<Time>, to: Option<Time>) -> String {
+    let mut parts = Vec::new();
+    if !escs.is_empty() {
+        let escs: Vec<String> = escs.iter().map(u8::to_string).collect();
+        parts.push(format!("esc={}", escs.join(",")));
+    }
+    if let Some(from) = from {
+        parts.push(format!("from={from}"));
+    }
+    if let Some(to) = to {
+        parts.push(format!("to={to}"));
+    }
+    parts.join(" ")
+}
+
 /// The warning for a time window that held no frame of the selected ESCs, naming the window
 /// as `filter` writes it (`from=100 to=200`) and the times the frames do have (`first` and
 /// `last`, seconds; `wall`: the source's clock is the wall clock). The one wording of the
@@ -254,6 +272,23 @@ mod tests {
         );
         assert!(!s.contains(0, Some(10.0)));
         assert!(s.contains(1, Some(11.0)) && !s.contains(1, Some(10.5)));
+    }
+
+    #[test]
+    fn the_filter_text_names_what_was_given() {
+        assert_eq!(filter_text(&[], None, None), "");
+        assert_eq!(
+            filter_text(
+                &[0, 2],
+                Some(Time::FromFirst(1.5)),
+                Some(Time::Seconds(3.0))
+            ),
+            "esc=0,2 from=+1.5 to=3"
+        );
+        assert_eq!(
+            filter_text(&[], None, Some(Time::Seconds(1700000002.0))),
+            "to=1700000002"
+        );
     }
 
     #[test]

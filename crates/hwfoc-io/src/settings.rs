@@ -21,8 +21,73 @@
 //! ```
 
 use std::collections::BTreeMap;
+use std::fmt;
 
 use hwfoc::{Settings, SettingsError};
+
+/// The value of one conversion setting, written as every output writes it: in text (a Parquet
+/// key-value entry, the CSV comment) by its `Display`, `64` or `2.5`; in JSON as a number,
+/// `64.0` or `7`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum SettingValue {
+    /// A scale or a ratio.
+    Real(f32),
+    /// A count.
+    Count(u16),
+}
+
+impl fmt::Display for SettingValue {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            SettingValue::Real(v) => v.fmt(f),
+            SettingValue::Count(v) => v.fmt(f),
+        }
+    }
+}
+
+impl From<SettingValue> for serde_json::Value {
+    fn from(v: SettingValue) -> serde_json::Value {
+        match v {
+            SettingValue::Real(v) => v.into(),
+            SettingValue::Count(v) => v.into(),
+        }
+    }
+}
+
+/// The fields of `settings` by their name in every output (Parquet metadata, the CSV comment,
+/// the JSON of `summary` and `monitor`, the Python package's keyword arguments), in that
+/// order: `current_scale`, `pole_pairs`, `gear_ratio`.
+pub fn fields(settings: &Settings) -> [(&'static str, SettingValue); 3] {
+    [
+        ("current_scale", SettingValue::Real(settings.current_scale)),
+        ("pole_pairs", SettingValue::Count(settings.pole_pairs)),
+        ("gear_ratio", SettingValue::Real(settings.gear_ratio)),
+    ]
+}
+
+/// The fields of `settings` as people read them, each its name in words and its value:
+/// `["current scale 64", "pole pairs 7", "gear ratio 1"]` (`hwfoc summary`); with `default`,
+/// only those that differ from it.
+pub fn words(settings: &Settings, default: Option<&Settings>) -> Vec<String> {
+    let defaults = default.map(fields);
+    fields(settings)
+        .into_iter()
+        .enumerate()
+        .filter(|&(i, (_, value))| defaults.is_none_or(|d| d[i].1 != value))
+        .map(|(_, (name, value))| format!("{} {value}", name.replace('_', " ")))
+        .collect()
+}
+
+/// Settings as a JSON object, keyed as [`fields`] names them:
+/// `{"current_scale": 64.0, "pole_pairs": 7, "gear_ratio": 1.0}`.
+pub fn settings_json(settings: &Settings) -> serde_json::Value {
+    serde_json::Value::Object(
+        fields(settings)
+            .into_iter()
+            .map(|(name, value)| (name.to_string(), value.into()))
+            .collect(),
+    )
+}
 
 /// Some of the fields of [`Settings`]; `None` leaves a field to the next level.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
@@ -57,6 +122,24 @@ impl SettingsPatch {
     /// Whether no field is set.
     pub fn is_empty(&self) -> bool {
         *self == SettingsPatch::default()
+    }
+
+    /// The fields that are set, named and ordered as [`fields`] has them.
+    pub fn fields(&self) -> impl Iterator<Item = (&'static str, SettingValue)> {
+        let given = [
+            self.current_scale.is_some(),
+            self.pole_pairs.is_some(),
+            self.gear_ratio.is_some(),
+        ];
+        let values = fields(&Settings {
+            current_scale: self.current_scale.unwrap_or_default(),
+            pole_pairs: self.pole_pairs.unwrap_or_default(),
+            gear_ratio: self.gear_ratio.unwrap_or_default(),
+        });
+        values
+            .into_iter()
+            .zip(given)
+            .filter_map(|(field, given)| given.then_some(field))
     }
 }
 
@@ -252,6 +335,33 @@ mod tests {
             "{rpm:?}"
         );
         assert!(!rpm.contains(&(1, 100.0)), "{rpm:?}");
+    }
+
+    #[test]
+    fn settings_are_written_under_their_names() {
+        let s = Settings::new(100.0, 14, 2.5).unwrap();
+        let text: Vec<String> = fields(&s).iter().map(|(n, v)| format!("{n}={v}")).collect();
+        assert_eq!(
+            text,
+            ["current_scale=100", "pole_pairs=14", "gear_ratio=2.5"]
+        );
+        assert_eq!(
+            settings_json(&Settings::DEFAULT).to_string(),
+            r#"{"current_scale":64.0,"pole_pairs":7,"gear_ratio":1.0}"#
+        );
+        let set: Vec<String> = patch(None, Some(3), Some(0.5))
+            .fields()
+            .map(|(n, v)| format!("{n}={v}"))
+            .collect();
+        assert_eq!(set, ["pole_pairs=3", "gear_ratio=0.5"]);
+        assert_eq!(patch(None, None, None).fields().count(), 0);
+        assert_eq!(
+            words(&s, None),
+            ["current scale 100", "pole pairs 14", "gear ratio 2.5"]
+        );
+        let other = Settings::new(100.0, 7, 2.5).unwrap();
+        assert_eq!(words(&s, Some(&other)), ["pole pairs 14"]);
+        assert!(words(&s, Some(&s)).is_empty());
     }
 
     #[test]

@@ -35,10 +35,10 @@ pub use crate::episode::{Episode, Mark};
 use crate::escape::Escaped;
 use crate::fixed::Fixed;
 use crate::input::InputError;
+use crate::settings::{self, settings_json};
 use crate::sources::{Handler, Sources};
 use crate::stream::EscLink;
 use crate::time::{self, Clock};
-use crate::write::settings_json;
 use hwfoc::datalink::LengthByte;
 
 /// What to tell a user whose wire gave bytes but no frame.
@@ -577,11 +577,11 @@ impl<'a> Report<'a> {
         let escs = self.escs();
         let _ = write!(
             o,
-            "settings     current scale {}, pole pairs {}, gear ratio {}",
-            self.settings.current_scale, self.settings.pole_pairs, self.settings.gear_ratio
+            "settings     {}",
+            settings::words(self.settings, None).join(", ")
         );
         for esc in &escs {
-            let differing = settings_differing(&esc.settings, self.settings);
+            let differing = settings::words(&esc.settings, Some(self.settings));
             if !differing.is_empty() {
                 let _ = write!(o, "; ESC {}: {}", esc.index, differing.join(", "));
             }
@@ -702,22 +702,6 @@ impl<'a> Report<'a> {
             "energy_total": total_energy(&reports).as_ref().map(energy_json),
         })
     }
-}
-
-/// The fields of `settings` that differ from `default`, as the summary names them
-/// (`pole pairs 14`).
-fn settings_differing(settings: &Settings, default: &Settings) -> Vec<String> {
-    let mut fields = Vec::new();
-    if settings.current_scale != default.current_scale {
-        fields.push(format!("current scale {}", settings.current_scale));
-    }
-    if settings.pole_pairs != default.pole_pairs {
-        fields.push(format!("pole pairs {}", settings.pole_pairs));
-    }
-    if settings.gear_ratio != default.gear_ratio {
-        fields.push(format!("gear ratio {}", settings.gear_ratio));
-    }
-    fields
 }
 
 /// The figures of every ESC with data frames added, when there are two or more.
@@ -1019,14 +1003,10 @@ impl EscReport<'_> {
             .infos
             .iter()
             .map(|(i, n)| {
-                json!({
-                    "product": i.product(),
-                    "hardware": i.hardware(),
-                    "firmware": i.firmware(),
-                    "id": i.id(),
-                    "text": i.to_string(),
-                    "frames": n,
-                })
+                let mut info = device_json(i);
+                info.insert("text".to_string(), json!(i.to_string()));
+                info.insert("frames".to_string(), json!(n));
+                Value::Object(info)
             })
             .collect();
         let episodes: Vec<Value> = self
@@ -1077,6 +1057,20 @@ impl EscReport<'_> {
             "warning": warning,
         })
     }
+}
+
+/// What an information frame says of the device, as every JSON output names it (`summary
+/// --json`, `monitor --json`): `{"product": ..., "hardware": ..., "firmware": ..., "id": ...}`.
+pub fn device_json(info: &Info) -> serde_json::Map<String, Value> {
+    [
+        ("product", info.product()),
+        ("hardware", info.hardware()),
+        ("firmware", info.firmware()),
+        ("id", info.id()),
+    ]
+    .into_iter()
+    .map(|(name, value)| (name.to_string(), json!(value)))
+    .collect()
 }
 
 /// An episode in one line: when (dates on a wall clock), how long, which faults.
@@ -1131,6 +1125,15 @@ fn percent(part: u64, whole: u64) -> f64 {
 mod tests {
     use super::*;
     use hwfoc::DataFrame;
+
+    #[test]
+    fn the_device_is_named_field_by_field() {
+        let info = Info::from(hwfoc::InfoFrame::new("HW1", "V2", "XR-01.0.00", "42").unwrap());
+        assert_eq!(
+            Value::Object(device_json(&info)).to_string(),
+            r#"{"product":"HW1","hardware":"V2","firmware":"XR-01.0.00","id":"42"}"#
+        );
+    }
 
     #[test]
     fn temperature_stats_come_from_the_histogram() {

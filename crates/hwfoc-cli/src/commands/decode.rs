@@ -8,14 +8,13 @@
 //! giving no records; a date for an input without a wall clock is refused likewise.
 
 use clap::{Args, ValueEnum};
-use serde_json::json;
 
 use crate::args::{InputArgs, SelectArgs, SettingsArgs};
 use crate::error::CliError;
 use hwfoc_io::settings::{SettingsMap, SettingsPatch};
 use hwfoc_io::sources::Sources;
 use hwfoc_io::time::Clock;
-use hwfoc_io::write::{Export, OutputFormat, Provenance};
+use hwfoc_io::write::{Export, OutputFormat, Provenance, metadata};
 
 /// Record output formats.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
@@ -95,7 +94,7 @@ pub fn run(args: &DecodeArgs) -> Result<(), CliError> {
     }
     let (kept, span) = (export.kept(), export.span());
     // Whatever was decoded before an input error is still written out.
-    let metadata = vec![("escs".to_string(), escs_json(&sources))];
+    let metadata = vec![(metadata::ESCS.to_string(), metadata::escs_json(&sources))];
     let finished = export.finish(metadata);
     result?;
     finished?;
@@ -132,23 +131,6 @@ fn overrides(map: &SettingsMap) -> Vec<(String, SettingsPatch)> {
         .esc_patches()
         .map(|(esc, p)| (format!("esc.{esc}"), differing(p)));
     ports.chain(escs).filter(|(_, p)| !p.is_empty()).collect()
-}
-
-/// Which ESC is which: `[{"esc": 0, "input": "a.pcapng", "stream": "/dev/ttyUSB0"}, ...]`.
-fn escs_json(sources: &Sources) -> String {
-    let escs: Vec<serde_json::Value> = sources
-        .escs()
-        .iter()
-        .enumerate()
-        .map(|(i, esc)| {
-            json!({
-                "esc": i,
-                "input": sources.names()[esc.input],
-                "stream": esc.name,
-            })
-        })
-        .collect();
-    serde_json::Value::from(escs).to_string()
 }
 
 /// Warnings on standard error: ESCs whose bytes held no frame, ESCs asked for but not found.

@@ -416,7 +416,10 @@ impl Export {
         }
         let escs = self.esc_settings();
         if !escs.is_empty() {
-            metadata.push(("esc_settings".to_string(), esc_settings_json(&escs)));
+            metadata.push((
+                super::metadata::ESC_SETTINGS.to_string(),
+                esc_settings_json(&escs),
+            ));
         }
         let written = self
             .send(true, true)

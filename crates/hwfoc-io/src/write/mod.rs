@@ -24,14 +24,14 @@
 //! Modules: `export.rs`, the pipeline ([`Export`] and its chunks of frames); `text.rs`,
 //! `arrow.rs`, `parquet.rs`, the writers; `staging.rs`, a new file renamed over its target when
 //! complete; `file.rs`, the output file's own thread; `safety.rs`, which files may be written
-//! ([`create_file`], [`FileId`]); `json.rs`, settings as JSON; `error.rs`, the errors
+//! ([`create_file`], [`FileId`]); `metadata.rs`, what every export records (settings as JSON among it); `error.rs`, the errors
 //! ([`WriteError`], [`ExportError`]); here, the formats.
 
 pub mod arrow;
 mod error;
 mod export;
 mod file;
-mod json;
+pub mod metadata;
 pub(crate) mod parquet;
 mod safety;
 mod staging;
@@ -40,7 +40,7 @@ mod text;
 pub use error::{ExportError, WriteError};
 pub use export::Export;
 pub(crate) use export::{Chunk, EscTable, Sink, ToWriter};
-pub use json::{esc_settings_json, settings_json};
+pub use metadata::esc_settings_json;
 pub use safety::{FileId, create_file, same_file};
 pub use staging::{PARTIAL_SUFFIX, Staging};
 

@@ -3,11 +3,8 @@
 //!
 //! Columns, types and units are those of `docs/RECORD-SCHEMA.md`, from the column table
 //! ([`crate::record::columns`]); each Arrow field carries its unit in its metadata (key `unit`,
-//! `-` for a number without unit). The file's key-value metadata holds `hwfoc_version`, the
-//! settings (`current_scale`, `pole_pairs`, `gear_ratio`), `inputs` (a JSON array of the input
-//! names), `escs` (a JSON array of `{"esc", "input", "stream"}`), when some ESCs' records were
-//! converted under settings of their own `esc_settings` (a JSON object of their settings by ESC
-//! index, see [`super::esc_settings_json`]) and, when records were filtered, `filter`.
+//! `-` for a number without unit). The file's key-value metadata is that of
+//! [`super::metadata`] (settings and provenance).
 //!
 //! Each column is one Parquet leaf column, encoded by code generic over the column: its values
 //! computed from the frames, a block of rows at a time, and stored as its value type says
@@ -106,7 +103,6 @@ mod encode {
     use std::sync::atomic::{AtomicUsize, Ordering};
     use std::sync::mpsc::{Receiver, SyncSender};
 
-    use arrow_schema::Schema;
     use bytes::Bytes;
     use hwfoc::{Settings, Status};
     use parquet::arrow::{ArrowSchemaConverter, add_encoded_arrow_schema_to_metadata};
@@ -125,6 +121,7 @@ mod encode {
     use parquet::schema::types::{ColumnDescPtr, SchemaDescriptor};
 
     use super::super::arrow::schema;
+    use super::super::metadata::schema_with;
     use super::super::{Chunk, Provenance, Sink, ToWriter, WriteError};
     use crate::record::columns::{COLUMNS, COUNT, visit};
     use crate::record::{Column, FaultList, Visitor};
@@ -185,46 +182,18 @@ mod encode {
         named.iter().copied().chain(others).collect()
     }
 
-    /// The key-value metadata known before the first row: the version, the settings, the
-    /// inputs and the filter.
-    fn provenance_metadata(provenance: &Provenance) -> Vec<KeyValue> {
-        let s = provenance.settings;
-        let mut kv = vec![
-            KeyValue::new(
-                "hwfoc_version".to_string(),
-                env!("CARGO_PKG_VERSION").to_string(),
-            ),
-            KeyValue::new("current_scale".to_string(), s.current_scale.to_string()),
-            KeyValue::new("pole_pairs".to_string(), s.pole_pairs.to_string()),
-            KeyValue::new("gear_ratio".to_string(), s.gear_ratio.to_string()),
-            KeyValue::new(
-                "inputs".to_string(),
-                serde_json::Value::from(provenance.inputs.clone()).to_string(),
-            ),
-        ];
-        if !provenance.filter.is_empty() {
-            kv.push(KeyValue::new(
-                "filter".to_string(),
-                provenance.filter.clone(),
-            ));
-        }
-        kv
-    }
-
     /// The Arrow schema as the `ARROW:schema` key-value entry, its own metadata holding every
     /// other key-value entry of the file: readers that rebuild the Arrow schema from it
     /// (`pyarrow.parquet.read_table(f).schema.metadata`, arrow-rs) show the settings and
     /// provenance there, as readers of the footer see them in its key-value metadata. The
     /// parquet crate encodes the schema only into writer properties, so it is taken from there.
-    fn encoded_schema(schema: &Schema, metadata: &[KeyValue]) -> Option<KeyValue> {
-        let with_metadata = schema.clone().with_metadata(
-            metadata
-                .iter()
-                .filter_map(|kv| Some((kv.key.clone(), kv.value.clone()?)))
-                .collect::<std::collections::HashMap<_, _>>(),
-        );
+    fn encoded_schema(metadata: &[KeyValue]) -> Option<KeyValue> {
+        let entries: Vec<(String, String)> = metadata
+            .iter()
+            .filter_map(|kv| Some((kv.key.clone(), kv.value.clone()?)))
+            .collect();
         let mut props = WriterProperties::builder().build();
-        add_encoded_arrow_schema_to_metadata(&with_metadata, &mut props);
+        add_encoded_arrow_schema_to_metadata(&schema_with(&entries), &mut props);
         props
             .key_value_metadata()?
             .iter()
@@ -711,7 +680,11 @@ mod encode {
         let name = sink.name;
         let fail = |e| write_error(&name, e);
         let parquet_schema = ArrowSchemaConverter::new().convert(&schema).map_err(fail)?;
-        let mut metadata = provenance_metadata(provenance);
+        let mut metadata: Vec<KeyValue> = provenance
+            .key_values()
+            .into_iter()
+            .map(|(key, value)| KeyValue::new(key, value))
+            .collect();
         let props = Arc::new(properties(&parquet_schema, metadata.clone()));
         let mut writer = SerializedFileWriter::new(
             HoldFooter::new(sink.writer),
@@ -749,7 +722,7 @@ mod encode {
         if let Some(columns) = previous {
             append_row_group(&mut writer, columns).map_err(fail)?;
         }
-        if let Some(kv) = encoded_schema(&schema, &metadata) {
+        if let Some(kv) = encoded_schema(&metadata) {
             writer.append_key_value_metadata(kv);
         }
         // The footer is held back, its float columns' order made the one every reader knows,

@@ -12,6 +12,7 @@ use hwfoc::Settings;
 use hwfoc::telemetry::Data;
 
 use crate::record::{Record, TextEncoder};
+use crate::settings;
 
 use super::{Chunk, EscTable, Provenance, Sink, ToWriter, WriteError};
 
@@ -184,35 +185,21 @@ fn header(csv: bool, provenance: &Provenance) -> Vec<u8> {
         return text;
     }
     if provenance.csv_comment {
-        let settings = provenance.settings;
-        let filter = if provenance.filter.is_empty() {
-            String::new()
-        } else {
-            format!(" filter={}", provenance.filter)
-        };
-        let mut overrides = String::new();
-        for (name, patch) in &provenance.overrides {
-            if let Some(scale) = patch.current_scale {
-                overrides.push_str(&format!(" {name}.current_scale={scale}"));
-            }
-            if let Some(pairs) = patch.pole_pairs {
-                overrides.push_str(&format!(" {name}.pole_pairs={pairs}"));
-            }
-            if let Some(ratio) = patch.gear_ratio {
-                overrides.push_str(&format!(" {name}.gear_ratio={ratio}"));
+        let mut comment = String::from("# hwfoc decode:");
+        for (name, value) in settings::fields(&provenance.settings) {
+            comment.push_str(&format!(" {name}={value}"));
+        }
+        for (entry, patch) in &provenance.overrides {
+            for (name, value) in patch.fields() {
+                comment.push_str(&format!(" {entry}.{name}={value}"));
             }
         }
-        text.extend_from_slice(
-            format!(
-                "# hwfoc decode: current_scale={} pole_pairs={} gear_ratio={}{overrides} \
-                 input={}{filter}\n",
-                settings.current_scale,
-                settings.pole_pairs,
-                settings.gear_ratio,
-                provenance.inputs.join(" "),
-            )
-            .as_bytes(),
-        );
+        comment.push_str(&format!(" input={}", provenance.inputs.join(" ")));
+        if !provenance.filter.is_empty() {
+            comment.push_str(&format!(" filter={}", provenance.filter));
+        }
+        comment.push('\n');
+        text.extend_from_slice(comment.as_bytes());
     }
     Record::write_csv_header(&mut text);
     text

@@ -28,6 +28,8 @@ use super::feed::Msg;
 use super::fleet::{EscView, HISTORY_S, Link, LogEntry, total_energy, total_power_w};
 use super::{Session, number};
 use crate::error::CliError;
+use crate::shown::{Measure, Shown};
+use hwfoc::Quantity;
 use hwfoc_io::energy::Energy;
 use hwfoc_io::escape::Escaped;
 use hwfoc_io::fixed::Fixed;
@@ -489,45 +491,65 @@ fn draw_detail(frame: &mut Frame, area: Rect, index: usize, esc: &EscView, now: 
     // Two braille dots per cell across: more points than that cannot show, so each column of
     // dots gets the lowest and highest value that fell in it (spikes stay visible).
     let columns = usize::from(rpm_area.width).max(1) * 2;
-    let series = |f: &dyn Fn(&super::fleet::Sample) -> Option<f32>| -> Vec<(f64, f64)> {
-        envelope(
-            esc.history
-                .iter()
-                .filter_map(|s| f(s).map(|v| (s.t - now, f64::from(v)))),
-            columns,
-        )
-    };
-    let rpm = series(&|s| Some(s.rpm));
-    let current = series(&|s| Some(s.current_a));
-    let phase = series(&|s| Some(s.phase_current_a));
-    let volt = series(&|s| Some(s.voltage_v));
-    let mos = series(&|s| s.mos_temp_c);
-    let cap = series(&|s| s.cap_temp_c);
-    chart(frame, rpm_area, "RPM", &[("rpm", Color::Cyan, &rpm)], true);
-    chart(
-        frame,
-        current_area,
-        "Current A",
-        &[
-            ("input", Color::Yellow, &current),
-            ("phase", Color::Magenta, &phase),
-        ],
-        true,
-    );
-    chart(
-        frame,
-        volt_area,
-        "Voltage V",
-        &[("input", Color::Green, &volt)],
-        false,
-    );
-    chart(
-        frame,
-        temp_area,
-        "Temperature °C",
-        &[("MOS", Color::Red, &mos), ("CAP", Color::LightBlue, &cap)],
-        false,
-    );
+    let areas = [rpm_area, current_area, volt_area, temp_area];
+    for (measure, area) in CHARTS.into_iter().zip(areas) {
+        let series: Vec<(&str, Color, Points)> = measure
+            .shown()
+            .map(|q| {
+                let points = esc
+                    .history
+                    .iter()
+                    .filter_map(|s| s.get(q).map(|v| (s.t - now, f64::from(v))));
+                (q.short(), colour(q), envelope(points, columns))
+            })
+            .collect();
+        let lines: Vec<Series> = series
+            .iter()
+            .map(|(name, color, data)| (*name, *color, data.as_slice()))
+            .collect();
+        chart(
+            frame,
+            area,
+            &chart_title(measure),
+            &lines,
+            from_zero(measure),
+        );
+    }
+}
+
+/// The measures charted for the selected ESC, left to right and top to bottom (and as
+/// sparklines where the charts do not fit).
+const CHARTS: [Measure; 4] = [
+    Measure::Speed,
+    Measure::Current,
+    Measure::Voltage,
+    Measure::Temperature,
+];
+
+/// A chart's title: `RPM`, `Current A`, `Voltage V`, `Temperature °C`.
+fn chart_title(measure: Measure) -> String {
+    match measure {
+        Measure::Speed => "RPM".to_string(),
+        m => format!("{} {}", m.title(), m.unit()),
+    }
+}
+
+/// Whether a chart of `measure` starts from zero (speeds and currents) or spans its values.
+fn from_zero(measure: Measure) -> bool {
+    matches!(measure, Measure::Speed | Measure::Current)
+}
+
+/// The colour of a quantity's line.
+fn colour(q: Shown) -> Color {
+    match q {
+        Shown::Carried(Quantity::Rpm) => Color::Cyan,
+        Shown::Carried(Quantity::Current) => Color::Yellow,
+        Shown::Carried(Quantity::PhaseCurrent) => Color::Magenta,
+        Shown::Carried(Quantity::Voltage) => Color::Green,
+        Shown::Carried(Quantity::MosTemp) => Color::Red,
+        Shown::Carried(Quantity::CapTemp) => Color::LightBlue,
+        _ => Color::Gray,
+    }
 }
 
 /// `power 480 W (peak 1210 W) · used 312.5 mAh · 7.41 Wh`, and what it is of.
@@ -592,37 +614,38 @@ fn sparkline(points: &[(f64, f64)], width: usize, from_zero: bool) -> String {
         .collect()
 }
 
+/// A sparkline: its label, its quantity, the decimals and unit of its latest value, and
+/// whether it starts from zero.
+type Sparkline = (String, Option<Shown>, usize, String, bool);
+
+/// The sparklines: the first quantity of each chart.
+fn sparklines() -> [Sparkline; CHARTS.len()] {
+    CHARTS.map(|m| {
+        let q = m.shown().next();
+        let (name, decimals, unit) = match m {
+            Measure::Speed => ("RPM".to_string(), 0, String::new()),
+            Measure::Temperature => {
+                let name = format!("{} temp", q.map_or("", Shown::short));
+                (name, 0, format!(" {}", m.unit()))
+            }
+            m => (m.title().to_string(), 1, format!(" {}", m.unit())),
+        };
+        (name, q, decimals, unit, from_zero(m))
+    })
+}
+
 /// Where the charts do not fit (a terminal of 24 rows): one sparkline row per quantity, as many
 /// as there is room for, each with its latest value.
 fn draw_sparklines(frame: &mut Frame, area: Rect, esc: &EscView, now: f64) {
-    type Pick = fn(&super::fleet::Sample) -> Option<f32>;
-    let rows: [(&str, Color, Pick, usize, &str, bool); 4] = [
-        ("RPM", Color::Cyan, |s| Some(s.rpm), 0, "", true),
-        (
-            "Current",
-            Color::Yellow,
-            |s| Some(s.current_a),
-            1,
-            " A",
-            true,
-        ),
-        (
-            "Voltage",
-            Color::Green,
-            |s| Some(s.voltage_v),
-            1,
-            " V",
-            false,
-        ),
-        ("MOS temp", Color::Red, |s| s.mos_temp_c, 0, " °C", false),
-    ];
+    let rows = sparklines();
     let label_width = 9;
     let value_width = 10;
     let width = usize::from(area.width).saturating_sub(label_width + value_width + 1);
     let lines: Vec<Line> = rows
         .iter()
         .take(usize::from(area.height))
-        .map(|&(name, color, pick, decimals, unit, from_zero)| {
+        .map(|(name, q, decimals, unit, from_zero)| {
+            let pick = |s: &super::fleet::Sample| q.and_then(|q| s.get(q));
             let points: Vec<(f64, f64)> = esc
                 .history
                 .iter()
@@ -633,11 +656,15 @@ fn draw_sparklines(frame: &mut Frame, area: Rect, esc: &EscView, now: f64) {
                 .back()
                 .and_then(pick)
                 .map_or("-".to_string(), |v| {
-                    format!("{}{unit}", number(v, decimals))
+                    format!("{}{unit}", number(v, *decimals))
                 });
+            let color = q.map_or(Color::Gray, colour);
             Line::from(vec![
                 Span::raw(format!("{name:<label_width$}")).bold(),
-                Span::styled(sparkline(&points, width, from_zero), Style::new().fg(color)),
+                Span::styled(
+                    sparkline(&points, width, *from_zero),
+                    Style::new().fg(color),
+                ),
                 Span::raw(format!(" {latest:>value_width$}")),
             ])
         })
@@ -690,6 +717,9 @@ fn envelope(points: impl Iterator<Item = (f64, f64)>, columns: usize) -> Vec<(f6
 
 /// One line of a chart: its name, colour and points (seconds before now, value).
 type Series<'a> = (&'a str, Color, &'a [(f64, f64)]);
+
+/// A line's points: seconds before now, value.
+type Points = Vec<(f64, f64)>;
 
 /// One chart of the last minute: x from -60 s to now, y fitted to the data.
 fn chart(frame: &mut Frame, area: Rect, title: &str, lines: &[Series<'_>], from_zero: bool) {
@@ -839,6 +869,44 @@ fn draw_help(frame: &mut Frame, session: &Session) {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_charts_and_their_lines() {
+        type Charts = Vec<(String, Vec<(&'static str, Color)>, bool)>;
+        let got: Charts = CHARTS
+            .iter()
+            .map(|&m| {
+                let lines = m.shown().map(|q| (q.short(), colour(q))).collect();
+                (chart_title(m), lines, from_zero(m))
+            })
+            .collect();
+        let want: Charts = vec![
+            ("RPM".into(), vec![("rpm", Color::Cyan)], true),
+            (
+                "Current A".into(),
+                vec![("input", Color::Yellow), ("phase", Color::Magenta)],
+                true,
+            ),
+            ("Voltage V".into(), vec![("input", Color::Green)], false),
+            (
+                "Temperature °C".into(),
+                vec![("MOS", Color::Red), ("CAP", Color::LightBlue)],
+                false,
+            ),
+        ];
+        assert_eq!(got, want);
+        let rows: Vec<(String, usize, String)> = sparklines()
+            .into_iter()
+            .map(|(name, _, decimals, unit, _)| (name, decimals, unit))
+            .collect();
+        let want: Vec<(String, usize, String)> = vec![
+            ("RPM".into(), 0, "".into()),
+            ("Current".into(), 1, " A".into()),
+            ("Voltage".into(), 1, " V".into()),
+            ("MOS temp".into(), 0, " °C".into()),
+        ];
+        assert_eq!(rows, want);
+    }
 
     #[test]
     fn the_envelope_keeps_each_columns_extremes_in_time_order() {

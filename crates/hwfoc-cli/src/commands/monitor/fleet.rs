@@ -10,6 +10,7 @@ use hwfoc_io::stream::{EscLink, WireKind};
 
 use super::alarms::{Change, Kind, Latch, Level, Threshold};
 use super::config::Limits;
+use crate::shown::{self, Shown, Values};
 use hwfoc_io::InputError;
 use hwfoc_io::energy::Energy;
 use hwfoc_io::handler::Handler;
@@ -34,18 +35,16 @@ const FULL_CELL_V: f64 = 4.35;
 pub struct Sample {
     /// Receive time, Unix seconds.
     pub t: f64,
-    /// Mechanical RPM.
-    pub rpm: f32,
-    /// Input current, A.
-    pub current_a: f32,
-    /// Phase current, A.
-    pub phase_current_a: f32,
-    /// Input voltage, V.
-    pub voltage_v: f32,
-    /// MOSFET temperature, degC.
-    pub mos_temp_c: Option<f32>,
-    /// Capacitor temperature, degC.
-    pub cap_temp_c: Option<f32>,
+    /// The values of the quantities shown, by [`Shown::index`] (NaN: none).
+    pub values: Values,
+}
+
+impl Sample {
+    /// The value of `q`, if the frame had one.
+    pub fn get(&self, q: Shown) -> Option<f32> {
+        let v = self.values[q.index()];
+        (!v.is_nan()).then_some(v)
+    }
 }
 
 /// Extremes since the start or the last reset.
@@ -556,12 +555,7 @@ impl Fleet {
         }
         esc.history.push_back(Sample {
             t,
-            rpm: r.rpm,
-            current_a: r.current_a,
-            phase_current_a: r.phase_current_a,
-            voltage_v: r.voltage_v,
-            mos_temp_c: r.mos_temp_c,
-            cap_temp_c: r.cap_temp_c,
+            values: shown::values(&r),
         });
         while esc.history.len() > HISTORY_MAX
             || esc.history.front().is_some_and(|s| s.t < t - HISTORY_S)

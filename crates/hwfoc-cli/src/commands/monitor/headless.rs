@@ -270,18 +270,9 @@ fn status_json(i: usize, esc: &EscView, now: f64) -> Value {
         },
         "energy": energy_json(esc.power_w(), esc.energy.peak_w(), &esc.energy),
         "battery_cells": esc.cells,
-        "info": esc.info.as_ref().map(|info| json!({
-            "product": info.product(),
-            "hardware": info.hardware(),
-            "firmware": info.firmware(),
-            "id": info.id(),
-        })),
+        "info": esc.info.as_ref().map(hwfoc_io::summary::device_json),
         "alarms": alarms,
-        "settings": {
-            "current_scale": esc.settings.current_scale,
-            "pole_pairs": esc.settings.pole_pairs,
-            "gear_ratio": esc.settings.gear_ratio,
-        },
+        "settings": hwfoc_io::settings::settings_json(&esc.settings),
     })
 }
 

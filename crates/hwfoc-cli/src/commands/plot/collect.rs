@@ -23,6 +23,7 @@ use hwfoc::telemetry::Info;
 use hwfoc::{Settings, Status};
 
 use crate::error::CliError;
+use crate::shown::{COUNT, Shown, Values, values};
 use hwfoc_io::clock::Step;
 use hwfoc_io::energy::{self, Energy};
 use hwfoc_io::episode::{Episode, Mark};
@@ -45,74 +46,6 @@ const FIRST_WIDTH: f64 = 0.001;
 /// Fault spans kept per ESC; beyond this, each new one is merged into the last.
 const MAX_SPANS: usize = 10_000;
 
-/// The plotted quantities, in the order of a bucket's arrays.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Quantity {
-    /// Input throttle, %.
-    ThrottleIn,
-    /// Output throttle, %.
-    ThrottleOut,
-    /// Motor (or output shaft) speed, rev/min.
-    Rpm,
-    /// Input current, A.
-    Current,
-    /// Phase current, A.
-    PhaseCurrent,
-    /// Input voltage, V.
-    Voltage,
-    /// Electrical input power, W: voltage times input current.
-    Power,
-    /// MOSFET temperature, degC.
-    MosTemp,
-    /// Capacitor temperature, degC.
-    CapTemp,
-}
-
-impl Quantity {
-    /// Its value in a record; NaN for a temperature out of the table's range.
-    #[inline]
-    pub fn of(self, r: &Record) -> f32 {
-        match self {
-            Quantity::ThrottleIn => r.throttle_in_pct,
-            Quantity::ThrottleOut => r.throttle_out_pct,
-            Quantity::Rpm => r.rpm,
-            Quantity::Current => r.current_a,
-            Quantity::PhaseCurrent => r.phase_current_a,
-            Quantity::Voltage => r.voltage_v,
-            Quantity::Power => {
-                energy::power_w(f64::from(r.voltage_v), f64::from(r.current_a)) as f32
-            }
-            Quantity::MosTemp => r.mos_temp_c.unwrap_or(f32::NAN),
-            Quantity::CapTemp => r.cap_temp_c.unwrap_or(f32::NAN),
-        }
-    }
-}
-
-/// How many quantities a bucket holds.
-pub const QUANTITIES: usize = 9;
-
-/// The values of one frame, by [`Quantity`] (NaN: no value).
-pub(super) type Values = [f32; QUANTITIES];
-
-/// The values of a record.
-#[inline]
-pub(super) fn values(r: &Record) -> Values {
-    ALL.map(|q| q.of(r))
-}
-
-/// Every quantity, in the order of a bucket's arrays.
-const ALL: [Quantity; QUANTITIES] = [
-    Quantity::ThrottleIn,
-    Quantity::ThrottleOut,
-    Quantity::Rpm,
-    Quantity::Current,
-    Quantity::PhaseCurrent,
-    Quantity::Voltage,
-    Quantity::Power,
-    Quantity::MosTemp,
-    Quantity::CapTemp,
-];
-
 /// The frames of one stretch of time: per quantity the first, lowest, highest and last value
 /// (NaN for first and last, lowest above highest, where no frame had a value).
 #[derive(Debug, Clone, Copy)]
@@ -132,10 +65,10 @@ impl Bucket {
     pub const EMPTY: Bucket = Bucket {
         frames: 0,
         gap_before: false,
-        first: [f32::NAN; QUANTITIES],
-        min: [f32::INFINITY; QUANTITIES],
-        max: [f32::NEG_INFINITY; QUANTITIES],
-        last: [f32::NAN; QUANTITIES],
+        first: [f32::NAN; COUNT],
+        min: [f32::INFINITY; COUNT],
+        max: [f32::NEG_INFINITY; COUNT],
+        last: [f32::NAN; COUNT],
     };
 
     /// Adds a frame's values.
@@ -167,7 +100,7 @@ impl Bucket {
             return;
         }
         self.frames = self.frames.saturating_add(later.frames);
-        for q in 0..QUANTITIES {
+        for q in 0..COUNT {
             if self.first[q].is_nan() {
                 self.first[q] = later.first[q];
             }
@@ -180,8 +113,8 @@ impl Bucket {
     }
 
     /// First, lowest, highest and last value of quantity `q`, if any of the frames had one.
-    pub fn values(&self, q: Quantity) -> Option<[f64; 4]> {
-        let i = q as usize;
+    pub fn values(&self, q: Shown) -> Option<[f64; 4]> {
+        let i = q.index();
         if self.frames == 0 || self.min[i] > self.max[i] {
             return None;
         }
@@ -543,7 +476,7 @@ fn esc_data<'a>(
 mod tests {
     use super::*;
 
-    use hwfoc::{DataFrame, Temperature};
+    use hwfoc::{DataFrame, Quantity, Temperature};
 
     /// The record of a frame at `t` with this throttle and status word.
     fn frame(t: f64, throttle: u16, status: u16) -> Record {
@@ -574,7 +507,7 @@ mod tests {
         b.add(0.0009, &values_of(768), false);
         assert_eq!(b.cells[0].frames, 3);
         assert_eq!(
-            b.cells[0].values(Quantity::ThrottleIn),
+            b.cells[0].values(Shown::Carried(Quantity::ThrottleIn)),
             Some([50.0, 25.0, 75.0, 75.0])
         );
         assert!(b.cells[0].gap_before);
@@ -583,14 +516,17 @@ mod tests {
         assert_eq!(b.width, 0.004);
         assert_eq!(b.cells[0].frames, 3);
         assert_eq!(
-            b.cells[0].values(Quantity::ThrottleIn),
+            b.cells[0].values(Shown::Carried(Quantity::ThrottleIn)),
             Some([50.0, 25.0, 75.0, 75.0])
         );
         assert_eq!(b.cells[2].frames, 1);
-        assert_eq!(b.cells[2].values(Quantity::Voltage), Some([100.0; 4]));
+        assert_eq!(
+            b.cells[2].values(Shown::Carried(Quantity::Voltage)),
+            Some([100.0; 4])
+        );
         assert!(!b.cells[2].gap_before);
         assert_eq!(b.cells[1].frames + b.cells[3].frames, 0);
-        assert_eq!(b.cells[1].values(Quantity::Rpm), None);
+        assert_eq!(b.cells[1].values(Shown::Carried(Quantity::Rpm)), None);
     }
 
     #[test]
@@ -618,20 +554,23 @@ mod tests {
                 "{q:?}: {got} {expected}"
             );
         };
-        near(Quantity::ThrottleIn, 300.0 * 100.0 / 1024.0);
-        near(Quantity::ThrottleOut, 280.0 * 100.0 / 1024.0);
-        near(Quantity::Rpm, 1234.0 * 10.0 / (2.0 * 7.0));
-        near(Quantity::Voltage, 25.1);
+        near(Shown::Carried(Quantity::ThrottleIn), 300.0 * 100.0 / 1024.0);
+        near(
+            Shown::Carried(Quantity::ThrottleOut),
+            280.0 * 100.0 / 1024.0,
+        );
+        near(Shown::Carried(Quantity::Rpm), 1234.0 * 10.0 / (2.0 * 7.0));
+        near(Shown::Carried(Quantity::Voltage), 25.1);
         // 25.1 V times -1.5 A.
         assert!(
-            (v(Quantity::Power) - 25.1 * -1.5).abs() < 1e-4,
+            (v(Shown::Power) - 25.1 * -1.5).abs() < 1e-4,
             "{}",
-            v(Quantity::Power)
+            v(Shown::Power)
         );
-        near(Quantity::Current, -150.0 / 100.0);
-        near(Quantity::PhaseCurrent, 420.0 / 100.0);
-        assert_eq!(v(Quantity::MosTemp), 28.0);
-        assert_eq!(v(Quantity::CapTemp), 40.0);
+        near(Shown::Carried(Quantity::Current), -150.0 / 100.0);
+        near(Shown::Carried(Quantity::PhaseCurrent), 420.0 / 100.0);
+        assert_eq!(v(Shown::Carried(Quantity::MosTemp)), 28.0);
+        assert_eq!(v(Shown::Carried(Quantity::CapTemp)), 40.0);
     }
 
     #[test]
@@ -646,16 +585,22 @@ mod tests {
             values(&Record::new(None, 0, &f.into(), &Settings::DEFAULT))
         };
         b.add(&with(250), false); // below range: no value
-        assert_eq!(b.values(Quantity::MosTemp), None);
+        assert_eq!(b.values(Shown::Carried(Quantity::MosTemp)), None);
         b.add(&with(206), false); // 28 degC
         b.add(&with(183), false); // 40 degC
         b.add(&with(10), false); // above range: no value
-        assert_eq!(b.values(Quantity::MosTemp), Some([28.0, 28.0, 40.0, 40.0]));
+        assert_eq!(
+            b.values(Shown::Carried(Quantity::MosTemp)),
+            Some([28.0, 28.0, 40.0, 40.0])
+        );
         let mut later = Bucket::EMPTY;
         later.add(&with(250), false);
         b.merge(&later);
         assert_eq!(b.frames, 5);
-        assert_eq!(b.values(Quantity::MosTemp).unwrap()[3], 40.0);
+        assert_eq!(
+            b.values(Shown::Carried(Quantity::MosTemp)).unwrap()[3],
+            40.0
+        );
     }
 
     #[test]

@@ -19,10 +19,12 @@ use hwfoc_io::sources::Sources;
 use hwfoc_io::summary::no_frames;
 use hwfoc_io::time::{self, Clock};
 
-use super::collect::{Bucket, Collector, EscData, FRAME_PERIOD, Quantity, Span};
+use super::collect::{Bucket, Collector, EscData, FRAME_PERIOD, Span};
 use super::target::{ImageFile, ImageFormat};
 use super::text::Glyphs;
 use super::{MAX_SIZE, Options};
+use crate::shown::{Measure, Shown};
+use hwfoc::Quantity;
 
 /// The width of an image unless `--width` is given, px.
 pub const DEFAULT_WIDTH: u32 = 1600;
@@ -78,65 +80,64 @@ enum Scale {
     Auto(f64),
 }
 
-/// One panel of an ESC's row.
+/// One panel of an ESC's row: the quantities of one [`Measure`].
 struct Panel {
     /// Caption.
     title: &'static str,
     /// Value axis description, with the unit.
-    axis: &'static str,
+    axis: String,
     /// The lines: quantity, legend text, colour.
-    lines: &'static [(Quantity, &'static str, RGBColor)],
+    lines: Vec<(Shown, &'static str, RGBColor)>,
     scale: Scale,
 }
 
+impl Panel {
+    /// The panel of the quantities of `measure`.
+    fn of(measure: Measure) -> Panel {
+        Panel {
+            title: measure.title(),
+            axis: format!("{} ({})", measure.title().to_lowercase(), measure.unit()),
+            lines: measure
+                .shown()
+                .map(|q| (q, q.legend(), colour(q)))
+                .collect(),
+            scale: match measure {
+                Measure::Throttle => Scale::Percent,
+                Measure::Speed | Measure::Current | Measure::Power => Scale::FromZero,
+                Measure::Voltage => Scale::Auto(1.0),
+                Measure::Temperature => Scale::Auto(10.0),
+            },
+        }
+    }
+}
+
+/// How many panels a row has.
+const PANELS: usize = Measure::ALL.len();
+
 /// The panels of a row, left to right.
-const PANELS: [Panel; 6] = [
-    Panel {
-        title: "Throttle",
-        axis: "throttle (%)",
-        lines: &[
-            (Quantity::ThrottleIn, "input", BLUE),
-            (Quantity::ThrottleOut, "output", ORANGE),
-        ],
-        scale: Scale::Percent,
-    },
-    Panel {
-        title: "Speed",
-        axis: "speed (rpm)",
-        lines: &[(Quantity::Rpm, "rpm", GREEN)],
-        scale: Scale::FromZero,
-    },
-    Panel {
-        title: "Current",
-        axis: "current (A)",
-        lines: &[
-            (Quantity::Current, "input", BLUE),
-            (Quantity::PhaseCurrent, "phase", ORANGE),
-        ],
-        scale: Scale::FromZero,
-    },
-    Panel {
-        title: "Power",
-        axis: "power (W)",
-        lines: &[(Quantity::Power, "input", GREEN)],
-        scale: Scale::FromZero,
-    },
-    Panel {
-        title: "Voltage",
-        axis: "voltage (V)",
-        lines: &[(Quantity::Voltage, "input", PURPLE)],
-        scale: Scale::Auto(1.0),
-    },
-    Panel {
-        title: "Temperature",
-        axis: "temperature (°C)",
-        lines: &[
-            (Quantity::MosTemp, "MOSFET", RED),
-            (Quantity::CapTemp, "capacitor", TEAL),
-        ],
-        scale: Scale::Auto(10.0),
-    },
-];
+fn panels() -> [Panel; PANELS] {
+    Measure::ALL.map(Panel::of)
+}
+
+/// The colour of a quantity's line: the first of a panel's blue (green where it is alone),
+/// the second orange; the voltage purple, the temperatures red and teal.
+fn colour(q: Shown) -> RGBColor {
+    match q {
+        Shown::Carried(Quantity::Voltage) => PURPLE,
+        Shown::Carried(Quantity::MosTemp) => RED,
+        Shown::Carried(Quantity::CapTemp) => TEAL,
+        _ => {
+            let Some(m) = q.measure() else {
+                return ORANGE;
+            };
+            match (m.shown().position(|s| s == q), m.shown().count()) {
+                (Some(0), 1) => GREEN,
+                (Some(0), _) => BLUE,
+                _ => ORANGE,
+            }
+        }
+    }
+}
 
 /// The height that gives every one of `rows` ESCs a full row.
 fn default_height(rows: usize) -> u32 {
@@ -259,7 +260,9 @@ struct Scene<'a> {
     rows: Vec<Row<'a>>,
     time: TimeAxis,
     /// Value axis of each panel column.
-    ranges: [(f64, f64); PANELS.len()],
+    ranges: [(f64, f64); PANELS],
+    /// The panels of every row.
+    panels: [Panel; PANELS],
 }
 
 impl<'a> Scene<'a> {
@@ -345,7 +348,8 @@ impl<'a> Scene<'a> {
             time.hi = time.lo + 1.0;
         }
         let settings = *collector.settings();
-        let ranges = std::array::from_fn(|p| value_range(&PANELS[p], &rows));
+        let panels = panels();
+        let ranges = std::array::from_fn(|p| value_range(&panels[p], &rows));
         let timed = rows.iter().any(|r| r.data.is_some_and(|d| d.timed));
         let untimed = rows.iter().any(|r| r.data.is_some_and(|d| !d.timed));
         let title = options.title.clone().unwrap_or_else(|| {
@@ -429,6 +433,7 @@ impl<'a> Scene<'a> {
             rows,
             time,
             ranges,
+            panels,
         })
     }
 
@@ -513,8 +518,9 @@ impl<'a> Scene<'a> {
             body.draw_text(message, &style, (w as i32 / 2, h as i32 / 2))?;
             return Ok(());
         };
-        let areas = body.split_evenly((1, PANELS.len()));
-        let mut captions = PANELS
+        let areas = body.split_evenly((1, PANELS));
+        let mut captions = self
+            .panels
             .iter()
             .zip(&areas)
             .map(|(panel, area)| Caption::new(area, panel))
@@ -531,7 +537,14 @@ impl<'a> Scene<'a> {
         for (p, (area, caption)) in areas.iter().zip(captions).enumerate() {
             let (top, chart) = area.split_vertically(caption_h);
             caption.draw(&top)?;
-            self.draw_panel(&chart, &PANELS[p], self.ranges[p], data, row.offset, p == 0)?;
+            self.draw_panel(
+                &chart,
+                &self.panels[p],
+                self.ranges[p],
+                data,
+                row.offset,
+                p == 0,
+            )?;
         }
         Ok(())
     }
@@ -577,7 +590,7 @@ impl<'a> Scene<'a> {
             .x_label_formatter(&x_fmt)
             .y_label_formatter(&y_fmt)
             .x_desc(x_desc)
-            .y_desc(panel.axis)
+            .y_desc(&panel.axis)
             .label_style(text(12, TEXT))
             .axis_desc_style(text(12, MUTED))
             .bold_line_style(GRID.stroke_width(1))
@@ -676,7 +689,7 @@ impl Caption {
         let title_w = area.estimate_text_size(panel.title, &bold(14, TEXT))?.0 as i32;
         let mut legend = Vec::new();
         if panel.lines.len() > 1 {
-            for &(_, name, colour) in panel.lines {
+            for &(_, name, colour) in &panel.lines {
                 let w = area.estimate_text_size(name, &text(12, MUTED))?.0 as i32;
                 legend.push((name, colour, w));
             }
@@ -790,7 +803,7 @@ fn value_range(panel: &Panel, rows: &[Row]) -> (f64, f64) {
     for row in rows {
         let Some(data) = row.data else { continue };
         for cell in &data.buckets.cells {
-            for &(q, _, _) in panel.lines {
+            for &(q, _, _) in &panel.lines {
                 if let Some([_, a, b, _]) = cell.values(q) {
                     lo = lo.min(a);
                     hi = hi.max(b);
@@ -862,7 +875,7 @@ fn columns(data: &EscData, offset: f64, time: TimeAxis, plot_w: u32) -> Vec<(f64
 
 /// The lines of one quantity through the columns: first, lowest, highest and last value of
 /// each, broken at gaps and where the quantity has no value.
-fn paths(columns: &[(f64, Bucket)], q: Quantity) -> Vec<Vec<(f64, f64)>> {
+fn paths(columns: &[(f64, Bucket)], q: Shown) -> Vec<Vec<(f64, f64)>> {
     let mut paths = Vec::new();
     let mut path: Vec<(f64, f64)> = Vec::new();
     for (x, b) in columns {
@@ -1007,6 +1020,39 @@ mod tests {
     use super::*;
 
     #[test]
+    fn the_panels_and_their_lines() {
+        type Lines = Vec<(&'static str, RGBColor)>;
+        let got: Vec<(&str, String, Lines)> = panels()
+            .iter()
+            .map(|p| {
+                let lines = p.lines.iter().map(|&(_, legend, c)| (legend, c)).collect();
+                (p.title, p.axis.clone(), lines)
+            })
+            .collect();
+        let want: Vec<(&str, String, Lines)> = vec![
+            (
+                "Throttle",
+                "throttle (%)".into(),
+                vec![("input", BLUE), ("output", ORANGE)],
+            ),
+            ("Speed", "speed (rpm)".into(), vec![("rpm", GREEN)]),
+            (
+                "Current",
+                "current (A)".into(),
+                vec![("input", BLUE), ("phase", ORANGE)],
+            ),
+            ("Power", "power (W)".into(), vec![("input", GREEN)]),
+            ("Voltage", "voltage (V)".into(), vec![("input", PURPLE)]),
+            (
+                "Temperature",
+                "temperature (°C)".into(),
+                vec![("MOSFET", RED), ("capacitor", TEAL)],
+            ),
+        ];
+        assert_eq!(got, want);
+    }
+
+    #[test]
     fn number_format_fits_the_range() {
         assert_eq!(number_format(0.0..100.0)(&25.0), "25");
         assert_eq!(number_format(23.0..25.0)(&24.5), "24.5");
@@ -1022,7 +1068,7 @@ mod tests {
                 mos_adc: mos,
                 ..Default::default()
             };
-            super::super::collect::values(&hwfoc_io::record::Record::new(
+            crate::shown::values(&hwfoc_io::record::Record::new(
                 None,
                 0,
                 &f.into(),
@@ -1039,7 +1085,7 @@ mod tests {
         missing.add(&frame(512, 250), false);
         let cols = [(0.0, a), (1.0, a), (2.0, gap), (3.0, missing), (4.0, a)];
         // Throttle: broken at the gap only; its points are first, min, max, last.
-        let p = paths(&cols, Quantity::ThrottleIn);
+        let p = paths(&cols, Shown::Carried(hwfoc::Quantity::ThrottleIn));
         assert_eq!(p.len(), 2);
         assert_eq!(
             p[0],
@@ -1056,7 +1102,7 @@ mod tests {
         );
         assert_eq!(p[1][0], (2.0, 50.0));
         // Temperature: broken at the gap and where out of range.
-        let p = paths(&cols, Quantity::MosTemp);
+        let p = paths(&cols, Shown::Carried(Quantity::MosTemp));
         assert_eq!(p.len(), 3);
         assert_eq!(p[2], [(4.0, 28.0)]);
     }
