@@ -10,6 +10,7 @@ mod config;
 mod demo;
 mod error;
 mod output;
+mod stop;
 
 use std::process::ExitCode;
 
