@@ -278,6 +278,64 @@ mod tests {
         assert!(Failure::Down.error("x").is_none());
     }
 
+    /// A pty behind a symlink stands in for a USB adapter unplugged and plugged in again.
+    #[cfg(unix)]
+    #[test]
+    fn a_lost_port_is_reopened_at_its_path_as_the_policy_says_and_set_up_again() {
+        use std::sync::Arc;
+        use std::sync::atomic::{AtomicU32, Ordering};
+
+        use hwfoc_sim::pty::RawPair;
+
+        let dir = tempfile::tempdir().unwrap();
+        let link = dir.path().join("port");
+        let first = RawPair::open().unwrap();
+        std::os::unix::fs::symlink(&first.path, &link).unwrap();
+        let setups = Arc::new(AtomicU32::new(0));
+        let counted = Arc::clone(&setups);
+        let options = PortOptions {
+            setup: Some(Box::new(move |_| {
+                counted.fetch_add(1, Ordering::Relaxed);
+                Ok(())
+            })),
+            drain: false,
+        };
+        let mut port = ReopeningPort::open(link.to_str().unwrap(), 115_200, options).unwrap();
+        assert_eq!(setups.load(Ordering::Relaxed), 1);
+        let t0 = Instant::now();
+        port.write(b"x", t0).unwrap();
+        // Unplugged: the kernel hangs the port up a moment after the other side closes.
+        drop(first);
+        let mut lost = None;
+        for _ in 0..100 {
+            match port.write(b"x", t0) {
+                Err(Failure::Lost(reason)) => {
+                    lost = Some(reason);
+                    break;
+                }
+                Ok(()) => std::thread::sleep(Duration::from_millis(10)),
+                Err(other) => panic!("{other:?}"),
+            }
+        }
+        assert!(lost.is_some(), "the loss was never noticed");
+        assert!(!port.is_open());
+        assert_eq!(port.losses(), 1);
+        let ms = |n: u64| t0 + Duration::from_millis(n);
+        // Away: no attempt before a quarter second; the attempt then finds nothing there.
+        assert_eq!(port.write(b"x", ms(249)), Err(Failure::Down));
+        assert_eq!(port.write(b"x", ms(250)), Err(Failure::Down));
+        // Plugged in again: found at the next attempt, half a second after the failed one.
+        let second = RawPair::open().unwrap();
+        std::fs::remove_file(&link).unwrap();
+        std::os::unix::fs::symlink(&second.path, &link).unwrap();
+        assert_eq!(port.write(b"x", ms(749)), Err(Failure::Down));
+        assert_eq!(port.reopens(), 0);
+        assert_eq!(port.write(b"x", ms(750)), Ok(()));
+        assert!(port.is_open());
+        assert_eq!(port.reopens(), 1);
+        assert_eq!(setups.load(Ordering::Relaxed), 2);
+    }
+
     #[test]
     fn a_port_that_does_not_exist_is_not_opened() {
         let err =
