@@ -1,5 +1,7 @@
 //! The module's exceptions: one per error type of the libraries, all under `HwfocError`, each
-//! with the message the `hwfoc` command prints after `hwfoc: ` (the error's `Display`).
+//! with the message the `hwfoc` command prints after `hwfoc: ` (the error's `Display`), except
+//! that where the command names its option (`--from`, `--to`) the message names the keyword
+//! argument (`start`, `end`).
 
 use hwfoc_io::select::EmptyWindow;
 use pyo3::PyErr;
@@ -43,6 +45,10 @@ create_exception!(
 pub fn input(e: hwfoc_io::InputError) -> PyErr {
     match e {
         hwfoc_io::InputError::Port(e) => port(e),
+        hwfoc_io::InputError::NoTiming { input } => InputError::new_err(format!(
+            "start/end select frames by time, but {input} is raw bytes without receive times: \
+             read a recording or a logic-analyser CSV, or leave out start and end"
+        )),
         e => InputError::new_err(e.to_string()),
     }
 }
@@ -52,9 +58,9 @@ pub fn port(e: hwfoc_io::serial::PortError) -> PyErr {
     PortError::new_err(e.to_string())
 }
 
-/// The Python exception of an empty time window.
+/// The Python exception of an empty time window, naming the keyword arguments.
 pub fn window(e: EmptyWindow) -> PyErr {
-    SelectionError::new_err(e.to_string())
+    SelectionError::new_err(e.between("start", "end").to_string())
 }
 
 /// The Python exception of a setting out of range, worded as the command words it.

@@ -25,6 +25,7 @@ use hwfoc::DataFrame;
 use hwfoc::datalink::{self, DatalinkFrame};
 
 use crate::output::{Output, OutputError, OutputStats, Update};
+use crate::port::{PortOptions, ReopeningPort};
 
 /// When DataLink frames are sent (see the module documentation).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -49,17 +50,10 @@ impl Default for Pacing {
 /// The most frames of one ESC waiting to be sent.
 pub const QUEUE: usize = 4;
 
-/// How long a lost port waits before it is reopened.
-const REOPEN_AFTER: Duration = Duration::from_secs(1);
-
 /// Where the frames go.
 enum Line {
     /// A serial port (or a pty), reopened when lost.
-    Port {
-        path: String,
-        port: Option<Box<dyn serialport::SerialPort>>,
-        retry_at: Instant,
-    },
+    Port(ReopeningPort),
     /// Any writer (tests, files).
     Writer(Box<dyn Write + Send>),
 }
@@ -88,20 +82,19 @@ impl DatalinkOutput {
     /// DataLink frames on serial port `path` at 115200 baud, 8N1.
     pub fn open(path: &str, pacing: Pacing) -> Result<DatalinkOutput, OutputError> {
         let name = format!("datalink {path}");
-        let port =
-            hwfoc_io::serial::open(path, datalink::BAUD_RATE).map_err(|e| OutputError::Open {
-                output: name.clone(),
-                reason: e.to_string(),
-            })?;
-        Ok(DatalinkOutput::with_line(
-            name,
-            Line::Port {
-                path: path.to_string(),
-                port: Some(port),
-                retry_at: Instant::now(),
+        let port = ReopeningPort::open(
+            path,
+            datalink::BAUD_RATE,
+            PortOptions {
+                setup: None,
+                drain: true,
             },
-            pacing,
-        ))
+        )
+        .map_err(|reason| OutputError::Open {
+            output: name.clone(),
+            reason,
+        })?;
+        Ok(DatalinkOutput::with_line(name, Line::Port(port), pacing))
     }
 
     /// DataLink frames written to `writer`, named `name` in messages.
@@ -169,44 +162,11 @@ impl DatalinkOutput {
                 .write_all(bytes)
                 .and_then(|()| w.flush())
                 .map_err(|e| failed(e.to_string())),
-            Line::Port {
-                path,
-                port,
-                retry_at,
-            } => {
-                if port.is_none() {
-                    if now < *retry_at {
-                        return Err(failed("the port is being reopened".into()));
-                    }
-                    match hwfoc_io::serial::open(path, datalink::BAUD_RATE) {
-                        Ok(p) => *port = Some(p),
-                        Err(e) => {
-                            *retry_at = now + REOPEN_AFTER;
-                            return Err(OutputError::Lost {
-                                output: name.clone(),
-                                reason: e.to_string(),
-                            });
-                        }
-                    }
-                }
-                let Some(p) = port else {
-                    unreachable!("opened above")
-                };
-                match p.write_all(bytes).and_then(|()| p.flush()) {
-                    Ok(()) => Ok(()),
-                    Err(e) if e.kind() == std::io::ErrorKind::TimedOut => {
-                        Err(failed("the port did not take the frame in time".into()))
-                    }
-                    Err(e) => {
-                        *port = None;
-                        *retry_at = now + REOPEN_AFTER;
-                        Err(OutputError::Lost {
-                            output: name.clone(),
-                            reason: e.to_string(),
-                        })
-                    }
-                }
-            }
+            Line::Port(port) => port.write(bytes, now).map_err(|failure| {
+                failure
+                    .error(name)
+                    .unwrap_or_else(|| failed("the port is being reopened".into()))
+            }),
         }
     }
 

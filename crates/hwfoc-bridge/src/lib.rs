@@ -16,6 +16,7 @@ pub mod fanout;
 pub mod latency;
 pub mod mavlink;
 pub mod output;
+pub mod port;
 pub mod replay;
 
 pub use latency::Latency;

@@ -34,7 +34,7 @@ pub struct InputArgs {
 }
 
 impl InputArgs {
-    /// The flag Ctrl-C and SIGTERM set ([`hwfoc_io::stop::interrupted`], whose handlers it
+    /// The flag Ctrl-C and SIGTERM set ([`crate::stop::interrupted`], whose handlers it
     /// installs), when every input is read to its end: an export or a plot of files is then
     /// abandoned on the signal, its temporary file removed. `None` for serial ports, pipes and
     /// terminals, which end their input on the signal instead (what they gave is kept), or
@@ -48,7 +48,7 @@ impl InputArgs {
             };
             meta.is_some_and(|m| m.is_file())
         });
-        read_to_end.then(hwfoc_io::stop::interrupted)
+        read_to_end.then(crate::stop::interrupted)
     }
 
     /// Opens every input, in the order given: each file (or standard input) as one [`Input`],
@@ -70,7 +70,11 @@ impl InputArgs {
             }),
             (Some(_), None) => {
                 let ports: Vec<String> = ports.into_iter().cloned().collect();
-                Ok(vec![Input::open_ports(&ports, self.baud)?])
+                Ok(vec![Input::open_ports(
+                    &ports,
+                    self.baud,
+                    crate::stop::interrupted(),
+                )?])
             }
             _ => Ok(files
                 .into_iter()

@@ -1,8 +1,10 @@
 //! The command's errors: each one names what went wrong and where, in one line.
 //!
 //! The libraries' errors (inputs, ports, outputs, the simulator) are wrapped as they are, so their
-//! messages are the libraries'; the variants of its own are the command line's: options,
-//! configuration files, the terminal, plots.
+//! messages are the libraries', except where a library's error is about what an option of the
+//! command gave: the libraries name no option, and the message here names it (`--from`/`--to`,
+//! `--fault`, `--link`, `--link-dir`) from the data the error carries. The variants of its own
+//! are the command line's: options, configuration files, the terminal, plots.
 
 use std::fmt;
 use std::io;
@@ -139,12 +141,37 @@ impl From<SimError> for CliError {
 impl fmt::Display for CliError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
+            CliError::Input(InputError::NoTiming { input }) => write!(
+                f,
+                "--from/--to select frames by time, but {input} is raw bytes without receive \
+                 times: use a recording (`hwfoc record`) or a logic-analyser CSV, or leave out \
+                 --from/--to"
+            ),
             CliError::Input(e) => e.fmt(f),
             CliError::Port(e) => e.fmt(f),
+            // The library's message, and the option that answers it.
+            CliError::Write(e @ WriteError::Exists { .. }) => write!(f, "{e}, or pass --overwrite"),
+            CliError::Write(e @ WriteError::Create { source, .. })
+                if source.kind() == std::io::ErrorKind::PermissionDenied =>
+            {
+                write!(f, "{e} (choose another place with -o)")
+            }
             CliError::Write(e) => e.fmt(f),
+            CliError::Sim(SimError::NoSuchEsc { esc, n }) => write!(
+                f,
+                "--fault: ESC {esc} does not exist: there are {n} (0..{})",
+                n.saturating_sub(1)
+            ),
+            CliError::Sim(SimError::LinkCount { links, n }) => write!(
+                f,
+                "--link: {links} links for {n} ESCs: give one per ESC, or one with {{esc}} in it"
+            ),
+            CliError::Sim(e @ SimError::LinkTaken { .. }) => {
+                write!(f, "{e}, or a directory of your own with --link-dir")
+            }
             CliError::Sim(e) => e.fmt(f),
             CliError::Output(e) => e.fmt(f),
-            CliError::Window(e) => e.fmt(f),
+            CliError::Window(e) => e.between("--from", "--to").fmt(f),
             CliError::Settings(e) => write!(f, "invalid setting: {e}"),
             CliError::IsInput { output, input } => write!(
                 f,

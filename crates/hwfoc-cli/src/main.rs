@@ -12,6 +12,7 @@ mod error;
 mod output;
 mod safety;
 mod shown;
+mod stop;
 
 use std::process::ExitCode;
 

@@ -452,7 +452,12 @@ fn esc_and_time_filters() {
     let o = run(&["decode", s(&a), s(&raw), "--from", "1", "-o", s(&out)]);
     assert_fails_with(
         &o,
-        &format!("{} is raw bytes without receive times", s(&raw)),
+        &format!(
+            "hwfoc: --from/--to select frames by time, but {} is raw bytes without receive \
+             times: use a recording (`hwfoc record`) or a logic-analyser CSV, or leave out \
+             --from/--to\n",
+            s(&raw)
+        ),
     );
     assert!(!out.exists());
     assert_fails_with(

@@ -430,7 +430,10 @@ fn a_recording_is_never_overwritten_unasked() {
     ok(record(&port, &out, &[]));
     let first = std::fs::read(&out).unwrap();
     let again = record(&port, &out, &[]);
-    assert_fails_with(&again, "rec.pcapng exists and is never overwritten unasked");
+    assert_fails_with(
+        &again,
+        "rec.pcapng exists and is never overwritten unasked: choose another name, or pass --overwrite",
+    );
     assert_eq!(std::fs::read(&out).unwrap(), first);
     std::fs::write(&out, "stale").unwrap();
     ok(record(&port, &out, &["--overwrite"]));

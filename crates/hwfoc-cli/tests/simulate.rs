@@ -456,11 +456,57 @@ fn link_dir_never_replaces_a_users_link() {
         "--link-dir",
         links.to_str().unwrap(),
     ]);
-    assert_fails_with(&o, "a link of someone else's is there");
+    assert_fails_with(
+        &o,
+        &format!(
+            "hwfoc: cannot create the link {}: a link of someone else's is there (not to a \
+             pseudo-terminal of an earlier run): choose another path, or a directory of your own \
+             with --link-dir\n",
+            links.join("esc2").display()
+        ),
+    );
     assert_eq!(
         std::fs::read_link(links.join("esc2")).unwrap(),
         Path::new("/nonexistent")
     );
     assert!(std::fs::symlink_metadata(links.join("esc0")).is_err());
     assert!(std::fs::symlink_metadata(links.join("esc1")).is_err());
+}
+
+/// The simulator's library names no option; the command's messages name `--fault` and
+/// `--link` from what its errors carry.
+#[test]
+fn a_fault_or_links_for_escs_that_do_not_exist_name_their_option() {
+    let dir = Dir::new();
+    let o = run(&[
+        "simulate",
+        "--escs",
+        "2",
+        "--duration",
+        "1",
+        "--fault",
+        "2:mos_short@0.5",
+        "-o",
+        &dir.arg("x.pcapng"),
+    ]);
+    assert_fails_with(
+        &o,
+        "hwfoc: --fault: ESC 2 does not exist: there are 2 (0..1)\n",
+    );
+    let o = run(&[
+        "simulate",
+        "--pty",
+        "--escs",
+        "3",
+        "--duration",
+        "1",
+        "--link",
+        &dir.arg("a"),
+        "--link",
+        &dir.arg("b"),
+    ]);
+    assert_fails_with(
+        &o,
+        "hwfoc: --link: 2 links for 3 ESCs: give one per ESC, or one with {esc} in it\n",
+    );
 }

@@ -16,7 +16,11 @@
 //! - [`time`]: times as people write them (`--from +5`, ISO 8601) and dates shown where the
 //!   source has a wall clock; [`energy`]: charge and energy integrated over frame times;
 //! - [`serial`]: serial ports that survive being unplugged; [`clock`]: receive times;
-//!   [`stop`]: Ctrl-C and SIGTERM as a request to stop that every loop honours.
+//!   every loop that waits (a port input, an export's [`stop_on`](write::Export::stop_on))
+//!   ends when a stop flag its caller passes in (an `Arc<AtomicBool>`) is set: the library
+//!   installs no signal handler, so that a program embedding it keeps its own (the `hwfoc`
+//!   command sets the flag on Ctrl-C and SIGTERM; the Python package's own loops check for
+//!   `KeyboardInterrupt`).
 //!
 //! Each module has its own error type, an enum carrying what went wrong and where, whose
 //! `Display` is the one-line message a person reads.
@@ -39,7 +43,6 @@ pub mod select;
 pub mod serial;
 pub mod settings;
 pub mod sources;
-pub mod stop;
 pub mod stream;
 pub mod summary;
 pub mod time;

@@ -146,14 +146,31 @@ pub struct EmptyWindow {
     pub relative: bool,
 }
 
+impl EmptyWindow {
+    /// The message with the start and the end named as a front end names them (`--from` and
+    /// `--to` in the command, `start=` and `end=` in Python): `--from 2 is not before --to 1:
+    /// no frame can be selected`.
+    pub fn between<'a>(&'a self, start: &'a str, end: &'a str) -> impl fmt::Display + 'a {
+        struct Named<'a>(&'a EmptyWindow, &'a str, &'a str);
+        impl fmt::Display for Named<'_> {
+            fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+                let Named(w, start, end) = self;
+                let sign = if w.relative { "+" } else { "" };
+                write!(
+                    f,
+                    "{start} {sign}{} is not before {end} {sign}{}: no frame can be selected",
+                    w.from, w.to
+                )
+            }
+        }
+        Named(self, start, end)
+    }
+}
+
+/// The message naming no front end's options: `the start 2 is not before the end 1: ...`.
 impl fmt::Display for EmptyWindow {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        let sign = if self.relative { "+" } else { "" };
-        write!(
-            f,
-            "--from {sign}{} is not before --to {sign}{}: no frame can be selected",
-            self.from, self.to
-        )
+        self.between("the start", "the end").fmt(f)
     }
 }
 
@@ -240,8 +257,13 @@ mod tests {
         assert!(w.contains(Some(1.0)) && !w.contains(Some(2.0)) && !w.contains(None));
         let mut all = Window::ALL;
         assert!(all.contains(None) && !all.is_limited());
+        let empty = Window::new(Some(2.0), Some(2.0)).unwrap_err();
         assert_eq!(
-            Window::new(Some(2.0), Some(2.0)).unwrap_err().to_string(),
+            empty.to_string(),
+            "the start 2 is not before the end 2: no frame can be selected"
+        );
+        assert_eq!(
+            empty.between("--from", "--to").to_string(),
             "--from 2 is not before --to 2: no frame can be selected"
         );
         assert!(Window::new(Some(f64::NAN), None).is_err());
@@ -297,7 +319,7 @@ mod tests {
             .unwrap_err();
         assert_eq!(
             e.to_string(),
-            "--from +10 is not before --to +5: no frame can be selected"
+            "the start +10 is not before the end +5: no frame can be selected"
         );
         // One end of each kind: known only once resolved; empty then, it selects nothing.
         let mut w =

@@ -2,9 +2,9 @@
 //!
 //! Outputs and serial ports fail with the I/O library's own errors, wrapped as they are; the
 //! rest are the simulator's: a throttle profile that cannot be read, a fault or a link for an
-//! ESC that does not exist, a pseudo-terminal or a link to one that cannot be made. Where a
-//! mistake is in how the simulation was described, the message names the `hwfoc simulate`
-//! option that describes it (`--fault`, `--link`), as every front end so far spells them.
+//! ESC that does not exist, a pseudo-terminal or a link to one that cannot be made. The
+//! messages name no option of a front end: each variant carries what a front end needs to
+//! name its own (the `hwfoc` command's `CliError` adds `--fault`, `--link`, `--link-dir`).
 
 use std::fmt;
 use std::io;
@@ -65,6 +65,14 @@ pub enum SimError {
         /// Why.
         source: io::Error,
     },
+    /// Something other than a link left by an earlier run is where a symlink to a
+    /// pseudo-terminal was to be made: it is left as it is.
+    LinkTaken {
+        /// The link's path.
+        path: String,
+        /// Whether what is there is a dangling link (of someone else's).
+        dangling: bool,
+    },
     /// A symlink to a pseudo-terminal (or its directory) could not be made.
     Link {
         /// The link's path.
@@ -109,7 +117,7 @@ impl fmt::Display for SimError {
             ),
             SimError::NoSuchEsc { esc, n } => write!(
                 f,
-                "--fault: ESC {esc} does not exist: there are {n} (0..{})",
+                "a fault is scheduled on ESC {esc}, which does not exist: there are {n} (0..{})",
                 n.saturating_sub(1)
             ),
             SimError::SharedRaw { n } => write!(
@@ -119,8 +127,21 @@ impl fmt::Display for SimError {
             ),
             SimError::LinkCount { links, n } => write!(
                 f,
-                "--link: {links} links for {n} ESCs: give one per ESC, or one with {{esc}} in it"
+                "{links} links to pseudo-terminals for {n} ESCs: give one per ESC, or one with \
+                 {{esc}} in it"
             ),
+            SimError::LinkTaken { path, dangling } => {
+                let what = if *dangling {
+                    "a link of someone else's is there (not to a pseudo-terminal of an earlier \
+                     run)"
+                } else {
+                    "something is there already (not a link left by an earlier run)"
+                };
+                write!(
+                    f,
+                    "cannot create the link {path}: {what}: choose another path"
+                )
+            }
             SimError::Pty { source } => write!(f, "cannot create a pseudo-terminal: {source}"),
             SimError::Link { path, source } => write!(f, "cannot create the link {path}: {source}"),
         }

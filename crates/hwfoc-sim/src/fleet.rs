@@ -149,7 +149,7 @@ pub(crate) mod tests {
         s.faults = vec!["2:mos_short@1".parse().unwrap()];
         assert_eq!(
             s.build().unwrap_err().to_string(),
-            "--fault: ESC 2 does not exist: there are 2 (0..1)"
+            "a fault is scheduled on ESC 2, which does not exist: there are 2 (0..1)"
         );
         assert!(matches!(
             spec(MAX_ESCS + 1).build(),

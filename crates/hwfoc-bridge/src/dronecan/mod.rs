@@ -41,9 +41,9 @@
 //! with `C`, `S<code>`, `O` (see [`slcan`]). What the adapter answers is read and ignored
 //! (refusals, BEL, counted in [`DronecanOutput::refusals`]). A write that fails because the
 //! port is gone is [`OutputError::Lost`]; the port is reopened (and set up again) at a later
-//! poll, after 0.25 s, doubling to at most 4 s while it stays away. A write that times out
-//! (the adapter does not take bytes) is [`OutputError::Send`] and the port is kept. Every error
-//! returned is also counted in [`OutputStats::errors`].
+//! poll, as [`crate::port::Retry`] says. A write that times out (the adapter does not take
+//! bytes) is [`OutputError::Send`] and the port is kept. Every error returned is also counted
+//! in [`OutputStats::errors`].
 //!
 //! # Why by hand
 //!
@@ -60,13 +60,13 @@ pub mod dsdl;
 pub mod slcan;
 pub mod transport;
 
-use std::io::{self, Read, Write};
 use std::time::{Duration, Instant};
 
 use hwfoc::Telemetry;
 use serialport::SerialPort;
 
 use crate::output::{Output, OutputError, OutputStats, SILENT_AFTER, Update};
+use crate::port::{PortOptions, ReopeningPort, Setup};
 use dsdl::{EscStatus, EscStatusExtended, Health, NodeStatus};
 
 /// The default node id: outside the usual flight controller's (10) and the allocator's range
@@ -84,12 +84,6 @@ pub const NODE_STATUS_EVERY: Duration = Duration::from_secs(1);
 pub const EXTENDED_EVERY: Duration = Duration::from_millis(250);
 /// The most ESCs `esc_index` (uint5) can number.
 pub const MAX_ESCS: usize = 32;
-
-/// The first wait before reopening a lost adapter, doubled after each failure up to
-/// [`REOPEN_MAX`].
-const REOPEN_FIRST: Duration = Duration::from_millis(250);
-/// The longest wait between two attempts at reopening.
-const REOPEN_MAX: Duration = Duration::from_secs(4);
 
 /// The node's settings.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -204,19 +198,15 @@ pub struct DronecanOutput {
     name: String,
     target: SlcanTarget,
     options: DronecanOptions,
-    code: u8,
-    port: Option<Box<dyn SerialPort>>,
+    port: ReopeningPort,
     opened: Instant,
     next_node_status: Option<Instant>,
-    reopen_at: Instant,
-    reopen_wait: Duration,
     escs: Vec<Esc>,
     esc_transfer_id: u8,
     extended_transfer_id: u8,
     node_transfer_id: u8,
     stats: OutputStats,
     frames: u64,
-    reopens: u64,
     refusals: u64,
     not_sent: u64,
     out: Vec<u8>,
@@ -227,7 +217,7 @@ impl std::fmt::Debug for DronecanOutput {
         f.debug_struct("DronecanOutput")
             .field("name", &self.name)
             .field("options", &self.options)
-            .field("connected", &self.port.is_some())
+            .field("connected", &self.port.is_open())
             .finish_non_exhaustive()
     }
 }
@@ -256,25 +246,30 @@ impl DronecanOutput {
                 target.bitrate
             ))
         })?;
-        let port = open_adapter(&target.port, options.baud, code).map_err(open_err)?;
+        let setup: Setup = Box::new(move |port| set_up_adapter(port, code));
+        let port = ReopeningPort::open(
+            &target.port,
+            options.baud,
+            PortOptions {
+                setup: Some(setup),
+                drain: true,
+            },
+        )
+        .map_err(open_err)?;
         let now = Instant::now();
         Ok(DronecanOutput {
             name,
             target,
             options,
-            code,
-            port: Some(port),
+            port,
             opened: now,
             next_node_status: None,
-            reopen_at: now,
-            reopen_wait: REOPEN_FIRST,
             escs: vec![Esc::default(); MAX_ESCS],
             esc_transfer_id: 0,
             extended_transfer_id: 0,
             node_transfer_id: 0,
             stats: OutputStats::default(),
             frames: 0,
-            reopens: 0,
             refusals: 0,
             not_sent: 0,
             out: Vec::with_capacity(256),
@@ -288,7 +283,7 @@ impl DronecanOutput {
 
     /// Whether the adapter is open now (false between a loss and its reopening).
     pub fn connected(&self) -> bool {
-        self.port.is_some()
+        self.port.is_open()
     }
 
     /// CAN frames written so far ([`OutputStats::messages`] counts transfers: an esc.Status is
@@ -299,7 +294,7 @@ impl DronecanOutput {
 
     /// How many times a lost adapter was opened again.
     pub fn reopens(&self) -> u64 {
-        self.reopens
+        self.port.reopens()
     }
 
     /// Commands the adapter refused (BEL answers), e.g. frames it could not send on the bus.
@@ -341,36 +336,18 @@ impl DronecanOutput {
 
     /// Writes `self.out` (the lines of whole transfers); an error makes the port lost or not.
     fn write_out(&mut self, now: Instant) -> Result<(), OutputError> {
-        let Some(port) = self.port.as_mut() else {
-            return Ok(());
-        };
-        match port.write_all(&self.out).and_then(|()| port.flush()) {
+        match self.port.write(&self.out, now) {
             Ok(()) => {
                 self.stats.bytes += self.out.len() as u64;
                 Ok(())
             }
-            Err(e) => {
-                self.stats.errors += 1;
-                let reason = e.to_string();
-                if matches!(
-                    e.kind(),
-                    io::ErrorKind::TimedOut
-                        | io::ErrorKind::WouldBlock
-                        | io::ErrorKind::Interrupted
-                ) {
-                    Err(OutputError::Send {
-                        output: self.name.clone(),
-                        reason,
-                    })
-                } else {
-                    self.port = None;
-                    self.reopen_at = now + self.reopen_wait;
-                    Err(OutputError::Lost {
-                        output: self.name.clone(),
-                        reason,
-                    })
+            Err(failure) => match failure.error(&self.name) {
+                Some(error) => {
+                    self.stats.errors += 1;
+                    Err(error)
                 }
-            }
+                None => Ok(()),
+            },
         }
     }
 
@@ -385,7 +362,7 @@ impl DronecanOutput {
 
     /// Reads and drops what the adapter answered, counting refusals.
     fn drain(&mut self) {
-        let Some(port) = self.port.as_mut() else {
+        let Some(port) = self.port.port() else {
             return;
         };
         let mut buf = [0u8; 256];
@@ -403,26 +380,6 @@ impl DronecanOutput {
             }
         }
     }
-
-    /// Tries to reopen a lost adapter if it is time.
-    fn reopen(&mut self, now: Instant) {
-        if now < self.reopen_at {
-            return;
-        }
-        match open_adapter(&self.target.port, self.options.baud, self.code) {
-            Ok(port) => {
-                self.port = Some(port);
-                self.reopens += 1;
-                self.reopen_wait = REOPEN_FIRST;
-                // A NodeStatus straight away: the bus learns the node is back.
-                self.next_node_status = Some(now);
-            }
-            Err(_) => {
-                self.reopen_wait = (self.reopen_wait * 2).min(REOPEN_MAX);
-                self.reopen_at = now + self.reopen_wait;
-            }
-        }
-    }
 }
 
 /// The transfer id to use from a message type's counter, which moves on (5 bits, wrapping).
@@ -432,15 +389,13 @@ fn next_transfer_id(counter: &mut u8) -> u8 {
     tid
 }
 
-/// Opens an SLCAN adapter and sends its setup.
-fn open_adapter(port: &str, baud: u32, code: u8) -> Result<Box<dyn SerialPort>, String> {
-    let mut p = hwfoc_io::serial::open(port, baud).map_err(|e| e.to_string())?;
+/// Sets an SLCAN adapter just opened up, at the CAN bitrate of SLCAN `code`.
+fn set_up_adapter(port: &mut dyn SerialPort, code: u8) -> Result<(), String> {
     // Whatever was waiting is from before us.
-    let _ = p.clear(serialport::ClearBuffer::Input);
-    p.write_all(&slcan::setup(code))
-        .and_then(|()| p.flush())
-        .map_err(|e| format!("cannot set the SLCAN adapter up: {e}"))?;
-    Ok(p)
+    let _ = port.clear(serialport::ClearBuffer::Input);
+    port.write_all(&slcan::setup(code))
+        .and_then(|()| port.flush())
+        .map_err(|e| format!("cannot set the SLCAN adapter up: {e}"))
 }
 
 impl Output for DronecanOutput {
@@ -488,11 +443,12 @@ impl Output for DronecanOutput {
     }
 
     fn poll(&mut self, now: Instant) -> Result<(), OutputError> {
-        if self.port.is_none() {
-            self.reopen(now);
-            if self.port.is_none() {
+        if !self.port.is_open() {
+            if !self.port.reopen_if_due(now) {
                 return Ok(());
             }
+            // A NodeStatus straight away: the bus learns the node is back.
+            self.next_node_status = Some(now);
         }
         self.drain();
         for i in 0..self.escs.len() {

@@ -373,9 +373,7 @@ impl MavlinkOutput {
         let name = format!("mavlink {target}");
         let link = match &target {
             MavlinkTarget::Udp(addr) => Link::udp(*addr).map_err(|e| e.to_string()),
-            MavlinkTarget::Serial { port, baud } => {
-                Link::serial(port, *baud).map_err(|e| e.to_string())
-            }
+            MavlinkTarget::Serial { port, baud } => Link::serial(port, *baud),
             MavlinkTarget::File(path) => {
                 Link::tlog(path, options.overwrite).map_err(|e| e.to_string())
             }

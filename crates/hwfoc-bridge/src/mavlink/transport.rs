@@ -6,7 +6,7 @@ use std::io::{self, Write};
 use std::net::{Ipv4Addr, Ipv6Addr, SocketAddr, UdpSocket};
 use std::time::Instant;
 
-use serialport::SerialPort;
+use crate::port::{Failure, PortOptions, ReopeningPort};
 
 /// Why a frame was not written.
 #[derive(Debug)]
@@ -31,13 +31,8 @@ pub(crate) enum Link {
         /// becomes `ECONNREFUSED` on a later send). Retried before each send until it does.
         connected: bool,
     },
-    Serial {
-        port: String,
-        baud: u32,
-        open: Option<Box<dyn SerialPort>>,
-        /// When to try to reopen a lost port.
-        retry_at: Instant,
-    },
+    /// A serial port, reopened when lost.
+    Serial(ReopeningPort),
     /// A telemetry log (`.tlog`): each frame after its time, microseconds since the Unix epoch
     /// as a 64-bit big-endian integer, as Mission Planner writes and reads them.
     Tlog {
@@ -69,14 +64,12 @@ impl Link {
 
     /// The serial port `port` at `baud` (8N1; `hwfoc_io::serial::open`, whose timeout of 50 ms
     /// bounds each write).
-    pub(crate) fn serial(port: &str, baud: u32) -> Result<Link, hwfoc_io::serial::PortError> {
-        let open = hwfoc_io::serial::open(port, baud)?;
-        Ok(Link::Serial {
-            port: port.to_string(),
+    pub(crate) fn serial(port: &str, baud: u32) -> Result<Link, String> {
+        Ok(Link::Serial(ReopeningPort::open(
+            port,
             baud,
-            open: Some(open),
-            retry_at: Instant::now(),
-        })
+            PortOptions::default(),
+        )?))
     }
 
     /// A new telemetry log at `path`; an existing file is replaced only if `overwrite`
@@ -127,42 +120,11 @@ impl Link {
                     Err(e) => Err(LinkError::Send(e.to_string())),
                 }
             }
-            Link::Serial {
-                port,
-                baud,
-                open,
-                retry_at,
-            } => {
-                if open.is_none() {
-                    if now < *retry_at {
-                        return Err(LinkError::Down);
-                    }
-                    match hwfoc_io::serial::open(port, *baud) {
-                        Ok(p) => *open = Some(p),
-                        Err(_) => {
-                            *retry_at = now + hwfoc_io::serial::RETRY_EVERY;
-                            return Err(LinkError::Down);
-                        }
-                    }
-                }
-                let Some(p) = open.as_mut() else {
-                    return Err(LinkError::Down);
-                };
-                match p.write_all(frame) {
-                    Ok(()) => Ok(()),
-                    Err(e) if e.kind() == io::ErrorKind::TimedOut => Err(LinkError::Stalled(
-                        "write timed out (is the other end reading?)".to_string(),
-                    )),
-                    Err(e) if e.kind() == io::ErrorKind::Interrupted => {
-                        Err(LinkError::Send(e.to_string()))
-                    }
-                    Err(e) => {
-                        *open = None;
-                        *retry_at = now + hwfoc_io::serial::RETRY_EVERY;
-                        Err(LinkError::Lost(e.to_string()))
-                    }
-                }
-            }
+            Link::Serial(port) => port.write(frame, now).map_err(|failure| match failure {
+                Failure::Stalled(reason) => LinkError::Stalled(reason),
+                Failure::Lost(reason) => LinkError::Lost(reason),
+                Failure::Down => LinkError::Down,
+            }),
         }
     }
 
@@ -175,7 +137,7 @@ impl Link {
     pub(crate) fn local_addr(&self) -> Option<SocketAddr> {
         match self {
             Link::Udp { socket, .. } => socket.local_addr().ok(),
-            Link::Serial { .. } | Link::Tlog { .. } => None,
+            Link::Serial(_) | Link::Tlog { .. } => None,
         }
     }
 }

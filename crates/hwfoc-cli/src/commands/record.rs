@@ -194,7 +194,7 @@ pub struct Recorder {
 /// Runs `hwfoc record`.
 pub fn run(args: &RecordArgs) -> Result<(), CliError> {
     // Install the Ctrl-C / SIGTERM handler first, so that no signal is lost once ports are open.
-    let interrupted = hwfoc_io::stop::interrupted();
+    let interrupted = crate::stop::interrupted();
     let set = PortSet::open(&args.ports, args.baud)?;
     let started = Instant::now();
     let plan = Plan {

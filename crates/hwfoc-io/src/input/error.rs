@@ -92,9 +92,9 @@ impl fmt::Display for InputError {
             } => write!(f, "{input}:{line}: {message}"),
             InputError::NoTiming { input } => write!(
                 f,
-                "--from/--to select frames by time, but {input} is raw bytes without receive \
-                 times: use a recording (`hwfoc record`) or a logic-analyser CSV, or leave out \
-                 --from/--to"
+                "a time window selects frames by their receive times, but {input} is raw bytes \
+                 without receive times: read a recording or a logic-analyser CSV, or select no \
+                 time window"
             ),
             InputError::TooManyEscs { input } => write!(
                 f,
@@ -127,5 +127,23 @@ impl std::error::Error for InputError {
             InputError::Port(e) => Some(e),
             _ => None,
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_window_on_raw_bytes_is_worded_without_a_front_ends_options() {
+        let e = InputError::NoTiming {
+            input: "run.bin".into(),
+        };
+        assert_eq!(
+            e.to_string(),
+            "a time window selects frames by their receive times, but run.bin is raw bytes \
+             without receive times: read a recording or a logic-analyser CSV, or select no time \
+             window"
+        );
     }
 }

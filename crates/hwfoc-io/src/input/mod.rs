@@ -29,6 +29,8 @@ mod recording;
 use std::fmt;
 use std::fs::File;
 use std::io::{self, BufReader, Cursor, Read};
+use std::sync::Arc;
+use std::sync::atomic::AtomicBool;
 
 use crate::notice::{self, Notice, NoticeSink};
 use crate::pcapng;
@@ -304,14 +306,18 @@ impl Input {
     }
 
     /// Opens serial ports at `baud` (8N1) as one input with one stream per port, in the order
-    /// given. Reading ends on Ctrl-C or SIGTERM (the signals stop the input rather than the
-    /// process); a port that is unplugged is waited for, with a warning.
-    pub fn open_ports(names: &[String], baud: u32) -> Result<Input, InputError> {
-        let interrupted = crate::stop::interrupted();
+    /// given. Reading ends once `stop` is set (the `hwfoc` command sets it on Ctrl-C or
+    /// SIGTERM; the library installs no signal handler); a port that is unplugged is waited
+    /// for, with a warning.
+    pub fn open_ports(
+        names: &[String],
+        baud: u32,
+        stop: Arc<AtomicBool>,
+    ) -> Result<Input, InputError> {
         let set = PortSet::open(names, baud)?;
         Ok(Input::new(
             &names.join(", "),
-            Box::new(Ports::new(set, interrupted)),
+            Box::new(Ports::new(set, stop)),
         ))
     }
 
@@ -867,7 +873,8 @@ mod tests {
                 name.to_string_lossy().into_owned()
             })
             .collect();
-        let mut input = Input::open_ports(&names, 19200).unwrap();
+        let stop = Arc::new(AtomicBool::new(false));
+        let mut input = Input::open_ports(&names, 19200, stop).unwrap();
         assert_eq!(input.format(), InputFormat::SERIAL);
         assert_eq!(input.streams(), 2);
         assert_eq!(input.stream_name(1), names[1]);

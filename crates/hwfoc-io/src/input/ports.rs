@@ -17,7 +17,7 @@ const PORT_POLL: Duration = Duration::from_millis(100);
 /// Live serial ports.
 pub(super) struct Ports {
     set: PortSet,
-    /// Set by Ctrl-C or SIGTERM: the input ends.
+    /// Set by the caller (the `hwfoc` command on Ctrl-C or SIGTERM): the input ends.
     interrupted: Arc<AtomicBool>,
 }
 

@@ -88,8 +88,7 @@ impl fmt::Display for WriteError {
             WriteError::Write { output, source } => write!(f, "cannot write {output}: {source}"),
             WriteError::Exists { output } => write!(
                 f,
-                "{output} exists and is never overwritten unasked: choose another name, or pass \
-                 --overwrite"
+                "{output} exists and is never overwritten unasked: choose another name"
             ),
             WriteError::Interrupted { output: None } => write!(f, "interrupted"),
             WriteError::Interrupted {
@@ -110,10 +109,9 @@ impl fmt::Display for WriteError {
                         "cannot write {output}: the directory {dir} does not exist"
                     )
                 }
-                io::ErrorKind::PermissionDenied => write!(
-                    f,
-                    "cannot write {output}: permission denied (choose another place with -o)"
-                ),
+                io::ErrorKind::PermissionDenied => {
+                    write!(f, "cannot write {output}: permission denied")
+                }
                 io::ErrorKind::IsADirectory => {
                     write!(f, "cannot write {output}: it is a directory, not a file")
                 }

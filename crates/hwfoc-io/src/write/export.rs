@@ -258,8 +258,8 @@ impl Export {
         self
     }
 
-    /// Abandons the export once `flag` is set (by Ctrl-C or SIGTERM: see
-    /// [`crate::stop::interrupted`]): the next batch's end fails with
+    /// Abandons the export once `flag` is set (the `hwfoc` command sets it on Ctrl-C or
+    /// SIGTERM): the next batch's end fails with
     /// [`WriteError::Interrupted`], and [`Export::finish`] then removes the temporary file,
     /// leaving any earlier file at the path as it was. For inputs that are read to their end;
     /// live ports end their input on the signal, and what they gave is kept.

@@ -251,7 +251,7 @@ fn live(
     fanout: &mut Fanout,
     errors: &mut Errors,
 ) -> Result<(), CliError> {
-    let stop = hwfoc_io::stop::interrupted();
+    let stop = crate::stop::interrupted();
     let clock = hwfoc_io::clock::ReceiveClock::new();
     while !stop.load(Ordering::Relaxed) && deadline.is_none_or(|d| Instant::now() < d) {
         let mut msg = match rx.recv_timeout(POLL) {
@@ -315,7 +315,7 @@ fn replay(
         .map(|f| hwfoc_io::Input::open(f))
         .collect::<Result<Vec<_>, _>>()?;
     let mut sources = Sources::new(inputs, settings);
-    let stop = hwfoc_io::stop::interrupted();
+    let stop = crate::stop::interrupted();
     // The deadline stops the replay as Ctrl-C would.
     let timer = deadline.map(|d| {
         let stop = std::sync::Arc::clone(&stop);

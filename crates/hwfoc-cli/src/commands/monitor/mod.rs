@@ -187,7 +187,7 @@ pub struct Session {
 
 impl Session {
     fn start(args: &MonitorArgs, config: MonitorSetup) -> Result<Session, CliError> {
-        let interrupted = hwfoc_io::stop::interrupted();
+        let interrupted = crate::stop::interrupted();
         let (tx, rx) = mpsc::channel();
         let ports: Vec<String> = if args.ports.is_empty() {
             config.ports.clone()

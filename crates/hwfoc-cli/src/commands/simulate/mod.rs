@@ -359,7 +359,7 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
     if args.pty {
         announce(session.outputs())?;
     }
-    let reports = session.run(&hwfoc_io::stop::interrupted())?;
+    let reports = session.run(&crate::stop::interrupted())?;
     if !args.quiet {
         for (esc, r) in reports.iter().enumerate() {
             eprintln!("{}", report(esc, r));

@@ -1,4 +1,10 @@
-//! Stopping cleanly: Ctrl-C and SIGTERM ask every loop to end, rather than ending the process.
+//! Stopping cleanly: Ctrl-C and SIGTERM ask every loop of the command to end, rather than
+//! ending the process.
+//!
+//! The libraries install no signal handler: they take a stop flag from their caller
+//! (`Input::open_ports`, `Export::stop_on`, the simulator's and the bridge's loops). The
+//! command installs the handlers here, on first use, so that a command that never waits keeps
+//! the signals' default action, and hands the flag down.
 
 use std::sync::atomic::AtomicBool;
 use std::sync::{Arc, OnceLock};
