@@ -1,0 +1,360 @@
+//! What the summary gathers of each ESC's frames as they are decoded: raw integers (ranges in
+//! lanes, histograms of temperature codes, fault counts, episodes, times, raw energy), the
+//! per-frame cost of `hwfoc summary`.
+
+use hwfoc::telemetry::{Conversion, Data, Frame, Info, Telemetry};
+use hwfoc::{Quantity, Temperature};
+
+use super::MAX_EPISODES;
+use crate::clock::Step;
+use crate::energy::Energy;
+use crate::episode::{Episode, Mark};
+
+/// Min, max and sum of one raw integer field.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Range {
+    pub(super) min: i32,
+    pub(super) max: i32,
+    pub(super) sum: i64,
+}
+
+/// The raw integers with a [`Range`], in lanes: eight at once, so that a frame's six minima,
+/// maxima and sums are a few vector instructions (the summary's per-frame cost).
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Ranges {
+    pub(super) min: [i32; LANES],
+    pub(super) max: [i32; LANES],
+    pub(super) sum: [i64; LANES],
+    /// Data frames that did not carry the lane's quantity (their protocol lacks it).
+    pub(super) missing: [u64; LANES],
+}
+
+/// Lanes of [`Ranges`]: six quantities, and two unused (a seventh, the raw power, made `summary`
+/// of a large file 40 % slower: it is summed apart, see [`Accumulator::count`]).
+pub(super) const LANES: usize = 8;
+
+/// The quantity of each lane. RPM is eRPM's lane, converted otherwise.
+pub(super) const LANE_QUANTITIES: [Quantity; 6] = [
+    Quantity::ThrottleIn,
+    Quantity::ThrottleOut,
+    Quantity::Erpm,
+    Quantity::Voltage,
+    Quantity::Current,
+    Quantity::PhaseCurrent,
+];
+/// The lane of each quantity of [`LANE_QUANTITIES`].
+pub(super) const ERPM: usize = 2;
+pub(super) const CURRENT: usize = 4;
+
+/// The lane of `quantity`, if it has one.
+pub(super) const fn lane(quantity: Quantity) -> Option<usize> {
+    match quantity {
+        Quantity::Rpm => Some(ERPM),
+        q => {
+            let mut i = 0;
+            while i < LANE_QUANTITIES.len() {
+                if LANE_QUANTITIES[i] as u8 == q as u8 {
+                    return Some(i);
+                }
+                i += 1;
+            }
+            None
+        }
+    }
+}
+
+impl Default for Ranges {
+    fn default() -> Self {
+        Ranges {
+            min: [i32::MAX; LANES],
+            max: [i32::MIN; LANES],
+            sum: [0; LANES],
+            missing: [0; LANES],
+        }
+    }
+}
+
+impl Ranges {
+    /// Adds a frame's raw integers. A quantity the frame does not carry leaves its lane's
+    /// minimum, maximum and sum as they are and is counted as missing (for a protocol that
+    /// carries every lane's quantity, the compiler removes that branch).
+    #[inline(always)]
+    pub(super) fn add(&mut self, f: &impl Telemetry) {
+        let (mut low, mut high, mut add) = ([i32::MAX; LANES], [i32::MIN; LANES], [0i64; LANES]);
+        let mut take = |lane: usize| match f.raw(LANE_QUANTITIES[lane]) {
+            Some(raw) => (low[lane], high[lane], add[lane]) = (raw, raw, i64::from(raw)),
+            None => self.missing[lane] += 1,
+        };
+        // Written out, not a loop: each call is then a field read.
+        take(0);
+        take(1);
+        take(2);
+        take(3);
+        take(4);
+        take(5);
+        self.min = std::array::from_fn(|i| self.min[i].min(low[i]));
+        self.max = std::array::from_fn(|i| self.max[i].max(high[i]));
+        self.sum = std::array::from_fn(|i| self.sum[i] + add[i]);
+    }
+
+    /// The range of the quantity in `lane`, and the number of frames that carried it among
+    /// `frames`.
+    pub(super) fn get(&self, lane: usize, frames: u64) -> (Range, u64) {
+        let range = Range {
+            min: self.min[lane],
+            max: self.max[lane],
+            sum: self.sum[lane],
+        };
+        (range, frames - self.missing[lane])
+    }
+}
+
+impl Range {
+    /// Min, max and mean after applying a monotonic increasing conversion.
+    pub(super) fn convert(&self, n: u64, f: impl Fn(f64) -> f64) -> Option<[f64; 3]> {
+        (n > 0).then(|| {
+            [
+                f(f64::from(self.min)),
+                f(f64::from(self.max)),
+                f(self.sum as f64 / n as f64),
+            ]
+        })
+    }
+}
+
+/// Everything the summary needs from the frames of one ESC, gathered as they are decoded.
+#[derive(Debug)]
+pub(super) struct Accumulator {
+    pub(super) frames: u64,
+    /// A data frame of the ESC (its first), whose protocol's conversions the report uses.
+    pub(super) sample: Option<Data>,
+    /// Whether the next data frame may take [`Accumulator::add_clean`]: the ESC's sample is
+    /// known and no fault episode is open.
+    pub(super) fast: bool,
+    pub(super) ranges: Ranges,
+    /// Histograms of each temperature's raw codes (a table's codes, 0..=255), and the frames
+    /// whose temperature was not such a code or was not carried.
+    pub(super) mos_codes: [u64; 256],
+    pub(super) cap_codes: [u64; 256],
+    pub(super) uncoded: [u64; 2],
+    pub(super) fault_frames: [u64; 16],
+    pub(super) first_t: Option<f64>,
+    pub(super) last_t: Option<f64>,
+    /// The last timed data frame's packet number, where its protocol sends one.
+    pub(super) last_packet: Option<u16>,
+    /// Seconds that passed between the timed data frames: the sum of the steps that are not
+    /// clock discontinuities.
+    pub(super) elapsed: f64,
+    /// Clock discontinuities between timed data frames: steps back, jumps forward.
+    pub(super) steps_back: u64,
+    pub(super) jumps: u64,
+    /// Charge and energy of timed frames in raw units (voltage and current as sent); frames
+    /// without times are integrated from the lanes' sums at the end (see [`Self::energy`]).
+    pub(super) energy: Energy,
+    /// The last data frame's raw voltage and current.
+    pub(super) last: (i32, i32),
+    /// Sum and largest of the raw power (voltage times current: for HW-FOC at most 65535 x
+    /// 32768 in magnitude, within an `i32`) of every data frame.
+    pub(super) power_sum: i64,
+    pub(super) power_max: i32,
+    pub(super) infos: Vec<(Info, u64)>,
+    pub(super) episode: Option<Episode>,
+    pub(super) episodes: Vec<Episode>,
+    pub(super) episode_count: u64,
+}
+
+impl Default for Accumulator {
+    fn default() -> Self {
+        Accumulator {
+            frames: 0,
+            sample: None,
+            fast: false,
+            ranges: Ranges::default(),
+            mos_codes: [0; 256],
+            cap_codes: [0; 256],
+            uncoded: [0; 2],
+            fault_frames: [0; 16],
+            first_t: None,
+            last_t: None,
+            last_packet: None,
+            elapsed: 0.0,
+            steps_back: 0,
+            jumps: 0,
+            energy: Energy::new(),
+            last: (0, 0),
+            power_sum: 0,
+            power_max: i32::MIN,
+            infos: Vec::new(),
+            episode: None,
+            episodes: Vec::new(),
+            episode_count: 0,
+        }
+    }
+}
+
+impl Accumulator {
+    #[inline]
+    pub(super) fn add(&mut self, t: Option<f64>, frame: &Frame) {
+        match frame {
+            Frame::Data(f) => self.add_data(t, f),
+            Frame::Info(info) => match self.infos.iter_mut().find(|(i, _)| i == info) {
+                Some((_, n)) => *n += 1,
+                None => self.infos.push((*info, 1)),
+            },
+        }
+    }
+
+    /// A data frame without faults, outside a fault episode, of an ESC whose sample is known:
+    /// what [`Self::add_data`] does with it (no fault to count, no episode started or ended).
+    #[inline(always)]
+    pub(super) fn add_clean(&mut self, t: Option<f64>, f: &Data) {
+        debug_assert!(self.fast && self.sample.is_some() && self.episode.is_none());
+        self.count(t, f);
+    }
+
+    /// What every data frame adds: its count, ranges, temperature codes and time.
+    #[inline(always)]
+    pub(super) fn count(&mut self, t: Option<f64>, f: &Data) {
+        self.frames += 1;
+        self.ranges.add(f);
+        let code = |quantity: Quantity, codes: &mut [u64; 256], uncoded: &mut u64| match f
+            .raw(quantity)
+            .and_then(|raw| u8::try_from(raw).ok())
+        {
+            Some(code) => codes[usize::from(code)] += 1,
+            None => *uncoded += 1,
+        };
+        code(Quantity::MosTemp, &mut self.mos_codes, &mut self.uncoded[0]);
+        code(Quantity::CapTemp, &mut self.cap_codes, &mut self.uncoded[1]);
+        let (Some(volts), Some(amps)) = (f.raw(Quantity::Voltage), f.raw(Quantity::Current)) else {
+            return self.untimed_power(t, f);
+        };
+        self.last = (volts, amps);
+        let power = volts * amps;
+        self.power_sum += i64::from(power);
+        // A branch rarely taken, not a chain of conditional moves from frame to frame.
+        if power > self.power_max {
+            self.power_max = power;
+        }
+        if let Some(t) = t {
+            self.timed(t, f);
+        }
+    }
+
+    /// What a frame with a time adds: out of the decoder's loop, which stays as small as it
+    /// was for inputs without times (the summary of a large raw file).
+    #[inline(never)]
+    pub(super) fn timed(&mut self, t: f64, f: &Data) {
+        let (volts, amps) = self.last;
+        self.energy.add(Some(t), f64::from(volts), f64::from(amps));
+        self.clock(t, f);
+    }
+
+    /// The time of a data frame: the duration and the clock's discontinuities.
+    #[inline]
+    pub(super) fn clock(&mut self, t: f64, f: &Data) {
+        let packet = f.packet();
+        if let Some(last) = self.last_t {
+            let counted = packet.zip(self.last_packet).map(|(p, l)| p.wrapping_sub(l));
+            match Step::between(last, t, counted) {
+                Step::Back => self.steps_back += 1,
+                Step::Jump => self.jumps += 1,
+                step => self.elapsed += step.elapsed().unwrap_or(0.0),
+            }
+        }
+        self.first_t.get_or_insert(t);
+        self.last_t = Some(t);
+        self.last_packet = packet;
+    }
+
+    /// The rest of a data frame that does not carry both voltage and current: its time, and no
+    /// power (a protocol without them has no energy to integrate).
+    #[cold]
+    pub(super) fn untimed_power(&mut self, t: Option<f64>, f: &Data) {
+        if let Some(t) = t {
+            self.clock(t, f);
+        }
+    }
+
+    #[inline]
+    pub(super) fn add_data(&mut self, t: Option<f64>, f: &Data) {
+        self.sample.get_or_insert(*f);
+        let index = self.frames;
+        self.count(t, f);
+        let status = f.status().unwrap_or_default();
+        if !status.is_ok() {
+            for fault in status.faults() {
+                self.fault_frames[usize::from(fault.bit())] += 1;
+            }
+        }
+        let mark = Mark {
+            t,
+            frame: index,
+            packet: f.packet(),
+        };
+        if let Some(ended) = Episode::track(&mut self.episode, mark, status) {
+            self.episode_count += 1;
+            if self.episodes.len() < MAX_EPISODES {
+                self.episodes.push(ended);
+            }
+        }
+        self.fast = self.episode.is_none();
+    }
+}
+
+impl Accumulator {
+    /// Charge, energy and power in raw units: integrated frame by frame over receive times,
+    /// or for a stream without times (whose frames all lack them) from the lanes' sums.
+    pub(super) fn energy(&self) -> Energy {
+        if self.first_t.is_some() {
+            return self.energy;
+        }
+        let (v, i) = self.last;
+        Energy::untimed(
+            self.frames,
+            self.ranges.sum[CURRENT] as f64,
+            self.power_sum as f64,
+            (f64::from(v), f64::from(i)),
+            (self.frames > 0).then(|| f64::from(self.power_max)),
+        )
+    }
+}
+
+/// Temperature statistics from a histogram of ADC codes.
+#[derive(Debug, Default, PartialEq)]
+pub(super) struct TempStats {
+    pub(super) range: Option<[f64; 3]>,
+    pub(super) below: u64,
+    pub(super) above: u64,
+}
+
+/// Temperature statistics from a histogram of codes read through `conversion`: a table's, whose
+/// codes outside it are counted below or above it, or a linear one.
+pub(super) fn temp_stats(codes: &[u64; 256], conversion: Conversion) -> TempStats {
+    let mut s = TempStats::default();
+    let (mut min, mut max, mut sum, mut n) = (f64::MAX, f64::MIN, 0.0, 0u64);
+    for (code, &count) in codes.iter().enumerate() {
+        if count == 0 {
+            continue;
+        }
+        let temperature = match conversion {
+            Conversion::AdcTable => Temperature::from_adc(code as u8),
+            Conversion::Linear(linear) => Temperature::Celsius(linear.to_f32(code as f32)),
+        };
+        match temperature {
+            Temperature::Celsius(c) => {
+                let c = f64::from(c);
+                min = min.min(c);
+                max = max.max(c);
+                sum += c * count as f64;
+                n += count;
+            }
+            Temperature::BelowRange => s.below += count,
+            Temperature::AboveRange => s.above += count,
+        }
+    }
+    if n > 0 {
+        s.range = Some([min, max, sum / n as f64]);
+    }
+    s
+}

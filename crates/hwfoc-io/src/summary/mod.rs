@@ -1,0 +1,358 @@
+//! The summary of a run of inputs: what they hold, ESC by ESC, and how good each link was,
+//! as text for a person or as JSON (`hwfoc summary`, `--json`).
+//!
+//! [`Summary`] is a [`Handler`]: give it to [`Sources::run`], then ask it for the
+//! [`Summary::report`].
+//!
+//! Statistics are gathered on the raw integers of each quantity a frame carries
+//! ([`Telemetry::raw`]: min, max and sum per quantity, a histogram of each temperature's codes)
+//! and converted to physical units once, at the end, through the conversion the ESC's protocol
+//! gives under its settings ([`Telemetry::reading`] of a frame of the ESC): every conversion is
+//! monotonic, so this is exact, and it keeps the per-frame cost to a few integer operations.
+//!
+//! Charge, energy and power ([`Energy`]) are integrated per ESC over its data frames' times
+//! (each frame's current holding until the next), on the raw voltage and current, converted
+//! once at the end; an input without times counts each frame as the nominal period, and the
+//! report says so. The duration of an ESC's frames is the time that passed between them: a
+//! clock that steps back or jumps forward ([`Step`]) adds nothing, and the report counts such
+//! discontinuities. Times of sources with a wall clock (recordings, serial ports) are shown as
+//! ISO 8601 dates in UTC; other sources' times as their seconds.
+//!
+//! A fault episode is a maximal run of consecutive data frames of one ESC whose status word is
+//! not zero; it is reported with its first and last frame (times where the input has them,
+//! frame indices and packet numbers always) and the fault bits seen during it.
+//!
+//! Here: the handler and the report's parts; `accumulate.rs`, what is gathered per frame;
+//! `text.rs` and `json.rs`, the report as text and as JSON.
+
+use hwfoc::telemetry::{Conversion, Frame, Info, Telemetry};
+use hwfoc::units::Linear;
+use hwfoc::{Fault, Quantity, Settings, Status};
+use serde_json::{Value, json};
+
+use crate::energy::{Energy, NOMINAL_PERIOD_S};
+pub use crate::episode::{Episode, Mark};
+use crate::escape::Escaped;
+use crate::fixed::Fixed;
+use crate::input::InputError;
+use crate::settings::{self, settings_json};
+use crate::sources::{Handler, Sources};
+use crate::stream::EscLink;
+use crate::time::{self, Clock};
+use hwfoc::datalink::LengthByte;
+
+mod accumulate;
+mod json;
+#[cfg(test)]
+mod tests;
+mod text;
+
+use accumulate::{Accumulator, TempStats, lane, temp_stats};
+pub use json::device_json;
+
+/// What to tell a user whose wire gave bytes but no frame.
+pub static NO_FRAMES: std::sync::LazyLock<String> = std::sync::LazyLock::new(|| {
+    format!(
+        "no valid HW-FOC frames: check the baud rate ({}) and the wiring",
+        hwfoc::wire::BAUD_RATE
+    )
+});
+
+/// Why ESC `esc`'s bytes gave no frame, as every output says it: what its input looks like
+/// when that is not telemetry (`text, not telemetry`, `looks like a PNG image, not telemetry`:
+/// a file given by mistake), else [`NO_FRAMES`], the advice for a wire (a port, a recording,
+/// a raw capture of bytes).
+pub fn no_frames(sources: &Sources, esc: usize) -> String {
+    sources
+        .escs()
+        .get(esc)
+        .and_then(|e| sources.inputs().get(e.input))
+        .and_then(|input| input.looks)
+        .map_or_else(|| NO_FRAMES.clone(), |looks| looks.to_string())
+}
+
+/// Fault episodes kept per ESC in detail (all are counted).
+const MAX_EPISODES: usize = 10_000;
+
+/// Fault episodes listed per ESC in the text output (`--json` lists all those kept).
+const TEXT_EPISODES: usize = 20;
+
+/// How an ESC is named in messages: its input, and its stream when the input has several
+/// (names from a recording [`Escaped`]).
+pub fn esc_label(sources: &Sources, esc: usize) -> String {
+    let e = &sources.escs()[esc];
+    let input = &sources.names()[e.input];
+    let single = sources
+        .inputs()
+        .get(e.input)
+        .is_none_or(|info| info.escs.len() == 1);
+    let channel = match e.hub {
+        Some((_, channel)) => format!(" channel {channel}"),
+        None if sources.is_hub(esc) => " channel 0".to_string(),
+        None => String::new(),
+    };
+    let input = Escaped(input);
+    if single && e.name == *input.0 && channel.is_empty() {
+        input.to_string()
+    } else if e.name == *input.0 {
+        format!("{input}{channel} (ESC {esc})")
+    } else {
+        format!("{input}: {}{channel} (ESC {esc})", Escaped(&e.name))
+    }
+}
+
+/// What the summary gathers from the frames: one accumulator per ESC.
+#[derive(Default)]
+pub struct Summary(Vec<Accumulator>);
+
+impl Summary {
+    /// Nothing gathered yet.
+    pub fn new() -> Summary {
+        Summary::default()
+    }
+
+    /// The report on what was gathered from `sources` (after [`Sources::run`]): each ESC's
+    /// figures converted under its own settings ([`Sources::esc_settings`]).
+    pub fn report<'a>(&'a self, sources: &'a Sources) -> Report<'a> {
+        Report {
+            sources,
+            settings: sources.settings(),
+            accs: &self.0,
+        }
+    }
+}
+
+impl Handler for Summary {
+    type Error = InputError;
+
+    /// Takes frames as decoded: statistics are kept on the raw integers (see the module
+    /// documentation), converted once at the end.
+    ///
+    /// The usual frame, a data frame without faults outside a fault episode of a known ESC, is
+    /// a few integer operations, inlined into the decoder's loop (its fields go from registers
+    /// to the accumulator, not through a `Decoded` in memory); every other frame is taken out of
+    /// line.
+    #[inline(always)]
+    fn frame(&mut self, esc: u8, t: Option<f64>, frame: &Frame, _: &Settings) {
+        let esc = usize::from(esc);
+        if let Frame::Data(f) = frame
+            && let Some(acc) = self.0.get_mut(esc)
+            && acc.fast
+            && f.status().is_none_or(Status::is_ok)
+        {
+            acc.add_clean(t, f);
+        } else {
+            self.add(esc, t, frame);
+        }
+    }
+}
+
+impl Summary {
+    /// Any frame of ESC `esc`.
+    #[cold]
+    #[inline(never)]
+    fn add(&mut self, esc: usize, t: Option<f64>, frame: &Frame) {
+        if self.0.len() <= esc {
+            self.0.resize_with(esc + 1, Accumulator::default);
+        }
+        self.0[esc].add(t, frame);
+    }
+}
+
+/// The summary, ready to be printed: [`Report::text`] or [`Report::json`].
+pub struct Report<'a> {
+    sources: &'a Sources,
+    /// The settings of ESCs without settings of their own.
+    settings: &'a Settings,
+    accs: &'a [Accumulator],
+}
+
+/// One row of the field table: name, unit, and min/max/mean if there were frames.
+type FieldRow = (&'static str, &'static str, Option<[f64; 3]>);
+
+/// One ESC's part of the report.
+struct EscReport<'a> {
+    index: usize,
+    label: String,
+    stream: &'a str,
+    input: &'a str,
+    stats: EscLink,
+    settings: Settings,
+    acc: &'a Accumulator,
+    /// The episode still open at the end, closed for the report.
+    episodes: Vec<Episode>,
+    episode_count: u64,
+    /// The clock of its input's times.
+    clock: Clock,
+    /// Why its bytes gave no frame, if they gave none ([`no_frames`]).
+    no_frames: String,
+}
+
+impl<'a> Report<'a> {
+    fn escs(&self) -> Vec<EscReport<'a>> {
+        static EMPTY: std::sync::OnceLock<Accumulator> = std::sync::OnceLock::new();
+        let empty = EMPTY.get_or_init(Accumulator::default);
+        self.sources
+            .escs()
+            .iter()
+            .enumerate()
+            // A hub's channels that carried no ESC are not ESCs.
+            .filter(|&(i, _)| !self.sources.is_hub(i) || self.sources.link(i).frames() > 0)
+            .map(|(i, esc)| {
+                let acc = self.accs.get(i).unwrap_or(empty);
+                let mut episodes = acc.episodes.clone();
+                let mut episode_count = acc.episode_count;
+                if let Some(mut open) = acc.episode {
+                    open.ongoing = true;
+                    episode_count += 1;
+                    if episodes.len() < MAX_EPISODES {
+                        episodes.push(open);
+                    }
+                }
+                let clock = self
+                    .sources
+                    .inputs()
+                    .get(esc.input)
+                    .map_or(Clock::None, |info| info.format.clock());
+                EscReport {
+                    clock,
+                    no_frames: no_frames(self.sources, i),
+                    index: i,
+                    label: esc_label(self.sources, i),
+                    stream: &esc.name,
+                    input: &self.sources.names()[esc.input],
+                    stats: self.sources.link(i),
+                    settings: self.sources.esc_settings(i),
+                    acc,
+                    episodes,
+                    episode_count,
+                }
+            })
+            .collect()
+    }
+}
+
+/// The figures of every ESC with data frames added, when there are two or more.
+fn total_energy(escs: &[EscReport]) -> Option<Energy> {
+    let with_frames: Vec<Energy> = escs.iter().filter_map(EscReport::energy).collect();
+    (with_frames.len() > 1).then(|| {
+        let mut total = Energy::new();
+        for e in &with_frames {
+            total.merge(e);
+        }
+        total
+    })
+}
+
+impl EscReport<'_> {
+    /// Charge, energy and power, converted from the raw units under the settings.
+    /// `None` for an ESC without data frames, or whose protocol sends no voltage or current.
+    fn energy(&self) -> Option<Energy> {
+        let volts = self.linear(Quantity::Voltage)?.to_f64(1.0);
+        let amps = self.linear(Quantity::Current)?.to_f64(1.0);
+        Some(self.acc.energy().scaled(volts, amps))
+    }
+
+    /// The conversion of `quantity` in this ESC's protocol under its settings, if the protocol
+    /// carries it (and the ESC gave a data frame): through which raw statistics are converted.
+    fn conversion(&self, quantity: Quantity) -> Option<Conversion> {
+        let sample = self.acc.sample?;
+        Some(sample.reading(quantity, &self.settings)?.conversion)
+    }
+
+    /// The linear conversion of `quantity` (see [`Self::conversion`]).
+    fn linear(&self, quantity: Quantity) -> Option<Linear> {
+        self.conversion(quantity)?.linear()
+    }
+
+    /// A time as shown: a date on a wall clock, else the source's seconds.
+    fn date(&self, t: Option<f64>) -> Option<String> {
+        t.filter(|_| self.clock == Clock::Wall).map(time::iso8601)
+    }
+
+    /// Seconds that passed between the first and the last timed data frame, not counting
+    /// across clock discontinuities.
+    fn duration(&self) -> Option<f64> {
+        self.acc.first_t.map(|_| self.acc.elapsed)
+    }
+
+    /// The clock's discontinuities in words, if there were any.
+    fn discontinuities(&self) -> Option<String> {
+        let (back, jumps) = (self.acc.steps_back, self.acc.jumps);
+        let times = |n: u64| {
+            if n == 1 {
+                "once".to_string()
+            } else {
+                format!("{n} times")
+            }
+        };
+        let text = match (back, jumps) {
+            (0, 0) => return None,
+            (b, 0) => format!("the clock steps back {}", times(b)),
+            (0, j) => format!("the clock jumps forward {}", times(j)),
+            (b, j) => format!(
+                "the clock steps back {} and jumps forward {}",
+                times(b),
+                times(j)
+            ),
+        };
+        let across = if back + jumps == 1 { "it" } else { "them" };
+        Some(format!("{text}: no time counted across {across}"))
+    }
+
+    /// Data frames per second between the first and the last frame.
+    fn frame_rate(&self) -> Option<f64> {
+        let d = self.duration()?;
+        (d > 0.0).then(|| (self.acc.frames - 1) as f64 / d)
+    }
+
+    fn fields(&self) -> Vec<FieldRow> {
+        // The protocol's conversions, applied to the raw min, max and mean.
+        let field = |q: Quantity| {
+            let stats = match lane(q) {
+                Some(lane) => {
+                    let (range, n) = self.acc.ranges.get(lane, self.acc.frames);
+                    let linear = self.linear(q);
+                    linear.and_then(|linear| range.convert(n, |x| linear.to_f64(x)))
+                }
+                None => self.temperature(q).range,
+            };
+            (q.name(), q.unit(), stats)
+        };
+        Quantity::ALL.into_iter().map(field).collect()
+    }
+
+    /// The statistics of temperature `quantity` (a histogram of its codes).
+    fn temperature(&self, quantity: Quantity) -> TempStats {
+        let (codes, uncoded) = match quantity {
+            Quantity::CapTemp => (&self.acc.cap_codes, self.acc.uncoded[1]),
+            _ => (&self.acc.mos_codes, self.acc.uncoded[0]),
+        };
+        match self.conversion(quantity) {
+            // Every data frame's temperature is in the histogram: its statistics are whole.
+            Some(conversion) if uncoded == 0 => temp_stats(codes, conversion),
+            // A protocol that does not send it, or not as a code of 0..=255: no statistics
+            // rather than those of some frames.
+            _ => TempStats::default(),
+        }
+    }
+
+    fn faults(&self) -> impl Iterator<Item = (Fault, u64)> + '_ {
+        Fault::ALL
+            .into_iter()
+            .map(|f| (f, self.acc.fault_frames[usize::from(f.bit())]))
+            .filter(|&(_, n)| n > 0)
+    }
+}
+
+fn fault_names(status: Status) -> Vec<&'static str> {
+    status.faults().map(Fault::name).collect()
+}
+
+fn percent(part: u64, whole: u64) -> f64 {
+    if whole == 0 {
+        0.0
+    } else {
+        part as f64 * 100.0 / whole as f64
+    }
+}

@@ -1,0 +1,85 @@
+//! The summary's own tests.
+use super::accumulate::*;
+use super::*;
+use hwfoc::DataFrame;
+
+#[test]
+fn the_device_is_named_field_by_field() {
+    let info = Info::from(hwfoc::InfoFrame::new("HW1", "V2", "XR-01.0.00", "42").unwrap());
+    assert_eq!(
+        Value::Object(device_json(&info)).to_string(),
+        r#"{"product":"HW1","hardware":"V2","firmware":"XR-01.0.00","id":"42"}"#
+    );
+}
+
+#[test]
+fn temperature_stats_come_from_the_histogram() {
+    let mut codes = [0u64; 256];
+    codes[206] = 3; // 28 degC
+    codes[183] = 1; // 40 degC
+    codes[250] = 2; // below range
+    codes[10] = 1; // above range
+    let t = temp_stats(&codes, Conversion::AdcTable);
+    assert_eq!(t.range, Some([28.0, 40.0, (3.0 * 28.0 + 40.0) / 4.0]));
+    assert_eq!((t.below, t.above), (2, 1));
+}
+
+#[test]
+fn ranges_convert_monotonically() {
+    let mut r = Ranges::default();
+    for v in [-64, 128, 0] {
+        r.add(&DataFrame {
+            current_raw: v,
+            voltage_raw: (v + 64) as u16,
+            ..Default::default()
+        });
+    }
+    let voltage = lane(Quantity::Voltage).unwrap();
+    let (current, n) = r.get(CURRENT, 3);
+    assert_eq!(n, 3);
+    assert_eq!(
+        current.convert(n, |x| x / 64.0),
+        Some([-1.0, 2.0, 64.0 / 3.0 / 64.0])
+    );
+    assert_eq!(
+        r.get(voltage, 3).0.convert(3, |x| x),
+        Some([0.0, 192.0, 256.0 / 3.0])
+    );
+    assert_eq!(Ranges::default().get(ERPM, 0).0.convert(0, |x| x), None);
+}
+
+#[test]
+fn episodes_are_maximal_runs_of_faulty_frames() {
+    let mut acc = Accumulator::default();
+    let statuses = [
+        0u16, 0x0001, 0x0040, 0x0001, 0, 0, 0x8000, 0, 0x0002, 0x0002,
+    ];
+    for (i, &s) in statuses.iter().enumerate() {
+        let frame = DataFrame {
+            packet: 100 + i as u16,
+            status: Status(s),
+            ..Default::default()
+        };
+        acc.add(Some(i as f64 * 0.05), &Frame::Data(frame.into()));
+    }
+    assert_eq!(acc.episode_count, 2);
+    let first = acc.episodes[0];
+    assert_eq!(
+        (first.first.frame, first.last.frame, first.frames),
+        (1, 3, 3)
+    );
+    assert_eq!(
+        (first.first.packet, first.last.packet),
+        (Some(101), Some(103))
+    );
+    assert_eq!(first.first.t, Some(0.05));
+    assert_eq!(
+        fault_names(first.bits),
+        ["input_voltage_high", "mos_overheat"]
+    );
+    assert!(!first.ongoing);
+    assert_eq!(acc.episodes[1].frames, 1);
+    // The last run is still open at the end of the stream.
+    let open = acc.episode.unwrap();
+    assert_eq!((open.first.frame, open.last.frame, open.frames), (8, 9, 2));
+}
