@@ -75,26 +75,38 @@ impl Default for Ranges {
 }
 
 impl Ranges {
-    /// Adds a frame's raw integers. A quantity the frame does not carry leaves its lane's
-    /// minimum, maximum and sum as they are and is counted as missing (for a protocol that
-    /// carries every lane's quantity, the compiler removes that branch).
+    /// Adds a frame's raw integers. A frame that carries every lane's quantity (for a protocol
+    /// that carries them all, the compiler knows it) is added as one array, a few vector
+    /// instructions; any other goes through [`Ranges::add_some`].
     #[inline(always)]
     pub(super) fn add(&mut self, f: &impl Telemetry) {
-        let (mut low, mut high, mut add) = ([i32::MAX; LANES], [i32::MIN; LANES], [0i64; LANES]);
-        let mut take = |lane: usize| match f.raw(LANE_QUANTITIES[lane]) {
-            Some(raw) => (low[lane], high[lane], add[lane]) = (raw, raw, i64::from(raw)),
-            None => self.missing[lane] += 1,
+        let raw = |lane: usize| f.raw(LANE_QUANTITIES[lane]);
+        let (Some(a), Some(b), Some(c), Some(d), Some(e), Some(g)) =
+            (raw(0), raw(1), raw(2), raw(3), raw(4), raw(5))
+        else {
+            return self.add_some(f);
         };
-        // Written out, not a loop: each call is then a field read.
-        take(0);
-        take(1);
-        take(2);
-        take(3);
-        take(4);
-        take(5);
-        self.min = std::array::from_fn(|i| self.min[i].min(low[i]));
-        self.max = std::array::from_fn(|i| self.max[i].max(high[i]));
-        self.sum = std::array::from_fn(|i| self.sum[i] + add[i]);
+        let mut v = [0i32; LANES];
+        (v[0], v[1], v[2], v[3], v[4], v[5]) = (a, b, c, d, e, g);
+        self.min = std::array::from_fn(|i| self.min[i].min(v[i]));
+        self.max = std::array::from_fn(|i| self.max[i].max(v[i]));
+        self.sum = std::array::from_fn(|i| self.sum[i] + i64::from(v[i]));
+    }
+
+    /// Adds the quantities a frame carries; one it does not carry leaves its lane's minimum,
+    /// maximum and sum as they are and is counted as missing.
+    #[cold]
+    fn add_some(&mut self, f: &impl Telemetry) {
+        for (lane, &quantity) in LANE_QUANTITIES.iter().enumerate() {
+            match f.raw(quantity) {
+                Some(raw) => {
+                    self.min[lane] = self.min[lane].min(raw);
+                    self.max[lane] = self.max[lane].max(raw);
+                    self.sum[lane] += i64::from(raw);
+                }
+                None => self.missing[lane] += 1,
+            }
+        }
     }
 
     /// The range of the quantity in `lane`, and the number of frames that carried it among
