@@ -45,7 +45,7 @@ use hwfoc::datalink::LengthByte;
 pub static NO_FRAMES: std::sync::LazyLock<String> = std::sync::LazyLock::new(|| {
     format!(
         "no valid HW-FOC frames: check the baud rate ({}) and the wiring",
-        hwfoc::wire::BAUD_RATE
+        hwfoc::foc::BAUD_RATE
     )
 });
 
@@ -1124,11 +1124,11 @@ fn percent(part: u64, whole: u64) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use hwfoc::DataFrame;
+    use hwfoc::foc::DataFrame;
 
     #[test]
     fn the_device_is_named_field_by_field() {
-        let info = Info::from(hwfoc::InfoFrame::new("HW1", "V2", "XR-01.0.00", "42").unwrap());
+        let info = Info::from(hwfoc::foc::InfoFrame::new("HW1", "V2", "XR-01.0.00", "42").unwrap());
         assert_eq!(
             Value::Object(device_json(&info)).to_string(),
             r#"{"product":"HW1","hardware":"V2","firmware":"XR-01.0.00","id":"42"}"#
