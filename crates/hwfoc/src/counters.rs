@@ -23,16 +23,18 @@
 /// the larger the gap allowed, the more restarts pass for losses: an ESC whose counter stood
 /// within `MAX_PACKET_GAP` below the number it restarts from (a chance of about 1000 in 65536)
 /// looks like a gap forward. On a timed source,
-/// [`Decoder::line_silent`](crate::foc::Decoder::line_silent) settles both cases from the time that
-/// passed.
+/// [`Decoder::line_silent`](crate::foc::Decoder::line_silent) settles both cases from the time
+/// that passed.
 pub const MAX_PACKET_GAP: u16 = 1000;
 
 /// The largest step forward of a packet number (modulo 65536): a larger one is a step backwards.
 const MAX_FORWARD_STEP: u16 = 0x8000;
 
-/// The two byte counters of [`foc::Stats`](crate::foc::Stats), of 48 bits each: a `u32` and a `u16`. They take 12
-/// bytes at an alignment of 4, where two `u64` would take 16 at an alignment of 8: that is what
-/// keeps [`foc::Stats`](crate::foc::Stats), with every event counter a `u32`, at 40 bytes, and the [`Decoder`] at 120.
+/// The two byte counters of a protocol's statistics ([`foc::Stats`](crate::foc::Stats),
+/// [`datalink::Stats`](crate::datalink::Stats)), of 48 bits each: a `u32` and a `u16`. They take
+/// 12 bytes at an alignment of 4, where two `u64` would take 16 at an alignment of 8: that is
+/// what keeps [`foc::Stats`](crate::foc::Stats), with every event counter a `u32`, at 40 bytes,
+/// and the HW-FOC [`Decoder`] at 120.
 ///
 /// 2^48 bytes are 4.6 million years of a 19200-baud wire, or 78 hours of reading a file at
 /// 1 GB/s; past that a count wraps to 0. Saturating instead would cost about 110 bytes of

@@ -13,7 +13,8 @@
 //! ```
 //!
 //! The length byte counts the bytes before the check bytes (`LEN - w`) and is what tells the
-//! kinds apart; version and command are then checked against the kind (see `docs/PROTOCOL-NOTES.md`).
+//! kinds apart; version and command are then checked against the kind (see
+//! `docs/PROTOCOL-NOTES.md`).
 
 use crate::foc::FrameError;
 
@@ -127,9 +128,9 @@ pub const fn crc16_ccitt(mut crc: u16, bytes: &[u8]) -> u16 {
 
 /// How a frame kind protects its bytes: the check bytes at the end of the frame.
 ///
-/// Each kind names one in [`FrameKind::CHECKSUM`](crate::foc::FrameKind::CHECKSUM) (and the DataLink frame of
-/// [`crate::datalink`] uses [`Checksum::Crc16Xmodem`]); the shared code computes, verifies and
-/// writes it. A new kind of check is one more arm here and in the methods below.
+/// Each kind names one in [`FrameKind::CHECKSUM`](crate::foc::FrameKind::CHECKSUM) (and the
+/// DataLink frame of [`crate::datalink`] uses [`Checksum::Crc16Xmodem`]); the shared code computes,
+/// verifies and writes it. A new kind of check is one more arm here and in the methods below.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 #[non_exhaustive]
 pub enum Checksum {

@@ -256,11 +256,12 @@ impl scan::Scanner for Scanner {
 ///
 /// [`line_silent`](StreamDecoder::line_silent)`(max_frames, ..)`: at most `max_frames`
 /// DataLink frames could have been sent in the silence (160 byte times each at
-/// [`BAUD_RATE`](super::BAUD_RATE), about 13.9 ms). As for the ESC [`Decoder`](crate::foc::Decoder),
-/// the held bytes are decided at once and the next frame's counter step counts as a loss only
-/// up to `max_frames + 1` (a larger step is a restart). Each channel's next packet-number step
-/// counts as a loss only up to [`esc_frames_in`](super::esc_frames_in)`(max_frames) + 1`, the
-/// most frames that ESC could have sent on its own 19200-baud wire in that time.
+/// [`BAUD_RATE`](super::BAUD_RATE), about 13.9 ms). As for the ESC
+/// [`Decoder`](crate::foc::Decoder), the held bytes are decided at once and the next frame's
+/// counter step counts as a loss only up to `max_frames + 1` (a larger step is a restart). Each
+/// channel's next packet-number step counts as a loss only up to
+/// [`esc_frames_in`](super::esc_frames_in)`(max_frames) + 1`, the most frames that ESC could have
+/// sent on its own 19200-baud wire in that time.
 ///
 /// ```
 /// use hwfoc::datalink::{BAUD_RATE, Decoder, Frame, FRAME_LEN};

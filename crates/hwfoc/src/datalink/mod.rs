@@ -3,8 +3,8 @@
 //!
 //! A family of its own beside the HW-FOC decoder ([`crate::foc`]), not a kind of
 //! [`crate::foc::Frame`]: a hub's wire carries only these frames, an ESC's wire never does, so
-//! neither decoder pays for the other (the HW-FOC [`Decoder`](crate::foc::Decoder) keeps its 76-byte
-//! buffer; this one holds up to 159 bytes). What the two share is not copied:
+//! neither decoder pays for the other (the HW-FOC [`Decoder`](crate::foc::Decoder) keeps its
+//! 76-byte buffer; this one holds up to 159 bytes). What the two share is not copied:
 //!
 //! - the sync byte and version ([`crate::wire::SYNC`], [`crate::wire::VERSION`]), the byte
 //!   timing ([`byte_ns`](crate::wire::byte_ns) of this module's [`BAUD_RATE`]) and the check
@@ -13,8 +13,8 @@
 //! - each record's 18 payload bytes, read and written by [`DataFrame`](crate::foc::DataFrame)'s own
 //!   code (a record is a channel byte and a data frame's payload);
 //! - the sync-pair search of the HW-FOC scanner, with 0x9E / 0xA0 as the second byte;
-//! - the following of a counter ([`PacketSequence`](crate::counters::PacketSequence)), for the hub's frame
-//!   counter and each channel's packet numbers.
+//! - the following of a counter ([`PacketSequence`](crate::counters::PacketSequence)), for the
+//!   hub's frame counter and each channel's packet numbers.
 //!
 //! | module | holds |
 //! |---|---|

@@ -9,10 +9,10 @@
 //! byte: scanning resumes at the byte after the rejected `0x9B`, so a lone `0x9B`, a fake header,
 //! a cut frame or a run of garbage never hides a following intact frame.
 //!
-//! The scanner names no frame kind: it asks the list of kinds in [`crate::foc::frame`] whether a frame
-//! starts at a candidate, and how long a candidate with a given length byte is. Those calls are
-//! inlined with every kind's constants: no dynamic dispatch, no function pointer, and no loop over
-//! the kinds is left in the scanner.
+//! The scanner names no frame kind: it asks the list of kinds in [`crate::foc::frame`] whether a
+//! frame starts at a candidate, and how long a candidate with a given length byte is. Those calls
+//! are inlined with every kind's constants: no dynamic dispatch, no function pointer, and no loop
+//! over the kinds is left in the scanner.
 
 use crate::foc::frame::{Frame, MAX_FRAME_LEN, candidate_len, or_length_bytes, wire_len_of};
 use crate::foc::stats::Stats;

@@ -18,10 +18,11 @@ use crate::wire::{Checksum, SYNC};
 
 /// A kind of frame: its header, length, check bytes and payload layout.
 ///
-/// Each kind lives in its own module under [`crate::foc::kinds`] and has one arm in [`crate::foc::Frame`];
-/// the scanner and [`crate::foc::parse`] reach it only through this trait, with every constant known at
-/// compile time (no `dyn`, no function pointers: after inlining, the code is what a hand-written
-/// check of that one kind would be). See [`crate::foc`] for how to add a kind.
+/// Each kind lives in its own module under [`crate::foc::kinds`] and has one arm in
+/// [`crate::foc::Frame`]; the scanner and [`crate::foc::parse`] reach it only through this trait,
+/// with every constant known at compile time (no `dyn`, no function pointers: after inlining, the
+/// code is what a hand-written check of that one kind would be). See [`crate::foc`] for how to add
+/// a kind.
 ///
 /// The trait is sealed: a kind is only useful with its arm in [`crate::foc::Frame`], so it is
 /// implemented inside this crate. Its constants and provided methods are for everyone.
