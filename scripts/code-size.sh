@@ -6,7 +6,7 @@
 # raw fields of the last data frame), then with `hwfoc_probe_push_units` as well (feature `units`:
 # voltage, currents and RPM under caller settings, temperatures from the ADC table), then with
 # `hwfoc_probe_datalink_push` alone (feature `datalink` without the default `esc`:
-# DatalinkDecoder::push, the counter and a few raw fields of each ESC of the last hub frame).
+# datalink::Decoder::push, the counter and a few raw fields of each ESC of the last hub frame).
 #
 # After LTO the probe's own object in the archive holds exactly the code those entry points reach.
 # Counted, from that object: its .text* sections (entry points, hwfoc code, core's panic stubs;
@@ -94,7 +94,7 @@ measure "DataLink decoder alone (push + frame fields)" --no-default-features --f
 state=$(sed -n 's/^pub const DECODER_STATE_BYTES: usize = \([0-9]*\);.*/\1/p' src/lib.rs)
 echo "decoder state: ${state:?} bytes (size_of::<Decoder>(), owned by the caller)"
 dl_state=$(sed -n 's/^pub const DATALINK_DECODER_STATE_BYTES: usize = \([0-9]*\);.*/\1/p' src/lib.rs)
-echo "DataLink decoder state: ${dl_state:?} bytes (size_of::<DatalinkDecoder>(), owned by the caller)"
+echo "DataLink decoder state: ${dl_state:?} bytes (size_of::<datalink::Decoder>(), owned by the caller)"
 
 # Symbols the probe objects take from outside (all three builds).
 helpers=$(sort -u "$tmp/helpers" | tr '\n' ' ')

@@ -21,8 +21,8 @@ use std::collections::VecDeque;
 use std::io::Write;
 use std::time::{Duration, Instant};
 
-use hwfoc::DataFrame;
-use hwfoc::datalink::{self, DatalinkFrame};
+use hwfoc::datalink;
+use hwfoc::foc::DataFrame;
 
 use crate::output::{Output, OutputError, OutputStats, Update};
 use crate::port::{PortOptions, ReopeningPort};
@@ -132,7 +132,7 @@ impl DatalinkOutput {
         // is lost, as on a real line, and the next one carries the next frames.
         let carried: [Option<Slot>; datalink::CHANNELS] =
             std::array::from_fn(|i| self.slots[i].pop_front());
-        let frame = DatalinkFrame {
+        let frame = datalink::Frame {
             counter: self.counter,
             slots: carried.map(|slot| slot.map(|s| s.frame)),
         };

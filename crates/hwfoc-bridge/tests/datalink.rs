@@ -5,9 +5,10 @@ use std::io::{self, Write};
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
-use hwfoc::datalink::{self, DatalinkFrame};
+use hwfoc::datalink;
+use hwfoc::foc::DataFrame;
 use hwfoc::telemetry::Data;
-use hwfoc::{DataFrame, Settings, Status};
+use hwfoc::{Settings, Status};
 use hwfoc_bridge::Output;
 use hwfoc_bridge::Update;
 use hwfoc_bridge::datalink::{DatalinkOutput, Pacing, QUEUE};
@@ -75,7 +76,7 @@ fn crc_xmodem(bytes: &[u8]) -> u16 {
     crc
 }
 
-fn frames_written(shared: &Shared) -> Vec<DatalinkFrame> {
+fn frames_written(shared: &Shared) -> Vec<datalink::Frame> {
     let bytes = shared.bytes.lock().unwrap().clone();
     assert_eq!(bytes.len() % datalink::FRAME_LEN, 0);
     for chunk in bytes.chunks(datalink::FRAME_LEN) {
@@ -84,7 +85,7 @@ fn frames_written(shared: &Shared) -> Vec<DatalinkFrame> {
         assert_eq!(chunk[158..], crc.to_le_bytes(), "CRC, low byte first");
     }
     let mut got = Vec::new();
-    let mut decoder = datalink::DatalinkDecoder::new();
+    let mut decoder = datalink::Decoder::new();
     decoder.decode_all(&bytes, |d| got.push(d.frame));
     assert_eq!(decoder.stats().bytes_skipped(), 0);
     got

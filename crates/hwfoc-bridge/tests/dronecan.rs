@@ -13,8 +13,9 @@ use std::sync::{Arc, Mutex, mpsc};
 use std::thread;
 use std::time::{Duration, Instant};
 
+use hwfoc::foc::DataFrame;
 use hwfoc::telemetry::Data;
-use hwfoc::{DataFrame, Settings, Status};
+use hwfoc::{Settings, Status};
 use hwfoc_bridge::dronecan::dsdl::{
     self, EscStatus, EscStatusExtended, Health, NodeStatus, f16_bits,
 };

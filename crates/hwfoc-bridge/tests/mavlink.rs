@@ -4,8 +4,9 @@
 use std::net::{SocketAddr, UdpSocket};
 use std::time::{Duration, Instant};
 
+use hwfoc::foc::DataFrame;
 use hwfoc::telemetry::Data;
-use hwfoc::{DataFrame, Fault, Settings, Status};
+use hwfoc::{Fault, Settings, Status};
 use hwfoc_bridge::mavlink::{
     MAV_COMP_ID_PERIPHERAL, MavlinkOptions, MavlinkOutput, MavlinkTarget, messages,
 };

@@ -13,8 +13,9 @@ use std::path::Path;
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
+use hwfoc::foc::DataFrame;
 use hwfoc::telemetry::Data;
-use hwfoc::{DataFrame, Fault, Settings, Status};
+use hwfoc::{Fault, Settings, Status};
 use hwfoc_bridge::mavlink::{MavlinkOptions, MavlinkOutput, MavlinkTarget};
 use hwfoc_bridge::{Output, SILENT_AFTER, Update};
 use hwfoc_io::Record;

@@ -7,11 +7,12 @@
 
 use std::fmt::Write as _;
 
+use hwfoc::foc::{DataFrame, InfoFrame};
 use hwfoc::units::ADC_TABLE;
-use hwfoc::{DataFrame, Fault, InfoFrame, Status};
+use hwfoc::{Fault, Status};
 
 /// Seconds per byte at the HW-FOC baud rate, 8N1 (10 bits a byte).
-const BYTE_S: f64 = 10.0 / hwfoc::wire::BAUD_RATE as f64;
+const BYTE_S: f64 = 10.0 / hwfoc::foc::BAUD_RATE as f64;
 
 /// The demo capture as logic-analyser CSV text.
 pub fn capture_csv() -> Vec<u8> {

@@ -17,8 +17,9 @@ use std::time::{Duration, Instant};
 
 use common::{Dir, by_esc, hwfoc, ok, records, run};
 use common::{Pty, Running, pty};
-use hwfoc::datalink::{DatalinkFrame, LengthByte};
-use hwfoc::{DataFrame, Status};
+use hwfoc::Status;
+use hwfoc::datalink::{self, LengthByte};
+use hwfoc::foc::DataFrame;
 use nix::poll::{PollFd, PollFlags, PollTimeout, poll};
 use nix::sys::signal::Signal;
 use serde_json::Value;
@@ -185,7 +186,7 @@ fn hub_bytes() -> Vec<u8> {
     };
     let mut bytes = Vec::new();
     for k in 0..10u16 {
-        let mut frame = DatalinkFrame::new(k);
+        let mut frame = datalink::Frame::new(k);
         for channel in 0..3 {
             frame.slots[usize::from(channel)] = Some(esc(channel, k));
         }
@@ -364,7 +365,7 @@ fn the_monitor_shows_a_datalink_port_as_its_escs() {
     thread::spawn(move || {
         let mut k = 0u16;
         while !writing.load(Ordering::Relaxed) {
-            let mut frame = DatalinkFrame::new(k);
+            let mut frame = datalink::Frame::new(k);
             for channel in [0usize, 1, 5] {
                 frame.slots[channel] = Some(DataFrame {
                     packet: k,

@@ -7,7 +7,8 @@ use std::path::{Path, PathBuf};
 use std::process::{Output, Stdio};
 
 use common::{SCHEMA, XROTOR, assert_fails_with, capture, hwfoc, stdout};
-use hwfoc::{DataFrame, Fault, InfoFrame, Status};
+use hwfoc::foc::{DataFrame, InfoFrame};
+use hwfoc::{Fault, Status};
 use serde_json::Value;
 
 fn golden(name: &str) -> PathBuf {

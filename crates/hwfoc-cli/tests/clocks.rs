@@ -8,7 +8,7 @@ use std::process::Output;
 use std::time::Duration;
 
 use common::{Dir, Running, hwfoc, ok, stdout};
-use hwfoc::DataFrame;
+use hwfoc::foc::DataFrame;
 use hwfoc_io::pcapng;
 use serde_json::Value;
 

@@ -22,12 +22,12 @@ fn crafted(dir: &Dir) -> String {
     let mut w = hwfoc_io::pcapng::Writer::new(file).unwrap();
     let port = w.add_interface(PORT, 19_200).unwrap();
     let t0 = 1_700_000_000_000_000_000u64;
-    let info = hwfoc::InfoFrame::new("\x1b[2JXR\x07", "\x1b]0;hw\x07", "\rFAKE\x1b[1A", "id")
+    let info = hwfoc::foc::InfoFrame::new("\x1b[2JXR\x07", "\x1b]0;hw\x07", "\rFAKE\x1b[1A", "id")
         .unwrap()
         .encode();
     w.write(port, t0, &info).unwrap();
     for packet in 0..40u16 {
-        let frame = hwfoc::DataFrame {
+        let frame = hwfoc::foc::DataFrame {
             packet,
             erpm_raw: 70,
             ..Default::default()

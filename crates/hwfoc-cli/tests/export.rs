@@ -14,7 +14,8 @@ use arrow_array::cast::AsArray;
 use arrow_array::types::{Float32Type, Float64Type, UInt8Type, UInt16Type, UInt32Type};
 use arrow_array::{Array, ArrayRef, RecordBatch};
 use arrow_schema::DataType;
-use hwfoc::{DataFrame, Fault, InfoFrame, Status};
+use hwfoc::foc::{DataFrame, InfoFrame};
+use hwfoc::{Fault, Status};
 use parquet::arrow::arrow_reader::ParquetRecordBatchReaderBuilder;
 use serde_json::{Value, json};
 

@@ -8,7 +8,8 @@
 
 mod common;
 
-use hwfoc::{DataFrame, Status};
+use hwfoc::Status;
+use hwfoc::foc::DataFrame;
 
 use common::{Dir, hwfoc, ok, run};
 

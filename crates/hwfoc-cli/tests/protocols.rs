@@ -11,8 +11,8 @@ use std::thread;
 use std::time::Duration;
 
 use common::{Dir, hwfoc, stdout};
-use hwfoc::DataFrame;
-use hwfoc::datalink::DatalinkFrame;
+use hwfoc::datalink;
+use hwfoc::foc::DataFrame;
 use serde_json::Value;
 
 /// ESC data frames `packets`.
@@ -34,7 +34,7 @@ fn esc(packets: std::ops::Range<u16>) -> Vec<u8> {
 fn hub(id: u16, counters: std::ops::Range<u16>, channels: &[usize]) -> Vec<u8> {
     counters
         .flat_map(|counter| {
-            let mut frame = DatalinkFrame::new(counter);
+            let mut frame = datalink::Frame::new(counter);
             for &c in channels {
                 frame.slots[c] = Some(DataFrame {
                     packet: 1000 + 100 * id + c as u16,

@@ -13,7 +13,7 @@ use std::thread;
 use std::time::{Duration, Instant};
 
 use common::{Pty, Running, hwfoc, pty, run, spawn, unix_now};
-use hwfoc::{DataFrame, InfoFrame};
+use hwfoc::foc::{DataFrame, InfoFrame};
 use nix::sys::signal::{Signal, kill};
 use nix::unistd::Pid;
 use serde_json::Value;

@@ -14,7 +14,7 @@ use std::time::{Duration, Instant};
 
 use common::{Dir, assert_fails_with, hwfoc, ok};
 
-use hwfoc::{Decoder, Frame};
+use hwfoc::foc::{Decoder, Frame};
 use serde_json::Value;
 
 fn run(args: &[&str]) -> Output {

@@ -11,7 +11,7 @@ use std::process::Output;
 
 use arrow_array::{Array, Float64Array, UInt8Array};
 use common::{Dir, assert_fails_with, capture, hwfoc, ok, stdout};
-use hwfoc::DataFrame;
+use hwfoc::foc::DataFrame;
 use hwfoc_io::pcapng;
 use parquet::arrow::arrow_reader::ParquetRecordBatchReaderBuilder;
 use serde_json::Value;

@@ -12,7 +12,7 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 
 use common::{hwfoc, run};
-use hwfoc::{DataFrame, Frame, InfoFrame};
+use hwfoc::foc::{DataFrame, Frame, InfoFrame};
 use hwfoc_io::pcapng;
 use serde_json::Value;
 
@@ -299,7 +299,7 @@ fn info_frames(file: &Path) -> Vec<(u32, InfoFrame)> {
     }
     let mut out = Vec::new();
     for (i, s) in streams.iter().enumerate() {
-        hwfoc::Decoder::new().decode_all(s, |d| {
+        hwfoc::foc::Decoder::new().decode_all(s, |d| {
             if let Frame::Info(info) = d.frame {
                 out.push((i as u32, info));
             }

@@ -22,7 +22,7 @@ use serialport::{DataBits, FlowControl, Parity, SerialPort, StopBits};
 use std::fmt;
 
 /// The HW-FOC telemetry rate, the default of every serial input.
-pub const DEFAULT_BAUD: u32 = hwfoc::wire::BAUD_RATE;
+pub const DEFAULT_BAUD: u32 = hwfoc::foc::BAUD_RATE;
 
 /// How long a read waits for bytes before the thread checks whether it should stop.
 const READ_TIMEOUT: Duration = Duration::from_millis(50);

@@ -276,7 +276,7 @@ mod tests {
     fn wire() -> Vec<u8> {
         (0..3u16)
             .flat_map(|packet| {
-                hwfoc::DataFrame {
+                hwfoc::foc::DataFrame {
                     packet,
                     erpm_raw: 70,
                     current_raw: 819,

@@ -5,11 +5,11 @@
 //! port events). [`crate::clock::byte_times`] is the one place where a chunk's receive time
 //! becomes the time of each of its bytes.
 
-use hwfoc::datalink::{self, DatalinkDecoded, DatalinkStats};
-use hwfoc::mixed::{MixedDecoded, MixedDecoder};
-use hwfoc::stats::PacketSequence;
+use hwfoc::counters::PacketSequence;
+use hwfoc::datalink;
+use hwfoc::mixed;
 use hwfoc::telemetry::{Data, Frame};
-use hwfoc::{LinkStats, Settings};
+use hwfoc::{Settings, foc};
 
 use crate::clock::byte_times;
 use crate::esc_numbers::UNNUMBERED;
@@ -22,21 +22,21 @@ use crate::settings::SettingsMap;
 /// How many receive times to keep from earlier batches: a frame still arriving is shorter than
 /// the longest frame (a DataLink frame, 160 bytes), so its first byte is never further back
 /// than this.
-const TIME_HISTORY: usize = if hwfoc::frame::MAX_FRAME_LEN > datalink::FRAME_LEN {
-    hwfoc::frame::MAX_FRAME_LEN
+const TIME_HISTORY: usize = if hwfoc::foc::MAX_FRAME_LEN > datalink::FRAME_LEN {
+    hwfoc::foc::MAX_FRAME_LEN
 } else {
     datalink::FRAME_LEN
 };
 
 /// A silence of the line longer than this, between two bytes, may hide a restart of the ESC:
-/// the decoder is told of it (see [`hwfoc::Decoder::line_silent`]). Real ESCs send a frame at
+/// the decoder is told of it (see [`hwfoc::foc::Decoder::line_silent`]). Real ESCs send a frame at
 /// least every 364 ms (idle), and a read may return a little late.
 pub const SILENCE_S: f64 = crate::clock::MAX_STEP_S;
 
 /// The most data frames a silence of `seconds` can have hidden: one per 24 byte times, the
 /// fastest the line carries them (real ESCs send one every 50 ms at most).
 fn frames_in(seconds: f64) -> u32 {
-    let frame_s = 24.0 * hwfoc::wire::byte_ns(hwfoc::wire::BAUD_RATE) * 1e-9;
+    let frame_s = 24.0 * hwfoc::wire::byte_ns(hwfoc::foc::BAUD_RATE) * 1e-9;
     (seconds / frame_s).ceil().min(f64::from(u32::MAX)) as u32
 }
 
@@ -63,7 +63,7 @@ pub enum WireKind {
 /// Hands each ESC frame of a hub frame on as `(channel, offset, frame)`, at the hub frame's
 /// offset.
 #[inline]
-fn hub_records(d: &DatalinkDecoded, emit: &mut impl FnMut(Option<u8>, u64, &Frame)) {
+fn hub_records(d: &datalink::Decoded, emit: &mut impl FnMut(Option<u8>, u64, &Frame)) {
     for (channel, frame) in d.frame.escs() {
         emit(
             Some(channel as u8),
@@ -78,10 +78,10 @@ fn hub_records(d: &DatalinkDecoded, emit: &mut impl FnMut(Option<u8>, u64, &Fram
 /// stream offset of its first byte. The one place where the codec's protocol frames become
 /// neutral frames.
 #[inline(always)]
-fn emit_mixed(d: MixedDecoded, emit: &mut impl FnMut(Option<u8>, u64, &Frame)) {
+fn emit_mixed(d: mixed::Decoded, emit: &mut impl FnMut(Option<u8>, u64, &Frame)) {
     match d {
-        MixedDecoded::Esc(d) => emit(None, d.offset, &Frame::from(d.frame)),
-        MixedDecoded::Hub(d) => hub_records(&d, emit),
+        mixed::Decoded::Esc(d) => emit(None, d.offset, &Frame::from(d.frame)),
+        mixed::Decoded::Hub(d) => hub_records(&d, emit),
     }
 }
 
@@ -90,11 +90,11 @@ fn emit_mixed(d: MixedDecoded, emit: &mut impl FnMut(Option<u8>, u64, &Frame)) {
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum EscLink {
     /// An ESC on its own wire (or a stream whose protocol is not known yet).
-    Wire(LinkStats),
+    Wire(foc::Stats),
     /// Channel `channel` of a DataLink hub.
     Hub {
         /// The hub link's statistics.
-        hub: DatalinkStats,
+        hub: datalink::Stats,
         /// The ESC's channel.
         channel: usize,
     },
@@ -102,7 +102,7 @@ pub enum EscLink {
 
 impl Default for EscLink {
     fn default() -> Self {
-        EscLink::Wire(LinkStats::new())
+        EscLink::Wire(foc::Stats::new())
     }
 }
 
@@ -179,12 +179,12 @@ impl EscLink {
 
 /// A decoder that also gives each frame the receive time of its first byte.
 ///
-/// It reads both protocols at once ([`MixedDecoder`]): the frames of an ESC's own wire and of
+/// It reads both protocols at once ([`mixed::Decoder`]): the frames of an ESC's own wire and of
 /// a DataLink hub, in byte order, whatever the chunking, also when the stream changes from one
 /// to the other; bytes in a frame of either are not skipped bytes of the other.
 #[derive(Debug, Default)]
 pub struct Stream {
-    wire: MixedDecoder,
+    wire: mixed::Decoder,
     /// Receive times of the last bytes of earlier batches, oldest first.
     history: Vec<f64>,
 }
@@ -301,7 +301,7 @@ impl Stream {
     }
 
     /// The DataLink hub's statistics, once the stream has carried a hub frame.
-    pub fn hub(&self) -> Option<&DatalinkStats> {
+    pub fn hub(&self) -> Option<&datalink::Stats> {
         self.hub_frames().then_some(&self.wire.stats().hub)
     }
 
@@ -318,7 +318,7 @@ impl Stream {
 /// `emit(channel, offset, frame)` gets each ESC frame as [`emit_mixed`] hands it on.
 #[inline(always)]
 fn feed(
-    decoder: &mut MixedDecoder,
+    decoder: &mut mixed::Decoder,
     data: &[u8],
     silence_s: Option<f64>,
     emit: &mut impl FnMut(Option<u8>, u64, &Frame),
@@ -479,7 +479,7 @@ fn time_at(history: &[f64], times: &[f64], start: u64, offset: u64) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use hwfoc::DataFrame;
+    use hwfoc::foc::DataFrame;
 
     #[test]
     fn frame_times_survive_any_batching() {

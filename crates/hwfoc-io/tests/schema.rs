@@ -5,7 +5,8 @@
 //! not a copy of it): a new column is a row of that table as well as an entry in the column table.
 
 use arrow_schema::{DataType, Field};
-use hwfoc::{DataFrame, Settings, Status};
+use hwfoc::foc::DataFrame;
+use hwfoc::{Settings, Status};
 use hwfoc_io::record::{COLUMNS, Column, Record, TextEncoder, UNITS, Visitor, columns};
 use hwfoc_io::write::arrow::schema;
 use std::sync::Arc;

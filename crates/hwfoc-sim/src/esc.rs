@@ -22,7 +22,8 @@
 use std::collections::VecDeque;
 use std::rc::Rc;
 
-use hwfoc::{DataFrame, Decoder, Fault, Frame, InfoFrame};
+use hwfoc::Fault;
+use hwfoc::foc::{DataFrame, Decoder, Frame, InfoFrame};
 
 use crate::faults::{Fate, FaultSchedule, LineFaults, LinkRates};
 use crate::model::{Model, ModelConfig};

@@ -22,8 +22,9 @@
 //! Each ESC gets slightly different parameters (a few percent on KV, load, battery resistance,
 //! cooling; its own sensor offsets), drawn from its own random stream.
 
+use hwfoc::foc::DataFrame;
 use hwfoc::units::ADC_TABLE;
-use hwfoc::{DataFrame, Fault, Status};
+use hwfoc::{Fault, Status};
 
 use crate::rng::Rng;
 

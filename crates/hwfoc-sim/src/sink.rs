@@ -2,7 +2,8 @@
 
 use std::io::{self, BufWriter, Write};
 
-use hwfoc::{DataFrame, Settings};
+use hwfoc::Settings;
+use hwfoc::foc::DataFrame;
 
 use hwfoc_io::pcapng;
 use hwfoc_io::record::Record;

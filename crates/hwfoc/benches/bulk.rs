@@ -25,12 +25,11 @@ use std::hint::black_box;
 use std::time::Duration;
 
 use criterion::{BenchmarkGroup, Criterion, Throughput, criterion_group, criterion_main};
-use hwfoc::datalink::{
-    self, DatalinkDecoded, DatalinkDecoder, DatalinkFrame, DatalinkScanner, FRAME_LEN,
-};
-use hwfoc::decoder::HwFocScanner;
+use hwfoc::Status;
+use hwfoc::datalink::{self, FRAME_LEN};
+use hwfoc::foc;
+use hwfoc::foc::{DataFrame, Decoded, Decoder, Frame, InfoFrame, frames};
 use hwfoc::scan::{Scan, Scanner, StreamDecoder};
-use hwfoc::{DataFrame, Decoded, Decoder, Frame, InfoFrame, Status, frames};
 
 /// Size of each generated stream.
 const STREAM_LEN: usize = 8 << 20;
@@ -351,7 +350,7 @@ fn datalink_stream(noisy: bool) -> (Vec<u8>, Expected) {
         if noisy && rng.chance(350) {
             e.garbage_bytes += garbage(&mut rng, &mut buf, false);
         }
-        let mut frame = DatalinkFrame::new(counter);
+        let mut frame = datalink::Frame::new(counter);
         counter = counter.wrapping_add(1);
         for (slot, esc) in frame.slots.iter_mut().zip(&mut escs) {
             *slot = Some(esc.next_data());
@@ -377,7 +376,7 @@ fn datalink_stream(noisy: bool) -> (Vec<u8>, Expected) {
 
 /// Something from every DataLink frame, so that no decoding work can be optimised away.
 #[inline(always)]
-fn fold_datalink(acc: u64, d: &DatalinkDecoded) -> u64 {
+fn fold_datalink(acc: u64, d: &datalink::Decoded) -> u64 {
     let v = d.frame.slots[5].map_or(0, |e| u64::from(e.packet) ^ u64::from(e.status.0) << 16);
     acc.wrapping_mul(31)
         .wrapping_add(v ^ d.offset ^ u64::from(d.frame.counter))
@@ -387,7 +386,7 @@ fn fold_datalink(acc: u64, d: &DatalinkDecoded) -> u64 {
 /// the streaming decoder in agreement.
 fn check_datalink(name: &str, buf: &[u8], e: &Expected) {
     let mut it = datalink::frames(buf);
-    let decoded: Vec<DatalinkDecoded> = it.by_ref().collect();
+    let decoded: Vec<datalink::Decoded> = it.by_ref().collect();
     let s = *it.stats();
     let offsets: Vec<u64> = decoded.iter().map(|d| d.offset).collect();
     assert_eq!(offsets, e.offsets, "{name}: exactly the intact frames");
@@ -402,12 +401,12 @@ fn check_datalink(name: &str, buf: &[u8], e: &Expected) {
         e.flipped_frames,
         e.cut_frames,
     );
-    let mut dec = DatalinkDecoder::new();
+    let mut dec = datalink::Decoder::new();
     let mut all = Vec::with_capacity(decoded.len());
     dec.decode_all(buf, |d| all.push(d));
     assert_eq!(
         all, decoded,
-        "{name}: DatalinkDecoder and frames() disagree"
+        "{name}: datalink::Decoder and frames() disagree"
     );
     assert_eq!(*dec.stats(), s, "{name}: statistics disagree");
 }
@@ -417,7 +416,7 @@ fn bulk(c: &mut Criterion) {
         let (buf, expected) = datalink_stream(noisy);
         check_datalink(name, &buf, &expected);
         let mut g = c.benchmark_group(name);
-        bench_decoder::<DatalinkScanner>(&mut g, &buf, fold_datalink);
+        bench_decoder::<datalink::Scanner>(&mut g, &buf, fold_datalink);
         g.finish();
     }
     let streams = [
@@ -428,7 +427,7 @@ fn bulk(c: &mut Criterion) {
     for (name, (buf, expected)) in streams {
         check(name, &buf, &expected);
         let mut g = c.benchmark_group(name);
-        bench_decoder::<HwFocScanner>(&mut g, &buf, fold);
+        bench_decoder::<foc::Scanner>(&mut g, &buf, fold);
         g.finish();
     }
 }

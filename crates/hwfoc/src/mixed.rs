@@ -1,4 +1,4 @@
-//! Streams that may carry either protocol, or both one after the other: the [`MixedDecoder`]
+//! Streams that may carry either protocol, or both one after the other: the [`Decoder`]
 //! reads HW-FOC frames (an ESC's own wire) and DataLink V2 frames (a hub) at once, in byte
 //! order.
 //!
@@ -11,19 +11,19 @@
 //! protocol's own scanner. So whatever the chunking, and however often a stream changes
 //! protocol (an adapter moved from an ESC to a hub), every intact frame of both is found.
 //!
-//! The statistics ([`MixedStats`]) are each protocol's: [`LinkStats`] for the ESC frames,
-//! [`DatalinkStats`] for the hub frames. Both count every byte of the stream, and both count as
+//! The statistics ([`Stats`]) are each protocol's: [`foc::Stats`] for the ESC frames,
+//! [`datalink::Stats`] for the hub frames. Both count every byte of the stream, and both count as
 //! skipped only the bytes in no frame of either protocol.
 //!
 //! Back-to-back ESC data frames take the HW-FOC scanner's own first guess, so a stream of ESC
-//! frames is read as fast as by the [`Decoder`](crate::Decoder); the search over bytes in no
+//! frames is read as fast as by the [`Decoder`](crate::foc::Decoder); the search over bytes in no
 //! frame compares each word with four second bytes instead of two.
 
-use crate::datalink::{DatalinkDecoded, DatalinkStats, FRAME_LEN, LengthByte};
-use crate::decoder::{Decoded, bytes_equal, find_sync_then, is_length_byte, take_candidate};
-use crate::frame::{Frame, MAX_FRAME_LEN, or_length_bytes};
-use crate::scan::{Candidate, Scan, Scanner, Stats, StreamDecoder};
-use crate::stats::LinkStats;
+use crate::datalink::{self, FRAME_LEN, LengthByte};
+use crate::foc::decoder::{bytes_equal, find_sync_then, is_length_byte, take_candidate};
+use crate::foc::frame::or_length_bytes;
+use crate::foc::{self, MAX_FRAME_LEN};
+use crate::scan::{self, Candidate, Scan, StreamDecoder};
 
 /// The longest candidate of either protocol.
 const MAX_LEN: usize = if MAX_FRAME_LEN > FRAME_LEN {
@@ -34,38 +34,38 @@ const MAX_LEN: usize = if MAX_FRAME_LEN > FRAME_LEN {
 
 /// A frame of either protocol, with its stream offset.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-pub enum MixedDecoded {
+pub enum Decoded {
     /// A HW-FOC frame (an ESC's own wire).
-    Esc(Decoded),
+    Esc(foc::Decoded),
     /// A DataLink V2 hub frame.
-    Hub(DatalinkDecoded),
+    Hub(datalink::Decoded),
 }
 
-impl MixedDecoded {
+impl Decoded {
     /// Offset of the frame's first byte in the stream.
     pub fn offset(&self) -> u64 {
         match self {
-            MixedDecoded::Esc(d) => d.offset,
-            MixedDecoded::Hub(d) => d.offset,
+            Decoded::Esc(d) => d.offset,
+            Decoded::Hub(d) => d.offset,
         }
     }
 }
 
-/// The statistics of a stream read by the [`MixedDecoder`]: each protocol's.
+/// The statistics of a stream read by the [`Decoder`]: each protocol's.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct MixedStats {
+pub struct Stats {
     /// The HW-FOC frames' statistics (its bytes and skipped bytes are the stream's).
-    pub esc: LinkStats,
+    pub esc: foc::Stats,
     /// The DataLink frames' statistics (its bytes and skipped bytes are the stream's).
-    pub hub: DatalinkStats,
+    pub hub: datalink::Stats,
 }
 
-impl MixedStats {
+impl Stats {
     /// No bytes seen.
     pub const fn new() -> Self {
-        MixedStats {
-            esc: LinkStats::new(),
-            hub: DatalinkStats::new(),
+        Stats {
+            esc: foc::Stats::new(),
+            hub: datalink::Stats::new(),
         }
     }
 
@@ -82,20 +82,20 @@ impl MixedStats {
     }
 }
 
-impl Default for MixedStats {
+impl Default for Stats {
     fn default() -> Self {
         Self::new()
     }
 }
 
-impl crate::scan::sealed::Sealed for MixedStats {}
+impl crate::scan::sealed::Sealed for Stats {}
 
-impl Stats for MixedStats {
-    const NEW: Self = MixedStats::new();
+impl scan::Stats for Stats {
+    const NEW: Self = Stats::new();
 
     #[inline]
     fn bytes(&self) -> u64 {
-        MixedStats::bytes(self)
+        Stats::bytes(self)
     }
 
     #[inline]
@@ -140,7 +140,7 @@ fn find_header(hay: &[u8]) -> Option<usize> {
 fn candidate_len(held: &[u8]) -> usize {
     match held.get(1) {
         Some(&b) if is_hub_length_byte(b) => crate::datalink::decoder::candidate_len(held.len()),
-        Some(_) => crate::frame::candidate_len(held),
+        Some(_) => crate::foc::frame::candidate_len(held),
         None => 2,
     }
 }
@@ -152,12 +152,12 @@ fn candidate_len(held: &[u8]) -> usize {
 fn scan_next(
     data: &[u8],
     pos: &mut usize,
-    stats: &mut MixedStats,
+    stats: &mut Stats,
     at_end: bool,
     first_guess: bool,
-) -> Option<(usize, MixedFrame)> {
-    if first_guess && let Some((at, frame)) = Frame::take_first(data, pos, &mut stats.esc) {
-        return Some((at, MixedFrame::Esc(frame)));
+) -> Option<(usize, Found)> {
+    if first_guess && let Some((at, frame)) = foc::Frame::take_first(data, pos, &mut stats.esc) {
+        return Some((at, Found::Esc(frame)));
     }
     loop {
         let Some(k) = find_header(&data[*pos..]) else {
@@ -174,19 +174,19 @@ fn scan_next(
             Some(&b) if is_hub_length_byte(b) => {
                 match crate::datalink::decoder::take_candidate(data, pos, &mut stats.hub, at_end) {
                     Candidate::Frame((at, frame, report)) => {
-                        // Its stream offset is set by `MixedFrame::at`.
-                        let hub = DatalinkDecoded {
+                        // Its stream offset is set by `Found::at`.
+                        let hub = datalink::Decoded {
                             offset: 0,
                             frame,
                             report,
                         };
-                        return Some((at, MixedFrame::Hub(hub)));
+                        return Some((at, Found::Hub(hub)));
                     }
                     other => other.is_decided(),
                 }
             }
             _ => match take_candidate(data, pos, &mut stats.esc, at_end) {
-                Candidate::Frame((at, frame)) => return Some((at, MixedFrame::Esc(frame))),
+                Candidate::Frame((at, frame)) => return Some((at, Found::Esc(frame))),
                 other => other.is_decided(),
             },
         };
@@ -199,34 +199,34 @@ fn scan_next(
 }
 
 /// A frame found, its offset given apart.
-enum MixedFrame {
-    Esc(Frame),
-    Hub(DatalinkDecoded),
+enum Found {
+    Esc(foc::Frame),
+    Hub(datalink::Decoded),
 }
 
-impl MixedFrame {
+impl Found {
     #[inline(always)]
-    fn at(self, offset: u64) -> MixedDecoded {
+    fn at(self, offset: u64) -> Decoded {
         match self {
-            MixedFrame::Esc(frame) => MixedDecoded::Esc(Decoded { offset, frame }),
-            MixedFrame::Hub(mut d) => {
+            Found::Esc(frame) => Decoded::Esc(foc::Decoded { offset, frame }),
+            Found::Hub(mut d) => {
                 d.offset = offset;
-                MixedDecoded::Hub(d)
+                Decoded::Hub(d)
             }
         }
     }
 }
 
 /// The scanner of both protocols, as the streaming layer ([`crate::scan`]) runs it:
-/// [`MixedDecoder`] and [`MixedFrames`] are it under [`StreamDecoder`] and [`Scan`].
+/// [`Decoder`] and [`Frames`] are it under [`StreamDecoder`] and [`Scan`].
 #[derive(Debug, Clone, Copy, Default)]
-pub struct MixedScanner;
+pub struct Scanner;
 
-impl crate::scan::sealed::Sealed for MixedScanner {}
+impl crate::scan::sealed::Sealed for Scanner {}
 
-impl Scanner for MixedScanner {
-    type Item = MixedDecoded;
-    type Stats = MixedStats;
+impl scan::Scanner for Scanner {
+    type Item = Decoded;
+    type Stats = Stats;
     type Held = [u8; MAX_LEN - 1];
     type Pair = [u8; 2 * MAX_LEN];
     const HELD: Self::Held = [0; MAX_LEN - 1];
@@ -243,14 +243,14 @@ impl Scanner for MixedScanner {
     fn scan_all<const AT_END: bool>(
         data: &[u8],
         base: u64,
-        stats: &mut MixedStats,
-        on_frame: &mut impl FnMut(MixedDecoded),
+        stats: &mut Stats,
+        on_frame: &mut impl FnMut(Decoded),
     ) -> usize {
         let mut pos = 0;
         loop {
             // Back-to-back ESC data frames: the HW-FOC scanner's first guess.
-            while let Some((at, frame)) = Frame::take_first(data, &mut pos, &mut stats.esc) {
-                on_frame(MixedDecoded::Esc(Decoded {
+            while let Some((at, frame)) = foc::Frame::take_first(data, &mut pos, &mut stats.esc) {
+                on_frame(Decoded::Esc(foc::Decoded {
                     offset: base + at as u64,
                     frame,
                 }));
@@ -263,7 +263,7 @@ impl Scanner for MixedScanner {
     }
 
     #[inline]
-    fn scan_next(data: &[u8], pos: &mut usize, stats: &mut MixedStats) -> Option<MixedDecoded> {
+    fn scan_next(data: &[u8], pos: &mut usize, stats: &mut Stats) -> Option<Decoded> {
         scan_next(data, pos, stats, true, true).map(|(at, frame)| frame.at(at as u64))
     }
 }
@@ -272,20 +272,20 @@ impl Scanner for MixedScanner {
 /// in any chunking, get every HW-FOC and DataLink frame once, in byte order.
 ///
 /// ```
-/// use hwfoc::datalink::DatalinkFrame;
-/// use hwfoc::mixed::{MixedDecoded, MixedDecoder};
-/// use hwfoc::DataFrame;
+/// use hwfoc::datalink;
+/// use hwfoc::mixed::{Decoded, Decoder};
+/// use hwfoc::foc::DataFrame;
 ///
 /// // An adapter on an ESC, then moved to a hub.
 /// let mut wire = DataFrame { packet: 7, ..Default::default() }.encode().to_vec();
-/// wire.extend_from_slice(&DatalinkFrame::new(1).encode());
-/// let mut decoder = MixedDecoder::new();
+/// wire.extend_from_slice(&datalink::Frame::new(1).encode());
+/// let mut decoder = Decoder::new();
 /// let mut got = Vec::new();
 /// for chunk in wire.chunks(5) {
 ///     decoder.feed(chunk, |d| got.push(d));
 /// }
 /// decoder.flush(|d| got.push(d));
-/// assert!(matches!(got[..], [MixedDecoded::Esc(_), MixedDecoded::Hub(_)]));
+/// assert!(matches!(got[..], [Decoded::Esc(_), Decoded::Hub(_)]));
 /// assert_eq!(decoder.stats().esc.bytes_skipped(), 0);
 /// assert_eq!(decoder.stats().hub.bytes_skipped(), 0);
 /// ```
@@ -293,13 +293,13 @@ impl Scanner for MixedScanner {
 /// # Silences
 ///
 /// [`line_silent_each`](StreamDecoder::line_silent_each) tells it how many frames of each
-/// protocol a silence could have hidden (see [`Decoder`](crate::Decoder) and
-/// [`DatalinkDecoder`](crate::datalink::DatalinkDecoder));
+/// protocol a silence could have hidden (see [`Decoder`](crate::foc::Decoder) and
+/// [`datalink::Decoder`]);
 /// [`line_silent`](StreamDecoder::line_silent) takes ESC data frames and counts nine tenths of
 /// them (rounded up) as hub frames, the hub frames that fit in the same time.
-pub type MixedDecoder = StreamDecoder<MixedScanner>;
+pub type Decoder = StreamDecoder<Scanner>;
 
-impl StreamDecoder<MixedScanner> {
+impl StreamDecoder<Scanner> {
     /// The line was silent for a time in which at most `esc_frames` ESC data frames, or
     /// `hub_frames` DataLink frames, could have been sent: the held bytes are decided at once,
     /// and each protocol's next number step is judged as its own decoder's `line_silent` says.
@@ -307,7 +307,7 @@ impl StreamDecoder<MixedScanner> {
         &mut self,
         esc_frames: u32,
         hub_frames: u32,
-        on_frame: impl FnMut(MixedDecoded),
+        on_frame: impl FnMut(Decoded),
     ) {
         self.flush(on_frame);
         let stats = self.stats_mut();
@@ -317,19 +317,19 @@ impl StreamDecoder<MixedScanner> {
 }
 
 /// Decodes every frame of both protocols in a complete buffer, in place: the bulk path. It
-/// yields exactly what a [`MixedDecoder`] fed the same bytes and then flushed would.
-pub fn frames(data: &[u8]) -> MixedFrames<'_> {
+/// yields exactly what a [`Decoder`] fed the same bytes and then flushed would.
+pub fn frames(data: &[u8]) -> Frames<'_> {
     Scan::new(data)
 }
 
 /// Iterator returned by [`frames`].
-pub type MixedFrames<'a> = Scan<'a, MixedScanner>;
+pub type Frames<'a> = Scan<'a, Scanner>;
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::datalink::DatalinkFrame;
-    use crate::{DataFrame, DatalinkDecoder, Decoder};
+    use crate::foc::DataFrame;
+    use crate::{datalink, foc};
 
     fn esc(packets: core::ops::Range<u16>, out: &mut [u8], at: &mut usize) {
         for packet in packets {
@@ -346,7 +346,7 @@ mod tests {
 
     fn hub(counters: core::ops::Range<u16>, out: &mut [u8], at: &mut usize) {
         for counter in counters {
-            let mut frame = DatalinkFrame::new(counter);
+            let mut frame = datalink::Frame::new(counter);
             for (c, slot) in frame.slots.iter_mut().enumerate() {
                 *slot = Some(DataFrame {
                     packet: 1000 + counter * 8 + c as u16,
@@ -362,7 +362,7 @@ mod tests {
     #[test]
     fn find_header_matches_a_plain_search() {
         let near = [0x16, 0x4C, 0x9E, 0xA0, 0x9F, 0x17];
-        crate::decoder::tests::assert_matches_a_plain_search(
+        crate::foc::decoder::tests::assert_matches_a_plain_search(
             find_header,
             &[0x16, 0x4C, 0x9E, 0xA0],
             near,
@@ -395,13 +395,13 @@ mod tests {
         let (mut escs, mut hubs) = (0, 0);
         let bulk: usize = frames(wire)
             .map(|d| match d {
-                MixedDecoded::Esc(_) => escs += 1,
-                MixedDecoded::Hub(_) => hubs += 1,
+                Decoded::Esc(_) => escs += 1,
+                Decoded::Hub(_) => hubs += 1,
             })
             .count();
         assert_eq!((bulk, escs, hubs), (86, 80, 6));
         for chunk in [1, 2, 3, 5, 24, 77, 159, 160, 161, 1000, n] {
-            let mut d = MixedDecoder::new();
+            let mut d = Decoder::new();
             let mut offsets = [0u64; 86];
             let mut k = 0;
             for c in wire.chunks(chunk) {
@@ -424,10 +424,10 @@ mod tests {
             assert_eq!(s.hub.lost_frames(), 0);
         }
         // Each protocol's own decoder sees only its own frames in the same bytes.
-        let mut own = Decoder::new();
+        let mut own = foc::Decoder::new();
         let mut n_esc = 0;
         own.decode_all(wire, |_| n_esc += 1);
-        let mut own_hub = DatalinkDecoder::new();
+        let mut own_hub = datalink::Decoder::new();
         let mut n_hub = 0;
         own_hub.decode_all(wire, |_| n_hub += 1);
         assert_eq!((n_esc, n_hub), (80, 6));

@@ -9,12 +9,12 @@
 //! the undecided tail (a candidate shorter than its longest frame), which it completes with the
 //! first bytes of the next chunk.
 //!
-//! The scanners are [`HwFocScanner`](crate::decoder::HwFocScanner) (the ESC wire:
-//! [`Decoder`](crate::Decoder), [`frames`](crate::frames)) and
-//! [`DatalinkScanner`](crate::datalink::DatalinkScanner) (the DataLink hub:
-//! [`DatalinkDecoder`](crate::datalink::DatalinkDecoder),
-//! [`datalink::frames`](crate::datalink::frames)); [`MixedScanner`](crate::mixed::MixedScanner)
-//! reads both at once ([`MixedDecoder`](crate::mixed::MixedDecoder)), for a stream that may
+//! The scanners are [`foc::Scanner`](crate::foc::Scanner) (the ESC wire:
+//! [`Decoder`](crate::foc::Decoder), [`frames`](crate::foc::frames)) and
+//! [`datalink::Scanner`](crate::datalink::Scanner) (the DataLink hub:
+//! [`datalink::Decoder`](crate::datalink::Decoder),
+//! [`datalink::frames`](crate::datalink::frames)); [`mixed::Scanner`](crate::mixed::Scanner)
+//! reads both at once ([`mixed::Decoder`](crate::mixed::Decoder)), for a stream that may
 //! carry either. A new protocol is a module with its scanner
 //! and one `impl Scanner`; the trait is sealed (its scanners live in this crate).
 
@@ -82,7 +82,7 @@ pub trait Stats: sealed::Sealed + Clone + fmt::Debug {
 
 /// What a protocol's candidate (where its search for a header stopped) comes to, counted in
 /// its statistics: each protocol decides its own candidates, for its scanner and for
-/// [`MixedScanner`](crate::mixed::MixedScanner).
+/// [`mixed::Scanner`](crate::mixed::Scanner).
 pub(crate) enum Candidate<T> {
     /// A verified frame, taken whole.
     Frame(T),
@@ -110,8 +110,8 @@ pub(crate) mod sealed {
 ///
 /// Its state is a buffer for a candidate still arriving (shorter than the longest frame) and
 /// the statistics: no allocation, no timing. Large chunks are scanned in place; only an
-/// unfinished tail is copied. See [`Decoder`](crate::Decoder) and
-/// [`DatalinkDecoder`](crate::datalink::DatalinkDecoder) for each protocol's.
+/// unfinished tail is copied. See [`Decoder`](crate::foc::Decoder) and
+/// [`datalink::Decoder`](crate::datalink::Decoder) for each protocol's.
 pub struct StreamDecoder<S: Scanner> {
     buf: S::Held,
     len: u8,
@@ -244,8 +244,8 @@ impl<S: Scanner> StreamDecoder<S> {
     /// The silence ends whatever frame was arriving, so the held bytes are decided at once, as
     /// by [`StreamDecoder::flush`]; and the next frame's number step (an ESC's packet number,
     /// a hub's frame counter) counts as a loss only up to `max_frames + 1`: a larger step is a
-    /// restart. Each protocol's decoder says more ([`Decoder`](crate::Decoder),
-    /// [`DatalinkDecoder`](crate::datalink::DatalinkDecoder)).
+    /// restart. Each protocol's decoder says more ([`Decoder`](crate::foc::Decoder),
+    /// [`datalink::Decoder`](crate::datalink::Decoder)).
     pub fn line_silent(&mut self, max_frames: u32, on_frame: impl FnMut(S::Item)) {
         self.flush(on_frame);
         self.stats.line_silent(max_frames);
@@ -269,7 +269,7 @@ impl<S: Scanner> StreamDecoder<S> {
     }
 
     /// The statistics, for a protocol's own silence rule (see
-    /// [`MixedDecoder`](crate::mixed::MixedDecoder)).
+    /// [`mixed::Decoder`](crate::mixed::Decoder)).
     pub(crate) fn stats_mut(&mut self) -> &mut S::Stats {
         &mut self.stats
     }
@@ -284,7 +284,7 @@ impl<S: Scanner> StreamDecoder<S> {
 ///
 /// It borrows the slice and allocates nothing; a frame cut off by the end of the slice is
 /// skipped. It yields exactly what a [`StreamDecoder`] fed the same bytes and then flushed
-/// would, with the same statistics. Made by [`frames`](crate::frames) and
+/// would, with the same statistics. Made by [`frames`](crate::foc::frames) and
 /// [`datalink::frames`](crate::datalink::frames).
 pub struct Scan<'a, S: Scanner> {
     data: &'a [u8],

@@ -16,17 +16,17 @@
 //!
 //! let bytes = [0x9B, 0x16, 0x01, 0x02, 0x05, 0xC2, 0, 0, 0, 0, 0, 0, 0x00, 0xF7,
 //!              0xFF, 0xFF, 0xFF, 0xFF, 0xCE, 0xD1, 0x00, 0x00, 0x0D, 0x08];
-//! let data = Data::from(hwfoc::DataFrame::parse(&bytes)?);
+//! let data = Data::from(hwfoc::foc::DataFrame::parse(&bytes)?);
 //! let s = Settings::default();
 //! assert_eq!(data.packet(), Some(1474));
 //! assert_eq!(data.value(Quantity::Voltage, &s), Some(24.7));
 //! assert_eq!(data.reading(Quantity::Current, &s).map(|r| r.raw), Some(-1));
 //! assert_eq!(data.value(Quantity::MosTemp, &s), Some(28.0));
-//! # Ok::<(), hwfoc::FrameError>(())
+//! # Ok::<(), hwfoc::foc::FrameError>(())
 //! ```
 
-use crate::kinds::data::DataFrame;
-use crate::kinds::info::InfoFrame;
+use crate::foc::kinds::data::DataFrame;
+use crate::foc::kinds::info::InfoFrame;
 use crate::status::Status;
 use crate::units::{Linear, Quantity, Settings, Temperature};
 
@@ -268,12 +268,12 @@ pub enum Frame {
     Info(Info),
 }
 
-impl From<crate::frame::Frame> for Frame {
+impl From<crate::foc::frame::Frame> for Frame {
     #[inline(always)]
-    fn from(frame: crate::frame::Frame) -> Frame {
+    fn from(frame: crate::foc::frame::Frame) -> Frame {
         match frame {
-            crate::frame::Frame::Data(f) => Frame::Data(Data::HwFoc(f)),
-            crate::frame::Frame::Info(i) => Frame::Info(Info::HwFoc(i)),
+            crate::foc::frame::Frame::Data(f) => Frame::Data(Data::HwFoc(f)),
+            crate::foc::frame::Frame::Info(i) => Frame::Info(Info::HwFoc(i)),
         }
     }
 }

@@ -8,7 +8,8 @@
 //! mean) to `f64`, each bit for bit as the formulas written out by hand did:
 //!
 //! ```
-//! use hwfoc::{DataFrame, Quantity, Settings, Telemetry};
+//! use hwfoc::{Quantity, Settings, Telemetry};
+//! use hwfoc::foc::DataFrame;
 //!
 //! let settings = Settings::default(); // current scale 64, 7 pole pairs, gear ratio 1
 //! let frame = DataFrame { erpm_raw: 350, current_raw: -1, ..Default::default() };
@@ -19,7 +20,7 @@
 //! assert_eq!((Quantity::Current.name(), Quantity::Current.unit()), ("current_a", "A"));
 //! ```
 //!
-//! [`DataFrame`]: crate::DataFrame
+//! [`DataFrame`]: crate::foc::DataFrame
 
 use core::fmt;
 

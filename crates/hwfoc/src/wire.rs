@@ -1,12 +1,11 @@
-//! What every HW-FOC frame kind shares on the wire: the line settings, the sync and version
-//! bytes, the header layout, the kinds of check bytes, the errors, and the [`FrameKind`] trait
-//! that each kind implements in its own module under [`crate::kinds`].
+//! What the Hobbywing protocols share on the wire: byte timing ([`byte_ns`]), the sync and
+//! version bytes, and the kinds of check bytes ([`Checksum`]: the sums of HW-FOC
+//! ([`crate::foc`]), the CRC-16/XMODEM of DataLink V2 ([`crate::datalink`])).
 //!
-//! This is the lowest layer of the codec: it knows no particular frame kind. The list of kinds
-//! ([`crate::Frame`], [`crate::frame::MAX_FRAME_LEN`], [`crate::parse`]) is built on top of it in
-//! [`crate::frame`], and the scanner in [`crate::decoder`] on top of that.
+//! This is the lowest layer of the codec: it knows no particular protocol or frame kind. Each
+//! protocol's frames are built on top of it in its own module.
 //!
-//! Every HW-FOC frame has the same outline:
+//! Every HW-FOC frame (and a DataLink V2 frame) has the same outline:
 //!
 //! ```text
 //!  0      1             2        3        4 ..              LEN - w .. LEN
@@ -14,22 +13,24 @@
 //! ```
 //!
 //! The length byte counts the bytes before the check bytes (`LEN - w`) and is what tells the
-//! kinds apart; version and command are then checked against the kind (see `docs/PROTOCOL-NOTES.md`).
+//! kinds apart; version and command are then checked against the kind (see
+//! `docs/PROTOCOL-NOTES.md`).
 
-/// Baud rate of the HW-FOC telemetry wire (8 data bits, no parity, 1 stop bit: 8N1).
-pub const BAUD_RATE: u32 = 19_200;
+use crate::foc::FrameError;
 
 /// Bits on the wire per byte on an 8N1 line: start bit, 8 data bits, stop bit.
 pub const BITS_PER_BYTE: u32 = 10;
 
 /// Duration of one byte on an 8N1 wire at `baud` (a baud rate of 0 is taken as 1), in
-/// nanoseconds: `10e9 / baud`, about 520 833.3 ns at [`BAUD_RATE`].
+/// nanoseconds: `10e9 / baud`, about 520 833.3 ns at HW-FOC's
+/// [`BAUD_RATE`](crate::foc::BAUD_RATE).
 ///
 /// The one definition of byte timing: recorders and simulators that place bytes in time use it,
 /// so that their timestamps agree to the last bit.
 ///
 /// ```
-/// use hwfoc::wire::{BAUD_RATE, byte_ns};
+/// use hwfoc::foc::BAUD_RATE;
+/// use hwfoc::wire::byte_ns;
 ///
 /// assert_eq!(byte_ns(BAUD_RATE), 1e10 / 19200.0);
 /// assert!((24.0 * byte_ns(BAUD_RATE) - 12.5e6).abs() < 1e-3); // a data frame lasts 12.5 ms
@@ -127,9 +128,9 @@ pub const fn crc16_ccitt(mut crc: u16, bytes: &[u8]) -> u16 {
 
 /// How a frame kind protects its bytes: the check bytes at the end of the frame.
 ///
-/// Each kind names one in [`FrameKind::CHECKSUM`] (and the DataLink frame of
-/// [`crate::datalink`] uses [`Checksum::Crc16Xmodem`]); the shared code computes, verifies and
-/// writes it. A new kind of check is one more arm here and in the methods below.
+/// Each kind names one in [`FrameKind::CHECKSUM`](crate::foc::FrameKind::CHECKSUM) (and the
+/// DataLink frame of [`crate::datalink`] uses [`Checksum::Crc16Xmodem`]); the shared code computes,
+/// verifies and writes it. A new kind of check is one more arm here and in the methods below.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 #[non_exhaustive]
 pub enum Checksum {
@@ -218,182 +219,10 @@ impl Checksum {
     }
 }
 
-/// A kind of frame: its header, length, check bytes and payload layout.
-///
-/// Each kind lives in its own module under [`crate::kinds`] and has one arm in [`crate::Frame`];
-/// the scanner and [`crate::parse`] reach it only through this trait, with every constant known at
-/// compile time (no `dyn`, no function pointers: after inlining, the code is what a hand-written
-/// check of that one kind would be). See [`crate::frame`] for how to add a kind.
-///
-/// The trait is sealed: a kind is only useful with its arm in [`crate::Frame`], so it is
-/// implemented inside this crate. Its constants and provided methods are for everyone.
-///
-/// ```
-/// use hwfoc::{DataFrame, FrameKind, InfoFrame};
-///
-/// assert_eq!(DataFrame::HEADER, [0x9B, 0x16, 0x01, 0x02]);
-/// assert_eq!((DataFrame::LEN, InfoFrame::LEN), (24, 77));
-/// let bytes = InfoFrame::new("XR_FOC_ESC", "", "", "")?.encode();
-/// assert_eq!(<InfoFrame as FrameKind>::parse(&bytes)?.product(), "XR_FOC_ESC");
-/// # Ok::<(), Box<dyn core::error::Error>>(())
-/// ```
-pub trait FrameKind: Sized + Copy + sealed::Sealed {
-    /// Byte 1: the number of bytes before the check bytes (`LEN - CHECKSUM.width()`), from
-    /// which the scanner knows a candidate's length. Kinds are told apart by their whole
-    /// [`FrameKind::HEADER`]: two may share a length byte if they share a length.
-    const LENGTH_BYTE: u8;
-    /// Byte 2: the protocol version.
-    const VERSION: u8;
-    /// Byte 3: the command.
-    const COMMAND: u8;
-    /// Length of the whole frame on the wire, check bytes included.
-    const LEN: usize;
-    /// The check bytes that end the frame.
-    const CHECKSUM: Checksum;
-    /// The first four bytes of every frame of this kind.
-    const HEADER: [u8; 4] = [SYNC, Self::LENGTH_BYTE, Self::VERSION, Self::COMMAND];
-    /// [`FrameKind::HEADER`] as a little-endian `u32`, to compare four bytes at once.
-    const HEADER_WORD: u32 = u32::from_le_bytes(Self::HEADER);
-
-    /// Checks and decodes a candidate whose sync and length bytes already matched, from its
-    /// first [`FrameKind::LEN`] bytes: check bytes first, then version and command, then the
-    /// kind's own rules (a device-information frame's text must be ASCII).
-    #[inline(always)]
-    fn verify(candidate: &[u8]) -> Result<Self, FrameError> {
-        let Some(frame) = candidate.get(..Self::LEN) else {
-            return Err(FrameError::Truncated {
-                needed: Self::LEN,
-                got: candidate.len(),
-            });
-        };
-        Self::CHECKSUM.verify(frame)?;
-        if frame[2] != Self::VERSION || frame[3] != Self::COMMAND {
-            return Err(FrameError::UnknownCommand {
-                version: frame[2],
-                command: frame[3],
-            });
-        }
-        Self::read(frame)
-    }
-
-    /// The scanner's verdict on a candidate that starts with the sync byte and a known length
-    /// byte: `Some` exactly when [`FrameKind::verify`] would succeed (and `None` when fewer than
-    /// [`FrameKind::LEN`] bytes are given).
-    ///
-    /// It runs at every candidate, for every kind until one accepts, so it is tuned for what it
-    /// mostly sees: the default compares the header first and verifies only a match; a kind may
-    /// order its checks otherwise (the data frame decides with one branch).
-    #[inline(always)]
-    fn accept(candidate: &[u8]) -> Option<Self> {
-        let frame = candidate.get(..Self::LEN)?;
-        let header = u32::from_le_bytes([frame[0], frame[1], frame[2], frame[3]]);
-        if header != Self::HEADER_WORD {
-            return None;
-        }
-        Self::verify(frame).ok()
-    }
-
-    /// Decodes a frame of this kind from the first [`FrameKind::LEN`] bytes of `bytes`, checking
-    /// everything: length, sync byte, length byte, then as [`FrameKind::verify`]. Bytes after the
-    /// frame are ignored.
-    fn parse(bytes: &[u8]) -> Result<Self, FrameError> {
-        let Some(frame) = bytes.get(..Self::LEN) else {
-            return Err(FrameError::Truncated {
-                needed: Self::LEN,
-                got: bytes.len(),
-            });
-        };
-        if frame[0] != SYNC {
-            return Err(FrameError::NoSync { found: frame[0] });
-        }
-        if frame[1] != Self::LENGTH_BYTE {
-            return Err(FrameError::UnknownLength { found: frame[1] });
-        }
-        Self::verify(frame)
-    }
-
-    /// Encodes the frame into the start of `out` (header, payload, check bytes) and returns the
-    /// number of bytes written, [`FrameKind::LEN`], or `None` when `out` is shorter.
-    fn encode_into(&self, out: &mut [u8]) -> Option<usize> {
-        let frame = out.get_mut(..Self::LEN)?;
-        frame[..4].copy_from_slice(&Self::HEADER);
-        self.write(&mut frame[4..Self::LEN - Self::CHECKSUM.width()]);
-        Self::CHECKSUM.seal(frame);
-        Some(Self::LEN)
-    }
-}
-
-/// The part of [`FrameKind`] only this crate uses (and the seal: no kind outside the crate).
-pub(crate) mod sealed {
-    use crate::stats::LinkStats;
-    use crate::wire::FrameError;
-
-    /// Crate-internal methods of a frame kind: reading and writing its payload, counting it.
-    pub trait Sealed: Sized {
-        /// Reads the fields of `frame`, exactly `LEN` bytes whose header and check bytes are
-        /// already verified, and applies the kind's own rules (a device-information frame's
-        /// text must be ASCII).
-        fn read(frame: &[u8]) -> Result<Self, FrameError>;
-
-        /// Writes the payload into `payload`, exactly bytes `4..LEN - CHECKSUM.width()` of a
-        /// frame (it may panic given another length).
-        fn write(&self, payload: &mut [u8]);
-
-        /// Counts an accepted frame of this kind in the link statistics.
-        fn count(&self, stats: &mut LinkStats);
-    }
-}
-
-/// Why bytes are not a valid frame.
-///
-/// Its [`Display`](core::fmt::Display) is implemented in [`crate::frame`], beside the list of kinds,
-/// because the message for an unknown length byte names every kind's.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-pub enum FrameError {
-    /// The first byte is not the sync byte 0x9B.
-    NoSync {
-        /// The byte found instead.
-        found: u8,
-    },
-    /// The length byte is not that of any known frame kind (0x16 data, 0x4C device information).
-    UnknownLength {
-        /// The length byte found.
-        found: u8,
-    },
-    /// Fewer bytes than a whole frame.
-    Truncated {
-        /// Bytes a whole frame has.
-        needed: usize,
-        /// Bytes given.
-        got: usize,
-    },
-    /// The checksum does not match the bytes: the frame was corrupted on the wire.
-    Checksum {
-        /// Checksum computed over the received bytes.
-        expected: u16,
-        /// Checksum carried by the frame.
-        found: u16,
-    },
-    /// Checksum correct, but a version or command this decoder does not know.
-    UnknownCommand {
-        /// Version byte (byte 2).
-        version: u8,
-        /// Command byte (byte 3).
-        command: u8,
-    },
-    /// A device-information candidate whose text holds a byte that is not ASCII: not a real
-    /// frame (typically a cut one with another frame behind it).
-    NotText {
-        /// Offset of the first such byte in the frame.
-        offset: usize,
-        /// The byte.
-        found: u8,
-    },
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::foc::BAUD_RATE;
 
     #[test]
     fn byte_ns_is_the_recorders_formula() {

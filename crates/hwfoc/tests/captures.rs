@@ -2,7 +2,8 @@
 //! `shared/captures/`, kept in the repository so that a clone alone passes; see
 //! `testdata/README.md` for their source).
 
-use hwfoc::{DataFrame, Decoded, Decoder, Frame, InfoFrame, LinkStats, Settings, frames};
+use hwfoc::foc::{DataFrame, Decoded, Decoder, Frame, InfoFrame, frames};
+use hwfoc::{Settings, foc};
 
 const CAPTURES: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../testdata/captures/");
 const XROTOR: &str = "xrotor-v4-pro-hv-80A.csv";
@@ -51,13 +52,13 @@ fn load(name: &str) -> Capture {
     capture
 }
 
-fn bulk(bytes: &[u8]) -> (Vec<Decoded>, LinkStats) {
+fn bulk(bytes: &[u8]) -> (Vec<Decoded>, foc::Stats) {
     let mut it = frames(bytes);
     let out: Vec<Decoded> = it.by_ref().collect();
     (out, *it.stats())
 }
 
-fn streamed_bytewise(bytes: &[u8]) -> (Vec<Decoded>, LinkStats) {
+fn streamed_bytewise(bytes: &[u8]) -> (Vec<Decoded>, foc::Stats) {
     let mut d = Decoder::new();
     let mut out = Vec::new();
     for &b in bytes {
@@ -67,7 +68,7 @@ fn streamed_bytewise(bytes: &[u8]) -> (Vec<Decoded>, LinkStats) {
     (out, *d.stats())
 }
 
-fn streamed_chunks(bytes: &[u8], size: usize) -> (Vec<Decoded>, LinkStats) {
+fn streamed_chunks(bytes: &[u8], size: usize) -> (Vec<Decoded>, foc::Stats) {
     let mut d = Decoder::new();
     let mut out = Vec::new();
     for chunk in bytes.chunks(size) {

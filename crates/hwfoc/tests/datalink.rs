@@ -6,13 +6,11 @@
 mod common;
 
 use common::{cut_points, data_frame, streamed_bytewise};
-use hwfoc::datalink::{
-    self, CHANNELS, DatalinkDecoded, DatalinkDecoder, DatalinkError, DatalinkFrame,
-    DatalinkScanner, DatalinkStats, FRAME_LEN, FrameReport, LengthByte, RECORD_LEN, RECORDS_AT,
-};
-use hwfoc::stats::MAX_PACKET_GAP;
+use hwfoc::Status;
+use hwfoc::counters::MAX_PACKET_GAP;
+use hwfoc::datalink::{self, CHANNELS, FRAME_LEN, FrameReport, LengthByte, RECORD_LEN, RECORDS_AT};
+use hwfoc::foc::DataFrame;
 use hwfoc::wire::{Checksum, crc16_xmodem};
-use hwfoc::{DataFrame, Status};
 use proptest::collection::vec;
 use proptest::prelude::*;
 use proptest::sample::Index;
@@ -31,7 +29,7 @@ fn slot() -> impl Strategy<Value = Option<DataFrame>> {
     ]
 }
 
-fn datalink_frame() -> impl Strategy<Value = DatalinkFrame> {
+fn datalink_frame() -> impl Strategy<Value = datalink::Frame> {
     (
         any::<u16>(),
         [
@@ -45,7 +43,7 @@ fn datalink_frame() -> impl Strategy<Value = DatalinkFrame> {
             slot(),
         ],
     )
-        .prop_map(|(counter, slots)| DatalinkFrame { counter, slots })
+        .prop_map(|(counter, slots)| datalink::Frame { counter, slots })
 }
 
 /// An ESC whose record is never empty on the wire.
@@ -61,7 +59,7 @@ fn length_byte() -> impl Strategy<Value = LengthByte> {
 }
 
 /// What a frame reads back as: an all-zero ESC is an empty slot.
-fn normalized(f: &DatalinkFrame) -> DatalinkFrame {
+fn normalized(f: &datalink::Frame) -> datalink::Frame {
     let mut f = *f;
     for slot in &mut f.slots {
         if *slot == Some(DataFrame::default()) {
@@ -88,13 +86,13 @@ fn noisy_byte() -> impl Strategy<Value = u8> {
 #[derive(Debug, Clone)]
 enum Piece {
     /// A whole, valid frame.
-    Intact(DatalinkFrame, LengthByte),
+    Intact(datalink::Frame, LengthByte),
     /// Noise.
     Garbage(Vec<u8>),
     /// The first `n` bytes of a frame (`1 <= n < 160`).
-    Cut(DatalinkFrame, LengthByte, usize),
+    Cut(datalink::Frame, LengthByte, usize),
     /// A frame with one bit flipped.
-    Flipped(DatalinkFrame, LengthByte, usize),
+    Flipped(datalink::Frame, LengthByte, usize),
     /// A header with nothing of its frame after it.
     Fake(&'static [u8]),
 }
@@ -126,7 +124,7 @@ fn pieces(max: usize) -> impl Strategy<Value = Vec<Piece>> {
 /// A wire and the intact frames put into it, with their offsets and length bytes.
 struct Wire {
     bytes: Vec<u8>,
-    intact: Vec<(u64, DatalinkFrame, LengthByte)>,
+    intact: Vec<(u64, datalink::Frame, LengthByte)>,
 }
 
 fn build(pieces: &[Piece]) -> Wire {
@@ -157,7 +155,7 @@ fn build(pieces: &[Piece]) -> Wire {
 /// Whether a valid frame, formed by chance, starts outside the intact frames and overlaps one:
 /// a CRC matching by chance (about 1 in 65536 per candidate running into an intact frame). The
 /// CRC cannot settle such a wire; the tests that need every intact frame found discard it.
-fn ambiguous(bytes: &[u8], intact: &[(u64, DatalinkFrame, LengthByte)]) -> bool {
+fn ambiguous(bytes: &[u8], intact: &[(u64, datalink::Frame, LengthByte)]) -> bool {
     let spans: Vec<(usize, usize)> = intact
         .iter()
         .map(|(o, _, _)| (*o as usize, *o as usize + FRAME_LEN))
@@ -165,7 +163,7 @@ fn ambiguous(bytes: &[u8], intact: &[(u64, DatalinkFrame, LengthByte)]) -> bool 
     (0..bytes.len())
         .filter(|&p| !spans.iter().any(|&(s, e)| (s..e).contains(&p)))
         .any(|p| {
-            DatalinkFrame::parse(&bytes[p..]).is_ok()
+            datalink::Frame::parse(&bytes[p..]).is_ok()
                 && spans.iter().any(|&(s, e)| p < e && s < p + FRAME_LEN)
         })
 }
@@ -174,15 +172,15 @@ fn ambiguous(bytes: &[u8], intact: &[(u64, DatalinkFrame, LengthByte)]) -> bool 
 // Decoding paths and the reference scanner
 // ---------------------------------------------------------------------------------------------
 
-fn bulk(bytes: &[u8]) -> (Vec<DatalinkDecoded>, DatalinkStats) {
+fn bulk(bytes: &[u8]) -> (Vec<datalink::Decoded>, datalink::Stats) {
     let mut it = datalink::frames(bytes);
-    let out: Vec<DatalinkDecoded> = it.by_ref().collect();
+    let out: Vec<datalink::Decoded> = it.by_ref().collect();
     assert_eq!(it.next(), None);
     (out, *it.stats())
 }
 
-fn streamed_at(bytes: &[u8], cuts: &[usize]) -> (Vec<DatalinkDecoded>, DatalinkStats) {
-    let mut d = DatalinkDecoder::new();
+fn streamed_at(bytes: &[u8], cuts: &[usize]) -> (Vec<datalink::Decoded>, datalink::Stats) {
+    let mut d = datalink::Decoder::new();
     let mut out = Vec::new();
     for w in cuts.windows(2) {
         d.feed(&bytes[w[0]..w[1]], |x| out.push(x));
@@ -229,7 +227,7 @@ impl RefSequence {
         self.last = Some(n);
     }
 
-    fn matches(&self, s: &hwfoc::PacketSequence) -> bool {
+    fn matches(&self, s: &hwfoc::counters::PacketSequence) -> bool {
         (s.count(), s.lost(), s.duplicates(), s.restarts(), s.last())
             == (
                 self.count,
@@ -241,7 +239,7 @@ impl RefSequence {
     }
 }
 
-/// Counters of the reference scanner, named as in `DatalinkStats`.
+/// Counters of the reference scanner, named as in `datalink::Stats`.
 #[derive(Debug, Default)]
 struct RefStats {
     bytes_skipped: u64,
@@ -259,7 +257,7 @@ struct RefStats {
 /// a candidate whose bytes 2, 3 are not `01 02` is rejected there, else one whose 160 bytes are
 /// there is a frame if its CRC matches (its records read by channel byte, one at a time), else
 /// rejected; a rejected or cut candidate costs one byte.
-fn reference(bytes: &[u8]) -> (Vec<DatalinkDecoded>, RefStats) {
+fn reference(bytes: &[u8]) -> (Vec<datalink::Decoded>, RefStats) {
     let (out, s, _) = reference_scan(bytes, true);
     (out, s)
 }
@@ -273,7 +271,7 @@ fn reference_held(bytes: &[u8]) -> usize {
 
 /// The reference scanner over `bytes`; unless `at_end`, it stops at the first undecided
 /// candidate and also returns how many bytes are left from there.
-fn reference_scan(bytes: &[u8], at_end: bool) -> (Vec<DatalinkDecoded>, RefStats, usize) {
+fn reference_scan(bytes: &[u8], at_end: bool) -> (Vec<datalink::Decoded>, RefStats, usize) {
     let mut s = RefStats::default();
     let mut out = Vec::new();
     let mut i = 0;
@@ -295,7 +293,7 @@ fn reference_scan(bytes: &[u8], at_end: bool) -> (Vec<DatalinkDecoded>, RefStats
             let f = &bytes[i..i + FRAME_LEN];
             if crc16_xmodem(&f[..158]) == u16::from(f[158]) | u16::from(f[159]) << 8 {
                 let (frame, report) = reference_read(f, &mut s);
-                out.push(DatalinkDecoded {
+                out.push(datalink::Decoded {
                     offset: i as u64,
                     frame,
                     report,
@@ -311,7 +309,7 @@ fn reference_scan(bytes: &[u8], at_end: bool) -> (Vec<DatalinkDecoded>, RefStats
     (out, s, 0)
 }
 
-fn reference_read(f: &[u8], s: &mut RefStats) -> (DatalinkFrame, FrameReport) {
+fn reference_read(f: &[u8], s: &mut RefStats) -> (datalink::Frame, FrameReport) {
     let length_byte = if f[1] == 0x9E {
         LengthByte::Covered
     } else {
@@ -320,7 +318,7 @@ fn reference_read(f: &[u8], s: &mut RefStats) -> (DatalinkFrame, FrameReport) {
     s.length_bytes[usize::from(f[1] == 0xA0)] += 1;
     let counter = u16::from_be_bytes([f[4], f[5]]);
     s.counter.next(counter);
-    let mut frame = DatalinkFrame::new(counter);
+    let mut frame = datalink::Frame::new(counter);
     let mut report = FrameReport {
         length_byte,
         empty_slots: 0,
@@ -363,7 +361,7 @@ fn reference_read(f: &[u8], s: &mut RefStats) -> (DatalinkFrame, FrameReport) {
 }
 
 /// Checks `stats` against the reference's, and the invariants every stream keeps.
-fn assert_stats(bytes: &[u8], stats: &DatalinkStats, r: &RefStats) {
+fn assert_stats(bytes: &[u8], stats: &datalink::Stats, r: &RefStats) {
     assert_eq!(stats.bytes(), bytes.len() as u64);
     assert_eq!(stats.bytes_skipped(), r.bytes_skipped);
     assert_eq!(stats.crc_failures(), r.crc_failures);
@@ -409,7 +407,7 @@ fn assert_stats(bytes: &[u8], stats: &DatalinkStats, r: &RefStats) {
 }
 
 /// Decodes `bytes` every way and checks them all against the reference; returns the frames.
-fn decode_checked(bytes: &[u8], picks: &[Index]) -> (Vec<DatalinkDecoded>, DatalinkStats) {
+fn decode_checked(bytes: &[u8], picks: &[Index]) -> (Vec<datalink::Decoded>, datalink::Stats) {
     let (frames, stats) = bulk(bytes);
     let (ref_frames, ref_stats) = reference(bytes);
     assert_eq!(frames, ref_frames, "frames() and the reference scanner");
@@ -421,18 +419,18 @@ fn decode_checked(bytes: &[u8], picks: &[Index]) -> (Vec<DatalinkDecoded>, Datal
         "chunked"
     );
     assert_eq!(
-        streamed_bytewise::<DatalinkScanner>(bytes),
+        streamed_bytewise::<datalink::Scanner>(bytes),
         (frames.clone(), stats),
         "bytewise"
     );
-    let mut all = DatalinkDecoder::new();
+    let mut all = datalink::Decoder::new();
     let mut got = Vec::new();
     all.decode_all(bytes, |d| got.push(d));
     assert_eq!((got, *all.stats()), (frames.clone(), stats), "decode_all");
     for d in &frames {
         let at = d.offset as usize;
         assert_eq!(
-            DatalinkFrame::parse_with_report(&bytes[at..]),
+            datalink::Frame::parse_with_report(&bytes[at..]),
             Ok((d.frame, d.report))
         );
     }
@@ -466,7 +464,7 @@ proptest! {
         let back = normalized(&f);
         let empties = back.slots.iter().filter(|s| s.is_none()).count() as u8;
         prop_assert_eq!(
-            DatalinkFrame::parse_with_report(&bytes),
+            datalink::Frame::parse_with_report(&bytes),
             Ok((back, FrameReport {
                 length_byte: l,
                 empty_slots: empties,
@@ -504,7 +502,7 @@ proptest! {
         expected.slots[which] = None;
         let empties = f.slots.iter().filter(|s| s.is_none()).count() as u8;
         prop_assert_eq!(
-            DatalinkFrame::parse_with_report(&bytes),
+            datalink::Frame::parse_with_report(&bytes),
             Ok((expected, FrameReport {
                 length_byte: l,
                 empty_slots: empties,
@@ -538,7 +536,7 @@ proptest! {
         Checksum::Crc16Xmodem.seal(&mut bytes);
         let mut expected = f;
         expected.slots[second] = None;
-        let (frame, report) = DatalinkFrame::parse_with_report(&bytes).unwrap();
+        let (frame, report) = datalink::Frame::parse_with_report(&bytes).unwrap();
         prop_assert_eq!(frame, expected);
         prop_assert_eq!((report.duplicate_channels, report.bad_channels), (1, 0));
         // And the other way round: the earlier record claims the later one's channel, which
@@ -564,7 +562,7 @@ proptest! {
     ) {
         let mut bytes = f.encode_as(l);
         bytes[bit / 8] ^= 1 << (bit % 8);
-        prop_assert!(DatalinkFrame::parse(&bytes).is_err());
+        prop_assert!(datalink::Frame::parse(&bytes).is_err());
         let (decoded, stats) = decode_checked(&bytes, &[]);
         prop_assert!(decoded.is_empty());
         prop_assert_eq!(stats.bytes_skipped(), 160);
@@ -574,7 +572,7 @@ proptest! {
 /// Every single-bit flip of a few frames, exhaustively (1280 flips each).
 #[test]
 fn every_single_bit_flip_is_rejected() {
-    let mut full = DatalinkFrame::new(0xFFFF);
+    let mut full = datalink::Frame::new(0xFFFF);
     for (ch, slot) in full.slots.iter_mut().enumerate() {
         *slot = Some(DataFrame {
             packet: 100 * ch as u16,
@@ -584,13 +582,13 @@ fn every_single_bit_flip_is_rejected() {
             ..Default::default()
         });
     }
-    for frame in [DatalinkFrame::new(0), full] {
+    for frame in [datalink::Frame::new(0), full] {
         for l in LengthByte::ALL {
             let good = frame.encode_as(l);
             for bit in 0..FRAME_LEN * 8 {
                 let mut bytes = good;
                 bytes[bit / 8] ^= 1 << (bit % 8);
-                assert!(DatalinkFrame::parse(&bytes).is_err(), "bit {bit}");
+                assert!(datalink::Frame::parse(&bytes).is_err(), "bit {bit}");
                 let (decoded, _) = bulk(&bytes);
                 assert!(decoded.is_empty(), "bit {bit}");
             }
@@ -641,7 +639,7 @@ proptest! {
         let wire = build(&ps);
         prop_assume!(!ambiguous(&wire.bytes, &wire.intact));
         let (decoded, stats) = decode_checked(&wire.bytes, &[]);
-        let found: Vec<(u64, DatalinkFrame, LengthByte)> = decoded
+        let found: Vec<(u64, datalink::Frame, LengthByte)> = decoded
             .iter()
             .filter(|d| wire.intact.iter().any(|(o, _, _)| *o == d.offset))
             .map(|d| (d.offset, d.frame, d.report.length_byte))
@@ -672,7 +670,7 @@ proptest! {
         let mut sent = 0u32;
         let mut dropped_inside = 0u32;
         for (i, &corrupt) in corrupt.iter().enumerate().take(n) {
-            let mut f = DatalinkFrame::new(start.wrapping_add(i as u16));
+            let mut f = datalink::Frame::new(start.wrapping_add(i as u16));
             for (ch, &p) in packets.iter().enumerate() {
                 f.slots[2 * ch] = Some(DataFrame { packet: p.wrapping_add(i as u16), voltage_raw: 1, ..Default::default() });
             }
@@ -718,7 +716,7 @@ fn encoder_matches_an_independent_crc() {
         0xCE, 0xD1, 0x00, 0x00, 0x0D, 0x08,
     ])
     .unwrap();
-    let mut f = DatalinkFrame::new(1);
+    let mut f = datalink::Frame::new(1);
     f.slots[0] = Some(esc);
     let b = f.encode();
     assert_eq!(b[..7], [0x9B, 0x9E, 0x01, 0x02, 0x00, 0x01, 0x00]);
@@ -748,7 +746,7 @@ fn both_length_bytes_are_counted() {
     .into_iter()
     .enumerate()
     {
-        wire.extend_from_slice(&DatalinkFrame::new(i as u16).encode_as(l));
+        wire.extend_from_slice(&datalink::Frame::new(i as u16).encode_as(l));
     }
     let (decoded, stats) = decode_checked(&wire, &[]);
     assert_eq!(decoded.len(), 5);
@@ -763,10 +761,10 @@ fn both_length_bytes_are_counted() {
 #[test]
 fn one_non_zero_byte_makes_a_record() {
     for at in 0..18 {
-        let mut b = DatalinkFrame::new(5).encode();
+        let mut b = datalink::Frame::new(5).encode();
         b[RECORDS_AT + 2 * RECORD_LEN + 1 + at] = 0x80;
         Checksum::Crc16Xmodem.seal(&mut b);
-        let (frame, report) = DatalinkFrame::parse_with_report(&b).unwrap();
+        let (frame, report) = datalink::Frame::parse_with_report(&b).unwrap();
         assert!(frame.slots[2].is_some(), "{at}");
         assert_eq!(frame.escs().count(), 1);
         assert_eq!(report.empty_slots, 7);
@@ -778,12 +776,12 @@ fn one_non_zero_byte_makes_a_record() {
 #[test]
 fn other_length_bytes_are_not_frames() {
     for length in [0x9D, 0x9F, 0xA1, 0x16, 0x4C] {
-        let mut b = DatalinkFrame::new(5).encode();
+        let mut b = datalink::Frame::new(5).encode();
         b[1] = length;
         Checksum::Crc16Xmodem.seal(&mut b);
         assert_eq!(
-            DatalinkFrame::parse(&b),
-            Err(DatalinkError::UnknownLength { found: length })
+            datalink::Frame::parse(&b),
+            Err(datalink::Error::UnknownLength { found: length })
         );
         let (decoded, stats) = decode_checked(&b, &[]);
         assert!(decoded.is_empty());
@@ -795,13 +793,13 @@ fn other_length_bytes_are_not_frames() {
 /// byte: the frame right behind the fake header's `9B` is still found.
 #[test]
 fn bad_header_costs_one_byte() {
-    let good = DatalinkFrame::new(77).encode();
+    let good = datalink::Frame::new(77).encode();
     let mut bad = good;
     bad[3] = 0x01;
     Checksum::Crc16Xmodem.seal(&mut bad);
     assert_eq!(
-        DatalinkFrame::parse(&bad),
-        Err(DatalinkError::UnknownCommand {
+        datalink::Frame::parse(&bad),
+        Err(datalink::Error::UnknownCommand {
             version: 1,
             command: 1
         })
@@ -820,8 +818,8 @@ fn bad_header_costs_one_byte() {
 /// as a CRC failure; a frame cut by the end of the stream is skipped and not counted.
 #[test]
 fn cut_frames() {
-    let a = DatalinkFrame::new(1).encode();
-    let mut b = DatalinkFrame::new(2);
+    let a = datalink::Frame::new(1).encode();
+    let mut b = datalink::Frame::new(2);
     b.slots[4] = Some(DataFrame {
         packet: 9,
         ..Default::default()
@@ -836,7 +834,7 @@ fn cut_frames() {
     assert_eq!(decoded[0].frame.slots[4].map(|e| e.packet), Some(9));
     assert_eq!(stats.crc_failures(), 1);
     assert_eq!(stats.bytes_skipped(), 250);
-    let mut d = DatalinkDecoder::new();
+    let mut d = datalink::Decoder::new();
     d.feed(&wire, |_| {});
     assert_eq!(d.buffered(), 150);
     d.flush(|_| {});
@@ -847,7 +845,7 @@ fn cut_frames() {
 /// (a field of 0x9B9E), never hide or split a frame.
 #[test]
 fn sync_bytes_inside_records() {
-    let mut f = DatalinkFrame::new(0x9B9E);
+    let mut f = datalink::Frame::new(0x9B9E);
     for slot in &mut f.slots {
         *slot = Some(DataFrame {
             packet: 0x9BA0,
@@ -875,7 +873,7 @@ fn sync_bytes_inside_records() {
 /// an ESC's stream: each wire's bytes are all skipped by the other.
 #[test]
 fn the_two_decoders_do_not_see_each_others_frames() {
-    let mut f = DatalinkFrame::new(1);
+    let mut f = datalink::Frame::new(1);
     f.slots[0] = Some(DataFrame {
         packet: 5,
         voltage_raw: 252,
@@ -892,7 +890,7 @@ fn the_two_decoders_do_not_see_each_others_frames() {
             .encode(),
         );
     }
-    assert_eq!(hwfoc::frames(&hub).count(), 0);
+    assert_eq!(hwfoc::foc::frames(&hub).count(), 0);
     let (decoded, stats) = decode_checked(&esc, &[]);
     assert!(decoded.is_empty());
     assert_eq!(stats.bytes_skipped(), esc.len() as u64);
@@ -903,14 +901,14 @@ fn the_two_decoders_do_not_see_each_others_frames() {
 #[test]
 fn line_silent_limits_counter_and_channels() {
     let frame = |counter: u16, packet: u16| {
-        let mut f = DatalinkFrame::new(counter);
+        let mut f = datalink::Frame::new(counter);
         f.slots[6] = Some(DataFrame {
             packet,
             ..Default::default()
         });
         f.encode()
     };
-    let mut d = DatalinkDecoder::new();
+    let mut d = datalink::Decoder::new();
     let mut n = 0;
     d.feed(&frame(10, 500), |_| n += 1);
     d.feed(&frame(11, 501)[..90], |_| n += 1);
@@ -925,29 +923,29 @@ fn line_silent_limits_counter_and_channels() {
     assert_eq!((ch.lost(), ch.restarts()), (9, 0));
     assert_eq!(s.bytes_skipped(), 90);
     d.reset();
-    assert_eq!(d.stats(), &DatalinkStats::new());
+    assert_eq!(d.stats(), &datalink::Stats::new());
 }
 
 #[test]
 fn error_messages() {
     let cases = [
         (
-            DatalinkError::Truncated { got: 3 },
+            datalink::Error::Truncated { got: 3 },
             "truncated DataLink frame: 3 of 160 bytes",
         ),
         (
-            DatalinkError::NoSync { found: 0 },
+            datalink::Error::NoSync { found: 0 },
             "DataLink frame starts with 0x00, not the sync byte 0x9B",
         ),
         (
-            DatalinkError::UnknownCommand {
+            datalink::Error::UnknownCommand {
                 version: 1,
                 command: 3,
             },
             "unknown DataLink version 0x01 / command 0x03 (expected 01 02)",
         ),
         (
-            DatalinkError::Crc {
+            datalink::Error::Crc {
                 expected: 0x31C3,
                 found: 0xC331,
             },
@@ -961,7 +959,7 @@ fn error_messages() {
 
 #[test]
 fn stats_display_names_every_counter() {
-    let (_, stats) = bulk(&DatalinkFrame::new(1).encode_as(LengthByte::Total));
+    let (_, stats) = bulk(&datalink::Frame::new(1).encode_as(LengthByte::Total));
     assert_eq!(
         stats.to_string(),
         "160 bytes, 1 frames (0 with length byte 0x9E, 1 with 0xA0), 0 CRC failures, \

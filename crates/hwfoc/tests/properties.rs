@@ -7,14 +7,13 @@
 mod common;
 
 use common::{cut_points, data_frame, streamed_bytewise};
-use hwfoc::decoder::HwFocScanner;
-use hwfoc::kinds::data::DATA_FRAME_LEN;
-use hwfoc::kinds::info::INFO_FRAME_LEN;
-use hwfoc::stats::MAX_PACKET_GAP;
-use hwfoc::{
-    DataFrame, Decoded, Decoder, Frame, FrameError, InfoFrame, LinkStats, Parsed, Status, frames,
-    parse,
+use hwfoc::counters::MAX_PACKET_GAP;
+use hwfoc::foc::kinds::data::DATA_FRAME_LEN;
+use hwfoc::foc::kinds::info::INFO_FRAME_LEN;
+use hwfoc::foc::{
+    DataFrame, Decoded, Decoder, Frame, FrameError, InfoFrame, Parsed, frames, parse,
 };
+use hwfoc::{Status, foc};
 use proptest::collection::vec;
 use proptest::prelude::*;
 use proptest::sample::Index;
@@ -126,13 +125,13 @@ fn build(pieces: &[Piece]) -> Wire {
 // Decoding paths
 // ---------------------------------------------------------------------------------------------
 
-fn bulk(bytes: &[u8]) -> (Vec<Decoded>, LinkStats) {
+fn bulk(bytes: &[u8]) -> (Vec<Decoded>, foc::Stats) {
     let mut it = frames(bytes);
     let out: Vec<Decoded> = it.by_ref().collect();
     (out, *it.stats())
 }
 
-fn streamed_at(bytes: &[u8], cuts: &[usize]) -> (Vec<Decoded>, LinkStats) {
+fn streamed_at(bytes: &[u8], cuts: &[usize]) -> (Vec<Decoded>, foc::Stats) {
     let mut d = Decoder::new();
     let mut out = Vec::new();
     for w in cuts.windows(2) {
@@ -144,7 +143,7 @@ fn streamed_at(bytes: &[u8], cuts: &[usize]) -> (Vec<Decoded>, LinkStats) {
     (out, *d.stats())
 }
 
-/// Counters of the naive reference scanner, named as in [`LinkStats`].
+/// Counters of the naive reference scanner, named as in [`foc::Stats`].
 #[derive(Debug, Default, PartialEq)]
 struct RefStats {
     bytes: u64,
@@ -160,8 +159,8 @@ struct RefStats {
     silent_frames: Option<u64>,
 }
 
-impl From<&LinkStats> for RefStats {
-    fn from(s: &LinkStats) -> Self {
+impl From<&foc::Stats> for RefStats {
+    fn from(s: &foc::Stats) -> Self {
         RefStats {
             bytes: s.bytes(),
             bytes_skipped: s.bytes_skipped(),
@@ -425,7 +424,7 @@ proptest! {
         let chunked = streamed_at(&wire.bytes, &cuts);
         prop_assert_eq!(&chunked.0, &whole.0);
         prop_assert_eq!(&chunked.1, &whole.1);
-        prop_assert_eq!(&streamed_bytewise::<HwFocScanner>(&wire.bytes), &whole);
+        prop_assert_eq!(&streamed_bytewise::<foc::Scanner>(&wire.bytes), &whole);
     }
 
     /// (b) The streaming decoder holds back only an undecided candidate: after every chunk, the
@@ -503,7 +502,7 @@ proptest! {
                 + 77 * u64::from(stats.info_frames())
                 + stats.bytes_skipped()
         );
-        prop_assert_eq!(&streamed_bytewise::<HwFocScanner>(&wire.bytes), &(decoded, stats));
+        prop_assert_eq!(&streamed_bytewise::<foc::Scanner>(&wire.bytes), &(decoded, stats));
     }
 
     /// (d) One flipped bit anywhere in a frame is always caught, whatever surrounds it.
@@ -576,7 +575,7 @@ proptest! {
         let streamed = streamed_at(&wire.bytes, &cuts);
         prop_assert_eq!(&streamed.0, &decoded);
         prop_assert_eq!(&streamed.1, &stats);
-        prop_assert_eq!(&streamed_bytewise::<HwFocScanner>(&wire.bytes), &(decoded.clone(), stats));
+        prop_assert_eq!(&streamed_bytewise::<foc::Scanner>(&wire.bytes), &(decoded.clone(), stats));
         let mut all = Decoder::new();
         let mut out = Vec::new();
         all.decode_all(&wire.bytes, |d| out.push(d));
@@ -587,7 +586,7 @@ proptest! {
         prop_assert_eq!(RefStats::from(&stats), ref_stats);
     }
 
-    /// Packet accounting over arbitrary packet sequences matches the rule of `LinkStats` (steps
+    /// Packet accounting over arbitrary packet sequences matches the rule of `foc::Stats` (steps
     /// modulo 65536: 0 is a duplicate, 2..=MAX_PACKET_GAP + 1 a loss of step - 1, anything else
     /// but 1 a restart), and every step is counted as exactly one event.
     #[test]
@@ -824,7 +823,7 @@ fn streamed_with_silences(
     parts: &[Vec<u8>],
     silences: &[u32],
     chunks: Chunks<'_>,
-) -> (Vec<Decoded>, LinkStats) {
+) -> (Vec<Decoded>, foc::Stats) {
     let mut d = Decoder::new();
     let mut out = Vec::new();
     for (i, part) in parts.iter().enumerate() {

@@ -5,15 +5,16 @@
 //! Every stream test decodes twice, with the bulk iterator and with the streaming decoder fed one
 //! byte at a time, and checks that both agree (frames and statistics) before checking values.
 
-use hwfoc::kinds::data::DATA_FRAME_LEN;
-use hwfoc::kinds::info::INFO_FRAME_LEN;
-use hwfoc::stats::MAX_PACKET_GAP;
+use hwfoc::counters::MAX_PACKET_GAP;
+use hwfoc::foc::kinds::data::DATA_FRAME_LEN;
+use hwfoc::foc::kinds::info::INFO_FRAME_LEN;
+use hwfoc::foc::{
+    DataFrame, Decoded, Decoder, Frame, FrameError, InfoFieldError, InfoFrame, Parsed, frames,
+    parse,
+};
 use hwfoc::units::{ADC_MAX, ADC_MIN, ADC_TABLE};
 use hwfoc::wire::sum16;
-use hwfoc::{
-    DataFrame, Decoded, Decoder, Fault, Frame, FrameError, InfoFieldError, InfoFrame, LinkStats,
-    Parsed, Settings, SettingsError, Status, Temperature, frames, parse,
-};
+use hwfoc::{Fault, Settings, SettingsError, Status, Temperature, foc};
 
 // ---------------------------------------------------------------------------------------------
 // Real bytes
@@ -240,7 +241,7 @@ const SPEC_TABLE: [(u8, u8); 130] = [
 
 /// Decodes `bytes` with the bulk iterator and with a streaming decoder fed one byte at a time
 /// (then flushed), checks that both give the same frames and statistics, and returns them.
-fn decode(bytes: &[u8]) -> (Vec<Decoded>, LinkStats) {
+fn decode(bytes: &[u8]) -> (Vec<Decoded>, foc::Stats) {
     let mut it = frames(bytes);
     let bulk: Vec<Decoded> = it.by_ref().collect();
     let stats = *it.stats();
@@ -885,7 +886,7 @@ fn lone_sync_byte_held_until_flush_by_the_streaming_decoder() {
     assert_eq!(d.stats().lost_packets(), 0);
     assert_eq!(d.stats().frames(), 2);
     d.reset();
-    assert_eq!(*d.stats(), LinkStats::new());
+    assert_eq!(*d.stats(), foc::Stats::new());
 }
 
 #[test]
@@ -1195,7 +1196,7 @@ fn interleaved_sequences_count_restarts_not_losses() {
 
 /// Decodes `parts` one byte at a time and in whole parts, telling the decoder before each part
 /// but the first that the line was silent for `silences[i]` frames; both ways must agree.
-fn decode_with_silences(parts: &[Vec<u8>], silences: &[u32]) -> (Vec<Decoded>, LinkStats) {
+fn decode_with_silences(parts: &[Vec<u8>], silences: &[u32]) -> (Vec<Decoded>, foc::Stats) {
     let mut results = Vec::new();
     for bytewise in [false, true] {
         let mut d = Decoder::new();
@@ -1330,8 +1331,8 @@ fn silence_decides_the_held_bytes_first() {
 
 #[test]
 fn no_frame_no_packet_statistics() {
-    let s = LinkStats::new();
-    assert_eq!(s, LinkStats::default());
+    let s = foc::Stats::new();
+    assert_eq!(s, foc::Stats::default());
     assert_eq!(s.last_packet(), None);
     assert_eq!(s.delivery_ratio(), None);
     let (_, s) = decode(&info_bytes());

@@ -2,8 +2,9 @@
 //! frame's methods as they were written out (f32), and the CLI summary's conversions of minima,
 //! maxima and means (f64). Every raw value of every field, under several settings.
 
+use hwfoc::foc::DataFrame;
 use hwfoc::units::{ERPM_PER_RAW, Linear};
-use hwfoc::{DataFrame, Quantity, Settings, Telemetry, Temperature};
+use hwfoc::{Quantity, Settings, Telemetry, Temperature};
 
 /// The quantities an HW-FOC frame converts linearly (every one but the two temperatures).
 const LINEAR: [Quantity; 7] = [

@@ -442,7 +442,7 @@ impl Recorder {
                     Escaped(&state.name),
                     state.unframed_bytes,
                     NO_FRAMES_AFTER.as_secs(),
-                    hwfoc::wire::BAUD_RATE
+                    hwfoc::foc::BAUD_RATE
                 );
             }
             if state

@@ -115,7 +115,7 @@ mod tests {
     fn telemetry_and_noise_look_like_nothing_else() {
         // HW-FOC frames (0x9B lead byte), a capture at the wrong baud rate, random bytes.
         let frames: Vec<u8> = (0..10)
-            .flat_map(|_| hwfoc::DataFrame::default().encode())
+            .flat_map(|_| hwfoc::foc::DataFrame::default().encode())
             .collect();
         assert_eq!(Looks::of(&frames), None);
         let mut x: u32 = 12345;

@@ -14,7 +14,7 @@
 //! times one byte time apart so finds every frame's first byte at the time it would have found
 //! it in the read chunk (to the rounding of a nanosecond).
 
-use hwfoc::Decoder;
+use hwfoc::foc::Decoder;
 
 /// One port's bytes on their way to packets.
 #[derive(Debug, Clone)]
@@ -185,7 +185,7 @@ pub(crate) trait Emit {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use hwfoc::{DataFrame, InfoFrame};
+    use hwfoc::foc::{DataFrame, InfoFrame};
 
     struct Pieces(Vec<(u64, Vec<u8>)>);
 

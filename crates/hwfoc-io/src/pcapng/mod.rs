@@ -162,7 +162,7 @@ mod tests {
     /// A port's stream: frames (data, information, one failing its checksum), noise and a frame
     /// cut by the end, read in chunks of 7 bytes 3 ms apart.
     fn port_stream() -> (Vec<u8>, Vec<(u64, Vec<u8>)>) {
-        use hwfoc::{DataFrame, InfoFrame};
+        use hwfoc::foc::{DataFrame, InfoFrame};
         let mut wire = Vec::new();
         for packet in 0..20u16 {
             wire.extend_from_slice(
@@ -221,7 +221,7 @@ mod tests {
             at += p.data.len();
         }
         let mut found = 0;
-        hwfoc::Decoder::new().decode_all(&wire, |d| {
+        hwfoc::foc::Decoder::new().decode_all(&wire, |d| {
             let offset = d.offset as usize;
             let k = starts
                 .iter()
@@ -240,7 +240,7 @@ mod tests {
 
     #[test]
     fn held_bytes_are_written_by_settle_comment_and_flush() {
-        let frame = hwfoc::DataFrame::default().encode();
+        let frame = hwfoc::foc::DataFrame::default().encode();
         let mut w = Writer::new(Vec::new()).unwrap();
         w.add_interface("a", 19200).unwrap();
         w.add_interface("b", 19200).unwrap();

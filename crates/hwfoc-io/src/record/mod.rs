@@ -42,7 +42,8 @@ impl Record {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use hwfoc::{DataFrame, Settings, Status};
+    use hwfoc::foc::DataFrame;
+    use hwfoc::{Settings, Status};
 
     /// Reading a column from the record gives what computing it from the frame gives.
     #[test]

@@ -376,8 +376,8 @@ impl TextEncoder {
 mod tests {
     use super::*;
     use crate::record::COLUMNS;
-    use hwfoc::DataFrame;
     use hwfoc::Settings;
+    use hwfoc::foc::DataFrame;
 
     /// The longest row of the table fits the row buffer, fixed-size copies included.
     #[test]

@@ -36,7 +36,7 @@ pub(crate) mod tests;
 use std::collections::{HashMap, VecDeque};
 
 use hwfoc::Settings;
-use hwfoc::datalink::DatalinkStats;
+use hwfoc::datalink;
 
 pub use crate::handler::Handler;
 use crate::input::{Input, InputError, InputFormat};
@@ -195,7 +195,7 @@ impl Sources {
 
     /// The DataLink hubs found: the ESC whose stream each came in (its channel 0), and the
     /// hub link's statistics.
-    pub fn hubs(&self) -> impl Iterator<Item = (usize, DatalinkStats)> + '_ {
+    pub fn hubs(&self) -> impl Iterator<Item = (usize, datalink::Stats)> + '_ {
         let mut owners: Vec<usize> = self.hubs.keys().copied().collect();
         owners.sort_unstable();
         owners

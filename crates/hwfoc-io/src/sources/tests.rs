@@ -4,8 +4,8 @@ use super::*;
 use crate::notice::Notice;
 use crate::pcapng;
 use crate::record::Record;
-use hwfoc::DataFrame;
 use hwfoc::datalink::CHANNELS;
+use hwfoc::foc::DataFrame;
 use hwfoc::telemetry::Frame;
 
 /// Collects the records, by ESC.
@@ -364,7 +364,7 @@ fn hubs_and_escs_together_number_every_esc_once_live_and_recorded() {
     let hub = |port: u16| -> Vec<u8> {
         (0..3)
             .flat_map(|counter| {
-                let mut frame = hwfoc::datalink::DatalinkFrame {
+                let mut frame = hwfoc::datalink::Frame {
                     counter,
                     slots: [None; CHANNELS],
                 };
@@ -473,7 +473,7 @@ fn hubs_and_escs_together_number_every_esc_once_live_and_recorded() {
 pub(crate) fn hub_wire(id: u16, counters: std::ops::Range<u16>, channels: &[usize]) -> Vec<u8> {
     counters
         .flat_map(|counter| {
-            let mut frame = hwfoc::datalink::DatalinkFrame::new(counter);
+            let mut frame = hwfoc::datalink::Frame::new(counter);
             for &c in channels {
                 frame.slots[c] = Some(DataFrame {
                     packet: 1000 + 100 * id + c as u16,

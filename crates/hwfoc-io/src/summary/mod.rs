@@ -54,7 +54,7 @@ pub use json::device_json;
 pub static NO_FRAMES: std::sync::LazyLock<String> = std::sync::LazyLock::new(|| {
     format!(
         "no valid HW-FOC frames: check the baud rate ({}) and the wiring",
-        hwfoc::wire::BAUD_RATE
+        hwfoc::foc::BAUD_RATE
     )
 });
 

@@ -1,11 +1,11 @@
 //! The summary's own tests.
 use super::accumulate::*;
 use super::*;
-use hwfoc::DataFrame;
+use hwfoc::foc::DataFrame;
 
 #[test]
 fn the_device_is_named_field_by_field() {
-    let info = Info::from(hwfoc::InfoFrame::new("HW1", "V2", "XR-01.0.00", "42").unwrap());
+    let info = Info::from(hwfoc::foc::InfoFrame::new("HW1", "V2", "XR-01.0.00", "42").unwrap());
     assert_eq!(
         Value::Object(device_json(&info)).to_string(),
         r#"{"product":"HW1","hardware":"V2","firmware":"XR-01.0.00","id":"42"}"#

@@ -173,7 +173,8 @@ fn batch(schema: SchemaRef, records: &[Record]) -> RecordBatch {
 /// with exactly the schema of [`schema`] (units in the fields' metadata).
 ///
 /// ```
-/// use hwfoc::{DataFrame, Settings};
+/// use hwfoc::Settings;
+/// use hwfoc::foc::DataFrame;
 /// use hwfoc_io::write::arrow::RecordBatchBuilder;
 ///
 /// let mut builder = RecordBatchBuilder::new();

@@ -514,7 +514,7 @@ mod tests {
     use crate::settings::SettingsMap;
     use crate::settings::SettingsPatch;
     use crate::sources::Sources;
-    use hwfoc::DataFrame;
+    use hwfoc::foc::DataFrame;
     use std::path::PathBuf;
 
     /// Ports named `p0`, `p1`, ...: frames of raw eRPM 70 (700 eRPM) and raw current 819 each.

@@ -155,7 +155,7 @@ mod tests {
     #[test]
     fn escs_name_their_input_and_stream() {
         let inputs = ["front", "rear"].map(|name| {
-            let frame = hwfoc::DataFrame::default().encode();
+            let frame = hwfoc::foc::DataFrame::default().encode();
             crate::Input::from_memory(name, frame.to_vec()).unwrap()
         });
         let mut sources = Sources::new(inputs.into(), hwfoc::Settings::DEFAULT);

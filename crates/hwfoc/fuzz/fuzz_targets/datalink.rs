@@ -1,4 +1,4 @@
-//! The DataLink V2 decoder: `DatalinkDecoder` fed in chunks whose sizes come from the input
+//! The DataLink V2 decoder: `datalink::Decoder` fed in chunks whose sizes come from the input
 //! itself, fed a byte at a time, and through `decode_all`, all checked against the bulk
 //! `datalink::frames` iterator.
 //!
@@ -16,7 +16,6 @@
 
 #![no_main]
 
-use hwfoc::DatalinkDecoder;
 use hwfoc::datalink;
 use hwfoc_fuzz::check_datalink_stream;
 use libfuzzer_sys::fuzz_target;
@@ -37,7 +36,7 @@ fuzz_target!(|data: &[u8]| {
     let stats = *it.stats();
     check_datalink_stream(input, &bulk, &stats);
 
-    let mut dec = DatalinkDecoder::new();
+    let mut dec = datalink::Decoder::new();
     let mut got = Vec::new();
     let mut at = 0;
     let mut step = 0;
@@ -90,14 +89,14 @@ fuzz_target!(|data: &[u8]| {
     }
     dec.flush(|d| got.push(d));
     assert_eq!(dec.buffered(), 0);
-    assert_eq!(got, bulk, "chunked DatalinkDecoder and frames() disagree");
+    assert_eq!(got, bulk, "chunked datalink::Decoder and frames() disagree");
     assert_eq!(
         dec.stats(),
         &stats,
-        "chunked DatalinkDecoder and frames() statistics"
+        "chunked datalink::Decoder and frames() statistics"
     );
 
-    let mut bytewise = DatalinkDecoder::new();
+    let mut bytewise = datalink::Decoder::new();
     got.clear();
     for &b in input {
         bytewise.push(b, |d| got.push(d));
@@ -105,11 +104,11 @@ fuzz_target!(|data: &[u8]| {
     bytewise.flush(|d| got.push(d));
     assert_eq!(
         got, bulk,
-        "byte-at-a-time DatalinkDecoder and frames() disagree"
+        "byte-at-a-time datalink::Decoder and frames() disagree"
     );
     assert_eq!(bytewise.stats(), &stats);
 
-    let mut all = DatalinkDecoder::new();
+    let mut all = datalink::Decoder::new();
     got.clear();
     all.decode_all(input, |d| got.push(d));
     assert_eq!(got, bulk, "decode_all and frames() disagree");

@@ -15,7 +15,7 @@
 
 #![no_main]
 
-use hwfoc::{Decoder, frames};
+use hwfoc::foc::{Decoder, frames};
 use hwfoc_fuzz::check_stream;
 use libfuzzer_sys::fuzz_target;
 

@@ -1,9 +1,8 @@
 //! Invariant checks shared by the fuzz targets in `fuzz_targets/`.
 
 use hwfoc::datalink::LengthByte;
-use hwfoc::{
-    DatalinkDecoded, DatalinkFrame, DatalinkStats, Decoded, Frame, LinkStats, Parsed, parse,
-};
+use hwfoc::foc::{Decoded, Frame, Parsed, parse};
+use hwfoc::{datalink, foc};
 
 /// Panics unless `decoded` and `stats` are a consistent decoding of `input`, a whole stream
 /// (a flushed `Decoder`, or an exhausted `frames` iterator):
@@ -13,7 +12,7 @@ use hwfoc::{
 /// - offsets strictly increase and frames never overlap;
 /// - each frame re-encodes to exactly the input bytes at its offset, and `parse` reads the same
 ///   frame there.
-pub fn check_stream(input: &[u8], decoded: &[Decoded], stats: &LinkStats) {
+pub fn check_stream(input: &[u8], decoded: &[Decoded], stats: &foc::Stats) {
     assert_eq!(stats.bytes(), input.len() as u64, "bytes counted");
     assert_eq!(
         stats.bytes(),
@@ -72,17 +71,17 @@ pub fn check_stream(input: &[u8], decoded: &[Decoded], stats: &LinkStats) {
 }
 
 /// Panics unless `decoded` and `stats` are a consistent DataLink decoding of `input`, a whole
-/// stream (a flushed `DatalinkDecoder`, or an exhausted `datalink::frames` iterator):
+/// stream (a flushed `datalink::Decoder`, or an exhausted `datalink::frames` iterator):
 ///
 /// - every byte is accounted for: `bytes == input.len() == 160*frames + skipped`, and every
 ///   frame counted under one length byte;
 /// - every record of every frame counted once (a channel's, empty, bad or duplicate channel),
 ///   and each channel's record count matches the frames given;
 /// - offsets strictly increase and frames never overlap;
-/// - `DatalinkFrame::parse_with_report` reads the same frame and report at each offset, and
+/// - `datalink::Frame::parse_with_report` reads the same frame and report at each offset, and
 ///   the frame re-encodes to the input bytes when nothing of it was dropped (no bad or
 ///   duplicate channel, the length byte 0x9E, every channel byte its position).
-pub fn check_datalink_stream(input: &[u8], decoded: &[DatalinkDecoded], stats: &DatalinkStats) {
+pub fn check_datalink_stream(input: &[u8], decoded: &[datalink::Decoded], stats: &datalink::Stats) {
     assert_eq!(stats.bytes(), input.len() as u64, "bytes counted");
     assert_eq!(
         stats.bytes(),
@@ -126,7 +125,7 @@ pub fn check_datalink_stream(input: &[u8], decoded: &[DatalinkDecoded], stats: &
         let end = start + 160;
         assert!(end <= input.len(), "frame at {start} runs past the input");
         assert_eq!(
-            DatalinkFrame::parse_with_report(&input[start..]),
+            datalink::Frame::parse_with_report(&input[start..]),
             Ok((d.frame, d.report)),
             "parse disagrees at {start}"
         );

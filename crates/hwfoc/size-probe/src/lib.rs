@@ -5,8 +5,9 @@
 //! - `hwfoc_probe_push`: one byte into a [`Decoder`], a few raw fields of the last data frame out.
 //! - `hwfoc_probe_push_units` (feature `units`): the same, then physical values (voltage,
 //!   currents and RPM under the caller's settings, temperatures from the ADC table).
-//! - `hwfoc_probe_datalink_push` (feature `datalink`): one byte into a [`DatalinkDecoder`], the
-//!   frame counter and a few raw fields of each ESC of the last DataLink frame out.
+//! - `hwfoc_probe_datalink_push` (feature `datalink`): one byte into a
+//!   [`hwfoc::datalink::Decoder`], the frame counter and a few raw fields of each ESC of the last
+//!   DataLink frame out.
 //!
 //! The HW-FOC entry points are behind the default feature `esc`, so that
 //! `--no-default-features --features datalink` measures the DataLink decoder alone.
@@ -16,15 +17,16 @@
 
 #![no_std]
 
-use hwfoc::{DatalinkDecoder, Decoder};
+use hwfoc::foc::Decoder;
 
 /// `size_of::<Decoder>()` on the target; the build fails if it changes (the script reports it).
 pub const DECODER_STATE_BYTES: usize = 120;
 const _: () = assert!(core::mem::size_of::<Decoder>() == DECODER_STATE_BYTES);
 
-/// `size_of::<DatalinkDecoder>()` on the target, checked as [`DECODER_STATE_BYTES`] is.
+/// `size_of::<hwfoc::datalink::Decoder>()` on the target, checked as [`DECODER_STATE_BYTES`] is.
 pub const DATALINK_DECODER_STATE_BYTES: usize = 380;
-const _: () = assert!(core::mem::size_of::<DatalinkDecoder>() == DATALINK_DECODER_STATE_BYTES);
+const _: () =
+    assert!(core::mem::size_of::<hwfoc::datalink::Decoder>() == DATALINK_DECODER_STATE_BYTES);
 
 /// Raw fields of a data frame, as firmware might copy them out.
 #[repr(C)]
@@ -55,7 +57,7 @@ pub use esc::*;
 
 #[cfg(feature = "esc")]
 mod esc {
-    use hwfoc::{Decoder, Frame};
+    use hwfoc::foc::{Decoder, Frame};
 
     use crate::ProbeFrame;
 
@@ -94,7 +96,8 @@ pub use units::*;
 
 #[cfg(feature = "units")]
 mod units {
-    use hwfoc::{DataFrame, Decoder, Settings, Status};
+    use hwfoc::foc::{DataFrame, Decoder};
+    use hwfoc::{Settings, Status};
 
     use crate::{ProbeFrame, hwfoc_probe_push};
 
@@ -173,7 +176,7 @@ pub use datalink::*;
 
 #[cfg(feature = "datalink")]
 mod datalink {
-    use hwfoc::DatalinkDecoder;
+    use hwfoc::datalink;
     use hwfoc::datalink::CHANNELS;
 
     /// Raw fields of one ESC of a DataLink frame.
@@ -210,7 +213,7 @@ mod datalink {
     /// DataLink frame.
     #[unsafe(no_mangle)]
     pub extern "C" fn hwfoc_probe_datalink_push(
-        state: &mut DatalinkDecoder,
+        state: &mut datalink::Decoder,
         byte: u8,
         out: &mut ProbeDatalink,
     ) -> bool {

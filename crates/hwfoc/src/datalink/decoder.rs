@@ -1,30 +1,30 @@
-//! Finding DataLink V2 frames in a byte stream: the streaming [`DatalinkDecoder`] and the bulk
-//! [`frames`] iterator, with the guarantees of the HW-FOC scanner ([`crate::decoder`]).
+//! Finding DataLink V2 frames in a byte stream: the streaming [`Decoder`] and the bulk
+//! [`frames`] iterator, with the guarantees of the HW-FOC scanner ([`crate::foc::decoder`]).
 //!
 //! The scanner is content-based: a candidate is a `9B` followed by a length byte 0x9E or 0xA0.
 //! It is rejected as soon as its version and command bytes are not `01 02` (a
-//! [bad header](DatalinkStats::bad_headers)), or once its 160 bytes are there and the CRC does
-//! not match (a [CRC failure](DatalinkStats::crc_failures)); a rejected candidate costs one
+//! [bad header](Stats::bad_headers)), or once its 160 bytes are there and the CRC does
+//! not match (a [CRC failure](Stats::crc_failures)); a rejected candidate costs one
 //! byte: scanning resumes at the byte after its `9B`, so a lone `9B`, a fake header, a cut frame
 //! or garbage never hides a following intact frame. A verified frame is taken whole. Both
 //! decoders run the same scanner, so they give the same frames and statistics for the same
 //! bytes however the stream is cut into chunks.
 
-use crate::decoder::{bytes_equal, find_sync_then};
-use crate::scan::{Candidate, Scan, Scanner, Stats, StreamDecoder};
+use crate::foc::decoder::{bytes_equal, find_sync_then};
+use crate::scan::{self, Candidate, Scan, StreamDecoder};
 
-use super::frame::{DatalinkFrame, FrameReport};
+use super::frame::{Frame, FrameReport};
 use super::layout::{FRAME_LEN, LengthByte, is_version_and_command};
-use super::stats::DatalinkStats;
+use super::stats::Stats;
 
 /// A DataLink frame, where it started in the stream, and what reading its records found.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-pub struct DatalinkDecoded {
+pub struct Decoded {
     /// Offset of the frame's first byte, counting every byte given to the decoder since it was
     /// created (or, for [`frames`], from the start of the slice).
     pub offset: u64,
     /// The frame.
-    pub frame: DatalinkFrame,
+    pub frame: Frame,
     /// Its length byte, and its empty, bad-channel and duplicate-channel records.
     pub report: FrameReport,
 }
@@ -56,7 +56,7 @@ pub(crate) fn candidate_len(held: usize) -> usize {
 
 /// What a candidate (a `9B` and a length byte, or a `9B` alone at the end) is.
 enum Verdict {
-    Frame(DatalinkFrame, FrameReport),
+    Frame(Frame, FrameReport),
     BadHeader,
     BadCrc,
     /// More bytes are needed.
@@ -76,12 +76,12 @@ fn judge(candidate: &[u8]) -> Verdict {
     let Some(frame) = candidate.first_chunk::<FRAME_LEN>() else {
         return Verdict::Undecided;
     };
-    if !DatalinkFrame::crc_ok(frame) {
+    if !Frame::crc_ok(frame) {
         return Verdict::BadCrc;
     }
     match LengthByte::from_byte(length_byte) {
         Some(length_byte) => {
-            let (frame, report) = DatalinkFrame::read(frame, length_byte);
+            let (frame, report) = Frame::read(frame, length_byte);
             Verdict::Frame(frame, report)
         }
         // `find_header` stops at no other length byte.
@@ -98,9 +98,9 @@ fn judge(candidate: &[u8]) -> Verdict {
 fn scan_next(
     data: &[u8],
     pos: &mut usize,
-    stats: &mut DatalinkStats,
+    stats: &mut Stats,
     at_end: bool,
-) -> Option<(usize, DatalinkFrame, FrameReport)> {
+) -> Option<(usize, Frame, FrameReport)> {
     loop {
         let Some(k) = find_header(&data[*pos..]) else {
             stats.skip(data.len() - *pos);
@@ -127,9 +127,9 @@ fn scan_next(
 pub(crate) fn take_candidate(
     data: &[u8],
     pos: &mut usize,
-    stats: &mut DatalinkStats,
+    stats: &mut Stats,
     at_end: bool,
-) -> Candidate<(usize, DatalinkFrame, FrameReport)> {
+) -> Candidate<(usize, Frame, FrameReport)> {
     let i = *pos;
     match judge(&data[i..]) {
         Verdict::Frame(frame, report) => {
@@ -152,34 +152,34 @@ pub(crate) fn take_candidate(
 }
 
 /// The DataLink V2 scanner, as the streaming layer ([`crate::scan`]) runs it:
-/// [`DatalinkDecoder`] and [`DatalinkFrames`] are it under [`StreamDecoder`] and [`Scan`].
+/// [`Decoder`] and [`Frames`] are it under [`StreamDecoder`] and [`Scan`].
 #[derive(Debug, Clone, Copy, Default)]
-pub struct DatalinkScanner;
+pub struct Scanner;
 
-impl crate::scan::sealed::Sealed for DatalinkScanner {}
-impl crate::scan::sealed::Sealed for DatalinkStats {}
+impl crate::scan::sealed::Sealed for Scanner {}
+impl crate::scan::sealed::Sealed for Stats {}
 
-impl Stats for DatalinkStats {
-    const NEW: Self = DatalinkStats::new();
+impl scan::Stats for Stats {
+    const NEW: Self = Stats::new();
 
     #[inline]
     fn bytes(&self) -> u64 {
-        DatalinkStats::bytes(self)
+        Stats::bytes(self)
     }
 
     #[inline]
     fn add_bytes(&mut self, n: usize) {
-        DatalinkStats::add_bytes(self, n);
+        Stats::add_bytes(self, n);
     }
 
     fn line_silent(&mut self, max_frames: u32) {
-        DatalinkStats::line_silent(self, max_frames);
+        Stats::line_silent(self, max_frames);
     }
 }
 
-impl Scanner for DatalinkScanner {
-    type Item = DatalinkDecoded;
-    type Stats = DatalinkStats;
+impl scan::Scanner for Scanner {
+    type Item = Decoded;
+    type Stats = Stats;
     type Held = [u8; FRAME_LEN - 1];
     type Pair = [u8; 2 * FRAME_LEN];
     const HELD: Self::Held = [0; FRAME_LEN - 1];
@@ -197,12 +197,12 @@ impl Scanner for DatalinkScanner {
     fn scan_all<const AT_END: bool>(
         data: &[u8],
         base: u64,
-        stats: &mut DatalinkStats,
-        on_frame: &mut impl FnMut(DatalinkDecoded),
+        stats: &mut Stats,
+        on_frame: &mut impl FnMut(Decoded),
     ) -> usize {
         let mut pos = 0;
         while let Some((at, frame, report)) = scan_next(data, &mut pos, stats, AT_END) {
-            on_frame(DatalinkDecoded {
+            on_frame(Decoded {
                 offset: base + at as u64,
                 frame,
                 report,
@@ -212,12 +212,8 @@ impl Scanner for DatalinkScanner {
     }
 
     #[inline]
-    fn scan_next(
-        data: &[u8],
-        pos: &mut usize,
-        stats: &mut DatalinkStats,
-    ) -> Option<DatalinkDecoded> {
-        scan_next(data, pos, stats, true).map(|(at, frame, report)| DatalinkDecoded {
+    fn scan_next(data: &[u8], pos: &mut usize, stats: &mut Stats) -> Option<Decoded> {
+        scan_next(data, pos, stats, true).map(|(at, frame, report)| Decoded {
             offset: at as u64,
             frame,
             report,
@@ -228,21 +224,21 @@ impl Scanner for DatalinkScanner {
 /// A streaming DataLink V2 decoder: feed it bytes in any chunking, get every frame once (the
 /// streaming layer's [`StreamDecoder`] over the DataLink scanner).
 ///
-/// Its state is a 159-byte buffer for a frame still arriving plus the [`DatalinkStats`]:
-/// 380 bytes (`size_of::<DatalinkDecoder>()`, checked by a test), no allocation, no timing.
+/// Its state is a 159-byte buffer for a frame still arriving plus the [`Stats`]:
+/// 380 bytes (`size_of::<Decoder>()`, checked by a test), no allocation, no timing.
 /// Large chunks are scanned in place; only an unfinished tail is copied. One byte pushed
 /// completes at most one frame.
 ///
 /// ```
-/// use hwfoc::datalink::{DatalinkDecoder, DatalinkFrame, LengthByte};
-/// use hwfoc::DataFrame;
+/// use hwfoc::datalink::{Decoder, Frame, LengthByte};
+/// use hwfoc::foc::DataFrame;
 ///
-/// let mut frame = DatalinkFrame::new(7);
+/// let mut frame = Frame::new(7);
 /// frame.slots[1] = Some(DataFrame { packet: 300, voltage_raw: 252, ..Default::default() });
 /// let mut wire = vec![0x00, 0x9B, 0x9E]; // noise and a fake header
 /// wire.extend_from_slice(&frame.encode_as(LengthByte::Total));
 ///
-/// let mut decoder = DatalinkDecoder::new();
+/// let mut decoder = Decoder::new();
 /// let mut got = Vec::new();
 /// for &byte in &wire {
 ///     decoder.push(byte, |d| got.push(d));
@@ -260,41 +256,42 @@ impl Scanner for DatalinkScanner {
 ///
 /// [`line_silent`](StreamDecoder::line_silent)`(max_frames, ..)`: at most `max_frames`
 /// DataLink frames could have been sent in the silence (160 byte times each at
-/// [`BAUD_RATE`](super::BAUD_RATE), about 13.9 ms). As for the ESC [`Decoder`](crate::Decoder),
-/// the held bytes are decided at once and the next frame's counter step counts as a loss only
-/// up to `max_frames + 1` (a larger step is a restart). Each channel's next packet-number step
-/// counts as a loss only up to [`esc_frames_in`](super::esc_frames_in)`(max_frames) + 1`, the
-/// most frames that ESC could have sent on its own 19200-baud wire in that time.
+/// [`BAUD_RATE`](super::BAUD_RATE), about 13.9 ms). As for the ESC
+/// [`Decoder`](crate::foc::Decoder), the held bytes are decided at once and the next frame's
+/// counter step counts as a loss only up to `max_frames + 1` (a larger step is a restart). Each
+/// channel's next packet-number step counts as a loss only up to
+/// [`esc_frames_in`](super::esc_frames_in)`(max_frames) + 1`, the most frames that ESC could have
+/// sent on its own 19200-baud wire in that time.
 ///
 /// ```
-/// use hwfoc::datalink::{BAUD_RATE, DatalinkDecoder, DatalinkFrame, FRAME_LEN};
+/// use hwfoc::datalink::{BAUD_RATE, Decoder, Frame, FRAME_LEN};
 /// use hwfoc::wire::byte_ns;
 ///
-/// let mut decoder = DatalinkDecoder::new();
-/// decoder.feed(&DatalinkFrame::new(1000).encode(), |_| {});
+/// let mut decoder = Decoder::new();
+/// decoder.feed(&Frame::new(1000).encode(), |_| {});
 /// // 1 s without a byte: at most 1 s / 160 byte times = 72 frames could have been sent.
 /// let max_frames = (1e9 / (FRAME_LEN as f64 * byte_ns(BAUD_RATE))) as u32;
 /// assert_eq!(max_frames, 72);
 /// decoder.line_silent(max_frames, |_| {});
-/// decoder.feed(&DatalinkFrame::new(1200).encode(), |_| {}); // the hub restarted
-/// decoder.feed(&DatalinkFrame::new(1203).encode(), |_| {}); // 2 frames lost
+/// decoder.feed(&Frame::new(1200).encode(), |_| {}); // the hub restarted
+/// decoder.feed(&Frame::new(1203).encode(), |_| {}); // 2 frames lost
 /// assert_eq!(decoder.stats().restarts(), 1);
 /// assert_eq!(decoder.stats().lost_frames(), 2);
 /// ```
-pub type DatalinkDecoder = StreamDecoder<DatalinkScanner>;
+pub type Decoder = StreamDecoder<Scanner>;
 
 /// Decodes every DataLink frame in a complete buffer, in place: the bulk path.
 ///
 /// The iterator borrows the slice and allocates nothing; a frame cut off by the end of the
-/// slice is skipped. It yields exactly what a [`DatalinkDecoder`] fed the same bytes and then
+/// slice is skipped. It yields exactly what a [`Decoder`] fed the same bytes and then
 /// flushed would, with the same statistics.
 ///
 /// ```
-/// use hwfoc::datalink::{self, DatalinkFrame};
+/// use hwfoc::datalink::{self, Frame};
 ///
 /// let mut wire = Vec::new();
 /// for counter in 0..3u16 {
-///     wire.extend_from_slice(&DatalinkFrame::new(counter).encode());
+///     wire.extend_from_slice(&Frame::new(counter).encode());
 /// }
 /// wire[200] ^= 0x04; // corrupt the second frame
 /// let mut it = datalink::frames(&wire);
@@ -303,12 +300,12 @@ pub type DatalinkDecoder = StreamDecoder<DatalinkScanner>;
 /// assert_eq!(it.stats().crc_failures(), 1);
 /// assert_eq!(it.stats().lost_frames(), 1);
 /// ```
-pub fn frames(data: &[u8]) -> DatalinkFrames<'_> {
+pub fn frames(data: &[u8]) -> Frames<'_> {
     Scan::new(data)
 }
 
 /// Iterator returned by [`frames`].
-pub type DatalinkFrames<'a> = Scan<'a, DatalinkScanner>;
+pub type Frames<'a> = Scan<'a, Scanner>;
 
 #[cfg(test)]
 mod tests {
@@ -318,19 +315,19 @@ mod tests {
     #[test]
     fn find_header_matches_a_plain_search() {
         let near = [0x9E, 0xA0, 0x9D, 0x9F, 0xA1, 0x16];
-        crate::decoder::tests::assert_matches_a_plain_search(find_header, &[0x9E, 0xA0], near);
+        crate::foc::decoder::tests::assert_matches_a_plain_search(find_header, &[0x9E, 0xA0], near);
     }
 
     #[test]
     fn state_size() {
-        assert_eq!(size_of::<DatalinkDecoder>(), 380);
-        assert!(size_of::<DatalinkDecoder>() <= 384);
+        assert_eq!(size_of::<Decoder>(), 380);
+        assert!(size_of::<Decoder>() <= 384);
     }
 
     #[test]
     fn held_candidate_resolves_across_calls() {
-        let f = DatalinkFrame::new(9).encode();
-        let mut d = DatalinkDecoder::new();
+        let f = Frame::new(9).encode();
+        let mut d = Decoder::new();
         let mut n = 0;
         for (i, chunk) in [&f[..1], &f[1..3], &f[3..4], &f[4..159]].iter().enumerate() {
             d.feed(chunk, |_| n += 1);

@@ -4,10 +4,10 @@ use core::fmt;
 
 use super::layout::{FRAME_LEN, LengthByte};
 
-/// Why [`DatalinkFrame::parse`](super::DatalinkFrame::parse) refused bytes, in the order it
+/// Why [`Frame::parse`](super::Frame::parse) refused bytes, in the order it
 /// checks them (the streaming decoder rejects candidates in the same order).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-pub enum DatalinkError {
+pub enum Error {
     /// Fewer than [`FRAME_LEN`] bytes.
     Truncated {
         /// Bytes given.
@@ -39,27 +39,27 @@ pub enum DatalinkError {
     },
 }
 
-impl fmt::Display for DatalinkError {
+impl fmt::Display for Error {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match *self {
-            DatalinkError::Truncated { got } => {
+            Error::Truncated { got } => {
                 write!(f, "truncated DataLink frame: {got} of {FRAME_LEN} bytes")
             }
-            DatalinkError::NoSync { found } => write!(
+            Error::NoSync { found } => write!(
                 f,
                 "DataLink frame starts with 0x{found:02X}, not the sync byte 0x9B"
             ),
-            DatalinkError::UnknownLength { found } => write!(
+            Error::UnknownLength { found } => write!(
                 f,
                 "unknown DataLink length byte 0x{found:02X} (expected 0x{:02X} or 0x{:02X})",
                 LengthByte::Covered.byte(),
                 LengthByte::Total.byte()
             ),
-            DatalinkError::UnknownCommand { version, command } => write!(
+            Error::UnknownCommand { version, command } => write!(
                 f,
                 "unknown DataLink version 0x{version:02X} / command 0x{command:02X} (expected 01 02)"
             ),
-            DatalinkError::Crc { expected, found } => write!(
+            Error::Crc { expected, found } => write!(
                 f,
                 "DataLink CRC mismatch: bytes give 0x{expected:04X}, frame carries 0x{found:04X}"
             ),
@@ -67,4 +67,4 @@ impl fmt::Display for DatalinkError {
     }
 }
 
-impl core::error::Error for DatalinkError {}
+impl core::error::Error for Error {}

@@ -1,9 +1,10 @@
 //! The DataLink V2 frame: a frame counter and up to eight ESCs' data, read and written.
 
-use crate::kinds::data::{DATA_PAYLOAD_LEN, DataFrame};
-use crate::wire::{FrameError, SYNC};
+use crate::foc::FrameError;
+use crate::foc::kinds::data::{DATA_PAYLOAD_LEN, DataFrame};
+use crate::wire::SYNC;
 
-use super::error::DatalinkError;
+use super::error::Error;
 use super::layout::{
     CHANNELS, CHECK_AT, CHECKSUM, COUNTER_AT, FRAME_LEN, LengthByte, RECORD_LEN, RECORDS_AT,
     header, is_version_and_command,
@@ -17,20 +18,20 @@ use super::layout::{
 /// every field is zero encodes as an empty slot and parses back as `None`.
 ///
 /// ```
-/// use hwfoc::datalink::{DatalinkFrame, FRAME_LEN};
-/// use hwfoc::DataFrame;
+/// use hwfoc::datalink::{Frame, FRAME_LEN};
+/// use hwfoc::foc::DataFrame;
 ///
-/// let mut frame = DatalinkFrame::new(41);
+/// let mut frame = Frame::new(41);
 /// frame.slots[2] = Some(DataFrame { packet: 7, voltage_raw: 252, ..Default::default() });
 /// let bytes = frame.encode();
 /// assert_eq!(bytes.len(), FRAME_LEN);
 /// assert_eq!(&bytes[..6], &[0x9B, 0x9E, 0x01, 0x02, 0x00, 41]);
 /// assert_eq!(bytes[6 + 2 * 19], 2); // the channel byte of slot 2's record
-/// assert_eq!(DatalinkFrame::parse(&bytes)?, frame);
-/// # Ok::<(), hwfoc::DatalinkError>(())
+/// assert_eq!(Frame::parse(&bytes)?, frame);
+/// # Ok::<(), hwfoc::datalink::Error>(())
 /// ```
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
-pub struct DatalinkFrame {
+pub struct Frame {
     /// The hub's frame counter (bytes 4..6, big-endian).
     pub counter: u16,
     /// The ESC records by channel; `None` for an empty slot.
@@ -38,7 +39,7 @@ pub struct DatalinkFrame {
 }
 
 /// What reading a frame's records found besides the ESCs' data, and which length byte the frame
-/// carried: the per-frame part of [`DatalinkStats`](super::DatalinkStats).
+/// carried: the per-frame part of [`Stats`](super::Stats).
 ///
 /// The eight records of a frame are each exactly one of: an ESC's data (in its slot),
 /// [empty](FrameReport::empty_slots), a [bad channel](FrameReport::bad_channels) or a
@@ -57,10 +58,10 @@ pub struct FrameReport {
     pub duplicate_channels: u8,
 }
 
-impl DatalinkFrame {
+impl Frame {
     /// A frame with counter `counter` and every slot empty.
     pub const fn new(counter: u16) -> Self {
-        DatalinkFrame {
+        Frame {
             counter,
             slots: [None; CHANNELS],
         }
@@ -100,34 +101,32 @@ impl DatalinkFrame {
     /// ignored), checking in this order: length, sync byte, length byte (0x9E or 0xA0), version
     /// and command (`01 02`), CRC. The records are read as the decoder reads them (see
     /// [`FrameReport`]): a bad or duplicate channel drops that record, not the frame.
-    pub fn parse(bytes: &[u8]) -> Result<DatalinkFrame, DatalinkError> {
+    pub fn parse(bytes: &[u8]) -> Result<Frame, Error> {
         Self::parse_with_report(bytes).map(|(frame, _)| frame)
     }
 
     /// [`Self::parse`], with what reading the records found.
-    pub fn parse_with_report(bytes: &[u8]) -> Result<(DatalinkFrame, FrameReport), DatalinkError> {
+    pub fn parse_with_report(bytes: &[u8]) -> Result<(Frame, FrameReport), Error> {
         let Some(f) = bytes.first_chunk::<FRAME_LEN>() else {
-            return Err(DatalinkError::Truncated { got: bytes.len() });
+            return Err(Error::Truncated { got: bytes.len() });
         };
         if f[0] != SYNC {
-            return Err(DatalinkError::NoSync { found: f[0] });
+            return Err(Error::NoSync { found: f[0] });
         }
         let Some(length_byte) = LengthByte::from_byte(f[1]) else {
-            return Err(DatalinkError::UnknownLength { found: f[1] });
+            return Err(Error::UnknownLength { found: f[1] });
         };
         if !is_version_and_command(f[2], f[3]) {
-            return Err(DatalinkError::UnknownCommand {
+            return Err(Error::UnknownCommand {
                 version: f[2],
                 command: f[3],
             });
         }
         match CHECKSUM.verify(f) {
             Ok(()) => Ok(Self::read(f, length_byte)),
-            Err(FrameError::Checksum { expected, found }) => {
-                Err(DatalinkError::Crc { expected, found })
-            }
+            Err(FrameError::Checksum { expected, found }) => Err(Error::Crc { expected, found }),
             // A 160-byte frame always holds its check bytes.
-            Err(_) => Err(DatalinkError::Truncated { got: bytes.len() }),
+            Err(_) => Err(Error::Truncated { got: bytes.len() }),
         }
     }
 
@@ -139,11 +138,8 @@ impl DatalinkFrame {
 
     /// Reads the counter and records of a frame whose header and CRC are verified.
     #[inline]
-    pub(crate) fn read(
-        f: &[u8; FRAME_LEN],
-        length_byte: LengthByte,
-    ) -> (DatalinkFrame, FrameReport) {
-        let mut frame = DatalinkFrame::new(u16::from_be_bytes([f[COUNTER_AT], f[COUNTER_AT + 1]]));
+    pub(crate) fn read(f: &[u8; FRAME_LEN], length_byte: LengthByte) -> (Frame, FrameReport) {
+        let mut frame = Frame::new(u16::from_be_bytes([f[COUNTER_AT], f[COUNTER_AT + 1]]));
         let mut report = FrameReport {
             length_byte,
             empty_slots: 0,
@@ -203,7 +199,7 @@ mod tests {
     /// and its CRC against Python's `binascii.crc_hqx(bytes[:158], 0)` (CRC-16/XMODEM).
     #[test]
     fn encode_writes_the_documented_layout() {
-        let mut frame = DatalinkFrame::new(0x1234);
+        let mut frame = Frame::new(0x1234);
         frame.slots[0] = Some(esc(0xABCD));
         frame.slots[7] = Some(esc(1));
         let b = frame.encode();
@@ -230,7 +226,7 @@ mod tests {
 
     #[test]
     fn records_by_channel_byte_not_position() {
-        let mut b = DatalinkFrame::new(3).encode();
+        let mut b = Frame::new(3).encode();
         // Record 0 for channel 5, record 1 for channel 9, record 2 again for channel 5,
         // record 3 empty with a channel byte of 200.
         let r = |i: usize| 6 + 19 * i;
@@ -242,7 +238,7 @@ mod tests {
         b[r(2) + 2] = 3;
         b[r(3)] = 200;
         CHECKSUM.seal(&mut b);
-        let (frame, report) = DatalinkFrame::parse_with_report(&b).unwrap();
+        let (frame, report) = Frame::parse_with_report(&b).unwrap();
         assert_eq!(frame.slots[5].map(|e| e.packet), Some(1));
         assert_eq!(frame.escs().count(), 1);
         assert_eq!(
@@ -258,35 +254,29 @@ mod tests {
 
     #[test]
     fn parse_errors_in_order() {
-        let good = DatalinkFrame::new(1).encode();
+        let good = Frame::new(1).encode();
         assert_eq!(
-            DatalinkFrame::parse(&good[..159]),
-            Err(DatalinkError::Truncated { got: 159 })
+            Frame::parse(&good[..159]),
+            Err(Error::Truncated { got: 159 })
         );
         let mut b = good;
         b[0] = 0x9C;
         b[1] = 0x16;
-        assert_eq!(
-            DatalinkFrame::parse(&b),
-            Err(DatalinkError::NoSync { found: 0x9C })
-        );
+        assert_eq!(Frame::parse(&b), Err(Error::NoSync { found: 0x9C }));
         b[0] = 0x9B;
-        assert_eq!(
-            DatalinkFrame::parse(&b),
-            Err(DatalinkError::UnknownLength { found: 0x16 })
-        );
+        assert_eq!(Frame::parse(&b), Err(Error::UnknownLength { found: 0x16 }));
         b[1] = 0xA0;
         b[3] = 0x01;
         assert_eq!(
-            DatalinkFrame::parse(&b),
-            Err(DatalinkError::UnknownCommand {
+            Frame::parse(&b),
+            Err(Error::UnknownCommand {
                 version: 1,
                 command: 1
             })
         );
         b[3] = 0x02;
         let carried = u16::from_le_bytes([b[158], b[159]]);
-        let Err(DatalinkError::Crc { expected, found }) = DatalinkFrame::parse(&b) else {
+        let Err(Error::Crc { expected, found }) = Frame::parse(&b) else {
             panic!("a changed length byte breaks the CRC");
         };
         assert_eq!(
@@ -296,14 +286,14 @@ mod tests {
         assert_ne!(expected, found);
         let mut longer = [0u8; 200];
         longer[..160].copy_from_slice(&good);
-        assert_eq!(DatalinkFrame::parse(&longer), Ok(DatalinkFrame::new(1)));
+        assert_eq!(Frame::parse(&longer), Ok(Frame::new(1)));
     }
 
     #[test]
     fn error_messages() {
         use core::fmt::Write;
         let mut s = heapless_string();
-        write!(s, "{}", DatalinkError::UnknownLength { found: 0x9F }).unwrap();
+        write!(s, "{}", Error::UnknownLength { found: 0x9F }).unwrap();
         assert_eq!(
             s.as_str(),
             "unknown DataLink length byte 0x9F (expected 0x9E or 0xA0)"

@@ -7,7 +7,7 @@
 //!                                     18 payload bytes (BE)                of bytes 0..=157
 //! ```
 
-use crate::kinds::data::{CMD_DATA, DATA_PAYLOAD_LEN};
+use crate::foc::kinds::data::{CMD_DATA, DATA_PAYLOAD_LEN};
 use crate::wire::{Checksum, SYNC, VERSION};
 
 /// Baud rate of the hub's output wire (8N1); byte times come from

@@ -3,35 +3,35 @@
 
 use core::fmt;
 
-use crate::kinds::data::DATA_FRAME_LEN;
-use crate::stats::{ByteCounts, Bytes, PacketSequence};
+use crate::counters::{ByteCounts, Bytes, PacketSequence};
+use crate::foc::kinds::data::DATA_FRAME_LEN;
 
-use super::frame::{DatalinkFrame, FrameReport};
+use super::frame::{Frame, FrameReport};
 use super::layout::{BAUD_RATE, CHANNELS, FRAME_LEN, LengthByte};
 
-/// Counters kept per stream by [`DatalinkDecoder`](super::DatalinkDecoder) and
-/// [`DatalinkFrames`](super::DatalinkFrames). Event counters are `u32` and saturate; byte
-/// counters hold 48 bits, as [`LinkStats`](crate::LinkStats)'.
+/// Counters kept per stream by [`Decoder`](super::Decoder) and
+/// [`Frames`](super::Frames). Event counters are `u32` and saturate; byte
+/// counters hold 48 bits, as [`foc::Stats`](crate::foc::Stats)'.
 ///
-/// Every byte fed ends up either in an accepted frame or in [`DatalinkStats::bytes_skipped`]:
-/// after [`DatalinkDecoder::flush`](super::DatalinkDecoder::flush),
+/// Every byte fed ends up either in an accepted frame or in [`Stats::bytes_skipped`]:
+/// after [`Decoder::flush`](super::Decoder::flush),
 /// `bytes == 160 * frames + bytes_skipped`, and
 /// `frames == frames_with_length_byte(Covered) + frames_with_length_byte(Total)`.
 ///
 /// Every record of an accepted frame is counted once: as its channel's
-/// ([`DatalinkStats::channel`]), an [empty slot](DatalinkStats::empty_slots), a
-/// [bad channel](DatalinkStats::bad_channels) or a
-/// [duplicate channel](DatalinkStats::duplicate_channels); so
+/// ([`Stats::channel`]), an [empty slot](Stats::empty_slots), a
+/// [bad channel](Stats::bad_channels) or a
+/// [duplicate channel](Stats::duplicate_channels); so
 /// `8 * frames == records + empty_slots + bad_channels + duplicate_channels`.
 ///
-/// The hub's frame counter is followed exactly as [`LinkStats`](crate::LinkStats) follows an
-/// ESC's packet numbers (a [`PacketSequence`]: [lost frames](DatalinkStats::lost_frames),
-/// [duplicates](DatalinkStats::duplicate_frames), [restarts](DatalinkStats::restarts)), and so
+/// The hub's frame counter is followed exactly as [`foc::Stats`](crate::foc::Stats) follows an
+/// ESC's packet numbers (a [`PacketSequence`]: [lost frames](Stats::lost_frames),
+/// [duplicates](Stats::duplicate_frames), [restarts](Stats::restarts)), and so
 /// is each channel's packet number, record after record. A channel's lost packets are the
 /// numbers the stream did not carry, whether the ESC's own wire lost them or the hub forwarded
 /// its records less often than the ESC sent frames.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
-pub struct DatalinkStats {
+pub struct Stats {
     bytes: ByteCounts,
     crc_failures: u32,
     bad_headers: u32,
@@ -43,10 +43,10 @@ pub struct DatalinkStats {
     channels: [PacketSequence; CHANNELS],
 }
 
-impl DatalinkStats {
+impl Stats {
     /// All counters zero.
     pub const fn new() -> Self {
-        DatalinkStats {
+        Stats {
             bytes: ByteCounts::new(),
             crc_failures: 0,
             bad_headers: 0,
@@ -116,7 +116,7 @@ impl DatalinkStats {
     }
 
     /// Frame-counter values missing between consecutive frames (as
-    /// [`LinkStats::lost_packets`](crate::LinkStats::lost_packets)).
+    /// [`foc::Stats::lost_packets`](crate::foc::Stats::lost_packets)).
     pub const fn lost_frames(&self) -> u32 {
         self.counter.lost()
     }
@@ -127,7 +127,7 @@ impl DatalinkStats {
     }
 
     /// Frames whose counter starts a new sequence (the hub restarted, or two streams are
-    /// interleaved), as [`LinkStats::restarts`](crate::LinkStats::restarts).
+    /// interleaved), as [`foc::Stats::restarts`](crate::foc::Stats::restarts).
     pub const fn restarts(&self) -> u32 {
         self.counter.restarts()
     }
@@ -175,7 +175,7 @@ impl DatalinkStats {
 
     /// Counts an accepted frame.
     #[inline]
-    pub(crate) fn frame(&mut self, frame: &DatalinkFrame, report: &FrameReport) {
+    pub(crate) fn frame(&mut self, frame: &Frame, report: &FrameReport) {
         self.counter.next(frame.counter);
         let n = &mut self.length_bytes[report.length_byte as usize];
         *n = n.saturating_add(1);
@@ -205,7 +205,7 @@ impl DatalinkStats {
 /// The most data frames an ESC can send on its own 19200-baud wire (24 bytes each) in the time
 /// of `hub_frames` DataLink frames (160 bytes each at 115200 baud): `ceil(hub_frames * 10 / 9)`.
 pub const fn esc_frames_in(hub_frames: u32) -> u32 {
-    let hub_bits = hub_frames as u64 * FRAME_LEN as u64 * crate::wire::BAUD_RATE as u64;
+    let hub_bits = hub_frames as u64 * FRAME_LEN as u64 * crate::foc::BAUD_RATE as u64;
     let esc_bits = DATA_FRAME_LEN as u64 * BAUD_RATE as u64;
     let n = hub_bits.div_ceil(esc_bits);
     if n > u32::MAX as u64 {
@@ -215,7 +215,7 @@ pub const fn esc_frames_in(hub_frames: u32) -> u32 {
     }
 }
 
-impl fmt::Display for DatalinkStats {
+impl fmt::Display for Stats {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         write!(
             f,
@@ -243,7 +243,7 @@ impl fmt::Display for DatalinkStats {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::DataFrame;
+    use crate::foc::DataFrame;
 
     #[test]
     fn esc_frames_in_a_silence() {
@@ -256,12 +256,12 @@ mod tests {
 
     #[test]
     fn size() {
-        assert_eq!(size_of::<DatalinkStats>(), 220);
+        assert_eq!(size_of::<Stats>(), 220);
     }
 
     #[test]
     fn silence_reaches_the_counter_and_every_channel() {
-        let mut s = DatalinkStats::new();
+        let mut s = Stats::new();
         let report = FrameReport {
             length_byte: LengthByte::Total,
             empty_slots: 7,
@@ -269,7 +269,7 @@ mod tests {
             duplicate_channels: 0,
         };
         let frame = |counter: u16, packet: u16| {
-            let mut f = DatalinkFrame::new(counter);
+            let mut f = Frame::new(counter);
             f.slots[3] = Some(DataFrame {
                 packet,
                 ..Default::default()

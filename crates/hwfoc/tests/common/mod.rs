@@ -1,8 +1,9 @@
 //! What the property tests of both protocols share: the data-frame generator, cut points, and
 //! the byte-at-a-time decoding path (one for any scanner of `hwfoc::scan`).
 
+use hwfoc::Status;
+use hwfoc::foc::DataFrame;
 use hwfoc::scan::{Scanner, StreamDecoder};
-use hwfoc::{DataFrame, Status};
 use proptest::prelude::*;
 use proptest::sample::Index;
 

@@ -686,7 +686,8 @@ impl Fleet {
 mod tests {
     use super::*;
     use crate::commands::monitor::config::{MonitorSetup, Overrides};
-    use hwfoc::{DataFrame, Status};
+    use hwfoc::Status;
+    use hwfoc::foc::DataFrame;
 
     fn fleet(n: usize) -> Fleet {
         let config = MonitorSetup::load(&Overrides {

@@ -476,7 +476,8 @@ fn esc_data<'a>(
 mod tests {
     use super::*;
 
-    use hwfoc::{DataFrame, Quantity, Temperature};
+    use hwfoc::foc::DataFrame;
+    use hwfoc::{Quantity, Temperature};
 
     /// The record of a frame at `t` with this throttle and status word.
     fn frame(t: f64, throttle: u16, status: u16) -> Record {

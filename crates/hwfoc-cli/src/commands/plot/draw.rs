@@ -1063,7 +1063,7 @@ mod tests {
     #[test]
     fn paths_break_at_gaps_and_missing_values() {
         let frame = |throttle: u16, mos: u8| {
-            let f = hwfoc::DataFrame {
+            let f = hwfoc::foc::DataFrame {
                 throttle_in_raw: throttle,
                 mos_adc: mos,
                 ..Default::default()

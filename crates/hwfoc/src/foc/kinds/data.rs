@@ -9,9 +9,11 @@
 //! byte first ([`Checksum::Sum16Le`]; see `docs/PROTOCOL-NOTES.md`: real frames do not match
 //! CRC-16/MODBUS, the sum does).
 
+use super::{FrameKind, sealed};
+use crate::foc::FrameError;
 use crate::status::Status;
 use crate::units::{ERPM_PER_RAW, Linear, Settings, Temperature};
-use crate::wire::{Checksum, FrameError, FrameKind, VERSION, sealed, sum16};
+use crate::wire::{Checksum, VERSION, sum16};
 
 /// Command byte of a real-time data frame.
 pub const CMD_DATA: u8 = 0x02;
@@ -31,7 +33,8 @@ const _: () = assert!(DATA_FRAME_LEN == 4 + DATA_PAYLOAD_LEN + 2);
 /// conversion depends on them (current scale, pole pairs, gear ratio).
 ///
 /// ```
-/// use hwfoc::{DataFrame, Settings};
+/// use hwfoc::Settings;
+/// use hwfoc::foc::DataFrame;
 ///
 /// let bytes = [0x9B, 0x16, 0x01, 0x02, 0x05, 0xC2, 0, 0, 0, 0, 0, 0, 0x00, 0xF7,
 ///              0xFF, 0xFF, 0xFF, 0xFF, 0xCE, 0xD1, 0x00, 0x00, 0x0D, 0x08];
@@ -41,7 +44,7 @@ const _: () = assert!(DATA_FRAME_LEN == 4 + DATA_PAYLOAD_LEN + 2);
 /// assert_eq!(frame.current_a(&Settings::default()), -0.015625);
 /// assert_eq!(frame.mos_temp().celsius(), Some(28.0));
 /// assert_eq!(frame.encode(), bytes);
-/// # Ok::<(), hwfoc::FrameError>(())
+/// # Ok::<(), hwfoc::foc::FrameError>(())
 /// ```
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
 pub struct DataFrame {
@@ -117,7 +120,7 @@ impl sealed::Sealed for DataFrame {
     }
 
     #[inline(always)]
-    fn count(&self, stats: &mut crate::LinkStats) {
+    fn count(&self, stats: &mut crate::foc::Stats) {
         stats.data_frame(self.packet);
     }
 }

@@ -19,8 +19,10 @@
 
 use core::fmt;
 
-use crate::stats::LinkStats;
-use crate::wire::{Checksum, FrameError, FrameKind, VERSION, sealed};
+use super::{FrameKind, sealed};
+use crate::foc::FrameError;
+use crate::foc::stats::Stats;
+use crate::wire::{Checksum, VERSION};
 
 /// Length byte of a device-information frame: bytes before the check byte.
 pub const INFO_LENGTH_BYTE: u8 = 0x4C;
@@ -71,7 +73,7 @@ impl core::error::Error for InfoFieldError {}
 /// A device-information frame: 72 bytes of space-padded ASCII text.
 ///
 /// ```
-/// use hwfoc::InfoFrame;
+/// use hwfoc::foc::InfoFrame;
 ///
 /// let info = InfoFrame::new("XR_FOC_ESC", "HW577_KZ1_V1.1", "XR-01.0.00", "01040443")?;
 /// let bytes = info.encode();
@@ -213,7 +215,7 @@ impl sealed::Sealed for InfoFrame {
     }
 
     #[inline(always)]
-    fn count(&self, stats: &mut LinkStats) {
+    fn count(&self, stats: &mut Stats) {
         stats.info_frame();
     }
 }

@@ -9,14 +9,14 @@
 //! byte: scanning resumes at the byte after the rejected `0x9B`, so a lone `0x9B`, a fake header,
 //! a cut frame or a run of garbage never hides a following intact frame.
 //!
-//! The scanner names no frame kind: it asks the list of kinds in [`crate::frame`] whether a frame
-//! starts at a candidate, and how long a candidate with a given length byte is. Those calls are
-//! inlined with every kind's constants: no dynamic dispatch, no function pointer, and no loop over
-//! the kinds is left in the scanner.
+//! The scanner names no frame kind: it asks the list of kinds in [`crate::foc::frame`] whether a
+//! frame starts at a candidate, and how long a candidate with a given length byte is. Those calls
+//! are inlined with every kind's constants: no dynamic dispatch, no function pointer, and no loop
+//! over the kinds is left in the scanner.
 
-use crate::frame::{Frame, MAX_FRAME_LEN, candidate_len, or_length_bytes, wire_len_of};
-use crate::scan::{Candidate, Scan, Scanner, Stats, StreamDecoder};
-use crate::stats::LinkStats;
+use crate::foc::frame::{Frame, MAX_FRAME_LEN, candidate_len, or_length_bytes, wire_len_of};
+use crate::foc::stats::Stats;
+use crate::scan::{self, Candidate, Scan, StreamDecoder};
 use crate::wire::SYNC;
 
 /// A frame and where it started in the stream.
@@ -103,7 +103,7 @@ pub(crate) fn find_sync_then(
 fn scan_next(
     data: &[u8],
     pos: &mut usize,
-    stats: &mut LinkStats,
+    stats: &mut Stats,
     at_end: bool,
     first_guess: bool,
 ) -> Option<(usize, Frame)> {
@@ -138,7 +138,7 @@ fn scan_next(
 pub(crate) fn take_candidate(
     data: &[u8],
     pos: &mut usize,
-    stats: &mut LinkStats,
+    stats: &mut Stats,
     at_end: bool,
 ) -> Candidate<(usize, Frame)> {
     let i = *pos;
@@ -170,32 +170,32 @@ pub(crate) fn take_candidate(
 /// The HW-FOC scanner, as the streaming layer ([`crate::scan`]) runs it: [`Decoder`] and
 /// [`Frames`] are it under [`StreamDecoder`] and [`Scan`].
 #[derive(Debug, Clone, Copy, Default)]
-pub struct HwFocScanner;
+pub struct Scanner;
 
-impl crate::scan::sealed::Sealed for HwFocScanner {}
-impl crate::scan::sealed::Sealed for LinkStats {}
+impl crate::scan::sealed::Sealed for Scanner {}
+impl crate::scan::sealed::Sealed for Stats {}
 
-impl Stats for LinkStats {
-    const NEW: Self = LinkStats::new();
+impl scan::Stats for Stats {
+    const NEW: Self = Stats::new();
 
     #[inline]
     fn bytes(&self) -> u64 {
-        LinkStats::bytes(self)
+        Stats::bytes(self)
     }
 
     #[inline]
     fn add_bytes(&mut self, n: usize) {
-        LinkStats::add_bytes(self, n);
+        Stats::add_bytes(self, n);
     }
 
     fn line_silent(&mut self, max_frames: u32) {
-        LinkStats::line_silent(self, max_frames);
+        Stats::line_silent(self, max_frames);
     }
 }
 
-impl Scanner for HwFocScanner {
+impl scan::Scanner for Scanner {
     type Item = Decoded;
-    type Stats = LinkStats;
+    type Stats = Stats;
     type Held = [u8; MAX_FRAME_LEN - 1];
     type Pair = [u8; 2 * MAX_FRAME_LEN];
     const HELD: Self::Held = [0; MAX_FRAME_LEN - 1];
@@ -217,7 +217,7 @@ impl Scanner for HwFocScanner {
     fn scan_all<const AT_END: bool>(
         data: &[u8],
         base: u64,
-        stats: &mut LinkStats,
+        stats: &mut Stats,
         on_frame: &mut impl FnMut(Decoded),
     ) -> usize {
         let mut pos = 0;
@@ -242,7 +242,7 @@ impl Scanner for HwFocScanner {
     }
 
     #[inline(always)]
-    fn scan_next(data: &[u8], pos: &mut usize, stats: &mut LinkStats) -> Option<Decoded> {
+    fn scan_next(data: &[u8], pos: &mut usize, stats: &mut Stats) -> Option<Decoded> {
         scan_next(data, pos, stats, true, true).map(|(at, frame)| Decoded {
             offset: at as u64,
             frame,
@@ -253,14 +253,14 @@ impl Scanner for HwFocScanner {
 /// A streaming decoder of the ESC wire: feed it bytes in any chunking, get every frame once
 /// (the streaming layer's [`StreamDecoder`] over the HW-FOC scanner).
 ///
-/// Its whole state is a 76-byte buffer for a frame still arriving plus the [`LinkStats`]:
+/// Its whole state is a 76-byte buffer for a frame still arriving plus the [`Stats`]:
 /// 120 bytes (`size_of::<Decoder>()`, checked by a test), no allocation, no timing.
 /// Large chunks are scanned in place (the bulk path); only the unfinished tail is copied. One
 /// byte pushed completes at most three frames (when a rejected device-information candidate
 /// turns out to hold data frames).
 ///
 /// ```
-/// use hwfoc::{Decoder, DataFrame, Frame};
+/// use hwfoc::foc::{DataFrame, Decoder, Frame};
 ///
 /// let frame = DataFrame { packet: 7, voltage_raw: 252, ..Default::default() };
 /// let mut wire = vec![0x00, 0x9B, 0x13]; // noise and a lone sync byte
@@ -286,8 +286,8 @@ impl Scanner for HwFocScanner {
 /// been sent. The held bytes are decided at once, and the next data frame (the first one after
 /// the silence, whatever its bytes' chunking) counts as a loss of `step - 1` packets only if
 /// its packet-number step is from 2 to `max_frames + 1`; a larger step is a
-/// [restart](LinkStats::restarts). A step of 0 is still a duplicate and 1 the next frame. The
-/// rule replaces the [`MAX_PACKET_GAP`](crate::stats::MAX_PACKET_GAP) rule for that one frame,
+/// [restart](Stats::restarts). A step of 0 is still a duplicate and 1 the next frame. The
+/// rule replaces the [`MAX_PACKET_GAP`](crate::counters::MAX_PACKET_GAP) rule for that one frame,
 /// then the default returns. Several calls before that frame add up (their silences could each
 /// have hidden frames); a step beyond 32768 is a step backwards, a restart whatever
 /// `max_frames` says. Before the first data frame there is no step, and the call only decides
@@ -302,8 +302,9 @@ impl Scanner for HwFocScanner {
 /// silence of the line; call it only for gaps longer than the receiving path can introduce.
 ///
 /// ```
-/// use hwfoc::wire::{BAUD_RATE, byte_ns};
-/// use hwfoc::{DataFrame, Decoder};
+/// use hwfoc::foc::BAUD_RATE;
+/// use hwfoc::wire::byte_ns;
+/// use hwfoc::foc::{DataFrame, Decoder};
 ///
 /// let frame = |packet| DataFrame { packet, ..Default::default() }.encode();
 /// let mut decoder = Decoder::new();
@@ -317,7 +318,7 @@ impl Scanner for HwFocScanner {
 /// assert_eq!(decoder.stats().restarts(), 1);
 /// assert_eq!(decoder.stats().lost_packets(), 2);
 /// ```
-pub type Decoder = StreamDecoder<HwFocScanner>;
+pub type Decoder = StreamDecoder<Scanner>;
 
 /// Decodes every frame in a complete buffer, in place: the bulk path.
 ///
@@ -326,7 +327,7 @@ pub type Decoder = StreamDecoder<HwFocScanner>;
 /// would, with the same statistics.
 ///
 /// ```
-/// use hwfoc::{frames, DataFrame, Frame};
+/// use hwfoc::foc::{DataFrame, Frame, frames};
 ///
 /// let mut wire = Vec::new();
 /// for packet in 0..3u16 {
@@ -347,12 +348,12 @@ pub fn frames(data: &[u8]) -> Frames<'_> {
 }
 
 /// Iterator returned by [`frames`].
-pub type Frames<'a> = Scan<'a, HwFocScanner>;
+pub type Frames<'a> = Scan<'a, Scanner>;
 
 #[cfg(test)]
 pub(crate) mod tests {
     use super::*;
-    use crate::DataFrame;
+    use crate::foc::DataFrame;
 
     /// Asserts that `find_header` (a scanner's word-at-a-time search for a sync byte followed
     /// by one of `seconds`) finds what a plain byte-by-byte search finds, over 20 000 random

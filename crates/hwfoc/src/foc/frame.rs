@@ -1,82 +1,14 @@
 //! The list of frame kinds, and what is built from it: [`Frame`] (one arm per kind),
-//! [`MAX_FRAME_LEN`], [`parse`] and the dispatch the scanner of [`crate::decoder`] uses.
-//!
-//! The layers of the codec, each knowing only those below it:
-//!
-//! | module | holds |
-//! |---|---|
-//! | [`crate::wire`] | line settings ([`BAUD_RATE`](crate::wire::BAUD_RATE), [`byte_ns`](crate::wire::byte_ns)), sync byte, [`Checksum`](crate::wire::Checksum) kinds, [`FrameError`], the [`FrameKind`] trait |
-//! | [`crate::kinds`] | one module per kind: [`DataFrame`], [`InfoFrame`] |
-//! | `frame` (here) | the list of kinds: [`Frame`], [`MAX_FRAME_LEN`], [`parse`], [`Parsed`] |
-//! | [`crate::decoder`] | the scanner: [`Decoder`](crate::Decoder), [`frames`](crate::frames) |
-//!
-//! Beside them, [`crate::datalink`] holds the DataLink V2 hub's frame, scanner and statistics,
-//! built on [`crate::wire`], [`DataFrame`]'s payload and the scanner's sync-pair search.
-//!
-//! The scanner never names a kind: right after a frame it asks the first kind of the list
-//! whether another starts there; otherwise it finds a sync byte followed by a known length byte,
-//! asks each kind in turn whether a frame starts there ([`FrameKind::accept`]), and otherwise learns
-//! from the length byte how many bytes the candidate needs before it can be rejected. Every
-//! constant of every kind is known at compile time, so this dispatch compiles to the same
-//! compares a hand-written scanner for these two kinds would make.
-//!
-//! # Adding a frame kind
-//!
-//! A new HW-FOC frame kind (another command, or the older XRotor-Pro `9B 16 03` frame of
-//! `docs/OLDER-PROTOCOLS.md` that should be recognised and reported as unsupported) is:
-//!
-//! 1. **One new file**, `src/kinds/<name>.rs` (plus its `pub mod` line in `src/kinds/mod.rs`):
-//!    the type, with `impl FrameKind` (length byte, version, command, length,
-//!    [`Checksum`](crate::wire::Checksum) kind, and optionally a faster [`FrameKind::accept`]) and
-//!    `impl Sealed` (read the payload of a verified frame, write it, count the frame in
-//!    [`LinkStats`]).
-//! 2. **One arm** in the `frame_kinds!` list below: `Name(Type)` with its doc comment. That arm
-//!    makes the [`Frame`] variant, a `From` conversion, its place in [`Frame::wire_len`],
-//!    [`Frame::encode_into`], [`parse`], the scanner's dispatch, the known length bytes of
-//!    [`FrameError::UnknownLength`] and [`MAX_FRAME_LEN`]. Arms are tried in order, and only the
-//!    first is tried right after a frame: keep the most frequent kind first.
-//! 3. If the kind should be counted apart, a counter in [`LinkStats`]
-//!    (`stats.rs`) for its `count` to call.
-//!
-//! Compile-time checks below reject a kind whose length byte is not its length minus its check
-//! bytes, two kinds with the same header, and two kinds sharing a length byte but not a length
-//! (two kinds *may* share a length byte: the `9B 16 03` frame would share the data frame's).
-//! A kind longer than 77 bytes raises [`MAX_FRAME_LEN`], and with it the [`Decoder`](crate::Decoder)'s
-//! state (`MAX_FRAME_LEN - 1` bytes of buffer) and the size of [`Frame`]: the decoder's
-//! `state_is_under_128_bytes` test and the size probe's `DECODER_STATE_BYTES` check catch it.
-//!
-//! # Another protocol
-//!
-//! - **DataLink V2** (the hub's aggregate frame, `docs/PROTOCOL-NOTES.md`): `9B 9E 01 02` (or a
-//!   length byte 0xA0, which some drivers write), 160 bytes, a frame counter and 8 ESC records,
-//!   CRC-16/XMODEM of bytes 0..=157, low byte first, on a 115200-baud wire. It is **not** a kind
-//!   of this list but a module family of its own, [`crate::datalink`], with its own scanner
-//!   ([`DatalinkDecoder`](crate::DatalinkDecoder), [`datalink::frames`](crate::datalink::frames))
-//!   and statistics ([`DatalinkStats`](crate::DatalinkStats)): as a kind it would have made
-//!   [`MAX_FRAME_LEN`] 160, every [`Decoder`](crate::Decoder) 200 bytes instead of 120 and
-//!   [`Frame`] the size of 8 records, also in firmware that reads one ESC's own wire, where a
-//!   hub frame never comes; and its two length bytes for one length break this list's rule that
-//!   the length byte is the length minus the check bytes. What it shares is shared, not copied:
-//!   the [`Checksum::Crc16Xmodem`](crate::wire::Checksum::Crc16Xmodem) arm, [`SYNC`] and the
-//!   version byte, [`byte_ns`](crate::wire::byte_ns), the data frame's payload layout (a record
-//!   is a channel byte and those 18 bytes), the scanner's sync-pair search, and the following of
-//!   a counter ([`PacketSequence`](crate::PacketSequence)).
-//! - **Hobbywing V3/V4** (`docs/OLDER-PROTOCOLS.md`): same sync byte and baud rate, but no length
-//!   byte and no checksum. Frames are recognised by fixed bytes, by chaining (the next header
-//!   exactly where the previous frame ended) and by the packet counter, which needs state across
-//!   frames. That is a different scanner, not a kind: a module of its own beside
-//!   [`crate::decoder`], using [`SYNC`], [`BAUD_RATE`](crate::wire::BAUD_RATE)
-//!   and [`byte_ns`](crate::wire::byte_ns) from [`crate::wire`] and its own frame types (only
-//!   their conversions, not their layout, resemble [`DataFrame`]'s). Auto-detection would sit
-//!   above both scanners.
+//! [`MAX_FRAME_LEN`], [`parse`] and the dispatch the scanner of [`crate::foc::decoder`] uses.
 
 use core::fmt;
 
-use crate::kinds::data::DataFrame;
-use crate::kinds::info::InfoFrame;
-use crate::stats::LinkStats;
-use crate::wire::sealed::Sealed;
-use crate::wire::{FrameError, FrameKind, SYNC};
+use crate::foc::kinds::FrameKind;
+use crate::foc::kinds::data::DataFrame;
+use crate::foc::kinds::info::InfoFrame;
+use crate::foc::kinds::sealed::Sealed;
+use crate::foc::stats::Stats;
+use crate::wire::SYNC;
 
 /// Declares the frame kinds: one arm per kind, `Variant(Type)`, in the order the scanner tries
 /// them. Everything that lists the kinds is generated from this one list.
@@ -172,7 +104,7 @@ macro_rules! frame_kinds {
             pub(crate) fn take_first(
                 data: &[u8],
                 pos: &mut usize,
-                stats: &mut LinkStats,
+                stats: &mut Stats,
             ) -> Option<(usize, Frame)> {
                 let at = *pos;
                 let frame = <$first_kind as FrameKind>::accept(&data[at..])?;
@@ -187,7 +119,7 @@ macro_rules! frame_kinds {
             pub(crate) fn take(
                 data: &[u8],
                 pos: &mut usize,
-                stats: &mut LinkStats,
+                stats: &mut Stats,
             ) -> Option<(usize, Frame)> {
                 let at = *pos;
                 $(
@@ -323,10 +255,10 @@ pub enum Parsed {
 ///
 /// Like `httparse`, it never allocates and reports a valid but incomplete prefix as
 /// [`Parsed::Partial`] instead of an error. It does not search for a frame: use
-/// [`crate::Decoder`] or [`crate::frames`] for a stream.
+/// [`crate::foc::Decoder`] or [`crate::foc::frames`] for a stream.
 ///
 /// ```
-/// use hwfoc::{parse, Parsed, FrameError};
+/// use hwfoc::foc::{FrameError, Parsed, parse};
 ///
 /// assert_eq!(parse(&[0x9B, 0x16, 0x01]), Ok(Parsed::Partial(24)));
 /// assert_eq!(parse(&[0x9B, 0x42]), Err(FrameError::UnknownLength { found: 0x42 }));
@@ -348,6 +280,53 @@ pub fn parse(bytes: &[u8]) -> Result<Parsed, FrameError> {
         return Ok(Parsed::Partial(len));
     }
     Ok(Parsed::Complete(Frame::verify(bytes, length_byte)?, len))
+}
+
+/// Why bytes are not a valid frame.
+///
+/// Its [`Display`](core::fmt::Display) is implemented in `frame.rs`, beside the list of kinds,
+/// because the message for an unknown length byte names every kind's.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum FrameError {
+    /// The first byte is not the sync byte 0x9B.
+    NoSync {
+        /// The byte found instead.
+        found: u8,
+    },
+    /// The length byte is not that of any known frame kind (0x16 data, 0x4C device information).
+    UnknownLength {
+        /// The length byte found.
+        found: u8,
+    },
+    /// Fewer bytes than a whole frame.
+    Truncated {
+        /// Bytes a whole frame has.
+        needed: usize,
+        /// Bytes given.
+        got: usize,
+    },
+    /// The checksum does not match the bytes: the frame was corrupted on the wire.
+    Checksum {
+        /// Checksum computed over the received bytes.
+        expected: u16,
+        /// Checksum carried by the frame.
+        found: u16,
+    },
+    /// Checksum correct, but a version or command this decoder does not know.
+    UnknownCommand {
+        /// Version byte (byte 2).
+        version: u8,
+        /// Command byte (byte 3).
+        command: u8,
+    },
+    /// A device-information candidate whose text holds a byte that is not ASCII: not a real
+    /// frame (typically a cut one with another frame behind it).
+    NotText {
+        /// Offset of the first such byte in the frame.
+        offset: usize,
+        /// The byte.
+        found: u8,
+    },
 }
 
 impl fmt::Display for FrameError {

@@ -1,0 +1,220 @@
+//! The counters both protocols' statistics keep ([`crate::foc::Stats`],
+//! [`crate::datalink::Stats`]): byte counts of 48 bits, and the following of a packet counter.
+//!
+//! A [`PacketSequence`] sorts every step from one number to the next into one of four events:
+//! the next number (nothing to count), the same number again (a
+//! [duplicate](PacketSequence::duplicates)), a small gap forward ([lost](PacketSequence::lost):
+//! the numbers in between), or a jump that no lost frames explain: a step backwards, or forwards
+//! by more than [`MAX_PACKET_GAP`] + 1. Such a jump is a [restart](PacketSequence::restarts): the
+//! ESC rebooted (its counter starts again), another simulator took over the port, or two
+//! sequences are interleaved. It counts as one restart and no loss, and the sequence continues
+//! from the new number.
+//!
+//! A caller that knows when bytes arrived can tighten the rule for the number after a silence
+//! with [`crate::foc::Decoder::line_silent`]: an ESC that rebooted in a second and a half cannot
+//! have sent 535 frames in that time, so a step of 536 after it is a restart, not a loss of 535.
+
+/// The most data frames one gap in packet numbers is counted as losing: a step forward of more
+/// than `MAX_PACKET_GAP + 1` is a [restart](crate::foc::Stats::restarts), not a loss.
+///
+/// Why 1000: a running ESC sends a data frame every 50 to 56 ms, so 1000 lost frames are 50 s
+/// without a single frame getting through (six minutes of an idle ESC's frames, one every
+/// ~364 ms): longer than any dropout a live link survives unnoticed (such a link was cut). And
+/// the larger the gap allowed, the more restarts pass for losses: an ESC whose counter stood
+/// within `MAX_PACKET_GAP` below the number it restarts from (a chance of about 1000 in 65536)
+/// looks like a gap forward. On a timed source,
+/// [`Decoder::line_silent`](crate::foc::Decoder::line_silent) settles both cases from the time
+/// that passed.
+pub const MAX_PACKET_GAP: u16 = 1000;
+
+/// The largest step forward of a packet number (modulo 65536): a larger one is a step backwards.
+const MAX_FORWARD_STEP: u16 = 0x8000;
+
+/// The two byte counters of a protocol's statistics ([`foc::Stats`](crate::foc::Stats),
+/// [`datalink::Stats`](crate::datalink::Stats)), of 48 bits each: a `u32` and a `u16`. They take
+/// 12 bytes at an alignment of 4, where two `u64` would take 16 at an alignment of 8: that is
+/// what keeps [`foc::Stats`](crate::foc::Stats), with every event counter a `u32`, at 40 bytes,
+/// and the HW-FOC [`Decoder`] at 120.
+///
+/// 2^48 bytes are 4.6 million years of a 19200-baud wire, or 78 hours of reading a file at
+/// 1 GB/s; past that a count wraps to 0. Saturating instead would cost about 110 bytes of
+/// Cortex-M code (the counters are added to all through the scanner) for a count that no stream
+/// reaches.
+///
+/// [`Decoder`]: crate::foc::Decoder
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+pub(crate) struct ByteCounts {
+    low: [u32; 2],
+    high: [u16; 2],
+}
+
+/// Which of the [`ByteCounts`].
+#[derive(Clone, Copy)]
+pub(crate) enum Bytes {
+    /// Bytes fed.
+    Fed = 0,
+    /// Bytes skipped.
+    Skipped = 1,
+}
+
+impl ByteCounts {
+    pub(crate) const fn new() -> Self {
+        ByteCounts {
+            low: [0; 2],
+            high: [0; 2],
+        }
+    }
+
+    pub(crate) const fn get(&self, which: Bytes) -> u64 {
+        self.low[which as usize] as u64 + ((self.high[which as usize] as u64) << 32)
+    }
+
+    #[inline]
+    pub(crate) fn add(&mut self, which: Bytes, n: usize) {
+        let sum = self.get(which).wrapping_add(n as u64);
+        self.low[which as usize] = sum as u32;
+        self.high[which as usize] = (sum >> 32) as u16;
+    }
+}
+
+/// The numbers of one counter (an ESC's packet numbers, a DataLink hub's frame counter),
+/// followed step by step: each number after the first is sorted into exactly one of the next
+/// number, a [duplicate](PacketSequence::duplicates), a gap of [lost](PacketSequence::lost)
+/// numbers, or a [restart](PacketSequence::restarts), by the rule of the [module](self)
+/// documentation ([`MAX_PACKET_GAP`], and the tighter limit after a silence of the line).
+///
+/// [`foc::Stats`](crate::foc::Stats) keeps one for the data frames' packet numbers;
+/// [`datalink::Stats`](crate::datalink::Stats) one for the hub's frame counter and one per ESC
+/// channel. Counters are `u32` and saturate; 20 bytes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+pub struct PacketSequence {
+    pub(crate) count: u32,
+    pub(crate) lost: u32,
+    pub(crate) duplicates: u32,
+    pub(crate) restarts: u32,
+    pub(crate) last: u16,
+    /// The largest step to the next number that counts as a loss, as set by
+    /// [`PacketSequence::line_silent`]; 0 (no silence since the last number) means
+    /// `MAX_PACKET_GAP + 1`.
+    pub(crate) gap_limit: u16,
+}
+
+impl PacketSequence {
+    /// No number seen yet.
+    pub const fn new() -> Self {
+        PacketSequence {
+            count: 0,
+            lost: 0,
+            duplicates: 0,
+            restarts: 0,
+            last: 0,
+            gap_limit: 0,
+        }
+    }
+
+    /// Numbers seen (frames or records counted).
+    pub const fn count(&self) -> u32 {
+        self.count
+    }
+
+    /// Numbers missing between consecutive numbers of one sequence: a step of
+    /// `d = (next - last) mod 65536` counts `d - 1` when `2 <= d <= MAX_PACKET_GAP + 1`
+    /// (after a silence, the limit it set); a larger step is a restart and loses nothing.
+    pub const fn lost(&self) -> u32 {
+        self.lost
+    }
+
+    /// Numbers equal to the one before (not a loss).
+    pub const fn duplicates(&self) -> u32 {
+        self.duplicates
+    }
+
+    /// Numbers that start a new sequence: a step backwards (`d > 32768` modulo 65536) or
+    /// forwards beyond the gap limit. A restart counts no loss and no duplicate.
+    pub const fn restarts(&self) -> u32 {
+        self.restarts
+    }
+
+    /// The last number seen, if any.
+    pub const fn last(&self) -> Option<u16> {
+        if self.count == 0 {
+            None
+        } else {
+            Some(self.last)
+        }
+    }
+
+    /// Fraction of expected numbers that arrived: `count / (count + lost)`, or `None` before
+    /// the first. Restarts expect nothing.
+    pub fn delivery_ratio(&self) -> Option<f64> {
+        if self.count == 0 {
+            return None;
+        }
+        let count = f64::from(self.count);
+        Some(count / (count + f64::from(self.lost)))
+    }
+
+    /// The line was silent for a time in which at most `max_frames` numbers could have been
+    /// sent: the next step counts as a loss only up to `max_frames + 1` (at most 32768).
+    /// Silences before one number add up.
+    pub(crate) fn line_silent(&mut self, max_frames: u32) {
+        let limit = if self.gap_limit == 0 {
+            1
+        } else {
+            u32::from(self.gap_limit)
+        };
+        let limit = limit.saturating_add(max_frames);
+        self.gap_limit = limit.min(u32::from(MAX_FORWARD_STEP)) as u16;
+    }
+
+    /// Takes the next number and classifies its step from the last one.
+    #[inline]
+    pub(crate) fn next(&mut self, number: u16) {
+        if self.count != 0 {
+            let limit = if self.gap_limit == 0 {
+                MAX_PACKET_GAP + 1
+            } else {
+                self.gap_limit
+            };
+            match number.wrapping_sub(self.last) {
+                0 => self.duplicates = self.duplicates.saturating_add(1),
+                // The next number (a step of 1) loses nothing; the limit is at least 1.
+                step if step <= limit => {
+                    self.lost = self.lost.saturating_add(u32::from(step - 1));
+                }
+                _ => self.restarts = self.restarts.saturating_add(1),
+            }
+        }
+        self.gap_limit = 0;
+        self.count = self.count.saturating_add(1);
+        self.last = number;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn byte_counters_hold_48_bits() {
+        let mut c = ByteCounts::default();
+        for n in [1, 0xFFFF, 1, 0xFFFF_0000, 0x1234_5678_9ABC] {
+            let before = c.get(Bytes::Fed);
+            c.add(Bytes::Fed, n);
+            assert_eq!(c.get(Bytes::Fed), before + n as u64);
+            assert_eq!(c.get(Bytes::Skipped), 0);
+        }
+        assert_eq!(c.get(Bytes::Fed), 0x1235_5678_9ABD);
+        c.add(Bytes::Skipped, 0xFFFF_FFFF);
+        c.add(Bytes::Skipped, 2);
+        assert_eq!(c.get(Bytes::Skipped), 0x1_0000_0001);
+        c.add(Bytes::Fed, (1 << 48) - 0x1235_5678_9ABD + 5);
+        assert_eq!(c.get(Bytes::Fed), 5);
+        assert_eq!(c.get(Bytes::Skipped), 0x1_0000_0001);
+    }
+
+    #[test]
+    fn a_sequence_fits_in_20_bytes() {
+        assert_eq!(size_of::<PacketSequence>(), 20);
+    }
+}

@@ -1,0 +1,89 @@
+//! HW-FOC: the telemetry an ESC sends on its own wire (19200 baud, a 24-byte data frame every
+//! 50 ms, a 77-byte device-information frame at start), `docs/PROTOCOL-NOTES.md`.
+//!
+//! Its layers, each knowing only those below it, over what the protocols share in
+//! [`crate::wire`] (byte timing, sync byte, [`Checksum`](crate::wire::Checksum) kinds):
+//!
+//! | module | holds |
+//! |---|---|
+//! | [`kinds`] | the [`FrameKind`] trait; one module per kind: [`DataFrame`], [`InfoFrame`] |
+//! | `frame` | the list of kinds: [`Frame`], [`MAX_FRAME_LEN`], [`parse`], [`Parsed`], [`FrameError`] |
+//! | `stats` | the link statistics: [`Stats`] |
+//! | `decoder` | the scanner: [`Decoder`], [`frames`], [`Decoded`], under the streaming layer of [`crate::scan`] |
+//!
+//! Beside this module, [`crate::datalink`] holds the DataLink V2 hub's frame, scanner and
+//! statistics, built on [`crate::wire`], [`DataFrame`]'s payload and the scanner's sync-pair
+//! search.
+//!
+//! The scanner never names a kind: right after a frame it asks the first kind of the list
+//! whether another starts there; otherwise it finds a sync byte followed by a known length byte,
+//! asks each kind in turn whether a frame starts there ([`FrameKind::accept`]), and otherwise
+//! learns from the length byte how many bytes the candidate needs before it can be rejected. Every
+//! constant of every kind is known at compile time, so this dispatch compiles to the same
+//! compares a hand-written scanner for these two kinds would make.
+//!
+//! # Adding a frame kind
+//!
+//! A new HW-FOC frame kind (another command, or the older XRotor-Pro `9B 16 03` frame of
+//! `docs/OLDER-PROTOCOLS.md` that should be recognised and reported as unsupported) is:
+//!
+//! 1. **One new file**, `src/foc/kinds/<name>.rs` (plus its `pub mod` line in
+//!    `src/foc/kinds/mod.rs`): the type, with `impl FrameKind` (length byte, version, command,
+//!    length, [`Checksum`](crate::wire::Checksum) kind, and optionally a faster
+//!    [`FrameKind::accept`]) and `impl Sealed` (read the payload of a verified frame, write it,
+//!    count the frame in [`Stats`]).
+//! 2. **One arm** in the `frame_kinds!` list of `frame.rs`: `Name(Type)` with its doc comment. That
+//!    arm makes the [`Frame`] variant, a `From` conversion, its place in [`Frame::wire_len`],
+//!    [`Frame::encode_into`], [`parse`], the scanner's dispatch, the known length bytes of
+//!    [`FrameError::UnknownLength`] and [`MAX_FRAME_LEN`]. Arms are tried in order, and only the
+//!    first is tried right after a frame: keep the most frequent kind first.
+//! 3. If the kind should be counted apart, a counter in [`Stats`]
+//!    (`stats.rs`) for its `count` to call.
+//!
+//! Compile-time checks in `frame.rs` reject a kind whose length byte is not its length minus its
+//! check bytes, two kinds with the same header, and two kinds sharing a length byte but not a
+//! length (two kinds *may* share a length byte: the `9B 16 03` frame would share the data frame's).
+//! A kind longer than 77 bytes raises [`MAX_FRAME_LEN`], and with it the [`Decoder`]'s
+//! state (`MAX_FRAME_LEN - 1` bytes of buffer) and the size of [`Frame`]: the decoder's
+//! `state_is_under_128_bytes` test and the size probe's `DECODER_STATE_BYTES` check catch it.
+//!
+//! # Another protocol
+//!
+//! - **DataLink V2** (the hub's aggregate frame, `docs/PROTOCOL-NOTES.md`): `9B 9E 01 02` (or a
+//!   length byte 0xA0, which some drivers write), 160 bytes, a frame counter and 8 ESC records,
+//!   CRC-16/XMODEM of bytes 0..=157, low byte first, on a 115200-baud wire. It is **not** a kind
+//!   of this list but a module family of its own, [`crate::datalink`], with its own scanner
+//!   ([`datalink::Decoder`](crate::datalink::Decoder),
+//!   [`datalink::frames`](crate::datalink::frames)) and statistics
+//!   ([`datalink::Stats`](crate::datalink::Stats)): as a kind it would have made [`MAX_FRAME_LEN`]
+//!   160, every [`Decoder`] 200 bytes instead of 120 and [`Frame`] the size of 8 records, also in
+//!   firmware that reads one ESC's own wire, where a hub frame never comes; and its two length
+//!   bytes for one length break this list's rule that the length byte is the length minus the check
+//!   bytes. What it shares is shared, not copied: the
+//!   [`Checksum::Crc16Xmodem`](crate::wire::Checksum::Crc16Xmodem) arm, [`SYNC`](crate::wire::SYNC)
+//!   and the version byte, [`byte_ns`](crate::wire::byte_ns), the data frame's payload layout (a
+//!   record is a channel byte and those 18 bytes), the scanner's sync-pair search, and the
+//!   following of a counter ([`PacketSequence`](crate::counters::PacketSequence)).
+//! - **Hobbywing V3/V4** (`docs/OLDER-PROTOCOLS.md`): same sync byte and baud rate, but no length
+//!   byte and no checksum. Frames are recognised by fixed bytes, by chaining (the next header
+//!   exactly where the previous frame ended) and by the packet counter, which needs state across
+//!   frames. That is a different scanner, not a kind: a protocol module of its own beside
+//!   this one and [`crate::datalink`], using [`SYNC`](crate::wire::SYNC) and
+//!   [`byte_ns`](crate::wire::byte_ns) from [`crate::wire`], the same baud rate and its own frame
+//!   types (only their conversions, not their layout, resemble [`DataFrame`]'s). Auto-detection
+//!   would sit above both scanners.
+
+pub(crate) mod decoder;
+pub(crate) mod frame;
+pub mod kinds;
+mod stats;
+
+/// Baud rate of the HW-FOC telemetry wire (8 data bits, no parity, 1 stop bit: 8N1).
+pub const BAUD_RATE: u32 = 19_200;
+
+pub use decoder::{Decoded, Decoder, Frames, Scanner, frames};
+pub use frame::{Frame, FrameError, MAX_FRAME_LEN, Parsed, parse};
+pub use kinds::FrameKind;
+pub use kinds::data::DataFrame;
+pub use kinds::info::{InfoFieldError, InfoFrame};
+pub use stats::Stats;
