@@ -14,7 +14,7 @@
 //! (each frame's current holding until the next), on the raw voltage and current, converted
 //! once at the end; an input without times counts each frame as the nominal period, and the
 //! report says so. The duration of an ESC's frames is the time that passed between them: a
-//! clock that steps back or jumps forward ([`Step`]) adds nothing, and the report counts such
+//! clock that steps back or jumps forward ([`Step`](crate::clock::Step)) adds nothing, and the report counts such
 //! discontinuities. Times of sources with a wall clock (recordings, serial ports) are shown as
 //! ISO 8601 dates in UTC; other sources' times as their seconds.
 //!
