@@ -100,6 +100,20 @@
 //! assert_eq!(text.lines().count(), 3); // the header and two records
 //! # Ok::<(), ExportError>(())
 //! ```
+//!
+//! # Paths
+//!
+//! Each item has one public path: those above. The modules behind the crate-root items are
+//! private, and so are the helpers the public modules use among themselves
+//! (`tests/surface.rs` lists the whole surface):
+//!
+//! ```compile_fail,E0603
+//! use hwfoc_io::sources::Sources;
+//! ```
+//!
+//! ```compile_fail,E0603
+//! use hwfoc_io::write::metadata::schema_with;
+//! ```
 
 #![forbid(unsafe_op_in_unsafe_fn)]
 #![warn(missing_docs)]

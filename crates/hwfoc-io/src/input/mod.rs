@@ -15,7 +15,7 @@
 //!
 //! Each kind of input is a module (`raw.rs`, `csv.rs`, `recording.rs`, `ports.rs`) declaring
 //! its [`InputFormat`] (names, clock, whether live, whether its streams are recorded ports:
-//! what [`crate::sources::Sources`] and the summary ask of a format) and implementing `Source`
+//! what [`crate::Sources`] and the summary ask of a format) and implementing `Source`
 //! (its reading, its streams, its flagged bytes). Standard input and files are read as their
 //! content says.
 
