@@ -149,29 +149,32 @@ mod stream;
 /// the schema's keys.
 pub const JSON_SCHEMA_VERSION: u32 = 1;
 
-/// Inputs: where bytes come from, each opened as an [`Input`] whose format is detected from its
-/// content, read as [`Batch`]es of bytes with their receive times.
+// The crate-root items, by role (a comment, not a doc comment: rustdoc would prepend a doc
+// comment on a re-export to the docs of each item it names).
+
+// Inputs: where bytes come from, each opened as an `Input` whose format is detected from its
+// content, read as `Batch`es of bytes with their receive times.
 pub use input::{Batch, Input, InputError, InputFormat, Looks, read_small_file};
 
-/// Decoding: [`Sources`] reads inputs, merges them in time order and decodes each ESC's bytes
-/// with a [`Stream`] ([`PortStreams`] for live ports), handing frames to a [`Handler`].
+// Decoding: `Sources` reads inputs, merges them in time order and decodes each ESC's bytes
+// with a `Stream` (`PortStreams` for live ports), handing frames to a `Handler`.
 pub use handler::{Both, Handler};
 pub use sources::{Esc, InputInfo, MAX_QUEUED, Sources};
 pub use stream::{EscLink, PortStreams, SILENCE_S, Stream, WireKind};
 
-/// Settings: each ESC's conversion settings ([`hwfoc::Settings`]), as given per ESC and shown.
+// Settings: each ESC's conversion settings (`hwfoc::Settings`), as given per ESC and shown.
 pub use settings::{SettingValue, SettingsMap, SettingsPatch, settings_json};
 
-/// Records: the record of `docs/RECORD-SCHEMA.md` ([`record`] has its columns and text
-/// encodings).
+// Records: the record of `docs/RECORD-SCHEMA.md` (`record` has its columns and text
+// encodings).
 pub use record::Record;
 
-/// Selection of records by ESC and time window.
+// Selection of records by ESC and time window.
 pub use select::{EmptyWindow, Selection, Window, filter_text, no_frame_in_window};
 
-/// What an input tells a person while it is read (a port unplugged, a damaged recording).
+// What an input tells a person while it is read (a port unplugged, a damaged recording).
 pub use notice::Notice;
 
-/// Text helpers: a name shown safely ([`Escaped`]), a number with fixed decimals ([`Fixed`]).
+// Text helpers: a name shown safely (`Escaped`), a number with fixed decimals (`Fixed`).
 pub use escape::Escaped;
 pub use fixed::Fixed;
