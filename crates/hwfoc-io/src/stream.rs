@@ -308,7 +308,7 @@ impl Stream {
     /// The receive time of the first byte the decoder holds for a frame still arriving, if it
     /// holds any: no frame completed later can be older (later bytes are no older than the
     /// held ones). `None` when nothing is held or the stream has no times.
-    pub fn held_since(&self) -> Option<f64> {
+    pub(crate) fn held_since(&self) -> Option<f64> {
         let held = self.wire.buffered();
         (held > 0 && held <= self.history.len()).then(|| self.history[self.history.len() - held])
     }
