@@ -1,10 +1,10 @@
 //! Times as people write and read them: the `--from`/`--to` grammar, and ISO 8601 display of
 //! receive times where the source has a wall clock.
 //!
-//! A source's clock ([`Clock`], from its [`InputFormat`](crate::InputFormat)) says what its `t_s` numbers mean:
-//! Unix seconds for pcapng recordings and serial ports ([`Clock::Wall`]), seconds from the
-//! start of the capture for a logic-analyser CSV export ([`Clock::Capture`]), nothing for raw
-//! bytes ([`Clock::None`]). Only wall-clock times are shown as dates. (The clock that stamps
+//! A source's clock ([`Clock`], from its [`InputFormat`](crate::InputFormat)) says what its `t_s`
+//! numbers mean: Unix seconds for pcapng recordings and serial ports ([`Clock::Wall`]), seconds
+//! from the start of the capture for a logic-analyser CSV export ([`Clock::Capture`]), nothing for
+//! raw bytes ([`Clock::None`]). Only wall-clock times are shown as dates. (The clock that stamps
 //! what is received is [`crate::clock::ReceiveClock`].)
 //!
 //! # The grammar of a time ([`parse`])

@@ -2,9 +2,9 @@
 //! Parquet export's footer (and of its `ARROW:schema`, whose own metadata repeats them) and of
 //! the metadata of the Python package's Arrow schema (`hwfoc.read`, `scan`, `record_schema`).
 //!
-//! The entries: `hwfoc_version`; the settings (`current_scale`,
-//! `pole_pairs`, `gear_ratio`, named as in every output); `inputs`, a JSON array of the input names; `filter` when
-//! records were selected ([`crate::filter_text`]); and, once every input is read,
+//! The entries: `hwfoc_version`; the settings (`current_scale`, `pole_pairs`, `gear_ratio`,
+//! named as in every output); `inputs`, a JSON array of the input names; `filter` when records
+//! were selected ([`crate::filter_text`]); and, once every input is read,
 //! [`ESCS`] ([`escs_json`]) and, for the Parquet export when some ESC had settings of its own,
 //! [`ESC_SETTINGS`] ([`esc_settings_json`]).
 
