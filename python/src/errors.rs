@@ -3,7 +3,7 @@
 //! that where the command names its option (`--from`, `--to`) the message names the keyword
 //! argument (`start`, `end`).
 
-use hwfoc_io::select::EmptyWindow;
+use hwfoc_io::EmptyWindow;
 use pyo3::PyErr;
 use pyo3::create_exception;
 use pyo3::exceptions::PyException;

@@ -10,7 +10,7 @@ use std::time::Duration;
 
 use arrow_array::RecordBatch;
 use arrow_pyarrow::ToPyArrow;
-use hwfoc_io::sources::Sources;
+use hwfoc_io::Sources;
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 

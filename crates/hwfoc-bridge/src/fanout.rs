@@ -8,7 +8,7 @@ use hwfoc_io::{Handler, InputError, Record};
 
 use crate::output::{Output, OutputError, Update};
 
-/// The outputs of a bridge, fed by [`hwfoc_io::stream::PortStreams::feed`] (live ports, virtual
+/// The outputs of a bridge, fed by [`hwfoc_io::PortStreams::feed`] (live ports, virtual
 /// ESCs) or [`hwfoc_io::Sources::run`] (recordings, through [`crate::replay::Replay`]).
 pub struct Fanout {
     outputs: Vec<Box<dyn Output>>,

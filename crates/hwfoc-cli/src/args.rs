@@ -4,12 +4,12 @@
 use std::path::PathBuf;
 
 use clap::Args;
-use hwfoc_io::select::{Selection, Window};
+use hwfoc_io::SettingsPatch;
+use hwfoc_io::Sources;
 use hwfoc_io::serial;
-use hwfoc_io::settings::SettingsPatch;
-use hwfoc_io::sources::Sources;
 use hwfoc_io::time::{Clock, Time, TimeError};
 use hwfoc_io::{Input, InputError};
+use hwfoc_io::{Selection, Window};
 
 use crate::demo;
 use crate::error::CliError;
@@ -194,7 +194,7 @@ impl SelectArgs {
 
     /// The filters, as recorded with an output: `esc=0,2 from=+1.5 to=1795442580`, or empty.
     pub fn text(&self) -> String {
-        hwfoc_io::select::filter_text(&self.esc, self.from, self.to)
+        hwfoc_io::filter_text(&self.esc, self.from, self.to)
     }
 }
 

@@ -42,8 +42,8 @@ use std::path::{Path, PathBuf};
 
 use hwfoc::Settings;
 use hwfoc_io::InputError;
-use hwfoc_io::input::read_small_file;
-use hwfoc_io::settings::{SettingsMap, SettingsPatch};
+use hwfoc_io::read_small_file;
+use hwfoc_io::{SettingsMap, SettingsPatch};
 use serde::Deserialize;
 use serde::de::{self, Deserializer, MapAccess, SeqAccess, Visitor};
 use toml::Spanned;

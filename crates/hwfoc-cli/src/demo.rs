@@ -102,8 +102,8 @@ mod tests {
     use super::*;
     use hwfoc::telemetry::Frame;
     use hwfoc::{Quantity, Telemetry};
-    use hwfoc_io::input::Input;
-    use hwfoc_io::stream::Stream;
+    use hwfoc_io::Input;
+    use hwfoc_io::Stream;
 
     #[test]
     fn demo_decodes_as_designed() {

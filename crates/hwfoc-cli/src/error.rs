@@ -9,8 +9,8 @@
 use std::fmt;
 use std::io;
 
+use hwfoc_io::EmptyWindow;
 use hwfoc_io::InputError;
-use hwfoc_io::select::EmptyWindow;
 use hwfoc_io::serial::PortError;
 use hwfoc_io::write::{ExportError, WriteError};
 use hwfoc_sim::SimError;

@@ -74,7 +74,7 @@ fn main() -> ExitCode {
         Err(e) if e.is_broken_pipe() => ExitCode::SUCCESS,
         Err(e) => {
             // Errors quote file content (a key, a name): shown escaped, and on one line.
-            eprintln!("hwfoc: {}", hwfoc_io::escape::Escaped(&e));
+            eprintln!("hwfoc: {}", hwfoc_io::Escaped(&e));
             ExitCode::FAILURE
         }
     }

@@ -59,7 +59,7 @@ impl Default for ReceiveClock {
 /// The longest step between two frames of one ESC that is always time passing at the frame
 /// rate: 20 frame periods (an idle ESC sends a frame every ~364 ms, a read may return a
 /// little late). The same second after which the stream tells the decoder of a silence
-/// ([`crate::stream::SILENCE_S`]).
+/// ([`crate::SILENCE_S`]).
 pub const MAX_STEP_S: f64 = 1.0;
 
 /// The longest time an ESC takes per data frame it counts in its packet number, s: an idle

@@ -1,6 +1,6 @@
 //! ESC numbers: the one rule by which the channels of a DataLink hub are numbered, for inputs
-//! read to their end ([`crate::sources::Sources`]) and live ports
-//! ([`crate::stream::PortStreams`]) alike.
+//! read to their end ([`crate::Sources`]) and live ports
+//! ([`crate::PortStreams`]) alike.
 //!
 //! Each stream (a file, a recording's port, a serial port) is an ESC, numbered in the order
 //! given. A stream found to carry a DataLink hub keeps its number for the hub's channel 0;

@@ -1,7 +1,7 @@
 //! The seam between reading telemetry and doing something with it, as `Sink` is in ripgrep.
 //!
-//! [`crate::sources::Sources::run`] (inputs read to their end) and
-//! [`crate::stream::PortStreams::feed`] (live port events) hand every frame to a [`Handler`].
+//! [`crate::Sources::run`] (inputs read to their end) and
+//! [`crate::PortStreams::feed`] (live port events) hand every frame to a [`Handler`].
 //! A front end (a command, a bridge, a binding) implements [`Handler::record`] and
 //! [`Handler::info`]: it sees records in physical units, the same whatever protocol the bytes
 //! were in, never the codec's frames. The library's own handlers (the writers, the summary)

@@ -1,17 +1,22 @@
 //! Everything between the bytes on an ESC's telemetry wire and the records every output shows.
 //!
 //! The codec (`hwfoc`) turns bytes into frames; this library does what lies around it, for every
-//! front end alike (the `hwfoc` command, bridges, bindings):
+//! front end alike (the `hwfoc` command, bridges, bindings). Its surface, by role (the items
+//! at the crate root, the rest in the public modules named):
 //!
-//! - [`input`]: where bytes come from (raw files, logic-analyser CSV exports, pcapng recordings,
-//!   serial ports, standard input), the format detected from the content, each byte with its
-//!   receive time where the source has a clock;
-//! - [`stream`] and [`sources`]: the one path from timed bytes to frames, a decoding stream per
-//!   ESC, each converted under its own [`settings`]; [`handler`]: the [`Handler`] seam through which records reach a front end;
-//! - [`record`]: the record of `docs/RECORD-SCHEMA.md` (one row per data frame, physical units), its
-//!   columns declared once in one table, and its text encodings;
+//! - inputs: where bytes come from (raw files, logic-analyser CSV exports, pcapng recordings,
+//!   serial ports, standard input), an [`Input`] whose [`InputFormat`] is detected from the
+//!   content, read as [`Batch`]es of bytes with their receive times where the source has a
+//!   clock;
+//! - decoding: [`Sources`] and [`Stream`] ([`PortStreams`] for live ports), the one path from
+//!   timed bytes to frames, a decoding stream per ESC, each converted under its own settings
+//!   ([`SettingsMap`]); the [`Handler`] seam through which records reach a front end;
+//! - [`record`]: the [`Record`] of `docs/RECORD-SCHEMA.md` (one row per data frame, physical
+//!   units), its columns declared once in one table, and its text encodings; [`Selection`]: the
+//!   records kept, by ESC and time [`Window`];
 //! - [`write`](mod@write): writers of records (JSON Lines, CSV, Parquet with the `parquet`
 //!   feature), each on a thread of its own, and Arrow record batches;
+//! - [`summary`]: what a run of inputs contained, as text or JSON;
 //! - [`pcapng`]: the recording format (writer and truncation-tolerant reader);
 //! - [`time`]: times as people write them (`--from +5`, ISO 8601) and dates shown where the
 //!   source has a wall clock; [`energy`]: charge and energy integrated over frame times;
@@ -22,31 +27,120 @@
 //!   command sets the flag on Ctrl-C and SIGTERM; the Python package's own loops check for
 //!   `KeyboardInterrupt`).
 //!
-//! Each module has its own error type, an enum carrying what went wrong and where, whose
+//! Each part has its own error type, an enum carrying what went wrong and where, whose
 //! `Display` is the one-line message a person reads.
+//!
+//! # Reading records
+//!
+//! An input (here bytes in memory: three HW-FOC data frames) read by [`Sources`], whose records
+//! a [`Handler`] collects:
+//!
+//! ```
+//! use hwfoc::Settings;
+//! use hwfoc::foc::DataFrame;
+//! use hwfoc_io::{Handler, Input, InputError, Record, Sources};
+//!
+//! let mut bytes = Vec::new();
+//! for packet in 0..3 {
+//!     let frame = DataFrame { packet, voltage_raw: 247, ..DataFrame::default() };
+//!     bytes.extend_from_slice(&frame.encode());
+//! }
+//!
+//! /// Keeps every record.
+//! struct Collect(Vec<Record>);
+//!
+//! impl Handler for Collect {
+//!     type Error = InputError;
+//!     fn record(&mut self, record: &Record) {
+//!         self.0.push(*record);
+//!     }
+//! }
+//!
+//! let input = Input::from_memory("example", bytes)?;
+//! let mut sources = Sources::new(vec![input], Settings::default());
+//! let mut records = Collect(Vec::new());
+//! sources.run(&mut records)?;
+//!
+//! assert_eq!(records.0.len(), 3);
+//! assert_eq!(records.0[0].esc, 0);
+//! assert_eq!(records.0[2].voltage_v, 24.7);
+//! # Ok::<(), InputError>(())
+//! ```
+//!
+//! # Writing records
+//!
+//! An [`Export`](write::Export) is a [`Handler`] too: the same run written to a CSV file, which
+//! appears under its name when the export finishes.
+//!
+//! ```
+//! use hwfoc::Settings;
+//! use hwfoc::foc::DataFrame;
+//! use hwfoc_io::write::{Export, ExportError, OutputFormat, Provenance};
+//! use hwfoc_io::{Input, Sources};
+//!
+//! let frame = DataFrame { voltage_raw: 247, ..DataFrame::default() };
+//! let input = Input::from_memory("example", frame.encode().repeat(2))?;
+//! let mut sources = Sources::new(vec![input], Settings::default());
+//!
+//! let dir = tempfile::tempdir().unwrap();
+//! let path = dir.path().join("records.csv");
+//! let provenance = Provenance {
+//!     settings: Settings::default(),
+//!     overrides: Vec::new(),
+//!     inputs: vec!["example".to_string()],
+//!     filter: String::new(),
+//!     csv_comment: false,
+//! };
+//! let mut export = Export::create(OutputFormat::Csv, path.to_str(), provenance)?;
+//! sources.run(&mut export)?;
+//! export.finish(Vec::new())?;
+//!
+//! let text = std::fs::read_to_string(&path).unwrap();
+//! assert!(text.starts_with("t_s,esc,"));
+//! assert_eq!(text.lines().count(), 3); // the header and two records
+//! # Ok::<(), ExportError>(())
+//! ```
+//!
+//! # Paths
+//!
+//! Each item has one public path: those above. The modules behind the crate-root items are
+//! private, and so are the helpers the public modules use among themselves
+//! (`tests/surface.rs` lists the whole surface):
+//!
+//! ```compile_fail,E0603
+//! use hwfoc_io::sources::Sources;
+//! ```
+//!
+//! ```compile_fail,E0603
+//! use hwfoc_io::write::metadata::schema_with;
+//! ```
 
 #![forbid(unsafe_op_in_unsafe_fn)]
 #![warn(missing_docs)]
 
+// Modules whose names are a namespace for their items (`time::parse`, `serial::open`,
+// `pcapng::Reader`, `write::arrow::schema`): public, each exporting only its public items.
 pub mod clock;
 pub mod energy;
-pub mod episode;
-mod esc_numbers;
-pub mod escape;
-pub mod fixed;
-pub mod handler;
-pub mod input;
-pub mod notice;
 pub mod pcapng;
 pub mod record;
-pub mod select;
 pub mod serial;
-pub mod settings;
-pub mod sources;
-pub mod stream;
 pub mod summary;
 pub mod time;
 pub mod write;
+
+// Modules whose public items are re-exported below, by role.
+mod episode;
+mod esc_numbers;
+mod escape;
+mod fixed;
+mod handler;
+mod input;
+mod notice;
+mod select;
+mod settings;
+mod sources;
+mod stream;
 
 /// The version of the layout of the JSON objects the project prints (`hwfoc summary --json`,
 /// the status and alarm lines of `hwfoc monitor --json`), as their `"schema_version"` key: it
@@ -55,8 +149,32 @@ pub mod write;
 /// the schema's keys.
 pub const JSON_SCHEMA_VERSION: u32 = 1;
 
-pub use handler::Handler;
-pub use input::{Batch, Input, InputError, InputFormat};
+// The crate-root items, by role (a comment, not a doc comment: rustdoc would prepend a doc
+// comment on a re-export to the docs of each item it names).
+
+// Inputs: where bytes come from, each opened as an `Input` whose format is detected from its
+// content, read as `Batch`es of bytes with their receive times.
+pub use input::{Batch, Input, InputError, InputFormat, Looks, read_small_file};
+
+// Decoding: `Sources` reads inputs, merges them in time order and decodes each ESC's bytes
+// with a `Stream` (`PortStreams` for live ports), handing frames to a `Handler`.
+pub use handler::{Both, Handler};
+pub use sources::{Esc, InputInfo, MAX_QUEUED, Sources};
+pub use stream::{EscLink, PortStreams, SILENCE_S, Stream, WireKind};
+
+// Settings: each ESC's conversion settings (`hwfoc::Settings`), as given per ESC and shown.
+pub use settings::{SettingValue, SettingsMap, SettingsPatch, settings_json};
+
+// Records: the record of `docs/RECORD-SCHEMA.md` (`record` has its columns and text
+// encodings).
 pub use record::Record;
-pub use sources::Sources;
-pub use stream::Stream;
+
+// Selection of records by ESC and time window.
+pub use select::{EmptyWindow, Selection, Window, filter_text, no_frame_in_window};
+
+// What an input tells a person while it is read (a port unplugged, a damaged recording).
+pub use notice::Notice;
+
+// Text helpers: a name shown safely (`Escaped`), a number with fixed decimals (`Fixed`).
+pub use escape::Escaped;
+pub use fixed::Fixed;

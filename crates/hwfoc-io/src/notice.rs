@@ -160,10 +160,10 @@ impl fmt::Display for Notice {
 }
 
 /// Where an input's notices go.
-pub type NoticeSink = Box<dyn FnMut(Notice) + Send>;
+pub(crate) type NoticeSink = Box<dyn FnMut(Notice) + Send>;
 
 /// The default sink: each notice's [`Notice::line`] on standard error.
-pub fn to_stderr() -> NoticeSink {
+pub(crate) fn to_stderr() -> NoticeSink {
     Box::new(|notice| eprintln!("{}", notice.line()))
 }
 

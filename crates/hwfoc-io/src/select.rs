@@ -12,7 +12,7 @@ use crate::time::Time;
 /// then resolved when it first sees a frame with a time ([`Window::observe`]), which every
 /// handler does for every data frame, of every ESC, before choosing by ESC. So "the first
 /// frame" is the first data frame with a time that the inputs give, whichever ESC it is of;
-/// [`crate::sources::Sources`] hands frames of inputs given together in time order, so it is
+/// [`crate::Sources`] hands frames of inputs given together in time order, so it is
 /// the earliest one.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Window {

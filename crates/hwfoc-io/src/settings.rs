@@ -10,7 +10,7 @@
 //!
 //! ```
 //! use hwfoc::Settings;
-//! use hwfoc_io::settings::{SettingsMap, SettingsPatch};
+//! use hwfoc_io::{SettingsMap, SettingsPatch};
 //!
 //! let mut map = SettingsMap::from(Settings::DEFAULT);
 //! map.set_port("/dev/ttyUSB1", SettingsPatch { current_scale: Some(100.0), ..Default::default() });
@@ -57,7 +57,7 @@ impl From<SettingValue> for serde_json::Value {
 /// The fields of `settings` by their name in every output (Parquet metadata, the CSV comment,
 /// the JSON of `summary` and `monitor`, the Python package's keyword arguments), in that
 /// order: `current_scale`, `pole_pairs`, `gear_ratio`.
-pub fn fields(settings: &Settings) -> [(&'static str, SettingValue); 3] {
+pub(crate) fn fields(settings: &Settings) -> [(&'static str, SettingValue); 3] {
     [
         ("current_scale", SettingValue::Real(settings.current_scale)),
         ("pole_pairs", SettingValue::Count(settings.pole_pairs)),
@@ -68,7 +68,7 @@ pub fn fields(settings: &Settings) -> [(&'static str, SettingValue); 3] {
 /// The fields of `settings` as people read them, each its name in words and its value:
 /// `["current scale 64", "pole pairs 7", "gear ratio 1"]` (`hwfoc summary`); with `default`,
 /// only those that differ from it.
-pub fn words(settings: &Settings, default: Option<&Settings>) -> Vec<String> {
+pub(crate) fn words(settings: &Settings, default: Option<&Settings>) -> Vec<String> {
     let defaults = default.map(fields);
     fields(settings)
         .into_iter()
@@ -78,7 +78,7 @@ pub fn words(settings: &Settings, default: Option<&Settings>) -> Vec<String> {
         .collect()
 }
 
-/// Settings as a JSON object, keyed as [`fields`] names them:
+/// Settings as a JSON object, keyed by their names in every output:
 /// `{"current_scale": 64.0, "pole_pairs": 7, "gear_ratio": 1.0}`.
 pub fn settings_json(settings: &Settings) -> serde_json::Value {
     serde_json::Value::Object(
@@ -124,7 +124,8 @@ impl SettingsPatch {
         *self == SettingsPatch::default()
     }
 
-    /// The fields that are set, named and ordered as [`fields`] has them.
+    /// The fields that are set, named and ordered as in every output
+    /// (`current_scale`, `pole_pairs`, `gear_ratio`).
     pub fn fields(&self) -> impl Iterator<Item = (&'static str, SettingValue)> {
         let given = [
             self.current_scale.is_some(),

@@ -1,7 +1,7 @@
 //! Timed decoding: the codec's streaming decoder plus the receive time of each frame.
 //!
 //! [`Stream`] is one ESC's stream: every command's frames come out of one (through
-//! [`crate::sources::Sources`] for inputs read to their end, through [`PortStreams`] for live
+//! [`crate::Sources`] for inputs read to their end, through [`PortStreams`] for live
 //! port events). [`crate::clock::byte_times`] is the one place where a chunk's receive time
 //! becomes the time of each of its bytes.
 
@@ -308,7 +308,7 @@ impl Stream {
     /// The receive time of the first byte the decoder holds for a frame still arriving, if it
     /// holds any: no frame completed later can be older (later bytes are no older than the
     /// held ones). `None` when nothing is held or the stream has no times.
-    pub fn held_since(&self) -> Option<f64> {
+    pub(crate) fn held_since(&self) -> Option<f64> {
         let held = self.wire.buffered();
         (held > 0 && held <= self.history.len()).then(|| self.history[self.history.len() - held])
     }
@@ -333,7 +333,7 @@ fn feed(
 /// `monitor`, `record` and the bridges (and of [`crate::Input::open_ports`], through
 /// [`byte_times`]).
 ///
-/// ESC numbers are those [`crate::sources::Sources`] gives a recording of the same ports: port
+/// ESC numbers are those [`crate::Sources`] gives a recording of the same ports: port
 /// `i` is ESC `i`; a port found to carry a DataLink hub has its channel 0 as that ESC and its
 /// channels 1 to 7 as the next numbers after all ports' (in the order the hubs are found), so
 /// that a hub read alone numbers its ESCs 0 to 7 by channel and no two ESCs share a number

@@ -1,10 +1,10 @@
 //! Times as people write and read them: the `--from`/`--to` grammar, and ISO 8601 display of
 //! receive times where the source has a wall clock.
 //!
-//! A source's clock ([`Clock`], from its [`InputFormat`](crate::input::InputFormat)) says what its `t_s` numbers mean:
-//! Unix seconds for pcapng recordings and serial ports ([`Clock::Wall`]), seconds from the
-//! start of the capture for a logic-analyser CSV export ([`Clock::Capture`]), nothing for raw
-//! bytes ([`Clock::None`]). Only wall-clock times are shown as dates. (The clock that stamps
+//! A source's clock ([`Clock`], from its [`InputFormat`](crate::InputFormat)) says what its `t_s`
+//! numbers mean: Unix seconds for pcapng recordings and serial ports ([`Clock::Wall`]), seconds
+//! from the start of the capture for a logic-analyser CSV export ([`Clock::Capture`]), nothing for
+//! raw bytes ([`Clock::None`]). Only wall-clock times are shown as dates. (The clock that stamps
 //! what is received is [`crate::clock::ReceiveClock`].)
 //!
 //! # The grammar of a time ([`parse`])
@@ -21,7 +21,7 @@
 //!
 //! "The first frame" is the first data frame with a receive time among the inputs given
 //! together (their records come in time order, so it is the earliest one): see
-//! [`crate::select::Window`].
+//! [`crate::Window`].
 
 use std::fmt;
 
@@ -171,7 +171,7 @@ pub fn parse(text: &str) -> Result<Time, TimeError> {
 }
 
 /// [`parse`], with local date-times in `zone`.
-pub fn parse_in(text: &str, zone: &TimeZone) -> Result<Time, TimeError> {
+pub(crate) fn parse_in(text: &str, zone: &TimeZone) -> Result<Time, TimeError> {
     let s = text.trim();
     if let Some(rest) = s.strip_prefix('+') {
         return after_first(rest)
@@ -300,7 +300,7 @@ pub fn iso8601_local(t_s: f64) -> String {
 }
 
 /// [`iso8601_local`] in `zone`.
-pub fn iso8601_in(t_s: f64, zone: &TimeZone) -> String {
+pub(crate) fn iso8601_in(t_s: f64, zone: &TimeZone) -> String {
     match instant(t_s) {
         Some(t) => t
             .to_zoned(zone.clone())

@@ -13,7 +13,7 @@
 use std::fmt;
 use std::str::FromStr;
 
-use hwfoc_io::input::read_small_file;
+use hwfoc_io::read_small_file;
 
 use crate::error::SimError;
 

@@ -11,10 +11,10 @@ use clap::{Args, ValueEnum};
 
 use crate::args::{InputArgs, SelectArgs, SettingsArgs};
 use crate::error::CliError;
-use hwfoc_io::settings::{SettingsMap, SettingsPatch};
-use hwfoc_io::sources::Sources;
+use hwfoc_io::Sources;
 use hwfoc_io::time::Clock;
 use hwfoc_io::write::{Export, OutputFormat, Provenance, metadata};
+use hwfoc_io::{SettingsMap, SettingsPatch};
 
 /// Record output formats.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
@@ -102,7 +102,7 @@ pub fn run(args: &DecodeArgs) -> Result<(), CliError> {
     if let (true, 0, Some((first, last))) = (selection.window.is_limited(), kept, span) {
         eprintln!(
             "hwfoc: warning: {}",
-            hwfoc_io::select::no_frame_in_window(
+            hwfoc_io::no_frame_in_window(
                 &args.select.text(),
                 first,
                 last,

@@ -24,14 +24,14 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::Ordering;
 use std::time::{Duration, Instant};
 
-use hwfoc_io::stream::EscLink;
+use hwfoc_io::EscLink;
 
 use crate::error::CliError;
-use hwfoc_io::escape::Escaped;
-use hwfoc_io::notice::Notice;
+use hwfoc_io::Escaped;
+use hwfoc_io::Notice;
+use hwfoc_io::PortStreams;
 use hwfoc_io::pcapng;
 use hwfoc_io::serial::{self, PortEvent, PortSet};
-use hwfoc_io::stream::PortStreams;
 use hwfoc_io::write::WriteError;
 
 /// Longest time a received byte stays in this process before it is written to the file.

@@ -2,8 +2,8 @@
 //! itself is `hwfoc_io::summary`'s), optionally plotted alongside.
 
 use clap::Args;
-use hwfoc_io::handler::Both;
-use hwfoc_io::sources::Sources;
+use hwfoc_io::Both;
+use hwfoc_io::Sources;
 use hwfoc_io::summary::Summary;
 use hwfoc_io::write::WriteError;
 

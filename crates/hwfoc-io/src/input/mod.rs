@@ -15,7 +15,7 @@
 //!
 //! Each kind of input is a module (`raw.rs`, `csv.rs`, `recording.rs`, `ports.rs`) declaring
 //! its [`InputFormat`] (names, clock, whether live, whether its streams are recorded ports:
-//! what [`crate::sources::Sources`] and the summary ask of a format) and implementing `Source`
+//! what [`crate::Sources`] and the summary ask of a format) and implementing `Source`
 //! (its reading, its streams, its flagged bytes). Standard input and files are read as their
 //! content says.
 
@@ -99,14 +99,14 @@ impl InputFormat {
     /// Whether each stream is a recorded port, named by the recording (pcapng): the streams
     /// are declared as the input is read, and the streams of inputs read together that name
     /// the same port are one ESC, one stream, its bytes merged in time order.
-    pub fn has_recorded_ports(self) -> bool {
+    pub(crate) fn has_recorded_ports(self) -> bool {
         self.recorded_ports
     }
 
     /// Whether inputs of this format are read together with those of the same clock given
     /// next to them, their records handed on in time order: inputs with times that are not
     /// live (recordings, analyser CSVs).
-    pub fn is_merged_in_time(self) -> bool {
+    pub(crate) fn is_merged_in_time(self) -> bool {
         !self.live && self.clock != Clock::None
     }
 }
@@ -518,7 +518,7 @@ impl Input {
 
     /// The batch [`Input::next_batch`] returned last, again (`None` before the first and at
     /// the end).
-    pub fn current_batch(&self) -> Option<Batch<'_>> {
+    pub(crate) fn current_batch(&self) -> Option<Batch<'_>> {
         if self.bytes.is_empty() || self.done {
             return None;
         }

@@ -16,7 +16,7 @@ use crate::time::Clock;
 /// batch, in the order of their first byte's time: so batches are kilobytes rather than a
 /// frame (decoding an 8-port recording is ten times faster), and come in order of their first
 /// byte's time (packets of a recording are in time order), which is what
-/// [`crate::sources::Sources`] needs to hand records of every port on in time order.
+/// [`crate::Sources`] needs to hand records of every port on in time order.
 pub(super) struct RecordingReader {
     reader: pcapng::Reader<Box<dyn Read>>,
     /// The interfaces with bytes in the current window, in the order of their first packet,

@@ -11,7 +11,7 @@
 //! two files is whole). Where two inputs hold the same port's bytes of the same time (the same
 //! recording given twice, a recording and a copy of part of it), that time is decoded once,
 //! from the input that reached it first, and the other is told of it
-//! ([`crate::notice::Notice::Overlap`]).
+//! ([`crate::Notice::Overlap`]).
 //!
 //! # Time order
 //!

@@ -136,7 +136,7 @@ impl Sources {
     /// input, one per port), in the order given up to the first recording (which declares its
     /// ports as it is read: they and the inputs after them are numbered as they are read): the
     /// channels of a DataLink hub, found later in any of them, take numbers after all of these,
-    /// as they do live (see [`PortStreams`](crate::stream::PortStreams)).
+    /// as they do live (see [`PortStreams`](crate::PortStreams)).
     pub(super) fn number_inputs(&mut self, inputs: &VecDeque<Input>) {
         let base = self.read.len();
         self.numbered.resize(base, Vec::new());

@@ -355,7 +355,7 @@ fn untimed_inputs_keep_their_place() {
 
 /// Hubs and ESCs plugged in together never share an ESC number: a hub's channel 0 is its
 /// port's number, its other channels the next numbers after all ports', hub by hub in the
-/// order they are found. Live ports ([`PortStreams`](crate::stream::PortStreams)) and a
+/// order they are found. Live ports ([`PortStreams`](crate::PortStreams)) and a
 /// recording of them number them alike, and convert each under its own settings.
 #[test]
 fn hubs_and_escs_together_number_every_esc_once_live_and_recorded() {

@@ -10,13 +10,13 @@
 //! gives under its settings ([`Telemetry::reading`] of a frame of the ESC): every conversion is
 //! monotonic, so this is exact, and it keeps the per-frame cost to a few integer operations.
 //!
-//! Charge, energy and power ([`Energy`]) are integrated per ESC over its data frames' times
-//! (each frame's current holding until the next), on the raw voltage and current, converted
-//! once at the end; an input without times counts each frame as the nominal period, and the
-//! report says so. The duration of an ESC's frames is the time that passed between them: a
-//! clock that steps back or jumps forward ([`Step`]) adds nothing, and the report counts such
-//! discontinuities. Times of sources with a wall clock (recordings, serial ports) are shown as
-//! ISO 8601 dates in UTC; other sources' times as their seconds.
+//! Charge, energy and power ([`Energy`]) are integrated per ESC over its data frames' times (each
+//! frame's current holding until the next), on the raw voltage and current, converted once at the
+//! end; an input without times counts each frame as the nominal period, and the report says so. The
+//! duration of an ESC's frames is the time that passed between them: a clock that steps back or
+//! jumps forward ([`Step`](crate::clock::Step)) adds nothing, and the report counts such
+//! discontinuities. Times of sources with a wall clock (recordings, serial ports) are shown as ISO
+//! 8601 dates in UTC; other sources' times as their seconds.
 //!
 //! A fault episode is a maximal run of consecutive data frames of one ESC whose status word is
 //! not zero; it is reported with its first and last frame (times where the input has them,

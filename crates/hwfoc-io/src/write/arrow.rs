@@ -123,7 +123,7 @@ fn fault_item() -> FieldRef {
 }
 
 /// The Arrow field of column `C`: name, type, nullability, and the unit in the metadata.
-pub fn field<C: Column>() -> Field {
+pub(crate) fn field<C: Column>() -> Field {
     let metadata = HashMap::from([("unit".to_string(), C::UNIT.to_string())]);
     Field::new(C::NAME, <C::Value as ArrowValue>::data_type(), C::NULLABLE).with_metadata(metadata)
 }

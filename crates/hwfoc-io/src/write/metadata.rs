@@ -2,9 +2,9 @@
 //! Parquet export's footer (and of its `ARROW:schema`, whose own metadata repeats them) and of
 //! the metadata of the Python package's Arrow schema (`hwfoc.read`, `scan`, `record_schema`).
 //!
-//! The entries: `hwfoc_version`; the settings ([`crate::settings::fields`]: `current_scale`,
-//! `pole_pairs`, `gear_ratio`); `inputs`, a JSON array of the input names; `filter` when
-//! records were selected ([`crate::select::filter_text`]); and, once every input is read,
+//! The entries: `hwfoc_version`; the settings (`current_scale`, `pole_pairs`, `gear_ratio`,
+//! named as in every output); `inputs`, a JSON array of the input names; `filter` when records
+//! were selected ([`crate::filter_text`]); and, once every input is read,
 //! [`ESCS`] ([`escs_json`]) and, for the Parquet export when some ESC had settings of its own,
 //! [`ESC_SETTINGS`] ([`esc_settings_json`]).
 
@@ -22,12 +22,12 @@ use crate::sources::Sources;
 /// The key of which ESC is which ([`escs_json`]).
 pub const ESCS: &str = "escs";
 
-/// The key of the settings of ESCs that had their own ([`super::esc_settings_json`]).
+/// The key of the settings of ESCs that had their own ([`esc_settings_json`]).
 pub const ESC_SETTINGS: &str = "esc_settings";
 
 impl Provenance {
     /// What records made under `settings` from `inputs` (their names), selected as `filter`
-    /// says ([`crate::select::filter_text`], empty for all), record: for a reader of records
+    /// says ([`crate::filter_text`], empty for all), record: for a reader of records
     /// that writes no CSV (no settings by port or ESC, no CSV comment).
     pub fn new(settings: hwfoc::Settings, inputs: Vec<String>, filter: String) -> Provenance {
         Provenance {
@@ -103,7 +103,7 @@ pub fn escs_json(sources: &Sources) -> String {
 }
 
 /// The record schema ([`schema`]) with `metadata` as its own key-value metadata.
-pub fn schema_with<'a>(metadata: impl IntoIterator<Item = &'a (String, String)>) -> Schema {
+pub(crate) fn schema_with<'a>(metadata: impl IntoIterator<Item = &'a (String, String)>) -> Schema {
     schema().with_metadata(
         metadata
             .into_iter()

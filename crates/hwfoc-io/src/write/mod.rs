@@ -8,9 +8,9 @@
 //! row group for Parquet), so memory stays bounded whatever the size of the input: about 45 MB
 //! at most (with the output file's two 4 MiB blocks).
 //!
-//! Each row is converted under its ESC's settings, those that [`Sources`](crate::sources::Sources)
-//! hands to [`Handler::frame`](crate::handler::Handler::frame) with its frames: the export learns them at an ESC's first
-//! frame, and a chunk carries a table of them (`EscTable`) only when some ESC's settings
+//! Each row is converted under its ESC's settings, those that [`Sources`](crate::Sources) hands to
+//! [`Handler::frame`](crate::Handler::frame) with its frames: the export learns them at an ESC's
+//! first frame, and a chunk carries a table of them (`EscTable`) only when some ESC's settings
 //! differ from [`Provenance::settings`]; otherwise (the usual case) every row of the chunk is
 //! converted under those.
 //!
@@ -40,9 +40,9 @@ mod text;
 pub use error::{ExportError, WriteError};
 pub use export::Export;
 pub(crate) use export::{Chunk, EscTable, Sink, ToWriter};
-pub use metadata::esc_settings_json;
+pub(crate) use metadata::esc_settings_json;
 pub use safety::{FileId, create_file, same_file};
-pub use staging::{PARTIAL_SUFFIX, Staging};
+pub use staging::Staging;
 
 use hwfoc::Settings;
 

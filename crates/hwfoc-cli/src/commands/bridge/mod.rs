@@ -19,11 +19,11 @@ use hwfoc_bridge::dronecan::{self, DronecanOptions, DronecanOutput, SlcanTarget}
 use hwfoc_bridge::fanout::Fanout;
 use hwfoc_bridge::mavlink::{self, MavlinkOptions, MavlinkOutput, MavlinkTarget};
 use hwfoc_bridge::replay::{POLL, Replay, ReplayError};
+use hwfoc_io::Notice;
+use hwfoc_io::PortStreams;
+use hwfoc_io::SettingsMap;
 use hwfoc_io::Sources;
-use hwfoc_io::notice::Notice;
 use hwfoc_io::serial::{self, PortEvent};
-use hwfoc_io::settings::SettingsMap;
-use hwfoc_io::stream::PortStreams;
 
 use crate::args::{SettingsArgs, seconds};
 use crate::commands::monitor::feed::{Feed, Msg};

@@ -7,7 +7,7 @@ use std::time::{Duration, Instant};
 
 use hwfoc_bridge::OutputError;
 use hwfoc_bridge::fanout::Fanout;
-use hwfoc_io::escape::Escaped;
+use hwfoc_io::Escaped;
 
 /// How long the same failure message is not repeated.
 const REPEAT_AFTER: Duration = Duration::from_secs(10);

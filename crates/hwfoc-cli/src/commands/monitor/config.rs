@@ -30,8 +30,8 @@
 
 use std::path::PathBuf;
 
+use hwfoc_io::SettingsMap;
 use hwfoc_io::serial;
-use hwfoc_io::settings::SettingsMap;
 
 use super::alarms::Threshold;
 use crate::args::SettingsArgs;

@@ -30,9 +30,9 @@ use super::{Session, number};
 use crate::error::CliError;
 use crate::shown::{Measure, Shown};
 use hwfoc::Quantity;
+use hwfoc_io::Escaped;
+use hwfoc_io::Fixed;
 use hwfoc_io::energy::Energy;
-use hwfoc_io::escape::Escaped;
-use hwfoc_io::fixed::Fixed;
 
 /// Shortest time between redraws while frames arrive.
 const FRAME_EVERY: Duration = Duration::from_millis(50);

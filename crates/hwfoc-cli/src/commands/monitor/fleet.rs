@@ -6,18 +6,18 @@ use std::collections::{HashMap, VecDeque};
 
 use hwfoc::telemetry::Info;
 use hwfoc::{Fault, Settings};
-use hwfoc_io::stream::{EscLink, WireKind};
+use hwfoc_io::{EscLink, WireKind};
 
 use super::alarms::{Change, Kind, Latch, Level, Threshold};
 use super::config::Limits;
 use crate::shown::{self, Shown, Values};
+use hwfoc_io::Handler;
 use hwfoc_io::InputError;
+use hwfoc_io::PortStreams;
+use hwfoc_io::SettingsMap;
 use hwfoc_io::energy::Energy;
-use hwfoc_io::handler::Handler;
 use hwfoc_io::record::Record;
 use hwfoc_io::serial::PortEvent;
-use hwfoc_io::settings::SettingsMap;
-use hwfoc_io::stream::PortStreams;
 
 /// Seconds of history kept for the charts.
 pub const HISTORY_S: f64 = 60.0;

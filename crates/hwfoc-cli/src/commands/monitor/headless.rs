@@ -11,9 +11,9 @@ use serde_json::{Value, json};
 use super::fleet::{EscView, Fleet, Link, LogEntry};
 use super::{Session, number};
 use crate::error::CliError;
+use hwfoc_io::Escaped;
+use hwfoc_io::Fixed;
 use hwfoc_io::energy::Energy;
-use hwfoc_io::escape::Escaped;
-use hwfoc_io::fixed::Fixed;
 use hwfoc_io::record::Record;
 use hwfoc_io::write::WriteError;
 
@@ -272,7 +272,7 @@ fn status_json(i: usize, esc: &EscView, now: f64) -> Value {
         "battery_cells": esc.cells,
         "info": esc.info.as_ref().map(hwfoc_io::summary::device_json),
         "alarms": alarms,
-        "settings": hwfoc_io::settings::settings_json(&esc.settings),
+        "settings": hwfoc_io::settings_json(&esc.settings),
     })
 }
 

@@ -493,7 +493,7 @@ pub fn local_time(t: f64, pattern: &str) -> String {
 
 /// `v` with `decimals` decimals, without the sign of a value that rounds to zero (`-0.0`).
 pub fn number(v: f32, decimals: usize) -> String {
-    hwfoc_io::fixed::Fixed(f64::from(v), decimals).to_string()
+    hwfoc_io::Fixed(f64::from(v), decimals).to_string()
 }
 
 #[cfg(test)]

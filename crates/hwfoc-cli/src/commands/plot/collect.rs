@@ -24,13 +24,13 @@ use hwfoc::{Settings, Status};
 
 use crate::error::CliError;
 use crate::shown::{COUNT, Shown, Values, values};
+use hwfoc_io::Handler;
 use hwfoc_io::clock::Step;
 use hwfoc_io::energy::{self, Energy};
-use hwfoc_io::episode::{Episode, Mark};
 use hwfoc_io::record::Record;
-use hwfoc_io::select::{Selection, Window};
-use hwfoc_io::sources::Handler;
+use hwfoc_io::summary::{Episode, Mark};
 use hwfoc_io::write::WriteError;
+use hwfoc_io::{Selection, Window};
 
 /// The nominal time between two data frames of a running ESC, s: the clock of inputs without
 /// receive times, and the width given to a fault episode's last frame.

@@ -13,9 +13,9 @@ use plotters::style::text_anchor::{HPos, Pos, VPos};
 use plotters::style::{FontStyle, register_font};
 
 use crate::error::CliError;
-use hwfoc_io::escape::Escaped;
-use hwfoc_io::fixed::Fixed;
-use hwfoc_io::sources::Sources;
+use hwfoc_io::Escaped;
+use hwfoc_io::Fixed;
+use hwfoc_io::Sources;
 use hwfoc_io::summary::no_frames;
 use hwfoc_io::time::{self, Clock};
 
@@ -944,7 +944,7 @@ fn fault_names(status: hwfoc::Status) -> String {
 }
 
 /// The header's fault text, and its colour: an only episode with its times as the summary
-/// gives them ([`hwfoc_io::episode::Episode::when`]), several by their count.
+/// gives them ([`hwfoc_io::summary::Episode::when`]), several by their count.
 fn fault_summary(data: &EscData, wall: bool) -> (String, RGBColor) {
     let Some(first) = data.first_episode.as_ref() else {
         return ("no faults".to_string(), OK_TEXT);

@@ -20,10 +20,10 @@ use hwfoc::telemetry::Info;
 
 use crate::args::{InputArgs, SelectArgs, SettingsArgs};
 use crate::error::CliError;
+use hwfoc_io::Selection;
 use hwfoc_io::record::Record;
-use hwfoc_io::select::Selection;
-use hwfoc_io::sources::{Handler, Sources};
 use hwfoc_io::write::WriteError;
+use hwfoc_io::{Handler, Sources};
 
 use collect::Collector;
 use target::ImageFile;

@@ -1,0 +1,66 @@
+//! The public surface of `hwfoc-io`: this list is the API.
+//!
+//! Every item a user of the crate may name is imported here by its public path, grouped as
+//! `lib.rs` groups them; the test does not compile when one goes missing or moves. An item added
+//! to the surface is added here, so that a change of the API is a change of this file, seen in
+//! review. Internals are private (`pub(crate)` or in a private module): the `compile_fail`
+//! examples in `lib.rs` check a few of them.
+
+#![allow(unused_imports)]
+
+// Inputs.
+use hwfoc_io::{Batch, Input, InputError, InputFormat, Looks, read_small_file};
+
+// Decoding.
+use hwfoc_io::{Both, Esc, EscLink, Handler, InputInfo, MAX_QUEUED, PortStreams};
+use hwfoc_io::{SILENCE_S, Sources, Stream, WireKind};
+
+// Settings.
+use hwfoc_io::{SettingValue, SettingsMap, SettingsPatch, settings_json};
+
+// Records and their selection.
+use hwfoc_io::Record;
+use hwfoc_io::record::columns::{self, COUNT, visit};
+use hwfoc_io::record::{COLUMNS, Column, FaultList, TextEncoder, UNITS, Value, Visitor};
+use hwfoc_io::{EmptyWindow, Selection, Window, filter_text, no_frame_in_window};
+
+// Notices and text helpers.
+use hwfoc_io::{Escaped, Fixed, JSON_SCHEMA_VERSION, Notice};
+
+// Writers.
+use hwfoc_io::write::arrow::{ArrowValue, RecordBatchBuilder, record_batch, schema};
+use hwfoc_io::write::metadata::{ESC_SETTINGS, ESCS, esc_settings_json, escs_json};
+use hwfoc_io::write::{Export, ExportError, OutputFormat, Provenance, WriteError};
+use hwfoc_io::write::{FileId, Staging, create_file, same_file};
+
+// Summary.
+use hwfoc_io::summary::{Episode, Mark, NO_FRAMES, Report, Summary};
+use hwfoc_io::summary::{device_json, esc_label, no_frames};
+
+// Recordings.
+use hwfoc_io::pcapng::{Damage, Interface, LINKTYPE, MAGIC, MAX_CHUNK, Packet, Reader, Writer};
+
+// Serial ports.
+use hwfoc_io::serial::{DEFAULT_BAUD, PortError, PortEvent, PortSet, RETRY_EVERY, Readers};
+use hwfoc_io::serial::{available_ports, is_port, open};
+
+// Times, clocks and energy.
+use hwfoc_io::clock::{MAX_FRAME_SPACING_S, MAX_STEP_S, ReceiveClock, Step};
+use hwfoc_io::clock::{byte_time_s, byte_times, unix_now_ns};
+use hwfoc_io::energy::{Energy, NOMINAL_PERIOD_S, drawn_w, power_w};
+use hwfoc_io::time::{Clock, Time, TimeError, iso8601, iso8601_local, parse, span_text};
+
+/// The constants of the surface, against the documents that fix them (`docs/RECORD-SCHEMA.md`,
+/// `docs/REFERENCE.md`, the pcapng format, the HW-FOC baud rate).
+#[test]
+fn the_surface_constants_are_those_of_the_specs() {
+    assert_eq!(COLUMNS.len(), COUNT);
+    assert_eq!(UNITS.len(), COUNT);
+    assert_eq!(COLUMNS[..2], ["t_s", "esc"]);
+    // The pcapng section header block's type, and the link type of `docs/REFERENCE.md` (USER0).
+    assert_eq!(MAGIC, [0x0A, 0x0D, 0x0D, 0x0A]);
+    assert_eq!(LINKTYPE, 147);
+    assert_eq!(DEFAULT_BAUD, 19_200);
+    assert_eq!(NOMINAL_PERIOD_S, 0.05);
+    assert_eq!(JSON_SCHEMA_VERSION, 1);
+}
