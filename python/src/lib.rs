@@ -17,7 +17,6 @@ use arrow_array::RecordBatch;
 use arrow_pyarrow::{IntoPyArrow, Table};
 use hwfoc::Settings;
 use hwfoc_io::Notice;
-use hwfoc_io::{Selection, Window, filter_text};
 use hwfoc_io::Sources;
 use hwfoc_io::summary::{Summary, esc_label, no_frames as no_frames_text};
 use hwfoc_io::time::Time;
@@ -25,6 +24,7 @@ use hwfoc_io::write::Provenance;
 use hwfoc_io::write::arrow::schema;
 use hwfoc_io::write::metadata::escs_json;
 use hwfoc_io::{Input, InputError};
+use hwfoc_io::{Selection, Window, filter_text};
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
 

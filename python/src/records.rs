@@ -6,10 +6,10 @@ use arrow_array::{RecordBatch, new_null_array};
 use arrow_schema::SchemaRef;
 use hwfoc::Settings;
 use hwfoc::telemetry::{Data, Frame};
-use hwfoc_io::InputError;
 use hwfoc_io::Handler;
-use hwfoc_io::record::{Column, Visitor, columns};
+use hwfoc_io::InputError;
 use hwfoc_io::Selection;
+use hwfoc_io::record::{Column, Visitor, columns};
 use hwfoc_io::write::arrow::ArrowValue;
 
 /// Data frames as received, column by column: what a batch is made from.
@@ -179,9 +179,9 @@ impl<F: FnMut(Frames) -> Result<(), Stop>> Collect<F> {
     /// times are the wall clock's.
     pub fn empty_window(&self, filter: &str, wall: bool) -> Option<String> {
         match (self.selection.window.is_limited(), self.kept, self.span) {
-            (true, 0, Some((first, last))) => Some(hwfoc_io::no_frame_in_window(
-                filter, first, last, wall,
-            )),
+            (true, 0, Some((first, last))) => {
+                Some(hwfoc_io::no_frame_in_window(filter, first, last, wall))
+            }
             _ => None,
         }
     }
