@@ -9,7 +9,7 @@ use hwfoc::counters::PacketSequence;
 use hwfoc::datalink;
 use hwfoc::mixed;
 use hwfoc::telemetry::{Data, Frame};
-use hwfoc::{Settings, foc};
+use hwfoc::{Protocol, Settings, foc};
 
 use crate::clock::byte_times;
 use crate::esc_numbers::UNNUMBERED;
@@ -85,6 +85,115 @@ fn emit_mixed(d: mixed::Decoded, emit: &mut impl FnMut(Option<u8>, u64, &Frame))
     }
 }
 
+/// The decoder of a stream: of every protocol at once (the bytes tell which), or of the one
+/// protocol a user forced.
+#[derive(Debug)]
+enum Wire {
+    /// Every protocol, in byte order ([`mixed::Decoder`]).
+    Any(mixed::Decoder),
+    /// HW-FOC only.
+    HwFoc(foc::Decoder),
+    /// DataLink V2 only.
+    DataLink(datalink::Decoder),
+}
+
+impl Wire {
+    fn new(forced: Option<Protocol>) -> Wire {
+        match forced {
+            None => Wire::Any(mixed::Decoder::new()),
+            Some(Protocol::HwFoc) => Wire::HwFoc(foc::Decoder::new()),
+            Some(Protocol::DataLink) => Wire::DataLink(datalink::Decoder::new()),
+        }
+    }
+
+    /// Decodes `data` (ending with a silence of the line of `silence_s` seconds when given):
+    /// `emit(channel, offset, frame)` gets each ESC frame as [`emit_mixed`] hands it on.
+    #[inline(always)]
+    fn feed(
+        &mut self,
+        data: &[u8],
+        silence_s: Option<f64>,
+        emit: &mut impl FnMut(Option<u8>, u64, &Frame),
+    ) {
+        match self {
+            Wire::Any(d) => {
+                d.feed(data, |d| emit_mixed(d, emit));
+                if let Some(s) = silence_s {
+                    d.line_silent_each(frames_in(s), hub_frames_in(s), |d| emit_mixed(d, emit));
+                }
+            }
+            Wire::HwFoc(d) => {
+                d.feed(data, |d| emit_mixed(mixed::Decoded::Esc(d), emit));
+                if let Some(s) = silence_s {
+                    d.line_silent(frames_in(s), |d| emit_mixed(mixed::Decoded::Esc(d), emit));
+                }
+            }
+            Wire::DataLink(d) => {
+                d.feed(data, |d| emit_mixed(mixed::Decoded::Hub(d), emit));
+                if let Some(s) = silence_s {
+                    d.line_silent(hub_frames_in(s), |d| {
+                        emit_mixed(mixed::Decoded::Hub(d), emit)
+                    });
+                }
+            }
+        }
+    }
+
+    /// Ends the stream, handing on what the held bytes still hold.
+    fn flush(&mut self, emit: &mut impl FnMut(Option<u8>, u64, &Frame)) {
+        match self {
+            Wire::Any(d) => d.flush(|d| emit_mixed(d, emit)),
+            Wire::HwFoc(d) => d.flush(|d| emit_mixed(mixed::Decoded::Esc(d), emit)),
+            Wire::DataLink(d) => d.flush(|d| emit_mixed(mixed::Decoded::Hub(d), emit)),
+        }
+    }
+
+    /// Every byte fed so far.
+    fn bytes(&self) -> u64 {
+        match self {
+            Wire::Any(d) => d.stats().bytes(),
+            Wire::HwFoc(d) => d.stats().bytes(),
+            Wire::DataLink(d) => d.stats().bytes(),
+        }
+    }
+
+    /// Bytes held for a frame still arriving.
+    fn buffered(&self) -> usize {
+        match self {
+            Wire::Any(d) => d.buffered(),
+            Wire::HwFoc(d) => d.buffered(),
+            Wire::DataLink(d) => d.buffered(),
+        }
+    }
+
+    /// The HW-FOC statistics, unless only DataLink is read.
+    fn esc(&self) -> Option<&foc::Stats> {
+        match self {
+            Wire::Any(d) => Some(&d.stats().esc),
+            Wire::HwFoc(d) => Some(d.stats()),
+            Wire::DataLink(_) => None,
+        }
+    }
+
+    /// The DataLink statistics, unless only HW-FOC is read.
+    fn hub(&self) -> Option<&datalink::Stats> {
+        match self {
+            Wire::Any(d) => Some(&d.stats().hub),
+            Wire::HwFoc(_) => None,
+            Wire::DataLink(d) => Some(d.stats()),
+        }
+    }
+
+    /// The protocol forced, if one is.
+    fn forced(&self) -> Option<Protocol> {
+        match self {
+            Wire::Any(_) => None,
+            Wire::HwFoc(_) => Some(Protocol::HwFoc),
+            Wire::DataLink(_) => Some(Protocol::DataLink),
+        }
+    }
+}
+
 /// The link statistics of one ESC: those of its own wire, or of its channel of a DataLink hub
 /// (whose bytes, skipped bytes and CRC failures are the hub link's, shared by its channels).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -98,6 +207,12 @@ pub enum EscLink {
         /// The ESC's channel.
         channel: usize,
     },
+}
+
+impl Default for Stream {
+    fn default() -> Self {
+        Stream::new()
+    }
 }
 
 impl Default for EscLink {
@@ -181,18 +296,33 @@ impl EscLink {
 ///
 /// It reads both protocols at once ([`mixed::Decoder`]): the frames of an ESC's own wire and of
 /// a DataLink hub, in byte order, whatever the chunking, also when the stream changes from one
-/// to the other; bytes in a frame of either are not skipped bytes of the other.
-#[derive(Debug, Default)]
+/// to the other; bytes in a frame of either are not skipped bytes of the other. Or, made by
+/// [`Stream::forced`], it reads one protocol only: the bytes of any other are skipped bytes.
+#[derive(Debug)]
 pub struct Stream {
-    wire: mixed::Decoder,
+    wire: Wire,
     /// Receive times of the last bytes of earlier batches, oldest first.
     history: Vec<f64>,
 }
 
 impl Stream {
-    /// A stream with nothing decoded yet.
+    /// A stream with nothing decoded yet, reading every protocol.
     pub fn new() -> Stream {
-        Stream::default()
+        Stream::forced(None)
+    }
+
+    /// A stream with nothing decoded yet, reading protocol `forced` only (every protocol when
+    /// `None`).
+    pub fn forced(forced: Option<Protocol>) -> Stream {
+        Stream {
+            wire: Wire::new(forced),
+            history: Vec::new(),
+        }
+    }
+
+    /// The protocol the stream was made to read only, if any.
+    pub fn forced_protocol(&self) -> Option<Protocol> {
+        self.wire.forced()
     }
 
     /// Decodes a batch; `on_frame(t, channel, frame)` gets each ESC frame with its time
@@ -203,11 +333,11 @@ impl Stream {
         batch: Batch<'_>,
         mut on_frame: impl FnMut(Option<f64>, Option<u8>, &Frame),
     ) {
-        let start = self.wire.stats().bytes();
+        let start = self.wire.bytes();
         match batch.times {
             None => {
                 self.history.clear();
-                feed(&mut self.wire, batch.bytes, None, &mut |channel, _, f| {
+                self.wire.feed(batch.bytes, None, &mut |channel, _, f| {
                     on_frame(None, channel, f)
                 });
             }
@@ -225,17 +355,13 @@ impl Stream {
                     if let Some(before) = last
                         && t - before > SILENCE_S
                     {
-                        feed(
-                            &mut self.wire,
-                            &batch.bytes[from..i],
-                            Some(t - before),
-                            &mut emit,
-                        );
+                        self.wire
+                            .feed(&batch.bytes[from..i], Some(t - before), &mut emit);
                         from = i;
                     }
                     last = Some(t);
                 }
-                feed(&mut self.wire, &batch.bytes[from..], None, &mut emit);
+                self.wire.feed(&batch.bytes[from..], None, &mut emit);
                 let keep = TIME_HISTORY.min(self.history.len() + times.len());
                 let from_times = keep.min(times.len());
                 let from_history = keep - from_times;
@@ -248,14 +374,14 @@ impl Stream {
 
     /// Ends the stream: a frame cut off at the end is dropped, frames inside it are still found.
     pub fn finish(&mut self, mut on_frame: impl FnMut(Option<f64>, Option<u8>, &Frame)) {
-        let end = self.wire.stats().bytes();
+        let end = self.wire.bytes();
         let history = &self.history;
         let timed = !history.is_empty();
         let mut emit = |channel: Option<u8>, offset: u64, f: &Frame| {
             let t = timed.then(|| time_at(history, &[], end, offset));
             on_frame(t, channel, f)
         };
-        self.wire.flush(|d| emit_mixed(d, &mut emit));
+        self.wire.flush(&mut emit);
     }
 
     /// Which protocols the stream has been heard speaking.
@@ -270,13 +396,14 @@ impl Stream {
 
     /// Whether an ESC frame (data or device information) has been found.
     fn esc_frames(&self) -> bool {
-        let s = &self.wire.stats().esc;
-        s.packets().count() > 0 || s.info_frames() > 0
+        self.wire
+            .esc()
+            .is_some_and(|s| s.packets().count() > 0 || s.info_frames() > 0)
     }
 
     /// Whether a DataLink frame has been found.
     fn hub_frames(&self) -> bool {
-        self.wire.stats().hub.frames() > 0
+        self.wire.hub().is_some_and(|s| s.frames() > 0)
     }
 
     /// The link statistics of the stream's ESC: of its own wire, or of the hub's channel 0
@@ -287,22 +414,23 @@ impl Stream {
 
     /// The link statistics of the stream's ESC on `channel`: the hub's channel once hub frames
     /// were found (channel 0: unless the stream also carried ESC frames of its own, whose
-    /// statistics are then given), else the ESC's own wire (any channel).
+    /// statistics are then given), else the ESC's own wire (any channel). A stream forced to
+    /// read DataLink only gives the hub's channel from its first byte.
     pub fn link(&self, channel: u8) -> EscLink {
-        let stats = self.wire.stats();
-        if self.hub_frames() && (channel != 0 || !self.esc_frames()) {
-            EscLink::Hub {
-                hub: stats.hub,
+        let esc = self.wire.esc();
+        let from_hub = esc.is_none() || self.hub_frames() && (channel != 0 || !self.esc_frames());
+        match self.wire.hub().filter(|_| from_hub) {
+            Some(hub) => EscLink::Hub {
+                hub: *hub,
                 channel: usize::from(channel),
-            }
-        } else {
-            EscLink::Wire(stats.esc)
+            },
+            None => EscLink::Wire(esc.copied().unwrap_or_default()),
         }
     }
 
     /// The DataLink hub's statistics, once the stream has carried a hub frame.
     pub fn hub(&self) -> Option<&datalink::Stats> {
-        self.hub_frames().then_some(&self.wire.stats().hub)
+        self.wire.hub().filter(|s| s.frames() > 0)
     }
 
     /// The receive time of the first byte the decoder holds for a frame still arriving, if it
@@ -311,21 +439,6 @@ impl Stream {
     pub(crate) fn held_since(&self) -> Option<f64> {
         let held = self.wire.buffered();
         (held > 0 && held <= self.history.len()).then(|| self.history[self.history.len() - held])
-    }
-}
-
-/// Decodes `data` (ending with a silence of the line of `silence_s` seconds when given):
-/// `emit(channel, offset, frame)` gets each ESC frame as [`emit_mixed`] hands it on.
-#[inline(always)]
-fn feed(
-    decoder: &mut mixed::Decoder,
-    data: &[u8],
-    silence_s: Option<f64>,
-    emit: &mut impl FnMut(Option<u8>, u64, &Frame),
-) {
-    decoder.feed(data, |d| emit_mixed(d, emit));
-    if let Some(s) = silence_s {
-        decoder.line_silent_each(frames_in(s), hub_frames_in(s), |d| emit_mixed(d, emit));
     }
 }
 
@@ -429,6 +542,14 @@ impl PortStreams {
             },
         );
         Some(stream.stats())
+    }
+
+    /// Makes every port's stream read protocol `protocol` only (see [`Stream::forced`]); what
+    /// the streams decoded before is forgotten, so call it before the first event.
+    pub fn force_protocol(&mut self, protocol: Protocol) {
+        for stream in &mut self.streams {
+            *stream = Stream::forced(Some(protocol));
+        }
     }
 
     /// The link statistics of `port`'s stream (of its channel 0, from a hub).
@@ -707,5 +828,67 @@ mod mixed_tests {
             );
             assert_eq!(s.checksum_failures(), 0);
         }
+    }
+}
+
+#[cfg(test)]
+mod forced_tests {
+    use super::*;
+    use crate::sources::tests::{hub_wire, wire as esc};
+
+    /// The records of `wire` read by a stream forced to `protocol`, fed in `chunk`-byte
+    /// batches, as `(channel, packet)`, and the stream.
+    fn decode(wire: &[u8], chunk: usize, protocol: Protocol) -> (Vec<(Option<u8>, u16)>, Stream) {
+        let mut stream = Stream::forced(Some(protocol));
+        let mut got = Vec::new();
+        let mut on = |_: Option<f64>, channel: Option<u8>, frame: &Frame| {
+            if let Frame::Data(f) = frame {
+                got.push((channel, f.to_hwfoc().packet));
+            }
+        };
+        for b in wire.chunks(chunk) {
+            let batch = Batch {
+                bytes: b,
+                times: None,
+                stream: 0,
+            };
+            stream.feed(batch, &mut on);
+        }
+        stream.finish(&mut on);
+        (got, stream)
+    }
+
+    /// ESC frames, hub frames, ESC frames: a stream forced to one protocol hands on that
+    /// protocol's frames only and counts the other's bytes as skipped.
+    #[test]
+    fn a_forced_protocol_reads_its_frames_only() {
+        let mut wire = esc(0..20);
+        let hub = hub_wire(0, 0..3, &[0, 1, 2, 3, 4, 5, 6, 7]);
+        wire.extend(&hub);
+        wire.extend(esc(20..30));
+        for chunk in [1, 24, 161, wire.len()] {
+            let (got, stream) = decode(&wire, chunk, Protocol::HwFoc);
+            assert_eq!(got, (0..30).map(|p| (None, p)).collect::<Vec<_>>());
+            assert_eq!(stream.forced_protocol(), Some(Protocol::HwFoc));
+            assert_eq!(stream.kind(), WireKind::Esc);
+            assert_eq!(stream.hub(), None);
+            let s = stream.stats();
+            assert_eq!((s.frames(), s.bytes_skipped()), (30, hub.len() as u64));
+
+            let (got, stream) = decode(&wire, chunk, Protocol::DataLink);
+            assert_eq!(got.len(), 3 * 8, "chunk {chunk}");
+            assert!(got.iter().all(|(c, _)| c.is_some()));
+            assert_eq!(stream.kind(), WireKind::Hub);
+            let s = stream.stats();
+            assert!(matches!(s, EscLink::Hub { channel: 0, .. }));
+            assert_eq!(s.bytes_skipped(), 30 * 24, "chunk {chunk}");
+            assert_eq!(stream.hub().map(|h| h.frames()), Some(3));
+        }
+        // Forced to DataLink, a stream of ESC frames only is a hub link that found nothing.
+        let (got, stream) = decode(&esc(0..10), 24, Protocol::DataLink);
+        assert!(got.is_empty());
+        assert!(matches!(stream.stats(), EscLink::Hub { .. }));
+        assert_eq!(stream.stats().bytes_skipped(), 240);
+        assert_eq!(stream.kind(), WireKind::Unknown);
     }
 }

@@ -7,12 +7,14 @@ pub mod counters;
 pub mod datalink;
 pub mod foc;
 pub mod mixed;
+pub mod protocol;
 pub mod scan;
 pub mod status;
 pub mod telemetry;
 pub mod units;
 pub mod wire;
 
+pub use protocol::Protocol;
 pub use scan::{Scan, StreamDecoder};
 pub use status::{Fault, Faults, Status};
 pub use telemetry::{Conversion, Reading, Telemetry};

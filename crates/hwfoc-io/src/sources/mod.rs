@@ -35,8 +35,8 @@ pub(crate) mod tests;
 
 use std::collections::{HashMap, VecDeque};
 
-use hwfoc::Settings;
 use hwfoc::datalink;
+use hwfoc::{Protocol, Settings};
 
 pub use crate::handler::Handler;
 use crate::input::{Input, InputError, InputFormat};
@@ -106,6 +106,8 @@ pub struct Sources {
     /// By ESC: the input (index) whose bytes its stream was fed last, and the time of the last
     /// of them.
     fed: Vec<Option<(usize, f64)>>,
+    /// The one protocol read, when a user forced one.
+    forced: Option<Protocol>,
 }
 
 impl Sources {
@@ -126,7 +128,20 @@ impl Sources {
             queue: Queue::default(),
             readers: Vec::new(),
             fed: Vec::new(),
+            forced: None,
         }
+    }
+
+    /// Reads protocol `protocol` only, instead of every protocol the bytes may hold (the bytes of
+    /// any other are skipped bytes): for the streams of the ESCs found from now on, so call it
+    /// before [`Sources::run`].
+    pub fn force_protocol(&mut self, protocol: Protocol) {
+        self.forced = Some(protocol);
+    }
+
+    /// The protocol forced by [`Sources::force_protocol`], if any.
+    pub fn forced_protocol(&self) -> Option<Protocol> {
+        self.forced
     }
 
     /// Makes an input without receive times an error ([`InputError::NoTiming`]): raw-byte inputs

@@ -37,7 +37,7 @@ impl Sources {
                     self.push_esc(Esc {
                         input: self.escs[esc].input,
                         name: self.escs[esc].name.clone(),
-                        stream: Stream::new(),
+                        stream: Stream::forced(self.forced),
                         hub: Some((esc, channel as u8)),
                     });
                 }
@@ -103,7 +103,7 @@ impl Sources {
                 self.push_esc(Esc {
                     input: index,
                     name,
-                    stream: Stream::new(),
+                    stream: Stream::forced(self.forced),
                     hub: None,
                 });
                 self.escs.len() - 1

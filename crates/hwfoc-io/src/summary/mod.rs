@@ -39,6 +39,7 @@ use crate::settings::{self, settings_json};
 use crate::sources::{Handler, Sources};
 use crate::stream::EscLink;
 use crate::time::{self, Clock};
+use hwfoc::Protocol;
 use hwfoc::datalink::LengthByte;
 
 mod accumulate;
@@ -50,25 +51,37 @@ mod text;
 use accumulate::{Accumulator, TempStats, lane, temp_stats};
 pub use json::device_json;
 
-/// What to tell a user whose wire gave bytes but no frame.
-pub static NO_FRAMES: std::sync::LazyLock<String> = std::sync::LazyLock::new(|| {
+/// What to tell a user whose wire gave bytes but no frame: [`no_frames_of`] HW-FOC, the
+/// protocol of an ESC's own wire.
+pub static NO_FRAMES: std::sync::LazyLock<String> =
+    std::sync::LazyLock::new(|| no_frames_of(Protocol::HwFoc));
+
+/// What to tell a user whose wire gave bytes but no frame of `protocol`: its baud rate and the
+/// wiring.
+pub fn no_frames_of(protocol: Protocol) -> String {
     format!(
-        "no valid HW-FOC frames: check the baud rate ({}) and the wiring",
-        hwfoc::foc::BAUD_RATE
+        "no valid {} frames: check the baud rate ({}) and the wiring",
+        protocol.title(),
+        protocol.baud_rate()
     )
-});
+}
 
 /// Why ESC `esc`'s bytes gave no frame, as every output says it: what its input looks like
 /// when that is not telemetry (`text, not telemetry`, `looks like a PNG image, not telemetry`:
 /// a file given by mistake), else [`NO_FRAMES`], the advice for a wire (a port, a recording,
-/// a raw capture of bytes).
+/// a raw capture of bytes), or that of the protocol forced ([`Sources::force_protocol`]).
 pub fn no_frames(sources: &Sources, esc: usize) -> String {
+    let advice = || {
+        sources
+            .forced_protocol()
+            .map_or_else(|| NO_FRAMES.clone(), no_frames_of)
+    };
     sources
         .escs()
         .get(esc)
         .and_then(|e| sources.inputs().get(e.input))
         .and_then(|input| input.looks)
-        .map_or_else(|| NO_FRAMES.clone(), |looks| looks.to_string())
+        .map_or_else(advice, |looks| looks.to_string())
 }
 
 /// Fault episodes kept per ESC in detail (all are counted).
