@@ -19,6 +19,7 @@
 //! (its reading, its streams, its flagged bytes). Standard input and files are read as their
 //! content says.
 
+mod ahead;
 mod csv;
 mod error;
 mod looks;
@@ -242,7 +243,11 @@ impl Input {
                 input: spec.to_string(),
             });
         }
-        let mut input = Input::from_reader(spec, Box::new(file))?;
+        let mut input = if meta.is_file() {
+            Input::from_file(spec, file)?
+        } else {
+            Input::from_reader(spec, Box::new(file))?
+        };
         if meta.is_file() {
             // Closed until read: a year of rotated recordings is thousands of inputs, more
             // than a process may hold open. (A pipe or a device cannot be opened again.)
@@ -262,7 +267,7 @@ impl Input {
             input: self.name.clone(),
             source,
         })?;
-        let fresh = Input::from_reader(&self.name, Box::new(file))?;
+        let fresh = Input::from_file(&self.name, file)?;
         if fresh.format != self.format {
             return Err(InputError::Changed {
                 input: self.name.clone(),
@@ -329,60 +334,32 @@ impl Input {
     /// Detects the format from the first bytes of `reader`: the one place formats are
     /// detected, each format's reader made in a line of its own.
     pub fn from_reader(name: &str, mut reader: Box<dyn Read>) -> Result<Input, InputError> {
-        let read_err = |source| InputError::Read {
-            input: name.to_string(),
-            source,
-        };
-        // A CSV export starts with its header line ("Time [s],Value,..."); raw telemetry does not
-        // start with 'T' (or a UTF-8 byte-order mark). Read no further than needed to decide, so
-        // that a live raw stream is not held up.
-        let mut head = Vec::new();
-        let mut byte = [0u8; 1];
-        loop {
-            let n = read_some(&mut reader, &mut byte).map_err(read_err)?;
-            if n == 0 {
-                break;
-            }
-            head.push(byte[0]);
-            if !may_be_header(&head) || byte[0] == b'\n' || head.len() >= 512 {
-                break;
-            }
-        }
-        if head.is_empty() {
-            return Err(InputError::Empty {
-                input: name.to_string(),
-            });
-        }
-        // A classic libpcap file (Wireshark's older format) starts with its magic number.
-        while head.len() < 4 && CLASSIC_PCAP.iter().any(|m| m.starts_with(&head)) {
-            let n = read_some(&mut reader, &mut byte).map_err(read_err)?;
-            if n == 0 {
-                break;
-            }
-            head.push(byte[0]);
-        }
+        let head = read_head(name, &mut reader)?;
+        Input::with_head(name, head, Opened::Reader(reader))
+    }
+
+    /// [`Input::from_reader`] of a regular file: raw bytes are read ahead on a thread of their
+    /// own (see `ahead.rs`).
+    fn from_file(name: &str, mut file: File) -> Result<Input, InputError> {
+        let head = read_head(name, &mut file)?;
+        Input::with_head(name, head, Opened::File(file))
+    }
+
+    /// The input whose first bytes, `head`, were read of `opened`.
+    fn with_head(name: &str, head: Vec<u8>, opened: Opened) -> Result<Input, InputError> {
         if CLASSIC_PCAP.iter().any(|m| head.starts_with(m)) {
             return Err(InputError::ClassicPcap {
                 input: name.to_string(),
             });
         }
-        // A pcapng recording starts with the section header's type, 0A 0D 0D 0A, and its
-        // byte-order magic follows at bytes 8..12.
-        while head.len() < 12 && pcapng::MAGIC.starts_with(&head[..head.len().min(4)]) {
-            let n = read_some(&mut reader, &mut byte).map_err(read_err)?;
-            if n == 0 {
-                break;
-            }
-            head.push(byte[0]);
-        }
         let source: Box<dyn Source> = if recording::is_start(&head) {
-            let reader = Box::new(Cursor::new(head).chain(reader));
+            let reader = Box::new(Cursor::new(head).chain(opened.reader()));
             Box::new(RecordingReader::new(reader))
         } else if csv::is_header(&head) {
-            let reader = BufReader::with_capacity(BATCH, reader);
+            let reader = BufReader::with_capacity(BATCH, opened.reader());
             Box::new(CsvRows::open(name, reader, head)?)
         } else {
-            Box::new(RawReader::new(reader, head))
+            Box::new(RawReader::new(opened.raw(), head))
         };
         Ok(Input::new(name, source))
     }
@@ -582,6 +559,80 @@ fn file_kind(kind: &std::fs::FileType) -> Option<&'static str> {
         }
     }
     kind.is_dir().then_some("a directory")
+}
+
+/// The first bytes of an input, as many as detecting its format takes; an empty input is an
+/// error naming it.
+fn read_head(name: &str, reader: &mut dyn Read) -> Result<Vec<u8>, InputError> {
+    let read_err = |source| InputError::Read {
+        input: name.to_string(),
+        source,
+    };
+    // A CSV export starts with its header line ("Time [s],Value,..."); raw telemetry does not
+    // start with 'T' (or a UTF-8 byte-order mark). Read no further than needed to decide, so
+    // that a live raw stream is not held up.
+    let mut head = Vec::new();
+    let mut byte = [0u8; 1];
+    loop {
+        let n = read_some(reader, &mut byte).map_err(read_err)?;
+        if n == 0 {
+            break;
+        }
+        head.push(byte[0]);
+        if !may_be_header(&head) || byte[0] == b'\n' || head.len() >= 512 {
+            break;
+        }
+    }
+    if head.is_empty() {
+        return Err(InputError::Empty {
+            input: name.to_string(),
+        });
+    }
+    // A classic libpcap file (Wireshark's older format) starts with its magic number.
+    while head.len() < 4 && CLASSIC_PCAP.iter().any(|m| m.starts_with(&head)) {
+        let n = read_some(reader, &mut byte).map_err(read_err)?;
+        if n == 0 {
+            break;
+        }
+        head.push(byte[0]);
+    }
+    // A pcapng recording starts with the section header's type, 0A 0D 0D 0A, and its
+    // byte-order magic follows at bytes 8..12.
+    while head.len() < 12 && pcapng::MAGIC.starts_with(&head[..head.len().min(4)]) {
+        let n = read_some(reader, &mut byte).map_err(read_err)?;
+        if n == 0 {
+            break;
+        }
+        head.push(byte[0]);
+    }
+    Ok(head)
+}
+
+/// What an input is read from once its first bytes are known.
+enum Opened {
+    /// Any reader.
+    Reader(Box<dyn Read>),
+    /// A regular file: raw bytes of it are read ahead.
+    File(File),
+}
+
+impl Opened {
+    fn reader(self) -> Box<dyn Read> {
+        match self {
+            Opened::Reader(reader) => reader,
+            Opened::File(file) => Box::new(file),
+        }
+    }
+
+    fn raw(self) -> raw::Reader {
+        match self {
+            Opened::Reader(reader) => raw::Reader::Plain(reader),
+            Opened::File(file) => match ahead::ReadAhead::start(file) {
+                Ok(ahead) => raw::Reader::Ahead(ahead),
+                Err(file) => raw::Reader::Plain(Box::new(file)),
+            },
+        }
+    }
 }
 
 /// `read` that retries when interrupted by a signal.

@@ -2,6 +2,7 @@
 
 use std::io::Read;
 
+use super::ahead::ReadAhead;
 use super::{BATCH, InputError, InputFormat, Looks, Source, looks, read_some};
 use crate::notice::Notice;
 use crate::time::Clock;
@@ -17,9 +18,17 @@ impl InputFormat {
     };
 }
 
+/// What raw bytes are read from.
+pub(super) enum Reader {
+    /// Any reader, read in turn.
+    Plain(Box<dyn Read>),
+    /// A regular file read ahead.
+    Ahead(ReadAhead),
+}
+
 /// A raw input being read.
 pub(super) struct RawReader {
-    reader: Box<dyn Read>,
+    reader: Reader,
     /// Bytes read during format detection, handed out first.
     pending: Vec<u8>,
     /// The first bytes (up to [`looks::SAMPLE`]), to say what they look like if they hold no
@@ -29,7 +38,7 @@ pub(super) struct RawReader {
 
 impl RawReader {
     /// Reads `reader`, after `head`, the bytes format detection read of it.
-    pub(super) fn new(reader: Box<dyn Read>, head: Vec<u8>) -> RawReader {
+    pub(super) fn new(reader: Reader, head: Vec<u8>) -> RawReader {
         RawReader {
             reader,
             pending: head,
@@ -54,10 +63,17 @@ impl Source for RawReader {
             std::mem::swap(bytes, &mut self.pending);
             self.pending.clear();
         } else {
-            // The buffer keeps its length from the last read: only bytes never read into are
-            // zeroed here (zeroing all of it every time cost more than the read).
-            bytes.resize(BATCH, 0);
-            match read_some(&mut self.reader, bytes) {
+            let read = match &mut self.reader {
+                Reader::Plain(reader) => {
+                    // The buffer keeps its length from the last read: only bytes never read
+                    // into are zeroed here (zeroing all of it every time cost more than the
+                    // read).
+                    bytes.resize(BATCH, 0);
+                    read_some(reader, bytes)
+                }
+                Reader::Ahead(ahead) => ahead.read(bytes),
+            };
+            match read {
                 Ok(n) => bytes.truncate(n),
                 Err(source) => {
                     bytes.clear();
