@@ -170,6 +170,12 @@ impl PacketSequence {
     /// Takes the next number and classifies its step from the last one.
     #[inline]
     pub(crate) fn next(&mut self, number: u16) {
+        // The usual step: the next number, nothing lost, no silence before it.
+        if number == self.last.wrapping_add(1) && self.gap_limit == 0 && self.count != 0 {
+            self.count = self.count.saturating_add(1);
+            self.last = number;
+            return;
+        }
         if self.count != 0 {
             let limit = if self.gap_limit == 0 {
                 MAX_PACKET_GAP + 1
