@@ -10,7 +10,7 @@
 //! integers for exact means; none of them names a protocol's frame type.
 
 use hwfoc::Settings;
-use hwfoc::telemetry::{Frame, Info};
+use hwfoc::telemetry::{Data, Frame, Info};
 
 use crate::input::InputError;
 use crate::record::Record;
@@ -47,6 +47,16 @@ pub trait Handler {
         }
     }
 
+    /// Data frames of ESC `esc`, one after another, without receive times (a raw input's):
+    /// what handing each to [`Handler::frame`] in turn does, which the default does. A handler
+    /// that gathers statistics takes them in a loop of its own.
+    #[inline]
+    fn untimed_data(&mut self, esc: u8, frames: &[Data], settings: &Settings) {
+        for f in frames {
+            self.frame(esc, None, &Frame::Data(*f), settings);
+        }
+    }
+
     /// The end of a batch of bytes; `live` when it was small, as from a serial port (what it
     /// produced should be passed on at once). An error stops the run.
     fn end_batch(&mut self, live: bool) -> Result<(), Self::Error> {
@@ -78,6 +88,12 @@ where
     fn frame(&mut self, esc: u8, t: Option<f64>, frame: &Frame, settings: &Settings) {
         self.0.frame(esc, t, frame, settings);
         self.1.frame(esc, t, frame, settings);
+    }
+
+    #[inline]
+    fn untimed_data(&mut self, esc: u8, frames: &[Data], settings: &Settings) {
+        self.0.untimed_data(esc, frames, settings);
+        self.1.untimed_data(esc, frames, settings);
     }
 
     fn end_batch(&mut self, live: bool) -> Result<(), B::Error> {

@@ -113,23 +113,39 @@ impl Wire {
         &mut self,
         data: &[u8],
         silence_s: Option<f64>,
-        emit: &mut impl FnMut(Option<u8>, u64, &Frame),
+        mut emit: impl FnMut(Option<u8>, u64, &Frame),
     ) {
+        let emit = &mut emit;
         match self {
+            // The closures inlined into the scanner's loop, so that the handler may be too: a
+            // frame's fields then reach it in registers, not through a frame stored and loaded
+            // back.
             Wire::Any(d) => {
-                d.feed(data, |d| emit_mixed(d, emit));
+                d.feed(
+                    data,
+                    #[inline(always)]
+                    |d| emit_mixed(d, emit),
+                );
                 if let Some(s) = silence_s {
                     d.line_silent_each(frames_in(s), hub_frames_in(s), |d| emit_mixed(d, emit));
                 }
             }
             Wire::HwFoc(d) => {
-                d.feed(data, |d| emit_mixed(mixed::Decoded::Esc(d), emit));
+                d.feed(
+                    data,
+                    #[inline(always)]
+                    |d| emit_mixed(mixed::Decoded::Esc(d), emit),
+                );
                 if let Some(s) = silence_s {
                     d.line_silent(frames_in(s), |d| emit_mixed(mixed::Decoded::Esc(d), emit));
                 }
             }
             Wire::DataLink(d) => {
-                d.feed(data, |d| emit_mixed(mixed::Decoded::Hub(d), emit));
+                d.feed(
+                    data,
+                    #[inline(always)]
+                    |d| emit_mixed(mixed::Decoded::Hub(d), emit),
+                );
                 if let Some(s) = silence_s {
                     d.line_silent(hub_frames_in(s), |d| {
                         emit_mixed(mixed::Decoded::Hub(d), emit)
@@ -337,9 +353,12 @@ impl Stream {
         match batch.times {
             None => {
                 self.history.clear();
-                self.wire.feed(batch.bytes, None, &mut |channel, _, f| {
-                    on_frame(None, channel, f)
-                });
+                self.wire.feed(
+                    batch.bytes,
+                    None,
+                    #[inline(always)]
+                    |channel, _, f| on_frame(None, channel, f),
+                );
             }
             Some(times) => {
                 let history = &self.history;

@@ -3,7 +3,7 @@
 //! per-frame cost of `hwfoc summary`.
 
 use hwfoc::telemetry::{Conversion, Data, Frame, Info, Telemetry};
-use hwfoc::{Quantity, Temperature};
+use hwfoc::{Quantity, Status, Temperature};
 
 use super::MAX_EPISODES;
 use crate::clock::Step;
@@ -134,16 +134,99 @@ impl Range {
     }
 }
 
+/// The count, ranges and power of an ESC's data frames: what every data frame adds, apart from
+/// the rest of the [`Accumulator`] so that a run of frames is added in registers
+/// ([`Accumulator::add_clean_run`]).
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Tally {
+    pub(super) frames: u64,
+    pub(super) ranges: Ranges,
+    /// The last data frame's raw voltage and current.
+    pub(super) last: (i32, i32),
+    /// Sum and largest of the raw power (voltage times current: for HW-FOC at most 65535 x
+    /// 32768 in magnitude, within an `i32`) of every data frame.
+    pub(super) power_sum: i64,
+    pub(super) power_max: i32,
+}
+
+impl Default for Tally {
+    fn default() -> Self {
+        Tally {
+            frames: 0,
+            ranges: Ranges::default(),
+            last: (0, 0),
+            power_sum: 0,
+            power_max: i32::MIN,
+        }
+    }
+}
+
+impl Tally {
+    /// Adds a data frame: its count and ranges, and its power when it carries voltage and
+    /// current (whether it does).
+    #[inline(always)]
+    fn add(&mut self, f: &Data) -> bool {
+        self.frames += 1;
+        self.ranges.add(f);
+        let (Some(volts), Some(amps)) = (f.raw(Quantity::Voltage), f.raw(Quantity::Current)) else {
+            return false;
+        };
+        self.last = (volts, amps);
+        let power = volts * amps;
+        self.power_sum += i64::from(power);
+        // A branch rarely taken, not a chain of conditional moves from frame to frame.
+        if power > self.power_max {
+            self.power_max = power;
+        }
+        true
+    }
+}
+
+/// The code of temperature `quantity` in a data frame: its raw value when that is a table's
+/// code (0..=255), `None` when it is not or the frame does not carry it.
+#[inline(always)]
+fn code(f: &Data, quantity: Quantity) -> Option<u8> {
+    f.raw(quantity).and_then(|raw| u8::try_from(raw).ok())
+}
+
+/// A run of frames with one temperature code, counted in the histogram when the code changes.
+#[derive(Default)]
+struct CodeRun {
+    code: u8,
+    frames: u64,
+}
+
+impl CodeRun {
+    /// A frame's code (`None`: not a code, counted in `uncoded` at once).
+    #[inline(always)]
+    fn add(&mut self, code: Option<u8>, codes: &mut [u64; 256], uncoded: &mut u64) {
+        match code {
+            Some(code) if code == self.code => self.frames += 1,
+            Some(code) => {
+                codes[usize::from(self.code)] += self.frames;
+                *self = CodeRun { code, frames: 1 };
+            }
+            None => *uncoded += 1,
+        }
+    }
+
+    /// Counts the run in the histogram.
+    #[inline(always)]
+    fn end(self, codes: &mut [u64; 256]) {
+        codes[usize::from(self.code)] += self.frames;
+    }
+}
+
 /// Everything the summary needs from the frames of one ESC, gathered as they are decoded.
 #[derive(Debug)]
 pub(super) struct Accumulator {
-    pub(super) frames: u64,
+    /// The count, ranges and power of the data frames.
+    pub(super) tally: Tally,
     /// A data frame of the ESC (its first), whose protocol's conversions the report uses.
     pub(super) sample: Option<Data>,
     /// Whether the next data frame may take [`Accumulator::add_clean`]: the ESC's sample is
     /// known and no fault episode is open.
     pub(super) fast: bool,
-    pub(super) ranges: Ranges,
     /// Histograms of each temperature's raw codes (a table's codes, 0..=255), and the frames
     /// whose temperature was not such a code or was not carried.
     pub(super) mos_codes: [u64; 256],
@@ -163,12 +246,6 @@ pub(super) struct Accumulator {
     /// Charge and energy of timed frames in raw units (voltage and current as sent); frames
     /// without times are integrated from the lanes' sums at the end (see [`Self::energy`]).
     pub(super) energy: Energy,
-    /// The last data frame's raw voltage and current.
-    pub(super) last: (i32, i32),
-    /// Sum and largest of the raw power (voltage times current: for HW-FOC at most 65535 x
-    /// 32768 in magnitude, within an `i32`) of every data frame.
-    pub(super) power_sum: i64,
-    pub(super) power_max: i32,
     pub(super) infos: Vec<(Info, u64)>,
     pub(super) episode: Option<Episode>,
     pub(super) episodes: Vec<Episode>,
@@ -178,10 +255,9 @@ pub(super) struct Accumulator {
 impl Default for Accumulator {
     fn default() -> Self {
         Accumulator {
-            frames: 0,
+            tally: Tally::default(),
             sample: None,
             fast: false,
-            ranges: Ranges::default(),
             mos_codes: [0; 256],
             cap_codes: [0; 256],
             uncoded: [0; 2],
@@ -193,9 +269,6 @@ impl Default for Accumulator {
             steps_back: 0,
             jumps: 0,
             energy: Energy::new(),
-            last: (0, 0),
-            power_sum: 0,
-            power_max: i32::MIN,
             infos: Vec::new(),
             episode: None,
             episodes: Vec::new(),
@@ -227,37 +300,76 @@ impl Accumulator {
     /// What every data frame adds: its count, ranges, temperature codes and time.
     #[inline(always)]
     pub(super) fn count(&mut self, t: Option<f64>, f: &Data) {
-        self.frames += 1;
-        self.ranges.add(f);
-        let code = |quantity: Quantity, codes: &mut [u64; 256], uncoded: &mut u64| match f
-            .raw(quantity)
-            .and_then(|raw| u8::try_from(raw).ok())
-        {
-            Some(code) => codes[usize::from(code)] += 1,
-            None => *uncoded += 1,
-        };
-        code(Quantity::MosTemp, &mut self.mos_codes, &mut self.uncoded[0]);
-        code(Quantity::CapTemp, &mut self.cap_codes, &mut self.uncoded[1]);
-        let (Some(volts), Some(amps)) = (f.raw(Quantity::Voltage), f.raw(Quantity::Current)) else {
+        let powered = self.tally.add(f);
+        self.code(f);
+        if !powered {
             return self.untimed_power(t, f);
-        };
-        self.last = (volts, amps);
-        let power = volts * amps;
-        self.power_sum += i64::from(power);
-        // A branch rarely taken, not a chain of conditional moves from frame to frame.
-        if power > self.power_max {
-            self.power_max = power;
         }
         if let Some(t) = t {
             self.timed(t, f);
         }
     }
 
+    /// Adds the data frames without times at the start of `frames` that [`Self::add_clean`]
+    /// would take (no fault), up to the first that it would not: how many. Their tally is kept
+    /// in registers for the run, not loaded and stored back for each frame, and their
+    /// temperature codes counted a run of one code at a time (adding one to the same count frame
+    /// after frame waits for the previous store each time).
+    #[inline(always)]
+    pub(super) fn add_clean_run(&mut self, frames: &[Data]) -> usize {
+        debug_assert!(self.fast && self.sample.is_some() && self.episode.is_none());
+        let mut tally = self.tally;
+        let mut mos = CodeRun::default();
+        let mut cap = CodeRun::default();
+        let mut n = 0;
+        for f in frames {
+            if !f.status().is_none_or(Status::is_ok) {
+                break;
+            }
+            // Without voltage and current, an untimed frame adds no power and no time.
+            tally.add(f);
+            mos.add(
+                code(f, Quantity::MosTemp),
+                &mut self.mos_codes,
+                &mut self.uncoded[0],
+            );
+            cap.add(
+                code(f, Quantity::CapTemp),
+                &mut self.cap_codes,
+                &mut self.uncoded[1],
+            );
+            n += 1;
+        }
+        self.tally = tally;
+        mos.end(&mut self.mos_codes);
+        cap.end(&mut self.cap_codes);
+        n
+    }
+
+    /// Counts a data frame's temperature codes.
+    #[inline(always)]
+    fn code(&mut self, f: &Data) {
+        let count = |code: Option<u8>, codes: &mut [u64; 256], uncoded: &mut u64| match code {
+            Some(code) => codes[usize::from(code)] += 1,
+            None => *uncoded += 1,
+        };
+        count(
+            code(f, Quantity::MosTemp),
+            &mut self.mos_codes,
+            &mut self.uncoded[0],
+        );
+        count(
+            code(f, Quantity::CapTemp),
+            &mut self.cap_codes,
+            &mut self.uncoded[1],
+        );
+    }
+
     /// What a frame with a time adds: out of the decoder's loop, which stays as small as it
     /// was for inputs without times (the summary of a large raw file).
     #[inline(never)]
     pub(super) fn timed(&mut self, t: f64, f: &Data) {
-        let (volts, amps) = self.last;
+        let (volts, amps) = self.tally.last;
         self.energy.add(Some(t), f64::from(volts), f64::from(amps));
         self.clock(t, f);
     }
@@ -291,7 +403,7 @@ impl Accumulator {
     #[inline]
     pub(super) fn add_data(&mut self, t: Option<f64>, f: &Data) {
         self.sample.get_or_insert(*f);
-        let index = self.frames;
+        let index = self.tally.frames;
         self.count(t, f);
         let status = f.status().unwrap_or_default();
         if !status.is_ok() {
@@ -321,13 +433,19 @@ impl Accumulator {
         if self.first_t.is_some() {
             return self.energy;
         }
-        let (v, i) = self.last;
+        let Tally {
+            frames,
+            ranges,
+            last: (v, i),
+            power_sum,
+            power_max,
+        } = self.tally;
         Energy::untimed(
-            self.frames,
-            self.ranges.sum[CURRENT] as f64,
-            self.power_sum as f64,
+            frames,
+            ranges.sum[CURRENT] as f64,
+            power_sum as f64,
             (f64::from(v), f64::from(i)),
-            (self.frames > 0).then(|| f64::from(self.power_max)),
+            (frames > 0).then(|| f64::from(power_max)),
         )
     }
 }

@@ -25,7 +25,7 @@
 //! Here: the handler and the report's parts; `accumulate.rs`, what is gathered per frame;
 //! `text.rs` and `json.rs`, the report as text and as JSON.
 
-use hwfoc::telemetry::{Conversion, Frame, Info, Telemetry};
+use hwfoc::telemetry::{Conversion, Data, Frame, Info, Telemetry};
 use hwfoc::units::Linear;
 use hwfoc::{Fault, Quantity, Settings, Status};
 use serde_json::{Value, json};
@@ -156,6 +156,25 @@ impl Handler for Summary {
             acc.add_clean(t, f);
         } else {
             self.add(esc, t, frame);
+        }
+    }
+
+    /// The frames of a raw input: the clean ones (as in [`Summary::frame`]) in a loop that
+    /// holds the ESC's accumulator, any other out of line.
+    #[inline]
+    fn untimed_data(&mut self, esc: u8, frames: &[Data], _: &Settings) {
+        let esc = usize::from(esc);
+        let mut i = 0;
+        while i < frames.len() {
+            if let Some(acc) = self.0.get_mut(esc)
+                && acc.fast
+            {
+                i += acc.add_clean_run(&frames[i..]);
+            }
+            if let Some(f) = frames.get(i) {
+                self.add(esc, None, &Frame::Data(*f));
+                i += 1;
+            }
         }
     }
 }
@@ -316,7 +335,7 @@ impl EscReport<'_> {
     /// Data frames per second between the first and the last frame.
     fn frame_rate(&self) -> Option<f64> {
         let d = self.duration()?;
-        (d > 0.0).then(|| (self.acc.frames - 1) as f64 / d)
+        (d > 0.0).then(|| (self.acc.tally.frames - 1) as f64 / d)
     }
 
     fn fields(&self) -> Vec<FieldRow> {
@@ -324,7 +343,7 @@ impl EscReport<'_> {
         let field = |q: Quantity| {
             let stats = match lane(q) {
                 Some(lane) => {
-                    let (range, n) = self.acc.ranges.get(lane, self.acc.frames);
+                    let (range, n) = self.acc.tally.ranges.get(lane, self.acc.tally.frames);
                     let linear = self.linear(q);
                     linear.and_then(|linear| range.convert(n, |x| linear.to_f64(x)))
                 }

@@ -83,3 +83,46 @@ fn episodes_are_maximal_runs_of_faulty_frames() {
     let open = acc.episode.unwrap();
     assert_eq!((open.first.frame, open.last.frame, open.frames), (8, 9, 2));
 }
+
+/// Frames of a raw input handed on together ([`Handler::untimed_data`], in runs of any length)
+/// are summarised exactly as when handed on one at a time: ranges, temperature codes that
+/// change and repeat, faults and their episodes, power.
+#[test]
+fn frames_handed_on_together_are_summarised_as_one_at_a_time() {
+    let frames: Vec<Data> = (0..3000u16)
+        .map(|i| {
+            let status = match i {
+                700..=720 | 1999 | 2500..=2502 => Status(0x0040 | (i & 1)),
+                _ => Status(0),
+            };
+            Data::from(DataFrame {
+                packet: i.wrapping_mul(7),
+                throttle_in_raw: i % 1000,
+                throttle_out_raw: 999 - i % 1000,
+                erpm_raw: i.wrapping_mul(31),
+                voltage_raw: 200 + i % 57,
+                current_raw: (i % 300) as i16 - 150,
+                phase_current_raw: -((i % 77) as i16),
+                mos_adc: 180 + (i / 100) as u8,
+                cap_adc: if i % 500 < 250 { 200 } else { (i % 13) as u8 },
+                status,
+            })
+        })
+        .collect();
+    let settings = Settings::DEFAULT;
+    let mut one_at_a_time = Summary::new();
+    for f in &frames {
+        one_at_a_time.frame(0, None, &Frame::Data(*f), &settings);
+    }
+    for run in [1, 2, 7, 512, 3000] {
+        let mut together = Summary::new();
+        for chunk in frames.chunks(run) {
+            together.untimed_data(0, chunk, &settings);
+        }
+        assert_eq!(
+            format!("{:?}", together.0),
+            format!("{:?}", one_at_a_time.0),
+            "runs of {run}"
+        );
+    }
+}

@@ -64,7 +64,7 @@ impl Report<'_> {
             let _ = writeln!(
                 o,
                 "\ntotal        {} ESCs: {}",
-                escs.iter().filter(|e| e.acc.frames > 0).count(),
+                escs.iter().filter(|e| e.acc.tally.frames > 0).count(),
                 energy_text(&total)
             );
             let _ = writeln!(
@@ -135,7 +135,7 @@ impl EscReport<'_> {
         for (info, n) in &self.acc.infos {
             let _ = writeln!(o, "device       {}  ({n} info frames)", Escaped(info));
         }
-        if self.acc.frames == 0 {
+        if self.acc.tally.frames == 0 {
             return;
         }
         let _ = writeln!(
