@@ -166,8 +166,15 @@ impl Tally {
     /// current (whether it does).
     #[inline(always)]
     fn add(&mut self, f: &Data) -> bool {
-        self.frames += 1;
         self.ranges.add(f);
+        self.count(f)
+    }
+
+    /// Adds a data frame but for its ranges: its count, and its power when it carries voltage
+    /// and current (whether it does).
+    #[inline(always)]
+    fn count(&mut self, f: &Data) -> bool {
+        self.frames += 1;
         let (Some(volts), Some(amps)) = (f.raw(Quantity::Voltage), f.raw(Quantity::Current)) else {
             return false;
         };
@@ -318,30 +325,41 @@ impl Accumulator {
     #[inline(always)]
     pub(super) fn add_clean_run(&mut self, frames: &[Data]) -> usize {
         debug_assert!(self.fast && self.sample.is_some() && self.episode.is_none());
+        // A pass for each part, each with few enough values to stay in registers (the run is
+        // in the L1 cache): the count and power up to the first frame with a fault, then the
+        // ranges and the temperatures of the frames before it.
         let mut tally = self.tally;
-        let mut mos = CodeRun::default();
-        let mut cap = CodeRun::default();
         let mut n = 0;
         for f in frames {
             if !f.status().is_none_or(Status::is_ok) {
                 break;
             }
             // Without voltage and current, an untimed frame adds no power and no time.
-            tally.add(f);
+            tally.count(f);
+            n += 1;
+        }
+        let run = &frames[..n];
+        for f in run {
+            tally.ranges.add(f);
+        }
+        self.tally = tally;
+        let mut mos = CodeRun::default();
+        for f in run {
             mos.add(
                 code(f, Quantity::MosTemp),
                 &mut self.mos_codes,
                 &mut self.uncoded[0],
             );
+        }
+        mos.end(&mut self.mos_codes);
+        let mut cap = CodeRun::default();
+        for f in run {
             cap.add(
                 code(f, Quantity::CapTemp),
                 &mut self.cap_codes,
                 &mut self.uncoded[1],
             );
-            n += 1;
         }
-        self.tally = tally;
-        mos.end(&mut self.mos_codes);
         cap.end(&mut self.cap_codes);
         n
     }
