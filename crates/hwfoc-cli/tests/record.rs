@@ -491,6 +491,42 @@ fn wrong_baud_rate_is_named() {
     assert!(rec.wait(Duration::from_secs(10)));
 }
 
+/// `--protocol datalink` opens the port at DataLink's 115200 baud and counts hub frames only:
+/// an ESC's own frames are bytes without a valid frame, and the warning names DataLink V2 and
+/// its baud rate. Every byte is recorded all the same.
+#[test]
+fn a_forced_protocol_sets_the_baud_rate_and_the_warning() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("esc.pcapng");
+    let mut pty = pty();
+    let port = pty.path.to_str().unwrap().to_string();
+    let mut rec = Running::start(&[
+        "record",
+        &port,
+        "-o",
+        out.to_str().unwrap(),
+        "--protocol",
+        "datalink",
+        "--duration",
+        "4.5",
+    ]);
+    let started = rec.wait_for("recording", Duration::from_secs(10));
+    assert!(started.contains("at 115200 baud"), "{started}");
+    feed(&mut pty, 0..70, Duration::from_millis(50));
+    let line = rec.wait_for("no valid DataLink V2 frame", Duration::from_secs(5));
+    assert!(
+        line.contains("read at 115200; DataLink V2 telemetry is 115200, see --baud"),
+        "{line}"
+    );
+    assert!(rec.wait(Duration::from_secs(10)), "{}", rec.stderr());
+    let end = rec.stderr();
+    assert!(
+        end.contains(&format!("{port} 1680 bytes, 0 frames")),
+        "{end}"
+    );
+    assert_eq!(decode(&out).0.len(), 70, "every byte is recorded");
+}
+
 #[test]
 fn errors_name_the_port_or_file() {
     let dir = tempfile::tempdir().unwrap();
