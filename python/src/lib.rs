@@ -59,7 +59,6 @@ pub(crate) struct Options {
 }
 
 impl Options {
-    #[allow(clippy::too_many_arguments)]
     pub fn new(
         esc: Option<&Bound<'_, PyAny>>,
         start: Option<&Bound<'_, PyAny>>,
@@ -67,7 +66,6 @@ impl Options {
         current_scale: f32,
         pole_pairs: u16,
         gear_ratio: f32,
-        protocol: Option<&str>,
     ) -> PyResult<Options> {
         let settings =
             Settings::new(current_scale, pole_pairs, gear_ratio).map_err(errors::settings)?;
@@ -79,7 +77,16 @@ impl Options {
             settings,
             selection: Selection::new(&escs, window),
             filter: filter_text(&escs, from.map(Time::Seconds), to.map(Time::Seconds)),
+            protocol: None,
+        })
+    }
+
+    /// These options, reading the protocol named `protocol` only (`protocol=`: see
+    /// [`protocol_arg`]).
+    pub fn forced(self, protocol: Option<&str>) -> PyResult<Options> {
+        Ok(Options {
             protocol: protocol_arg(protocol)?,
+            ..self
         })
     }
 
@@ -342,15 +349,8 @@ fn read<'py>(
     gear_ratio: f32,
     protocol: Option<&str>,
 ) -> PyResult<Bound<'py, PyAny>> {
-    let options = Options::new(
-        esc,
-        start,
-        end,
-        current_scale,
-        pole_pairs,
-        gear_ratio,
-        protocol,
-    )?;
+    let options =
+        Options::new(esc, start, end, current_scale, pole_pairs, gear_ratio)?.forced(protocol)?;
     let specs = source::specs(source)?;
     let provenance = options.provenance(&specs);
     let notes = Notes::default();

@@ -123,15 +123,8 @@ pub fn scan(
     if batch_rows == 0 {
         return Err(PyValueError::new_err("batch_rows must be at least 1"));
     }
-    let options = Options::new(
-        esc,
-        start,
-        end,
-        current_scale,
-        pole_pairs,
-        gear_ratio,
-        protocol,
-    )?;
+    let options =
+        Options::new(esc, start, end, current_scale, pole_pairs, gear_ratio)?.forced(protocol)?;
     let specs = crate::source::specs(sources)?;
     // The batches' metadata: the ESCs are known only at the end, so `escs` is not in it.
     let schema = options.provenance(&specs).schema(None);
