@@ -384,3 +384,29 @@ fn the_monitor_reads_the_protocol_forced_only() {
     assert!(hub["bytes"].as_u64().unwrap() > 0, "{hub}");
     assert_eq!(hub["bytes_skipped"], hub["bytes"], "{hub}");
 }
+
+/// The bridge reads the protocol forced only: its virtual ESCs' HW-FOC frames reach the
+/// DataLink output under `--protocol hw-foc`, and none under `--protocol datalink`.
+#[cfg(unix)]
+#[test]
+fn the_bridge_reads_the_protocol_forced_only() {
+    let pty = common::pty();
+    let output = pty.path.to_string_lossy().into_owned();
+    let report = |protocol: &str| {
+        let out = hwfoc()
+            .args(["bridge", "--sim", "2", "--no-config", "--duration", "1.2"])
+            .args(["--datalink", &output, "--protocol", protocol])
+            .output()
+            .unwrap();
+        let report = String::from_utf8_lossy(&out.stderr).into_owned();
+        assert!(out.status.success(), "{report}");
+        report
+    };
+    let esc = report("hw-foc");
+    assert!(
+        esc.contains(" frames of 2 ESCs") && !esc.contains(" 0 frames"),
+        "{esc}"
+    );
+    let hub = report("datalink");
+    assert!(hub.contains(" 0 frames of 0 ESCs"), "{hub}");
+}
