@@ -12,6 +12,10 @@ the ``hwfoc`` command): one row per data frame, in physical units.
   serial ports, as ``hwfoc monitor`` reads them;
 - :mod:`hwfoc.dask` and :mod:`hwfoc.spark`: fleets of recordings on Dask and Spark.
 
+Every function and class that reads inputs takes ``protocol=``, a name of :data:`PROTOCOLS`
+(as the command's ``--protocol``), to read that protocol only; by default every protocol is
+recognised from the bytes.
+
 Errors are raised as :class:`HwfocError` subclasses whose message is the one the ``hwfoc``
 command prints after ``hwfoc:``.
 
@@ -26,6 +30,7 @@ from ._hwfoc import (
     DEFAULT_CURRENT_SCALE,
     DEFAULT_GEAR_RATIO,
     DEFAULT_POLE_PAIRS,
+    PROTOCOLS,
     Decoder,
     HwfocError,
     HwfocWarning,
@@ -48,6 +53,7 @@ __all__ = [
     "DEFAULT_CURRENT_SCALE",
     "DEFAULT_GEAR_RATIO",
     "DEFAULT_POLE_PAIRS",
+    "PROTOCOLS",
     "Decoder",
     "HwfocError",
     "HwfocWarning",

@@ -3,7 +3,7 @@
 import datetime
 import os
 from types import TracebackType
-from typing import IO, Any, Dict, Iterator, List, Optional, Sequence, Union
+from typing import IO, Any, Dict, Iterator, List, Optional, Sequence, Tuple, Union
 
 import pyarrow as pa
 
@@ -16,6 +16,10 @@ DEFAULT_CURRENT_SCALE: float
 DEFAULT_POLE_PAIRS: int
 #: The default of every ``gear_ratio`` argument: motor turns per output shaft turn.
 DEFAULT_GEAR_RATIO: float
+#: The names every ``protocol`` argument takes (``"hw-foc"``: an ESC's own wire, 19200 baud;
+#: ``"datalink"``: a DataLink V2 hub, 115200 baud), as the command's ``--protocol``. The
+#: default, None, recognises every protocol from the bytes.
+PROTOCOLS: Tuple[str, ...]
 
 #: One input: a path, bytes in memory, or a binary file object.
 Source = Union[str, "os.PathLike[str]", bytes, bytearray, memoryview, IO[bytes]]
@@ -58,6 +62,7 @@ def read(
     current_scale: float = ...,
     pole_pairs: int = ...,
     gear_ratio: float = ...,
+    protocol: Optional[str] = None,
 ) -> pa.Table:
     """Reads telemetry whole into a ``pyarrow.Table`` of docs/RECORD-SCHEMA.md's records.
 
@@ -66,14 +71,17 @@ def read(
     a binary file object, or a list of these read one after another (the files of a rotated
     recording continue each port's stream). ``esc``, ``start`` and ``end`` select as the
     command's ``--esc``, ``--from`` (inclusive) and ``--to`` (exclusive); a time window needs
-    inputs with receive times. The settings convert currents and RPM.
+    inputs with receive times. The settings convert currents and RPM. ``protocol``: a name of
+    :data:`PROTOCOLS`, to read that protocol's frames only (the bytes of any other are skipped
+    bytes), as the command's ``--protocol``; None reads every protocol.
 
     The schema's metadata holds what ``hwfoc decode --format parquet`` writes in its file:
     ``hwfoc_version``, ``current_scale``, ``pole_pairs``, ``gear_ratio``, ``inputs`` and
     ``escs`` (JSON) and ``filter`` when records were selected; each field has its ``unit``.
 
     Raises InputError (also for a serial port's path: read ports with :func:`open_ports`),
-    SelectionError, SettingsError; TypeError for a source of another type. Warns HwfocWarning
+    SelectionError, SettingsError; TypeError for a source of another type; ValueError for a
+    ``protocol`` not in :data:`PROTOCOLS`. Warns HwfocWarning
     for inputs without frames and for a recording's damage and notes.
     """
 
@@ -87,6 +95,7 @@ def scan(
     current_scale: float = ...,
     pole_pairs: int = ...,
     gear_ratio: float = ...,
+    protocol: Optional[str] = None,
 ) -> "Scan":
     """The records of ``sources`` as ``pyarrow.RecordBatch``es of at most ``batch_rows`` rows,
     in bounded memory whatever the size of the inputs (read a block at a time on a thread of
@@ -113,10 +122,12 @@ def summary(
     current_scale: float = ...,
     pole_pairs: int = ...,
     gear_ratio: float = ...,
+    protocol: Optional[str] = None,
 ) -> Dict[str, Any]:
     """What ``hwfoc summary --json`` prints for ``source``, as Python objects: the settings,
     the inputs (format, bytes, ESCs) and per ESC its link statistics, field ranges, faults and
-    fault episodes. Raises InputError as :func:`read`."""
+    fault episodes. ``protocol`` as :func:`read`'s. Raises InputError and ValueError as
+    :func:`read`."""
 
 def record_schema(
     *, current_scale: float = ..., pole_pairs: int = ..., gear_ratio: float = ...
@@ -133,13 +144,16 @@ class Decoder:
         self,
         *,
         esc: int = 0,
-        baud: int = 19200,
+        baud: Optional[int] = None,
         current_scale: float = ...,
         pole_pairs: int = ...,
         gear_ratio: float = ...,
+        protocol: Optional[str] = None,
     ) -> None:
         """``esc``: the ``esc`` column of the records; ``baud``: the line's rate, for the time of
-        each byte."""
+        each byte (by default that of ``protocol``, else 19200); ``protocol``: a name of
+        :data:`PROTOCOLS` to decode that protocol only (None: every one, from the bytes).
+        Raises ValueError for another name."""
 
     def feed(
         self, data: Union[bytes, bytearray, memoryview], t: Optional[float] = None
@@ -164,16 +178,19 @@ class Decoder:
 def open_ports(
     ports: Sequence[str],
     *,
-    baud: int = 19200,
+    baud: Optional[int] = None,
     current_scale: float = ...,
     pole_pairs: int = ...,
     gear_ratio: float = ...,
+    protocol: Optional[str] = None,
 ) -> "Ports":
-    """Opens serial ports (8N1), one ESC each in the order given, read as ``hwfoc monitor``
-    reads them: a reader thread per port, a port that is unplugged retried (a
-    :class:`PortWarning` says so). Iterate for the records, as dicts with the schema's keys
-    (``t_s`` is Unix time); Ctrl-C raises KeyboardInterrupt and closes the ports. Raises
-    PortError."""
+    """Opens serial ports (8N1) at ``baud`` (by default that of ``protocol``, else 19200), one
+    ESC each in the order given, read as ``hwfoc monitor`` reads them: a reader thread per
+    port, a port that is unplugged retried (a :class:`PortWarning` says so). ``protocol``: a
+    name of :data:`PROTOCOLS` to read that protocol only (None: every one, from the bytes).
+    Iterate for the records, as dicts with the schema's keys (``t_s`` is Unix time); Ctrl-C
+    raises KeyboardInterrupt and closes the ports. Raises PortError; ValueError for an unknown
+    ``protocol``."""
 
 class Ports(Iterator[Dict[str, Any]]):
     """Live records of serial ports: see :func:`open_ports`. A context manager that closes

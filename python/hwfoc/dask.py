@@ -86,7 +86,7 @@ def read(
     the name of a string column holding each record's file (ESC numbers restart at 0 in each
     recording, so a fleet's ESC is the pair of the two); ``frame_column``: the name of a
     ``uint64`` column numbering each ESC's data frames in its recording. ``options`` are
-    :func:`hwfoc.read`'s (``esc``, ``start``, ``end``, the settings). Errors surface when the
+    :func:`hwfoc.read`'s (``esc``, ``start``, ``end``, the settings, ``protocol``). Errors surface when the
     partitions are computed, as the :class:`hwfoc.HwfocError` :func:`hwfoc.read` raises.
     """
     import dask.dataframe as dd

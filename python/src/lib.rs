@@ -15,7 +15,7 @@ use std::sync::{Arc, Mutex};
 
 use arrow_array::RecordBatch;
 use arrow_pyarrow::{IntoPyArrow, Table};
-use hwfoc::Settings;
+use hwfoc::{Protocol, Settings};
 use hwfoc_io::Notice;
 use hwfoc_io::Sources;
 use hwfoc_io::summary::{Summary, esc_label, no_frames as no_frames_text};
@@ -54,6 +54,8 @@ pub(crate) struct Options {
     pub settings: Settings,
     pub selection: Selection,
     pub filter: String,
+    /// The one protocol read, when forced.
+    pub protocol: Option<Protocol>,
 }
 
 impl Options {
@@ -75,6 +77,16 @@ impl Options {
             settings,
             selection: Selection::new(&escs, window),
             filter: filter_text(&escs, from.map(Time::Seconds), to.map(Time::Seconds)),
+            protocol: None,
+        })
+    }
+
+    /// These options, reading the protocol named `protocol` only (`protocol=`: see
+    /// [`protocol_arg`]).
+    pub fn forced(self, protocol: Option<&str>) -> PyResult<Options> {
+        Ok(Options {
+            protocol: protocol_arg(protocol)?,
+            ..self
         })
     }
 
@@ -105,6 +117,49 @@ fn escs_arg(esc: Option<&Bound<'_, PyAny>>) -> PyResult<Vec<u8>> {
             })
         })
         .collect()
+}
+
+/// `protocol=`: a protocol's name (`hw-foc`, `datalink`: [`Protocol::name`]), or `None` for
+/// every protocol; another name is a `ValueError` naming the names.
+pub(crate) fn protocol_arg(name: Option<&str>) -> PyResult<Option<Protocol>> {
+    let Some(name) = name else {
+        return Ok(None);
+    };
+    Protocol::from_name(name).map(Some).ok_or_else(|| {
+        let names: Vec<String> = Protocol::ALL
+            .iter()
+            .map(|p| format!("{:?}", p.name()))
+            .collect();
+        PyValueError::new_err(format!(
+            "protocol: {name:?} is not a protocol: give one of {} (or None for every one)",
+            names.join(", ")
+        ))
+    })
+}
+
+/// `baud=`: the baud rate given, else that of the protocol forced, else the default, as the
+/// command's `--baud`; 0 is a `ValueError`.
+pub(crate) fn baud_arg(baud: Option<u32>, protocol: Option<Protocol>) -> PyResult<u32> {
+    let baud = baud
+        .or(protocol.map(Protocol::baud_rate))
+        .unwrap_or(hwfoc_io::serial::DEFAULT_BAUD);
+    if baud == 0 {
+        return Err(PyValueError::new_err("baud must be at least 1"));
+    }
+    Ok(baud)
+}
+
+/// The inputs read with `settings`, of `protocol` only when one is forced.
+pub(crate) fn sources(
+    inputs: Vec<Input>,
+    settings: Settings,
+    protocol: Option<Protocol>,
+) -> Sources {
+    let mut sources = Sources::new(inputs, settings);
+    if let Some(protocol) = protocol {
+        sources.force_protocol(protocol);
+    }
+    sources
 }
 
 /// `start=`/`end=`: seconds as `t_s` has them (a number), or a `datetime` (its Unix time).
@@ -204,7 +259,7 @@ where
 
 /// Decodes `specs` whole. Decoding runs on this thread, converting on worker threads.
 fn decode_all(specs: Vec<Spec>, options: &Options, notes: &Notes) -> Result<Decoded, Stop> {
-    let mut sources = Sources::new(open_all(specs, notes)?, options.settings);
+    let mut sources = sources(open_all(specs, notes)?, options.settings, options.protocol);
     if options.selection.window.is_limited() {
         sources.require_timing()?;
     }
@@ -276,11 +331,12 @@ pub(crate) fn stop_error(stop: Stop) -> PyErr {
 /// `source`: a path (raw bytes, logic-analyser CSV or pcapng recording, detected from the
 /// content), bytes, a binary file object, or a list of these read one after another. `esc`,
 /// `start`, `end` select as the command's `--esc`, `--from`, `--to`; the settings convert
-/// currents and RPM. The schema metadata is that of `hwfoc decode --format parquet`. Raises
-/// InputError, SelectionError, SettingsError; warns HwfocWarning for inputs without frames and
-/// for damage or notes in a recording.
+/// currents and RPM; `protocol` (a name, as the command's `--protocol`) reads that protocol
+/// only. The schema metadata is that of `hwfoc decode --format parquet`. Raises InputError,
+/// SelectionError, SettingsError, ValueError for an unknown protocol; warns HwfocWarning for
+/// inputs without frames and for damage or notes in a recording.
 #[pyfunction]
-#[pyo3(signature = (source, *, esc=None, start=None, end=None, current_scale=CURRENT_SCALE, pole_pairs=POLE_PAIRS, gear_ratio=GEAR_RATIO), text_signature = "(source, *, esc=None, start=None, end=None, current_scale=DEFAULT_CURRENT_SCALE, pole_pairs=DEFAULT_POLE_PAIRS, gear_ratio=DEFAULT_GEAR_RATIO)")]
+#[pyo3(signature = (source, *, esc=None, start=None, end=None, current_scale=CURRENT_SCALE, pole_pairs=POLE_PAIRS, gear_ratio=GEAR_RATIO, protocol=None), text_signature = "(source, *, esc=None, start=None, end=None, current_scale=DEFAULT_CURRENT_SCALE, pole_pairs=DEFAULT_POLE_PAIRS, gear_ratio=DEFAULT_GEAR_RATIO, protocol=None)")]
 #[allow(clippy::too_many_arguments)]
 fn read<'py>(
     py: Python<'py>,
@@ -291,8 +347,10 @@ fn read<'py>(
     current_scale: f32,
     pole_pairs: u16,
     gear_ratio: f32,
+    protocol: Option<&str>,
 ) -> PyResult<Bound<'py, PyAny>> {
-    let options = Options::new(esc, start, end, current_scale, pole_pairs, gear_ratio)?;
+    let options =
+        Options::new(esc, start, end, current_scale, pole_pairs, gear_ratio)?.forced(protocol)?;
     let specs = source::specs(source)?;
     let provenance = options.provenance(&specs);
     let notes = Notes::default();
@@ -316,30 +374,37 @@ fn read<'py>(
 }
 
 /// The summary of `hwfoc summary --json`, as one JSON text.
-fn summary_json(specs: Vec<Spec>, settings: Settings, notes: &Notes) -> Result<String, InputError> {
-    let mut sources = Sources::new(open_all(specs, notes)?, settings);
+fn summary_json(
+    specs: Vec<Spec>,
+    settings: Settings,
+    protocol: Option<Protocol>,
+    notes: &Notes,
+) -> Result<String, InputError> {
+    let mut sources = sources(open_all(specs, notes)?, settings, protocol);
     let mut summary = Summary::new();
     sources.run(&mut summary)?;
     Ok(summary.report(&sources).json().to_string())
 }
 
 /// What `hwfoc summary --json` prints for `source` (as `read` takes it), as Python objects:
-/// settings, inputs, and per ESC its link statistics, field ranges, faults and fault episodes.
-/// Raises InputError.
+/// settings, inputs, and per ESC its link statistics, field ranges, faults and fault episodes;
+/// `protocol` as `read`'s. Raises InputError, ValueError for an unknown protocol.
 #[pyfunction]
-#[pyo3(signature = (source, *, current_scale=CURRENT_SCALE, pole_pairs=POLE_PAIRS, gear_ratio=GEAR_RATIO), text_signature = "(source, *, current_scale=DEFAULT_CURRENT_SCALE, pole_pairs=DEFAULT_POLE_PAIRS, gear_ratio=DEFAULT_GEAR_RATIO)")]
+#[pyo3(signature = (source, *, current_scale=CURRENT_SCALE, pole_pairs=POLE_PAIRS, gear_ratio=GEAR_RATIO, protocol=None), text_signature = "(source, *, current_scale=DEFAULT_CURRENT_SCALE, pole_pairs=DEFAULT_POLE_PAIRS, gear_ratio=DEFAULT_GEAR_RATIO, protocol=None)")]
 fn summary<'py>(
     py: Python<'py>,
     source: &Bound<'py, PyAny>,
     current_scale: f32,
     pole_pairs: u16,
     gear_ratio: f32,
+    protocol: Option<&str>,
 ) -> PyResult<Bound<'py, PyAny>> {
     let settings =
         Settings::new(current_scale, pole_pairs, gear_ratio).map_err(errors::settings)?;
+    let protocol = protocol_arg(protocol)?;
     let specs = source::specs(source)?;
     let notes = Notes::default();
-    let json = py.detach(|| summary_json(specs, settings, &notes));
+    let json = py.detach(|| summary_json(specs, settings, protocol, &notes));
     warn_notices(py, &notes)?;
     let json = json.map_err(errors::input)?;
     py.import("json")?.call_method1("loads", (json,))
@@ -385,5 +450,7 @@ fn _hwfoc(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("DEFAULT_CURRENT_SCALE", CURRENT_SCALE)?;
     m.add("DEFAULT_POLE_PAIRS", POLE_PAIRS)?;
     m.add("DEFAULT_GEAR_RATIO", GEAR_RATIO)?;
+    let protocols: Vec<&str> = Protocol::ALL.iter().map(|p| p.name()).collect();
+    m.add("PROTOCOLS", pyo3::types::PyTuple::new(py, protocols)?)?;
     Ok(())
 }

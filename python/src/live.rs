@@ -18,7 +18,7 @@ use hwfoc_io::Handler;
 use hwfoc_io::InputError;
 use hwfoc_io::Notice;
 use hwfoc_io::clock::byte_times;
-use hwfoc_io::serial::{DEFAULT_BAUD, PortSet};
+use hwfoc_io::serial::PortSet;
 use hwfoc_io::{PortStreams, Stream};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
@@ -120,22 +120,22 @@ impl Decoder {
 #[pymethods]
 impl Decoder {
     #[new]
-    #[pyo3(signature = (*, esc=0, baud=DEFAULT_BAUD, current_scale=CURRENT_SCALE, pole_pairs=POLE_PAIRS, gear_ratio=GEAR_RATIO), text_signature = "(*, esc=0, baud=..., current_scale=DEFAULT_CURRENT_SCALE, pole_pairs=DEFAULT_POLE_PAIRS, gear_ratio=DEFAULT_GEAR_RATIO)")]
+    #[pyo3(signature = (*, esc=0, baud=None, current_scale=CURRENT_SCALE, pole_pairs=POLE_PAIRS, gear_ratio=GEAR_RATIO, protocol=None), text_signature = "(*, esc=0, baud=None, current_scale=DEFAULT_CURRENT_SCALE, pole_pairs=DEFAULT_POLE_PAIRS, gear_ratio=DEFAULT_GEAR_RATIO, protocol=None)")]
     fn new(
         esc: u8,
-        baud: u32,
+        baud: Option<u32>,
         current_scale: f32,
         pole_pairs: u16,
         gear_ratio: f32,
+        protocol: Option<&str>,
     ) -> PyResult<Self> {
         let settings =
             Settings::new(current_scale, pole_pairs, gear_ratio).map_err(errors::settings)?;
-        if baud == 0 {
-            return Err(PyValueError::new_err("baud must be at least 1"));
-        }
+        let protocol = crate::protocol_arg(protocol)?;
+        let baud = crate::baud_arg(baud, protocol)?;
         Ok(Decoder {
             state: Mutex::new(DecoderState {
-                stream: Stream::new(),
+                stream: Stream::forced(protocol),
                 times: Vec::new(),
                 timed: None,
             }),
@@ -249,27 +249,30 @@ pub struct Ports {
 
 /// Opens serial ports: see `hwfoc.open_ports`.
 #[pyfunction]
-#[pyo3(signature = (ports, *, baud=DEFAULT_BAUD, current_scale=CURRENT_SCALE, pole_pairs=POLE_PAIRS, gear_ratio=GEAR_RATIO), text_signature = "(ports, *, baud=..., current_scale=DEFAULT_CURRENT_SCALE, pole_pairs=DEFAULT_POLE_PAIRS, gear_ratio=DEFAULT_GEAR_RATIO)")]
+#[pyo3(signature = (ports, *, baud=None, current_scale=CURRENT_SCALE, pole_pairs=POLE_PAIRS, gear_ratio=GEAR_RATIO, protocol=None), text_signature = "(ports, *, baud=None, current_scale=DEFAULT_CURRENT_SCALE, pole_pairs=DEFAULT_POLE_PAIRS, gear_ratio=DEFAULT_GEAR_RATIO, protocol=None)")]
 pub fn open_ports(
     py: Python<'_>,
     ports: Vec<String>,
-    baud: u32,
+    baud: Option<u32>,
     current_scale: f32,
     pole_pairs: u16,
     gear_ratio: f32,
+    protocol: Option<&str>,
 ) -> PyResult<Ports> {
     let settings =
         Settings::new(current_scale, pole_pairs, gear_ratio).map_err(errors::settings)?;
     if ports.is_empty() {
         return Err(PyValueError::new_err("no port given"));
     }
-    if baud == 0 {
-        return Err(PyValueError::new_err("baud must be at least 1"));
-    }
+    let protocol = crate::protocol_arg(protocol)?;
+    let baud = crate::baud_arg(baud, protocol)?;
     let set = py
         .detach(|| PortSet::open(&ports, baud))
         .map_err(errors::port)?;
-    let streams = PortStreams::new(ports.len(), baud, settings);
+    let mut streams = PortStreams::new(ports.len(), baud, settings);
+    if let Some(protocol) = protocol {
+        streams.force_protocol(protocol);
+    }
     Ok(Ports {
         state: Mutex::new(Some(PortsState { set, streams })),
         pending: Mutex::new(VecDeque::new()),

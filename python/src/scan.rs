@@ -10,7 +10,6 @@ use std::time::Duration;
 
 use arrow_array::RecordBatch;
 use arrow_pyarrow::ToPyArrow;
-use hwfoc_io::Sources;
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
@@ -63,7 +62,7 @@ fn produce(
     if tx.send(Msg::Opened).is_err() {
         return;
     }
-    let mut sources = Sources::new(inputs, options.settings);
+    let mut sources = crate::sources(inputs, options.settings, options.protocol);
     if options.selection.window.is_limited()
         && let Err(e) = sources.require_timing()
     {
@@ -107,7 +106,7 @@ fn produce(
 /// batches ahead. Errors opening the inputs are raised at once, later ones by the iterator after
 /// the batches before them.
 #[pyfunction]
-#[pyo3(signature = (sources, *, batch_rows=65536, esc=None, start=None, end=None, current_scale=CURRENT_SCALE, pole_pairs=POLE_PAIRS, gear_ratio=GEAR_RATIO), text_signature = "(sources, *, batch_rows=65536, esc=None, start=None, end=None, current_scale=DEFAULT_CURRENT_SCALE, pole_pairs=DEFAULT_POLE_PAIRS, gear_ratio=DEFAULT_GEAR_RATIO)")]
+#[pyo3(signature = (sources, *, batch_rows=65536, esc=None, start=None, end=None, current_scale=CURRENT_SCALE, pole_pairs=POLE_PAIRS, gear_ratio=GEAR_RATIO, protocol=None), text_signature = "(sources, *, batch_rows=65536, esc=None, start=None, end=None, current_scale=DEFAULT_CURRENT_SCALE, pole_pairs=DEFAULT_POLE_PAIRS, gear_ratio=DEFAULT_GEAR_RATIO, protocol=None)")]
 #[allow(clippy::too_many_arguments)]
 pub fn scan(
     py: Python<'_>,
@@ -119,11 +118,13 @@ pub fn scan(
     current_scale: f32,
     pole_pairs: u16,
     gear_ratio: f32,
+    protocol: Option<&str>,
 ) -> PyResult<Scan> {
     if batch_rows == 0 {
         return Err(PyValueError::new_err("batch_rows must be at least 1"));
     }
-    let options = Options::new(esc, start, end, current_scale, pole_pairs, gear_ratio)?;
+    let options =
+        Options::new(esc, start, end, current_scale, pole_pairs, gear_ratio)?.forced(protocol)?;
     let specs = crate::source::specs(sources)?;
     // The batches' metadata: the ESCs are known only at the end, so `escs` is not in it.
     let schema = options.provenance(&specs).schema(None);

@@ -17,7 +17,7 @@ import pyarrow.parquet as pq
 import pytest
 
 import hwfoc
-from conftest import CAPTURES, assert_same_records, cli_error, cli_records, run_cli
+from conftest import CAPTURES, assert_same_records, cli_error, cli_records, run_cli, simulate
 
 
 @pytest.mark.parametrize("capture", CAPTURES, ids=lambda p: p.name)
@@ -306,3 +306,82 @@ def test_polars_and_pandas_take_the_table(sim_dir):
     assert str(pdf["packet"].dtype) == "uint16"
     assert pdf["mos_temp_c"].max() == pytest.approx(float(pa.compute.max(table.column("mos_temp_c")).as_py()))
     assert isinstance(pdf, pd.DataFrame)
+
+
+def _hub_bytes(cli):
+    """DataLink V2 frames of eight virtual ESCs: what `hwfoc bridge --datalink` writes to a
+    pseudo-terminal in a second and a half."""
+    import select
+    import time
+
+    master, slave = os.openpty()
+    try:
+        bridge = subprocess.Popen(
+            [cli, "bridge", "--sim", "8", "--datalink", os.ttyname(slave), "--duration", "1.5",
+             "--quiet", "--no-config"],
+            stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+        got = b""
+        until = time.time() + 30
+        while time.time() < until:
+            ready, _, _ = select.select([master], [], [], 0.2)
+            if ready:
+                got += os.read(master, 65536)
+            elif bridge.poll() is not None:
+                break
+        assert bridge.wait(timeout=10) == 0, bridge.stderr.read()
+        return got
+    finally:
+        os.close(master)
+        os.close(slave)
+
+
+@pytest.fixture(scope="module")
+def mixed(cli, tmp_path_factory):
+    """ESC frames, hub frames, ESC frames: the three parts' bytes and the whole."""
+    d = tmp_path_factory.mktemp("mixed")
+    first = simulate(cli, d / "a.bin", "--seed", "1", "--duration", "3").read_bytes()
+    last = simulate(cli, d / "b.bin", "--seed", "2", "--duration", "3").read_bytes()
+    hub = _hub_bytes(cli)
+    return first, hub, last, first + hub + last
+
+
+def _rows(table):
+    return [(r["esc"], r["packet"], r["voltage_v"]) for r in table.to_pylist()]
+
+
+def test_a_forced_protocol_reads_its_frames_only(mixed):
+    first, hub, last, whole = mixed
+    escs = hwfoc.read(first + last)
+    hubs = hwfoc.read(hub)
+    assert escs.num_rows > 10 and set(hubs.column("esc").to_pylist()) == set(range(8))
+    forced_esc = hwfoc.read(whole, protocol="hw-foc")
+    assert _rows(forced_esc) == _rows(escs)
+    forced_hub = hwfoc.read(whole, protocol="datalink")
+    assert _rows(forced_hub) == _rows(hubs)
+    assert hwfoc.read(whole).num_rows == escs.num_rows + hubs.num_rows
+    # The other protocol's bytes are skipped bytes; scan and the decoder read alike.
+    link = hwfoc.summary(whole, protocol="hw-foc")["escs"][0]["link"]
+    assert link["bytes_skipped"] >= len(hub)
+    scanned = pa.Table.from_batches(list(hwfoc.scan(whole, protocol="datalink")))
+    assert _rows(scanned) == _rows(hubs)
+    decoder = hwfoc.Decoder(protocol="datalink")
+    fed = [decoder.feed(whole[i:i + 100]) for i in range(0, len(whole), 100)] + [decoder.finish()]
+    assert _rows(pa.Table.from_batches(fed)) == _rows(hubs)
+    assert decoder.stats["bytes_skipped"] == len(first) + len(last)
+
+
+def test_a_forced_protocol_that_finds_nothing_warns_with_its_advice(mixed):
+    first = mixed[0]
+    with pytest.warns(hwfoc.HwfocWarning, match=r"no valid DataLink V2 frames: check the baud rate \(115200\)"):
+        assert hwfoc.read(first, protocol="datalink").num_rows == 0
+
+
+def test_protocol_names_and_their_defaults():
+    assert hwfoc.PROTOCOLS == ("hw-foc", "datalink")
+    for f in (hwfoc.read, hwfoc.scan, hwfoc.summary, hwfoc.Decoder, hwfoc.open_ports):
+        assert inspect.signature(f).parameters["protocol"].default is None, f
+    for call in (lambda: hwfoc.read(b"", protocol="hw5"), lambda: hwfoc.scan(b"", protocol="HW5"),
+                 lambda: hwfoc.summary(b"", protocol="dl"), lambda: hwfoc.Decoder(protocol="x"),
+                 lambda: hwfoc.open_ports(["/dev/null"], protocol="x")):
+        with pytest.raises(ValueError, match=r'protocol: ".*" is not a protocol: give one of "hw-foc", "datalink"'):
+            call()

@@ -4,12 +4,14 @@
 use std::path::PathBuf;
 
 use clap::Args;
-use hwfoc_io::SettingsPatch;
+use clap::builder::{PossibleValue, PossibleValuesParser, TypedValueParser};
+use hwfoc::Protocol;
 use hwfoc_io::Sources;
 use hwfoc_io::serial;
 use hwfoc_io::time::{Clock, Time, TimeError};
 use hwfoc_io::{Input, InputError};
 use hwfoc_io::{Selection, Window};
+use hwfoc_io::{SettingsMap, SettingsPatch};
 
 use crate::demo;
 use crate::error::CliError;
@@ -24,13 +26,43 @@ pub struct InputArgs {
     /// raw files and standard input, which have no receive times, are read one after another.
     #[arg(value_name = "FILE|PORT|-", required_unless_present = "demo", num_args = 1..)]
     pub inputs: Vec<String>,
-    /// Baud rate of serial ports (8N1).
-    #[arg(long, value_name = "N", default_value_t = serial::DEFAULT_BAUD,
-          value_parser = clap::value_parser!(u32).range(1..))]
-    pub baud: u32,
-    /// Use the built-in demo capture of a virtual ESC instead of FILE.
+    /// Baud rate of serial ports (8N1) [default: that of --protocol, else 19200].
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..))]
+    pub baud: Option<u32>,
+    /// Use the built-in demo capture of a virtual ESC (HW-FOC) instead of FILE.
     #[arg(long, conflicts_with = "inputs")]
     pub demo: bool,
+    #[command(flatten)]
+    pub protocol: ProtocolArgs,
+}
+
+/// `--protocol`: one protocol read instead of every one the bytes may hold.
+#[derive(Debug, Default, Clone, Copy, Args)]
+pub struct ProtocolArgs {
+    /// Read only this protocol's frames; the bytes of any other are skipped. Without it, every
+    /// protocol is recognised from the bytes.
+    #[arg(long, value_name = "NAME", value_parser = protocol_parser())]
+    pub protocol: Option<Protocol>,
+}
+
+/// The names of [`Protocol::ALL`] as `--protocol` takes them (shown by `--help` and
+/// completed by the shells), each with its title and baud rate.
+fn protocol_parser() -> impl TypedValueParser<Value = Protocol> {
+    let names = Protocol::ALL.map(|p| {
+        PossibleValue::new(p.name()).help(format!("{}, {} baud", p.title(), p.baud_rate()))
+    });
+    // Every possible value is a protocol's name: the mapping finds it.
+    PossibleValuesParser::new(names)
+        .map(|name| Protocol::from_name(&name).unwrap_or(Protocol::ALL[0]))
+}
+
+impl ProtocolArgs {
+    /// The baud rate of serial ports: `baud` (`--baud`) when given, else the forced protocol's,
+    /// else [`serial::DEFAULT_BAUD`].
+    pub fn baud(&self, baud: Option<u32>) -> u32 {
+        baud.or(self.protocol.map(Protocol::baud_rate))
+            .unwrap_or(serial::DEFAULT_BAUD)
+    }
 }
 
 impl InputArgs {
@@ -72,7 +104,7 @@ impl InputArgs {
                 let ports: Vec<String> = ports.into_iter().cloned().collect();
                 Ok(vec![Input::open_ports(
                     &ports,
-                    self.baud,
+                    self.protocol.baud(self.baud),
                     crate::stop::interrupted(),
                 )?])
             }
@@ -81,6 +113,16 @@ impl InputArgs {
                 .map(|f| Input::open(f))
                 .collect::<Result<_, InputError>>()?),
         }
+    }
+
+    /// Every input opened ([`InputArgs::open_all`]) as the [`Sources`] read with `settings`,
+    /// forced to read the protocol of `--protocol` only when it is given.
+    pub fn sources(&self, settings: SettingsMap) -> Result<Sources, CliError> {
+        let mut sources = Sources::new(self.open_all()?, settings);
+        if let Some(protocol) = self.protocol.protocol {
+            sources.force_protocol(protocol);
+        }
+        Ok(sources)
     }
 }
 

@@ -24,6 +24,7 @@
 //! [monitor]
 //! ports = ["/dev/ttyUSB0", "/dev/ttyUSB1"]   # watched when none are named
 //! baud = 19200
+//! protocol = "hw-foc"     # read this protocol only (hw-foc, datalink); default: every one
 //! record_dir = "/home/pi/recordings"
 //!
 //! [alarms]                # the monitor's levels: see `hwfoc monitor --help`
@@ -40,7 +41,7 @@ use std::collections::BTreeMap;
 use std::fmt;
 use std::path::{Path, PathBuf};
 
-use hwfoc::Settings;
+use hwfoc::{Protocol, Settings};
 use hwfoc_io::InputError;
 use hwfoc_io::read_small_file;
 use hwfoc_io::{SettingsMap, SettingsPatch};
@@ -183,8 +184,24 @@ pub struct MonitorKeys {
     pub ports: Vec<String>,
     /// Baud rate of the ports.
     pub baud: Option<u32>,
+    /// The one protocol read, by name (as `--protocol`).
+    #[serde(default, deserialize_with = "protocol")]
+    pub protocol: Option<Protocol>,
     /// Where the `r` key puts its recordings.
     pub record_dir: Option<PathBuf>,
+}
+
+/// A protocol by its name ([`Protocol::from_name`]); another name is an error listing the
+/// names.
+fn protocol<'de, D: Deserializer<'de>>(deserializer: D) -> Result<Option<Protocol>, D::Error> {
+    let name = String::deserialize(deserializer)?;
+    Protocol::from_name(&name).map(Some).ok_or_else(|| {
+        let names: Vec<&str> = Protocol::ALL.iter().map(|p| p.name()).collect();
+        de::Error::custom(format!(
+            "protocol {name:?} is not one of {}",
+            names.join(", ")
+        ))
+    })
 }
 
 /// The `[alarms]` table (and the monitor's matching flags).
@@ -816,6 +833,25 @@ mod tests {
              [monitor]\nports = [\"/dev/ttyUSB1\"]\n",
         );
         config.unwrap();
+    }
+
+    /// `[monitor] protocol` names a protocol; another name is an error naming the line and
+    /// the names.
+    #[test]
+    fn the_monitor_protocol_is_a_name() {
+        let (_dir, config) = load("[monitor]\nprotocol = \"datalink\"\n");
+        assert_eq!(
+            config.unwrap().file.monitor.protocol,
+            Some(Protocol::DataLink)
+        );
+        let (_dir, config) = load("[monitor]\nbaud = 9600\nprotocol = \"hw5\"\n");
+        let err = config.unwrap_err().to_string();
+        assert!(err.contains("config.toml line 3"), "{err}");
+        assert!(
+            err.contains("\"hw5\" is not one of hw-foc, datalink"),
+            "{err}"
+        );
+        assert!(!err.contains('\n'), "{err}");
     }
 
     #[test]

@@ -209,3 +209,204 @@ fn files_a_recording_and_ports_number_hubs_alike() {
     let recorded = stdout(&hwfoc().args(["decode", &rec]).output().unwrap());
     assert_eq!(by_esc(&recorded), expected, "recording");
 }
+
+/// The JSON summary of `args`, and whether the command succeeded.
+fn summary_json(args: &[&str]) -> (Value, bool) {
+    let out = hwfoc()
+        .arg("summary")
+        .arg("--json")
+        .args(args)
+        .output()
+        .unwrap();
+    (
+        serde_json::from_slice(&out.stdout).unwrap(),
+        out.status.success(),
+    )
+}
+
+/// ESC frames, hub frames of eight ESCs, ESC frames: `--protocol hw-foc` gives the ESC's
+/// records only, the hub's bytes skipped; `--protocol datalink` the hub's only, the ESC's
+/// bytes skipped; without it, both.
+#[test]
+fn a_forced_protocol_reads_its_frames_only() {
+    let dir = Dir::new();
+    let all: Vec<usize> = (0..8).collect();
+    let hub_bytes = hub(0, 0..3, &all);
+    let bytes = [esc(0..20), hub_bytes.clone(), esc(20..30)].concat();
+    std::fs::write(dir.path("mixed.bin"), &bytes).unwrap();
+    let file = dir.arg("mixed.bin");
+    let decode = |protocol: &[&str]| {
+        let out = hwfoc()
+            .arg("decode")
+            .args(protocol)
+            .arg(&file)
+            .output()
+            .unwrap();
+        by_esc(&stdout(&out))
+    };
+
+    let esc_only = decode(&["--protocol", "hw-foc"]);
+    assert_eq!(esc_only, BTreeMap::from([(0, (0..30).collect())]));
+    let (summary, ok) = summary_json(&["--protocol", "hw-foc", &file]);
+    assert!(ok, "{summary}");
+    assert_eq!(summary["hubs"], Value::Array(Vec::new()), "{summary}");
+    assert_eq!(summary["escs"].as_array().unwrap().len(), 1, "{summary}");
+    let link = &summary["escs"][0]["link"];
+    assert_eq!(link["bytes_skipped"], hub_bytes.len() as u64, "{summary}");
+
+    let hub_only = decode(&["--protocol", "datalink"]);
+    let expected: BTreeMap<u64, Vec<u64>> = (0..8u64).map(|c| (c, vec![1000 + c; 3])).collect();
+    assert_eq!(hub_only, expected);
+    let (summary, ok) = summary_json(&["--protocol", "datalink", &file]);
+    assert!(ok, "{summary}");
+    assert_eq!(summary["escs"].as_array().unwrap().len(), 8, "{summary}");
+    let mut skipped = Vec::new();
+    skipped_bytes(&summary, &mut skipped);
+    assert!(
+        skipped.iter().all(|&n| n == 30 * 24) && !skipped.is_empty(),
+        "the ESC's bytes are the hub link's skipped bytes: {summary}"
+    );
+
+    let both = decode(&[]);
+    assert_eq!(both.values().map(Vec::len).sum::<usize>(), 30 + 3 * 8);
+    assert_eq!(
+        both[&0].len(),
+        33,
+        "the ESC and the hub's channel 0 keep ESC 0"
+    );
+    assert_eq!(both[&7], vec![1007; 3]);
+}
+
+/// A forced protocol that finds nothing gives its own advice (its name and baud rate) and
+/// the exit status of any input without frames.
+#[test]
+fn a_forced_protocol_that_finds_nothing_says_so() {
+    let dir = Dir::new();
+    std::fs::write(dir.path("esc.bin"), esc(0..50)).unwrap();
+    let file = dir.arg("esc.bin");
+    let advice = "no valid DataLink V2 frames: check the baud rate (115200) and the wiring";
+    let decoded = hwfoc()
+        .args(["decode", "--protocol", "datalink", &file])
+        .output()
+        .unwrap();
+    assert_eq!(decoded.status.code(), Some(1));
+    assert!(decoded.stdout.is_empty());
+    let err = String::from_utf8_lossy(&decoded.stderr);
+    assert!(err.contains(advice), "{err}");
+    assert!(err.contains("no data frame in any input"), "{err}");
+
+    let text = hwfoc()
+        .args(["summary", "--protocol", "datalink", &file])
+        .output()
+        .unwrap();
+    assert_eq!(text.status.code(), Some(1));
+    let said = String::from_utf8_lossy(&text.stdout);
+    assert!(said.contains(advice), "{said}");
+    let (summary, ok) = summary_json(&["--protocol", "datalink", &file]);
+    assert!(!ok);
+    assert_eq!(summary["escs"][0]["warning"], advice, "{summary}");
+    // Unforced, the same file is read.
+    let (_, ok) = summary_json(&[&file]);
+    assert!(ok);
+}
+
+/// `--protocol` takes the protocols' names (shown by `--help` and the shell completions); any
+/// other is a usage error listing them, on every command that reads inputs.
+#[test]
+fn an_unknown_protocol_is_a_usage_error_listing_the_names() {
+    let dir = Dir::new();
+    std::fs::write(dir.path("esc.bin"), esc(0..5)).unwrap();
+    let file = dir.arg("esc.bin");
+    let png = dir.arg("p.png");
+    for args in [
+        vec!["decode", &file],
+        vec!["summary", &file],
+        vec!["plot", &file, "-o", &png],
+        vec!["record", "/dev/ttyUSB_hwfoc_missing", "-o", &png],
+        vec!["monitor", "--plain", "/dev/ttyUSB_hwfoc_missing"],
+        vec!["bridge", &file, "--mavlink", "udp"],
+    ] {
+        let out = hwfoc()
+            .args(&args)
+            .args(["--protocol", "hw5"])
+            .output()
+            .unwrap();
+        assert_eq!(out.status.code(), Some(2), "{args:?}");
+        assert!(out.stdout.is_empty(), "{args:?}");
+        let err = String::from_utf8_lossy(&out.stderr);
+        let first = err.lines().next().unwrap_or_default();
+        assert!(
+            first.contains("invalid value 'hw5' for '--protocol"),
+            "{err}"
+        );
+        assert!(err.contains("hw-foc, datalink"), "{err}");
+        assert!(!dir.path("p.png").exists());
+
+        let help = stdout(&hwfoc().arg(args[0]).arg("--help").output().unwrap());
+        assert!(
+            help.contains("--protocol <NAME>")
+                && help.contains("datalink: DataLink V2, 115200 baud"),
+            "{help}"
+        );
+    }
+    let bash = stdout(&hwfoc().args(["completions", "bash"]).output().unwrap());
+    assert!(bash.contains("hw-foc datalink"), "completions");
+}
+
+/// The monitor reads the protocol forced only: a virtual ESC's HW-FOC frames are frames under
+/// `--protocol hw-foc` and skipped bytes under `--protocol datalink`.
+#[test]
+fn the_monitor_reads_the_protocol_forced_only() {
+    let last_status = |protocol: &str| {
+        let out = hwfoc()
+            .args(["monitor", "--sim", "1", "--json", "--no-config"])
+            .args([
+                "--interval",
+                "0.5",
+                "--duration",
+                "1.6",
+                "--protocol",
+                protocol,
+            ])
+            .output()
+            .unwrap();
+        let lines: Vec<Value> = stdout(&out)
+            .lines()
+            .map(|l| serde_json::from_str(l).unwrap())
+            .filter(|v: &Value| v["type"] == "status")
+            .collect();
+        lines.last().cloned().expect("a status line")
+    };
+    let esc = last_status("hw-foc");
+    assert!(esc["frames"].as_u64().unwrap() > 0, "{esc}");
+    let hub = last_status("datalink");
+    assert_eq!(hub["frames"], 0, "{hub}");
+    assert!(hub["bytes"].as_u64().unwrap() > 0, "{hub}");
+    assert_eq!(hub["bytes_skipped"], hub["bytes"], "{hub}");
+}
+
+/// The bridge reads the protocol forced only: its virtual ESCs' HW-FOC frames reach the
+/// DataLink output under `--protocol hw-foc`, and none under `--protocol datalink`.
+#[cfg(unix)]
+#[test]
+fn the_bridge_reads_the_protocol_forced_only() {
+    let pty = common::pty();
+    let output = pty.path.to_string_lossy().into_owned();
+    let report = |protocol: &str| {
+        let out = hwfoc()
+            .args(["bridge", "--sim", "2", "--no-config", "--duration", "1.2"])
+            .args(["--datalink", &output, "--protocol", protocol])
+            .output()
+            .unwrap();
+        let report = String::from_utf8_lossy(&out.stderr).into_owned();
+        assert!(out.status.success(), "{report}");
+        report
+    };
+    let esc = report("hw-foc");
+    assert!(
+        esc.contains(" frames of 2 ESCs") && !esc.contains(" 0 frames"),
+        "{esc}"
+    );
+    let hub = report("datalink");
+    assert!(hub.contains(" 0 frames of 0 ESCs"), "{hub}");
+}

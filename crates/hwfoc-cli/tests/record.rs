@@ -46,6 +46,24 @@ fn feed(pty: &mut Pty, ks: std::ops::Range<u16>, every: Duration) -> Vec<(u16, f
     sent
 }
 
+/// `hwfoc record` of a new pty to `name` in a new directory, with `args` after the output, once
+/// it says it is recording: the directory, the recording's path, the pty and its port, the
+/// running command and its first line.
+fn record_pty(
+    name: &str,
+    args: &[&str],
+) -> (tempfile::TempDir, PathBuf, Pty, String, Running, String) {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join(name);
+    let pty = pty();
+    let port = pty.path.to_str().unwrap().to_string();
+    let mut all = vec!["record", &port, "-o", out.to_str().unwrap()];
+    all.extend(args);
+    let rec = Running::start(&all);
+    let started = rec.wait_for("recording", Duration::from_secs(10));
+    (dir, out, pty, port, rec, started)
+}
+
 /// `hwfoc decode FILE` as JSON records, and its standard error.
 fn decode(path: &Path) -> (Vec<Value>, String) {
     let out = run(hwfoc().arg("decode").arg(path));
@@ -383,19 +401,7 @@ fn rotation_makes_complete_numbered_files() {
 
 #[test]
 fn truncated_recording_decodes_what_is_there() {
-    let dir = tempfile::tempdir().unwrap();
-    let out = dir.path().join("full.pcapng");
-    let mut pty = pty();
-    let port = pty.path.to_str().unwrap().to_string();
-    let mut rec = Running::start(&[
-        "record",
-        &port,
-        "-o",
-        out.to_str().unwrap(),
-        "--duration",
-        "1.2",
-    ]);
-    rec.wait_for("recording", Duration::from_secs(10));
+    let (dir, out, mut pty, _, mut rec, _) = record_pty("full.pcapng", &["--duration", "1.2"]);
     feed(&mut pty, 0..12, Duration::from_millis(50));
     assert!(rec.wait(Duration::from_secs(10)));
     let file = std::fs::read(&out).unwrap();
@@ -458,19 +464,7 @@ fn decode_reads_a_live_port_until_ctrl_c() {
 
 #[test]
 fn wrong_baud_rate_is_named() {
-    let dir = tempfile::tempdir().unwrap();
-    let out = dir.path().join("noise.pcapng");
-    let mut pty = pty();
-    let port = pty.path.to_str().unwrap().to_string();
-    let mut rec = Running::start(&[
-        "record",
-        &port,
-        "-o",
-        out.to_str().unwrap(),
-        "--duration",
-        "4",
-    ]);
-    rec.wait_for("recording", Duration::from_secs(10));
+    let (_dir, _, mut pty, _, mut rec, _) = record_pty("noise.pcapng", &["--duration", "4"]);
     // What 19200-baud frames look like read at the wrong rate: bytes, but never a frame.
     let mut x = 12345u32;
     for _ in 0..70 {
@@ -489,6 +483,29 @@ fn wrong_baud_rate_is_named() {
         "{line}"
     );
     assert!(rec.wait(Duration::from_secs(10)));
+}
+
+/// `--protocol datalink` opens the port at DataLink's 115200 baud and counts hub frames only:
+/// an ESC's own frames are bytes without a valid frame, and the warning names DataLink V2 and
+/// its baud rate. Every byte is recorded all the same.
+#[test]
+fn a_forced_protocol_sets_the_baud_rate_and_the_warning() {
+    let args = ["--protocol", "datalink", "--duration", "4.5"];
+    let (_dir, out, mut pty, port, mut rec, started) = record_pty("esc.pcapng", &args);
+    assert!(started.contains("at 115200 baud"), "{started}");
+    feed(&mut pty, 0..70, Duration::from_millis(50));
+    let line = rec.wait_for("no valid DataLink V2 frame", Duration::from_secs(5));
+    assert!(
+        line.contains("read at 115200; DataLink V2 telemetry is 115200, see --baud"),
+        "{line}"
+    );
+    assert!(rec.wait(Duration::from_secs(10)), "{}", rec.stderr());
+    let end = rec.stderr();
+    assert!(
+        end.contains(&format!("{port} 1680 bytes, 0 frames")),
+        "{end}"
+    );
+    assert_eq!(decode(&out).0.len(), 70, "every byte is recorded");
 }
 
 #[test]

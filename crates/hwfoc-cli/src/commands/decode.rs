@@ -59,8 +59,7 @@ pub fn run(args: &DecodeArgs) -> Result<(), CliError> {
     // end their input on them, and what they gave is written; a pipe or a terminal on standard
     // input ends the process (its export stays in the temporary file).
     let stop = args.input.stop_if_read_to_end();
-    let inputs = args.input.open_all()?;
-    let mut sources = Sources::new(inputs, settings_map);
+    let mut sources = args.input.sources(settings_map)?;
     if selection.window.is_limited() {
         sources.require_timing()?;
         args.select.check_clocks(&sources)?;

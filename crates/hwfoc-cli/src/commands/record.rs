@@ -24,14 +24,16 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::Ordering;
 use std::time::{Duration, Instant};
 
+use hwfoc::Protocol;
 use hwfoc_io::EscLink;
 
+use crate::args::ProtocolArgs;
 use crate::error::CliError;
 use hwfoc_io::Escaped;
 use hwfoc_io::Notice;
 use hwfoc_io::PortStreams;
 use hwfoc_io::pcapng;
-use hwfoc_io::serial::{self, PortEvent, PortSet};
+use hwfoc_io::serial::{PortEvent, PortSet};
 use hwfoc_io::write::WriteError;
 
 /// Longest time a received byte stays in this process before it is written to the file.
@@ -63,10 +65,12 @@ pub struct RecordArgs {
     /// numbered: FILE `out.pcapng` gives `out-0001.pcapng`, `out-0002.pcapng`, …
     #[arg(short, long, value_name = "FILE")]
     pub output: String,
-    /// Baud rate of the ports (8N1).
-    #[arg(long, value_name = "N", default_value_t = serial::DEFAULT_BAUD,
-          value_parser = clap::value_parser!(u32).range(1..))]
-    pub baud: u32,
+    /// Baud rate of the ports (8N1) [default: that of --protocol, else 19200].
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..))]
+    pub baud: Option<u32>,
+    /// The protocol whose frames are counted (every byte is recorded whatever it is).
+    #[command(flatten)]
+    pub protocol: ProtocolArgs,
     /// Start a new file before one would grow past BYTES (suffixes k, M, G, or KiB, MiB, GiB).
     #[arg(long, value_name = "BYTES", value_parser = parse_size, conflicts_with = "rotate_time")]
     pub rotate_size: Option<u64>,
@@ -159,6 +163,8 @@ pub struct Plan {
     pub rotate_time: Option<Duration>,
     /// Baud rate of the ports (in each interface's description).
     pub baud: u32,
+    /// The one protocol whose frames are counted, when forced (every protocol otherwise).
+    pub protocol: Option<Protocol>,
     /// Print gaps and link warnings on standard error (not under a full-screen display).
     pub warn: bool,
     /// Replace an existing recording (and, with rotation, the earlier series' files).
@@ -172,6 +178,8 @@ pub struct Recorder {
     rotate_size: Option<u64>,
     rotate_time: Option<Duration>,
     baud: u32,
+    /// The protocol forced, if one is: the one the warnings name.
+    protocol: Option<Protocol>,
     /// Files written, the current one last.
     files: Vec<String>,
     /// The number of the next file of a rotated recording.
@@ -195,13 +203,15 @@ pub struct Recorder {
 pub fn run(args: &RecordArgs) -> Result<(), CliError> {
     // Install the Ctrl-C / SIGTERM handler first, so that no signal is lost once ports are open.
     let interrupted = crate::stop::interrupted();
-    let set = PortSet::open(&args.ports, args.baud)?;
+    let baud = args.protocol.baud(args.baud);
+    let set = PortSet::open(&args.ports, baud)?;
     let started = Instant::now();
     let plan = Plan {
         output: args.output.clone(),
         rotate_size: args.rotate_size,
         rotate_time: args.rotate_time.map(Duration::from_secs_f64),
-        baud: args.baud,
+        baud,
+        protocol: args.protocol.protocol,
         warn: true,
         overwrite: args.overwrite,
     };
@@ -209,7 +219,7 @@ pub fn run(args: &RecordArgs) -> Result<(), CliError> {
     eprintln!(
         "hwfoc: recording {} at {} baud to {}; Ctrl-C stops",
         Escaped(set.names().join(", ")),
-        args.baud,
+        baud,
         recorder.current()
     );
     let stop_at = args.duration.map(|s| started + Duration::from_secs_f64(s));
@@ -280,12 +290,18 @@ impl Recorder {
         }
         let writer = create(&first, ports, plan.baud, plan.overwrite)?;
         let now = Instant::now();
+        // Frames are only counted: the conversion settings do not matter.
+        let mut streams = PortStreams::new(ports.len(), plan.baud, hwfoc::Settings::DEFAULT);
+        if let Some(protocol) = plan.protocol {
+            streams.force_protocol(protocol);
+        }
         Ok(Recorder {
             warn: plan.warn,
             base: plan.output,
             rotate_size: plan.rotate_size,
             rotate_time: plan.rotate_time,
             baud: plan.baud,
+            protocol: plan.protocol,
             files: vec![first],
             next_number: 2,
             writer: Some(writer),
@@ -294,8 +310,7 @@ impl Recorder {
             last_flush: now,
             last_sync: now,
             clock,
-            // Frames are only counted: the conversion settings do not matter.
-            streams: PortStreams::new(ports.len(), plan.baud, hwfoc::Settings::DEFAULT),
+            streams,
             ports: ports
                 .iter()
                 .map(|name| PortState {
@@ -426,7 +441,7 @@ impl Recorder {
         if !self.warn {
             return Ok(());
         }
-        let baud = self.baud;
+        let (baud, protocol) = (self.baud, self.protocol);
         for state in &mut self.ports {
             if !state.warned_unframed
                 && state
@@ -436,13 +451,8 @@ impl Recorder {
             {
                 state.warned_unframed = true;
                 eprintln!(
-                    "hwfoc: warning: {}: {} bytes in {} s but no valid HW-FOC frame: likely a \
-                     wrong baud rate (read at {baud}; HW-FOC telemetry is {}, see --baud) or \
-                     swapped TX/RX wires (the adapter's RX must be on the ESC's telemetry wire)",
-                    Escaped(&state.name),
-                    state.unframed_bytes,
-                    NO_FRAMES_AFTER.as_secs(),
-                    hwfoc::foc::BAUD_RATE
+                    "hwfoc: warning: {}",
+                    no_frame_warning(&state.name, state.unframed_bytes, baud, protocol)
                 );
             }
             if state
@@ -574,6 +584,21 @@ impl Recorder {
     }
 }
 
+/// The warning for port `name`, read at `baud`, whose `bytes` in [`NO_FRAMES_AFTER`] held no
+/// valid frame of `protocol` (without one forced, of HW-FOC: an ESC's own wire).
+fn no_frame_warning(name: &str, bytes: u64, baud: u32, protocol: Option<Protocol>) -> String {
+    let protocol = protocol.unwrap_or(Protocol::HwFoc);
+    let title = protocol.title();
+    format!(
+        "{}: {bytes} bytes in {} s but no valid {title} frame: likely a wrong baud rate (read at \
+         {baud}; {title} telemetry is {}, see --baud) or swapped TX/RX wires (the adapter's RX \
+         must be on the ESC's telemetry wire)",
+        Escaped(name),
+        NO_FRAMES_AFTER.as_secs(),
+        protocol.baud_rate()
+    )
+}
+
 /// Creates a recording file with its headers, one interface per port. An existing file is an
 /// error unless `overwrite`.
 fn create(
@@ -670,6 +695,26 @@ mod tests {
         assert!(parse_seconds("-1").is_err());
         assert!(parse_seconds("inf").is_err());
         assert!(parse_seconds("1e300").is_err());
+    }
+
+    /// Without a protocol forced the warning names HW-FOC at 19200 baud; forced, the protocol's
+    /// title and baud rate.
+    #[test]
+    fn the_no_frame_warning_names_the_protocol_forced() {
+        assert_eq!(
+            no_frame_warning("/dev/ttyUSB0", 640, 115_200, None),
+            "/dev/ttyUSB0: 640 bytes in 3 s but no valid HW-FOC frame: likely a wrong baud rate \
+             (read at 115200; HW-FOC telemetry is 19200, see --baud) or swapped TX/RX wires (the \
+             adapter's RX must be on the ESC's telemetry wire)"
+        );
+        let forced = no_frame_warning("/dev/ttyUSB0", 640, 19_200, Some(Protocol::DataLink));
+        assert!(
+            forced.contains(
+                "no valid DataLink V2 frame: likely a wrong baud rate (read at 19200; DataLink \
+                 V2 telemetry is 115200, see --baud)"
+            ),
+            "{forced}"
+        );
     }
 
     #[test]

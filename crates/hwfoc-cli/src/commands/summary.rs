@@ -3,7 +3,6 @@
 
 use clap::Args;
 use hwfoc_io::Both;
-use hwfoc_io::Sources;
 use hwfoc_io::summary::Summary;
 use hwfoc_io::write::WriteError;
 
@@ -42,7 +41,7 @@ pub fn run(args: &SummaryArgs) -> Result<(), CliError> {
         }
         None => None,
     };
-    let mut sources = Sources::new(args.input.open_all()?, settings_map);
+    let mut sources = args.input.sources(settings_map)?;
     let mut summary = Summary::new();
     // On an input error, what was read before it is summarised, then the error reported.
     let result = match &mut plot {

@@ -25,7 +25,7 @@ use hwfoc_io::SettingsMap;
 use hwfoc_io::Sources;
 use hwfoc_io::serial::{self, PortEvent};
 
-use crate::args::{SettingsArgs, seconds};
+use crate::args::{ProtocolArgs, SettingsArgs, seconds};
 use crate::commands::monitor::feed::{Feed, Msg};
 use crate::commands::simulate::ModelArgs;
 use crate::config::Config;
@@ -59,10 +59,11 @@ pub struct BridgeArgs {
     /// `hwfoc simulate` shape them).
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u16).range(1..=MAX_SIM as i64))]
     sim: Option<u16>,
-    /// Baud rate of the input ports (8N1).
-    #[arg(long, value_name = "N", default_value_t = serial::DEFAULT_BAUD,
-          value_parser = clap::value_parser!(u32).range(1..))]
-    baud: u32,
+    /// Baud rate of the input ports (8N1) [default: that of --protocol, else 19200].
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..))]
+    baud: Option<u32>,
+    #[command(flatten)]
+    protocol: ProtocolArgs,
 
     /// DataLink V2 frames (115200 baud) of ESCs 0 to 7 on this serial port: hwfoc as the
     /// DataLink box a flight controller reads.
@@ -145,8 +146,17 @@ pub fn run(args: &BridgeArgs) -> Result<(), CliError> {
             file: file.to_string(),
         });
     }
+    let protocol = args.protocol.protocol;
+    let baud = args.protocol.baud(args.baud);
     let result = if ports.is_empty() && args.sim.is_none() {
-        replay(&files, settings, deadline, &mut fanout, &mut errors)
+        replay(
+            &files,
+            settings,
+            protocol,
+            deadline,
+            &mut fanout,
+            &mut errors,
+        )
     } else {
         let (tx, rx) = mpsc::channel();
         let (names, feed) = match args.sim {
@@ -154,7 +164,7 @@ pub fn run(args: &BridgeArgs) -> Result<(), CliError> {
                 let feed = Feed::simulated(
                     &args.model,
                     usize::from(n),
-                    args.baud,
+                    baud,
                     settings.default_settings(),
                     tx,
                 )?;
@@ -162,12 +172,15 @@ pub fn run(args: &BridgeArgs) -> Result<(), CliError> {
             }
             None => {
                 let names: Vec<String> = ports.iter().map(|p| p.to_string()).collect();
-                let feed = Feed::ports(&names, args.baud, tx)?;
+                let feed = Feed::ports(&names, baud, tx)?;
                 (names, feed)
             }
         };
-        let mut streams = PortStreams::with_map(args.baud, names.clone(), settings);
-        let per_byte_ns = hwfoc::wire::byte_ns(args.baud);
+        let mut streams = PortStreams::with_map(baud, names.clone(), settings);
+        if let Some(protocol) = protocol {
+            streams.force_protocol(protocol);
+        }
+        let per_byte_ns = hwfoc::wire::byte_ns(baud);
         let result = live(
             &rx,
             &names,
@@ -302,10 +315,11 @@ fn take(
     }
 }
 
-/// Recordings and other inputs, replayed in real time.
+/// Recordings and other inputs, replayed in real time (reading `protocol` only when given).
 fn replay(
     files: &[&String],
     settings: SettingsMap,
+    protocol: Option<hwfoc::Protocol>,
     deadline: Option<Instant>,
     fanout: &mut Fanout,
     errors: &mut Errors,
@@ -315,6 +329,9 @@ fn replay(
         .map(|f| hwfoc_io::Input::open(f))
         .collect::<Result<Vec<_>, _>>()?;
     let mut sources = Sources::new(inputs, settings);
+    if let Some(protocol) = protocol {
+        sources.force_protocol(protocol);
+    }
     let stop = crate::stop::interrupted();
     // The deadline stops the replay as Ctrl-C would.
     let timer = deadline.map(|d| {

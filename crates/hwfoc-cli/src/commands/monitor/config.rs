@@ -9,6 +9,7 @@
 //! [monitor]
 //! ports = ["/dev/ttyUSB0"]   # watched when none are named on the command line
 //! baud = 19200
+//! protocol = "hw-foc"        # read this protocol only (hw-foc, datalink); default: every one
 //! record_dir = "/home/pi/recordings"
 //!
 //! [port."/dev/ttyUSB0"]
@@ -30,6 +31,7 @@
 
 use std::path::PathBuf;
 
+use hwfoc::Protocol;
 use hwfoc_io::SettingsMap;
 use hwfoc_io::serial;
 
@@ -77,6 +79,8 @@ pub struct MonitorSetup {
     pub settings: SettingsMap,
     /// Baud rate of the ports.
     pub baud: u32,
+    /// The one protocol read, when forced (every protocol otherwise).
+    pub protocol: Option<Protocol>,
     /// Ports from the file, when none are named on the command line.
     pub ports: Vec<String>,
     /// Where recordings started with the `r` key go.
@@ -94,6 +98,8 @@ pub struct Overrides {
     pub settings: SettingsArgs,
     /// `--baud`.
     pub baud: Option<u32>,
+    /// `--protocol`.
+    pub protocol: Option<Protocol>,
     /// `--record-dir`.
     pub record_dir: Option<PathBuf>,
     /// The alarm flags.
@@ -122,9 +128,13 @@ impl MonitorSetup {
             None => format!("--{}", key.replace('_', "-")),
         };
         let settings = general.settings_map(&flags.settings)?;
+        // Flags first (a protocol named implies its baud rate), then the file likewise.
+        let file_protocol = general.file.monitor.protocol;
         let baud = flags
             .baud
+            .or(flags.protocol.map(Protocol::baud_rate))
             .or(general.baud())
+            .or(file_protocol.map(Protocol::baud_rate))
             .unwrap_or(serial::DEFAULT_BAUD);
         if baud == 0 {
             return Err(invalid(origin("baud"), "the baud rate must be more than 0"));
@@ -201,6 +211,7 @@ impl MonitorSetup {
             file: general.path.clone(),
             settings,
             baud,
+            protocol: flags.protocol.or(file_protocol),
             ports: general.ports(),
             record_dir: flags
                 .record_dir
@@ -295,6 +306,40 @@ mod tests {
         assert_eq!(config.baud, 9600);
         assert_eq!(config.limits.mos.warning, 70.0);
         assert_eq!(config.limits.mos.critical, 95.0);
+    }
+
+    /// `--protocol` over `[monitor] protocol`; each implies its baud rate where no baud rate
+    /// is given at its level (flags, then the file).
+    #[test]
+    fn a_protocol_sets_the_baud_rate_a_flag_or_the_file_leaves_open() {
+        let none = parse("").unwrap();
+        assert_eq!((none.protocol, none.baud), (None, 19_200));
+        let file = parse("[monitor]\nprotocol = \"datalink\"\n").unwrap();
+        assert_eq!(
+            (file.protocol, file.baud),
+            (Some(Protocol::DataLink), 115_200)
+        );
+        let file = parse("[monitor]\nprotocol = \"datalink\"\nbaud = 57600\n").unwrap();
+        assert_eq!(file.baud, 57_600);
+
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("m.toml");
+        std::fs::write(&path, "[monitor]\nbaud = 57600\nprotocol = \"datalink\"\n").unwrap();
+        let mut flags = Overrides {
+            settings: SettingsArgs {
+                config: Some(path),
+                ..SettingsArgs::default()
+            },
+            protocol: Some(Protocol::HwFoc),
+            ..Overrides::default()
+        };
+        let config = MonitorSetup::load(&flags).unwrap();
+        assert_eq!(
+            (config.protocol, config.baud),
+            (Some(Protocol::HwFoc), 19_200)
+        );
+        flags.baud = Some(38_400);
+        assert_eq!(MonitorSetup::load(&flags).unwrap().baud, 38_400);
     }
 
     #[test]

@@ -395,6 +395,11 @@ impl Fleet {
         }
     }
 
+    /// Reads protocol `protocol` only, on every port (call it before the first event).
+    pub fn force_protocol(&mut self, protocol: hwfoc::Protocol) {
+        self.streams.force_protocol(protocol);
+    }
+
     /// The alarm levels in force.
     pub fn limits(&self) -> &Limits {
         &self.limits

@@ -26,7 +26,7 @@ use self::feed::{Feed, Msg};
 use self::fleet::Fleet;
 use self::perf::Perf;
 use super::record::{self, Recorder};
-use crate::args::SettingsArgs;
+use crate::args::{ProtocolArgs, SettingsArgs};
 use crate::commands::simulate::ModelArgs;
 use crate::error::CliError;
 use hwfoc_io::serial::PortEvent;
@@ -83,9 +83,12 @@ pub struct MonitorArgs {
     /// A name for each ESC, in order (repeat the option).
     #[arg(long = "label", value_name = "TEXT")]
     labels: Vec<String>,
-    /// Baud rate of the ports (8N1) [default: from the configuration file, else 19200].
+    /// Baud rate of the ports (8N1) [default: that of --protocol, else from the configuration
+    /// file, else 19200].
     #[arg(long, value_name = "N")]
     baud: Option<u32>,
+    #[command(flatten)]
+    protocol: ProtocolArgs,
     /// Conversion settings and the configuration file.
     #[command(flatten)]
     settings: SettingsArgs,
@@ -124,6 +127,7 @@ pub fn run(args: &MonitorArgs) -> Result<(), CliError> {
     let config = MonitorSetup::load(&Overrides {
         settings: args.settings.clone(),
         baud: args.baud,
+        protocol: args.protocol.protocol,
         record_dir: args.record_dir.clone(),
         alarms: args.alarms.clone(),
     })?;
@@ -176,6 +180,8 @@ pub struct Session {
     clock: hwfoc_io::clock::ReceiveClock,
     names: Vec<String>,
     baud: u32,
+    /// The one protocol read, when forced.
+    protocol: Option<hwfoc::Protocol>,
     record_dir: PathBuf,
     /// Whether `--record` may replace an existing file.
     overwrite: bool,
@@ -240,13 +246,16 @@ impl Session {
             Feed::Simulated { .. } => hwfoc_io::clock::ReceiveClock::new(),
         };
         let now = clock.now_ns() as f64 / 1e9;
-        let fleet = Fleet::new(
+        let mut fleet = Fleet::new(
             labelled,
             config.settings.clone(),
             config.limits.clone(),
             config.baud,
             now,
         );
+        if let Some(protocol) = config.protocol {
+            fleet.force_protocol(protocol);
+        }
         let mut session = Session {
             fleet,
             recorder: None,
@@ -260,6 +269,7 @@ impl Session {
             clock,
             names,
             baud: config.baud,
+            protocol: config.protocol,
             record_dir: config.record_dir,
             overwrite: args.overwrite,
             recorded: Vec::new(),
@@ -372,6 +382,7 @@ impl Session {
             rotate_size: None,
             rotate_time: None,
             baud: self.baud,
+            protocol: self.protocol,
             warn: false,
             overwrite: self.overwrite,
         };

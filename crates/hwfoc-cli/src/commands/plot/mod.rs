@@ -93,7 +93,7 @@ pub fn run(args: &PlotArgs) -> Result<(), CliError> {
         title: args.title.clone(),
         escs: args.select.esc.clone(),
     };
-    let mut sources = Sources::new(args.input.open_all()?, settings_map);
+    let mut sources = args.input.sources(settings_map)?;
     if selection.window.is_limited() {
         sources.require_timing()?;
         args.select.check_clocks(&sources)?;
