@@ -253,6 +253,18 @@ fn a_forced_protocol_reads_its_frames_only() {
     assert_eq!(summary["escs"].as_array().unwrap().len(), 1, "{summary}");
     let link = &summary["escs"][0]["link"];
     assert_eq!(link["bytes_skipped"], hub_bytes.len() as u64, "{summary}");
+    assert_eq!(summary["protocol"], "hw-foc", "{summary}");
+    let text = hwfoc()
+        .args(["summary", "--protocol", "datalink", &file])
+        .output()
+        .unwrap();
+    let text = stdout(&text);
+    assert!(
+        text.contains(
+            "\nprotocol     DataLink V2 only (the bytes of any other protocol skipped)\n"
+        ),
+        "{text}"
+    );
 
     let hub_only = decode(&["--protocol", "datalink"]);
     let expected: BTreeMap<u64, Vec<u64>> = (0..8u64).map(|c| (c, vec![1000 + c; 3])).collect();
@@ -267,6 +279,13 @@ fn a_forced_protocol_reads_its_frames_only() {
         "the ESC's bytes are the hub link's skipped bytes: {summary}"
     );
 
+    let (summary, ok) = summary_json(&[&file]);
+    assert!(ok, "{summary}");
+    assert_eq!(
+        summary.get("protocol"),
+        None,
+        "said only when forced: {summary}"
+    );
     let both = decode(&[]);
     assert_eq!(both.values().map(Vec::len).sum::<usize>(), 30 + 3 * 8);
     assert_eq!(

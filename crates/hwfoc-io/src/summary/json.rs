@@ -55,14 +55,21 @@ impl Report<'_> {
                 })
             })
             .collect();
-        json!({
+        let mut report = json!({
             "schema_version": crate::JSON_SCHEMA_VERSION,
             "settings": settings_json(self.settings),
             "inputs": inputs,
             "hubs": hubs,
             "escs": escs,
             "energy_total": total_energy(&reports).as_ref().map(energy_json),
-        })
+        });
+        // Only when one protocol was read: the report of every protocol read is unchanged.
+        if let (Some(protocol), Some(object)) =
+            (self.sources.forced_protocol(), report.as_object_mut())
+        {
+            object.insert("protocol".to_string(), json!(protocol.name()));
+        }
+        report
     }
 }
 

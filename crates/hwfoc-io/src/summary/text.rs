@@ -49,6 +49,13 @@ impl Report<'_> {
                 );
             }
         }
+        if let Some(protocol) = self.sources.forced_protocol() {
+            let _ = writeln!(
+                o,
+                "protocol     {} only (the bytes of any other protocol skipped)",
+                protocol.title()
+            );
+        }
         for (esc, hub) in self.sources.hubs() {
             let _ = writeln!(
                 o,
