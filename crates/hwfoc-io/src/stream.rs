@@ -781,7 +781,16 @@ mod mixed_tests {
     /// The records of `wire` fed to one stream in batches of `chunk` bytes, as `(channel,
     /// packet)`, and the stream.
     fn decode(wire: &[u8], chunk: usize) -> (Vec<(Option<u8>, u16)>, Stream) {
-        let mut stream = Stream::new();
+        decode_forced(wire, chunk, None)
+    }
+
+    /// [`decode`] by a stream reading `forced` only (every protocol when `None`).
+    pub(super) fn decode_forced(
+        wire: &[u8],
+        chunk: usize,
+        forced: Option<Protocol>,
+    ) -> (Vec<(Option<u8>, u16)>, Stream) {
+        let mut stream = Stream::forced(forced);
         let mut got = Vec::new();
         let mut on = |_: Option<f64>, channel: Option<u8>, frame: &Frame| {
             if let Frame::Data(f) = frame {
@@ -858,23 +867,7 @@ mod forced_tests {
     /// The records of `wire` read by a stream forced to `protocol`, fed in `chunk`-byte
     /// batches, as `(channel, packet)`, and the stream.
     fn decode(wire: &[u8], chunk: usize, protocol: Protocol) -> (Vec<(Option<u8>, u16)>, Stream) {
-        let mut stream = Stream::forced(Some(protocol));
-        let mut got = Vec::new();
-        let mut on = |_: Option<f64>, channel: Option<u8>, frame: &Frame| {
-            if let Frame::Data(f) = frame {
-                got.push((channel, f.to_hwfoc().packet));
-            }
-        };
-        for b in wire.chunks(chunk) {
-            let batch = Batch {
-                bytes: b,
-                times: None,
-                stream: 0,
-            };
-            stream.feed(batch, &mut on);
-        }
-        stream.finish(&mut on);
-        (got, stream)
+        super::mixed_tests::decode_forced(wire, chunk, Some(protocol))
     }
 
     /// ESC frames, hub frames, ESC frames: a stream forced to one protocol hands on that

@@ -217,6 +217,16 @@ impl CodeRun {
         }
     }
 
+    /// Counts the codes of temperature `quantity` in `frames`, a run at a time.
+    #[inline(always)]
+    fn count(frames: &[Data], quantity: Quantity, codes: &mut [u64; 256], uncoded: &mut u64) {
+        let mut run = CodeRun::default();
+        for f in frames {
+            run.add(code(f, quantity), codes, uncoded);
+        }
+        run.end(codes);
+    }
+
     /// Counts the run in the histogram.
     #[inline(always)]
     fn end(self, codes: &mut [u64; 256]) {
@@ -343,24 +353,18 @@ impl Accumulator {
             tally.ranges.add(f);
         }
         self.tally = tally;
-        let mut mos = CodeRun::default();
-        for f in run {
-            mos.add(
-                code(f, Quantity::MosTemp),
-                &mut self.mos_codes,
-                &mut self.uncoded[0],
-            );
-        }
-        mos.end(&mut self.mos_codes);
-        let mut cap = CodeRun::default();
-        for f in run {
-            cap.add(
-                code(f, Quantity::CapTemp),
-                &mut self.cap_codes,
-                &mut self.uncoded[1],
-            );
-        }
-        cap.end(&mut self.cap_codes);
+        CodeRun::count(
+            run,
+            Quantity::MosTemp,
+            &mut self.mos_codes,
+            &mut self.uncoded[0],
+        );
+        CodeRun::count(
+            run,
+            Quantity::CapTemp,
+            &mut self.cap_codes,
+            &mut self.uncoded[1],
+        );
         n
     }
 
