@@ -47,9 +47,17 @@ pub trait Handler {
         }
     }
 
-    /// Data frames of ESC `esc`, one after another, without receive times (a raw input's):
-    /// what handing each to [`Handler::frame`] in turn does, which the default does. A handler
-    /// that gathers statistics takes them in a loop of its own.
+    /// Whether the handler takes a raw input's data frames a run at a time
+    /// ([`Handler::untimed_data`]), its regular files read ahead ([`crate::Input::read_ahead`]):
+    /// for a handler whose work for a frame is small beside the decoder's (the summary). A
+    /// handler that does more (the writers, on threads of their own) takes each frame in the
+    /// decoder's loop, as by default.
+    const TAKES_RUNS: bool = false;
+
+    /// Data frames of ESC `esc`, one after another, without receive times (a raw input's),
+    /// for a handler that [`takes runs`](Handler::TAKES_RUNS): what handing each to
+    /// [`Handler::frame`] in turn does, which the default does. A handler that gathers
+    /// statistics takes them in a loop of its own.
     #[inline]
     fn untimed_data(&mut self, esc: u8, frames: &[Data], settings: &Settings) {
         for f in frames {
@@ -83,6 +91,8 @@ where
     B::Error: From<A::Error>,
 {
     type Error = B::Error;
+
+    const TAKES_RUNS: bool = A::TAKES_RUNS && B::TAKES_RUNS;
 
     #[inline]
     fn frame(&mut self, esc: u8, t: Option<f64>, frame: &Frame, settings: &Settings) {

@@ -148,6 +148,7 @@ mod tests {
         for len in [1, BATCH - 1, BATCH, 5 * BATCH + 17] {
             let (_dir, path, bytes) = counting_file(len);
             let mut input = Input::open(&path).unwrap();
+            input.read_ahead(true);
             for _ in 0..2 {
                 let mut got = Vec::new();
                 while let Some(batch) = input.next_batch().unwrap() {

@@ -220,6 +220,9 @@ pub struct Input {
     /// rewind already gave (those are not given again).
     told: usize,
     muted: usize,
+    /// Whether a regular file of raw bytes is read ahead on a thread of its own when it is
+    /// opened to be read (see [`Input::read_ahead`]).
+    ahead: bool,
 }
 
 impl Input {
@@ -244,7 +247,7 @@ impl Input {
             });
         }
         let mut input = if meta.is_file() {
-            Input::from_file(spec, file)?
+            Input::from_file(spec, file, false)?
         } else {
             Input::from_reader(spec, Box::new(file))?
         };
@@ -267,7 +270,7 @@ impl Input {
             input: self.name.clone(),
             source,
         })?;
-        let fresh = Input::from_file(&self.name, file)?;
+        let fresh = Input::from_file(&self.name, file, self.ahead)?;
         if fresh.format != self.format {
             return Err(InputError::Changed {
                 input: self.name.clone(),
@@ -339,10 +342,24 @@ impl Input {
     }
 
     /// [`Input::from_reader`] of a regular file: raw bytes are read ahead on a thread of their
-    /// own (see `ahead.rs`).
-    fn from_file(name: &str, mut file: File) -> Result<Input, InputError> {
+    /// own (see `ahead.rs`) when `ahead`.
+    fn from_file(name: &str, mut file: File, ahead: bool) -> Result<Input, InputError> {
         let head = read_head(name, &mut file)?;
-        Input::with_head(name, head, Opened::File(file))
+        let opened = if ahead {
+            Opened::File(file)
+        } else {
+            Opened::Reader(Box::new(file))
+        };
+        Input::with_head(name, head, opened)
+    }
+
+    /// Reads a regular file of raw bytes ahead on a thread of its own, from the next time it is
+    /// opened to be read (its first [`Input::next_batch`]): the kernel's copy of its bytes then
+    /// runs beside the decoder. Worth it where the decoder's loop is the bottleneck and a core
+    /// is free (a summary); [`crate::Sources`] sets it for the handlers that ask
+    /// ([`crate::Handler::TAKES_RUNS`]). Other inputs ignore it.
+    pub fn read_ahead(&mut self, ahead: bool) {
+        self.ahead = ahead;
     }
 
     /// The input whose first bytes, `head`, were read of `opened`.
@@ -386,6 +403,7 @@ impl Input {
             path: None,
             told: 0,
             muted: 0,
+            ahead: false,
         }
     }
 

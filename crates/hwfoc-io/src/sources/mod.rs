@@ -373,6 +373,7 @@ impl Sources {
         handler: &mut H,
     ) -> Result<(), H::Error> {
         let index = self.open(&input);
+        input.read_ahead(H::TAKES_RUNS);
         let mut escs = self.numbered(index);
         let mut bytes = 0;
         let result = self.read_input(&mut input, index, &mut escs, &mut bytes, handler);
@@ -420,9 +421,10 @@ impl Sources {
             let settings = &self.esc_settings(esc);
             let hub = self.hubs.get(&esc);
             let mut pending = Vec::new();
-            // The stream's own data frames without times are held and handed on together
-            // ([`Handler::untimed_data`]), in order with every other frame: the decoder's loop
-            // only copies a frame's fields, the handler's loop takes them.
+            // For a handler that takes runs, the stream's own data frames without times are
+            // held and handed on together ([`Handler::untimed_data`]), in order with every
+            // other frame: the decoder's loop only copies a frame's fields, the handler's loop
+            // takes them.
             let held = &mut *self.held;
             let hand_on = |held: &mut Held, handler: &mut H| {
                 handler.untimed_data(id, held.frames(), settings);
@@ -432,7 +434,7 @@ impl Sources {
                 batch,
                 #[inline(always)]
                 |t, channel, d| {
-                    if let (None, None, Frame::Data(f)) = (t, channel, d) {
+                    if let (true, None, None, Frame::Data(f)) = (H::TAKES_RUNS, t, channel, d) {
                         if held.len == HELD {
                             hand_on(held, handler);
                         }

@@ -40,7 +40,7 @@ pub(crate) fn wire(packets: std::ops::Range<u16>) -> Vec<u8> {
 /// A recording with one interface per `(port, bytes, first byte's time in ns)`, in the
 /// order given; each port's bytes in packets of 7 bytes, 4 ms apart (7 bytes take 3.6 ms
 /// at 19200 baud).
-fn recording(ports: &[(&str, &[u8], u64)]) -> Vec<u8> {
+pub(crate) fn recording(ports: &[(&str, &[u8], u64)]) -> Vec<u8> {
     let mut w = pcapng::Writer::new(Vec::new()).unwrap();
     for (port, _, _) in ports {
         w.add_interface(port, 19200).unwrap();
@@ -605,4 +605,61 @@ fn files_and_ports_number_a_hub_alike_at_the_last_esc_number() {
     assert_eq!(live.0, expected, "ports");
     assert_eq!(streams.channel_of(249, 255), Some(6));
     assert!(streams.settings_of(255).is_some());
+}
+
+/// Every call a handler gets, in order; `RUNS` says whether it takes runs of untimed data
+/// frames (which it hands on one at a time, as the default `untimed_data` does).
+#[derive(Debug, Default, PartialEq)]
+struct Calls<const RUNS: bool>(Vec<String>);
+
+impl<const RUNS: bool> Handler for Calls<RUNS> {
+    type Error = InputError;
+
+    const TAKES_RUNS: bool = RUNS;
+
+    fn frame(&mut self, esc: u8, t: Option<f64>, frame: &Frame, _: &Settings) {
+        let what = match frame {
+            Frame::Data(d) => format!("{}", d.to_hwfoc().packet),
+            Frame::Info(_) => "info".to_string(),
+        };
+        self.0.push(format!("{esc} {t:?} {what}"));
+    }
+
+    fn end_batch(&mut self, live: bool) -> Result<(), InputError> {
+        self.0.push(format!("end {live}"));
+        Ok(())
+    }
+}
+
+/// A handler that takes runs of a raw input's data frames gets every frame in the order a
+/// handler taking them one at a time does: ESC frames, a hub's frames between them, a
+/// recording after.
+#[test]
+fn runs_of_untimed_frames_keep_the_order_of_every_frame() {
+    let inputs = || {
+        // Hub frames found in one batch, then ESC and hub frames in turn within later ones.
+        let mut raw = wire(0..3000);
+        raw.extend(hub_wire(0, 0..500, &[0, 2, 5]));
+        for k in 0..20u16 {
+            raw.extend(wire(3000 + 50 * k..3050 + 50 * k));
+            raw.extend(hub_wire(0, 500 + 10 * k..510 + 10 * k, &[0, 2, 5]));
+        }
+        raw.extend(wire(4000..6000));
+        let (a, b) = (wire(10..400), wire(500..900));
+        let rec = recording(&[("/dev/ttyA", &a, 1_000_000_000), ("/dev/ttyB", &b, 0)]);
+        vec![
+            Input::from_memory("raw", raw).unwrap(),
+            Input::from_memory("rec", rec).unwrap(),
+        ]
+    };
+    let mut each = Calls::<false>::default();
+    Sources::new(inputs(), Settings::DEFAULT)
+        .run(&mut each)
+        .unwrap();
+    let mut runs = Calls::<true>::default();
+    Sources::new(inputs(), Settings::DEFAULT)
+        .run(&mut runs)
+        .unwrap();
+    assert!(each.0.len() > 8800, "{} calls", each.0.len());
+    assert_eq!(runs.0, each.0);
 }

@@ -138,6 +138,8 @@ impl Summary {
 impl Handler for Summary {
     type Error = InputError;
 
+    const TAKES_RUNS: bool = true;
+
     /// Takes frames as decoded: statistics are kept on the raw integers (see the module
     /// documentation), converted once at the end.
     ///
