@@ -131,27 +131,15 @@ impl Wire {
                 }
             }
             Wire::HwFoc(d) => {
-                d.feed(
-                    data,
-                    #[inline(always)]
-                    |d| emit_mixed(mixed::Decoded::Esc(d), emit),
-                );
-                if let Some(s) = silence_s {
-                    d.line_silent(frames_in(s), |d| emit_mixed(mixed::Decoded::Esc(d), emit));
-                }
+                feed_one(d, data, silence_s.map(frames_in), mixed::Decoded::Esc, emit)
             }
-            Wire::DataLink(d) => {
-                d.feed(
-                    data,
-                    #[inline(always)]
-                    |d| emit_mixed(mixed::Decoded::Hub(d), emit),
-                );
-                if let Some(s) = silence_s {
-                    d.line_silent(hub_frames_in(s), |d| {
-                        emit_mixed(mixed::Decoded::Hub(d), emit)
-                    });
-                }
-            }
+            Wire::DataLink(d) => feed_one(
+                d,
+                data,
+                silence_s.map(hub_frames_in),
+                mixed::Decoded::Hub,
+                emit,
+            ),
         }
     }
 
@@ -207,6 +195,27 @@ impl Wire {
             Wire::HwFoc(_) => Some(Protocol::HwFoc),
             Wire::DataLink(_) => Some(Protocol::DataLink),
         }
+    }
+}
+
+/// Decodes `data` with one protocol's decoder (ending with a silence of the line in which at
+/// most `silent` of its frames fit, when given): each frame, made a [`mixed::Decoded`] by
+/// `wrap`, is handed on as [`emit_mixed`] does.
+#[inline(always)]
+fn feed_one<S: hwfoc::scan::Scanner>(
+    decoder: &mut hwfoc::StreamDecoder<S>,
+    data: &[u8],
+    silent: Option<u32>,
+    wrap: impl Fn(S::Item) -> mixed::Decoded,
+    emit: &mut impl FnMut(Option<u8>, u64, &Frame),
+) {
+    decoder.feed(
+        data,
+        #[inline(always)]
+        |d| emit_mixed(wrap(d), emit),
+    );
+    if let Some(frames) = silent {
+        decoder.line_silent(frames, |d| emit_mixed(wrap(d), emit));
     }
 }
 
@@ -422,7 +431,7 @@ impl Stream {
 
     /// Whether a DataLink frame has been found.
     fn hub_frames(&self) -> bool {
-        self.wire.hub().is_some_and(|s| s.frames() > 0)
+        self.hub().is_some()
     }
 
     /// The link statistics of the stream's ESC: of its own wire, or of the hub's channel 0
