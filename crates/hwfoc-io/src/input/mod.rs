@@ -246,11 +246,7 @@ impl Input {
                 input: spec.to_string(),
             });
         }
-        let mut input = if meta.is_file() {
-            Input::from_file(spec, file, false)?
-        } else {
-            Input::from_reader(spec, Box::new(file))?
-        };
+        let mut input = Input::from_reader(spec, Box::new(file))?;
         if meta.is_file() {
             // Closed until read: a year of rotated recordings is thousands of inputs, more
             // than a process may hold open. (A pipe or a device cannot be opened again.)
