@@ -189,6 +189,13 @@ impl Tally {
     }
 }
 
+/// Whether a data frame carries no fault: what [`Accumulator::add_clean`] and
+/// [`Accumulator::add_clean_run`] take (a protocol without a status word has none).
+#[inline(always)]
+pub(super) fn is_clean(f: &Data) -> bool {
+    f.status().is_none_or(Status::is_ok)
+}
+
 /// The code of temperature `quantity` in a data frame: its raw value when that is a table's
 /// code (0..=255), `None` when it is not or the frame does not carry it.
 #[inline(always)]
@@ -318,7 +325,7 @@ impl Accumulator {
     #[inline(always)]
     pub(super) fn count(&mut self, t: Option<f64>, f: &Data) {
         let powered = self.tally.add(f);
-        self.code(f);
+        self.count_codes(std::slice::from_ref(f));
         if !powered {
             return self.untimed_power(t, f);
         }
@@ -341,7 +348,7 @@ impl Accumulator {
         let mut tally = self.tally;
         let mut n = 0;
         for f in frames {
-            if !f.status().is_none_or(Status::is_ok) {
+            if !is_clean(f) {
                 break;
             }
             // Without voltage and current, an untimed frame adds no power and no time.
@@ -353,35 +360,22 @@ impl Accumulator {
             tally.ranges.add(f);
         }
         self.tally = tally;
+        self.count_codes(run);
+        n
+    }
+
+    /// Counts the temperature codes of `frames`, each temperature a run of one code at a time.
+    #[inline(always)]
+    fn count_codes(&mut self, frames: &[Data]) {
         CodeRun::count(
-            run,
+            frames,
             Quantity::MosTemp,
             &mut self.mos_codes,
             &mut self.uncoded[0],
         );
         CodeRun::count(
-            run,
+            frames,
             Quantity::CapTemp,
-            &mut self.cap_codes,
-            &mut self.uncoded[1],
-        );
-        n
-    }
-
-    /// Counts a data frame's temperature codes.
-    #[inline(always)]
-    fn code(&mut self, f: &Data) {
-        let count = |code: Option<u8>, codes: &mut [u64; 256], uncoded: &mut u64| match code {
-            Some(code) => codes[usize::from(code)] += 1,
-            None => *uncoded += 1,
-        };
-        count(
-            code(f, Quantity::MosTemp),
-            &mut self.mos_codes,
-            &mut self.uncoded[0],
-        );
-        count(
-            code(f, Quantity::CapTemp),
             &mut self.cap_codes,
             &mut self.uncoded[1],
         );

@@ -27,7 +27,7 @@
 
 use hwfoc::telemetry::{Conversion, Data, Frame, Info, Telemetry};
 use hwfoc::units::Linear;
-use hwfoc::{Fault, Quantity, Settings, Status};
+use hwfoc::{Fault, Protocol, Quantity, Settings, Status};
 use serde_json::{Value, json};
 
 use crate::energy::{Energy, NOMINAL_PERIOD_S};
@@ -39,7 +39,6 @@ use crate::settings::{self, settings_json};
 use crate::sources::{Handler, Sources};
 use crate::stream::EscLink;
 use crate::time::{self, Clock};
-use hwfoc::Protocol;
 use hwfoc::datalink::LengthByte;
 
 mod accumulate;
@@ -48,7 +47,7 @@ mod json;
 mod tests;
 mod text;
 
-use accumulate::{Accumulator, TempStats, lane, temp_stats};
+use accumulate::{Accumulator, TempStats, is_clean, lane, temp_stats};
 pub use json::device_json;
 
 /// What to tell a user whose wire gave bytes but no frame: [`no_frames_of`] HW-FOC, the
@@ -153,7 +152,7 @@ impl Handler for Summary {
         if let Frame::Data(f) = frame
             && let Some(acc) = self.0.get_mut(esc)
             && acc.fast
-            && f.status().is_none_or(Status::is_ok)
+            && is_clean(f)
         {
             acc.add_clean(t, f);
         } else {
