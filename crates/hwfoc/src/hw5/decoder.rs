@@ -48,9 +48,9 @@ pub(crate) enum Taken {
 }
 
 /// Offset of the first candidate in `hay`: `FE 01` or `01 FD`, or an `FE` or `01` that is the
-/// last byte of `hay`.
+/// last byte of `hay` (`mixed.rs` can look for HW5 candidates with it).
 #[inline]
-fn find_start(hay: &[u8]) -> Option<usize> {
+pub(crate) fn find_start(hay: &[u8]) -> Option<usize> {
     let mut base = 0;
     // Eight positions at a time: the word at `base` for the first bytes and the word one byte
     // later for the second bytes.

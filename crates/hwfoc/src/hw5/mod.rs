@@ -61,7 +61,7 @@
 //!
 //! | module | holds |
 //! |---|---|
-//! | `layout` | [`BAUD_RATE`], [`FRAME_PERIOD_RUNNING`], [`FRAME_PERIOD_IDLE`], [`TELEMETRY_LEN`], [`MAX_FRAME_LEN`], types, [`Kind`], [`Direction`], [`kinds_of`], the conversions [`VOLTS`], [`AMPS`], [`ERPM`] |
+//! | `layout` | [`BAUD_RATE`], [`FRAME_PERIOD_RUNNING`], [`FRAME_PERIOD_IDLE`], [`TELEMETRY_LEN`], [`MAX_FRAME_LEN`], the envelope bytes and offsets, types, [`Kind`], [`Direction`], [`kinds_of`], the conversions [`VOLTS`], [`AMPS`], [`ERPM`] |
 //! | `frame` | [`TelemetryFrame`] (encode, parse, conversions), [`Fault`], [`FaultCode`], [`Faults`], [`identify`] |
 //! | `error` | [`Error`] |
 //! | `stats` | [`Stats`] |
@@ -97,8 +97,9 @@ pub use decoder::{Decoded, Decoder, Frames, Scanner, frames};
 pub use error::Error;
 pub use frame::{Fault, FaultCode, Faults, TelemetryFrame, identify};
 pub use layout::{
-    AMPS, BAUD_RATE, CHECKSUM, Direction, ERPM, FRAME_PERIOD_IDLE, FRAME_PERIOD_RUNNING, Kind,
-    MAX_FRAME_LEN, TELEMETRY_HEADER, TELEMETRY_LEN, TYPE_DEVICE_INFO, TYPE_PARAMETERS, TYPE_PING,
-    TYPE_RESET, TYPE_TELEMETRY, VOLTS, envelope, kinds_of,
+    AMPS, BAUD_RATE, CHECKSUM, CODE_AT, Direction, ERPM, ESC_ADDRESS, ESC_BYTE2, ESC_START,
+    FRAME_PERIOD_IDLE, FRAME_PERIOD_RUNNING, HEADER_LEN, Kind, MAX_FRAME_LEN, PAYLOAD_LEN_AT,
+    REQUEST_BYTE2, REQUEST_MARK, TELEMETRY_HEADER, TELEMETRY_LEN, TYPE_AT, TYPE_DEVICE_INFO,
+    TYPE_PARAMETERS, TYPE_PING, TYPE_RESET, TYPE_TELEMETRY, VOLTS, envelope, kinds_of,
 };
 pub use stats::Stats;
