@@ -6,6 +6,7 @@
 pub mod counters;
 pub mod datalink;
 pub mod foc;
+pub mod hw5;
 pub mod mixed;
 pub mod protocol;
 pub mod scan;

@@ -1,6 +1,7 @@
 //! What the Hobbywing protocols share on the wire: byte timing ([`byte_ns`]), the sync and
 //! version bytes, and the kinds of check bytes ([`Checksum`]: the sums of HW-FOC
-//! ([`crate::foc`]), the CRC-16/XMODEM of DataLink V2 ([`crate::datalink`])).
+//! ([`crate::foc`]), the CRC-16/XMODEM of DataLink V2 ([`crate::datalink`]), the CRC-16/MODBUS
+//! of HW5 ([`crate::hw5`])).
 //!
 //! This is the lowest layer of the codec: it knows no particular protocol or frame kind. Each
 //! protocol's frames are built on top of it in its own module.
@@ -126,6 +127,52 @@ pub const fn crc16_ccitt(mut crc: u16, bytes: &[u8]) -> u16 {
     crc
 }
 
+/// The CRC-16/MODBUS lookup table (polynomial 0x8005 reflected: 0xA001): entry `i` is the CRC
+/// register after shifting the byte `i` through a zero register, least significant bit first.
+/// Built at compile time; 512 bytes.
+const CRC16_MODBUS_TABLE: [u16; 256] = {
+    let mut table = [0u16; 256];
+    let mut i = 0;
+    while i < 256 {
+        let mut crc = i as u16;
+        let mut bit = 0;
+        while bit < 8 {
+            crc = if crc & 1 != 0 {
+                (crc >> 1) ^ CRC16_MODBUS_POLY_REFLECTED
+            } else {
+                crc >> 1
+            };
+            bit += 1;
+        }
+        table[i] = crc;
+        i += 1;
+    }
+    table
+};
+
+/// The generator polynomial of CRC-16/MODBUS (x^16 + x^15 + x^2 + 1, 0x8005), bit-reversed for
+/// the reflected (least significant bit first) register.
+const CRC16_MODBUS_POLY_REFLECTED: u16 = 0xA001;
+
+/// The CRC-16/MODBUS of `bytes`: polynomial 0x8005 reflected (0xA001), initial value 0xFFFF,
+/// input and output reflected, no final XOR (check value 0x4B37 for `"123456789"`). The check
+/// of every HW5 frame ([`crate::hw5`]), sent low byte first; table-driven, one byte per step.
+///
+/// ```
+/// assert_eq!(hwfoc::wire::crc16_modbus(b"123456789"), 0x4B37);
+/// assert_eq!(hwfoc::wire::crc16_modbus(&[]), 0xFFFF);
+/// ```
+#[inline]
+pub const fn crc16_modbus(bytes: &[u8]) -> u16 {
+    let mut crc = 0xFFFFu16;
+    let mut i = 0;
+    while i < bytes.len() {
+        crc = (crc >> 8) ^ CRC16_MODBUS_TABLE[(crc as u8 ^ bytes[i]) as usize];
+        i += 1;
+    }
+    crc
+}
+
 /// How a frame kind protects its bytes: the check bytes at the end of the frame.
 ///
 /// Each kind names one in [`FrameKind::CHECKSUM`](crate::foc::FrameKind::CHECKSUM) (and the
@@ -143,6 +190,9 @@ pub enum Checksum {
     /// The CRC-16/XMODEM ([`crc16_xmodem`]) of every byte before the check bytes, sent low byte
     /// first (2 check bytes): DataLink V2 hub frames ([`crate::datalink`]).
     Crc16Xmodem,
+    /// The CRC-16/MODBUS ([`crc16_modbus`]) of every byte before the check bytes, sent low byte
+    /// first (2 check bytes): HW5 frames ([`crate::hw5`]).
+    Crc16Modbus,
 }
 
 impl Checksum {
@@ -150,7 +200,7 @@ impl Checksum {
     #[inline]
     pub const fn width(self) -> usize {
         match self {
-            Checksum::Sum16Le | Checksum::Crc16Xmodem => 2,
+            Checksum::Sum16Le | Checksum::Crc16Xmodem | Checksum::Crc16Modbus => 2,
             Checksum::Sum8 => 1,
         }
     }
@@ -162,6 +212,7 @@ impl Checksum {
             Checksum::Sum16Le => sum16(covered),
             Checksum::Sum8 => sum16(covered) & 0xFF,
             Checksum::Crc16Xmodem => crc16_xmodem(covered),
+            Checksum::Crc16Modbus => crc16_modbus(covered),
         }
     }
 
@@ -170,7 +221,7 @@ impl Checksum {
     #[inline(always)]
     pub fn carried(self, check: &[u8]) -> Option<u16> {
         match self {
-            Checksum::Sum16Le | Checksum::Crc16Xmodem => {
+            Checksum::Sum16Le | Checksum::Crc16Xmodem | Checksum::Crc16Modbus => {
                 check.first_chunk().map(|&b| u16::from_le_bytes(b))
             }
             Checksum::Sum8 => check.first().map(|&b| u16::from(b)),
@@ -211,7 +262,7 @@ impl Checksum {
         let (covered, check) = frame.split_at_mut(at);
         let value = self.compute(covered);
         match self {
-            Checksum::Sum16Le | Checksum::Crc16Xmodem => {
+            Checksum::Sum16Le | Checksum::Crc16Xmodem | Checksum::Crc16Modbus => {
                 check.copy_from_slice(&value.to_le_bytes())
             }
             Checksum::Sum8 => check[0] = value as u8,
@@ -295,6 +346,70 @@ mod tests {
             Err(FrameError::Checksum {
                 expected: crc16_xmodem(&frame[..9]),
                 found: 0x31C3
+            })
+        );
+    }
+
+    /// CRC-16/MODBUS one bit at a time, straight from its definition: the register starts at
+    /// 0xFFFF, each byte is XORed into its low end and shifted out least significant bit first,
+    /// with 0xA001 (0x8005 reversed) fed back on a 1.
+    fn crc16_modbus_bitwise(bytes: &[u8]) -> u16 {
+        let mut crc = 0xFFFFu16;
+        for &b in bytes {
+            crc ^= u16::from(b);
+            for _ in 0..8 {
+                let out = crc & 1;
+                crc >>= 1;
+                if out != 0 {
+                    crc ^= 0xA001;
+                }
+            }
+        }
+        crc
+    }
+
+    #[test]
+    fn crc16_modbus_check_value_and_bitwise_reference() {
+        assert_eq!(crc16_modbus(b"123456789"), 0x4B37);
+        assert_eq!(crc16_modbus_bitwise(b"123456789"), 0x4B37);
+        assert_eq!(crc16_modbus(&[]), 0xFFFF);
+        assert_eq!(CRC16_MODBUS_TABLE[1], 0xC0C1);
+        assert_eq!(CRC16_MODBUS_TABLE[128], 0xA001);
+        assert_eq!(CRC16_MODBUS_TABLE[255], 0x4040);
+        let mut x = 0x9E37_79B9_7F4A_7C15u64;
+        let mut buf = [0u8; 200];
+        for len in 0..buf.len() {
+            for b in buf.iter_mut() {
+                x ^= x << 13;
+                x ^= x >> 7;
+                x ^= x << 17;
+                *b = x as u8;
+            }
+            assert_eq!(
+                crc16_modbus(&buf[..len]),
+                crc16_modbus_bitwise(&buf[..len]),
+                "{len}"
+            );
+        }
+        for b in 0..=255u8 {
+            assert_eq!(crc16_modbus(&[b]), crc16_modbus_bitwise(&[b]));
+        }
+    }
+
+    #[test]
+    fn crc16_modbus_checksum_arm() {
+        let mut frame = *b"123456789\0\0";
+        Checksum::Crc16Modbus.seal(&mut frame);
+        assert_eq!(frame[9..], [0x37, 0x4B], "low byte first");
+        assert_eq!(Checksum::Crc16Modbus.width(), 2);
+        assert_eq!(Checksum::Crc16Modbus.verify(&frame), Ok(()));
+        assert_eq!(Checksum::Crc16Modbus.carried(&frame[9..]), Some(0x4B37));
+        frame[8] ^= 0x01;
+        assert_eq!(
+            Checksum::Crc16Modbus.verify(&frame),
+            Err(FrameError::Checksum {
+                expected: crc16_modbus(&frame[..9]),
+                found: 0x4B37
             })
         );
     }
