@@ -8,29 +8,29 @@
 //!    `B9` at 12), else a data frame.
 //! 2. **Plausible** ([`DataFrame::is_plausible`] under the full scale in use,
 //!    [`InfoFrame::is_plausible`]); otherwise rejected ([implausible](Stats::implausible)).
-//! 3. **Chained**: it starts exactly where the last accepted frame (with its trailer, if one
-//!    came) ended ([`Stats::chain_end`]) and, for a data frame, carries the counter after the
-//!    last data frame's (any counter right after an info frame that started a chain): accepted
-//!    on its own, a data frame on its 19th byte, an info frame on its 13th.
-//! 4. **Confirmed**: otherwise (the first frame of a stream, after garbage or a cut or corrupted
-//!    frame, a counter that jumped) it must start a new chain: a data frame followed by two
-//!    chained plausible data frames with counters +1 (fast mode), or a data frame and an info
-//!    frame chained either way round (slow mode, where they alternate). At most 59 bytes decide
+//! 3. **An info frame** is accepted when a plausible data frame (any counter) starts right
+//!    after it, chained to the last accepted frame or not (in slow mode every info frame has
+//!    one; decided on the 32nd byte). Its fixed bytes alone would come by chance in bytes rich
+//!    in `9B` and `B9` (about one in 30 000 positions when a quarter of the bytes are each), and
+//!    a cut info frame completed by the next frame's bytes would pass for one.
+//! 4. **A chained data frame**: it starts exactly where the last accepted frame (with its
+//!    trailer, if one came) ended ([`Stats::chain_end`]) and carries the counter after the last
+//!    data frame's (any counter right after an info frame that started a chain): accepted on
+//!    its own, on its 19th byte.
+//! 5. **A confirmed data frame**: otherwise (the first frame of a stream, after garbage or a cut
+//!    or corrupted frame, a counter that jumped) it must start a new chain: followed by two
+//!    chained plausible data frames with counters +1 (fast mode), or by an info frame, after
+//!    it or after the next data frame (slow mode, where they alternate). At most 59 bytes decide
 //!    it. The frames after it are then accepted as chained, so a chain loses none of its
 //!    frames; its first counter's step from the last accepted one counts
 //!    [lost frames](Stats::lost_frames), a [duplicate](Stats::duplicate_frames) or a
 //!    [restart](Stats::restarts).
-//! 5. Otherwise it is rejected ([unconfirmed](Stats::unconfirmed)) and costs one byte: scanning
+//! 6. Otherwise it is rejected ([unconfirmed](Stats::unconfirmed)) and costs one byte: scanning
 //!    resumes at the byte after its `9B`.
 //!
 //! A `B9` right where an accepted data frame ended is its trailer ([`Stats::trailers`]), taken
 //! as part of it: a data frame is accepted on its 19th byte without waiting for the next byte
 //! (in fast mode, the next frame's first, 40 ms later).
-//!
-//! An info frame alone does not start a chain: in slow mode every info frame has a data frame
-//! beside it, and on bytes rich in `9B` and `B9` an info frame's four fixed bytes alone
-//! would come by chance (about one in 30 000 positions when a quarter of the bytes are `9B` or
-//! `B9`).
 //!
 //! Everything the rule reads of the past (the chain's end and expected counter, the adopted
 //! full scale) lives in the [`Stats`], which the streaming layer hands to the scanner with
@@ -147,12 +147,10 @@ fn judge(c: &[u8], at: u64, stats: &Stats) -> Verdict {
     let first = match found_at(c, 0, full_scale) {
         Found::Undecided => return Verdict::Undecided,
         Found::Nothing => return Verdict::Implausible,
+        // Chained or not, an info frame needs a plausible data frame right after it.
         Found::Info(info) => {
-            if stats.chained(at) {
-                return Verdict::Info(info, false);
-            }
             return match found_at(c, INFO_FRAME_LEN, full_scale) {
-                Found::Data(_) => Verdict::Info(info, true),
+                Found::Data(_) => Verdict::Info(info, !stats.chained(at)),
                 Found::Undecided => Verdict::Undecided,
                 Found::Info(_) | Found::Nothing => Verdict::Unconfirmed,
             };
@@ -465,20 +463,28 @@ mod tests {
         let mut it = frames(&w[..32]);
         assert_eq!(it.by_ref().count(), 2);
         assert_eq!(it.stats().syncs(), 1);
-        // Alone, or followed by noise: not accepted.
+        // Alone, or followed by noise: not accepted, even chained to a data frame.
         let mut it = frames(&w[..13]);
         assert_eq!(it.by_ref().count(), 0);
+        let mut chained = [0u8; 33];
+        chained[..20].copy_from_slice(&data(7).encode_with_trailer());
+        chained[20..].copy_from_slice(&INFO.encode());
+        let mut it = frames(&chained);
+        assert_eq!(it.by_ref().count(), 1); // the data frame, confirmed by the info frame
+        assert_eq!(it.stats().info_frames(), 0);
         w[13] = 0;
         let mut it = frames(&w[..32]);
         assert_eq!(it.by_ref().count(), 0);
         assert_eq!(it.stats().unconfirmed(), 1);
-        // A data frame followed by an info frame starts a chain too.
-        let mut w = [0u8; 33];
+        // A data frame, an info frame and a data frame: all three.
+        let mut w = [0u8; 52];
         w[..20].copy_from_slice(&data(7).encode_with_trailer());
-        w[20..].copy_from_slice(&INFO.encode());
+        w[20..33].copy_from_slice(&INFO.encode());
+        w[33..].copy_from_slice(&data(8).encode());
         let mut it = frames(&w);
-        assert_eq!(it.by_ref().count(), 2);
-        assert_eq!(it.stats().trailers(), 1);
+        assert_eq!(it.by_ref().count(), 3);
+        let s = it.stats();
+        assert_eq!((s.trailers(), s.syncs(), s.bytes_skipped()), (1, 1, 0));
     }
 
     #[test]

@@ -28,8 +28,10 @@
 //! With no checksum, frames are recognised by plausibility (throttle and PWM at most full scale,
 //! ADC fields below 4096, an info frame's fixed bytes and non-zero divisors), by chaining (the
 //! next `9B` exactly where the previous frame ended) and by the counter going up by one. The
-//! decoder locks onto a stream after three chained data frames, or an info frame chained with a
-//! data frame; it then accepts each frame that continues the chain. Anything else (garbage, a
+//! decoder locks onto a stream after three chained data frames, or a data frame and an info
+//! frame chained either way round; it then accepts each data frame that continues the chain.
+//! An info frame is accepted only with a plausible data frame right after it (so the last info
+//! frame of a stream that ends with it is dropped). Anything else (garbage, a
 //! cut or corrupted frame, a counter that jumps because frames were lost or the ESC restarted)
 //! must start a new chain, whose first counter's step from the last accepted one is counted.
 //! An info frame's constants are adopted once two identical copies came in a row. The
