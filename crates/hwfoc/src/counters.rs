@@ -286,7 +286,8 @@ impl PacketSequence24 {
         Some(count / (count + f64::from(self.lost)))
     }
 
-    /// As [`PacketSequence::line_silent`]: the next step counts as a loss only up to
+    /// The line was silent for a time in which at most `max_frames` numbers could have been
+    /// sent, as for [`PacketSequence`]: the next step counts as a loss only up to
     /// `max_frames + 1` (at most 2^23); silences before one number add up.
     pub fn line_silent(&mut self, max_frames: u32) {
         let limit = if self.gap_limit == 0 {
