@@ -197,6 +197,129 @@ impl PacketSequence {
     }
 }
 
+/// The largest value of a 24-bit counter (the packet counters of Hobbywing V3 and V4,
+/// [`crate::v3`], [`crate::v4`]); it wraps to 0 after this.
+pub const COUNTER24_MAX: u32 = 0xFF_FFFF;
+
+/// The largest step forward of a 24-bit counter: a larger one (modulo 2^24) is a step backwards.
+const MAX_FORWARD_STEP24: u32 = 0x80_0000;
+
+/// [`PacketSequence`] for a 24-bit counter (the packet counters of Hobbywing V3 and V4): the same
+/// four events by the same rule ([`MAX_PACKET_GAP`], the tighter limit after a silence), with
+/// steps taken modulo 2^24 and a step backwards being one of more than 2^23.
+///
+/// A separate type rather than a wider [`PacketSequence`], so that the HW-FOC and DataLink
+/// statistics keep their sizes. Counters are `u32` and saturate; 24 bytes.
+///
+/// ```
+/// use hwfoc::counters::PacketSequence24;
+///
+/// let mut s = PacketSequence24::new();
+/// for n in [0xFF_FFFE, 0xFF_FFFF, 0, 3, 3, 100_000] {
+///     s.next(n);
+/// }
+/// assert_eq!((s.count(), s.lost(), s.duplicates(), s.restarts()), (6, 2, 1, 1));
+/// assert_eq!(s.last(), Some(100_000));
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+pub struct PacketSequence24 {
+    count: u32,
+    lost: u32,
+    duplicates: u32,
+    restarts: u32,
+    last: u32,
+    /// As [`PacketSequence`]'s: 0 means `MAX_PACKET_GAP + 1`.
+    gap_limit: u32,
+}
+
+impl PacketSequence24 {
+    /// No number seen yet.
+    pub const fn new() -> Self {
+        PacketSequence24 {
+            count: 0,
+            lost: 0,
+            duplicates: 0,
+            restarts: 0,
+            last: 0,
+            gap_limit: 0,
+        }
+    }
+
+    /// Numbers seen.
+    pub const fn count(&self) -> u32 {
+        self.count
+    }
+
+    /// Numbers missing between consecutive numbers: a step of `d = (next - last) mod 2^24`
+    /// counts `d - 1` when `2 <= d <= MAX_PACKET_GAP + 1` (after a silence, the limit it set).
+    pub const fn lost(&self) -> u32 {
+        self.lost
+    }
+
+    /// Numbers equal to the one before.
+    pub const fn duplicates(&self) -> u32 {
+        self.duplicates
+    }
+
+    /// Numbers that start a new sequence: a step backwards (`d > 2^23`) or forwards beyond the
+    /// gap limit.
+    pub const fn restarts(&self) -> u32 {
+        self.restarts
+    }
+
+    /// The last number seen, if any.
+    pub const fn last(&self) -> Option<u32> {
+        if self.count == 0 {
+            None
+        } else {
+            Some(self.last)
+        }
+    }
+
+    /// Fraction of expected numbers that arrived: `count / (count + lost)`, or `None` before
+    /// the first.
+    pub fn delivery_ratio(&self) -> Option<f64> {
+        if self.count == 0 {
+            return None;
+        }
+        let count = f64::from(self.count);
+        Some(count / (count + f64::from(self.lost)))
+    }
+
+    /// The line was silent for a time in which at most `max_frames` numbers could have been
+    /// sent, as for [`PacketSequence`]: the next step counts as a loss only up to
+    /// `max_frames + 1` (at most 2^23); silences before one number add up.
+    pub fn line_silent(&mut self, max_frames: u32) {
+        let limit = if self.gap_limit == 0 {
+            1
+        } else {
+            self.gap_limit
+        };
+        self.gap_limit = limit.saturating_add(max_frames).min(MAX_FORWARD_STEP24);
+    }
+
+    /// Takes the next number (its low 24 bits) and classifies its step from the last one.
+    #[inline]
+    pub fn next(&mut self, number: u32) {
+        let number = number & COUNTER24_MAX;
+        if self.count != 0 {
+            let limit = if self.gap_limit == 0 {
+                u32::from(MAX_PACKET_GAP) + 1
+            } else {
+                self.gap_limit
+            };
+            match number.wrapping_sub(self.last) & COUNTER24_MAX {
+                0 => self.duplicates = self.duplicates.saturating_add(1),
+                step if step <= limit => self.lost = self.lost.saturating_add(step - 1),
+                _ => self.restarts = self.restarts.saturating_add(1),
+            }
+        }
+        self.gap_limit = 0;
+        self.count = self.count.saturating_add(1);
+        self.last = number;
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -222,5 +345,22 @@ mod tests {
     #[test]
     fn a_sequence_fits_in_20_bytes() {
         assert_eq!(size_of::<PacketSequence>(), 20);
+    }
+
+    #[test]
+    fn sequence24_follows_the_16_bit_rule_in_24_bits() {
+        let mut s = PacketSequence24::new();
+        s.next(0xFF_FFFF);
+        s.next(0x1_0000); // 0x10001 steps: beyond the gap limit, a restart
+        s.next(0x1_0000 + 1001); // step 1001: 1000 lost
+        s.next(0x1_0000 + 2003); // step 1002: a restart
+        s.next(5); // backwards: a restart
+        assert_eq!((s.lost(), s.restarts(), s.duplicates()), (1000, 3, 0));
+        s.line_silent(2);
+        s.next(9); // step 4 > 2 + 1 after the silence: a restart
+        s.line_silent(2);
+        s.next(12); // step 3: 2 lost
+        assert_eq!((s.count(), s.lost(), s.restarts()), (7, 1002, 4));
+        assert_eq!(size_of::<PacketSequence24>(), 24);
     }
 }

@@ -13,6 +13,8 @@ pub mod scan;
 pub mod status;
 pub mod telemetry;
 pub mod units;
+pub mod v3;
+pub mod v4;
 pub mod wire;
 
 pub use protocol::Protocol;

@@ -1,0 +1,183 @@
+//! Statistics of one V3 stream, and the state the scanner keeps between frames (where the chain
+//! of accepted frames ends).
+
+use core::fmt;
+
+use crate::counters::{ByteCounts, Bytes, COUNTER24_MAX, PacketSequence24};
+
+use super::frame::{FRAME_LEN, Frame};
+
+/// Counters kept per stream by [`Decoder`](super::Decoder) and [`Frames`](super::Frames), and
+/// where the last accepted frame ended (the scanner's lock). Event counters are `u32` and
+/// saturate; byte counters hold 48 bits, as [`foc::Stats`](crate::foc::Stats)'.
+///
+/// Every byte fed ends up either in an accepted frame or in [`Stats::bytes_skipped`]: after
+/// [`Decoder::flush`](super::Decoder::flush), `bytes == 10 * frames + bytes_skipped`.
+///
+/// Every `9B` the scanner stops at (one that is not inside an accepted frame) is either the
+/// start of an accepted frame, or a rejected candidate ([`Stats::rejected`]: an
+/// [implausible](Stats::implausible) one or an [unconfirmed](Stats::unconfirmed) one), or,
+/// at the very end of the stream, cut off (skipped, not counted).
+///
+/// The counter of accepted frames is followed as [`foc::Stats`](crate::foc::Stats) follows an
+/// ESC's packet numbers, in 24 bits ([`PacketSequence24`]): the step to the first frame of each
+/// new chain tells [lost frames](Stats::lost_frames), a [duplicate](Stats::duplicate_frames) or
+/// a [restart](Stats::restarts).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+pub struct Stats {
+    bytes: ByteCounts,
+    implausible: u32,
+    unconfirmed: u32,
+    syncs: u32,
+    counter: PacketSequence24,
+    /// Stream offset just after the last accepted frame: where a chained frame starts.
+    chain_end: Option<u64>,
+}
+
+impl Stats {
+    /// All counters zero, not locked.
+    pub const fn new() -> Self {
+        Stats {
+            bytes: ByteCounts::new(),
+            implausible: 0,
+            unconfirmed: 0,
+            syncs: 0,
+            counter: PacketSequence24::new(),
+            chain_end: None,
+        }
+    }
+
+    /// Bytes fed to the decoder.
+    pub const fn bytes(&self) -> u64 {
+        self.bytes.get(Bytes::Fed)
+    }
+
+    /// Bytes that were not part of an accepted frame: noise, rejected and cut frames, other
+    /// formats.
+    pub const fn bytes_skipped(&self) -> u64 {
+        self.bytes.get(Bytes::Skipped)
+    }
+
+    /// Frames accepted.
+    pub const fn frames(&self) -> u32 {
+        self.counter.count()
+    }
+
+    /// Rejected candidates: [`Stats::implausible`] + [`Stats::unconfirmed`].
+    pub const fn rejected(&self) -> u32 {
+        self.implausible.saturating_add(self.unconfirmed)
+    }
+
+    /// Candidates whose own fields are impossible (throttle or PWM above 255): noise, corrupted
+    /// frames, other formats.
+    pub const fn implausible(&self) -> u32 {
+        self.implausible
+    }
+
+    /// Plausible candidates that neither continue the chain of accepted frames (right where
+    /// the last one ended, with the next counter) nor start a chain of three: noise, a frame
+    /// whose counter does not follow, frames around a corrupted one.
+    pub const fn unconfirmed(&self) -> u32 {
+        self.unconfirmed
+    }
+
+    /// Frames accepted by a chain of three (the decoder locked, or locked again after a break):
+    /// 1 for a clean stream.
+    pub const fn syncs(&self) -> u32 {
+        self.syncs
+    }
+
+    /// Counter values missing between accepted frames (as
+    /// [`foc::Stats::lost_packets`](crate::foc::Stats::lost_packets), in 24 bits).
+    pub const fn lost_frames(&self) -> u32 {
+        self.counter.lost()
+    }
+
+    /// Accepted frames whose counter equals the previous one's.
+    pub const fn duplicate_frames(&self) -> u32 {
+        self.counter.duplicates()
+    }
+
+    /// Accepted frames whose counter starts a new sequence (the ESC restarted).
+    pub const fn restarts(&self) -> u32 {
+        self.counter.restarts()
+    }
+
+    /// The counter of the last accepted frame, if any.
+    pub const fn last_counter(&self) -> Option<u32> {
+        self.counter.last()
+    }
+
+    /// The counters of the accepted frames, followed step by step.
+    pub const fn counter(&self) -> &PacketSequence24 {
+        &self.counter
+    }
+
+    /// Stream offset just after the last accepted frame, if any: a frame starting there with
+    /// the next counter is accepted on its own.
+    pub const fn chain_end(&self) -> Option<u64> {
+        self.chain_end
+    }
+
+    /// Whether a frame at stream offset `at` with `counter` continues the chain.
+    #[inline(always)]
+    pub(crate) fn continues_chain(&self, at: u64, counter: u32) -> bool {
+        match (self.chain_end, self.counter.last()) {
+            (Some(end), Some(last)) => end == at && counter == (last + 1) & COUNTER24_MAX,
+            _ => false,
+        }
+    }
+
+    #[inline]
+    pub(crate) fn add_bytes(&mut self, n: usize) {
+        self.bytes.add(Bytes::Fed, n);
+    }
+
+    #[inline]
+    pub(crate) fn skip(&mut self, n: usize) {
+        self.bytes.add(Bytes::Skipped, n);
+    }
+
+    #[inline]
+    pub(crate) fn reject_implausible(&mut self) {
+        self.implausible = self.implausible.saturating_add(1);
+    }
+
+    #[inline]
+    pub(crate) fn reject_unconfirmed(&mut self) {
+        self.unconfirmed = self.unconfirmed.saturating_add(1);
+    }
+
+    /// Counts a frame accepted at stream offset `at`; `synced`: by a chain of three.
+    #[inline]
+    pub(crate) fn accept(&mut self, at: u64, frame: &Frame, synced: bool) {
+        if synced {
+            self.syncs = self.syncs.saturating_add(1);
+        }
+        self.counter.next(frame.counter);
+        self.chain_end = Some(at + FRAME_LEN as u64);
+    }
+
+    pub(crate) fn line_silent(&mut self, max_frames: u32) {
+        self.counter.line_silent(max_frames);
+    }
+}
+
+impl fmt::Display for Stats {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(
+            f,
+            "{} bytes, {} frames, {} bytes skipped, {} implausible and {} unconfirmed candidates, \
+             {} syncs, {} lost frames, {} duplicate frames, {} restarts",
+            self.bytes(),
+            self.frames(),
+            self.bytes_skipped(),
+            self.implausible,
+            self.unconfirmed,
+            self.syncs,
+            self.lost_frames(),
+            self.duplicate_frames(),
+            self.restarts(),
+        )
+    }
+}

@@ -1,0 +1,104 @@
+//! What the tests of the V3 and V4 decoders share: the logic-analyser CSV loader (as in
+//! `captures.rs`), the decoding paths for any scanner of `hwfoc::scan`, and a seeded random
+//! byte source.
+
+use hwfoc::scan::{Scan, Scanner, StreamDecoder};
+
+const CAPTURES: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../testdata/captures/");
+/// The Platinum Pro V3 capture: 699 V3 frames.
+pub const PLATINUM_PRO_V3: &str = "platinum-pro-v3.csv";
+/// The Platinum V4 capture: 297 data frames and 26 info frames.
+pub const PLATINUM_V4: &str = "platinum-v4.csv";
+/// The XRotor capture: HW-FOC.
+pub const XROTOR: &str = "xrotor-v4-pro-hv-80A.csv";
+
+/// The bytes of a logic-analyser CSV export: header `Time [s],Value,Parity Error,Framing Error`,
+/// then one row per byte with the value written `0xNN`.
+pub fn load(name: &str) -> Vec<u8> {
+    let path = format!("{CAPTURES}{name}");
+    let text = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{path}: {e}"));
+    let mut lines = text.lines();
+    assert_eq!(
+        lines.next(),
+        Some("Time [s],Value,Parity Error,Framing Error"),
+        "{name}: header"
+    );
+    let mut bytes = Vec::new();
+    for (i, line) in lines.enumerate() {
+        if line.is_empty() {
+            continue;
+        }
+        let cols: Vec<&str> = line.split(',').collect();
+        assert_eq!(cols.len(), 4, "{name} row {i}: {line:?}");
+        let hex = cols[1]
+            .strip_prefix("0x")
+            .unwrap_or_else(|| panic!("{name} row {i}: value {:?}", cols[1]));
+        let byte = u8::from_str_radix(hex, 16)
+            .unwrap_or_else(|e| panic!("{name} row {i}: value {:?}: {e}", cols[1]));
+        bytes.push(byte);
+    }
+    bytes
+}
+
+/// The bulk path: every frame of `bytes` and the statistics.
+pub fn bulk<S: Scanner>(bytes: &[u8]) -> (Vec<S::Item>, S::Stats) {
+    let mut it = Scan::<S>::new(bytes);
+    let out: Vec<S::Item> = it.by_ref().collect();
+    (out, it.stats().clone())
+}
+
+/// `bytes` fed in the chunks between consecutive `cuts` (which start at 0 and end at
+/// `bytes.len()`), then flushed; checks that fewer than `MAX_LEN` bytes are ever held.
+pub fn streamed_at<S: Scanner>(bytes: &[u8], cuts: &[usize]) -> (Vec<S::Item>, S::Stats) {
+    let mut d = StreamDecoder::<S>::new();
+    let mut out = Vec::new();
+    for w in cuts.windows(2) {
+        d.feed(&bytes[w[0]..w[1]], |x| out.push(x));
+        assert!(d.buffered() < S::MAX_LEN);
+    }
+    d.flush(|x| out.push(x));
+    assert_eq!(d.buffered(), 0);
+    (out, d.stats().clone())
+}
+
+/// `bytes` fed in chunks of `size`, then flushed.
+pub fn streamed_chunks<S: Scanner>(bytes: &[u8], size: usize) -> (Vec<S::Item>, S::Stats) {
+    let mut cuts: Vec<usize> = (0..bytes.len()).step_by(size).collect();
+    cuts.push(bytes.len());
+    streamed_at::<S>(bytes, &cuts)
+}
+
+/// A seeded xorshift64 generator: the same bytes on every run.
+pub struct Rng(pub u64);
+
+impl Rng {
+    /// The next 64 random bits.
+    pub fn next(&mut self) -> u64 {
+        self.0 ^= self.0 << 13;
+        self.0 ^= self.0 >> 7;
+        self.0 ^= self.0 << 17;
+        self.0
+    }
+
+    /// `n` uniformly random bytes.
+    pub fn uniform(&mut self, n: usize) -> Vec<u8> {
+        (0..n).map(|_| self.next() as u8).collect()
+    }
+
+    /// `n` random bytes of which about a quarter are `9B` and a quarter `B9`.
+    pub fn rich(&mut self, n: usize) -> Vec<u8> {
+        (0..n)
+            .map(|_| {
+                let x = self.next();
+                match x >> 62 {
+                    0 => 0x9B,
+                    1 => 0xB9,
+                    _ => x as u8,
+                }
+            })
+            .collect()
+    }
+}
+
+/// Two million random bytes, uniform or rich in `9B` and `B9`.
+pub const RANDOM_LEN: usize = 2_000_000;
