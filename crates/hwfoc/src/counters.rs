@@ -75,6 +75,15 @@ impl ByteCounts {
         self.low[which as usize] = sum as u32;
         self.high[which as usize] = (sum >> 32) as u16;
     }
+
+    /// Adds the counts of the bytes that came after these (see [`PacketSequence::then`]).
+    pub(crate) fn then(&mut self, later: &ByteCounts) {
+        for which in [Bytes::Fed, Bytes::Skipped] {
+            let sum = self.get(which).wrapping_add(later.get(which));
+            self.low[which as usize] = sum as u32;
+            self.high[which as usize] = (sum >> 32) as u16;
+        }
+    }
 }
 
 /// The numbers of one counter (an ESC's packet numbers, a DataLink hub's frame counter),
@@ -165,6 +174,24 @@ impl PacketSequence {
         };
         let limit = limit.saturating_add(max_frames);
         self.gap_limit = limit.min(u32::from(MAX_FORWARD_STEP)) as u16;
+    }
+
+    /// This sequence followed by `later`, which followed the numbers that came right after this
+    /// one's, from its first number `first` on: afterwards this is the sequence one follower of
+    /// every number would have kept. The step from this sequence's last number to `first` is
+    /// sorted by the usual rule (`later` began with no silence of the line before `first`); the
+    /// steps after it are `later`'s. Nothing changes when `later` has no number.
+    pub fn then(&mut self, first: u16, later: &PacketSequence) {
+        if later.count == 0 {
+            return;
+        }
+        self.next(first);
+        self.count = self.count.saturating_add(later.count - 1);
+        self.lost = self.lost.saturating_add(later.lost);
+        self.duplicates = self.duplicates.saturating_add(later.duplicates);
+        self.restarts = self.restarts.saturating_add(later.restarts);
+        self.last = later.last;
+        self.gap_limit = later.gap_limit;
     }
 
     /// Takes the next number and classifies its step from the last one.
@@ -340,6 +367,29 @@ mod tests {
         c.add(Bytes::Fed, (1 << 48) - 0x1235_5678_9ABD + 5);
         assert_eq!(c.get(Bytes::Fed), 5);
         assert_eq!(c.get(Bytes::Skipped), 0x1_0000_0001);
+    }
+
+    /// A sequence split anywhere and joined with [`PacketSequence::then`] is the sequence of
+    /// the whole: every kind of step at the seam (next, gap, duplicate, restart) and inside
+    /// either part, and a part with no number.
+    #[test]
+    fn a_sequence_split_and_joined_is_the_whole() {
+        let numbers = [7u16, 8, 10, 10, 11, 3, 4, 4, 900, 65535, 0, 1, 5];
+        let mut whole = PacketSequence::new();
+        for &n in &numbers {
+            whole.next(n);
+        }
+        assert_eq!(
+            (whole.lost(), whole.duplicates(), whole.restarts()),
+            (899, 2, 2)
+        );
+        for seam in 0..=numbers.len() {
+            let (mut first, mut later) = (PacketSequence::new(), PacketSequence::new());
+            numbers[..seam].iter().for_each(|&n| first.next(n));
+            numbers[seam..].iter().for_each(|&n| later.next(n));
+            first.then(numbers.get(seam).copied().unwrap_or(0), &later);
+            assert_eq!(first, whole, "seam before number {seam}");
+        }
     }
 
     #[test]

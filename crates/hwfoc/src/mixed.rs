@@ -112,6 +112,17 @@ impl scan::Stats for Stats {
         self.hub
             .line_silent(u32::try_from(hub_frames).unwrap_or(u32::MAX));
     }
+
+    /// Joined when `later` found no hub frame: both protocols' statistics, each the sum of the
+    /// two parts (the bytes in a frame of either are skipped bytes of neither).
+    fn then(&mut self, later: &Self, first_packet: Option<u16>) -> bool {
+        let mut joined = *self;
+        if joined.esc.then(&later.esc, first_packet) && joined.hub.then(&later.hub) {
+            *self = joined;
+            return true;
+        }
+        false
+    }
 }
 
 /// Whether `b` is a DataLink length byte.

@@ -78,6 +78,16 @@ pub trait Stats: sealed::Sealed + Clone + fmt::Debug {
     /// sent (see [`StreamDecoder::line_silent`]).
     #[doc(hidden)]
     fn line_silent(&mut self, max_frames: u32);
+
+    /// These statistics followed by `later`'s ([`StreamDecoder::then`]): true when joined.
+    /// False (the default, and nothing changes) for a scanner that keeps state beyond its held
+    /// bytes (a chain of frames, a counter it expects), whose later frames depend on the
+    /// earlier ones.
+    #[doc(hidden)]
+    fn then(&mut self, later: &Self, first_packet: Option<u16>) -> bool {
+        let _ = (later, first_packet);
+        false
+    }
 }
 
 /// What a protocol's candidate (where its search for a header stopped) comes to, counted in
@@ -249,6 +259,56 @@ impl<S: Scanner> StreamDecoder<S> {
     pub fn line_silent(&mut self, max_frames: u32, on_frame: impl FnMut(S::Item)) {
         self.flush(on_frame);
         self.stats.line_silent(max_frames);
+    }
+
+    /// Continues this decoder with the work of `later`, a decoder started new at the stream
+    /// offset where this one has been fed to, and fed the rest of the stream: for a stream read
+    /// in two parts at once. Where this decoder holds nothing ([`StreamDecoder::buffered`] is
+    /// 0), no byte before that offset waits for a later one, so the frames `later` found are
+    /// exactly those this decoder would have found in the same bytes; its statistics become
+    /// those of the whole stream, and it holds what `later` holds. `first_packet` is the packet
+    /// number of `later`'s first data frame, whose step from this decoder's last one is
+    /// counted as usual.
+    ///
+    /// False, and nothing changes, when this decoder holds bytes (the two parts must be read
+    /// as one), when `later` counted data frames but `first_packet` is `None`, or when the
+    /// protocol's decoding depends on more than the held bytes (V3, V4: chains of frames) or
+    /// `later` found frames whose counters' first numbers are not known here (DataLink hub
+    /// frames).
+    ///
+    /// ```
+    /// use hwfoc::foc::{self, DataFrame};
+    ///
+    /// let frame = |packet| DataFrame { packet, ..Default::default() }.encode();
+    /// let mut stream = Vec::new();
+    /// for packet in [5, 6, 8, 9, 10] {
+    ///     stream.extend_from_slice(&frame(packet));
+    /// }
+    /// let seam = 3 * 24; // where the frame of packet 9 starts
+    /// let mut whole = foc::Decoder::new();
+    /// whole.decode_all(&stream, |_| {});
+    /// let (mut first, mut later) = (foc::Decoder::new(), foc::Decoder::new());
+    /// first.feed(&stream[..seam], |_| {});
+    /// later.decode_all(&stream[seam..], |_| {});
+    /// assert!(first.then(&later, Some(9)));
+    /// assert_eq!(first.stats(), whole.stats());
+    /// assert_eq!(first.stats().lost_packets(), 1);
+    /// ```
+    pub fn then(&mut self, later: &StreamDecoder<S>, first_packet: Option<u16>) -> bool {
+        if self.len != 0 {
+            return false;
+        }
+        let mut stats = self.stats.clone();
+        if !stats.then(&later.stats, first_packet) {
+            return false;
+        }
+        *self = StreamDecoder {
+            buf: later.buf.clone(),
+            len: later.len,
+            stats,
+            scanner: PhantomData,
+        };
+        true
     }
 
     /// Feeds a whole stream and flushes it: the bulk path for a buffer in memory.

@@ -175,6 +175,11 @@ impl scan::Stats for Stats {
     fn line_silent(&mut self, max_frames: u32) {
         Stats::line_silent(self, max_frames);
     }
+
+    /// Joined when `later` found no hub frame (`first_packet` is an ESC's, not the hub's).
+    fn then(&mut self, later: &Self, _: Option<u16>) -> bool {
+        Stats::then(self, later)
+    }
 }
 
 impl scan::Scanner for Scanner {

@@ -163,6 +163,20 @@ impl Stats {
         self.bytes.add(Bytes::Skipped, n);
     }
 
+    /// These statistics followed by `later`'s (see [`crate::foc::Stats`]'s `then`), when
+    /// `later` found no hub frame: its bytes, skipped bytes, CRC failures and bad headers are
+    /// added. False, and nothing changes, when it found one (its counters' first numbers are
+    /// not known here).
+    pub(crate) fn then(&mut self, later: &Stats) -> bool {
+        if later.counter.count() > 0 {
+            return false;
+        }
+        self.bytes.then(&later.bytes);
+        self.crc_failures = self.crc_failures.saturating_add(later.crc_failures);
+        self.bad_headers = self.bad_headers.saturating_add(later.bad_headers);
+        true
+    }
+
     #[inline]
     pub(crate) fn crc_failure(&mut self) {
         self.crc_failures = self.crc_failures.saturating_add(1);

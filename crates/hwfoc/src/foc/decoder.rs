@@ -191,6 +191,10 @@ impl scan::Stats for Stats {
     fn line_silent(&mut self, max_frames: u32) {
         Stats::line_silent(self, max_frames);
     }
+
+    fn then(&mut self, later: &Self, first_packet: Option<u16>) -> bool {
+        Stats::then(self, later, first_packet)
+    }
 }
 
 impl scan::Scanner for Scanner {

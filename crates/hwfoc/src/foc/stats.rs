@@ -127,6 +127,25 @@ impl Stats {
         self.bytes.add(Bytes::Skipped, n);
     }
 
+    /// These statistics followed by `later`'s: those of a decoder started new where this
+    /// one's stream stopped with nothing held ([`StreamDecoder::then`](crate::StreamDecoder::then)),
+    /// whose first data frame's packet number is `first_packet`. False, and nothing changes,
+    /// when `later` counted data frames but `first_packet` is `None`.
+    pub(crate) fn then(&mut self, later: &Stats, first_packet: Option<u16>) -> bool {
+        let first = match first_packet {
+            Some(first) => first,
+            None if later.packets.count() == 0 => 0,
+            None => return false,
+        };
+        self.bytes.then(&later.bytes);
+        self.info_frames = self.info_frames.saturating_add(later.info_frames);
+        self.checksum_failures = self
+            .checksum_failures
+            .saturating_add(later.checksum_failures);
+        self.packets.then(first, &later.packets);
+        true
+    }
+
     #[inline]
     pub(crate) fn checksum_failure(&mut self) {
         self.checksum_failures = self.checksum_failures.saturating_add(1);
