@@ -9,6 +9,8 @@
 //! [`hwfoc::Telemetry`], to convert a block at a time on their own threads or to keep raw
 //! integers for exact means; none of them names a protocol's frame type.
 
+use std::any::Any;
+
 use hwfoc::Settings;
 use hwfoc::telemetry::{Data, Frame, Info};
 
@@ -71,6 +73,36 @@ pub trait Handler {
         let _ = live;
         Ok(())
     }
+
+    /// A part of this handler with nothing taken yet, to take on a thread of its own the frames
+    /// of the later half of a large raw file while this handler takes those of the earlier
+    /// half ([`crate::Sources`] reads such a file in two halves at once, the two decoders
+    /// joined where they meet); [`Handler::join`] takes back what it gathered. `None`, the
+    /// default, for a handler that must take every frame itself, in order (every writer: its
+    /// output is in the frames' order).
+    fn fork(&self) -> Option<Box<dyn LaterPart>> {
+        None
+    }
+
+    /// Takes what `later`, a part made by [`Handler::fork`] (as [`LaterPart::into_any`] gives
+    /// it), gathered of the frames that came right after every frame this handler has taken:
+    /// afterwards the handler is as if it had taken them all itself, in order.
+    fn join(&mut self, later: Box<dyn Any + Send>) {
+        let _ = later;
+    }
+}
+
+/// What a [`Handler`] forks ([`Handler::fork`]): it takes the frames of the later half of a raw
+/// input (which have no receive times) on a thread of its own.
+pub trait LaterPart: Send {
+    /// A frame of ESC `esc`, as [`Handler::frame`] takes it (no receive time).
+    fn frame(&mut self, esc: u8, frame: &Frame, settings: &Settings);
+
+    /// Data frames of ESC `esc`, as [`Handler::untimed_data`] takes them.
+    fn untimed_data(&mut self, esc: u8, frames: &[Data], settings: &Settings);
+
+    /// The part, for its handler's [`Handler::join`].
+    fn into_any(self: Box<Self>) -> Box<dyn Any + Send>;
 }
 
 /// No handler: the frames are decoded (for their link statistics) and dropped.

@@ -400,6 +400,42 @@ impl Stream {
         }
     }
 
+    /// Decodes bytes without receive times; `on_frame(offset, channel, frame)` gets each ESC
+    /// frame with the stream offset of its first byte and its DataLink channel (`None` on an
+    /// ESC's own wire).
+    pub(crate) fn feed_untimed(
+        &mut self,
+        bytes: &[u8],
+        on_frame: impl FnMut(Option<u8>, u64, &Frame),
+    ) {
+        self.history.clear();
+        self.wire.feed(bytes, None, on_frame);
+    }
+
+    /// Bytes held for a frame still arriving: none when no byte fed so far waits for a later
+    /// one to be decided.
+    pub(crate) fn buffered(&self) -> usize {
+        self.wire.buffered()
+    }
+
+    /// Continues this stream with `later`'s work ([`hwfoc::StreamDecoder::then`]): `later`, a
+    /// stream of the same protocols started new where this one has been fed to, was fed the
+    /// rest of the stream's bytes, both without receive times; `first_packet` is the packet
+    /// number of its first data frame. Its statistics become those of the whole stream. False,
+    /// and nothing changes, when this stream holds bytes, either has times, or the decoders
+    /// cannot be joined.
+    pub(crate) fn then(&mut self, later: &Stream, first_packet: Option<u16>) -> bool {
+        if !self.history.is_empty() || !later.history.is_empty() {
+            return false;
+        }
+        match (&mut self.wire, &later.wire) {
+            (Wire::Any(a), Wire::Any(b)) => a.then(b, first_packet),
+            (Wire::HwFoc(a), Wire::HwFoc(b)) => a.then(b, first_packet),
+            (Wire::DataLink(a), Wire::DataLink(b)) => a.then(b, first_packet),
+            _ => false,
+        }
+    }
+
     /// Ends the stream: a frame cut off at the end is dropped, frames inside it are still found.
     pub fn finish(&mut self, mut on_frame: impl FnMut(Option<f64>, Option<u8>, &Frame)) {
         let end = self.wire.bytes();

@@ -48,7 +48,7 @@ use crate::time::Clock;
 /// How many bytes a raw read asks for: small enough that what the kernel copies in is still in
 /// the L2 cache when the decoder reads it (1 MiB reads made `summary` 1.6x slower), large enough
 /// that system calls cost nothing. Also the read buffer of a CSV input.
-const BATCH: usize = 64 << 10;
+pub(crate) const BATCH: usize = 64 << 10;
 /// The magic numbers of a classic libpcap file, as its first four bytes: microsecond and
 /// nanosecond timestamps, either byte order.
 const CLASSIC_PCAP: [[u8; 4]; 4] = [
@@ -157,6 +157,12 @@ trait Source {
 
     /// What the first bytes look like when they are not telemetry (raw bytes only).
     fn looks(&self) -> Option<Looks>;
+
+    /// A second handle on the regular file being read, for positional reads of a later part
+    /// ([`Input::later_half`]): raw bytes only.
+    fn file(&self) -> Option<&File> {
+        None
+    }
 }
 
 /// What a closed file's [`Source`] knew, asked for after its end.
@@ -341,11 +347,7 @@ impl Input {
     /// own (see `ahead.rs`) when `ahead`.
     fn from_file(name: &str, mut file: File, ahead: bool) -> Result<Input, InputError> {
         let head = read_head(name, &mut file)?;
-        let opened = if ahead {
-            Opened::File(file)
-        } else {
-            Opened::Reader(Box::new(file))
-        };
+        let opened = Opened::File { file, ahead };
         Input::with_head(name, head, opened)
     }
 
@@ -356,6 +358,23 @@ impl Input {
     /// ([`crate::Handler::TAKES_RUNS`]). Other inputs ignore it.
     pub fn read_ahead(&mut self, ahead: bool) {
         self.ahead = ahead;
+    }
+
+    /// The length of a raw input that is a regular file, as it is now (before it is read).
+    pub(crate) fn raw_file_len(&self) -> Option<u64> {
+        let path = self
+            .path
+            .as_ref()
+            .filter(|_| self.format == InputFormat::RAW)?;
+        std::fs::metadata(path).ok().map(|meta| meta.len())
+    }
+
+    /// A raw input that is a regular file, being read: a second handle on it, for positional
+    /// reads of a later part, and its length now.
+    pub(crate) fn later_half(&self) -> Option<(File, u64)> {
+        let file = self.source.as_ref()?.file()?;
+        let len = file.metadata().ok()?.len();
+        Some((file.try_clone().ok()?, len))
     }
 
     /// The input whose first bytes, `head`, were read of `opened`.
@@ -372,7 +391,8 @@ impl Input {
             let reader = BufReader::with_capacity(BATCH, opened.reader());
             Box::new(CsvRows::open(name, reader, head)?)
         } else {
-            Box::new(RawReader::new(opened.raw(), head))
+            let (reader, file) = opened.raw();
+            Box::new(RawReader::new(reader, file, head))
         };
         Ok(Input::new(name, source))
     }
@@ -626,25 +646,34 @@ fn read_head(name: &str, reader: &mut dyn Read) -> Result<Vec<u8>, InputError> {
 enum Opened {
     /// Any reader.
     Reader(Box<dyn Read>),
-    /// A regular file: raw bytes of it are read ahead.
-    File(File),
+    /// A regular file: raw bytes of it are read ahead when `ahead`.
+    File { file: File, ahead: bool },
 }
 
 impl Opened {
     fn reader(self) -> Box<dyn Read> {
         match self {
             Opened::Reader(reader) => reader,
-            Opened::File(file) => Box::new(file),
+            Opened::File { file, .. } => Box::new(file),
         }
     }
 
-    fn raw(self) -> raw::Reader {
+    /// The reader of raw bytes, and a second handle on a regular file (for positional reads
+    /// of a later part: [`Input::later_half`]).
+    fn raw(self) -> (raw::Reader, Option<File>) {
         match self {
-            Opened::Reader(reader) => raw::Reader::Plain(reader),
-            Opened::File(file) => match ahead::ReadAhead::start(file) {
-                Ok(ahead) => raw::Reader::Ahead(ahead),
-                Err(file) => raw::Reader::Plain(Box::new(file)),
-            },
+            Opened::Reader(reader) => (raw::Reader::Plain(reader), None),
+            Opened::File { file, ahead } => {
+                let second = file.try_clone().ok();
+                let reader = match ahead {
+                    true => match ahead::ReadAhead::start(file) {
+                        Ok(ahead) => raw::Reader::Ahead(ahead),
+                        Err(file) => raw::Reader::Plain(Box::new(file)),
+                    },
+                    false => raw::Reader::Plain(Box::new(file)),
+                };
+                (reader, second)
+            }
         }
     }
 }

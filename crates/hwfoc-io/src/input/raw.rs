@@ -1,5 +1,6 @@
 //! Raw bytes as they came off the wire: no timing, one stream.
 
+use std::fs::File;
 use std::io::Read;
 
 use super::ahead::ReadAhead;
@@ -34,15 +35,19 @@ pub(super) struct RawReader {
     /// The first bytes (up to [`looks::SAMPLE`]), to say what they look like if they hold no
     /// frame.
     sample: Vec<u8>,
+    /// A second handle on a regular file read, for positional reads of a later part.
+    file: Option<File>,
 }
 
 impl RawReader {
-    /// Reads `reader`, after `head`, the bytes format detection read of it.
-    pub(super) fn new(reader: Reader, head: Vec<u8>) -> RawReader {
+    /// Reads `reader` (a regular file when `file`, a second handle on it, is given), after
+    /// `head`, the bytes format detection read of it.
+    pub(super) fn new(reader: Reader, file: Option<File>, head: Vec<u8>) -> RawReader {
         RawReader {
             reader,
             pending: head,
             sample: Vec::new(),
+            file,
         }
     }
 }
@@ -105,5 +110,9 @@ impl Source for RawReader {
 
     fn looks(&self) -> Option<Looks> {
         Looks::of(&self.sample)
+    }
+
+    fn file(&self) -> Option<&File> {
+        self.file.as_ref()
     }
 }

@@ -30,6 +30,7 @@
 
 mod merge;
 mod numbering;
+mod split;
 #[cfg(test)]
 pub(crate) mod tests;
 
@@ -41,40 +42,25 @@ use hwfoc::telemetry::{Data, Frame};
 use hwfoc::{Protocol, Settings};
 
 pub use crate::handler::Handler;
-use crate::input::{Input, InputError, InputFormat};
+use crate::handler::LaterPart;
+use crate::input::{Batch, Input, InputError, InputFormat};
 use crate::settings::SettingsMap;
 use crate::stream::{EscLink, Stream};
 use crate::time::Clock;
 
 pub use self::merge::MAX_QUEUED;
 use self::merge::Queue;
-use self::numbering::{Deliver, Hub, route};
+use self::numbering::{Deliver, Hub, Pending, route};
+use self::split::{Later, SPLIT_MIN};
 
 /// Data frames without times held at most before they are handed on together (18 bytes each
 /// for HW-FOC: within the L1 cache).
 const HELD: usize = 512;
 
-/// Data frames without times, held to be handed on together (a `Vec`'s length and capacity
-/// checks cost a fifth of the decoder's loop).
+/// Data frames without times, held to be handed on together ([`feed_runs`]; a `Vec`'s length and
+/// capacity checks cost a fifth of the decoder's loop).
 struct Held {
     frames: [Data; HELD],
-    len: usize,
-}
-
-impl Held {
-    /// Adds a frame; there must be room (`len < HELD`).
-    #[inline(always)]
-    fn push(&mut self, frame: Data) {
-        if let Some(slot) = self.frames.get_mut(self.len) {
-            *slot = frame;
-            self.len += 1;
-        }
-    }
-
-    /// The frames held.
-    fn frames(&self) -> &[Data] {
-        &self.frames[..self.len.min(HELD)]
-    }
 }
 
 /// Batches shorter than this come from a live source: what they produce is passed on at once.
@@ -139,6 +125,11 @@ pub struct Sources {
     forced: Option<Protocol>,
     /// Data frames without times not handed on yet (see [`HELD`]).
     held: Box<Held>,
+    /// The smallest raw file read in two halves at once (`split.rs`).
+    split_min: u64,
+    /// Raw files read in two halves at once whose halves were joined (for the tests).
+    #[cfg(test)]
+    joined: u32,
 }
 
 impl Sources {
@@ -160,9 +151,11 @@ impl Sources {
             readers: Vec::new(),
             fed: Vec::new(),
             forced: None,
+            split_min: SPLIT_MIN,
+            #[cfg(test)]
+            joined: 0,
             held: Box::new(Held {
                 frames: [Data::from(DataFrame::default()); HELD],
-                len: 0,
             }),
         }
     }
@@ -273,6 +266,19 @@ impl Sources {
         (0..self.escs.len()).any(|esc| self.link(esc).frames() > 0)
     }
 
+    /// How many raw files were read in two halves at once, their halves joined (`split.rs`).
+    #[cfg(test)]
+    pub(crate) fn joined_halves(&self) -> u32 {
+        self.joined
+    }
+
+    /// Reads raw files of at least `bytes` bytes in two halves at once, for a handler that can
+    /// be forked (every such file of 64 MiB and more, by default).
+    #[cfg(test)]
+    pub(crate) fn split_at_least(&mut self, bytes: u64) {
+        self.split_min = bytes;
+    }
+
     /// The most frames that waited at once in the time-order queue (at most [`MAX_QUEUED`]).
     pub fn peak_queued(&self) -> usize {
         self.queue.peak
@@ -366,17 +372,27 @@ impl Sources {
     }
 
     /// Reads an input without times (or a live one) to its end, its frames handed on as they
-    /// are decoded: the path of `summary` on a raw file, kept to the decoder's loop.
+    /// are decoded: the path of `summary` on a raw file, kept to the decoder's loop. A large
+    /// raw file is read in two halves at once for a handler that can be forked
+    /// ([`Handler::fork`], `split.rs`), else read ahead for a handler that takes runs.
     fn read_alone<H: Handler>(
         &mut self,
         mut input: Input,
         handler: &mut H,
     ) -> Result<(), H::Error> {
         let index = self.open(&input);
-        input.read_ahead(H::TAKES_RUNS);
+        let part = input
+            .raw_file_len()
+            .is_some_and(|len| len >= self.split_min)
+            .then(|| handler.fork())
+            .flatten();
+        input.read_ahead(H::TAKES_RUNS && part.is_none());
         let mut escs = self.numbered(index);
         let mut bytes = 0;
-        let result = self.read_input(&mut input, index, &mut escs, &mut bytes, handler);
+        let mut split = Split::Planned(part);
+        let result = self.read_input(
+            &mut input, index, &mut escs, &mut bytes, handler, &mut split,
+        );
         self.number_streams(&input, index, &mut escs);
         // A recorded port's stream may go on in the next recording: it is finished at the
         // end of the run. Other streams end with their input.
@@ -398,6 +414,7 @@ impl Sources {
         escs: &mut Vec<Option<usize>>,
         bytes: &mut u64,
         handler: &mut H,
+        split: &mut Split,
     ) -> Result<(), H::Error> {
         loop {
             let Some(batch) = input.next_batch()? else {
@@ -410,56 +427,186 @@ impl Sources {
                 .into());
             }
             let (stream, len) = (batch.stream, batch.bytes.len());
+            let from = *bytes;
             *bytes += len as u64;
             // The batch borrows the input: its stream's ESC is found first, by a second look.
             let _ = batch;
             let esc = self.esc_of(input, index, stream, escs)?;
+            if let Split::Planned(part) = split {
+                // The file is open once its first batch is read: its later half is read from
+                // now on, by a part of the handler.
+                let later = part
+                    .take()
+                    .zip(input.later_half())
+                    .and_then(|(part, (file, len))| {
+                        let id = u8::try_from(esc).ok()?;
+                        let forced = self.escs[esc].stream.forced_protocol();
+                        Later::start(file, len, forced, part, id, self.esc_settings(esc))
+                    });
+                *split = later.map_or(Split::None, Split::Reading);
+            }
             let Some(batch) = input.current_batch() else {
                 continue;
             };
-            let id = u8::try_from(esc).unwrap_or(u8::MAX);
-            let settings = &self.esc_settings(esc);
-            let hub = self.hubs.get(&esc);
             let mut pending = Vec::new();
-            // For a handler that takes runs, the stream's own data frames without times are
-            // held and handed on together ([`Handler::untimed_data`]), in order with every
-            // other frame: the decoder's loop only copies a frame's fields, the handler's loop
-            // takes them.
-            let held = &mut *self.held;
-            let hand_on = |held: &mut Held, handler: &mut H| {
-                handler.untimed_data(id, held.frames(), settings);
-                held.len = 0;
+            let cut = match split {
+                Split::Reading(later) => later.cut(from, len),
+                _ => None,
             };
-            self.escs[esc].stream.feed(
-                batch,
-                #[inline(always)]
-                |t, channel, d| {
-                    if let (true, None, None, Frame::Data(f)) = (H::TAKES_RUNS, t, channel, d) {
-                        if held.len == HELD {
-                            hand_on(held, handler);
-                        }
-                        held.push(*f);
-                        return;
-                    }
-                    if held.len > 0 {
-                        hand_on(held, handler);
-                    }
-                    match route(esc, hub, t, channel, d, &mut pending) {
-                        Some((_, None)) => handler.frame(id, t, d, settings),
-                        Some((esc, Some(settings))) => {
-                            if let Ok(esc) = u8::try_from(esc) {
-                                handler.frame(esc, t, d, settings);
-                            }
-                        }
-                        None => {}
-                    }
-                },
-            );
-            if held.len > 0 {
-                hand_on(held, handler);
+            let (before, after) = batch.bytes.split_at(cut.unwrap_or(len));
+            let times = batch.times.map(|t| t.split_at(before.len()));
+            let part = |bytes, times| Batch {
+                bytes,
+                times,
+                stream,
+            };
+            self.feed(esc, part(before, times.map(|t| t.0)), &mut pending, handler);
+            if cut.is_some()
+                && let Split::Reading(later) = std::mem::replace(split, Split::None)
+                && let Some(later_bytes) = self.join_later(esc, later, handler)
+            {
+                *bytes = from + before.len() as u64 + later_bytes;
+                self.deliver(esc, pending, &mut Deliver::Handler(handler));
+                return handler.end_batch(false);
+            }
+            if !after.is_empty() {
+                self.feed(esc, part(after, times.map(|t| t.1)), &mut pending, handler);
             }
             self.deliver(esc, pending, &mut Deliver::Handler(handler));
             handler.end_batch(len < LIVE_BATCH)?;
         }
     }
+
+    /// Decodes a batch of ESC `esc`'s stream, its frames to `handler` (or, for hub channels not
+    /// numbered yet, to `pending`).
+    #[inline(always)]
+    fn feed<H: Handler>(
+        &mut self,
+        esc: usize,
+        batch: Batch<'_>,
+        pending: &mut Vec<Pending>,
+        handler: &mut H,
+    ) {
+        let settings = &self.esc_settings(esc);
+        let mut to = ToHandler {
+            handler,
+            own: esc,
+            id: u8::try_from(esc).unwrap_or(u8::MAX),
+            settings,
+            hub: self.hubs.get(&esc),
+            pending,
+        };
+        feed_runs::<H>(&mut self.escs[esc].stream, batch, &mut self.held, &mut to);
+    }
+
+    /// Joins the later half of ESC `esc`'s raw file, read by `later` from where its stream has
+    /// been fed to (`split.rs`): the bytes it read, or `None` (and it is dropped) where it
+    /// cannot be joined: the stream holds bytes there, has carried hub frames, or the later
+    /// half's reader could not go to the end.
+    fn join_later<H: Handler>(&mut self, esc: usize, later: Later, handler: &mut H) -> Option<u64> {
+        let stream = &mut self.escs[esc].stream;
+        if stream.buffered() > 0 || stream.hub().is_some() {
+            return None;
+        }
+        let done = later.finish()?;
+        if !stream.then(&done.stream, done.first_packet) {
+            return None;
+        }
+        handler.join(done.part.into_any());
+        #[cfg(test)]
+        {
+            self.joined += 1;
+        }
+        Some(done.bytes)
+    }
+}
+
+/// Where [`feed_runs`] hands a stream's frames.
+trait Takes {
+    /// Data frames of the stream's own ESC without receive times, one after another.
+    fn run(&mut self, frames: &[Data]);
+    /// Any other frame (with a receive time, of a hub's channel, or device information).
+    fn other(&mut self, t: Option<f64>, channel: Option<u8>, frame: &Frame);
+}
+
+/// Decodes `batch` with `stream`: for a handler that takes runs (`H::TAKES_RUNS`), the
+/// stream's own data frames without times are held in `held` and handed on together
+/// ([`Takes::run`]), in order with every other frame ([`Takes::other`]); the decoder's loop
+/// only copies a frame's fields, the handler's loop takes them. How many are held is a local,
+/// kept in a register: a count stored with the frames was loaded back for every frame.
+#[inline(always)]
+fn feed_runs<H: Handler>(
+    stream: &mut Stream,
+    batch: Batch<'_>,
+    held: &mut Held,
+    to: &mut impl Takes,
+) {
+    let held = &mut held.frames;
+    let mut n = 0;
+    stream.feed(
+        batch,
+        #[inline(always)]
+        |t, channel, d| {
+            if let (true, None, None, Frame::Data(f)) = (H::TAKES_RUNS, t, channel, d) {
+                if n == HELD {
+                    to.run(held);
+                    n = 0;
+                }
+                if let Some(slot) = held.get_mut(n) {
+                    *slot = *f;
+                    n += 1;
+                }
+                return;
+            }
+            if n > 0 {
+                to.run(&held[..n]);
+                n = 0;
+            }
+            to.other(t, channel, d);
+        },
+    );
+    if n > 0 {
+        to.run(&held[..n]);
+    }
+}
+
+/// A handler as [`feed_runs`] hands it frames: those of hub channels routed to their ESCs.
+struct ToHandler<'a, 'h, H> {
+    handler: &'a mut H,
+    /// The stream's ESC, and its number as handlers take it.
+    own: usize,
+    id: u8,
+    settings: &'a Settings,
+    hub: Option<&'h Hub>,
+    pending: &'a mut Vec<Pending>,
+}
+
+impl<H: Handler> Takes for ToHandler<'_, '_, H> {
+    #[inline(always)]
+    fn run(&mut self, frames: &[Data]) {
+        self.handler.untimed_data(self.id, frames, self.settings);
+    }
+
+    #[inline(always)]
+    fn other(&mut self, t: Option<f64>, channel: Option<u8>, d: &Frame) {
+        match route(self.own, self.hub, t, channel, d, self.pending) {
+            Some((_, None)) => self.handler.frame(self.id, t, d, self.settings),
+            Some((esc, Some(settings))) => {
+                if let Ok(esc) = u8::try_from(esc) {
+                    self.handler.frame(esc, t, d, settings);
+                }
+            }
+            None => {}
+        }
+    }
+}
+
+/// Whether and how an input is read in two halves at once (`split.rs`).
+enum Split {
+    /// Not.
+    None,
+    /// Once its file is open, by this part of the handler.
+    Planned(Option<Box<dyn LaterPart>>),
+    /// The later half being read.
+    Reading(Later),
 }

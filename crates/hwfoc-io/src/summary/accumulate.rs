@@ -109,6 +109,16 @@ impl Ranges {
         }
     }
 
+    /// Adds the ranges of the frames that came after these.
+    fn join(&mut self, later: &Ranges) {
+        for lane in 0..LANES {
+            self.min[lane] = self.min[lane].min(later.min[lane]);
+            self.max[lane] = self.max[lane].max(later.max[lane]);
+            self.sum[lane] += later.sum[lane];
+            self.missing[lane] += later.missing[lane];
+        }
+    }
+
     /// The range of the quantity in `lane`, and the number of frames that carried it among
     /// `frames`.
     pub(super) fn get(&self, lane: usize, frames: u64) -> (Range, u64) {
@@ -141,8 +151,8 @@ impl Range {
 pub(super) struct Tally {
     pub(super) frames: u64,
     pub(super) ranges: Ranges,
-    /// The last data frame's raw voltage and current.
-    pub(super) last: (i32, i32),
+    /// The raw voltage and current of the last data frame that carried both.
+    pub(super) last: Option<(i32, i32)>,
     /// Sum and largest of the raw power (voltage times current: for HW-FOC at most 65535 x
     /// 32768 in magnitude, within an `i32`) of every data frame.
     pub(super) power_sum: i64,
@@ -154,7 +164,7 @@ impl Default for Tally {
         Tally {
             frames: 0,
             ranges: Ranges::default(),
-            last: (0, 0),
+            last: None,
             power_sum: 0,
             power_max: i32::MIN,
         }
@@ -170,6 +180,42 @@ impl Tally {
         self.count(f)
     }
 
+    /// Adds the tally of the frames that came after these.
+    fn join(&mut self, later: &Tally) {
+        self.frames += later.frames;
+        self.ranges.join(&later.ranges);
+        self.last = later.last.or(self.last);
+        self.power_sum += later.power_sum;
+        self.power_max = self.power_max.max(later.power_max);
+    }
+
+    /// Adds a run of untimed data frames: what [`Tally::add`] adds for each, in two passes over
+    /// the run (in the L1 cache), each of whose running values are locals, kept in registers and
+    /// stored once (a running value in memory is stored and loaded back every frame).
+    #[inline(always)]
+    fn add_run(&mut self, run: &[Data]) {
+        let powered = |f: &Data| Some((f.raw(Quantity::Voltage)?, f.raw(Quantity::Current)?));
+        let (mut power_sum, mut power_max) = (self.power_sum, self.power_max);
+        for (volts, amps) in run.iter().filter_map(powered) {
+            let power = volts * amps;
+            power_sum += i64::from(power);
+            // A branch rarely taken, not a chain of conditional moves from frame to frame.
+            if power > power_max {
+                power_max = power;
+            }
+        }
+        (self.power_sum, self.power_max) = (power_sum, power_max);
+        if let Some(last) = run.iter().rev().find_map(powered) {
+            self.last = Some(last);
+        }
+        let mut ranges = self.ranges;
+        for f in run {
+            ranges.add(f);
+        }
+        self.ranges = ranges;
+        self.frames += run.len() as u64;
+    }
+
     /// Adds a data frame but for its ranges: its count, and its power when it carries voltage
     /// and current (whether it does).
     #[inline(always)]
@@ -178,7 +224,7 @@ impl Tally {
         let (Some(volts), Some(amps)) = (f.raw(Quantity::Voltage), f.raw(Quantity::Current)) else {
             return false;
         };
-        self.last = (volts, amps);
+        self.last = Some((volts, amps));
         let power = volts * amps;
         self.power_sum += i64::from(power);
         // A branch rarely taken, not a chain of conditional moves from frame to frame.
@@ -335,31 +381,19 @@ impl Accumulator {
     }
 
     /// Adds the data frames without times at the start of `frames` that [`Self::add_clean`]
-    /// would take (no fault), up to the first that it would not: how many. Their tally is kept
-    /// in registers for the run, not loaded and stored back for each frame, and their
-    /// temperature codes counted a run of one code at a time (adding one to the same count frame
-    /// after frame waits for the previous store each time).
+    /// would take (no fault), up to the first that it would not: how many. Their tally is added
+    /// in passes over the run ([`Tally::add_run`]) and their temperature codes counted a run of
+    /// one code at a time (adding one to the same count frame after frame waits for the
+    /// previous store each time).
     #[inline(always)]
     pub(super) fn add_clean_run(&mut self, frames: &[Data]) -> usize {
         debug_assert!(self.fast && self.sample.is_some() && self.episode.is_none());
-        // A pass for each part, each with few enough values to stay in registers (the run is
-        // in the L1 cache): the count and power up to the first frame with a fault, then the
-        // ranges and the temperatures of the frames before it.
-        let mut tally = self.tally;
-        let mut n = 0;
-        for f in frames {
-            if !is_clean(f) {
-                break;
-            }
-            // Without voltage and current, an untimed frame adds no power and no time.
-            tally.count(f);
-            n += 1;
-        }
+        let n = frames
+            .iter()
+            .position(|f| !is_clean(f))
+            .unwrap_or(frames.len());
         let run = &frames[..n];
-        for f in run {
-            tally.ranges.add(f);
-        }
-        self.tally = tally;
+        self.tally.add_run(run);
         self.count_codes(run);
         n
     }
@@ -385,7 +419,7 @@ impl Accumulator {
     /// was for inputs without times (the summary of a large raw file).
     #[inline(never)]
     pub(super) fn timed(&mut self, t: f64, f: &Data) {
-        let (volts, amps) = self.tally.last;
+        let (volts, amps) = self.tally.last.unwrap_or_default();
         self.energy.add(Some(t), f64::from(volts), f64::from(amps));
         self.clock(t, f);
     }
@@ -443,6 +477,74 @@ impl Accumulator {
 }
 
 impl Accumulator {
+    /// Takes what `later` gathered of the frames of the ESC that came right after every frame
+    /// this one took, both without receive times (the two halves of a raw file read at once):
+    /// afterwards this is what one accumulator given every frame in order would hold. Counts,
+    /// ranges and histograms add up; device-information frames keep the order they were first
+    /// seen in; `later`'s frame indices follow this one's; a fault episode open at the end of
+    /// this part goes on into `later`'s first frame when that one has a fault too, and ends
+    /// there otherwise.
+    pub(super) fn join(&mut self, later: Accumulator) {
+        debug_assert!(self.first_t.is_none() && later.first_t.is_none());
+        for (info, n) in later.infos {
+            match self.infos.iter_mut().find(|(i, _)| *i == info) {
+                Some((_, m)) => *m += n,
+                None => self.infos.push((info, n)),
+            }
+        }
+        if later.tally.frames == 0 {
+            return;
+        }
+        let base = self.tally.frames;
+        self.sample = self.sample.or(later.sample);
+        self.tally.join(&later.tally);
+        for (codes, more) in [
+            (&mut self.mos_codes, &later.mos_codes),
+            (&mut self.cap_codes, &later.cap_codes),
+        ] {
+            codes.iter_mut().zip(more).for_each(|(n, m)| *n += m);
+        }
+        self.uncoded[0] += later.uncoded[0];
+        self.uncoded[1] += later.uncoded[1];
+        for (n, m) in self.fault_frames.iter_mut().zip(later.fault_frames) {
+            *n += m;
+        }
+        let rebase = |mut e: Episode| {
+            e.first.frame += base;
+            e.last.frame += base;
+            e
+        };
+        let mut ended: Vec<Episode> = later.episodes.into_iter().map(rebase).collect();
+        let mut open = later.episode.map(rebase);
+        if let Some(before) = self.episode.take() {
+            // `later`'s first episode, if its first frame has a fault: the one open here goes on.
+            let first = match ended.first_mut() {
+                Some(e) => Some(e),
+                None => open.as_mut(),
+            }
+            .filter(|e| e.first.frame == base);
+            match first {
+                Some(e) => {
+                    e.first = before.first;
+                    e.frames += before.frames;
+                    e.bits = Status(e.bits.0 | before.bits.0);
+                }
+                None => {
+                    self.episode_count += 1;
+                    if self.episodes.len() < MAX_EPISODES {
+                        self.episodes.push(before);
+                    }
+                }
+            }
+        }
+        let room = MAX_EPISODES.saturating_sub(self.episodes.len());
+        ended.truncate(room);
+        self.episodes.append(&mut ended);
+        self.episode_count += later.episode_count;
+        self.episode = open;
+        self.fast = self.sample.is_some() && self.episode.is_none();
+    }
+
     /// Charge, energy and power in raw units: integrated frame by frame over receive times,
     /// or for a stream without times (whose frames all lack them) from the lanes' sums.
     pub(super) fn energy(&self) -> Energy {
@@ -452,10 +554,11 @@ impl Accumulator {
         let Tally {
             frames,
             ranges,
-            last: (v, i),
+            last,
             power_sum,
             power_max,
         } = self.tally;
+        let (v, i) = last.unwrap_or_default();
         Energy::untimed(
             frames,
             ranges.sum[CURRENT] as f64,

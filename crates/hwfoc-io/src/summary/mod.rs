@@ -25,6 +25,8 @@
 //! Here: the handler and the report's parts; `accumulate.rs`, what is gathered per frame;
 //! `text.rs` and `json.rs`, the report as text and as JSON.
 
+use std::any::Any;
+
 use hwfoc::telemetry::{Conversion, Data, Frame, Info, Telemetry};
 use hwfoc::units::Linear;
 use hwfoc::{Fault, Protocol, Quantity, Settings, Status};
@@ -34,6 +36,7 @@ use crate::energy::{Energy, NOMINAL_PERIOD_S};
 pub use crate::episode::{Episode, Mark};
 use crate::escape::Escaped;
 use crate::fixed::Fixed;
+use crate::handler::LaterPart;
 use crate::input::InputError;
 use crate::settings::{self, settings_json};
 use crate::sources::{Handler, Sources};
@@ -177,6 +180,42 @@ impl Handler for Summary {
                 i += 1;
             }
         }
+    }
+
+    /// A summary of its own for the later half of a large raw file: what it gathers adds up
+    /// with this one's exactly ([`Summary::join`]).
+    fn fork(&self) -> Option<Box<dyn LaterPart>> {
+        Some(Box::new(Part(Summary::new())))
+    }
+
+    /// Takes what the summary made by [`Summary::fork`] gathered (anything else is ignored).
+    fn join(&mut self, later: Box<dyn Any + Send>) {
+        let Ok(later) = later.downcast::<Part>() else {
+            return;
+        };
+        for (esc, acc) in later.0.0.into_iter().enumerate() {
+            if self.0.len() <= esc {
+                self.0.resize_with(esc + 1, Accumulator::default);
+            }
+            self.0[esc].join(acc);
+        }
+    }
+}
+
+/// The summary of the later half of a raw file ([`Summary::fork`]).
+struct Part(Summary);
+
+impl LaterPart for Part {
+    fn frame(&mut self, esc: u8, frame: &Frame, settings: &Settings) {
+        self.0.frame(esc, None, frame, settings);
+    }
+
+    fn untimed_data(&mut self, esc: u8, frames: &[Data], settings: &Settings) {
+        self.0.untimed_data(esc, frames, settings);
+    }
+
+    fn into_any(self: Box<Self>) -> Box<dyn Any + Send> {
+        self
     }
 }
 
