@@ -5,6 +5,7 @@
 
 pub mod counters;
 pub mod datalink;
+pub mod dronecan;
 pub mod foc;
 pub mod hw5;
 pub mod mixed;
