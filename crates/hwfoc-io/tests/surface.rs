@@ -12,7 +12,7 @@
 use hwfoc_io::{Batch, Input, InputError, InputFormat, Looks, read_small_file};
 
 // Decoding.
-use hwfoc_io::{Both, Esc, EscLink, Handler, InputInfo, MAX_QUEUED, PortStreams};
+use hwfoc_io::{Both, Esc, EscLink, Handler, InputInfo, LaterPart, MAX_QUEUED, PortStreams};
 use hwfoc_io::{SILENCE_S, Sources, Stream, WireKind};
 
 // Settings.
