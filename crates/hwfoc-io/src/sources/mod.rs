@@ -496,7 +496,7 @@ impl Sources {
             hub: self.hubs.get(&esc),
             pending,
         };
-        feed_runs::<H>(&mut self.escs[esc].stream, batch, &mut self.held, &mut to);
+        feed_runs(&mut self.escs[esc].stream, batch, &mut self.held, &mut to);
     }
 
     /// Joins the later half of ESC `esc`'s raw file, read by `later` from where its stream has
@@ -523,31 +523,30 @@ impl Sources {
 
 /// Where [`feed_runs`] hands a stream's frames.
 trait Takes {
+    /// Whether the stream's own data frames without times are handed on in runs
+    /// ([`Takes::run`]), or each as any other frame ([`Takes::other`]).
+    const RUNS: bool;
+
     /// Data frames of the stream's own ESC without receive times, one after another.
     fn run(&mut self, frames: &[Data]);
     /// Any other frame (with a receive time, of a hub's channel, or device information).
     fn other(&mut self, t: Option<f64>, channel: Option<u8>, frame: &Frame);
 }
 
-/// Decodes `batch` with `stream`: for a handler that takes runs (`H::TAKES_RUNS`), the
+/// Decodes `batch` with `stream`: for a handler that takes runs ([`Takes::RUNS`]), the
 /// stream's own data frames without times are held in `held` and handed on together
 /// ([`Takes::run`]), in order with every other frame ([`Takes::other`]); the decoder's loop
 /// only copies a frame's fields, the handler's loop takes them. How many are held is a local,
 /// kept in a register: a count stored with the frames was loaded back for every frame.
 #[inline(always)]
-fn feed_runs<H: Handler>(
-    stream: &mut Stream,
-    batch: Batch<'_>,
-    held: &mut Held,
-    to: &mut impl Takes,
-) {
+fn feed_runs<T: Takes>(stream: &mut Stream, batch: Batch<'_>, held: &mut Held, to: &mut T) {
     let held = &mut held.frames;
     let mut n = 0;
     stream.feed(
         batch,
         #[inline(always)]
         |t, channel, d| {
-            if let (true, None, None, Frame::Data(f)) = (H::TAKES_RUNS, t, channel, d) {
+            if let (true, None, None, Frame::Data(f)) = (T::RUNS, t, channel, d) {
                 if n == HELD {
                     to.run(held);
                     n = 0;
@@ -582,6 +581,8 @@ struct ToHandler<'a, 'h, H> {
 }
 
 impl<H: Handler> Takes for ToHandler<'_, '_, H> {
+    const RUNS: bool = H::TAKES_RUNS;
+
     #[inline(always)]
     fn run(&mut self, frames: &[Data]) {
         self.handler.untimed_data(self.id, frames, self.settings);

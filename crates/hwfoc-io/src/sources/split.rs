@@ -34,7 +34,6 @@ use super::{HELD, Held, Takes, feed_runs};
 use crate::handler::LaterPart;
 use crate::input::{BATCH, Batch};
 use crate::stream::Stream;
-use crate::summary::Summary;
 
 /// The smallest raw file read in two halves: below it, starting a thread is not worth it.
 pub(super) const SPLIT_MIN: u64 = 64 << 20;
@@ -210,8 +209,7 @@ impl Reader {
                 times: None,
                 stream: 0,
             };
-            // The runs are taken as the summary's earlier half takes them.
-            feed_runs::<Summary>(&mut stream, batch, &mut held, &mut to);
+            feed_runs(&mut stream, batch, &mut held, &mut to);
             if to.hub {
                 return None;
             }
@@ -264,6 +262,9 @@ impl ToPart<'_> {
 }
 
 impl Takes for ToPart<'_> {
+    /// As the summary takes them.
+    const RUNS: bool = true;
+
     #[inline(always)]
     fn run(&mut self, frames: &[Data]) {
         if let Some(f) = frames.first() {
