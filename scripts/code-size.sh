@@ -6,7 +6,12 @@
 # raw fields of the last data frame), then with `hwfoc_probe_push_units` as well (feature `units`:
 # voltage, currents and RPM under caller settings, temperatures from the ADC table), then with
 # `hwfoc_probe_datalink_push` alone (feature `datalink` without the default `esc`:
-# datalink::Decoder::push, the counter and a few raw fields of each ESC of the last hub frame).
+# datalink::Decoder::push, the counter and a few raw fields of each ESC of the last hub frame),
+# then each of the newer decoders alone the same way: `hwfoc_probe_v3_push` (feature `v3`),
+# `hwfoc_probe_v4_push` (`v4`), `hwfoc_probe_hw5_push` (`hw5`): Decoder::push and a few raw
+# fields of the last frame; `hwfoc_probe_dronecan_push` (`dronecan`): the DroneCAN receive path,
+# Receiver::push of one CAN frame (reassembly, transfer CRC, decoding of every known type,
+# per-node statistics) and a few fields of a completed ESC message.
 #
 # After LTO the probe's own object in the archive holds exactly the code those entry points reach.
 # Counted, from that object: its .text* sections (entry points, hwfoc code, core's panic stubs;
@@ -88,14 +93,31 @@ echo "hwfoc release code size on $target ($(rustc -V); opt-level \"s\", LTO, pan
 measure "decoder (push + frame fields)"
 measure "decoder + units (conversions, ADC table)" --features units
 measure "DataLink decoder alone (push + frame fields)" --no-default-features --features datalink
+measure "V3 decoder alone (push + frame fields)" --no-default-features --features v3
+measure "V4 decoder alone (push + frame fields)" --no-default-features --features v4
+measure "HW5 decoder alone (push + telemetry fields)" --no-default-features --features hw5
+measure "DroneCAN receiver alone (push a CAN frame + message fields)" \
+    --no-default-features --features dronecan
 
 # The build asserts size_of::<Decoder>() == DECODER_STATE_BYTES for the target, and the same of
-# the DataLink decoder.
+# the DataLink, V3, V4 and HW5 decoders and the DroneCAN receiver.
 state=$(sed -n 's/^pub const DECODER_STATE_BYTES: usize = \([0-9]*\);.*/\1/p' src/lib.rs)
 echo "decoder state: ${state:?} bytes (size_of::<Decoder>(), owned by the caller)"
 dl_state=$(sed -n 's/^pub const DATALINK_DECODER_STATE_BYTES: usize = \([0-9]*\);.*/\1/p' src/lib.rs)
 echo "DataLink decoder state: ${dl_state:?} bytes (size_of::<datalink::Decoder>(), owned by the caller)"
+state_of() { # state_of CONST: the value of `pub const CONST: usize = N;` in the probe
+    sed -n "s/^pub const $1: usize = \([0-9]*\);.*/\1/p" src/lib.rs
+}
+v3_state=$(state_of V3_DECODER_STATE_BYTES)
+echo "V3 decoder state: ${v3_state:?} bytes (size_of::<v3::Decoder>(), owned by the caller)"
+v4_state=$(state_of V4_DECODER_STATE_BYTES)
+echo "V4 decoder state: ${v4_state:?} bytes (size_of::<v4::Decoder>(), owned by the caller)"
+hw5_state=$(state_of HW5_DECODER_STATE_BYTES)
+echo "HW5 decoder state: ${hw5_state:?} bytes (size_of::<hw5::Decoder>(), owned by the caller)"
+can_state=$(state_of DRONECAN_RECEIVER_STATE_BYTES)
+echo "DroneCAN receiver state: ${can_state:?} bytes (size_of::<dronecan::Receiver>(): 16 slots," \
+    "statistics of 128 node ids; owned by the caller)"
 
-# Symbols the probe objects take from outside (all three builds).
+# Symbols the probe objects take from outside (every build).
 helpers=$(sort -u "$tmp/helpers" | tr '\n' ' ')
 echo "not counted: ${helpers:-nothing }(compiler-builtins helpers), .ARM.exidx unwind index"

@@ -13,13 +13,24 @@
 //!   frames (160 bytes, 6 of 8 slots filled from 6 independent ESC profiles, counter +1), then the
 //!   same frames with garbage runs as in `noisy` before ~35% of frames, ~2% flipped and ~2% cut.
 //!
+//! - `v3_clean`, `v3_noisy`, `v4_clean`, `v4_noisy`, `hw5_clean`, `hw5_noisy`: the older
+//!   protocols' decoders on ~8 MiB of their frames, with fields from the same flight profile:
+//!   V3 (10-byte frames, no checksum), V4 (19-byte data frames back to back while running, and
+//!   every 400 frames 20 idle ones, each after an info frame and with its `B9` trailer), HW5
+//!   (32-byte telemetry frames with a CRC, after every 50 a ping request and the ESC's answer);
+//!   the noisy streams as `noisy` (garbage runs, ~2% flipped, ~2% cut). V3 and V4 have no
+//!   checksum: they lock on chains of frames, so after each break the frames until a new chain
+//!   is confirmed are lost (the share found is printed before measuring).
+//!
 //! Each stream is measured three ways: the `frames` iterator over the whole buffer, a `Decoder`
 //! fed 64 KiB chunks then flushed, and a `Decoder` pushed one byte at a time (the
 //! microcontroller path; on a 256 KiB slice only, as it is much slower).
 //!
-//! Run: `cargo bench -p hwfoc --bench bulk` (about 30 s once built on a 2-core machine; add a
-//! filter such as `-- noisy/frames` for one measurement). Before measuring, each stream is
-//! decoded once and checked: every intact frame found, `Decoder` and `frames` in agreement.
+//! Run: `cargo bench -p hwfoc --bench bulk` (about 30 s for the HW-FOC and DataLink streams,
+//! 70 s more for V3, V4 and HW5, once built on a 2-core machine; add a filter such as
+//! `-- noisy/frames` or `-- v4_` for some measurements). Before measuring, each stream is
+//! decoded once and checked: every intact frame found (of the noisy V3 and V4 streams, the share
+//! found is shown), `Decoder` and `frames` in agreement.
 
 use std::hint::black_box;
 use std::time::Duration;
@@ -30,6 +41,8 @@ use hwfoc::datalink::{self, FRAME_LEN};
 use hwfoc::foc;
 use hwfoc::foc::{DataFrame, Decoded, Decoder, Frame, InfoFrame, frames};
 use hwfoc::scan::{Scan, Scanner, StreamDecoder};
+use hwfoc::wire::Checksum;
+use hwfoc::{hw5, v3, v4};
 
 /// Size of each generated stream.
 const STREAM_LEN: usize = 8 << 20;
@@ -155,6 +168,9 @@ struct Expected {
     garbage_bytes: usize,
     flipped_frames: u32,
     cut_frames: u32,
+    /// Offsets of the flipped and of the cut frames (kept by [`stream_of`] only).
+    flipped: Vec<u64>,
+    cut: Vec<u64>,
 }
 
 fn clean_stream() -> (Vec<u8>, Expected) {
@@ -411,6 +427,308 @@ fn check_datalink(name: &str, buf: &[u8], e: &Expected) {
     assert_eq!(*dec.stats(), s, "{name}: statistics disagree");
 }
 
+/// What a frame of a generated stream is: one the decoder hands on, or one it only counts (an
+/// HW5 ping and its answer).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Made {
+    Data,
+    Info,
+    Counted,
+}
+
+/// A stream of frames from `next` (which appends one frame's bytes and says what it is), back
+/// to back up to [`STREAM_LEN`] and on until a data frame ends it; with `noisy`, garbage runs
+/// before ~35% of frames, ~2% flipped and ~2% cut, as in [`noisy_stream`].
+fn stream_of(
+    noisy: bool,
+    seed: u64,
+    mut next: impl FnMut(&mut Vec<u8>) -> Made,
+) -> (Vec<u8>, Expected) {
+    let mut rng = Rng(seed);
+    let mut buf = Vec::with_capacity(STREAM_LEN + 256);
+    let mut frame = Vec::with_capacity(128);
+    let mut e = Expected::default();
+    let mut last = Made::Info;
+    while buf.len() < STREAM_LEN || last != Made::Data {
+        if noisy && rng.chance(350) {
+            e.garbage_bytes += garbage(&mut rng, &mut buf, false);
+        }
+        frame.clear();
+        last = next(&mut frame);
+        if noisy && rng.chance(20) {
+            let bit = rng.range(0, frame.len() as u32 * 8 - 1) as usize;
+            frame[bit / 8] ^= 1 << (bit % 8);
+            e.flipped_frames += 1;
+            e.flipped.push(buf.len() as u64);
+        } else if noisy && rng.chance(20) {
+            let keep = rng.range(1, frame.len() as u32 - 1) as usize;
+            frame.truncate(keep);
+            e.cut_frames += 1;
+            e.cut.push(buf.len() as u64);
+        } else {
+            match last {
+                Made::Data => e.data_frames += 1,
+                Made::Info => e.info_frames += 1,
+                Made::Counted => {}
+            }
+            if last != Made::Counted {
+                e.offsets.push(buf.len() as u64);
+            }
+        }
+        buf.extend_from_slice(&frame);
+    }
+    (buf, e)
+}
+
+/// V3 frames (10 bytes, no checksum) following the same flight profile as HW-FOC's: throttle
+/// and PWM scaled to 0..=255, the period of the eRPM (the start-up placeholder when stopped),
+/// the 24-bit counter starting just before its wrap.
+fn v3_stream(noisy: bool) -> (Vec<u8>, Expected) {
+    let mut t = Telemetry::new(0x9B00_0064_0028_0026);
+    let mut counter = 0xFF_FF00u32;
+    stream_of(noisy, 0x0BAD_5EED_0000_0003, move |out| {
+        let f = t.next_data();
+        let erpm = u32::from(f.erpm_raw) * 10;
+        let frame = v3::Frame {
+            counter,
+            throttle_in_raw: (u32::from(f.throttle_in_raw) * 255 / 1024) as u16,
+            pwm_out_raw: (u32::from(f.throttle_out_raw) * 255 / 1024) as u16,
+            period_us: match erpm {
+                0 => v3::PLACEHOLDER_PERIOD_US,
+                e => (v3::US_PER_MINUTE / e).min(65_535) as u16,
+            },
+        };
+        counter = (counter + 1) & 0xFF_FFFF;
+        out.extend_from_slice(&frame.encode());
+        Made::Data
+    })
+}
+
+/// V4 frames: running (19-byte data frames back to back), and every 400 frames 20 frames of
+/// idle (an info frame before each data frame, which carries its `B9` trailer), the fields from
+/// the HW-FOC flight profile within their 12-bit ADC ranges.
+fn v4_stream(noisy: bool) -> (Vec<u8>, Expected) {
+    let mut t = Telemetry::new(0x9B9B_03E8_0108_5B0B);
+    let info = v4::InfoFrame {
+        full_scale: 1000,
+        v1: 8,
+        v2: 91,
+        i1: 11,
+        i2: 2,
+        i3: 1,
+        t1: 0x21,
+        t2: 0x21,
+    };
+    let mut counter = 0xFF_FF00u32;
+    let mut step = 0u32;
+    let mut info_next = false;
+    stream_of(noisy, 0x0BAD_5EED_0000_0004, move |out| {
+        let idle = step % 400 < 20;
+        if idle && info_next {
+            info_next = false;
+            out.extend_from_slice(&info.encode());
+            return Made::Info;
+        }
+        step += 1;
+        info_next = true;
+        let f = t.next_data();
+        let mut frame = v4::DataFrame {
+            counter,
+            throttle_in_raw: f.throttle_in_raw.min(1000),
+            throttle_out_raw: f.throttle_out_raw.min(1000),
+            erpm: u32::from(f.erpm_raw) * 10,
+            voltage_adc: (u32::from(f.voltage_raw) * 91 / 8).min(4095) as u16,
+            current_adc: (f.current_raw.max(0) / 4).min(4095) as u16,
+            temp_adc: u16::from(f.mos_adc) * 16,
+            temp2_adc: u16::from(f.cap_adc) * 16,
+        };
+        counter = (counter + 1) & 0xFF_FFFF;
+        if idle {
+            frame.throttle_in_raw = 0;
+            frame.throttle_out_raw = 0;
+            frame.erpm = 0;
+            out.extend_from_slice(&frame.encode_with_trailer());
+        } else {
+            out.extend_from_slice(&frame.encode());
+        }
+        Made::Data
+    })
+}
+
+/// HW5 telemetry frames (32 bytes, CRC-16/MODBUS) from the HW-FOC flight profile, and after
+/// every 50 a flight controller's ping request and the ESC's 11-byte answer (counted, not
+/// handed on), as on a half-duplex wire.
+fn hw5_stream(noisy: bool) -> (Vec<u8>, Expected) {
+    let mut t = Telemetry::new(0xFE01_0003_305C_1706);
+    let mut ping = [0u8; 11];
+    ping[..6].copy_from_slice(&[0xFE, 0x01, 0x00, 0x03, 0x2C, 0x24]);
+    ping[6..9].copy_from_slice(&[0x00, 0x01, 0x02]);
+    Checksum::Crc16Modbus.seal(&mut ping);
+    let request = [0x01, 0xFD, 0x03, 0x03, 0x2C, 0x24, 0x00, 0x01, 0x60, 0x60];
+    let mut n = 0u32;
+    stream_of(noisy, 0x0BAD_5EED_0000_0005, move |out| {
+        n += 1;
+        match n % 52 {
+            50 => {
+                out.extend_from_slice(&request);
+                return Made::Counted;
+            }
+            51 => {
+                out.extend_from_slice(&ping);
+                return Made::Counted;
+            }
+            _ => {}
+        }
+        let f = t.next_data();
+        let frame = hw5::TelemetryFrame {
+            throttle: (u32::from(f.throttle_in_raw) * 100 / 1024) as u8,
+            fault: hw5::FaultCode(if f.status.0 != 0 {
+                1 << (f.status.0.trailing_zeros() % 8)
+            } else {
+                0
+            }),
+            erpm_raw: f.erpm_raw,
+            voltage_raw: f.voltage_raw * 2,
+            current_raw: (f.current_raw.max(0) / 6) as u16,
+            esc_temp: f.mos_adc / 4,
+            bec_temp: f.cap_adc / 5,
+            motor_temp: f.mos_adc / 3,
+            bec_voltage_raw: 84,
+            bec_current_raw: 12,
+            ..Default::default()
+        };
+        out.extend_from_slice(&frame.encode());
+        Made::Data
+    })
+}
+
+/// Decodes a V3, V4 or HW5 stream once with the bulk iterator and checks it against the
+/// streaming decoder (the same frames and statistics) and against what was made: on a clean
+/// stream exactly the frames made; on a noisy one, for HW5 (a CRC) exactly the intact frames,
+/// for V3 and V4 (no checksum, frames taken by chains) the share of intact frames found is
+/// shown, and so are the frames found elsewhere: flipped frames that stayed plausible and
+/// chained (about half of all single-bit flips, as `v3`'s and `v4`'s documentation says), cut
+/// frames completed by the next frame's bytes into a plausible chained frame (as `v3`'s test
+/// `a_cut_frame_that_stays_plausible_is_taken` shows), and anything else (garbage), which must
+/// be rare.
+fn check_scanner<S: Scanner>(
+    name: &str,
+    buf: &[u8],
+    e: &Expected,
+    noisy: bool,
+    exact: bool,
+    offset: impl Fn(&S::Item) -> u64,
+) where
+    S::Item: PartialEq + std::fmt::Debug,
+    S::Stats: PartialEq + std::fmt::Display,
+{
+    let mut it = Scan::<S>::new(buf);
+    let decoded: Vec<S::Item> = it.by_ref().collect();
+    let s = it.stats().clone();
+    let offsets: Vec<u64> = decoded.iter().map(&offset).collect();
+    let found = e
+        .offsets
+        .iter()
+        .filter(|o| offsets.binary_search(o).is_ok())
+        .count();
+    let elsewhere: Vec<u64> = offsets
+        .iter()
+        .filter(|o| e.offsets.binary_search(o).is_err())
+        .copied()
+        .collect();
+    let flipped = elsewhere
+        .iter()
+        .filter(|o| e.flipped.binary_search(o).is_ok())
+        .count();
+    let cut = elsewhere
+        .iter()
+        .filter(|o| e.cut.binary_search(o).is_ok())
+        .count();
+    let extra = elsewhere.len() - flipped - cut;
+    if !noisy || exact {
+        assert_eq!(offsets, e.offsets, "{name}: exactly the intact frames");
+    } else {
+        assert!(
+            extra * 1000 < decoded.len(),
+            "{name}: {extra} frames not made"
+        );
+    }
+    eprintln!(
+        "{name}: {} bytes, {} data + {} info frames, {} garbage bytes ({:.1}%), {} flipped-bit \
+         frames, {} cut frames; found {found} of the intact frames ({:.1}%), {flipped} flipped \
+         ones, {cut} cut ones and {extra} more\n  \
+         decoder: {s}",
+        buf.len(),
+        e.data_frames,
+        e.info_frames,
+        e.garbage_bytes,
+        100.0 * e.garbage_bytes as f64 / buf.len() as f64,
+        e.flipped_frames,
+        e.cut_frames,
+        100.0 * found as f64 / e.offsets.len() as f64,
+    );
+    let mut dec = StreamDecoder::<S>::new();
+    let mut all = Vec::with_capacity(decoded.len());
+    for chunk in buf.chunks(CHUNK) {
+        dec.feed(chunk, |d| all.push(d));
+    }
+    dec.flush(|d| all.push(d));
+    assert!(all == decoded, "{name}: Decoder and frames() disagree");
+    assert!(*dec.stats() == s, "{name}: statistics disagree");
+}
+
+/// Something from every V3 frame, so that no decoding work can be optimised away.
+#[inline(always)]
+fn fold_v3(acc: u64, d: &v3::Decoded) -> u64 {
+    acc.wrapping_mul(31)
+        .wrapping_add(u64::from(d.frame.counter) ^ u64::from(d.frame.period_us) << 24 ^ d.offset)
+}
+
+/// Something from every V4 frame.
+#[inline(always)]
+fn fold_v4(acc: u64, d: &v4::Decoded) -> u64 {
+    let v = match d.frame {
+        v4::Frame::Data(f) => u64::from(f.frame.counter) ^ u64::from(f.frame.voltage_adc) << 24,
+        v4::Frame::Info(i) => u64::from(i.full_scale),
+    };
+    acc.wrapping_mul(31).wrapping_add(v ^ d.offset)
+}
+
+/// Something from every HW5 telemetry frame.
+#[inline(always)]
+fn fold_hw5(acc: u64, d: &hw5::Decoded) -> u64 {
+    acc.wrapping_mul(31)
+        .wrapping_add(u64::from(d.frame.erpm_raw) ^ u64::from(d.frame.voltage_raw) << 16 ^ d.offset)
+}
+
+/// The V3, V4 and HW5 decoders, each on a clean and a noisy stream.
+fn older(c: &mut Criterion) {
+    for noisy in [false, true] {
+        let kind = if noisy { "noisy" } else { "clean" };
+
+        let name = format!("v3_{kind}");
+        let (buf, e) = v3_stream(noisy);
+        check_scanner::<v3::Scanner>(&name, &buf, &e, noisy, false, |d| d.offset);
+        let mut g = c.benchmark_group(&name);
+        bench_decoder::<v3::Scanner>(&mut g, &buf, fold_v3);
+        g.finish();
+
+        let name = format!("v4_{kind}");
+        let (buf, e) = v4_stream(noisy);
+        check_scanner::<v4::Scanner>(&name, &buf, &e, noisy, false, |d| d.offset);
+        let mut g = c.benchmark_group(&name);
+        bench_decoder::<v4::Scanner>(&mut g, &buf, fold_v4);
+        g.finish();
+
+        let name = format!("hw5_{kind}");
+        let (buf, e) = hw5_stream(noisy);
+        check_scanner::<hw5::Scanner>(&name, &buf, &e, noisy, true, |d| d.offset);
+        let mut g = c.benchmark_group(&name);
+        bench_decoder::<hw5::Scanner>(&mut g, &buf, fold_hw5);
+        g.finish();
+    }
+}
+
 fn bulk(c: &mut Criterion) {
     for (name, noisy) in [("datalink_clean", false), ("datalink_noisy", true)] {
         let (buf, expected) = datalink_stream(noisy);
@@ -438,6 +756,6 @@ criterion_group! {
         .sample_size(20)
         .warm_up_time(Duration::from_millis(500))
         .measurement_time(Duration::from_secs(3));
-    targets = bulk
+    targets = bulk, older
 }
 criterion_main!(benches);

@@ -1,8 +1,11 @@
 //! Invariant checks shared by the fuzz targets in `fuzz_targets/`.
 
+use std::fmt;
+
 use hwfoc::datalink::LengthByte;
 use hwfoc::foc::{Decoded, Frame, Parsed, parse};
-use hwfoc::{datalink, foc};
+use hwfoc::scan::{Scan, Scanner, Stats as _, StreamDecoder};
+use hwfoc::{datalink, foc, hw5, v3, v4};
 
 /// Panics unless `decoded` and `stats` are a consistent decoding of `input`, a whole stream
 /// (a flushed `Decoder`, or an exhausted `frames` iterator):
@@ -143,5 +146,340 @@ pub fn check_datalink_stream(input: &[u8], decoded: &[datalink::Decoded], stats:
             );
         }
         next_free = end as u64;
+    }
+}
+
+/// The input of a scheduled streaming target (`stream.rs`, `datalink.rs`, `v3.rs`, `v4.rs`,
+/// `hw5.rs`): byte 0 gives the number `n` (1..=8) of schedule bytes that follow; the rest is the
+/// stream. `None` when the input is too short to hold them.
+pub fn split_schedule(data: &[u8]) -> Option<(&[u8], &[u8])> {
+    let (&n, rest) = data.split_first()?;
+    let n = usize::from(n % 8) + 1;
+    if rest.len() < n {
+        return None;
+    }
+    Some(rest.split_at(n))
+}
+
+/// What [`feed_scheduled`] gave: every frame, the final statistics, and whether the stream was
+/// settled mid-way (a `flush` or `line_silent` before the end, after which the frames may
+/// differ from the bulk path's: a candidate cut by the silence is dropped).
+pub struct Scheduled<S: Scanner> {
+    /// The frames, in the order given.
+    pub frames: Vec<S::Item>,
+    /// The statistics after the final flush.
+    pub stats: S::Stats,
+    /// A `flush` or `line_silent` came before the end of the stream.
+    pub settled_mid_stream: bool,
+}
+
+/// Feeds `input` to a new `StreamDecoder<S>` as `schedule` says, used cyclically, one byte per
+/// step:
+///
+/// - `0`: an empty `feed`;
+/// - `1..=189`: `feed` that many bytes;
+/// - `190..=194`: `flush` now, then go on;
+/// - `195..=199`: `line_silent(k)` with `k = op - 195` (0..=4 frames' time of silence);
+/// - `200..=254`: `push` 1..=55 bytes one at a time;
+/// - `255`: `feed` all the rest;
+///
+/// then flushes. Checks after every call: fewer than `S::MAX_LEN` bytes held (none after a
+/// flush), the byte count, and the last frame's offset (`offset_of`) before the bytes fed.
+pub fn feed_scheduled<S: Scanner>(
+    schedule: &[u8],
+    input: &[u8],
+    offset_of: impl Fn(&S::Item) -> u64,
+) -> Scheduled<S> {
+    let n = schedule.len();
+    let mut dec = StreamDecoder::<S>::new();
+    let mut got = Vec::new();
+    let mut at = 0;
+    let mut step = 0;
+    let mut idle_steps = 0;
+    let mut settled_mid_stream = false;
+    while at < input.len() {
+        let op = schedule[step % n];
+        step += 1;
+        let left = input.len() - at;
+        match op {
+            0 | 190..=199 => {
+                match op {
+                    0 => dec.feed(&[], |d| got.push(d)),
+                    190..=194 => dec.flush(|d| got.push(d)),
+                    _ => dec.line_silent(u32::from(op - 195), |d| got.push(d)),
+                }
+                if op != 0 {
+                    assert_eq!(dec.buffered(), 0, "flush leaves nothing held");
+                    settled_mid_stream = true;
+                }
+                // A schedule that never consumes a byte still has to end.
+                idle_steps += 1;
+                if idle_steps >= n {
+                    dec.push(input[at], |d| got.push(d));
+                    at += 1;
+                    idle_steps = 0;
+                }
+            }
+            200..=254 => {
+                for &b in &input[at..at + usize::from(op - 199).min(left)] {
+                    dec.push(b, |d| got.push(d));
+                    assert!(
+                        dec.buffered() < S::MAX_LEN,
+                        "buffered {} after push",
+                        dec.buffered()
+                    );
+                    at += 1;
+                }
+                idle_steps = 0;
+            }
+            _ => {
+                let len = if op == 255 {
+                    left
+                } else {
+                    usize::from(op).min(left)
+                };
+                dec.feed(&input[at..at + len], |d| got.push(d));
+                at += len;
+                idle_steps = 0;
+            }
+        }
+        assert!(
+            dec.buffered() < S::MAX_LEN,
+            "buffered {} after a call",
+            dec.buffered()
+        );
+        assert_eq!(dec.stats().bytes(), at as u64, "bytes fed so far");
+        if let Some(last) = got.last() {
+            assert!(offset_of(last) < at as u64, "a frame beyond the bytes fed");
+        }
+    }
+    dec.flush(|d| got.push(d));
+    assert_eq!(dec.buffered(), 0);
+    Scheduled {
+        frames: got,
+        stats: dec.stats().clone(),
+        settled_mid_stream,
+    }
+}
+
+/// The bulk `Scan<S>` over the whole input, checked fused, against a `StreamDecoder<S>` fed a
+/// byte at a time and through `decode_all` (the same frames and statistics); returns its frames
+/// and statistics.
+pub fn bulk_and_bytewise<S: Scanner>(input: &[u8]) -> (Vec<S::Item>, S::Stats)
+where
+    S::Item: PartialEq + fmt::Debug,
+    S::Stats: PartialEq,
+{
+    let mut it = Scan::<S>::new(input);
+    let bulk: Vec<S::Item> = it.by_ref().collect();
+    assert!(it.next().is_none(), "the bulk iterator is fused");
+    let stats = it.stats().clone();
+
+    let mut bytewise = StreamDecoder::<S>::new();
+    let mut got = Vec::new();
+    for &b in input {
+        bytewise.push(b, |d| got.push(d));
+        assert!(bytewise.buffered() < S::MAX_LEN);
+    }
+    bytewise.flush(|d| got.push(d));
+    assert_eq!(
+        got, bulk,
+        "byte-at-a-time decoder and the bulk iterator disagree"
+    );
+    assert_eq!(bytewise.stats(), &stats, "byte-at-a-time statistics");
+
+    let mut all = StreamDecoder::<S>::new();
+    got.clear();
+    all.decode_all(input, |d| got.push(d));
+    assert_eq!(got, bulk, "decode_all and the bulk iterator disagree");
+    assert_eq!(all.stats(), &stats, "decode_all statistics");
+    (bulk, stats)
+}
+
+/// The whole check of a scheduled streaming target for scanner `S`: the bulk path and the
+/// byte-at-a-time and `decode_all` decoders agree; the scheduled decoder gives the same frames
+/// and statistics when nothing settled the stream mid-way; `check` (a protocol's whole-stream
+/// invariants) holds for the bulk decoding and for the scheduled one.
+pub fn check_scheduled<S: Scanner>(
+    data: &[u8],
+    offset_of: impl Fn(&S::Item) -> u64,
+    check: impl Fn(&[u8], &[S::Item], &S::Stats),
+) where
+    S::Item: PartialEq + fmt::Debug,
+    S::Stats: PartialEq,
+{
+    let Some((schedule, input)) = split_schedule(data) else {
+        return;
+    };
+    let (bulk, stats) = bulk_and_bytewise::<S>(input);
+    check(input, &bulk, &stats);
+    let got = feed_scheduled::<S>(schedule, input, offset_of);
+    check(input, &got.frames, &got.stats);
+    if !got.settled_mid_stream {
+        assert_eq!(
+            got.frames, bulk,
+            "chunked decoder and the bulk iterator disagree"
+        );
+        assert_eq!(got.stats, stats, "chunked decoder and bulk statistics");
+    }
+}
+
+/// Asserts that frames at `spans` (offset, length), in the order given, lie inside a stream of
+/// `len` bytes at strictly increasing offsets without overlapping.
+fn assert_disjoint(len: usize, spans: impl IntoIterator<Item = (u64, usize)>) {
+    let mut next_free = 0u64;
+    let mut last: Option<u64> = None;
+    for (offset, n) in spans {
+        if let Some(prev) = last {
+            assert!(
+                offset > prev,
+                "offsets not increasing: {prev} then {offset}"
+            );
+        }
+        assert!(
+            offset >= next_free,
+            "frame at {offset} overlaps the one before"
+        );
+        let end = offset + n as u64;
+        assert!(end <= len as u64, "frame at {offset} runs past the input");
+        last = Some(offset);
+        next_free = end;
+    }
+}
+
+/// Panics unless `decoded` and `stats` are a consistent V3 decoding of `input`, a whole stream:
+/// `bytes == input.len() == 10*frames + skipped`; the frame count and the last counter match
+/// the frames given; frames in order without overlap; each one plausible, parsed the same at its
+/// offset and re-encoding to exactly the bytes there.
+pub fn check_v3_stream(input: &[u8], decoded: &[v3::Decoded], stats: &v3::Stats) {
+    assert_eq!(stats.bytes(), input.len() as u64, "bytes counted");
+    assert_eq!(
+        stats.bytes(),
+        10 * u64::from(stats.frames()) + stats.bytes_skipped(),
+        "bytes == 10*frames + skipped: {stats}"
+    );
+    assert_eq!(decoded.len() as u64, u64::from(stats.frames()), "frames");
+    assert!(stats.syncs() <= stats.frames(), "syncs: {stats}");
+    assert_eq!(
+        stats.last_counter(),
+        decoded.last().map(|d| d.frame.counter),
+        "last counter"
+    );
+    assert_disjoint(
+        input.len(),
+        decoded.iter().map(|d| (d.offset, v3::FRAME_LEN)),
+    );
+    for d in decoded {
+        let start = d.offset as usize;
+        assert!(d.frame.is_plausible(), "implausible frame at {start}");
+        assert_eq!(
+            v3::Frame::parse(&input[start..]),
+            Some(d.frame),
+            "parse at {start}"
+        );
+        assert_eq!(
+            &input[start..start + v3::FRAME_LEN],
+            &d.frame.encode()[..],
+            "frame at {start} does not re-encode to its bytes"
+        );
+    }
+}
+
+/// Panics unless `decoded` and `stats` are a consistent V4 decoding of `input`, a whole stream:
+/// `bytes == input.len() == 19*frames + 13*info_frames + trailers + skipped`; the data and info
+/// frame counts match the frames given; frames in order without overlap; each one plausible
+/// (a data frame under the full scale of the info frame it carries), re-encoding to exactly the
+/// bytes at its offset; a data frame's adopted info frame is one decoded before it.
+pub fn check_v4_stream(input: &[u8], decoded: &[v4::Decoded], stats: &v4::Stats) {
+    assert_eq!(stats.bytes(), input.len() as u64, "bytes counted");
+    assert_eq!(
+        stats.bytes(),
+        19 * u64::from(stats.frames())
+            + 13 * u64::from(stats.info_frames())
+            + u64::from(stats.trailers())
+            + stats.bytes_skipped(),
+        "bytes == 19*frames + 13*info_frames + trailers + skipped: {stats}"
+    );
+    let data = decoded
+        .iter()
+        .filter(|d| matches!(d.frame, v4::Frame::Data(_)))
+        .count();
+    assert_eq!(data as u64, u64::from(stats.frames()), "data frames");
+    assert_eq!(
+        (decoded.len() - data) as u64,
+        u64::from(stats.info_frames()),
+        "info frames"
+    );
+    assert!(stats.trailers() <= stats.frames(), "trailers: {stats}");
+    let len_of = |d: &v4::Decoded| match d.frame {
+        v4::Frame::Data(_) => v4::DATA_FRAME_LEN,
+        v4::Frame::Info(_) => v4::INFO_FRAME_LEN,
+    };
+    assert_disjoint(input.len(), decoded.iter().map(|d| (d.offset, len_of(d))));
+    let mut infos_seen: Vec<v4::InfoFrame> = Vec::new();
+    for d in decoded {
+        let start = d.offset as usize;
+        match d.frame {
+            v4::Frame::Data(data) => {
+                assert!(
+                    data.frame.is_plausible(data.full_scale()),
+                    "implausible data frame at {start}"
+                );
+                assert_eq!(
+                    &input[start..start + v4::DATA_FRAME_LEN],
+                    &data.frame.encode()[..],
+                    "data frame at {start} does not re-encode to its bytes"
+                );
+                if let Some(info) = data.info {
+                    assert!(
+                        infos_seen.contains(&info),
+                        "data frame at {start} carries an info frame never decoded"
+                    );
+                }
+            }
+            v4::Frame::Info(info) => {
+                assert!(info.is_plausible(), "implausible info frame at {start}");
+                assert_eq!(v4::InfoFrame::parse(&input[start..]), Some(info));
+                assert_eq!(
+                    &input[start..start + v4::INFO_FRAME_LEN],
+                    &info.encode()[..],
+                    "info frame at {start} does not re-encode to its bytes"
+                );
+                infos_seen.push(info);
+            }
+        }
+    }
+}
+
+/// Panics unless `decoded` and `stats` are a consistent HW5 decoding of `input`, a whole
+/// stream: `bytes == input.len() == frame_bytes + skipped` (frames of every kind); the telemetry
+/// count matches the frames given; frames in order without overlap; each one identified and
+/// parsed the same at its offset, and its encoding parsed back to it.
+pub fn check_hw5_stream(input: &[u8], decoded: &[hw5::Decoded], stats: &hw5::Stats) {
+    assert_eq!(stats.bytes(), input.len() as u64, "bytes counted");
+    assert_eq!(
+        stats.bytes(),
+        stats.frame_bytes() + stats.bytes_skipped(),
+        "bytes == frame bytes + skipped: {stats}"
+    );
+    assert_eq!(
+        decoded.len() as u64,
+        u64::from(stats.telemetry_frames()),
+        "telemetry frames"
+    );
+    assert_disjoint(
+        input.len(),
+        decoded.iter().map(|d| (d.offset, hw5::TELEMETRY_LEN)),
+    );
+    for d in decoded {
+        let start = d.offset as usize;
+        let bytes = &input[start..start + hw5::TELEMETRY_LEN];
+        assert_eq!(hw5::identify(bytes), Ok(hw5::Kind::Telemetry), "at {start}");
+        assert_eq!(
+            hw5::TelemetryFrame::parse(bytes),
+            Ok(d.frame),
+            "parse at {start}"
+        );
+        assert_eq!(hw5::TelemetryFrame::parse(&d.frame.encode()), Ok(d.frame));
     }
 }
