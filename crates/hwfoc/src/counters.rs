@@ -14,6 +14,9 @@
 //! with [`crate::foc::Decoder::line_silent`]: an ESC that rebooted in a second and a half cannot
 //! have sent 535 frames in that time, so a step of 536 after it is a restart, not a loss of 535.
 
+use core::fmt;
+use core::hash::Hash;
+
 /// The most data frames one gap in packet numbers is counted as losing: a step forward of more
 /// than `MAX_PACKET_GAP + 1` is a [restart](crate::foc::Stats::restarts), not a loss.
 ///
@@ -26,9 +29,6 @@
 /// [`Decoder::line_silent`](crate::foc::Decoder::line_silent) settles both cases from the time
 /// that passed.
 pub const MAX_PACKET_GAP: u16 = 1000;
-
-/// The largest step forward of a packet number (modulo 65536): a larger one is a step backwards.
-const MAX_FORWARD_STEP: u16 = 0x8000;
 
 /// The two byte counters of a protocol's statistics ([`foc::Stats`](crate::foc::Stats),
 /// [`datalink::Stats`](crate::datalink::Stats)), of 48 bits each: a `u32` and a `u16`. They take
@@ -86,38 +86,126 @@ impl ByteCounts {
     }
 }
 
-/// The numbers of one counter (an ESC's packet numbers, a DataLink hub's frame counter),
-/// followed step by step: each number after the first is sorted into exactly one of the next
-/// number, a [duplicate](PacketSequence::duplicates), a gap of [lost](PacketSequence::lost)
-/// numbers, or a [restart](PacketSequence::restarts), by the rule of the [module](self)
-/// documentation ([`MAX_PACKET_GAP`], and the tighter limit after a silence of the line).
+/// The numbers of one counter (an ESC's packet numbers, a DataLink hub's frame counter, the
+/// 24-bit counter of a Hobbywing V3 or V4 ESC), followed step by step: each number after the
+/// first is sorted into exactly one of the next number, a [duplicate](Sequence::duplicates), a
+/// gap of [lost](Sequence::lost) numbers, or a [restart](Sequence::restarts), by the rule of
+/// the [module](self) documentation ([`MAX_PACKET_GAP`], and the tighter limit after a silence
+/// of the line), with steps taken modulo the counter's width `W`: [`PacketSequence`] (16 bits)
+/// and [`PacketSequence24`] (24 bits) are its two instances.
 ///
-/// [`foc::Stats`](crate::foc::Stats) keeps one for the data frames' packet numbers;
-/// [`datalink::Stats`](crate::datalink::Stats) one for the hub's frame counter and one per ESC
-/// channel. Counters are `u32` and saturate; 20 bytes.
+/// Counters are `u32` and saturate; the last number and the gap limit are kept in the width's
+/// own type ([`Width::Number`]), so a [`PacketSequence`] takes 20 bytes and a
+/// [`PacketSequence24`] 24.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
-pub struct PacketSequence {
+pub struct Sequence<W: Width> {
     pub(crate) count: u32,
     pub(crate) lost: u32,
     pub(crate) duplicates: u32,
     pub(crate) restarts: u32,
-    pub(crate) last: u16,
+    pub(crate) last: W::Number,
     /// The largest step to the next number that counts as a loss, as set by
-    /// [`PacketSequence::line_silent`]; 0 (no silence since the last number) means
+    /// [`Sequence::line_silent`]; 0 (no silence since the last number) means
     /// `MAX_PACKET_GAP + 1`.
-    pub(crate) gap_limit: u16,
+    pub(crate) gap_limit: W::Number,
 }
 
-impl PacketSequence {
+/// The width of the counter a [`Sequence`] follows (sealed: [`Bits16`], [`Bits24`]).
+pub trait Width: sealed::Sealed + Copy + fmt::Debug + PartialEq + Eq + Hash + Default {
+    /// The type a number is given in and kept in.
+    type Number: Copy + fmt::Debug + PartialEq + Eq + Hash + Default + Into<u32>;
+    /// Number 0.
+    #[doc(hidden)]
+    const ZERO: Self::Number;
+    /// The largest number; numbers wrap to 0 after it.
+    const MAX: u32;
+    /// `n` (at most [`Width::MAX`]) as a number.
+    #[doc(hidden)]
+    fn number(n: u32) -> Self::Number;
+}
+
+/// A 16-bit counter: an HW-FOC ESC's packet numbers, a DataLink hub's frame counter.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+pub struct Bits16;
+
+/// A 24-bit counter: the packet counters of Hobbywing V3 and V4 ([`crate::v3`], [`crate::v4`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+pub struct Bits24;
+
+mod sealed {
+    /// Keeps [`Width`](super::Width) to this crate.
+    pub trait Sealed {}
+    impl Sealed for super::Bits16 {}
+    impl Sealed for super::Bits24 {}
+}
+
+impl Width for Bits16 {
+    type Number = u16;
+    const ZERO: u16 = 0;
+    const MAX: u32 = 0xFFFF;
+
+    #[inline(always)]
+    fn number(n: u32) -> u16 {
+        n as u16
+    }
+}
+
+impl Width for Bits24 {
+    type Number = u32;
+    const ZERO: u32 = 0;
+    const MAX: u32 = COUNTER24_MAX;
+
+    #[inline(always)]
+    fn number(n: u32) -> u32 {
+        n
+    }
+}
+
+/// The numbers of one 16-bit counter (an ESC's packet numbers, a DataLink hub's frame counter):
+/// a [`Sequence`] of [`Bits16`].
+///
+/// [`foc::Stats`](crate::foc::Stats) keeps one for the data frames' packet numbers;
+/// [`datalink::Stats`](crate::datalink::Stats) one for the hub's frame counter and one per ESC
+/// channel. Counters are `u32` and saturate; 20 bytes.
+pub type PacketSequence = Sequence<Bits16>;
+
+/// The largest value of a 24-bit counter (the packet counters of Hobbywing V3 and V4,
+/// [`crate::v3`], [`crate::v4`]); it wraps to 0 after this.
+pub const COUNTER24_MAX: u32 = 0xFF_FFFF;
+
+/// [`PacketSequence`] for a 24-bit counter (the packet counters of Hobbywing V3 and V4): a
+/// [`Sequence`] of [`Bits24`], the same four events by the same rule ([`MAX_PACKET_GAP`], the
+/// tighter limit after a silence), with steps taken modulo 2^24 and a step backwards being one
+/// of more than 2^23.
+///
+/// A separate instance rather than a wider [`PacketSequence`], so that the HW-FOC and DataLink
+/// statistics keep their sizes. Counters are `u32` and saturate; 24 bytes.
+///
+/// ```
+/// use hwfoc::counters::PacketSequence24;
+///
+/// let mut s = PacketSequence24::new();
+/// for n in [0xFF_FFFE, 0xFF_FFFF, 0, 3, 3, 100_000] {
+///     s.next(n);
+/// }
+/// assert_eq!((s.count(), s.lost(), s.duplicates(), s.restarts()), (6, 2, 1, 1));
+/// assert_eq!(s.last(), Some(100_000));
+/// ```
+pub type PacketSequence24 = Sequence<Bits24>;
+
+impl<W: Width> Sequence<W> {
+    /// The largest step forward (modulo the width): a larger one is a step backwards.
+    const MAX_FORWARD_STEP: u32 = W::MAX / 2 + 1;
+
     /// No number seen yet.
     pub const fn new() -> Self {
-        PacketSequence {
+        Sequence {
             count: 0,
             lost: 0,
             duplicates: 0,
             restarts: 0,
-            last: 0,
-            gap_limit: 0,
+            last: W::ZERO,
+            gap_limit: W::ZERO,
         }
     }
 
@@ -127,8 +215,9 @@ impl PacketSequence {
     }
 
     /// Numbers missing between consecutive numbers of one sequence: a step of
-    /// `d = (next - last) mod 65536` counts `d - 1` when `2 <= d <= MAX_PACKET_GAP + 1`
-    /// (after a silence, the limit it set); a larger step is a restart and loses nothing.
+    /// `d = (next - last)` modulo the width (65536, 2^24) counts `d - 1` when
+    /// `2 <= d <= MAX_PACKET_GAP + 1` (after a silence, the limit it set); a larger step is a
+    /// restart and loses nothing.
     pub const fn lost(&self) -> u32 {
         self.lost
     }
@@ -138,14 +227,14 @@ impl PacketSequence {
         self.duplicates
     }
 
-    /// Numbers that start a new sequence: a step backwards (`d > 32768` modulo 65536) or
-    /// forwards beyond the gap limit. A restart counts no loss and no duplicate.
+    /// Numbers that start a new sequence: a step backwards (`d` above half the modulus: 32768,
+    /// 2^23) or forwards beyond the gap limit. A restart counts no loss and no duplicate.
     pub const fn restarts(&self) -> u32 {
         self.restarts
     }
 
     /// The last number seen, if any.
-    pub const fn last(&self) -> Option<u16> {
+    pub const fn last(&self) -> Option<W::Number> {
         if self.count == 0 {
             None
         } else {
@@ -164,16 +253,15 @@ impl PacketSequence {
     }
 
     /// The line was silent for a time in which at most `max_frames` numbers could have been
-    /// sent: the next step counts as a loss only up to `max_frames + 1` (at most 32768).
-    /// Silences before one number add up.
-    pub(crate) fn line_silent(&mut self, max_frames: u32) {
-        let limit = if self.gap_limit == 0 {
-            1
-        } else {
-            u32::from(self.gap_limit)
+    /// sent: the next step counts as a loss only up to `max_frames + 1` (at most half the
+    /// modulus: 32768, 2^23). Silences before one number add up.
+    pub fn line_silent(&mut self, max_frames: u32) {
+        let limit = match self.gap_limit.into() {
+            0 => 1,
+            limit => limit,
         };
         let limit = limit.saturating_add(max_frames);
-        self.gap_limit = limit.min(u32::from(MAX_FORWARD_STEP)) as u16;
+        self.gap_limit = W::number(limit.min(Self::MAX_FORWARD_STEP));
     }
 
     /// This sequence followed by `later`, which followed the numbers that came right after this
@@ -181,7 +269,7 @@ impl PacketSequence {
     /// every number would have kept. The step from this sequence's last number to `first` is
     /// sorted by the usual rule (`later` began with no silence of the line before `first`); the
     /// steps after it are `later`'s. Nothing changes when `later` has no number.
-    pub fn then(&mut self, first: u16, later: &PacketSequence) {
+    pub fn then(&mut self, first: W::Number, later: &Sequence<W>) {
         if later.count == 0 {
             return;
         }
@@ -194,156 +282,35 @@ impl PacketSequence {
         self.gap_limit = later.gap_limit;
     }
 
-    /// Takes the next number and classifies its step from the last one.
+    /// Takes the next number (its low bits of the width) and classifies its step from the last
+    /// one.
     #[inline]
-    pub(crate) fn next(&mut self, number: u16) {
+    pub fn next(&mut self, number: W::Number) {
+        let number = number.into() & W::MAX;
+        let last = self.last.into();
+        let gap_limit = self.gap_limit.into();
         // The usual step: the next number, nothing lost, no silence before it.
-        if number == self.last.wrapping_add(1) && self.gap_limit == 0 && self.count != 0 {
+        if number == (last.wrapping_add(1) & W::MAX) && gap_limit == 0 && self.count != 0 {
             self.count = self.count.saturating_add(1);
-            self.last = number;
+            self.last = W::number(number);
             return;
         }
         if self.count != 0 {
-            let limit = if self.gap_limit == 0 {
-                MAX_PACKET_GAP + 1
-            } else {
-                self.gap_limit
-            };
-            match number.wrapping_sub(self.last) {
-                0 => self.duplicates = self.duplicates.saturating_add(1),
-                // The next number (a step of 1) loses nothing; the limit is at least 1.
-                step if step <= limit => {
-                    self.lost = self.lost.saturating_add(u32::from(step - 1));
-                }
-                _ => self.restarts = self.restarts.saturating_add(1),
-            }
-        }
-        self.gap_limit = 0;
-        self.count = self.count.saturating_add(1);
-        self.last = number;
-    }
-}
-
-/// The largest value of a 24-bit counter (the packet counters of Hobbywing V3 and V4,
-/// [`crate::v3`], [`crate::v4`]); it wraps to 0 after this.
-pub const COUNTER24_MAX: u32 = 0xFF_FFFF;
-
-/// The largest step forward of a 24-bit counter: a larger one (modulo 2^24) is a step backwards.
-const MAX_FORWARD_STEP24: u32 = 0x80_0000;
-
-/// [`PacketSequence`] for a 24-bit counter (the packet counters of Hobbywing V3 and V4): the same
-/// four events by the same rule ([`MAX_PACKET_GAP`], the tighter limit after a silence), with
-/// steps taken modulo 2^24 and a step backwards being one of more than 2^23.
-///
-/// A separate type rather than a wider [`PacketSequence`], so that the HW-FOC and DataLink
-/// statistics keep their sizes. Counters are `u32` and saturate; 24 bytes.
-///
-/// ```
-/// use hwfoc::counters::PacketSequence24;
-///
-/// let mut s = PacketSequence24::new();
-/// for n in [0xFF_FFFE, 0xFF_FFFF, 0, 3, 3, 100_000] {
-///     s.next(n);
-/// }
-/// assert_eq!((s.count(), s.lost(), s.duplicates(), s.restarts()), (6, 2, 1, 1));
-/// assert_eq!(s.last(), Some(100_000));
-/// ```
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
-pub struct PacketSequence24 {
-    count: u32,
-    lost: u32,
-    duplicates: u32,
-    restarts: u32,
-    last: u32,
-    /// As [`PacketSequence`]'s: 0 means `MAX_PACKET_GAP + 1`.
-    gap_limit: u32,
-}
-
-impl PacketSequence24 {
-    /// No number seen yet.
-    pub const fn new() -> Self {
-        PacketSequence24 {
-            count: 0,
-            lost: 0,
-            duplicates: 0,
-            restarts: 0,
-            last: 0,
-            gap_limit: 0,
-        }
-    }
-
-    /// Numbers seen.
-    pub const fn count(&self) -> u32 {
-        self.count
-    }
-
-    /// Numbers missing between consecutive numbers: a step of `d = (next - last) mod 2^24`
-    /// counts `d - 1` when `2 <= d <= MAX_PACKET_GAP + 1` (after a silence, the limit it set).
-    pub const fn lost(&self) -> u32 {
-        self.lost
-    }
-
-    /// Numbers equal to the one before.
-    pub const fn duplicates(&self) -> u32 {
-        self.duplicates
-    }
-
-    /// Numbers that start a new sequence: a step backwards (`d > 2^23`) or forwards beyond the
-    /// gap limit.
-    pub const fn restarts(&self) -> u32 {
-        self.restarts
-    }
-
-    /// The last number seen, if any.
-    pub const fn last(&self) -> Option<u32> {
-        if self.count == 0 {
-            None
-        } else {
-            Some(self.last)
-        }
-    }
-
-    /// Fraction of expected numbers that arrived: `count / (count + lost)`, or `None` before
-    /// the first.
-    pub fn delivery_ratio(&self) -> Option<f64> {
-        if self.count == 0 {
-            return None;
-        }
-        let count = f64::from(self.count);
-        Some(count / (count + f64::from(self.lost)))
-    }
-
-    /// The line was silent for a time in which at most `max_frames` numbers could have been
-    /// sent, as for [`PacketSequence`]: the next step counts as a loss only up to
-    /// `max_frames + 1` (at most 2^23); silences before one number add up.
-    pub fn line_silent(&mut self, max_frames: u32) {
-        let limit = if self.gap_limit == 0 {
-            1
-        } else {
-            self.gap_limit
-        };
-        self.gap_limit = limit.saturating_add(max_frames).min(MAX_FORWARD_STEP24);
-    }
-
-    /// Takes the next number (its low 24 bits) and classifies its step from the last one.
-    #[inline]
-    pub fn next(&mut self, number: u32) {
-        let number = number & COUNTER24_MAX;
-        if self.count != 0 {
-            let limit = if self.gap_limit == 0 {
+            let limit = if gap_limit == 0 {
                 u32::from(MAX_PACKET_GAP) + 1
             } else {
-                self.gap_limit
+                gap_limit
             };
-            match number.wrapping_sub(self.last) & COUNTER24_MAX {
+            match number.wrapping_sub(last) & W::MAX {
                 0 => self.duplicates = self.duplicates.saturating_add(1),
+                // The next number (a step of 1) loses nothing; the limit is at least 1.
                 step if step <= limit => self.lost = self.lost.saturating_add(step - 1),
                 _ => self.restarts = self.restarts.saturating_add(1),
             }
         }
-        self.gap_limit = 0;
+        self.gap_limit = W::ZERO;
         self.count = self.count.saturating_add(1);
-        self.last = number;
+        self.last = W::number(number);
     }
 }
 

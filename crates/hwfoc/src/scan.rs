@@ -110,6 +110,118 @@ impl<T> Candidate<T> {
     }
 }
 
+/// Statistics that count the bytes a scanner passes over (as [`next_candidate`] needs).
+pub(crate) trait SkipBytes {
+    /// Counts `n` bytes skipped.
+    fn skip(&mut self, n: usize);
+}
+
+/// The search loop of a scanner that stops at candidate starts and decides each (V3, V4,
+/// HW5): from `*pos`, `find` gives the offset of the next candidate start in the bytes left
+/// (the bytes before it are skipped), and `take` decides the candidate at `*pos`. A frame is
+/// returned, with `*pos` where `take` left it (just after the frame); a rejected candidate
+/// costs one byte and the search goes on. `None` when no further frame can be decided: `*pos`
+/// is then `data.len()`, or the start of a candidate `take` found undecided (nothing of it
+/// counted yet).
+#[inline(always)]
+pub(crate) fn next_candidate<St: SkipBytes, T>(
+    data: &[u8],
+    pos: &mut usize,
+    stats: &mut St,
+    find: impl Fn(&[u8]) -> Option<usize>,
+    mut take: impl FnMut(&[u8], &mut usize, &mut St) -> Candidate<T>,
+) -> Option<T> {
+    loop {
+        let Some(k) = find(&data[*pos..]) else {
+            stats.skip(data.len() - *pos);
+            *pos = data.len();
+            return None;
+        };
+        stats.skip(k);
+        let i = *pos + k;
+        *pos = i;
+        match take(data, pos, stats) {
+            Candidate::Frame(frame) => return Some(frame),
+            Candidate::Undecided => return None,
+            Candidate::Rejected => {}
+        }
+        stats.skip(1);
+        *pos = i + 1;
+    }
+}
+
+/// The streaming layer's traits for a protocol whose scanner is a function
+/// `$next(data, pos, base, stats, at_end) -> Option<(usize, Frame)>` (a frame and its start in
+/// `data`, whose first byte is at stream offset `base`; see [`next_candidate`]), its items
+/// `$item { offset, frame }`: [`Scanner`] for `$scanner`, [`Stats`] for `$stats` (whose
+/// `new`, `bytes`, `add_bytes` and `line_silent` it calls), `$max_len` the longest candidate
+/// and `$candidate_len(held)` the fewest bytes that may decide one. Used by V3, V4 and HW5.
+macro_rules! impl_scanner {
+    ($scanner:ty, $stats:ty, $item:ident, $max_len:expr, $candidate_len:expr, $next:path) => {
+        impl $crate::scan::sealed::Sealed for $scanner {}
+        impl $crate::scan::sealed::Sealed for $stats {}
+
+        impl $crate::scan::Stats for $stats {
+            const NEW: Self = <$stats>::new();
+
+            #[inline]
+            fn bytes(&self) -> u64 {
+                <$stats>::bytes(self)
+            }
+
+            #[inline]
+            fn add_bytes(&mut self, n: usize) {
+                <$stats>::add_bytes(self, n);
+            }
+
+            fn line_silent(&mut self, max_frames: u32) {
+                <$stats>::line_silent(self, max_frames);
+            }
+        }
+
+        impl $crate::scan::Scanner for $scanner {
+            type Item = $item;
+            type Stats = $stats;
+            type Held = [u8; $max_len - 1];
+            type Pair = [u8; 2 * $max_len];
+            const HELD: Self::Held = [0; $max_len - 1];
+            const PAIR: Self::Pair = [0; 2 * $max_len];
+            const MAX_LEN: usize = $max_len;
+
+            #[inline(always)]
+            fn candidate_len(held: &[u8]) -> usize {
+                ($candidate_len)(held)
+            }
+
+            #[inline(never)]
+            fn scan_all<const AT_END: bool>(
+                data: &[u8],
+                base: u64,
+                stats: &mut $stats,
+                on_frame: &mut impl FnMut($item),
+            ) -> usize {
+                let mut pos = 0;
+                while let Some((at, frame)) = $next(data, &mut pos, base, stats, AT_END) {
+                    on_frame($item {
+                        offset: base + at as u64,
+                        frame,
+                    });
+                }
+                pos
+            }
+
+            #[inline]
+            fn scan_next(data: &[u8], pos: &mut usize, stats: &mut $stats) -> Option<$item> {
+                $next(data, pos, 0, stats, true).map(|(at, frame)| $item {
+                    offset: at as u64,
+                    frame,
+                })
+            }
+        }
+    };
+}
+pub(crate) use impl_scanner;
+
 pub(crate) mod sealed {
     /// Keeps [`Scanner`](super::Scanner) and [`Stats`](super::Stats) to this crate.
     pub trait Sealed {}

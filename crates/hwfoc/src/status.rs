@@ -4,8 +4,6 @@
 //! byte, bit 8 of the high byte. Names are those of `docs/PROTOCOL-NOTES.md` and are stable across every
 //! output of the project.
 
-use core::fmt;
-
 /// One bit of the status word.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
 #[repr(u8)]
@@ -65,25 +63,6 @@ impl Fault {
         Fault::Reserved15,
     ];
 
-    /// The bit number, 0..=15.
-    pub const fn bit(self) -> u8 {
-        self as u8
-    }
-
-    /// The flag's mask in the status word.
-    pub const fn mask(self) -> u16 {
-        1 << (self as u8)
-    }
-
-    /// The flag for bit `bit`, or `None` above 15.
-    pub const fn from_bit(bit: u8) -> Option<Fault> {
-        if bit < 16 {
-            Some(Self::ALL[bit as usize])
-        } else {
-            None
-        }
-    }
-
     /// The stable machine name used in every output, e.g. `mos_overheat`.
     pub const fn name(self) -> &'static str {
         match self {
@@ -104,11 +83,6 @@ impl Fault {
             Fault::OpampPhaseA => "opamp_phase_a",
             Fault::Reserved15 => "reserved_15",
         }
-    }
-
-    /// The flag whose [`Fault::name`] is `name`.
-    pub fn from_name(name: &str) -> Option<Fault> {
-        Self::ALL.into_iter().find(|f| f.name() == name)
     }
 
     /// A short English description, e.g. "MOSFET overheat".
@@ -134,12 +108,6 @@ impl Fault {
     }
 }
 
-impl fmt::Display for Fault {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(self.name())
-    }
-}
-
 /// The raw status word with named access to its flags.
 ///
 /// ```
@@ -153,85 +121,140 @@ impl fmt::Display for Fault {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
 pub struct Status(pub u16);
 
-impl Status {
-    /// No flag set.
-    pub const OK: Status = Status(0);
+fault_flags!(
+    Fault,
+    Status,
+    /// Iterator over the flags set in a status word, in bit order.
+    Faults,
+    u16,
+    "status word",
+    15
+);
 
-    /// Whether `fault` is set.
-    pub const fn contains(self, fault: Fault) -> bool {
-        self.0 & fault.mask() != 0
-    }
-
-    /// Whether no flag is set.
-    pub const fn is_ok(self) -> bool {
-        self.0 == 0
-    }
-
-    /// The word with `fault` set as well.
-    #[must_use]
-    pub const fn with(self, fault: Fault) -> Status {
-        Status(self.0 | fault.mask())
-    }
-
-    /// The set flags, in bit order (bit 0 first).
-    pub fn faults(self) -> Faults {
-        Faults(self.0)
-    }
-}
-
-impl From<u16> for Status {
-    fn from(word: u16) -> Self {
-        Status(word)
-    }
-}
-
-impl FromIterator<Fault> for Status {
-    fn from_iter<I: IntoIterator<Item = Fault>>(iter: I) -> Self {
-        Status(iter.into_iter().fold(0, |w, f| w | f.mask()))
-    }
-}
-
-impl IntoIterator for Status {
-    type Item = Fault;
-    type IntoIter = Faults;
-    fn into_iter(self) -> Faults {
-        self.faults()
-    }
-}
-
-impl fmt::Display for Status {
-    /// The set flags' names joined by `|` (the CSV form), or nothing when no flag is set.
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        for (i, fault) in self.faults().enumerate() {
-            if i > 0 {
-                f.write_str("|")?;
+/// The flag-set behaviour shared by HW-FOC's status word and HW5's fault byte: for a
+/// `#[repr(u8)]` enum `$fault` of the bits of a `$word` (with its own `ALL` in bit order and
+/// `name`), its `bit`, `mask`, `from_bit`, `from_name` and `Display` (the name); for the
+/// tuple struct `$flags($word)`, named access to its flags (`OK`, `contains`, `is_ok`, `with`,
+/// `faults`, `From<$word>`, `FromIterator<$fault>`, `IntoIterator`, and `Display`: the set
+/// flags' names joined by `|`, the CSV form); and `$faults`, the iterator over the flags set,
+/// in bit order. `$what` names the word in the docs; `$max` is its highest bit.
+macro_rules! fault_flags {
+    ($fault:ident, $flags:ident, $(#[$faults_doc:meta])* $faults:ident, $word:ty, $what:literal, $max:literal) => {
+        impl $fault {
+            #[doc = concat!("The bit number, 0..=", $max, ".")]
+            pub const fn bit(self) -> u8 {
+                self as u8
             }
-            f.write_str(fault.name())?;
+
+            #[doc = concat!("The flag's mask in the ", $what, ".")]
+            pub const fn mask(self) -> $word {
+                1 << (self as u8)
+            }
+
+            #[doc = concat!("The flag for bit `bit`, or `None` above ", $max, ".")]
+            pub const fn from_bit(bit: u8) -> Option<$fault> {
+                if bit <= $max {
+                    Some(Self::ALL[bit as usize])
+                } else {
+                    None
+                }
+            }
+
+            #[doc = concat!("The flag whose [`", stringify!($fault), "::name`] is `name`.")]
+            pub fn from_name(name: &str) -> Option<$fault> {
+                Self::ALL.into_iter().find(|f| f.name() == name)
+            }
         }
-        Ok(())
-    }
-}
 
-/// Iterator over the flags set in a status word, in bit order.
-#[derive(Debug, Clone)]
-pub struct Faults(u16);
-
-impl Iterator for Faults {
-    type Item = Fault;
-
-    fn next(&mut self) -> Option<Fault> {
-        if self.0 == 0 {
-            return None;
+        impl core::fmt::Display for $fault {
+            fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+                f.write_str(self.name())
+            }
         }
-        let bit = self.0.trailing_zeros() as u8;
-        self.0 &= self.0 - 1;
-        Fault::from_bit(bit)
-    }
 
-    fn size_hint(&self) -> (usize, Option<usize>) {
-        let n = self.0.count_ones() as usize;
-        (n, Some(n))
-    }
+        impl $flags {
+            /// No flag set.
+            pub const OK: $flags = $flags(0);
+
+            /// Whether `fault` is set.
+            pub const fn contains(self, fault: $fault) -> bool {
+                self.0 & fault.mask() != 0
+            }
+
+            /// Whether no flag is set.
+            pub const fn is_ok(self) -> bool {
+                self.0 == 0
+            }
+
+            #[doc = concat!("The ", $what, " with `fault` set as well.")]
+            #[must_use]
+            pub const fn with(self, fault: $fault) -> $flags {
+                $flags(self.0 | fault.mask())
+            }
+
+            /// The set flags, in bit order (bit 0 first).
+            pub fn faults(self) -> $faults {
+                $faults(self.0)
+            }
+        }
+
+        impl From<$word> for $flags {
+            fn from(word: $word) -> Self {
+                $flags(word)
+            }
+        }
+
+        impl FromIterator<$fault> for $flags {
+            fn from_iter<I: IntoIterator<Item = $fault>>(iter: I) -> Self {
+                $flags(iter.into_iter().fold(0, |w, f| w | f.mask()))
+            }
+        }
+
+        impl IntoIterator for $flags {
+            type Item = $fault;
+            type IntoIter = $faults;
+            fn into_iter(self) -> $faults {
+                self.faults()
+            }
+        }
+
+        impl core::fmt::Display for $flags {
+            /// The set flags' names joined by `|` (the CSV form), or nothing when no flag is
+            /// set.
+            fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+                for (i, fault) in self.faults().enumerate() {
+                    if i > 0 {
+                        f.write_str("|")?;
+                    }
+                    f.write_str(fault.name())?;
+                }
+                Ok(())
+            }
+        }
+
+        $(#[$faults_doc])*
+        #[derive(Debug, Clone)]
+        pub struct $faults($word);
+
+        impl Iterator for $faults {
+            type Item = $fault;
+
+            fn next(&mut self) -> Option<$fault> {
+                if self.0 == 0 {
+                    return None;
+                }
+                let bit = self.0.trailing_zeros() as u8;
+                self.0 &= self.0 - 1;
+                $fault::from_bit(bit)
+            }
+
+            fn size_hint(&self) -> (usize, Option<usize>) {
+                let n = self.0.count_ones() as usize;
+                (n, Some(n))
+            }
+        }
+
+        impl ExactSizeIterator for $faults {}
+    };
 }
-
-impl ExactSizeIterator for Faults {}
+pub(crate) use fault_flags;

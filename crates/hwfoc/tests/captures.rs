@@ -2,13 +2,16 @@
 //! `shared/captures/`, kept in the repository so that a clone alone passes; see
 //! `testdata/README.md` for their source).
 
-use hwfoc::foc::{DataFrame, Decoded, Decoder, Frame, InfoFrame, frames};
+use hwfoc::foc::{DataFrame, Decoded, Decoder, Frame, InfoFrame};
 use hwfoc::{Settings, foc};
 
-const CAPTURES: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../testdata/captures/");
-const XROTOR: &str = "xrotor-v4-pro-hv-80A.csv";
-const PLATINUM_V4: &str = "platinum-v4.csv";
-const PLATINUM_PRO_V3: &str = "platinum-pro-v3.csv";
+use older::{PLATINUM_PRO_V3, PLATINUM_V4, XROTOR};
+
+#[allow(dead_code)] // the property tests' generators
+mod common;
+#[allow(dead_code)] // the V3 and V4 tests' helpers
+mod older;
+
 const ALL: [&str; 3] = [XROTOR, PLATINUM_V4, PLATINUM_PRO_V3];
 
 /// One capture: the byte values and, row for row, the time of each byte.
@@ -17,65 +20,23 @@ struct Capture {
     bytes: Vec<u8>,
 }
 
-/// Reads a logic-analyser CSV export: header `Time [s],Value,Parity Error,Framing Error`, then
-/// one row per byte with the value written `0xNN`.
+/// Reads a logic-analyser CSV export (the loader of `older/mod.rs`).
 fn load(name: &str) -> Capture {
-    let path = format!("{CAPTURES}{name}");
-    let text = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{path}: {e}"));
-    let mut lines = text.lines();
-    assert_eq!(
-        lines.next(),
-        Some("Time [s],Value,Parity Error,Framing Error"),
-        "{name}: header"
-    );
-    let mut capture = Capture {
-        times: Vec::new(),
-        bytes: Vec::new(),
-    };
-    for (i, line) in lines.enumerate() {
-        if line.is_empty() {
-            continue;
-        }
-        let cols: Vec<&str> = line.split(',').collect();
-        assert_eq!(cols.len(), 4, "{name} row {i}: {line:?}");
-        let time: f64 = cols[0]
-            .parse()
-            .unwrap_or_else(|e| panic!("{name} row {i}: time {:?}: {e}", cols[0]));
-        let hex = cols[1]
-            .strip_prefix("0x")
-            .unwrap_or_else(|| panic!("{name} row {i}: value {:?}", cols[1]));
-        let byte = u8::from_str_radix(hex, 16)
-            .unwrap_or_else(|e| panic!("{name} row {i}: value {:?}: {e}", cols[1]));
-        capture.times.push(time);
-        capture.bytes.push(byte);
-    }
-    capture
+    let (times, bytes) = older::load_timed(name);
+    Capture { times, bytes }
 }
 
+/// The bulk path over the HW-FOC scanner (shared with the V3 and V4 tests).
 fn bulk(bytes: &[u8]) -> (Vec<Decoded>, foc::Stats) {
-    let mut it = frames(bytes);
-    let out: Vec<Decoded> = it.by_ref().collect();
-    (out, *it.stats())
+    older::bulk::<foc::Scanner>(bytes)
 }
 
 fn streamed_bytewise(bytes: &[u8]) -> (Vec<Decoded>, foc::Stats) {
-    let mut d = Decoder::new();
-    let mut out = Vec::new();
-    for &b in bytes {
-        d.push(b, |x| out.push(x));
-    }
-    d.flush(|x| out.push(x));
-    (out, *d.stats())
+    common::streamed_bytewise::<foc::Scanner>(bytes)
 }
 
 fn streamed_chunks(bytes: &[u8], size: usize) -> (Vec<Decoded>, foc::Stats) {
-    let mut d = Decoder::new();
-    let mut out = Vec::new();
-    for chunk in bytes.chunks(size) {
-        d.feed(chunk, |x| out.push(x));
-    }
-    d.flush(|x| out.push(x));
-    (out, *d.stats())
+    older::streamed_chunks::<foc::Scanner>(bytes, size)
 }
 
 fn data(decoded: &[Decoded]) -> Vec<(u64, DataFrame)> {

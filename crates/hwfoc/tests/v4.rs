@@ -9,8 +9,8 @@ mod older;
 use common::{cut_points, streamed_bytewise};
 use hwfoc::counters::PacketSequence24;
 use hwfoc::v4::{
-    self, DATA_FRAME_LEN, Data, DataFrame, Decoded, Decoder, Frame, INFO_FRAME_LEN, InfoFrame,
-    Scanner, VoltsPerStep,
+    self, DATA_FRAME_LEN, Data, DataFrame, Decoded, Frame, INFO_FRAME_LEN, InfoFrame, Scanner,
+    VoltsPerStep,
 };
 use hwfoc::{foc, v3};
 use older::{PLATINUM_PRO_V3, PLATINUM_V4, RANDOM_LEN, Rng, XROTOR, bulk, load};
@@ -134,25 +134,12 @@ fn capture_values() {
 #[test]
 fn capture_in_any_chunking() {
     let bytes = load(PLATINUM_V4);
-    let reference = bulk::<Scanner>(&bytes);
-    assert_eq!(
-        streamed_bytewise::<Scanner>(&bytes),
-        reference,
-        "byte at a time"
+    older::assert_every_path_agrees::<Scanner>(
+        &bytes,
+        &[
+            2, 3, 12, 13, 14, 18, 19, 20, 21, 32, 33, 59, 60, 61, 1000, 7000,
+        ],
     );
-    for size in [
-        2, 3, 12, 13, 14, 18, 19, 20, 21, 32, 33, 59, 60, 61, 1000, 7000,
-    ] {
-        assert_eq!(
-            older::streamed_chunks::<Scanner>(&bytes, size),
-            reference,
-            "chunks of {size}"
-        );
-    }
-    let mut all_at_once = Decoder::new();
-    let mut out = Vec::new();
-    all_at_once.decode_all(&bytes, |d| out.push(d));
-    assert_eq!((out, *all_at_once.stats()), reference, "decode_all");
 }
 
 #[test]

@@ -20,7 +20,7 @@
 //! for the same bytes however the stream is cut into chunks.
 
 use crate::foc::decoder::bytes_equal;
-use crate::scan::{self, Candidate, Scan, StreamDecoder};
+use crate::scan::{self, Candidate, Scan, SkipBytes, StreamDecoder, impl_scanner};
 
 use super::frame::{TelemetryFrame, crc_ok};
 use super::layout::{
@@ -202,35 +202,32 @@ pub(crate) fn take_candidate(
 }
 
 /// Finds the next telemetry frame in `data` from `*pos`, counting what it passes over in
-/// `stats` (frames of other kinds are taken and counted on the way).
-///
-/// Returns the frame and its start offset, with `*pos` just after it. Returns `None` when no
-/// further frame can be decided: `*pos` is then `data.len()`, or, unless `at_end`, the start of
-/// a candidate that needs more bytes (nothing of it counted yet).
+/// `stats` (frames of other kinds are taken and counted on the way): the search loop of
+/// [`scan::next_candidate`] over [`find_start`] and [`take_candidate`]. Offsets are in `data`
+/// (`_base`, the stream offset of its first byte, is not needed).
 #[inline(always)]
 fn scan_next(
     data: &[u8],
     pos: &mut usize,
+    _base: u64,
     stats: &mut Stats,
     at_end: bool,
 ) -> Option<(usize, TelemetryFrame)> {
     loop {
-        let Some(k) = find_start(&data[*pos..]) else {
-            stats.skip(data.len() - *pos);
-            *pos = data.len();
-            return None;
+        let take = |data: &[u8], pos: &mut usize, stats: &mut Stats| {
+            take_candidate(data, pos, stats, at_end)
         };
-        stats.skip(k);
-        let i = *pos + k;
-        *pos = i;
-        match take_candidate(data, pos, stats, at_end) {
-            Candidate::Frame((at, Taken::Telemetry(frame))) => return Some((at, frame)),
-            Candidate::Frame((_, Taken::Other(_))) => continue,
-            Candidate::Undecided => return None,
-            Candidate::Rejected => {}
+        match scan::next_candidate(data, pos, stats, find_start, take)? {
+            (at, Taken::Telemetry(frame)) => return Some((at, frame)),
+            (_, Taken::Other(_)) => {}
         }
-        stats.skip(1);
-        *pos = i + 1;
+    }
+}
+
+impl SkipBytes for Stats {
+    #[inline]
+    fn skip(&mut self, n: usize) {
+        Stats::skip(self, n);
     }
 }
 
@@ -239,66 +236,14 @@ fn scan_next(
 #[derive(Debug, Clone, Copy, Default)]
 pub struct Scanner;
 
-impl crate::scan::sealed::Sealed for Scanner {}
-impl crate::scan::sealed::Sealed for Stats {}
-
-impl scan::Stats for Stats {
-    const NEW: Self = Stats::new();
-
-    #[inline]
-    fn bytes(&self) -> u64 {
-        Stats::bytes(self)
-    }
-
-    #[inline]
-    fn add_bytes(&mut self, n: usize) {
-        Stats::add_bytes(self, n);
-    }
-
-    fn line_silent(&mut self, max_frames: u32) {
-        Stats::line_silent(self, max_frames);
-    }
-}
-
-impl scan::Scanner for Scanner {
-    type Item = Decoded;
-    type Stats = Stats;
-    type Held = [u8; MAX_FRAME_LEN - 1];
-    type Pair = [u8; 2 * MAX_FRAME_LEN];
-    const HELD: Self::Held = [0; MAX_FRAME_LEN - 1];
-    const PAIR: Self::Pair = [0; 2 * MAX_FRAME_LEN];
-    const MAX_LEN: usize = MAX_FRAME_LEN;
-
-    #[inline(always)]
-    fn candidate_len(held: &[u8]) -> usize {
-        candidate_len(held)
-    }
-
-    #[inline(never)]
-    fn scan_all<const AT_END: bool>(
-        data: &[u8],
-        base: u64,
-        stats: &mut Stats,
-        on_frame: &mut impl FnMut(Decoded),
-    ) -> usize {
-        let mut pos = 0;
-        while let Some((at, frame)) = scan_next(data, &mut pos, stats, AT_END) {
-            on_frame(Decoded {
-                offset: base + at as u64,
-                frame,
-            });
-        }
-        pos
-    }
-
-    #[inline]
-    fn scan_next(data: &[u8], pos: &mut usize, stats: &mut Stats) -> Option<Decoded> {
-        scan_next(data, pos, stats, true).map(|(at, frame)| Decoded {
-            offset: at as u64,
-            frame,
-        })
-    }
-}
+impl_scanner!(
+    Scanner,
+    Stats,
+    Decoded,
+    MAX_FRAME_LEN,
+    candidate_len,
+    scan_next
+);
 
 /// A streaming HW5 decoder: feed it bytes in any chunking, get every telemetry frame once (the
 /// streaming layer's [`StreamDecoder`] over the HW5 scanner).

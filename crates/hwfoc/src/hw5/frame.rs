@@ -7,8 +7,6 @@
 //!                                                    (LE)    (LE)    (LE)    degC degC degC  *10    *10
 //! ```
 
-use core::fmt;
-
 use crate::foc::FrameError;
 
 use super::error::Error;
@@ -53,25 +51,6 @@ impl Fault {
         Fault::MotorConnectionError,
     ];
 
-    /// The bit number, 0..=7.
-    pub const fn bit(self) -> u8 {
-        self as u8
-    }
-
-    /// The flag's mask in the fault byte.
-    pub const fn mask(self) -> u8 {
-        1 << (self as u8)
-    }
-
-    /// The flag for bit `bit`, or `None` above 7.
-    pub const fn from_bit(bit: u8) -> Option<Fault> {
-        if bit < 8 {
-            Some(Self::ALL[bit as usize])
-        } else {
-            None
-        }
-    }
-
     /// The stable machine name, e.g. `throttle_signal_lost`.
     pub const fn name(self) -> &'static str {
         match self {
@@ -84,11 +63,6 @@ impl Fault {
             Fault::InputVoltageError => "input_voltage_error",
             Fault::MotorConnectionError => "motor_connection_error",
         }
-    }
-
-    /// The flag whose [`Fault::name`] is `name`.
-    pub fn from_name(name: &str) -> Option<Fault> {
-        Self::ALL.into_iter().find(|f| f.name() == name)
     }
 
     /// A short English description, e.g. "throttle signal lost".
@@ -106,12 +80,6 @@ impl Fault {
     }
 }
 
-impl fmt::Display for Fault {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(self.name())
-    }
-}
-
 /// The raw fault byte with named access to its flags.
 ///
 /// ```
@@ -126,88 +94,15 @@ impl fmt::Display for Fault {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
 pub struct FaultCode(pub u8);
 
-impl FaultCode {
-    /// No flag set.
-    pub const OK: FaultCode = FaultCode(0);
-
-    /// Whether `fault` is set.
-    pub const fn contains(self, fault: Fault) -> bool {
-        self.0 & fault.mask() != 0
-    }
-
-    /// Whether no flag is set.
-    pub const fn is_ok(self) -> bool {
-        self.0 == 0
-    }
-
-    /// The byte with `fault` set as well.
-    #[must_use]
-    pub const fn with(self, fault: Fault) -> FaultCode {
-        FaultCode(self.0 | fault.mask())
-    }
-
-    /// The set flags, in bit order (bit 0 first).
-    pub fn faults(self) -> Faults {
-        Faults(self.0)
-    }
-}
-
-impl From<u8> for FaultCode {
-    fn from(byte: u8) -> Self {
-        FaultCode(byte)
-    }
-}
-
-impl FromIterator<Fault> for FaultCode {
-    fn from_iter<I: IntoIterator<Item = Fault>>(iter: I) -> Self {
-        FaultCode(iter.into_iter().fold(0, |b, f| b | f.mask()))
-    }
-}
-
-impl IntoIterator for FaultCode {
-    type Item = Fault;
-    type IntoIter = Faults;
-    fn into_iter(self) -> Faults {
-        self.faults()
-    }
-}
-
-impl fmt::Display for FaultCode {
-    /// The set flags' names joined by `|`, or nothing when no flag is set.
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        for (i, fault) in self.faults().enumerate() {
-            if i > 0 {
-                f.write_str("|")?;
-            }
-            f.write_str(fault.name())?;
-        }
-        Ok(())
-    }
-}
-
-/// Iterator over the flags set in a fault byte, in bit order.
-#[derive(Debug, Clone)]
-pub struct Faults(u8);
-
-impl Iterator for Faults {
-    type Item = Fault;
-
-    fn next(&mut self) -> Option<Fault> {
-        if self.0 == 0 {
-            return None;
-        }
-        let bit = self.0.trailing_zeros() as u8;
-        self.0 &= self.0 - 1;
-        Fault::from_bit(bit)
-    }
-
-    fn size_hint(&self) -> (usize, Option<usize>) {
-        let n = self.0.count_ones() as usize;
-        (n, Some(n))
-    }
-}
-
-impl ExactSizeIterator for Faults {}
+crate::status::fault_flags!(
+    Fault,
+    FaultCode,
+    /// Iterator over the flags set in a fault byte, in bit order.
+    Faults,
+    u8,
+    "fault byte",
+    7
+);
 
 /// One HW5 telemetry frame (type 0x5C30), every field as the raw integer sent on the wire;
 /// physical values come from the conversion methods.

@@ -24,8 +24,9 @@
 //! start (the held bytes of a [`Decoder`]), and each decision reads only bytes that are there.
 //! So both decoders give the same frames and statistics however the stream is cut into chunks.
 
+use crate::chain::{self, Verdict};
 use crate::counters::COUNTER24_MAX;
-use crate::scan::{self, Scan, StreamDecoder};
+use crate::scan::{Scan, StreamDecoder, impl_scanner};
 use crate::wire::SYNC;
 
 use super::frame::{FRAME_LEN, Frame};
@@ -47,20 +48,10 @@ pub struct Decoded {
     pub frame: Frame,
 }
 
-/// What a candidate is.
-enum Verdict {
-    /// A frame: chained (`false`), or the first of a chain of three (`true`).
-    Frame(Frame, bool),
-    Implausible,
-    Unconfirmed,
-    /// More bytes are needed.
-    Undecided,
-}
-
 /// Judges the candidate at the start of `c` (a `9B` at stream offset `at`) from the bytes
 /// there; decided by at most [`MAX_LEN`] bytes.
 #[inline(always)]
-fn judge(c: &[u8], at: u64, stats: &Stats) -> Verdict {
+fn judge(c: &[u8], at: u64, stats: &Stats) -> Verdict<Frame> {
     let Some(first) = c.first_chunk::<FRAME_LEN>() else {
         return Verdict::Undecided;
     };
@@ -104,11 +95,8 @@ const fn candidate_len(held: usize) -> usize {
     }
 }
 
-/// Finds the next frame in `data` (its first byte at stream offset `base`) from `*pos`,
-/// counting what it passes over in `stats`. Returns the frame and its start in `data`, with
-/// `*pos` just after it; `None` when no further frame can be decided: `*pos` is then
-/// `data.len()`, or, unless `at_end`, the start of a candidate that needs more bytes (nothing
-/// of it counted yet).
+/// Finds the next frame in `data` (its first byte at stream offset `base`) from `*pos`, as
+/// [`chain::scan_next`] does with V3's [`judge`].
 #[inline(always)]
 fn scan_next(
     data: &[u8],
@@ -117,31 +105,18 @@ fn scan_next(
     stats: &mut Stats,
     at_end: bool,
 ) -> Option<(usize, Frame)> {
-    loop {
-        let Some(k) = data[*pos..].iter().position(|&b| b == SYNC) else {
-            stats.skip(data.len() - *pos);
-            *pos = data.len();
-            return None;
-        };
-        stats.skip(k);
-        let i = *pos + k;
-        *pos = i;
-        let at = base + i as u64;
-        match judge(&data[i..], at, stats) {
-            Verdict::Frame(frame, synced) => {
-                stats.accept(at, &frame, synced);
-                *pos = i + FRAME_LEN;
-                return Some((i, frame));
-            }
-            Verdict::Implausible => stats.reject_implausible(),
-            Verdict::Unconfirmed => stats.reject_unconfirmed(),
-            Verdict::Undecided if !at_end => return None,
-            // Cut off by the end of the stream: skipped, not counted as rejected.
-            Verdict::Undecided => {}
-        }
-        stats.skip(1);
-        *pos = i + 1;
-    }
+    chain::scan_next(
+        data,
+        pos,
+        base,
+        stats,
+        at_end,
+        judge,
+        |stats, at, frame, synced| {
+            stats.accept(at, &frame, synced);
+            (FRAME_LEN, frame)
+        },
+    )
 }
 
 /// The V3 scanner, as the streaming layer ([`crate::scan`]) runs it: [`Decoder`] and
@@ -149,66 +124,14 @@ fn scan_next(
 #[derive(Debug, Clone, Copy, Default)]
 pub struct Scanner;
 
-impl crate::scan::sealed::Sealed for Scanner {}
-impl crate::scan::sealed::Sealed for Stats {}
-
-impl scan::Stats for Stats {
-    const NEW: Self = Stats::new();
-
-    #[inline]
-    fn bytes(&self) -> u64 {
-        Stats::bytes(self)
-    }
-
-    #[inline]
-    fn add_bytes(&mut self, n: usize) {
-        Stats::add_bytes(self, n);
-    }
-
-    fn line_silent(&mut self, max_frames: u32) {
-        Stats::line_silent(self, max_frames);
-    }
-}
-
-impl scan::Scanner for Scanner {
-    type Item = Decoded;
-    type Stats = Stats;
-    type Held = [u8; MAX_LEN - 1];
-    type Pair = [u8; 2 * MAX_LEN];
-    const HELD: Self::Held = [0; MAX_LEN - 1];
-    const PAIR: Self::Pair = [0; 2 * MAX_LEN];
-    const MAX_LEN: usize = MAX_LEN;
-
-    #[inline(always)]
-    fn candidate_len(held: &[u8]) -> usize {
-        candidate_len(held.len())
-    }
-
-    #[inline(never)]
-    fn scan_all<const AT_END: bool>(
-        data: &[u8],
-        base: u64,
-        stats: &mut Stats,
-        on_frame: &mut impl FnMut(Decoded),
-    ) -> usize {
-        let mut pos = 0;
-        while let Some((at, frame)) = scan_next(data, &mut pos, base, stats, AT_END) {
-            on_frame(Decoded {
-                offset: base + at as u64,
-                frame,
-            });
-        }
-        pos
-    }
-
-    #[inline]
-    fn scan_next(data: &[u8], pos: &mut usize, stats: &mut Stats) -> Option<Decoded> {
-        scan_next(data, pos, 0, stats, true).map(|(at, frame)| Decoded {
-            offset: at as u64,
-            frame,
-        })
-    }
-}
+impl_scanner!(
+    Scanner,
+    Stats,
+    Decoded,
+    MAX_LEN,
+    |held: &[u8]| candidate_len(held.len()),
+    scan_next
+);
 
 /// A streaming V3 decoder: feed it bytes in any chunking, get every frame once (the streaming
 /// layer's [`StreamDecoder`] over the V3 scanner).

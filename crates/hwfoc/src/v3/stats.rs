@@ -3,7 +3,9 @@
 
 use core::fmt;
 
-use crate::counters::{ByteCounts, Bytes, COUNTER24_MAX, PacketSequence24};
+use crate::chain::{ChainStats, Counts};
+use crate::counters::{COUNTER24_MAX, PacketSequence24};
+use crate::scan::SkipBytes;
 
 use super::frame::{FRAME_LEN, Frame};
 
@@ -25,11 +27,7 @@ use super::frame::{FRAME_LEN, Frame};
 /// a [restart](Stats::restarts).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
 pub struct Stats {
-    bytes: ByteCounts,
-    implausible: u32,
-    unconfirmed: u32,
-    syncs: u32,
-    counter: PacketSequence24,
+    counts: Counts,
     /// Stream offset just after the last accepted frame: where a chained frame starts.
     chain_end: Option<u64>,
 }
@@ -38,79 +36,75 @@ impl Stats {
     /// All counters zero, not locked.
     pub const fn new() -> Self {
         Stats {
-            bytes: ByteCounts::new(),
-            implausible: 0,
-            unconfirmed: 0,
-            syncs: 0,
-            counter: PacketSequence24::new(),
+            counts: Counts::new(),
             chain_end: None,
         }
     }
 
     /// Bytes fed to the decoder.
     pub const fn bytes(&self) -> u64 {
-        self.bytes.get(Bytes::Fed)
+        self.counts.bytes()
     }
 
     /// Bytes that were not part of an accepted frame: noise, rejected and cut frames, other
     /// formats.
     pub const fn bytes_skipped(&self) -> u64 {
-        self.bytes.get(Bytes::Skipped)
+        self.counts.bytes_skipped()
     }
 
     /// Frames accepted.
     pub const fn frames(&self) -> u32 {
-        self.counter.count()
+        self.counts.counter.count()
     }
 
     /// Rejected candidates: [`Stats::implausible`] + [`Stats::unconfirmed`].
     pub const fn rejected(&self) -> u32 {
-        self.implausible.saturating_add(self.unconfirmed)
+        self.counts.rejected()
     }
 
     /// Candidates whose own fields are impossible (throttle or PWM above 255): noise, corrupted
     /// frames, other formats.
     pub const fn implausible(&self) -> u32 {
-        self.implausible
+        self.counts.implausible
     }
 
     /// Plausible candidates that neither continue the chain of accepted frames (right where
     /// the last one ended, with the next counter) nor start a chain of three: noise, a frame
     /// whose counter does not follow, frames around a corrupted one.
     pub const fn unconfirmed(&self) -> u32 {
-        self.unconfirmed
+        self.counts.unconfirmed
     }
 
     /// Frames accepted by a chain of three (the decoder locked, or locked again after a break):
     /// 1 for a clean stream.
     pub const fn syncs(&self) -> u32 {
-        self.syncs
+        self.counts.syncs
     }
 
     /// Counter values missing between accepted frames (as
     /// [`foc::Stats::lost_packets`](crate::foc::Stats::lost_packets), in 24 bits).
     pub const fn lost_frames(&self) -> u32 {
-        self.counter.lost()
+        self.counts.counter.lost()
     }
 
     /// Accepted frames whose counter equals the previous one's.
     pub const fn duplicate_frames(&self) -> u32 {
-        self.counter.duplicates()
+        self.counts.counter.duplicates()
     }
 
     /// Accepted frames whose counter starts a new sequence (the ESC restarted).
     pub const fn restarts(&self) -> u32 {
-        self.counter.restarts()
+        self.counts.counter.restarts()
     }
 
     /// The counter of the last accepted frame, if any.
     pub const fn last_counter(&self) -> Option<u32> {
-        self.counter.last()
+        self.counts.counter.last()
     }
 
     /// The counters of the accepted frames, followed step by step.
     pub const fn counter(&self) -> &PacketSequence24 {
-        &self.counter
+        &self.counts.counter
     }
 
     /// Stream offset just after the last accepted frame, if any: a frame starting there with
@@ -122,7 +116,7 @@ impl Stats {
     /// Whether a frame at stream offset `at` with `counter` continues the chain.
     #[inline(always)]
     pub(crate) fn continues_chain(&self, at: u64, counter: u32) -> bool {
-        match (self.chain_end, self.counter.last()) {
+        match (self.chain_end, self.counts.counter.last()) {
             (Some(end), Some(last)) => end == at && counter == (last + 1) & COUNTER24_MAX,
             _ => false,
         }
@@ -130,36 +124,33 @@ impl Stats {
 
     #[inline]
     pub(crate) fn add_bytes(&mut self, n: usize) {
-        self.bytes.add(Bytes::Fed, n);
-    }
-
-    #[inline]
-    pub(crate) fn skip(&mut self, n: usize) {
-        self.bytes.add(Bytes::Skipped, n);
-    }
-
-    #[inline]
-    pub(crate) fn reject_implausible(&mut self) {
-        self.implausible = self.implausible.saturating_add(1);
-    }
-
-    #[inline]
-    pub(crate) fn reject_unconfirmed(&mut self) {
-        self.unconfirmed = self.unconfirmed.saturating_add(1);
+        self.counts.add_bytes(n);
     }
 
     /// Counts a frame accepted at stream offset `at`; `synced`: by a chain of three.
     #[inline]
     pub(crate) fn accept(&mut self, at: u64, frame: &Frame, synced: bool) {
-        if synced {
-            self.syncs = self.syncs.saturating_add(1);
-        }
-        self.counter.next(frame.counter);
+        self.counts.sync(synced);
+        self.counts.counter.next(frame.counter);
         self.chain_end = Some(at + FRAME_LEN as u64);
     }
 
     pub(crate) fn line_silent(&mut self, max_frames: u32) {
-        self.counter.line_silent(max_frames);
+        self.counts.line_silent(max_frames);
+    }
+}
+
+impl SkipBytes for Stats {
+    #[inline]
+    fn skip(&mut self, n: usize) {
+        self.counts.skip(n);
+    }
+}
+
+impl ChainStats for Stats {
+    #[inline(always)]
+    fn counts(&mut self) -> &mut Counts {
+        &mut self.counts
     }
 }
 
@@ -167,17 +158,10 @@ impl fmt::Display for Stats {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         write!(
             f,
-            "{} bytes, {} frames, {} bytes skipped, {} implausible and {} unconfirmed candidates, \
-             {} syncs, {} lost frames, {} duplicate frames, {} restarts",
+            "{} bytes, {} frames, {}",
             self.bytes(),
             self.frames(),
-            self.bytes_skipped(),
-            self.implausible,
-            self.unconfirmed,
-            self.syncs,
-            self.lost_frames(),
-            self.duplicate_frames(),
-            self.restarts(),
+            self.counts
         )
     }
 }

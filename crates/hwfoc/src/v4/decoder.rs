@@ -38,8 +38,9 @@
 //! start always decide it (the [`Decoder`]'s held bytes). So both decoders give the same frames
 //! and statistics however the stream is cut into chunks.
 
+use crate::chain::{self, Verdict};
 use crate::counters::COUNTER24_MAX;
-use crate::scan::{self, Scan, StreamDecoder};
+use crate::scan::{Scan, StreamDecoder, impl_scanner};
 use crate::wire::SYNC;
 
 use super::data::{Data, DataFrame};
@@ -72,16 +73,10 @@ pub struct Decoded {
     pub frame: Frame,
 }
 
-/// What a candidate is.
-enum Verdict {
-    /// A data frame: chained (`false`) or starting a chain (`true`).
-    Data(DataFrame, bool),
-    /// An info frame: chained (`false`) or starting a chain (`true`).
-    Info(InfoFrame, bool),
-    Implausible,
-    Unconfirmed,
-    /// More bytes are needed.
-    Undecided,
+/// The frame a candidate is found to be (in a [`Verdict`]).
+enum Judged {
+    Data(DataFrame),
+    Info(InfoFrame),
 }
 
 /// What starts at an offset of a candidate's bytes.
@@ -130,7 +125,7 @@ fn found_at(c: &[u8], at: usize, full_scale: u16) -> Found {
 /// Where the frame after a data frame at `c[at..]` starts: after its trailer if byte 19 is
 /// `B9`, right after it if byte 19 is `9B`; `Err` with the verdict otherwise.
 #[inline(always)]
-fn after_data(c: &[u8], at: usize) -> Result<usize, Verdict> {
+fn after_data(c: &[u8], at: usize) -> Result<usize, Verdict<Judged>> {
     match c.get(at + DATA_FRAME_LEN) {
         None => Err(Verdict::Undecided),
         Some(&TRAILER) => Ok(at + SLOW_DATA_FRAME_LEN),
@@ -142,7 +137,7 @@ fn after_data(c: &[u8], at: usize) -> Result<usize, Verdict> {
 /// Judges the candidate at the start of `c` (a `9B` at stream offset `at`) from the bytes
 /// there; decided by at most [`MAX_LEN`] bytes.
 #[inline(always)]
-fn judge(c: &[u8], at: u64, stats: &Stats) -> Verdict {
+fn judge(c: &[u8], at: u64, stats: &Stats) -> Verdict<Judged> {
     let full_scale = stats.full_scale();
     let first = match found_at(c, 0, full_scale) {
         Found::Undecided => return Verdict::Undecided,
@@ -150,7 +145,7 @@ fn judge(c: &[u8], at: u64, stats: &Stats) -> Verdict {
         // Chained or not, an info frame needs a plausible data frame right after it.
         Found::Info(info) => {
             return match found_at(c, INFO_FRAME_LEN, full_scale) {
-                Found::Data(_) => Verdict::Info(info, !stats.chained(at)),
+                Found::Data(_) => Verdict::Frame(Judged::Info(info), !stats.chained(at)),
                 Found::Undecided => Verdict::Undecided,
                 Found::Info(_) | Found::Nothing => Verdict::Unconfirmed,
             };
@@ -158,7 +153,7 @@ fn judge(c: &[u8], at: u64, stats: &Stats) -> Verdict {
         Found::Data(frame) => frame,
     };
     if stats.continues_chain(at, first.counter) {
-        return Verdict::Data(first, false);
+        return Verdict::Frame(Judged::Data(first), false);
     }
     // A new chain: data + info, or three data frames with counters +1 (an info frame after the
     // second also does).
@@ -173,12 +168,12 @@ fn judge(c: &[u8], at: u64, stats: &Stats) -> Verdict {
         match found_at(c, frame_at, full_scale) {
             Found::Undecided => return Verdict::Undecided,
             Found::Nothing => return Verdict::Unconfirmed,
-            Found::Info(_) => return Verdict::Data(first, true),
+            Found::Info(_) => return Verdict::Frame(Judged::Data(first), true),
             Found::Data(next) if next.counter != counter => return Verdict::Unconfirmed,
             Found::Data(_) => {}
         }
     }
-    Verdict::Data(first, true)
+    Verdict::Frame(Judged::Data(first), true)
 }
 
 /// The fewest bytes that may decide a candidate whose first `held` bytes are there: 13 (an
@@ -192,11 +187,10 @@ const fn candidate_len(held: usize) -> usize {
     }
 }
 
-/// Finds the next frame in `data` (its first byte at stream offset `base`) from `*pos`,
-/// counting what it passes over in `stats`. Returns the frame and its start in `data`, with
-/// `*pos` just after it; `None` when no further frame can be decided: `*pos` is then
-/// `data.len()`, or, unless `at_end`, the start of a candidate that needs more bytes (nothing
-/// of it counted yet).
+/// Finds the next frame in `data` (its first byte at stream offset `base`) from `*pos`, as
+/// [`chain::scan_next`] does with V4's [`judge`], after taking a trailer at `*pos` (a `B9`
+/// where the data frame just accepted ended: only ever at the start of a call, as that frame
+/// ends a call).
 #[inline(always)]
 fn scan_next(
     data: &[u8],
@@ -205,44 +199,32 @@ fn scan_next(
     stats: &mut Stats,
     at_end: bool,
 ) -> Option<(usize, Frame)> {
-    loop {
-        if data.get(*pos) == Some(&TRAILER) && stats.trailer_at(base + *pos as u64) {
-            stats.take_trailer();
-            *pos += 1;
-        }
-        let Some(k) = data[*pos..].iter().position(|&b| b == SYNC) else {
-            stats.skip(data.len() - *pos);
-            *pos = data.len();
-            return None;
-        };
-        stats.skip(k);
-        let i = *pos + k;
-        *pos = i;
-        let at = base + i as u64;
-        match judge(&data[i..], at, stats) {
-            Verdict::Data(frame, synced) => {
+    if data.get(*pos) == Some(&TRAILER) && stats.trailer_at(base + *pos as u64) {
+        stats.take_trailer();
+        *pos += 1;
+    }
+    chain::scan_next(
+        data,
+        pos,
+        base,
+        stats,
+        at_end,
+        judge,
+        |stats, at, judged, synced| match judged {
+            Judged::Data(frame) => {
                 stats.accept_data(at, &frame, synced);
-                *pos = i + DATA_FRAME_LEN;
                 let data = Data {
                     frame,
                     info: stats.adopted(),
                 };
-                return Some((i, Frame::Data(data)));
+                (DATA_FRAME_LEN, Frame::Data(data))
             }
-            Verdict::Info(info, synced) => {
+            Judged::Info(info) => {
                 stats.accept_info(at, &info, synced);
-                *pos = i + INFO_FRAME_LEN;
-                return Some((i, Frame::Info(info)));
+                (INFO_FRAME_LEN, Frame::Info(info))
             }
-            Verdict::Implausible => stats.reject_implausible(),
-            Verdict::Unconfirmed => stats.reject_unconfirmed(),
-            Verdict::Undecided if !at_end => return None,
-            // Cut off by the end of the stream: skipped, not counted as rejected.
-            Verdict::Undecided => {}
-        }
-        stats.skip(1);
-        *pos = i + 1;
-    }
+        },
+    )
 }
 
 /// The V4 scanner, as the streaming layer ([`crate::scan`]) runs it: [`Decoder`] and
@@ -250,66 +232,14 @@ fn scan_next(
 #[derive(Debug, Clone, Copy, Default)]
 pub struct Scanner;
 
-impl crate::scan::sealed::Sealed for Scanner {}
-impl crate::scan::sealed::Sealed for Stats {}
-
-impl scan::Stats for Stats {
-    const NEW: Self = Stats::new();
-
-    #[inline]
-    fn bytes(&self) -> u64 {
-        Stats::bytes(self)
-    }
-
-    #[inline]
-    fn add_bytes(&mut self, n: usize) {
-        Stats::add_bytes(self, n);
-    }
-
-    fn line_silent(&mut self, max_frames: u32) {
-        Stats::line_silent(self, max_frames);
-    }
-}
-
-impl scan::Scanner for Scanner {
-    type Item = Decoded;
-    type Stats = Stats;
-    type Held = [u8; MAX_LEN - 1];
-    type Pair = [u8; 2 * MAX_LEN];
-    const HELD: Self::Held = [0; MAX_LEN - 1];
-    const PAIR: Self::Pair = [0; 2 * MAX_LEN];
-    const MAX_LEN: usize = MAX_LEN;
-
-    #[inline(always)]
-    fn candidate_len(held: &[u8]) -> usize {
-        candidate_len(held.len())
-    }
-
-    #[inline(never)]
-    fn scan_all<const AT_END: bool>(
-        data: &[u8],
-        base: u64,
-        stats: &mut Stats,
-        on_frame: &mut impl FnMut(Decoded),
-    ) -> usize {
-        let mut pos = 0;
-        while let Some((at, frame)) = scan_next(data, &mut pos, base, stats, AT_END) {
-            on_frame(Decoded {
-                offset: base + at as u64,
-                frame,
-            });
-        }
-        pos
-    }
-
-    #[inline]
-    fn scan_next(data: &[u8], pos: &mut usize, stats: &mut Stats) -> Option<Decoded> {
-        scan_next(data, pos, 0, stats, true).map(|(at, frame)| Decoded {
-            offset: at as u64,
-            frame,
-        })
-    }
-}
+impl_scanner!(
+    Scanner,
+    Stats,
+    Decoded,
+    MAX_LEN,
+    |held: &[u8]| candidate_len(held.len()),
+    scan_next
+);
 
 /// A streaming V4 decoder: feed it bytes in any chunking, get every frame once (the streaming
 /// layer's [`StreamDecoder`] over the V4 scanner).

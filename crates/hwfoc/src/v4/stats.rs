@@ -3,7 +3,9 @@
 
 use core::fmt;
 
-use crate::counters::{ByteCounts, Bytes, COUNTER24_MAX, PacketSequence24};
+use crate::chain::{ChainStats, Counts};
+use crate::counters::{COUNTER24_MAX, PacketSequence24};
+use crate::scan::SkipBytes;
 
 use super::data::DataFrame;
 use super::info::InfoFrame;
@@ -40,15 +42,11 @@ struct Chain {
 /// [duplicate](Stats::duplicate_frames) or a [restart](Stats::restarts).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub struct Stats {
-    bytes: ByteCounts,
-    implausible: u32,
-    unconfirmed: u32,
-    syncs: u32,
+    counts: Counts,
     info_frames: u32,
     adoptions: u32,
     disagreements: u32,
     trailers: u32,
-    counter: PacketSequence24,
     chain: Option<Chain>,
     last_info: Option<InfoFrame>,
     adopted: Option<InfoFrame>,
@@ -64,15 +62,11 @@ impl Stats {
     /// All counters zero, not locked, no info frame.
     pub const fn new() -> Self {
         Stats {
-            bytes: ByteCounts::new(),
-            implausible: 0,
-            unconfirmed: 0,
-            syncs: 0,
+            counts: Counts::new(),
             info_frames: 0,
             adoptions: 0,
             disagreements: 0,
             trailers: 0,
-            counter: PacketSequence24::new(),
             chain: None,
             last_info: None,
             adopted: None,
@@ -81,18 +75,18 @@ impl Stats {
 
     /// Bytes fed to the decoder.
     pub const fn bytes(&self) -> u64 {
-        self.bytes.get(Bytes::Fed)
+        self.counts.bytes()
     }
 
     /// Bytes that were not part of an accepted frame or trailer: noise, rejected and cut
     /// frames, other formats.
     pub const fn bytes_skipped(&self) -> u64 {
-        self.bytes.get(Bytes::Skipped)
+        self.counts.bytes_skipped()
     }
 
     /// Data frames accepted.
     pub const fn frames(&self) -> u32 {
-        self.counter.count()
+        self.counts.counter.count()
     }
 
     /// Accepted data frames followed by their trailing `B9` (slow, idle mode).
@@ -138,51 +132,51 @@ impl Stats {
 
     /// Rejected candidates: [`Stats::implausible`] + [`Stats::unconfirmed`].
     pub const fn rejected(&self) -> u32 {
-        self.implausible.saturating_add(self.unconfirmed)
+        self.counts.rejected()
     }
 
     /// Candidates whose own fields are impossible: a data frame with throttle or PWM above full
     /// scale or an ADC field of 4096 or more, an info frame with a zero divisor.
     pub const fn implausible(&self) -> u32 {
-        self.implausible
+        self.counts.implausible
     }
 
     /// Plausible candidates that neither continue the chain of accepted frames nor start a new
     /// one (three chained data frames with counters +1, or a data frame and an info frame
     /// chained): noise, a frame whose counter does not follow, frames around a corrupted one.
     pub const fn unconfirmed(&self) -> u32 {
-        self.unconfirmed
+        self.counts.unconfirmed
     }
 
     /// Frames accepted by starting a new chain (the decoder locked, or locked again after a
     /// break): 1 for a clean stream.
     pub const fn syncs(&self) -> u32 {
-        self.syncs
+        self.counts.syncs
     }
 
     /// Counter values missing between accepted data frames (in 24 bits).
     pub const fn lost_frames(&self) -> u32 {
-        self.counter.lost()
+        self.counts.counter.lost()
     }
 
     /// Accepted data frames whose counter equals the previous one's.
     pub const fn duplicate_frames(&self) -> u32 {
-        self.counter.duplicates()
+        self.counts.counter.duplicates()
     }
 
     /// Accepted data frames whose counter starts a new sequence (the ESC restarted).
     pub const fn restarts(&self) -> u32 {
-        self.counter.restarts()
+        self.counts.counter.restarts()
     }
 
     /// The counter of the last accepted data frame, if any.
     pub const fn last_counter(&self) -> Option<u32> {
-        self.counter.last()
+        self.counts.counter.last()
     }
 
     /// The data frames' counters, followed step by step.
     pub const fn counter(&self) -> &PacketSequence24 {
-        &self.counter
+        &self.counts.counter
     }
 
     /// Stream offset just after the last accepted frame (and its trailer, once taken), if any:
@@ -225,35 +219,14 @@ impl Stats {
 
     #[inline]
     pub(crate) fn add_bytes(&mut self, n: usize) {
-        self.bytes.add(Bytes::Fed, n);
-    }
-
-    #[inline]
-    pub(crate) fn skip(&mut self, n: usize) {
-        self.bytes.add(Bytes::Skipped, n);
-    }
-
-    #[inline]
-    pub(crate) fn reject_implausible(&mut self) {
-        self.implausible = self.implausible.saturating_add(1);
-    }
-
-    #[inline]
-    pub(crate) fn reject_unconfirmed(&mut self) {
-        self.unconfirmed = self.unconfirmed.saturating_add(1);
-    }
-
-    fn sync(&mut self, synced: bool) {
-        if synced {
-            self.syncs = self.syncs.saturating_add(1);
-        }
+        self.counts.add_bytes(n);
     }
 
     /// Counts a data frame accepted at stream offset `at`; `synced`: it started a new chain.
     #[inline]
     pub(crate) fn accept_data(&mut self, at: u64, frame: &DataFrame, synced: bool) {
-        self.sync(synced);
-        self.counter.next(frame.counter);
+        self.counts.sync(synced);
+        self.counts.counter.next(frame.counter);
         self.chain = Some(Chain {
             end: at + DATA_FRAME_LEN as u64,
             next: Some((frame.counter + 1) & COUNTER24_MAX),
@@ -264,7 +237,7 @@ impl Stats {
     /// Counts an info frame accepted at stream offset `at` (`synced`: it started a new chain)
     /// and adopts its constants if it is the second identical copy in a row.
     pub(crate) fn accept_info(&mut self, at: u64, info: &InfoFrame, synced: bool) {
-        self.sync(synced);
+        self.counts.sync(synced);
         self.info_frames = self.info_frames.saturating_add(1);
         let same_as_last = self.last_info == Some(*info);
         if same_as_last && self.adopted != Some(*info) {
@@ -289,7 +262,21 @@ impl Stats {
     }
 
     pub(crate) fn line_silent(&mut self, max_frames: u32) {
-        self.counter.line_silent(max_frames);
+        self.counts.line_silent(max_frames);
+    }
+}
+
+impl SkipBytes for Stats {
+    #[inline]
+    fn skip(&mut self, n: usize) {
+        self.counts.skip(n);
+    }
+}
+
+impl ChainStats for Stats {
+    #[inline(always)]
+    fn counts(&mut self) -> &mut Counts {
+        &mut self.counts
     }
 }
 
@@ -298,21 +285,14 @@ impl fmt::Display for Stats {
         write!(
             f,
             "{} bytes, {} data frames ({} with trailer), {} info frames ({} adoptions, {} \
-             disagreeing), {} bytes skipped, {} implausible and {} unconfirmed candidates, \
-             {} syncs, {} lost frames, {} duplicate frames, {} restarts",
+             disagreeing), {}",
             self.bytes(),
             self.frames(),
             self.trailers,
             self.info_frames,
             self.adoptions,
             self.disagreements,
-            self.bytes_skipped(),
-            self.implausible,
-            self.unconfirmed,
-            self.syncs,
-            self.lost_frames(),
-            self.duplicate_frames(),
-            self.restarts(),
+            self.counts,
         )
     }
 }

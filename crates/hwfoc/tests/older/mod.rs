@@ -2,7 +2,11 @@
 //! `captures.rs`), the decoding paths for any scanner of `hwfoc::scan`, and a seeded random
 //! byte source.
 
+use std::fmt::Debug;
+
 use hwfoc::scan::{Scan, Scanner, StreamDecoder};
+
+use crate::common::streamed_bytewise;
 
 const CAPTURES: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../testdata/captures/");
 /// The Platinum Pro V3 capture: 699 V3 frames.
@@ -12,9 +16,15 @@ pub const PLATINUM_V4: &str = "platinum-v4.csv";
 /// The XRotor capture: HW-FOC.
 pub const XROTOR: &str = "xrotor-v4-pro-hv-80A.csv";
 
-/// The bytes of a logic-analyser CSV export: header `Time [s],Value,Parity Error,Framing Error`,
-/// then one row per byte with the value written `0xNN`.
+/// The bytes of a logic-analyser CSV export (see [`load_timed`]).
 pub fn load(name: &str) -> Vec<u8> {
+    load_timed(name).1
+}
+
+/// A logic-analyser CSV export: header `Time [s],Value,Parity Error,Framing Error`, then one
+/// row per byte with the value written `0xNN`; the time of each byte and its value, row for
+/// row (`captures.rs` reads the HW-FOC captures with it too).
+pub fn load_timed(name: &str) -> (Vec<f64>, Vec<u8>) {
     let path = format!("{CAPTURES}{name}");
     let text = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{path}: {e}"));
     let mut lines = text.lines();
@@ -23,21 +33,25 @@ pub fn load(name: &str) -> Vec<u8> {
         Some("Time [s],Value,Parity Error,Framing Error"),
         "{name}: header"
     );
-    let mut bytes = Vec::new();
+    let (mut times, mut bytes) = (Vec::new(), Vec::new());
     for (i, line) in lines.enumerate() {
         if line.is_empty() {
             continue;
         }
         let cols: Vec<&str> = line.split(',').collect();
         assert_eq!(cols.len(), 4, "{name} row {i}: {line:?}");
+        let time: f64 = cols[0]
+            .parse()
+            .unwrap_or_else(|e| panic!("{name} row {i}: time {:?}: {e}", cols[0]));
         let hex = cols[1]
             .strip_prefix("0x")
             .unwrap_or_else(|| panic!("{name} row {i}: value {:?}", cols[1]));
         let byte = u8::from_str_radix(hex, 16)
             .unwrap_or_else(|e| panic!("{name} row {i}: value {:?}: {e}", cols[1]));
+        times.push(time);
         bytes.push(byte);
     }
-    bytes
+    (times, bytes)
 }
 
 /// The bulk path: every frame of `bytes` and the statistics.
@@ -66,6 +80,28 @@ pub fn streamed_chunks<S: Scanner>(bytes: &[u8], size: usize) -> (Vec<S::Item>, 
     let mut cuts: Vec<usize> = (0..bytes.len()).step_by(size).collect();
     cuts.push(bytes.len());
     streamed_at::<S>(bytes, &cuts)
+}
+
+/// Asserts that every decoding path of `S` gives what the bulk path gives for `bytes`: a
+/// byte at a time, in chunks of each of `sizes`, and `decode_all`.
+pub fn assert_every_path_agrees<S: Scanner>(bytes: &[u8], sizes: &[usize])
+where
+    S::Item: PartialEq + Debug,
+    S::Stats: Copy + PartialEq + Debug,
+{
+    let reference = bulk::<S>(bytes);
+    assert_eq!(streamed_bytewise::<S>(bytes), reference, "byte at a time");
+    for &size in sizes {
+        assert_eq!(
+            streamed_chunks::<S>(bytes, size),
+            reference,
+            "chunks of {size}"
+        );
+    }
+    let mut all_at_once = StreamDecoder::<S>::new();
+    let mut out = Vec::new();
+    all_at_once.decode_all(bytes, |d| out.push(d));
+    assert_eq!((out, *all_at_once.stats()), reference, "decode_all");
 }
 
 /// A seeded xorshift64 generator: the same bytes on every run.
