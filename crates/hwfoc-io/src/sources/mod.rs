@@ -383,7 +383,7 @@ impl Sources {
         let index = self.open(&input);
         let part = input
             .raw_file_len()
-            .is_some_and(|len| len >= self.split_min)
+            .is_some_and(|len| split::AVAILABLE && len >= self.split_min)
             .then(|| handler.fork())
             .flatten();
         input.read_ahead(H::TAKES_RUNS && part.is_none());

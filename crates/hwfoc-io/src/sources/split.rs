@@ -38,6 +38,10 @@ use crate::stream::Stream;
 /// The smallest raw file read in two halves: below it, starting a thread is not worth it.
 pub(super) const SPLIT_MIN: u64 = 64 << 20;
 
+/// Whether the platform has positional reads that leave the earlier half's file offset alone:
+/// Unix's `pread` (Windows' `seek_read` moves the offset a duplicated handle shares).
+pub(super) const AVAILABLE: bool = cfg!(unix);
+
 /// The later half of a raw file, being read on a thread of its own.
 pub(super) struct Later {
     /// Where its reader starts looking for the seam: the middle of the file.
@@ -76,9 +80,7 @@ impl Later {
         esc: u8,
         settings: Settings,
     ) -> Option<Later> {
-        // Positional reads that leave the earlier half's file offset alone: Unix's `pread`
-        // (Windows' `seek_read` moves the offset a duplicated handle shares).
-        if !cfg!(unix) {
+        if !AVAILABLE {
             return None;
         }
         let start = len / 2;
