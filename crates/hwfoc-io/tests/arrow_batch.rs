@@ -172,10 +172,10 @@ fn the_record_fields_are_the_batch_columns() {
     for (row, r) in records.iter().enumerate() {
         assert_eq!(t.is_valid(row).then(|| t.value(row)), r.t_s);
         assert_eq!(mos.is_valid(row).then(|| mos.value(row)), r.mos_temp_c);
-        assert_eq!(rpm.value(row), r.rpm);
-        assert_eq!(current.value(row), r.current_a);
-        assert_eq!(status.value(row), r.status.0);
-        assert_eq!(erpm.value(row), r.erpm);
+        assert_eq!(Some(rpm.value(row)), r.rpm);
+        assert_eq!(Some(current.value(row)), r.current_a);
+        assert_eq!(Some(status.value(row)), r.status.map(|s| s.0));
+        assert_eq!(Some(erpm.value(row)), r.erpm);
     }
     // The extremes: the largest eRPM and the most negative current.
     assert_eq!(erpm.value(7), u32::from(u16::MAX) * 10);
