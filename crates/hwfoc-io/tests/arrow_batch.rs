@@ -4,7 +4,7 @@
 use std::sync::Arc;
 
 use arrow_array::cast::AsArray;
-use arrow_array::types::{Float32Type, Float64Type, UInt8Type, UInt16Type, UInt32Type};
+use arrow_array::types::{Float32Type, Float64Type, Int8Type, UInt8Type, UInt16Type, UInt32Type};
 use arrow_array::{Array, ArrayRef, RecordBatch};
 use arrow_schema::DataType;
 use hwfoc::foc::DataFrame;
@@ -69,6 +69,11 @@ fn value(array: &ArrayRef, row: usize) -> Value {
             let names = list.as_string::<i32>();
             assert_eq!(names.null_count(), 0);
             Value::from_iter(names.iter().map(|n| n.unwrap().to_string()))
+        }
+        DataType::Dictionary(_, _) => {
+            let dict = array.as_dictionary::<Int8Type>();
+            let key = dict.keys().value(row);
+            Value::from(dict.values().as_string::<i32>().value(key as usize))
         }
         other => panic!("a type this test does not know: {other}"),
     }
