@@ -10,8 +10,8 @@ use std::fmt;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 
-use hwfoc::{Protocol, Settings};
 use hwfoc::telemetry::{Frame, Telemetry};
+use hwfoc::{Protocol, Settings};
 use hwfoc_io::clock::Step;
 use hwfoc_io::energy::NOMINAL_PERIOD_S;
 use hwfoc_io::{Handler, InputError};

@@ -611,8 +611,14 @@ fn pydronecan_decodes_esc_status_extended_and_node_status() {
                 // Within float16 precision of the record itself.
                 let close =
                     |got: f64, x: f32| (got - f64::from(x)).abs() <= f64::from(x).abs() / 1024.0;
-                assert!(close(v["voltage"].as_f64().unwrap(), r.voltage_v.unwrap()), "{line}");
-                assert!(close(v["current"].as_f64().unwrap(), r.current_a.unwrap()), "{line}");
+                assert!(
+                    close(v["voltage"].as_f64().unwrap(), r.voltage_v.unwrap()),
+                    "{line}"
+                );
+                assert!(
+                    close(v["current"].as_f64().unwrap(), r.current_a.unwrap()),
+                    "{line}"
+                );
                 if esc == 3 {
                     assert!(v["temperature"].is_null(), "{line}");
                 }

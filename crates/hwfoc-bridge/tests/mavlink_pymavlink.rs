@@ -81,7 +81,9 @@ impl Known {
     fn mah(&self) -> f64 {
         self.records
             .windows(2)
-            .map(|w| f64::from(w[0].0.current_a.unwrap()) * (w[1].0.t_s.unwrap() - w[0].0.t_s.unwrap()))
+            .map(|w| {
+                f64::from(w[0].0.current_a.unwrap()) * (w[1].0.t_s.unwrap() - w[0].0.t_s.unwrap())
+            })
             .sum::<f64>()
             / 3.6
     }

@@ -344,7 +344,12 @@ fn several_inputs_are_numbered_escs_in_order() {
                 .collect()
         } else {
             let mut lines = out.lines();
-            assert!(lines.next().unwrap().starts_with("t_s,esc,protocol,packet,"));
+            assert!(
+                lines
+                    .next()
+                    .unwrap()
+                    .starts_with("t_s,esc,protocol,packet,")
+            );
             lines
                 .map(|l| {
                     let f: Vec<&str> = l.split(',').collect();
@@ -664,7 +669,13 @@ fn live_input_is_written_as_it_arrives() {
             // A raw stream starts with its first byte: send one so that the header comes out.
             stdin.write_all(&frame(0, Status::OK).encode()).unwrap();
             stdin.flush().unwrap();
-            assert!(lines.next().unwrap().unwrap().starts_with("t_s,esc,protocol,packet"));
+            assert!(
+                lines
+                    .next()
+                    .unwrap()
+                    .unwrap()
+                    .starts_with("t_s,esc,protocol,packet")
+            );
             assert!(lines.next().unwrap().unwrap().starts_with(",0,hw-foc,0,"));
         }
         // Each frame's record comes out while the input is still open.

@@ -264,7 +264,12 @@ fn protocol_and_the_columns_not_carried_in_every_format() {
     use hwfoc::telemetry::Data;
     use hwfoc_io::write::arrow::RecordBatchBuilder;
 
-    const NOT_CARRIED: [&str; 4] = ["motor_temp_c", "bec_temp_c", "bec_voltage_v", "bec_current_a"];
+    const NOT_CARRIED: [&str; 4] = [
+        "motor_temp_c",
+        "bec_temp_c",
+        "bec_voltage_v",
+        "bec_current_a",
+    ];
     let frame = DataFrame {
         packet: 70_00,
         voltage_raw: 247,
@@ -314,9 +319,17 @@ fn protocol_and_the_columns_not_carried_in_every_format() {
         .collect();
     assert_eq!(values, ["hw-foc", "datalink"]);
     for column in NOT_CARRIED {
-        assert_eq!(batch.column_by_name(column).unwrap().null_count(), 2, "{column}");
+        assert_eq!(
+            batch.column_by_name(column).unwrap().null_count(),
+            2,
+            "{column}"
+        );
     }
     for column in ["packet", "voltage_v", "status", "faults"] {
-        assert_eq!(batch.column_by_name(column).unwrap().null_count(), 0, "{column}");
+        assert_eq!(
+            batch.column_by_name(column).unwrap().null_count(),
+            0,
+            "{column}"
+        );
     }
 }

@@ -117,10 +117,16 @@ impl TelemetryColumns {
             let u16max = f64::from(u16::MAX);
             c.temperature[i] = temperature_c(r).map_or(0, |t| round_to(f64::from(t), 255.0) as u8);
             // A quantity the ESC's protocol does not carry is 0: the fields have no "unknown".
-            c.voltage[i] = r.voltage_v.map_or(0, |v| round_to(f64::from(v) * 100.0, u16max) as u16);
-            c.current[i] = r.current_a.map_or(0, |a| round_to(f64::from(a) * 100.0, u16max) as u16);
+            c.voltage[i] = r
+                .voltage_v
+                .map_or(0, |v| round_to(f64::from(v) * 100.0, u16max) as u16);
+            c.current[i] = r
+                .current_a
+                .map_or(0, |a| round_to(f64::from(a) * 100.0, u16max) as u16);
             c.totalcurrent[i] = round_to(s.consumed_mah, u16max) as u16;
-            c.rpm[i] = r.rpm.map_or(0, |rpm| round_to(f64::from(rpm), u16max) as u16);
+            c.rpm[i] = r
+                .rpm
+                .map_or(0, |rpm| round_to(f64::from(rpm), u16max) as u16);
             c.count[i] = s.frames as u16;
         }
         c

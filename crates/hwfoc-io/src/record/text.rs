@@ -540,10 +540,7 @@ mod tests {
                 let mut json = Vec::new();
                 record.write_json(&mut json);
                 let v: serde_json::Value = serde_json::from_slice(&json).unwrap();
-                assert_eq!(
-                    v["current_a"].as_f64().map(|c| c as f32),
-                    record.current_a
-                );
+                assert_eq!(v["current_a"].as_f64().map(|c| c as f32), record.current_a);
                 assert_eq!(v["rpm"].as_f64().map(|c| c as f32), record.rpm);
                 assert_eq!(v["packet"], i as u16);
                 assert_eq!(v["t_s"].as_f64(), record.t_s);

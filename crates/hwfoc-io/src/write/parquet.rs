@@ -461,9 +461,9 @@ mod encode {
             values: impl ExactSizeIterator<Item = Self> + Clone,
             levels: &mut Levels<ByteArray>,
         ) {
-            levels.values.extend(
-                values.map(|p| ByteArray::from(Bytes::from_static(p.name().as_bytes()))),
-            );
+            levels
+                .values
+                .extend(values.map(|p| ByteArray::from(Bytes::from_static(p.name().as_bytes()))));
         }
     }
 

@@ -568,11 +568,7 @@ impl Fleet {
             esc.history.pop_front();
         }
         if let Some(volts) = r.voltage_v.filter(|&v| esc.cells.is_none() && v > 2.0) {
-            esc.cells = Some(
-                (f64::from(volts) / FULL_CELL_V)
-                    .ceil()
-                    .clamp(1.0, 255.0) as u8,
-            );
+            esc.cells = Some((f64::from(volts) / FULL_CELL_V).ceil().clamp(1.0, 255.0) as u8);
             esc.cells_detected = true;
         }
 
