@@ -66,7 +66,15 @@ def test_schema_and_metadata_are_the_parquet_exports(cli, sim_dir, tmp_path):
         assert file_meta[key] == value, key
     assert set(table.schema.metadata) == {k for k in file_meta if k != b"ARROW:schema"}
     assert table.schema.metadata[b"filter"] == b"esc=0,2 from=1700000002"
-    assert table.equals(exported)
+    # `protocol` is a dictionary on both sides, but a Parquet reader makes its own dictionary
+    # (of the names in the file) where hwfoc's holds every protocol's: the same values, compared
+    # as strings.
+    def decoded(t):
+        at = t.schema.get_field_index("protocol")
+        return t.set_column(at, "protocol", t.column("protocol").cast(pa.string()))
+
+    assert pa.types.is_dictionary(table.schema.field("protocol").type)
+    assert decoded(table).equals(decoded(exported))
 
 
 def test_settings_change_values_and_metadata(cli, sim_dir):
