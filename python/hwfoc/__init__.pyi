@@ -75,9 +75,16 @@ def read(
     :data:`PROTOCOLS`, to read that protocol's frames only (the bytes of any other are skipped
     bytes), as the command's ``--protocol``; None reads every protocol.
 
+    The columns are record schema version 2's: ``protocol`` a dictionary of strings
+    (``hw-foc``, ``datalink``: a categorical in pandas and polars), ``packet`` uint32, and every
+    measurement, ``status`` and ``faults`` nullable (null where the ESC's format does not carry
+    it: ``motor_temp_c``, ``bec_temp_c``, ``bec_voltage_v`` and ``bec_current_a`` in every
+    HW-FOC and DataLink record).
+
     The schema's metadata holds what ``hwfoc decode --format parquet`` writes in its file:
-    ``hwfoc_version``, ``current_scale``, ``pole_pairs``, ``gear_ratio``, ``inputs`` and
-    ``escs`` (JSON) and ``filter`` when records were selected; each field has its ``unit``.
+    ``hwfoc_version``, ``record_schema_version`` (``2``), ``current_scale``, ``pole_pairs``,
+    ``gear_ratio``, ``inputs`` and ``escs`` (JSON) and ``filter`` when records were selected;
+    each field has its ``unit``.
 
     Raises InputError (also for a serial port's path: read ports with :func:`open_ports`),
     SelectionError, SettingsError; TypeError for a source of another type; ValueError for a

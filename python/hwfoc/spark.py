@@ -8,8 +8,9 @@ installed).
     df = hwfoc.spark.read(spark, paths, path_column="recording", frame_column="frame")
     hwfoc.spark.esc_aggregates(df).show()
 
-Spark has no unsigned integers: ``esc`` (uint8) becomes ``short``, ``packet`` and ``status``
-(uint16) ``int``, ``erpm`` (uint32) and the frame column (uint64) ``long``; every value fits.
+Spark has no unsigned integers: ``esc`` (uint8) becomes ``short``, ``status`` (uint16)
+``int``, ``packet`` and ``erpm`` (uint32) and the frame column (uint64) ``long``; every value
+fits. Nor has it dictionaries: ``protocol`` (a dictionary of strings) becomes ``string``.
 Floats, nulls and the ``faults`` list are kept; each field's unit is in its metadata.
 """
 
@@ -31,10 +32,17 @@ _WIDER = {
 }
 
 
+def _spark_type(t: pa.DataType) -> pa.DataType:
+    """An Arrow type as Spark takes it: a dictionary as its values, unsigned integers wider."""
+    if pa.types.is_dictionary(t):
+        t = t.value_type
+    return _WIDER.get(t, t)
+
+
 def arrow_schema(path_column: Optional[str] = None, frame_column: Optional[str] = None, **settings: Any) -> pa.Schema:
     """The record schema as Spark takes it from Arrow: unsigned integers widened to signed."""
     empty = add_columns(hwfoc.record_schema(**settings).empty_table(), None, path_column, frame_column)
-    fields = [f.with_type(_WIDER.get(f.type, f.type)) for f in empty.schema]
+    fields = [f.with_type(_spark_type(f.type)) for f in empty.schema]
     return pa.schema(fields, metadata=empty.schema.metadata)
 
 

@@ -60,7 +60,20 @@ def cli_records(cli, *args):
     return [json.loads(line) for line in out.splitlines()]
 
 
-FLOAT32 = {"throttle_in_pct", "throttle_out_pct", "rpm", "voltage_v", "current_a", "phase_current_a", "mos_temp_c", "cap_temp_c"}
+FLOAT32 = {
+    "throttle_in_pct",
+    "throttle_out_pct",
+    "rpm",
+    "voltage_v",
+    "current_a",
+    "phase_current_a",
+    "mos_temp_c",
+    "cap_temp_c",
+    "motor_temp_c",
+    "bec_temp_c",
+    "bec_voltage_v",
+    "bec_current_a",
+}
 
 
 def assert_same_records(table: pa.Table, records):

@@ -66,7 +66,15 @@ def test_schema_and_metadata_are_the_parquet_exports(cli, sim_dir, tmp_path):
         assert file_meta[key] == value, key
     assert set(table.schema.metadata) == {k for k in file_meta if k != b"ARROW:schema"}
     assert table.schema.metadata[b"filter"] == b"esc=0,2 from=1700000002"
-    assert table.equals(exported)
+    # `protocol` is a dictionary on both sides, but a Parquet reader makes its own dictionary
+    # (of the names in the file) where hwfoc's holds every protocol's: the same values, compared
+    # as strings.
+    def decoded(t):
+        at = t.schema.get_field_index("protocol")
+        return t.set_column(at, "protocol", t.column("protocol").cast(pa.string()))
+
+    assert pa.types.is_dictionary(table.schema.field("protocol").type)
+    assert decoded(table).equals(decoded(exported))
 
 
 def test_settings_change_values_and_metadata(cli, sim_dir):
@@ -303,7 +311,11 @@ def test_polars_and_pandas_take_the_table(sim_dir):
     hot = df.group_by("esc").agg(pl.col("mos_temp_c").max()).sort("esc")
     assert hot.height == 3
     pdf = table.to_pandas()
-    assert str(pdf["packet"].dtype) == "uint16"
+    # Record schema 2: packet uint32 (nullable: pandas' nullable or plain integer type), protocol
+    # a categorical.
+    assert str(pdf["packet"].dtype).lower() == "uint32"
+    assert str(pdf["protocol"].dtype) == "category"
+    assert df.schema["protocol"] == pl.Categorical or isinstance(df.schema["protocol"], (pl.Categorical, pl.Enum))
     assert pdf["mos_temp_c"].max() == pytest.approx(float(pa.compute.max(table.column("mos_temp_c")).as_py()))
     assert isinstance(pdf, pd.DataFrame)
 
@@ -358,6 +370,16 @@ def test_a_forced_protocol_reads_its_frames_only(mixed):
     assert _rows(forced_esc) == _rows(escs)
     forced_hub = hwfoc.read(whole, protocol="datalink")
     assert _rows(forced_hub) == _rows(hubs)
+    # The protocol column says which frames were whose: an ESC's own, or a hub's channels;
+    # the columns no protocol read today carries are null.
+    assert set(escs.column("protocol").to_pylist()) == {"hw-foc"}
+    assert set(hubs.column("protocol").to_pylist()) == {"datalink"}
+    assert pa.types.is_dictionary(hubs.schema.field("protocol").type)
+    assert pa.types.is_uint32(hubs.schema.field("packet").type)
+    whole_table = hwfoc.read(whole)
+    assert set(whole_table.column("protocol").to_pylist()) == {"hw-foc", "datalink"}
+    for name in ("motor_temp_c", "bec_temp_c", "bec_voltage_v", "bec_current_a"):
+        assert whole_table.column(name).null_count == whole_table.num_rows, name
     assert hwfoc.read(whole).num_rows == escs.num_rows + hubs.num_rows
     # The other protocol's bytes are skipped bytes; scan and the decoder read alike.
     link = hwfoc.summary(whole, protocol="hw-foc")["escs"][0]["link"]

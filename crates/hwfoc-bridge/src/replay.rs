@@ -10,8 +10,8 @@ use std::fmt;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 
-use hwfoc::Settings;
 use hwfoc::telemetry::{Frame, Telemetry};
+use hwfoc::{Protocol, Settings};
 use hwfoc_io::clock::Step;
 use hwfoc_io::energy::NOMINAL_PERIOD_S;
 use hwfoc_io::{Handler, InputError};
@@ -62,11 +62,11 @@ pub struct Replay<'a, E> {
     origin: Option<(f64, Instant)>,
     /// Per ESC, its last timed frame: receive time, packet number (of a data frame), and
     /// seconds after the origin's instant it was due.
-    last: Vec<Option<(f64, Option<u16>, f64)>>,
+    last: Vec<Option<(f64, Option<u32>, f64)>>,
     /// The last timed frame of any ESC, as in `last`: what an ESC's first frame is measured
     /// from (without a packet number in common, a step over [`hwfoc_io::clock::MAX_STEP_S`]
     /// is a jump).
-    latest: Option<(f64, Option<u16>, f64)>,
+    latest: Option<(f64, Option<u32>, f64)>,
     /// When the replay started, for untimed frames.
     start: Instant,
     /// Untimed frames handed on so far, per ESC.
@@ -90,7 +90,8 @@ impl<'a, E: FnMut(OutputError)> Replay<'a, E> {
     }
 
     /// When a frame of `esc` received at `t` is due; `packet` is a data frame's packet number.
-    fn due(&mut self, esc: u8, t: Option<f64>, packet: Option<u16>) -> Instant {
+    fn due(&mut self, esc: u8, t: Option<f64>, packet: Option<(Protocol, u32)>) -> Instant {
+        let (protocol, packet) = (packet.map(|(p, _)| p), packet.map(|(_, n)| n));
         match t {
             Some(t) => {
                 let esc = usize::from(esc);
@@ -103,7 +104,10 @@ impl<'a, E: FnMut(OutputError)> Replay<'a, E> {
                     None => self.latest.map(|(t, _, due)| (t, None, due)),
                 };
                 if let Some((last_t, last_packet, last_due)) = before {
-                    let packets = last_packet.zip(packet).map(|(a, b)| b.wrapping_sub(a));
+                    let packets = last_packet
+                        .zip(packet)
+                        .zip(protocol)
+                        .and_then(|((a, b), p)| p.packets_between(a, b));
                     if Step::between(last_t, t, packets).is_discontinuity() {
                         // One frame period after the ESC's frame before.
                         t0 = t - (last_due + NOMINAL_PERIOD_S);
@@ -148,7 +152,7 @@ impl<E: FnMut(OutputError)> Handler for Replay<'_, E> {
             return;
         }
         let packet = match frame {
-            Frame::Data(f) => f.packet(),
+            Frame::Data(f) => f.packet().map(|n| (f.protocol(), n)),
             Frame::Info(_) => None,
         };
         let due = self.due(esc, t, packet);
@@ -185,7 +189,7 @@ mod tests {
         let dues: Vec<Instant> = times
             .iter()
             .enumerate()
-            .map(|(k, &t)| replay.due(0, Some(t), Some(k as u16)))
+            .map(|(k, &t)| replay.due(0, Some(t), Some((Protocol::HwFoc, k as u32))))
             .collect();
         let first = dues[0];
         for (k, due) in dues.iter().enumerate() {
@@ -203,10 +207,10 @@ mod tests {
         let stop = AtomicBool::new(false);
         let mut replay = Replay::new(&mut fanout, &stop, |_| {});
         let start = 1_795_442_580.0;
-        let first = replay.due(0, Some(start), Some(0));
-        let then = replay.due(0, Some(start + 0.05), Some(1));
+        let first = replay.due(0, Some(start), Some((Protocol::HwFoc, 0)));
+        let then = replay.due(0, Some(start + 0.05), Some((Protocol::HwFoc, 1)));
         // ESC 1's first frame, stamped in 2226.
-        let late = replay.due(1, Some(8_000_000_000.0), Some(0));
+        let late = replay.due(1, Some(8_000_000_000.0), Some((Protocol::HwFoc, 0)));
         let after = |due: Instant, first| due.duration_since(first).as_secs_f64();
         assert!((after(then, first) - 0.05).abs() < 1e-6);
         assert!(
@@ -217,8 +221,8 @@ mod tests {
         // ESC 1 heard half a second after ESC 0: its own time.
         let mut fanout = Fanout::new(Vec::new());
         let mut replay = Replay::new(&mut fanout, &stop, |_| {});
-        let first = replay.due(0, Some(start), Some(0));
-        let other = replay.due(1, Some(start + 0.5), Some(9));
+        let first = replay.due(0, Some(start), Some((Protocol::HwFoc, 0)));
+        let other = replay.due(1, Some(start + 0.5), Some((Protocol::HwFoc, 9)));
         assert!((after(other, first) - 0.5).abs() < 1e-6);
     }
 }

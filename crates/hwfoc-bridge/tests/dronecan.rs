@@ -103,11 +103,11 @@ fn update(out: &mut DronecanOutput, esc: u8, frame: &DataFrame, arrived: Instant
 fn expected(r: &Record, error_count: u32) -> EscStatus {
     EscStatus {
         error_count,
-        voltage: r.voltage_v,
-        current: r.current_a,
+        voltage: r.voltage_v.unwrap(),
+        current: r.current_a.unwrap(),
         temperature: r.mos_temp_c.map_or(f32::NAN, |c| c + 273.15),
-        rpm: r.rpm.round() as i32,
-        power_rating_pct: r.throttle_out_pct.round().clamp(0.0, 127.0) as u8,
+        rpm: r.rpm.unwrap().round() as i32,
+        power_rating_pct: r.throttle_out_pct.unwrap().round().clamp(0.0, 127.0) as u8,
         esc_index: r.esc,
     }
 }
@@ -115,8 +115,8 @@ fn expected(r: &Record, error_count: u32) -> EscStatus {
 /// The esc.StatusExtended the output should send for `r` (frame `f`).
 fn expected_extended(r: &Record, f: &DataFrame) -> EscStatusExtended {
     EscStatusExtended {
-        input_pct: r.throttle_in_pct.round() as u8,
-        output_pct: r.throttle_out_pct.round() as u8,
+        input_pct: r.throttle_in_pct.unwrap().round() as u8,
+        output_pct: r.throttle_out_pct.unwrap().round() as u8,
         motor_temperature_deg_c: 0,
         motor_angle: 0,
         status_flags: u32::from(f.status.0),
@@ -600,7 +600,7 @@ fn pydronecan_decodes_esc_status_extended_and_node_status() {
                 let rpm = v["rpm"].as_i64().unwrap() as i32;
                 let (r, error_count, _) = sent
                     .iter()
-                    .find(|(r, _, _)| r.esc == esc && r.rpm.round() as i32 == rpm)
+                    .find(|(r, _, _)| r.esc == esc && r.rpm.unwrap().round() as i32 == rpm)
                     .unwrap_or_else(|| panic!("decoded but never sent: {line}"));
                 let want = expected(r, *error_count);
                 assert_eq!(v["error_count"], want.error_count, "{line}");
@@ -611,8 +611,14 @@ fn pydronecan_decodes_esc_status_extended_and_node_status() {
                 // Within float16 precision of the record itself.
                 let close =
                     |got: f64, x: f32| (got - f64::from(x)).abs() <= f64::from(x).abs() / 1024.0;
-                assert!(close(v["voltage"].as_f64().unwrap(), r.voltage_v), "{line}");
-                assert!(close(v["current"].as_f64().unwrap(), r.current_a), "{line}");
+                assert!(
+                    close(v["voltage"].as_f64().unwrap(), r.voltage_v.unwrap()),
+                    "{line}"
+                );
+                assert!(
+                    close(v["current"].as_f64().unwrap(), r.current_a.unwrap()),
+                    "{line}"
+                );
                 if esc == 3 {
                     assert!(v["temperature"].is_null(), "{line}");
                 }

@@ -127,7 +127,7 @@ fn one_esc_decodes_with_its_values_in_the_messages_units() {
         panic!()
     };
     assert_eq!(s.index, 0);
-    assert_eq!(s.voltage, [record.voltage_v, 0.0, 0.0, 0.0]);
+    assert_eq!(s.voltage, [record.voltage_v.unwrap(), 0.0, 0.0, 0.0]);
     assert_eq!(s.current, [12.5, 0.0, 0.0, 0.0]);
     assert_eq!(s.rpm, [4286, 0, 0, 0]);
     assert!(

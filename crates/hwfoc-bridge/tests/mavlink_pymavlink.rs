@@ -81,7 +81,9 @@ impl Known {
     fn mah(&self) -> f64 {
         self.records
             .windows(2)
-            .map(|w| f64::from(w[0].0.current_a) * (w[1].0.t_s.unwrap() - w[0].0.t_s.unwrap()))
+            .map(|w| {
+                f64::from(w[0].0.current_a.unwrap()) * (w[1].0.t_s.unwrap() - w[0].0.t_s.unwrap())
+            })
             .sum::<f64>()
             / 3.6
     }
@@ -162,8 +164,8 @@ fn pymavlink_decodes_every_message_with_the_records_values() {
                 &Data::from(frame),
                 &Settings::default(),
             );
-            let before = known.records.last().map_or(0, |(r, _)| r.status.0);
-            known.errors += (record.status.0 & !before).count_ones();
+            let before = known.records.last().map_or(0, |(r, _)| r.status.unwrap().0);
+            known.errors += (record.status.unwrap().0 & !before).count_ones();
             known.records.push((record, now));
             fresh[esc / 4] = true;
             out.update(&Update {
@@ -191,7 +193,7 @@ fn pymavlink_decodes_every_message_with_the_records_values() {
             for (i, slot) in slots.enumerate() {
                 if let Some(r) = slot {
                     info |= 1 << i;
-                    f[i] = flags(r.status);
+                    f[i] = flags(r.status.unwrap());
                 }
             }
             let state = (info, f);
@@ -289,10 +291,10 @@ fn check(m: &Value, poll: &Poll) {
                     continue;
                 };
                 want[0][i] = temperature(r).round();
-                want[1][i] = (f64::from(r.voltage_v) * 100.0).round();
-                want[2][i] = (f64::from(r.current_a) * 100.0).round().max(0.0);
+                want[1][i] = (f64::from(r.voltage_v.unwrap()) * 100.0).round();
+                want[2][i] = (f64::from(r.current_a.unwrap()) * 100.0).round().max(0.0);
                 want[3][i] = known.mah().round().max(0.0);
-                want[4][i] = f64::from(r.rpm).round();
+                want[4][i] = f64::from(r.rpm.unwrap()).round();
                 want[5][i] = known.records.len() as f64;
             }
             for (k, field) in [
@@ -328,16 +330,16 @@ fn check(m: &Value, poll: &Poll) {
             if name == "ESC_STATUS" {
                 let rpm = slots
                     .iter()
-                    .map(|s| s.map_or(0.0, |(_, r)| f64::from(r.rpm).round()));
+                    .map(|s| s.map_or(0.0, |(_, r)| f64::from(r.rpm.unwrap()).round()));
                 assert_eq!(array(&f["rpm"]), rpm.collect::<Vec<_>>());
                 // float32 on the wire: exactly the record's f32.
                 let v = slots
                     .iter()
-                    .map(|s| s.map_or(0.0, |(_, r)| f64::from(r.voltage_v)));
+                    .map(|s| s.map_or(0.0, |(_, r)| f64::from(r.voltage_v.unwrap())));
                 assert_eq!(array(&f["voltage"]), v.collect::<Vec<_>>());
                 let a = slots
                     .iter()
-                    .map(|s| s.map_or(0.0, |(_, r)| f64::from(r.current_a)));
+                    .map(|s| s.map_or(0.0, |(_, r)| f64::from(r.current_a.unwrap())));
                 assert_eq!(array(&f["current"]), a.collect::<Vec<_>>());
             } else {
                 assert_eq!(f["count"], ESCS, "ESC_INFO.count");
@@ -354,7 +356,7 @@ fn check(m: &Value, poll: &Poll) {
                 assert_eq!(f["counter"], counter % 65536);
                 let fl = slots
                     .iter()
-                    .map(|s| s.map_or(0, |(_, r)| flags(r.status)) as f64);
+                    .map(|s| s.map_or(0, |(_, r)| flags(r.status.unwrap())) as f64);
                 assert_eq!(array(&f["failure_flags"]), fl.collect::<Vec<_>>());
                 let errors = (index..index + 4)
                     .map(|e| poll.escs.get(e).map_or(0.0, |k| f64::from(k.errors)));

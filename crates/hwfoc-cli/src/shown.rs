@@ -96,8 +96,17 @@ pub enum Shown {
     Power,
 }
 
-/// The codec's quantities not shown: the electrical RPM (the motor's is).
-const HIDDEN: [Quantity; 1] = [Quantity::Erpm];
+/// The codec's quantities not shown: the electrical RPM (the motor's is), and those no
+/// protocol read today carries (HW5's motor and BEC readings: null in every record of HW-FOC
+/// and DataLink, so no frame of any ESC carries them). They join the list, with a word in
+/// [`Shown::legend`], when a protocol that carries them is read.
+const HIDDEN: [Quantity; 5] = [
+    Quantity::Erpm,
+    Quantity::MotorTemp,
+    Quantity::BecTemp,
+    Quantity::BecVoltage,
+    Quantity::BecCurrent,
+];
 
 /// How many quantities are shown.
 pub const COUNT: usize = Quantity::ALL.len() - HIDDEN.len() + 1;
@@ -170,24 +179,32 @@ impl Shown {
         }
     }
 
-    /// Its value in a record; NaN where the record has none (a temperature out of the table's
-    /// range).
+    /// Its value in a record; NaN where the record has none (a quantity the ESC's protocol
+    /// does not carry, a temperature out of the table's range).
     #[inline]
     pub fn of(self, r: &Record) -> f32 {
-        match self {
+        let value = match self {
             Shown::Carried(q) => match q {
                 Quantity::ThrottleIn => r.throttle_in_pct,
                 Quantity::ThrottleOut => r.throttle_out_pct,
-                Quantity::Erpm => r.erpm as f32,
+                Quantity::Erpm => r.erpm.map(|e| e as f32),
                 Quantity::Rpm => r.rpm,
                 Quantity::Voltage => r.voltage_v,
                 Quantity::Current => r.current_a,
                 Quantity::PhaseCurrent => r.phase_current_a,
-                Quantity::MosTemp => r.mos_temp_c.unwrap_or(f32::NAN),
-                Quantity::CapTemp => r.cap_temp_c.unwrap_or(f32::NAN),
+                Quantity::MosTemp => r.mos_temp_c,
+                Quantity::CapTemp => r.cap_temp_c,
+                Quantity::MotorTemp => r.motor_temp_c,
+                Quantity::BecTemp => r.bec_temp_c,
+                Quantity::BecVoltage => r.bec_voltage_v,
+                Quantity::BecCurrent => r.bec_current_a,
             },
-            Shown::Power => energy::power_w(f64::from(r.voltage_v), f64::from(r.current_a)) as f32,
-        }
+            Shown::Power => r
+                .voltage_v
+                .zip(r.current_a)
+                .map(|(v, a)| energy::power_w(f64::from(v), f64::from(a)) as f32),
+        };
+        value.unwrap_or(f32::NAN)
     }
 }
 

@@ -159,7 +159,14 @@ fn eight_virtual_escs_through_the_datalink_bridge_decode_whole_in_their_channels
             let want = sent
                 .get(start + k)
                 .unwrap_or_else(|| panic!("esc {esc}: more frames than were sent"));
-            for field in got.as_object().unwrap().keys().filter(|k| *k != "t_s") {
+            // Sent on the ESCs' own wires, received as the hub's channels.
+            assert_eq!(want["protocol"], "hw-foc", "esc {esc}: frame {k} as sent");
+            assert_eq!(
+                got["protocol"], "datalink",
+                "esc {esc}: frame {k} as received"
+            );
+            let compared = |k: &&String| *k != "t_s" && *k != "protocol";
+            for field in got.as_object().unwrap().keys().filter(compared) {
                 assert_eq!(
                     got[field], want[field],
                     "esc {esc}: {field} of frame {k} (packet {})",

@@ -11,7 +11,7 @@ use std::sync::Arc;
 use common::{SCHEMA, XROTOR, assert_fails_with, capture, hwfoc, stdout};
 
 use arrow_array::cast::AsArray;
-use arrow_array::types::{Float32Type, Float64Type, UInt8Type, UInt16Type, UInt32Type};
+use arrow_array::types::{Float32Type, Float64Type, Int8Type, UInt8Type, UInt16Type, UInt32Type};
 use arrow_array::{Array, ArrayRef, RecordBatch};
 use arrow_schema::DataType;
 use hwfoc::foc::{DataFrame, InfoFrame};
@@ -129,6 +129,11 @@ fn json_value(array: &ArrayRef, row: usize) -> Value {
             let names = array.as_list::<i32>().value(row);
             let names = names.as_string::<i32>();
             Value::from_iter(names.iter().map(|n| n.unwrap().to_string()))
+        }
+        DataType::Dictionary(_, _) => {
+            let dict = array.as_dictionary::<Int8Type>();
+            let key = dict.keys().value(row);
+            Value::from(dict.values().as_string::<i32>().value(key as usize))
         }
         other => panic!("a column type this test does not know: {other}"),
     }
@@ -300,9 +305,9 @@ fn parquet_row_groups_and_standard_input() {
         let packets = batch
             .column_by_name("packet")
             .unwrap()
-            .as_primitive::<UInt16Type>();
+            .as_primitive::<UInt32Type>();
         for p in packets.values() {
-            assert_eq!(*p, next as u16);
+            assert_eq!(*p, next % 65_536, "a 16-bit counter in a uint32 column");
             next += 1;
         }
     }
@@ -339,11 +344,17 @@ fn several_inputs_are_numbered_escs_in_order() {
                 .collect()
         } else {
             let mut lines = out.lines();
-            assert!(lines.next().unwrap().starts_with("t_s,esc,packet,"));
+            assert!(
+                lines
+                    .next()
+                    .unwrap()
+                    .starts_with("t_s,esc,protocol,packet,")
+            );
             lines
                 .map(|l| {
                     let f: Vec<&str> = l.split(',').collect();
-                    (f[1].parse().unwrap(), f[2].parse().unwrap())
+                    assert_eq!(f[2], "hw-foc");
+                    (f[1].parse().unwrap(), f[3].parse().unwrap())
                 })
                 .collect()
         };
@@ -600,7 +611,7 @@ fn an_input_error_leaves_a_readable_parquet_file() {
     let packets = batch
         .column_by_name("packet")
         .unwrap()
-        .as_primitive::<UInt16Type>();
+        .as_primitive::<UInt32Type>();
     assert_eq!(packets.value(49), 49);
 }
 
@@ -635,7 +646,7 @@ fn text_output_keeps_the_input_order() {
         } else {
             text.lines()
                 .skip(1)
-                .map(|l| l.split(',').nth(2).unwrap().parse().unwrap())
+                .map(|l| l.split(',').nth(3).unwrap().parse().unwrap())
                 .collect()
         };
         assert_eq!(packets, (0..60_000).collect::<Vec<u64>>(), "{format}");
@@ -658,8 +669,14 @@ fn live_input_is_written_as_it_arrives() {
             // A raw stream starts with its first byte: send one so that the header comes out.
             stdin.write_all(&frame(0, Status::OK).encode()).unwrap();
             stdin.flush().unwrap();
-            assert!(lines.next().unwrap().unwrap().starts_with("t_s,esc,packet"));
-            assert!(lines.next().unwrap().unwrap().starts_with(",0,0,"));
+            assert!(
+                lines
+                    .next()
+                    .unwrap()
+                    .unwrap()
+                    .starts_with("t_s,esc,protocol,packet")
+            );
+            assert!(lines.next().unwrap().unwrap().starts_with(",0,hw-foc,0,"));
         }
         // Each frame's record comes out while the input is still open.
         for packet in 1..4u16 {
@@ -669,7 +686,7 @@ fn live_input_is_written_as_it_arrives() {
             stdin.flush().unwrap();
             let line = lines.next().unwrap().unwrap();
             let expected = if format == "csv" {
-                format!(",0,{packet},")
+                format!(",0,hw-foc,{packet},")
             } else {
                 format!("\"packet\":{packet},")
             };

@@ -25,19 +25,27 @@ import pyarrow.parquet as pq
 SCHEMA = [
     ("t_s", pa.float64(), True, "s"),
     ("esc", pa.uint8(), False, "-"),
-    ("packet", pa.uint16(), False, "-"),
-    ("throttle_in_pct", pa.float32(), False, "%"),
-    ("throttle_out_pct", pa.float32(), False, "%"),
-    ("erpm", pa.uint32(), False, "rev/min"),
-    ("rpm", pa.float32(), False, "rev/min"),
-    ("voltage_v", pa.float32(), False, "V"),
-    ("current_a", pa.float32(), False, "A"),
-    ("phase_current_a", pa.float32(), False, "A"),
+    ("protocol", pa.dictionary(pa.int8(), pa.string()), False, "-"),
+    ("packet", pa.uint32(), True, "-"),
+    ("throttle_in_pct", pa.float32(), True, "%"),
+    ("throttle_out_pct", pa.float32(), True, "%"),
+    ("erpm", pa.uint32(), True, "rev/min"),
+    ("rpm", pa.float32(), True, "rev/min"),
+    ("voltage_v", pa.float32(), True, "V"),
+    ("current_a", pa.float32(), True, "A"),
+    ("phase_current_a", pa.float32(), True, "A"),
     ("mos_temp_c", pa.float32(), True, "degC"),
     ("cap_temp_c", pa.float32(), True, "degC"),
-    ("status", pa.uint16(), False, "-"),
-    ("faults", pa.list_(pa.field("item", pa.string(), nullable=False)), False, "-"),
+    ("motor_temp_c", pa.float32(), True, "degC"),
+    ("bec_temp_c", pa.float32(), True, "degC"),
+    ("bec_voltage_v", pa.float32(), True, "V"),
+    ("bec_current_a", pa.float32(), True, "A"),
+    ("status", pa.uint16(), True, "-"),
+    ("faults", pa.list_(pa.field("item", pa.string(), nullable=False)), True, "-"),
 ]
+
+# Columns of record schema 2 that no protocol read today carries: null in every row.
+NOT_CARRIED = ["motor_temp_c", "bec_temp_c", "bec_voltage_v", "bec_current_a"]
 
 SETTINGS = {"current_scale": "100", "pole_pairs": "14", "gear_ratio": "2.5"}
 
@@ -78,6 +86,7 @@ def main():
     for key, value in SETTINGS.items():
         check(kv.get(key.encode()) == value.encode(), f"metadata {key}: {kv.get(key.encode())!r}")
     check(kv.get(b"hwfoc_version", b"") != b"", "no hwfoc_version in the metadata")
+    check(kv.get(b"record_schema_version") == b"2", f"record_schema_version {kv.get(b'record_schema_version')!r}")
     check(json.loads(kv[b"inputs"]) == ["demo capture"], f"inputs {kv[b'inputs']!r}")
     escs = json.loads(kv[b"escs"])
     check(escs == [{"esc": 0, "input": "demo capture", "stream": "demo capture"}], f"escs {escs}")
@@ -98,6 +107,22 @@ def main():
             if name in floats and value is not None:
                 value = f32(value)
             check(got == value, f"row {i} {name}: parquet {got!r}, JSON {value!r}")
+    # `protocol` is dictionary-encoded in the Parquet file itself (its column chunks), and read
+    # back as a dictionary; the demo is one ESC's own wire.
+    meta = pq.ParquetFile(parquet_path).metadata
+    at = schema.names.index("protocol")
+    for g in range(meta.num_row_groups):
+        column = meta.row_group(g).column(at)
+        check(column.has_dictionary_page, f"protocol: row group {g} has no dictionary page")
+        check(column.physical_type == "BYTE_ARRAY", f"protocol: physical type {column.physical_type}")
+    protocol = table.column("protocol")
+    check(pa.types.is_dictionary(protocol.type), f"protocol read as {protocol.type}")
+    check(set(protocol.to_pylist()) == {"hw-foc"}, f"protocol values {set(protocol.to_pylist())}")
+    check(pa.types.is_uint32(table.column("packet").type), f"packet read as {table.column('packet').type}")
+    check(max(r["packet"] for r in rows) > 0, "packet numbers all 0")
+    for name in NOT_CARRIED:
+        check(table.column(name).null_count == table.num_rows, f"{name}: not null in every row")
+        check(all(r[name] is None for r in records), f"{name}: not null in the JSON records")
     # The demo has a fault episode: the list column holds names, not just empty lists.
     check(any(r["faults"] for r in rows), "no faults in the demo's records")
     print("pyarrow_check: %d rows, schema, units and metadata as docs/RECORD-SCHEMA.md" % len(rows))

@@ -114,7 +114,11 @@ local f = {
     time = ProtoField.absolute_time("hwfoc.time", "First byte received", base.UTC),
     time_epoch = ProtoField.relative_time("hwfoc.time_epoch",
         "First byte received (seconds since 1970, as hwfoc's t_s)"),
-    packet = ProtoField.uint16("hwfoc.packet", "Packet number", base.DEC),
+    -- uint32 as the record's `packet` (record schema 2: the older formats count in 24 bits);
+    -- an HW-FOC frame's counter is its 2 bytes.
+    packet = ProtoField.uint32("hwfoc.packet", "Packet number", base.DEC),
+    -- The record's `protocol`: the format of the frame, as `--protocol` names it.
+    protocol = ProtoField.string("hwfoc.protocol", "Protocol (record's protocol column)"),
     throttle_in_raw = ProtoField.uint16("hwfoc.throttle_in_raw", "Input throttle (raw, of 1024)"),
     throttle_in = ProtoField.double("hwfoc.throttle_in_pct", "Input throttle"),
     throttle_out_raw = ProtoField.uint16("hwfoc.throttle_out_raw", "Output throttle (raw, of 1024)"),
@@ -416,6 +420,8 @@ local function frame(item, r, tree, pinfo, when)
     local len = kind.len
     local subtree = tree:add(hwfoc, r, kind.name)
     subtree:add(f.kind, r, kind.len == DATA_LEN and "data" or "info")
+    -- Every frame this dissector reads is an ESC's own HW-FOC frame.
+    subtree:add(f.protocol, r(0, 1), "hw-foc"):set_generated()
     -- Its first byte's time: that of the first byte of the packet it is in (or, reassembled, of
     -- the packet where it began), plus a byte time per byte before it (10 bits at the baud rate).
     local ns = math.floor(when.k * when.byte_s * 1e9 + 0.5)

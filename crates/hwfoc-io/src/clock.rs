@@ -92,7 +92,7 @@ impl Step {
     /// The step from a frame received at `from` to one received at `to` (s); `packets` is
     /// how far the packet number advanced between them (wrapping), where both are data frames
     /// of one ESC. Without it, a step longer than [`MAX_STEP_S`] is a [`Step::Jump`].
-    pub fn between(from: f64, to: f64, packets: Option<u16>) -> Step {
+    pub fn between(from: f64, to: f64, packets: Option<u32>) -> Step {
         let dt = to - from;
         if dt.is_nan() || dt < 0.0 {
             return Step::Back;

@@ -11,7 +11,7 @@ pub struct Mark {
     /// Index of the data frame among the ESC's data frames (0-based).
     pub frame: u64,
     /// Its packet number, where its protocol sends one.
-    pub packet: Option<u16>,
+    pub packet: Option<u32>,
 }
 
 /// A maximal run of consecutive data frames with a non-zero status word.

@@ -63,7 +63,8 @@
 //!
 //! assert_eq!(records.0.len(), 3);
 //! assert_eq!(records.0[0].esc, 0);
-//! assert_eq!(records.0[2].voltage_v, 24.7);
+//! assert_eq!(records.0[2].voltage_v, Some(24.7));
+//! assert_eq!(records.0[2].protocol, hwfoc::Protocol::HwFoc);
 //! # Ok::<(), InputError>(())
 //! ```
 //!
@@ -148,6 +149,13 @@ mod stream;
 /// added. The records of `docs/RECORD-SCHEMA.md` (JSON Lines) carry no such key: they have exactly
 /// the schema's keys.
 pub const JSON_SCHEMA_VERSION: u32 = 1;
+
+/// The version of the record schema of `docs/RECORD-SCHEMA.md` (its columns, their types and
+/// nullability), recorded with the outputs that carry metadata: the Parquet export's key-value
+/// metadata and the Python package's Arrow schema, key `record_schema_version`. Version 2 added
+/// `protocol`, the BEC and motor columns, a 32-bit nullable `packet` and null for what a format
+/// does not carry (the document's "Changes").
+pub const RECORD_SCHEMA_VERSION: u32 = 2;
 
 // The crate-root items, by role (a comment, not a doc comment: rustdoc would prepend a doc
 // comment on a re-export to the docs of each item it names).

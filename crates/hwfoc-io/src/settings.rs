@@ -269,7 +269,7 @@ mod tests {
         type Error = crate::InputError;
 
         fn record(&mut self, r: &crate::Record) {
-            self.0.push((r.esc, r.rpm, r.current_a));
+            self.0.push((r.esc, r.rpm.unwrap(), r.current_a.unwrap()));
         }
     }
 

@@ -68,7 +68,7 @@ fn hub_records(d: &datalink::Decoded, emit: &mut impl FnMut(Option<u8>, u64, &Fr
         emit(
             Some(channel as u8),
             d.offset,
-            &Frame::Data(Data::from(*frame)),
+            &Frame::Data(Data::DataLink(*frame)),
         );
     }
 }

@@ -4,7 +4,7 @@
 use std::sync::Arc;
 
 use arrow_array::cast::AsArray;
-use arrow_array::types::{Float32Type, Float64Type, UInt8Type, UInt16Type, UInt32Type};
+use arrow_array::types::{Float32Type, Float64Type, Int8Type, UInt8Type, UInt16Type, UInt32Type};
 use arrow_array::{Array, ArrayRef, RecordBatch};
 use arrow_schema::DataType;
 use hwfoc::foc::DataFrame;
@@ -69,6 +69,11 @@ fn value(array: &ArrayRef, row: usize) -> Value {
             let names = list.as_string::<i32>();
             assert_eq!(names.null_count(), 0);
             Value::from_iter(names.iter().map(|n| n.unwrap().to_string()))
+        }
+        DataType::Dictionary(_, _) => {
+            let dict = array.as_dictionary::<Int8Type>();
+            let key = dict.keys().value(row);
+            Value::from(dict.values().as_string::<i32>().value(key as usize))
         }
         other => panic!("a type this test does not know: {other}"),
     }
@@ -172,10 +177,10 @@ fn the_record_fields_are_the_batch_columns() {
     for (row, r) in records.iter().enumerate() {
         assert_eq!(t.is_valid(row).then(|| t.value(row)), r.t_s);
         assert_eq!(mos.is_valid(row).then(|| mos.value(row)), r.mos_temp_c);
-        assert_eq!(rpm.value(row), r.rpm);
-        assert_eq!(current.value(row), r.current_a);
-        assert_eq!(status.value(row), r.status.0);
-        assert_eq!(erpm.value(row), r.erpm);
+        assert_eq!(Some(rpm.value(row)), r.rpm);
+        assert_eq!(Some(current.value(row)), r.current_a);
+        assert_eq!(Some(status.value(row)), r.status.map(|s| s.0));
+        assert_eq!(Some(erpm.value(row)), r.erpm);
     }
     // The extremes: the largest eRPM and the most negative current.
     assert_eq!(erpm.value(7), u32::from(u16::MAX) * 10);

@@ -63,6 +63,9 @@ fn arrow_type(words: &str) -> (DataType, bool) {
         "list of strings (CSV: `|`-joined)" => {
             DataType::List(Arc::new(Field::new("item", DataType::Utf8, false)))
         }
+        "dictionary of strings (int8 keys)" => {
+            DataType::Dictionary(Box::new(DataType::Int8), Box::new(DataType::Utf8))
+        }
         other => panic!("a type this test does not know: {other:?}"),
     };
     (data_type, nullable)
@@ -200,7 +203,133 @@ fn text_follows_the_table() {
                 let joined: Vec<&str> = names.iter().map(|n| n.as_str().unwrap()).collect();
                 assert_eq!(*field, joined.join("|"), "{name}");
             }
+            serde_json::Value::String(text) => assert_eq!(field, text, "{name}"),
             other => assert_eq!(*field, other.to_string(), "{name}"),
         }
+    }
+}
+
+/// Schema version 2: the columns' order, types and nullability as written out here (the
+/// document and the code are both checked against this list: a change to either shows).
+#[test]
+fn version_2_order_types_and_nullability() {
+    let dict = DataType::Dictionary(Box::new(DataType::Int8), Box::new(DataType::Utf8));
+    let faults = DataType::List(Arc::new(Field::new("item", DataType::Utf8, false)));
+    let f32n = (DataType::Float32, true);
+    let want: Vec<(&str, (DataType, bool))> = vec![
+        ("t_s", (DataType::Float64, true)),
+        ("esc", (DataType::UInt8, false)),
+        ("protocol", (dict, false)),
+        ("packet", (DataType::UInt32, true)),
+        ("throttle_in_pct", f32n.clone()),
+        ("throttle_out_pct", f32n.clone()),
+        ("erpm", (DataType::UInt32, true)),
+        ("rpm", f32n.clone()),
+        ("voltage_v", f32n.clone()),
+        ("current_a", f32n.clone()),
+        ("phase_current_a", f32n.clone()),
+        ("mos_temp_c", f32n.clone()),
+        ("cap_temp_c", f32n.clone()),
+        ("motor_temp_c", f32n.clone()),
+        ("bec_temp_c", f32n.clone()),
+        ("bec_voltage_v", f32n.clone()),
+        ("bec_current_a", f32n),
+        ("status", (DataType::UInt16, true)),
+        ("faults", (faults, true)),
+    ];
+    let schema = schema();
+    let got: Vec<(&str, (DataType, bool))> = schema
+        .fields()
+        .iter()
+        .map(|f| (f.name().as_str(), (f.data_type().clone(), f.is_nullable())))
+        .collect();
+    assert_eq!(got, want);
+    let documented: Vec<(String, (DataType, bool))> = expected()
+        .into_iter()
+        .map(|c| (c.name, (c.data_type, c.nullable)))
+        .collect();
+    let want: Vec<(String, (DataType, bool))> =
+        want.into_iter().map(|(n, t)| (n.to_string(), t)).collect();
+    assert_eq!(documented, want);
+    assert!(record_schema_md().contains("Record schema **version 2**"));
+    assert_eq!(hwfoc_io::RECORD_SCHEMA_VERSION, 2);
+}
+
+/// The `protocol` column of an ESC's own frame and of a DataLink hub's, and the columns no
+/// protocol read today carries, in every format: JSON `null`, an empty CSV cell, an Arrow null.
+#[test]
+fn protocol_and_the_columns_not_carried_in_every_format() {
+    use arrow_array::cast::AsArray;
+    use arrow_array::types::Int8Type;
+    use hwfoc::telemetry::Data;
+    use hwfoc_io::write::arrow::RecordBatchBuilder;
+
+    const NOT_CARRIED: [&str; 4] = [
+        "motor_temp_c",
+        "bec_temp_c",
+        "bec_voltage_v",
+        "bec_current_a",
+    ];
+    let frame = DataFrame {
+        packet: 70_00,
+        voltage_raw: 247,
+        mos_adc: 206,
+        cap_adc: 206,
+        ..Default::default()
+    };
+    let s = Settings::default();
+    let mut builder = RecordBatchBuilder::new();
+    for (data, name) in [
+        (Data::from(frame), "hw-foc"),
+        (Data::DataLink(frame), "datalink"),
+    ] {
+        let record = Record::new(Some(1.0), 2, &data, &s);
+        builder.push(record);
+        let mut json = Vec::new();
+        TextEncoder::cached().json_frame(&record, &data, &mut json);
+        let v: serde_json::Value = serde_json::from_slice(&json).unwrap();
+        assert_eq!(v["protocol"], name);
+        assert_eq!(v["packet"], 7000);
+        assert_eq!(v["voltage_v"].as_f64().map(|x| x as f32), Some(24.7));
+        for column in NOT_CARRIED {
+            assert!(v[column].is_null(), "{column}: {v}");
+        }
+        let mut csv = Vec::new();
+        TextEncoder::new().csv(&record, &mut csv);
+        let csv = String::from_utf8(csv).unwrap();
+        let fields: Vec<&str> = csv.trim_end().split(',').collect();
+        let at = |c: &str| COLUMNS.iter().position(|n| *n == c).unwrap();
+        assert_eq!(fields[at("protocol")], name);
+        assert_eq!(fields[at("packet")], "7000");
+        for column in NOT_CARRIED {
+            assert_eq!(fields[at(column)], "", "{column}: {csv}");
+        }
+    }
+    let batch = builder.finish();
+    let protocol = batch
+        .column_by_name("protocol")
+        .unwrap()
+        .as_dictionary::<Int8Type>();
+    let names = protocol.values().as_string::<i32>();
+    let values: Vec<&str> = protocol
+        .keys()
+        .values()
+        .iter()
+        .map(|&k| names.value(k as usize))
+        .collect();
+    assert_eq!(values, ["hw-foc", "datalink"]);
+    for column in NOT_CARRIED {
+        assert_eq!(
+            batch.column_by_name(column).unwrap().null_count(),
+            2,
+            "{column}"
+        );
+    }
+    for column in ["packet", "voltage_v", "status", "faults"] {
+        assert_eq!(
+            batch.column_by_name(column).unwrap().null_count(),
+            0,
+            "{column}"
+        );
     }
 }

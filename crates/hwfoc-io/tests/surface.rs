@@ -25,11 +25,12 @@ use hwfoc_io::record::{COLUMNS, Column, FaultList, TextEncoder, UNITS, Value, Vi
 use hwfoc_io::{EmptyWindow, Selection, Window, filter_text, no_frame_in_window};
 
 // Notices and text helpers.
-use hwfoc_io::{Escaped, Fixed, JSON_SCHEMA_VERSION, Notice};
+use hwfoc_io::{Escaped, Fixed, JSON_SCHEMA_VERSION, Notice, RECORD_SCHEMA_VERSION};
 
 // Writers.
 use hwfoc_io::write::arrow::{ArrowValue, RecordBatchBuilder, record_batch, schema};
-use hwfoc_io::write::metadata::{ESC_SETTINGS, ESCS, esc_settings_json, escs_json};
+use hwfoc_io::write::metadata::{ESC_SETTINGS, ESCS, RECORD_SCHEMA_VERSION_KEY};
+use hwfoc_io::write::metadata::{esc_settings_json, escs_json};
 use hwfoc_io::write::{Export, ExportError, OutputFormat, Provenance, WriteError};
 use hwfoc_io::write::{FileId, Staging, create_file, same_file};
 
@@ -56,11 +57,13 @@ use hwfoc_io::time::{Clock, Time, TimeError, iso8601, iso8601_local, parse, span
 fn the_surface_constants_are_those_of_the_specs() {
     assert_eq!(COLUMNS.len(), COUNT);
     assert_eq!(UNITS.len(), COUNT);
-    assert_eq!(COLUMNS[..2], ["t_s", "esc"]);
+    assert_eq!(COLUMNS[..4], ["t_s", "esc", "protocol", "packet"]);
     // The pcapng section header block's type, and the link type of `docs/REFERENCE.md` (USER0).
     assert_eq!(MAGIC, [0x0A, 0x0D, 0x0D, 0x0A]);
     assert_eq!(LINKTYPE, 147);
     assert_eq!(DEFAULT_BAUD, 19_200);
     assert_eq!(NOMINAL_PERIOD_S, 0.05);
     assert_eq!(JSON_SCHEMA_VERSION, 1);
+    assert_eq!(RECORD_SCHEMA_VERSION, 2);
+    assert_eq!(RECORD_SCHEMA_VERSION_KEY, "record_schema_version");
 }

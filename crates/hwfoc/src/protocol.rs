@@ -49,6 +49,29 @@ impl Protocol {
         }
     }
 
+    /// The width of its packet counter in bits (which it wraps at), or `None` for a protocol
+    /// that sends no counter: 16 for HW-FOC and DataLink.
+    pub const fn packet_bits(self) -> Option<u32> {
+        match self {
+            Protocol::HwFoc | Protocol::DataLink => Some(16),
+        }
+    }
+
+    /// How far a packet counter of this protocol advanced from `from` to `to`, wrapping at its
+    /// width (`None` for a protocol without counter).
+    ///
+    /// ```
+    /// use hwfoc::Protocol;
+    ///
+    /// assert_eq!(Protocol::HwFoc.packets_between(65_535, 1), Some(2));
+    /// ```
+    pub const fn packets_between(self, from: u32, to: u32) -> Option<u32> {
+        match self.packet_bits() {
+            Some(bits) => Some(to.wrapping_sub(from) & (u32::MAX >> (32 - bits))),
+            None => None,
+        }
+    }
+
     /// The protocol named `name` (as [`Protocol::name`] spells it, any case).
     pub fn from_name(name: &str) -> Option<Protocol> {
         Protocol::ALL

@@ -27,6 +27,7 @@
 
 use crate::foc::kinds::data::DataFrame;
 use crate::foc::kinds::info::InfoFrame;
+use crate::protocol::Protocol;
 use crate::status::Status;
 use crate::units::{Linear, Quantity, Settings, Temperature};
 
@@ -84,8 +85,9 @@ impl Reading {
 /// The protocol-neutral reading of a data frame: which quantities it carries, as sent and
 /// converted. Implemented by every protocol's data frame, and by [`Data`].
 pub trait Telemetry {
-    /// The frame's packet counter, where the protocol sends one.
-    fn packet(&self) -> Option<u16>;
+    /// The frame's packet counter, where the protocol sends one (16 bits in HW-FOC and
+    /// DataLink, 24 in the older formats; HW5 has none).
+    fn packet(&self) -> Option<u32>;
 
     /// The frame's status word (sixteen fault bits, [`Status`]), where the protocol sends one.
     fn status(&self) -> Option<Status>;
@@ -111,8 +113,8 @@ pub trait Telemetry {
 
 impl Telemetry for DataFrame {
     #[inline(always)]
-    fn packet(&self) -> Option<u16> {
-        Some(self.packet)
+    fn packet(&self) -> Option<u32> {
+        Some(u32::from(self.packet))
     }
 
     #[inline(always)]
@@ -140,6 +142,10 @@ impl Telemetry for DataFrame {
             Quantity::PhaseCurrent => linear(self.phase_current_raw.into(), settings.amps_linear()),
             Quantity::MosTemp => adc(self.mos_adc),
             Quantity::CapTemp => adc(self.cap_adc),
+            Quantity::MotorTemp
+            | Quantity::BecTemp
+            | Quantity::BecVoltage
+            | Quantity::BecCurrent => return None,
         })
     }
 }
@@ -168,45 +174,76 @@ macro_rules! per_protocol {
     };
 }
 
-per_protocol! {
-    /// A data frame of any supported protocol.
-    pub enum Data {
-        /// An HW-FOC data frame (also a DataLink V2 record, which carries the same payload).
-        HwFoc(DataFrame),
+/// A data frame of any supported protocol: one arm per protocol, so that what a record says
+/// of its source ([`Data::protocol`]) is a property of the frame, as its readings are.
+///
+/// `From<foc::DataFrame>` gives the HW-FOC arm (an ESC's own wire); a DataLink V2 hub's record,
+/// which carries the same payload, is made as `Data::DataLink(frame)`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Data {
+    /// An HW-FOC data frame, from an ESC's own wire.
+    HwFoc(DataFrame),
+    /// A DataLink V2 hub's record of one ESC channel: the HW-FOC payload the hub forwards.
+    DataLink(DataFrame),
+}
+
+impl From<DataFrame> for Data {
+    /// The HW-FOC arm: a frame from an ESC's own wire.
+    #[inline]
+    fn from(frame: DataFrame) -> Data {
+        Data::HwFoc(frame)
     }
 }
 
 impl Telemetry for Data {
     #[inline(always)]
-    fn packet(&self) -> Option<u16> {
+    fn packet(&self) -> Option<u32> {
         match self {
-            Data::HwFoc(f) => f.packet(),
+            Data::HwFoc(f) | Data::DataLink(f) => f.packet(),
         }
     }
 
     #[inline(always)]
     fn status(&self) -> Option<Status> {
         match self {
-            Data::HwFoc(f) => Telemetry::status(f),
+            Data::HwFoc(f) | Data::DataLink(f) => Telemetry::status(f),
         }
     }
 
     #[inline(always)]
     fn reading(&self, quantity: Quantity, settings: &Settings) -> Option<Reading> {
         match self {
-            Data::HwFoc(f) => f.reading(quantity, settings),
+            Data::HwFoc(f) | Data::DataLink(f) => f.reading(quantity, settings),
         }
     }
 }
 
 impl Data {
+    /// The protocol the frame was received in (the record's `protocol` column).
+    ///
+    /// ```
+    /// use hwfoc::Protocol;
+    /// use hwfoc::foc::DataFrame;
+    /// use hwfoc::telemetry::Data;
+    ///
+    /// assert_eq!(Data::from(DataFrame::default()).protocol(), Protocol::HwFoc);
+    /// assert_eq!(Data::DataLink(DataFrame::default()).protocol(), Protocol::DataLink);
+    /// ```
+    #[inline(always)]
+    pub const fn protocol(&self) -> Protocol {
+        match self {
+            Data::HwFoc(_) => Protocol::HwFoc,
+            Data::DataLink(_) => Protocol::DataLink,
+        }
+    }
+
     /// The HW-FOC data frame with this frame's readings: what a DataLink V2 hub record holds
     /// (the hub forwards HW-FOC payloads), for outputs that speak HW-FOC. An HW-FOC frame is
     /// itself.
     #[inline]
     pub fn to_hwfoc(&self) -> DataFrame {
         match self {
-            Data::HwFoc(f) => *f,
+            Data::HwFoc(f) | Data::DataLink(f) => *f,
         }
     }
 }

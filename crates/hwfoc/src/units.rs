@@ -91,11 +91,19 @@ pub enum Quantity {
     MosTemp,
     /// Capacitor temperature, degC (`cap_temp_c`).
     CapTemp,
+    /// Motor temperature, degC (`motor_temp_c`): HW5; no protocol read today carries it.
+    MotorTemp,
+    /// BEC temperature, degC (`bec_temp_c`): HW5; no protocol read today carries it.
+    BecTemp,
+    /// BEC output voltage, V (`bec_voltage_v`): HW5; no protocol read today carries it.
+    BecVoltage,
+    /// BEC output current, A (`bec_current_a`): HW5; no protocol read today carries it.
+    BecCurrent,
 }
 
 impl Quantity {
     /// Every quantity, in the order of the telemetry record.
-    pub const ALL: [Quantity; 9] = [
+    pub const ALL: [Quantity; 13] = [
         Quantity::ThrottleIn,
         Quantity::ThrottleOut,
         Quantity::Erpm,
@@ -105,6 +113,10 @@ impl Quantity {
         Quantity::PhaseCurrent,
         Quantity::MosTemp,
         Quantity::CapTemp,
+        Quantity::MotorTemp,
+        Quantity::BecTemp,
+        Quantity::BecVoltage,
+        Quantity::BecCurrent,
     ];
 
     /// The column name in every output, e.g. `voltage_v`.
@@ -119,6 +131,10 @@ impl Quantity {
             Quantity::PhaseCurrent => "phase_current_a",
             Quantity::MosTemp => "mos_temp_c",
             Quantity::CapTemp => "cap_temp_c",
+            Quantity::MotorTemp => "motor_temp_c",
+            Quantity::BecTemp => "bec_temp_c",
+            Quantity::BecVoltage => "bec_voltage_v",
+            Quantity::BecCurrent => "bec_current_a",
         }
     }
 
@@ -127,9 +143,11 @@ impl Quantity {
         match self {
             Quantity::ThrottleIn | Quantity::ThrottleOut => "%",
             Quantity::Erpm | Quantity::Rpm => "rev/min",
-            Quantity::Voltage => "V",
-            Quantity::Current | Quantity::PhaseCurrent => "A",
-            Quantity::MosTemp | Quantity::CapTemp => "degC",
+            Quantity::Voltage | Quantity::BecVoltage => "V",
+            Quantity::Current | Quantity::PhaseCurrent | Quantity::BecCurrent => "A",
+            Quantity::MosTemp | Quantity::CapTemp | Quantity::MotorTemp | Quantity::BecTemp => {
+                "degC"
+            }
         }
     }
 }

@@ -55,7 +55,7 @@ fn old_f32(q: Quantity, raw: i32, s: &Settings) -> f32 {
         }
         Quantity::Voltage => f32::from(raw as u16) / 10.0,
         Quantity::Current | Quantity::PhaseCurrent => f32::from(raw as i16) / s.current_scale,
-        Quantity::MosTemp | Quantity::CapTemp => unreachable!("not linear"),
+        _ => unreachable!("not linear, or not carried by HW-FOC"),
     }
 }
 
@@ -67,7 +67,7 @@ fn old_f64(q: Quantity, x: f64, s: &Settings) -> f64 {
         Quantity::Rpm => x * 10.0 / (f64::from(s.gear_ratio) * f64::from(s.pole_pairs)),
         Quantity::Voltage => x / 10.0,
         Quantity::Current | Quantity::PhaseCurrent => x / f64::from(s.current_scale),
-        Quantity::MosTemp | Quantity::CapTemp => unreachable!("not linear"),
+        _ => unreachable!("not linear, or not carried by HW-FOC"),
     }
 }
 
@@ -83,6 +83,7 @@ fn method(f: &DataFrame, q: Quantity, s: &Settings) -> f32 {
         Quantity::PhaseCurrent => f.phase_current_a(s),
         Quantity::MosTemp => f.mos_temp().celsius().unwrap_or(f32::NAN),
         Quantity::CapTemp => f.cap_temp().celsius().unwrap_or(f32::NAN),
+        _ => unreachable!("not carried by HW-FOC"),
     }
 }
 
@@ -98,6 +99,7 @@ fn frame_with(q: Quantity, bits: u16) -> DataFrame {
         Quantity::PhaseCurrent => f.phase_current_raw = bits as i16,
         Quantity::MosTemp => f.mos_adc = bits as u8,
         Quantity::CapTemp => f.cap_adc = bits as u8,
+        _ => unreachable!("not carried by HW-FOC"),
     }
     f
 }
@@ -163,8 +165,38 @@ fn names_and_units_are_the_record_schema() {
             ("phase_current_a", "A"),
             ("mos_temp_c", "degC"),
             ("cap_temp_c", "degC"),
+            ("motor_temp_c", "degC"),
+            ("bec_temp_c", "degC"),
+            ("bec_voltage_v", "V"),
+            ("bec_current_a", "A"),
         ]
     );
+}
+
+/// An HW-FOC frame carries none of the quantities only other formats send (HW5's motor and
+/// BEC readings): their reading is `None`, whatever the frame holds.
+#[test]
+fn hwfoc_frames_do_not_carry_the_bec_and_motor_quantities() {
+    let s = Settings::default();
+    let f = DataFrame {
+        packet: 9,
+        voltage_raw: 247,
+        mos_adc: 206,
+        cap_adc: 206,
+        ..Default::default()
+    };
+    for q in [
+        Quantity::MotorTemp,
+        Quantity::BecTemp,
+        Quantity::BecVoltage,
+        Quantity::BecCurrent,
+    ] {
+        assert_eq!(f.reading(q, &s), None, "{q:?}");
+        assert_eq!(f.raw(q), None, "{q:?}");
+    }
+    for q in &Quantity::ALL[..9] {
+        assert!(f.reading(*q, &s).is_some(), "{q:?}");
+    }
 }
 
 /// The temperatures of an HW-FOC frame are ADC codes read through the table: every code gives

@@ -23,8 +23,11 @@
 //!   frame of its last one (4 a second at the ESC's 20). Fields: `input_pct` and `output_pct` =
 //!   the input and output throttle %, rounded, 0..=100; `status_flags` = the frame's status word
 //!   as the ESC sent it (the fault bits of `hwfoc::Fault`); `esc_index` as in esc.Status;
-//!   `motor_temperature_degC` = 0 and `motor_angle` = 0: HW-FOC frames carry neither, and the
-//!   DSDL has no "unknown" for them (a receiver logging motor temperature logs 0 °C).
+//!   `motor_temperature_degC` = the record's `motor_temp_c`, rounded, where the ESC's protocol
+//!   sends it (HW5), else 0, as `motor_angle` always is: HW-FOC and DataLink frames carry
+//!   neither, and the DSDL has no "unknown" for them (a receiver logging motor temperature logs
+//!   0 °C). A quantity the protocol does not carry is otherwise sent as the DSDL's unknown
+//!   where it has one (NaN for the float16 fields), else 0.
 //! - **NodeStatus** (341), every second from the first poll: `uptime_sec` since the output was
 //!   opened; `mode` OPERATIONAL; `health` OK, or WARNING while an ESC that was heard is silent
 //!   or the last frame of a live ESC had a fault bit set; `vendor_specific_status_code` = bit
@@ -409,7 +412,7 @@ impl Output for DronecanOutput {
             return;
         };
         let r = update.record;
-        let fault = r.status.0 != 0;
+        let fault = r.status.is_some_and(|s| s.0 != 0);
         esc.heard = Some(update.arrived);
         esc.fault = fault;
         if fault {
@@ -417,18 +420,22 @@ impl Output for DronecanOutput {
         }
         let status = EscStatus {
             error_count: esc.error_count,
-            voltage: r.voltage_v,
-            current: r.current_a,
+            voltage: r.voltage_v.unwrap_or(f32::NAN),
+            current: r.current_a.unwrap_or(f32::NAN),
             temperature: r.mos_temp_c.map_or(f32::NAN, |c| c + 273.15),
-            rpm: r.rpm.round() as i32,
-            power_rating_pct: r.throttle_out_pct.round().clamp(0.0, 127.0) as u8,
+            rpm: r.rpm.map_or(0, |rpm| rpm.round() as i32),
+            power_rating_pct: r
+                .throttle_out_pct
+                .map_or(0, |pct| pct.round().clamp(0.0, 127.0) as u8),
             esc_index: update.esc,
         };
-        let percent = |pct: f32| pct.round().clamp(0.0, 100.0) as u8;
+        let percent = |pct: Option<f32>| pct.map_or(0, |pct| pct.round().clamp(0.0, 100.0) as u8);
         let extended = EscStatusExtended {
             input_pct: percent(r.throttle_in_pct),
             output_pct: percent(r.throttle_out_pct),
-            motor_temperature_deg_c: 0,
+            motor_temperature_deg_c: r
+                .motor_temp_c
+                .map_or(0, |c| c.round().clamp(-256.0, 255.0) as i16),
             motor_angle: 0,
             status_flags: u32::from(update.frame.status().unwrap_or_default().0),
             esc_index: update.esc,

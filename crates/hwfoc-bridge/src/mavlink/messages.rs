@@ -116,10 +116,17 @@ impl TelemetryColumns {
             let r = &s.record;
             let u16max = f64::from(u16::MAX);
             c.temperature[i] = temperature_c(r).map_or(0, |t| round_to(f64::from(t), 255.0) as u8);
-            c.voltage[i] = round_to(f64::from(r.voltage_v) * 100.0, u16max) as u16;
-            c.current[i] = round_to(f64::from(r.current_a) * 100.0, u16max) as u16;
+            // A quantity the ESC's protocol does not carry is 0: the fields have no "unknown".
+            c.voltage[i] = r
+                .voltage_v
+                .map_or(0, |v| round_to(f64::from(v) * 100.0, u16max) as u16);
+            c.current[i] = r
+                .current_a
+                .map_or(0, |a| round_to(f64::from(a) * 100.0, u16max) as u16);
             c.totalcurrent[i] = round_to(s.consumed_mah, u16max) as u16;
-            c.rpm[i] = round_to(f64::from(r.rpm), u16max) as u16;
+            c.rpm[i] = r
+                .rpm
+                .map_or(0, |rpm| round_to(f64::from(rpm), u16max) as u16);
             c.count[i] = s.frames as u16;
         }
         c
@@ -165,11 +172,14 @@ pub fn esc_status(group: usize, time_usec: u64, slots: &[Option<Slot>; GROUP]) -
     };
     for (i, slot) in slots.iter().enumerate() {
         let Some(s) = slot else { continue };
-        data.rpm[i] = f64::from(s.record.rpm)
-            .round()
-            .clamp(f64::from(i32::MIN), f64::from(i32::MAX)) as i32;
-        data.voltage[i] = s.record.voltage_v;
-        data.current[i] = s.record.current_a;
+        // A quantity the ESC's protocol does not carry: rpm 0, voltage and current NaN.
+        data.rpm[i] = s.record.rpm.map_or(0, |rpm| {
+            f64::from(rpm)
+                .round()
+                .clamp(f64::from(i32::MIN), f64::from(i32::MAX)) as i32
+        });
+        data.voltage[i] = s.record.voltage_v.unwrap_or(f32::NAN);
+        data.current[i] = s.record.current_a.unwrap_or(f32::NAN);
     }
     MavMessage::ESC_STATUS(data)
 }
@@ -182,7 +192,7 @@ pub fn info_state(slots: &[Option<Slot>; GROUP]) -> (u8, [u16; 4]) {
     for (i, slot) in slots.iter().enumerate() {
         if let Some(s) = slot {
             info |= 1 << i;
-            flags[i] = failure_flags(s.record.status);
+            flags[i] = s.record.status.map_or(0, failure_flags);
         }
     }
     (info, flags)

@@ -537,15 +537,14 @@ impl Output for MavlinkOutput {
                 .saturating_duration_since(opened)
                 .as_secs_f64()
         });
-        esc.energy.add(
-            Some(t_s),
-            f64::from(record.voltage_v),
-            f64::from(record.current_a),
-        );
-        let before = esc.latest.map_or(0, |(r, _)| r.status.0);
+        if let (Some(volts), Some(amps)) = (record.voltage_v, record.current_a) {
+            esc.energy.add(Some(t_s), f64::from(volts), f64::from(amps));
+        }
+        let bits = |r: &Record| r.status.map_or(0, |s| s.0);
+        let before = esc.latest.map_or(0, |(r, _)| bits(&r));
         esc.errors = esc
             .errors
-            .saturating_add((record.status.0 & !before).count_ones());
+            .saturating_add((bits(record) & !before).count_ones());
         esc.frames += 1;
         esc.latest = Some((*record, update.arrived));
         esc.fresh = Some(update.arrived);

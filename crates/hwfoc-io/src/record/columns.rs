@@ -18,6 +18,9 @@
 //! 2. Its row in the copy of that table in hwfoc-io's `tests/schema.rs` (and the example line
 //!    there, which has every column), the test of the schema's order, types and units.
 //!
+//! A column of a measurement is nullable (`Option`): null where the frame's protocol does not
+//! carry the quantity ([`Telemetry::reading`] gives `None`), never 0.
+//!
 //! That is all the code: the writers and the other tests follow the table. A column with a
 //! value type that no column had before (a new [`Value`](super::Value)) also needs that type's
 //! text, Arrow and Parquet encodings (the compiler names what is missing). A Parquet column
@@ -27,18 +30,12 @@
 //! `tests/cli.rs`) and the column list of `tests/pyarrow_check.py` follow it.
 
 use hwfoc::telemetry::{Data, Telemetry};
-use hwfoc::{Quantity, Settings, Status};
+use hwfoc::{Protocol, Quantity};
 
 use super::FaultList;
 
-/// The value of `quantity`, a quantity of a column that is never null: every supported protocol
-/// carries it (`every_protocol_carries_the_columns_that_are_never_null` in `record/mod.rs`).
-#[inline(always)]
-fn carried(frame: &Data, quantity: Quantity, settings: &Settings) -> f32 {
-    frame.value(quantity, settings).unwrap_or(f32::NAN)
-}
-
-/// The raw integer of `quantity` (the text cache's key; 0 where it is not carried).
+/// The raw integer of `quantity` (the text cache's key; 0 where it is not carried, where the
+/// value is null and no text is cached).
 #[inline(always)]
 fn raw(frame: &Data, quantity: Quantity) -> u32 {
     frame.raw(quantity).map_or(0, |raw| raw as u32)
@@ -51,27 +48,31 @@ columns! {
     t_s: Option<f64>, "s", |t_s, _, _, _| t_s;
     /// Which ESC: the index of the input port or stream the frame came from (0-based).
     esc: u8, "-", |_, esc, _, _| esc;
-    /// Packet number from the frame.
-    packet: u16, "-", |_, _, f, _| f.packet().unwrap_or(0);
+    /// The protocol the frame came in (`hw-foc`, `datalink`: [`Protocol::name`]),
+    /// dictionary-encoded in Arrow and Parquet.
+    protocol: Protocol, "-", |_, _, f, _| f.protocol();
+    /// Packet number from the frame (16 bits in HW-FOC and DataLink, 24 in the older formats);
+    /// null where the protocol sends none.
+    packet: Option<u32>, "-", |_, _, f, _| f.packet();
     /// Input throttle, %: raw * 100 / 1024.
-    throttle_in_pct: f32, "%", |_, _, f, s| carried(f, Quantity::ThrottleIn, s),
+    throttle_in_pct: Option<f32>, "%", |_, _, f, s| f.value(Quantity::ThrottleIn, s),
         text key |f| raw(f, Quantity::ThrottleIn);
     /// Output throttle, %: raw * 100 / 1024.
-    throttle_out_pct: f32, "%", |_, _, f, s| carried(f, Quantity::ThrottleOut, s),
+    throttle_out_pct: Option<f32>, "%", |_, _, f, s| f.value(Quantity::ThrottleOut, s),
         text key |f| raw(f, Quantity::ThrottleOut);
     /// Electrical RPM: raw * 10.
-    erpm: u32, "rev/min", |_, _, f, s| carried(f, Quantity::Erpm, s) as u32;
+    erpm: Option<u32>, "rev/min", |_, _, f, s| f.value(Quantity::Erpm, s).map(|v| v as u32);
     /// Motor (or geared output) RPM under the settings: raw * 10 / (gear ratio * pole pairs).
-    rpm: f32, "rev/min", |_, _, f, s| carried(f, Quantity::Rpm, s),
+    rpm: Option<f32>, "rev/min", |_, _, f, s| f.value(Quantity::Rpm, s),
         text key |f| raw(f, Quantity::Rpm);
     /// Input voltage, V: raw / 10.
-    voltage_v: f32, "V", |_, _, f, s| carried(f, Quantity::Voltage, s),
+    voltage_v: Option<f32>, "V", |_, _, f, s| f.value(Quantity::Voltage, s),
         text key |f| raw(f, Quantity::Voltage);
     /// Input current, A: raw (signed) / current scale; negative while braking regeneratively.
-    current_a: f32, "A", |_, _, f, s| carried(f, Quantity::Current, s),
+    current_a: Option<f32>, "A", |_, _, f, s| f.value(Quantity::Current, s),
         text key |f| raw(f, Quantity::Current);
     /// Phase current, A: raw (signed) / current scale.
-    phase_current_a: f32, "A", |_, _, f, s| carried(f, Quantity::PhaseCurrent, s),
+    phase_current_a: Option<f32>, "A", |_, _, f, s| f.value(Quantity::PhaseCurrent, s),
         text key |f| raw(f, Quantity::PhaseCurrent);
     /// MOSFET temperature, degC, from the ADC table; null when out of the table's range.
     mos_temp_c: Option<f32>, "degC", |_, _, f, s| f.value(Quantity::MosTemp, s),
@@ -79,10 +80,22 @@ columns! {
     /// Capacitor temperature, degC, from the ADC table; null when out of the table's range.
     cap_temp_c: Option<f32>, "degC", |_, _, f, s| f.value(Quantity::CapTemp, s),
         text key |f| raw(f, Quantity::CapTemp);
-    /// The raw status word (an unsigned 16-bit integer).
-    status: Status, "-", |_, _, f, _| f.status().unwrap_or(Status(0));
+    /// Motor temperature, degC (HW5; null in HW-FOC and DataLink).
+    motor_temp_c: Option<f32>, "degC", |_, _, f, s| f.value(Quantity::MotorTemp, s),
+        text key |f| raw(f, Quantity::MotorTemp);
+    /// BEC temperature, degC (HW5; null in HW-FOC and DataLink).
+    bec_temp_c: Option<f32>, "degC", |_, _, f, s| f.value(Quantity::BecTemp, s),
+        text key |f| raw(f, Quantity::BecTemp);
+    /// BEC output voltage, V (HW5; null in HW-FOC and DataLink).
+    bec_voltage_v: Option<f32>, "V", |_, _, f, s| f.value(Quantity::BecVoltage, s),
+        text key |f| raw(f, Quantity::BecVoltage);
+    /// BEC output current, A (HW5; null in HW-FOC and DataLink).
+    bec_current_a: Option<f32>, "A", |_, _, f, s| f.value(Quantity::BecCurrent, s),
+        text key |f| raw(f, Quantity::BecCurrent);
+    /// The raw status word (an unsigned 16-bit integer); null where the protocol sends none.
+    status: Option<hwfoc::Status>, "-", |_, _, f, _| f.status();
     /// Names of the set status bits, in bit order (from `docs/PROTOCOL-NOTES.md`); derived from
-    /// `status`, not a field of the record.
-    faults: FaultList, "-", |_, _, f, _| FaultList(f.status().unwrap_or(Status(0))),
-        record |r| FaultList(r.status);
+    /// `status`, not a field of the record; null where `status` is.
+    faults: Option<FaultList>, "-", |_, _, f, _| f.status().map(FaultList),
+        record |r| r.status.map(FaultList);
 }

@@ -93,15 +93,15 @@ mod tests {
         }
     }
 
-    /// A column that is never null (the schema's non-nullable columns) holds a quantity every
-    /// supported protocol carries: for one frame of each protocol, each such column's quantity
-    /// is carried and has a value (a frame without it would have no true value to write). A
+    /// Only `esc` and `protocol` are never null (schema version 2): every measurement,
+    /// `packet`, `status` and `faults` may be null, and a quantity's column is null exactly
+    /// where the frame's protocol does not carry it (never 0). One sample of each protocol; a
     /// new protocol is a new arm of `Data`: the `match` below does not compile until it has a
     /// sample here.
     #[test]
-    fn every_protocol_carries_the_columns_that_are_never_null() {
-        use hwfoc::Quantity;
+    fn a_column_is_null_exactly_where_the_protocol_does_not_carry_it() {
         use hwfoc::telemetry::{Data, Telemetry};
+        use hwfoc::{Protocol, Quantity};
 
         struct NonNull(Vec<&'static str>);
         impl Visitor for NonNull {
@@ -114,37 +114,44 @@ mod tests {
         let mut non_null = NonNull(Vec::new());
         columns::visit(&mut non_null);
         // Written out: the schema's table (docs/RECORD-SCHEMA.md) as it stands.
-        assert_eq!(
-            non_null.0,
-            [
-                "esc",
-                "packet",
-                "throttle_in_pct",
-                "throttle_out_pct",
-                "erpm",
-                "rpm",
-                "voltage_v",
-                "current_a",
-                "phase_current_a",
-                "status",
-                "faults"
-            ]
-        );
-        let samples = [Data::from(DataFrame {
-            mos_adc: 250,
+        assert_eq!(non_null.0, ["esc", "protocol"]);
+        let frame = DataFrame {
+            packet: 3,
+            voltage_raw: 247,
+            mos_adc: 206,
+            cap_adc: 206,
             ..DataFrame::default()
-        })];
+        };
+        let samples = [Data::from(frame), Data::DataLink(frame)];
+        let s = Settings::default();
         for sample in samples {
-            match sample {
-                Data::HwFoc(_) => {}
-            }
-            let s = Settings::default();
+            let protocol = match sample {
+                Data::HwFoc(_) => Protocol::HwFoc,
+                Data::DataLink(_) => Protocol::DataLink,
+            };
+            assert_eq!(sample.protocol(), protocol);
+            let mut json = Vec::new();
+            Record::new(None, 0, &sample, &s).write_json(&mut json);
+            let v: serde_json::Value = serde_json::from_slice(&json).unwrap();
+            assert_eq!(v["protocol"], protocol.name());
             for q in Quantity::ALL {
-                if non_null.0.contains(&q.name()) {
-                    assert!(sample.value(q, &s).is_some(), "{sample:?} {q:?}");
-                }
+                let carried = sample.value(q, &s).is_some();
+                assert_eq!(!v[q.name()].is_null(), carried, "{sample:?} {q:?}");
             }
-            assert!(sample.packet().is_some() && sample.status().is_some());
+            // HW-FOC and DataLink carry every quantity of schema version 1, and none of the
+            // four added in version 2.
+            let added = [
+                Quantity::MotorTemp,
+                Quantity::BecTemp,
+                Quantity::BecVoltage,
+                Quantity::BecCurrent,
+            ];
+            for q in Quantity::ALL {
+                assert_eq!(sample.reading(q, &s).is_none(), added.contains(&q), "{q:?}");
+            }
+            assert_eq!(v["packet"], 3);
+            assert_eq!(v["status"], 0);
+            assert_eq!(v["faults"], serde_json::json!([]));
         }
     }
 }

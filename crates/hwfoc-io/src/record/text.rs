@@ -8,7 +8,7 @@
 use std::marker::PhantomData;
 
 use hwfoc::telemetry::Data;
-use hwfoc::{Fault, Status};
+use hwfoc::{Fault, Protocol, Status};
 
 use super::Record;
 use super::column::{Column, FaultList, Visitor};
@@ -163,6 +163,33 @@ impl TextValue for Status {
     #[inline(always)]
     fn text<F: Format>(self, e: &mut TextEncoder, _: Option<(usize, u32)>) {
         e.uint(u32::from(self.0));
+    }
+}
+
+impl TextValue for Protocol {
+    // The longest name, quoted.
+    const TEXT_MAX: usize = {
+        let mut n = 0;
+        let mut i = 0;
+        while i < Protocol::ALL.len() {
+            if Protocol::ALL[i].name().len() > n {
+                n = Protocol::ALL[i].name().len();
+            }
+            i += 1;
+        }
+        n + 2
+    };
+
+    /// The protocol's name: quoted in JSON (names are plain ASCII: nothing to escape).
+    #[inline(always)]
+    fn text<F: Format>(self, e: &mut TextEncoder, _: Option<(usize, u32)>) {
+        if F::JSON {
+            e.lit(b"\"");
+            e.lit(self.name().as_bytes());
+            e.lit(b"\"");
+        } else {
+            e.lit(self.name().as_bytes());
+        }
     }
 }
 
@@ -513,11 +540,8 @@ mod tests {
                 let mut json = Vec::new();
                 record.write_json(&mut json);
                 let v: serde_json::Value = serde_json::from_slice(&json).unwrap();
-                assert_eq!(
-                    v["current_a"].as_f64().map(|c| c as f32),
-                    Some(record.current_a)
-                );
-                assert_eq!(v["rpm"].as_f64().map(|c| c as f32), Some(record.rpm));
+                assert_eq!(v["current_a"].as_f64().map(|c| c as f32), record.current_a);
+                assert_eq!(v["rpm"].as_f64().map(|c| c as f32), record.rpm);
                 assert_eq!(v["packet"], i as u16);
                 assert_eq!(v["t_s"].as_f64(), record.t_s);
             }

@@ -258,7 +258,8 @@ impl ToPart<'_> {
     #[inline(always)]
     fn data(&mut self, f: &Data) {
         if self.first_packet.is_none() {
-            self.first_packet = Some(f.packet());
+            // A stream read in halves is HW-FOC's (a hub's is not joined): 16-bit counters.
+            self.first_packet = Some(f.packet().and_then(|p| u16::try_from(p).ok()));
         }
     }
 }

@@ -20,8 +20,13 @@ impl Handler for ByEsc {
         if self.0.len() <= esc {
             self.0.resize(esc + 1, Vec::new());
         }
-        self.0[esc].push((r.packet, r.t_s.unwrap_or(f64::NAN)));
+        self.0[esc].push((packet(r), r.t_s.unwrap_or(f64::NAN)));
     }
+}
+
+/// The packet number of a record of these tests' HW-FOC and DataLink frames (16 bits).
+fn packet(r: &Record) -> u16 {
+    u16::try_from(r.packet.expect("HW-FOC and DataLink send packet numbers")).unwrap()
 }
 
 /// The bytes of data frames `packets`.
@@ -145,7 +150,7 @@ impl Handler for InOrder {
     type Error = InputError;
 
     fn record(&mut self, r: &Record) {
-        self.0.push((r.esc, r.packet, r.t_s.unwrap_or(f64::NAN)));
+        self.0.push((r.esc, packet(r), r.t_s.unwrap_or(f64::NAN)));
     }
 }
 
@@ -405,7 +410,7 @@ fn hubs_and_escs_together_number_every_esc_once_live_and_recorded() {
     impl Handler for Escs {
         type Error = InputError;
         fn record(&mut self, r: &Record) {
-            self.0.push((r.esc, r.packet));
+            self.0.push((r.esc, packet(r)));
         }
         fn frame(&mut self, esc: u8, t: Option<f64>, d: &Frame, settings: &Settings) {
             // ESC 12 (port 0's channel 2) has settings of its own; port 2's channels
@@ -493,7 +498,7 @@ impl Handler for Packets {
     type Error = InputError;
 
     fn record(&mut self, r: &Record) {
-        self.0.entry(r.esc).or_default().push(r.packet);
+        self.0.entry(r.esc).or_default().push(packet(r));
     }
 }
 

@@ -306,7 +306,7 @@ pub(super) struct Accumulator {
     pub(super) first_t: Option<f64>,
     pub(super) last_t: Option<f64>,
     /// The last timed data frame's packet number, where its protocol sends one.
-    pub(super) last_packet: Option<u16>,
+    pub(super) last_packet: Option<u32>,
     /// Seconds that passed between the timed data frames: the sum of the steps that are not
     /// clock discontinuities.
     pub(super) elapsed: f64,
@@ -429,7 +429,9 @@ impl Accumulator {
     pub(super) fn clock(&mut self, t: f64, f: &Data) {
         let packet = f.packet();
         if let Some(last) = self.last_t {
-            let counted = packet.zip(self.last_packet).map(|(p, l)| p.wrapping_sub(l));
+            let counted = packet
+                .zip(self.last_packet)
+                .and_then(|(p, l)| f.protocol().packets_between(l, p));
             match Step::between(last, t, counted) {
                 Step::Back => self.steps_back += 1,
                 Step::Jump => self.jumps += 1,

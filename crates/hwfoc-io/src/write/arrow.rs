@@ -10,11 +10,12 @@ use std::collections::HashMap;
 use std::sync::Arc;
 
 use arrow_array::builder::OffsetBufferBuilder;
-use arrow_array::types::{Float32Type, Float64Type, UInt8Type, UInt16Type, UInt32Type};
-use arrow_array::{ArrayRef, ListArray, PrimitiveArray, RecordBatch, StringArray};
+use arrow_array::types::{Float32Type, Float64Type, Int8Type, UInt8Type, UInt16Type, UInt32Type};
+use arrow_array::{ArrayRef, DictionaryArray, ListArray, PrimitiveArray, RecordBatch, StringArray};
+use arrow_buffer::NullBuffer;
 use arrow_schema::{DataType, Field, FieldRef, Schema, SchemaRef};
 use hwfoc::telemetry::Data;
-use hwfoc::{Settings, Status};
+use hwfoc::{Protocol, Settings, Status};
 
 use crate::record::{Column, FaultList, Record, Visitor, columns};
 
@@ -83,6 +84,55 @@ impl ArrowValue for Status {
     }
 }
 
+impl ArrowValue for Option<Status> {
+    const NULLABLE: bool = true;
+
+    fn data_type() -> DataType {
+        DataType::UInt16
+    }
+
+    fn array(values: impl ExactSizeIterator<Item = Self>) -> ArrayRef {
+        Option::<u16>::array(values.map(|s| s.map(|s| s.0)))
+    }
+}
+
+/// The fault lists of `values` (`None`: a null list), as one list array.
+///
+/// The offsets of the lists and the names' offsets and bytes go straight into their buffers,
+/// without a builder call per row: most rows have no fault, an empty list, which is only its
+/// offset repeated; a null buffer is made only where a list is null.
+fn fault_lists(values: impl ExactSizeIterator<Item = Option<FaultList>>) -> ArrayRef {
+    let mut lists = OffsetBufferBuilder::<i32>::new(values.len());
+    let mut names = OffsetBufferBuilder::<i32>::new(0);
+    let mut bytes: Vec<u8> = Vec::new();
+    let mut valid: Vec<bool> = Vec::new();
+    let mut any_null = false;
+    for faults in values {
+        valid.push(faults.is_some());
+        let Some(faults) = faults else {
+            any_null = true;
+            lists.push_length(0);
+            continue;
+        };
+        let count = faults.0.0.count_ones() as usize;
+        if count != 0 {
+            for name in faults.names() {
+                bytes.extend_from_slice(name.as_bytes());
+                names.push_length(name.len());
+            }
+        }
+        lists.push_length(count);
+    }
+    let names = StringArray::new(names.finish(), bytes.into(), None);
+    let nulls = any_null.then(|| NullBuffer::from(valid));
+    Arc::new(ListArray::new(
+        fault_item(),
+        lists.finish(),
+        Arc::new(names),
+        nulls,
+    ))
+}
+
 impl ArrowValue for FaultList {
     const NULLABLE: bool = false;
 
@@ -90,30 +140,47 @@ impl ArrowValue for FaultList {
         DataType::List(fault_item())
     }
 
-    /// The offsets of the lists and the names' offsets and bytes go straight into their
-    /// buffers, without a builder call per row: most rows have no fault, an empty list, which
-    /// is only its offset repeated.
     fn array(values: impl ExactSizeIterator<Item = Self>) -> ArrayRef {
-        let mut lists = OffsetBufferBuilder::<i32>::new(values.len());
-        let mut names = OffsetBufferBuilder::<i32>::new(0);
-        let mut bytes: Vec<u8> = Vec::new();
-        for faults in values {
-            let count = faults.0.0.count_ones() as usize;
-            if count != 0 {
-                for name in faults.names() {
-                    bytes.extend_from_slice(name.as_bytes());
-                    names.push_length(name.len());
-                }
-            }
-            lists.push_length(count);
-        }
-        let names = StringArray::new(names.finish(), bytes.into(), None);
-        Arc::new(ListArray::new(
-            fault_item(),
-            lists.finish(),
-            Arc::new(names),
-            None,
-        ))
+        fault_lists(values.map(Some))
+    }
+}
+
+impl ArrowValue for Option<FaultList> {
+    const NULLABLE: bool = true;
+
+    fn data_type() -> DataType {
+        DataType::List(fault_item())
+    }
+
+    fn array(values: impl ExactSizeIterator<Item = Self>) -> ArrayRef {
+        fault_lists(values)
+    }
+}
+
+/// The Arrow type of the `protocol` column's dictionary keys.
+type ProtocolKey = Int8Type;
+
+impl ArrowValue for Protocol {
+    const NULLABLE: bool = false;
+
+    /// A dictionary of the protocols' names ([`Protocol::ALL`], in that order), by an `int8`
+    /// key: each record stores one byte, and readers see a categorical column.
+    fn data_type() -> DataType {
+        DataType::Dictionary(Box::new(DataType::Int8), Box::new(DataType::Utf8))
+    }
+
+    fn array(values: impl ExactSizeIterator<Item = Self>) -> ArrayRef {
+        let keys = PrimitiveArray::<ProtocolKey>::from_iter_values(values.map(|p| {
+            Protocol::ALL
+                .iter()
+                .position(|&q| q == p)
+                .expect("every protocol is in Protocol::ALL") as i8
+        }));
+        let names = StringArray::from_iter_values(Protocol::ALL.map(Protocol::name));
+        Arc::new(
+            DictionaryArray::<ProtocolKey>::try_new(keys, Arc::new(names))
+                .expect("every key is an index of the names"),
+        )
     }
 }
 

@@ -2,7 +2,8 @@
 //! Parquet export's footer (and of its `ARROW:schema`, whose own metadata repeats them) and of
 //! the metadata of the Python package's Arrow schema (`hwfoc.read`, `scan`, `record_schema`).
 //!
-//! The entries: `hwfoc_version`; the settings (`current_scale`, `pole_pairs`, `gear_ratio`,
+//! The entries: `hwfoc_version`; `record_schema_version` ([`crate::RECORD_SCHEMA_VERSION`]);
+//! the settings (`current_scale`, `pole_pairs`, `gear_ratio`,
 //! named as in every output); `inputs`, a JSON array of the input names; `filter` when records
 //! were selected ([`crate::filter_text`]); and, once every input is read,
 //! [`ESCS`] ([`escs_json`]) and, for the Parquet export when some ESC had settings of its own,
@@ -18,6 +19,9 @@ use hwfoc::Settings;
 
 use crate::settings;
 use crate::sources::Sources;
+
+/// The key of the record schema's version ([`crate::RECORD_SCHEMA_VERSION`]).
+pub const RECORD_SCHEMA_VERSION_KEY: &str = "record_schema_version";
 
 /// The key of which ESC is which ([`escs_json`]).
 pub const ESCS: &str = "escs";
@@ -40,12 +44,19 @@ impl Provenance {
     }
 
     /// The key-value entries known before the first record, in this order: `hwfoc_version`,
-    /// the settings, `inputs`, and `filter` when records were selected.
+    /// `record_schema_version`, the settings, `inputs`, and `filter` when records were
+    /// selected.
     pub fn key_values(&self) -> Vec<(String, String)> {
-        let mut kv = vec![(
-            "hwfoc_version".to_string(),
-            env!("CARGO_PKG_VERSION").to_string(),
-        )];
+        let mut kv = vec![
+            (
+                "hwfoc_version".to_string(),
+                env!("CARGO_PKG_VERSION").to_string(),
+            ),
+            (
+                RECORD_SCHEMA_VERSION_KEY.to_string(),
+                crate::RECORD_SCHEMA_VERSION.to_string(),
+            ),
+        ];
         kv.extend(
             settings::fields(&self.settings)
                 .into_iter()
@@ -127,6 +138,7 @@ mod tests {
             kv,
             [
                 ("hwfoc_version", env!("CARGO_PKG_VERSION")),
+                ("record_schema_version", "2"),
                 ("current_scale", "100"),
                 ("pole_pairs", "14"),
                 ("gear_ratio", "2.5"),
@@ -144,6 +156,7 @@ mod tests {
             keys,
             [
                 "hwfoc_version",
+                "record_schema_version",
                 "current_scale",
                 "pole_pairs",
                 "gear_ratio",
@@ -174,7 +187,8 @@ mod tests {
         assert_eq!(s.fields(), schema().fields());
         let p = Provenance::new(hwfoc::Settings::DEFAULT, Vec::new(), String::new());
         let with_escs = p.schema(Some("[]".to_string()));
-        assert_eq!(with_escs.metadata().len(), 6);
+        assert_eq!(with_escs.metadata().len(), 7);
+        assert_eq!(with_escs.metadata()["record_schema_version"], "2");
         assert_eq!(with_escs.metadata()["escs"], "[]");
         assert_eq!(with_escs.metadata()["pole_pairs"], "7");
         assert!(p.schema(None).metadata().get("escs").is_none());

@@ -104,7 +104,7 @@ mod encode {
     use std::sync::mpsc::{Receiver, SyncSender};
 
     use bytes::Bytes;
-    use hwfoc::{Settings, Status};
+    use hwfoc::{Protocol, Settings, Status};
     use parquet::arrow::{ArrowSchemaConverter, add_encoded_arrow_schema_to_metadata};
     use parquet::basic::{Compression, Encoding};
     use parquet::column::writer::{ColumnCloseResult, get_column_writer, get_typed_column_writer};
@@ -145,15 +145,17 @@ mod encode {
         "phase_current_a",
     ];
 
-    /// Columns with a dictionary: the fault names, few and repeated.
-    pub const DICTIONARY: [&str; 1] = ["faults"];
+    /// Columns with a dictionary: the protocol names and the fault names, few and repeated.
+    /// (`protocol` is a dictionary in the Arrow schema too, which readers of the embedded
+    /// schema restore.)
+    pub const DICTIONARY: [&str; 2] = ["protocol", "faults"];
 
     /// The columns costliest to encode first: the two threads then end a row group together,
     /// give or take one of the cheap columns at the end (measured on `scripts/bench-export.sh`
     /// input: delta-encoded `packet` and `erpm`, then the byte-stream-split and compressed
     /// floats, down to `esc`, `status` and `t_s`, which compress to nearly nothing). Columns
     /// not named come last, in schema order.
-    pub const BY_COST: [&str; 14] = [
+    pub const BY_COST: [&str; 19] = [
         "packet",
         "erpm",
         "rpm",
@@ -165,9 +167,14 @@ mod encode {
         "cap_temp_c",
         "faults",
         "voltage_v",
+        "protocol",
         "esc",
         "status",
         "t_s",
+        "motor_temp_c",
+        "bec_temp_c",
+        "bec_voltage_v",
+        "bec_current_a",
     ];
 
     /// The position of column `name` in the schema.
@@ -380,31 +387,83 @@ mod encode {
             self.0.is_ok()
         }
 
-        /// The fault names of each row: each name has a repetition level (0 for a row's
-        /// first), and an empty list is one level pair (0, 0) and no value. Rows without
-        /// fault come in long runs (a whole row group, usually): a run's levels are added at
-        /// once, at its end, so that such a row costs a test and an increment.
         fn fill(
             values: impl ExactSizeIterator<Item = Self> + Clone,
             levels: &mut Levels<ByteArray>,
         ) {
-            // Rows without fault whose levels are still to be added.
-            let mut run = 0;
-            for faults in values {
-                if faults.0.is_ok() {
-                    run += 1;
-                    continue;
-                }
-                levels.push_empty(run);
+            fill_fault_lists(values.map(Some), 0, levels);
+        }
+    }
+
+    impl ParquetValue for Option<FaultList> {
+        type Physical = ByteArrayType;
+        /// 0: a null list; 1: an empty list; 2: a name.
+        const MAX_DEF: i16 = 2;
+        const MAX_REP: i16 = 1;
+        /// As for [`FaultList`]: a row group without fault and without null is levels only.
+        const ONE_BATCH: bool = true;
+
+        #[inline(always)]
+        fn is_bare(&self) -> bool {
+            self.is_some_and(|f| f.0.is_ok())
+        }
+
+        fn fill(
+            values: impl ExactSizeIterator<Item = Self> + Clone,
+            levels: &mut Levels<ByteArray>,
+        ) {
+            fill_fault_lists(values, 1, levels);
+        }
+    }
+
+    /// The fault names of each row (`None`: a null list, level 0): each name has a repetition
+    /// level (0 for a row's first) and the definition level `empty + 1`; an empty list is one
+    /// level pair (`empty`, 0) and no value. Rows without fault come in long runs (a whole row
+    /// group, usually): a run's levels are added at once, at its end, so that such a row costs
+    /// a test and an increment.
+    #[inline(always)]
+    fn fill_fault_lists(
+        values: impl Iterator<Item = Option<FaultList>>,
+        empty: i16,
+        levels: &mut Levels<ByteArray>,
+    ) {
+        // Rows without fault whose levels are still to be added.
+        let mut run = 0;
+        for faults in values {
+            let Some(faults) = faults else {
+                levels.push_empty(run, empty);
                 run = 0;
-                for (i, name) in faults.names().enumerate() {
-                    levels
-                        .values
-                        .push(ByteArray::from(Bytes::from_static(name.as_bytes())));
-                    levels.push(1, i16::from(i > 0));
-                }
+                levels.push(0, 0);
+                continue;
+            };
+            if faults.0.is_ok() {
+                run += 1;
+                continue;
             }
-            levels.push_empty(run);
+            levels.push_empty(run, empty);
+            run = 0;
+            for (i, name) in faults.names().enumerate() {
+                levels
+                    .values
+                    .push(ByteArray::from(Bytes::from_static(name.as_bytes())));
+                levels.push(empty + 1, i16::from(i > 0));
+            }
+        }
+        levels.push_empty(run, empty);
+    }
+
+    impl ParquetValue for Protocol {
+        type Physical = ByteArrayType;
+
+        /// The protocol's name (the column is dictionary-encoded: [`DICTIONARY`]).
+        #[inline(always)]
+        fn fill(
+            values: impl ExactSizeIterator<Item = Self> + Clone,
+            levels: &mut Levels<ByteArray>,
+        ) {
+            levels
+                .values
+                .extend(values.map(|p| ByteArray::from(Bytes::from_static(p.name().as_bytes()))));
         }
     }
 
@@ -594,9 +653,10 @@ mod encode {
             self.rep.push(rep);
         }
 
-        /// Adds the level pairs (0, 0) of `rows` nulls or empty lists.
-        fn push_empty(&mut self, rows: usize) {
-            self.def.resize(self.def.len() + rows, 0);
+        /// Adds the level pairs (`def`, 0) of `rows` empty lists (`def`: the list's level of
+        /// an empty list).
+        fn push_empty(&mut self, rows: usize, def: i16) {
+            self.def.resize(self.def.len() + rows, def);
             self.rep.resize(self.rep.len() + rows, 0);
         }
     }

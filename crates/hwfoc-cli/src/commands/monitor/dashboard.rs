@@ -26,7 +26,7 @@ use ratatui::widgets::{
 use super::alarms::{Change, Level};
 use super::feed::Msg;
 use super::fleet::{EscView, HISTORY_S, Link, LogEntry, total_energy, total_power_w};
-use super::{Session, number};
+use super::{Session, number, reading};
 use crate::error::CliError;
 use crate::shown::{Measure, Shown};
 use hwfoc::Quantity;
@@ -348,15 +348,15 @@ fn draw_table(frame: &mut Frame, area: Rect, ui: &Ui, view: View<'_>) {
                     vec![
                         Cell::from(format!(
                             "{}/{}",
-                            number(r.throttle_in_pct, 0),
-                            number(r.throttle_out_pct, 0)
+                            reading(r.throttle_in_pct, 0),
+                            reading(r.throttle_out_pct, 0)
                         )),
-                        Cell::from(with_peak(number(r.rpm, 0), "↑", p.rpm, 0)),
-                        Cell::from(with_peak(number(r.voltage_v, 1), "↓", p.min_voltage_v, 1))
+                        Cell::from(with_peak(reading(r.rpm, 0), "↑", p.rpm, 0)),
+                        Cell::from(with_peak(reading(r.voltage_v, 1), "↓", p.min_voltage_v, 1))
                             .style(level_style(a.voltage.level())),
-                        Cell::from(with_peak(number(r.current_a, 1), "↑", p.current_a, 1)),
+                        Cell::from(with_peak(reading(r.current_a, 1), "↑", p.current_a, 1)),
                         Cell::from(with_peak(
-                            number(r.phase_current_a, 1),
+                            reading(r.phase_current_a, 1),
                             "↑",
                             p.phase_current_a,
                             1,

@@ -71,15 +71,14 @@ impl Peaks {
                 *slot = Some(slot.map_or(v, |s| s.max(v)));
             }
         }
-        max(&mut self.rpm, Some(r.rpm));
-        max(&mut self.current_a, Some(r.current_a));
-        max(&mut self.phase_current_a, Some(r.phase_current_a));
+        max(&mut self.rpm, r.rpm);
+        max(&mut self.current_a, r.current_a);
+        max(&mut self.phase_current_a, r.phase_current_a);
         max(&mut self.mos_temp_c, r.mos_temp_c);
         max(&mut self.cap_temp_c, r.cap_temp_c);
-        self.min_voltage_v = Some(
-            self.min_voltage_v
-                .map_or(r.voltage_v, |s| s.min(r.voltage_v)),
-        );
+        if let Some(v) = r.voltage_v {
+            self.min_voltage_v = Some(self.min_voltage_v.map_or(v, |s| s.min(v)));
+        }
     }
 }
 
@@ -219,7 +218,7 @@ impl EscView {
     pub fn power_w(&self) -> Option<f64> {
         self.last
             .as_ref()
-            .map(|r| f64::from(r.voltage_v) * f64::from(r.current_a))
+            .and_then(|r| Some(f64::from(r.voltage_v?) * f64::from(r.current_a?)))
     }
 
     /// Seconds since the latest frame, at `now`.
@@ -552,8 +551,9 @@ impl Fleet {
         esc.last = Some(r);
         esc.last_frame_t = Some(t);
         esc.peaks.add(&r);
-        esc.energy
-            .add(Some(t), f64::from(r.voltage_v), f64::from(r.current_a));
+        if let (Some(volts), Some(amps)) = (r.voltage_v, r.current_a) {
+            esc.energy.add(Some(t), f64::from(volts), f64::from(amps));
+        }
         esc.recent.push_back(t);
         while esc.recent.front().is_some_and(|&f| f <= t - RATE_WINDOW_S) {
             esc.recent.pop_front();
@@ -567,12 +567,8 @@ impl Fleet {
         {
             esc.history.pop_front();
         }
-        if esc.cells.is_none() && r.voltage_v > 2.0 {
-            esc.cells = Some(
-                (f64::from(r.voltage_v) / FULL_CELL_V)
-                    .ceil()
-                    .clamp(1.0, 255.0) as u8,
-            );
+        if let Some(volts) = r.voltage_v.filter(|&v| esc.cells.is_none() && v > 2.0) {
+            esc.cells = Some((f64::from(volts) / FULL_CELL_V).ceil().clamp(1.0, 255.0) as u8);
             esc.cells_detected = true;
         }
 
@@ -584,7 +580,7 @@ impl Fleet {
             None,
         ));
         for fault in Fault::ALL {
-            let on = r.status.contains(fault);
+            let on = r.status.is_some_and(|s| s.contains(fault));
             let latch = &mut a.faults[usize::from(fault.bit())];
             if on || latch.level().is_some() {
                 let change = latch.set(on, Kind::fault_level(fault), limits.fault_hold_s, t);
@@ -601,7 +597,7 @@ impl Fleet {
         threshold(Kind::CapTemp, &mut a.cap, &limits.cap, r.cap_temp_c);
         if let Some(cells) = esc.cells {
             let th = limits.voltage(cells);
-            threshold(Kind::LowVoltage, &mut a.voltage, &th, Some(r.voltage_v));
+            threshold(Kind::LowVoltage, &mut a.voltage, &th, r.voltage_v);
         }
         for (kind, change, value) in changes {
             self.note(i, kind, change, t, value);
@@ -640,8 +636,9 @@ impl Fleet {
             if let Some(r) = &esc.last {
                 esc.peaks.add(r);
                 let t = esc.last_frame_t.or(r.t_s);
-                esc.energy
-                    .add(t, f64::from(r.voltage_v), f64::from(r.current_a));
+                if let (Some(volts), Some(amps)) = (r.voltage_v, r.current_a) {
+                    esc.energy.add(t, f64::from(volts), f64::from(amps));
+                }
             }
         }
         self.note_total_power();
@@ -753,7 +750,7 @@ mod tests {
             assert_eq!(f.on_event(&data(1, t, frame(k, Status::OK, cool, 252))), 1);
         }
         let esc = &f.escs[1];
-        assert_eq!(esc.last.unwrap().packet, 39);
+        assert_eq!(esc.last.unwrap().packet, Some(39));
         assert_eq!(esc.cells, Some(6));
         assert!(esc.cells_detected);
         assert!((esc.frame_rate(1001.95) - 20.0).abs() < 0.6);

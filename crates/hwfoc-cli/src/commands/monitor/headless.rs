@@ -9,7 +9,7 @@ use std::time::{Duration, Instant};
 use serde_json::{Value, json};
 
 use super::fleet::{EscView, Fleet, Link, LogEntry};
-use super::{Session, number};
+use super::{Session, number, reading};
 use crate::error::CliError;
 use hwfoc_io::Escaped;
 use hwfoc_io::Fixed;
@@ -150,12 +150,12 @@ fn status_line(i: usize, esc: &EscView, now: f64) -> String {
             line.push_str(&format!(
                 "thr {}/{} % {} rpm {} V {} A (phase {} A) mos {} cap {} | {:.1} fr/s lost {} \
                  dup {} crc {} restarts {} | age {:.2} s",
-                number(r.throttle_in_pct, 1),
-                number(r.throttle_out_pct, 1),
-                number(r.rpm, 0),
-                number(r.voltage_v, 1),
-                number(r.current_a, 1),
-                number(r.phase_current_a, 1),
+                reading(r.throttle_in_pct, 1),
+                reading(r.throttle_out_pct, 1),
+                reading(r.rpm, 0),
+                reading(r.voltage_v, 1),
+                reading(r.current_a, 1),
+                reading(r.phase_current_a, 1),
                 temp(r.mos_temp_c),
                 temp(r.cap_temp_c),
                 esc.frame_rate(now),

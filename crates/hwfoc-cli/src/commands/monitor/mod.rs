@@ -507,6 +507,12 @@ pub fn number(v: f32, decimals: usize) -> String {
     hwfoc_io::Fixed(f64::from(v), decimals).to_string()
 }
 
+/// A record's value as [`number`] writes it, or `-` where the record has none (a quantity
+/// the ESC's protocol does not carry).
+pub fn reading(v: Option<f32>, decimals: usize) -> String {
+    v.map_or_else(|| "-".to_string(), |v| number(v, decimals))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

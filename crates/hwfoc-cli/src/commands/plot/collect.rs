@@ -218,7 +218,7 @@ pub struct EscData {
     /// Discontinuities of its receive times ([`Step`]): the clock goes on across them.
     pub discontinuities: u64,
     /// The last timed data frame's receive time and packet number.
-    last_timed: Option<(f64, u16)>,
+    last_timed: Option<(f64, Option<u32>)>,
     /// What is added to a receive time to place it on the clock: it changes at each
     /// discontinuity, so that the clock goes on one frame period after the frame before.
     shift: f64,
@@ -263,8 +263,11 @@ impl EscData {
             *first = first.min(t);
             *last = last.max(t);
             if let Some((last_t, last_packet)) = self.last_timed {
-                let packets = r.packet.wrapping_sub(last_packet);
-                if Step::between(last_t, t, Some(packets)).is_discontinuity() {
+                let packets = r
+                    .packet
+                    .zip(last_packet)
+                    .and_then(|(p, l)| r.protocol.packets_between(l, p));
+                if Step::between(last_t, t, packets).is_discontinuity() {
                     self.discontinuities += 1;
                     self.shift = last_t + self.shift + FRAME_PERIOD - t;
                     jumped = true;
@@ -293,20 +296,23 @@ impl EscData {
             }
         };
         self.buckets.add(c, &values(r), gap);
-        self.energy
-            .add(t, f64::from(r.voltage_v), f64::from(r.current_a));
+        if let (Some(volts), Some(amps)) = (r.voltage_v, r.current_a) {
+            self.energy.add(t, f64::from(volts), f64::from(amps));
+        }
         // Episodes are placed on the clock too.
         let mark = Mark {
             t: t.map(|_| c),
             frame: index,
-            packet: Some(r.packet),
+            packet: r.packet,
         };
-        if let Some(ended) = Episode::track(&mut self.open, mark, r.status) {
+        // A protocol without status word shows no fault episode.
+        let status = r.status.unwrap_or_default();
+        if let Some(ended) = Episode::track(&mut self.open, mark, status) {
             self.keep(&ended);
         }
         if self.first_episode.is_none() {
             let own = Mark { t, ..mark };
-            self.first_episode = Episode::track(&mut self.first_open, own, r.status);
+            self.first_episode = Episode::track(&mut self.first_open, own, status);
         }
     }
 
@@ -660,7 +666,7 @@ mod tests {
         times.extend((0..40).map(|k| start - 3598.0 + k as f64 * 0.05));
         for (k, &t) in times.iter().enumerate() {
             let mut r = frame(t, 0, 0);
-            r.packet = k as u16;
+            r.packet = Some(k as u32);
             esc.add(&r, &mut all());
         }
         assert_eq!(esc.discontinuities, 3);
