@@ -79,7 +79,7 @@ impl EscReport<'_> {
         let fields: serde_json::Map<String, Value> = self
             .fields()
             .into_iter()
-            .map(|(name, unit, range)| {
+            .map(|(name, unit, range, _)| {
                 let v = match range {
                     Some([min, max, mean]) => {
                         json!({"min": min, "max": max, "mean": mean, "unit": unit})

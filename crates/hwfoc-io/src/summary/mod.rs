@@ -239,8 +239,9 @@ pub struct Report<'a> {
     accs: &'a [Accumulator],
 }
 
-/// One row of the field table: name, unit, and min/max/mean if there were frames.
-type FieldRow = (&'static str, &'static str, Option<[f64; 3]>);
+/// One row of the field table: name, unit, min/max/mean if there were frames, and whether the
+/// ESC's protocol carries the quantity at all.
+type FieldRow = (&'static str, &'static str, Option<[f64; 3]>, bool);
 
 /// One ESC's part of the report.
 struct EscReport<'a> {
@@ -389,7 +390,7 @@ impl EscReport<'_> {
                 }
                 None => self.temperature(q).range,
             };
-            (q.name(), q.unit(), stats)
+            (q.name(), q.unit(), stats, self.conversion(q).is_some())
         };
         Quantity::ALL.into_iter().map(field).collect()
     }

@@ -126,3 +126,38 @@ fn frames_handed_on_together_are_summarised_as_one_at_a_time() {
         );
     }
 }
+
+/// A quantity the ESC's protocol does not send (HW-FOC has no BEC or motor temperature) has no
+/// row in the text, and its key in JSON is null; one it sends has both.
+#[test]
+fn a_quantity_the_protocol_does_not_send_has_no_text_row() {
+    let mut bytes = Vec::new();
+    for packet in 0..3 {
+        let frame = hwfoc::foc::DataFrame {
+            packet,
+            voltage_raw: 247,
+            ..Default::default()
+        };
+        bytes.extend_from_slice(&frame.encode());
+    }
+    let input = crate::Input::from_memory("three frames", bytes).unwrap();
+    let mut sources = crate::Sources::new(vec![input], Settings::DEFAULT);
+    let mut summary = Summary::new();
+    sources.run(&mut summary).unwrap();
+    let report = summary.report(&sources);
+    let text = report.text();
+    assert!(text.contains("\nvoltage_v "), "{text}");
+    assert!(text.contains("\ncap_temp_c "), "{text}");
+    for absent in [
+        "motor_temp_c",
+        "bec_temp_c",
+        "bec_voltage_v",
+        "bec_current_a",
+    ] {
+        assert!(!text.contains(absent), "{absent} in\n{text}");
+        let field = &report.json()["escs"][0]["fields"][absent];
+        assert_eq!(field["min"], serde_json::Value::Null, "{absent}");
+        assert!(field["unit"].is_string(), "{absent}");
+    }
+    assert_eq!(report.json()["escs"][0]["fields"]["voltage_v"]["max"], 24.7);
+}

@@ -150,7 +150,8 @@ impl EscReport<'_> {
             "\n{:<18} {:>12} {:>12} {:>12}  unit",
             "field", "min", "max", "mean"
         );
-        for (name, unit, range) in self.fields() {
+        // A quantity the ESC's protocol does not send has no row (JSON keeps its key, null).
+        for (name, unit, range, _) in self.fields().into_iter().filter(|row| row.3) {
             match range {
                 Some([min, max, mean]) => {
                     let _ = writeln!(o, "{name:<18} {min:>12.3} {max:>12.3} {mean:>12.3}  {unit}");
