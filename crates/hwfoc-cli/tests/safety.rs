@@ -727,3 +727,23 @@ fn simulate_never_writes_over_what_it_reads_or_its_own_outputs() {
     );
     assert_eq!(std::fs::read_to_string(&o0).unwrap(), "earlier");
 }
+
+/// `hwfoc record` never writes its recording over a port it reads, even with --overwrite: the
+/// port named as the output is refused before anything is opened, and left as it was.
+#[test]
+fn a_recording_is_never_written_over_a_port_it_reads() {
+    let dir = Dir::new();
+    let port = dir.arg("ttyUSB9");
+    std::fs::write(&port, b"not to be destroyed").unwrap();
+    let o = run(hwfoc().args([
+        "record",
+        &port,
+        "-o",
+        &port,
+        "--overwrite",
+        "--duration",
+        "0.2",
+    ]));
+    assert_fails_with(&o, &format!("cannot write {port}: it is the input {port}"));
+    assert_eq!(std::fs::read(&port).unwrap(), b"not to be destroyed");
+}

@@ -203,6 +203,9 @@ pub struct Recorder {
 pub fn run(args: &RecordArgs) -> Result<(), CliError> {
     // Install the Ctrl-C / SIGTERM handler first, so that no signal is lost once ports are open.
     let interrupted = crate::stop::interrupted();
+    // A port is an input: a recording is never written over one (a device node replaced by a
+    // file, or a file named as a port), whatever --overwrite says.
+    crate::safety::refuse_input(&args.output, args.ports.iter().map(Path::new))?;
     let baud = args.protocol.baud(args.baud);
     let set = PortSet::open(&args.ports, baud)?;
     let started = Instant::now();
