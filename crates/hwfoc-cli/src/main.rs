@@ -21,7 +21,8 @@ use clap::{CommandFactory, Parser, Subcommand};
 use crate::commands::{bridge, completions, decode, man, monitor, plot, record, simulate, summary};
 use crate::error::CliError;
 
-/// Decode and analyse the telemetry of Hobbywing FOC ESCs (HW-FOC protocol, 19200 baud).
+/// Decode and analyse the telemetry of Hobbywing ESCs: an XRotor FOC ESC's own wire (HW-FOC,
+/// 19200 baud) or a DataLink V2 hub's (115200 baud).
 #[derive(Debug, Parser)]
 #[command(name = "hwfoc", version = env!("HWFOC_VERSION"), about, propagate_version = true)]
 struct Cli {
