@@ -395,11 +395,13 @@ impl EscReport<'_> {
         Quantity::ALL.into_iter().map(field).collect()
     }
 
-    /// The statistics of temperature `quantity` (a histogram of its codes).
+    /// The statistics of `quantity` from the histogram of its codes: the MOSFET's and the
+    /// capacitor's temperatures; none for a quantity the summary keeps no histogram of.
     fn temperature(&self, quantity: Quantity) -> TempStats {
         let (codes, uncoded) = match quantity {
+            Quantity::MosTemp => (&self.acc.mos_codes, self.acc.uncoded[0]),
             Quantity::CapTemp => (&self.acc.cap_codes, self.acc.uncoded[1]),
-            _ => (&self.acc.mos_codes, self.acc.uncoded[0]),
+            _ => return TempStats::default(),
         };
         match self.conversion(quantity) {
             // Every data frame's temperature is in the histogram: its statistics are whole.
