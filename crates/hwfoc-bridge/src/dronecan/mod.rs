@@ -48,7 +48,16 @@
 //! bytes) is [`OutputError::Send`] and the port is kept. Every error returned is also counted
 //! in [`OutputStats::errors`].
 //!
-//! # Why by hand
+//! # Encoding
+//!
+//! The messages are the codec's ([`hwfoc::dronecan`]: [`EscStatus`], [`EscStatusExtended`],
+//! [`NodeStatus`], their data type ids and signatures in [`hwfoc::dronecan::Kind`]) and so are
+//! their frames ([`Message::frames`]: CAN id, tail bytes, the signature-seeded transfer CRC),
+//! all checked against pydronecan's own frames; only SLCAN ([`slcan`]) is the bridge's.
+//! float16 fields are converted as pydronecan and libuavcan convert (what the receivers people
+//! use do): rounded to nearest with ties away from zero, ±infinity saturated to ±65504 (DSDL's
+//! cast), NaN sent as `0x7FFF`. (The output used the `half` crate before: ties to even,
+//! infinity kept, NaN `0x7E00`.)
 //!
 //! The crates.io crates were read first: `dronecan` 0.2.0 (MPL-2.0) only
 //! reassembles received transfers and parses CAN IDs: no transmit-side splitting, no DSDL
@@ -56,16 +65,14 @@
 //! FD-CAN peripheral and has no `esc.Status`. `slcan` 0.1.3 (2020) is built on the unmaintained
 //! `serial` crate and `mini-slcan` / `serial-can` are codecs of a few lines of what
 //! [`slcan::push_extended`] does. `canadensis` is Cyphal (UAVCAN v1), another transport.
-//! The transport here is a hundred lines ([`transport`]), tested against pydronecan's bytes,
-//! and float16 is the `half` crate's.
 
 pub mod dsdl;
 pub mod slcan;
-pub mod transport;
 
 use std::time::{Duration, Instant};
 
 use hwfoc::Telemetry;
+use hwfoc::dronecan::Message;
 use serialport::SerialPort;
 
 use crate::output::{Output, OutputError, OutputStats, SILENT_AFTER, Update};
@@ -330,7 +337,7 @@ impl DronecanOutput {
         NodeStatus {
             uptime_sec: u32::try_from(now.saturating_duration_since(self.opened).as_secs())
                 .unwrap_or(u32::MAX),
-            health: if warning { Health::Warning } else { Health::Ok },
+            health: if warning { Health::Warning } else { Health::Ok } as u8,
             mode: dsdl::MODE_OPERATIONAL,
             sub_mode: 0,
             vendor_specific_status_code: live_mask,
@@ -354,11 +361,12 @@ impl DronecanOutput {
         }
     }
 
-    /// Appends one transfer's SLCAN lines to `self.out`.
-    fn push_transfer(&mut self, data_type: u16, signature: u64, transfer_id: u8, payload: &[u8]) {
-        let id = transport::message_id(PRIORITY, data_type, self.options.node_id);
-        for frame in transport::frames(id, signature, transfer_id, payload) {
-            slcan::push_extended(&mut self.out, frame.id, frame.data());
+    /// Appends the SLCAN lines of one transfer of `message` (a broadcast from the node at
+    /// [`PRIORITY`]) to `self.out`.
+    fn push_transfer(&mut self, message: impl Into<Message>, transfer_id: u8) {
+        let message = message.into();
+        for frame in message.frames(PRIORITY, self.options.node_id, 0, transfer_id) {
+            slcan::push_extended(&mut self.out, frame.id(), frame.data());
             self.frames += 1;
         }
     }
@@ -468,39 +476,24 @@ impl Output for DronecanOutput {
             }
             self.out.clear();
             let tid = next_transfer_id(&mut self.esc_transfer_id);
-            self.push_transfer(
-                dsdl::ESC_STATUS_ID,
-                dsdl::ESC_STATUS_SIGNATURE,
-                tid,
-                &status.serialize(),
-            );
+            self.push_transfer(status, tid);
             let extended_due = self.escs[i]
                 .extended_sent
                 .is_none_or(|sent| arrived.saturating_duration_since(sent) >= EXTENDED_EVERY);
             if extended_due {
                 self.escs[i].extended_sent = Some(arrived);
                 let tid = next_transfer_id(&mut self.extended_transfer_id);
-                self.push_transfer(
-                    dsdl::ESC_STATUS_EXTENDED_ID,
-                    dsdl::ESC_STATUS_EXTENDED_SIGNATURE,
-                    tid,
-                    &extended.serialize(),
-                );
+                self.push_transfer(extended, tid);
             }
             self.write_out(now)?;
             self.stats.messages += 1 + u64::from(extended_due);
             self.stats.latency.add(Instant::now() - arrived);
         }
         if self.next_node_status.is_none_or(|t| now >= t) {
-            let payload = self.node_status(now).serialize();
+            let node_status = self.node_status(now);
             self.out.clear();
             let tid = next_transfer_id(&mut self.node_transfer_id);
-            self.push_transfer(
-                dsdl::NODE_STATUS_ID,
-                dsdl::NODE_STATUS_SIGNATURE,
-                tid,
-                &payload,
-            );
+            self.push_transfer(node_status, tid);
             // A second after this one was due; a second after now if far behind.
             let next = self.next_node_status.unwrap_or(now) + NODE_STATUS_EVERY;
             self.next_node_status = Some(if next <= now {
