@@ -511,3 +511,50 @@ impl Output for DronecanOutput {
         &self.stats
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// What `push_transfer` writes for an esc.Status from node 100 with transfer id 5: the CAN
+    /// id of a broadcast at [`PRIORITY`] and the three frames pydronecan 1.0.27 makes of the
+    /// same message (the transfer CRC 0xC75C first), as SLCAN lines. (These were the tests of
+    /// the bridge's own transport before it used the codec's.)
+    #[test]
+    fn esc_status_lines_as_pydronecan() {
+        let status = EscStatus {
+            error_count: 7,
+            voltage: 16.5,
+            current: -2.25,
+            temperature: 273.15 + 40.0,
+            rpm: -1234,
+            power_rating_pct: 55,
+            esc_index: 3,
+        };
+        let mut out = Vec::new();
+        for frame in Message::from(status).frames(PRIORITY, 100, 0, 5) {
+            slcan::push_extended(&mut out, frame.id(), frame.data());
+        }
+        assert_eq!(
+            String::from_utf8(out).unwrap(),
+            "T10040A6485CC7070000002085\r\
+             T10040A6484C80C0E55C2EFB25\r\
+             T10040A643DB8C45\r"
+        );
+        // NodeStatus fits one frame: no CRC, start and end set.
+        let node = NodeStatus {
+            uptime_sec: 123_456,
+            health: Health::Warning as u8,
+            mode: dsdl::MODE_OPERATIONAL,
+            sub_mode: 0,
+            vendor_specific_status_code: 0xABCD,
+        };
+        let frames: Vec<_> = Message::from(node).frames(PRIORITY, 100, 0, 31).collect();
+        assert_eq!(frames.len(), 1);
+        assert_eq!(frames[0].id(), 0x1001_5564);
+        assert_eq!(
+            frames[0].data(),
+            [0x40, 0xE2, 0x01, 0x00, 0x40, 0xCD, 0xAB, 0xDF]
+        );
+    }
+}
