@@ -29,7 +29,7 @@ pub enum Health {
 pub const MODE_OPERATIONAL: u8 = 0;
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use hwfoc::dronecan::MAX_PAYLOAD_LEN;
 
@@ -40,12 +40,9 @@ mod tests {
         out[..n].to_vec()
     }
 
-    /// Checked by hand from the DSDL: 7 | 16.5 V = 0x4C20 | -2.25 A = 0xC080 | 313.15 K =
-    /// 0x5CE5 | rpm -1234 = 0x3FB2E (18 bits: 2E FB, then 0b11) | 55 = 0b0110111 | 3 = 0b00011:
-    /// byte 12 = 11 011011, byte 13 = 1 00011 00. The same bytes as pydronecan 1.0.27's.
-    #[test]
-    fn esc_status_bytes() {
-        let s = EscStatus {
+    /// The esc.Status of the tests that compare with pydronecan's bytes and frames.
+    pub(crate) fn example_esc_status() -> EscStatus {
+        EscStatus {
             error_count: 7,
             voltage: 16.5,
             current: -2.25,
@@ -53,7 +50,15 @@ mod tests {
             rpm: -1234,
             power_rating_pct: 55,
             esc_index: 3,
-        };
+        }
+    }
+
+    /// Checked by hand from the DSDL: 7 | 16.5 V = 0x4C20 | -2.25 A = 0xC080 | 313.15 K =
+    /// 0x5CE5 | rpm -1234 = 0x3FB2E (18 bits: 2E FB, then 0b11) | 55 = 0b0110111 | 3 = 0b00011:
+    /// byte 12 = 11 011011, byte 13 = 1 00011 00. The same bytes as pydronecan 1.0.27's.
+    #[test]
+    fn esc_status_bytes() {
+        let s = example_esc_status();
         assert_eq!(
             bytes(&s),
             [

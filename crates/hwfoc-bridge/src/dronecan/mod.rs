@@ -522,15 +522,8 @@ mod tests {
     /// the bridge's own transport before it used the codec's.)
     #[test]
     fn esc_status_lines_as_pydronecan() {
-        let status = EscStatus {
-            error_count: 7,
-            voltage: 16.5,
-            current: -2.25,
-            temperature: 273.15 + 40.0,
-            rpm: -1234,
-            power_rating_pct: 55,
-            esc_index: 3,
-        };
+        // esc.Status of dsdl.rs's test: 7, 16.5 V, -2.25 A, 313.15 K, -1234 rpm, 55 %, ESC 3.
+        let status = dsdl::tests::example_esc_status();
         let mut out = Vec::new();
         for frame in Message::from(status).frames(PRIORITY, 100, 0, 5) {
             slcan::push_extended(&mut out, frame.id(), frame.data());
