@@ -13,13 +13,11 @@ use std::sync::{Arc, Mutex, mpsc};
 use std::thread;
 use std::time::{Duration, Instant};
 
+use hwfoc::dronecan::{DataType, Kind, MAX_PAYLOAD_LEN, f16_from_f32, saturate_f16, transfer_crc};
 use hwfoc::foc::DataFrame;
 use hwfoc::telemetry::Data;
 use hwfoc::{Settings, Status};
-use hwfoc_bridge::dronecan::dsdl::{
-    self, EscStatus, EscStatusExtended, Health, NodeStatus, f16_bits,
-};
-use hwfoc_bridge::dronecan::transport::transfer_crc;
+use hwfoc_bridge::dronecan::dsdl::{EscStatus, EscStatusExtended, Health, NodeStatus};
 use hwfoc_bridge::dronecan::{DronecanOptions, DronecanOutput, SlcanTarget};
 use hwfoc_bridge::{Output, OutputError, SILENT_AFTER, Update};
 use hwfoc_io::Record;
@@ -124,6 +122,13 @@ fn expected_extended(r: &Record, f: &DataFrame) -> EscStatusExtended {
     }
 }
 
+/// The DSDL serialisation of `m` (the codec's, which the output sends).
+fn bytes<T: DataType>(m: &T) -> Vec<u8> {
+    let mut out = [0u8; MAX_PAYLOAD_LEN];
+    let n = m.encode_into(&mut out);
+    out[..n].to_vec()
+}
+
 /// The data type of a transfer's CAN id.
 fn data_type(t: &Transfer) -> u32 {
     t.id >> 8 & 0xFFFF
@@ -180,8 +185,8 @@ fn parse(bytes: &[u8]) -> (Vec<String>, Vec<Transfer>) {
             let (id, tid, _, mut payload) = open.take().unwrap();
             if !start {
                 let signature = match (id >> 8) & 0xFFFF {
-                    1034 => dsdl::ESC_STATUS_SIGNATURE,
-                    341 => dsdl::NODE_STATUS_SIGNATURE,
+                    1034 => Kind::EscStatus.signature(),
+                    341 => Kind::NodeStatus.signature(),
                     other => panic!("data type {other}"),
                 };
                 let crc = u16::from_le_bytes([payload[0], payload[1]]);
@@ -285,36 +290,33 @@ fn setup_then_one_transfer_per_esc_frame_and_node_status() {
     assert_eq!(transfers.len(), 5, "{transfers:?}");
     assert_eq!(transfers[0].id, 0x1004_0A2A);
     assert_eq!(transfers[0].transfer_id, 0);
-    assert_eq!(transfers[0].payload, expected(&r0, 0).serialize());
+    assert_eq!(transfers[0].payload, bytes(&expected(&r0, 0)));
     assert_eq!(transfers[1].id, 0x1004_0C2A);
     assert_eq!(transfers[1].transfer_id, 0);
-    assert_eq!(
-        transfers[1].payload,
-        expected_extended(&r0, &f0b).serialize()
-    );
+    assert_eq!(transfers[1].payload, bytes(&expected_extended(&r0, &f0b)));
     assert_eq!(transfers[2].transfer_id, 1);
     let s2 = expected(&r2, 1);
     assert!(s2.temperature.is_nan());
-    assert_eq!(transfers[2].payload, s2.serialize());
+    assert_eq!(transfers[2].payload, bytes(&s2));
     let x2 = expected_extended(&r2, &f2);
     assert_eq!((x2.status_flags, x2.input_pct), (0x0004, 59));
     assert_eq!(
         (transfers[3].transfer_id, data_type(&transfers[3])),
         (1, 1036)
     );
-    assert_eq!(transfers[3].payload, x2.serialize());
+    assert_eq!(transfers[3].payload, bytes(&x2));
     let transfers = &transfers[2..];
     // NodeStatus: node 42, its own transfer id, WARNING (ESC 2's fault), ESCs 0 and 2 live.
     assert_eq!(transfers[2].id, 0x1001_552A);
     assert_eq!(transfers[2].transfer_id, 0);
     let node = NodeStatus {
         uptime_sec: 0,
-        health: Health::Warning,
+        health: Health::Warning as u8,
         mode: 0,
         sub_mode: 0,
         vendor_specific_status_code: 0b101,
     };
-    assert_eq!(transfers[2].payload, node.serialize());
+    assert_eq!(transfers[2].payload, bytes(&node));
     let s = out.stats();
     assert_eq!((s.messages, s.superseded, s.errors), (5, 1, 0));
     assert_eq!(s.latency.count(), 2);
@@ -328,7 +330,7 @@ fn setup_then_one_transfer_per_esc_frame_and_node_status() {
     out.poll(t0 + Duration::from_millis(600)).unwrap();
     let (_, transfers) = parse(&pty.read_now());
     assert_eq!(transfers.len(), 1, "{transfers:?}");
-    assert_eq!(transfers[0].payload, expected(&r2, 1).serialize());
+    assert_eq!(transfers[0].payload, bytes(&expected(&r2, 1)));
     // A second later: NodeStatus, uptime 1; ESC 2 is fine now (its esc.StatusExtended due
     // again, with status flags 0) and ESC 0 silent (health WARNING: heard, then silent) and not
     // sent.
@@ -338,22 +340,19 @@ fn setup_then_one_transfer_per_esc_frame_and_node_status() {
     out.poll(later).unwrap();
     let (_, transfers) = parse(&pty.read_now());
     assert_eq!(transfers.len(), 3, "{transfers:?}");
-    assert_eq!(transfers[0].payload, expected(&r2, 1).serialize());
+    assert_eq!(transfers[0].payload, bytes(&expected(&r2, 1)));
     assert_eq!(transfers[0].transfer_id, 3);
-    assert_eq!(
-        transfers[1].payload,
-        expected_extended(&r2, &f2).serialize()
-    );
+    assert_eq!(transfers[1].payload, bytes(&expected_extended(&r2, &f2)));
     assert_eq!(transfers[1].transfer_id, 2);
     let transfers = &transfers[1..];
     let node = NodeStatus {
         uptime_sec: 1,
-        health: Health::Warning,
+        health: Health::Warning as u8,
         mode: 0,
         sub_mode: 0,
         vendor_specific_status_code: 0b100,
     };
-    assert_eq!(transfers[1].payload, node.serialize());
+    assert_eq!(transfers[1].payload, bytes(&node));
     assert_eq!(transfers[1].transfer_id, 1);
 }
 
@@ -585,7 +584,7 @@ fn pydronecan_decodes_esc_status_extended_and_node_status() {
     assert!(b_commands.lock().unwrap().iter().any(|c| c == "S8"));
 
     let f16 = |v: f32| -> Option<f64> {
-        let h = f16_bits(v);
+        let h = f16_from_f32(saturate_f16(v));
         let x = f64::from(half_to_f32(h));
         (!x.is_nan()).then_some(x)
     };

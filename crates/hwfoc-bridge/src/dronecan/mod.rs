@@ -48,7 +48,16 @@
 //! bytes) is [`OutputError::Send`] and the port is kept. Every error returned is also counted
 //! in [`OutputStats::errors`].
 //!
-//! # Why by hand
+//! # Encoding
+//!
+//! The messages are the codec's ([`hwfoc::dronecan`]: [`EscStatus`], [`EscStatusExtended`],
+//! [`NodeStatus`], their data type ids and signatures in [`hwfoc::dronecan::Kind`]) and so are
+//! their frames ([`Message::frames`]: CAN id, tail bytes, the signature-seeded transfer CRC),
+//! all checked against pydronecan's own frames; only SLCAN ([`slcan`]) is the bridge's.
+//! float16 fields are converted as pydronecan and libuavcan convert (what the receivers people
+//! use do): rounded to nearest with ties away from zero, ±infinity saturated to ±65504 (DSDL's
+//! cast), NaN sent as `0x7FFF`. (The output used the `half` crate before: ties to even,
+//! infinity kept, NaN `0x7E00`.)
 //!
 //! The crates.io crates were read first: `dronecan` 0.2.0 (MPL-2.0) only
 //! reassembles received transfers and parses CAN IDs: no transmit-side splitting, no DSDL
@@ -56,16 +65,14 @@
 //! FD-CAN peripheral and has no `esc.Status`. `slcan` 0.1.3 (2020) is built on the unmaintained
 //! `serial` crate and `mini-slcan` / `serial-can` are codecs of a few lines of what
 //! [`slcan::push_extended`] does. `canadensis` is Cyphal (UAVCAN v1), another transport.
-//! The transport here is a hundred lines ([`transport`]), tested against pydronecan's bytes,
-//! and float16 is the `half` crate's.
 
 pub mod dsdl;
 pub mod slcan;
-pub mod transport;
 
 use std::time::{Duration, Instant};
 
 use hwfoc::Telemetry;
+use hwfoc::dronecan::Message;
 use serialport::SerialPort;
 
 use crate::output::{Output, OutputError, OutputStats, SILENT_AFTER, Update};
@@ -330,7 +337,7 @@ impl DronecanOutput {
         NodeStatus {
             uptime_sec: u32::try_from(now.saturating_duration_since(self.opened).as_secs())
                 .unwrap_or(u32::MAX),
-            health: if warning { Health::Warning } else { Health::Ok },
+            health: if warning { Health::Warning } else { Health::Ok } as u8,
             mode: dsdl::MODE_OPERATIONAL,
             sub_mode: 0,
             vendor_specific_status_code: live_mask,
@@ -354,11 +361,12 @@ impl DronecanOutput {
         }
     }
 
-    /// Appends one transfer's SLCAN lines to `self.out`.
-    fn push_transfer(&mut self, data_type: u16, signature: u64, transfer_id: u8, payload: &[u8]) {
-        let id = transport::message_id(PRIORITY, data_type, self.options.node_id);
-        for frame in transport::frames(id, signature, transfer_id, payload) {
-            slcan::push_extended(&mut self.out, frame.id, frame.data());
+    /// Appends the SLCAN lines of one transfer of `message` (a broadcast from the node at
+    /// [`PRIORITY`]) to `self.out`.
+    fn push_transfer(&mut self, message: impl Into<Message>, transfer_id: u8) {
+        let message = message.into();
+        for frame in message.frames(PRIORITY, self.options.node_id, 0, transfer_id) {
+            slcan::push_extended(&mut self.out, frame.id(), frame.data());
             self.frames += 1;
         }
     }
@@ -468,39 +476,24 @@ impl Output for DronecanOutput {
             }
             self.out.clear();
             let tid = next_transfer_id(&mut self.esc_transfer_id);
-            self.push_transfer(
-                dsdl::ESC_STATUS_ID,
-                dsdl::ESC_STATUS_SIGNATURE,
-                tid,
-                &status.serialize(),
-            );
+            self.push_transfer(status, tid);
             let extended_due = self.escs[i]
                 .extended_sent
                 .is_none_or(|sent| arrived.saturating_duration_since(sent) >= EXTENDED_EVERY);
             if extended_due {
                 self.escs[i].extended_sent = Some(arrived);
                 let tid = next_transfer_id(&mut self.extended_transfer_id);
-                self.push_transfer(
-                    dsdl::ESC_STATUS_EXTENDED_ID,
-                    dsdl::ESC_STATUS_EXTENDED_SIGNATURE,
-                    tid,
-                    &extended.serialize(),
-                );
+                self.push_transfer(extended, tid);
             }
             self.write_out(now)?;
             self.stats.messages += 1 + u64::from(extended_due);
             self.stats.latency.add(Instant::now() - arrived);
         }
         if self.next_node_status.is_none_or(|t| now >= t) {
-            let payload = self.node_status(now).serialize();
+            let node_status = self.node_status(now);
             self.out.clear();
             let tid = next_transfer_id(&mut self.node_transfer_id);
-            self.push_transfer(
-                dsdl::NODE_STATUS_ID,
-                dsdl::NODE_STATUS_SIGNATURE,
-                tid,
-                &payload,
-            );
+            self.push_transfer(node_status, tid);
             // A second after this one was due; a second after now if far behind.
             let next = self.next_node_status.unwrap_or(now) + NODE_STATUS_EVERY;
             self.next_node_status = Some(if next <= now {
@@ -516,5 +509,45 @@ impl Output for DronecanOutput {
 
     fn stats(&self) -> &OutputStats {
         &self.stats
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// What `push_transfer` writes for an esc.Status from node 100 with transfer id 5: the CAN
+    /// id of a broadcast at [`PRIORITY`] and the three frames pydronecan 1.0.27 makes of the
+    /// same message (the transfer CRC 0xC75C first), as SLCAN lines. (These were the tests of
+    /// the bridge's own transport before it used the codec's.)
+    #[test]
+    fn esc_status_lines_as_pydronecan() {
+        // esc.Status of dsdl.rs's test: 7, 16.5 V, -2.25 A, 313.15 K, -1234 rpm, 55 %, ESC 3.
+        let status = dsdl::tests::example_esc_status();
+        let mut out = Vec::new();
+        for frame in Message::from(status).frames(PRIORITY, 100, 0, 5) {
+            slcan::push_extended(&mut out, frame.id(), frame.data());
+        }
+        assert_eq!(
+            String::from_utf8(out).unwrap(),
+            "T10040A6485CC7070000002085\r\
+             T10040A6484C80C0E55C2EFB25\r\
+             T10040A643DB8C45\r"
+        );
+        // NodeStatus fits one frame: no CRC, start and end set.
+        let node = NodeStatus {
+            uptime_sec: 123_456,
+            health: Health::Warning as u8,
+            mode: dsdl::MODE_OPERATIONAL,
+            sub_mode: 0,
+            vendor_specific_status_code: 0xABCD,
+        };
+        let frames: Vec<_> = Message::from(node).frames(PRIORITY, 100, 0, 31).collect();
+        assert_eq!(frames.len(), 1);
+        assert_eq!(frames[0].id(), 0x1001_5564);
+        assert_eq!(
+            frames[0].data(),
+            [0x40, 0xE2, 0x01, 0x00, 0x40, 0xCD, 0xAB, 0xDF]
+        );
     }
 }
