@@ -154,6 +154,18 @@ impl Protocol {
         }
     }
 
+    /// A short English description of bit `bit` of this protocol's fault word (see
+    /// [`Protocol::fault_name`]).
+    pub fn fault_description(self, bit: u8) -> Option<&'static str> {
+        match self {
+            Protocol::HwFoc | Protocol::DataLink => {
+                crate::Fault::from_bit(bit).map(|f| f.description())
+            }
+            Protocol::Hw5 => crate::hw5::Fault::from_bit(bit).map(|f| f.description()),
+            Protocol::HwV4 | Protocol::HwV3 => None,
+        }
+    }
+
     /// The names of the bits set in `status`, a fault word of this protocol, in bit order.
     pub fn fault_names(self, status: Status) -> impl Iterator<Item = &'static str> {
         (0..16u8)

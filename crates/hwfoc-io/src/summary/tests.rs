@@ -60,7 +60,11 @@ fn episodes_are_maximal_runs_of_faulty_frames() {
             status: Status(s),
             ..Default::default()
         };
-        acc.add(Some(i as f64 * 0.05), &Frame::Data(frame.into()));
+        acc.add(
+            Some(i as f64 * 0.05),
+            &Frame::Data(frame.into()),
+            &Settings::DEFAULT,
+        );
     }
     assert_eq!(acc.episode_count, 2);
     let first = acc.episodes[0];
@@ -74,7 +78,7 @@ fn episodes_are_maximal_runs_of_faulty_frames() {
     );
     assert_eq!(first.first.t, Some(0.05));
     assert_eq!(
-        fault_names(first.bits),
+        Protocol::HwFoc.fault_names(first.bits).collect::<Vec<_>>(),
         ["input_voltage_high", "mos_overheat"]
     );
     assert!(!first.ongoing);

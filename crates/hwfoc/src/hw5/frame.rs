@@ -14,7 +14,7 @@ use crate::units::{Linear, Quantity, Settings};
 
 use super::error::Error;
 use super::layout::{
-    AMPS, CHECKSUM, ERPM, CODE_AT, HEADER_LEN, Kind, PAYLOAD_LEN_AT, TELEMETRY_BYTES_7_8,
+    AMPS, CHECKSUM, CODE_AT, ERPM, HEADER_LEN, Kind, PAYLOAD_LEN_AT, TELEMETRY_BYTES_7_8,
     TELEMETRY_CHECK_AT, TELEMETRY_HEADER, TELEMETRY_LEN, TELEMETRY_PAYLOAD_LEN, TYPE_AT, VOLTS, at,
     direction_of, kinds_of,
 };

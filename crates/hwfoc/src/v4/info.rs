@@ -141,7 +141,11 @@ impl core::fmt::Display for InfoFrame {
     /// ```
     fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
         let v = self.volts_per_step();
-        write!(f, "full scale {}, {}/{} V per step, ", self.full_scale, v.num, v.den)?;
+        write!(
+            f,
+            "full scale {}, {}/{} V per step, ",
+            self.full_scale, v.num, v.den
+        )?;
         match self.current_scale() {
             Some(c) => write!(f, "current adc * {} / {} - {} A", c.mul, c.div, c.offset)?,
             None => f.write_str("no current sensor")?,
