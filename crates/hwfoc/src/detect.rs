@@ -264,7 +264,7 @@ impl Decoder {
             on_frame(Decoded::HwV3(d))
         });
         self.bytes += n as u64;
-        if self.bytes % SLICE == 0 {
+        if self.bytes.is_multiple_of(SLICE) {
             self.end_slice();
         }
         n
@@ -340,8 +340,9 @@ impl Decoder {
             self.hw5.line_silent(esc_frames, |d| take(Decoded::Hw5(d)));
         }
         if all || self.locked == Some(Family::HwV4) {
-            self.v4
-                .line_silent(scaled(v4::DATA_FRAME_LEN as u64), |d| take(Decoded::HwV4(d)));
+            self.v4.line_silent(scaled(v4::DATA_FRAME_LEN as u64), |d| {
+                take(Decoded::HwV4(d))
+            });
         }
         if all || self.locked == Some(Family::HwV3) {
             self.v3
@@ -402,7 +403,8 @@ impl Decoder {
     pub fn then(&mut self, later: &Decoder, first_packet: Option<u16>) -> bool {
         let only_mixed = |d: &Decoder| {
             d.last_locked.is_none_or(|f| f == Family::Mixed)
-                && d.v4.stats().frames() == 0 && d.v4.stats().info_frames() == 0
+                && d.v4.stats().frames() == 0
+                && d.v4.stats().info_frames() == 0
                 && d.v3.stats().frames() == 0
                 && d.hw5.stats().telemetry_frames() == 0
         };
