@@ -13,10 +13,13 @@
 //! ([`StreamDecoder::pass_over`]): they are its skipped bytes, so every decoder's offsets and
 //! statistics are the stream's.
 //!
-//! The frames, and where it locks, are the same however the stream is cut into chunks: slices
-//! and the bytes counted since the last frame are counted from the stream's start. Frames of
-//! two formats found in one slice while detecting come out format by format; HW-FOC and
-//! DataLink frames always in byte order ([`mixed`]).
+//! The frames, each format's in the same order, and where it locks, are the same however the
+//! stream is cut into chunks: slices and the bytes counted since the last frame are counted
+//! from the stream's start. Frames of two formats found in one slice while detecting come out
+//! format by format within each chunk given (the formats' decoders read a chunk one after the
+//! other), so how they interleave depends on the chunking: a chunk holding the whole slice
+//! gives them format by format, bytes given one at a time give them in the order they were
+//! decided. HW-FOC and DataLink frames always come in byte order ([`mixed`]).
 //!
 //! How soon it locks: on the first checksummed frame (an HW-FOC or HW5 frame), on three
 //! chained V3 frames (about 60 ms of a V3 ESC's wire) or V4 frames (150 ms running), or a V4

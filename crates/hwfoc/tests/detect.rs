@@ -607,6 +607,25 @@ fn assert_same_frames(
     Ok(())
 }
 
+/// Frames of two formats in one slice while detecting: format by format in a chunk holding
+/// the slice, in the order decided a byte at a time (each format's in the same order).
+#[test]
+fn two_formats_in_one_slice_interleave_as_the_chunks_say() {
+    // A V3 chain (decided on byte 30) and an HW-FOC frame after it (decided on byte 54).
+    let mut bytes = v3_stream(0..3);
+    bytes.extend(foc_stream(9..10));
+    let (frames, end) = bulk(&bytes);
+    let families: Vec<Family> = frames.iter().map(Decoded::family).collect();
+    use Family::{HwV3, Mixed};
+    assert_eq!(families, [Mixed, HwV3, HwV3, HwV3]);
+    let (by_byte, by_byte_end, _) = bytewise(&bytes);
+    let families: Vec<Family> = by_byte.iter().map(Decoded::family).collect();
+    assert_eq!(families, [HwV3, HwV3, HwV3, Mixed]);
+    assert_same_frames(&by_byte, &frames, "byte at a time").unwrap();
+    // The lock is the same: HW-FOC first among the formats found in the slice.
+    assert_eq!((end.locked, by_byte_end), (Some(Mixed), end));
+}
+
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(64))]
 
