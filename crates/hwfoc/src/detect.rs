@@ -10,7 +10,7 @@
 //! speed. After a silence of the line ([`Decoder::line_silent_each`]), and when
 //! [`RELOCK_AFTER`] bytes have passed since the locked format's last frame, it reads every
 //! format again (a stream may change format: an adapter moved from one ESC to another); a decoder that was not given some bytes passes over them
-//! ([`StreamDecoder::pass_over`]): they are its skipped bytes, so every decoder's offsets and
+//! ([`StreamDecoder::pass_over`](crate::StreamDecoder::pass_over)): they are its skipped bytes, so every decoder's offsets and
 //! statistics are the stream's.
 //!
 //! The frames, each format's in the same order, and where it locks, are the same however the
