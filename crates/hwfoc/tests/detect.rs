@@ -607,6 +607,65 @@ fn assert_same_frames(
     Ok(())
 }
 
+/// Asserts that each format's statistics account for every byte (in a frame, or skipped) and
+/// count the frames given; HW-FOC's and DataLink's when only one of them was found.
+fn assert_every_byte_counted(frames: &[Decoded], end: &State, len: usize) {
+    let len = len as u64;
+    let count = |f: Family| frames.iter().filter(|d| d.family() == f).count() as u64;
+    let s = &end.v3;
+    assert_eq!(s.bytes(), len);
+    assert_eq!(
+        10 * u64::from(s.frames()) + s.bytes_skipped(),
+        len,
+        "V3: {s}"
+    );
+    assert_eq!(u64::from(s.frames()), count(Family::HwV3));
+    let s = &end.v4;
+    let in_frames = 19 * u64::from(s.frames()) + 13 * u64::from(s.info_frames());
+    assert_eq!(
+        in_frames + u64::from(s.trailers()) + s.bytes_skipped(),
+        len,
+        "V4: {s}"
+    );
+    assert_eq!(u64::from(s.frames() + s.info_frames()), count(Family::HwV4));
+    let s = &end.hw5;
+    assert_eq!(s.frame_bytes() + s.bytes_skipped(), len, "HW5: {s}");
+    assert_eq!(u64::from(s.telemetry_frames()), count(Family::Hw5));
+    let (esc, hub) = (&end.mixed.esc, &end.mixed.hub);
+    assert_eq!((esc.bytes(), hub.bytes()), (len, len));
+    if hub.frames() == 0 {
+        let in_frames = 24 * u64::from(esc.frames()) + 77 * u64::from(esc.info_frames());
+        assert_eq!(in_frames + esc.bytes_skipped(), len, "HW-FOC: {esc}");
+    }
+    if esc.frames() + esc.info_frames() == 0 {
+        let in_frames = datalink::FRAME_LEN as u64 * u64::from(hub.frames());
+        assert_eq!(in_frames + hub.bytes_skipped(), len, "DataLink: {hub}");
+    }
+}
+
+/// A decoder that locks at a slice's end while another holds a candidate, the stream ending
+/// there: at the flush the other drops it, counted as skipped (it held 6 bytes that no
+/// statistic counted, found by the fuzz target `detect`).
+#[test]
+fn a_flush_when_locked_counts_every_byte_of_every_format() {
+    let mut bytes = foc_stream(3..4);
+    bytes.resize(SLICE as usize - 6, 0);
+    // The first 6 bytes of a plausible V3 frame: V3's decoder holds them.
+    bytes.extend_from_slice(&v3_stream(9..10)[..6]);
+    let (frames, end) = assert_every_path_agrees(&bytes, &[1, 7]);
+    assert_eq!(end.locked, Some(Family::Mixed));
+    assert_eq!(frames.len(), 1);
+    assert_eq!(end.v3.bytes_skipped(), SLICE);
+    assert_every_byte_counted(&frames, &end, bytes.len());
+    // Fed on after the flush, the decoder goes on as it was.
+    let mut d = Decoder::new();
+    d.decode_all(&bytes, |_| {});
+    let mut n = 0;
+    d.decode_all(&foc_stream(4..6), |_| n += 1);
+    assert_eq!((n, d.locked()), (2, Some(Family::Mixed)));
+    assert_eq!(d.v3_stats().bytes_skipped(), SLICE + 48);
+}
+
 /// Frames of two formats in one slice while detecting: format by format in a chunk holding
 /// the slice, in the order decided a byte at a time (each format's in the same order).
 #[test]
@@ -646,6 +705,7 @@ proptest! {
         let (got, got_end, got_states) = chunked(&bytes, &cuts);
         assert_same_frames(&got, &frames, &format!("cuts {cuts:?}"))?;
         prop_assert_eq!(&got_end, &end);
+        assert_every_byte_counted(&frames, &end, bytes.len());
         for (at, s) in got_states {
             if at > 0 {
                 prop_assert_eq!(&s, &states[at - 1], "after byte {}", at);
