@@ -10,13 +10,16 @@
 //! speed. After a silence of the line ([`Decoder::line_silent_each`]), and when
 //! [`RELOCK_AFTER`] bytes have passed since the locked format's last frame, it reads every
 //! format again (a stream may change format: an adapter moved from one ESC to another); a decoder that was not given some bytes passes over them
-//! ([`StreamDecoder::pass_over`]): they are its skipped bytes, so every decoder's offsets and
+//! ([`StreamDecoder::pass_over`](crate::StreamDecoder::pass_over)): they are its skipped bytes, so every decoder's offsets and
 //! statistics are the stream's.
 //!
-//! The frames, and where it locks, are the same however the stream is cut into chunks: slices
-//! and the bytes counted since the last frame are counted from the stream's start. Frames of
-//! two formats found in one slice while detecting come out format by format; HW-FOC and
-//! DataLink frames always in byte order ([`mixed`]).
+//! The frames, each format's in the same order, and where it locks, are the same however the
+//! stream is cut into chunks: slices and the bytes counted since the last frame are counted
+//! from the stream's start. Frames of two formats found in one slice while detecting come out
+//! format by format within each chunk given (the formats' decoders read a chunk one after the
+//! other), so how they interleave depends on the chunking: a chunk holding the whole slice
+//! gives them format by format, bytes given one at a time give them in the order they were
+//! decided. HW-FOC and DataLink frames always come in byte order ([`mixed`]).
 //!
 //! How soon it locks: on the first checksummed frame (an HW-FOC or HW5 frame), on three
 //! chained V3 frames (about 60 ms of a V3 ESC's wire) or V4 frames (150 ms running), or a V4
@@ -242,7 +245,7 @@ impl Decoder {
     /// Gives every decoder the bytes of `data` to the end of the current slice; at its end,
     /// locks onto the first family that found a frame in it. Returns how many it took.
     fn feed_detecting(&mut self, data: &[u8], on_frame: &mut impl FnMut(Decoded)) -> usize {
-        self.catch_up();
+        self.catch_up(false);
         let to_end = SLICE - self.bytes % SLICE;
         let n = usize::try_from(to_end).map_or(data.len(), |k| k.min(data.len()));
         let piece = &data[..n];
@@ -287,23 +290,25 @@ impl Decoder {
     }
 
     /// Brings every decoder to the stream's end: each passes over the bytes it was not given.
-    fn catch_up(&mut self) {
+    /// With `settle` (at a flush), a decoder that was given every byte but is not being given
+    /// bytes now (one other than the locked one) also drops what it holds (its skipped bytes):
+    /// it was not flushed, and its statistics must count every byte.
+    fn catch_up(&mut self, settle: bool) {
         let bytes = self.bytes;
-        let behind = |b: u64| bytes - b;
-        let n = behind(self.mixed.stats().bytes());
-        if n > 0 {
+        let behind = |b: u64, held: usize| {
+            let n = bytes - b;
+            (n > 0 || (settle && held > 0)).then_some(n)
+        };
+        if let Some(n) = behind(self.mixed.stats().bytes(), self.mixed.buffered()) {
             self.mixed.pass_over(n);
         }
-        let n = behind(self.v4.stats().bytes());
-        if n > 0 {
+        if let Some(n) = behind(self.v4.stats().bytes(), self.v4.buffered()) {
             self.v4.pass_over(n);
         }
-        let n = behind(self.v3.stats().bytes());
-        if n > 0 {
+        if let Some(n) = behind(self.v3.stats().bytes(), self.v3.buffered()) {
             self.v3.pass_over(n);
         }
-        let n = behind(self.hw5.stats().bytes());
-        if n > 0 {
+        if let Some(n) = behind(self.hw5.stats().bytes(), self.hw5.buffered()) {
             self.hw5.pass_over(n);
         }
     }
@@ -385,7 +390,7 @@ impl Decoder {
         if all {
             self.end_slice();
         }
-        self.catch_up();
+        self.catch_up(true);
     }
 
     /// Feeds a whole stream and flushes it.
@@ -411,7 +416,7 @@ impl Decoder {
         if self.buffered() != 0 || !only_mixed(self) || !only_mixed(later) {
             return false;
         }
-        self.catch_up();
+        self.catch_up(false);
         if !self.mixed.then(&later.mixed, first_packet) {
             return false;
         }
