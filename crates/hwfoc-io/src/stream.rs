@@ -96,9 +96,23 @@ fn emit_any(d: detect::Decoded, emit: &mut impl FnMut(Option<u8>, u64, &Frame)) 
             emit(None, d.offset, &Frame::from(d.frame))
         }
         detect::Decoded::Mixed(mixed::Decoded::Hub(d)) => hub_records(&d, emit),
+        other => emit_other(other, emit),
+    }
+}
+
+/// [`emit_any`] for the formats of ESCs that send at most about 50 frames a second (V4, V3,
+/// HW5): out of line, so that the loop of an HW-FOC stream holds none of it.
+#[cold]
+#[inline(never)]
+fn emit_other(d: detect::Decoded, emit: &mut impl FnMut(Option<u8>, u64, &Frame)) {
+    match d {
         detect::Decoded::HwV4(d) => emit(None, d.offset, &Frame::from(d.frame)),
         detect::Decoded::HwV3(d) => emit(None, d.offset, &Frame::Data(Data::HwV3(d.frame))),
         detect::Decoded::Hw5(d) => emit(None, d.offset, &Frame::Data(Data::Hw5(d.frame))),
+        detect::Decoded::Mixed(d) => match d {
+            mixed::Decoded::Esc(d) => emit(None, d.offset, &Frame::from(d.frame)),
+            mixed::Decoded::Hub(d) => hub_records(&d, emit),
+        },
     }
 }
 

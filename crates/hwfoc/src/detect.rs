@@ -7,15 +7,14 @@
 //! one or more of them found a frame, it locks onto the first of those in the order HW-FOC and
 //! DataLink, HW5, V4, V3 (checksummed formats before the chained ones). Locked, it gives the
 //! bytes to that format's decoder only, so a stream of one format is read at that decoder's
-//! speed. After a silence of the line ([`Decoder::line_silent_each`]), and when
-//! [`RELOCK_AFTER`] bytes have passed since the locked format's last frame, it reads every
-//! format again (a stream may change format: an adapter moved from one ESC to another); a decoder that was not given some bytes passes over them
+//! speed. After a silence of the line ([`Decoder::line_silent_each`]), and at the end of a
+//! block of [`RELOCK_AFTER`] bytes (blocks start at its multiples in the stream) in which the
+//! locked format's decoder handed on no frame, it reads every format again (a stream may change format: an adapter moved from one ESC to another); a decoder that was not given some bytes passes over them
 //! ([`StreamDecoder::pass_over`](crate::StreamDecoder::pass_over)): they are its skipped bytes, so every decoder's offsets and
 //! statistics are the stream's.
 //!
 //! The frames, each format's in the same order, and where it locks, are the same however the
-//! stream is cut into chunks: slices and the bytes counted since the last frame are counted
-//! from the stream's start. Frames of two formats found in one slice while detecting come out
+//! stream is cut into chunks: slices and blocks are counted from the stream's start. Frames of two formats found in one slice while detecting come out
 //! format by format within each chunk given (the formats' decoders read a chunk one after the
 //! other), so how they interleave depends on the chunking: a chunk holding the whole slice
 //! gives them format by format, bytes given one at a time give them in the order they were
@@ -47,9 +46,13 @@ use crate::{hw5, mixed, v3, v4};
 /// Bytes per slice while detecting (see the module documentation).
 pub const SLICE: u64 = 64;
 
-/// Bytes after the locked format's last frame from which every format is read again: more
-/// than any format's frame and the gap between two of them on a working wire.
-pub const RELOCK_AFTER: u64 = 2048;
+/// The blocks of the stream, at multiples of this many bytes, at whose end every format is read
+/// again when the locked format's decoder handed on no frame in the block: more than any
+/// format's frame and the gap between two of them on a working wire. (Blocks, not bytes since
+/// the last frame: the frames' offsets need not be followed, so the decoder of a locked HW-FOC
+/// stream runs as fast as [`mixed`]'s alone.) A new format is found at most two blocks and a
+/// slice after the change.
+pub const RELOCK_AFTER: u64 = 4096;
 
 /// A format the decoder locks onto: HW-FOC and DataLink are read by one decoder ([`mixed`]),
 /// which tells them apart frame by frame.
@@ -118,8 +121,9 @@ pub struct Decoder {
     locked: Option<Family>,
     /// The format locked onto last (it stays when detection starts again, until another is).
     last_locked: Option<Family>,
-    /// Locked: the stream offset at which detection starts again unless a frame comes first.
-    until: u64,
+    /// Locked: the locked decoder's frames handed on by the start of the current block, or
+    /// `None` for the block it locked in (not judged: it is only partly locked).
+    block_start: Option<u64>,
     /// Detecting: which families found a frame in the current slice, and the last one's offset.
     found: [Option<u64>; 4],
 }
@@ -195,8 +199,9 @@ impl Decoder {
         }
     }
 
-    /// Gives the locked family's decoder the bytes of `data` up to where detection would start
-    /// again; returns how many it took.
+    /// Gives the locked family's decoder the bytes of `data` to the end of the current block;
+    /// at its end, reads every format again if the decoder handed on no frame in the block.
+    /// Returns how many it took.
     #[inline(always)]
     fn feed_locked(
         &mut self,
@@ -204,42 +209,53 @@ impl Decoder {
         data: &[u8],
         on_frame: &mut impl FnMut(Decoded),
     ) -> usize {
-        let room = self.until.saturating_sub(self.bytes);
-        if room == 0 {
-            self.locked = None;
-            self.found = [None; 4];
-            return 0;
-        }
-        let n = usize::try_from(room).map_or(data.len(), |room| room.min(data.len()));
+        let to_end = RELOCK_AFTER - self.bytes % RELOCK_AFTER;
+        let n = usize::try_from(to_end).map_or(data.len(), |k| k.min(data.len()));
         let piece = &data[..n];
-        let mut last = None;
         match family {
             Family::Mixed => self.mixed.feed(
                 piece,
                 #[inline(always)]
-                |d| {
-                    last = Some(d.offset());
-                    on_frame(Decoded::Mixed(d))
-                },
+                |d| on_frame(Decoded::Mixed(d)),
             ),
-            Family::HwV4 => self.v4.feed(piece, |d| {
-                last = Some(d.offset);
-                on_frame(Decoded::HwV4(d))
-            }),
-            Family::HwV3 => self.v3.feed(piece, |d| {
-                last = Some(d.offset);
-                on_frame(Decoded::HwV3(d))
-            }),
-            Family::Hw5 => self.hw5.feed(piece, |d| {
-                last = Some(d.offset);
-                on_frame(Decoded::Hw5(d))
-            }),
+            Family::HwV4 => self.v4.feed(piece, |d| on_frame(Decoded::HwV4(d))),
+            Family::HwV3 => self.v3.feed(piece, |d| on_frame(Decoded::HwV3(d))),
+            Family::Hw5 => self.hw5.feed(piece, |d| on_frame(Decoded::Hw5(d))),
         }
         self.bytes += n as u64;
-        if let Some(at) = last {
-            self.until = self.until.max(at + RELOCK_AFTER);
+        if self.bytes.is_multiple_of(RELOCK_AFTER) {
+            self.end_block(family);
         }
         n
+    }
+
+    /// The frames `family`'s decoder has handed on so far (data and information frames).
+    fn handed_on(&self, family: Family) -> u64 {
+        match family {
+            Family::Mixed => {
+                let s = self.mixed.stats();
+                u64::from(s.esc.packets().count())
+                    + u64::from(s.esc.info_frames())
+                    + u64::from(s.hub.frames())
+            }
+            Family::HwV4 => {
+                u64::from(self.v4.stats().frames()) + u64::from(self.v4.stats().info_frames())
+            }
+            Family::HwV3 => u64::from(self.v3.stats().frames()),
+            Family::Hw5 => u64::from(self.hw5.stats().telemetry_frames()),
+        }
+    }
+
+    /// At the end of a block while locked: detection starts again when the locked decoder
+    /// handed on no frame since the block's start.
+    #[cold]
+    fn end_block(&mut self, family: Family) {
+        let now = self.handed_on(family);
+        if self.block_start == Some(now) {
+            self.locked = None;
+            self.found = [None; 4];
+        }
+        self.block_start = Some(now);
     }
 
     /// Gives every decoder the bytes of `data` to the end of the current slice; at its end,
@@ -275,16 +291,11 @@ impl Decoder {
 
     /// At the end of a slice while detecting: locks onto the first family that found a frame.
     fn end_slice(&mut self) {
-        if let Some((i, at)) = self
-            .found
-            .iter()
-            .enumerate()
-            .find_map(|(i, at)| at.map(|at| (i, at)))
-        {
+        if let Some(i) = self.found.iter().position(Option::is_some) {
             let family = Family::ALL[i];
             self.locked = Some(family);
             self.last_locked = Some(family);
-            self.until = at + RELOCK_AFTER;
+            self.block_start = None;
         }
         self.found = [None; 4];
     }
@@ -428,7 +439,8 @@ impl Decoder {
         self.locked = later.locked;
         self.last_locked = later.last_locked.or(self.last_locked);
         let base = self.bytes - n;
-        self.until = later.until + base;
+        // Its frame count is the whole stream's now: the block it is in is not judged.
+        self.block_start = None;
         self.found = later.found.map(|at| at.map(|at| at + base));
         true
     }

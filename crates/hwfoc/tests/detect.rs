@@ -2,8 +2,8 @@
 //! streams made by the codec's encoders it finds exactly what each format's own decoder finds,
 //! with the same statistics; it gives the same frames and state however the stream is cut into
 //! chunks; it follows a stream that changes format (after a line silence at once, without one
-//! within `RELOCK_AFTER` and a slice); it never locks on random bytes; and it locks within the
-//! times of `docs/OLDER-PROTOCOLS.md` ("Auto-detection"), measured and printed here.
+//! within two blocks of `RELOCK_AFTER` and a slice); it never locks on random bytes; and it
+//! locks within the times of `docs/OLDER-PROTOCOLS.md` ("Auto-detection"), measured and printed here.
 
 #[allow(dead_code)] // the HW-FOC generator and the other protocols' paths
 mod common;
@@ -776,12 +776,12 @@ impl Format {
     }
 }
 
-/// Format `a` for 3000 bytes, then `b` for 5000 (with other counters), with a line silence
+/// Format `a` for 3000 bytes, then `b` for three blocks and 1000 bytes (with other counters), with a line silence
 /// between them or not: the stream, where `b` starts, and what each one's own decoder finds
 /// in its part (offsets in the whole stream).
 fn switch(a: Format, b: Format) -> (Vec<u8>, usize, Vec<Decoded>, Vec<Decoded>) {
     let first = a.stream(100, 3000);
-    let second = b.stream(5000, 5000);
+    let second = b.stream(5000, 3 * RELOCK_AFTER as usize + 1000);
     let at = first.len();
     let mine = own(a.family(), &first);
     let theirs: Vec<Decoded> = own(b.family(), &second)
@@ -825,7 +825,7 @@ fn after_a_line_silence_every_frame_of_both_formats() {
 }
 
 #[test]
-fn without_a_silence_the_new_format_is_found_within_relock_after_and_a_slice() {
+fn without_a_silence_the_new_format_is_found_within_two_blocks_and_a_slice() {
     let mut worst = 0;
     for a in Format::ALL {
         for b in Format::ALL {
@@ -858,17 +858,17 @@ fn without_a_silence_the_new_format_is_found_within_relock_after_and_a_slice() {
                 .unwrap_or_else(|| panic!("{a:?} then {b:?}: {first:?} is not the second's"));
             assert_eq!(after, theirs[k..], "{a:?} then {b:?}");
             let late = first.offset() - at as u64;
-            let bound = RELOCK_AFTER + 3 * b.period() as u64 + SLICE;
+            let bound = 2 * RELOCK_AFTER + 3 * b.period() as u64 + SLICE;
             assert!(
                 late <= bound,
                 "{a:?} then {b:?}: first frame {late} bytes after the switch (> {bound})"
             );
-            // Every frame starting RELOCK_AFTER after the switch is found.
+            // Every frame starting two blocks after the switch is found.
             assert!(
                 theirs[..k]
                     .iter()
-                    .all(|d| d.offset() < at as u64 + RELOCK_AFTER),
-                "{a:?} then {b:?}: a frame lost after RELOCK_AFTER"
+                    .all(|d| d.offset() < at as u64 + 2 * RELOCK_AFTER),
+                "{a:?} then {b:?}: a frame lost two blocks after the switch"
             );
             assert_eq!(end.locked, Some(b.family()));
             worst = worst.max(late);

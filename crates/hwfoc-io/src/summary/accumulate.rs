@@ -2,6 +2,7 @@
 //! lanes, histograms of temperature codes, fault counts, episodes, times, raw energy), the
 //! per-frame cost of `hwfoc summary`.
 
+use hwfoc::foc::DataFrame;
 use hwfoc::telemetry::{Conversion, Data, Frame, Info, Telemetry};
 use hwfoc::{Protocol, Quantity, Settings, Status, Temperature};
 
@@ -193,8 +194,8 @@ impl Tally {
     /// the run (in the L1 cache), each of whose running values are locals, kept in registers and
     /// stored once (a running value in memory is stored and loaded back every frame).
     #[inline(always)]
-    fn add_run(&mut self, run: &[Data]) {
-        let powered = |f: &Data| Some((f.raw(Quantity::Voltage)?, f.raw(Quantity::Current)?));
+    fn add_run(&mut self, run: &[DataFrame]) {
+        let powered = |f: &DataFrame| Some((f.raw(Quantity::Voltage)?, f.raw(Quantity::Current)?));
         let (mut power_sum, mut power_max) = (self.power_sum, self.power_max);
         for (volts, amps) in run.iter().filter_map(powered) {
             let power = volts * amps;
@@ -379,7 +380,7 @@ pub(super) fn is_clean(f: &Data) -> bool {
 /// The code of temperature `quantity` in a data frame: its raw value when that is a table's
 /// code (0..=255), `None` when it is not or the frame does not carry it.
 #[inline(always)]
-fn code(f: &Data, quantity: Quantity) -> Option<u8> {
+fn code(f: &impl Telemetry, quantity: Quantity) -> Option<u8> {
     f.raw(quantity).and_then(|raw| u8::try_from(raw).ok())
 }
 
@@ -404,12 +405,12 @@ impl CodeRun {
         }
     }
 
-    /// Counts the codes of temperature `quantity` in `frames`, a run at a time.
+    /// Counts the temperature codes `codes` of frames, a run of one code at a time.
     #[inline(always)]
-    fn count(frames: &[Data], quantity: Quantity, codes: &mut [u64; 256], uncoded: &mut u64) {
+    fn count(frames: impl Iterator<Item = Option<u8>>, codes: &mut [u64; 256], uncoded: &mut u64) {
         let mut run = CodeRun::default();
-        for f in frames {
-            run.add(code(f, quantity), codes, uncoded);
+        for code in frames {
+            run.add(code, codes, uncoded);
         }
         run.end(codes);
     }
@@ -509,7 +510,10 @@ impl Accumulator {
     #[inline(always)]
     pub(super) fn count(&mut self, t: Option<f64>, f: &Data) {
         let powered = self.tally.add(f);
-        self.count_codes(std::slice::from_ref(f));
+        self.count_codes(
+            std::iter::once(code(f, Quantity::MosTemp)),
+            std::iter::once(code(f, Quantity::CapTemp)),
+        );
         if !powered {
             return self.untimed_power(t, f);
         }
@@ -518,39 +522,35 @@ impl Accumulator {
         }
     }
 
-    /// Adds the data frames without times at the start of `frames` that [`Self::add_clean`]
+    /// Adds the HW-FOC data frames without times at the start of `frames` that [`Self::add_clean`]
     /// would take (no fault), up to the first that it would not: how many. Their tally is added
     /// in passes over the run ([`Tally::add_run`]) and their temperature codes counted a run of
     /// one code at a time (adding one to the same count frame after frame waits for the
     /// previous store each time).
     #[inline(always)]
-    pub(super) fn add_clean_run(&mut self, frames: &[Data]) -> usize {
+    pub(super) fn add_clean_run(&mut self, frames: &[DataFrame]) -> usize {
         debug_assert!(self.fast && self.sample.is_some() && self.episode.is_none());
         let n = frames
             .iter()
-            .position(|f| !is_clean(f))
+            .position(|f| !f.status.is_ok())
             .unwrap_or(frames.len());
         let run = &frames[..n];
         self.tally.add_run(run);
-        self.count_codes(run);
+        let codes = |q| run.iter().map(move |f| code(f, q));
+        self.count_codes(codes(Quantity::MosTemp), codes(Quantity::CapTemp));
         n
     }
 
-    /// Counts the temperature codes of `frames`, each temperature a run of one code at a time.
+    /// Counts the MOSFET's and the capacitor's temperature codes of frames, each a run of one
+    /// code at a time.
     #[inline(always)]
-    fn count_codes(&mut self, frames: &[Data]) {
-        CodeRun::count(
-            frames,
-            Quantity::MosTemp,
-            &mut self.mos_codes,
-            &mut self.uncoded[0],
-        );
-        CodeRun::count(
-            frames,
-            Quantity::CapTemp,
-            &mut self.cap_codes,
-            &mut self.uncoded[1],
-        );
+    fn count_codes(
+        &mut self,
+        mos: impl Iterator<Item = Option<u8>>,
+        cap: impl Iterator<Item = Option<u8>>,
+    ) {
+        CodeRun::count(mos, &mut self.mos_codes, &mut self.uncoded[0]);
+        CodeRun::count(cap, &mut self.cap_codes, &mut self.uncoded[1]);
     }
 
     /// What a frame with a time adds: out of the decoder's loop, which stays as small as it

@@ -27,6 +27,7 @@
 
 use std::any::Any;
 
+use hwfoc::foc::DataFrame;
 use hwfoc::telemetry::{Conversion, Data, Frame, Info, Telemetry};
 use hwfoc::units::Linear;
 use hwfoc::{Protocol, Quantity, Settings, Status};
@@ -172,7 +173,7 @@ impl Handler for Summary {
     /// The frames of a raw input: the clean ones (as in [`Summary::frame`]) in a loop that
     /// holds the ESC's accumulator, any other out of line.
     #[inline]
-    fn untimed_data(&mut self, esc: u8, frames: &[Data], settings: &Settings) {
+    fn untimed_data(&mut self, esc: u8, frames: &[DataFrame], settings: &Settings) {
         let esc = usize::from(esc);
         let mut i = 0;
         while i < frames.len() {
@@ -182,7 +183,7 @@ impl Handler for Summary {
                 i += acc.add_clean_run(&frames[i..]);
             }
             if let Some(f) = frames.get(i) {
-                self.add(esc, None, &Frame::Data(*f), settings);
+                self.add(esc, None, &Frame::Data(Data::HwFoc(*f)), settings);
                 i += 1;
             }
         }
@@ -216,7 +217,7 @@ impl LaterPart for Part {
         self.0.frame(esc, None, frame, settings);
     }
 
-    fn untimed_data(&mut self, esc: u8, frames: &[Data], settings: &Settings) {
+    fn untimed_data(&mut self, esc: u8, frames: &[DataFrame], settings: &Settings) {
         self.0.untimed_data(esc, frames, settings);
     }
 
