@@ -306,7 +306,7 @@ impl TextEncoder {
     /// takes the text of numbers from its caches. Every record given to one cached encoder
     /// must be converted under the same settings. (A frame of a protocol whose raw integers
     /// convert otherwise from frame to frame, V4 before and after its info frame, or otherwise
-    /// than HW-FOC's, is written without the caches: [`caches_apply`].)
+    /// than HW-FOC's, is written without the caches.)
     pub fn json_frame(&mut self, r: &Record, frame: &Data, out: &mut Vec<u8>) {
         if caches_apply(frame) {
             self.row::<Json>(r, Some(frame), out);
