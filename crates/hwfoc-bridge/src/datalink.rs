@@ -65,8 +65,9 @@ struct Slot {
     arrived: Instant,
 }
 
-/// DataLink V2 frames of up to eight ESCs (ESC `n` in channel `n`; ESCs past 7 are not carried
-/// and are counted in [`DatalinkOutput::escs_not_carried`]).
+/// DataLink V2 frames of up to eight ESCs (ESC `n` in channel `n`; ESCs past 7, and frames of a
+/// format other than HW-FOC, are not carried and are counted in
+/// [`DatalinkOutput::escs_not_carried`]).
 pub struct DatalinkOutput {
     name: String,
     line: Line,
@@ -115,7 +116,8 @@ impl DatalinkOutput {
         }
     }
 
-    /// Frames of ESCs numbered 8 or more, which a DataLink frame has no channel for.
+    /// Frames of ESCs numbered 8 or more, which a DataLink frame has no channel for, and of
+    /// formats other than HW-FOC (V4, V3, HW5), whose fields a hub record does not hold.
     pub fn escs_not_carried(&self) -> u64 {
         self.not_carried
     }
@@ -189,13 +191,19 @@ impl Output for DatalinkOutput {
             self.not_carried += 1;
             return;
         };
+        // A hub record is an HW-FOC frame: another format's frame, whose fields an HW-FOC frame
+        // does not hold as sent, is not carried.
+        let Some(frame) = update.frame.to_hwfoc() else {
+            self.not_carried += 1;
+            return;
+        };
         let queue = &mut self.slots[index];
         if queue.len() == QUEUE {
             queue.pop_front();
             self.stats.superseded += 1;
         }
         queue.push_back(Slot {
-            frame: update.frame.to_hwfoc(),
+            frame,
             arrived: update.arrived,
         });
         // A second frame of this ESC is waiting: send as soon as the line allows. (A failure

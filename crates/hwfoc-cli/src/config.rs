@@ -844,11 +844,13 @@ mod tests {
             config.unwrap().file.monitor.protocol,
             Some(Protocol::DataLink)
         );
-        let (_dir, config) = load("[monitor]\nbaud = 9600\nprotocol = \"hw5\"\n");
+        let (_dir, config) = load("[monitor]\nprotocol = \"hw5\"\n");
+        assert_eq!(config.unwrap().file.monitor.protocol, Some(Protocol::Hw5));
+        let (_dir, config) = load("[monitor]\nbaud = 9600\nprotocol = \"hw6\"\n");
         let err = config.unwrap_err().to_string();
         assert!(err.contains("config.toml line 3"), "{err}");
         assert!(
-            err.contains("\"hw5\" is not one of hw-foc, datalink"),
+            err.contains("\"hw6\" is not one of hw-foc, datalink, hw-v4, hw-v3, hw5"),
             "{err}"
         );
         assert!(!err.contains('\n'), "{err}");

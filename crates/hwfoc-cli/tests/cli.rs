@@ -153,32 +153,81 @@ fn summary_of_real_capture() {
     assert!(text.contains("2 checksum failures, 2 lost packets, 1 duplicate packets"));
 }
 
+/// The Platinum captures, told from their bytes (no `--protocol`): every frame decoded, as the
+/// golden files hold them (`UPDATE_GOLDEN=1` rewrites them), and their summaries' figures.
 #[test]
-fn other_protocols_give_no_frames_and_say_so() {
-    for name in ["platinum-v4.csv", "platinum-pro-v3.csv"] {
+fn platinum_captures_decode_exactly() {
+    for (name, protocol, frames, info, first, last) in [
+        ("platinum-v4.csv", "hw-v4", 297, 26, 817, 1113),
+        ("platinum-pro-v3.csv", "hw-v3", 699, 0, 0, 698),
+    ] {
         let path = capture(name);
         let path = path.to_str().unwrap();
         let out = run(&["decode", path]);
-        assert!(out.stdout.is_empty(), "{name}");
-        assert_eq!(out.status.code(), Some(1), "{name}");
-        let err = String::from_utf8_lossy(&out.stderr);
-        assert!(err.contains("no valid HW-FOC frames"), "{err}");
+        assert!(out.status.success(), "{name}");
+        let jsonl = stdout(&out);
+        let records: Vec<Value> = jsonl
+            .lines()
+            .map(|l| serde_json::from_str(l).unwrap())
+            .collect();
+        assert_eq!(records.len(), frames, "{name}");
+        assert!(records.iter().all(|r| r["protocol"] == protocol), "{name}");
+        let packets: Vec<u64> = records
+            .iter()
+            .map(|r| r["packet"].as_u64().unwrap())
+            .collect();
+        assert_eq!(packets, (first..=last).collect::<Vec<u64>>(), "{name}");
+        let peak = records
+            .iter()
+            .filter_map(|r| r["throttle_in_pct"].as_f64())
+            .fold(0.0, f64::max);
+        check_golden(&name.replace(".csv", ".jsonl"), &jsonl);
 
         let out = run(&["summary", "--json", path]);
-        assert_eq!(out.status.code(), Some(1), "{name}");
-        let v: Value = serde_json::from_slice(&out.stdout).unwrap();
-        let v = &v["escs"][0];
-        assert_eq!(v["frames"], 0, "{name}");
-        assert_eq!(v["info_frames"], 0, "{name}");
-        assert_eq!(
-            v["warning"],
-            "no valid HW-FOC frames: check the baud rate (19200) and the wiring"
+        assert!(out.status.success(), "{name}");
+        let text = stdout(&out);
+        let v: Value = serde_json::from_str(&text).unwrap();
+        let esc = &v["escs"][0];
+        assert_eq!(esc["protocol"], protocol, "{name}");
+        assert_eq!(esc["frames"], frames, "{name}");
+        assert_eq!(esc["info_frames"], info, "{name}");
+        assert_eq!(esc["link"]["bytes_skipped"], 0, "{name}");
+        assert_eq!(esc["link"]["rejected_candidates"], 0, "{name}");
+        assert_eq!(esc["link"]["checksum_failures"], Value::Null, "{name}");
+        assert_eq!(esc["link"]["lost_packets"], 0, "{name}");
+        assert_eq!(esc["warning"], Value::Null, "{name}");
+        if protocol == "hw-v4" {
+            // A 3S pack; throttle peaks at exactly full scale (1000 of 1000).
+            assert_eq!(peak, 100.0);
+            let volts = &esc["fields"]["voltage_v"];
+            let (min, max) = (
+                volts["min"].as_f64().unwrap(),
+                volts["max"].as_f64().unwrap(),
+            );
+            assert!(
+                (11.865..11.875).contains(&min) && (12.015..12.025).contains(&max),
+                "{volts}"
+            );
+            assert_eq!(esc["fields"]["current_a"]["min"], Value::Null);
+            assert_eq!(esc["fields"]["phase_current_a"]["min"], Value::Null);
+        } else {
+            assert_eq!(esc["fields"]["voltage_v"]["min"], Value::Null);
+        }
+        let portable = text.replace(
+            &serde_json::to_string(path).unwrap(),
+            &format!("\"{name}\""),
         );
-        let text = String::from_utf8(run(&["summary", path]).stdout).unwrap();
-        assert!(
-            text.contains("no valid HW-FOC frames: check the baud rate (19200) and the wiring")
-        );
+        check_golden(&name.replace(".csv", ".summary.json"), &portable);
     }
+    // Forced to read HW-FOC, the V4 capture has no frame of it, and says so.
+    let path = capture("platinum-v4.csv");
+    let out = run(&["decode", "--protocol", "hw-foc", path.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("no valid HW-FOC frames: check the baud rate (19200) and the wiring"),
+        "{err}"
+    );
 }
 
 /// A file that is not telemetry is named as such, not blamed on the baud rate and the wiring

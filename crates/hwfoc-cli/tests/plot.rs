@@ -430,7 +430,7 @@ fn bad_outputs_and_empty_inputs_are_errors() {
         existing.to_str().unwrap(),
     ]);
     assert_fails_with(&o, "nothing to plot");
-    assert_fails_with(&o, "no valid HW-FOC frames");
+    assert_fails_with(&o, "no valid frame of any Hobbywing format");
     assert_eq!(std::fs::read(&existing).unwrap(), b"an older plot");
     let o = run(&["plot", &dir.arg("absent.pcapng"), "-o", &dir.arg("y.svg")]);
     assert_fails_with(&o, "cannot open");

@@ -347,7 +347,7 @@ fn an_unknown_protocol_is_a_usage_error_listing_the_names() {
     ] {
         let out = hwfoc()
             .args(&args)
-            .args(["--protocol", "hw5"])
+            .args(["--protocol", "hw6"])
             .output()
             .unwrap();
         assert_eq!(out.status.code(), Some(2), "{args:?}");
@@ -355,16 +355,17 @@ fn an_unknown_protocol_is_a_usage_error_listing_the_names() {
         let err = String::from_utf8_lossy(&out.stderr);
         let first = err.lines().next().unwrap_or_default();
         assert!(
-            first.contains("invalid value 'hw5' for '--protocol"),
+            first.contains("invalid value 'hw6' for '--protocol"),
             "{err}"
         );
-        assert!(err.contains("hw-foc, datalink"), "{err}");
+        assert!(err.contains("hw-foc, datalink, hw-v4, hw-v3, hw5"), "{err}");
         assert!(!dir.path("p.png").exists());
 
         let help = stdout(&hwfoc().arg(args[0]).arg("--help").output().unwrap());
         assert!(
             help.contains("--protocol <NAME>")
-                && help.contains("datalink: DataLink V2, 115200 baud"),
+                && help.contains("datalink: DataLink V2, 115200 baud")
+                && help.contains("hw5:      HW5, 115200 baud"),
             "{help}"
         );
     }

@@ -477,7 +477,10 @@ fn wrong_baud_rate_is_named() {
         pty.master.write_all(&noise).unwrap();
         thread::sleep(Duration::from_millis(50));
     }
-    let line = rec.wait_for("no valid HW-FOC frame", Duration::from_secs(5));
+    let line = rec.wait_for(
+        "no valid frame of any Hobbywing format",
+        Duration::from_secs(5),
+    );
     assert!(
         line.contains("baud rate") && line.contains("TX/RX"),
         "{line}"

@@ -12,6 +12,7 @@
 use std::any::Any;
 
 use hwfoc::Settings;
+use hwfoc::foc::DataFrame;
 use hwfoc::telemetry::{Data, Frame, Info};
 
 use crate::input::InputError;
@@ -56,14 +57,17 @@ pub trait Handler {
     /// decoder's loop, as by default.
     const TAKES_RUNS: bool = false;
 
-    /// Data frames of ESC `esc`, one after another, without receive times (a raw input's),
-    /// for a handler that [`takes runs`](Handler::TAKES_RUNS): what handing each to
-    /// [`Handler::frame`] in turn does, which the default does. A handler that gathers
-    /// statistics takes them in a loop of its own.
+    /// HW-FOC data frames of ESC `esc`'s own wire, one after another, without receive times
+    /// (a raw input's), for a handler that [`takes runs`](Handler::TAKES_RUNS): what handing
+    /// each to [`Handler::frame`] in turn (as [`Data::HwFoc`]) does, which the default does. A
+    /// handler that gathers statistics takes them in a loop of its own. (The bulk path of the
+    /// format of nearly every large file: its frames as the codec's HW-FOC type, whose readings
+    /// are known at compile time and which is half the size of a [`Data`]; frames of every
+    /// other format come through [`Handler::frame`].)
     #[inline]
-    fn untimed_data(&mut self, esc: u8, frames: &[Data], settings: &Settings) {
+    fn untimed_data(&mut self, esc: u8, frames: &[DataFrame], settings: &Settings) {
         for f in frames {
-            self.frame(esc, None, &Frame::Data(*f), settings);
+            self.frame(esc, None, &Frame::Data(Data::HwFoc(*f)), settings);
         }
     }
 
@@ -99,7 +103,7 @@ pub trait LaterPart: Send {
     fn frame(&mut self, esc: u8, frame: &Frame, settings: &Settings);
 
     /// Data frames of ESC `esc`, as [`Handler::untimed_data`] takes them.
-    fn untimed_data(&mut self, esc: u8, frames: &[Data], settings: &Settings);
+    fn untimed_data(&mut self, esc: u8, frames: &[DataFrame], settings: &Settings);
 
     /// The part, for its handler's [`Handler::join`].
     fn into_any(self: Box<Self>) -> Box<dyn Any + Send>;
@@ -133,7 +137,7 @@ where
     }
 
     #[inline]
-    fn untimed_data(&mut self, esc: u8, frames: &[Data], settings: &Settings) {
+    fn untimed_data(&mut self, esc: u8, frames: &[DataFrame], settings: &Settings) {
         self.0.untimed_data(esc, frames, settings);
         self.1.untimed_data(esc, frames, settings);
     }

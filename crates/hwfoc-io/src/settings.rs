@@ -136,6 +136,7 @@ impl SettingsPatch {
             current_scale: self.current_scale.unwrap_or_default(),
             pole_pairs: self.pole_pairs.unwrap_or_default(),
             gear_ratio: self.gear_ratio.unwrap_or_default(),
+            ..Settings::DEFAULT
         });
         values
             .into_iter()

@@ -5,11 +5,10 @@
 //! port events). [`crate::clock::byte_times`] is the one place where a chunk's receive time
 //! becomes the time of each of its bytes.
 
-use hwfoc::counters::PacketSequence;
-use hwfoc::datalink;
-use hwfoc::mixed;
+use hwfoc::counters::{PacketSequence, PacketSequence24};
 use hwfoc::telemetry::{Data, Frame};
 use hwfoc::{Protocol, Settings, foc};
+use hwfoc::{datalink, detect, hw5, mixed, v3, v4};
 
 use crate::clock::byte_times;
 use crate::esc_numbers::UNNUMBERED;
@@ -33,18 +32,29 @@ const TIME_HISTORY: usize = if hwfoc::foc::MAX_FRAME_LEN > datalink::FRAME_LEN {
 /// least every 364 ms (idle), and a read may return a little late.
 pub const SILENCE_S: f64 = crate::clock::MAX_STEP_S;
 
-/// The most data frames a silence of `seconds` can have hidden: one per 24 byte times, the
-/// fastest the line carries them (real ESCs send one every 50 ms at most).
-fn frames_in(seconds: f64) -> u32 {
-    let frame_s = 24.0 * hwfoc::wire::byte_ns(hwfoc::foc::BAUD_RATE) * 1e-9;
+/// The most data frames of `protocol` a silence of `seconds` can have hidden: one per frame
+/// length of byte times at its baud rate, the fastest the line carries them (real ESCs send
+/// far fewer).
+fn frames_in_of(protocol: Protocol, seconds: f64) -> u32 {
+    let len = match protocol {
+        Protocol::HwFoc => foc::kinds::data::DATA_FRAME_LEN,
+        Protocol::DataLink => datalink::FRAME_LEN,
+        Protocol::HwV4 => v4::DATA_FRAME_LEN,
+        Protocol::HwV3 => v3::FRAME_LEN,
+        Protocol::Hw5 => hw5::TELEMETRY_LEN,
+    };
+    let frame_s = len as f64 * hwfoc::wire::byte_ns(protocol.baud_rate()) * 1e-9;
     (seconds / frame_s).ceil().min(f64::from(u32::MAX)) as u32
 }
 
-/// The most DataLink frames a silence of `seconds` can have hidden: one per 160 byte times at
-/// the hub's 115200 baud.
+/// The most HW-FOC data frames a silence of `seconds` can have hidden (see [`frames_in_of`]).
+fn frames_in(seconds: f64) -> u32 {
+    frames_in_of(Protocol::HwFoc, seconds)
+}
+
+/// The most DataLink frames a silence of `seconds` can have hidden (see [`frames_in_of`]).
 fn hub_frames_in(seconds: f64) -> u32 {
-    let frame_s = datalink::FRAME_LEN as f64 * hwfoc::wire::byte_ns(datalink::BAUD_RATE) * 1e-9;
-    (seconds / frame_s).ceil().min(f64::from(u32::MAX)) as u32
+    frames_in_of(Protocol::DataLink, seconds)
 }
 
 /// Which protocols a stream has been heard speaking, from the frames found so far.
@@ -58,6 +68,8 @@ pub enum WireKind {
     Hub,
     /// Both, one after the other (an adapter moved between an ESC and a hub).
     Mixed,
+    /// One ESC's own wire of another format: Hobbywing V4, V3 or HW5 (the last one found).
+    Other(Protocol),
 }
 
 /// Hands each ESC frame of a hub frame on as `(channel, offset, frame)`, at the hub frame's
@@ -78,36 +90,96 @@ fn hub_records(d: &datalink::Decoded, emit: &mut impl FnMut(Option<u8>, u64, &Fr
 /// stream offset of its first byte. The one place where the codec's protocol frames become
 /// neutral frames.
 #[inline(always)]
-fn emit_mixed(d: mixed::Decoded, emit: &mut impl FnMut(Option<u8>, u64, &Frame)) {
+fn emit_any(d: detect::Decoded, emit: &mut impl FnMut(Option<u8>, u64, &Frame)) {
     match d {
-        mixed::Decoded::Esc(d) => emit(None, d.offset, &Frame::from(d.frame)),
-        mixed::Decoded::Hub(d) => hub_records(&d, emit),
+        detect::Decoded::Mixed(mixed::Decoded::Esc(d)) => {
+            emit(None, d.offset, &Frame::from(d.frame))
+        }
+        detect::Decoded::Mixed(mixed::Decoded::Hub(d)) => hub_records(&d, emit),
+        other => emit_other(other, emit),
+    }
+}
+
+/// [`emit_any`] for the formats of ESCs that send at most about 50 frames a second (V4, V3,
+/// HW5): out of line, so that the loop of an HW-FOC stream holds none of it.
+#[cold]
+#[inline(never)]
+fn emit_other(d: detect::Decoded, emit: &mut impl FnMut(Option<u8>, u64, &Frame)) {
+    match d {
+        detect::Decoded::HwV4(d) => emit(None, d.offset, &Frame::from(d.frame)),
+        detect::Decoded::HwV3(d) => emit(None, d.offset, &Frame::Data(Data::HwV3(d.frame))),
+        detect::Decoded::Hw5(d) => emit(None, d.offset, &Frame::Data(Data::Hw5(d.frame))),
+        detect::Decoded::Mixed(d) => match d {
+            mixed::Decoded::Esc(d) => emit(None, d.offset, &Frame::from(d.frame)),
+            mixed::Decoded::Hub(d) => hub_records(&d, emit),
+        },
     }
 }
 
 /// The decoder of a stream: of every protocol at once (the bytes tell which), or of the one
-/// protocol a user forced.
+/// protocol a user forced. (Its arms' sizes differ, a few hundred bytes at most: one per
+/// stream, held inline, so that the decoder of every byte is not behind a pointer.)
 #[derive(Debug)]
+#[allow(clippy::large_enum_variant)]
 enum Wire {
-    /// Every protocol, in byte order ([`mixed::Decoder`]).
-    Any(mixed::Decoder),
+    /// Every protocol ([`detect::Decoder`]).
+    Any(detect::Decoder),
     /// HW-FOC only.
     HwFoc(foc::Decoder),
     /// DataLink V2 only.
     DataLink(datalink::Decoder),
+    /// Hobbywing V4 only.
+    HwV4(v4::Decoder),
+    /// Hobbywing V3 only.
+    HwV3(v3::Decoder),
+    /// HW5 only.
+    Hw5(hw5::Decoder),
+}
+
+/// Calls `$body` with `$d` bound to the forced protocol's decoder and `$wrap` to the function
+/// making its frames [`detect::Decoded`], for each forced arm of [`Wire`].
+macro_rules! each_forced {
+    ($wire:expr, $any:pat => $any_body:expr, |$d:ident, $wrap:ident| $body:expr) => {
+        match $wire {
+            $any => $any_body,
+            Wire::HwFoc($d) => {
+                let $wrap = |d| detect::Decoded::Mixed(mixed::Decoded::Esc(d));
+                $body
+            }
+            Wire::DataLink($d) => {
+                let $wrap = |d| detect::Decoded::Mixed(mixed::Decoded::Hub(d));
+                $body
+            }
+            Wire::HwV4($d) => {
+                let $wrap = detect::Decoded::HwV4;
+                $body
+            }
+            Wire::HwV3($d) => {
+                let $wrap = detect::Decoded::HwV3;
+                $body
+            }
+            Wire::Hw5($d) => {
+                let $wrap = detect::Decoded::Hw5;
+                $body
+            }
+        }
+    };
 }
 
 impl Wire {
     fn new(forced: Option<Protocol>) -> Wire {
         match forced {
-            None => Wire::Any(mixed::Decoder::new()),
+            None => Wire::Any(detect::Decoder::new()),
             Some(Protocol::HwFoc) => Wire::HwFoc(foc::Decoder::new()),
             Some(Protocol::DataLink) => Wire::DataLink(datalink::Decoder::new()),
+            Some(Protocol::HwV4) => Wire::HwV4(v4::Decoder::new()),
+            Some(Protocol::HwV3) => Wire::HwV3(v3::Decoder::new()),
+            Some(Protocol::Hw5) => Wire::Hw5(hw5::Decoder::new()),
         }
     }
 
     /// Decodes `data` (ending with a silence of the line of `silence_s` seconds when given):
-    /// `emit(channel, offset, frame)` gets each ESC frame as [`emit_mixed`] hands it on.
+    /// `emit(channel, offset, frame)` gets each ESC frame as [`emit_any`] hands it on.
     #[inline(always)]
     fn feed(
         &mut self,
@@ -116,7 +188,8 @@ impl Wire {
         mut emit: impl FnMut(Option<u8>, u64, &Frame),
     ) {
         let emit = &mut emit;
-        match self {
+        let forced = self.forced();
+        each_forced!(self,
             // The closures inlined into the scanner's loop, so that the handler may be too: a
             // frame's fields then reach it in registers, not through a frame stored and loaded
             // back.
@@ -124,67 +197,69 @@ impl Wire {
                 d.feed(
                     data,
                     #[inline(always)]
-                    |d| emit_mixed(d, emit),
+                    |d| emit_any(d, emit),
                 );
                 if let Some(s) = silence_s {
-                    d.line_silent_each(frames_in(s), hub_frames_in(s), |d| emit_mixed(d, emit));
+                    d.line_silent_each(frames_in(s), hub_frames_in(s), |d| emit_any(d, emit));
                 }
+            },
+            |d, wrap| {
+                let silent = silence_s.zip(forced).map(|(s, p)| frames_in_of(p, s));
+                feed_one(d, data, silent, wrap, emit)
             }
-            Wire::HwFoc(d) => {
-                feed_one(d, data, silence_s.map(frames_in), mixed::Decoded::Esc, emit)
-            }
-            Wire::DataLink(d) => feed_one(
-                d,
-                data,
-                silence_s.map(hub_frames_in),
-                mixed::Decoded::Hub,
-                emit,
-            ),
-        }
+        )
     }
 
     /// Ends the stream, handing on what the held bytes still hold.
     fn flush(&mut self, emit: &mut impl FnMut(Option<u8>, u64, &Frame)) {
-        match self {
-            Wire::Any(d) => d.flush(|d| emit_mixed(d, emit)),
-            Wire::HwFoc(d) => d.flush(|d| emit_mixed(mixed::Decoded::Esc(d), emit)),
-            Wire::DataLink(d) => d.flush(|d| emit_mixed(mixed::Decoded::Hub(d), emit)),
-        }
+        each_forced!(self,
+            Wire::Any(d) => d.flush(|d| emit_any(d, emit)),
+            |d, wrap| d.flush(|d| emit_any(wrap(d), emit))
+        )
     }
 
     /// Every byte fed so far.
     fn bytes(&self) -> u64 {
-        match self {
-            Wire::Any(d) => d.stats().bytes(),
-            Wire::HwFoc(d) => d.stats().bytes(),
-            Wire::DataLink(d) => d.stats().bytes(),
-        }
+        each_forced!(self, Wire::Any(d) => d.bytes(), |d, _w| d.stats().bytes())
     }
 
     /// Bytes held for a frame still arriving.
     fn buffered(&self) -> usize {
-        match self {
-            Wire::Any(d) => d.buffered(),
-            Wire::HwFoc(d) => d.buffered(),
-            Wire::DataLink(d) => d.buffered(),
-        }
+        each_forced!(self, Wire::Any(d) => d.buffered(), |d, _w| d.buffered())
     }
 
-    /// The HW-FOC statistics, unless only DataLink is read.
+    /// The HW-FOC statistics, unless another protocol is forced.
     fn esc(&self) -> Option<&foc::Stats> {
         match self {
-            Wire::Any(d) => Some(&d.stats().esc),
+            Wire::Any(d) => Some(&d.mixed_stats().esc),
             Wire::HwFoc(d) => Some(d.stats()),
-            Wire::DataLink(_) => None,
+            _ => None,
         }
     }
 
-    /// The DataLink statistics, unless only HW-FOC is read.
+    /// The DataLink statistics, unless another protocol is forced.
     fn hub(&self) -> Option<&datalink::Stats> {
         match self {
-            Wire::Any(d) => Some(&d.stats().hub),
-            Wire::HwFoc(_) => None,
+            Wire::Any(d) => Some(&d.mixed_stats().hub),
             Wire::DataLink(d) => Some(d.stats()),
+            _ => None,
+        }
+    }
+
+    /// The link of another format (V4, V3, HW5) when the stream is read as it: forced, or
+    /// the format last locked onto.
+    fn other(&self) -> Option<EscLink> {
+        match self {
+            Wire::Any(d) => match d.last_locked()? {
+                detect::Family::Mixed => None,
+                detect::Family::HwV4 => Some(EscLink::HwV4(*d.v4_stats())),
+                detect::Family::HwV3 => Some(EscLink::HwV3(*d.v3_stats())),
+                detect::Family::Hw5 => Some(EscLink::Hw5(*d.hw5_stats())),
+            },
+            Wire::HwV4(d) => Some(EscLink::HwV4(*d.stats())),
+            Wire::HwV3(d) => Some(EscLink::HwV3(*d.stats())),
+            Wire::Hw5(d) => Some(EscLink::Hw5(*d.stats())),
+            Wire::HwFoc(_) | Wire::DataLink(_) => None,
         }
     }
 
@@ -194,28 +269,31 @@ impl Wire {
             Wire::Any(_) => None,
             Wire::HwFoc(_) => Some(Protocol::HwFoc),
             Wire::DataLink(_) => Some(Protocol::DataLink),
+            Wire::HwV4(_) => Some(Protocol::HwV4),
+            Wire::HwV3(_) => Some(Protocol::HwV3),
+            Wire::Hw5(_) => Some(Protocol::Hw5),
         }
     }
 }
 
 /// Decodes `data` with one protocol's decoder (ending with a silence of the line in which at
-/// most `silent` of its frames fit, when given): each frame, made a [`mixed::Decoded`] by
-/// `wrap`, is handed on as [`emit_mixed`] does.
+/// most `silent` of its frames fit, when given): each frame, made a [`detect::Decoded`] by
+/// `wrap`, is handed on as [`emit_any`] does.
 #[inline(always)]
 fn feed_one<S: hwfoc::scan::Scanner>(
     decoder: &mut hwfoc::StreamDecoder<S>,
     data: &[u8],
     silent: Option<u32>,
-    wrap: impl Fn(S::Item) -> mixed::Decoded,
+    wrap: impl Fn(S::Item) -> detect::Decoded,
     emit: &mut impl FnMut(Option<u8>, u64, &Frame),
 ) {
     decoder.feed(
         data,
         #[inline(always)]
-        |d| emit_mixed(wrap(d), emit),
+        |d| emit_any(wrap(d), emit),
     );
     if let Some(frames) = silent {
-        decoder.line_silent(frames, |d| emit_mixed(wrap(d), emit));
+        decoder.line_silent(frames, |d| emit_any(wrap(d), emit));
     }
 }
 
@@ -223,7 +301,7 @@ fn feed_one<S: hwfoc::scan::Scanner>(
 /// (whose bytes, skipped bytes and CRC failures are the hub link's, shared by its channels).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum EscLink {
-    /// An ESC on its own wire (or a stream whose protocol is not known yet).
+    /// An ESC on its own HW-FOC wire (or a stream whose protocol is not known yet).
     Wire(foc::Stats),
     /// Channel `channel` of a DataLink hub.
     Hub {
@@ -232,6 +310,12 @@ pub enum EscLink {
         /// The ESC's channel.
         channel: usize,
     },
+    /// A Hobbywing V4 ESC's wire.
+    HwV4(v4::Stats),
+    /// A Hobbywing V3 ESC's wire.
+    HwV3(v3::Stats),
+    /// An HW5 ESC's wire.
+    Hw5(hw5::Stats),
 }
 
 impl Default for Stream {
@@ -246,11 +330,31 @@ impl Default for EscLink {
     }
 }
 
+/// The packet counting of a link: 16 bits (HW-FOC, DataLink) or 24 (V3, V4).
+enum Counting<'a> {
+    Bits16(&'a PacketSequence),
+    Bits24(&'a PacketSequence24),
+}
+
 impl EscLink {
-    fn channel(&self) -> Option<&PacketSequence> {
+    fn counting(&self) -> Option<Counting<'_>> {
         match self {
-            EscLink::Wire(s) => Some(s.packets()),
-            EscLink::Hub { hub, channel } => hub.channel(*channel),
+            EscLink::Wire(s) => Some(Counting::Bits16(s.packets())),
+            EscLink::Hub { hub, channel } => hub.channel(*channel).map(Counting::Bits16),
+            EscLink::HwV4(s) => Some(Counting::Bits24(s.counter())),
+            EscLink::HwV3(s) => Some(Counting::Bits24(s.counter())),
+            EscLink::Hw5(_) => None,
+        }
+    }
+
+    /// The protocol of the link's frames.
+    pub fn protocol(&self) -> Protocol {
+        match self {
+            EscLink::Wire(_) => Protocol::HwFoc,
+            EscLink::Hub { .. } => Protocol::DataLink,
+            EscLink::HwV4(_) => Protocol::HwV4,
+            EscLink::HwV3(_) => Protocol::HwV3,
+            EscLink::Hw5(_) => Protocol::Hw5,
         }
     }
 
@@ -259,61 +363,129 @@ impl EscLink {
         match self {
             EscLink::Wire(s) => s.bytes(),
             EscLink::Hub { hub, .. } => hub.bytes(),
+            EscLink::HwV4(s) => s.bytes(),
+            EscLink::HwV3(s) => s.bytes(),
+            EscLink::Hw5(s) => s.bytes(),
         }
     }
 
-    /// Bytes of that stream that were in no accepted frame.
+    /// Bytes of that stream that were in no accepted frame (of the link's protocol; an HW5
+    /// wire's other frame kinds, requests and answers, are not skipped).
     pub fn bytes_skipped(&self) -> u64 {
         match self {
             EscLink::Wire(s) => s.bytes_skipped(),
             EscLink::Hub { hub, .. } => hub.bytes_skipped(),
+            EscLink::HwV4(s) => s.bytes_skipped(),
+            EscLink::HwV3(s) => s.bytes_skipped(),
+            EscLink::Hw5(s) => s.bytes_skipped(),
         }
     }
 
     /// Data frames of the ESC (records of its channel, behind a hub).
     pub fn frames(&self) -> u32 {
-        self.channel().map_or(0, PacketSequence::count)
-    }
-
-    /// Device-information frames (a hub forwards none).
-    pub fn info_frames(&self) -> u32 {
         match self {
-            EscLink::Wire(s) => s.info_frames(),
-            EscLink::Hub { .. } => 0,
+            EscLink::HwV4(s) => s.frames(),
+            EscLink::HwV3(s) => s.frames(),
+            EscLink::Hw5(s) => s.telemetry_frames(),
+            _ => match self.counting() {
+                Some(Counting::Bits16(c)) => c.count(),
+                Some(Counting::Bits24(c)) => c.count(),
+                None => 0,
+            },
         }
     }
 
-    /// Frames rejected by their checksum (behind a hub: the hub frames' CRC failures).
+    /// Device-information frames (V4: info frames; a hub forwards none).
+    pub fn info_frames(&self) -> u32 {
+        match self {
+            EscLink::Wire(s) => s.info_frames(),
+            EscLink::HwV4(s) => s.info_frames(),
+            EscLink::Hub { .. } | EscLink::HwV3(_) | EscLink::Hw5(_) => 0,
+        }
+    }
+
+    /// Whether the link's frames carry a checksum (V3 and V4 do not: their frames are
+    /// recognised by plausibility and chaining, see [`EscLink::rejected_frames`]).
+    pub fn has_checksum(&self) -> bool {
+        !matches!(self, EscLink::HwV4(_) | EscLink::HwV3(_))
+    }
+
+    /// Frames rejected by their checksum (behind a hub: the hub frames' CRC failures; 0 for a
+    /// format without checksum).
     pub fn checksum_failures(&self) -> u32 {
         match self {
             EscLink::Wire(s) => s.checksum_failures(),
             EscLink::Hub { hub, .. } => hub.crc_failures(),
+            EscLink::Hw5(s) => s.crc_failures(),
+            EscLink::HwV4(_) | EscLink::HwV3(_) => 0,
         }
+    }
+
+    /// Candidates of a format without checksum that were not taken: implausible, or not
+    /// confirmed by a chain (`None` for a checksummed format).
+    pub fn rejected_frames(&self) -> Option<u32> {
+        match self {
+            EscLink::HwV4(s) => Some(s.rejected()),
+            EscLink::HwV3(s) => Some(s.rejected()),
+            _ => None,
+        }
+    }
+
+    /// Whether the link's frames carry a packet counter, from which loss is counted (HW5's
+    /// do not: its lost, duplicate and restart counts are 0 and say nothing).
+    pub fn counts_packets(&self) -> bool {
+        self.protocol().packet_bits().is_some()
     }
 
     /// Packet numbers skipped.
     pub fn lost_packets(&self) -> u32 {
-        self.channel().map_or(0, PacketSequence::lost)
+        match self.counting() {
+            Some(Counting::Bits16(c)) => c.lost(),
+            Some(Counting::Bits24(c)) => c.lost(),
+            None => 0,
+        }
     }
 
     /// Packet numbers received twice in a row.
     pub fn duplicate_packets(&self) -> u32 {
-        self.channel().map_or(0, PacketSequence::duplicates)
+        match self.counting() {
+            Some(Counting::Bits16(c)) => c.duplicates(),
+            Some(Counting::Bits24(c)) => c.duplicates(),
+            None => 0,
+        }
     }
 
     /// Jumps of the packet numbers that no loss explains.
     pub fn restarts(&self) -> u32 {
-        self.channel().map_or(0, PacketSequence::restarts)
+        match self.counting() {
+            Some(Counting::Bits16(c)) => c.restarts(),
+            Some(Counting::Bits24(c)) => c.restarts(),
+            None => 0,
+        }
     }
 
     /// The last packet number received.
-    pub fn last_packet(&self) -> Option<u16> {
-        self.channel().and_then(PacketSequence::last)
+    pub fn last_packet(&self) -> Option<u32> {
+        match self.counting()? {
+            Counting::Bits16(c) => c.last().map(u32::from),
+            Counting::Bits24(c) => c.last(),
+        }
     }
 
     /// Frames received over frames sent, from the packet numbers.
     pub fn delivery_ratio(&self) -> Option<f64> {
-        self.channel().and_then(PacketSequence::delivery_ratio)
+        match self.counting()? {
+            Counting::Bits16(c) => c.delivery_ratio(),
+            Counting::Bits24(c) => c.delivery_ratio(),
+        }
+    }
+
+    /// The V4 info frame whose constants were adopted (two identical copies in a row), if any.
+    pub fn adopted_info(&self) -> Option<v4::InfoFrame> {
+        match self {
+            EscLink::HwV4(s) => s.adopted(),
+            _ => None,
+        }
     }
 }
 
@@ -430,6 +602,8 @@ impl Stream {
         }
         match (&mut self.wire, &later.wire) {
             (Wire::Any(a), Wire::Any(b)) => a.then(b, first_packet),
+            // V3 and V4 chains are state beyond the held bytes; HW5 is read in one too (the
+            // summary of an HW5 file does not need two cores).
             (Wire::HwFoc(a), Wire::HwFoc(b)) => a.then(b, first_packet),
             (Wire::DataLink(a), Wire::DataLink(b)) => a.then(b, first_packet),
             _ => false,
@@ -450,6 +624,13 @@ impl Stream {
 
     /// Which protocols the stream has been heard speaking.
     pub fn kind(&self) -> WireKind {
+        if let Some(link) = self
+            .wire
+            .other()
+            .filter(|l| l.frames() + l.info_frames() > 0)
+        {
+            return WireKind::Other(link.protocol());
+        }
         match (self.esc_frames(), self.hub_frames()) {
             (false, false) => WireKind::Unknown,
             (true, false) => WireKind::Esc,
@@ -481,6 +662,9 @@ impl Stream {
     /// statistics are then given), else the ESC's own wire (any channel). A stream forced to
     /// read DataLink only gives the hub's channel from its first byte.
     pub fn link(&self, channel: u8) -> EscLink {
+        if let Some(link) = self.wire.other() {
+            return link;
+        }
         let esc = self.wire.esc();
         let from_hub = esc.is_none() || self.hub_frames() && (channel != 0 || !self.esc_frames());
         match self.wire.hub().filter(|_| from_hub) {
@@ -839,7 +1023,10 @@ mod mixed_tests {
         let mut got = Vec::new();
         let mut on = |_: Option<f64>, channel: Option<u8>, frame: &Frame| {
             if let Frame::Data(f) = frame {
-                got.push((channel, f.to_hwfoc().packet));
+                got.push((
+                    channel,
+                    hwfoc::Telemetry::packet(f).unwrap_or_default() as u16,
+                ));
             }
         };
         for b in wire.chunks(chunk) {

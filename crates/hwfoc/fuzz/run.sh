@@ -3,9 +3,10 @@
 #
 #   crates/hwfoc/fuzz/run.sh [DURATION]
 #
-# Seven targets: stream, bulk (HW-FOC), datalink, v3, v4, hw5, dronecan. The whole run takes
-# 7 x DURATION seconds of fuzzing plus the build: at 30 s (CI), 210 s of fuzzing, and about
-# 1.5 minutes to build the targets the first time on a 2-core machine (seconds once built).
+# Eight targets: stream, bulk (HW-FOC), datalink, v3, v4, hw5, detect (every serial format at
+# once), dronecan. The whole run takes 8 x DURATION seconds of fuzzing plus the build: at 30 s
+# (CI), 240 s of fuzzing, and about 1.5 minutes to build the targets the first time on a 2-core
+# machine (seconds once built).
 #
 # Needs cargo-fuzz (installed here with `cargo install cargo-fuzz --locked` when missing: about
 # a minute on a 2-core machine) and a nightly toolchain. Without nightly (a machine whose rustup
@@ -186,6 +187,10 @@ for target in $(cargo "${toolchain[@]}" fuzz list); do
     v4) seed_new "$target" '\x00\x07' "v4-idle=$v4_slow" "v4-stream=$v4_stream" ;;
     hw5) seed_new "$target" '\x00\x07' "hw5-stream=$hw5_stream" "hw5-others=$hw5_others" \
         "hw5-parameters-read=$hw5_read" "hw5-device-info=$hw5_device_info" ;;
+    # detect: the same schedule layout; every format's seeds, and streams that change format.
+    detect) seed_new "$target" '\x00\x07' "v3-then-v4=$v3_stream$v4_stream" \
+        "v4-then-hwfoc=$v4_slow$seed_stream" "hw5-then-v3=$hw5_stream$v3_chain" \
+        "datalink-then-hw5=$datalink_stream$hw5_others" ;;
     # dronecan: records of CAN frames and of transfers to encode (no schedule).
     dronecan) seed_new "$target" '' "can-extended=$can_extended" \
         "can-socketcan=$can_socketcan" "can-messages=$can_messages" ;;

@@ -6,6 +6,7 @@
 mod chain;
 pub mod counters;
 pub mod datalink;
+pub mod detect;
 pub mod dronecan;
 pub mod foc;
 pub mod hw5;

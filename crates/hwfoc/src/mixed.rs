@@ -113,6 +113,11 @@ impl scan::Stats for Stats {
             .line_silent(u32::try_from(hub_frames).unwrap_or(u32::MAX));
     }
 
+    #[inline]
+    fn skip_bytes(&mut self, n: usize) {
+        self.skip(n);
+    }
+
     /// Joined when `later` found no hub frame: both protocols' statistics, each the sum of the
     /// two parts (the bytes in a frame of either are skipped bytes of neither).
     fn then(&mut self, later: &Self, first_packet: Option<u16>) -> bool {

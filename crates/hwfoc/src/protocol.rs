@@ -4,6 +4,9 @@
 
 use core::fmt;
 
+use crate::status::Status;
+use crate::units::Quantity;
+
 /// A wire protocol the codec reads.
 ///
 /// ```
@@ -19,25 +22,47 @@ pub enum Protocol {
     HwFoc,
     /// DataLink V2: a Hobbywing hub's frames of up to eight ESCs ([`crate::datalink`]).
     DataLink,
+    /// Platinum V4 (and Platinum Pro V4, FlyFun V5): `9B` data and info frames without checksum
+    /// ([`crate::v4`]).
+    HwV4,
+    /// Platinum V3 (and Platinum Pro V3): 10-byte `9B` frames without checksum ([`crate::v3`]).
+    HwV3,
+    /// HW5 (Platinum V5, VBAR firmware): `FE` frames with a CRC-16/MODBUS at 115200 baud
+    /// ([`crate::hw5`]).
+    Hw5,
 }
 
 impl Protocol {
     /// Every protocol, in the order they are listed to a user.
-    pub const ALL: [Protocol; 2] = [Protocol::HwFoc, Protocol::DataLink];
+    pub const ALL: [Protocol; 5] = [
+        Protocol::HwFoc,
+        Protocol::DataLink,
+        Protocol::HwV4,
+        Protocol::HwV3,
+        Protocol::Hw5,
+    ];
 
-    /// The protocol's name as users give it and outputs show it: `hw-foc`, `datalink`.
+    /// The protocol's name as users give it and outputs show it: `hw-foc`, `datalink`, `hw-v4`,
+    /// `hw-v3`, `hw5`.
     pub const fn name(self) -> &'static str {
         match self {
             Protocol::HwFoc => "hw-foc",
             Protocol::DataLink => "datalink",
+            Protocol::HwV4 => "hw-v4",
+            Protocol::HwV3 => "hw-v3",
+            Protocol::Hw5 => "hw5",
         }
     }
 
-    /// The protocol's name in prose: `HW-FOC`, `DataLink V2`.
+    /// The protocol's name in prose: `HW-FOC`, `DataLink V2`, `Hobbywing V4`, `Hobbywing V3`,
+    /// `HW5`.
     pub const fn title(self) -> &'static str {
         match self {
             Protocol::HwFoc => "HW-FOC",
             Protocol::DataLink => "DataLink V2",
+            Protocol::HwV4 => "Hobbywing V4",
+            Protocol::HwV3 => "Hobbywing V3",
+            Protocol::Hw5 => "HW5",
         }
     }
 
@@ -46,14 +71,19 @@ impl Protocol {
         match self {
             Protocol::HwFoc => crate::foc::BAUD_RATE,
             Protocol::DataLink => crate::datalink::BAUD_RATE,
+            Protocol::HwV4 => crate::v4::BAUD_RATE,
+            Protocol::HwV3 => crate::v3::BAUD_RATE,
+            Protocol::Hw5 => crate::hw5::BAUD_RATE,
         }
     }
 
     /// The width of its packet counter in bits (which it wraps at), or `None` for a protocol
-    /// that sends no counter: 16 for HW-FOC and DataLink.
+    /// that sends no counter: 16 for HW-FOC and DataLink, 24 for V3 and V4, none for HW5.
     pub const fn packet_bits(self) -> Option<u32> {
         match self {
             Protocol::HwFoc | Protocol::DataLink => Some(16),
+            Protocol::HwV4 | Protocol::HwV3 => Some(24),
+            Protocol::Hw5 => None,
         }
     }
 
@@ -70,6 +100,77 @@ impl Protocol {
             Some(bits) => Some(to.wrapping_sub(from) & (u32::MAX >> (32 - bits))),
             None => None,
         }
+    }
+
+    /// Whether this protocol's data frames carry `quantity` at all (a frame may still have no
+    /// value for it: a V3 start-up placeholder, a V4 temperature of 0, a V4 current before its
+    /// info frame): the columns and fields shown for an ESC of this protocol.
+    ///
+    /// ```
+    /// use hwfoc::{Protocol, Quantity};
+    ///
+    /// assert!(Protocol::HwFoc.carries(Quantity::PhaseCurrent));
+    /// assert!(!Protocol::HwV3.carries(Quantity::Voltage));
+    /// assert!(Protocol::Hw5.carries(Quantity::BecVoltage));
+    /// ```
+    pub const fn carries(self, quantity: Quantity) -> bool {
+        use Quantity as Q;
+        match self {
+            Protocol::HwFoc | Protocol::DataLink => !matches!(
+                quantity,
+                Q::MotorTemp | Q::BecTemp | Q::BecVoltage | Q::BecCurrent
+            ),
+            Protocol::HwV4 => !matches!(
+                quantity,
+                Q::PhaseCurrent | Q::MotorTemp | Q::BecTemp | Q::BecVoltage | Q::BecCurrent
+            ),
+            Protocol::HwV3 => matches!(quantity, Q::ThrottleIn | Q::ThrottleOut | Q::Erpm | Q::Rpm),
+            Protocol::Hw5 => !matches!(quantity, Q::ThrottleOut | Q::PhaseCurrent | Q::CapTemp),
+        }
+    }
+
+    /// Whether this protocol's data frames carry a fault word (a record's `status` and
+    /// `faults`): HW-FOC's and DataLink's sixteen status bits, HW5's eight fault bits.
+    pub const fn has_faults(self) -> bool {
+        matches!(self, Protocol::HwFoc | Protocol::DataLink | Protocol::Hw5)
+    }
+
+    /// The name of bit `bit` of this protocol's fault word ([`Status`] holds it), as every
+    /// output names it: HW-FOC's [`Fault`](crate::Fault), HW5's
+    /// [`hw5::Fault`](crate::hw5::Fault); `None` for a bit it does not define.
+    ///
+    /// ```
+    /// use hwfoc::Protocol;
+    ///
+    /// assert_eq!(Protocol::HwFoc.fault_name(14), Some("opamp_phase_a"));
+    /// assert_eq!(Protocol::Hw5.fault_name(3), Some("throttle_signal_lost"));
+    /// assert_eq!(Protocol::Hw5.fault_name(8), None);
+    /// ```
+    pub fn fault_name(self, bit: u8) -> Option<&'static str> {
+        match self {
+            Protocol::HwFoc | Protocol::DataLink => crate::Fault::from_bit(bit).map(|f| f.name()),
+            Protocol::Hw5 => crate::hw5::Fault::from_bit(bit).map(|f| f.name()),
+            Protocol::HwV4 | Protocol::HwV3 => None,
+        }
+    }
+
+    /// A short English description of bit `bit` of this protocol's fault word (see
+    /// [`Protocol::fault_name`]).
+    pub fn fault_description(self, bit: u8) -> Option<&'static str> {
+        match self {
+            Protocol::HwFoc | Protocol::DataLink => {
+                crate::Fault::from_bit(bit).map(|f| f.description())
+            }
+            Protocol::Hw5 => crate::hw5::Fault::from_bit(bit).map(|f| f.description()),
+            Protocol::HwV4 | Protocol::HwV3 => None,
+        }
+    }
+
+    /// The names of the bits set in `status`, a fault word of this protocol, in bit order.
+    pub fn fault_names(self, status: Status) -> impl Iterator<Item = &'static str> {
+        (0..16u8)
+            .filter(move |&bit| status.0 & (1 << bit) != 0)
+            .filter_map(move |bit| self.fault_name(bit))
     }
 
     /// The protocol named `name` (as [`Protocol::name`] spells it, any case).
@@ -105,5 +206,9 @@ mod tests {
         assert_eq!(Protocol::from_name("HW-FOC"), Some(Protocol::HwFoc));
         assert_eq!(Protocol::from_name("hwfoc"), None);
         assert_eq!(Protocol::DataLink.baud_rate(), 115_200);
+        assert_eq!(Protocol::Hw5.baud_rate(), 115_200);
+        assert_eq!(Protocol::HwV4.baud_rate(), 19_200);
+        assert_eq!(Protocol::HwV3.packets_between(0xFF_FFFF, 0), Some(1));
+        assert_eq!(Protocol::Hw5.packets_between(1, 2), None);
     }
 }

@@ -78,6 +78,9 @@ pub trait Stats: sealed::Sealed + Clone + fmt::Debug {
     /// sent (see [`StreamDecoder::line_silent`]).
     #[doc(hidden)]
     fn line_silent(&mut self, max_frames: u32);
+    /// Counts `n` bytes already given as skipped (in no frame).
+    #[doc(hidden)]
+    fn skip_bytes(&mut self, n: usize);
 
     /// These statistics followed by `later`'s ([`StreamDecoder::then`]): true when joined.
     /// False (the default, and nothing changes) for a scanner that keeps state beyond its held
@@ -176,6 +179,11 @@ macro_rules! impl_scanner {
 
             fn line_silent(&mut self, max_frames: u32) {
                 <$stats>::line_silent(self, max_frames);
+            }
+
+            #[inline]
+            fn skip_bytes(&mut self, n: usize) {
+                $crate::scan::SkipBytes::skip(self, n);
             }
         }
 
@@ -371,6 +379,23 @@ impl<S: Scanner> StreamDecoder<S> {
     pub fn line_silent(&mut self, max_frames: u32, on_frame: impl FnMut(S::Item)) {
         self.flush(on_frame);
         self.stats.line_silent(max_frames);
+    }
+
+    /// Passes over `n` bytes of the stream that this decoder is not given (another protocol's,
+    /// while [`crate::detect`] reads that one only): the bytes it holds and those `n` are
+    /// counted as skipped, so that its offsets and statistics stay the stream's. Whatever it
+    /// held is dropped (a frame of it cannot continue across bytes it did not see).
+    pub fn pass_over(&mut self, n: u64) {
+        let held = usize::from(self.len);
+        self.len = 0;
+        self.stats.skip_bytes(held);
+        let mut left = n;
+        while left > 0 {
+            let k = usize::try_from(left).unwrap_or(usize::MAX);
+            self.stats.add_bytes(k);
+            self.stats.skip_bytes(k);
+            left -= k as u64;
+        }
     }
 
     /// Continues this decoder with the work of `later`, a decoder started new at the stream

@@ -39,6 +39,12 @@ pub enum Conversion {
     /// An ADC code of the ESC's NTC thermistor, through the table of [`Temperature::from_adc`]:
     /// degC inside the table, no value outside it.
     AdcTable,
+    /// A 12-bit ADC code of a Hobbywing V4 ESC's NTC thermistor, through its formula
+    /// ([`crate::v4::ntc_celsius`]): no value for 0 (no reading).
+    Ntc,
+    /// A Hobbywing V4 current ADC code through its info frame's constants,
+    /// `adc * I1 / I2 - I3`, not below 0 ([`crate::v4::CurrentScale`]).
+    V4Current(crate::v4::CurrentScale),
 }
 
 impl Conversion {
@@ -51,6 +57,8 @@ impl Conversion {
             Conversion::AdcTable => u8::try_from(raw)
                 .ok()
                 .and_then(|code| Temperature::from_adc(code).celsius()),
+            Conversion::Ntc => u16::try_from(raw).ok().and_then(crate::v4::ntc_celsius),
+            Conversion::V4Current(scale) => u16::try_from(raw).ok().map(|adc| scale.amps(adc)),
         }
     }
 
@@ -60,7 +68,7 @@ impl Conversion {
     pub fn linear(self) -> Option<Linear> {
         match self {
             Conversion::Linear(linear) => Some(linear),
-            Conversion::AdcTable => None,
+            Conversion::AdcTable | Conversion::Ntc | Conversion::V4Current(_) => None,
         }
     }
 }
@@ -185,6 +193,33 @@ pub enum Data {
     HwFoc(DataFrame),
     /// A DataLink V2 hub's record of one ESC channel: the HW-FOC payload the hub forwards.
     DataLink(DataFrame),
+    /// A Hobbywing V4 data frame, with the info frame adopted when it was decoded.
+    HwV4(crate::v4::Data),
+    /// A Hobbywing V3 frame.
+    HwV3(crate::v3::Frame),
+    /// An HW5 telemetry frame.
+    Hw5(crate::hw5::TelemetryFrame),
+}
+
+impl From<crate::v4::Data> for Data {
+    #[inline]
+    fn from(data: crate::v4::Data) -> Data {
+        Data::HwV4(data)
+    }
+}
+
+impl From<crate::v3::Frame> for Data {
+    #[inline]
+    fn from(frame: crate::v3::Frame) -> Data {
+        Data::HwV3(frame)
+    }
+}
+
+impl From<crate::hw5::TelemetryFrame> for Data {
+    #[inline]
+    fn from(frame: crate::hw5::TelemetryFrame) -> Data {
+        Data::Hw5(frame)
+    }
 }
 
 impl From<DataFrame> for Data {
@@ -200,6 +235,9 @@ impl Telemetry for Data {
     fn packet(&self) -> Option<u32> {
         match self {
             Data::HwFoc(f) | Data::DataLink(f) => f.packet(),
+            Data::HwV4(f) => Telemetry::packet(f),
+            Data::HwV3(f) => Telemetry::packet(f),
+            Data::Hw5(f) => Telemetry::packet(f),
         }
     }
 
@@ -207,6 +245,9 @@ impl Telemetry for Data {
     fn status(&self) -> Option<Status> {
         match self {
             Data::HwFoc(f) | Data::DataLink(f) => Telemetry::status(f),
+            Data::HwV4(f) => Telemetry::status(f),
+            Data::HwV3(f) => Telemetry::status(f),
+            Data::Hw5(f) => Telemetry::status(f),
         }
     }
 
@@ -214,6 +255,9 @@ impl Telemetry for Data {
     fn reading(&self, quantity: Quantity, settings: &Settings) -> Option<Reading> {
         match self {
             Data::HwFoc(f) | Data::DataLink(f) => f.reading(quantity, settings),
+            Data::HwV4(f) => f.reading(quantity, settings),
+            Data::HwV3(f) => f.reading(quantity, settings),
+            Data::Hw5(f) => f.reading(quantity, settings),
         }
     }
 }
@@ -234,16 +278,20 @@ impl Data {
         match self {
             Data::HwFoc(_) => Protocol::HwFoc,
             Data::DataLink(_) => Protocol::DataLink,
+            Data::HwV4(_) => Protocol::HwV4,
+            Data::HwV3(_) => Protocol::HwV3,
+            Data::Hw5(_) => Protocol::Hw5,
         }
     }
 
-    /// The HW-FOC data frame with this frame's readings: what a DataLink V2 hub record holds
-    /// (the hub forwards HW-FOC payloads), for outputs that speak HW-FOC. An HW-FOC frame is
-    /// itself.
+    /// The HW-FOC data frame this frame is, for outputs that speak HW-FOC: an HW-FOC frame
+    /// itself, or what a DataLink V2 hub record holds (the hub forwards HW-FOC payloads);
+    /// `None` for another protocol's frame, whose fields HW-FOC's do not hold as sent.
     #[inline]
-    pub fn to_hwfoc(&self) -> DataFrame {
+    pub fn to_hwfoc(&self) -> Option<DataFrame> {
         match self {
-            Data::HwFoc(f) | Data::DataLink(f) => *f,
+            Data::HwFoc(f) | Data::DataLink(f) => Some(*f),
+            Data::HwV4(_) | Data::HwV3(_) | Data::Hw5(_) => None,
         }
     }
 }
@@ -253,6 +301,8 @@ per_protocol! {
     pub enum Info {
         /// An HW-FOC device-information frame.
         HwFoc(InfoFrame),
+        /// A Hobbywing V4 info frame: the ESC's scales, no names.
+        HwV4(crate::v4::InfoFrame),
     }
 }
 
@@ -261,6 +311,7 @@ impl Info {
     pub fn product(&self) -> &str {
         match self {
             Info::HwFoc(i) => i.product(),
+            Info::HwV4(_) => "",
         }
     }
 
@@ -268,6 +319,7 @@ impl Info {
     pub fn hardware(&self) -> &str {
         match self {
             Info::HwFoc(i) => i.hardware(),
+            Info::HwV4(_) => "",
         }
     }
 
@@ -275,6 +327,7 @@ impl Info {
     pub fn firmware(&self) -> &str {
         match self {
             Info::HwFoc(i) => i.firmware(),
+            Info::HwV4(_) => "",
         }
     }
 
@@ -282,15 +335,18 @@ impl Info {
     pub fn id(&self) -> &str {
         match self {
             Info::HwFoc(i) => i.id(),
+            Info::HwV4(_) => "",
         }
     }
 }
 
 impl core::fmt::Display for Info {
-    /// The device's text as each protocol shows it (HW-FOC: its words joined by single spaces).
+    /// The device's text as each protocol shows it (HW-FOC: its words joined by single spaces;
+    /// V4: its constants).
     fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
         match self {
             Info::HwFoc(i) => i.fmt(f),
+            Info::HwV4(i) => i.fmt(f),
         }
     }
 }
@@ -303,6 +359,16 @@ pub enum Frame {
     Data(Data),
     /// A device-information frame.
     Info(Info),
+}
+
+impl From<crate::v4::Frame> for Frame {
+    #[inline(always)]
+    fn from(frame: crate::v4::Frame) -> Frame {
+        match frame {
+            crate::v4::Frame::Data(d) => Frame::Data(Data::HwV4(d)),
+            crate::v4::Frame::Info(i) => Frame::Info(Info::HwV4(i)),
+        }
+    }
 }
 
 impl From<crate::foc::frame::Frame> for Frame {

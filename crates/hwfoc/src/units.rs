@@ -24,6 +24,8 @@
 
 use core::fmt;
 
+use crate::v4::VoltsPerStep;
+
 /// Electrical RPM per unit of a data frame's raw eRPM field.
 pub const ERPM_PER_RAW: u16 = 10;
 
@@ -48,6 +50,8 @@ impl Linear {
     pub const ERPM: Linear = Linear::new(ERPM_PER_RAW as f32, 1.0, 1.0);
     /// Input voltage in volts: `raw / 10`.
     pub const VOLTS: Linear = Linear::new(1.0, 10.0, 1.0);
+    /// The value as sent: `raw` (a quantity sent in its unit, such as HW5's degC).
+    pub const IDENTITY: Linear = Linear::new(1.0, 1.0, 1.0);
 
     /// The conversion `raw * mul / (div * div2)`.
     pub const fn new(mul: f32, div: f32, div2: f32) -> Linear {
@@ -165,6 +169,10 @@ pub struct Settings {
     pub pole_pairs: u16,
     /// Gear ratio between motor and the shaft whose RPM is wanted (1 for direct drive).
     pub gear_ratio: f32,
+    /// Volts per voltage ADC step of a Hobbywing V4 ESC until its first info frame is adopted
+    /// (which then gives its own): [`VoltsPerStep::LOW_VOLTAGE`], 8/910, by default,
+    /// [`VoltsPerStep::HIGH_VOLTAGE`], 11/650, for HV models.
+    pub v4_volts_per_step: VoltsPerStep,
 }
 
 impl Default for Settings {
@@ -179,6 +187,7 @@ impl Settings {
         current_scale: 64.0,
         pole_pairs: 7,
         gear_ratio: 1.0,
+        v4_volts_per_step: VoltsPerStep::DEFAULT,
     };
 
     /// The smallest current scale [`Settings::new`] accepts, `1e-34`: the largest current,
@@ -235,6 +244,7 @@ impl Settings {
             current_scale,
             pole_pairs,
             gear_ratio,
+            ..Settings::DEFAULT
         })
     }
 

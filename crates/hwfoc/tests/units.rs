@@ -305,6 +305,7 @@ fn bounds_are_the_tightest_powers_of_ten() {
         current_scale,
         pole_pairs,
         gear_ratio,
+        ..Settings::DEFAULT
     };
     let s = unchecked(Settings::CURRENT_SCALE_MIN / 10.0, 7, 1.0);
     assert_eq!(s.amps(i16::MIN), f32::NEG_INFINITY);

@@ -588,17 +588,24 @@ impl Recorder {
 }
 
 /// The warning for port `name`, read at `baud`, whose `bytes` in [`NO_FRAMES_AFTER`] held no
-/// valid frame of `protocol` (without one forced, of HW-FOC: an ESC's own wire).
+/// valid frame of `protocol` (without one forced, of any format).
 fn no_frame_warning(name: &str, bytes: u64, baud: u32, protocol: Option<Protocol>) -> String {
-    let protocol = protocol.unwrap_or(Protocol::HwFoc);
-    let title = protocol.title();
+    let (what, rates) = match protocol {
+        Some(p) => (
+            format!("{} frame", p.title()),
+            format!("{} telemetry is {}", p.title(), p.baud_rate()),
+        ),
+        None => (
+            "frame of any Hobbywing format".to_string(),
+            "HW-FOC, V4 and V3 telemetry is 19200, DataLink and HW5 115200".to_string(),
+        ),
+    };
     format!(
-        "{}: {bytes} bytes in {} s but no valid {title} frame: likely a wrong baud rate (read at \
-         {baud}; {title} telemetry is {}, see --baud) or swapped TX/RX wires (the adapter's RX \
-         must be on the ESC's telemetry wire)",
+        "{}: {bytes} bytes in {} s but no valid {what}: likely a wrong baud rate (read at \
+         {baud}; {rates}, see --baud) or swapped TX/RX wires (the adapter's RX must be on the \
+         ESC's telemetry wire)",
         Escaped(name),
         NO_FRAMES_AFTER.as_secs(),
-        protocol.baud_rate()
     )
 }
 
@@ -700,15 +707,16 @@ mod tests {
         assert!(parse_seconds("1e300").is_err());
     }
 
-    /// Without a protocol forced the warning names HW-FOC at 19200 baud; forced, the protocol's
-    /// title and baud rate.
+    /// Without a protocol forced the warning names every format's baud rate; forced, the
+    /// protocol's title and baud rate.
     #[test]
     fn the_no_frame_warning_names_the_protocol_forced() {
         assert_eq!(
             no_frame_warning("/dev/ttyUSB0", 640, 115_200, None),
-            "/dev/ttyUSB0: 640 bytes in 3 s but no valid HW-FOC frame: likely a wrong baud rate \
-             (read at 115200; HW-FOC telemetry is 19200, see --baud) or swapped TX/RX wires (the \
-             adapter's RX must be on the ESC's telemetry wire)"
+            "/dev/ttyUSB0: 640 bytes in 3 s but no valid frame of any Hobbywing format: likely a \
+             wrong baud rate (read at 115200; HW-FOC, V4 and V3 telemetry is 19200, DataLink and \
+             HW5 115200, see --baud) or swapped TX/RX wires (the adapter's RX must be on the \
+             ESC's telemetry wire)"
         );
         let forced = no_frame_warning("/dev/ttyUSB0", 640, 19_200, Some(Protocol::DataLink));
         assert!(

@@ -16,6 +16,17 @@ pub enum Looks {
     Zeros,
     /// A file format known by its first bytes, named.
     Format(&'static str),
+    /// Binary bytes, as a wire gives, in which no frame of any format was found: how many were
+    /// looked at, and how many of them are lead bytes of a Hobbywing format (`9B`: HW-FOC,
+    /// DataLink, V4, V3; `FE`: HW5).
+    Unframed {
+        /// Bytes looked at (the input's first, up to 4096).
+        bytes: usize,
+        /// `9B` bytes among them.
+        sync_9b: usize,
+        /// `FE` bytes among them.
+        sync_fe: usize,
+    },
 }
 
 /// Known formats by their first bytes: those a user is likely to give by mistake.
@@ -36,9 +47,26 @@ const MAGIC: &[(&[u8], &str)] = &[
 ];
 
 impl Looks {
-    /// What `head`, an input's first bytes (up to its first 4096), looks like, if it is something
-    /// other than telemetry; `None` for binary bytes (a capture at the wrong baud rate, say).
+    /// What `head`, an input's first bytes (up to its first 4096), looks like when it held no
+    /// frame: something other than telemetry, or [`Looks::Unframed`] binary bytes (a capture at
+    /// the wrong baud rate, say); `None` for no bytes.
     pub fn of(head: &[u8]) -> Option<Looks> {
+        Self::other_than_telemetry(head).or_else(|| {
+            (!head.is_empty()).then(|| Looks::Unframed {
+                bytes: head.len(),
+                sync_9b: head.iter().filter(|&&b| b == hwfoc::wire::SYNC).count(),
+                sync_fe: head.iter().filter(|&&b| b == hwfoc::hw5::ESC_START).count(),
+            })
+        })
+    }
+
+    /// Whether `head` is something other than telemetry: text, zeros, a known file format.
+    pub fn is_other_than_telemetry(&self) -> bool {
+        !matches!(self, Looks::Unframed { .. })
+    }
+
+    /// What `head` looks like, if it is something other than telemetry.
+    fn other_than_telemetry(head: &[u8]) -> Option<Looks> {
         if head.is_empty() {
             return None;
         }
@@ -78,6 +106,16 @@ impl fmt::Display for Looks {
             Looks::Text => f.write_str("text, not telemetry"),
             Looks::Zeros => f.write_str("only zero bytes, not telemetry"),
             Looks::Format(name) => write!(f, "looks like {name}, not telemetry"),
+            Looks::Unframed {
+                bytes,
+                sync_9b,
+                sync_fe,
+            } => write!(
+                f,
+                "no valid frame of any Hobbywing format in {bytes} bytes ({sync_9b} 9B and \
+                 {sync_fe} FE lead bytes among the first): check the baud rate (19200; 115200 \
+                 for DataLink and HW5) and the wiring"
+            ),
         }
     }
 }
@@ -113,11 +151,19 @@ mod tests {
 
     #[test]
     fn telemetry_and_noise_look_like_nothing_else() {
-        // HW-FOC frames (0x9B lead byte), a capture at the wrong baud rate, random bytes.
+        // HW-FOC frames (0x9B lead byte), a capture at the wrong baud rate, random bytes: binary
+        // bytes, described by their lead bytes.
         let frames: Vec<u8> = (0..10)
             .flat_map(|_| hwfoc::foc::DataFrame::default().encode())
             .collect();
-        assert_eq!(Looks::of(&frames), None);
+        let unframed = |bytes, sync_9b, sync_fe| {
+            Some(Looks::Unframed {
+                bytes,
+                sync_9b,
+                sync_fe,
+            })
+        };
+        assert_eq!(Looks::of(&frames), unframed(240, 10, 0));
         let mut x: u32 = 12345;
         let noise: Vec<u8> = (0..4096)
             .map(|_| {
@@ -125,11 +171,22 @@ mod tests {
                 (x >> 16) as u8
             })
             .collect();
-        assert_eq!(Looks::of(&noise), None);
+        let looks = Looks::of(&noise).unwrap();
+        assert!(!looks.is_other_than_telemetry(), "{looks:?}");
+        assert!(
+            looks
+                .to_string()
+                .starts_with("no valid frame of any Hobbywing format in 4096 bytes (")
+        );
         // One byte repeated is a line's pattern, not text.
-        assert_eq!(Looks::of(&[0x55; 4096]), None);
+        assert_eq!(Looks::of(&[0x55; 4096]), unframed(4096, 0, 0));
         // Text with a few control bytes in it is not text.
-        assert_eq!(Looks::of(b"abc\x01\x02\x03\x04def"), None);
+        assert_eq!(Looks::of(b"abc\x01\x02\x03\x04def"), unframed(10, 0, 0));
+        assert_eq!(
+            Looks::of(&[0xFE, 0x9B, 0x9B]).unwrap().to_string(),
+            "no valid frame of any Hobbywing format in 3 bytes (2 9B and 1 FE lead bytes among \
+             the first): check the baud rate (19200; 115200 for DataLink and HW5) and the wiring"
+        );
     }
 
     #[test]

@@ -3,7 +3,7 @@
 //! [`columns`](super::columns) into all of these.
 
 use hwfoc::telemetry::Data;
-use hwfoc::{Settings, Status};
+use hwfoc::{Protocol, Settings, Status};
 
 use super::Record;
 use super::text::TextValue;
@@ -70,15 +70,22 @@ pub trait Visitor {
     fn column<C: Column>(&mut self);
 }
 
-/// The `faults` column's value: the names of the flags set in a status word, in bit order (a
-/// list of strings; in CSV joined by `|`).
+/// The `faults` column's value: the names of the flags set in a fault word of a protocol, in
+/// bit order (a list of strings; in CSV joined by `|`): HW-FOC's and DataLink's status word,
+/// HW5's fault byte ([`Protocol::fault_name`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct FaultList(pub Status);
+pub struct FaultList(pub Status, pub Protocol);
 
 impl FaultList {
     /// The names of the set flags, in bit order.
     pub fn names(self) -> impl ExactSizeIterator<Item = &'static str> {
-        self.0.faults().map(|f| f.name())
+        let mut names = [""; 16];
+        let mut n = 0;
+        for name in self.1.fault_names(self.0) {
+            names[n] = name;
+            n += 1;
+        }
+        names.into_iter().take(n)
     }
 }
 

@@ -92,10 +92,12 @@ columns! {
     /// BEC output current, A (HW5; null in HW-FOC and DataLink).
     bec_current_a: Option<f32>, "A", |_, _, f, s| f.value(Quantity::BecCurrent, s),
         text key |f| raw(f, Quantity::BecCurrent);
-    /// The raw status word (an unsigned 16-bit integer); null where the protocol sends none.
+    /// The raw fault word (an unsigned 16-bit integer: HW-FOC's and DataLink's status word,
+    /// HW5's fault byte); null where the protocol sends none (V4, V3).
     status: Option<hwfoc::Status>, "-", |_, _, f, _| f.status();
-    /// Names of the set status bits, in bit order (from `docs/PROTOCOL-NOTES.md`); derived from
-    /// `status`, not a field of the record; null where `status` is.
-    faults: Option<FaultList>, "-", |_, _, f, _| f.status().map(FaultList),
-        record |r| r.status.map(FaultList);
+    /// Names of the set fault bits, in bit order, as the frame's protocol names them (HW-FOC:
+    /// `docs/PROTOCOL-NOTES.md`; HW5: `docs/HW5-AND-CAN.md`); derived from `status`, not a
+    /// field of the record; null where `status` is.
+    faults: Option<FaultList>, "-", |_, _, f, _| f.status().map(|s| FaultList(s, f.protocol())),
+        record |r| r.status.map(|s| FaultList(s, r.protocol));
 }

@@ -122,12 +122,55 @@ mod tests {
             cap_adc: 206,
             ..DataFrame::default()
         };
-        let samples = [Data::from(frame), Data::DataLink(frame)];
+        let info = hwfoc::v4::InfoFrame {
+            full_scale: 1000,
+            v1: 8,
+            v2: 91,
+            i1: 1,
+            i2: 2,
+            i3: 0,
+            t1: 0x21,
+            t2: 0x21,
+        };
+        let v4 = hwfoc::v4::DataFrame {
+            counter: 3,
+            throttle_in_raw: 500,
+            voltage_adc: 1365,
+            current_adc: 40,
+            temp_adc: 3244,
+            temp2_adc: 3244,
+            ..Default::default()
+        };
+        let v3 = hwfoc::v3::Frame {
+            counter: 3,
+            throttle_in_raw: 51,
+            pwm_out_raw: 51,
+            period_us: 1500,
+        };
+        let hw5 = hwfoc::hw5::TelemetryFrame {
+            throttle: 42,
+            fault: hwfoc::hw5::FaultCode(0b1000_1000),
+            voltage_raw: 504,
+            ..Default::default()
+        };
+        let samples = [
+            Data::from(frame),
+            Data::DataLink(frame),
+            Data::from(hwfoc::v4::Data {
+                frame: v4,
+                info: Some(info),
+            }),
+            Data::from(v3),
+            Data::from(hw5),
+        ];
         let s = Settings::default();
         for sample in samples {
             let protocol = match sample {
                 Data::HwFoc(_) => Protocol::HwFoc,
                 Data::DataLink(_) => Protocol::DataLink,
+                Data::HwV4(_) => Protocol::HwV4,
+                Data::HwV3(_) => Protocol::HwV3,
+                Data::Hw5(_) => Protocol::Hw5,
             };
             assert_eq!(sample.protocol(), protocol);
             let mut json = Vec::new();
@@ -135,7 +178,9 @@ mod tests {
             let v: serde_json::Value = serde_json::from_slice(&json).unwrap();
             assert_eq!(v["protocol"], protocol.name());
             for q in Quantity::ALL {
-                let carried = sample.value(q, &s).is_some();
+                // Each sample has a value for every quantity its protocol carries.
+                let carried = protocol.carries(q);
+                assert_eq!(sample.reading(q, &s).is_some(), carried, "{sample:?} {q:?}");
                 assert_eq!(!v[q.name()].is_null(), carried, "{sample:?} {q:?}");
             }
             // HW-FOC and DataLink carry every quantity of schema version 1, and none of the
@@ -146,12 +191,53 @@ mod tests {
                 Quantity::BecVoltage,
                 Quantity::BecCurrent,
             ];
-            for q in Quantity::ALL {
-                assert_eq!(sample.reading(q, &s).is_none(), added.contains(&q), "{q:?}");
+            if matches!(protocol, Protocol::HwFoc | Protocol::DataLink) {
+                for q in Quantity::ALL {
+                    assert_eq!(sample.reading(q, &s).is_none(), added.contains(&q), "{q:?}");
+                }
             }
-            assert_eq!(v["packet"], 3);
-            assert_eq!(v["status"], 0);
-            assert_eq!(v["faults"], serde_json::json!([]));
+            match protocol {
+                Protocol::Hw5 => {
+                    assert!(v["packet"].is_null());
+                    assert_eq!(v["status"], 0x88);
+                    assert_eq!(
+                        v["faults"],
+                        serde_json::json!(["throttle_signal_lost", "motor_connection_error"])
+                    );
+                }
+                Protocol::HwV4 | Protocol::HwV3 => {
+                    assert_eq!(v["packet"], 3);
+                    assert!(v["status"].is_null() && v["faults"].is_null());
+                }
+                Protocol::HwFoc | Protocol::DataLink => {
+                    assert_eq!(v["packet"], 3);
+                    assert_eq!(v["status"], 0);
+                    assert_eq!(v["faults"], serde_json::json!([]));
+                }
+            }
         }
+        // Where a format has no value: a V4 temperature of 0, a V4 current before an info
+        // frame, a V3 start-up placeholder.
+        let idle = Data::from(hwfoc::v4::Data {
+            frame: hwfoc::v4::DataFrame { temp2_adc: 0, ..v4 },
+            info: None,
+        });
+        let mut json = Vec::new();
+        Record::new(None, 0, &idle, &s).write_json(&mut json);
+        let v: serde_json::Value = serde_json::from_slice(&json).unwrap();
+        assert!(v["cap_temp_c"].is_null() && v["current_a"].is_null());
+        assert_eq!(
+            v["voltage_v"].as_f64().map(|x| (x * 100.0).round()),
+            Some(1200.0)
+        );
+        let placeholder = Data::from(hwfoc::v3::Frame {
+            period_us: hwfoc::v3::PLACEHOLDER_PERIOD_US,
+            ..v3
+        });
+        let mut json = Vec::new();
+        Record::new(None, 0, &placeholder, &s).write_json(&mut json);
+        let v: serde_json::Value = serde_json::from_slice(&json).unwrap();
+        assert!(v["erpm"].is_null() && v["rpm"].is_null());
+        assert!(v["throttle_in_pct"].is_number());
     }
 }

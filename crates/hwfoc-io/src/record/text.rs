@@ -256,6 +256,14 @@ impl<F: Format> Visitor for Row<'_, F> {
     }
 }
 
+/// Whether the number caches, keyed by raw integers, may give the text of `frame`'s values:
+/// for HW-FOC and DataLink frames, whose raw integers convert one way under one set of
+/// settings.
+#[inline(always)]
+fn caches_apply(frame: &Data) -> bool {
+    matches!(frame.protocol(), Protocol::HwFoc | Protocol::DataLink)
+}
+
 /// Marks the columns with a text key: the visitor of [`TextEncoder::cached`].
 struct MakeCaches<'a>(&'a mut [FloatCache; COUNT]);
 
@@ -296,9 +304,15 @@ impl TextEncoder {
 
     /// Appends `r`, the record of `frame`, as [`TextEncoder::json`] does; a cached encoder
     /// takes the text of numbers from its caches. Every record given to one cached encoder
-    /// must be converted under the same settings.
+    /// must be converted under the same settings. (A frame of a protocol whose raw integers
+    /// convert otherwise from frame to frame, V4 before and after its info frame, or otherwise
+    /// than HW-FOC's, is written without the caches.)
     pub fn json_frame(&mut self, r: &Record, frame: &Data, out: &mut Vec<u8>) {
-        self.row::<Json>(r, Some(frame), out);
+        if caches_apply(frame) {
+            self.row::<Json>(r, Some(frame), out);
+        } else {
+            self.row::<Json>(r, None, out);
+        }
     }
 
     /// Appends `r` as one CSV row (the columns of [`COLUMNS`](super::COLUMNS)): empty fields
@@ -310,7 +324,11 @@ impl TextEncoder {
     /// Appends `r`, the record of `frame`, as [`TextEncoder::csv`] does. A cached encoder takes
     /// the text of numbers from its caches, as [`TextEncoder::json_frame`] does.
     pub fn csv_frame(&mut self, r: &Record, frame: &Data, out: &mut Vec<u8>) {
-        self.row::<Csv>(r, Some(frame), out);
+        if caches_apply(frame) {
+            self.row::<Csv>(r, Some(frame), out);
+        } else {
+            self.row::<Csv>(r, None, out);
+        }
     }
 
     /// Assembles the row of `r` in format `F` and appends it to `out`. Inlined into each
@@ -421,7 +439,7 @@ mod tests {
         // Every fault set: the longest list.
         let mut e = TextEncoder::new();
         e.pos = 0;
-        FaultList(Status(0xFFFF)).text::<Json>(&mut e, None);
+        FaultList(Status(0xFFFF), Protocol::HwFoc).text::<Json>(&mut e, None);
         // Sixteen names and fifteen commas between them: room for one more comma.
         assert_eq!(e.pos + 1, FaultList::TEXT_MAX);
     }

@@ -53,14 +53,14 @@ use self::merge::Queue;
 use self::numbering::{Deliver, Hub, Pending, route};
 use self::split::{Later, SPLIT_MIN};
 
-/// Data frames without times held at most before they are handed on together (18 bytes each
-/// for HW-FOC: within the L1 cache).
+/// HW-FOC data frames without times held at most before they are handed on together (18
+/// bytes each: within the L1 cache).
 const HELD: usize = 512;
 
 /// Data frames without times, held to be handed on together ([`feed_runs`]; a `Vec`'s length and
 /// capacity checks cost a fifth of the decoder's loop).
 struct Held {
-    frames: [Data; HELD],
+    frames: [DataFrame; HELD],
 }
 
 /// Batches shorter than this come from a live source: what they produce is passed on at once.
@@ -155,7 +155,7 @@ impl Sources {
             #[cfg(test)]
             joined: 0,
             held: Box::new(Held {
-                frames: [Data::from(DataFrame::default()); HELD],
+                frames: [DataFrame::default(); HELD],
             }),
         }
     }
@@ -528,7 +528,7 @@ trait Takes {
     const RUNS: bool;
 
     /// Data frames of the stream's own ESC without receive times, one after another.
-    fn run(&mut self, frames: &[Data]);
+    fn run(&mut self, frames: &[DataFrame]);
     /// Any other frame (with a receive time, of a hub's channel, or device information).
     fn other(&mut self, t: Option<f64>, channel: Option<u8>, frame: &Frame);
 }
@@ -546,7 +546,7 @@ fn feed_runs<T: Takes>(stream: &mut Stream, batch: Batch<'_>, held: &mut Held, t
         batch,
         #[inline(always)]
         |t, channel, d| {
-            if let (true, None, None, Frame::Data(f)) = (T::RUNS, t, channel, d) {
+            if let (true, None, None, Frame::Data(Data::HwFoc(f))) = (T::RUNS, t, channel, d) {
                 if n == HELD {
                     to.run(held);
                     n = 0;
@@ -584,7 +584,7 @@ impl<H: Handler> Takes for ToHandler<'_, '_, H> {
     const RUNS: bool = H::TAKES_RUNS;
 
     #[inline(always)]
-    fn run(&mut self, frames: &[Data]) {
+    fn run(&mut self, frames: &[DataFrame]) {
         self.handler.untimed_data(self.id, frames, self.settings);
     }
 

@@ -191,7 +191,7 @@ impl Reader {
     fn decode(&self, seam: u64, mut part: Box<dyn LaterPart>, block: &mut [u8]) -> Option<Done> {
         let mut stream = Stream::forced(self.forced);
         let mut held = Box::new(Held {
-            frames: [Data::from(hwfoc::foc::DataFrame::default()); HELD],
+            frames: [hwfoc::foc::DataFrame::default(); HELD],
         });
         let mut to = ToPart {
             part: &mut *part,
@@ -269,9 +269,9 @@ impl Takes for ToPart<'_> {
     const RUNS: bool = true;
 
     #[inline(always)]
-    fn run(&mut self, frames: &[Data]) {
+    fn run(&mut self, frames: &[hwfoc::foc::DataFrame]) {
         if let Some(f) = frames.first() {
-            self.data(f);
+            self.data(&Data::HwFoc(*f));
         }
         self.part.untimed_data(self.esc, frames, self.settings);
     }

@@ -624,7 +624,7 @@ impl<const RUNS: bool> Handler for Calls<RUNS> {
 
     fn frame(&mut self, esc: u8, t: Option<f64>, frame: &Frame, _: &Settings) {
         let what = match frame {
-            Frame::Data(d) => format!("{}", d.to_hwfoc().packet),
+            Frame::Data(d) => format!("{}", hwfoc::Telemetry::packet(d).unwrap_or_default()),
             Frame::Info(_) => "info".to_string(),
         };
         self.0.push(format!("{esc} {t:?} {what}"));

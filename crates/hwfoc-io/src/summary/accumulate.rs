@@ -2,8 +2,9 @@
 //! lanes, histograms of temperature codes, fault counts, episodes, times, raw energy), the
 //! per-frame cost of `hwfoc summary`.
 
+use hwfoc::foc::DataFrame;
 use hwfoc::telemetry::{Conversion, Data, Frame, Info, Telemetry};
-use hwfoc::{Quantity, Status, Temperature};
+use hwfoc::{Protocol, Quantity, Settings, Status, Temperature};
 
 use super::MAX_EPISODES;
 use crate::clock::Step;
@@ -193,8 +194,8 @@ impl Tally {
     /// the run (in the L1 cache), each of whose running values are locals, kept in registers and
     /// stored once (a running value in memory is stored and loaded back every frame).
     #[inline(always)]
-    fn add_run(&mut self, run: &[Data]) {
-        let powered = |f: &Data| Some((f.raw(Quantity::Voltage)?, f.raw(Quantity::Current)?));
+    fn add_run(&mut self, run: &[DataFrame]) {
+        let powered = |f: &DataFrame| Some((f.raw(Quantity::Voltage)?, f.raw(Quantity::Current)?));
         let (mut power_sum, mut power_max) = (self.power_sum, self.power_max);
         for (volts, amps) in run.iter().filter_map(powered) {
             let power = volts * amps;
@@ -235,6 +236,140 @@ impl Tally {
     }
 }
 
+/// Min, max and sum of one quantity's converted values.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct ValueRange {
+    pub(super) min: f64,
+    pub(super) max: f64,
+    pub(super) sum: f64,
+    pub(super) n: u64,
+}
+
+impl Default for ValueRange {
+    fn default() -> Self {
+        ValueRange {
+            min: f64::INFINITY,
+            max: f64::NEG_INFINITY,
+            sum: 0.0,
+            n: 0,
+        }
+    }
+}
+
+impl ValueRange {
+    #[inline]
+    fn add(&mut self, v: f64) {
+        self.min = self.min.min(v);
+        self.max = self.max.max(v);
+        self.sum += v;
+        self.n += 1;
+    }
+
+    fn join(&mut self, later: &ValueRange) {
+        self.min = self.min.min(later.min);
+        self.max = self.max.max(later.max);
+        self.sum += later.sum;
+        self.n += later.n;
+    }
+
+    /// Min, max and mean, if any value was added.
+    pub(super) fn stats(&self) -> Option<[f64; 3]> {
+        (self.n > 0).then(|| [self.min, self.max, self.sum / self.n as f64])
+    }
+}
+
+/// What the summary keeps of the frames of a protocol whose conversions are not one linear
+/// conversion per ESC for the whole stream (V4: its constants change when an info frame is
+/// adopted, its temperatures and current are not linear; V3: eRPM from a period; HW5: the
+/// quantities HW-FOC has no lane or histogram for): every quantity's converted values, and the
+/// power in watts. Such ESCs send at most about 50 frames a second, so converting each frame
+/// costs nothing that matters, and the means are those of the values shown.
+#[derive(Debug, Clone, Default)]
+pub(super) struct Values {
+    pub(super) ranges: [ValueRange; Quantity::ALL.len()],
+    /// Frames with both voltage and current values: their count, the sums of current and
+    /// power, the largest power and the last values.
+    pub(super) powered: u64,
+    pub(super) current_sum: f64,
+    pub(super) power_sum: f64,
+    pub(super) power_max: f64,
+    pub(super) last: Option<(f64, f64)>,
+    /// Charge and energy over receive times, in amperes and volts.
+    pub(super) energy: Energy,
+}
+
+impl Values {
+    /// Adds a data frame's values under `settings`; the voltage and current it carried.
+    fn add(&mut self, f: &Data, settings: &Settings) -> Option<(f64, f64)> {
+        for (i, &q) in Quantity::ALL.iter().enumerate() {
+            if let Some(v) = f.value(q, settings) {
+                self.ranges[i].add(f64::from(v));
+            }
+        }
+        let volts = f64::from(f.value(Quantity::Voltage, settings)?);
+        let amps = f64::from(f.value(Quantity::Current, settings)?);
+        let power = volts * amps;
+        self.powered += 1;
+        self.current_sum += amps;
+        self.power_sum += power;
+        self.power_max = if self.powered == 1 {
+            power
+        } else {
+            self.power_max.max(power)
+        };
+        self.last = Some((volts, amps));
+        Some((volts, amps))
+    }
+
+    fn join(&mut self, later: &Values) {
+        for (r, l) in self.ranges.iter_mut().zip(&later.ranges) {
+            r.join(l);
+        }
+        if later.powered > 0 {
+            self.power_max = if self.powered == 0 {
+                later.power_max
+            } else {
+                self.power_max.max(later.power_max)
+            };
+            self.last = later.last;
+        }
+        self.powered += later.powered;
+        self.current_sum += later.current_sum;
+        self.power_sum += later.power_sum;
+    }
+
+    /// The range of `quantity`'s values.
+    pub(super) fn range(&self, quantity: Quantity) -> &ValueRange {
+        let i = Quantity::ALL.iter().position(|&q| q == quantity);
+        &self.ranges[i.unwrap_or(0)]
+    }
+
+    /// Charge, energy and power in amperes and volts: over receive times, or for frames
+    /// without times from the sums (each frame the nominal period).
+    fn energy(&self, timed: bool) -> Option<Energy> {
+        if self.powered == 0 {
+            return None;
+        }
+        if timed {
+            return Some(self.energy);
+        }
+        Some(Energy::untimed(
+            self.powered,
+            self.current_sum,
+            self.power_sum,
+            self.last.unwrap_or_default(),
+            Some(self.power_max),
+        ))
+    }
+}
+
+/// Whether the summary keeps the raw integers of `protocol`'s frames (HW-FOC, DataLink: one
+/// linear conversion per ESC, the fast path) rather than their values ([`Values`]).
+#[inline(always)]
+pub(super) const fn keeps_raw(protocol: Protocol) -> bool {
+    matches!(protocol, Protocol::HwFoc | Protocol::DataLink)
+}
+
 /// Whether a data frame carries no fault: what [`Accumulator::add_clean`] and
 /// [`Accumulator::add_clean_run`] take (a protocol without a status word has none).
 #[inline(always)]
@@ -245,7 +380,7 @@ pub(super) fn is_clean(f: &Data) -> bool {
 /// The code of temperature `quantity` in a data frame: its raw value when that is a table's
 /// code (0..=255), `None` when it is not or the frame does not carry it.
 #[inline(always)]
-fn code(f: &Data, quantity: Quantity) -> Option<u8> {
+fn code(f: &impl Telemetry, quantity: Quantity) -> Option<u8> {
     f.raw(quantity).and_then(|raw| u8::try_from(raw).ok())
 }
 
@@ -270,12 +405,12 @@ impl CodeRun {
         }
     }
 
-    /// Counts the codes of temperature `quantity` in `frames`, a run at a time.
+    /// Counts the temperature codes `codes` of frames, a run of one code at a time.
     #[inline(always)]
-    fn count(frames: &[Data], quantity: Quantity, codes: &mut [u64; 256], uncoded: &mut u64) {
+    fn count(frames: impl Iterator<Item = Option<u8>>, codes: &mut [u64; 256], uncoded: &mut u64) {
         let mut run = CodeRun::default();
-        for f in frames {
-            run.add(code(f, quantity), codes, uncoded);
+        for code in frames {
+            run.add(code, codes, uncoded);
         }
         run.end(codes);
     }
@@ -317,6 +452,8 @@ pub(super) struct Accumulator {
     /// without times are integrated from the lanes' sums at the end (see [`Self::energy`]).
     pub(super) energy: Energy,
     pub(super) infos: Vec<(Info, u64)>,
+    /// The values of frames of a protocol [`keeps_raw`] is false for.
+    pub(super) values: Option<Box<Values>>,
     pub(super) episode: Option<Episode>,
     pub(super) episodes: Vec<Episode>,
     pub(super) episode_count: u64,
@@ -340,6 +477,7 @@ impl Default for Accumulator {
             jumps: 0,
             energy: Energy::new(),
             infos: Vec::new(),
+            values: None,
             episode: None,
             episodes: Vec::new(),
             episode_count: 0,
@@ -349,8 +487,9 @@ impl Default for Accumulator {
 
 impl Accumulator {
     #[inline]
-    pub(super) fn add(&mut self, t: Option<f64>, frame: &Frame) {
+    pub(super) fn add(&mut self, t: Option<f64>, frame: &Frame, settings: &Settings) {
         match frame {
+            Frame::Data(f) if !keeps_raw(f.protocol()) => self.add_values(t, f, settings),
             Frame::Data(f) => self.add_data(t, f),
             Frame::Info(info) => match self.infos.iter_mut().find(|(i, _)| i == info) {
                 Some((_, n)) => *n += 1,
@@ -371,7 +510,10 @@ impl Accumulator {
     #[inline(always)]
     pub(super) fn count(&mut self, t: Option<f64>, f: &Data) {
         let powered = self.tally.add(f);
-        self.count_codes(std::slice::from_ref(f));
+        self.count_codes(
+            std::iter::once(code(f, Quantity::MosTemp)),
+            std::iter::once(code(f, Quantity::CapTemp)),
+        );
         if !powered {
             return self.untimed_power(t, f);
         }
@@ -380,39 +522,35 @@ impl Accumulator {
         }
     }
 
-    /// Adds the data frames without times at the start of `frames` that [`Self::add_clean`]
+    /// Adds the HW-FOC data frames without times at the start of `frames` that [`Self::add_clean`]
     /// would take (no fault), up to the first that it would not: how many. Their tally is added
     /// in passes over the run ([`Tally::add_run`]) and their temperature codes counted a run of
     /// one code at a time (adding one to the same count frame after frame waits for the
     /// previous store each time).
     #[inline(always)]
-    pub(super) fn add_clean_run(&mut self, frames: &[Data]) -> usize {
+    pub(super) fn add_clean_run(&mut self, frames: &[DataFrame]) -> usize {
         debug_assert!(self.fast && self.sample.is_some() && self.episode.is_none());
         let n = frames
             .iter()
-            .position(|f| !is_clean(f))
+            .position(|f| !f.status.is_ok())
             .unwrap_or(frames.len());
         let run = &frames[..n];
         self.tally.add_run(run);
-        self.count_codes(run);
+        let codes = |q| run.iter().map(move |f| code(f, q));
+        self.count_codes(codes(Quantity::MosTemp), codes(Quantity::CapTemp));
         n
     }
 
-    /// Counts the temperature codes of `frames`, each temperature a run of one code at a time.
+    /// Counts the MOSFET's and the capacitor's temperature codes of frames, each a run of one
+    /// code at a time.
     #[inline(always)]
-    fn count_codes(&mut self, frames: &[Data]) {
-        CodeRun::count(
-            frames,
-            Quantity::MosTemp,
-            &mut self.mos_codes,
-            &mut self.uncoded[0],
-        );
-        CodeRun::count(
-            frames,
-            Quantity::CapTemp,
-            &mut self.cap_codes,
-            &mut self.uncoded[1],
-        );
+    fn count_codes(
+        &mut self,
+        mos: impl Iterator<Item = Option<u8>>,
+        cap: impl Iterator<Item = Option<u8>>,
+    ) {
+        CodeRun::count(mos, &mut self.mos_codes, &mut self.uncoded[0]);
+        CodeRun::count(cap, &mut self.cap_codes, &mut self.uncoded[1]);
     }
 
     /// What a frame with a time adds: out of the decoder's loop, which stays as small as it
@@ -450,6 +588,21 @@ impl Accumulator {
         if let Some(t) = t {
             self.clock(t, f);
         }
+    }
+
+    /// A data frame of a protocol whose values are kept ([`Values`]): its values, and what
+    /// [`Self::add_data`] adds but its raw energy.
+    #[cold]
+    #[inline(never)]
+    fn add_values(&mut self, t: Option<f64>, f: &Data, settings: &Settings) {
+        let values = self.values.get_or_insert_with(Default::default);
+        let powered = values.add(f, settings);
+        if let (Some(t), Some((volts, amps))) = (t, powered) {
+            values.energy.add(Some(t), volts, amps);
+        }
+        self.add_data(t, f);
+        // Never the fast path, which keeps raw integers only.
+        self.fast = false;
     }
 
     #[inline]
@@ -499,6 +652,11 @@ impl Accumulator {
         }
         let base = self.tally.frames;
         self.sample = self.sample.or(later.sample);
+        match (&mut self.values, later.values) {
+            (Some(v), Some(l)) => v.join(&l),
+            (v @ None, l) => *v = l,
+            (Some(_), None) => {}
+        }
         self.tally.join(&later.tally);
         for (codes, more) in [
             (&mut self.mos_codes, &later.mos_codes),
@@ -544,12 +702,17 @@ impl Accumulator {
         self.episodes.append(&mut ended);
         self.episode_count += later.episode_count;
         self.episode = open;
-        self.fast = self.sample.is_some() && self.episode.is_none();
+        self.fast = self.sample.is_some() && self.episode.is_none() && self.values.is_none();
     }
 
     /// Charge, energy and power in raw units: integrated frame by frame over receive times,
     /// or for a stream without times (whose frames all lack them) from the lanes' sums.
     pub(super) fn energy(&self) -> Energy {
+        if let Some(values) = &self.values {
+            return values
+                .energy(self.first_t.is_some())
+                .unwrap_or_else(Energy::new);
+        }
         if self.first_t.is_some() {
             return self.energy;
         }
@@ -590,7 +753,11 @@ pub(super) fn temp_stats(codes: &[u64; 256], conversion: Conversion) -> TempStat
         }
         let temperature = match conversion {
             Conversion::AdcTable => Temperature::from_adc(code as u8),
-            Conversion::Linear(linear) => Temperature::Celsius(linear.to_f32(code as f32)),
+            other => match other.to_f32(code as i32) {
+                Some(c) => Temperature::Celsius(c),
+                // No value (a V4 code of 0): no reading, neither below nor above a range.
+                None => continue,
+            },
         };
         match temperature {
             Temperature::Celsius(c) => {

@@ -91,7 +91,7 @@ impl EscReport<'_> {
             .collect();
         let faults: serde_json::Map<String, Value> = self
             .faults()
-            .map(|(f, n)| (f.name().to_string(), json!(n)))
+            .map(|(name, _, n)| (name.to_string(), json!(n)))
             .collect();
         let infos: Vec<Value> = self
             .acc
@@ -101,13 +101,17 @@ impl EscReport<'_> {
                 let mut info = device_json(i);
                 info.insert("text".to_string(), json!(i.to_string()));
                 info.insert("frames".to_string(), json!(n));
+                if let Info::HwV4(v4) = i {
+                    let adopted = st.adopted_info() == Some(*v4);
+                    info.insert("adopted".to_string(), json!(adopted));
+                }
                 Value::Object(info)
             })
             .collect();
         let episodes: Vec<Value> = self
             .episodes
             .iter()
-            .map(|e| episode_json(e, self.clock))
+            .map(|e| episode_json(e, self.clock, &self.fault_names(e.bits)))
             .collect();
         let temps = |t: TempStats| json!({"below_range": t.below, "above_range": t.above});
         let warning = if st.bytes() == 0 {
@@ -115,6 +119,7 @@ impl EscReport<'_> {
         } else {
             (st.frames() == 0).then_some(self.no_frames.as_str())
         };
+        let counted = st.counts_packets();
         json!({
             "esc": self.index,
             "input": self.input,
@@ -131,11 +136,13 @@ impl EscReport<'_> {
             "clock_steps_back": self.acc.steps_back,
             "clock_jumps": self.acc.jumps,
             "frame_rate_hz": self.frame_rate(),
+            "protocol": self.protocol().map(Protocol::name),
             "link": {
-                "checksum_failures": st.checksum_failures(),
-                "lost_packets": st.lost_packets(),
-                "duplicate_packets": st.duplicate_packets(),
-                "restarts": st.restarts(),
+                "checksum_failures": st.has_checksum().then(|| st.checksum_failures()),
+                "rejected_candidates": st.rejected_frames(),
+                "lost_packets": counted.then(|| st.lost_packets()),
+                "duplicate_packets": counted.then(|| st.duplicate_packets()),
+                "restarts": counted.then(|| st.restarts()),
                 "bytes_skipped": st.bytes_skipped(),
                 "delivery_ratio": st.delivery_ratio(),
             },
@@ -178,18 +185,32 @@ fn clock_name(clock: Clock) -> &'static str {
 /// What an information frame says of the device, as every JSON output names it (`summary
 /// --json`, `monitor --json`): `{"product": ..., "hardware": ..., "firmware": ..., "id": ...}`.
 pub fn device_json(info: &Info) -> serde_json::Map<String, Value> {
-    [
-        ("product", info.product()),
-        ("hardware", info.hardware()),
-        ("firmware", info.firmware()),
-        ("id", info.id()),
-    ]
-    .into_iter()
-    .map(|(name, value)| (name.to_string(), json!(value)))
-    .collect()
+    let pairs: Vec<(&str, Value)> = match info {
+        Info::HwFoc(_) => vec![
+            ("product", json!(info.product())),
+            ("hardware", json!(info.hardware())),
+            ("firmware", json!(info.firmware())),
+            ("id", json!(info.id())),
+        ],
+        // A V4 info frame carries constants, no names (docs/OLDER-PROTOCOLS.md).
+        Info::HwV4(i) => vec![
+            ("full_scale", json!(i.full_scale)),
+            ("v1", json!(i.v1)),
+            ("v2", json!(i.v2)),
+            ("i1", json!(i.i1)),
+            ("i2", json!(i.i2)),
+            ("i3", json!(i.i3)),
+            ("t1", json!(i.t1)),
+            ("t2", json!(i.t2)),
+        ],
+    };
+    pairs
+        .into_iter()
+        .map(|(name, value)| (name.to_string(), value))
+        .collect()
 }
 
-fn episode_json(e: &Episode, clock: Clock) -> Value {
+fn episode_json(e: &Episode, clock: Clock, names: &[&str]) -> Value {
     let date = |t: Option<f64>| t.filter(|_| clock == Clock::Wall).map(time::iso8601);
     json!({
         "start_t_s": e.first.t,
@@ -203,7 +224,7 @@ fn episode_json(e: &Episode, clock: Clock) -> Value {
         "end_packet": e.last.packet,
         "frames": e.frames,
         "status": e.bits.0,
-        "faults": fault_names(e.bits),
+        "faults": names,
         "ongoing": e.ongoing,
     })
 }

@@ -27,9 +27,10 @@
 
 use std::any::Any;
 
+use hwfoc::foc::DataFrame;
 use hwfoc::telemetry::{Conversion, Data, Frame, Info, Telemetry};
 use hwfoc::units::Linear;
-use hwfoc::{Fault, Protocol, Quantity, Settings, Status};
+use hwfoc::{Protocol, Quantity, Settings, Status};
 use serde_json::{Value, json};
 
 use crate::energy::{Energy, NOMINAL_PERIOD_S};
@@ -53,10 +54,13 @@ mod text;
 use accumulate::{Accumulator, TempStats, is_clean, lane, temp_stats};
 pub use json::device_json;
 
-/// What to tell a user whose wire gave bytes but no frame: [`no_frames_of`] HW-FOC, the
-/// protocol of an ESC's own wire.
-pub static NO_FRAMES: std::sync::LazyLock<String> =
-    std::sync::LazyLock::new(|| no_frames_of(Protocol::HwFoc));
+/// What to tell a user whose wire gave bytes but no frame of any format: the formats, their
+/// baud rates and the wiring.
+pub static NO_FRAMES: std::sync::LazyLock<String> = std::sync::LazyLock::new(|| {
+    "no valid frame of any Hobbywing format (HW-FOC, DataLink V2, Hobbywing V4, Hobbywing V3, \
+     HW5): check the baud rate (19200; 115200 for DataLink and HW5) and the wiring"
+        .to_string()
+});
 
 /// What to tell a user whose wire gave bytes but no frame of `protocol`: its baud rate and the
 /// wiring.
@@ -70,20 +74,23 @@ pub fn no_frames_of(protocol: Protocol) -> String {
 
 /// Why ESC `esc`'s bytes gave no frame, as every output says it: what its input looks like
 /// when that is not telemetry (`text, not telemetry`, `looks like a PNG image, not telemetry`:
-/// a file given by mistake), else [`NO_FRAMES`], the advice for a wire (a port, a recording,
-/// a raw capture of bytes), or that of the protocol forced ([`Sources::force_protocol`]).
+/// a file given by mistake), else the advice of the protocol forced
+/// ([`Sources::force_protocol`]), else what the bytes of a raw input hold
+/// ([`Looks::Unframed`](crate::Looks::Unframed): its lead bytes, the baud rates and the
+/// wiring), else [`NO_FRAMES`], the advice for a wire (a port, a recording).
 pub fn no_frames(sources: &Sources, esc: usize) -> String {
-    let advice = || {
-        sources
-            .forced_protocol()
-            .map_or_else(|| NO_FRAMES.clone(), no_frames_of)
-    };
-    sources
+    let looks = sources
         .escs()
         .get(esc)
         .and_then(|e| sources.inputs().get(e.input))
-        .and_then(|input| input.looks)
-        .map_or_else(advice, |looks| looks.to_string())
+        .and_then(|input| input.looks);
+    if let Some(looks) = looks.filter(|l| l.is_other_than_telemetry()) {
+        return looks.to_string();
+    }
+    if let Some(protocol) = sources.forced_protocol() {
+        return no_frames_of(protocol);
+    }
+    looks.map_or_else(|| NO_FRAMES.clone(), |looks| looks.to_string())
 }
 
 /// Fault episodes kept per ESC in detail (all are counted).
@@ -150,7 +157,7 @@ impl Handler for Summary {
     /// to the accumulator, not through a `Decoded` in memory); every other frame is taken out of
     /// line.
     #[inline(always)]
-    fn frame(&mut self, esc: u8, t: Option<f64>, frame: &Frame, _: &Settings) {
+    fn frame(&mut self, esc: u8, t: Option<f64>, frame: &Frame, settings: &Settings) {
         let esc = usize::from(esc);
         if let Frame::Data(f) = frame
             && let Some(acc) = self.0.get_mut(esc)
@@ -159,14 +166,14 @@ impl Handler for Summary {
         {
             acc.add_clean(t, f);
         } else {
-            self.add(esc, t, frame);
+            self.add(esc, t, frame, settings);
         }
     }
 
     /// The frames of a raw input: the clean ones (as in [`Summary::frame`]) in a loop that
     /// holds the ESC's accumulator, any other out of line.
     #[inline]
-    fn untimed_data(&mut self, esc: u8, frames: &[Data], _: &Settings) {
+    fn untimed_data(&mut self, esc: u8, frames: &[DataFrame], settings: &Settings) {
         let esc = usize::from(esc);
         let mut i = 0;
         while i < frames.len() {
@@ -176,7 +183,7 @@ impl Handler for Summary {
                 i += acc.add_clean_run(&frames[i..]);
             }
             if let Some(f) = frames.get(i) {
-                self.add(esc, None, &Frame::Data(*f));
+                self.add(esc, None, &Frame::Data(Data::HwFoc(*f)), settings);
                 i += 1;
             }
         }
@@ -210,7 +217,7 @@ impl LaterPart for Part {
         self.0.frame(esc, None, frame, settings);
     }
 
-    fn untimed_data(&mut self, esc: u8, frames: &[Data], settings: &Settings) {
+    fn untimed_data(&mut self, esc: u8, frames: &[DataFrame], settings: &Settings) {
         self.0.untimed_data(esc, frames, settings);
     }
 
@@ -223,11 +230,11 @@ impl Summary {
     /// Any frame of ESC `esc`.
     #[cold]
     #[inline(never)]
-    fn add(&mut self, esc: usize, t: Option<f64>, frame: &Frame) {
+    fn add(&mut self, esc: usize, t: Option<f64>, frame: &Frame, settings: &Settings) {
         if self.0.len() <= esc {
             self.0.resize_with(esc + 1, Accumulator::default);
         }
-        self.0[esc].add(t, frame);
+        self.0[esc].add(t, frame, settings);
     }
 }
 
@@ -321,6 +328,9 @@ impl EscReport<'_> {
     /// Charge, energy and power, converted from the raw units under the settings.
     /// `None` for an ESC without data frames, or whose protocol sends no voltage or current.
     fn energy(&self) -> Option<Energy> {
+        if let Some(values) = &self.acc.values {
+            return (values.powered > 0).then(|| self.acc.energy());
+        }
         let volts = self.linear(Quantity::Voltage)?.to_f64(1.0);
         let amps = self.linear(Quantity::Current)?.to_f64(1.0);
         Some(self.acc.energy().scaled(volts, amps))
@@ -379,7 +389,22 @@ impl EscReport<'_> {
         (d > 0.0).then(|| (self.acc.tally.frames - 1) as f64 / d)
     }
 
+    /// The protocol of the ESC's frames (of its first data frame), if it sent one.
+    fn protocol(&self) -> Option<Protocol> {
+        self.acc.sample.map(|s| s.protocol())
+    }
+
     fn fields(&self) -> Vec<FieldRow> {
+        if let (Some(values), Some(protocol)) = (&self.acc.values, self.protocol()) {
+            return Quantity::ALL
+                .into_iter()
+                .map(|q| {
+                    let carried = protocol.carries(q);
+                    let stats = values.range(q).stats().filter(|_| carried);
+                    (q.name(), q.unit(), stats, carried)
+                })
+                .collect();
+        }
         // The protocol's conversions, applied to the raw min, max and mean.
         let field = |q: Quantity| {
             let stats = match lane(q) {
@@ -412,16 +437,21 @@ impl EscReport<'_> {
         }
     }
 
-    fn faults(&self) -> impl Iterator<Item = (Fault, u64)> + '_ {
-        Fault::ALL
-            .into_iter()
-            .map(|f| (f, self.acc.fault_frames[usize::from(f.bit())]))
-            .filter(|&(_, n)| n > 0)
+    /// Each fault of the ESC's protocol seen: its name, description and frames.
+    fn faults(&self) -> impl Iterator<Item = (&'static str, &'static str, u64)> + '_ {
+        let protocol = self.protocol().unwrap_or(Protocol::HwFoc);
+        (0..16u8).filter_map(move |bit| {
+            let n = self.acc.fault_frames[usize::from(bit)];
+            let name = protocol.fault_name(bit)?;
+            (n > 0).then(|| (name, protocol.fault_description(bit).unwrap_or(name), n))
+        })
     }
-}
 
-fn fault_names(status: Status) -> Vec<&'static str> {
-    status.faults().map(Fault::name).collect()
+    /// The names of the faults set in `status`, a fault word of the ESC's protocol.
+    fn fault_names(&self, status: Status) -> Vec<&'static str> {
+        let protocol = self.protocol().unwrap_or(Protocol::HwFoc);
+        protocol.fault_names(status).collect()
+    }
 }
 
 fn percent(part: u64, whole: u64) -> f64 {

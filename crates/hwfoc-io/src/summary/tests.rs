@@ -60,7 +60,11 @@ fn episodes_are_maximal_runs_of_faulty_frames() {
             status: Status(s),
             ..Default::default()
         };
-        acc.add(Some(i as f64 * 0.05), &Frame::Data(frame.into()));
+        acc.add(
+            Some(i as f64 * 0.05),
+            &Frame::Data(frame.into()),
+            &Settings::DEFAULT,
+        );
     }
     assert_eq!(acc.episode_count, 2);
     let first = acc.episodes[0];
@@ -74,7 +78,7 @@ fn episodes_are_maximal_runs_of_faulty_frames() {
     );
     assert_eq!(first.first.t, Some(0.05));
     assert_eq!(
-        fault_names(first.bits),
+        Protocol::HwFoc.fault_names(first.bits).collect::<Vec<_>>(),
         ["input_voltage_high", "mos_overheat"]
     );
     assert!(!first.ongoing);
@@ -89,13 +93,13 @@ fn episodes_are_maximal_runs_of_faulty_frames() {
 /// change and repeat, faults and their episodes, power.
 #[test]
 fn frames_handed_on_together_are_summarised_as_one_at_a_time() {
-    let frames: Vec<Data> = (0..3000u16)
+    let frames: Vec<DataFrame> = (0..3000u16)
         .map(|i| {
             let status = match i {
                 700..=720 | 1999 | 2500..=2502 => Status(0x0040 | (i & 1)),
                 _ => Status(0),
             };
-            Data::from(DataFrame {
+            DataFrame {
                 packet: i.wrapping_mul(7),
                 throttle_in_raw: i % 1000,
                 throttle_out_raw: 999 - i % 1000,
@@ -106,13 +110,13 @@ fn frames_handed_on_together_are_summarised_as_one_at_a_time() {
                 mos_adc: 180 + (i / 100) as u8,
                 cap_adc: if i % 500 < 250 { 200 } else { (i % 13) as u8 },
                 status,
-            })
+            }
         })
         .collect();
     let settings = Settings::DEFAULT;
     let mut one_at_a_time = Summary::new();
     for f in &frames {
-        one_at_a_time.frame(0, None, &Frame::Data(*f), &settings);
+        one_at_a_time.frame(0, None, &Frame::Data(Data::HwFoc(*f)), &settings);
     }
     for run in [1, 2, 7, 512, 3000] {
         let mut together = Summary::new();

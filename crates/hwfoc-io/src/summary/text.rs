@@ -123,13 +123,23 @@ impl EscReport<'_> {
                 let _ = writeln!(o, "clock        {text}");
             }
         }
+        let checks = match st.rejected_frames() {
+            Some(n) => format!("{n} rejected candidates (no checksum)"),
+            None => format!("{} checksum failures", st.checksum_failures()),
+        };
+        let counted = if st.counts_packets() {
+            format!(
+                "{} lost packets, {} duplicate packets, {} restarts",
+                st.lost_packets(),
+                st.duplicate_packets(),
+                st.restarts()
+            )
+        } else {
+            "no packet counter (loss not counted)".to_string()
+        };
         let _ = writeln!(
             o,
-            "link         {} checksum failures, {} lost packets, {} duplicate packets, {} restarts, {} bytes skipped ({:.2} %)",
-            st.checksum_failures(),
-            st.lost_packets(),
-            st.duplicate_packets(),
-            st.restarts(),
+            "link         {checks}, {counted}, {} bytes skipped ({:.2} %)",
             st.bytes_skipped(),
             percent(st.bytes_skipped(), st.bytes())
         );
@@ -139,8 +149,17 @@ impl EscReport<'_> {
         if st.frames() == 0 {
             let _ = writeln!(o, "             no data frames: {}", self.no_frames);
         }
+        let adopted = st.adopted_info();
         for (info, n) in &self.acc.infos {
-            let _ = writeln!(o, "device       {}  ({n} info frames)", Escaped(info));
+            let adopted = match info {
+                hwfoc::telemetry::Info::HwV4(i) if Some(*i) == adopted => ", adopted",
+                _ => "",
+            };
+            let _ = writeln!(
+                o,
+                "device       {}  ({n} info frames{adopted})",
+                Escaped(info)
+            );
         }
         if self.acc.tally.frames == 0 {
             return;
@@ -183,13 +202,8 @@ impl EscReport<'_> {
             let _ = writeln!(o, "faults       none");
             return;
         }
-        for (fault, n) in self.faults() {
-            let _ = writeln!(
-                o,
-                "fault        {:<22} in {n} frames ({})",
-                fault.name(),
-                fault.description()
-            );
+        for (name, description, n) in self.faults() {
+            let _ = writeln!(o, "fault        {name:<22} in {n} frames ({description})");
         }
         let _ = writeln!(
             o,
@@ -197,7 +211,12 @@ impl EscReport<'_> {
             self.episode_count
         );
         for (i, e) in self.episodes.iter().take(TEXT_EPISODES).enumerate() {
-            let _ = writeln!(o, "  {:>4}  {}", i + 1, episode_text(e, self.clock));
+            let _ = writeln!(
+                o,
+                "  {:>4}  {}",
+                i + 1,
+                episode_text(e, self.clock, &self.fault_names(e.bits))
+            );
         }
         let more = self.episode_count - self.episodes.len().min(TEXT_EPISODES) as u64;
         if more > 0 {
@@ -230,7 +249,7 @@ fn energy_text(e: &Energy) -> String {
 }
 
 /// An episode in one line: when (dates on a wall clock), how long, which faults.
-fn episode_text(e: &Episode, clock: Clock) -> String {
+fn episode_text(e: &Episode, clock: Clock, names: &[&str]) -> String {
     let mut s = format!("{} (", e.when(clock == Clock::Wall));
     if let (Some(a), Some(b)) = (e.first.t, e.last.t) {
         let _ = write!(s, "{:.3} s, ", b - a);
@@ -239,7 +258,7 @@ fn episode_text(e: &Episode, clock: Clock) -> String {
     if let (Some(a), Some(b)) = (e.first.packet, e.last.packet) {
         let _ = write!(s, ", packets {a} .. {b}");
     }
-    let _ = write!(s, ")  {}", fault_names(e.bits).join(", "));
+    let _ = write!(s, ")  {}", names.join(", "));
     if e.ongoing {
         s.push_str("  (still on at the end)");
     }

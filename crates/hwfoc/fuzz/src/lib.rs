@@ -5,7 +5,7 @@ use std::fmt;
 use hwfoc::datalink::LengthByte;
 use hwfoc::foc::{Decoded, Frame, Parsed, parse};
 use hwfoc::scan::{Scan, Scanner, Stats as _, StreamDecoder};
-use hwfoc::{datalink, foc, hw5, v3, v4};
+use hwfoc::{datalink, detect, foc, hw5, mixed, v3, v4};
 
 /// Panics unless `decoded` and `stats` are a consistent decoding of `input`, a whole stream
 /// (a flushed `Decoder`, or an exhausted `frames` iterator):
@@ -481,5 +481,159 @@ pub fn check_hw5_stream(input: &[u8], decoded: &[hw5::Decoded], stats: &hw5::Sta
             "parse at {start}"
         );
         assert_eq!(hw5::TelemetryFrame::parse(&d.frame.encode()), Ok(d.frame));
+    }
+}
+
+/// What a `detect::Decoder` tells of itself: the format locked onto (and last), the bytes
+/// given and each format's statistics.
+#[derive(Debug, Clone, PartialEq)]
+pub struct DetectState {
+    /// `locked()` and `last_locked()`.
+    pub locked: (Option<detect::Family>, Option<detect::Family>),
+    /// `bytes()`.
+    pub bytes: u64,
+    /// Each format's statistics.
+    pub stats: (mixed::Stats, hw5::Stats, v4::Stats, v3::Stats),
+}
+
+/// The state of `d`.
+pub fn detect_state(d: &detect::Decoder) -> DetectState {
+    DetectState {
+        locked: (d.locked(), d.last_locked()),
+        bytes: d.bytes(),
+        stats: (
+            *d.mixed_stats(),
+            *d.hw5_stats(),
+            *d.v4_stats(),
+            *d.v3_stats(),
+        ),
+    }
+}
+
+/// Panics unless `got` holds the frames of `expected`: each format's in the same order, and
+/// the same ones in all (frames of two formats found in one slice while detecting interleave
+/// as the chunks say, see `hwfoc::detect`).
+pub fn assert_same_detected(got: &[detect::Decoded], expected: &[detect::Decoded], what: &str) {
+    for family in detect::Family::ALL {
+        let of = |v: &[detect::Decoded]| -> Vec<detect::Decoded> {
+            v.iter().filter(|d| d.family() == family).copied().collect()
+        };
+        assert_eq!(of(got), of(expected), "{what}: {family:?} frames");
+    }
+    assert_eq!(got.len(), expected.len(), "{what}: frames");
+}
+
+/// Panics unless `decoded` and the state of `d` (flushed) are a consistent decoding of
+/// `input`: every format's decoder counted every byte, and each format's frames pass that
+/// format's whole-stream checks (`check_v3_stream` and the others; HW-FOC's and DataLink's
+/// when the stream held frames of one of them only, as their byte counts assume).
+pub fn check_detected(input: &[u8], decoded: &[detect::Decoded], d: &detect::Decoder) {
+    assert_eq!(d.bytes(), input.len() as u64, "bytes given");
+    assert_eq!(d.buffered(), 0, "nothing held after a flush");
+    let (mut esc, mut hub, mut five, mut four, mut three) =
+        (vec![], vec![], vec![], vec![], vec![]);
+    for x in decoded {
+        match *x {
+            detect::Decoded::Mixed(mixed::Decoded::Esc(f)) => esc.push(f),
+            detect::Decoded::Mixed(mixed::Decoded::Hub(f)) => hub.push(f),
+            detect::Decoded::Hw5(f) => five.push(f),
+            detect::Decoded::HwV4(f) => four.push(f),
+            detect::Decoded::HwV3(f) => three.push(f),
+        }
+    }
+    let m = d.mixed_stats();
+    assert_eq!(m.hub.bytes(), input.len() as u64, "DataLink bytes counted");
+    if hub.is_empty() {
+        check_stream(input, &esc, &m.esc);
+    }
+    if esc.is_empty() {
+        check_datalink_stream(input, &hub, &m.hub);
+    }
+    check_hw5_stream(input, &five, d.hw5_stats());
+    check_v4_stream(input, &four, d.v4_stats());
+    check_v3_stream(input, &three, d.v3_stats());
+}
+
+/// The whole check of the `detect` target: `decode_all` (checked by [`check_detected`]), a
+/// byte at a time (the same frames and state), and fed as the schedule says (the layout of
+/// [`feed_scheduled`], `line_silent_each(k, k)` for `195..=199`), checked after every call
+/// (the byte count, a frame's offset before the bytes given) and at the end (by
+/// [`check_detected`], and the same frames and state as `decode_all` when nothing settled
+/// the stream mid-way).
+pub fn check_detect(data: &[u8]) {
+    let Some((schedule, input)) = split_schedule(data) else {
+        return;
+    };
+    let mut all = detect::Decoder::new();
+    let mut bulk = Vec::new();
+    all.decode_all(input, |x| bulk.push(x));
+    check_detected(input, &bulk, &all);
+    let state = detect_state(&all);
+
+    let mut bytewise = detect::Decoder::new();
+    let mut got = Vec::new();
+    for &b in input {
+        bytewise.feed(&[b], |x| got.push(x));
+    }
+    bytewise.flush(|x| got.push(x));
+    assert_same_detected(&got, &bulk, "byte at a time");
+    assert_eq!(detect_state(&bytewise), state, "byte at a time");
+
+    let n = schedule.len();
+    let mut dec = detect::Decoder::new();
+    let mut got = Vec::new();
+    let (mut at, mut step, mut idle_steps) = (0, 0, 0);
+    let mut settled_mid_stream = false;
+    while at < input.len() {
+        let op = schedule[step % n];
+        step += 1;
+        let left = input.len() - at;
+        match op {
+            0 | 190..=199 => {
+                match op {
+                    0 => dec.feed(&[], |x| got.push(x)),
+                    190..=194 => dec.flush(|x| got.push(x)),
+                    _ => {
+                        let k = u32::from(op - 195);
+                        dec.line_silent_each(k, k, |x| got.push(x));
+                        assert_eq!(dec.locked(), None, "detecting after a silence");
+                    }
+                }
+                settled_mid_stream |= op != 0;
+                idle_steps += 1;
+                if idle_steps >= n {
+                    dec.feed(&input[at..at + 1], |x| got.push(x));
+                    at += 1;
+                    idle_steps = 0;
+                }
+            }
+            200..=254 => {
+                for &b in &input[at..at + usize::from(op - 199).min(left)] {
+                    dec.feed(&[b], |x| got.push(x));
+                    at += 1;
+                }
+                idle_steps = 0;
+            }
+            _ => {
+                let len = if op == 255 {
+                    left
+                } else {
+                    usize::from(op).min(left)
+                };
+                dec.feed(&input[at..at + len], |x| got.push(x));
+                at += len;
+                idle_steps = 0;
+            }
+        }
+        assert_eq!(dec.bytes(), at as u64, "bytes fed so far");
+        if let Some(last) = got.last() {
+            assert!(last.offset() < at as u64, "a frame beyond the bytes fed");
+        }
+    }
+    dec.flush(|x| got.push(x));
+    check_detected(input, &got, &dec);
+    if !settled_mid_stream {
+        assert_same_detected(&got, &bulk, "scheduled");
+        assert_eq!(detect_state(&dec), state, "scheduled");
     }
 }

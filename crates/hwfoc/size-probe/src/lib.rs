@@ -186,6 +186,7 @@ mod units {
             current_scale: settings.current_scale,
             pole_pairs: settings.pole_pairs,
             gear_ratio: settings.gear_ratio,
+            ..Settings::DEFAULT
         };
         out.voltage_v = frame.voltage_v();
         out.current_a = frame.current_a(&settings);

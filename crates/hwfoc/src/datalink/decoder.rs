@@ -176,6 +176,11 @@ impl scan::Stats for Stats {
         Stats::line_silent(self, max_frames);
     }
 
+    #[inline]
+    fn skip_bytes(&mut self, n: usize) {
+        self.skip(n);
+    }
+
     /// Joined when `later` found no hub frame (`first_packet` is an ESC's, not the hub's).
     fn then(&mut self, later: &Self, _: Option<u16>) -> bool {
         Stats::then(self, later)

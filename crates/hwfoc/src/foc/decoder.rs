@@ -192,6 +192,11 @@ impl scan::Stats for Stats {
         Stats::line_silent(self, max_frames);
     }
 
+    #[inline]
+    fn skip_bytes(&mut self, n: usize) {
+        self.skip(n);
+    }
+
     fn then(&mut self, later: &Self, first_packet: Option<u16>) -> bool {
         Stats::then(self, later, first_packet)
     }

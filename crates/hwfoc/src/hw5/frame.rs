@@ -8,10 +8,13 @@
 //! ```
 
 use crate::foc::FrameError;
+use crate::status::Status;
+use crate::telemetry::{Conversion, Reading, Telemetry};
+use crate::units::{Linear, Quantity, Settings};
 
 use super::error::Error;
 use super::layout::{
-    AMPS, CHECKSUM, CODE_AT, HEADER_LEN, Kind, PAYLOAD_LEN_AT, TELEMETRY_BYTES_7_8,
+    AMPS, CHECKSUM, CODE_AT, ERPM, HEADER_LEN, Kind, PAYLOAD_LEN_AT, TELEMETRY_BYTES_7_8,
     TELEMETRY_CHECK_AT, TELEMETRY_HEADER, TELEMETRY_LEN, TELEMETRY_PAYLOAD_LEN, TYPE_AT, VOLTS, at,
     direction_of, kinds_of,
 };
@@ -292,6 +295,45 @@ impl TelemetryFrame {
     /// BEC current in amperes (raw / 10).
     pub fn bec_current_a(&self) -> f32 {
         AMPS.to_f32(f32::from(self.bec_current_raw))
+    }
+}
+
+impl Telemetry for TelemetryFrame {
+    /// None: HW5 sends no packet counter.
+    #[inline]
+    fn packet(&self) -> Option<u32> {
+        None
+    }
+
+    /// The fault byte as a fault word of eight bits ([`Fault`]'s, named through
+    /// [`Protocol::Hw5`](crate::Protocol::fault_name)).
+    #[inline]
+    fn status(&self) -> Option<Status> {
+        Some(Status(u16::from(self.fault.0)))
+    }
+
+    /// Throttle (one value: the input throttle's column) in percent as sent, eRPM / 10,
+    /// voltages and currents in tenths, temperatures in degC; no output throttle, phase current
+    /// or capacitor temperature. Current is the wire's (see [`TelemetryFrame::current_raw`]).
+    #[inline]
+    fn reading(&self, quantity: Quantity, settings: &Settings) -> Option<Reading> {
+        let linear = |raw: u16, linear: Linear| Reading {
+            raw: i32::from(raw),
+            conversion: Conversion::Linear(linear),
+        };
+        Some(match quantity {
+            Quantity::ThrottleIn => linear(self.throttle.into(), Linear::IDENTITY),
+            Quantity::Erpm => linear(self.erpm_raw, ERPM),
+            Quantity::Rpm => linear(self.erpm_raw, settings.rpm_linear()),
+            Quantity::Voltage => linear(self.voltage_raw, VOLTS),
+            Quantity::Current => linear(self.current_raw, AMPS),
+            Quantity::MosTemp => linear(self.esc_temp.into(), Linear::IDENTITY),
+            Quantity::MotorTemp => linear(self.motor_temp.into(), Linear::IDENTITY),
+            Quantity::BecTemp => linear(self.bec_temp.into(), Linear::IDENTITY),
+            Quantity::BecVoltage => linear(self.bec_voltage_raw.into(), VOLTS),
+            Quantity::BecCurrent => linear(self.bec_current_raw.into(), AMPS),
+            Quantity::ThrottleOut | Quantity::PhaseCurrent | Quantity::CapTemp => return None,
+        })
     }
 }
 

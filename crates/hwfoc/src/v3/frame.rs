@@ -6,7 +6,9 @@
 //!       u24       u16, 0..=255   u16, 0..=255  (35314 before the motor turns: no speed)
 //! ```
 
-use crate::units::Linear;
+use crate::status::Status;
+use crate::telemetry::{Conversion, Reading, Telemetry};
+use crate::units::{Linear, Quantity, Settings};
 use crate::wire::SYNC;
 
 /// Length of a V3 frame (the only frame type).
@@ -109,6 +111,37 @@ impl Frame {
     /// start-up placeholder [`PLACEHOLDER_PERIOD_US`] and a period of 0.
     pub const fn erpm(&self) -> Option<u32> {
         erpm_of_period(self.period_us)
+    }
+}
+
+impl Telemetry for Frame {
+    #[inline]
+    fn packet(&self) -> Option<u32> {
+        Some(self.counter)
+    }
+
+    /// None: V3 sends no status word.
+    #[inline]
+    fn status(&self) -> Option<Status> {
+        None
+    }
+
+    /// Throttle and PWM in 255ths; eRPM (and RPM) from the period, its raw integer the eRPM
+    /// rounded down ([`Frame::erpm`]), not carried by the start-up placeholder or a period of
+    /// 0. V3 carries nothing else.
+    #[inline]
+    fn reading(&self, quantity: Quantity, settings: &Settings) -> Option<Reading> {
+        let linear = |raw: u32, linear: Linear| Reading {
+            raw: raw as i32,
+            conversion: Conversion::Linear(linear),
+        };
+        Some(match quantity {
+            Quantity::ThrottleIn => linear(self.throttle_in_raw.into(), Self::THROTTLE_PCT),
+            Quantity::ThrottleOut => linear(self.pwm_out_raw.into(), Self::THROTTLE_PCT),
+            Quantity::Erpm => linear(self.erpm()?, Linear::IDENTITY),
+            Quantity::Rpm => linear(self.erpm()?, settings.erpm_to_rpm()),
+            _ => return None,
+        })
     }
 }
 

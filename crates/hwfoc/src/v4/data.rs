@@ -1,7 +1,9 @@
 //! The V4 data frame: its raw fields ([`DataFrame`]), and the frame as the decoder emits it with
 //! the scales it was decoded under ([`Data`]).
 
-use crate::units::Linear;
+use crate::status::Status;
+use crate::telemetry::{Conversion, Reading, Telemetry};
+use crate::units::{Linear, Quantity, Settings};
 use crate::wire::SYNC;
 
 use super::info::{InfoFrame, VoltsPerStep, throttle_linear};
@@ -221,6 +223,58 @@ impl Data {
     /// Second temperature in degC, or `None` for no reading.
     pub fn temp2_c(&self) -> Option<f32> {
         self.frame.temp2_c()
+    }
+}
+
+impl Telemetry for Data {
+    #[inline]
+    fn packet(&self) -> Option<u32> {
+        Some(self.frame.counter)
+    }
+
+    /// None: V4 sends no status word.
+    #[inline]
+    fn status(&self) -> Option<Status> {
+        None
+    }
+
+    /// Throttle and PWM through the full scale, voltage through the info frame's volts per step
+    /// (before one, `settings.v4_volts_per_step`), current through its constants (not carried
+    /// before one, nor without a current sensor), temperatures through the NTC formula.
+    #[inline]
+    fn reading(&self, quantity: Quantity, settings: &Settings) -> Option<Reading> {
+        let linear = |raw: u32, linear: Linear| Reading {
+            raw: raw as i32,
+            conversion: Conversion::Linear(linear),
+        };
+        let f = &self.frame;
+        Some(match quantity {
+            Quantity::ThrottleIn => linear(f.throttle_in_raw.into(), self.throttle_linear()),
+            Quantity::ThrottleOut => linear(f.throttle_out_raw.into(), self.throttle_linear()),
+            Quantity::Erpm => linear(f.erpm, Linear::IDENTITY),
+            Quantity::Rpm => linear(f.erpm, settings.erpm_to_rpm()),
+            Quantity::Voltage => linear(
+                f.voltage_adc.into(),
+                self.volts_per_step(settings.v4_volts_per_step).linear(),
+            ),
+            Quantity::Current => Reading {
+                raw: f.current_adc.into(),
+                conversion: Conversion::V4Current(self.info?.current_scale()?),
+            },
+            Quantity::MosTemp => Reading {
+                raw: f.temp_adc.into(),
+                conversion: Conversion::Ntc,
+            },
+            Quantity::CapTemp => Reading {
+                raw: f.temp2_adc.into(),
+                conversion: Conversion::Ntc,
+            },
+            Quantity::PhaseCurrent
+            | Quantity::MotorTemp
+            | Quantity::BecTemp
+            | Quantity::BecVoltage
+            | Quantity::BecCurrent => return None,
+        })
     }
 }
 

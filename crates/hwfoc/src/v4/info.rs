@@ -129,6 +129,31 @@ impl InfoFrame {
     }
 }
 
+impl core::fmt::Display for InfoFrame {
+    /// The constants in words: `full scale 1000, 8/910 V per step, no current sensor, T1 0x21
+    /// T2 0x21` (with a sensor: `current adc * 1 / 2 - 0 A`).
+    ///
+    /// ```
+    /// use hwfoc::v4::InfoFrame;
+    ///
+    /// let info = InfoFrame { full_scale: 1000, v1: 8, v2: 91, i1: 0, i2: 1, i3: 0, t1: 0x21, t2: 0x21 };
+    /// assert_eq!(info.to_string(), "full scale 1000, 8/910 V per step, no current sensor, T1 0x21 T2 0x21");
+    /// ```
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        let v = self.volts_per_step();
+        write!(
+            f,
+            "full scale {}, {}/{} V per step, ",
+            self.full_scale, v.num, v.den
+        )?;
+        match self.current_scale() {
+            Some(c) => write!(f, "current adc * {} / {} - {} A", c.mul, c.div, c.offset)?,
+            None => f.write_str("no current sensor")?,
+        }
+        write!(f, ", T1 0x{:02X} T2 0x{:02X}", self.t1, self.t2)
+    }
+}
+
 /// The conversion of throttle and PWM to percent under `full_scale`: `raw * 100 / full_scale`.
 pub const fn throttle_linear(full_scale: u16) -> Linear {
     Linear::new(100.0, full_scale as f32, 1.0)

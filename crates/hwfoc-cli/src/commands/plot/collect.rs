@@ -207,6 +207,8 @@ pub struct EscData {
     pub clock: Option<(f64, f64)>,
     /// Its first device-information frame.
     pub info: Option<Info>,
+    /// The protocol of its first data frame (which names its fault bits).
+    pub protocol: Option<hwfoc::Protocol>,
     /// Its plotted frames.
     pub buckets: Buckets,
     /// Its fault spans, in time order.
@@ -248,12 +250,14 @@ impl EscData {
             shift: 0.0,
             open: None,
             first_episode: None,
+            protocol: None,
             first_open: None,
         }
     }
 
     #[inline]
     fn add(&mut self, r: &Record, window: &mut Window) {
+        self.protocol.get_or_insert(r.protocol);
         let t = r.t_s;
         let index = self.frames;
         self.frames += 1;

@@ -635,7 +635,7 @@ impl<'a> Scene<'a> {
             // Where each text was last put: the same names are not repeated close by.
             let mut seen: Vec<(String, i32)> = Vec::new();
             for &(a, _, bits) in &spans {
-                let names = fault_names(bits);
+                let names = fault_names(data.protocol, bits);
                 let (tw, th) = chart.plotting_area().estimate_text_size(&names, &small)?;
                 let (tw, th) = (tw as i32, th as i32);
                 let (px, _) = chart.backend_coord(&(a, y_hi));
@@ -934,11 +934,11 @@ fn cut_at_sharp_turns(
     pieces
 }
 
-/// The fault names of a status word, joined.
-fn fault_names(status: hwfoc::Status) -> String {
-    status
-        .faults()
-        .map(hwfoc::Fault::name)
+/// The fault names of a fault word of `protocol`, joined.
+fn fault_names(protocol: Option<hwfoc::Protocol>, status: hwfoc::Status) -> String {
+    protocol
+        .unwrap_or(hwfoc::Protocol::HwFoc)
+        .fault_names(status)
         .collect::<Vec<_>>()
         .join(", ")
 }
@@ -950,7 +950,7 @@ fn fault_summary(data: &EscData, wall: bool) -> (String, RGBColor) {
         return ("no faults".to_string(), OK_TEXT);
     };
     let bits = data.spans.iter().fold(0u16, |acc, s| acc | s.bits.0);
-    let names = fault_names(hwfoc::Status(bits));
+    let names = fault_names(data.protocol, hwfoc::Status(bits));
     let text = if data.episodes == 1 {
         format!(
             "fault: {names}, {}{}",

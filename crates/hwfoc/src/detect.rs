@@ -1,0 +1,447 @@
+//! Streams of any Hobbywing serial format, told from their bytes: the [`Decoder`] reads HW-FOC
+//! and DataLink V2 ([`mixed`]), Hobbywing V4 ([`v4`]), V3 ([`v3`]) and HW5 ([`hw5`]) and locks
+//! onto the format it finds.
+//!
+//! Until it has locked, every format's decoder is given every byte, in slices of [`SLICE`]
+//! bytes that start at multiples of [`SLICE`] in the stream; at the end of a slice in which
+//! one or more of them found a frame, it locks onto the first of those in the order HW-FOC and
+//! DataLink, HW5, V4, V3 (checksummed formats before the chained ones). Locked, it gives the
+//! bytes to that format's decoder only, so a stream of one format is read at that decoder's
+//! speed. After a silence of the line ([`Decoder::line_silent_each`]), and at the end of a
+//! block of [`RELOCK_AFTER`] bytes (blocks start at its multiples in the stream) in which the
+//! locked format's decoder handed on no frame, it reads every format again (a stream may change format: an adapter moved from one ESC to another); a decoder that was not given some bytes passes over them
+//! ([`StreamDecoder::pass_over`](crate::StreamDecoder::pass_over)): they are its skipped bytes, so every decoder's offsets and
+//! statistics are the stream's.
+//!
+//! The frames, each format's in the same order, and where it locks, are the same however the
+//! stream is cut into chunks: slices and blocks are counted from the stream's start. Frames of two formats found in one slice while detecting come out
+//! format by format within each chunk given (the formats' decoders read a chunk one after the
+//! other), so how they interleave depends on the chunking: a chunk holding the whole slice
+//! gives them format by format, bytes given one at a time give them in the order they were
+//! decided. HW-FOC and DataLink frames always come in byte order ([`mixed`]).
+//!
+//! How soon it locks: on the first checksummed frame (an HW-FOC or HW5 frame), on three
+//! chained V3 frames (about 60 ms of a V3 ESC's wire) or V4 frames (150 ms running), or a V4
+//! data and info frame chained (idle), each within a slice more.
+//!
+//! ```
+//! use hwfoc::detect::{Decoder, Decoded, Family};
+//! use hwfoc::v3;
+//!
+//! let mut wire = Vec::new();
+//! for counter in 0..5 {
+//!     let frame = v3::Frame { counter, throttle_in_raw: 51, pwm_out_raw: 51, period_us: 1500 };
+//!     wire.extend_from_slice(&frame.encode());
+//! }
+//! let mut decoder = Decoder::new();
+//! let mut found = Vec::new();
+//! decoder.decode_all(&wire, |d| found.push(d));
+//! assert_eq!(found.len(), 5);
+//! assert!(matches!(found[0], Decoded::HwV3(_)));
+//! assert_eq!(decoder.locked(), Some(Family::HwV3));
+//! ```
+
+use crate::{hw5, mixed, v3, v4};
+
+/// Bytes per slice while detecting (see the module documentation).
+pub const SLICE: u64 = 64;
+
+/// The blocks of the stream, at multiples of this many bytes, at whose end every format is read
+/// again when the locked format's decoder handed on no frame in the block: more than any
+/// format's frame and the gap between two of them on a working wire. (Blocks, not bytes since
+/// the last frame: the frames' offsets need not be followed, so the decoder of a locked HW-FOC
+/// stream runs as fast as [`mixed`]'s alone.) A new format is found at most two blocks and a
+/// slice after the change.
+pub const RELOCK_AFTER: u64 = 4096;
+
+/// A format the decoder locks onto: HW-FOC and DataLink are read by one decoder ([`mixed`]),
+/// which tells them apart frame by frame.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Family {
+    /// HW-FOC or DataLink V2 ([`mixed`]).
+    Mixed,
+    /// HW5 ([`hw5`]).
+    Hw5,
+    /// Hobbywing V4 ([`v4`]).
+    HwV4,
+    /// Hobbywing V3 ([`v3`]).
+    HwV3,
+}
+
+impl Family {
+    /// Every family, in the order they are preferred when two find frames in one slice.
+    pub const ALL: [Family; 4] = [Family::Mixed, Family::Hw5, Family::HwV4, Family::HwV3];
+}
+
+/// A frame of any format, with its stream offset.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Decoded {
+    /// An HW-FOC or DataLink V2 frame.
+    Mixed(mixed::Decoded),
+    /// A Hobbywing V4 frame (data or info).
+    HwV4(v4::Decoded),
+    /// A Hobbywing V3 frame.
+    HwV3(v3::Decoded),
+    /// An HW5 telemetry frame.
+    Hw5(hw5::Decoded),
+}
+
+impl Decoded {
+    /// Offset of the frame's first byte in the stream.
+    pub fn offset(&self) -> u64 {
+        match self {
+            Decoded::Mixed(d) => d.offset(),
+            Decoded::HwV4(d) => d.offset,
+            Decoded::HwV3(d) => d.offset,
+            Decoded::Hw5(d) => d.offset,
+        }
+    }
+
+    /// The family of its format.
+    pub fn family(&self) -> Family {
+        match self {
+            Decoded::Mixed(_) => Family::Mixed,
+            Decoded::HwV4(_) => Family::HwV4,
+            Decoded::HwV3(_) => Family::HwV3,
+            Decoded::Hw5(_) => Family::Hw5,
+        }
+    }
+}
+
+/// A decoder of every Hobbywing serial format at once (see the module documentation).
+#[derive(Debug, Clone, Default)]
+pub struct Decoder {
+    mixed: mixed::Decoder,
+    v4: v4::Decoder,
+    v3: v3::Decoder,
+    hw5: hw5::Decoder,
+    /// Every byte given so far.
+    bytes: u64,
+    /// The format locked onto, if any.
+    locked: Option<Family>,
+    /// The format locked onto last (it stays when detection starts again, until another is).
+    last_locked: Option<Family>,
+    /// Locked: the locked decoder's frames handed on by the start of the current block, or
+    /// `None` for the block it locked in (not judged: it is only partly locked).
+    block_start: Option<u64>,
+    /// Detecting: which families found a frame in the current slice, and the last one's offset.
+    found: [Option<u64>; 4],
+}
+
+impl Decoder {
+    /// A decoder with nothing seen, detecting.
+    pub fn new() -> Decoder {
+        Decoder::default()
+    }
+
+    /// The format locked onto, if it is locked.
+    pub fn locked(&self) -> Option<Family> {
+        self.locked
+    }
+
+    /// The format it last locked onto (while it detects again too), if it ever locked.
+    pub fn last_locked(&self) -> Option<Family> {
+        self.last_locked
+    }
+
+    /// Every byte given so far.
+    pub fn bytes(&self) -> u64 {
+        self.bytes
+    }
+
+    /// Bytes held for a frame still arriving: the locked decoder's, or while detecting, the
+    /// most any decoder holds.
+    pub fn buffered(&self) -> usize {
+        match self.locked {
+            Some(Family::Mixed) => self.mixed.buffered(),
+            Some(Family::HwV4) => self.v4.buffered(),
+            Some(Family::HwV3) => self.v3.buffered(),
+            Some(Family::Hw5) => self.hw5.buffered(),
+            None => self
+                .mixed
+                .buffered()
+                .max(self.v4.buffered())
+                .max(self.v3.buffered())
+                .max(self.hw5.buffered()),
+        }
+    }
+
+    /// HW-FOC's and DataLink's statistics (of the bytes given to their decoder so far: all
+    /// of them after [`Decoder::flush`]).
+    pub fn mixed_stats(&self) -> &mixed::Stats {
+        self.mixed.stats()
+    }
+
+    /// V4's statistics (see [`Decoder::mixed_stats`]).
+    pub fn v4_stats(&self) -> &v4::Stats {
+        self.v4.stats()
+    }
+
+    /// V3's statistics (see [`Decoder::mixed_stats`]).
+    pub fn v3_stats(&self) -> &v3::Stats {
+        self.v3.stats()
+    }
+
+    /// HW5's statistics (see [`Decoder::mixed_stats`]).
+    pub fn hw5_stats(&self) -> &hw5::Stats {
+        self.hw5.stats()
+    }
+
+    /// Feeds a chunk of bytes; `on_frame` gets each frame found.
+    #[inline]
+    pub fn feed(&mut self, mut data: &[u8], mut on_frame: impl FnMut(Decoded)) {
+        while !data.is_empty() {
+            let n = match self.locked {
+                Some(family) => self.feed_locked(family, data, &mut on_frame),
+                None => self.feed_detecting(data, &mut on_frame),
+            };
+            data = &data[n..];
+        }
+    }
+
+    /// Gives the locked family's decoder the bytes of `data` to the end of the current block;
+    /// at its end, reads every format again if the decoder handed on no frame in the block.
+    /// Returns how many it took.
+    #[inline(always)]
+    fn feed_locked(
+        &mut self,
+        family: Family,
+        data: &[u8],
+        on_frame: &mut impl FnMut(Decoded),
+    ) -> usize {
+        let to_end = RELOCK_AFTER - self.bytes % RELOCK_AFTER;
+        let n = usize::try_from(to_end).map_or(data.len(), |k| k.min(data.len()));
+        let piece = &data[..n];
+        match family {
+            Family::Mixed => self.mixed.feed(
+                piece,
+                #[inline(always)]
+                |d| on_frame(Decoded::Mixed(d)),
+            ),
+            Family::HwV4 => self.v4.feed(piece, |d| on_frame(Decoded::HwV4(d))),
+            Family::HwV3 => self.v3.feed(piece, |d| on_frame(Decoded::HwV3(d))),
+            Family::Hw5 => self.hw5.feed(piece, |d| on_frame(Decoded::Hw5(d))),
+        }
+        self.bytes += n as u64;
+        if self.bytes.is_multiple_of(RELOCK_AFTER) {
+            self.end_block(family);
+        }
+        n
+    }
+
+    /// The frames `family`'s decoder has handed on so far (data and information frames).
+    fn handed_on(&self, family: Family) -> u64 {
+        match family {
+            Family::Mixed => {
+                let s = self.mixed.stats();
+                u64::from(s.esc.packets().count())
+                    + u64::from(s.esc.info_frames())
+                    + u64::from(s.hub.frames())
+            }
+            Family::HwV4 => {
+                u64::from(self.v4.stats().frames()) + u64::from(self.v4.stats().info_frames())
+            }
+            Family::HwV3 => u64::from(self.v3.stats().frames()),
+            Family::Hw5 => u64::from(self.hw5.stats().telemetry_frames()),
+        }
+    }
+
+    /// At the end of a block while locked: detection starts again when the locked decoder
+    /// handed on no frame since the block's start.
+    #[cold]
+    fn end_block(&mut self, family: Family) {
+        let now = self.handed_on(family);
+        if self.block_start == Some(now) {
+            self.locked = None;
+            self.found = [None; 4];
+        }
+        self.block_start = Some(now);
+    }
+
+    /// Gives every decoder the bytes of `data` to the end of the current slice; at its end,
+    /// locks onto the first family that found a frame in it. Returns how many it took.
+    fn feed_detecting(&mut self, data: &[u8], on_frame: &mut impl FnMut(Decoded)) -> usize {
+        self.catch_up(false);
+        let to_end = SLICE - self.bytes % SLICE;
+        let n = usize::try_from(to_end).map_or(data.len(), |k| k.min(data.len()));
+        let piece = &data[..n];
+        let found = &mut self.found;
+        self.mixed.feed(piece, |d| {
+            found[0] = Some(d.offset());
+            on_frame(Decoded::Mixed(d))
+        });
+        self.hw5.feed(piece, |d| {
+            found[1] = Some(d.offset);
+            on_frame(Decoded::Hw5(d))
+        });
+        self.v4.feed(piece, |d| {
+            found[2] = Some(d.offset);
+            on_frame(Decoded::HwV4(d))
+        });
+        self.v3.feed(piece, |d| {
+            found[3] = Some(d.offset);
+            on_frame(Decoded::HwV3(d))
+        });
+        self.bytes += n as u64;
+        if self.bytes.is_multiple_of(SLICE) {
+            self.end_slice();
+        }
+        n
+    }
+
+    /// At the end of a slice while detecting: locks onto the first family that found a frame.
+    fn end_slice(&mut self) {
+        if let Some(i) = self.found.iter().position(Option::is_some) {
+            let family = Family::ALL[i];
+            self.locked = Some(family);
+            self.last_locked = Some(family);
+            self.block_start = None;
+        }
+        self.found = [None; 4];
+    }
+
+    /// Brings every decoder to the stream's end: each passes over the bytes it was not given.
+    /// With `settle` (at a flush), a decoder that was given every byte but is not being given
+    /// bytes now (one other than the locked one) also drops what it holds (its skipped bytes):
+    /// it was not flushed, and its statistics must count every byte.
+    fn catch_up(&mut self, settle: bool) {
+        let bytes = self.bytes;
+        let behind = |b: u64, held: usize| {
+            let n = bytes - b;
+            (n > 0 || (settle && held > 0)).then_some(n)
+        };
+        if let Some(n) = behind(self.mixed.stats().bytes(), self.mixed.buffered()) {
+            self.mixed.pass_over(n);
+        }
+        if let Some(n) = behind(self.v4.stats().bytes(), self.v4.buffered()) {
+            self.v4.pass_over(n);
+        }
+        if let Some(n) = behind(self.v3.stats().bytes(), self.v3.buffered()) {
+            self.v3.pass_over(n);
+        }
+        if let Some(n) = behind(self.hw5.stats().bytes(), self.hw5.buffered()) {
+            self.hw5.pass_over(n);
+        }
+    }
+
+    /// Tells the decoders being given bytes that the line was silent for a time in which at
+    /// most `esc_frames` HW-FOC frames (24 byte times each) and `hub_frames` DataLink frames
+    /// could have been sent (see [`StreamDecoder::line_silent`](crate::StreamDecoder::line_silent));
+    /// `on_frame` gets the frames still found in the bytes they held.
+    pub fn line_silent_each(
+        &mut self,
+        esc_frames: u32,
+        hub_frames: u32,
+        mut on_frame: impl FnMut(Decoded),
+    ) {
+        // As many frames of the shorter formats fit in the same time: 24 byte times against
+        // V3's 10 and V4's 19.
+        let scaled = |len: u64| {
+            u32::try_from((u64::from(esc_frames) * 24).div_ceil(len)).unwrap_or(u32::MAX)
+        };
+        let all = self.locked.is_none();
+        let found = &mut self.found;
+        let mut take = |d: Decoded| {
+            if all {
+                let i = Family::ALL.iter().position(|&f| f == d.family());
+                found[i.unwrap_or(0)] = Some(d.offset());
+            }
+            on_frame(d)
+        };
+        if all || self.locked == Some(Family::Mixed) {
+            self.mixed
+                .line_silent_each(esc_frames, hub_frames, |d| take(Decoded::Mixed(d)));
+        }
+        if all || self.locked == Some(Family::Hw5) {
+            self.hw5.line_silent(esc_frames, |d| take(Decoded::Hw5(d)));
+        }
+        if all || self.locked == Some(Family::HwV4) {
+            self.v4.line_silent(scaled(v4::DATA_FRAME_LEN as u64), |d| {
+                take(Decoded::HwV4(d))
+            });
+        }
+        if all || self.locked == Some(Family::HwV3) {
+            self.v3
+                .line_silent(scaled(v3::FRAME_LEN as u64), |d| take(Decoded::HwV3(d)));
+        }
+        if all {
+            self.end_slice();
+        }
+        // A silence may be a change of ESC: every format is read again from here.
+        self.locked = None;
+        self.found = [None; 4];
+    }
+
+    /// Ends the stream: the decoders being given bytes decide what they hold (as each
+    /// protocol's `flush`), and every decoder passes over the bytes it was not given, so that
+    /// each one's statistics count the whole stream. A decoder still detecting locks onto
+    /// what the last slice found.
+    pub fn flush(&mut self, mut on_frame: impl FnMut(Decoded)) {
+        let all = self.locked.is_none();
+        let found = &mut self.found;
+        let mut take = |d: Decoded| {
+            if all {
+                let i = Family::ALL.iter().position(|&f| f == d.family());
+                found[i.unwrap_or(0)] = Some(d.offset());
+            }
+            on_frame(d)
+        };
+        if all || self.locked == Some(Family::Mixed) {
+            self.mixed.flush(|d| take(Decoded::Mixed(d)));
+        }
+        if all || self.locked == Some(Family::Hw5) {
+            self.hw5.flush(|d| take(Decoded::Hw5(d)));
+        }
+        if all || self.locked == Some(Family::HwV4) {
+            self.v4.flush(|d| take(Decoded::HwV4(d)));
+        }
+        if all || self.locked == Some(Family::HwV3) {
+            self.v3.flush(|d| take(Decoded::HwV3(d)));
+        }
+        if all {
+            self.end_slice();
+        }
+        self.catch_up(true);
+    }
+
+    /// Feeds a whole stream and flushes it.
+    pub fn decode_all(&mut self, data: &[u8], mut on_frame: impl FnMut(Decoded)) {
+        self.feed(data, &mut on_frame);
+        self.flush(on_frame);
+    }
+
+    /// Continues this decoder with `later`'s work, as [`StreamDecoder::then`] does: when both
+    /// read HW-FOC and DataLink only (no other format's frame in either) and nothing is held
+    /// here. Its HW-FOC and DataLink statistics are then the whole stream's; the other formats'
+    /// decoders pass over `later`'s bytes. False, and nothing changes, otherwise.
+    ///
+    /// [`StreamDecoder::then`]: crate::StreamDecoder::then
+    pub fn then(&mut self, later: &Decoder, first_packet: Option<u16>) -> bool {
+        let only_mixed = |d: &Decoder| {
+            d.last_locked.is_none_or(|f| f == Family::Mixed)
+                && d.v4.stats().frames() == 0
+                && d.v4.stats().info_frames() == 0
+                && d.v3.stats().frames() == 0
+                && d.hw5.stats().telemetry_frames() == 0
+        };
+        if self.buffered() != 0 || !only_mixed(self) || !only_mixed(later) {
+            return false;
+        }
+        self.catch_up(false);
+        if !self.mixed.then(&later.mixed, first_packet) {
+            return false;
+        }
+        let n = later.bytes;
+        self.v4.pass_over(n);
+        self.v3.pass_over(n);
+        self.hw5.pass_over(n);
+        self.bytes += n;
+        self.locked = later.locked;
+        self.last_locked = later.last_locked.or(self.last_locked);
+        let base = self.bytes - n;
+        // Its frame count is the whole stream's now: the block it is in is not judged.
+        self.block_start = None;
+        self.found = later.found.map(|at| at.map(|at| at + base));
+        true
+    }
+}
