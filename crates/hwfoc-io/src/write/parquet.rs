@@ -106,20 +106,24 @@ mod encode {
     use bytes::Bytes;
     use hwfoc::{Protocol, Settings, Status};
     use parquet::arrow::{ArrowSchemaConverter, add_encoded_arrow_schema_to_metadata};
+    use parquet::basic::Repetition;
     use parquet::basic::{Compression, Encoding};
-    use parquet::column::page::{CompressedPage, Page, PageWriter};
+    use parquet::column::page::{CompressedPage, Page, PageWriteSpec, PageWriter};
     use parquet::column::writer::{ColumnCloseResult, get_column_writer, get_typed_column_writer};
     use parquet::data_type::{
         ByteArray, ByteArrayType, DataType as ParquetType, DoubleType, FloatType, Int32Type,
     };
     use parquet::errors::ParquetError;
-    use parquet::file::metadata::{ColumnChunkMetaDataBuilder, KeyValue, OffsetIndexBuilder};
+    use parquet::file::metadata::{
+        ColumnChunkMetaData, ColumnChunkMetaDataBuilder, KeyValue, LevelHistogram,
+        OffsetIndexBuilder,
+    };
     use parquet::file::properties::WriterPropertiesPtr;
     use parquet::file::properties::{
         DeltaBinaryPackedEncoderOptions, EnabledStatistics, WriterProperties, WriterVersion,
     };
     use parquet::file::writer::{SerializedFileWriter, SerializedPageWriter, TrackedWrite};
-    use parquet::schema::types::{ColumnDescPtr, SchemaDescriptor};
+    use parquet::schema::types::{ColumnDescPtr, ColumnDescriptor, SchemaDescriptor, Type};
 
     use super::super::arrow::schema;
     use super::super::metadata::schema_with;
@@ -504,10 +508,6 @@ mod encode {
         ByteArray::from(Bytes::from_static(p.name().as_bytes()))
     }
 
-    /// Values in a group of the RLE/bit-packing hybrid encoding; a run of fewer repeats is
-    /// bit-packed by the parquet crate.
-    const RLE_GROUP: usize = 8;
-
     /// The column chunk of a required, dictionary-encoded byte-array column whose `rows` rows
     /// all hold `value`, byte for byte as the parquet crate's column writer makes it; `None`
     /// where this cannot be sure of that (then the column writer encodes the rows).
@@ -519,7 +519,7 @@ mod encode {
     /// encoded by the crate, and a data page written by the crate's page writer, whose values
     /// are written here: the dictionary's bit width (0: one entry) and one RLE run of index 0
     /// (the run's length as a ULEB128 varint shifted left by one, and no value bytes at bit
-    /// width 0), as the crate's `RleEncoder` writes a run of 8 or more. Five bytes at most,
+    /// width 0), as the crate's `RleEncoder` writes a run of equal values. Five bytes at most,
     /// which LZ4 cannot make smaller: the page is stored uncompressed, as the crate stores a
     /// page that does not compress. The metadata differ from the template's only in counts,
     /// sizes and the data page's offset-index entry.
@@ -531,7 +531,7 @@ mod encode {
     ) -> Result<Option<EncodedColumn>, ParquetError> {
         let (Ok(count), false, 0, 0) = (
             u32::try_from(rows),
-            rows < RLE_GROUP,
+            rows == 0,
             descr.max_def_level(),
             descr.max_rep_level(),
         ) else {
@@ -565,12 +565,7 @@ mod encode {
         let unencoded = i64::try_from(value.len() * rows).ok();
 
         let mut values = vec![0u8];
-        let mut run = u64::from(count) << 1;
-        while run >= 0x80 {
-            values.push((run as u8 & 0x7F) | 0x80);
-            run >>= 7;
-        }
-        values.push(run as u8);
+        push_varint(&mut values, u64::from(count) << 1);
         let mut buf = TrackedWrite::new(Vec::with_capacity(dictionary as usize + 32));
         buf.write_all(&once[..dictionary as usize])?;
         let spec = {
@@ -813,7 +808,28 @@ mod encode {
     /// Encodes one column chunk of `rows` rows into memory, `block_rows` rows at a time:
     /// `fill` appends the values, and the levels if the column has them, of a block of rows
     /// to the empty buffers it is given.
+    ///
+    /// A nullable column (not a list) whose first block has every value is encoded as if
+    /// it were required, its definition levels added to each page as one run
+    /// ([`encode_present`]), until a block has a null: then by the column writer, levels and
+    /// all, from the start.
     fn encode_in<T: ParquetType>(
+        block_rows: usize,
+        descr: ColumnDescPtr,
+        props: &WriterPropertiesPtr,
+        rows: usize,
+        fill: impl Fn(Range<usize>, &mut Levels<T::T>),
+    ) -> Encoded {
+        if descr.max_def_level() == 1 && descr.max_rep_level() == 0 && rows > 0 {
+            if let Some(encoded) = encode_present::<T>(block_rows, &descr, props, rows, &fill)? {
+                return Ok(encoded);
+            }
+        }
+        encode_levels::<T>(block_rows, descr, props, rows, fill)
+    }
+
+    /// [`encode_in`] by the column writer, levels and all.
+    fn encode_levels<T: ParquetType>(
         block_rows: usize,
         descr: ColumnDescPtr,
         props: &WriterPropertiesPtr,
@@ -853,6 +869,218 @@ mod encode {
             writer.close()?
         };
         Ok((Bytes::from(buf.into_inner()?), close))
+    }
+
+    /// The chunk of a nullable column (not a list) whose every value is there, byte for byte
+    /// as the column writer makes it, or `None` at the first block that has a null (or if the
+    /// first block has none at all).
+    ///
+    /// The column writer takes definition levels only as a slice of one level per row, which
+    /// it encodes, and counts into its histogram, row by row: for the 15 nullable columns
+    /// that are there in every row of a HW-FOC frame, that was about a tenth of the export's
+    /// CPU time. (Its own run-length path, `LevelDataRef::Uniform`, is open only to the
+    /// crate's Arrow writer, which hands it the values by index, a copy of each.) So the
+    /// values go to a column writer of the same column declared required, which writes no
+    /// levels, through a page writer ([`AddLevels`]) that puts the run of definition levels
+    /// 1 in front of each data page's values as the column writer would; the metadata are
+    /// then the required column's (whose sizes are those of the pages written, levels
+    /// included) with the nullable column's descriptor and the histogram of definition levels
+    /// (no null, every value defined).
+    ///
+    /// The column writer stores a data page compressed where its compressed values are
+    /// smaller than the page's levels and values together (times a threshold, 1 here): a
+    /// page that the required column stores compressed is compressed with levels too, but
+    /// one that it stores as it is might have been compressed with the levels' few bytes
+    /// more, and the compressed size is not known here; such a chunk (some of `current_a`'s
+    /// and the temperatures') is encoded again by the column writer, levels and all.
+    fn encode_present<T: ParquetType>(
+        block_rows: usize,
+        descr: &ColumnDescPtr,
+        props: &WriterPropertiesPtr,
+        rows: usize,
+        fill: &impl Fn(Range<usize>, &mut Levels<T::T>),
+    ) -> Result<Option<EncodedColumn>, ParquetError> {
+        let block_rows = block_rows.max(1);
+        let mut buf = TrackedWrite::new(Vec::new());
+        let mut pages = Vec::new();
+        let required = {
+            let page_writer = AddLevels {
+                pages: SerializedPageWriter::new(&mut buf),
+                written: &mut pages,
+                compressing: props.compression(descr.path()) != Compression::UNCOMPRESSED,
+            };
+            let mut writer = get_typed_column_writer::<T>(get_column_writer(
+                required_twin(descr)?,
+                props.clone(),
+                Box::new(page_writer),
+            ));
+            let mut block = Levels {
+                values: Vec::with_capacity(block_rows),
+                def: Vec::with_capacity(block_rows),
+                rep: Vec::new(),
+            };
+            let mut start = 0;
+            while start < rows {
+                let end = rows.min(start + block_rows);
+                block.values.clear();
+                block.def.clear();
+                fill(start..end, &mut block);
+                if block.values.len() != end - start {
+                    return Ok(None);
+                }
+                writer.write_batch(&block.values, None, None)?;
+                start = end;
+            }
+            writer.close()?
+        };
+        if pages.iter().any(|p| p.undecided) {
+            return Ok(None);
+        }
+        let meta = &required.metadata;
+        let mut builder = ColumnChunkMetaData::builder(descr.clone())
+            .set_compression(meta.compression())
+            .set_encodings_mask(*meta.encodings_mask())
+            .set_total_compressed_size(meta.compressed_size())
+            .set_total_uncompressed_size(meta.uncompressed_size())
+            .set_num_values(meta.num_values())
+            .set_data_page_offset(meta.data_page_offset())
+            .set_dictionary_page_offset(meta.dictionary_page_offset())
+            .set_unencoded_byte_array_data_bytes(meta.unencoded_byte_array_data_bytes())
+            .set_repetition_level_histogram(None)
+            .set_definition_level_histogram(Some(LevelHistogram::from(vec![0, meta.num_values()])));
+        if let Some(stats) = meta.page_encoding_stats() {
+            builder = builder.set_page_encoding_stats(stats.clone());
+        }
+        if let Some(stats) = meta.statistics() {
+            builder = builder.set_statistics(stats.clone());
+        }
+        let offset_index = required.offset_index.as_ref().map(|_| {
+            let mut index = OffsetIndexBuilder::new();
+            for page in &pages {
+                index.append_offset_and_size(page.offset as i64, page.size as i32);
+                index.append_row_count(i64::from(page.rows));
+            }
+            index.build()
+        });
+        let close = ColumnCloseResult {
+            bytes_written: buf.bytes_written() as u64,
+            rows_written: required.rows_written,
+            metadata: builder.build()?,
+            bloom_filter: required.bloom_filter,
+            column_index: required.column_index,
+            offset_index,
+        };
+        Ok(Some((Bytes::from(buf.into_inner()?), close)))
+    }
+
+    /// The column `descr` (a nullable one) declared required: the same name, path and types.
+    fn required_twin(descr: &ColumnDescPtr) -> Result<ColumnDescPtr, ParquetError> {
+        let info = descr.self_type().get_basic_info();
+        let twin = Type::primitive_type_builder(descr.name(), descr.physical_type())
+            .with_repetition(Repetition::REQUIRED)
+            .with_converted_type(descr.converted_type())
+            .with_logical_type(descr.logical_type_ref().cloned())
+            .with_length(descr.type_length())
+            .with_precision(descr.type_precision())
+            .with_scale(descr.type_scale())
+            .with_id(info.has_id().then(|| info.id()))
+            .build()?;
+        Ok(Arc::new(ColumnDescriptor::new(
+            Arc::new(twin),
+            0,
+            0,
+            descr.path().clone(),
+        )))
+    }
+
+    /// A data page as written by [`AddLevels`]: its offset and size in the column chunk (header
+    /// included), its rows, and whether it is stored as it is where the column writer might
+    /// have compressed it (see [`encode_present`]).
+    struct WrittenPage {
+        offset: u64,
+        size: usize,
+        rows: u32,
+        undecided: bool,
+    }
+
+    /// The page writer of [`encode_present`]: puts in front of each data page's values the
+    /// definition levels of its rows, all 1 (every value defined), as the column writer's
+    /// level encoder writes them (`LevelEncoder::v2_streaming` of maximum level 1: the
+    /// RLE/bit-packing hybrid at bit width 1, without a length prefix in a page of format 2).
+    struct AddLevels<'a, 'b> {
+        pages: SerializedPageWriter<'a, Vec<u8>>,
+        written: &'b mut Vec<WrittenPage>,
+        /// Whether the column is compressed.
+        compressing: bool,
+    }
+
+    impl PageWriter for AddLevels<'_, '_> {
+        fn write_page(&mut self, page: CompressedPage) -> Result<PageWriteSpec, ParquetError> {
+            let uncompressed = page.uncompressed_size();
+            let Page::DataPageV2 {
+                buf,
+                num_values,
+                encoding,
+                num_nulls: 0,
+                num_rows,
+                def_levels_byte_len: 0,
+                rep_levels_byte_len: 0,
+                is_compressed,
+                statistics,
+            } = page.compressed_page().clone()
+            else {
+                return Err(ParquetError::General(
+                    "a page of a required column other than a data page of format 2".to_string(),
+                ));
+            };
+            let mut levels = level_run(1, num_values as usize);
+            let added = levels.len();
+            levels.extend_from_slice(&buf);
+            let page = Page::DataPageV2 {
+                buf: Bytes::from(levels),
+                num_values,
+                encoding,
+                num_nulls: 0,
+                num_rows,
+                def_levels_byte_len: added as u32,
+                rep_levels_byte_len: 0,
+                is_compressed,
+                statistics,
+            };
+            let spec = self
+                .pages
+                .write_page(CompressedPage::new(page, uncompressed + added))?;
+            self.written.push(WrittenPage {
+                offset: spec.offset,
+                size: spec.compressed_size,
+                rows: num_rows,
+                undecided: self.compressing && !is_compressed,
+            });
+            Ok(spec)
+        }
+
+        fn close(&mut self) -> Result<(), ParquetError> {
+            self.pages.close()
+        }
+    }
+
+    /// `count` levels `level` (0 or 1) at bit width 1 as the parquet crate's `RleEncoder`
+    /// writes them: one RLE run (its length shifted left by one as a ULEB128 varint, then the
+    /// level in a byte), for any count (it ends a run of fewer than 8 equal values as a run).
+    fn level_run(level: u8, count: usize) -> Vec<u8> {
+        let mut bytes = Vec::with_capacity(6);
+        push_varint(&mut bytes, (count as u64) << 1);
+        bytes.push(level);
+        bytes
+    }
+
+    /// Appends `value` as a ULEB128 varint.
+    fn push_varint(bytes: &mut Vec<u8>, mut value: u64) {
+        while value >= 0x80 {
+            bytes.push((value as u8 & 0x7F) | 0x80);
+            value >>= 7;
+        }
+        bytes.push(value as u8);
     }
 
     /// A column chunk encoded in memory: its bytes and the metadata that goes with them.
@@ -1250,13 +1478,13 @@ mod encode {
             rows: usize,
             fill: impl Fn(Range<usize>, &mut Levels<T::T>),
         ) -> (Bytes, String) {
-            let (bytes, close) = encode_in::<T>(BLOCK, descr, props, rows, fill).unwrap();
+            let (bytes, close) = encode_levels::<T>(BLOCK, descr, props, rows, fill).unwrap();
             (bytes, format!("{close:?}"))
         }
 
         /// The protocol column of a row group of one protocol is byte for byte what the column
-        /// writer makes of it, metadata included; of two protocols, or of fewer rows than a
-        /// run, the column writer encodes it.
+        /// writer makes of it, metadata included; of two protocols, the column writer encodes
+        /// it.
         #[test]
         fn one_protocol_is_encoded_as_the_column_writer_would() {
             let (descr, props) = schema_and_properties();
@@ -1294,8 +1522,69 @@ mod encode {
             }
             let mixed = |i: usize| [Protocol::HwFoc, Protocol::DataLink][usize::from(i == 500)];
             assert!(Protocol::encode_whole(mixed, 1000, &column, &props).is_none());
-            assert!(Protocol::encode_whole(|_| Protocol::HwFoc, 7, &column, &props).is_none());
             assert!(Protocol::encode_whole(|_| Protocol::HwFoc, 0, &column, &props).is_none());
+        }
+
+        /// A nullable column's chunk with every value there is byte for byte what the column
+        /// writer makes of it, metadata included, whatever its type and encoding, in one page or
+        /// several (a page holds up to 1 MB of values), of fewer rows than a run of levels or
+        /// more; with a null after the first block, or none there at all, the column writer
+        /// encodes it.
+        #[test]
+        fn a_column_with_every_value_is_encoded_as_the_column_writer_would() {
+            fn check<T: ParquetType>(
+                column: &ColumnDescPtr,
+                props: &WriterPropertiesPtr,
+                value: impl Fn(usize) -> T::T + Copy,
+            ) {
+                let name = column.path().string();
+                for rows in [1, 7, 8, 9, 4096, 4097, 100_000, 300_000] {
+                    let every = |_: usize| true;
+                    let later_null = |i: usize| i != BLOCK + 3;
+                    let none = |_: usize| false;
+                    for present in [&every as &dyn Fn(usize) -> bool, &later_null, &none] {
+                        let fill = |block: Range<usize>, levels: &mut Levels<T::T>| {
+                            for i in block {
+                                levels.def.push(i16::from(present(i)));
+                                if present(i) {
+                                    levels.values.push(value(i));
+                                }
+                            }
+                        };
+                        let (bytes, close) =
+                            encode_in::<T>(BLOCK, column.clone(), props, rows, fill).unwrap();
+                        let expected = by_the_column_writer::<T>(column.clone(), props, rows, fill);
+                        assert!(
+                            bytes == expected.0,
+                            "{name}, {rows} rows: bytes differ: {bytes:?} {:?}",
+                            expected.0
+                        );
+                        assert_eq!(format!("{close:?}"), expected.1, "{name}, {rows} rows");
+                    }
+                }
+            }
+            let (descr, props) = schema_and_properties();
+            let mut checked = Vec::new();
+            for column in descr.columns() {
+                if column.max_def_level() != 1 || column.max_rep_level() != 0 {
+                    continue;
+                }
+                match column.physical_type() {
+                    PhysicalType::FLOAT => {
+                        check::<FloatType>(column, &props, |i| (i % 1000) as f32 * 0.37 - 20.0)
+                    }
+                    PhysicalType::DOUBLE => {
+                        check::<DoubleType>(column, &props, |i| 1.7e9 + i as f64 / 7.0)
+                    }
+                    // Unsigned columns among them: values above i32::MAX as negative numbers.
+                    PhysicalType::INT32 => check::<Int32Type>(column, &props, |i| {
+                        (i as u32).wrapping_mul(2_654_435_761) as i32
+                    }),
+                    other => panic!("{}: no test values of {other}", column.path()),
+                }
+                checked.push(column.name().to_string());
+            }
+            assert!(checked.len() >= 15, "{checked:?}");
         }
 
         /// Every column is encoded, once.
