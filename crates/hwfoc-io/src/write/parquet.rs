@@ -34,7 +34,17 @@
 //! - values handed to the column writers `WRITE_BATCH` at a time, and no limit on a page's
 //!   rows, so that a page holds a whole column chunk up to the 1 MB page size (fewer, larger
 //!   pages: less work per value, better compression);
-//! - no dictionaries, except for the fault names (`DICTIONARY`);
+//! - no dictionaries, except for the protocol and the fault names (`DICTIONARY`);
+//! - a row group's `protocol` column, usually of one protocol, put together from the crate's
+//!   dictionary page of that name and a data page of one run of index 0
+//!   (`repeated_dictionary_chunk`): the crate's dictionary encoder hashes and compares every
+//!   row's name;
+//! - a nullable column with every value in a row group (each measurement the protocol carries,
+//!   the time where the input has one) encoded as a required column, its definition levels
+//!   added to each page as one run (`encode_present`): the crate takes levels one per row and
+//!   encodes them one by one. Both make the bytes the column writer makes (tests check them
+//!   against it, metadata included); a column null throughout goes to the column writer as
+//!   levels only.
 //! - statistics per row group for every column: minimum, maximum and null count (NaN count
 //!   for the floats), so that a reader (DuckDB, pyarrow datasets, polars, Spark) skips the row
 //!   groups a filter on any column excludes (`WHERE mos_temp_c > 100`, a range of `t_s` or
