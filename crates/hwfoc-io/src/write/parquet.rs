@@ -830,10 +830,12 @@ mod encode {
         rows: usize,
         fill: impl Fn(Range<usize>, &mut Levels<T::T>),
     ) -> Encoded {
-        if descr.max_def_level() == 1 && descr.max_rep_level() == 0 && rows > 0 {
-            if let Some(encoded) = encode_present::<T>(block_rows, &descr, props, rows, &fill)? {
-                return Ok(encoded);
-            }
+        if descr.max_def_level() == 1
+            && descr.max_rep_level() == 0
+            && rows > 0
+            && let Some(encoded) = encode_present::<T>(block_rows, &descr, props, rows, &fill)?
+        {
+            return Ok(encoded);
         }
         encode_levels::<T>(block_rows, descr, props, rows, fill)
     }
