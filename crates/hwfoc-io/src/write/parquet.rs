@@ -34,7 +34,17 @@
 //! - values handed to the column writers `WRITE_BATCH` at a time, and no limit on a page's
 //!   rows, so that a page holds a whole column chunk up to the 1 MB page size (fewer, larger
 //!   pages: less work per value, better compression);
-//! - no dictionaries, except for the fault names (`DICTIONARY`);
+//! - no dictionaries, except for the protocol and the fault names (`DICTIONARY`);
+//! - a row group's `protocol` column, usually of one protocol, put together from the crate's
+//!   dictionary page of that name and a data page of one run of index 0
+//!   (`repeated_dictionary_chunk`): the crate's dictionary encoder hashes and compares every
+//!   row's name;
+//! - a nullable column with every value in a row group (each measurement the protocol carries,
+//!   the time where the input has one) encoded as a required column, its definition levels
+//!   added to each page as one run (`encode_present`): the crate takes levels one per row and
+//!   encodes them one by one. Both make the bytes the column writer makes (tests check them
+//!   against it, metadata included); a column null throughout goes to the column writer as
+//!   levels only.
 //! - statistics per row group for every column: minimum, maximum and null count (NaN count
 //!   for the floats), so that a reader (DuckDB, pyarrow datasets, polars, Spark) skips the row
 //!   groups a filter on any column excludes (`WHERE mos_temp_c > 100`, a range of `t_s` or
@@ -97,7 +107,7 @@ mod off {
 /// The writer, with the `parquet` feature.
 #[cfg(feature = "parquet")]
 mod encode {
-    use std::io;
+    use std::io::{self, Write};
     use std::ops::Range;
     use std::sync::Arc;
     use std::sync::atomic::{AtomicUsize, Ordering};
@@ -106,19 +116,24 @@ mod encode {
     use bytes::Bytes;
     use hwfoc::{Protocol, Settings, Status};
     use parquet::arrow::{ArrowSchemaConverter, add_encoded_arrow_schema_to_metadata};
+    use parquet::basic::Repetition;
     use parquet::basic::{Compression, Encoding};
+    use parquet::column::page::{CompressedPage, Page, PageWriteSpec, PageWriter};
     use parquet::column::writer::{ColumnCloseResult, get_column_writer, get_typed_column_writer};
     use parquet::data_type::{
         ByteArray, ByteArrayType, DataType as ParquetType, DoubleType, FloatType, Int32Type,
     };
     use parquet::errors::ParquetError;
-    use parquet::file::metadata::KeyValue;
+    use parquet::file::metadata::{
+        ColumnChunkMetaData, ColumnChunkMetaDataBuilder, KeyValue, LevelHistogram,
+        OffsetIndexBuilder,
+    };
     use parquet::file::properties::WriterPropertiesPtr;
     use parquet::file::properties::{
         DeltaBinaryPackedEncoderOptions, EnabledStatistics, WriterProperties, WriterVersion,
     };
     use parquet::file::writer::{SerializedFileWriter, SerializedPageWriter, TrackedWrite};
-    use parquet::schema::types::{ColumnDescPtr, SchemaDescriptor};
+    use parquet::schema::types::{ColumnDescPtr, ColumnDescriptor, SchemaDescriptor, Type};
 
     use super::super::arrow::schema;
     use super::super::metadata::schema_with;
@@ -282,6 +297,20 @@ mod encode {
             values: impl ExactSizeIterator<Item = Self> + Clone,
             levels: &mut Levels<<Self::Physical as ParquetType>::T>,
         );
+
+        /// The column chunk of `rows` rows (row `i`'s value: `value(i)`) encoded in one go,
+        /// where this value type has a faster way than the column writer's, value by value,
+        /// for these rows; `None` where not (the column writer then takes them, a block at a
+        /// time). The bytes and metadata must be those the column writer would give.
+        #[inline(always)]
+        fn encode_whole(
+            _value: impl Fn(usize) -> Self,
+            _rows: usize,
+            _descr: &ColumnDescPtr,
+            _props: &WriterPropertiesPtr,
+        ) -> Option<Encoded> {
+            None
+        }
     }
 
     /// A value type stored as one physical value, never null (and, in an `Option`, nullable).
@@ -461,10 +490,133 @@ mod encode {
             values: impl ExactSizeIterator<Item = Self> + Clone,
             levels: &mut Levels<ByteArray>,
         ) {
-            levels
-                .values
-                .extend(values.map(|p| ByteArray::from(Bytes::from_static(p.name().as_bytes()))));
+            levels.values.extend(values.map(protocol_name));
         }
+
+        /// A row group of one protocol (the usual one): its chunk made from the dictionary
+        /// page of that one name and a data page of one run of index 0
+        /// ([`repeated_dictionary_chunk`]), rather than by the column writer's dictionary
+        /// encoder, which hashes and compares every row's name, after a byte array was made of
+        /// it and compared for the statistics (in all about 1.8 s of the 7.3 s of user time of
+        /// the export of the 2 GiB benchmark input).
+        fn encode_whole(
+            value: impl Fn(usize) -> Self,
+            rows: usize,
+            descr: &ColumnDescPtr,
+            props: &WriterPropertiesPtr,
+        ) -> Option<Encoded> {
+            let first = value(0);
+            if rows == 0 || (1..rows).any(|i| value(i) != first) {
+                return None;
+            }
+            repeated_dictionary_chunk(&protocol_name(first), rows, descr, props).transpose()
+        }
+    }
+
+    /// The protocol's name as a byte array.
+    #[inline(always)]
+    fn protocol_name(p: Protocol) -> ByteArray {
+        ByteArray::from(Bytes::from_static(p.name().as_bytes()))
+    }
+
+    /// The column chunk of a required, dictionary-encoded byte-array column whose `rows` rows
+    /// all hold `value`, byte for byte as the parquet crate's column writer makes it; `None`
+    /// where this cannot be sure of that (then the column writer encodes the rows).
+    ///
+    /// The crate has no way to hand its dictionary encoder indices rather than values (its
+    /// `DictEncoder` interns each value; the Arrow writer's dictionary arrays too), nor to
+    /// write a data page of levels given as runs, so the chunk is put together here from the
+    /// crate's own parts: the dictionary page and the metadata of the chunk of the value once,
+    /// encoded by the crate, and a data page written by the crate's page writer, whose values
+    /// are written here: the dictionary's bit width (0: one entry) and one RLE run of index 0
+    /// (the run's length as a ULEB128 varint shifted left by one, and no value bytes at bit
+    /// width 0), as the crate's `RleEncoder` writes a run of equal values. Five bytes at most,
+    /// which LZ4 cannot make smaller: the page is stored uncompressed, as the crate stores a
+    /// page that does not compress. The metadata differ from the template's only in counts,
+    /// sizes and the data page's offset-index entry.
+    fn repeated_dictionary_chunk(
+        value: &ByteArray,
+        rows: usize,
+        descr: &ColumnDescPtr,
+        props: &WriterPropertiesPtr,
+    ) -> Result<Option<EncodedColumn>, ParquetError> {
+        let (Ok(count), false, 0, 0) = (
+            u32::try_from(rows),
+            rows == 0,
+            descr.max_def_level(),
+            descr.max_rep_level(),
+        ) else {
+            return Ok(None);
+        };
+        let (once, template) = encode_in::<ByteArrayType>(1, descr.clone(), props, 1, |_, l| {
+            l.values.push(value.clone())
+        })?;
+        let meta = &template.metadata;
+        let Some(index) = template.offset_index.as_ref() else {
+            return Ok(None);
+        };
+        // The dictionary page first, then one data page of one index.
+        let (Some(0), [page], 1, true, WriterVersion::PARQUET_2_0) = (
+            meta.dictionary_page_offset(),
+            index.page_locations().as_slice(),
+            meta.num_values(),
+            props.dictionary_enabled(descr.path()),
+            props.writer_version(),
+        ) else {
+            return Ok(None);
+        };
+        let dictionary = meta.data_page_offset();
+        if page.offset != dictionary || page.first_row_index != 0 {
+            return Ok(None);
+        }
+        // The template's data page (two bytes of values) is stored uncompressed too: the
+        // dictionary page's sizes are the chunk's less the data page's.
+        let dictionary_uncompressed =
+            meta.uncompressed_size() - i64::from(page.compressed_page_size);
+        let unencoded = i64::try_from(value.len() * rows).ok();
+
+        let mut values = vec![0u8];
+        push_varint(&mut values, u64::from(count) << 1);
+        let mut buf = TrackedWrite::new(Vec::with_capacity(dictionary as usize + 32));
+        buf.write_all(&once[..dictionary as usize])?;
+        let spec = {
+            let mut pages = SerializedPageWriter::new(&mut buf);
+            let size = values.len();
+            let page = Page::DataPageV2 {
+                buf: Bytes::from(values),
+                num_values: count,
+                encoding: Encoding::RLE_DICTIONARY,
+                num_nulls: 0,
+                num_rows: count,
+                def_levels_byte_len: 0,
+                rep_levels_byte_len: 0,
+                is_compressed: false,
+                statistics: None,
+            };
+            let spec = pages.write_page(CompressedPage::new(page, size))?;
+            pages.close()?;
+            spec
+        };
+        let metadata = ColumnChunkMetaDataBuilder::from(meta.clone())
+            .set_num_values(i64::from(count))
+            .set_total_compressed_size(dictionary + spec.compressed_size as i64)
+            .set_total_uncompressed_size(dictionary_uncompressed + spec.uncompressed_size as i64)
+            .set_unencoded_byte_array_data_bytes(unencoded)
+            .build()?;
+        let mut offsets = OffsetIndexBuilder::new();
+        offsets.append_offset_and_size(spec.offset as i64, spec.compressed_size as i32);
+        offsets.append_row_count(i64::from(count));
+        offsets.append_unencoded_byte_array_data_bytes(unencoded);
+        let bytes_written = buf.bytes_written() as u64;
+        let close = ColumnCloseResult {
+            bytes_written,
+            rows_written: u64::from(count),
+            metadata,
+            bloom_filter: None,
+            column_index: template.column_index.clone(),
+            offset_index: Some(offsets.build()),
+        };
+        Ok(Some((Bytes::from(buf.into_inner()?), close)))
     }
 
     /// Converts frames to Parquet columns under fixed settings and encodes them.
@@ -529,6 +681,9 @@ mod encode {
                 settings(esc),
             )
         };
+        if let Some(encoded) = <C::Value as ParquetValue>::encode_whole(value, n, &descr, props) {
+            return encoded;
+        }
         let block_rows =
             if <C::Value as ParquetValue>::ONE_BATCH && (0..n).all(|i| value(i).is_bare()) {
                 n
@@ -664,7 +819,30 @@ mod encode {
     /// Encodes one column chunk of `rows` rows into memory, `block_rows` rows at a time:
     /// `fill` appends the values, and the levels if the column has them, of a block of rows
     /// to the empty buffers it is given.
+    ///
+    /// A nullable column (not a list) whose first block has every value is encoded as if
+    /// it were required, its definition levels added to each page as one run
+    /// ([`encode_present`]), until a block has a null: then by the column writer, levels and
+    /// all, from the start.
     fn encode_in<T: ParquetType>(
+        block_rows: usize,
+        descr: ColumnDescPtr,
+        props: &WriterPropertiesPtr,
+        rows: usize,
+        fill: impl Fn(Range<usize>, &mut Levels<T::T>),
+    ) -> Encoded {
+        if descr.max_def_level() == 1
+            && descr.max_rep_level() == 0
+            && rows > 0
+            && let Some(encoded) = encode_present::<T>(block_rows, &descr, props, rows, &fill)?
+        {
+            return Ok(encoded);
+        }
+        encode_levels::<T>(block_rows, descr, props, rows, fill)
+    }
+
+    /// [`encode_in`] by the column writer, levels and all.
+    fn encode_levels<T: ParquetType>(
         block_rows: usize,
         descr: ColumnDescPtr,
         props: &WriterPropertiesPtr,
@@ -704,6 +882,219 @@ mod encode {
             writer.close()?
         };
         Ok((Bytes::from(buf.into_inner()?), close))
+    }
+
+    /// The chunk of a nullable column (not a list) whose every value is there, byte for byte
+    /// as the column writer makes it, or `None` at the first block that has a null (or if the
+    /// first block has none at all).
+    ///
+    /// The column writer takes definition levels only as a slice of one level per row, which
+    /// it encodes, and counts into its histogram, row by row: for the 15 nullable columns
+    /// that are there in every row of a HW-FOC frame, that was about a tenth of the export's
+    /// CPU time (0.3-0.8 s of 5.2-6.0 s of user time on the 2 GiB benchmark input). (Its own run-length path, `LevelDataRef::Uniform`, is open only to the
+    /// crate's Arrow writer, which hands it the values by index, a copy of each.) So the
+    /// values go to a column writer of the same column declared required, which writes no
+    /// levels, through a page writer ([`AddLevels`]) that puts the run of definition levels
+    /// 1 in front of each data page's values as the column writer would; the metadata are
+    /// then the required column's (whose sizes are those of the pages written, levels
+    /// included) with the nullable column's descriptor and the histogram of definition levels
+    /// (no null, every value defined).
+    ///
+    /// The column writer stores a data page compressed where its compressed values are
+    /// smaller than the page's levels and values together (times a threshold, 1 here): a
+    /// page that the required column stores compressed is compressed with levels too, but
+    /// one that it stores as it is might have been compressed with the levels' few bytes
+    /// more, and the compressed size is not known here; such a chunk (one of a few rows,
+    /// which LZ4 does not shrink; none on the benchmark input) is encoded again by the column
+    /// writer, levels and all.
+    fn encode_present<T: ParquetType>(
+        block_rows: usize,
+        descr: &ColumnDescPtr,
+        props: &WriterPropertiesPtr,
+        rows: usize,
+        fill: &impl Fn(Range<usize>, &mut Levels<T::T>),
+    ) -> Result<Option<EncodedColumn>, ParquetError> {
+        let block_rows = block_rows.max(1);
+        let mut buf = TrackedWrite::new(Vec::new());
+        let mut pages = Vec::new();
+        let required = {
+            let page_writer = AddLevels {
+                pages: SerializedPageWriter::new(&mut buf),
+                written: &mut pages,
+                compressing: props.compression(descr.path()) != Compression::UNCOMPRESSED,
+            };
+            let mut writer = get_typed_column_writer::<T>(get_column_writer(
+                required_twin(descr)?,
+                props.clone(),
+                Box::new(page_writer),
+            ));
+            let mut block = Levels {
+                values: Vec::with_capacity(block_rows),
+                def: Vec::with_capacity(block_rows),
+                rep: Vec::new(),
+            };
+            let mut start = 0;
+            while start < rows {
+                let end = rows.min(start + block_rows);
+                block.values.clear();
+                block.def.clear();
+                fill(start..end, &mut block);
+                if block.values.len() != end - start {
+                    return Ok(None);
+                }
+                writer.write_batch(&block.values, None, None)?;
+                start = end;
+            }
+            writer.close()?
+        };
+        if pages.iter().any(|p| p.undecided) {
+            return Ok(None);
+        }
+        let meta = &required.metadata;
+        let mut builder = ColumnChunkMetaData::builder(descr.clone())
+            .set_compression(meta.compression())
+            .set_encodings_mask(*meta.encodings_mask())
+            .set_total_compressed_size(meta.compressed_size())
+            .set_total_uncompressed_size(meta.uncompressed_size())
+            .set_num_values(meta.num_values())
+            .set_data_page_offset(meta.data_page_offset())
+            .set_dictionary_page_offset(meta.dictionary_page_offset())
+            .set_unencoded_byte_array_data_bytes(meta.unencoded_byte_array_data_bytes())
+            .set_repetition_level_histogram(None)
+            .set_definition_level_histogram(Some(LevelHistogram::from(vec![0, meta.num_values()])));
+        if let Some(stats) = meta.page_encoding_stats() {
+            builder = builder.set_page_encoding_stats(stats.clone());
+        }
+        if let Some(stats) = meta.statistics() {
+            builder = builder.set_statistics(stats.clone());
+        }
+        let offset_index = required.offset_index.as_ref().map(|_| {
+            let mut index = OffsetIndexBuilder::new();
+            for page in &pages {
+                index.append_offset_and_size(page.offset as i64, page.size as i32);
+                index.append_row_count(i64::from(page.rows));
+            }
+            index.build()
+        });
+        let close = ColumnCloseResult {
+            bytes_written: buf.bytes_written() as u64,
+            rows_written: required.rows_written,
+            metadata: builder.build()?,
+            bloom_filter: required.bloom_filter,
+            column_index: required.column_index,
+            offset_index,
+        };
+        Ok(Some((Bytes::from(buf.into_inner()?), close)))
+    }
+
+    /// The column `descr` (a nullable one) declared required: the same name, path and types.
+    fn required_twin(descr: &ColumnDescPtr) -> Result<ColumnDescPtr, ParquetError> {
+        let info = descr.self_type().get_basic_info();
+        let twin = Type::primitive_type_builder(descr.name(), descr.physical_type())
+            .with_repetition(Repetition::REQUIRED)
+            .with_converted_type(descr.converted_type())
+            .with_logical_type(descr.logical_type_ref().cloned())
+            .with_length(descr.type_length())
+            .with_precision(descr.type_precision())
+            .with_scale(descr.type_scale())
+            .with_id(info.has_id().then(|| info.id()))
+            .build()?;
+        Ok(Arc::new(ColumnDescriptor::new(
+            Arc::new(twin),
+            0,
+            0,
+            descr.path().clone(),
+        )))
+    }
+
+    /// A data page as written by [`AddLevels`]: its offset and size in the column chunk (header
+    /// included), its rows, and whether it is stored as it is where the column writer might
+    /// have compressed it (see [`encode_present`]).
+    struct WrittenPage {
+        offset: u64,
+        size: usize,
+        rows: u32,
+        undecided: bool,
+    }
+
+    /// The page writer of [`encode_present`]: puts in front of each data page's values the
+    /// definition levels of its rows, all 1 (every value defined), as the column writer's
+    /// level encoder writes them (`LevelEncoder::v2_streaming` of maximum level 1: the
+    /// RLE/bit-packing hybrid at bit width 1, without a length prefix in a page of format 2).
+    struct AddLevels<'a, 'b> {
+        pages: SerializedPageWriter<'a, Vec<u8>>,
+        written: &'b mut Vec<WrittenPage>,
+        /// Whether the column is compressed.
+        compressing: bool,
+    }
+
+    impl PageWriter for AddLevels<'_, '_> {
+        fn write_page(&mut self, page: CompressedPage) -> Result<PageWriteSpec, ParquetError> {
+            let uncompressed = page.uncompressed_size();
+            let Page::DataPageV2 {
+                buf,
+                num_values,
+                encoding,
+                num_nulls: 0,
+                num_rows,
+                def_levels_byte_len: 0,
+                rep_levels_byte_len: 0,
+                is_compressed,
+                statistics,
+            } = page.compressed_page().clone()
+            else {
+                return Err(ParquetError::General(
+                    "a page of a required column other than a data page of format 2".to_string(),
+                ));
+            };
+            let mut levels = level_run(1, num_values as usize);
+            let added = levels.len();
+            levels.extend_from_slice(&buf);
+            let page = Page::DataPageV2 {
+                buf: Bytes::from(levels),
+                num_values,
+                encoding,
+                num_nulls: 0,
+                num_rows,
+                def_levels_byte_len: added as u32,
+                rep_levels_byte_len: 0,
+                is_compressed,
+                statistics,
+            };
+            let spec = self
+                .pages
+                .write_page(CompressedPage::new(page, uncompressed + added))?;
+            self.written.push(WrittenPage {
+                offset: spec.offset,
+                size: spec.compressed_size,
+                rows: num_rows,
+                undecided: self.compressing && !is_compressed,
+            });
+            Ok(spec)
+        }
+
+        fn close(&mut self) -> Result<(), ParquetError> {
+            self.pages.close()
+        }
+    }
+
+    /// `count` levels `level` (0 or 1) at bit width 1 as the parquet crate's `RleEncoder`
+    /// writes them: one RLE run (its length shifted left by one as a ULEB128 varint, then the
+    /// level in a byte), for any count (it ends a run of fewer than 8 equal values as a run).
+    fn level_run(level: u8, count: usize) -> Vec<u8> {
+        let mut bytes = Vec::with_capacity(6);
+        push_varint(&mut bytes, (count as u64) << 1);
+        bytes.push(level);
+        bytes
+    }
+
+    /// Appends `value` as a ULEB128 varint.
+    fn push_varint(bytes: &mut Vec<u8>, mut value: u64) {
+        while value >= 0x80 {
+            bytes.push((value as u8 & 0x7F) | 0x80);
+            value >>= 7;
+        }
+        bytes.push(value as u8);
     }
 
     /// A column chunk encoded in memory: its bytes and the metadata that goes with them.
@@ -1084,6 +1475,130 @@ mod encode {
             assert_eq!(w.inner, b"data");
             w.release(3).unwrap();
             assert_eq!(w.inner, b"datatail");
+        }
+
+        /// The writer's schema and properties.
+        fn schema_and_properties() -> (SchemaDescriptor, WriterPropertiesPtr) {
+            let descr = ArrowSchemaConverter::new().convert(&schema()).unwrap();
+            let props = Arc::new(properties(&descr, Vec::new()));
+            (descr, props)
+        }
+
+        /// A column chunk as the column writer encodes it, `BLOCK` rows at a time: its bytes
+        /// and its metadata as text (`ColumnCloseResult` has no `PartialEq`).
+        fn by_the_column_writer<T: ParquetType>(
+            descr: ColumnDescPtr,
+            props: &WriterPropertiesPtr,
+            rows: usize,
+            fill: impl Fn(Range<usize>, &mut Levels<T::T>),
+        ) -> (Bytes, String) {
+            let (bytes, close) = encode_levels::<T>(BLOCK, descr, props, rows, fill).unwrap();
+            (bytes, format!("{close:?}"))
+        }
+
+        /// The protocol column of a row group of one protocol is byte for byte what the column
+        /// writer makes of it, metadata included; of two protocols, the column writer encodes
+        /// it.
+        #[test]
+        fn one_protocol_is_encoded_as_the_column_writer_would() {
+            let (descr, props) = schema_and_properties();
+            let column = descr.column(index_of("protocol").unwrap());
+            for protocol in [Protocol::HwFoc, Protocol::DataLink] {
+                for rows in [
+                    8,
+                    9,
+                    127,
+                    128,
+                    4096,
+                    16_383,
+                    16_384,
+                    super::super::ROW_GROUP_ROWS + 4321,
+                ] {
+                    let (bytes, close) =
+                        Protocol::encode_whole(|_| protocol, rows, &column, &props)
+                            .expect("one protocol")
+                            .unwrap();
+                    let expected = by_the_column_writer::<ByteArrayType>(
+                        column.clone(),
+                        &props,
+                        rows,
+                        |block, levels| {
+                            levels.values.extend(block.map(|_| protocol_name(protocol)))
+                        },
+                    );
+                    assert_eq!(bytes, expected.0, "{protocol:?}, {rows} rows");
+                    assert_eq!(
+                        format!("{close:?}"),
+                        expected.1,
+                        "{protocol:?}, {rows} rows"
+                    );
+                }
+            }
+            let mixed = |i: usize| [Protocol::HwFoc, Protocol::DataLink][usize::from(i == 500)];
+            assert!(Protocol::encode_whole(mixed, 1000, &column, &props).is_none());
+            assert!(Protocol::encode_whole(|_| Protocol::HwFoc, 0, &column, &props).is_none());
+        }
+
+        /// A nullable column's chunk with every value there is byte for byte what the column
+        /// writer makes of it, metadata included, whatever its type and encoding, in one page or
+        /// several (a page holds up to 1 MB of values), of fewer rows than a run of levels or
+        /// more; with a null after the first block, or none there at all, the column writer
+        /// encodes it.
+        #[test]
+        fn a_column_with_every_value_is_encoded_as_the_column_writer_would() {
+            fn check<T: ParquetType>(
+                column: &ColumnDescPtr,
+                props: &WriterPropertiesPtr,
+                value: impl Fn(usize) -> T::T + Copy,
+            ) {
+                let name = column.path().string();
+                for rows in [1, 7, 8, 9, 4096, 4097, 100_000, 300_000] {
+                    let every = |_: usize| true;
+                    let later_null = |i: usize| i != BLOCK + 3;
+                    let none = |_: usize| false;
+                    for present in [&every as &dyn Fn(usize) -> bool, &later_null, &none] {
+                        let fill = |block: Range<usize>, levels: &mut Levels<T::T>| {
+                            for i in block {
+                                levels.def.push(i16::from(present(i)));
+                                if present(i) {
+                                    levels.values.push(value(i));
+                                }
+                            }
+                        };
+                        let (bytes, close) =
+                            encode_in::<T>(BLOCK, column.clone(), props, rows, fill).unwrap();
+                        let expected = by_the_column_writer::<T>(column.clone(), props, rows, fill);
+                        assert!(
+                            bytes == expected.0,
+                            "{name}, {rows} rows: bytes differ: {bytes:?} {:?}",
+                            expected.0
+                        );
+                        assert_eq!(format!("{close:?}"), expected.1, "{name}, {rows} rows");
+                    }
+                }
+            }
+            let (descr, props) = schema_and_properties();
+            let mut checked = Vec::new();
+            for column in descr.columns() {
+                if column.max_def_level() != 1 || column.max_rep_level() != 0 {
+                    continue;
+                }
+                match column.physical_type() {
+                    PhysicalType::FLOAT => {
+                        check::<FloatType>(column, &props, |i| (i % 1000) as f32 * 0.37 - 20.0)
+                    }
+                    PhysicalType::DOUBLE => {
+                        check::<DoubleType>(column, &props, |i| 1.7e9 + i as f64 / 7.0)
+                    }
+                    // Unsigned columns among them: values above i32::MAX as negative numbers.
+                    PhysicalType::INT32 => check::<Int32Type>(column, &props, |i| {
+                        (i as u32).wrapping_mul(2_654_435_761) as i32
+                    }),
+                    other => panic!("{}: no test values of {other}", column.path()),
+                }
+                checked.push(column.name().to_string());
+            }
+            assert!(checked.len() >= 15, "{checked:?}");
         }
 
         /// Every column is encoded, once.
