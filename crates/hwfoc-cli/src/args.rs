@@ -6,6 +6,7 @@ use std::path::PathBuf;
 use clap::Args;
 use clap::builder::{PossibleValue, PossibleValuesParser, TypedValueParser};
 use hwfoc::Protocol;
+use hwfoc::v4::VoltsPerStep;
 use hwfoc_io::Sources;
 use hwfoc_io::serial;
 use hwfoc_io::time::{Clock, Time, TimeError};
@@ -163,6 +164,11 @@ pub struct SettingsArgs {
     /// configuration file, else 1].
     #[arg(long, value_name = "X", help_heading = "Settings")]
     pub gear_ratio: Option<f32>,
+    /// Volts per voltage step of Hobbywing V4 ESCs until their first info frame is adopted
+    /// (which gives its own): N/D, or low (8/910, low-voltage models) or hv (11/650, HV
+    /// models) [default: from the configuration file, else 8/910].
+    #[arg(long, value_name = "N/D", help_heading = "Settings")]
+    pub v4_volts_per_step: Option<VoltsPerStep>,
     /// Configuration file (TOML) [default: $HWFOC_CONFIG, else hwfoc/config.toml in the user's
     /// configuration directory, if it exists].
     #[arg(long, value_name = "FILE", help_heading = "Settings", long_help = SETTINGS_HELP)]
@@ -179,6 +185,7 @@ impl SettingsArgs {
             current_scale: self.current_scale,
             pole_pairs: self.pole_pairs,
             gear_ratio: self.gear_ratio,
+            v4_volts_per_step: self.v4_volts_per_step,
         }
     }
 }

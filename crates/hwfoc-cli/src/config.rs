@@ -41,6 +41,7 @@ use std::collections::BTreeMap;
 use std::fmt;
 use std::path::{Path, PathBuf};
 
+use hwfoc::v4::VoltsPerStep;
 use hwfoc::{Protocol, Settings};
 use hwfoc_io::InputError;
 use hwfoc_io::read_small_file;
@@ -94,8 +95,19 @@ struct Entry {
     current_scale: Option<f32>,
     pole_pairs: Option<u16>,
     gear_ratio: Option<f32>,
+    /// `"8/910"`, `"11/650"`, `"low"` or `"hv"`.
+    #[serde(default, deserialize_with = "volts_per_step")]
+    v4_volts_per_step: Option<VoltsPerStep>,
     /// A name shown by the monitor (not in `[settings]`).
     label: Option<String>,
+}
+
+/// A V4 volts-per-step setting, written as `"8/910"` (or `"low"`, `"hv"`).
+fn volts_per_step<'de, D: serde::Deserializer<'de>>(
+    d: D,
+) -> Result<Option<VoltsPerStep>, D::Error> {
+    let text = String::deserialize(d)?;
+    text.parse().map(Some).map_err(serde::de::Error::custom)
 }
 
 impl Entry {
@@ -104,6 +116,7 @@ impl Entry {
             current_scale: self.current_scale,
             pole_pairs: self.pole_pairs,
             gear_ratio: self.gear_ratio,
+            v4_volts_per_step: self.v4_volts_per_step,
         }
     }
 }
@@ -116,6 +129,8 @@ struct PortEntry {
     current_scale: Option<f32>,
     pole_pairs: Option<u16>,
     gear_ratio: Option<f32>,
+    #[serde(default, deserialize_with = "volts_per_step")]
+    v4_volts_per_step: Option<VoltsPerStep>,
     label: Option<String>,
 }
 
@@ -125,6 +140,7 @@ impl PortEntry {
             current_scale: self.current_scale,
             pole_pairs: self.pole_pairs,
             gear_ratio: self.gear_ratio,
+            v4_volts_per_step: self.v4_volts_per_step,
             label: self.label.clone(),
         }
     }
@@ -355,6 +371,7 @@ impl Config {
             current_scale: f.current_scale,
             pole_pairs: f.pole_pairs,
             gear_ratio: f.gear_ratio,
+            v4_volts_per_step: None,
         })
     }
 
@@ -622,6 +639,7 @@ mod tests {
             current_scale: None,
             pole_pairs: None,
             gear_ratio: None,
+            v4_volts_per_step: None,
             config: config.map(Path::to_path_buf),
             no_config: config.is_none(),
         }
@@ -854,6 +872,22 @@ mod tests {
             "{err}"
         );
         assert!(!err.contains('\n'), "{err}");
+    }
+
+    /// `v4_volts_per_step` is a fraction in every settings table; a bad one names the line.
+    #[test]
+    fn the_v4_volts_per_step_is_a_fraction() {
+        let (_dir, config) = load(
+            "[settings]\nv4_volts_per_step = \"hv\"\n[esc.1]\nv4_volts_per_step = \"9/700\"\n",
+        );
+        let config = config.unwrap();
+        let map = config.settings_map(&flags(None)).unwrap();
+        let v = |esc| map.get(esc, "x").v4_volts_per_step.to_string();
+        assert_eq!((v(0), v(1)), ("11/650".to_string(), "9/700".to_string()));
+        let (_dir, config) = load("[settings]\nv4_volts_per_step = \"9/0\"\n");
+        let err = config.unwrap_err().to_string();
+        assert!(err.contains("config.toml line 2"), "{err}");
+        assert!(err.contains("volts per step must be N/D"), "{err}");
     }
 
     #[test]

@@ -262,7 +262,7 @@ fn decode_converts_each_esc_under_its_own_settings() {
     let comment = lines.next().unwrap();
     assert!(
         comment.starts_with(
-            "# hwfoc decode: current_scale=64 pole_pairs=7 gear_ratio=1 \
+            "# hwfoc decode: current_scale=64 pole_pairs=7 gear_ratio=1 v4_volts_per_step=8/910 \
              esc.1.current_scale=128 esc.1.pole_pairs=14 input="
         ),
         "{comment}"
@@ -291,7 +291,12 @@ fn decode_converts_each_esc_under_its_own_settings() {
     let escs: Value = serde_json::from_str(&metadata("esc_settings").unwrap()).unwrap();
     assert_eq!(
         escs,
-        serde_json::json!({"1": {"current_scale": 128.0, "pole_pairs": 14, "gear_ratio": 1.0}})
+        serde_json::json!({"1": {
+            "current_scale": 128.0,
+            "pole_pairs": 14,
+            "gear_ratio": 1.0,
+            "v4_volts_per_step": "8/910"
+        }})
     );
     // Without settings of an ESC's own, no such key.
     let pq = dir.arg("plain.parquet");
@@ -422,7 +427,12 @@ fn summary_converts_each_esc_under_its_own_settings() {
     // ESC 1's settings in its object; the others' are the report's.
     assert_eq!(
         configured["escs"][1]["settings"],
-        serde_json::json!({"current_scale": 128.0, "pole_pairs": 14, "gear_ratio": 1.0})
+        serde_json::json!({
+            "current_scale": 128.0,
+            "pole_pairs": 14,
+            "gear_ratio": 1.0,
+            "v4_volts_per_step": "8/910"
+        })
     );
     assert!(configured["escs"][0].get("settings").is_none());
     assert!(plain["escs"][1].get("settings").is_none());

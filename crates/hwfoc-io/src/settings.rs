@@ -23,6 +23,7 @@
 use std::collections::BTreeMap;
 use std::fmt;
 
+use hwfoc::v4::VoltsPerStep;
 use hwfoc::{Settings, SettingsError};
 
 /// The value of one conversion setting, written as every output writes it: in text (a Parquet
@@ -34,6 +35,8 @@ pub enum SettingValue {
     Real(f32),
     /// A count.
     Count(u16),
+    /// A fraction, `8/910` (the V4 volts per step before an info frame).
+    Fraction(VoltsPerStep),
 }
 
 impl fmt::Display for SettingValue {
@@ -41,6 +44,7 @@ impl fmt::Display for SettingValue {
         match self {
             SettingValue::Real(v) => v.fmt(f),
             SettingValue::Count(v) => v.fmt(f),
+            SettingValue::Fraction(v) => v.fmt(f),
         }
     }
 }
@@ -50,30 +54,38 @@ impl From<SettingValue> for serde_json::Value {
         match v {
             SettingValue::Real(v) => v.into(),
             SettingValue::Count(v) => v.into(),
+            SettingValue::Fraction(v) => v.to_string().into(),
         }
     }
 }
 
 /// The fields of `settings` by their name in every output (Parquet metadata, the CSV comment,
 /// the JSON of `summary` and `monitor`, the Python package's keyword arguments), in that
-/// order: `current_scale`, `pole_pairs`, `gear_ratio`.
-pub(crate) fn fields(settings: &Settings) -> [(&'static str, SettingValue); 3] {
+/// order: `current_scale`, `pole_pairs`, `gear_ratio`, `v4_volts_per_step`.
+pub(crate) fn fields(settings: &Settings) -> [(&'static str, SettingValue); 4] {
     [
         ("current_scale", SettingValue::Real(settings.current_scale)),
         ("pole_pairs", SettingValue::Count(settings.pole_pairs)),
         ("gear_ratio", SettingValue::Real(settings.gear_ratio)),
+        (
+            "v4_volts_per_step",
+            SettingValue::Fraction(settings.v4_volts_per_step),
+        ),
     ]
 }
 
 /// The fields of `settings` as people read them, each its name in words and its value:
-/// `["current scale 64", "pole pairs 7", "gear ratio 1"]` (`hwfoc summary`); with `default`,
-/// only those that differ from it.
+/// `["current scale 64", "pole pairs 7", "gear ratio 1"]` (`hwfoc summary`; the V4 volts per
+/// step, which only V4 ESCs read, only where it is not the default 8/910); with `default`, only
+/// those that differ from it.
 pub(crate) fn words(settings: &Settings, default: Option<&Settings>) -> Vec<String> {
     let defaults = default.map(fields);
+    let builtin = fields(&Settings::DEFAULT);
     fields(settings)
         .into_iter()
         .enumerate()
         .filter(|&(i, (_, value))| defaults.is_none_or(|d| d[i].1 != value))
+        .filter(|&(i, (name, value))| name != "v4_volts_per_step" || builtin[i].1 != value)
         .map(|(_, (name, value))| format!("{} {value}", name.replace('_', " ")))
         .collect()
 }
@@ -98,6 +110,8 @@ pub struct SettingsPatch {
     pub pole_pairs: Option<u16>,
     /// Gear ratio between motor and output shaft.
     pub gear_ratio: Option<f32>,
+    /// Volts per voltage step of a V4 ESC before its info frame.
+    pub v4_volts_per_step: Option<VoltsPerStep>,
 }
 
 impl SettingsPatch {
@@ -107,16 +121,20 @@ impl SettingsPatch {
             current_scale: self.current_scale.or(under.current_scale),
             pole_pairs: self.pole_pairs.or(under.pole_pairs),
             gear_ratio: self.gear_ratio.or(under.gear_ratio),
+            v4_volts_per_step: self.v4_volts_per_step.or(under.v4_volts_per_step),
         }
     }
 
     /// `base` with the fields of `self` that are set, checked as [`Settings::new`] does.
     pub fn apply(&self, base: &Settings) -> Result<Settings, SettingsError> {
-        Settings::new(
-            self.current_scale.unwrap_or(base.current_scale),
-            self.pole_pairs.unwrap_or(base.pole_pairs),
-            self.gear_ratio.unwrap_or(base.gear_ratio),
-        )
+        Ok(Settings {
+            v4_volts_per_step: self.v4_volts_per_step.unwrap_or(base.v4_volts_per_step),
+            ..Settings::new(
+                self.current_scale.unwrap_or(base.current_scale),
+                self.pole_pairs.unwrap_or(base.pole_pairs),
+                self.gear_ratio.unwrap_or(base.gear_ratio),
+            )?
+        })
     }
 
     /// Whether no field is set.
@@ -125,18 +143,19 @@ impl SettingsPatch {
     }
 
     /// The fields that are set, named and ordered as in every output
-    /// (`current_scale`, `pole_pairs`, `gear_ratio`).
+    /// (`current_scale`, `pole_pairs`, `gear_ratio`, `v4_volts_per_step`).
     pub fn fields(&self) -> impl Iterator<Item = (&'static str, SettingValue)> {
         let given = [
             self.current_scale.is_some(),
             self.pole_pairs.is_some(),
             self.gear_ratio.is_some(),
+            self.v4_volts_per_step.is_some(),
         ];
         let values = fields(&Settings {
             current_scale: self.current_scale.unwrap_or_default(),
             pole_pairs: self.pole_pairs.unwrap_or_default(),
             gear_ratio: self.gear_ratio.unwrap_or_default(),
-            ..Settings::DEFAULT
+            v4_volts_per_step: self.v4_volts_per_step.unwrap_or_default(),
         });
         values
             .into_iter()
@@ -239,6 +258,7 @@ mod tests {
             current_scale: scale,
             pole_pairs: pairs,
             gear_ratio: ratio,
+            v4_volts_per_step: None,
         }
     }
 
@@ -345,11 +365,16 @@ mod tests {
         let text: Vec<String> = fields(&s).iter().map(|(n, v)| format!("{n}={v}")).collect();
         assert_eq!(
             text,
-            ["current_scale=100", "pole_pairs=14", "gear_ratio=2.5"]
+            [
+                "current_scale=100",
+                "pole_pairs=14",
+                "gear_ratio=2.5",
+                "v4_volts_per_step=8/910"
+            ]
         );
         assert_eq!(
             settings_json(&Settings::DEFAULT).to_string(),
-            r#"{"current_scale":64.0,"pole_pairs":7,"gear_ratio":1.0}"#
+            r#"{"current_scale":64.0,"pole_pairs":7,"gear_ratio":1.0,"v4_volts_per_step":"8/910"}"#
         );
         let set: Vec<String> = patch(None, Some(3), Some(0.5))
             .fields()

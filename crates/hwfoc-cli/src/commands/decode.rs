@@ -121,6 +121,9 @@ fn overrides(map: &SettingsMap) -> Vec<(String, SettingsPatch)> {
         current_scale: p.current_scale.filter(|&v| v != default.current_scale),
         pole_pairs: p.pole_pairs.filter(|&v| v != default.pole_pairs),
         gear_ratio: p.gear_ratio.filter(|&v| v != default.gear_ratio),
+        v4_volts_per_step: p
+            .v4_volts_per_step
+            .filter(|&v| v != default.v4_volts_per_step),
     };
     let ports = map.port_patches().map(|(name, p)| {
         let quoted = serde_json::Value::from(name).to_string();

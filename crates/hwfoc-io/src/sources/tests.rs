@@ -436,6 +436,7 @@ fn hubs_and_escs_together_number_every_esc_once_live_and_recorded() {
         current_scale: scale,
         pole_pairs: poles,
         gear_ratio: None,
+        v4_volts_per_step: None,
     };
     map.set_port(&names[2], patch(None, Some(14))).unwrap();
     map.set_esc(12, patch(Some(100.0), None)).unwrap();

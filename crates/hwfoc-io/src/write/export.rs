@@ -557,6 +557,7 @@ mod tests {
                 current_scale: Some(s.current_scale),
                 pole_pairs: Some(s.pole_pairs),
                 gear_ratio: None,
+                v4_volts_per_step: None,
             };
             map.set_port(format!("p{esc}"), patch).unwrap();
         }
@@ -634,8 +635,8 @@ mod tests {
         let comment = lines.next().unwrap();
         assert!(
             comment.starts_with(
-                "# hwfoc decode: current_scale=64 pole_pairs=7 gear_ratio=1 esc.1.pole_pairs=3 \
-                 input=p0"
+                "# hwfoc decode: current_scale=64 pole_pairs=7 gear_ratio=1 v4_volts_per_step=8/910 \
+                 esc.1.pole_pairs=3 input=p0"
             ),
             "{comment}"
         );
@@ -686,9 +687,9 @@ mod tests {
         assert_eq!(
             escs,
             serde_json::json!({
-                "1": {"current_scale": 11.0, "pole_pairs": 3, "gear_ratio": 1.0},
-                "2": {"current_scale": 12.0, "pole_pairs": 4, "gear_ratio": 1.0},
-                "4": {"current_scale": 14.0, "pole_pairs": 6, "gear_ratio": 1.0},
+                "1": {"current_scale": 11.0, "pole_pairs": 3, "gear_ratio": 1.0, "v4_volts_per_step": "8/910"},
+                "2": {"current_scale": 12.0, "pole_pairs": 4, "gear_ratio": 1.0, "v4_volts_per_step": "8/910"},
+                "4": {"current_scale": 14.0, "pole_pairs": 6, "gear_ratio": 1.0, "v4_volts_per_step": "8/910"},
             })
         );
         let mut rows = Vec::new();
@@ -720,6 +721,7 @@ mod tests {
                 pole_pairs: Some(settings_of(esc).pole_pairs),
                 current_scale: Some(settings_of(esc).current_scale),
                 gear_ratio: None,
+                v4_volts_per_step: None,
             };
             map.set_port(format!("p{esc}"), patch).unwrap();
         }

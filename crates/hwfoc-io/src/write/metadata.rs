@@ -142,6 +142,7 @@ mod tests {
                 ("current_scale", "100"),
                 ("pole_pairs", "14"),
                 ("gear_ratio", "2.5"),
+                ("v4_volts_per_step", "8/910"),
                 ("inputs", r#"["a.pcapng","b \"c\".csv"]"#),
                 ("filter", "esc=1 from=+2"),
             ]
@@ -160,6 +161,7 @@ mod tests {
                 "current_scale",
                 "pole_pairs",
                 "gear_ratio",
+                "v4_volts_per_step",
                 "inputs"
             ]
         );
@@ -187,7 +189,7 @@ mod tests {
         assert_eq!(s.fields(), schema().fields());
         let p = Provenance::new(hwfoc::Settings::DEFAULT, Vec::new(), String::new());
         let with_escs = p.schema(Some("[]".to_string()));
-        assert_eq!(with_escs.metadata().len(), 7);
+        assert_eq!(with_escs.metadata().len(), 8);
         assert_eq!(with_escs.metadata()["record_schema_version"], "2");
         assert_eq!(with_escs.metadata()["escs"], "[]");
         assert_eq!(with_escs.metadata()["pole_pairs"], "7");

@@ -189,6 +189,66 @@ impl VoltsPerStep {
     }
 }
 
+impl core::fmt::Display for VoltsPerStep {
+    /// `8/910`: as [`VoltsPerStep::from_str`](core::str::FromStr) reads it.
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        write!(f, "{}/{}", self.num, self.den)
+    }
+}
+
+/// Why a text is not a [`VoltsPerStep`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum VoltsPerStepError {
+    /// Not `N/D` with two whole numbers from 1 to 65535, nor `low` or `hv`.
+    Form,
+}
+
+impl core::fmt::Display for VoltsPerStepError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.write_str(
+            "volts per step must be N/D with whole numbers from 1 to 65535 (8/910 for \
+             low-voltage models, 11/650 for HV), or low or hv",
+        )
+    }
+}
+
+impl core::error::Error for VoltsPerStepError {}
+
+impl core::str::FromStr for VoltsPerStep {
+    type Err = VoltsPerStepError;
+
+    /// `N/D` (`8/910`), or `low` ([`VoltsPerStep::LOW_VOLTAGE`]) or `hv`
+    /// ([`VoltsPerStep::HIGH_VOLTAGE`]).
+    ///
+    /// ```
+    /// use hwfoc::v4::VoltsPerStep;
+    ///
+    /// assert_eq!("11/650".parse(), Ok(VoltsPerStep::HIGH_VOLTAGE));
+    /// assert_eq!("low".parse(), Ok(VoltsPerStep::LOW_VOLTAGE));
+    /// assert!("8/0".parse::<VoltsPerStep>().is_err());
+    /// assert_eq!(VoltsPerStep::HIGH_VOLTAGE.to_string(), "11/650");
+    /// ```
+    fn from_str(text: &str) -> Result<VoltsPerStep, VoltsPerStepError> {
+        match text.trim() {
+            "low" => return Ok(VoltsPerStep::LOW_VOLTAGE),
+            "hv" => return Ok(VoltsPerStep::HIGH_VOLTAGE),
+            _ => {}
+        }
+        let (num, den) = text.trim().split_once('/').ok_or(VoltsPerStepError::Form)?;
+        let whole = |t: &str| {
+            t.trim()
+                .parse::<u16>()
+                .ok()
+                .filter(|&n| n > 0)
+                .ok_or(VoltsPerStepError::Form)
+        };
+        Ok(VoltsPerStep {
+            num: whole(num)?,
+            den: whole(den)?,
+        })
+    }
+}
+
 impl Default for VoltsPerStep {
     fn default() -> Self {
         Self::DEFAULT

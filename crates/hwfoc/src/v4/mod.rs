@@ -95,7 +95,7 @@ pub const BAUD_RATE: u32 = crate::foc::BAUD_RATE;
 
 pub use data::{Data, DataFrame};
 pub use decoder::{CHAIN_TO_LOCK, Decoded, Decoder, Frame, Frames, Scanner, frames};
-pub use info::{CurrentScale, InfoFrame, VoltsPerStep, throttle_linear};
+pub use info::{CurrentScale, InfoFrame, VoltsPerStep, VoltsPerStepError, throttle_linear};
 pub use layout::{
     ADC_LIMIT, COUNTER_AT, DATA_FRAME_LEN, DEFAULT_FULL_SCALE, INFO_FRAME_LEN, INFO_MARK,
     SLOW_DATA_FRAME_LEN, TRAILER,
