@@ -219,6 +219,39 @@ fn platinum_captures_decode_exactly() {
         );
         check_golden(&name.replace(".csv", ".summary.json"), &portable);
     }
+    // The Parquet export says which format each ESC spoke and the V4 constants adopted.
+    let dir = tempfile::tempdir().unwrap();
+    let pq = dir.path().join("v4.parquet");
+    let path = capture("platinum-v4.csv");
+    let out = run(&[
+        "decode",
+        "--format",
+        "parquet",
+        "-o",
+        pq.to_str().unwrap(),
+        path.to_str().unwrap(),
+    ]);
+    assert!(out.status.success());
+    let reader =
+        parquet::file::reader::SerializedFileReader::new(std::fs::File::open(&pq).unwrap())
+            .unwrap();
+    let kv = parquet::file::reader::FileReader::metadata(&reader)
+        .file_metadata()
+        .key_value_metadata()
+        .cloned()
+        .unwrap_or_default();
+    let value = |key: &str| {
+        kv.iter()
+            .find(|e| e.key == key)
+            .and_then(|e| e.value.clone())
+    };
+    let escs: Value = serde_json::from_str(&value("escs").unwrap()).unwrap();
+    assert_eq!(escs[0]["protocol"], "hw-v4");
+    assert_eq!(
+        escs[0]["v4_info"],
+        serde_json::json!({"full_scale": 1000, "v1": 8, "v2": 91, "i1": 0, "i2": 1, "i3": 0, "t1": 33, "t2": 33})
+    );
+    assert_eq!(value("v4_volts_per_step").as_deref(), Some("8/910"));
     // Forced to read HW-FOC, the V4 capture has no frame of it, and says so.
     let path = capture("platinum-v4.csv");
     let out = run(&["decode", "--protocol", "hw-foc", path.to_str().unwrap()]);

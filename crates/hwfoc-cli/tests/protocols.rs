@@ -430,3 +430,85 @@ fn the_bridge_reads_the_protocol_forced_only() {
     let hub = report("datalink");
     assert!(hub.contains(" 0 frames of 0 ESCs"), "{hub}");
 }
+
+/// An HW5 wire (telemetry frames, a configurator's ping between them, noise) told from its
+/// bytes: records of protocol `hw5` without packet numbers, HW5's fault names, the BEC and
+/// motor columns; the summary counts no loss (no counter), names the faults by HW5's names and
+/// integrates energy from voltage and current.
+#[test]
+fn an_hw5_wire_is_read_with_its_own_fields_and_faults() {
+    use hwfoc::hw5::{Fault, FaultCode, TelemetryFrame};
+    let frame = |i: u16, fault: FaultCode| TelemetryFrame {
+        throttle: 40,
+        fault,
+        erpm_raw: 3000 + i,
+        voltage_raw: 504,
+        current_raw: 123,
+        esc_temp: 45,
+        bec_temp: 40,
+        motor_temp: 60,
+        bec_voltage_raw: 84,
+        bec_current_raw: 15,
+        ..Default::default()
+    };
+    let mut wire = b"noise".to_vec();
+    for i in 0..20u16 {
+        let fault = if (5..8).contains(&i) {
+            FaultCode::OK.with(Fault::LowVoltage)
+        } else {
+            FaultCode::OK
+        };
+        wire.extend_from_slice(&frame(i, fault).encode());
+        if i == 10 {
+            // Rotorflight's ping request: recognised, counted, not a record.
+            wire.extend_from_slice(&[0x01, 0xFD, 0x03, 0x03, 0x2C, 0x24, 0x00, 0x01, 0x60, 0x60]);
+        }
+    }
+    let dir = Dir::new();
+    std::fs::write(dir.path("hw5.bin"), &wire).unwrap();
+    let file = dir.arg("hw5.bin");
+    for forced in [None, Some("hw5")] {
+        let mut args = vec!["decode", file.as_str()];
+        args.extend(forced.iter().flat_map(|p| ["--protocol", *p]));
+        let out = hwfoc().args(&args).output().unwrap();
+        assert!(out.status.success(), "{forced:?}");
+        let records: Vec<Value> = stdout(&out)
+            .lines()
+            .map(|l| serde_json::from_str(l).unwrap())
+            .collect();
+        assert_eq!(records.len(), 20, "{forced:?}");
+        let r = &records[6];
+        assert_eq!(r["protocol"], "hw5");
+        assert_eq!(r["packet"], Value::Null);
+        assert_eq!(r["throttle_in_pct"], 40.0);
+        assert_eq!(r["throttle_out_pct"], Value::Null);
+        assert_eq!(r["erpm"], 30_060);
+        assert_eq!(r["bec_voltage_v"], 8.4);
+        assert_eq!(r["motor_temp_c"], 60.0);
+        assert_eq!(r["status"], 0x20);
+        assert_eq!(r["faults"], serde_json::json!(["low_voltage"]));
+        assert_eq!(records[0]["faults"], serde_json::json!([]));
+    }
+    let out = hwfoc().args(["summary", "--json", &file]).output().unwrap();
+    assert!(out.status.success());
+    let v: Value = serde_json::from_str(&stdout(&out)).unwrap();
+    let esc = &v["escs"][0];
+    assert_eq!(esc["protocol"], "hw5");
+    assert_eq!(esc["frames"], 20);
+    assert_eq!(esc["link"]["lost_packets"], Value::Null);
+    assert_eq!(esc["link"]["delivery_ratio"], Value::Null);
+    assert_eq!(esc["link"]["checksum_failures"], 0);
+    // The noise only: the ping request is a frame, not skipped bytes.
+    assert_eq!(esc["link"]["bytes_skipped"], 5);
+    assert_eq!(esc["faults"], serde_json::json!({"low_voltage": 3}));
+    assert_eq!(esc["fault_episode_count"], 1);
+    assert_eq!(esc["fields"]["bec_current_a"]["max"], 1.5);
+    assert!(esc["energy"]["charge_mah"].as_f64().unwrap() > 0.0);
+    let text = stdout(&hwfoc().args(["summary", &file]).output().unwrap());
+    assert!(
+        text.contains("no packet counter (loss not counted)"),
+        "{text}"
+    );
+    assert!(text.contains("low_voltage"), "{text}");
+    assert!(!text.contains("phase_current_a"), "{text}");
+}

@@ -96,18 +96,31 @@ pub fn esc_settings_json(escs: &[(u8, Settings)]) -> String {
 }
 
 /// Which ESC is which, the value of [`ESCS`]:
-/// `[{"esc": 0, "input": "a.pcapng", "stream": "/dev/ttyUSB0"}, ...]`.
+/// `[{"esc": 0, "input": "a.pcapng", "stream": "/dev/ttyUSB0", "protocol": "hw-foc"}, ...]`;
+/// `protocol` is the format its frames came in (null without frames), and a V4 ESC has
+/// `v4_info`: the info frame whose constants were adopted (two identical copies), as
+/// [`device_json`](crate::summary::device_json) gives it, or null before one was.
 pub fn escs_json(sources: &Sources) -> String {
     let escs: Vec<serde_json::Value> = sources
         .escs()
         .iter()
         .enumerate()
         .map(|(i, esc)| {
-            serde_json::json!({
+            let link = sources.link(i);
+            let framed = link.frames() + link.info_frames() > 0;
+            let mut entry = serde_json::json!({
                 "esc": i,
                 "input": sources.names()[esc.input],
                 "stream": esc.name,
-            })
+                "protocol": framed.then(|| link.protocol().name()),
+            });
+            if framed && link.protocol() == hwfoc::Protocol::HwV4 {
+                let info = link
+                    .adopted_info()
+                    .map(|i| crate::summary::device_json(&hwfoc::telemetry::Info::HwV4(i)));
+                entry["v4_info"] = serde_json::json!(info);
+            }
+            entry
         })
         .collect();
     serde_json::Value::from(escs).to_string()
