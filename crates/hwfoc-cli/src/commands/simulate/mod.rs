@@ -228,6 +228,7 @@ impl ModelArgs {
         FleetSpec {
             n,
             seed: self.seed,
+            protocol: hwfoc::Protocol::HwFoc,
             baud,
             start_packet: self.start_packet,
             profile: self.profile.clone(),
