@@ -997,11 +997,9 @@ pub(crate) mod tests {
             if running {
                 assert!((gap - 20.0).abs() < 1e-3 || t < 2.1, "{gap} at {t}");
                 run += 1;
-            } else if t > 5.0 || t < 2.0 {
-                assert!(
-                    (gap - 400.0).abs() < 1e-3 || (gap < 400.0 && t < 5.0),
-                    "{gap}"
-                );
+            } else {
+                // Idle, and the first frame once the motor has stopped: 400 ms.
+                assert!((gap - 400.0).abs() < 1e-3, "{gap} at {t}");
                 idle += 1;
             }
         }
