@@ -510,3 +510,232 @@ fn a_fault_or_links_for_escs_that_do_not_exist_name_their_option() {
         "hwfoc: --link: 2 links for 3 ESCs: give one per ESC, or one with {esc} in it\n",
     );
 }
+
+/// Simulates 7 s of one ESC speaking `protocol` (idle 2 s, 40 % for 2 s, then idle) to a
+/// recording, with `extra` options and its ground truth; returns the records `hwfoc decode`
+/// finds by itself (checked equal to those it finds told the protocol), the truth, and the
+/// summary's JSON.
+fn simulate_protocol(protocol: &str, extra: &[&str]) -> (Vec<Value>, Vec<Value>, Value) {
+    let dir = Dir::new();
+    std::fs::write(
+        dir.path("p.csv"),
+        "time_s,throttle_percent\n0,0\n2,0\n2,40\n4,40\n4,0\n",
+    )
+    .unwrap();
+    let profile = format!("csv:{}", dir.arg("p.csv"));
+    let file = dir.arg("run.pcapng");
+    let truth = dir.arg("truth.jsonl");
+    let o = ok(hwfoc()
+        .args(["simulate", "--protocol", protocol, "--profile", &profile])
+        .args(["--duration", "7", "--start-time", "0", "-o", &file])
+        .args(["--truth", &truth])
+        .args(extra)
+        .output()
+        .unwrap());
+    // The report: no device id but HW-FOC's.
+    let report = String::from_utf8(o.stderr).unwrap();
+    assert!(report.starts_with(&format!("esc 0 ({file}): ")), "{report}");
+    let detected = decode(&dir.path("run.pcapng"));
+    let forced = jsonl(&ok(run(&["decode", "--protocol", protocol, &file])).stdout);
+    assert_eq!(detected, forced);
+    assert!(detected.iter().all(|r| r["protocol"] == protocol));
+    let summary = ok(run(&["summary", "--json", &file])).stdout;
+    (
+        detected,
+        read_jsonl(&dir.path("truth.jsonl")),
+        serde_json::from_slice(&summary).unwrap(),
+    )
+}
+
+fn t_s(r: &Value) -> f64 {
+    r["t_s"].as_f64().unwrap()
+}
+
+fn f(r: &Value, key: &str) -> f64 {
+    r[key].as_f64().unwrap_or_else(|| panic!("{key} in {r}"))
+}
+
+/// Packet counters from 0, +1 per data frame.
+fn assert_counts_from_zero(records: &[Value]) {
+    for (k, r) in records.iter().enumerate() {
+        assert_eq!(r["packet"], k as u64, "{r}");
+    }
+}
+
+#[test]
+fn protocol_hw_v4_fast_and_slow_modes_with_info_frames() {
+    let (records, truth, summary) = simulate_protocol("hw-v4", &[]);
+    assert_counts_from_zero(&records);
+    // Idle ("slow"): no second temperature, a data frame every 400 ms (an info frame between);
+    // running ("fast"): 51 ms.
+    let fast = |r: &Value| !r["cap_temp_c"].is_null();
+    let (mut fast_gaps, mut slow_gaps) = (0, 0);
+    for w in records.windows(2) {
+        let gap_ms = (t_s(&w[1]) - t_s(&w[0])) * 1e3;
+        match (fast(&w[0]), fast(&w[1])) {
+            (true, true) => {
+                assert!((gap_ms - 51.0).abs() < 1e-3, "{gap_ms} at {}", t_s(&w[0]));
+                fast_gaps += 1;
+            }
+            (false, false) => {
+                assert!((gap_ms - 400.0).abs() < 1e-3, "{gap_ms} at {}", t_s(&w[0]));
+                slow_gaps += 1;
+            }
+            _ => assert!(gap_ms < 400.0),
+        }
+    }
+    assert!(fast_gaps > 70 && slow_gaps >= 5, "{fast_gaps} {slow_gaps}");
+    // Fast from the first frame with throttle; slow again 1.5 s after the motor stopped.
+    let first_fast = records.iter().find(|r| fast(r)).map(t_s).unwrap();
+    assert!((2.0..2.06).contains(&first_fast), "{first_fast}");
+    let last_fast = records.iter().rev().find(|r| fast(r)).map(t_s).unwrap();
+    assert!((5.7..6.5).contains(&last_fast), "{last_fast}");
+    // The info frames are there, adopted: full scale 1000, the capture's 8/910 V per step,
+    // 0.05 A per step.
+    let esc = &summary["escs"][0];
+    assert_eq!(esc["protocol"], "hw-v4");
+    assert!(esc["info_frames"].as_u64().unwrap() >= 5, "{esc}");
+    let info = &esc["info"][0];
+    assert_eq!(info["adopted"], true);
+    assert_eq!(
+        (&info["full_scale"], &info["v1"], &info["v2"]),
+        (&Value::from(1000), &Value::from(8), &Value::from(91))
+    );
+    assert_eq!(
+        (&info["i1"], &info["i2"]),
+        (&Value::from(1), &Value::from(20))
+    );
+    // Values: a 6S pack, 40 % throttle, current while running (once the info frame is adopted).
+    for r in &records {
+        assert!((23.5..25.7).contains(&f(r, "voltage_v")), "{r}");
+        assert!((15.0..40.0).contains(&f(r, "mos_temp_c")), "{r}");
+        if (2.5..4.0).contains(&t_s(r)) {
+            assert!((38.0..42.0).contains(&f(r, "throttle_in_pct")), "{r}");
+            assert!(f(r, "current_a") > 2.0 && f(r, "erpm") > 10_000.0, "{r}");
+        }
+    }
+    // The truth is each frame as its ESC meant it, under its own info frame: the records from
+    // the adoption on are exactly the truth's.
+    assert_eq!(truth.len(), records.len());
+    let adopted = records
+        .iter()
+        .position(|r| !r["current_a"].is_null())
+        .unwrap();
+    assert!(adopted <= 3, "{adopted}");
+    assert_eq!(records[adopted..], truth[adopted..]);
+}
+
+#[test]
+fn protocol_hw_v3_steady_frames_and_the_start_up_placeholder() {
+    let (records, truth, _) = simulate_protocol("hw-v3", &[]);
+    assert_eq!(records, truth);
+    assert_counts_from_zero(&records);
+    for w in records.windows(2) {
+        let gap_ms = (t_s(&w[1]) - t_s(&w[0])) * 1e3;
+        assert!((gap_ms - 19.5).abs() < 1e-3, "{gap_ms}");
+    }
+    assert!((355..360).contains(&records.len()), "{}", records.len());
+    for r in &records {
+        let t = t_s(r);
+        // Stopped: the placeholder period, no speed.
+        if !(2.0..5.5).contains(&t) {
+            assert!(r["erpm"].is_null() && r["rpm"].is_null(), "{r}");
+            assert_eq!(f(r, "throttle_in_pct"), 0.0);
+        }
+        if (2.5..4.0).contains(&t) {
+            assert!((38.0..42.0).contains(&f(r, "throttle_in_pct")), "{r}");
+            assert!((10_000.0..40_000.0).contains(&f(r, "erpm")), "{r}");
+        }
+        assert!(r["voltage_v"].is_null());
+    }
+}
+
+#[test]
+fn protocol_hw5_rates_values_and_faults() {
+    let (records, truth, summary) = simulate_protocol(
+        "hw5",
+        &[
+            "--fault",
+            "motor_blocked@3-3.5",
+            "--fault",
+            "over_current@6",
+        ],
+    );
+    assert_eq!(records, truth);
+    assert_eq!(summary["escs"][0]["protocol"], "hw5");
+    let running = |r: &Value| f(r, "erpm") > 0.0;
+    let (mut run_gaps, mut idle_gaps) = (0, 0);
+    for w in records.windows(2) {
+        let gap_ms = (t_s(&w[1]) - t_s(&w[0])) * 1e3;
+        match (running(&w[0]), running(&w[1])) {
+            (true, true) => {
+                assert!((gap_ms - 20.0).abs() < 1e-3, "{gap_ms}");
+                run_gaps += 1;
+            }
+            // Idle, and the first frame once the motor has stopped.
+            (_, false) => {
+                assert!((gap_ms - 400.0).abs() < 1e-3, "{gap_ms}");
+                idle_gaps += 1;
+            }
+            // Starting: the next 20 ms check.
+            (false, true) => assert!(gap_ms < 400.0),
+        }
+    }
+    // 50 Hz for about 2.8 s, 2.5 Hz for about 4 s.
+    assert!((120..150).contains(&run_gaps), "{run_gaps}");
+    assert!((7..12).contains(&idle_gaps), "{idle_gaps}");
+    for r in &records {
+        let t = t_s(r);
+        assert!((24.0..25.7).contains(&f(r, "voltage_v")), "{r}");
+        assert!((8.25..8.55).contains(&f(r, "bec_voltage_v")), "{r}");
+        if (2.5..4.0).contains(&t) {
+            assert!((38.0..42.0).contains(&f(r, "throttle_in_pct")), "{r}");
+            assert!(f(r, "current_a") > 2.0, "{r}");
+        }
+        let faults: &[&str] = if (3.0..3.5).contains(&t) {
+            &["motor_locked"]
+        } else if t >= 6.0 {
+            &["over_current"]
+        } else {
+            &[]
+        };
+        assert_eq!(r["faults"], serde_json::json!(faults), "{r}");
+    }
+}
+
+#[test]
+fn protocol_errors_name_what_is_wrong() {
+    let dir = Dir::new();
+    let out = dir.arg("x.bin");
+    assert_fails_with(
+        &run(&[
+            "simulate",
+            "--protocol",
+            "hw5",
+            "--fault",
+            "mos_short@1",
+            "-o",
+            &out,
+        ]),
+        "hwfoc: --fault: the fault mos_short has no flag in HW5's fault byte; HW5 carries ",
+    );
+    assert_fails_with(
+        &run(&[
+            "simulate",
+            "--protocol",
+            "hw-v4",
+            "--drop-rate",
+            "0.1",
+            "-o",
+            &out,
+        ]),
+        "link faults (bit errors, drops, cuts, garbage) are simulated for HW-FOC only, not for \
+         Hobbywing V4 (hw-v4)",
+    );
+    let o = run(&["simulate", "--protocol", "datalink", "-o", &out]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(
+        String::from_utf8_lossy(&o.stderr).contains("[possible values: hw-foc, hw-v4, hw-v3, hw5]")
+    );
+    assert!(!dir.path("x.bin").exists());
+}

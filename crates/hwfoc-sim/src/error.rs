@@ -53,6 +53,21 @@ pub enum SimError {
         /// How many ESCs there are.
         n: usize,
     },
+    /// A protocol no virtual ESC speaks (DataLink: a hub's).
+    Protocol {
+        /// The protocol asked for.
+        protocol: hwfoc::Protocol,
+    },
+    /// Link faults (bit errors, drops, cuts, garbage) asked of a protocol other than HW-FOC.
+    LinkFaults {
+        /// The protocol.
+        protocol: hwfoc::Protocol,
+    },
+    /// A fault injected on ESCs speaking HW5, whose fault byte has no flag for it.
+    NoHw5Fault {
+        /// The fault.
+        fault: hwfoc::Fault,
+    },
     /// Symlinks to pseudo-terminals, neither one per ESC nor one template.
     LinkCount {
         /// How many links were given.
@@ -125,6 +140,24 @@ impl fmt::Display for SimError {
                 "raw bytes of {n} ESCs cannot share one output: give each its own file \
                  ({{esc}} in the name) or write a recording (pcapng)"
             ),
+            SimError::Protocol { protocol } => write!(
+                f,
+                "virtual ESCs do not speak {} ({protocol}): they speak {}",
+                protocol.title(),
+                crate::protocols::SIMULATED.map(|p| p.name()).join(", ")
+            ),
+            SimError::LinkFaults { protocol } => write!(
+                f,
+                "link faults (bit errors, drops, cuts, garbage) are simulated for HW-FOC only, \
+                 not for {} ({protocol})",
+                protocol.title()
+            ),
+            SimError::NoHw5Fault { fault } => write!(
+                f,
+                "the fault {} has no flag in HW5's fault byte; HW5 carries {}",
+                fault.name(),
+                hw5_carried().join(", ")
+            ),
             SimError::LinkCount { links, n } => write!(
                 f,
                 "{links} links to pseudo-terminals for {n} ESCs: give one per ESC, or one with \
@@ -146,6 +179,16 @@ impl fmt::Display for SimError {
             SimError::Link { path, source } => write!(f, "cannot create the link {path}: {source}"),
         }
     }
+}
+
+/// The simulator's fault names that HW5 carries (each with the flag it is sent as).
+fn hw5_carried() -> Vec<String> {
+    hwfoc::Fault::ALL
+        .iter()
+        .filter_map(|f| {
+            crate::protocols::hw5_fault(*f).map(|h| format!("{} (as {})", f.name(), h.name()))
+        })
+        .collect()
 }
 
 impl std::error::Error for SimError {

@@ -5,6 +5,7 @@ use std::rc::Rc;
 use std::sync::atomic::AtomicBool;
 use std::time::Instant;
 
+use hwfoc::Protocol;
 use hwfoc_io::clock::unix_now_ns;
 
 use crate::error::SimError;
@@ -12,6 +13,7 @@ use crate::esc::{Setup, VirtualEsc, spread};
 use crate::faults::{FaultSchedule, FaultSpec, LinkRates};
 use crate::model::ModelConfig;
 use crate::profile::{Profile, ProfileSpec, Shape};
+use crate::protocols;
 use crate::schedule::{self, Pace, SimClock};
 use crate::sink::Sink;
 
@@ -25,6 +27,8 @@ pub struct FleetSpec {
     pub n: usize,
     /// Seed of every random choice: the same seed and description give the same bytes.
     pub seed: u64,
+    /// The protocol every ESC speaks (one of [`protocols::SIMULATED`]).
+    pub protocol: Protocol,
     /// Line rate, baud (8N1).
     pub baud: u32,
     /// First packet number of every ESC; random per ESC (from the seed) if `None`.
@@ -42,11 +46,30 @@ pub struct FleetSpec {
 }
 
 impl FleetSpec {
-    /// The fleet, checked (at most [`MAX_ESCS`] ESCs, every fault's ESC exists) and its profile loaded (a CSV file read),
-    /// but not started.
+    /// The fleet, checked (at most [`MAX_ESCS`] ESCs, every fault's ESC exists, the protocol is
+    /// one a virtual ESC speaks, link faults only on HW-FOC, every fault has a flag in an HW5
+    /// fault byte when speaking HW5) and its profile loaded (a CSV file read), but not started.
     pub fn build(self) -> Result<VirtualFleet, SimError> {
         if self.n > MAX_ESCS {
             return Err(SimError::TooManyEscs { n: self.n });
+        }
+        if !protocols::simulated(self.protocol) {
+            return Err(SimError::Protocol {
+                protocol: self.protocol,
+            });
+        }
+        if self.protocol != Protocol::HwFoc && self.link != LinkRates::default() {
+            return Err(SimError::LinkFaults {
+                protocol: self.protocol,
+            });
+        }
+        if self.protocol == Protocol::Hw5
+            && let Some(f) = self
+                .faults
+                .iter()
+                .find(|f| protocols::hw5_fault(f.fault).is_none())
+        {
+            return Err(SimError::NoHw5Fault { fault: f.fault });
         }
         if let Some(esc) = self
             .faults
@@ -92,6 +115,7 @@ impl VirtualFleet {
                 VirtualEsc::new(Setup {
                     index,
                     seed: spec.seed,
+                    protocol: spec.protocol,
                     baud: spec.baud,
                     start_packet: spec.start_packet,
                     model: spec.model,
@@ -127,6 +151,7 @@ pub(crate) mod tests {
         FleetSpec {
             n,
             seed: 1,
+            protocol: Protocol::HwFoc,
             baud: 19200,
             start_packet: None,
             profile: ProfileSpec::Steps,
@@ -162,5 +187,40 @@ pub(crate) mod tests {
             escs.iter().map(VirtualEsc::index).collect::<Vec<_>>(),
             [0, 1, 2]
         );
+    }
+
+    #[test]
+    fn building_checks_the_protocol() {
+        let with = |protocol: Protocol| FleetSpec {
+            protocol,
+            ..spec(1)
+        };
+        assert_eq!(
+            with(Protocol::DataLink).build().unwrap_err().to_string(),
+            "virtual ESCs do not speak DataLink V2 (datalink): they speak hw-foc, hw-v4, hw-v3, hw5"
+        );
+        let mut s = with(Protocol::HwV3);
+        s.link.drop = 0.1;
+        assert_eq!(
+            s.build().unwrap_err().to_string(),
+            "link faults (bit errors, drops, cuts, garbage) are simulated for HW-FOC only, not \
+             for Hobbywing V3 (hw-v3)"
+        );
+        let mut s = with(Protocol::Hw5);
+        s.faults = vec!["over_current@1".parse().unwrap()];
+        assert!(s.clone().build().is_ok());
+        s.faults.push("mos_short@2".parse().unwrap());
+        let e = s.build().unwrap_err().to_string();
+        assert!(
+            e.starts_with(
+                "the fault mos_short has no flag in HW5's fault byte; HW5 carries \
+                 input_voltage_high (as input_voltage_error), input_voltage_low (as low_voltage), "
+            ),
+            "{e}"
+        );
+        // V3 and V4 carry no fault word: faults act on the model only.
+        let mut s = with(Protocol::HwV4);
+        s.faults = vec!["mos_short@2".parse().unwrap()];
+        assert!(s.build().is_ok());
     }
 }

@@ -1,4 +1,5 @@
-//! Virtual HW-FOC ESCs that speak the protocol as real ones do, for every front end alike (the
+//! Virtual Hobbywing ESCs that speak their protocol as real ones do (HW-FOC, and Platinum V4, V3
+//! and HW5: [`protocols`]), for every front end alike (the
 //! `hwfoc simulate` command, `hwfoc monitor --sim`, bridges, bindings, tests that need
 //! recordings).
 //!
@@ -26,6 +27,7 @@ pub mod faults;
 pub mod fleet;
 pub mod model;
 pub mod profile;
+pub mod protocols;
 #[cfg(unix)]
 pub mod pty;
 pub mod rng;

@@ -356,6 +356,65 @@ impl Model {
     }
 }
 
+/// What an ESC measures at one moment, in physical units, with a little sensor noise: what the
+/// frames of the protocols other than HW-FOC are made from ([`Model::measure`]; HW-FOC's frame
+/// is [`Model::frame`], unchanged).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Measured {
+    /// Input throttle, percent.
+    pub throttle_in_pct: f64,
+    /// Output throttle (PWM), percent.
+    pub throttle_out_pct: f64,
+    /// Electrical RPM (0 when stopped).
+    pub erpm: f64,
+    /// Bus voltage, V.
+    pub voltage_v: f64,
+    /// Input current, A (negative while braking regeneratively; 0 when stopped).
+    pub current_a: f64,
+    /// MOSFET temperature, degC (at least the threshold's while an overheat is injected).
+    pub mos_c: f64,
+    /// Capacitor temperature, degC (likewise).
+    pub cap_c: f64,
+    /// The ambient temperature, degC.
+    pub ambient_c: f64,
+    /// The model's status bits plus the injected ones.
+    pub status: Status,
+    /// Whether the motor turns (or is driven).
+    pub spinning: bool,
+}
+
+impl Model {
+    /// The measurements the ESC sends now, with `injected` status bits (see [`Measured`]).
+    pub fn measure(&self, injected: Status, noise: &mut Rng) -> Measured {
+        let p = &self.p;
+        let spinning = self.spinning();
+        let erpm = if self.rpm > 0.0 {
+            self.rpm * (1.0 + noise.noise(0.002)) * f64::from(p.pole_pairs)
+        } else {
+            0.0
+        };
+        let current_a = if spinning {
+            self.i_in + noise.noise(0.05) + self.i_in.abs() * noise.noise(0.01)
+        } else {
+            0.0
+        };
+        Measured {
+            throttle_in_pct: self.throttle_in,
+            throttle_out_pct: self.throttle_out,
+            erpm,
+            voltage_v: self.v_bus + noise.noise(0.03),
+            current_a,
+            mos_c: overheated(self.t_mos, injected, Fault::MosOverheat, MOS_OVERHEAT_C)
+                + noise.noise(0.15),
+            cap_c: overheated(self.t_cap, injected, Fault::CapOverheat, CAP_OVERHEAT_C)
+                + noise.noise(0.15),
+            ambient_c: p.ambient_c,
+            status: Status(self.status().0 | injected.0),
+            spinning,
+        }
+    }
+}
+
 /// The temperature an ESC reports with an injected overheat: an overheat bit comes with the
 /// temperature that raises it, so the sensor reads at least 2 degC above the threshold (`set`)
 /// while `fault` is injected; otherwise the model's `t_c`.

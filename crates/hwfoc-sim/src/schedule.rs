@@ -76,6 +76,15 @@ impl Tally {
                 }
                 fate
             }
+            What::Telemetry { .. } => {
+                self.data += 1;
+                if delivered {
+                    self.intact += 1;
+                } else {
+                    self.undelivered += 1;
+                }
+                return;
+            }
             What::Info { fate } => {
                 self.info += 1;
                 fate
@@ -200,13 +209,13 @@ pub fn run(
         }
         lane.tally.count(&lane.burst, lane.delivered);
         if lane.delivered
-            && let Some(frame) = lane.burst.intact_frame()
+            && let Some(data) = lane.burst.intact_data()
             && let Some(truth) = truth.as_deref_mut()
         {
             // Seconds exactly as the recording's reader computes them for a packet's first
             // byte, so that decoding a recording gives the same `t_s`.
             let t_ns = clock.origin_ns + lane.burst.t_ns;
-            truth.record(hwfoc_io::clock::byte_time_s(t_ns, 0, 0.0), index, frame)?;
+            truth.record_data(hwfoc_io::clock::byte_time_s(t_ns, 0, 0.0), index, &data)?;
         }
         lane.burst = lane.esc.next_burst();
         lane.written = 0;

@@ -68,7 +68,8 @@ impl Plan {
 pub struct EscReport {
     /// Its output, as a person would name it (a path, a port, standard output).
     pub output: String,
-    /// The id in its device information.
+    /// The id in its device information (empty for a protocol whose ESCs send none: all but
+    /// HW-FOC).
     pub id: String,
     /// What it sent.
     pub tally: Tally,
@@ -145,7 +146,14 @@ impl Session {
             realtime,
             duration_ns,
         } = self;
-        let ids: Vec<String> = escs.iter().map(|e| e.info().id().to_string()).collect();
+        // Only HW-FOC's device information names the ESC.
+        let ids: Vec<String> = escs
+            .iter()
+            .map(|e| match e.protocol() {
+                hwfoc::Protocol::HwFoc => e.info().id().to_string(),
+                _ => String::new(),
+            })
+            .collect();
         let clock = SimClock {
             origin_ns,
             real: realtime.then(Instant::now),

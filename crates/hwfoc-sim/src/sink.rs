@@ -4,6 +4,7 @@ use std::io::{self, BufWriter, Write};
 
 use hwfoc::Settings;
 use hwfoc::foc::DataFrame;
+use hwfoc::telemetry::Data;
 
 use hwfoc_io::pcapng;
 use hwfoc_io::record::Record;
@@ -256,10 +257,15 @@ impl Truth {
 
     /// Records `frame` of ESC `esc`, whose first byte started at `t_s`.
     pub fn record(&mut self, t_s: f64, esc: usize, frame: &DataFrame) -> Result<(), WriteError> {
+        self.record_data(t_s, esc, &(*frame).into())
+    }
+
+    /// Records `data`, a data frame of any protocol, of ESC `esc`, whose first byte started at
+    /// `t_s` (a V4 frame converted under the info frame it carries).
+    pub fn record_data(&mut self, t_s: f64, esc: usize, data: &Data) -> Result<(), WriteError> {
         self.line.clear();
         // ESC indices are below 256 (checked when the fleet is built).
-        Record::new(Some(t_s), esc as u8, &(*frame).into(), &self.settings)
-            .write_json(&mut self.line);
+        Record::new(Some(t_s), esc as u8, data, &self.settings).write_json(&mut self.line);
         self.out
             .write_all(&self.line)
             .map_err(write_error(&self.name))

@@ -1,4 +1,5 @@
-//! `hwfoc simulate`: virtual HW-FOC ESCs that speak the protocol as real ones do.
+//! `hwfoc simulate`: virtual ESCs that speak their protocol as real ones do (HW-FOC by default;
+//! `--protocol hw-v4`, `hw-v3` or `hw5`: [`hwfoc_sim::protocols`]).
 //!
 //! The simulator is the `hwfoc_sim` library; this command turns its options into the library's
 //! description of a run (a [`FleetSpec`] and a [`Plan`]), refuses options that do not go
@@ -8,7 +9,8 @@
 use std::io::{IsTerminal, Write};
 
 use clap::ValueEnum;
-use hwfoc::Settings;
+use clap::builder::{PossibleValue, PossibleValuesParser, TypedValueParser};
+use hwfoc::{Protocol, Settings};
 
 use crate::args::SettingsArgs;
 use crate::error::CliError;
@@ -17,10 +19,13 @@ use hwfoc_sim::faults::{FaultSpec, LinkRates};
 use hwfoc_sim::fleet::MAX_ESCS;
 use hwfoc_sim::model::ModelConfig;
 use hwfoc_sim::profile::{ProfileSpec, Shape};
+use hwfoc_sim::protocols::SIMULATED;
 #[cfg(unix)]
 use hwfoc_sim::pty::PtyLinks;
 use hwfoc_sim::sink::expand;
-use hwfoc_sim::{Destination, EscReport, FileFormat, FleetSpec, Plan, Session, VirtualFleet};
+use hwfoc_sim::{
+    Destination, EscReport, FileFormat, FleetSpec, Plan, Session, SimError, VirtualFleet,
+};
 
 /// File formats of `-o`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
@@ -48,7 +53,8 @@ Examples:
   hwfoc simulate -o run.bin --truth truth.jsonl       # raw bytes, 18 s simulated, at once
   hwfoc simulate --escs 4 -o run.pcapng --profile sine --duration 60
   hwfoc simulate --drop-rate 0.02 --bit-error-rate 1e-4 --fault mos_overheat@5-7 | hwfoc decode -
-  hwfoc simulate --port /dev/ttyUSB0 --profile csv:flight.csv";
+  hwfoc simulate --port /dev/ttyUSB0 --profile csv:flight.csv
+  hwfoc simulate --protocol hw5 --fault motor_blocked@5-6 -o hw5.pcapng  # an HW5 ESC at 115200 baud";
 
 /// Arguments of `hwfoc simulate`.
 #[derive(Debug, clap::Args)]
@@ -61,10 +67,16 @@ pub struct SimulateArgs {
     /// standard output; until Ctrl-C in real time.
     #[arg(long, value_name = "S", value_parser = crate::args::seconds)]
     duration: Option<f64>,
-    /// Line rate in baud (8N1).
-    #[arg(long, value_name = "BAUD", default_value_t = hwfoc_io::serial::DEFAULT_BAUD,
+    /// The protocol the virtual ESCs speak: hw-foc (default), hw-v4 (Platinum V4), hw-v3
+    /// (Platinum V3) or hw5 (Platinum V5, VBAR). V3 and V4 carry no fault word (faults act on the
+    /// model only); HW5's fault byte carries the faults that map to its flags; link faults are
+    /// for hw-foc only.
+    #[arg(long, value_name = "NAME", value_parser = protocol_parser())]
+    protocol: Option<Protocol>,
+    /// Line rate in baud (8N1). Default: the protocol's (19200; 115200 for hw5).
+    #[arg(long, value_name = "BAUD",
           value_parser = clap::value_parser!(u32).range(9_600..=4_000_000))]
-    baud: u32,
+    baud: Option<u32>,
     /// The virtual ESCs: random seed, throttle profile, physical model, faults.
     #[command(flatten)]
     pub model: ModelArgs,
@@ -228,6 +240,7 @@ impl ModelArgs {
         FleetSpec {
             n,
             seed: self.seed,
+            protocol: hwfoc::Protocol::HwFoc,
             baud,
             start_packet: self.start_packet,
             profile: self.profile.clone(),
@@ -268,6 +281,16 @@ impl ModelArgs {
     ) -> Result<VirtualFleet, CliError> {
         Ok(self.spec(n, baud, settings).build()?)
     }
+}
+
+/// The names of the protocols a virtual ESC speaks, each with its title and baud rate.
+fn protocol_parser() -> impl TypedValueParser<Value = Protocol> {
+    let names = SIMULATED.map(|p| {
+        PossibleValue::new(p.name()).help(format!("{}, {} baud", p.title(), p.baud_rate()))
+    });
+    // Every possible value is a protocol's name: the mapping finds it.
+    PossibleValuesParser::new(names)
+        .map(|name| Protocol::from_name(&name).unwrap_or(Protocol::HwFoc))
 }
 
 fn number(s: &str) -> Result<f64, String> {
@@ -354,7 +377,16 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
         .chain(crate::safety::config_read(&config))
         .collect();
     refuse_clashes(&plan, n, &reads)?;
-    let fleet = args.model.fleet(n, args.baud, &settings)?;
+    let protocol = args.protocol.unwrap_or(Protocol::HwFoc);
+    let baud = args.baud.unwrap_or(protocol.baud_rate());
+    let spec = FleetSpec {
+        protocol,
+        ..args.model.spec(n, baud, &settings)
+    };
+    let fleet = spec.build().map_err(|e| match e {
+        e @ SimError::NoHw5Fault { .. } => usage("--fault", e.to_string()),
+        e => CliError::from(e),
+    })?;
     let session = Session::open(fleet, &plan)?;
     if args.pty {
         announce(session.outputs())?;
@@ -525,9 +557,14 @@ fn announce(paths: &[String]) -> Result<(), CliError> {
 /// The end-of-run line for one ESC.
 fn report(esc: usize, r: &EscReport) -> String {
     let t = &r.tally;
+    let id = if r.id.is_empty() {
+        String::new()
+    } else {
+        format!(", id {}", r.id)
+    };
     let mut line = format!(
-        "esc {esc} ({}, id {}): {} data frames, {} intact",
-        r.output, r.id, t.data, t.intact
+        "esc {esc} ({}{id}): {} data frames, {} intact",
+        r.output, t.data, t.intact
     );
     for (count, what) in [
         (t.dropped, "dropped"),
@@ -538,7 +575,9 @@ fn report(esc: usize, r: &EscReport) -> String {
             line.push_str(&format!(", {count} {what}"));
         }
     }
-    line.push_str(&format!("; {} device-information frames", t.info));
+    if t.info > 0 || !r.id.is_empty() {
+        line.push_str(&format!("; {} device-information frames", t.info));
+    }
     if t.garbage > 0 {
         line.push_str(&format!("; {} garbage bursts", t.garbage));
     }
