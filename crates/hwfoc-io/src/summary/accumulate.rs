@@ -296,6 +296,51 @@ pub(super) struct Values {
     pub(super) last: Option<(f64, f64)>,
     /// Charge and energy over receive times, in amperes and volts.
     pub(super) energy: Energy,
+    /// Frames lost, judged from the times of a format without packet counter (HW5).
+    pub(super) loss: TimedLoss,
+}
+
+/// Frames of a format without packet counter (HW5) lost, judged from their receive times: a
+/// step between two frames longer than one and a half of the nominal period counts the frames
+/// that would have come in it (the period of a running ESC, 20 ms, between two frames of a
+/// turning motor; else the idle one, 400 ms, so that a change of rate is never a loss). A step
+/// over a second (the ESC may have been off) is not judged, only counted.
+#[derive(Debug, Clone, Copy, Default)]
+pub(super) struct TimedLoss {
+    /// The last timed frame's time and whether its motor turned.
+    last: Option<(f64, bool)>,
+    /// Frames judged lost.
+    pub(super) lost: u64,
+    /// Steps over a second, not judged.
+    pub(super) unjudged: u64,
+    /// Steps judged.
+    pub(super) judged: u64,
+}
+
+impl TimedLoss {
+    /// The frame received at `t`, whose motor turned or not.
+    fn add(&mut self, t: f64, turning: bool) {
+        if let Some((last, was_turning)) = self.last {
+            let dt = t - last;
+            if dt > crate::clock::MAX_STEP_S {
+                self.unjudged += 1;
+            } else if dt > 0.0 {
+                let period = if turning && was_turning {
+                    hwfoc::hw5::FRAME_PERIOD_RUNNING
+                } else {
+                    hwfoc::hw5::FRAME_PERIOD_IDLE
+                }
+                .as_secs_f64();
+                if dt > 1.5 * period {
+                    self.lost += (dt / period).round() as u64 - 1;
+                }
+                self.judged += 1;
+            }
+        }
+        if t >= self.last.map_or(f64::MIN, |(last, _)| last) {
+            self.last = Some((t, turning));
+        }
+    }
 }
 
 impl Values {
@@ -333,6 +378,7 @@ impl Values {
             };
             self.last = later.last;
         }
+        // (Halves are joined only without times: nothing was judged from them.)
         self.powered += later.powered;
         self.current_sum += later.current_sum;
         self.power_sum += later.power_sum;
@@ -597,6 +643,12 @@ impl Accumulator {
     fn add_values(&mut self, t: Option<f64>, f: &Data, settings: &Settings) {
         let values = self.values.get_or_insert_with(Default::default);
         let powered = values.add(f, settings);
+        if let (Some(t), None) = (t, f.packet()) {
+            let turning = [Quantity::Erpm, Quantity::ThrottleIn]
+                .into_iter()
+                .any(|q| f.raw(q).is_some_and(|raw| raw > 0));
+            values.loss.add(t, turning);
+        }
         if let (Some(t), Some((volts, amps))) = (t, powered) {
             values.energy.add(Some(t), volts, amps);
         }

@@ -143,6 +143,8 @@ impl EscReport<'_> {
                 "lost_packets": counted.then(|| st.lost_packets()),
                 "duplicate_packets": counted.then(|| st.duplicate_packets()),
                 "restarts": counted.then(|| st.restarts()),
+                "lost_frames_from_time": self.timed_loss().map(|l| l.lost),
+                "silences_not_judged": self.timed_loss().map(|l| l.unjudged),
                 "bytes_skipped": st.bytes_skipped(),
                 "delivery_ratio": st.delivery_ratio(),
             },

@@ -389,6 +389,13 @@ impl EscReport<'_> {
         (d > 0.0).then(|| (self.acc.tally.frames - 1) as f64 / d)
     }
 
+    /// Frames lost judged from their times, for a format without packet counter whose frames
+    /// have times (HW5).
+    fn timed_loss(&self) -> Option<accumulate::TimedLoss> {
+        let values = self.acc.values.as_ref()?;
+        (!self.stats.counts_packets() && self.acc.first_t.is_some()).then_some(values.loss)
+    }
+
     /// The protocol of the ESC's frames (of its first data frame), if it sent one.
     fn protocol(&self) -> Option<Protocol> {
         self.acc.sample.map(|s| s.protocol())

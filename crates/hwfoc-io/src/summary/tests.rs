@@ -165,3 +165,42 @@ fn a_quantity_the_protocol_does_not_send_has_no_text_row() {
     }
     assert_eq!(report.json()["escs"][0]["fields"]["voltage_v"]["max"], 24.7);
 }
+
+/// HW5 has no packet counter: its loss is judged from the frames' times, at the running period
+/// between two frames of a turning motor, at the idle one otherwise (a change of rate is no
+/// loss), and a silence over a second is not judged.
+#[test]
+fn hw5_loss_is_judged_from_time() {
+    let frame = |erpm_raw: u16| {
+        Frame::Data(Data::Hw5(hwfoc::hw5::TelemetryFrame {
+            throttle: if erpm_raw > 0 { 30 } else { 0 },
+            erpm_raw,
+            voltage_raw: 504,
+            current_raw: 100,
+            ..Default::default()
+        }))
+    };
+    let mut acc = Accumulator::default();
+    let mut add = |t: f64, erpm: u16| acc.add(Some(t), &frame(erpm), &Settings::DEFAULT);
+    // Idle at 400 ms, then running at 20 ms (the first running frame 400 ms after: no loss).
+    for t in [0.0, 0.4, 0.8] {
+        add(t, 0);
+    }
+    let mut t = 1.2;
+    for k in 0..20 {
+        // Frames 8, 9 and 10 lost: a step of 80 ms.
+        if !(8..=10).contains(&k) {
+            add(t, 3000);
+        }
+        t += 0.02;
+    }
+    // Stopped: idle frames 400 ms apart again (the first at the idle rate: no loss), one lost.
+    add(t + 0.38, 0);
+    add(t + 0.78, 0);
+    add(t + 1.58, 0);
+    // Off for 5 s: not judged.
+    add(t + 6.58, 0);
+    let loss = acc.values.as_ref().unwrap().loss;
+    assert_eq!((loss.lost, loss.unjudged), (3 + 1, 1));
+    assert_eq!(loss.judged, 2 + 1 + 16 + 3);
+}

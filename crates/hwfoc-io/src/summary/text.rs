@@ -135,7 +135,13 @@ impl EscReport<'_> {
                 st.restarts()
             )
         } else {
-            "no packet counter (loss not counted)".to_string()
+            match self.timed_loss() {
+                Some(loss) => format!(
+                    "no packet counter: {} frames lost judged from their times ({} silences over 1 s not judged)",
+                    loss.lost, loss.unjudged
+                ),
+                None => "no packet counter (loss not counted)".to_string(),
+            }
         };
         let _ = writeln!(
             o,
