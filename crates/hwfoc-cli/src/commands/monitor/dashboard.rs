@@ -341,7 +341,13 @@ fn draw_table(frame: &mut Frame, area: Rect, ui: &Ui, view: View<'_>) {
                 Cell::from(format!("disconnected {:.0} s", view.now - since))
                     .style(level_style(Some(Level::Critical))),
             ),
-            (Link::Up, None) => (vec![Cell::from(""); 6], Cell::from(esc.waiting())),
+            (Link::Up, None) => (
+                vec![Cell::from(""); 6],
+                Cell::from(match esc.trying {
+                    Some(baud) => format!("finding the baud rate: trying {baud}"),
+                    None => esc.waiting().to_string(),
+                }),
+            ),
             (Link::Up, Some(r)) => {
                 let temp = |t: Option<f32>| t.map_or("-".to_string(), |t| number(t, 0));
                 (

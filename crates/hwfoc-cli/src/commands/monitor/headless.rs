@@ -70,6 +70,9 @@ pub fn run(session: &mut Session, json: bool, interval_s: f64) -> Result<(), Cli
         if let Some(notice) = session.notice.take() {
             eprintln!("hwfoc: {}", Escaped(&notice));
         }
+        for found in session.found.drain(..) {
+            eprintln!("{}", found.line());
+        }
         if !text.is_empty() {
             out.write_all(&text)
                 .and_then(|()| out.flush())
