@@ -243,6 +243,55 @@ impl EscView {
         }
     }
 
+    /// The format of its frames: of the latest data frame, else of those its link counted;
+    /// `None` before any frame.
+    pub fn protocol(&self) -> Option<hwfoc::Protocol> {
+        self.last.as_ref().map(|r| r.protocol).or_else(|| {
+            (self.stats.frames() + self.stats.info_frames() > 0).then(|| self.stats.protocol())
+        })
+    }
+
+    /// Its port's rate and format: `115200 baud (HW5)`, `19200 baud` before a frame, or
+    /// `finding the baud rate: trying 115200`.
+    pub fn rate_text(&self) -> String {
+        match (self.baud, self.trying) {
+            (Some(baud), _) => match self.protocol() {
+                Some(p) => format!("{baud} baud ({})", p.title()),
+                None => format!("{baud} baud"),
+            },
+            (None, Some(baud)) => format!("finding the baud rate: trying {baud}"),
+            (None, None) => "finding the baud rate".to_string(),
+        }
+    }
+
+    /// Whether its format carries `q` (every one before the format is known).
+    pub fn carries(&self, q: Shown) -> bool {
+        self.protocol().is_none_or(|p| q.carried_by(p))
+    }
+
+    /// Its link's figures as its format has them: packet loss where frames are numbered
+    /// (`lost 0 dup 0`; HW5's are not), checksum failures where they have one (`crc 0`), or
+    /// candidates rejected by plausibility (`rejected 0`: V3, V4), restarts where numbered.
+    pub fn link_text(&self) -> String {
+        let s = &self.stats;
+        let mut parts = Vec::new();
+        if s.counts_packets() {
+            parts.push(format!(
+                "lost {} dup {}",
+                s.lost_packets(),
+                s.duplicate_packets()
+            ));
+        }
+        match s.rejected_frames() {
+            Some(rejected) => parts.push(format!("rejected {rejected}")),
+            None => parts.push(format!("crc {}", s.checksum_failures())),
+        }
+        if s.counts_packets() {
+            parts.push(format!("restarts {}", s.restarts()));
+        }
+        parts.join(" ")
+    }
+
     /// The name to show: the label, or the port.
     pub fn title(&self) -> &str {
         self.label.as_deref().unwrap_or(&self.name)
