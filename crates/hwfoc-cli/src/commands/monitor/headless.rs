@@ -141,22 +141,17 @@ fn total_json(fleet: &Fleet, now: f64) -> Value {
     })
 }
 
-/// `2026-… esc0 /dev/ttyUSB0 (19200 baud (HW-FOC)): thr 50.0/48.2 % 12000 rpm 24.1 V 20.3 A
-/// (phase 35.1 A) mos 45.0C cap 40.0C | 20.0 fr/s lost 0 dup 0 crc 0 restarts 0 | age 0.03 s |
+/// `2026-… esc0 /dev/ttyUSB0: thr 50.0/48.2 % 12000 rpm 24.1 V 20.3 A (phase 35.1 A) mos
+/// 45.0C cap 40.0C | 19200 baud (HW-FOC) 20.0 fr/s lost 0 dup 0 crc 0 restarts 0 | age 0.03 s |
 /// power 489 W (peak 520 W) used 12.5 mAh 0.30 Wh | ok`: the figures the ESC's format has
 /// (see [`EscView::carries`], [`EscView::link_text`]), HW5's BEC and motor ones too.
 fn status_line(i: usize, esc: &EscView, now: f64) -> String {
-    let mut line = format!(
-        "{} esc{i} {} ({}): ",
-        timestamp(now),
-        Escaped(esc.title()),
-        esc.rate_text()
-    );
+    let mut line = format!("{} esc{i} {}: ", timestamp(now), Escaped(esc.title()));
     match (&esc.link, &esc.last) {
         (Link::Down { since, reason }, _) => {
             line.push_str(&format!("disconnected for {:.1} s ({reason})", now - since));
         }
-        (Link::Up, None) => line.push_str(esc.waiting()),
+        (Link::Up, None) => line.push_str(&format!("{} ({})", esc.waiting(), esc.rate_text())),
         (Link::Up, Some(r)) => {
             let temp = |t: Option<f32>| t.map_or("-".to_string(), |t| format!("{}C", number(t, 1)));
             let has = |q: Quantity| esc.carries(Shown::Carried(q));
@@ -199,7 +194,8 @@ fn status_line(i: usize, esc: &EscView, now: f64) -> String {
             }
             line.push_str(&parts.join(" "));
             line.push_str(&format!(
-                " | {:.1} fr/s {} | age {:.2} s",
+                " | {} {:.1} fr/s {} | age {:.2} s",
+                esc.rate_text(),
                 esc.frame_rate(now),
                 esc.link_text(),
                 esc.age(now).unwrap_or(0.0),
