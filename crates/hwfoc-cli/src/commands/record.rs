@@ -43,7 +43,7 @@ use hwfoc_io::Escaped;
 use hwfoc_io::Notice;
 use hwfoc_io::PortStreams;
 use hwfoc_io::pcapng;
-use hwfoc_io::serial::{Baud, DEFAULT_BAUD, PortEvent, PortSet, SEARCH_RATES};
+use hwfoc_io::serial::{Baud, DEFAULT_BAUD, PortEvent, PortSet, SEARCH_BYTES_FOR, SEARCH_RATES};
 use hwfoc_io::write::WriteError;
 
 /// Longest time a received byte stays in this process before it is written to the file.
@@ -407,8 +407,8 @@ impl Recorder {
         .into()
     }
 
-    /// Writes what a port reported: bytes as a packet, a loss or return, or a rate found, as a
-    /// note. While a port's rate is being found, it is held (see the module's documentation).
+    /// Writes what a port reported: bytes as a packet, a loss or return as a note (a rate
+    /// found is its interface's). While a port's rate is being found, it is held (see the module's documentation).
     pub fn handle(&mut self, event: PortEvent) -> Result<(), CliError> {
         match &event {
             PortEvent::Data { port, .. } => self.decode(*port, &event),
@@ -418,8 +418,12 @@ impl Recorder {
                 self.streams.feed(&event, &mut ());
                 let state = &mut self.ports[*port];
                 if *discarded > 0 {
+                    // The rate left was read for at least SEARCH_BYTES_FOR since its first
+                    // byte: that is when the bytes without a frame began.
+                    let now = Instant::now();
+                    let began = now.checked_sub(SEARCH_BYTES_FOR).unwrap_or(now);
                     state.silent_since = None;
-                    state.unframed_since.get_or_insert_with(Instant::now);
+                    state.unframed_since.get_or_insert(began);
                     state.unframed_bytes += discarded;
                 }
                 // No bytes to record, nothing the file must say.
@@ -458,19 +462,9 @@ impl Recorder {
     fn write_event(&mut self, event: PortEvent) -> Result<(), CliError> {
         match event {
             PortEvent::Searching { .. } => {}
-            PortEvent::Found {
-                port,
-                t_ns,
-                baud,
-                protocol,
-            } => {
-                let note = format!(
-                    "{}: {baud} baud ({}), found from the bytes",
-                    self.ports[port].name,
-                    protocol.title()
-                );
-                self.note(port, t_ns, &note)?;
-            }
+            // The interface's rate says it (a note at the lock would come after the bytes it
+            // precedes in time).
+            PortEvent::Found { .. } => {}
             PortEvent::Data { port, t_ns, bytes } => {
                 if let (Some(limit), Some(writer)) = (self.rotate_size, &self.writer) {
                     // What the file would be were it closed after these bytes (held bytes
