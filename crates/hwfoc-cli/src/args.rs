@@ -27,7 +27,8 @@ pub struct InputArgs {
     /// raw files and standard input, which have no receive times, are read one after another.
     #[arg(value_name = "FILE|PORT|-", required_unless_present = "demo", num_args = 1..)]
     pub inputs: Vec<String>,
-    /// Baud rate of serial ports (8N1) [default: that of --protocol, else 19200].
+    /// Baud rate of serial ports (8N1) [default: that of --protocol, else found from the
+    /// bytes: 19200 and 115200 tried in turn].
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..))]
     pub baud: Option<u32>,
     /// Use the built-in demo capture of a virtual ESC (HW-FOC) instead of FILE.
@@ -59,10 +60,12 @@ fn protocol_parser() -> impl TypedValueParser<Value = Protocol> {
 
 impl ProtocolArgs {
     /// The baud rate of serial ports: `baud` (`--baud`) when given, else the forced protocol's,
-    /// else [`serial::DEFAULT_BAUD`].
-    pub fn baud(&self, baud: Option<u32>) -> u32 {
-        baud.or(self.protocol.map(Protocol::baud_rate))
-            .unwrap_or(serial::DEFAULT_BAUD)
+    /// else found by each port from its bytes ([`serial::Baud::Auto`]).
+    pub fn baud(&self, baud: Option<u32>) -> serial::Baud {
+        match baud.or(self.protocol.map(Protocol::baud_rate)) {
+            Some(baud) => serial::Baud::Fixed(baud),
+            None => serial::Baud::Auto,
+        }
     }
 }
 

@@ -96,10 +96,10 @@ pub enum Shown {
     Power,
 }
 
-/// The codec's quantities not shown: the electrical RPM (the motor's is), and those no
-/// protocol read today carries (HW5's motor and BEC readings: null in every record of HW-FOC
-/// and DataLink, so no frame of any ESC carries them). They join the list, with a word in
-/// [`Shown::legend`], when a protocol that carries them is read.
+/// The codec's quantities not charted: the electrical RPM (the motor's is), and HW5's motor
+/// and BEC readings (HIDDEN's last four: the monitor shows them as figures for an ESC whose format
+/// carries them; charted and plotted, they would be lines of every panel that only one format
+/// fills). Which of the rest an ESC has follows from its format ([`Shown::carried_by`]).
 const HIDDEN: [Quantity; 5] = [
     Quantity::Erpm,
     Quantity::MotorTemp,
@@ -179,6 +179,17 @@ impl Shown {
         }
     }
 
+    /// Whether a frame of `protocol` carries it (power: where voltage and current are both
+    /// carried).
+    pub fn carried_by(self, protocol: hwfoc::Protocol) -> bool {
+        match self {
+            Shown::Carried(q) => protocol.carries(q),
+            Shown::Power => {
+                protocol.carries(Quantity::Voltage) && protocol.carries(Quantity::Current)
+            }
+        }
+    }
+
     /// Its value in a record; NaN where the record has none (a quantity the ESC's protocol
     /// does not carry, a temperature out of the table's range).
     #[inline]
@@ -248,6 +259,27 @@ mod tests {
         for (i, s) in Shown::ALL.iter().enumerate() {
             assert_eq!(s.index(), i);
             assert!(s.measure().is_some(), "{s:?} is in no panel");
+        }
+        // Per format: V3 has throttles and RPM only; HW5 no phase current, capacitor or
+        // output throttle; every extra is HW5's.
+        let of = |p: hwfoc::Protocol| -> Vec<Shown> {
+            Shown::ALL.into_iter().filter(|s| s.carried_by(p)).collect()
+        };
+        assert_eq!(
+            of(hwfoc::Protocol::HwV3),
+            [
+                Shown::Carried(ThrottleIn),
+                Shown::Carried(ThrottleOut),
+                Shown::Carried(Rpm)
+            ]
+        );
+        assert!(!of(hwfoc::Protocol::Hw5).contains(&Shown::Carried(PhaseCurrent)));
+        assert!(of(hwfoc::Protocol::Hw5).contains(&Shown::Power));
+        assert_eq!(of(hwfoc::Protocol::HwFoc), Shown::ALL);
+        for q in &HIDDEN[1..] {
+            let q = *q;
+            assert!(hwfoc::Protocol::Hw5.carries(q), "{q:?}");
+            assert!(!hwfoc::Protocol::HwFoc.carries(q), "{q:?}");
         }
     }
 }

@@ -811,3 +811,94 @@ fn an_idle_esc_shows_no_negative_zero_and_no_negative_peak() {
     // The case the test is about: an ESC that reported a negative current.
     assert!(negative_current, "{json}");
 }
+
+/// The speed a pseudo-terminal is set to (`c_ospeed` of its `termios2`).
+#[cfg(target_os = "linux")]
+fn pty_speed(fd: &std::os::fd::OwnedFd) -> u32 {
+    use nix::libc;
+    use std::os::fd::AsRawFd;
+    let mut t: libc::termios2 = unsafe { std::mem::zeroed() };
+    // SAFETY: TCGETS2 fills a termios2 of a terminal's fd; the fd is open.
+    let r = unsafe { libc::ioctl(fd.as_raw_fd(), libc::TCGETS2, &mut t) };
+    assert_eq!(r, 0, "TCGETS2");
+    t.c_ospeed
+}
+
+/// An HW5 ESC on a pseudo-terminal that speaks only while the terminal is set to 115200 baud
+/// (garbage otherwise, as a UART at another rate reads): the monitor, given no rate, finds it,
+/// says so, and shows the format's figures only (BEC voltage; no packet loss: null).
+#[cfg(target_os = "linux")]
+#[test]
+fn an_hw5_esc_is_found_at_115200_and_shown_with_its_own_fields() {
+    use std::io::Write;
+    use std::sync::Arc;
+    use std::sync::atomic::{AtomicBool, Ordering};
+    let pair = hwfoc_sim::pty::RawPair::open().unwrap();
+    let path = pair.path.to_str().unwrap().to_string();
+    let stop = Arc::new(AtomicBool::new(false));
+    let flag = Arc::clone(&stop);
+    let esc = thread::spawn(move || {
+        let mut master = pair.master;
+        let mut seed = 5u32;
+        let mut i = 0u16;
+        while !flag.load(Ordering::Relaxed) {
+            let bytes: Vec<u8> = if pty_speed(&pair.slave) == 115_200 {
+                hwfoc::hw5::TelemetryFrame {
+                    throttle: 30,
+                    erpm_raw: 1000 + i,
+                    voltage_raw: 252,
+                    current_raw: 55,
+                    esc_temp: 41,
+                    bec_temp: 35,
+                    motor_temp: 38,
+                    bec_voltage_raw: 84,
+                    bec_current_raw: 12,
+                    ..Default::default()
+                }
+                .encode()
+                .to_vec()
+            } else {
+                (0..40)
+                    .map(|_| {
+                        seed = seed.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
+                        (seed >> 24) as u8
+                    })
+                    .collect()
+            };
+            i = i.wrapping_add(1);
+            let _ = master.write_all(&bytes);
+            thread::sleep(Duration::from_millis(20));
+        }
+    });
+    let started = std::time::Instant::now();
+    let mut monitor = Running::start(&[
+        "monitor",
+        &path,
+        "--json",
+        "--no-config",
+        "--interval",
+        "0.25",
+    ]);
+    let status = monitor.wait_for_stdout("\"bec_voltage_v\":8.4", Duration::from_secs(10));
+    let took = started.elapsed();
+    eprintln!("HW5 found and shown after {took:?}");
+    assert!(took < Duration::from_secs(4), "{took:?}");
+    let v: serde_json::Value = serde_json::from_str(&status).unwrap();
+    assert_eq!(v["protocol"], "hw5", "{status}");
+    assert_eq!(v["baud"], 115_200);
+    assert_eq!(v["lost"], serde_json::Value::Null);
+    assert_eq!(v["restarts"], serde_json::Value::Null);
+    assert_eq!(v["checksum_failures"], 0);
+    assert_eq!(v["rejected_frames"], serde_json::Value::Null);
+    assert!(v["bytes_at_other_rates"].as_u64().unwrap() > 0, "{status}");
+    assert_eq!(v["record"]["phase_current_a"], serde_json::Value::Null);
+    monitor.signal(Signal::SIGTERM);
+    assert!(monitor.wait(Duration::from_secs(5)));
+    let stderr = monitor.stderr();
+    assert!(
+        stderr.contains(&format!("hwfoc: {path}: 115200 baud (HW5)")),
+        "{stderr}"
+    );
+    stop.store(true, Ordering::Relaxed);
+    esc.join().unwrap();
+}

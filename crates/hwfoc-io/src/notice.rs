@@ -28,6 +28,15 @@ pub enum Notice {
         /// The port as named.
         port: String,
     },
+    /// A serial port read without a rate given found its rate from the bytes (auto-baud).
+    PortBaud {
+        /// The port as named.
+        port: String,
+        /// The rate found.
+        baud: u32,
+        /// The protocol of the first frames found at it.
+        protocol: hwfoc::Protocol,
+    },
     /// A comment written in a recording (`hwfoc record` notes gaps and restarts there).
     Comment {
         /// The input as named.
@@ -68,11 +77,22 @@ pub enum Notice {
 }
 
 impl Notice {
-    /// The notice of a port's [`PortEvent::Lost`] or [`PortEvent::Back`], the port named as in
-    /// `names` (the set's names); `None` for bytes, or a port `names` does not hold.
+    /// The notice of a port's [`PortEvent::Lost`], [`PortEvent::Back`] or
+    /// [`PortEvent::Found`], the port named as in `names` (the set's names); `None` for bytes,
+    /// a rate tried, or a port `names` does not hold.
     pub fn of_port_event(event: &PortEvent, names: &[String]) -> Option<Notice> {
         match event {
-            PortEvent::Data { .. } => None,
+            PortEvent::Data { .. } | PortEvent::Searching { .. } => None,
+            PortEvent::Found {
+                port,
+                baud,
+                protocol,
+                ..
+            } => Some(Notice::PortBaud {
+                port: names.get(*port)?.clone(),
+                baud: *baud,
+                protocol: *protocol,
+            }),
             PortEvent::Lost { port, reason, .. } => Some(Notice::PortLost {
                 port: names.get(*port)?.clone(),
                 reason: reason.clone(),
@@ -118,6 +138,11 @@ impl fmt::Display for Notice {
                 crate::serial::RETRY_EVERY.as_millis()
             ),
             Notice::PortBack { port } => write!(f, "{} is back", Escaped(port)),
+            Notice::PortBaud {
+                port,
+                baud,
+                protocol,
+            } => write!(f, "{}: {baud} baud ({})", Escaped(port), protocol.title()),
             Notice::Comment {
                 input,
                 interface,
@@ -217,5 +242,16 @@ mod tests {
             bytes: vec![1],
         };
         assert_eq!(Notice::of_port_event(&event, &names), None);
+        let event = PortEvent::Found {
+            port: 0,
+            t_ns: 0,
+            baud: 115_200,
+            protocol: hwfoc::Protocol::Hw5,
+        };
+        let found = Notice::of_port_event(&event, &names).unwrap();
+        assert_eq!(
+            found.line(),
+            format!("hwfoc: {}: 115200 baud (HW5)", names[0])
+        );
     }
 }

@@ -702,7 +702,13 @@ impl Stream {
 #[derive(Debug)]
 pub struct PortStreams {
     streams: Vec<Stream>,
-    per_byte_ns: f64,
+    /// Each port's byte time, ns: at the rate given, or found ([`PortEvent::Found`]).
+    per_byte_ns: Vec<f64>,
+    /// Each port's rate once known: given, or found.
+    bauds: Vec<Option<u32>>,
+    /// Bytes each port read at rates an auto-baud search left ([`PortEvent::Searching`]):
+    /// skipped bytes that no decoder saw.
+    discarded: Vec<u64>,
     times: Vec<f64>,
     /// Each port's name, as the settings know it.
     names: Vec<String>,
@@ -732,7 +738,9 @@ impl PortStreams {
     pub fn with_map(baud: u32, names: Vec<String>, map: SettingsMap) -> PortStreams {
         PortStreams {
             streams: names.iter().map(|_| Stream::new()).collect(),
-            per_byte_ns: hwfoc::wire::byte_ns(baud),
+            per_byte_ns: vec![hwfoc::wire::byte_ns(baud); names.len()],
+            bauds: vec![Some(baud); names.len()],
+            discarded: vec![0; names.len()],
             times: Vec::new(),
             esc_settings: names
                 .iter()
@@ -750,13 +758,34 @@ impl PortStreams {
     /// `esc` column numbers 256). Other events, and ports beyond those made, are ignored.
     /// Returns the port's link statistics after the bytes (of its channel 0, from a hub), or
     /// `None` when there were no bytes for a known port.
+    ///
+    /// An auto-baud search's events set the port's rate: a [`PortEvent::Searching`] counts the
+    /// bytes it left as skipped ([`PortStreams::discarded`]), a [`PortEvent::Found`] sets the
+    /// port's byte time and starts its stream again, so that no byte read at another rate is
+    /// in a frame.
     pub fn feed<H: Handler>(&mut self, event: &PortEvent, handler: &mut H) -> Option<EscLink> {
-        let PortEvent::Data { port, t_ns, bytes } = event else {
-            return None;
+        let (port, t_ns, bytes) = match event {
+            PortEvent::Data { port, t_ns, bytes } => (port, t_ns, bytes),
+            PortEvent::Searching {
+                port, discarded, ..
+            } => {
+                if let Some(d) = self.discarded.get_mut(*port) {
+                    *d += discarded;
+                    self.bauds[*port] = None;
+                }
+                return None;
+            }
+            PortEvent::Found { port, baud, .. } => {
+                self.set_baud(*port, *baud);
+                return None;
+            }
+            PortEvent::Lost { .. } | PortEvent::Back { .. } => return None,
         };
         let PortStreams {
             streams,
             per_byte_ns,
+            bauds: _,
+            discarded: _,
             times,
             names,
             map,
@@ -765,7 +794,7 @@ impl PortStreams {
         } = self;
         let stream = streams.get_mut(*port)?;
         times.clear();
-        byte_times(*t_ns, *per_byte_ns, bytes.len(), times);
+        byte_times(*t_ns, per_byte_ns[*port], bytes.len(), times);
         let hub = &mut hubs[*port];
         stream.feed(
             Batch {
@@ -798,6 +827,40 @@ impl PortStreams {
         for stream in &mut self.streams {
             *stream = Stream::forced(Some(protocol));
         }
+    }
+
+    /// Reads `port` at `baud` from now on (its rate found): its byte time changes, and its
+    /// stream starts again (reading the same protocols), so that what it held of bytes at
+    /// another rate makes no frame.
+    pub fn set_baud(&mut self, port: usize, baud: u32) {
+        let Some(stream) = self.streams.get_mut(port) else {
+            return;
+        };
+        if self.bauds[port].is_some_and(|b| b != baud) && stream.wire.bytes() > 0 {
+            // Bytes fed at another rate: what the decoder holds of a frame still arriving is
+            // skipped, never completed by bytes at this rate.
+            self.discarded[port] += stream.buffered() as u64;
+            *stream = Stream::forced(stream.forced_protocol());
+        }
+        self.per_byte_ns[port] = hwfoc::wire::byte_ns(baud);
+        self.bauds[port] = Some(baud);
+    }
+
+    /// Every port's rate is to be found ([`crate::serial::Baud::Auto`]): unknown until its
+    /// [`PortEvent::Found`].
+    pub fn auto_baud(&mut self) {
+        self.bauds.fill(None);
+    }
+
+    /// The rate `port` is read at: given, or found; `None` while an auto-baud search goes on.
+    pub fn baud(&self, port: usize) -> Option<u32> {
+        self.bauds.get(port).copied().flatten()
+    }
+
+    /// Bytes of `port` read at rates an auto-baud search left: never decoded, so in none of
+    /// [`PortStreams::stats`]'s counts; skipped bytes all the same.
+    pub fn discarded(&self, port: usize) -> u64 {
+        self.discarded.get(port).copied().unwrap_or(0)
     }
 
     /// The link statistics of `port`'s stream (of its channel 0, from a hub).
@@ -994,6 +1057,50 @@ mod tests {
         let close = timed(&[65_528, 65_529], 10.2);
         let s = run(&[before, close], 24);
         assert_eq!((s.restarts(), s.lost_packets()), (0, 535));
+    }
+}
+
+#[cfg(test)]
+mod port_tests {
+    use super::*;
+
+    /// An auto-baud search's events: the bytes it left are counted, the rate found sets the
+    /// port's byte time, and the frames read at it are decoded.
+    #[test]
+    fn a_found_rate_is_the_ports_and_the_bytes_left_are_skipped() {
+        let names = vec!["a".to_string(), "b".to_string()];
+        let map = SettingsMap::from(Settings::DEFAULT);
+        let mut streams = PortStreams::with_map(19_200, names, map);
+        streams.auto_baud();
+        assert_eq!(streams.baud(1), None);
+        let searching = PortEvent::Searching {
+            port: 1,
+            t_ns: 1,
+            baud: 115_200,
+            discarded: 500,
+        };
+        assert_eq!(streams.feed(&searching, &mut ()), None);
+        let found = PortEvent::Found {
+            port: 1,
+            t_ns: 2,
+            baud: 115_200,
+            protocol: Protocol::Hw5,
+        };
+        assert_eq!(streams.feed(&found, &mut ()), None);
+        assert_eq!((streams.baud(0), streams.baud(1)), (None, Some(115_200)));
+        let bytes: Vec<u8> = (0..3)
+            .flat_map(|_| hw5::TelemetryFrame::default().encode())
+            .collect();
+        let data = PortEvent::Data {
+            port: 1,
+            t_ns: 1_000_000_000,
+            bytes,
+        };
+        let link = streams.feed(&data, &mut ()).unwrap();
+        assert_eq!((link.protocol(), link.frames()), (Protocol::Hw5, 3));
+        assert_eq!(link.bytes_skipped(), 0);
+        assert_eq!((streams.discarded(1), streams.discarded(0)), (500, 0));
+        assert_eq!(streams.per_byte_ns[1], hwfoc::wire::byte_ns(115_200));
     }
 }
 

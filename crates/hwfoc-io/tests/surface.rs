@@ -42,6 +42,7 @@ use hwfoc_io::summary::{device_json, esc_label, no_frames};
 use hwfoc_io::pcapng::{Damage, Interface, LINKTYPE, MAGIC, MAX_CHUNK, Packet, Reader, Writer};
 
 // Serial ports.
+use hwfoc_io::serial::{Baud, SEARCH_BYTES_FOR, SEARCH_RATES, SEARCH_SILENT_FOR, Search, Verdict};
 use hwfoc_io::serial::{DEFAULT_BAUD, PortError, PortEvent, PortSet, RETRY_EVERY, Readers};
 use hwfoc_io::serial::{available_ports, is_port, open};
 

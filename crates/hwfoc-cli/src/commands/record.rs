@@ -17,6 +17,16 @@
 //!
 //! Frames are decoded on the fly, only to count them and to warn when a port sends bytes but
 //! no valid frame (a wrong baud rate or swapped wires) or nothing at all.
+//!
+//! Without `--baud` (or `--protocol`, which gives its rate) each port finds its rate from the
+//! bytes ([`hwfoc_io::serial::Baud::Auto`]), and the recording says the rate each port was
+//! read at: the file's interfaces are declared, each with its port's rate, once every port has
+//! found it. Until then, what the ports found bytes give is held in memory (a port's bytes
+//! reach the recorder only once its rate is found: bytes read at a rate that gave no frame
+//! are not the wire's bytes and are not recorded, and are counted in the warnings). A port's
+//! rate never changes after that, so one interface per port is the whole truth; a port still
+//! searching when the recording ends is declared at 19200 with a comment saying that its rate
+//! was not found and nothing of it recorded.
 
 use std::fs::File;
 use std::io::BufWriter;
@@ -33,7 +43,7 @@ use hwfoc_io::Escaped;
 use hwfoc_io::Notice;
 use hwfoc_io::PortStreams;
 use hwfoc_io::pcapng;
-use hwfoc_io::serial::{PortEvent, PortSet};
+use hwfoc_io::serial::{Baud, DEFAULT_BAUD, PortEvent, PortSet, SEARCH_BYTES_FOR, SEARCH_RATES};
 use hwfoc_io::write::WriteError;
 
 /// Longest time a received byte stays in this process before it is written to the file.
@@ -65,7 +75,8 @@ pub struct RecordArgs {
     /// numbered: FILE `out.pcapng` gives `out-0001.pcapng`, `out-0002.pcapng`, …
     #[arg(short, long, value_name = "FILE")]
     pub output: String,
-    /// Baud rate of the ports (8N1) [default: that of --protocol, else 19200].
+    /// Baud rate of the ports (8N1) [default: that of --protocol, else found from the bytes:
+    /// 19200 and 115200 tried in turn].
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..))]
     pub baud: Option<u32>,
     /// The protocol whose frames are counted (every byte is recorded whatever it is).
@@ -161,8 +172,9 @@ pub struct Plan {
     pub rotate_size: Option<u64>,
     /// Rotate after this long.
     pub rotate_time: Option<Duration>,
-    /// Baud rate of the ports (in each interface's description).
-    pub baud: u32,
+    /// Each port's baud rate (in its interface's description): given or found already, or
+    /// `None` while it is being found (the file's interfaces then wait for it).
+    pub bauds: Vec<Option<u32>>,
     /// The one protocol whose frames are counted, when forced (every protocol otherwise).
     pub protocol: Option<Protocol>,
     /// Print gaps and link warnings on standard error (not under a full-screen display).
@@ -177,7 +189,12 @@ pub struct Recorder {
     base: String,
     rotate_size: Option<u64>,
     rotate_time: Option<Duration>,
-    baud: u32,
+    /// Each port's rate, once known.
+    bauds: Vec<Option<u32>>,
+    /// The file, created, before its headers are written: while a port's rate is not known.
+    pending: Option<File>,
+    /// What the ports reported while the file waits for its headers.
+    held: Vec<PortEvent>,
     /// The protocol forced, if one is: the one the warnings name.
     protocol: Option<Protocol>,
     /// Files written, the current one last.
@@ -213,16 +230,19 @@ pub fn run(args: &RecordArgs) -> Result<(), CliError> {
         output: args.output.clone(),
         rotate_size: args.rotate_size,
         rotate_time: args.rotate_time.map(Duration::from_secs_f64),
-        baud,
+        bauds: vec![baud.fixed(); args.ports.len()],
         protocol: args.protocol.protocol,
         warn: true,
         overwrite: args.overwrite,
     };
     let mut recorder = Recorder::new(plan, set.names(), set.clock())?;
+    let rate = match baud {
+        Baud::Fixed(baud) => format!("at {baud} baud"),
+        Baud::Auto => format!("(baud rate found from the bytes: {} in turn)", rates_text()),
+    };
     eprintln!(
-        "hwfoc: recording {} at {} baud to {}; Ctrl-C stops",
+        "hwfoc: recording {} {rate} to {}; Ctrl-C stops",
         Escaped(set.names().join(", ")),
-        baud,
         recorder.current()
     );
     let stop_at = args.duration.map(|s| started + Duration::from_secs_f64(s));
@@ -291,23 +311,35 @@ impl Recorder {
                 }
             }
         }
-        let writer = create(&first, ports, plan.baud, plan.overwrite)?;
+        let file = hwfoc_io::write::create_file(&first, plan.overwrite)?;
         let now = Instant::now();
         // Frames are only counted: the conversion settings do not matter.
-        let mut streams = PortStreams::new(ports.len(), plan.baud, hwfoc::Settings::DEFAULT);
+        let initial = plan.bauds.iter().flatten().next().copied();
+        let mut streams = PortStreams::new(
+            ports.len(),
+            initial.unwrap_or(DEFAULT_BAUD),
+            hwfoc::Settings::DEFAULT,
+        );
+        for (port, baud) in plan.bauds.iter().enumerate() {
+            if let Some(baud) = baud {
+                streams.set_baud(port, *baud);
+            }
+        }
         if let Some(protocol) = plan.protocol {
             streams.force_protocol(protocol);
         }
-        Ok(Recorder {
+        let mut recorder = Recorder {
             warn: plan.warn,
             base: plan.output,
             rotate_size: plan.rotate_size,
             rotate_time: plan.rotate_time,
-            baud: plan.baud,
+            bauds: plan.bauds,
+            pending: Some(file),
+            held: Vec::new(),
             protocol: plan.protocol,
             files: vec![first],
             next_number: 2,
-            writer: Some(writer),
+            writer: None,
             file_has_packets: false,
             file_started: now,
             last_flush: now,
@@ -325,7 +357,41 @@ impl Recorder {
                     lost_at: None,
                 })
                 .collect(),
-        })
+        };
+        if recorder.bauds.iter().all(Option::is_some) {
+            recorder.begin()?;
+        }
+        Ok(recorder)
+    }
+
+    /// Writes the file's headers, an interface per port at its rate (a port whose rate was not
+    /// found at 19200, with a comment saying so), then what was held for them.
+    fn begin(&mut self) -> Result<(), CliError> {
+        let Some(file) = self.pending.take() else {
+            return Ok(());
+        };
+        let names: Vec<String> = self.ports.iter().map(|p| p.name.clone()).collect();
+        let mut writer = headers(self.current(), file, &names, &self.bauds)?;
+        let now_ns = self.clock.now_ns();
+        for (port, baud) in self.bauds.iter().enumerate() {
+            if baud.is_none() {
+                let text = format!(
+                    "{}: no baud rate found ({} tried in turn): nothing of it was recorded",
+                    names[port],
+                    rates_text()
+                );
+                writer
+                    .comment(port as u32, now_ns, &text)
+                    .map_err(|e| self.write_error(e))?;
+                self.file_has_packets = true;
+            }
+        }
+        self.writer = Some(writer);
+        self.file_started = Instant::now();
+        for event in std::mem::take(&mut self.held) {
+            self.write_event(event)?;
+        }
+        Ok(())
     }
 
     /// The file being written.
@@ -341,12 +407,64 @@ impl Recorder {
         .into()
     }
 
-    /// Writes what a port reported: bytes as a packet, a loss or return as a note.
+    /// Writes what a port reported: bytes as a packet, a loss or return as a note (a rate
+    /// found is its interface's). While a port's rate is being found, it is held (see the module's documentation).
     pub fn handle(&mut self, event: PortEvent) -> Result<(), CliError> {
-        if let PortEvent::Data { port, .. } = event {
-            self.decode(port, &event);
+        match &event {
+            PortEvent::Data { port, .. } => self.decode(*port, &event),
+            PortEvent::Searching {
+                port, discarded, ..
+            } => {
+                self.streams.feed(&event, &mut ());
+                let state = &mut self.ports[*port];
+                if *discarded > 0 {
+                    // The rate left was read for at least SEARCH_BYTES_FOR since its first
+                    // byte: that is when the bytes without a frame began.
+                    let now = Instant::now();
+                    let began = now.checked_sub(SEARCH_BYTES_FOR).unwrap_or(now);
+                    state.silent_since = None;
+                    state.unframed_since.get_or_insert(began);
+                    state.unframed_bytes += discarded;
+                }
+                // No bytes to record, nothing the file must say.
+                return Ok(());
+            }
+            PortEvent::Found {
+                port,
+                baud,
+                protocol,
+                ..
+            } => {
+                self.streams.feed(&event, &mut ());
+                self.bauds[*port] = Some(*baud);
+                if self.warn {
+                    let found = Notice::PortBaud {
+                        port: self.ports[*port].name.clone(),
+                        baud: *baud,
+                        protocol: *protocol,
+                    };
+                    eprintln!("{}", found.line());
+                }
+            }
+            PortEvent::Lost { .. } | PortEvent::Back { .. } => {}
         }
+        if self.pending.is_some() {
+            if !self.bauds.iter().all(Option::is_some) {
+                self.held.push(event);
+                return Ok(());
+            }
+            self.begin()?;
+        }
+        self.write_event(event)
+    }
+
+    /// Writes what a port reported, the file's headers written.
+    fn write_event(&mut self, event: PortEvent) -> Result<(), CliError> {
         match event {
+            PortEvent::Searching { .. } => {}
+            // The interface's rate says it (a note at the lock would come after the bytes it
+            // precedes in time).
+            PortEvent::Found { .. } => {}
             PortEvent::Data { port, t_ns, bytes } => {
                 if let (Some(limit), Some(writer)) = (self.rotate_size, &self.writer) {
                     // What the file would be were it closed after these bytes (held bytes
@@ -444,8 +562,9 @@ impl Recorder {
         if !self.warn {
             return Ok(());
         }
-        let (baud, protocol) = (self.baud, self.protocol);
-        for state in &mut self.ports {
+        let protocol = self.protocol;
+        for (port, state) in self.ports.iter_mut().enumerate() {
+            let baud = self.bauds[port];
             if !state.warned_unframed
                 && state
                     .unframed_since
@@ -509,7 +628,7 @@ impl Recorder {
         let (next, mut writer) = loop {
             let next = numbered(&self.base, self.next_number);
             self.next_number += 1;
-            match create(&next, &names, self.baud, false) {
+            match create(&next, &names, &self.bauds, false) {
                 Ok(writer) => break (next, writer),
                 Err(CliError::Write(WriteError::Exists { .. })) if taken.len() < MAX_TAKEN => {
                     taken.push(next);
@@ -553,8 +672,10 @@ impl Recorder {
         Ok(())
     }
 
-    /// Writes everything out and syncs the file.
+    /// Writes everything out and syncs the file (its headers first, if they still waited for a
+    /// port's rate).
     pub fn close(&mut self) -> Result<(), CliError> {
+        self.begin()?;
         self.rotate()
     }
 
@@ -587,9 +708,25 @@ impl Recorder {
     }
 }
 
-/// The warning for port `name`, read at `baud`, whose `bytes` in [`NO_FRAMES_AFTER`] held no
-/// valid frame of `protocol` (without one forced, of any format).
-fn no_frame_warning(name: &str, bytes: u64, baud: u32, protocol: Option<Protocol>) -> String {
+/// The rates an auto-baud search tries: `19200 and 115200`.
+fn rates_text() -> String {
+    let rates: Vec<String> = SEARCH_RATES.iter().map(u32::to_string).collect();
+    rates.join(" and ")
+}
+
+/// The warning for port `name`, read at `baud` (`None`: at every rate searched), whose `bytes`
+/// in [`NO_FRAMES_AFTER`] held no valid frame of `protocol` (without one forced, of any
+/// format).
+fn no_frame_warning(
+    name: &str,
+    bytes: u64,
+    baud: Option<u32>,
+    protocol: Option<Protocol>,
+) -> String {
+    let read_at = match baud {
+        Some(baud) => format!("read at {baud}"),
+        None => format!("read at {} in turn", rates_text()),
+    };
     let (what, rates) = match protocol {
         Some(p) => (
             format!("{} frame", p.title()),
@@ -601,29 +738,41 @@ fn no_frame_warning(name: &str, bytes: u64, baud: u32, protocol: Option<Protocol
         ),
     };
     format!(
-        "{}: {bytes} bytes in {} s but no valid {what}: likely a wrong baud rate (read at \
-         {baud}; {rates}, see --baud) or swapped TX/RX wires (the adapter's RX must be on the \
+        "{}: {bytes} bytes in {} s but no valid {what}: likely a wrong baud rate ({read_at}; \
+         {rates}, see --baud) or swapped TX/RX wires (the adapter's RX must be on the \
          ESC's telemetry wire)",
         Escaped(name),
         NO_FRAMES_AFTER.as_secs(),
     )
 }
 
-/// Creates a recording file with its headers, one interface per port. An existing file is an
-/// error unless `overwrite`.
+/// Creates a recording file with its headers, one interface per port at its rate. An
+/// existing file is an error unless `overwrite`.
 fn create(
     path: &str,
     ports: &[String],
-    baud: u32,
+    bauds: &[Option<u32>],
     overwrite: bool,
+) -> Result<pcapng::Writer<BufWriter<File>>, CliError> {
+    let file = hwfoc_io::write::create_file(path, overwrite)?;
+    headers(path, file, ports, bauds)
+}
+
+/// Writes the headers of the recording `path` into `file`: one interface per port at its
+/// rate (19200 for a rate not known).
+fn headers(
+    path: &str,
+    file: File,
+    ports: &[String],
+    bauds: &[Option<u32>],
 ) -> Result<pcapng::Writer<BufWriter<File>>, CliError> {
     let err = |source| WriteError::Write {
         output: path.to_string(),
         source,
     };
-    let file = hwfoc_io::write::create_file(path, overwrite)?;
     let mut writer = pcapng::Writer::new(BufWriter::with_capacity(BUFFER, file)).map_err(err)?;
-    for port in ports {
+    for (i, port) in ports.iter().enumerate() {
+        let baud = bauds.get(i).copied().flatten().unwrap_or(DEFAULT_BAUD);
         writer.add_interface(port, baud).map_err(err)?;
     }
     writer.flush().map_err(err)?;
@@ -712,13 +861,18 @@ mod tests {
     #[test]
     fn the_no_frame_warning_names_the_protocol_forced() {
         assert_eq!(
-            no_frame_warning("/dev/ttyUSB0", 640, 115_200, None),
+            no_frame_warning("/dev/ttyUSB0", 640, Some(115_200), None),
             "/dev/ttyUSB0: 640 bytes in 3 s but no valid frame of any Hobbywing format: likely a \
              wrong baud rate (read at 115200; HW-FOC, V4 and V3 telemetry is 19200, DataLink and \
              HW5 115200, see --baud) or swapped TX/RX wires (the adapter's RX must be on the \
              ESC's telemetry wire)"
         );
-        let forced = no_frame_warning("/dev/ttyUSB0", 640, 19_200, Some(Protocol::DataLink));
+        let forced = no_frame_warning("/dev/ttyUSB0", 640, Some(19_200), Some(Protocol::DataLink));
+        let searched = no_frame_warning("/dev/ttyUSB0", 640, None, None);
+        assert!(
+            searched.contains("likely a wrong baud rate (read at 19200 and 115200 in turn; "),
+            "{searched}"
+        );
         assert!(
             forced.contains(
                 "no valid DataLink V2 frame: likely a wrong baud rate (read at 19200; DataLink \

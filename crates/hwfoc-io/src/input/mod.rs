@@ -315,13 +315,14 @@ impl Input {
         (self.notices)(notice);
     }
 
-    /// Opens serial ports at `baud` (8N1) as one input with one stream per port, in the order
-    /// given. Reading ends once `stop` is set (the `hwfoc` command sets it on Ctrl-C or
-    /// SIGTERM; the library installs no signal handler); a port that is unplugged is waited
-    /// for, with a warning.
+    /// Opens serial ports at `baud` (8N1; at [`crate::serial::Baud::Auto`] each port finds its
+    /// rate, told as a notice) as one input with one stream per port, in the order given.
+    /// Reading ends once `stop` is set (the `hwfoc` command sets it on Ctrl-C or SIGTERM; the
+    /// library installs no signal handler); a port that is unplugged is waited for, with a
+    /// warning.
     pub fn open_ports(
         names: &[String],
-        baud: u32,
+        baud: impl Into<crate::serial::Baud>,
         stop: Arc<AtomicBool>,
     ) -> Result<Input, InputError> {
         let set = PortSet::open(names, baud)?;

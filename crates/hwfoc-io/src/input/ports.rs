@@ -17,6 +17,8 @@ const PORT_POLL: Duration = Duration::from_millis(100);
 /// Live serial ports.
 pub(super) struct Ports {
     set: PortSet,
+    /// Each port's byte time, ns: of the rate given, or found ([`PortEvent::Found`]).
+    per_byte_ns: Vec<f64>,
     /// Set by the caller (the `hwfoc` command on Ctrl-C or SIGTERM): the input ends.
     interrupted: Arc<AtomicBool>,
 }
@@ -24,7 +26,12 @@ pub(super) struct Ports {
 impl Ports {
     /// Reads `set` until `interrupted` is set.
     pub(super) fn new(set: PortSet, interrupted: Arc<AtomicBool>) -> Ports {
-        Ports { set, interrupted }
+        let per_byte = hwfoc::wire::byte_ns(set.baud().initial());
+        Ports {
+            per_byte_ns: vec![per_byte; set.names().len()],
+            set,
+            interrupted,
+        }
     }
 
     /// The ports' names, in order.
@@ -33,15 +40,14 @@ impl Ports {
     }
 
     /// Waits for the next chunk of bytes and puts it, with its receive times, in `bytes` and
-    /// `times`; returns its port. Returns with nothing once interrupted. Ports that are lost
-    /// or come back are told to `notices`.
+    /// `times`; returns its port. Returns with nothing once interrupted. Ports that are lost,
+    /// come back or find their rate are told to `notices`.
     pub(super) fn read(
         &mut self,
         bytes: &mut Vec<u8>,
         times: &mut Vec<f64>,
         notices: &mut dyn FnMut(Notice),
     ) -> usize {
-        let per_byte = hwfoc::wire::byte_ns(self.set.baud());
         while !self.interrupted.load(Ordering::Relaxed) {
             match self.set.next_event(PORT_POLL) {
                 Some(PortEvent::Data {
@@ -49,11 +55,16 @@ impl Ports {
                     t_ns,
                     bytes: data,
                 }) => {
-                    byte_times(t_ns, per_byte, data.len(), times);
+                    byte_times(t_ns, self.per_byte_ns[port], data.len(), times);
                     bytes.extend_from_slice(&data);
                     return port;
                 }
                 Some(event) => {
+                    if let PortEvent::Found { port, baud, .. } = event
+                        && let Some(per_byte) = self.per_byte_ns.get_mut(port)
+                    {
+                        *per_byte = hwfoc::wire::byte_ns(baud);
+                    }
                     if let Some(notice) = Notice::of_port_event(&event, self.set.names()) {
                         notices(notice);
                     }

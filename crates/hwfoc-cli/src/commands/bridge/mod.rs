@@ -59,7 +59,8 @@ pub struct BridgeArgs {
     /// `hwfoc simulate` shape them).
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u16).range(1..=MAX_SIM as i64))]
     sim: Option<u16>,
-    /// Baud rate of the input ports (8N1) [default: that of --protocol, else 19200].
+    /// Baud rate of the input ports (8N1) [default: that of --protocol, else found from the
+    /// bytes: 19200 and 115200 tried in turn].
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..))]
     baud: Option<u32>,
     #[command(flatten)]
@@ -164,7 +165,7 @@ pub fn run(args: &BridgeArgs) -> Result<(), CliError> {
                 let feed = Feed::simulated(
                     &args.model,
                     usize::from(n),
-                    baud,
+                    baud.initial(),
                     settings.default_settings(),
                     tx,
                 )?;
@@ -176,11 +177,14 @@ pub fn run(args: &BridgeArgs) -> Result<(), CliError> {
                 (names, feed)
             }
         };
-        let mut streams = PortStreams::with_map(baud, names.clone(), settings);
+        let mut streams = PortStreams::with_map(baud.initial(), names.clone(), settings);
         if let Some(protocol) = protocol {
             streams.force_protocol(protocol);
         }
-        let per_byte_ns = hwfoc::wire::byte_ns(baud);
+        if baud == hwfoc_io::serial::Baud::Auto && args.sim.is_none() {
+            streams.auto_baud();
+        }
+        let per_byte_ns = hwfoc::wire::byte_ns(baud.initial());
         let result = live(
             &rx,
             &names,
@@ -296,8 +300,11 @@ fn take(
     fanout: &mut Fanout,
 ) {
     match event {
-        PortEvent::Data { t_ns, bytes, .. } => {
+        PortEvent::Data { port, t_ns, bytes } => {
             // The read that completed these bytes returned when the last of them arrived.
+            let per_byte_ns = streams
+                .baud(*port)
+                .map_or(per_byte_ns, hwfoc::wire::byte_ns);
             let last_ns = *t_ns as f64 + per_byte_ns * bytes.len().saturating_sub(1) as f64;
             let ago_ns = (clock.now_ns() as f64 - last_ns).max(0.0);
             let now = Instant::now();
@@ -307,7 +314,12 @@ fn take(
             );
             streams.feed(event, fanout);
         }
-        PortEvent::Lost { .. } | PortEvent::Back { .. } => {
+        PortEvent::Searching { .. } => {
+            streams.feed(event, fanout);
+        }
+        PortEvent::Lost { .. } | PortEvent::Back { .. } | PortEvent::Found { .. } => {
+            // A rate found sets the port's byte time.
+            streams.feed(event, fanout);
             if let Some(notice) = Notice::of_port_event(event, names) {
                 eprintln!("{}", notice.line());
             }

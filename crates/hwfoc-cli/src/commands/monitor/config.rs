@@ -77,8 +77,9 @@ pub struct MonitorSetup {
     pub file: Option<PathBuf>,
     /// Conversion settings, by ESC and port.
     pub settings: SettingsMap,
-    /// Baud rate of the ports.
-    pub baud: u32,
+    /// Baud rate of the ports: given (by a flag or the file, or by the protocol named), or
+    /// found by each port from its bytes.
+    pub baud: serial::Baud,
     /// The one protocol read, when forced (every protocol otherwise).
     pub protocol: Option<Protocol>,
     /// Ports from the file, when none are named on the command line.
@@ -134,11 +135,12 @@ impl MonitorSetup {
             .baud
             .or(flags.protocol.map(Protocol::baud_rate))
             .or(general.baud())
-            .or(file_protocol.map(Protocol::baud_rate))
-            .unwrap_or(serial::DEFAULT_BAUD);
-        if baud == 0 {
+            .or(file_protocol.map(Protocol::baud_rate));
+        if baud == Some(0) {
             return Err(invalid(origin("baud"), "the baud rate must be more than 0"));
         }
+        // Neither given: each port finds its own.
+        let baud = baud.map_or(serial::Baud::Auto, serial::Baud::Fixed);
         let a = &flags.alarms;
         let f = &general.file.alarms;
         let pick =
@@ -240,6 +242,7 @@ fn invalid(origin: String, message: impl Into<String>) -> CliError {
 mod tests {
     use super::*;
     use hwfoc::Settings;
+    use hwfoc_io::serial::Baud;
 
     fn parse(text: &str) -> Result<MonitorSetup, CliError> {
         let dir = tempfile::tempdir().unwrap();
@@ -269,7 +272,7 @@ mod tests {
         let six = config.limits.voltage(6);
         assert_eq!((six.warning, six.hysteresis), (3.5 * 6.0, 0.1 * 6.0));
         assert!((six.critical - 19.8).abs() < 1e-9 && six.low_is_bad);
-        assert_eq!(config.baud, 19_200);
+        assert_eq!(config.baud, hwfoc_io::serial::Baud::Auto);
         assert_eq!(config.settings, SettingsMap::from(Settings::DEFAULT));
         assert!(config.ports.is_empty());
         assert_eq!(config.record_dir, default_record_dir());
@@ -282,7 +285,7 @@ mod tests {
                     mos_critical_c = 95\nbattery_cells = 12\n[[esc]]\nport = \"/dev/ttyUSB0\"\n\
                     label = \"front left\"\n[[esc]]\nport = \"/dev/ttyUSB1\"\n";
         let config = parse(text).unwrap();
-        assert_eq!(config.baud, 115_200);
+        assert_eq!(config.baud, Baud::Fixed(115_200));
         assert_eq!(config.settings.get(0, "/dev/ttyUSB0").pole_pairs, 14);
         assert_eq!(config.limits.mos.warning, 80.0);
         assert_eq!(config.limits.cells, Some(12));
@@ -303,7 +306,7 @@ mod tests {
         };
         flags.alarms.mos_warning_c = Some(70.0);
         let config = MonitorSetup::load(&flags).unwrap();
-        assert_eq!(config.baud, 9600);
+        assert_eq!(config.baud, Baud::Fixed(9600));
         assert_eq!(config.limits.mos.warning, 70.0);
         assert_eq!(config.limits.mos.critical, 95.0);
     }
@@ -313,14 +316,14 @@ mod tests {
     #[test]
     fn a_protocol_sets_the_baud_rate_a_flag_or_the_file_leaves_open() {
         let none = parse("").unwrap();
-        assert_eq!((none.protocol, none.baud), (None, 19_200));
+        assert_eq!((none.protocol, none.baud), (None, Baud::Auto));
         let file = parse("[monitor]\nprotocol = \"datalink\"\n").unwrap();
         assert_eq!(
             (file.protocol, file.baud),
-            (Some(Protocol::DataLink), 115_200)
+            (Some(Protocol::DataLink), Baud::Fixed(115_200))
         );
         let file = parse("[monitor]\nprotocol = \"datalink\"\nbaud = 57600\n").unwrap();
-        assert_eq!(file.baud, 57_600);
+        assert_eq!(file.baud, Baud::Fixed(57_600));
 
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("m.toml");
@@ -336,10 +339,13 @@ mod tests {
         let config = MonitorSetup::load(&flags).unwrap();
         assert_eq!(
             (config.protocol, config.baud),
-            (Some(Protocol::HwFoc), 19_200)
+            (Some(Protocol::HwFoc), Baud::Fixed(19_200))
         );
         flags.baud = Some(38_400);
-        assert_eq!(MonitorSetup::load(&flags).unwrap().baud, 38_400);
+        assert_eq!(
+            MonitorSetup::load(&flags).unwrap().baud,
+            Baud::Fixed(38_400)
+        );
     }
 
     #[test]

@@ -30,6 +30,7 @@ use super::{Session, number, reading};
 use crate::error::CliError;
 use crate::shown::{Measure, Shown};
 use hwfoc::Quantity;
+use hwfoc::telemetry::Info;
 use hwfoc_io::Escaped;
 use hwfoc_io::Fixed;
 use hwfoc_io::energy::Energy;
@@ -341,7 +342,13 @@ fn draw_table(frame: &mut Frame, area: Rect, ui: &Ui, view: View<'_>) {
                 Cell::from(format!("disconnected {:.0} s", view.now - since))
                     .style(level_style(Some(Level::Critical))),
             ),
-            (Link::Up, None) => (vec![Cell::from(""); 6], Cell::from(esc.waiting())),
+            (Link::Up, None) => (
+                vec![Cell::from(""); 6],
+                Cell::from(match esc.trying {
+                    Some(baud) => format!("finding the baud rate: trying {baud}"),
+                    None => esc.waiting().to_string(),
+                }),
+            ),
             (Link::Up, Some(r)) => {
                 let temp = |t: Option<f32>| t.map_or("-".to_string(), |t| number(t, 0));
                 (
@@ -434,7 +441,38 @@ fn alarm_cell(esc: &EscView) -> Cell<'static> {
 }
 
 fn draw_detail(frame: &mut Frame, area: Rect, index: usize, esc: &EscView, now: f64) {
+    let hw5 = esc.protocol() == Some(hwfoc::Protocol::Hw5);
     let info = match &esc.info {
+        // V4: the scales of its info frame, and whether they were taken (two identical copies).
+        Some(Info::HwV4(i)) => format!(
+            "V4 constants: full scale {} · v {} {} · i {} {} {} · t {} {} · {}",
+            i.full_scale,
+            i.v1,
+            i.v2,
+            i.i1,
+            i.i2,
+            i.i3,
+            i.t1,
+            i.t2,
+            if esc.stats.adopted_info().is_some() {
+                "adopted"
+            } else {
+                "not adopted yet (two identical copies needed)"
+            }
+        ),
+        // HW5 sends no device information: its BEC and motor instead.
+        None if hw5 => {
+            let r = esc.last.as_ref();
+            let temp =
+                |t: Option<f32>| t.map_or("-".to_string(), |t| format!("{}°C", number(t, 0)));
+            format!(
+                "BEC {} V {} A {} · motor {}",
+                reading(r.and_then(|r| r.bec_voltage_v), 1),
+                reading(r.and_then(|r| r.bec_current_a), 1),
+                temp(r.and_then(|r| r.bec_temp_c)),
+                temp(r.and_then(|r| r.motor_temp_c))
+            )
+        }
         Some(info) => Escaped(format_args!(
             "{} · hw {} · fw {} · id {}",
             info.product(),
@@ -454,6 +492,7 @@ fn draw_detail(frame: &mut Frame, area: Rect, index: usize, esc: &EscView, now: 
     let block = Block::bordered().title(Line::from(vec![
         format!(" esc{index} ").bold(),
         format!("{} ", Escaped(esc.title())).into(),
+        format!("· {} ", esc.rate_text()).dark_gray(),
     ]));
     let inner = block.inner(area);
     frame.render_widget(block, area);
@@ -463,12 +502,11 @@ fn draw_detail(frame: &mut Frame, area: Rect, index: usize, esc: &EscView, now: 
             energy_line(esc.power_w(), esc.energy.peak_w(), &esc.energy, "this ESC"),
             Line::from(info),
             Line::from(format!(
-                "{cells} · {} frames · {} bytes, {} skipped · {} checksum failures · {} restarts",
+                "{cells} · {} frames · {} bytes, {} skipped · {}",
                 stats.frames(),
                 stats.bytes(),
-                stats.bytes_skipped(),
-                stats.checksum_failures(),
-                stats.restarts()
+                stats.bytes_skipped() + esc.discarded,
+                esc.link_text()
             ))
             .dark_gray(),
         ]),
@@ -495,6 +533,7 @@ fn draw_detail(frame: &mut Frame, area: Rect, index: usize, esc: &EscView, now: 
     for (measure, area) in CHARTS.into_iter().zip(areas) {
         let series: Vec<(&str, Color, Points)> = measure
             .shown()
+            .filter(|&q| esc.carries(q))
             .map(|q| {
                 let points = esc
                     .history

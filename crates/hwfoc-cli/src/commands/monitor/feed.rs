@@ -13,7 +13,7 @@ use hwfoc::Settings;
 
 use crate::commands::simulate::ModelArgs;
 use crate::error::CliError;
-use hwfoc_io::serial::{PortEvent, Readers};
+use hwfoc_io::serial::{Baud, PortEvent, Readers};
 use hwfoc_io::write::WriteError;
 use hwfoc_sim::{Sink, VirtualFleet};
 
@@ -53,9 +53,10 @@ impl Drop for Feed {
 }
 
 impl Feed {
-    /// Opens `ports` at `baud` (all of them, or an error naming the first that fails); their
-    /// reader threads send their events straight to `tx`.
-    pub fn ports(ports: &[String], baud: u32, tx: Sender<Msg>) -> Result<Feed, CliError> {
+    /// Opens `ports` at `baud` (all of them, or an error naming the first that fails; at
+    /// [`Baud::Auto`] each finds its rate); their reader threads send their events straight to
+    /// `tx`.
+    pub fn ports(ports: &[String], baud: Baud, tx: Sender<Msg>) -> Result<Feed, CliError> {
         let readers = Readers::start(ports, baud, tx, Msg::Port)?;
         Ok(Feed::Ports(readers))
     }

@@ -17,7 +17,7 @@ use hwfoc_io::PortStreams;
 use hwfoc_io::SettingsMap;
 use hwfoc_io::energy::Energy;
 use hwfoc_io::record::Record;
-use hwfoc_io::serial::PortEvent;
+use hwfoc_io::serial::{Baud, PortEvent};
 
 /// Seconds of history kept for the charts.
 pub const HISTORY_S: f64 = 60.0;
@@ -191,6 +191,12 @@ pub struct EscView {
     pub info: Option<Info>,
     /// Link statistics of its decoder.
     pub stats: EscLink,
+    /// Its port's baud rate: given, or found from the bytes; `None` while it is being found.
+    pub baud: Option<u32>,
+    /// While the port's rate is being found: the rate tried.
+    pub trying: Option<u32>,
+    /// Bytes its port read at rates the search left (skipped, never decoded).
+    pub discarded: u64,
     /// Battery cells: configured, or detected from the first voltage.
     pub cells: Option<u8>,
     /// Whether `cells` was detected rather than configured.
@@ -235,6 +241,55 @@ impl EscView {
             (bytes, 0) if bytes >= 64 => "bytes but no valid frame: baud rate? swapped wires?",
             _ => "no frames yet",
         }
+    }
+
+    /// The format of its frames: of the latest data frame, else of those its link counted;
+    /// `None` before any frame.
+    pub fn protocol(&self) -> Option<hwfoc::Protocol> {
+        self.last.as_ref().map(|r| r.protocol).or_else(|| {
+            (self.stats.frames() + self.stats.info_frames() > 0).then(|| self.stats.protocol())
+        })
+    }
+
+    /// Its port's rate and format: `115200 baud (HW5)`, `19200 baud` before a frame, or
+    /// `finding the baud rate: trying 115200`.
+    pub fn rate_text(&self) -> String {
+        match (self.baud, self.trying) {
+            (Some(baud), _) => match self.protocol() {
+                Some(p) => format!("{baud} baud ({})", p.title()),
+                None => format!("{baud} baud"),
+            },
+            (None, Some(baud)) => format!("finding the baud rate: trying {baud}"),
+            (None, None) => "finding the baud rate".to_string(),
+        }
+    }
+
+    /// Whether its format carries `q` (every one before the format is known).
+    pub fn carries(&self, q: Shown) -> bool {
+        self.protocol().is_none_or(|p| q.carried_by(p))
+    }
+
+    /// Its link's figures as its format has them: packet loss where frames are numbered
+    /// (`lost 0 dup 0`; HW5's are not), checksum failures where they have one (`crc 0`), or
+    /// candidates rejected by plausibility (`rejected 0`: V3, V4), restarts where numbered.
+    pub fn link_text(&self) -> String {
+        let s = &self.stats;
+        let mut parts = Vec::new();
+        if s.counts_packets() {
+            parts.push(format!(
+                "lost {} dup {}",
+                s.lost_packets(),
+                s.duplicate_packets()
+            ));
+        }
+        match s.rejected_frames() {
+            Some(rejected) => parts.push(format!("rejected {rejected}")),
+            None => parts.push(format!("crc {}", s.checksum_failures())),
+        }
+        if s.counts_packets() {
+            parts.push(format!("restarts {}", s.restarts()));
+        }
+        parts.join(" ")
     }
 
     /// The name to show: the label, or the port.
@@ -342,19 +397,22 @@ pub struct Fleet {
 impl Fleet {
     /// ESCs read from the ports `names` (labels beside them), their frames converted under
     /// `settings` (by port name and ESC number, a hub's channels included), watched from Unix
-    /// time `now`, their bytes arriving at `baud`.
+    /// time `now`, their bytes arriving at `baud` (at [`Baud::Auto`], found by each port).
     pub fn new(
         names: Vec<(String, Option<String>)>,
         settings: SettingsMap,
         limits: Limits,
-        baud: u32,
+        baud: Baud,
         now: f64,
     ) -> Fleet {
-        let streams = PortStreams::with_map(
-            baud,
+        let mut streams = PortStreams::with_map(
+            baud.initial(),
             names.iter().map(|(name, _)| name.clone()).collect(),
             settings,
         );
+        if baud == Baud::Auto {
+            streams.auto_baud();
+        }
         let escs = names
             .into_iter()
             .enumerate()
@@ -374,6 +432,9 @@ impl Fleet {
                 history: VecDeque::new(),
                 info: None,
                 stats: EscLink::default(),
+                baud: baud.fixed(),
+                trying: (baud == Baud::Auto).then_some(baud.initial()),
+                discarded: 0,
                 cells: limits.cells,
                 cells_detected: false,
                 alarms: Alarms::default(),
@@ -402,6 +463,11 @@ impl Fleet {
     /// The alarm levels in force.
     pub fn limits(&self) -> &Limits {
         &self.limits
+    }
+
+    /// The baud rate of port `port`: given, or found; `None` while it is being found.
+    pub fn port_baud(&self, port: usize) -> Option<u32> {
+        self.streams.baud(port)
     }
 
     /// Takes in what a port (or a virtual ESC) reported; returns the number of data frames it
@@ -455,6 +521,23 @@ impl Fleet {
                     self.note_total_power();
                 }
                 data
+            }
+            PortEvent::Searching { port, baud, .. } => {
+                self.streams.feed(event, &mut ());
+                let discarded = self.streams.discarded(*port);
+                for i in self.views_of(*port) {
+                    let esc = &mut self.escs[i];
+                    (esc.baud, esc.trying, esc.discarded) = (None, Some(*baud), discarded);
+                }
+                0
+            }
+            PortEvent::Found { port, baud, .. } => {
+                self.streams.feed(event, &mut ());
+                for i in self.views_of(*port) {
+                    let esc = &mut self.escs[i];
+                    (esc.baud, esc.trying) = (Some(*baud), None);
+                }
+                0
             }
             PortEvent::Lost { port, t_ns, reason } => {
                 let t = *t_ns as f64 / 1e9;
@@ -701,7 +784,13 @@ mod tests {
         })
         .unwrap();
         let names = (0..n).map(|i| (format!("esc{i}"), None)).collect();
-        Fleet::new(names, config.settings, config.limits, 19_200, 1000.0)
+        Fleet::new(
+            names,
+            config.settings,
+            config.limits,
+            Baud::Fixed(19_200),
+            1000.0,
+        )
     }
 
     fn frame(packet: u16, status: Status, mos_code: u8, volt_raw: u16) -> Vec<u8> {

@@ -11,6 +11,9 @@ use serde_json::{Value, json};
 use super::fleet::{EscView, Fleet, Link, LogEntry};
 use super::{Session, number, reading};
 use crate::error::CliError;
+use crate::shown::Shown;
+use hwfoc::Quantity;
+use hwfoc::telemetry::Info;
 use hwfoc_io::Escaped;
 use hwfoc_io::Fixed;
 use hwfoc_io::energy::Energy;
@@ -69,6 +72,9 @@ pub fn run(session: &mut Session, json: bool, interval_s: f64) -> Result<(), Cli
         }
         if let Some(notice) = session.notice.take() {
             eprintln!("hwfoc: {}", Escaped(&notice));
+        }
+        for found in session.found.drain(..) {
+            eprintln!("{}", found.line());
         }
         if !text.is_empty() {
             out.write_all(&text)
@@ -135,34 +141,63 @@ fn total_json(fleet: &Fleet, now: f64) -> Value {
     })
 }
 
-/// `2026-… esc0 /dev/ttyUSB0: thr 50.0/48.2 % 12000 rpm 24.1 V 20.3 A (phase 35.1 A) mos 45.0C
-/// cap 40.0C | 20.0 fr/s lost 0 dup 0 crc 0 | age 0.03 s | power 489 W (peak 520 W) used
-/// 12.5 mAh 0.30 Wh | ok`
+/// `2026-… esc0 /dev/ttyUSB0: thr 50.0/48.2 % 12000 rpm 24.1 V 20.3 A (phase 35.1 A) mos
+/// 45.0C cap 40.0C | 19200 baud (HW-FOC) 20.0 fr/s lost 0 dup 0 crc 0 restarts 0 | age 0.03 s |
+/// power 489 W (peak 520 W) used 12.5 mAh 0.30 Wh | ok`: the figures the ESC's format has
+/// (see [`EscView::carries`], [`EscView::link_text`]), HW5's BEC and motor ones too.
 fn status_line(i: usize, esc: &EscView, now: f64) -> String {
     let mut line = format!("{} esc{i} {}: ", timestamp(now), Escaped(esc.title()));
     match (&esc.link, &esc.last) {
         (Link::Down { since, reason }, _) => {
             line.push_str(&format!("disconnected for {:.1} s ({reason})", now - since));
         }
-        (Link::Up, None) => line.push_str(esc.waiting()),
+        (Link::Up, None) => line.push_str(&format!("{} ({})", esc.waiting(), esc.rate_text())),
         (Link::Up, Some(r)) => {
             let temp = |t: Option<f32>| t.map_or("-".to_string(), |t| format!("{}C", number(t, 1)));
+            let has = |q: Quantity| esc.carries(Shown::Carried(q));
+            let mut parts: Vec<String> = Vec::new();
+            if has(Quantity::ThrottleIn) {
+                parts.push(format!(
+                    "thr {}/{} %",
+                    reading(r.throttle_in_pct, 1),
+                    reading(r.throttle_out_pct, 1)
+                ));
+            }
+            if has(Quantity::Rpm) {
+                parts.push(format!("{} rpm", reading(r.rpm, 0)));
+            }
+            if has(Quantity::Voltage) {
+                parts.push(format!("{} V", reading(r.voltage_v, 1)));
+            }
+            if has(Quantity::Current) {
+                parts.push(format!("{} A", reading(r.current_a, 1)));
+            }
+            if has(Quantity::PhaseCurrent) {
+                parts.push(format!("(phase {} A)", reading(r.phase_current_a, 1)));
+            }
+            if has(Quantity::MosTemp) {
+                parts.push(format!("mos {}", temp(r.mos_temp_c)));
+            }
+            if has(Quantity::CapTemp) {
+                parts.push(format!("cap {}", temp(r.cap_temp_c)));
+            }
+            if has(Quantity::BecVoltage) {
+                parts.push(format!(
+                    "bec {} V {} A {}",
+                    reading(r.bec_voltage_v, 1),
+                    reading(r.bec_current_a, 1),
+                    temp(r.bec_temp_c)
+                ));
+            }
+            if has(Quantity::MotorTemp) {
+                parts.push(format!("motor {}", temp(r.motor_temp_c)));
+            }
+            line.push_str(&parts.join(" "));
             line.push_str(&format!(
-                "thr {}/{} % {} rpm {} V {} A (phase {} A) mos {} cap {} | {:.1} fr/s lost {} \
-                 dup {} crc {} restarts {} | age {:.2} s",
-                reading(r.throttle_in_pct, 1),
-                reading(r.throttle_out_pct, 1),
-                reading(r.rpm, 0),
-                reading(r.voltage_v, 1),
-                reading(r.current_a, 1),
-                reading(r.phase_current_a, 1),
-                temp(r.mos_temp_c),
-                temp(r.cap_temp_c),
+                " | {} {:.1} fr/s {} | age {:.2} s",
+                esc.rate_text(),
                 esc.frame_rate(now),
-                esc.stats.lost_packets(),
-                esc.stats.duplicate_packets(),
-                esc.stats.checksum_failures(),
-                esc.stats.restarts(),
+                esc.link_text(),
                 esc.age(now).unwrap_or(0.0),
             ));
             line.push_str(" | ");
@@ -227,6 +262,7 @@ fn alarm_json(entry: &LogEntry, esc: &EscView) -> Value {
 }
 
 fn status_json(i: usize, esc: &EscView, now: f64) -> Value {
+    let counted = esc.stats.counts_packets();
     let record = esc.last.as_ref().map(record_json);
     let (link, down_since, reason) = match &esc.link {
         Link::Up => ("up", None, None),
@@ -252,13 +288,20 @@ fn status_json(i: usize, esc: &EscView, now: f64) -> Value {
         "down_reason": reason,
         "age_s": esc.age(now),
         "frame_rate_hz": esc.frame_rate(now),
+        "protocol": esc.protocol().map(hwfoc::Protocol::name),
+        "baud": esc.baud,
         "frames": esc.stats.frames(),
-        "lost": esc.stats.lost_packets(),
-        "duplicates": esc.stats.duplicate_packets(),
-        "restarts": esc.stats.restarts(),
-        "checksum_failures": esc.stats.checksum_failures(),
+        // Null where the format has no such figure (HW5 numbers no packet, V3 and V4 frames
+        // carry no checksum), never 0.
+        "lost": counted.then(|| esc.stats.lost_packets()),
+        "duplicates": counted.then(|| esc.stats.duplicate_packets()),
+        "restarts": counted.then(|| esc.stats.restarts()),
+        "checksum_failures": esc.stats.has_checksum().then(|| esc.stats.checksum_failures()),
+        "rejected_frames": esc.stats.rejected_frames(),
         "bytes": esc.stats.bytes(),
         "bytes_skipped": esc.stats.bytes_skipped(),
+        "bytes_at_other_rates": esc.discarded,
+        "info_adopted": esc.stats.adopted_info().map(|i| hwfoc_io::summary::device_json(&Info::HwV4(i))),
         "record": record,
         "peaks": {
             "rpm": p.rpm,

@@ -29,7 +29,7 @@ use super::record::{self, Recorder};
 use crate::args::{ProtocolArgs, SettingsArgs};
 use crate::commands::simulate::ModelArgs;
 use crate::error::CliError;
-use hwfoc_io::serial::PortEvent;
+use hwfoc_io::serial::{Baud, PortEvent};
 
 /// The most virtual ESCs `--sim` runs.
 const MAX_SIM: u16 = 64;
@@ -84,7 +84,7 @@ pub struct MonitorArgs {
     #[arg(long = "label", value_name = "TEXT")]
     labels: Vec<String>,
     /// Baud rate of the ports (8N1) [default: that of --protocol, else from the configuration
-    /// file, else 19200].
+    /// file, else found from the bytes: 19200 and 115200 tried in turn].
     #[arg(long, value_name = "N")]
     baud: Option<u32>,
     #[command(flatten)]
@@ -179,7 +179,9 @@ pub struct Session {
     feed: Option<Feed>,
     clock: hwfoc_io::clock::ReceiveClock,
     names: Vec<String>,
-    baud: u32,
+    baud: Baud,
+    /// The ports' rates found from their bytes since the headless monitor last printed them.
+    pub found: Vec<hwfoc_io::Notice>,
     /// The one protocol read, when forced.
     protocol: Option<hwfoc::Protocol>,
     record_dir: PathBuf,
@@ -205,7 +207,7 @@ impl Session {
                 let feed = Feed::simulated(
                     &args.model,
                     usize::from(n),
-                    config.baud,
+                    config.baud.initial(),
                     config.settings.default_settings(),
                     tx.clone(),
                 )?;
@@ -246,11 +248,16 @@ impl Session {
             Feed::Simulated { .. } => hwfoc_io::clock::ReceiveClock::new(),
         };
         let now = clock.now_ns() as f64 / 1e9;
+        // Virtual ESCs send at the rate they are given: nothing to find.
+        let baud = match args.sim {
+            Some(_) => Baud::Fixed(config.baud.initial()),
+            None => config.baud,
+        };
         let mut fleet = Fleet::new(
             labelled,
             config.settings.clone(),
             config.limits.clone(),
-            config.baud,
+            baud,
             now,
         );
         if let Some(protocol) = config.protocol {
@@ -268,7 +275,8 @@ impl Session {
             feed: Some(feed),
             clock,
             names,
-            baud: config.baud,
+            baud,
+            found: Vec::new(),
             protocol: config.protocol,
             record_dir: config.record_dir,
             overwrite: args.overwrite,
@@ -337,6 +345,11 @@ impl Session {
 
     fn take(&mut self, event: PortEvent) {
         let received = self.received_at(&event);
+        if let Some(notice @ hwfoc_io::Notice::PortBaud { .. }) =
+            hwfoc_io::Notice::of_port_event(&event, &self.names)
+        {
+            self.found.push(notice);
+        }
         if self.fleet.on_event(&event) > 0 {
             self.perf.arrived(received);
         }
@@ -353,13 +366,14 @@ impl Session {
     /// the screen's delay is counted from here.
     fn received_at(&self, event: &PortEvent) -> Instant {
         let now = Instant::now();
-        let PortEvent::Data { t_ns, bytes, .. } = event else {
+        let PortEvent::Data { port, t_ns, bytes } = event else {
             return now;
         };
         let span = if self.simulated {
             0
         } else {
-            (bytes.len().saturating_sub(1) as f64 * hwfoc::wire::byte_ns(self.baud)) as u64
+            let baud = self.fleet.port_baud(*port).unwrap_or(self.baud.initial());
+            (bytes.len().saturating_sub(1) as f64 * hwfoc::wire::byte_ns(baud)) as u64
         };
         let ago = self.clock.now_ns().saturating_sub(t_ns + span);
         now.checked_sub(Duration::from_nanos(ago)).unwrap_or(now)
@@ -381,7 +395,9 @@ impl Session {
             output: path.clone(),
             rotate_size: None,
             rotate_time: None,
-            baud: self.baud,
+            bauds: (0..self.names.len())
+                .map(|port| self.fleet.port_baud(port))
+                .collect(),
             protocol: self.protocol,
             warn: false,
             overwrite: self.overwrite,
