@@ -217,8 +217,8 @@ fn parquet_has_the_schema_units_and_metadata_and_the_jsonl_values() {
     assert_eq!(
         escs,
         json!([
-            {"esc": 0, "input": s(&real), "stream": s(&real)},
-            {"esc": 1, "input": s(&raw), "stream": s(&raw)},
+            {"esc": 0, "input": s(&real), "stream": s(&real), "protocol": "hw-foc"},
+            {"esc": 1, "input": s(&raw), "stream": s(&raw), "protocol": "hw-foc"},
         ])
     );
     assert_same_records(&batch, &records);

@@ -44,7 +44,7 @@ SCHEMA = [
     ("faults", pa.list_(pa.field("item", pa.string(), nullable=False)), True, "-"),
 ]
 
-# Columns of record schema 2 that no protocol read today carries: null in every row.
+# Columns of record schema 2 that HW-FOC (the demo capture) does not carry: null in every row.
 NOT_CARRIED = ["motor_temp_c", "bec_temp_c", "bec_voltage_v", "bec_current_a"]
 
 SETTINGS = {"current_scale": "100", "pole_pairs": "14", "gear_ratio": "2.5"}
@@ -89,7 +89,7 @@ def main():
     check(kv.get(b"record_schema_version") == b"2", f"record_schema_version {kv.get(b'record_schema_version')!r}")
     check(json.loads(kv[b"inputs"]) == ["demo capture"], f"inputs {kv[b'inputs']!r}")
     escs = json.loads(kv[b"escs"])
-    check(escs == [{"esc": 0, "input": "demo capture", "stream": "demo capture"}], f"escs {escs}")
+    check(escs == [{"esc": 0, "input": "demo capture", "stream": "demo capture", "protocol": "hw-foc"}], f"escs {escs}")
 
     table = pq.read_table(parquet_path)
     check(table.num_rows == len(records), f"{table.num_rows} rows, {len(records)} JSON records")

@@ -190,7 +190,7 @@ mod tests {
         sources.run(&mut crate::summary::Summary::new()).unwrap();
         assert_eq!(
             escs_json(&sources),
-            r#"[{"esc":0,"input":"front","stream":"front"},{"esc":1,"input":"rear","stream":"rear"}]"#
+            r#"[{"esc":0,"input":"front","stream":"front","protocol":"hw-foc"},{"esc":1,"input":"rear","stream":"rear","protocol":"hw-foc"}]"#
         );
     }
 
