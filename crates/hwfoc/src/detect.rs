@@ -108,6 +108,22 @@ impl Decoded {
     }
 }
 
+/// `on_frame`, noting in `found` the family of each frame while detecting (`all`): for the
+/// frames a silence or the end of the stream settles.
+fn noting<'a>(
+    all: bool,
+    found: &'a mut [Option<u64>; 4],
+    on_frame: &'a mut impl FnMut(Decoded),
+) -> impl FnMut(Decoded) + 'a {
+    move |d: Decoded| {
+        if all {
+            let i = Family::ALL.iter().position(|&f| f == d.family());
+            found[i.unwrap_or(0)] = Some(d.offset());
+        }
+        on_frame(d)
+    }
+}
+
 /// A decoder of every Hobbywing serial format at once (see the module documentation).
 #[derive(Debug, Clone, Default)]
 pub struct Decoder {
@@ -340,14 +356,7 @@ impl Decoder {
             u32::try_from((u64::from(esc_frames) * 24).div_ceil(len)).unwrap_or(u32::MAX)
         };
         let all = self.locked.is_none();
-        let found = &mut self.found;
-        let mut take = |d: Decoded| {
-            if all {
-                let i = Family::ALL.iter().position(|&f| f == d.family());
-                found[i.unwrap_or(0)] = Some(d.offset());
-            }
-            on_frame(d)
-        };
+        let mut take = noting(all, &mut self.found, &mut on_frame);
         if all || self.locked == Some(Family::Mixed) {
             self.mixed
                 .line_silent_each(esc_frames, hub_frames, |d| take(Decoded::Mixed(d)));
@@ -364,6 +373,7 @@ impl Decoder {
             self.v3
                 .line_silent(scaled(v3::FRAME_LEN as u64), |d| take(Decoded::HwV3(d)));
         }
+        drop(take);
         if all {
             self.end_slice();
         }
@@ -378,14 +388,7 @@ impl Decoder {
     /// what the last slice found.
     pub fn flush(&mut self, mut on_frame: impl FnMut(Decoded)) {
         let all = self.locked.is_none();
-        let found = &mut self.found;
-        let mut take = |d: Decoded| {
-            if all {
-                let i = Family::ALL.iter().position(|&f| f == d.family());
-                found[i.unwrap_or(0)] = Some(d.offset());
-            }
-            on_frame(d)
-        };
+        let mut take = noting(all, &mut self.found, &mut on_frame);
         if all || self.locked == Some(Family::Mixed) {
             self.mixed.flush(|d| take(Decoded::Mixed(d)));
         }
@@ -398,6 +401,7 @@ impl Decoder {
         if all || self.locked == Some(Family::HwV3) {
             self.v3.flush(|d| take(Decoded::HwV3(d)));
         }
+        drop(take);
         if all {
             self.end_slice();
         }

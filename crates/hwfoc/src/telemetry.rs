@@ -83,6 +83,15 @@ pub struct Reading {
 }
 
 impl Reading {
+    /// `raw` under the linear conversion `linear` (every protocol's most common reading).
+    #[inline(always)]
+    pub const fn linear(raw: i32, linear: Linear) -> Reading {
+        Reading {
+            raw,
+            conversion: Conversion::Linear(linear),
+        }
+    }
+
     /// The value in the quantity's unit, or `None` where the conversion has none.
     #[inline]
     pub fn value(self) -> Option<f32> {
@@ -132,10 +141,7 @@ impl Telemetry for DataFrame {
 
     #[inline(always)]
     fn reading(&self, quantity: Quantity, settings: &Settings) -> Option<Reading> {
-        let linear = |raw: i32, linear: Linear| Reading {
-            raw,
-            conversion: Conversion::Linear(linear),
-        };
+        let linear = Reading::linear;
         let adc = |code: u8| Reading {
             raw: i32::from(code),
             conversion: Conversion::AdcTable,

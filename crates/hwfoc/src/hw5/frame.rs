@@ -9,7 +9,7 @@
 
 use crate::foc::FrameError;
 use crate::status::Status;
-use crate::telemetry::{Conversion, Reading, Telemetry};
+use crate::telemetry::{Reading, Telemetry};
 use crate::units::{Linear, Quantity, Settings};
 
 use super::error::Error;
@@ -317,10 +317,7 @@ impl Telemetry for TelemetryFrame {
     /// or capacitor temperature. Current is the wire's (see [`TelemetryFrame::current_raw`]).
     #[inline]
     fn reading(&self, quantity: Quantity, settings: &Settings) -> Option<Reading> {
-        let linear = |raw: u16, linear: Linear| Reading {
-            raw: i32::from(raw),
-            conversion: Conversion::Linear(linear),
-        };
+        let linear = |raw: u16, linear| Reading::linear(i32::from(raw), linear);
         Some(match quantity {
             Quantity::ThrottleIn => linear(self.throttle.into(), Linear::IDENTITY),
             Quantity::Erpm => linear(self.erpm_raw, ERPM),

@@ -7,7 +7,7 @@
 //! ```
 
 use crate::status::Status;
-use crate::telemetry::{Conversion, Reading, Telemetry};
+use crate::telemetry::{Reading, Telemetry};
 use crate::units::{Linear, Quantity, Settings};
 use crate::wire::SYNC;
 
@@ -131,10 +131,7 @@ impl Telemetry for Frame {
     /// 0. V3 carries nothing else.
     #[inline]
     fn reading(&self, quantity: Quantity, settings: &Settings) -> Option<Reading> {
-        let linear = |raw: u32, linear: Linear| Reading {
-            raw: raw as i32,
-            conversion: Conversion::Linear(linear),
-        };
+        let linear = |raw: u32, linear| Reading::linear(raw as i32, linear);
         Some(match quantity {
             Quantity::ThrottleIn => linear(self.throttle_in_raw.into(), Self::THROTTLE_PCT),
             Quantity::ThrottleOut => linear(self.pwm_out_raw.into(), Self::THROTTLE_PCT),

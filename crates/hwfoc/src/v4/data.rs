@@ -243,10 +243,7 @@ impl Telemetry for Data {
     /// before one, nor without a current sensor), temperatures through the NTC formula.
     #[inline]
     fn reading(&self, quantity: Quantity, settings: &Settings) -> Option<Reading> {
-        let linear = |raw: u32, linear: Linear| Reading {
-            raw: raw as i32,
-            conversion: Conversion::Linear(linear),
-        };
+        let linear = |raw: u32, linear| Reading::linear(raw as i32, linear);
         let f = &self.frame;
         Some(match quantity {
             Quantity::ThrottleIn => linear(f.throttle_in_raw.into(), self.throttle_linear()),
