@@ -62,7 +62,7 @@ pub const SEARCH_SILENT_FOR: Duration = Duration::from_millis(3000);
 
 /// Frames that lock a rate: two, so that a frame whose checksum a run of garbage happened to
 /// match (one in 65536 candidates) does not (V3 and V4 frames come only from chains of three).
-const SEARCH_LOCK_FRAMES: u32 = 2;
+pub const SEARCH_LOCK_FRAMES: u32 = 2;
 
 /// The baud rate a port is read at.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
