@@ -1,4 +1,4 @@
-"""Hobbywing HW-FOC ESC telemetry as Arrow tables.
+"""Hobbywing ESC telemetry as Arrow tables (HW-FOC, DataLink V2, Platinum V4 and V3, HW5).
 
 The records are those of docs/RECORD-SCHEMA.md (the same names, types and units as every output of
 the ``hwfoc`` command): one row per data frame, in physical units.
@@ -30,6 +30,7 @@ from ._hwfoc import (
     DEFAULT_CURRENT_SCALE,
     DEFAULT_GEAR_RATIO,
     DEFAULT_POLE_PAIRS,
+    DEFAULT_V4_VOLTS_PER_STEP,
     PROTOCOLS,
     Decoder,
     HwfocError,
@@ -53,6 +54,7 @@ __all__ = [
     "DEFAULT_CURRENT_SCALE",
     "DEFAULT_GEAR_RATIO",
     "DEFAULT_POLE_PAIRS",
+    "DEFAULT_V4_VOLTS_PER_STEP",
     "PROTOCOLS",
     "Decoder",
     "HwfocError",

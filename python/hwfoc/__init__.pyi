@@ -16,9 +16,14 @@ DEFAULT_CURRENT_SCALE: float
 DEFAULT_POLE_PAIRS: int
 #: The default of every ``gear_ratio`` argument: motor turns per output shaft turn.
 DEFAULT_GEAR_RATIO: float
+#: The default of every ``v4_volts_per_step`` argument, ``"8/910"``: volts per voltage ADC step
+#: of a Platinum V4 ESC until its info frame is adopted (the ``hwfoc`` command's
+#: ``--v4-volts-per-step``; ``"low"`` is 8/910, ``"hv"`` 11/650 for HV models).
+DEFAULT_V4_VOLTS_PER_STEP: str
 #: The names every ``protocol`` argument takes (``"hw-foc"``: an ESC's own wire, 19200 baud;
-#: ``"datalink"``: a DataLink V2 hub, 115200 baud), as the command's ``--protocol``. The
-#: default, None, recognises every protocol from the bytes.
+#: ``"datalink"``: a DataLink V2 hub, 115200 baud; ``"hw-v4"`` and ``"hw-v3"``: Platinum V4 and
+#: V3, 19200 baud; ``"hw5"``: HW5, 115200 baud), as the command's ``--protocol``. The default,
+#: None, recognises every protocol from the bytes.
 PROTOCOLS: Tuple[str, ...]
 
 #: One input: a path, bytes in memory, or a binary file object.
@@ -62,6 +67,7 @@ def read(
     current_scale: float = ...,
     pole_pairs: int = ...,
     gear_ratio: float = ...,
+    v4_volts_per_step: str = ...,
     protocol: Optional[str] = None,
 ) -> pa.Table:
     """Reads telemetry whole into a ``pyarrow.Table`` of docs/RECORD-SCHEMA.md's records.
@@ -71,24 +77,28 @@ def read(
     a binary file object, or a list of these read one after another (the files of a rotated
     recording continue each port's stream). ``esc``, ``start`` and ``end`` select as the
     command's ``--esc``, ``--from`` (inclusive) and ``--to`` (exclusive); a time window needs
-    inputs with receive times. The settings convert currents and RPM. ``protocol``: a name of
+    inputs with receive times. The settings convert currents and RPM; ``v4_volts_per_step``
+    (``"N/D"``, ``"low"`` or ``"hv"``, as the command's ``--v4-volts-per-step``) converts a
+    Platinum V4 ESC's voltage until its info frame is adopted. ``protocol``: a name of
     :data:`PROTOCOLS`, to read that protocol's frames only (the bytes of any other are skipped
     bytes), as the command's ``--protocol``; None reads every protocol.
 
-    The columns are record schema version 2's: ``protocol`` a dictionary of strings
-    (``hw-foc``, ``datalink``: a categorical in pandas and polars), ``packet`` uint32, and every
+    The columns are record schema version 2's: ``protocol`` a dictionary of strings (a name of
+    :data:`PROTOCOLS`: a categorical in pandas and polars), ``packet`` uint32, and every
     measurement, ``status`` and ``faults`` nullable (null where the ESC's format does not carry
     it: ``motor_temp_c``, ``bec_temp_c``, ``bec_voltage_v`` and ``bec_current_a`` in every
-    HW-FOC and DataLink record).
+    HW-FOC and DataLink record; all but throttle, eRPM and RPM in a V3 record; ``packet``,
+    output throttle, phase current and ``cap_temp_c`` in an HW5 record, whose ``faults`` are
+    HW5's fault names).
 
     The schema's metadata holds what ``hwfoc decode --format parquet`` writes in its file:
     ``hwfoc_version``, ``record_schema_version`` (``2``), ``current_scale``, ``pole_pairs``,
-    ``gear_ratio``, ``inputs`` and ``escs`` (JSON) and ``filter`` when records were selected;
+    ``gear_ratio``, ``v4_volts_per_step``, ``inputs`` and ``escs`` (JSON) and ``filter`` when records were selected;
     each field has its ``unit``.
 
     Raises InputError (also for a serial port's path: read ports with :func:`open_ports`),
     SelectionError, SettingsError; TypeError for a source of another type; ValueError for a
-    ``protocol`` not in :data:`PROTOCOLS`. Warns HwfocWarning
+    ``protocol`` not in :data:`PROTOCOLS` or a ``v4_volts_per_step`` that is not a fraction. Warns HwfocWarning
     for inputs without frames and for a recording's damage and notes.
     """
 
@@ -102,6 +112,7 @@ def scan(
     current_scale: float = ...,
     pole_pairs: int = ...,
     gear_ratio: float = ...,
+    v4_volts_per_step: str = ...,
     protocol: Optional[str] = None,
 ) -> "Scan":
     """The records of ``sources`` as ``pyarrow.RecordBatch``es of at most ``batch_rows`` rows,
@@ -129,6 +140,7 @@ def summary(
     current_scale: float = ...,
     pole_pairs: int = ...,
     gear_ratio: float = ...,
+    v4_volts_per_step: str = ...,
     protocol: Optional[str] = None,
 ) -> Dict[str, Any]:
     """What ``hwfoc summary --json`` prints for ``source``, as Python objects: the settings,
@@ -137,7 +149,11 @@ def summary(
     :func:`read`."""
 
 def record_schema(
-    *, current_scale: float = ..., pole_pairs: int = ..., gear_ratio: float = ...
+    *,
+    current_scale: float = ...,
+    pole_pairs: int = ...,
+    gear_ratio: float = ...,
+    v4_volts_per_step: str = ...,
 ) -> pa.Schema:
     """The Arrow schema of the records (units in the fields' metadata, settings in the
     schema's)."""
@@ -155,6 +171,7 @@ class Decoder:
         current_scale: float = ...,
         pole_pairs: int = ...,
         gear_ratio: float = ...,
+        v4_volts_per_step: str = ...,
         protocol: Optional[str] = None,
     ) -> None:
         """``esc``: the ``esc`` column of the records; ``baud``: the line's rate, for the time of
@@ -189,6 +206,7 @@ def open_ports(
     current_scale: float = ...,
     pole_pairs: int = ...,
     gear_ratio: float = ...,
+    v4_volts_per_step: str = ...,
     protocol: Optional[str] = None,
 ) -> "Ports":
     """Opens serial ports (8N1) at ``baud`` (by default that of ``protocol``, else 19200), one

@@ -15,6 +15,7 @@ use std::sync::{Arc, Mutex};
 
 use arrow_array::RecordBatch;
 use arrow_pyarrow::{IntoPyArrow, Table};
+use hwfoc::v4::VoltsPerStep;
 use hwfoc::{Protocol, Settings};
 use hwfoc_io::Notice;
 use hwfoc_io::Sources;
@@ -32,13 +33,17 @@ use records::{Collect, Frames, Stop};
 use source::Spec;
 
 /// The defaults of every function's settings arguments (`current_scale`, `pole_pairs`,
-/// `gear_ratio`), those of the library: Python has them as `hwfoc.DEFAULT_CURRENT_SCALE`,
-/// `DEFAULT_POLE_PAIRS` and `DEFAULT_GEAR_RATIO`.
+/// `gear_ratio`, `v4_volts_per_step`), those of the library: Python has them as
+/// `hwfoc.DEFAULT_CURRENT_SCALE`, `DEFAULT_POLE_PAIRS`, `DEFAULT_GEAR_RATIO` and
+/// `DEFAULT_V4_VOLTS_PER_STEP`.
 pub(crate) const CURRENT_SCALE: f32 = Settings::DEFAULT.current_scale;
 /// See [`CURRENT_SCALE`].
 pub(crate) const POLE_PAIRS: u16 = Settings::DEFAULT.pole_pairs;
 /// See [`CURRENT_SCALE`].
 pub(crate) const GEAR_RATIO: f32 = Settings::DEFAULT.gear_ratio;
+/// See [`CURRENT_SCALE`]: the text of [`VoltsPerStep::DEFAULT`] (the module's
+/// `DEFAULT_V4_VOLTS_PER_STEP` is made from the library's value, and a test checks they agree).
+pub(crate) const V4_VOLTS_PER_STEP: &str = "8/910";
 
 /// Rows per record batch of `read`'s table: blocks converted side by side on the workers. A
 /// block of frames this size (under 2 MiB: 29 bytes a frame) stays in a core's L2 cache while
@@ -63,12 +68,8 @@ impl Options {
         esc: Option<&Bound<'_, PyAny>>,
         start: Option<&Bound<'_, PyAny>>,
         end: Option<&Bound<'_, PyAny>>,
-        current_scale: f32,
-        pole_pairs: u16,
-        gear_ratio: f32,
+        settings: Settings,
     ) -> PyResult<Options> {
-        let settings =
-            Settings::new(current_scale, pole_pairs, gear_ratio).map_err(errors::settings)?;
         let escs = escs_arg(esc)?;
         let from = time_arg(start)?;
         let to = time_arg(end)?;
@@ -97,6 +98,27 @@ impl Options {
             self.filter.clone(),
         )
     }
+}
+
+/// The conversion settings of a call, checked: `current_scale`, `pole_pairs` and `gear_ratio`
+/// out of range are a `SettingsError` worded as the command's; `v4_volts_per_step` (`"N/D"`,
+/// `"low"` or `"hv"`, as the command's `--v4-volts-per-step`) that is none of these is a
+/// `ValueError` naming the argument.
+pub(crate) fn settings_arg(
+    current_scale: f32,
+    pole_pairs: u16,
+    gear_ratio: f32,
+    v4_volts_per_step: &str,
+) -> PyResult<Settings> {
+    let settings =
+        Settings::new(current_scale, pole_pairs, gear_ratio).map_err(errors::settings)?;
+    let v4_volts_per_step = v4_volts_per_step.parse::<VoltsPerStep>().map_err(|e| {
+        PyValueError::new_err(format!("v4_volts_per_step: {v4_volts_per_step:?}: {e}"))
+    })?;
+    Ok(Settings {
+        v4_volts_per_step,
+        ..settings
+    })
 }
 
 /// `esc=`: an ESC index or a list of them.
@@ -336,7 +358,7 @@ pub(crate) fn stop_error(stop: Stop) -> PyErr {
 /// SelectionError, SettingsError, ValueError for an unknown protocol; warns HwfocWarning for
 /// inputs without frames and for damage or notes in a recording.
 #[pyfunction]
-#[pyo3(signature = (source, *, esc=None, start=None, end=None, current_scale=CURRENT_SCALE, pole_pairs=POLE_PAIRS, gear_ratio=GEAR_RATIO, protocol=None), text_signature = "(source, *, esc=None, start=None, end=None, current_scale=DEFAULT_CURRENT_SCALE, pole_pairs=DEFAULT_POLE_PAIRS, gear_ratio=DEFAULT_GEAR_RATIO, protocol=None)")]
+#[pyo3(signature = (source, *, esc=None, start=None, end=None, current_scale=CURRENT_SCALE, pole_pairs=POLE_PAIRS, gear_ratio=GEAR_RATIO, v4_volts_per_step=V4_VOLTS_PER_STEP, protocol=None), text_signature = "(source, *, esc=None, start=None, end=None, current_scale=DEFAULT_CURRENT_SCALE, pole_pairs=DEFAULT_POLE_PAIRS, gear_ratio=DEFAULT_GEAR_RATIO, v4_volts_per_step=DEFAULT_V4_VOLTS_PER_STEP, protocol=None)")]
 #[allow(clippy::too_many_arguments)]
 fn read<'py>(
     py: Python<'py>,
@@ -347,10 +369,11 @@ fn read<'py>(
     current_scale: f32,
     pole_pairs: u16,
     gear_ratio: f32,
+    v4_volts_per_step: &str,
     protocol: Option<&str>,
 ) -> PyResult<Bound<'py, PyAny>> {
-    let options =
-        Options::new(esc, start, end, current_scale, pole_pairs, gear_ratio)?.forced(protocol)?;
+    let settings = settings_arg(current_scale, pole_pairs, gear_ratio, v4_volts_per_step)?;
+    let options = Options::new(esc, start, end, settings)?.forced(protocol)?;
     let specs = source::specs(source)?;
     let provenance = options.provenance(&specs);
     let notes = Notes::default();
@@ -390,17 +413,17 @@ fn summary_json(
 /// settings, inputs, and per ESC its link statistics, field ranges, faults and fault episodes;
 /// `protocol` as `read`'s. Raises InputError, ValueError for an unknown protocol.
 #[pyfunction]
-#[pyo3(signature = (source, *, current_scale=CURRENT_SCALE, pole_pairs=POLE_PAIRS, gear_ratio=GEAR_RATIO, protocol=None), text_signature = "(source, *, current_scale=DEFAULT_CURRENT_SCALE, pole_pairs=DEFAULT_POLE_PAIRS, gear_ratio=DEFAULT_GEAR_RATIO, protocol=None)")]
+#[pyo3(signature = (source, *, current_scale=CURRENT_SCALE, pole_pairs=POLE_PAIRS, gear_ratio=GEAR_RATIO, v4_volts_per_step=V4_VOLTS_PER_STEP, protocol=None), text_signature = "(source, *, current_scale=DEFAULT_CURRENT_SCALE, pole_pairs=DEFAULT_POLE_PAIRS, gear_ratio=DEFAULT_GEAR_RATIO, v4_volts_per_step=DEFAULT_V4_VOLTS_PER_STEP, protocol=None)")]
 fn summary<'py>(
     py: Python<'py>,
     source: &Bound<'py, PyAny>,
     current_scale: f32,
     pole_pairs: u16,
     gear_ratio: f32,
+    v4_volts_per_step: &str,
     protocol: Option<&str>,
 ) -> PyResult<Bound<'py, PyAny>> {
-    let settings =
-        Settings::new(current_scale, pole_pairs, gear_ratio).map_err(errors::settings)?;
+    let settings = settings_arg(current_scale, pole_pairs, gear_ratio, v4_volts_per_step)?;
     let protocol = protocol_arg(protocol)?;
     let specs = source::specs(source)?;
     let notes = Notes::default();
@@ -413,15 +436,15 @@ fn summary<'py>(
 /// The Arrow schema of the records (names, types, nullability, units in the fields' metadata),
 /// with the settings in its metadata.
 #[pyfunction]
-#[pyo3(signature = (*, current_scale=CURRENT_SCALE, pole_pairs=POLE_PAIRS, gear_ratio=GEAR_RATIO), text_signature = "(*, current_scale=DEFAULT_CURRENT_SCALE, pole_pairs=DEFAULT_POLE_PAIRS, gear_ratio=DEFAULT_GEAR_RATIO)")]
-fn record_schema(
-    py: Python<'_>,
+#[pyo3(signature = (*, current_scale=CURRENT_SCALE, pole_pairs=POLE_PAIRS, gear_ratio=GEAR_RATIO, v4_volts_per_step=V4_VOLTS_PER_STEP), text_signature = "(*, current_scale=DEFAULT_CURRENT_SCALE, pole_pairs=DEFAULT_POLE_PAIRS, gear_ratio=DEFAULT_GEAR_RATIO, v4_volts_per_step=DEFAULT_V4_VOLTS_PER_STEP)")]
+fn record_schema<'py>(
+    py: Python<'py>,
     current_scale: f32,
     pole_pairs: u16,
     gear_ratio: f32,
-) -> PyResult<Bound<'_, PyAny>> {
-    let settings =
-        Settings::new(current_scale, pole_pairs, gear_ratio).map_err(errors::settings)?;
+    v4_volts_per_step: &str,
+) -> PyResult<Bound<'py, PyAny>> {
+    let settings = settings_arg(current_scale, pole_pairs, gear_ratio, v4_volts_per_step)?;
     let provenance = Provenance::new(settings, Vec::new(), String::new());
     let schema = provenance.schema(None);
     arrow_pyarrow::ToPyArrow::to_pyarrow(schema.as_ref(), py)
@@ -450,6 +473,10 @@ fn _hwfoc(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("DEFAULT_CURRENT_SCALE", CURRENT_SCALE)?;
     m.add("DEFAULT_POLE_PAIRS", POLE_PAIRS)?;
     m.add("DEFAULT_GEAR_RATIO", GEAR_RATIO)?;
+    m.add(
+        "DEFAULT_V4_VOLTS_PER_STEP",
+        Settings::DEFAULT.v4_volts_per_step.to_string(),
+    )?;
     let protocols: Vec<&str> = Protocol::ALL.iter().map(|p| p.name()).collect();
     m.add("PROTOCOLS", pyo3::types::PyTuple::new(py, protocols)?)?;
     Ok(())

@@ -2,7 +2,7 @@
 //! serial ports read as `hwfoc monitor` reads them (`PortSet`: a reader thread per port that
 //! survives unplugging; `PortStreams`: a timed decoding stream per port).
 
-use crate::{CURRENT_SCALE, GEAR_RATIO, POLE_PAIRS};
+use crate::{CURRENT_SCALE, GEAR_RATIO, POLE_PAIRS, V4_VOLTS_PER_STEP};
 use std::collections::VecDeque;
 use std::sync::Mutex;
 use std::time::Duration;
@@ -120,17 +120,18 @@ impl Decoder {
 #[pymethods]
 impl Decoder {
     #[new]
-    #[pyo3(signature = (*, esc=0, baud=None, current_scale=CURRENT_SCALE, pole_pairs=POLE_PAIRS, gear_ratio=GEAR_RATIO, protocol=None), text_signature = "(*, esc=0, baud=None, current_scale=DEFAULT_CURRENT_SCALE, pole_pairs=DEFAULT_POLE_PAIRS, gear_ratio=DEFAULT_GEAR_RATIO, protocol=None)")]
+    #[pyo3(signature = (*, esc=0, baud=None, current_scale=CURRENT_SCALE, pole_pairs=POLE_PAIRS, gear_ratio=GEAR_RATIO, v4_volts_per_step=V4_VOLTS_PER_STEP, protocol=None), text_signature = "(*, esc=0, baud=None, current_scale=DEFAULT_CURRENT_SCALE, pole_pairs=DEFAULT_POLE_PAIRS, gear_ratio=DEFAULT_GEAR_RATIO, v4_volts_per_step=DEFAULT_V4_VOLTS_PER_STEP, protocol=None)")]
     fn new(
         esc: u8,
         baud: Option<u32>,
         current_scale: f32,
         pole_pairs: u16,
         gear_ratio: f32,
+        v4_volts_per_step: &str,
         protocol: Option<&str>,
     ) -> PyResult<Self> {
         let settings =
-            Settings::new(current_scale, pole_pairs, gear_ratio).map_err(errors::settings)?;
+            crate::settings_arg(current_scale, pole_pairs, gear_ratio, v4_volts_per_step)?;
         let protocol = crate::protocol_arg(protocol)?;
         let baud = crate::baud_arg(baud, protocol)?;
         Ok(Decoder {
@@ -249,7 +250,8 @@ pub struct Ports {
 
 /// Opens serial ports: see `hwfoc.open_ports`.
 #[pyfunction]
-#[pyo3(signature = (ports, *, baud=None, current_scale=CURRENT_SCALE, pole_pairs=POLE_PAIRS, gear_ratio=GEAR_RATIO, protocol=None), text_signature = "(ports, *, baud=None, current_scale=DEFAULT_CURRENT_SCALE, pole_pairs=DEFAULT_POLE_PAIRS, gear_ratio=DEFAULT_GEAR_RATIO, protocol=None)")]
+#[allow(clippy::too_many_arguments)]
+#[pyo3(signature = (ports, *, baud=None, current_scale=CURRENT_SCALE, pole_pairs=POLE_PAIRS, gear_ratio=GEAR_RATIO, v4_volts_per_step=V4_VOLTS_PER_STEP, protocol=None), text_signature = "(ports, *, baud=None, current_scale=DEFAULT_CURRENT_SCALE, pole_pairs=DEFAULT_POLE_PAIRS, gear_ratio=DEFAULT_GEAR_RATIO, v4_volts_per_step=DEFAULT_V4_VOLTS_PER_STEP, protocol=None)")]
 pub fn open_ports(
     py: Python<'_>,
     ports: Vec<String>,
@@ -257,10 +259,10 @@ pub fn open_ports(
     current_scale: f32,
     pole_pairs: u16,
     gear_ratio: f32,
+    v4_volts_per_step: &str,
     protocol: Option<&str>,
 ) -> PyResult<Ports> {
-    let settings =
-        Settings::new(current_scale, pole_pairs, gear_ratio).map_err(errors::settings)?;
+    let settings = crate::settings_arg(current_scale, pole_pairs, gear_ratio, v4_volts_per_step)?;
     if ports.is_empty() {
         return Err(PyValueError::new_err("no port given"));
     }

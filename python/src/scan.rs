@@ -3,7 +3,7 @@
 //! and converts each block of frames into a record batch, handing them over a channel of
 //! `QUEUE` batches; the iterator waits for the next with the interpreter's lock released.
 
-use crate::{CURRENT_SCALE, GEAR_RATIO, POLE_PAIRS};
+use crate::{CURRENT_SCALE, GEAR_RATIO, POLE_PAIRS, V4_VOLTS_PER_STEP};
 use std::sync::Mutex;
 use std::sync::mpsc::{Receiver, RecvTimeoutError, sync_channel};
 use std::time::Duration;
@@ -106,7 +106,7 @@ fn produce(
 /// batches ahead. Errors opening the inputs are raised at once, later ones by the iterator after
 /// the batches before them.
 #[pyfunction]
-#[pyo3(signature = (sources, *, batch_rows=65536, esc=None, start=None, end=None, current_scale=CURRENT_SCALE, pole_pairs=POLE_PAIRS, gear_ratio=GEAR_RATIO, protocol=None), text_signature = "(sources, *, batch_rows=65536, esc=None, start=None, end=None, current_scale=DEFAULT_CURRENT_SCALE, pole_pairs=DEFAULT_POLE_PAIRS, gear_ratio=DEFAULT_GEAR_RATIO, protocol=None)")]
+#[pyo3(signature = (sources, *, batch_rows=65536, esc=None, start=None, end=None, current_scale=CURRENT_SCALE, pole_pairs=POLE_PAIRS, gear_ratio=GEAR_RATIO, v4_volts_per_step=V4_VOLTS_PER_STEP, protocol=None), text_signature = "(sources, *, batch_rows=65536, esc=None, start=None, end=None, current_scale=DEFAULT_CURRENT_SCALE, pole_pairs=DEFAULT_POLE_PAIRS, gear_ratio=DEFAULT_GEAR_RATIO, v4_volts_per_step=DEFAULT_V4_VOLTS_PER_STEP, protocol=None)")]
 #[allow(clippy::too_many_arguments)]
 pub fn scan(
     py: Python<'_>,
@@ -118,13 +118,14 @@ pub fn scan(
     current_scale: f32,
     pole_pairs: u16,
     gear_ratio: f32,
+    v4_volts_per_step: &str,
     protocol: Option<&str>,
 ) -> PyResult<Scan> {
     if batch_rows == 0 {
         return Err(PyValueError::new_err("batch_rows must be at least 1"));
     }
-    let options =
-        Options::new(esc, start, end, current_scale, pole_pairs, gear_ratio)?.forced(protocol)?;
+    let settings = crate::settings_arg(current_scale, pole_pairs, gear_ratio, v4_volts_per_step)?;
+    let options = Options::new(esc, start, end, settings)?.forced(protocol)?;
     let specs = crate::source::specs(sources)?;
     // The batches' metadata: the ESCs are known only at the end, so `escs` is not in it.
     let schema = options.provenance(&specs).schema(None);

@@ -30,14 +30,15 @@ def test_real_captures_equal_decode(cli, capture):
 
 
 def test_the_real_captures_hold_frames():
-    # The comparison above is not empty: the X-Rotor capture has HW-FOC data frames (the
-    # Platinum captures are another protocol: no frame, a warning, as the command says).
-    sizes = []
+    # The comparison above is not empty: the Platinum Pro V3 and Platinum V4 captures and the
+    # X-Rotor capture's HW-FOC frames, each with its protocol (test_protocols.py reads them).
+    sizes, protocols = [], []
     for c in CAPTURES:
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore", hwfoc.HwfocWarning)
-            sizes.append(hwfoc.read(str(c)).num_rows)
-    assert sizes == [0, 0, 248], sizes
+        table = hwfoc.read(str(c))
+        sizes.append(table.num_rows)
+        protocols.append(set(table.column("protocol").to_pylist()))
+    assert sizes == [699, 297, 248], sizes
+    assert protocols == [{"hw-v3"}, {"hw-v4"}, {"hw-foc"}], protocols
 
 
 @pytest.mark.parametrize("name", ["three.pcapng", "one.bin"])
@@ -88,18 +89,20 @@ def test_settings_change_values_and_metadata(cli, sim_dir):
 
 
 def test_the_default_settings_are_the_librarys(sim_dir):
-    # docs/RECORD-SCHEMA.md: current scale 64, 7 pole pairs, gear ratio 1.
-    defaults = (hwfoc.DEFAULT_CURRENT_SCALE, hwfoc.DEFAULT_POLE_PAIRS, hwfoc.DEFAULT_GEAR_RATIO)
-    assert defaults == (64.0, 7, 1.0)
+    # docs/RECORD-SCHEMA.md: current scale 64, 7 pole pairs, gear ratio 1, 8/910 V per V4 step.
+    defaults = (hwfoc.DEFAULT_CURRENT_SCALE, hwfoc.DEFAULT_POLE_PAIRS, hwfoc.DEFAULT_GEAR_RATIO,
+                hwfoc.DEFAULT_V4_VOLTS_PER_STEP)
+    assert defaults == (64.0, 7, 1.0, "8/910")
     assert isinstance(hwfoc.DEFAULT_POLE_PAIRS, int)
     meta = hwfoc.record_schema().metadata
-    assert (meta[b"current_scale"], meta[b"pole_pairs"], meta[b"gear_ratio"]) == (b"64", b"7", b"1")
+    names = ("current_scale", "pole_pairs", "gear_ratio", "v4_volts_per_step")
+    assert tuple(meta[name.encode()] for name in names) == (b"64", b"7", b"1", b"8/910")
     for f in (hwfoc.read, hwfoc.scan, hwfoc.summary, hwfoc.record_schema, hwfoc.Decoder, hwfoc.open_ports):
         params = inspect.signature(f).parameters
-        got = tuple(params[name].default for name in ("current_scale", "pole_pairs", "gear_ratio"))
+        got = tuple(params[name].default for name in names)
         assert got == defaults, f
     path = sim_dir / "one.bin"
-    given = hwfoc.read(path, current_scale=defaults[0], pole_pairs=defaults[1], gear_ratio=defaults[2])
+    given = hwfoc.read(path, **dict(zip(names, defaults)))
     assert given.equals(hwfoc.read(path))
 
 
@@ -399,11 +402,20 @@ def test_a_forced_protocol_that_finds_nothing_warns_with_its_advice(mixed):
 
 
 def test_protocol_names_and_their_defaults():
-    assert hwfoc.PROTOCOLS == ("hw-foc", "datalink")
+    assert hwfoc.PROTOCOLS == ("hw-foc", "datalink", "hw-v4", "hw-v3", "hw5")
     for f in (hwfoc.read, hwfoc.scan, hwfoc.summary, hwfoc.Decoder, hwfoc.open_ports):
         assert inspect.signature(f).parameters["protocol"].default is None, f
-    for call in (lambda: hwfoc.read(b"", protocol="hw5"), lambda: hwfoc.scan(b"", protocol="HW5"),
+    for call in (lambda: hwfoc.read(b"", protocol="hw4"), lambda: hwfoc.scan(b"", protocol="v3"),
                  lambda: hwfoc.summary(b"", protocol="dl"), lambda: hwfoc.Decoder(protocol="x"),
                  lambda: hwfoc.open_ports(["/dev/null"], protocol="x")):
-        with pytest.raises(ValueError, match=r'protocol: ".*" is not a protocol: give one of "hw-foc", "datalink"'):
+        with pytest.raises(ValueError, match=r'protocol: ".*" is not a protocol: give one of "hw-foc", '
+                                             r'"datalink", "hw-v4", "hw-v3", "hw5"'):
             call()
+    # Every name is taken (any case), by every function.
+    for name in hwfoc.PROTOCOLS + ("HW5", "Hw-V4"):
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", hwfoc.HwfocWarning)
+            assert hwfoc.read(b"\0", protocol=name).num_rows == 0
+            assert list(hwfoc.scan(b"\0", protocol=name)) == []
+            assert hwfoc.summary(b"\0", protocol=name)["escs"][0]["frames"] == 0
+        assert hwfoc.Decoder(protocol=name).finish().num_rows == 0

@@ -1,8 +1,10 @@
 //! The Wireshark dissector (`hwfoc wireshark`), run by tshark on recordings: every frame it shows
 //! as valid has exactly the values `hwfoc decode` gives (data frames) and the codec reads (device
 //! information), with the same time, in recordings of the compact layout and of the
-//! read-chunk layout; bad checksums show as bad, faults by name; `install` puts it where tshark
-//! loads it and never replaces another file unasked.
+//! read-chunk layout; bad checksums show as bad, faults by name; the older formats (the Platinum
+//! V4 and V3 captures, an HW5 stream) recorded as `hwfoc record` cuts their bytes, frame for
+//! frame as `hwfoc decode` reads them; `install` puts it where tshark loads it and never
+//! replaces another file unasked.
 
 #![cfg(unix)]
 
@@ -935,4 +937,508 @@ fn a_candidate_that_fails_is_given_up_where_the_decoder_gives_it_up() {
         .filter(|s| s["frame.interface_id"] == "0")
         .count();
     assert_eq!(infos, 1, "device-information frames of port 0");
+}
+
+/// The bytes of a logic-analyser CSV capture of `testdata/captures/`, each with its time (s).
+fn capture(name: &str) -> Vec<(f64, u8)> {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../testdata/captures")
+        .join(name);
+    std::fs::read_to_string(path)
+        .unwrap()
+        .lines()
+        .skip(1)
+        .map(|line| {
+            let mut cols = line.split(',');
+            let t = cols.next().unwrap().parse::<f64>().unwrap();
+            let v = u8::from_str_radix(cols.next().unwrap().trim_start_matches("0x"), 16).unwrap();
+            (t, v)
+        })
+        .collect()
+}
+
+/// Records `bytes` (times in seconds after `start_ns`) as `hwfoc record` does: reads of 1 to
+/// 40 bytes, each written at its first byte's time through the pcapng writer's cutter, so
+/// frames of the older formats lie across packets.
+fn record_reads(file: &Path, baud: u32, start_ns: u64, bytes: &[(f64, u8)], seed: u64) {
+    let mut w = pcapng::Writer::new(std::fs::File::create(file).unwrap()).unwrap();
+    let iface = w.add_interface("/dev/ttyUSB0", baud).unwrap();
+    let mut rng = hwfoc_sim::rng::Rng::for_esc(seed, 0, hwfoc_sim::rng::Purpose::Link);
+    let mut rest = bytes;
+    while !rest.is_empty() {
+        let n = (1 + rng.below(40) as usize).min(rest.len());
+        let t_ns = start_ns + (rest[0].0 * 1e9).round() as u64;
+        let data: Vec<u8> = rest[..n].iter().map(|&(_, b)| b).collect();
+        w.write(iface, t_ns, &data).unwrap();
+        rest = &rest[n..];
+    }
+    w.into_inner().unwrap();
+}
+
+/// The fields a frame of `protocol` and `kind` always has, among `fields`.
+fn applies(protocol: &str, kind: &str, field: &str) -> bool {
+    match (protocol, kind, field) {
+        (_, _, "hwfoc.protocol" | "hwfoc.kind" | "hwfoc.time_epoch") => true,
+        ("hw-v4", "data", f) => matches!(
+            f,
+            "hwfoc.packet"
+                | "hwfoc.throttle_in_pct"
+                | "hwfoc.throttle_out_pct"
+                | "hwfoc.erpm"
+                | "hwfoc.rpm"
+                | "hwfoc.voltage_v"
+                | "hwfoc.v4.temp_adc"
+                | "hwfoc.v4.temp2_adc"
+        ),
+        ("hw-v4", "info", f) => matches!(f, "hwfoc.v4.full_scale" | "hwfoc.v4.volts_per_step"),
+        ("hw-v3", "data", f) => matches!(
+            f,
+            "hwfoc.packet"
+                | "hwfoc.throttle_in_pct"
+                | "hwfoc.throttle_out_pct"
+                | "hwfoc.v3.period_us"
+        ),
+        ("hw5", "data", f) => matches!(
+            f,
+            "hwfoc.throttle_in_pct"
+                | "hwfoc.erpm"
+                | "hwfoc.rpm"
+                | "hwfoc.voltage_v"
+                | "hwfoc.current_a"
+                | "hwfoc.mos_temp_c"
+                | "hwfoc.motor_temp_c"
+                | "hwfoc.bec_temp_c"
+                | "hwfoc.bec_voltage_v"
+                | "hwfoc.bec_current_a"
+                | "hwfoc.status"
+                | "hwfoc.faults"
+                | "hwfoc.checksum.status"
+        ),
+        _ => false,
+    }
+}
+
+/// The fields of [`OLDER_FIELDS`] every frame of `protocol` has (of one kind or another).
+fn fields_of(protocol: &str) -> Vec<&'static str> {
+    OLDER_FIELDS
+        .into_iter()
+        .filter(|f| {
+            ["data", "info"]
+                .iter()
+                .any(|kind| applies(protocol, kind, f))
+        })
+        .collect()
+}
+
+/// Every frame of the older formats tshark shows in `file` (fields `fields`, which begin with
+/// protocol and kind), in order; the values of fields a frame of its kind always has.
+fn older_frames(file: &Path, options: &[&str], fields: &[&'static str]) -> Vec<Shown> {
+    let mut cmd = Command::new("tshark");
+    cmd.arg("-X")
+        .arg(format!("lua_script:{}", dissector().display()))
+        .args(options)
+        .arg("-r")
+        .arg(file)
+        .args(["-T", "fields", "-E", "occurrence=a", "-E", "aggregator=;"])
+        .args(["-E", "separator=/t"]);
+    for f in fields {
+        cmd.args(["-e", f]);
+    }
+    let out = cmd.output().expect("tshark");
+    assert!(
+        out.status.success(),
+        "tshark: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!err.contains("Lua") && !err.contains("rror"), "{err}");
+    let mut frames = Vec::new();
+    for line in String::from_utf8(out.stdout).unwrap().lines() {
+        let cols: Vec<&str> = line.split('\t').collect();
+        assert_eq!(cols.len(), fields.len(), "{line}");
+        let mut queues: Vec<std::collections::VecDeque<&str>> = cols
+            .iter()
+            .map(|c| c.split(';').filter(|v| !v.is_empty()).collect())
+            .collect();
+        while let Some(protocol) = queues[0].pop_front() {
+            let kind = queues[1].pop_front().expect(line);
+            let mut shown = Shown::new();
+            shown.insert("hwfoc.protocol", protocol.to_string());
+            shown.insert("hwfoc.kind", kind.to_string());
+            for (i, f) in fields.iter().enumerate().skip(2) {
+                let v = if applies(protocol, kind, f) {
+                    queues[i]
+                        .pop_front()
+                        .unwrap_or_else(|| panic!("{f} in {line}"))
+                } else {
+                    ""
+                };
+                shown.insert(f, v.to_string());
+            }
+            frames.push(shown);
+        }
+        assert!(
+            queues.iter().all(|q| q.is_empty()),
+            "fields left over in {line}"
+        );
+    }
+    frames
+}
+
+/// Asserts that `got` (a number tshark shows) is `want` (a record's value) as the f32 it is.
+fn same_value(got: &str, want: &Value, what: &str) {
+    assert_eq!(
+        as_f32(got),
+        want.as_f64().unwrap_or_else(|| panic!("{what}: null")) as f32,
+        "{what}"
+    );
+}
+
+fn same_time(shown: &Shown, record: &Value, what: &str) {
+    let t = uint(&shown["hwfoc.time_epoch"].replace('.', "")) as f64 * 1e-9;
+    let dt = (t - record["t_s"].as_f64().unwrap()).abs();
+    assert!(dt < 1e-6, "{what}: time differs by {dt} s");
+}
+
+const OLDER_FIELDS: [&str; 23] = [
+    "hwfoc.protocol",
+    "hwfoc.kind",
+    "hwfoc.time_epoch",
+    "hwfoc.packet",
+    "hwfoc.throttle_in_pct",
+    "hwfoc.throttle_out_pct",
+    "hwfoc.erpm",
+    "hwfoc.rpm",
+    "hwfoc.voltage_v",
+    "hwfoc.current_a",
+    "hwfoc.mos_temp_c",
+    "hwfoc.motor_temp_c",
+    "hwfoc.bec_temp_c",
+    "hwfoc.bec_voltage_v",
+    "hwfoc.bec_current_a",
+    "hwfoc.status",
+    "hwfoc.faults",
+    "hwfoc.checksum.status",
+    "hwfoc.v4.temp_adc",
+    "hwfoc.v4.temp2_adc",
+    "hwfoc.v4.full_scale",
+    "hwfoc.v4.volts_per_step",
+    "hwfoc.v3.period_us",
+];
+
+/// The Platinum V4 capture recorded in reads cut anywhere: the dissector shows its 297 data
+/// frames with `hwfoc decode`'s values and times, its 26 info frames, and no checksum.
+#[test]
+#[ignore = "needs tshark: .ci/run installs it and runs these with --ignored"]
+fn a_platinum_v4_recording_dissects_as_decode_reads_it() {
+    need_tshark();
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("v4.pcapng");
+    record_reads(
+        &file,
+        19200,
+        1_754_000_000_000_000_000,
+        &capture("platinum-v4.csv"),
+        4,
+    );
+    let shown = older_frames(&file, &[], &fields_of("hw-v4"));
+    let decoded = decode(&file, &["--format", "jsonl"]);
+    assert_eq!(decoded.len(), 297);
+    let data: Vec<&Shown> = shown.iter().filter(|s| s["hwfoc.kind"] == "data").collect();
+    let info: Vec<&Shown> = shown.iter().filter(|s| s["hwfoc.kind"] == "info").collect();
+    assert!(shown.iter().all(|s| s["hwfoc.protocol"] == "hw-v4"));
+    assert_eq!(data.len(), decoded.len(), "data frames");
+    assert_eq!(info.len(), 26, "info frames");
+    assert!(
+        info.iter()
+            .all(|s| s["hwfoc.v4.full_scale"] == "1000" && s["hwfoc.v4.volts_per_step"] == "8/910")
+    );
+    for (s, r) in data.iter().zip(&decoded) {
+        let what = format!("packet {}", r["packet"]);
+        assert_eq!(
+            uint(&s["hwfoc.packet"]),
+            r["packet"].as_u64().unwrap(),
+            "{what}"
+        );
+        assert_eq!(
+            uint(&s["hwfoc.erpm"]),
+            r["erpm"].as_u64().unwrap(),
+            "{what}"
+        );
+        for (field, column) in [
+            ("hwfoc.throttle_in_pct", "throttle_in_pct"),
+            ("hwfoc.throttle_out_pct", "throttle_out_pct"),
+            ("hwfoc.rpm", "rpm"),
+            ("hwfoc.voltage_v", "voltage_v"),
+        ] {
+            same_value(&s[field], &r[column], &format!("{what}: {column}"));
+        }
+        assert_eq!(r["protocol"], "hw-v4");
+        same_time(s, r, &what);
+    }
+    let peak = data
+        .iter()
+        .map(|s| as_f32(&s["hwfoc.throttle_in_pct"]))
+        .fold(0.0, f32::max);
+    assert_eq!(peak, 100.0);
+    // The temperatures, for the packets of one data frame (aggregated fields are told apart by
+    // their presence only there): as hwfoc decodes them; an ADC value of 0 is no reading.
+    let temps = Command::new("tshark")
+        .arg("-X")
+        .arg(format!("lua_script:{}", dissector().display()))
+        .arg("-r")
+        .arg(&file)
+        .args(["-Y", "count(hwfoc.kind) == 1 && hwfoc.kind == \"data\""])
+        .args(["-T", "fields", "-E", "separator=/t"])
+        .args([
+            "-e",
+            "hwfoc.packet",
+            "-e",
+            "hwfoc.mos_temp_c",
+            "-e",
+            "hwfoc.cap_temp_c",
+        ])
+        .args(["-e", "hwfoc.v4.temp2_adc"])
+        .output()
+        .unwrap();
+    let temps = String::from_utf8(temps.stdout).unwrap();
+    assert!(
+        temps.lines().count() > 100,
+        "{} packets of one data frame",
+        temps.lines().count()
+    );
+    let mut cap = 0;
+    for line in temps.lines() {
+        let cols: Vec<&str> = line.split('\t').collect();
+        let r = decoded
+            .iter()
+            .find(|r| r["packet"].as_u64() == Some(uint(cols[0])))
+            .unwrap();
+        let got = as_f32(cols[1]);
+        let want = r["mos_temp_c"].as_f64().unwrap() as f32;
+        assert!(
+            (got - want).abs() < 1e-4,
+            "packet {}: {got} {want}",
+            r["packet"]
+        );
+        // The second temperature: an ADC value of 0 (at idle in the capture) is no reading.
+        match r["cap_temp_c"].as_f64() {
+            Some(want) => assert!((as_f32(cols[2]) - want as f32).abs() < 1e-4, "{line}"),
+            None => assert_eq!((cols[2], cols[3]), ("", "0"), "{line}"),
+        }
+        cap += usize::from(!r["cap_temp_c"].is_null());
+    }
+    assert!(cap > 10, "{cap} second temperatures");
+    // No checksum in the format: the tree says so; the preference converts voltages.
+    let none = Command::new("tshark")
+        .arg("-X")
+        .arg(format!("lua_script:{}", dissector().display()))
+        .args(["-o", "hwfoc.v4_volts_per_step:hv", "-r"])
+        .arg(&file)
+        .args([
+            "-Y",
+            "hwfoc.no_checksum",
+            "-T",
+            "fields",
+            "-E",
+            "aggregator=;",
+        ])
+        .args(["-e", "hwfoc.voltage_v"])
+        .output()
+        .unwrap();
+    let volts: Vec<f64> = String::from_utf8(none.stdout)
+        .unwrap()
+        .split(['\n', ';'])
+        .filter(|v| !v.is_empty())
+        .map(|v| v.parse().unwrap())
+        .collect();
+    assert_eq!(volts.len(), 297);
+    assert!(volts.iter().all(|v| (22.0..24.0).contains(v)), "{volts:?}");
+}
+
+/// The Platinum Pro V3 capture recorded in reads cut anywhere: its 699 frames, with
+/// `hwfoc decode`'s values and times (no speed where the ESC sends its placeholder).
+#[test]
+#[ignore = "needs tshark: .ci/run installs it and runs these with --ignored"]
+fn a_platinum_v3_recording_dissects_as_decode_reads_it() {
+    need_tshark();
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("v3.pcapng");
+    record_reads(
+        &file,
+        19200,
+        1_754_000_000_000_000_000,
+        &capture("platinum-pro-v3.csv"),
+        3,
+    );
+    let shown = older_frames(&file, &[], &fields_of("hw-v3"));
+    let decoded = decode(&file, &["--format", "jsonl"]);
+    assert_eq!(decoded.len(), 699);
+    assert_eq!(shown.len(), decoded.len(), "frames");
+    let mut placeholders = 0;
+    for (s, r) in shown.iter().zip(&decoded) {
+        let what = format!("packet {}", r["packet"]);
+        assert_eq!(
+            (s["hwfoc.protocol"].as_str(), s["hwfoc.kind"].as_str()),
+            ("hw-v3", "data")
+        );
+        assert_eq!(
+            uint(&s["hwfoc.packet"]),
+            r["packet"].as_u64().unwrap(),
+            "{what}"
+        );
+        for (field, column) in [
+            ("hwfoc.throttle_in_pct", "throttle_in_pct"),
+            ("hwfoc.throttle_out_pct", "throttle_out_pct"),
+        ] {
+            same_value(&s[field], &r[column], &format!("{what}: {column}"));
+        }
+        let period = uint(&s["hwfoc.v3.period_us"]);
+        match r["erpm"].as_u64() {
+            Some(erpm) => assert_eq!(erpm, 60_000_000 / period, "{what}"),
+            None => {
+                assert!(period == 35_314 || period == 0, "{what}");
+                placeholders += 1;
+            }
+        }
+        same_time(s, r, &what);
+    }
+    assert!(placeholders > 0);
+}
+
+/// HW5 telemetry frames (115200 baud) with faults, line noise and a frame with a bad CRC,
+/// recorded in reads cut anywhere: the valid frames are `hwfoc decode`'s records, faults by
+/// HW5's names, the BEC's values; the bad CRC shows as bad.
+#[test]
+#[ignore = "needs tshark: .ci/run installs it and runs these with --ignored"]
+fn an_hw5_recording_dissects_as_decode_reads_it() {
+    use hwfoc::hw5::{Fault, FaultCode, TelemetryFrame};
+    need_tshark();
+    let byte_s = 10.0 / 115_200.0;
+    let mut bytes: Vec<(f64, u8)> = Vec::new();
+    let mut t = 0.0;
+    let mut push = |data: &[u8], gap: f64| {
+        for (k, &b) in data.iter().enumerate() {
+            bytes.push((t + k as f64 * byte_s, b));
+        }
+        t += data.len() as f64 * byte_s + gap;
+    };
+    let mut rng = hwfoc_sim::rng::Rng::for_esc(5, 0, hwfoc_sim::rng::Purpose::Link);
+    for k in 0..120u16 {
+        let mut fault = FaultCode::OK;
+        if (40..50).contains(&k) {
+            fault = fault.with(Fault::LowVoltage);
+        }
+        if k % 37 == 5 {
+            fault = fault
+                .with(Fault::ThrottleSignalLost)
+                .with(Fault::MotorLocked);
+        }
+        let frame = TelemetryFrame {
+            throttle: (k % 101) as u8,
+            fault,
+            erpm_raw: k * 37,
+            voltage_raw: 504 - k,
+            current_raw: rng.below(900) as u16,
+            esc_temp: 30 + (k / 4) as u8,
+            bec_temp: 35,
+            motor_temp: 40 + (k / 3) as u8,
+            bec_voltage_raw: 84,
+            bec_current_raw: (k % 20) as u8,
+            ..Default::default()
+        };
+        let mut encoded = frame.encode();
+        if k == 60 {
+            encoded[17] ^= 0x10;
+        }
+        push(&encoded, 0.02);
+        if k % 25 == 3 {
+            push(&[0x00, 0xFE, 0x01, 0x13, 0x77], 0.001);
+        }
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("hw5.pcapng");
+    record_reads(&file, 115_200, 1_754_000_000_000_000_000, &bytes, 9);
+    let shown = older_frames(&file, &[], &fields_of("hw5"));
+    let decoded = decode(&file, &["--format", "jsonl"]);
+    assert_eq!(decoded.len(), 119);
+    let good: Vec<&Shown> = shown
+        .iter()
+        .filter(|s| s["hwfoc.checksum.status"] == "1")
+        .collect();
+    let bad: Vec<&Shown> = shown
+        .iter()
+        .filter(|s| s["hwfoc.checksum.status"] == "0")
+        .collect();
+    assert_eq!((good.len(), bad.len()), (119, 1));
+    assert!(
+        shown
+            .iter()
+            .all(|s| s["hwfoc.protocol"] == "hw5" && s["hwfoc.kind"] == "data")
+    );
+    for (s, r) in good.iter().zip(&decoded) {
+        let what = format!("t {}", r["t_s"]);
+        assert_eq!(r["protocol"], "hw5");
+        assert_eq!(
+            uint(&s["hwfoc.erpm"]),
+            r["erpm"].as_u64().unwrap(),
+            "{what}"
+        );
+        assert_eq!(
+            uint(&s["hwfoc.status"]),
+            r["status"].as_u64().unwrap(),
+            "{what}"
+        );
+        for (field, column) in [
+            ("hwfoc.throttle_in_pct", "throttle_in_pct"),
+            ("hwfoc.rpm", "rpm"),
+            ("hwfoc.voltage_v", "voltage_v"),
+            ("hwfoc.current_a", "current_a"),
+            ("hwfoc.mos_temp_c", "mos_temp_c"),
+            ("hwfoc.motor_temp_c", "motor_temp_c"),
+            ("hwfoc.bec_temp_c", "bec_temp_c"),
+            ("hwfoc.bec_voltage_v", "bec_voltage_v"),
+            ("hwfoc.bec_current_a", "bec_current_a"),
+        ] {
+            same_value(&s[field], &r[column], &format!("{what}: {column}"));
+        }
+        let faults: Vec<&str> = r["faults"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|f| f.as_str().unwrap())
+            .collect();
+        let faults = if faults.is_empty() {
+            "none".to_string()
+        } else {
+            faults.join(",")
+        };
+        assert_eq!(s["hwfoc.faults"], faults, "{what}");
+        same_time(s, r, &what);
+    }
+    assert!(
+        good.iter()
+            .any(|s| s["hwfoc.faults"] == "motor_locked,throttle_signal_lost")
+    );
+    assert!(good.iter().any(|s| s["hwfoc.faults"] == "low_voltage"));
+    // The fault bits by name, as filters.
+    let named = Command::new("tshark")
+        .arg("-X")
+        .arg(format!("lua_script:{}", dissector().display()))
+        .arg("-r")
+        .arg(&file)
+        .args([
+            "-Y",
+            "hwfoc.hw5.fault.low_voltage == 1",
+            "-T",
+            "fields",
+            "-e",
+            "frame.number",
+        ])
+        .output()
+        .unwrap();
+    assert!(
+        !named.stdout.is_empty(),
+        "no frame with hwfoc.hw5.fault.low_voltage"
+    );
 }
