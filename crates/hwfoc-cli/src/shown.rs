@@ -96,17 +96,10 @@ pub enum Shown {
     Power,
 }
 
-/// The codec's quantities not charted: the electrical RPM (the motor's is), and HW5's motor
-/// and BEC readings (HIDDEN's last four: the monitor shows them as figures for an ESC whose format
-/// carries them; charted and plotted, they would be lines of every panel that only one format
-/// fills). Which of the rest an ESC has follows from its format ([`Shown::carried_by`]).
-const HIDDEN: [Quantity; 5] = [
-    Quantity::Erpm,
-    Quantity::MotorTemp,
-    Quantity::BecTemp,
-    Quantity::BecVoltage,
-    Quantity::BecCurrent,
-];
+/// The codec's quantities not charted: the electrical RPM (the motor's is). Which of the rest
+/// an ESC has follows from its format ([`Shown::carried_by`]): the plot and the dashboard draw
+/// those only (HW5's motor and BEC readings for an HW5 ESC).
+const HIDDEN: [Quantity; 1] = [Quantity::Erpm];
 
 /// How many quantities are shown.
 pub const COUNT: usize = Quantity::ALL.len() - HIDDEN.len() + 1;
@@ -165,6 +158,10 @@ impl Shown {
             Shown::Carried(Quantity::PhaseCurrent) => "phase",
             Shown::Carried(Quantity::MosTemp) => "MOSFET",
             Shown::Carried(Quantity::CapTemp) => "capacitor",
+            Shown::Carried(Quantity::MotorTemp) => "motor",
+            Shown::Carried(Quantity::BecTemp | Quantity::BecVoltage | Quantity::BecCurrent) => {
+                "BEC"
+            }
             Shown::Carried(q) => q.name(),
             Shown::Power => "input",
         }
@@ -246,16 +243,23 @@ mod tests {
                 Shown::Carried(PhaseCurrent),
                 Shown::Carried(MosTemp),
                 Shown::Carried(CapTemp),
+                Shown::Carried(MotorTemp),
+                Shown::Carried(BecTemp),
+                Shown::Carried(BecVoltage),
+                Shown::Carried(BecCurrent),
                 Shown::Power,
             ]
         );
         let of = |m: Measure| -> Vec<&str> { m.shown().map(Shown::legend).collect() };
         assert_eq!(of(Measure::Throttle), ["input", "output"]);
         assert_eq!(of(Measure::Speed), ["rpm"]);
-        assert_eq!(of(Measure::Current), ["input", "phase"]);
+        assert_eq!(of(Measure::Current), ["input", "phase", "BEC"]);
         assert_eq!(of(Measure::Power), ["input"]);
-        assert_eq!(of(Measure::Voltage), ["input"]);
-        assert_eq!(of(Measure::Temperature), ["MOSFET", "capacitor"]);
+        assert_eq!(of(Measure::Voltage), ["input", "BEC"]);
+        assert_eq!(
+            of(Measure::Temperature),
+            ["MOSFET", "capacitor", "motor", "BEC"]
+        );
         for (i, s) in Shown::ALL.iter().enumerate() {
             assert_eq!(s.index(), i);
             assert!(s.measure().is_some(), "{s:?} is in no panel");
@@ -275,11 +279,15 @@ mod tests {
         );
         assert!(!of(hwfoc::Protocol::Hw5).contains(&Shown::Carried(PhaseCurrent)));
         assert!(of(hwfoc::Protocol::Hw5).contains(&Shown::Power));
-        assert_eq!(of(hwfoc::Protocol::HwFoc), Shown::ALL);
-        for q in &HIDDEN[1..] {
-            let q = *q;
-            assert!(hwfoc::Protocol::Hw5.carries(q), "{q:?}");
-            assert!(!hwfoc::Protocol::HwFoc.carries(q), "{q:?}");
+        let extras = [MotorTemp, BecTemp, BecVoltage, BecCurrent].map(Shown::Carried);
+        let hwfoc: Vec<Shown> = Shown::ALL
+            .into_iter()
+            .filter(|s| !extras.contains(s))
+            .collect();
+        assert_eq!(of(hwfoc::Protocol::HwFoc), hwfoc);
+        for s in extras {
+            assert!(s.carried_by(hwfoc::Protocol::Hw5), "{s:?}");
+            assert!(!s.carried_by(hwfoc::Protocol::HwFoc), "{s:?}");
         }
     }
 }

@@ -587,6 +587,10 @@ fn colour(q: Shown) -> Color {
         Shown::Carried(Quantity::Voltage) => Color::Green,
         Shown::Carried(Quantity::MosTemp) => Color::Red,
         Shown::Carried(Quantity::CapTemp) => Color::LightBlue,
+        // HW5's, each apart from the others of its chart.
+        Shown::Carried(Quantity::BecCurrent | Quantity::BecVoltage) => Color::LightCyan,
+        Shown::Carried(Quantity::MotorTemp) => Color::LightMagenta,
+        Shown::Carried(Quantity::BecTemp) => Color::LightCyan,
         _ => Color::Gray,
     }
 }
@@ -923,13 +927,26 @@ mod tests {
             ("RPM".into(), vec![("rpm", Color::Cyan)], true),
             (
                 "Current A".into(),
-                vec![("input", Color::Yellow), ("phase", Color::Magenta)],
+                vec![
+                    ("input", Color::Yellow),
+                    ("phase", Color::Magenta),
+                    ("BEC", Color::LightCyan),
+                ],
                 true,
             ),
-            ("Voltage V".into(), vec![("input", Color::Green)], false),
+            (
+                "Voltage V".into(),
+                vec![("input", Color::Green), ("BEC", Color::LightCyan)],
+                false,
+            ),
             (
                 "Temperature °C".into(),
-                vec![("MOS", Color::Red), ("CAP", Color::LightBlue)],
+                vec![
+                    ("MOS", Color::Red),
+                    ("CAP", Color::LightBlue),
+                    ("motor", Color::LightMagenta),
+                    ("BEC", Color::LightCyan),
+                ],
                 false,
             ),
         ];

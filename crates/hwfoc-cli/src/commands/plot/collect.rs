@@ -503,7 +503,7 @@ mod tests {
     /// Every quantity at the value of a throttle of `raw` (temperatures 79.0 degC).
     fn values_of(raw: u16) -> Values {
         let pct = raw as f32 * 100.0 / 1024.0;
-        [pct, pct, pct, pct, pct, pct, pct, 79.0, 79.0]
+        std::array::from_fn(|i| if i < 7 { pct } else { 79.0 })
     }
 
     fn all() -> Window {

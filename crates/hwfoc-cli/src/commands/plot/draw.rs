@@ -111,6 +111,23 @@ impl Panel {
     }
 }
 
+impl Panel {
+    /// The panel with the lines of the quantities a frame of `protocol` carries (every line
+    /// before a frame told the format).
+    fn carried_by(&self, protocol: Option<hwfoc::Protocol>) -> Panel {
+        Panel {
+            lines: self
+                .lines
+                .iter()
+                .filter(|(q, _, _)| protocol.is_none_or(|p| q.carried_by(p)))
+                .copied()
+                .collect(),
+            axis: self.axis.clone(),
+            ..*self
+        }
+    }
+}
+
 /// How many panels a row has.
 const PANELS: usize = Measure::ALL.len();
 
@@ -126,6 +143,10 @@ fn colour(q: Shown) -> RGBColor {
         Shown::Carried(Quantity::Voltage) => PURPLE,
         Shown::Carried(Quantity::MosTemp) => RED,
         Shown::Carried(Quantity::CapTemp) => TEAL,
+        // HW5's: apart from every HW-FOC line's colour of their panel.
+        Shown::Carried(Quantity::MotorTemp | Quantity::BecVoltage) => ORANGE,
+        Shown::Carried(Quantity::BecTemp) => BLUE,
+        Shown::Carried(Quantity::BecCurrent) => GREEN,
         _ => {
             let Some(m) = q.measure() else {
                 return ORANGE;
@@ -519,8 +540,13 @@ impl<'a> Scene<'a> {
             return Ok(());
         };
         let areas = body.split_evenly((1, PANELS));
-        let mut captions = self
+        // The lines of the quantities this ESC's format carries (HW5's BEC and motor, V3's few).
+        let panels: Vec<Panel> = self
             .panels
+            .iter()
+            .map(|panel| panel.carried_by(data.protocol))
+            .collect();
+        let mut captions = panels
             .iter()
             .zip(&areas)
             .map(|(panel, area)| Caption::new(area, panel))
@@ -537,14 +563,7 @@ impl<'a> Scene<'a> {
         for (p, (area, caption)) in areas.iter().zip(captions).enumerate() {
             let (top, chart) = area.split_vertically(caption_h);
             caption.draw(&top)?;
-            self.draw_panel(
-                &chart,
-                &self.panels[p],
-                self.ranges[p],
-                data,
-                row.offset,
-                p == 0,
-            )?;
+            self.draw_panel(&chart, &panels[p], self.ranges[p], data, row.offset, p == 0)?;
         }
         Ok(())
     }
@@ -1039,17 +1058,57 @@ mod tests {
             (
                 "Current",
                 "current (A)".into(),
-                vec![("input", BLUE), ("phase", ORANGE)],
+                vec![("input", BLUE), ("phase", ORANGE), ("BEC", GREEN)],
             ),
             ("Power", "power (W)".into(), vec![("input", GREEN)]),
-            ("Voltage", "voltage (V)".into(), vec![("input", PURPLE)]),
+            (
+                "Voltage",
+                "voltage (V)".into(),
+                vec![("input", PURPLE), ("BEC", ORANGE)],
+            ),
             (
                 "Temperature",
                 "temperature (°C)".into(),
-                vec![("MOSFET", RED), ("capacitor", TEAL)],
+                vec![
+                    ("MOSFET", RED),
+                    ("capacitor", TEAL),
+                    ("motor", ORANGE),
+                    ("BEC", BLUE),
+                ],
             ),
         ];
         assert_eq!(got, want);
+        // An ESC's row has the lines its format carries: HW-FOC's as before HW5's were added,
+        // HW5's without phase current or capacitor, every line before a frame told the format.
+        let legends = |p: Option<hwfoc::Protocol>| -> Vec<Vec<&str>> {
+            panels()
+                .iter()
+                .map(|panel| panel.carried_by(p).lines.iter().map(|l| l.1).collect())
+                .collect()
+        };
+        assert_eq!(
+            legends(Some(hwfoc::Protocol::HwFoc)),
+            [
+                vec!["input", "output"],
+                vec!["rpm"],
+                vec!["input", "phase"],
+                vec!["input"],
+                vec!["input"],
+                vec!["MOSFET", "capacitor"],
+            ]
+        );
+        assert_eq!(
+            legends(Some(hwfoc::Protocol::Hw5)),
+            [
+                vec!["input"],
+                vec!["rpm"],
+                vec!["input", "BEC"],
+                vec!["input"],
+                vec!["input", "BEC"],
+                vec!["MOSFET", "motor", "BEC"],
+            ]
+        );
+        assert_eq!(legends(None)[5].len(), 4);
     }
 
     #[test]
