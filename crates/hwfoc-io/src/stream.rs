@@ -188,8 +188,8 @@ impl Wire {
         mut emit: impl FnMut(Option<u8>, u64, &Frame),
     ) {
         let emit = &mut emit;
-        let forced = self.forced();
-        each_forced!(self,
+        let silent = |p: Protocol| silence_s.map(|s| frames_in_of(p, s));
+        match self {
             // The closures inlined into the scanner's loop, so that the handler may be too: a
             // frame's fields then reach it in registers, not through a frame stored and loaded
             // back.
@@ -202,20 +202,66 @@ impl Wire {
                 if let Some(s) = silence_s {
                     d.line_silent_each(frames_in(s), hub_frames_in(s), |d| emit_any(d, emit));
                 }
-            },
-            |d, wrap| {
-                let silent = silence_s.zip(forced).map(|(s, p)| frames_in_of(p, s));
-                feed_one(d, data, silent, wrap, emit)
             }
-        )
+            Wire::HwFoc(d) => feed_one(
+                d,
+                data,
+                silent(Protocol::HwFoc),
+                |d| detect::Decoded::Mixed(mixed::Decoded::Esc(d)),
+                emit,
+            ),
+            Wire::DataLink(d) => feed_one(
+                d,
+                data,
+                silent(Protocol::DataLink),
+                |d| detect::Decoded::Mixed(mixed::Decoded::Hub(d)),
+                emit,
+            ),
+            Wire::HwV4(_) | Wire::HwV3(_) | Wire::Hw5(_) => self.feed_slow(data, silence_s, emit),
+        }
+    }
+
+    /// [`Wire::feed`] of a format whose ESCs send at most about 50 frames a second (V4, V3,
+    /// HW5), forced: its frames through a `dyn` callback, so that its scanner is compiled once,
+    /// not once per handler.
+    fn feed_slow(
+        &mut self,
+        data: &[u8],
+        silence_s: Option<f64>,
+        mut emit: &mut dyn FnMut(Option<u8>, u64, &Frame),
+    ) {
+        let forced = self.forced();
+        let silent = silence_s.zip(forced).map(|(s, p)| frames_in_of(p, s));
+        match self {
+            Wire::HwV4(d) => feed_one(d, data, silent, detect::Decoded::HwV4, &mut emit),
+            Wire::HwV3(d) => feed_one(d, data, silent, detect::Decoded::HwV3, &mut emit),
+            Wire::Hw5(d) => feed_one(d, data, silent, detect::Decoded::Hw5, &mut emit),
+            _ => {}
+        }
     }
 
     /// Ends the stream, handing on what the held bytes still hold.
     fn flush(&mut self, emit: &mut impl FnMut(Option<u8>, u64, &Frame)) {
-        each_forced!(self,
+        match self {
             Wire::Any(d) => d.flush(|d| emit_any(d, emit)),
-            |d, wrap| d.flush(|d| emit_any(wrap(d), emit))
-        )
+            Wire::HwFoc(d) => {
+                d.flush(|d| emit_any(detect::Decoded::Mixed(mixed::Decoded::Esc(d)), emit))
+            }
+            Wire::DataLink(d) => {
+                d.flush(|d| emit_any(detect::Decoded::Mixed(mixed::Decoded::Hub(d)), emit))
+            }
+            Wire::HwV4(_) | Wire::HwV3(_) | Wire::Hw5(_) => self.flush_slow(emit),
+        }
+    }
+
+    /// [`Wire::flush`] of a forced V4, V3 or HW5 decoder (see [`Wire::feed_slow`]).
+    fn flush_slow(&mut self, mut emit: &mut dyn FnMut(Option<u8>, u64, &Frame)) {
+        match self {
+            Wire::HwV4(d) => d.flush(|d| emit_any(detect::Decoded::HwV4(d), &mut emit)),
+            Wire::HwV3(d) => d.flush(|d| emit_any(detect::Decoded::HwV3(d), &mut emit)),
+            Wire::Hw5(d) => d.flush(|d| emit_any(detect::Decoded::Hw5(d), &mut emit)),
+            _ => {}
+        }
     }
 
     /// Every byte fed so far.

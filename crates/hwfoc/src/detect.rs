@@ -234,9 +234,7 @@ impl Decoder {
                 #[inline(always)]
                 |d| on_frame(Decoded::Mixed(d)),
             ),
-            Family::HwV4 => self.v4.feed(piece, |d| on_frame(Decoded::HwV4(d))),
-            Family::HwV3 => self.v3.feed(piece, |d| on_frame(Decoded::HwV3(d))),
-            Family::Hw5 => self.hw5.feed(piece, |d| on_frame(Decoded::Hw5(d))),
+            other => self.feed_slow(other, piece, on_frame),
         }
         self.bytes += n as u64;
         if self.bytes.is_multiple_of(RELOCK_AFTER) {
@@ -276,7 +274,20 @@ impl Decoder {
 
     /// Gives every decoder the bytes of `data` to the end of the current slice; at its end,
     /// locks onto the first family that found a frame in it. Returns how many it took.
-    fn feed_detecting(&mut self, data: &[u8], on_frame: &mut impl FnMut(Decoded)) -> usize {
+    /// The locked decoder of a format whose ESCs send at most about 50 frames a second (V4,
+    /// V3, HW5) given `piece`: its frames through a `dyn` callback, so that its scanner is
+    /// compiled once, not once per caller (every handler's, which made the binary 10 % larger).
+    fn feed_slow(&mut self, family: Family, piece: &[u8], on_frame: &mut dyn FnMut(Decoded)) {
+        match family {
+            Family::HwV4 => self.v4.feed(piece, |d| on_frame(Decoded::HwV4(d))),
+            Family::HwV3 => self.v3.feed(piece, |d| on_frame(Decoded::HwV3(d))),
+            Family::Hw5 => self.hw5.feed(piece, |d| on_frame(Decoded::Hw5(d))),
+            Family::Mixed => self.mixed.feed(piece, |d| on_frame(Decoded::Mixed(d))),
+        }
+    }
+
+    /// (Through a `dyn` callback, as [`Decoder::feed_slow`]: detection reads a few slices.)
+    fn feed_detecting(&mut self, data: &[u8], on_frame: &mut dyn FnMut(Decoded)) -> usize {
         self.catch_up(false);
         let to_end = SLICE - self.bytes % SLICE;
         let n = usize::try_from(to_end).map_or(data.len(), |k| k.min(data.len()));
@@ -350,6 +361,16 @@ impl Decoder {
         hub_frames: u32,
         mut on_frame: impl FnMut(Decoded),
     ) {
+        self.line_silent_dyn(esc_frames, hub_frames, &mut on_frame);
+    }
+
+    /// [`Decoder::line_silent_each`], compiled once (as [`Decoder::feed_slow`]).
+    fn line_silent_dyn(
+        &mut self,
+        esc_frames: u32,
+        hub_frames: u32,
+        mut on_frame: &mut dyn FnMut(Decoded),
+    ) {
         // As many frames of the shorter formats fit in the same time: 24 byte times against
         // V3's 10 and V4's 19.
         let scaled = |len: u64| {
@@ -387,6 +408,11 @@ impl Decoder {
     /// each one's statistics count the whole stream. A decoder still detecting locks onto
     /// what the last slice found.
     pub fn flush(&mut self, mut on_frame: impl FnMut(Decoded)) {
+        self.flush_dyn(&mut on_frame);
+    }
+
+    /// [`Decoder::flush`], compiled once (as [`Decoder::feed_slow`]).
+    fn flush_dyn(&mut self, mut on_frame: &mut dyn FnMut(Decoded)) {
         let all = self.locked.is_none();
         let mut take = noting(all, &mut self.found, &mut on_frame);
         if all || self.locked == Some(Family::Mixed) {
