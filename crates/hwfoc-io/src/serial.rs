@@ -162,13 +162,7 @@ impl Search {
         let (frames, protocol) = (&mut self.frames, &mut self.protocol);
         self.decoder.feed(bytes, |d| {
             *frames += 1;
-            protocol.get_or_insert(match d {
-                detect::Decoded::Mixed(hwfoc::mixed::Decoded::Esc(_)) => Protocol::HwFoc,
-                detect::Decoded::Mixed(hwfoc::mixed::Decoded::Hub(_)) => Protocol::DataLink,
-                detect::Decoded::HwV4(_) => Protocol::HwV4,
-                detect::Decoded::HwV3(_) => Protocol::HwV3,
-                detect::Decoded::Hw5(_) => Protocol::Hw5,
-            });
+            protocol.get_or_insert(d.protocol());
         });
         self.verdict()
     }

@@ -136,36 +136,6 @@ enum Wire {
     Hw5(hw5::Decoder),
 }
 
-/// Calls `$body` with `$d` bound to the forced protocol's decoder and `$wrap` to the function
-/// making its frames [`detect::Decoded`], for each forced arm of [`Wire`].
-macro_rules! each_forced {
-    ($wire:expr, $any:pat => $any_body:expr, |$d:ident, $wrap:ident| $body:expr) => {
-        match $wire {
-            $any => $any_body,
-            Wire::HwFoc($d) => {
-                let $wrap = |d| detect::Decoded::Mixed(mixed::Decoded::Esc(d));
-                $body
-            }
-            Wire::DataLink($d) => {
-                let $wrap = |d| detect::Decoded::Mixed(mixed::Decoded::Hub(d));
-                $body
-            }
-            Wire::HwV4($d) => {
-                let $wrap = detect::Decoded::HwV4;
-                $body
-            }
-            Wire::HwV3($d) => {
-                let $wrap = detect::Decoded::HwV3;
-                $body
-            }
-            Wire::Hw5($d) => {
-                let $wrap = detect::Decoded::Hw5;
-                $body
-            }
-        }
-    };
-}
-
 impl Wire {
     fn new(forced: Option<Protocol>) -> Wire {
         match forced {
@@ -266,12 +236,26 @@ impl Wire {
 
     /// Every byte fed so far.
     fn bytes(&self) -> u64 {
-        each_forced!(self, Wire::Any(d) => d.bytes(), |d, _w| d.stats().bytes())
+        match self {
+            Wire::Any(d) => d.bytes(),
+            Wire::HwFoc(d) => d.stats().bytes(),
+            Wire::DataLink(d) => d.stats().bytes(),
+            Wire::HwV4(d) => d.stats().bytes(),
+            Wire::HwV3(d) => d.stats().bytes(),
+            Wire::Hw5(d) => d.stats().bytes(),
+        }
     }
 
     /// Bytes held for a frame still arriving.
     fn buffered(&self) -> usize {
-        each_forced!(self, Wire::Any(d) => d.buffered(), |d, _w| d.buffered())
+        match self {
+            Wire::Any(d) => d.buffered(),
+            Wire::HwFoc(d) => d.buffered(),
+            Wire::DataLink(d) => d.buffered(),
+            Wire::HwV4(d) => d.buffered(),
+            Wire::HwV3(d) => d.buffered(),
+            Wire::Hw5(d) => d.buffered(),
+        }
     }
 
     /// The HW-FOC statistics, unless another protocol is forced.

@@ -41,7 +41,7 @@
 //! assert_eq!(decoder.locked(), Some(Family::HwV3));
 //! ```
 
-use crate::{hw5, mixed, v3, v4};
+use crate::{Protocol, hw5, mixed, v3, v4};
 
 /// Bytes per slice while detecting (see the module documentation).
 pub const SLICE: u64 = 64;
@@ -94,6 +94,17 @@ impl Decoded {
             Decoded::HwV4(d) => d.offset,
             Decoded::HwV3(d) => d.offset,
             Decoded::Hw5(d) => d.offset,
+        }
+    }
+
+    /// The protocol the frame came in.
+    pub fn protocol(&self) -> Protocol {
+        match self {
+            Decoded::Mixed(mixed::Decoded::Esc(_)) => Protocol::HwFoc,
+            Decoded::Mixed(mixed::Decoded::Hub(_)) => Protocol::DataLink,
+            Decoded::HwV4(_) => Protocol::HwV4,
+            Decoded::HwV3(_) => Protocol::HwV3,
+            Decoded::Hw5(_) => Protocol::Hw5,
         }
     }
 
