@@ -9,6 +9,10 @@ pub const MAX_EXTENDED_ID: u32 = 0x1FFF_FFFF;
 /// The largest 11-bit (standard) identifier.
 pub const MAX_STANDARD_ID: u32 = 0x7FF;
 
+/// The bytes of a frame in pcapng's `LINKTYPE_CAN_SOCKETCAN` layout
+/// ([`CanFrame::to_socketcan_record`]).
+pub const SOCKETCAN_RECORD_LEN: usize = 16;
+
 /// SocketCAN's flag for an extended identifier in `can_id` (`CAN_EFF_FLAG`).
 pub const SOCKETCAN_EFF_FLAG: u32 = 0x8000_0000;
 /// SocketCAN's flag for a remote transmission request (`CAN_RTR_FLAG`).
@@ -131,6 +135,42 @@ impl CanFrame {
             FrameKind::Error => id |= SOCKETCAN_ERR_FLAG,
         }
         id
+    }
+
+    /// The frame as pcapng's `LINKTYPE_CAN_SOCKETCAN` carries it, SocketCAN's `struct can_frame`
+    /// with its identifier in network byte order: `can_id` (4 bytes, big-endian, with its
+    /// flags), the data length (1 byte), 3 bytes of zeros (padding and reserved), then 8 data
+    /// bytes (zeros past the length). This is also how the layers above hwfoc's codec carry CAN
+    /// frames in a stream of bytes: [`SOCKETCAN_RECORD_LEN`] bytes a frame.
+    ///
+    /// ```
+    /// use hwfoc::dronecan::CanFrame;
+    ///
+    /// let f = CanFrame::extended(0x104E_5201, &[1, 2, 0xC0]).unwrap();
+    /// let record = f.to_socketcan_record();
+    /// assert_eq!(&record[..8], &[0x90, 0x4E, 0x52, 0x01, 3, 0, 0, 0]);
+    /// assert_eq!(CanFrame::from_socketcan_record(&record), Some(f));
+    /// ```
+    pub fn to_socketcan_record(&self) -> [u8; SOCKETCAN_RECORD_LEN] {
+        let mut out = [0u8; SOCKETCAN_RECORD_LEN];
+        out[..4].copy_from_slice(&self.socketcan_id().to_be_bytes());
+        out[4] = self.len;
+        out[8..].copy_from_slice(&self.data);
+        if self.kind == FrameKind::Remote {
+            out[8..].fill(0);
+        }
+        out
+    }
+
+    /// The frame of a `LINKTYPE_CAN_SOCKETCAN` record ([`CanFrame::to_socketcan_record`]);
+    /// `None` where its length byte is over 8 (a CAN FD frame, not read).
+    pub fn from_socketcan_record(record: &[u8; SOCKETCAN_RECORD_LEN]) -> Option<CanFrame> {
+        let can_id = u32::from_be_bytes([record[0], record[1], record[2], record[3]]);
+        let len = usize::from(record[4]);
+        if len > 8 {
+            return None;
+        }
+        CanFrame::from_socketcan(can_id, &record[8..8 + len])
     }
 
     /// The identifier (11 or 29 bits; an error frame's class bits).

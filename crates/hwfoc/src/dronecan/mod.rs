@@ -84,7 +84,7 @@ mod types;
 pub use bits::{F16_MAX, f16_from_f32, f32_from_f16, saturate_f16};
 pub use frame::{
     CanFrame, FrameKind, MAX_EXTENDED_ID, MAX_STANDARD_ID, SOCKETCAN_EFF_FLAG, SOCKETCAN_ERR_FLAG,
-    SOCKETCAN_RTR_FLAG,
+    SOCKETCAN_RECORD_LEN, SOCKETCAN_RTR_FLAG,
 };
 pub use id::{Header, IdError, MAX_NODE_ID, MAX_PRIORITY, TailByte, TransferType};
 pub use kind::{DataType, Form, Kind, MAX_PAYLOAD_LEN, Message, PayloadError};
