@@ -78,7 +78,7 @@ fn decode_real_capture_matches_schema_and_golden() {
     // The schema document's example is the capture's first frame.
     assert_eq!(
         lines[0],
-        r#"{"t_s":0.22798,"esc":0,"protocol":"hw-foc","packet":1474,"throttle_in_pct":0.0,"throttle_out_pct":0.0,"erpm":0,"rpm":0.0,"voltage_v":24.7,"current_a":-0.015625,"phase_current_a":-0.015625,"mos_temp_c":28.0,"cap_temp_c":26.0,"motor_temp_c":null,"bec_temp_c":null,"bec_voltage_v":null,"bec_current_a":null,"status":0,"faults":[]}"#
+        r#"{"t_s":0.22798,"esc":0,"protocol":"hw-foc","packet":1474,"throttle_in_pct":0.0,"throttle_out_pct":0.0,"erpm":0,"rpm":0.0,"voltage_v":24.7,"current_a":-0.015625,"phase_current_a":-0.015625,"mos_temp_c":28.0,"cap_temp_c":26.0,"motor_temp_c":null,"bec_temp_c":null,"bec_voltage_v":null,"bec_current_a":null,"status":0,"faults":[],"node":null,"msg2_age_ms":null,"msg3_age_ms":null}"#
     );
     let mut last_t = f64::MIN;
     let mut max_v = 0.0f64;
@@ -393,7 +393,7 @@ fn csv_output_has_header_and_joined_faults() {
     // No time in a raw file; MOSFET code 250 is below the table's range, capacitor code 0 above.
     assert_eq!(
         lines[3],
-        ",0,hw-foc,1,0.0,0.0,0,0.0,0.0,-1.28,0.0,,,,,,,16388,over_current|opamp_phase_a"
+        ",0,hw-foc,1,0.0,0.0,0,0.0,0.0,-1.28,0.0,,,,,,,16388,over_current|opamp_phase_a,,,"
     );
 }
 

@@ -86,7 +86,7 @@ def main():
     for key, value in SETTINGS.items():
         check(kv.get(key.encode()) == value.encode(), f"metadata {key}: {kv.get(key.encode())!r}")
     check(kv.get(b"hwfoc_version", b"") != b"", "no hwfoc_version in the metadata")
-    check(kv.get(b"record_schema_version") == b"2", f"record_schema_version {kv.get(b'record_schema_version')!r}")
+    check(kv.get(b"record_schema_version") == b"3", f"record_schema_version {kv.get(b'record_schema_version')!r}")
     check(json.loads(kv[b"inputs"]) == ["demo capture"], f"inputs {kv[b'inputs']!r}")
     escs = json.loads(kv[b"escs"])
     check(escs == [{"esc": 0, "input": "demo capture", "stream": "demo capture", "protocol": "hw-foc"}], f"escs {escs}")

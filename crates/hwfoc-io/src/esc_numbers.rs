@@ -6,9 +6,10 @@
 //! given. A stream found to carry a DataLink hub keeps its number for the hub's channel 0;
 //! channels 1 to 7 take the next numbers not given yet, in channel order, so that a hub read
 //! alone numbers its ESCs 0 to 7 by channel and no two ESCs share a number whatever mix of
-//! hubs and ESCs is read. Numbers stop at [`MAX_ESCS`]: the record's `esc` column is a `u8`.
-
-use hwfoc::datalink::CHANNELS;
+//! hubs and ESCs is read. A CAN bus is numbered alike by the places of its ESCs on the bus
+//! (its own number for place 0, the next ones for the places up to the highest heard), so that
+//! a bus read alone numbers its ESCs by their place. Numbers stop at [`MAX_ESCS`]: the record's
+//! `esc` column is a `u8`.
 
 /// How many ESCs the record's `esc` column (a `u8`) can number.
 pub(crate) const MAX_ESCS: usize = 256;
@@ -17,22 +18,36 @@ pub(crate) const MAX_ESCS: usize = 256;
 /// column could not tell them from another ESC's.
 pub(crate) const UNNUMBERED: usize = usize::MAX;
 
-/// The ESC numbers of the channels of a hub found on the stream of ESC `own`, when `next`
-/// numbers have been given: `own` for channel 0, `next`, `next + 1`, ... for channels 1 to 7,
-/// [`UNNUMBERED`] from [`MAX_ESCS`] on. The caller gives the numbered channels their ESCs, in
-/// channel order.
-pub(crate) fn hub_channels(own: usize, next: usize) -> [usize; CHANNELS] {
-    let mut escs = [own; CHANNELS];
-    for (channel, esc) in escs.iter_mut().enumerate().skip(1) {
-        let n = next + channel - 1;
-        *esc = if n < MAX_ESCS { n } else { UNNUMBERED };
+/// The ESC number of channel `channel` of the stream of ESC `own` (a DataLink hub's channel, a
+/// CAN bus's place: [`hwfoc::telemetry::Data::bus_index`]) numbered when `next` numbers have
+/// been given, the channels before it numbered already: `own` for channel 0, else `next`
+/// ([`UNNUMBERED`] from [`MAX_ESCS`] on). A CAN bus's places are numbered up to the highest
+/// one heard, so that a bus read alone numbers its ESCs by their place (throttle channel - 1
+/// for a mapped Hobbywing ESC, node id before, a standard ESC's `esc_index`).
+pub(crate) fn channel_number(own: usize, next: usize, channel: usize) -> usize {
+    match channel {
+        0 => own,
+        _ if next < MAX_ESCS => next,
+        _ => UNNUMBERED,
     }
-    escs
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use hwfoc::datalink::CHANNELS;
+
+    /// The numbers of a hub's eight channels found on the stream of ESC `own` when `next`
+    /// numbers have been given, as the callers number them: in channel order.
+    fn hub_channels(own: usize, mut next: usize) -> [usize; CHANNELS] {
+        core::array::from_fn(|channel| {
+            let n = channel_number(own, next, channel);
+            if n != own && n != UNNUMBERED {
+                next += 1;
+            }
+            n
+        })
+    }
 
     #[test]
     fn a_hubs_channels_take_the_next_numbers_up_to_the_last() {

@@ -209,10 +209,10 @@ fn text_follows_the_table() {
     }
 }
 
-/// Schema version 2: the columns' order, types and nullability as written out here (the
+/// Schema version 3: the columns' order, types and nullability as written out here (the
 /// document and the code are both checked against this list: a change to either shows).
 #[test]
-fn version_2_order_types_and_nullability() {
+fn version_3_order_types_and_nullability() {
     let dict = DataType::Dictionary(Box::new(DataType::Int8), Box::new(DataType::Utf8));
     let faults = DataType::List(Arc::new(Field::new("item", DataType::Utf8, false)));
     let f32n = (DataType::Float32, true);
@@ -236,6 +236,9 @@ fn version_2_order_types_and_nullability() {
         ("bec_current_a", f32n),
         ("status", (DataType::UInt16, true)),
         ("faults", (faults, true)),
+        ("node", (DataType::UInt8, true)),
+        ("msg2_age_ms", (DataType::UInt32, true)),
+        ("msg3_age_ms", (DataType::UInt32, true)),
     ];
     let schema = schema();
     let got: Vec<(&str, (DataType, bool))> = schema
@@ -251,8 +254,8 @@ fn version_2_order_types_and_nullability() {
     let want: Vec<(String, (DataType, bool))> =
         want.into_iter().map(|(n, t)| (n.to_string(), t)).collect();
     assert_eq!(documented, want);
-    assert!(record_schema_md().contains("Record schema **version 2**"));
-    assert_eq!(hwfoc_io::RECORD_SCHEMA_VERSION, 2);
+    assert!(record_schema_md().contains("Record schema **version 3**"));
+    assert_eq!(hwfoc_io::RECORD_SCHEMA_VERSION, 3);
 }
 
 /// The `protocol` column of an ESC's own frame and of a DataLink hub's, and the columns no

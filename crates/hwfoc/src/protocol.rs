@@ -30,17 +30,40 @@ pub enum Protocol {
     /// HW5 (Platinum V5, VBAR firmware): `FE` frames with a CRC-16/MODBUS at 115200 baud
     /// ([`crate::hw5`]).
     Hw5,
+    /// Hobbywing's DroneCAN ESCs (XRotor X6/X8/X9 and H-series "CAN" versions):
+    /// `com.hobbywing.esc.StatusMsg1/2/3` on a CAN bus (`hw-can`).
+    HwCan,
+    /// Standard DroneCAN ESCs: `uavcan.equipment.esc.Status` and `StatusExtended` on a CAN
+    /// bus (`dronecan`).
+    DroneCan,
 }
 
 impl Protocol {
     /// Every protocol, in the order they are listed to a user.
-    pub const ALL: [Protocol; 5] = [
+    pub const ALL: [Protocol; 7] = [
+        Protocol::HwFoc,
+        Protocol::DataLink,
+        Protocol::HwV4,
+        Protocol::HwV3,
+        Protocol::Hw5,
+        Protocol::HwCan,
+        Protocol::DroneCan,
+    ];
+
+    /// The protocols of a serial line, which `--protocol` can force a stream to read: all but
+    /// the CAN protocols (a CAN bus is read as one, whatever its ESCs speak).
+    pub const SERIAL: [Protocol; 5] = [
         Protocol::HwFoc,
         Protocol::DataLink,
         Protocol::HwV4,
         Protocol::HwV3,
         Protocol::Hw5,
     ];
+
+    /// Whether the protocol is carried on a CAN bus (`hw-can`, `dronecan`), not a serial line.
+    pub const fn is_can(self) -> bool {
+        matches!(self, Protocol::HwCan | Protocol::DroneCan)
+    }
 
     /// The protocol's name as users give it and outputs show it: `hw-foc`, `datalink`, `hw-v4`,
     /// `hw-v3`, `hw5`.
@@ -51,6 +74,8 @@ impl Protocol {
             Protocol::HwV4 => "hw-v4",
             Protocol::HwV3 => "hw-v3",
             Protocol::Hw5 => "hw5",
+            Protocol::HwCan => "hw-can",
+            Protocol::DroneCan => "dronecan",
         }
     }
 
@@ -63,10 +88,13 @@ impl Protocol {
             Protocol::HwV4 => "Hobbywing V4",
             Protocol::HwV3 => "Hobbywing V3",
             Protocol::Hw5 => "HW5",
+            Protocol::HwCan => "Hobbywing DroneCAN",
+            Protocol::DroneCan => "DroneCAN ESC",
         }
     }
 
-    /// The baud rate its senders use (8N1).
+    /// The baud rate its senders use (8N1); for a CAN protocol, the bus's bit rate as
+    /// Hobbywing's ESCs leave the factory ([`HOBBYWING_BITRATE`](crate::dronecan::HOBBYWING_BITRATE)).
     pub const fn baud_rate(self) -> u32 {
         match self {
             Protocol::HwFoc => crate::foc::BAUD_RATE,
@@ -74,16 +102,18 @@ impl Protocol {
             Protocol::HwV4 => crate::v4::BAUD_RATE,
             Protocol::HwV3 => crate::v3::BAUD_RATE,
             Protocol::Hw5 => crate::hw5::BAUD_RATE,
+            Protocol::HwCan | Protocol::DroneCan => crate::dronecan::HOBBYWING_BITRATE,
         }
     }
 
     /// The width of its packet counter in bits (which it wraps at), or `None` for a protocol
-    /// that sends no counter: 16 for HW-FOC and DataLink, 24 for V3 and V4, none for HW5.
+    /// that sends no counter: 16 for HW-FOC and DataLink, 24 for V3 and V4, none for HW5 and the
+    /// CAN protocols (a transfer id is the transport's: its gaps are counted per node).
     pub const fn packet_bits(self) -> Option<u32> {
         match self {
             Protocol::HwFoc | Protocol::DataLink => Some(16),
             Protocol::HwV4 | Protocol::HwV3 => Some(24),
-            Protocol::Hw5 => None,
+            Protocol::Hw5 | Protocol::HwCan | Protocol::DroneCan => None,
         }
     }
 
@@ -126,11 +156,33 @@ impl Protocol {
             ),
             Protocol::HwV3 => matches!(quantity, Q::ThrottleIn | Q::ThrottleOut | Q::Erpm | Q::Rpm),
             Protocol::Hw5 => !matches!(quantity, Q::ThrottleOut | Q::PhaseCurrent | Q::CapTemp),
+            Protocol::HwCan => matches!(
+                quantity,
+                Q::ThrottleOut
+                    | Q::Rpm
+                    | Q::Voltage
+                    | Q::Current
+                    | Q::MosTemp
+                    | Q::CapTemp
+                    | Q::MotorTemp
+            ),
+            Protocol::DroneCan => matches!(
+                quantity,
+                Q::ThrottleIn
+                    | Q::ThrottleOut
+                    | Q::Rpm
+                    | Q::Voltage
+                    | Q::Current
+                    | Q::MosTemp
+                    | Q::MotorTemp
+            ),
         }
     }
 
     /// Whether this protocol's data frames carry a fault word (a record's `status` and
-    /// `faults`): HW-FOC's and DataLink's sixteen status bits, HW5's eight fault bits.
+    /// `faults`): HW-FOC's and DataLink's sixteen status bits, HW5's eight fault bits. (A
+    /// Hobbywing CAN ESC's `status` word is kept raw, but its only known bit is the direction:
+    /// no fault bits.)
     pub const fn has_faults(self) -> bool {
         matches!(self, Protocol::HwFoc | Protocol::DataLink | Protocol::Hw5)
     }
@@ -150,7 +202,7 @@ impl Protocol {
         match self {
             Protocol::HwFoc | Protocol::DataLink => crate::Fault::from_bit(bit).map(|f| f.name()),
             Protocol::Hw5 => crate::hw5::Fault::from_bit(bit).map(|f| f.name()),
-            Protocol::HwV4 | Protocol::HwV3 => None,
+            Protocol::HwV4 | Protocol::HwV3 | Protocol::HwCan | Protocol::DroneCan => None,
         }
     }
 
@@ -162,7 +214,7 @@ impl Protocol {
                 crate::Fault::from_bit(bit).map(|f| f.description())
             }
             Protocol::Hw5 => crate::hw5::Fault::from_bit(bit).map(|f| f.description()),
-            Protocol::HwV4 | Protocol::HwV3 => None,
+            Protocol::HwV4 | Protocol::HwV3 | Protocol::HwCan | Protocol::DroneCan => None,
         }
     }
 

@@ -31,6 +31,15 @@ use crate::protocol::Protocol;
 use crate::status::Status;
 use crate::units::{Linear, Quantity, Settings, Temperature};
 
+/// 0 degC in kelvins.
+const KELVIN_AT_0_C: f32 = 273.15;
+
+/// The value of a float16's bits; `None` for NaN (DroneCAN's "unknown").
+fn half(raw: i32) -> Option<f32> {
+    let v = crate::dronecan::f32_from_f16(u16::try_from(raw).ok()?);
+    (!v.is_nan()).then_some(v)
+}
+
 /// How a quantity's raw integer becomes its value in the quantity's unit.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Conversion {
@@ -45,6 +54,10 @@ pub enum Conversion {
     /// A Hobbywing V4 current ADC code through its info frame's constants,
     /// `adc * I1 / I2 - I3`, not below 0 ([`crate::v4::CurrentScale`]).
     V4Current(crate::v4::CurrentScale),
+    /// A float16's bits (DroneCAN's `float16`), the value in its unit.
+    Half,
+    /// A float16's bits holding kelvins, the value in degC (`- 273.15`).
+    HalfKelvin,
 }
 
 impl Conversion {
@@ -59,6 +72,8 @@ impl Conversion {
                 .and_then(|code| Temperature::from_adc(code).celsius()),
             Conversion::Ntc => u16::try_from(raw).ok().and_then(crate::v4::ntc_celsius),
             Conversion::V4Current(scale) => u16::try_from(raw).ok().map(|adc| scale.amps(adc)),
+            Conversion::Half => half(raw),
+            Conversion::HalfKelvin => half(raw).map(|k| k - KELVIN_AT_0_C),
         }
     }
 
@@ -68,7 +83,11 @@ impl Conversion {
     pub fn linear(self) -> Option<Linear> {
         match self {
             Conversion::Linear(linear) => Some(linear),
-            Conversion::AdcTable | Conversion::Ntc | Conversion::V4Current(_) => None,
+            Conversion::AdcTable
+            | Conversion::Ntc
+            | Conversion::V4Current(_)
+            | Conversion::Half
+            | Conversion::HalfKelvin => None,
         }
     }
 }
@@ -205,6 +224,24 @@ pub enum Data {
     HwV3(crate::v3::Frame),
     /// An HW5 telemetry frame.
     Hw5(crate::hw5::TelemetryFrame),
+    /// A Hobbywing CAN ESC's record at a `StatusMsg1` (with its node's slower messages).
+    HwCan(crate::dronecan::HwCanEsc),
+    /// A standard DroneCAN ESC's record at a `uavcan.equipment.esc.Status`.
+    DroneCan(crate::dronecan::DroneCanEsc),
+}
+
+impl From<crate::dronecan::HwCanEsc> for Data {
+    #[inline]
+    fn from(esc: crate::dronecan::HwCanEsc) -> Data {
+        Data::HwCan(esc)
+    }
+}
+
+impl From<crate::dronecan::DroneCanEsc> for Data {
+    #[inline]
+    fn from(esc: crate::dronecan::DroneCanEsc) -> Data {
+        Data::DroneCan(esc)
+    }
 }
 
 impl From<crate::v4::Data> for Data {
@@ -244,6 +281,8 @@ impl Telemetry for Data {
             Data::HwV4(f) => Telemetry::packet(f),
             Data::HwV3(f) => Telemetry::packet(f),
             Data::Hw5(f) => Telemetry::packet(f),
+            Data::HwCan(f) => Telemetry::packet(f),
+            Data::DroneCan(f) => Telemetry::packet(f),
         }
     }
 
@@ -254,6 +293,8 @@ impl Telemetry for Data {
             Data::HwV4(f) => Telemetry::status(f),
             Data::HwV3(f) => Telemetry::status(f),
             Data::Hw5(f) => Telemetry::status(f),
+            Data::HwCan(f) => Telemetry::status(f),
+            Data::DroneCan(f) => Telemetry::status(f),
         }
     }
 
@@ -264,6 +305,8 @@ impl Telemetry for Data {
             Data::HwV4(f) => f.reading(quantity, settings),
             Data::HwV3(f) => f.reading(quantity, settings),
             Data::Hw5(f) => f.reading(quantity, settings),
+            Data::HwCan(f) => f.reading(quantity, settings),
+            Data::DroneCan(f) => f.reading(quantity, settings),
         }
     }
 }
@@ -287,6 +330,8 @@ impl Data {
             Data::HwV4(_) => Protocol::HwV4,
             Data::HwV3(_) => Protocol::HwV3,
             Data::Hw5(_) => Protocol::Hw5,
+            Data::HwCan(_) => Protocol::HwCan,
+            Data::DroneCan(_) => Protocol::DroneCan,
         }
     }
 
@@ -297,7 +342,55 @@ impl Data {
     pub fn to_hwfoc(&self) -> Option<DataFrame> {
         match self {
             Data::HwFoc(f) | Data::DataLink(f) => Some(*f),
-            Data::HwV4(_) | Data::HwV3(_) | Data::Hw5(_) => None,
+            Data::HwV4(_) | Data::HwV3(_) | Data::Hw5(_) | Data::HwCan(_) | Data::DroneCan(_) => {
+                None
+            }
+        }
+    }
+}
+
+impl Data {
+    /// The CAN node that sent the record (`hw-can`, `dronecan`); `None` for a serial format.
+    #[inline]
+    pub const fn node(&self) -> Option<u8> {
+        match self {
+            Data::HwCan(e) => Some(e.node),
+            Data::DroneCan(e) => Some(e.node),
+            _ => None,
+        }
+    }
+
+    /// Where the ESC is on its CAN bus: a Hobbywing ESC's throttle channel - 1 once a GetEscID
+    /// answer mapped its node, until then its node id; a standard ESC's `esc_index`. `None` for
+    /// a serial format.
+    #[inline]
+    pub fn bus_index(&self) -> Option<u8> {
+        match self {
+            Data::HwCan(e) => Some(e.bus_index()),
+            Data::DroneCan(e) => Some(e.bus_index()),
+            _ => None,
+        }
+    }
+
+    /// The age in milliseconds of the record's values from the second message of its ESC: a
+    /// Hobbywing CAN ESC's `StatusMsg2` (voltage, current), a standard ESC's `StatusExtended`
+    /// (throttles, motor temperature); `None` otherwise or where times are unknown.
+    #[inline]
+    pub const fn msg2_age_ms(&self) -> Option<u32> {
+        match self {
+            Data::HwCan(e) => e.msg2_age_ms,
+            Data::DroneCan(e) => e.ext_age_ms,
+            _ => None,
+        }
+    }
+
+    /// The age in milliseconds of a Hobbywing CAN ESC's `StatusMsg3` values (temperatures) at
+    /// the record; `None` otherwise or where times are unknown.
+    #[inline]
+    pub const fn msg3_age_ms(&self) -> Option<u32> {
+        match self {
+            Data::HwCan(e) => e.msg3_age_ms,
+            _ => None,
         }
     }
 }

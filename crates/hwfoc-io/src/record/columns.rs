@@ -46,7 +46,9 @@ columns! {
     /// one (a logic-analyser CSV's or a pcapng capture's timestamps), Unix time for live input;
     /// null where the source has no timing (a raw byte file).
     t_s: Option<f64>, "s", |t_s, _, _, _| t_s;
-    /// Which ESC: the index of the input port or stream the frame came from (0-based).
+    /// Which ESC: the index of the input port or stream the frame came from (0-based); behind
+    /// a DataLink hub or on a CAN bus, numbered by channel or place on the bus
+    /// (`esc_numbers.rs`).
     esc: u8, "-", |_, esc, _, _| esc;
     /// The protocol the frame came in (`hw-foc`, `datalink`: [`Protocol::name`]),
     /// dictionary-encoded in Arrow and Parquet.
@@ -93,11 +95,31 @@ columns! {
     bec_current_a: Option<f32>, "A", |_, _, f, s| f.value(Quantity::BecCurrent, s),
         text key |f| raw(f, Quantity::BecCurrent);
     /// The raw fault word (an unsigned 16-bit integer: HW-FOC's and DataLink's status word,
-    /// HW5's fault byte); null where the protocol sends none (V4, V3).
+    /// HW5's fault byte, a Hobbywing CAN ESC's `status`, whose bit 14 is the direction); null
+    /// where the protocol sends none (V4, V3, standard DroneCAN).
     status: Option<hwfoc::Status>, "-", |_, _, f, _| f.status();
     /// Names of the set fault bits, in bit order, as the frame's protocol names them (HW-FOC:
     /// `docs/PROTOCOL-NOTES.md`; HW5: `docs/HW5-AND-CAN.md`); derived from `status`, not a
     /// field of the record; null where `status` is.
-    faults: Option<FaultList>, "-", |_, _, f, _| f.status().map(|s| FaultList(s, f.protocol())),
-        record |r| r.status.map(|s| FaultList(s, r.protocol));
+    faults: Option<FaultList>, "-", |_, _, f, _| fault_list(f.status(), f.protocol()),
+        record |r| fault_list(r.status, r.protocol);
+    /// The CAN node that sent the record (`hw-can`, `dronecan`); null for a serial format.
+    node: Option<u8>, "-", |_, _, f, _| f.node();
+    /// Age of the record's values from its ESC's second message, ms: a Hobbywing CAN ESC's
+    /// `StatusMsg2` (voltage, current; its temperature until a `StatusMsg3` comes), a standard
+    /// DroneCAN ESC's `StatusExtended` (throttles, motor temperature); null otherwise, and
+    /// where no such message came yet.
+    msg2_age_ms: Option<u32>, "ms", |_, _, f, _| f.msg2_age_ms();
+    /// Age of a Hobbywing CAN ESC's `StatusMsg3` values (MOSFET, capacitor, motor
+    /// temperatures), ms; null otherwise.
+    msg3_age_ms: Option<u32>, "ms", |_, _, f, _| f.msg3_age_ms();
+}
+
+/// The `faults` of a fault word of `protocol`: null where the protocol has no fault bits (a
+/// Hobbywing CAN ESC's `status` word is kept, its only known bit is the direction).
+#[inline(always)]
+fn fault_list(status: Option<hwfoc::Status>, protocol: Protocol) -> Option<FaultList> {
+    status
+        .filter(|_| protocol.has_faults())
+        .map(|s| FaultList(s, protocol))
 }

@@ -162,6 +162,44 @@ mod tests {
             }),
             Data::from(v3),
             Data::from(hw5),
+            Data::from(hwfoc::dronecan::HwCanEsc {
+                node: 7,
+                channel: Some(2),
+                transfer_id: 3,
+                rpm: 1200,
+                pwm: 300,
+                status: 1 << 14,
+                power: Some(hwfoc::dronecan::Power {
+                    input_voltage: 252,
+                    current: 11,
+                    temperature: 35,
+                }),
+                msg2_age_ms: Some(12),
+                temperatures: Some(hwfoc::dronecan::Temperatures {
+                    mos: 36,
+                    cap: 30,
+                    motor: 41,
+                }),
+                msg3_age_ms: Some(80),
+            }),
+            Data::from(hwfoc::dronecan::DroneCanEsc {
+                node: 9,
+                transfer_id: 3,
+                esc_index: 1,
+                error_count: 0,
+                voltage_f16: hwfoc::dronecan::f16_from_f32(24.5),
+                current_f16: hwfoc::dronecan::f16_from_f32(3.0),
+                temperature_f16: hwfoc::dronecan::f16_from_f32(300.0),
+                rpm: 900,
+                power_rating_pct: 10,
+                extended: Some(hwfoc::dronecan::Extended {
+                    input_pct: 20,
+                    output_pct: 19,
+                    motor_temperature_deg_c: 30,
+                    status_flags: 0,
+                }),
+                ext_age_ms: Some(5),
+            }),
         ];
         let s = Settings::default();
         for sample in samples {
@@ -171,6 +209,8 @@ mod tests {
                 Data::HwV4(_) => Protocol::HwV4,
                 Data::HwV3(_) => Protocol::HwV3,
                 Data::Hw5(_) => Protocol::Hw5,
+                Data::HwCan(_) => Protocol::HwCan,
+                Data::DroneCan(_) => Protocol::DroneCan,
             };
             assert_eq!(sample.protocol(), protocol);
             let mut json = Vec::new();
@@ -208,6 +248,27 @@ mod tests {
                 Protocol::HwV4 | Protocol::HwV3 => {
                     assert_eq!(v["packet"], 3);
                     assert!(v["status"].is_null() && v["faults"].is_null());
+                }
+                Protocol::HwCan => {
+                    // The raw word kept (bit 14: counter-clockwise), no fault names.
+                    assert!(v["packet"].is_null() && v["faults"].is_null());
+                    assert_eq!(v["status"], 0x4000);
+                    assert_eq!(
+                        (&v["node"], &v["esc"]),
+                        (&serde_json::json!(7), &serde_json::json!(0))
+                    );
+                    assert_eq!(
+                        (&v["msg2_age_ms"], &v["msg3_age_ms"]),
+                        (&serde_json::json!(12), &serde_json::json!(80))
+                    );
+                    assert_eq!(v["throttle_out_pct"], 30.0);
+                    assert_eq!(v["rpm"], 1200.0);
+                }
+                Protocol::DroneCan => {
+                    assert!(v["packet"].is_null() && v["status"].is_null());
+                    assert_eq!(v["msg2_age_ms"], 5);
+                    assert!(v["msg3_age_ms"].is_null());
+                    assert_eq!(v["voltage_v"], 24.5);
                 }
                 Protocol::HwFoc | Protocol::DataLink => {
                     assert_eq!(v["packet"], 3);

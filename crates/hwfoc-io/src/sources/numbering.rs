@@ -8,14 +8,16 @@ use hwfoc::datalink::CHANNELS;
 use hwfoc::telemetry::Frame;
 
 use super::{Esc, Handler, Sources};
-use crate::esc_numbers::{MAX_ESCS, UNNUMBERED, hub_channels};
+use crate::esc_numbers::{MAX_ESCS, UNNUMBERED, channel_number};
 use crate::input::{Input, InputError};
 use crate::stream::Stream;
 
 impl Sources {
-    /// Hands on the frames of a stream just found to come from a DataLink hub, once its
-    /// channels have ESCs (made here, in channel order: channel 0 is the stream's own ESC): to
-    /// a handler, or to the time-order queue.
+    /// Hands on the frames of a stream found to carry several ESCs (a DataLink hub's channels,
+    /// a CAN bus's places) whose channel has no ESC yet, once it has one (made here, in channel
+    /// order: channel 0 is the stream's own ESC): to a handler, or to the time-order queue.
+    /// A hub's eight channels are numbered at once; a bus's places up to the highest one heard
+    /// (`esc_numbers.rs`).
     pub(super) fn deliver<H: Handler>(
         &mut self,
         esc: usize,
@@ -25,28 +27,17 @@ impl Sources {
         if pending.is_empty() {
             return;
         }
-        let hub = match self.hubs.get(&esc) {
-            Some(&hub) => hub,
-            None => {
-                let escs = hub_channels(esc, self.escs.len());
-                for (channel, &number) in escs.iter().enumerate().skip(1) {
-                    if number == UNNUMBERED {
-                        continue;
-                    }
-                    debug_assert_eq!(number, self.escs.len());
-                    self.push_esc(Esc {
-                        input: self.escs[esc].input,
-                        name: self.escs[esc].name.clone(),
-                        stream: Stream::forced(self.forced),
-                        hub: Some((esc, channel as u8)),
-                    });
-                }
-                let settings = escs.map(|e| self.esc_settings(e));
-                let hub = Hub { escs, settings };
-                self.hubs.insert(esc, hub);
-                hub
-            }
+        let places = if self.escs[esc].stream.is_can() {
+            pending
+                .iter()
+                .map(|p| usize::from(p.1) + 1)
+                .max()
+                .unwrap_or(0)
+        } else {
+            CHANNELS
         };
+        self.grow_hub(esc, places);
+        let hub = &self.hubs[&esc];
         for (t, channel, d) in pending {
             let c = usize::from(channel);
             let Some(&id) = hub.escs.get(c).filter(|&&e| e != UNNUMBERED) else {
@@ -59,6 +50,28 @@ impl Sources {
                 Deliver::Queue => self.queue.push(id, t, &d),
             }
         }
+    }
+
+    /// Numbers the channels of the stream of ESC `esc` up to `places` (see
+    /// [`channel_number`]): each a new ESC of the stream's input.
+    fn grow_hub(&mut self, esc: usize, places: usize) {
+        let mut hub = self.hubs.remove(&esc).unwrap_or_default();
+        while hub.escs.len() < places {
+            let channel = hub.escs.len();
+            let number = channel_number(esc, self.escs.len(), channel);
+            if number != UNNUMBERED && number != esc {
+                debug_assert_eq!(number, self.escs.len());
+                self.push_esc(Esc {
+                    input: self.escs[esc].input,
+                    name: self.escs[esc].name.clone(),
+                    stream: Stream::forced(self.forced),
+                    hub: Some((esc, channel as u8)),
+                });
+            }
+            hub.settings.push(self.esc_settings(number));
+            hub.escs.push(number);
+        }
+        self.hubs.insert(esc, hub);
     }
 
     /// A new ESC, its settings looked up once.
@@ -159,20 +172,21 @@ impl Sources {
     }
 }
 
-/// The ESCs of a DataLink hub's channels, and their settings.
-#[derive(Debug, Clone, Copy)]
+/// The ESCs of the channels numbered so far of a DataLink hub or a CAN bus, and their
+/// settings.
+#[derive(Debug, Clone, Default)]
 pub(super) struct Hub {
-    escs: [usize; CHANNELS],
-    settings: [Settings; CHANNELS],
+    escs: Vec<usize>,
+    settings: Vec<Settings>,
 }
 
-/// A frame of a DataLink channel that has no ESC yet: its time, channel and frame.
+/// A frame of a channel that has no ESC yet: its time, channel and frame.
 pub(super) type Pending = (Option<f64>, u8, Frame);
 
 /// The ESC a frame of the stream of ESC `own` belongs to: `own` on its own wire; behind a hub
 /// whose channels are numbered (`hub`), its channel's ESC with that ESC's settings; `None` for a
-/// channel the `esc` column cannot number, or when the hub's channels are not numbered yet (the
-/// frame then waits in `pending`).
+/// channel the `esc` column cannot number, or when the channel is not numbered yet (the frame
+/// then waits in `pending`).
 #[inline(always)]
 pub(super) fn route<'h>(
     own: usize,
@@ -184,11 +198,11 @@ pub(super) fn route<'h>(
 ) -> Option<(usize, Option<&'h Settings>)> {
     match (channel, hub) {
         (None, _) => Some((own, None)),
-        (Some(c), Some(hub)) => {
+        (Some(c), Some(hub)) if usize::from(c) < hub.escs.len() => {
             let c = usize::from(c);
             (hub.escs[c] != UNNUMBERED).then(|| (hub.escs[c], Some(&hub.settings[c])))
         }
-        (Some(c), None) => {
+        (Some(c), _) => {
             pending.push((t, c, *d));
             None
         }

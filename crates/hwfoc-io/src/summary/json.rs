@@ -147,6 +147,7 @@ impl EscReport<'_> {
                 "silences_not_judged": self.timed_loss().map(|l| l.unjudged),
                 "bytes_skipped": st.bytes_skipped(),
                 "delivery_ratio": st.delivery_ratio(),
+                "can": can_json(&st),
             },
             "info": infos,
             "fields": fields,
@@ -161,6 +162,31 @@ impl EscReport<'_> {
             "warning": warning,
         })
     }
+}
+
+/// An ESC's node and bus figures on a CAN bus (null elsewhere).
+fn can_json(st: &crate::stream::EscLink) -> Value {
+    let crate::stream::EscLink::Can(c) = st else {
+        return Value::Null;
+    };
+    let n = &c.node_stats;
+    json!({
+        "node": c.node,
+        "transfers": n.total_transfers(),
+        "gaps": n.gaps(),
+        "missed_transfers": n.missed(),
+        "duplicates": n.duplicates(),
+        "toggle_errors": n.toggle_errors(),
+        "crc_errors": n.crc_errors(),
+        "cut_short": n.cut_short(),
+        "orphan_frames": n.orphan_frames(),
+        "bad_payloads": n.bad_payloads(),
+        "unknown_types": n.unknown_types(),
+        "bus_frames": c.bus.frames(),
+        "not_dronecan": c.bus.not_dronecan(),
+        "error_frames": c.bus.error_frames(),
+        "bad_records": c.bad_records,
+    })
 }
 
 /// Charge, energy and power as JSON.

@@ -152,6 +152,27 @@ impl EscReport<'_> {
         if let Some(ratio) = st.delivery_ratio() {
             let _ = writeln!(o, "delivery     {:.2} % of data frames", ratio * 100.0);
         }
+        if let crate::stream::EscLink::Can(c) = &st {
+            let n = &c.node_stats;
+            let node = c
+                .node
+                .map_or("no node yet".to_string(), |n| format!("node {n}"));
+            let _ = writeln!(
+                o,
+                "can          {node}: {} transfers, {} gaps in transfer ids ({} missed), {} duplicates, {} toggle errors, {} CRC errors, {} cut short, {} of unknown types; bus: {} frames, {} not DroneCAN ({} error frames)",
+                n.total_transfers(),
+                n.gaps(),
+                n.missed(),
+                n.duplicates(),
+                n.toggle_errors(),
+                n.crc_errors(),
+                n.cut_short(),
+                n.unknown_types(),
+                c.bus.frames(),
+                c.bus.not_dronecan(),
+                c.bus.error_frames()
+            );
+        }
         if st.frames() == 0 {
             let _ = writeln!(o, "             no data frames: {}", self.no_frames);
         }

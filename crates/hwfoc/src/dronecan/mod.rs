@@ -71,8 +71,14 @@
 //! | `transfer` | [`transfer_crc`], [`signature_crc`], [`Frames`] |
 //! | `receiver` | [`Receiver`], [`Received`], [`DEFAULT_SLOTS`] |
 //! | `stats` | [`LinkStats`], [`BusStats`], [`NodeStats`] |
+//! | `escs` | [`Escs`] (which node is which ESC), the records [`HwCanEsc`], [`DroneCanEsc`] |
+
+/// The CAN bit rate Hobbywing's DroneCAN ESCs leave the factory with, bit/s (every one as
+/// node 1: `docs/HW5-AND-CAN.md`).
+pub const HOBBYWING_BITRATE: u32 = 500_000;
 
 mod bits;
+mod escs;
 mod frame;
 mod id;
 mod kind;
@@ -82,6 +88,7 @@ mod transfer;
 mod types;
 
 pub use bits::{F16_MAX, f16_from_f32, f32_from_f16, saturate_f16};
+pub use escs::{DroneCanEsc, Escs, Extended, HwCanEsc, Power, Temperatures};
 pub use frame::{
     CanFrame, FrameKind, MAX_EXTENDED_ID, MAX_STANDARD_ID, SOCKETCAN_EFF_FLAG, SOCKETCAN_ERR_FLAG,
     SOCKETCAN_RECORD_LEN, SOCKETCAN_RTR_FLAG,

@@ -10,8 +10,12 @@ use hwfoc::telemetry::{Data, Frame};
 use hwfoc::{Protocol, Settings, foc};
 use hwfoc::{datalink, detect, hw5, mixed, v3, v4};
 
+mod can;
+
+pub use self::can::CanLink;
+use self::can::CanWire;
 use crate::clock::byte_times;
-use crate::esc_numbers::UNNUMBERED;
+use crate::esc_numbers::{UNNUMBERED, channel_number};
 use crate::handler::Handler;
 
 use crate::input::Batch;
@@ -42,6 +46,8 @@ fn frames_in_of(protocol: Protocol, seconds: f64) -> u32 {
         Protocol::HwV4 => v4::DATA_FRAME_LEN,
         Protocol::HwV3 => v3::FRAME_LEN,
         Protocol::Hw5 => hw5::TELEMETRY_LEN,
+        // Not read from a serial line (a bus's stream is not told of silences).
+        Protocol::HwCan | Protocol::DroneCan => hwfoc::dronecan::SOCKETCAN_RECORD_LEN,
     };
     let frame_s = len as f64 * hwfoc::wire::byte_ns(protocol.baud_rate()) * 1e-9;
     (seconds / frame_s).ceil().min(f64::from(u32::MAX)) as u32
@@ -134,6 +140,8 @@ enum Wire {
     HwV3(v3::Decoder),
     /// HW5 only.
     Hw5(hw5::Decoder),
+    /// A CAN bus (`can.rs`): its own stream, whatever `--protocol` says.
+    Can(Box<CanWire>),
 }
 
 impl Wire {
@@ -145,6 +153,7 @@ impl Wire {
             Some(Protocol::HwV4) => Wire::HwV4(v4::Decoder::new()),
             Some(Protocol::HwV3) => Wire::HwV3(v3::Decoder::new()),
             Some(Protocol::Hw5) => Wire::Hw5(hw5::Decoder::new()),
+            Some(Protocol::HwCan | Protocol::DroneCan) => Wire::Can(Box::new(CanWire::new())),
         }
     }
 
@@ -188,6 +197,10 @@ impl Wire {
                 emit,
             ),
             Wire::HwV4(_) | Wire::HwV3(_) | Wire::Hw5(_) => self.feed_slow(data, silence_s, emit),
+            Wire::Can(c) => {
+                let at = c.bytes();
+                c.feed(data, None, &mut |_, place, f| emit(place, at, f));
+            }
         }
     }
 
@@ -221,6 +234,7 @@ impl Wire {
                 d.flush(|d| emit_any(detect::Decoded::Mixed(mixed::Decoded::Hub(d)), emit))
             }
             Wire::HwV4(_) | Wire::HwV3(_) | Wire::Hw5(_) => self.flush_slow(emit),
+            Wire::Can(c) => c.finish(),
         }
     }
 
@@ -243,6 +257,7 @@ impl Wire {
             Wire::HwV4(d) => d.stats().bytes(),
             Wire::HwV3(d) => d.stats().bytes(),
             Wire::Hw5(d) => d.stats().bytes(),
+            Wire::Can(c) => c.bytes(),
         }
     }
 
@@ -255,6 +270,7 @@ impl Wire {
             Wire::HwV4(d) => d.buffered(),
             Wire::HwV3(d) => d.buffered(),
             Wire::Hw5(d) => d.buffered(),
+            Wire::Can(c) => c.buffered(),
         }
     }
 
@@ -289,6 +305,7 @@ impl Wire {
             Wire::HwV4(d) => Some(EscLink::HwV4(*d.stats())),
             Wire::HwV3(d) => Some(EscLink::HwV3(*d.stats())),
             Wire::Hw5(d) => Some(EscLink::Hw5(*d.stats())),
+            Wire::Can(c) => Some(EscLink::Can(c.link(0))),
             Wire::HwFoc(_) | Wire::DataLink(_) => None,
         }
     }
@@ -302,6 +319,7 @@ impl Wire {
             Wire::HwV4(_) => Some(Protocol::HwV4),
             Wire::HwV3(_) => Some(Protocol::HwV3),
             Wire::Hw5(_) => Some(Protocol::Hw5),
+            Wire::Can(_) => None,
         }
     }
 }
@@ -346,6 +364,8 @@ pub enum EscLink {
     HwV3(v3::Stats),
     /// An HW5 ESC's wire.
     Hw5(hw5::Stats),
+    /// An ESC on a CAN bus (its node's and the bus's statistics).
+    Can(CanLink),
 }
 
 impl Default for Stream {
@@ -373,7 +393,7 @@ impl EscLink {
             EscLink::Hub { hub, channel } => hub.channel(*channel).map(Counting::Bits16),
             EscLink::HwV4(s) => Some(Counting::Bits24(s.counter())),
             EscLink::HwV3(s) => Some(Counting::Bits24(s.counter())),
-            EscLink::Hw5(_) => None,
+            EscLink::Hw5(_) | EscLink::Can(_) => None,
         }
     }
 
@@ -385,6 +405,7 @@ impl EscLink {
             EscLink::HwV4(_) => Protocol::HwV4,
             EscLink::HwV3(_) => Protocol::HwV3,
             EscLink::Hw5(_) => Protocol::Hw5,
+            EscLink::Can(c) => c.protocol,
         }
     }
 
@@ -396,6 +417,7 @@ impl EscLink {
             EscLink::HwV4(s) => s.bytes(),
             EscLink::HwV3(s) => s.bytes(),
             EscLink::Hw5(s) => s.bytes(),
+            EscLink::Can(c) => c.bytes,
         }
     }
 
@@ -408,6 +430,7 @@ impl EscLink {
             EscLink::HwV4(s) => s.bytes_skipped(),
             EscLink::HwV3(s) => s.bytes_skipped(),
             EscLink::Hw5(s) => s.bytes_skipped(),
+            EscLink::Can(c) => c.bytes_skipped(),
         }
     }
 
@@ -417,6 +440,7 @@ impl EscLink {
             EscLink::HwV4(s) => s.frames(),
             EscLink::HwV3(s) => s.frames(),
             EscLink::Hw5(s) => s.telemetry_frames(),
+            EscLink::Can(c) => c.records,
             _ => match self.counting() {
                 Some(Counting::Bits16(c)) => c.count(),
                 Some(Counting::Bits24(c)) => c.count(),
@@ -430,7 +454,7 @@ impl EscLink {
         match self {
             EscLink::Wire(s) => s.info_frames(),
             EscLink::HwV4(s) => s.info_frames(),
-            EscLink::Hub { .. } | EscLink::HwV3(_) | EscLink::Hw5(_) => 0,
+            EscLink::Hub { .. } | EscLink::HwV3(_) | EscLink::Hw5(_) | EscLink::Can(_) => 0,
         }
     }
 
@@ -447,6 +471,7 @@ impl EscLink {
             EscLink::Wire(s) => s.checksum_failures(),
             EscLink::Hub { hub, .. } => hub.crc_failures(),
             EscLink::Hw5(s) => s.crc_failures(),
+            EscLink::Can(c) => c.node_stats.crc_errors(),
             EscLink::HwV4(_) | EscLink::HwV3(_) => 0,
         }
     }
@@ -462,13 +487,18 @@ impl EscLink {
     }
 
     /// Whether the link's frames carry a packet counter, from which loss is counted (HW5's
-    /// do not: its lost, duplicate and restart counts are 0 and say nothing).
+    /// do not: its lost, duplicate and restart counts are 0 and say nothing). On a CAN bus,
+    /// the transfer ids of every transfer of the ESC's node are counted.
     pub fn counts_packets(&self) -> bool {
-        self.protocol().packet_bits().is_some()
+        matches!(self, EscLink::Can(_)) || self.protocol().packet_bits().is_some()
     }
 
-    /// Packet numbers skipped.
+    /// Packet numbers skipped (on a CAN bus: transfers of the node missed, from the gaps in
+    /// their transfer ids).
     pub fn lost_packets(&self) -> u32 {
+        if let EscLink::Can(c) = self {
+            return c.node_stats.missed();
+        }
         match self.counting() {
             Some(Counting::Bits16(c)) => c.lost(),
             Some(Counting::Bits24(c)) => c.lost(),
@@ -476,8 +506,11 @@ impl EscLink {
         }
     }
 
-    /// Packet numbers received twice in a row.
+    /// Packet numbers received twice in a row (on a CAN bus: transfers of the node).
     pub fn duplicate_packets(&self) -> u32 {
+        if let EscLink::Can(c) = self {
+            return c.node_stats.duplicates();
+        }
         match self.counting() {
             Some(Counting::Bits16(c)) => c.duplicates(),
             Some(Counting::Bits24(c)) => c.duplicates(),
@@ -502,8 +535,12 @@ impl EscLink {
         }
     }
 
-    /// Frames received over frames sent, from the packet numbers.
+    /// Frames received over frames sent, from the packet numbers (on a CAN bus: the node's
+    /// transfers, from their transfer ids).
     pub fn delivery_ratio(&self) -> Option<f64> {
+        if let EscLink::Can(c) = self {
+            return c.delivery_ratio();
+        }
         match self.counting()? {
             Counting::Bits16(c) => c.delivery_ratio(),
             Counting::Bits24(c) => c.delivery_ratio(),
@@ -547,6 +584,36 @@ impl Stream {
         }
     }
 
+    /// A CAN bus's stream (CAN frames as `LINKTYPE_CAN_SOCKETCAN` records: `can.rs`), nothing
+    /// decoded yet.
+    pub fn can() -> Stream {
+        Stream {
+            wire: Wire::Can(Box::new(CanWire::new())),
+            history: Vec::new(),
+        }
+    }
+
+    /// Whether the stream is a CAN bus's.
+    pub fn is_can(&self) -> bool {
+        matches!(self.wire, Wire::Can(_))
+    }
+
+    /// The ESCs a CAN bus's stream knows (GetEscID answers, whether any turns).
+    pub fn can_escs(&self) -> Option<&hwfoc::dronecan::Escs> {
+        match &self.wire {
+            Wire::Can(c) => Some(c.escs()),
+            _ => None,
+        }
+    }
+
+    /// A CAN bus's statistics, per node and of the bus.
+    pub fn can_stats(&self) -> Option<&hwfoc::dronecan::LinkStats> {
+        match &self.wire {
+            Wire::Can(c) => Some(c.stats()),
+            _ => None,
+        }
+    }
+
     /// The protocol the stream was made to read only, if any.
     pub fn forced_protocol(&self) -> Option<Protocol> {
         self.wire.forced()
@@ -560,6 +627,9 @@ impl Stream {
         batch: Batch<'_>,
         mut on_frame: impl FnMut(Option<f64>, Option<u8>, &Frame),
     ) {
+        if let Wire::Can(c) = &mut self.wire {
+            return c.feed(batch.bytes, batch.times, &mut on_frame);
+        }
         let start = self.wire.bytes();
         match batch.times {
             None => {
@@ -692,6 +762,9 @@ impl Stream {
     /// statistics are then given), else the ESC's own wire (any channel). A stream forced to
     /// read DataLink only gives the hub's channel from its first byte.
     pub fn link(&self, channel: u8) -> EscLink {
+        if let Wire::Can(c) = &self.wire {
+            return EscLink::Can(c.link(channel));
+        }
         if let Some(link) = self.wire.other() {
             return link;
         }
@@ -747,8 +820,9 @@ pub struct PortStreams {
     /// The settings of each ESC number given so far (the ports', then hubs' channels): its
     /// length is the next number to give.
     esc_settings: Vec<Settings>,
-    /// The ESC number of each channel of each port found to be a hub.
-    hubs: Vec<Option<[usize; datalink::CHANNELS]>>,
+    /// The ESC number of each channel numbered so far of each port found to be a hub or a CAN
+    /// bus (`esc_numbers.rs`).
+    hubs: Vec<Vec<usize>>,
 }
 
 impl PortStreams {
@@ -777,7 +851,7 @@ impl PortStreams {
                 .enumerate()
                 .map(|(esc, name)| map.get(esc, name))
                 .collect(),
-            hubs: vec![None; names.len()],
+            hubs: vec![Vec::new(); names.len()],
             names,
             map,
         }
@@ -826,6 +900,7 @@ impl PortStreams {
         times.clear();
         byte_times(*t_ns, per_byte_ns[*port], bytes.len(), times);
         let hub = &mut hubs[*port];
+        let can = stream.is_can();
         stream.feed(
             Batch {
                 bytes,
@@ -835,13 +910,22 @@ impl PortStreams {
             |t, channel, d| {
                 let esc = match channel {
                     None => *port,
-                    Some(c) => hub.get_or_insert_with(|| {
-                        let escs = crate::esc_numbers::hub_channels(*port, esc_settings.len());
-                        for &e in escs[1..].iter().filter(|&&e| e != UNNUMBERED) {
-                            esc_settings.push(map.get(e, &names[*port]));
+                    Some(c) => {
+                        // A hub's channels all at once, a bus's places up to the one heard.
+                        let places = if can {
+                            usize::from(c) + 1
+                        } else {
+                            datalink::CHANNELS
+                        };
+                        while hub.len() < places {
+                            let n = channel_number(*port, esc_settings.len(), hub.len());
+                            if n != UNNUMBERED && n != *port {
+                                esc_settings.push(map.get(n, &names[*port]));
+                            }
+                            hub.push(n);
                         }
-                        escs
-                    })[usize::from(c)],
+                        hub[usize::from(c)]
+                    }
                 };
                 if let Ok(id) = u8::try_from(esc) {
                     handler.frame(id, t, d, &esc_settings[esc]);
@@ -854,8 +938,17 @@ impl PortStreams {
     /// Makes every port's stream read protocol `protocol` only (see [`Stream::forced`]); what
     /// the streams decoded before is forgotten, so call it before the first event.
     pub fn force_protocol(&mut self, protocol: Protocol) {
-        for stream in &mut self.streams {
+        for stream in self.streams.iter_mut().filter(|s| !s.is_can()) {
             *stream = Stream::forced(Some(protocol));
+        }
+    }
+
+    /// Makes `port` a CAN bus's (its events carry CAN frames as records: see [`Stream::can`]);
+    /// call it before its first event.
+    pub fn set_can(&mut self, port: usize) {
+        if let Some(stream) = self.streams.get_mut(port) {
+            *stream = Stream::can();
+            self.bauds[port] = None;
         }
     }
 
@@ -863,7 +956,7 @@ impl PortStreams {
     /// stream starts again (reading the same protocols), so that what it held of bytes at
     /// another rate makes no frame.
     pub fn set_baud(&mut self, port: usize, baud: u32) {
-        let Some(stream) = self.streams.get_mut(port) else {
+        let Some(stream) = self.streams.get_mut(port).filter(|s| !s.is_can()) else {
             return;
         };
         if self.bauds[port].is_some_and(|b| b != baud) && stream.wire.bytes() > 0 {
@@ -911,7 +1004,7 @@ impl PortStreams {
     /// The DataLink channel that ESC `esc` is on, if `port` is a hub that has handed on
     /// frames and `esc` is one of its channels' numbers.
     pub fn channel_of(&self, port: usize, esc: u8) -> Option<u8> {
-        let escs = self.hubs.get(port)?.as_ref()?;
+        let escs = self.hubs.get(port)?;
         let channel = escs.iter().position(|&e| e == usize::from(esc))?;
         u8::try_from(channel).ok()
     }
