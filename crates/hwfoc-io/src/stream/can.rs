@@ -27,6 +27,9 @@ const NODES: usize = hwfoc::dronecan::NODES;
 /// stream's clock (DroneCAN's transfer timeout is 2 s).
 const EXPIRE_EVERY_S: f64 = 1.0;
 
+/// Where a bus's records go: `emit(t, place, frame)`.
+pub(crate) type Emit<'a> = dyn FnMut(Option<f64>, Option<u8>, &Frame) + 'a;
+
 /// The decoding state of a CAN bus's stream.
 #[derive(Debug)]
 pub(crate) struct CanWire {
@@ -74,7 +77,7 @@ impl CanWire {
         &mut self,
         bytes: &[u8],
         times: Option<&[f64]>,
-        emit: &mut dyn FnMut(Option<f64>, Option<u8>, &Frame),
+        emit: &mut Emit<'_>,
     ) {
         self.bytes += bytes.len() as u64;
         for (i, &b) in bytes.iter().enumerate() {
@@ -95,7 +98,7 @@ impl CanWire {
         &mut self,
         record: &[u8; SOCKETCAN_RECORD_LEN],
         t: Option<f64>,
-        emit: &mut dyn FnMut(Option<f64>, Option<u8>, &Frame),
+        emit: &mut Emit<'_>,
     ) {
         let Some(frame) = CanFrame::from_socketcan_record(record) else {
             self.bad_records += 1;
