@@ -46,6 +46,11 @@ use hwfoc_io::serial::{Baud, SEARCH_BYTES_FOR, SEARCH_RATES, SEARCH_SILENT_FOR, 
 use hwfoc_io::serial::{DEFAULT_BAUD, PortError, PortEvent, PortSet, RETRY_EVERY, Readers};
 use hwfoc_io::serial::{available_ports, is_port, open};
 
+// CAN frames: SLCAN adapters, candump logs.
+use hwfoc_io::can::candump::{Line, LineError, Logged, looks_like_line, parse_line, push_line};
+use hwfoc_io::can::slcan::{BEL, BITRATES, CLOSE, Counts, Event, MAX_LINE, Parser};
+use hwfoc_io::can::slcan::{bitrate_code, push_extended, push_frame, setup};
+
 // Times, clocks and energy.
 use hwfoc_io::clock::{MAX_FRAME_SPACING_S, MAX_STEP_S, ReceiveClock, Step};
 use hwfoc_io::clock::{byte_time_s, byte_times, unix_now_ns};
