@@ -39,6 +39,7 @@ use hwfoc_io::summary::{Episode, Mark, NO_FRAMES, Report, Summary};
 use hwfoc_io::summary::{device_json, esc_label, no_frames};
 
 // Recordings.
+use hwfoc_io::pcapng::LINKTYPE_CAN_SOCKETCAN;
 use hwfoc_io::pcapng::{Damage, Interface, LINKTYPE, MAGIC, MAX_CHUNK, Packet, Reader, Writer};
 
 // Serial ports.
@@ -67,6 +68,7 @@ fn the_surface_constants_are_those_of_the_specs() {
     // The pcapng section header block's type, and the link type of `docs/REFERENCE.md` (USER0).
     assert_eq!(MAGIC, [0x0A, 0x0D, 0x0D, 0x0A]);
     assert_eq!(LINKTYPE, 147);
+    assert_eq!(LINKTYPE_CAN_SOCKETCAN, 227);
     assert_eq!(DEFAULT_BAUD, 19_200);
     assert_eq!(NOMINAL_PERIOD_S, 0.05);
     assert_eq!(JSON_SCHEMA_VERSION, 1);
