@@ -51,6 +51,8 @@ use hwfoc_io::serial::{available_ports, is_port, open};
 use hwfoc_io::can::candump::{Line, LineError, Logged, looks_like_line, parse_line, push_line};
 use hwfoc_io::can::slcan::{BEL, BITRATES, CLOSE, Counts, Event, MAX_LINE, Parser};
 use hwfoc_io::can::slcan::{bitrate_code, push_extended, push_frame, setup};
+use hwfoc_io::can::{ASK_EVERY, ASK_PRIORITY, AskIds, DEFAULT_SOURCE_NODE};
+use hwfoc_io::can::{CanBus, CanError, CanSpec, DEFAULT_BITRATE, SLCAN_BAUD, is_can_spec};
 
 // Times, clocks and energy.
 use hwfoc_io::clock::{MAX_FRAME_SPACING_S, MAX_STEP_S, ReceiveClock, Step};
