@@ -103,6 +103,40 @@ impl fmt::Display for CanError {
 
 impl std::error::Error for CanError {}
 
+impl CanError {
+    /// The error as a port's that could not be opened ([`PortError`]), for a bus opened among
+    /// serial ports ([`crate::serial::PortSet`]).
+    pub fn into_port_error(self) -> PortError {
+        let other = |port: String, message: &str| PortError::Other {
+            port,
+            message: message.to_string(),
+        };
+        match self {
+            CanError::Port(e) => e,
+            CanError::Permission { bus } => PortError::Permission {
+                port: bus,
+                group: None,
+            },
+            CanError::Spec { bus, reason } => other(bus, &reason),
+            CanError::NoSuchInterface { interface } => other(
+                format!("can:{interface}"),
+                "no such network interface (`ip link` lists them)",
+            ),
+            CanError::NotCan { interface } => {
+                other(format!("can:{interface}"), "not a CAN interface")
+            }
+            CanError::BitrateRefused { bus, bitrate } => other(
+                bus,
+                &format!("the adapter refused the bit rate {bitrate} bit/s"),
+            ),
+            CanError::Unsupported { bus } => {
+                other(bus, "SocketCAN interfaces are read on Linux only")
+            }
+            CanError::Lost { bus, reason } => other(bus, &reason),
+        }
+    }
+}
+
 /// A parsed bus spec.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub enum CanSpec {
