@@ -722,3 +722,79 @@ fn rotation_skips_a_name_taken_meanwhile() {
         (1000..1060).collect::<Vec<u16>>()
     );
 }
+
+/// `hwfoc record slcan:PTY`: each frame the adapter reports is a packet of a
+/// `LINKTYPE_CAN_SOCKETCAN` interface at its receive time, read back as the recording's CAN
+/// stream (and by tshark as CAN frames where it is installed).
+#[test]
+fn records_an_slcan_bus_as_can_frames() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("bus.pcapng");
+    let mut pty = pty();
+    let bus = format!("slcan:{}", pty.path.to_str().unwrap());
+    let mut rec = Running::start(&[
+        "record",
+        &bus,
+        "-o",
+        out.to_str().unwrap(),
+        "--duration",
+        "2.5",
+    ]);
+    rec.wait_for("recording", Duration::from_secs(10));
+    let before = unix_now();
+    for k in 0..5u8 {
+        let line = format!("T1050527F3{k:02X}00C{k}\r");
+        pty.master.write_all(line.as_bytes()).unwrap();
+        thread::sleep(Duration::from_millis(50));
+    }
+    let after = unix_now();
+    assert!(rec.wait(Duration::from_secs(10)), "{}", rec.stderr());
+
+    let file = std::fs::read(&out).unwrap();
+    let mut reader = hwfoc_io::pcapng::Reader::new(&file[..]);
+    let mut frames = Vec::new();
+    while let Some(p) = reader.next_packet().unwrap() {
+        assert!(p.interface.is_can(), "{:?}", p.interface);
+        if p.data.is_empty() {
+            continue; // a note
+        }
+        let t = p.t_ns as f64 * 1e-9;
+        assert!(
+            t >= before - 0.01 && t <= after + 0.5,
+            "{t} not in {before}..{after}"
+        );
+        frames.push(p.can_frame().unwrap().to_string());
+    }
+    assert_eq!(
+        frames,
+        (0..5)
+            .map(|k| format!("1050527F#{k:02X}00C{k}"))
+            .collect::<Vec<_>>()
+    );
+    assert_eq!(reader.interfaces()[0].name, bus);
+    assert_eq!(reader.interfaces()[0].baud, Some(500_000));
+    let mut input = hwfoc_io::Input::open(out.to_str().unwrap()).unwrap();
+    let mut records = 0;
+    while let Some(b) = input.next_batch().unwrap() {
+        records += b.bytes.len() / 16;
+    }
+    assert!(input.is_can(0));
+    assert_eq!(records, 5);
+    if tshark_available() {
+        let shown = run(Command::new("tshark").arg("-r").arg(&out).args([
+            "-Y",
+            "can",
+            "-T",
+            "fields",
+            "-e",
+            "can.id",
+            "-e",
+            "data.data",
+        ]));
+        let text = String::from_utf8_lossy(&shown.stdout).into_owned();
+        // 0x1050527F
+        assert_eq!(text.lines().count(), 5, "{text}");
+        assert!(text.lines().all(|l| l.starts_with("273699455\t")), "{text}");
+        assert!(text.contains("0200c2"), "{text}");
+    }
+}

@@ -20,6 +20,7 @@
 //! - [`pcapng`]: the recording format (writer and truncation-tolerant reader);
 //! - [`time`]: times as people write them (`--from +5`, ISO 8601) and dates shown where the
 //!   source has a wall clock; [`energy`]: charge and energy integrated over frame times;
+//! - [`can`]: CAN frames in and out (SLCAN adapters, `candump` logs);
 //! - [`serial`]: serial ports that survive being unplugged; [`clock`]: receive times;
 //!   every loop that waits (a port input, an export's [`stop_on`](write::Export::stop_on))
 //!   ends when a stop flag its caller passes in (an `Arc<AtomicBool>`) is set: the library
@@ -121,6 +122,7 @@
 
 // Modules whose names are a namespace for their items (`time::parse`, `serial::open`,
 // `pcapng::Reader`, `write::arrow::schema`): public, each exporting only its public items.
+pub mod can;
 pub mod clock;
 pub mod energy;
 pub mod pcapng;

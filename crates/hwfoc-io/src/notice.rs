@@ -55,6 +55,16 @@ pub enum Notice {
         /// Its pcapng link type.
         link_type: u16,
     },
+    /// Frames of a CAN interface or log that are not classic CAN (CAN FD), skipped: told once
+    /// per interface, with their number, at the end of the input.
+    NotClassicCan {
+        /// The input as named.
+        input: String,
+        /// The interface (bus).
+        interface: String,
+        /// How many were skipped.
+        frames: u64,
+    },
     /// A damaged place in a recording, skipped.
     Damage {
         /// The input as named.
@@ -109,6 +119,7 @@ impl Notice {
             self,
             Notice::PortLost { .. }
                 | Notice::ForeignInterface { .. }
+                | Notice::NotClassicCan { .. }
                 | Notice::Damage { .. }
                 | Notice::Overlap { .. }
         )
@@ -162,6 +173,16 @@ impl fmt::Display for Notice {
                 f,
                 "{}: interface {} has link type {link_type}, not serial bytes: its packets are \
                  skipped",
+                Escaped(input),
+                Escaped(interface)
+            ),
+            Notice::NotClassicCan {
+                input,
+                interface,
+                frames,
+            } => write!(
+                f,
+                "{}: {}: {frames} CAN FD frames skipped (only classic CAN is read)",
                 Escaped(input),
                 Escaped(interface)
             ),

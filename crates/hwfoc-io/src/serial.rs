@@ -13,6 +13,12 @@
 //! at a rate that gave no frame are not handed on (read at the wrong rate they are not the
 //! wire's bytes: [`PortEvent::Searching`] counts them), so that nothing downstream, a decoder
 //! or a recording, ever takes them for telemetry.
+//!
+//! A port named `slcan:PORT[:BITRATE]` or `can:IFACE` ([`crate::can::is_can_spec`]) is a CAN
+//! bus ([`crate::can::CanBus`]), read by a thread of its own that hands on each frame as a
+//! [`PortEvent::Data`] of its 16-byte record at the frame's time ([`PortSet::is_can`]), asks
+//! the bus's ESCs for their ids ([`crate::can::AskIds`]), and is lost and back as a serial port
+//! is; no rate is searched on it.
 
 use std::io::{self, Read};
 use std::path::Path;
@@ -22,6 +28,7 @@ use std::sync::mpsc::{self, Receiver, Sender};
 use std::thread::{self, JoinHandle};
 use std::time::{Duration, Instant};
 
+use crate::can::{CanBus, CanError};
 use crate::clock::ReceiveClock;
 
 use hwfoc::Protocol;
@@ -501,6 +508,8 @@ pub struct PortSet {
 /// (wrapped in the caller's message type); dropping it stops them.
 pub struct Readers {
     names: Vec<String>,
+    /// Whether each port is a CAN bus.
+    can: Vec<bool>,
     baud: Baud,
     clock: ReceiveClock,
     stop: Arc<AtomicBool>,
@@ -532,16 +541,42 @@ impl Readers {
                 ),
             });
         }
+        let clock = ReceiveClock::new();
         let ports = names
             .iter()
-            .map(|name| open(name, baud.initial()))
+            .map(|name| match crate::can::is_can_spec(name) {
+                true => CanBus::open_with_clock(name, true, clock)
+                    .map(|bus| Opened::Can(Box::new(bus)))
+                    .map_err(CanError::into_port_error),
+                false => open(name, baud.initial()).map(Opened::Serial),
+            })
             .collect::<Result<Vec<_>, _>>()?;
-        let clock = ReceiveClock::new();
+        let can: Vec<bool> = ports.iter().map(|p| matches!(p, Opened::Can(_))).collect();
         let stop = Arc::new(AtomicBool::new(false));
         let threads = ports
             .into_iter()
             .enumerate()
             .map(|(index, port)| {
+                let port = match port {
+                    Opened::Serial(port) => port,
+                    Opened::Can(bus) => {
+                        let reader = CanReader {
+                            index,
+                            name: names[index].clone(),
+                            clock,
+                            stop: Arc::clone(&stop),
+                            tx: tx.clone(),
+                            wrap,
+                        };
+                        return thread::Builder::new()
+                            .name(format!("read {}", names[index]))
+                            .spawn(move || reader.run(*bus))
+                            .map_err(|e| PortError::Other {
+                                port: names[index].clone(),
+                                message: format!("cannot start its reader thread: {e}"),
+                            });
+                    }
+                };
                 let reader = PortReader {
                     index,
                     name: names[index].clone(),
@@ -565,6 +600,7 @@ impl Readers {
             .collect::<Result<Vec<_>, _>>()?;
         Ok(Readers {
             names: names.to_vec(),
+            can,
             baud,
             clock,
             stop,
@@ -580,6 +616,13 @@ impl Readers {
     /// The rate the ports were opened with: given, or [`Baud::Auto`].
     pub fn baud(&self) -> Baud {
         self.baud
+    }
+
+    /// Whether port `port` is a CAN bus (`slcan:...`, `can:...`): its bytes are frame records
+    /// of 16 bytes ([`hwfoc::dronecan::CanFrame::to_socketcan_record`]), one
+    /// [`PortEvent::Data`] per frame.
+    pub fn is_can(&self, port: usize) -> bool {
+        self.can.get(port).copied().unwrap_or(false)
     }
 
     /// The clock the events' times come from.
@@ -627,6 +670,11 @@ impl PortSet {
         self.readers.clock()
     }
 
+    /// Whether port `port` is a CAN bus ([`Readers::is_can`]).
+    pub fn is_can(&self, port: usize) -> bool {
+        self.readers.is_can(port)
+    }
+
     /// The next event, waiting at most `timeout`; `None` if none came.
     pub fn next_event(&self, timeout: Duration) -> Option<PortEvent> {
         self.events.recv_timeout(timeout).ok()
@@ -642,6 +690,74 @@ impl PortSet {
     pub fn close(mut self) -> Vec<PortEvent> {
         self.readers.shut_down();
         self.events.try_iter().collect()
+    }
+}
+
+/// A port as opened: a serial port or a CAN bus.
+enum Opened {
+    Serial(Box<dyn SerialPort>),
+    Can(Box<CanBus>),
+}
+
+/// A CAN bus's reader thread: a [`PortEvent::Data`] per frame, lost and back as a port.
+struct CanReader<M> {
+    index: usize,
+    name: String,
+    clock: ReceiveClock,
+    stop: Arc<AtomicBool>,
+    tx: Sender<M>,
+    wrap: fn(PortEvent) -> M,
+}
+
+impl<M> CanReader<M> {
+    fn run(self, bus: CanBus) {
+        let mut bus = Some(bus);
+        while !self.stop.load(Ordering::Relaxed) {
+            let Some(b) = bus.as_mut() else {
+                bus = self.reopen();
+                continue;
+            };
+            let event = match b.recv(READ_TIMEOUT) {
+                Ok(None) => continue,
+                Ok(Some((t_s, frame))) => PortEvent::Data {
+                    port: self.index,
+                    t_ns: (t_s * 1e9).round() as u64,
+                    bytes: frame.to_socketcan_record().to_vec(),
+                },
+                Err(e) => {
+                    bus = None;
+                    PortEvent::Lost {
+                        port: self.index,
+                        t_ns: self.clock.now_ns(),
+                        reason: match e {
+                            CanError::Lost { reason, .. } => reason,
+                            e => e.to_string(),
+                        },
+                    }
+                }
+            };
+            if self.tx.send((self.wrap)(event)).is_err() {
+                return;
+            }
+        }
+    }
+
+    /// Waits [`RETRY_EVERY`] (or until asked to stop) and tries to open the bus again.
+    fn reopen(&self) -> Option<CanBus> {
+        let until = Instant::now() + RETRY_EVERY;
+        while Instant::now() < until {
+            if self.stop.load(Ordering::Relaxed) {
+                return None;
+            }
+            thread::sleep(Duration::from_millis(20));
+        }
+        let bus = CanBus::open_with_clock(&self.name, true, self.clock).ok()?;
+        let event = PortEvent::Back {
+            port: self.index,
+            t_ns: self.clock.now_ns(),
+        };
+        self.tx.send((self.wrap)(event)).ok()?;
+        Some(bus)
     }
 }
 

@@ -39,12 +39,20 @@ use hwfoc_io::summary::{Episode, Mark, NO_FRAMES, Report, Summary};
 use hwfoc_io::summary::{device_json, esc_label, no_frames};
 
 // Recordings.
+use hwfoc_io::pcapng::LINKTYPE_CAN_SOCKETCAN;
 use hwfoc_io::pcapng::{Damage, Interface, LINKTYPE, MAGIC, MAX_CHUNK, Packet, Reader, Writer};
 
 // Serial ports.
 use hwfoc_io::serial::{Baud, SEARCH_BYTES_FOR, SEARCH_RATES, SEARCH_SILENT_FOR, Search, Verdict};
 use hwfoc_io::serial::{DEFAULT_BAUD, PortError, PortEvent, PortSet, RETRY_EVERY, Readers};
 use hwfoc_io::serial::{available_ports, is_port, open};
+
+// CAN frames: SLCAN adapters, candump logs.
+use hwfoc_io::can::candump::{Line, LineError, Logged, looks_like_line, parse_line, push_line};
+use hwfoc_io::can::slcan::{BEL, BITRATES, CLOSE, Counts, Event, MAX_LINE, Parser};
+use hwfoc_io::can::slcan::{bitrate_code, push_extended, push_frame, setup};
+use hwfoc_io::can::{ASK_EVERY, ASK_PRIORITY, AskIds, DEFAULT_SOURCE_NODE};
+use hwfoc_io::can::{CanBus, CanError, CanSpec, DEFAULT_BITRATE, SLCAN_BAUD, is_can_spec};
 
 // Times, clocks and energy.
 use hwfoc_io::clock::{MAX_FRAME_SPACING_S, MAX_STEP_S, ReceiveClock, Step};
@@ -62,6 +70,7 @@ fn the_surface_constants_are_those_of_the_specs() {
     // The pcapng section header block's type, and the link type of `docs/REFERENCE.md` (USER0).
     assert_eq!(MAGIC, [0x0A, 0x0D, 0x0D, 0x0A]);
     assert_eq!(LINKTYPE, 147);
+    assert_eq!(LINKTYPE_CAN_SOCKETCAN, 227);
     assert_eq!(DEFAULT_BAUD, 19_200);
     assert_eq!(NOMINAL_PERIOD_S, 0.05);
     assert_eq!(JSON_SCHEMA_VERSION, 1);

@@ -67,7 +67,7 @@
 //! [`slcan::push_extended`] does. `canadensis` is Cyphal (UAVCAN v1), another transport.
 
 pub mod dsdl;
-pub mod slcan;
+pub use hwfoc_io::can::slcan;
 
 use std::time::{Duration, Instant};
 

@@ -521,6 +521,11 @@ impl Recorder {
 
     /// Decodes a chunk to count frames and to notice a port that sends no valid frame.
     fn decode(&mut self, port: usize, event: &PortEvent) {
+        if hwfoc_io::can::is_can_spec(&self.ports[port].name) {
+            // A CAN bus's frame records: never given to the serial formats' detection.
+            self.ports[port].silent_since = None;
+            return;
+        }
         let before = self.streams.stats(port).map_or(0, frames);
         let after = self.streams.feed(event, &mut ()).map_or(0, frames);
         let bytes = match event {
@@ -772,6 +777,17 @@ fn headers(
     };
     let mut writer = pcapng::Writer::new(BufWriter::with_capacity(BUFFER, file)).map_err(err)?;
     for (i, port) in ports.iter().enumerate() {
+        if let Ok(spec) = hwfoc_io::can::CanSpec::parse(port)
+            && hwfoc_io::can::is_can_spec(port)
+        {
+            // A CAN bus: one packet per frame (`pcapng::Writer::write` takes its records).
+            let bitrate = match spec {
+                hwfoc_io::can::CanSpec::Slcan { bitrate, .. } => Some(bitrate),
+                hwfoc_io::can::CanSpec::SocketCan { .. } => None,
+            };
+            writer.add_can_interface(port, bitrate).map_err(err)?;
+            continue;
+        }
         let baud = bauds.get(i).copied().flatten().unwrap_or(DEFAULT_BAUD);
         writer.add_interface(port, baud).map_err(err)?;
     }

@@ -6,6 +6,9 @@
 //! bytes on standard input behave identically:
 //! - a pcapng recording (`hwfoc record`, or any pcapng of raw UART bytes), whatever the file is
 //!   called: one stream per interface, times from the packets' timestamps (Unix seconds);
+//!   an interface of link type `LINKTYPE_CAN_SOCKETCAN` is a CAN stream (each frame's 16-byte
+//!   record, [`Input::is_can`]);
+//! - a `candump -l` log: one CAN stream per interface named in it, times its timestamps;
 //! - a logic-analyser CSV export (`Time [s],Value,Parity Error,Framing Error`, values as `0xNN`
 //!   or decimal), whose times become `t_s`;
 //! - otherwise raw bytes as they came off the wire (no timing).
@@ -13,13 +16,14 @@
 //! Serial ports are opened with [`Input::open_ports`]: one input with one stream per port,
 //! times being the Unix time each byte was received.
 //!
-//! Each kind of input is a module (`raw.rs`, `csv.rs`, `recording.rs`, `ports.rs`) declaring
+//! Each kind of input is a module (`raw.rs`, `csv.rs`, `recording.rs`, `candump.rs`, `ports.rs`) declaring
 //! its [`InputFormat`] (names, clock, whether live, whether its streams are recorded ports:
 //! what [`crate::Sources`] and the summary ask of a format) and implementing `Source`
 //! (its reading, its streams, its flagged bytes). Standard input and files are read as their
 //! content says.
 
 mod ahead;
+mod candump;
 mod csv;
 mod error;
 mod looks;
@@ -37,6 +41,7 @@ use crate::notice::{self, Notice, NoticeSink};
 use crate::pcapng;
 use crate::serial::PortSet;
 
+use self::candump::CandumpReader;
 use self::csv::{CsvRows, may_be_header};
 pub use self::error::InputError;
 pub use self::looks::Looks;
@@ -155,6 +160,12 @@ trait Source {
     /// Bytes flagged with a parity or framing error by what captured them, so far.
     fn flagged_bytes(&self) -> u64;
 
+    /// Whether stream `i` is a CAN bus: its bytes are frames of 16 bytes each
+    /// ([`hwfoc::dronecan::CanFrame::to_socketcan_record`]), every byte at its frame's time.
+    fn is_can(&self, _stream: usize) -> bool {
+        false
+    }
+
     /// What the first bytes look like when they are not telemetry (raw bytes only).
     fn looks(&self) -> Option<Looks>;
 
@@ -171,6 +182,8 @@ struct Kept {
     streams: usize,
     /// The names of its streams, where it names them.
     names: Vec<String>,
+    /// Which of its streams are CAN buses.
+    can: Vec<bool>,
     flagged: u64,
     looks: Option<Looks>,
 }
@@ -183,6 +196,7 @@ impl Kept {
             names: (0..streams)
                 .map_while(|i| source.stream_name(i).map(str::to_string))
                 .collect(),
+            can: (0..streams).map(|i| source.is_can(i)).collect(),
             flagged: source.flagged_bytes(),
             looks: source.looks(),
         }
@@ -388,6 +402,9 @@ impl Input {
         let source: Box<dyn Source> = if recording::is_start(&head) {
             let reader = Box::new(Cursor::new(head).chain(opened.reader()));
             Box::new(RecordingReader::new(reader))
+        } else if candump::is_start(&head) {
+            let reader = Box::new(Cursor::new(head).chain(opened.reader()));
+            Box::new(CandumpReader::new(reader))
         } else if csv::is_header(&head) {
             let reader = BufReader::with_capacity(BATCH, opened.reader());
             Box::new(CsvRows::open(name, reader, head)?)
@@ -464,6 +481,18 @@ impl Input {
             None => self.kept.names.get(i).map(String::as_str),
         };
         name.unwrap_or(&self.name).to_string()
+    }
+
+    /// Whether stream `i` is a CAN bus (a `candump` log's interface, a recording's CAN
+    /// interface, a CAN adapter): its bytes are frames of
+    /// [`SOCKETCAN_RECORD_LEN`](hwfoc::dronecan::SOCKETCAN_RECORD_LEN) bytes each, in
+    /// [`CanFrame::to_socketcan_record`](hwfoc::dronecan::CanFrame::to_socketcan_record)'s
+    /// layout, every byte with its frame's receive time.
+    pub fn is_can(&self, i: usize) -> bool {
+        match &self.source {
+            Some(source) => source.is_can(i),
+            None => self.kept.can.get(i).copied().unwrap_or(false),
+        }
     }
 
     /// The next batch of bytes, or `None` at the end of the input.
@@ -614,7 +643,9 @@ fn read_head(name: &str, reader: &mut dyn Read) -> Result<Vec<u8>, InputError> {
             break;
         }
         head.push(byte[0]);
-        if !may_be_header(&head) || byte[0] == b'\n' || head.len() >= 512 {
+        // A candump log starts with its first line, `(` and a timestamp, read whole.
+        let may_be = may_be_header(&head) || candump::may_start(&head);
+        if !may_be || byte[0] == b'\n' || head.len() >= 512 {
             break;
         }
     }

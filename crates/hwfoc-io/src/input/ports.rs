@@ -28,7 +28,10 @@ impl Ports {
     pub(super) fn new(set: PortSet, interrupted: Arc<AtomicBool>) -> Ports {
         let per_byte = hwfoc::wire::byte_ns(set.baud().initial());
         Ports {
-            per_byte_ns: vec![per_byte; set.names().len()],
+            // A CAN bus's bytes all have their frame's time.
+            per_byte_ns: (0..set.names().len())
+                .map(|i| if set.is_can(i) { 0.0 } else { per_byte })
+                .collect(),
             set,
             interrupted,
         }
@@ -110,6 +113,10 @@ impl Source for Ports {
 
     fn stream_name(&self, i: usize) -> Option<&str> {
         self.names().get(i).map(String::as_str)
+    }
+
+    fn is_can(&self, stream: usize) -> bool {
+        self.set.is_can(stream)
     }
 
     fn flagged_bytes(&self) -> u64 {

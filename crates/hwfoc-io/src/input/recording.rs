@@ -39,6 +39,9 @@ pub(super) struct RecordingReader {
     error: Option<InputError>,
     /// Interfaces whose link type is not telemetry, already warned about.
     skipped: std::collections::HashSet<u32>,
+    /// Packets of CAN interfaces that are not classic CAN frames (CAN FD), by interface: told
+    /// at the end.
+    not_classic: std::collections::BTreeMap<u32, u64>,
 }
 
 /// One interface's bytes of a window.
@@ -68,6 +71,7 @@ impl RecordingReader {
             ended: false,
             error: None,
             skipped: Default::default(),
+            not_classic: Default::default(),
         }
     }
 
@@ -97,6 +101,13 @@ impl RecordingReader {
                 Ok(None) => {
                     self.ended = true;
                     self.report_damage(name, notices);
+                    for (&iface, &frames) in &self.not_classic {
+                        notices(Notice::NotClassicCan {
+                            input: name.to_string(),
+                            interface: self.reader.interfaces()[iface as usize].name.clone(),
+                            frames,
+                        });
+                    }
                     return Ok(());
                 }
                 Err(e) => {
@@ -113,9 +124,29 @@ impl RecordingReader {
                 });
             }
             let mut full = false;
-            if packet.data.is_empty() {
-                // A note only.
-            } else if !interface.is_user_link_type() {
+            let mut data = packet.data;
+            let record;
+            if interface.is_can() && !data.is_empty() {
+                // A CAN frame: its record, each byte at the frame's time.
+                match packet.can_frame() {
+                    Some(frame) => {
+                        record = frame.to_socketcan_record();
+                        data = &record;
+                    }
+                    None => {
+                        *self.not_classic.entry(iface).or_default() += 1;
+                        data = &[];
+                    }
+                }
+            }
+            let per_byte_ns = if interface.is_can() {
+                0.0
+            } else {
+                interface.byte_ns()
+            };
+            if data.is_empty() {
+                // A note only (or a CAN frame not read).
+            } else if !interface.is_user_link_type() && !interface.is_can() {
                 if self.skipped.insert(iface) {
                     notices(Notice::ForeignInterface {
                         input: name.to_string(),
@@ -134,8 +165,8 @@ impl RecordingReader {
                     self.pending.len() - 1
                 });
                 let Gathered { bytes, times, .. } = &mut self.pending[i];
-                byte_times(t_ns, interface.byte_ns(), packet.data.len(), times);
-                bytes.extend_from_slice(packet.data);
+                byte_times(t_ns, per_byte_ns, data.len(), times);
+                bytes.extend_from_slice(data);
                 let start = *self.window_start.get_or_insert(t_ns);
                 full = bytes.len() >= RECORDING_BATCH
                     || t_ns.saturating_sub(start) >= RECORDING_WINDOW_NS;
@@ -235,6 +266,10 @@ impl Source for RecordingReader {
 
     fn stream_name(&self, i: usize) -> Option<&str> {
         self.interfaces().get(i).map(|f| f.name.as_str())
+    }
+
+    fn is_can(&self, stream: usize) -> bool {
+        self.interfaces().get(stream).is_some_and(|f| f.is_can())
     }
 
     fn flagged_bytes(&self) -> u64 {

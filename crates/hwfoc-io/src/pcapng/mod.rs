@@ -1,5 +1,10 @@
 //! Recordings in pcapng, the capture format of Wireshark and tshark.
 //!
+//! A CAN bus is recorded as an interface of link type [`LINKTYPE_CAN_SOCKETCAN`] (`if_name` the
+//! bus, `if_speed` its bit rate when known), one packet per frame (its 16-byte record) at the
+//! frame's receive time ([`Writer::add_can_interface`], [`Writer::write_can`]; read back with
+//! [`Packet::can_frame`]). What follows is the serial ports' layout.
+//!
 //! A recording holds the bytes received on one or more serial ports exactly as they arrived,
 //! every byte in order, with its receive time:
 //! - a section header block (SHB) naming the writing application (`shb_userappl` = `hwfoc` and
@@ -46,6 +51,10 @@ pub use write::Writer;
 
 /// `LINKTYPE_USER0`: raw HW-FOC UART bytes (the user range 147..=162 is for private use).
 pub const LINKTYPE: u32 = 147;
+
+/// `LINKTYPE_CAN_SOCKETCAN`: CAN frames, each packet SocketCAN's `struct can_frame` with its
+/// identifier big-endian (16 bytes: [`hwfoc::dronecan::CanFrame::to_socketcan_record`]).
+pub const LINKTYPE_CAN_SOCKETCAN: u32 = 227;
 
 /// The first four bytes of every pcapng file (the section header block's type; the same in
 /// both byte orders).

@@ -36,6 +36,11 @@ impl Interface {
         hwfoc::wire::byte_ns(self.baud.unwrap_or(crate::serial::DEFAULT_BAUD))
     }
 
+    /// Whether the interface carries CAN frames ([`super::LINKTYPE_CAN_SOCKETCAN`]).
+    pub fn is_can(&self) -> bool {
+        u32::from(self.link_type) == super::LINKTYPE_CAN_SOCKETCAN
+    }
+
     /// Whether the link type is in the user range (147..=162), where HW-FOC bytes are stored.
     pub fn is_user_link_type(&self) -> bool {
         (147..=162).contains(&self.link_type)
@@ -56,6 +61,23 @@ pub struct Packet<'a> {
     pub comment: Option<&'a str>,
     /// The interface `iface`.
     pub interface: &'a Interface,
+}
+
+impl Packet<'_> {
+    /// The classic CAN frame a packet of a CAN interface ([`Interface::is_can`]) holds: its 16
+    /// bytes (SocketCAN's `struct can_frame`, identifier big-endian), or the 8-byte header and
+    /// only the data bytes its length says. `None` for any other packet (a CAN FD frame, a
+    /// note, a packet cut short).
+    pub fn can_frame(&self) -> Option<hwfoc::dronecan::CanFrame> {
+        let header = self.data.get(..8)?;
+        let len = usize::from(header[4]);
+        let data = self.data.get(8..8 + len)?;
+        if len > 8 || (self.data.len() != 8 + len && self.data.len() != 16) {
+            return None;
+        }
+        let can_id = u32::from_be_bytes([header[0], header[1], header[2], header[3]]);
+        hwfoc::dronecan::CanFrame::from_socketcan(can_id, data)
+    }
 }
 
 /// A place in a recording that could not be read.

@@ -2,10 +2,12 @@
 
 use std::io::{self, Write};
 
+use hwfoc::dronecan::SOCKETCAN_RECORD_LEN;
+
 use super::cut::{Cutter, Emit};
 use super::{
-    BYTE_ORDER_MAGIC, EPB, IDB, IF_DESCRIPTION, IF_NAME, IF_SPEED, IF_TSRESOL, LINKTYPE, MAX_CHUNK,
-    OPT_COMMENT, OPT_END, SHB, SHB_OS, SHB_USERAPPL,
+    BYTE_ORDER_MAGIC, EPB, IDB, IF_DESCRIPTION, IF_NAME, IF_SPEED, IF_TSRESOL, LINKTYPE,
+    LINKTYPE_CAN_SOCKETCAN, MAX_CHUNK, OPT_COMMENT, OPT_END, SHB, SHB_OS, SHB_USERAPPL,
 };
 
 /// Writes a pcapng recording: the section header on creation, then interfaces, frames and notes.
@@ -19,6 +21,8 @@ pub struct Writer<W: Write> {
     inner: W,
     /// Baud rate and cutter of each interface, by id.
     ports: Vec<(u32, Cutter)>,
+    /// Whether each interface is a CAN bus ([`Writer::add_can_interface`]).
+    can: Vec<bool>,
     block: Vec<u8>,
     written: u64,
 }
@@ -61,6 +65,7 @@ impl<W: Write> Writer<W> {
         let mut writer = Writer {
             inner: w,
             ports: Vec::new(),
+            can: Vec::new(),
             block: Vec::with_capacity(256),
             written: 0,
         };
@@ -105,7 +110,63 @@ impl<W: Write> Writer<W> {
         self.finish()?;
         self.ports
             .push((baud, Cutter::new(hwfoc::wire::byte_ns(baud))));
+        self.can.push(false);
         Ok(id)
+    }
+
+    /// Declares a CAN bus: writes an interface description block of link type
+    /// [`LINKTYPE_CAN_SOCKETCAN`] (`if_name` = `bus`, `if_speed` = `bitrate` where known, the
+    /// description "CAN bus (DroneCAN), 500000 bit/s") and returns its interface id. Its frames
+    /// are written with [`Writer::write_can`] (or [`Writer::write`], which takes them as
+    /// records back to back).
+    pub fn add_can_interface(&mut self, bus: &str, bitrate: Option<u32>) -> io::Result<u32> {
+        let id = u32::try_from(self.ports.len())
+            .map_err(|_| io::Error::new(io::ErrorKind::InvalidInput, "too many interfaces"))?;
+        self.begin(IDB);
+        self.put_u16(LINKTYPE_CAN_SOCKETCAN as u16);
+        self.put_u16(0); // reserved
+        self.put_u32(0); // snap length: no limit
+        self.option(IF_NAME, bus.as_bytes());
+        let description = match bitrate {
+            Some(b) => format!("CAN bus (DroneCAN), {b} bit/s"),
+            None => "CAN bus (DroneCAN)".to_string(),
+        };
+        self.option(IF_DESCRIPTION, description.as_bytes());
+        if let Some(b) = bitrate.filter(|&b| b > 0) {
+            self.option(IF_SPEED, &u64::from(b).to_le_bytes());
+        }
+        self.option(IF_TSRESOL, &[9]);
+        self.end_options();
+        self.finish()?;
+        // The baud rate is not used for a CAN interface (its packets are never cut).
+        let baud = crate::serial::DEFAULT_BAUD;
+        self.ports
+            .push((baud, Cutter::new(hwfoc::wire::byte_ns(baud))));
+        self.can.push(true);
+        Ok(id)
+    }
+
+    /// Writes one CAN frame received on the CAN interface `iface` at `t_ns` (Unix ns): one
+    /// packet holding its record ([`hwfoc::dronecan::CanFrame::to_socketcan_record`]).
+    pub fn write_can(
+        &mut self,
+        iface: u32,
+        t_ns: u64,
+        record: &[u8; SOCKETCAN_RECORD_LEN],
+    ) -> io::Result<()> {
+        if !self.is_can(iface)? {
+            return Err(io::Error::new(
+                io::ErrorKind::InvalidInput,
+                format!("interface {iface} is not a CAN interface"),
+            ));
+        }
+        self.packet(iface, t_ns, record, None)
+    }
+
+    /// Whether interface `iface` is a CAN bus; an error if it was never added.
+    fn is_can(&self, iface: u32) -> io::Result<bool> {
+        self.baud(iface)?;
+        Ok(self.can[iface as usize])
     }
 
     /// Writes bytes received on interface `iface`, `t_ns` the Unix time in nanoseconds of the
@@ -113,8 +174,23 @@ impl<W: Write> Writer<W> {
     /// becomes a packet, timestamped with its first byte's time, and the bytes between frames
     /// packets of their own (see the module documentation). The bytes of a frame still arriving
     /// are held for the next call. An empty `data` writes nothing.
+    ///
+    /// On a CAN interface, `data` is frame records back to back (a CAN stream's bytes), each
+    /// written as a packet at `t_ns`; a length that is not a multiple of 16 is an error.
     pub fn write(&mut self, iface: u32, t_ns: u64, data: &[u8]) -> io::Result<()> {
-        self.baud(iface)?;
+        if self.is_can(iface)? {
+            let (records, rest) = data.as_chunks::<SOCKETCAN_RECORD_LEN>();
+            if !rest.is_empty() {
+                return Err(io::Error::new(
+                    io::ErrorKind::InvalidInput,
+                    format!("{} bytes are not whole CAN frame records", data.len()),
+                ));
+            }
+            for record in records {
+                self.packet(iface, t_ns, record, None)?;
+            }
+            return Ok(());
+        }
         let mut cutter = self.take_cutter(iface);
         let result = cutter.feed(
             t_ns,
@@ -153,14 +229,16 @@ impl<W: Write> Writer<W> {
     /// How many bytes the file would grow by if `data` were written on `iface` at this moment
     /// and the recording then ended (every held byte written): a bound for rotating by size.
     pub fn cost(&self, iface: u32, data: &[u8]) -> io::Result<u64> {
-        self.baud(iface)?;
         let mut cost = Cost(0);
+        if self.is_can(iface)? {
+            cost.0 = (data.len() / SOCKETCAN_RECORD_LEN) as u64 * epb_size(SOCKETCAN_RECORD_LEN);
+        }
         for (i, (_, cutter)) in self.ports.iter().enumerate() {
             if i != iface as usize && !cutter.holds() {
                 continue;
             }
             let mut cutter = cutter.clone();
-            if i == iface as usize {
+            if i == iface as usize && !self.can[i] {
                 let Ok(()) = cutter.feed(0, data, &mut cost);
             }
             let Ok(()) = cutter.settle(&mut cost);
