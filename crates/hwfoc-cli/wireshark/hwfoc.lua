@@ -1406,7 +1406,7 @@ local function type_extras(t, values, p, tree)
             tree:add(df.escid_channel, p(1, 1))
             return string.format("answer: node %d, throttle channel %d", payload[1], payload[2])
         end
-        tree:add(df.escid_what, p, "other")
+        if p then tree:add(df.escid_what, p, "other") else tree:add(df.escid_what, "other") end
     elseif t.name == HW_ESC .. "SetReportingFrequency" then
         local of = MESSAGES[values.MSG_ID]
         if of then values["MSG_ID item"]:append_text(" (" .. of.name .. ")") end
