@@ -31,3 +31,9 @@ grep -q "pydronecan frames dissected" "$log" \
 # The codec's DroneCAN test vectors (testdata/dronecan/vectors.txt) are pydronecan's: made again
 # here by the installed package, they must be the file committed.
 "$venv/bin/python" scripts/dronecan-vectors.py --check
+# The CAN capture of pydronecan's frames the documentation's examples read
+# (testdata/dronecan/pydronecan-frames.pcapng): made again here, it must be the file committed.
+capture=${TMPDIR:-/tmp}/hwfoc-ci-dronecan-frames.pcapng
+"$venv/bin/python" crates/hwfoc-cli/tests/py/dronecan_pcapng.py "$capture" > /dev/null
+cmp "$capture" testdata/dronecan/pydronecan-frames.pcapng \
+  || { echo "testdata/dronecan/pydronecan-frames.pcapng differs from what dronecan_pcapng.py writes" >&2; exit 1; }

@@ -1,6 +1,7 @@
 -- hwfoc.lua: a Wireshark dissector for Hobbywing ESC telemetry recorded by hwfoc: HW-FOC frames,
 -- and the older formats hwfoc reads (Platinum V4 data and info frames, Platinum V3 frames, HW5
--- telemetry frames; docs/OLDER-PROTOCOLS.md, docs/HW5-AND-CAN.md).
+-- telemetry frames; docs/OLDER-PROTOCOLS.md, docs/HW5-AND-CAN.md); and DroneCAN on CAN captures
+-- (Hobbywing's CAN ESCs, below).
 --
 -- `hwfoc record` (and `hwfoc simulate -o FILE.pcapng`, and the monitor's recording) write pcapng
 -- files with link type USER0 (147): each packet holds the raw bytes of one serial port (one
@@ -34,6 +35,29 @@
 -- per step" (8/910, as hwfoc's --v4-volts-per-step) and throttle a full scale of 1000; hwfoc
 -- adopts an info frame's constants once two identical copies came, which this dissector does
 -- not follow (it shows each info frame's constants), nor does it give a V4 current.
+--
+-- DroneCAN (protocol `dronecan`; docs/HW5-AND-CAN.md, "Hobbywing DroneCAN ESCs"): CAN captures
+-- (link type LINKTYPE_CAN_SOCKETCAN, 227: what Wireshark captures on a SocketCAN interface) are
+-- read by Wireshark's own `can` dissector; this adds DroneCAN as a heuristic sub-dissector of it,
+-- taking every extended data frame whose tail byte can be DroneCAN's (a transfer's first frame has
+-- its toggle bit clear, a service names both nodes; standard, remote and error frames are left
+-- alone; turn it off in Analyze > Enabled Protocols on a bus with another protocol in extended
+-- frames). Each frame shows the CAN id's fields (priority, data type id and name, message,
+-- anonymous message or service request/response, source and destination node) and its tail byte
+-- (start, end, toggle, transfer id). A single-frame transfer's payload is decoded field by field
+-- (DSDL bit packing: fields one after the other, a field's bytes little-endian, each byte most
+-- significant bit first): com.hobbywing.esc.StatusMsg1/2/3 (status bit 14 shown as the direction,
+-- CCW or CW; input voltage and current, sent in 0.1 V and 0.1 A, shown in V and A), GetEscID
+-- (`[0]` a request for ids, `[node, throttle channel]` an answer), uavcan.protocol.NodeStatus,
+-- uavcan.equipment.esc.StatusExtended, and Hobbywing's setup services (210-217, 241, 242),
+-- request and response. A multi-frame transfer (uavcan.equipment.esc.Status: 14 bytes, the
+-- transfer CRC first, over 3 frames) is reassembled by source, data type, transfer kind,
+-- destination and transfer id, its toggle bits followed; on its last frame the CRC
+-- (CRC-16/CCITT-FALSE over the data type signature's 8 bytes, little-endian, then the payload) is
+-- shown ok or bad and, when ok, the fields decoded. A data type not listed here is shown with its
+-- id and its payload's bytes. Field names: dronecan.<type>.<DSDL field in lower case>, <type>
+-- hobbywing.<name> for com.hobbywing.esc.<Name>, esc.<name> for uavcan.equipment.esc.<Name>,
+-- nodestatus.
 --
 -- Install: `hwfoc wireshark install` (copies this file into Wireshark's personal Lua plugin
 -- folder), or run `tshark -X lua_script:hwfoc.lua -r FILE`.
@@ -1286,7 +1310,6 @@ local function crc16_ccitt(crc, s)
     return crc
 end
 -- The CRC of a signature's 8 bytes, little-endian: where a transfer's CRC starts.
-for _, t in pairs(MESSAGES) do t.base_crc = nil end
 local function base_crc(t)
     if not t.base_crc then
         local bytes = {}
