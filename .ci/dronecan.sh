@@ -2,7 +2,9 @@
 # The DroneCAN output read by pydronecan (the `dronecan` Python package, with pyserial for its
 # SLCAN driver): crates/hwfoc-bridge/tests/dronecan.rs relays the output's SLCAN through two
 # pseudo-terminals to crates/hwfoc-bridge/tests/py/dronecan_check.py and compares every
-# esc.Status it decodes with the records sent. Called by .ci/run; runs on its own too.
+# esc.Status it decodes with the records sent. And the Wireshark dissector on pydronecan's
+# frames (crates/hwfoc-cli/tests/wireshark.rs, with crates/hwfoc-cli/tests/py/dronecan_pcapng.py;
+# it needs tshark too, which .ci/run installs). Called by .ci/run; runs on its own too.
 set -euo pipefail
 export CARGO_TERM_COLOR=never
 cd "$(dirname "$0")/.."
@@ -18,6 +20,20 @@ HWFOC_DRONECAN_PY="$venv/bin/python" cargo test -p hwfoc-bridge --test dronecan 
 grep -Eq "^test result: ok\. [1-9][0-9]* passed; 0 failed; 0 ignored" "$log" \
   || { echo "the DroneCAN tests did not all run and pass (see $log)" >&2; exit 1; }
 grep -q "pydronecan decoded" "$log" || { echo "the pydronecan test did not run" >&2; exit 1; }
+# The dissector's test on pydronecan's frames, by name (the file's other tests run in .ci/run).
+log=${TMPDIR:-/tmp}/hwfoc-ci-dronecan-wireshark.log
+HWFOC_DRONECAN_PY="$venv/bin/python" cargo test -p hwfoc-cli --test wireshark pydronecan \
+  -- --ignored --nocapture 2>&1 | tee "$log"
+grep -Eq "^test result: ok\. 1 passed; 0 failed; 0 ignored" "$log" \
+  || { echo "the dissector's pydronecan test did not run and pass (see $log)" >&2; exit 1; }
+grep -q "pydronecan frames dissected" "$log" \
+  || { echo "the dissector's pydronecan test did not run" >&2; exit 1; }
 # The codec's DroneCAN test vectors (testdata/dronecan/vectors.txt) are pydronecan's: made again
 # here by the installed package, they must be the file committed.
 "$venv/bin/python" scripts/dronecan-vectors.py --check
+# The CAN capture of pydronecan's frames the documentation's examples read
+# (testdata/dronecan/pydronecan-frames.pcapng): made again here, it must be the file committed.
+capture=${TMPDIR:-/tmp}/hwfoc-ci-dronecan-frames.pcapng
+"$venv/bin/python" crates/hwfoc-cli/tests/py/dronecan_pcapng.py "$capture" > /dev/null
+cmp "$capture" testdata/dronecan/pydronecan-frames.pcapng \
+  || { echo "testdata/dronecan/pydronecan-frames.pcapng differs from what dronecan_pcapng.py writes" >&2; exit 1; }

@@ -4,11 +4,15 @@
 //! read-chunk layout; bad checksums show as bad, faults by name; the older formats (the Platinum
 //! V4 and V3 captures, an HW5 stream) recorded as `hwfoc record` cuts their bytes, frame for
 //! frame as `hwfoc decode` reads them; `install` puts it where tshark loads it and never
-//! replaces another file unasked.
+//! replaces another file unasked. DroneCAN on CAN captures (LINKTYPE_CAN_SOCKETCAN): frames
+//! pydronecan made show the values it encoded (ignored unless asked for: they need a Python with
+//! `dronecan`, which `.ci/dronecan.sh` makes), and garbage frames never make the dissector fail.
 
 #![cfg(unix)]
 
 mod common;
+#[path = "../../hwfoc-bridge/tests/py/python.rs"]
+mod python;
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -1440,5 +1444,311 @@ fn an_hw5_recording_dissects_as_decode_reads_it() {
     assert!(
         !named.stdout.is_empty(),
         "no frame with hwfoc.hw5.fault.low_voltage"
+    );
+}
+
+/// A pcapng file of one LINKTYPE_CAN_SOCKETCAN (227) interface, a packet per record, a
+/// millisecond apart (hwfoc_io's writer writes hwfoc's USER0 recordings; these few blocks are
+/// written here).
+fn can_pcapng(file: &Path, records: &[Vec<u8>]) {
+    fn block(out: &mut Vec<u8>, kind: u32, body: &[u8]) {
+        let pad = body.len().next_multiple_of(4) - body.len();
+        let len = (body.len() + pad + 12) as u32;
+        out.extend_from_slice(&kind.to_le_bytes());
+        out.extend_from_slice(&len.to_le_bytes());
+        out.extend_from_slice(body);
+        out.extend(std::iter::repeat_n(0, pad));
+        out.extend_from_slice(&len.to_le_bytes());
+    }
+    let mut out = Vec::new();
+    let mut shb = Vec::new();
+    shb.extend_from_slice(&0x1A2B_3C4Du32.to_le_bytes());
+    shb.extend_from_slice(&[1, 0, 0, 0]);
+    shb.extend_from_slice(&(-1i64).to_le_bytes());
+    block(&mut out, 0x0A0D_0D0A, &shb);
+    let mut idb = Vec::new();
+    idb.extend_from_slice(&227u16.to_le_bytes());
+    idb.extend_from_slice(&[0, 0]);
+    idb.extend_from_slice(&16u32.to_le_bytes());
+    block(&mut out, 1, &idb);
+    for (i, rec) in records.iter().enumerate() {
+        let t_us = 1_700_000_000_000_000u64 + i as u64 * 1000;
+        let mut epb = Vec::new();
+        epb.extend_from_slice(&0u32.to_le_bytes());
+        epb.extend_from_slice(&((t_us >> 32) as u32).to_le_bytes());
+        epb.extend_from_slice(&(t_us as u32).to_le_bytes());
+        epb.extend_from_slice(&(rec.len() as u32).to_le_bytes());
+        epb.extend_from_slice(&(rec.len() as u32).to_le_bytes());
+        epb.extend_from_slice(rec);
+        block(&mut out, 6, &epb);
+    }
+    std::fs::write(file, out).unwrap();
+}
+
+/// tshark with the dissector on `file`: `-T fields` of `fields` (one row per packet, each
+/// field's occurrences joined by `,`), and the `-V` tree, which must hold no Lua error.
+fn tshark_can(file: &Path, fields: &[&str]) -> (Vec<Vec<String>>, String) {
+    let script = format!("lua_script:{}", dissector().display());
+    let mut cmd = Command::new("tshark");
+    cmd.args(["-X", &script, "-r"]).arg(file).args([
+        "-T",
+        "fields",
+        "-E",
+        "occurrence=a",
+        "-E",
+        "aggregator=,",
+        "-E",
+        "separator=/t",
+    ]);
+    for f in fields {
+        cmd.args(["-e", f]);
+    }
+    let out = cmd.output().expect("tshark");
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "tshark: {err}");
+    assert!(!err.contains("Lua"), "tshark: {err}");
+    let rows = String::from_utf8(out.stdout)
+        .unwrap()
+        .lines()
+        .map(|l| l.split('\t').map(str::to_string).collect::<Vec<_>>())
+        .collect::<Vec<_>>();
+    let tree = Command::new("tshark")
+        .args(["-X", &script, "-r"])
+        .arg(file)
+        .arg("-V")
+        .output()
+        .expect("tshark");
+    assert!(tree.status.success());
+    let tree = String::from_utf8(tree.stdout).unwrap();
+    assert!(!tree.contains("Lua Error"), "{tree}");
+    (rows, tree)
+}
+
+/// Whether tshark's `shown` (a field's occurrences joined by `,`) is `want`: numbers within a
+/// part in 10^12 (tshark prints doubles to 15 digits; hexadecimal fields as 0x...), booleans as 1/0, strings exactly.
+fn shown_is(shown: &str, want: &[Value]) -> bool {
+    let got: Vec<&str> = if shown.is_empty() {
+        Vec::new()
+    } else {
+        shown.split(',').collect()
+    };
+    got.len() == want.len()
+        && got.iter().zip(want).all(|(g, w)| match w {
+            Value::Bool(b) => {
+                *g == if *b { "1" } else { "0" } || g.eq_ignore_ascii_case(&b.to_string())
+            }
+            Value::Number(n) => match g.strip_prefix("0x") {
+                Some(hex) => u64::from_str_radix(hex, 16).ok() == n.as_u64(),
+                None => g.parse::<f64>().is_ok_and(|g| {
+                    let w = n.as_f64().unwrap();
+                    (g - w).abs() <= 1e-12 * w.abs().max(1.0)
+                }),
+            },
+            Value::String(s) => g == s,
+            _ => false,
+        })
+}
+
+/// pydronecan's frames of every message and service the dissector knows (written as a CAN
+/// capture by tests/py/dronecan_pcapng.py): each packet shows the header, tail byte and field
+/// values pydronecan encoded; esc.Status is reassembled over its three frames, interleaved with
+/// another node's, its CRC ok, and bad where the capture corrupted it.
+#[test]
+#[ignore = "needs tshark and a Python with dronecan (HWFOC_DRONECAN_PY or python3): .ci/dronecan.sh runs it"]
+fn pydronecan_frames_dissect_to_the_values_encoded() {
+    need_tshark();
+    let python = python::python_with("HWFOC_DRONECAN_PY", "dronecan", ".ci/dronecan.sh");
+    let dir = common::Dir::new();
+    let file = dir.path("dronecan.pcapng");
+    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/py/dronecan_pcapng.py");
+    let out = Command::new(&python)
+        .arg(&script)
+        .arg(&file)
+        .output()
+        .expect("cannot run HWFOC_DRONECAN_PY");
+    assert!(
+        out.status.success(),
+        "{}: {}",
+        script.display(),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let expected: Vec<Value> = serde_json::from_slice(&out.stdout).unwrap();
+    let mut fields: Vec<&str> = expected
+        .iter()
+        .flat_map(|e| e["fields"].as_object().unwrap().keys().map(String::as_str))
+        .collect();
+    fields.sort_unstable();
+    fields.dedup();
+    let mut asked = vec!["frame.number"];
+    asked.extend(&fields);
+    let (rows, tree) = tshark_can(&file, &asked);
+    assert_eq!(rows.len(), expected.len(), "one row per packet");
+    let mut compared = 0;
+    for e in &expected {
+        let frame = e["frame"].as_u64().unwrap() as usize;
+        let row = &rows[frame - 1];
+        assert_eq!(row[0], frame.to_string());
+        for (field, want) in e["fields"].as_object().unwrap() {
+            let at = asked.iter().position(|f| f == field).unwrap();
+            let want = want.as_array().unwrap();
+            assert!(
+                shown_is(&row[at], want),
+                "frame {frame}: {field} is {:?}, pydronecan encoded {want:?}",
+                row[at]
+            );
+            compared += want.len();
+        }
+    }
+    // Every data type's decoded fields were there to compare, and the CRCs said as they should.
+    for name in [
+        "dronecan.hobbywing.statusmsg1.rpm",
+        "dronecan.hobbywing.statusmsg2.temperature",
+        "dronecan.hobbywing.statusmsg3.motor_t",
+        "dronecan.hobbywing.getescid.throttle_channel",
+        "dronecan.nodestatus.health",
+        "dronecan.esc.status.esc_index",
+        "dronecan.esc.statusextended.motor_temperature_degc",
+        "dronecan.hobbywing.setid.node_id",
+        "dronecan.hobbywing.setbaud.baud",
+        "dronecan.hobbywing.setled.blink",
+        "dronecan.hobbywing.setdirection.direction",
+        "dronecan.hobbywing.setreportingfrequency.msg_id",
+        "dronecan.hobbywing.setthrottlesource.source",
+        "dronecan.hobbywing.selftest.status",
+        "dronecan.hobbywing.setangle.angle",
+        "dronecan.hobbywing.getmaintenanceinformation.time_since_maintainence_min",
+        "dronecan.hobbywing.getmajorconfig.positioning_angle",
+    ] {
+        assert!(fields.contains(&name), "{name} not checked");
+    }
+    assert_eq!(tree.matches("[CRC ok]").count(), 2, "{tree}");
+    assert_eq!(tree.matches("[CRC bad").count(), 1, "{tree}");
+    assert!(tree.contains("Direction (status bit 14: CCW): CCW"));
+    assert!(tree.contains("Input voltage: 50.4 V (raw 504)"));
+    assert!(tree.contains("DroneCAN message of unknown data type 12345, node 9"));
+    eprintln!(
+        "pydronecan frames dissected: {} packets, {compared} field values compared",
+        rows.len()
+    );
+}
+
+/// Garbage on a CAN capture: standard frames, empty, remote and error frames, an impossible
+/// length, and random extended frames (random tail bytes, data type ids the dissector knows with
+/// payloads of every length, continuations of transfers never begun): no Lua error, standard
+/// frames left to the `can` dissector, and the rest shown as DroneCAN where it can be.
+#[test]
+#[ignore = "needs tshark: .ci/run installs it and runs these with --ignored"]
+fn garbage_can_frames_do_not_make_the_dissector_fail() {
+    use hwfoc::dronecan::CanFrame;
+    need_tshark();
+    let mut records: Vec<Vec<u8>> = Vec::new();
+    let record = |f: Option<CanFrame>| f.unwrap().to_socketcan_record().to_vec();
+    records.push(record(CanFrame::standard(0x123, &[1, 2, 3, 0xC0])));
+    records.push(record(CanFrame::standard(0x7FF, &[])));
+    records.push(record(CanFrame::extended(0x104E_5203, &[])));
+    records.push(record(CanFrame::remote(0x104E_5203, true, 7)));
+    records.push(record(CanFrame::error(0x4, &[0, 0, 0, 0, 0, 0, 0, 0])));
+    // a service with destination 0, an anonymous multi-frame transfer
+    records.push(record(CanFrame::extended(0x18D2_0081, &[5, 3, 0xC1])));
+    records.push(record(CanFrame::extended(
+        0x1000_0100,
+        &[1, 2, 3, 4, 5, 6, 7, 0x81],
+    )));
+    // StatusMsg1 too short; a continuation of nothing; a toggle out of sequence
+    records.push(record(CanFrame::extended(0x104E_5203, &[1, 2, 0xC1])));
+    records.push(record(CanFrame::extended(0x1004_0A14, &[1, 2, 3, 0x45])));
+    records.push(record(CanFrame::extended(
+        0x1004_0A14,
+        &[1, 2, 3, 4, 5, 6, 7, 0x86],
+    )));
+    records.push(record(CanFrame::extended(
+        0x1004_0A14,
+        &[1, 2, 3, 4, 5, 6, 7, 0x06],
+    )));
+    let fixed = records.len();
+    // an impossible length byte (15 on classic CAN)
+    let mut bad_len = CanFrame::extended(0x104E_5203, &[0; 8])
+        .unwrap()
+        .to_socketcan_record()
+        .to_vec();
+    bad_len[4] = 15;
+    records.push(bad_len);
+    let known: [u32; 8] = [20050, 20051, 20052, 20013, 341, 1034, 1036, 12345];
+    let services: [u32; 4] = [210, 214, 217, 242];
+    let mut seed = 0x2545_F491_4F6C_DD1Du64;
+    let mut next = move || {
+        seed ^= seed << 13;
+        seed ^= seed >> 7;
+        seed ^= seed << 17;
+        seed
+    };
+    for _ in 0..3000 {
+        let r = next();
+        let node = 1 + (r >> 8) as u32 % 4;
+        let id = match r % 4 {
+            0 => (r >> 32) as u32 & 0x1FFF_FFFF,
+            1 => (16 << 24) | (known[(r >> 16) as usize % 8] << 8) | node,
+            2 => {
+                let service = services[(r >> 16) as usize % 4];
+                (24 << 24) | (service << 16) | ((r >> 20) as u32 & 1) << 15 | 5 << 8 | 0x80 | node
+            }
+            _ => (16 << 24) | (1034 << 8) | node,
+        };
+        let len = 1 + (r >> 40) as usize % 8;
+        let mut data: Vec<u8> = (0..len).map(|k| (next() >> (k * 3)) as u8).collect();
+        if r % 4 == 1 {
+            // single-frame transfers of the messages, of every length
+            data[len - 1] = 0xC0 | ((r >> 50) as u8 % 32);
+        } else if r % 4 == 3 {
+            // esc.Status frames with tail bytes that begin, continue and end transfers
+            let tail = [0x80u8, 0x20, 0x00, 0x40, 0x60, 0xC0][(r >> 24) as usize % 6];
+            data[len - 1] = tail | ((r >> 50) as u8 % 3);
+        }
+        records.push(record(CanFrame::extended(id, &data)));
+    }
+    let dir = common::Dir::new();
+    let file = dir.path("garbage.pcapng");
+    can_pcapng(&file, &records);
+    let fields = [
+        "frame.number",
+        "can.flags.xtd",
+        "dronecan.type_id",
+        "dronecan.crc.status",
+        "_ws.expert.message",
+        "dronecan.hobbywing.statusmsg1.rpm",
+        "dronecan.hobbywing.statusmsg2.temperature",
+        "dronecan.hobbywing.statusmsg3.mos_t",
+        "dronecan.nodestatus.health",
+    ];
+    let (rows, _) = tshark_can(&file, &fields);
+    assert_eq!(rows.len(), records.len());
+    // the fixed cases: standard frames, empty, remote and error frames, an invalid service id,
+    // an anonymous transfer of more than one frame are not DroneCAN
+    for row in &rows[..7] {
+        assert_eq!(row[2], "", "{row:?}");
+    }
+    assert_eq!(rows[7][2], "20050");
+    assert!(rows[7][4].contains("payload bytes"), "{:?}", rows[7]);
+    assert!(
+        rows[8][4].contains("first frame was not seen"),
+        "{:?}",
+        rows[8]
+    );
+    assert!(rows[10][4].contains("Toggle bit"), "{:?}", rows[10]);
+    let random = &rows[fixed + 1..];
+    let claimed = random.iter().filter(|r| !r[2].is_empty()).count();
+    let decoded = random
+        .iter()
+        .filter(|r| r[5..].iter().any(|v| !v.is_empty()))
+        .count();
+    let crcs = random.iter().filter(|r| !r[3].is_empty()).count();
+    assert!(
+        claimed > 1000 && decoded > 20 && crcs > 10,
+        "{claimed} claimed, {decoded} status messages decoded, {crcs} CRCs checked"
+    );
+    eprintln!(
+        "garbage CAN frames: {claimed} of {} random frames shown as DroneCAN, {decoded} status \
+         messages decoded, {crcs} CRCs checked",
+        random.len()
     );
 }

@@ -1,6 +1,7 @@
 -- hwfoc.lua: a Wireshark dissector for Hobbywing ESC telemetry recorded by hwfoc: HW-FOC frames,
 -- and the older formats hwfoc reads (Platinum V4 data and info frames, Platinum V3 frames, HW5
--- telemetry frames; docs/OLDER-PROTOCOLS.md, docs/HW5-AND-CAN.md).
+-- telemetry frames; docs/OLDER-PROTOCOLS.md, docs/HW5-AND-CAN.md); and DroneCAN on CAN captures
+-- (Hobbywing's CAN ESCs, below).
 --
 -- `hwfoc record` (and `hwfoc simulate -o FILE.pcapng`, and the monitor's recording) write pcapng
 -- files with link type USER0 (147): each packet holds the raw bytes of one serial port (one
@@ -34,6 +35,29 @@
 -- per step" (8/910, as hwfoc's --v4-volts-per-step) and throttle a full scale of 1000; hwfoc
 -- adopts an info frame's constants once two identical copies came, which this dissector does
 -- not follow (it shows each info frame's constants), nor does it give a V4 current.
+--
+-- DroneCAN (protocol `dronecan`; docs/HW5-AND-CAN.md, "Hobbywing DroneCAN ESCs"): CAN captures
+-- (link type LINKTYPE_CAN_SOCKETCAN, 227: what Wireshark captures on a SocketCAN interface) are
+-- read by Wireshark's own `can` dissector; this adds DroneCAN as a heuristic sub-dissector of it,
+-- taking every extended data frame whose tail byte can be DroneCAN's (a transfer's first frame has
+-- its toggle bit clear, a service names both nodes; standard, remote and error frames are left
+-- alone; turn it off in Analyze > Enabled Protocols on a bus with another protocol in extended
+-- frames). Each frame shows the CAN id's fields (priority, data type id and name, message,
+-- anonymous message or service request/response, source and destination node) and its tail byte
+-- (start, end, toggle, transfer id). A single-frame transfer's payload is decoded field by field
+-- (DSDL bit packing: fields one after the other, a field's bytes little-endian, each byte most
+-- significant bit first): com.hobbywing.esc.StatusMsg1/2/3 (status bit 14 shown as the direction,
+-- CCW or CW; input voltage and current, sent in 0.1 V and 0.1 A, shown in V and A), GetEscID
+-- (`[0]` a request for ids, `[node, throttle channel]` an answer), uavcan.protocol.NodeStatus,
+-- uavcan.equipment.esc.StatusExtended, and Hobbywing's setup services (210-217, 241, 242),
+-- request and response. A multi-frame transfer (uavcan.equipment.esc.Status: 14 bytes, the
+-- transfer CRC first, over 3 frames) is reassembled by source, data type, transfer kind,
+-- destination and transfer id, its toggle bits followed; on its last frame the CRC
+-- (CRC-16/CCITT-FALSE over the data type signature's 8 bytes, little-endian, then the payload) is
+-- shown ok or bad and, when ok, the fields decoded. A data type not listed here is shown with its
+-- id and its payload's bytes. Field names: dronecan.<type>.<DSDL field in lower case>, <type>
+-- hobbywing.<name> for com.hobbywing.esc.<Name>, esc.<name> for uavcan.equipment.esc.<Name>,
+-- nodestatus.
 --
 -- Install: `hwfoc wireshark install` (copies this file into Wireshark's personal Lua plugin
 -- folder), or run `tshark -X lua_script:hwfoc.lua -r FILE`.
@@ -1031,3 +1055,587 @@ end
 local encap = DissectorTable.get("wtap_encap")
 fallback = encap:get_dissector(wtap_encaps.USER0)
 encap:add(wtap_encaps.USER0, hwfoc)
+
+-- ---------------------------------------------------------------------------------------------
+-- DroneCAN on CAN: Hobbywing's CAN ESCs (docs/HW5-AND-CAN.md, "Hobbywing DroneCAN ESCs"), as the
+-- codec's `dronecan` module reads them (crates/hwfoc/src/dronecan/). Wireshark's own `can`
+-- dissector reads the frames (LINKTYPE_CAN_SOCKETCAN captures); this is a heuristic
+-- sub-dissector of it that takes every extended data frame with a tail byte that can be
+-- DroneCAN's (a transfer's first frame has its toggle bit clear; a service names a source and a
+-- destination node).
+
+local dronecan = Proto("dronecan", "DroneCAN (hwfoc: Hobbywing CAN ESCs)")
+
+local f_can_id = Field.new("can.id")
+local f_can_xtd = Field.new("can.flags.xtd")
+local f_can_rtr = Field.new("can.flags.rtr")
+local f_can_err = Field.new("can.flags.err")
+
+local HEALTH = { [0] = "OK", [1] = "Warning", [2] = "Error", [3] = "Critical" }
+local MODE = { [0] = "Operational", [1] = "Initialization", [2] = "Maintenance",
+    [3] = "Software update", [7] = "Offline" }
+local BAUD = { [0] = "1 Mbit/s", [1] = "500 kbit/s", [2] = "250 kbit/s", [3] = "200 kbit/s",
+    [4] = "100 kbit/s", [5] = "50 kbit/s" }
+local DIRECTION = { [0] = "clockwise", [1] = "counter-clockwise", [255] = "query" }
+local READ_WRITE = { [0] = "read", [1] = "write" }
+local RATE = { [1] = "500 Hz", [2] = "250 Hz", [3] = "200 Hz", [4] = "100 Hz", [5] = "50 Hz",
+    [6] = "20 Hz", [7] = "10 Hz", [8] = "1 Hz", [9] = "0 Hz (off)" }
+local SOURCE = { [0] = "CAN", [1] = "PWM" }
+local PASS_FAIL = { [0] = "pass", [1] = "fail" }
+
+-- The data types: field lists as pydronecan 1.0.27 ships them (crates/hwfoc/src/dronecan/
+-- types.rs), `prefix` the fields' filter names (dronecan.<prefix>.<DSDL field name in lower
+-- case>), `sig` the data type signature (seeds a multi-frame transfer's CRC). A field is
+-- { DSDL name, kind, bits, label, options }: kind "u" unsigned, "i" signed, "f16" float16,
+-- "bool", "tail" (a last array of `bits`-bit unsigned elements, up to `max`, with no length on
+-- the wire), "static" (an array of `n` elements). Options: vs (names of the values), div and
+-- unit (shown as value / div in unit), unit, hex.
+local function fld(name, kind, bits, label, opts)
+    opts = opts or {}
+    opts.name, opts.kind, opts.bits, opts.label = name, kind, bits, label
+    return opts
+end
+local HW_ESC = "com.hobbywing.esc."
+local MESSAGES = {
+    [20050] = { name = HW_ESC .. "StatusMsg1", sig = "0813B3E2C4AD670E", fields = {
+        fld("rpm", "u", 16, "RPM (as the ESC reports it)", { unit = "rev/min" }),
+        fld("pwm", "u", 16, "PWM (output throttle, nominally of 1000)"),
+        fld("status", "u", 16, "Status", { hex = true }),
+    } },
+    [20051] = { name = HW_ESC .. "StatusMsg2", sig = "1675DA01C3B91297", fields = {
+        fld("input_voltage", "i", 16, "Input voltage", { div = 10, unit = "V" }),
+        fld("current", "i", 16, "Current", { div = 10, unit = "A" }),
+        fld("temperature", "u", 8, "Temperature", { unit = "\194\176C" }),
+    } },
+    [20052] = { name = HW_ESC .. "StatusMsg3", sig = "24919CD1EB34ECE9", fields = {
+        fld("MOS_T", "u", 8, "MOSFET temperature", { unit = "\194\176C" }),
+        fld("CAP_T", "u", 8, "Capacitor temperature", { unit = "\194\176C" }),
+        fld("Motor_T", "u", 8, "Motor temperature", { unit = "\194\176C" }),
+    } },
+    [20013] = { name = HW_ESC .. "GetEscID", sig = "0000000000004E2D", fields = {
+        fld("payload", "tail", 8, "Payload byte", { max = 3 }),
+    } },
+    [341] = { name = "uavcan.protocol.NodeStatus", sig = "0F0868D0C1A7C6F1", fields = {
+        fld("uptime_sec", "u", 32, "Uptime", { unit = "s" }),
+        fld("health", "u", 2, "Health", { vs = HEALTH }),
+        fld("mode", "u", 3, "Mode", { vs = MODE }),
+        fld("sub_mode", "u", 3, "Sub-mode"),
+        fld("vendor_specific_status_code", "u", 16, "Vendor-specific status code", { hex = true }),
+    } },
+    [1034] = { name = "uavcan.equipment.esc.Status", sig = "A9AF28AEA2FBB254", fields = {
+        fld("error_count", "u", 32, "Error count"),
+        fld("voltage", "f16", 16, "Voltage", { unit = "V" }),
+        fld("current", "f16", 16, "Current", { unit = "A" }),
+        fld("temperature", "f16", 16, "Temperature", { unit = "K" }),
+        fld("rpm", "i", 18, "RPM", { unit = "rev/min" }),
+        fld("power_rating_pct", "u", 7, "Power rating", { unit = "%" }),
+        fld("esc_index", "u", 5, "ESC index"),
+    } },
+    [1036] = { name = "uavcan.equipment.esc.StatusExtended", sig = "02DC203C50960EDC", fields = {
+        fld("input_pct", "u", 7, "Input (throttle received)", { unit = "%" }),
+        fld("output_pct", "u", 7, "Output (to the motor)", { unit = "%" }),
+        fld("motor_temperature_degC", "i", 9, "Motor temperature", { unit = "\194\176C" }),
+        fld("motor_angle", "u", 9, "Motor angle", { unit = "\194\176" }),
+        fld("status_flags", "u", 19, "Status flags (manufacturer-specific)", { hex = true }),
+        fld("esc_index", "u", 5, "ESC index"),
+    } },
+}
+local function u8(name, label, opts) return fld(name, "u", 8, label, opts) end
+local SERVICES = {
+    [210] = { name = HW_ESC .. "SetID", sig = "C323CB5E9EC2B6F7",
+        request = { u8("node_id", "Node id"), u8("throttle_channel", "Throttle channel") },
+        response = { u8("node_id", "Node id"), u8("throttle_channel", "Throttle channel") } },
+    [211] = { name = HW_ESC .. "SetBaud", sig = "ADA98653B52DE435",
+        request = { u8("baud", "Bit rate", { vs = BAUD }) }, response = {} },
+    [212] = { name = HW_ESC .. "SetLED", sig = "B493BD48C0853EE5",
+        request = { u8("option", "Option (1 = save)"), u8("color", "Colour (R = 4, G = 2, B = 1)"),
+            u8("blink", "Blink (0 = off)") },
+        response = { u8("option", "Option (1 = save)"), u8("color", "Colour (R = 4, G = 2, B = 1)"),
+            u8("blink", "Blink (0 = off)") } },
+    [213] = { name = HW_ESC .. "SetDirection", sig = "9D793111D262BA68",
+        request = { u8("direction", "Direction", { vs = DIRECTION }) },
+        response = { u8("direction", "Direction", { vs = DIRECTION }) } },
+    [214] = { name = HW_ESC .. "SetReportingFrequency", sig = "1FD0404420983DEB",
+        request = { u8("option", "Option", { vs = READ_WRITE }),
+            fld("MSG_ID", "u", 16, "Message (data type id)"), u8("rate", "Rate", { vs = RATE }) },
+        response = { u8("option", "Option", { vs = READ_WRITE }),
+            fld("MSG_ID", "u", 16, "Message (data type id)"), u8("rate", "Rate", { vs = RATE }) } },
+    [215] = { name = HW_ESC .. "SetThrottleSource", sig = "0C248FAAEFE5E29A",
+        request = { u8("source", "Throttle source", { vs = SOURCE }) },
+        response = { u8("source", "Throttle source", { vs = SOURCE }) } },
+    [216] = { name = HW_ESC .. "SelfTest", sig = "C48D4DE61C5295DF",
+        request = {}, response = { u8("status", "Self-test", { vs = PASS_FAIL }) } },
+    [217] = { name = HW_ESC .. "SetAngle", sig = "81D9B10761C28E0A",
+        request = { u8("option", "Option"), fld("angle", "u", 16, "Angle") },
+        response = { u8("option", "Option"), fld("angle", "tail", 16, "Angle", { max = 2 }) } },
+    [241] = { name = HW_ESC .. "GetMaintenanceInformation", sig = "B81DBD4EC9A5977D",
+        request = { u8("option", "Option (1 = clear)") },
+        response = { fld("total_rotation_time_min", "u", 32, "Total rotation time", { unit = "min" }),
+            fld("time_since_maintainence_min", "u", 24, "Time since maintenance", { unit = "min" }) } },
+    [242] = { name = HW_ESC .. "GetMajorConfig", sig = "1506774DA3930BFD",
+        request = { u8("option", "Option") },
+        response = { fld("direction", "bool", 1, "Direction counter-clockwise"),
+            fld("throttle_source", "bool", 1, "Throttle source PWM"),
+            fld("throttle_channel", "u", 6, "Throttle channel"),
+            fld("led_status", "u", 5, "LED status"), fld("led_color", "u", 3, "LED colour"),
+            fld("MSG2_rate", "u", 4, "StatusMsg2 rate"), fld("MSG1_rate", "u", 4, "StatusMsg1 rate"),
+            fld("positioning_angle", "u", 16, "Positioning angle"),
+            fld("reserved", "static", 8, "Reserved", { n = 2, hex = true }) } },
+}
+
+local KIND_NAMES = { message = "Message", anonymous = "Anonymous message",
+    request = "Service request", response = "Service response" }
+local CRC_STATUS = { [0] = "bad", [1] = "ok" }
+local df = {
+    priority = ProtoField.uint8("dronecan.priority", "Priority"),
+    type_id = ProtoField.uint16("dronecan.type_id", "Data type id"),
+    type_name = ProtoField.string("dronecan.type_name", "Data type"),
+    kind = ProtoField.string("dronecan.kind", "Transfer (message, anonymous, request, response)"),
+    source = ProtoField.uint8("dronecan.source", "Source node"),
+    destination = ProtoField.uint8("dronecan.destination", "Destination node"),
+    discriminator = ProtoField.uint16("dronecan.discriminator", "Discriminator (anonymous)",
+        base.HEX),
+    tail = ProtoField.uint8("dronecan.tail", "Tail byte", base.HEX),
+    tail_start = ProtoField.bool("dronecan.tail.start", "Start of transfer", 8, nil, 0x80),
+    tail_end = ProtoField.bool("dronecan.tail.end", "End of transfer", 8, nil, 0x40),
+    tail_toggle = ProtoField.bool("dronecan.tail.toggle", "Toggle", 8, nil, 0x20),
+    tail_tid = ProtoField.uint8("dronecan.tail.transfer_id", "Transfer id", base.DEC, nil, 0x1F),
+    frame_index = ProtoField.uint8("dronecan.transfer.frame_index", "Frame of the transfer"),
+    first_frame = ProtoField.framenum("dronecan.transfer.first_frame",
+        "First frame of the transfer", base.NONE),
+    frames = ProtoField.uint8("dronecan.transfer.frames", "Frames in the transfer"),
+    length = ProtoField.uint8("dronecan.transfer.length", "Payload length (bytes)"),
+    crc = ProtoField.uint16("dronecan.crc", "Transfer CRC", base.HEX),
+    crc_computed = ProtoField.uint16("dronecan.crc.computed", "Transfer CRC computed", base.HEX),
+    crc_status = ProtoField.uint8("dronecan.crc.status", "CRC", base.DEC, CRC_STATUS),
+    payload = ProtoField.bytes("dronecan.payload", "Payload"),
+    direction = ProtoField.string("dronecan.hobbywing.statusmsg1.direction",
+        "Direction (status bit 14: CCW)"),
+    escid_what = ProtoField.string("dronecan.hobbywing.getescid.what",
+        "GetEscID (request for ids, answer)"),
+    escid_node = ProtoField.uint8("dronecan.hobbywing.getescid.node_id", "Node id"),
+    escid_channel = ProtoField.uint8("dronecan.hobbywing.getescid.throttle_channel",
+        "Throttle channel"),
+}
+
+-- A type's filter-name prefix: hobbywing.<name> for com.hobbywing.esc.<Name>, esc.<name> for
+-- uavcan.equipment.esc.<Name>, <name> for uavcan.protocol.<Name>.
+local function type_prefix(name)
+    local rest = name:match("^com%.hobbywing%.esc%.(.*)$")
+    if rest then return "hobbywing." .. rest:lower() end
+    rest = name:match("^uavcan%.equipment%.esc%.(.*)$")
+    if rest then return "esc." .. rest:lower() end
+    return name:match("([^.]*)$"):lower()
+end
+
+-- Each DSDL field's ProtoField (a service's request and response share one per name).
+local dc_field_of = {}
+local function make_field(prefix, spec)
+    local abbr = "dronecan." .. prefix .. "." .. spec.name:lower()
+    if not dc_field_of[abbr] then
+        local pf
+        if spec.kind == "f16" or spec.div then
+            pf = ProtoField.double(abbr, spec.label)
+        elseif spec.kind == "bool" then
+            pf = ProtoField.bool(abbr, spec.label)
+        elseif spec.kind == "i" then
+            pf = (spec.bits <= 8 and ProtoField.int8 or spec.bits <= 16 and ProtoField.int16 or
+                ProtoField.int32)(abbr, spec.label, base.DEC)
+        else
+            pf = (spec.bits <= 8 and ProtoField.uint8 or spec.bits <= 16 and ProtoField.uint16 or
+                ProtoField.uint32)(abbr, spec.label, spec.hex and base.HEX or base.DEC, spec.vs)
+        end
+        dc_field_of[abbr] = pf
+        df["field " .. abbr] = pf
+    end
+    spec.pf = dc_field_of[abbr]
+end
+-- Bits of the fields before a tail array, and the payload's length bounds in bytes.
+local function layout(fields)
+    local fixed, extra = 0, 0
+    for _, spec in ipairs(fields) do
+        if spec.kind == "tail" then
+            extra = spec.bits * spec.max
+        elseif spec.kind == "static" then
+            fixed = fixed + spec.bits * spec.n
+        else
+            fixed = fixed + spec.bits
+        end
+    end
+    return { fields = fields, fixed = fixed, min = math.ceil(fixed / 8),
+        max = math.ceil((fixed + extra) / 8) }
+end
+for _, t in pairs(MESSAGES) do
+    t.prefix = type_prefix(t.name)
+    for _, spec in ipairs(t.fields) do make_field(t.prefix, spec) end
+    t.message = layout(t.fields)
+end
+for _, t in pairs(SERVICES) do
+    t.prefix = type_prefix(t.name)
+    for _, form in ipairs({ "request", "response" }) do
+        for _, spec in ipairs(t[form]) do make_field(t.prefix, spec) end
+        t[form] = layout(t[form])
+    end
+end
+
+local dc_fields = {}
+for _, field in pairs(df) do dc_fields[#dc_fields + 1] = field end
+dronecan.fields = dc_fields
+
+local dce = {
+    crc = ProtoExpert.new("dronecan.crc.bad", "Bad transfer CRC", expert.group.CHECKSUM,
+        expert.severity.ERROR),
+    length = ProtoExpert.new("dronecan.length.bad", "Payload length not the data type's",
+        expert.group.MALFORMED, expert.severity.ERROR),
+    orphan = ProtoExpert.new("dronecan.transfer.orphan",
+        "Frame of a transfer whose earlier frames were not seen", expert.group.SEQUENCE,
+        expert.severity.NOTE),
+    toggle = ProtoExpert.new("dronecan.transfer.toggle", "Toggle bit out of sequence",
+        expert.group.SEQUENCE, expert.severity.WARN),
+    unknown = ProtoExpert.new("dronecan.type.unknown", "Data type not known to hwfoc",
+        expert.group.UNDECODED, expert.severity.NOTE),
+}
+dronecan.experts = { dce.crc, dce.length, dce.orphan, dce.toggle, dce.unknown }
+
+-- CRC-16/CCITT-FALSE (poly 0x1021) of the bytes of `s`, from `crc`.
+local function crc16_ccitt(crc, s)
+    for k = 1, #s do
+        crc = bxor16(crc, s:byte(k) * 256)
+        for _ = 1, 8 do
+            local high = crc >= 0x8000
+            crc = (crc * 2) % 65536
+            if high then crc = bxor16(crc, 0x1021) end
+        end
+    end
+    return crc
+end
+-- The CRC of a signature's 8 bytes, little-endian: where a transfer's CRC starts.
+local function base_crc(t)
+    if not t.base_crc then
+        local bytes = {}
+        for k = 8, 1, -1 do bytes[#bytes + 1] = string.char(tonumber(t.sig:sub(2 * k - 1, 2 * k), 16)) end
+        t.base_crc = crc16_ccitt(0xFFFF, table.concat(bytes))
+    end
+    return t.base_crc
+end
+
+-- `width` bits at bit `pos` of `s` (DSDL: each byte most significant bit first, a field's
+-- bytes little-endian, the last one its `width % 8` low bits).
+local function get_bits(s, pos, width)
+    local out, scale, left = 0, 1, width
+    while left > 0 do
+        local n = math.min(left, 8)
+        local byte = 0
+        for _ = 1, n do
+            local b = s:byte(math.floor(pos / 8) + 1) or 0
+            byte = byte * 2 + math.floor(b / 2 ^ (7 - pos % 8)) % 2
+            pos = pos + 1
+        end
+        out = out + byte * scale
+        scale, left = scale * 256, left - n
+    end
+    return out
+end
+
+-- The value of float16 bits (exact).
+local function float16(h)
+    local sign = h >= 0x8000 and -1 or 1
+    local e, m = math.floor(h / 1024) % 32, h % 1024
+    if e == 31 then return m == 0 and sign * math.huge or 0 / 0 end
+    if e == 0 then return sign * m * 2 ^ -24 end
+    return sign * (1 + m / 1024) * 2 ^ (e - 15)
+end
+
+-- Adds the fields of a payload (`p`, a Tvb or TvbRange, `s` its bytes) to `tree`; returns the
+-- values by DSDL name and a summary.
+local function decode_fields(layout_, p, s, tree)
+    local values, parts = {}, {}
+    local pos = 0
+    local function range(at, width)
+        local first = math.floor(at / 8)
+        return p(first, math.floor((at + width - 1) / 8) - first + 1)
+    end
+    local function add(spec, raw, at, width)
+        local r = range(at, width)
+        local value, shown
+        if spec.kind == "i" then
+            value = raw >= 2 ^ (width - 1) and raw - 2 ^ width or raw
+        elseif spec.kind == "f16" then
+            value = float16(raw)
+        elseif spec.kind == "bool" then
+            value = raw == 1
+        else
+            value = raw
+        end
+        if spec.div then value = value / spec.div end
+        if spec.kind == "bool" then
+            shown = value and "yes" or "no"
+        elseif spec.kind == "f16" or spec.div then
+            shown = fmt(value)
+        elseif spec.hex then
+            shown = string.format("0x%0" .. math.ceil(width / 4) .. "X", value)
+        else
+            shown = string.format("%d", value)
+        end
+        if spec.vs and spec.vs[value] then shown = spec.vs[value] .. " (" .. shown .. ")" end
+        if spec.unit then shown = shown .. " " .. spec.unit end
+        local item = tree:add(spec.pf, r, value, spec.label .. ": " .. shown)
+        if spec.div then item:append_text(string.format(" (raw %d)", raw >= 2 ^ (width - 1)
+            and spec.kind == "i" and raw - 2 ^ width or raw)) end
+        if spec.unit == "K" and value == value and math.abs(value) < math.huge then
+            item:append_text(" (" .. fmt(value - 273.15) .. " \194\176C)")
+        end
+        return value, shown, item
+    end
+    for _, spec in ipairs(layout_.fields) do
+        if spec.kind == "tail" or spec.kind == "static" then
+            local n = spec.n or math.floor((#s * 8 - pos) / spec.bits)
+            local list, shown = {}, {}
+            for k = 1, n do
+                local v, text = add(spec, get_bits(s, pos, spec.bits), pos, spec.bits)
+                list[k], shown[k] = v, text
+                pos = pos + spec.bits
+            end
+            values[spec.name] = list
+            parts[#parts + 1] = spec.name .. " [" .. table.concat(shown, ", ") .. "]"
+        else
+            local v, shown, item = add(spec, get_bits(s, pos, spec.bits), pos, spec.bits)
+            values[spec.name] = v
+            values[spec.name .. " item"] = item
+            parts[#parts + 1] = spec.name .. " " .. shown
+            pos = pos + spec.bits
+        end
+    end
+    return values, table.concat(parts, ", ")
+end
+
+-- What a type's decoded values add beyond their fields (returns a summary, or nil for the
+-- fields' own).
+local function type_extras(t, values, p, tree)
+    if t.name == HW_ESC .. "StatusMsg1" then
+        local ccw = math.floor(values.status / 0x4000) % 2 == 1
+        values["status item"]:add(df.direction, p(4, 2), ccw and "CCW" or "CW")
+            :append_text(ccw and " (counter-clockwise)" or " (clockwise)")
+        return string.format("rpm %d, pwm %d, status 0x%04X (%s)", values.rpm, values.pwm,
+            values.status, ccw and "CCW" or "CW")
+    elseif t.name == HW_ESC .. "GetEscID" then
+        local payload = values.payload
+        if #payload == 1 and payload[1] == 0 then
+            tree:add(df.escid_what, p, "request"):append_text(" for every ESC's node id and channel")
+            return "request for ids"
+        elseif #payload == 2 then
+            tree:add(df.escid_what, p, "answer")
+            tree:add(df.escid_node, p(0, 1))
+            tree:add(df.escid_channel, p(1, 1))
+            return string.format("answer: node %d, throttle channel %d", payload[1], payload[2])
+        end
+        if p then tree:add(df.escid_what, p, "other") else tree:add(df.escid_what, "other") end
+    elseif t.name == HW_ESC .. "SetReportingFrequency" then
+        local of = MESSAGES[values.MSG_ID]
+        if of then values["MSG_ID item"]:append_text(" (" .. of.name .. ")") end
+    end
+    return nil
+end
+
+-- First pass over a file: the multi-frame transfers under way (by source, type, transfer kind
+-- and destination) and, per frame, where it stands in its transfer.
+local dc_partial = {}
+local dc_frame = {}
+function dronecan.init()
+    dc_partial = {}
+    dc_frame = {}
+end
+
+-- The fields of a 29-bit CAN id, or nil if it can be no DroneCAN id.
+local function parse_id(id)
+    local h = { priority = math.floor(id / 2 ^ 24) % 32, source = id % 128 }
+    if math.floor(id / 128) % 2 == 1 then
+        h.destination = math.floor(id / 256) % 128
+        if h.source == 0 or h.destination == 0 then return nil end
+        h.type_id = math.floor(id / 65536) % 256
+        h.kind = math.floor(id / 32768) % 2 == 1 and "request" or "response"
+    elseif h.source == 0 then
+        h.kind = "anonymous"
+        h.type_id = math.floor(id / 256) % 4
+        h.discriminator = math.floor(id / 1024) % 16384
+    else
+        h.kind = "message"
+        h.type_id = math.floor(id / 256) % 65536
+    end
+    return h
+end
+
+-- Where this frame stands in its transfer (first pass: worked out and kept; later passes: the
+-- kept answer). Returns { single = true }, or { index, first, whole = payload with its CRC
+-- when this frame ends the transfer }, or { orphan = reason }.
+local function transfer_state(pinfo, h, tail, data)
+    local kept = dc_frame[pinfo.number]
+    if pinfo.visited and kept then return kept end
+    local start, last = tail >= 0x80, math.floor(tail / 0x40) % 2 == 1
+    local toggle, tid = math.floor(tail / 0x20) % 2 == 1, tail % 32
+    local key = table.concat({ h.source, h.kind, h.type_id, h.destination or 0 }, ":")
+    local state
+    if start and last then
+        state = { single = true }
+    elseif start then
+        dc_partial[key] = { bytes = { data }, tid = tid, toggle = false, first = pinfo.number }
+        state = { index = 1, first = pinfo.number }
+    else
+        local p = dc_partial[key]
+        if p and p.tid == tid and toggle ~= p.toggle then
+            p.bytes[#p.bytes + 1] = data
+            p.toggle = toggle
+            state = { index = #p.bytes, first = p.first }
+            if last then
+                state.whole = table.concat(p.bytes)
+                dc_partial[key] = nil
+            end
+        elseif p and p.tid == tid then
+            state = { orphan = "toggle" }
+            dc_partial[key] = nil
+        else
+            state = { orphan = "start" }
+        end
+    end
+    dc_frame[pinfo.number] = state
+    return state
+end
+
+local function dronecan_frame(tvb, pinfo, tree)
+    local xtd, rtr, err, idf = f_can_xtd(), f_can_rtr(), f_can_err(), f_can_id()
+    if not (xtd and xtd.value) or (rtr and rtr.value) or (err and err.value) or not idf then
+        return false
+    end
+    local n = tvb:len()
+    if n < 1 or n > 8 then return false end
+    local h = parse_id(idf.value)
+    if not h then return false end
+    local tail = tvb(n - 1, 1):uint()
+    local start, toggle = tail >= 0x80, math.floor(tail / 0x20) % 2 == 1
+    if start and toggle then return false end
+    local single = start and math.floor(tail / 0x40) % 2 == 1
+    if h.kind == "anonymous" and not single then return false end
+
+    local t, layout_
+    if h.kind == "message" then
+        t = MESSAGES[h.type_id]
+        layout_ = t and t.message
+    elseif h.kind ~= "anonymous" then
+        t = SERVICES[h.type_id]
+        layout_ = t and t[h.kind]
+    end
+    local short = t and t.name:match("([^.]*)$") or string.format("data type %d", h.type_id)
+    pinfo.cols.protocol = "DroneCAN"
+    local route = h.destination and string.format("%d \226\134\146 %d", h.source, h.destination) or
+        string.format("node %d", h.source)
+    local root = tree:add(dronecan, tvb(), "DroneCAN " .. KIND_NAMES[h.kind]:lower() .. " " ..
+        (t and t.name or string.format("of unknown data type %d", h.type_id)) .. ", " .. route)
+    root:add(df.priority, h.priority):set_generated()
+    root:add(df.kind, h.kind):set_generated()
+    root:add(df.type_id, h.type_id):set_generated()
+    if t then
+        root:add(df.type_name, t.name):set_generated()
+    else
+        root:add_proto_expert_info(dce.unknown, string.format(
+            "Data type %d (%s) is not one hwfoc knows: its payload is shown undecoded", h.type_id,
+            h.kind))
+    end
+    root:add(df.source, h.source):set_generated()
+    if h.destination then root:add(df.destination, h.destination):set_generated() end
+    if h.discriminator then root:add(df.discriminator, h.discriminator):set_generated() end
+    local tail_item = root:add(df.tail, tvb(n - 1, 1))
+    tail_item:add(df.tail_start, tvb(n - 1, 1))
+    tail_item:add(df.tail_end, tvb(n - 1, 1))
+    tail_item:add(df.tail_toggle, tvb(n - 1, 1))
+    tail_item:add(df.tail_tid, tvb(n - 1, 1))
+
+    local info = string.format("%s %s %s", short, h.kind ~= "message" and h.kind or "", route)
+        :gsub("  ", " ")
+    local state = transfer_state(pinfo, h, tail, tvb:raw(0, n - 1))
+
+    -- The payload to decode: this frame's, or the transfer's it completes.
+    local p, s
+    if state.single then
+        s = tvb:raw(0, n - 1)
+        p = n > 1 and tvb(0, n - 1) or nil
+    elseif state.orphan then
+        local item = root:add(df.payload, tvb(0, n - 1))
+        if state.orphan == "toggle" then
+            item:add_proto_expert_info(dce.toggle,
+                "Toggle bit not the alternate of the last frame's: the transfer is dropped")
+        else
+            item:add_proto_expert_info(dce.orphan,
+                "Continues a transfer whose first frame was not seen")
+        end
+        pinfo.cols.info = info .. " (frame of a transfer not seen from its start)"
+        return true
+    else
+        root:add(df.frame_index, state.index):set_generated()
+        root:add(df.first_frame, state.first):set_generated()
+        if not state.whole then
+            root:add(df.payload, tvb(0, n - 1)):append_text(" (part of a multi-frame transfer)")
+            pinfo.cols.info = string.format("%s (frame %d of a transfer)", info, state.index)
+            return true
+        end
+        root:add(df.frames, state.index):set_generated()
+        local whole = ByteArray.new(state.whole, true):tvb("Reassembled DroneCAN transfer")
+        local carried = whole(0, 2):le_uint()
+        local crc_item = root:add(df.crc, whole(0, 2), carried)
+        local summary_crc
+        if t then
+            s = state.whole:sub(3)
+            local computed = crc16_ccitt(base_crc(t), s)
+            crc_item:add(df.crc_computed, whole(0, 2), computed):set_generated()
+            local ok = computed == carried
+            crc_item:add(df.crc_status, whole(0, 2), ok and 1 or 0):set_generated()
+            if ok then
+                crc_item:append_text(" [CRC ok]")
+            else
+                crc_item:append_text(string.format(" [CRC bad: 0x%04X computed]", computed))
+                crc_item:add_proto_expert_info(dce.crc, string.format(
+                    "Bad transfer CRC: 0x%04X carried, 0x%04X computed", carried, computed))
+                summary_crc = "CRC bad"
+            end
+        else
+            crc_item:append_text(" (not checked: the data type's signature is not known)")
+        end
+        if #state.whole > 2 then p = whole(2) end
+        if summary_crc then
+            if p then root:add(df.payload, p) end
+            pinfo.cols.info = string.format("%s (%d frames): %s", info, state.index, summary_crc)
+            return true
+        end
+    end
+
+    local length = s and #s or (n - 1)
+    root:add(df.length, length):set_generated()
+    if not layout_ then
+        if p then root:add(df.payload, p) end
+        pinfo.cols.info = info
+        return true
+    end
+    local fits = length >= layout_.min and length <= layout_.max
+    for _, spec in ipairs(layout_.fields) do
+        if spec.kind == "tail" and (length * 8 - layout_.fixed) % spec.bits ~= 0 then fits = false end
+    end
+    if not fits then
+        local item = root:add(df.payload, p or tvb(0, 0))
+        item:add_proto_expert_info(dce.length, string.format(
+            "%d payload bytes: a %s %s has %s", length, t.name, h.kind,
+            layout_.min == layout_.max and tostring(layout_.min) or
+            string.format("%d to %d", layout_.min, layout_.max)))
+        pinfo.cols.info = info .. ": bad length"
+        return true
+    end
+    local body = root:add(dronecan, p or tvb(0, 0), short .. " " .. h.kind)
+    local values, summary = decode_fields(layout_, p, s or "", body)
+    summary = type_extras(t, values, p, body) or summary
+    if summary ~= "" then
+        body:append_text(": " .. summary)
+        info = info .. ": " .. summary
+    end
+    pinfo.cols.info = info
+    return true
+end
+
+dronecan:register_heuristic("can", dronecan_frame)
