@@ -240,7 +240,7 @@ mod tests {
         let (reply, _) = feed(&mut a, &[b'T'; 200]);
         assert!(reply.is_empty());
         assert_eq!(feed(&mut a, b"\rC\rT1E4E2D7F0\r").0, b"\x07\r\x07");
-        assert_eq!(a.refused(), 11);
+        assert_eq!(a.refused(), 10);
     }
 
     #[test]
