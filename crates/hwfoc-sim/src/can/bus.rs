@@ -78,7 +78,11 @@ impl CanBus {
         if spec.link != LinkRates::default() {
             return Err(SimError::CanLinkFaults);
         }
-        if let Some(esc) = spec.faults.iter().find_map(|f| f.esc.filter(|&e| e >= spec.n)) {
+        if let Some(esc) = spec
+            .faults
+            .iter()
+            .find_map(|f| f.esc.filter(|&e| e >= spec.n))
+        {
             return Err(SimError::NoSuchEsc { esc, n: spec.n });
         }
         let profile = Rc::new(Profile::load(&spec.profile, &spec.shape)?);

@@ -6,9 +6,9 @@ use std::rc::Rc;
 
 use hwfoc::Status;
 use hwfoc::dronecan::{
-    GetEscId, GetMaintenanceInformationResponse, GetMajorConfigResponse, Kind, Message,
-    NodeStatus, SelfTestResponse, SetBaudRequest, SetBaudResponse, SetDirectionResponse,
-    SetIdResponse, SetLedResponse, SetReportingFrequencyRequest, SetReportingFrequencyResponse,
+    GetEscId, GetMaintenanceInformationResponse, GetMajorConfigResponse, Kind, Message, NodeStatus,
+    SelfTestResponse, SetBaudRequest, SetBaudResponse, SetDirectionResponse, SetIdResponse,
+    SetLedResponse, SetReportingFrequencyRequest, SetReportingFrequencyResponse,
     SetThrottleSourceResponse, StatusMsg1, StatusMsg2, StatusMsg3,
 };
 

@@ -360,7 +360,10 @@ pub fn truth_json(out: &mut String, origin_ns: u64, s: &Sent) {
         Message::SetThrottleSourceResponse(m) => vec![("source", m.source.to_string())],
         Message::SelfTestResponse(m) => vec![("status", m.status.to_string())],
         Message::GetMaintenanceInformationResponse(m) => vec![
-            ("total_rotation_time_min", m.total_rotation_time_min.to_string()),
+            (
+                "total_rotation_time_min",
+                m.total_rotation_time_min.to_string(),
+            ),
             (
                 "time_since_maintainence_min",
                 m.time_since_maintenance_min.to_string(),

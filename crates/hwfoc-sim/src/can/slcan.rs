@@ -156,9 +156,9 @@ fn parse_frame(kind: u8, rest: &[u8]) -> Option<CanFrame> {
 
 /// The value of hex digits (either case), or `None`.
 fn hex(digits: &[u8]) -> Option<u32> {
-    digits.iter().try_fold(0u32, |v, &d| {
-        Some(v << 4 | char::from(d).to_digit(16)?)
-    })
+    digits
+        .iter()
+        .try_fold(0u32, |v, &d| Some(v << 4 | char::from(d).to_digit(16)?))
 }
 
 /// Appends the line that hands `frame` on: `T` + 8 hex digits of identifier (`t` + 3 for a
@@ -246,7 +246,10 @@ mod tests {
     #[test]
     fn lines_out() {
         let mut out = Vec::new();
-        push_frame(&mut out, &CanFrame::extended(0x104E_5201, &[1, 0xAB, 0xC3]).unwrap());
+        push_frame(
+            &mut out,
+            &CanFrame::extended(0x104E_5201, &[1, 0xAB, 0xC3]).unwrap(),
+        );
         push_frame(&mut out, &CanFrame::standard(0x7F, &[]).unwrap());
         push_frame(&mut out, &CanFrame::remote(0x12, true, 4).unwrap());
         push_frame(&mut out, &CanFrame::error(4, &[0; 8]).unwrap());

@@ -358,13 +358,19 @@ fn each_setup_service() {
         }
         .into()
     };
+    assert_eq!(ask(&mut b, 2 * S, freq(0, 20052, 0)), answer(0, 20052, 7));
     assert_eq!(
-        ask(&mut b, 2 * S, freq(0, 20052, 0)),
-        answer(0, 20052, 7)
+        ask(&mut b, 2 * S + 10_000_000, freq(1, 20050, 7)),
+        answer(1, 20050, 7)
     );
-    assert_eq!(ask(&mut b, 2 * S + 10_000_000, freq(1, 20050, 7)), answer(1, 20050, 7));
-    assert_eq!(ask(&mut b, 2 * S + 20_000_000, freq(1, 20050, 10)), answer(1, 20050, 7));
-    assert_eq!(ask(&mut b, 2 * S + 30_000_000, freq(0, 1034, 0)), answer(0, 1034, 9));
+    assert_eq!(
+        ask(&mut b, 2 * S + 20_000_000, freq(1, 20050, 10)),
+        answer(1, 20050, 7)
+    );
+    assert_eq!(
+        ask(&mut b, 2 * S + 30_000_000, freq(0, 1034, 0)),
+        answer(0, 1034, 9)
+    );
     let got = decode(&mut b, 4 * S + 40_000_000, &mut Receiver::new());
     let msg1 = got
         .iter()
@@ -374,7 +380,10 @@ fn each_setup_service() {
     // StatusMsg2 off (code 9, 0 Hz).
     assert_eq!(ask(&mut b, 5 * S, freq(1, 20051, 9)), answer(1, 20051, 9));
     let got = decode(&mut b, 6 * S, &mut Receiver::new());
-    assert!(!got.iter().any(|(_, r)| r.message.kind() == Kind::StatusMsg2));
+    assert!(
+        !got.iter()
+            .any(|(_, r)| r.message.kind() == Kind::StatusMsg2)
+    );
     // GetMajorConfig: all of the above.
     assert_eq!(
         ask(&mut b, 6 * S, GetMajorConfigRequest { option: 0 }),
@@ -392,8 +401,7 @@ fn each_setup_service() {
         .into()
     );
     // SelfTest: fails while the motor turns (50 % from 5.5 s).
-    let Message::SelfTestResponse(r) = ask(&mut b, 6 * S + 100_000_000, SelfTestRequest {})
-    else {
+    let Message::SelfTestResponse(r) = ask(&mut b, 6 * S + 100_000_000, SelfTestRequest {}) else {
         panic!()
     };
     assert_eq!(r.status, 1);
@@ -414,7 +422,10 @@ fn each_setup_service() {
         panic!()
     };
     assert_eq!(cleared.time_since_maintenance_min, 0);
-    assert_eq!(cleared.total_rotation_time_min, before.total_rotation_time_min);
+    assert_eq!(
+        cleared.total_rotation_time_min,
+        before.total_rotation_time_min
+    );
     // SetAngle is not answered; nor a request to another node.
     let angle = SetAngleRequest {
         option: 0,
@@ -496,7 +507,9 @@ fn a_candump_log_and_its_truth() {
     };
     let session = CanSession::open(bus(2, false), &plan).unwrap();
     assert_eq!(session.output(), path("bus.log"));
-    let report = session.run(&std::sync::atomic::AtomicBool::new(false)).unwrap();
+    let report = session
+        .run(&std::sync::atomic::AtomicBool::new(false))
+        .unwrap();
     let log = std::fs::read_to_string(path("bus.log")).unwrap();
     let truth = std::fs::read_to_string(path("truth.jsonl")).unwrap();
     assert_eq!(log.lines().count() as u64, report.frames);
