@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # The DroneCAN output read by pydronecan (the `dronecan` Python package, with pyserial for its
-# SLCAN driver): crates/hwfoc-bridge/tests/dronecan.rs relays the output's SLCAN through two
-# pseudo-terminals to crates/hwfoc-bridge/tests/py/dronecan_check.py and compares every
+# SLCAN driver), and the simulator's virtual CAN ESCs checked by it (below):
+# crates/hwfoc-bridge/tests/dronecan.rs relays the output's SLCAN through two pseudo-terminals to crates/hwfoc-bridge/tests/py/dronecan_check.py and compares every
 # esc.Status it decodes with the records sent. Called by .ci/run; runs on its own too.
 set -euo pipefail
 export CARGO_TERM_COLOR=never
@@ -18,6 +18,16 @@ HWFOC_DRONECAN_PY="$venv/bin/python" cargo test -p hwfoc-bridge --test dronecan 
 grep -Eq "^test result: ok\. [1-9][0-9]* passed; 0 failed; 0 ignored" "$log" \
   || { echo "the DroneCAN tests did not all run and pass (see $log)" >&2; exit 1; }
 grep -q "pydronecan decoded" "$log" || { echo "the pydronecan test did not run" >&2; exit 1; }
+# The simulator's virtual Hobbywing CAN ESCs (crates/hwfoc-sim/tests/can_pydronecan.rs, with
+# crates/hwfoc-sim/tests/py/can_check.py): a candump log decoded by pydronecan as meant, and
+# pydronecan's node setting them up over the SLCAN pty.
+simlog=${TMPDIR:-/tmp}/hwfoc-ci-dronecan-sim.log
+HWFOC_DRONECAN_PY="$venv/bin/python" cargo test -p hwfoc-sim --test can_pydronecan \
+  -- --include-ignored --nocapture 2>&1 | tee "$simlog"
+grep -Eq "^test result: ok\. 2 passed; 0 failed; 0 ignored" "$simlog" \
+  || { echo "the simulator's pydronecan tests did not all run and pass (see $simlog)" >&2; exit 1; }
+grep -q "as the simulator meant them" "$simlog" && grep -q "pydronecan over SLCAN" "$simlog" \
+  || { echo "a simulator pydronecan test did not run (see $simlog)" >&2; exit 1; }
 # The codec's DroneCAN test vectors (testdata/dronecan/vectors.txt) are pydronecan's: made again
 # here by the installed package, they must be the file committed.
 "$venv/bin/python" scripts/dronecan-vectors.py --check

@@ -7,7 +7,7 @@ use hwfoc_sim::can::{CanBus, CanDestination, CanPlan, CanReport, CanSession};
 #[cfg(unix)]
 use hwfoc_sim::pty::PtyLinks;
 
-use super::{Format, SimulateArgs, announce, usage};
+use super::{Format, SimulateArgs, usage};
 use crate::config::Config;
 use crate::error::CliError;
 
@@ -95,13 +95,28 @@ pub fn run(args: &SimulateArgs, config: &Config, settings: Settings) -> Result<(
     let bus = CanBus::build(&spec, args.factory)?;
     let session = CanSession::open(bus, &plan)?;
     if args.pty {
-        announce(&[session.output().to_string()])?;
+        announce_slcan(session.output())?;
     }
     let report = session.run(&crate::stop::interrupted())?;
     if !args.quiet {
         eprintln!("{}", line(n, &report));
     }
     Ok(())
+}
+
+/// Prints `slcan: PATH`: the pseudo-terminal to open as an SLCAN adapter.
+fn announce_slcan(path: &str) -> Result<(), CliError> {
+    use std::io::Write;
+    let mut stdout = std::io::stdout().lock();
+    writeln!(stdout, "slcan: {path}")
+        .and_then(|()| stdout.flush())
+        .map_err(|source| {
+            hwfoc_io::write::WriteError::Write {
+                output: "standard output".to_string(),
+                source,
+            }
+            .into()
+        })
 }
 
 /// The end-of-run line.
