@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # The DroneCAN output read by pydronecan (the `dronecan` Python package, with pyserial for its
 # SLCAN driver), and the simulator's virtual CAN ESCs checked by it (below):
-# crates/hwfoc-bridge/tests/dronecan.rs relays the output's SLCAN through two pseudo-terminals to crates/hwfoc-bridge/tests/py/dronecan_check.py and compares every
-# esc.Status it decodes with the records sent. Called by .ci/run; runs on its own too.
+# crates/hwfoc-bridge/tests/dronecan.rs relays the output's SLCAN through two pseudo-terminals
+# to crates/hwfoc-bridge/tests/py/dronecan_check.py and compares every esc.Status it decodes
+# with the records sent. Called by .ci/run; runs on its own too.
 set -euo pipefail
 export CARGO_TERM_COLOR=never
 cd "$(dirname "$0")/.."
