@@ -2,9 +2,10 @@
 # The DroneCAN output read by pydronecan (the `dronecan` Python package, with pyserial for its
 # SLCAN driver): crates/hwfoc-bridge/tests/dronecan.rs relays the output's SLCAN through two
 # pseudo-terminals to crates/hwfoc-bridge/tests/py/dronecan_check.py and compares every
-# esc.Status it decodes with the records sent. And the Wireshark dissector on pydronecan's
-# frames (crates/hwfoc-cli/tests/wireshark.rs, with crates/hwfoc-cli/tests/py/dronecan_pcapng.py;
-# it needs tshark too, which .ci/run installs). Called by .ci/run; runs on its own too.
+# esc.Status it decodes with the records sent. The Wireshark dissector on pydronecan's frames
+# (crates/hwfoc-cli/tests/wireshark.rs, with crates/hwfoc-cli/tests/py/dronecan_pcapng.py; it
+# needs tshark too, which .ci/run installs), and the simulator's virtual CAN ESCs checked by it
+# (below). Called by .ci/run; runs on its own too.
 set -euo pipefail
 export CARGO_TERM_COLOR=never
 cd "$(dirname "$0")/.."
@@ -28,6 +29,16 @@ grep -Eq "^test result: ok\. 1 passed; 0 failed; 0 ignored" "$log" \
   || { echo "the dissector's pydronecan test did not run and pass (see $log)" >&2; exit 1; }
 grep -q "pydronecan frames dissected" "$log" \
   || { echo "the dissector's pydronecan test did not run" >&2; exit 1; }
+# The simulator's virtual Hobbywing CAN ESCs (crates/hwfoc-sim/tests/can_pydronecan.rs, with
+# crates/hwfoc-sim/tests/py/can_check.py): a candump log decoded by pydronecan as meant, and
+# pydronecan's node setting them up over the SLCAN pty.
+simlog=${TMPDIR:-/tmp}/hwfoc-ci-dronecan-sim.log
+HWFOC_DRONECAN_PY="$venv/bin/python" cargo test -p hwfoc-sim --test can_pydronecan \
+  -- --include-ignored --nocapture 2>&1 | tee "$simlog"
+grep -Eq "^test result: ok\. 2 passed; 0 failed; 0 ignored" "$simlog" \
+  || { echo "the simulator's pydronecan tests did not all run and pass (see $simlog)" >&2; exit 1; }
+grep -q "as the simulator meant them" "$simlog" && grep -q "pydronecan over SLCAN" "$simlog" \
+  || { echo "a simulator pydronecan test did not run (see $simlog)" >&2; exit 1; }
 # The codec's DroneCAN test vectors (testdata/dronecan/vectors.txt) are pydronecan's: made again
 # here by the installed package, they must be the file committed.
 "$venv/bin/python" scripts/dronecan-vectors.py --check

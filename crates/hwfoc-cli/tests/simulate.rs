@@ -735,7 +735,8 @@ fn protocol_errors_name_what_is_wrong() {
     let o = run(&["simulate", "--protocol", "datalink", "-o", &out]);
     assert_eq!(o.status.code(), Some(2));
     assert!(
-        String::from_utf8_lossy(&o.stderr).contains("[possible values: hw-foc, hw-v4, hw-v3, hw5]")
+        String::from_utf8_lossy(&o.stderr)
+            .contains("[possible values: hw-foc, hw-v4, hw-v3, hw5, hw-can]")
     );
     assert!(!dir.path("x.bin").exists());
 }

@@ -40,6 +40,14 @@ pub enum SimError {
         /// How many were asked for.
         n: usize,
     },
+    /// More ESCs on a simulated CAN bus than it can have
+    /// ([`MAX_CAN_ESCS`](crate::can::MAX_CAN_ESCS)).
+    TooManyCanEscs {
+        /// How many were asked for.
+        n: usize,
+    },
+    /// Link faults (bit errors, drops, cuts, garbage) asked of a CAN bus.
+    CanLinkFaults,
     /// A fault was scheduled on an ESC the fleet does not have.
     NoSuchEsc {
         /// The ESC named.
@@ -129,6 +137,15 @@ impl fmt::Display for SimError {
                 f,
                 "{n} ESCs: at most {} (an ESC's number is a byte)",
                 crate::fleet::MAX_ESCS
+            ),
+            SimError::TooManyCanEscs { n } => write!(
+                f,
+                "{n} ESCs on a CAN bus: at most {} (a throttle channel has 6 bits)",
+                crate::can::MAX_CAN_ESCS
+            ),
+            SimError::CanLinkFaults => f.write_str(
+                "link faults (bit errors, drops, cuts, garbage) are simulated for HW-FOC only, \
+                 not on a CAN bus",
             ),
             SimError::NoSuchEsc { esc, n } => write!(
                 f,

@@ -432,18 +432,13 @@ impl VirtualEsc {
 
     /// Runs the model up to `t_ns`.
     fn advance_to(&mut self, t_ns: u64) {
-        while self.model_ns < t_ns {
-            let dt = MODEL_STEP_NS.min(t_ns - self.model_ns);
-            let now = seconds(self.model_ns);
-            let lost = self
-                .setup
-                .faults
-                .status_at(now)
-                .contains(Fault::ThrottleSignalLost);
-            let throttle = self.setup.profile.throttle(now - self.setup.lag_s);
-            self.model.step(dt as f64 * 1e-9, throttle, lost);
-            self.model_ns += dt;
-        }
+        let s = &self.setup;
+        drive(
+            &mut self.model,
+            &mut self.model_ns,
+            t_ns,
+            (&s.profile, s.lag_s, &s.faults),
+        );
     }
 
     /// Puts a frame due at `due_ns` on the wire, through the link's faults.
@@ -533,6 +528,24 @@ impl VirtualEsc {
     }
 }
 
+/// Runs `model`, which has reached `model_ns`, up to `t_ns` in steps of at most 5 ms, under
+/// the throttle of `profile` seen `lag_s` late and the injected `faults` (a lost throttle
+/// signal): every virtual ESC, serial or CAN, is driven this way.
+pub(crate) fn drive(
+    model: &mut Model,
+    model_ns: &mut u64,
+    t_ns: u64,
+    (profile, lag_s, faults): (&Profile, f64, &FaultSchedule),
+) {
+    while *model_ns < t_ns {
+        let dt = MODEL_STEP_NS.min(t_ns - *model_ns);
+        let now = seconds(*model_ns);
+        let lost = faults.status_at(now).contains(Fault::ThrottleSignalLost);
+        model.step(dt as f64 * 1e-9, profile.throttle(now - lag_s), lost);
+        *model_ns += dt;
+    }
+}
+
 /// The longest an ESC runs behind the profile, seconds (see [`spread`]).
 pub const MAX_LAG_S: f64 = 1.0;
 /// How far an ESC's load is from the model's, as a fraction (see [`spread`]).
@@ -559,7 +572,7 @@ pub fn spread(seed: u64, index: usize) -> (f64, f64) {
 const SPREAD_SALT: u64 = 0x5350_5245_4144_2d31;
 
 /// Simulated seconds for simulated nanoseconds.
-fn seconds(t_ns: u64) -> f64 {
+pub(crate) fn seconds(t_ns: u64) -> f64 {
     t_ns as f64 * 1e-9
 }
 

@@ -20,6 +20,7 @@
 #![forbid(unsafe_op_in_unsafe_fn)]
 #![warn(missing_docs)]
 
+pub mod can;
 pub mod destination;
 pub mod error;
 pub mod esc;

@@ -99,6 +99,8 @@ pub struct Pty {
     master: File,
     path: PathBuf,
     undelivered: u64,
+    /// Keep what the reader writes for [`Pty::read`] instead of discarding it.
+    keep_input: bool,
 }
 
 impl Pty {
@@ -112,6 +114,7 @@ impl Pty {
             master: pair.master,
             path: pair.path,
             undelivered: 0,
+            keep_input: false,
         })
     }
 
@@ -149,8 +152,23 @@ impl Pty {
         sent == bytes.len()
     }
 
+    /// Keeps what the reader writes to the port, for [`Pty::read`] (a virtual CAN adapter
+    /// reads its commands), instead of discarding it.
+    pub fn keep_input(&mut self) {
+        self.keep_input = true;
+    }
+
+    /// What the reader wrote to the port since the last call, up to `buf.len()` bytes, without
+    /// waiting: the number of bytes.
+    pub fn read(&mut self, buf: &mut [u8]) -> usize {
+        self.master.read(buf).unwrap_or_default()
+    }
+
     /// Reads and throws away what the reader wrote to the port, so that it never blocks.
     fn discard_input(&mut self) {
+        if self.keep_input {
+            return;
+        }
         let mut buf = [0u8; 512];
         for _ in 0..16 {
             match self.master.read(&mut buf) {

@@ -26,9 +26,9 @@ use crate::sink::{self, Truth};
 
 /// Extra seconds after one run of the profile, for runs written at once without a duration:
 /// the motor stops and the idle frames and device information show.
-const TAIL_S: f64 = 2.0;
+pub(crate) const TAIL_S: f64 = 2.0;
 /// How long the ptys stay open after the last write.
-const PTY_LINGER: Duration = Duration::from_millis(300);
+pub(crate) const PTY_LINGER: Duration = Duration::from_millis(300);
 
 /// How a fleet is run: where its bytes go, at what rate, from when, for how long, and where
 /// the ground truth goes.

@@ -1,5 +1,6 @@
 //! `hwfoc simulate`: virtual ESCs that speak their protocol as real ones do (HW-FOC by default;
-//! `--protocol hw-v4`, `hw-v3` or `hw5`: [`hwfoc_sim::protocols`]).
+//! `--protocol hw-v4`, `hw-v3` or `hw5`: [`hwfoc_sim::protocols`]; `--protocol hw-can`: a CAN
+//! bus of Hobbywing DroneCAN ESCs, [`hwfoc_sim::can`], run by the `can` module).
 //!
 //! The simulator is the `hwfoc_sim` library; this command turns its options into the library's
 //! description of a run (a [`FleetSpec`] and a [`Plan`]), refuses options that do not go
@@ -11,6 +12,8 @@ use std::io::{IsTerminal, Write};
 use clap::ValueEnum;
 use clap::builder::{PossibleValue, PossibleValuesParser, TypedValueParser};
 use hwfoc::{Protocol, Settings};
+
+mod can;
 
 use crate::args::SettingsArgs;
 use crate::error::CliError;
@@ -54,7 +57,9 @@ Examples:
   hwfoc simulate --escs 4 -o run.pcapng --profile sine --duration 60
   hwfoc simulate --drop-rate 0.02 --bit-error-rate 1e-4 --fault mos_overheat@5-7 | hwfoc decode -
   hwfoc simulate --port /dev/ttyUSB0 --profile csv:flight.csv
-  hwfoc simulate --protocol hw5 --fault motor_blocked@5-6 -o hw5.pcapng  # an HW5 ESC at 115200 baud";
+  hwfoc simulate --protocol hw5 --fault motor_blocked@5-6 -o hw5.pcapng  # an HW5 ESC at 115200 baud
+  hwfoc simulate --protocol hw-can --escs 4 -o bus.log # a candump log of 4 DroneCAN ESCs
+  hwfoc simulate --protocol hw-can --escs 4 --factory --pty  # an SLCAN adapter, all ESCs node 1";
 
 /// Arguments of `hwfoc simulate`.
 #[derive(Debug, clap::Args)]
@@ -68,11 +73,16 @@ pub struct SimulateArgs {
     #[arg(long, value_name = "S", value_parser = crate::args::seconds)]
     duration: Option<f64>,
     /// The protocol the virtual ESCs speak: hw-foc (default), hw-v4 (Platinum V4), hw-v3
-    /// (Platinum V3) or hw5 (Platinum V5, VBAR). V3 and V4 carry no fault word (faults act on the
-    /// model only); HW5's fault byte carries the faults that map to its flags; link faults are
-    /// for hw-foc only.
+    /// (Platinum V3), hw5 (Platinum V5, VBAR) or hw-can (Hobbywing DroneCAN ESCs on a CAN
+    /// bus: a candump log with -o, an SLCAN adapter with --pty). V3 and V4 carry no fault word
+    /// (faults act on the model only); HW5's fault byte carries the faults that map to its
+    /// flags; link faults are for hw-foc only.
     #[arg(long, value_name = "NAME", value_parser = protocol_parser())]
-    protocol: Option<Protocol>,
+    protocol: Option<SimProtocol>,
+    /// hw-can: every ESC as it leaves the factory (node 1, throttle channel 1, 500 kbit/s)
+    /// instead of set up (node 10 + N, channel N + 1).
+    #[arg(long)]
+    factory: bool,
     /// Line rate in baud (8N1). Default: the protocol's (19200; 115200 for hw5).
     #[arg(long, value_name = "BAUD",
           value_parser = clap::value_parser!(u32).range(9_600..=4_000_000))]
@@ -283,14 +293,33 @@ impl ModelArgs {
     }
 }
 
+/// What the virtual ESCs speak: a serial protocol, or DroneCAN on a CAN bus.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SimProtocol {
+    /// One of [`SIMULATED`].
+    Serial(Protocol),
+    /// Hobbywing's DroneCAN messages on a CAN bus (`hw-can`).
+    HwCan,
+}
+
+/// The name of the CAN bus's protocol.
+const HW_CAN: &str = "hw-can";
+
 /// The names of the protocols a virtual ESC speaks, each with its title and baud rate.
-fn protocol_parser() -> impl TypedValueParser<Value = Protocol> {
-    let names = SIMULATED.map(|p| {
-        PossibleValue::new(p.name()).help(format!("{}, {} baud", p.title(), p.baud_rate()))
-    });
+fn protocol_parser() -> impl TypedValueParser<Value = SimProtocol> {
+    let names = SIMULATED
+        .map(|p| {
+            PossibleValue::new(p.name()).help(format!("{}, {} baud", p.title(), p.baud_rate()))
+        })
+        .into_iter()
+        .chain([
+            PossibleValue::new(HW_CAN).help("Hobbywing DroneCAN ESCs on a CAN bus, 500 kbit/s")
+        ]);
     // Every possible value is a protocol's name: the mapping finds it.
-    PossibleValuesParser::new(names)
-        .map(|name| Protocol::from_name(&name).unwrap_or(Protocol::HwFoc))
+    PossibleValuesParser::new(names).map(|name| match name.as_str() {
+        HW_CAN => SimProtocol::HwCan,
+        name => SimProtocol::Serial(Protocol::from_name(name).unwrap_or(Protocol::HwFoc)),
+    })
 }
 
 fn number(s: &str) -> Result<f64, String> {
@@ -365,6 +394,14 @@ fn usage(option: &str, message: impl Into<String>) -> CliError {
 pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
     let config = args.settings.config()?;
     let settings = config.settings(&args.settings)?;
+    let protocol = match args.protocol {
+        Some(SimProtocol::HwCan) => return can::run(args, &config, settings),
+        Some(SimProtocol::Serial(p)) => p,
+        None => Protocol::HwFoc,
+    };
+    if args.factory {
+        return Err(usage("--factory", "only for --protocol hw-can"));
+    }
     let n = count_escs(args)?;
     let plan = plan(args, n, settings)?;
     // The files read: the profile and the configuration.
@@ -377,7 +414,6 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
         .chain(crate::safety::config_read(&config))
         .collect();
     refuse_clashes(&plan, n, &reads)?;
-    let protocol = args.protocol.unwrap_or(Protocol::HwFoc);
     let baud = args.baud.unwrap_or(protocol.baud_rate());
     let spec = FleetSpec {
         protocol,

@@ -1,0 +1,391 @@
+//! Running a bus of virtual CAN ESCs into its output: a `candump -l` log (a file or standard
+//! output, as fast as possible or in real time), or a pseudo-terminal that speaks SLCAN like
+//! a CANable adapter (always in real time, answering the controller on the other end), with
+//! the ground truth of every transfer sent.
+
+use std::io::{BufWriter, Write};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::{Duration, Instant};
+
+use hwfoc::dronecan::{CanFrame, Form, Message};
+use hwfoc_io::clock::unix_now_ns;
+use hwfoc_io::write::WriteError;
+
+use super::bus::{CanBus, Sent};
+use super::slcan::{self, Action, Adapter};
+use crate::error::SimError;
+#[cfg(unix)]
+use crate::pty::{self, PtyLinks};
+use crate::session::{PTY_LINGER, TAIL_S};
+use crate::sink;
+
+/// The interface name in candump lines.
+pub const INTERFACE: &str = "can0";
+/// Simulated time handled per step when writing at once, ns.
+const STEP_NS: u64 = 100_000_000;
+/// How often the real-time loop looks at the pty and the bus.
+const TICK: Duration = Duration::from_millis(2);
+
+/// Where a CAN bus goes.
+#[derive(Debug, Clone, PartialEq)]
+pub enum CanDestination {
+    /// A `candump -l` log: `(secs.usecs) can0 ID#DATA` lines, to a file or standard output
+    /// (`-`).
+    Candump(String),
+    /// A pseudo-terminal speaking SLCAN (the controller's adapter), with optional symlinks.
+    #[cfg(unix)]
+    Pty(PtyLinks),
+}
+
+/// How a CAN bus is run.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CanPlan {
+    /// Where the frames go.
+    pub destination: CanDestination,
+    /// Write a log at the real rate instead of as fast as possible (a pty always is).
+    pub realtime: bool,
+    /// Unix time (seconds) of the start of a log written at once. Default: now.
+    pub start_s: Option<f64>,
+    /// Seconds of simulated time. Default: one run of the profile plus 2 s for a log written
+    /// at once; until stopped in real time.
+    pub duration_s: Option<f64>,
+    /// The ground truth's file (`-`: standard output): one JSON object per transfer sent.
+    pub truth: Option<String>,
+    /// Replace output files that exist.
+    pub overwrite: bool,
+}
+
+/// What a run of a CAN bus did.
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct CanReport {
+    /// The output, as a person would name it (a path, standard output, a pty).
+    pub output: String,
+    /// Transfers the ESCs sent.
+    pub transfers: u64,
+    /// Frames on the bus.
+    pub frames: u64,
+    /// Frames no one received (a pty without a reader, or its channel closed).
+    pub undelivered: u64,
+    /// Frames the controller sent (pty).
+    pub received: u64,
+    /// Answers the ESCs gave to the controller's requests.
+    pub answers: u64,
+    /// SLCAN commands refused (pty).
+    pub refused: u64,
+}
+
+/// A CAN bus with its outputs open, ready to run.
+pub struct CanSession {
+    bus: CanBus,
+    out: Out,
+    truth: Option<(String, BufWriter<Box<dyn Write>>)>,
+    realtime: bool,
+    origin_ns: u64,
+    duration_ns: Option<u64>,
+    report: CanReport,
+}
+
+enum Out {
+    Log(String, BufWriter<Box<dyn Write>>),
+    /// The pty, and its symlinks (removed when dropped).
+    #[cfg(unix)]
+    Pty(pty::Pty, #[allow(dead_code)] pty::Links),
+}
+
+impl CanSession {
+    /// Opens `plan`'s outputs for `bus` (every file checked before any is created).
+    pub fn open(bus: CanBus, plan: &CanPlan) -> Result<CanSession, SimError> {
+        let live = !matches!(plan.destination, CanDestination::Candump(_));
+        let realtime = plan.realtime || live;
+        let mut files: Vec<String> = plan.truth.iter().cloned().collect();
+        if let CanDestination::Candump(path) = &plan.destination {
+            files.push(path.clone());
+        }
+        sink::check_new(files.iter().map(String::as_str), plan.overwrite)?;
+        let truth = match &plan.truth {
+            Some(path) => {
+                let (name, w) = sink::create(path, plan.overwrite)?;
+                Some((name, BufWriter::with_capacity(1 << 16, w)))
+            }
+            None => None,
+        };
+        let out = match &plan.destination {
+            CanDestination::Candump(path) => {
+                let (name, w) = sink::create(path, plan.overwrite)?;
+                Out::Log(name, BufWriter::with_capacity(1 << 16, w))
+            }
+            #[cfg(unix)]
+            CanDestination::Pty(links) => {
+                let (mut ptys, links) = pty::open_all(1, links)?;
+                let mut p = ptys.remove(0);
+                p.keep_input();
+                Out::Pty(p, links)
+            }
+        };
+        let duration_s = match plan.duration_s {
+            Some(d) => Some(d),
+            None if realtime => None,
+            None => Some(bus.natural_length_s() + TAIL_S),
+        };
+        let origin_ns = match (realtime, plan.start_s) {
+            (false, Some(s)) => (s * 1e9).round() as u64,
+            _ => unix_now_ns(),
+        };
+        let output = match &out {
+            Out::Log(name, _) => name.clone(),
+            #[cfg(unix)]
+            Out::Pty(p, _) => p.path().display().to_string(),
+        };
+        Ok(CanSession {
+            bus,
+            out,
+            truth,
+            realtime,
+            origin_ns,
+            duration_ns: duration_s.map(|s| (s * 1e9).round() as u64),
+            report: CanReport {
+                output,
+                ..CanReport::default()
+            },
+        })
+    }
+
+    /// The output, as a person would name it: for a pty, the path to open.
+    pub fn output(&self) -> &str {
+        &self.report.output
+    }
+
+    /// Runs to the end of the duration, or until `stop` is set.
+    pub fn run(mut self, stop: &AtomicBool) -> Result<CanReport, SimError> {
+        let start = Instant::now();
+        let mut adapter = Adapter::new();
+        let mut t_ns = 0u64;
+        let mut reply = Vec::new();
+        let mut actions = Vec::new();
+        let mut lines = Vec::new();
+        while !stop.load(Ordering::Relaxed) {
+            if self.duration_ns.is_some_and(|d| t_ns >= d) {
+                break;
+            }
+            t_ns = if self.realtime {
+                start.elapsed().as_nanos() as u64
+            } else {
+                t_ns + STEP_NS
+            };
+            if let Some(d) = self.duration_ns {
+                t_ns = t_ns.min(d);
+            }
+            #[cfg(unix)]
+            if let Out::Pty(p, _) = &mut self.out {
+                let mut buf = [0u8; 1024];
+                loop {
+                    let n = p.read(&mut buf);
+                    if n == 0 {
+                        break;
+                    }
+                    adapter.feed(&buf[..n], &mut reply, &mut actions);
+                }
+                for a in actions.drain(..) {
+                    match a {
+                        Action::Bitrate(b) => self.bus.set_bitrate(b),
+                        Action::Frame(f) => {
+                            self.report.received += 1;
+                            self.report.answers += self.bus.receive(t_ns, &f) as u64;
+                        }
+                    }
+                }
+                self.report.refused = adapter.refused();
+                if !reply.is_empty() {
+                    p.write(&reply);
+                    reply.clear();
+                }
+            }
+            let frames = self.bus.frames_until(t_ns);
+            self.report.frames += frames.len() as u64;
+            self.write_frames(&frames, adapter.is_open(), &mut lines)?;
+            self.write_truth()?;
+            if self.realtime {
+                self.flush()?;
+                std::thread::sleep(TICK);
+            }
+        }
+        self.flush()?;
+        #[cfg(unix)]
+        if matches!(self.out, Out::Pty(..)) {
+            std::thread::sleep(PTY_LINGER);
+        }
+        Ok(self.report)
+    }
+
+    fn write_frames(
+        &mut self,
+        frames: &[(u64, CanFrame)],
+        open: bool,
+        lines: &mut Vec<u8>,
+    ) -> Result<(), WriteError> {
+        lines.clear();
+        match &mut self.out {
+            Out::Log(name, w) => {
+                for (t, f) in frames {
+                    let ns = self.origin_ns + t;
+                    writeln!(
+                        lines,
+                        "({}.{:06}) {INTERFACE} {f}",
+                        ns / 1_000_000_000,
+                        ns % 1_000_000_000 / 1000
+                    )
+                    .map_err(write_error(name))?;
+                }
+                w.write_all(lines).map_err(write_error(name))?;
+            }
+            #[cfg(unix)]
+            Out::Pty(p, _) => {
+                if !open {
+                    self.report.undelivered += frames.len() as u64;
+                    return Ok(());
+                }
+                for (_, f) in frames {
+                    slcan::push_frame(lines, f);
+                }
+                if !lines.is_empty() && !p.write(lines) {
+                    self.report.undelivered += frames.len() as u64;
+                }
+            }
+        }
+        let _ = open;
+        Ok(())
+    }
+
+    fn write_truth(&mut self) -> Result<(), WriteError> {
+        let sent = self.bus.take_sent();
+        self.report.transfers += sent.len() as u64;
+        if let Some((name, w)) = &mut self.truth {
+            let mut line = String::new();
+            for s in &sent {
+                line.clear();
+                truth_json(&mut line, self.origin_ns, s);
+                w.write_all(line.as_bytes()).map_err(write_error(name))?;
+            }
+        }
+        Ok(())
+    }
+
+    fn flush(&mut self) -> Result<(), WriteError> {
+        if let Out::Log(name, w) = &mut self.out {
+            w.flush().map_err(write_error(name))?;
+        }
+        if let Some((name, w)) = &mut self.truth {
+            w.flush().map_err(write_error(name))?;
+        }
+        Ok(())
+    }
+}
+
+fn write_error(name: &str) -> impl FnOnce(std::io::Error) -> WriteError + '_ {
+    move |source| WriteError::Write {
+        output: name.to_string(),
+        source,
+    }
+}
+
+/// Appends the ground truth's line for a transfer sent: `t_s` (Unix seconds of its first
+/// frame, `origin_ns` being the run's start), `esc`, `source`, `destination` (0: a
+/// broadcast), `priority`, `transfer_id`, `type` (the DSDL name), `form` (`message` or
+/// `response`) and `fields`, named as in the DSDL (pydronecan's attribute names).
+pub fn truth_json(out: &mut String, origin_ns: u64, s: &Sent) {
+    use std::fmt::Write as _;
+    let o = &s.out;
+    let kind = o.message.kind();
+    let form = match kind.form() {
+        Form::Message => "message",
+        Form::Request => "request",
+        Form::Response => "response",
+    };
+    let ns = origin_ns + s.t_ns;
+    let _ = write!(
+        out,
+        "{{\"t_s\":{}.{:09},\"esc\":{},\"source\":{},\"destination\":{},\"priority\":{},\
+         \"transfer_id\":{},\"type\":\"{}\",\"form\":\"{form}\",\"fields\":{{",
+        ns / 1_000_000_000,
+        ns % 1_000_000_000,
+        s.esc,
+        o.source,
+        o.destination,
+        o.priority,
+        o.transfer_id,
+        kind.full_name()
+    );
+    let fields: Vec<(&str, String)> = match o.message {
+        Message::StatusMsg1(m) => vec![
+            ("rpm", m.rpm.to_string()),
+            ("pwm", m.pwm.to_string()),
+            ("status", m.status.to_string()),
+        ],
+        Message::StatusMsg2(m) => vec![
+            ("input_voltage", m.input_voltage.to_string()),
+            ("current", m.current.to_string()),
+            ("temperature", m.temperature.to_string()),
+        ],
+        Message::StatusMsg3(m) => vec![
+            ("MOS_T", m.mos_t.to_string()),
+            ("CAP_T", m.cap_t.to_string()),
+            ("Motor_T", m.motor_t.to_string()),
+        ],
+        Message::NodeStatus(m) => vec![
+            ("uptime_sec", m.uptime_sec.to_string()),
+            ("health", m.health.to_string()),
+            ("mode", m.mode.to_string()),
+            ("sub_mode", m.sub_mode.to_string()),
+            (
+                "vendor_specific_status_code",
+                m.vendor_specific_status_code.to_string(),
+            ),
+        ],
+        Message::GetEscId(m) => vec![("payload", format!("{:?}", m.payload()))],
+        Message::SetIdResponse(m) => vec![
+            ("node_id", m.node_id.to_string()),
+            ("throttle_channel", m.throttle_channel.to_string()),
+        ],
+        Message::SetLedResponse(m) => vec![
+            ("option", m.option.to_string()),
+            ("color", m.color.to_string()),
+            ("blink", m.blink.to_string()),
+        ],
+        Message::SetDirectionResponse(m) => vec![("direction", m.direction.to_string())],
+        Message::SetReportingFrequencyResponse(m) => vec![
+            ("option", m.option.to_string()),
+            ("MSG_ID", m.msg_id.to_string()),
+            ("rate", m.rate.to_string()),
+        ],
+        Message::SetThrottleSourceResponse(m) => vec![("source", m.source.to_string())],
+        Message::SelfTestResponse(m) => vec![("status", m.status.to_string())],
+        Message::GetMaintenanceInformationResponse(m) => vec![
+            (
+                "total_rotation_time_min",
+                m.total_rotation_time_min.to_string(),
+            ),
+            (
+                "time_since_maintainence_min",
+                m.time_since_maintenance_min.to_string(),
+            ),
+        ],
+        Message::GetMajorConfigResponse(m) => vec![
+            ("direction", u8::from(m.direction).to_string()),
+            ("throttle_source", u8::from(m.throttle_source).to_string()),
+            ("throttle_channel", m.throttle_channel.to_string()),
+            ("led_status", m.led_status.to_string()),
+            ("led_color", m.led_color.to_string()),
+            ("MSG2_rate", m.msg2_rate.to_string()),
+            ("MSG1_rate", m.msg1_rate.to_string()),
+            ("positioning_angle", m.positioning_angle.to_string()),
+            ("reserved", format!("{:?}", m.reserved)),
+        ],
+        // SetBaud's response is empty; the ESCs send nothing else.
+        _ => Vec::new(),
+    };
+    for (i, (name, value)) in fields.iter().enumerate() {
+        let comma = if i > 0 { "," } else { "" };
+        let _ = write!(out, "{comma}\"{name}\":{value}");
+    }
+    out.push_str("}}\n");
+}
