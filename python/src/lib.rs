@@ -141,14 +141,16 @@ fn escs_arg(esc: Option<&Bound<'_, PyAny>>) -> PyResult<Vec<u8>> {
         .collect()
 }
 
-/// `protocol=`: a protocol's name (`hw-foc`, `datalink`: [`Protocol::name`]), or `None` for
-/// every protocol; another name is a `ValueError` naming the names.
+/// `protocol=`: a serial protocol's name (`hw-foc`, `datalink`: [`Protocol::name`]), or
+/// `None` for every protocol; another name is a `ValueError` naming the names (a CAN bus is read
+/// as one whatever this says).
 pub(crate) fn protocol_arg(name: Option<&str>) -> PyResult<Option<Protocol>> {
     let Some(name) = name else {
         return Ok(None);
     };
-    Protocol::from_name(name).map(Some).ok_or_else(|| {
-        let names: Vec<String> = Protocol::ALL
+    let serial = Protocol::from_name(name).filter(|p| !p.is_can());
+    serial.map(Some).ok_or_else(|| {
+        let names: Vec<String> = Protocol::SERIAL
             .iter()
             .map(|p| format!("{:?}", p.name()))
             .collect();

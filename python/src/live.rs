@@ -271,7 +271,7 @@ pub fn open_ports(
     let set = py
         .detach(|| PortSet::open(&ports, baud))
         .map_err(errors::port)?;
-    let mut streams = PortStreams::new(ports.len(), baud, settings);
+    let mut streams = PortStreams::with_map(baud, ports.clone(), settings.into());
     if let Some(protocol) = protocol {
         streams.force_protocol(protocol);
     }

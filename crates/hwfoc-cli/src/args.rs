@@ -47,10 +47,10 @@ pub struct ProtocolArgs {
     pub protocol: Option<Protocol>,
 }
 
-/// The names of [`Protocol::ALL`] as `--protocol` takes them (shown by `--help` and
+/// The names of [`Protocol::SERIAL`] as `--protocol` takes them (shown by `--help` and
 /// completed by the shells), each with its title and baud rate.
 fn protocol_parser() -> impl TypedValueParser<Value = Protocol> {
-    let names = Protocol::ALL.map(|p| {
+    let names = Protocol::SERIAL.map(|p| {
         PossibleValue::new(p.name()).help(format!("{}, {} baud", p.title(), p.baud_rate()))
     });
     // Every possible value is a protocol's name: the mapping finds it.

@@ -841,9 +841,22 @@ impl PortStreams {
     /// a hub's channels included).
     pub fn with_map(baud: u32, names: Vec<String>, map: SettingsMap) -> PortStreams {
         PortStreams {
-            streams: names.iter().map(|_| Stream::new()).collect(),
+            // A CAN bus (`slcan:`, `can:`) carries CAN frames as records (`can.rs`).
+            streams: names
+                .iter()
+                .map(|n| {
+                    if crate::can::is_can_spec(n) {
+                        Stream::can()
+                    } else {
+                        Stream::new()
+                    }
+                })
+                .collect(),
             per_byte_ns: vec![hwfoc::wire::byte_ns(baud); names.len()],
-            bauds: vec![Some(baud); names.len()],
+            bauds: names
+                .iter()
+                .map(|n| (!crate::can::is_can_spec(n)).then_some(baud))
+                .collect(),
             discarded: vec![0; names.len()],
             times: Vec::new(),
             esc_settings: names
@@ -940,15 +953,6 @@ impl PortStreams {
     pub fn force_protocol(&mut self, protocol: Protocol) {
         for stream in self.streams.iter_mut().filter(|s| !s.is_can()) {
             *stream = Stream::forced(Some(protocol));
-        }
-    }
-
-    /// Makes `port` a CAN bus's (its events carry CAN frames as records: see [`Stream::can`]);
-    /// call it before its first event.
-    pub fn set_can(&mut self, port: usize) {
-        if let Some(stream) = self.streams.get_mut(port) {
-            *stream = Stream::can();
-            self.bauds[port] = None;
         }
     }
 

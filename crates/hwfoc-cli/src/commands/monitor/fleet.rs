@@ -480,17 +480,17 @@ impl Fleet {
                 let Some(stats) = self.streams.feed(event, &mut got) else {
                     return 0;
                 };
-                let hub = self
-                    .streams
-                    .stream(port)
-                    .is_some_and(|s| matches!(s.kind(), WireKind::Hub | WireKind::Mixed));
+                // A hub's channels and a CAN bus's ESCs each have a view of their own.
+                let hub = self.streams.stream(port).is_some_and(|s| {
+                    s.is_can() || matches!(s.kind(), WireKind::Hub | WireKind::Mixed)
+                });
                 let mut data = 0;
                 for item in got.0 {
                     match item {
                         Item::Record(r) => {
                             let i = if hub {
                                 let channel = self.streams.channel_of(port, r.esc).unwrap_or(0);
-                                self.channel_view(port, usize::from(channel), r.esc)
+                                self.channel_view(port, usize::from(channel), &r)
                             } else {
                                 port
                             };
@@ -592,8 +592,23 @@ impl Fleet {
     /// The ESC shown for channel `channel` (ESC number `esc`) of the DataLink hub on `port`:
     /// the port's own ESC for the first channel heard, a new one (after all others) for each
     /// next channel; made with that ESC's settings.
-    fn channel_view(&mut self, port: usize, channel: usize, esc: u8) -> usize {
+    fn channel_view(&mut self, port: usize, channel: usize, r: &Record) -> usize {
+        let esc = r.esc;
         if let Some(&i) = self.channels.get(&(port, channel)) {
+            return i;
+        }
+        // A CAN ESC keeps its view when its place on the bus changes (numbered by its node id
+        // until a GetEscID answer gives its throttle channel): the view follows the node.
+        let moved = r.node.and_then(|node| {
+            let name = format!(" node {node}");
+            self.channels
+                .iter()
+                .find(|&(&(p, _), &i)| p == port && self.escs[i].name.ends_with(&name))
+                .map(|(&key, &i)| (key, i))
+        });
+        if let Some((old, i)) = moved {
+            self.channels.remove(&old);
+            self.channels.insert((port, channel), i);
             return i;
         }
         let taken = self.channels.keys().any(|&(p, _)| p == port);
@@ -601,6 +616,7 @@ impl Fleet {
             .name
             .split(" channel ")
             .next()
+            .and_then(|n| n.split(" node ").next())
             .unwrap_or_default()
             .to_string();
         let i = if taken {
@@ -620,7 +636,11 @@ impl Fleet {
         } else {
             port
         };
-        self.escs[i].name = format!("{name} channel {channel}");
+        // A CAN ESC by its node (its place on the bus is its ESC number).
+        self.escs[i].name = match r.node {
+            Some(node) => format!("{name} node {node}"),
+            None => format!("{name} channel {channel}"),
+        };
         if let Some(settings) = self.streams.settings_of(esc) {
             self.escs[i].settings = *settings;
         }
@@ -663,7 +683,9 @@ impl Fleet {
             None,
         ));
         for fault in Fault::ALL {
-            let on = r.status.is_some_and(|s| s.contains(fault));
+            // A word of fault bits only (a Hobbywing CAN ESC's status is not one).
+            let word = r.status.filter(|_| r.protocol.has_faults());
+            let on = word.is_some_and(|s| s.contains(fault));
             let latch = &mut a.faults[usize::from(fault.bit())];
             if on || latch.level().is_some() {
                 let change = latch.set(on, Kind::fault_level(fault), limits.fault_hold_s, t);
