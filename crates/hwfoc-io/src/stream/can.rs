@@ -73,12 +73,7 @@ impl CanWire {
 
     /// Decodes `bytes` (with each byte's receive time, or none): `emit(t, place, frame)` gets
     /// each record with the time of its CAN frame and its ESC's place on the bus.
-    pub(crate) fn feed(
-        &mut self,
-        bytes: &[u8],
-        times: Option<&[f64]>,
-        emit: &mut Emit<'_>,
-    ) {
+    pub(crate) fn feed(&mut self, bytes: &[u8], times: Option<&[f64]>, emit: &mut Emit<'_>) {
         self.bytes += bytes.len() as u64;
         for (i, &b) in bytes.iter().enumerate() {
             if self.held_len == 0 {
@@ -94,12 +89,7 @@ impl CanWire {
         }
     }
 
-    fn frame(
-        &mut self,
-        record: &[u8; SOCKETCAN_RECORD_LEN],
-        t: Option<f64>,
-        emit: &mut Emit<'_>,
-    ) {
+    fn frame(&mut self, record: &[u8; SOCKETCAN_RECORD_LEN], t: Option<f64>, emit: &mut Emit<'_>) {
         let Some(frame) = CanFrame::from_socketcan_record(record) else {
             self.bad_records += 1;
             return;
