@@ -7,7 +7,7 @@ use std::time::{Duration, Instant};
 
 use hwfoc::dronecan::{
     CanFrame, Form, GetEscId, GetMaintenanceInformationRequest, GetMaintenanceInformationResponse,
-    GetMajorConfigRequest, GetMajorConfigResponse, Kind, Message, Received, SetDirectionRequest,
+    GetMajorConfigRequest, GetMajorConfigResponse, Message, Received, SetDirectionRequest,
     SetReportingFrequencyRequest, TransferType,
 };
 
@@ -109,7 +109,7 @@ impl<L: Link> Client<L> {
             stop,
             heard: Heard::new(),
             transfer_ids: HashMap::new(),
-            ask_tid: 0,
+            ask_tid: first_transfer_id(),
             last_ask: None,
         }
     }
@@ -219,7 +219,10 @@ impl<L: Link> Client<L> {
         debug_assert_eq!(kind.form(), Form::Request);
         let service = kind.data_type_id();
         let tid = {
-            let t = self.transfer_ids.entry((service, node)).or_insert(0);
+            let t = self
+                .transfer_ids
+                .entry((service, node))
+                .or_insert_with(first_transfer_id);
             let tid = *t;
             *t = (tid + 1) & 31;
             tid
@@ -361,16 +364,12 @@ impl<L: Link> Client<L> {
                 self.listen_until(deadline, |h, _| {
                     h.node(node).is_some_and(|n| !n.channels.is_empty())
                 })?;
-                let channel = self
-                    .heard
-                    .node(node)
-                    .and_then(|n| n.channels.last().copied())
-                    .ok_or_else(|| SetupError::NoAnswer {
-                        bus: self.bus().to_string(),
-                        node,
-                        service: Kind::GetEscId,
-                        timeout,
-                    })?;
+                // GetMajorConfig's channel if no GetEscID answer came (a receiver may take
+                // the request for a repeat of an earlier run's, whose transfer id it had).
+                let channel = match self.heard.node(node).and_then(|n| n.channels.last()) {
+                    Some(&c) => c,
+                    None => self.major_config(node, timeout)?.throttle_channel,
+                };
                 Change::NodeId {
                     node_id: node,
                     channel,
@@ -449,6 +448,15 @@ impl<L: Link> Client<L> {
             elapsed: start.elapsed(),
         })
     }
+}
+
+/// A transfer id to start from, from the clock: a receiver that drops a message whose
+/// transfer id is its sender's previous one (as a repeat) would otherwise drop the first
+/// request of every run after one that sent a single request.
+fn first_transfer_id() -> u8 {
+    std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map_or(0, |d| (d.subsec_nanos() >> 10) as u8 & 31)
 }
 
 /// An answer, `None` if the node did not give one in time; other errors as they are.

@@ -74,6 +74,24 @@ pub enum SetupError {
         /// The change.
         change: Change,
     },
+    /// The ESC answered, but read back says otherwise than asked.
+    NotTaken {
+        /// The bus as given.
+        bus: String,
+        /// The node.
+        node: u8,
+        /// What was asked.
+        asked: Change,
+        /// What the ESC says.
+        said: Change,
+    },
+    /// The ESC's self test failed (`SelfTest` answered 1).
+    SelfTestFailed {
+        /// The bus as given.
+        bus: String,
+        /// The node.
+        node: u8,
+    },
     /// The stop flag was set (Ctrl-C).
     Stopped {
         /// The bus as given.
@@ -112,6 +130,15 @@ impl fmt::Display for SetupError {
             ),
             SetupError::Unsupported { change } => {
                 write!(f, "{change}: no setup service sets that")
+            }
+            SetupError::NotTaken {
+                bus,
+                node,
+                asked,
+                said,
+            } => write!(f, "{bus}: node {node} was asked {asked} but says {said}"),
+            SetupError::SelfTestFailed { bus, node } => {
+                write!(f, "{bus}: node {node}: the self test failed")
             }
             SetupError::Stopped { bus } => write!(f, "{bus}: interrupted"),
         }
