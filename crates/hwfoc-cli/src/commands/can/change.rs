@@ -215,19 +215,19 @@ fn report(client: &Client, node: u8, done: &[(Change, Option<Change>)]) -> Resul
 /// Shows the plan and asks for a yes on the terminal; `--yes` skips the question; without a
 /// terminal and without `--yes`, refuses.
 fn confirm(yes: bool, plan: &[String]) -> Result<(), CliError> {
+    let stdin = std::io::stdin();
+    if !yes && !stdin.is_terminal() {
+        return Err(CliError::Usage {
+            option: "--yes".to_string(),
+            message: "no terminal to confirm the change on: pass --yes to make it".to_string(),
+        });
+    }
     let mut err = std::io::stderr().lock();
     for line in plan {
         let _ = writeln!(err, "{line}");
     }
     if yes {
         return Ok(());
-    }
-    let stdin = std::io::stdin();
-    if !stdin.is_terminal() {
-        return Err(CliError::Usage {
-            option: "--yes".to_string(),
-            message: "no terminal to confirm the change on: pass --yes to make it".to_string(),
-        });
     }
     let _ = write!(err, "Make the change? [y/N] ");
     let _ = err.flush();
