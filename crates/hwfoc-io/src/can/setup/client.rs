@@ -343,7 +343,7 @@ impl<L: Link> Client<L> {
     ) -> Result<Message, SetupError> {
         let request = change
             .request()
-            .ok_or_else(|| SetupError::Unsupported { change: *change })?;
+            .ok_or(SetupError::Unsupported { change: *change })?;
         self.call(node, request, timeout)
     }
 
