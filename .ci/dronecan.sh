@@ -5,7 +5,8 @@
 # esc.Status it decodes with the records sent. The Wireshark dissector on pydronecan's frames
 # (crates/hwfoc-cli/tests/wireshark.rs, with crates/hwfoc-cli/tests/py/dronecan_pcapng.py; it
 # needs tshark too, which .ci/run installs), and the simulator's virtual CAN ESCs checked by it
-# (below). Called by .ci/run; runs on its own too.
+# (below), and `hwfoc can` setting up a pydronecan ESC stand-in. Called by .ci/run; runs on its
+# own too.
 set -euo pipefail
 export CARGO_TERM_COLOR=never
 cd "$(dirname "$0")/.."
@@ -48,3 +49,13 @@ capture=${TMPDIR:-/tmp}/hwfoc-ci-dronecan-frames.pcapng
 "$venv/bin/python" crates/hwfoc-cli/tests/py/dronecan_pcapng.py "$capture" > /dev/null
 cmp "$capture" testdata/dronecan/pydronecan-frames.pcapng \
   || { echo "testdata/dronecan/pydronecan-frames.pcapng differs from what dronecan_pcapng.py writes" >&2; exit 1; }
+# `hwfoc can` against an ESC stand-in written with pydronecan's node
+# (crates/hwfoc-cli/tests/can_setup.rs, with crates/hwfoc-cli/tests/py/esc_standin.py): list,
+# set --direction and set-id read back what it says. The file's other tests run in .ci/run.
+canlog=${TMPDIR:-/tmp}/hwfoc-ci-dronecan-can.log
+HWFOC_DRONECAN_PY="$venv/bin/python" cargo test -p hwfoc-cli --test can_setup pydronecan \
+  -- --ignored --nocapture 2>&1 | tee "$canlog"
+grep -Eq "^test result: ok\. 1 passed; 0 failed; 0 ignored" "$canlog" \
+  || { echo "the hwfoc can pydronecan test did not run and pass (see $canlog)" >&2; exit 1; }
+grep -q "pydronecan ESC stand-in set up by hwfoc can" "$canlog" \
+  || { echo "the hwfoc can pydronecan test did not run (see $canlog)" >&2; exit 1; }

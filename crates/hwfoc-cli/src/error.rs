@@ -26,6 +26,10 @@ pub enum CliError {
     Write(WriteError),
     /// A bridge output could not be opened.
     Output(hwfoc_bridge::OutputError),
+    /// A CAN bus could not be used, or an ESC on it did not do what was asked (`hwfoc can`).
+    Can(hwfoc_io::can::setup::SetupError),
+    /// The user did not confirm a change (`hwfoc can`).
+    Declined,
     /// The virtual ESCs could not be set up or run (`hwfoc simulate`, `hwfoc monitor --sim`).
     Sim(SimError),
     /// `--from` is not before `--to`.
@@ -114,6 +118,18 @@ impl From<ExportError> for CliError {
     }
 }
 
+impl From<hwfoc_io::can::setup::SetupError> for CliError {
+    fn from(e: hwfoc_io::can::setup::SetupError) -> Self {
+        CliError::Can(e)
+    }
+}
+
+impl From<hwfoc_io::can::CanError> for CliError {
+    fn from(e: hwfoc_io::can::CanError) -> Self {
+        CliError::Can(e.into())
+    }
+}
+
 impl From<PortError> for CliError {
     fn from(e: PortError) -> Self {
         CliError::Port(e)
@@ -171,6 +187,8 @@ impl fmt::Display for CliError {
             }
             CliError::Sim(e) => e.fmt(f),
             CliError::Output(e) => e.fmt(f),
+            CliError::Can(e) => e.fmt(f),
+            CliError::Declined => f.write_str("not confirmed: nothing was changed"),
             CliError::Window(e) => e.between("--from", "--to").fmt(f),
             CliError::Settings(e) => write!(f, "invalid setting: {e}"),
             CliError::IsInput { output, input } => write!(
@@ -212,6 +230,7 @@ impl std::error::Error for CliError {
             CliError::Write(e) => Some(e),
             CliError::Sim(e) => Some(e),
             CliError::Output(e) => Some(e),
+            CliError::Can(e) => Some(e),
             CliError::Window(e) => Some(e),
             CliError::Terminal { source } => Some(source),
             CliError::Settings(e) => Some(e),

@@ -18,7 +18,9 @@ use std::process::ExitCode;
 
 use clap::{CommandFactory, Parser, Subcommand};
 
-use crate::commands::{bridge, completions, decode, man, monitor, plot, record, simulate, summary};
+use crate::commands::{
+    bridge, can, completions, decode, man, monitor, plot, record, simulate, summary,
+};
 use crate::error::CliError;
 
 /// Decode and analyse the telemetry of Hobbywing ESCs: an XRotor FOC ESC's own wire (HW-FOC,
@@ -48,6 +50,9 @@ enum Command {
     /// Bridge ESC telemetry (ports, recordings, virtual ESCs) to flight controllers and ground
     /// stations: DataLink V2 frames, MAVLink, DroneCAN.
     Bridge(Box<bridge::BridgeArgs>),
+    /// Set up Hobbywing DroneCAN ESCs on a CAN bus: list them, give each a node id and
+    /// throttle channel, change direction, LED, rates, throttle source, run the self test.
+    Can(can::CanArgs),
     /// The Wireshark dissector for recordings: install it, print where it goes, or print it.
     Wireshark(commands::wireshark::WiresharkArgs),
     /// Print the completion script for a shell (bash, zsh, fish, powershell, elvish).
@@ -66,6 +71,7 @@ fn main() -> ExitCode {
         Command::Simulate(args) => simulate::run(args),
         Command::Plot(args) => plot::run(args),
         Command::Bridge(args) => bridge::run(args),
+        Command::Can(args) => can::run(args),
         Command::Wireshark(args) => commands::wireshark::run(args),
         Command::Completions(args) => completions::run(args, Cli::command()),
         Command::Man(args) => man::run(args, Cli::command()),

@@ -1,6 +1,7 @@
 //! One module per subcommand: its options (a clap `Args` struct) and its `run`.
 
 pub mod bridge;
+pub mod can;
 pub mod completions;
 pub mod decode;
 pub mod man;

@@ -1,6 +1,7 @@
 //! CAN frames in and out: SLCAN adapters' ASCII protocol ([`slcan`]), `candump -l` logs
 //! ([`candump`]), live buses ([`CanBus`]: an SLCAN adapter or a SocketCAN interface) and the
-//! rule of asking the ESCs on a bus for their ids ([`AskIds`]).
+//! rule of asking the ESCs on a bus for their ids ([`AskIds`]), and setting the ESCs up
+//! ([`setup`]).
 //!
 //! Above this module a CAN bus is carried as a stream of bytes like any port's: each frame as
 //! the 16 bytes of [`CanFrame::to_socketcan_record`](hwfoc::dronecan::CanFrame::to_socketcan_record)
@@ -10,6 +11,7 @@
 mod ask;
 mod bus;
 pub mod candump;
+pub mod setup;
 pub mod slcan;
 #[cfg(target_os = "linux")]
 mod socketcan;

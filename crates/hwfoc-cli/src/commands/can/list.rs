@@ -1,0 +1,218 @@
+//! `hwfoc can list`: the ESCs on a bus, as a table or JSON, and the factory state told.
+
+use std::time::Duration;
+
+use clap::Args;
+use hwfoc_io::can::setup::{EscSurvey, LED_COLORS, Survey, rate_hz};
+use serde_json::{Value, json};
+
+use super::BusArgs;
+use crate::error::CliError;
+use crate::output::TextSink;
+
+/// `hwfoc can list`'s options.
+#[derive(Debug, Args)]
+pub struct ListArgs {
+    #[command(flatten)]
+    bus: BusArgs,
+    /// Listen at most this long for ESCs, seconds (it ends sooner once 0.5 s pass without a
+    /// new one).
+    #[arg(long, value_name = "S", default_value = "3", value_parser = crate::args::seconds)]
+    listen: f64,
+    /// Print one JSON object instead of a table.
+    #[arg(long)]
+    json: bool,
+}
+
+/// Runs `hwfoc can list`.
+pub fn run(args: &ListArgs) -> Result<(), CliError> {
+    let mut client = args.bus.open()?;
+    let survey = client.survey(Duration::from_secs_f64(args.listen), args.bus.timeout())?;
+    let text = if args.json {
+        format!("{}\n", json(&args.bus.bus, &survey))
+    } else {
+        table(&args.bus.bus, &survey)
+    };
+    let mut out = TextSink::create(None)?;
+    out.write(&mut text.into_bytes())?;
+    out.flush()
+}
+
+fn opt<T: ToString>(v: Option<T>) -> String {
+    v.map_or_else(|| "-".to_string(), |v| v.to_string())
+}
+
+fn led_text(color: u8, blink: u8) -> String {
+    let c = LED_COLORS.get(usize::from(color)).unwrap_or(&"?");
+    if blink == 0 {
+        c.to_string()
+    } else {
+        format!("{c}/{blink}Hz")
+    }
+}
+
+fn hz(code: u8) -> String {
+    rate_hz(code).map_or_else(|| format!("?{code}"), |h| h.to_string())
+}
+
+/// The channels an ESC's GetEscID answers gave: `3`, `1,1,1`.
+fn channels(e: &EscSurvey) -> String {
+    let c = &e.heard.channels;
+    if c.is_empty() {
+        e.config
+            .map_or("-".into(), |c| c.throttle_channel.to_string())
+    } else {
+        c.iter().map(u8::to_string).collect::<Vec<_>>().join(",")
+    }
+}
+
+/// The table, the factory state told under it, and the time the survey took.
+fn table(bus: &str, s: &Survey) -> String {
+    let header = [
+        "node",
+        "escs",
+        "channel",
+        "dir",
+        "throttle",
+        "led",
+        "msg1/2/3 Hz",
+        "rpm",
+        "pwm",
+        "V",
+        "A",
+        "degC",
+        "run min",
+        "since maint",
+    ];
+    let mut rows = vec![header.map(str::to_string).to_vec()];
+    for e in &s.escs {
+        let h = &e.heard;
+        let c = e.config;
+        rows.push(vec![
+            h.node.to_string(),
+            h.escs().to_string(),
+            channels(e),
+            opt(e.direction.map(|d| d.name())),
+            opt(c.map(|c| if c.throttle_source { "pwm" } else { "can" })),
+            opt(c.map(|c| led_text(c.led_color, c.led_status))),
+            format!(
+                "{}/{}/{}",
+                opt(c.map(|c| hz(c.msg1_rate))),
+                opt(c.map(|c| hz(c.msg2_rate))),
+                opt(e.msg3_rate.map(hz))
+            ),
+            opt(h.status1.map(|s| s.rpm)),
+            opt(h.status1.map(|s| s.pwm)),
+            opt(h
+                .status2
+                .map(|s| format!("{:.1}", f64::from(s.input_voltage) / 10.0))),
+            opt(h
+                .status2
+                .map(|s| format!("{:.1}", f64::from(s.current) / 10.0))),
+            opt(h.status2.map(|s| s.temperature)),
+            opt(e.maintenance.map(|m| m.total_rotation_time_min)),
+            opt(e.maintenance.map(|m| m.time_since_maintenance_min)),
+        ]);
+    }
+    let widths: Vec<usize> = (0..header.len())
+        .map(|i| rows.iter().map(|r| r[i].len()).max().unwrap_or(0))
+        .collect();
+    let mut out = String::new();
+    for r in &rows {
+        let cells: Vec<String> = r
+            .iter()
+            .zip(&widths)
+            .map(|(c, w)| format!("{c:>w$}"))
+            .collect();
+        out.push_str(cells.join("  ").trim_end());
+        out.push('\n');
+    }
+    let n = s.escs.len();
+    out.push_str(&format!(
+        "{bus}: {n} node{} heard, answered within {:.2} s\n",
+        if n == 1 { "" } else { "s" },
+        s.elapsed.as_secs_f64()
+    ));
+    for e in s.shared() {
+        out.push_str(&shared_advice(bus, e));
+    }
+    out
+}
+
+/// What to do about several ESCs under one node id.
+fn shared_advice(bus: &str, e: &EscSurvey) -> String {
+    let node = e.heard.node;
+    let distinct = {
+        let mut c = e.heard.channels.clone();
+        c.sort_unstable();
+        c.dedup();
+        c.len() == e.heard.channels.len() && c.len() > 1
+    };
+    let mut s = format!(
+        "factory state: {} ESCs answer as node {node}: a request to node {node} reaches them all.\n",
+        e.heard.escs()
+    );
+    if distinct {
+        s.push_str(&format!(
+            "  They report throttle channels {}: connect one ESC at a time and give it the node \
+             id of its channel, e.g. `hwfoc can set-id {bus} --node {node} --to 1C --channel C` \
+             (10 + C).\n",
+            channels(e)
+        ));
+    } else {
+        s.push_str(&format!(
+            "  Connect one ESC at a time (unplug the others' CAN lead) and give each its own node \
+             id and throttle channel: `hwfoc can set-id {bus} --node {node} --to 11 --channel 1`, \
+             then --to 12 --channel 2 for the next, and so on.\n"
+        ));
+    }
+    s
+}
+
+/// One JSON object: the bus, the time taken, each node.
+fn json(bus: &str, s: &Survey) -> Value {
+    let escs: Vec<Value> = s
+        .escs
+        .iter()
+        .map(|e| {
+            let h = &e.heard;
+            json!({
+                "node": h.node,
+                "escs": h.escs(),
+                "shared": h.is_shared(),
+                "channels": h.channels,
+                "direction": e.direction.map(|d| d.name()),
+                "config": e.config.map(|c| json!({
+                    "direction": if c.direction { "ccw" } else { "cw" },
+                    "throttle_source": if c.throttle_source { "pwm" } else { "can" },
+                    "throttle_channel": c.throttle_channel,
+                    "led_color": LED_COLORS.get(usize::from(c.led_color)),
+                    "led_status": c.led_status,
+                    "msg1_rate_hz": rate_hz(c.msg1_rate),
+                    "msg2_rate_hz": rate_hz(c.msg2_rate),
+                    "positioning_angle": c.positioning_angle,
+                })),
+                "msg3_rate_hz": e.msg3_rate.and_then(rate_hz),
+                "maintenance": e.maintenance.map(|m| json!({
+                    "total_rotation_time_min": m.total_rotation_time_min,
+                    "time_since_maintenance_min": m.time_since_maintenance_min,
+                })),
+                "rpm": h.status1.map(|s| s.rpm),
+                "pwm": h.status1.map(|s| s.pwm),
+                "status": h.status1.map(|s| s.status),
+                "voltage_v": h.status2.map(|s| f64::from(s.input_voltage) / 10.0),
+                "current_a": h.status2.map(|s| f64::from(s.current) / 10.0),
+                "temperature_c": h.status2.map(|s| s.temperature),
+                "mos_c": h.status3.map(|s| s.mos_t),
+                "cap_c": h.status3.map(|s| s.cap_t),
+                "motor_c": h.status3.map(|s| s.motor_t),
+            })
+        })
+        .collect();
+    json!({
+        "bus": bus,
+        "elapsed_s": s.elapsed.as_secs_f64(),
+        "factory_state": s.shared().next().is_some(),
+        "escs": escs,
+    })
+}
