@@ -350,6 +350,14 @@ impl Data {
 }
 
 impl Data {
+    /// The frame's fault word: its [`Telemetry::status`] where its protocol has fault bits
+    /// ([`Protocol::has_faults`]; a Hobbywing CAN ESC's `status` word is kept raw but is no
+    /// fault word).
+    #[inline(always)]
+    pub fn fault_word(&self) -> Option<Status> {
+        self.status().filter(|_| self.protocol().has_faults())
+    }
+
     /// The CAN node that sent the record (`hw-can`, `dronecan`); `None` for a serial format.
     #[inline]
     pub const fn node(&self) -> Option<u8> {

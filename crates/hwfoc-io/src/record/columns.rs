@@ -101,7 +101,7 @@ columns! {
     /// Names of the set fault bits, in bit order, as the frame's protocol names them (HW-FOC:
     /// `docs/PROTOCOL-NOTES.md`; HW5: `docs/HW5-AND-CAN.md`); derived from `status`, not a
     /// field of the record; null where `status` is.
-    faults: Option<FaultList>, "-", |_, _, f, _| fault_list(f.status(), f.protocol()),
+    faults: Option<FaultList>, "-", |_, _, f, _| f.fault_word().map(|s| FaultList(s, f.protocol())),
         record |r| fault_list(r.status, r.protocol);
     /// The CAN node that sent the record (`hw-can`, `dronecan`); null for a serial format.
     node: Option<u8>, "-", |_, _, f, _| f.node();
@@ -115,8 +115,9 @@ columns! {
     msg3_age_ms: Option<u32>, "ms", |_, _, f, _| f.msg3_age_ms();
 }
 
-/// The `faults` of a fault word of `protocol`: null where the protocol has no fault bits (a
-/// Hobbywing CAN ESC's `status` word is kept, its only known bit is the direction).
+/// The `faults` of a record's `status` (see [`Data::fault_word`]): null where the protocol has
+/// no fault bits (a Hobbywing CAN ESC's `status` word is kept, its only known bit is the
+/// direction).
 #[inline(always)]
 fn fault_list(status: Option<hwfoc::Status>, protocol: Protocol) -> Option<FaultList> {
     status

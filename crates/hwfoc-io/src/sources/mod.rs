@@ -320,12 +320,16 @@ impl Sources {
             self.finish(esc);
         }
         self.release(f64::INFINITY, handler);
-        // A hub's channels that carried an ESC are ESCs of its input.
+        // A hub's channels that carried an ESC are ESCs of its input; a CAN bus's stream is
+        // one only if an ESC of its own was at its place 0.
         for esc in 0..self.escs.len() {
-            if self.escs[esc].hub.is_some() && self.link(esc).frames() > 0 {
-                let escs = &mut self.read[self.escs[esc].input].escs;
+            let frames = self.link(esc).frames() > 0;
+            let escs = &mut self.read[self.escs[esc].input].escs;
+            if self.escs[esc].hub.is_some() && frames {
                 escs.push(esc);
                 escs.sort_unstable();
+            } else if self.escs[esc].stream.is_can() && !frames {
+                escs.retain(|&e| e != esc);
             }
         }
         result?;

@@ -113,10 +113,16 @@ impl Sources {
                 if recorded {
                     self.ports.insert(name.clone(), self.escs.len());
                 }
+                // A CAN bus's stream reads CAN frames, whatever `--protocol` says.
+                let stream = if input.is_can(stream) {
+                    Stream::can()
+                } else {
+                    Stream::forced(self.forced)
+                };
                 self.push_esc(Esc {
                     input: index,
                     name,
-                    stream: Stream::forced(self.forced),
+                    stream,
                     hub: None,
                 });
                 self.escs.len() - 1

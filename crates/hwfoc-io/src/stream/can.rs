@@ -73,12 +73,7 @@ impl CanWire {
 
     /// Decodes `bytes` (with each byte's receive time, or none): `emit(t, place, frame)` gets
     /// each record with the time of its CAN frame and its ESC's place on the bus.
-    pub(crate) fn feed(
-        &mut self,
-        bytes: &[u8],
-        times: Option<&[f64]>,
-        emit: &mut Emit<'_>,
-    ) {
+    pub(crate) fn feed(&mut self, bytes: &[u8], times: Option<&[f64]>, emit: &mut Emit<'_>) {
         self.bytes += bytes.len() as u64;
         for (i, &b) in bytes.iter().enumerate() {
             if self.held_len == 0 {
@@ -94,12 +89,7 @@ impl CanWire {
         }
     }
 
-    fn frame(
-        &mut self,
-        record: &[u8; SOCKETCAN_RECORD_LEN],
-        t: Option<f64>,
-        emit: &mut Emit<'_>,
-    ) {
+    fn frame(&mut self, record: &[u8; SOCKETCAN_RECORD_LEN], t: Option<f64>, emit: &mut Emit<'_>) {
         let Some(frame) = CanFrame::from_socketcan_record(record) else {
             self.bad_records += 1;
             return;
@@ -161,6 +151,7 @@ impl CanWire {
         let stats = self.rx.stats();
         CanLink {
             node,
+            channel: node.and_then(|n| self.escs.channel(n)),
             protocol: node
                 .and_then(|n| self.protocol[usize::from(n) % NODES])
                 .unwrap_or(Protocol::HwCan),
@@ -179,6 +170,8 @@ impl CanWire {
 pub struct CanLink {
     /// The node whose records the ESC's place on the bus had last (`None` before any).
     pub node: Option<u8>,
+    /// Its node's throttle channel (1-based) from a GetEscID answer, if one came.
+    pub channel: Option<u8>,
     /// The protocol of its records: `hw-can` or `dronecan`.
     pub protocol: Protocol,
     /// The records at its place on the bus (StatusMsg1 or Status transfers decoded).

@@ -420,7 +420,7 @@ pub(super) const fn keeps_raw(protocol: Protocol) -> bool {
 /// [`Accumulator::add_clean_run`] take (a protocol without a status word has none).
 #[inline(always)]
 pub(super) fn is_clean(f: &Data) -> bool {
-    f.status().is_none_or(Status::is_ok)
+    f.fault_word().is_none_or(Status::is_ok)
 }
 
 /// The code of temperature `quantity` in a data frame: its raw value when that is a table's
@@ -662,7 +662,7 @@ impl Accumulator {
         self.sample.get_or_insert(*f);
         let index = self.tally.frames;
         self.count(t, f);
-        let status = f.status().unwrap_or_default();
+        let status = f.fault_word().unwrap_or_default();
         if !status.is_ok() {
             for fault in status.faults() {
                 self.fault_frames[usize::from(fault.bit())] += 1;

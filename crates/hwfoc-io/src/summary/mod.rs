@@ -99,6 +99,18 @@ const MAX_EPISODES: usize = 10_000;
 /// Fault episodes listed per ESC in the text output (`--json` lists all those kept).
 const TEXT_EPISODES: usize = 20;
 
+/// Where an ESC is on a CAN bus, as its label says it.
+fn can_place(c: &crate::stream::CanLink) -> String {
+    match (c.node, c.channel, c.protocol) {
+        (Some(node), Some(channel), _) => format!(" throttle channel {channel}, node {node}"),
+        (Some(node), None, Protocol::HwCan) => {
+            format!(" node {node} (no GetEscID answer: numbered by node id)")
+        }
+        (Some(node), None, _) => format!(" node {node}"),
+        (None, ..) => String::new(),
+    }
+}
+
 /// How an ESC is named in messages: its input, and its stream when the input has several
 /// (names from a recording [`Escaped`]).
 pub fn esc_label(sources: &Sources, esc: usize) -> String {
@@ -108,10 +120,11 @@ pub fn esc_label(sources: &Sources, esc: usize) -> String {
         .inputs()
         .get(e.input)
         .is_none_or(|info| info.escs.len() == 1);
-    let channel = match e.hub {
-        Some((_, channel)) => format!(" channel {channel}"),
-        None if sources.is_hub(esc) => " channel 0".to_string(),
-        None => String::new(),
+    let channel = match (sources.link(esc), e.hub) {
+        (crate::stream::EscLink::Can(c), _) => can_place(&c),
+        (_, Some((_, channel))) => format!(" channel {channel}"),
+        _ if sources.is_hub(esc) => " channel 0".to_string(),
+        _ => String::new(),
     };
     let input = Escaped(input);
     if single && e.name == *input.0 && channel.is_empty() {
