@@ -64,7 +64,7 @@
 //! | `esc` | [`CanEsc`], [`EscConfig`], [`Stream`], the defaults |
 //! | `bus` | [`CanBus`], [`Sent`] |
 //! | `slcan` | the adapter's side of SLCAN ([`slcan::Adapter`]) |
-//! | `run` | [`CanSession`]: a bus into a candump log or an SLCAN pty, with its ground truth |
+//! | `run` | [`CanSession`]: a bus into a candump log, a pcapng recording or an SLCAN pty, with its ground truth and, in a log, a virtual controller asking for ids |
 
 mod bus;
 mod esc;
