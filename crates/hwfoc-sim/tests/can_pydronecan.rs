@@ -97,6 +97,8 @@ fn pydronecan_decodes_a_candump_log_as_the_simulator_meant() {
         duration_s: Some(4.0),
         truth: Some(path("truth.jsonl")),
         overwrite: false,
+        // The requests are this test's own.
+        ask_ids: false,
     };
     let mut bus = CanBus::build(&spec(4), false).unwrap();
     // The requests at the start (GetEscID broadcast, SetID to node 11, the rest to node 12),
@@ -170,6 +172,7 @@ fn pydronecan_sets_up_the_virtual_escs_over_slcan() {
             duration_s: Some(60.0),
             truth: None,
             overwrite: false,
+            ask_ids: false,
         };
         let session = CanSession::open(CanBus::build(&spec(3), false).unwrap(), &plan).unwrap();
         tx.send(session.output().to_string()).unwrap();

@@ -1,8 +1,12 @@
 //! Asking a bus's Hobbywing ESCs for their ids (`com.hobbywing.esc.GetEscID`), as ArduPilot
 //! does: a broadcast of payload `[0]` once a second, only while no ESC turns (the request can
 //! make some ESCs stutter: `docs/HW5-AND-CAN.md`).
+//!
+//! Its clock is a monotonic time given as a [`Duration`] since any fixed start, so that a live
+//! bus (the time since it was opened) and the simulator's virtual controller (simulated time)
+//! ask by the same rule.
 
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 use hwfoc::dronecan::{CanFrame, GetEscId, Message, NODES, Receiver};
 
@@ -23,7 +27,8 @@ pub struct AskIds {
     receiver: Receiver,
     /// Whether each node's latest `StatusMsg1` had rpm or pwm above 0.
     turning: [bool; NODES],
-    last: Option<Instant>,
+    /// When the last request was sent.
+    last: Option<Duration>,
     transfer_id: u8,
     source: u8,
 }
@@ -57,10 +62,16 @@ impl AskIds {
         self.turning.iter().any(|&t| t)
     }
 
-    /// The request's frames if one is due at `now` (each call that returns some counts as
-    /// sent: the next is due [`ASK_EVERY`] later, with the next transfer id).
-    pub fn due(&mut self, now: Instant) -> Option<Vec<CanFrame>> {
-        if self.any_turning() || self.last.is_some_and(|l| now.duration_since(l) < ASK_EVERY) {
+    /// The request's frames if one is due at `now` (a monotonic time since any fixed start,
+    /// the same for every call; each call that returns some counts as sent: the next is due
+    /// [`ASK_EVERY`] later, with the next transfer id). A time before the last request's asks
+    /// nothing.
+    pub fn due(&mut self, now: Duration) -> Option<Vec<CanFrame>> {
+        if self.any_turning()
+            || self
+                .last
+                .is_some_and(|l| now.checked_sub(l).is_none_or(|d| d < ASK_EVERY))
+        {
             return None;
         }
         self.last = Some(now);
@@ -87,7 +98,7 @@ mod tests {
 
     #[test]
     fn asks_once_a_second_while_no_esc_turns() {
-        let t0 = Instant::now();
+        let t0 = Duration::from_secs(1000);
         let mut ask = AskIds::new(DEFAULT_SOURCE_NODE);
         let first = ask.due(t0).expect("due at once");
         assert_eq!(first.len(), 1);
@@ -100,6 +111,10 @@ mod tests {
         assert!(ask.due(t0 + Duration::from_millis(999)).is_none());
         let second = ask.due(t0 + ASK_EVERY).unwrap();
         assert_eq!(second[0].data(), &[0x00, 0xC1], "the next transfer id");
+        assert!(
+            ask.due(t0).is_none(),
+            "a time before the last request asks nothing"
+        );
         // An ESC turns: no request; an ESC stopped at 0 rpm but pwm > 0 still counts.
         for f in status(5, 1200, 300, 0) {
             ask.heard(&f);
@@ -130,7 +145,7 @@ mod tests {
 
     #[test]
     fn transfer_ids_wrap_at_32() {
-        let t0 = Instant::now();
+        let t0 = Duration::from_secs(1000);
         let mut ask = AskIds::new(100);
         for k in 0..40u32 {
             let f = ask.due(t0 + k * ASK_EVERY).unwrap();

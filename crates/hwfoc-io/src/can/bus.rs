@@ -212,6 +212,8 @@ pub struct CanBus {
     link: Link,
     bitrate: Option<u32>,
     asker: Option<AskIds>,
+    /// When the bus was opened: the start of the asker's clock.
+    opened: Instant,
     clock: ReceiveClock,
 }
 
@@ -266,6 +268,7 @@ impl CanBus {
             link,
             bitrate,
             asker: ask_ids.then(|| AskIds::new(DEFAULT_SOURCE_NODE)),
+            opened: Instant::now(),
             clock,
         })
     }
@@ -283,7 +286,11 @@ impl CanBus {
     /// The next frame the bus carried, with its receive time (Unix seconds), waiting at most
     /// `timeout`; `None` if none came. Sends the ESCs' id request first when it is due.
     pub fn recv(&mut self, timeout: Duration) -> Result<Option<(f64, CanFrame)>, CanError> {
-        if let Some(frames) = self.asker.as_mut().and_then(|a| a.due(Instant::now())) {
+        if let Some(frames) = self
+            .asker
+            .as_mut()
+            .and_then(|a| a.due(self.opened.elapsed()))
+        {
             for frame in frames {
                 self.send(&frame)?;
             }

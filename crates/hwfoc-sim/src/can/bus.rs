@@ -219,6 +219,22 @@ impl CanBus {
         self.bus_free_ns = t;
     }
 
+    /// Puts a controller's `frames` (a transfer) on the bus from `t_ns` on, each waiting for the
+    /// bus and occupying it as the ESCs' do, and has the ESCs take them ([`CanBus::receive`]).
+    /// Returns the frames with the times they start on the bus, and how many ESCs will answer.
+    pub fn transmit(&mut self, t_ns: u64, frames: &[CanFrame]) -> (Vec<(u64, CanFrame)>, usize) {
+        let mut out = Vec::with_capacity(frames.len());
+        let mut answers = 0;
+        let mut t = t_ns.max(self.bus_free_ns);
+        for frame in frames {
+            out.push((t, *frame));
+            answers += self.receive(t, frame);
+            t += frame_bits(frame.len()) * 1_000_000_000 / u64::from(self.bitrate);
+        }
+        self.bus_free_ns = t;
+        (out, answers)
+    }
+
     /// Takes a frame a controller sent at `t_ns`: a whole GetEscID request (`[0]`) has every
     /// ESC answer; a whole service request to a node has every ESC of that node answer (in the
     /// factory state, all of them), [`ANSWER_NS`] later, as a response to the requester with

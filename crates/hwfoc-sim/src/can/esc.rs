@@ -32,6 +32,11 @@ pub const MAX_CHANNEL: u8 = 63;
 pub const DEFAULT_RATES: [u8; 3] = [5, 5, 7];
 /// `uavcan.protocol.NodeStatus` interval, ns (1 Hz, as DroneCAN asks).
 pub const NODE_STATUS_NS: u64 = 1_000_000_000;
+/// The start of the run in which an ESC sends no message of its own, ns (5 ms, a choice): a
+/// controller's GetEscID request at time zero ([`ANSWER_NS`](super::ANSWER_NS) to answer, up
+/// to 63 answers of about 0.2 ms) is answered before any status message, so that a log's ESCs
+/// are numbered by their throttle channel from their first record.
+pub const QUIET_START_NS: u64 = 5_000_000;
 /// Priority of the ESC's broadcasts (status messages, GetEscID answers, NodeStatus): 16,
 /// DroneCAN's "medium" (a choice: Hobbywing documents none). A service response has its
 /// request's priority.
@@ -187,7 +192,7 @@ pub struct CanEsc {
 
 impl CanEsc {
     /// An ESC at rest at time zero; its first messages come at a random phase within their
-    /// first interval.
+    /// first interval, past [`QUIET_START_NS`].
     pub fn new(setup: CanSetup) -> CanEsc {
         let mut params = Rng::for_esc(setup.seed, setup.index, Purpose::Params);
         let mut config = setup.model;
@@ -199,7 +204,10 @@ impl CanEsc {
                 Stream::NodeStatus => Some(NODE_STATUS_NS),
                 s => rate_interval_ns(setup.config.rates[s as usize]),
             };
-            due_ns[s as usize] = interval.map(|i| params.below(i));
+            due_ns[s as usize] = interval.map(|i| match i.checked_sub(QUIET_START_NS) {
+                Some(rest) if rest > 0 => QUIET_START_NS + params.below(rest),
+                _ => params.below(i),
+            });
         }
         let total_min0 = 100 + params.below(20_000) as u32;
         let since_min0 = params.below(u64::from(total_min0)) as u32;

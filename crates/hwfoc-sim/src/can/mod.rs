@@ -13,7 +13,8 @@
 //! | `uavcan.protocol.NodeStatus` (341) | 1 Hz | 16 | uptime, health OK (WARNING while the model or an injected fault raises a status bit), mode OPERATIONAL |
 //!
 //! Each message has its own 5-bit transfer id counter per ESC (as have the ESC's GetEscID
-//! answers), and starts at a random phase within its first interval (from the seed). The
+//! answers), and starts at a random phase within its first interval (from the seed), not in
+//! the first 5 ms ([`QUIET_START_NS`]: a controller's request at the start is answered first). The
 //! rates are the simulator's choice (Hobbywing documents no default); `SetReportingFrequency`
 //! changes them (codes 1..9 = 500, 250, 200, 100, 50, 20, 10, 1, 0 Hz). Priority 16 is
 //! DroneCAN's "medium", a choice too.
@@ -63,7 +64,7 @@
 //! | `esc` | [`CanEsc`], [`EscConfig`], [`Stream`], the defaults |
 //! | `bus` | [`CanBus`], [`Sent`] |
 //! | `slcan` | the adapter's side of SLCAN ([`slcan::Adapter`]) |
-//! | `run` | [`CanSession`]: a bus into a candump log or an SLCAN pty, with its ground truth |
+//! | `run` | [`CanSession`]: a bus into a candump log, a pcapng recording or an SLCAN pty, with its ground truth and, in a log, a virtual controller asking for ids |
 
 mod bus;
 mod esc;
@@ -73,7 +74,8 @@ pub mod slcan;
 pub use bus::{ANSWER_NS, CanBus, MAX_CAN_ESCS, Sent, frame_bits};
 pub use esc::{
     CanEsc, CanSetup, DEFAULT_LED, DEFAULT_RATES, EscConfig, FACTORY_BITRATE, FACTORY_NODE,
-    FIRST_NODE, MAX_CHANNEL, NODE_STATUS_NS, Outgoing, PRIORITY, Stream, rate_interval_ns,
+    FIRST_NODE, MAX_CHANNEL, NODE_STATUS_NS, Outgoing, PRIORITY, QUIET_START_NS, Stream,
+    rate_interval_ns,
 };
 pub use run::{CanDestination, CanPlan, CanReport, CanSession, INTERFACE, truth_json};
 

@@ -1,14 +1,22 @@
-//! Running a bus of virtual CAN ESCs into its output: a `candump -l` log (a file or standard
-//! output, as fast as possible or in real time), or a pseudo-terminal that speaks SLCAN like
-//! a CANable adapter (always in real time, answering the controller on the other end), with
-//! the ground truth of every transfer sent.
+//! Running a bus of virtual CAN ESCs into its output: a `candump -l` log or a pcapng recording
+//! (a file or standard output, as fast as possible or in real time), or a pseudo-terminal that
+//! speaks SLCAN like a CANable adapter (always in real time, answering the controller on the
+//! other end), with the ground truth of every transfer sent.
+//!
+//! In a log or a recording a virtual controller (node [`DEFAULT_SOURCE_NODE`], 127) asks the
+//! ESCs for their ids as ArduPilot does, by the rule of [`AskIds`] (a GetEscID `[0]` at the
+//! start and once a second while no ESC turns), on the simulated clock; its requests are frames
+//! of the bus like the ESCs' (not in the ground truth, which lists the ESCs' transfers), and the
+//! ESCs answer them. On a pty the controller on the other end asks, or not.
 
 use std::io::{BufWriter, Write};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 
 use hwfoc::dronecan::{CanFrame, Form, Message};
+use hwfoc_io::can::{AskIds, DEFAULT_SOURCE_NODE, candump};
 use hwfoc_io::clock::unix_now_ns;
+use hwfoc_io::pcapng;
 use hwfoc_io::write::WriteError;
 
 use super::bus::{CanBus, Sent};
@@ -32,6 +40,10 @@ pub enum CanDestination {
     /// A `candump -l` log: `(secs.usecs) can0 ID#DATA` lines, to a file or standard output
     /// (`-`).
     Candump(String),
+    /// A pcapng recording with one `LINKTYPE_CAN_SOCKETCAN` interface ([`INTERFACE`], the bus's
+    /// bit rate) and a packet per frame, nanosecond timestamps, to a file or standard output
+    /// (`-`).
+    Pcapng(String),
     /// A pseudo-terminal speaking SLCAN (the controller's adapter), with optional symlinks.
     #[cfg(unix)]
     Pty(PtyLinks),
@@ -53,6 +65,8 @@ pub struct CanPlan {
     pub truth: Option<String>,
     /// Replace output files that exist.
     pub overwrite: bool,
+    /// In a log or a recording, a virtual controller asks the ESCs for their ids ([`AskIds`]).
+    pub ask_ids: bool,
 }
 
 /// What a run of a CAN bus did.
@@ -62,11 +76,12 @@ pub struct CanReport {
     pub output: String,
     /// Transfers the ESCs sent.
     pub transfers: u64,
-    /// Frames on the bus.
+    /// Frames on the bus (the controller's included).
     pub frames: u64,
     /// Frames no one received (a pty without a reader, or its channel closed).
     pub undelivered: u64,
-    /// Frames the controller sent (pty).
+    /// Frames the controller sent: the one on the pty, or the virtual controller's requests in
+    /// a log.
     pub received: u64,
     /// Answers the ESCs gave to the controller's requests.
     pub answers: u64,
@@ -82,11 +97,17 @@ pub struct CanSession {
     realtime: bool,
     origin_ns: u64,
     duration_ns: Option<u64>,
+    ask_ids: bool,
     report: CanReport,
 }
 
+/// A pcapng writer over a buffered output.
+type RecordingWriter = pcapng::Writer<BufWriter<Box<dyn Write>>>;
+
 enum Out {
     Log(String, BufWriter<Box<dyn Write>>),
+    /// The recording, and its CAN interface.
+    Pcapng(String, Box<RecordingWriter>, u32),
     /// The pty, and its symlinks (removed when dropped).
     #[cfg(unix)]
     Pty(pty::Pty, #[allow(dead_code)] pty::Links),
@@ -95,10 +116,13 @@ enum Out {
 impl CanSession {
     /// Opens `plan`'s outputs for `bus` (every file checked before any is created).
     pub fn open(bus: CanBus, plan: &CanPlan) -> Result<CanSession, SimError> {
-        let live = !matches!(plan.destination, CanDestination::Candump(_));
+        let live = !matches!(
+            plan.destination,
+            CanDestination::Candump(_) | CanDestination::Pcapng(_)
+        );
         let realtime = plan.realtime || live;
         let mut files: Vec<String> = plan.truth.iter().cloned().collect();
-        if let CanDestination::Candump(path) = &plan.destination {
+        if let CanDestination::Candump(path) | CanDestination::Pcapng(path) = &plan.destination {
             files.push(path.clone());
         }
         sink::check_new(files.iter().map(String::as_str), plan.overwrite)?;
@@ -113,6 +137,15 @@ impl CanSession {
             CanDestination::Candump(path) => {
                 let (name, w) = sink::create(path, plan.overwrite)?;
                 Out::Log(name, BufWriter::with_capacity(1 << 16, w))
+            }
+            CanDestination::Pcapng(path) => {
+                let (name, w) = sink::create(path, plan.overwrite)?;
+                let mut writer = pcapng::Writer::new(BufWriter::with_capacity(1 << 16, w))
+                    .map_err(write_error(&name))?;
+                let iface = writer
+                    .add_can_interface(INTERFACE, Some(bus.bitrate()))
+                    .map_err(write_error(&name))?;
+                Out::Pcapng(name, Box::new(writer), iface)
             }
             #[cfg(unix)]
             CanDestination::Pty(links) => {
@@ -132,7 +165,7 @@ impl CanSession {
             _ => unix_now_ns(),
         };
         let output = match &out {
-            Out::Log(name, _) => name.clone(),
+            Out::Log(name, _) | Out::Pcapng(name, ..) => name.clone(),
             #[cfg(unix)]
             Out::Pty(p, _) => p.path().display().to_string(),
         };
@@ -143,6 +176,7 @@ impl CanSession {
             realtime,
             origin_ns,
             duration_ns: duration_s.map(|s| (s * 1e9).round() as u64),
+            ask_ids: plan.ask_ids && !live,
             report: CanReport {
                 output,
                 ..CanReport::default()
@@ -163,9 +197,21 @@ impl CanSession {
         let mut reply = Vec::new();
         let mut actions = Vec::new();
         let mut lines = Vec::new();
+        let mut asker = self.ask_ids.then(|| AskIds::new(DEFAULT_SOURCE_NODE));
         while !stop.load(Ordering::Relaxed) {
             if self.duration_ns.is_some_and(|d| t_ns >= d) {
                 break;
+            }
+            // The virtual controller asks at the time reached, having heard the frames before.
+            if let Some(request) = asker
+                .as_mut()
+                .and_then(|a| a.due(Duration::from_nanos(t_ns)))
+            {
+                let (frames, answers) = self.bus.transmit(t_ns, &request);
+                self.report.received += frames.len() as u64;
+                self.report.answers += answers as u64;
+                self.report.frames += frames.len() as u64;
+                self.write_frames(&frames, adapter.is_open(), &mut lines)?;
             }
             t_ns = if self.realtime {
                 start.elapsed().as_nanos() as u64
@@ -201,6 +247,11 @@ impl CanSession {
                 }
             }
             let frames = self.bus.frames_until(t_ns);
+            if let Some(a) = asker.as_mut() {
+                for (_, f) in &frames {
+                    a.heard(f);
+                }
+            }
             self.report.frames += frames.len() as u64;
             self.write_frames(&frames, adapter.is_open(), &mut lines)?;
             self.write_truth()?;
@@ -226,17 +277,17 @@ impl CanSession {
         lines.clear();
         match &mut self.out {
             Out::Log(name, w) => {
+                let mut text = String::new();
                 for (t, f) in frames {
-                    let ns = self.origin_ns + t;
-                    writeln!(
-                        lines,
-                        "({}.{:06}) {INTERFACE} {f}",
-                        ns / 1_000_000_000,
-                        ns % 1_000_000_000 / 1000
-                    )
-                    .map_err(write_error(name))?;
+                    candump::push_line(&mut text, log_seconds(self.origin_ns + t), INTERFACE, f);
                 }
-                w.write_all(lines).map_err(write_error(name))?;
+                w.write_all(text.as_bytes()).map_err(write_error(name))?;
+            }
+            Out::Pcapng(name, w, iface) => {
+                for (t, f) in frames {
+                    w.write_can(*iface, self.origin_ns + t, &f.to_socketcan_record())
+                        .map_err(write_error(name))?;
+                }
             }
             #[cfg(unix)]
             Out::Pty(p, _) => {
@@ -271,14 +322,24 @@ impl CanSession {
     }
 
     fn flush(&mut self) -> Result<(), WriteError> {
-        if let Out::Log(name, w) = &mut self.out {
-            w.flush().map_err(write_error(name))?;
+        match &mut self.out {
+            Out::Log(name, w) => w.flush().map_err(write_error(name))?,
+            Out::Pcapng(name, w, _) => w.flush().map_err(write_error(name))?,
+            #[cfg(unix)]
+            Out::Pty(..) => {}
         }
         if let Some((name, w)) = &mut self.truth {
             w.flush().map_err(write_error(name))?;
         }
         Ok(())
     }
+}
+
+/// Unix nanoseconds as the seconds of a candump line: whole microseconds (as candump writes
+/// them, the rest dropped), which an `f64` holds exactly enough for `push_line` to write them
+/// back as they were.
+fn log_seconds(ns: u64) -> f64 {
+    (ns / 1000) as f64 / 1e6
 }
 
 fn write_error(name: &str) -> impl FnOnce(std::io::Error) -> WriteError + '_ {

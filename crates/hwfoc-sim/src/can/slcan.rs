@@ -10,17 +10,17 @@
 //! not parse, with BEL (`\x07`). Frames from the bus go out as `T` lines while the channel is
 //! open, without timestamps.
 //!
-//! Written here because no crate of the workspace speaks the adapter's side of SLCAN (the
-//! bridge's `slcan` module speaks the host's).
+//! Written here because no crate of the workspace speaks the adapter's side of SLCAN: the io
+//! crate's [`hwfoc_io::can::slcan`] speaks the host's. Its [`Parser`] reads the frames of the
+//! `T`/`t`/`R`/`r` commands (a host's send command has the layout of an adapter's received
+//! frame) and its [`push_frame`] writes the frames handed on; the commands `C`, `S0`..`S8`,
+//! `O`, `F`, `V`, `v`, `N`, `Z`, `M`, `m`, `X`, `W` are handled here, as that parser, made for
+//! an adapter's output, does not know them.
 
 use hwfoc::dronecan::CanFrame;
+pub use hwfoc_io::can::slcan::{BEL, BITRATES, push_frame};
+use hwfoc_io::can::slcan::{Event, Parser};
 
-/// The CAN bit rates of the `S` command, bit/s, by code (`S0` = 10 kbit/s ... `S8` = 1 Mbit/s).
-pub const BITRATES: [u32; 9] = [
-    10_000, 20_000, 50_000, 100_000, 125_000, 250_000, 500_000, 800_000, 1_000_000,
-];
-/// The answer to a refused command.
-pub const BEL: u8 = 0x07;
 /// The longest command kept; a longer line is refused whole (BEL).
 pub const MAX_LINE: usize = 64;
 
@@ -37,6 +37,8 @@ pub enum Action {
 #[derive(Debug, Clone, Default)]
 pub struct Adapter {
     open: bool,
+    /// Reads the frame of a `T`/`t`/`R`/`r` command.
+    frames: Parser,
     line: Vec<u8>,
     overlong: bool,
     refused: u64,
@@ -78,6 +80,23 @@ impl Adapter {
         }
     }
 
+    /// The frame of a `T`/`t`/`R`/`r` command (the whole line, without its `\r`): identifier
+    /// (8 or 3 hex digits), length, data (2 hex digits a byte; none for a remote frame), and an
+    /// optional timestamp (4 hex digits) that is ignored; `None` unless the line is exactly that.
+    fn parse_frame(&mut self, line: &[u8]) -> Option<CanFrame> {
+        let mut events = 0;
+        let mut frame = None;
+        let mut take = |e: Event| {
+            events += 1;
+            if let Event::Frame(f, _) = e {
+                frame = Some(f);
+            }
+        };
+        self.frames.push(line, &mut take);
+        self.frames.push(b"\r", &mut take);
+        frame.filter(|_| events == 1)
+    }
+
     fn refuse(&mut self, reply: &mut Vec<u8>) {
         self.refused += 1;
         reply.push(BEL);
@@ -103,87 +122,21 @@ impl Adapter {
             [b'v'] => b"v1013\r",
             [b'N'] => b"NHWFC\r",
             [b'Z' | b'M' | b'm' | b'X' | b'W', ..] => b"\r",
-            [kind @ (b'T' | b't' | b'R' | b'r'), rest @ ..] if self.open => {
-                match parse_frame(*kind, rest) {
-                    Some(frame) => {
-                        actions.push(Action::Frame(frame));
-                        if kind.is_ascii_uppercase() {
-                            b"Z\r"
-                        } else {
-                            b"z\r"
-                        }
+            [kind @ (b'T' | b't' | b'R' | b'r'), ..] if self.open => match self.parse_frame(line) {
+                Some(frame) => {
+                    actions.push(Action::Frame(frame));
+                    if kind.is_ascii_uppercase() {
+                        b"Z\r"
+                    } else {
+                        b"z\r"
                     }
-                    None => return self.refuse(reply),
                 }
-            }
+                None => return self.refuse(reply),
+            },
             _ => return self.refuse(reply),
         };
         reply.extend_from_slice(ok);
     }
-}
-
-/// The frame of a `T`/`t`/`R`/`r` command after its letter: identifier (8 or 3 hex digits),
-/// length (1 digit), data (2 hex digits a byte; none for a remote frame), and an optional
-/// timestamp (4 hex digits) that is ignored.
-fn parse_frame(kind: u8, rest: &[u8]) -> Option<CanFrame> {
-    let extended = kind.is_ascii_uppercase();
-    let id_len = if extended { 8 } else { 3 };
-    let id = hex(rest.get(..id_len)?)?;
-    let len = hex(rest.get(id_len..=id_len)?)? as usize;
-    if len > 8 {
-        return None;
-    }
-    let body = &rest[id_len + 1..];
-    if matches!(kind, b'R' | b'r') {
-        if !(body.is_empty() || body.len() == 4) {
-            return None;
-        }
-        return CanFrame::remote(id, extended, len as u8);
-    }
-    if !(body.len() == 2 * len || body.len() == 2 * len + 4) {
-        return None;
-    }
-    let mut data = [0u8; 8];
-    for (i, d) in data.iter_mut().take(len).enumerate() {
-        *d = hex(&body[2 * i..2 * i + 2])? as u8;
-    }
-    if extended {
-        CanFrame::extended(id, &data[..len])
-    } else {
-        CanFrame::standard(id, &data[..len])
-    }
-}
-
-/// The value of hex digits (either case), or `None`.
-fn hex(digits: &[u8]) -> Option<u32> {
-    digits
-        .iter()
-        .try_fold(0u32, |v, &d| Some(v << 4 | char::from(d).to_digit(16)?))
-}
-
-/// Appends the line that hands `frame` on: `T` + 8 hex digits of identifier (`t` + 3 for a
-/// standard one), the length, 2 hex digits a byte, `\r`; `R`/`r` for a remote frame. Error
-/// frames are not handed on (an SLCAN adapter has no line for them).
-pub fn push_frame(out: &mut Vec<u8>, frame: &CanFrame) {
-    use hwfoc::dronecan::FrameKind;
-    use std::io::Write;
-    let letter = match (frame.kind(), frame.is_extended()) {
-        (FrameKind::Error, _) => return,
-        (FrameKind::Data, true) => 'T',
-        (FrameKind::Data, false) => 't',
-        (FrameKind::Remote, true) => 'R',
-        (FrameKind::Remote, false) => 'r',
-    };
-    // Writing to a Vec cannot fail.
-    let _ = if frame.is_extended() {
-        write!(out, "{letter}{:08X}{}", frame.id(), frame.len())
-    } else {
-        write!(out, "{letter}{:03X}{}", frame.id(), frame.len())
-    };
-    for b in frame.data() {
-        let _ = write!(out, "{b:02X}");
-    }
-    out.push(b'\r');
 }
 
 #[cfg(test)]
@@ -241,18 +194,5 @@ mod tests {
         assert!(reply.is_empty());
         assert_eq!(feed(&mut a, b"\rC\rT1E4E2D7F0\r").0, b"\x07\r\x07");
         assert_eq!(a.refused(), 10);
-    }
-
-    #[test]
-    fn lines_out() {
-        let mut out = Vec::new();
-        push_frame(
-            &mut out,
-            &CanFrame::extended(0x104E_5201, &[1, 0xAB, 0xC3]).unwrap(),
-        );
-        push_frame(&mut out, &CanFrame::standard(0x7F, &[]).unwrap());
-        push_frame(&mut out, &CanFrame::remote(0x12, true, 4).unwrap());
-        push_frame(&mut out, &CanFrame::error(4, &[0; 8]).unwrap());
-        assert_eq!(out, b"T104E5201301ABC3\rt07F0\rR000000124\r");
     }
 }

@@ -504,6 +504,7 @@ fn a_candump_log_and_its_truth() {
         duration_s: Some(2.0),
         truth: Some(path("truth.jsonl")),
         overwrite: false,
+        ask_ids: false,
     };
     let session = CanSession::open(bus(2, false), &plan).unwrap();
     assert_eq!(session.output(), path("bus.log"));
@@ -525,4 +526,113 @@ fn a_candump_log_and_its_truth() {
     assert_eq!(t["priority"], 16);
     // Asked again: the file exists.
     assert!(CanSession::open(bus(2, false), &plan).is_err());
+}
+
+#[test]
+fn the_virtual_controller_asks_for_ids_while_no_motor_turns() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = |n: &str| dir.path().join(n).display().to_string();
+    let run = |name: &str, ask_ids: bool, seconds: f64| {
+        let plan = CanPlan {
+            destination: CanDestination::Candump(path(name)),
+            realtime: false,
+            start_s: Some(1.7e9),
+            duration_s: Some(seconds),
+            truth: None,
+            overwrite: false,
+            ask_ids,
+        };
+        let report = CanSession::open(bus(3, false), &plan)
+            .unwrap()
+            .run(&std::sync::atomic::AtomicBool::new(false))
+            .unwrap();
+        let log = std::fs::read_to_string(path(name)).unwrap();
+        assert_eq!(log.lines().count() as u64, report.frames);
+        let frames: Vec<CanFrame> = log
+            .lines()
+            .map(|l| {
+                let (_, frame) = l.split_once(") can0 ").unwrap();
+                let (id, data) = frame.split_once('#').unwrap();
+                let bytes: Vec<u8> = (0..data.len() / 2)
+                    .map(|i| u8::from_str_radix(&data[2 * i..2 * i + 2], 16).unwrap())
+                    .collect();
+                CanFrame::extended(u32::from_str_radix(id, 16).unwrap(), &bytes).unwrap()
+            })
+            .collect();
+        (report, frames)
+    };
+    let kind = |f: &CanFrame| {
+        let h = Header::parse(f.id()).unwrap();
+        (h.source_node, Kind::of(&h).unwrap())
+    };
+    // Idle for the first 1.5 s (the lead-in, then the level 0): asked at 0 and 1 s; at 1.5 s
+    // the motors start, and an ESC that turns stops the requests.
+    let (report, frames) = run("ask.log", true, 2.5);
+    let asked: Vec<usize> = (0..frames.len())
+        .filter(|&i| kind(&frames[i]).0 == hwfoc_io::can::DEFAULT_SOURCE_NODE)
+        .collect();
+    assert_eq!(report.received, asked.len() as u64);
+    assert_eq!(asked.len(), 2, "{asked:?}");
+    assert_eq!(report.answers, 3 * report.received);
+    // The log starts with the request, then the three answers [node, channel], before any
+    // status message.
+    assert_eq!(asked[0], 0);
+    assert_eq!(frames[0].data(), &[0x00, 0xC0]);
+    for (esc, f) in frames[1..4].iter().enumerate() {
+        assert_eq!(kind(f), (FIRST_NODE + esc as u8, Kind::GetEscId));
+        assert_eq!(&f.data()[..2], &[FIRST_NODE + esc as u8, esc as u8 + 1]);
+    }
+    // Without the controller: no request, no answer, and the ESCs' own frames are the same.
+    let (quiet, alone) = run("quiet.log", false, 2.5);
+    assert_eq!((quiet.received, quiet.answers), (0, 0));
+    let own = |fs: &[CanFrame]| -> Vec<CanFrame> {
+        fs.iter()
+            .filter(|f| kind(f).1 != Kind::GetEscId)
+            .copied()
+            .collect()
+    };
+    assert_eq!(own(&frames), own(&alone));
+}
+
+#[test]
+fn a_pcapng_recording_of_the_bus() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("bus.pcapng").display().to_string();
+    let plan = CanPlan {
+        destination: CanDestination::Pcapng(path.clone()),
+        realtime: false,
+        start_s: Some(1.7e9),
+        duration_s: Some(1.0),
+        truth: None,
+        overwrite: false,
+        ask_ids: true,
+    };
+    let report = CanSession::open(bus(2, false), &plan)
+        .unwrap()
+        .run(&std::sync::atomic::AtomicBool::new(false))
+        .unwrap();
+    let bytes = std::fs::read(&path).unwrap();
+    // A section header, then an interface of LINKTYPE_CAN_SOCKETCAN (227).
+    assert_eq!(&bytes[..4], &[0x0A, 0x0D, 0x0D, 0x0A]);
+    let shb_len = u32::from_le_bytes(bytes[4..8].try_into().unwrap()) as usize;
+    let idb = &bytes[shb_len..];
+    assert_eq!(u32::from_le_bytes(idb[..4].try_into().unwrap()), 1);
+    assert_eq!(u16::from_le_bytes(idb[8..10].try_into().unwrap()), 227);
+    // One enhanced packet block (type 6) per frame, each holding a 16-byte record.
+    let mut at = shb_len;
+    let mut packets = 0u64;
+    while at < bytes.len() {
+        let kind = u32::from_le_bytes(bytes[at..at + 4].try_into().unwrap());
+        let len = u32::from_le_bytes(bytes[at + 4..at + 8].try_into().unwrap()) as usize;
+        if kind == 6 {
+            packets += 1;
+            assert_eq!(
+                u32::from_le_bytes(bytes[at + 20..at + 24].try_into().unwrap()),
+                16
+            );
+        }
+        at += len;
+    }
+    assert_eq!(packets, report.frames);
+    assert!(report.received >= 1);
 }

@@ -1,6 +1,10 @@
 //! `hwfoc simulate --protocol hw-can`: a CAN bus of virtual Hobbywing DroneCAN ESCs
-//! ([`hwfoc_sim::can`]) into a candump log (`-o FILE`, or standard output) or an SLCAN
-//! pseudo-terminal (`--pty`), with the ground truth of every transfer (`--truth`).
+//! ([`hwfoc_sim::can`]) into a candump log or a pcapng recording (`-o FILE`, or standard
+//! output) or an SLCAN pseudo-terminal (`--pty`), with the ground truth of every transfer
+//! (`--truth`). In a log or a recording a virtual controller asks for the ESCs' ids unless
+//! `--no-ask-ids`.
+
+use std::io::IsTerminal;
 
 use hwfoc::Settings;
 use hwfoc_sim::can::{CanBus, CanDestination, CanPlan, CanReport, CanSession};
@@ -25,10 +29,21 @@ pub fn run(args: &SimulateArgs, config: &Config, settings: Settings) -> Result<(
             "a CAN bus runs at 500 kbit/s; an SLCAN program sets the rate with S0..S8",
         ));
     }
-    if args.format.is_some_and(|f| f != Format::Raw) {
+    if args.format == Some(Format::Raw) {
         return Err(usage(
             "--format",
-            "a CAN bus is written as a candump log (pcapng of a CAN bus is not written yet)",
+            "a CAN bus is written as a candump log (--format candump) or pcapng",
+        ));
+    }
+    if args.pty && (args.format.is_some() || args.no_ask_ids) {
+        let option = if args.no_ask_ids {
+            "--no-ask-ids"
+        } else {
+            "--format"
+        };
+        return Err(usage(
+            option,
+            "only for a log (-o or standard output): on the pty the controller asks, or not",
         ));
     }
     let n = usize::from(args.escs.unwrap_or(1));
@@ -44,13 +59,22 @@ pub fn run(args: &SimulateArgs, config: &Config, settings: Settings) -> Result<(
         return Err(usage("--pty", "pseudo-terminals need a Unix system"));
     } else {
         let path = args.output.clone().unwrap_or_else(|| "-".to_string());
-        if path.ends_with(".pcapng") {
+        let pcapng = match args.format {
+            Some(f) => f == Format::Pcapng,
+            None => path.ends_with(".pcapng"),
+        };
+        if pcapng && path == "-" && std::io::stdout().is_terminal() {
             return Err(usage(
-                "-o",
-                "pcapng of a CAN bus is not written yet: write a candump log (e.g. bus.log)",
+                "--format",
+                "not writing a pcapng recording to a terminal: give -o FILE, or pipe the output \
+                 (e.g. into `hwfoc decode -`)",
             ));
         }
-        CanDestination::Candump(path)
+        if pcapng {
+            CanDestination::Pcapng(path)
+        } else {
+            CanDestination::Candump(path)
+        }
     };
     let plan = CanPlan {
         destination,
@@ -59,6 +83,7 @@ pub fn run(args: &SimulateArgs, config: &Config, settings: Settings) -> Result<(
         duration_s: args.duration,
         truth: args.truth.clone(),
         overwrite: args.overwrite,
+        ask_ids: !args.no_ask_ids,
     };
     if args.pty && args.start_time.is_some() {
         return Err(usage(
@@ -75,7 +100,7 @@ pub fn run(args: &SimulateArgs, config: &Config, settings: Settings) -> Result<(
     .chain(crate::safety::config_read(config))
     .collect();
     let outputs: Vec<&String> = match &plan.destination {
-        CanDestination::Candump(path) => vec![path],
+        CanDestination::Candump(path) | CanDestination::Pcapng(path) => vec![path],
         #[cfg(unix)]
         CanDestination::Pty(_) => vec![],
     };

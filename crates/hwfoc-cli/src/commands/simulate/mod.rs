@@ -35,16 +35,20 @@ use hwfoc_sim::{
 pub enum Format {
     /// The bytes as they were on the wire.
     Raw,
-    /// A pcapng recording (one interface per ESC, nanosecond timestamps), as `hwfoc record`
-    /// writes.
+    /// A pcapng recording (one interface per ESC, nanosecond timestamps; hw-can: one
+    /// SocketCAN interface, a packet per frame), as `hwfoc record` writes.
     Pcapng,
+    /// hw-can: a `candump -l` log, `(secs.usecs) can0 ID#DATA` lines.
+    Candump,
 }
 
-impl From<Format> for FileFormat {
-    fn from(format: Format) -> FileFormat {
-        match format {
-            Format::Raw => FileFormat::Raw,
-            Format::Pcapng => FileFormat::Pcapng,
+impl Format {
+    /// The serial simulator's file format; `None` for a CAN bus's only ([`Format::Candump`]).
+    fn serial(self) -> Option<FileFormat> {
+        match self {
+            Format::Raw => Some(FileFormat::Raw),
+            Format::Pcapng => Some(FileFormat::Pcapng),
+            Format::Candump => None,
         }
     }
 }
@@ -59,6 +63,7 @@ Examples:
   hwfoc simulate --port /dev/ttyUSB0 --profile csv:flight.csv
   hwfoc simulate --protocol hw5 --fault motor_blocked@5-6 -o hw5.pcapng  # an HW5 ESC at 115200 baud
   hwfoc simulate --protocol hw-can --escs 4 -o bus.log # a candump log of 4 DroneCAN ESCs
+  hwfoc simulate --protocol hw-can --escs 4 -o bus.pcapng --no-ask-ids  # pcapng, no GetEscID
   hwfoc simulate --protocol hw-can --escs 4 --factory --pty  # an SLCAN adapter, all ESCs node 1";
 
 /// Arguments of `hwfoc simulate`.
@@ -74,15 +79,21 @@ pub struct SimulateArgs {
     duration: Option<f64>,
     /// The protocol the virtual ESCs speak: hw-foc (default), hw-v4 (Platinum V4), hw-v3
     /// (Platinum V3), hw5 (Platinum V5, VBAR) or hw-can (Hobbywing DroneCAN ESCs on a CAN
-    /// bus: a candump log with -o, an SLCAN adapter with --pty). V3 and V4 carry no fault word
-    /// (faults act on the model only); HW5's fault byte carries the faults that map to its
-    /// flags; link faults are for hw-foc only.
+    /// bus: a candump log or pcapng with -o, an SLCAN adapter with --pty). V3 and V4 carry no
+    /// fault word (faults act on the model only); HW5's fault byte carries the faults that map
+    /// to its flags; link faults are for hw-foc only. Standard DroneCAN ESCs (dronecan) are not
+    /// simulated.
     #[arg(long, value_name = "NAME", value_parser = protocol_parser())]
-    protocol: Option<SimProtocol>,
+    protocol: Option<Protocol>,
     /// hw-can: every ESC as it leaves the factory (node 1, throttle channel 1, 500 kbit/s)
     /// instead of set up (node 10 + N, channel N + 1).
     #[arg(long)]
     factory: bool,
+    /// hw-can, a log or pcapng: no virtual controller asking the ESCs for their ids (by
+    /// default node 127 sends GetEscID [0] at the start and once a second while no ESC turns,
+    /// as ArduPilot does, and the ESCs answer).
+    #[arg(long)]
+    no_ask_ids: bool,
     /// Line rate in baud (8N1). Default: the protocol's (19200; 115200 for hw5).
     #[arg(long, value_name = "BAUD",
           value_parser = clap::value_parser!(u32).range(9_600..=4_000_000))]
@@ -119,7 +130,7 @@ pub struct SimulateArgs {
     /// standard output.
     #[arg(short, long, value_name = "FILE", help_heading = "Output")]
     output: Option<String>,
-    /// File format. Default: pcapng for a name ending in .pcapng, raw otherwise.
+    /// File format. Default: pcapng for a name ending in .pcapng, else raw (hw-can: candump).
     #[arg(long, value_enum, help_heading = "Output")]
     format: Option<Format>,
     /// Write the file or standard output at the real rate instead of as fast as possible.
@@ -293,33 +304,21 @@ impl ModelArgs {
     }
 }
 
-/// What the virtual ESCs speak: a serial protocol, or DroneCAN on a CAN bus.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum SimProtocol {
-    /// One of [`SIMULATED`].
-    Serial(Protocol),
-    /// Hobbywing's DroneCAN messages on a CAN bus (`hw-can`).
-    HwCan,
-}
-
-/// The name of the CAN bus's protocol.
-const HW_CAN: &str = "hw-can";
-
-/// The names of the protocols a virtual ESC speaks, each with its title and baud rate.
-fn protocol_parser() -> impl TypedValueParser<Value = SimProtocol> {
+/// The names of the protocols a virtual ESC speaks, each with its title and rate: the serial
+/// protocols of [`SIMULATED`] and `hw-can`; `dronecan` is taken (hidden) to be refused with a
+/// line of its own.
+fn protocol_parser() -> impl TypedValueParser<Value = Protocol> {
     let names = SIMULATED
-        .map(|p| {
-            PossibleValue::new(p.name()).help(format!("{}, {} baud", p.title(), p.baud_rate()))
-        })
         .into_iter()
-        .chain([
-            PossibleValue::new(HW_CAN).help("Hobbywing DroneCAN ESCs on a CAN bus, 500 kbit/s")
-        ]);
+        .chain([Protocol::HwCan])
+        .map(|p| {
+            let unit = if p.is_can() { "bit/s" } else { "baud" };
+            PossibleValue::new(p.name()).help(format!("{}, {} {unit}", p.title(), p.baud_rate()))
+        })
+        .chain([PossibleValue::new(Protocol::DroneCan.name()).hide(true)]);
     // Every possible value is a protocol's name: the mapping finds it.
-    PossibleValuesParser::new(names).map(|name| match name.as_str() {
-        HW_CAN => SimProtocol::HwCan,
-        name => SimProtocol::Serial(Protocol::from_name(name).unwrap_or(Protocol::HwFoc)),
-    })
+    PossibleValuesParser::new(names)
+        .map(|name| Protocol::from_name(&name).unwrap_or(Protocol::HwFoc))
 }
 
 fn number(s: &str) -> Result<f64, String> {
@@ -394,13 +393,23 @@ fn usage(option: &str, message: impl Into<String>) -> CliError {
 pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
     let config = args.settings.config()?;
     let settings = config.settings(&args.settings)?;
-    let protocol = match args.protocol {
-        Some(SimProtocol::HwCan) => return can::run(args, &config, settings),
-        Some(SimProtocol::Serial(p)) => p,
-        None => Protocol::HwFoc,
-    };
+    let protocol = args.protocol.unwrap_or(Protocol::HwFoc);
+    match protocol {
+        Protocol::HwCan => return can::run(args, &config, settings),
+        Protocol::DroneCan => {
+            return Err(usage(
+                "--protocol",
+                "standard DroneCAN ESCs (dronecan) are not simulated: --protocol hw-can \
+                 simulates Hobbywing's DroneCAN ESCs",
+            ));
+        }
+        _ => {}
+    }
     if args.factory {
         return Err(usage("--factory", "only for --protocol hw-can"));
+    }
+    if args.no_ask_ids {
+        return Err(usage("--no-ask-ids", "only for --protocol hw-can"));
     }
     let n = count_escs(args)?;
     let plan = plan(args, n, settings)?;
@@ -477,7 +486,12 @@ fn plan(args: &SimulateArgs, n: usize, settings: Settings) -> Result<Plan, CliEr
     } else if !args.port.is_empty() {
         Destination::Ports(args.port.clone())
     } else {
-        let format = args.format.map(FileFormat::from);
+        let format = match args.format {
+            Some(f) => Some(f.serial().ok_or_else(|| {
+                usage("--format", "candump is for a CAN bus (--protocol hw-can)")
+            })?),
+            None => None,
+        };
         match args.output.as_deref() {
             None | Some("-") => Destination::Stdout(format.unwrap_or(FileFormat::Raw)),
             Some(path) => Destination::File {
