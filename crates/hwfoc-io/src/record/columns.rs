@@ -102,7 +102,7 @@ columns! {
     /// `docs/PROTOCOL-NOTES.md`; HW5: `docs/HW5-AND-CAN.md`); derived from `status`, not a
     /// field of the record; null where `status` is.
     faults: Option<FaultList>, "-", |_, _, f, _| f.fault_word().map(|s| FaultList(s, f.protocol())),
-        record |r| fault_list(r.status, r.protocol);
+        record |r| r.fault_word().map(|s| FaultList(s, r.protocol));
     /// The CAN node that sent the record (`hw-can`, `dronecan`); null for a serial format.
     node: Option<u8>, "-", |_, _, f, _| f.node();
     /// Age of the record's values from its ESC's second message, ms: a Hobbywing CAN ESC's
@@ -113,14 +113,4 @@ columns! {
     /// Age of a Hobbywing CAN ESC's `StatusMsg3` values (MOSFET, capacitor, motor
     /// temperatures), ms; null otherwise.
     msg3_age_ms: Option<u32>, "ms", |_, _, f, _| f.msg3_age_ms();
-}
-
-/// The `faults` of a record's `status` (see [`Data::fault_word`]): null where the protocol has
-/// no fault bits (a Hobbywing CAN ESC's `status` word is kept, its only known bit is the
-/// direction).
-#[inline(always)]
-fn fault_list(status: Option<hwfoc::Status>, protocol: Protocol) -> Option<FaultList> {
-    status
-        .filter(|_| protocol.has_faults())
-        .map(|s| FaultList(s, protocol))
 }

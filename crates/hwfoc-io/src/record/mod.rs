@@ -25,6 +25,12 @@ pub use columns::{COLUMNS, Record, UNITS};
 pub use text::TextEncoder;
 
 impl Record {
+    /// The record's fault word: its `status` where its protocol has fault bits (see
+    /// [`hwfoc::telemetry::Data::fault_word`]: a Hobbywing CAN ESC's `status` is no fault word).
+    pub fn fault_word(&self) -> Option<hwfoc::Status> {
+        self.status.filter(|_| self.protocol.has_faults())
+    }
+
     /// Appends the record as one JSON object and a newline.
     ///
     /// For many records, [`TextEncoder`] is faster: it remembers the text of recent numbers.

@@ -442,6 +442,7 @@ fn alarm_cell(esc: &EscView) -> Cell<'static> {
 
 fn draw_detail(frame: &mut Frame, area: Rect, index: usize, esc: &EscView, now: f64) {
     let hw5 = esc.protocol() == Some(hwfoc::Protocol::Hw5);
+    let can = esc.protocol().is_some_and(hwfoc::Protocol::is_can);
     let info = match &esc.info {
         // V4: the scales of its info frame, and whether they were taken (two identical copies).
         Some(Info::HwV4(i)) => format!(
@@ -471,6 +472,26 @@ fn draw_detail(frame: &mut Frame, area: Rect, index: usize, esc: &EscView, now: 
                 reading(r.and_then(|r| r.bec_current_a), 1),
                 temp(r.and_then(|r| r.bec_temp_c)),
                 temp(r.and_then(|r| r.motor_temp_c))
+            )
+        }
+        // A CAN ESC: its node, its direction (a Hobbywing ESC's status bit 14), the ages of
+        // the slower messages' values.
+        None if can => {
+            let r = esc.last.as_ref();
+            let age = |a: Option<u32>| a.map_or("-".to_string(), |a| format!("{a} ms"));
+            let direction = match r.and_then(|r| r.status) {
+                Some(s) if s.0 & hwfoc::dronecan::StatusMsg1::STATUS_CCW != 0 => "ccw",
+                Some(_) => "cw",
+                None => "-",
+            };
+            format!(
+                "CAN node {} · direction {direction} · StatusMsg2 age {} · StatusMsg3 age {} · status word {}",
+                r.and_then(|r| r.node)
+                    .map_or("-".to_string(), |n| n.to_string()),
+                age(r.and_then(|r| r.msg2_age_ms)),
+                age(r.and_then(|r| r.msg3_age_ms)),
+                r.and_then(|r| r.status)
+                    .map_or("-".to_string(), |s| format!("0x{:04X}", s.0)),
             )
         }
         Some(info) => Escaped(format_args!(

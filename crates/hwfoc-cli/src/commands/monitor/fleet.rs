@@ -684,8 +684,7 @@ impl Fleet {
         ));
         for fault in Fault::ALL {
             // A word of fault bits only (a Hobbywing CAN ESC's status is not one).
-            let word = r.status.filter(|_| r.protocol.has_faults());
-            let on = word.is_some_and(|s| s.contains(fault));
+            let on = r.fault_word().is_some_and(|s| s.contains(fault));
             let latch = &mut a.faults[usize::from(fault.bit())];
             if on || latch.level().is_some() {
                 let change = latch.set(on, Kind::fault_level(fault), limits.fault_hold_s, t);

@@ -310,7 +310,7 @@ impl EscData {
             packet: r.packet,
         };
         // A protocol without status word shows no fault episode.
-        let status = r.status.unwrap_or_default();
+        let status = r.fault_word().unwrap_or_default();
         if let Some(ended) = Episode::track(&mut self.open, mark, status) {
             self.keep(&ended);
         }
