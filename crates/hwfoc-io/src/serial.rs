@@ -928,6 +928,9 @@ mod tests {
             r"\\.\COM10",
             "/dev/ttyUSB9",
             "/dev/serial/by-id/x",
+            "slcan:/dev/ttyACM0",
+            "slcan:/dev/ttyACM0:1000000",
+            "can:can0",
         ] {
             assert!(is_port(port), "{port}");
         }
