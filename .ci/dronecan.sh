@@ -5,7 +5,8 @@
 # esc.Status it decodes with the records sent. The Wireshark dissector on pydronecan's frames
 # (crates/hwfoc-cli/tests/wireshark.rs, with crates/hwfoc-cli/tests/py/dronecan_pcapng.py; it
 # needs tshark too, which .ci/run installs), and the simulator's virtual CAN ESCs checked by it
-# (below), and `hwfoc can` setting up a pydronecan ESC stand-in. Called by .ci/run; runs on its
+# (below), `hwfoc can` setting up a pydronecan ESC stand-in, and CAN inputs read against
+# pydronecan's frames (crates/hwfoc-cli/tests/can.rs, at the end). Called by .ci/run; runs on its
 # own too.
 set -euo pipefail
 export CARGO_TERM_COLOR=never
@@ -59,3 +60,20 @@ grep -Eq "^test result: ok\. 1 passed; 0 failed; 0 ignored" "$canlog" \
   || { echo "the hwfoc can pydronecan test did not run and pass (see $canlog)" >&2; exit 1; }
 grep -q "pydronecan ESC stand-in set up by hwfoc can" "$canlog" \
   || { echo "the hwfoc can pydronecan test did not run (see $canlog)" >&2; exit 1; }
+# CAN inputs read against pydronecan (crates/hwfoc-cli/tests/can.rs, with
+# crates/hwfoc-cli/tests/py/can_frames.py): a bus of Hobbywing and standard DroneCAN ESCs it
+# encodes, decoded by hwfoc from a candump log and live from SLCAN lines on a pty, compared
+# record by record with the records the script says the schema makes.
+canlog=${TMPDIR:-/tmp}/hwfoc-ci-dronecan-can-inputs.log
+HWFOC_DRONECAN_PY="$venv/bin/python" cargo test -p hwfoc-cli --test can pydronecan \
+  -- --ignored --nocapture 2>&1 | tee "$canlog"
+grep -Eq "^test result: ok\. 2 passed; 0 failed; 0 ignored" "$canlog" \
+  || { echo "the CAN input pydronecan tests did not all run and pass (see $canlog)" >&2; exit 1; }
+grep -q "pydronecan candump log: " "$canlog" && grep -q "pydronecan SLCAN on a pty: " "$canlog" \
+  || { echo "a CAN input pydronecan test did not run (see $canlog)" >&2; exit 1; }
+# The candump log of that bus the golden tests and the Python tests read
+# (testdata/dronecan/can-bus.log): made again here, it must be the file committed.
+bus=${TMPDIR:-/tmp}/hwfoc-ci-dronecan-can-bus.log
+"$venv/bin/python" crates/hwfoc-cli/tests/py/can_frames.py log "$bus" "$bus.expected.json"
+cmp "$bus" testdata/dronecan/can-bus.log \
+  || { echo "testdata/dronecan/can-bus.log differs from what can_frames.py writes" >&2; exit 1; }

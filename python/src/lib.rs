@@ -257,12 +257,14 @@ struct Decoded {
     warnings: Vec<String>,
 }
 
-/// The warnings `hwfoc decode` prints for ESCs whose bytes held no frame.
+/// The warnings `hwfoc decode` prints for ESCs whose bytes held no frame (not a hub's or a
+/// CAN bus's stream: its ESCs are its channels, and a place on the bus without records is no
+/// wire without frames).
 pub(crate) fn no_frames(sources: &Sources) -> Vec<String> {
     (0..sources.escs().len())
         .filter(|&i| {
             let stats = sources.escs()[i].stream.stats();
-            stats.bytes() > 0 && stats.frames() == 0
+            stats.bytes() > 0 && stats.frames() == 0 && !sources.is_hub(i)
         })
         .map(|i| format!("{}: {}", esc_label(sources, i), no_frames_text(sources, i)))
         .collect()

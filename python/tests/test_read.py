@@ -402,7 +402,7 @@ def test_a_forced_protocol_that_finds_nothing_warns_with_its_advice(mixed):
 
 
 def test_protocol_names_and_their_defaults():
-    assert hwfoc.PROTOCOLS == ("hw-foc", "datalink", "hw-v4", "hw-v3", "hw5")
+    assert hwfoc.PROTOCOLS == ("hw-foc", "datalink", "hw-v4", "hw-v3", "hw5", "hw-can", "dronecan")
     for f in (hwfoc.read, hwfoc.scan, hwfoc.summary, hwfoc.Decoder, hwfoc.open_ports):
         assert inspect.signature(f).parameters["protocol"].default is None, f
     for call in (lambda: hwfoc.read(b"", protocol="hw4"), lambda: hwfoc.scan(b"", protocol="v3"),
@@ -411,8 +411,11 @@ def test_protocol_names_and_their_defaults():
         with pytest.raises(ValueError, match=r'protocol: ".*" is not a protocol: give one of "hw-foc", '
                                              r'"datalink", "hw-v4", "hw-v3", "hw5"'):
             call()
-    # Every name is taken (any case), by every function.
-    for name in hwfoc.PROTOCOLS + ("HW5", "Hw-V4"):
+    # A CAN bus is read as one whatever protocol= says: only the serial protocols are forced.
+    with pytest.raises(ValueError, match=r'protocol: "hw-can" is not a protocol: give one of'):
+        hwfoc.read(b"", protocol="hw-can")
+    # Every serial protocol's name is taken (any case), by every function.
+    for name in hwfoc.PROTOCOLS[:5] + ("HW5", "Hw-V4"):
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", hwfoc.HwfocWarning)
             assert hwfoc.read(b"\0", protocol=name).num_rows == 0

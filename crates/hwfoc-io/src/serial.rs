@@ -289,8 +289,11 @@ impl std::error::Error for PortError {}
 /// `COM3` (or `\\.\COM12`); a character device that is a terminal; or a path under `/dev` that
 /// looks like a serial device (`/dev/ttyUSB0`, `/dev/ttyACM0`, `/dev/cu.usbserial-1`,
 /// `/dev/serial/by-id/…`, `/dev/pts/3`), even when it does not exist, so that a missing adapter
-/// is reported as a missing port.
+/// is reported as a missing port. A CAN bus (`slcan:PORT[:BITRATE]`, `can:IFACE`) is a port.
 pub fn is_port(spec: &str) -> bool {
+    if crate::can::is_can_spec(spec) {
+        return true;
+    }
     let upper = spec.to_ascii_uppercase();
     let com = upper.strip_prefix(r"\\.\").unwrap_or(&upper);
     if com
@@ -925,6 +928,9 @@ mod tests {
             r"\\.\COM10",
             "/dev/ttyUSB9",
             "/dev/serial/by-id/x",
+            "slcan:/dev/ttyACM0",
+            "slcan:/dev/ttyACM0:1000000",
+            "can:can0",
         ] {
             assert!(is_port(port), "{port}");
         }

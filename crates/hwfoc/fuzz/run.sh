@@ -3,9 +3,9 @@
 #
 #   crates/hwfoc/fuzz/run.sh [DURATION]
 #
-# Eight targets: stream, bulk (HW-FOC), datalink, v3, v4, hw5, detect (every serial format at
-# once), dronecan. The whole run takes 8 x DURATION seconds of fuzzing plus the build: at 30 s
-# (CI), 240 s of fuzzing, and about 1.5 minutes to build the targets the first time on a 2-core
+# Nine targets: stream, bulk (HW-FOC), datalink, v3, v4, hw5, detect (every serial format at
+# once), dronecan, canrecords (a CAN bus's record stream). The whole run takes 9 x DURATION
+# seconds of fuzzing plus the build: at 30 s (CI), 270 s of fuzzing, and about 1.5 minutes to build the targets the first time on a 2-core
 # machine (seconds once built).
 #
 # Needs cargo-fuzz (installed here with `cargo install cargo-fuzz --locked` when missing: about
@@ -154,6 +154,32 @@ for len in 6 5 3 3 7 14 7 2 2 1 0 3 3 1 1 4 4 1 1 0 1 3 5 1 7 1 7; do
     k=$((k + 1))
 done
 
+# canrecords (see fuzz_targets/canrecords.rs): timed (byte 0 even); transfers made by the
+# target's encoder (0xFD, kind, node, transfer id, length, payload): node 5's StatusMsg2,
+# GetEscID answer [5, 3], StatusMsg1, node 9's StatusExtended and esc.Status (the kinds' longest
+# payloads); then 16-byte SocketCAN records after a time step: node 5's StatusMsg3 twice,
+# an error frame and a remote frame.
+sock() { # sock ID BYTE...: a LINKTYPE_CAN_SOCKETCAN record, the id big-endian
+    local id=$1 b
+    shift
+    printf '%s\\x%02x\\x00\\x00\\x00' "$(be 4 "$id")" $#
+    for b in "$@" 00 00 00 00 00 00 00 00; do printf '\\x%02x' $((0x$b)); done | cut -c1-32
+}
+can_records='\x00'
+k=0
+for spec in "1 5 5" "3 5 2 5 3" "0 5 6" "5 9 7" "4 9 14"; do
+    set -- $spec
+    can_records+=$(printf '\\xfd\\x%02x\\x%02x\\x%02x\\x%02x' "$1" "$2" $k "$3")
+    if [ $# -gt 3 ]; then
+        for b in "${@:4}"; do can_records+=$(printf '\\x%02x' "$b"); done
+    else
+        can_records+=$(ramp "$3")
+    fi
+    k=$((k + 1))
+done
+can_records+="\\x14$(sock $((0x904E5405)) 30 29 37 c0)\\x01$(sock $((0x904E5405)) 30 29 37 c1)"
+can_records+="\\x00$(sock $((0x20000004)) 00 04 00 00 00 00 00 00)\\x02$(sock $((0xC0000123)))"
+
 seed_new() { # seed_new TARGET PREFIX NAME=SEED...: as seed, with the given seeds
     local dir="$fuzz_dir/corpus/$1" prefix=$2 name_seed
     shift 2
@@ -194,6 +220,8 @@ for target in $(cargo "${toolchain[@]}" fuzz list); do
     # dronecan: records of CAN frames and of transfers to encode (no schedule).
     dronecan) seed_new "$target" '' "can-extended=$can_extended" \
         "can-socketcan=$can_socketcan" "can-messages=$can_messages" ;;
+    # canrecords: its own layout (no schedule).
+    canrecords) seed_new "$target" '' "can-records=$can_records" ;;
     *) seed "$target" '' ;;
     esac
     echo "=== fuzz target $target: ${duration} s" >&2

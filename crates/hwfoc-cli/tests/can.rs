@@ -1,0 +1,519 @@
+//! DroneCAN ESC telemetry read from CAN inputs, end to end through the `hwfoc` binary.
+//!
+//! - pydronecan (PyPI `dronecan`, an implementation hwfoc did not write) is the oracle:
+//!   `tests/py/can_frames.py` encodes a bus of Hobbywing and standard DroneCAN ESCs and says
+//!   which records docs/RECORD-SCHEMA.md makes of it; hwfoc's records of its candump log, and
+//!   of its SLCAN lines on a pseudo-terminal (`slcan:PTY`), are compared field by field
+//!   (ignored unless asked: they need a Python with `dronecan`, `HWFOC_DRONECAN_PY` or
+//!   `python3`; `.ci/dronecan.sh` makes one and runs them).
+//! - Golden outputs of the committed log of that bus (`testdata/dronecan/can-bus.log`).
+//! - Bad input: broken transfers, frames that are not DroneCAN, error frames, CAN FD lines and
+//!   garbage in a candump log; a CAN pcapng cut in the middle of a block. Counted or named in
+//!   one line, never a panic.
+
+mod common;
+
+#[path = "../../hwfoc-bridge/tests/py/python.rs"]
+mod python;
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output, Stdio};
+use std::time::Duration;
+
+use common::{Dir, assert_fails_with, hwfoc, records, stdout};
+use hwfoc::dronecan::{
+    CanFrame, EscStatus, GetEscId, Message, SOCKETCAN_ERR_FLAG, StatusMsg1, StatusMsg2,
+};
+use serde_json::Value;
+
+const SCRIPT: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/py/can_frames.py");
+
+/// The committed candump log of pydronecan's bus (`testdata/dronecan/README.md`).
+fn bus_log() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../testdata/dronecan/can-bus.log")
+}
+
+/// The committed CAN capture of pydronecan's frames.
+fn frames_pcapng() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../testdata/dronecan/pydronecan-frames.pcapng")
+}
+
+fn golden(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/golden")
+        .join(name)
+}
+
+fn run(args: &[&str]) -> Output {
+    hwfoc().args(args).output().expect("run hwfoc")
+}
+
+/// Compares with a golden file; `UPDATE_GOLDEN=1` rewrites it instead (as in tests/cli.rs).
+fn check_golden(name: &str, actual: &str) {
+    let path = golden(name);
+    if std::env::var_os("UPDATE_GOLDEN").is_some() {
+        std::fs::write(&path, actual).unwrap();
+    }
+    let expected = std::fs::read_to_string(&path)
+        .unwrap_or_else(|e| panic!("{}: {e} (run with UPDATE_GOLDEN=1)", path.display()));
+    assert!(
+        expected == actual,
+        "{name} differs from the golden file {}",
+        path.display()
+    );
+}
+
+fn python() -> String {
+    python::python_with("HWFOC_DRONECAN_PY", "dronecan", ".ci/dronecan.sh")
+}
+
+/// How closely an age must match: exactly for a file; on a live bus, within the scheduling of
+/// the script's writes and of hwfoc's reader.
+#[derive(Clone, Copy)]
+enum Ages {
+    Exact,
+    Within(u64),
+}
+
+/// Compares hwfoc's records with the script's, every column: floats as their f32 value,
+/// `t_s` to the microsecond (null in `expected`: only present), ages as `ages` says. Returns
+/// the number of values compared.
+fn compare(got: &[Value], expected: &[Value], ages: Ages) -> usize {
+    assert_eq!(
+        got.len(),
+        expected.len(),
+        "records: hwfoc made {}, pydronecan's bus makes {}",
+        got.len(),
+        expected.len()
+    );
+    let mut compared = 0;
+    for (i, (g, e)) in got.iter().zip(expected).enumerate() {
+        let (g, e) = (g.as_object().unwrap(), e.as_object().unwrap());
+        assert_eq!(
+            g.keys().collect::<Vec<_>>(),
+            e.keys().collect::<Vec<_>>(),
+            "record {i}: the schema's columns"
+        );
+        for (key, want) in e {
+            let have = &g[key];
+            let same = match (key.as_str(), want, have) {
+                ("t_s", Value::Null, h) => h.is_f64(),
+                ("t_s", w, h) => {
+                    (w.as_f64().unwrap() - h.as_f64().unwrap_or(f64::NAN)).abs() < 1e-6
+                }
+                ("msg2_age_ms" | "msg3_age_ms", Value::Number(w), Value::Number(h)) => {
+                    let (w, h) = (w.as_u64().unwrap(), h.as_u64().unwrap());
+                    match ages {
+                        Ages::Exact => w == h,
+                        Ages::Within(ms) => w.abs_diff(h) <= ms,
+                    }
+                }
+                (_, Value::Number(w), Value::Number(h)) if w.is_f64() || h.is_f64() => {
+                    w.as_f64().unwrap() as f32 == h.as_f64().unwrap() as f32
+                }
+                _ => want == have,
+            };
+            assert!(
+                same,
+                "record {i} ({} of node {}): {key} is {have}, pydronecan's values make {want}\n\
+                 hwfoc: {g:?}\nexpected: {e:?}",
+                e["protocol"], e["node"]
+            );
+            compared += 1;
+        }
+    }
+    compared
+}
+
+/// Runs the script with `args`; its expected records.
+fn script(python: &str, args: &[&str], expected: &Path, stdout: Stdio) -> std::process::Child {
+    Command::new(python)
+        .arg(SCRIPT)
+        .args(args)
+        .arg(expected)
+        .stdout(stdout)
+        .stderr(Stdio::inherit())
+        .spawn()
+        .expect("cannot run HWFOC_DRONECAN_PY")
+}
+
+fn expected_records(path: &Path) -> Vec<Value> {
+    serde_json::from_slice(&std::fs::read(path).unwrap()).unwrap()
+}
+
+/// pydronecan's frames of every message above, as a candump log: hwfoc decodes them to exactly
+/// the values pydronecan encoded, numbered as the schema says (node id, then the throttle
+/// channel minus 1 once GetEscID maps the node; a standard ESC's esc_index), with the ages of
+/// the slower messages the script's own times give.
+#[test]
+#[ignore = "needs pydronecan (HWFOC_DRONECAN_PY, or python3 with the dronecan package; .ci/dronecan.sh)"]
+fn pydronecan_candump_log_decodes_to_the_values_encoded() {
+    let python = python();
+    let dir = Dir::new();
+    let (log, expected) = (dir.path("bus.log"), dir.path("expected.json"));
+    let log_arg = log.to_str().unwrap();
+    let status = script(&python, &["log", log_arg], &expected, Stdio::null())
+        .wait()
+        .unwrap();
+    assert!(status.success(), "{SCRIPT} failed");
+    let expected = expected_records(&expected);
+    let got = records(&stdout(&run(&["decode", log_arg])));
+    let n = compare(&got, &expected, Ages::Exact);
+    // Both protocols, ESCs renumbered by their channel, a NaN read as null.
+    let escs: std::collections::BTreeSet<(u64, u64)> = got
+        .iter()
+        .map(|r| (r["esc"].as_u64().unwrap(), r["node"].as_u64().unwrap()))
+        .collect();
+    assert_eq!(
+        escs.into_iter().collect::<Vec<_>>(),
+        [
+            (0, 11),
+            (1, 12),
+            (3, 40),
+            (4, 41),
+            (11, 11),
+            (12, 12),
+            (13, 13)
+        ]
+    );
+    assert!(
+        got.iter()
+            .any(|r| r["protocol"] == "dronecan" && r["voltage_v"].is_null())
+    );
+    println!(
+        "pydronecan candump log: {} records, {n} values compared",
+        got.len()
+    );
+}
+
+/// The same bus as SLCAN lines written by the script on a pseudo-terminal in real time, read
+/// live by `hwfoc decode slcan:PTY`: the same records, values and numbering; the ages within
+/// 80 ms of the script's (receive times are hwfoc's; the margin is for a loaded machine).
+#[cfg(unix)]
+#[test]
+#[ignore = "needs pydronecan (HWFOC_DRONECAN_PY, or python3 with the dronecan package; .ci/dronecan.sh)"]
+fn pydronecan_slcan_lines_on_a_pty_decode_live() {
+    use nix::sys::signal::{Signal, kill};
+    use nix::unistd::Pid;
+
+    let python = python();
+    let dir = Dir::new();
+    let expected = dir.path("expected.json");
+    let pty = common::pty();
+    let port = format!("slcan:{}", pty.path.display());
+    let before = common::unix_now();
+    let child = hwfoc()
+        .args(["decode", &port])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    // Time to open the adapter and set it up (what hwfoc writes to it is not read back: the
+    // pseudo-terminal's buffer holds it).
+    std::thread::sleep(Duration::from_millis(700));
+    let master = pty.master.try_clone().unwrap();
+    let status = script(&python, &["slcan"], &expected, Stdio::from(master))
+        .wait()
+        .unwrap();
+    assert!(status.success(), "{SCRIPT} failed");
+    std::thread::sleep(Duration::from_millis(400));
+    kill(Pid::from_raw(child.id() as i32), Signal::SIGINT).unwrap();
+    let out = child.wait_with_output().unwrap();
+    let after = common::unix_now();
+    let got = records(&stdout(&out));
+    let n = compare(&got, &expected_records(&expected), Ages::Within(80));
+    for r in &got {
+        let t = r["t_s"].as_f64().unwrap();
+        assert!(t >= before && t <= after, "t_s {t} is no receive time");
+    }
+    println!(
+        "pydronecan SLCAN on a pty: {} records, {n} values compared",
+        got.len()
+    );
+}
+
+/// The committed log of pydronecan's bus, decoded and summarised as the golden files hold them
+/// (`UPDATE_GOLDEN=1` rewrites them).
+#[test]
+fn can_bus_log_decodes_and_summarises_as_the_golden_files() {
+    let log = bus_log();
+    let path = log.to_str().unwrap();
+    let jsonl = stdout(&run(&["decode", path]));
+    let got = records(&jsonl);
+    assert_eq!(got.len(), 58);
+    check_golden("can-bus.jsonl", &jsonl);
+    let out = stdout(&run(&["summary", "--json", path]));
+    let v: Value = serde_json::from_str(&out).unwrap();
+    assert_eq!(v["inputs"][0]["format"], "candump");
+    let escs = v["escs"].as_array().unwrap();
+    let esc = |n: u64| escs.iter().find(|e| e["esc"] == n).unwrap();
+    assert_eq!(esc(0)["protocol"], "hw-can");
+    assert_eq!(esc(3)["protocol"], "dronecan");
+    assert_eq!(esc(0)["link"]["can"]["node"], 11);
+    assert_eq!(esc(0)["link"]["can"]["unknown_types"], 1);
+    assert_eq!(esc(4)["link"]["can"]["crc_errors"], 1);
+    assert_eq!(esc(4)["frames"], 9);
+    let portable = out.replace(
+        &serde_json::to_string(path).unwrap(),
+        "\"testdata/dronecan/can-bus.log\"",
+    );
+    check_golden("can-bus.summary.json", &portable);
+}
+
+/// A candump log line of `frame` at `t` seconds.
+fn line(t: f64, frame: &CanFrame) -> String {
+    let us = (t * 1e6).round() as u64;
+    format!("({}.{:06}) can0 {frame}\n", us / 1_000_000, us % 1_000_000)
+}
+
+/// The frames of `m` from `node` with transfer id `tid`.
+fn frames(m: impl Into<Message>, node: u8, tid: u8) -> Vec<CanFrame> {
+    m.into().frames(16, node, 0, tid).collect()
+}
+
+fn status(index: u8, rpm: i32) -> EscStatus {
+    EscStatus {
+        error_count: 0,
+        voltage: 24.0,
+        current: -2.5,
+        temperature: 300.0,
+        rpm,
+        power_rating_pct: 10,
+        esc_index: index,
+    }
+}
+
+const M1: StatusMsg1 = StatusMsg1 {
+    rpm: 1000,
+    pwm: 300,
+    status: 0,
+};
+
+/// A log of a Hobbywing ESC (node 5) and a standard one (node 9, esc_index 1) whose transfers
+/// are broken every way a bus breaks them, among frames that are not DroneCAN, error frames
+/// (a bus at the wrong bit rate), CAN FD frames, and lines candump writes otherwise (`.`
+/// between bytes, a trailing direction).
+fn bad_bus_log() -> String {
+    let mut t = 1_700_000_100.0;
+    let mut out = String::new();
+    let mut put = |out: &mut String, f: &CanFrame| {
+        t += 0.001;
+        out.push_str(&line(t, f));
+    };
+    for f in frames(M1, 5, 0) {
+        put(&mut out, &f);
+    }
+    for f in frames(status(1, 500), 9, 0) {
+        put(&mut out, &f);
+    }
+    // Cut short: tid 1's first two frames, then tid 2 whole.
+    for f in &frames(status(1, 600), 9, 1)[..2] {
+        put(&mut out, f);
+    }
+    for f in frames(status(1, 700), 9, 2) {
+        put(&mut out, &f);
+    }
+    // A wrong toggle: tid 3 without its middle frame.
+    let three = frames(status(1, 800), 9, 3);
+    put(&mut out, &three[0]);
+    put(&mut out, &three[2]);
+    // A CRC error: tid 4's first byte changed.
+    let four = frames(status(1, 900), 9, 4);
+    let mut first = four[0].data().to_vec();
+    first[0] ^= 0xFF;
+    put(&mut out, &CanFrame::extended(four[0].id(), &first).unwrap());
+    put(&mut out, &four[1]);
+    put(&mut out, &four[2]);
+    // An unknown data type (12345) from each node.
+    for node in [5u32, 9] {
+        let id = (16 << 24) | (12345 << 8) | node;
+        put(&mut out, &CanFrame::extended(id, &[1, 2, 0xC0]).unwrap());
+    }
+    // Not DroneCAN: a standard frame, standard and extended remote frames.
+    put(&mut out, &CanFrame::standard(0x123, &[1, 2]).unwrap());
+    out.push_str("(1700000100.050000) can0 123#R\n");
+    out.push_str("(1700000100.050100) can0 1C4E2D01#R2\n");
+    // Error frames, as a bus at the wrong bit rate makes them (CAN_ERR_FLAG | CAN_ERR_PROT).
+    let error = CanFrame::from_socketcan(SOCKETCAN_ERR_FLAG | 0x08, &[0, 0, 0x08, 0, 0, 0, 0, 0]);
+    out.push_str(&line(1_700_000_100.050_2, &error.unwrap()));
+    out.push_str("(1700000100.050300) can0 20000004#0004000000000000\n");
+    // CAN FD frames.
+    out.push_str("(1700000100.050400) can0 1C4E5205##10102C0\n");
+    out.push_str("(1700000100.050500) can0 123##0\n");
+    // A StatusMsg2 with `.` between its bytes and candump's direction at the end; then the
+    // ESCs' last records.
+    let m2 = frames(
+        StatusMsg2 {
+            input_voltage: 240,
+            current: -30,
+            temperature: 33,
+        },
+        5,
+        0,
+    );
+    let dotted: Vec<String> = m2[0].data().iter().map(|b| format!("{b:02X}")).collect();
+    out.push_str(&format!(
+        "(1700000100.060000) can0 {:08X}#{} R\n",
+        m2[0].id(),
+        dotted.join(".")
+    ));
+    out.push_str(&line(1_700_000_100.07, &frames(M1, 5, 1)[0]));
+    for (k, f) in frames(status(1, 1000), 9, 5).iter().enumerate() {
+        out.push_str(&line(1_700_000_100.08 + k as f64 * 1e-4, f));
+    }
+    out
+}
+
+/// Every kind of bad input in a candump log is counted in the summary's `link.can` of the ESC
+/// whose node sent it (or the bus's counts, on every ESC of it), the good transfers decoded,
+/// and nothing panics.
+#[test]
+fn a_candump_log_of_broken_transfers_and_foreign_frames_is_counted() {
+    let dir = Dir::new();
+    let log = dir.path("bad.log");
+    std::fs::write(&log, bad_bus_log()).unwrap();
+    let log = log.to_str().unwrap();
+    let out = run(&["decode", log]);
+    assert!(!String::from_utf8_lossy(&out.stderr).contains("panicked"));
+    let got = records(&stdout(&out));
+    let rpms = |node: u64| -> Vec<f64> {
+        got.iter()
+            .filter(|r| r["node"] == node)
+            .map(|r| r["rpm"].as_f64().unwrap())
+            .collect()
+    };
+    // Node 9: tids 0, 2 and 5 whole; 1 cut short, 3 toggled wrong, 4 with a bad CRC.
+    assert_eq!(rpms(9), [500.0, 700.0, 1000.0]);
+    assert_eq!(rpms(5), [1000.0, 1000.0]);
+    let last5 = got.iter().rfind(|r| r["node"] == 5).unwrap();
+    assert_eq!(last5["esc"], 5);
+    assert_eq!(last5["voltage_v"], 24.0);
+    assert_eq!(last5["current_a"], -3.0);
+    assert_eq!(last5["msg2_age_ms"], 10);
+    assert!(got.iter().filter(|r| r["node"] == 9).all(|r| r["esc"] == 1));
+
+    let out = run(&["summary", "--json", log]);
+    assert!(!String::from_utf8_lossy(&out.stderr).contains("panicked"));
+    let v: Value = serde_json::from_str(&stdout(&out)).unwrap();
+    let escs = v["escs"].as_array().unwrap();
+    let can = |n: u64| escs.iter().find(|e| e["esc"] == n).unwrap()["link"]["can"].clone();
+    let (hw, std) = (can(5), can(1));
+    assert_eq!(std["node"], 9);
+    assert_eq!(std["cut_short"], 1, "{std}");
+    assert_eq!(std["toggle_errors"], 1, "{std}");
+    assert_eq!(std["crc_errors"], 1, "{std}");
+    assert_eq!(std["unknown_types"], 1, "{std}");
+    assert_eq!(hw["node"], 5);
+    assert_eq!(hw["unknown_types"], 1, "{hw}");
+    assert_eq!(
+        (hw["toggle_errors"].as_u64(), hw["crc_errors"].as_u64()),
+        (Some(0), Some(0)),
+        "{hw}"
+    );
+    for c in [&hw, &std] {
+        // 3 foreign frames (a standard and two remote frames) and 2 error frames.
+        assert_eq!(c["not_dronecan"], 5, "{c}");
+        assert_eq!(c["error_frames"], 2, "{c}");
+        assert_eq!(c["bus_frames"], 26, "{c}");
+    }
+    // A candump log's CAN FD lines are not records of the bus's stream: told on standard error,
+    // once per interface, with their number.
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(
+        err.trim_end(),
+        format!("hwfoc: warning: {log}: can0: 2 CAN FD frames skipped (only classic CAN is read)")
+    );
+}
+
+/// A garbage line: a one-line error naming the file and the line, exit code 1, the records
+/// before it decoded.
+#[test]
+fn a_garbage_line_is_named_with_its_file_and_line() {
+    let dir = Dir::new();
+    let mut text = String::new();
+    for (k, f) in frames(M1, 5, 0).iter().chain(&frames(M1, 5, 1)).enumerate() {
+        text.push_str(&line(1_700_000_000.0 + k as f64 * 0.01, f));
+    }
+    text.push_str("(1700000000.100000) can0 1C4E5205#zz\n");
+    text.push_str(&line(1_700_000_000.2, &frames(M1, 5, 2)[0]));
+    for bad in [
+        "(1700000000.100000) can0 1C4E5205#zz",
+        "this is not candump",
+        "(1700000000.1 can0 123#00",
+        "(1700000000.100000) can0 123#000102030405060708",
+        "(1700000000.100000) can0 12345#00",
+    ] {
+        let text = text.replace("(1700000000.100000) can0 1C4E5205#zz", bad);
+        let path = dir.path("garbage.log");
+        std::fs::write(&path, &text).unwrap();
+        let o = run(&["decode", path.to_str().unwrap()]);
+        assert_fails_with(&o, "garbage.log:3: not a candump -l line");
+        let got = records(&String::from_utf8(o.stdout.clone()).unwrap());
+        assert_eq!(got.len(), 2, "{bad}: the records before the line");
+        let o = run(&["summary", "--json", path.to_str().unwrap()]);
+        assert_fails_with(&o, "garbage.log:3: not a candump -l line");
+    }
+}
+
+/// A CAN pcapng cut in the middle of a block decodes what is there, with a warning; cut in
+/// its headers, the warning and a one-line error that nothing is left to decode.
+#[test]
+fn a_can_pcapng_cut_in_a_block_decodes_what_is_there() {
+    let file = std::fs::read(frames_pcapng()).unwrap();
+    let whole = records(&stdout(&run(&[
+        "decode",
+        frames_pcapng().to_str().unwrap(),
+    ])));
+    assert!(whole.len() >= 4, "{whole:?}");
+    let dir = Dir::new();
+    for cut in [file.len() - 1, file.len() - 20, file.len() / 2] {
+        let path = dir.path(&format!("cut-{cut}.pcapng"));
+        std::fs::write(&path, &file[..cut]).unwrap();
+        let o = run(&["decode", path.to_str().unwrap()]);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(!err.contains("panicked"), "{err}");
+        assert!(o.status.success(), "cut at {cut}: {err}");
+        assert!(err.contains("stopped at byte"), "cut at {cut}: {err}");
+        let got = records(&String::from_utf8(o.stdout).unwrap());
+        assert!(!got.is_empty() && got.len() <= whole.len(), "cut at {cut}");
+        assert_eq!(got[..], whole[..got.len()], "cut at {cut}");
+    }
+    for cut in [30, 45] {
+        let path = dir.path(&format!("cut-{cut}.pcapng"));
+        std::fs::write(&path, &file[..cut]).unwrap();
+        let o = run(&["decode", path.to_str().unwrap()]);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(1), "{err}");
+        assert!(!err.contains("panicked"), "{err}");
+        let lines: Vec<&str> = err.lines().collect();
+        assert_eq!(lines.len(), 2, "{err}");
+        assert!(lines[0].starts_with("hwfoc: warning: ") && lines[0].contains("stopped at byte"));
+        assert!(lines[1].ends_with(&format!(
+            "cut-{cut}.pcapng is empty: there is nothing to decode"
+        )));
+    }
+}
+
+/// GetEscID: a request ([0]) maps nothing; an answer [node, channel] renumbers its node's
+/// records from then on, whoever sends it.
+#[test]
+fn a_get_esc_id_answer_renumbers_its_node() {
+    let dir = Dir::new();
+    let mut text = String::new();
+    let mut t = 1_700_000_000.0;
+    let mut put = |f: &CanFrame| {
+        t += 0.01;
+        text.push_str(&line(t, f));
+    };
+    put(&frames(M1, 7, 0)[0]);
+    put(&frames(GetEscId::new(&[0]).unwrap(), 127, 0)[0]);
+    put(&frames(M1, 7, 1)[0]);
+    put(&frames(GetEscId::new(&[7, 4]).unwrap(), 7, 0)[0]);
+    put(&frames(M1, 7, 2)[0]);
+    let path = dir.path("ids.log");
+    std::fs::write(&path, &text).unwrap();
+    let got = records(&stdout(&run(&["decode", path.to_str().unwrap()])));
+    let escs: Vec<u64> = got.iter().map(|r| r["esc"].as_u64().unwrap()).collect();
+    assert_eq!(escs, [7, 7, 3]);
+    assert!(got.iter().all(|r| r["node"] == 7));
+}
