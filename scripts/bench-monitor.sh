@@ -8,7 +8,11 @@
 #   1. `hwfoc monitor --sim ESCS`: the virtual ESCs run inside the monitor process (their cost
 #      is included);
 #   2. `hwfoc monitor PTY...`: ESCS (default 16) virtual ESCs in a separate `hwfoc simulate --pty`
-#      process, read through pseudo-terminals as real serial ports are (one reader thread each).
+#      process, read through pseudo-terminals as real serial ports are (one reader thread each);
+#   3. `hwfoc monitor slcan:PTY`: a CAN bus of ESCS virtual Hobbywing DroneCAN ESCs at their
+#      message rates (StatusMsg1 and 2 at 50 Hz, StatusMsg3 at 10 Hz, NodeStatus at 1 Hz, at
+#      500 kbit/s) behind one SLCAN adapter (`hwfoc simulate --protocol hw-can --pty`), hwfoc
+#      asking them for their ids as a controller does.
 # Each run ends by itself (--duration) and prints its --stats line: CPU time of the monitor
 # process (user + system, from getrusage) as a share of one core, the redraws, and the delay
 # from bytes taken in to the redraw that shows them reaching the terminal. Needs tmux.
@@ -47,3 +51,9 @@ while [ "$(wc -l <"$work/ptys")" -lt "$escs" ]; do sleep 0.2; done
 ports=$(for i in $(seq 0 $((escs - 1))); do printf '%s ' "$work/escs/esc$i"; done)
 # shellcheck disable=SC2086
 run_in_tmux "$escs pseudo-terminals (ESCs in another process)" "$bin" monitor $ports
+kill "$sim" 2>/dev/null || true
+
+"$bin" simulate --protocol hw-can --escs "$escs" --pty >"$work/bus" &
+sim=$!
+until grep -q '^slcan: ' "$work/bus"; do sleep 0.2; done
+run_in_tmux "a CAN bus of $escs Hobbywing ESCs (SLCAN pty)" "$bin" monitor "slcan:$(sed -n 's/^slcan: //p' "$work/bus")"

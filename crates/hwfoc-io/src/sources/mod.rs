@@ -324,12 +324,15 @@ impl Sources {
         // one only if an ESC of its own was at its place 0.
         for esc in 0..self.escs.len() {
             let frames = self.link(esc).frames() > 0;
-            let escs = &mut self.read[self.escs[esc].input].escs;
+            // (An input whose reading failed has no entry.)
+            let Some(read) = self.read.get_mut(self.escs[esc].input) else {
+                continue;
+            };
             if self.escs[esc].hub.is_some() && frames {
-                escs.push(esc);
-                escs.sort_unstable();
+                read.escs.push(esc);
+                read.escs.sort_unstable();
             } else if self.escs[esc].stream.is_can() && !frames {
-                escs.retain(|&e| e != esc);
+                read.escs.retain(|&e| e != esc);
             }
         }
         result?;
