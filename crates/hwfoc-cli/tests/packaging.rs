@@ -171,6 +171,7 @@ fn man_pages_for_the_command_and_every_subcommand_render() {
     pages.extend(subcommands().iter().map(|s| format!("hwfoc-{s}.1")));
     // A subcommand's own subcommands have pages too.
     pages.extend(["install", "path", "print"].map(|s| format!("hwfoc-wireshark-{s}.1")));
+    pages.extend(["list", "set-id", "set", "self-test"].map(|s| format!("hwfoc-can-{s}.1")));
     let mut written: Vec<String> = std::fs::read_dir(&out_dir)
         .unwrap()
         .map(|e| e.unwrap().file_name().into_string().unwrap())
