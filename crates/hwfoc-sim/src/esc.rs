@@ -192,10 +192,7 @@ enum Other {
 impl VirtualEsc {
     /// An ESC at rest at time zero.
     pub fn new(setup: Setup) -> VirtualEsc {
-        let mut params = Rng::for_esc(setup.seed, setup.index, Purpose::Params);
-        let mut config = setup.model;
-        config.full_current_a *= setup.load;
-        let model = Model::new(&config, &mut params);
+        let (model, mut params) = Model::for_esc(setup.model, setup.load, setup.seed, setup.index);
         let packet = setup
             .start_packet
             .unwrap_or_else(|| params.below(1 << 16) as u16);

@@ -139,6 +139,16 @@ pub struct Model {
 }
 
 impl Model {
+    /// The model of ESC `index` of a run with `seed`: `config` with its full current scaled by
+    /// `load`, its tolerances drawn from the ESC's parameter stream, which is returned for the
+    /// ESC's other parameters (what every kind of virtual ESC starts from).
+    pub fn for_esc(config: ModelConfig, load: f64, seed: u64, index: usize) -> (Model, Rng) {
+        let mut params = Rng::for_esc(seed, index, crate::rng::Purpose::Params);
+        let mut config = config;
+        config.full_current_a *= load;
+        (Model::new(&config, &mut params), params)
+    }
+
     /// A model at rest (disarmed, motor stopped, at ambient temperature), with this ESC's
     /// tolerances drawn from `rng`.
     pub fn new(config: &ModelConfig, rng: &mut Rng) -> Model {

@@ -194,10 +194,7 @@ impl CanEsc {
     /// An ESC at rest at time zero; its first messages come at a random phase within their
     /// first interval, past [`QUIET_START_NS`].
     pub fn new(setup: CanSetup) -> CanEsc {
-        let mut params = Rng::for_esc(setup.seed, setup.index, Purpose::Params);
-        let mut config = setup.model;
-        config.full_current_a *= setup.load;
-        let model = Model::new(&config, &mut params);
+        let (model, mut params) = Model::for_esc(setup.model, setup.load, setup.seed, setup.index);
         let mut due_ns = [None; 4];
         for s in Stream::ALL {
             let interval = match s {
