@@ -416,8 +416,11 @@ fn a_candump_log_of_broken_transfers_and_foreign_frames_is_counted() {
         assert_eq!(c["error_frames"], 2, "{c}");
         assert_eq!(c["bus_frames"], 26, "{c}");
     }
-    // A candump log's CAN FD lines are not records of the bus's stream: told on standard error,
-    // once per interface, with their number.
+    // A candump log's CAN FD lines: counted by the bus's stream (not decoded), and told on
+    // standard error, once per interface, with their number.
+    for c in [&hw, &std] {
+        assert_eq!(c["bad_records"], 2, "{c}");
+    }
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(
         err.trim_end(),

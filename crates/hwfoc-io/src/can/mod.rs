@@ -6,7 +6,8 @@
 //! Above this module a CAN bus is carried as a stream of bytes like any port's: each frame as
 //! the 16 bytes of [`CanFrame::to_socketcan_record`](hwfoc::dronecan::CanFrame::to_socketcan_record)
 //! (pcapng's `LINKTYPE_CAN_SOCKETCAN` layout), every one of its bytes with the frame's receive
-//! time.
+//! time. A frame that is no classic CAN frame (CAN FD) is [`NOT_CLASSIC_RECORD`], so that the
+//! bus's link figures count it.
 
 mod ask;
 mod bus;
@@ -17,4 +18,13 @@ pub mod slcan;
 mod socketcan;
 
 pub use ask::{ASK_EVERY, ASK_PRIORITY, AskIds, DEFAULT_SOURCE_NODE};
+
+/// The record that stands for a frame that is no classic CAN frame (a CAN FD frame of a
+/// `candump` log or a pcapng): a length byte of 255, which no classic frame has, so that a
+/// bus's stream counts it (`CanLink::bad_records`) and decodes nothing of it.
+pub const NOT_CLASSIC_RECORD: [u8; hwfoc::dronecan::SOCKETCAN_RECORD_LEN] = {
+    let mut record = [0u8; hwfoc::dronecan::SOCKETCAN_RECORD_LEN];
+    record[4] = 255;
+    record
+};
 pub use bus::{CanBus, CanError, CanSpec, DEFAULT_BITRATE, SLCAN_BAUD, is_can_spec};

@@ -138,9 +138,13 @@ impl CandumpReader {
             };
             let (t_s, interface, frame) = parsed;
             let stream = self.stream(&interface);
-            let Logged::Classic(frame) = frame else {
-                self.not_classic[stream] += 1;
-                continue;
+            // A CAN FD frame: told once at the end, and counted by the bus's stream.
+            let record = match frame {
+                Logged::Classic(frame) => frame.to_socketcan_record(),
+                Logged::Fd => {
+                    self.not_classic[stream] += 1;
+                    crate::can::NOT_CLASSIC_RECORD
+                }
             };
             let i = *slot.entry(stream).or_insert_with(|| {
                 pending.push(Gathered {
@@ -151,7 +155,6 @@ impl CandumpReader {
                 pending.len() - 1
             });
             let g = &mut pending[i];
-            let record = frame.to_socketcan_record();
             let t_ns = (t_s * 1e9).round() as u64;
             byte_times(t_ns, 0.0, record.len(), &mut g.times);
             g.bytes.extend_from_slice(&record);
@@ -260,6 +263,7 @@ mod tests {
         let sink = std::sync::Arc::clone(&seen);
         input.set_notices(move |n| sink.lock().unwrap().push(n));
         let mut got = Vec::new();
+        let mut fd = 0;
         while let Some(b) = input.next_batch().unwrap() {
             let times = b.times.unwrap();
             assert_eq!(b.bytes.len() % 16, 0);
@@ -270,6 +274,11 @@ mod tests {
                         .iter()
                         .all(|&t| t == times[16 * k])
                 );
+                // A CAN FD line: the record that stands for one, counted by the stream.
+                if *record == crate::can::NOT_CLASSIC_RECORD {
+                    fd += 1;
+                    continue;
+                }
                 got.push((
                     b.stream,
                     times[16 * k],
@@ -283,6 +292,7 @@ mod tests {
             ("can0".into(), "vcan1".into())
         );
         assert!(input.is_can(0) && input.is_can(1) && !input.is_can(2));
+        assert_eq!(fd, 1);
         let frames: Vec<(usize, String)> = got.iter().map(|g| (g.0, g.2.to_string())).collect();
         assert_eq!(
             frames,
@@ -317,7 +327,8 @@ mod tests {
                 Err(e) => break e,
             }
         };
-        assert_eq!(frames, 3);
+        // Three frames and the record of a CAN FD frame.
+        assert_eq!(frames, 4);
         assert_eq!(
             e.to_string(),
             "bus.log:6: not a candump -l line: the frame is not ID#DATA"

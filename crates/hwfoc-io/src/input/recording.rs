@@ -135,7 +135,7 @@ impl RecordingReader {
                     }
                     None => {
                         *self.not_classic.entry(iface).or_default() += 1;
-                        data = &[];
+                        data = &crate::can::NOT_CLASSIC_RECORD;
                     }
                 }
             }

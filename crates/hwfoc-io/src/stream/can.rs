@@ -182,7 +182,8 @@ pub struct CanLink {
     pub bus: BusStats,
     /// Bytes of the bus's stream ([`SOCKETCAN_RECORD_LEN`] per frame).
     pub bytes: u64,
-    /// Records of the stream that were no classic CAN frame.
+    /// Records of the stream that were no classic CAN frame (CAN FD frames of a log or a
+    /// recording: [`crate::can::NOT_CLASSIC_RECORD`]).
     pub bad_records: u32,
 }
 
