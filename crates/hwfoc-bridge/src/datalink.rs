@@ -16,6 +16,13 @@
 //! The gap matters to receivers: ArduPilot's DataLink driver reads only when exactly one
 //! frame (160 bytes) is waiting, polling every 10 ms; frames sent back to back would be
 //! discarded. [`Pacing::default`] keeps at least 10 ms of silence between frames.
+//!
+//! # What a frame carries
+//!
+//! Every format: an HW-FOC frame as received, another format's frame as the HW-FOC frame a hub
+//! would have sent for it, its values converted back to HW-FOC's raw fields
+//! ([`hub_record`](crate::hub_record), which says how, and what a field is where the format does
+//! not carry its quantity).
 
 use std::collections::VecDeque;
 use std::io::Write;
@@ -24,6 +31,7 @@ use std::time::{Duration, Instant};
 use hwfoc::datalink;
 use hwfoc::foc::DataFrame;
 
+use crate::hub_record::hub_record;
 use crate::output::{Output, OutputError, OutputStats, Update};
 use crate::port::{PortOptions, ReopeningPort};
 
@@ -65,15 +73,16 @@ struct Slot {
     arrived: Instant,
 }
 
-/// DataLink V2 frames of up to eight ESCs (ESC `n` in channel `n`; ESCs past 7, and frames of a
-/// format other than HW-FOC, are not carried and are counted in
-/// [`DatalinkOutput::escs_not_carried`]).
+/// DataLink V2 frames of up to eight ESCs of any format (ESC `n` in channel `n`; ESCs past 7
+/// are not carried and are counted in [`DatalinkOutput::escs_not_carried`]).
 pub struct DatalinkOutput {
     name: String,
     line: Line,
     pacing: Pacing,
     slots: [VecDeque<Slot>; datalink::CHANNELS],
     counter: u16,
+    /// Each channel's packet counter, for formats without their own.
+    packets: [u16; datalink::CHANNELS],
     last_sent: Option<Instant>,
     not_carried: u64,
     stats: OutputStats,
@@ -110,14 +119,14 @@ impl DatalinkOutput {
             pacing,
             slots: Default::default(),
             counter: 0,
+            packets: [0; datalink::CHANNELS],
             last_sent: None,
             not_carried: 0,
             stats: OutputStats::default(),
         }
     }
 
-    /// Frames of ESCs numbered 8 or more, which a DataLink frame has no channel for, and of
-    /// formats other than HW-FOC (V4, V3, HW5), whose fields a hub record does not hold.
+    /// Frames of ESCs numbered 8 or more, which a DataLink frame has no channel for.
     pub fn escs_not_carried(&self) -> u64 {
         self.not_carried
     }
@@ -191,12 +200,10 @@ impl Output for DatalinkOutput {
             self.not_carried += 1;
             return;
         };
-        // A hub record is an HW-FOC frame: another format's frame, whose fields an HW-FOC frame
-        // does not hold as sent, is not carried.
-        let Some(frame) = update.frame.to_hwfoc() else {
-            self.not_carried += 1;
-            return;
-        };
+        // A hub record is an HW-FOC frame: another format's is converted to one.
+        let packet = self.packets[index];
+        self.packets[index] = packet.wrapping_add(1);
+        let frame = hub_record(update.frame, update.settings, packet);
         let queue = &mut self.slots[index];
         if queue.len() == QUEUE {
             queue.pop_front();

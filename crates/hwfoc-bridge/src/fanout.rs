@@ -72,6 +72,7 @@ impl Handler for Fanout {
             esc,
             frame,
             record: &record,
+            settings,
             arrived: self.arrived,
         };
         for output in &mut self.outputs {

@@ -13,6 +13,7 @@
 pub mod datalink;
 pub mod dronecan;
 pub mod fanout;
+pub mod hub_record;
 pub mod latency;
 pub mod mavlink;
 pub mod output;

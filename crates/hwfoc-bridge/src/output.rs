@@ -3,6 +3,7 @@
 use std::fmt;
 use std::time::{Duration, Instant};
 
+use hwfoc::Settings;
 use hwfoc::telemetry::Data;
 use hwfoc_io::Record;
 
@@ -22,6 +23,9 @@ pub struct Update<'a> {
     pub frame: &'a Data,
     /// The frame in physical units, under the bridge's settings.
     pub record: &'a Record,
+    /// The ESC's settings, under which `record` was converted (an output converting values
+    /// back to another protocol's raw fields takes these).
+    pub settings: &'a Settings,
     /// When the read that completed the frame returned: where the bridge's latency starts.
     pub arrived: Instant,
 }

@@ -56,6 +56,7 @@ fn update(out: &mut DatalinkOutput, esc: u8, packet: u16) {
         esc,
         frame: &Data::from(f),
         record: &record,
+        settings: &Settings::DEFAULT,
         arrived: Instant::now(),
     });
 }

@@ -92,6 +92,7 @@ fn update(out: &mut DronecanOutput, esc: u8, frame: &DataFrame, arrived: Instant
         esc,
         frame: &Data::from(*frame),
         record: &r,
+        settings: &Settings::DEFAULT,
         arrived,
     });
     r

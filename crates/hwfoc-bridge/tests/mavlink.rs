@@ -50,6 +50,7 @@ impl Rig {
             esc,
             frame: &Data::from(*frame),
             record: &record,
+            settings: &Settings::DEFAULT,
             arrived,
         });
         record
@@ -413,6 +414,7 @@ fn an_unreachable_destination_is_counted_and_survived() {
             esc: 0,
             frame: &Data::from(f),
             record: &record,
+            settings: &Settings::DEFAULT,
             arrived: at,
         });
         if let Err(e) = out.poll(at) {
@@ -446,6 +448,7 @@ fn an_unreachable_destination_is_counted_and_survived() {
         esc: 0,
         frame: &Data::from(f),
         record: &record,
+        settings: &Settings::DEFAULT,
         arrived: at,
     });
     out.poll(at).unwrap();
@@ -574,6 +577,7 @@ fn a_telemetry_log_has_each_message_after_the_time_of_its_data() {
                 esc,
                 frame: &Data::from(frame(k as u16, Status::OK)),
                 record: &record,
+                settings: &Settings::DEFAULT,
                 arrived,
             });
             out.poll(arrived + Duration::from_millis(3)).unwrap();
@@ -626,6 +630,7 @@ fn a_telemetry_log_has_each_message_after_the_time_of_its_data() {
         esc: 0,
         frame: &Data::from(frame(1, Status::OK)),
         record: &record,
+        settings: &Settings::DEFAULT,
         arrived: now,
     });
     out.poll(now).unwrap();
@@ -675,6 +680,7 @@ fn a_serial_port_carries_the_same_messages() {
             esc,
             frame: &Data::from(f),
             record: &record,
+            settings: &Settings::DEFAULT,
             arrived: now,
         });
         out.poll(Instant::now()).unwrap();

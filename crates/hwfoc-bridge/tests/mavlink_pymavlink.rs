@@ -172,6 +172,7 @@ fn pymavlink_decodes_every_message_with_the_records_values() {
                 esc: esc as u8,
                 frame: &Data::from(frame),
                 record: &record,
+                settings: &Settings::DEFAULT,
                 arrived: now,
             });
         }

@@ -414,3 +414,76 @@ fn the_monitor_shows_a_datalink_port_as_its_escs() {
         "an empty slot is not an ESC: {out}"
     );
 }
+
+/// A buffer the pump fills and the test reads.
+#[derive(Clone, Default)]
+struct Buffer(Arc<std::sync::Mutex<Vec<u8>>>);
+
+impl Write for Buffer {
+    fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
+        self.0.lock().unwrap().extend_from_slice(buf);
+        Ok(buf.len())
+    }
+    fn flush(&mut self) -> std::io::Result<()> {
+        Ok(())
+    }
+}
+
+#[test]
+fn a_candump_log_of_can_escs_goes_out_on_datalink_with_their_voltages_and_currents() {
+    let dir = Dir::new();
+    let log = dir.path("bus.log");
+    let log = log.to_string_lossy();
+    ok(run(hwfoc().args([
+        "simulate",
+        "--protocol",
+        "hw-can",
+        "--profile",
+        "sine",
+        "--escs",
+        "4",
+        "--duration",
+        "3",
+        "-o",
+        &log,
+    ])));
+    let line = pty();
+    let stop = Arc::new(AtomicBool::new(false));
+    let got = Buffer::default();
+    pump(
+        line.master.try_clone().unwrap(),
+        got.clone(),
+        Arc::clone(&stop),
+    );
+    let bridge = run(hwfoc().args(["bridge", &log, "--datalink", &line.path.to_string_lossy()]));
+    let report = String::from_utf8_lossy(&bridge.stderr).into_owned();
+    assert!(bridge.status.success(), "bridge failed: {report}");
+    thread::sleep(Duration::from_millis(300));
+    stop.store(true, Ordering::Relaxed);
+
+    let bytes = got.0.lock().unwrap().clone();
+    let mut decoder = datalink::Decoder::new();
+    let mut slots: Vec<Vec<DataFrame>> = vec![Vec::new(); datalink::CHANNELS];
+    decoder.decode_all(&bytes, |d| {
+        for (channel, slot) in d.frame.slots.iter().enumerate() {
+            slots[channel].extend(*slot);
+        }
+    });
+    assert_eq!(decoder.stats().bytes_skipped(), 0, "{report}");
+    let carried: Vec<usize> = (0..datalink::CHANNELS)
+        .filter(|&c| !slots[c].is_empty())
+        .collect();
+    assert_eq!(carried.len(), 4, "four ESCs, each in a channel: {report}");
+    for c in carried {
+        let frames = &slots[c];
+        assert!(frames.len() > 10, "channel {c}: {} frames", frames.len());
+        assert!(
+            frames.iter().any(|f| f.voltage_raw > 0),
+            "channel {c}: no voltage"
+        );
+        assert!(
+            frames.iter().any(|f| f.current_raw != 0),
+            "channel {c}: no current"
+        );
+    }
+}

@@ -70,6 +70,44 @@ impl Linear {
     pub fn to_f64(self, raw: f64) -> f64 {
         raw * f64::from(self.mul) / (f64::from(self.div) * f64::from(self.div2))
     }
+
+    /// The raw value whose conversion is nearest `value`: `value * div * div2 / mul` in `f64`,
+    /// rounded to the nearest integer (halves away from zero), the inverse of
+    /// [`Linear::to_f32`] for every raw integer. Not saturated: the caller's `as` cast to the
+    /// field's integer type saturates it to the type's range (and NaN to 0).
+    ///
+    /// ```
+    /// use hwfoc::units::Linear;
+    ///
+    /// assert_eq!(Linear::VOLTS.raw_of(24.66), 247.0);
+    /// assert_eq!(Linear::THROTTLE_PCT.raw_of(50.0), 512.0);
+    /// assert_eq!(Linear::VOLTS.raw_of(1e9) as u16, u16::MAX); // saturated by the cast
+    /// ```
+    #[inline]
+    pub fn raw_of(self, value: f32) -> f64 {
+        let raw =
+            f64::from(value) * f64::from(self.div) * f64::from(self.div2) / f64::from(self.mul);
+        round_half_away(raw)
+    }
+}
+
+/// `x` rounded to the nearest integer, halves away from zero (`f64::round`, which `core` lacks
+/// without `std`; the codec takes no `libm` for one function). NaN and infinities are returned
+/// as they are.
+fn round_half_away(x: f64) -> f64 {
+    // From 2^52 on every f64 is an integer; below, the truncation fits an i64.
+    if x.is_nan() || x.abs() >= 4_503_599_627_370_496.0 {
+        return x;
+    }
+    let whole = x as i64 as f64;
+    let frac = x - whole;
+    if frac >= 0.5 {
+        whole + 1.0
+    } else if frac <= -0.5 {
+        whole - 1.0
+    } else {
+        whole
+    }
 }
 
 /// A quantity a data frame may carry, with its name and unit in every output of the project
@@ -359,6 +397,12 @@ pub const ADC_MAX: u8 = ADC_TABLE[0];
 /// Lowest ADC code in the table (129 degC); lower codes are hotter than the table covers.
 pub const ADC_MIN: u8 = ADC_TABLE[129];
 
+/// The ADC code an HW-FOC frame carries for "no temperature": 255, above the table (what a
+/// disconnected sensor reads), which [`Temperature::from_adc`] gives no degC for.
+pub const ADC_NO_VALUE: u8 = u8::MAX;
+
+const _: () = assert!(ADC_NO_VALUE > ADC_MAX);
+
 /// Temperature for every code in `ADC_MIN..=ADC_MAX`, built at compile time (index = code).
 static CELSIUS: [f32; 256] = build_celsius();
 
@@ -434,6 +478,37 @@ impl Temperature {
         }
     }
 
+    /// The ADC code whose temperature is nearest `celsius`, the inverse of
+    /// [`Temperature::from_adc`] for every code in the table's range ([`ADC_MIN`]..=[`ADC_MAX`]):
+    /// saturated to that range (below 0 degC gives [`ADC_MAX`], above 129 degC [`ADC_MIN`]);
+    /// NaN gives [`ADC_NO_VALUE`].
+    ///
+    /// ```
+    /// use hwfoc::Temperature;
+    ///
+    /// assert_eq!(Temperature::adc_of(28.0), 206);
+    /// assert_eq!(Temperature::adc_of(15.4), 225); // 15.5 degC, between 226 and 224
+    /// assert_eq!(Temperature::adc_of(-40.0), 241); // saturated to 0 degC
+    /// assert_eq!(Temperature::adc_of(300.0), 33); // saturated to 129 degC
+    /// ```
+    pub fn adc_of(celsius: f32) -> u8 {
+        if celsius.is_nan() {
+            return ADC_NO_VALUE;
+        }
+        // The table's temperatures fall strictly as codes rise: the nearest is one of the two
+        // codes around `celsius`. (A linear scan of 209 codes: this runs once per frame.)
+        let mut best = ADC_MAX;
+        let mut best_gap = f32::INFINITY;
+        for code in ADC_MIN..=ADC_MAX {
+            let gap = (CELSIUS[code as usize] - celsius).abs();
+            if gap < best_gap {
+                best = code;
+                best_gap = gap;
+            }
+        }
+        best
+    }
+
     /// The reading in degC, or `None` when out of the table's range.
     pub fn celsius(self) -> Option<f32> {
         match self {
@@ -450,5 +525,106 @@ impl fmt::Display for Temperature {
             Temperature::BelowRange => f.write_str("below 0 degC (out of range)"),
             Temperature::AboveRange => f.write_str("above 129 degC (out of range)"),
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    extern crate std;
+
+    use super::*;
+
+    /// The linear conversions of the HW-FOC fields, and RPM under two settings.
+    fn conversions() -> [(&'static str, Linear); 8] {
+        let odd = Settings::new(100.0, 14, 2.5).unwrap();
+        [
+            ("throttle", Linear::THROTTLE_PCT),
+            ("erpm", Linear::ERPM),
+            ("volts", Linear::VOLTS),
+            ("identity", Linear::IDENTITY),
+            ("amps /64", Settings::DEFAULT.amps_linear()),
+            ("amps /100", odd.amps_linear()),
+            ("rpm", Settings::DEFAULT.rpm_linear()),
+            ("rpm 14 pp x2.5", odd.rpm_linear()),
+        ]
+    }
+
+    #[test]
+    fn round_half_away_is_std_round() {
+        for x in [
+            0.0,
+            0.49,
+            0.5,
+            1.5,
+            2.5,
+            -0.5,
+            -2.5,
+            -2.49,
+            1e300,
+            4503599627370495.5,
+        ] {
+            assert_eq!(round_half_away(x), x.round(), "{x}");
+            assert_eq!(round_half_away(-x), (-x).round(), "{}", -x);
+        }
+        assert!(round_half_away(f64::NAN).is_nan());
+        assert_eq!(round_half_away(f64::INFINITY), f64::INFINITY);
+    }
+
+    #[test]
+    fn raw_of_inverts_to_f32_for_every_raw_value() {
+        for (name, linear) in conversions() {
+            for raw in i32::from(i16::MIN)..=i32::from(u16::MAX) {
+                let value = linear.to_f32(raw as f32);
+                assert_eq!(linear.raw_of(value), f64::from(raw), "{name}: raw {raw}");
+            }
+        }
+    }
+
+    #[test]
+    fn to_f32_of_raw_of_is_within_half_a_step() {
+        for (name, linear) in conversions() {
+            let step = f64::from(linear.to_f32(1.0));
+            let (lo, hi) = (linear.to_f64(-32768.0), linear.to_f64(65535.0));
+            // 100 001 values over the range, none of them on a raw step.
+            for i in 0..=100_000 {
+                let x = (lo + (hi - lo) * (f64::from(i) + 0.37) / 100_001.0) as f32;
+                let back = f64::from(linear.to_f32(linear.raw_of(x) as f32));
+                let x = f64::from(x);
+                let error = (back - x).abs();
+                // Half a step, plus the rounding of the forward conversion's `f32` result.
+                let rounding = x.abs() * f64::from(f32::EPSILON);
+                assert!(error <= step / 2.0 + rounding, "{name}: {x} -> {back}");
+            }
+        }
+    }
+
+    #[test]
+    fn adc_of_inverts_from_adc_for_every_code_in_the_table() {
+        for code in ADC_MIN..=ADC_MAX {
+            let celsius = Temperature::from_adc(code).celsius().unwrap();
+            assert_eq!(Temperature::adc_of(celsius), code, "{celsius} degC");
+        }
+        assert_eq!(Temperature::adc_of(f32::NAN), ADC_NO_VALUE);
+        assert_eq!(Temperature::from_adc(ADC_NO_VALUE).celsius(), None);
+    }
+
+    #[test]
+    fn from_adc_of_adc_of_is_within_half_a_step() {
+        let t = |code: u8| Temperature::from_adc(code).celsius().unwrap();
+        for i in 0..12_900 {
+            let celsius = i as f32 / 100.0 + 0.003;
+            let code = Temperature::adc_of(celsius);
+            let error = (t(code) - celsius).abs();
+            // The step to the neighbouring code on the side of `celsius` (codes rise as it
+            // falls).
+            let step = if t(code) > celsius {
+                t(code) - t(code + 1)
+            } else {
+                t(code - 1) - t(code)
+            };
+            assert!(error <= step / 2.0 + 1e-4, "{celsius} degC -> {code}");
+        }
+        assert_eq!(Temperature::adc_of(-5.0), ADC_MAX);
+        assert_eq!(Temperature::adc_of(135.0), ADC_MIN);
     }
 }

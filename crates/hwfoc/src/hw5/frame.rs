@@ -107,6 +107,44 @@ crate::status::fault_flags!(
     7
 );
 
+impl Fault {
+    /// The HW-FOC status bit for the same fault, where one clearly is: motor locked is
+    /// [`motor_blocked`](crate::Fault::MotorBlocked), throttle not at zero at start-up
+    /// [`throttle_not_zeroed`](crate::Fault::ThrottleNotZeroed), throttle signal lost,
+    /// over-current, and low voltage [`input_voltage_low`](crate::Fault::InputVoltageLow).
+    /// `None` for over-temperature (HW-FOC tells a MOSFET from a capacitor overheat; HW5 does
+    /// not say which), input voltage error (too high or too low?) and motor connection error
+    /// (HW-FOC names open bridges and shorts, none clearly this).
+    pub const fn hwfoc(self) -> Option<crate::Fault> {
+        use crate::Fault as Foc;
+        match self {
+            Fault::MotorLocked => Some(Foc::MotorBlocked),
+            Fault::ThrottleNotZeroAtStart => Some(Foc::ThrottleNotZeroed),
+            Fault::ThrottleSignalLost => Some(Foc::ThrottleSignalLost),
+            Fault::OverCurrent => Some(Foc::OverCurrent),
+            Fault::LowVoltage => Some(Foc::InputVoltageLow),
+            Fault::OverTemperature | Fault::InputVoltageError | Fault::MotorConnectionError => None,
+        }
+    }
+}
+
+impl FaultCode {
+    /// The HW-FOC status word of the same faults ([`Fault::hwfoc`]); a fault without an HW-FOC
+    /// bit is left out.
+    ///
+    /// ```
+    /// use hwfoc::hw5::{Fault, FaultCode};
+    ///
+    /// let code = FaultCode::OK.with(Fault::LowVoltage).with(Fault::OverTemperature);
+    /// assert_eq!(code.hwfoc_status(), hwfoc::Status::OK.with(hwfoc::Fault::InputVoltageLow));
+    /// ```
+    pub fn hwfoc_status(self) -> Status {
+        self.faults()
+            .filter_map(Fault::hwfoc)
+            .fold(Status::OK, Status::with)
+    }
+}
+
 /// One HW5 telemetry frame (type 0x5C30), every field as the raw integer sent on the wire;
 /// physical values come from the conversion methods.
 ///
