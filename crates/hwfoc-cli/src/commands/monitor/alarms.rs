@@ -14,7 +14,17 @@
 
 use std::fmt;
 
-use hwfoc::Fault;
+use hwfoc::{Fault, Protocol};
+
+/// A fault bit of a protocol's fault word (HW-FOC's sixteen status bits, HW5's eight fault
+/// bits: [`Protocol::fault_name`]): the same bit means another fault in another protocol.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub struct FaultBit {
+    /// The protocol whose word it is.
+    pub protocol: Protocol,
+    /// The bit, 0 to 15.
+    pub bit: u8,
+}
 
 /// How bad an alarm is.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
@@ -44,8 +54,8 @@ impl fmt::Display for Level {
 /// What an alarm is about.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum Kind {
-    /// A status bit the ESC reports.
-    Fault(Fault),
+    /// A fault bit the ESC reports.
+    Fault(FaultBit),
     /// MOSFET temperature over a threshold.
     MosTemp,
     /// Capacitor temperature over a threshold.
@@ -59,11 +69,13 @@ pub enum Kind {
 }
 
 impl Kind {
-    /// The alarm's name in logs and JSON: a status bit's name as in docs/PROTOCOL-NOTES.md
-    /// (`mos_overheat`), or `mos_temp`, `cap_temp`, `low_voltage`, `stale`, `disconnected`.
+    /// The alarm's name in logs and JSON: a fault bit's name as its protocol names it
+    /// (HW-FOC's as in docs/PROTOCOL-NOTES.md, `mos_overheat`; HW5's as in
+    /// docs/HW5-AND-CAN.md, `motor_locked`), or `mos_temp`, `cap_temp`, `low_voltage`, `stale`,
+    /// `disconnected`.
     pub fn name(self) -> &'static str {
         match self {
-            Kind::Fault(fault) => fault.name(),
+            Kind::Fault(f) => f.protocol.fault_name(f.bit).unwrap_or("unknown_fault"),
             Kind::MosTemp => "mos_temp",
             Kind::CapTemp => "cap_temp",
             Kind::LowVoltage => "low_voltage",
@@ -72,17 +84,33 @@ impl Kind {
         }
     }
 
-    /// The level of a status-bit alarm: faults that damage hardware or stop the motor are
+    /// The level of a fault-bit alarm: faults that damage hardware or stop the motor are
     /// critical; voltage limits, throttle-signal problems and unassigned bits are warnings.
-    pub fn fault_level(fault: Fault) -> Level {
-        match fault {
-            Fault::InputVoltageHigh
-            | Fault::InputVoltageLow
-            | Fault::Reserved3
-            | Fault::ThrottleSignalLost
-            | Fault::ThrottleNotZeroed
-            | Fault::Reserved15 => Level::Warning,
-            _ => Level::Critical,
+    pub fn fault_level(f: FaultBit) -> Level {
+        use hwfoc::hw5::Fault as Hw5;
+        match f.protocol {
+            Protocol::Hw5 => match Hw5::from_bit(f.bit) {
+                Some(
+                    Hw5::ThrottleNotZeroAtStart
+                    | Hw5::ThrottleSignalLost
+                    | Hw5::LowVoltage
+                    | Hw5::InputVoltageError,
+                )
+                | None => Level::Warning,
+                Some(_) => Level::Critical,
+            },
+            _ => match Fault::from_bit(f.bit) {
+                Some(
+                    Fault::InputVoltageHigh
+                    | Fault::InputVoltageLow
+                    | Fault::Reserved3
+                    | Fault::ThrottleSignalLost
+                    | Fault::ThrottleNotZeroed
+                    | Fault::Reserved15,
+                )
+                | None => Level::Warning,
+                Some(_) => Level::Critical,
+            },
         }
     }
 }
@@ -467,8 +495,24 @@ mod tests {
 
     #[test]
     fn fault_levels() {
-        assert_eq!(Kind::fault_level(Fault::MosOverheat), Level::Critical);
-        assert_eq!(Kind::fault_level(Fault::ThrottleSignalLost), Level::Warning);
-        assert_eq!(Kind::Fault(Fault::MosOverheat).name(), "mos_overheat");
+        let foc = |f: Fault| FaultBit {
+            protocol: Protocol::HwFoc,
+            bit: f.bit(),
+        };
+        assert_eq!(Kind::fault_level(foc(Fault::MosOverheat)), Level::Critical);
+        assert_eq!(
+            Kind::fault_level(foc(Fault::ThrottleSignalLost)),
+            Level::Warning
+        );
+        assert_eq!(Kind::Fault(foc(Fault::MosOverheat)).name(), "mos_overheat");
+        // HW5's bits are HW5's faults: bit 5 is its low voltage (a warning), not HW-FOC's.
+        let hw5 = |bit| FaultBit {
+            protocol: Protocol::Hw5,
+            bit,
+        };
+        assert_eq!(Kind::Fault(hw5(5)).name(), "low_voltage");
+        assert_eq!(Kind::fault_level(hw5(5)), Level::Warning);
+        assert_eq!(Kind::Fault(hw5(0)).name(), "motor_locked");
+        assert_eq!(Kind::fault_level(hw5(0)), Level::Critical);
     }
 }

@@ -4,11 +4,11 @@
 
 use std::collections::{HashMap, VecDeque};
 
+use hwfoc::Settings;
 use hwfoc::telemetry::Info;
-use hwfoc::{Fault, Settings};
 use hwfoc_io::{EscLink, WireKind};
 
-use super::alarms::{Change, Kind, Latch, Level, Threshold};
+use super::alarms::{Change, FaultBit, Kind, Latch, Level, Threshold};
 use super::config::Limits;
 use crate::shown::{self, Shown, Values};
 use hwfoc_io::Handler;
@@ -120,8 +120,11 @@ pub enum Link {
 /// The alarms of one ESC.
 #[derive(Debug, Clone, Default)]
 pub struct Alarms {
-    /// One per status bit, in bit order.
+    /// One per bit of the fault word, in bit order.
     pub faults: [Latch; 16],
+    /// The protocol whose fault word those bits are (that of the last record; HW-FOC's
+    /// before one).
+    pub protocol: Option<hwfoc::Protocol>,
     /// MOSFET temperature.
     pub mos: Latch,
     /// Capacitor temperature.
@@ -138,7 +141,7 @@ impl Alarms {
     /// The latch of `kind`.
     pub fn latch(&self, kind: Kind) -> &Latch {
         match kind {
-            Kind::Fault(f) => &self.faults[usize::from(f.bit())],
+            Kind::Fault(f) => &self.faults[usize::from(f.bit) % 16],
             Kind::MosTemp => &self.mos,
             Kind::CapTemp => &self.cap,
             Kind::LowVoltage => &self.voltage,
@@ -149,9 +152,9 @@ impl Alarms {
 
     /// The active alarms, worst first.
     pub fn active(&self) -> Vec<(Kind, Level)> {
-        let mut all: Vec<(Kind, Level)> = Fault::ALL
-            .iter()
-            .map(|&f| Kind::Fault(f))
+        let protocol = self.protocol.unwrap_or(hwfoc::Protocol::HwFoc);
+        let mut all: Vec<(Kind, Level)> = (0..16u8)
+            .map(|bit| Kind::Fault(FaultBit { protocol, bit }))
             .chain([
                 Kind::Disconnected,
                 Kind::Stale,
@@ -682,10 +685,17 @@ impl Fleet {
             a.stale.set(false, Level::Warning, 0.0, t),
             None,
         ));
-        for fault in Fault::ALL {
-            // A word of fault bits only (a Hobbywing CAN ESC's status is not one).
-            let on = r.fault_word().is_some_and(|s| s.contains(fault));
-            let latch = &mut a.faults[usize::from(fault.bit())];
+        // The bits of the record's fault word, named by its protocol (a Hobbywing CAN ESC's
+        // status is no fault word).
+        a.protocol = Some(r.protocol);
+        let word = r.fault_word().unwrap_or_default();
+        for bit in 0..16u8 {
+            let fault = FaultBit {
+                protocol: r.protocol,
+                bit,
+            };
+            let on = word.0 & (1 << bit) != 0;
+            let latch = &mut a.faults[usize::from(bit)];
             if on || latch.level().is_some() {
                 let change = latch.set(on, Kind::fault_level(fault), limits.fault_hold_s, t);
                 changes.push((Kind::Fault(fault), change, None));
@@ -875,7 +885,7 @@ mod tests {
     fn a_fault_bit_is_logged_once_by_name_and_clears_after_the_hold() {
         let mut f = fleet(1);
         let cool = hwfoc::units::ADC_TABLE[40];
-        let hot = Status::OK.with(Fault::MosOverheat);
+        let hot = Status::OK.with(hwfoc::Fault::MosOverheat);
         for k in 0..60u16 {
             let t = 1000.0 + f64::from(k) * 0.05;
             // On for frames 10..30, flickering off on every third.
