@@ -9,9 +9,7 @@
 //! number of its own (`esc_numbers.rs`).
 
 use hwfoc::Protocol;
-use hwfoc::dronecan::{
-    BusStats, CanFrame, Escs, LinkStats, NodeStats, Receiver, SOCKETCAN_RECORD_LEN,
-};
+use hwfoc::dronecan::{BusStats, CanFrame, Escs, NodeStats, Receiver, SOCKETCAN_RECORD_LEN};
 #[cfg(test)]
 use hwfoc::telemetry::Data;
 use hwfoc::telemetry::Frame;
@@ -133,16 +131,6 @@ impl CanWire {
     /// Bytes held of a record still arriving.
     pub(crate) fn buffered(&self) -> usize {
         self.held_len
-    }
-
-    /// The bus's and its nodes' statistics.
-    pub(crate) fn stats(&self) -> &LinkStats {
-        self.rx.stats()
-    }
-
-    /// Which ESCs the bus knows (GetEscID answers) and whether any turns.
-    pub(crate) fn escs(&self) -> &Escs {
-        &self.escs
     }
 
     /// The link of the ESC at `place` on the bus.

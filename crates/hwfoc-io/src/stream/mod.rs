@@ -598,22 +598,6 @@ impl Stream {
         matches!(self.wire, Wire::Can(_))
     }
 
-    /// The ESCs a CAN bus's stream knows (GetEscID answers, whether any turns).
-    pub fn can_escs(&self) -> Option<&hwfoc::dronecan::Escs> {
-        match &self.wire {
-            Wire::Can(c) => Some(c.escs()),
-            _ => None,
-        }
-    }
-
-    /// A CAN bus's statistics, per node and of the bus.
-    pub fn can_stats(&self) -> Option<&hwfoc::dronecan::LinkStats> {
-        match &self.wire {
-            Wire::Can(c) => Some(c.stats()),
-            _ => None,
-        }
-    }
-
     /// The protocol the stream was made to read only, if any.
     pub fn forced_protocol(&self) -> Option<Protocol> {
         self.wire.forced()
