@@ -3,7 +3,7 @@
 //! A line is a timestamp in parentheses (Unix seconds and a fraction), an interface name and a
 //! frame in candump's compact form ([`CanFrame`]'s `Display`): 3 hex digits of a standard id
 //! or 8 of an extended one (with SocketCAN's flags: an error frame's id has
-//! [`SOCKETCAN_ERR_FLAG`](hwfoc::dronecan::SOCKETCAN_ERR_FLAG)), `#`, the data in hex (can-utils'
+//! [`SOCKETCAN_ERR_FLAG`]), `#`, the data in hex (can-utils'
 //! `parse_canframe` also takes `.` between bytes), or `R` and an optional length for a remote
 //! frame. A CAN FD frame (`123##1...`) is read as [`Logged::Fd`]: not classic CAN, counted by
 //! the caller, not an error. Newer candump may end a line with ` T` or ` R` (sent or received):

@@ -278,7 +278,8 @@ fn age_ms(now: Option<u64>, then: Option<u64>) -> Option<u32> {
     Some(u32::try_from(ms).unwrap_or(u32::MAX))
 }
 
-/// The ESCs of one DroneCAN bus (see the [module](self)). No allocation; about 4 KiB.
+/// The ESCs of one DroneCAN bus: which node is which ESC, and a record per status message with
+/// its node's slower messages and their ages ([`Escs::push`]). No allocation; about 4 KiB.
 #[derive(Debug, Clone)]
 pub struct Escs {
     nodes: [Node; NODES],

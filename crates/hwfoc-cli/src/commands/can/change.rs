@@ -46,7 +46,7 @@ pub struct SetArgs {
     /// Where the throttle comes from: can or pwm (SetThrottleSource).
     #[arg(long, value_name = "can|pwm", group = "changes")]
     throttle_source: Option<ThrottleSource>,
-    /// LED: COLOR[,BLINK][,save]; COLOR off, blue, green, cyan, red, magenta, yellow, white;
+    /// LED: `COLOR[,BLINK][,save]`; COLOR off, blue, green, cyan, red, magenta, yellow, white;
     /// BLINK 0 (steady), 1, 2 or 5 Hz; save to keep it (SetLED).
     #[arg(long, value_name = "COLOR[,BLINK][,save]", group = "changes")]
     led: Option<Led>,

@@ -51,7 +51,7 @@ enum CanCommand {
 /// The bus and how hwfoc speaks on it: every subcommand's.
 #[derive(Debug, Args)]
 struct BusArgs {
-    /// The CAN bus: slcan:PORT[:BITRATE] (an SLCAN adapter such as a CANable; 500k, the ESCs'
+    /// The CAN bus: `slcan:PORT[:BITRATE]` (an SLCAN adapter such as a CANable; 500k, the ESCs'
     /// factory rate, unless given) or can:IFACE (a SocketCAN interface, Linux).
     #[arg(value_name = "BUS")]
     bus: String,

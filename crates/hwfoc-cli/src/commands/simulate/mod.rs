@@ -90,7 +90,7 @@ pub struct SimulateArgs {
     #[arg(long)]
     factory: bool,
     /// hw-can, a log or pcapng: no virtual controller asking the ESCs for their ids (by
-    /// default node 127 sends GetEscID [0] at the start and once a second while no ESC turns,
+    /// default node 127 sends GetEscID `[0]` at the start and once a second while no ESC turns,
     /// as ArduPilot does, and the ESCs answer).
     #[arg(long)]
     no_ask_ids: bool,

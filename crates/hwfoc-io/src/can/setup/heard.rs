@@ -62,7 +62,7 @@ impl NodeHeard {
 
     /// How many ESCs answer as this node, at least: the most GetEscID answers to one request,
     /// or 2 when its StatusMsg1 transfer ids interleave (at least a quarter out of sequence
-    /// after [`JUDGED_AFTER`]), else 1.
+    /// after the first 8), else 1.
     pub fn escs(&self) -> usize {
         let interleaved =
             self.status1_count >= JUDGED_AFTER && self.out_of_sequence * 4 >= self.status1_count;
