@@ -42,10 +42,15 @@ SCHEMA = [
     ("bec_current_a", pa.float32(), True, "A"),
     ("status", pa.uint16(), True, "-"),
     ("faults", pa.list_(pa.field("item", pa.string(), nullable=False)), True, "-"),
+    ("node", pa.uint8(), True, "-"),
+    ("msg2_age_ms", pa.uint32(), True, "ms"),
+    ("msg3_age_ms", pa.uint32(), True, "ms"),
 ]
 
-# Columns of record schema 2 that HW-FOC (the demo capture) does not carry: null in every row.
-NOT_CARRIED = ["motor_temp_c", "bec_temp_c", "bec_voltage_v", "bec_current_a"]
+# Columns of record schemas 2 and 3 that HW-FOC (the demo capture) does not carry: null in every
+# row.
+NOT_CARRIED = ["motor_temp_c", "bec_temp_c", "bec_voltage_v", "bec_current_a", "node", "msg2_age_ms",
+               "msg3_age_ms"]
 
 SETTINGS = {"current_scale": "100", "pole_pairs": "14", "gear_ratio": "2.5"}
 
