@@ -48,12 +48,13 @@ FLOAT32 = {"throttle_in_pct", "throttle_out_pct", "rpm", "voltage_v", "current_a
            "phase_current_a", "mos_temp_c", "cap_temp_c", "motor_temp_c", "bec_temp_c",
            "bec_voltage_v", "bec_current_a"}
 
-# Leaf columns of record schema 2 (faults: its one leaf).
-COLUMNS = 19
+# Leaf columns of record schema 3 (faults: its one leaf).
+COLUMNS = 22
 
-# Columns no protocol read today carries (record schema 2): null in every row, so a row group
-# has a null count and no minimum or maximum.
-NOT_CARRIED = {"motor_temp_c", "bec_temp_c", "bec_voltage_v", "bec_current_a"}
+# Columns the decoded file (HW-FOC ESCs) does not carry (record schemas 2 and 3): null in every
+# row, so a row group has a null count and no minimum or maximum.
+NOT_CARRIED = {"motor_temp_c", "bec_temp_c", "bec_voltage_v", "bec_current_a", "node", "msg2_age_ms",
+               "msg3_age_ms"}
 
 
 def f32(x):
