@@ -154,6 +154,13 @@ pub enum CanSpec {
     },
 }
 
+/// The longest network interface name plus its NUL: Linux's `IFNAMSIZ` (SocketCAN is
+/// Linux's; elsewhere `can:` names are checked alike, then refused when opened).
+#[cfg(target_os = "linux")]
+const IFNAMSIZ: usize = libc::IFNAMSIZ;
+#[cfg(not(target_os = "linux"))]
+const IFNAMSIZ: usize = 16;
+
 impl CanSpec {
     /// Parses `slcan:PORT[:BITRATE]` (BITRATE in bit/s, or with `k` or `M`: `500k`, `1M`;
     /// default [`DEFAULT_BITRATE`]) or `can:IFACE`.
@@ -163,8 +170,7 @@ impl CanSpec {
             reason,
         };
         if let Some(interface) = spec.strip_prefix("can:") {
-            if interface.is_empty() || interface.len() >= libc::IFNAMSIZ || interface.contains('\0')
-            {
+            if interface.is_empty() || interface.len() >= IFNAMSIZ || interface.contains('\0') {
                 return Err(err("expected can:IFACE, a network interface name".into()));
             }
             return Ok(CanSpec::SocketCan {

@@ -20,11 +20,15 @@ use hwfoc_io::pcapng;
 use hwfoc_io::write::WriteError;
 
 use super::bus::{CanBus, Sent};
-use super::slcan::{self, Action, Adapter};
+use super::slcan::Adapter;
+#[cfg(unix)]
+use super::slcan::{self, Action};
 use crate::error::SimError;
 #[cfg(unix)]
 use crate::pty::{self, PtyLinks};
-use crate::session::{PTY_LINGER, TAIL_S};
+#[cfg(unix)]
+use crate::session::PTY_LINGER;
+use crate::session::TAIL_S;
 use crate::sink;
 
 /// The interface name in candump lines.
@@ -194,8 +198,9 @@ impl CanSession {
         let start = Instant::now();
         let mut adapter = Adapter::new();
         let mut t_ns = 0u64;
-        let mut reply = Vec::new();
-        let mut actions = Vec::new();
+        // What the pty's controller sends and is answered (a pty is Unix's).
+        #[cfg(unix)]
+        let (mut reply, mut actions) = (Vec::new(), Vec::new());
         let mut lines = Vec::new();
         let mut asker = self.ask_ids.then(|| AskIds::new(DEFAULT_SOURCE_NODE));
         while !stop.load(Ordering::Relaxed) {
