@@ -65,6 +65,18 @@ pub enum Notice {
         /// How many were skipped.
         frames: u64,
     },
+    /// Records of a CAN bus whose protocol is not the one forced, left out: told once per bus,
+    /// with their number by protocol, at the end of the input.
+    LeftOut {
+        /// The input as named.
+        input: String,
+        /// The interface (bus).
+        interface: String,
+        /// The protocol forced.
+        forced: hwfoc::Protocol,
+        /// The records left out, by protocol.
+        records: Vec<(hwfoc::Protocol, u64)>,
+    },
     /// A damaged place in a recording, skipped.
     Damage {
         /// The input as named.
@@ -120,6 +132,7 @@ impl Notice {
             Notice::PortLost { .. }
                 | Notice::ForeignInterface { .. }
                 | Notice::NotClassicCan { .. }
+                | Notice::LeftOut { .. }
                 | Notice::Damage { .. }
                 | Notice::Overlap { .. }
         )
@@ -186,6 +199,24 @@ impl fmt::Display for Notice {
                 Escaped(input),
                 Escaped(interface)
             ),
+            Notice::LeftOut {
+                input,
+                interface,
+                forced,
+                records,
+            } => {
+                let counts: Vec<String> = records
+                    .iter()
+                    .map(|(p, n)| format!("{n} {} records", p.name()))
+                    .collect();
+                write!(
+                    f,
+                    "{}: {}: {} left out (not {forced}, the protocol forced)",
+                    Escaped(input),
+                    Escaped(interface),
+                    counts.join(" and ")
+                )
+            }
             Notice::Damage { input, damage } => write!(f, "{}: {damage}", Escaped(input)),
             Notice::Overlap {
                 input,
@@ -269,6 +300,20 @@ mod tests {
             baud: 115_200,
             protocol: hwfoc::Protocol::Hw5,
         };
+        let left_out = Notice::LeftOut {
+            input: "bus.log".into(),
+            interface: "can0".into(),
+            forced: hwfoc::Protocol::Hw5,
+            records: vec![
+                (hwfoc::Protocol::HwCan, 39),
+                (hwfoc::Protocol::DroneCan, 19),
+            ],
+        };
+        assert_eq!(
+            left_out.line(),
+            "hwfoc: warning: bus.log: can0: 39 hw-can records and 19 dronecan records left out \
+             (not hw5, the protocol forced)"
+        );
         let found = Notice::of_port_event(&event, &names).unwrap();
         assert_eq!(
             found.line(),

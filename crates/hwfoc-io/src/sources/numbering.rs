@@ -113,9 +113,9 @@ impl Sources {
                 if recorded {
                     self.ports.insert(name.clone(), self.escs.len());
                 }
-                // A CAN bus's stream reads CAN frames, whatever `--protocol` says.
+                // A CAN bus's stream reads CAN frames, keeping the forced protocol's records.
                 let stream = if input.is_can(stream) {
-                    Stream::can()
+                    Stream::can_forced(self.forced)
                 } else {
                     Stream::forced(self.forced)
                 };

@@ -11,9 +11,10 @@ use hwfoc::{Protocol, Settings, foc};
 use hwfoc::{datalink, detect, hw5, mixed, v3, v4};
 
 mod can;
+mod forced;
 
 pub use self::can::CanLink;
-use self::can::CanWire;
+use self::forced::{Bus, Probe};
 use crate::clock::byte_times;
 use crate::esc_numbers::{UNNUMBERED, channel_number};
 use crate::handler::Handler;
@@ -140,8 +141,12 @@ enum Wire {
     HwV3(v3::Decoder),
     /// HW5 only.
     Hw5(hw5::Decoder),
-    /// A CAN bus (`can.rs`): its own stream, whatever `--protocol` says.
-    Can(Box<CanWire>),
+    /// A CAN bus (`can.rs`), its records of the protocol forced only when one is
+    /// (`forced.rs`).
+    Can(Box<Bus>),
+    /// A serial line forced to read a CAN protocol: nothing decodes, every byte is passed
+    /// over (skipped).
+    NotCan(foc::Decoder, Protocol),
 }
 
 impl Wire {
@@ -153,7 +158,9 @@ impl Wire {
             Some(Protocol::HwV4) => Wire::HwV4(v4::Decoder::new()),
             Some(Protocol::HwV3) => Wire::HwV3(v3::Decoder::new()),
             Some(Protocol::Hw5) => Wire::Hw5(hw5::Decoder::new()),
-            Some(Protocol::HwCan | Protocol::DroneCan) => Wire::Can(Box::new(CanWire::new())),
+            Some(p @ (Protocol::HwCan | Protocol::DroneCan)) => {
+                Wire::NotCan(foc::Decoder::new(), p)
+            }
         }
     }
 
@@ -198,9 +205,10 @@ impl Wire {
             ),
             Wire::HwV4(_) | Wire::HwV3(_) | Wire::Hw5(_) => self.feed_slow(data, silence_s, emit),
             Wire::Can(c) => {
-                let at = c.bytes();
+                let at = c.wire.bytes();
                 c.feed(data, None, &mut |_, place, f| emit(place, at, f));
             }
+            Wire::NotCan(d, _) => d.pass_over(data.len() as u64),
         }
     }
 
@@ -234,7 +242,8 @@ impl Wire {
                 d.flush(|d| emit_any(detect::Decoded::Mixed(mixed::Decoded::Hub(d)), emit))
             }
             Wire::HwV4(_) | Wire::HwV3(_) | Wire::Hw5(_) => self.flush_slow(emit),
-            Wire::Can(c) => c.finish(),
+            Wire::Can(c) => c.wire.finish(),
+            Wire::NotCan(..) => {}
         }
     }
 
@@ -257,7 +266,8 @@ impl Wire {
             Wire::HwV4(d) => d.stats().bytes(),
             Wire::HwV3(d) => d.stats().bytes(),
             Wire::Hw5(d) => d.stats().bytes(),
-            Wire::Can(c) => c.bytes(),
+            Wire::Can(c) => c.wire.bytes(),
+            Wire::NotCan(d, _) => d.stats().bytes(),
         }
     }
 
@@ -270,7 +280,8 @@ impl Wire {
             Wire::HwV4(d) => d.buffered(),
             Wire::HwV3(d) => d.buffered(),
             Wire::Hw5(d) => d.buffered(),
-            Wire::Can(c) => c.buffered(),
+            Wire::Can(c) => c.wire.buffered(),
+            Wire::NotCan(d, _) => d.buffered(),
         }
     }
 
@@ -278,7 +289,7 @@ impl Wire {
     fn esc(&self) -> Option<&foc::Stats> {
         match self {
             Wire::Any(d) => Some(&d.mixed_stats().esc),
-            Wire::HwFoc(d) => Some(d.stats()),
+            Wire::HwFoc(d) | Wire::NotCan(d, _) => Some(d.stats()),
             _ => None,
         }
     }
@@ -306,7 +317,7 @@ impl Wire {
             Wire::HwV3(d) => Some(EscLink::HwV3(*d.stats())),
             Wire::Hw5(d) => Some(EscLink::Hw5(*d.stats())),
             Wire::Can(c) => Some(EscLink::Can(c.link(0))),
-            Wire::HwFoc(_) | Wire::DataLink(_) => None,
+            Wire::HwFoc(_) | Wire::DataLink(_) | Wire::NotCan(..) => None,
         }
     }
 
@@ -319,7 +330,8 @@ impl Wire {
             Wire::HwV4(_) => Some(Protocol::HwV4),
             Wire::HwV3(_) => Some(Protocol::HwV3),
             Wire::Hw5(_) => Some(Protocol::Hw5),
-            Wire::Can(_) => None,
+            Wire::Can(c) => c.forced(),
+            Wire::NotCan(_, p) => Some(*p),
         }
     }
 }
@@ -567,6 +579,8 @@ pub struct Stream {
     wire: Wire,
     /// Receive times of the last bytes of earlier batches, oldest first.
     history: Vec<f64>,
+    /// Of a serial stream forced to read one protocol: every format read over its first bytes.
+    probe: Option<Box<Probe>>,
 }
 
 impl Stream {
@@ -577,20 +591,50 @@ impl Stream {
 
     /// A stream with nothing decoded yet, reading protocol `forced` only (every protocol when
     /// `None`).
+    ///
+    /// A CAN protocol forced on a serial stream decodes nothing (its bytes are not CAN
+    /// frames): every byte is skipped. A forced stream also reads its first bytes as every
+    /// format ([`Stream::found_instead`]).
     pub fn forced(forced: Option<Protocol>) -> Stream {
         Stream {
             wire: Wire::new(forced),
             history: Vec::new(),
+            probe: forced.map(|_| Box::default()),
         }
     }
 
     /// A CAN bus's stream (CAN frames as `LINKTYPE_CAN_SOCKETCAN` records: `can.rs`), nothing
     /// decoded yet.
     pub fn can() -> Stream {
+        Stream::can_forced(None)
+    }
+
+    /// A CAN bus's stream keeping the records of protocol `forced` only (every record when
+    /// `None`): the others, and every record when a serial protocol is forced, are left out
+    /// and counted ([`Stream::left_out`]).
+    pub fn can_forced(forced: Option<Protocol>) -> Stream {
         Stream {
-            wire: Wire::Can(Box::new(CanWire::new())),
+            wire: Wire::Can(Box::new(Bus::new(forced))),
             history: Vec::new(),
+            probe: None,
         }
+    }
+
+    /// Of a CAN bus's stream read with a protocol forced: the records of other protocols left
+    /// out, by protocol (those of which some were).
+    pub fn left_out(&self) -> Vec<(Protocol, u64)> {
+        match &self.wire {
+            Wire::Can(c) => c.left_out(),
+            _ => Vec::new(),
+        }
+    }
+
+    /// Of a serial stream forced to read one protocol: the protocol of the first frame found
+    /// in its first bytes read as every format (64 KiB), when it is not the one forced. What
+    /// to tell a user whose forced protocol found nothing.
+    pub fn found_instead(&self) -> Option<Protocol> {
+        let found = self.probe.as_ref()?.found()?;
+        (Some(found) != self.forced_protocol()).then_some(found)
     }
 
     /// Whether the stream is a CAN bus's.
@@ -613,6 +657,9 @@ impl Stream {
     ) {
         if let Wire::Can(c) = &mut self.wire {
             return c.feed(batch.bytes, batch.times, &mut on_frame);
+        }
+        if let Some(probe) = &mut self.probe {
+            probe.feed(batch.bytes);
         }
         let start = self.wire.bytes();
         match batch.times {
@@ -665,6 +712,9 @@ impl Stream {
         on_frame: impl FnMut(Option<u8>, u64, &Frame),
     ) {
         self.history.clear();
+        if let Some(probe) = &mut self.probe {
+            probe.feed(bytes);
+        }
         self.wire.feed(bytes, None, on_frame);
     }
 
@@ -932,11 +982,16 @@ impl PortStreams {
         Some(stream.stats())
     }
 
-    /// Makes every port's stream read protocol `protocol` only (see [`Stream::forced`]); what
-    /// the streams decoded before is forgotten, so call it before the first event.
+    /// Makes every port's stream read protocol `protocol` only (see [`Stream::forced`]; a
+    /// CAN bus's keeps the records of `protocol` only, [`Stream::can_forced`]); what the
+    /// streams decoded before is forgotten, so call it before the first event.
     pub fn force_protocol(&mut self, protocol: Protocol) {
-        for stream in self.streams.iter_mut().filter(|s| !s.is_can()) {
-            *stream = Stream::forced(Some(protocol));
+        for stream in self.streams.iter_mut() {
+            *stream = if stream.is_can() {
+                Stream::can_forced(Some(protocol))
+            } else {
+                Stream::forced(Some(protocol))
+            };
         }
     }
 

@@ -62,14 +62,34 @@ pub static NO_FRAMES: std::sync::LazyLock<String> = std::sync::LazyLock::new(|| 
         .to_string()
 });
 
-/// What to tell a user whose wire gave bytes but no frame of `protocol`: its baud rate and the
-/// wiring.
-pub fn no_frames_of(protocol: Protocol) -> String {
-    format!(
-        "no valid {} frames: check the baud rate ({}) and the wiring",
-        protocol.title(),
-        protocol.baud_rate()
-    )
+/// What to tell a user whose wire gave bytes but no frame of `protocol`, forced: the protocol
+/// the bytes are of when they were found to be another's (`found`), else its baud rate and the
+/// wiring; of a CAN protocol, that the bytes are no CAN frames.
+pub fn no_frames_of(protocol: Protocol, found: Option<Protocol>) -> String {
+    let instead = found.map(|p| {
+        let name = p.name();
+        format!("{name} frames (try --protocol {name}, or leave --protocol out)")
+    });
+    match instead {
+        Some(instead) if protocol.is_can() => format!(
+            "no {} records: these bytes are not CAN frames but {instead}",
+            protocol.title()
+        ),
+        None if protocol.is_can() => format!(
+            "no {} records: these bytes are not CAN frames (read a candump log, a CAN \
+             recording or a slcan:/can: bus)",
+            protocol.title()
+        ),
+        Some(instead) => format!(
+            "no valid {} frames: these bytes are {instead}",
+            protocol.title()
+        ),
+        None => format!(
+            "no valid {} frames: check the baud rate ({}) and the wiring",
+            protocol.title(),
+            protocol.baud_rate()
+        ),
+    }
 }
 
 /// Why ESC `esc`'s bytes gave no frame, as every output says it: what its input looks like
@@ -88,9 +108,37 @@ pub fn no_frames(sources: &Sources, esc: usize) -> String {
         return looks.to_string();
     }
     if let Some(protocol) = sources.forced_protocol() {
-        return no_frames_of(protocol);
+        let stream = sources.escs().get(esc).map(|e| &e.stream);
+        if stream.is_some_and(|s| s.is_can()) {
+            return format!(
+                "no {} records on this CAN bus (its records of other protocols left out)",
+                protocol.title()
+            );
+        }
+        return no_frames_of(protocol, stream.and_then(|s| s.found_instead()));
     }
     looks.map_or_else(|| NO_FRAMES.clone(), |looks| looks.to_string())
+}
+
+/// The notices of the CAN buses whose records of protocols other than the one forced were left
+/// out ([`Sources::force_protocol`]): one per bus, with their number by protocol.
+pub fn left_out(sources: &Sources) -> Vec<crate::Notice> {
+    let Some(forced) = sources.forced_protocol() else {
+        return Vec::new();
+    };
+    sources
+        .escs()
+        .iter()
+        .filter_map(|e| {
+            let records = e.stream.left_out();
+            (!records.is_empty()).then(|| crate::Notice::LeftOut {
+                input: sources.names()[e.input].clone(),
+                interface: e.name.clone(),
+                forced,
+                records,
+            })
+        })
+        .collect()
 }
 
 /// Fault episodes kept per ESC in detail (all are counted).

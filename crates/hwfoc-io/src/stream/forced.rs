@@ -1,0 +1,172 @@
+//! What a forced protocol (`--protocol`, [`super::Stream::forced`]) adds to a stream: a CAN
+//! bus's records of the other protocols left out and counted ([`Bus`]), and what the bytes of
+//! a serial stream are when the protocol forced finds none of its frames ([`Probe`]).
+
+use hwfoc::telemetry::Frame;
+use hwfoc::{Protocol, detect};
+
+use super::can::{CanLink, CanWire, Emit};
+
+/// How many of a forced stream's first bytes are also read by every format at once, to say
+/// what they are when the protocol forced finds nothing in them.
+pub(crate) const PROBE_BYTES: u64 = 64 * 1024;
+
+/// Every format read at once over a forced stream's first [`PROBE_BYTES`]: the protocol of the
+/// first frame found.
+#[derive(Debug, Default)]
+pub(crate) struct Probe {
+    decoder: detect::Decoder,
+    found: Option<Protocol>,
+}
+
+impl Probe {
+    /// Reads `data`, the stream's next bytes, while nothing is found and within the first
+    /// [`PROBE_BYTES`].
+    pub(crate) fn feed(&mut self, data: &[u8]) {
+        let room = PROBE_BYTES.saturating_sub(self.decoder.bytes());
+        if self.found.is_some() || room == 0 {
+            return;
+        }
+        let data = &data[..data.len().min(usize::try_from(room).unwrap_or(usize::MAX))];
+        let found = &mut self.found;
+        self.decoder.feed(data, |d| {
+            found.get_or_insert(d.protocol());
+        });
+    }
+
+    /// The protocol of the first frame found, if any.
+    pub(crate) fn found(&self) -> Option<Protocol> {
+        self.found
+    }
+}
+
+/// A CAN bus's stream, its records of protocols other than the one forced (if one is) left
+/// out and counted by protocol.
+#[derive(Debug)]
+pub(crate) struct Bus {
+    pub(crate) wire: CanWire,
+    forced: Option<Protocol>,
+    left_out: [u64; Protocol::ALL.len()],
+}
+
+impl Bus {
+    /// A bus with nothing decoded, keeping the records of `forced` only (all when `None`).
+    pub(crate) fn new(forced: Option<Protocol>) -> Bus {
+        Bus {
+            wire: CanWire::new(),
+            forced,
+            left_out: [0; Protocol::ALL.len()],
+        }
+    }
+
+    /// Decodes `bytes` as [`CanWire::feed`] does, handing on the records kept.
+    pub(crate) fn feed(&mut self, bytes: &[u8], times: Option<&[f64]>, emit: &mut Emit<'_>) {
+        let (forced, left_out) = (self.forced, &mut self.left_out);
+        self.wire.feed(bytes, times, &mut |t, place, frame| {
+            let protocol = match frame {
+                Frame::Data(d) => Some(d.protocol()),
+                Frame::Info(_) => None,
+            };
+            match forced.zip(protocol) {
+                Some((forced, p)) if p != forced => {
+                    let i = Protocol::ALL.iter().position(|&q| q == p).unwrap_or(0);
+                    left_out[i] += 1;
+                }
+                _ => emit(t, place, frame),
+            }
+        });
+    }
+
+    /// The link of the ESC at `place`: no record where its protocol is not the one forced.
+    pub(crate) fn link(&self, place: u8) -> CanLink {
+        let mut link = self.wire.link(place);
+        if self.forced.is_some_and(|p| p != link.protocol) {
+            link.records = 0;
+        }
+        link
+    }
+
+    /// The protocol forced, if one is.
+    pub(crate) fn forced(&self) -> Option<Protocol> {
+        self.forced
+    }
+
+    /// The records left out, by protocol (those of which some were), in
+    /// [`Protocol::ALL`]'s order.
+    pub(crate) fn left_out(&self) -> Vec<(Protocol, u64)> {
+        Protocol::ALL
+            .into_iter()
+            .zip(self.left_out)
+            .filter(|&(_, n)| n > 0)
+            .collect()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use hwfoc::dronecan::{EscStatus, Message, StatusMsg1};
+
+    #[test]
+    fn the_probe_finds_a_format_in_the_first_bytes_only() {
+        let frame = hwfoc::foc::DataFrame::default().encode();
+        let mut probe = Probe::default();
+        probe.feed(&vec![0x55; PROBE_BYTES as usize]);
+        for _ in 0..20 {
+            probe.feed(&frame);
+        }
+        assert_eq!(probe.found(), None, "past its first bytes");
+        let mut probe = Probe::default();
+        for _ in 0..20 {
+            probe.feed(&frame);
+        }
+        assert_eq!(probe.found(), Some(Protocol::HwFoc));
+    }
+
+    #[test]
+    fn a_bus_keeps_the_forced_protocols_records_and_counts_the_others() {
+        let hw: Message = StatusMsg1 {
+            rpm: 1,
+            pwm: 1,
+            status: 0,
+        }
+        .into();
+        let std: Message = EscStatus {
+            error_count: 0,
+            voltage: 24.0,
+            current: 1.0,
+            temperature: 300.0,
+            rpm: 100,
+            power_rating_pct: 10,
+            esc_index: 1,
+        }
+        .into();
+        let mut bytes = Vec::new();
+        for tid in 0..3 {
+            for (m, node) in [(hw, 5), (std, 9)] {
+                for f in m.frames(16, node, 0, tid) {
+                    bytes.extend_from_slice(&f.to_socketcan_record());
+                }
+            }
+        }
+        for (forced, kept, left_out) in [
+            (None, 6, vec![]),
+            (Some(Protocol::HwCan), 3, vec![(Protocol::DroneCan, 3)]),
+            (Some(Protocol::DroneCan), 3, vec![(Protocol::HwCan, 3)]),
+            (
+                Some(Protocol::Hw5),
+                0,
+                vec![(Protocol::HwCan, 3), (Protocol::DroneCan, 3)],
+            ),
+        ] {
+            let mut bus = Bus::new(forced);
+            let mut n = 0;
+            bus.feed(&bytes, None, &mut |_, _, f| {
+                let Frame::Data(d) = f else { return };
+                assert!(forced.is_none_or(|p| p == d.protocol()));
+                n += 1;
+            });
+            assert_eq!((n, bus.left_out()), (kept, left_out), "{forced:?}");
+        }
+    }
+}
