@@ -41,17 +41,25 @@ pub struct InputArgs {
 /// `--protocol`: one protocol read instead of every one the bytes may hold.
 #[derive(Debug, Default, Clone, Copy, Args)]
 pub struct ProtocolArgs {
-    /// Read only this protocol's frames; the bytes of any other are skipped. Without it, every
-    /// protocol is recognised from the bytes.
+    /// Read only this protocol's frames; the bytes of any other are skipped, and a CAN bus's
+    /// records of any other left out (counted in a warning). A CAN protocol reads CAN inputs
+    /// only: serial bytes then decode to nothing, and serial ports are an error. Without it,
+    /// every protocol is recognised from the bytes.
     #[arg(long, value_name = "NAME", value_parser = protocol_parser())]
     pub protocol: Option<Protocol>,
 }
 
-/// The names of [`Protocol::SERIAL`] as `--protocol` takes them (shown by `--help` and
-/// completed by the shells), each with its title and baud rate.
+/// The names of [`Protocol::ALL`] as `--protocol` takes them (shown by `--help` and
+/// completed by the shells), each with its title and baud rate (a CAN protocol's: on a CAN
+/// bus).
 fn protocol_parser() -> impl TypedValueParser<Value = Protocol> {
-    let names = Protocol::SERIAL.map(|p| {
-        PossibleValue::new(p.name()).help(format!("{}, {} baud", p.title(), p.baud_rate()))
+    let names = Protocol::ALL.map(|p| {
+        let help = if p.is_can() {
+            format!("{}, on a CAN bus", p.title())
+        } else {
+            format!("{}, {} baud", p.title(), p.baud_rate())
+        };
+        PossibleValue::new(p.name()).help(help)
     });
     // Every possible value is a protocol's name: the mapping finds it.
     PossibleValuesParser::new(names)
@@ -59,12 +67,34 @@ fn protocol_parser() -> impl TypedValueParser<Value = Protocol> {
 }
 
 impl ProtocolArgs {
-    /// The baud rate of serial ports: `baud` (`--baud`) when given, else the forced protocol's,
-    /// else found by each port from its bytes ([`serial::Baud::Auto`]).
+    /// The baud rate of serial ports: `baud` (`--baud`) when given, else the forced serial
+    /// protocol's, else found by each port from its bytes ([`serial::Baud::Auto`]).
     pub fn baud(&self, baud: Option<u32>) -> serial::Baud {
-        match baud.or(self.protocol.map(Protocol::baud_rate)) {
+        let serial = self.protocol.filter(|p| !p.is_can());
+        match baud.or(serial.map(Protocol::baud_rate)) {
             Some(baud) => serial::Baud::Fixed(baud),
             None => serial::Baud::Auto,
+        }
+    }
+
+    /// An error when a CAN protocol is forced on a serial port of `ports` (not a CAN bus,
+    /// `slcan:`/`can:`): its bytes could never be CAN frames.
+    pub fn check_ports<'a>(
+        &self,
+        ports: impl IntoIterator<Item = &'a str>,
+    ) -> Result<(), CliError> {
+        let Some(protocol) = self.protocol.filter(|p| p.is_can()) else {
+            return Ok(());
+        };
+        match ports.into_iter().find(|p| !hwfoc_io::can::is_can_spec(p)) {
+            Some(port) => Err(CliError::Usage {
+                option: format!("--protocol {protocol}"),
+                message: format!(
+                    "a CAN protocol reads CAN buses (slcan:PORT, can:INTERFACE), not the serial \
+                     port {port}"
+                ),
+            }),
+            None => Ok(()),
         }
     }
 }
@@ -105,6 +135,8 @@ impl InputArgs {
                 file: file.to_string(),
             }),
             (Some(_), None) => {
+                self.protocol
+                    .check_ports(ports.iter().map(|p| p.as_str()))?;
                 let ports: Vec<String> = ports.into_iter().cloned().collect();
                 Ok(vec![Input::open_ports(
                     &ports,

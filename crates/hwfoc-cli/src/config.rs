@@ -207,13 +207,12 @@ pub struct MonitorKeys {
     pub record_dir: Option<PathBuf>,
 }
 
-/// A serial protocol by its name ([`Protocol::from_name`]); another name is an error listing
-/// the names (a CAN bus is read as one whatever this says).
+/// A protocol by its name ([`Protocol::from_name`]: as `--protocol`); another name is an
+/// error listing the names.
 fn protocol<'de, D: Deserializer<'de>>(deserializer: D) -> Result<Option<Protocol>, D::Error> {
     let name = String::deserialize(deserializer)?;
-    let serial = Protocol::from_name(&name).filter(|p| !p.is_can());
-    serial.map(Some).ok_or_else(|| {
-        let names: Vec<&str> = Protocol::SERIAL.iter().map(|p| p.name()).collect();
+    Protocol::from_name(&name).map(Some).ok_or_else(|| {
+        let names: Vec<&str> = Protocol::ALL.iter().map(|p| p.name()).collect();
         de::Error::custom(format!(
             "protocol {name:?} is not one of {}",
             names.join(", ")

@@ -252,13 +252,16 @@ fn platinum_captures_decode_exactly() {
         serde_json::json!({"full_scale": 1000, "v1": 8, "v2": 91, "i1": 0, "i2": 1, "i3": 0, "t1": 33, "t2": 33})
     );
     assert_eq!(value("v4_volts_per_step").as_deref(), Some("8/910"));
-    // Forced to read HW-FOC, the V4 capture has no frame of it, and says so.
+    // Forced to read HW-FOC, the V4 capture has no frame of it, and says what it has.
     let path = capture("platinum-v4.csv");
     let out = run(&["decode", "--protocol", "hw-foc", path.to_str().unwrap()]);
     assert_eq!(out.status.code(), Some(1));
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(
-        err.contains("no valid HW-FOC frames: check the baud rate (19200) and the wiring"),
+        err.contains(
+            "no valid HW-FOC frames: these bytes are hw-v4 frames (try --protocol hw-v4, or \
+             leave --protocol out)"
+        ),
         "{err}"
     );
 }

@@ -303,7 +303,8 @@ fn a_forced_protocol_that_finds_nothing_says_so() {
     let dir = Dir::new();
     std::fs::write(dir.path("esc.bin"), esc(0..50)).unwrap();
     let file = dir.arg("esc.bin");
-    let advice = "no valid DataLink V2 frames: check the baud rate (115200) and the wiring";
+    let advice = "no valid DataLink V2 frames: these bytes are hw-foc frames (try --protocol \
+                  hw-foc, or leave --protocol out)";
     let decoded = hwfoc()
         .args(["decode", "--protocol", "datalink", &file])
         .output()
@@ -358,19 +359,27 @@ fn an_unknown_protocol_is_a_usage_error_listing_the_names() {
             first.contains("invalid value 'hw6' for '--protocol"),
             "{err}"
         );
-        assert!(err.contains("hw-foc, datalink, hw-v4, hw-v3, hw5"), "{err}");
+        assert!(
+            err.contains("hw-foc, datalink, hw-v4, hw-v3, hw5, hw-can, dronecan"),
+            "{err}"
+        );
         assert!(!dir.path("p.png").exists());
 
         let help = stdout(&hwfoc().arg(args[0]).arg("--help").output().unwrap());
         assert!(
             help.contains("--protocol <NAME>")
                 && help.contains("datalink: DataLink V2, 115200 baud")
-                && help.contains("hw5:      HW5, 115200 baud"),
+                && help.contains("hw5:      HW5, 115200 baud")
+                && help.contains("hw-can:   Hobbywing DroneCAN, on a CAN bus")
+                && help.contains("dronecan: DroneCAN ESC, on a CAN bus"),
             "{help}"
         );
     }
     let bash = stdout(&hwfoc().args(["completions", "bash"]).output().unwrap());
-    assert!(bash.contains("hw-foc datalink"), "completions");
+    assert!(
+        bash.contains("hw-foc datalink hw-v4 hw-v3 hw5 hw-can dronecan"),
+        "completions"
+    );
 }
 
 /// The monitor reads the protocol forced only: a virtual ESC's HW-FOC frames are frames under
@@ -511,4 +520,177 @@ fn an_hw5_wire_is_read_with_its_own_fields_and_faults() {
     );
     assert!(text.contains("low_voltage"), "{text}");
     assert!(!text.contains("phase_current_a"), "{text}");
+}
+
+/// The committed candump log of a bus of Hobbywing (39 records) and standard DroneCAN ESCs
+/// (19 records).
+fn bus_log() -> String {
+    concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../testdata/dronecan/can-bus.log"
+    )
+    .to_string()
+}
+
+/// The `protocol` of each record `decode` made of `args`, its standard error and exit code.
+fn decoded_protocols(args: &[&str]) -> (Vec<String>, String, Option<i32>) {
+    let out = hwfoc().arg("decode").args(args).output().unwrap();
+    let protocols = String::from_utf8_lossy(&out.stdout)
+        .lines()
+        .map(|l| serde_json::from_str::<Value>(l).unwrap()["protocol"].to_string())
+        .collect();
+    let err = String::from_utf8_lossy(&out.stderr).into_owned();
+    (protocols, err, out.status.code())
+}
+
+/// A forced protocol filters a CAN bus: `--protocol hw-can` keeps the Hobbywing ESCs'
+/// records, `--protocol dronecan` the standard ESCs', a serial protocol none; what was left
+/// out is counted in a warning naming the input.
+#[test]
+fn a_forced_protocol_filters_a_can_bus() {
+    let log = bus_log();
+    let (all, _, code) = decoded_protocols(&[&log]);
+    assert_eq!((all.len(), code), (58, Some(0)));
+
+    let (hw, err, code) = decoded_protocols(&["--protocol", "hw-can", &log]);
+    assert_eq!((hw.len(), code), (39, Some(0)), "{err}");
+    assert!(hw.iter().all(|p| p == "\"hw-can\""), "{hw:?}");
+    assert!(
+        err.contains(
+            "can-bus.log: can0: 19 dronecan records left out (not hw-can, the protocol forced)"
+        ),
+        "{err}"
+    );
+
+    let (std, err, code) = decoded_protocols(&["--protocol", "dronecan", &log]);
+    assert_eq!((std.len(), code), (19, Some(0)), "{err}");
+    assert!(std.iter().all(|p| p == "\"dronecan\""), "{std:?}");
+    assert!(
+        err.contains("can0: 39 hw-can records left out (not dronecan, the protocol forced)"),
+        "{err}"
+    );
+
+    let (none, err, code) = decoded_protocols(&["--protocol", "hw5", &log]);
+    assert_eq!((none.len(), code), (0, Some(1)), "{err}");
+    assert!(
+        err.contains(
+            "can0: 39 hw-can records and 19 dronecan records left out (not hw5, the \
+                      protocol forced)"
+        ),
+        "{err}"
+    );
+    assert!(
+        err.contains("no HW5 records on this CAN bus (its records of other protocols left out)"),
+        "{err}"
+    );
+    assert!(!err.contains("baud rate"), "{err}");
+
+    let (summary, ok) = summary_json(&["--protocol", "dronecan", &log]);
+    assert!(ok, "{summary}");
+    let escs = summary["escs"].as_array().unwrap();
+    assert!(
+        !escs.is_empty() && escs.iter().all(|e| e["protocol"] == "dronecan"),
+        "{summary}"
+    );
+}
+
+/// A CAN protocol forced on serial bytes decodes nothing, and says in CAN words what the
+/// bytes are instead.
+#[test]
+fn a_can_protocol_forced_on_serial_bytes_names_what_they_are() {
+    let dir = Dir::new();
+    std::fs::write(dir.path("esc.bin"), esc(0..50)).unwrap();
+    let file = dir.arg("esc.bin");
+    let (records, err, code) = decoded_protocols(&["--protocol", "hw-can", &file]);
+    assert_eq!((records.len(), code), (0, Some(1)), "{err}");
+    assert!(
+        err.contains(
+            "no Hobbywing DroneCAN records: these bytes are not CAN frames but hw-foc frames \
+             (try --protocol hw-foc, or leave --protocol out)"
+        ),
+        "{err}"
+    );
+    assert!(!err.contains("baud rate"), "{err}");
+}
+
+/// A forced serial protocol that finds none of its frames in bytes of another known format
+/// names that format, not the baud rate and the wiring.
+#[test]
+fn a_forced_protocol_names_the_format_the_bytes_are() {
+    use hwfoc::hw5::TelemetryFrame;
+    let dir = Dir::new();
+    let hw5: Vec<u8> = (0..30u16)
+        .flat_map(|i| {
+            TelemetryFrame {
+                erpm_raw: 100 + i,
+                voltage_raw: 500,
+                ..Default::default()
+            }
+            .encode()
+        })
+        .collect();
+    std::fs::write(dir.path("hw5.bin"), hw5).unwrap();
+    let file = dir.arg("hw5.bin");
+    let (records, err, code) = decoded_protocols(&["--protocol", "hw-foc", &file]);
+    assert_eq!((records.len(), code), (0, Some(1)), "{err}");
+    assert!(
+        err.contains(
+            "no valid HW-FOC frames: these bytes are hw5 frames (try --protocol hw5, or leave \
+             --protocol out)"
+        ),
+        "{err}"
+    );
+    // Hobbywing V4 frames (a capture of a real ESC) read as HW5.
+    let v4 = common::capture("platinum-v4.csv");
+    let (_, err, code) = decoded_protocols(&["--protocol", "hw5", v4.to_str().unwrap()]);
+    assert_eq!(code, Some(1), "{err}");
+    assert!(
+        err.contains(
+            "no valid HW5 frames: these bytes are hw-v4 frames (try --protocol hw-v4, or leave \
+             --protocol out)"
+        ),
+        "{err}"
+    );
+    // Bytes of no known format keep the advice of the wire.
+    let mut x = 1u32;
+    let noise: Vec<u8> = (0..4096)
+        .map(|_| {
+            x = x.wrapping_mul(1_103_515_245).wrapping_add(12_345);
+            (x >> 16) as u8
+        })
+        .collect();
+    std::fs::write(dir.path("noise.bin"), noise).unwrap();
+    let (_, err, _) = decoded_protocols(&["--protocol", "hw-foc", &dir.arg("noise.bin")]);
+    assert!(
+        err.contains("check the baud rate (19200) and the wiring"),
+        "{err}"
+    );
+}
+
+/// A CAN protocol names CAN buses: forced on a serial port, it is an error naming the port
+/// before anything is opened.
+#[test]
+fn a_can_protocol_forced_on_a_serial_port_is_an_error() {
+    let port = "/dev/ttyUSB_hwfoc_missing";
+    for args in [
+        vec!["decode", port],
+        vec!["summary", port],
+        vec!["monitor", "--plain", "--no-config", port],
+        vec!["bridge", port, "--mavlink", "udp"],
+    ] {
+        let out = hwfoc()
+            .args(&args)
+            .args(["--protocol", "dronecan"])
+            .output()
+            .unwrap();
+        assert_eq!(out.status.code(), Some(1), "{args:?}");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(
+            err.contains(
+                "--protocol dronecan: a CAN protocol reads CAN buses (slcan:PORT, can:INTERFACE), \
+                 not the serial port /dev/ttyUSB_hwfoc_missing"
+            ),
+            "{err}"
+        );
+    }
 }

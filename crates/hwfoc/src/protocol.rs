@@ -50,8 +50,9 @@ impl Protocol {
         Protocol::DroneCan,
     ];
 
-    /// The protocols of a serial line, which `--protocol` can force a stream to read: all but
-    /// the CAN protocols (a CAN bus is read as one, whatever its ESCs speak).
+    /// The protocols of a serial line: all but the CAN protocols. (`--protocol` forces any of
+    /// [`Protocol::ALL`]: a serial stream then reads that protocol only, a CAN bus keeps that
+    /// protocol's records only.)
     pub const SERIAL: [Protocol; 5] = [
         Protocol::HwFoc,
         Protocol::DataLink,

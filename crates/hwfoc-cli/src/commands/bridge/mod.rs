@@ -173,6 +173,8 @@ pub fn run(args: &BridgeArgs) -> Result<(), CliError> {
             }
             None => {
                 let names: Vec<String> = ports.iter().map(|p| p.to_string()).collect();
+                args.protocol
+                    .check_ports(names.iter().map(String::as_str))?;
                 let feed = Feed::ports(&names, baud, tx)?;
                 (names, feed)
             }

@@ -226,6 +226,10 @@ impl Session {
                 });
             }
             None => {
+                let forced = crate::args::ProtocolArgs {
+                    protocol: config.protocol,
+                };
+                forced.check_ports(ports.iter().map(String::as_str))?;
                 let feed = Feed::ports(&ports, config.baud, tx.clone())?;
                 (ports, feed)
             }
