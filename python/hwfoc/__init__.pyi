@@ -22,8 +22,11 @@ DEFAULT_GEAR_RATIO: float
 DEFAULT_V4_VOLTS_PER_STEP: str
 #: The names every ``protocol`` argument takes (``"hw-foc"``: an ESC's own wire, 19200 baud;
 #: ``"datalink"``: a DataLink V2 hub, 115200 baud; ``"hw-v4"`` and ``"hw-v3"``: Platinum V4 and
-#: V3, 19200 baud; ``"hw5"``: HW5, 115200 baud), as the command's ``--protocol``. The default,
-#: None, recognises every protocol from the bytes.
+#: V3, 19200 baud; ``"hw5"``: HW5, 115200 baud; ``"hw-can"`` and ``"dronecan"``: Hobbywing's
+#: and standard DroneCAN ESCs on a CAN bus), as the command's ``--protocol``. A forced protocol
+#: leaves a CAN bus's records of any other out (counted in a HwfocWarning); a CAN protocol
+#: decodes nothing of serial bytes, and is a ValueError for a serial port. The default, None,
+#: recognises every protocol from the bytes.
 PROTOCOLS: Tuple[str, ...]
 
 #: One input: a path, bytes in memory, or a binary file object.

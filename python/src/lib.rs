@@ -141,16 +141,15 @@ fn escs_arg(esc: Option<&Bound<'_, PyAny>>) -> PyResult<Vec<u8>> {
         .collect()
 }
 
-/// `protocol=`: a serial protocol's name (`hw-foc`, `datalink`: [`Protocol::name`]), or
-/// `None` for every protocol; another name is a `ValueError` naming the names (a CAN bus is read
-/// as one whatever this says).
+/// `protocol=`: a protocol's name (`hw-foc`, `datalink`, `hw-can`: [`Protocol::name`], as the
+/// command's `--protocol`), or `None` for every protocol; another name is a `ValueError` naming
+/// the names.
 pub(crate) fn protocol_arg(name: Option<&str>) -> PyResult<Option<Protocol>> {
     let Some(name) = name else {
         return Ok(None);
     };
-    let serial = Protocol::from_name(name).filter(|p| !p.is_can());
-    serial.map(Some).ok_or_else(|| {
-        let names: Vec<String> = Protocol::SERIAL
+    Protocol::from_name(name).map(Some).ok_or_else(|| {
+        let names: Vec<String> = Protocol::ALL
             .iter()
             .map(|p| format!("{:?}", p.name()))
             .collect();
@@ -161,11 +160,11 @@ pub(crate) fn protocol_arg(name: Option<&str>) -> PyResult<Option<Protocol>> {
     })
 }
 
-/// `baud=`: the baud rate given, else that of the protocol forced, else the default, as the
-/// command's `--baud`; 0 is a `ValueError`.
+/// `baud=`: the baud rate given, else that of the serial protocol forced, else the default, as
+/// the command's `--baud`; 0 is a `ValueError`.
 pub(crate) fn baud_arg(baud: Option<u32>, protocol: Option<Protocol>) -> PyResult<u32> {
     let baud = baud
-        .or(protocol.map(Protocol::baud_rate))
+        .or(protocol.filter(|p| !p.is_can()).map(Protocol::baud_rate))
         .unwrap_or(hwfoc_io::serial::DEFAULT_BAUD);
     if baud == 0 {
         return Err(PyValueError::new_err("baud must be at least 1"));
@@ -257,17 +256,21 @@ struct Decoded {
     warnings: Vec<String>,
 }
 
-/// The warnings `hwfoc decode` prints for ESCs whose bytes held no frame (not a hub's or a
-/// CAN bus's stream: its ESCs are its channels, and a place on the bus without records is no
-/// wire without frames).
+/// The warnings `hwfoc decode` prints: a CAN bus's records of protocols other than the one
+/// forced, left out ([`hwfoc_io::summary::left_out`]); ESCs whose bytes held no frame (not a
+/// hub's or a CAN bus's stream: its ESCs are its channels, and a place on the bus without
+/// records is no wire without frames).
 pub(crate) fn no_frames(sources: &Sources) -> Vec<String> {
-    (0..sources.escs().len())
+    let left_out = hwfoc_io::summary::left_out(sources)
+        .into_iter()
+        .map(|n| n.to_string());
+    let none = (0..sources.escs().len())
         .filter(|&i| {
             let stats = sources.escs()[i].stream.stats();
             stats.bytes() > 0 && stats.frames() == 0 && !sources.is_hub(i)
         })
-        .map(|i| format!("{}: {}", esc_label(sources, i), no_frames_text(sources, i)))
-        .collect()
+        .map(|i| format!("{}: {}", esc_label(sources, i), no_frames_text(sources, i)));
+    left_out.chain(none).collect()
 }
 
 /// The command's warning for a time window that held no frame, if `collect`'s did not.

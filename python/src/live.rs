@@ -267,6 +267,16 @@ pub fn open_ports(
         return Err(PyValueError::new_err("no port given"));
     }
     let protocol = crate::protocol_arg(protocol)?;
+    if let Some(p) = protocol.filter(|p| p.is_can()) {
+        let serial = ports.iter().find(|n| !hwfoc_io::can::is_can_spec(n));
+        if let Some(port) = serial {
+            return Err(PyValueError::new_err(format!(
+                "protocol: {:?} reads CAN buses (slcan:PORT, can:INTERFACE), not the serial port \
+                 {port}",
+                p.name()
+            )));
+        }
+    }
     let baud = crate::baud_arg(baud, protocol)?;
     let set = py
         .detach(|| PortSet::open(&ports, baud))

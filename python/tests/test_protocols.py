@@ -377,3 +377,32 @@ def test_spark_reads_every_format(spark, tmp_path, hw5_stream):
     assert list(hw5[2]["faults"]) == ["throttle_signal_lost", "low_voltage"]
     schema = hwfoc.spark.spark_schema("recording", "frame", v4_volts_per_step="hv")
     assert df.schema == schema
+
+
+# ---- the CAN protocols and what a forced protocol finds --------------------------------------
+
+CAN_LOG = ROOT / "testdata" / "dronecan" / "can-bus.log"
+
+
+def test_the_can_protocols_are_listed_and_filter_a_bus():
+    assert hwfoc.PROTOCOLS[-2:] == ("hw-can", "dronecan")
+    assert hwfoc.read(CAN_LOG).num_rows == 58
+    for protocol, rows, other, left in [("hw-can", 39, "dronecan", 19), ("dronecan", 19, "hw-can", 39)]:
+        with pytest.warns(hwfoc.HwfocWarning, match=f"{left} {other} records left out"):
+            table = hwfoc.read(CAN_LOG, protocol=protocol)
+        assert table.num_rows == rows
+        assert set(table.column("protocol").to_pylist()) == {protocol}
+    with pytest.warns(hwfoc.HwfocWarning, match="39 hw-can records and 19 dronecan records"):
+        assert hwfoc.read(CAN_LOG, protocol="hw5").num_rows == 0
+
+
+def test_a_forced_protocol_names_the_format_the_bytes_are():
+    with pytest.warns(hwfoc.HwfocWarning, match="these bytes are hw-v4 frames"):
+        assert hwfoc.read(V4, protocol="hw5").num_rows == 0
+    with pytest.warns(hwfoc.HwfocWarning, match="not CAN frames but hw-v4 frames"):
+        assert hwfoc.read(V4, protocol="hw-can").num_rows == 0
+
+
+def test_a_can_protocol_on_a_serial_port_is_a_value_error():
+    with pytest.raises(ValueError, match="reads CAN buses"):
+        hwfoc.open_ports(["/dev/ttyUSB_hwfoc_missing"], protocol="dronecan")

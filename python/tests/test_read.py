@@ -397,7 +397,9 @@ def test_a_forced_protocol_reads_its_frames_only(mixed):
 
 def test_a_forced_protocol_that_finds_nothing_warns_with_its_advice(mixed):
     first = mixed[0]
-    with pytest.warns(hwfoc.HwfocWarning, match=r"no valid DataLink V2 frames: check the baud rate \(115200\)"):
+    # Its bytes are HW-FOC frames: the warning says so, not the baud rate and the wiring.
+    with pytest.warns(hwfoc.HwfocWarning, match=r"no valid DataLink V2 frames: these bytes are hw-foc frames "
+                                                 r"\(try --protocol hw-foc, or leave --protocol out\)"):
         assert hwfoc.read(first, protocol="datalink").num_rows == 0
 
 
@@ -409,13 +411,11 @@ def test_protocol_names_and_their_defaults():
                  lambda: hwfoc.summary(b"", protocol="dl"), lambda: hwfoc.Decoder(protocol="x"),
                  lambda: hwfoc.open_ports(["/dev/null"], protocol="x")):
         with pytest.raises(ValueError, match=r'protocol: ".*" is not a protocol: give one of "hw-foc", '
-                                             r'"datalink", "hw-v4", "hw-v3", "hw5"'):
+                                             r'"datalink", "hw-v4", "hw-v3", "hw5", "hw-can", "dronecan"'):
             call()
-    # A CAN bus is read as one whatever protocol= says: only the serial protocols are forced.
-    with pytest.raises(ValueError, match=r'protocol: "hw-can" is not a protocol: give one of'):
-        hwfoc.read(b"", protocol="hw-can")
-    # Every serial protocol's name is taken (any case), by every function.
-    for name in hwfoc.PROTOCOLS[:5] + ("HW5", "Hw-V4"):
+    # Every protocol's name is taken (any case), by every function; a CAN protocol's too (it
+    # keeps a bus's records of that protocol; serial bytes give nothing).
+    for name in hwfoc.PROTOCOLS + ("HW5", "Hw-V4", "DroneCAN"):
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", hwfoc.HwfocWarning)
             assert hwfoc.read(b"\0", protocol=name).num_rows == 0
