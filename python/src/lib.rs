@@ -164,7 +164,7 @@ pub(crate) fn protocol_arg(name: Option<&str>) -> PyResult<Option<Protocol>> {
 /// the command's `--baud`; 0 is a `ValueError`.
 pub(crate) fn baud_arg(baud: Option<u32>, protocol: Option<Protocol>) -> PyResult<u32> {
     let baud = baud
-        .or(protocol.filter(|p| !p.is_can()).map(Protocol::baud_rate))
+        .or(protocol.and_then(Protocol::serial_baud_rate))
         .unwrap_or(hwfoc_io::serial::DEFAULT_BAUD);
     if baud == 0 {
         return Err(PyValueError::new_err("baud must be at least 1"));

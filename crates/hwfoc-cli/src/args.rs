@@ -70,8 +70,7 @@ impl ProtocolArgs {
     /// The baud rate of serial ports: `baud` (`--baud`) when given, else the forced serial
     /// protocol's, else found by each port from its bytes ([`serial::Baud::Auto`]).
     pub fn baud(&self, baud: Option<u32>) -> serial::Baud {
-        let serial = self.protocol.filter(|p| !p.is_can());
-        match baud.or(serial.map(Protocol::baud_rate)) {
+        match baud.or(self.protocol.and_then(Protocol::serial_baud_rate)) {
             Some(baud) => serial::Baud::Fixed(baud),
             None => serial::Baud::Auto,
         }
@@ -159,6 +158,14 @@ impl InputArgs {
             sources.force_protocol(protocol);
         }
         Ok(sources)
+    }
+}
+
+/// Warns on standard error of what `--protocol` left out of the CAN buses read
+/// ([`hwfoc_io::summary::left_out`]): one line per bus.
+pub fn warn_left_out(sources: &Sources) {
+    for notice in hwfoc_io::summary::left_out(sources) {
+        eprintln!("{}", notice.line());
     }
 }
 

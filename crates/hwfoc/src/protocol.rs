@@ -107,6 +107,23 @@ impl Protocol {
         }
     }
 
+    /// The baud rate of a serial line carrying it ([`Protocol::baud_rate`]), or `None` for a
+    /// CAN protocol: the rate a port is opened at when this protocol is forced.
+    ///
+    /// ```
+    /// use hwfoc::Protocol;
+    ///
+    /// assert_eq!(Protocol::Hw5.serial_baud_rate(), Some(115_200));
+    /// assert_eq!(Protocol::HwCan.serial_baud_rate(), None);
+    /// ```
+    pub const fn serial_baud_rate(self) -> Option<u32> {
+        if self.is_can() {
+            None
+        } else {
+            Some(self.baud_rate())
+        }
+    }
+
     /// The width of its packet counter in bits (which it wraps at), or `None` for a protocol
     /// that sends no counter: 16 for HW-FOC and DataLink, 24 for V3 and V4, none for HW5 and the
     /// CAN protocols (a transfer id is the transport's: its gaps are counted per node).

@@ -133,9 +133,9 @@ impl MonitorSetup {
         let file_protocol = general.file.monitor.protocol;
         let baud = flags
             .baud
-            .or(flags.protocol.map(Protocol::baud_rate))
+            .or(flags.protocol.and_then(Protocol::serial_baud_rate))
             .or(general.baud())
-            .or(file_protocol.map(Protocol::baud_rate));
+            .or(file_protocol.and_then(Protocol::serial_baud_rate));
         if baud == Some(0) {
             return Err(invalid(origin("baud"), "the baud rate must be more than 0"));
         }
@@ -324,6 +324,12 @@ mod tests {
         );
         let file = parse("[monitor]\nprotocol = \"datalink\"\nbaud = 57600\n").unwrap();
         assert_eq!(file.baud, Baud::Fixed(57_600));
+        // A CAN protocol is taken, and sets no serial rate (a CAN bus has its own).
+        let file = parse("[monitor]\nprotocol = \"hw-can\"\n").unwrap();
+        assert_eq!(
+            (file.protocol, file.baud),
+            (Some(Protocol::HwCan), Baud::Auto)
+        );
 
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("m.toml");
