@@ -585,13 +585,31 @@ fn a_forced_protocol_filters_a_can_bus() {
     );
     assert!(!err.contains("baud rate"), "{err}");
 
-    let (summary, ok) = summary_json(&["--protocol", "dronecan", &log]);
+    let out = hwfoc()
+        .args(["summary", "--json", "--protocol", "dronecan", &log])
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("can0: 39 hw-can records left out"), "{err}");
+    let (summary, ok) = (
+        serde_json::from_slice::<Value>(&out.stdout).unwrap(),
+        out.status.success(),
+    );
     assert!(ok, "{summary}");
     let escs = summary["escs"].as_array().unwrap();
     assert!(
         !escs.is_empty() && escs.iter().all(|e| e["protocol"] == "dronecan"),
         "{summary}"
     );
+    let dir = Dir::new();
+    let png = dir.arg("bus.png");
+    let out = hwfoc()
+        .args(["plot", "--protocol", "hw-can", &log, "-o", &png])
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{err}");
+    assert!(err.contains("can0: 19 dronecan records left out"), "{err}");
 }
 
 /// A CAN protocol forced on serial bytes decodes nothing, and says in CAN words what the

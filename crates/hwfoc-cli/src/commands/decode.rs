@@ -137,9 +137,7 @@ fn overrides(map: &SettingsMap) -> Vec<(String, SettingsPatch)> {
 
 /// Warnings on standard error: ESCs whose bytes held no frame, ESCs asked for but not found.
 fn warn(sources: &Sources, wanted: &[u8]) {
-    for notice in hwfoc_io::summary::left_out(sources) {
-        eprintln!("{}", notice.line());
-    }
+    crate::args::warn_left_out(sources);
     for i in 0..sources.escs().len() {
         let stats = sources.link(i);
         if stats.bytes() > 0 && stats.frames() == 0 && !sources.is_hub(i) {

@@ -48,9 +48,7 @@ pub fn run(args: &SummaryArgs) -> Result<(), CliError> {
         Some(plot) => sources.run(&mut Both(&mut summary, plot)),
         None => sources.run(&mut summary).map_err(CliError::from),
     };
-    for notice in hwfoc_io::summary::left_out(&sources) {
-        eprintln!("{}", notice.line());
-    }
+    crate::args::warn_left_out(&sources);
     let report = summary.report(&sources);
     let text = if args.json {
         let mut s = serde_json::to_string_pretty(&report.json()).unwrap_or_default();

@@ -101,6 +101,7 @@ pub fn run(args: &PlotArgs) -> Result<(), CliError> {
     let mut collector = Collector::new(settings, selection, options.width)
         .stop_on(args.input.stop_if_read_to_end(), &args.output);
     let result = sources.run(&mut collector);
+    crate::args::warn_left_out(&sources);
     if let Err(e @ CliError::Write(WriteError::Interrupted { .. })) = result {
         return Err(e);
     }
