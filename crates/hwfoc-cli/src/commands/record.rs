@@ -201,6 +201,8 @@ pub struct Recorder {
     files: Vec<String>,
     /// The number of the next file of a rotated recording.
     next_number: u32,
+    /// The recording's identity, in every file of it (rotated files alike).
+    recording: pcapng::RecordingId,
     /// The file being written; `None` after a rotation until there is something to write, so
     /// that a recording never ends with a file holding nothing.
     writer: Option<pcapng::Writer<BufWriter<File>>>,
@@ -339,6 +341,7 @@ impl Recorder {
             protocol: plan.protocol,
             files: vec![first],
             next_number: 2,
+            recording: pcapng::RecordingId::new(),
             writer: None,
             file_has_packets: false,
             file_started: now,
@@ -371,7 +374,7 @@ impl Recorder {
             return Ok(());
         };
         let names: Vec<String> = self.ports.iter().map(|p| p.name.clone()).collect();
-        let mut writer = headers(self.current(), file, &names, &self.bauds)?;
+        let mut writer = headers(self.current(), file, &names, &self.bauds, self.recording)?;
         let now_ns = self.clock.now_ns();
         for (port, baud) in self.bauds.iter().enumerate() {
             if baud.is_none() {
@@ -633,7 +636,7 @@ impl Recorder {
         let (next, mut writer) = loop {
             let next = numbered(&self.base, self.next_number);
             self.next_number += 1;
-            match create(&next, &names, &self.bauds, false) {
+            match create(&next, &names, &self.bauds, self.recording) {
                 Ok(writer) => break (next, writer),
                 Err(CliError::Write(WriteError::Exists { .. })) if taken.len() < MAX_TAKEN => {
                     taken.push(next);
@@ -752,30 +755,32 @@ fn no_frame_warning(
 }
 
 /// Creates a recording file with its headers, one interface per port at its rate. An
-/// existing file is an error unless `overwrite`.
+/// existing file is an error. The file is part of recording `recording`.
 fn create(
     path: &str,
     ports: &[String],
     bauds: &[Option<u32>],
-    overwrite: bool,
+    recording: pcapng::RecordingId,
 ) -> Result<pcapng::Writer<BufWriter<File>>, CliError> {
-    let file = hwfoc_io::write::create_file(path, overwrite)?;
-    headers(path, file, ports, bauds)
+    let file = hwfoc_io::write::create_file(path, false)?;
+    headers(path, file, ports, bauds, recording)
 }
 
-/// Writes the headers of the recording `path` into `file`: one interface per port at its
-/// rate (19200 for a rate not known).
+/// Writes the headers of the file `path` of recording `recording` into `file`: one interface
+/// per port at its rate (19200 for a rate not known).
 fn headers(
     path: &str,
     file: File,
     ports: &[String],
     bauds: &[Option<u32>],
+    recording: pcapng::RecordingId,
 ) -> Result<pcapng::Writer<BufWriter<File>>, CliError> {
     let err = |source| WriteError::Write {
         output: path.to_string(),
         source,
     };
-    let mut writer = pcapng::Writer::new(BufWriter::with_capacity(BUFFER, file)).map_err(err)?;
+    let buffered = BufWriter::with_capacity(BUFFER, file);
+    let mut writer = pcapng::Writer::continuing(buffered, recording).map_err(err)?;
     for (i, port) in ports.iter().enumerate() {
         if let Ok(spec) = hwfoc_io::can::CanSpec::parse(port)
             && hwfoc_io::can::is_can_spec(port)

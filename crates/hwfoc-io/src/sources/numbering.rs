@@ -1,5 +1,6 @@
 //! Which stream of which input is which ESC: an input's streams in the order given, the
-//! recordings of one port one ESC, a hub's channels after all inputs' streams (see [`super`]).
+//! streams of one port in one recording one ESC (`esc_table.rs`), a hub's channels after all
+//! inputs' streams (see [`super`]).
 
 use std::collections::VecDeque;
 
@@ -9,6 +10,7 @@ use hwfoc::telemetry::Frame;
 
 use super::{Esc, Handler, Sources};
 use crate::esc_numbers::{MAX_ESCS, UNNUMBERED, channel_number};
+use crate::esc_table::{EscKey, Place, Recording};
 use crate::input::{Input, InputError};
 use crate::stream::Stream;
 
@@ -61,12 +63,20 @@ impl Sources {
             let number = channel_number(esc, self.escs.len(), channel);
             if number != UNNUMBERED && number != esc {
                 debug_assert_eq!(number, self.escs.len());
-                self.push_esc(Esc {
-                    input: self.escs[esc].input,
-                    name: self.escs[esc].name.clone(),
-                    stream: Stream::forced(self.forced),
-                    hub: Some((esc, channel as u8)),
-                });
+                let owner = &self.table[esc];
+                let key = EscKey {
+                    place: Place::Channel(channel as u8),
+                    ..owner.key.clone()
+                };
+                let input = owner.input;
+                self.push_esc(
+                    Esc {
+                        stream: Stream::forced(self.forced),
+                        hub: Some((esc, channel as u8)),
+                    },
+                    key,
+                    input,
+                );
             }
             hub.settings.push(self.esc_settings(number));
             hub.escs.push(number);
@@ -74,13 +84,25 @@ impl Sources {
         self.hubs.insert(esc, hub);
     }
 
-    /// A new ESC, its settings looked up once.
-    fn push_esc(&mut self, esc: Esc) {
-        let settings = self.settings.get(self.escs.len(), &esc.name);
+    /// A new ESC, `key` of input `input`, its settings looked up once.
+    fn push_esc(&mut self, esc: Esc, key: EscKey, input: usize) {
+        let settings = self.settings.get(self.escs.len(), &key.port);
+        self.table.push(key, input);
         self.escs.push(esc);
         self.esc_settings.push(settings);
         self.readers.push(0);
         self.fed.push(None);
+        self.span.push(None);
+    }
+
+    /// The recording input `index` is a part of (`esc_table.rs`): one of its own unless it
+    /// names one (hwfoc's recordings) or the recordings are joined (`--join`).
+    fn recording_of(&self, input: &Input, index: usize) -> Recording {
+        match (self.join, input.recording_id()) {
+            (true, _) if input.format().has_recorded_ports() => Recording::Joined,
+            (_, Some(id)) => Recording::Id(id),
+            _ => Recording::Input(index),
+        }
     }
 
     /// The ESC of stream `stream` of `input` (number `index`), made when first seen; `escs`
@@ -95,13 +117,13 @@ impl Sources {
         if let Some(&Some(esc)) = escs.get(stream) {
             return Ok(esc);
         }
-        let name = input.stream_name(stream);
-        let recorded = input.format().has_recorded_ports();
-        let earlier = self
-            .ports
-            .get(&name)
-            .copied()
-            .filter(|e| recorded && !escs.contains(&Some(*e)));
+        let key = EscKey {
+            recording: self.recording_of(input, index),
+            port: input.stream_name(stream),
+            place: Place::Own,
+        };
+        // A port's stream in a recording that an earlier input of it had (a rotated series).
+        let earlier = self.table.find(&key).filter(|e| !escs.contains(&Some(*e)));
         let esc = match earlier {
             Some(esc) => esc,
             None => {
@@ -110,21 +132,13 @@ impl Sources {
                         input: self.names[index].clone(),
                     });
                 }
-                if recorded {
-                    self.ports.insert(name.clone(), self.escs.len());
-                }
                 // A CAN bus's stream reads CAN frames, whatever `--protocol` says.
                 let stream = if input.is_can(stream) {
                     Stream::can()
                 } else {
                     Stream::forced(self.forced)
                 };
-                self.push_esc(Esc {
-                    input: index,
-                    name,
-                    stream,
-                    hub: None,
-                });
+                self.push_esc(Esc { stream, hub: None }, key, index);
                 self.escs.len() - 1
             }
         };

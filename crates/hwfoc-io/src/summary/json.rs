@@ -38,7 +38,7 @@ impl Report<'_> {
             .hubs()
             .map(|(esc, h)| {
                 json!({
-                    "stream": self.sources.escs()[esc].name,
+                    "stream": self.sources.esc_table()[esc].key.port,
                     "bytes": h.bytes(),
                     "bytes_skipped": h.bytes_skipped(),
                     "frames": h.frames(),

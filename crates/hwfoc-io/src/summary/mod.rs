@@ -80,7 +80,7 @@ pub fn no_frames_of(protocol: Protocol) -> String {
 /// wiring), else [`NO_FRAMES`], the advice for a wire (a port, a recording).
 pub fn no_frames(sources: &Sources, esc: usize) -> String {
     let looks = sources
-        .escs()
+        .esc_table()
         .get(esc)
         .and_then(|e| sources.inputs().get(e.input))
         .and_then(|input| input.looks);
@@ -114,25 +114,26 @@ fn can_place(c: &crate::stream::CanLink) -> String {
 /// How an ESC is named in messages: its input, and its stream when the input has several
 /// (names from a recording [`Escaped`]).
 pub fn esc_label(sources: &Sources, esc: usize) -> String {
-    let e = &sources.escs()[esc];
+    let e = &sources.esc_table()[esc];
     let input = &sources.names()[e.input];
     let single = sources
         .inputs()
         .get(e.input)
         .is_none_or(|info| info.escs.len() == 1);
-    let channel = match (sources.link(esc), e.hub) {
+    let channel = match (sources.link(esc), sources.escs()[esc].hub) {
         (crate::stream::EscLink::Can(c), _) => can_place(&c),
         (_, Some((_, channel))) => format!(" channel {channel}"),
         _ if sources.is_hub(esc) => " channel 0".to_string(),
         _ => String::new(),
     };
     let input = Escaped(input);
-    if single && e.name == *input.0 && channel.is_empty() {
+    let port = &e.key.port;
+    if single && *port == *input.0 && channel.is_empty() {
         input.to_string()
-    } else if e.name == *input.0 {
+    } else if *port == *input.0 {
         format!("{input}{channel} (ESC {esc})")
     } else {
-        format!("{input}: {}{channel} (ESC {esc})", Escaped(&e.name))
+        format!("{input}: {}{channel} (ESC {esc})", Escaped(port))
     }
 }
 
@@ -286,7 +287,7 @@ impl<'a> Report<'a> {
         static EMPTY: std::sync::OnceLock<Accumulator> = std::sync::OnceLock::new();
         let empty = EMPTY.get_or_init(Accumulator::default);
         self.sources
-            .escs()
+            .esc_table()
             .iter()
             .enumerate()
             // A hub's channels that carried no ESC are not ESCs.
@@ -312,7 +313,7 @@ impl<'a> Report<'a> {
                     no_frames: no_frames(self.sources, i),
                     index: i,
                     label: esc_label(self.sources, i),
-                    stream: &esc.name,
+                    stream: &esc.key.port,
                     input: &self.sources.names()[esc.input],
                     stats: self.sources.link(i),
                     settings: self.sources.esc_settings(i),

@@ -60,7 +60,7 @@ impl Report<'_> {
             let _ = writeln!(
                 o,
                 "hub          {}: DataLink V2, {hub}",
-                Escaped(&self.sources.escs()[esc].name)
+                Escaped(&self.sources.esc_table()[esc].key.port)
             );
         }
         for esc in &escs {
