@@ -23,6 +23,16 @@ impl Report<'_> {
         }
         o.push('\n');
         for info in self.sources.inputs() {
+            if let Some(earlier) = info.duplicate_of {
+                let _ = writeln!(
+                    o,
+                    "input        {} ({}, the same bytes as {}: read once)",
+                    Escaped(&info.name),
+                    info.format,
+                    Escaped(&self.sources.names()[earlier])
+                );
+                continue;
+            }
             let escs = match info.escs.as_slice() {
                 [] => "no ESC".to_string(),
                 [one] => format!("ESC {one}"),
