@@ -140,3 +140,20 @@ fn two_can_logs_are_two_buses_and_a_copy_is_read_once() {
     let summary = stdout(&hwfoc().args(["summary", &logs[0], &copy]).output().unwrap());
     assert!(summary.contains("the same bytes as"), "{summary}");
 }
+
+/// A raw file (no times) given twice is read once too, and takes no second ESC.
+#[test]
+fn a_raw_file_given_twice_is_one_esc() {
+    let dir = Dir::new();
+    let raw = dir.arg("flight.bin");
+    ok(hwfoc()
+        .args(["simulate", "--duration", "5", "-o", &raw])
+        .output()
+        .unwrap());
+    let (alone, _) = run(&["decode", &raw]);
+    let (twice, err) = run(&["decode", &raw, &raw]);
+    assert_eq!(twice, alone);
+    assert!(err.contains("holds the same bytes as"), "{err}");
+    let (summary, _) = run(&["summary", &raw, &raw]);
+    assert!(!summary.contains("ESC 1"), "{summary}");
+}

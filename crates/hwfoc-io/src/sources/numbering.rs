@@ -178,6 +178,11 @@ impl Sources {
                 break;
             }
             let mut escs = Vec::new();
+            // A copy of an earlier input is not read: it has no ESC.
+            if self.duplicates.get(base + k).copied().flatten().is_some() {
+                self.numbered.push(escs);
+                continue;
+            }
             self.number_streams(input, base + k, &mut escs);
             self.numbered.push(escs);
         }
