@@ -22,6 +22,30 @@ impl RecordingId {
         RecordingId(uuid::Uuid::new_v4())
     }
 
+    /// An id made from `parts` alone (the same parts, the same id), for a writer whose bytes
+    /// must be the same run after run: the simulator's, from its seed and start time. Ids of
+    /// different parts differ as random ones do (the parts are mixed by SplitMix64, then laid
+    /// out as a version 4 UUID).
+    pub fn derived(parts: &[u64]) -> RecordingId {
+        let mut state = 0x6877_666f_6320_7265u64; // "hwfoc re"
+        let mut next = |x: u64| {
+            // SplitMix64 (Steele, Lea and Flood): a well-mixed 64-bit output per input.
+            state = state.wrapping_add(x).wrapping_add(0x9E37_79B9_7F4A_7C15);
+            let mut z = state;
+            z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+            z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+            z ^ (z >> 31)
+        };
+        for &p in parts {
+            next(p);
+        }
+        let (hi, lo) = (next(1), next(2));
+        let mut bytes = [0u8; 16];
+        bytes[..8].copy_from_slice(&hi.to_le_bytes());
+        bytes[8..].copy_from_slice(&lo.to_le_bytes());
+        RecordingId(uuid::Builder::from_random_bytes(bytes).into_uuid())
+    }
+
     /// The id a section header comment names, if it is one (`hwfoc recording UUID`).
     pub fn from_comment(comment: &str) -> Option<RecordingId> {
         let rest = comment.strip_prefix(PREFIX)?;
@@ -60,5 +84,10 @@ mod tests {
             RecordingId::from_comment("hwfoc recording not-a-uuid"),
             None
         );
+        let d = RecordingId::derived(&[7, 1_000_000_000]);
+        assert_eq!(d, RecordingId::derived(&[7, 1_000_000_000]));
+        assert_ne!(d, RecordingId::derived(&[8, 1_000_000_000]));
+        assert_ne!(d, RecordingId::derived(&[7, 2_000_000_000]));
+        assert_eq!(RecordingId::from_comment(&d.comment()), Some(d));
     }
 }
