@@ -18,8 +18,9 @@
 //! With no checksum, a frame is recognised by its plausibility (throttle and PWM at most 255),
 //! by chaining (the next `9B` exactly where the previous frame ended) and by its counter going
 //! up by one. The decoder locks onto a stream after three chained frames and then accepts each
-//! frame that continues the chain; anything else (garbage, a cut or corrupted frame, a counter
-//! that jumps because frames were lost or the ESC restarted) must start a new chain of three,
+//! frame that continues the chain (also across up to [`MAX_CHAINED_GAP`] frames cut out whole,
+//! counted lost); anything else (garbage, a cut or corrupted frame, a counter that jumps
+//! further because frames were lost or the ESC restarted) must start a new chain of three,
 //! whose first counter's step from the last accepted one is counted (lost frames, a duplicate,
 //! a restart). The scanner's state (where the chain ends, the last counter) lives in its
 //! [`Stats`], which the streaming layer of [`crate::scan`] hands it with every chunk, and a
@@ -69,6 +70,7 @@ mod stats;
 /// Baud rate of the V3 telemetry wire (8N1), as HW-FOC's.
 pub const BAUD_RATE: u32 = crate::foc::BAUD_RATE;
 
+pub use crate::chain::MAX_CHAINED_GAP;
 pub use decoder::{CHAIN_TO_LOCK, Decoded, Decoder, Frames, Scanner, frames};
 pub use frame::{
     COUNTER_AT, FRAME_LEN, FULL_SCALE, Frame, PLACEHOLDER_PERIOD_US, US_PER_MINUTE, erpm_of_period,

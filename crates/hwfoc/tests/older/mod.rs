@@ -104,6 +104,22 @@ where
     assert_eq!((out, *all_at_once.stats()), reference, "decode_all");
 }
 
+/// Which of `wanted.len()` frames are sent when those marked in `wanted` are cut out whole:
+/// all but the first three (which lock the decoder) and the last (after which a loss would not
+/// show), and at most `max_run` in a row (a longer run is an outage, after which a chain of
+/// three must lock again).
+pub fn sent_frames(wanted: &[bool], max_run: u32) -> Vec<bool> {
+    let mut run = 0;
+    let last = wanted.len().saturating_sub(1);
+    (0..wanted.len())
+        .map(|k| {
+            let cut = wanted[k] && k >= 3 && k < last && run < max_run;
+            run = if cut { run + 1 } else { 0 };
+            !cut
+        })
+        .collect()
+}
+
 /// A seeded xorshift64 generator: the same bytes on every run.
 pub struct Rng(pub u64);
 
@@ -119,6 +135,16 @@ impl Rng {
     /// `n` uniformly random bytes.
     pub fn uniform(&mut self, n: usize) -> Vec<u8> {
         (0..n).map(|_| self.next() as u8).collect()
+    }
+
+    /// `count` distinct indices drawn uniformly from `range`, in increasing order.
+    pub fn sample(&mut self, range: std::ops::Range<usize>, count: usize) -> Vec<usize> {
+        assert!(count <= range.len());
+        let mut picked = std::collections::BTreeSet::new();
+        while picked.len() < count {
+            picked.insert(range.start + (self.next() % range.len() as u64) as usize);
+        }
+        picked.into_iter().collect()
     }
 
     /// `n` random bytes of which about a quarter are `9B` and a quarter `B9`.
