@@ -4,6 +4,7 @@
 
 use std::fmt::Debug;
 
+use hwfoc::counters::PacketSequence24;
 use hwfoc::scan::{Scan, Scanner, StreamDecoder};
 
 use crate::common::streamed_bytewise;
@@ -118,6 +119,58 @@ pub fn sent_frames(wanted: &[bool], max_run: u32) -> Vec<bool> {
             !cut
         })
         .collect()
+}
+
+/// Asserts that the frames `got` (offset and counter) are those `want`ed, first naming the
+/// wanted frames missing by their counters' distance from `first`.
+pub fn assert_frames(got: &[(u64, u32)], want: &[(u64, u32)], first: u32) {
+    let missed: Vec<u32> = want
+        .iter()
+        .filter(|f| !got.contains(f))
+        .map(|(_, c)| c - first)
+        .collect();
+    assert!(missed.is_empty(), "intact frames lost: {missed:?}");
+    assert_eq!(got, want);
+}
+
+/// A chained scanner's figures of a link: the counter's lost, duplicate and restarted numbers,
+/// bytes skipped, rejected candidates, syncs.
+#[derive(Debug, PartialEq, Eq)]
+pub struct Figures {
+    pub lost: u32,
+    pub duplicates: u32,
+    pub restarts: u32,
+    pub skipped: u64,
+    pub rejected: u32,
+    pub syncs: u32,
+}
+
+impl Figures {
+    /// The figures of a scanner's statistics.
+    pub fn of(counter: &PacketSequence24, skipped: u64, rejected: u32, syncs: u32) -> Figures {
+        Figures {
+            lost: counter.lost(),
+            duplicates: counter.duplicates(),
+            restarts: counter.restarts(),
+            skipped,
+            rejected,
+            syncs,
+        }
+    }
+
+    /// What a scanner must report of a clean stream from which `cut` frames were cut out whole
+    /// (not the first three, nor the last): each counted lost, nothing skipped or rejected, one
+    /// sync.
+    pub fn after_cuts(cut: usize) -> Figures {
+        Figures {
+            lost: cut as u32,
+            duplicates: 0,
+            restarts: 0,
+            skipped: 0,
+            rejected: 0,
+            syncs: 1,
+        }
+    }
 }
 
 /// A seeded xorshift64 generator: the same bytes on every run.
