@@ -197,6 +197,21 @@ fn a_frame_between_two_cut_frames_continues_the_chain_up_to_the_bound() {
     }
 }
 
+/// The documented limit of the gap rule: a flip that moves a counter forward by at most
+/// `MAX_CHAINED_GAP` (bit 0 or 1 of its low byte) passes for frames cut before it; the frame is
+/// taken with its wrong counter and the next one, whose counter goes back, starts a new chain.
+#[test]
+fn a_counter_flipped_forward_within_the_gap_passes_for_cut_frames() {
+    let mut wire = encode_all(0..8);
+    wire[4 * FRAME_LEN + 3] ^= 0x02; // frame 4's counter becomes 6
+    let (decoded, stats) = bulk::<Scanner>(&wire);
+    assert_eq!(counters(&decoded), [0, 1, 2, 3, 6, 5, 6, 7]);
+    assert_eq!(
+        (stats.lost_frames(), stats.restarts(), stats.syncs()),
+        (2, 1, 2)
+    );
+}
+
 /// The documented limit: a chained frame that is cut short, whose counter follows and which
 /// the next frame's bytes complete into a plausible one, cannot be told from a real frame; the
 /// frame whose start it swallowed is lost, and the chain resumes three frames later.

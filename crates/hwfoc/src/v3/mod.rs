@@ -32,7 +32,10 @@
 //! - **A corruption that keeps a frame plausible**: the period (any value), the low bytes of
 //!   throttle and PWM, and any flip leaving both at most 255 go undetected in a chained frame:
 //!   about half of all single-bit flips. Only a flip in the counter or in bytes 4 and 6 is
-//!   caught (and then the frame and the next two are needed to lock again, see below).
+//!   caught (and then the frame and the next two are needed to lock again, see below), and of
+//!   the counter's, not one that moves it forward by at most [`MAX_CHAINED_GAP`] (bit 0 or 1
+//!   of its low byte set): that frame is taken with a wrong counter, as if frames had been cut
+//!   before it, and the next frame (whose counter goes back) starts a new chain.
 //! - **A chain break near the end of a stream**: after a break, the next frames are accepted
 //!   only once three chain; the last one or two frames of a stream after a break are dropped.
 //! - **V4 frames chaining on a V3 stream**: bytes 0-7 of a V4 data frame read as a plausible

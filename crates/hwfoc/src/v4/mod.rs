@@ -46,7 +46,10 @@
 //!
 //! - **A corruption that keeps a frame plausible**: eRPM (any value), the low bits of every
 //!   field, and any flip leaving a frame plausible go undetected in a chained frame: about half
-//!   of all single-bit flips. A flipped info frame is not adopted unless it comes twice.
+//!   of all single-bit flips. A flipped info frame is not adopted unless it comes twice. A flip
+//!   that moves the counter forward by at most [`MAX_CHAINED_GAP`] (bit 0 or 1 of its low byte
+//!   set) leaves the frame taken with a wrong counter, as if frames had been cut before it; the
+//!   next frame (whose counter goes back) starts a new chain.
 //! - **A chain break near the end of a stream**: after a break, frames are accepted only once a
 //!   new chain forms; the last one or two data frames of a running stream after a break are
 //!   dropped.
