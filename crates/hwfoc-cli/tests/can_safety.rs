@@ -16,8 +16,12 @@ use std::time::{Duration, Instant};
 use can_standin::{Answers, Bus, Esc, Node};
 use common::{hwfoc, run};
 
-fn can(args: &[&str]) -> Output {
-    run(hwfoc().arg("can").args(args).stdin(Stdio::null()))
+/// `hwfoc can` with the arguments of `line` (split at spaces), no terminal.
+fn can(line: &str) -> Output {
+    run(hwfoc()
+        .arg("can")
+        .args(line.split_whitespace())
+        .stdin(Stdio::null()))
 }
 
 fn text(o: &Output) -> (String, String) {
@@ -49,6 +53,11 @@ fn assert_fails_with(o: &Output, needle: &str) {
     );
 }
 
+/// Asserts that `text` holds `needle`.
+fn assert_has(text: &str, needle: &str) {
+    assert!(text.contains(needle), "{needle:?} not in {text:?}");
+}
+
 fn one(esc: Esc) -> Bus {
     Bus::start(vec![Node::Hobbywing(esc)])
 }
@@ -59,22 +68,14 @@ fn a_node_whose_status_is_off_is_refused_a_direction_but_not_an_led() {
         msg1: None,
         ..Esc::new(10, 1)
     });
-    let out = can(&[
-        "set",
-        &bus.spec,
-        "--node",
-        "10",
-        "--direction",
-        "ccw",
-        "--yes",
-    ]);
+    let out = can(&format!("set {} --node 10 --direction ccw --yes", bus.spec));
     show("set --direction ccw, StatusMsg1 off", &out);
     assert_fails_with(&out, "node 10 sends no StatusMsg1");
     assert_fails_with(&out, "--rate msg1=50");
     assert!(bus.writes().is_empty(), "{:?}", bus.writes());
-    let out = can(&["set", &bus.spec, "--node", "10", "--led", "red", "--yes"]);
+    let out = can(&format!("set {} --node 10 --led red --yes", bus.spec));
     assert!(out.status.success(), "{:?}", text(&out));
-    assert!(text(&out).0.contains("node 10 now says: LED red steady"));
+    assert_has(&text(&out).0, "node 10 now says: LED red steady");
 }
 
 #[test]
@@ -84,15 +85,7 @@ fn an_esc_heard_only_through_status_msg2_with_current_is_not_written_to() {
         msg2_current: Some(250),
         ..Esc::new(10, 1)
     });
-    let out = can(&[
-        "set",
-        &bus.spec,
-        "--node",
-        "10",
-        "--direction",
-        "ccw",
-        "--yes",
-    ]);
+    let out = can(&format!("set {} --node 10 --direction ccw --yes", bus.spec));
     assert_eq!(out.status.code(), Some(1), "{:?}", text(&out));
     assert!(bus.writes().is_empty(), "{:?}", bus.writes());
 }
@@ -104,15 +97,7 @@ fn a_motor_turning_at_1_hz_after_the_listen_phase_is_not_changed() {
         turns_after: Some(Duration::from_millis(2500)),
         ..Esc::new(10, 1)
     });
-    let out = can(&[
-        "set",
-        &bus.spec,
-        "--node",
-        "10",
-        "--direction",
-        "ccw",
-        "--yes",
-    ]);
+    let out = can(&format!("set {} --node 10 --direction ccw --yes", bus.spec));
     show(
         "set --direction ccw, StatusMsg1 at 1 Hz, turning from 2.5 s",
         &out,
@@ -154,11 +139,8 @@ fn a_motor_that_starts_during_the_question_is_not_changed() {
         &out,
     );
     let (_, err) = text(&out);
-    assert!(err.contains("Make the change? [y/N]"), "{err}");
-    assert!(
-        err.contains("nothing is changed while a motor turns"),
-        "{err}"
-    );
+    assert_has(&err, "Make the change? [y/N]");
+    assert_has(&err, "nothing is changed while a motor turns");
     assert_eq!(out.status.code(), Some(1));
     assert!(bus.writes().is_empty(), "{:?}", bus.writes());
 }
@@ -169,17 +151,10 @@ fn set_id_is_refused_while_its_esc_turns() {
         turns_after: Some(Duration::ZERO),
         ..Esc::new(12, 2)
     });
-    let out = can(&[
-        "set-id",
-        &bus.spec,
-        "--node",
-        "12",
-        "--to",
-        "40",
-        "--channel",
-        "2",
-        "--yes",
-    ]);
+    let out = can(&format!(
+        "set-id {} --node 12 --to 40 --channel 2 --yes",
+        bus.spec
+    ));
     assert_fails_with(&out, "node 12 reports rpm 3000, pwm 400");
     assert!(bus.writes().is_empty(), "{:?}", bus.writes());
 }
@@ -195,29 +170,11 @@ fn a_standard_esc_turning_stops_set_set_id_and_self_test() {
         },
     ]);
     for args in [
-        &[
-            "set",
-            &bus.spec,
-            "--node",
-            "10",
-            "--direction",
-            "ccw",
-            "--yes",
-        ][..],
-        &[
-            "set-id",
-            &bus.spec,
-            "--node",
-            "10",
-            "--to",
-            "20",
-            "--channel",
-            "2",
-            "--yes",
-        ],
-        &["self-test", &bus.spec, "--node", "10"],
+        "set {spec} --node 10 --direction ccw --yes",
+        "set-id {spec} --node 10 --to 20 --channel 2 --yes",
+        "self-test {spec} --node 10",
     ] {
-        let out = can(args);
+        let out = can(&args.replace("{spec}", &bus.spec));
         assert_fails_with(&out, "node 30 reports rpm 5000, 10.0 A");
     }
     assert!(bus.writes().is_empty(), "{:?}", bus.writes());
@@ -229,19 +186,12 @@ fn set_id_hears_a_node_sending_node_status_at_1_hz_and_source_is_refused_as_it()
         Node::Hobbywing(Esc::new(10, 1)),
         Node::Gps { node: 20 },
     ]);
-    let out = can(&[
-        "set-id",
-        &bus.spec,
-        "--node",
-        "10",
-        "--to",
-        "20",
-        "--channel",
-        "1",
-        "--yes",
-    ]);
+    let out = can(&format!(
+        "set-id {} --node 10 --to 20 --channel 1 --yes",
+        bus.spec
+    ));
     assert_fails_with(&out, "node 20 is already on");
-    let out = can(&["list", &bus.spec, "--source", "20"]);
+    let out = can(&format!("list {} --source 20", bus.spec));
     assert_fails_with(&out, "node 20 is on the bus");
     assert!(bus.writes().is_empty(), "{:?}", bus.writes());
     assert!(
@@ -258,33 +208,21 @@ fn a_write_answered_late_is_read_back() {
         answers: Answers::LateWrites(Duration::from_millis(1500)),
         ..Esc::new(10, 1)
     });
-    let out = can(&[
-        "set",
-        &bus.spec,
-        "--node",
-        "10",
-        "--direction",
-        "ccw",
-        "--timeout",
-        "1",
-        "--yes",
-    ]);
+    let out = can(&format!(
+        "set {} --node 10 --direction ccw --timeout 1 --yes",
+        bus.spec
+    ));
     show(
         "set --direction ccw, SetDirection answered 1.5 s late, --timeout 1",
         &out,
     );
     let (stdout, stderr) = text(&out);
     assert!(out.status.success(), "{stdout}{stderr}");
-    assert!(
-        stderr.contains(
-            "node 10 did not answer SetDirection within 1 s: the change may have been made"
-        ),
-        "{stderr}"
+    assert_has(
+        &stderr,
+        "node 10 did not answer SetDirection within 1 s: the change may have been made",
     );
-    assert!(
-        stdout.contains("node 10 now says: direction ccw"),
-        "{stdout}"
-    );
+    assert_has(&stdout, "node 10 now says: direction ccw");
 }
 
 #[test]
@@ -293,34 +231,16 @@ fn a_later_failure_lists_the_changes_made_before_it() {
         mutes_led: true,
         ..Esc::new(10, 1)
     });
-    let out = can(&[
-        "set",
-        &bus.spec,
-        "--node",
-        "10",
-        "--direction",
-        "ccw",
-        "--led",
-        "red",
-        "--timeout",
-        "0.5",
-        "--yes",
-    ]);
+    let out = can(&format!(
+        "set {} --node 10 --direction ccw --led red --timeout 0.5 --yes",
+        bus.spec
+    ));
     show("set --direction ccw --led red, SetLED unanswered", &out);
     let (stdout, stderr) = text(&out);
     assert_eq!(out.status.code(), Some(1), "{stdout}{stderr}");
-    assert!(
-        stdout.contains("node 10 now says: direction ccw"),
-        "{stdout}"
-    );
-    assert!(
-        stderr.contains("did not answer SetLED within 0.5 s"),
-        "{stderr}"
-    );
-    assert!(
-        stderr.contains("read back, it says LED green steady"),
-        "{stderr}"
-    );
+    assert_has(&stdout, "node 10 now says: direction ccw");
+    assert_has(&stderr, "did not answer SetLED within 0.5 s");
+    assert_has(&stderr, "read back, it says LED green steady");
 }
 
 #[test]
@@ -329,17 +249,10 @@ fn a_read_back_that_differs_stops_the_changes() {
         keeps_direction: true,
         ..Esc::new(10, 1)
     });
-    let out = can(&[
-        "set",
-        &bus.spec,
-        "--node",
-        "10",
-        "--direction",
-        "ccw",
-        "--led",
-        "red",
-        "--yes",
-    ]);
+    let out = can(&format!(
+        "set {} --node 10 --direction ccw --led red --yes",
+        bus.spec
+    ));
     show(
         "set --direction ccw --led red, direction read back cw",
         &out,
@@ -360,45 +273,25 @@ fn answers_twice_from_another_node_or_with_a_wrong_transfer_id() {
         answers: Answers::Twice,
         ..Esc::new(10, 1)
     });
-    let out = can(&[
-        "set",
-        &bus.spec,
-        "--node",
-        "10",
-        "--direction",
-        "ccw",
-        "--led",
-        "red,save",
-        "--yes",
-    ]);
+    let out = can(&format!(
+        "set {} --node 10 --direction ccw --led red,save --yes",
+        bus.spec
+    ));
     let (stdout, _) = text(&out);
     assert!(out.status.success(), "{:?}", text(&out));
-    assert!(
-        stdout.contains("node 10 now says: direction ccw"),
-        "{stdout}"
-    );
+    assert_has(&stdout, "node 10 now says: direction ccw");
     // "saved" is not what the ESC said: it cannot report it.
-    assert!(
-        stdout.contains("node 10 now says: LED red steady\n"),
-        "{stdout}"
-    );
-    assert!(stdout.contains("cannot be read back"), "{stdout}");
+    assert_has(&stdout, "node 10 now says: LED red steady\n");
+    assert_has(&stdout, "cannot be read back");
     for answers in [Answers::FromNode(30), Answers::WrongTransferId] {
         let bus = one(Esc {
             answers,
             ..Esc::new(10, 1)
         });
-        let out = can(&[
-            "set",
-            &bus.spec,
-            "--node",
-            "10",
-            "--led",
-            "blue",
-            "--timeout",
-            "0.5",
-            "--yes",
-        ]);
+        let out = can(&format!(
+            "set {} --node 10 --led blue --timeout 0.5 --yes",
+            bus.spec
+        ));
         assert_fails_with(&out, "node 10 did not answer GetMajorConfig within 0.5 s");
         assert!(bus.writes().is_empty(), "{:?}", bus.writes());
     }
@@ -410,17 +303,10 @@ fn a_set_id_not_applied_says_so() {
         ignores_set_id: true,
         ..Esc::new(12, 2)
     });
-    let out = can(&[
-        "set-id",
-        &bus.spec,
-        "--node",
-        "12",
-        "--to",
-        "40",
-        "--channel",
-        "2",
-        "--yes",
-    ]);
+    let out = can(&format!(
+        "set-id {} --node 12 --to 40 --channel 2 --yes",
+        bus.spec
+    ));
     assert_fails_with(
         &out,
         "node 12 still answers as node 12: SetID was not applied",
@@ -433,24 +319,14 @@ fn set_id_answered_late_is_read_back_at_the_new_node() {
         answers: Answers::LateWrites(Duration::from_millis(1500)),
         ..Esc::new(12, 2)
     });
-    let out = can(&[
-        "set-id",
-        &bus.spec,
-        "--node",
-        "12",
-        "--to",
-        "40",
-        "--channel",
-        "3",
-        "--yes",
-    ]);
+    let out = can(&format!(
+        "set-id {} --node 12 --to 40 --channel 3 --yes",
+        bus.spec
+    ));
     let (stdout, stderr) = text(&out);
     assert!(out.status.success(), "{stdout}{stderr}");
-    assert!(
-        stdout.contains("node 12 now says: node id 40, throttle channel 3"),
-        "{stdout}"
-    );
-    assert!(stderr.contains("the change may have been made"), "{stderr}");
+    assert_has(&stdout, "node 12 now says: node id 40, throttle channel 3");
+    assert_has(&stderr, "the change may have been made");
 }
 
 #[test]
@@ -466,7 +342,7 @@ fn self_test_is_refused_on_a_factory_bus() {
             ..Esc::new(1, 1)
         }),
     ]);
-    let out = can(&["self-test", &bus.spec, "--node", "1"]);
+    let out = can(&format!("self-test {} --node 1", bus.spec));
     assert_fails_with(&out, "ESCs answer as node 1 (the factory state)");
     assert!(bus.writes().is_empty(), "{:?}", bus.writes());
 }
@@ -480,11 +356,11 @@ fn list_asks_nothing_while_an_esc_turns() {
             ..Esc::new(11, 2)
         }),
     ]);
-    let out = can(&["list", &bus.spec]);
+    let out = can(&format!("list {}", bus.spec));
     let (stdout, _) = text(&out);
     assert!(out.status.success(), "{stdout}");
     assert!(bus.requests().is_empty(), "{:?}", bus.requests());
-    assert!(stdout.contains("a motor turns: nothing asked"), "{stdout}");
+    assert_has(&stdout, "a motor turns: nothing asked");
 }
 
 #[test]
@@ -493,21 +369,18 @@ fn list_flags_two_escs_on_one_throttle_channel_and_names_the_bit_rate_when_empty
         Node::Hobbywing(Esc::new(10, 1)),
         Node::Hobbywing(Esc::new(11, 1)),
     ]);
-    let (stdout, _) = text(&can(&["list", &bus.spec]));
-    assert!(
-        stdout.contains(
-            "nodes 10 and 11 both say throttle channel 1: both would take the same throttle"
-        ),
-        "{stdout}"
+    let (stdout, _) = text(&can(&format!("list {}", bus.spec)));
+    assert_has(
+        &stdout,
+        "nodes 10 and 11 both say throttle channel 1: both would take the same throttle",
     );
     let empty = Bus::start(vec![]);
-    let out = can(&["list", &empty.spec, "--listen", "0.5"]);
+    let out = can(&format!("list {} --listen 0.5", empty.spec));
     let (stdout, stderr) = text(&out);
     show("list, no node", &out);
-    assert!(
-        stdout.contains("no node heard at 500000 bit/s (the ESCs' factory bit rate is 500 kbit/s")
-            || stderr.contains("no node heard at 500000 bit/s"),
-        "{stdout}{stderr}"
+    assert_has(
+        &stdout,
+        "no node heard at 500000 bit/s (the ESCs' factory bit rate is 500 kbit/s",
     );
     assert!(!(stdout + &stderr).to_lowercase().contains("baud"));
 }
@@ -515,7 +388,7 @@ fn list_flags_two_escs_on_one_throttle_channel_and_names_the_bit_rate_when_empty
 #[test]
 fn nothing_is_sent_before_a_refusal_for_lack_of_a_terminal() {
     let bus = one(Esc::new(10, 1));
-    let out = can(&["set", &bus.spec, "--node", "10", "--direction", "ccw"]);
+    let out = can(&format!("set {} --node 10 --direction ccw", bus.spec));
     assert_fails_with(&out, "--yes: no terminal to confirm");
     assert!(bus.requests().is_empty(), "{:?}", bus.requests());
 }

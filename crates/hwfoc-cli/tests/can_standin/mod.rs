@@ -240,13 +240,9 @@ fn run(mut pair: RawPair, nodes: Vec<Node>, stop: &AtomicBool, log: &Mutex<Vec<R
                 Node::Standard { node, rpm, current } => (
                     node,
                     EscStatus {
-                        error_count: 0,
-                        voltage: 16.0,
                         current,
-                        temperature: 300.0,
                         rpm,
-                        power_rating_pct: 20,
-                        esc_index: 0,
+                        ..EscStatus::default()
                     }
                     .into(),
                     100,
@@ -273,10 +269,7 @@ fn run(mut pair: RawPair, nodes: Vec<Node>, stop: &AtomicBool, log: &Mutex<Vec<R
 fn node_status(start: Instant) -> Message {
     NodeStatus {
         uptime_sec: start.elapsed().as_secs() as u32,
-        health: 0,
-        mode: 0,
-        sub_mode: 0,
-        vendor_specific_status_code: 0,
+        ..NodeStatus::default()
     }
     .into()
 }

@@ -381,13 +381,9 @@ mod tests {
         );
         assert!(h.any_turning());
         let status = |rpm, current| EscStatus {
-            error_count: 0,
-            voltage: 16.0,
             current,
-            temperature: 300.0,
             rpm,
-            power_rating_pct: 20,
-            esc_index: 0,
+            ..EscStatus::default()
         };
         feed(&mut h, 30, status(0, 0.25), 0);
         assert!(!h.node(30).unwrap().turning());
@@ -396,14 +392,7 @@ mod tests {
         assert!(n.turning_now() && n.is_esc());
         assert_eq!(n.window_motion.unwrap().to_string(), "rpm 5000, 10.0 A");
         // A node sending NodeStatus only is no ESC.
-        let ns = NodeStatus {
-            uptime_sec: 1,
-            health: 0,
-            mode: 0,
-            sub_mode: 0,
-            vendor_specific_status_code: 0,
-        };
-        feed(&mut h, 20, ns, 0);
+        feed(&mut h, 20, NodeStatus::default(), 0);
         assert!(!h.node(20).unwrap().is_esc());
     }
 
