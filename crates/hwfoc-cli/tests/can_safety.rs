@@ -160,6 +160,20 @@ fn set_id_is_refused_while_its_esc_turns() {
 }
 
 #[test]
+fn set_id_is_not_sent_to_an_esc_that_starts_turning_after_the_listen() {
+    let bus = one(Esc {
+        turns_after: Some(Duration::from_millis(1300)),
+        ..Esc::new(12, 2)
+    });
+    let out = can(&format!(
+        "set-id {} --node 12 --to 40 --channel 2 --yes",
+        bus.spec
+    ));
+    assert_fails_with(&out, "node 12 reports rpm 3000, pwm 400");
+    assert!(bus.writes().is_empty(), "{:?}", bus.writes());
+}
+
+#[test]
 fn a_standard_esc_turning_stops_set_set_id_and_self_test() {
     let bus = Bus::start(vec![
         Node::Hobbywing(Esc::new(10, 1)),
