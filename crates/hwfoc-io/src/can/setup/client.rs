@@ -12,7 +12,7 @@ use hwfoc::dronecan::{
 };
 
 use super::SetupError;
-use super::heard::{Heard, Motion, NodeHeard};
+use super::heard::{Heard, NodeHeard};
 use super::values::{Change, Direction, Led, StatusMessage, ThrottleSource};
 use crate::can::{ASK_EVERY, ASK_PRIORITY, CanBus, CanError};
 
@@ -200,11 +200,6 @@ impl<L: Link> Client<L> {
         self.listen_until(until, |_, _| false)
     }
 
-    /// The id hwfoc sends from.
-    pub fn source(&self) -> u8 {
-        self.source
-    }
-
     fn watch(&mut self) {
         if !self.watching {
             self.heard.start_window();
@@ -260,11 +255,15 @@ impl<L: Link> Client<L> {
                     && h.node(node)
                         .is_none_or(|n| n.status1.is_none() || fresh(n, now)))
         })?;
-        if let Some(n) = self.heard.nodes().find(|n| n.turning()) {
+        let turned = self
+            .heard
+            .nodes()
+            .find_map(|n| n.window_motion.map(|m| (n.node, m)));
+        if let Some((node, motion)) = turned {
             return Err(SetupError::Turning {
                 bus: self.bus().to_string(),
-                node: n.node,
-                motion: n.window_motion.unwrap_or(Motion::RpmPwm { rpm: 0, pwm: 0 }),
+                node,
+                motion,
             });
         }
         if !motor {
@@ -278,12 +277,8 @@ impl<L: Link> Client<L> {
         };
         match self.heard.node(node) {
             Some(n) if fresh(n, now) => {}
-            Some(n) => {
-                return Err(unseen(
-                    node,
-                    n.status1.is_some() || n.is_esc() || n.node_status.is_some(),
-                ));
-            }
+            // Heard, but not its rpm and pwm of late.
+            Some(_) => return Err(unseen(node, true)),
             None => return Err(unseen(node, false)),
         }
         match reporting
