@@ -53,6 +53,15 @@ fn assert_fails_with(o: &Output, needle: &str) {
     );
 }
 
+/// Runs `hwfoc can` with `line` (`{spec}` the bus), asserts it is refused with `needle` and
+/// that nothing was written to the bus.
+fn refused_unwritten(bus: &Bus, line: &str, needle: &str) -> Output {
+    let out = can(&line.replace("{spec}", &bus.spec));
+    assert_fails_with(&out, needle);
+    assert!(bus.writes().is_empty(), "{:?}", bus.writes());
+    out
+}
+
 /// Asserts that `text` holds `needle`.
 fn assert_has(text: &str, needle: &str) {
     assert!(text.contains(needle), "{needle:?} not in {text:?}");
@@ -97,13 +106,15 @@ fn a_motor_turning_at_1_hz_after_the_listen_phase_is_not_changed() {
         turns_after: Some(Duration::from_millis(2500)),
         ..Esc::new(10, 1)
     });
-    let out = can(&format!("set {} --node 10 --direction ccw --yes", bus.spec));
+    let out = refused_unwritten(
+        &bus,
+        "set {spec} --node 10 --direction ccw --yes",
+        "nothing is changed while a motor turns",
+    );
     show(
         "set --direction ccw, StatusMsg1 at 1 Hz, turning from 2.5 s",
         &out,
     );
-    assert_fails_with(&out, "nothing is changed while a motor turns");
-    assert!(bus.writes().is_empty(), "{:?}", bus.writes());
 }
 
 #[test]
@@ -145,32 +156,21 @@ fn a_motor_that_starts_during_the_question_is_not_changed() {
     assert!(bus.writes().is_empty(), "{:?}", bus.writes());
 }
 
+/// set-id is not sent to an ESC turning from the start, nor to one that starts after the
+/// first listen.
 #[test]
 fn set_id_is_refused_while_its_esc_turns() {
-    let bus = one(Esc {
-        turns_after: Some(Duration::ZERO),
-        ..Esc::new(12, 2)
-    });
-    let out = can(&format!(
-        "set-id {} --node 12 --to 40 --channel 2 --yes",
-        bus.spec
-    ));
-    assert_fails_with(&out, "node 12 reports rpm 3000, pwm 400");
-    assert!(bus.writes().is_empty(), "{:?}", bus.writes());
-}
-
-#[test]
-fn set_id_is_not_sent_to_an_esc_that_starts_turning_after_the_listen() {
-    let bus = one(Esc {
-        turns_after: Some(Duration::from_millis(1300)),
-        ..Esc::new(12, 2)
-    });
-    let out = can(&format!(
-        "set-id {} --node 12 --to 40 --channel 2 --yes",
-        bus.spec
-    ));
-    assert_fails_with(&out, "node 12 reports rpm 3000, pwm 400");
-    assert!(bus.writes().is_empty(), "{:?}", bus.writes());
+    for ms in [0, 1300] {
+        let bus = one(Esc {
+            turns_after: Some(Duration::from_millis(ms)),
+            ..Esc::new(12, 2)
+        });
+        refused_unwritten(
+            &bus,
+            "set-id {spec} --node 12 --to 40 --channel 2 --yes",
+            "node 12 reports rpm 3000, pwm 400",
+        );
+    }
 }
 
 #[test]
@@ -188,10 +188,8 @@ fn a_standard_esc_turning_stops_set_set_id_and_self_test() {
         "set-id {spec} --node 10 --to 20 --channel 2 --yes",
         "self-test {spec} --node 10",
     ] {
-        let out = can(&args.replace("{spec}", &bus.spec));
-        assert_fails_with(&out, "node 30 reports rpm 5000, 10.0 A");
+        refused_unwritten(&bus, args, "node 30 reports rpm 5000, 10.0 A");
     }
-    assert!(bus.writes().is_empty(), "{:?}", bus.writes());
 }
 
 #[test]
@@ -205,9 +203,7 @@ fn set_id_hears_a_node_sending_node_status_at_1_hz_and_source_is_refused_as_it()
         bus.spec
     ));
     assert_fails_with(&out, "node 20 is already on");
-    let out = can(&format!("list {} --source 20", bus.spec));
-    assert_fails_with(&out, "node 20 is on the bus");
-    assert!(bus.writes().is_empty(), "{:?}", bus.writes());
+    refused_unwritten(&bus, "list {spec} --source 20", "node 20 is on the bus");
     assert!(
         bus.requests()
             .iter()
@@ -302,12 +298,11 @@ fn answers_twice_from_another_node_or_with_a_wrong_transfer_id() {
             answers,
             ..Esc::new(10, 1)
         });
-        let out = can(&format!(
-            "set {} --node 10 --led blue --timeout 0.5 --yes",
-            bus.spec
-        ));
-        assert_fails_with(&out, "node 10 did not answer GetMajorConfig within 0.5 s");
-        assert!(bus.writes().is_empty(), "{:?}", bus.writes());
+        refused_unwritten(
+            &bus,
+            "set {spec} --node 10 --led blue --timeout 0.5 --yes",
+            "node 10 did not answer GetMajorConfig within 0.5 s",
+        );
     }
 }
 
@@ -356,9 +351,11 @@ fn self_test_is_refused_on_a_factory_bus() {
             ..Esc::new(1, 1)
         }),
     ]);
-    let out = can(&format!("self-test {} --node 1", bus.spec));
-    assert_fails_with(&out, "ESCs answer as node 1 (the factory state)");
-    assert!(bus.writes().is_empty(), "{:?}", bus.writes());
+    refused_unwritten(
+        &bus,
+        "self-test {spec} --node 1",
+        "ESCs answer as node 1 (the factory state)",
+    );
 }
 
 #[test]
