@@ -28,6 +28,7 @@
 //! in time order (a heap of the batches read ahead, a queue per ESC, the bytes two inputs hold
 //! of one port left out once); `mod.rs` reads the inputs, alone or together.
 
+mod can_plan;
 mod merge;
 mod numbering;
 mod split;
@@ -45,7 +46,7 @@ pub use crate::handler::Handler;
 use crate::handler::LaterPart;
 use crate::input::{Batch, Input, InputError, InputFormat};
 use crate::settings::SettingsMap;
-use crate::stream::{EscLink, Stream};
+use crate::stream::{BusPlan, EscLink, Stream};
 use crate::time::Clock;
 
 pub use self::merge::MAX_QUEUED;
@@ -113,6 +114,8 @@ pub struct Sources {
     /// The ESC of each channel of each stream found to come from a DataLink hub, by the ESC
     /// of its stream.
     hubs: HashMap<usize, Hub>,
+    /// The slots of the ESCs of each CAN bus read ahead (`can_plan.rs`), by its stream's name.
+    buses: HashMap<String, BusPlan>,
     /// The ESCs of each input's streams numbered before it is read, by input.
     numbered: Vec<Vec<Option<usize>>>,
     queue: Queue,
@@ -145,6 +148,7 @@ impl Sources {
             need_timing: false,
             ports: HashMap::new(),
             hubs: HashMap::new(),
+            buses: HashMap::new(),
             numbered: Vec::new(),
             esc_settings: Vec::new(),
             queue: Queue::default(),
@@ -291,6 +295,7 @@ impl Sources {
     /// finished), and the error is returned without reading further.
     pub fn run<H: Handler>(&mut self, handler: &mut H) -> Result<(), H::Error> {
         let mut inputs: VecDeque<Input> = std::mem::take(&mut self.pending).into();
+        self.plan_buses(&mut inputs);
         self.number_inputs(&inputs);
         let mut result = Ok(());
         while let Some(first) = inputs.front() {

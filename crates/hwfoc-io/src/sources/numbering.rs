@@ -74,13 +74,25 @@ impl Sources {
         self.hubs.insert(esc, hub);
     }
 
-    /// A new ESC, its settings looked up once.
-    fn push_esc(&mut self, esc: Esc) {
+    /// A new ESC, its settings looked up once. A CAN bus read ahead (`can_plan.rs`) has its
+    /// ESCs' slots fixed and numbered at once, so that its ESCs' numbers follow each other
+    /// whatever is heard on other buses meanwhile.
+    fn push_esc(&mut self, mut esc: Esc) {
+        let plan = match esc.stream.is_can() {
+            true => self.buses.get(&esc.name).cloned(),
+            false => None,
+        };
+        if let Some(plan) = &plan {
+            esc.stream.plan_can(plan);
+        }
         let settings = self.settings.get(self.escs.len(), &esc.name);
         self.escs.push(esc);
         self.esc_settings.push(settings);
         self.readers.push(0);
         self.fed.push(None);
+        if let Some(plan) = plan.filter(|p| !p.is_empty()) {
+            self.grow_hub(self.escs.len() - 1, plan.len());
+        }
     }
 
     /// The ESC of stream `stream` of `input` (number `index`), made when first seen; `escs`
@@ -119,13 +131,15 @@ impl Sources {
                 } else {
                     Stream::forced(self.forced)
                 };
+                // (A CAN bus read ahead numbers its ESCs after its own at once.)
+                let esc = self.escs.len();
                 self.push_esc(Esc {
                     input: index,
                     name,
                     stream,
                     hub: None,
                 });
-                self.escs.len() - 1
+                esc
             }
         };
         if escs.len() <= stream {
