@@ -560,13 +560,13 @@ fn esc_id(node: u8, channel: u8) -> Message {
     GetEscId::new(&[node, channel]).unwrap().into()
 }
 
-/// Decodes `log`: its records' `(node, esc)` pairs in order, and standard error.
+/// Decodes `log`: its records' `(node, esc)` pairs in order, its records, and standard error.
 fn decode_log(log: &str) -> (Vec<(u64, u64)>, Vec<Value>, String) {
     let dir = Dir::new();
     let path = dir.path("bus.log");
     std::fs::write(&path, log).unwrap();
     let out = run(&["decode", path.to_str().unwrap()]);
-    let got = records(&stdout(&out));
+    let got = records(&String::from_utf8(out.stdout).unwrap());
     let pairs = got
         .iter()
         .map(|r| (r["node"].as_u64().unwrap(), r["esc"].as_u64().unwrap()))
@@ -687,4 +687,59 @@ fn a_stray_frame_on_another_interface_moves_no_esc() {
     log.insert_str(at, &line_on(1_700_000_001.505, "vcan1", &stray));
     let (pairs, _, err) = decode_log(&log);
     assert_eq!(esc_of_nodes(&pairs), [(1, 0), (2, 1)], "{err}");
+    assert_eq!(err, "", "a bus without ESCs is no ESC to warn of");
+    // The stray frame first in the log: it took ESC 0, can0's ESCs 1 and 2.
+    let log = format!("{}{log}", line_on(1_699_999_999.0, "vcan1", &stray));
+    let (pairs, _, err) = decode_log(&log);
+    assert_eq!(esc_of_nodes(&pairs), [(1, 0), (2, 1)], "{err}");
+    assert_eq!(err, "");
+}
+
+/// A bus of error frames and no ESC status is told of in CAN words, with a wrong bit rate as
+/// its likely cause (it was told to check the baud rate and the wiring of an ESC's serial
+/// wire): read ahead from a file, or read once from standard input.
+#[test]
+fn a_bus_of_error_frames_suggests_a_wrong_bit_rate_in_can_words() {
+    let error = CanFrame::from_socketcan(SOCKETCAN_ERR_FLAG | 0x08, &[0, 0, 0x08, 0, 0, 0, 0, 0]);
+    let mut log = String::new();
+    for k in 0..3 {
+        log.push_str(&line(
+            1_700_000_000.0 + f64::from(k) * 0.01,
+            error.as_ref().unwrap(),
+        ));
+    }
+    log.push_str(&line(
+        1_700_000_000.5,
+        &CanFrame::standard(0x123, &[1]).unwrap(),
+    ));
+    let (_, got, err) = decode_log(&log);
+    assert!(got.is_empty());
+    let from_stdin = {
+        let mut child = hwfoc()
+            .args(["decode", "-"])
+            .stdin(Stdio::piped())
+            .stdout(Stdio::null())
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap();
+        use std::io::Write;
+        child
+            .stdin
+            .take()
+            .unwrap()
+            .write_all(log.as_bytes())
+            .unwrap();
+        String::from_utf8(child.wait_with_output().unwrap().stderr).unwrap()
+    };
+    for err in [&err, &from_stdin] {
+        assert!(
+            err.contains(
+                "4 CAN frames, 3 of them error frames, and no ESC status: check the bit rate"
+            ),
+            "{err}"
+        );
+        for word in ["baud", "wiring", "RX"] {
+            assert!(!err.contains(word), "{word}: {err}");
+        }
+    }
 }

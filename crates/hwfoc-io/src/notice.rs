@@ -65,17 +65,18 @@ pub enum Notice {
         /// How many were skipped.
         frames: u64,
     },
-    /// Two ESCs of a CAN bus that claim one throttle channel (two nodes answering GetEscID with
-    /// one channel, a Hobbywing ESC beside a standard one of that `esc_index`): read as two
-    /// ESCs, the second numbered after the bus's channels.
-    SharedCanChannel {
+    /// Something amiss on a CAN bus of a file, found when it was read ahead: two ESCs that
+    /// claim one throttle channel (two nodes answering GetEscID with one channel, a Hobbywing
+    /// ESC beside a standard one of that `esc_index`: read as two ESCs, the second numbered
+    /// after the bus's channels), or error frames and no ESC status (a wrong bit rate).
+    CanBus {
         /// The input as named.
         input: String,
         /// The interface (bus).
         interface: String,
-        /// Both ESCs and the channel, in words (`node 10 and node 11 both claim throttle
-        /// channel 1: read as two ESCs`).
-        clash: String,
+        /// What, in words (`node 10 and node 11 both claim throttle channel 1: read as two
+        /// ESCs`).
+        message: String,
     },
     /// A damaged place in a recording, skipped.
     Damage {
@@ -132,7 +133,7 @@ impl Notice {
             Notice::PortLost { .. }
                 | Notice::ForeignInterface { .. }
                 | Notice::NotClassicCan { .. }
-                | Notice::SharedCanChannel { .. }
+                | Notice::CanBus { .. }
                 | Notice::Damage { .. }
                 | Notice::Overlap { .. }
         )
@@ -199,11 +200,11 @@ impl fmt::Display for Notice {
                 Escaped(input),
                 Escaped(interface)
             ),
-            Notice::SharedCanChannel {
+            Notice::CanBus {
                 input,
                 interface,
-                clash,
-            } => write!(f, "{}: {}: {clash}", Escaped(input), Escaped(interface)),
+                message,
+            } => write!(f, "{}: {}: {message}", Escaped(input), Escaped(interface)),
             Notice::Damage { input, damage } => write!(f, "{}: {damage}", Escaped(input)),
             Notice::Overlap {
                 input,

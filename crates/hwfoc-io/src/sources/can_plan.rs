@@ -8,7 +8,7 @@ use std::collections::VecDeque;
 use super::Sources;
 use crate::input::{Input, InputFormat};
 use crate::notice::Notice;
-use crate::stream::BusLearner;
+use crate::stream::{BusLearner, BusPlan, no_status};
 
 impl Sources {
     /// Reads ahead the CAN buses of the inputs that can be read twice (candump logs and
@@ -54,17 +54,33 @@ impl Sources {
             input.rewind();
         }
         for (name, learner, k) in buses {
+            let bus = learner.bus();
             let plan = learner.plan();
-            for clash in &plan.clashes {
-                let input = &mut inputs[k];
-                let notice = Notice::SharedCanChannel {
+            let mut messages: Vec<String> = plan.clashes.iter().map(|c| c.to_string()).collect();
+            // A bus of stray frames says nothing; one of error frames, its likely cause.
+            if plan.is_empty() && bus.error_frames() > 0 {
+                messages.push(no_status(&bus));
+            }
+            let input = &mut inputs[k];
+            for message in messages {
+                let notice = Notice::CanBus {
                     input: input.name().to_string(),
                     interface: name.clone(),
-                    clash: clash.to_string(),
+                    message,
                 };
                 input.tell(notice);
             }
             self.buses.insert(name, plan);
         }
+    }
+
+    /// Whether stream `stream` of `input` is a CAN bus read ahead that carries no ESC status
+    /// (an interface of stray frames): it is no ESC, takes no number and moves none.
+    pub(super) fn is_silent_bus(&self, input: &Input, stream: usize) -> bool {
+        input.is_can(stream)
+            && self
+                .buses
+                .get(&input.stream_name(stream))
+                .is_some_and(BusPlan::is_empty)
     }
 }

@@ -222,14 +222,26 @@ impl Sources {
         count: bool,
     ) -> Result<(), InputError> {
         let reading = &mut run[k];
-        let batch = match reading.input.next_batch() {
-            Ok(Some(batch)) => batch,
-            Ok(None) => {
-                reading.ahead = None;
-                self.end_of(run, k, more_recordings);
-                return Ok(());
+        loop {
+            let (stream, len) = match reading.input.next_batch() {
+                Ok(Some(batch)) => (batch.stream, batch.bytes.len()),
+                Ok(None) => {
+                    reading.ahead = None;
+                    self.end_of(run, k, more_recordings);
+                    return Ok(());
+                }
+                Err(e) => return Err(e),
+            };
+            // A CAN bus without ESCs is no ESC (`can_plan.rs`): its bytes are counted only.
+            if !self.is_silent_bus(&reading.input, stream) {
+                break;
             }
-            Err(e) => return Err(e),
+            if count {
+                reading.bytes += len as u64;
+            }
+        }
+        let Some(batch) = reading.input.current_batch() else {
+            return Ok(());
         };
         let Some(times) = batch.times else {
             return Err(InputError::NoTiming {

@@ -159,6 +159,9 @@ impl Sources {
         escs: &mut Vec<Option<usize>>,
     ) {
         for stream in 0..input.streams() {
+            if self.is_silent_bus(input, stream) {
+                continue;
+            }
             if self.esc_of(input, index, stream, escs).is_err() {
                 break;
             }

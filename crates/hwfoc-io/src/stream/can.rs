@@ -168,6 +168,11 @@ impl BusLearner {
         });
     }
 
+    /// The bus's frame statistics.
+    pub(crate) fn bus(&self) -> BusStats {
+        *self.wire.rx.stats().bus()
+    }
+
     /// The slots of the bus's ESCs: each at the place it had last, an ESC that claims a place
     /// another had first after the bus's places.
     pub(crate) fn plan(self) -> BusPlan {
@@ -371,7 +376,28 @@ pub struct CanLink {
     pub bad_records: u32,
 }
 
+/// Why a bus gave no ESC status, in CAN words: its frames, and a wrong bit rate where it is the
+/// likely cause (no frame at all, or error frames).
+pub(crate) fn no_status(bus: &BusStats) -> String {
+    let rate = format!(
+        "check the bit rate the bus is read at (Hobbywing's DroneCAN ESCs are {} kbit/s from \
+         the factory)",
+        crate::can::DEFAULT_BITRATE / 1000
+    );
+    match (bus.frames(), bus.error_frames()) {
+        (0, _) => format!("no CAN frame: {rate}, and that the ESCs are powered"),
+        (n, 0) => format!("{n} CAN frames but no ESC status from any node"),
+        (n, e) => format!("{n} CAN frames, {e} of them error frames, and no ESC status: {rate}"),
+    }
+}
+
 impl CanLink {
+    /// Why the ESC's bus gave no ESC status (see [`CanLink::records`]), in CAN words: its
+    /// frames, and a wrong bit rate where it is the likely cause.
+    pub fn no_status(&self) -> String {
+        no_status(&self.bus)
+    }
+
     /// Bytes of frames that were not DroneCAN, or no classic CAN frame.
     pub fn bytes_skipped(&self) -> u64 {
         (u64::from(self.bus.not_dronecan()) + u64::from(self.bad_records))

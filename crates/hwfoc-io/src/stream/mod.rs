@@ -14,7 +14,7 @@ mod can;
 
 pub use self::can::CanLink;
 use self::can::CanWire;
-pub(crate) use self::can::{BusLearner, BusPlan};
+pub(crate) use self::can::{BusLearner, BusPlan, no_status};
 use crate::clock::byte_times;
 use crate::esc_numbers::{UNNUMBERED, channel_number};
 use crate::handler::Handler;
