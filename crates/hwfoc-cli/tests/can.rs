@@ -515,6 +515,10 @@ fn a_late_get_esc_id_answer_numbers_its_node_for_the_whole_file() {
     let escs: Vec<u64> = got.iter().map(|r| r["esc"].as_u64().unwrap()).collect();
     assert_eq!(escs, [3, 3, 3]);
     assert!(got.iter().all(|r| r["node"] == 7));
+    // Not read ahead (standard input, as live): the node keeps the number it was first heard
+    // at, its node id.
+    let (pairs, ..) = decode_stdin(&text);
+    assert_eq!(pairs, [(7, 7); 3]);
 }
 
 /// A candump log line of `frame` at `t` seconds on `interface`.
@@ -565,7 +569,24 @@ fn decode_log(log: &str) -> (Vec<(u64, u64)>, Vec<Value>, String) {
     let dir = Dir::new();
     let path = dir.path("bus.log");
     std::fs::write(&path, log).unwrap();
-    let out = run(&["decode", path.to_str().unwrap()]);
+    outcome(run(&["decode", path.to_str().unwrap()]))
+}
+
+/// Decodes `log` from standard input (which is not read ahead), as [`decode_log`].
+fn decode_stdin(log: &str) -> (Vec<(u64, u64)>, Vec<Value>, String) {
+    let dir = Dir::new();
+    let path = dir.path("bus.log");
+    std::fs::write(&path, log).unwrap();
+    let out = hwfoc()
+        .args(["decode", "-"])
+        .stdin(std::fs::File::open(&path).unwrap())
+        .output()
+        .unwrap();
+    outcome(out)
+}
+
+/// A decoding's records' `(node, esc)` pairs in order, its records, and standard error.
+fn outcome(out: Output) -> (Vec<(u64, u64)>, Vec<Value>, String) {
     let got = records(&String::from_utf8(out.stdout).unwrap());
     let pairs = got
         .iter()
@@ -618,6 +639,14 @@ fn two_nodes_claiming_one_channel_stay_two_escs() {
     );
     assert!(err.contains("throttle channel 1"), "{err}");
     assert_eq!(err.lines().count(), 1, "{err}");
+    // Not read ahead (standard input, as live): the same ESCs and the same warning, once.
+    let (stdin_pairs, _, stdin_err) = decode_stdin(&bus(&sent));
+    assert_eq!(stdin_pairs, pairs);
+    assert_eq!(
+        stdin_err.trim_end(),
+        "hwfoc: warning: standard input: can0: node 10 and node 11 both claim throttle channel 1: \
+         read as two ESCs"
+    );
 }
 
 /// A Hobbywing ESC on channel 1 beside a standard DroneCAN ESC of `esc_index` 0 (the mixed bus
@@ -715,15 +744,7 @@ fn a_bus_of_error_frames_suggests_a_wrong_bit_rate_in_can_words() {
     let (_, got, err) = decode_log(&log);
     assert!(got.is_empty());
     // Standard input cannot be read ahead: the bus is an ESC without records, which says why.
-    let dir = Dir::new();
-    let path = dir.path("errors.log");
-    std::fs::write(&path, &log).unwrap();
-    let out = hwfoc()
-        .args(["decode", "-"])
-        .stdin(std::fs::File::open(&path).unwrap())
-        .output()
-        .unwrap();
-    let from_stdin = String::from_utf8(out.stderr).unwrap();
+    let (_, _, from_stdin) = decode_stdin(&log);
     for err in [&err, &from_stdin] {
         assert!(
             err.contains(

@@ -74,6 +74,18 @@ impl Sources {
         }
     }
 
+    /// Tells of the ESCs of ESC `esc`'s CAN bus that claimed a throttle channel another holds,
+    /// heard since the last call (on a bus not read ahead: standard input, live ports).
+    pub(super) fn tell_can_clashes(&mut self, input: &mut Input, esc: usize) {
+        for message in self.escs[esc].stream.take_can_clashes() {
+            input.tell(Notice::CanBus {
+                input: input.name().to_string(),
+                interface: self.escs[esc].name.clone(),
+                message,
+            });
+        }
+    }
+
     /// Whether stream `stream` of `input` is a CAN bus read ahead that carries no ESC status
     /// (an interface of stray frames): it is no ESC, takes no number and moves none.
     pub(super) fn is_silent_bus(&self, input: &Input, stream: usize) -> bool {

@@ -135,6 +135,7 @@ impl Sources {
                     }
                 });
                 self.deliver(esc, pending, &mut Deliver::<H>::Queue);
+                self.tell_can_clashes(&mut run[k].input, esc);
             }
             result = self.read_ahead(&mut run, k, more_recordings);
             if let Some((t, _)) = run[k].ahead {

@@ -485,6 +485,7 @@ impl Sources {
                 self.feed(esc, part(after, times.map(|t| t.1)), &mut pending, handler);
             }
             self.deliver(esc, pending, &mut Deliver::Handler(handler));
+            self.tell_can_clashes(input, esc);
             handler.end_batch(len < LIVE_BATCH)?;
         }
     }

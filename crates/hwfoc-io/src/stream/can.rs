@@ -265,6 +265,12 @@ impl CanWire {
         self.plan.clashes.clear();
     }
 
+    /// The ESCs heard since the last call that claimed a place another held (those of a plan
+    /// set were told when it was made).
+    pub(crate) fn take_clashes(&mut self) -> Vec<Clash> {
+        std::mem::take(&mut self.plan.clashes)
+    }
+
     /// Decodes `bytes` (with each byte's receive time, or none): `emit(t, slot, frame)` gets
     /// each record with the time of its CAN frame and its ESC's slot on the bus.
     pub(crate) fn feed(&mut self, bytes: &[u8], times: Option<&[f64]>, emit: &mut Emit<'_>) {

@@ -601,6 +601,15 @@ impl Stream {
         }
     }
 
+    /// A CAN bus's ESCs heard since the last call that claim a throttle channel another holds,
+    /// in words (none for any other stream).
+    pub(crate) fn take_can_clashes(&mut self) -> Vec<String> {
+        match &mut self.wire {
+            Wire::Can(c) => c.take_clashes().iter().map(|c| c.to_string()).collect(),
+            _ => Vec::new(),
+        }
+    }
+
     /// Whether the stream is a CAN bus's.
     pub fn is_can(&self) -> bool {
         matches!(self.wire, Wire::Can(_))
