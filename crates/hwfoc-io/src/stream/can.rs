@@ -63,26 +63,61 @@ impl std::fmt::Display for EscKey {
     }
 }
 
+/// An ESC at its place, and whether the place is its node id (a Hobbywing ESC without a
+/// GetEscID answer) rather than a throttle channel - 1 (an answer's, a standard ESC's
+/// `esc_index`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) struct Claim {
+    pub(crate) key: EscKey,
+    pub(crate) by_node_id: bool,
+}
+
+impl Claim {
+    /// The ESC of a record at its place.
+    fn of(data: &Data) -> Option<Claim> {
+        Some(Claim {
+            key: EscKey::of(data)?,
+            by_node_id: matches!(data, Data::HwCan(r) if r.channel.is_none()),
+        })
+    }
+}
+
+impl std::fmt::Display for Claim {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self.by_node_id {
+            true => write!(f, "{} (no GetEscID answer: by its node id)", self.key),
+            false => write!(f, "{}", self.key),
+        }
+    }
+}
+
 /// Two ESCs of a bus that claim one place: the first keeps it, the second is an ESC of its own
 /// in a slot after the bus's places.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(crate) struct Clash {
-    /// The place both claim (a throttle channel - 1).
+    /// The place both claim.
     pub(crate) place: u8,
     /// The ESC that holds it, and the other.
-    pub(crate) first: EscKey,
-    pub(crate) second: EscKey,
+    pub(crate) first: Claim,
+    pub(crate) second: Claim,
 }
 
 impl std::fmt::Display for Clash {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(
-            f,
-            "{} and {} both claim throttle channel {}: read as two ESCs",
-            self.first,
-            self.second,
-            u16::from(self.place) + 1
-        )
+        let (first, second) = (self.first, self.second);
+        if first.by_node_id || second.by_node_id {
+            write!(
+                f,
+                "{first} and {second} both claim place {} on the bus: read as two ESCs",
+                self.place
+            )
+        } else {
+            write!(
+                f,
+                "{first} and {second} both claim throttle channel {}: read as two ESCs",
+                u16::from(self.place) + 1
+            )
+        }
     }
 }
 
@@ -90,8 +125,8 @@ impl std::fmt::Display for Clash {
 /// first heard (live).
 #[derive(Debug, Clone, Default, PartialEq, Eq)]
 pub(crate) struct BusPlan {
-    /// Each ESC's slot, in the order they were first heard.
-    slots: Vec<(EscKey, u8)>,
+    /// Each ESC's slot, in the order they were first heard, with its place when it got it.
+    slots: Vec<(Claim, u8)>,
     /// ESCs that claimed a place another held.
     pub(crate) clashes: Vec<Clash>,
 }
@@ -99,8 +134,8 @@ pub(crate) struct BusPlan {
 impl BusPlan {
     /// The slot of `key` at `place`: the one it has, else given now (its place if free, else
     /// the next after the highest slot given; `None` past the last slot).
-    fn slot(&mut self, key: EscKey, place: u8) -> Option<u8> {
-        if let Some(&(_, slot)) = self.slots.iter().find(|(k, _)| *k == key) {
+    fn slot(&mut self, claim: Claim, place: u8) -> Option<u8> {
+        if let Some(&(_, slot)) = self.slots.iter().find(|(c, _)| c.key == claim.key) {
             return Some(slot);
         }
         let slot = match self.slots.iter().find(|(_, s)| *s == place) {
@@ -109,12 +144,12 @@ impl BusPlan {
                 self.clashes.push(Clash {
                     place,
                     first,
-                    second: key,
+                    second: claim,
                 });
                 self.end()?
             }
         };
-        self.slots.push((key, slot));
+        self.slots.push((claim, slot));
         Some(slot)
     }
 
@@ -142,7 +177,7 @@ impl BusPlan {
 #[derive(Debug)]
 pub(crate) struct BusLearner {
     wire: CanWire,
-    last: Vec<(EscKey, u8)>,
+    last: Vec<(Claim, u8)>,
 }
 
 impl BusLearner {
@@ -158,12 +193,12 @@ impl BusLearner {
         let last = &mut self.last;
         self.wire.feed(bytes, times, &mut |_, _, f| {
             let Frame::Data(d) = f else { return };
-            let (Some(key), Some(place)) = (EscKey::of(d), d.bus_index()) else {
+            let (Some(claim), Some(place)) = (Claim::of(d), d.bus_index()) else {
                 return;
             };
-            match last.iter_mut().find(|(k, _)| *k == key) {
-                Some(e) => e.1 = place,
-                None => last.push((key, place)),
+            match last.iter_mut().find(|(c, _)| c.key == claim.key) {
+                Some(e) => *e = (claim, place),
+                None => last.push((claim, place)),
             }
         });
     }
@@ -181,23 +216,23 @@ impl BusLearner {
         let highest = self.last.iter().map(|&(_, p)| p).max();
         let mut claimed = Vec::new();
         let mut next = highest.map_or(0, |h| u16::from(h) + 1);
-        for &(key, place) in &self.last {
+        for &(claim, place) in &self.last {
             let slot = match claimed.iter().find(|&&(p, _)| p == place) {
                 None => Some(place),
                 Some(&(_, first)) => {
                     plan.clashes.push(Clash {
                         place,
                         first,
-                        second: key,
+                        second: claim,
                     });
                     let slot = u8::try_from(next).ok();
                     next += 1;
                     slot
                 }
             };
-            claimed.push((place, key));
+            claimed.push((place, claim));
             if let Some(slot) = slot {
-                plan.slots.push((key, slot));
+                plan.slots.push((claim, slot));
             }
         }
         plan
@@ -313,10 +348,10 @@ impl CanWire {
         };
         let node = received.header.source_node;
         self.protocol[usize::from(node) % NODES] = Some(data.protocol());
-        let (Some(key), Some(place)) = (EscKey::of(&data), data.bus_index()) else {
+        let (Some(claim), Some(place)) = (Claim::of(&data), data.bus_index()) else {
             return;
         };
-        let Some(slot) = self.plan.slot(key, place) else {
+        let Some(slot) = self.plan.slot(claim, place) else {
             return;
         };
         self.place_node[usize::from(slot)] = Some(node);
@@ -536,7 +571,8 @@ mod tests {
                 index: Some(2),
             },
         );
-        assert_eq!(plan.slots, [(hw, 0), (std, 3), (other, 2)]);
+        let slots: Vec<(EscKey, u8)> = plan.slots.iter().map(|&(c, s)| (c.key, s)).collect();
+        assert_eq!(slots, [(hw, 0), (std, 3), (other, 2)]);
         assert_eq!(plan.len(), 4);
         assert_eq!(
             plan.clashes
@@ -544,6 +580,26 @@ mod tests {
                 .map(Clash::to_string)
                 .collect::<Vec<_>>(),
             ["node 10 and node 20 (esc_index 0) both claim throttle channel 1: read as two ESCs"]
+        );
+        // A node without a GetEscID answer claims its node id, not a channel.
+        let clash = Clash {
+            place: 0,
+            first: Claim {
+                key: std,
+                by_node_id: false,
+            },
+            second: Claim {
+                key: EscKey {
+                    node: 0,
+                    index: None,
+                },
+                by_node_id: true,
+            },
+        };
+        assert_eq!(
+            clash.to_string(),
+            "node 20 (esc_index 0) and node 0 (no GetEscID answer: by its node id) both claim \
+             place 0 on the bus: read as two ESCs"
         );
         // Decoded with the plan: node 10's records in slot 0 from the first.
         let mut wire = CanWire::new();
