@@ -14,10 +14,10 @@ use crate::stream::Stream;
 
 impl Sources {
     /// Hands on the frames of a stream found to carry several ESCs (a DataLink hub's channels,
-    /// a CAN bus's places) whose channel has no ESC yet, once it has one (made here, in channel
+    /// a CAN bus's slots) whose channel has no ESC yet, once it has one (made here, in channel
     /// order: channel 0 is the stream's own ESC): to a handler, or to the time-order queue.
-    /// A hub's eight channels are numbered at once; a bus's places up to the highest one heard
-    /// (`esc_numbers.rs`).
+    /// A hub's eight channels are numbered at once; a bus's slots up to the highest one heard
+    /// (`esc_numbers.rs`; a bus read ahead had all its slots numbered with its stream).
     pub(super) fn deliver<H: Handler>(
         &mut self,
         esc: usize,
