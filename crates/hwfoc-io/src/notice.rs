@@ -65,6 +65,19 @@ pub enum Notice {
         /// How many were skipped.
         frames: u64,
     },
+    /// Something amiss on a CAN bus of a file, found when it was read ahead: two ESCs that
+    /// claim one throttle channel (two nodes answering GetEscID with one channel, a Hobbywing
+    /// ESC beside a standard one of that `esc_index`: read as two ESCs, the second numbered
+    /// after the bus's channels), or error frames and no ESC status (a wrong bit rate).
+    CanBus {
+        /// The input as named.
+        input: String,
+        /// The interface (bus).
+        interface: String,
+        /// What, in words (`node 10 and node 11 both claim throttle channel 1: read as two
+        /// ESCs`).
+        message: String,
+    },
     /// A damaged place in a recording, skipped.
     Damage {
         /// The input as named.
@@ -151,6 +164,7 @@ impl Notice {
             Notice::PortLost { .. }
                 | Notice::ForeignInterface { .. }
                 | Notice::NotClassicCan { .. }
+                | Notice::CanBus { .. }
                 | Notice::Damage { .. }
                 | Notice::Overlap { .. }
                 | Notice::Duplicate { .. }
@@ -220,6 +234,11 @@ impl fmt::Display for Notice {
                 Escaped(input),
                 Escaped(interface)
             ),
+            Notice::CanBus {
+                input,
+                interface,
+                message,
+            } => write!(f, "{}: {}: {message}", Escaped(input), Escaped(interface)),
             Notice::Damage { input, damage } => write!(f, "{}: {damage}", Escaped(input)),
             Notice::Duplicate { input, earlier } => write!(
                 f,

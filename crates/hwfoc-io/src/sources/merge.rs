@@ -144,6 +144,7 @@ impl Sources {
                     }
                 });
                 self.deliver(esc, pending, &mut Deliver::<H>::Queue);
+                self.tell_can_clashes(&mut run[k].input, esc);
             }
             result = self.read_ahead(&mut run, k, more_recordings);
             if let Some((t, _)) = run[k].ahead {
@@ -234,14 +235,26 @@ impl Sources {
         count: bool,
     ) -> Result<(), InputError> {
         let reading = &mut run[k];
-        let batch = match reading.input.next_batch() {
-            Ok(Some(batch)) => batch,
-            Ok(None) => {
-                reading.ahead = None;
-                self.end_of(run, k, more_recordings);
-                return Ok(());
+        loop {
+            let (stream, len) = match reading.input.next_batch() {
+                Ok(Some(batch)) => (batch.stream, batch.bytes.len()),
+                Ok(None) => {
+                    reading.ahead = None;
+                    self.end_of(run, k, more_recordings);
+                    return Ok(());
+                }
+                Err(e) => return Err(e),
+            };
+            // A CAN bus without ESCs is no ESC (`can_plan.rs`): its bytes are counted only.
+            if !self.is_silent_bus(&reading.input, reading.index, stream) {
+                break;
             }
-            Err(e) => return Err(e),
+            if count {
+                reading.bytes += len as u64;
+            }
+        }
+        let Some(batch) = reading.input.current_batch() else {
+            return Ok(());
         };
         let Some(times) = batch.times else {
             return Err(InputError::NoTiming {

@@ -28,6 +28,7 @@
 //! in time order (a heap of the batches read ahead, a queue per ESC, the bytes two inputs hold
 //! of one port left out once); `mod.rs` reads the inputs, alone or together.
 
+mod can_plan;
 #[cfg(test)]
 mod fleet_tests;
 mod merge;
@@ -43,13 +44,13 @@ use hwfoc::foc::DataFrame;
 use hwfoc::telemetry::{Data, Frame};
 use hwfoc::{Protocol, Settings};
 
-use crate::esc_table::EscTable;
+use crate::esc_table::{EscTable, Recording};
 pub use crate::handler::Handler;
 use crate::handler::LaterPart;
 use crate::input::{Batch, Input, InputError, InputFormat};
 use crate::notice::Notice;
 use crate::settings::SettingsMap;
-use crate::stream::{EscLink, Stream};
+use crate::stream::{BusPlan, EscLink, Stream};
 use crate::time::Clock;
 
 pub use self::merge::MAX_QUEUED;
@@ -118,6 +119,8 @@ pub struct Sources {
     /// The ESC of each channel of each stream found to come from a DataLink hub, by the ESC
     /// of its stream.
     hubs: HashMap<usize, Hub>,
+    /// The slots of the ESCs of each CAN bus read ahead (`can_plan.rs`), by its stream's name.
+    buses: HashMap<(Recording, String), BusPlan>,
     /// The ESCs of each input's streams numbered before it is read, by input.
     numbered: Vec<Vec<Option<usize>>>,
     queue: Queue,
@@ -156,6 +159,7 @@ impl Sources {
             join: false,
             need_timing: false,
             hubs: HashMap::new(),
+            buses: HashMap::new(),
             numbered: Vec::new(),
             esc_settings: Vec::new(),
             queue: Queue::default(),
@@ -321,6 +325,7 @@ impl Sources {
         let base = self.read.len();
         self.duplicates.resize(base, None);
         self.duplicates.extend(duplicates(&inputs, base));
+        self.plan_buses(&mut inputs, base);
         self.number_inputs(&inputs);
         let mut result = Ok(());
         while let Some(first) = inputs.front() {
@@ -528,6 +533,7 @@ impl Sources {
                 self.feed(esc, part(after, times.map(|t| t.1)), &mut pending, handler);
             }
             self.deliver(esc, pending, &mut Deliver::Handler(handler));
+            self.tell_can_clashes(input, esc);
             handler.end_batch(len < LIVE_BATCH)?;
         }
     }

@@ -16,10 +16,10 @@ use crate::stream::Stream;
 
 impl Sources {
     /// Hands on the frames of a stream found to carry several ESCs (a DataLink hub's channels,
-    /// a CAN bus's places) whose channel has no ESC yet, once it has one (made here, in channel
+    /// a CAN bus's slots) whose channel has no ESC yet, once it has one (made here, in channel
     /// order: channel 0 is the stream's own ESC): to a handler, or to the time-order queue.
-    /// A hub's eight channels are numbered at once; a bus's places up to the highest one heard
-    /// (`esc_numbers.rs`).
+    /// A hub's eight channels are numbered at once; a bus's slots up to the highest one heard
+    /// (`esc_numbers.rs`; a bus read ahead had all its slots numbered with its stream).
     pub(super) fn deliver<H: Handler>(
         &mut self,
         esc: usize,
@@ -84,8 +84,17 @@ impl Sources {
         self.hubs.insert(esc, hub);
     }
 
-    /// A new ESC, `key` of input `input`, its settings looked up once.
-    fn push_esc(&mut self, esc: Esc, key: EscKey, input: usize) {
+    /// A new ESC, `key` of input `input`, its settings looked up once. A CAN bus read ahead
+    /// (`can_plan.rs`) has its ESCs' slots fixed and numbered at once, so that its ESCs'
+    /// numbers follow each other whatever is heard on other buses meanwhile.
+    fn push_esc(&mut self, mut esc: Esc, key: EscKey, input: usize) {
+        let plan = match esc.stream.is_can() {
+            true => self.buses.get(&(key.recording, key.port.clone())).cloned(),
+            false => None,
+        };
+        if let Some(plan) = &plan {
+            esc.stream.plan_can(plan);
+        }
         let settings = self.settings.get(self.escs.len(), &key.port);
         self.table.push(key, input);
         self.escs.push(esc);
@@ -93,11 +102,14 @@ impl Sources {
         self.readers.push(0);
         self.fed.push(None);
         self.span.push(None);
+        if let Some(plan) = plan.filter(|p| !p.is_empty()) {
+            self.grow_hub(self.escs.len() - 1, plan.len());
+        }
     }
 
     /// The recording input `index` is a part of (`esc_table.rs`): one of its own unless it
     /// names one (hwfoc's recordings) or the recordings are joined (`--join`).
-    fn recording_of(&self, input: &Input, index: usize) -> Recording {
+    pub(super) fn recording_of(&self, input: &Input, index: usize) -> Recording {
         match (self.join, input.recording_id()) {
             (true, _) if input.format().has_recorded_ports() => Recording::Joined,
             (_, Some(id)) => Recording::Id(id),
@@ -138,8 +150,10 @@ impl Sources {
                 } else {
                     Stream::forced(self.forced)
                 };
+                // (A CAN bus read ahead numbers its ESCs after its own at once.)
+                let esc = self.escs.len();
                 self.push_esc(Esc { stream, hub: None }, key, index);
-                self.escs.len() - 1
+                esc
             }
         };
         if escs.len() <= stream {
@@ -159,6 +173,9 @@ impl Sources {
         escs: &mut Vec<Option<usize>>,
     ) {
         for stream in 0..input.streams() {
+            if self.is_silent_bus(input, index, stream) {
+                continue;
+            }
             if self.esc_of(input, index, stream, escs).is_err() {
                 break;
             }

@@ -14,6 +14,7 @@ mod can;
 
 pub use self::can::CanLink;
 use self::can::CanWire;
+pub(crate) use self::can::{BusLearner, BusPlan, no_status};
 use crate::clock::byte_times;
 use crate::esc_numbers::{UNNUMBERED, channel_number};
 use crate::handler::Handler;
@@ -590,6 +591,22 @@ impl Stream {
         Stream {
             wire: Wire::Can(Box::new(CanWire::new())),
             history: Vec::new(),
+        }
+    }
+
+    /// Fixes the slots of a CAN bus's ESCs ahead (`can.rs`); nothing for any other stream.
+    pub(crate) fn plan_can(&mut self, plan: &BusPlan) {
+        if let Wire::Can(c) = &mut self.wire {
+            c.set_plan(plan);
+        }
+    }
+
+    /// A CAN bus's ESCs heard since the last call that claim a throttle channel another holds,
+    /// in words (none for any other stream).
+    pub(crate) fn take_can_clashes(&mut self) -> Vec<String> {
+        match &mut self.wire {
+            Wire::Can(c) => c.take_clashes().iter().map(|c| c.to_string()).collect(),
+            _ => Vec::new(),
         }
     }
 

@@ -74,7 +74,8 @@ pub fn no_frames_of(protocol: Protocol) -> String {
 
 /// Why ESC `esc`'s bytes gave no frame, as every output says it: what its input looks like
 /// when that is not telemetry (`text, not telemetry`, `looks like a PNG image, not telemetry`:
-/// a file given by mistake), else the advice of the protocol forced
+/// a file given by mistake), on a CAN bus its frames in CAN words (a wrong bit rate where it is
+/// the likely cause), else the advice of the protocol forced
 /// ([`Sources::force_protocol`]), else what the bytes of a raw input hold
 /// ([`Looks::Unframed`](crate::Looks::Unframed): its lead bytes, the baud rates and the
 /// wiring), else [`NO_FRAMES`], the advice for a wire (a port, a recording).
@@ -86,6 +87,9 @@ pub fn no_frames(sources: &Sources, esc: usize) -> String {
         .and_then(|input| input.looks);
     if let Some(looks) = looks.filter(|l| l.is_other_than_telemetry()) {
         return looks.to_string();
+    }
+    if let EscLink::Can(c) = sources.link(esc) {
+        return c.no_status();
     }
     if let Some(protocol) = sources.forced_protocol() {
         return no_frames_of(protocol);
