@@ -72,13 +72,16 @@ def read(
     gear_ratio: float = ...,
     v4_volts_per_step: str = ...,
     protocol: Optional[str] = None,
+    join: bool = False,
 ) -> pa.Table:
     """Reads telemetry whole into a ``pyarrow.Table`` of docs/RECORD-SCHEMA.md's records.
 
     ``source``: a path (raw bytes from the wire, a logic-analyser CSV export or a pcapng
     recording: the format is detected from the content), ``bytes``/``bytearray``/``memoryview``,
-    a binary file object, or a list of these read one after another (the files of a rotated
-    recording continue each port's stream). ``esc``, ``start`` and ``end`` select as the
+    a binary file object, or a list of these read one after another (the files of one
+    recording, such as a rotated one, continue each port's stream; other files are ESCs of their
+    own, however their ports are named, unless ``join=True`` reads them as one recording, as the
+    command's ``--join``; a file given twice is read once). ``esc``, ``start`` and ``end`` select as the
     command's ``--esc``, ``--from`` (inclusive) and ``--to`` (exclusive); a time window needs
     inputs with receive times. The settings convert currents and RPM; ``v4_volts_per_step``
     (``"N/D"``, ``"low"`` or ``"hv"``, as the command's ``--v4-volts-per-step``) converts a
@@ -117,6 +120,7 @@ def scan(
     gear_ratio: float = ...,
     v4_volts_per_step: str = ...,
     protocol: Optional[str] = None,
+    join: bool = False,
 ) -> "Scan":
     """The records of ``sources`` as ``pyarrow.RecordBatch``es of at most ``batch_rows`` rows,
     in bounded memory whatever the size of the inputs (read a block at a time on a thread of
@@ -145,6 +149,7 @@ def summary(
     gear_ratio: float = ...,
     v4_volts_per_step: str = ...,
     protocol: Optional[str] = None,
+    join: bool = False,
 ) -> Dict[str, Any]:
     """What ``hwfoc summary --json`` prints for ``source``, as Python objects: the settings,
     the inputs (format, bytes, ESCs) and per ESC its link statistics, field ranges, faults and

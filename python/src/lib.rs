@@ -61,6 +61,8 @@ pub(crate) struct Options {
     pub filter: String,
     /// The one protocol read, when forced.
     pub protocol: Option<Protocol>,
+    /// Whether the recordings given are read as one (`join=True`, the command's `--join`).
+    pub join: bool,
 }
 
 impl Options {
@@ -79,6 +81,7 @@ impl Options {
             selection: Selection::new(&escs, window),
             filter: filter_text(&escs, from.map(Time::Seconds), to.map(Time::Seconds)),
             protocol: None,
+            join: false,
         })
     }
 
@@ -89,6 +92,11 @@ impl Options {
             protocol: protocol_arg(protocol)?,
             ..self
         })
+    }
+
+    /// The options with the recordings joined as one, or not (`join=`).
+    pub fn joined(self, join: bool) -> Options {
+        Options { join, ..self }
     }
 
     fn provenance(&self, specs: &[Spec]) -> Provenance {
@@ -172,15 +180,19 @@ pub(crate) fn baud_arg(baud: Option<u32>, protocol: Option<Protocol>) -> PyResul
     Ok(baud)
 }
 
-/// The inputs read with `settings`, of `protocol` only when one is forced.
+/// The inputs read with `settings`, of `protocol` only when one is forced, the recordings
+/// read as one with `join` (see [`Sources::join_recordings`]).
 pub(crate) fn sources(
     inputs: Vec<Input>,
     settings: Settings,
-    protocol: Option<Protocol>,
+    (protocol, join): (Option<Protocol>, bool),
 ) -> Sources {
     let mut sources = Sources::new(inputs, settings);
     if let Some(protocol) = protocol {
         sources.force_protocol(protocol);
+    }
+    if join {
+        sources.join_recordings();
     }
     sources
 }
@@ -288,7 +300,8 @@ where
 
 /// Decodes `specs` whole. Decoding runs on this thread, converting on worker threads.
 fn decode_all(specs: Vec<Spec>, options: &Options, notes: &Notes) -> Result<Decoded, Stop> {
-    let mut sources = sources(open_all(specs, notes)?, options.settings, options.protocol);
+    let forced = (options.protocol, options.join);
+    let mut sources = sources(open_all(specs, notes)?, options.settings, forced);
     if options.selection.window.is_limited() {
         sources.require_timing()?;
     }
@@ -361,11 +374,13 @@ pub(crate) fn stop_error(stop: Stop) -> PyErr {
 /// content), bytes, a binary file object, or a list of these read one after another. `esc`,
 /// `start`, `end` select as the command's `--esc`, `--from`, `--to`; the settings convert
 /// currents and RPM; `protocol` (a name, as the command's `--protocol`) reads that protocol
-/// only. The schema metadata is that of `hwfoc decode --format parquet`. Raises InputError,
+/// only; `join=True` reads the recordings given as one, as the command's `--join` (without it,
+/// each file is ESCs of its own unless it is a file of the same `hwfoc record` run as another).
+/// The schema metadata is that of `hwfoc decode --format parquet`. Raises InputError,
 /// SelectionError, SettingsError, ValueError for an unknown protocol; warns HwfocWarning for
 /// inputs without frames and for damage or notes in a recording.
 #[pyfunction]
-#[pyo3(signature = (source, *, esc=None, start=None, end=None, current_scale=CURRENT_SCALE, pole_pairs=POLE_PAIRS, gear_ratio=GEAR_RATIO, v4_volts_per_step=V4_VOLTS_PER_STEP, protocol=None), text_signature = "(source, *, esc=None, start=None, end=None, current_scale=DEFAULT_CURRENT_SCALE, pole_pairs=DEFAULT_POLE_PAIRS, gear_ratio=DEFAULT_GEAR_RATIO, v4_volts_per_step=DEFAULT_V4_VOLTS_PER_STEP, protocol=None)")]
+#[pyo3(signature = (source, *, esc=None, start=None, end=None, current_scale=CURRENT_SCALE, pole_pairs=POLE_PAIRS, gear_ratio=GEAR_RATIO, v4_volts_per_step=V4_VOLTS_PER_STEP, protocol=None, join=false), text_signature = "(source, *, esc=None, start=None, end=None, current_scale=DEFAULT_CURRENT_SCALE, pole_pairs=DEFAULT_POLE_PAIRS, gear_ratio=DEFAULT_GEAR_RATIO, v4_volts_per_step=DEFAULT_V4_VOLTS_PER_STEP, protocol=None, join=False)")]
 #[allow(clippy::too_many_arguments)]
 fn read<'py>(
     py: Python<'py>,
@@ -378,9 +393,12 @@ fn read<'py>(
     gear_ratio: f32,
     v4_volts_per_step: &str,
     protocol: Option<&str>,
+    join: bool,
 ) -> PyResult<Bound<'py, PyAny>> {
     let settings = settings_arg(current_scale, pole_pairs, gear_ratio, v4_volts_per_step)?;
-    let options = Options::new(esc, start, end, settings)?.forced(protocol)?;
+    let options = Options::new(esc, start, end, settings)?
+        .forced(protocol)?
+        .joined(join);
     let specs = source::specs(source)?;
     let provenance = options.provenance(&specs);
     let notes = Notes::default();
@@ -407,10 +425,10 @@ fn read<'py>(
 fn summary_json(
     specs: Vec<Spec>,
     settings: Settings,
-    protocol: Option<Protocol>,
+    (protocol, join): (Option<Protocol>, bool),
     notes: &Notes,
 ) -> Result<String, InputError> {
-    let mut sources = sources(open_all(specs, notes)?, settings, protocol);
+    let mut sources = sources(open_all(specs, notes)?, settings, (protocol, join));
     let mut summary = Summary::new();
     sources.run(&mut summary)?;
     Ok(summary.report(&sources).json().to_string())
@@ -418,9 +436,10 @@ fn summary_json(
 
 /// What `hwfoc summary --json` prints for `source` (as `read` takes it), as Python objects:
 /// settings, inputs, and per ESC its link statistics, field ranges, faults and fault episodes;
-/// `protocol` as `read`'s. Raises InputError, ValueError for an unknown protocol.
+/// `protocol` and `join` as `read`'s. Raises InputError, ValueError for an unknown protocol.
 #[pyfunction]
-#[pyo3(signature = (source, *, current_scale=CURRENT_SCALE, pole_pairs=POLE_PAIRS, gear_ratio=GEAR_RATIO, v4_volts_per_step=V4_VOLTS_PER_STEP, protocol=None), text_signature = "(source, *, current_scale=DEFAULT_CURRENT_SCALE, pole_pairs=DEFAULT_POLE_PAIRS, gear_ratio=DEFAULT_GEAR_RATIO, v4_volts_per_step=DEFAULT_V4_VOLTS_PER_STEP, protocol=None)")]
+#[pyo3(signature = (source, *, current_scale=CURRENT_SCALE, pole_pairs=POLE_PAIRS, gear_ratio=GEAR_RATIO, v4_volts_per_step=V4_VOLTS_PER_STEP, protocol=None, join=false), text_signature = "(source, *, current_scale=DEFAULT_CURRENT_SCALE, pole_pairs=DEFAULT_POLE_PAIRS, gear_ratio=DEFAULT_GEAR_RATIO, v4_volts_per_step=DEFAULT_V4_VOLTS_PER_STEP, protocol=None, join=False)")]
+#[allow(clippy::too_many_arguments)]
 fn summary<'py>(
     py: Python<'py>,
     source: &Bound<'py, PyAny>,
@@ -429,12 +448,13 @@ fn summary<'py>(
     gear_ratio: f32,
     v4_volts_per_step: &str,
     protocol: Option<&str>,
+    join: bool,
 ) -> PyResult<Bound<'py, PyAny>> {
     let settings = settings_arg(current_scale, pole_pairs, gear_ratio, v4_volts_per_step)?;
     let protocol = protocol_arg(protocol)?;
     let specs = source::specs(source)?;
     let notes = Notes::default();
-    let json = py.detach(|| summary_json(specs, settings, protocol, &notes));
+    let json = py.detach(|| summary_json(specs, settings, (protocol, join), &notes));
     warn_notices(py, &notes)?;
     let json = json.map_err(errors::input)?;
     py.import("json")?.call_method1("loads", (json,))

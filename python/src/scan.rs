@@ -62,7 +62,7 @@ fn produce(
     if tx.send(Msg::Opened).is_err() {
         return;
     }
-    let mut sources = crate::sources(inputs, options.settings, options.protocol);
+    let mut sources = crate::sources(inputs, options.settings, (options.protocol, options.join));
     if options.selection.window.is_limited()
         && let Err(e) = sources.require_timing()
     {
@@ -106,7 +106,7 @@ fn produce(
 /// batches ahead. Errors opening the inputs are raised at once, later ones by the iterator after
 /// the batches before them.
 #[pyfunction]
-#[pyo3(signature = (sources, *, batch_rows=65536, esc=None, start=None, end=None, current_scale=CURRENT_SCALE, pole_pairs=POLE_PAIRS, gear_ratio=GEAR_RATIO, v4_volts_per_step=V4_VOLTS_PER_STEP, protocol=None), text_signature = "(sources, *, batch_rows=65536, esc=None, start=None, end=None, current_scale=DEFAULT_CURRENT_SCALE, pole_pairs=DEFAULT_POLE_PAIRS, gear_ratio=DEFAULT_GEAR_RATIO, v4_volts_per_step=DEFAULT_V4_VOLTS_PER_STEP, protocol=None)")]
+#[pyo3(signature = (sources, *, batch_rows=65536, esc=None, start=None, end=None, current_scale=CURRENT_SCALE, pole_pairs=POLE_PAIRS, gear_ratio=GEAR_RATIO, v4_volts_per_step=V4_VOLTS_PER_STEP, protocol=None, join=false), text_signature = "(sources, *, batch_rows=65536, esc=None, start=None, end=None, current_scale=DEFAULT_CURRENT_SCALE, pole_pairs=DEFAULT_POLE_PAIRS, gear_ratio=DEFAULT_GEAR_RATIO, v4_volts_per_step=DEFAULT_V4_VOLTS_PER_STEP, protocol=None, join=False)")]
 #[allow(clippy::too_many_arguments)]
 pub fn scan(
     py: Python<'_>,
@@ -120,12 +120,15 @@ pub fn scan(
     gear_ratio: f32,
     v4_volts_per_step: &str,
     protocol: Option<&str>,
+    join: bool,
 ) -> PyResult<Scan> {
     if batch_rows == 0 {
         return Err(PyValueError::new_err("batch_rows must be at least 1"));
     }
     let settings = crate::settings_arg(current_scale, pole_pairs, gear_ratio, v4_volts_per_step)?;
-    let options = Options::new(esc, start, end, settings)?.forced(protocol)?;
+    let options = Options::new(esc, start, end, settings)?
+        .forced(protocol)?
+        .joined(join);
     let specs = crate::source::specs(sources)?;
     // The batches' metadata: the ESCs are known only at the end, so `escs` is not in it.
     let schema = options.provenance(&specs).schema(None);

@@ -46,10 +46,11 @@ def test_can_records_carry_protocol_node_and_ages():
     rows = hwfoc.read(str(LOG)).to_pylist()
     assert len(rows) == 58
     assert {r["protocol"] for r in rows} == {"hw-can", "dronecan"}
-    # ESCs by place on the bus: nodes 11 and 12 by their node id, then by throttle channel - 1
-    # once their GetEscID answers came; node 13 never answered; standard ESCs by esc_index.
+    # ESCs by place on the bus, the file read ahead: nodes 11 and 12 by the throttle channel - 1
+    # their GetEscID answers give, every record; node 13 never answered (its node id);
+    # standard ESCs by esc_index.
     pairs = sorted({(r["esc"], r["node"]) for r in rows})
-    assert pairs == [(0, 11), (1, 12), (3, 40), (4, 41), (11, 11), (12, 12), (13, 13)]
+    assert pairs == [(0, 11), (1, 12), (3, 40), (4, 41), (13, 13)]
     hw = [r for r in rows if r["protocol"] == "hw-can"]
     std = [r for r in rows if r["protocol"] == "dronecan"]
     assert all(r["packet"] is None and r["throttle_in_pct"] is None and r["faults"] is None for r in hw)

@@ -2,16 +2,19 @@
 session (local[2]); per-ESC aggregates equal the single-process results exactly, and the
 fault episodes are the summary's."""
 
+import json
 import os
 import sys
 import time
 
 import pandas as pd
+import pyarrow as pa
+import pyarrow.compute
 import pytest
 
 import hwfoc
 import hwfoc.dask
-from conftest import FLEET_NOW, WEEK
+from conftest import FLEET_NOW, WEEK, cli_records, run_cli
 
 TIMES = {}
 
@@ -158,3 +161,38 @@ def test_report_times():
     for k, v in TIMES.items():
         print(f"fleet of 50: {k}: {v:.2f} s")
     assert "single process" in TIMES
+
+
+def test_drones_recorded_together_give_each_recordings_rows_everywhere(cli, tmp_path, spark):
+    """Three drones recorded at the same time on ports named alike (esc-0, esc-1): the command,
+    hwfoc.read, Dask and Spark give each recording's rows as the recording read alone, and the
+    escs metadata names each ESC's input."""
+    import hwfoc.spark
+
+    paths = []
+    for i in (1, 2, 3):
+        path = tmp_path / f"drone-{i}.pcapng"
+        run_cli(cli, "simulate", "--escs", 2, "--duration", 10, "--seed", i, "-o", path)
+        paths.append(str(path))
+    alone = {p: hwfoc.read(p) for p in paths}
+    rows = {p: t.num_rows for p, t in alone.items()}
+    # The command: every recording's records, ESCs numbered in the order given.
+    together = cli_records(cli, *paths)
+    assert len(together) == sum(rows.values())
+    table = hwfoc.read(paths)
+    assert table.num_rows == len(together)
+    assert table.column("esc").to_pylist() == [r["esc"] for r in together]
+    escs = json.loads(table.schema.metadata[b"escs"])
+    assert [(e["esc"], e["input"]) for e in escs] == [
+        (2 * k + e, p) for k, p in enumerate(paths) for e in (0, 1)
+    ]
+    for k, p in enumerate(paths):
+        for e in (0, 1):
+            mine = table.filter(pa.compute.equal(table.column("esc"), 2 * k + e))
+            theirs = alone[p].filter(pa.compute.equal(alone[p].column("esc"), e))
+            for column in ("t_s", "packet", "rpm", "voltage_v"):
+                assert mine.column(column).to_pylist() == theirs.column(column).to_pylist(), (p, e)
+    ddf = hwfoc.dask.read(paths, path_column="recording").compute(scheduler="sync")
+    assert ddf.groupby("recording").size().to_dict() == rows
+    df = hwfoc.spark.read(spark, paths, path_column="recording")
+    assert {r["recording"]: r["count"] for r in df.groupBy("recording").count().collect()} == rows

@@ -31,6 +31,19 @@ impl Write for Shared {
 
 /// `frames` of ESC 0 through a DataLink output, one DataLink frame each, decoded back.
 fn through_datalink(frames: &[Data], settings: &Settings) -> Vec<hwfoc::foc::DataFrame> {
+    let bytes = datalink_bytes(frames, settings);
+    let mut got = Vec::new();
+    let mut decoder = datalink::Decoder::new();
+    decoder.decode_all(&bytes, |d| {
+        got.push(d.frame.slots[0].expect("ESC 0's slot"))
+    });
+    assert_eq!(decoder.stats().bytes_skipped(), 0);
+    assert_eq!(got.len(), frames.len());
+    got
+}
+
+/// The bytes a DataLink output sends for `frames` of ESC 0, one DataLink frame each.
+fn datalink_bytes(frames: &[Data], settings: &Settings) -> Vec<u8> {
     let shared = Shared::default();
     let mut out = DatalinkOutput::to_writer("test", Box::new(shared.clone()), Pacing::default());
     let t0 = Instant::now();
@@ -46,15 +59,7 @@ fn through_datalink(frames: &[Data], settings: &Settings) -> Vec<hwfoc::foc::Dat
         out.poll(t0 + Duration::from_secs(k as u64 + 1)).unwrap();
     }
     assert_eq!(out.escs_not_carried(), 0);
-    let bytes = shared.0.lock().unwrap().clone();
-    let mut got = Vec::new();
-    let mut decoder = datalink::Decoder::new();
-    decoder.decode_all(&bytes, |d| {
-        got.push(d.frame.slots[0].expect("ESC 0's slot"))
-    });
-    assert_eq!(decoder.stats().bytes_skipped(), 0);
-    assert_eq!(got.len(), frames.len());
-    got
+    shared.0.lock().unwrap().clone()
 }
 
 /// The largest step between the temperatures of two neighbouring ADC codes.
@@ -230,4 +235,40 @@ fn hobbywing_can_records_go_out_with_erpm_from_rpm_and_the_settings() {
     assert_eq!(out[0].voltage_raw, 0, "no StatusMsg2 yet");
     assert_eq!(out[1].cap_adc, ADC_NO_VALUE, "no StatusMsg3 yet");
     assert_ne!(out[2].cap_adc, ADC_NO_VALUE);
+}
+
+/// A quantity the ESC's format does not carry (an HW5 ESC's capacitor temperature) goes out as
+/// the DataLink's no-value code and comes back through hwfoc's own summary as no value: no
+/// row of a temperature out of the table's range.
+#[test]
+fn a_temperature_not_carried_comes_back_through_the_summary_as_no_value() {
+    let settings = Settings::DEFAULT;
+    let frames: Vec<Data> = (0..10u16)
+        .map(|k| {
+            Data::from(TelemetryFrame {
+                throttle: 20,
+                voltage_raw: 480 + k,
+                esc_temp: 40,
+                ..Default::default()
+            })
+        })
+        .collect();
+    assert_eq!(frames[0].value(Quantity::CapTemp, &settings), None);
+    let bytes = datalink_bytes(&frames, &settings);
+    let input = hwfoc_io::Input::from_memory("bridge.bin", bytes).unwrap();
+    let mut sources = hwfoc_io::Sources::new(vec![input], settings);
+    let mut summary = hwfoc_io::summary::Summary::new();
+    sources.run(&mut summary).unwrap();
+    let report = summary.report(&sources);
+    let text = report.text();
+    assert!(!text.contains("out of the table's range"), "{text}");
+    let json = report.json();
+    let esc = &json["escs"][0];
+    assert_eq!(esc["frames"], serde_json::json!(10), "{esc}");
+    let cap = &esc["temperature_out_of_range"]["cap_temp_c"];
+    assert_eq!(
+        *cap,
+        serde_json::json!({"below_range": 0, "above_range": 0}),
+        "{esc}"
+    );
 }

@@ -22,9 +22,11 @@ use crate::error::CliError;
 pub struct InputArgs {
     /// Serial ports (`/dev/ttyUSB0`, `COM3`; one ESC each, in the order given), recordings
     /// (pcapng), raw bytes from the wire or logic-analyser CSV exports (detected); `-` reads
-    /// standard input. Recordings and analyser CSV exports given together are merged in time
-    /// order (the files of one port, such as a rotated recording, are one continuous stream);
-    /// raw files and standard input, which have no receive times, are read one after another.
+    /// standard input. Each input's ESCs are its own, numbered in the order given. Recordings
+    /// and analyser CSV exports given together are merged in time order (the files of one
+    /// recording, such as a rotated one, continue each port's stream; a file given twice is
+    /// read once); raw files and standard input, which have no receive times, are read one
+    /// after another.
     #[arg(value_name = "FILE|PORT|-", required_unless_present = "demo", num_args = 1..)]
     pub inputs: Vec<String>,
     /// Baud rate of serial ports (8N1) [default: that of --protocol, else found from the
@@ -34,6 +36,14 @@ pub struct InputArgs {
     /// Use the built-in demo capture of a virtual ESC (HW-FOC) instead of FILE.
     #[arg(long, conflicts_with = "inputs")]
     pub demo: bool,
+    /// Read the recordings given as one: their ports go on from file to file by name. Without
+    /// it, only the files of one `hwfoc record` run (rotated files: they carry its recording
+    /// id) are one recording; every other file is ESCs of its own, however its ports are
+    /// named (port names such as /dev/ttyUSB0 are the same on every drone). Give it for the
+    /// parts of one recording that another program wrote or cut.
+    #[arg(long)]
+    pub join: bool,
+
     #[command(flatten)]
     pub protocol: ProtocolArgs,
 }
@@ -156,6 +166,9 @@ impl InputArgs {
         let mut sources = Sources::new(self.open_all()?, settings);
         if let Some(protocol) = self.protocol.protocol {
             sources.force_protocol(protocol);
+        }
+        if self.join {
+            sources.join_recordings();
         }
         Ok(sources)
     }

@@ -142,8 +142,9 @@ fn expected_records(path: &Path) -> Vec<Value> {
 }
 
 /// pydronecan's frames of every message above, as a candump log: hwfoc decodes them to exactly
-/// the values pydronecan encoded, numbered as the schema says (node id, then the throttle
-/// channel minus 1 once GetEscID maps the node; a standard ESC's esc_index), with the ages of
+/// the values pydronecan encoded, numbered as the schema says (the throttle channel minus 1 a
+/// GetEscID answer maps the node to, for the whole file; node id for a node never mapped; a
+/// standard ESC's esc_index), with the ages of
 /// the slower messages the script's own times give.
 #[test]
 #[ignore = "needs pydronecan (HWFOC_DRONECAN_PY, or python3 with the dronecan package; .ci/dronecan.sh)"]
@@ -159,22 +160,15 @@ fn pydronecan_candump_log_decodes_to_the_values_encoded() {
     let expected = expected_records(&expected);
     let got = records(&stdout(&run(&["decode", log_arg])));
     let n = compare(&got, &expected, Ages::Exact);
-    // Both protocols, ESCs renumbered by their channel, a NaN read as null.
+    // Both protocols, nodes 11 and 12 numbered by the channel they answer for the whole file, a
+    // NaN read as null.
     let escs: std::collections::BTreeSet<(u64, u64)> = got
         .iter()
         .map(|r| (r["esc"].as_u64().unwrap(), r["node"].as_u64().unwrap()))
         .collect();
     assert_eq!(
         escs.into_iter().collect::<Vec<_>>(),
-        [
-            (0, 11),
-            (1, 12),
-            (3, 40),
-            (4, 41),
-            (11, 11),
-            (12, 12),
-            (13, 13)
-        ]
+        [(0, 11), (1, 12), (3, 40), (4, 41), (13, 13)]
     );
     assert!(
         got.iter()
@@ -497,10 +491,12 @@ fn a_can_pcapng_cut_in_a_block_decodes_what_is_there() {
     }
 }
 
-/// GetEscID: a request ([0]) maps nothing; an answer [node, channel] renumbers its node's
-/// records from then on, whoever sends it.
+/// GetEscID: a request ([0]) maps nothing; an answer [node, channel] maps its node, whoever
+/// sends it. A file is read ahead: the node keeps the number of the channel it learned for the
+/// whole file, its records before the answer included (it was split into two ESCs, ESC 7 and
+/// ESC 3, before).
 #[test]
-fn a_get_esc_id_answer_renumbers_its_node() {
+fn a_late_get_esc_id_answer_numbers_its_node_for_the_whole_file() {
     let dir = Dir::new();
     let mut text = String::new();
     let mut t = 1_700_000_000.0;
@@ -517,6 +513,247 @@ fn a_get_esc_id_answer_renumbers_its_node() {
     std::fs::write(&path, &text).unwrap();
     let got = records(&stdout(&run(&["decode", path.to_str().unwrap()])));
     let escs: Vec<u64> = got.iter().map(|r| r["esc"].as_u64().unwrap()).collect();
-    assert_eq!(escs, [7, 7, 3]);
+    assert_eq!(escs, [3, 3, 3]);
     assert!(got.iter().all(|r| r["node"] == 7));
+    // Not read ahead (standard input, as live): the node keeps the number it was first heard
+    // at, its node id.
+    let (pairs, ..) = decode_stdin(&text);
+    assert_eq!(pairs, [(7, 7); 3]);
+}
+
+/// A candump log line of `frame` at `t` seconds on `interface`.
+fn line_on(t: f64, interface: &str, frame: &CanFrame) -> String {
+    line(t, frame).replacen(" can0 ", &format!(" {interface} "), 1)
+}
+
+/// A log of `(interface, node, message)` sent one after another, 10 ms apart, each transfer
+/// with the next transfer id of its node.
+fn bus(sent: &[(&str, u8, Message)]) -> String {
+    let mut tids = [0u8; 128];
+    let mut out = String::new();
+    for (k, (interface, node, m)) in sent.iter().enumerate() {
+        let tid = &mut tids[usize::from(*node)];
+        for f in m.frames(16, *node, 0, *tid) {
+            out.push_str(&line_on(1_700_000_000.0 + k as f64 * 0.01, interface, &f));
+        }
+        *tid = (*tid + 1) % 32;
+    }
+    out
+}
+
+/// A Hobbywing status of `rpm` and a StatusMsg2 of `decivolts`.
+fn hw(rpm: u16) -> Message {
+    StatusMsg1 {
+        rpm,
+        pwm: 300,
+        status: 0,
+    }
+    .into()
+}
+
+fn volts(decivolts: i16) -> Message {
+    StatusMsg2 {
+        input_voltage: decivolts,
+        current: 10,
+        temperature: 30,
+    }
+    .into()
+}
+
+fn esc_id(node: u8, channel: u8) -> Message {
+    GetEscId::new(&[node, channel]).unwrap().into()
+}
+
+/// Decodes `log`: its records' `(node, esc)` pairs in order, its records, and standard error.
+fn decode_log(log: &str) -> (Vec<(u64, u64)>, Vec<Value>, String) {
+    let dir = Dir::new();
+    let path = dir.path("bus.log");
+    std::fs::write(&path, log).unwrap();
+    outcome(run(&["decode", path.to_str().unwrap()]))
+}
+
+/// Decodes `log` from standard input (which is not read ahead), as [`decode_log`].
+fn decode_stdin(log: &str) -> (Vec<(u64, u64)>, Vec<Value>, String) {
+    let dir = Dir::new();
+    let path = dir.path("bus.log");
+    std::fs::write(&path, log).unwrap();
+    let out = hwfoc()
+        .args(["decode", "-"])
+        .stdin(std::fs::File::open(&path).unwrap())
+        .output()
+        .unwrap();
+    outcome(out)
+}
+
+/// A decoding's records' `(node, esc)` pairs in order, its records, and standard error.
+fn outcome(out: Output) -> (Vec<(u64, u64)>, Vec<Value>, String) {
+    let got = records(&String::from_utf8(out.stdout).unwrap());
+    let pairs = got
+        .iter()
+        .map(|r| (r["node"].as_u64().unwrap(), r["esc"].as_u64().unwrap()))
+        .collect();
+    (
+        pairs,
+        got,
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+/// The ESC of each node, in order of node.
+fn esc_of_nodes(pairs: &[(u64, u64)]) -> Vec<(u64, u64)> {
+    let set: std::collections::BTreeSet<(u64, u64)> = pairs.iter().copied().collect();
+    set.into_iter().collect()
+}
+
+/// Two Hobbywing nodes that both answer GetEscID with channel 1 are two ESCs (they were one,
+/// its rpm alternating 1000/3000 and its voltage 20/24 V): the first at the channel's number,
+/// the second after the bus's places; a warning names both nodes and the channel.
+#[test]
+fn two_nodes_claiming_one_channel_stay_two_escs() {
+    let mut sent = vec![("can0", 10, esc_id(10, 1)), ("can0", 11, esc_id(11, 1))];
+    for _ in 0..5 {
+        sent.extend([
+            ("can0", 10, volts(200)),
+            ("can0", 10, hw(1000)),
+            ("can0", 11, volts(240)),
+            ("can0", 11, hw(3000)),
+        ]);
+    }
+    let (pairs, got, err) = decode_log(&bus(&sent));
+    assert_eq!(got.len(), 10);
+    assert_eq!(esc_of_nodes(&pairs), [(10, 0), (11, 1)]);
+    for r in &got {
+        let (rpm, v) = if r["node"] == 10 {
+            (1000.0, 20.0)
+        } else {
+            (3000.0, 24.0)
+        };
+        assert_eq!(
+            (r["rpm"].as_f64(), r["voltage_v"].as_f64()),
+            (Some(rpm), Some(v))
+        );
+    }
+    assert!(
+        err.contains("warning") && err.contains("node 10") && err.contains("node 11"),
+        "{err}"
+    );
+    assert!(err.contains("throttle channel 1"), "{err}");
+    assert_eq!(err.lines().count(), 1, "{err}");
+    // Not read ahead (standard input, as live): the same ESCs and the same warning, once.
+    let (stdin_pairs, _, stdin_err) = decode_stdin(&bus(&sent));
+    assert_eq!(stdin_pairs, pairs);
+    assert_eq!(
+        stdin_err.trim_end(),
+        "hwfoc: warning: standard input: can0: node 10 and node 11 both claim throttle channel 1: \
+         read as two ESCs"
+    );
+}
+
+/// A Hobbywing ESC on channel 1 beside a standard DroneCAN ESC of `esc_index` 0 (the mixed bus
+/// the README shows): two ESCs, a warning naming both nodes.
+#[test]
+fn a_hobbywing_and_a_standard_esc_at_one_place_stay_two_escs() {
+    let mut sent = vec![("can0", 10, esc_id(10, 1))];
+    for k in 0..4 {
+        sent.extend([
+            ("can0", 10, hw(1000 + k)),
+            ("can0", 20, status(0, 3000).into()),
+        ]);
+    }
+    let (pairs, got, err) = decode_log(&bus(&sent));
+    assert_eq!(got.len(), 8);
+    assert_eq!(esc_of_nodes(&pairs), [(10, 0), (20, 1)]);
+    assert!(
+        got.iter()
+            .all(|r| (r["node"] == 10) == (r["protocol"] == "hw-can"))
+    );
+    assert!(err.contains("node 10") && err.contains("node 20"), "{err}");
+}
+
+/// Two buses of a log are numbered one after the other, can0's ESCs before can1's, whatever
+/// order their ESCs are first heard in (they were numbered in order of arrival, interleaved).
+#[test]
+fn two_buses_are_numbered_one_after_the_other() {
+    let mut sent = vec![
+        ("can0", 1, esc_id(1, 1)),
+        ("can0", 2, esc_id(2, 2)),
+        ("can1", 3, esc_id(3, 1)),
+        ("can1", 4, esc_id(4, 2)),
+        ("can0", 1, hw(100)),
+        ("can1", 3, hw(300)),
+        ("can1", 4, hw(400)),
+    ];
+    // can0's channel-2 ESC heard last.
+    for _ in 0..300 {
+        sent.push(("can0", 1, hw(100)));
+    }
+    sent.push(("can0", 2, hw(200)));
+    let (pairs, _, err) = decode_log(&bus(&sent));
+    assert_eq!(
+        esc_of_nodes(&pairs),
+        [(1, 0), (2, 1), (3, 2), (4, 3)],
+        "{err}"
+    );
+}
+
+/// A stray frame on an interface that carries no ESC takes no number and moves none (it made
+/// can0's channel-2 ESC ESC 2 instead of ESC 1).
+#[test]
+fn a_stray_frame_on_another_interface_moves_no_esc() {
+    let mut sent = vec![
+        ("can0", 1, esc_id(1, 1)),
+        ("can0", 2, esc_id(2, 2)),
+        ("can0", 1, hw(100)),
+    ];
+    for _ in 0..300 {
+        sent.push(("can0", 1, hw(100)));
+    }
+    sent.push(("can0", 2, hw(200)));
+    let mut log = bus(&sent);
+    let stray = CanFrame::standard(0x123, &[1]).unwrap();
+    // After can0's first window, before its channel-2 ESC is heard.
+    let at = log.match_indices('\n').nth(150).unwrap().0 + 1;
+    log.insert_str(at, &line_on(1_700_000_001.505, "vcan1", &stray));
+    let (pairs, _, err) = decode_log(&log);
+    assert_eq!(esc_of_nodes(&pairs), [(1, 0), (2, 1)], "{err}");
+    assert_eq!(err, "", "a bus without ESCs is no ESC to warn of");
+    // The stray frame first in the log: it took ESC 0, can0's ESCs 1 and 2.
+    let log = format!("{}{log}", line_on(1_699_999_999.0, "vcan1", &stray));
+    let (pairs, _, err) = decode_log(&log);
+    assert_eq!(esc_of_nodes(&pairs), [(1, 0), (2, 1)], "{err}");
+    assert_eq!(err, "");
+}
+
+/// A bus of error frames and no ESC status is told of in CAN words, with a wrong bit rate as
+/// its likely cause (it was told to check the baud rate and the wiring of an ESC's serial
+/// wire): read ahead from a file, or read once from standard input.
+#[test]
+fn a_bus_of_error_frames_suggests_a_wrong_bit_rate_in_can_words() {
+    let error = CanFrame::from_socketcan(SOCKETCAN_ERR_FLAG | 0x08, &[0, 0, 0x08, 0, 0, 0, 0, 0]);
+    let mut log = String::new();
+    for k in 0..3 {
+        log.push_str(&line(
+            1_700_000_000.0 + f64::from(k) * 0.01,
+            error.as_ref().unwrap(),
+        ));
+    }
+    log.push_str(&line(
+        1_700_000_000.5,
+        &CanFrame::standard(0x123, &[1]).unwrap(),
+    ));
+    let (_, got, err) = decode_log(&log);
+    assert!(got.is_empty());
+    // Standard input cannot be read ahead: the bus is an ESC without records, which says why.
+    let (_, _, from_stdin) = decode_stdin(&log);
+    for err in [&err, &from_stdin] {
+        assert!(
+            err.contains(
+                "4 CAN frames, 3 of them error frames, and no ESC status: check the bit rate"
+            ),
+            "{err}"
+        );
+        for word in ["baud", "wiring", "RX"] {
+            assert!(!err.contains(word), "{word}: {err}");
+        }
+    }
 }

@@ -6,9 +6,10 @@
 //! given. A stream found to carry a DataLink hub keeps its number for the hub's channel 0;
 //! channels 1 to 7 take the next numbers not given yet, in channel order, so that a hub read
 //! alone numbers its ESCs 0 to 7 by channel and no two ESCs share a number whatever mix of
-//! hubs and ESCs is read. A CAN bus is numbered alike by the places of its ESCs on the bus
-//! (its own number for place 0, the next ones for the places up to the highest heard), so that
-//! a bus read alone numbers its ESCs by their place. Numbers stop at [`MAX_ESCS`]: the record's
+//! hubs and ESCs is read. A CAN bus is numbered alike by the slots of its ESCs on the bus
+//! (`stream/can.rs`: an ESC's place, unless another ESC holds it; its own number for slot 0,
+//! the next ones for the slots up to the highest heard, all at once for a file's bus read
+//! ahead), so that a bus read alone numbers its ESCs by their place and two ESCs are never one. Numbers stop at [`MAX_ESCS`]: the record's
 //! `esc` column is a `u8`.
 
 /// How many ESCs the record's `esc` column (a `u8`) can number.
@@ -19,11 +20,12 @@ pub(crate) const MAX_ESCS: usize = 256;
 pub(crate) const UNNUMBERED: usize = usize::MAX;
 
 /// The ESC number of channel `channel` of the stream of ESC `own` (a DataLink hub's channel, a
-/// CAN bus's place: [`hwfoc::telemetry::Data::bus_index`]) numbered when `next` numbers have
-/// been given, the channels before it numbered already: `own` for channel 0, else `next`
-/// ([`UNNUMBERED`] from [`MAX_ESCS`] on). A CAN bus's places are numbered up to the highest
-/// one heard, so that a bus read alone numbers its ESCs by their place (throttle channel - 1
-/// for a mapped Hobbywing ESC, node id before, a standard ESC's `esc_index`).
+/// CAN bus's slot: its ESC's place, [`hwfoc::telemetry::Data::bus_index`], unless another ESC
+/// holds it) numbered when `next` numbers have been given, the channels before it numbered
+/// already: `own` for channel 0, else `next` ([`UNNUMBERED`] from [`MAX_ESCS`] on). A CAN bus's
+/// slots are numbered up to the highest one heard, so that a bus read alone numbers its ESCs by
+/// their place (throttle channel - 1 for a mapped Hobbywing ESC, node id if never mapped, a
+/// standard ESC's `esc_index`).
 pub(crate) fn channel_number(own: usize, next: usize, channel: usize) -> usize {
     match channel {
         0 => own,

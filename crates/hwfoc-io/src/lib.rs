@@ -135,6 +135,7 @@ pub mod write;
 // Modules whose public items are re-exported below, by role.
 mod episode;
 mod esc_numbers;
+mod esc_table;
 mod escape;
 mod fixed;
 mod handler;
@@ -169,6 +170,7 @@ pub use input::{Batch, Input, InputError, InputFormat, Looks, read_small_file};
 
 // Decoding: `Sources` reads inputs, merges them in time order and decodes each ESC's bytes
 // with a `Stream` (`PortStreams` for live ports), handing frames to a `Handler`.
+pub use esc_table::{EscEntry, EscKey, EscTable, Place, Recording};
 pub use handler::{Both, Handler, LaterPart};
 pub use sources::{Esc, InputInfo, MAX_QUEUED, Sources};
 pub use stream::{EscLink, PortStreams, SILENCE_S, Stream, WireKind};

@@ -77,6 +77,19 @@ pub enum Notice {
         /// The records left out, by protocol.
         records: Vec<(hwfoc::Protocol, u64)>,
     },
+    /// Something amiss on a CAN bus of a file, found when it was read ahead: two ESCs that
+    /// claim one throttle channel (two nodes answering GetEscID with one channel, a Hobbywing
+    /// ESC beside a standard one of that `esc_index`: read as two ESCs, the second numbered
+    /// after the bus's channels), or error frames and no ESC status (a wrong bit rate).
+    CanBus {
+        /// The input as named.
+        input: String,
+        /// The interface (bus).
+        interface: String,
+        /// What, in words (`node 10 and node 11 both claim throttle channel 1: read as two
+        /// ESCs`).
+        message: String,
+    },
     /// A damaged place in a recording, skipped.
     Damage {
         /// The input as named.
@@ -95,6 +108,37 @@ pub enum Notice {
         earlier: String,
         /// How long the overlap lasts, in seconds.
         seconds: f64,
+    },
+    /// An input that holds the same bytes as an earlier one (the same file given twice, or a
+    /// copy): it was not read again.
+    Duplicate {
+        /// The input as named that was not read.
+        input: String,
+        /// The earlier input with the same bytes.
+        earlier: String,
+    },
+    /// Ports of an input named as an earlier input's, at the same time, in another recording
+    /// (the port names of every drone and laptop are alike): other ESCs, numbered apart.
+    SamePortNames {
+        /// The input as named.
+        input: String,
+        /// The earlier input.
+        earlier: String,
+        /// The ports named alike, with this input's ESC number and the earlier input's.
+        ports: Vec<(String, usize, usize)>,
+    },
+    /// Ports of an input named as an earlier input's whose bytes begin where the earlier
+    /// one's end, in files that name no recording (another program wrote them): read as other
+    /// ESCs, since only the user can say that they are one recording (`--join`).
+    MayContinue {
+        /// The input as named.
+        input: String,
+        /// The earlier input.
+        earlier: String,
+        /// The ports named alike.
+        ports: Vec<String>,
+        /// Seconds from the end of the earlier input's bytes to the start of this one's.
+        gap: f64,
     },
 }
 
@@ -133,8 +177,10 @@ impl Notice {
                 | Notice::ForeignInterface { .. }
                 | Notice::NotClassicCan { .. }
                 | Notice::LeftOut { .. }
+                | Notice::CanBus { .. }
                 | Notice::Damage { .. }
                 | Notice::Overlap { .. }
+                | Notice::Duplicate { .. }
         )
     }
 
@@ -143,7 +189,9 @@ impl Notice {
     pub fn line(&self) -> String {
         let level = match self {
             _ if self.is_warning() => "warning: ",
-            Notice::Comment { .. } => "note: ",
+            Notice::Comment { .. } | Notice::SamePortNames { .. } | Notice::MayContinue { .. } => {
+                "note: "
+            }
             _ => "",
         };
         format!("hwfoc: {level}{self}")
@@ -217,7 +265,56 @@ impl fmt::Display for Notice {
                     counts.join(" and ")
                 )
             }
+            Notice::CanBus {
+                input,
+                interface,
+                message,
+            } => write!(f, "{}: {}: {message}", Escaped(input), Escaped(interface)),
             Notice::Damage { input, damage } => write!(f, "{}: {damage}", Escaped(input)),
+            Notice::Duplicate { input, earlier } => write!(
+                f,
+                "{} holds the same bytes as {}: read once",
+                Escaped(input),
+                Escaped(earlier)
+            ),
+            Notice::SamePortNames {
+                input,
+                earlier,
+                ports,
+            } => {
+                write!(
+                    f,
+                    "{}: its ports named as {}'s at the same time are of another recording, so \
+                     other ESCs: ",
+                    Escaped(input),
+                    Escaped(earlier)
+                )?;
+                for (k, (port, esc, other)) in ports.iter().enumerate() {
+                    let sep = if k == 0 { "" } else { ", " };
+                    write!(f, "{sep}{} is ESC {esc} (not ESC {other})", Escaped(port))?;
+                }
+                Ok(())
+            }
+            Notice::MayContinue {
+                input,
+                earlier,
+                ports,
+                gap,
+            } => {
+                write!(f, "{}: ", Escaped(input))?;
+                for (k, port) in ports.iter().enumerate() {
+                    let sep = if k == 0 { "" } else { ", " };
+                    write!(f, "{sep}{}", Escaped(port))?;
+                }
+                write!(
+                    f,
+                    " begin{} {gap:.3} s after {} ends, with the same port names: read as other \
+                     ESCs; if the files are one recording, read them joined (hwfoc --join, \
+                     Python join=True)",
+                    if ports.len() == 1 { "s" } else { "" },
+                    Escaped(earlier)
+                )
+            }
             Notice::Overlap {
                 input,
                 port,

@@ -56,8 +56,8 @@ use hwfoc_io::can::{CanBus, CanError, CanSpec, DEFAULT_BITRATE, SLCAN_BAUD, is_c
 // Setting Hobbywing's CAN ESCs up.
 use hwfoc_io::can::setup::{Change, Client, EscSurvey, Heard, Link, NodeHeard, SetupError, Survey};
 use hwfoc_io::can::setup::{Direction, LED_BLINKS, LED_COLORS, Led, StatusMessage, ThrottleSource};
+use hwfoc_io::can::setup::{Made, Motion, rate_text, short_name};
 use hwfoc_io::can::setup::{REQUEST_PRIORITY, baud_code, parse_rate, rate_code, rate_hz};
-use hwfoc_io::can::setup::{rate_text, short_name};
 
 // Times, clocks and energy.
 use hwfoc_io::clock::{MAX_FRAME_SPACING_S, MAX_STEP_S, ReceiveClock, Step};

@@ -117,7 +117,13 @@ impl Destination {
     /// Opens the destination for `n` ESCs at `baud`; existing files are replaced only if
     /// `overwrite` ([`Session::open`](crate::Session::open) has refused them all before any
     /// is created; each creation still refuses a file that appeared since).
-    pub(crate) fn open(&self, n: usize, baud: u32, overwrite: bool) -> Result<Opened, SimError> {
+    pub(crate) fn open(
+        &self,
+        n: usize,
+        baud: u32,
+        overwrite: bool,
+        recording: hwfoc_io::pcapng::RecordingId,
+    ) -> Result<Opened, SimError> {
         #[cfg(unix)]
         let mut links = pty::Links::default();
         let (sink, names, linger): (Box<dyn Sink>, Vec<String>, bool) = match self {
@@ -150,7 +156,9 @@ impl Destination {
                 let names = file_of.iter().map(|&f| outs[f].0.clone()).collect();
                 let sink: Box<dyn Sink> = match format {
                     FileFormat::Raw => Box::new(RawSink::new(outs)),
-                    FileFormat::Pcapng => Box::new(PcapngSink::new(outs, &file_of, baud)?),
+                    FileFormat::Pcapng => {
+                        Box::new(PcapngSink::new(outs, &file_of, baud, recording)?)
+                    }
                 };
                 (sink, names, false)
             }

@@ -96,6 +96,7 @@ impl Session {
         let realtime = plan.is_realtime();
         let n = fleet.spec().n;
         let baud = fleet.spec().baud;
+        let seed = fleet.spec().seed;
         let duration_s = match plan.duration_s {
             Some(d) => Some(d),
             None if realtime => None,
@@ -119,8 +120,10 @@ impl Session {
             (false, Some(FileFormat::Raw)) => start_ns.unwrap_or(0),
             _ => unix_now_ns(),
         };
+        // The recording's id, from what makes its bytes: the same seed and start, the same id.
+        let recording = hwfoc_io::pcapng::RecordingId::derived(&[seed, origin_ns]);
         Ok(Session {
-            opened: plan.destination.open(n, baud, plan.overwrite)?,
+            opened: plan.destination.open(n, baud, plan.overwrite, recording)?,
             escs,
             truth,
             pace: plan.destination.pace(realtime, baud),

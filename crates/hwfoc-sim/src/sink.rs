@@ -112,16 +112,18 @@ pub struct PcapngSink {
 
 impl PcapngSink {
     /// One recording per output, each ESC an interface named `esc-N` in the file at
-    /// `file_of[esc]`.
+    /// `file_of[esc]`; the files are parts of recording `recording`.
     pub fn new(
         outs: Vec<(String, Box<dyn Write>)>,
         file_of: &[usize],
         baud: u32,
+        recording: pcapng::RecordingId,
     ) -> Result<PcapngSink, WriteError> {
         let mut files = Vec::with_capacity(outs.len());
         for (name, w) in outs {
-            let writer = pcapng::Writer::new(BufWriter::with_capacity(1 << 16, w))
-                .map_err(write_error(&name))?;
+            let buffered = BufWriter::with_capacity(1 << 16, w);
+            let writer =
+                pcapng::Writer::continuing(buffered, recording).map_err(write_error(&name))?;
             files.push((name, writer));
         }
         let mut route = Vec::with_capacity(file_of.len());

@@ -9,7 +9,7 @@ mod older;
 use common::{cut_points, streamed_bytewise};
 use hwfoc::counters::PacketSequence24;
 use hwfoc::v3::{self, Decoded, Decoder, FRAME_LEN, Frame, Scanner};
-use older::{PLATINUM_PRO_V3, PLATINUM_V4, RANDOM_LEN, Rng, XROTOR, bulk, load};
+use older::{Figures, PLATINUM_PRO_V3, PLATINUM_V4, RANDOM_LEN, Rng, XROTOR, bulk, load};
 use proptest::collection::vec;
 use proptest::prelude::*;
 use proptest::sample::Index;
@@ -176,6 +176,42 @@ fn a_corrupted_counter_costs_that_frame() {
     );
 }
 
+#[test]
+fn a_frame_between_two_cut_frames_continues_the_chain_up_to_the_bound() {
+    // 3 and 5 cut out whole: 4 and 6 have no consecutive neighbour, yet each starts where the
+    // chain ends with its counter advanced by two.
+    let (decoded, stats) = bulk::<Scanner>(&encode_all([0, 1, 2, 4, 6]));
+    assert_eq!(counters(&decoded), [0, 1, 2, 4, 6]);
+    assert_eq!((stats.lost_frames(), stats.syncs()), (2, 1));
+    // Up to MAX_CHAINED_GAP frames missing; one more, and the frame needs a chain of three.
+    let last = 2 + v3::MAX_CHAINED_GAP + 1;
+    let (decoded, _) = bulk::<Scanner>(&encode_all([0, 1, 2, last, last + 2]));
+    assert_eq!(counters(&decoded), [0, 1, 2, last, last + 2]);
+    let (decoded, stats) = bulk::<Scanner>(&encode_all([0, 1, 2, last + 1, last + 3]));
+    assert_eq!(counters(&decoded), [0, 1, 2]);
+    assert_eq!(stats.unconfirmed(), 1);
+    // Not a step back, nor the same counter again.
+    for repeated in [0, 2] {
+        let (decoded, _) = bulk::<Scanner>(&encode_all([0, 1, 2, repeated, 9]));
+        assert_eq!(counters(&decoded), [0, 1, 2]);
+    }
+}
+
+/// The documented limit of the gap rule: a flip that moves a counter forward by at most
+/// `MAX_CHAINED_GAP` (bit 0 or 1 of its low byte) passes for frames cut before it; the frame is
+/// taken with its wrong counter and the next one, whose counter goes back, starts a new chain.
+#[test]
+fn a_counter_flipped_forward_within_the_gap_passes_for_cut_frames() {
+    let mut wire = encode_all(0..8);
+    wire[4 * FRAME_LEN + 3] ^= 0x02; // frame 4's counter becomes 6
+    let (decoded, stats) = bulk::<Scanner>(&wire);
+    assert_eq!(counters(&decoded), [0, 1, 2, 3, 6, 5, 6, 7]);
+    assert_eq!(
+        (stats.lost_frames(), stats.restarts(), stats.syncs()),
+        (2, 1, 2)
+    );
+}
+
 /// The documented limit: a chained frame that is cut short, whose counter follows and which
 /// the next frame's bytes complete into a plausible one, cannot be told from a real frame; the
 /// frame whose start it swallowed is lost, and the chain resumes three frames later.
@@ -190,6 +226,41 @@ fn a_cut_frame_that_stays_plausible_is_taken() {
     // Frame "3" took the first two bytes of frame 4 as its period.
     assert_eq!(decoded[3].frame.period_us, 0x9B00);
     assert_eq!(stats.lost_frames(), 1);
+}
+
+/// The stream for V3: 120 s of a V3 ESC as `hwfoc simulate --protocol hw-v3
+/// --duration 120` sends them (6154 frames back to back) with 5 % of them (308) cut out whole.
+/// Every frame left intact is decoded, also one that lies between two cut frames (and so has
+/// no consecutive neighbour to confirm it), and exactly the frames cut are counted lost.
+#[test]
+fn no_intact_frame_is_lost_between_frames_cut_out_whole() {
+    let mut rng = Rng(0x5EED_0120);
+    let sent: Vec<Frame> = (0..6154u32)
+        .map(|k| Frame {
+            counter: 0xAB_0000 + k,
+            throttle_in_raw: (rng.next() % 256) as u16,
+            pwm_out_raw: (rng.next() % 256) as u16,
+            period_us: rng.next() as u16,
+        })
+        .collect();
+    // The first and the last frame are kept, so that every frame cut is a visible loss.
+    let cut = rng.sample(1..sent.len() - 1, 308);
+    let mut wire = Vec::new();
+    let mut want = Vec::new();
+    for (k, f) in sent.iter().enumerate() {
+        if cut.binary_search(&k).is_err() {
+            want.push((wire.len() as u64, f.counter));
+            wire.extend_from_slice(&f.encode());
+        }
+    }
+    let (decoded, stats) = bulk::<Scanner>(&wire);
+    let got: Vec<(u64, u32)> = decoded
+        .iter()
+        .map(|d| (d.offset, d.frame.counter))
+        .collect();
+    older::assert_frames(&got, &want, 0xAB_0000);
+    assert_eq!(figures(&stats), Figures::after_cuts(cut.len()));
+    older::assert_every_path_agrees::<Scanner>(&wire, &[10, 11, 64]);
 }
 
 #[test]
@@ -374,6 +445,43 @@ proptest! {
     }
 
     #[test]
+    fn every_frame_left_between_frames_cut_out_whole_is_decoded(
+        (start, fields) in (0u32..1 << 24, vec((0u16..=255, 0u16..=255, any::<u16>()), 4..60)),
+        cuts in vec(prop::bool::weighted(0.3), 60),
+    ) {
+        let sent = older::sent_frames(&cuts[..fields.len()], v3::MAX_CHAINED_GAP);
+        let mut wire = Vec::new();
+        let mut want = Vec::new();
+        for (k, &(t, p, e)) in fields.iter().enumerate() {
+            let f = Frame {
+                counter: (start + k as u32) & 0xFF_FFFF,
+                throttle_in_raw: t,
+                pwm_out_raw: p,
+                period_us: e,
+            };
+            if sent[k] {
+                want.push((wire.len() as u64, f));
+                wire.extend_from_slice(&f.encode());
+            }
+        }
+        let (decoded, stats) = bulk::<Scanner>(&wire);
+        let got: Vec<(u64, Frame)> = decoded.iter().map(|d| (d.offset, d.frame)).collect();
+        prop_assert_eq!(got, want);
+        prop_assert_eq!(figures(&stats), Figures::after_cuts(sent.iter().filter(|&&s| !s).count()));
+        prop_assert_eq!(streamed_bytewise::<Scanner>(&wire), (decoded, stats));
+    }
+
+    #[test]
+    fn random_bytes_after_a_chain_give_no_frame(
+        (start, fields) in chain(),
+        bytes in vec(noisy_byte(), 0..300),
+    ) {
+        // The bytes start where the chain ends: any `9B` there is judged against the chain.
+        let w = build(&[Piece::Chain(start, fields), Piece::Garbage(bytes)]);
+        assert_finds_exactly(&w)?;
+    }
+
+    #[test]
     fn random_bytes_give_no_frame(bytes in vec(noisy_byte(), 0..3000)) {
         let (decoded, stats) = bulk::<Scanner>(&bytes);
         prop_assert!(decoded.is_empty());
@@ -399,6 +507,16 @@ fn syncs_outside(bytes: &[u8], starts: impl Iterator<Item = u64>) -> (u32, u32) 
         }
     }
     (outside, near_end)
+}
+
+/// The figures of a link that [`Figures`] compares.
+fn figures(stats: &v3::Stats) -> Figures {
+    Figures::of(
+        stats.counter(),
+        stats.bytes_skipped(),
+        stats.rejected(),
+        stats.syncs(),
+    )
 }
 
 #[test]

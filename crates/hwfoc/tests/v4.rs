@@ -13,7 +13,7 @@ use hwfoc::v4::{
     VoltsPerStep,
 };
 use hwfoc::{foc, v3};
-use older::{PLATINUM_PRO_V3, PLATINUM_V4, RANDOM_LEN, Rng, XROTOR, bulk, load};
+use older::{Figures, PLATINUM_PRO_V3, PLATINUM_V4, RANDOM_LEN, Rng, XROTOR, bulk, load};
 use proptest::collection::vec;
 use proptest::prelude::*;
 use proptest::sample::Index;
@@ -256,11 +256,146 @@ fn a_plausible_running_stream_with_a_restart_and_a_gap() {
     }
     let (decoded, stats) = bulk::<Scanner>(&wire);
     assert_eq!(counters(&decoded).len(), 12);
+    // The restart starts a new chain; the gap of three frames (3 to 7) continues it.
     assert_eq!(
         (stats.restarts(), stats.lost_frames(), stats.syncs()),
-        (1, 3, 3)
+        (1, 3, 2)
     );
     assert_eq!((stats.bytes_skipped(), stats.trailers()), (0, 0));
+}
+
+#[test]
+fn a_frame_between_two_cut_frames_continues_the_chain_up_to_the_bound() {
+    let wire =
+        |counters: &[u32]| -> Vec<u8> { counters.iter().flat_map(|&c| data(c).encode()).collect() };
+    // 3 and 5 cut out whole: 4 and 6 have no consecutive neighbour, yet each starts where the
+    // chain ends with its counter advanced by two.
+    let (decoded, stats) = bulk::<Scanner>(&wire(&[0, 1, 2, 4, 6]));
+    assert_eq!(counters(&decoded), [0, 1, 2, 4, 6]);
+    assert_eq!((stats.lost_frames(), stats.syncs()), (2, 1));
+    // Up to MAX_CHAINED_GAP frames missing; one more, and the frame needs a chain of three.
+    let last = 2 + v4::MAX_CHAINED_GAP + 1;
+    let (decoded, _) = bulk::<Scanner>(&wire(&[0, 1, 2, last, last + 2]));
+    assert_eq!(counters(&decoded), [0, 1, 2, last, last + 2]);
+    let (decoded, stats) = bulk::<Scanner>(&wire(&[0, 1, 2, last + 1, last + 3]));
+    assert_eq!(counters(&decoded), [0, 1, 2]);
+    assert_eq!(stats.unconfirmed(), 1);
+    // In slow mode: the info frame before a cut data frame is confirmed by the next info frame.
+    let info = InfoFrame::parse(&CAPTURE_INFO).unwrap();
+    let mut slow = Vec::new();
+    for c in [0, 2, 3] {
+        if c != 2 {
+            slow.extend_from_slice(&data(c).encode_with_trailer());
+        }
+        slow.extend_from_slice(&info.encode());
+    }
+    slow.extend_from_slice(&data(4).encode_with_trailer());
+    let (decoded, stats) = bulk::<Scanner>(&slow);
+    assert_eq!(counters(&decoded), [0, 3, 4]);
+    assert_eq!(infos_of(&decoded).len(), 3);
+    assert_eq!(
+        (stats.lost_frames(), stats.syncs(), stats.bytes_skipped()),
+        (2, 1, 0)
+    );
+}
+
+/// One frame of a V4 ESC's stream as sent: a data frame (with its trailer while idle) or an
+/// info frame (`data` is `None`), and its bytes.
+struct Sent {
+    data: Option<DataFrame>,
+    bytes: Vec<u8>,
+}
+
+/// 120 s of a V4 ESC as `hwfoc simulate --protocol hw-v4 --duration 120` sends them (2060 data
+/// frames, 42 info frames): idle (an info frame and a data frame with its trailer,
+/// alternating), running (data frames back to back), idle again; counters from 0x12_3400,
+/// fields from `rng`.
+fn simulated_v4(rng: &mut Rng) -> Vec<Sent> {
+    let info = InfoFrame::parse(&CAPTURE_INFO).unwrap();
+    let mut counter = 0x12_3400;
+    let mut next_data = |rng: &mut Rng, running: bool| {
+        let mut random = |below: u64| (rng.next() % below) as u16;
+        let f = DataFrame {
+            counter,
+            throttle_in_raw: if running { random(1001) } else { 0 },
+            throttle_out_raw: if running { random(1001) } else { 0 },
+            erpm: if running {
+                u32::from(random(60_000))
+            } else {
+                0
+            },
+            voltage_adc: 2600 + random(200),
+            current_adc: if running { random(4096) } else { 0 },
+            temp_adc: 3000 + random(300),
+            temp2_adc: if running { 3000 + random(300) } else { 0 },
+        };
+        counter += 1;
+        f
+    };
+    let mut sent = Vec::new();
+    for (frames, running) in [(21, false), (2018, true), (21, false)] {
+        for _ in 0..frames {
+            let f = next_data(rng, running);
+            if running {
+                sent.push(Sent {
+                    data: Some(f),
+                    bytes: f.encode().to_vec(),
+                });
+            } else {
+                sent.push(Sent {
+                    data: None,
+                    bytes: info.encode().to_vec(),
+                });
+                sent.push(Sent {
+                    data: Some(f),
+                    bytes: f.encode_with_trailer().to_vec(),
+                });
+            }
+        }
+    }
+    sent
+}
+
+/// The stream: 120 s of a V4 ESC with 5 % of its data frames (103 of 2060) cut out
+/// whole, each with its trailer. Every frame left intact is decoded, also one that lies between
+/// two cut frames (and so has no consecutive neighbour to confirm it), and exactly the frames
+/// cut are counted lost.
+#[test]
+fn no_intact_frame_is_lost_between_data_frames_cut_out_whole() {
+    let mut rng = Rng(0x5EED_0120);
+    let sent = simulated_v4(&mut rng);
+    let data_at: Vec<usize> = (0..sent.len())
+        .filter(|&k| sent[k].data.is_some())
+        .collect();
+    assert_eq!((data_at.len(), sent.len() - data_at.len()), (2060, 42));
+    // The first and the last data frame are kept, so that every frame cut is a visible loss.
+    let cut: Vec<usize> = rng
+        .sample(1..data_at.len() - 1, 103)
+        .into_iter()
+        .map(|k| data_at[k])
+        .collect();
+    let mut wire = Vec::new();
+    let (mut want_data, mut want_info) = (Vec::new(), Vec::new());
+    for (k, s) in sent.iter().enumerate() {
+        if cut.binary_search(&k).is_ok() {
+            continue;
+        }
+        match s.data {
+            Some(f) => want_data.push((wire.len() as u64, f.counter)),
+            None => want_info.push(wire.len() as u64),
+        }
+        wire.extend_from_slice(&s.bytes);
+    }
+    let (decoded, stats) = bulk::<Scanner>(&wire);
+    let got_data: Vec<(u64, u32)> = data_of(&decoded)
+        .iter()
+        .map(|(at, d)| (*at, d.packet()))
+        .collect();
+    let got_info: Vec<u64> = infos_of(&decoded).iter().map(|(at, _)| *at).collect();
+    older::assert_frames(&got_data, &want_data, 0x12_3400);
+    assert_eq!(got_info, want_info, "info frames");
+    assert_eq!(figures(&stats), Figures::after_cuts(cut.len()));
+    older::assert_every_path_agrees::<Scanner>(&wire, &[19, 20, 33, 64]);
 }
 
 #[test]
@@ -549,11 +684,17 @@ fn push_data(
 /// Whether the wire holds an info frame's fixed bytes (with plausible divisors) anywhere but
 /// where the real ones are: noise that is an info frame as far as any decoder can tell.
 fn has_fake_info(w: &Wire) -> bool {
-    w.bytes
+    fake_info_outside(&w.bytes, &w.info_at)
+}
+
+/// Whether `bytes` hold an info frame's fixed bytes (with plausible divisors) anywhere but at
+/// `info_at`.
+fn fake_info_outside(bytes: &[u8], info_at: &[usize]) -> bool {
+    bytes
         .windows(INFO_FRAME_LEN)
         .enumerate()
         .any(|(at, window)| {
-            InfoFrame::parse(window).is_some_and(|i| i.is_plausible()) && !w.info_at.contains(&at)
+            InfoFrame::parse(window).is_some_and(|i| i.is_plausible()) && !info_at.contains(&at)
         })
 }
 
@@ -646,6 +787,54 @@ proptest! {
     }
 
     #[test]
+    fn every_frame_left_between_data_frames_cut_out_whole_is_decoded(
+        start in 0u32..1 << 24,
+        frames in vec((plausible_fields(), any::<bool>()), 4..60),
+        cuts in vec(prop::bool::weighted(0.3), 60),
+    ) {
+        // Each data frame in fast mode, or in slow mode after an info frame, with its trailer; a
+        // data frame cut out whole takes its trailer with it, not the info frame before it.
+        let info = InfoFrame::parse(&CAPTURE_INFO).unwrap();
+        let sent = older::sent_frames(&cuts[..frames.len()], v4::MAX_CHAINED_GAP);
+        let mut wire = Vec::new();
+        let (mut want_data, mut want_info) = (Vec::new(), Vec::new());
+        for (k, (f, slow)) in frames.iter().enumerate() {
+            let f = DataFrame { counter: (start + k as u32) & 0xFF_FFFF, ..*f };
+            if *slow {
+                want_info.push(wire.len());
+                wire.extend_from_slice(&info.encode());
+            }
+            if sent[k] {
+                want_data.push((wire.len() as u64, f.counter));
+                match slow {
+                    true => wire.extend_from_slice(&f.encode_with_trailer()),
+                    false => wire.extend_from_slice(&f.encode()),
+                }
+            }
+        }
+        prop_assume!(!fake_info_outside(&wire, &want_info));
+        let (decoded, stats) = bulk::<Scanner>(&wire);
+        let got_data: Vec<(u64, u32)> =
+            data_of(&decoded).iter().map(|(at, d)| (*at, d.packet())).collect();
+        let got_info: Vec<usize> = infos_of(&decoded).iter().map(|(at, _)| *at as usize).collect();
+        prop_assert_eq!(got_data, want_data);
+        prop_assert_eq!(got_info, want_info);
+        prop_assert_eq!(figures(&stats), Figures::after_cuts(sent.iter().filter(|&&s| !s).count()));
+        prop_assert_eq!(streamed_bytewise::<Scanner>(&wire), (decoded, stats));
+    }
+
+    #[test]
+    fn random_bytes_after_a_chain_give_no_frame(
+        chain in chain(),
+        bytes in vec(noisy_byte(), 1..300),
+    ) {
+        // The bytes start where the chain ends: any `9B` there is judged against the chain.
+        let w = build(&[chain, Piece::Garbage(bytes)]);
+        prop_assume!(!has_fake_info(&w));
+        assert_finds_exactly(&w)?;
+    }
+
+    #[test]
     fn random_bytes_rich_in_9b_and_b9_give_no_frame(bytes in vec(noisy_byte(), 0..3000)) {
         let (decoded, stats) = bulk::<Scanner>(&bytes);
         prop_assert!(decoded.is_empty());
@@ -690,6 +879,16 @@ proptest! {
         let want4: Vec<(u64, Frame)> = v4_part.frames.iter().map(|(at, f)| (at + base, *f)).collect();
         prop_assert_eq!(got4, want4);
     }
+}
+
+/// The figures of a link that [`Figures`] compares.
+fn figures(stats: &v4::Stats) -> Figures {
+    Figures::of(
+        stats.counter(),
+        stats.bytes_skipped(),
+        stats.rejected(),
+        stats.syncs(),
+    )
 }
 
 #[test]

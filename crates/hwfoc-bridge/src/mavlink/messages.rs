@@ -241,6 +241,59 @@ pub fn esc_info(group: usize, context: &InfoContext, slots: &[Option<Slot>; GROU
 mod tests {
     use super::*;
 
+    /// A Hobbywing CAN ESC before its StatusMsg2 and StatusMsg3 (no voltage, current or
+    /// temperature): each field goes out as its message's "not available" where the definition
+    /// has one (`ESC_INFO.temperature` `INT16_MAX`; NaN for `ESC_STATUS`'s floats), else 0.
+    #[test]
+    fn quantities_not_carried_go_out_as_not_available_where_defined() {
+        use hwfoc::dronecan::HwCanEsc;
+        let data = hwfoc::telemetry::Data::from(HwCanEsc {
+            node: 3,
+            channel: Some(1),
+            transfer_id: 0,
+            rpm: 1200,
+            pwm: 300,
+            status: 0,
+            power: None,
+            msg2_age_ms: None,
+            temperatures: None,
+            msg3_age_ms: None,
+        });
+        let record = Record::new(None, 0, &data, &hwfoc::Settings::DEFAULT);
+        assert_eq!((record.voltage_v, record.mos_temp_c), (None, None));
+        let slot = Slot {
+            record,
+            frames: 1,
+            consumed_mah: 0.0,
+        };
+        let slots = [Some(slot), None, None, None];
+        let MavMessage::ESC_STATUS(status) = esc_status(0, 1, &slots) else {
+            unreachable!()
+        };
+        assert!(status.voltage[0].is_nan() && status.current[0].is_nan());
+        assert_eq!(status.rpm[0], 1200);
+        let context = InfoContext {
+            time_usec: 1,
+            count: 1,
+            counter: 1,
+            error_count: [0; 4],
+        };
+        let MavMessage::ESC_INFO(info) = esc_info(0, &context, &slots) else {
+            unreachable!()
+        };
+        assert_eq!(info.temperature[0], i16::MAX);
+        let columns = TelemetryColumns::new(&slots);
+        assert_eq!(
+            (
+                columns.temperature[0],
+                columns.voltage[0],
+                columns.current[0]
+            ),
+            (0, 0, 0)
+        );
+        assert_eq!(columns.rpm[0], 1200);
+    }
+
     #[test]
     fn fault_bits_map_to_failure_flags() {
         let flag = |f: Fault| failure_flags(Status::OK.with(f));

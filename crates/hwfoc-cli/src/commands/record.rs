@@ -27,6 +27,10 @@
 //! rate never changes after that, so one interface per port is the whole truth; a port still
 //! searching when the recording ends is declared at 19200 with a comment saying that its rate
 //! was not found and nothing of it recorded.
+//!
+//! A CAN bus (`slcan:PORT[:BITRATE]`, `can:IFACE`) has no baud rate to find: it is a
+//! `LINKTYPE_CAN_SOCKETCAN` interface from the start, one packet per CAN frame (never an empty
+//! one), and the report counts its CAN frames and the DroneCAN nodes heard.
 
 use std::fs::File;
 use std::io::BufWriter;
@@ -35,6 +39,7 @@ use std::sync::atomic::Ordering;
 use std::time::{Duration, Instant};
 
 use hwfoc::Protocol;
+use hwfoc::dronecan::{CanFrame, Header, SOCKETCAN_RECORD_LEN};
 use hwfoc_io::EscLink;
 
 use crate::args::ProtocolArgs;
@@ -156,6 +161,24 @@ struct PortState {
     silent_since: Option<Instant>,
     /// Unix time (ns) at which the port was lost, while it is.
     lost_at: Option<u64>,
+    /// A CAN bus's bit rate where named (`None` for a serial port, `Some(None)` for a SocketCAN
+    /// interface): a bus has no baud rate to find.
+    can: Option<Option<u32>>,
+    /// A CAN bus's frames recorded.
+    can_frames: u64,
+    /// The DroneCAN source nodes heard on a CAN bus (bit `n` for node `n`).
+    can_nodes: u128,
+}
+
+/// Whether port `name` is a CAN bus, and its bit rate where its name gives it.
+fn can_bus(name: &str) -> Option<Option<u32>> {
+    if !hwfoc_io::can::is_can_spec(name) {
+        return None;
+    }
+    match hwfoc_io::can::CanSpec::parse(name) {
+        Ok(hwfoc_io::can::CanSpec::Slcan { bitrate, .. }) => Some(Some(bitrate)),
+        _ => Some(None),
+    }
 }
 
 /// Frames of either kind a port's stream has decoded.
@@ -201,6 +224,8 @@ pub struct Recorder {
     files: Vec<String>,
     /// The number of the next file of a rotated recording.
     next_number: u32,
+    /// The recording's identity, in every file of it (rotated files alike).
+    recording: pcapng::RecordingId,
     /// The file being written; `None` after a rotation until there is something to write, so
     /// that a recording never ends with a file holding nothing.
     writer: Option<pcapng::Writer<BufWriter<File>>>,
@@ -237,6 +262,8 @@ pub fn run(args: &RecordArgs) -> Result<(), CliError> {
     };
     let mut recorder = Recorder::new(plan, set.names(), set.clock())?;
     let rate = match baud {
+        // A CAN bus has no baud rate: its bit rate is in the report.
+        _ if args.ports.iter().all(|p| can_bus(p).is_some()) => "(CAN)".to_string(),
         Baud::Fixed(baud) => format!("at {baud} baud"),
         Baud::Auto => format!("(baud rate found from the bytes: {} in turn)", rates_text()),
     };
@@ -339,6 +366,7 @@ impl Recorder {
             protocol: plan.protocol,
             files: vec![first],
             next_number: 2,
+            recording: pcapng::RecordingId::new(),
             writer: None,
             file_has_packets: false,
             file_started: now,
@@ -355,26 +383,37 @@ impl Recorder {
                     warned_unframed: false,
                     silent_since: Some(now),
                     lost_at: None,
+                    can: can_bus(name),
+                    can_frames: 0,
+                    can_nodes: 0,
                 })
                 .collect(),
         };
-        if recorder.bauds.iter().all(Option::is_some) {
+        if recorder.rates_known() {
             recorder.begin()?;
         }
         Ok(recorder)
     }
 
-    /// Writes the file's headers, an interface per port at its rate (a port whose rate was not
-    /// found at 19200, with a comment saying so), then what was held for them.
+    /// Whether every serial port's baud rate is known (a CAN bus has none to find).
+    fn rates_known(&self) -> bool {
+        self.ports
+            .iter()
+            .zip(&self.bauds)
+            .all(|(port, baud)| port.can.is_some() || baud.is_some())
+    }
+
+    /// Writes the file's headers, an interface per port at its rate (a serial port whose rate
+    /// was not found at 19200, with a comment saying so), then what was held for them.
     fn begin(&mut self) -> Result<(), CliError> {
         let Some(file) = self.pending.take() else {
             return Ok(());
         };
         let names: Vec<String> = self.ports.iter().map(|p| p.name.clone()).collect();
-        let mut writer = headers(self.current(), file, &names, &self.bauds)?;
+        let mut writer = headers(self.current(), file, &names, &self.bauds, self.recording)?;
         let now_ns = self.clock.now_ns();
         for (port, baud) in self.bauds.iter().enumerate() {
-            if baud.is_none() {
+            if baud.is_none() && self.ports[port].can.is_none() {
                 let text = format!(
                     "{}: no baud rate found ({} tried in turn): nothing of it was recorded",
                     names[port],
@@ -449,7 +488,7 @@ impl Recorder {
             PortEvent::Lost { .. } | PortEvent::Back { .. } => {}
         }
         if self.pending.is_some() {
-            if !self.bauds.iter().all(Option::is_some) {
+            if !self.rates_known() {
                 self.held.push(event);
                 return Ok(());
             }
@@ -521,9 +560,23 @@ impl Recorder {
 
     /// Decodes a chunk to count frames and to notice a port that sends no valid frame.
     fn decode(&mut self, port: usize, event: &PortEvent) {
-        if hwfoc_io::can::is_can_spec(&self.ports[port].name) {
-            // A CAN bus's frame records: never given to the serial formats' detection.
-            self.ports[port].silent_since = None;
+        let state = &mut self.ports[port];
+        if state.can.is_some() {
+            // A CAN bus's frame records: counted, never given to the serial formats' detection.
+            state.silent_since = None;
+            if let PortEvent::Data { bytes, .. } = event {
+                let (records, _) = bytes.as_chunks::<SOCKETCAN_RECORD_LEN>();
+                for record in records {
+                    state.can_frames += 1;
+                    let frame = CanFrame::from_socketcan_record(record);
+                    if let Some(header) = frame
+                        .filter(CanFrame::is_dronecan_shaped)
+                        .and_then(|f| Header::parse(f.id()).ok())
+                    {
+                        state.can_nodes |= 1 << (header.source_node & 0x7F);
+                    }
+                }
+            }
             return;
         }
         let before = self.streams.stats(port).map_or(0, frames);
@@ -633,7 +686,7 @@ impl Recorder {
         let (next, mut writer) = loop {
             let next = numbered(&self.base, self.next_number);
             self.next_number += 1;
-            match create(&next, &names, &self.bauds, false) {
+            match create(&next, &names, &self.bauds, self.recording) {
                 Ok(writer) => break (next, writer),
                 Err(CliError::Write(WriteError::Exists { .. })) if taken.len() < MAX_TAKEN => {
                     taken.push(next);
@@ -696,6 +749,9 @@ impl Recorder {
             .iter()
             .enumerate()
             .map(|(i, p)| {
+                if let Some(bitrate) = p.can {
+                    return can_status(&p.name, bitrate, p.can_nodes.count_ones(), p.can_frames);
+                }
                 let stats = self.streams.stats(i).unwrap_or_default();
                 format!(
                     "{} {} bytes, {} frames",
@@ -711,6 +767,18 @@ impl Recorder {
             ports.join("; ")
         )
     }
+}
+
+/// What the report says of CAN bus `name`: its bit rate where known, the DroneCAN nodes heard
+/// and the CAN frames recorded (`slcan:/dev/ttyACM0 500000 bit/s, 4 nodes, 1341 CAN frames`).
+fn can_status(name: &str, bitrate: Option<u32>, nodes: u32, frames: u64) -> String {
+    let rate = bitrate.map_or_else(String::new, |b| format!(" {b} bit/s,"));
+    let plural = |n: u64, what: &str| format!("{n} {what}{}", if n == 1 { "" } else { "s" });
+    format!(
+        "{name}{rate} {}, {}",
+        plural(u64::from(nodes), "node"),
+        plural(frames, "CAN frame")
+    )
 }
 
 /// The rates an auto-baud search tries: `19200 and 115200`.
@@ -752,39 +820,35 @@ fn no_frame_warning(
 }
 
 /// Creates a recording file with its headers, one interface per port at its rate. An
-/// existing file is an error unless `overwrite`.
+/// existing file is an error. The file is part of recording `recording`.
 fn create(
     path: &str,
     ports: &[String],
     bauds: &[Option<u32>],
-    overwrite: bool,
+    recording: pcapng::RecordingId,
 ) -> Result<pcapng::Writer<BufWriter<File>>, CliError> {
-    let file = hwfoc_io::write::create_file(path, overwrite)?;
-    headers(path, file, ports, bauds)
+    let file = hwfoc_io::write::create_file(path, false)?;
+    headers(path, file, ports, bauds, recording)
 }
 
-/// Writes the headers of the recording `path` into `file`: one interface per port at its
-/// rate (19200 for a rate not known).
+/// Writes the headers of the file `path` of recording `recording` into `file`: one interface
+/// per port at its rate (19200 for a rate not known).
 fn headers(
     path: &str,
     file: File,
     ports: &[String],
     bauds: &[Option<u32>],
+    recording: pcapng::RecordingId,
 ) -> Result<pcapng::Writer<BufWriter<File>>, CliError> {
     let err = |source| WriteError::Write {
         output: path.to_string(),
         source,
     };
-    let mut writer = pcapng::Writer::new(BufWriter::with_capacity(BUFFER, file)).map_err(err)?;
+    let buffered = BufWriter::with_capacity(BUFFER, file);
+    let mut writer = pcapng::Writer::continuing(buffered, recording).map_err(err)?;
     for (i, port) in ports.iter().enumerate() {
-        if let Ok(spec) = hwfoc_io::can::CanSpec::parse(port)
-            && hwfoc_io::can::is_can_spec(port)
-        {
+        if let Some(bitrate) = can_bus(port) {
             // A CAN bus: one packet per frame (`pcapng::Writer::write` takes its records).
-            let bitrate = match spec {
-                hwfoc_io::can::CanSpec::Slcan { bitrate, .. } => Some(bitrate),
-                hwfoc_io::can::CanSpec::SocketCan { .. } => None,
-            };
             writer.add_can_interface(port, bitrate).map_err(err)?;
             continue;
         }

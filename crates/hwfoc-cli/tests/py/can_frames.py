@@ -173,9 +173,13 @@ def age_ms(now, then):
     return None if then is None else (now - then) // 1000
 
 
-def expected_records(transfers):
-    """The records of docs/RECORD-SCHEMA.md hwfoc must make of the transfers."""
+def expected_records(transfers, ahead):
+    """The records of docs/RECORD-SCHEMA.md hwfoc must make of the transfers. An ESC's number is
+    its place on the bus: a file is read ahead (`ahead`), so a Hobbywing node has for the whole
+    file the throttle channel - 1 it is answered with, its node id if never; live, a node keeps
+    the place it had when first heard (its node id: the answers come at 0.2 s)."""
     channel = {}
+    number = {}
     msg2, msg3, ext = {}, {}, {}
     records = []
     for t, name, v, src, ok in transfers:
@@ -195,8 +199,13 @@ def expected_records(transfers):
             m3, t3 = msg3.get(src, (None, None))
             mos = m3["MOS_T"] if m3 else (m2["temperature"] if m2 else None)
             ch = channel.get(src)
+            if ahead:
+                final = HW_NODES[src]
+                esc = final - 1 if final else src
+            else:
+                esc = number.setdefault(src, ch - 1 if ch else src)
             records.append(record(
-                t, ch - 1 if ch else src, "hw-can", src,
+                t, esc, "hw-can", src,
                 throttle_out_pct=f32(v["pwm"] / 10), rpm=float(v["rpm"]),
                 voltage_v=f32(m2["input_voltage"] / 10) if m2 else None,
                 current_a=f32(m2["current"] / 10) if m2 else None,
@@ -247,7 +256,7 @@ def slcan_line(can_id, data):
 def main():
     mode = sys.argv[1] if len(sys.argv) > 1 else ""
     frames, transfers = bus()
-    expected = expected_records(transfers)
+    expected = expected_records(transfers, ahead=mode == "log")
     if mode == "log" and len(sys.argv) == 4:
         for r in expected:
             r["t_s"] = (T0_US + round(r["t_s"] * 1e6)) / 1e6

@@ -174,6 +174,12 @@ trait Source {
     fn file(&self) -> Option<&File> {
         None
     }
+
+    /// The recording the input is a part of, where it names one (an hwfoc pcapng recording:
+    /// [`pcapng::RecordingId`]), once its start is read.
+    fn recording_id(&self) -> Option<pcapng::RecordingId> {
+        None
+    }
 }
 
 /// What a closed file's [`Source`] knew, asked for after its end.
@@ -186,6 +192,7 @@ struct Kept {
     can: Vec<bool>,
     flagged: u64,
     looks: Option<Looks>,
+    recording: Option<pcapng::RecordingId>,
 }
 
 impl Kept {
@@ -199,6 +206,7 @@ impl Kept {
             can: (0..streams).map(|i| source.is_can(i)).collect(),
             flagged: source.flagged_bytes(),
             looks: source.looks(),
+            recording: source.recording_id(),
         }
     }
 }
@@ -324,6 +332,30 @@ impl Input {
         true
     }
 
+    /// The recording this input is a part of, where it names one ([`pcapng::RecordingId`]:
+    /// hwfoc's recordings do, in their section header), once its first batch is read.
+    pub fn recording_id(&self) -> Option<pcapng::RecordingId> {
+        match &self.source {
+            Some(source) => source.recording_id(),
+            None => self.kept.recording,
+        }
+    }
+
+    /// The length of a regular file opened by its path, as it is now.
+    pub(crate) fn file_len(&self) -> Option<u64> {
+        std::fs::metadata(self.path.as_ref()?).ok().map(|m| m.len())
+    }
+
+    /// Whether this input and `other` are regular files holding the same bytes (the same
+    /// file given twice, or a copy of it): compared only when their lengths are equal, and
+    /// then to the first byte that differs.
+    pub(crate) fn same_bytes_as(&self, other: &Input) -> bool {
+        let (Some(a), Some(b)) = (&self.path, &other.path) else {
+            return false;
+        };
+        same_file_bytes(a, b).unwrap_or(false)
+    }
+
     /// Hands `notice` to the input's notice sink.
     pub(crate) fn tell(&mut self, notice: Notice) {
         (self.notices)(notice);
@@ -377,11 +409,7 @@ impl Input {
 
     /// The length of a raw input that is a regular file, as it is now (before it is read).
     pub(crate) fn raw_file_len(&self) -> Option<u64> {
-        let path = self
-            .path
-            .as_ref()
-            .filter(|_| self.format == InputFormat::RAW)?;
-        std::fs::metadata(path).ok().map(|meta| meta.len())
+        self.file_len().filter(|_| self.format == InputFormat::RAW)
     }
 
     /// A raw input that is a regular file, being read: a second handle on it, for positional
@@ -568,6 +596,30 @@ impl Input {
             times: (self.format.clock() != Clock::None).then_some(&self.times[..]),
             stream: self.stream,
         })
+    }
+}
+
+/// Whether files `a` and `b` hold the same bytes: their lengths first, then their contents in
+/// blocks up to the first that differs.
+fn same_file_bytes(a: &str, b: &str) -> io::Result<bool> {
+    let (fa, fb) = (File::open(a)?, File::open(b)?);
+    if fa.metadata()?.len() != fb.metadata()?.len() {
+        return Ok(false);
+    }
+    let (mut fa, mut fb) = (BufReader::new(fa), BufReader::new(fb));
+    let (mut ba, mut bb) = (vec![0u8; 1 << 16], vec![0u8; 1 << 16]);
+    loop {
+        // `take(..).read_to_end` reads a block whole (a plain `read` may stop short).
+        ba.clear();
+        bb.clear();
+        let n = (&mut fa).take(1 << 16).read_to_end(&mut ba)?;
+        let m = (&mut fb).take(1 << 16).read_to_end(&mut bb)?;
+        if ba != bb {
+            return Ok(false);
+        }
+        if n == 0 && m == 0 {
+            return Ok(true);
+        }
     }
 }
 

@@ -212,6 +212,10 @@ pub(super) fn is_start(head: &[u8]) -> bool {
 }
 
 impl Source for RecordingReader {
+    fn recording_id(&self) -> Option<pcapng::RecordingId> {
+        self.reader.recording_id()
+    }
+
     fn format(&self) -> InputFormat {
         InputFormat::RECORDING
     }

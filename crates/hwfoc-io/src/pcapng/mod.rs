@@ -8,7 +8,9 @@
 //! A recording holds the bytes received on one or more serial ports exactly as they arrived,
 //! every byte in order, with its receive time:
 //! - a section header block (SHB) naming the writing application (`shb_userappl` = `hwfoc` and
-//!   its version);
+//!   its version) and the recording (`opt_comment` = `hwfoc recording UUID`, [`RecordingId`]:
+//!   the same in every file of one `hwfoc record` run, rotated files alike, so that files are
+//!   read as one recording only when they are one);
 //! - one interface description block (IDB) per port: link type [`LINKTYPE`] (`LINKTYPE_USER0`,
 //!   raw HW-FOC UART bytes), `if_name` = the port, `if_description` = "HW-FOC telemetry, 19200
 //!   baud 8N1", `if_speed` = the baud rate, `if_tsresol` = 9 (nanoseconds);
@@ -43,9 +45,11 @@
 //! block types, option codes and the byte-order magic.
 
 mod cut;
+mod id;
 mod read;
 mod write;
 
+pub use id::RecordingId;
 pub use read::{Damage, Interface, Packet, Reader};
 pub use write::Writer;
 

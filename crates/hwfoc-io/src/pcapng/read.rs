@@ -7,7 +7,7 @@ use std::ops::Range;
 
 use super::{
     EPB, IDB, IF_DESCRIPTION, IF_NAME, IF_SPEED, IF_TSOFFSET, IF_TSRESOL, ISB, MAX_CHUNK, NRB,
-    OPT_COMMENT, OPT_END, PB, SHB, SPB,
+    OPT_COMMENT, OPT_END, PB, RecordingId, SHB, SPB,
 };
 
 /// Longest block the reader accepts (a sanity bound on a length field that may be damaged).
@@ -208,6 +208,8 @@ pub struct Reader<R: Read> {
     /// The number of the current section (1 for the first).
     section: u64,
     damage: Vec<Damage>,
+    /// The recording the first section header names, if it names one.
+    recording: Option<RecordingId>,
 }
 
 impl<R: Read> Reader<R> {
@@ -226,6 +228,7 @@ impl<R: Read> Reader<R> {
             by_port: HashMap::new(),
             section: 0,
             damage: Vec::new(),
+            recording: None,
         }
     }
 
@@ -237,6 +240,12 @@ impl<R: Read> Reader<R> {
     /// The interfaces declared so far, the reader let go.
     pub fn into_interfaces(self) -> Vec<Interface> {
         self.interfaces
+    }
+
+    /// The recording the file's first section header names (`hwfoc recording UUID`), once it
+    /// is read: `None` for a file another program wrote.
+    pub fn recording_id(&self) -> Option<RecordingId> {
+        self.recording
     }
 
     /// The places that could not be read since the last call.
@@ -399,6 +408,15 @@ impl<R: Read> Reader<R> {
         }
         self.local.clear();
         self.section += 1;
+        if self.section == 1 {
+            let recording = self
+                .options(body.start + 16..body.end)
+                .filter(|(code, _)| *code == OPT_COMMENT)
+                .find_map(|(_, value)| {
+                    RecordingId::from_comment(std::str::from_utf8(&self.buf[value]).ok()?)
+                });
+            self.recording = recording;
+        }
         Ok(Step::Other)
     }
 

@@ -7,7 +7,8 @@ use hwfoc::dronecan::SOCKETCAN_RECORD_LEN;
 use super::cut::{Cutter, Emit};
 use super::{
     BYTE_ORDER_MAGIC, EPB, IDB, IF_DESCRIPTION, IF_NAME, IF_SPEED, IF_TSRESOL, LINKTYPE,
-    LINKTYPE_CAN_SOCKETCAN, MAX_CHUNK, OPT_COMMENT, OPT_END, SHB, SHB_OS, SHB_USERAPPL,
+    LINKTYPE_CAN_SOCKETCAN, MAX_CHUNK, OPT_COMMENT, OPT_END, RecordingId, SHB, SHB_OS,
+    SHB_USERAPPL,
 };
 
 /// Writes a pcapng recording: the section header on creation, then interfaces, frames and notes.
@@ -25,6 +26,8 @@ pub struct Writer<W: Write> {
     can: Vec<bool>,
     block: Vec<u8>,
     written: u64,
+    /// The recording the file is part of, named in its section header.
+    recording: RecordingId,
 }
 
 /// Bytes of file an EPB without options takes for `len` bytes of packet.
@@ -59,15 +62,22 @@ impl Emit for Cost {
 }
 
 impl<W: Write> Writer<W> {
-    /// Starts a recording: writes the section header block (little-endian, naming `hwfoc` and
-    /// its version as the writing application).
+    /// Starts a new recording: writes the section header block (little-endian, naming `hwfoc`
+    /// and its version as the writing application, and a new [`RecordingId`]).
     pub fn new(w: W) -> io::Result<Self> {
+        Writer::continuing(w, RecordingId::new())
+    }
+
+    /// Starts a file of recording `recording` (the next file of a rotated recording: the same
+    /// id in every file tells readers the files are one recording).
+    pub fn continuing(w: W, recording: RecordingId) -> io::Result<Self> {
         let mut writer = Writer {
             inner: w,
             ports: Vec::new(),
             can: Vec::new(),
             block: Vec::with_capacity(256),
             written: 0,
+            recording,
         };
         writer.begin(SHB);
         writer.put_u32(BYTE_ORDER_MAGIC);
@@ -79,6 +89,7 @@ impl<W: Write> Writer<W> {
             SHB_USERAPPL,
             concat!("hwfoc ", env!("CARGO_PKG_VERSION")).as_bytes(),
         );
+        writer.option(OPT_COMMENT, recording.comment().as_bytes());
         writer.end_options();
         writer.finish()?;
         Ok(writer)
@@ -278,6 +289,11 @@ impl<W: Write> Writer<W> {
     /// The underlying writer (for example to `sync_data` the file under a `BufWriter`).
     pub fn get_ref(&self) -> &W {
         &self.inner
+    }
+
+    /// The recording this file is part of (see [`Writer::continuing`]).
+    pub fn recording_id(&self) -> RecordingId {
+        self.recording
     }
 
     /// Bytes handed to `W` so far, section header included.

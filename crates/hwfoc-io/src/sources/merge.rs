@@ -15,18 +15,24 @@
 //! far as the queue allows.
 
 use std::cmp::Ordering;
-use std::collections::{BinaryHeap, VecDeque};
+use std::collections::{BTreeMap, BinaryHeap, VecDeque};
 
 use hwfoc::telemetry::Frame;
 
 use super::numbering::{Deliver, route};
 use super::{Handler, LIVE_BATCH, Sources};
+use crate::esc_table::{Place, Recording};
 use crate::input::{Batch, Input, InputError};
 use crate::notice::Notice;
 
 /// The most frames waiting in the time-order queue: past it, the earliest is handed on at once
 /// (about 7 MB of frames; a recording of 256 ports needs at most 51 200).
 pub const MAX_QUEUED: usize = 1 << 16;
+
+/// The longest silence between the end of one file's port and the start of another's named
+/// alike for the two to look like one recording cut in files (a rotated series has none; a
+/// recorder restarted on the same machine, a few seconds).
+const LINED_UP_S: f64 = 10.0;
 
 /// An input being read in a run of inputs read together.
 struct Reading {
@@ -82,8 +88,11 @@ impl Sources {
         // file is closed again until its turn comes. After an error, the inputs not begun are
         // not read.
         let mut result = Ok(());
-        for input in inputs {
+        for mut input in inputs {
             let index = self.open(&input);
+            if self.skip_duplicate(&mut input, index) {
+                continue;
+            }
             let escs = self.numbered(index);
             run.push(Reading {
                 input,
@@ -135,6 +144,7 @@ impl Sources {
                     }
                 });
                 self.deliver(esc, pending, &mut Deliver::<H>::Queue);
+                self.tell_can_clashes(&mut run[k].input, esc);
             }
             result = self.read_ahead(&mut run, k, more_recordings);
             if let Some((t, _)) = run[k].ahead {
@@ -148,6 +158,7 @@ impl Sources {
                 self.end_of(&mut run, k, more_recordings);
             }
         }
+        self.tell_alike_ports(&mut run);
         self.release(f64::INFINITY, handler);
         Ok(result?)
     }
@@ -189,8 +200,10 @@ impl Sources {
             }
             _ => 0,
         };
-        if let Some(&last) = times[skip..].last() {
+        if let (Some(&first), Some(&last)) = (times[skip..].first(), times[skip..].last()) {
             self.fed[esc] = Some((index, last));
+            let span = self.span[esc].get_or_insert((first, last));
+            *span = (span.0.min(first), span.1.max(last));
         }
         Batch {
             bytes: &batch.bytes[skip..],
@@ -222,14 +235,26 @@ impl Sources {
         count: bool,
     ) -> Result<(), InputError> {
         let reading = &mut run[k];
-        let batch = match reading.input.next_batch() {
-            Ok(Some(batch)) => batch,
-            Ok(None) => {
-                reading.ahead = None;
-                self.end_of(run, k, more_recordings);
-                return Ok(());
+        loop {
+            let (stream, len) = match reading.input.next_batch() {
+                Ok(Some(batch)) => (batch.stream, batch.bytes.len()),
+                Ok(None) => {
+                    reading.ahead = None;
+                    self.end_of(run, k, more_recordings);
+                    return Ok(());
+                }
+                Err(e) => return Err(e),
+            };
+            // A CAN bus without ESCs is no ESC (`can_plan.rs`): its bytes are counted only.
+            if !self.is_silent_bus(&reading.input, reading.index, stream) {
+                break;
             }
-            Err(e) => return Err(e),
+            if count {
+                reading.bytes += len as u64;
+            }
+        }
+        let Some(batch) = reading.input.current_batch() else {
+            return Ok(());
         };
         let Some(times) = batch.times else {
             return Err(InputError::NoTiming {
@@ -260,7 +285,7 @@ impl Sources {
         for o in std::mem::take(&mut reading.overlaps) {
             reading.input.tell(Notice::Overlap {
                 input: self.names[reading.index].clone(),
-                port: self.escs[o.esc].name.clone(),
+                port: self.table[o.esc].key.port.clone(),
                 earlier: self.names[o.earlier].clone(),
                 seconds: o.to - o.from,
             });
@@ -272,6 +297,70 @@ impl Sources {
             }
         }
         reading.escs = escs;
+    }
+
+    /// Tells, through the later input of each pair, of the ports of inputs of `run` that are
+    /// named alike in different recordings (see `esc_table.rs`): at the same time, they are
+    /// other ESCs ([`Notice::SamePortNames`]); one beginning where the other ends, in files
+    /// that name no recording, they may be one recording the user can join
+    /// ([`Notice::MayContinue`]). Each ESC is told of with the first earlier ESC named alike.
+    fn tell_alike_ports(&self, run: &mut [Reading]) {
+        // By (later input, earlier input): the ports at the same time, and those lined up.
+        let mut same: BTreeMap<(usize, usize), Vec<(String, usize, usize)>> = BTreeMap::new();
+        let mut lined: BTreeMap<(usize, usize), (Vec<String>, f64)> = BTreeMap::new();
+        for (esc, entry) in self.table.iter().enumerate() {
+            let (Place::Own, Some(span)) = (entry.key.place, self.span[esc]) else {
+                continue;
+            };
+            let earlier = (0..esc).find_map(|e| {
+                let other = &self.table[e];
+                let alike = other.key.place == Place::Own
+                    && other.key.port == entry.key.port
+                    && other.key.recording != entry.key.recording
+                    && other.input != entry.input;
+                Some((e, other, self.span[e]?)).filter(|_| alike)
+            });
+            let Some((e, other, before)) = earlier else {
+                continue;
+            };
+            let pair = (entry.input, other.input);
+            if span.0 <= before.1 && before.0 <= span.1 {
+                same.entry(pair)
+                    .or_default()
+                    .push((entry.key.port.clone(), esc, e));
+            } else if let (Recording::Input(_), Recording::Input(_)) =
+                (entry.key.recording, other.key.recording)
+            {
+                let gap = (span.0 - before.1).max(before.0 - span.1);
+                if gap <= LINED_UP_S {
+                    let (ports, g) = lined.entry(pair).or_insert((Vec::new(), gap));
+                    ports.push(entry.key.port.clone());
+                    *g = g.min(gap);
+                }
+            }
+        }
+        let mut tell = |input: usize, notice: Notice| {
+            if let Some(r) = run.iter_mut().find(|r| r.index == input) {
+                r.input.tell(notice);
+            }
+        };
+        for ((input, earlier), ports) in same {
+            let notice = Notice::SamePortNames {
+                input: self.names[input].clone(),
+                earlier: self.names[earlier].clone(),
+                ports,
+            };
+            tell(input, notice);
+        }
+        for ((input, earlier), (ports, gap)) in lined {
+            let notice = Notice::MayContinue {
+                input: self.names[input].clone(),
+                earlier: self.names[earlier].clone(),
+                ports,
+                gap,
+            };
+            tell(input, notice);
+        }
     }
 
     /// The time before which no input being read can give a frame any more: the earliest

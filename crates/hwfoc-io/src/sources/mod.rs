@@ -28,6 +28,9 @@
 //! in time order (a heap of the batches read ahead, a queue per ESC, the bytes two inputs hold
 //! of one port left out once); `mod.rs` reads the inputs, alone or together.
 
+mod can_plan;
+#[cfg(test)]
+mod fleet_tests;
 mod merge;
 mod numbering;
 mod split;
@@ -41,11 +44,13 @@ use hwfoc::foc::DataFrame;
 use hwfoc::telemetry::{Data, Frame};
 use hwfoc::{Protocol, Settings};
 
+use crate::esc_table::{EscTable, Recording};
 pub use crate::handler::Handler;
 use crate::handler::LaterPart;
 use crate::input::{Batch, Input, InputError, InputFormat};
+use crate::notice::Notice;
 use crate::settings::SettingsMap;
-use crate::stream::{EscLink, Stream};
+use crate::stream::{BusPlan, EscLink, Stream};
 use crate::time::Clock;
 
 pub use self::merge::MAX_QUEUED;
@@ -66,13 +71,9 @@ struct Held {
 /// Batches shorter than this come from a live source: what they produce is passed on at once.
 const LIVE_BATCH: usize = 4096;
 
-/// One ESC: a stream of one input.
+/// One ESC's decoding: a stream of one input (which ESC it is: [`Sources::esc_table`]).
 #[derive(Debug)]
 pub struct Esc {
-    /// Index of its input in [`Sources::inputs`].
-    pub input: usize,
-    /// Name of the stream: the port it was recorded from, or the input's name.
-    pub name: String,
     /// Its decoder and receive times; its link statistics. (Behind a DataLink hub, the hub's
     /// stream is that of the ESC on channel 0; the others' is never fed: see [`Sources::link`].)
     pub stream: Stream,
@@ -96,6 +97,9 @@ pub struct InputInfo {
     /// What its bytes look like, read to its end, when they are not telemetry (a raw input's:
     /// text, zeros, another file format).
     pub looks: Option<crate::input::Looks>,
+    /// The earlier input (index) that holds the same bytes, where this one is a copy: it was
+    /// not read again.
+    pub duplicate_of: Option<usize>,
 }
 
 /// The inputs of a command and the ESCs found in them.
@@ -107,12 +111,16 @@ pub struct Sources {
     names: Vec<String>,
     read: Vec<InputInfo>,
     escs: Vec<Esc>,
+    /// Which ESC is which (`esc_table.rs`).
+    table: EscTable,
+    /// Whether the recordings given are one (`--join`): their ports go on by name.
+    join: bool,
     need_timing: bool,
-    /// The ESC of each port named by a recording's interface so far.
-    ports: HashMap<String, usize>,
     /// The ESC of each channel of each stream found to come from a DataLink hub, by the ESC
     /// of its stream.
     hubs: HashMap<usize, Hub>,
+    /// The slots of the ESCs of each CAN bus read ahead (`can_plan.rs`), by its stream's name.
+    buses: HashMap<(Recording, String), BusPlan>,
     /// The ESCs of each input's streams numbered before it is read, by input.
     numbered: Vec<Vec<Option<usize>>>,
     queue: Queue,
@@ -121,6 +129,11 @@ pub struct Sources {
     /// By ESC: the input (index) whose bytes its stream was fed last, and the time of the last
     /// of them.
     fed: Vec<Option<(usize, f64)>>,
+    /// By ESC: the times of the first and the last byte its stream was fed (inputs with
+    /// times), to tell of ports named alike in other recordings.
+    span: Vec<Option<(f64, f64)>>,
+    /// By input: the earlier input that holds the same bytes, where it is a copy.
+    duplicates: Vec<Option<usize>>,
     /// The one protocol read, when a user forced one.
     forced: Option<Protocol>,
     /// Data frames without times not handed on yet (see [`HELD`]).
@@ -142,14 +155,18 @@ impl Sources {
             pending: inputs,
             read: Vec::new(),
             escs: Vec::new(),
+            table: EscTable::default(),
+            join: false,
             need_timing: false,
-            ports: HashMap::new(),
             hubs: HashMap::new(),
+            buses: HashMap::new(),
             numbered: Vec::new(),
             esc_settings: Vec::new(),
             queue: Queue::default(),
             readers: Vec::new(),
             fed: Vec::new(),
+            span: Vec::new(),
+            duplicates: Vec::new(),
             forced: None,
             split_min: SPLIT_MIN,
             #[cfg(test)]
@@ -165,6 +182,15 @@ impl Sources {
     /// before [`Sources::run`].
     pub fn force_protocol(&mut self, protocol: Protocol) {
         self.forced = Some(protocol);
+    }
+
+    /// Reads the recordings given as one (`--join`): the streams of recordings that name the
+    /// same port are one ESC, its bytes in time order, whatever recording each file names
+    /// (files another program wrote name none). Without it, only the files of one recording
+    /// (the same [`RecordingId`](crate::pcapng::RecordingId), as every file of one `hwfoc
+    /// record` run carries) go on from one to the next; other files are ESCs of their own.
+    pub fn join_recordings(&mut self) {
+        self.join = true;
     }
 
     /// The protocol forced by [`Sources::force_protocol`], if any.
@@ -199,7 +225,7 @@ impl Sources {
         match self.esc_settings.get(esc) {
             Some(settings) => *settings,
             None => {
-                let name = self.escs.get(esc).map_or("", |e| e.name.as_str());
+                let name = self.table.get(esc).map_or("", |e| e.key.port.as_str());
                 self.settings.get(esc, name)
             }
         }
@@ -231,9 +257,14 @@ impl Sources {
             .then_some(first)
     }
 
-    /// The ESCs found so far, by index.
+    /// The ESCs found so far, by index: their decoding.
     pub fn escs(&self) -> &[Esc] {
         &self.escs
+    }
+
+    /// Which ESC is which: each ESC's key (recording, port, place) and input, by index.
+    pub fn esc_table(&self) -> &EscTable {
+        &self.table
     }
 
     /// The DataLink hubs found: the ESC whose stream each came in (its channel 0), and the
@@ -291,6 +322,10 @@ impl Sources {
     /// finished), and the error is returned without reading further.
     pub fn run<H: Handler>(&mut self, handler: &mut H) -> Result<(), H::Error> {
         let mut inputs: VecDeque<Input> = std::mem::take(&mut self.pending).into();
+        let base = self.read.len();
+        self.duplicates.resize(base, None);
+        self.duplicates.extend(duplicates(&inputs, base));
+        self.plan_buses(&mut inputs, base);
         self.number_inputs(&inputs);
         let mut result = Ok(());
         while let Some(first) = inputs.front() {
@@ -325,7 +360,7 @@ impl Sources {
         for esc in 0..self.escs.len() {
             let frames = self.link(esc).frames() > 0;
             // (An input whose reading failed has no entry.)
-            let Some(read) = self.read.get_mut(self.escs[esc].input) else {
+            let Some(read) = self.read.get_mut(self.table[esc].input) else {
                 continue;
             };
             if self.escs[esc].hub.is_some() && frames {
@@ -365,6 +400,20 @@ impl Sources {
         }
     }
 
+    /// Whether input `index` holds the same bytes as an earlier one: then it is noted so and
+    /// told, and not read.
+    fn skip_duplicate(&mut self, input: &mut Input, index: usize) -> bool {
+        let Some(earlier) = self.duplicates.get(index).copied().flatten() else {
+            return false;
+        };
+        self.read[index].duplicate_of = Some(earlier);
+        input.tell(Notice::Duplicate {
+            input: self.names[index].clone(),
+            earlier: self.names[earlier].clone(),
+        });
+        true
+    }
+
     /// Notes an input as begun, in command-line order.
     fn open(&mut self, input: &Input) -> usize {
         self.read.push(InputInfo {
@@ -374,6 +423,7 @@ impl Sources {
             bytes: 0,
             escs: Vec::new(),
             looks: None,
+            duplicate_of: None,
         });
         self.read.len() - 1
     }
@@ -388,6 +438,9 @@ impl Sources {
         handler: &mut H,
     ) -> Result<(), H::Error> {
         let index = self.open(&input);
+        if self.skip_duplicate(&mut input, index) {
+            return Ok(());
+        }
         let part = input
             .raw_file_len()
             .is_some_and(|len| split::AVAILABLE && len >= self.split_min)
@@ -480,6 +533,7 @@ impl Sources {
                 self.feed(esc, part(after, times.map(|t| t.1)), &mut pending, handler);
             }
             self.deliver(esc, pending, &mut Deliver::Handler(handler));
+            self.tell_can_clashes(input, esc);
             handler.end_batch(len < LIVE_BATCH)?;
         }
     }
@@ -526,6 +580,28 @@ impl Sources {
         }
         Some(done.bytes)
     }
+}
+
+/// For each of `inputs` (numbered from `base`), the earlier one that holds the same bytes, if
+/// any: only regular files of the same length are compared, block by block up to the first
+/// that differs (the files of a rotated series differ in their first block).
+fn duplicates(inputs: &VecDeque<Input>, base: usize) -> Vec<Option<usize>> {
+    let mut by_len: HashMap<u64, Vec<usize>> = HashMap::new();
+    for (k, input) in inputs.iter().enumerate() {
+        if let Some(len) = input.file_len() {
+            by_len.entry(len).or_default().push(k);
+        }
+    }
+    let mut found = vec![None; inputs.len()];
+    for same_len in by_len.values().filter(|v| v.len() > 1) {
+        for (i, &k) in same_len.iter().enumerate() {
+            found[k] = same_len[..i]
+                .iter()
+                .find(|&&j| found[j].is_none() && inputs[k].same_bytes_as(&inputs[j]))
+                .map(|&j| base + j);
+        }
+    }
+    found
 }
 
 /// Where [`feed_runs`] hands a stream's frames.

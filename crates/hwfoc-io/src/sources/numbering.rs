@@ -1,5 +1,6 @@
 //! Which stream of which input is which ESC: an input's streams in the order given, the
-//! recordings of one port one ESC, a hub's channels after all inputs' streams (see [`super`]).
+//! streams of one port in one recording one ESC (`esc_table.rs`), a hub's channels after all
+//! inputs' streams (see [`super`]).
 
 use std::collections::VecDeque;
 
@@ -9,15 +10,16 @@ use hwfoc::telemetry::Frame;
 
 use super::{Esc, Handler, Sources};
 use crate::esc_numbers::{MAX_ESCS, UNNUMBERED, channel_number};
+use crate::esc_table::{EscKey, Place, Recording};
 use crate::input::{Input, InputError};
 use crate::stream::Stream;
 
 impl Sources {
     /// Hands on the frames of a stream found to carry several ESCs (a DataLink hub's channels,
-    /// a CAN bus's places) whose channel has no ESC yet, once it has one (made here, in channel
+    /// a CAN bus's slots) whose channel has no ESC yet, once it has one (made here, in channel
     /// order: channel 0 is the stream's own ESC): to a handler, or to the time-order queue.
-    /// A hub's eight channels are numbered at once; a bus's places up to the highest one heard
-    /// (`esc_numbers.rs`).
+    /// A hub's eight channels are numbered at once; a bus's slots up to the highest one heard
+    /// (`esc_numbers.rs`; a bus read ahead had all its slots numbered with its stream).
     pub(super) fn deliver<H: Handler>(
         &mut self,
         esc: usize,
@@ -61,12 +63,20 @@ impl Sources {
             let number = channel_number(esc, self.escs.len(), channel);
             if number != UNNUMBERED && number != esc {
                 debug_assert_eq!(number, self.escs.len());
-                self.push_esc(Esc {
-                    input: self.escs[esc].input,
-                    name: self.escs[esc].name.clone(),
-                    stream: Stream::forced(self.forced),
-                    hub: Some((esc, channel as u8)),
-                });
+                let owner = &self.table[esc];
+                let key = EscKey {
+                    place: Place::Channel(channel as u8),
+                    ..owner.key.clone()
+                };
+                let input = owner.input;
+                self.push_esc(
+                    Esc {
+                        stream: Stream::forced(self.forced),
+                        hub: Some((esc, channel as u8)),
+                    },
+                    key,
+                    input,
+                );
             }
             hub.settings.push(self.esc_settings(number));
             hub.escs.push(number);
@@ -74,13 +84,37 @@ impl Sources {
         self.hubs.insert(esc, hub);
     }
 
-    /// A new ESC, its settings looked up once.
-    fn push_esc(&mut self, esc: Esc) {
-        let settings = self.settings.get(self.escs.len(), &esc.name);
+    /// A new ESC, `key` of input `input`, its settings looked up once. A CAN bus read ahead
+    /// (`can_plan.rs`) has its ESCs' slots fixed and numbered at once, so that its ESCs'
+    /// numbers follow each other whatever is heard on other buses meanwhile.
+    fn push_esc(&mut self, mut esc: Esc, key: EscKey, input: usize) {
+        let plan = match esc.stream.is_can() {
+            true => self.buses.get(&(key.recording, key.port.clone())).cloned(),
+            false => None,
+        };
+        if let Some(plan) = &plan {
+            esc.stream.plan_can(plan);
+        }
+        let settings = self.settings.get(self.escs.len(), &key.port);
+        self.table.push(key, input);
         self.escs.push(esc);
         self.esc_settings.push(settings);
         self.readers.push(0);
         self.fed.push(None);
+        self.span.push(None);
+        if let Some(plan) = plan.filter(|p| !p.is_empty()) {
+            self.grow_hub(self.escs.len() - 1, plan.len());
+        }
+    }
+
+    /// The recording input `index` is a part of (`esc_table.rs`): one of its own unless it
+    /// names one (hwfoc's recordings) or the recordings are joined (`--join`).
+    pub(super) fn recording_of(&self, input: &Input, index: usize) -> Recording {
+        match (self.join, input.recording_id()) {
+            (true, _) if input.format().has_recorded_ports() => Recording::Joined,
+            (_, Some(id)) => Recording::Id(id),
+            _ => Recording::Input(index),
+        }
     }
 
     /// The ESC of stream `stream` of `input` (number `index`), made when first seen; `escs`
@@ -95,13 +129,13 @@ impl Sources {
         if let Some(&Some(esc)) = escs.get(stream) {
             return Ok(esc);
         }
-        let name = input.stream_name(stream);
-        let recorded = input.format().has_recorded_ports();
-        let earlier = self
-            .ports
-            .get(&name)
-            .copied()
-            .filter(|e| recorded && !escs.contains(&Some(*e)));
+        let key = EscKey {
+            recording: self.recording_of(input, index),
+            port: input.stream_name(stream),
+            place: Place::Own,
+        };
+        // A port's stream in a recording that an earlier input of it had (a rotated series).
+        let earlier = self.table.find(&key).filter(|e| !escs.contains(&Some(*e)));
         let esc = match earlier {
             Some(esc) => esc,
             None => {
@@ -110,22 +144,16 @@ impl Sources {
                         input: self.names[index].clone(),
                     });
                 }
-                if recorded {
-                    self.ports.insert(name.clone(), self.escs.len());
-                }
                 // A CAN bus's stream reads CAN frames, keeping the forced protocol's records.
                 let stream = if input.is_can(stream) {
                     Stream::can_forced(self.forced)
                 } else {
                     Stream::forced(self.forced)
                 };
-                self.push_esc(Esc {
-                    input: index,
-                    name,
-                    stream,
-                    hub: None,
-                });
-                self.escs.len() - 1
+                // (A CAN bus read ahead numbers its ESCs after its own at once.)
+                let esc = self.escs.len();
+                self.push_esc(Esc { stream, hub: None }, key, index);
+                esc
             }
         };
         if escs.len() <= stream {
@@ -145,6 +173,9 @@ impl Sources {
         escs: &mut Vec<Option<usize>>,
     ) {
         for stream in 0..input.streams() {
+            if self.is_silent_bus(input, index, stream) {
+                continue;
+            }
             if self.esc_of(input, index, stream, escs).is_err() {
                 break;
             }
@@ -164,6 +195,11 @@ impl Sources {
                 break;
             }
             let mut escs = Vec::new();
+            // A copy of an earlier input is not read: it has no ESC.
+            if self.duplicates.get(base + k).copied().flatten().is_some() {
+                self.numbered.push(escs);
+                continue;
+            }
             self.number_streams(input, base + k, &mut escs);
             self.numbered.push(escs);
         }

@@ -42,11 +42,18 @@ pub(crate) fn wire(packets: std::ops::Range<u16>) -> Vec<u8> {
         .collect()
 }
 
-/// A recording with one interface per `(port, bytes, first byte's time in ns)`, in the
-/// order given; each port's bytes in packets of 7 bytes, 4 ms apart (7 bytes take 3.6 ms
-/// at 19200 baud).
+/// The recording the files these tests write are parts of, unless a test says otherwise (as
+/// the files of one `hwfoc record` run: see `esc_table.rs`).
+pub(crate) fn one_recording() -> pcapng::RecordingId {
+    pcapng::RecordingId::from_comment("hwfoc recording 6f1c1a52-8f3e-4d0b-9a57-0c2b3e4d5f60")
+        .unwrap()
+}
+
+/// A file of [`one_recording`] with one interface per `(port, bytes, first byte's time in
+/// ns)`, in the order given; each port's bytes in packets of 7 bytes, 4 ms apart (7 bytes take
+/// 3.6 ms at 19200 baud).
 pub(crate) fn recording(ports: &[(&str, &[u8], u64)]) -> Vec<u8> {
-    let mut w = pcapng::Writer::new(Vec::new()).unwrap();
+    let mut w = pcapng::Writer::continuing(Vec::new(), one_recording()).unwrap();
     for (port, _, _) in ports {
         w.add_interface(port, 19200).unwrap();
     }
@@ -154,10 +161,22 @@ impl Handler for InOrder {
     }
 }
 
-/// A recording as `hwfoc record` writes one: packets of every port in time order, a data
-/// frame per packet every 50 ms per port from `t0` (ns), port `p` `p` ms after port 0.
+/// A file of [`one_recording`] as `hwfoc record` writes one: packets of every port in time
+/// order, a data frame per packet every 50 ms per port from `t0` (ns), port `p` `p` ms after
+/// port 0.
 fn live_recording(ports: &[&str], first_packet: u16, frames: u16, t0: u64) -> Vec<u8> {
-    let mut w = pcapng::Writer::new(Vec::new()).unwrap();
+    live_recording_of(one_recording(), ports, first_packet, frames, t0)
+}
+
+/// A file of recording `id` as [`live_recording`] writes one.
+fn live_recording_of(
+    id: pcapng::RecordingId,
+    ports: &[&str],
+    first_packet: u16,
+    frames: u16,
+    t0: u64,
+) -> Vec<u8> {
+    let mut w = pcapng::Writer::continuing(Vec::new(), id).unwrap();
     for port in ports {
         w.add_interface(port, 19200).unwrap();
     }
@@ -219,7 +238,7 @@ fn several_recordings_are_merged_by_time() {
     assert_eq!(got.0.len(), 900);
     assert_time_order(&got.0);
     // The later file was given first: its port is ESC 0.
-    assert_eq!(sources.escs()[0].name, "/dev/ttyUSB1");
+    assert_eq!(sources.esc_table()[0].key.port, "/dev/ttyUSB1");
     assert_eq!(sources.inputs()[1].escs, [1, 2]);
     assert_eq!(got.0[0].0, 1);
     let first_of_late = got.0.iter().position(|r| r.0 == 0).unwrap();

@@ -14,6 +14,7 @@ mod can;
 mod forced;
 
 pub use self::can::CanLink;
+pub(crate) use self::can::{BusLearner, BusPlan, no_status};
 use self::forced::{Bus, Probe};
 use crate::clock::byte_times;
 use crate::esc_numbers::{UNNUMBERED, channel_number};
@@ -625,6 +626,27 @@ impl Stream {
     pub fn left_out(&self) -> Vec<(Protocol, u64)> {
         match &self.wire {
             Wire::Can(c) => c.left_out(),
+            _ => Vec::new(),
+        }
+    }
+
+    /// Fixes the slots of a CAN bus's ESCs ahead (`can.rs`); nothing for any other stream.
+    pub(crate) fn plan_can(&mut self, plan: &BusPlan) {
+        if let Wire::Can(c) = &mut self.wire {
+            c.wire.set_plan(plan);
+        }
+    }
+
+    /// A CAN bus's ESCs heard since the last call that claim a throttle channel another holds,
+    /// in words (none for any other stream).
+    pub(crate) fn take_can_clashes(&mut self) -> Vec<String> {
+        match &mut self.wire {
+            Wire::Can(c) => c
+                .wire
+                .take_clashes()
+                .iter()
+                .map(|c| c.to_string())
+                .collect(),
             _ => Vec::new(),
         }
     }

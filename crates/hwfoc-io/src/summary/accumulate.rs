@@ -4,6 +4,7 @@
 
 use hwfoc::foc::DataFrame;
 use hwfoc::telemetry::{Conversion, Data, Frame, Info, Telemetry};
+use hwfoc::units::ADC_NO_VALUE;
 use hwfoc::{Protocol, Quantity, Settings, Status, Temperature};
 
 use super::MAX_EPISODES;
@@ -804,6 +805,9 @@ pub(super) fn temp_stats(codes: &[u64; 256], conversion: Conversion) -> TempStat
             continue;
         }
         let temperature = match conversion {
+            // No value (the code of no sensor, what a hub or the bridge sends for a temperature
+            // not carried): no reading, neither below nor above the table.
+            Conversion::AdcTable if code == usize::from(ADC_NO_VALUE) => continue,
             Conversion::AdcTable => Temperature::from_adc(code as u8),
             other => match other.to_f32(code as i32) {
                 Some(c) => Temperature::Celsius(c),

@@ -10,13 +10,18 @@ impl Report<'_> {
             .inputs()
             .iter()
             .map(|info| {
-                json!({
+                let mut v = json!({
                     "input": info.name,
                     "format": info.format.short_name(),
                     "bytes": info.bytes,
                     "flagged_bytes": info.flagged_bytes,
                     "escs": info.escs,
-                })
+                });
+                // A copy of an earlier input, not read: which (the key only then).
+                if let Some(earlier) = info.duplicate_of {
+                    v["duplicate_of"] = json!(self.sources.names()[earlier]);
+                }
+                v
             })
             .collect();
         let reports = self.escs();
@@ -38,7 +43,7 @@ impl Report<'_> {
             .hubs()
             .map(|(esc, h)| {
                 json!({
-                    "stream": self.sources.escs()[esc].name,
+                    "stream": self.sources.esc_table()[esc].key.port,
                     "bytes": h.bytes(),
                     "bytes_skipped": h.bytes_skipped(),
                     "frames": h.frames(),

@@ -94,18 +94,22 @@ pub fn no_frames_of(protocol: Protocol, found: Option<Protocol>) -> String {
 
 /// Why ESC `esc`'s bytes gave no frame, as every output says it: what its input looks like
 /// when that is not telemetry (`text, not telemetry`, `looks like a PNG image, not telemetry`:
-/// a file given by mistake), else the advice of the protocol forced
+/// a file given by mistake), on a CAN bus its frames in CAN words (a wrong bit rate where it is
+/// the likely cause), else the advice of the protocol forced
 /// ([`Sources::force_protocol`]), else what the bytes of a raw input hold
 /// ([`Looks::Unframed`](crate::Looks::Unframed): its lead bytes, the baud rates and the
 /// wiring), else [`NO_FRAMES`], the advice for a wire (a port, a recording).
 pub fn no_frames(sources: &Sources, esc: usize) -> String {
     let looks = sources
-        .escs()
+        .esc_table()
         .get(esc)
         .and_then(|e| sources.inputs().get(e.input))
         .and_then(|input| input.looks);
     if let Some(looks) = looks.filter(|l| l.is_other_than_telemetry()) {
         return looks.to_string();
+    }
+    if let EscLink::Can(c) = sources.link(esc) {
+        return c.no_status();
     }
     if let Some(protocol) = sources.forced_protocol() {
         let stream = sources.escs().get(esc).map(|e| &e.stream);
@@ -129,11 +133,13 @@ pub fn left_out(sources: &Sources) -> Vec<crate::Notice> {
     sources
         .escs()
         .iter()
-        .filter_map(|e| {
+        .enumerate()
+        .filter_map(|(i, e)| {
+            let place = &sources.esc_table()[i];
             let records = e.stream.left_out();
             (!records.is_empty()).then(|| crate::Notice::LeftOut {
-                input: sources.names()[e.input].clone(),
-                interface: e.name.clone(),
+                input: sources.names()[place.input].clone(),
+                interface: place.key.port.clone(),
                 forced,
                 records,
             })
@@ -162,25 +168,26 @@ fn can_place(c: &crate::stream::CanLink) -> String {
 /// How an ESC is named in messages: its input, and its stream when the input has several
 /// (names from a recording [`Escaped`]).
 pub fn esc_label(sources: &Sources, esc: usize) -> String {
-    let e = &sources.escs()[esc];
+    let e = &sources.esc_table()[esc];
     let input = &sources.names()[e.input];
     let single = sources
         .inputs()
         .get(e.input)
         .is_none_or(|info| info.escs.len() == 1);
-    let channel = match (sources.link(esc), e.hub) {
+    let channel = match (sources.link(esc), sources.escs()[esc].hub) {
         (crate::stream::EscLink::Can(c), _) => can_place(&c),
         (_, Some((_, channel))) => format!(" channel {channel}"),
         _ if sources.is_hub(esc) => " channel 0".to_string(),
         _ => String::new(),
     };
     let input = Escaped(input);
-    if single && e.name == *input.0 && channel.is_empty() {
+    let port = &e.key.port;
+    if single && *port == *input.0 && channel.is_empty() {
         input.to_string()
-    } else if e.name == *input.0 {
+    } else if *port == *input.0 {
         format!("{input}{channel} (ESC {esc})")
     } else {
-        format!("{input}: {}{channel} (ESC {esc})", Escaped(&e.name))
+        format!("{input}: {}{channel} (ESC {esc})", Escaped(port))
     }
 }
 
@@ -334,7 +341,7 @@ impl<'a> Report<'a> {
         static EMPTY: std::sync::OnceLock<Accumulator> = std::sync::OnceLock::new();
         let empty = EMPTY.get_or_init(Accumulator::default);
         self.sources
-            .escs()
+            .esc_table()
             .iter()
             .enumerate()
             // A hub's channels that carried no ESC are not ESCs.
@@ -360,7 +367,7 @@ impl<'a> Report<'a> {
                     no_frames: no_frames(self.sources, i),
                     index: i,
                     label: esc_label(self.sources, i),
-                    stream: &esc.name,
+                    stream: &esc.key.port,
                     input: &self.sources.names()[esc.input],
                     stats: self.sources.link(i),
                     settings: self.sources.esc_settings(i),

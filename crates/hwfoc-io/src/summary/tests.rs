@@ -19,6 +19,7 @@ fn temperature_stats_come_from_the_histogram() {
     codes[183] = 1; // 40 degC
     codes[250] = 2; // below range
     codes[10] = 1; // above range
+    codes[255] = 4; // no value (ADC_NO_VALUE): neither
     let t = temp_stats(&codes, Conversion::AdcTable);
     assert_eq!(t.range, Some([28.0, 40.0, (3.0 * 28.0 + 40.0) / 4.0]));
     assert_eq!((t.below, t.above), (2, 1));

@@ -23,6 +23,16 @@ impl Report<'_> {
         }
         o.push('\n');
         for info in self.sources.inputs() {
+            if let Some(earlier) = info.duplicate_of {
+                let _ = writeln!(
+                    o,
+                    "input        {} ({}, the same bytes as {}: read once)",
+                    Escaped(&info.name),
+                    info.format,
+                    Escaped(&self.sources.names()[earlier])
+                );
+                continue;
+            }
             let escs = match info.escs.as_slice() {
                 [] => "no ESC".to_string(),
                 [one] => format!("ESC {one}"),
@@ -60,7 +70,7 @@ impl Report<'_> {
             let _ = writeln!(
                 o,
                 "hub          {}: DataLink V2, {hub}",
-                Escaped(&self.sources.escs()[esc].name)
+                Escaped(&self.sources.esc_table()[esc].key.port)
             );
         }
         for esc in &escs {

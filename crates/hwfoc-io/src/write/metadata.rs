@@ -102,7 +102,7 @@ pub fn esc_settings_json(escs: &[(u8, Settings)]) -> String {
 /// [`device_json`](crate::summary::device_json) gives it, or null before one was.
 pub fn escs_json(sources: &Sources) -> String {
     let escs: Vec<serde_json::Value> = sources
-        .escs()
+        .esc_table()
         .iter()
         .enumerate()
         .map(|(i, esc)| {
@@ -111,7 +111,7 @@ pub fn escs_json(sources: &Sources) -> String {
             let mut entry = serde_json::json!({
                 "esc": i,
                 "input": sources.names()[esc.input],
-                "stream": esc.name,
+                "stream": esc.key.port,
                 "protocol": framed.then(|| link.protocol().name()),
             });
             if framed && link.protocol() == hwfoc::Protocol::HwV4 {

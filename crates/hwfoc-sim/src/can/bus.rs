@@ -64,6 +64,8 @@ pub struct CanBus {
     rx: Receiver,
     sent: Vec<Sent>,
     natural_s: f64,
+    /// The run's seed.
+    seed: u64,
 }
 
 impl CanBus {
@@ -109,6 +111,7 @@ impl CanBus {
                 .collect(),
         );
         bus.natural_s = natural_s;
+        bus.seed = spec.seed;
         Ok(bus)
     }
 
@@ -127,12 +130,18 @@ impl CanBus {
             rx: Receiver::new(),
             sent: Vec::new(),
             natural_s: 0.0,
+            seed: 0,
         }
     }
 
     /// The ESCs.
     pub fn escs(&self) -> &[CanEsc] {
         &self.escs
+    }
+
+    /// The seed of its ESCs' random choices (0 for a bus made with [`CanBus::new`]).
+    pub fn seed(&self) -> u64 {
+        self.seed
     }
 
     /// The bus's bit rate, bit/s.

@@ -137,6 +137,10 @@ impl CanSession {
             }
             None => None,
         };
+        let origin_ns = match (realtime, plan.start_s) {
+            (false, Some(s)) => (s * 1e9).round() as u64,
+            _ => unix_now_ns(),
+        };
         let out = match &plan.destination {
             CanDestination::Candump(path) => {
                 let (name, w) = sink::create(path, plan.overwrite)?;
@@ -144,8 +148,12 @@ impl CanSession {
             }
             CanDestination::Pcapng(path) => {
                 let (name, w) = sink::create(path, plan.overwrite)?;
-                let mut writer = pcapng::Writer::new(BufWriter::with_capacity(1 << 16, w))
-                    .map_err(write_error(&name))?;
+                // The recording's id, from what makes its bytes: the same seed and start,
+                // the same id.
+                let recording = pcapng::RecordingId::derived(&[bus.seed(), origin_ns]);
+                let buffered = BufWriter::with_capacity(1 << 16, w);
+                let mut writer =
+                    pcapng::Writer::continuing(buffered, recording).map_err(write_error(&name))?;
                 let iface = writer
                     .add_can_interface(INTERFACE, Some(bus.bitrate()))
                     .map_err(write_error(&name))?;
@@ -163,10 +171,6 @@ impl CanSession {
             Some(d) => Some(d),
             None if realtime => None,
             None => Some(bus.natural_length_s() + TAIL_S),
-        };
-        let origin_ns = match (realtime, plan.start_s) {
-            (false, Some(s)) => (s * 1e9).round() as u64,
-            _ => unix_now_ns(),
         };
         let output = match &out {
             Out::Log(name, _) | Out::Pcapng(name, ..) => name.clone(),

@@ -7,14 +7,17 @@
 //! 1. **Plausible**: throttle and PWM at most 255 ([`Frame::is_plausible`]); otherwise it is
 //!    rejected ([implausible](Stats::implausible)).
 //! 2. **Chained**: it starts exactly where the last accepted frame ended
-//!    ([`Stats::chain_end`]) and its counter is that frame's + 1: accepted on its own, decided
-//!    on its tenth byte.
+//!    ([`Stats::chain_end`]) and its counter is that frame's + 1, or skips at most
+//!    [`MAX_CHAINED_GAP`](super::MAX_CHAINED_GAP) counters (frames cut out whole, counted
+//!    [lost](Stats::lost_frames)): accepted on its own, decided on its tenth byte. So a frame
+//!    between two cut frames, with no consecutive neighbour, is not lost.
 //! 3. **Confirmed**: otherwise (the first frame of a stream, after garbage, a cut or corrupted
-//!    frame, a counter that jumped) it is accepted only as the first of three chained plausible
-//!    frames with counters +1: decided on at most 30 bytes, each byte looked at once more. The
-//!    frames after it are then accepted as chained, so a chain loses none of its frames; its
-//!    first counter's step from the last accepted one counts [lost frames](Stats::lost_frames),
-//!    a [duplicate](Stats::duplicate_frames) or a [restart](Stats::restarts).
+//!    frame, a counter that jumped further) it is accepted only as the first of three chained
+//!    plausible frames with counters +1: decided on at most 30 bytes, each byte looked at once
+//!    more. The frames after it are then accepted as chained, so a chain loses none of its
+//!    frames; its first counter's step from the last accepted one counts
+//!    [lost frames](Stats::lost_frames), a [duplicate](Stats::duplicate_frames) or a
+//!    [restart](Stats::restarts).
 //! 4. Otherwise it is rejected ([unconfirmed](Stats::unconfirmed)) and costs one byte: scanning
 //!    resumes at the byte after its `9B`.
 //!

@@ -18,8 +18,9 @@
 //! With no checksum, a frame is recognised by its plausibility (throttle and PWM at most 255),
 //! by chaining (the next `9B` exactly where the previous frame ended) and by its counter going
 //! up by one. The decoder locks onto a stream after three chained frames and then accepts each
-//! frame that continues the chain; anything else (garbage, a cut or corrupted frame, a counter
-//! that jumps because frames were lost or the ESC restarted) must start a new chain of three,
+//! frame that continues the chain (also across up to [`MAX_CHAINED_GAP`] frames cut out whole,
+//! counted lost); anything else (garbage, a cut or corrupted frame, a counter that jumps
+//! further because frames were lost or the ESC restarted) must start a new chain of three,
 //! whose first counter's step from the last accepted one is counted (lost frames, a duplicate,
 //! a restart). The scanner's state (where the chain ends, the last counter) lives in its
 //! [`Stats`], which the streaming layer of [`crate::scan`] hands it with every chunk, and a
@@ -31,7 +32,10 @@
 //! - **A corruption that keeps a frame plausible**: the period (any value), the low bytes of
 //!   throttle and PWM, and any flip leaving both at most 255 go undetected in a chained frame:
 //!   about half of all single-bit flips. Only a flip in the counter or in bytes 4 and 6 is
-//!   caught (and then the frame and the next two are needed to lock again, see below).
+//!   caught (and then the frame and the next two are needed to lock again, see below), and of
+//!   the counter's, not one that moves it forward by at most [`MAX_CHAINED_GAP`] (bit 0 or 1
+//!   of its low byte set): that frame is taken with a wrong counter, as if frames had been cut
+//!   before it, and the next frame (whose counter goes back) starts a new chain.
 //! - **A chain break near the end of a stream**: after a break, the next frames are accepted
 //!   only once three chain; the last one or two frames of a stream after a break are dropped.
 //! - **V4 frames chaining on a V3 stream**: bytes 0-7 of a V4 data frame read as a plausible
@@ -69,6 +73,7 @@ mod stats;
 /// Baud rate of the V3 telemetry wire (8N1), as HW-FOC's.
 pub const BAUD_RATE: u32 = crate::foc::BAUD_RATE;
 
+pub use crate::chain::MAX_CHAINED_GAP;
 pub use decoder::{CHAIN_TO_LOCK, Decoded, Decoder, Frames, Scanner, frames};
 pub use frame::{
     COUNTER_AT, FRAME_LEN, FULL_SCALE, Frame, PLACEHOLDER_PERIOD_US, US_PER_MINUTE, erpm_of_period,

@@ -3,7 +3,7 @@
 
 use core::fmt;
 
-use crate::chain::{ChainStats, Counts};
+use crate::chain::{self, ChainStats, Counts};
 use crate::counters::{COUNTER24_MAX, PacketSequence24};
 use crate::scan::SkipBytes;
 
@@ -113,11 +113,15 @@ impl Stats {
         self.chain_end
     }
 
-    /// Whether a frame at stream offset `at` with `counter` continues the chain.
+    /// Whether a frame at stream offset `at` with `counter` continues the chain: it starts
+    /// where the chain ends, its counter the last one's + 1 or up to
+    /// [`MAX_CHAINED_GAP`](super::MAX_CHAINED_GAP) after that.
     #[inline(always)]
     pub(crate) fn continues_chain(&self, at: u64, counter: u32) -> bool {
         match (self.chain_end, self.counts.counter.last()) {
-            (Some(end), Some(last)) => end == at && counter == (last + 1) & COUNTER24_MAX,
+            (Some(end), Some(last)) => {
+                end == at && chain::continues((last + 1) & COUNTER24_MAX, counter)
+            }
             _ => false,
         }
     }

@@ -10,16 +10,19 @@
 //!    [`InfoFrame::is_plausible`]); otherwise rejected ([implausible](Stats::implausible)).
 //! 3. **An info frame** is accepted when a plausible data frame (any counter) starts right
 //!    after it, chained to the last accepted frame or not (in slow mode every info frame has
-//!    one; decided on the 32nd byte). Its fixed bytes alone would come by chance in bytes rich
-//!    in `9B` and `B9` (about one in 30 000 positions when a quarter of the bytes are each), and
-//!    a cut info frame completed by the next frame's bytes would pass for one.
+//!    one; decided on the 32nd byte), or, chained, when another plausible info frame does (the
+//!    data frame between them was cut out whole). Its fixed bytes alone would come by chance in
+//!    bytes rich in `9B` and `B9` (about one in 30 000 positions when a quarter of the bytes are
+//!    each), and a cut info frame completed by the next frame's bytes would pass for one.
 //! 4. **A chained data frame**: it starts exactly where the last accepted frame (with its
 //!    trailer, if one came) ended ([`Stats::chain_end`]) and carries the counter after the last
-//!    data frame's (any counter right after an info frame that started a chain): accepted on
-//!    its own, on its 19th byte.
+//!    data frame's, or one at most [`MAX_CHAINED_GAP`](super::MAX_CHAINED_GAP) further (frames
+//!    cut out whole, counted [lost](Stats::lost_frames); any counter right after an info frame
+//!    that started a chain): accepted on its own, on its 19th byte. So a frame between two cut
+//!    frames, with no consecutive neighbour, is not lost.
 //! 5. **A confirmed data frame**: otherwise (the first frame of a stream, after garbage or a cut
-//!    or corrupted frame, a counter that jumped) it must start a new chain: followed by two
-//!    chained plausible data frames with counters +1 (fast mode), or by an info frame, after
+//!    or corrupted frame, a counter that jumped further) it must start a new chain: followed by
+//!    two chained plausible data frames with counters +1 (fast mode), or by an info frame, after
 //!    it or after the next data frame (slow mode, where they alternate). At most 59 bytes decide
 //!    it. The frames after it are then accepted as chained, so a chain loses none of its
 //!    frames; its first counter's step from the last accepted one counts
@@ -142,10 +145,13 @@ fn judge(c: &[u8], at: u64, stats: &Stats) -> Verdict<Judged> {
     let first = match found_at(c, 0, full_scale) {
         Found::Undecided => return Verdict::Undecided,
         Found::Nothing => return Verdict::Implausible,
-        // Chained or not, an info frame needs a plausible data frame right after it.
+        // An info frame needs a plausible data frame right after it, or, where the chain ends,
+        // another info frame (the data frame between them was cut out whole).
         Found::Info(info) => {
+            let chained = stats.chained(at);
             return match found_at(c, INFO_FRAME_LEN, full_scale) {
-                Found::Data(_) => Verdict::Frame(Judged::Info(info), !stats.chained(at)),
+                Found::Data(_) => Verdict::Frame(Judged::Info(info), !chained),
+                Found::Info(_) if chained => Verdict::Frame(Judged::Info(info), false),
                 Found::Undecided => Verdict::Undecided,
                 Found::Info(_) | Found::Nothing => Verdict::Unconfirmed,
             };

@@ -29,11 +29,13 @@
 //! ADC fields below 4096, an info frame's fixed bytes and non-zero divisors), by chaining (the
 //! next `9B` exactly where the previous frame ended) and by the counter going up by one. The
 //! decoder locks onto a stream after three chained data frames, or a data frame and an info
-//! frame chained either way round; it then accepts each data frame that continues the chain.
-//! An info frame is accepted only with a plausible data frame right after it (so the last info
-//! frame of a stream that ends with it is dropped). Anything else (garbage, a
-//! cut or corrupted frame, a counter that jumps because frames were lost or the ESC restarted)
-//! must start a new chain, whose first counter's step from the last accepted one is counted.
+//! frame chained either way round; it then accepts each data frame that continues the chain
+//! (also across up to [`MAX_CHAINED_GAP`] data frames cut out whole, counted lost). An info
+//! frame is accepted only with a plausible data frame right after it, or, chained, another info
+//! frame (so the last info frame of a stream that ends with it is dropped). Anything else
+//! (garbage, a cut or corrupted frame, a counter that jumps further because frames were lost or
+//! the ESC restarted) must start a new chain, whose first counter's step from the last accepted
+//! one is counted.
 //! An info frame's constants are adopted once two identical copies came in a row. The
 //! scanner's state (the chain's end, the counter it expects, the info frames) lives in its
 //! [`Stats`], which the streaming layer of [`crate::scan`] hands it with every chunk, and a
@@ -44,7 +46,10 @@
 //!
 //! - **A corruption that keeps a frame plausible**: eRPM (any value), the low bits of every
 //!   field, and any flip leaving a frame plausible go undetected in a chained frame: about half
-//!   of all single-bit flips. A flipped info frame is not adopted unless it comes twice.
+//!   of all single-bit flips. A flipped info frame is not adopted unless it comes twice. A flip
+//!   that moves the counter forward by at most [`MAX_CHAINED_GAP`] (bit 0 or 1 of its low byte
+//!   set) leaves the frame taken with a wrong counter, as if frames had been cut before it; the
+//!   next frame (whose counter goes back) starts a new chain.
 //! - **A chain break near the end of a stream**: after a break, frames are accepted only once a
 //!   new chain forms; the last one or two data frames of a running stream after a break are
 //!   dropped.
@@ -93,6 +98,7 @@ mod temperature;
 /// Baud rate of the V4 telemetry wire (8N1), as HW-FOC's.
 pub const BAUD_RATE: u32 = crate::foc::BAUD_RATE;
 
+pub use crate::chain::MAX_CHAINED_GAP;
 pub use data::{Data, DataFrame};
 pub use decoder::{CHAIN_TO_LOCK, Decoded, Decoder, Frame, Frames, Scanner, frames};
 pub use info::{CurrentScale, InfoFrame, VoltsPerStep, VoltsPerStepError, throttle_linear};

@@ -3,7 +3,7 @@
 
 use core::fmt;
 
-use crate::chain::{ChainStats, Counts};
+use crate::chain::{self, ChainStats, Counts};
 use crate::counters::{COUNTER24_MAX, PacketSequence24};
 use crate::scan::SkipBytes;
 
@@ -194,11 +194,14 @@ impl Stats {
         self.chain.is_some_and(|c| c.end == at)
     }
 
-    /// Whether a data frame at `at` with `counter` continues the chain.
+    /// Whether a data frame at `at` with `counter` continues the chain: it starts where the
+    /// chain ends, its counter the one expected or up to
+    /// [`MAX_CHAINED_GAP`](super::MAX_CHAINED_GAP) after it.
     #[inline(always)]
     pub(crate) fn continues_chain(&self, at: u64, counter: u32) -> bool {
-        self.chain
-            .is_some_and(|c| c.end == at && c.next.is_none_or(|next| next == counter))
+        self.chain.is_some_and(|c| {
+            c.end == at && c.next.is_none_or(|next| chain::continues(next, counter))
+        })
     }
 
     /// Whether a `B9` at `at` is the trailer of the data frame just accepted.

@@ -4,6 +4,7 @@
 
 use std::fmt::Debug;
 
+use hwfoc::counters::PacketSequence24;
 use hwfoc::scan::{Scan, Scanner, StreamDecoder};
 
 use crate::common::streamed_bytewise;
@@ -104,6 +105,74 @@ where
     assert_eq!((out, *all_at_once.stats()), reference, "decode_all");
 }
 
+/// Which of `wanted.len()` frames are sent when those marked in `wanted` are cut out whole:
+/// all but the first three (which lock the decoder) and the last (after which a loss would not
+/// show), and at most `max_run` in a row (a longer run is an outage, after which a chain of
+/// three must lock again).
+pub fn sent_frames(wanted: &[bool], max_run: u32) -> Vec<bool> {
+    let mut run = 0;
+    let last = wanted.len().saturating_sub(1);
+    (0..wanted.len())
+        .map(|k| {
+            let cut = wanted[k] && k >= 3 && k < last && run < max_run;
+            run = if cut { run + 1 } else { 0 };
+            !cut
+        })
+        .collect()
+}
+
+/// Asserts that the frames `got` (offset and counter) are those `want`ed, first naming the
+/// wanted frames missing by their counters' distance from `first`.
+pub fn assert_frames(got: &[(u64, u32)], want: &[(u64, u32)], first: u32) {
+    let missed: Vec<u32> = want
+        .iter()
+        .filter(|f| !got.contains(f))
+        .map(|(_, c)| c - first)
+        .collect();
+    assert!(missed.is_empty(), "intact frames lost: {missed:?}");
+    assert_eq!(got, want);
+}
+
+/// A chained scanner's figures of a link: the counter's lost, duplicate and restarted numbers,
+/// bytes skipped, rejected candidates, syncs.
+#[derive(Debug, PartialEq, Eq)]
+pub struct Figures {
+    pub lost: u32,
+    pub duplicates: u32,
+    pub restarts: u32,
+    pub skipped: u64,
+    pub rejected: u32,
+    pub syncs: u32,
+}
+
+impl Figures {
+    /// The figures of a scanner's statistics.
+    pub fn of(counter: &PacketSequence24, skipped: u64, rejected: u32, syncs: u32) -> Figures {
+        Figures {
+            lost: counter.lost(),
+            duplicates: counter.duplicates(),
+            restarts: counter.restarts(),
+            skipped,
+            rejected,
+            syncs,
+        }
+    }
+
+    /// What a scanner must report of a clean stream from which `cut` frames were cut out whole
+    /// (not the first three, nor the last): each counted lost, nothing skipped or rejected, one
+    /// sync.
+    pub fn after_cuts(cut: usize) -> Figures {
+        Figures {
+            lost: cut as u32,
+            duplicates: 0,
+            restarts: 0,
+            skipped: 0,
+            rejected: 0,
+            syncs: 1,
+        }
+    }
+}
+
 /// A seeded xorshift64 generator: the same bytes on every run.
 pub struct Rng(pub u64);
 
@@ -119,6 +188,16 @@ impl Rng {
     /// `n` uniformly random bytes.
     pub fn uniform(&mut self, n: usize) -> Vec<u8> {
         (0..n).map(|_| self.next() as u8).collect()
+    }
+
+    /// `count` distinct indices drawn uniformly from `range`, in increasing order.
+    pub fn sample(&mut self, range: std::ops::Range<usize>, count: usize) -> Vec<usize> {
+        assert!(count <= range.len());
+        let mut picked = std::collections::BTreeSet::new();
+        while picked.len() < count {
+            picked.insert(range.start + (self.next() % range.len() as u64) as usize);
+        }
+        picked.into_iter().collect()
     }
 
     /// `n` random bytes of which about a quarter are `9B` and a quarter `B9`.

@@ -65,6 +65,13 @@ pub struct BridgeArgs {
     baud: Option<u32>,
     #[command(flatten)]
     protocol: ProtocolArgs,
+    /// Read the recordings given as one: their ports go on from file to file by name. Without
+    /// it, only the files of one `hwfoc record` run (rotated files: they carry its recording
+    /// id) are one recording; every other file is ESCs of its own, however its ports are
+    /// named (port names such as /dev/ttyUSB0 are the same on every drone). Give it for the
+    /// parts of one recording that another program wrote or cut.
+    #[arg(long)]
+    join: bool,
 
     /// DataLink V2 frames (115200 baud) of ESCs 0 to 7 on this serial port: hwfoc as the
     /// DataLink box a flight controller reads.
@@ -153,7 +160,7 @@ pub fn run(args: &BridgeArgs) -> Result<(), CliError> {
         replay(
             &files,
             settings,
-            protocol,
+            (protocol, args.join),
             deadline,
             &mut fanout,
             &mut errors,
@@ -329,11 +336,12 @@ fn take(
     }
 }
 
-/// Recordings and other inputs, replayed in real time (reading `protocol` only when given).
+/// Recordings and other inputs, replayed in real time (reading `protocol` only when given, the
+/// recordings joined as one with `join`).
 fn replay(
     files: &[&String],
     settings: SettingsMap,
-    protocol: Option<hwfoc::Protocol>,
+    (protocol, join): (Option<hwfoc::Protocol>, bool),
     deadline: Option<Instant>,
     fanout: &mut Fanout,
     errors: &mut Errors,
@@ -345,6 +353,9 @@ fn replay(
     let mut sources = Sources::new(inputs, settings);
     if let Some(protocol) = protocol {
         sources.force_protocol(protocol);
+    }
+    if join {
+        sources.join_recordings();
     }
     let stop = crate::stop::interrupted();
     // The deadline stops the replay as Ctrl-C would.

@@ -84,9 +84,8 @@ fn bitrate(text: &str) -> Result<u32, String> {
 
 /// Runs `hwfoc can set-id`.
 pub fn set_id(args: &SetIdArgs) -> Result<(), CliError> {
+    can_confirm(args.yes)?;
     let mut client = args.bus.open()?;
-    client.check_idle()?;
-    client.check_alone(args.node)?;
     if args.to != args.node && client.heard().node(args.to).is_some() {
         return Err(CliError::Usage {
             option: format!("--to {}", args.to),
@@ -96,6 +95,8 @@ pub fn set_id(args: &SetIdArgs) -> Result<(), CliError> {
             ),
         });
     }
+    client.check_at_rest(args.node, true)?;
+    client.check_alone(args.node)?;
     let was = match client
         .heard()
         .node(args.node)
@@ -112,13 +113,12 @@ pub fn set_id(args: &SetIdArgs) -> Result<(), CliError> {
         args.yes,
         &[format!("node {}: {was} -> {change}", args.node)],
     )?;
-    client.apply(args.node, &change, args.bus.timeout())?;
-    let said = client.read(args.to, &change, args.bus.timeout())?;
-    report(&client, args.node, &[(change, said)])
+    make(&mut client, &args.bus, args.node, &change)
 }
 
 /// Runs `hwfoc can set`.
 pub fn set(args: &SetArgs) -> Result<(), CliError> {
+    can_confirm(args.yes)?;
     let mut changes: Vec<Change> = Vec::new();
     changes.extend(args.direction.map(Change::Direction));
     changes.extend(args.throttle_source.map(Change::ThrottleSource));
@@ -126,14 +126,14 @@ pub fn set(args: &SetArgs) -> Result<(), CliError> {
     changes.extend(args.rate.iter().copied());
     changes.extend(args.bitrate.map(Change::Bitrate));
     let mut client = args.bus.open()?;
-    client.check_idle()?;
+    client.check_at_rest(args.node, changes.iter().any(Change::affects_motor))?;
     client.check_alone(args.node)?;
     let timeout = args.bus.timeout();
     let mut plan = Vec::new();
     for c in &changes {
         let was = match client.read(args.node, c, timeout)? {
             Some(was) => was.to_string(),
-            None => match bus_bitrate(&client) {
+            None => match args.bus.bitrate() {
                 Some(b) => format!("bit rate {b} bit/s"),
                 None => "bit rate of the bus".to_string(),
             },
@@ -141,18 +141,41 @@ pub fn set(args: &SetArgs) -> Result<(), CliError> {
         plan.push(format!("node {}: {was} -> {c}", args.node));
     }
     confirm(args.yes, &plan)?;
-    let mut done = Vec::new();
+    // Each change is said as it is made: a later one that fails leaves them listed.
     for c in &changes {
-        client.apply(args.node, c, timeout)?;
-        done.push((*c, client.read(args.node, c, timeout)?));
+        make(&mut client, &args.bus, args.node, c)?;
     }
-    report(&client, args.node, &done)
+    Ok(())
+}
+
+/// Checks again that every motor is at rest, makes `change` and says what the ESC now says
+/// (an error if it says otherwise: nothing more is sent).
+fn make(client: &mut Client, bus: &BusArgs, node: u8, change: &Change) -> Result<(), CliError> {
+    client.check_at_rest(node, change.affects_motor())?;
+    let made = client.change(node, change, bus.timeout())?;
+    if let Some(late) = made.late {
+        eprintln!("hwfoc: {late}");
+    }
+    match (made.said, change) {
+        (Some(said), _) => println!("node {node} now says: {said}"),
+        (None, Change::Bitrate(b)) => println!(
+            "node {node} answered: {change}; it is now heard only at that rate (open the bus at \
+             it: slcan:PORT:{b})"
+        ),
+        (None, _) => {}
+    }
+    if let Change::Led(Led { save: true, .. }) = change {
+        println!("node {node}: whether the LED was saved cannot be read back");
+    }
+    Ok(())
 }
 
 /// Runs `hwfoc can self-test`.
 pub fn self_test(args: &SelfTestArgs) -> Result<(), CliError> {
     let mut client = args.bus.open()?;
-    client.check_idle()?;
+    client.check_at_rest(args.node, true)?;
+    client.check_alone(args.node)?;
+    client.check_at_rest(args.node, true)?;
     let answer = client.call(
         args.node,
         Message::from(SelfTestRequest {}),
@@ -171,57 +194,24 @@ pub fn self_test(args: &SelfTestArgs) -> Result<(), CliError> {
     }
 }
 
-/// The bit rate of an `slcan:` bus.
-fn bus_bitrate(client: &Client) -> Option<u32> {
-    match hwfoc_io::can::CanSpec::parse(client.bus()).ok()? {
-        hwfoc_io::can::CanSpec::Slcan { bitrate, .. } => Some(bitrate),
-        hwfoc_io::can::CanSpec::SocketCan { .. } => None,
-    }
-}
-
-/// Prints what each ESC now says; an error if one says otherwise than asked.
-fn report(client: &Client, node: u8, done: &[(Change, Option<Change>)]) -> Result<(), CliError> {
-    let mut wrong = None;
-    for (asked, said) in done {
-        match said {
-            Some(said) => {
-                println!("node {node} now says: {said}");
-                if !asked.agrees(said) && wrong.is_none() {
-                    wrong = Some((*asked, *said));
-                }
-            }
-            None => println!(
-                "node {node} answered: {asked}; it is now heard only at that rate (open the bus \
-                 at it: slcan:PORT:{})",
-                match asked {
-                    Change::Bitrate(b) => *b,
-                    _ => 0,
-                }
-            ),
-        }
-    }
-    match wrong {
-        Some((asked, said)) => Err(SetupError::NotTaken {
-            bus: client.bus().to_string(),
-            node,
-            asked,
-            said,
-        }
-        .into()),
-        None => Ok(()),
-    }
-}
-
-/// Shows the plan and asks for a yes on the terminal; `--yes` skips the question; without a
-/// terminal and without `--yes`, refuses.
-fn confirm(yes: bool, plan: &[String]) -> Result<(), CliError> {
-    let stdin = std::io::stdin();
-    if !yes && !stdin.is_terminal() {
+/// Refuses before anything is sent on the bus when the change could not be confirmed: no
+/// terminal and no `--yes`.
+fn can_confirm(yes: bool) -> Result<(), CliError> {
+    if !yes && !std::io::stdin().is_terminal() {
         return Err(CliError::Usage {
             option: "--yes".to_string(),
             message: "no terminal to confirm the change on: pass --yes to make it".to_string(),
         });
     }
+    Ok(())
+}
+
+/// Shows the plan and asks for a yes on the terminal; `--yes` skips the question; without a
+/// terminal and without `--yes`, refuses ([`can_confirm`], also called before the bus is
+/// opened).
+fn confirm(yes: bool, plan: &[String]) -> Result<(), CliError> {
+    can_confirm(yes)?;
+    let stdin = std::io::stdin();
     let mut err = std::io::stderr().lock();
     for line in plan {
         let _ = writeln!(err, "{line}");

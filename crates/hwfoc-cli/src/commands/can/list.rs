@@ -31,7 +31,7 @@ pub fn run(args: &ListArgs) -> Result<(), CliError> {
     let text = if args.json {
         format!("{}\n", json(&args.bus.bus, &survey))
     } else {
-        table(&args.bus.bus, &survey)
+        table(&args.bus, &survey)
     };
     let mut out = TextSink::create(None)?;
     out.write(&mut text.into_bytes())?;
@@ -66,8 +66,59 @@ fn channels(e: &EscSurvey) -> String {
     }
 }
 
+/// The nodes that say one throttle channel, by channel: a set-up error where several do
+/// (nodes shared by several ESCs, the factory state, told apart).
+fn channel_clashes(s: &Survey) -> Vec<(u8, Vec<u8>)> {
+    let mut by_channel: std::collections::BTreeMap<u8, Vec<u8>> = Default::default();
+    for e in s.escs.iter().filter(|e| !e.heard.is_shared()) {
+        let channel = e
+            .heard
+            .channels
+            .last()
+            .copied()
+            .or(e.config.map(|c| c.throttle_channel));
+        if let Some(c) = channel {
+            by_channel.entry(c).or_default().push(e.heard.node);
+        }
+    }
+    by_channel
+        .into_iter()
+        .filter(|(_, n)| n.len() > 1)
+        .collect()
+}
+
+/// `10 and 11`, `10, 11 and 12`.
+fn and_list(nodes: &[u8]) -> String {
+    match nodes.split_last() {
+        Some((last, [])) => last.to_string(),
+        Some((last, rest)) => {
+            let rest: Vec<String> = rest.iter().map(u8::to_string).collect();
+            format!("{} and {last}", rest.join(", "))
+        }
+        None => String::new(),
+    }
+}
+
+/// What is said when no node was heard: the bit rate used, and the ESCs' factory one.
+fn nothing_heard(bus: &BusArgs) -> String {
+    let at = bus
+        .bitrate()
+        .map_or("the interface's bit rate".to_string(), |b| {
+            format!("{b} bit/s")
+        });
+    format!(
+        "{}: no node heard at {at} (the ESCs' factory bit rate is 500 kbit/s; an ESC set to \
+         another is heard only at it: slcan:PORT:BITRATE)\n",
+        bus.bus
+    )
+}
+
 /// The table, the factory state told under it, and the time the survey took.
-fn table(bus: &str, s: &Survey) -> String {
+fn table(args: &BusArgs, s: &Survey) -> String {
+    let bus = args.bus.as_str();
+    if s.escs.is_empty() {
+        return nothing_heard(args);
+    }
     let header = [
         "node",
         "escs",
@@ -133,8 +184,23 @@ fn table(bus: &str, s: &Survey) -> String {
         if n == 1 { "" } else { "s" },
         s.elapsed.as_secs_f64()
     ));
+    if !s.asked {
+        out.push_str(
+            "a motor turns: nothing asked (settings are read only while every motor rests)\n",
+        );
+    }
     for e in s.shared() {
         out.push_str(&shared_advice(bus, e));
+    }
+    for (channel, nodes) in channel_clashes(s) {
+        out.push_str(&format!(
+            "set-up error: nodes {} {} say throttle channel {channel}: {} would take the same \
+             throttle; give each its own (`hwfoc can set-id {bus} --node {} --to N --channel C`)\n",
+            and_list(&nodes),
+            if nodes.len() == 2 { "both" } else { "all" },
+            if nodes.len() == 2 { "both" } else { "all" },
+            nodes[nodes.len() - 1]
+        ));
     }
     out
 }
@@ -213,6 +279,11 @@ fn json(bus: &str, s: &Survey) -> Value {
         "bus": bus,
         "elapsed_s": s.elapsed.as_secs_f64(),
         "factory_state": s.shared().next().is_some(),
+        "asked": s.asked,
+        "channel_clashes": channel_clashes(s)
+            .into_iter()
+            .map(|(channel, nodes)| json!({"channel": channel, "nodes": nodes}))
+            .collect::<Vec<_>>(),
         "escs": escs,
     })
 }

@@ -23,8 +23,10 @@ const AFTER_HELP: &str = "Examples:
   hwfoc can set slcan:/dev/ttyACM0 --node 11 --direction ccw --led red,2
   hwfoc can self-test slcan:/dev/ttyACM0 --node 11
 
-Nothing is changed while an ESC reports rpm or throttle above zero; every change is shown
-and confirmed (--yes for scripts), then read back from the ESC.";
+hwfoc listens 1.1 s before it sends anything. Nothing is changed while any node reports its
+motor turning, and nothing that can turn a motor (direction, throttle source, node id, bit
+rate) is sent to an ESC whose rpm and pwm (StatusMsg1) were not heard at rest just before;
+every change is shown and confirmed (--yes for scripts), then read back from the ESC.";
 
 /// `hwfoc can`'s options.
 #[derive(Debug, Args)]
@@ -65,14 +67,30 @@ struct BusArgs {
 }
 
 impl BusArgs {
-    /// The bus opened, as a client stopped by Ctrl-C.
+    /// The bus opened, as a client stopped by Ctrl-C, after listening so that every node is
+    /// heard ([`Client::listen_first`]); refused if another node has `--source`'s id.
     fn open(&self) -> Result<Client, CliError> {
         let bus = CanBus::open(&self.bus, false)?;
-        Ok(Client::new(
-            bus,
-            self.source,
-            Arc::clone(&crate::stop::interrupted()),
-        ))
+        let mut client = Client::new(bus, self.source, Arc::clone(&crate::stop::interrupted()));
+        client.listen_first()?;
+        if client.heard().node(self.source).is_some() {
+            return Err(CliError::Usage {
+                option: format!("--source {}", self.source),
+                message: format!(
+                    "node {} is on the bus {}: hwfoc would send as it; choose a free node id",
+                    self.source, self.bus
+                ),
+            });
+        }
+        Ok(client)
+    }
+
+    /// The bit rate the bus was opened at, where known (an `slcan:` bus's).
+    fn bitrate(&self) -> Option<u32> {
+        match hwfoc_io::can::CanSpec::parse(&self.bus).ok()? {
+            hwfoc_io::can::CanSpec::Slcan { bitrate, .. } => Some(bitrate),
+            hwfoc_io::can::CanSpec::SocketCan { .. } => None,
+        }
     }
 
     fn timeout(&self) -> Duration {

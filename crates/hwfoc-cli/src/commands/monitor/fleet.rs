@@ -6,6 +6,7 @@ use std::collections::{HashMap, VecDeque};
 
 use hwfoc::Settings;
 use hwfoc::telemetry::Info;
+use hwfoc_io::can::{CanSpec, is_can_spec};
 use hwfoc_io::{EscLink, WireKind};
 
 use super::alarms::{Change, FaultBit, Kind, Latch, Level, Threshold};
@@ -194,8 +195,11 @@ pub struct EscView {
     pub info: Option<Info>,
     /// Link statistics of its decoder.
     pub stats: EscLink,
-    /// Its port's baud rate: given, or found from the bytes; `None` while it is being found.
+    /// Its port's baud rate: given, or found from the bytes; `None` while it is being found
+    /// (and on a CAN bus).
     pub baud: Option<u32>,
+    /// Its port, when it is a CAN bus (`slcan:`, `can:`).
+    pub can: Option<CanSpec>,
     /// While the port's rate is being found: the rate tried.
     pub trying: Option<u32>,
     /// Bytes its port read at rates the search left (skipped, never decoded).
@@ -237,8 +241,20 @@ impl EscView {
 
     /// What to show for an ESC that has sent no data frame yet: nothing at all (is it powered,
     /// is the wire on RX?), bytes that never make a frame (baud rate? swapped wires?), or just
-    /// not yet.
+    /// not yet. On a CAN bus: no CAN frame, or error frames (the bus's bit rate?), or frames but
+    /// no ESC status yet.
     pub fn waiting(&self) -> &'static str {
+        if self.can.is_some() {
+            let bus = match &self.stats {
+                EscLink::Can(c) => c.bus,
+                _ => Default::default(),
+            };
+            return match (bus.frames(), bus.error_frames()) {
+                (0, _) => "no CAN frame yet: bit rate? ESCs powered?",
+                (_, 1..) => "error frames, no ESC status: the bus's bit rate?",
+                _ => "CAN frames but no ESC status yet",
+            };
+        }
         match (self.stats.bytes(), self.stats.frames()) {
             (0, _) => "no bytes yet: ESC powered? telemetry wire on RX?",
             (bytes, 0) if bytes >= 64 => "bytes but no valid frame: baud rate? swapped wires?",
@@ -257,6 +273,13 @@ impl EscView {
     /// Its port's rate and format: `115200 baud (HW5)`, `19200 baud` before a frame, or
     /// `finding the baud rate: trying 115200`.
     pub fn rate_text(&self) -> String {
+        match &self.can {
+            Some(CanSpec::Slcan { bitrate, .. }) => {
+                return format!("CAN {} kbit/s", bitrate / 1000);
+            }
+            Some(CanSpec::SocketCan { .. }) => return "CAN".to_string(),
+            None => {}
+        }
         match (self.baud, self.trying) {
             (Some(baud), _) => match self.protocol() {
                 Some(p) => format!("{baud} baud ({})", p.title()),
@@ -299,6 +322,24 @@ impl EscView {
     pub fn title(&self) -> &str {
         self.label.as_deref().unwrap_or(&self.name)
     }
+}
+
+/// The row name of a CAN ESC: its bus (a SocketCAN interface; an SLCAN adapter's device), its
+/// node and the throttle channel a GetEscID answer gave it (`can0 node 10 ch 2`). Its ESC number
+/// stays the one it was first heard at.
+fn can_name(spec: &CanSpec, node: Option<u8>, channel: Option<u8>) -> String {
+    let bus = match spec {
+        CanSpec::SocketCan { interface } => interface.as_str(),
+        CanSpec::Slcan { port, .. } => port.strip_prefix("/dev/").unwrap_or(port),
+    };
+    let mut name = bus.to_string();
+    if let Some(node) = node {
+        name.push_str(&format!(" node {node}"));
+    }
+    if let Some(channel) = channel {
+        name.push_str(&format!(" ch {channel}"));
+    }
+    name
 }
 
 /// One line of the alarm log.
@@ -420,6 +461,9 @@ impl Fleet {
             .into_iter()
             .enumerate()
             .map(|(i, (name, label))| EscView {
+                can: is_can_spec(&name)
+                    .then(|| CanSpec::parse(&name).ok())
+                    .flatten(),
                 name,
                 label,
                 settings: u8::try_from(i)
@@ -512,7 +556,11 @@ impl Fleet {
                     if let Some(stream) = self.streams.stream(port) {
                         for (&(p, channel), &i) in &self.channels {
                             if p == port {
-                                self.escs[i].stats = stream.link(channel as u8);
+                                let view = &mut self.escs[i];
+                                view.stats = stream.link(channel as u8);
+                                if let (Some(spec), EscLink::Can(c)) = (&view.can, &view.stats) {
+                                    view.name = can_name(spec, c.node, c.channel);
+                                }
                             }
                         }
                     }
@@ -600,20 +648,6 @@ impl Fleet {
         if let Some(&i) = self.channels.get(&(port, channel)) {
             return i;
         }
-        // A CAN ESC keeps its view when its place on the bus changes (numbered by its node id
-        // until a GetEscID answer gives its throttle channel): the view follows the node.
-        let moved = r.node.and_then(|node| {
-            let name = format!(" node {node}");
-            self.channels
-                .iter()
-                .find(|&(&(p, _), &i)| p == port && self.escs[i].name.ends_with(&name))
-                .map(|(&key, &i)| (key, i))
-        });
-        if let Some((old, i)) = moved {
-            self.channels.remove(&old);
-            self.channels.insert((port, channel), i);
-            return i;
-        }
         let taken = self.channels.keys().any(|&(p, _)| p == port);
         let name = self.escs[port]
             .name
@@ -639,7 +673,7 @@ impl Fleet {
         } else {
             port
         };
-        // A CAN ESC by its node (its place on the bus is its ESC number).
+        // A CAN ESC by its bus and node (named in full from its link: `can_name`).
         self.escs[i].name = match r.node {
             Some(node) => format!("{name} node {node}"),
             None => format!("{name} channel {channel}"),
@@ -806,6 +840,11 @@ mod tests {
     use hwfoc::foc::DataFrame;
 
     fn fleet(n: usize) -> Fleet {
+        fleet_of((0..n).map(|i| format!("esc{i}")).collect())
+    }
+
+    /// A fleet of the ports `names`.
+    fn fleet_of(names: Vec<String>) -> Fleet {
         let config = MonitorSetup::load(&Overrides {
             settings: crate::args::SettingsArgs {
                 no_config: true,
@@ -814,7 +853,7 @@ mod tests {
             ..Overrides::default()
         })
         .unwrap();
-        let names = (0..n).map(|i| (format!("esc{i}"), None)).collect();
+        let names = names.into_iter().map(|n| (n, None)).collect();
         Fleet::new(
             names,
             config.settings,
@@ -987,6 +1026,48 @@ mod tests {
         assert_eq!(f.escs[1].link, Link::Up);
         assert_eq!(f.log_since(5).count(), 2);
         assert_eq!(f.log_since(0).count(), 7);
+    }
+
+    /// A CAN ESC's row names its bus and node, and the channel it learns; it keeps its ESC
+    /// number and its view when a GetEscID answer maps it. A bus says what it lacks in CAN
+    /// words (it was "finding the baud rate").
+    #[test]
+    fn a_can_esc_is_named_by_bus_node_and_channel_and_keeps_its_number() {
+        use hwfoc::dronecan::{GetEscId, Message, StatusMsg1};
+        let mut f = fleet_of(vec![
+            "can:vcan0".to_string(),
+            "slcan:/dev/ttyACM0:1M".to_string(),
+        ]);
+        assert_eq!(
+            f.escs[0].waiting(),
+            "no CAN frame yet: bit rate? ESCs powered?"
+        );
+        assert_eq!(
+            (f.escs[0].rate_text(), f.escs[1].rate_text()),
+            ("CAN".to_string(), "CAN 1000 kbit/s".to_string())
+        );
+        let bytes = |m: Message, tid: u8| -> Vec<u8> {
+            m.frames(16, 10, 0, tid)
+                .flat_map(|fr| fr.to_socketcan_record())
+                .collect()
+        };
+        let m1 = StatusMsg1 {
+            rpm: 100,
+            pwm: 100,
+            status: 0,
+        };
+        f.on_event(&data(0, 1000.0, bytes(m1.into(), 0)));
+        let esc = f.escs[0].last.unwrap().esc;
+        assert_eq!(f.escs[0].name, "vcan0 node 10");
+        f.on_event(&data(
+            0,
+            1000.1,
+            bytes(GetEscId::new(&[10, 2]).unwrap().into(), 1),
+        ));
+        f.on_event(&data(0, 1000.2, bytes(m1.into(), 2)));
+        let views: Vec<&str> = f.escs.iter().map(|e| e.name.as_str()).collect();
+        assert_eq!(views, ["vcan0 node 10 ch 2", "slcan:/dev/ttyACM0:1M"]);
+        assert_eq!(f.escs[0].last.unwrap().esc, esc);
     }
 
     #[test]

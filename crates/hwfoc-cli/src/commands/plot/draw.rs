@@ -350,7 +350,7 @@ impl<'a> Scene<'a> {
                     empty,
                     wall: sources
                         .inputs()
-                        .get(sources.escs()[i].input)
+                        .get(sources.esc_table()[i].input)
                         .is_some_and(|input| input.format.clock() == Clock::Wall),
                 }
             })
@@ -397,7 +397,7 @@ impl<'a> Scene<'a> {
             .iter()
             .filter(|r| r.data.is_some_and(|d| d.timed))
             .all(|r| {
-                let input = sources.escs()[r.esc].input;
+                let input = sources.esc_table()[r.esc].input;
                 sources
                     .inputs()
                     .get(input)
@@ -984,12 +984,12 @@ fn fault_summary(data: &EscData, wall: bool) -> (String, RGBColor) {
 
 /// How an ESC's source is named: its input, and its stream when that says more.
 fn source_name(sources: &Sources, esc: usize) -> String {
-    let e = &sources.escs()[esc];
-    let input = &sources.names()[e.input];
-    if e.name == *input || e.name.is_empty() {
+    let e = &sources.esc_table()[esc];
+    let (input, port) = (&sources.names()[e.input], &e.key.port);
+    if port == input || port.is_empty() {
         input.clone()
     } else {
-        format!("{input}: {}", e.name)
+        format!("{input}: {port}")
     }
 }
 

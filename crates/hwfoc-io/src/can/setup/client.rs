@@ -19,8 +19,15 @@ use crate::can::{ASK_EVERY, ASK_PRIORITY, CanBus, CanError};
 /// Priority of hwfoc's service requests: 16, DroneCAN's "medium" (pydronecan's and
 /// ArduPilot's default).
 pub const REQUEST_PRIORITY: u8 = 16;
-/// The shortest listen of the safety check.
+/// The shortest listen of the first safety check.
 const IDLE_MIN: Duration = Duration::from_millis(100);
+/// How long [`Client::listen_first`] listens before anything is sent: a NodeStatus period
+/// (1 s, DroneCAN's slowest) and a margin, so that every node on the bus is heard.
+const LISTEN_FIRST: Duration = Duration::from_millis(1100);
+/// How old a target's `StatusMsg1` may be when a change that can turn its motor is sent.
+const FRESH: Duration = Duration::from_millis(300);
+/// The most frames taken at once from what the bus buffered ([`Client::check_at_rest`]).
+const DRAIN_MAX: usize = 10_000;
 /// The longest listen of the safety check: two StatusMsg1 at the slowest rate but 0 Hz (1 Hz).
 const IDLE_MAX: Duration = Duration::from_millis(2200);
 /// How long [`Client::survey`] listens at least, and for how long no new node ends it.
@@ -52,6 +59,16 @@ impl Link for CanBus {
     }
 }
 
+/// A change made ([`Client::change`]).
+#[derive(Debug)]
+pub struct Made {
+    /// What the ESC now says (`None` for a bit rate, which cannot be read at the old one).
+    pub said: Option<Change>,
+    /// The write's answer did not come in time, though the read-back agrees
+    /// ([`SetupError::Unanswered`]).
+    pub late: Option<SetupError>,
+}
+
 /// What [`Client::survey`] learnt of one node: what it sent, and its answers (`None` where
 /// it did not answer in time).
 #[derive(Debug, Clone, PartialEq)]
@@ -73,6 +90,8 @@ pub struct EscSurvey {
 pub struct Survey {
     /// Each node heard, by id.
     pub escs: Vec<EscSurvey>,
+    /// Whether the ESCs were asked their settings (not while a motor turns).
+    pub asked: bool,
     /// From the start of the survey to the last answer.
     pub elapsed: Duration,
 }
@@ -86,7 +105,7 @@ impl Survey {
 
 /// hwfoc as a node (`source`) on a bus: it listens ([`Heard`]), asks the ESCs for their ids
 /// (GetEscID `[0]`, at most once a second and only while no ESC turns), checks that no motor
-/// turns before a change ([`Client::check_idle`]), and calls a service of one node,
+/// turns before a change ([`Client::check_at_rest`]), and calls a service of one node,
 /// waiting for the response that matches ([`Client::call`]). Every wait ends when the stop
 /// flag is set ([`SetupError::Stopped`]).
 pub struct Client<L: Link = CanBus> {
@@ -98,6 +117,8 @@ pub struct Client<L: Link = CanBus> {
     transfer_ids: HashMap<(u16, u8), u8>,
     ask_tid: u8,
     last_ask: Option<Instant>,
+    /// Whether the window of motion reports began ([`Client::check_at_rest`]).
+    watching: bool,
 }
 
 impl<L: Link> Client<L> {
@@ -111,6 +132,7 @@ impl<L: Link> Client<L> {
             transfer_ids: HashMap::new(),
             ask_tid: first_transfer_id(),
             last_ask: None,
+            watching: false,
         }
     }
 
@@ -154,7 +176,7 @@ impl<L: Link> Client<L> {
     /// passed since the last; returns whether it did.
     pub fn ask_ids(&mut self, now_anyway: bool) -> Result<bool, SetupError> {
         let now = Instant::now();
-        if self.heard.any_turning()
+        if self.heard.nodes().any(|n| n.turning() || n.turning_now())
             || (!now_anyway && self.last_ask.is_some_and(|t| now - t < ASK_EVERY))
         {
             return Ok(false);
@@ -170,22 +192,100 @@ impl<L: Link> Client<L> {
         Ok(true)
     }
 
-    /// The safety check before a change: listens until every node heard has sent two
-    /// StatusMsg1 (a whole period; at least 100 ms, at most 2.2 s), then refuses if any of
-    /// them said rpm or pwm above 0.
-    pub fn check_idle(&mut self) -> Result<(), SetupError> {
-        let start = Instant::now();
-        self.heard.start_window();
-        self.listen_until(start + IDLE_MAX, |h, now| {
-            now - start >= IDLE_MIN && h.nodes().all(|n| n.window_status1 >= 2)
+    /// Listens 1.1 s without sending anything, so that every node is heard before
+    /// hwfoc speaks: each reported motion is kept from here on ([`Client::check_at_rest`]).
+    pub fn listen_first(&mut self) -> Result<(), SetupError> {
+        self.watch();
+        let until = Instant::now() + LISTEN_FIRST;
+        self.listen_until(until, |_, _| false)
+    }
+
+    fn watch(&mut self) {
+        if !self.watching {
+            self.heard.start_window();
+            self.watching = true;
+        }
+    }
+
+    /// Takes what the bus buffered while nothing read it (a question on the terminal).
+    fn drain(&mut self) -> Result<(), SetupError> {
+        for _ in 0..DRAIN_MAX {
+            if self.stop.load(Ordering::Relaxed) {
+                return Err(SetupError::Stopped {
+                    bus: self.bus().to_string(),
+                });
+            }
+            match self.link.recv(Duration::ZERO)? {
+                Some(f) => {
+                    self.heard.take(&f);
+                }
+                None => break,
+            }
+        }
+        Ok(())
+    }
+
+    /// The safety check before each change of `node`, and after the confirmation: takes what
+    /// the bus buffered, then listens until every node that sends `StatusMsg1` has sent one
+    /// anew (at least 100 ms the first time, at most 2.2 s: two periods at 1 Hz) and `node`'s
+    /// latest is at most 0.3 s old. Refuses if any node reported its motor turning since
+    /// the first check (or [`Client::listen_first`]): rpm or pwm above 0, 1 A or more, a
+    /// standard `esc.Status` rpm. For a change that can turn a motor (`motor`), refuses too if
+    /// `node` was not seen at rest in the last 0.3 s (its `StatusMsg1` off, never sent or
+    /// stopped), or another node's `StatusMsg1` stopped.
+    pub fn check_at_rest(&mut self, node: u8, motor: bool) -> Result<(), SetupError> {
+        let first = !self.watching;
+        self.watch();
+        self.drain()?;
+        let since = Instant::now();
+        let least = if first { IDLE_MIN } else { Duration::ZERO };
+        let reporting: Vec<u8> = self
+            .heard
+            .nodes()
+            .filter(|n| n.status1.is_some())
+            .map(|n| n.node)
+            .collect();
+        let anew = |n: &NodeHeard| n.status1_at.is_some_and(|t| t >= since);
+        let fresh =
+            |n: &NodeHeard, now: Instant| anew(n) && n.status1_at.is_some_and(|t| now - t <= FRESH);
+        self.listen_until(since + IDLE_MAX, |h, now| {
+            h.nodes().any(NodeHeard::turning)
+                || (now - since >= least
+                    && reporting.iter().all(|&r| h.node(r).is_some_and(anew))
+                    && h.node(node)
+                        .is_none_or(|n| n.status1.is_none() || fresh(n, now)))
         })?;
-        match self.heard.nodes().find(|n| n.turning()) {
-            Some(n) => Err(SetupError::Turning {
+        let turned = self
+            .heard
+            .nodes()
+            .find_map(|n| n.window_motion.map(|m| (n.node, m)));
+        if let Some((node, motion)) = turned {
+            return Err(SetupError::Turning {
                 bus: self.bus().to_string(),
-                node: n.node,
-                rpm: n.window_max.0,
-                pwm: n.window_max.1,
-            }),
+                node,
+                motion,
+            });
+        }
+        if !motor {
+            return Ok(());
+        }
+        let now = Instant::now();
+        let unseen = |node: u8, heard: bool| SetupError::Unseen {
+            bus: self.bus().to_string(),
+            node,
+            heard,
+        };
+        match self.heard.node(node) {
+            Some(n) if fresh(n, now) => {}
+            // Heard, but not its rpm and pwm of late.
+            Some(_) => return Err(unseen(node, true)),
+            None => return Err(unseen(node, false)),
+        }
+        match reporting
+            .iter()
+            .find(|&&r| !self.heard.node(r).is_some_and(anew))
+        {
+            Some(&r) => Err(unseen(r, true)),
             None => Ok(()),
         }
     }
@@ -347,6 +447,76 @@ impl<L: Link> Client<L> {
         self.call(node, request, timeout)
     }
 
+    /// Makes `change` on `node` and reads it back. A write whose answer did not come in
+    /// time may have been made: it is read back all the same, and [`Made::late`] says so
+    /// (an error if the read-back fails or differs). A new node id is read back at the new id;
+    /// if that is not heard and the old id still answers, [`SetupError::IdNotTaken`].
+    pub fn change(
+        &mut self,
+        node: u8,
+        change: &Change,
+        timeout: Duration,
+    ) -> Result<Made, SetupError> {
+        let late = match self.apply(node, change, timeout) {
+            Ok(_) => None,
+            Err(e @ SetupError::NoAnswer { .. }) => Some(e),
+            Err(e) => return Err(e),
+        };
+        let unanswered = |said: Option<Change>| match &late {
+            Some(SetupError::NoAnswer {
+                bus,
+                service,
+                timeout,
+                ..
+            }) => Some(SetupError::Unanswered {
+                bus: bus.clone(),
+                node,
+                service: *service,
+                timeout: *timeout,
+                said,
+            }),
+            _ => None,
+        };
+        let read_at = match *change {
+            Change::NodeId { node_id, .. } => node_id,
+            _ => node,
+        };
+        let said = match self.read(read_at, change, timeout) {
+            Ok(said) => said,
+            Err(SetupError::NoAnswer { .. }) if read_at != node => {
+                return Err(if answer(self.direction(node, timeout))?.is_some() {
+                    SetupError::IdNotTaken {
+                        bus: self.bus().to_string(),
+                        node,
+                        to: read_at,
+                    }
+                } else {
+                    unanswered(None).unwrap_or(SetupError::IdLost {
+                        bus: self.bus().to_string(),
+                        node,
+                        to: read_at,
+                    })
+                });
+            }
+            Err(e @ SetupError::NoAnswer { .. }) => return Err(unanswered(None).unwrap_or(e)),
+            Err(e) => return Err(e),
+        };
+        if let Some(s) = said
+            && !change.agrees(&s)
+        {
+            return Err(unanswered(said).unwrap_or(SetupError::NotTaken {
+                bus: self.bus().to_string(),
+                node,
+                asked: *change,
+                said: s,
+            }));
+        }
+        Ok(Made {
+            said,
+            late: unanswered(said),
+        })
+    }
+
     /// What `node` now says of the setting `change` is about (`None` for the bit rate, which
     /// cannot be read at the old one). For a new node id: GetEscID answers from the new node
     /// (`node` is the new id); else `SetDirection` 255, `GetMajorConfig` or
@@ -380,12 +550,13 @@ impl<L: Link> Client<L> {
                 let c = self.major_config(node, timeout)?;
                 Change::ThrottleSource(ThrottleSource::from_pwm(c.throttle_source))
             }
-            Change::Led(asked) => {
+            Change::Led(_) => {
                 let c = self.major_config(node, timeout)?;
+                // Whether it was saved, the ESC cannot say.
                 Change::Led(Led {
                     color: c.led_color,
                     blink: c.led_status,
-                    save: asked.save,
+                    save: false,
                 })
             }
             Change::Rate { message, .. } => Change::Rate {
@@ -396,9 +567,11 @@ impl<L: Link> Client<L> {
         }))
     }
 
-    /// Lists the ESCs on the bus: listens (asking for ids) until no new node came for 0.5 s
+    /// Lists the ESCs on the bus (after [`Client::listen_first`]): listens (asking for ids
+    /// while no motor turns) until no new node came for 0.5 s
     /// (at least 0.5 s, at most `listen`), then asks each node heard its direction, major
-    /// configuration, maintenance counters and StatusMsg3 rate, `timeout` each.
+    /// configuration, maintenance counters and StatusMsg3 rate, `timeout` each, unless a motor
+    /// turns ([`Survey::asked`]).
     pub fn survey(&mut self, listen: Duration, timeout: Duration) -> Result<Survey, SetupError> {
         let start = Instant::now();
         self.ask_ids(true)?;
@@ -420,8 +593,20 @@ impl<L: Link> Client<L> {
         }
         let nodes: Vec<u8> = self.heard.nodes().map(|n| n.node).collect();
         let mut escs = Vec::new();
+        let mut asked = true;
         for node in nodes {
-            let direction = answer(self.direction(node, timeout))?;
+            // Nothing is asked while a motor turns (GetEscID and queries can make ESCs
+            // stutter), nor of a node that is no ESC.
+            asked &= !self.heard.nodes().any(|n| n.turning() || n.turning_now());
+            let esc = self
+                .heard
+                .node(node)
+                .is_some_and(|n| n.is_esc() || !n.channels.is_empty());
+            let direction = if asked && esc {
+                answer(self.direction(node, timeout))?
+            } else {
+                None
+            };
             // A node that does not answer one does not answer the others: not asked again.
             let (config, maintenance, msg3_rate) = if direction.is_some() {
                 (
@@ -445,6 +630,7 @@ impl<L: Link> Client<L> {
         }
         Ok(Survey {
             escs,
+            asked,
             elapsed: start.elapsed(),
         })
     }

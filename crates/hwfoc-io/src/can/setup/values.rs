@@ -310,6 +310,12 @@ impl Change {
         })
     }
 
+    /// Whether the change can make a motor turn, or turn otherwise: direction, throttle source,
+    /// node id or channel, bit rate (not the LED nor a reporting rate).
+    pub fn affects_motor(&self) -> bool {
+        !matches!(self, Change::Led(_) | Change::Rate { .. })
+    }
+
     /// Whether the ESC says what was asked: equal, the LED's save flag aside (it cannot be
     /// read back).
     pub fn agrees(&self, said: &Change) -> bool {
@@ -342,6 +348,24 @@ impl fmt::Display for Change {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn what_can_turn_a_motor() {
+        let led = Change::Led("red".parse().unwrap());
+        let rate = parse_rate("msg1=0").unwrap();
+        assert!(!led.affects_motor() && !rate.affects_motor());
+        for c in [
+            Change::Direction(Direction::from_ccw(true)),
+            Change::ThrottleSource(ThrottleSource::from_pwm(true)),
+            Change::NodeId {
+                node_id: 12,
+                channel: 2,
+            },
+            Change::Bitrate(250_000),
+        ] {
+            assert!(c.affects_motor(), "{c}");
+        }
+    }
 
     #[test]
     fn names_parse_and_print() {
