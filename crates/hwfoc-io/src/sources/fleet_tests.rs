@@ -50,8 +50,7 @@ impl Port {
 /// A file of recording `id` (`None`: another program's, naming no recording) holding the frames
 /// of `ports` whose times are in `from..to`, every port's packets in time order.
 fn file(id: Option<RecordingId>, ports: &[Port], from: u64, to: u64) -> Vec<u8> {
-    let mut w =
-        pcapng::Writer::continuing(Vec::new(), id.unwrap_or_else(RecordingId::new)).unwrap();
+    let mut w = pcapng::Writer::continuing(Vec::new(), id.unwrap_or_default()).unwrap();
     for p in ports {
         w.add_interface(p.name, 19200).unwrap();
     }

@@ -305,9 +305,11 @@ impl Sources {
     /// that name no recording, they may be one recording the user can join
     /// ([`Notice::MayContinue`]). Each ESC is told of with the first earlier ESC named alike.
     fn tell_alike_ports(&self, run: &mut [Reading]) {
-        // By (later input, earlier input): the ports at the same time, and those lined up.
-        let mut same: BTreeMap<(usize, usize), Vec<(String, usize, usize)>> = BTreeMap::new();
-        let mut lined: BTreeMap<(usize, usize), (Vec<String>, f64)> = BTreeMap::new();
+        // By (later input, earlier input): the ports at the same time (with this ESC and the
+        // earlier one), and those lined up (with the shortest gap).
+        type Pair = (usize, usize);
+        let mut same: BTreeMap<Pair, Vec<(String, usize, usize)>> = BTreeMap::new();
+        let mut lined: BTreeMap<Pair, (Vec<String>, f64)> = BTreeMap::new();
         for (esc, entry) in self.table.iter().enumerate() {
             let (Place::Own, Some(span)) = (entry.key.place, self.span[esc]) else {
                 continue;
