@@ -116,7 +116,7 @@ typedef struct hwfoc_foc_stats {
 /** The decoder: caller-owned, zeroed by hwfoc_foc_init. */
 typedef struct hwfoc_foc_decoder {
     hwfoc_foc_stats stats;
-    uint8_t held[HWFOC_FOC_MAX_LEN - 1];
+    uint8_t held[HWFOC_FOC_MAX_LEN];
     uint8_t len;
 } hwfoc_foc_decoder;
 
@@ -169,7 +169,7 @@ typedef struct hwfoc_dl_stats {
 
 typedef struct hwfoc_dl_decoder {
     hwfoc_dl_stats stats;
-    uint8_t held[HWFOC_DL_FRAME_LEN - 1];
+    uint8_t held[HWFOC_DL_FRAME_LEN];
     uint8_t len;
 } hwfoc_dl_decoder;
 
@@ -225,7 +225,7 @@ typedef struct hwfoc_v3_stats {
 
 typedef struct hwfoc_v3_decoder {
     hwfoc_v3_stats stats;
-    uint8_t held[HWFOC_V3_MAX_LEN - 1];
+    uint8_t held[HWFOC_V3_MAX_LEN];
     uint8_t len;
 } hwfoc_v3_decoder;
 
@@ -294,7 +294,7 @@ typedef struct hwfoc_v4_stats {
 
 typedef struct hwfoc_v4_decoder {
     hwfoc_v4_stats stats;
-    uint8_t held[HWFOC_V4_MAX_LEN - 1];
+    uint8_t held[HWFOC_V4_MAX_LEN];
     uint8_t len;
 } hwfoc_v4_decoder;
 
@@ -355,7 +355,7 @@ typedef struct hwfoc_hw5_stats {
 
 typedef struct hwfoc_hw5_decoder {
     hwfoc_hw5_stats stats;
-    uint8_t held[HWFOC_HW5_MAX_LEN - 1];
+    uint8_t held[HWFOC_HW5_MAX_LEN];
     uint8_t len;
 } hwfoc_hw5_decoder;
 
@@ -415,6 +415,11 @@ extern "C" {
 #endif
 
 #define HWFOC__BYTES_MASK 0xFFFFFFFFFFFFull /* byte counts wrap at 2^48, as in Rust */
+#if defined(__GNUC__) || defined(__clang__)
+#define HWFOC__OUT_OF_LINE __attribute__((noinline)) /* called from several places: smaller */
+#else
+#define HWFOC__OUT_OF_LINE
+#endif
 
 static inline uint32_t hwfoc__sat(uint32_t a, uint32_t b) { return a > 0xFFFFFFFFu - b ? 0xFFFFFFFFu : a + b; }
 static inline void hwfoc__inc(uint32_t *a) { *a = hwfoc__sat(*a, 1u); }
@@ -494,63 +499,115 @@ uint16_t hwfoc_crc16_modbus(const uint8_t *p, size_t n) {
     return (uint16_t)crc;
 }
 
-/* The streaming layer (the Rust `scan::StreamDecoder`), one instance per format: a candidate
- * still arriving is held (fewer than MAXLEN bytes); a chunk is scanned in place, the held
- * bytes first completed with at most MAXLEN bytes of it. PFX##_scan_all(d, data, n, base,
+/* The streaming layer (the Rust `scan::StreamDecoder`), shared by every format: bytes are taken
+ * one at a time, as the Rust decoder's `push` takes them (the same frames and statistics for any
+ * chunking), onto the candidate held (at most max_len bytes), which is scanned as soon as its
+ * bytes may decide it; what stays undecided is held for the next byte. A format's scan(d, data, n, base,
  * at_end, cb, ctx) returns where it stopped (n, or an undecided candidate's start, none of
- * whose bytes is counted); PFX##_candidate_len(held, n) is how many bytes may decide it. */
-#define HWFOC__STREAM(PFX, MAXLEN, DEC, CB, SILENT)                                              \
-    static void PFX##_hold(DEC *d, const uint8_t *tail, size_t n) {                              \
-        if (n > sizeof d->held) n = sizeof d->held; /* cannot happen: MAXLEN decides all */     \
-        memmove(d->held, tail, n);                                                               \
-        d->len = (uint8_t)n;                                                                     \
-    }                                                                                            \
-    void PFX##_feed(DEC *d, const uint8_t *data, size_t n, CB cb, void *ctx) {                  \
-        uint64_t start, base;                                                                    \
-        size_t pos;                                                                              \
-        if (n == 0) return;                                                                      \
-        start = d->stats.HWFOC__BYTES;                                                           \
-        hwfoc__add_bytes(&d->stats.HWFOC__BYTES, n);                                             \
-        base = start;                                                                            \
-        if (d->len > 0) {                                                                        \
-            uint8_t pair[2 * (MAXLEN)];                                                          \
-            size_t held = d->len, take, total;                                                   \
-            if (held + n < PFX##_candidate_len(d->held, held)) {                                 \
-                memcpy(d->held + held, data, n);                                                 \
-                d->len = (uint8_t)(held + n);                                                    \
-                return;                                                                          \
-            }                                                                                    \
-            take = n < (MAXLEN) ? n : (MAXLEN);                                                  \
-            memcpy(pair, d->held, held);                                                         \
-            memcpy(pair + held, data, take);                                                     \
-            total = held + take;                                                                 \
-            pos = PFX##_scan_all(d, pair, total, (start - held) & HWFOC__BYTES_MASK, 0, cb, ctx); \
-            if (pos < held) {                                                                    \
-                PFX##_hold(d, pair + pos, total - pos);                                          \
-                return;                                                                          \
-            }                                                                                    \
-            data += pos - held;                                                                  \
-            n -= pos - held;                                                                     \
-            base += pos - held;                                                                  \
-        }                                                                                        \
-        pos = PFX##_scan_all(d, data, n, base, 0, cb, ctx);                                      \
-        PFX##_hold(d, data + pos, n - pos);                                                      \
-    }                                                                                            \
-    void PFX##_push(DEC *d, uint8_t byte, CB cb, void *ctx) { PFX##_feed(d, &byte, 1, cb, ctx); } \
-    void PFX##_flush(DEC *d, CB cb, void *ctx) {                                                 \
-        size_t held = d->len;                                                                    \
-        (void)PFX##_scan_all(d, d->held, held,                                                   \
-                             (d->stats.HWFOC__BYTES - held) & HWFOC__BYTES_MASK, 1, cb, ctx);    \
-        d->len = 0;                                                                              \
-    }                                                                                            \
-    void PFX##_line_silent(DEC *d, uint32_t max_frames, CB cb, void *ctx) {                      \
-        PFX##_flush(d, cb, ctx);                                                                 \
-        SILENT;                                                                                  \
-    }                                                                                            \
-    void PFX##_init(DEC *d) { memset(d, 0, sizeof *d); }
+ * whose bytes is counted); candidate_len(held, n) is how many bytes may decide it. Callbacks
+ * pass through as `void (*)(void)` and are converted back to their own type before a call. */
+typedef void (*hwfoc__any_cb)(void);
+typedef size_t (*hwfoc__len_fn)(const uint8_t *held, size_t n);
+typedef size_t (*hwfoc__find_fn)(const uint8_t *h, size_t n);
+/* Decides the candidate at c[0..n], stream offset `at`: HWFOC__FRAME (handed on, its length in
+ * *len), HWFOC__REJECTED (counted) or HWFOC__UNDECIDED (nothing counted; rejected at_end). */
+typedef int (*hwfoc__take_fn)(void *d, const uint8_t *c, size_t n, uint64_t at, int at_end, size_t *len,
+                              hwfoc__any_cb cb, void *ctx);
+/* Before each search: V4 takes a data frame's trailer byte; returns the new position. */
+typedef size_t (*hwfoc__pre_fn)(void *d, const uint8_t *data, size_t n, uint64_t base, size_t pos);
+typedef struct hwfoc__format {
+    uint16_t bytes_at, skipped_at, held_at, len_at; /* offsets in the decoder */
+    hwfoc__len_fn candidate_len;
+    hwfoc__find_fn find;
+    hwfoc__take_fn take;
+    hwfoc__pre_fn pre;
+} hwfoc__format;
 
 /* The Rust scanners' candidate verdicts. */
 enum { HWFOC__FRAME, HWFOC__REJECTED, HWFOC__UNDECIDED };
+
+#define HWFOC__AT(d, off, T) ((T *)(void *)((char *)(d) + (off)))
+
+/* The search loop of every scanner (the Rust `scan::next_candidate` and `scan_all`): from each
+ * candidate start `find` gives, `take` decides; the bytes before a candidate, and a rejected
+ * candidate's first byte, are skipped. Returns where it stopped: n, or an undecided start. */
+static size_t hwfoc__scan(const hwfoc__format *fmt, void *d, const uint8_t *data, size_t n, uint64_t base,
+                          int at_end, hwfoc__any_cb cb, void *ctx) {
+    uint64_t *skipped = HWFOC__AT(d, fmt->skipped_at, uint64_t);
+    size_t pos = 0, k, i, len = 0;
+    for (;;) {
+        if (fmt->pre) pos = fmt->pre(d, data, n, base, pos);
+        for (;;) {
+            k = fmt->find(data + pos, n - pos);
+            hwfoc__add_bytes(skipped, k);
+            if (pos + k == n) return n;
+            i = pos + k;
+            switch (fmt->take(d, data + i, n - i, (base + i) & HWFOC__BYTES_MASK, at_end, &len, cb, ctx)) {
+            case HWFOC__FRAME: pos = i + len; break;
+            case HWFOC__UNDECIDED: return i;
+            default:
+                hwfoc__add_bytes(skipped, 1);
+                pos = i + 1;
+                continue;
+            }
+            break;
+        }
+    }
+}
+
+static void hwfoc__feed(const hwfoc__format *fmt, void *d, const uint8_t *data, size_t n, hwfoc__any_cb cb, void *ctx) {
+    uint64_t *bytes = HWFOC__AT(d, fmt->bytes_at, uint64_t);
+    uint8_t *held = HWFOC__AT(d, fmt->held_at, uint8_t);
+    uint8_t *len = HWFOC__AT(d, fmt->len_at, uint8_t);
+    size_t i, m, pos;
+    for (i = 0; i < n; i++) {
+        m = *len;
+        held[m] = data[i];
+        hwfoc__add_bytes(bytes, 1);
+        /* The held candidate cannot be decided with this byte yet: just keep it. */
+        if (m > 0 && m + 1u < fmt->candidate_len(held, m)) {
+            *len = (uint8_t)(m + 1u);
+            continue;
+        }
+        m++;
+        pos = hwfoc__scan(fmt, d, held, m, (*bytes - m) & HWFOC__BYTES_MASK, 0, cb, ctx);
+        memmove(held, held + pos, m - pos);
+        *len = (uint8_t)(m - pos);
+    }
+}
+
+/* A candidate of V3, V4 and HW5 is scanned again with every byte (the Rust decoders' byte
+ * counts that decide one are a speed-up only: an undecided candidate changes nothing). */
+static inline size_t hwfoc__next_byte(const uint8_t *held, size_t n) {
+    (void)held;
+    return n + 1u;
+}
+
+static void hwfoc__flush(const hwfoc__format *fmt, void *d, hwfoc__any_cb cb, void *ctx) {
+    uint8_t *len = HWFOC__AT(d, fmt->len_at, uint8_t);
+    size_t held = *len;
+    (void)hwfoc__scan(fmt, d, HWFOC__AT(d, fmt->held_at, uint8_t), held,
+                      (*HWFOC__AT(d, fmt->bytes_at, uint64_t) - held) & HWFOC__BYTES_MASK, 1, cb, ctx);
+    *len = 0;
+}
+
+/* A format's public streaming functions over the shared layer. */
+#define HWFOC__STREAM(PFX, DEC, CB, BYTES, SKIPPED, LEN_FN, FIND, PRE, SILENT)              \
+    static const hwfoc__format PFX##_format = {offsetof(DEC, stats.BYTES), offsetof(DEC, stats.SKIPPED), \
+                                               offsetof(DEC, held), offsetof(DEC, len), LEN_FN,     \
+                                               FIND, PFX##_take, PRE};                              \
+    void PFX##_feed(DEC *d, const uint8_t *data, size_t n, CB cb, void *ctx) {                      \
+        hwfoc__feed(&PFX##_format, d, data, n, (hwfoc__any_cb)cb, ctx);                             \
+    }                                                                                               \
+    void PFX##_push(DEC *d, uint8_t byte, CB cb, void *ctx) {                                       \
+        hwfoc__feed(&PFX##_format, d, &byte, 1, (hwfoc__any_cb)cb, ctx);                            \
+    }                                                                                               \
+    void PFX##_flush(DEC *d, CB cb, void *ctx) { hwfoc__flush(&PFX##_format, d, (hwfoc__any_cb)cb, ctx); } \
+    void PFX##_line_silent(DEC *d, uint32_t max_frames, CB cb, void *ctx) {                         \
+        PFX##_flush(d, cb, ctx);                                                                    \
+        SILENT;                                                                                     \
+    }                                                                                               \
+    void PFX##_init(DEC *d) { memset(d, 0, sizeof *d); }
 
 /* ---------------------------------------------------------------- HW-FOC implementation */
 #if !defined(HWFOC_NO_FOC) || !defined(HWFOC_NO_DATALINK)
@@ -591,7 +648,6 @@ static void hwfoc__foc_write_payload(const hwfoc_foc_data *f, uint8_t *p) {
 #endif
 
 #ifndef HWFOC_NO_FOC
-#define HWFOC__BYTES bytes
 
 void hwfoc_foc_encode_data(const hwfoc_foc_data *f, uint8_t out[HWFOC_FOC_DATA_LEN]) {
     out[0] = HWFOC_SYNC; out[1] = 0x16; out[2] = 0x01; out[3] = 0x02;
@@ -647,44 +703,34 @@ static int hwfoc__foc_take(hwfoc_foc_decoder *d, const uint8_t *c, size_t n, int
     return at_end ? HWFOC__REJECTED : HWFOC__UNDECIDED;
 }
 
-static size_t hwfoc_foc_scan_all(hwfoc_foc_decoder *d, const uint8_t *data, size_t n, uint64_t base,
-                                 int at_end, hwfoc_foc_cb cb, void *ctx) {
-    size_t pos = 0, k, i;
+static int hwfoc_foc_take(void *dec, const uint8_t *c, size_t n, uint64_t at, int at_end, size_t *len,
+                          hwfoc__any_cb any, void *ctx) {
     hwfoc_foc_frame f;
-    for (;;) {
-        k = hwfoc__foc_find(data + pos, n - pos);
-        hwfoc__add_bytes(&d->stats.bytes_skipped, k);
-        if (pos + k == n) return n;
-        i = pos + k;
-        switch (hwfoc__foc_take(d, data + i, n - i, at_end, &f)) {
-        case HWFOC__FRAME:
-            f.offset = (base + i) & HWFOC__BYTES_MASK;
-            pos = i + (f.kind == HWFOC_FOC_KIND_DATA ? 24u : 77u);
-            if (cb) cb(ctx, &f);
-            break;
-        case HWFOC__UNDECIDED:
-            return i;
-        default:
-            hwfoc__add_bytes(&d->stats.bytes_skipped, 1);
-            pos = i + 1;
-        }
+    int v = hwfoc__foc_take((hwfoc_foc_decoder *)dec, c, n, at_end, &f);
+    if (v == HWFOC__FRAME) {
+        f.offset = at;
+        *len = f.kind == HWFOC_FOC_KIND_DATA ? HWFOC_FOC_DATA_LEN : HWFOC_FOC_INFO_LEN;
+        if (any) ((hwfoc_foc_cb)any)(ctx, &f);
     }
+    return v;
 }
 
-HWFOC__STREAM(hwfoc_foc, HWFOC_FOC_MAX_LEN, hwfoc_foc_decoder, hwfoc_foc_cb,
+HWFOC__STREAM(hwfoc_foc, hwfoc_foc_decoder, hwfoc_foc_cb, bytes, bytes_skipped,
+              hwfoc_foc_candidate_len, hwfoc__foc_find, NULL,
               hwfoc_sequence_line_silent(&d->stats.packets, max_frames, HWFOC_COUNTER16_MAX))
-#undef HWFOC__BYTES
 #endif
 
 /* ---------------------------------------------------------------- DataLink implementation */
 #ifndef HWFOC_NO_DATALINK
-#define HWFOC__BYTES bytes
+
+/* A hub frame lasts 160 bytes at 115200 baud, an ESC frame 24 bytes at 19200: 10/9 of one. */
+typedef char hwfoc__hub_to_esc_is_10_9[HWFOC_DL_FRAME_LEN * HWFOC_FOC_BAUD * 9u ==
+                                       HWFOC_FOC_DATA_LEN * HWFOC_DL_BAUD * 10u ? 1 : -1];
 
 uint32_t hwfoc_dl_esc_frames_in(uint32_t hub_frames) {
-    uint64_t hub_bits = (uint64_t)hub_frames * HWFOC_DL_FRAME_LEN * HWFOC_FOC_BAUD;
-    uint64_t esc_bits = (uint64_t)HWFOC_FOC_DATA_LEN * HWFOC_DL_BAUD;
-    uint64_t n = (hub_bits + esc_bits - 1u) / esc_bits;
-    return n > 0xFFFFFFFFu ? 0xFFFFFFFFu : (uint32_t)n;
+    /* ceil(hub_frames * 10 / 9), saturated, in 32 bits (no 64-bit division on a Cortex-M). */
+    uint32_t q = hub_frames / 9u, extra = (hub_frames % 9u * 10u + 8u) / 9u;
+    return q > (0xFFFFFFFFu - extra) / 10u ? 0xFFFFFFFFu : q * 10u + extra;
 }
 
 void hwfoc_dl_encode(const hwfoc_dl_frame *f, uint8_t out[HWFOC_DL_FRAME_LEN]) {
@@ -698,7 +744,7 @@ void hwfoc_dl_encode(const hwfoc_dl_frame *f, uint8_t out[HWFOC_DL_FRAME_LEN]) {
     for (ch = 0; ch < HWFOC_DL_CHANNELS; ch++) {
         uint8_t *r = out + 6 + 19 * ch;
         r[0] = (uint8_t)ch;
-        if (f->present >> ch & 1u) hwfoc__foc_write_payload(&f->slots[ch], r + 1);
+        if ((unsigned)f->present >> ch & 1u) hwfoc__foc_write_payload(&f->slots[ch], r + 1);
     }
     hwfoc__put_le16(out + 158, hwfoc_crc16_xmodem(out, 158));
 }
@@ -730,7 +776,7 @@ static void hwfoc__dl_read(const uint8_t *c, hwfoc_dl_frame *f) {
             f->empty_slots++;
         } else if (ch >= HWFOC_DL_CHANNELS) {
             f->bad_channels++;
-        } else if (f->present >> ch & 1u) {
+        } else if ((unsigned)f->present >> ch & 1u) {
             f->duplicate_channels++;
         } else {
             f->present = (uint8_t)(f->present | 1u << ch);
@@ -739,45 +785,37 @@ static void hwfoc__dl_read(const uint8_t *c, hwfoc_dl_frame *f) {
     }
 }
 
-static size_t hwfoc_dl_scan_all(hwfoc_dl_decoder *d, const uint8_t *data, size_t n, uint64_t base,
-                                int at_end, hwfoc_dl_cb cb, void *ctx) {
-    size_t pos = 0, k, i, rest;
-    unsigned ch;
-    hwfoc_dl_stats *s = &d->stats;
+static int hwfoc_dl_take(void *dec, const uint8_t *c, size_t n, uint64_t at, int at_end, size_t *len,
+                         hwfoc__any_cb any, void *ctx) {
+    hwfoc_dl_stats *s = &((hwfoc_dl_decoder *)dec)->stats;
     hwfoc_dl_frame f;
-    for (;;) {
-        const uint8_t *c;
-        k = hwfoc__dl_find(data + pos, n - pos);
-        hwfoc__add_bytes(&s->bytes_skipped, k);
-        if (pos + k == n) return n;
-        i = pos + k;
-        c = data + i;
-        rest = n - i;
-        if (rest < 4 || (rest < HWFOC_DL_FRAME_LEN && c[2] == 0x01 && c[3] == 0x02)) {
-            if (!at_end) return i;
-        } else if (c[2] != 0x01 || c[3] != 0x02) {
-            hwfoc__inc(&s->bad_headers);
-        } else if (hwfoc_crc16_xmodem(c, 158) != hwfoc__le16(c + 158)) {
-            hwfoc__inc(&s->crc_failures);
-        } else if (!hwfoc__dl_is_length(c[1])) {
-            hwfoc__inc(&s->bad_headers);
-        } else {
-            hwfoc__dl_read(c, &f);
-            f.offset = (base + i) & HWFOC__BYTES_MASK;
-            hwfoc_sequence_next(&s->counter, f.counter, HWFOC_COUNTER16_MAX);
-            hwfoc__inc(&s->length_bytes[c[1] == HWFOC_DL_LENGTH_TOTAL]);
-            s->empty_slots = hwfoc__sat(s->empty_slots, f.empty_slots);
-            s->bad_channels = hwfoc__sat(s->bad_channels, f.bad_channels);
-            s->duplicate_channels = hwfoc__sat(s->duplicate_channels, f.duplicate_channels);
-            for (ch = 0; ch < HWFOC_DL_CHANNELS; ch++)
-                if (f.present >> ch & 1u) hwfoc_sequence_next(&s->channels[ch], f.slots[ch].packet, HWFOC_COUNTER16_MAX);
-            pos = i + HWFOC_DL_FRAME_LEN;
-            if (cb) cb(ctx, &f);
-            continue;
-        }
-        hwfoc__add_bytes(&s->bytes_skipped, 1);
-        pos = i + 1;
+    unsigned ch;
+    if (n < 4 || (n < HWFOC_DL_FRAME_LEN && c[2] == 0x01 && c[3] == 0x02))
+        return at_end ? HWFOC__REJECTED : HWFOC__UNDECIDED;
+    if (c[2] != 0x01 || c[3] != 0x02) {
+        hwfoc__inc(&s->bad_headers);
+        return HWFOC__REJECTED;
     }
+    if (hwfoc_crc16_xmodem(c, 158) != hwfoc__le16(c + 158)) {
+        hwfoc__inc(&s->crc_failures);
+        return HWFOC__REJECTED;
+    }
+    if (!hwfoc__dl_is_length(c[1])) { /* the search stops at no other */
+        hwfoc__inc(&s->bad_headers);
+        return HWFOC__REJECTED;
+    }
+    hwfoc__dl_read(c, &f);
+    f.offset = at;
+    hwfoc_sequence_next(&s->counter, f.counter, HWFOC_COUNTER16_MAX);
+    hwfoc__inc(&s->length_bytes[c[1] == HWFOC_DL_LENGTH_TOTAL]);
+    s->empty_slots = hwfoc__sat(s->empty_slots, f.empty_slots);
+    s->bad_channels = hwfoc__sat(s->bad_channels, f.bad_channels);
+    s->duplicate_channels = hwfoc__sat(s->duplicate_channels, f.duplicate_channels);
+    for (ch = 0; ch < HWFOC_DL_CHANNELS; ch++)
+        if ((unsigned)f.present >> ch & 1u) hwfoc_sequence_next(&s->channels[ch], f.slots[ch].packet, HWFOC_COUNTER16_MAX);
+    *len = HWFOC_DL_FRAME_LEN;
+    if (any) ((hwfoc_dl_cb)any)(ctx, &f);
+    return HWFOC__FRAME;
 }
 
 static void hwfoc__dl_silent(hwfoc_dl_stats *s, uint32_t max_frames) {
@@ -787,8 +825,9 @@ static void hwfoc__dl_silent(hwfoc_dl_stats *s, uint32_t max_frames) {
     for (ch = 0; ch < HWFOC_DL_CHANNELS; ch++) hwfoc_sequence_line_silent(&s->channels[ch], esc, HWFOC_COUNTER16_MAX);
 }
 
-HWFOC__STREAM(hwfoc_dl, HWFOC_DL_FRAME_LEN, hwfoc_dl_decoder, hwfoc_dl_cb, hwfoc__dl_silent(&d->stats, max_frames))
-#undef HWFOC__BYTES
+HWFOC__STREAM(hwfoc_dl, hwfoc_dl_decoder, hwfoc_dl_cb, bytes, bytes_skipped,
+              hwfoc_dl_candidate_len, hwfoc__dl_find, NULL,
+              hwfoc__dl_silent(&d->stats, max_frames))
 #endif
 
 /* ---------------------------------------------------------------- V3 and V4 implementation */
@@ -813,7 +852,6 @@ static int hwfoc__chain_reject(hwfoc_chain_counts *c, int verdict, int at_end) {
 #endif
 
 #ifndef HWFOC_NO_V3
-#define HWFOC__BYTES counts.bytes
 
 uint32_t hwfoc_v3_erpm(uint16_t period_us) {
     return period_us == 0 || period_us == HWFOC_V3_PLACEHOLDER_PERIOD_US ? 0u : 60000000u / period_us;
@@ -838,10 +876,7 @@ static int hwfoc__v3_plausible(const hwfoc_v3_frame *f) {
     return f->throttle_in_raw <= HWFOC_V3_FULL_SCALE && f->pwm_out_raw <= HWFOC_V3_FULL_SCALE;
 }
 
-static size_t hwfoc_v3_candidate_len(const uint8_t *c, size_t n) {
-    (void)c;
-    return n < 10 ? 10u : n == 10 ? 11u : n < 20 ? 20u : n == 20 ? 21u : HWFOC_V3_MAX_LEN;
-}
+
 
 /* Returns a verdict; *synced is set for a frame that starts a chain. */
 static int hwfoc__v3_judge(const hwfoc_v3_stats *s, const uint8_t *c, size_t n, uint64_t at,
@@ -871,41 +906,28 @@ static int hwfoc__v3_judge(const hwfoc_v3_stats *s, const uint8_t *c, size_t n, 
     return HWFOC__CHAIN_FRAME;
 }
 
-static size_t hwfoc_v3_scan_all(hwfoc_v3_decoder *d, const uint8_t *data, size_t n, uint64_t base,
-                                int at_end, hwfoc_v3_cb cb, void *ctx) {
-    size_t pos = 0, k, i;
-    int synced = 0, v;
-    hwfoc_v3_stats *s = &d->stats;
+static int hwfoc_v3_take(void *dec, const uint8_t *c, size_t n, uint64_t at, int at_end, size_t *len,
+                         hwfoc__any_cb any, void *ctx) {
+    hwfoc_v3_stats *s = &((hwfoc_v3_decoder *)dec)->stats;
     hwfoc_v3_frame f;
-    for (;;) {
-        k = hwfoc__find_sync(data + pos, n - pos);
-        hwfoc__add_bytes(&s->counts.bytes_skipped, k);
-        if (pos + k == n) return n;
-        i = pos + k;
-        f.offset = (base + i) & HWFOC__BYTES_MASK;
-        v = hwfoc__v3_judge(s, data + i, n - i, f.offset, &f, &synced);
-        if (v == HWFOC__CHAIN_FRAME) {
-            if (synced) hwfoc__inc(&s->counts.syncs);
-            hwfoc_sequence_next(&s->counts.counter, f.counter, HWFOC_COUNTER24_MAX);
-            s->has_chain = 1;
-            s->chain_end = f.offset + HWFOC_V3_FRAME_LEN;
-            pos = i + HWFOC_V3_FRAME_LEN;
-            if (cb) cb(ctx, &f);
-            continue;
-        }
-        if (hwfoc__chain_reject(&s->counts, v, at_end) == HWFOC__UNDECIDED) return i;
-        hwfoc__add_bytes(&s->counts.bytes_skipped, 1);
-        pos = i + 1;
-    }
+    int synced = 0, v = hwfoc__v3_judge(s, c, n, at, &f, &synced);
+    if (v != HWFOC__CHAIN_FRAME) return hwfoc__chain_reject(&s->counts, v, at_end);
+    if (synced) hwfoc__inc(&s->counts.syncs);
+    hwfoc_sequence_next(&s->counts.counter, f.counter, HWFOC_COUNTER24_MAX);
+    s->has_chain = 1;
+    s->chain_end = at + HWFOC_V3_FRAME_LEN;
+    f.offset = at;
+    *len = HWFOC_V3_FRAME_LEN;
+    if (any) ((hwfoc_v3_cb)any)(ctx, &f);
+    return HWFOC__FRAME;
 }
 
-HWFOC__STREAM(hwfoc_v3, HWFOC_V3_MAX_LEN, hwfoc_v3_decoder, hwfoc_v3_cb,
+HWFOC__STREAM(hwfoc_v3, hwfoc_v3_decoder, hwfoc_v3_cb, counts.bytes, counts.bytes_skipped,
+              hwfoc__next_byte, hwfoc__find_sync, NULL,
               hwfoc_sequence_line_silent(&d->stats.counts.counter, max_frames, HWFOC_COUNTER24_MAX))
-#undef HWFOC__BYTES
 #endif
 
 #ifndef HWFOC_NO_V4
-#define HWFOC__BYTES counts.bytes
 
 void hwfoc_v4_encode_data(const hwfoc_v4_data *f, uint8_t out[HWFOC_V4_DATA_LEN]) {
     out[0] = HWFOC_SYNC;
@@ -943,15 +965,12 @@ uint32_t hwfoc_v4_current_ma(uint16_t adc, const hwfoc_v4_info *info) {
 
 enum { HWFOC__V4_DATA, HWFOC__V4_INFO, HWFOC__V4_NOTHING, HWFOC__V4_UNDECIDED };
 
-static int hwfoc__v4_info_eq(const hwfoc_v4_info *a, const hwfoc_v4_info *b) {
+HWFOC__OUT_OF_LINE static int hwfoc__v4_info_eq(const hwfoc_v4_info *a, const hwfoc_v4_info *b) {
     return a->full_scale == b->full_scale && a->v1 == b->v1 && a->v2 == b->v2 && a->i1 == b->i1 &&
            a->i2 == b->i2 && a->i3 == b->i3 && a->t1 == b->t1 && a->t2 == b->t2;
 }
 
-static size_t hwfoc_v4_candidate_len(const uint8_t *c, size_t n) {
-    (void)c;
-    return n < HWFOC_V4_INFO_LEN ? HWFOC_V4_INFO_LEN : n + 1u;
-}
+
 
 /* What is found at c[at..n]: a plausible data frame, a plausible info frame, nothing, or too few bytes. */
 static int hwfoc__v4_found_at(const uint8_t *c, size_t n, size_t at, unsigned full_scale,
@@ -1063,47 +1082,39 @@ static void hwfoc__v4_accept(hwfoc_v4_stats *s, hwfoc_v4_frame *f, int synced) {
     }
 }
 
-static size_t hwfoc_v4_scan_all(hwfoc_v4_decoder *d, const uint8_t *data, size_t n, uint64_t base,
-                                int at_end, hwfoc_v4_cb cb, void *ctx) {
-    size_t pos = 0, k, i;
-    int synced = 0, v;
-    hwfoc_v4_stats *s = &d->stats;
-    hwfoc_v4_frame f;
-    for (;;) {
-        /* A data frame's trailer byte, where the chain ends. */
-        if (pos < n && data[pos] == HWFOC_V4_TRAILER && s->has_chain && s->chain_trailer &&
-            s->chain_end == ((base + pos) & HWFOC__BYTES_MASK)) {
-            s->chain_end += 1;
-            s->chain_trailer = 0;
-            hwfoc__inc(&s->trailers);
-            pos += 1;
-        }
-        for (;;) {
-            k = hwfoc__find_sync(data + pos, n - pos);
-            hwfoc__add_bytes(&s->counts.bytes_skipped, k);
-            if (pos + k == n) return n;
-            i = pos + k;
-            f.offset = (base + i) & HWFOC__BYTES_MASK;
-            v = hwfoc__v4_judge(s, data + i, n - i, f.offset, &f, &synced);
-            if (v == HWFOC__CHAIN_FRAME) break;
-            if (hwfoc__chain_reject(&s->counts, v, at_end) == HWFOC__UNDECIDED) return i;
-            hwfoc__add_bytes(&s->counts.bytes_skipped, 1);
-            pos = i + 1;
-        }
-        hwfoc__v4_accept(s, &f, synced);
-        pos = i + (f.kind == HWFOC_V4_KIND_DATA ? HWFOC_V4_DATA_LEN : HWFOC_V4_INFO_LEN);
-        if (cb) cb(ctx, &f);
+static size_t hwfoc_v4_trailer(void *dec, const uint8_t *data, size_t n, uint64_t base, size_t pos) {
+    hwfoc_v4_stats *s = &((hwfoc_v4_decoder *)dec)->stats;
+    if (pos < n && data[pos] == HWFOC_V4_TRAILER && s->has_chain && s->chain_trailer &&
+        s->chain_end == ((base + pos) & HWFOC__BYTES_MASK)) {
+        s->chain_end += 1;
+        s->chain_trailer = 0;
+        hwfoc__inc(&s->trailers);
+        return pos + 1;
     }
+    return pos;
 }
 
-HWFOC__STREAM(hwfoc_v4, HWFOC_V4_MAX_LEN, hwfoc_v4_decoder, hwfoc_v4_cb,
+static int hwfoc_v4_take(void *dec, const uint8_t *c, size_t n, uint64_t at, int at_end, size_t *len,
+                         hwfoc__any_cb any, void *ctx) {
+    hwfoc_v4_stats *s = &((hwfoc_v4_decoder *)dec)->stats;
+    hwfoc_v4_frame f;
+    int synced = 0, v;
+    f.offset = at;
+    v = hwfoc__v4_judge(s, c, n, at, &f, &synced);
+    if (v != HWFOC__CHAIN_FRAME) return hwfoc__chain_reject(&s->counts, v, at_end);
+    hwfoc__v4_accept(s, &f, synced);
+    *len = f.kind == HWFOC_V4_KIND_DATA ? HWFOC_V4_DATA_LEN : HWFOC_V4_INFO_LEN;
+    if (any) ((hwfoc_v4_cb)any)(ctx, &f);
+    return HWFOC__FRAME;
+}
+
+HWFOC__STREAM(hwfoc_v4, hwfoc_v4_decoder, hwfoc_v4_cb, counts.bytes, counts.bytes_skipped,
+              hwfoc__next_byte, hwfoc__find_sync, hwfoc_v4_trailer,
               hwfoc_sequence_line_silent(&d->stats.counts.counter, max_frames, HWFOC_COUNTER24_MAX))
-#undef HWFOC__BYTES
 #endif
 
 /* ---------------------------------------------------------------- HW5 implementation */
 #ifndef HWFOC_NO_HW5
-#define HWFOC__BYTES bytes
 
 static const char *const hwfoc__hw5_faults[8] = {
     "motor_locked", "over_temperature", "throttle_not_zero_at_start", "throttle_signal_lost",
@@ -1152,19 +1163,7 @@ static unsigned hwfoc__hw5_kind(unsigned first, unsigned count, unsigned j) {
     return count == 3 ? hwfoc__hw5_parameters[j] : first;
 }
 
-static size_t hwfoc_hw5_candidate_len(const uint8_t *c, size_t n) {
-    unsigned first = 0, count = 0, j;
-    if (n < 2) return 2;
-    if (n == 2) return 3;
-    if (n < 6) return 6;
-    hwfoc__hw5_kinds(hwfoc__hw5_direction(c[0], c[1]), c[3], hwfoc__le16(c + 4), &first, &count);
-    if (count && first == HWFOC_HW5_TELEMETRY && n == 6) return 7;
-    for (j = 0; j < count; j++) {
-        size_t len = hwfoc__hw5_len[hwfoc__hw5_kind(first, count, j)];
-        if (len > n) return len;
-    }
-    return n + 1;
-}
+
 
 static size_t hwfoc__hw5_find(const uint8_t *h, size_t n) {
     size_t j;
@@ -1200,51 +1199,36 @@ static int hwfoc__hw5_judge(hwfoc_hw5_stats *s, const uint8_t *c, size_t n, int 
     return HWFOC__REJECTED;
 }
 
-static size_t hwfoc_hw5_scan_all(hwfoc_hw5_decoder *d, const uint8_t *data, size_t n, uint64_t base,
-                                 int at_end, hwfoc_hw5_cb cb, void *ctx) {
-    size_t pos = 0, k, i;
-    unsigned kind = 0;
-    hwfoc_hw5_stats *s = &d->stats;
+static int hwfoc_hw5_take(void *dec, const uint8_t *c, size_t n, uint64_t at, int at_end, size_t *len,
+                          hwfoc__any_cb any, void *ctx) {
+    hwfoc_hw5_stats *s = &((hwfoc_hw5_decoder *)dec)->stats;
     hwfoc_hw5_frame f;
-    for (;;) {
-        const uint8_t *c;
-        k = hwfoc__hw5_find(data + pos, n - pos);
-        hwfoc__add_bytes(&s->bytes_skipped, k);
-        if (pos + k == n) return n;
-        i = pos + k;
-        c = data + i;
-        switch (hwfoc__hw5_judge(s, c, n - i, at_end, &kind)) {
-        case HWFOC__FRAME:
-            hwfoc__inc(&s->frames[kind]);
-            pos = i + hwfoc__hw5_len[kind];
-            if (kind == HWFOC_HW5_TELEMETRY) {
-                f.offset = (base + i) & HWFOC__BYTES_MASK;
-                f.throttle = c[9];
-                f.unknown[0] = c[10];
-                f.unknown[1] = c[11];
-                f.fault = c[12];
-                f.erpm_raw = hwfoc__le16(c + 13);
-                f.voltage_raw = hwfoc__le16(c + 15);
-                f.current_raw = hwfoc__le16(c + 17);
-                f.esc_temp = c[19];
-                f.bec_temp = c[20];
-                f.motor_temp = c[21];
-                f.bec_voltage_raw = c[22];
-                f.bec_current_raw = c[23];
-                if (cb) cb(ctx, &f);
-            }
-            break;
-        case HWFOC__UNDECIDED:
-            return i;
-        default:
-            hwfoc__add_bytes(&s->bytes_skipped, 1);
-            pos = i + 1;
-        }
-    }
+    unsigned kind = 0;
+    int v = hwfoc__hw5_judge(s, c, n, at_end, &kind);
+    if (v != HWFOC__FRAME) return v;
+    hwfoc__inc(&s->frames[kind]);
+    *len = hwfoc__hw5_len[kind];
+    if (kind != HWFOC_HW5_TELEMETRY) return HWFOC__FRAME; /* counted, not handed on */
+    f.offset = at;
+    f.throttle = c[9];
+    f.unknown[0] = c[10];
+    f.unknown[1] = c[11];
+    f.fault = c[12];
+    f.erpm_raw = hwfoc__le16(c + 13);
+    f.voltage_raw = hwfoc__le16(c + 15);
+    f.current_raw = hwfoc__le16(c + 17);
+    f.esc_temp = c[19];
+    f.bec_temp = c[20];
+    f.motor_temp = c[21];
+    f.bec_voltage_raw = c[22];
+    f.bec_current_raw = c[23];
+    if (any) ((hwfoc_hw5_cb)any)(ctx, &f);
+    return HWFOC__FRAME;
 }
 
-HWFOC__STREAM(hwfoc_hw5, HWFOC_HW5_MAX_LEN, hwfoc_hw5_decoder, hwfoc_hw5_cb, (void)d; (void)max_frames)
-#undef HWFOC__BYTES
+HWFOC__STREAM(hwfoc_hw5, hwfoc_hw5_decoder, hwfoc_hw5_cb, bytes, bytes_skipped,
+              hwfoc__next_byte, hwfoc__hw5_find, NULL,
+              (void)d; (void)max_frames)
 #endif
 
 /* ---------------------------------------------------------------- conversions */

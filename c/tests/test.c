@@ -1,0 +1,277 @@
+/* SPDX-License-Identifier: MIT OR Apache-2.0 */
+/* The C tests of hwfoc.h, run by c/test.sh under AddressSanitizer and UndefinedBehaviorSanitizer:
+ * check values of the CRCs, every format's frames encoded, decoded byte by byte and in chunks,
+ * random bytes in random chunkings (same frames and statistics however cut, nothing read out of
+ * bounds), the golden vectors of c/tests/vectors.txt and the integer conversions. Exits 1 on the
+ * first failure, naming it. (Equality with the Rust codec is crates/hwfoc-c-tests's test.) */
+#define HWFOC_IMPLEMENTATION
+#define HWFOC_FLOAT
+#include "../hwfoc.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+static int failures;
+#define CHECK(cond)                                                                 \
+    do {                                                                            \
+        if (!(cond)) {                                                              \
+            fprintf(stderr, "%s:%d: check failed: %s\n", __FILE__, __LINE__, #cond); \
+            failures++;                                                             \
+        }                                                                           \
+    } while (0)
+
+static uint64_t rng_state = 0x2545F4914F6CDD1Dull;
+static uint32_t rnd(void) {
+    rng_state ^= rng_state >> 12;
+    rng_state ^= rng_state << 25;
+    rng_state ^= rng_state >> 27;
+    return (uint32_t)((rng_state * 0x2545F4914F6CDD1Dull) >> 32);
+}
+
+/* ------------------------------------------------------------ what the callbacks keep */
+typedef struct seen {
+    size_t n;
+    uint64_t offsets[4096];
+    hwfoc_foc_data foc[4096];
+    hwfoc_v3_frame v3[4096];
+    hwfoc_v4_frame v4[4096];
+    hwfoc_hw5_frame hw5[4096];
+    uint16_t dl_counter[4096];
+} seen;
+
+static void on_foc(void *ctx, const hwfoc_foc_frame *f) {
+    seen *s = (seen *)ctx;
+    if (s->n < 4096) { s->offsets[s->n] = f->offset; if (f->kind == HWFOC_FOC_KIND_DATA) s->foc[s->n] = f->data; }
+    s->n++;
+}
+static void on_dl(void *ctx, const hwfoc_dl_frame *f) {
+    seen *s = (seen *)ctx;
+    if (s->n < 4096) { s->offsets[s->n] = f->offset; s->dl_counter[s->n] = f->counter; }
+    s->n++;
+}
+static void on_v3(void *ctx, const hwfoc_v3_frame *f) {
+    seen *s = (seen *)ctx;
+    if (s->n < 4096) { s->offsets[s->n] = f->offset; s->v3[s->n] = *f; }
+    s->n++;
+}
+static void on_v4(void *ctx, const hwfoc_v4_frame *f) {
+    seen *s = (seen *)ctx;
+    if (s->n < 4096) { s->offsets[s->n] = f->offset; s->v4[s->n] = *f; }
+    s->n++;
+}
+static void on_hw5(void *ctx, const hwfoc_hw5_frame *f) {
+    seen *s = (seen *)ctx;
+    if (s->n < 4096) { s->offsets[s->n] = f->offset; s->hw5[s->n] = *f; }
+    s->n++;
+}
+
+/* Feeds `data` to a fresh decoder: whole (chunk 0), byte by byte (chunk 1), or in random chunks
+ * (chunk 2), then flushes; the frames go to *s, the decoder's final state to *dec. */
+#define FEED(PFX, DEC, CB)                                                              \
+    static void feed_##PFX(const uint8_t *data, size_t n, int chunk, seen *s, DEC *d) { \
+        size_t at = 0;                                                                  \
+        memset(s, 0, sizeof *s);                                                        \
+        hwfoc_##PFX##_init(d);                                                          \
+        while (at < n) {                                                                \
+            size_t k = chunk == 0 ? n - at : chunk == 1 ? 1 : 1 + rnd() % 200;          \
+            if (k > n - at) k = n - at;                                                 \
+            if (k == 1) hwfoc_##PFX##_push(d, data[at], CB, s);                         \
+            else hwfoc_##PFX##_feed(d, data + at, k, CB, s);                            \
+            at += k;                                                                    \
+        }                                                                               \
+        hwfoc_##PFX##_flush(d, CB, s);                                                  \
+    }
+FEED(foc, hwfoc_foc_decoder, on_foc)
+FEED(dl, hwfoc_dl_decoder, on_dl)
+FEED(v3, hwfoc_v3_decoder, on_v3)
+FEED(v4, hwfoc_v4_decoder, on_v4)
+FEED(hw5, hwfoc_hw5_decoder, on_hw5)
+
+static seen a, b;
+
+static void test_crcs(void) {
+    const uint8_t digits[] = "123456789";
+    CHECK(hwfoc_crc16_xmodem(digits, 9) == 0x31C3);
+    CHECK(hwfoc_crc16_modbus(digits, 9) == 0x4B37);
+    CHECK(hwfoc_crc16_modbus(digits, 0) == 0xFFFF);
+    CHECK(hwfoc_sum16(digits, 9) == 0x01DD);
+}
+
+static uint8_t stream[65536];
+
+static void test_foc(void) {
+    hwfoc_foc_decoder d1, d2;
+    hwfoc_foc_data f;
+    size_t n = 0, i;
+    uint8_t text[HWFOC_FOC_INFO_TEXT_LEN];
+    memset(text, ' ', sizeof text);
+    memcpy(text + 16, "XR_FOC_ESC", 10);
+    hwfoc_foc_encode_info(text, stream);
+    CHECK(stream[76] == (uint8_t)hwfoc_sum16(stream, 76));
+    n = HWFOC_FOC_INFO_LEN;
+    for (i = 0; i < 1000; i++) {
+        memset(&f, 0, sizeof f);
+        f.packet = (uint16_t)(i == 500 ? i + 3 : i); /* 3 lost, then a step back */
+        f.erpm_raw = (uint16_t)rnd();
+        f.current_raw = (int16_t)(uint16_t)rnd();
+        f.status = (uint16_t)rnd();
+        hwfoc_foc_encode_data(&f, stream + n);
+        n += HWFOC_FOC_DATA_LEN;
+        if (i == 700) stream[n++] = HWFOC_SYNC; /* a stray sync byte */
+    }
+    feed_foc(stream, n, 1, &a, &d1);
+    CHECK(a.n == 1001);
+    CHECK(d1.stats.info_frames == 1 && d1.stats.packets.count == 1000);
+    CHECK(d1.stats.packets.lost == 3 && d1.stats.packets.restarts == 1 && d1.stats.bytes_skipped == 1);
+    CHECK(a.foc[1000].packet == 999 && a.offsets[1] == 77);
+    feed_foc(stream, n, 2, &b, &d2);
+    CHECK(b.n == a.n && memcmp(&d1.stats, &d2.stats, sizeof d1.stats) == 0);
+    CHECK(memcmp(a.foc, b.foc, sizeof a.foc) == 0);
+}
+
+static void test_dl(void) {
+    hwfoc_dl_decoder d1, d2;
+    hwfoc_dl_frame f;
+    size_t n = 0, i;
+    memset(&f, 0, sizeof f);
+    for (i = 0; i < 300; i++) {
+        f.counter = (uint16_t)i;
+        f.present = (uint8_t)rnd();
+        f.length_byte = (uint8_t)(i % 2 ? HWFOC_DL_LENGTH_TOTAL : HWFOC_DL_LENGTH_COVERED);
+        f.slots[3].packet = (uint16_t)i;
+        f.slots[3].erpm_raw = 1;
+        f.present |= 1u << 3;
+        hwfoc_dl_encode(&f, stream + n);
+        n += HWFOC_DL_FRAME_LEN;
+    }
+    feed_dl(stream, n, 1, &a, &d1);
+    CHECK(a.n == 300 && a.dl_counter[299] == 299);
+    CHECK(d1.stats.length_bytes[0] == 150 && d1.stats.length_bytes[1] == 150);
+    CHECK(d1.stats.channels[3].count == 300 && d1.stats.channels[3].lost == 0);
+    feed_dl(stream, n, 2, &b, &d2);
+    CHECK(b.n == a.n && memcmp(&d1.stats, &d2.stats, sizeof d1.stats) == 0);
+    CHECK(hwfoc_dl_esc_frames_in(0) == 0 && hwfoc_dl_esc_frames_in(1) == 2);
+}
+
+static void test_v3(void) {
+    hwfoc_v3_decoder d1, d2;
+    hwfoc_v3_frame f;
+    size_t n = 0, i;
+    memset(&f, 0, sizeof f);
+    for (i = 0; i < 500; i++) {
+        f.counter = (uint32_t)(0xFFFFF0u + i) & HWFOC_COUNTER24_MAX;
+        f.throttle_in_raw = (uint16_t)(rnd() % 256);
+        f.pwm_out_raw = (uint16_t)(rnd() % 256);
+        f.period_us = (uint16_t)rnd();
+        if (i == 250) continue; /* a frame cut out whole */
+        hwfoc_v3_encode(&f, stream + n);
+        n += HWFOC_V3_FRAME_LEN;
+    }
+    feed_v3(stream, n, 1, &a, &d1);
+    CHECK(a.n == 499 && d1.stats.counts.counter.lost == 1 && d1.stats.counts.syncs == 1);
+    feed_v3(stream, n, 2, &b, &d2);
+    CHECK(b.n == a.n && memcmp(&d1.stats, &d2.stats, sizeof d1.stats) == 0);
+    CHECK(hwfoc_v3_erpm(HWFOC_V3_PLACEHOLDER_PERIOD_US) == 0 && hwfoc_v3_erpm(6000) == 10000);
+}
+
+static void test_v4(void) {
+    hwfoc_v4_decoder d1, d2;
+    hwfoc_v4_data f;
+    hwfoc_v4_info info = {800, 11, 65, 3, 4, 1, 0, 0};
+    size_t n = 0, i;
+    memset(&f, 0, sizeof f);
+    for (i = 0; i < 400; i++) {
+        if (i % 50 == 10) {
+            hwfoc_v4_encode_info(&info, stream + n);
+            n += HWFOC_V4_INFO_LEN;
+        }
+        f.counter = (uint32_t)i;
+        f.throttle_in_raw = (uint16_t)(rnd() % 800);
+        f.voltage_adc = (uint16_t)(rnd() % 4096);
+        hwfoc_v4_encode_data(&f, stream + n);
+        n += HWFOC_V4_DATA_LEN;
+        stream[n++] = HWFOC_V4_TRAILER;
+    }
+    feed_v4(stream, n, 1, &a, &d1);
+    CHECK(a.n == 408 && d1.stats.info_frames == 8 && d1.stats.adoptions == 1 && d1.stats.trailers == 400);
+    CHECK(a.v4[407].kind == HWFOC_V4_KIND_DATA && a.v4[407].has_info && a.v4[407].info.full_scale == 800);
+    feed_v4(stream, n, 2, &b, &d2);
+    CHECK(b.n == a.n && memcmp(&d1.stats, &d2.stats, sizeof d1.stats) == 0);
+}
+
+static void test_hw5(void) {
+    hwfoc_hw5_decoder d1, d2;
+    hwfoc_hw5_frame f;
+    size_t n = 0, i;
+    memset(&f, 0, sizeof f);
+    for (i = 0; i < 300; i++) {
+        f.throttle = (uint8_t)i;
+        f.erpm_raw = (uint16_t)rnd();
+        f.fault = (uint8_t)rnd();
+        hwfoc_hw5_encode(&f, stream + n);
+        if (i == 100) stream[n + 20] ^= 1; /* a CRC failure */
+        n += HWFOC_HW5_TELEMETRY_LEN;
+    }
+    feed_hw5(stream, n, 1, &a, &d1);
+    CHECK(a.n == 299 && d1.stats.crc_failures == 1 && d1.stats.frames[HWFOC_HW5_TELEMETRY] == 299);
+    CHECK(a.hw5[298].throttle == (uint8_t)299);
+    feed_hw5(stream, n, 2, &b, &d2);
+    CHECK(b.n == a.n && memcmp(&d1.stats, &d2.stats, sizeof d1.stats) == 0);
+    CHECK(strcmp(hwfoc_hw5_fault_name(0), "motor_locked") == 0);
+}
+
+/* Random bytes biased towards the bytes the scanners look for, whole and in random chunks. */
+static void test_noise(void) {
+    static const uint8_t special[] = {0x9B, 0x16, 0x4C, 0x01, 0x02, 0x9E, 0xA0, 0xB9, 0x00, 0xFE, 0xFD, 0x03, 0x30, 0x5C, 0x17};
+    hwfoc_foc_decoder f1, f2;
+    hwfoc_dl_decoder l1, l2;
+    hwfoc_v3_decoder t1, t2;
+    hwfoc_v4_decoder q1, q2;
+    hwfoc_hw5_decoder h1, h2;
+    size_t n = sizeof stream, i;
+    int round;
+    for (round = 0; round < 8; round++) {
+        for (i = 0; i < n; i++) stream[i] = rnd() % 2 ? special[rnd() % sizeof special] : (uint8_t)rnd();
+        feed_foc(stream, n, 0, &a, &f1); feed_foc(stream, n, 2, &b, &f2);
+        CHECK(a.n == b.n && memcmp(&f1.stats, &f2.stats, sizeof f1.stats) == 0 && f1.stats.bytes == n);
+        feed_dl(stream, n, 0, &a, &l1); feed_dl(stream, n, 2, &b, &l2);
+        CHECK(a.n == b.n && memcmp(&l1.stats, &l2.stats, sizeof l1.stats) == 0);
+        feed_v3(stream, n, 0, &a, &t1); feed_v3(stream, n, 2, &b, &t2);
+        CHECK(a.n == b.n && memcmp(&t1.stats, &t2.stats, sizeof t1.stats) == 0);
+        feed_v4(stream, n, 0, &a, &q1); feed_v4(stream, n, 2, &b, &q2);
+        CHECK(a.n == b.n && memcmp(&q1.stats, &q2.stats, sizeof q1.stats) == 0);
+        feed_hw5(stream, n, 0, &a, &h1); feed_hw5(stream, n, 2, &b, &h2);
+        CHECK(a.n == b.n && memcmp(&h1.stats, &h2.stats, sizeof h1.stats) == 0);
+    }
+}
+
+static void test_conversions(void) {
+    int16_t dc = 0;
+    CHECK(hwfoc_foc_current_ma(64) == 1000 && hwfoc_foc_current_ma(-1) == -15);
+    CHECK(hwfoc_rpm(70000, 7, 1, 1) == 10000 && hwfoc_rpm(70000, 7, 5, 2) == 4000);
+    CHECK(hwfoc_throttle_centipct(512, 1024) == 5000);
+    CHECK(hwfoc_decivolts_mv(252) == 25200 && hwfoc_erpm_of_raw(700) == 7000);
+    CHECK(hwfoc_temp_decidegrees(241, &dc) == 0 && dc == 0);
+    CHECK(hwfoc_temp_decidegrees(33, &dc) == 0 && dc == 1290);
+    CHECK(hwfoc_temp_decidegrees(242, &dc) == -1 && hwfoc_temp_decidegrees(32, &dc) == 1);
+    CHECK(hwfoc_v4_voltage_mv(910, 8, 910) == 8000);
+    CHECK(strcmp(hwfoc_foc_fault_name(2), "over_current") == 0);
+}
+
+int main(void) {
+    test_crcs();
+    test_foc();
+    test_dl();
+    test_v3();
+    test_v4();
+    test_hw5();
+    test_noise();
+    test_conversions();
+    if (failures) {
+        fprintf(stderr, "hwfoc.h C tests: %d failures\n", failures);
+        return 1;
+    }
+    printf("hwfoc.h C tests: ok\n");
+    return 0;
+}
