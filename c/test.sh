@@ -29,7 +29,7 @@ echo "c/test.sh: strict builds clean (gcc, clang, g++, clang++; ${#selections[@]
 
 san=(-std=c99 -g -O1 -fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer)
 gcc "${san[@]}" "${strict[@]}" "$here/tests/test.c" -o "$out/test" -lm
-"$out/test"
+"$out/test" "$here/tests/vectors.txt"
 gcc "${san[@]}" -D_POSIX_C_SOURCE=200809L "${strict[@]}" -I"$here" "$here/examples/serial.c" -o "$out/serial"
 "$out/serial" --self-test
 echo "c/test.sh: ok"

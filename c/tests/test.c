@@ -259,7 +259,208 @@ static void test_conversions(void) {
     CHECK(strcmp(hwfoc_foc_fault_name(2), "over_current") == 0);
 }
 
-int main(void) {
+/* ------------------------------------------------------------ golden vectors */
+typedef struct vec_frames {
+    size_t n, want;
+    int found;
+    hwfoc_foc_frame foc;
+    hwfoc_dl_frame dl;
+    hwfoc_v3_frame v3;
+    hwfoc_v4_frame v4;
+    hwfoc_hw5_frame hw5;
+} vec_frames;
+#define VEC_CB(PFX, T, FIELD)                                    \
+    static void vec_##PFX(void *ctx, const T *f) {               \
+        vec_frames *v = (vec_frames *)ctx;                       \
+        if (v->n++ == v->want) { v->FIELD = *f; v->found = 1; } \
+    }
+VEC_CB(foc, hwfoc_foc_frame, foc)
+VEC_CB(dl, hwfoc_dl_frame, dl)
+VEC_CB(v3, hwfoc_v3_frame, v3)
+VEC_CB(v4, hwfoc_v4_frame, v4)
+VEC_CB(hw5, hwfoc_hw5_frame, hw5)
+
+/* A field of an info frame's text, trimmed of spaces and NULs, into out. */
+static void info_field(const uint8_t *text, size_t start, size_t end, char *out) {
+    while (start < end && (text[start] == ' ' || text[start] == 0)) start++;
+    while (end > start && (text[end - 1] == ' ' || text[end - 1] == 0)) end--;
+    memcpy(out, text + start, end - start);
+    out[end - start] = 0;
+}
+
+/* An HW-FOC record's key: 1 with its value in *v, 0 for an unknown key. */
+static int foc_key(const hwfoc_foc_data *d, const char *key, long long *v) {
+    int16_t dc = 0;
+    if (!strcmp(key, "packet")) *v = d->packet;
+    else if (!strcmp(key, "throttle_in_raw")) *v = d->throttle_in_raw;
+    else if (!strcmp(key, "throttle_out_raw")) *v = d->throttle_out_raw;
+    else if (!strcmp(key, "erpm_raw")) *v = d->erpm_raw;
+    else if (!strcmp(key, "voltage_raw")) *v = d->voltage_raw;
+    else if (!strcmp(key, "current_raw")) *v = d->current_raw;
+    else if (!strcmp(key, "phase_current_raw")) *v = d->phase_current_raw;
+    else if (!strcmp(key, "mos_adc")) *v = d->mos_adc;
+    else if (!strcmp(key, "cap_adc")) *v = d->cap_adc;
+    else if (!strcmp(key, "status")) *v = d->status;
+    else if (!strcmp(key, "erpm")) *v = hwfoc_erpm_of_raw(d->erpm_raw);
+    else if (!strcmp(key, "rpm")) *v = hwfoc_rpm(hwfoc_erpm_of_raw(d->erpm_raw), 7, 1, 1);
+    else if (!strcmp(key, "mv")) *v = hwfoc_decivolts_mv(d->voltage_raw);
+    else if (!strcmp(key, "current_ma")) *v = hwfoc_foc_current_ma(d->current_raw);
+    else if (!strcmp(key, "phase_current_ma")) *v = hwfoc_foc_current_ma(d->phase_current_raw);
+    else if (!strcmp(key, "throttle_centipct")) *v = hwfoc_throttle_centipct(d->throttle_in_raw, 1024);
+    else if (!strcmp(key, "mos_dc")) { if (hwfoc_temp_decidegrees(d->mos_adc, &dc)) return 0; *v = dc; }
+    else if (!strcmp(key, "cap_dc")) { if (hwfoc_temp_decidegrees(d->cap_adc, &dc)) return 0; *v = dc; }
+    else return 0;
+    return 1;
+}
+
+static int v4_info_key(const hwfoc_v4_info *i, const char *key, long long *v) {
+    if (!strcmp(key, "full_scale")) *v = i->full_scale;
+    else if (!strcmp(key, "v1")) *v = i->v1;
+    else if (!strcmp(key, "v2")) *v = i->v2;
+    else if (!strcmp(key, "i1")) *v = i->i1;
+    else if (!strcmp(key, "i2")) *v = i->i2;
+    else if (!strcmp(key, "i3")) *v = i->i3;
+    else return 0;
+    return 1;
+}
+
+/* The value of `key` in the frame found: 1 (and *v or text), 0 for a key the format lacks. */
+static int vec_key(const char *format, const vec_frames *f, const char *key, long long *v, char *text) {
+    if (!strcmp(format, "foc")) {
+        const uint8_t *t = f->foc.info_text;
+        if (f->foc.kind == HWFOC_FOC_KIND_DATA) return foc_key(&f->foc.data, key, v);
+        if (!strcmp(key, "product")) info_field(t, 16, 32, text);
+        else if (!strcmp(key, "hardware")) info_field(t, 32, 48, text);
+        else if (!strcmp(key, "firmware")) info_field(t, 48, 64, text);
+        else if (!strcmp(key, "id")) info_field(t, 64, 72, text);
+        else return 0;
+        return 2;
+    }
+    if (!strcmp(format, "datalink")) {
+        unsigned ch;
+        if (!strcmp(key, "counter")) *v = f->dl.counter;
+        else if (!strcmp(key, "slots")) *v = f->dl.present;
+        else if (key[0] == 'c' && key[1] == 'h' && key[2] >= '0' && key[2] <= '7' && key[3] == '.') {
+            ch = (unsigned)(key[2] - '0');
+            return ((unsigned)f->dl.present >> ch & 1u) && foc_key(&f->dl.slots[ch], key + 4, v);
+        } else return 0;
+        return 1;
+    }
+    if (!strcmp(format, "v3")) {
+        const hwfoc_v3_frame *d = &f->v3;
+        if (!strcmp(key, "counter")) *v = d->counter;
+        else if (!strcmp(key, "throttle_in_raw")) *v = d->throttle_in_raw;
+        else if (!strcmp(key, "pwm_out_raw")) *v = d->pwm_out_raw;
+        else if (!strcmp(key, "period_us")) *v = d->period_us;
+        else if (!strcmp(key, "erpm")) *v = hwfoc_v3_erpm(d->period_us);
+        else if (!strcmp(key, "throttle_centipct")) *v = hwfoc_throttle_centipct(d->throttle_in_raw, HWFOC_V3_FULL_SCALE);
+        else return 0;
+        return 1;
+    }
+    if (!strcmp(format, "v4")) {
+        const hwfoc_v4_frame *g = &f->v4;
+        const hwfoc_v4_data *d = &g->data;
+        unsigned full = g->has_info ? g->info.full_scale : HWFOC_V4_DEFAULT_FULL_SCALE;
+        if (g->kind == HWFOC_V4_KIND_INFO) return v4_info_key(&g->info, key, v);
+        if (!strcmp(key, "counter")) *v = d->counter;
+        else if (!strcmp(key, "throttle_in_raw")) *v = d->throttle_in_raw;
+        else if (!strcmp(key, "throttle_out_raw")) *v = d->throttle_out_raw;
+        else if (!strcmp(key, "erpm")) *v = d->erpm;
+        else if (!strcmp(key, "voltage_adc")) *v = d->voltage_adc;
+        else if (!strcmp(key, "current_adc")) *v = d->current_adc;
+        else if (!strcmp(key, "temp_adc")) *v = d->temp_adc;
+        else if (!strcmp(key, "temp2_adc")) *v = d->temp2_adc;
+        else if (!strcmp(key, "has_info")) *v = g->has_info;
+        else if (!strcmp(key, "full_scale")) *v = full;
+        else if (!strcmp(key, "mv"))
+            *v = g->has_info ? hwfoc_v4_voltage_mv(d->voltage_adc, g->info.v1, (uint16_t)(g->info.v2 * 10u))
+                             : hwfoc_v4_voltage_mv(d->voltage_adc, 8, 910);
+        else if (!strcmp(key, "current_ma")) {
+            if (!g->has_info || !g->info.i1) return 0;
+            *v = hwfoc_v4_current_ma(d->current_adc, &g->info);
+        } else if (!strcmp(key, "throttle_centipct")) *v = hwfoc_throttle_centipct(d->throttle_in_raw, full);
+        else return 0;
+        return 1;
+    }
+    if (!strcmp(format, "hw5")) {
+        const hwfoc_hw5_frame *d = &f->hw5;
+        if (!strcmp(key, "throttle")) *v = d->throttle;
+        else if (!strcmp(key, "fault")) *v = d->fault;
+        else if (!strcmp(key, "erpm_raw")) *v = d->erpm_raw;
+        else if (!strcmp(key, "erpm")) *v = hwfoc_erpm_of_raw(d->erpm_raw);
+        else if (!strcmp(key, "voltage_raw")) *v = d->voltage_raw;
+        else if (!strcmp(key, "mv")) *v = hwfoc_decivolts_mv(d->voltage_raw);
+        else if (!strcmp(key, "current_raw")) *v = d->current_raw;
+        else if (!strcmp(key, "current_ma")) *v = hwfoc_decivolts_mv(d->current_raw); /* deciamps: x100 mA */
+        else if (!strcmp(key, "esc_temp")) *v = d->esc_temp;
+        else if (!strcmp(key, "bec_temp")) *v = d->bec_temp;
+        else if (!strcmp(key, "motor_temp")) *v = d->motor_temp;
+        else if (!strcmp(key, "bec_voltage_raw")) *v = d->bec_voltage_raw;
+        else if (!strcmp(key, "bec_mv")) *v = hwfoc_decivolts_mv(d->bec_voltage_raw);
+        else if (!strcmp(key, "bec_current_raw")) *v = d->bec_current_raw;
+        else if (!strcmp(key, "bec_current_ma")) *v = hwfoc_decivolts_mv(d->bec_current_raw);
+        else return 0;
+        return 1;
+    }
+    return 0;
+}
+
+static uint8_t vec_bytes[1024];
+
+/* Checks every vector of the file at `path`; returns the number of values checked. */
+static int test_vectors(const char *path) {
+    static char line[4096];
+    int lineno = 0, values = 0;
+    FILE *file = fopen(path, "r");
+    if (!file) {
+        fprintf(stderr, "%s: cannot open\n", path);
+        failures++;
+        return 0;
+    }
+    while (fgets(line, sizeof line, file)) {
+        char *format, *hex, *word, *eq, text[80];
+        size_t n = 0, k;
+        vec_frames f;
+        long long v = 0;
+        lineno++;
+        format = strtok(line, " \t\r\n");
+        if (!format || format[0] == '#') continue;
+        hex = strtok(NULL, " \t\r\n");
+        for (k = 0; hex && hex[k] && hex[k + 1] && n < sizeof vec_bytes; k += 2) {
+            unsigned byte;
+            if (sscanf(hex + k, "%2x", &byte) != 1) break;
+            vec_bytes[n++] = (uint8_t)byte;
+        }
+        memset(&f, 0, sizeof f);
+        while ((word = strtok(NULL, " \t\r\n")) != NULL) {
+            int got;
+            if (!(eq = strchr(word, '='))) { fprintf(stderr, "%s:%d: %s\n", path, lineno, word); failures++; continue; }
+            *eq++ = 0;
+            if (!strcmp(word, "frame")) {
+                static hwfoc_foc_decoder fd; static hwfoc_dl_decoder dd; static hwfoc_v3_decoder d3;
+                static hwfoc_v4_decoder d4; static hwfoc_hw5_decoder d5;
+                f.want = (size_t)atoi(eq);
+                if (!strcmp(format, "foc")) { hwfoc_foc_init(&fd); hwfoc_foc_feed(&fd, vec_bytes, n, vec_foc, &f); hwfoc_foc_flush(&fd, vec_foc, &f); }
+                else if (!strcmp(format, "datalink")) { hwfoc_dl_init(&dd); hwfoc_dl_feed(&dd, vec_bytes, n, vec_dl, &f); hwfoc_dl_flush(&dd, vec_dl, &f); }
+                else if (!strcmp(format, "v3")) { hwfoc_v3_init(&d3); hwfoc_v3_feed(&d3, vec_bytes, n, vec_v3, &f); hwfoc_v3_flush(&d3, vec_v3, &f); }
+                else if (!strcmp(format, "v4")) { hwfoc_v4_init(&d4); hwfoc_v4_feed(&d4, vec_bytes, n, vec_v4, &f); hwfoc_v4_flush(&d4, vec_v4, &f); }
+                else if (!strcmp(format, "hw5")) { hwfoc_hw5_init(&d5); hwfoc_hw5_feed(&d5, vec_bytes, n, vec_hw5, &f); hwfoc_hw5_flush(&d5, vec_hw5, &f); }
+                if (!f.found) { fprintf(stderr, "%s:%d: no frame %s of %s\n", path, lineno, eq, format); failures++; break; }
+                continue;
+            }
+            got = vec_key(format, &f, word, &v, text);
+            if (got == 0) { fprintf(stderr, "%s:%d: %s has no %s\n", path, lineno, format, word); failures++; }
+            else if (got == 2 && strcmp(text, eq)) { fprintf(stderr, "%s:%d: %s is %s, not %s\n", path, lineno, word, text, eq); failures++; }
+            else if (got == 1 && v != atoll(eq)) { fprintf(stderr, "%s:%d: %s is %lld, not %s\n", path, lineno, word, v, eq); failures++; }
+            values++;
+        }
+    }
+    fclose(file);
+    return values;
+}
+
+int main(int argc, char **argv) {
+    int values;
     test_crcs();
     test_foc();
     test_dl();
@@ -268,10 +469,12 @@ int main(void) {
     test_hw5();
     test_noise();
     test_conversions();
+    values = test_vectors(argc > 1 ? argv[1] : "vectors.txt");
+    CHECK(values >= 100);
     if (failures) {
         fprintf(stderr, "hwfoc.h C tests: %d failures\n", failures);
         return 1;
     }
-    printf("hwfoc.h C tests: ok\n");
+    printf("hwfoc.h C tests: ok (%d golden values)\n", values);
     return 0;
 }
