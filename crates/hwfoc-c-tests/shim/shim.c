@@ -38,6 +38,13 @@ static void put_seq(shim *s, const hwfoc_sequence *q, uint64_t none) {
     put(s, q->count ? q->last : none);
 }
 
+/* A chained scanner's counts and where its chain ends (V3 and V4). */
+static void put_chain(shim *s, const hwfoc_chain_counts *c, int has_chain, uint64_t chain_end) {
+    put(s, c->bytes); put(s, c->bytes_skipped); put(s, c->implausible); put(s, c->unconfirmed); put(s, c->syncs);
+    put_seq(s, &c->counter, UINT64_MAX);
+    put(s, has_chain ? chain_end : UINT64_MAX);
+}
+
 static void put_foc_data(shim *s, const hwfoc_foc_data *f) {
     put(s, f->packet); put(s, f->throttle_in_raw); put(s, f->throttle_out_raw); put(s, f->erpm_raw);
     put(s, f->voltage_raw); put(s, (uint16_t)f->current_raw); put(s, (uint16_t)f->phase_current_raw);
@@ -188,18 +195,12 @@ long shim_stats(shim *s, const uint64_t **out) {
     }
     case V3: {
         const hwfoc_v3_stats *t = &s->d.v3.stats;
-        put(s, t->counts.bytes); put(s, t->counts.bytes_skipped); put(s, t->counts.implausible);
-        put(s, t->counts.unconfirmed); put(s, t->counts.syncs);
-        put_seq(s, &t->counts.counter, none);
-        put(s, t->has_chain ? t->chain_end : none);
+        put_chain(s, &t->counts, t->has_chain, t->chain_end);
         break;
     }
     case V4: {
         const hwfoc_v4_stats *t = &s->d.v4.stats;
-        put(s, t->counts.bytes); put(s, t->counts.bytes_skipped); put(s, t->counts.implausible);
-        put(s, t->counts.unconfirmed); put(s, t->counts.syncs);
-        put_seq(s, &t->counts.counter, none);
-        put(s, t->has_chain ? t->chain_end : none);
+        put_chain(s, &t->counts, t->has_chain, t->chain_end);
         put(s, t->info_frames); put(s, t->adoptions); put(s, t->disagreements); put(s, t->trailers);
         put(s, t->has_last_info);
         if (t->has_last_info) put_v4_info(s, &t->last_info);

@@ -32,6 +32,17 @@ fn sequence<W: Width>(s: &Sequence<W>, out: &mut Vec<u64>) {
     out.push(s.last().map_or(NONE, |n| u64::from(n.into())));
 }
 
+/// A chained scanner's counts and where its chain ends (V3's and V4's statistics, which name
+/// them alike).
+macro_rules! chain_stats {
+    ($s:expr, $out:expr) => {
+        $out.extend([$s.bytes(), $s.bytes_skipped()]);
+        $out.extend([$s.implausible(), $s.unconfirmed(), $s.syncs()].map(u64::from));
+        sequence($s.counter(), $out);
+        $out.push(opt($s.chain_end()));
+    };
+}
+
 fn foc_data(f: &foc::DataFrame, out: &mut Vec<u64>) {
     out.extend(
         [
@@ -136,10 +147,7 @@ impl Flat for v3::Scanner {
         out.extend([f.throttle_in_raw, f.pwm_out_raw, f.period_us].map(u64::from));
     }
     fn stats(s: &v3::Stats, out: &mut Vec<u64>) {
-        out.extend([s.bytes(), s.bytes_skipped()]);
-        out.extend([s.implausible(), s.unconfirmed(), s.syncs()].map(u64::from));
-        sequence(s.counter(), out);
-        out.push(opt(s.chain_end()));
+        chain_stats!(s, out);
     }
     fn encode(item: &v3::Decoded) -> Vec<u8> {
         item.frame.encode().to_vec()
@@ -166,10 +174,7 @@ impl Flat for v4::Scanner {
         }
     }
     fn stats(s: &v4::Stats, out: &mut Vec<u64>) {
-        out.extend([s.bytes(), s.bytes_skipped()]);
-        out.extend([s.implausible(), s.unconfirmed(), s.syncs()].map(u64::from));
-        sequence(s.counter(), out);
-        out.push(opt(s.chain_end()));
+        chain_stats!(s, out);
         out.extend(
             [
                 s.info_frames(),
