@@ -11,10 +11,12 @@
  *   V3          hwfoc_v3_*    Hobbywing V3 (Platinum Pro V3), 19200 baud
  *   V4          hwfoc_v4_*    Hobbywing V4 (Platinum V4, XRotor V4), 19200 baud, info frame
  *   HW5         hwfoc_hw5_*   HW5 telemetry, 115200 baud, CRC-16/MODBUS
+ *   DroneCAN    hwfoc_can_*   payloads of com.hobbywing.esc and the standard ESC messages, for
+ *                             a driver with its own transfer layer (PX4's, ArduPilot's, libcanard)
  *
  * Use: in exactly one C file, `#define HWFOC_IMPLEMENTATION` before `#include "hwfoc.h"`.
  * Leave out formats with HWFOC_NO_FOC, HWFOC_NO_DATALINK, HWFOC_NO_V3, HWFOC_NO_V4,
- * HWFOC_NO_HW5; HWFOC_FLOAT adds float helpers (the core has no floating point).
+ * HWFOC_NO_HW5, HWFOC_NO_CAN; HWFOC_FLOAT adds float helpers (the core has no floating point).
  *
  * Every decoder is a struct the caller owns (no allocation, no stdio, no globals), fed bytes
  * one at a time (`_push`, from a UART interrupt's queue) or in chunks (`_feed`); each frame
@@ -371,6 +373,57 @@ void hwfoc_hw5_encode(const hwfoc_hw5_frame *f, uint8_t out[HWFOC_HW5_TELEMETRY_
 const char *hwfoc_hw5_fault_name(unsigned bit);
 #endif
 
+/* ---------------------------------------------------------------- DroneCAN payloads */
+#ifndef HWFOC_NO_CAN
+/** The longest payload of these data types. */
+#define HWFOC_CAN_MAX_PAYLOAD 14u
+
+/** The data types of fixed layout whose payloads hwfoc_can_pack and hwfoc_can_unpack handle:
+ *  Hobbywing's com.hobbywing.esc messages and services, and the standard uavcan ones an ESC
+ *  sends. Their fields, in DSDL order, are given as int32 (unsigned fields in their width;
+ *  signed fields sign-extended; EscStatus's float16 fields as their 16 raw bits). */
+typedef enum hwfoc_can_type {
+    HWFOC_CAN_STATUS_MSG1,                /**< rpm u16, pwm u16, status u16 */
+    HWFOC_CAN_STATUS_MSG2,                /**< input_voltage i16 (0.1 V), current i16 (0.1 A), temperature u8 */
+    HWFOC_CAN_STATUS_MSG3,                /**< mos_t u8, cap_t u8, motor_t u8 */
+    HWFOC_CAN_NODE_STATUS,                /**< uptime_sec u32, health u2, mode u3, sub_mode u3, vendor u16 */
+    HWFOC_CAN_ESC_STATUS,                 /**< error_count u32, voltage f16, current f16, temperature f16 (K), rpm i18, power_rating_pct u7, esc_index u5 */
+    HWFOC_CAN_ESC_STATUS_EXTENDED,        /**< input_pct u7, output_pct u7, motor_temperature_deg_c i9, motor_angle u9, status_flags u19, esc_index u5 */
+    HWFOC_CAN_SET_ID_REQUEST,             /**< node_id u8, throttle_channel u8 (1-indexed) */
+    HWFOC_CAN_SET_ID_RESPONSE,            /**< node_id u8, throttle_channel u8 */
+    HWFOC_CAN_SET_BAUD_REQUEST,           /**< baud u8 */
+    HWFOC_CAN_SET_BAUD_RESPONSE,          /**< (empty) */
+    HWFOC_CAN_SET_LED_REQUEST,            /**< option u8, color u8, blink u8 */
+    HWFOC_CAN_SET_LED_RESPONSE,           /**< option u8, color u8, blink u8 */
+    HWFOC_CAN_SET_DIRECTION_REQUEST,      /**< direction u8 */
+    HWFOC_CAN_SET_DIRECTION_RESPONSE,     /**< direction u8 */
+    HWFOC_CAN_SET_REPORTING_FREQUENCY_REQUEST,  /**< option u8, msg_id u16, rate u8 */
+    HWFOC_CAN_SET_REPORTING_FREQUENCY_RESPONSE, /**< option u8, msg_id u16, rate u8 */
+    HWFOC_CAN_SET_THROTTLE_SOURCE_REQUEST,  /**< source u8 */
+    HWFOC_CAN_SET_THROTTLE_SOURCE_RESPONSE, /**< source u8 */
+    HWFOC_CAN_SELF_TEST_REQUEST,          /**< (empty) */
+    HWFOC_CAN_SELF_TEST_RESPONSE,         /**< status u8 */
+    HWFOC_CAN_SET_ANGLE_REQUEST,          /**< option u8, angle u16 */
+    HWFOC_CAN_GET_MAINTENANCE_INFORMATION_REQUEST,  /**< option u8 */
+    HWFOC_CAN_GET_MAINTENANCE_INFORMATION_RESPONSE, /**< total_rotation_time_min u32, time_since_maintenance_min u24 */
+    HWFOC_CAN_GET_MAJOR_CONFIG_REQUEST,   /**< option u8 */
+    HWFOC_CAN_GET_MAJOR_CONFIG_RESPONSE,  /**< direction u1, throttle_source u1, throttle_channel u6, led_status u5, led_color u3, msg2_rate u4, msg1_rate u4, positioning_angle u16, reserved u16 */
+    HWFOC_CAN_TYPES
+} hwfoc_can_type;
+
+/** The most fields of any of these types. */
+#define HWFOC_CAN_MAX_FIELDS 9u
+
+/** How many fields `type` has (0 for an unknown type). */
+unsigned hwfoc_can_fields(hwfoc_can_type type);
+/** Packs the fields into `out`; returns the payload's length. A value beyond its field's range
+ *  is saturated (as the Rust codec does). */
+size_t hwfoc_can_pack(hwfoc_can_type type, const int32_t *fields, uint8_t out[HWFOC_CAN_MAX_PAYLOAD]);
+/** Unpacks a payload of exactly the type's length into `fields`; returns 0, or -1 for another
+ *  length or an unknown type. */
+int hwfoc_can_unpack(hwfoc_can_type type, const uint8_t *payload, size_t len, int32_t *fields);
+#endif
+
 /* ---------------------------------------------------------------- conversions (integer) */
 /** Hundredths of a percent of `raw` out of `full_scale` (HW-FOC: 1024; V3: 255; V4: info's). */
 uint32_t hwfoc_throttle_centipct(uint32_t raw, uint32_t full_scale);
@@ -499,6 +552,8 @@ uint16_t hwfoc_crc16_modbus(const uint8_t *p, size_t n) {
     return (uint16_t)crc;
 }
 
+#if !defined(HWFOC_NO_FOC) || !defined(HWFOC_NO_DATALINK) || !defined(HWFOC_NO_V3) || \
+    !defined(HWFOC_NO_V4) || !defined(HWFOC_NO_HW5)
 /* The streaming layer (the Rust `scan::StreamDecoder`), shared by every format: bytes are taken
  * one at a time, as the Rust decoder's `push` takes them (the same frames and statistics for any
  * chunking), onto the candidate held (at most max_len bytes), which is scanned as soon as its
@@ -608,6 +663,7 @@ static void hwfoc__flush(const hwfoc__format *fmt, void *d, hwfoc__any_cb cb, vo
         SILENT;                                                                                     \
     }                                                                                               \
     void PFX##_init(DEC *d) { memset(d, 0, sizeof *d); }
+#endif
 
 /* ---------------------------------------------------------------- HW-FOC implementation */
 #if !defined(HWFOC_NO_FOC) || !defined(HWFOC_NO_DATALINK)
@@ -1229,6 +1285,104 @@ static int hwfoc_hw5_take(void *dec, const uint8_t *c, size_t n, uint64_t at, in
 HWFOC__STREAM(hwfoc_hw5, hwfoc_hw5_decoder, hwfoc_hw5_cb, bytes, bytes_skipped,
               hwfoc__next_byte, hwfoc__hw5_find, NULL,
               (void)d; (void)max_frames)
+#endif
+
+/* ---------------------------------------------------------------- DroneCAN implementation */
+#ifndef HWFOC_NO_CAN
+/* Each type's fields: a width of 1..32 bits, 0x40 added for a signed field, 0x80 for a float16
+ * (packed as the Rust codec packs it from a float: infinities saturated to +-65504, any NaN
+ * made 0x7FFF with its sign); 0 ends the list. */
+#define HWFOC__S 0x40u
+#define HWFOC__F 0x80u
+static const uint8_t hwfoc__can_layout[HWFOC_CAN_TYPES][HWFOC_CAN_MAX_FIELDS + 1] = {
+    {16, 16, 16},
+    {16 | HWFOC__S, 16 | HWFOC__S, 8},
+    {8, 8, 8},
+    {32, 2, 3, 3, 16},
+    {32, 16 | HWFOC__F, 16 | HWFOC__F, 16 | HWFOC__F, 18 | HWFOC__S, 7, 5},
+    {7, 7, 9 | HWFOC__S, 9, 19, 5},
+    {8, 8},
+    {8, 8},
+    {8},
+    {0},
+    {8, 8, 8},
+    {8, 8, 8},
+    {8},
+    {8},
+    {8, 16, 8},
+    {8, 16, 8},
+    {8},
+    {8},
+    {0},
+    {8},
+    {8, 16},
+    {8},
+    {32, 24},
+    {8},
+    {1, 1, 6, 5, 3, 4, 4, 16, 16}};
+
+unsigned hwfoc_can_fields(hwfoc_can_type type) {
+    unsigned n = 0;
+    if ((unsigned)type >= HWFOC_CAN_TYPES) return 0;
+    while (n < HWFOC_CAN_MAX_FIELDS && hwfoc__can_layout[type][n]) n++;
+    return n;
+}
+
+static unsigned hwfoc__can_bits(hwfoc_can_type type) {
+    unsigned i, bits = 0;
+    for (i = 0; i < hwfoc_can_fields(type); i++) bits += hwfoc__can_layout[type][i] & 0x3Fu;
+    return bits;
+}
+
+/* DroneCAN's bit order: a value's bytes little-endian, each byte's bits (the last byte's low
+ * bits only) most significant first. */
+size_t hwfoc_can_pack(hwfoc_can_type type, const int32_t *fields, uint8_t out[HWFOC_CAN_MAX_PAYLOAD]) {
+    unsigned i, k, bit = 0;
+    memset(out, 0, HWFOC_CAN_MAX_PAYLOAD);
+    for (i = 0; i < hwfoc_can_fields(type); i++) {
+        unsigned width = hwfoc__can_layout[type][i] & 0x3Fu, left = width;
+        uint32_t max = width == 32 ? 0xFFFFFFFFu : (1u << width) - 1u, value;
+        if (hwfoc__can_layout[type][i] & HWFOC__S) {
+            int32_t most = (int32_t)(max >> 1), v = fields[i];
+            v = v > most ? most : v < -most - 1 ? -most - 1 : v;
+            value = (uint32_t)v & max;
+        } else {
+            value = (uint32_t)fields[i] > max ? max : (uint32_t)fields[i];
+            if ((hwfoc__can_layout[type][i] & HWFOC__F) && (value & 0x7C00u) == 0x7C00u)
+                value = (value & 0x8000u) | (value & 0x03FFu ? 0x7FFFu : 0x7BFFu);
+        }
+        while (left) {
+            unsigned n = left < 8 ? left : 8;
+            for (k = n; k-- > 0; bit++)
+                if (value >> k & 1u) out[bit / 8] = (uint8_t)(out[bit / 8] | 0x80u >> (bit % 8));
+            value >>= 8;
+            left -= n;
+        }
+    }
+    return (hwfoc__can_bits(type) + 7u) / 8u;
+}
+
+int hwfoc_can_unpack(hwfoc_can_type type, const uint8_t *payload, size_t len, int32_t *fields) {
+    unsigned i, k, bit = 0;
+    if ((unsigned)type >= HWFOC_CAN_TYPES || len != (hwfoc__can_bits(type) + 7u) / 8u) return -1;
+    for (i = 0; i < hwfoc_can_fields(type); i++) {
+        unsigned width = hwfoc__can_layout[type][i] & 0x3Fu, left = width, shift = 0;
+        uint32_t value = 0;
+        while (left) {
+            unsigned n = left < 8 ? left : 8, byte = 0;
+            for (k = 0; k < n; k++, bit++) byte = byte << 1 | ((unsigned)payload[bit / 8] >> (7u - bit % 8) & 1u);
+            value |= (uint32_t)byte << shift;
+            shift += 8;
+            left -= n;
+        }
+        if ((hwfoc__can_layout[type][i] & HWFOC__S) && width < 32 && (value >> (width - 1) & 1u))
+            value |= ~0u << width; /* sign-extended */
+        fields[i] = (int32_t)value;
+    }
+    return 0;
+}
+#undef HWFOC__S
+#undef HWFOC__F
 #endif
 
 /* ---------------------------------------------------------------- conversions */

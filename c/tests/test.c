@@ -246,6 +246,20 @@ static void test_noise(void) {
     }
 }
 
+/* DroneCAN payloads: a StatusMsg1 little-endian, EscStatus's 18-bit signed rpm across bytes. */
+static void test_can(void) {
+    int32_t in[HWFOC_CAN_MAX_FIELDS] = {0x1234, 500, 0x4000}, out[HWFOC_CAN_MAX_FIELDS];
+    uint8_t p[HWFOC_CAN_MAX_PAYLOAD];
+    CHECK(hwfoc_can_pack(HWFOC_CAN_STATUS_MSG1, in, p) == 6);
+    CHECK(p[0] == 0x34 && p[1] == 0x12 && p[2] == 0xF4 && p[3] == 0x01 && p[5] == 0x40);
+    CHECK(hwfoc_can_unpack(HWFOC_CAN_STATUS_MSG1, p, 6, out) == 0 && out[0] == 0x1234 && out[2] == 0x4000);
+    CHECK(hwfoc_can_unpack(HWFOC_CAN_STATUS_MSG1, p, 5, out) == -1);
+    in[0] = 7; in[1] = 0x3C00; in[2] = 0; in[3] = 0x5C00; in[4] = -1000; in[5] = 200; in[6] = 3;
+    CHECK(hwfoc_can_pack(HWFOC_CAN_ESC_STATUS, in, p) == 14);
+    CHECK(hwfoc_can_unpack(HWFOC_CAN_ESC_STATUS, p, 14, out) == 0 && out[4] == -1000 && out[5] == 127 && out[6] == 3);
+    CHECK(hwfoc_can_fields(HWFOC_CAN_GET_MAJOR_CONFIG_RESPONSE) == 9 && hwfoc_can_fields(HWFOC_CAN_TYPES) == 0);
+}
+
 static void test_conversions(void) {
     int16_t dc = 0;
     CHECK(hwfoc_foc_current_ma(64) == 1000 && hwfoc_foc_current_ma(-1) == -15);
@@ -469,6 +483,7 @@ int main(int argc, char **argv) {
     test_hw5();
     test_noise();
     test_conversions();
+    test_can();
     values = test_vectors(argc > 1 ? argv[1] : "vectors.txt");
     CHECK(values >= 100);
     if (failures) {

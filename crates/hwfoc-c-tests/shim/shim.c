@@ -297,3 +297,14 @@ size_t shim_encode(int format, const uint64_t *p, uint8_t *out) {
     }
     }
 }
+
+/* The header's DroneCAN payload codec: unpack `payload` as `type` into `fields` (returns the
+ * count of fields, or -1), and pack `fields` (returns the payload's length). */
+int shim_can_unpack(int type, const uint8_t *payload, size_t len, int32_t *fields) {
+    if (hwfoc_can_unpack((hwfoc_can_type)type, payload, len, fields) != 0) return -1;
+    return (int)hwfoc_can_fields((hwfoc_can_type)type);
+}
+
+size_t shim_can_pack(int type, const int32_t *fields, uint8_t *out) {
+    return hwfoc_can_pack((hwfoc_can_type)type, fields, out);
+}

@@ -16,6 +16,30 @@ unsafe extern "C" {
     fn shim_take_frames(s: *mut Shim, out: *mut *const u64) -> c_long;
     fn shim_stats(s: *mut Shim, out: *mut *const u64) -> c_long;
     fn shim_encode(format: c_int, flat: *const u64, out: *mut u8) -> usize;
+    fn shim_can_unpack(kind: c_int, payload: *const u8, len: usize, fields: *mut i32) -> c_int;
+    fn shim_can_pack(kind: c_int, fields: *const i32, out: *mut u8) -> usize;
+}
+
+/// The most fields of a DroneCAN type (`HWFOC_CAN_MAX_FIELDS`).
+pub const CAN_MAX_FIELDS: usize = 9;
+
+/// `hwfoc_can_unpack` of `payload` as the header's type number `kind`: its fields, or `None`
+/// for a payload of another length.
+pub fn can_unpack(kind: i32, payload: &[u8]) -> Option<Vec<i32>> {
+    let mut fields = [0i32; CAN_MAX_FIELDS];
+    // SAFETY: `payload` is valid for its length; the header writes at most 9 fields.
+    let n = unsafe { shim_can_unpack(kind, payload.as_ptr(), payload.len(), fields.as_mut_ptr()) };
+    usize::try_from(n).ok().map(|n| fields[..n].to_vec())
+}
+
+/// `hwfoc_can_pack` of `fields` (padded with zeros to 9) as type `kind`: the payload.
+pub fn can_pack(kind: i32, fields: &[i32]) -> Vec<u8> {
+    let mut padded = [0i32; CAN_MAX_FIELDS];
+    padded[..fields.len()].copy_from_slice(fields);
+    let mut out = [0u8; 14];
+    // SAFETY: the header reads at most 9 fields and writes at most 14 bytes.
+    let n = unsafe { shim_can_pack(kind, padded.as_ptr(), out.as_mut_ptr()) };
+    out[..n].to_vec()
 }
 
 /// The bytes the header's encoder of `format` writes for the frame whose flat form
