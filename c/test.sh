@@ -33,4 +33,24 @@ gcc "${san[@]}" "${strict[@]}" "$here/tests/test.c" -o "$out/test" -lm
 "$out/test" "$here/tests/vectors.txt"
 gcc "${san[@]}" -D_POSIX_C_SOURCE=200809L "${strict[@]}" -I"$here" "$here/examples/serial.c" -o "$out/serial"
 "$out/serial" --self-test
+
+# The example against the simulator, every serial format it speaks: as many frames printed as
+# the simulator says it sent (data and device-information frames). Needs the hwfoc binary:
+# $HWFOC, else target/debug/hwfoc (built by the workspace's tests); skipped without it.
+hwfoc=${HWFOC:-$here/../target/debug/hwfoc}
+if [ -x "$hwfoc" ]; then
+  for pair in hw-foc:foc hw-v3:v3 hw-v4:v4 hw5:hw5; do
+    protocol=${pair%%:*} format=${pair##*:}
+    said=$("$hwfoc" simulate --protocol "$protocol" --escs 1 --duration 5 -o "$out/sim-$format.bin" 2>&1 | tail -1)
+    sent=$(echo "$said" | grep -oE '[0-9]+ (data|device-information) frames' | awk '{ n += $1 } END { print n + 0 }')
+    printed=$("$out/serial" "$out/sim-$format.bin" "$format" | wc -l)
+    if [ "$sent" -eq 0 ] || [ "$printed" -ne "$sent" ]; then
+      echo "c/test.sh: $protocol: the example printed $printed frames, the simulator sent $sent ($said)" >&2
+      exit 1
+    fi
+    echo "c/test.sh: $protocol: the example printed all $sent frames of the simulator"
+  done
+else
+  echo "c/test.sh: no hwfoc binary at $hwfoc: the check against the simulator is skipped" >&2
+fi
 echo "c/test.sh: ok"
