@@ -3,7 +3,8 @@
 //! as the same flat lists of integers ([`flat`]) so that a test compares them whole.
 //!
 //! Nothing in the workspace depends on this crate; its tests are the differential test
-//! (`tests/differential.rs`) and the golden vectors (`tests/vectors.rs`).
+//! (`tests/differential.rs`), the golden vectors (`tests/vectors.rs`) and the DroneCAN payloads
+//! (`tests/dronecan.rs`).
 
 pub mod ffi;
 pub mod flat;
