@@ -354,7 +354,12 @@ fn adversarial_byte() -> impl Strategy<Value = u8> {
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig::with_cases(400))]
+    // No regression files: the project keeps none.
+    #![proptest_config(ProptestConfig {
+        cases: 400,
+        failure_persistence: None,
+        ..ProptestConfig::default()
+    })]
 
     /// Random and adversarial bytes, and frames spliced into them, in random chunkings.
     #[test]
