@@ -1,0 +1,17 @@
+//! Compiles `c/hwfoc.h` (through `shim/shim.c`) with the `cc` crate, with the warnings the
+//! header promises to build clean under made errors.
+
+fn main() {
+    let header_dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../../c");
+    println!("cargo:rerun-if-changed=shim/shim.c");
+    println!("cargo:rerun-if-changed={header_dir}/hwfoc.h");
+    cc::Build::new()
+        .file("shim/shim.c")
+        .include(header_dir)
+        .std("c99")
+        .flag_if_supported("-Wall")
+        .flag_if_supported("-Wextra")
+        .flag_if_supported("-Wpedantic")
+        .warnings_into_errors(true)
+        .compile("hwfoc_c_shim");
+}
