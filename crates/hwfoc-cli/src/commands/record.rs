@@ -640,12 +640,7 @@ impl Recorder {
                 .is_some_and(|t| t.elapsed() >= SILENT_AFTER)
             {
                 state.silent_since = None;
-                eprintln!(
-                    "hwfoc: warning: {}: nothing received in {} s: is the ESC powered, and its \
-                     telemetry wire on the adapter's RX pin (not TX)?",
-                    Escaped(&state.name),
-                    SILENT_AFTER.as_secs()
-                );
+                eprintln!("hwfoc: warning: {}", silent_warning(state));
             }
         }
         Ok(())
@@ -785,6 +780,24 @@ fn can_status(name: &str, bitrate: Option<u32>, nodes: u32, frames: u64) -> Stri
 fn rates_text() -> String {
     let rates: Vec<String> = SEARCH_RATES.iter().map(u32::to_string).collect();
     rates.join(" and ")
+}
+
+/// The warning for a port that received nothing in [`SILENT_AFTER`]: in CAN words for a bus.
+fn silent_warning(state: &PortState) -> String {
+    let name = Escaped(&state.name);
+    let secs = SILENT_AFTER.as_secs();
+    match state.can {
+        Some(bitrate) => format!(
+            "{name}: no CAN frame in {secs} s{}: is the adapter on the bus and are the ESCs \
+             powered, at the bus's bit rate (Hobbywing's DroneCAN ESCs are 500 kbit/s from the \
+             factory)?",
+            bitrate.map_or(String::new(), |b| format!(" at {b} bit/s"))
+        ),
+        None => format!(
+            "{name}: nothing received in {secs} s: is the ESC powered, and its telemetry wire \
+             on the adapter's RX pin (not TX)?"
+        ),
+    }
 }
 
 /// The warning for port `name`, read at `baud` (`None`: at every rate searched), whose `bytes`
@@ -960,6 +973,28 @@ mod tests {
             ),
             "{forced}"
         );
+    }
+
+    /// A silent CAN bus is told of in CAN words (bit rates, frames), a serial port in serial
+    /// ones (the RX wire).
+    #[test]
+    fn a_silent_bus_is_told_of_in_can_words() {
+        let state = |name: &str| PortState {
+            name: name.to_string(),
+            unframed_since: None,
+            unframed_bytes: 0,
+            warned_unframed: false,
+            silent_since: None,
+            lost_at: None,
+            can: can_bus(name),
+            can_frames: 0,
+            can_nodes: 0,
+        };
+        let bus = silent_warning(&state("slcan:/dev/ttyACM0:250000"));
+        assert!(bus.contains("no CAN frame in 5 s at 250000 bit/s"), "{bus}");
+        assert!(bus.contains("500 kbit/s") && !bus.contains("baud") && !bus.contains("RX"));
+        let port = silent_warning(&state("/dev/ttyUSB0"));
+        assert!(port.contains("RX pin"), "{port}");
     }
 
     #[test]
