@@ -1,0 +1,165 @@
+//! `candump`'s own text (can-utils, without `-l`), with times (`-ta`, `-tA`) as an input: one
+//! CAN stream per interface.
+//!
+//! A line is an optional time in parentheses (`-ta`: Unix seconds; `-tA`: a local date and
+//! time, `2023-11-14 22:13:20.007000`), the interface, the id (3 hex digits standard, 8
+//! extended), the length in brackets and the data bytes in hex (`  can0  123   [3]  11 22 33`),
+//! or `remote request` for a remote frame. CAN FD frames have their length in brackets of two
+//! digits (`[64]`). A log without times (`candump` without `-t`) is refused as such: its
+//! frames have no time to be records of.
+//!
+//! Written here: no crate reads candump's text.
+
+use std::io::Read;
+
+use jiff::civil::DateTime;
+use jiff::tz::TimeZone;
+
+use super::can_log::{CanLogReader, Entry, Frames, Lines, decimal_ns, frame};
+use super::{InputError, InputFormat};
+use crate::can::candump::Logged;
+use crate::time::Clock;
+
+impl InputFormat {
+    /// `candump`'s text with times: one CAN stream per interface, times its own.
+    pub const CANDUMP_TEXT: InputFormat = InputFormat {
+        name: "candump text",
+        short_name: "candump-text",
+        clock: Clock::Wall,
+        live: false,
+        recorded_ports: true,
+    };
+}
+
+/// What the log is called in its errors.
+const WHAT: &str = "candump's text";
+
+/// Whether `head`, an input's first bytes, may still be the start of candump's text: spaces,
+/// or a time in parentheses, then more.
+pub(super) fn may_start(head: &[u8]) -> bool {
+    matches!(head, [b' ', ..] | [b'(']) || matches!(head, [b'(', d, ..] if d.is_ascii_digit())
+}
+
+/// Whether `head`, an input's first line, is a line of candump's text.
+pub(super) fn is_start(head: &[u8]) -> bool {
+    std::str::from_utf8(head).is_ok_and(|line| parse(line.trim_end()).is_some())
+}
+
+/// A line's time (`None` where it has none), interface and frame.
+fn parse(line: &str) -> Option<(Option<u64>, &str, Logged)> {
+    let line = line.trim_start();
+    let (t_ns, rest) = match line.strip_prefix('(') {
+        Some(rest) => {
+            let (stamp, rest) = rest.split_once(')')?;
+            (Some(stamp_ns(stamp.trim())?), rest)
+        }
+        None => (None, line),
+    };
+    let mut words = rest.split_ascii_whitespace();
+    let interface = words.next()?;
+    let id = words.next()?;
+    let len = words.next()?.strip_prefix('[')?.strip_suffix(']')?;
+    let extended = match id.len() {
+        3 => false,
+        8 => true,
+        _ => return None,
+    };
+    let id = u32::from_str_radix(id, 16).ok()?;
+    let len: usize = len.parse().ok()?;
+    if len > 8 {
+        return Some((t_ns, interface, Logged::Fd));
+    }
+    let rest: Vec<&str> = words.collect();
+    if rest.starts_with(&["remote", "request"]) {
+        return Some((t_ns, interface, frame(id, extended, true, &[0; 8][..len])?));
+    }
+    let data: Vec<u8> = rest
+        .iter()
+        .take(len)
+        .map(|w| u8::from_str_radix(w, 16).ok())
+        .collect::<Option<_>>()?;
+    if data.len() != len {
+        return None;
+    }
+    Some((t_ns, interface, frame(id, extended, false, &data)?))
+}
+
+/// A time of `-ta` (Unix seconds) or `-tA` (a local date and time) as Unix nanoseconds.
+fn stamp_ns(stamp: &str) -> Option<u64> {
+    if let Some(t) = decimal_ns(stamp, 1_000_000_000) {
+        return Some(t);
+    }
+    let civil: DateTime = stamp.parse().ok()?;
+    let zoned = civil.to_zoned(TimeZone::system()).ok()?;
+    u64::try_from(zoned.timestamp().as_nanosecond()).ok()
+}
+
+/// The lines of candump's text, read as frames.
+pub(super) struct CandumpText(Lines);
+
+impl CandumpText {
+    /// Reads the text `reader` gives, from its first line.
+    pub(super) fn reader(reader: Box<dyn Read>) -> CanLogReader<CandumpText> {
+        CanLogReader::new(CandumpText(Lines::new(reader)))
+    }
+}
+
+impl Frames for CandumpText {
+    fn format(&self) -> InputFormat {
+        InputFormat::CANDUMP_TEXT
+    }
+
+    fn next(&mut self, name: &str, bus: &mut String) -> Result<Option<Entry>, InputError> {
+        loop {
+            let Some(text) = self.0.next(name, WHAT)? else {
+                return Ok(None);
+            };
+            if text.trim().is_empty() {
+                continue;
+            }
+            let Some((t_ns, interface, frame)) = parse(text) else {
+                return Err(self.0.error(
+                    name,
+                    format!("not a line of {WHAT} (`  can0  123   [2]  11 22`)"),
+                ));
+            };
+            let Some(t_ns) = t_ns else {
+                return Err(self.0.error(
+                    name,
+                    "candump's text without times: its frames have no time to be records of \
+                     (run candump with -ta, or -l for a log)"
+                        .to_string(),
+                ));
+            };
+            bus.push_str(interface);
+            return Ok(Some(Entry { t_ns, frame }));
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn lines_with_and_without_times_are_read() {
+        let (t, interface, frame) =
+            parse(" (1700000000.007000)  can0  10040A28   [3]  00 0C 40").unwrap();
+        assert_eq!((t, interface), (Some(1_700_000_000_007_000_000), "can0"));
+        assert_eq!(
+            frame,
+            Logged::Classic(
+                hwfoc::dronecan::CanFrame::extended(0x1004_0A28, &[0, 0x0C, 0x40]).unwrap()
+            )
+        );
+        let (t, _, frame) = parse("  vcan1  123   [2]  remote request").unwrap();
+        assert_eq!(t, None);
+        assert_eq!(
+            frame,
+            Logged::Classic(hwfoc::dronecan::CanFrame::remote(0x123, false, 2).unwrap())
+        );
+        assert_eq!(parse("  can0  123  [12]  00").unwrap().2, Logged::Fd);
+        assert!(parse("  can0  123   [3]  00 01").is_none());
+        assert!(parse("hello world").is_none());
+    }
+}
