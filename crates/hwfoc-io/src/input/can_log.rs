@@ -222,6 +222,11 @@ pub(super) struct CanLogReader<F> {
     ready: VecDeque<Gathered>,
     ended: bool,
     error: Option<InputError>,
+    /// Classic frames, those of them with 11-bit ids, and the source nodes (the id's low 7
+    /// bits) of the 29-bit ones, for what the log looks like without ESCs.
+    classic: u64,
+    standard: u64,
+    nodes: u128,
 }
 
 impl<F: Frames> CanLogReader<F> {
@@ -236,6 +241,9 @@ impl<F: Frames> CanLogReader<F> {
             ready: VecDeque::new(),
             ended: false,
             error: None,
+            classic: 0,
+            standard: 0,
+            nodes: 0,
         }
     }
 
@@ -283,7 +291,15 @@ impl<F: Frames> CanLogReader<F> {
             let stream = self.stream();
             // A CAN FD frame: told once at the end, and counted by the bus's stream.
             let record = match entry.frame {
-                Logged::Classic(frame) => frame.to_socketcan_record(),
+                Logged::Classic(frame) => {
+                    self.classic += 1;
+                    if frame.is_extended() {
+                        self.nodes |= 1 << (frame.id() & 0x7F);
+                    } else {
+                        self.standard += 1;
+                    }
+                    frame.to_socketcan_record()
+                }
                 Logged::Fd => {
                     self.not_classic[stream] += 1;
                     crate::can::NOT_CLASSIC_RECORD
@@ -362,8 +378,13 @@ impl<F: Frames> Source for CanLogReader<F> {
         0
     }
 
+    /// The log's frames in CAN words, said where none was an ESC's status.
     fn looks(&self) -> Option<Looks> {
-        None
+        Some(Looks::Can {
+            frames: self.classic,
+            standard: self.standard,
+            nodes: self.nodes.count_ones(),
+        })
     }
 }
 
