@@ -146,54 +146,52 @@ impl BlfObjects {
 
     /// Reads the next log container into `held`; false at the end of the file.
     fn container(&mut self, name: &str) -> Result<bool, InputError> {
-        loop {
-            let Some(base) = self.read(name, 16)? else {
-                return Ok(false);
-            };
-            if &base[..4] != OBJECT {
-                return Err(self.error(name, "an object does not start with LOBJ"));
-            }
-            let (kind, size) = (u32_at(&base, 12), u32_at(&base, 8) as usize);
-            if !(16..=MAX_OBJECT).contains(&size) {
-                return Err(self.error(name, "an object's size is wrong"));
-            }
-            let body = self
-                .read(name, size - 16 + size % 4)?
-                .ok_or_else(|| self.error(name, "the file ends inside an object"))?;
-            if kind != LOG_CONTAINER {
-                // An object outside containers: read as one inside.
-                self.held.drain(..self.at);
-                self.at = 0;
-                self.held.extend_from_slice(&base);
-                self.held.extend_from_slice(&body);
-                return Ok(true);
-            }
-            if body.len() < 16 {
-                return Err(self.error(name, "a log container is cut short"));
-            }
-            let method = u16::from_le_bytes([body[0], body[1]]);
-            let inflated = u32_at(&body, 8) as usize;
-            if inflated > MAX_OBJECT {
-                return Err(self.error(name, "a log container is larger than 16 MiB"));
-            }
-            let data = &body[16..size - 16];
+        let Some(base) = self.read(name, 16)? else {
+            return Ok(false);
+        };
+        if &base[..4] != OBJECT {
+            return Err(self.error(name, "an object does not start with LOBJ"));
+        }
+        let (kind, size) = (u32_at(&base, 12), u32_at(&base, 8) as usize);
+        if !(16..=MAX_OBJECT).contains(&size) {
+            return Err(self.error(name, "an object's size is wrong"));
+        }
+        let body = self
+            .read(name, size - 16 + size % 4)?
+            .ok_or_else(|| self.error(name, "the file ends inside an object"))?;
+        if kind != LOG_CONTAINER {
+            // An object outside containers: read as one inside.
             self.held.drain(..self.at);
             self.at = 0;
-            match method {
-                0 => self.held.extend_from_slice(data),
-                2 => {
-                    let before = self.held.len();
-                    let read = ZlibDecoder::new(data)
-                        .take(inflated as u64)
-                        .read_to_end(&mut self.held);
-                    if read.is_err() || self.held.len() - before != inflated {
-                        return Err(self.error(name, "a log container's zlib data is damaged"));
-                    }
-                }
-                _ => return Err(self.error(name, "a log container's compression is unknown")),
-            }
+            self.held.extend_from_slice(&base);
+            self.held.extend_from_slice(&body);
             return Ok(true);
         }
+        if body.len() < 16 {
+            return Err(self.error(name, "a log container is cut short"));
+        }
+        let method = u16::from_le_bytes([body[0], body[1]]);
+        let inflated = u32_at(&body, 8) as usize;
+        if inflated > MAX_OBJECT {
+            return Err(self.error(name, "a log container is larger than 16 MiB"));
+        }
+        let data = &body[16..size - 16];
+        self.held.drain(..self.at);
+        self.at = 0;
+        match method {
+            0 => self.held.extend_from_slice(data),
+            2 => {
+                let before = self.held.len();
+                let read = ZlibDecoder::new(data)
+                    .take(inflated as u64)
+                    .read_to_end(&mut self.held);
+                if read.is_err() || self.held.len() - before != inflated {
+                    return Err(self.error(name, "a log container's zlib data is damaged"));
+                }
+            }
+            _ => return Err(self.error(name, "a log container's compression is unknown")),
+        }
+        Ok(true)
     }
 
     /// The next frame of the objects held, passing over other objects; `None` where the held
@@ -211,7 +209,7 @@ impl BlfObjects {
             let header = u16::from_le_bytes([rest[4], rest[5]]) as usize;
             let version = u16::from_le_bytes([rest[6], rest[7]]);
             let (size, kind) = (u32_at(rest, 8) as usize, u32_at(rest, 12));
-            if size < header || size < 32 || size > MAX_OBJECT {
+            if size < header || !(32..=MAX_OBJECT).contains(&size) {
                 return Err(self.error(name, "an object's size in a container is wrong"));
             }
             let padded = size + size % 4;
