@@ -212,7 +212,6 @@ impl Frames for AscLines {
             let Some(text) = self.lines.next(name, WHAT)? else {
                 return Ok(None);
             };
-            let text = text.trim().to_string();
             if self.header(name, &text)? {
                 continue;
             }

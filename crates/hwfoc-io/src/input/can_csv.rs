@@ -61,10 +61,10 @@ impl Frames for CanCsvRows {
             let Some(text) = self.0.next(name, WHAT)? else {
                 return Ok(None);
             };
-            if text.trim().is_empty() || text.trim() == HEADER {
+            if text == HEADER {
                 continue;
             }
-            let fields: Vec<&str> = text.trim().split(',').collect();
+            let fields: Vec<&str> = text.split(',').collect();
             let [time, id, extended, remote, error, dlc, data] = fields[..] else {
                 return Err(self
                     .0

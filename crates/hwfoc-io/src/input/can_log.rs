@@ -167,30 +167,33 @@ impl Lines {
         }
     }
 
-    /// The next line without its line end; `None` at the end. `format` names the log in the
-    /// error of a line too long.
-    pub(super) fn next(&mut self, name: &str, format: &str) -> Result<Option<&str>, InputError> {
-        self.row.clear();
-        let n = (&mut self.reader)
-            .take(MAX_LINE as u64 + 1)
-            .read_until(b'\n', &mut self.row)
-            .map_err(|source| InputError::Read {
-                input: name.to_string(),
-                source,
-            })?;
-        if n == 0 {
-            return Ok(None);
+    /// The next line that is not blank, without the white space around it; `None` at the
+    /// end. `format` names the log in the error of a line too long or not text.
+    pub(super) fn next(&mut self, name: &str, format: &str) -> Result<Option<String>, InputError> {
+        loop {
+            self.row.clear();
+            let n = (&mut self.reader)
+                .take(MAX_LINE as u64 + 1)
+                .read_until(b'\n', &mut self.row)
+                .map_err(|source| InputError::Read {
+                    input: name.to_string(),
+                    source,
+                })?;
+            if n == 0 {
+                return Ok(None);
+            }
+            self.number += 1;
+            if self.row.len() > MAX_LINE {
+                let e = format!("the line is longer than {MAX_LINE} bytes: not {format}");
+                return Err(self.error(name, e));
+            }
+            let text = std::str::from_utf8(&self.row)
+                .map_err(|_| self.error(name, format!("the line is not text: not {format}")))?
+                .trim();
+            if !text.is_empty() {
+                return Ok(Some(text.to_string()));
+            }
         }
-        self.number += 1;
-        if self.row.len() > MAX_LINE {
-            return Err(self.error(
-                name,
-                format!("the line is longer than {MAX_LINE} bytes: not {format}"),
-            ));
-        }
-        let text = std::str::from_utf8(&self.row)
-            .map_err(|_| self.error(name, format!("the line is not text: not {format}")))?;
-        Ok(Some(text.trim_end_matches(['\r', '\n'])))
     }
 
     /// An error about the last line read.

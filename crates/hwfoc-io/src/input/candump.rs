@@ -46,30 +46,24 @@ impl Frames for CandumpLines {
     }
 
     fn next(&mut self, name: &str, bus: &mut String) -> Result<Option<Entry>, InputError> {
-        loop {
-            let Some(text) = self.0.next(name, "a candump -l log")? else {
-                return Ok(None);
-            };
-            let text = text.trim_end().to_string();
-            if text.is_empty() {
-                continue;
+        let Some(text) = self.0.next(name, "a candump -l log")? else {
+            return Ok(None);
+        };
+        match candump::parse_line(&text, self.0.number) {
+            Ok(l) => {
+                bus.push_str(l.interface);
+                // The stamp as written, exactly (`parse_line` took it for seconds).
+                let stamp = text[1..].split_once(')').map_or("", |s| s.0);
+                Ok(Some(Entry {
+                    t_ns: decimal_ns(stamp, 1_000_000_000).unwrap_or(u64::MAX),
+                    frame: l.frame,
+                }))
             }
-            return match candump::parse_line(&text, self.0.number) {
-                Ok(l) => {
-                    bus.push_str(l.interface);
-                    // The stamp as written, exactly (`parse_line` took it for seconds).
-                    let stamp = text[1..].split_once(')').map_or("", |s| s.0);
-                    Ok(Some(Entry {
-                        t_ns: decimal_ns(stamp, 1_000_000_000).unwrap_or(u64::MAX),
-                        frame: l.frame,
-                    }))
-                }
-                Err(e) => Err(InputError::Csv {
-                    input: name.to_string(),
-                    line: e.line,
-                    message: format!("not a candump -l line: {}", e.reason),
-                }),
-            };
+            Err(e) => Err(InputError::Csv {
+                input: name.to_string(),
+                line: e.line,
+                message: format!("not a candump -l line: {}", e.reason),
+            }),
         }
     }
 }

@@ -110,30 +110,25 @@ impl Frames for CandumpText {
     }
 
     fn next(&mut self, name: &str, bus: &mut String) -> Result<Option<Entry>, InputError> {
-        loop {
-            let Some(text) = self.0.next(name, WHAT)? else {
-                return Ok(None);
-            };
-            if text.trim().is_empty() {
-                continue;
-            }
-            let Some((t_ns, interface, frame)) = parse(text) else {
-                return Err(self.0.error(
-                    name,
-                    format!("not a line of {WHAT} (`  can0  123   [2]  11 22`)"),
-                ));
-            };
-            let Some(t_ns) = t_ns else {
-                return Err(self.0.error(
-                    name,
-                    "candump's text without times: its frames have no time to be records of \
-                     (run candump with -ta, or -l for a log)"
-                        .to_string(),
-                ));
-            };
-            bus.push_str(interface);
-            return Ok(Some(Entry { t_ns, frame }));
-        }
+        let Some(text) = self.0.next(name, WHAT)? else {
+            return Ok(None);
+        };
+        let Some((t_ns, interface, frame)) = parse(&text) else {
+            return Err(self.0.error(
+                name,
+                format!("not a line of {WHAT} (`  can0  123   [2]  11 22`)"),
+            ));
+        };
+        let Some(t_ns) = t_ns else {
+            return Err(self.0.error(
+                name,
+                "candump's text without times: its frames have no time to be records of \
+                 (run candump with -ta, or -l for a log)"
+                    .to_string(),
+            ));
+        };
+        bus.push_str(interface);
+        Ok(Some(Entry { t_ns, frame }))
     }
 }
 

@@ -207,12 +207,8 @@ impl Frames for TrcLines {
             let Some(text) = self.lines.next(name, WHAT)? else {
                 return Ok(None);
             };
-            let text = text.trim().to_string();
             if text.starts_with(';') {
                 self.header(name, &text)?;
-                continue;
-            }
-            if text.is_empty() {
                 continue;
             }
             if let Some(entry) = self.message(name, &text, bus)? {
