@@ -8,7 +8,9 @@
 //!   called: one stream per interface, times from the packets' timestamps (Unix seconds);
 //!   an interface of link type `LINKTYPE_CAN_SOCKETCAN` is a CAN stream (each frame's 16-byte
 //!   record, [`Input::is_can`]);
-//! - a `candump -l` log: one CAN stream per interface named in it, times its timestamps;
+//! - a CAN log: a `candump -l` log, candump's text with times, Vector ASC or BLF, PEAK TRC
+//!   (1.1 to 2.1), python-can CSV (`can_log.rs` and a module per format): one CAN stream per
+//!   interface or channel named in it, times its own;
 //! - a logic-analyser CSV export (`Time [s],Value,Parity Error,Framing Error`, values as `0xNN`
 //!   or decimal), whose times become `t_s`;
 //! - otherwise raw bytes as they came off the wire (no timing).
@@ -16,7 +18,8 @@
 //! Serial ports are opened with [`Input::open_ports`]: one input with one stream per port,
 //! times being the Unix time each byte was received.
 //!
-//! Each kind of input is a module (`raw.rs`, `csv.rs`, `recording.rs`, `candump.rs`, `ports.rs`) declaring
+//! Each kind of input is a module (`raw.rs`, `csv.rs`, `recording.rs`, `candump.rs`, `asc.rs`,
+//! `blf.rs`, `trc.rs`, `can_csv.rs`, `candump_text.rs`, `ports.rs`) declaring
 //! its [`InputFormat`] (names, clock, whether live, whether its streams are recorded ports:
 //! what [`crate::Sources`] and the summary ask of a format) and implementing `Source`
 //! (its reading, its streams, its flagged bytes). Standard input and files are read as their
