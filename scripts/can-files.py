@@ -22,8 +22,9 @@ The files, each from the same 135 frames:
   are to the microsecond, as 2.1's (PEAK's own 1.1 writes tenths of a millisecond, which would
   not keep the bus's microseconds).
 - can-bus.csv: python-can's CSVWriter.
-- can-bus.candump.txt: candump's own text with absolute times (`candump -ta can0`), written
-  here (python-can has no writer of it).
+- can-bus.candump.txt: candump's own text with absolute times (`candump -ta can0`), and
+  can-bus.candump-untimed.txt without them (`candump can0`), written here in can-utils' layout
+  (python-can has no writer of it).
 
 Dates are in UTC (ASC's are local times: the script sets TZ=UTC, and the test reads with it).
 """
@@ -51,6 +52,7 @@ FILES = [
     "can-bus-v1.1.trc",
     "can-bus.csv",
     "can-bus.candump.txt",
+    "can-bus.candump-untimed.txt",
 ]
 
 
@@ -121,12 +123,13 @@ def write_trc11(path, msgs):
     path.write_bytes(("\r\n".join(lines) + "\r\n").encode())
 
 
-def write_candump_text(path, msgs):
+def write_candump_text(path, msgs, timed=True):
     lines = []
     for m in msgs:
         arb = f"{m.arbitration_id:08X}" if m.is_extended_id else f"{m.arbitration_id:03X}"
         data = "  ".join([""] + [" ".join(f"{b:02X}" for b in m.data)]) if m.data else ""
-        lines.append(f" ({m.timestamp:.6f})  {m.channel}  {arb}   [{m.dlc}]{data}")
+        stamp = f" ({m.timestamp:.6f}) " if timed else " "
+        lines.append(f"{stamp} {m.channel}  {arb}   [{m.dlc}]{data}")
     path.write_text("\n".join(lines) + "\n")
 
 
@@ -138,6 +141,7 @@ def write_all(folder):
     write_trc11(folder / "can-bus-v1.1.trc", msgs)
     write_with(can.CSVWriter(str(folder / "can-bus.csv")), msgs)
     write_candump_text(folder / "can-bus.candump.txt", msgs)
+    write_candump_text(folder / "can-bus.candump-untimed.txt", msgs, timed=False)
     return msgs
 
 

@@ -58,6 +58,19 @@ fn every_python_can_file_decodes_to_the_records_of_the_candump_log() {
         assert_eq!(summary["inputs"][0]["format"], format, "{file}");
         eprintln!("{file}: {} records as the candump log's", got.len());
     }
+    // candump's text without times: the same records, without times (nor the ages of the
+    // slower messages, which are times).
+    let untimed = dronecan("can-bus.candump-untimed.txt");
+    let got = records(&stdout(&run(&["decode", untimed.to_str().unwrap()])));
+    let timeless = |r: &serde_json::Value| {
+        let mut r = r.clone();
+        for key in ["t_s", "msg2_age_ms", "msg3_age_ms"] {
+            r[key] = serde_json::Value::Null;
+        }
+        r
+    };
+    assert_eq!(got, want.iter().map(timeless).collect::<Vec<_>>());
+    eprintln!("can-bus.candump-untimed.txt: {} records as the candump log's, untimed", got.len());
     // The format is read from the content: on standard input too, as the candump log there
     // (which cannot be read ahead: its ESCs are numbered as they are heard).
     let want = on_stdin("can-bus.log");
@@ -191,9 +204,9 @@ fn damaged_can_files_are_one_line_errors_naming_them() {
             "old.trc:1: version 3.0 is not read (1.1 to 2.1 are)",
         ),
         (
-            "untimed.txt",
-            b"  can0  123   [2]  11 22\n".to_vec(),
-            "untimed.txt:1: candump's text without times",
+            "mixed.txt",
+            b" (1700000000.000000)  can0  123   [2]  11 22\n  can0  123   [2]  11 22\n".to_vec(),
+            "mixed.txt:2: a line with no time among lines with times: not one candump's text",
         ),
     ];
     for (name, bytes, needle) in cases {

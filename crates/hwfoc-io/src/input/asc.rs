@@ -144,7 +144,7 @@ impl AscLines {
             bus.push_str("channel ");
             bus.push_str(channel);
             return Ok(Some(Entry {
-                t_ns,
+                t_ns: Some(t_ns),
                 frame: Logged::Fd,
             }));
         }
@@ -198,7 +198,10 @@ impl AscLines {
             .ok_or_else(|| bad(&self.lines, "the id is too large for its kind"))?;
         bus.push_str("channel ");
         bus.push_str(channel);
-        Ok(Some(Entry { t_ns, frame }))
+        Ok(Some(Entry {
+            t_ns: Some(t_ns),
+            frame,
+        }))
     }
 }
 

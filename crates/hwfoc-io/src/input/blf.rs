@@ -241,7 +241,7 @@ impl BlfObjects {
             bus.push_str("channel ");
             bus.push_str(&channel.to_string());
             return Ok(Some(Entry {
-                t_ns: start_ns.saturating_add(after_ns),
+                t_ns: Some(start_ns.saturating_add(after_ns)),
                 frame: logged,
             }));
         }

@@ -98,7 +98,10 @@ impl Frames for CanCsvRows {
                     format!("the row is not a classic CAN frame: not {WHAT}"),
                 ));
             };
-            return Ok(Some(Entry { t_ns, frame }));
+            return Ok(Some(Entry {
+                t_ns: Some(t_ns),
+                frame,
+            }));
         }
     }
 }

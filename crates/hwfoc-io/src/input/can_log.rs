@@ -26,8 +26,11 @@ pub(super) const MAX_LINE: usize = 1024;
 pub(super) enum Log {
     /// `candump -l` (and `-L`).
     Candump,
-    /// candump's own text, with times.
-    CandumpText,
+    /// candump's own text, with times or (`timed` false) without.
+    CandumpText {
+        /// Whether its lines have times.
+        timed: bool,
+    },
     /// Vector ASC.
     Asc,
     /// Vector BLF.
@@ -39,9 +42,10 @@ pub(super) enum Log {
 }
 
 /// The formats of CAN logs.
-pub(super) const FORMATS: [InputFormat; 6] = [
+pub(super) const FORMATS: [InputFormat; 7] = [
     InputFormat::CANDUMP,
     InputFormat::CANDUMP_TEXT,
+    InputFormat::CANDUMP_UNTIMED,
     InputFormat::ASC,
     InputFormat::BLF,
     InputFormat::TRC,
@@ -64,7 +68,11 @@ impl Log {
     pub(super) fn of(head: &[u8]) -> Option<Log> {
         [
             (candump::is_start as fn(&[u8]) -> bool, Log::Candump),
-            (candump_text::is_start, Log::CandumpText),
+            (
+                candump_text::is_timed_start,
+                Log::CandumpText { timed: true },
+            ),
+            (candump_text::is_start, Log::CandumpText { timed: false }),
             (asc::is_start, Log::Asc),
             (blf::is_start, Log::Blf),
             (trc::is_start, Log::Trc),
@@ -78,7 +86,9 @@ impl Log {
     pub(super) fn source(self, reader: Box<dyn Read>) -> Box<dyn Source> {
         match self {
             Log::Candump => Box::new(candump::CandumpLines::reader(reader)),
-            Log::CandumpText => Box::new(candump_text::CandumpText::reader(reader)),
+            Log::CandumpText { timed } => {
+                Box::new(candump_text::CandumpText::reader(reader, timed))
+            }
             Log::Asc => Box::new(asc::AscLines::reader(reader)),
             Log::Blf => Box::new(blf::BlfObjects::reader(reader)),
             Log::Trc => Box::new(trc::TrcLines::reader(reader)),
@@ -89,8 +99,9 @@ impl Log {
 
 /// One frame of a CAN log.
 pub(super) struct Entry {
-    /// Its time, Unix nanoseconds.
-    pub t_ns: u64,
+    /// Its time, Unix nanoseconds; `None` in a log without times (candump's text without
+    /// `-t`).
+    pub t_ns: Option<u64>,
     /// The frame.
     pub frame: Logged,
 }
@@ -317,20 +328,27 @@ impl<F: Frames> CanLogReader<F> {
                 pending.len() - 1
             });
             let g = &mut pending[i];
+            g.bytes.extend_from_slice(&record);
+            let full = g.bytes.len() >= MAX_GATHERED;
+            let Some(t_ns) = entry.t_ns else {
+                if full {
+                    break;
+                }
+                continue;
+            };
             // The time as a candump log's is read, whatever the format: the same frames are
             // the same records.
-            let t_ns = (seconds(entry.t_ns) * 1e9).round() as u64;
+            let t_ns = (seconds(t_ns) * 1e9).round() as u64;
             byte_times(t_ns, 0.0, record.len(), &mut g.times);
-            g.bytes.extend_from_slice(&record);
             let start = *start.get_or_insert(t_ns);
-            if g.bytes.len() >= MAX_GATHERED || t_ns.saturating_sub(start) >= RECORDING_WINDOW_NS {
+            if full || t_ns.saturating_sub(start) >= RECORDING_WINDOW_NS {
                 break;
             }
         }
-        pending.sort_by(|a, b| {
-            a.times[0]
-                .total_cmp(&b.times[0])
-                .then(a.stream.cmp(&b.stream))
+        // In the order of their first frame's time (untimed: as first met).
+        pending.sort_by(|a, b| match (a.times.first(), b.times.first()) {
+            (Some(x), Some(y)) => x.total_cmp(y).then(a.stream.cmp(&b.stream)),
+            _ => std::cmp::Ordering::Equal,
         });
         self.ready.extend(pending);
     }

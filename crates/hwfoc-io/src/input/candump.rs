@@ -55,7 +55,7 @@ impl Frames for CandumpLines {
                 // The stamp as written, exactly (`parse_line` took it for seconds).
                 let stamp = text[1..].split_once(')').map_or("", |s| s.0);
                 Ok(Some(Entry {
-                    t_ns: decimal_ns(stamp, 1_000_000_000).unwrap_or(u64::MAX),
+                    t_ns: Some(decimal_ns(stamp, 1_000_000_000).unwrap_or(u64::MAX)),
                     frame: l.frame,
                 }))
             }

@@ -1,12 +1,11 @@
-//! `candump`'s own text (can-utils, without `-l`), with times (`-ta`, `-tA`) as an input: one
-//! CAN stream per interface.
+//! `candump`'s own text (can-utils, without `-l`) as an input: one CAN stream per interface,
+//! times its own (`-ta`, `-tA`), or none (without `-t`: the records have no `t_s`).
 //!
 //! A line is an optional time in parentheses (`-ta`: Unix seconds; `-tA`: a local date and
 //! time, `2023-11-14 22:13:20.007000`), the interface, the id (3 hex digits standard, 8
 //! extended), the length in brackets and the data bytes in hex (`  can0  123   [3]  11 22 33`),
 //! or `remote request` for a remote frame. CAN FD frames have their length in brackets of two
-//! digits (`[64]`). A log without times (`candump` without `-t`) is refused as such: its
-//! frames have no time to be records of.
+//! digits (`[64]`). Every line has a time, or none does (as the first line).
 //!
 //! Written here: no crate reads candump's text.
 
@@ -29,6 +28,15 @@ impl InputFormat {
         live: false,
         recorded_ports: true,
     };
+
+    /// `candump`'s text without times (`candump can0`): one CAN stream per interface, no times.
+    pub const CANDUMP_UNTIMED: InputFormat = InputFormat {
+        name: "candump text without times",
+        short_name: "candump-untimed",
+        clock: Clock::None,
+        live: false,
+        recorded_ports: true,
+    };
 }
 
 /// What the log is called in its errors.
@@ -43,6 +51,12 @@ pub(super) fn may_start(head: &[u8]) -> bool {
 /// Whether `head`, an input's first line, is a line of candump's text.
 pub(super) fn is_start(head: &[u8]) -> bool {
     std::str::from_utf8(head).is_ok_and(|line| parse(line.trim_end()).is_some())
+}
+
+/// Whether `head`, an input's first line, is a line of candump's text with a time.
+pub(super) fn is_timed_start(head: &[u8]) -> bool {
+    std::str::from_utf8(head)
+        .is_ok_and(|line| parse(line.trim_end()).is_some_and(|l| l.0.is_some()))
 }
 
 /// A line's time (`None` where it has none), interface and frame.
@@ -94,19 +108,23 @@ fn stamp_ns(stamp: &str) -> Option<u64> {
     u64::try_from(zoned.timestamp().as_nanosecond()).ok()
 }
 
-/// The lines of candump's text, read as frames.
-pub(super) struct CandumpText(Lines);
+/// The lines of candump's text, read as frames: with times, or (`.1` false) without.
+pub(super) struct CandumpText(Lines, bool);
 
 impl CandumpText {
-    /// Reads the text `reader` gives, from its first line.
-    pub(super) fn reader(reader: Box<dyn Read>) -> CanLogReader<CandumpText> {
-        CanLogReader::new(CandumpText(Lines::new(reader)))
+    /// Reads the text `reader` gives, from its first line; `timed`: whether it has times.
+    pub(super) fn reader(reader: Box<dyn Read>, timed: bool) -> CanLogReader<CandumpText> {
+        CanLogReader::new(CandumpText(Lines::new(reader), timed))
     }
 }
 
 impl Frames for CandumpText {
     fn format(&self) -> InputFormat {
-        InputFormat::CANDUMP_TEXT
+        if self.1 {
+            InputFormat::CANDUMP_TEXT
+        } else {
+            InputFormat::CANDUMP_UNTIMED
+        }
     }
 
     fn next(&mut self, name: &str, bus: &mut String) -> Result<Option<Entry>, InputError> {
@@ -119,14 +137,14 @@ impl Frames for CandumpText {
                 format!("not a line of {WHAT} (`  can0  123   [2]  11 22`)"),
             ));
         };
-        let Some(t_ns) = t_ns else {
-            return Err(self.0.error(
-                name,
-                "candump's text without times: its frames have no time to be records of \
-                 (run candump with -ta, or -l for a log)"
-                    .to_string(),
-            ));
-        };
+        if t_ns.is_some() != self.1 {
+            let (has, others) = match self.1 {
+                true => ("no time", "with times"),
+                false => ("a time", "without times"),
+            };
+            let e = format!("a line with {has} among lines {others}: not one {WHAT}");
+            return Err(self.0.error(name, e));
+        }
         bus.push_str(interface);
         Ok(Some(Entry { t_ns, frame }))
     }

@@ -142,7 +142,7 @@ impl TrcLines {
                 "FD" | "FB" | "FE" | "BI" => {
                     push_bus(bus, column('B'));
                     return Ok(Some(Entry {
-                        t_ns: start + offset,
+                        t_ns: Some(start + offset),
                         frame: Logged::Fd,
                     }));
                 }
@@ -185,7 +185,7 @@ impl TrcLines {
             .ok_or_else(|| bad(&self.lines, "the id is too large for its kind"))?;
         push_bus(bus, column('B'));
         Ok(Some(Entry {
-            t_ns: start + offset,
+            t_ns: Some(start + offset),
             frame,
         }))
     }
