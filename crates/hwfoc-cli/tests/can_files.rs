@@ -70,7 +70,10 @@ fn every_python_can_file_decodes_to_the_records_of_the_candump_log() {
         r
     };
     assert_eq!(got, want.iter().map(timeless).collect::<Vec<_>>());
-    eprintln!("can-bus.candump-untimed.txt: {} records as the candump log's, untimed", got.len());
+    eprintln!(
+        "can-bus.candump-untimed.txt: {} records as the candump log's, untimed",
+        got.len()
+    );
     // The format is read from the content: on standard input too, as the candump log there
     // (which cannot be read ahead: its ESCs are numbered as they are heard).
     let want = on_stdin("can-bus.log");
