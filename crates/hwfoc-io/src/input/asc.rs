@@ -18,7 +18,7 @@ use jiff::civil::DateTime;
 use jiff::fmt::strtime;
 use jiff::tz::TimeZone;
 
-use super::can_log::{CanLogReader, Entry, Frames, Lines, decimal_ns, frame};
+use super::can_log::{CanLogReader, Entry, LineFrames, Lines, decimal_ns, frame};
 use super::{InputError, InputFormat};
 use crate::can::candump::Logged;
 use crate::time::Clock;
@@ -205,23 +205,25 @@ impl AscLines {
     }
 }
 
-impl Frames for AscLines {
+impl LineFrames for AscLines {
     fn format(&self) -> InputFormat {
         InputFormat::ASC
     }
 
-    fn next(&mut self, name: &str, bus: &mut String) -> Result<Option<Entry>, InputError> {
-        loop {
-            let Some(text) = self.lines.next(name, WHAT)? else {
-                return Ok(None);
-            };
-            if self.header(name, &text)? {
-                continue;
-            }
-            if let Some(entry) = self.event(name, &text, bus)? {
-                return Ok(Some(entry));
-            }
+    fn lines(&mut self) -> (&mut Lines, &'static str) {
+        (&mut self.lines, WHAT)
+    }
+
+    fn line(
+        &mut self,
+        name: &str,
+        text: &str,
+        bus: &mut String,
+    ) -> Result<Option<Entry>, InputError> {
+        if self.header(name, text)? {
+            return Ok(None);
         }
+        self.event(name, text, bus)
     }
 }
 

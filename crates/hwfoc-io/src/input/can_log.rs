@@ -116,6 +116,42 @@ pub(super) trait Frames {
     fn next(&mut self, name: &str, bus: &mut String) -> Result<Option<Entry>, InputError>;
 }
 
+/// A text log's parser, line by line: a [`Frames`] of the log's lines.
+pub(super) trait LineFrames {
+    /// The format read.
+    fn format(&self) -> InputFormat;
+
+    /// The log's lines, and what the log is called in their errors.
+    fn lines(&mut self) -> (&mut Lines, &'static str);
+
+    /// The frame of a line (not blank, trimmed), with its bus in `bus`; `None` for a line
+    /// that is no frame (a header, an event).
+    fn line(
+        &mut self,
+        name: &str,
+        text: &str,
+        bus: &mut String,
+    ) -> Result<Option<Entry>, InputError>;
+}
+
+impl<T: LineFrames> Frames for T {
+    fn format(&self) -> InputFormat {
+        LineFrames::format(self)
+    }
+
+    fn next(&mut self, name: &str, bus: &mut String) -> Result<Option<Entry>, InputError> {
+        loop {
+            let (lines, what) = self.lines();
+            let Some(text) = lines.next(name, what)? else {
+                return Ok(None);
+            };
+            if let Some(entry) = self.line(name, &text, bus)? {
+                return Ok(Some(entry));
+            }
+        }
+    }
+}
+
 /// The frame of an id, its kind and data, as a log line or object gives them; `None` where
 /// they make no classic CAN frame (an id too large, more than 8 bytes).
 pub(super) fn frame(id: u32, extended: bool, remote: bool, data: &[u8]) -> Option<Logged> {

@@ -14,7 +14,7 @@
 
 use std::io::Read;
 
-use super::can_log::{CanLogReader, Entry, Frames, Lines, decimal_ns, frame};
+use super::can_log::{CanLogReader, Entry, LineFrames, Lines, decimal_ns, frame};
 use super::{InputError, InputFormat};
 use crate::can::candump::Logged;
 use crate::time::Clock;
@@ -197,23 +197,25 @@ fn push_bus(bus: &mut String, number: Option<&str>) {
     bus.push_str(number.filter(|n| n.parse::<u16>().is_ok()).unwrap_or("1"));
 }
 
-impl Frames for TrcLines {
+impl LineFrames for TrcLines {
     fn format(&self) -> InputFormat {
         InputFormat::TRC
     }
 
-    fn next(&mut self, name: &str, bus: &mut String) -> Result<Option<Entry>, InputError> {
-        loop {
-            let Some(text) = self.lines.next(name, WHAT)? else {
-                return Ok(None);
-            };
-            if text.starts_with(';') {
-                self.header(name, &text)?;
-                continue;
-            }
-            if let Some(entry) = self.message(name, &text, bus)? {
-                return Ok(Some(entry));
-            }
+    fn lines(&mut self) -> (&mut Lines, &'static str) {
+        (&mut self.lines, WHAT)
+    }
+
+    fn line(
+        &mut self,
+        name: &str,
+        text: &str,
+        bus: &mut String,
+    ) -> Result<Option<Entry>, InputError> {
+        if text.starts_with(';') {
+            self.header(name, text)?;
+            return Ok(None);
         }
+        self.message(name, text, bus)
     }
 }
