@@ -32,5 +32,12 @@ export HWFOC_BIN
 step format cargo fmt --manifest-path python/Cargo.toml -- --check
 step clippy env PYO3_PYTHON="$venv/bin/python" cargo clippy --manifest-path python/Cargo.toml --all-targets -- -D warnings
 step install "$venv/bin/pip" install -q "./python[test]"
+# python-can: hwfoc.CanDecoder fed its Messages (python/tests/test_can.py, skipped without it).
+step python-can "$venv/bin/pip" install -q 'python-can>=4,<5'
 # pytest exits non-zero when no test ran, as when any failed.
-step pytest "$venv/bin/python" -m pytest -q -p no:cacheprovider python/tests
+step pytest "$venv/bin/python" -m pytest -q -p no:cacheprovider -rs python/tests 2>&1 | tee "${TMPDIR:-/tmp}/hwfoc-ci-pytest.log"
+# The python-can test ran (pytest -rs lists what was skipped, with the reason).
+if grep -q "python-can is not installed" "${TMPDIR:-/tmp}/hwfoc-ci-pytest.log"; then
+  echo "the python-can test of hwfoc.CanDecoder was skipped" >&2
+  exit 1
+fi

@@ -8,7 +8,8 @@ the ``hwfoc`` command): one row per data frame, in physical units.
 - :func:`scan`: the same records as ``pyarrow.RecordBatch`` es, in bounded memory, for inputs
   larger than memory;
 - :func:`summary`: what ``hwfoc summary --json`` prints, as Python objects;
-- :class:`Decoder`: a streaming decoder for live bytes; :func:`open_ports`: live records from
+- :class:`Decoder`: a streaming decoder for live bytes; :class:`CanDecoder`: one for CAN frames
+  already held (python-can messages); :func:`open_ports`: live records from
   serial ports, as ``hwfoc monitor`` reads them;
 - :mod:`hwfoc.dask` and :mod:`hwfoc.spark`: fleets of recordings on Dask and Spark.
 
@@ -32,6 +33,7 @@ from ._hwfoc import (
     DEFAULT_POLE_PAIRS,
     DEFAULT_V4_VOLTS_PER_STEP,
     PROTOCOLS,
+    CanDecoder,
     Decoder,
     HwfocError,
     HwfocWarning,
@@ -56,6 +58,7 @@ __all__ = [
     "DEFAULT_POLE_PAIRS",
     "DEFAULT_V4_VOLTS_PER_STEP",
     "PROTOCOLS",
+    "CanDecoder",
     "Decoder",
     "HwfocError",
     "HwfocWarning",

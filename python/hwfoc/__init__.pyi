@@ -3,7 +3,7 @@
 import datetime
 import os
 from types import TracebackType
-from typing import IO, Any, Dict, Iterator, List, Optional, Sequence, Tuple, Union
+from typing import IO, Any, Dict, Iterable, Iterator, List, Optional, Sequence, Tuple, Union
 
 import pyarrow as pa
 
@@ -165,6 +165,45 @@ def record_schema(
 ) -> pa.Schema:
     """The Arrow schema of the records (units in the fields' metadata, settings in the
     schema's)."""
+
+class CanDecoder:
+    """A streaming decoder of one CAN bus's frames that the caller already holds (python-can
+    ``Message`` objects, or ``(timestamp, arbitration_id, data, is_extended)`` tuples), read
+    as ``hwfoc.read`` reads a CAN log: DroneCAN transfers, then a record per ESC status. An ESC
+    at slot ``s`` of the bus (its throttle channel - 1, or its node id until an ESC id answer,
+    as on a live bus) is ESC ``esc + s``; every other column is as ``hwfoc.read`` of the
+    candump log of the same frames gives it."""
+
+    def __init__(
+        self,
+        *,
+        esc: int = 0,
+        current_scale: float = ...,
+        pole_pairs: int = ...,
+        gear_ratio: float = ...,
+        v4_volts_per_step: str = ...,
+    ) -> None: ...
+    def feed(
+        self,
+        frames: Union[
+            Iterable[Any],
+            Tuple[float, int, Union[bytes, bytearray, memoryview, List[int]], bool],
+            Any,
+        ],
+    ) -> pa.RecordBatch:
+        """Decodes the next frames in the order received: an iterable of python-can
+        ``Message`` objects (duck-typed: ``timestamp``, ``arbitration_id``, ``data``,
+        ``is_extended_id``) or tuples ``(timestamp, arbitration_id, data, is_extended)``, or
+        one of them. ``timestamp``: Unix seconds. Raises ValueError for a frame that is no
+        classic CAN data frame. Returns the records of the ESC statuses completed."""
+
+    @property
+    def stats(self) -> Dict[str, Any]:
+        """The bus's statistics, as :attr:`Decoder.stats`."""
+
+    @property
+    def schema(self) -> pa.Schema:
+        """The schema of the batches."""
 
 class Decoder:
     """A streaming decoder of one ESC's bytes as they arrive (a frame split between two

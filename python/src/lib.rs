@@ -4,6 +4,7 @@
 //! per row. Decoding runs with the interpreter's lock released; every error becomes an
 //! exception of `hwfoc` (see `errors.rs`) whose message is the one the `hwfoc` command prints.
 
+mod can;
 mod errors;
 mod live;
 mod records;
@@ -488,6 +489,7 @@ fn _hwfoc(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(live::open_ports, m)?)?;
     m.add_class::<scan::Scan>()?;
     m.add_class::<live::Decoder>()?;
+    m.add_class::<can::CanDecoder>()?;
     m.add_class::<live::Ports>()?;
     m.add("HwfocError", py.get_type::<errors::HwfocError>())?;
     m.add("InputError", py.get_type::<errors::InputError>())?;

@@ -46,7 +46,7 @@ impl Handler for Gather {
 }
 
 /// The link statistics as a dict.
-fn stats_dict<'py>(py: Python<'py>, s: &EscLink) -> PyResult<Bound<'py, PyDict>> {
+pub(crate) fn stats_dict<'py>(py: Python<'py>, s: &EscLink) -> PyResult<Bound<'py, PyDict>> {
     let d = PyDict::new(py);
     d.set_item("bytes", s.bytes())?;
     d.set_item("bytes_skipped", s.bytes_skipped())?;
@@ -62,7 +62,7 @@ fn stats_dict<'py>(py: Python<'py>, s: &EscLink) -> PyResult<Bound<'py, PyDict>>
 }
 
 /// The bytes of a `bytes`, `bytearray` or `memoryview`.
-fn bytes_of(data: &Bound<'_, PyAny>) -> PyResult<Vec<u8>> {
+pub(crate) fn bytes_of(data: &Bound<'_, PyAny>) -> PyResult<Vec<u8>> {
     if let Ok(b) = data.cast::<PyBytes>() {
         return Ok(b.as_bytes().to_vec());
     }
@@ -80,7 +80,7 @@ fn bytes_of(data: &Bound<'_, PyAny>) -> PyResult<Vec<u8>> {
 }
 
 /// The record schema with `settings` in its metadata.
-fn live_schema(settings: Settings, inputs: Vec<String>) -> SchemaRef {
+pub(crate) fn live_schema(settings: Settings, inputs: Vec<String>) -> SchemaRef {
     Provenance::new(settings, inputs, String::new()).schema(None)
 }
 

@@ -4,6 +4,8 @@ records `hwfoc decode` makes, with the schema's Arrow types for the CAN columns 
 node, the ages), and hwfoc.summary the CAN link figures `hwfoc summary --json` gives."""
 
 import json
+import re
+import subprocess
 import warnings
 from pathlib import Path
 
@@ -89,3 +91,84 @@ def test_summary_of_a_can_bus_is_the_commands(cli):
     assert by_esc[0]["link"]["can"]["node"] == 11
     assert by_esc[4]["link"]["can"]["crc_errors"] == 1
     assert by_esc[0]["link"]["can"]["unknown_types"] == 1
+
+
+# hwfoc.CanDecoder: frames a caller holds, as tuples or python-can Messages. Its ESCs are
+# numbered as a live bus's are (as `hwfoc decode -` reads the log, not ahead); every other
+# column is what hwfoc.read gives of the candump log of the same frames.
+
+
+def _log_tuples():
+    """The candump log's frames as (timestamp, arbitration_id, data, is_extended) tuples."""
+    frames = []
+    for line in LOG.read_text().splitlines():
+        stamp, _, frame = line.split()
+        ident, data = frame.split("#")
+        frames.append((float(stamp.strip("()")), int(ident, 16), bytes.fromhex(data), len(ident) == 8))
+    return frames
+
+
+def _decoded(batches):
+    return pa.Table.from_batches([b for b in batches if b.num_rows], schema=batches[0].schema)
+
+
+def _live_records(cli):
+    """`hwfoc decode -` of the candump log: its ESCs numbered as heard."""
+    with open(LOG, "rb") as f:
+        out = subprocess.run([cli, "decode", "-"], stdin=f, capture_output=True, check=True).stdout
+    return [json.loads(line) for line in out.splitlines()]
+
+
+def _without_esc(rows):
+    return [{k: v for k, v in r.items() if k != "esc"} for r in rows]
+
+
+def test_can_decoder_gives_the_records_of_the_log_from_tuples(cli):
+    frames = _log_tuples()
+    assert len(frames) == 135
+    whole = hwfoc.CanDecoder()
+    table = _decoded([whole.feed(frames)])
+    assert_same_records(table, _live_records(cli))
+    assert _without_esc(table.to_pylist()) == _without_esc(hwfoc.read(str(LOG)).to_pylist())
+    assert whole.stats["bytes"] == 135 * 16
+    # Fed one frame at a time, or in uneven pieces: the same records.
+    one = hwfoc.CanDecoder()
+    assert _decoded([one.feed(f) for f in frames]).equals(table)
+    pieces = hwfoc.CanDecoder()
+    assert _decoded([pieces.feed(frames[i : i + 7]) for i in range(0, len(frames), 7)]).equals(table)
+    # `esc` offsets the ESC numbers.
+    shifted = hwfoc.CanDecoder(esc=20).feed(frames)
+    assert shifted.column("esc").to_pylist() == [e + 20 for e in table.column("esc").to_pylist()]
+
+
+def test_can_decoder_takes_python_can_messages(cli):
+    can = pytest.importorskip("can", reason="python-can is not installed (.ci/python.sh installs it)")
+    messages = list(can.LogReader(str(LOG)))
+    decoder = hwfoc.CanDecoder()
+    table = _decoded([decoder.feed(messages)])
+    assert_same_records(table, _live_records(cli))
+    assert _without_esc(table.to_pylist()) == _without_esc(hwfoc.read(str(LOG)).to_pylist())
+    # The files python-can writes of those frames, read back by python-can, give them again
+    # (not its TRC: its reader adds float offsets to a float start, so its times move by ulps).
+    for name in ["can-bus.blf", "can-bus.csv"]:
+        again = _decoded([hwfoc.CanDecoder().feed(can.LogReader(str(DRONECAN / name)))])
+        assert again.equals(table), name
+
+
+def test_can_decoder_refuses_what_is_no_classic_can_frame():
+    decoder = hwfoc.CanDecoder()
+    bad = [
+        ((1.0, 0x800, b"", False), "arbitration_id 0x800 with 0 data bytes is no classic CAN frame"),
+        ((1.0, 0x123, bytes(9), False), "with 9 data bytes is no classic CAN frame"),
+        ((1.0, 0x2000_0000, b"", True), "is no classic CAN frame (29-bit id"),
+        ((2e10, 0x123, b"", False), "timestamp: 20000000000 is not a time in seconds from 1970"),
+        ((float("nan"), 0x123, b"", False), "timestamp: NaN is not a time"),
+        ((-1.0, 0x123, b"", False), "timestamp: -1 is not a time"),
+        ((1.0, 0x123, b""), "a frame tuple is (timestamp, arbitration_id, data, is_extended)"),
+    ]
+    for frame, message in bad:
+        with pytest.raises(ValueError, match=re.escape(message)):
+            decoder.feed([frame])
+    with pytest.raises(TypeError):
+        decoder.feed([(1.0, 0x123, "text", False)])
+    assert decoder.feed([]).num_rows == 0

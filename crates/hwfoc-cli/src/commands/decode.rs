@@ -138,6 +138,14 @@ fn overrides(map: &SettingsMap) -> Vec<(String, SettingsPatch)> {
 /// Warnings on standard error: ESCs whose bytes held no frame, ESCs asked for but not found.
 fn warn(sources: &Sources, wanted: &[u8]) {
     crate::args::warn_left_out(sources);
+    // A CAN log in which no ESC was heard: its frames in CAN words.
+    for info in sources.inputs() {
+        if let (true, Some(looks @ hwfoc_io::Looks::Can { .. })) =
+            (info.escs.is_empty(), info.looks)
+        {
+            eprintln!("hwfoc: warning: {}: {looks}", hwfoc_io::Escaped(&info.name));
+        }
+    }
     for i in 0..sources.escs().len() {
         let stats = sources.link(i);
         if stats.bytes() > 0 && stats.frames() == 0 && !sources.is_hub(i) {

@@ -1,13 +1,10 @@
 //! A `candump -l` log as an input: one CAN stream per interface named in it.
 
-use std::collections::{HashMap, VecDeque};
-use std::io::{BufRead, BufReader, Read};
+use std::io::Read;
 
-use super::recording::RECORDING_WINDOW_NS;
-use super::{BATCH, InputError, InputFormat, Looks, Source};
-use crate::can::candump::{self, Logged};
-use crate::clock::byte_times;
-use crate::notice::Notice;
+use super::can_log::{CanLogReader, Entry, Frames, Lines, decimal_ns};
+use super::{InputError, InputFormat};
+use crate::can::candump;
 use crate::time::Clock;
 
 impl InputFormat {
@@ -22,11 +19,6 @@ impl InputFormat {
     };
 }
 
-/// The longest line read: a classic CAN line is under 60 bytes, a CAN FD one under 200.
-const MAX_LINE: usize = 1024;
-/// Most bytes gathered for one interface before the window's batches are handed out.
-const MAX_GATHERED: usize = 1 << 18;
-
 /// Whether `head`, an input's first bytes, may still be the start of a candump log (format
 /// detection reads its first line whole while it may).
 pub(super) fn may_start(head: &[u8]) -> bool {
@@ -38,208 +30,41 @@ pub(super) fn is_start(head: &[u8]) -> bool {
     std::str::from_utf8(head).is_ok_and(|line| candump::parse_line(line.trim_end(), 1).is_ok())
 }
 
-/// One interface's frames of a window.
-struct Gathered {
-    stream: usize,
-    bytes: Vec<u8>,
-    times: Vec<f64>,
-}
+/// The lines of a candump log, read as frames ([`CanLogReader`]: one stream per interface).
+pub(super) struct CandumpLines(Lines);
 
-/// A candump log being read. Lines of the interfaces interleave; as a recording's packets
-/// (`recording.rs`), they are gathered per interface over a window of log time and each
-/// interface's frames of the window handed out as one batch, in the order of their first
-/// frame's time.
-pub(super) struct CandumpReader {
-    reader: BufReader<Box<dyn Read>>,
-    /// Number of the last line read (1-based).
-    line: u64,
-    row: Vec<u8>,
-    names: Vec<String>,
-    index: HashMap<String, usize>,
-    /// CAN FD lines, by stream.
-    not_classic: Vec<u64>,
-    ready: VecDeque<Gathered>,
-    ended: bool,
-    error: Option<InputError>,
-}
-
-impl CandumpReader {
+impl CandumpLines {
     /// Reads the log `reader` gives, from its first line.
-    pub(super) fn new(reader: Box<dyn Read>) -> CandumpReader {
-        CandumpReader {
-            reader: BufReader::with_capacity(BATCH, reader),
-            line: 0,
-            row: Vec::new(),
-            names: Vec::new(),
-            index: HashMap::new(),
-            not_classic: Vec::new(),
-            ready: VecDeque::new(),
-            ended: false,
-            error: None,
-        }
-    }
-
-    /// The stream of `interface`, declared when first met.
-    fn stream(&mut self, interface: &str) -> usize {
-        if let Some(&i) = self.index.get(interface) {
-            return i;
-        }
-        let i = self.names.len();
-        self.names.push(interface.to_string());
-        self.index.insert(interface.to_string(), i);
-        self.not_classic.push(0);
-        i
-    }
-
-    /// Reads lines into per-interface batches until the window is over, a batch is full, or
-    /// the log ends (or an error, kept for after the batches).
-    fn read_window(&mut self, name: &str, notices: &mut dyn FnMut(Notice)) {
-        let mut pending: Vec<Gathered> = Vec::new();
-        let mut slot: HashMap<usize, usize> = HashMap::new();
-        let mut start = None;
-        loop {
-            match self.next_line(name) {
-                Ok(true) => {}
-                Ok(false) => {
-                    self.ended = true;
-                    for (i, &frames) in self.not_classic.iter().enumerate() {
-                        if frames > 0 {
-                            notices(Notice::NotClassicCan {
-                                input: name.to_string(),
-                                interface: self.names[i].clone(),
-                                frames,
-                            });
-                        }
-                    }
-                    break;
-                }
-                Err(e) => {
-                    self.error = Some(e);
-                    self.ended = true;
-                    break;
-                }
-            }
-            let text = String::from_utf8_lossy(&self.row);
-            let text = text.trim_end();
-            if text.is_empty() {
-                continue;
-            }
-            let parsed = match candump::parse_line(text, self.line) {
-                Ok(l) => (l.t_s, l.interface.to_string(), l.frame),
-                Err(e) => {
-                    self.error = Some(InputError::Csv {
-                        input: name.to_string(),
-                        line: e.line,
-                        message: format!("not a candump -l line: {}", e.reason),
-                    });
-                    self.ended = true;
-                    break;
-                }
-            };
-            let (t_s, interface, frame) = parsed;
-            let stream = self.stream(&interface);
-            // A CAN FD frame: told once at the end, and counted by the bus's stream.
-            let record = match frame {
-                Logged::Classic(frame) => frame.to_socketcan_record(),
-                Logged::Fd => {
-                    self.not_classic[stream] += 1;
-                    crate::can::NOT_CLASSIC_RECORD
-                }
-            };
-            let i = *slot.entry(stream).or_insert_with(|| {
-                pending.push(Gathered {
-                    stream,
-                    bytes: Vec::new(),
-                    times: Vec::new(),
-                });
-                pending.len() - 1
-            });
-            let g = &mut pending[i];
-            let t_ns = (t_s * 1e9).round() as u64;
-            byte_times(t_ns, 0.0, record.len(), &mut g.times);
-            g.bytes.extend_from_slice(&record);
-            let start = *start.get_or_insert(t_ns);
-            if g.bytes.len() >= MAX_GATHERED || t_ns.saturating_sub(start) >= RECORDING_WINDOW_NS {
-                break;
-            }
-        }
-        pending.sort_by(|a, b| {
-            a.times[0]
-                .total_cmp(&b.times[0])
-                .then(a.stream.cmp(&b.stream))
-        });
-        self.ready.extend(pending);
-    }
-
-    /// Reads the next line into `row`; false at the end.
-    fn next_line(&mut self, name: &str) -> Result<bool, InputError> {
-        self.row.clear();
-        let n = (&mut self.reader)
-            .take(MAX_LINE as u64 + 1)
-            .read_until(b'\n', &mut self.row)
-            .map_err(|source| InputError::Read {
-                input: name.to_string(),
-                source,
-            })?;
-        if n == 0 {
-            return Ok(false);
-        }
-        self.line += 1;
-        if self.row.len() > MAX_LINE {
-            return Err(InputError::Csv {
-                input: name.to_string(),
-                line: self.line,
-                message: format!("the line is longer than {MAX_LINE} bytes: not a candump -l log"),
-            });
-        }
-        Ok(true)
+    pub(super) fn reader(reader: Box<dyn Read>) -> CanLogReader<CandumpLines> {
+        CanLogReader::new(CandumpLines(Lines::new(reader)))
     }
 }
 
-impl Source for CandumpReader {
+impl Frames for CandumpLines {
     fn format(&self) -> InputFormat {
         InputFormat::CANDUMP
     }
 
-    fn fill(
-        &mut self,
-        name: &str,
-        bytes: &mut Vec<u8>,
-        times: &mut Vec<f64>,
-        notices: &mut dyn FnMut(Notice),
-    ) -> Result<usize, InputError> {
-        bytes.clear();
-        loop {
-            if let Some(next) = self.ready.pop_front() {
-                *bytes = next.bytes;
-                *times = next.times;
-                return Ok(next.stream);
+    fn next(&mut self, name: &str, bus: &mut String) -> Result<Option<Entry>, InputError> {
+        let Some(text) = self.0.next(name, "a candump -l log")? else {
+            return Ok(None);
+        };
+        match candump::parse_line(&text, self.0.number) {
+            Ok(l) => {
+                bus.push_str(l.interface);
+                // The stamp as written, exactly (`parse_line` took it for seconds).
+                let stamp = text[1..].split_once(')').map_or("", |s| s.0);
+                Ok(Some(Entry {
+                    t_ns: Some(decimal_ns(stamp, 1_000_000_000).unwrap_or(u64::MAX)),
+                    frame: l.frame,
+                }))
             }
-            if self.ended {
-                return self.error.take().map_or(Ok(0), Err);
-            }
-            self.read_window(name, notices);
+            Err(e) => Err(InputError::Csv {
+                input: name.to_string(),
+                line: e.line,
+                message: format!("not a candump -l line: {}", e.reason),
+            }),
         }
-    }
-
-    fn streams(&self) -> usize {
-        self.names.len()
-    }
-
-    fn stream_name(&self, i: usize) -> Option<&str> {
-        self.names.get(i).map(String::as_str)
-    }
-
-    fn is_can(&self, stream: usize) -> bool {
-        stream < self.names.len()
-    }
-
-    fn flagged_bytes(&self) -> u64 {
-        0
-    }
-
-    fn looks(&self) -> Option<Looks> {
-        None
     }
 }
 

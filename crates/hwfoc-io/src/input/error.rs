@@ -41,6 +41,15 @@ pub enum InputError {
         /// What is wrong with it.
         message: String,
     },
+    /// A binary log (a BLF file) could not be read at a byte of it.
+    Binary {
+        /// The input as named on the command line.
+        input: String,
+        /// Where in the file, in bytes from its start.
+        offset: u64,
+        /// What is wrong there.
+        message: String,
+    },
     /// Frames were to be selected by time, but the input has no receive times.
     NoTiming {
         /// The input as named on the command line.
@@ -90,6 +99,11 @@ impl fmt::Display for InputError {
                 line,
                 message,
             } => write!(f, "{input}:{line}: {message}"),
+            InputError::Binary {
+                input,
+                offset,
+                message,
+            } => write!(f, "{input}: at byte {offset}: {message}"),
             InputError::NoTiming { input } => write!(
                 f,
                 "a time window selects frames by their receive times, but {input} is raw bytes \

@@ -16,6 +16,17 @@ pub enum Looks {
     Zeros,
     /// A file format known by its first bytes, named.
     Format(&'static str),
+    /// A CAN log's frames, in which no ESC status was found (see [`crate::Input::looks`]): how
+    /// many, how many of them with 11-bit ids (DroneCAN's are 29-bit), and how many nodes sent
+    /// 29-bit frames (their id's low 7 bits).
+    Can {
+        /// Classic CAN frames in the log.
+        frames: u64,
+        /// Those with an 11-bit (standard) id.
+        standard: u64,
+        /// Source nodes of the 29-bit frames.
+        nodes: u32,
+    },
     /// Binary bytes, as a wire gives, in which no frame of any format was found: how many were
     /// looked at, and how many of them are lead bytes of a Hobbywing format (`9B`: HW-FOC,
     /// DataLink, V4, V3; `FE`: HW5).
@@ -62,7 +73,7 @@ impl Looks {
 
     /// Whether `head` is something other than telemetry: text, zeros, a known file format.
     pub fn is_other_than_telemetry(&self) -> bool {
-        !matches!(self, Looks::Unframed { .. })
+        !matches!(self, Looks::Unframed { .. } | Looks::Can { .. })
     }
 
     /// What `head` looks like, if it is something other than telemetry.
@@ -106,6 +117,17 @@ impl fmt::Display for Looks {
             Looks::Text => f.write_str("text, not telemetry"),
             Looks::Zeros => f.write_str("only zero bytes, not telemetry"),
             Looks::Format(name) => write!(f, "looks like {name}, not telemetry"),
+            Looks::Can { frames: 0, .. } => f.write_str("no CAN frame in the log"),
+            Looks::Can {
+                frames,
+                standard,
+                nodes,
+            } => write!(
+                f,
+                "{frames} CAN frames ({standard} with 11-bit ids, which DroneCAN does not use; \
+                 29-bit frames from {nodes} nodes) and no ESC status of DroneCAN from any node: \
+                 a log of another bus, or of ESCs not set to DroneCAN"
+            ),
             Looks::Unframed {
                 bytes,
                 sync_9b,

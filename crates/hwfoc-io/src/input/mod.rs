@@ -8,7 +8,9 @@
 //!   called: one stream per interface, times from the packets' timestamps (Unix seconds);
 //!   an interface of link type `LINKTYPE_CAN_SOCKETCAN` is a CAN stream (each frame's 16-byte
 //!   record, [`Input::is_can`]);
-//! - a `candump -l` log: one CAN stream per interface named in it, times its timestamps;
+//! - a CAN log: a `candump -l` log, candump's text with times, Vector ASC or BLF, PEAK TRC
+//!   (1.1 to 2.1), python-can CSV (`can_log.rs` and a module per format): one CAN stream per
+//!   interface or channel named in it, times its own;
 //! - a logic-analyser CSV export (`Time [s],Value,Parity Error,Framing Error`, values as `0xNN`
 //!   or decimal), whose times become `t_s`;
 //! - otherwise raw bytes as they came off the wire (no timing).
@@ -16,20 +18,27 @@
 //! Serial ports are opened with [`Input::open_ports`]: one input with one stream per port,
 //! times being the Unix time each byte was received.
 //!
-//! Each kind of input is a module (`raw.rs`, `csv.rs`, `recording.rs`, `candump.rs`, `ports.rs`) declaring
+//! Each kind of input is a module (`raw.rs`, `csv.rs`, `recording.rs`, `candump.rs`, `asc.rs`,
+//! `blf.rs`, `trc.rs`, `can_csv.rs`, `candump_text.rs`, `ports.rs`) declaring
 //! its [`InputFormat`] (names, clock, whether live, whether its streams are recorded ports:
 //! what [`crate::Sources`] and the summary ask of a format) and implementing `Source`
 //! (its reading, its streams, its flagged bytes). Standard input and files are read as their
 //! content says.
 
 mod ahead;
+mod asc;
+mod blf;
+mod can_csv;
+mod can_log;
 mod candump;
+mod candump_text;
 mod csv;
 mod error;
 mod looks;
 mod ports;
 mod raw;
 mod recording;
+mod trc;
 
 use std::fmt;
 use std::fs::File;
@@ -41,7 +50,6 @@ use crate::notice::{self, Notice, NoticeSink};
 use crate::pcapng;
 use crate::serial::PortSet;
 
-use self::candump::CandumpReader;
 use self::csv::{CsvRows, may_be_header};
 pub use self::error::InputError;
 pub use self::looks::Looks;
@@ -107,6 +115,12 @@ impl InputFormat {
     /// the same port are one ESC, one stream, its bytes merged in time order.
     pub(crate) fn has_recorded_ports(self) -> bool {
         self.recorded_ports
+    }
+
+    /// Whether an input of this format may carry CAN buses that can be read ahead: a CAN log
+    /// or a recording (its buses planned before it is read: `sources/can_plan.rs`).
+    pub(crate) fn may_carry_can(self) -> bool {
+        self == InputFormat::RECORDING || can_log::FORMATS.contains(&self)
     }
 
     /// Whether inputs of this format are read together with those of the same clock given
@@ -430,9 +444,8 @@ impl Input {
         let source: Box<dyn Source> = if recording::is_start(&head) {
             let reader = Box::new(Cursor::new(head).chain(opened.reader()));
             Box::new(RecordingReader::new(reader))
-        } else if candump::is_start(&head) {
-            let reader = Box::new(Cursor::new(head).chain(opened.reader()));
-            Box::new(CandumpReader::new(reader))
+        } else if let Some(log) = can_log::Log::of(&head) {
+            log.source(Box::new(Cursor::new(head).chain(opened.reader())))
         } else if csv::is_header(&head) {
             let reader = BufReader::with_capacity(BATCH, opened.reader());
             Box::new(CsvRows::open(name, reader, head)?)
@@ -695,8 +708,9 @@ fn read_head(name: &str, reader: &mut dyn Read) -> Result<Vec<u8>, InputError> {
             break;
         }
         head.push(byte[0]);
-        // A candump log starts with its first line, `(` and a timestamp, read whole.
-        let may_be = may_be_header(&head) || candump::may_start(&head);
+        // A CAN log starts with its first line, read whole (a candump log's `(` and a
+        // timestamp, an ASC log's date), or its magic (BLF).
+        let may_be = may_be_header(&head) || can_log::may_start(&head);
         if !may_be || byte[0] == b'\n' || head.len() >= 512 {
             break;
         }

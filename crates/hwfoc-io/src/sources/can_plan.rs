@@ -7,12 +7,12 @@ use std::collections::VecDeque;
 
 use super::Sources;
 use crate::esc_table::Recording;
-use crate::input::{Input, InputFormat};
+use crate::input::Input;
 use crate::notice::Notice;
 use crate::stream::{BusLearner, BusPlan, no_status};
 
 impl Sources {
-    /// Reads ahead the CAN buses of the inputs that can be read twice (candump logs and
+    /// Reads ahead the CAN buses of the inputs that can be read twice (CAN logs and
     /// recordings given as files; not copies of an earlier input, which are not read), bus by
     /// bus as their streams are named in their recording (the interfaces of the files of one
     /// recording that name one bus are one bus: `esc_table.rs`), and tells of the ESCs that
@@ -26,10 +26,7 @@ impl Sources {
         for (k, input) in inputs.iter_mut().enumerate() {
             let format = input.format();
             let copy = self.duplicates.get(base + k).copied().flatten().is_some();
-            if copy
-                || !(format == InputFormat::CANDUMP || format == InputFormat::RECORDING)
-                || !input.rewind()
-            {
+            if copy || !format.may_carry_can() || !input.rewind() {
                 continue;
             }
             let mut first = true;

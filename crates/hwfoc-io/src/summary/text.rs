@@ -34,7 +34,11 @@ impl Report<'_> {
                 continue;
             }
             let escs = match info.escs.as_slice() {
-                [] => "no ESC".to_string(),
+                [] => match info.looks {
+                    // A CAN log without ESC status: its frames in CAN words.
+                    Some(looks @ crate::Looks::Can { .. }) => format!("no ESC: {looks}"),
+                    _ => "no ESC".to_string(),
+                },
                 [one] => format!("ESC {one}"),
                 [first, .., last] if last - first + 1 == info.escs.len() => {
                     format!("ESCs {first} to {last}")
