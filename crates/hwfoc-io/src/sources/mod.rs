@@ -109,6 +109,9 @@ pub struct Sources {
     esc_settings: Vec<Settings>,
     pending: Vec<Input>,
     names: Vec<String>,
+    /// The first input with frames of an ESC past the last ESC number, not handed on: the run
+    /// fails ([`InputError::TooManyEscs`]) once the others are.
+    unnumbered: Option<usize>,
     read: Vec<InputInfo>,
     escs: Vec<Esc>,
     /// Which ESC is which (`esc_table.rs`).
@@ -152,6 +155,7 @@ impl Sources {
         Sources {
             settings: settings.into(),
             names: inputs.iter().map(|i| i.name().to_string()).collect(),
+            unnumbered: None,
             pending: inputs,
             read: Vec::new(),
             escs: Vec::new(),
@@ -371,6 +375,12 @@ impl Sources {
             }
         }
         result?;
+        if let Some(input) = self.unnumbered {
+            return Err(InputError::TooManyEscs {
+                input: self.names[input].clone(),
+            }
+            .into());
+        }
         handler.end_batch(false)
     }
 

@@ -40,9 +40,11 @@ impl Sources {
         };
         self.grow_hub(esc, places);
         let hub = &self.hubs[&esc];
+        let mut unnumbered = false;
         for (t, channel, d) in pending {
             let c = usize::from(channel);
             let Some(&id) = hub.escs.get(c).filter(|&&e| e != UNNUMBERED) else {
+                unnumbered = true;
                 continue;
             };
             match to {
@@ -51,6 +53,10 @@ impl Sources {
                 }
                 Deliver::Queue => self.queue.push(id, t, &d),
             }
+        }
+        // An ESC past the last number: told at the end of the run (`Sources::run`).
+        if unnumbered {
+            self.unnumbered.get_or_insert(self.table[esc].input);
         }
     }
 
@@ -242,7 +248,12 @@ pub(super) fn route<'h>(
         (None, _) => Some((own, None)),
         (Some(c), Some(hub)) if usize::from(c) < hub.escs.len() => {
             let c = usize::from(c);
-            (hub.escs[c] != UNNUMBERED).then(|| (hub.escs[c], Some(&hub.settings[c])))
+            if hub.escs[c] == UNNUMBERED {
+                // To `Sources::deliver`, which tells of it.
+                pending.push((t, c as u8, *d));
+                return None;
+            }
+            Some((hub.escs[c], Some(&hub.settings[c])))
         }
         (Some(c), _) => {
             pending.push((t, c, *d));
