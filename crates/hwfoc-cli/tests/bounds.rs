@@ -47,6 +47,18 @@ fn intervals_and_durations_have_a_range() {
         ],
         "not a positive",
     );
+    // A file a second at most: --rotate-time 0.001 wrote about 38 files a second.
+    refused(
+        &[
+            "record",
+            "/dev/ttyUSB9",
+            "-o",
+            "x.pcapng",
+            "--rotate-time",
+            "0.001",
+        ],
+        "--rotate-time is at least 1 second",
+    );
 }
 
 #[test]
