@@ -214,6 +214,9 @@ pub struct EscView {
     recent: VecDeque<f64>,
     /// When watching started (for an ESC that never sends: stale from then on).
     started: f64,
+    /// Its ESC number, the records' `esc` (a hub channel's, a CAN ESC's place on its bus):
+    /// the port's own index until a frame says.
+    pub number: usize,
 }
 
 impl EscView {
@@ -487,6 +490,7 @@ impl Fleet {
                 alarms: Alarms::default(),
                 recent: VecDeque::new(),
                 started: now,
+                number: i,
             })
             .collect::<Vec<_>>();
         Fleet {
@@ -688,6 +692,7 @@ impl Fleet {
     fn on_data(&mut self, i: usize, t: f64, r: Record) {
         let limits = &self.limits;
         let esc = &mut self.escs[i];
+        esc.number = usize::from(r.esc);
         esc.last = Some(r);
         esc.last_frame_t = Some(t);
         esc.peaks.add(&r);
@@ -1068,6 +1073,37 @@ mod tests {
         let views: Vec<&str> = f.escs.iter().map(|e| e.name.as_str()).collect();
         assert_eq!(views, ["vcan0 node 10 ch 2", "slcan:/dev/ttyACM0:1M"]);
         assert_eq!(f.escs[0].last.unwrap().esc, esc);
+    }
+
+    /// A CAN ESC's view carries the records' ESC number (its place: node id before a GetEscID
+    /// answer), whatever order the ESCs were heard in: the monitor's `esc` is the records'.
+    #[test]
+    fn a_can_escs_view_is_numbered_as_its_records() {
+        use hwfoc::dronecan::{Message, StatusMsg1};
+        let mut f = fleet_of(vec!["can:vcan0".to_string()]);
+        let bytes = |m: Message, node: u8| -> Vec<u8> {
+            m.frames(16, node, 0, 0)
+                .flat_map(|fr| fr.to_socketcan_record())
+                .collect()
+        };
+        let m1 = StatusMsg1 {
+            rpm: 100,
+            pwm: 100,
+            status: 0,
+        };
+        f.on_event(&data(0, 1000.0, bytes(m1.into(), 13)));
+        f.on_event(&data(0, 1000.1, bytes(m1.into(), 11)));
+        let got: Vec<(usize, u8)> = f
+            .escs
+            .iter()
+            .map(|e| (e.number, e.last.unwrap().esc))
+            .collect();
+        assert_eq!(got, [(13, 13), (11, 11)]);
+        // --json and --plain say so.
+        let json = super::super::headless::status_json(&f.escs[1], 1000.2);
+        assert_eq!(json["esc"], 11, "{json}");
+        let line = super::super::headless::status_line(&f.escs[1], 1000.2);
+        assert!(line.contains(" esc11 "), "{line}");
     }
 
     #[test]
