@@ -678,11 +678,23 @@ impl<H: Handler> Takes for ToHandler<'_, '_, H> {
 
     #[inline(always)]
     fn run(&mut self, frames: &[DataFrame]) {
+        // After a hub frame waiting for its channel's number: in order, behind it.
+        if !self.pending.is_empty() {
+            let frames = frames.iter().map(|f| Frame::Data(Data::HwFoc(*f)));
+            self.pending.extend(frames.map(|f| (None, None, f)));
+            return;
+        }
         self.handler.untimed_data(self.id, frames, self.settings);
     }
 
     #[inline(always)]
     fn other(&mut self, t: Option<f64>, channel: Option<u8>, d: &Frame) {
+        // After a hub frame waiting for its channel's number: in order, behind it (a file read
+        // in one batch gave the hub's frames after every later ESC frame of the batch).
+        if !self.pending.is_empty() {
+            self.pending.push((t, channel, *d));
+            return;
+        }
         match route(self.own, self.hub, t, channel, d, self.pending) {
             Some((_, None)) => self.handler.frame(self.id, t, d, self.settings),
             Some((esc, Some(settings))) => {
