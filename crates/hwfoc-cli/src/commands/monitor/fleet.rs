@@ -1033,12 +1033,28 @@ mod tests {
         assert_eq!(f.log_since(0).count(), 7);
     }
 
+    /// The SocketCAN records of message `m` from node `node`, transfer id `tid`.
+    fn can_bytes(m: hwfoc::dronecan::Message, node: u8, tid: u8) -> Vec<u8> {
+        m.frames(16, node, 0, tid)
+            .flat_map(|fr| fr.to_socketcan_record())
+            .collect()
+    }
+
+    /// A Hobbywing StatusMsg1 of a motor turning slowly.
+    fn status1() -> hwfoc::dronecan::StatusMsg1 {
+        hwfoc::dronecan::StatusMsg1 {
+            rpm: 100,
+            pwm: 100,
+            status: 0,
+        }
+    }
+
     /// A CAN ESC's row names its bus and node, and the channel it learns; it keeps its ESC
     /// number and its view when a GetEscID answer maps it. A bus says what it lacks in CAN
     /// words (it was "finding the baud rate").
     #[test]
     fn a_can_esc_is_named_by_bus_node_and_channel_and_keeps_its_number() {
-        use hwfoc::dronecan::{GetEscId, Message, StatusMsg1};
+        use hwfoc::dronecan::{GetEscId, Message};
         let mut f = fleet_of(vec![
             "can:vcan0".to_string(),
             "slcan:/dev/ttyACM0:1M".to_string(),
@@ -1051,16 +1067,8 @@ mod tests {
             (f.escs[0].rate_text(), f.escs[1].rate_text()),
             ("CAN".to_string(), "CAN 1000 kbit/s".to_string())
         );
-        let bytes = |m: Message, tid: u8| -> Vec<u8> {
-            m.frames(16, 10, 0, tid)
-                .flat_map(|fr| fr.to_socketcan_record())
-                .collect()
-        };
-        let m1 = StatusMsg1 {
-            rpm: 100,
-            pwm: 100,
-            status: 0,
-        };
+        let bytes = |m: Message, tid: u8| can_bytes(m, 10, tid);
+        let m1 = status1();
         f.on_event(&data(0, 1000.0, bytes(m1.into(), 0)));
         let esc = f.escs[0].last.unwrap().esc;
         assert_eq!(f.escs[0].name, "vcan0 node 10");
@@ -1079,20 +1087,9 @@ mod tests {
     /// answer), whatever order the ESCs were heard in: the monitor's `esc` is the records'.
     #[test]
     fn a_can_escs_view_is_numbered_as_its_records() {
-        use hwfoc::dronecan::{Message, StatusMsg1};
         let mut f = fleet_of(vec!["can:vcan0".to_string()]);
-        let bytes = |m: Message, node: u8| -> Vec<u8> {
-            m.frames(16, node, 0, 0)
-                .flat_map(|fr| fr.to_socketcan_record())
-                .collect()
-        };
-        let m1 = StatusMsg1 {
-            rpm: 100,
-            pwm: 100,
-            status: 0,
-        };
-        f.on_event(&data(0, 1000.0, bytes(m1.into(), 13)));
-        f.on_event(&data(0, 1000.1, bytes(m1.into(), 11)));
+        f.on_event(&data(0, 1000.0, can_bytes(status1().into(), 13, 0)));
+        f.on_event(&data(0, 1000.1, can_bytes(status1().into(), 11, 0)));
         let got: Vec<(usize, u8)> = f
             .escs
             .iter()
