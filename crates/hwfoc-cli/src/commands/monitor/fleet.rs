@@ -1101,6 +1101,24 @@ mod tests {
         assert_eq!(json["esc"], 11, "{json}");
         let line = super::super::headless::status_line(&f.escs[1], 1000.2);
         assert!(line.contains(" esc11 "), "{line}");
+        // `[esc.11]` applies to node 11's view, whatever order the ESCs were heard in.
+        let mut settings = hwfoc_io::SettingsMap::new(Settings::DEFAULT);
+        let patch = hwfoc_io::SettingsPatch {
+            pole_pairs: Some(14),
+            ..Default::default()
+        };
+        settings.set_esc(11, patch).unwrap();
+        let limits = f.limits.clone();
+        let names = vec![("can:vcan0".to_string(), None)];
+        let mut f = Fleet::new(names, settings, limits, Baud::Fixed(19_200), 1000.0);
+        f.on_event(&data(0, 1000.0, can_bytes(status1().into(), 13, 0)));
+        f.on_event(&data(0, 1000.1, can_bytes(status1().into(), 11, 0)));
+        let pole_pairs: Vec<(usize, u16)> = f
+            .escs
+            .iter()
+            .map(|e| (e.number, e.settings.pole_pairs))
+            .collect();
+        assert_eq!(pole_pairs, [(13, 7), (11, 14)]);
     }
 
     #[test]
