@@ -73,8 +73,9 @@ struct Slot {
     arrived: Instant,
 }
 
-/// DataLink V2 frames of up to eight ESCs of any format (ESC `n` in channel `n`; ESCs past 7
-/// are not carried and are counted in [`DatalinkOutput::escs_not_carried`]).
+/// DataLink V2 frames of up to eight ESCs of any format (ESC `n` in channel `n`: an ESC is
+/// sent in the channel of its ESC number, a CAN ESC's too; ESCs past 7 are not carried and are
+/// counted in [`OutputStats::left_out`]).
 pub struct DatalinkOutput {
     name: String,
     line: Line,
@@ -84,7 +85,6 @@ pub struct DatalinkOutput {
     /// Each channel's packet counter, for formats without their own.
     packets: [u16; datalink::CHANNELS],
     last_sent: Option<Instant>,
-    not_carried: u64,
     stats: OutputStats,
 }
 
@@ -121,14 +121,13 @@ impl DatalinkOutput {
             counter: 0,
             packets: [0; datalink::CHANNELS],
             last_sent: None,
-            not_carried: 0,
             stats: OutputStats::default(),
         }
     }
 
     /// Frames of ESCs numbered 8 or more, which a DataLink frame has no channel for.
     pub fn escs_not_carried(&self) -> u64 {
-        self.not_carried
+        self.stats.left_out.frames
     }
 
     /// Whether the gap since the last frame is at least `gap`.
@@ -197,7 +196,7 @@ impl Output for DatalinkOutput {
 
     fn update(&mut self, update: &Update<'_>) {
         let Some(index) = Some(usize::from(update.esc)).filter(|&e| e < datalink::CHANNELS) else {
-            self.not_carried += 1;
+            self.stats.left_out.add(update.esc);
             return;
         };
         // A hub record is an HW-FOC frame: another format's is converted to one.
@@ -237,5 +236,9 @@ impl Output for DatalinkOutput {
 
     fn stats(&self) -> &OutputStats {
         &self.stats
+    }
+
+    fn carries(&self) -> usize {
+        datalink::CHANNELS
     }
 }

@@ -1,5 +1,6 @@
 //! Every frame of every ESC to every output: the bridge's [`Handler`].
 
+use std::collections::BTreeSet;
 use std::time::Instant;
 
 use hwfoc::Settings;
@@ -14,8 +15,8 @@ pub struct Fanout {
     outputs: Vec<Box<dyn Output>>,
     arrived: Instant,
     frames: u64,
-    /// The highest ESC number seen, plus one.
-    escs: usize,
+    /// The ESCs heard, by number.
+    escs: BTreeSet<u8>,
 }
 
 impl Fanout {
@@ -25,7 +26,7 @@ impl Fanout {
             outputs,
             arrived: Instant::now(),
             frames: 0,
-            escs: 0,
+            escs: BTreeSet::new(),
         }
     }
 
@@ -54,9 +55,9 @@ impl Fanout {
         self.frames
     }
 
-    /// How many ESCs were heard (the highest ESC number plus one).
-    pub fn escs(&self) -> usize {
-        self.escs
+    /// The ESCs heard, by number (CAN ESCs numbered by node id may start at 10).
+    pub fn escs(&self) -> &BTreeSet<u8> {
+        &self.escs
     }
 }
 
@@ -79,6 +80,6 @@ impl Handler for Fanout {
             output.update(&update);
         }
         self.frames += 1;
-        self.escs = self.escs.max(usize::from(esc) + 1);
+        self.escs.insert(esc);
     }
 }

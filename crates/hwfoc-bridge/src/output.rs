@@ -1,5 +1,6 @@
 //! The seam between the bridge's inputs and its outputs: the [`Output`] trait.
 
+use std::collections::BTreeSet;
 use std::fmt;
 use std::time::{Duration, Instant};
 
@@ -49,6 +50,59 @@ pub trait Output {
 
     /// The output's counters so far.
     fn stats(&self) -> &OutputStats;
+
+    /// How many ESCs its protocol can carry: ESCs numbered this or more are not sent (counted
+    /// in [`OutputStats::left_out`]).
+    fn carries(&self) -> usize;
+}
+
+/// The frames an output could not send because their ESC's number is past what its protocol
+/// carries ([`Output::carries`]).
+#[derive(Debug, Clone, Default)]
+pub struct LeftOut {
+    /// Frames not sent.
+    pub frames: u64,
+    /// The ESCs they were of.
+    pub escs: BTreeSet<u8>,
+}
+
+impl LeftOut {
+    /// A frame of ESC `esc`, not sent.
+    pub fn add(&mut self, esc: u8) {
+        self.frames += 1;
+        self.escs.insert(esc);
+    }
+}
+
+/// ESC numbers as people read a list of them: `10 to 13`, `8, 9, 12`.
+pub fn esc_list(escs: &BTreeSet<u8>) -> String {
+    let mut runs: Vec<(u8, u8)> = Vec::new();
+    for &esc in escs {
+        match runs.last_mut() {
+            Some((_, last)) if u16::from(*last) + 1 == u16::from(esc) => *last = esc,
+            _ => runs.push((esc, esc)),
+        }
+    }
+    let runs: Vec<String> = runs
+        .iter()
+        .map(|&(a, b)| match b - a {
+            0 => a.to_string(),
+            1 => format!("{a}, {b}"),
+            _ => format!("{a} to {b}"),
+        })
+        .collect();
+    runs.join(", ")
+}
+
+/// The error of an output that left ESCs out ([`OutputError::NotCarried`]), if it did.
+pub fn left_out(output: &dyn Output) -> Option<OutputError> {
+    let left = &output.stats().left_out;
+    (left.frames > 0).then(|| OutputError::NotCarried {
+        output: output.name().to_string(),
+        escs: esc_list(&left.escs),
+        frames: left.frames,
+        carries: output.carries(),
+    })
 }
 
 /// What an output has done.
@@ -64,6 +118,8 @@ pub struct OutputStats {
     pub superseded: u64,
     /// From the read that completed an ESC frame to the write of the message carrying it.
     pub latency: Latency,
+    /// Frames of ESCs numbered past what the output's protocol carries.
+    pub left_out: LeftOut,
 }
 
 /// Why an output could not send.
@@ -84,6 +140,17 @@ pub enum OutputError {
         /// What the operating system said.
         reason: String,
     },
+    /// Frames of ESCs numbered past what the output's protocol carries were not sent.
+    NotCarried {
+        /// The output ([`Output::name`]).
+        output: String,
+        /// The ESCs left out, as [`esc_list`] words them.
+        escs: String,
+        /// How many frames.
+        frames: u64,
+        /// How many ESCs the output carries ([`Output::carries`]).
+        carries: usize,
+    },
     /// The output cannot be opened at all: a bad address, a port that does not exist.
     Open {
         /// The output as the user named it.
@@ -101,8 +168,37 @@ impl fmt::Display for OutputError {
                 write!(f, "{output}: lost ({reason}); reopening")
             }
             OutputError::Open { output, reason } => write!(f, "{output}: cannot open: {reason}"),
+            OutputError::NotCarried {
+                output,
+                escs,
+                frames,
+                carries,
+            } => write!(
+                f,
+                "{output}: {frames} frames of ESC{} {escs} not sent: it carries ESCs 0 to {}",
+                if escs.contains(|c: char| !c.is_ascii_digit()) {
+                    "s"
+                } else {
+                    ""
+                },
+                carries.saturating_sub(1)
+            ),
         }
     }
 }
 
 impl std::error::Error for OutputError {}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn esc_lists_join_runs() {
+        let list = |escs: &[u8]| esc_list(&escs.iter().copied().collect());
+        assert_eq!(list(&[10, 11, 12, 13]), "10 to 13");
+        assert_eq!(list(&[8, 9, 12]), "8, 9, 12");
+        assert_eq!(list(&[254, 255]), "254, 255");
+        assert_eq!(list(&[]), "");
+    }
+}

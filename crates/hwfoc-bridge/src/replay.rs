@@ -2,7 +2,9 @@
 //! the first frame as passed between them on the wire. A discontinuity of an ESC's receive
 //! clock ([`Step`]: a step back, or a jump forward its packet numbers do not explain, such as
 //! a computer that booted in 1970 and then synced) is replayed as one frame period: the replay
-//! never waits for a clock that jumped years ahead. An ESC's first frame is measured from the
+//! never waits for a clock that jumped years ahead. Each ESC's clock is followed on its own: a
+//! step back seen on one ESC moves that ESC's origin only, so the frames of the others still
+//! before the step are not held back by it. An ESC's first frame is measured from the
 //! frame before it of any ESC: more than a second after it (every ESC silent, or a jump) is
 //! one frame period.
 
@@ -48,6 +50,20 @@ impl fmt::Display for ReplayError {
 
 impl std::error::Error for ReplayError {}
 
+/// An ESC's last timed frame, as replayed.
+#[derive(Debug, Clone, Copy)]
+struct Timed {
+    /// Its receive time.
+    t: f64,
+    /// Its packet number, of a data frame.
+    packet: Option<u32>,
+    /// Seconds after the replay's first instant it was due.
+    after: f64,
+    /// The receive time replayed at the replay's first instant, for this ESC: a frame at `t`
+    /// is due `t - origin` seconds after it.
+    origin: f64,
+}
+
 /// A [`Handler`] that holds each frame back until its time has come, then hands it to the
 /// [`Fanout`]; the outputs are polled meanwhile. Frames with receive times keep their spacing
 /// (their times are taken in the order the inputs give them: a frame due earlier than the one
@@ -57,16 +73,15 @@ pub struct Replay<'a, E> {
     fanout: &'a mut Fanout,
     stop: &'a AtomicBool,
     on_error: E,
-    /// The receive time replayed at an instant, and that instant: a frame at `t` is due
-    /// `t - origin.0` seconds after `origin.1`. It moves at each discontinuity.
-    origin: Option<(f64, Instant)>,
-    /// Per ESC, its last timed frame: receive time, packet number (of a data frame), and
-    /// seconds after the origin's instant it was due.
-    last: Vec<Option<(f64, Option<u32>, f64)>>,
-    /// The last timed frame of any ESC, as in `last`: what an ESC's first frame is measured
-    /// from (without a packet number in common, a step over [`hwfoc_io::clock::MAX_STEP_S`]
-    /// is a jump).
-    latest: Option<(f64, Option<u32>, f64)>,
+    /// The instant the first timed frame was replayed at: every due time is counted from it.
+    at: Option<Instant>,
+    /// Per ESC, its last timed frame ([`Timed`]). Each ESC has its own origin, moved at each
+    /// discontinuity of its own clock only: a clock that steps back on every ESC, one ESC
+    /// after another, never holds the other ESCs back by the step.
+    last: Vec<Option<Timed>>,
+    /// The last timed frame of any ESC: what an ESC's first frame is measured from (without a
+    /// packet number in common, a step over [`hwfoc_io::clock::MAX_STEP_S`] is a jump).
+    latest: Option<Timed>,
     /// When the replay started, for untimed frames.
     start: Instant,
     /// Untimed frames handed on so far, per ESC.
@@ -81,7 +96,7 @@ impl<'a, E: FnMut(OutputError)> Replay<'a, E> {
             fanout,
             stop,
             on_error,
-            origin: None,
+            at: None,
             last: Vec::new(),
             latest: None,
             start: Instant::now(),
@@ -98,25 +113,39 @@ impl<'a, E: FnMut(OutputError)> Replay<'a, E> {
                 if self.last.len() <= esc {
                     self.last.resize(esc + 1, None);
                 }
-                let (mut t0, at) = *self.origin.get_or_insert((t, Instant::now()));
+                let at = *self.at.get_or_insert_with(Instant::now);
                 let before = match self.last[esc] {
                     Some(own) => Some(own),
-                    None => self.latest.map(|(t, _, due)| (t, None, due)),
+                    None => self.latest.map(|latest| Timed {
+                        packet: None,
+                        ..latest
+                    }),
                 };
-                if let Some((last_t, last_packet, last_due)) = before {
-                    let packets = last_packet
-                        .zip(packet)
-                        .zip(protocol)
-                        .and_then(|((a, b), p)| p.packets_between(a, b));
-                    if Step::between(last_t, t, packets).is_discontinuity() {
-                        // One frame period after the ESC's frame before.
-                        t0 = t - (last_due + NOMINAL_PERIOD_S);
-                        self.origin = Some((t0, at));
+                let origin = match before {
+                    None => t,
+                    Some(before) => {
+                        let packets = before
+                            .packet
+                            .zip(packet)
+                            .zip(protocol)
+                            .and_then(|((a, b), p)| p.packets_between(a, b));
+                        if Step::between(before.t, t, packets).is_discontinuity() {
+                            // One frame period after the ESC's frame before.
+                            t - (before.after + NOMINAL_PERIOD_S)
+                        } else {
+                            before.origin
+                        }
                     }
-                }
-                let after = (t - t0).clamp(0.0, 1e9);
-                self.last[esc] = Some((t, packet, after));
-                self.latest = self.last[esc];
+                };
+                let after = (t - origin).clamp(0.0, 1e9);
+                let timed = Timed {
+                    t,
+                    packet,
+                    after,
+                    origin,
+                };
+                self.last[esc] = Some(timed);
+                self.latest = Some(timed);
                 at + Duration::from_secs_f64(after)
             }
             None => {
@@ -224,5 +253,59 @@ mod tests {
         let first = replay.due(0, Some(start), Some((Protocol::HwFoc, 0)));
         let other = replay.due(1, Some(start + 0.5), Some((Protocol::HwFoc, 9)));
         assert!((after(other, first) - 0.5).abs() < 1e-6);
+    }
+
+    #[test]
+    fn a_clock_stepping_back_on_every_esc_holds_none_back() {
+        // 4 ESCs, 74 frames each 50 ms apart (3.7 s), the clock set back 10 s after frame 36,
+        // ESC 0's first frame after the step handed on before the other ESCs' last ones
+        // before it (the merge hands on the earliest time first).
+        let mut fanout = Fanout::new(Vec::new());
+        let stop = AtomicBool::new(false);
+        let mut replay = Replay::new(&mut fanout, &stop, |_| {});
+        let start = 1_795_442_580.0;
+        let time = |k: u32| {
+            let t = start + f64::from(k) * 0.05;
+            if k >= 37 { t - 10.0 } else { t }
+        };
+        let mut order: Vec<(u8, u32)> = Vec::new();
+        for k in 0..74 {
+            for esc in 0..4 {
+                order.push((esc, k));
+            }
+        }
+        let first_after = order.iter().position(|&f| f == (0, 37)).unwrap();
+        let moved = order.remove(first_after);
+        order.insert(first_after - 3, moved);
+        let dues: Vec<Instant> = order
+            .iter()
+            .map(|&(esc, k)| replay.due(esc, Some(time(k)), Some((Protocol::HwFoc, k))))
+            .collect();
+        let first = dues[0];
+        let last = dues
+            .iter()
+            .max()
+            .unwrap()
+            .duration_since(first)
+            .as_secs_f64();
+        assert!(
+            last < 3.8,
+            "the replay lasts {last} s for a 3.7 s recording"
+        );
+        // Each ESC keeps its own spacing across the step.
+        for esc in 0..4 {
+            let own: Vec<f64> = order
+                .iter()
+                .zip(&dues)
+                .filter(|((e, _), _)| *e == esc)
+                .map(|(_, due)| due.duration_since(first).as_secs_f64())
+                .collect();
+            for pair in own.windows(2) {
+                assert!(
+                    (pair[1] - pair[0] - 0.05).abs() < 1e-6,
+                    "ESC {esc}: {pair:?}"
+                );
+            }
+        }
     }
 }

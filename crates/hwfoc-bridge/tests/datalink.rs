@@ -186,6 +186,13 @@ fn a_silent_esc_is_sent_empty_and_escs_past_seven_are_counted() {
     assert!(frames[0].slots[1].is_some());
     assert_eq!(frames[1].slots[1], None);
     assert_eq!(out.escs_not_carried(), 1);
+    let error = hwfoc_bridge::output::left_out(&out).expect("ESC 9 left out");
+    assert!(
+        error
+            .to_string()
+            .ends_with(": 1 frames of ESC 9 not sent: it carries ESCs 0 to 7"),
+        "{error}"
+    );
 }
 
 #[test]

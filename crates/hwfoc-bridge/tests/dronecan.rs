@@ -386,6 +386,14 @@ fn transfer_ids_wrap_and_stale_or_unnumbered_escs_are_not_sent() {
         "{transfers:?}"
     );
     assert_eq!(out.not_sent(), 2);
+    // ESC 32 is told, the stale frame (not a limit) is not.
+    let error = hwfoc_bridge::output::left_out(&out).expect("ESC 32 left out");
+    assert!(
+        error
+            .to_string()
+            .ends_with(": 1 frames of ESC 32 not sent: it carries ESCs 0 to 31"),
+        "{error}"
+    );
 }
 
 #[test]

@@ -278,6 +278,26 @@ fn groups_follow_the_number_of_escs() {
 }
 
 #[test]
+fn escs_past_64_are_not_sent_and_told() {
+    let mut rig = Rig::new(MavlinkOptions::default());
+    let now = Instant::now();
+    for esc in [63, 64, 65, 200] {
+        rig.update(esc, None, &frame(1, Status::OK), now);
+    }
+    rig.out.poll(now).unwrap();
+    let got = names(&rig.received());
+    assert!(got.contains(&"ESC_STATUS[60]".to_string()), "{got:?}");
+    assert!(got.iter().all(|m| !m.ends_with("[64]")), "{got:?}");
+    let error = hwfoc_bridge::output::left_out(&rig.out).expect("ESCs 64 and up left out");
+    assert!(
+        error
+            .to_string()
+            .ends_with(": 3 frames of ESCs 64, 65, 200 not sent: it carries ESCs 0 to 63"),
+        "{error}"
+    );
+}
+
+#[test]
 fn a_silent_esc_is_zeros_offline_and_then_not_sent() {
     let mut rig = Rig::new(MavlinkOptions::default());
     let t0 = Instant::now();

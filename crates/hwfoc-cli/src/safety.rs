@@ -72,3 +72,34 @@ pub fn refuse_input<'a>(
         None => Ok(()),
     }
 }
+
+/// Whether writing `a` and writing `b` would write one file: the same name, the same existing
+/// file (by device and inode), or the same place once links are followed, dangling ones too
+/// (`--truth link` where `link` points at the recording `-o` is about to create).
+pub fn same_output(a: &str, b: &str) -> bool {
+    a == b
+        || hwfoc_io::write::same_file(a, b)
+        || written_at(Path::new(a)).is_some_and(|p| Some(p) == written_at(Path::new(b)))
+}
+
+/// Where a file written at `path` lands: its links followed (at most 40, as the kernel does),
+/// whether or not their target exists, in its directory made absolute; `None` when that
+/// directory cannot be told.
+fn written_at(path: &Path) -> Option<PathBuf> {
+    let mut path = path.to_path_buf();
+    for _ in 0..40 {
+        let Ok(target) = std::fs::read_link(&path) else {
+            break;
+        };
+        path = match path.parent() {
+            Some(dir) => dir.join(target),
+            None => target,
+        };
+    }
+    let name = path.file_name()?;
+    let dir = match path.parent() {
+        Some(dir) if !dir.as_os_str().is_empty() => dir.to_path_buf(),
+        _ => PathBuf::from("."),
+    };
+    Some(dir.canonicalize().ok()?.join(name))
+}

@@ -487,3 +487,36 @@ fn a_candump_log_of_can_escs_goes_out_on_datalink_with_their_voltages_and_curren
         );
     }
 }
+
+#[test]
+fn can_escs_numbered_by_node_id_past_the_datalink_channels_are_told_and_fail_the_bridge() {
+    // Four ESCs never asked for their ids: nodes 10 to 13, ESCs 10 to 13, which DataLink's
+    // eight channels cannot carry.
+    let dir = Dir::new();
+    let log = dir.arg("bus.log");
+    ok(run(hwfoc().args([
+        "simulate",
+        "--protocol",
+        "hw-can",
+        "--escs",
+        "4",
+        "--no-ask-ids",
+        "--duration",
+        "1",
+        "-o",
+        &log,
+    ])));
+    let (line, stop) = drained();
+    let bridge = run(hwfoc().args(["bridge", &log, "--datalink", &line.path.to_string_lossy()]));
+    stop.store(true, Ordering::Relaxed);
+    let report = String::from_utf8_lossy(&bridge.stderr).into_owned();
+    assert!(!bridge.status.success(), "output was lost: {report}");
+    assert!(
+        report.contains(" frames of 4 ESCs (10 to 13), "),
+        "{report}"
+    );
+    assert!(
+        report.contains("frames of ESCs 10 to 13 not sent: it carries ESCs 0 to 7"),
+        "{report}"
+    );
+}

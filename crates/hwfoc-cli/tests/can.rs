@@ -20,7 +20,7 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
 use std::time::Duration;
 
-use common::{Dir, assert_fails_with, hwfoc, records, stdout};
+use common::{Dir, assert_fails_with, hwfoc, ok, records, stdout};
 use hwfoc::dronecan::{
     CanFrame, EscStatus, GetEscId, Message, SOCKETCAN_ERR_FLAG, StatusMsg1, StatusMsg2,
 };
@@ -755,5 +755,36 @@ fn a_bus_of_error_frames_suggests_a_wrong_bit_rate_in_can_words() {
         for word in ["baud", "wiring", "RX"] {
             assert!(!err.contains(word), "{word}: {err}");
         }
+    }
+}
+
+/// Four buses of 63 ESCs never asked for their ids (nodes 10 to 72: 73 places a bus) need 292
+/// ESC numbers; records number 256. The ESCs past them are not dropped without a word: the
+/// command fails, naming the input.
+#[test]
+fn can_escs_past_the_last_esc_number_fail_the_command() {
+    let dir = Dir::new();
+    let one = dir.arg("bus.log");
+    ok(run(&[
+        "simulate",
+        "--protocol",
+        "hw-can",
+        "--escs",
+        "63",
+        "--no-ask-ids",
+        "--duration",
+        "1",
+        "-o",
+        &one,
+    ]));
+    let log = std::fs::read_to_string(&one).unwrap();
+    let four: String = (0..4)
+        .map(|bus| log.replace(" can0 ", &format!(" can{bus} ")))
+        .collect();
+    let buses = dir.arg("buses.log");
+    std::fs::write(&buses, four).unwrap();
+    for command in ["decode", "summary"] {
+        let out = run(&[command, &buses]);
+        assert_fails_with(&out, "buses.log: too many ESCs");
     }
 }

@@ -747,3 +747,42 @@ fn a_recording_is_never_written_over_a_port_it_reads() {
     assert_fails_with(&o, &format!("cannot write {port}: it is the input {port}"));
     assert_eq!(std::fs::read(&port).unwrap(), b"not to be destroyed");
 }
+
+/// `--truth` through a dangling link to the recording `-o` is about to write (serial pcapng,
+/// CAN candump and pcapng alike) is refused, as the same command is when the recording exists:
+/// written through, the truth would replace the recording.
+#[cfg(unix)]
+#[test]
+fn the_ground_truth_never_lands_on_the_recording_through_a_dangling_link() {
+    let cases: [&[&str]; 3] = [
+        &["--duration", "1"],
+        &["--protocol", "hw-can", "--escs", "2", "--duration", "1"],
+        &[
+            "--protocol",
+            "hw-can",
+            "--escs",
+            "2",
+            "--duration",
+            "1",
+            "--format",
+            "candump",
+        ],
+    ];
+    for extra in cases {
+        let dir = Dir::new();
+        let rec = dir.arg("rec.pcapng");
+        let link = dir.arg("link.jsonl");
+        std::os::unix::fs::symlink("rec.pcapng", &link).unwrap();
+        for (o, truth) in [(&rec, &link), (&link, &rec)] {
+            let out = run(hwfoc()
+                .arg("simulate")
+                .args(["-o", o, "--truth", truth, "--overwrite"])
+                .args(extra));
+            assert_fails_with(&out, "is also the output -o");
+            assert!(
+                !dir.path("rec.pcapng").exists(),
+                "{extra:?}: nothing written"
+            );
+        }
+    }
+}

@@ -417,6 +417,7 @@ impl Output for DronecanOutput {
     fn update(&mut self, update: &Update<'_>) {
         let Some(esc) = self.escs.get_mut(usize::from(update.esc)) else {
             self.not_sent += 1;
+            self.stats.left_out.add(update.esc);
             return;
         };
         let r = update.record;
@@ -509,6 +510,10 @@ impl Output for DronecanOutput {
 
     fn stats(&self) -> &OutputStats {
         &self.stats
+    }
+
+    fn carries(&self) -> usize {
+        MAX_ESCS
     }
 }
 

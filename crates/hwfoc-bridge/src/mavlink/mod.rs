@@ -520,6 +520,7 @@ impl Output for MavlinkOutput {
     fn update(&mut self, update: &Update<'_>) {
         let index = usize::from(update.esc);
         if index >= STATUS_GROUPS * GROUP {
+            self.stats.left_out.add(update.esc);
             return;
         }
         if self.escs.len() <= index {
@@ -623,5 +624,9 @@ impl Output for MavlinkOutput {
 
     fn stats(&self) -> &OutputStats {
         &self.stats
+    }
+
+    fn carries(&self) -> usize {
+        STATUS_GROUPS * GROUP
     }
 }

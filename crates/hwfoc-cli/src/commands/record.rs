@@ -90,8 +90,8 @@ pub struct RecordArgs {
     /// Start a new file before one would grow past BYTES (suffixes k, M, G, or KiB, MiB, GiB).
     #[arg(long, value_name = "BYTES", value_parser = parse_size, conflicts_with = "rotate_time")]
     pub rotate_size: Option<u64>,
-    /// Start a new file every SECONDS.
-    #[arg(long, value_name = "SECONDS", value_parser = parse_seconds)]
+    /// Start a new file every SECONDS (at least 1).
+    #[arg(long, value_name = "SECONDS", value_parser = parse_rotate_time)]
     pub rotate_time: Option<f64>,
     /// Stop after S seconds (otherwise on Ctrl-C or SIGTERM).
     #[arg(long, value_name = "S", value_parser = parse_seconds)]
@@ -132,6 +132,20 @@ fn parse_size(text: &str) -> Result<u64, String> {
 /// A positive number of seconds (see [`crate::args::seconds`]).
 fn parse_seconds(text: &str) -> Result<f64, String> {
     crate::args::seconds(text)
+}
+
+/// The shortest `--rotate-time`, s: a file a second at most.
+pub const MIN_ROTATE_S: f64 = 1.0;
+
+/// `--rotate-time`: seconds, at least [`MIN_ROTATE_S`].
+fn parse_rotate_time(text: &str) -> Result<f64, String> {
+    let s = crate::args::seconds(text)?;
+    if s < MIN_ROTATE_S {
+        return Err(format!(
+            "{text:?}: --rotate-time is at least {MIN_ROTATE_S} second (a new file a second at most)"
+        ));
+    }
+    Ok(s)
 }
 
 /// The name of file number `n` of a rotated recording: `out.pcapng` → `out-0001.pcapng`.

@@ -57,7 +57,7 @@ pub enum InputError {
     },
     /// More streams than the record's `esc` column can number (0..=255).
     TooManyEscs {
-        /// The input whose stream would be ESC 256 or more.
+        /// The input whose stream, hub channel or CAN ESC would be ESC 256 or more.
         input: String,
     },
     /// A classic libpcap file: recordings are read in pcapng.
@@ -112,7 +112,7 @@ impl fmt::Display for InputError {
             ),
             InputError::TooManyEscs { input } => write!(
                 f,
-                "{input}: too many streams: records number ESCs 0 to 255; read fewer inputs at once"
+                "{input}: too many ESCs: records number ESCs 0 to 255; read fewer inputs or buses at once"
             ),
             InputError::ClassicPcap { input } => {
                 let converted = match input.strip_suffix(".pcap") {

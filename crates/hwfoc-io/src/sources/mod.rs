@@ -109,6 +109,9 @@ pub struct Sources {
     esc_settings: Vec<Settings>,
     pending: Vec<Input>,
     names: Vec<String>,
+    /// The first input with frames of an ESC past the last ESC number, not handed on: the run
+    /// fails ([`InputError::TooManyEscs`]) once the others are.
+    unnumbered: Option<usize>,
     read: Vec<InputInfo>,
     escs: Vec<Esc>,
     /// Which ESC is which (`esc_table.rs`).
@@ -152,6 +155,7 @@ impl Sources {
         Sources {
             settings: settings.into(),
             names: inputs.iter().map(|i| i.name().to_string()).collect(),
+            unnumbered: None,
             pending: inputs,
             read: Vec::new(),
             escs: Vec::new(),
@@ -371,6 +375,12 @@ impl Sources {
             }
         }
         result?;
+        if let Some(input) = self.unnumbered {
+            return Err(InputError::TooManyEscs {
+                input: self.names[input].clone(),
+            }
+            .into());
+        }
         handler.end_batch(false)
     }
 
@@ -668,11 +678,23 @@ impl<H: Handler> Takes for ToHandler<'_, '_, H> {
 
     #[inline(always)]
     fn run(&mut self, frames: &[DataFrame]) {
+        // After a hub frame waiting for its channel's number: in order, behind it.
+        if !self.pending.is_empty() {
+            let frames = frames.iter().map(|f| Frame::Data(Data::HwFoc(*f)));
+            self.pending.extend(frames.map(|f| (None, None, f)));
+            return;
+        }
         self.handler.untimed_data(self.id, frames, self.settings);
     }
 
     #[inline(always)]
     fn other(&mut self, t: Option<f64>, channel: Option<u8>, d: &Frame) {
+        // After a hub frame waiting for its channel's number: in order, behind it (a file read
+        // in one batch gave the hub's frames after every later ESC frame of the batch).
+        if !self.pending.is_empty() {
+            self.pending.push((t, channel, *d));
+            return;
+        }
         match route(self.own, self.hub, t, channel, d, self.pending) {
             Some((_, None)) => self.handler.frame(self.id, t, d, self.settings),
             Some((esc, Some(settings))) => {

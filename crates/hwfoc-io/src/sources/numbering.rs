@@ -32,17 +32,29 @@ impl Sources {
         let places = if self.escs[esc].stream.is_can() {
             pending
                 .iter()
-                .map(|p| usize::from(p.1) + 1)
+                .filter_map(|p| p.1)
+                .map(|c| usize::from(c) + 1)
                 .max()
                 .unwrap_or(0)
         } else {
             CHANNELS
         };
         self.grow_hub(esc, places);
+        let own = self.esc_settings(esc);
         let hub = &self.hubs[&esc];
+        let mut unnumbered = false;
         for (t, channel, d) in pending {
+            // The stream's own frames that came after a hub frame in its batch, in their place.
+            let Some(channel) = channel else {
+                match to {
+                    Deliver::Handler(handler) => handler.frame(esc as u8, t, &d, &own),
+                    Deliver::Queue => self.queue.push(esc, t, &d),
+                }
+                continue;
+            };
             let c = usize::from(channel);
             let Some(&id) = hub.escs.get(c).filter(|&&e| e != UNNUMBERED) else {
+                unnumbered = true;
                 continue;
             };
             match to {
@@ -51,6 +63,10 @@ impl Sources {
                 }
                 Deliver::Queue => self.queue.push(id, t, &d),
             }
+        }
+        // An ESC past the last number: told at the end of the run (`Sources::run`).
+        if unnumbered {
+            self.unnumbered.get_or_insert(self.table[esc].input);
         }
     }
 
@@ -222,8 +238,9 @@ pub(super) struct Hub {
     settings: Vec<Settings>,
 }
 
-/// A frame of a channel that has no ESC yet: its time, channel and frame.
-pub(super) type Pending = (Option<f64>, u8, Frame);
+/// A frame of a channel that has no ESC yet (its time, channel and frame), or of the stream's
+/// own ESC (channel `None`) that came after one in its batch, kept in its place.
+pub(super) type Pending = (Option<f64>, Option<u8>, Frame);
 
 /// The ESC a frame of the stream of ESC `own` belongs to: `own` on its own wire; behind a hub
 /// whose channels are numbered (`hub`), its channel's ESC with that ESC's settings; `None` for a
@@ -242,10 +259,15 @@ pub(super) fn route<'h>(
         (None, _) => Some((own, None)),
         (Some(c), Some(hub)) if usize::from(c) < hub.escs.len() => {
             let c = usize::from(c);
-            (hub.escs[c] != UNNUMBERED).then(|| (hub.escs[c], Some(&hub.settings[c])))
+            if hub.escs[c] == UNNUMBERED {
+                // To `Sources::deliver`, which tells of it.
+                pending.push((t, Some(c as u8), *d));
+                return None;
+            }
+            Some((hub.escs[c], Some(&hub.settings[c])))
         }
         (Some(c), _) => {
-            pending.push((t, c, *d));
+            pending.push((t, Some(c), *d));
             None
         }
     }

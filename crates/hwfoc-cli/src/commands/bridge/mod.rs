@@ -209,7 +209,12 @@ pub fn run(args: &BridgeArgs) -> Result<(), CliError> {
     // What is still waiting goes out.
     fanout.poll(Instant::now(), |e| errors.report(&e));
     report::print(&fanout, started.elapsed());
-    result
+    result?;
+    // ESCs an output could not carry: output lost, said in the report and in the exit status.
+    match report::not_carried(&fanout) {
+        Some(e) => Err(CliError::Output(e)),
+        None => Ok(()),
+    }
 }
 
 /// Opens every output named; at least one.

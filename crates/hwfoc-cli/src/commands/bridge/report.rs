@@ -7,6 +7,7 @@ use std::time::{Duration, Instant};
 
 use hwfoc_bridge::OutputError;
 use hwfoc_bridge::fanout::Fanout;
+use hwfoc_bridge::output::{esc_list, left_out};
 use hwfoc_io::Escaped;
 
 /// How long the same failure message is not repeated.
@@ -61,12 +62,17 @@ pub fn print(fanout: &Fanout, ran: Duration) {
 /// counts ([`hwfoc_bridge::output::OutputStats::errors`]).
 fn counters(fanout: &Fanout, ran: Duration) -> String {
     let failures: u64 = fanout.outputs().iter().map(|o| o.stats().errors).sum();
+    let escs = fanout.escs();
     let mut text = format!(
-        "hwfoc bridge: {:.1} s, {} frames of {} ESC{}, {} output failure{}\n",
+        "hwfoc bridge: {:.1} s, {} frames of {} ESC{}{}, {} output failure{}\n",
         ran.as_secs_f64(),
         fanout.frames(),
-        fanout.escs(),
-        if fanout.escs() == 1 { "" } else { "s" },
+        escs.len(),
+        if escs.len() == 1 { "" } else { "s" },
+        match escs.is_empty() {
+            true => String::new(),
+            false => format!(" ({})", esc_list(escs)),
+        },
         failures,
         if failures == 1 { "" } else { "s" },
     );
@@ -87,8 +93,17 @@ fn counters(fanout: &Fanout, ran: Duration) -> String {
             ms(50.0),
             ms(99.0),
         );
+        if let Some(left_out) = left_out(output.as_ref()) {
+            text += &format!("  {}\n", Escaped(left_out));
+        }
     }
     text
+}
+
+/// The first output that left ESCs out (each is in the report), as the bridge's error: output
+/// was lost.
+pub fn not_carried(fanout: &Fanout) -> Option<OutputError> {
+    fanout.outputs().iter().find_map(|o| left_out(o.as_ref()))
 }
 
 #[cfg(test)]
@@ -115,6 +130,9 @@ mod tests {
         }
         fn stats(&self) -> &OutputStats {
             &self.stats
+        }
+        fn carries(&self) -> usize {
+            8
         }
     }
 

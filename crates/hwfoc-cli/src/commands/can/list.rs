@@ -4,6 +4,7 @@ use std::time::Duration;
 
 use clap::Args;
 use hwfoc_io::can::setup::{EscSurvey, LED_COLORS, Survey, rate_hz};
+use hwfoc_sim::can::MAX_CHANNEL;
 use serde_json::{Value, json};
 
 use super::BusArgs;
@@ -55,14 +56,30 @@ fn hz(code: u8) -> String {
     rate_hz(code).map_or_else(|| format!("?{code}"), |h| h.to_string())
 }
 
-/// The channels an ESC's GetEscID answers gave: `3`, `1,1,1`.
+/// Whether `channel` is a throttle channel: 1 to [`MAX_CHANNEL`] (1-based, 6 bits).
+fn is_channel(channel: u8) -> bool {
+    (1..=MAX_CHANNEL).contains(&channel)
+}
+
+/// A channel as shown: `3`, or `?0` for an answer out of range.
+fn channel_text(channel: u8) -> String {
+    match is_channel(channel) {
+        true => channel.to_string(),
+        false => format!("?{channel}"),
+    }
+}
+
+/// The channels an ESC's GetEscID answers gave: `3`, `1,1,1` (`?0` out of range).
 fn channels(e: &EscSurvey) -> String {
     let c = &e.heard.channels;
     if c.is_empty() {
         e.config
-            .map_or("-".into(), |c| c.throttle_channel.to_string())
+            .map_or("-".into(), |c| channel_text(c.throttle_channel))
     } else {
-        c.iter().map(u8::to_string).collect::<Vec<_>>().join(",")
+        c.iter()
+            .map(|&c| channel_text(c))
+            .collect::<Vec<_>>()
+            .join(",")
     }
 }
 
@@ -77,7 +94,7 @@ fn channel_clashes(s: &Survey) -> Vec<(u8, Vec<u8>)> {
             .last()
             .copied()
             .or(e.config.map(|c| c.throttle_channel));
-        if let Some(c) = channel {
+        if let Some(c) = channel.filter(|&c| is_channel(c)) {
             by_channel.entry(c).or_default().push(e.heard.node);
         }
     }
@@ -246,12 +263,13 @@ fn json(bus: &str, s: &Survey) -> Value {
                 "node": h.node,
                 "escs": h.escs(),
                 "shared": h.is_shared(),
-                "channels": h.channels,
+                "channels": h.channels.iter().filter(|&&c| is_channel(c)).collect::<Vec<_>>(),
+                "invalid_channels": h.channels.iter().filter(|&&c| !is_channel(c)).collect::<Vec<_>>(),
                 "direction": e.direction.map(|d| d.name()),
                 "config": e.config.map(|c| json!({
                     "direction": if c.direction { "ccw" } else { "cw" },
                     "throttle_source": if c.throttle_source { "pwm" } else { "can" },
-                    "throttle_channel": c.throttle_channel,
+                    "throttle_channel": is_channel(c.throttle_channel).then_some(c.throttle_channel),
                     "led_color": LED_COLORS.get(usize::from(c.led_color)),
                     "led_status": c.led_status,
                     "msg1_rate_hz": rate_hz(c.msg1_rate),
@@ -286,4 +304,59 @@ fn json(bus: &str, s: &Survey) -> Value {
             .collect::<Vec<_>>(),
         "escs": escs,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use hwfoc::dronecan::{GetEscId, Message, StatusMsg1};
+    use hwfoc_io::can::setup::Heard;
+
+    /// The survey of nodes that each sent a StatusMsg1 and answered GetEscID `[node, channel]`.
+    fn survey(answers: &[(u8, u8)]) -> Survey {
+        let mut heard = Heard::new();
+        for &(node, channel) in answers {
+            let status = StatusMsg1 {
+                rpm: 0,
+                pwm: 0,
+                status: 0,
+            };
+            let answer = GetEscId::new(&[node, channel]).unwrap();
+            for m in [Message::from(status), Message::from(answer)] {
+                for frame in m.frames(16, node, 0, 0) {
+                    heard.take(&frame);
+                }
+            }
+        }
+        let escs = answers
+            .iter()
+            .map(|&(node, _)| EscSurvey {
+                heard: heard.node(node).unwrap().clone(),
+                direction: None,
+                config: None,
+                maintenance: None,
+                msg3_rate: None,
+            })
+            .collect();
+        Survey {
+            escs,
+            asked: true,
+            elapsed: Duration::from_millis(20),
+        }
+    }
+
+    /// Throttle channels are 1 to 63 (`GetMajorConfig`'s 6 bits, 1-based): an answer of 0 or
+    /// 200 is shown as out of range, never as a channel, and makes no clash.
+    #[test]
+    fn out_of_range_channel_answers_are_not_shown_as_channels() {
+        let s = survey(&[(10, 0), (11, 200), (12, 200), (13, 4)]);
+        assert_eq!(channels(&s.escs[0]), "?0");
+        assert_eq!(channels(&s.escs[1]), "?200");
+        assert_eq!(channels(&s.escs[3]), "4");
+        assert!(channel_clashes(&s).is_empty(), "{:?}", channel_clashes(&s));
+        let json = json("can:vcan0", &s);
+        assert_eq!(json["escs"][0]["channels"], json!([]), "{json}");
+        assert_eq!(json["escs"][0]["invalid_channels"], json!([0]), "{json}");
+        assert_eq!(json["escs"][3]["channels"], json!([4]), "{json}");
+    }
 }

@@ -868,7 +868,10 @@ fn draw_log(frame: &mut Frame, area: Rect, view: View<'_>) {
                     },
                     Style::new().fg(Color::DarkGray),
                 ),
-                Span::raw(format!("esc{} ", e.esc)),
+                Span::raw(format!(
+                    "esc{} ",
+                    view.escs.get(e.esc).map_or(e.esc, |esc| esc.number)
+                )),
                 Span::styled(e.text(), style),
                 Span::styled(format!("  {name}"), Style::new().fg(Color::DarkGray)),
             ]))

@@ -214,6 +214,9 @@ pub struct EscView {
     recent: VecDeque<f64>,
     /// When watching started (for an ESC that never sends: stale from then on).
     started: f64,
+    /// Its ESC number, the records' `esc` (a hub channel's, a CAN ESC's place on its bus):
+    /// the port's own index until a frame says.
+    pub number: usize,
 }
 
 impl EscView {
@@ -487,6 +490,7 @@ impl Fleet {
                 alarms: Alarms::default(),
                 recent: VecDeque::new(),
                 started: now,
+                number: i,
             })
             .collect::<Vec<_>>();
         Fleet {
@@ -688,6 +692,7 @@ impl Fleet {
     fn on_data(&mut self, i: usize, t: f64, r: Record) {
         let limits = &self.limits;
         let esc = &mut self.escs[i];
+        esc.number = usize::from(r.esc);
         esc.last = Some(r);
         esc.last_frame_t = Some(t);
         esc.peaks.add(&r);
@@ -1028,12 +1033,28 @@ mod tests {
         assert_eq!(f.log_since(0).count(), 7);
     }
 
+    /// The SocketCAN records of message `m` from node `node`, transfer id `tid`.
+    fn can_bytes(m: hwfoc::dronecan::Message, node: u8, tid: u8) -> Vec<u8> {
+        m.frames(16, node, 0, tid)
+            .flat_map(|fr| fr.to_socketcan_record())
+            .collect()
+    }
+
+    /// A Hobbywing StatusMsg1 of a motor turning slowly.
+    fn status1() -> hwfoc::dronecan::StatusMsg1 {
+        hwfoc::dronecan::StatusMsg1 {
+            rpm: 100,
+            pwm: 100,
+            status: 0,
+        }
+    }
+
     /// A CAN ESC's row names its bus and node, and the channel it learns; it keeps its ESC
     /// number and its view when a GetEscID answer maps it. A bus says what it lacks in CAN
     /// words (it was "finding the baud rate").
     #[test]
     fn a_can_esc_is_named_by_bus_node_and_channel_and_keeps_its_number() {
-        use hwfoc::dronecan::{GetEscId, Message, StatusMsg1};
+        use hwfoc::dronecan::{GetEscId, Message};
         let mut f = fleet_of(vec![
             "can:vcan0".to_string(),
             "slcan:/dev/ttyACM0:1M".to_string(),
@@ -1046,16 +1067,8 @@ mod tests {
             (f.escs[0].rate_text(), f.escs[1].rate_text()),
             ("CAN".to_string(), "CAN 1000 kbit/s".to_string())
         );
-        let bytes = |m: Message, tid: u8| -> Vec<u8> {
-            m.frames(16, 10, 0, tid)
-                .flat_map(|fr| fr.to_socketcan_record())
-                .collect()
-        };
-        let m1 = StatusMsg1 {
-            rpm: 100,
-            pwm: 100,
-            status: 0,
-        };
+        let bytes = |m: Message, tid: u8| can_bytes(m, 10, tid);
+        let m1 = status1();
         f.on_event(&data(0, 1000.0, bytes(m1.into(), 0)));
         let esc = f.escs[0].last.unwrap().esc;
         assert_eq!(f.escs[0].name, "vcan0 node 10");
@@ -1068,6 +1081,44 @@ mod tests {
         let views: Vec<&str> = f.escs.iter().map(|e| e.name.as_str()).collect();
         assert_eq!(views, ["vcan0 node 10 ch 2", "slcan:/dev/ttyACM0:1M"]);
         assert_eq!(f.escs[0].last.unwrap().esc, esc);
+    }
+
+    /// A CAN ESC's view carries the records' ESC number (its place: node id before a GetEscID
+    /// answer), whatever order the ESCs were heard in: the monitor's `esc` is the records'.
+    #[test]
+    fn a_can_escs_view_is_numbered_as_its_records() {
+        let mut f = fleet_of(vec!["can:vcan0".to_string()]);
+        f.on_event(&data(0, 1000.0, can_bytes(status1().into(), 13, 0)));
+        f.on_event(&data(0, 1000.1, can_bytes(status1().into(), 11, 0)));
+        let got: Vec<(usize, u8)> = f
+            .escs
+            .iter()
+            .map(|e| (e.number, e.last.unwrap().esc))
+            .collect();
+        assert_eq!(got, [(13, 13), (11, 11)]);
+        // --json and --plain say so.
+        let json = super::super::headless::status_json(&f.escs[1], 1000.2);
+        assert_eq!(json["esc"], 11, "{json}");
+        let line = super::super::headless::status_line(&f.escs[1], 1000.2);
+        assert!(line.contains(" esc11 "), "{line}");
+        // `[esc.11]` applies to node 11's view, whatever order the ESCs were heard in.
+        let mut settings = hwfoc_io::SettingsMap::new(Settings::DEFAULT);
+        let patch = hwfoc_io::SettingsPatch {
+            pole_pairs: Some(14),
+            ..Default::default()
+        };
+        settings.set_esc(11, patch).unwrap();
+        let limits = f.limits.clone();
+        let names = vec![("can:vcan0".to_string(), None)];
+        let mut f = Fleet::new(names, settings, limits, Baud::Fixed(19_200), 1000.0);
+        f.on_event(&data(0, 1000.0, can_bytes(status1().into(), 13, 0)));
+        f.on_event(&data(0, 1000.1, can_bytes(status1().into(), 11, 0)));
+        let pole_pairs: Vec<(usize, u16)> = f
+            .escs
+            .iter()
+            .map(|e| (e.number, e.settings.pole_pairs))
+            .collect();
+        assert_eq!(pole_pairs, [(13, 7), (11, 14)]);
     }
 
     #[test]

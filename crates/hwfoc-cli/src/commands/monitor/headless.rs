@@ -47,11 +47,11 @@ pub fn run(session: &mut Session, json: bool, interval_s: f64) -> Result<(), Cli
         }
         seen = session.fleet.logged;
         if Instant::now() >= next_status {
-            for (i, esc) in session.fleet.escs.iter().enumerate() {
+            for esc in &session.fleet.escs {
                 if json {
-                    writeln!(text, "{}", status_json(i, esc, now)).ok();
+                    writeln!(text, "{}", status_json(esc, now)).ok();
                 } else {
-                    writeln!(text, "{}", status_line(i, esc, now)).ok();
+                    writeln!(text, "{}", status_line(esc, now)).ok();
                 }
             }
             // All ESCs together, when there are several.
@@ -145,8 +145,13 @@ fn total_json(fleet: &Fleet, now: f64) -> Value {
 /// 45.0C cap 40.0C | 19200 baud (HW-FOC) 20.0 fr/s lost 0 dup 0 crc 0 restarts 0 | age 0.03 s |
 /// power 489 W (peak 520 W) used 12.5 mAh 0.30 Wh | ok`: the figures the ESC's format has
 /// (see [`EscView::carries`], [`EscView::link_text`]), HW5's BEC and motor ones too.
-fn status_line(i: usize, esc: &EscView, now: f64) -> String {
-    let mut line = format!("{} esc{i} {}: ", timestamp(now), Escaped(esc.title()));
+pub(super) fn status_line(esc: &EscView, now: f64) -> String {
+    let mut line = format!(
+        "{} esc{} {}: ",
+        timestamp(now),
+        esc.number,
+        Escaped(esc.title())
+    );
     match (&esc.link, &esc.last) {
         (Link::Down { since, reason }, _) => {
             line.push_str(&format!("disconnected for {:.1} s ({reason})", now - since));
@@ -230,7 +235,7 @@ fn alarm_line(entry: &LogEntry, esc: &EscView) -> String {
     format!(
         "{} {tag} esc{} {}: {}",
         timestamp(entry.t),
-        entry.esc,
+        esc.number,
         Escaped(esc.title()),
         entry.text()
     )
@@ -248,7 +253,7 @@ fn alarm_json(entry: &LogEntry, esc: &EscView) -> Value {
         "type": "alarm",
         "time": timestamp(entry.t),
         "t_s": entry.t,
-        "esc": entry.esc,
+        "esc": esc.number,
         "name": esc.name,
         "label": esc.label,
         "alarm": entry.kind.name(),
@@ -261,7 +266,7 @@ fn alarm_json(entry: &LogEntry, esc: &EscView) -> Value {
     })
 }
 
-fn status_json(i: usize, esc: &EscView, now: f64) -> Value {
+pub(super) fn status_json(esc: &EscView, now: f64) -> Value {
     let counted = esc.stats.counts_packets();
     let record = esc.last.as_ref().map(record_json);
     let (link, down_since, reason) = match &esc.link {
@@ -280,7 +285,7 @@ fn status_json(i: usize, esc: &EscView, now: f64) -> Value {
         "type": "status",
         "time": timestamp(now),
         "t_s": now,
-        "esc": i,
+        "esc": esc.number,
         "name": esc.name,
         "label": esc.label,
         "link": link,

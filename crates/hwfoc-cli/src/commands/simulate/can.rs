@@ -108,7 +108,7 @@ pub fn run(args: &SimulateArgs, config: &Config, settings: Settings) -> Result<(
         crate::safety::refuse_input(out, reads.iter().map(std::path::PathBuf::as_path))?;
     }
     if let (Some(truth), [log]) = (&plan.truth, outputs.as_slice())
-        && (truth == *log || hwfoc_io::write::same_file(truth, log))
+        && crate::safety::same_output(truth, log)
     {
         return Err(usage(
             "--truth",

@@ -567,7 +567,7 @@ fn refuse_clashes(plan: &Plan, n: usize, reads: &[std::path::PathBuf]) -> Result
         crate::safety::refuse_input(out, reads.iter().map(std::path::PathBuf::as_path))?;
         let earlier = outputs[..i]
             .iter()
-            .find(|(_, o)| o == out || hwfoc_io::write::same_file(o, out));
+            .find(|(_, o)| crate::safety::same_output(o, out));
         match earlier {
             // The ground truth must not land on (and destroy) one of the recordings.
             Some((_, first)) if *option == "--truth" => {
