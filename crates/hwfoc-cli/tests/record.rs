@@ -350,16 +350,16 @@ fn rotation_makes_complete_numbered_files() {
         "-o",
         out.to_str().unwrap(),
         "--rotate-time",
-        "0.6",
+        "1",
         "--duration",
-        "2.2",
+        "3.4",
     ]);
     rec.wait_for("recording", Duration::from_secs(10));
     let writer = thread::spawn(move || {
-        feed(&mut b, 500..530, Duration::from_millis(50));
+        feed(&mut b, 500..560, Duration::from_millis(50));
         b
     });
-    feed(&mut a, 0..30, Duration::from_millis(50));
+    feed(&mut a, 0..60, Duration::from_millis(50));
     let _b = writer.join().unwrap();
     assert!(rec.wait(Duration::from_secs(10)), "{}", rec.stderr());
     assert!(rec.stderr().contains("files)"), "{}", rec.stderr());
@@ -386,8 +386,8 @@ fn rotation_makes_complete_numbered_files() {
     }
     // Chunks are never split between files, but a frame may arrive in two chunks, one each
     // side of a boundary: decoded file by file, at most one frame per boundary is missing.
-    let expect_a: Vec<u16> = (1000..1030).collect();
-    let expect_b: Vec<u16> = (1500..1530).collect();
+    let expect_a: Vec<u16> = (1000..1060).collect();
+    let expect_b: Vec<u16> = (1500..1560).collect();
     let missing_a = expect_a.iter().filter(|k| !per_port[0].contains(k)).count();
     let missing_b = expect_b.iter().filter(|k| !per_port[1].contains(k)).count();
     assert!(
@@ -407,7 +407,18 @@ fn rotation_makes_complete_numbered_files() {
     for r in records {
         got[r["esc"].as_u64().unwrap() as usize].push(r["packet"].as_u64().unwrap() as u16);
     }
-    assert_eq!(got, [expect_a, expect_b]);
+    assert_eq!(got, [expect_a.clone(), expect_b.clone()]);
+
+    // Given together as files, they are one recording too (each carries the run's recording
+    // id): two ESCs, every frame, a frame split between two files whole.
+    let o = hwfoc().arg("decode").args(&files).output().unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let mut together: [Vec<u16>; 2] = [Vec::new(), Vec::new()];
+    for line in String::from_utf8(o.stdout).unwrap().lines() {
+        let r: serde_json::Value = serde_json::from_str(line).unwrap();
+        together[r["esc"].as_u64().unwrap() as usize].push(r["packet"].as_u64().unwrap() as u16);
+    }
+    assert_eq!(together, [expect_a, expect_b]);
 }
 
 #[test]
