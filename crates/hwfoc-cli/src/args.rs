@@ -257,6 +257,27 @@ impl SelectArgs {
         Ok(())
     }
 
+    /// Refuses a bare number of seconds more than a year before the data's first receive time
+    /// `first` (`--from 5` meant as five seconds in: it would select everything, or nothing),
+    /// suggesting `+N`. Call it once the first time is known.
+    pub fn check_bare_seconds(&self, first: f64) -> Result<(), CliError> {
+        for (option, time) in [("--from", self.from), ("--to", self.to)] {
+            if let Some(Time::Seconds(s)) = time
+                && hwfoc_io::time::long_before(s, first)
+            {
+                return Err(CliError::Usage {
+                    option: format!("{option} {time}", time = Time::Seconds(s)),
+                    message: format!(
+                        "that is more than a year before the data (from {}): for seconds after \
+                         the first frame, give +{s}",
+                        hwfoc_io::time::iso8601(first)
+                    ),
+                });
+            }
+        }
+        Ok(())
+    }
+
     /// The filters, as recorded with an output: `esc=0,2 from=+1.5 to=1795442580`, or empty.
     pub fn text(&self) -> String {
         hwfoc_io::filter_text(&self.esc, self.from, self.to)

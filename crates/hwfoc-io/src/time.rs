@@ -42,6 +42,15 @@ pub enum Clock {
     None,
 }
 
+/// A year of 365.25 days, s.
+pub const YEAR_S: f64 = 365.25 * 86_400.0;
+
+/// Whether seconds of a source's clock, `s`, lie more than a year before `first`, the data's
+/// first receive time: a bare number meant as seconds after the first frame (`5` for `+5`).
+pub fn long_before(s: f64, first: f64) -> bool {
+    s < first - YEAR_S
+}
+
 /// A time as given on the command line ([`parse`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Time {
