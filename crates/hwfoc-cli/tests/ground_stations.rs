@@ -199,9 +199,10 @@ fn a_telemetry_log_has_the_recordings_times_and_never_overwrites() {
         .args(["--mavlink", &format!("file:{}", rec.display())]));
     common::assert_fails_with(&onto_input, "it is the input");
     assert_eq!(std::fs::read(&rec).unwrap(), recorded);
-    // Asked: replaced.
+    // Asked: replaced (by half a second of the recording, paced: another file than the
+    // whole one written as fast as it can be).
     ok(run(hwfoc()
-        .args(["bridge", "--no-config", "--overwrite", "--duration", "0.5"])
+        .args(["bridge", "--no-config", "--overwrite", "--realtime", "--duration", "0.5"])
         .arg(&rec)
         .args(["--mavlink", &spec])));
     assert_ne!(std::fs::read(&tlog).unwrap(), bytes);
