@@ -20,9 +20,10 @@ use crate::error::CliError;
 /// Where telemetry comes from.
 #[derive(Debug, Args)]
 pub struct InputArgs {
-    /// Serial ports (`/dev/ttyUSB0`, `COM3`; one ESC each, in the order given), recordings
-    /// (pcapng), raw bytes from the wire or logic-analyser CSV exports (detected); `-` reads
-    /// standard input. Each input's ESCs are its own, numbered in the order given. Recordings
+    /// Serial ports (`/dev/ttyUSB0`, `COM3`; one ESC each, in the order given), CAN buses
+    /// (`slcan:/dev/ttyACM0`, `can:can0`), recordings (pcapng, serial or CAN), `candump -l`
+    /// logs, raw bytes from the wire (HW-FOC, DataLink V2, V4, V3, HW5) or logic-analyser CSV
+    /// exports (the format detected); `-` reads standard input. Each input's ESCs are its own, numbered in the order given. Recordings
     /// and analyser CSV exports given together are merged in time order (the files of one
     /// recording, such as a rotated one, continue each port's stream; a file given twice is
     /// read once); raw files and standard input, which have no receive times, are read one
