@@ -202,7 +202,14 @@ fn a_telemetry_log_has_the_recordings_times_and_never_overwrites() {
     // Asked: replaced (by half a second of the recording, paced: another file than the
     // whole one written as fast as it can be).
     ok(run(hwfoc()
-        .args(["bridge", "--no-config", "--overwrite", "--realtime", "--duration", "0.5"])
+        .args([
+            "bridge",
+            "--no-config",
+            "--overwrite",
+            "--realtime",
+            "--duration",
+            "0.5",
+        ])
         .arg(&rec)
         .args(["--mavlink", &spec])));
     assert_ne!(std::fs::read(&tlog).unwrap(), bytes);
@@ -268,7 +275,8 @@ fn the_receiver_reads_a_telemetry_log_with_decodes_values_and_times() {
                 let mut newest = 0.0f64;
                 for record in telemetry_records(&kind, m, &per_esc) {
                     let t_s = record["t_s"].as_f64().unwrap();
-                    assert!((0.0..1.0).contains(&(time - t_s)), "{m} vs {record}");
+                    // A log's times are whole microseconds: at most half of one before the frame.
+                    assert!((-1e-6..1.0).contains(&(time - t_s)), "{m} vs {record}");
                     newest = newest.max(t_s);
                     values += 1;
                 }
@@ -575,10 +583,12 @@ fn mavlogdump_reads_a_half_hour_telemetry_log() {
         *counts.entry(kind).or_default() += 1;
     }
     eprintln!("mavlogdump: {counts:?}");
+    // ESC_STATUS (291) and ESC_INFO (290) are in no dialect bundled with pymavlink: it reads
+    // them as UNKNOWN_291 and UNKNOWN_290 (scripts/mavlink-receive.py adds them).
     for kind in [
         "ESC_TELEMETRY_1_TO_4",
-        "ESC_STATUS",
-        "ESC_INFO",
+        "UNKNOWN_291",
+        "UNKNOWN_290",
         "HEARTBEAT",
     ] {
         assert!(
