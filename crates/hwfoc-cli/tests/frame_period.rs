@@ -65,5 +65,9 @@ fn raw_files_are_timed_at_their_formats_frame_period() {
             image.contains(&format!("data frame index × {s} s")),
             "{protocol}: no period {s} in the subtitle"
         );
+        assert!(
+            image.contains(&format!("frame index × {s} (s)")),
+            "{protocol}: no period {s} on the time axis"
+        );
     }
 }

@@ -598,9 +598,9 @@ impl<'a> Scene<'a> {
         let x_fmt = number_format(t_lo..t_hi);
         let y_fmt = number_format(y_lo..y_hi);
         let x_desc = if data.timed {
-            "time (s)"
+            "time (s)".to_string()
         } else {
-            "frame index × 0.05 (s)"
+            format!("frame index × {} (s)", data.period())
         };
         // As many time labels as fit side by side, at most TICKS.
         let plot_w = chart.plotting_area().dim_in_pixel().0.max(1);
