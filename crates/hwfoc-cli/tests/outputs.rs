@@ -169,3 +169,47 @@ fn a_bare_number_long_before_the_data_suggests_plus() {
         &out,
     ]));
 }
+
+/// `--time iso` writes CSV's receive times as ISO 8601 dates in UTC (a `time` column, to the
+/// microsecond) for spreadsheets; for other formats, or inputs without a wall clock, it is
+/// refused.
+#[test]
+fn csv_times_as_iso_dates() {
+    let dir = Dir::new();
+    let rec = dir.arg("run.pcapng");
+    ok(run(&[
+        "simulate",
+        "-o",
+        &rec,
+        "--duration",
+        "2",
+        "--start-time",
+        "1795442580",
+        "--quiet",
+    ]));
+    let seconds = String::from_utf8(ok(run(&["decode", &rec, "--format", "csv"])).stdout).unwrap();
+    let iso =
+        String::from_utf8(ok(run(&["decode", &rec, "--format", "csv", "--time", "iso"])).stdout)
+            .unwrap();
+    assert!(iso.starts_with("time,esc,protocol,"), "{iso}");
+    assert_eq!(seconds.lines().count(), iso.lines().count());
+    for (s, i) in seconds.lines().zip(iso.lines()).skip(1) {
+        let (t, rest) = s.split_once(',').unwrap();
+        let (date, same) = i.split_once(',').unwrap();
+        assert_eq!(rest, same);
+        // Microseconds after 2026-11-23T14:03:00Z.
+        let t: f64 = t.parse().unwrap();
+        let m = (t * 1e6).round() as i64 - 1_795_442_580_000_000;
+        let expected = format!(
+            "2026-11-23T14:{:02}:{:02}.{:06}Z",
+            3 + m / 60_000_000,
+            m / 1_000_000 % 60,
+            m % 1_000_000
+        );
+        assert_eq!(date, expected, "{s}");
+    }
+    let o = run(&["decode", &rec, "--time", "iso", "-o", &dir.arg("x.parquet")]);
+    assert_fails_with(&o, "--time iso");
+    let o = run(&["decode", "--demo", "--format", "csv", "--time", "iso"]);
+    assert_fails_with(&o, "no wall clock");
+}

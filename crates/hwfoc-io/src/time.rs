@@ -301,6 +301,20 @@ pub fn iso8601(t_s: f64) -> String {
     }
 }
 
+/// Unix time `t_s` as an ISO 8601 date-time in UTC to the microsecond,
+/// `2026-11-23T14:03:00.160123Z`: a CSV export's `time` column (`--time iso`), which
+/// spreadsheets read as a date. Beyond the year 9999 or NaN it is [`iso8601`]'s text.
+pub fn iso8601_us(t_s: f64) -> String {
+    let us = (t_s * 1e6).round();
+    match Some(us)
+        .filter(|us| us.is_finite() && us.abs() < 1e18)
+        .and_then(|us| Timestamp::from_microsecond(us as i64).ok())
+    {
+        Some(t) => format!("{t:.6}"),
+        None => iso8601(t_s),
+    }
+}
+
 /// Unix time `t_s` as an ISO 8601 date-time in the local zone (`TZ` or the system's), with its
 /// offset, to the millisecond: `2026-11-23T15:03:00.160+01:00`. For a person watching live
 /// (the monitor); beyond the year 9999 or NaN it is shown as [`iso8601`] shows it.

@@ -27,6 +27,15 @@ pub enum RecordFormat {
     Parquet,
 }
 
+/// How CSV gives receive times.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum CsvTime {
+    /// Unix seconds, `t_s` (the source's own seconds for an analyser's export).
+    Seconds,
+    /// ISO 8601 dates in UTC, `time`: `2026-11-23T14:03:00.160123Z`.
+    Iso,
+}
+
 #[derive(Debug, Args)]
 pub struct DecodeArgs {
     #[command(flatten)]
@@ -40,6 +49,10 @@ pub struct DecodeArgs {
     /// CSV only: start with a `#` comment line giving the settings used.
     #[arg(long)]
     pub settings_comment: bool,
+    /// CSV only: receive times as Unix seconds (`t_s`), or as ISO 8601 dates in UTC to the
+    /// microsecond (a `time` column, which spreadsheets read as dates; recordings and ports).
+    #[arg(long, value_enum, default_value_t = CsvTime::Seconds)]
+    pub time: CsvTime,
     /// Write to FILE instead of standard output, in the format its name ends in.
     #[arg(short, long, value_name = "FILE", required_if_eq("format", "parquet"))]
     pub output: Option<String>,
@@ -59,6 +72,14 @@ pub fn run(args: &DecodeArgs) -> Result<(), CliError> {
     args.input
         .refuse_output(args.output.as_deref().unwrap_or("-"), &config)?;
     let format = output_format(args.format, args.output.as_deref())?;
+    if args.time == CsvTime::Iso && format != OutputFormat::Csv {
+        return Err(CliError::Usage {
+            option: "--time iso".to_string(),
+            message: "CSV only (Parquet and JSON Lines keep t_s): add --format csv or name the \
+                      output .csv"
+                .to_string(),
+        });
+    }
     // Ctrl-C and SIGTERM abandon an export of files read to their end, or of standard input
     // to a file, leaving any earlier file at the output as it was (standard input's at its next
     // bytes or its end: the Ctrl-C that stops a pipe's writer ends it too). Serial ports end
@@ -74,12 +95,24 @@ pub fn run(args: &DecodeArgs) -> Result<(), CliError> {
         sources.require_timing()?;
         args.select.check_clocks(&sources)?;
     }
+    if args.time == CsvTime::Iso
+        && let Some((input, format)) = sources.formats().find(|(_, f)| f.clock() == Clock::Capture)
+    {
+        return Err(CliError::Usage {
+            option: "--time iso".to_string(),
+            message: format!(
+                "{input} ({format}) has no wall clock, its times count from the start of its \
+                 capture: leave out --time iso"
+            ),
+        });
+    }
     let provenance = Provenance {
         settings,
         overrides,
         inputs: sources.names().to_vec(),
         filter: args.select.text(),
         csv_comment: args.settings_comment,
+        csv_time_iso: args.time == CsvTime::Iso,
     };
     keep_freed_memory();
     let output = args.output.as_deref();

@@ -586,6 +586,7 @@ mod tests {
             inputs: vec!["p0".to_string()],
             filter: String::new(),
             csv_comment: true,
+            csv_time_iso: false,
         };
         let mut export = Export::create(format, path.to_str(), false, provenance).unwrap();
         Sources::new(inputs(ports, frames), map)
@@ -743,6 +744,7 @@ mod tests {
             inputs: Vec::new(),
             filter: String::new(),
             csv_comment: false,
+            csv_time_iso: false,
         };
         let selection = Selection::new(&[0, 2], crate::select::Window::ALL);
         let mut export = Export::create(OutputFormat::Jsonl, path.to_str(), false, provenance)
@@ -789,6 +791,7 @@ mod tests {
             inputs: Vec::new(),
             filter: String::new(),
             csv_comment: false,
+            csv_time_iso: false,
         };
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("x.jsonl");

@@ -101,4 +101,7 @@ pub struct Provenance {
     pub filter: String,
     /// CSV only: start with a `#` comment line giving the settings.
     pub csv_comment: bool,
+    /// CSV only: receive times as ISO 8601 dates in UTC, to the microsecond, in a `time`
+    /// column ([`time::iso8601_us`](crate::time::iso8601_us)), rather than Unix seconds in `t_s`.
+    pub csv_time_iso: bool,
 }
