@@ -12,6 +12,16 @@ fn run(args: &[&str]) -> Output {
     hwfoc().args(args).output().expect("run hwfoc")
 }
 
+/// Virtual HW-FOC ESCs' telemetry of `seconds` written to `path` (its format from its name).
+fn simulate(path: &str, seconds: &str, more: &[&str]) {
+    let args = [
+        &["simulate", "-o", path, "--duration", seconds, "--quiet"],
+        more,
+    ]
+    .concat();
+    ok(run(&args));
+}
+
 /// `-o NAME` alone writes the format the name's extension names, in any case.
 #[test]
 fn decode_takes_the_format_from_the_output_name() {
@@ -94,14 +104,7 @@ fn ctrl_c_with_standard_input_leaves_no_partial_file() {
     use std::time::{Duration, Instant};
     let dir = Dir::new();
     let raw = dir.arg("run.bin");
-    ok(run(&[
-        "simulate",
-        "-o",
-        &raw,
-        "--duration",
-        "20",
-        "--quiet",
-    ]));
+    simulate(&raw, "20", &[]);
     let bytes = std::fs::read(&raw).unwrap();
     let out = dir.arg("out.csv");
     std::fs::write(&out, "the earlier export").unwrap();
@@ -140,7 +143,7 @@ fn ctrl_c_with_standard_input_leaves_no_partial_file() {
 fn a_bare_number_long_before_the_data_suggests_plus() {
     let dir = Dir::new();
     let rec = dir.arg("run.pcapng");
-    ok(run(&["simulate", "-o", &rec, "--duration", "3", "--quiet"]));
+    simulate(&rec, "3", &[]);
     let out = dir.arg("out.csv");
     for (option, value) in [("--from", "5"), ("--to", "10")] {
         let o = run(&["decode", &rec, option, value, "-o", &out]);
@@ -177,16 +180,7 @@ fn a_bare_number_long_before_the_data_suggests_plus() {
 fn csv_times_as_iso_dates() {
     let dir = Dir::new();
     let rec = dir.arg("run.pcapng");
-    ok(run(&[
-        "simulate",
-        "-o",
-        &rec,
-        "--duration",
-        "2",
-        "--start-time",
-        "1795442580",
-        "--quiet",
-    ]));
+    simulate(&rec, "2", &["--start-time", "1795442580"]);
     let seconds = String::from_utf8(ok(run(&["decode", &rec, "--format", "csv"])).stdout).unwrap();
     let iso =
         String::from_utf8(ok(run(&["decode", &rec, "--format", "csv", "--time", "iso"])).stdout)
