@@ -34,7 +34,9 @@ echo "::: mavlink-pymavlink: ok ($((SECONDS - start)) s)"
 
 # The bridge end to end: a recording replayed by `hwfoc bridge --mavlink`, received by pymavlink,
 # with the values `hwfoc decode` gives for the same recording; the receiver people paste
-# (scripts/mavlink-receive.py, stock pymavlink) live and from a tlog the bridge wrote.
+# (scripts/mavlink-receive.py, stock pymavlink) live and from a tlog the bridge wrote; and
+# pymavlink's mavlogdump.py on the tlog of a 30-minute flight, written as fast as it can be
+# (mavlogdump_reads_a_half_hour_telemetry_log, which says how long that took).
 start=$SECONDS
 echo "::: mavlink-bridge: cargo test -p hwfoc-cli --test ground_stations"
 log=${TMPDIR:-/tmp}/hwfoc-ci-mavlink-ground.log

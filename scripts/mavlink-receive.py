@@ -16,6 +16,7 @@ This script adds their definitions (from MAVLink's common.xml) to pymavlink's ar
 dialect with pymavlink's own generator, at start.
 """
 
+import argparse
 import contextlib
 import importlib.util
 import io
@@ -24,9 +25,8 @@ import os
 import sys
 import tempfile
 
-os.environ["MAVLINK20"] = "1"  # hwfoc sends MAVLink 2
-from pymavlink import mavutil  # noqa: E402
-from pymavlink.generator import mavgen  # noqa: E402
+os.environ["MAVLINK20"] = "1"  # hwfoc sends MAVLink 2 (set before pymavlink is imported)
+mavutil = mavgen = None  # pymavlink's modules, imported by main()
 
 ESC_MESSAGES = """<?xml version="1.0"?>
 <mavlink>
@@ -73,8 +73,23 @@ def esc_dialect(directory):
     return module
 
 
+def arguments():
+    """The command line: one optional SOURCE (`--help` prints the module's text)."""
+    parser = argparse.ArgumentParser(
+        description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument(
+        "source", nargs="?", default="udpin:0.0.0.0:14550", metavar="SOURCE",
+        help="a pymavlink connection (udpin:HOST:PORT, a serial port) or a telemetry log "
+             "(.tlog); default udpin:0.0.0.0:14550")
+    return parser.parse_args()
+
+
 def main():
-    source = sys.argv[1] if len(sys.argv) > 1 else "udpin:0.0.0.0:14550"
+    source = arguments().source
+    # Imported once the arguments are read, so that --help needs no pymavlink.
+    global mavutil, mavgen
+    from pymavlink import mavutil
+    from pymavlink.generator import mavgen
     with tempfile.TemporaryDirectory() as tmp:
         mavutil.mavlink = esc_dialect(tmp)  # the dialect of the connections made from here on
     log = os.path.isfile(source)

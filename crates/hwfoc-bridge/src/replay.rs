@@ -1,5 +1,8 @@
 //! Recordings replayed in real time: each frame is handed on when as much time has passed since
-//! the first frame as passed between them on the wire. A discontinuity of an ESC's receive
+//! the first frame as passed between them on the wire; or, for outputs that are files
+//! ([`Replay::as_fast_as_possible`]), at once, on a clock of the recording's own times (the
+//! outputs are polled as the clock passes, so they send what they would have sent, timed as
+//! they would have timed it). A discontinuity of an ESC's receive
 //! clock ([`Step`]: a step back, or a jump forward its packet numbers do not explain, such as
 //! a computer that booted in 1970 and then synced) is replayed as one frame period: the replay
 //! never waits for a clock that jumped years ahead. Each ESC's clock is followed on its own: a
@@ -15,7 +18,7 @@ use std::time::{Duration, Instant};
 use hwfoc::telemetry::{Frame, Telemetry};
 use hwfoc::{Protocol, Settings};
 use hwfoc_io::clock::Step;
-use hwfoc_io::energy::NOMINAL_PERIOD_S;
+use hwfoc_io::energy::nominal_period_s;
 use hwfoc_io::{Handler, InputError};
 
 use crate::fanout::Fanout;
@@ -67,8 +70,8 @@ struct Timed {
 /// A [`Handler`] that holds each frame back until its time has come, then hands it to the
 /// [`Fanout`]; the outputs are polled meanwhile. Frames with receive times keep their spacing
 /// (their times are taken in the order the inputs give them: a frame due earlier than the one
-/// before it goes at once); frames of an input without times come one per ESC every
-/// [`NOMINAL_PERIOD_S`], the protocol's frame period.
+/// before it goes at once); frames of an input without times come one per ESC every frame
+/// period of its protocol ([`nominal_period_s`]).
 pub struct Replay<'a, E> {
     fanout: &'a mut Fanout,
     stop: &'a AtomicBool,
@@ -86,6 +89,9 @@ pub struct Replay<'a, E> {
     start: Instant,
     /// Untimed frames handed on so far, per ESC.
     untimed: Vec<u32>,
+    /// Without pacing, the instant the replay's clock shows (see
+    /// [`Replay::as_fast_as_possible`]); `None`: real time.
+    clock: Option<Instant>,
 }
 
 impl<'a, E: FnMut(OutputError)> Replay<'a, E> {
@@ -101,19 +107,36 @@ impl<'a, E: FnMut(OutputError)> Replay<'a, E> {
             latest: None,
             start: Instant::now(),
             untimed: Vec::new(),
+            clock: None,
         }
     }
 
-    /// When a frame of `esc` received at `t` is due; `packet` is a data frame's packet number.
-    fn due(&mut self, esc: u8, t: Option<f64>, packet: Option<(Protocol, u32)>) -> Instant {
-        let (protocol, packet) = (packet.map(|(p, _)| p), packet.map(|(_, n)| n));
+    /// Hands every frame on at once, without waiting for its time: for outputs that are files
+    /// (a telemetry log), which take what a real-time replay would have given them, with the
+    /// same times, in a fraction of it. The outputs see a clock that moves from frame to frame
+    /// as the recording's times do, and are polled every [`POLL`] of it.
+    pub fn as_fast_as_possible(mut self) -> Self {
+        self.clock = Some(self.start);
+        self
+    }
+
+    /// When a frame of `esc` received at `t` is due; `protocol` is a data frame's, `packet` its
+    /// packet number.
+    fn due(
+        &mut self,
+        esc: u8,
+        t: Option<f64>,
+        protocol: Option<Protocol>,
+        packet: Option<u32>,
+    ) -> Instant {
         match t {
             Some(t) => {
                 let esc = usize::from(esc);
                 if self.last.len() <= esc {
                     self.last.resize(esc + 1, None);
                 }
-                let at = *self.at.get_or_insert_with(Instant::now);
+                let now = self.clock.unwrap_or_else(Instant::now);
+                let at = *self.at.get_or_insert(now);
                 let before = match self.last[esc] {
                     Some(own) => Some(own),
                     None => self.latest.map(|latest| Timed {
@@ -131,7 +154,7 @@ impl<'a, E: FnMut(OutputError)> Replay<'a, E> {
                             .and_then(|((a, b), p)| p.packets_between(a, b));
                         if Step::between(before.t, t, packets).is_discontinuity() {
                             // One frame period after the ESC's frame before.
-                            t - (before.after + NOMINAL_PERIOD_S)
+                            t - (before.after + nominal_period_s(protocol))
                         } else {
                             before.origin
                         }
@@ -155,18 +178,30 @@ impl<'a, E: FnMut(OutputError)> Replay<'a, E> {
                 }
                 let k = self.untimed[esc];
                 self.untimed[esc] += 1;
-                self.start + Duration::from_secs_f64(f64::from(k) * NOMINAL_PERIOD_S)
+                self.start + Duration::from_secs_f64(f64::from(k) * nominal_period_s(protocol))
             }
         }
     }
 
-    /// Polls the outputs until `due` (or a stop).
-    fn wait(&mut self, due: Instant) {
+    /// Polls the outputs until `due` (or a stop), and returns the instant: in real time, or on
+    /// the replay's own clock, moved on to `due` (never back) and the outputs polled every
+    /// [`POLL`] of it on the way.
+    fn wait(&mut self, due: Instant) -> Instant {
+        if let Some(clock) = self.clock {
+            let mut now = clock;
+            while now + POLL < due && !self.stop.load(Ordering::Relaxed) {
+                now += POLL;
+                self.fanout.poll(now, &mut self.on_error);
+            }
+            let now = now.max(due);
+            self.clock = Some(now);
+            return now;
+        }
         loop {
             let now = Instant::now();
             self.fanout.poll(now, &mut self.on_error);
             if now >= due || self.stop.load(Ordering::Relaxed) {
-                return;
+                return now;
             }
             std::thread::sleep((due - now).min(POLL));
         }
@@ -180,15 +215,16 @@ impl<E: FnMut(OutputError)> Handler for Replay<'_, E> {
         if self.stop.load(Ordering::Relaxed) {
             return;
         }
-        let packet = match frame {
-            Frame::Data(f) => f.packet().map(|n| (f.protocol(), n)),
-            Frame::Info(_) => None,
+        let (protocol, packet) = match frame {
+            Frame::Data(f) => (Some(f.protocol()), f.packet()),
+            Frame::Info(_) => (None, None),
         };
-        let due = self.due(esc, t, packet);
-        self.wait(due);
-        self.fanout.arrived(Instant::now());
+        let due = self.due(esc, t, protocol, packet);
+        let now = self.wait(due);
+        self.fanout.arrived(now);
         self.fanout.frame(esc, t, frame, settings);
-        self.fanout.poll(Instant::now(), &mut self.on_error);
+        let now = self.clock.unwrap_or_else(Instant::now);
+        self.fanout.poll(now, &mut self.on_error);
     }
 
     fn end_batch(&mut self, _live: bool) -> Result<(), ReplayError> {
@@ -218,13 +254,13 @@ mod tests {
         let dues: Vec<Instant> = times
             .iter()
             .enumerate()
-            .map(|(k, &t)| replay.due(0, Some(t), Some((Protocol::HwFoc, k as u32))))
+            .map(|(k, &t)| replay.due(0, Some(t), Some(Protocol::HwFoc), Some(k as u32)))
             .collect();
         let first = dues[0];
         for (k, due) in dues.iter().enumerate() {
             let after = due.duration_since(first).as_secs_f64();
             assert!(
-                (after - k as f64 * NOMINAL_PERIOD_S).abs() < 1e-6,
+                (after - k as f64 * nominal_period_s(Some(Protocol::HwFoc))).abs() < 1e-6,
                 "frame {k} due {after} s after the first"
             );
         }
@@ -236,10 +272,10 @@ mod tests {
         let stop = AtomicBool::new(false);
         let mut replay = Replay::new(&mut fanout, &stop, |_| {});
         let start = 1_795_442_580.0;
-        let first = replay.due(0, Some(start), Some((Protocol::HwFoc, 0)));
-        let then = replay.due(0, Some(start + 0.05), Some((Protocol::HwFoc, 1)));
+        let first = replay.due(0, Some(start), Some(Protocol::HwFoc), Some(0));
+        let then = replay.due(0, Some(start + 0.05), Some(Protocol::HwFoc), Some(1));
         // ESC 1's first frame, stamped in 2226.
-        let late = replay.due(1, Some(8_000_000_000.0), Some((Protocol::HwFoc, 0)));
+        let late = replay.due(1, Some(8_000_000_000.0), Some(Protocol::HwFoc), Some(0));
         let after = |due: Instant, first| due.duration_since(first).as_secs_f64();
         assert!((after(then, first) - 0.05).abs() < 1e-6);
         assert!(
@@ -250,8 +286,8 @@ mod tests {
         // ESC 1 heard half a second after ESC 0: its own time.
         let mut fanout = Fanout::new(Vec::new());
         let mut replay = Replay::new(&mut fanout, &stop, |_| {});
-        let first = replay.due(0, Some(start), Some((Protocol::HwFoc, 0)));
-        let other = replay.due(1, Some(start + 0.5), Some((Protocol::HwFoc, 9)));
+        let first = replay.due(0, Some(start), Some(Protocol::HwFoc), Some(0));
+        let other = replay.due(1, Some(start + 0.5), Some(Protocol::HwFoc), Some(9));
         assert!((after(other, first) - 0.5).abs() < 1e-6);
     }
 
@@ -279,7 +315,7 @@ mod tests {
         order.insert(first_after - 3, moved);
         let dues: Vec<Instant> = order
             .iter()
-            .map(|&(esc, k)| replay.due(esc, Some(time(k)), Some((Protocol::HwFoc, k))))
+            .map(|&(esc, k)| replay.due(esc, Some(time(k)), Some(Protocol::HwFoc), Some(k)))
             .collect();
         let first = dues[0];
         let last = dues

@@ -20,9 +20,10 @@ use crate::error::CliError;
 /// Where telemetry comes from.
 #[derive(Debug, Args)]
 pub struct InputArgs {
-    /// Serial ports (`/dev/ttyUSB0`, `COM3`; one ESC each, in the order given), recordings
-    /// (pcapng), raw bytes from the wire or logic-analyser CSV exports (detected); `-` reads
-    /// standard input. Each input's ESCs are its own, numbered in the order given. Recordings
+    /// Serial ports (`/dev/ttyUSB0`, `COM3`; one ESC each, in the order given), CAN buses
+    /// (`slcan:/dev/ttyACM0`, `can:can0`), recordings (pcapng, serial or CAN), `candump -l`
+    /// logs, raw bytes from the wire (HW-FOC, DataLink V2, V4, V3, HW5) or logic-analyser CSV
+    /// exports (the format detected); `-` reads standard input. Each input's ESCs are its own, numbered in the order given. Recordings
     /// and analyser CSV exports given together are merged in time order (the files of one
     /// recording, such as a rotated one, continue each port's stream; a file given twice is
     /// read once); raw files and standard input, which have no receive times, are read one
@@ -289,6 +290,27 @@ impl SelectArgs {
                     message: format!(
                         "{input} ({format}) has no wall clock, its times count from the start \
                          of its capture: give seconds of its clock or +S after the first frame"
+                    ),
+                });
+            }
+        }
+        Ok(())
+    }
+
+    /// Refuses a bare number of seconds more than a year before the data's first receive time
+    /// `first` (`--from 5` meant as five seconds in: it would select everything, or nothing),
+    /// suggesting `+N`. Call it once the first time is known.
+    pub fn check_bare_seconds(&self, first: f64) -> Result<(), CliError> {
+        for (option, time) in [("--from", self.from), ("--to", self.to)] {
+            if let Some(Time::Seconds(s)) = time
+                && hwfoc_io::time::long_before(s, first)
+            {
+                return Err(CliError::Usage {
+                    option: format!("{option} {time}", time = Time::Seconds(s)),
+                    message: format!(
+                        "that is more than a year before the data (from {}): for seconds after \
+                         the first frame, give +{s}",
+                        hwfoc_io::time::iso8601(first)
                     ),
                 });
             }

@@ -1,4 +1,4 @@
-//! `hwfoc`: decode and summarise Hobbywing HW-FOC ESC telemetry.
+//! `hwfoc`: decode, record, plot and bridge the telemetry of Hobbywing ESCs.
 //!
 //! A thin binary over the `hwfoc` codec and the `hwfoc-io` library: argument parsing and
 //! presentation only. Each subcommand is a module of [`commands`]; errors travel up as
@@ -23,8 +23,8 @@ use crate::commands::{
 };
 use crate::error::CliError;
 
-/// Decode and analyse the telemetry of Hobbywing ESCs: an XRotor FOC ESC's own wire (HW-FOC,
-/// 19200 baud) or a DataLink V2 hub's (115200 baud).
+/// Decode, record, plot and bridge the telemetry of Hobbywing ESCs: HW-FOC (an XRotor FOC
+/// ESC's own wire), DataLink V2 hubs, Platinum V4 and V3, HW5 and DroneCAN (CAN buses).
 #[derive(Debug, Parser)]
 #[command(name = "hwfoc", version = env!("HWFOC_VERSION"), about, propagate_version = true)]
 struct Cli {
@@ -43,7 +43,8 @@ enum Command {
     Summary(summary::SummaryArgs),
     /// Plot each ESC's telemetry over time, fault episodes marked (PNG or SVG).
     Plot(plot::PlotArgs),
-    /// Record serial ports losslessly, with nanosecond receive times, to pcapng (Wireshark opens it).
+    /// Record serial ports and CAN buses (slcan:, can:) losslessly, with nanosecond receive
+    /// times, to pcapng (Wireshark opens it).
     Record(record::RecordArgs),
     /// Virtual ESCs: the protocol from a physical model, to a pty, serial port, file or stdout.
     Simulate(Box<simulate::SimulateArgs>),

@@ -294,6 +294,7 @@ fn files_that_are_not_telemetry_are_named_and_every_command_fails_alike() {
                 "--format",
                 "csv",
                 input,
+                "--overwrite",
                 "-o",
                 out_file.to_str().unwrap(),
             ]),
@@ -514,7 +515,7 @@ fn bad_inputs_fail_with_one_clear_line() {
             "decode",
             "--demo",
             "-o",
-            dir.path().join("no/such/dir/x").to_str().unwrap(),
+            dir.path().join("no/such/dir/x.jsonl").to_str().unwrap(),
         ]),
         "cannot write",
     );

@@ -314,7 +314,7 @@ fn can_run(block: &Block) -> bool {
     if !block.text.contains("tshark") {
         return true;
     }
-    let found = Command::new("tshark")
+    let found = common::tshark()
         .arg("--version")
         .stdout(Stdio::null())
         .stderr(Stdio::null())
@@ -472,5 +472,82 @@ fn every_cited_document_exists() {
         missing.is_empty(),
         "cited, but not in the repository:\n{}",
         missing.join("\n")
+    );
+}
+
+/// The help of `hwfoc` and of every command and subcommand, all in one text.
+fn all_help() -> String {
+    let mut text = String::new();
+    let mut todo: Vec<Vec<String>> = vec![Vec::new()];
+    while let Some(path) = todo.pop() {
+        let out = common::hwfoc()
+            .args(&path)
+            .arg("--help")
+            .output()
+            .expect("hwfoc --help");
+        assert!(out.status.success(), "hwfoc {path:?} --help");
+        let help = String::from_utf8(out.stdout).unwrap();
+        // The commands of a "Commands:" section, up to the next blank line.
+        let commands = help
+            .lines()
+            .skip_while(|l| !l.starts_with("Commands:"))
+            .skip(1)
+            .take_while(|l| !l.trim().is_empty());
+        // A command's line is indented two spaces; its description's next lines, more.
+        for line in commands.filter(|l| l.starts_with("  ") && !l.starts_with("   ")) {
+            let name = line.split_whitespace().next().unwrap_or("help");
+            if name != "help" {
+                todo.push(path.iter().cloned().chain([name.to_string()]).collect());
+            }
+        }
+        text.push_str(&help);
+    }
+    text
+}
+
+/// Every `--option` the README names is one of hwfoc's (cargo's own, on its lines, aside).
+#[test]
+fn every_option_the_readme_names_exists() {
+    let readme = fs::read_to_string(root().join("README.md")).unwrap();
+    let help = all_help();
+    let is_option_char = |c: char| c.is_ascii_lowercase() || c.is_ascii_digit() || c == '-';
+    let mut missing = Vec::new();
+    for line in readme
+        .lines()
+        .filter(|l| !l.trim_start().starts_with("cargo "))
+    {
+        for (at, _) in line.match_indices("--") {
+            let before = line[..at].chars().last();
+            if before.is_some_and(|c| !matches!(c, ' ' | '`' | '(' | '[')) {
+                continue;
+            }
+            let name: String = line[at + 2..]
+                .chars()
+                .take_while(|&c| is_option_char(c))
+                .collect();
+            if name.is_empty() || !name.starts_with(|c: char| c.is_ascii_lowercase()) {
+                continue;
+            }
+            let option = format!("--{name}");
+            let named = help
+                .match_indices(&option)
+                .any(|(i, _)| !help[i + option.len()..].starts_with(is_option_char));
+            if !named {
+                missing.push(option);
+            }
+        }
+    }
+    assert!(missing.is_empty(), "options no command has: {missing:?}");
+}
+
+/// The README stays a short guide: at most 3,000 words (as `wc -w` counts them); details live in
+/// `docs/`.
+#[test]
+fn the_readme_stays_short() {
+    let readme = fs::read_to_string(root().join("README.md")).unwrap();
+    let words = readme.split_whitespace().count();
+    assert!(
+        words <= 3000,
+        "README.md has {words} words: move details to docs/"
     );
 }

@@ -188,7 +188,7 @@ fn eight_virtual_escs_recorded_for_twenty_seconds_match_the_ground_truth() {
     }
 
     // Standard tools open the recording and count the same packets.
-    match Command::new("tshark")
+    match common::tshark()
         .arg("-r")
         .arg(&recording)
         .args(["-Y", "frame.len > 0"])

@@ -558,8 +558,8 @@ fn summary_lists_fault_episodes_per_esc() {
 #[test]
 fn output_that_cannot_be_written() {
     let dir = tempfile::tempdir().unwrap();
-    let missing = dir.path().join("no/such/dir/out.parquet");
     for format in ["jsonl", "csv", "parquet"] {
+        let missing = dir.path().join(format!("no/such/dir/out.{format}"));
         assert_fails_with(
             &run(&["decode", "--demo", "--format", format, "-o", s(&missing)]),
             &format!(

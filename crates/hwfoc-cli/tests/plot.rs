@@ -167,7 +167,7 @@ fn default_height_grows_with_the_escs_shown() {
         .iter()
         .map(|esc| {
             let out = dir.path("x.png");
-            let mut args = vec!["plot", &input, "-o", out.to_str().unwrap()];
+            let mut args = vec!["plot", &input, "--overwrite", "-o", out.to_str().unwrap()];
             if let Some(esc) = esc {
                 args.extend(["--esc", esc]);
             }
@@ -426,6 +426,7 @@ fn bad_outputs_and_empty_inputs_are_errors() {
     let o = run(&[
         "plot",
         noise.to_str().unwrap(),
+        "--overwrite",
         "-o",
         existing.to_str().unwrap(),
     ]);
@@ -517,7 +518,7 @@ fn a_fault_episode_has_the_same_times_in_the_plot_and_the_summary() {
         let svg = dir.path("p.svg");
         let mut args = vec!["plot"];
         args.extend(&input);
-        args.extend(["-o", svg.to_str().unwrap()]);
+        args.extend(["--overwrite", "-o", svg.to_str().unwrap()]);
         let o = run(&args);
         assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
         let text = std::fs::read_to_string(&svg).unwrap();

@@ -8,7 +8,7 @@ mod common;
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Stdio};
+use std::process::Stdio;
 use std::thread;
 use std::time::{Duration, Instant};
 
@@ -130,7 +130,7 @@ fn record_for(port: &str, out: &Path, seconds: &str) -> Running {
 }
 
 fn tshark_found() -> bool {
-    Command::new("tshark")
+    common::tshark()
         .arg("--version")
         .output()
         .is_ok_and(|o| o.status.success())
@@ -214,7 +214,7 @@ fn records_a_pty_exactly() {
     assert!(chunks.windows(2).all(|w| w[1].1 > w[0].1));
 
     if tshark_available() {
-        let out = Command::new("tshark")
+        let out = common::tshark()
             .arg("-r")
             .arg(&out)
             .args([
@@ -802,7 +802,7 @@ fn records_an_slcan_bus_as_can_frames() {
     assert!(input.is_can(0));
     assert_eq!(records, 5);
     if tshark_available() {
-        let shown = run(Command::new("tshark").arg("-r").arg(&out).args([
+        let shown = run(common::tshark().arg("-r").arg(&out).args([
             "-Y",
             "can",
             "-T",
@@ -873,7 +873,7 @@ fn a_recorded_bus_has_no_malformed_packet_in_tshark() {
     let (_dir, out, _, stderr) = record_simulated_bus();
     let config = tempfile::tempdir().unwrap();
     let tshark = |filter: &str| {
-        let o = run(Command::new("tshark")
+        let o = run(common::tshark()
             .env("WIRESHARK_CONFIG_DIR", config.path())
             .env("XDG_CONFIG_HOME", config.path())
             .env("HOME", config.path())

@@ -100,7 +100,13 @@ fn a_finished_export_replaces_the_file_and_leaves_no_partial_file() {
     let (csv, _) = inputs(&dir);
     let out = dir.arg("out.jsonl");
     std::fs::write(&out, "an earlier export\n").unwrap();
-    ok(run(hwfoc().args(["decode", &csv, "-o", &out])));
+    ok(run(hwfoc().args([
+        "decode",
+        &csv,
+        "--overwrite",
+        "-o",
+        &out,
+    ])));
     let text = std::fs::read_to_string(&out).unwrap();
     assert_eq!(text.lines().count(), 248);
     assert!(partials(&dir).is_empty());
@@ -113,6 +119,7 @@ fn a_finished_export_replaces_the_file_and_leaves_no_partial_file() {
         ok(run(hwfoc().args([
             "decode",
             &csv,
+            "--overwrite",
             "-o",
             link.to_str().unwrap(),
         ])));
@@ -141,7 +148,7 @@ fn a_killed_export_leaves_the_earlier_file() {
         std::fs::write(&out, "the earlier export").unwrap();
         let mut child = spawn(
             hwfoc()
-                .args(["decode", "--format", format, "-", "-o", &out])
+                .args(["decode", "--format", format, "-", "--overwrite", "-o", &out])
                 .stdin(Stdio::piped()),
         );
         let mut stdin = child.stdin.take().unwrap();
@@ -187,7 +194,11 @@ fn sigterm_during_an_export_removes_the_temporary_file() {
     let out = dir.arg("out.csv");
     std::fs::write(&out, "the earlier export").unwrap();
     // Signalled once the export has written something to its temporary file.
-    let o = terminated(&dir, &["decode", "--format", "csv", &big, "-o", &out], true);
+    let o = terminated(
+        &dir,
+        &["decode", "--format", "csv", &big, "--overwrite", "-o", &out],
+        true,
+    );
     assert_fails_with(&o, "interrupted: ");
     assert!(partials(&dir).is_empty(), "{:?}", partials(&dir));
     assert_eq!(std::fs::read_to_string(&out).unwrap(), "the earlier export");
@@ -202,8 +213,8 @@ fn sigterm_while_a_plot_reads_removes_its_temporary_file() {
     let big = big_input(&dir);
     let image = dir.arg("old.png");
     for args in [
-        vec!["plot", &big, "-o", &image],
-        vec!["summary", &big, "--plot", &image],
+        vec!["plot", &big, "--overwrite", "-o", &image],
+        vec!["summary", &big, "--overwrite", "--plot", &image],
     ] {
         std::fs::write(&image, "the earlier plot").unwrap();
         let o = terminated(&dir, &args, false);
@@ -391,9 +402,15 @@ fn the_temporary_file_is_never_a_file_that_is_there() {
     std::fs::write(&victim, "mine").unwrap();
     std::os::unix::fs::symlink(&victim, &staged_input).unwrap();
     std::fs::set_permissions(&out, std::fs::Permissions::from_mode(0o640)).unwrap();
-    ok(run(hwfoc().args(["decode", "-o", &out, &csv])));
+    ok(run(hwfoc().args([
+        "decode",
+        "--overwrite",
+        "-o",
+        &out,
+        &csv,
+    ])));
     assert_eq!(std::fs::read_to_string(&victim).unwrap(), "mine");
-    assert!(std::fs::read_to_string(&out).unwrap().starts_with("{"));
+    assert!(std::fs::read_to_string(&out).unwrap().starts_with("t_s,"));
     let mode = std::fs::metadata(&out).unwrap().permissions().mode() & 0o777;
     assert_eq!(mode, 0o640);
     // A plot likewise.
@@ -580,7 +597,7 @@ fn a_plot_is_written_whole_to_a_file_and_not_to_a_device() {
     let (csv, _) = inputs(&dir);
     let png = dir.arg("p.png");
     std::fs::write(&png, "an earlier plot").unwrap();
-    ok(run(hwfoc().args(["plot", &csv, "-o", &png])));
+    ok(run(hwfoc().args(["plot", &csv, "--overwrite", "-o", &png])));
     assert!(std::fs::read(&png).unwrap().starts_with(b"\x89PNG"));
     assert!(partials(&dir).is_empty());
     #[cfg(unix)]
@@ -635,7 +652,7 @@ fn a_missing_output_directory_is_worded_once() {
             "parquet",
             csv,
             "-o",
-            "/nonexistent-hwfoc/x.csv",
+            "/nonexistent-hwfoc/x.parquet",
         ],
         &["plot", csv, "-o", "/nonexistent-hwfoc/x.png"],
         &["summary", csv, "--plot", "/nonexistent-hwfoc/x.svg"],

@@ -31,7 +31,7 @@ fn old_recording() -> PathBuf {
 }
 
 fn tshark_found() -> bool {
-    let found = Command::new("tshark")
+    let found = common::tshark()
         .arg("--version")
         .output()
         .is_ok_and(|o| o.status.success());
@@ -42,7 +42,7 @@ fn tshark_found() -> bool {
 /// test`; `.ci/run` installs tshark and runs them with `--ignored`): a missing tshark fails
 /// it, saying so.
 fn need_tshark() {
-    let found = Command::new("tshark")
+    let found = common::tshark()
         .arg("--version")
         .output()
         .is_ok_and(|o| o.status.success());
@@ -104,7 +104,7 @@ fn tshark_fields(
     with_script: bool,
     fields: &[&'static str],
 ) -> Vec<Shown> {
-    let mut cmd = Command::new("tshark");
+    let mut cmd = common::tshark();
     if with_script {
         cmd.arg("-X")
             .arg(format!("lua_script:{}", dissector().display()));
@@ -408,7 +408,7 @@ fn a_simulated_recording_dissects_as_decode_reads_it() {
     // The compact layout: every frame is alone in its packet.
     assert!(shown.iter().all(|s| s["hwfoc.mos_temp_c"] != "?"));
     // Noise is shown as such, and a bad frame has its expert info.
-    let expert = Command::new("tshark")
+    let expert = common::tshark()
         .arg("-X")
         .arg(format!("lua_script:{}", dissector().display()))
         .arg("-r")
@@ -417,7 +417,7 @@ fn a_simulated_recording_dissects_as_decode_reads_it() {
         .output()
         .unwrap();
     assert!(!expert.stdout.is_empty(), "no noise shown");
-    let bad_expert = Command::new("tshark")
+    let bad_expert = common::tshark()
         .arg("-X")
         .arg(format!("lua_script:{}", dissector().display()))
         .arg("-r")
@@ -537,9 +537,10 @@ fn other_user0_files_are_left_alone_unless_asked() {
     raw.add_interface("x", 19200).unwrap();
     raw.write(0, 1_000_000_000, &frame).unwrap();
     let mut file_bytes = raw.into_inner().unwrap();
-    // Rewrite the description ("HW-FOC telemetry, …") into something else of the same length.
-    let at = file_bytes.windows(6).position(|w| w == b"HW-FOC").unwrap();
-    file_bytes[at..at + 6].copy_from_slice(b"OTHER ");
+    // Rewrite the description ("ESC telemetry (hwfoc), …") into something else of the same
+    // length.
+    let at = file_bytes.windows(7).position(|w| w == b"(hwfoc)").unwrap();
+    file_bytes[at..at + 7].copy_from_slice(b"(other)");
     std::fs::write(&file, &file_bytes).unwrap();
     let shown = tshark(&file, &[], true);
     assert!(shown.is_empty(), "claimed another tool's USER0 packets");
@@ -581,7 +582,7 @@ fn install_path_and_print() {
     if tshark_found() {
         let file = home.join("codes.pcapng");
         every_code(&file);
-        let out = Command::new("tshark")
+        let out = common::tshark()
             .env("HOME", home)
             .arg("-r")
             .arg(&file)
@@ -1037,7 +1038,7 @@ fn fields_of(protocol: &str) -> Vec<&'static str> {
 /// Every frame of the older formats tshark shows in `file` (fields `fields`, which begin with
 /// protocol and kind), in order; the values of fields a frame of its kind always has.
 fn older_frames(file: &Path, options: &[&str], fields: &[&'static str]) -> Vec<Shown> {
-    let mut cmd = Command::new("tshark");
+    let mut cmd = common::tshark();
     cmd.arg("-X")
         .arg(format!("lua_script:{}", dissector().display()))
         .args(options)
@@ -1187,7 +1188,7 @@ fn a_platinum_v4_recording_dissects_as_decode_reads_it() {
     assert_eq!(peak, 100.0);
     // The temperatures, for the packets of one data frame (aggregated fields are told apart by
     // their presence only there): as hwfoc decodes them; an ADC value of 0 is no reading.
-    let temps = Command::new("tshark")
+    let temps = common::tshark()
         .arg("-X")
         .arg(format!("lua_script:{}", dissector().display()))
         .arg("-r")
@@ -1234,7 +1235,7 @@ fn a_platinum_v4_recording_dissects_as_decode_reads_it() {
     }
     assert!(cap > 10, "{cap} second temperatures");
     // No checksum in the format: the tree says so; the preference converts voltages.
-    let none = Command::new("tshark")
+    let none = common::tshark()
         .arg("-X")
         .arg(format!("lua_script:{}", dissector().display()))
         .args(["-o", "hwfoc.v4_volts_per_step:hv", "-r"])
@@ -1258,6 +1259,42 @@ fn a_platinum_v4_recording_dissects_as_decode_reads_it() {
         .collect();
     assert_eq!(volts.len(), 297);
     assert!(volts.iter().all(|v| (22.0..24.0).contains(v)), "{volts:?}");
+}
+
+/// A recording `hwfoc simulate` (or `record`) writes, one frame per packet: the first V3 or V4
+/// frame, which only the next one shows to be a frame, is shown (reassembled in the next
+/// packet) as `decode` reads it: as many frames, with the same packet numbers.
+#[test]
+#[ignore = "needs tshark: .ci/run installs it and runs these with --ignored"]
+fn the_first_v3_and_v4_frames_of_a_recording_are_shown() {
+    need_tshark();
+    let dir = tempfile::tempdir().unwrap();
+    for protocol in ["hw-v3", "hw-v4"] {
+        let file = dir.path().join(format!("{protocol}.pcapng"));
+        let o = run(hwfoc()
+            .args([
+                "simulate",
+                "--protocol",
+                protocol,
+                "--duration",
+                "3",
+                "--quiet",
+                "-o",
+            ])
+            .arg(&file));
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        let decoded = decode(&file, &["--format", "jsonl"]);
+        let shown: Vec<Shown> = older_frames(&file, &[], &fields_of(protocol))
+            .into_iter()
+            .filter(|s| s["hwfoc.kind"] == "data")
+            .collect();
+        assert_eq!(shown.len(), decoded.len(), "{protocol}: data frames");
+        assert_eq!(
+            uint(&shown[0]["hwfoc.packet"]),
+            decoded[0]["packet"].as_u64().unwrap(),
+            "{protocol}: the first frame"
+        );
+    }
 }
 
 /// The Platinum Pro V3 capture recorded in reads cut anywhere: its 699 frames, with
@@ -1426,7 +1463,7 @@ fn an_hw5_recording_dissects_as_decode_reads_it() {
     );
     assert!(good.iter().any(|s| s["hwfoc.faults"] == "low_voltage"));
     // The fault bits by name, as filters.
-    let named = Command::new("tshark")
+    let named = common::tshark()
         .arg("-X")
         .arg(format!("lua_script:{}", dissector().display()))
         .arg("-r")
@@ -1489,7 +1526,7 @@ fn can_pcapng(file: &Path, records: &[Vec<u8>]) {
 /// field's occurrences joined by `,`), and the `-V` tree, which must hold no Lua error.
 fn tshark_can(file: &Path, fields: &[&str]) -> (Vec<Vec<String>>, String) {
     let script = format!("lua_script:{}", dissector().display());
-    let mut cmd = Command::new("tshark");
+    let mut cmd = common::tshark();
     cmd.args(["-X", &script, "-r"]).arg(file).args([
         "-T",
         "fields",
@@ -1512,7 +1549,7 @@ fn tshark_can(file: &Path, fields: &[&str]) -> (Vec<Vec<String>>, String) {
         .lines()
         .map(|l| l.split('\t').map(str::to_string).collect::<Vec<_>>())
         .collect::<Vec<_>>();
-    let tree = Command::new("tshark")
+    let tree = common::tshark()
         .args(["-X", &script, "-r"])
         .arg(file)
         .arg("-V")

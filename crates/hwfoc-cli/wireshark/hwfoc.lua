@@ -5,7 +5,9 @@
 --
 -- `hwfoc record` (and `hwfoc simulate -o FILE.pcapng`, and the monitor's recording) write pcapng
 -- files with link type USER0 (147): each packet holds the raw bytes of one serial port (one
--- interface per port, described as "HW-FOC telemetry, 19200 baud 8N1"). Recordings written since
+-- interface per port, described as "HW5 telemetry (hwfoc), 115200 baud 8N1", naming the format
+-- when it is known, "ESC telemetry (hwfoc), ..." when not; before hwfoc named formats, "HW-FOC
+-- telemetry, 19200 baud 8N1"). Recordings written since
 -- hwfoc 0.1 (compact layout) hold one frame per packet, or the bytes between two frames; older
 -- ones hold each read of the port as a packet, cut anywhere in the frames.
 --
@@ -19,8 +21,8 @@
 -- own packets), and a silence of over a second ends a frame still arriving.
 --
 -- USER0 is a link type for private use: other tools write other things with it. The dissector
--- only takes packets of interfaces hwfoc described ("HW-FOC telemetry" in the interface
--- description); other USER0 packets go to the dissector that had USER0 before (the "User DLTs"
+-- only takes packets of interfaces hwfoc described ("telemetry (hwfoc)", or in older recordings
+-- "HW-FOC telemetry", in the interface description); other USER0 packets go to the dissector that had USER0 before (the "User DLTs"
 -- table of the preferences, or raw data), unless the preference "Dissect every USER0 packet" is
 -- set (for HW-FOC bytes recorded by another tool).
 --
@@ -922,8 +924,9 @@ local fallback = nil
 
 function hwfoc.dissector(tvb, pinfo, tree)
     local desc = f_iface_desc()
-    local ours = (desc and tostring(desc.value):find("HW-FOC telemetry", 1, true)) or
-        hwfoc.prefs.all_user0
+    local text = desc and tostring(desc.value)
+    local ours = (text and (text:find("telemetry (hwfoc)", 1, true) or
+        text:find("HW-FOC telemetry", 1, true))) or hwfoc.prefs.all_user0
     if not ours then
         if fallback then return fallback:call(tvb, pinfo, tree) end
         return Dissector.get("data"):call(tvb, pinfo, tree)
@@ -1001,7 +1004,10 @@ function hwfoc.dissector(tvb, pinfo, tree)
     local protos = {}
     local joined = nil
     for _, item in ipairs(items) do
-        if item.to > c then
+        -- An item with bytes of this packet; or a frame wholly in earlier packets, which were
+        -- left undecided there (the first V4 or V3 frame of a recording is a frame only if the
+        -- next one follows it): shown here, reassembled, as decode reads it.
+        if item.to > c or (item.what == "good" and item.from < c) then
             local when = when_of(item.from)
             local range
             if item.from >= c then

@@ -7,17 +7,25 @@
 //! silence (a cut line, an ESC that rebooted, a pause between recordings) is not filled with
 //! the last current seen, and nothing is integrated across a clock that stepped back or
 //! jumped; [`Energy::seconds`] is the sum of the steps integrated. For an input without times
-//! (raw bytes), every step is [`NOMINAL_PERIOD_S`], the protocol's frame period, and
+//! (raw bytes), every step is the protocol's frame period ([`nominal_period_s`]), and
 //! [`Energy::nominal`] says so.
 //!
 //! Regenerative braking (negative input current) gives charge back: the charge and energy are
 //! net figures, as a battery sees them.
 
+use hwfoc::Protocol;
+
 use crate::clock::Step;
 
-/// The protocol's frame period of a running ESC: 50 ms. The step between two frames of an input
-/// without times.
-pub const NOMINAL_PERIOD_S: f64 = 0.05;
+/// The step between two data frames of an input without times, s: the frame period of a running
+/// ESC of `protocol` ([`Protocol::frame_period`]), HW-FOC's for none (or a CAN protocol, whose
+/// frames always have times).
+pub fn nominal_period_s(protocol: Option<Protocol>) -> f64 {
+    protocol
+        .and_then(Protocol::frame_period)
+        .or(Protocol::HwFoc.frame_period())
+        .map_or(0.0, |d| d.as_secs_f64())
+}
 
 /// Electrical input power, W, of a frame's input voltage and current: the one definition the
 /// summary, the plots and [`Energy`] use.
@@ -47,13 +55,20 @@ pub struct Energy {
     seconds: f64,
     /// Largest electrical input power of a frame, W.
     peak_w: Option<f64>,
-    /// Whether some step used [`NOMINAL_PERIOD_S`] for want of times.
+    /// Whether some step used `period_s` for want of times.
     nominal: bool,
+    /// The step between frames without times, s ([`nominal_period_s`]).
+    period_s: f64,
 }
 
 impl Energy {
-    /// Nothing integrated yet.
-    pub const fn new() -> Energy {
+    /// Nothing integrated yet; frames without times a step of HW-FOC's frame period apart.
+    pub fn new() -> Energy {
+        Energy::at_period(nominal_period_s(None))
+    }
+
+    /// Nothing integrated yet; frames without times `period_s` apart ([`nominal_period_s`]).
+    pub const fn at_period(period_s: f64) -> Energy {
         Energy {
             last: None,
             charge_as: 0.0,
@@ -61,6 +76,7 @@ impl Energy {
             seconds: 0.0,
             peak_w: None,
             nominal: false,
+            period_s,
         }
     }
 
@@ -76,7 +92,7 @@ impl Energy {
                 },
                 _ => {
                     self.nominal = true;
-                    NOMINAL_PERIOD_S
+                    self.period_s
                 }
             };
             self.charge_as += i * step;
@@ -91,26 +107,28 @@ impl Energy {
     /// The figures [`Energy::add`] gives for `frames` frames without receive times, from sums
     /// a caller keeps anyway (the summary's raw lanes): `current_sum` and `power_sum` over
     /// every frame, `last` the last frame's volts and amps, `peak_w` the largest power. Each
-    /// frame but the last holds for [`NOMINAL_PERIOD_S`].
+    /// frame but the last holds for `period_s` ([`nominal_period_s`]).
     pub fn untimed(
         frames: u64,
         current_sum: f64,
         power_sum: f64,
         last: (f64, f64),
         peak_w: Option<f64>,
+        period_s: f64,
     ) -> Energy {
         if frames == 0 {
-            return Energy::new();
+            return Energy::at_period(period_s);
         }
-        let steps = (frames - 1) as f64 * NOMINAL_PERIOD_S;
+        let steps = (frames - 1) as f64 * period_s;
         let (v, i) = last;
         Energy {
             last: Some((None, v, i)),
-            charge_as: (current_sum - i) * NOMINAL_PERIOD_S,
-            energy_j: (power_sum - power_w(v, i)) * NOMINAL_PERIOD_S,
+            charge_as: (current_sum - i) * period_s,
+            energy_j: (power_sum - power_w(v, i)) * period_s,
             seconds: steps,
             peak_w: peak_w.map(drawn_w),
             nominal: frames > 1,
+            period_s,
         }
     }
 
@@ -146,9 +164,14 @@ impl Energy {
         self.peak_w
     }
 
-    /// Whether steps were taken as [`NOMINAL_PERIOD_S`] for want of receive times.
+    /// Whether steps were taken as [`Energy::period_s`] for want of receive times.
     pub fn nominal(&self) -> bool {
         self.nominal
+    }
+
+    /// The step between frames without receive times, s.
+    pub fn period_s(&self) -> f64 {
+        self.period_s
     }
 
     /// These figures with every voltage multiplied by `volts` and every current by `amps`
@@ -163,6 +186,7 @@ impl Energy {
             seconds: self.seconds,
             peak_w: self.peak_w.map(|p| p * volts * amps),
             nominal: self.nominal,
+            period_s: self.period_s,
         }
     }
 
@@ -178,6 +202,9 @@ impl Energy {
             (Some(a), Some(b)) => Some(a.max(b)),
             (a, b) => a.or(b),
         };
+        if !self.nominal {
+            self.period_s = other.period_s;
+        }
         self.nominal |= other.nominal;
         self.last = None;
     }
@@ -264,6 +291,7 @@ mod tests {
             sum(|&(v, i)| power_w(v, i)),
             (24.8, 7.25),
             Some(24.0 * 30.5),
+            nominal_period_s(None),
         );
         assert!((from_sums.charge_mah() - added.charge_mah()).abs() < 1e-12);
         assert!((from_sums.energy_wh() - added.energy_wh()).abs() < 1e-12);
@@ -271,10 +299,10 @@ mod tests {
         assert_eq!(from_sums.peak_w(), added.peak_w());
         assert!(from_sums.nominal() && added.nominal());
         assert_eq!(
-            Energy::untimed(0, 0.0, 0.0, (0.0, 0.0), None),
+            Energy::untimed(0, 0.0, 0.0, (0.0, 0.0), None, nominal_period_s(None)),
             Energy::new()
         );
-        let one = Energy::untimed(1, 5.0, 50.0, (10.0, 5.0), Some(50.0));
+        let one = Energy::untimed(1, 5.0, 50.0, (10.0, 5.0), Some(50.0), 0.02);
         assert_eq!(
             (one.seconds(), one.charge_mah(), one.nominal()),
             (0.0, 0.0, false)

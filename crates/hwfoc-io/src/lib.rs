@@ -92,8 +92,9 @@
 //!     inputs: vec!["example".to_string()],
 //!     filter: String::new(),
 //!     csv_comment: false,
+//!     csv_time_iso: false,
 //! };
-//! let mut export = Export::create(OutputFormat::Csv, path.to_str(), provenance)?;
+//! let mut export = Export::create(OutputFormat::Csv, path.to_str(), false, provenance)?;
 //! sources.run(&mut export)?;
 //! export.finish(Vec::new())?;
 //!

@@ -42,6 +42,15 @@ pub enum Clock {
     None,
 }
 
+/// A year of 365.25 days, s.
+pub const YEAR_S: f64 = 365.25 * 86_400.0;
+
+/// Whether seconds of a source's clock, `s`, lie more than a year before `first`, the data's
+/// first receive time: a bare number meant as seconds after the first frame (`5` for `+5`).
+pub fn long_before(s: f64, first: f64) -> bool {
+    s < first - YEAR_S
+}
+
 /// A time as given on the command line ([`parse`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Time {
@@ -289,6 +298,20 @@ pub fn iso8601(t_s: f64) -> String {
     match instant(t_s) {
         Some(t) => format!("{t:.3}"),
         None => format!("{t_s} s"),
+    }
+}
+
+/// Unix time `t_s` as an ISO 8601 date-time in UTC to the microsecond,
+/// `2026-11-23T14:03:00.160123Z`: a CSV export's `time` column (`--time iso`), which
+/// spreadsheets read as a date. Beyond the year 9999 or NaN it is [`iso8601`]'s text.
+pub fn iso8601_us(t_s: f64) -> String {
+    let us = (t_s * 1e6).round();
+    match Some(us)
+        .filter(|us| us.is_finite() && us.abs() < 1e18)
+        .and_then(|us| Timestamp::from_microsecond(us as i64).ok())
+    {
+        Some(t) => format!("{t:.6}"),
+        None => iso8601(t_s),
     }
 }
 

@@ -62,7 +62,7 @@ use hwfoc_io::can::setup::{REQUEST_PRIORITY, baud_code, parse_rate, rate_code, r
 // Times, clocks and energy.
 use hwfoc_io::clock::{MAX_FRAME_SPACING_S, MAX_STEP_S, ReceiveClock, Step};
 use hwfoc_io::clock::{byte_time_s, byte_times, unix_now_ns};
-use hwfoc_io::energy::{Energy, NOMINAL_PERIOD_S, drawn_w, power_w};
+use hwfoc_io::energy::{Energy, drawn_w, nominal_period_s, power_w};
 use hwfoc_io::time::{Clock, Time, TimeError, iso8601, iso8601_local, parse, span_text};
 
 /// The constants of the surface, against the documents that fix them (`docs/RECORD-SCHEMA.md`,
@@ -77,7 +77,7 @@ fn the_surface_constants_are_those_of_the_specs() {
     assert_eq!(LINKTYPE, 147);
     assert_eq!(LINKTYPE_CAN_SOCKETCAN, 227);
     assert_eq!(DEFAULT_BAUD, 19_200);
-    assert_eq!(NOMINAL_PERIOD_S, 0.05);
+    assert_eq!(nominal_period_s(None), 0.05);
     assert_eq!(JSON_SCHEMA_VERSION, 1);
     assert_eq!(RECORD_SCHEMA_VERSION, 3);
     assert_eq!(RECORD_SCHEMA_VERSION_KEY, "record_schema_version");

@@ -114,13 +114,14 @@ impl Destination {
         }
     }
 
-    /// Opens the destination for `n` ESCs at `baud`; existing files are replaced only if
-    /// `overwrite` ([`Session::open`](crate::Session::open) has refused them all before any
-    /// is created; each creation still refuses a file that appeared since).
+    /// Opens the destination for `n` ESCs at `baud`, speaking `protocol` (which a recording's
+    /// interfaces name); existing files are replaced only if `overwrite`
+    /// ([`Session::open`](crate::Session::open) has refused them all before any is created;
+    /// each creation still refuses a file that appeared since).
     pub(crate) fn open(
         &self,
         n: usize,
-        baud: u32,
+        (baud, protocol): (u32, Option<hwfoc::Protocol>),
         overwrite: bool,
         recording: hwfoc_io::pcapng::RecordingId,
     ) -> Result<Opened, SimError> {
@@ -156,9 +157,12 @@ impl Destination {
                 let names = file_of.iter().map(|&f| outs[f].0.clone()).collect();
                 let sink: Box<dyn Sink> = match format {
                     FileFormat::Raw => Box::new(RawSink::new(outs)),
-                    FileFormat::Pcapng => {
-                        Box::new(PcapngSink::new(outs, &file_of, baud, recording)?)
-                    }
+                    FileFormat::Pcapng => Box::new(PcapngSink::new(
+                        outs,
+                        &file_of,
+                        (baud, protocol),
+                        recording,
+                    )?),
                 };
                 (sink, names, false)
             }

@@ -123,7 +123,12 @@ impl Session {
         // The recording's id, from what makes its bytes: the same seed and start, the same id.
         let recording = hwfoc_io::pcapng::RecordingId::derived(&[seed, origin_ns]);
         Ok(Session {
-            opened: plan.destination.open(n, baud, plan.overwrite, recording)?,
+            opened: plan.destination.open(
+                n,
+                (baud, escs.first().map(VirtualEsc::protocol)),
+                plan.overwrite,
+                recording,
+            )?,
             escs,
             truth,
             pace: plan.destination.pace(realtime, baud),

@@ -112,11 +112,12 @@ pub struct PcapngSink {
 
 impl PcapngSink {
     /// One recording per output, each ESC an interface named `esc-N` in the file at
-    /// `file_of[esc]`; the files are parts of recording `recording`.
+    /// `file_of[esc]`, described as carrying `protocol` at `baud`; the files are parts of
+    /// recording `recording`.
     pub fn new(
         outs: Vec<(String, Box<dyn Write>)>,
         file_of: &[usize],
-        baud: u32,
+        (baud, protocol): (u32, Option<hwfoc::Protocol>),
         recording: pcapng::RecordingId,
     ) -> Result<PcapngSink, WriteError> {
         let mut files = Vec::with_capacity(outs.len());
@@ -130,7 +131,7 @@ impl PcapngSink {
         for (esc, &file) in file_of.iter().enumerate() {
             let (name, writer) = &mut files[file];
             let iface = writer
-                .add_interface(&format!("esc-{esc}"), baud)
+                .add_port(&format!("esc-{esc}"), baud, protocol)
                 .map_err(write_error(name))?;
             route.push((file, iface));
         }

@@ -124,6 +124,28 @@ impl Protocol {
         }
     }
 
+    /// The interval between two data frames of a running ESC, which raw bytes (without receive
+    /// times) are timed at: 50 ms for HW-FOC and DataLink (a hub relays its ESCs' frames), 51 ms
+    /// for V4, 19.5 ms for V3, 20 ms for HW5 ([`crate::hw5::FRAME_PERIOD_RUNNING`]); `None` for
+    /// the CAN protocols, whose frames always come with times.
+    ///
+    /// ```
+    /// use hwfoc::Protocol;
+    /// use core::time::Duration;
+    ///
+    /// assert_eq!(Protocol::HwV3.frame_period(), Some(Duration::from_micros(19_500)));
+    /// ```
+    pub const fn frame_period(self) -> Option<core::time::Duration> {
+        use core::time::Duration;
+        match self {
+            Protocol::HwFoc | Protocol::DataLink => Some(Duration::from_millis(50)),
+            Protocol::HwV4 => Some(Duration::from_millis(51)),
+            Protocol::HwV3 => Some(Duration::from_micros(19_500)),
+            Protocol::Hw5 => Some(crate::hw5::FRAME_PERIOD_RUNNING),
+            Protocol::HwCan | Protocol::DroneCan => None,
+        }
+    }
+
     /// The width of its packet counter in bits (which it wraps at), or `None` for a protocol
     /// that sends no counter: 16 for HW-FOC and DataLink, 24 for V3 and V4, none for HW5 and the
     /// CAN protocols (a transfer id is the transport's: its gaps are counted per node).

@@ -27,21 +27,38 @@ pub enum RecordFormat {
     Parquet,
 }
 
+/// How CSV gives receive times.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum CsvTime {
+    /// Unix seconds, `t_s` (the source's own seconds for an analyser's export).
+    Seconds,
+    /// ISO 8601 dates in UTC, `time`: `2026-11-23T14:03:00.160123Z`.
+    Iso,
+}
+
 #[derive(Debug, Args)]
 pub struct DecodeArgs {
     #[command(flatten)]
     pub input: InputArgs,
-    /// Output format.
-    #[arg(long, value_enum, default_value_t = RecordFormat::Jsonl)]
-    pub format: RecordFormat,
+    /// Output format: by default the one the -o file's name ends in (.jsonl or .ndjson, .csv,
+    /// .parquet), JSON Lines on standard output.
+    #[arg(long, value_enum)]
+    pub format: Option<RecordFormat>,
     #[command(flatten)]
     pub settings: SettingsArgs,
     /// CSV only: start with a `#` comment line giving the settings used.
     #[arg(long)]
     pub settings_comment: bool,
-    /// Write to FILE instead of standard output.
+    /// CSV only: receive times as Unix seconds (`t_s`), or as ISO 8601 dates in UTC to the
+    /// microsecond (a `time` column, which spreadsheets read as dates; recordings and ports).
+    #[arg(long, value_enum, default_value_t = CsvTime::Seconds)]
+    pub time: CsvTime,
+    /// Write to FILE instead of standard output, in the format its name ends in.
     #[arg(short, long, value_name = "FILE", required_if_eq("format", "parquet"))]
     pub output: Option<String>,
+    /// Replace the -o file if it exists.
+    #[arg(long, requires = "output")]
+    pub overwrite: bool,
     #[command(flatten)]
     pub select: SelectArgs,
 }
@@ -54,15 +71,40 @@ pub fn run(args: &DecodeArgs) -> Result<(), CliError> {
     let selection = args.select.selection()?;
     args.input
         .refuse_output(args.output.as_deref().unwrap_or("-"), &config)?;
-    // Ctrl-C and SIGTERM abandon an export of files read to their end, leaving any earlier
-    // file at the output as it was. Live inputs keep the signals' usual meaning: serial ports
-    // end their input on them, and what they gave is written; a pipe or a terminal on standard
-    // input ends the process (its export stays in the temporary file).
-    let stop = args.input.stop_if_read_to_end();
+    let format = output_format(args.format, args.output.as_deref())?;
+    if args.time == CsvTime::Iso && format != OutputFormat::Csv {
+        return Err(CliError::Usage {
+            option: "--time iso".to_string(),
+            message: "CSV only (Parquet and JSON Lines keep t_s): add --format csv or name the \
+                      output .csv"
+                .to_string(),
+        });
+    }
+    // Ctrl-C and SIGTERM abandon an export of files read to their end, or of standard input
+    // to a file, leaving any earlier file at the output as it was (standard input's at its next
+    // bytes or its end: the Ctrl-C that stops a pipe's writer ends it too). Serial ports end
+    // their input on them, and what they gave is written.
+    let to_file = args.output.as_deref().is_some_and(|p| p != "-");
+    let stdin = args.input.inputs.iter().any(|i| i == "-");
+    let stop = args
+        .input
+        .stop_if_read_to_end()
+        .or_else(|| (to_file && stdin).then(crate::stop::interrupted));
     let mut sources = args.input.sources(settings_map)?;
     if selection.window.is_limited() {
         sources.require_timing()?;
         args.select.check_clocks(&sources)?;
+    }
+    if args.time == CsvTime::Iso
+        && let Some((input, format)) = sources.formats().find(|(_, f)| f.clock() == Clock::Capture)
+    {
+        return Err(CliError::Usage {
+            option: "--time iso".to_string(),
+            message: format!(
+                "{input} ({format}) has no wall clock, its times count from the start of its \
+                 capture: leave out --time iso"
+            ),
+        });
     }
     let provenance = Provenance {
         settings,
@@ -70,15 +112,12 @@ pub fn run(args: &DecodeArgs) -> Result<(), CliError> {
         inputs: sources.names().to_vec(),
         filter: args.select.text(),
         csv_comment: args.settings_comment,
-    };
-    let format = match args.format {
-        RecordFormat::Jsonl => OutputFormat::Jsonl,
-        RecordFormat::Csv => OutputFormat::Csv,
-        RecordFormat::Parquet => OutputFormat::Parquet,
+        csv_time_iso: args.time == CsvTime::Iso,
     };
     keep_freed_memory();
+    let output = args.output.as_deref();
     let mut export =
-        Export::create(format, args.output.as_deref(), provenance)?.select(selection.clone());
+        Export::create(format, output, args.overwrite, provenance)?.select(selection.clone());
     if let Some(stop) = stop {
         export = export.stop_on(stop);
     }
@@ -92,6 +131,10 @@ pub fn run(args: &DecodeArgs) -> Result<(), CliError> {
         });
     }
     let (kept, span) = (export.kept(), export.span());
+    if let Some((first, _)) = span {
+        // A bare time long before the data: nothing is written.
+        args.select.check_bare_seconds(first)?;
+    }
     // Whatever was decoded before an input error is still written out.
     let metadata = vec![(metadata::ESCS.to_string(), metadata::escs_json(&sources))];
     let finished = export.finish(metadata);
@@ -110,6 +153,45 @@ pub fn run(args: &DecodeArgs) -> Result<(), CliError> {
         );
     }
     Ok(())
+}
+
+/// The format of the output: `--format`, the one the -o file's name names, JSON Lines for
+/// standard output, a device or a directory (refused as the output is created); a name naming none without `--format`, or another than
+/// `--format`, is refused naming both.
+fn output_format(
+    format: Option<RecordFormat>,
+    output: Option<&str>,
+) -> Result<OutputFormat, CliError> {
+    let given = format.map(|f| match f {
+        RecordFormat::Jsonl => OutputFormat::Jsonl,
+        RecordFormat::Csv => OutputFormat::Csv,
+        RecordFormat::Parquet => OutputFormat::Parquet,
+    });
+    let Some(path) = output.filter(|&p| p != "-") else {
+        return Ok(given.unwrap_or(OutputFormat::Jsonl));
+    };
+    let named = OutputFormat::from_name(path);
+    // A device or a pipe is written as it is; a directory is refused when created.
+    let device = std::fs::metadata(path).is_ok_and(|m| !m.is_file());
+    match (given, named) {
+        (Some(g), Some(n)) if g != n => Err(CliError::Usage {
+            option: format!("--format {} -o {path}", g.extension()),
+            message: format!(
+                "the file's name says {}: name it .{} or leave out --format",
+                n.extension(),
+                g.extension()
+            ),
+        }),
+        (Some(g), _) => Ok(g),
+        (None, Some(n)) => Ok(n),
+        (None, None) if device => Ok(OutputFormat::Jsonl),
+        (None, None) => Err(CliError::Usage {
+            option: format!("-o {path}"),
+            message: "the format follows the file name: end it in .jsonl (or .ndjson), .csv \
+                      or .parquet, or give --format"
+                .to_string(),
+        }),
+    }
 }
 
 /// The entries by port and by ESC of `map`, named as in the configuration file (`port."NAME"`,

@@ -21,6 +21,9 @@ pub struct SummaryArgs {
     /// Also plot the inputs to FILE (.png or .svg), as `hwfoc plot` does.
     #[arg(long, value_name = "FILE")]
     pub plot: Option<String>,
+    /// Replace the --plot file if it exists.
+    #[arg(long, requires = "plot")]
+    pub overwrite: bool,
     #[command(flatten)]
     pub settings: SettingsArgs,
 }
@@ -35,6 +38,7 @@ pub fn run(args: &SummaryArgs) -> Result<(), CliError> {
             args.input.refuse_output(path, &config)?;
             Some(plot::Alongside::open(
                 path,
+                args.overwrite,
                 settings,
                 args.input.stop_if_read_to_end(),
             )?)

@@ -291,3 +291,19 @@ pub fn hwfoc_unprivileged() -> Command {
     }
     cmd
 }
+
+/// `tshark`, kept from the user's Wireshark set-up: a home, configuration directory and plugin
+/// directories of its own (empty), so that a dissector the user installed (the README's
+/// `hwfoc wireshark install`) or their preferences never change what a test sees. A test that
+/// wants the dissector passes it explicitly (`-X lua_script:…`).
+pub fn tshark() -> Command {
+    static HOME: std::sync::OnceLock<tempfile::TempDir> = std::sync::OnceLock::new();
+    let home = HOME.get_or_init(|| tempfile::tempdir().unwrap()).path();
+    let mut cmd = Command::new("tshark");
+    cmd.env("HOME", home)
+        .env("XDG_CONFIG_HOME", home.join(".config"))
+        .env("WIRESHARK_CONFIG_DIR", home.join("wireshark"))
+        .env_remove("WIRESHARK_PLUGIN_DIR")
+        .env_remove("WIRESHARK_EXTCAP_DIR");
+    cmd
+}

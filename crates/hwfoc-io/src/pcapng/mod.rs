@@ -12,8 +12,9 @@
 //!   the same in every file of one `hwfoc record` run, rotated files alike, so that files are
 //!   read as one recording only when they are one);
 //! - one interface description block (IDB) per port: link type [`LINKTYPE`] (`LINKTYPE_USER0`,
-//!   raw HW-FOC UART bytes), `if_name` = the port, `if_description` = "HW-FOC telemetry, 19200
-//!   baud 8N1", `if_speed` = the baud rate, `if_tsresol` = 9 (nanoseconds);
+//!   raw UART bytes), `if_name` = the port, `if_description` its format when known: "HW5
+//!   telemetry (hwfoc), 115200 baud 8N1" ("ESC telemetry (hwfoc), 19200 baud 8N1" when not;
+//!   "HW-FOC telemetry, 19200 baud 8N1" before hwfoc named formats), `if_speed` = the baud rate, `if_tsresol` = 9 (nanoseconds);
 //! - one enhanced packet block (EPB) per frame, holding exactly the frame's bytes, timestamped
 //!   with the Unix time in nanoseconds of its first byte; the bytes between frames (line noise,
 //!   frames that fail their checksum) in packets of their own, one per read of the port they
@@ -120,7 +121,11 @@ mod tests {
     fn sample() -> (Vec<u8>, Vec<Owned>) {
         let mut w = Writer::new(Vec::new()).unwrap();
         assert_eq!(w.add_interface("/dev/ttyUSB0", 19200).unwrap(), 0);
-        assert_eq!(w.add_interface("COM7", 115_200).unwrap(), 1);
+        assert_eq!(
+            w.add_port("COM7", 115_200, Some(hwfoc::Protocol::Hw5))
+                .unwrap(),
+            1
+        );
         let mut expected = Vec::new();
         let t0 = 1_754_000_000_123_456_789u64;
         for k in 0..9u8 {
@@ -158,13 +163,13 @@ mod tests {
             vec![
                 Interface {
                     name: "/dev/ttyUSB0".into(),
-                    description: "HW-FOC telemetry, 19200 baud 8N1".into(),
+                    description: "ESC telemetry (hwfoc), 19200 baud 8N1".into(),
                     baud: Some(19200),
                     link_type: 147,
                 },
                 Interface {
                     name: "COM7".into(),
-                    description: "HW-FOC telemetry, 115200 baud 8N1".into(),
+                    description: "HW5 telemetry (hwfoc), 115200 baud 8N1".into(),
                     baud: Some(115_200),
                     link_type: 147,
                 },

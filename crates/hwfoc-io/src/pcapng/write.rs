@@ -96,8 +96,21 @@ impl<W: Write> Writer<W> {
     }
 
     /// Declares a port: writes its interface description block and returns its interface id
-    /// (0, 1, 2, … in the order of the calls). `baud` must not be zero.
+    /// (0, 1, 2, … in the order of the calls). `baud` must not be zero. Its description says
+    /// hwfoc recorded ESC telemetry; [`Writer::add_port`] names the format too.
     pub fn add_interface(&mut self, port: &str, baud: u32) -> io::Result<u32> {
+        self.add_port(port, baud, None)
+    }
+
+    /// [`Writer::add_interface`] for a port known to carry `protocol`: its description names
+    /// the format (`HW5 telemetry (hwfoc), 115200 baud 8N1`), for Wireshark and other readers
+    /// (hwfoc reads the bytes, whatever the description says).
+    pub fn add_port(
+        &mut self,
+        port: &str,
+        baud: u32,
+        protocol: Option<hwfoc::Protocol>,
+    ) -> io::Result<u32> {
         if baud == 0 {
             return Err(io::Error::new(
                 io::ErrorKind::InvalidInput,
@@ -111,10 +124,7 @@ impl<W: Write> Writer<W> {
         self.put_u16(0); // reserved
         self.put_u32(0); // snap length: no limit
         self.option(IF_NAME, port.as_bytes());
-        self.option(
-            IF_DESCRIPTION,
-            format!("HW-FOC telemetry, {baud} baud 8N1").as_bytes(),
-        );
+        self.option(IF_DESCRIPTION, port_description(protocol, baud).as_bytes());
         self.option(IF_SPEED, &u64::from(baud).to_le_bytes());
         self.option(IF_TSRESOL, &[9]);
         self.end_options();
@@ -429,4 +439,13 @@ fn truncate_utf8(text: &str, max: usize) -> &str {
         end -= 1;
     }
     &text[..end]
+}
+
+/// What the interface of a serial port says it holds: `HW5 telemetry (hwfoc), 115200 baud 8N1`,
+/// or for a port whose format is not known when it is declared `ESC telemetry (hwfoc), 19200
+/// baud 8N1`. The Wireshark dissector takes interfaces whose description holds
+/// `telemetry (hwfoc)` (and, as recordings before these words said, `HW-FOC telemetry`).
+fn port_description(protocol: Option<hwfoc::Protocol>, baud: u32) -> String {
+    let title = protocol.map_or("ESC", hwfoc::Protocol::title);
+    format!("{title} telemetry (hwfoc), {baud} baud 8N1")
 }

@@ -9,7 +9,7 @@ use hwfoc::{Protocol, Quantity, Settings, Status, Temperature};
 
 use super::MAX_EPISODES;
 use crate::clock::Step;
-use crate::energy::Energy;
+use crate::energy::{Energy, nominal_period_s};
 use crate::episode::{Episode, Mark};
 
 /// Min, max and sum of one raw integer field.
@@ -392,8 +392,8 @@ impl Values {
     }
 
     /// Charge, energy and power in amperes and volts: over receive times, or for frames
-    /// without times from the sums (each frame the nominal period).
-    fn energy(&self, timed: bool) -> Option<Energy> {
+    /// without times from the sums (each frame `period_s` apart).
+    fn energy(&self, timed: bool, period_s: f64) -> Option<Energy> {
         if self.powered == 0 {
             return None;
         }
@@ -406,6 +406,7 @@ impl Values {
             self.power_sum,
             self.last.unwrap_or_default(),
             Some(self.power_max),
+            period_s,
         ))
     }
 }
@@ -761,10 +762,12 @@ impl Accumulator {
     /// Charge, energy and power in raw units: integrated frame by frame over receive times,
     /// or for a stream without times (whose frames all lack them) from the lanes' sums.
     pub(super) fn energy(&self) -> Energy {
+        // Frames without times are their protocol's frame period apart.
+        let period_s = nominal_period_s(self.sample.as_ref().map(Data::protocol));
         if let Some(values) = &self.values {
             return values
-                .energy(self.first_t.is_some())
-                .unwrap_or_else(Energy::new);
+                .energy(self.first_t.is_some(), period_s)
+                .unwrap_or_else(|| Energy::at_period(period_s));
         }
         if self.first_t.is_some() {
             return self.energy;
@@ -783,6 +786,7 @@ impl Accumulator {
             power_sum as f64,
             (f64::from(v), f64::from(i)),
             (frames > 0).then(|| f64::from(power_max)),
+            period_s,
         )
     }
 }

@@ -33,7 +33,7 @@ use hwfoc::units::Linear;
 use hwfoc::{Protocol, Quantity, Settings, Status};
 use serde_json::{Value, json};
 
-use crate::energy::{Energy, NOMINAL_PERIOD_S};
+use crate::energy::Energy;
 pub use crate::episode::{Episode, Mark};
 use crate::escape::Escaped;
 use crate::fixed::Fixed;

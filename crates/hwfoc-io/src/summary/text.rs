@@ -283,7 +283,7 @@ fn energy_text(e: &Energy) -> String {
         let _ = write!(
             s,
             " (no receive times: each frame counted as {} ms)",
-            NOMINAL_PERIOD_S * 1000.0
+            (e.period_s() * 1e6).round() / 1000.0
         );
     }
     s

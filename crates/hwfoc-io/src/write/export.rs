@@ -146,9 +146,10 @@ pub(crate) struct Sink {
 
 impl Sink {
     /// Opens the output: standard output for `None` or `-`; a new or regular file under a
-    /// temporary name (see [`Staging`]), renamed over it once complete; anything else (a device
-    /// such as `/dev/null`, a pipe) as it is.
-    fn open(path: Option<&str>) -> Result<(Sink, Option<Staging>), WriteError> {
+    /// temporary name (see [`Staging`]), renamed over it once complete (an existing file only
+    /// if `overwrite`, else [`WriteError::Exists`]); anything else (a device such as
+    /// `/dev/null`, a pipe) as it is.
+    fn open(path: Option<&str>, overwrite: bool) -> Result<(Sink, Option<Staging>), WriteError> {
         let Some(path) = path.filter(|&p| p != "-") else {
             let stdout = Sink {
                 name: "standard output".to_string(),
@@ -167,7 +168,15 @@ impl Sink {
             if Path::new(path).is_dir() {
                 return Err(create_error(io::ErrorKind::IsADirectory.into()));
             }
-            let (staging, file) = Staging::create(Path::new(path)).map_err(create_error)?;
+            let (staging, file) =
+                Staging::create_new(Path::new(path), overwrite).map_err(|source| {
+                    match source.kind() {
+                        io::ErrorKind::AlreadyExists => WriteError::Exists {
+                            output: path.to_string(),
+                        },
+                        _ => create_error(source),
+                    }
+                })?;
             (file, Some(staging))
         };
         let sink = Sink {
@@ -187,13 +196,15 @@ impl Sink {
 }
 
 impl Export {
-    /// Creates the output (standard output for `None` or `-`) and starts the writer thread.
+    /// Creates the output (standard output for `None` or `-`) and starts the writer thread. An
+    /// existing file is replaced only if `overwrite` ([`WriteError::Exists`] otherwise).
     pub fn create(
         format: OutputFormat,
         path: Option<&str>,
+        overwrite: bool,
         provenance: Provenance,
     ) -> Result<Export, WriteError> {
-        let (sink, staged) = Sink::open(path)?;
+        let (sink, staged) = Sink::open(path, overwrite)?;
         let default = provenance.settings;
         type Work = Box<dyn FnOnce() -> Result<(), WriteError> + Send>;
         let (tx, mode, work): (SyncSender<ToWriter>, Pipeline, Work) = match format {
@@ -436,9 +447,10 @@ impl Export {
             return Err(self.interrupted());
         }
         let output = staged.target().display().to_string();
-        staged
-            .commit()
-            .map_err(|source| WriteError::Write { output, source })
+        staged.commit().map_err(|source| match source.kind() {
+            io::ErrorKind::AlreadyExists => WriteError::Exists { output },
+            _ => WriteError::Write { output, source },
+        })
     }
 
     fn join(&mut self) -> Result<(), WriteError> {
@@ -574,8 +586,9 @@ mod tests {
             inputs: vec!["p0".to_string()],
             filter: String::new(),
             csv_comment: true,
+            csv_time_iso: false,
         };
-        let mut export = Export::create(format, path.to_str(), provenance).unwrap();
+        let mut export = Export::create(format, path.to_str(), false, provenance).unwrap();
         Sources::new(inputs(ports, frames), map)
             .run(&mut export)
             .unwrap();
@@ -731,9 +744,10 @@ mod tests {
             inputs: Vec::new(),
             filter: String::new(),
             csv_comment: false,
+            csv_time_iso: false,
         };
         let selection = Selection::new(&[0, 2], crate::select::Window::ALL);
-        let mut export = Export::create(OutputFormat::Jsonl, path.to_str(), provenance)
+        let mut export = Export::create(OutputFormat::Jsonl, path.to_str(), false, provenance)
             .unwrap()
             .select(selection);
         Sources::new(inputs(3, 100), map).run(&mut export).unwrap();
@@ -777,10 +791,12 @@ mod tests {
             inputs: Vec::new(),
             filter: String::new(),
             csv_comment: false,
+            csv_time_iso: false,
         };
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("x.jsonl");
-        let mut export = Export::create(OutputFormat::Jsonl, path.to_str(), provenance).unwrap();
+        let mut export =
+            Export::create(OutputFormat::Jsonl, path.to_str(), false, provenance).unwrap();
         export.set_esc_settings(3, &Settings::DEFAULT);
         assert!(export.table.is_none() && export.esc_settings().is_empty());
         let other = Settings::new(100.0, 7, 1.0).unwrap();

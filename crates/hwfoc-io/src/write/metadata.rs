@@ -40,6 +40,7 @@ impl Provenance {
             inputs,
             filter,
             csv_comment: false,
+            csv_time_iso: false,
         }
     }
 

@@ -59,6 +59,32 @@ pub enum OutputFormat {
     Parquet,
 }
 
+impl OutputFormat {
+    /// Each format's file name extensions, the first its usual one.
+    pub const EXTENSIONS: [(OutputFormat, &'static [&'static str]); 3] = [
+        (OutputFormat::Jsonl, &["jsonl", "ndjson"]),
+        (OutputFormat::Csv, &["csv"]),
+        (OutputFormat::Parquet, &["parquet"]),
+    ];
+
+    /// The format a file name's extension names (in any case), if any.
+    pub fn from_name(name: &str) -> Option<OutputFormat> {
+        let ext = std::path::Path::new(name).extension()?.to_str()?;
+        Self::EXTENSIONS
+            .iter()
+            .find(|(_, exts)| exts.iter().any(|e| ext.eq_ignore_ascii_case(e)))
+            .map(|&(format, _)| format)
+    }
+
+    /// The format's usual extension, without its dot (`csv`).
+    pub fn extension(self) -> &'static str {
+        Self::EXTENSIONS
+            .iter()
+            .find(|&&(format, _)| format == self)
+            .map_or("", |(_, exts)| exts[0])
+    }
+}
+
 /// What an export records about how it was made (Parquet key-value metadata, the CSV comment).
 #[derive(Debug, Clone)]
 pub struct Provenance {
@@ -75,4 +101,7 @@ pub struct Provenance {
     pub filter: String,
     /// CSV only: start with a `#` comment line giving the settings.
     pub csv_comment: bool,
+    /// CSV only: receive times as ISO 8601 dates in UTC, to the microsecond, in a `time`
+    /// column ([`time::iso8601_us`](crate::time::iso8601_us)), rather than Unix seconds in `t_s`.
+    pub csv_time_iso: bool,
 }

@@ -6,6 +6,10 @@
 //! (`out.csv.Xy3k9Q.partial`), so that it can be no file the user has, and no other program
 //! can choose it in advance. It is removed when the [`Staging`] is dropped without
 //! [`Staging::commit`]. The replaced file's permissions are kept.
+//!
+//! [`Staging::create_new`] is the same for an output that must not replace a file: a file at the
+//! target is refused at once (`io::ErrorKind::AlreadyExists`), and the commit refuses one that
+//! appeared meanwhile rather than renaming over it.
 
 use std::fs::File;
 use std::io;
@@ -22,12 +26,28 @@ pub struct Staging {
     temp: tempfile::TempPath,
     /// The file replaced on [`Staging::commit`].
     target: PathBuf,
+    /// Whether a file at `target` may be replaced.
+    replace: bool,
 }
 
 impl Staging {
     /// Creates the temporary file for `path`, empty, and returns it open for writing. Through a
     /// link, the file the link points to is the one replaced, not the link.
     pub fn create(path: &Path) -> io::Result<(Staging, File)> {
+        Staging::open(path, true)
+    }
+
+    /// As [`Staging::create`] when `overwrite`; otherwise a file (or a link) at `path` is
+    /// refused with `io::ErrorKind::AlreadyExists`, before anything is created and again at the
+    /// commit.
+    pub fn create_new(path: &Path, overwrite: bool) -> io::Result<(Staging, File)> {
+        if !overwrite && std::fs::symlink_metadata(path).is_ok() {
+            return Err(io::ErrorKind::AlreadyExists.into());
+        }
+        Staging::open(path, overwrite)
+    }
+
+    fn open(path: &Path, replace: bool) -> io::Result<(Staging, File)> {
         let target = match std::fs::symlink_metadata(path) {
             Ok(m) if m.file_type().is_symlink() => {
                 std::fs::canonicalize(path).unwrap_or_else(|_| path.to_path_buf())
@@ -66,7 +86,14 @@ impl Staging {
             #[cfg(not(unix))]
             file.set_permissions(existing.permissions())?;
         }
-        Ok((Staging { temp, target }, file))
+        Ok((
+            Staging {
+                temp,
+                target,
+                replace,
+            },
+            file,
+        ))
     }
 
     /// The temporary file's path.
@@ -79,10 +106,17 @@ impl Staging {
         &self.target
     }
 
-    /// Renames the temporary file over the target (write and flush it first). On failure the
-    /// temporary file is removed.
+    /// Renames the temporary file over the target (write and flush it first); made by
+    /// [`Staging::create_new`] without `overwrite`, fails with `io::ErrorKind::AlreadyExists` if
+    /// a file appeared at the target meanwhile. On failure the temporary file is removed.
     pub fn commit(self) -> io::Result<()> {
-        self.temp.persist(&self.target).map_err(|e| e.error)
+        if self.replace {
+            self.temp.persist(&self.target).map_err(|e| e.error)
+        } else {
+            self.temp
+                .persist_noclobber(&self.target)
+                .map_err(|e| e.error)
+        }
     }
 }
 
@@ -121,6 +155,28 @@ mod tests {
         staging.commit().unwrap();
         assert_eq!(std::fs::read_to_string(&target).unwrap(), "whole");
         assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 3);
+    }
+
+    /// Without `overwrite`, a file at the target is refused at once, and one that appears
+    /// before the commit is left as it is.
+    #[test]
+    fn a_new_file_never_replaces_one() {
+        let dir = tempfile::tempdir().unwrap();
+        let target = dir.path().join("out.csv");
+        std::fs::write(&target, "mine").unwrap();
+        let e = Staging::create_new(&target, false).unwrap_err();
+        assert_eq!(e.kind(), io::ErrorKind::AlreadyExists);
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
+        std::fs::remove_file(&target).unwrap();
+        let (staging, _) = Staging::create_new(&target, false).unwrap();
+        std::fs::write(&target, "late").unwrap();
+        let e = staging.commit().unwrap_err();
+        assert_eq!(e.kind(), io::ErrorKind::AlreadyExists);
+        assert_eq!(std::fs::read_to_string(&target).unwrap(), "late");
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
+        let (staging, _) = Staging::create_new(&target, true).unwrap();
+        staging.commit().unwrap();
+        assert_eq!(std::fs::read_to_string(&target).unwrap(), "");
     }
 
     /// The replaced file keeps its mode; a new file gets the usual one (not tempfile's 0600).

@@ -116,6 +116,10 @@ pub struct BridgeArgs {
           help_heading = "Outputs", value_parser = clap::value_parser!(u32).range(1..))]
     dronecan_baud: u32,
 
+    /// Replay recordings in real time even when every output is a file: a `--mavlink file:`
+    /// telemetry log is otherwise written as fast as it can be, with the recording's own times.
+    #[arg(long)]
+    realtime: bool,
     /// How long to run, in seconds (default: until Ctrl-C, or the end of the recordings).
     #[arg(long, value_name = "S", value_parser = seconds)]
     duration: Option<f64>,
@@ -161,7 +165,7 @@ pub fn run(args: &BridgeArgs) -> Result<(), CliError> {
             &files,
             settings,
             (protocol, args.join),
-            deadline,
+            (deadline, !args.realtime && only_files(args)),
             &mut fanout,
             &mut errors,
         )
@@ -343,11 +347,23 @@ fn take(
 
 /// Recordings and other inputs, replayed in real time (reading `protocol` only when given, the
 /// recordings joined as one with `join`).
+/// Whether every output is a file (`--mavlink file:`), which a replay may write as fast as it
+/// can: the DataLink and DroneCAN outputs are serial ports, paced.
+fn only_files(args: &BridgeArgs) -> bool {
+    args.datalink.is_none()
+        && args.dronecan.is_none()
+        && !args.mavlink.is_empty()
+        && args
+            .mavlink
+            .iter()
+            .all(|spec| matches!(MavlinkTarget::parse(spec), Ok(MavlinkTarget::File(_))))
+}
+
 fn replay(
     files: &[&String],
     settings: SettingsMap,
     (protocol, join): (Option<hwfoc::Protocol>, bool),
-    deadline: Option<Instant>,
+    (deadline, fast): (Option<Instant>, bool),
     fanout: &mut Fanout,
     errors: &mut Errors,
 ) -> Result<(), CliError> {
@@ -373,7 +389,11 @@ fn replay(
             stop.store(true, Ordering::Relaxed);
         })
     });
-    let result = sources.run(&mut Replay::new(fanout, &stop, |e| errors.report(&e)));
+    let mut replay = Replay::new(fanout, &stop, |e| errors.report(&e));
+    if fast {
+        replay = replay.as_fast_as_possible();
+    }
+    let result = sources.run(&mut replay);
     stop.store(true, Ordering::Relaxed);
     if let Some(timer) = timer {
         let _ = timer.join();

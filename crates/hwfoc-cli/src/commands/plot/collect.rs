@@ -11,7 +11,8 @@
 //! `hwfoc decode` gives.
 //!
 //! Frames are placed on a clock: their receive time, or for inputs without receive times the
-//! data frame's index times the nominal frame period (50 ms). The clock of an ESC never goes
+//! data frame's index times its protocol's frame period (`energy::nominal_period_s`: 50 ms for
+//! HW-FOC, 20 ms for HW5, ...). The clock of an ESC never goes
 //! back: at a discontinuity of its receive times (a step back, or a jump forward its packet
 //! numbers do not explain: [`Step`]) it goes on one frame period after the frame before, and
 //! the lines break there; the plot's subtitle counts the discontinuities.
@@ -31,10 +32,6 @@ use hwfoc_io::record::Record;
 use hwfoc_io::summary::{Episode, Mark};
 use hwfoc_io::write::WriteError;
 use hwfoc_io::{Selection, Window};
-
-/// The nominal time between two data frames of a running ESC, s: the clock of inputs without
-/// receive times, and the width given to a fault episode's last frame.
-pub const FRAME_PERIOD: f64 = energy::NOMINAL_PERIOD_S;
 
 /// A pause longer than this between two data frames of an ESC (idle frames come every
 /// ~364 ms) is a gap in the recording: lines are not drawn across it.
@@ -255,9 +252,18 @@ impl EscData {
         }
     }
 
+    /// The time between two data frames of its protocol when running, s: the clock of inputs
+    /// without receive times, and the width given to a fault episode's last frame.
+    pub fn period(&self) -> f64 {
+        energy::nominal_period_s(self.protocol)
+    }
+
     #[inline]
     fn add(&mut self, r: &Record, window: &mut Window) {
-        self.protocol.get_or_insert(r.protocol);
+        if self.protocol.is_none() {
+            self.protocol = Some(r.protocol);
+            self.energy = Energy::at_period(self.period());
+        }
         let t = r.t_s;
         let index = self.frames;
         self.frames += 1;
@@ -273,7 +279,7 @@ impl EscData {
                     .and_then(|(p, l)| r.protocol.packets_between(l, p));
                 if Step::between(last_t, t, packets).is_discontinuity() {
                     self.discontinuities += 1;
-                    self.shift = last_t + self.shift + FRAME_PERIOD - t;
+                    self.shift = last_t + self.shift + self.period() - t;
                     jumped = true;
                 }
             }
@@ -282,7 +288,7 @@ impl EscData {
         if !window.contains(t) {
             return;
         }
-        let c = t.map_or_else(|| clock(None, index), |t| t + self.shift);
+        let c = t.map_or_else(|| clock(None, index, self.period()), |t| t + self.shift);
         if !c.is_finite() {
             return;
         }
@@ -325,8 +331,8 @@ impl EscData {
     fn keep(&mut self, e: &Episode) {
         self.episodes += 1;
         let span = Span {
-            start: clock(e.first.t, e.first.frame),
-            end: clock(e.last.t, e.last.frame) + FRAME_PERIOD,
+            start: clock(e.first.t, e.first.frame, self.period()),
+            end: clock(e.last.t, e.last.frame, self.period()) + self.period(),
             bits: e.bits,
             episodes: 1,
             ongoing: e.ongoing,
@@ -357,8 +363,8 @@ impl EscData {
 }
 
 /// The clock value of a data frame: its receive time, or its index times the frame period.
-fn clock(t: Option<f64>, index: u64) -> f64 {
-    t.unwrap_or(index as f64 * FRAME_PERIOD)
+fn clock(t: Option<f64>, index: u64, period: f64) -> f64 {
+    t.unwrap_or(index as f64 * period)
 }
 
 /// The [`Handler`] of a plot: the frames of the chosen ESCs, by ESC.
@@ -488,6 +494,9 @@ mod tests {
 
     use hwfoc::foc::DataFrame;
     use hwfoc::{Quantity, Temperature};
+
+    /// HW-FOC's frame period, s.
+    const FRAME_PERIOD: f64 = 0.05;
 
     /// The record of a frame at `t` with this throttle and status word.
     fn frame(t: f64, throttle: u16, status: u16) -> Record {

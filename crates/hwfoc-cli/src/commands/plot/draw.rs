@@ -19,7 +19,7 @@ use hwfoc_io::Sources;
 use hwfoc_io::summary::no_frames;
 use hwfoc_io::time::{self, Clock};
 
-use super::collect::{Bucket, Collector, EscData, FRAME_PERIOD, Span};
+use super::collect::{Bucket, Collector, EscData, Span};
 use super::target::{ImageFile, ImageFormat};
 use super::text::Glyphs;
 use super::{MAX_SIZE, Options};
@@ -360,9 +360,11 @@ impl<'a> Scene<'a> {
             hi: f64::NEG_INFINITY,
         };
         for row in &rows {
-            if let Some((first, last)) = row.data.and_then(|d| d.clock) {
+            if let Some(d) = row.data
+                && let Some((first, last)) = d.clock
+            {
                 time.lo = time.lo.min(first - row.offset);
-                time.hi = time.hi.max(last - row.offset + FRAME_PERIOD);
+                time.hi = time.hi.max(last - row.offset + d.period());
             }
         }
         if time.hi - time.lo < 1.0 {
@@ -416,9 +418,18 @@ impl<'a> Scene<'a> {
             }
         }
         if untimed {
+            // Each protocol's frame period, once.
+            let mut periods: Vec<f64> = Vec::new();
+            for d in rows.iter().filter_map(|r| r.data).filter(|d| !d.timed) {
+                if !periods.contains(&d.period()) {
+                    periods.push(d.period());
+                }
+            }
+            let periods: Vec<String> = periods.iter().map(|p| format!("{p}")).collect();
             subtitle.push_str(&format!(
-                " · {}inputs without receive times: data frame index × {FRAME_PERIOD} s",
-                if timed { "" } else { "time: " }
+                " · {}inputs without receive times: data frame index × {} s",
+                if timed { "" } else { "time: " },
+                periods.join(" or ")
             ));
         }
         let jumps: u64 = rows
@@ -518,7 +529,7 @@ impl<'a> Scene<'a> {
                 if e.nominal() {
                     format!(
                         " (each frame counted as {} ms)",
-                        hwfoc_io::energy::NOMINAL_PERIOD_S * 1000.0
+                        (e.period_s() * 1e6).round() / 1000.0
                     )
                 } else {
                     String::new()
@@ -587,9 +598,9 @@ impl<'a> Scene<'a> {
         let x_fmt = number_format(t_lo..t_hi);
         let y_fmt = number_format(y_lo..y_hi);
         let x_desc = if data.timed {
-            "time (s)"
+            "time (s)".to_string()
         } else {
-            "frame index × 0.05 (s)"
+            format!("frame index × {} (s)", data.period())
         };
         // As many time labels as fit side by side, at most TICKS.
         let plot_w = chart.plotting_area().dim_in_pixel().0.max(1);

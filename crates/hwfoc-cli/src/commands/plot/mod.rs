@@ -48,6 +48,9 @@ pub struct PlotArgs {
     /// The image to write: a name ending in .png or .svg gives the format.
     #[arg(short, long, value_name = "FILE")]
     output: String,
+    /// Replace the -o file if it exists.
+    #[arg(long)]
+    overwrite: bool,
     /// Width of the image in pixels.
     #[arg(long, value_name = "PX", default_value_t = draw::DEFAULT_WIDTH,
           value_parser = clap::value_parser!(u32).range(i64::from(MIN_SIZE)..=i64::from(MAX_SIZE)))]
@@ -86,7 +89,7 @@ pub fn run(args: &PlotArgs) -> Result<(), CliError> {
     // Opened first, so that a wrong name is reported before the inputs are read; a file
     // created here is removed again if the plot is not written.
     args.input.refuse_output(&args.output, &config)?;
-    let mut target = ImageFile::open(&args.output)?;
+    let mut target = ImageFile::open(&args.output, args.overwrite)?;
     let options = Options {
         width: args.width,
         height: args.height,
@@ -123,10 +126,11 @@ impl Alongside {
     /// Opens the image file (see [`ImageFile::open`]); `stop` as [`Collector::stop_on`].
     pub fn open(
         path: &str,
+        overwrite: bool,
         settings: Settings,
         stop: Option<Arc<AtomicBool>>,
     ) -> Result<Alongside, CliError> {
-        let target = ImageFile::open(path)?;
+        let target = ImageFile::open(path, overwrite)?;
         let options = Options {
             width: draw::DEFAULT_WIDTH,
             ..Options::default()

@@ -44,9 +44,9 @@ pub struct ImageFile {
 }
 
 impl ImageFile {
-    /// Checks the name's format, refuses anything but a (new or) regular file, and creates the
-    /// temporary file.
-    pub fn open(path: &str) -> Result<ImageFile, CliError> {
+    /// Checks the name's format, refuses anything but a (new or) regular file, and an existing
+    /// one unless `overwrite`, and creates the temporary file.
+    pub fn open(path: &str, overwrite: bool) -> Result<ImageFile, CliError> {
         let format = ImageFormat::from_name(path).ok_or_else(|| CliError::Usage {
             option: format!("-o {path}"),
             message: "the image format follows the file name: use a name ending in .png or .svg"
@@ -68,7 +68,13 @@ impl ImageFile {
             }
             _ => {}
         }
-        let (staging, file) = Staging::create(Path::new(path)).map_err(create)?;
+        let exists = |source: io::Error| match source.kind() {
+            io::ErrorKind::AlreadyExists => WriteError::Exists {
+                output: path.to_string(),
+            },
+            _ => create(source),
+        };
+        let (staging, file) = Staging::create_new(Path::new(path), overwrite).map_err(exists)?;
         Ok(ImageFile {
             path: path.to_string(),
             format,
@@ -99,7 +105,12 @@ impl ImageFile {
             .and_then(|()| file.flush())
             .map_err(error)?;
         drop(file);
-        staging.commit().map_err(error)?;
+        staging.commit().map_err(|source| match source.kind() {
+            io::ErrorKind::AlreadyExists => WriteError::Exists {
+                output: self.path.clone(),
+            },
+            _ => error(source),
+        })?;
         Ok(())
     }
 }
