@@ -21,22 +21,7 @@ fn run(args: &[&str]) -> (String, String) {
 fn three_drones_recorded_together_are_six_escs() {
     let dir = Dir::new();
     let files: Vec<String> = (1..=3)
-        .map(|i| {
-            let path = dir.arg(&format!("drone-{i}.pcapng"));
-            let seed = i.to_string();
-            let args = [
-                "simulate",
-                "--escs",
-                "2",
-                "--duration",
-                "10",
-                "--seed",
-                &seed,
-                "-o",
-            ];
-            ok(hwfoc().args(args).arg(&path).output().unwrap());
-            path
-        })
+        .map(|i| simulate(&dir, &format!("drone-{i}.pcapng"), i, &["--duration", "10"]))
         .collect();
     let alone: Vec<Vec<String>> = files
         .iter()
@@ -85,6 +70,19 @@ fn three_drones_recorded_together_are_six_escs() {
     );
 }
 
+/// Simulates two ESCs with seed `seed` and `args` into `name` in `dir`: its path.
+fn simulate(dir: &Dir, name: &str, seed: u32, args: &[&str]) -> String {
+    let path = dir.arg(name);
+    let seed = seed.to_string();
+    ok(hwfoc()
+        .args(["simulate", "--escs", "2", "--seed", &seed])
+        .args(args)
+        .args(["-o", &path])
+        .output()
+        .unwrap());
+    path
+}
+
 /// The records of ESC `esc` among JSON Lines `lines`.
 fn records_of<S: AsRef<str>>(lines: &[S], esc: usize) -> Vec<String> {
     let key = format!("\"esc\":{esc},");
@@ -111,22 +109,8 @@ fn two_can_logs_are_two_buses_and_a_copy_is_read_once() {
     let dir = Dir::new();
     let logs: Vec<String> = (1..=2)
         .map(|i| {
-            let path = dir.arg(&format!("bus-{i}.log"));
-            let seed = i.to_string();
-            let args = [
-                "simulate",
-                "--protocol",
-                "hw-can",
-                "--escs",
-                "2",
-                "--duration",
-                "5",
-                "--seed",
-                &seed,
-                "-o",
-            ];
-            ok(hwfoc().args(args).arg(&path).output().unwrap());
-            path
+            let args = ["--protocol", "hw-can", "--duration", "5"];
+            simulate(&dir, &format!("bus-{i}.log"), i, &args)
         })
         .collect();
     let count = |args: &[&str]| run(args).0.lines().count();

@@ -5,28 +5,11 @@ use std::sync::{Arc, Mutex};
 
 use proptest::prelude::*;
 
+use super::tests::ByEsc;
 use super::*;
 use crate::esc_table::Recording;
 use crate::notice::Notice;
 use crate::pcapng::{self, RecordingId};
-use crate::record::Record;
-
-/// The records of each ESC (packet number and time), by ESC.
-#[derive(Default)]
-struct ByEsc(Vec<Vec<(u16, f64)>>);
-
-impl Handler for ByEsc {
-    type Error = InputError;
-
-    fn record(&mut self, r: &Record) {
-        let esc = usize::from(r.esc);
-        if self.0.len() <= esc {
-            self.0.resize(esc + 1, Vec::new());
-        }
-        let packet = u16::try_from(r.packet.expect("HW-FOC sends packet numbers")).unwrap();
-        self.0[esc].push((packet, r.t_s.unwrap()));
-    }
-}
 
 const S: u64 = 1_000_000_000;
 const T0: u64 = 1_795_000_000 * S;

@@ -8,9 +8,9 @@ use hwfoc::datalink::CHANNELS;
 use hwfoc::foc::DataFrame;
 use hwfoc::telemetry::Frame;
 
-/// Collects the records, by ESC.
+/// Collects the records (packet number and time), by ESC.
 #[derive(Default)]
-struct ByEsc(Vec<Vec<(u16, f64)>>);
+pub(crate) struct ByEsc(pub(crate) Vec<Vec<(u16, f64)>>);
 
 impl Handler for ByEsc {
     type Error = InputError;
