@@ -269,6 +269,11 @@ impl fmt::Display for Notice {
                 input,
                 interface,
                 message,
+            } if input == interface => write!(f, "{}: {message}", Escaped(input)),
+            Notice::CanBus {
+                input,
+                interface,
+                message,
             } => write!(f, "{}: {}: {message}", Escaped(input), Escaped(interface)),
             Notice::Damage { input, damage } => write!(f, "{}: {damage}", Escaped(input)),
             Notice::Duplicate { input, earlier } => write!(

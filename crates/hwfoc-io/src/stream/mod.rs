@@ -21,6 +21,7 @@ use crate::esc_numbers::{UNNUMBERED, channel_number};
 use crate::handler::Handler;
 
 use crate::input::Batch;
+use crate::notice::Notice;
 use crate::serial::PortEvent;
 use crate::settings::SettingsMap;
 
@@ -1059,6 +1060,23 @@ impl PortStreams {
     /// The stream of `port`.
     pub fn stream(&self, port: usize) -> Option<&Stream> {
         self.streams.get(port)
+    }
+
+    /// What the ports' streams found since the last call that a person should be told: on a
+    /// live CAN bus, two ESCs that claim one throttle channel (each stays an ESC of its own;
+    /// [`Notice::CanBus`] names both nodes).
+    pub fn take_notices(&mut self) -> Vec<Notice> {
+        let mut notices = Vec::new();
+        for (stream, name) in self.streams.iter_mut().zip(&self.names) {
+            for message in stream.take_can_clashes() {
+                notices.push(Notice::CanBus {
+                    input: name.clone(),
+                    interface: name.clone(),
+                    message,
+                });
+            }
+        }
+        notices
     }
 
     /// The settings the records of ESC `esc` are made under, once it has a number.

@@ -264,6 +264,11 @@ fn draw_title(frame: &mut Frame, area: Rect, session: &Session, ui: &Ui, view: V
     if let Some(notice) = &session.notice {
         spans.push(format!("  {}", Escaped(notice)).cyan());
     }
+    // The latest warning the streams found (two CAN ESCs on one throttle channel): it stays
+    // until the set-up is mended and the monitor started again.
+    if let Some(warning) = session.found.iter().rev().find(|n| n.is_warning()) {
+        spans.push(format!("  {warning}").yellow().bold());
+    }
     spans.push(
         format!(
             "  {n} ESC{}{}  ",

@@ -426,6 +426,9 @@ pub struct Fleet {
     pub escs: Vec<EscView>,
     /// The alarm log, oldest first.
     pub log: VecDeque<LogEntry>,
+    /// What the ports' streams found that a person should be told (two CAN ESCs on one
+    /// throttle channel), not shown yet.
+    pub notices: Vec<hwfoc_io::Notice>,
     /// How many entries were ever logged (the log keeps the last [`LOG_MAX`]).
     pub logged: u64,
     /// Data frames decoded in all.
@@ -499,6 +502,7 @@ impl Fleet {
             channels: HashMap::new(),
             escs,
             log: VecDeque::new(),
+            notices: Vec::new(),
             logged: 0,
             frames: 0,
             peak_total_w: None,
@@ -531,6 +535,7 @@ impl Fleet {
                 let Some(stats) = self.streams.feed(event, &mut got) else {
                     return 0;
                 };
+                self.notices.extend(self.streams.take_notices());
                 // A hub's channels and a CAN bus's ESCs each have a view of their own.
                 let hub = self.streams.stream(port).is_some_and(|s| {
                     s.is_can() || matches!(s.kind(), WireKind::Hub | WireKind::Mixed)
@@ -1081,6 +1086,34 @@ mod tests {
         let views: Vec<&str> = f.escs.iter().map(|e| e.name.as_str()).collect();
         assert_eq!(views, ["vcan0 node 10 ch 2", "slcan:/dev/ttyACM0:1M"]);
         assert_eq!(f.escs[0].last.unwrap().esc, esc);
+    }
+
+    /// Two live CAN ESCs that claim one throttle channel stay two views, and the monitor is told
+    /// once, naming both nodes (the headless monitor prints it, the dashboard shows it).
+    #[test]
+    fn two_live_can_escs_on_one_channel_are_told_of_once() {
+        use hwfoc::dronecan::{GetEscId, Message};
+        let mut f = fleet_of(vec!["can:vcan0".to_string()]);
+        let send = |f: &mut Fleet, t: f64, m: Message, node: u8, tid: u8| {
+            f.on_event(&data(0, t, can_bytes(m, node, tid)));
+        };
+        for (k, node) in [10u8, 11].into_iter().enumerate() {
+            let t = 1000.0 + k as f64 * 0.01;
+            send(&mut f, t, GetEscId::answer(node, 1).into(), node, 0);
+            send(&mut f, t + 0.1, status1().into(), node, 1);
+            send(&mut f, t + 0.2, status1().into(), node, 2);
+        }
+        assert_eq!(f.escs.len(), 2, "two views");
+        let told: Vec<String> = f.notices.iter().map(|n| n.line()).collect();
+        assert_eq!(told.len(), 1, "{told:?}");
+        assert!(
+            told[0].starts_with(
+                "hwfoc: warning: can:vcan0: node 10 and node 11 both claim throttle channel 1"
+            ),
+            "{told:?}"
+        );
+        send(&mut f, 1000.5, status1().into(), 11, 3);
+        assert_eq!(f.notices.len(), 1, "told once");
     }
 
     /// A CAN ESC's view carries the records' ESC number (its place: node id before a GetEscID

@@ -180,7 +180,8 @@ pub struct Session {
     clock: hwfoc_io::clock::ReceiveClock,
     names: Vec<String>,
     baud: Baud,
-    /// The ports' rates found from their bytes since the headless monitor last printed them.
+    /// The ports' rates found from their bytes (and what the streams found to tell, such as two
+    /// CAN ESCs on one throttle channel) since the headless monitor last printed them.
     pub found: Vec<hwfoc_io::Notice>,
     /// The one protocol read, when forced.
     protocol: Option<hwfoc::Protocol>,
@@ -357,6 +358,8 @@ impl Session {
         if self.fleet.on_event(&event) > 0 {
             self.perf.arrived(received);
         }
+        // Told once: printed by the headless monitor, shown on the dashboard's status line.
+        self.found.append(&mut self.fleet.notices);
         if let Some(recorder) = &mut self.recorder
             && let Err(e) = recorder.handle(event)
         {
