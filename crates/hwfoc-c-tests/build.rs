@@ -6,6 +6,7 @@ fn main() {
     let header_dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../../c");
     println!("cargo:rerun-if-changed=shim/shim.c");
     println!("cargo:rerun-if-changed=shim/noinfo.c");
+    println!("cargo:rerun-if-changed=shim/flat_out.h");
     println!("cargo:rerun-if-changed={header_dir}/hwfoc.h");
     cc::Build::new()
         .file("shim/shim.c")

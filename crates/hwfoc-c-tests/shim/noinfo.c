@@ -66,24 +66,15 @@
 #define hwfoc_v4_voltage_v noinfo_hwfoc_v4_voltage_v
 #define HWFOC_IMPLEMENTATION
 #include "hwfoc.h"
-#include <stdlib.h>
+#include "flat_out.h"
 
 typedef struct noinfo {
     hwfoc_foc_decoder d;
-    uint64_t *out;
-    size_t len, cap;
-    int oom;
+    flat_out o;
 } noinfo;
 
 static void put(noinfo *s, uint64_t v) {
-    if (s->len == s->cap) {
-        size_t cap = s->cap ? 2 * s->cap : 1024;
-        uint64_t *out = (uint64_t *)realloc(s->out, cap * sizeof *out);
-        if (!out) { s->oom = 1; return; }
-        s->out = out;
-        s->cap = cap;
-    }
-    s->out[s->len++] = v;
+    flat_put(&s->o, v);
 }
 
 static void on_frame(void *ctx, const hwfoc_foc_frame *f) {
@@ -105,7 +96,7 @@ noinfo *noinfo_new(void) {
 }
 
 void noinfo_free(noinfo *s) {
-    if (s) free(s->out);
+    if (s) free(s->o.out);
     free(s);
 }
 
@@ -121,10 +112,7 @@ void noinfo_line_silent(noinfo *s, uint32_t max_frames) { hwfoc_foc_line_silent(
 
 /* The frames so far, flat (and forgets them): their count of integers, or -1 out of memory. */
 long noinfo_take_frames(noinfo *s, const uint64_t **out) {
-    long n = s->oom ? -1 : (long)s->len;
-    *out = s->out;
-    s->len = 0;
-    return n;
+    return flat_take(&s->o, out);
 }
 
 /* The statistics, flat (bytes, bytes_skipped, checksum_failures, the packet sequence), after
@@ -132,7 +120,7 @@ long noinfo_take_frames(noinfo *s, const uint64_t **out) {
 long noinfo_stats(noinfo *s, const uint64_t **out) {
     const hwfoc_foc_stats *t = &s->d.stats;
     const hwfoc_sequence *q = &t->packets;
-    s->len = 0;
+    s->o.len = 0;
     put(s, t->bytes); put(s, t->bytes_skipped); put(s, t->checksum_failures);
     put(s, q->count); put(s, q->lost); put(s, q->duplicates); put(s, q->restarts);
     put(s, q->count ? q->last : UINT64_MAX);

@@ -8,7 +8,7 @@
 use hwfoc::foc;
 use hwfoc::scan::StreamDecoder;
 use hwfoc_c_tests::ffi::NoInfoDecoder;
-use hwfoc_c_tests::ops::Rng;
+use hwfoc_c_tests::ops::{Rng, apply, disturb, foc_data_frame};
 use hwfoc_c_tests::{Flat, Op, chunked};
 
 /// The length byte of an info frame.
@@ -22,31 +22,11 @@ fn run(ops: &[Op], mut check: impl FnMut(usize, &[u64], &[u64], &[u64], &[u64]))
     let mut out = Outcome::default();
     for (i, op) in ops.iter().enumerate() {
         let mut frames = Vec::new();
-        let mut take = |item: foc::Decoded| {
+        apply(op, &mut rust, &mut c, |item: foc::Decoded| {
             if let foc::Frame::Data(_) = item.frame {
                 foc::Scanner::frame(&item, &mut frames);
             }
-        };
-        match op {
-            Op::Feed(bytes) => {
-                rust.feed(bytes, &mut take);
-                c.feed(bytes, false);
-            }
-            Op::Push(bytes) => {
-                for &b in bytes {
-                    rust.push(b, &mut take);
-                }
-                c.feed(bytes, true);
-            }
-            Op::Flush => {
-                rust.flush(&mut take);
-                c.flush();
-            }
-            Op::Silent(max) => {
-                rust.line_silent(*max, &mut take);
-                c.line_silent(*max);
-            }
-        }
+        });
         let c_frames = c.take_frames();
         out.rust_stats.clear();
         foc::Scanner::stats(rust.stats(), &mut out.rust_stats);
@@ -73,19 +53,7 @@ fn stream(rng: &mut Rng, frames: usize, info: bool) -> Vec<u8> {
     let mut out = Vec::new();
     let mut packet = rng.bits() as u16;
     for _ in 0..frames {
-        let d = foc::DataFrame {
-            packet,
-            throttle_in_raw: rng.below(1100) as u16,
-            throttle_out_raw: rng.below(1100) as u16,
-            erpm_raw: rng.bits() as u16,
-            voltage_raw: rng.bits() as u16,
-            current_raw: rng.bits() as i16,
-            phase_current_raw: rng.bits() as i16,
-            mos_adc: rng.bits() as u8,
-            cap_adc: rng.bits() as u8,
-            status: hwfoc::Status(rng.bits() as u16),
-        };
-        let mut bytes = d.encode().to_vec();
+        let mut bytes = foc_data_frame(rng, packet).encode().to_vec();
         if info && rng.below(8) == 0 {
             let text: [u8; 72] = core::array::from_fn(|_| 0x20 + rng.below(0x5F) as u8);
             bytes = foc::InfoFrame::from_text(text)
@@ -93,26 +61,7 @@ fn stream(rng: &mut Rng, frames: usize, info: bool) -> Vec<u8> {
                 .encode()
                 .to_vec();
         }
-        match rng.below(20) {
-            0 => bytes.clear(),
-            1 => bytes.truncate(rng.below(bytes.len() as u64) as usize),
-            2 => {
-                let at = rng.below(bytes.len() as u64) as usize;
-                bytes[at] ^= 1 << rng.below(8);
-            }
-            3 => {
-                let noise: Vec<u8> = (0..rng.below(40))
-                    .map(|_| match rng.below(4) {
-                        0 => 0x9B,
-                        1 => 0x16,
-                        2 => INFO_LENGTH_BYTE,
-                        _ => rng.bits() as u8,
-                    })
-                    .collect();
-                out.extend(noise);
-            }
-            _ => {}
-        }
+        disturb(rng, &mut bytes, &[0x9B, 0x16, INFO_LENGTH_BYTE, 0x01, 0x02]);
         out.extend(bytes);
         packet = packet.wrapping_add(if rng.below(30) == 0 { 3 } else { 1 });
     }
