@@ -16,7 +16,9 @@
  *
  * Use: in exactly one C file, `#define HWFOC_IMPLEMENTATION` before `#include "hwfoc.h"`.
  * Leave out formats with HWFOC_NO_FOC, HWFOC_NO_DATALINK, HWFOC_NO_V3, HWFOC_NO_V4,
- * HWFOC_NO_HW5, HWFOC_NO_CAN; HWFOC_FLOAT adds float helpers (the core has no floating point).
+ * HWFOC_NO_HW5, HWFOC_NO_CAN; HWFOC_NO_FOC_INFO makes the HW-FOC decoder read data frames only,
+ * its whole state 64 B (info frames counted as skipped bytes, byte counts 32-bit); HWFOC_FLOAT
+ * adds float helpers (the core has no floating point).
  *
  * Every decoder is a struct the caller owns (no allocation, no stdio, no globals), fed bytes
  * one at a time (`_push`, from a UART interrupt's queue) or in chunks (`_feed`); each frame
@@ -73,7 +75,13 @@ uint16_t hwfoc_crc16_modbus(const uint8_t *p, size_t n);
 #define HWFOC_FOC_DATA_LEN 24u
 #define HWFOC_FOC_INFO_LEN 77u
 #define HWFOC_FOC_INFO_TEXT_LEN 72u
+/** The longest candidate the HW-FOC decoder holds: an info frame, or with HWFOC_NO_FOC_INFO a
+ * data frame. */
+#ifdef HWFOC_NO_FOC_INFO
+#define HWFOC_FOC_MAX_LEN HWFOC_FOC_DATA_LEN
+#else
 #define HWFOC_FOC_MAX_LEN HWFOC_FOC_INFO_LEN
+#endif
 
 /** An HW-FOC data frame's fields, raw (also a DataLink channel's record). */
 typedef struct hwfoc_foc_data {
@@ -103,14 +111,28 @@ typedef struct hwfoc_foc_frame {
     uint64_t offset; /**< stream offset of its first byte */
     int kind;        /**< HWFOC_FOC_KIND_DATA or HWFOC_FOC_KIND_INFO */
     hwfoc_foc_data data;
+#ifndef HWFOC_NO_FOC_INFO
     uint8_t info_text[HWFOC_FOC_INFO_TEXT_LEN]; /**< product 16..32, hardware 32..48, firmware 48..64, id 64..72 */
+#endif
 } hwfoc_foc_frame;
 
-/** The Rust `foc::Stats`. */
+/** The HW-FOC decoder's byte counts: 64-bit, wrapping at 2^48 as in Rust; with
+ * HWFOC_NO_FOC_INFO 32-bit, wrapping at 2^32 (frame offsets too: 25 days at 19200 baud). */
+#ifdef HWFOC_NO_FOC_INFO
+typedef uint32_t hwfoc_foc_count;
+#else
+typedef uint64_t hwfoc_foc_count;
+#endif
+
+/** The Rust `foc::Stats`. With HWFOC_NO_FOC_INFO (data frames only, the whole decoder in 64 B):
+ * no info_frames; an info frame's bytes are counted in bytes_skipped, and checksum_failures
+ * counts data-frame candidates only. */
 typedef struct hwfoc_foc_stats {
-    uint64_t bytes;
-    uint64_t bytes_skipped;
+    hwfoc_foc_count bytes;
+    hwfoc_foc_count bytes_skipped;
+#ifndef HWFOC_NO_FOC_INFO
     uint32_t info_frames;
+#endif
     uint32_t checksum_failures;
     hwfoc_sequence packets; /**< data frames: count, lost, duplicates, restarts */
 } hwfoc_foc_stats;
@@ -576,32 +598,55 @@ typedef struct hwfoc__format {
     hwfoc__find_fn find;
     hwfoc__take_fn take;
     hwfoc__pre_fn pre;
+#ifdef HWFOC_NO_FOC_INFO
+    uint8_t narrow; /* 32-bit byte counts (HW-FOC's in this build) */
+#endif
 } hwfoc__format;
+
+/* Whether a format's byte counts are 32-bit: only HW-FOC's with HWFOC_NO_FOC_INFO, so the
+ * default build pays nothing for it. */
+#ifdef HWFOC_NO_FOC_INFO
+#define HWFOC__NARROW(fmt) ((fmt)->narrow)
+#define HWFOC__NARROW_INIT(DEC, BYTES) , sizeof(((DEC *)0)->stats.BYTES) == 4
+#else
+#define HWFOC__NARROW(fmt) ((void)(fmt), 0)
+#define HWFOC__NARROW_INIT(DEC, BYTES)
+#endif
+/* Where a format's byte counts (and so its frame offsets) wrap. */
+#define HWFOC__MASK(fmt) (HWFOC__NARROW(fmt) ? 0xFFFFFFFFu : HWFOC__BYTES_MASK)
 
 /* The Rust scanners' candidate verdicts. */
 enum { HWFOC__FRAME, HWFOC__REJECTED, HWFOC__UNDECIDED };
 
 #define HWFOC__AT(d, off, T) ((T *)(void *)((char *)(d) + (off)))
 
+/* A byte count of the decoder at `off`, 64-bit or (HWFOC__NARROW) 32-bit. */
+static inline uint64_t hwfoc__count(const hwfoc__format *fmt, void *d, uint16_t off) {
+    return HWFOC__NARROW(fmt) ? *HWFOC__AT(d, off, uint32_t) : *HWFOC__AT(d, off, uint64_t);
+}
+static inline void hwfoc__count_add(const hwfoc__format *fmt, void *d, uint16_t off, size_t n) {
+    if (HWFOC__NARROW(fmt)) *HWFOC__AT(d, off, uint32_t) += (uint32_t)n;
+    else hwfoc__add_bytes(HWFOC__AT(d, off, uint64_t), n);
+}
+
 /* The search loop of every scanner (the Rust `scan::next_candidate` and `scan_all`): from each
  * candidate start `find` gives, `take` decides; the bytes before a candidate, and a rejected
  * candidate's first byte, are skipped. Returns where it stopped: n, or an undecided start. */
 static size_t hwfoc__scan(const hwfoc__format *fmt, void *d, const uint8_t *data, size_t n, uint64_t base,
                           int at_end, hwfoc__any_cb cb, void *ctx) {
-    uint64_t *skipped = HWFOC__AT(d, fmt->skipped_at, uint64_t);
     size_t pos = 0, k, i, len = 0;
     for (;;) {
         if (fmt->pre) pos = fmt->pre(d, data, n, base, pos);
         for (;;) {
             k = fmt->find(data + pos, n - pos);
-            hwfoc__add_bytes(skipped, k);
+            hwfoc__count_add(fmt, d, fmt->skipped_at, k);
             if (pos + k == n) return n;
             i = pos + k;
-            switch (fmt->take(d, data + i, n - i, (base + i) & HWFOC__BYTES_MASK, at_end, &len, cb, ctx)) {
+            switch (fmt->take(d, data + i, n - i, (base + i) & HWFOC__MASK(fmt), at_end, &len, cb, ctx)) {
             case HWFOC__FRAME: pos = i + len; break;
             case HWFOC__UNDECIDED: return i;
             default:
-                hwfoc__add_bytes(skipped, 1);
+                hwfoc__count_add(fmt, d, fmt->skipped_at, 1);
                 pos = i + 1;
                 continue;
             }
@@ -611,21 +656,20 @@ static size_t hwfoc__scan(const hwfoc__format *fmt, void *d, const uint8_t *data
 }
 
 static void hwfoc__feed(const hwfoc__format *fmt, void *d, const uint8_t *data, size_t n, hwfoc__any_cb cb, void *ctx) {
-    uint64_t *bytes = HWFOC__AT(d, fmt->bytes_at, uint64_t);
     uint8_t *held = HWFOC__AT(d, fmt->held_at, uint8_t);
     uint8_t *len = HWFOC__AT(d, fmt->len_at, uint8_t);
     size_t i, m, pos;
     for (i = 0; i < n; i++) {
         m = *len;
         held[m] = data[i];
-        hwfoc__add_bytes(bytes, 1);
+        hwfoc__count_add(fmt, d, fmt->bytes_at, 1);
         /* The held candidate cannot be decided with this byte yet: just keep it. */
         if (m > 0 && m + 1u < fmt->candidate_len(held, m)) {
             *len = (uint8_t)(m + 1u);
             continue;
         }
         m++;
-        pos = hwfoc__scan(fmt, d, held, m, (*bytes - m) & HWFOC__BYTES_MASK, 0, cb, ctx);
+        pos = hwfoc__scan(fmt, d, held, m, (hwfoc__count(fmt, d, fmt->bytes_at) - m) & HWFOC__MASK(fmt), 0, cb, ctx);
         memmove(held, held + pos, m - pos);
         *len = (uint8_t)(m - pos);
     }
@@ -642,7 +686,7 @@ static void hwfoc__flush(const hwfoc__format *fmt, void *d, hwfoc__any_cb cb, vo
     uint8_t *len = HWFOC__AT(d, fmt->len_at, uint8_t);
     size_t held = *len;
     (void)hwfoc__scan(fmt, d, HWFOC__AT(d, fmt->held_at, uint8_t), held,
-                      (*HWFOC__AT(d, fmt->bytes_at, uint64_t) - held) & HWFOC__BYTES_MASK, 1, cb, ctx);
+                      (hwfoc__count(fmt, d, fmt->bytes_at) - held) & HWFOC__MASK(fmt), 1, cb, ctx);
     *len = 0;
 }
 
@@ -650,7 +694,7 @@ static void hwfoc__flush(const hwfoc__format *fmt, void *d, hwfoc__any_cb cb, vo
 #define HWFOC__STREAM(PFX, DEC, CB, BYTES, SKIPPED, LEN_FN, FIND, PRE, SILENT)              \
     static const hwfoc__format PFX##_format = {offsetof(DEC, stats.BYTES), offsetof(DEC, stats.SKIPPED), \
                                                offsetof(DEC, held), offsetof(DEC, len), LEN_FN,     \
-                                               FIND, PFX##_take, PRE};                              \
+                                               FIND, PFX##_take, PRE HWFOC__NARROW_INIT(DEC, BYTES)};                              \
     void PFX##_feed(DEC *d, const uint8_t *data, size_t n, CB cb, void *ctx) {                      \
         hwfoc__feed(&PFX##_format, d, data, n, (hwfoc__any_cb)cb, ctx);                             \
     }                                                                                               \
@@ -718,7 +762,11 @@ void hwfoc_foc_encode_info(const uint8_t text[HWFOC_FOC_INFO_TEXT_LEN], uint8_t 
 }
 
 /* The length byte's frame length; 0 for an unknown one. */
+#ifdef HWFOC_NO_FOC_INFO
+static size_t hwfoc__foc_len_of(uint8_t b) { return b == 0x16 ? 24u : 0u; }
+#else
 static size_t hwfoc__foc_len_of(uint8_t b) { return b == 0x16 ? 24u : b == 0x4C ? 77u : 0u; }
+#endif
 
 static size_t hwfoc_foc_candidate_len(const uint8_t *c, size_t n) {
     size_t len;
@@ -736,13 +784,16 @@ static size_t hwfoc__foc_find(const uint8_t *h, size_t n) {
 }
 
 static int hwfoc__foc_take(hwfoc_foc_decoder *d, const uint8_t *c, size_t n, int at_end, hwfoc_foc_frame *f) {
+#ifndef HWFOC_NO_FOC_INFO
     size_t i;
+#endif
     if (n >= 24 && c[1] == 0x16 && c[2] == 0x01 && c[3] == 0x02 && hwfoc_sum16(c, 22) == hwfoc__le16(c + 22)) {
         f->kind = HWFOC_FOC_KIND_DATA;
         hwfoc__foc_read_payload(c + 4, &f->data);
         hwfoc_sequence_next(&d->stats.packets, f->data.packet, HWFOC_COUNTER16_MAX);
         return HWFOC__FRAME;
     }
+#ifndef HWFOC_NO_FOC_INFO
     if (n >= 77 && c[1] == 0x4C && c[2] == 0x01 && c[3] == 0x01 && (uint8_t)hwfoc_sum16(c, 76) == c[76]) {
         for (i = 4; i < 76 && c[i] < 0x80u; i++) {}
         if (i == 76) {
@@ -752,6 +803,7 @@ static int hwfoc__foc_take(hwfoc_foc_decoder *d, const uint8_t *c, size_t n, int
             return HWFOC__FRAME;
         }
     }
+#endif
     if (n >= HWFOC_FOC_MAX_LEN || n >= hwfoc_foc_candidate_len(c, n)) {
         hwfoc__inc(&d->stats.checksum_failures);
         return HWFOC__REJECTED;
@@ -765,7 +817,7 @@ static int hwfoc_foc_take(void *dec, const uint8_t *c, size_t n, uint64_t at, in
     int v = hwfoc__foc_take((hwfoc_foc_decoder *)dec, c, n, at_end, &f);
     if (v == HWFOC__FRAME) {
         f.offset = at;
-        *len = f.kind == HWFOC_FOC_KIND_DATA ? HWFOC_FOC_DATA_LEN : HWFOC_FOC_INFO_LEN;
+        *len = f.kind == HWFOC_FOC_KIND_DATA ? HWFOC_FOC_DATA_LEN : HWFOC_FOC_MAX_LEN;
         if (any) ((hwfoc_foc_cb)any)(ctx, &f);
     }
     return v;

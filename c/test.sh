@@ -15,7 +15,7 @@ for cc in gcc clang; do
   command -v "$cc" >/dev/null || { echo "c/test.sh: $cc not found" >&2; exit 1; }
 done
 selections=("" "-DHWFOC_NO_FOC" "-DHWFOC_NO_DATALINK" "-DHWFOC_NO_V3" "-DHWFOC_NO_V4" "-DHWFOC_NO_HW5"
-  "-DHWFOC_NO_CAN" "-DHWFOC_NO_FOC -DHWFOC_NO_DATALINK" "-DHWFOC_NO_V3 -DHWFOC_NO_V4 -DHWFOC_NO_HW5"
+  "-DHWFOC_NO_CAN" "-DHWFOC_NO_FOC_INFO" "-DHWFOC_NO_FOC -DHWFOC_NO_DATALINK" "-DHWFOC_NO_V3 -DHWFOC_NO_V4 -DHWFOC_NO_HW5"
   "-DHWFOC_NO_FOC -DHWFOC_NO_DATALINK -DHWFOC_NO_V3 -DHWFOC_NO_V4 -DHWFOC_NO_HW5")
 for sel in "${selections[@]}"; do
   # shellcheck disable=SC2086

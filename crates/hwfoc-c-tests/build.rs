@@ -1,12 +1,16 @@
-//! Compiles `c/hwfoc.h` (through `shim/shim.c`) with the `cc` crate, with the warnings the
-//! header promises to build clean under made errors.
+//! Compiles `c/hwfoc.h` (through `shim/shim.c`, and with `HWFOC_NO_FOC_INFO` through
+//! `shim/noinfo.c`) with the `cc` crate, with the warnings the header promises to build clean
+//! under made errors.
 
 fn main() {
     let header_dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../../c");
     println!("cargo:rerun-if-changed=shim/shim.c");
+    println!("cargo:rerun-if-changed=shim/noinfo.c");
+    println!("cargo:rerun-if-changed=shim/flat_out.h");
     println!("cargo:rerun-if-changed={header_dir}/hwfoc.h");
     cc::Build::new()
         .file("shim/shim.c")
+        .file("shim/noinfo.c")
         .include(header_dir)
         .std("c99")
         .flag_if_supported("-Wall")

@@ -4,7 +4,7 @@
  * src/flat.rs lays out the Rust codec's. Test-only (it allocates). */
 #define HWFOC_IMPLEMENTATION
 #include "hwfoc.h"
-#include <stdlib.h>
+#include "flat_out.h"
 
 enum { FOC = 0, DL = 1, V3 = 2, V4 = 3, HW5 = 4 };
 
@@ -17,20 +17,11 @@ typedef struct shim {
         hwfoc_v4_decoder v4;
         hwfoc_hw5_decoder hw5;
     } d;
-    uint64_t *out;
-    size_t len, cap;
-    int oom;
+    flat_out o;
 } shim;
 
 static void put(shim *s, uint64_t v) {
-    if (s->len == s->cap) {
-        size_t cap = s->cap ? 2 * s->cap : 1024;
-        uint64_t *out = (uint64_t *)realloc(s->out, cap * sizeof *out);
-        if (!out) { s->oom = 1; return; }
-        s->out = out;
-        s->cap = cap;
-    }
-    s->out[s->len++] = v;
+    flat_put(&s->o, v);
 }
 
 static void put_seq(shim *s, const hwfoc_sequence *q, uint64_t none) {
@@ -116,7 +107,7 @@ shim *shim_new(int format) {
 }
 
 void shim_free(shim *s) {
-    if (s) free(s->out);
+    if (s) free(s->o.out);
     free(s);
 }
 
@@ -166,17 +157,14 @@ void shim_line_silent(shim *s, uint32_t max_frames) {
 
 /* The frames so far, flat (and forgets them): their count of integers, or -1 out of memory. */
 long shim_take_frames(shim *s, const uint64_t **out) {
-    long n = s->oom ? -1 : (long)s->len;
-    *out = s->out;
-    s->len = 0;
-    return n;
+    return flat_take(&s->o, out);
 }
 
 /* The statistics, flat, after the frames' integers are taken. */
 long shim_stats(shim *s, const uint64_t **out) {
     const uint64_t none = UINT64_MAX;
     unsigned i;
-    s->len = 0;
+    s->o.len = 0;
     switch (s->format) {
     case FOC: {
         const hwfoc_foc_stats *t = &s->d.foc.stats;

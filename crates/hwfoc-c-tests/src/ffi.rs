@@ -136,3 +136,87 @@ impl Drop for CDecoder {
         unsafe { shim_free(self.shim) }
     }
 }
+
+#[repr(C)]
+struct NoInfo {
+    _private: [u8; 0],
+}
+
+unsafe extern "C" {
+    fn noinfo_state_size() -> usize;
+    fn noinfo_new() -> *mut NoInfo;
+    fn noinfo_free(s: *mut NoInfo);
+    fn noinfo_feed(s: *mut NoInfo, data: *const u8, n: usize, push: c_int);
+    fn noinfo_flush(s: *mut NoInfo);
+    fn noinfo_line_silent(s: *mut NoInfo, max_frames: u32);
+    fn noinfo_take_frames(s: *mut NoInfo, out: *mut *const u64) -> c_long;
+    fn noinfo_stats(s: *mut NoInfo, out: *mut *const u64) -> c_long;
+}
+
+/// The HW-FOC decoder built with `HWFOC_NO_FOC_INFO` (`shim/noinfo.c`): data frames only.
+pub struct NoInfoDecoder {
+    shim: *mut NoInfo,
+}
+
+impl NoInfoDecoder {
+    /// `sizeof(hwfoc_foc_decoder)` in that build, on this machine.
+    pub fn state_size() -> usize {
+        // SAFETY: a constant of the C build.
+        unsafe { noinfo_state_size() }
+    }
+
+    /// A new decoder.
+    pub fn new() -> NoInfoDecoder {
+        // SAFETY: null only when out of memory.
+        let shim = unsafe { noinfo_new() };
+        assert!(!shim.is_null(), "noinfo_new: out of memory");
+        NoInfoDecoder { shim }
+    }
+
+    /// `hwfoc_foc_feed` (or `_push` byte by byte when `push`).
+    pub fn feed(&mut self, data: &[u8], push: bool) {
+        // SAFETY: `data` is valid for `data.len()` bytes for the call.
+        unsafe { noinfo_feed(self.shim, data.as_ptr(), data.len(), c_int::from(push)) }
+    }
+
+    /// `hwfoc_foc_flush`.
+    pub fn flush(&mut self) {
+        // SAFETY: a live shim.
+        unsafe { noinfo_flush(self.shim) }
+    }
+
+    /// `hwfoc_foc_line_silent`.
+    pub fn line_silent(&mut self, max_frames: u32) {
+        // SAFETY: a live shim.
+        unsafe { noinfo_line_silent(self.shim, max_frames) }
+    }
+
+    /// The data frames handed on since the last call, flat as [`crate::flat`]'s HW-FOC ones.
+    pub fn take_frames(&mut self) -> Vec<u64> {
+        let mut out = core::ptr::null();
+        // SAFETY: as in CDecoder::take_frames.
+        let n = unsafe { noinfo_take_frames(self.shim, &mut out) };
+        copy(out, n)
+    }
+
+    /// The statistics, flat: bytes, bytes skipped, checksum failures, the packet sequence.
+    pub fn stats(&mut self) -> Vec<u64> {
+        let mut out = core::ptr::null();
+        // SAFETY: as in CDecoder::take_frames.
+        let n = unsafe { noinfo_stats(self.shim, &mut out) };
+        copy(out, n)
+    }
+}
+
+impl Default for NoInfoDecoder {
+    fn default() -> NoInfoDecoder {
+        NoInfoDecoder::new()
+    }
+}
+
+impl Drop for NoInfoDecoder {
+    fn drop(&mut self) {
+        // SAFETY: created by noinfo_new, freed once.
+        unsafe { noinfo_free(self.shim) }
+    }
+}

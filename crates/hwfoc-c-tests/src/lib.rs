@@ -3,8 +3,9 @@
 //! as the same flat lists of integers ([`flat`]) so that a test compares them whole.
 //!
 //! Nothing in the workspace depends on this crate; its tests are the differential test
-//! (`tests/differential.rs`), the golden vectors (`tests/vectors.rs`) and the DroneCAN payloads
-//! (`tests/dronecan.rs`).
+//! (`tests/differential.rs`, and `tests/noinfo.rs` for the `HWFOC_NO_FOC_INFO` build), the
+//! golden vectors (`tests/vectors.rs`) and the DroneCAN payloads (`tests/dronecan.rs`);
+//! `examples/ipb.rs` is the Rust side of `c/bench/ipb.sh`.
 
 pub mod ffi;
 pub mod flat;

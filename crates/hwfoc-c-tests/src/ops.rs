@@ -5,9 +5,10 @@
 
 use std::sync::atomic::{AtomicU64, Ordering};
 
+use hwfoc::foc;
 use hwfoc::scan::StreamDecoder;
 
-use crate::ffi::CDecoder;
+use crate::ffi::{CDecoder, NoInfoDecoder};
 use crate::flat::Flat;
 
 /// One call on a decoder.
@@ -103,6 +104,101 @@ pub fn chunked(stream: &[u8], seed: u64, silences: bool) -> Vec<Op> {
     ops
 }
 
+/// A C decoder as an [`Op`] drives it.
+pub trait CSide {
+    /// `_feed` (or `_push` byte by byte when `push`).
+    fn feed(&mut self, data: &[u8], push: bool);
+    /// `_flush`.
+    fn flush(&mut self);
+    /// `_line_silent`.
+    fn line_silent(&mut self, max_frames: u32);
+}
+
+macro_rules! c_side {
+    ($($t:ty),*) => {$(
+        impl CSide for $t {
+            fn feed(&mut self, data: &[u8], push: bool) {
+                <$t>::feed(self, data, push)
+            }
+            fn flush(&mut self) {
+                <$t>::flush(self)
+            }
+            fn line_silent(&mut self, max_frames: u32) {
+                <$t>::line_silent(self, max_frames)
+            }
+        }
+    )*};
+}
+c_side!(CDecoder, NoInfoDecoder);
+
+/// Gives `op` to the Rust decoder (its frames to `take`) and to the C one.
+pub fn apply<S: Flat>(
+    op: &Op,
+    rust: &mut StreamDecoder<S>,
+    c: &mut impl CSide,
+    mut take: impl FnMut(S::Item),
+) {
+    match op {
+        Op::Feed(bytes) => {
+            rust.feed(bytes, &mut take);
+            c.feed(bytes, false);
+        }
+        Op::Push(bytes) => {
+            for &b in bytes {
+                rust.push(b, &mut take);
+            }
+            c.feed(bytes, true);
+        }
+        Op::Flush => {
+            rust.flush(&mut take);
+            c.flush();
+        }
+        Op::Silent(max) => {
+            rust.line_silent(*max, &mut take);
+            c.line_silent(*max);
+        }
+    }
+}
+
+/// An HW-FOC data frame numbered `packet`, its other fields random.
+pub fn foc_data_frame(rng: &mut Rng, packet: u16) -> foc::DataFrame {
+    foc::DataFrame {
+        packet,
+        throttle_in_raw: rng.below(1100) as u16,
+        throttle_out_raw: rng.below(1100) as u16,
+        erpm_raw: rng.bits() as u16,
+        voltage_raw: rng.bits() as u16,
+        current_raw: rng.bits() as i16,
+        phase_current_raw: rng.bits() as i16,
+        mos_adc: rng.bits() as u8,
+        cap_adc: rng.bits() as u8,
+        status: hwfoc::Status(rng.bits() as u16),
+    }
+}
+
+/// Now and then: drops the frame, cuts it short, flips a byte, or adds noise (biased towards
+/// the bytes a scanner looks for) before it.
+pub fn disturb(rng: &mut Rng, bytes: &mut Vec<u8>, special: &[u8]) {
+    match rng.below(25) {
+        0 => bytes.clear(),
+        1 => bytes.truncate(rng.below(bytes.len() as u64) as usize),
+        2 => {
+            let at = rng.below(bytes.len() as u64) as usize;
+            bytes[at] ^= 1 << rng.below(8);
+        }
+        3 => {
+            let noise: Vec<u8> = (0..rng.below(30))
+                .map(|_| match rng.below(2) {
+                    0 => special[rng.below(special.len() as u64) as usize],
+                    _ => rng.bits() as u8,
+                })
+                .collect();
+            bytes.splice(0..0, noise);
+        }
+        _ => {}
+    }
+}
+
 /// Gives `ops` to the Rust decoder of `S` and to the C decoder of the same format, and checks
 /// that after every operation both handed on the same frames and hold the same statistics.
 /// Returns the common outcome; panics, naming the operation, where they differ.
@@ -115,30 +211,10 @@ pub fn run_both<S: Flat>(ops: &[Op]) -> Outcome {
     for (i, op) in ops.iter().enumerate() {
         let mut frames = Vec::new();
         let mut n = 0usize;
-        let mut take = |item: S::Item| {
+        apply(op, &mut rust, &mut c, |item: S::Item| {
             S::frame(&item, &mut frames);
             n += 1;
-        };
-        match op {
-            Op::Feed(bytes) => {
-                rust.feed(bytes, &mut take);
-                c.feed(bytes, false);
-            }
-            Op::Push(bytes) => {
-                for &b in bytes {
-                    rust.push(b, &mut take);
-                }
-                c.feed(bytes, true);
-            }
-            Op::Flush => {
-                rust.flush(&mut take);
-                c.flush();
-            }
-            Op::Silent(max) => {
-                rust.line_silent(*max, &mut take);
-                c.line_silent(*max);
-            }
-        }
+        });
         let c_frames = c.take_frames();
         assert_eq!(
             c_frames,

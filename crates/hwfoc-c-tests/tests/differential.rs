@@ -9,7 +9,7 @@ use std::sync::atomic::Ordering;
 
 use hwfoc::{datalink, foc, hw5, v3, v4};
 use hwfoc_c_tests::ffi::{self, Format};
-use hwfoc_c_tests::ops::{Rng, VOLUME};
+use hwfoc_c_tests::ops::{Rng, VOLUME, disturb, foc_data_frame};
 use hwfoc_c_tests::{Flat, Op, chunked, run_both};
 use proptest::prelude::*;
 
@@ -87,19 +87,7 @@ fn foc_stream(rng: &mut Rng, frames: usize) -> Vec<u8> {
     let mut out = Vec::new();
     let mut packet = rng.bits() as u16;
     for _ in 0..frames {
-        let d = foc::DataFrame {
-            packet,
-            throttle_in_raw: rng.below(1100) as u16,
-            throttle_out_raw: rng.below(1100) as u16,
-            erpm_raw: rng.bits() as u16,
-            voltage_raw: rng.bits() as u16,
-            current_raw: rng.bits() as i16,
-            phase_current_raw: rng.bits() as i16,
-            mos_adc: rng.bits() as u8,
-            cap_adc: rng.bits() as u8,
-            status: hwfoc::Status(rng.bits() as u16),
-        };
-        let mut bytes = d.encode().to_vec();
+        let mut bytes = foc_data_frame(rng, packet).encode().to_vec();
         if rng.below(12) == 0 {
             let text: [u8; 72] = core::array::from_fn(|_| 0x20 + rng.below(0x5F) as u8);
             bytes = foc::InfoFrame::from_text(text)
@@ -126,29 +114,6 @@ fn step(rng: &mut Rng) -> u32 {
         1 => 2 + rng.below(5) as u32,
         2 => rng.bits() as u32,
         _ => 1,
-    }
-}
-
-/// Now and then: drops the frame, cuts it short, flips a byte, or adds noise (biased towards
-/// the bytes a scanner looks for) before it.
-fn disturb(rng: &mut Rng, bytes: &mut Vec<u8>, special: &[u8]) {
-    match rng.below(25) {
-        0 => bytes.clear(),
-        1 => bytes.truncate(rng.below(bytes.len() as u64) as usize),
-        2 => {
-            let at = rng.below(bytes.len() as u64) as usize;
-            bytes[at] ^= 1 << rng.below(8);
-        }
-        3 => {
-            let noise: Vec<u8> = (0..rng.below(30))
-                .map(|_| match rng.below(2) {
-                    0 => special[rng.below(special.len() as u64) as usize],
-                    _ => rng.bits() as u8,
-                })
-                .collect();
-            bytes.splice(0..0, noise);
-        }
-        _ => {}
     }
 }
 

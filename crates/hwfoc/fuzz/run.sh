@@ -3,9 +3,9 @@
 #
 #   crates/hwfoc/fuzz/run.sh [DURATION]
 #
-# Nine targets: stream, bulk (HW-FOC), datalink, v3, v4, hw5, detect (every serial format at
-# once), dronecan, canrecords (a CAN bus's record stream). The whole run takes 9 x DURATION
-# seconds of fuzzing plus the build: at 30 s (CI), 270 s of fuzzing, and about 1.5 minutes to build the targets the first time on a 2-core
+# Ten targets: stream, bulk (HW-FOC), datalink, v3, v4, hw5, detect (every serial format at
+# once), dronecan, canrecords (a CAN bus's record stream), c_header (c/hwfoc.h against the
+# codec). The whole run takes 10 x DURATION seconds of fuzzing plus the build: at 30 s (CI), 300 s of fuzzing, and about 1.5 minutes to build the targets the first time on a 2-core
 # machine (seconds once built).
 #
 # Needs cargo-fuzz (installed here with `cargo install cargo-fuzz --locked` when missing: about
