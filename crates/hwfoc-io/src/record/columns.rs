@@ -29,8 +29,8 @@
 //! command's golden outputs (`crates/hwfoc-cli/tests/golden/`, the lines written out in
 //! `tests/cli.rs`) and the column list of `tests/pyarrow_check.py` follow it.
 
-use hwfoc::telemetry::{Data, Telemetry};
-use hwfoc::{Protocol, Quantity};
+use hwfoc::telemetry::{Data, Reading, Telemetry};
+use hwfoc::{Protocol, Quantity, Settings};
 
 use super::FaultList;
 
@@ -39,6 +39,16 @@ use super::FaultList;
 #[inline(always)]
 fn raw(frame: &Data, quantity: Quantity) -> u32 {
     frame.raw(quantity).map_or(0, |raw| raw as u32)
+}
+
+/// `quantity` of `frame` in its unit under `settings`, as [`Telemetry::value`] gives it, but
+/// always inlined: each column's conversion is then specialised to its quantity (a field load
+/// and a multiplication per protocol). Out of line, as `Telemetry::value` was left in the release
+/// build, every value of every column went through one call matching on the protocol, then on
+/// the quantity: a fifth of the Parquet export's instructions (issue 31).
+#[inline(always)]
+fn value(frame: &Data, quantity: Quantity, settings: &Settings) -> Option<f32> {
+    frame.reading(quantity, settings).and_then(Reading::value)
 }
 
 columns! {
@@ -57,42 +67,42 @@ columns! {
     /// null where the protocol sends none.
     packet: Option<u32>, "-", |_, _, f, _| f.packet();
     /// Input throttle, %: raw * 100 / 1024.
-    throttle_in_pct: Option<f32>, "%", |_, _, f, s| f.value(Quantity::ThrottleIn, s),
+    throttle_in_pct: Option<f32>, "%", |_, _, f, s| value(f, Quantity::ThrottleIn, s),
         text key |f| raw(f, Quantity::ThrottleIn);
     /// Output throttle, %: raw * 100 / 1024.
-    throttle_out_pct: Option<f32>, "%", |_, _, f, s| f.value(Quantity::ThrottleOut, s),
+    throttle_out_pct: Option<f32>, "%", |_, _, f, s| value(f, Quantity::ThrottleOut, s),
         text key |f| raw(f, Quantity::ThrottleOut);
     /// Electrical RPM: raw * 10.
-    erpm: Option<u32>, "rev/min", |_, _, f, s| f.value(Quantity::Erpm, s).map(|v| v as u32);
+    erpm: Option<u32>, "rev/min", |_, _, f, s| value(f, Quantity::Erpm, s).map(|v| v as u32);
     /// Motor (or geared output) RPM under the settings: raw * 10 / (gear ratio * pole pairs).
-    rpm: Option<f32>, "rev/min", |_, _, f, s| f.value(Quantity::Rpm, s),
+    rpm: Option<f32>, "rev/min", |_, _, f, s| value(f, Quantity::Rpm, s),
         text key |f| raw(f, Quantity::Rpm);
     /// Input voltage, V: raw / 10.
-    voltage_v: Option<f32>, "V", |_, _, f, s| f.value(Quantity::Voltage, s),
+    voltage_v: Option<f32>, "V", |_, _, f, s| value(f, Quantity::Voltage, s),
         text key |f| raw(f, Quantity::Voltage);
     /// Input current, A: raw (signed) / current scale; negative while braking regeneratively.
-    current_a: Option<f32>, "A", |_, _, f, s| f.value(Quantity::Current, s),
+    current_a: Option<f32>, "A", |_, _, f, s| value(f, Quantity::Current, s),
         text key |f| raw(f, Quantity::Current);
     /// Phase current, A: raw (signed) / current scale.
-    phase_current_a: Option<f32>, "A", |_, _, f, s| f.value(Quantity::PhaseCurrent, s),
+    phase_current_a: Option<f32>, "A", |_, _, f, s| value(f, Quantity::PhaseCurrent, s),
         text key |f| raw(f, Quantity::PhaseCurrent);
     /// MOSFET temperature, degC, from the ADC table; null when out of the table's range.
-    mos_temp_c: Option<f32>, "degC", |_, _, f, s| f.value(Quantity::MosTemp, s),
+    mos_temp_c: Option<f32>, "degC", |_, _, f, s| value(f, Quantity::MosTemp, s),
         text key |f| raw(f, Quantity::MosTemp);
     /// Capacitor temperature, degC, from the ADC table; null when out of the table's range.
-    cap_temp_c: Option<f32>, "degC", |_, _, f, s| f.value(Quantity::CapTemp, s),
+    cap_temp_c: Option<f32>, "degC", |_, _, f, s| value(f, Quantity::CapTemp, s),
         text key |f| raw(f, Quantity::CapTemp);
     /// Motor temperature, degC (HW5; null in HW-FOC and DataLink).
-    motor_temp_c: Option<f32>, "degC", |_, _, f, s| f.value(Quantity::MotorTemp, s),
+    motor_temp_c: Option<f32>, "degC", |_, _, f, s| value(f, Quantity::MotorTemp, s),
         text key |f| raw(f, Quantity::MotorTemp);
     /// BEC temperature, degC (HW5; null in HW-FOC and DataLink).
-    bec_temp_c: Option<f32>, "degC", |_, _, f, s| f.value(Quantity::BecTemp, s),
+    bec_temp_c: Option<f32>, "degC", |_, _, f, s| value(f, Quantity::BecTemp, s),
         text key |f| raw(f, Quantity::BecTemp);
     /// BEC output voltage, V (HW5; null in HW-FOC and DataLink).
-    bec_voltage_v: Option<f32>, "V", |_, _, f, s| f.value(Quantity::BecVoltage, s),
+    bec_voltage_v: Option<f32>, "V", |_, _, f, s| value(f, Quantity::BecVoltage, s),
         text key |f| raw(f, Quantity::BecVoltage);
     /// BEC output current, A (HW5; null in HW-FOC and DataLink).
-    bec_current_a: Option<f32>, "A", |_, _, f, s| f.value(Quantity::BecCurrent, s),
+    bec_current_a: Option<f32>, "A", |_, _, f, s| value(f, Quantity::BecCurrent, s),
         text key |f| raw(f, Quantity::BecCurrent);
     /// The raw fault word (an unsigned 16-bit integer: HW-FOC's and DataLink's status word,
     /// HW5's fault byte, a Hobbywing CAN ESC's `status`, whose bit 14 is the direction); null
