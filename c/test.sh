@@ -2,7 +2,8 @@
 # The C checks of hwfoc.h (CI's `c-header` step): the header builds without a warning under
 # -std=c99 -Wall -Wextra -Wpedantic -Wconversion -Werror with gcc and clang, as C++11 with g++
 # and clang++, with every HWFOC_NO_* format left out in turn; tests/test.c and the example run
-# under AddressSanitizer and UndefinedBehaviorSanitizer. Needs gcc, g++, clang, clang++.
+# under AddressSanitizer and UndefinedBehaviorSanitizer, and the example reads the simulator's
+# files and pseudo-terminals. Needs gcc, g++, clang, clang++, python3 and the hwfoc binary.
 set -euo pipefail
 here=$(cd "$(dirname "$0")" && pwd)
 out=$(mktemp -d)
@@ -96,6 +97,61 @@ if [ -x "$hwfoc" ]; then
     fi
     echo "c/test.sh: $protocol: the example printed $printed of the $sent frames the simulator wrote to its pty"
   done
+
+  # DataLink: `hwfoc bridge --sim 1 --datalink PORT` writes the hub's frames to a serial port, so
+  # a relay joins two pseudo-terminals: the bridge writes to the first, the example reads the
+  # second. The relay copies until told to stop (after the bridge ends), then hangs up the second.
+  cat >"$out/relay.py" <<'PY'
+import os, pty, select, signal, time, tty
+ma, sa = pty.openpty()
+mb, sb = pty.openpty()
+tty.setraw(sa)
+tty.setraw(sb)
+print(os.ttyname(sa), os.ttyname(sb), flush=True)
+running = [True]
+signal.signal(signal.SIGTERM, lambda *_: running.__setitem__(0, False))
+def copy(timeout):
+    try:
+        if not select.select([ma], [], [], timeout)[0]:
+            return False
+    except InterruptedError:
+        return True
+    os.write(mb, os.read(ma, 4096))
+    return True
+while running[0]:
+    copy(0.2)
+while copy(0.1):
+    pass
+time.sleep(0.3)  # the example reads what is queued before the hang-up
+PY
+  timeout 15 python3 "$out/relay.py" >"$out/relay.names" &
+  relay=$!
+  pids+=("$relay")
+  names=
+  for _ in $(seq 100); do
+    names=$(cat "$out/relay.names")
+    [ -n "$names" ] && break
+    sleep 0.05
+  done
+  read -r bridge_side reader_side <<<"$names"
+  [ -n "${reader_side:-}" ] || { echo "c/test.sh: datalink: the pty relay printed no ptys" >&2; exit 1; }
+  timeout 15 "$out/serial" "$reader_side" datalink >"$out/pty-datalink.txt" &
+  reader=$!
+  pids+=("$reader")
+  timeout 10 "$hwfoc" bridge --sim 1 --datalink "$bridge_side" --duration 2 >"$out/bridge.report" 2>&1 ||
+    { echo "c/test.sh: datalink: hwfoc bridge failed: $(cat "$out/bridge.report")" >&2; exit 1; }
+  kill "$relay"
+  wait "$relay" || { echo "c/test.sh: datalink: the pty relay failed" >&2; exit 1; }
+  wait "$reader" || { echo "c/test.sh: datalink: the example failed on $reader_side" >&2; exit 1; }
+  # The bridge opens its port before it sends, and the example has the relay's pty open by then.
+  said=$(grep -E "datalink $bridge_side: " "$out/bridge.report" || true)
+  sent=$(echo "$said" | grep -oE '[0-9]+ messages' | awk '{ print $1 + 0 }')
+  printed=$(wc -l <"$out/pty-datalink.txt")
+  if [ -z "$sent" ] || [ "$sent" -eq 0 ] || [ "$printed" -ne "$sent" ]; then
+    echo "c/test.sh: datalink: the example printed $printed frames from $reader_side, the bridge sent ${sent:-none} ($said)" >&2
+    exit 1
+  fi
+  echo "c/test.sh: datalink: the example printed all $sent frames the bridge wrote to its pty"
 else
   echo "c/test.sh: no hwfoc binary at $hwfoc: the check against the simulator is skipped" >&2
 fi
