@@ -128,7 +128,7 @@ int main(int argc, char **argv) {
     uint8_t buf[256];
     const char *format;
     speed_t speed;
-    int fd;
+    int fd, tty;
     ssize_t n;
     if (argc == 2 && strcmp(argv[1], "--self-test") == 0) return self_test();
     if (argc != 3) {
@@ -147,7 +147,8 @@ int main(int argc, char **argv) {
         return 1;
     }
     speed = strcmp(format, "datalink") == 0 || strcmp(format, "hw5") == 0 ? B115200 : B19200;
-    if (isatty(fd)) {
+    tty = isatty(fd);
+    if (tty) {
         struct termios t;
         if (tcgetattr(fd, &t) != 0) {
             fprintf(stderr, "%s: %s: %s\n", argv[0], argv[1], strerror(errno));
@@ -184,7 +185,8 @@ int main(int argc, char **argv) {
         }
         fflush(stdout);
     }
-    if (n < 0) {
+    /* A pseudo-terminal whose other side closed reads EIO: the line hung up, the stream ended. */
+    if (n < 0 && !(errno == EIO && tty)) {
         fprintf(stderr, "%s: reading %s: %s\n", argv[0], argv[1], strerror(errno));
         return 1;
     }
