@@ -142,6 +142,7 @@ mod fixed;
 mod handler;
 mod input;
 mod notice;
+mod port;
 mod select;
 mod settings;
 mod sources;
