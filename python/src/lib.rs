@@ -4,6 +4,7 @@
 //! per row. Decoding runs with the interpreter's lock released; every error becomes an
 //! exception of `hwfoc` (see `errors.rs`) whose message is the one the `hwfoc` command prints.
 
+mod args;
 mod can;
 mod errors;
 mod live;
@@ -74,8 +75,8 @@ impl Options {
         settings: Settings,
     ) -> PyResult<Options> {
         let escs = escs_arg(esc)?;
-        let from = time_arg(start)?;
-        let to = time_arg(end)?;
+        let from = time_arg("start", start)?;
+        let to = time_arg("end", end)?;
         let window = Window::new(from, to).map_err(errors::window)?;
         Ok(Options {
             settings,
@@ -115,12 +116,12 @@ impl Options {
 /// `ValueError` naming the argument.
 pub(crate) fn settings_arg(
     current_scale: f32,
-    pole_pairs: u16,
+    pole_pairs: crate::args::PolePairs,
     gear_ratio: f32,
     v4_volts_per_step: &str,
 ) -> PyResult<Settings> {
     let settings =
-        Settings::new(current_scale, pole_pairs, gear_ratio).map_err(errors::settings)?;
+        Settings::new(current_scale, pole_pairs.0, gear_ratio).map_err(errors::settings)?;
     let v4_volts_per_step = v4_volts_per_step.parse::<VoltsPerStep>().map_err(|e| {
         PyValueError::new_err(format!("v4_volts_per_step: {v4_volts_per_step:?}: {e}"))
     })?;
@@ -170,15 +171,11 @@ pub(crate) fn protocol_arg(name: Option<&str>) -> PyResult<Option<Protocol>> {
 }
 
 /// `baud=`: the baud rate given, else that of the serial protocol forced, else the default, as
-/// the command's `--baud`; 0 is a `ValueError`.
-pub(crate) fn baud_arg(baud: Option<u32>, protocol: Option<Protocol>) -> PyResult<u32> {
-    let baud = baud
+/// the command's `--baud` (0 is refused as [`args::Baud`] is converted).
+pub(crate) fn baud_arg(baud: Option<args::Baud>, protocol: Option<Protocol>) -> u32 {
+    baud.map(|b| b.0)
         .or(protocol.and_then(Protocol::serial_baud_rate))
-        .unwrap_or(hwfoc_io::serial::DEFAULT_BAUD);
-    if baud == 0 {
-        return Err(PyValueError::new_err("baud must be at least 1"));
-    }
-    Ok(baud)
+        .unwrap_or(hwfoc_io::serial::DEFAULT_BAUD)
 }
 
 /// The inputs read with `settings`, of `protocol` only when one is forced, the recordings
@@ -199,7 +196,9 @@ pub(crate) fn sources(
 }
 
 /// `start=`/`end=`: seconds as `t_s` has them (a number), or a `datetime` (its Unix time).
-fn time_arg(t: Option<&Bound<'_, PyAny>>) -> PyResult<Option<f64>> {
+/// A `datetime` whose Unix time Python cannot compute (`datetime.min` in a time zone east of
+/// UTC) is a `ValueError` naming the argument.
+fn time_arg(name: &str, t: Option<&Bound<'_, PyAny>>) -> PyResult<Option<f64>> {
     let Some(t) = t.filter(|t| !t.is_none()) else {
         return Ok(None);
     };
@@ -207,7 +206,16 @@ fn time_arg(t: Option<&Bound<'_, PyAny>>) -> PyResult<Option<f64>> {
         return Ok(Some(s));
     }
     if t.hasattr("timestamp")? {
-        return Ok(Some(t.call_method0("timestamp")?.extract::<f64>()?));
+        return t
+            .call_method0("timestamp")
+            .and_then(|s| s.extract::<f64>())
+            .map(Some)
+            .map_err(|e| {
+                PyValueError::new_err(format!(
+                    "{name}: {t} has no Unix time ({e}): give a datetime between the years 1 \
+                     and 9999 that Python can convert, or seconds"
+                ))
+            });
     }
     Err(PyTypeError::new_err(
         "start/end: give seconds (a number, as in t_s) or a datetime",
@@ -381,7 +389,7 @@ pub(crate) fn stop_error(stop: Stop) -> PyErr {
 /// SelectionError, SettingsError, ValueError for an unknown protocol; warns HwfocWarning for
 /// inputs without frames and for damage or notes in a recording.
 #[pyfunction]
-#[pyo3(signature = (source, *, esc=None, start=None, end=None, current_scale=CURRENT_SCALE, pole_pairs=POLE_PAIRS, gear_ratio=GEAR_RATIO, v4_volts_per_step=V4_VOLTS_PER_STEP, protocol=None, join=false), text_signature = "(source, *, esc=None, start=None, end=None, current_scale=DEFAULT_CURRENT_SCALE, pole_pairs=DEFAULT_POLE_PAIRS, gear_ratio=DEFAULT_GEAR_RATIO, v4_volts_per_step=DEFAULT_V4_VOLTS_PER_STEP, protocol=None, join=False)")]
+#[pyo3(signature = (source, *, esc=None, start=None, end=None, current_scale=CURRENT_SCALE, pole_pairs=crate::args::PolePairs(POLE_PAIRS), gear_ratio=GEAR_RATIO, v4_volts_per_step=V4_VOLTS_PER_STEP, protocol=None, join=false), text_signature = "(source, *, esc=None, start=None, end=None, current_scale=DEFAULT_CURRENT_SCALE, pole_pairs=DEFAULT_POLE_PAIRS, gear_ratio=DEFAULT_GEAR_RATIO, v4_volts_per_step=DEFAULT_V4_VOLTS_PER_STEP, protocol=None, join=False)")]
 #[allow(clippy::too_many_arguments)]
 fn read<'py>(
     py: Python<'py>,
@@ -390,7 +398,7 @@ fn read<'py>(
     start: Option<&Bound<'py, PyAny>>,
     end: Option<&Bound<'py, PyAny>>,
     current_scale: f32,
-    pole_pairs: u16,
+    pole_pairs: crate::args::PolePairs,
     gear_ratio: f32,
     v4_volts_per_step: &str,
     protocol: Option<&str>,
@@ -439,13 +447,13 @@ fn summary_json(
 /// settings, inputs, and per ESC its link statistics, field ranges, faults and fault episodes;
 /// `protocol` and `join` as `read`'s. Raises InputError, ValueError for an unknown protocol.
 #[pyfunction]
-#[pyo3(signature = (source, *, current_scale=CURRENT_SCALE, pole_pairs=POLE_PAIRS, gear_ratio=GEAR_RATIO, v4_volts_per_step=V4_VOLTS_PER_STEP, protocol=None, join=false), text_signature = "(source, *, current_scale=DEFAULT_CURRENT_SCALE, pole_pairs=DEFAULT_POLE_PAIRS, gear_ratio=DEFAULT_GEAR_RATIO, v4_volts_per_step=DEFAULT_V4_VOLTS_PER_STEP, protocol=None, join=False)")]
+#[pyo3(signature = (source, *, current_scale=CURRENT_SCALE, pole_pairs=crate::args::PolePairs(POLE_PAIRS), gear_ratio=GEAR_RATIO, v4_volts_per_step=V4_VOLTS_PER_STEP, protocol=None, join=false), text_signature = "(source, *, current_scale=DEFAULT_CURRENT_SCALE, pole_pairs=DEFAULT_POLE_PAIRS, gear_ratio=DEFAULT_GEAR_RATIO, v4_volts_per_step=DEFAULT_V4_VOLTS_PER_STEP, protocol=None, join=False)")]
 #[allow(clippy::too_many_arguments)]
 fn summary<'py>(
     py: Python<'py>,
     source: &Bound<'py, PyAny>,
     current_scale: f32,
-    pole_pairs: u16,
+    pole_pairs: crate::args::PolePairs,
     gear_ratio: f32,
     v4_volts_per_step: &str,
     protocol: Option<&str>,
@@ -464,11 +472,11 @@ fn summary<'py>(
 /// The Arrow schema of the records (names, types, nullability, units in the fields' metadata),
 /// with the settings in its metadata.
 #[pyfunction]
-#[pyo3(signature = (*, current_scale=CURRENT_SCALE, pole_pairs=POLE_PAIRS, gear_ratio=GEAR_RATIO, v4_volts_per_step=V4_VOLTS_PER_STEP), text_signature = "(*, current_scale=DEFAULT_CURRENT_SCALE, pole_pairs=DEFAULT_POLE_PAIRS, gear_ratio=DEFAULT_GEAR_RATIO, v4_volts_per_step=DEFAULT_V4_VOLTS_PER_STEP)")]
+#[pyo3(signature = (*, current_scale=CURRENT_SCALE, pole_pairs=crate::args::PolePairs(POLE_PAIRS), gear_ratio=GEAR_RATIO, v4_volts_per_step=V4_VOLTS_PER_STEP), text_signature = "(*, current_scale=DEFAULT_CURRENT_SCALE, pole_pairs=DEFAULT_POLE_PAIRS, gear_ratio=DEFAULT_GEAR_RATIO, v4_volts_per_step=DEFAULT_V4_VOLTS_PER_STEP)")]
 fn record_schema<'py>(
     py: Python<'py>,
     current_scale: f32,
-    pole_pairs: u16,
+    pole_pairs: crate::args::PolePairs,
     gear_ratio: f32,
     v4_volts_per_step: &str,
 ) -> PyResult<Bound<'py, PyAny>> {
