@@ -7,6 +7,7 @@
 mod args;
 mod can;
 mod errors;
+mod interrupt;
 mod live;
 mod records;
 mod scan;
@@ -28,6 +29,7 @@ use hwfoc_io::write::arrow::schema;
 use hwfoc_io::write::metadata::escs_json;
 use hwfoc_io::{Input, InputError};
 use hwfoc_io::{Selection, Window, filter_text};
+use interrupt::Interruptible;
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
 
@@ -343,14 +345,17 @@ fn decode_all(specs: Vec<Spec>, options: &Options, notes: &Notes) -> Result<Deco
             });
         }
         let mut next = 0;
-        let mut collect = Collect::new(options.selection.clone(), READ_ROWS, |frames| {
+        let collect = Collect::new(options.selection.clone(), READ_ROWS, |frames| {
             tx.send((next, frames)).map_err(|_| Stop::Abandoned)?;
             next += 1;
             Ok(())
         })
         .reuse(spare_rx);
-        let result = sources.run(&mut collect).and_then(|()| collect.flush());
-        let empty = empty_window(&collect, options, &sources);
+        let mut collect = Interruptible::new(collect);
+        let result = sources
+            .run(&mut collect)
+            .and_then(|()| collect.inner.flush());
+        let empty = empty_window(&collect.inner, options, &sources);
         drop(collect);
         drop(tx);
         result.map(|()| empty)
@@ -438,9 +443,9 @@ fn summary_json(
     notes: &Notes,
 ) -> Result<String, InputError> {
     let mut sources = sources(open_all(specs, notes)?, settings, (protocol, join));
-    let mut summary = Summary::new();
+    let mut summary = Interruptible::new(Summary::new());
     sources.run(&mut summary)?;
-    Ok(summary.report(&sources).json().to_string())
+    Ok(summary.inner.report(&sources).json().to_string())
 }
 
 /// What `hwfoc summary --json` prints for `source` (as `read` takes it), as Python objects:

@@ -102,3 +102,29 @@ def test_a_candump_log_fed_to_the_byte_decoder_is_refused():
     log = b"(1700000000.000000) can0 1401550B#0011223344556677\n"
     with pytest.raises(hwfoc.InputError, match=r"candump log.*hwfoc\.CanDecoder"):
         hwfoc.Decoder().feed(log)
+
+
+@pytest.mark.parametrize(
+    "call",
+    ["hwfoc.read('/dev/zero')", "next(iter(hwfoc.scan('/dev/zero')))", "hwfoc.summary('/dev/zero')"],
+)
+def test_ctrl_c_stops_reading_an_endless_input(call):
+    """An endless input (/dev/zero) is read until Ctrl-C, which then stops it at once as
+    KeyboardInterrupt (every reading loop looks for signals)."""
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    code = f"import hwfoc, sys\nprint('reading', flush=True)\ntry:\n    {call}\nexcept KeyboardInterrupt:\n    sys.exit(42)\n"
+    p = subprocess.Popen([sys.executable, "-c", code], stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    try:
+        assert p.stdout.readline() == b"reading\n"
+        time.sleep(1.0)
+        p.send_signal(signal.SIGINT)
+        p.wait(timeout=10)
+    finally:
+        if p.poll() is None:
+            p.kill()
+            p.wait()
+    assert p.returncode == 42, p.stderr.read().decode()
