@@ -173,6 +173,8 @@ impl Decoder {
     /// Decodes `data`, the next bytes of the stream; `t`: Unix time (s) the first of them was
     /// received, the others following at the baud rate's byte time. Returns the records of
     /// the data frames completed, as a `pyarrow.RecordBatch`.
+    /// `t` outside 0 to 18446744073 (1970 to 2554) is a `ValueError`; first bytes that are a
+    /// candump log are an `InputError` (decode its frames with `hwfoc.CanDecoder`).
     #[pyo3(signature = (data, t=None))]
     fn feed(&self, py: Python<'_>, data: &Bound<'_, PyAny>, t: Option<f64>) -> PyResult<Py<PyAny>> {
         let bytes = bytes_of(data)?;
