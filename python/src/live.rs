@@ -352,9 +352,9 @@ impl Ports {
             if let Some(event) = &event {
                 state.streams.feed(event, &mut gather);
             }
-            Some((event, gather.0))
+            Some((event, gather.0, state.streams.take_notices()))
         });
-        let Some((event, frames)) = got else {
+        let Some((event, frames, notices)) = got else {
             return Ok(false);
         };
         if !frames.is_empty() {
@@ -374,9 +374,12 @@ impl Ports {
         {
             crate::warn_notice(py, notice)?;
         }
-        if event.is_none() {
-            py.check_signals()?;
+        // What the streams found (ESCs past number 255 left out, two CAN ESCs on one channel).
+        for notice in notices {
+            crate::warn_notice(py, notice)?;
         }
+        // Ctrl-C, whether the ports are busy or quiet.
+        py.check_signals()?;
         Ok(true)
     }
 
