@@ -880,6 +880,10 @@ pub struct PortStreams {
     /// The ESC number of each channel numbered so far of each port found to be a hub or a CAN
     /// bus (`esc_numbers.rs`).
     hubs: Vec<Vec<usize>>,
+    /// Data frames of each port left out, their ESC numbered past 255.
+    left_out: Vec<u64>,
+    /// Notices of ESCs left out, to be taken ([`PortStreams::take_notices`]).
+    past_last: Vec<Notice>,
 }
 
 impl PortStreams {
@@ -915,6 +919,8 @@ impl PortStreams {
                 .map(|n| (!crate::can::is_can_spec(n)).then_some(baud))
                 .collect(),
             discarded: vec![0; names.len()],
+            left_out: vec![0; names.len()],
+            past_last: Vec::new(),
             times: Vec::new(),
             esc_settings: names
                 .iter()
@@ -965,6 +971,8 @@ impl PortStreams {
             map,
             esc_settings,
             hubs,
+            left_out,
+            past_last,
         } = self;
         let stream = streams.get_mut(*port)?;
         times.clear();
@@ -999,6 +1007,20 @@ impl PortStreams {
                 };
                 if let Ok(id) = u8::try_from(esc) {
                     handler.frame(id, t, d, &esc_settings[esc]);
+                } else if matches!(d, Frame::Data(_)) {
+                    if left_out[*port] == 0 {
+                        past_last.push(Notice::PastLastEsc {
+                            input: names[*port].clone(),
+                            place: channel.map(|c| {
+                                if can {
+                                    format!("place {c} of the bus")
+                                } else {
+                                    format!("DataLink channel {c}")
+                                }
+                            }),
+                        });
+                    }
+                    left_out[*port] += 1;
                 }
             },
         );
@@ -1064,9 +1086,10 @@ impl PortStreams {
 
     /// What the ports' streams found since the last call that a person should be told: on a
     /// live CAN bus, two ESCs that claim one throttle channel (each stays an ESC of its own;
-    /// [`Notice::CanBus`] names both nodes).
+    /// [`Notice::CanBus`] names both nodes); ESCs past number 255, left out
+    /// ([`Notice::PastLastEsc`], once per port).
     pub fn take_notices(&mut self) -> Vec<Notice> {
-        let mut notices = Vec::new();
+        let mut notices = std::mem::take(&mut self.past_last);
         for (stream, name) in self.streams.iter_mut().zip(&self.names) {
             for message in stream.take_can_clashes() {
                 notices.push(Notice::CanBus {
@@ -1077,6 +1100,12 @@ impl PortStreams {
             }
         }
         notices
+    }
+
+    /// Data frames of `port` left out because their ESC would be numbered past 255 (told
+    /// once by a [`Notice::PastLastEsc`]).
+    pub fn left_out(&self, port: usize) -> u64 {
+        self.left_out.get(port).copied().unwrap_or(0)
     }
 
     /// The settings the records of ESC `esc` are made under, once it has a number.
