@@ -3,15 +3,32 @@
 use super::frame::{CanFrame, FrameKind};
 use super::id::{Header, TailByte, TransferType};
 use super::kind::{Form, Kind, MAX_PAYLOAD_LEN, Message};
-use super::stats::LinkStats;
+use super::stats::{LinkStats, NODES};
 use super::transfer::{FRAME_PAYLOAD, signature_crc};
 use crate::wire::crc16_ccitt;
 
+/// The known data types whose transfers take more than one frame (a payload over
+/// [`FRAME_PAYLOAD`] bytes): messages all (a test checks it), so a node has one transfer of
+/// each in progress at most.
+const MULTI_FRAME_TYPES: usize = {
+    let mut n = 0;
+    let mut i = 0;
+    while i < Kind::COUNT {
+        if Kind::ALL[i].max_len() > FRAME_PAYLOAD {
+            n += 1;
+        }
+        i += 1;
+    }
+    n
+};
+
 /// Reassembly slots of a [`Receiver`] by default: multi-frame transfers that can be in
-/// progress at once. Single-frame transfers take none; of the known types only
-/// `uavcan.equipment.esc.Status` is multi-frame, so 16 is one per ESC of a 16-ESC bus sending
-/// at the same moment.
-pub const DEFAULT_SLOTS: usize = 16;
+/// progress at once. Single-frame transfers take none; every node id can have one transfer of
+/// each known multi-frame type in progress (only `uavcan.equipment.esc.Status`), so 128 slots
+/// hold every transfer a bus can have in progress (of 40 bytes each: 5 KiB, beside the
+/// statistics' 21 KiB). A smaller receiver ([`Receiver::with_slots`]) counts a transfer that
+/// finds no slot ([`BusStats::no_slot`](super::BusStats::no_slot)).
+pub const DEFAULT_SLOTS: usize = NODES * MULTI_FRAME_TYPES;
 
 /// A decoded transfer.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -238,6 +255,7 @@ impl<const SLOTS: usize> Receiver<SLOTS> {
             Some(i) => i,
             None => {
                 let clock = self.clock;
+                self.stats.bus.no_slot = self.stats.bus.no_slot.saturating_add(1);
                 let (i, _) = self
                     .slots
                     .iter()
@@ -430,6 +448,19 @@ mod tests {
 
     fn frames(m: &Message, node: u8, tid: u8) -> Vec<CanFrame> {
         m.frames(16, node, 0, tid).collect()
+    }
+
+    /// Every known multi-frame type is a message (a node has one transfer of each in progress
+    /// at most, which [`DEFAULT_SLOTS`] counts on), and each slot is small.
+    #[test]
+    fn the_default_slots_hold_every_node_s_transfers() {
+        for k in Kind::ALL {
+            if k.max_len() > FRAME_PAYLOAD {
+                assert_eq!(k.form(), Form::Message, "{k:?}");
+            }
+        }
+        assert_eq!(DEFAULT_SLOTS, 128);
+        assert!(core::mem::size_of::<Slot>() <= 40);
     }
 
     #[test]

@@ -27,6 +27,7 @@ pub struct BusStats {
     pub(crate) empty: u32,
     pub(crate) bad_ids: u32,
     pub(crate) anonymous: u32,
+    pub(crate) no_slot: u32,
 }
 
 impl BusStats {
@@ -64,6 +65,13 @@ impl BusStats {
     /// Anonymous message frames (node 0: dynamic node id allocation): not decoded.
     pub const fn anonymous_frames(&self) -> u32 {
         self.anonymous
+    }
+
+    /// Multi-frame transfers dropped for want of a reassembly slot: each also counted as cut
+    /// short by its node. (A [`Receiver`](super::Receiver) of the default size has a slot for
+    /// every node id's transfer of every known multi-frame type, so none.)
+    pub const fn no_slot(&self) -> u32 {
+        self.no_slot
     }
 
     /// Frames that are not DroneCAN: standard, remote, error, empty frames and bad ids.
@@ -327,6 +335,7 @@ impl LinkStats {
                 empty: 0,
                 bad_ids: 0,
                 anonymous: 0,
+                no_slot: 0,
             },
             nodes: [NodeStats::new(); NODES],
         }
@@ -394,7 +403,7 @@ impl fmt::Display for BusStats {
         write!(
             f,
             "{} frames, {} not DroneCAN ({} standard, {} remote, {} error, {} empty, {} bad ids), \
-             {} anonymous",
+             {} anonymous, {} transfers without a reassembly slot",
             self.frames,
             self.not_dronecan(),
             self.standard,
@@ -402,7 +411,8 @@ impl fmt::Display for BusStats {
             self.error,
             self.empty,
             self.bad_ids,
-            self.anonymous
+            self.anonymous,
+            self.no_slot
         )
     }
 }
