@@ -464,13 +464,14 @@ impl EscLink {
         !matches!(self, EscLink::HwV4(_) | EscLink::HwV3(_))
     }
 
-    /// Frames rejected by their checksum (behind a hub: the hub frames' CRC failures; 0 for a
-    /// format without checksum).
+    /// Frames rejected by their checksum, or whose checksum matched but whose values are out of
+    /// their protocol's range (behind a hub: the hub frames' CRC failures; 0 for a format
+    /// without checksum).
     pub fn checksum_failures(&self) -> u32 {
         match self {
             EscLink::Wire(s) => s.checksum_failures(),
             EscLink::Hub { hub, .. } => hub.crc_failures(),
-            EscLink::Hw5(s) => s.crc_failures(),
+            EscLink::Hw5(s) => s.crc_failures().saturating_add(s.out_of_range()),
             EscLink::Can(c) => c.node_stats.crc_errors(),
             EscLink::HwV4(_) | EscLink::HwV3(_) => 0,
         }

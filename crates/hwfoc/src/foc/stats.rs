@@ -65,7 +65,9 @@ impl Stats {
     }
 
     /// Candidate frames (0x9B followed by a known length byte, long enough) that were rejected:
-    /// checksum mismatch, or a correct checksum with an unknown version or command, or a
+    /// checksum mismatch, or a correct checksum with an unknown version or command or a value
+    /// outside the protocol's range (a throttle over 100 %,
+    /// [`THROTTLE_MAX_RAW`](crate::foc::THROTTLE_MAX_RAW): the 16-bit sum is weak), or a
     /// device-information candidate whose text is not ASCII. Corrupted and cut frames, and fake
     /// headers in noise, all count here; a frame cut off by the end of the stream does not.
     pub const fn checksum_failures(&self) -> u32 {
