@@ -128,8 +128,12 @@ impl EscReport<'_> {
             None => format!("{} checksum failures", st.checksum_failures()),
         };
         let counted = if st.counts_packets() {
+            let reordered = match st.reordered_packets() {
+                0 => String::new(),
+                n => format!(", {n} reordered (adjacent frames swapped)"),
+            };
             format!(
-                "{} lost packets, {} duplicate packets, {} restarts",
+                "{} lost packets, {} duplicate packets, {} restarts{reordered}",
                 st.lost_packets(),
                 st.duplicate_packets(),
                 st.restarts()
