@@ -832,3 +832,86 @@ fn a_transfer_beyond_the_slots_is_counted() {
     assert_eq!(small.stats().bus().no_slot(), 1);
     assert_eq!(small.stats().node(1).cut_short(), 1);
 }
+
+/// Node 5's `StatusMsg1` transfers (single-frame) with transfer ids `first..first + n`, one
+/// every `period_us` from `t0_us` (jittered by up to a quarter period when `jitter`): each
+/// frame with its time.
+fn timed_msg1(
+    first: u32,
+    n: u32,
+    t0_us: u64,
+    period_us: u64,
+    jitter: bool,
+) -> Vec<(u64, CanFrame)> {
+    let m = Message::from(hwfoc::dronecan::StatusMsg1 {
+        rpm: 1000,
+        pwm: 200,
+        status: 0,
+    });
+    (0..n)
+        .map(|k| {
+            let wobble = if jitter {
+                (u64::from(k) * 7919 % 11) * period_us / 40
+            } else {
+                0
+            };
+            let t = t0_us + u64::from(k) * period_us + wobble;
+            let frame: Vec<CanFrame> = m.frames(16, 5, 0, ((first + k) % 32) as u8).collect();
+            (t, frame[0])
+        })
+        .collect()
+}
+
+fn push_timed(rx: &mut Receiver, frames: &[(u64, CanFrame)]) -> usize {
+    frames
+        .iter()
+        .filter(|(t, f)| rx.push_at(f, *t).is_some())
+        .count()
+}
+
+/// 40 transfers lost at 50 Hz are 40, judged by time (modulo 32 alone they were 8: issue 29);
+/// untimed, the ids alone still say 8. Jitter of a quarter period loses nothing.
+#[test]
+fn a_transfer_id_gap_is_judged_by_time() {
+    let before = timed_msg1(0, 100, 0, 20_000, true);
+    let after = timed_msg1(140, 50, 140 * 20_000, 20_000, true);
+    let mut rx = Receiver::new();
+    let got = push_timed(&mut rx, &before) + push_timed(&mut rx, &after);
+    let n = rx.stats().node(5);
+    assert_eq!(got, 150);
+    assert_eq!(
+        (n.gaps(), n.missed(), n.duplicates(), n.restarts()),
+        (1, 40, 0, 0)
+    );
+    let mut untimed = Receiver::new();
+    for (_, f) in before.iter().chain(&after) {
+        untimed.push(f);
+    }
+    assert_eq!(untimed.stats().node(5).missed(), 8);
+    // A repeated frame a millisecond later is still a duplicate.
+    let mut rx = Receiver::new();
+    push_timed(&mut rx, &before);
+    let (t, f) = before[99];
+    assert!(rx.push_at(&f, t + 1000).is_none());
+    assert_eq!(rx.stats().node(5).duplicates(), 1);
+}
+
+/// A bus power cycle: 2 s of silence, the node's transfer ids start again at 0. A restart,
+/// nothing missed (it counted 101 lost packets and 95.7 %: issue 29).
+#[test]
+fn a_bus_that_went_silent_and_came_back_is_a_restart() {
+    let before = timed_msg1(0, 100, 0, 20_000, false);
+    let after = timed_msg1(0, 100, 100 * 20_000 + 2_000_000, 20_000, false);
+    let mut rx = Receiver::new();
+    let got = push_timed(&mut rx, &before) + push_timed(&mut rx, &after);
+    let n = rx.stats().node(5);
+    assert_eq!(got, 200);
+    assert_eq!((n.gaps(), n.missed(), n.restarts()), (0, 0, 1));
+    // A silence under a second is no restart: what it hid is missed.
+    let after = timed_msg1(130, 10, 130 * 20_000, 20_000, false);
+    let mut rx = Receiver::new();
+    push_timed(&mut rx, &before);
+    push_timed(&mut rx, &after);
+    let n = rx.stats().node(5);
+    assert_eq!((n.missed(), n.restarts()), (30, 0));
+}

@@ -529,8 +529,12 @@ impl EscLink {
         }
     }
 
-    /// Jumps of the packet numbers that no loss explains.
+    /// Jumps of the packet numbers that no loss explains (on a CAN bus: the node's transfers
+    /// after a silence of the whole bus).
     pub fn restarts(&self) -> u32 {
+        if let EscLink::Can(c) = self {
+            return c.node_stats.restarts();
+        }
         match self.counting() {
             Some(Counting::Bits16(c)) => c.restarts(),
             Some(Counting::Bits24(c)) => c.restarts(),
