@@ -204,3 +204,47 @@ fn hw5_loss_is_judged_from_time() {
     assert_eq!((loss.lost, loss.unjudged), (3 + 1, 1));
     assert_eq!(loss.judged, 2 + 1 + 16 + 3);
 }
+
+/// A stream that changed format (HW5, then HW-FOC, no silence): the summary names both with
+/// their counts, its frames are both's, and the delivery says whose it is. (It said "frames
+/// 19", protocol hw5, delivery 100 %: issue 29.)
+#[test]
+fn a_stream_that_changed_format_names_both() {
+    let mut bytes = Vec::new();
+    for k in 0..658u32 {
+        let frame = hwfoc::hw5::TelemetryFrame {
+            throttle: 20,
+            erpm_raw: 1000 + (k % 7) as u16,
+            voltage_raw: 504,
+            ..Default::default()
+        };
+        bytes.extend_from_slice(&frame.encode());
+    }
+    for packet in [100, 101, 103] {
+        let frame = hwfoc::foc::DataFrame {
+            packet,
+            voltage_raw: 247,
+            ..Default::default()
+        };
+        bytes.extend_from_slice(&frame.encode());
+    }
+    let input = crate::Input::from_memory("hw5 then hw-foc", bytes).unwrap();
+    let mut sources = crate::Sources::new(vec![input], Settings::DEFAULT);
+    let mut summary = Summary::new();
+    sources.run(&mut summary).unwrap();
+    let report = summary.report(&sources);
+    let text = report.text();
+    assert!(text.contains("frames       661 data, 0 info"), "{text}");
+    assert!(
+        text.contains("formats      HW-FOC 3 data frames, HW5 658 data frames"),
+        "{text}"
+    );
+    assert!(
+        text.contains("delivery     75.00 % of HW-FOC data frames"),
+        "{text}"
+    );
+    let esc = &report.json()["escs"][0];
+    assert_eq!(esc["frames"], 661);
+    assert_eq!(esc["formats"]["hw5"], 658);
+    assert_eq!(esc["formats"]["hw-foc"], 3);
+}
