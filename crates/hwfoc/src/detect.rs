@@ -45,6 +45,7 @@
 //! assert_eq!(decoder.locked(), Some(Family::HwV3));
 //! ```
 
+use crate::scan::{self, Scanner, StreamDecoder};
 use crate::{Protocol, hw5, mixed, v3, v4};
 
 /// Bytes per slice while detecting (see the module documentation).
@@ -183,6 +184,27 @@ impl History {
         let first = n.min(HISTORY - start);
         (&self.0[start..start + first], &self.0[..n - first])
     }
+}
+
+/// Brings `decoder`, if it is behind the stream's end `to`, up to it: it passes over the bytes
+/// before `from` it was not given, then reads those from `from` on out of `history`.
+fn replay_into<S: Scanner>(
+    decoder: &mut StreamDecoder<S>,
+    history: &History,
+    from: u64,
+    to: u64,
+    on_frame: &mut dyn FnMut(S::Item),
+) {
+    let at = scan::Stats::bytes(decoder.stats());
+    if at >= to {
+        return;
+    }
+    if from > at {
+        decoder.pass_over(from.min(to) - at);
+    }
+    let (a, b) = history.between(at.max(from).min(to), to);
+    decoder.feed(a, &mut *on_frame);
+    decoder.feed(b, &mut *on_frame);
 }
 
 /// A decoder of every Hobbywing serial format at once (see the module documentation).
@@ -354,40 +376,18 @@ impl Decoder {
         let (history, found) = (&self.history, &mut self.found);
         let mut on_frame = on_frame;
         let mut take = noting(true, found, &mut on_frame);
-        let give = |at: u64, feed: &mut dyn FnMut(&[u8])| {
-            let (a, b) = history.between(at.max(from).min(to), to);
-            feed(a);
-            feed(b);
-        };
-        let behind = |at: u64| at < to;
-        let at = self.mixed.stats().bytes();
-        if behind(at) {
-            if from > at {
-                self.mixed.pass_over(from.min(to) - at);
-            }
-            give(at, &mut |p| self.mixed.feed(p, |d| take(Decoded::Mixed(d))));
-        }
-        let at = self.hw5.stats().bytes();
-        if behind(at) {
-            if from > at {
-                self.hw5.pass_over(from.min(to) - at);
-            }
-            give(at, &mut |p| self.hw5.feed(p, |d| take(Decoded::Hw5(d))));
-        }
-        let at = self.v4.stats().bytes();
-        if behind(at) {
-            if from > at {
-                self.v4.pass_over(from.min(to) - at);
-            }
-            give(at, &mut |p| self.v4.feed(p, |d| take(Decoded::HwV4(d))));
-        }
-        let at = self.v3.stats().bytes();
-        if behind(at) {
-            if from > at {
-                self.v3.pass_over(from.min(to) - at);
-            }
-            give(at, &mut |p| self.v3.feed(p, |d| take(Decoded::HwV3(d))));
-        }
+        replay_into(&mut self.mixed, history, from, to, &mut |d| {
+            take(Decoded::Mixed(d))
+        });
+        replay_into(&mut self.hw5, history, from, to, &mut |d| {
+            take(Decoded::Hw5(d))
+        });
+        replay_into(&mut self.v4, history, from, to, &mut |d| {
+            take(Decoded::HwV4(d))
+        });
+        replay_into(&mut self.v3, history, from, to, &mut |d| {
+            take(Decoded::HwV3(d))
+        });
     }
 
     /// Gives every decoder the bytes of `data` to the end of the current slice; at its end,
