@@ -1276,31 +1276,31 @@ static int hwfoc_hw5_take(void *dec, const uint8_t *c, size_t n, uint64_t at, in
     uint32_t *counter;
     int v = hwfoc__hw5_judge(s, c, n, at_end, &kind);
     if (v != HWFOC__FRAME) return v;
+    *len = hwfoc__hw5_len[kind];
     counter = &s->frames[kind];
-    if (kind == HWFOC_HW5_TELEMETRY &&
-        (c[9] > HWFOC_HW5_THROTTLE_MAX_PCT || hwfoc__le16(c + 15) > HWFOC_HW5_VOLTAGE_MAX_RAW)) {
-        counter = &s->out_of_range; /* a corrupted frame whose CRC still matches */
-        v = HWFOC__REJECTED;
+    if (kind == HWFOC_HW5_TELEMETRY) {
+        f.offset = at;
+        f.throttle = c[9];
+        f.unknown[0] = c[10];
+        f.unknown[1] = c[11];
+        f.fault = c[12];
+        f.erpm_raw = hwfoc__le16(c + 13);
+        f.voltage_raw = hwfoc__le16(c + 15);
+        f.current_raw = hwfoc__le16(c + 17);
+        f.esc_temp = c[19];
+        f.bec_temp = c[20];
+        f.motor_temp = c[21];
+        f.bec_voltage_raw = c[22];
+        f.bec_current_raw = c[23];
+        if (f.throttle > HWFOC_HW5_THROTTLE_MAX_PCT || f.voltage_raw > HWFOC_HW5_VOLTAGE_MAX_RAW) {
+            counter = &s->out_of_range; /* a corrupted frame whose CRC still matches */
+            v = HWFOC__REJECTED;
+        }
     }
     hwfoc__inc(counter);
-    if (v != HWFOC__FRAME) return v;
-    *len = hwfoc__hw5_len[kind];
-    if (kind != HWFOC_HW5_TELEMETRY) return HWFOC__FRAME; /* counted, not handed on */
-    f.offset = at;
-    f.throttle = c[9];
-    f.unknown[0] = c[10];
-    f.unknown[1] = c[11];
-    f.fault = c[12];
-    f.erpm_raw = hwfoc__le16(c + 13);
-    f.voltage_raw = hwfoc__le16(c + 15);
-    f.current_raw = hwfoc__le16(c + 17);
-    f.esc_temp = c[19];
-    f.bec_temp = c[20];
-    f.motor_temp = c[21];
-    f.bec_voltage_raw = c[22];
-    f.bec_current_raw = c[23];
-    if (any) ((hwfoc_hw5_cb)any)(ctx, &f);
-    return HWFOC__FRAME;
+    /* other kinds are counted, not handed on */
+    if (v == HWFOC__FRAME && kind == HWFOC_HW5_TELEMETRY && any) ((hwfoc_hw5_cb)any)(ctx, &f);
+    return v;
 }
 
 HWFOC__STREAM(hwfoc_hw5, hwfoc_hw5_decoder, hwfoc_hw5_cb, bytes, bytes_skipped,
