@@ -136,21 +136,7 @@ fn frames_handed_on_together_are_summarised_as_one_at_a_time() {
 /// row in the text, and its key in JSON is null; one it sends has both.
 #[test]
 fn a_quantity_the_protocol_does_not_send_has_no_text_row() {
-    let mut bytes = Vec::new();
-    for packet in 0..3 {
-        let frame = hwfoc::foc::DataFrame {
-            packet,
-            voltage_raw: 247,
-            ..Default::default()
-        };
-        bytes.extend_from_slice(&frame.encode());
-    }
-    let input = crate::Input::from_memory("three frames", bytes).unwrap();
-    let mut sources = crate::Sources::new(vec![input], Settings::DEFAULT);
-    let mut summary = Summary::new();
-    sources.run(&mut summary).unwrap();
-    let report = summary.report(&sources);
-    let text = report.text();
+    let (text, json) = summarised("three frames", foc_frames(0..3));
     assert!(text.contains("\nvoltage_v "), "{text}");
     assert!(text.contains("\ncap_temp_c "), "{text}");
     for absent in [
@@ -160,11 +146,36 @@ fn a_quantity_the_protocol_does_not_send_has_no_text_row() {
         "bec_current_a",
     ] {
         assert!(!text.contains(absent), "{absent} in\n{text}");
-        let field = &report.json()["escs"][0]["fields"][absent];
+        let field = &json["escs"][0]["fields"][absent];
         assert_eq!(field["min"], serde_json::Value::Null, "{absent}");
         assert!(field["unit"].is_string(), "{absent}");
     }
-    assert_eq!(report.json()["escs"][0]["fields"]["voltage_v"]["max"], 24.7);
+    assert_eq!(json["escs"][0]["fields"]["voltage_v"]["max"], 24.7);
+}
+
+/// HW-FOC data frames of these packet numbers (24.7 V), as bytes.
+fn foc_frames(packets: impl IntoIterator<Item = u16>) -> Vec<u8> {
+    packets
+        .into_iter()
+        .flat_map(|packet| {
+            hwfoc::foc::DataFrame {
+                packet,
+                voltage_raw: 247,
+                ..Default::default()
+            }
+            .encode()
+        })
+        .collect()
+}
+
+/// The summary of `bytes`, a raw input named `name`: its text and JSON.
+fn summarised(name: &str, bytes: Vec<u8>) -> (String, Value) {
+    let input = crate::Input::from_memory(name, bytes).unwrap();
+    let mut sources = crate::Sources::new(vec![input], Settings::DEFAULT);
+    let mut summary = Summary::new();
+    sources.run(&mut summary).unwrap();
+    let report = summary.report(&sources);
+    (report.text(), report.json())
 }
 
 /// HW5 has no packet counter: its loss is judged from the frames' times, at the running period
@@ -204,4 +215,36 @@ fn hw5_loss_is_judged_from_time() {
     let loss = acc.values.as_ref().unwrap().loss;
     assert_eq!((loss.lost, loss.unjudged), (3 + 1, 1));
     assert_eq!(loss.judged, 2 + 1 + 16 + 3);
+}
+
+/// A stream that changed format (HW5, then HW-FOC, no silence): the summary names both with
+/// their counts, its frames are both's, and the delivery says whose it is. (It said "frames
+/// 19", protocol hw5, delivery 100 %: issue 29.)
+#[test]
+fn a_stream_that_changed_format_names_both() {
+    let mut bytes = Vec::new();
+    for k in 0..658u32 {
+        let frame = hwfoc::hw5::TelemetryFrame {
+            throttle: 20,
+            erpm_raw: 1000 + (k % 7) as u16,
+            voltage_raw: 504,
+            ..Default::default()
+        };
+        bytes.extend_from_slice(&frame.encode());
+    }
+    bytes.extend(foc_frames([100, 101, 103]));
+    let (text, json) = summarised("hw5 then hw-foc", bytes);
+    assert!(text.contains("frames       661 data, 0 info"), "{text}");
+    assert!(
+        text.contains("formats      HW-FOC 3 data frames, HW5 658 data frames"),
+        "{text}"
+    );
+    assert!(
+        text.contains("delivery     75.00 % of HW-FOC data frames"),
+        "{text}"
+    );
+    let esc = &json["escs"][0];
+    assert_eq!(esc["frames"], 661);
+    assert_eq!(esc["formats"]["hw5"], 658);
+    assert_eq!(esc["formats"]["hw-foc"], 3);
 }

@@ -27,6 +27,12 @@ pub const DATA_PAYLOAD_LEN: usize = 18;
 
 const _: () = assert!(DATA_FRAME_LEN == 4 + DATA_PAYLOAD_LEN + 2);
 
+/// The largest input or output throttle a data frame can carry: 1024, 100 % (the protocol's
+/// range is 0..=1024). A frame with a larger one is no frame, whatever its checksum: the
+/// 16-bit sum is weak, and corruption that keeps it is counted as a rejected candidate
+/// ([`Stats::checksum_failures`](crate::foc::Stats::checksum_failures)), never recorded.
+pub const THROTTLE_MAX_RAW: u16 = 1024;
+
 /// One real-time telemetry frame (command 0x02), every field as the raw integer sent on the wire.
 ///
 /// Physical values come from the conversion methods, which take the user's [`Settings`] where a
@@ -89,7 +95,14 @@ impl FrameKind for DataFrame {
         let header = u32::from_le_bytes([d[0], d[1], d[2], d[3]]);
         let sum = u32::from(HEADER_SUM.wrapping_add(sum16(&d[4..22])));
         let found = u32::from(u16::from_le_bytes([d[22], d[23]]));
-        if (sum ^ found) | (header ^ Self::HEADER_WORD) == 0 {
+        // Both throttles (bytes 6..10, big-endian) over the largest at once: in each 16-bit
+        // lane, bit 15 is set after the add exactly when the lane is over it (no carry crosses
+        // a lane: 0x7FFF + 0x7BFF < 0x10000), or was set before.
+        let throttles = u32::from_be_bytes([d[6], d[7], d[8], d[9]]);
+        const BIAS: u32 = 0x8000 - 1 - THROTTLE_MAX_RAW as u32;
+        let over = (throttles & 0x7FFF_7FFF) + (BIAS << 16 | BIAS);
+        let implausible = (over | throttles) & 0x8000_8000;
+        if (sum ^ found) | (header ^ Self::HEADER_WORD) | implausible == 0 {
             Some(Self::from_verified(d))
         } else {
             None
@@ -104,7 +117,7 @@ impl sealed::Sealed for DataFrame {
     #[inline]
     fn read(frame: &[u8]) -> Result<Self, FrameError> {
         match frame.first_chunk::<DATA_FRAME_LEN>() {
-            Some(f) => Ok(Self::from_verified(f)),
+            Some(f) => Self::from_verified(f).plausible(),
             None => Err(FrameError::Truncated {
                 needed: DATA_FRAME_LEN,
                 got: frame.len(),
@@ -130,6 +143,23 @@ impl DataFrame {
     /// header and the checksum. Bytes after the frame are ignored.
     pub fn parse(bytes: &[u8]) -> Result<DataFrame, FrameError> {
         <Self as FrameKind>::parse(bytes)
+    }
+
+    /// The frame, if its values are in the protocol's ranges ([`THROTTLE_MAX_RAW`]).
+    fn plausible(self) -> Result<DataFrame, FrameError> {
+        for (field, raw) in [
+            ("input throttle", self.throttle_in_raw),
+            ("output throttle", self.throttle_out_raw),
+        ] {
+            if raw > THROTTLE_MAX_RAW {
+                return Err(FrameError::OutOfRange {
+                    field,
+                    raw,
+                    max: THROTTLE_MAX_RAW,
+                });
+            }
+        }
+        Ok(self)
     }
 
     /// Reads the fields of a frame whose header and checksum were already verified.
