@@ -143,8 +143,15 @@ typedef struct hwfoc_foc_stats {
 /** The decoder: caller-owned, zeroed by hwfoc_foc_init. */
 typedef struct hwfoc_foc_decoder {
     hwfoc_foc_stats stats;
+#ifdef HWFOC_NO_FOC_INFO
+    /* The candidate held starts at `len`: its first byte, always the sync byte, is not stored
+     * (the count of held bytes takes its place), so that the decoder takes 64 bytes. */
+    uint8_t len;
+    uint8_t held[HWFOC_FOC_MAX_LEN - 1u];
+#else
     uint8_t held[HWFOC_FOC_MAX_LEN];
     uint8_t len;
+#endif
 } hwfoc_foc_decoder;
 
 typedef void (*hwfoc_foc_cb)(void *ctx, const hwfoc_foc_frame *frame);
@@ -659,12 +666,23 @@ static size_t hwfoc__scan(const hwfoc__format *fmt, void *d, const uint8_t *data
     }
 }
 
+/* With HWFOC_NO_FOC_INFO, HW-FOC's held candidate starts at its count of held bytes (held_at ==
+ * len_at): the sync byte it stands for is put back before the candidate is read. */
+static inline void hwfoc__held_sync(const hwfoc__format *fmt, uint8_t *held, size_t m) {
+#ifdef HWFOC_NO_FOC_INFO
+    if (fmt->held_at == fmt->len_at && m > 0) held[0] = HWFOC_SYNC;
+#else
+    (void)fmt, (void)held, (void)m;
+#endif
+}
+
 static void hwfoc__feed(const hwfoc__format *fmt, void *d, const uint8_t *data, size_t n, hwfoc__any_cb cb, void *ctx) {
     uint8_t *held = HWFOC__AT(d, fmt->held_at, uint8_t);
     uint8_t *len = HWFOC__AT(d, fmt->len_at, uint8_t);
     size_t i, m, pos;
     for (i = 0; i < n; i++) {
         m = *len;
+        hwfoc__held_sync(fmt, held, m);
         held[m] = data[i];
         hwfoc__count_add(fmt, d, fmt->bytes_at, 1);
         /* The held candidate cannot be decided with this byte yet: just keep it. */
@@ -689,15 +707,17 @@ static inline size_t hwfoc__next_byte(const uint8_t *held, size_t n) {
 static void hwfoc__flush(const hwfoc__format *fmt, void *d, hwfoc__any_cb cb, void *ctx) {
     uint8_t *len = HWFOC__AT(d, fmt->len_at, uint8_t);
     size_t held = *len;
+    hwfoc__held_sync(fmt, HWFOC__AT(d, fmt->held_at, uint8_t), held);
     (void)hwfoc__scan(fmt, d, HWFOC__AT(d, fmt->held_at, uint8_t), held,
                       (hwfoc__count(fmt, d, fmt->bytes_at) - held) & HWFOC__MASK(fmt), 1, cb, ctx);
     *len = 0;
 }
 
 /* A format's public streaming functions over the shared layer. */
-#define HWFOC__STREAM(PFX, DEC, CB, BYTES, SKIPPED, LEN_FN, FIND, PRE, SILENT)              \
+/* HELD: the member the candidate held starts at (`held`, or HW-FOC's HWFOC__FOC_HELD). */
+#define HWFOC__STREAM(PFX, DEC, CB, BYTES, SKIPPED, HELD, LEN_FN, FIND, PRE, SILENT)        \
     static const hwfoc__format PFX##_format = {offsetof(DEC, stats.BYTES), offsetof(DEC, stats.SKIPPED), \
-                                               offsetof(DEC, held), offsetof(DEC, len), LEN_FN,     \
+                                               offsetof(DEC, HELD), offsetof(DEC, len), LEN_FN,     \
                                                FIND, PFX##_take, PRE HWFOC__NARROW_INIT(DEC, BYTES)};                              \
     void PFX##_feed(DEC *d, const uint8_t *data, size_t n, CB cb, void *ctx) {                      \
         hwfoc__feed(&PFX##_format, d, data, n, (hwfoc__any_cb)cb, ctx);                             \
@@ -829,7 +849,12 @@ static int hwfoc_foc_take(void *dec, const uint8_t *c, size_t n, uint64_t at, in
     return v;
 }
 
-HWFOC__STREAM(hwfoc_foc, hwfoc_foc_decoder, hwfoc_foc_cb, bytes, bytes_skipped,
+#ifdef HWFOC_NO_FOC_INFO
+#define HWFOC__FOC_HELD len
+#else
+#define HWFOC__FOC_HELD held
+#endif
+HWFOC__STREAM(hwfoc_foc, hwfoc_foc_decoder, hwfoc_foc_cb, bytes, bytes_skipped, HWFOC__FOC_HELD,
               hwfoc_foc_candidate_len, hwfoc__foc_find, NULL,
               hwfoc_sequence_line_silent(&d->stats.packets, max_frames, HWFOC_COUNTER16_MAX))
 #endif
@@ -939,7 +964,7 @@ static void hwfoc__dl_silent(hwfoc_dl_stats *s, uint32_t max_frames) {
     for (ch = 0; ch < HWFOC_DL_CHANNELS; ch++) hwfoc_sequence_line_silent(&s->channels[ch], esc, HWFOC_COUNTER16_MAX);
 }
 
-HWFOC__STREAM(hwfoc_dl, hwfoc_dl_decoder, hwfoc_dl_cb, bytes, bytes_skipped,
+HWFOC__STREAM(hwfoc_dl, hwfoc_dl_decoder, hwfoc_dl_cb, bytes, bytes_skipped, held,
               hwfoc_dl_candidate_len, hwfoc__dl_find, NULL,
               hwfoc__dl_silent(&d->stats, max_frames))
 #endif
@@ -1036,7 +1061,7 @@ static int hwfoc_v3_take(void *dec, const uint8_t *c, size_t n, uint64_t at, int
     return HWFOC__FRAME;
 }
 
-HWFOC__STREAM(hwfoc_v3, hwfoc_v3_decoder, hwfoc_v3_cb, counts.bytes, counts.bytes_skipped,
+HWFOC__STREAM(hwfoc_v3, hwfoc_v3_decoder, hwfoc_v3_cb, counts.bytes, counts.bytes_skipped, held,
               hwfoc__next_byte, hwfoc__find_sync, NULL,
               hwfoc_sequence_line_silent(&d->stats.counts.counter, max_frames, HWFOC_COUNTER24_MAX))
 #endif
@@ -1222,7 +1247,7 @@ static int hwfoc_v4_take(void *dec, const uint8_t *c, size_t n, uint64_t at, int
     return HWFOC__FRAME;
 }
 
-HWFOC__STREAM(hwfoc_v4, hwfoc_v4_decoder, hwfoc_v4_cb, counts.bytes, counts.bytes_skipped,
+HWFOC__STREAM(hwfoc_v4, hwfoc_v4_decoder, hwfoc_v4_cb, counts.bytes, counts.bytes_skipped, held,
               hwfoc__next_byte, hwfoc__find_sync, hwfoc_v4_trailer,
               hwfoc_sequence_line_silent(&d->stats.counts.counter, max_frames, HWFOC_COUNTER24_MAX))
 #endif
@@ -1348,7 +1373,7 @@ static int hwfoc_hw5_take(void *dec, const uint8_t *c, size_t n, uint64_t at, in
     return v;
 }
 
-HWFOC__STREAM(hwfoc_hw5, hwfoc_hw5_decoder, hwfoc_hw5_cb, bytes, bytes_skipped,
+HWFOC__STREAM(hwfoc_hw5, hwfoc_hw5_decoder, hwfoc_hw5_cb, bytes, bytes_skipped, held,
               hwfoc__next_byte, hwfoc__hw5_find, NULL,
               (void)d; (void)max_frames)
 #endif
