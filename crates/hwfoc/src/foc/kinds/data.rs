@@ -95,18 +95,15 @@ impl FrameKind for DataFrame {
         let header = u32::from_le_bytes([d[0], d[1], d[2], d[3]]);
         let sum = u32::from(HEADER_SUM.wrapping_add(sum16(&d[4..22])));
         let found = u32::from(u16::from_le_bytes([d[22], d[23]]));
-        // Both throttles (bytes 6..10, big-endian) over the largest at once: in each 16-bit
-        // lane, bit 15 is set after the add exactly when the lane is over it (no carry crosses
-        // a lane: 0x7FFF + 0x7BFF < 0x10000), or was set before.
-        let throttles = u32::from_be_bytes([d[6], d[7], d[8], d[9]]);
-        const BIAS: u32 = 0x8000 - 1 - THROTTLE_MAX_RAW as u32;
-        let over = (throttles & 0x7FFF_7FFF) + (BIAS << 16 | BIAS);
-        let implausible = (over | throttles) & 0x8000_8000;
-        if (sum ^ found) | (header ^ Self::HEADER_WORD) | implausible == 0 {
-            Some(Self::from_verified(d))
-        } else {
-            None
+        if (sum ^ found) | (header ^ Self::HEADER_WORD) != 0 {
+            return None;
         }
+        // The throttles' range (bytes 6..10, big-endian) only once the checksum matched: both
+        // high bytes under 4 (0..=1023) at once, else each one exactly.
+        let throttle = |at: usize| u16::from_be_bytes([d[at], d[at + 1]]);
+        let plausible = (d[6] | d[8]) < (THROTTLE_MAX_RAW >> 8) as u8
+            || throttle(6).max(throttle(8)) <= THROTTLE_MAX_RAW;
+        plausible.then(|| Self::from_verified(d))
     }
 }
 
