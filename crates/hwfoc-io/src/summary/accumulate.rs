@@ -411,17 +411,21 @@ impl Values {
     }
 }
 
-/// `protocol`'s place in [`Protocol::ALL`].
+/// `protocol`'s place in [`Protocol::ALL`]: its discriminant (a search per frame cost the
+/// summary instructions).
+#[inline(always)]
 const fn protocol_index(protocol: Protocol) -> usize {
+    protocol as usize
+}
+
+// [`Protocol::ALL`] lists the protocols in their declaration order.
+const _: () = {
     let mut i = 0;
     while i < Protocol::ALL.len() {
-        if Protocol::ALL[i] as u8 == protocol as u8 {
-            return i;
-        }
+        assert!(Protocol::ALL[i] as usize == i);
         i += 1;
     }
-    0
-}
+};
 
 /// Whether the summary keeps the raw integers of `protocol`'s frames (HW-FOC, DataLink: one
 /// linear conversion per ESC, the fast path) rather than their values ([`Values`]).
