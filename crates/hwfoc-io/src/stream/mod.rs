@@ -126,8 +126,8 @@ fn emit_other(d: detect::Decoded, emit: &mut impl FnMut(Option<u8>, u64, &Frame)
 }
 
 /// The decoder of a stream: of every protocol at once (the bytes tell which), or of the one
-/// protocol a user forced. (Its arms' sizes differ, a few hundred bytes at most: one per
-/// stream, held inline, so that the decoder of every byte is not behind a pointer.)
+/// protocol a user forced. (Its arms' sizes differ, by the 8 KiB `detect` keeps while locked at
+/// most: one per stream, held inline, so that the decoder of every byte is not behind a pointer.)
 #[derive(Debug)]
 #[allow(clippy::large_enum_variant)]
 enum Wire {
@@ -478,13 +478,14 @@ impl EscLink {
         !matches!(self, EscLink::HwV4(_) | EscLink::HwV3(_))
     }
 
-    /// Frames rejected by their checksum (behind a hub: the hub frames' CRC failures; 0 for a
-    /// format without checksum).
+    /// Frames rejected by their checksum, or whose checksum matched but whose values are out of
+    /// their protocol's range (behind a hub: the hub frames' CRC failures; 0 for a format
+    /// without checksum).
     pub fn checksum_failures(&self) -> u32 {
         match self {
             EscLink::Wire(s) => s.checksum_failures(),
             EscLink::Hub { hub, .. } => hub.crc_failures(),
-            EscLink::Hw5(s) => s.crc_failures(),
+            EscLink::Hw5(s) => s.crc_failures().saturating_add(s.out_of_range()),
             EscLink::Can(c) => c.node_stats.crc_errors(),
             EscLink::HwV4(_) | EscLink::HwV3(_) => 0,
         }
@@ -532,8 +533,22 @@ impl EscLink {
         }
     }
 
-    /// Jumps of the packet numbers that no loss explains.
+    /// Packet numbers that came right after the next one (two adjacent frames swapped): not
+    /// lost, no restart.
+    pub fn reordered_packets(&self) -> u32 {
+        match self.counting() {
+            Some(Counting::Bits16(c)) => c.reordered(),
+            Some(Counting::Bits24(c)) => c.reordered(),
+            None => 0,
+        }
+    }
+
+    /// Jumps of the packet numbers that no loss explains (on a CAN bus: the node's transfers
+    /// after a silence of the whole bus).
     pub fn restarts(&self) -> u32 {
+        if let EscLink::Can(c) = self {
+            return c.node_stats.restarts();
+        }
         match self.counting() {
             Some(Counting::Bits16(c)) => c.restarts(),
             Some(Counting::Bits24(c)) => c.restarts(),
@@ -1269,6 +1284,17 @@ mod tests {
         );
         assert_eq!(got, [times[24]]);
         assert_eq!(stream.held_since(), None);
+    }
+
+    /// Two adjacent frames swapped on the way: one reordering, no loss, no restart, every
+    /// frame delivered (they counted a restart and 2 lost packets, 96 %: issue 29).
+    #[test]
+    fn two_swapped_frames_are_a_reordering() {
+        let s = run(&[timed(&[1, 2, 4, 3, 5, 6], 10.0)], 7);
+        assert_eq!(s.frames(), 6);
+        assert_eq!((s.lost_packets(), s.restarts()), (0, 0));
+        assert_eq!(s.reordered_packets(), 1);
+        assert_eq!(s.delivery_ratio(), Some(1.0));
     }
 
     /// An ESC that restarts after a silence counts a restart, not the packets its new numbers

@@ -319,6 +319,17 @@ pub enum FrameError {
         /// Command byte (byte 3).
         command: u8,
     },
+    /// Checksum correct, but a value outside the range the protocol allows (a throttle over
+    /// [`THROTTLE_MAX_RAW`](crate::foc::THROTTLE_MAX_RAW)): a corrupted frame whose weak
+    /// checksum still matches.
+    OutOfRange {
+        /// The field.
+        field: &'static str,
+        /// Its raw value.
+        raw: u16,
+        /// The largest the protocol allows.
+        max: u16,
+    },
     /// A device-information candidate whose text holds a byte that is not ASCII: not a real
     /// frame (typically a cut one with another frame behind it).
     NotText {
@@ -350,6 +361,10 @@ impl fmt::Display for FrameError {
             FrameError::UnknownCommand { version, command } => write!(
                 f,
                 "unknown version 0x{version:02X} / command 0x{command:02X}"
+            ),
+            FrameError::OutOfRange { field, raw, max } => write!(
+                f,
+                "{field} {raw} out of the protocol's range 0..={max}: a corrupted frame whose checksum still matches"
             ),
             FrameError::NotText { offset, found } => write!(
                 f,
