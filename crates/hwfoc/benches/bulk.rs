@@ -31,11 +31,16 @@
 //! `-- noisy/frames` or `-- v4_` for some measurements). Before measuring, each stream is
 //! decoded once and checked: every intact frame found (of the noisy V3 and V4 streams, the share
 //! found is shown), `Decoder` and `frames` in agreement.
+//!
+//! With `HWFOC_BULK_ONCE=clean` (or `noisy`, `hostile`) in the environment, the bench instead
+//! makes that stream, checks it, decodes it once with `frames` in [`decode_once`] and exits
+//! (with `HWFOC_BULK_DECODES=N`, N times, 0 included): what `scripts/instructions.sh` counts the
+//! instructions of (cachegrind: a run with one decode less one with none).
 
 use std::hint::black_box;
 use std::time::Duration;
 
-use criterion::{BenchmarkGroup, Criterion, Throughput, criterion_group, criterion_main};
+use criterion::{BenchmarkGroup, Criterion, Throughput, criterion_group};
 use hwfoc::Status;
 use hwfoc::datalink::{self, FRAME_LEN};
 use hwfoc::foc;
@@ -750,6 +755,37 @@ fn bulk(c: &mut Criterion) {
     }
 }
 
+/// One bulk decode of `buf` (the function whose instructions `scripts/instructions.sh` counts).
+#[inline(never)]
+fn decode_once(buf: &[u8]) -> u64 {
+    frames(black_box(buf)).fold(0, |acc, d| fold(acc, &d))
+}
+
+/// The `HWFOC_BULK_ONCE` mode (see the module's documentation): one stream decoded once.
+fn once(name: &str) {
+    let (buf, expected) = match name {
+        "clean" => clean_stream(),
+        "noisy" => noisy_stream(false),
+        "hostile" => noisy_stream(true),
+        other => {
+            eprintln!("HWFOC_BULK_ONCE={other}: not a stream (clean, noisy, hostile)");
+            std::process::exit(2);
+        }
+    };
+    check(name, &buf, &expected);
+    let decodes: u32 = match std::env::var("HWFOC_BULK_DECODES").map(|n| n.parse()) {
+        Err(_) => 1,
+        Ok(Ok(n)) => n,
+        Ok(Err(e)) => {
+            eprintln!("HWFOC_BULK_DECODES: not a count ({e})");
+            std::process::exit(2);
+        }
+    };
+    for _ in 0..decodes {
+        println!("{name}: {} bytes, fold {:x}", buf.len(), decode_once(&buf));
+    }
+}
+
 criterion_group! {
     name = benches;
     config = Criterion::default()
@@ -758,4 +794,11 @@ criterion_group! {
         .measurement_time(Duration::from_secs(3));
     targets = bulk, older
 }
-criterion_main!(benches);
+fn main() {
+    if let Ok(name) = std::env::var("HWFOC_BULK_ONCE") {
+        once(&name);
+        return;
+    }
+    benches();
+    Criterion::default().configure_from_args().final_summary();
+}
