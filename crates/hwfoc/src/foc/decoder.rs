@@ -411,11 +411,7 @@ pub(crate) mod tests {
     fn a_candidate_is_tried_as_the_kind_of_its_whole_header() {
         use crate::foc::InfoFrame;
         use crate::wire::Checksum;
-        let data = DataFrame {
-            packet: 3,
-            ..Default::default()
-        }
-        .encode();
+        let data = DataFrame::default().encode();
         let mut fake = data;
         fake[3] = 0x01; // the info frame's command after the data frame's length byte
         Checksum::Sum16Le.seal(&mut fake);
