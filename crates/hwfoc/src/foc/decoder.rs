@@ -404,6 +404,35 @@ pub(crate) mod tests {
         assert_matches_a_plain_search(find_header, &[0x16, 0x4C], near);
     }
 
+    /// A candidate is tried only as the kind whose whole header it carries: one with the data
+    /// frame's length byte but another command, its sum sealed as a data frame's, is rejected
+    /// (and costs one byte), and the frames after it are found.
+    #[test]
+    fn a_candidate_is_tried_as_the_kind_of_its_whole_header() {
+        use crate::foc::InfoFrame;
+        use crate::wire::Checksum;
+        let data = DataFrame::default().encode();
+        let mut fake = data;
+        fake[3] = 0x01; // the info frame's command after the data frame's length byte
+        Checksum::Sum16Le.seal(&mut fake);
+        let info = InfoFrame::new("XR_FOC_ESC", "", "", "").map(|i| i.encode());
+        let info = info.unwrap_or([0; 77]);
+        let mut wire = [0u8; 24 + 77 + 24];
+        wire[..24].copy_from_slice(&fake);
+        wire[24..24 + 77].copy_from_slice(&info);
+        wire[24 + 77..].copy_from_slice(&data);
+        let mut it = frames(&wire);
+        let mut offsets = [0u64; 3];
+        let found = it
+            .by_ref()
+            .zip(&mut offsets)
+            .map(|(d, o)| *o = d.offset)
+            .count();
+        assert_eq!(&offsets[..found], [24, 24 + 77]);
+        assert_eq!(it.stats().checksum_failures(), 1);
+        assert_eq!(it.stats().bytes_skipped(), 24);
+    }
+
     #[test]
     fn state_is_under_128_bytes() {
         assert_eq!(core::mem::size_of::<Decoder>(), 124);

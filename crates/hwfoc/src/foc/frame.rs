@@ -122,8 +122,13 @@ macro_rules! frame_kinds {
                 stats: &mut Stats,
             ) -> Option<(usize, Frame)> {
                 let at = *pos;
+                // One load and one compare per kind: only the kind whose whole header the
+                // candidate carries checks it further (kinds' headers differ), so a fake header
+                // costs no checksum, and a kind's frame none of another kind's checks.
+                let header = data[at..].first_chunk::<4>().map(|h| u32::from_le_bytes(*h));
                 $(
-                    if let Some(frame) = <$kind as FrameKind>::accept(&data[at..]) {
+                    if header == Some(<$kind as FrameKind>::HEADER_WORD) {
+                        let frame = <$kind as FrameKind>::accept(&data[at..])?;
                         frame.count(stats);
                         *pos = at + <$kind as FrameKind>::LEN;
                         return Some((at, Frame::$arm(frame)));
