@@ -35,7 +35,7 @@ use hwfoc_io::write::{Export, ExportError, OutputFormat, Provenance, WriteError}
 use hwfoc_io::write::{FileId, Staging, create_file, same_file};
 
 // Check.
-use hwfoc_io::check::{Analyser, EscId, Finding, Severity, Span, Threshold, Value};
+use hwfoc_io::check::{Analyser, EscId, Finding, Severity, Span, Threshold, Value as CheckValue};
 use hwfoc_io::check::{
     Baseline, Check, EscBaseline, EscSeries, LinkFigures, Sample, analyse, check,
 };
