@@ -21,6 +21,33 @@ impl Limits {
     pub const fn new(warn: f64, critical: f64) -> Limits {
         Limits { warn, critical }
     }
+
+    /// How bad `value` is: limits whose critical value is below the warning one (a minimum
+    /// voltage) judge values below them, others values above them.
+    pub fn judge(&self, value: f64) -> super::Severity {
+        let beyond = |limit: f64| {
+            if self.critical < self.warn {
+                value <= limit
+            } else {
+                value >= limit
+            }
+        };
+        if beyond(self.critical) {
+            super::Severity::Critical
+        } else if beyond(self.warn) {
+            super::Severity::Warning
+        } else {
+            super::Severity::Ok
+        }
+    }
+
+    /// The limit a value judged `severity` crossed (the warning one for an ok value).
+    pub fn crossed(&self, severity: super::Severity) -> f64 {
+        match severity {
+            super::Severity::Critical => self.critical,
+            _ => self.warn,
+        }
+    }
 }
 
 /// `[check.heat]`: temperatures, judged on their peak and on sustained heat.
@@ -58,11 +85,11 @@ impl Default for HeatConfig {
 pub struct ImbalanceConfig {
     /// Throttle below which motors are not compared, % (default 15).
     pub min_throttle_pct: f64,
-    /// Current above the siblings' median at the same throttle, % (default 25 / 50).
+    /// Current above the siblings' median at the same throttle, % (default 30 / 60).
     pub current_pct: Limits,
     /// Rpm away from the siblings' median at the same throttle, % (default 10 / 20).
     pub rpm_pct: Limits,
-    /// Time at equal throttle needed to judge, s (default 3).
+    /// The window over which a deviation must hold, s (default 3): its median is judged.
     pub min_time_s: f64,
 }
 
@@ -70,7 +97,7 @@ impl Default for ImbalanceConfig {
     fn default() -> ImbalanceConfig {
         ImbalanceConfig {
             min_throttle_pct: 15.0,
-            current_pct: Limits::new(25.0, 50.0),
+            current_pct: Limits::new(30.0, 60.0),
             rpm_pct: Limits::new(10.0, 20.0),
             min_time_s: 3.0,
         }
@@ -85,6 +112,8 @@ pub struct DriftConfig {
     pub current_per_rpm_pct: Limits,
     /// Rpm per throttle below the baseline's, % (default 8 / 15).
     pub rpm_per_throttle_pct: Limits,
+    /// The window over which a drift must hold, s (default 3): its median is judged.
+    pub min_time_s: f64,
 }
 
 impl Default for DriftConfig {
@@ -92,6 +121,7 @@ impl Default for DriftConfig {
         DriftConfig {
             current_per_rpm_pct: Limits::new(15.0, 30.0),
             rpm_per_throttle_pct: Limits::new(8.0, 15.0),
+            min_time_s: 3.0,
         }
     }
 }
@@ -106,8 +136,6 @@ pub struct BatteryConfig {
     /// Lowest voltage per cell under load, V (default 3.3 / 3.0: below it, read as `warn` >
     /// value).
     pub min_cell_v: Limits,
-    /// Internal resistance per cell, milliohm (default 12 / 20).
-    pub resistance_mohm_per_cell: Limits,
     /// Rise of the internal resistance against the baseline's or the first recording's, %
     /// (default 30 / 60).
     pub resistance_rise_pct: Limits,
@@ -118,7 +146,6 @@ impl Default for BatteryConfig {
         BatteryConfig {
             cells: None,
             min_cell_v: Limits::new(3.3, 3.0),
-            resistance_mohm_per_cell: Limits::new(12.0, 20.0),
             resistance_rise_pct: Limits::new(30.0, 60.0),
         }
     }

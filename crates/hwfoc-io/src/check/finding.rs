@@ -172,6 +172,37 @@ pub struct Finding {
 }
 
 impl Finding {
+    /// An ok finding of `analyser` about the ESC of `series`, without evidence yet.
+    pub fn about(analyser: Analyser, series: &super::EscSeries) -> Finding {
+        Finding {
+            analyser,
+            severity: Severity::Ok,
+            esc: Some(series.esc.clone()),
+            recording: series.recording.clone(),
+            window: None,
+            values: Vec::new(),
+            threshold: None,
+            message: String::new(),
+        }
+    }
+
+    /// With the value `name` in `unit`.
+    pub fn value(mut self, name: &str, value: f64, unit: &str) -> Finding {
+        self.values.push(Value::new(name, value, unit));
+        self
+    }
+
+    /// Judged `severity` against the limit `limit` of value `name`.
+    pub fn judged(mut self, severity: Severity, name: &str, limit: f64, unit: &str) -> Finding {
+        self.severity = severity;
+        self.threshold = Some(Threshold {
+            name: name.to_string(),
+            value: limit,
+            unit: unit.to_string(),
+        });
+        self
+    }
+
     /// The worst severity of `findings` ([`Severity::Ok`] when there are none).
     pub fn worst(findings: &[Finding]) -> Severity {
         findings

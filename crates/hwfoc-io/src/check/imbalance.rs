@@ -1,8 +1,194 @@
-//! The imbalance analyser (`docs/CHECKS.md`).
+//! Imbalance between motors: at equal throttle, one ESC's current or rpm far from its
+//! siblings' (the other ESCs of its recording). Each sample is compared with the median, over
+//! the siblings, of their median at its throttle (bins of 5 %), so that motors that lag each
+//! other are compared alike; the deviation is judged on its median over a window.
 
-use super::{EscSeries, Finding, ImbalanceConfig};
+use std::collections::BTreeMap;
+
+use super::baseline::{MIN_BIN_SAMPLES, THROTTLE_BIN_PCT};
+use super::stats::{binned_medians, median, sustained};
+use super::{Analyser, EscSeries, Finding, ImbalanceConfig, Limits, Sample, Severity};
+
+/// Siblings needed to tell which motor is off: with two, either could be.
+const MIN_ESCS: usize = 3;
+
+/// A sibling median below this is not compared with (near idle, a ratio means nothing), A or
+/// rev/min.
+const MIN_REFERENCE: [f64; 2] = [1.0, 100.0];
 
 /// Adds the findings of each recording's ESCs in `series` to `out`.
 pub(super) fn analyse(series: &[EscSeries], config: &ImbalanceConfig, out: &mut Vec<Finding>) {
-    let _ = (series, config, out);
+    let mut recordings: BTreeMap<&str, Vec<&EscSeries>> = BTreeMap::new();
+    for s in series {
+        recordings.entry(&s.recording).or_default().push(s);
+    }
+    for escs in recordings.values().filter(|e| e.len() >= MIN_ESCS) {
+        for (what, get, limits, both_ways, min_ref) in [
+            (
+                "current",
+                (|s: &Sample| s.current_a) as fn(&Sample) -> Option<f32>,
+                config.current_pct,
+                false,
+                MIN_REFERENCE[0],
+            ),
+            (
+                "rpm",
+                |s: &Sample| s.rpm,
+                config.rpm_pct,
+                true,
+                MIN_REFERENCE[1],
+            ),
+        ] {
+            let curves: Vec<BTreeMap<i64, f64>> = escs
+                .iter()
+                .map(|s| curve(s, get, config.min_throttle_pct))
+                .collect();
+            for (i, s) in escs.iter().enumerate() {
+                let others: Vec<&BTreeMap<i64, f64>> = curves
+                    .iter()
+                    .enumerate()
+                    .filter(|&(j, c)| j != i && !c.is_empty())
+                    .map(|(_, c)| c)
+                    .collect();
+                if others.len() + 1 < MIN_ESCS || curves[i].is_empty() {
+                    continue;
+                }
+                let reference = |bin: i64| {
+                    let mut v: Vec<f64> =
+                        others.iter().filter_map(|c| c.get(&bin).copied()).collect();
+                    if v.len() + 1 < MIN_ESCS {
+                        return None;
+                    }
+                    median(&mut v).filter(|&r| r >= min_ref)
+                };
+                let points: Vec<(f64, f64)> = s
+                    .samples
+                    .iter()
+                    .filter_map(|x| {
+                        let throttle = f64::from(x.throttle_pct?);
+                        if throttle < config.min_throttle_pct {
+                            return None;
+                        }
+                        let r = reference((throttle / THROTTLE_BIN_PCT).floor() as i64)?;
+                        let d = (f64::from(get(x)?) - r) / r * 100.0;
+                        Some((x.t, if both_ways { d.abs() } else { d }))
+                    })
+                    .collect();
+                if let Some(f) = judge(s, what, &points, limits, config.min_time_s) {
+                    out.push(f);
+                }
+            }
+        }
+    }
+}
+
+/// The median of `get` per throttle bin of `series`, above `min_throttle`.
+fn curve(
+    series: &EscSeries,
+    get: fn(&Sample) -> Option<f32>,
+    min_throttle: f64,
+) -> BTreeMap<i64, f64> {
+    binned_medians(
+        series.samples.iter().filter_map(|s| {
+            let throttle = f64::from(s.throttle_pct?);
+            (throttle >= min_throttle).then_some((throttle, f64::from(get(s)?)))
+        }),
+        THROTTLE_BIN_PCT,
+        MIN_BIN_SAMPLES,
+    )
+    .into_iter()
+    .collect()
+}
+
+/// The finding of one ESC's deviation `points` `(t, %)` from its siblings.
+fn judge(
+    series: &EscSeries,
+    what: &str,
+    points: &[(f64, f64)],
+    limits: Limits,
+    window_s: f64,
+) -> Option<Finding> {
+    let s = sustained(points, window_s, limits.warn)?;
+    let severity = limits.judge(s.worst);
+    let name = format!("{what}_vs_siblings");
+    let mut f = Finding::about(Analyser::Imbalance, series)
+        .value(&name, s.worst, "%")
+        .judged(severity, &name, limits.crossed(severity), "%");
+    f.window = s.span.filter(|_| severity > Severity::Ok);
+    let direction = if what == "rpm" { "away from" } else { "above" };
+    f.message = format!(
+        "{what} {:.0} % {direction} its siblings' at the same throttle (median over {window_s} s){}",
+        s.worst,
+        match severity {
+            Severity::Ok => format!(", within {} %", limits.warn),
+            _ => format!(": at or beyond {} %", limits.crossed(severity)),
+        }
+    );
+    Some(f)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::tests::series_of;
+    use super::*;
+
+    /// Four ESCs on a throttle staircase; ESC `bad` draws `factor` times the current from
+    /// `from_s` on.
+    fn flight(bad: usize, factor: f32, from_s: f64) -> Vec<EscSeries> {
+        (0..4)
+            .map(|n| {
+                let load = [1.0, 1.1, 0.92, 1.05][n];
+                series_of(
+                    n,
+                    (0..1200).map(|i| {
+                        let t = i as f64 * 0.05;
+                        let throttle = 20.0 + 10.0 * ((t / 6.0).floor() % 6.0) as f32;
+                        let mut current = load * 0.006 * throttle * throttle;
+                        if n == bad && t >= from_s {
+                            current *= factor;
+                        }
+                        Sample {
+                            t,
+                            throttle_pct: Some(throttle),
+                            rpm: Some(100.0 * throttle),
+                            current_a: Some(current),
+                            ..Sample::default()
+                        }
+                    }),
+                )
+            })
+            .collect()
+    }
+
+    fn findings(series: &[EscSeries]) -> Vec<Finding> {
+        let mut out = Vec::new();
+        analyse(series, &ImbalanceConfig::default(), &mut out);
+        out
+    }
+
+    #[test]
+    fn motors_within_their_spread_are_ok() {
+        let out = findings(&flight(0, 1.0, 0.0));
+        assert_eq!(out.len(), 8);
+        assert!(out.iter().all(|f| f.severity == Severity::Ok), "{out:?}");
+    }
+
+    #[test]
+    fn a_motor_drawing_half_as_much_again_is_found_from_when_it_starts() {
+        let out = findings(&flight(2, 1.5, 30.0));
+        let bad: Vec<_> = out.iter().filter(|f| f.severity > Severity::Ok).collect();
+        assert_eq!(bad.len(), 1, "{out:?}");
+        assert_eq!(bad[0].esc.as_ref().unwrap().number, 2);
+        assert_eq!(bad[0].severity, Severity::Warning);
+        let w = bad[0].window.unwrap();
+        assert!(
+            (28.0..=31.0).contains(&w.start_s) && w.end_s > 59.0,
+            "{w:?}"
+        );
+    }
+
+    #[test]
+    fn two_escs_are_not_judged() {
+        assert!(findings(&flight(0, 2.0, 0.0)[..2]).is_empty());
+    }
 }

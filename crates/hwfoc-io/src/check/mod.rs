@@ -151,3 +151,29 @@ pub fn check(
 fn period_s(protocol: Protocol) -> f64 {
     protocol.frame_period().map_or(0.05, |d| d.as_secs_f64())
 }
+
+#[cfg(test)]
+pub(crate) mod tests {
+    use super::*;
+
+    /// ESC `number`'s series of `samples` in recording `flight`, with perfect link figures.
+    pub(crate) fn series_of(number: usize, samples: impl Iterator<Item = Sample>) -> EscSeries {
+        let samples: Vec<Sample> = samples.collect();
+        EscSeries {
+            esc: EscId {
+                number,
+                label: format!("esc {number}"),
+            },
+            recording: "flight".to_string(),
+            protocol: Protocol::HwFoc,
+            timed: true,
+            link: Some(LinkFigures {
+                frames: samples.len() as u64,
+                counts_packets: true,
+                has_checksum: true,
+                ..LinkFigures::default()
+            }),
+            samples,
+        }
+    }
+}
