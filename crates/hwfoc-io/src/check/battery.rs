@@ -11,11 +11,11 @@ const FULL_CELL_V: f64 = 4.25;
 /// Samples further apart than this are no step, s.
 const MAX_STEP_S: f64 = 0.25;
 
-/// The smallest current step read, A (and a tenth of the ESC's peak current).
+/// The smallest current step read, A (and a twentieth of the ESC's peak current).
 const MIN_STEP_A: f64 = 2.0;
 
 /// Steps an estimate needs.
-const MIN_STEPS: usize = 5;
+const MIN_STEPS: usize = 3;
 
 /// Current above which the battery is under load, A.
 const LOAD_A: f64 = 1.0;
@@ -121,7 +121,7 @@ pub(super) fn resistance_mohm(series: &EscSeries) -> Option<f64> {
         .filter_map(|s| s.current_a)
         .map(f64::from)
         .fold(0.0, f64::max);
-    let min_step = MIN_STEP_A.max(peak / 10.0);
+    let min_step = MIN_STEP_A.max(peak / 20.0);
     let (mut vi, mut ii, mut steps) = (0.0, 0.0, 0);
     for w in series.samples.windows(2) {
         let (a, b) = (&w[0], &w[1]);

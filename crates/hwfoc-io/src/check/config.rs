@@ -89,8 +89,9 @@ pub struct ImbalanceConfig {
     pub current_pct: Limits,
     /// Rpm away from the siblings' median at the same throttle, % (default 10 / 20).
     pub rpm_pct: Limits,
-    /// The window over which a deviation must hold, s (default 3): its median is judged.
-    pub min_time_s: f64,
+    /// The window each ESC's curve is compared in, s (default 10; windows overlap by half, a
+    /// deviation must hold in two in a row).
+    pub window_s: f64,
 }
 
 impl Default for ImbalanceConfig {
@@ -99,7 +100,7 @@ impl Default for ImbalanceConfig {
             min_throttle_pct: 15.0,
             current_pct: Limits::new(30.0, 60.0),
             rpm_pct: Limits::new(10.0, 20.0),
-            min_time_s: 3.0,
+            window_s: 10.0,
         }
     }
 }
@@ -112,8 +113,9 @@ pub struct DriftConfig {
     pub current_per_rpm_pct: Limits,
     /// Rpm per throttle below the baseline's, % (default 8 / 15).
     pub rpm_per_throttle_pct: Limits,
-    /// The window over which a drift must hold, s (default 3): its median is judged.
-    pub min_time_s: f64,
+    /// The window the ESC's curve is compared in, s (default 10; windows overlap by half, a
+    /// drift must hold in two in a row).
+    pub window_s: f64,
 }
 
 impl Default for DriftConfig {
@@ -121,7 +123,7 @@ impl Default for DriftConfig {
         DriftConfig {
             current_per_rpm_pct: Limits::new(15.0, 30.0),
             rpm_per_throttle_pct: Limits::new(8.0, 15.0),
-            min_time_s: 3.0,
+            window_s: 10.0,
         }
     }
 }

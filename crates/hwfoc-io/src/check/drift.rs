@@ -1,13 +1,15 @@
 //! Drift from a baseline: each ESC's current per rpm and rpm per throttle against the medians
-//! its healthy flights gave ([`Baseline`]), judged on the median over a window. More current
-//! for the same rpm points to a bearing or a motor going, or a heavier prop; less rpm for the
-//! same throttle to a motor losing its grip (or a sagging battery).
+//! its healthy flights gave ([`Baseline`]). In each window of time the ESC's medians per bin
+//! are compared with the baseline's; the window's drift is the median over its bins, and it
+//! must hold in two windows in a row. More current for the same rpm points to a bearing or a
+//! motor going, or a heavier prop; less rpm for the same throttle to a motor losing its grip
+//! (or a sagging battery).
 
 use std::collections::BTreeMap;
 
 use super::baseline::{RPM_BIN, THROTTLE_BIN_PCT};
-use super::stats::sustained;
-use super::{Analyser, Baseline, DriftConfig, EscSeries, Finding, Limits, Severity};
+use super::stats::{binned_medians, held, median, windows};
+use super::{Analyser, Baseline, DriftConfig, EscSeries, Finding, Limits, Sample, Severity, Span};
 
 /// A baseline value below this is not compared with, A or rev/min (near idle, a ratio means
 /// nothing).
@@ -15,6 +17,12 @@ const MIN_REFERENCE: [f64; 2] = [1.0, 100.0];
 
 /// Throttle below which rpm per throttle is not judged, %.
 const MIN_THROTTLE_PCT: f64 = 15.0;
+
+/// Samples a bin of a window needs.
+const MIN_BIN_SAMPLES: usize = 3;
+
+/// How one curve is read from a sample: `(x, y)`.
+type Point = fn(&Sample) -> Option<(f64, f64)>;
 
 /// Adds the findings of `series` against `baseline` to `out`.
 pub(super) fn analyse(
@@ -27,44 +35,51 @@ pub(super) fn analyse(
         let Some(base) = baseline.esc.get(&s.esc.number.to_string()) else {
             continue;
         };
-        let current = table(&base.rpm_bin, &base.current_a, RPM_BIN);
-        let rpm = table(&base.throttle_pct, &base.rpm, THROTTLE_BIN_PCT);
-        let current_points: Vec<(f64, f64)> = s
-            .samples
-            .iter()
-            .filter_map(|x| {
-                let r = f64::from(x.rpm?);
-                let b = *current.get(&((r / RPM_BIN).floor() as i64))?;
-                let i = f64::from(x.current_a?);
-                (r > 0.0 && b >= MIN_REFERENCE[0]).then(|| (x.t, (i - b) / b * 100.0))
-            })
-            .collect();
-        let rpm_points: Vec<(f64, f64)> = s
-            .samples
-            .iter()
-            .filter_map(|x| {
-                let throttle = f64::from(x.throttle_pct?);
-                let b = *rpm.get(&((throttle / THROTTLE_BIN_PCT).floor() as i64))?;
-                let r = f64::from(x.rpm?);
-                (throttle >= MIN_THROTTLE_PCT && b >= MIN_REFERENCE[1])
-                    .then(|| (x.t, (b - r) / b * 100.0))
-            })
-            .collect();
-        for (name, points, limits, what) in [
+        let current_per_rpm: Point = |x| {
+            let rpm = f64::from(x.rpm?);
+            (rpm > 0.0).then_some((rpm, f64::from(x.current_a?)))
+        };
+        let rpm_per_throttle: Point = |x| {
+            let throttle = f64::from(x.throttle_pct?);
+            (throttle >= MIN_THROTTLE_PCT).then_some((throttle, f64::from(x.rpm?)))
+        };
+        for (name, point, reference, width, min_ref, sign, limits, what) in [
             (
                 "current_per_rpm",
-                current_points,
+                current_per_rpm,
+                table(&base.rpm_bin, &base.current_a, RPM_BIN),
+                RPM_BIN,
+                MIN_REFERENCE[0],
+                1.0,
                 config.current_per_rpm_pct,
                 "current per rpm above the baseline's",
             ),
             (
                 "rpm_per_throttle",
-                rpm_points,
+                rpm_per_throttle,
+                table(&base.throttle_pct, &base.rpm, THROTTLE_BIN_PCT),
+                THROTTLE_BIN_PCT,
+                MIN_REFERENCE[1],
+                -1.0,
                 config.rpm_per_throttle_pct,
                 "rpm per throttle below the baseline's",
             ),
         ] {
-            if let Some(f) = judge(s, name, what, &points, limits, config.min_time_s) {
+            let drifts: Vec<(Span, f64)> = windows(&s.samples, config.window_s)
+                .filter_map(|(span, samples)| {
+                    let bins =
+                        binned_medians(samples.iter().filter_map(point), width, MIN_BIN_SAMPLES);
+                    let mut devs: Vec<f64> = bins
+                        .into_iter()
+                        .filter_map(|(bin, v)| {
+                            let r = *reference.get(&bin)?;
+                            (r >= min_ref).then(|| sign * (v - r) / r * 100.0)
+                        })
+                        .collect();
+                    Some((span, median(&mut devs)?))
+                })
+                .collect();
+            if let Some(f) = judge(s, name, what, &drifts, limits, config.window_s) {
                 out.push(f);
             }
         }
@@ -80,23 +95,23 @@ fn table(edges: &[f64], values: &[f64], width: f64) -> BTreeMap<i64, f64> {
         .collect()
 }
 
-/// The finding of one ESC's drift `points` `(t, %)`.
+/// The finding of one ESC's drifts by window.
 fn judge(
     series: &EscSeries,
     name: &str,
     what: &str,
-    points: &[(f64, f64)],
+    drifts: &[(Span, f64)],
     limits: Limits,
     window_s: f64,
 ) -> Option<Finding> {
-    let s = sustained(points, window_s, limits.warn)?;
+    let s = held(drifts, limits.warn)?;
     let severity = limits.judge(s.worst);
     let mut f = Finding::about(Analyser::Drift, series)
         .value(name, s.worst, "%")
         .judged(severity, name, limits.crossed(severity), "%");
     f.window = s.span.filter(|_| severity > Severity::Ok);
     f.message = format!(
-        "{what} by {:.0} % (median over {window_s} s){}",
+        "{what} by {:.0} % (held over windows of {window_s} s){}",
         s.worst,
         match severity {
             Severity::Ok => format!(", within {} %", limits.warn),

@@ -22,9 +22,12 @@ const SMOOTH_S: f64 = 5.0;
 /// A gap longer than this adds no time above a limit, s.
 const MAX_STEP_S: f64 = 1.0;
 
+/// A temperature: its name, how it is read, its limits.
+type Sensor = (&'static str, fn(&Sample) -> Option<f32>, Limits);
+
 /// Adds a finding per temperature of `series` to `out`.
 pub(super) fn analyse(series: &EscSeries, config: &HeatConfig, out: &mut Vec<Finding>) {
-    let sensors: [(&str, fn(&Sample) -> Option<f32>, Limits); 3] = [
+    let sensors: [Sensor; 3] = [
         ("mos_temp_c", |s| s.mos_temp_c, config.mos_c),
         ("cap_temp_c", |s| s.cap_temp_c, config.cap_c),
         ("motor_temp_c", |s| s.motor_temp_c, config.motor_c),

@@ -1,20 +1,27 @@
 //! Imbalance between motors: at equal throttle, one ESC's current or rpm far from its
-//! siblings' (the other ESCs of its recording). Each sample is compared with the median, over
-//! the siblings, of their median at its throttle (bins of 5 %), so that motors that lag each
-//! other are compared alike; the deviation is judged on its median over a window.
+//! siblings' (the other ESCs of its recording). In each window of time, each ESC's median per
+//! throttle bin (5 %) is compared with the median of its siblings' in the same bin, so that
+//! motors that lag each other, and the lag of rpm behind a moving throttle, are compared alike;
+//! the window's deviation is the median over its bins, and it must hold in two windows in a row.
 
 use std::collections::BTreeMap;
 
-use super::baseline::{MIN_BIN_SAMPLES, THROTTLE_BIN_PCT};
-use super::stats::{binned_medians, median, sustained};
-use super::{Analyser, EscSeries, Finding, ImbalanceConfig, Limits, Sample, Severity};
+use super::baseline::THROTTLE_BIN_PCT;
+use super::stats::{binned_medians, held, median, windows};
+use super::{Analyser, EscSeries, Finding, ImbalanceConfig, Limits, Sample, Severity, Span};
 
 /// Siblings needed to tell which motor is off: with two, either could be.
 const MIN_ESCS: usize = 3;
 
+/// Samples a bin of a window needs.
+const MIN_BIN_SAMPLES: usize = 3;
+
 /// A sibling median below this is not compared with (near idle, a ratio means nothing), A or
 /// rev/min.
 const MIN_REFERENCE: [f64; 2] = [1.0, 100.0];
+
+/// One ESC's curve in each window: the window's span and its medians by throttle bin.
+type Curves = BTreeMap<i64, (Span, BTreeMap<i64, f64>)>;
 
 /// Adds the findings of each recording's ESCs in `series` to `out`.
 pub(super) fn analyse(series: &[EscSeries], config: &ImbalanceConfig, out: &mut Vec<Finding>) {
@@ -39,42 +46,32 @@ pub(super) fn analyse(series: &[EscSeries], config: &ImbalanceConfig, out: &mut 
                 MIN_REFERENCE[1],
             ),
         ] {
-            let curves: Vec<BTreeMap<i64, f64>> = escs
-                .iter()
-                .map(|s| curve(s, get, config.min_throttle_pct))
-                .collect();
+            let curves: Vec<Curves> = escs.iter().map(|s| curves(s, get, config)).collect();
             for (i, s) in escs.iter().enumerate() {
-                let others: Vec<&BTreeMap<i64, f64>> = curves
+                let deviations: Vec<(Span, f64)> = curves[i]
                     .iter()
-                    .enumerate()
-                    .filter(|&(j, c)| j != i && !c.is_empty())
-                    .map(|(_, c)| c)
-                    .collect();
-                if others.len() + 1 < MIN_ESCS || curves[i].is_empty() {
-                    continue;
-                }
-                let reference = |bin: i64| {
-                    let mut v: Vec<f64> =
-                        others.iter().filter_map(|c| c.get(&bin).copied()).collect();
-                    if v.len() + 1 < MIN_ESCS {
-                        return None;
-                    }
-                    median(&mut v).filter(|&r| r >= min_ref)
-                };
-                let points: Vec<(f64, f64)> = s
-                    .samples
-                    .iter()
-                    .filter_map(|x| {
-                        let throttle = f64::from(x.throttle_pct?);
-                        if throttle < config.min_throttle_pct {
-                            return None;
-                        }
-                        let r = reference((throttle / THROTTLE_BIN_PCT).floor() as i64)?;
-                        let d = (f64::from(get(x)?) - r) / r * 100.0;
-                        Some((x.t, if both_ways { d.abs() } else { d }))
+                    .filter_map(|(k, (span, mine))| {
+                        let mut devs: Vec<f64> = mine
+                            .iter()
+                            .filter_map(|(bin, &v)| {
+                                let mut others: Vec<f64> = curves
+                                    .iter()
+                                    .enumerate()
+                                    .filter(|&(j, _)| j != i)
+                                    .filter_map(|(_, c)| c.get(k)?.1.get(bin).copied())
+                                    .collect();
+                                if others.len() + 1 < MIN_ESCS {
+                                    return None;
+                                }
+                                let r = median(&mut others).filter(|&r| r >= min_ref)?;
+                                let d = (v - r) / r * 100.0;
+                                Some(if both_ways { d.abs() } else { d })
+                            })
+                            .collect();
+                        Some((*span, median(&mut devs)?))
                     })
                     .collect();
-                if let Some(f) = judge(s, what, &points, limits, config.min_time_s) {
+                if let Some(f) = judge(s, what, &deviations, limits, config.window_s) {
                     out.push(f);
                 }
             }
@@ -82,43 +79,49 @@ pub(super) fn analyse(series: &[EscSeries], config: &ImbalanceConfig, out: &mut 
     }
 }
 
-/// The median of `get` per throttle bin of `series`, above `min_throttle`.
-fn curve(
-    series: &EscSeries,
-    get: fn(&Sample) -> Option<f32>,
-    min_throttle: f64,
-) -> BTreeMap<i64, f64> {
-    binned_medians(
-        series.samples.iter().filter_map(|s| {
-            let throttle = f64::from(s.throttle_pct?);
-            (throttle >= min_throttle).then_some((throttle, f64::from(get(s)?)))
-        }),
-        THROTTLE_BIN_PCT,
-        MIN_BIN_SAMPLES,
-    )
-    .into_iter()
-    .collect()
+/// The curves of `get` against throttle of `series`, window by window (above the least
+/// throttle compared).
+fn curves(series: &EscSeries, get: fn(&Sample) -> Option<f32>, config: &ImbalanceConfig) -> Curves {
+    windows(&series.samples, config.window_s)
+        .map(|(span, samples)| {
+            let bins = binned_medians(
+                samples.iter().filter_map(|s| {
+                    let throttle = f64::from(s.throttle_pct?);
+                    (throttle >= config.min_throttle_pct).then_some((throttle, f64::from(get(s)?)))
+                }),
+                THROTTLE_BIN_PCT,
+                MIN_BIN_SAMPLES,
+            );
+            let k = (span.start_s / (config.window_s / 2.0)).round() as i64;
+            (k, (span, bins.into_iter().collect::<BTreeMap<i64, f64>>()))
+        })
+        .filter(|(_, (_, bins))| !bins.is_empty())
+        .collect()
 }
 
-/// The finding of one ESC's deviation `points` `(t, %)` from its siblings.
+/// The finding of one ESC's deviations by window from its siblings.
 fn judge(
     series: &EscSeries,
     what: &str,
-    points: &[(f64, f64)],
+    deviations: &[(Span, f64)],
     limits: Limits,
     window_s: f64,
 ) -> Option<Finding> {
-    let s = sustained(points, window_s, limits.warn)?;
+    let s = held(deviations, limits.warn)?;
     let severity = limits.judge(s.worst);
     let name = format!("{what}_vs_siblings");
     let mut f = Finding::about(Analyser::Imbalance, series)
         .value(&name, s.worst, "%")
         .judged(severity, &name, limits.crossed(severity), "%");
     f.window = s.span.filter(|_| severity > Severity::Ok);
-    let direction = if what == "rpm" { "away from" } else { "above" };
+    let direction = match what {
+        "rpm" => "away from",
+        _ if s.worst < 0.0 => "below",
+        _ => "above",
+    };
     f.message = format!(
-        "{what} {:.0} % {direction} its siblings' at the same throttle (median over {window_s} s){}",
-        s.worst,
+        "{what} {:.0} % {direction} its siblings' at the same throttle (held over windows of {window_s} s){}",
+        s.worst.abs(),
         match severity {
             Severity::Ok => format!(", within {} %", limits.warn),
             _ => format!(": at or beyond {} %", limits.crossed(severity)),

@@ -7,11 +7,21 @@ use super::{Analyser, EscSeries, Finding, Limits, LinkConfig, Sample, Severity, 
 /// A jump of the packet counter larger than this is a restart, not a loss.
 const MAX_GAP_PACKETS: u64 = 1000;
 
+/// A figure judged: severity, name, value, limits, unit, window.
+type Judgement = (
+    Severity,
+    &'static str,
+    f64,
+    Limits,
+    &'static str,
+    Option<Span>,
+);
+
 /// Adds the finding of `series`'s link to `out`.
 pub(super) fn analyse(series: &EscSeries, config: &LinkConfig, out: &mut Vec<Finding>) {
     let mut f = Finding::about(Analyser::Link, series);
     // (severity, value name, value, limits, unit, window)
-    let mut judged: Vec<(Severity, &str, f64, Limits, &str, Option<Span>)> = Vec::new();
+    let mut judged: Vec<Judgement> = Vec::new();
     if let Some(link) = series.link {
         if link.counts_packets {
             let lost = percent(link.lost_packets, link.frames + link.lost_packets);
@@ -44,13 +54,14 @@ pub(super) fn analyse(series: &EscSeries, config: &LinkConfig, out: &mut Vec<Fin
         let l = config.dropout_s;
         judged.push((l.judge(gap), "dropout", gap, l, "s", Some(span)));
     }
-    let Some(&(severity, name, value, limits, unit, window)) = judged.iter().fold(
-        None,
-        |w: Option<&(Severity, &str, f64, Limits, &str, Option<Span>)>, j| match w {
-            Some(w) if w.0 >= j.0 => Some(w),
-            _ => Some(j),
-        },
-    ) else {
+    let Some(&(severity, name, value, limits, unit, window)) =
+        judged
+            .iter()
+            .fold(None, |w: Option<&Judgement>, j| match w {
+                Some(w) if w.0 >= j.0 => Some(w),
+                _ => Some(j),
+            })
+    else {
         return;
     };
     let limit = limits.crossed(severity);

@@ -13,10 +13,10 @@
 use hwfoc::Protocol;
 use hwfoc::telemetry::Info;
 
-use crate::InputError;
 use crate::record::Record;
 use crate::sources::{Handler, Sources};
 use crate::summary::esc_label;
+use crate::{InputError, Selection};
 
 mod baseline;
 mod battery;
@@ -43,12 +43,22 @@ pub use series::{EscSeries, LinkFigures, Sample};
 #[derive(Debug, Default)]
 pub struct Check {
     samples: Vec<Vec<Sample>>,
+    /// The frames taken (`--esc`, `--from`, `--to`); all without one.
+    selection: Option<Selection>,
 }
 
 impl Check {
     /// Nothing gathered yet.
     pub fn new() -> Check {
         Check::default()
+    }
+
+    /// Nothing gathered yet; of the frames to come, only those in `selection`.
+    pub fn selecting(selection: Selection) -> Check {
+        Check {
+            selection: Some(selection),
+            ..Check::default()
+        }
     }
 
     /// Each ESC's series of what was gathered from `sources` (after [`Sources::run`]): its
@@ -99,6 +109,11 @@ impl Handler for Check {
     type Error = InputError;
 
     fn record(&mut self, record: &Record) {
+        if let Some(selection) = &mut self.selection
+            && !selection.contains(record.esc, record.t_s)
+        {
+            return;
+        }
         let esc = usize::from(record.esc);
         if self.samples.len() <= esc {
             self.samples.resize_with(esc + 1, Vec::new);

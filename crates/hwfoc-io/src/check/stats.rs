@@ -37,11 +37,11 @@ pub(super) fn binned_medians(
 /// Points a window needs for its median to be judged.
 const MIN_WINDOW_POINTS: usize = 5;
 
-/// A quantity `(t, value)` judged over windows of `window_s` seconds: the worst (highest)
-/// median of a window, and the span of the windows whose median is at or above `limit`.
+/// A deviation judged where it holds ([`held`]): the worst, and the span where it was at or
+/// above the limit.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub(super) struct Sustained {
-    /// The highest median of a window.
+    /// The worst value held.
     pub worst: f64,
     /// From the start of the first window at or above the limit to the end of the last.
     pub span: Option<super::Span>,
@@ -70,13 +70,51 @@ pub(super) fn rolling_median(points: &[(f64, f64)], window_s: f64) -> Vec<(f64, 
     out
 }
 
-/// `points` judged over windows of `window_s` ([`rolling_median`]); `None` when no window
-/// qualifies.
-pub(super) fn sustained(points: &[(f64, f64)], window_s: f64, limit: f64) -> Option<Sustained> {
-    let medians = rolling_median(points, window_s);
-    let worst = medians.iter().map(|m| m.2).reduce(f64::max)?;
-    let first = medians.iter().find(|m| m.2 >= limit);
-    let last = medians.iter().rev().find(|m| m.2 >= limit);
+/// Windows of `window_s` overlapping by half, on a grid of absolute time (so that the windows
+/// of two ESCs are the same), over `samples` (in time order): each window's span and the
+/// samples in it.
+pub(super) fn windows(
+    samples: &[super::Sample],
+    window_s: f64,
+) -> impl Iterator<Item = (super::Span, &[super::Sample])> {
+    let step = window_s / 2.0;
+    let first = samples
+        .first()
+        .map_or(0, |s| (s.t / step).floor() as i64 - 1);
+    let last = samples.last().map_or(-1, |s| (s.t / step).floor() as i64);
+    (first..=last).filter_map(move |k| {
+        let start = k as f64 * step;
+        let end = start + window_s;
+        let a = samples.partition_point(|s| s.t < start);
+        let b = samples.partition_point(|s| s.t < end);
+        (b > a).then(|| {
+            (
+                super::Span {
+                    start_s: start,
+                    end_s: end,
+                },
+                &samples[a..b],
+            )
+        })
+    })
+}
+
+/// Deviations by window `(window, %)`, in time order, judged where they hold: the worst of
+/// the lesser deviation of two windows in a row (overlapping), and the span of the pairs at or
+/// above `limit` (each pair's two windows together: the span holds where it began). One window alone (a short flight) is judged by itself.
+pub(super) fn held(windows: &[(super::Span, f64)], limit: f64) -> Option<Sustained> {
+    let pairs: Vec<(f64, f64, f64)> = if windows.len() == 1 {
+        vec![(windows[0].0.start_s, windows[0].0.end_s, windows[0].1)]
+    } else {
+        windows
+            .windows(2)
+            .filter(|w| w[1].0.start_s < w[0].0.end_s)
+            .map(|w| (w[0].0.start_s, w[1].0.end_s, w[0].1.min(w[1].1)))
+            .collect()
+    };
+    let worst = pairs.iter().map(|p| p.2).reduce(f64::max)?;
+    let first = pairs.iter().find(|p| p.2 >= limit);
+    let last = pairs.iter().rev().find(|p| p.2 >= limit);
     let span = first.zip(last).map(|(a, b)| super::Span {
         start_s: a.0,
         end_s: b.1,
@@ -86,21 +124,62 @@ pub(super) fn sustained(points: &[(f64, f64)], window_s: f64, limit: f64) -> Opt
 
 #[cfg(test)]
 mod tests {
+    use super::super::{Sample, Span};
     use super::*;
 
     #[test]
-    fn a_sustained_deviation_is_found_in_its_window_and_a_spike_is_not() {
-        let mut points: Vec<(f64, f64)> = (0..400).map(|i| (i as f64 * 0.05, 1.0)).collect();
-        points[50].1 = 100.0; // a spike at 2.5 s
-        for p in &mut points[200..300] {
-            p.1 = 40.0; // 10 .. 15 s
-        }
-        let s = sustained(&points, 2.0, 30.0).unwrap();
+    fn a_deviation_held_in_two_windows_is_found_in_them_and_one_in_a_single_window_is_not() {
+        let w = |k: usize| Span {
+            start_s: k as f64 * 5.0,
+            end_s: k as f64 * 5.0 + 10.0,
+        };
+        let devs: Vec<(Span, f64)> = [1.0, 50.0, 2.0, 1.0, 40.0, 45.0, 1.0]
+            .into_iter()
+            .enumerate()
+            .map(|(k, d)| (w(k), d))
+            .collect();
+        let s = held(&devs, 30.0).unwrap();
         assert_eq!(s.worst, 40.0);
-        let span = s.span.unwrap();
-        assert!((9.0..=11.0).contains(&span.start_s), "{span:?}");
-        assert!((14.5..=16.5).contains(&span.end_s), "{span:?}");
-        assert!(sustained(&points[..100], 2.0, 30.0).unwrap().span.is_none());
+        assert_eq!(
+            s.span,
+            Some(Span {
+                start_s: 20.0,
+                end_s: 35.0
+            })
+        );
+        assert!(held(&devs[..4], 30.0).unwrap().span.is_none());
+    }
+
+    #[test]
+    fn windows_lie_on_a_grid_of_absolute_time() {
+        let samples: Vec<Sample> = (0..100)
+            .map(|i| Sample {
+                t: 3.0 + i as f64 * 0.1,
+                ..Sample::default()
+            })
+            .collect();
+        let spans: Vec<(f64, usize)> = windows(&samples, 4.0)
+            .map(|(s, x)| (s.start_s, x.len()))
+            .collect();
+        assert_eq!(
+            spans,
+            [
+                (0.0, 10),
+                (2.0, 30),
+                (4.0, 40),
+                (6.0, 40),
+                (8.0, 40),
+                (10.0, 30),
+                (12.0, 10)
+            ]
+        );
+    }
+
+    #[test]
+    fn a_rolling_median_ignores_a_spike() {
+        let mut points: Vec<(f64, f64)> = (0..100).map(|i| (i as f64 * 0.1, 1.0)).collect();
+        points[50].1 = 100.0;
+        assert!(rolling_median(&points, 1.0).iter().all(|m| m.2 == 1.0));
     }
 
     #[test]
