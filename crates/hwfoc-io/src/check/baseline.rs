@@ -7,7 +7,7 @@ use std::collections::BTreeMap;
 use serde::{Deserialize, Serialize};
 
 use super::EscSeries;
-use super::stats::binned_medians;
+use super::stats::curve;
 
 /// Width of a throttle bin, %.
 pub(super) const THROTTLE_BIN_PCT: f64 = 5.0;
@@ -18,18 +18,45 @@ pub(super) const RPM_BIN: f64 = 500.0;
 /// Samples a bin needs to be kept.
 pub(super) const MIN_BIN_SAMPLES: usize = 20;
 
-/// One ESC's healthy behaviour.
+/// A curve of medians: `y` against `x`, by `x` (each point the medians of a bin of `x`).
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Curve {
+    /// The points' `x`, rising.
+    pub x: Vec<f64>,
+    /// The points' `y`.
+    pub y: Vec<f64>,
+}
+
+impl Curve {
+    /// Its value at `x`: between two points at most `span` apart, on the line between them;
+    /// else at a point within a tenth of `span`; else none.
+    pub fn at(&self, x: f64, span: f64) -> Option<f64> {
+        let i = self.x.partition_point(|&p| p < x);
+        if i < self.x.len() && i > 0 {
+            let (x0, x1) = (self.x[i - 1], self.x[i]);
+            if x1 - x0 <= span {
+                let f = if x1 > x0 { (x - x0) / (x1 - x0) } else { 0.0 };
+                return Some(self.y[i - 1] + f * (self.y[i] - self.y[i - 1]));
+            }
+        }
+        [i.checked_sub(1), Some(i)]
+            .into_iter()
+            .flatten()
+            .filter(|&j| j < self.x.len() && (self.x[j] - x).abs() <= span / 10.0)
+            .map(|j| self.y[j])
+            .next()
+    }
+}
+
+/// One ESC's healthy behaviour, at a steady throttle.
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct EscBaseline {
-    /// Lower edges of the throttle bins, % (of width 5).
-    pub throttle_pct: Vec<f64>,
-    /// The median rpm in each throttle bin.
-    pub rpm: Vec<f64>,
-    /// Lower edges of the rpm bins, rev/min (of width 500).
-    pub rpm_bin: Vec<f64>,
-    /// The median current in each rpm bin, A.
-    pub current_a: Vec<f64>,
+    /// Rpm against throttle (%), in bins of 5 %.
+    pub rpm_by_throttle: Curve,
+    /// Current (A) against rpm, in bins of 500 rev/min.
+    pub current_by_rpm: Curve,
 }
 
 /// An airframe's baseline: each ESC's (by ESC number), and its battery's internal resistance.
@@ -45,8 +72,8 @@ pub struct Baseline {
 }
 
 impl Baseline {
-    /// The baseline of `series`, healthy flights: each ESC's samples of every recording
-    /// together.
+    /// The baseline of `series`, healthy flights: each ESC's samples at a steady throttle, of
+    /// every recording together.
     pub fn fit(series: &[EscSeries], cells: Option<u32>) -> Baseline {
         let mut by_esc: BTreeMap<usize, Vec<&EscSeries>> = BTreeMap::new();
         for s in series {
@@ -55,27 +82,25 @@ impl Baseline {
         let esc = by_esc
             .into_iter()
             .map(|(n, list)| {
-                let samples = || list.iter().flat_map(|s| s.samples.iter());
-                let rpm = binned_medians(
-                    samples().filter_map(|s| Some((f64::from(s.throttle_pct?), f64::from(s.rpm?)))),
-                    THROTTLE_BIN_PCT,
-                    MIN_BIN_SAMPLES,
-                );
-                let current = binned_medians(
-                    samples()
-                        .filter(|s| s.rpm.is_some_and(|r| r > 0.0))
-                        .filter_map(|s| Some((f64::from(s.rpm?), f64::from(s.current_a?)))),
-                    RPM_BIN,
-                    MIN_BIN_SAMPLES,
-                );
+                let steady: Vec<Vec<super::Sample>> = list
+                    .iter()
+                    .map(|s| super::stats::steady(&s.samples))
+                    .collect();
+                let samples = || steady.iter().flatten();
                 let b = EscBaseline {
-                    throttle_pct: rpm
-                        .iter()
-                        .map(|&(k, _)| k as f64 * THROTTLE_BIN_PCT)
-                        .collect(),
-                    rpm: rpm.iter().map(|&(_, v)| v).collect(),
-                    rpm_bin: current.iter().map(|&(k, _)| k as f64 * RPM_BIN).collect(),
-                    current_a: current.iter().map(|&(_, v)| v).collect(),
+                    rpm_by_throttle: curve(
+                        samples()
+                            .filter_map(|s| Some((f64::from(s.throttle_pct?), f64::from(s.rpm?)))),
+                        THROTTLE_BIN_PCT,
+                        MIN_BIN_SAMPLES,
+                    ),
+                    current_by_rpm: curve(
+                        samples()
+                            .filter(|s| s.rpm.is_some_and(|r| r > 0.0))
+                            .filter_map(|s| Some((f64::from(s.rpm?), f64::from(s.current_a?)))),
+                        RPM_BIN,
+                        MIN_BIN_SAMPLES,
+                    ),
                 };
                 (n.to_string(), b)
             })

@@ -85,7 +85,7 @@ impl Default for HeatConfig {
 pub struct ImbalanceConfig {
     /// Throttle below which motors are not compared, % (default 15).
     pub min_throttle_pct: f64,
-    /// Current above the siblings' median at the same throttle, % (default 30 / 60).
+    /// Current above the siblings' median at the same throttle, % (default 40 / 70).
     pub current_pct: Limits,
     /// Rpm away from the siblings' median at the same throttle, % (default 10 / 20).
     pub rpm_pct: Limits,
@@ -98,7 +98,7 @@ impl Default for ImbalanceConfig {
     fn default() -> ImbalanceConfig {
         ImbalanceConfig {
             min_throttle_pct: 15.0,
-            current_pct: Limits::new(30.0, 60.0),
+            current_pct: Limits::new(40.0, 70.0),
             rpm_pct: Limits::new(10.0, 20.0),
             window_s: 10.0,
         }

@@ -1,14 +1,12 @@
 //! Drift from a baseline: each ESC's current per rpm and rpm per throttle against the medians
-//! its healthy flights gave ([`Baseline`]). In each window of time the ESC's medians per bin
+//! its healthy flights gave ([`Baseline`]), at a steady throttle. In each window of time the ESC's medians per bin
 //! are compared with the baseline's; the window's drift is the median over its bins, and it
 //! must hold in two windows in a row. More current for the same rpm points to a bearing or a
 //! motor going, or a heavier prop; less rpm for the same throttle to a motor losing its grip
 //! (or a sagging battery).
 
-use std::collections::BTreeMap;
-
 use super::baseline::{RPM_BIN, THROTTLE_BIN_PCT};
-use super::stats::{binned_medians, held, median, windows};
+use super::stats::{curve, held, median, steady, windows};
 use super::{Analyser, Baseline, DriftConfig, EscSeries, Finding, Limits, Sample, Severity, Span};
 
 /// A baseline value below this is not compared with, A or rev/min (near idle, a ratio means
@@ -19,7 +17,7 @@ const MIN_REFERENCE: [f64; 2] = [1.0, 100.0];
 const MIN_THROTTLE_PCT: f64 = 15.0;
 
 /// Samples a bin of a window needs.
-const MIN_BIN_SAMPLES: usize = 3;
+const MIN_BIN_SAMPLES: usize = 5;
 
 /// How one curve is read from a sample: `(x, y)`.
 type Point = fn(&Sample) -> Option<(f64, f64)>;
@@ -35,6 +33,7 @@ pub(super) fn analyse(
         let Some(base) = baseline.esc.get(&s.esc.number.to_string()) else {
             continue;
         };
+        let steady = steady(&s.samples);
         let current_per_rpm: Point = |x| {
             let rpm = f64::from(x.rpm?);
             (rpm > 0.0).then_some((rpm, f64::from(x.current_a?)))
@@ -47,7 +46,7 @@ pub(super) fn analyse(
             (
                 "current_per_rpm",
                 current_per_rpm,
-                table(&base.rpm_bin, &base.current_a, RPM_BIN),
+                &base.current_by_rpm,
                 RPM_BIN,
                 MIN_REFERENCE[0],
                 1.0,
@@ -57,7 +56,7 @@ pub(super) fn analyse(
             (
                 "rpm_per_throttle",
                 rpm_per_throttle,
-                table(&base.throttle_pct, &base.rpm, THROTTLE_BIN_PCT),
+                &base.rpm_by_throttle,
                 THROTTLE_BIN_PCT,
                 MIN_REFERENCE[1],
                 -1.0,
@@ -65,14 +64,15 @@ pub(super) fn analyse(
                 "rpm per throttle below the baseline's",
             ),
         ] {
-            let drifts: Vec<(Span, f64)> = windows(&s.samples, config.window_s)
+            let drifts: Vec<(Span, f64)> = windows(&steady, config.window_s)
                 .filter_map(|(span, samples)| {
-                    let bins =
-                        binned_medians(samples.iter().filter_map(point), width, MIN_BIN_SAMPLES);
-                    let mut devs: Vec<f64> = bins
-                        .into_iter()
-                        .filter_map(|(bin, v)| {
-                            let r = *reference.get(&bin)?;
+                    let mine = curve(samples.iter().filter_map(point), width, MIN_BIN_SAMPLES);
+                    let mut devs: Vec<f64> = mine
+                        .x
+                        .iter()
+                        .zip(&mine.y)
+                        .filter_map(|(&x, &v)| {
+                            let r = reference.at(x, 2.0 * width)?;
                             (r >= min_ref).then(|| sign * (v - r) / r * 100.0)
                         })
                         .collect();
@@ -84,15 +84,6 @@ pub(super) fn analyse(
             }
         }
     }
-}
-
-/// A baseline curve by bin: lower edges `edges` of bins of `width`, and their values.
-fn table(edges: &[f64], values: &[f64], width: f64) -> BTreeMap<i64, f64> {
-    edges
-        .iter()
-        .zip(values)
-        .map(|(&e, &v)| ((e / width).round() as i64, v))
-        .collect()
 }
 
 /// The finding of one ESC's drifts by window.
@@ -160,7 +151,7 @@ mod tests {
     #[test]
     fn a_flight_like_the_baseline_is_ok_and_more_current_per_rpm_is_found_when_it_starts() {
         let baseline = Baseline::fit(&flight(1.0, 0.0), None);
-        assert!(!baseline.esc["1"].current_a.is_empty());
+        assert!(!baseline.esc["1"].current_by_rpm.y.is_empty());
         let same = drift(&flight(1.0, 0.0), &baseline);
         assert_eq!(same.len(), 2);
         assert!(same.iter().all(|f| f.severity == Severity::Ok), "{same:?}");

@@ -1,27 +1,29 @@
 //! Imbalance between motors: at equal throttle, one ESC's current or rpm far from its
-//! siblings' (the other ESCs of its recording). In each window of time, each ESC's median per
-//! throttle bin (5 %) is compared with the median of its siblings' in the same bin, so that
-//! motors that lag each other, and the lag of rpm behind a moving throttle, are compared alike;
+//! siblings' (the other ESCs of its recording). In each window of time, each ESC's medians per
+//! throttle bin (5 %) are compared with the median of its siblings' curves at the same
+//! throttle (between their points), so that
+//! motors that lag each other are compared alike, and only at a steady throttle (rpm lags a
+//! moving throttle, current spikes as a motor speeds up);
 //! the window's deviation is the median over its bins, and it must hold in two windows in a row.
 
 use std::collections::BTreeMap;
 
 use super::baseline::THROTTLE_BIN_PCT;
-use super::stats::{binned_medians, held, median, windows};
-use super::{Analyser, EscSeries, Finding, ImbalanceConfig, Limits, Sample, Severity, Span};
+use super::stats::{curve, held, median, steady, windows};
+use super::{Analyser, Curve, EscSeries, Finding, ImbalanceConfig, Limits, Sample, Severity, Span};
 
 /// Siblings needed to tell which motor is off: with two, either could be.
 const MIN_ESCS: usize = 3;
 
 /// Samples a bin of a window needs.
-const MIN_BIN_SAMPLES: usize = 3;
+const MIN_BIN_SAMPLES: usize = 5;
 
 /// A sibling median below this is not compared with (near idle, a ratio means nothing), A or
 /// rev/min.
 const MIN_REFERENCE: [f64; 2] = [1.0, 100.0];
 
 /// One ESC's curve in each window: the window's span and its medians by throttle bin.
-type Curves = BTreeMap<i64, (Span, BTreeMap<i64, f64>)>;
+type Curves = BTreeMap<i64, (Span, Curve)>;
 
 /// Adds the findings of each recording's ESCs in `series` to `out`.
 pub(super) fn analyse(series: &[EscSeries], config: &ImbalanceConfig, out: &mut Vec<Finding>) {
@@ -52,13 +54,15 @@ pub(super) fn analyse(series: &[EscSeries], config: &ImbalanceConfig, out: &mut 
                     .iter()
                     .filter_map(|(k, (span, mine))| {
                         let mut devs: Vec<f64> = mine
+                            .x
                             .iter()
-                            .filter_map(|(bin, &v)| {
+                            .zip(&mine.y)
+                            .filter_map(|(&x, &v)| {
                                 let mut others: Vec<f64> = curves
                                     .iter()
                                     .enumerate()
                                     .filter(|&(j, _)| j != i)
-                                    .filter_map(|(_, c)| c.get(k)?.1.get(bin).copied())
+                                    .filter_map(|(_, c)| c.get(k)?.1.at(x, 2.0 * THROTTLE_BIN_PCT))
                                     .collect();
                                 if others.len() + 1 < MIN_ESCS {
                                     return None;
@@ -82,9 +86,9 @@ pub(super) fn analyse(series: &[EscSeries], config: &ImbalanceConfig, out: &mut 
 /// The curves of `get` against throttle of `series`, window by window (above the least
 /// throttle compared).
 fn curves(series: &EscSeries, get: fn(&Sample) -> Option<f32>, config: &ImbalanceConfig) -> Curves {
-    windows(&series.samples, config.window_s)
+    windows(&steady(&series.samples), config.window_s)
         .map(|(span, samples)| {
-            let bins = binned_medians(
+            let c = curve(
                 samples.iter().filter_map(|s| {
                     let throttle = f64::from(s.throttle_pct?);
                     (throttle >= config.min_throttle_pct).then_some((throttle, f64::from(get(s)?)))
@@ -93,9 +97,9 @@ fn curves(series: &EscSeries, get: fn(&Sample) -> Option<f32>, config: &Imbalanc
                 MIN_BIN_SAMPLES,
             );
             let k = (span.start_s / (config.window_s / 2.0)).round() as i64;
-            (k, (span, bins.into_iter().collect::<BTreeMap<i64, f64>>()))
+            (k, (span, c))
         })
-        .filter(|(_, (_, bins))| !bins.is_empty())
+        .filter(|(_, (_, c))| !c.x.is_empty())
         .collect()
 }
 

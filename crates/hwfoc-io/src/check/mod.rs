@@ -31,7 +31,7 @@ mod runtime;
 mod series;
 mod stats;
 
-pub use baseline::{Baseline, EscBaseline};
+pub use baseline::{Baseline, Curve, EscBaseline};
 pub use config::{
     BatteryConfig, CheckConfig, DriftConfig, EscOverride, FaultsConfig, HeatConfig,
     ImbalanceConfig, Limits, LinkConfig, RuntimeConfig,

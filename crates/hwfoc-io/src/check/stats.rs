@@ -1,4 +1,6 @@
-//! Small statistics the analysers share: medians, percentiles, binned medians.
+//! Small statistics the analysers share: medians, percentiles, curves of medians, windows.
+
+use super::Curve;
 
 /// The `p`th percentile (0..=100) of `values`, by nearest rank; `None` when empty.
 pub(super) fn percentile(values: &mut [f64], p: f64) -> Option<f64> {
@@ -15,23 +17,27 @@ pub(super) fn median(values: &mut [f64]) -> Option<f64> {
     percentile(values, 50.0)
 }
 
-/// The median of `y` in each bin of `x` of width `width` (bin `k` holds `k*width <= x <
-/// (k+1)*width`), for bins holding at least `min` points: `(k, median)`, by `k`.
-pub(super) fn binned_medians(
-    points: impl Iterator<Item = (f64, f64)>,
-    width: f64,
-    min: usize,
-) -> Vec<(i64, f64)> {
-    let mut bins: std::collections::BTreeMap<i64, Vec<f64>> = Default::default();
+/// The curve of `points` `(x, y)`: in each bin of `x` of width `width` holding at least `min`
+/// points, the median `x` and the median `y`, by `x`.
+pub(super) fn curve(points: impl Iterator<Item = (f64, f64)>, width: f64, min: usize) -> Curve {
+    let mut bins: std::collections::BTreeMap<i64, (Vec<f64>, Vec<f64>)> = Default::default();
     for (x, y) in points {
         if x.is_finite() && y.is_finite() {
-            bins.entry((x / width).floor() as i64).or_default().push(y);
+            let bin = bins.entry((x / width).floor() as i64).or_default();
+            bin.0.push(x);
+            bin.1.push(y);
         }
     }
-    bins.into_iter()
-        .filter(|(_, ys)| ys.len() >= min)
-        .filter_map(|(k, mut ys)| Some((k, median(&mut ys)?)))
-        .collect()
+    let mut c = Curve::default();
+    for (_, (mut xs, mut ys)) in bins {
+        if xs.len() >= min
+            && let (Some(x), Some(y)) = (median(&mut xs), median(&mut ys))
+        {
+            c.x.push(x);
+            c.y.push(y);
+        }
+    }
+    c
 }
 
 /// Points a window needs for its median to be judged.
@@ -65,6 +71,38 @@ pub(super) fn rolling_median(points: &[(f64, f64)], window_s: f64) -> Vec<(f64, 
         }
         if i + 1 - start >= MIN_WINDOW_POINTS && t - points[start].0 >= window_s / 2.0 {
             out.push((points[start].0, t, sorted[(sorted.len() - 1) / 2]));
+        }
+    }
+    out
+}
+
+/// How long the throttle must have held for a sample to be steady, s: three of the motor's
+/// time constants (its rpm lags a moving throttle, its current spikes as it speeds up).
+const STEADY_S: f64 = 0.6;
+
+/// How far the throttle may move and still hold, %.
+const STEADY_PCT: f32 = 2.5;
+
+/// The samples of `samples` (in time order) taken with the throttle steady: within 2.5 % over
+/// the 0.6 s before. Where a throttle moves, rpm and current depend on how fast it moved, which
+/// differs from motor to motor and flight to flight; at a steady throttle they do not.
+pub(super) fn steady(samples: &[super::Sample]) -> Vec<super::Sample> {
+    let mut start = 0;
+    let mut out = Vec::new();
+    for (i, s) in samples.iter().enumerate() {
+        let Some(throttle) = s.throttle_pct else {
+            continue;
+        };
+        while samples[start].t < s.t - STEADY_S {
+            start += 1;
+        }
+        let held = s.t - samples[start].t >= STEADY_S * 0.75
+            && samples[start..i].iter().all(|x| {
+                x.throttle_pct
+                    .is_some_and(|p| (p - throttle).abs() <= STEADY_PCT)
+            });
+        if held {
+            out.push(*s);
         }
     }
     out
