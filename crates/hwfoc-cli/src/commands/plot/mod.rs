@@ -149,6 +149,16 @@ impl Alongside {
         self.collector
             .write(sources, &self.options, &mut self.target)
     }
+
+    /// As [`Alongside::finish`], the windows of `findings` (`hwfoc check --plot`) shaded.
+    pub fn finish_with(
+        mut self,
+        sources: &Sources,
+        findings: &[hwfoc_io::check::Finding],
+    ) -> Result<(), CliError> {
+        self.collector.shade(findings);
+        self.finish(sources)
+    }
 }
 
 impl Handler for Alongside {
