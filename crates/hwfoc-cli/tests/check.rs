@@ -6,7 +6,10 @@ mod common;
 
 use hwfoc::{Protocol, Settings};
 use hwfoc_io::Record;
-use hwfoc_io::check::{CheckConfig, EscId, EscSeries, Finding, Sample, Severity, analyse};
+use hwfoc_io::check::{
+    Analyser, Baseline, CheckConfig, EscId, EscSeries, Finding, Sample, Severity, analyse,
+};
+use hwfoc_sim::degrade::{DegradeKind, DegradeSpec};
 use hwfoc_sim::faults::LinkRates;
 use hwfoc_sim::fleet::FleetSpec;
 use hwfoc_sim::model::ModelConfig;
@@ -64,6 +67,7 @@ fn healthy(i: u64) -> FleetSpec {
         },
         faults: Vec::new(),
         link: LinkRates::default(),
+        degradations: Vec::new(),
     }
 }
 
@@ -139,4 +143,170 @@ fn two_hundred_healthy_simulated_flights_raise_no_warning() {
     );
     // Every analyser looked at them (no finding would pass the test too).
     assert!(judged > 200 * 3 * 6, "{judged} findings");
+}
+
+/// The airframe of the degradation tests: four ESCs on a staircase of throttle levels held 4 s
+/// each, `degradations` applied, seed `seed`.
+fn airframe(seed: u64, ambient_c: f64, degradations: Vec<DegradeSpec>) -> FleetSpec {
+    FleetSpec {
+        n: 4,
+        seed,
+        protocol: Protocol::HwFoc,
+        baud: 19200,
+        start_packet: None,
+        profile: ProfileSpec::Steps,
+        shape: Shape {
+            lead_in_s: 1.0,
+            levels: vec![
+                0.0, 30.0, 50.0, 70.0, 40.0, 60.0, 80.0, 50.0, 30.0, 60.0, 45.0, 0.0,
+            ],
+            hold_s: 4.0,
+            period_s: 10.0,
+            max_pct: 80.0,
+        },
+        model: ModelConfig {
+            kv: 500.0,
+            pole_pairs: 7,
+            full_current_a: 60.0,
+            cells: 6,
+            battery_r_ohm: 0.02,
+            capacity_mah: 16000.0,
+            ambient_c,
+            current_scale: 64.0,
+        },
+        faults: Vec::new(),
+        link: LinkRates::default(),
+        degradations,
+    }
+}
+
+/// ESC `esc` degraded by `kind` from `start_s` at `severity`.
+fn degrade(esc: usize, kind: DegradeKind, start_s: f64, severity: f64) -> Vec<DegradeSpec> {
+    vec![DegradeSpec {
+        esc,
+        kind,
+        start_s,
+        severity,
+    }]
+}
+
+/// The baseline of three healthy flights of [`airframe`].
+fn baseline() -> Baseline {
+    let series: Vec<EscSeries> = (1..=3)
+        .flat_map(|seed| {
+            fly(
+                airframe(seed, 25.0, Vec::new()),
+                50.0,
+                &format!("healthy {seed}"),
+            )
+        })
+        .collect();
+    Baseline::fit(&series, None)
+}
+
+/// The warnings and critical findings of `analyser` on the degraded flight.
+fn found(
+    degradations: Vec<DegradeSpec>,
+    seconds: f64,
+    ambient_c: f64,
+    baseline: Option<&Baseline>,
+    analyser: Analyser,
+) -> Vec<Finding> {
+    let series = fly(airframe(11, ambient_c, degradations), seconds, "degraded");
+    let findings = analyse(&series, &CheckConfig::default(), baseline);
+    let all: Vec<Finding> = findings
+        .into_iter()
+        .filter(|f| f.analyser == analyser)
+        .collect();
+    all.into_iter()
+        .filter(|f| f.severity > Severity::Ok)
+        .collect()
+}
+
+/// Asserts that `findings` are about ESC `esc` alone, each window holding `start_s` (or
+/// starting after it by less than `after_s`) and reaching past `until_s`.
+fn on_esc_in_window(findings: &[Finding], esc: usize, start_s: f64, after_s: f64, until_s: f64) {
+    assert!(!findings.is_empty(), "nothing found");
+    for f in findings {
+        assert_eq!(f.esc.as_ref().unwrap().number, esc, "{f:#?}");
+        let w = f.window.expect("a window");
+        assert!(
+            w.start_s <= start_s + after_s && w.start_s >= start_s - 10.0,
+            "{f:#?}"
+        );
+        assert!(w.end_s >= until_s, "{f:#?}");
+    }
+}
+
+#[test]
+fn a_worn_bearing_is_found_as_imbalance_and_as_drift_on_its_esc_from_when_it_starts() {
+    let bearing = || degrade(2, DegradeKind::Bearing, 20.0, 0.5);
+    let imbalance = found(bearing(), 50.0, 25.0, None, Analyser::Imbalance);
+    on_esc_in_window(&imbalance, 2, 20.0, 5.0, 45.0);
+    let baseline = baseline();
+    let drift = found(bearing(), 50.0, 25.0, Some(&baseline), Analyser::Drift);
+    on_esc_in_window(&drift, 2, 20.0, 5.0, 45.0);
+    assert!(
+        drift
+            .iter()
+            .all(|f| f.threshold.as_ref().unwrap().name == "current_per_rpm")
+    );
+    // Healthy, the same airframe drifts from nothing.
+    assert!(found(Vec::new(), 50.0, 25.0, Some(&baseline), Analyser::Drift).is_empty());
+}
+
+#[test]
+fn a_damaged_prop_is_found_as_imbalance_on_its_esc_from_when_it_starts() {
+    let prop = found(
+        degrade(1, DegradeKind::Prop, 15.0, 1.0),
+        50.0,
+        25.0,
+        None,
+        Analyser::Imbalance,
+    );
+    on_esc_in_window(&prop, 1, 15.0, 5.0, 45.0);
+}
+
+#[test]
+fn a_weak_battery_is_found_against_the_baseline_on_its_esc() {
+    let baseline = baseline();
+    let weak = found(
+        degrade(3, DegradeKind::Battery, 0.0, 0.5),
+        50.0,
+        25.0,
+        Some(&baseline),
+        Analyser::Battery,
+    );
+    assert_eq!(weak.len(), 1, "{weak:#?}");
+    assert_eq!(weak[0].esc.as_ref().unwrap().number, 3);
+    assert_eq!(weak[0].threshold.as_ref().unwrap().name, "resistance_rise");
+    assert!(found(Vec::new(), 50.0, 25.0, Some(&baseline), Analyser::Battery).is_empty());
+}
+
+#[test]
+fn a_loose_telemetry_wire_is_found_as_a_burst_of_loss_on_its_esc_when_it_starts() {
+    let wire = found(
+        degrade(0, DegradeKind::Wire, 25.0, 0.5),
+        50.0,
+        25.0,
+        None,
+        Analyser::Link,
+    );
+    on_esc_in_window(&wire, 0, 25.0, 5.0, 30.0);
+}
+
+#[test]
+fn a_slow_heat_build_up_is_found_on_its_esc_when_it_crosses_the_limit() {
+    let heat = found(
+        degrade(1, DegradeKind::Heat, 0.0, 1.0),
+        600.0,
+        60.0,
+        None,
+        Analyser::Heat,
+    );
+    assert!(!heat.is_empty());
+    for f in &heat {
+        assert_eq!(f.esc.as_ref().unwrap().number, 1, "{f:#?}");
+        assert!(f.window.unwrap().start_s > 300.0, "{f:#?}");
+    }
 }

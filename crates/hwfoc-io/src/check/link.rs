@@ -42,7 +42,7 @@ pub(super) fn analyse(series: &EscSeries, config: &LinkConfig, out: &mut Vec<Fin
             judged.push((l.judge(bad), "checksum_failures", bad, l, "%", None));
         }
     }
-    if let Some((burst, span)) = worst_burst(series, config.window_s) {
+    if let Some((burst, span)) = worst_burst(series, config.window_s, config.burst_pct.warn) {
         f = f.value("burst", burst, "%");
         let l = config.burst_pct;
         judged.push((l.judge(burst), "burst", burst, l, "%", Some(span)));
@@ -95,9 +95,10 @@ fn percent(part: u64, whole: u64) -> f64 {
     }
 }
 
-/// The window of `window_s` with the most packets lost, in % of those sent in it, and its
-/// span; `None` for a protocol without packet numbers or a series shorter than the window.
-fn worst_burst(series: &EscSeries, window_s: f64) -> Option<(f64, Span)> {
+/// The window of `window_s` with the most packets lost, in % of those sent in it, and the span
+/// from the first window with `limit` % lost or more to the last (the worst window's if none);
+/// `None` for a protocol without packet numbers or a series shorter than the window.
+fn worst_burst(series: &EscSeries, window_s: f64, limit: f64) -> Option<(f64, Span)> {
     let bits = series.protocol.packet_bits()?;
     let modulo = 1u64 << bits;
     // (t, packets lost just before this frame)
@@ -122,6 +123,7 @@ fn worst_burst(series: &EscSeries, window_s: f64) -> Option<(f64, Span)> {
         return None;
     }
     let (mut start, mut in_window, mut best) = (0, 0u64, None);
+    let mut above: Option<Span> = None;
     for (i, &(t, n)) in lost.iter().enumerate() {
         in_window += n;
         while lost[start].0 <= t - window_s {
@@ -130,6 +132,13 @@ fn worst_burst(series: &EscSeries, window_s: f64) -> Option<(f64, Span)> {
         }
         let received = (i + 1 - start) as u64;
         let p = percent(in_window, in_window + received);
+        if p >= limit {
+            let from = above.map_or(lost[start].0, |a| a.start_s);
+            above = Some(Span {
+                start_s: from,
+                end_s: t,
+            });
+        }
         if best.is_none_or(|(b, _)| p > b) {
             best = Some((
                 p,
@@ -140,7 +149,7 @@ fn worst_burst(series: &EscSeries, window_s: f64) -> Option<(f64, Span)> {
             ));
         }
     }
-    best
+    best.map(|(p, span)| (p, above.unwrap_or(span)))
 }
 
 /// The longest silence between two frames while the motor turned (at either end), and its
