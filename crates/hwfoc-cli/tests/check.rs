@@ -4,6 +4,10 @@
 
 mod common;
 
+use std::path::{Path, PathBuf};
+
+use common::{Dir, hwfoc, run};
+
 use hwfoc::{Protocol, Settings};
 use hwfoc_io::Record;
 use hwfoc_io::check::{
@@ -14,6 +18,7 @@ use hwfoc_sim::faults::LinkRates;
 use hwfoc_sim::fleet::FleetSpec;
 use hwfoc_sim::model::ModelConfig;
 use hwfoc_sim::profile::{ProfileSpec, Shape};
+use serde_json::Value;
 
 /// A small deterministic generator of flight parameters.
 struct Draw(u64);
@@ -309,4 +314,260 @@ fn a_slow_heat_build_up_is_found_on_its_esc_when_it_crosses_the_limit() {
         assert_eq!(f.esc.as_ref().unwrap().number, 1, "{f:#?}");
         assert!(f.window.unwrap().start_s > 300.0, "{f:#?}");
     }
+}
+
+/// Simulates four ESCs of seed `seed` for 40 s into `dir/name` (a pcapng), with `more`
+/// options (`--degrade`).
+fn simulate(dir: &Dir, name: &str, seed: u64, more: &[&str]) -> String {
+    let path = dir.arg(name);
+    let seed = seed.to_string();
+    let mut args = vec![
+        "simulate",
+        "--escs",
+        "4",
+        "--seed",
+        &seed,
+        "--levels",
+        "0,30,50,70,40,60,80,50,0",
+        "--hold",
+        "4",
+        "--duration",
+        "40",
+        "-o",
+        &path,
+    ];
+    args.extend_from_slice(more);
+    let out = run(hwfoc().args(&args));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    path
+}
+
+/// `hwfoc check --json ARGS`: its exit status and its report.
+fn check_json(args: &[&str]) -> (i32, Value) {
+    let out = run(hwfoc().args(["check", "--json", "--no-config"]).args(args));
+    let report = serde_json::from_slice(&out.stdout)
+        .unwrap_or_else(|e| panic!("{e}: {}", String::from_utf8_lossy(&out.stderr)));
+    (out.status.code().unwrap(), report)
+}
+
+/// The findings of `report` above ok: (analyser, ESC number).
+fn raised_in(report: &Value) -> Vec<(String, u64)> {
+    report["findings"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|f| f["severity"] != "ok")
+        .map(|f| {
+            (
+                f["analyser"].as_str().unwrap().to_string(),
+                f["esc"]["number"].as_u64().unwrap(),
+            )
+        })
+        .collect()
+}
+
+#[test]
+fn the_command_exits_0_on_a_healthy_flight_and_2_on_a_loose_wire_with_json_evidence() {
+    let dir = Dir::new();
+    let healthy = simulate(&dir, "healthy.pcapng", 5, &[]);
+    let (code, report) = check_json(&[&healthy]);
+    assert_eq!(code, 0, "{report:#}");
+    let first = report.as_object().unwrap().keys().next().unwrap().clone();
+    assert_eq!(first, "schema_version");
+    assert_eq!(report["worst"], "ok");
+    let findings = report["findings"].as_array().unwrap();
+    for analyser in ["heat", "imbalance", "battery", "faults", "link", "runtime"] {
+        assert!(
+            findings.iter().any(|f| f["analyser"] == analyser),
+            "{analyser}: {report:#}"
+        );
+    }
+    let loose = simulate(&dir, "loose.pcapng", 5, &["--degrade", "0:wire@10=0.5"]);
+    let (code, report) = check_json(&[&loose]);
+    assert_eq!(code, 2, "{report:#}");
+    assert_eq!(raised_in(&report), [("link".to_string(), 0)], "{report:#}");
+    let link = &report["findings"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|f| f["severity"] != "ok")
+        .unwrap();
+    assert!(
+        link["threshold"]["value"].as_f64().is_some()
+            && link["window"]["start_s"].as_f64().is_some()
+    );
+    // The text says it too.
+    let text = run(hwfoc().args(["check", "--no-config", &loose]));
+    assert_eq!(text.status.code(), Some(2));
+    let text = String::from_utf8(text.stdout).unwrap();
+    assert!(
+        text.contains("CRITICAL  link") && text.contains("(exit 2)"),
+        "{text}"
+    );
+}
+
+#[test]
+fn a_baseline_fitted_from_healthy_flights_finds_a_worn_bearing_as_drift() {
+    let dir = Dir::new();
+    let a = simulate(&dir, "a.pcapng", 1, &[]);
+    let b = simulate(&dir, "b.pcapng", 2, &[]);
+    let base = dir.arg("airframe.toml");
+    let fit = run(hwfoc().args([
+        "check",
+        "--no-config",
+        "--fit-baseline",
+        &a,
+        &b,
+        "-o",
+        &base,
+    ]));
+    assert!(
+        fit.status.success(),
+        "{}",
+        String::from_utf8_lossy(&fit.stderr)
+    );
+    assert!(fit.stdout.is_empty());
+    let toml = std::fs::read_to_string(&base).unwrap();
+    assert!(
+        toml.contains("recordings = 2") && toml.contains("[esc.3.rpm_by_throttle]"),
+        "{toml}"
+    );
+    // A third healthy flight is within it; a worn bearing is not.
+    let c = simulate(&dir, "c.pcapng", 3, &[]);
+    let (code, report) = check_json(&["--baseline", &base, &c]);
+    assert_eq!(code, 0, "{report:#}");
+    let worn = simulate(&dir, "worn.pcapng", 3, &["--degrade", "2:bearing@10=0.5"]);
+    let (code, report) = check_json(&["--baseline", &base, &worn]);
+    assert!(code >= 1, "{report:#}");
+    let raised = raised_in(&report);
+    assert!(raised.contains(&("drift".to_string(), 2)), "{report:#}");
+    assert!(raised.iter().all(|(_, esc)| *esc == 2), "{report:#}");
+}
+
+#[test]
+fn thresholds_come_from_the_configuration_files_check_table() {
+    let dir = Dir::new();
+    let flight = simulate(&dir, "f.pcapng", 4, &[]);
+    let config = dir.path("config.toml");
+    std::fs::write(
+        &config,
+        "[check.heat]\nmos_c = { warn = 20.0, critical = 200.0 }\n",
+    )
+    .unwrap();
+    let out = run(hwfoc().args([
+        "check",
+        "--json",
+        "--config",
+        config.to_str().unwrap(),
+        &flight,
+    ]));
+    assert_eq!(
+        out.status.code(),
+        Some(1),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    // A key that is not a threshold is an error naming the file and the line.
+    std::fs::write(&config, "[check.heat]\nmos = 3\n").unwrap();
+    let out = run(hwfoc().args(["check", "--config", config.to_str().unwrap(), &flight]));
+    assert_eq!(out.status.code(), Some(1));
+    assert!(out.stdout.is_empty());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.starts_with("hwfoc: ") && err.contains("line 2"),
+        "{err}"
+    );
+}
+
+#[test]
+fn an_input_error_exits_1_with_no_report() {
+    let out = run(hwfoc().args(["check", "--no-config", "/nonexistent/flight.pcapng"]));
+    assert_eq!(out.status.code(), Some(1));
+    assert!(out.stdout.is_empty());
+    assert!(String::from_utf8_lossy(&out.stderr).starts_with("hwfoc: "));
+}
+
+#[test]
+fn check_plot_shades_the_windows_of_its_findings() {
+    let dir = Dir::new();
+    let loose = simulate(&dir, "loose.pcapng", 6, &["--degrade", "1:wire@10=0.5"]);
+    let svg = dir.arg("check.svg");
+    let out = run(hwfoc().args(["check", "--no-config", &loose, "--plot", &svg]));
+    assert_eq!(
+        out.status.code(),
+        Some(2),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let image = std::fs::read_to_string(&svg).unwrap();
+    assert!(image.contains("critical link"), "no label of the finding");
+    // Without findings, nothing is shaded.
+    let healthy = simulate(&dir, "healthy.pcapng", 6, &[]);
+    let svg = dir.arg("healthy.svg");
+    let out = run(hwfoc().args(["check", "--no-config", &healthy, "--plot", &svg]));
+    assert_eq!(out.status.code(), Some(0));
+    assert!(
+        !std::fs::read_to_string(&svg)
+            .unwrap()
+            .contains("critical link")
+    );
+}
+
+/// Every recording and capture in `testdata/` that `hwfoc check` reads.
+fn testdata() -> Vec<PathBuf> {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../testdata");
+    ["captures", "recordings", "dronecan"]
+        .iter()
+        .flat_map(|d| std::fs::read_dir(root.join(d)).unwrap())
+        .map(|e| e.unwrap().path())
+        .filter(|p| !p.to_str().unwrap().ends_with(".md") && !p.ends_with("vectors.txt"))
+        .collect()
+}
+
+#[test]
+fn the_real_captures_give_no_finding_the_capture_does_not_show() {
+    let mut read = 0;
+    for path in testdata() {
+        let name = path.to_str().unwrap();
+        let out = run(hwfoc().args(["check", "--json", "--no-config", name]));
+        let Ok(report) = serde_json::from_slice::<Value>(&out.stdout) else {
+            continue; // no data frame in it
+        };
+        read += 1;
+        let summary: Value = serde_json::from_slice(
+            &run(hwfoc().args(["summary", "--json", "--no-config", name])).stdout,
+        )
+        .unwrap();
+        let esc = |n: u64| {
+            summary["escs"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .find(|e| e["esc"] == n)
+                .unwrap_or_else(|| panic!("{name}: no ESC {n} in the summary"))
+                .clone()
+        };
+        for (analyser, n) in raised_in(&report) {
+            let e = esc(n);
+            let shown = match analyser.as_str() {
+                // The summary lists the fault episodes found.
+                "faults" => e["fault_episode_count"].as_u64().unwrap() > 0,
+                // The summary counts the packets lost and the checksums failed.
+                "link" => {
+                    e["link"]["lost_packets"].as_u64().unwrap() > 0
+                        || e["link"]["checksum_failures"].as_u64().unwrap() > 0
+                }
+                _ => false,
+            };
+            assert!(
+                shown,
+                "{name}: ESC {n}: {analyser} not shown by the capture: {report:#}"
+            );
+        }
+    }
+    assert!(read >= 8, "only {read} captures read");
 }

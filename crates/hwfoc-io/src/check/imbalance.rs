@@ -181,8 +181,8 @@ mod tests {
     }
 
     #[test]
-    fn a_motor_drawing_half_as_much_again_is_found_from_when_it_starts() {
-        let out = findings(&flight(2, 1.5, 30.0));
+    fn a_motor_drawing_four_fifths_more_is_found_from_when_it_starts() {
+        let out = findings(&flight(2, 1.8, 30.0));
         let bad: Vec<_> = out.iter().filter(|f| f.severity > Severity::Ok).collect();
         assert_eq!(bad.len(), 1, "{out:?}");
         assert_eq!(bad[0].esc.as_ref().unwrap().number, 2);

@@ -58,7 +58,8 @@ pub(super) fn analyse(series: &EscSeries, config: &LinkConfig, out: &mut Vec<Fin
         judged
             .iter()
             .fold(None, |w: Option<&Judgement>, j| match w {
-                Some(w) if w.0 >= j.0 => Some(w),
+                // The worst; of equals, one with a window (a burst, a dropout) first.
+                Some(w) if w.0 > j.0 || (w.0 == j.0 && (w.5.is_some() || j.5.is_none())) => Some(w),
                 _ => Some(j),
             })
     else {
