@@ -102,6 +102,7 @@ fn fly(spec: FleetSpec, seconds: f64, recording: &str) -> Vec<EscSeries> {
                 esc: EscId {
                     number,
                     label: format!("esc {number}"),
+                    position: format!("esc-{number}"),
                 },
                 recording: recording.to_string(),
                 protocol: esc.protocol(),
@@ -433,7 +434,7 @@ fn a_baseline_fitted_from_healthy_flights_finds_a_worn_bearing_as_drift() {
     assert!(fit.stdout.is_empty());
     let toml = std::fs::read_to_string(&base).unwrap();
     assert!(
-        toml.contains("recordings = 2") && toml.contains("[esc.3.rpm_by_throttle]"),
+        toml.contains("recordings = 2") && toml.contains("[esc.esc-3.rpm_by_throttle]"),
         "{toml}"
     );
     // A third healthy flight is within it; a worn bearing is not.

@@ -59,7 +59,8 @@ pub struct EscBaseline {
     pub current_by_rpm: Curve,
 }
 
-/// An airframe's baseline: each ESC's (by ESC number), and its battery's internal resistance.
+/// An airframe's baseline: each ESC's (by its position: [`super::EscId::position`]), and its
+/// battery's internal resistance.
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Baseline {
@@ -67,7 +68,7 @@ pub struct Baseline {
     pub recordings: usize,
     /// The battery's internal resistance per cell, milliohm (median over the recordings).
     pub resistance_mohm_per_cell: Option<f64>,
-    /// Each ESC's, by its number.
+    /// Each ESC's, by its position (its port, and its place on a hub or bus).
     pub esc: BTreeMap<String, EscBaseline>,
 }
 
@@ -75,9 +76,9 @@ impl Baseline {
     /// The baseline of `series`, healthy flights: each ESC's samples at a steady throttle, of
     /// every recording together.
     pub fn fit(series: &[EscSeries], cells: Option<u32>) -> Baseline {
-        let mut by_esc: BTreeMap<usize, Vec<&EscSeries>> = BTreeMap::new();
+        let mut by_esc: BTreeMap<&str, Vec<&EscSeries>> = BTreeMap::new();
         for s in series {
-            by_esc.entry(s.esc.number).or_default().push(s);
+            by_esc.entry(s.esc.position.as_str()).or_default().push(s);
         }
         let esc = by_esc
             .into_iter()

@@ -42,7 +42,9 @@ pub(super) fn analyse(
             .or_else(|| {
                 let earlier = series
                     .iter()
-                    .find(|e| Some(e.recording.as_str()) == first && e.esc.number == s.esc.number)
+                    .find(|e| {
+                        Some(e.recording.as_str()) == first && e.esc.position == s.esc.position
+                    })
                     .filter(|e| e.recording != s.recording)?;
                 resistance_mohm(earlier).map(|r| r / cells)
             });

@@ -30,7 +30,7 @@ pub(super) fn analyse(
     out: &mut Vec<Finding>,
 ) {
     for s in series {
-        let Some(base) = baseline.esc.get(&s.esc.number.to_string()) else {
+        let Some(base) = baseline.esc.get(&s.esc.position) else {
             continue;
         };
         let steady = steady(&s.samples);
@@ -151,7 +151,7 @@ mod tests {
     #[test]
     fn a_flight_like_the_baseline_is_ok_and_more_current_per_rpm_is_found_when_it_starts() {
         let baseline = Baseline::fit(&flight(1.0, 0.0), None);
-        assert!(!baseline.esc["1"].current_by_rpm.y.is_empty());
+        assert!(!baseline.esc["esc-1"].current_by_rpm.y.is_empty());
         let same = drift(&flight(1.0, 0.0), &baseline);
         assert_eq!(same.len(), 2);
         assert!(same.iter().all(|f| f.severity == Severity::Ok), "{same:?}");
@@ -169,7 +169,7 @@ mod tests {
     #[test]
     fn an_esc_the_baseline_does_not_know_is_not_judged() {
         let mut other = flight(2.0, 0.0);
-        other[0].esc.number = 7;
+        other[0].esc.position = "esc-7".to_string();
         assert!(drift(&other, &Baseline::fit(&flight(1.0, 0.0), None)).is_empty());
     }
 }

@@ -103,6 +103,10 @@ pub struct EscId {
     pub number: usize,
     /// Its label, as every command names it (`flight.pcapng: ttyUSB1 (ESC 1)`).
     pub label: String,
+    /// Where it is on the vehicle, the same in every recording of it: its port (a
+    /// recording's interface name, a serial port) and, on a hub or a CAN bus, its place
+    /// (`ttyUSB1`, `can0#2`). A baseline is kept by position.
+    pub position: String,
 }
 
 /// When a finding happened, in seconds on its input's clock (the nominal frame period times the

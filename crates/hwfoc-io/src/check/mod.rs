@@ -84,6 +84,10 @@ impl Check {
                     esc: EscId {
                         number: i,
                         label: esc_label(sources, i),
+                        position: match entry.key.place {
+                            crate::Place::Own => entry.key.port.clone(),
+                            crate::Place::Channel(c) => format!("{}#{c}", entry.key.port),
+                        },
                     },
                     recording: recording_name(sources, entry),
                     protocol: link.protocol(),
@@ -178,6 +182,7 @@ pub(crate) mod tests {
             esc: EscId {
                 number,
                 label: format!("esc {number}"),
+                position: format!("esc-{number}"),
             },
             recording: "flight".to_string(),
             protocol: Protocol::HwFoc,
