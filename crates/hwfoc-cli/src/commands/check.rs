@@ -75,18 +75,13 @@ pub fn run(args: &CheckArgs) -> Result<Severity, CliError> {
         }
         None => None,
     };
-    let mut plot = match &args.plot {
-        Some(path) => {
-            args.input.refuse_output(path, &config)?;
-            Some(plot::Alongside::open(
-                path,
-                args.overwrite,
-                settings,
-                args.input.stop_if_read_to_end(),
-            )?)
-        }
-        None => None,
-    };
+    let mut plot = plot::Alongside::asked(
+        args.plot.as_deref(),
+        &args.input,
+        &config,
+        args.overwrite,
+        settings,
+    )?;
     let mut sources = args.input.sources(settings_map)?;
     if selection.window.is_limited() {
         sources.require_timing()?;

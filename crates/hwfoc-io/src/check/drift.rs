@@ -6,8 +6,8 @@
 //! (or a sagging battery).
 
 use super::baseline::{RPM_BIN, THROTTLE_BIN_PCT};
-use super::stats::{curve, held, median, steady, windows};
-use super::{Analyser, Baseline, DriftConfig, EscSeries, Finding, Limits, Sample, Severity, Span};
+use super::stats::{curve, held_finding, median, steady, windows};
+use super::{Analyser, Baseline, DriftConfig, EscSeries, Finding, Sample, Span};
 
 /// A baseline value below this is not compared with, A or rev/min (near idle, a ratio means
 /// nothing).
@@ -79,43 +79,26 @@ pub(super) fn analyse(
                     Some((span, median(&mut devs)?))
                 })
                 .collect();
-            if let Some(f) = judge(s, name, what, &drifts, limits, config.window_s) {
+            let f = held_finding(
+                Analyser::Drift,
+                s,
+                name,
+                &drifts,
+                limits,
+                config.window_s,
+                |d| format!("{what} by {d:.0} %"),
+            );
+            if let Some(f) = f {
                 out.push(f);
             }
         }
     }
 }
 
-/// The finding of one ESC's drifts by window.
-fn judge(
-    series: &EscSeries,
-    name: &str,
-    what: &str,
-    drifts: &[(Span, f64)],
-    limits: Limits,
-    window_s: f64,
-) -> Option<Finding> {
-    let s = held(drifts, limits.warn)?;
-    let severity = limits.judge(s.worst);
-    let mut f = Finding::about(Analyser::Drift, series)
-        .value(name, s.worst, "%")
-        .judged(severity, name, limits.crossed(severity), "%");
-    f.window = s.span.filter(|_| severity > Severity::Ok);
-    f.message = format!(
-        "{what} by {:.0} % (held over windows of {window_s} s){}",
-        s.worst,
-        match severity {
-            Severity::Ok => format!(", within {} %", limits.warn),
-            _ => format!(": at or beyond {} %", limits.crossed(severity)),
-        }
-    );
-    Some(f)
-}
-
 #[cfg(test)]
 mod tests {
     use super::super::tests::series_of;
-    use super::super::{CheckConfig, Sample, analyse as analyse_all};
+    use super::super::{CheckConfig, Severity, analyse as analyse_all};
     use super::*;
 
     /// ESC 1 on a throttle staircase, drawing `factor` times the current from `from_s` on.

@@ -9,8 +9,8 @@
 use std::collections::BTreeMap;
 
 use super::baseline::THROTTLE_BIN_PCT;
-use super::stats::{curve, held, median, steady, windows};
-use super::{Analyser, Curve, EscSeries, Finding, ImbalanceConfig, Limits, Sample, Severity, Span};
+use super::stats::{curve, held_finding, median, steady, windows};
+use super::{Analyser, Curve, EscSeries, Finding, ImbalanceConfig, Limits, Sample, Span};
 
 /// Siblings needed to tell which motor is off: with two, either could be.
 const MIN_ESCS: usize = 3;
@@ -111,31 +111,31 @@ fn judge(
     limits: Limits,
     window_s: f64,
 ) -> Option<Finding> {
-    let s = held(deviations, limits.warn)?;
-    let severity = limits.judge(s.worst);
     let name = format!("{what}_vs_siblings");
-    let mut f = Finding::about(Analyser::Imbalance, series)
-        .value(&name, s.worst, "%")
-        .judged(severity, &name, limits.crossed(severity), "%");
-    f.window = s.span.filter(|_| severity > Severity::Ok);
-    let direction = match what {
-        "rpm" => "away from",
-        _ if s.worst < 0.0 => "below",
-        _ => "above",
-    };
-    f.message = format!(
-        "{what} {:.0} % {direction} its siblings' at the same throttle (held over windows of {window_s} s){}",
-        s.worst.abs(),
-        match severity {
-            Severity::Ok => format!(", within {} %", limits.warn),
-            _ => format!(": at or beyond {} %", limits.crossed(severity)),
-        }
-    );
-    Some(f)
+    held_finding(
+        Analyser::Imbalance,
+        series,
+        &name,
+        deviations,
+        limits,
+        window_s,
+        |d| {
+            let direction = match what {
+                "rpm" => "away from",
+                _ if d < 0.0 => "below",
+                _ => "above",
+            };
+            format!(
+                "{what} {:.0} % {direction} its siblings' at the same throttle",
+                d.abs()
+            )
+        },
+    )
 }
 
 #[cfg(test)]
 mod tests {
+    use super::super::Severity;
     use super::super::tests::series_of;
     use super::*;
 

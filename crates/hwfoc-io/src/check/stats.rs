@@ -137,6 +137,35 @@ pub(super) fn windows(
     })
 }
 
+/// The finding of `analyser` on deviations by window `(window, %)` of `series`, judged where
+/// they hold ([`held`]) against `limits`, as value `name`; its message `what` says of the
+/// worst deviation held, followed by the windows' length and the limit.
+pub(super) fn held_finding(
+    analyser: super::Analyser,
+    series: &super::EscSeries,
+    name: &str,
+    deviations: &[(super::Span, f64)],
+    limits: super::Limits,
+    window_s: f64,
+    what: impl FnOnce(f64) -> String,
+) -> Option<super::Finding> {
+    let s = held(deviations, limits.warn)?;
+    let severity = limits.judge(s.worst);
+    let mut f = super::Finding::about(analyser, series)
+        .value(name, s.worst, "%")
+        .judged(severity, name, limits.crossed(severity), "%");
+    f.window = s.span.filter(|_| severity > super::Severity::Ok);
+    f.message = format!(
+        "{} (held over windows of {window_s} s){}",
+        what(s.worst),
+        match severity {
+            super::Severity::Ok => format!(", within {} %", limits.warn),
+            _ => format!(": at or beyond {} %", limits.crossed(severity)),
+        }
+    );
+    Some(f)
+}
+
 /// Deviations by window `(window, %)`, in time order, judged where they hold: the worst of
 /// the lesser deviation of two windows in a row (overlapping), and the span of the pairs at or
 /// above `limit` (each pair's two windows together: the span holds where it began). One window alone (a short flight) is judged by itself.
