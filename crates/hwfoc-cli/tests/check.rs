@@ -196,15 +196,22 @@ fn degrade(esc: usize, kind: DegradeKind, start_s: f64, severity: f64) -> Vec<De
     }]
 }
 
-/// The baseline of three healthy flights of [`airframe`].
+/// The seed of the degraded airframe: in the simulator a seed is an airframe (each ESC's share
+/// of the load, its motor's and battery's tolerances are drawn from it).
+const AIRFRAME: u64 = 11;
+
+/// The baseline of three healthy flights of [`airframe`] [`AIRFRAME`], flown other ways than
+/// the flights checked (a sine, a ramp, other levels).
 fn baseline() -> Baseline {
-    let series: Vec<EscSeries> = (1..=3)
-        .flat_map(|seed| {
-            fly(
-                airframe(seed, 25.0, Vec::new()),
-                50.0,
-                &format!("healthy {seed}"),
-            )
+    let series: Vec<EscSeries> = [ProfileSpec::Sine, ProfileSpec::Ramp, ProfileSpec::Steps]
+        .into_iter()
+        .enumerate()
+        .flat_map(|(i, profile)| {
+            let mut spec = airframe(AIRFRAME, 25.0, Vec::new());
+            spec.profile = profile;
+            spec.shape.levels = vec![0.0, 35.0, 55.0, 75.0, 45.0, 65.0, 85.0, 25.0, 0.0];
+            spec.shape.period_s = 8.0;
+            fly(spec, 50.0, &format!("healthy {i}"))
         })
         .collect();
     Baseline::fit(&series, None)
@@ -218,7 +225,7 @@ fn found(
     baseline: Option<&Baseline>,
     analyser: Analyser,
 ) -> Vec<Finding> {
-    let series = fly(airframe(11, ambient_c, degradations), seconds, "degraded");
+    let series = fly(airframe(AIRFRAME, ambient_c, degradations), seconds, "degraded");
     let findings = analyse(&series, &CheckConfig::default(), baseline);
     let all: Vec<Finding> = findings
         .into_iter()
@@ -414,8 +421,9 @@ fn the_command_exits_0_on_a_healthy_flight_and_2_on_a_loose_wire_with_json_evide
 #[test]
 fn a_baseline_fitted_from_healthy_flights_finds_a_worn_bearing_as_drift() {
     let dir = Dir::new();
-    let a = simulate(&dir, "a.pcapng", 1, &[]);
-    let b = simulate(&dir, "b.pcapng", 2, &[]);
+    // One airframe (a seed, in the simulator), flown other ways than the flights checked.
+    let a = simulate(&dir, "a.pcapng", 3, &["--profile", "sine", "--period", "8"]);
+    let b = simulate(&dir, "b.pcapng", 3, &["--levels", "0,35,55,75,25,0"]);
     let base = dir.arg("airframe.toml");
     let fit = run(hwfoc().args([
         "check",
