@@ -225,7 +225,11 @@ fn found(
     baseline: Option<&Baseline>,
     analyser: Analyser,
 ) -> Vec<Finding> {
-    let series = fly(airframe(AIRFRAME, ambient_c, degradations), seconds, "degraded");
+    let series = fly(
+        airframe(AIRFRAME, ambient_c, degradations),
+        seconds,
+        "degraded",
+    );
     let findings = analyse(&series, &CheckConfig::default(), baseline);
     let all: Vec<Finding> = findings
         .into_iter()
@@ -269,15 +273,17 @@ fn a_worn_bearing_is_found_as_imbalance_and_as_drift_on_its_esc_from_when_it_sta
 }
 
 #[test]
-fn a_damaged_prop_is_found_as_imbalance_on_its_esc_from_when_it_starts() {
-    let prop = found(
-        degrade(1, DegradeKind::Prop, 15.0, 1.0),
-        50.0,
-        25.0,
-        None,
-        Analyser::Imbalance,
+fn a_damaged_prop_is_found_as_imbalance_and_as_drift_on_its_esc_from_when_it_starts() {
+    let prop = || degrade(1, DegradeKind::Prop, 15.0, 1.0);
+    let imbalance = found(prop(), 50.0, 25.0, None, Analyser::Imbalance);
+    on_esc_in_window(&imbalance, 1, 15.0, 5.0, 45.0);
+    let drift = found(prop(), 50.0, 25.0, Some(&baseline()), Analyser::Drift);
+    on_esc_in_window(&drift, 1, 15.0, 5.0, 45.0);
+    assert!(
+        drift
+            .iter()
+            .all(|f| f.threshold.as_ref().unwrap().name == "rpm_per_throttle")
     );
-    on_esc_in_window(&prop, 1, 15.0, 5.0, 45.0);
 }
 
 #[test]

@@ -111,7 +111,7 @@ impl Default for ImbalanceConfig {
 pub struct DriftConfig {
     /// Current per rpm above the baseline's, % (default 15 / 30).
     pub current_per_rpm_pct: Limits,
-    /// Rpm per throttle below the baseline's, % (default 8 / 15).
+    /// Rpm per throttle away from the baseline's, either way, % (default 8 / 15).
     pub rpm_per_throttle_pct: Limits,
     /// The window the ESC's curve is compared in, s (default 10; windows overlap by half, a
     /// drift must hold in two in a row).

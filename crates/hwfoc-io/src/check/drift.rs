@@ -2,8 +2,8 @@
 //! its healthy flights gave ([`Baseline`]), at a steady throttle. In each window of time the ESC's medians per bin
 //! are compared with the baseline's; the window's drift is the median over its bins, and it
 //! must hold in two windows in a row. More current for the same rpm points to a bearing or a
-//! motor going, or a heavier prop; less rpm for the same throttle to a motor losing its grip
-//! (or a sagging battery).
+//! motor going, or a heavier prop; rpm per throttle away from the baseline's to a damaged
+//! (lighter) prop, or a motor losing its grip (or a sagging battery).
 
 use super::baseline::{RPM_BIN, THROTTLE_BIN_PCT};
 use super::stats::{curve, held_finding, median, steady, windows};
@@ -42,14 +42,14 @@ pub(super) fn analyse(
             let throttle = f64::from(x.throttle_pct?);
             (throttle >= MIN_THROTTLE_PCT).then_some((throttle, f64::from(x.rpm?)))
         };
-        for (name, point, reference, width, min_ref, sign, limits, what) in [
+        for (name, point, reference, width, min_ref, both_ways, limits, what) in [
             (
                 "current_per_rpm",
                 current_per_rpm,
                 &base.current_by_rpm,
                 RPM_BIN,
                 MIN_REFERENCE[0],
-                1.0,
+                false,
                 config.current_per_rpm_pct,
                 "current per rpm above the baseline's",
             ),
@@ -59,9 +59,9 @@ pub(super) fn analyse(
                 &base.rpm_by_throttle,
                 THROTTLE_BIN_PCT,
                 MIN_REFERENCE[1],
-                -1.0,
+                true,
                 config.rpm_per_throttle_pct,
-                "rpm per throttle below the baseline's",
+                "rpm per throttle away from the baseline's",
             ),
         ] {
             let drifts: Vec<(Span, f64)> = windows(&steady, config.window_s)
@@ -73,7 +73,8 @@ pub(super) fn analyse(
                         .zip(&mine.y)
                         .filter_map(|(&x, &v)| {
                             let r = reference.at(x, 2.0 * width)?;
-                            (r >= min_ref).then(|| sign * (v - r) / r * 100.0)
+                            let d = (v - r) / r * 100.0;
+                            (r >= min_ref).then_some(if both_ways { d.abs() } else { d })
                         })
                         .collect();
                     Some((span, median(&mut devs)?))
