@@ -6,11 +6,13 @@ import json
 import time
 
 import pyarrow as pa
+import pyarrow.compute
 import pytest
 
 import hwfoc
 import hwfoc.findings
 from conftest import run_cli, simulate
+from test_fleet import spark  # noqa: F401 (the fixture)
 
 
 def command_findings(cli, path, *args):
@@ -57,3 +59,12 @@ def test_dask_findings_equal_the_command(cli, degraded):
         got = df[df["path"] == path].drop(columns=["path"])
         table = pa.Table.from_pandas(got, schema=hwfoc.FINDINGS_SCHEMA, preserve_index=False)
         assert table.to_pylist() == command_findings(cli, path)
+
+
+def test_spark_findings_equal_the_command(cli, degraded, spark):
+    import hwfoc.spark
+
+    table = hwfoc.spark.findings(spark, degraded, path_column="path").toArrow()
+    for path in degraded:
+        got = table.filter(pa.compute.equal(table["path"], path)).drop_columns(["path"])
+        assert got.cast(hwfoc.FINDINGS_SCHEMA).to_pylist() == command_findings(cli, path)
