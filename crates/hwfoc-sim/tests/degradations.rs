@@ -2,8 +2,6 @@
 //! sends, on the degraded ESC only and from its start on: a run with the degradation is
 //! compared frame by frame with the same run (same seed) without it.
 
-mod common;
-
 use hwfoc::foc::DataFrame;
 use hwfoc::{Protocol, Temperature};
 use hwfoc_sim::FleetSpec;
@@ -30,7 +28,7 @@ fn spec(degradations: &[&str]) -> FleetSpec {
         },
         model: ModelConfig {
             capacity_mah: 50_000.0,
-            ..common::model()
+            ..ModelConfig::SIMULATE
         },
         faults: Vec::new(),
         link: LinkRates::default(),
