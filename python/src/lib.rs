@@ -5,6 +5,7 @@
 //! exception of `hwfoc` (see `errors.rs`) whose message is the one the `hwfoc` command prints.
 
 mod can;
+mod check;
 mod errors;
 mod live;
 mod records;
@@ -485,6 +486,7 @@ fn _hwfoc(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(read, m)?)?;
     m.add_function(wrap_pyfunction!(scan::scan, m)?)?;
     m.add_function(wrap_pyfunction!(summary, m)?)?;
+    m.add_function(wrap_pyfunction!(check::check_json, m)?)?;
     m.add_function(wrap_pyfunction!(record_schema, m)?)?;
     m.add_function(wrap_pyfunction!(live::open_ports, m)?)?;
     m.add_class::<scan::Scan>()?;

@@ -4,9 +4,9 @@
 //!
 //! - `bearing`: the motor needs more current for the same RPM (a worn bearing, a failing
 //!   winding): input current × (1 + SEVERITY) while motoring.
-//! - `prop`: a damaged propeller, lighter than its siblings': RPM × (1 + 0.1 × SEVERITY) and
-//!   input current × (1 − 0.3 × SEVERITY) for the load at that RPM (the load rising with RPM
-//!   cubed: about 7 % less current at full severity), at equal throttle, with a
+//! - `prop`: a damaged propeller, lighter than its siblings': RPM × (1 + 0.2 × SEVERITY) and
+//!   input current × (1 − 0.5 × SEVERITY) for the load at that RPM (the load rising with RPM
+//!   cubed: about 14 % less current at full severity), at equal throttle, with a
 //!   once-per-revolution ripple of ±10 % × SEVERITY on the current (vibration).
 //! - `battery`: a weak battery: internal and polarisation resistance × (1 + SEVERITY), so the
 //!   voltage sags more per ampere.
@@ -25,9 +25,9 @@ use crate::rng::Rng;
 /// Severity when a spec gives none.
 pub const DEFAULT_SEVERITY: f64 = 0.5;
 /// `prop`: RPM gain at full severity.
-pub const PROP_RPM: f64 = 0.1;
+pub const PROP_RPM: f64 = 0.2;
 /// `prop`: share of the current lost at full severity.
-pub const PROP_CURRENT: f64 = 0.3;
+pub const PROP_CURRENT: f64 = 0.5;
 /// `prop`: amplitude of the once-per-revolution current ripple at full severity.
 pub const PROP_RIPPLE: f64 = 0.1;
 /// `wire`: probability per frame of a burst of loss starting, at full severity.
@@ -35,7 +35,7 @@ pub const WIRE_BURST: f64 = 0.1;
 /// `wire`: shortest and longest burst, frames.
 pub const WIRE_BURST_FRAMES: (u64, u64) = (5, 20);
 /// `heat`: the MOSFETs' extra temperature rise at full severity, K.
-pub const HEAT_RISE_K: f64 = 40.0;
+pub const HEAT_RISE_K: f64 = 80.0;
 /// `heat`: seconds over which the extra rise builds up.
 pub const HEAT_RAMP_S: f64 = 600.0;
 

@@ -13,9 +13,8 @@ use hwfoc::Protocol;
 use hwfoc_sim::FleetSpec;
 use hwfoc_sim::can::{CanBus, CanDestination, CanPlan, CanSession};
 use hwfoc_sim::faults::LinkRates;
+use hwfoc_sim::model::ModelConfig;
 use hwfoc_sim::profile::{ProfileSpec, Shape};
-
-mod common;
 
 #[path = "../../hwfoc-bridge/tests/py/python.rs"]
 mod python;
@@ -42,7 +41,7 @@ fn spec(n: usize) -> FleetSpec {
             period_s: 10.0,
             max_pct: 80.0,
         },
-        model: common::model(),
+        model: ModelConfig::SIMULATE,
         faults: vec!["1:mos_overheat@2-3".parse().unwrap()],
         link: LinkRates::default(),
         degradations: Vec::new(),

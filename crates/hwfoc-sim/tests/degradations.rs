@@ -2,8 +2,6 @@
 //! sends, on the degraded ESC only and from its start on: a run with the degradation is
 //! compared frame by frame with the same run (same seed) without it.
 
-mod common;
-
 use hwfoc::foc::DataFrame;
 use hwfoc::{Protocol, Temperature};
 use hwfoc_sim::FleetSpec;
@@ -30,7 +28,7 @@ fn spec(degradations: &[&str]) -> FleetSpec {
         },
         model: ModelConfig {
             capacity_mah: 50_000.0,
-            ..common::model()
+            ..ModelConfig::SIMULATE
         },
         faults: Vec::new(),
         link: LinkRates::default(),
@@ -155,8 +153,8 @@ fn damaged_prop_turns_faster_on_less_current_with_a_ripple() {
     let after = pairs(&runs[0][1], &runs[1][1], (8.5, 20.0));
     let rpm = ratio(&after, erpm);
     let current = ratio(&after, amps);
-    assert!((1.07..1.12).contains(&rpm), "rpm x {rpm}");
-    assert!((0.9..0.96).contains(&current), "current x {current}");
+    assert!((1.17..1.23).contains(&rpm), "rpm x {rpm}");
+    assert!((0.8..0.9).contains(&current), "current x {current}");
     // The ripple: the frame-to-frame scatter of the current against the healthy run's, well
     // above that of a steady change of current (a bearing's), which is the sensor noise alone.
     let bearing = compare("1:bearing@8=0.4", 20.0);
@@ -232,9 +230,9 @@ fn heat_builds_up_over_minutes() {
     };
     let early = rise(10.0, 20.0);
     let late = rise(120.0, 130.0);
-    // 40 K over 600 s: 8 K after 120 s, less the MOSFETs' 20 s lag.
+    // 80 K over 600 s: 16 K after 120 s, less the MOSFETs' 20 s lag.
     assert!(early < 1.0, "{early}");
-    assert!((5.0..8.5).contains(&late), "{late}");
+    assert!((11.0..17.0).contains(&late), "{late}");
     // Rising steadily: the middle lies between.
     let middle = rise(65.0, 75.0);
     assert!(early < middle && middle < late, "{early} {middle} {late}");

@@ -227,9 +227,9 @@ pub struct ModelArgs {
     faults: Vec<FaultSpec>,
     /// Degrade ESC number ESC from START seconds on (0 without it) at SEVERITY from 0 to 1
     /// (0.5 without it). KIND: bearing (current x (1 + SEVERITY) for the same RPM), prop (a
-    /// damaged propeller: RPM +10 % x SEVERITY, current -30 % x SEVERITY, with a ripple),
+    /// damaged propeller: RPM +20 % x SEVERITY, load -50 % x SEVERITY, with a ripple),
     /// battery (resistance x (1 + SEVERITY): more sag per ampere), wire (bursts of 5-20 frames
-    /// lost, hw-foc only), heat (MOSFET temperature rising by up to 40 K x SEVERITY over 10
+    /// lost, hw-foc only), heat (MOSFET temperature rising by up to 80 K x SEVERITY over 10
     /// minutes). The truth (--truth) starts with one line per degradation. Repeatable.
     #[arg(
         long = "degrade",
