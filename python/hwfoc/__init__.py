@@ -8,6 +8,7 @@ the ``hwfoc`` command): one row per data frame, in physical units.
 - :func:`scan`: the same records as ``pyarrow.RecordBatch`` es, in bounded memory, for inputs
   larger than memory;
 - :func:`summary`: what ``hwfoc summary --json`` prints, as Python objects;
+- :func:`check`: the findings of ``hwfoc check`` (docs/CHECKS.md) as a ``pyarrow.Table``;
 - :class:`Decoder`: a streaming decoder for live bytes; :class:`CanDecoder`: one for CAN frames
   already held (python-can messages); :func:`open_ports`: live records from
   serial ports, as ``hwfoc monitor`` reads them;
@@ -51,8 +52,11 @@ from ._hwfoc import (
     scan,
     summary,
 )
+from .findings import FINDINGS_SCHEMA, check
 
 __all__ = [
+    "FINDINGS_SCHEMA",
+    "check",
     "DEFAULT_CURRENT_SCALE",
     "DEFAULT_GEAR_RATIO",
     "DEFAULT_POLE_PAIRS",

@@ -3,7 +3,7 @@
 import datetime
 import os
 from types import TracebackType
-from typing import IO, Any, Dict, Iterable, Iterator, List, Optional, Sequence, Tuple, Union
+from typing import IO, Any, Dict, Iterable, Iterator, List, Mapping, Optional, Sequence, Tuple, Union
 
 import pyarrow as pa
 
@@ -140,6 +140,22 @@ class Scan(Iterator[pa.RecordBatch]):
     def __next__(self) -> pa.RecordBatch: ...
     def close(self) -> None:
         """Stops the decoding thread; the iterator then ends."""
+
+FINDINGS_SCHEMA: pa.Schema
+
+def check(
+    source: Sources,
+    *,
+    config: Union[None, str, "os.PathLike[str]", Mapping[str, Any]] = None,
+    baseline: Union[None, str, "os.PathLike[str]", Mapping[str, Any]] = None,
+    current_scale: float = ...,
+    pole_pairs: int = ...,
+    gear_ratio: float = ...,
+    v4_volts_per_step: str = ...,
+) -> pa.Table:
+    """The findings of ``hwfoc check --json`` on ``source`` as a table of
+    :data:`FINDINGS_SCHEMA` (docs/CHECKS.md, "Python")."""
+    ...
 
 def summary(
     source: Sources,

@@ -20,7 +20,7 @@ import pyarrow as pa
 
 import hwfoc
 
-__all__ = ["read", "esc_aggregates", "paths", "to_pandas", "add_columns"]
+__all__ = ["read", "esc_aggregates", "findings", "paths", "to_pandas", "add_columns"]
 
 
 def paths(paths_or_glob: Union[str, "os.PathLike[str]", Sequence[Union[str, "os.PathLike[str]"]]]) -> List[str]:
@@ -144,3 +144,32 @@ def esc_aggregates(ddf: Any, path_column: str = "recording") -> Any:
     by = [path_column, "esc"]
     meta = _empty_aggregates(ddf._meta, by)
     return ddf.map_partitions(_esc_aggregates, by, meta=meta)
+
+
+def _findings(path: str, path_column: str, options: dict) -> pd.DataFrame:
+    table = hwfoc.check(path, **options)
+    return to_pandas(add_columns(table, path, path_column, None))
+
+
+def findings(
+    paths_or_glob: Union[str, "os.PathLike[str]", Sequence[Union[str, "os.PathLike[str]"]]],
+    *,
+    path_column: str = "path",
+    **options: Any,
+) -> Any:
+    """A Dask DataFrame of the findings of ``hwfoc check`` on each recording (one partition per
+    file, each :func:`hwfoc.check` of it: the command's findings on that file), with the file
+    in ``path_column``. ``options`` are :func:`hwfoc.check`'s (``config``, ``baseline``, the
+    settings)."""
+    import dask.dataframe as dd
+
+    empty = hwfoc.FINDINGS_SCHEMA.empty_table()
+    return dd.from_map(
+        _findings,
+        paths(paths_or_glob),
+        path_column=path_column,
+        options=options,
+        meta=to_pandas(add_columns(empty, None, path_column, None)),
+        label="hwfoc-check",
+        enforce_metadata=False,
+    )

@@ -22,7 +22,7 @@ import pyarrow as pa
 import hwfoc
 from hwfoc.dask import add_columns, paths as _paths
 
-__all__ = ["read", "arrow_schema", "spark_schema", "esc_aggregates"]
+__all__ = ["read", "arrow_schema", "spark_schema", "esc_aggregates", "findings"]
 
 _WIDER = {
     pa.uint8(): pa.int16(),
@@ -128,3 +128,32 @@ def esc_aggregates(df: Any, path_column: str = "recording", frame_column: str = 
         F.min("voltage_v").alias("min_voltage_v"),
         F.sum("_start").alias("fault_episodes"),
     )
+
+
+def findings(
+    spark: Any,
+    paths_or_glob: Union[str, "os.PathLike[str]", Sequence[Union[str, "os.PathLike[str]"]]],
+    *,
+    path_column: str = "path",
+    **options: Any,
+) -> Any:
+    """A Spark DataFrame of the findings of ``hwfoc check`` on each recording (one partition
+    per file, each :func:`hwfoc.check` of it on an executor), with the file as given in
+    ``path_column``; ``options`` as :func:`hwfoc.check`'s. Columns: those of
+    :data:`hwfoc.FINDINGS_SCHEMA` (``values`` an array of structs)."""
+    names: List[str] = _paths(paths_or_glob)
+    column, name_column = "_hwfoc_path", "_hwfoc_name"
+    listing = spark.createDataFrame(
+        [(os.path.abspath(p), p) for p in names], f"{column} string, {name_column} string"
+    ).repartition(len(names), column)
+    schema = add_columns(hwfoc.FINDINGS_SCHEMA.empty_table(), "", path_column, None).schema
+
+    def check(batches: Iterator[pa.RecordBatch]) -> Iterator[pa.RecordBatch]:
+        for batch in batches:
+            for path, name in zip(batch.column(column).to_pylist(), batch.column(name_column).to_pylist()):
+                table = add_columns(hwfoc.check(path, **options), name, path_column, None)
+                yield from table.cast(schema).to_batches()
+
+    from pyspark.sql.pandas.types import from_arrow_schema
+
+    return listing.mapInArrow(check, from_arrow_schema(schema))

@@ -6,6 +6,7 @@
 
 mod args;
 mod can;
+mod check;
 mod errors;
 mod interrupt;
 mod live;
@@ -498,6 +499,7 @@ fn _hwfoc(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(read, m)?)?;
     m.add_function(wrap_pyfunction!(scan::scan, m)?)?;
     m.add_function(wrap_pyfunction!(summary, m)?)?;
+    m.add_function(wrap_pyfunction!(check::check_json, m)?)?;
     m.add_function(wrap_pyfunction!(record_schema, m)?)?;
     m.add_function(wrap_pyfunction!(live::open_ports, m)?)?;
     m.add_class::<scan::Scan>()?;

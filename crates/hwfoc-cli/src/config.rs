@@ -80,6 +80,9 @@ pub struct File {
     /// The monitor's alarm levels.
     #[serde(default)]
     pub alarms: AlarmKeys,
+    /// `hwfoc check`'s thresholds (`docs/CHECKS.md`).
+    #[serde(default)]
+    pub check: hwfoc_io::check::CheckConfig,
     // The older layout's top-level keys.
     baud: Option<u32>,
     current_scale: Option<f32>,
@@ -447,31 +450,47 @@ const MAX_CONFIG: u64 = 1 << 20;
 
 /// Reads and parses a configuration file; errors name the file and the line.
 fn read_file(path: &Path) -> Result<File, CliError> {
+    let text = read_text(path)?;
+    let doc = DeTable::parse(&text).map_err(|e| toml_error(path, &text, e))?;
+    if let Some((line, message)) = same_names(doc.get_ref(), &text) {
+        return Err(CliError::Config {
+            path: path.display().to_string(),
+            line: Some(line),
+            message,
+        });
+    }
+    File::deserialize(toml::de::Deserializer::from(doc)).map_err(|e| toml_error(path, &text, e))
+}
+
+/// Reads and parses another TOML file the command takes (`hwfoc check --baseline`); errors
+/// name the file and the line, as the configuration file's do.
+pub fn read_toml<T: serde::de::DeserializeOwned>(path: &Path) -> Result<T, CliError> {
+    let text = read_text(path)?;
+    toml::from_str(&text).map_err(|e| toml_error(path, &text, e))
+}
+
+/// The text of a TOML file of at most [`MAX_CONFIG`] bytes.
+fn read_text(path: &Path) -> Result<String, CliError> {
     let open_error = |source| InputError::Open {
         input: path.display().to_string(),
         source,
     };
     let bytes = read_small_file(path, MAX_CONFIG).map_err(open_error)?;
-    let text = String::from_utf8(bytes).map_err(|_| {
+    Ok(String::from_utf8(bytes).map_err(|_| {
         open_error(std::io::Error::new(
             std::io::ErrorKind::InvalidData,
             "it is not UTF-8 text",
         ))
-    })?;
-    let config_error = |line, message| CliError::Config {
+    })?)
+}
+
+/// A TOML error of file `path`, holding `text`: its line and message.
+fn toml_error(path: &Path, text: &str, e: toml::de::Error) -> CliError {
+    CliError::Config {
         path: path.display().to_string(),
-        line,
-        message,
-    };
-    let toml_error = |e: toml::de::Error| {
-        let line = e.span().map(|span| line_of(&text, span.start));
-        config_error(line, e.message().trim().replace('\n', " "))
-    };
-    let doc = DeTable::parse(&text).map_err(toml_error)?;
-    if let Some((line, message)) = same_names(doc.get_ref(), &text) {
-        return Err(config_error(Some(line), message));
+        line: e.span().map(|span| line_of(text, span.start)),
+        message: e.message().trim().replace('\n', " "),
     }
-    File::deserialize(toml::de::Deserializer::from(doc)).map_err(toml_error)
 }
 
 /// The 1-based line of byte `offset` of `text`.

@@ -19,7 +19,7 @@ use std::process::ExitCode;
 use clap::{CommandFactory, Parser, Subcommand};
 
 use crate::commands::{
-    bridge, can, completions, decode, man, monitor, plot, record, simulate, summary,
+    bridge, can, check, completions, decode, man, monitor, plot, record, simulate, summary,
 };
 use crate::error::CliError;
 
@@ -41,6 +41,9 @@ enum Command {
     Decode(decode::DecodeArgs),
     /// Summarise a stream: frames, link quality, device information, min/max/mean of each field.
     Summary(summary::SummaryArgs),
+    /// Is this propulsion system healthy? Findings per ESC with their evidence (heat,
+    /// imbalance, drift from a baseline, battery, faults, link, runtime); exit 0, 1 or 2.
+    Check(check::CheckArgs),
     /// Plot each ESC's telemetry over time, fault episodes marked (PNG or SVG).
     Plot(plot::PlotArgs),
     /// Record serial ports and CAN buses (slcan:, can:) losslessly, with nanosecond receive
@@ -64,7 +67,10 @@ enum Command {
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
+    // What a command that judges (`hwfoc check`) exits with when it ran.
+    let mut code = 0u8;
     let result: Result<(), CliError> = match &cli.command {
+        Command::Check(args) => check::run(args).map(|worst| code = worst.exit_code()),
         Command::Monitor(args) => monitor::run(args),
         Command::Decode(args) => decode::run(args),
         Command::Summary(args) => summary::run(args),
@@ -78,7 +84,7 @@ fn main() -> ExitCode {
         Command::Man(args) => man::run(args, Cli::command()),
     };
     match result {
-        Ok(()) => ExitCode::SUCCESS,
+        Ok(()) => ExitCode::from(code),
         Err(e) if e.is_broken_pipe() => ExitCode::SUCCESS,
         Err(e) => {
             // Errors quote file content (a key, a name): shown escaped, and on one line.

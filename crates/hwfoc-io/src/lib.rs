@@ -124,6 +124,7 @@
 // Modules whose names are a namespace for their items (`time::parse`, `serial::open`,
 // `pcapng::Reader`, `write::arrow::schema`): public, each exporting only its public items.
 pub mod can;
+pub mod check;
 pub mod clock;
 pub mod energy;
 pub mod pcapng;

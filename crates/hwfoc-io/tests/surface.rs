@@ -36,6 +36,14 @@ use hwfoc_io::write::metadata::{esc_settings_json, escs_json};
 use hwfoc_io::write::{Export, ExportError, OutputFormat, Provenance, WriteError};
 use hwfoc_io::write::{FileId, Staging, create_file, same_file};
 
+// Check.
+use hwfoc_io::check::{Analyser, EscId, Finding, Severity, Span, Threshold, Value as CheckValue};
+use hwfoc_io::check::{
+    Baseline, Check, EscBaseline, EscSeries, LinkFigures, Sample, analyse, check,
+};
+use hwfoc_io::check::{BatteryConfig, CheckConfig, DriftConfig, EscOverride, FaultsConfig};
+use hwfoc_io::check::{HeatConfig, ImbalanceConfig, Limits, LinkConfig, RuntimeConfig};
+
 // Summary.
 use hwfoc_io::summary::{Episode, Mark, NO_FRAMES, Report, Summary};
 use hwfoc_io::summary::{device_json, esc_label, no_frames};

@@ -48,6 +48,20 @@ pub enum SimError {
     },
     /// Link faults (bit errors, drops, cuts, garbage) asked of a CAN bus.
     CanLinkFaults,
+    /// A degradation on an ESC the fleet does not have.
+    NoSuchDegradedEsc {
+        /// The degradation.
+        spec: crate::degrade::DegradeSpec,
+        /// How many ESCs there are.
+        n: usize,
+    },
+    /// A loose wire asked of ESCs speaking another protocol than HW-FOC.
+    WireDegradation {
+        /// The protocol.
+        protocol: hwfoc::Protocol,
+    },
+    /// Degradations asked of a CAN bus.
+    CanDegradations,
     /// A fault was scheduled on an ESC the fleet does not have.
     NoSuchEsc {
         /// The ESC named.
@@ -147,6 +161,22 @@ impl fmt::Display for SimError {
                 "link faults (bit errors, drops, cuts, garbage) are simulated for HW-FOC only, \
                  not on a CAN bus",
             ),
+            SimError::NoSuchDegradedEsc { spec, n } => write!(
+                f,
+                "a degradation ({}) is on ESC {}, which does not exist: there are {n} (0..{})",
+                spec.kind,
+                spec.esc,
+                n.saturating_sub(1)
+            ),
+            SimError::WireDegradation { protocol } => write!(
+                f,
+                "a loose wire (bursts of lost frames) is simulated for HW-FOC only, not for {} \
+                 ({protocol})",
+                protocol.title()
+            ),
+            SimError::CanDegradations => {
+                f.write_str("degradations are simulated for serial ESCs only, not on a CAN bus")
+            }
             SimError::NoSuchEsc { esc, n } => write!(
                 f,
                 "a fault is scheduled on ESC {esc}, which does not exist: there are {n} (0..{})",

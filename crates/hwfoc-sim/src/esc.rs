@@ -31,6 +31,7 @@ use hwfoc::foc::{DataFrame, Decoder, Frame, InfoFrame};
 use hwfoc::telemetry::Data;
 use hwfoc::{Fault, Protocol, v4};
 
+use crate::degrade::{DegradeSpec, ModelDegradations, WireLoss};
 use crate::faults::{Fate, FaultSchedule, LineFaults, LinkRates};
 use crate::model::{Model, ModelConfig};
 use crate::profile::Profile;
@@ -138,6 +139,8 @@ pub struct Setup {
     pub faults: FaultSchedule,
     /// Link fault rates.
     pub link: LinkRates,
+    /// Degradations of the run (those of this ESC act on it).
+    pub degradations: Vec<DegradeSpec>,
 }
 
 /// A virtual ESC: the model, its frame schedule and its link.
@@ -150,6 +153,8 @@ pub struct VirtualEsc {
     model_ns: u64,
     noise: Rng,
     link: LineFaults,
+    /// A loose wire's bursts of loss.
+    wire: WireLoss,
     packet: u16,
     info: InfoFrame,
     /// Next 50 ms check.
@@ -193,6 +198,7 @@ impl VirtualEsc {
     /// An ESC at rest at time zero.
     pub fn new(setup: Setup) -> VirtualEsc {
         let (model, mut params) = Model::for_esc(setup.model, setup.load, setup.seed, setup.index);
+        let model = model.degraded(ModelDegradations::for_esc(&setup.degradations, setup.index));
         let packet = setup
             .start_packet
             .unwrap_or_else(|| params.below(1 << 16) as u16);
@@ -236,6 +242,11 @@ impl VirtualEsc {
             link: LineFaults::new(
                 setup.link,
                 Rng::for_esc(setup.seed, setup.index, Purpose::Link),
+            ),
+            wire: WireLoss::for_esc(
+                &setup.degradations,
+                setup.index,
+                Rng::for_esc(setup.seed, setup.index, Purpose::Wire),
             ),
             packet,
             info,
@@ -453,7 +464,12 @@ impl VirtualEsc {
                 what: What::Garbage,
             }
         });
-        let fate = self.link.transmit(&mut bytes);
+        let fate = if self.wire.lost(seconds(start)) {
+            bytes.clear();
+            Fate::Dropped
+        } else {
+            self.link.transmit(&mut bytes)
+        };
         let intact = (fate == Fate::Intact).then_some(data).flatten();
         let mut glitch = 0;
         let committed = loop {
@@ -593,6 +609,7 @@ pub(crate) mod tests {
             load: 1.0,
             faults: FaultSchedule::default(),
             link,
+            degradations: Vec::new(),
         }
     }
 

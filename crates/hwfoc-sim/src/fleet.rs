@@ -8,6 +8,7 @@ use std::time::Instant;
 use hwfoc::Protocol;
 use hwfoc_io::clock::unix_now_ns;
 
+use crate::degrade::{DegradeKind, DegradeSpec};
 use crate::error::SimError;
 use crate::esc::{Setup, VirtualEsc, spread};
 use crate::faults::{FaultSchedule, FaultSpec, LinkRates};
@@ -43,6 +44,9 @@ pub struct FleetSpec {
     pub faults: Vec<FaultSpec>,
     /// How often the link misbehaves.
     pub link: LinkRates,
+    /// Degradations of motors, propellers, batteries, wires, power stages
+    /// ([`crate::degrade`]).
+    pub degradations: Vec<DegradeSpec>,
 }
 
 impl FleetSpec {
@@ -61,6 +65,22 @@ impl FleetSpec {
         if self.protocol != Protocol::HwFoc && self.link != LinkRates::default() {
             return Err(SimError::LinkFaults {
                 protocol: self.protocol,
+            });
+        }
+        if self.protocol != Protocol::HwFoc
+            && self
+                .degradations
+                .iter()
+                .any(|d| d.kind == DegradeKind::Wire)
+        {
+            return Err(SimError::WireDegradation {
+                protocol: self.protocol,
+            });
+        }
+        if let Some(d) = self.degradations.iter().find(|d| d.esc >= self.n) {
+            return Err(SimError::NoSuchDegradedEsc {
+                spec: *d,
+                n: self.n,
             });
         }
         if self.protocol == Protocol::Hw5
@@ -124,6 +144,7 @@ impl VirtualFleet {
                     load,
                     faults: FaultSchedule::for_esc(&spec.faults, index),
                     link: spec.link,
+                    degradations: spec.degradations.clone(),
                 })
             })
             .collect()
@@ -165,6 +186,7 @@ pub(crate) mod tests {
             model: config(),
             faults: Vec::new(),
             link: LinkRates::default(),
+            degradations: Vec::new(),
         }
     }
 

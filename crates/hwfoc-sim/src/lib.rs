@@ -21,6 +21,7 @@
 #![warn(missing_docs)]
 
 pub mod can;
+pub mod degrade;
 pub mod destination;
 pub mod error;
 pub mod esc;

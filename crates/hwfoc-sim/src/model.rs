@@ -26,6 +26,7 @@ use hwfoc::foc::DataFrame;
 use hwfoc::units::ADC_TABLE;
 use hwfoc::{Fault, Status};
 
+use crate::degrade::ModelDegradations;
 use crate::rng::Rng;
 
 /// Loaded RPM at full throttle as a fraction of `kv * volts` (the propeller's load).
@@ -94,6 +95,22 @@ pub struct ModelConfig {
     pub current_scale: f32,
 }
 
+impl ModelConfig {
+    /// The model of `hwfoc simulate`'s defaults: 500 KV, 7 pole pairs, 60 A at full throttle,
+    /// 6 cells of 5000 mAh at 0.02 ohm, 25 degC, 64 raw units per ampere (for tests and
+    /// examples that want a typical model).
+    pub const SIMULATE: ModelConfig = ModelConfig {
+        kv: 500.0,
+        pole_pairs: 7,
+        full_current_a: 60.0,
+        cells: 6,
+        battery_r_ohm: 0.02,
+        capacity_mah: 5000.0,
+        ambient_c: 25.0,
+        current_scale: 64.0,
+    };
+}
+
 /// One ESC's parameters: the configuration with this unit's tolerances applied.
 #[derive(Debug, Clone, Copy)]
 struct Params {
@@ -136,6 +153,8 @@ pub struct Model {
     t_mos: f64,
     t_cap: f64,
     faults: Status,
+    /// Degradations acting on the motor, propeller, battery or power stage.
+    degradations: ModelDegradations,
 }
 
 impl Model {
@@ -194,6 +213,15 @@ impl Model {
             t_mos: ambient_c + 1.5 * rng.unit(),
             t_cap: ambient_c + 1.0 * rng.unit(),
             faults: Status::OK,
+            degradations: ModelDegradations::default(),
+        }
+    }
+
+    /// The model with `degradations` acting on it from their start times on.
+    pub fn degraded(self, degradations: ModelDegradations) -> Model {
+        Model {
+            degradations,
+            ..self
         }
     }
 
@@ -226,7 +254,9 @@ impl Model {
         };
 
         // Motor and propeller.
-        let rpm_target = p.kv * self.v_bus * LOADED * self.throttle_out / 100.0;
+        let d = &mut self.degradations;
+        d.advance(dt, self.rpm);
+        let rpm_target = p.kv * self.v_bus * LOADED * self.throttle_out / 100.0 * d.rpm_factor();
         let tau = if rpm_target > self.rpm {
             TAU_UP_S
         } else {
@@ -247,7 +277,13 @@ impl Model {
             p_mech * ETA_REGEN
         };
         self.i_in = if spinning {
-            (p_in / self.v_bus + SPIN_A).max(-0.5 * p.full_current_a)
+            let i = p_in / self.v_bus + SPIN_A;
+            let i = if i > 0.0 {
+                i * self.degradations.current_factor()
+            } else {
+                i
+            };
+            i.max(-0.5 * p.full_current_a)
         } else {
             0.0
         };
@@ -260,16 +296,17 @@ impl Model {
 
         // Battery.
         self.soc = (self.soc - self.i_in * dt / 3600.0 / p.capacity_ah).clamp(0.0, 1.0);
-        self.v_polarisation +=
-            (self.i_in * p.r1 - self.v_polarisation) * (1.0 - (-dt / TAU_POLARISATION_S).exp());
+        let weak = self.degradations.resistance_factor();
+        self.v_polarisation += (self.i_in * p.r1 * weak - self.v_polarisation)
+            * (1.0 - (-dt / TAU_POLARISATION_S).exp());
         let v_open = p.cells * (CELL_EMPTY_V + CELL_SPAN_V * self.soc);
-        self.v_bus = (v_open - self.i_in * p.r0 - self.v_polarisation).max(0.5);
+        self.v_bus = (v_open - self.i_in * p.r0 * weak - self.v_polarisation).max(0.5);
 
         // Power stage temperatures.
         let p_mos = self.i_phase * self.i_phase * R_ON
             + K_SWITCH * self.i_in.abs() * self.v_bus
             + P_QUIESCENT_W;
-        let mos_eq = p.ambient_c + p_mos * p.r_th_mos;
+        let mos_eq = p.ambient_c + p_mos * p.r_th_mos + self.degradations.extra_heat_k();
         self.t_mos += (mos_eq - self.t_mos) * (1.0 - (-dt / TAU_MOS_S).exp());
         let cap_eq = p.ambient_c
             + CAP_COUPLING * (self.t_mos - p.ambient_c)
@@ -494,16 +531,7 @@ pub(crate) mod tests {
 
     /// The command line's defaults.
     pub(crate) fn config() -> ModelConfig {
-        ModelConfig {
-            kv: 500.0,
-            pole_pairs: 7,
-            full_current_a: 60.0,
-            cells: 6,
-            battery_r_ohm: 0.02,
-            capacity_mah: 5000.0,
-            ambient_c: 25.0,
-            current_scale: 64.0,
-        }
+        ModelConfig::SIMULATE
     }
 
     fn model() -> Model {

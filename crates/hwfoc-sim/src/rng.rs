@@ -17,6 +17,8 @@ pub enum Purpose {
     Link = 3,
     /// Choices shared by the whole run (drawn with ESC 0's index).
     Run = 4,
+    /// A loose telemetry wire's bursts of loss ([`crate::degrade::WireLoss`]).
+    Wire = 5,
 }
 
 impl Rng {

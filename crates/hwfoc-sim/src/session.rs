@@ -102,6 +102,12 @@ impl Session {
             None if realtime => None,
             None => Some(fleet.profile().natural_length_s() + TAIL_S),
         };
+        let notes: Vec<String> = fleet
+            .spec()
+            .degradations
+            .iter()
+            .map(|d| d.truth_line())
+            .collect();
         let escs = fleet.escs();
         // Every file is checked before any is created: a run fails whole or starts whole.
         let destination_files = plan.destination.files(n);
@@ -110,7 +116,11 @@ impl Session {
         let truth = match &plan.truth {
             Some(path) => {
                 let (name, out) = sink::create(path, plan.overwrite)?;
-                Some(Truth::new(name, out, plan.settings))
+                let mut truth = Truth::new(name, out, plan.settings);
+                for note in &notes {
+                    truth.note(note)?;
+                }
+                Some(truth)
             }
             None => None,
         };

@@ -274,6 +274,14 @@ impl Truth {
             .map_err(write_error(&self.name))
     }
 
+    /// Writes one line of its own (a JSON object and its newline) before the records: what a
+    /// degradation is, for instance ([`crate::degrade::DegradeSpec::truth_line`]).
+    pub fn note(&mut self, line: &str) -> Result<(), WriteError> {
+        self.out
+            .write_all(line.as_bytes())
+            .map_err(write_error(&self.name))
+    }
+
     /// Hands buffered records to the operating system.
     pub fn flush(&mut self) -> Result<(), WriteError> {
         self.out.flush().map_err(write_error(&self.name))

@@ -41,18 +41,10 @@ fn spec(n: usize) -> FleetSpec {
             period_s: 10.0,
             max_pct: 80.0,
         },
-        model: ModelConfig {
-            kv: 500.0,
-            pole_pairs: 7,
-            full_current_a: 60.0,
-            cells: 6,
-            battery_r_ohm: 0.02,
-            capacity_mah: 5000.0,
-            ambient_c: 25.0,
-            current_scale: 64.0,
-        },
+        model: ModelConfig::SIMULATE,
         faults: vec!["1:mos_overheat@2-3".parse().unwrap()],
         link: LinkRates::default(),
+        degradations: Vec::new(),
     }
 }
 

@@ -2,6 +2,7 @@
 
 pub mod bridge;
 pub mod can;
+pub mod check;
 pub mod completions;
 pub mod decode;
 pub mod man;

@@ -33,18 +33,13 @@ pub fn run(args: &SummaryArgs) -> Result<(), CliError> {
     let (config, settings_map) = args.settings.settings_map()?;
     let settings = *settings_map.default_settings();
     // The plot's file is opened first: a wrong name is reported before the inputs are read.
-    let mut plot = match &args.plot {
-        Some(path) => {
-            args.input.refuse_output(path, &config)?;
-            Some(plot::Alongside::open(
-                path,
-                args.overwrite,
-                settings,
-                args.input.stop_if_read_to_end(),
-            )?)
-        }
-        None => None,
-    };
+    let mut plot = plot::Alongside::asked(
+        args.plot.as_deref(),
+        &args.input,
+        &config,
+        args.overwrite,
+        settings,
+    )?;
     let mut sources = args.input.sources(settings_map)?;
     let mut summary = Summary::new();
     // On an input error, what was read before it is summarised, then the error reported.

@@ -80,6 +80,9 @@ impl CanBus {
         if spec.link != LinkRates::default() {
             return Err(SimError::CanLinkFaults);
         }
+        if !spec.degradations.is_empty() {
+            return Err(SimError::CanDegradations);
+        }
         if let Some(esc) = spec
             .faults
             .iter()

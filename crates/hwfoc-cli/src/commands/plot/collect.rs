@@ -189,6 +189,19 @@ pub struct Span {
     pub ongoing: bool,
 }
 
+/// The window of a finding of `hwfoc check` (a warning or a critical one), on the clock.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Shade {
+    /// Its start.
+    pub start: f64,
+    /// Its end.
+    pub end: f64,
+    /// How bad.
+    pub severity: hwfoc_io::check::Severity,
+    /// The analyser's name.
+    pub label: &'static str,
+}
+
 /// Everything plotted of one ESC.
 #[derive(Debug)]
 pub struct EscData {
@@ -212,6 +225,8 @@ pub struct EscData {
     pub spans: Vec<Span>,
     /// Fault episodes seen.
     pub episodes: u64,
+    /// The windows of the findings shaded ([`Collector::shade`]).
+    pub shades: Vec<Shade>,
     /// Charge and energy of its plotted frames.
     pub energy: Energy,
     /// Discontinuities of its receive times ([`Step`]): the clock goes on across them.
@@ -241,6 +256,7 @@ impl EscData {
             buckets: Buckets::new(buckets),
             spans: Vec::new(),
             episodes: 0,
+            shades: Vec::new(),
             energy: Energy::new(),
             discontinuities: 0,
             last_timed: None,
@@ -429,6 +445,27 @@ impl Collector {
     /// The data of ESC `esc`, if it had any frame.
     pub fn esc(&self, esc: usize) -> Option<&EscData> {
         self.escs.get(esc)
+    }
+
+    /// Shades the windows of `findings` (those of `hwfoc check`: warnings and critical ones
+    /// with a window) on their ESCs' panels.
+    pub fn shade(&mut self, findings: &[hwfoc_io::check::Finding]) {
+        for f in findings {
+            let (Some(esc), Some(w)) = (&f.esc, f.window) else {
+                continue;
+            };
+            if f.severity == hwfoc_io::check::Severity::Ok {
+                continue;
+            }
+            if let Some(data) = self.escs.get_mut(esc.number) {
+                data.shades.push(Shade {
+                    start: w.start_s,
+                    end: w.end_s,
+                    severity: f.severity,
+                    label: f.analyser.name(),
+                });
+            }
+        }
     }
 
     /// Ends every ESC's data: what was read is then ready to be drawn.

@@ -61,6 +61,9 @@ const GRID: RGBColor = RGBColor(225, 225, 225);
 const AXIS: RGBColor = RGBColor(120, 120, 120);
 const FAULT: RGBColor = RGBColor(214, 39, 40);
 const FAULT_TEXT: RGBColor = RGBColor(170, 20, 20);
+/// The windows of `hwfoc check`'s warnings and critical findings.
+const WARNING: RGBColor = RGBColor(255, 190, 0);
+const CRITICAL: RGBColor = RGBColor(148, 60, 189);
 const OK_TEXT: RGBColor = RGBColor(40, 130, 60);
 const BLUE: RGBColor = RGBColor(31, 119, 180);
 const ORANGE: RGBColor = RGBColor(255, 127, 14);
@@ -635,6 +638,23 @@ impl<'a> Scene<'a> {
                 .iter()
                 .map(|&(a, b, _)| Rectangle::new([(a, y_lo), (b, y_hi)], FAULT.mix(0.16).filled())),
         )?;
+        // The windows of check's findings under the lines, at least a pixel wide.
+        chart.draw_series(data.shades.iter().map(|sh| {
+            let a = sh.start - offset;
+            let b = (sh.end - offset).max(a + per_px);
+            Rectangle::new(
+                [(a, y_lo), (b, y_hi)],
+                shade_colour(sh.severity).mix(0.22).filled(),
+            )
+        }))?;
+        if label_faults {
+            let small = text(11, TEXT);
+            for sh in &data.shades {
+                let label = EmptyElement::at((sh.start - offset, y_lo))
+                    + Text::new(format!("{} {}", sh.severity, sh.label), (3, -16), &small);
+                chart.draw_series(std::iter::once(label))?;
+            }
+        }
         let columns = columns(data, offset, self.time, plot_w);
         for (i, &(quantity, _, colour)) in panel.lines.iter().enumerate() {
             // The first line of two is drawn wider, so that the second never hides it.
@@ -860,6 +880,14 @@ fn value_range(panel: &Panel, rows: &[Row]) -> (f64, f64) {
             let half = ((hi - lo) / 2.0).max(min_span / 2.0);
             pad(mid - half, mid + half)
         }
+    }
+}
+
+/// The colour of a finding's window: amber for a warning, purple for a critical finding.
+fn shade_colour(severity: hwfoc_io::check::Severity) -> RGBColor {
+    match severity {
+        hwfoc_io::check::Severity::Critical => CRITICAL,
+        _ => WARNING,
     }
 }
 

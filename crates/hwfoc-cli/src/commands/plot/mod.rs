@@ -144,10 +144,38 @@ impl Alongside {
         })
     }
 
+    /// The plot asked for with `--plot FILE` (`path`) beside a command reading `input`, if
+    /// asked: refused when it would be one of the files read (an input, the configuration file
+    /// `config`), else opened as [`Alongside::open`] does.
+    pub fn asked(
+        path: Option<&str>,
+        input: &InputArgs,
+        config: &crate::config::Config,
+        overwrite: bool,
+        settings: Settings,
+    ) -> Result<Option<Alongside>, CliError> {
+        let Some(path) = path else {
+            return Ok(None);
+        };
+        input.refuse_output(path, config)?;
+        let stop = input.stop_if_read_to_end();
+        Alongside::open(path, overwrite, settings, stop).map(Some)
+    }
+
     /// Draws the plot of what was read from `sources` and writes it.
     pub fn finish(mut self, sources: &Sources) -> Result<(), CliError> {
         self.collector
             .write(sources, &self.options, &mut self.target)
+    }
+
+    /// As [`Alongside::finish`], the windows of `findings` (`hwfoc check --plot`) shaded.
+    pub fn finish_with(
+        mut self,
+        sources: &Sources,
+        findings: &[hwfoc_io::check::Finding],
+    ) -> Result<(), CliError> {
+        self.collector.shade(findings);
+        self.finish(sources)
     }
 }
 

@@ -7,6 +7,7 @@
 use std::io::IsTerminal;
 
 use hwfoc::Settings;
+use hwfoc_sim::SimError;
 use hwfoc_sim::can::{CanBus, CanDestination, CanPlan, CanReport, CanSession};
 #[cfg(unix)]
 use hwfoc_sim::pty::PtyLinks;
@@ -117,7 +118,10 @@ pub fn run(args: &SimulateArgs, config: &Config, settings: Settings) -> Result<(
     }
     // The serial ESCs' spec carries the model, profile and faults; the bus takes those.
     let spec = args.model.spec(n, 0, &settings);
-    let bus = CanBus::build(&spec, args.factory)?;
+    let bus = CanBus::build(&spec, args.factory).map_err(|e| match e {
+        e @ SimError::CanDegradations => usage("--degrade", e.to_string()),
+        e => CliError::from(e),
+    })?;
     let session = CanSession::open(bus, &plan)?;
     if args.pty {
         announce_slcan(session.output())?;

@@ -18,6 +18,7 @@ mod can;
 use crate::args::SettingsArgs;
 use crate::error::CliError;
 use hwfoc_io::write::WriteError;
+use hwfoc_sim::degrade::DegradeSpec;
 use hwfoc_sim::faults::{FaultSpec, LinkRates};
 use hwfoc_sim::fleet::MAX_ESCS;
 use hwfoc_sim::model::ModelConfig;
@@ -224,6 +225,18 @@ pub struct ModelArgs {
         help_heading = "Faults"
     )]
     faults: Vec<FaultSpec>,
+    /// Degrade ESC number ESC from START seconds on (0 without it) at SEVERITY from 0 to 1
+    /// (0.5 without it). KIND: bearing (current x (1 + SEVERITY) for the same RPM), prop (a
+    /// damaged propeller: RPM +20 % x SEVERITY, load -50 % x SEVERITY, with a ripple),
+    /// battery (resistance x (1 + SEVERITY): more sag per ampere), wire (bursts of 5-20 frames
+    /// lost, hw-foc only), heat (MOSFET temperature rising by up to 80 K x SEVERITY over 10
+    /// minutes). The truth (--truth) starts with one line per degradation. Repeatable.
+    #[arg(
+        long = "degrade",
+        value_name = "ESC:KIND[@START][=SEVERITY]",
+        help_heading = "Faults"
+    )]
+    degradations: Vec<DegradeSpec>,
     /// Probability that a bit on the wire is flipped.
     #[arg(long, value_name = "P", default_value_t = 0.0, value_parser = probability,
           help_heading = "Faults")]
@@ -289,6 +302,7 @@ impl ModelArgs {
                 cut: self.cut_rate,
                 garbage: self.garbage_rate,
             },
+            degradations: self.degradations.clone(),
         }
     }
 
@@ -430,6 +444,9 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
     };
     let fleet = spec.build().map_err(|e| match e {
         e @ SimError::NoHw5Fault { .. } => usage("--fault", e.to_string()),
+        e @ (SimError::NoSuchDegradedEsc { .. } | SimError::WireDegradation { .. }) => {
+            usage("--degrade", e.to_string())
+        }
         e => CliError::from(e),
     })?;
     let session = Session::open(fleet, &plan)?;
