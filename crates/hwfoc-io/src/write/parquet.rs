@@ -122,6 +122,7 @@ mod encode {
     use parquet::column::writer::{ColumnCloseResult, get_column_writer, get_typed_column_writer};
     use parquet::data_type::{
         ByteArray, ByteArrayType, DataType as ParquetType, DoubleType, FloatType, Int32Type,
+        Int64Type,
     };
     use parquet::errors::ParquetError;
     use parquet::file::metadata::{
@@ -139,7 +140,7 @@ mod encode {
     use super::super::metadata::schema_with;
     use super::super::{Chunk, Provenance, Sink, ToWriter, WriteError};
     use crate::record::columns::{COLUMNS, COUNT, visit};
-    use crate::record::{Column, FaultList, Visitor};
+    use crate::record::{Column, FaultList, UtcTime, Visitor};
 
     /// Values handed to a column writer at a time (the crate's default, 1024, spends more time
     /// per value and makes pages of 1 MB at most).
@@ -351,6 +352,8 @@ mod encode {
         // UINT_32 is stored in an INT32 column with the same bits.
         u32 => Int32Type, |v| v as i32;
         Status => Int32Type, |v| i32::from(v.0);
+        // TIMESTAMP(MICROS, UTC) is an INT64 (the logical type from the Arrow field).
+        UtcTime => Int64Type, |v| v.0;
     }
 
     impl<T: Plain> ParquetValue for Option<T>
@@ -1593,6 +1596,10 @@ mod encode {
                     // Unsigned columns among them: values above i32::MAX as negative numbers.
                     PhysicalType::INT32 => check::<Int32Type>(column, &props, |i| {
                         (i as u32).wrapping_mul(2_654_435_761) as i32
+                    }),
+                    // Microseconds of the 2020s, 7 ms apart.
+                    PhysicalType::INT64 => check::<Int64Type>(column, &props, |i| {
+                        1_795_847_934_682_325 + 7_000 * i as i64
                     }),
                     other => panic!("{}: no test values of {other}", column.path()),
                 }
