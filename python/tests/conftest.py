@@ -3,6 +3,7 @@ captures, and recordings made with the simulator."""
 
 import datetime
 import json
+import math
 import os
 import subprocess
 from pathlib import Path
@@ -84,8 +85,12 @@ EPOCH = datetime.datetime(1970, 1, 1, tzinfo=datetime.timezone.utc)
 
 
 def instant(t_s):
-    """The UTC instant of `t_s` to the microsecond, as the `time` column holds it."""
-    return None if t_s is None else EPOCH + datetime.timedelta(microseconds=round(t_s * 1e6))
+    """The UTC instant of `t_s` to the microsecond, as the `time` column holds it (halves
+    rounded away from zero, as Rust's `f64::round`; Python's `round` takes the even one)."""
+    if t_s is None:
+        return None
+    us = t_s * 1e6
+    return EPOCH + datetime.timedelta(microseconds=math.copysign(math.floor(abs(us) + 0.5), us))
 
 
 def assert_same_records(table: pa.Table, records):

@@ -72,7 +72,7 @@ def test_time_is_a_utc_timestamp_to_pandas_polars_and_duckdb(sim_dir):
     records = table  # noqa: F841 (DuckDB reads the local variable by its name)
     kind, differ = duckdb.sql(
         "SELECT any_value(typeof(time)), count(*) FILTER (WHERE epoch_us(time) != round(t_s * 1e6)) "
-        "FROM records").fetchone()
+        "FROM records").fetchall()[0]
     assert (kind, differ) == ("TIMESTAMP WITH TIME ZONE", 0)
 
 

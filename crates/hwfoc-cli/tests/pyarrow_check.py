@@ -14,6 +14,7 @@ message on the first difference; prints "1 passed, 0 failed" when all is well.
 
 import datetime
 import json
+import math
 import os
 import struct
 import subprocess
@@ -56,8 +57,12 @@ EPOCH = datetime.datetime(1970, 1, 1, tzinfo=datetime.timezone.utc)
 
 
 def instant(t_s):
-    """The UTC instant of `t_s` to the microsecond, as the `time` column holds it."""
-    return None if t_s is None else EPOCH + datetime.timedelta(microseconds=round(t_s * 1e6))
+    """The UTC instant of `t_s` to the microsecond, as the `time` column holds it (halves
+    rounded away from zero, as Rust's `f64::round`; Python's `round` takes the even one)."""
+    if t_s is None:
+        return None
+    us = t_s * 1e6
+    return EPOCH + datetime.timedelta(microseconds=math.copysign(math.floor(abs(us) + 0.5), us))
 
 # Columns of record schemas 2 and 3 that HW-FOC (the demo capture) does not carry: null in every
 # row.
