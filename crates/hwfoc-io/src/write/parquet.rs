@@ -21,7 +21,7 @@
 //! - data pages of format version 2 (values compressed on their own, levels not, no copy of
 //!   the values before compression; a page that does not compress is stored as it is);
 //! - plain values compressed with LZ4 (`LZ4_RAW`: faster than Snappy here, and smaller);
-//! - `packet` and `erpm` as bit-packed differences (`DELTA`: `DELTA_BINARY_PACKED`, not
+//! - `packet`, `erpm` and `time` as bit-packed differences (`DELTA`: `DELTA_BINARY_PACKED`, not
 //!   compressed, a bit width per 128 values): they count up or drift, and plain they hardly
 //!   compress. (Their bytes split into streams and compressed would be smaller and cheaper
 //!   still, but integer columns in that encoding came with Parquet 2.11, in 2024: Spark 3.5
@@ -149,7 +149,9 @@ mod encode {
     /// Columns stored as bit-packed differences (`DELTA_BINARY_PACKED`), not compressed:
     /// packet numbers count up, eRPM drifts, so their differences pack into a few bits, smaller
     /// and cheaper than compressing the plain values (which barely compress).
-    pub const DELTA: [&str; 2] = ["packet", "erpm"];
+    /// `time` counts up by about the frame period: 1.34 M rows of 16 ESCs took 23.4 MB of file
+    /// so, 27.7 MB with `time` plain and compressed, 21.0 MB without the column.
+    pub const DELTA: [&str; 3] = ["packet", "erpm", "time"];
 
     /// Columns with their bytes split into streams (`BYTE_STREAM_SPLIT`) before compression:
     /// throttles and currents vary slowly, so their high bytes repeat.
