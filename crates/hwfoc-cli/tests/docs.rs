@@ -554,7 +554,8 @@ fn the_readme_stays_short() {
 
 /// The words issue 30 found stale stay gone: the command's one-line description names every
 /// family it reads, `record` names CAN buses, the input help of `decode`, `summary` and `plot`
-/// names candump logs, `slcan:` and `can:`, and docs/REFERENCE.md names `--mavlink file:`.
+/// names candump logs, `slcan:` and `can:`, docs/REFERENCE.md names `--mavlink file:`, and the
+/// README's Spark recipe sets `PYSPARK_PYTHON` (the workers' Python, with pyarrow).
 #[test]
 fn help_and_reference_name_every_input_kind() {
     let help = |args: &[&str]| {
@@ -582,4 +583,6 @@ fn help_and_reference_name_every_input_kind() {
     }
     let reference = fs::read_to_string(root().join("docs/REFERENCE.md")).unwrap();
     assert!(reference.contains("--mavlink file:"));
+    let readme = fs::read_to_string(root().join("README.md")).unwrap();
+    assert!(readme.contains("os.environ[\"PYSPARK_PYTHON\"]"));
 }
