@@ -98,7 +98,7 @@ def read(
     HW5's fault names).
 
     The schema's metadata holds what ``hwfoc decode --format parquet`` writes in its file:
-    ``hwfoc_version``, ``record_schema_version`` (``2``), ``current_scale``, ``pole_pairs``,
+    ``hwfoc_version``, ``record_schema_version`` (``4``), ``current_scale``, ``pole_pairs``,
     ``gear_ratio``, ``v4_volts_per_step``, ``inputs`` and ``escs`` (JSON) and ``filter`` when records were selected;
     each field has its ``unit``.
 

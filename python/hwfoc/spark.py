@@ -62,6 +62,9 @@ def spark_schema(path_column: Optional[str] = None, frame_column: Optional[str] 
     for f in arrow_schema(path_column, frame_column, **settings):
         if pa.types.is_list(f.type):
             spark_type = T.ArrayType(T.StringType(), containsNull=False)
+        elif pa.types.is_timestamp(f.type):
+            # `time`: a UTC instant, which Spark's TimestampType is (shown in the session's zone).
+            spark_type = T.TimestampType()
         else:
             spark_type = simple[f.type]
         metadata = {k.decode(): v.decode() for k, v in (f.metadata or {}).items()}

@@ -1,6 +1,7 @@
 """Shared fixtures: the hwfoc command (the reference the package must agree with), the real
 captures, and recordings made with the simulator."""
 
+import datetime
 import json
 import os
 import subprocess
@@ -76,14 +77,30 @@ FLOAT32 = {
 }
 
 
+# Columns of Arrow and Parquet only (record schema 4), after the JSON Lines record's.
+BINARY_ONLY = ["time"]
+
+EPOCH = datetime.datetime(1970, 1, 1, tzinfo=datetime.timezone.utc)
+
+
+def same_instant(time, t_s):
+    """Whether `time` (the `time` column's value) is `t_s` to the microsecond: null alike, or
+    its whole microseconds within half of one of `t_s`'s."""
+    if time is None or t_s is None:
+        return time is None and t_s is None
+    return abs((time - EPOCH) // datetime.timedelta(microseconds=1) - t_s * 1e6) <= 0.5
+
+
 def assert_same_records(table: pa.Table, records):
     """The table holds exactly the command's JSON Lines records: same keys in order, same
-    values (float32 columns compared as float32: JSON writes their shortest text)."""
-    assert table.column_names == list(records[0].keys()) if records else True
+    values (float32 columns compared as float32: JSON writes their shortest text), and `time`,
+    the instant of `t_s`."""
+    assert table.column_names == list(records[0].keys()) + BINARY_ONLY if records else True
     rows = table.to_pylist()
     assert len(rows) == len(records)
     for i, (got, want) in enumerate(zip(rows, records)):
-        assert list(got) == list(want), i
+        assert list(got) == list(want) + BINARY_ONLY, i
+        assert same_instant(got["time"], want["t_s"]), (i, got["time"], want["t_s"])
         for key, value in want.items():
             g = got[key]
             if key in FLOAT32 and value is not None:

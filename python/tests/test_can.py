@@ -41,7 +41,7 @@ def test_can_inputs_read_as_decode(cli, path):
 def test_can_columns_have_the_schema_types():
     table = hwfoc.read(str(LOG))
     schema = table.schema
-    assert schema.metadata[b"record_schema_version"] == b"3"
+    assert schema.metadata[b"record_schema_version"] == b"4"
     assert schema.field("protocol").type == pa.dictionary(pa.int8(), pa.string())
     assert schema.field("esc").type == pa.uint8()
     assert schema.field("node").type == pa.uint8() and schema.field("node").nullable

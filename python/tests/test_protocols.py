@@ -377,6 +377,11 @@ def test_spark_reads_every_format(spark, tmp_path, hw5_stream):
     assert list(hw5[2]["faults"]) == ["throttle_signal_lost", "low_voltage"]
     schema = hwfoc.spark.spark_schema("recording", "frame", v4_volts_per_step="hv")
     assert df.schema == schema
+    # `time` (record schema 4): a Spark timestamp, null exactly where `t_s` is.
+    from pyspark.sql import types as T
+
+    assert df.schema["time"].dataType == T.TimestampType()
+    assert all((r["time"] is None) == (r["t_s"] is None) for r in rows)
 
 
 # ---- the CAN protocols and what a forced protocol finds --------------------------------------

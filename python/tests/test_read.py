@@ -3,6 +3,7 @@ output, every kind of source, selections and settings, and errors with the comma
 messages."""
 
 import io
+import datetime
 import inspect
 import json
 import os
@@ -49,6 +50,30 @@ def test_simulated_recordings_equal_decode(cli, sim_dir, name):
     assert len(records) > 100
     assert any(r["faults"] for r in records)
     assert_same_records(table, records)
+
+
+def test_time_is_a_utc_timestamp_to_pandas_polars_and_duckdb(sim_dir):
+    """Record schema 4: `time` holds `t_s`'s instant as a UTC timestamp, which pandas, polars
+    and DuckDB take as a time with no conversion."""
+    table = hwfoc.read(sim_dir / "three.pcapng")
+    assert table.schema.field("time").type == pa.timestamp("us", tz="UTC")
+    t_s = table.column("t_s").to_pylist()
+    first = datetime.datetime.fromtimestamp(t_s[0], datetime.timezone.utc)
+    assert abs(table.column("time")[0].as_py() - first) < datetime.timedelta(microseconds=1)
+    frame = table.select(["t_s", "time"]).to_pandas()
+    assert str(frame["time"].dtype) == "datetime64[us, UTC]"
+    assert ((frame["time"].astype("int64") - frame["t_s"] * 1e6).abs() <= 0.5).all()
+    polars = pytest.importorskip("polars")
+    df = polars.from_arrow(table.select(["t_s", "time"]))
+    us = (df["t_s"] * 1e6).round(mode="half_away_from_zero").cast(polars.Int64)
+    assert (df["time"].dt.epoch("us") == us).all()
+    assert df.schema["time"] == polars.Datetime("us", "UTC")
+    duckdb = pytest.importorskip("duckdb")
+    records = table  # noqa: F841 (DuckDB reads the local variable by its name)
+    kind, differ = duckdb.sql(
+        "SELECT any_value(typeof(time)), count(*) FILTER (WHERE epoch_us(time) != round(t_s * 1e6)) "
+        "FROM records").fetchall()[0]
+    assert (kind, differ) == ("TIMESTAMP WITH TIME ZONE", 0)
 
 
 def test_schema_and_metadata_are_the_parquet_exports(cli, sim_dir, tmp_path):

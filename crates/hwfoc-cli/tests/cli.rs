@@ -6,7 +6,7 @@ use std::io::{Read, Write};
 use std::path::{Path, PathBuf};
 use std::process::{Output, Stdio};
 
-use common::{SCHEMA, XROTOR, assert_fails_with, capture, hwfoc, stdout};
+use common::{TEXT_SCHEMA, XROTOR, assert_fails_with, capture, hwfoc, stdout};
 use hwfoc::foc::{DataFrame, InfoFrame};
 use hwfoc::{Fault, Status};
 use serde_json::Value;
@@ -86,14 +86,14 @@ fn decode_real_capture_matches_schema_and_golden() {
     for line in &lines {
         // Exactly the schema's keys, in the schema's order.
         let mut at = 0;
-        for key in SCHEMA {
+        for key in TEXT_SCHEMA {
             let pos = line[at..]
                 .find(&format!("\"{key}\":"))
                 .unwrap_or_else(|| panic!("{key} missing or out of order in {line}"));
             at += pos;
         }
         let v: Value = serde_json::from_str(line).unwrap();
-        assert_eq!(v.as_object().unwrap().len(), SCHEMA.len());
+        assert_eq!(v.as_object().unwrap().len(), TEXT_SCHEMA.len());
         let t = v["t_s"].as_f64().unwrap();
         assert!(t > last_t, "timestamps increase");
         last_t = t;
@@ -392,7 +392,7 @@ fn csv_output_has_header_and_joined_faults() {
     ]));
     let lines: Vec<&str> = out.lines().collect();
     assert!(lines[0].starts_with("# hwfoc decode: current_scale=100 pole_pairs=7 gear_ratio=1"));
-    assert_eq!(lines[1], SCHEMA.join(","));
+    assert_eq!(lines[1], TEXT_SCHEMA.join(","));
     assert_eq!(lines.len(), 5);
     // No time in a raw file; MOSFET code 250 is below the table's range, capacitor code 0 above.
     assert_eq!(

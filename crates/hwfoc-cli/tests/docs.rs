@@ -568,3 +568,38 @@ fn the_readme_stays_short() {
         "README.md has {words} words: move details to docs/"
     );
 }
+
+/// The words issue 30 found stale stay gone: the command's one-line description names every
+/// family it reads, `record` names CAN buses, the input help of `decode`, `summary` and `plot`
+/// names candump logs, `slcan:` and `can:`, docs/REFERENCE.md names `--mavlink file:`, and the
+/// README's Spark recipe sets `PYSPARK_PYTHON` (the workers' Python, with pyarrow).
+#[test]
+fn help_and_reference_name_every_input_kind() {
+    let help = |args: &[&str]| {
+        let out = common::hwfoc().args(args).arg("--help").output().unwrap();
+        String::from_utf8(out.stdout).unwrap()
+    };
+    let top = help(&[]);
+    assert!(
+        !top.contains("Hobbywing HW-FOC ESC telemetry") && top.contains("DroneCAN"),
+        "{top}"
+    );
+    let record = help(&["record"]);
+    assert!(
+        record.lines().next().unwrap().contains("CAN buses"),
+        "{record}"
+    );
+    for command in ["decode", "summary", "plot"] {
+        let text = help(&[command]);
+        for kind in ["candump", "slcan:", "can:"] {
+            assert!(
+                text.contains(kind),
+                "`{command} --help` does not name {kind}"
+            );
+        }
+    }
+    let reference = fs::read_to_string(root().join("docs/REFERENCE.md")).unwrap();
+    assert!(reference.contains("--mavlink file:"));
+    let readme = fs::read_to_string(root().join("README.md")).unwrap();
+    assert!(readme.contains("os.environ[\"PYSPARK_PYTHON\"]"));
+}

@@ -11,9 +11,11 @@ use std::sync::Arc;
 use common::{SCHEMA, XROTOR, assert_fails_with, capture, hwfoc, stdout};
 
 use arrow_array::cast::AsArray;
-use arrow_array::types::{Float32Type, Float64Type, Int8Type, UInt8Type, UInt16Type, UInt32Type};
+use arrow_array::types::{
+    Float32Type, Float64Type, Int8Type, TimestampMicrosecondType, UInt8Type, UInt16Type, UInt32Type,
+};
 use arrow_array::{Array, ArrayRef, RecordBatch};
-use arrow_schema::DataType;
+use arrow_schema::{DataType, TimeUnit};
 use hwfoc::foc::{DataFrame, InfoFrame};
 use hwfoc::{Fault, Status};
 use parquet::arrow::arrow_reader::ParquetRecordBatchReaderBuilder;
@@ -135,6 +137,10 @@ fn json_value(array: &ArrayRef, row: usize) -> Value {
             let key = dict.keys().value(row);
             Value::from(dict.values().as_string::<i32>().value(key as usize))
         }
+        // `time` (Parquet only): microseconds since the epoch, UTC.
+        DataType::Timestamp(TimeUnit::Microsecond, Some(zone)) if &**zone == "UTC" => {
+            Value::from(array.as_primitive::<TimestampMicrosecondType>().value(row))
+        }
         other => panic!("a column type this test does not know: {other}"),
     }
 }
@@ -154,7 +160,15 @@ fn assert_same_records(batch: &RecordBatch, records: &[Value]) {
     for (row, r) in records.iter().enumerate() {
         for &(name, array) in &columns {
             let got = json_value(array, row);
-            let expected = &r[name];
+            // `time` (not in JSON Lines): the instant of `t_s`, in whole microseconds.
+            let time = |t: &Value| {
+                t.as_f64()
+                    .map_or(Value::Null, |t| ((t * 1e6).round() as i64).into())
+            };
+            let expected = &match name {
+                "time" => time(&r["t_s"]),
+                _ => r[name].clone(),
+            };
             if *array.data_type() == DataType::Float32 && !got.is_null() {
                 // JSON numbers are the shortest text of the f32: they read back to the same f32.
                 let as_f32 = |v: &Value| v.as_f64().map(|v| v as f32);

@@ -4,7 +4,7 @@
 
 mod common;
 
-use common::{SCHEMA, XROTOR, capture, hwfoc, ok, stdout};
+use common::{TEXT_SCHEMA, XROTOR, capture, hwfoc, ok, stdout};
 use serde_json::Value;
 
 /// The first key of `v` and its value.
@@ -65,7 +65,7 @@ fn monitor_json_status_alarm_and_total_lines_carry_the_schema_version() {
         // The record inside a status line is the schema's, without a version of its own.
         if let Some(record) = v["record"].as_object() {
             let keys: Vec<&str> = record.keys().map(String::as_str).collect();
-            assert_eq!(keys, SCHEMA);
+            assert_eq!(keys, TEXT_SCHEMA);
         }
     }
 }
@@ -82,6 +82,6 @@ fn records_have_exactly_the_schema_keys() {
     for line in out.lines() {
         let v: Value = serde_json::from_str(line).unwrap();
         let keys: Vec<&str> = v.as_object().unwrap().keys().map(String::as_str).collect();
-        assert_eq!(keys, SCHEMA, "{line}");
+        assert_eq!(keys, TEXT_SCHEMA, "{line}");
     }
 }

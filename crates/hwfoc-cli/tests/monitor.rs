@@ -10,7 +10,7 @@ use std::str::FromStr;
 use std::thread;
 use std::time::{Duration, Instant};
 
-use common::{Running, SCHEMA, hwfoc, ok, stdout};
+use common::{Running, TEXT_SCHEMA, hwfoc, ok, stdout};
 use nix::sys::signal::Signal;
 use serde_json::Value;
 
@@ -183,7 +183,7 @@ fn json_lines_carry_the_schema_record_link_and_alarms() {
     assert_eq!(last["link"], "up");
     let record = last["record"].as_object().expect("a record");
     let keys: Vec<&str> = record.keys().map(String::as_str).collect();
-    assert_eq!(keys, SCHEMA);
+    assert_eq!(keys, TEXT_SCHEMA);
     assert!(last["info"]["product"].is_string(), "{last}");
     assert_eq!(last["battery_cells"], 6);
     assert!(last["frame_rate_hz"].as_f64().unwrap() > 1.0);

@@ -25,6 +25,7 @@ Needs pyarrow, duckdb and polars. Exits non-zero with a message on the first dif
 "1 passed, 0 failed" when all is well.
 """
 
+import datetime
 import math
 import os
 import re
@@ -48,8 +49,8 @@ FLOAT32 = {"throttle_in_pct", "throttle_out_pct", "rpm", "voltage_v", "current_a
            "phase_current_a", "mos_temp_c", "cap_temp_c", "motor_temp_c", "bec_temp_c",
            "bec_voltage_v", "bec_current_a"}
 
-# Leaf columns of record schema 3 (faults: its one leaf).
-COLUMNS = 22
+# Leaf columns of record schema 4 (faults: its one leaf).
+COLUMNS = 23
 
 # Columns the decoded file (HW-FOC ESCs) does not carry (record schemas 2 and 3): null in every
 # row, so a row group has a null count and no minimum or maximum.
@@ -165,6 +166,11 @@ def check_duckdb_metadata(path, groups):
               f"DuckDB: row group {rg} {name}: no minimum and maximum")
         if isinstance(want_lo, str):
             check((lo, hi) == (want_lo, want_hi), f"DuckDB: row group {rg} {name}: {lo}..{hi}")
+        elif isinstance(want_lo, datetime.datetime):
+            # `time`: DuckDB writes the instants as text, `2023-11-14 22:13:20.005807+00`.
+            lo, hi = datetime.datetime.fromisoformat(lo), datetime.datetime.fromisoformat(hi)
+            check((lo, hi) == (want_lo, want_hi),
+                  f"DuckDB: row group {rg} {name}: {lo}..{hi}, pyarrow {want_lo}..{want_hi}")
         else:
             # DuckDB prints a float32 as its shortest text: compare as float32 there.
             as_type = f32 if name in FLOAT32 else float
@@ -238,6 +244,34 @@ def check_pruning(path, groups, column, lo, hi):
         print(f"{engine:8} {where}: {read} of {total} row groups read, {count} rows")
 
 
+def check_time(path):
+    """DuckDB, polars and pyarrow read `time` as a UTC timestamp with no conversion, holding
+    the instant of `t_s` in every row."""
+    start = datetime.datetime.fromtimestamp(START, datetime.timezone.utc)
+    kind = duckdb.sql(f"SELECT typeof(time) FROM '{path}' LIMIT 1").fetchall()[0][0]
+    check(kind == "TIMESTAMP WITH TIME ZONE", f"DuckDB reads time as {kind}")
+    rows, differ, first = duckdb.sql(
+        "SELECT count(*), count(*) FILTER (WHERE epoch_us(time) != round(t_s * 1e6)), "
+        f"epoch_us(min(time)) FROM '{path}'").fetchall()[0]
+    check(rows > 0 and differ == 0, f"DuckDB: {differ} of {rows} rows' time is not t_s")
+    check(first // 1_000_000 == START, f"DuckDB: the first time is {first} us")
+    out = run(sys.executable, "-c", POLARS_TIME, path).stdout.split()
+    check(out[0] == "Datetime(time_unit='us',time_zone='UTC')", f"polars reads time as {out[0]}")
+    check(out[1] == "0", f"polars: {out[1]} rows' time is not t_s")
+    column = pq.read_table(path, columns=["time"]).column("time")
+    check(column.type == pa.timestamp("us", tz="UTC"), f"pyarrow reads time as {column.type}")
+    check(column[0].as_py().replace(microsecond=0) == start, f"pyarrow: first time {column[0]}")
+    print(f"time: a UTC timestamp in DuckDB, polars and pyarrow, {rows} rows equal to t_s")
+
+
+POLARS_TIME = """
+import sys, polars as pl
+df = pl.read_parquet(sys.argv[1], columns=["t_s", "time"])
+us = (df["t_s"] * 1e6).round(mode="half_away_from_zero").cast(pl.Int64)
+print(str(df.schema["time"]).replace(" ", ""), (df["time"].dt.epoch("us") != us).sum())
+"""
+
+
 def main():
     if len(sys.argv) not in (2, 3):
         sys.exit(__doc__.split("\n\n")[1])
@@ -256,6 +290,7 @@ def main():
     # Five minutes, twenty minutes in.
     t0 = START + 1200.0
     check_pruning(path, groups, "t_s", t0, t0 + 300.0)
+    check_time(path)
     print("1 passed, 0 failed")
 
 

@@ -465,6 +465,31 @@ fn decode_reads_a_live_port_until_ctrl_c() {
     );
 }
 
+/// The interface descriptions of the recording at `path`.
+fn descriptions(path: &Path) -> Vec<String> {
+    let file = std::fs::read(path).unwrap();
+    let mut reader = hwfoc_io::pcapng::Reader::new(&file[..]);
+    while reader.next_packet().unwrap().is_some() {}
+    reader
+        .interfaces()
+        .iter()
+        .map(|i| i.description.clone())
+        .collect()
+}
+
+/// Without `--protocol`, a port's interface is declared once its rate is found, by its first
+/// frames: its description names their format, as with `--protocol` (issue 30).
+#[test]
+fn the_interface_names_the_format_found() {
+    let (_dir, out, mut pty, _, mut rec, _) = record_pty("found.pcapng", &["--duration", "2.5"]);
+    feed(&mut pty, 0..20, Duration::from_millis(50));
+    assert!(rec.wait(Duration::from_secs(10)), "{}", rec.stderr());
+    assert_eq!(
+        descriptions(&out),
+        ["HW-FOC telemetry (hwfoc), 19200 baud 8N1"]
+    );
+}
+
 #[test]
 fn wrong_baud_rate_is_named() {
     let (_dir, _, mut pty, _, mut rec, _) = record_pty("noise.pcapng", &["--duration", "4"]);
@@ -512,6 +537,10 @@ fn a_forced_protocol_sets_the_baud_rate_and_the_warning() {
         "{end}"
     );
     assert_eq!(decode(&out).0.len(), 70, "every byte is recorded");
+    assert_eq!(
+        descriptions(&out),
+        ["DataLink V2 telemetry (hwfoc), 115200 baud 8N1"]
+    );
 }
 
 #[test]

@@ -162,7 +162,7 @@ pub const JSON_SCHEMA_VERSION: u32 = 1;
 /// `protocol`, the BEC and motor columns, a 32-bit nullable `packet` and null for what a format
 /// does not carry; version 3 the CAN bus's `node`, `msg2_age_ms` and `msg3_age_ms` (the
 /// document's "Changes").
-pub const RECORD_SCHEMA_VERSION: u32 = 3;
+pub const RECORD_SCHEMA_VERSION: u32 = 4;
 
 // The crate-root items, by role (a comment, not a doc comment: rustdoc would prepend a doc
 // comment on a re-export to the docs of each item it names).

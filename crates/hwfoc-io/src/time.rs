@@ -305,14 +305,17 @@ pub fn iso8601(t_s: f64) -> String {
 /// `2026-11-23T14:03:00.160123Z`: a CSV export's `time` column (`--time iso`), which
 /// spreadsheets read as a date. Beyond the year 9999 or NaN it is [`iso8601`]'s text.
 pub fn iso8601_us(t_s: f64) -> String {
-    let us = (t_s * 1e6).round();
-    match Some(us)
-        .filter(|us| us.is_finite() && us.abs() < 1e18)
-        .and_then(|us| Timestamp::from_microsecond(us as i64).ok())
-    {
+    match unix_us(t_s).and_then(|us| Timestamp::from_microsecond(us).ok()) {
         Some(t) => format!("{t:.6}"),
         None => iso8601(t_s),
     }
+}
+
+/// Unix time `t_s` in whole microseconds (rounded), the unit of the binary formats' `time`
+/// column and of [`iso8601_us`]; `None` for NaN, infinities and beyond about 31,700 years.
+pub fn unix_us(t_s: f64) -> Option<i64> {
+    let us = (t_s * 1e6).round();
+    (us.is_finite() && us.abs() < 1e18).then_some(us as i64)
 }
 
 /// Unix time `t_s` as an ISO 8601 date-time in the local zone (`TZ` or the system's), with its

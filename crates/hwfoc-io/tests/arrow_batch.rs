@@ -4,9 +4,11 @@
 use std::sync::Arc;
 
 use arrow_array::cast::AsArray;
-use arrow_array::types::{Float32Type, Float64Type, Int8Type, UInt8Type, UInt16Type, UInt32Type};
+use arrow_array::types::{
+    Float32Type, Float64Type, Int8Type, TimestampMicrosecondType, UInt8Type, UInt16Type, UInt32Type,
+};
 use arrow_array::{Array, ArrayRef, RecordBatch};
-use arrow_schema::DataType;
+use arrow_schema::{DataType, TimeUnit};
 use hwfoc::foc::DataFrame;
 use hwfoc::{Fault, Settings, Status};
 use hwfoc_io::record::{COLUMNS, Record};
@@ -75,6 +77,10 @@ fn value(array: &ArrayRef, row: usize) -> Value {
             let key = dict.keys().value(row);
             Value::from(dict.values().as_string::<i32>().value(key as usize))
         }
+        // Microseconds since the epoch, in UTC only.
+        DataType::Timestamp(TimeUnit::Microsecond, Some(zone)) if &**zone == "UTC" => {
+            Value::from(array.as_primitive::<TimestampMicrosecondType>().value(row))
+        }
         other => panic!("a type this test does not know: {other}"),
     }
 }
@@ -87,7 +93,15 @@ fn assert_same(batch: &RecordBatch, records: &[Record]) {
         let expected = json(record);
         for (name, array) in COLUMNS.iter().zip(batch.columns()) {
             let got = value(array, row);
-            let want = &expected[*name];
+            // `time` (not in JSON): the instant of `t_s`, in whole microseconds.
+            let time = |t: &Value| {
+                t.as_f64()
+                    .map_or(Value::Null, |t| ((t * 1e6).round() as i64).into())
+            };
+            let want = &match *name {
+                "time" => time(&expected["t_s"]),
+                _ => expected[*name].clone(),
+            };
             if *array.data_type() == DataType::Float32 && !got.is_null() {
                 let as_f32 = |v: &Value| v.as_f64().map(|x| x as f32);
                 assert_eq!(as_f32(&got), as_f32(want), "{name} row {row}");
@@ -96,6 +110,27 @@ fn assert_same(batch: &RecordBatch, records: &[Record]) {
             }
         }
     }
+}
+
+/// The `time` column is a UTC timestamp to the microsecond holding the instant of `t_s` (a
+/// pcapng capture's receive time), and null where `t_s` is.
+#[test]
+fn time_is_a_utc_timestamp_of_t_s() {
+    let frame = hwfoc::telemetry::Data::from(DataFrame::default());
+    let settings = Settings::default();
+    let batch = record_batch(&[
+        Record::new(Some(1_795_847_934.682_325), 0, &frame, &settings),
+        Record::new(None, 0, &frame, &settings),
+    ]);
+    let time = batch.column_by_name("time").expect("a time column");
+    let time = time.as_primitive::<TimestampMicrosecondType>();
+    assert_eq!(time.timezone(), Some("UTC"));
+    assert_eq!(time.value(0), 1_795_847_934_682_325);
+    assert_eq!(
+        time.value_as_datetime(0).unwrap().to_string(),
+        "2026-11-28 06:38:54.682325"
+    );
+    assert!(time.is_null(1));
 }
 
 #[test]

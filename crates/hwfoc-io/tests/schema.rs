@@ -4,10 +4,12 @@
 //! The expected schema is read from `docs/RECORD-SCHEMA.md` at test time (the document itself,
 //! not a copy of it): a new column is a row of that table as well as an entry in the column table.
 
-use arrow_schema::{DataType, Field};
+use arrow_schema::{DataType, Field, TimeUnit};
 use hwfoc::foc::DataFrame;
 use hwfoc::{Settings, Status};
-use hwfoc_io::record::{COLUMNS, Column, Record, TextEncoder, UNITS, Visitor, columns};
+use hwfoc_io::record::{
+    COLUMNS, Column, Record, TEXT_COLUMNS, TextEncoder, UNITS, Visitor, columns,
+};
 use hwfoc_io::write::arrow::schema;
 use std::sync::Arc;
 
@@ -63,6 +65,7 @@ fn arrow_type(words: &str) -> (DataType, bool) {
         "list of strings (CSV: `|`-joined)" => {
             DataType::List(Arc::new(Field::new("item", DataType::Utf8, false)))
         }
+        "timestamp[us, UTC]" => DataType::Timestamp(TimeUnit::Microsecond, Some("UTC".into())),
         "dictionary of strings (int8 keys)" => {
             DataType::Dictionary(Box::new(DataType::Int8), Box::new(DataType::Utf8))
         }
@@ -185,17 +188,19 @@ fn text_follows_the_table() {
     let object: serde_json::Map<String, serde_json::Value> = serde_json::from_slice(&json).unwrap();
     // serde_json keeps the order of the keys (feature preserve_order).
     let keys: Vec<&str> = object.keys().map(String::as_str).collect();
-    assert_eq!(keys, COLUMNS);
+    // Every column but `time` (Parquet and Arrow only), in order.
+    assert_eq!(TEXT_COLUMNS.as_slice(), &COLUMNS[..COLUMNS.len() - 1]);
+    assert_eq!(keys, TEXT_COLUMNS);
 
     let mut csv = Vec::new();
     Record::write_csv_header(&mut csv);
     encoder.csv_frame(&record, &hwfoc::telemetry::Data::from(frame), &mut csv);
     let csv = String::from_utf8(csv).unwrap();
     let lines: Vec<&str> = csv.lines().collect();
-    assert_eq!(lines[0], COLUMNS.join(","));
+    assert_eq!(lines[0], TEXT_COLUMNS.join(","));
     let fields: Vec<&str> = lines[1].split(',').collect();
-    assert_eq!(fields.len(), COLUMNS.len());
-    for (name, field) in COLUMNS.iter().zip(&fields) {
+    assert_eq!(fields.len(), TEXT_COLUMNS.len());
+    for (name, field) in TEXT_COLUMNS.iter().zip(&fields) {
         let value = &object[*name];
         match value {
             serde_json::Value::Null => assert_eq!(*field, "", "{name}"),
@@ -209,10 +214,10 @@ fn text_follows_the_table() {
     }
 }
 
-/// Schema version 3: the columns' order, types and nullability as written out here (the
+/// Schema version 4: the columns' order, types and nullability as written out here (the
 /// document and the code are both checked against this list: a change to either shows).
 #[test]
-fn version_3_order_types_and_nullability() {
+fn version_4_order_types_and_nullability() {
     let dict = DataType::Dictionary(Box::new(DataType::Int8), Box::new(DataType::Utf8));
     let faults = DataType::List(Arc::new(Field::new("item", DataType::Utf8, false)));
     let f32n = (DataType::Float32, true);
@@ -239,6 +244,13 @@ fn version_3_order_types_and_nullability() {
         ("node", (DataType::UInt8, true)),
         ("msg2_age_ms", (DataType::UInt32, true)),
         ("msg3_age_ms", (DataType::UInt32, true)),
+        (
+            "time",
+            (
+                DataType::Timestamp(TimeUnit::Microsecond, Some("UTC".into())),
+                true,
+            ),
+        ),
     ];
     let schema = schema();
     let got: Vec<(&str, (DataType, bool))> = schema
@@ -254,8 +266,8 @@ fn version_3_order_types_and_nullability() {
     let want: Vec<(String, (DataType, bool))> =
         want.into_iter().map(|(n, t)| (n.to_string(), t)).collect();
     assert_eq!(documented, want);
-    assert!(record_schema_md().contains("Record schema **version 3**"));
-    assert_eq!(hwfoc_io::RECORD_SCHEMA_VERSION, 3);
+    assert!(record_schema_md().contains("Record schema **version 4**"));
+    assert_eq!(hwfoc_io::RECORD_SCHEMA_VERSION, 4);
 }
 
 /// The `protocol` column of an ESC's own frame and of a DataLink hub's, and the columns no

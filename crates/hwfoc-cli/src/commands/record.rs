@@ -228,6 +228,9 @@ pub struct Recorder {
     rotate_time: Option<Duration>,
     /// Each port's rate, once known.
     bauds: Vec<Option<u32>>,
+    /// Each port's format, in its interface's description: the one forced, or the one its rate
+    /// was found by (`None` for a rate given with `--baud`: no frame waited for).
+    formats: Vec<Option<Protocol>>,
     /// The file, created, before its headers are written: while a port's rate is not known.
     pending: Option<File>,
     /// What the ports reported while the file waits for its headers.
@@ -374,6 +377,7 @@ impl Recorder {
             base: plan.output,
             rotate_size: plan.rotate_size,
             rotate_time: plan.rotate_time,
+            formats: vec![plan.protocol; plan.bauds.len()],
             bauds: plan.bauds,
             pending: Some(file),
             held: Vec::new(),
@@ -424,7 +428,8 @@ impl Recorder {
             return Ok(());
         };
         let names: Vec<String> = self.ports.iter().map(|p| p.name.clone()).collect();
-        let mut writer = headers(self.current(), file, &names, &self.bauds, self.recording)?;
+        let interfaces = (&names[..], &self.bauds[..], &self.formats[..]);
+        let mut writer = headers(self.current(), file, interfaces, self.recording)?;
         let now_ns = self.clock.now_ns();
         for (port, baud) in self.bauds.iter().enumerate() {
             if baud.is_none() && self.ports[port].can.is_none() {
@@ -490,6 +495,7 @@ impl Recorder {
             } => {
                 self.streams.feed(&event, &mut ());
                 self.bauds[*port] = Some(*baud);
+                self.formats[*port] = Some(*protocol);
                 if self.warn {
                     let found = Notice::PortBaud {
                         port: self.ports[*port].name.clone(),
@@ -695,7 +701,8 @@ impl Recorder {
         let (next, mut writer) = loop {
             let next = numbered(&self.base, self.next_number);
             self.next_number += 1;
-            match create(&next, &names, &self.bauds, self.recording) {
+            let interfaces = (&names[..], &self.bauds[..], &self.formats[..]);
+            match create(&next, interfaces, self.recording) {
                 Ok(writer) => break (next, writer),
                 Err(CliError::Write(WriteError::Exists { .. })) if taken.len() < MAX_TAKEN => {
                     taken.push(next);
@@ -846,25 +853,27 @@ fn no_frame_warning(
     )
 }
 
+/// Each port's name, rate (`None`: not found) and format (`None`: not known), in port order:
+/// what its interface says.
+type Interfaces<'a> = (&'a [String], &'a [Option<u32>], &'a [Option<Protocol>]);
+
 /// Creates a recording file with its headers, one interface per port at its rate. An
 /// existing file is an error. The file is part of recording `recording`.
 fn create(
     path: &str,
-    ports: &[String],
-    bauds: &[Option<u32>],
+    interfaces: Interfaces,
     recording: pcapng::RecordingId,
 ) -> Result<pcapng::Writer<BufWriter<File>>, CliError> {
     let file = hwfoc_io::write::create_file(path, false)?;
-    headers(path, file, ports, bauds, recording)
+    headers(path, file, interfaces, recording)
 }
 
 /// Writes the headers of the file `path` of recording `recording` into `file`: one interface
-/// per port at its rate (19200 for a rate not known).
+/// per port at its rate (19200 for a rate not known), naming its format where known.
 fn headers(
     path: &str,
     file: File,
-    ports: &[String],
-    bauds: &[Option<u32>],
+    (ports, bauds, formats): Interfaces,
     recording: pcapng::RecordingId,
 ) -> Result<pcapng::Writer<BufWriter<File>>, CliError> {
     let err = |source| WriteError::Write {
@@ -880,7 +889,8 @@ fn headers(
             continue;
         }
         let baud = bauds.get(i).copied().flatten().unwrap_or(DEFAULT_BAUD);
-        writer.add_interface(port, baud).map_err(err)?;
+        let format = formats.get(i).copied().flatten();
+        writer.add_port(port, baud, format).map_err(err)?;
     }
     writer.flush().map_err(err)?;
     Ok(writer)

@@ -17,6 +17,11 @@ pub use self::unix::*;
 #[allow(unused_imports)]
 pub use hwfoc_io::record::COLUMNS as SCHEMA;
 
+/// The columns JSON Lines and CSV write, in order: all of [`SCHEMA`] but `time` (Parquet and
+/// Arrow only).
+#[allow(unused_imports)]
+pub use hwfoc_io::record::TEXT_COLUMNS as TEXT_SCHEMA;
+
 /// The real capture of an XRotor ESC in `testdata/captures`.
 pub const XROTOR: &str = "xrotor-v4-pro-hv-80A.csv";
 

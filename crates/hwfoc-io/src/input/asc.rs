@@ -18,7 +18,7 @@ use jiff::civil::DateTime;
 use jiff::fmt::strtime;
 use jiff::tz::TimeZone;
 
-use super::can_log::{CanLogReader, Entry, LineFrames, Lines, decimal_ns, frame};
+use super::can_log::{CanLogReader, Entry, LineFrame, LineFrames, Lines, decimal_ns};
 use super::{InputError, InputFormat};
 use crate::can::candump::Logged;
 use crate::time::Clock;
@@ -184,18 +184,13 @@ impl AscLines {
             None if remote => 0,
             None => return Err(bad(&self.lines, "the data frame has no length")),
         };
-        let mut data = [0u8; 8];
-        if !remote {
-            for byte in data.iter_mut().take(dlc) {
-                *byte = words
-                    .next()
-                    .and_then(|w| u8::from_str_radix(w, radix).ok())
-                    .ok_or_else(|| bad(&self.lines, "fewer data bytes than its length"))?;
-            }
-        }
-        let data = &data[..dlc];
-        let frame = frame(id, extended, remote, data)
-            .ok_or_else(|| bad(&self.lines, "the id is too large for its kind"))?;
+        let line = LineFrame {
+            id,
+            extended,
+            remote,
+            len: dlc,
+        };
+        let frame = line.read(words, radix, |what| bad(&self.lines, what))?;
         bus.push_str("channel ");
         bus.push_str(channel);
         Ok(Some(Entry {

@@ -8,6 +8,7 @@ use std::io::{BufRead, BufReader, Read};
 
 use hwfoc::dronecan::CanFrame;
 
+use super::end::End;
 use super::recording::RECORDING_WINDOW_NS;
 use super::{BATCH, InputError, InputFormat, Looks, Source};
 use super::{asc, blf, can_csv, candump, candump_text, trc};
@@ -152,6 +153,41 @@ impl<T: LineFrames> Frames for T {
     }
 }
 
+/// A frame as a text log's line describes it (ASC, TRC), before its data bytes are read.
+pub(super) struct LineFrame {
+    /// The id.
+    pub id: u32,
+    /// Whether the id is a 29-bit one.
+    pub extended: bool,
+    /// A remote frame (no data bytes on the line).
+    pub remote: bool,
+    /// The length (0 to 8).
+    pub len: usize,
+}
+
+impl LineFrame {
+    /// The frame, its data bytes the first `len` of `words` in base `radix` (none for a
+    /// remote frame); `bad` makes the error about the line, given what is wrong.
+    pub(super) fn read<'a>(
+        self,
+        mut words: impl Iterator<Item = &'a str>,
+        radix: u32,
+        bad: impl Fn(&str) -> InputError,
+    ) -> Result<Logged, InputError> {
+        let mut data = [0u8; 8];
+        if !self.remote {
+            for byte in data.iter_mut().take(self.len) {
+                *byte = words
+                    .next()
+                    .and_then(|w| u8::from_str_radix(w, radix).ok())
+                    .ok_or_else(|| bad("fewer data bytes than its length"))?;
+            }
+        }
+        frame(self.id, self.extended, self.remote, &data[..self.len])
+            .ok_or_else(|| bad("the id is too large for its kind"))
+    }
+}
+
 /// The frame of an id, its kind and data, as a log line or object gives them; `None` where
 /// they make no classic CAN frame (an id too large, more than 8 bytes).
 pub(super) fn frame(id: u32, extended: bool, remote: bool, data: &[u8]) -> Option<Logged> {
@@ -270,8 +306,7 @@ pub(super) struct CanLogReader<F> {
     /// CAN FD frames, by stream.
     not_classic: Vec<u64>,
     ready: VecDeque<Gathered>,
-    ended: bool,
-    error: Option<InputError>,
+    end: End,
     /// Classic frames, those of them with 11-bit ids, and the source nodes (the id's low 7
     /// bits) of the 29-bit ones, for what the log looks like without ESCs.
     classic: u64,
@@ -289,8 +324,7 @@ impl<F: Frames> CanLogReader<F> {
             index: HashMap::new(),
             not_classic: Vec::new(),
             ready: VecDeque::new(),
-            ended: false,
-            error: None,
+            end: End::default(),
             classic: 0,
             standard: 0,
             nodes: 0,
@@ -320,7 +354,7 @@ impl<F: Frames> CanLogReader<F> {
             let entry = match self.frames.next(name, &mut self.bus) {
                 Ok(Some(entry)) => entry,
                 Ok(None) => {
-                    self.ended = true;
+                    self.end.reach();
                     for (i, &frames) in self.not_classic.iter().enumerate() {
                         if frames > 0 {
                             notices(Notice::NotClassicCan {
@@ -333,8 +367,7 @@ impl<F: Frames> CanLogReader<F> {
                     break;
                 }
                 Err(e) => {
-                    self.error = Some(e);
-                    self.ended = true;
+                    self.end.fail(e);
                     break;
                 }
             };
@@ -409,8 +442,8 @@ impl<F: Frames> Source for CanLogReader<F> {
                 *times = next.times;
                 return Ok(next.stream);
             }
-            if self.ended {
-                return self.error.take().map_or(Ok(0), Err);
+            if let Some(result) = self.end.result() {
+                return result;
             }
             self.read_window(name, notices);
         }

@@ -33,6 +33,7 @@ mod can_log;
 mod candump;
 mod candump_text;
 mod csv;
+mod end;
 mod error;
 mod looks;
 mod ports;

@@ -2,6 +2,7 @@
 
 use std::io::Read;
 
+use super::end::End;
 use super::{InputError, InputFormat, Looks, Source};
 use crate::clock::byte_times;
 use crate::notice::Notice;
@@ -34,9 +35,8 @@ pub(super) struct RecordingReader {
     draining: bool,
     /// Time of the first packet of the current window.
     window_start: Option<u64>,
-    /// The file is read to its end (or to a read error, kept in `error`).
-    ended: bool,
-    error: Option<InputError>,
+    /// The file is read to its end (or to a read error, kept there until handed out).
+    end: End,
     /// Interfaces whose link type is not telemetry, already warned about.
     skipped: std::collections::HashSet<u32>,
     /// Packets of CAN interfaces that are not classic CAN frames (CAN FD), by interface: told
@@ -68,8 +68,7 @@ impl RecordingReader {
             spare: Vec::new(),
             draining: false,
             window_start: None,
-            ended: false,
-            error: None,
+            end: End::default(),
             skipped: Default::default(),
             not_classic: Default::default(),
         }
@@ -99,7 +98,7 @@ impl RecordingReader {
             let packet = match packet {
                 Ok(Some(p)) => p,
                 Ok(None) => {
-                    self.ended = true;
+                    self.end.reach();
                     self.report_damage(name, notices);
                     for (&iface, &frames) in &self.not_classic {
                         notices(Notice::NotClassicCan {
@@ -244,8 +243,8 @@ impl Source for RecordingReader {
                 }
                 self.draining = false;
             }
-            if self.ended {
-                return self.error.take().map_or(Ok(0), Err);
+            if let Some(result) = self.end.result() {
+                return result;
             }
             for mut done in self.pending.drain(..) {
                 done.bytes.clear();
@@ -255,8 +254,7 @@ impl Source for RecordingReader {
             self.slot.clear();
             self.handed = 0;
             if let Err(e) = self.read_window(name, notices) {
-                self.error = Some(e);
-                self.ended = true;
+                self.end.fail(e);
             }
             self.pending
                 .sort_by(|a, b| (a.times[0].total_cmp(&b.times[0])).then(a.iface.cmp(&b.iface)));

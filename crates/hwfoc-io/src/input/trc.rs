@@ -14,7 +14,7 @@
 
 use std::io::Read;
 
-use super::can_log::{CanLogReader, Entry, LineFrames, Lines, decimal_ns, frame};
+use super::can_log::{CanLogReader, Entry, LineFrame, LineFrames, Lines, decimal_ns};
 use super::{InputError, InputFormat};
 use crate::can::candump::Logged;
 use crate::time::Clock;
@@ -172,17 +172,13 @@ impl TrcLines {
         if rest.first() == Some(&"RTR") {
             remote = true;
         }
-        let mut data = [0u8; 8];
-        if !remote {
-            for (k, byte) in data.iter_mut().take(len).enumerate() {
-                *byte = rest
-                    .get(k)
-                    .and_then(|w| u8::from_str_radix(w, 16).ok())
-                    .ok_or_else(|| bad(&self.lines, "fewer data bytes than its length"))?;
-            }
-        }
-        let frame = frame(id, id_text.len() > 4, remote, &data[..len])
-            .ok_or_else(|| bad(&self.lines, "the id is too large for its kind"))?;
+        let line = LineFrame {
+            id,
+            extended: id_text.len() > 4,
+            remote,
+            len,
+        };
+        let frame = line.read(rest.iter().copied(), 16, |what| bad(&self.lines, what))?;
         push_bus(bus, column('B'));
         Ok(Some(Entry {
             t_ns: Some(start + offset),

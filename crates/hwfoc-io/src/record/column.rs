@@ -26,6 +26,9 @@ pub trait Column: 'static {
     /// `,"NAME":`, the text before its value in a JSON object (the first column's comma becomes
     /// the opening brace).
     const JSON_KEY: &'static str;
+    /// Whether JSON Lines and CSV write the column (all but `time`, the binary formats' typed
+    /// copy of `t_s`).
+    const TEXT: bool = <Self::Value as TextValue>::WRITTEN;
     /// Whether a cached [`TextEncoder`](super::TextEncoder) keeps the text of its values, keyed
     /// by [`Column::text_key`].
     const TEXT_CACHED: bool;
@@ -60,6 +63,20 @@ pub trait Value:
 impl<T> Value for T where
     T: Copy + PartialEq + std::fmt::Debug + TextValue + ArrowValue + ParquetValue
 {
+}
+
+/// The `time` column's value: a receive time as whole microseconds since the Unix epoch, UTC
+/// (an Arrow `Timestamp(Microsecond, "UTC")`, a Parquet `TIMESTAMP(MICROS, UTC)`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct UtcTime(pub i64);
+
+impl UtcTime {
+    /// The instant of `t_s`, Unix time in seconds, to the microsecond (as
+    /// [`iso8601_us`](crate::time::iso8601_us) writes it); `None` where it has none.
+    #[inline(always)]
+    pub fn from_seconds(t_s: Option<f64>) -> Option<UtcTime> {
+        t_s.and_then(crate::time::unix_us).map(UtcTime)
+    }
 }
 
 /// Something done for each column, in schema order: [`visit`](super::columns::visit) calls
@@ -162,6 +179,34 @@ macro_rules! columns {
 
         /// Unit of each column, in schema order (`-` for a number without unit).
         pub const UNITS: [&str; COUNT] = [$($unit),*];
+
+        /// Whether JSON Lines and CSV write each column ([`Column::TEXT`](crate::record::Column::TEXT)).
+        const TEXT: [bool; COUNT] = [$(<$name as $crate::record::Column>::TEXT),*];
+
+        /// Number of columns JSON Lines and CSV write.
+        const TEXT_COUNT: usize = {
+            let mut n = 0;
+            let mut i = 0;
+            while i < COUNT {
+                n += TEXT[i] as usize;
+                i += 1;
+            }
+            n
+        };
+
+        /// Names of the columns JSON Lines and CSV write, in schema order: the CSV header.
+        pub const TEXT_COLUMNS: [&str; TEXT_COUNT] = {
+            let mut names = [""; TEXT_COUNT];
+            let (mut i, mut n) = (0, 0);
+            while i < COUNT {
+                if TEXT[i] {
+                    names[n] = COLUMNS[i];
+                    n += 1;
+                }
+                i += 1;
+            }
+            names
+        };
 
         /// Calls `visitor` for each column, in schema order.
         #[inline(always)]

@@ -32,7 +32,7 @@
 use hwfoc::telemetry::{Data, Reading, Telemetry};
 use hwfoc::{Protocol, Quantity, Settings};
 
-use super::FaultList;
+use super::{FaultList, UtcTime};
 
 /// The raw integer of `quantity` (the text cache's key; 0 where it is not carried, where the
 /// value is null and no text is cached).
@@ -123,4 +123,9 @@ columns! {
     /// Age of a Hobbywing CAN ESC's `StatusMsg3` values (MOSFET, capacitor, motor
     /// temperatures), ms; null otherwise.
     msg3_age_ms: Option<u32>, "ms", |_, _, f, _| f.msg3_age_ms();
+    /// `t_s` as a UTC timestamp to the microsecond, which DuckDB, polars, pandas and Spark read
+    /// as a time; in Arrow and Parquet only (JSON Lines and CSV carry `t_s`; CSV's
+    /// `--time iso` writes it as a date); derived from `t_s`, not a field of the record.
+    time: Option<UtcTime>, "-", |t_s, _, _, _| UtcTime::from_seconds(t_s),
+        record |r| UtcTime::from_seconds(r.t_s);
 }

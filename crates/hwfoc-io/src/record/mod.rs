@@ -20,8 +20,8 @@ mod column;
 pub mod columns;
 mod text;
 
-pub use column::{Column, FaultList, Value, Visitor};
-pub use columns::{COLUMNS, Record, UNITS};
+pub use column::{Column, FaultList, UtcTime, Value, Visitor};
+pub use columns::{COLUMNS, Record, TEXT_COLUMNS, UNITS};
 pub use text::TextEncoder;
 
 impl Record {
@@ -38,9 +38,10 @@ impl Record {
         TextEncoder::new().json(self, out);
     }
 
-    /// Appends the CSV header row: the column names, joined by commas.
+    /// Appends the CSV header row: the names of the columns text formats write
+    /// ([`TEXT_COLUMNS`]), joined by commas.
     pub fn write_csv_header(out: &mut Vec<u8>) {
-        out.extend_from_slice(COLUMNS.join(",").as_bytes());
+        out.extend_from_slice(TEXT_COLUMNS.join(",").as_bytes());
         out.push(b'\n');
     }
 }

@@ -11,7 +11,7 @@ use hwfoc::telemetry::Data;
 use hwfoc::{Fault, Protocol, Status};
 
 use super::Record;
-use super::column::{Column, FaultList, Visitor};
+use super::column::{Column, FaultList, UtcTime, Visitor};
 use super::columns::{self, COUNT};
 
 /// Longest text of one record: the keys (about 200 bytes), thirteen numbers of at most 24
@@ -106,6 +106,8 @@ pub trait TextValue: Copy {
     /// Bytes a value may take in the row buffer while it is written (fixed-size copies
     /// included).
     const TEXT_MAX: usize;
+    /// Whether text formats write values of this type (not [`UtcTime`]: see [`Column::TEXT`]).
+    const WRITTEN: bool = true;
 
     /// Appends the value's text in format `F`; `cache`: the column's index and the raw integer
     /// the value was converted from, for a column with a text key.
@@ -132,6 +134,7 @@ impl TextValue for f64 {
 
 impl<T: TextValue> TextValue for Option<T> {
     const TEXT_MAX: usize = if T::TEXT_MAX > 4 { T::TEXT_MAX } else { 4 };
+    const WRITTEN: bool = T::WRITTEN;
 
     #[inline(always)]
     fn text<F: Format>(self, e: &mut TextEncoder, cache: Option<(usize, u32)>) {
@@ -156,6 +159,15 @@ macro_rules! unsigned_text {
 }
 
 unsigned_text!(u8, u16, u32);
+
+/// Not written: JSON Lines and CSV carry the instant as `t_s` (and CSV's `--time iso`).
+impl TextValue for UtcTime {
+    const TEXT_MAX: usize = 0;
+    const WRITTEN: bool = false;
+
+    #[inline(always)]
+    fn text<F: Format>(self, _: &mut TextEncoder, _: Option<(usize, u32)>) {}
+}
 
 impl TextValue for Status {
     const TEXT_MAX: usize = 5;
@@ -243,6 +255,9 @@ struct Row<'a, F> {
 impl<F: Format> Visitor for Row<'_, F> {
     #[inline(always)]
     fn column<C: Column>(&mut self) {
+        if !C::TEXT {
+            return;
+        }
         if F::JSON {
             self.e.lit(C::JSON_KEY.as_bytes());
         } else if C::INDEX > 0 {
@@ -420,7 +435,7 @@ impl TextEncoder {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::record::COLUMNS;
+    use crate::record::TEXT_COLUMNS;
     use hwfoc::Settings;
     use hwfoc::foc::DataFrame;
 
@@ -474,7 +489,7 @@ mod tests {
         );
         // serde_json keeps the order of the keys (feature preserve_order): the schema's order.
         let keys: Vec<&str> = v.as_object().unwrap().keys().map(|k| k.as_str()).collect();
-        assert_eq!(keys, COLUMNS);
+        assert_eq!(keys, TEXT_COLUMNS);
 
         let mut csv = Vec::new();
         Record::write_csv_header(&mut csv);
@@ -482,10 +497,10 @@ mod tests {
         let csv = String::from_utf8(csv).unwrap();
         let lines: Vec<&str> = csv.lines().collect();
         assert_eq!(lines.len(), 2);
-        assert_eq!(lines[0], COLUMNS.join(","));
+        assert_eq!(lines[0], TEXT_COLUMNS.join(","));
         let fields: Vec<&str> = lines[1].split(',').collect();
-        assert_eq!(fields.len(), COLUMNS.len());
-        let field = |name: &str| fields[COLUMNS.iter().position(|&c| c == name).unwrap()];
+        assert_eq!(fields.len(), TEXT_COLUMNS.len());
+        let field = |name: &str| fields[TEXT_COLUMNS.iter().position(|&c| c == name).unwrap()];
         for (name, text) in [
             ("t_s", ""),
             ("esc", "2"),

@@ -10,14 +10,16 @@ use std::collections::HashMap;
 use std::sync::Arc;
 
 use arrow_array::builder::OffsetBufferBuilder;
-use arrow_array::types::{Float32Type, Float64Type, Int8Type, UInt8Type, UInt16Type, UInt32Type};
+use arrow_array::types::{
+    Float32Type, Float64Type, Int8Type, TimestampMicrosecondType, UInt8Type, UInt16Type, UInt32Type,
+};
 use arrow_array::{ArrayRef, DictionaryArray, ListArray, PrimitiveArray, RecordBatch, StringArray};
 use arrow_buffer::NullBuffer;
-use arrow_schema::{DataType, Field, FieldRef, Schema, SchemaRef};
+use arrow_schema::{DataType, Field, FieldRef, Schema, SchemaRef, TimeUnit};
 use hwfoc::telemetry::Data;
 use hwfoc::{Protocol, Settings, Status};
 
-use crate::record::{Column, FaultList, Record, Visitor, columns};
+use crate::record::{Column, FaultList, Record, UtcTime, Visitor, columns};
 
 /// Name of the `faults` list's item field (Arrow's default).
 pub(crate) const ITEM: &str = "item";
@@ -93,6 +95,24 @@ impl ArrowValue for Option<Status> {
 
     fn array(values: impl ExactSizeIterator<Item = Self>) -> ArrayRef {
         Option::<u16>::array(values.map(|s| s.map(|s| s.0)))
+    }
+}
+
+/// The zone of the `time` column: a UTC instant, which engines show as a time with zone
+/// (DuckDB `TIMESTAMP WITH TIME ZONE`, Spark `TimestampType`, pandas `datetime64[us, UTC]`).
+pub const TIME_ZONE: &str = "UTC";
+
+impl ArrowValue for Option<UtcTime> {
+    const NULLABLE: bool = true;
+
+    fn data_type() -> DataType {
+        DataType::Timestamp(TimeUnit::Microsecond, Some(TIME_ZONE.into()))
+    }
+
+    fn array(values: impl ExactSizeIterator<Item = Self>) -> ArrayRef {
+        let times: PrimitiveArray<TimestampMicrosecondType> =
+            values.map(|t| t.map(|t| t.0)).collect();
+        Arc::new(times.with_timezone(TIME_ZONE))
     }
 }
 

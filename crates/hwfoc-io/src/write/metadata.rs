@@ -152,7 +152,7 @@ mod tests {
             kv,
             [
                 ("hwfoc_version", env!("CARGO_PKG_VERSION")),
-                ("record_schema_version", "3"),
+                ("record_schema_version", "4"),
                 ("current_scale", "100"),
                 ("pole_pairs", "14"),
                 ("gear_ratio", "2.5"),
@@ -204,7 +204,7 @@ mod tests {
         let p = Provenance::new(hwfoc::Settings::DEFAULT, Vec::new(), String::new());
         let with_escs = p.schema(Some("[]".to_string()));
         assert_eq!(with_escs.metadata().len(), 8);
-        assert_eq!(with_escs.metadata()["record_schema_version"], "3");
+        assert_eq!(with_escs.metadata()["record_schema_version"], "4");
         assert_eq!(with_escs.metadata()["escs"], "[]");
         assert_eq!(with_escs.metadata()["pole_pairs"], "7");
         assert!(p.schema(None).metadata().get("escs").is_none());

@@ -21,7 +21,7 @@
 //! - data pages of format version 2 (values compressed on their own, levels not, no copy of
 //!   the values before compression; a page that does not compress is stored as it is);
 //! - plain values compressed with LZ4 (`LZ4_RAW`: faster than Snappy here, and smaller);
-//! - `packet` and `erpm` as bit-packed differences (`DELTA`: `DELTA_BINARY_PACKED`, not
+//! - `packet`, `erpm` and `time` as bit-packed differences (`DELTA`: `DELTA_BINARY_PACKED`, not
 //!   compressed, a bit width per 128 values): they count up or drift, and plain they hardly
 //!   compress. (Their bytes split into streams and compressed would be smaller and cheaper
 //!   still, but integer columns in that encoding came with Parquet 2.11, in 2024: Spark 3.5
@@ -122,6 +122,7 @@ mod encode {
     use parquet::column::writer::{ColumnCloseResult, get_column_writer, get_typed_column_writer};
     use parquet::data_type::{
         ByteArray, ByteArrayType, DataType as ParquetType, DoubleType, FloatType, Int32Type,
+        Int64Type,
     };
     use parquet::errors::ParquetError;
     use parquet::file::metadata::{
@@ -139,7 +140,7 @@ mod encode {
     use super::super::metadata::schema_with;
     use super::super::{Chunk, Provenance, Sink, ToWriter, WriteError};
     use crate::record::columns::{COLUMNS, COUNT, visit};
-    use crate::record::{Column, FaultList, Visitor};
+    use crate::record::{Column, FaultList, UtcTime, Visitor};
 
     /// Values handed to a column writer at a time (the crate's default, 1024, spends more time
     /// per value and makes pages of 1 MB at most).
@@ -148,7 +149,9 @@ mod encode {
     /// Columns stored as bit-packed differences (`DELTA_BINARY_PACKED`), not compressed:
     /// packet numbers count up, eRPM drifts, so their differences pack into a few bits, smaller
     /// and cheaper than compressing the plain values (which barely compress).
-    pub const DELTA: [&str; 2] = ["packet", "erpm"];
+    /// `time` counts up by about the frame period: 1.34 M rows of 16 ESCs took 23.4 MB of file
+    /// so, 27.7 MB with `time` plain and compressed, 21.0 MB without the column.
+    pub const DELTA: [&str; 3] = ["packet", "erpm", "time"];
 
     /// Columns with their bytes split into streams (`BYTE_STREAM_SPLIT`) before compression:
     /// throttles and currents vary slowly, so their high bytes repeat.
@@ -351,6 +354,8 @@ mod encode {
         // UINT_32 is stored in an INT32 column with the same bits.
         u32 => Int32Type, |v| v as i32;
         Status => Int32Type, |v| i32::from(v.0);
+        // TIMESTAMP(MICROS, UTC) is an INT64 (the logical type from the Arrow field).
+        UtcTime => Int64Type, |v| v.0;
     }
 
     impl<T: Plain> ParquetValue for Option<T>
@@ -1593,6 +1598,10 @@ mod encode {
                     // Unsigned columns among them: values above i32::MAX as negative numbers.
                     PhysicalType::INT32 => check::<Int32Type>(column, &props, |i| {
                         (i as u32).wrapping_mul(2_654_435_761) as i32
+                    }),
+                    // Microseconds of the 2020s, 7 ms apart.
+                    PhysicalType::INT64 => check::<Int64Type>(column, &props, |i| {
+                        1_795_847_934_682_325 + 7_000 * i as i64
                     }),
                     other => panic!("{}: no test values of {other}", column.path()),
                 }
