@@ -92,6 +92,8 @@ impl Frames {
             frames: &'a Frames,
             rows: std::ops::Range<usize>,
             settings: &'a Settings,
+            /// Whether every frame of `rows` is HW-FOC (looked at once, not per column).
+            hwfoc_only: bool,
             arrays: Vec<arrow_array::ArrayRef>,
         }
         impl Visitor for Arrays<'_> {
@@ -107,15 +109,28 @@ impl Frames {
                     return;
                 }
                 let (t, esc, frames) = (&f.t[rows.clone()], &f.esc[rows.clone()], &f.frames[rows]);
-                let values = t.iter().zip(esc).zip(frames).map(|((&t, &esc), frame)| {
-                    let t = (!t.is_nan()).then_some(t);
-                    C::from_frame(t, esc, frame, s)
-                });
-                self.arrays.push(<C::Value as ArrowValue>::array(values));
+                let rows = t.iter().zip(esc).zip(frames);
+                let array = if self.hwfoc_only {
+                    // HW-FOC frames only (a raw file's): each value read by field, without a
+                    // match on the protocol per value (as the Parquet export reads them).
+                    <C::Value as ArrowValue>::array(rows.map(|((&t, &esc), frame)| {
+                        let frame = Data::HwFoc(frame.to_hwfoc().unwrap_or_default());
+                        C::from_frame((!t.is_nan()).then_some(t), esc, &frame, s)
+                    }))
+                } else {
+                    <C::Value as ArrowValue>::array(rows.map(|((&t, &esc), frame)| {
+                        C::from_frame((!t.is_nan()).then_some(t), esc, frame, s)
+                    }))
+                };
+                self.arrays.push(array);
             }
         }
+        let hwfoc_only = self.frames[rows.clone()]
+            .iter()
+            .all(|f| matches!(f, Data::HwFoc(_)));
         let mut arrays = Arrays {
             frames: self,
+            hwfoc_only,
             rows,
             settings,
             arrays: Vec::with_capacity(columns::COUNT),
