@@ -53,8 +53,9 @@ typedef struct hwfoc_sequence {
     uint32_t lost;       /**< numbers missing in gaps of at most the gap limit */
     uint32_t duplicates; /**< numbers equal to the one before */
     uint32_t restarts;   /**< steps backwards or beyond the gap limit */
+    uint32_t reordered;  /**< the number a gap of one skipped, right after it (a swap: its loss taken back) */
     uint32_t last;       /**< the last number (valid when count > 0) */
-    uint32_t gap_limit;  /**< set by a silence; 0: HWFOC_MAX_PACKET_GAP + 1 */
+    uint32_t gap_limit;  /**< set by a silence; 0: HWFOC_MAX_PACKET_GAP + 1; `max`: the same after a gap of one */
 } hwfoc_sequence;
 
 /** Takes the next number of a counter whose largest value is `max` (0xFFFF or 0xFFFFFF). */
@@ -82,6 +83,8 @@ uint16_t hwfoc_crc16_modbus(const uint8_t *p, size_t n);
 #else
 #define HWFOC_FOC_MAX_LEN HWFOC_FOC_INFO_LEN
 #endif
+/** The largest throttle a data frame carries (100 %); a frame over it is counted a checksum failure. */
+#define HWFOC_FOC_THROTTLE_MAX_RAW 1024u
 
 /** An HW-FOC data frame's fields, raw (also a DataLink channel's record). */
 typedef struct hwfoc_foc_data {
@@ -140,8 +143,15 @@ typedef struct hwfoc_foc_stats {
 /** The decoder: caller-owned, zeroed by hwfoc_foc_init. */
 typedef struct hwfoc_foc_decoder {
     hwfoc_foc_stats stats;
+#ifdef HWFOC_NO_FOC_INFO
+    /* The candidate held starts at `len`: its first byte, always the sync byte, is not stored
+     * (the count of held bytes takes its place), so that the decoder takes 64 bytes. */
+    uint8_t len;
+    uint8_t held[HWFOC_FOC_MAX_LEN - 1u];
+#else
     uint8_t held[HWFOC_FOC_MAX_LEN];
     uint8_t len;
+#endif
 } hwfoc_foc_decoder;
 
 typedef void (*hwfoc_foc_cb)(void *ctx, const hwfoc_foc_frame *frame);
@@ -344,6 +354,11 @@ uint32_t hwfoc_v4_current_ma(uint16_t adc, const hwfoc_v4_info *info);
 #define HWFOC_HW5_MAX_LEN 105u
 #define HWFOC_HW5_KINDS 8u
 
+/** The largest throttle (percent) and input voltage (0.1 V) of a telemetry frame; a frame
+ * over either is counted in hwfoc_hw5_stats.out_of_range, not handed on. */
+#define HWFOC_HW5_THROTTLE_MAX_PCT 100u
+#define HWFOC_HW5_VOLTAGE_MAX_RAW 1000u
+
 /** HW5 frame kinds, counted in hwfoc_hw5_stats.frames. */
 enum {
     HWFOC_HW5_TELEMETRY = 0,
@@ -375,6 +390,7 @@ typedef struct hwfoc_hw5_stats {
     uint32_t crc_failures;
     uint32_t bad_headers;
     uint32_t unknown_types;
+    uint32_t out_of_range; /**< telemetry frames whose CRC matched with a value over its maximum */
 } hwfoc_hw5_stats;
 
 typedef struct hwfoc_hw5_decoder {
@@ -507,31 +523,33 @@ static inline void hwfoc__put_le16(uint8_t *p, uint16_t v) { p[0] = (uint8_t)v; 
 static inline void hwfoc__put_be24(uint8_t *p, uint32_t v) { p[0] = (uint8_t)(v >> 16); p[1] = (uint8_t)(v >> 8); p[2] = (uint8_t)v; }
 
 void hwfoc_sequence_next(hwfoc_sequence *s, uint32_t number, uint32_t max) {
-    uint32_t last = s->last, limit, step;
+    uint32_t gap = s->gap_limit, step = (number - s->last) & max, add = 1u, *counter = &s->restarts;
     number &= max;
-    if (s->count != 0 && s->gap_limit == 0 && number == ((last + 1u) & max)) {
-        hwfoc__inc(&s->count);
-        s->last = number;
-        return;
-    }
-    if (s->count != 0) {
-        limit = s->gap_limit == 0 ? HWFOC_MAX_PACKET_GAP + 1u : s->gap_limit;
-        step = (number - last) & max;
-        if (step == 0) {
-            hwfoc__inc(&s->duplicates);
-        } else if (step <= limit) {
-            s->lost = hwfoc__sat(s->lost, step - 1u);
-        } else {
-            hwfoc__inc(&s->restarts);
-        }
-    }
     s->gap_limit = 0;
+    if (s->count != 0) {
+        if (step == 0) {
+            counter = &s->duplicates;
+        } else if (step == max && gap == max) {
+            /* The number the gap of one before skipped: a swap. That gap counted one loss (so
+             * lost > 0), taken back; the last number stays. */
+            s->lost--;
+            counter = &s->reordered;
+            number = s->last;
+        } else if (step <= (gap - 1u < max - 1u ? gap : HWFOC_MAX_PACKET_GAP + 1u)) {
+            /* (a gap limit of 0 or the swap mark max means HWFOC_MAX_PACKET_GAP + 1) */
+            counter = &s->lost;
+            add = step - 1u;
+            if (step == 2u) s->gap_limit = max; /* a gap of one: the next number may fill it */
+        }
+        *counter = hwfoc__sat(*counter, add);
+    }
     hwfoc__inc(&s->count);
     s->last = number;
 }
 
 void hwfoc_sequence_line_silent(hwfoc_sequence *s, uint32_t max_frames, uint32_t max) {
-    uint32_t limit = s->gap_limit == 0 ? 1u : s->gap_limit;
+    /* 0 and the swap mark (max: a number after a silence is no swap) mean 1 */
+    uint32_t limit = s->gap_limit - 1u < max - 1u ? s->gap_limit : 1u;
     uint32_t most = max / 2u + 1u;
     limit = hwfoc__sat(limit, max_frames);
     s->gap_limit = limit < most ? limit : most;
@@ -544,32 +562,25 @@ uint16_t hwfoc_sum16(const uint8_t *p, size_t n) {
     return (uint16_t)sum;
 }
 
-/* Nibble tables: 32 bytes each, where a byte table takes 512. */
-static const uint16_t hwfoc__xmodem_nibble[16] = {
-    0x0000, 0x1021, 0x2042, 0x3063, 0x4084, 0x50A5, 0x60C6, 0x70E7,
-    0x8108, 0x9129, 0xA14A, 0xB16B, 0xC18C, 0xD1AD, 0xE1CE, 0xF1EF};
-
+/* Both CRCs bit by bit, without a table: on a Cortex-M4 each is about 45 bytes smaller than by
+ * nibbles (a 32-byte table; a byte table takes 512), and fast enough for a 160-byte DataLink
+ * frame at 115200 baud or a 32-byte HW5 frame at 19200. */
 uint16_t hwfoc_crc16_xmodem(const uint8_t *p, size_t n) {
-    unsigned crc = 0;
+    unsigned crc = 0, bit;
     size_t i;
     for (i = 0; i < n; i++) {
-        crc = (crc << 4 & 0xFFFFu) ^ hwfoc__xmodem_nibble[(crc >> 12) ^ (p[i] >> 4)];
-        crc = (crc << 4 & 0xFFFFu) ^ hwfoc__xmodem_nibble[(crc >> 12) ^ (p[i] & 0x0Fu)];
+        crc ^= (unsigned)p[i] << 8;
+        for (bit = 0; bit < 8u; bit++) crc = (crc & 0x8000u ? crc << 1 ^ 0x1021u : crc << 1) & 0xFFFFu;
     }
     return (uint16_t)crc;
 }
 
-static const uint16_t hwfoc__modbus_nibble[16] = {
-    0x0000, 0xCC01, 0xD801, 0x1400, 0xF001, 0x3C00, 0x2800, 0xE401,
-    0xA001, 0x6C00, 0x7800, 0xB401, 0x5000, 0x9C01, 0x8801, 0x4400};
-
 uint16_t hwfoc_crc16_modbus(const uint8_t *p, size_t n) {
-    unsigned crc = 0xFFFFu;
+    unsigned crc = 0xFFFFu, bit;
     size_t i;
     for (i = 0; i < n; i++) {
         crc ^= p[i];
-        crc = (crc >> 4) ^ hwfoc__modbus_nibble[crc & 0x0Fu];
-        crc = (crc >> 4) ^ hwfoc__modbus_nibble[crc & 0x0Fu];
+        for (bit = 0; bit < 8u; bit++) crc = crc & 1u ? crc >> 1 ^ 0xA001u : crc >> 1;
     }
     return (uint16_t)crc;
 }
@@ -655,12 +666,23 @@ static size_t hwfoc__scan(const hwfoc__format *fmt, void *d, const uint8_t *data
     }
 }
 
+/* With HWFOC_NO_FOC_INFO, HW-FOC's held candidate starts at its count of held bytes (held_at ==
+ * len_at): the sync byte it stands for is put back before the candidate is read. */
+static inline void hwfoc__held_sync(const hwfoc__format *fmt, uint8_t *held, size_t m) {
+#ifdef HWFOC_NO_FOC_INFO
+    if (fmt->held_at == fmt->len_at && m > 0) held[0] = HWFOC_SYNC;
+#else
+    (void)fmt, (void)held, (void)m;
+#endif
+}
+
 static void hwfoc__feed(const hwfoc__format *fmt, void *d, const uint8_t *data, size_t n, hwfoc__any_cb cb, void *ctx) {
     uint8_t *held = HWFOC__AT(d, fmt->held_at, uint8_t);
     uint8_t *len = HWFOC__AT(d, fmt->len_at, uint8_t);
     size_t i, m, pos;
     for (i = 0; i < n; i++) {
         m = *len;
+        hwfoc__held_sync(fmt, held, m);
         held[m] = data[i];
         hwfoc__count_add(fmt, d, fmt->bytes_at, 1);
         /* The held candidate cannot be decided with this byte yet: just keep it. */
@@ -685,15 +707,17 @@ static inline size_t hwfoc__next_byte(const uint8_t *held, size_t n) {
 static void hwfoc__flush(const hwfoc__format *fmt, void *d, hwfoc__any_cb cb, void *ctx) {
     uint8_t *len = HWFOC__AT(d, fmt->len_at, uint8_t);
     size_t held = *len;
+    hwfoc__held_sync(fmt, HWFOC__AT(d, fmt->held_at, uint8_t), held);
     (void)hwfoc__scan(fmt, d, HWFOC__AT(d, fmt->held_at, uint8_t), held,
                       (hwfoc__count(fmt, d, fmt->bytes_at) - held) & HWFOC__MASK(fmt), 1, cb, ctx);
     *len = 0;
 }
 
 /* A format's public streaming functions over the shared layer. */
-#define HWFOC__STREAM(PFX, DEC, CB, BYTES, SKIPPED, LEN_FN, FIND, PRE, SILENT)              \
+/* HELD: the member the candidate held starts at (`held`, or HW-FOC's HWFOC__FOC_HELD). */
+#define HWFOC__STREAM(PFX, DEC, CB, BYTES, SKIPPED, HELD, LEN_FN, FIND, PRE, SILENT)        \
     static const hwfoc__format PFX##_format = {offsetof(DEC, stats.BYTES), offsetof(DEC, stats.SKIPPED), \
-                                               offsetof(DEC, held), offsetof(DEC, len), LEN_FN,     \
+                                               offsetof(DEC, HELD), offsetof(DEC, len), LEN_FN,     \
                                                FIND, PFX##_take, PRE HWFOC__NARROW_INIT(DEC, BYTES)};                              \
     void PFX##_feed(DEC *d, const uint8_t *data, size_t n, CB cb, void *ctx) {                      \
         hwfoc__feed(&PFX##_format, d, data, n, (hwfoc__any_cb)cb, ctx);                             \
@@ -790,8 +814,10 @@ static int hwfoc__foc_take(hwfoc_foc_decoder *d, const uint8_t *c, size_t n, int
     if (n >= 24 && c[1] == 0x16 && c[2] == 0x01 && c[3] == 0x02 && hwfoc_sum16(c, 22) == hwfoc__le16(c + 22)) {
         f->kind = HWFOC_FOC_KIND_DATA;
         hwfoc__foc_read_payload(c + 4, &f->data);
-        hwfoc_sequence_next(&d->stats.packets, f->data.packet, HWFOC_COUNTER16_MAX);
-        return HWFOC__FRAME;
+        if (f->data.throttle_in_raw <= HWFOC_FOC_THROTTLE_MAX_RAW && f->data.throttle_out_raw <= HWFOC_FOC_THROTTLE_MAX_RAW) {
+            hwfoc_sequence_next(&d->stats.packets, f->data.packet, HWFOC_COUNTER16_MAX);
+            return HWFOC__FRAME;
+        } /* else a corrupted frame whose checksum still matches: a checksum failure below */
     }
 #ifndef HWFOC_NO_FOC_INFO
     if (n >= 77 && c[1] == 0x4C && c[2] == 0x01 && c[3] == 0x01 && (uint8_t)hwfoc_sum16(c, 76) == c[76]) {
@@ -823,7 +849,12 @@ static int hwfoc_foc_take(void *dec, const uint8_t *c, size_t n, uint64_t at, in
     return v;
 }
 
-HWFOC__STREAM(hwfoc_foc, hwfoc_foc_decoder, hwfoc_foc_cb, bytes, bytes_skipped,
+#ifdef HWFOC_NO_FOC_INFO
+#define HWFOC__FOC_HELD len
+#else
+#define HWFOC__FOC_HELD held
+#endif
+HWFOC__STREAM(hwfoc_foc, hwfoc_foc_decoder, hwfoc_foc_cb, bytes, bytes_skipped, HWFOC__FOC_HELD,
               hwfoc_foc_candidate_len, hwfoc__foc_find, NULL,
               hwfoc_sequence_line_silent(&d->stats.packets, max_frames, HWFOC_COUNTER16_MAX))
 #endif
@@ -933,7 +964,7 @@ static void hwfoc__dl_silent(hwfoc_dl_stats *s, uint32_t max_frames) {
     for (ch = 0; ch < HWFOC_DL_CHANNELS; ch++) hwfoc_sequence_line_silent(&s->channels[ch], esc, HWFOC_COUNTER16_MAX);
 }
 
-HWFOC__STREAM(hwfoc_dl, hwfoc_dl_decoder, hwfoc_dl_cb, bytes, bytes_skipped,
+HWFOC__STREAM(hwfoc_dl, hwfoc_dl_decoder, hwfoc_dl_cb, bytes, bytes_skipped, held,
               hwfoc_dl_candidate_len, hwfoc__dl_find, NULL,
               hwfoc__dl_silent(&d->stats, max_frames))
 #endif
@@ -1030,7 +1061,7 @@ static int hwfoc_v3_take(void *dec, const uint8_t *c, size_t n, uint64_t at, int
     return HWFOC__FRAME;
 }
 
-HWFOC__STREAM(hwfoc_v3, hwfoc_v3_decoder, hwfoc_v3_cb, counts.bytes, counts.bytes_skipped,
+HWFOC__STREAM(hwfoc_v3, hwfoc_v3_decoder, hwfoc_v3_cb, counts.bytes, counts.bytes_skipped, held,
               hwfoc__next_byte, hwfoc__find_sync, NULL,
               hwfoc_sequence_line_silent(&d->stats.counts.counter, max_frames, HWFOC_COUNTER24_MAX))
 #endif
@@ -1216,7 +1247,7 @@ static int hwfoc_v4_take(void *dec, const uint8_t *c, size_t n, uint64_t at, int
     return HWFOC__FRAME;
 }
 
-HWFOC__STREAM(hwfoc_v4, hwfoc_v4_decoder, hwfoc_v4_cb, counts.bytes, counts.bytes_skipped,
+HWFOC__STREAM(hwfoc_v4, hwfoc_v4_decoder, hwfoc_v4_cb, counts.bytes, counts.bytes_skipped, held,
               hwfoc__next_byte, hwfoc__find_sync, hwfoc_v4_trailer,
               hwfoc_sequence_line_silent(&d->stats.counts.counter, max_frames, HWFOC_COUNTER24_MAX))
 #endif
@@ -1312,29 +1343,37 @@ static int hwfoc_hw5_take(void *dec, const uint8_t *c, size_t n, uint64_t at, in
     hwfoc_hw5_stats *s = &((hwfoc_hw5_decoder *)dec)->stats;
     hwfoc_hw5_frame f;
     unsigned kind = 0;
+    uint32_t *counter;
     int v = hwfoc__hw5_judge(s, c, n, at_end, &kind);
     if (v != HWFOC__FRAME) return v;
-    hwfoc__inc(&s->frames[kind]);
     *len = hwfoc__hw5_len[kind];
-    if (kind != HWFOC_HW5_TELEMETRY) return HWFOC__FRAME; /* counted, not handed on */
-    f.offset = at;
-    f.throttle = c[9];
-    f.unknown[0] = c[10];
-    f.unknown[1] = c[11];
-    f.fault = c[12];
-    f.erpm_raw = hwfoc__le16(c + 13);
-    f.voltage_raw = hwfoc__le16(c + 15);
-    f.current_raw = hwfoc__le16(c + 17);
-    f.esc_temp = c[19];
-    f.bec_temp = c[20];
-    f.motor_temp = c[21];
-    f.bec_voltage_raw = c[22];
-    f.bec_current_raw = c[23];
-    if (any) ((hwfoc_hw5_cb)any)(ctx, &f);
-    return HWFOC__FRAME;
+    counter = &s->frames[kind];
+    if (kind == HWFOC_HW5_TELEMETRY) {
+        f.offset = at;
+        f.throttle = c[9];
+        f.unknown[0] = c[10];
+        f.unknown[1] = c[11];
+        f.fault = c[12];
+        f.erpm_raw = hwfoc__le16(c + 13);
+        f.voltage_raw = hwfoc__le16(c + 15);
+        f.current_raw = hwfoc__le16(c + 17);
+        f.esc_temp = c[19];
+        f.bec_temp = c[20];
+        f.motor_temp = c[21];
+        f.bec_voltage_raw = c[22];
+        f.bec_current_raw = c[23];
+        if (f.throttle > HWFOC_HW5_THROTTLE_MAX_PCT || f.voltage_raw > HWFOC_HW5_VOLTAGE_MAX_RAW) {
+            counter = &s->out_of_range; /* a corrupted frame whose CRC still matches */
+            v = HWFOC__REJECTED;
+        }
+    }
+    hwfoc__inc(counter);
+    /* other kinds are counted, not handed on */
+    if (v == HWFOC__FRAME && kind == HWFOC_HW5_TELEMETRY && any) ((hwfoc_hw5_cb)any)(ctx, &f);
+    return v;
 }
 
-HWFOC__STREAM(hwfoc_hw5, hwfoc_hw5_decoder, hwfoc_hw5_cb, bytes, bytes_skipped,
+HWFOC__STREAM(hwfoc_hw5, hwfoc_hw5_decoder, hwfoc_hw5_cb, bytes, bytes_skipped, held,
               hwfoc__next_byte, hwfoc__hw5_find, NULL,
               (void)d; (void)max_frames)
 #endif

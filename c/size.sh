@@ -6,7 +6,7 @@
 # them). Prints the table and fails past the budgets:
 #   HW-FOC decoder <= 1024 B of code, and <= 64 B of state (the whole hwfoc_foc_decoder, its
 #   candidate buffer included) in the build the state budget applies to: HWFOC_NO_FOC_INFO
-#   (data frames only; the default build holds a 77-byte info frame, 128 B in all),
+#   (data frames only; the default build holds a 77-byte info frame, 136 B in all),
 #   DataLink decoder <= 1536 B, all serial decoders together <= 4096 B, the DroneCAN payload
 #   codec <= 2048 B.
 # Needs Debian's gcc-arm-none-eabi and libnewlib-arm-none-eabi.

@@ -100,6 +100,30 @@ static void test_crcs(void) {
 
 static uint8_t stream[65536];
 
+/* Two adjacent frames swapped (5, 7, 6, 8) are one reordering, not two lost and a restart; a
+ * gap of one that stays one is a loss; a silence between the gap and the number: no swap (the
+ * Rust counters' two_adjacent_frames_swapped_are_a_reordering). */
+static void test_sequence(void) {
+    static const uint32_t first[] = {4, 5, 7, 6, 8, 9, 11, 12, 13, 65535, 1, 0, 2};
+    static const uint32_t wide[] = {0xFFFFFE, 0, 0xFFFFFF, 1};
+    hwfoc_sequence s, t, u;
+    size_t i;
+    memset(&s, 0, sizeof s);
+    memset(&t, 0, sizeof t);
+    memset(&u, 0, sizeof u);
+    for (i = 0; i < 10; i++) hwfoc_sequence_next(&s, first[i], HWFOC_COUNTER16_MAX);
+    CHECK(s.count == 10 && s.lost == 1 && s.restarts == 1 && s.duplicates == 0 && s.reordered == 1);
+    for (; i < 13; i++) hwfoc_sequence_next(&s, first[i], HWFOC_COUNTER16_MAX); /* across the wrap */
+    CHECK(s.lost == 1 && s.restarts == 1 && s.reordered == 2 && s.last == 2);
+    for (i = 0; i < 4; i++) hwfoc_sequence_next(&t, wide[i], HWFOC_COUNTER24_MAX);
+    CHECK(t.lost == 0 && t.restarts == 0 && t.reordered == 1);
+    hwfoc_sequence_next(&u, 5, HWFOC_COUNTER16_MAX);
+    hwfoc_sequence_next(&u, 7, HWFOC_COUNTER16_MAX);
+    hwfoc_sequence_line_silent(&u, 3, HWFOC_COUNTER16_MAX);
+    hwfoc_sequence_next(&u, 6, HWFOC_COUNTER16_MAX);
+    CHECK(u.lost == 1 && u.restarts == 1 && u.reordered == 0);
+}
+
 static void test_foc(void) {
     hwfoc_foc_decoder d1, d2;
     hwfoc_foc_data f;
@@ -116,15 +140,17 @@ static void test_foc(void) {
         f.erpm_raw = (uint16_t)rnd();
         f.current_raw = (int16_t)(uint16_t)rnd();
         f.status = (uint16_t)rnd();
+        if (i == 800) f.throttle_out_raw = HWFOC_FOC_THROTTLE_MAX_RAW + 1u; /* checksum right, no frame */
+        if (i == 801) f.throttle_in_raw = HWFOC_FOC_THROTTLE_MAX_RAW;       /* 100 %: a frame */
         hwfoc_foc_encode_data(&f, stream + n);
         n += HWFOC_FOC_DATA_LEN;
         if (i == 700) stream[n++] = HWFOC_SYNC; /* a stray sync byte */
     }
     feed_foc(stream, n, 1, &a, &d1);
-    CHECK(a.n == 1001);
-    CHECK(d1.stats.info_frames == 1 && d1.stats.packets.count == 1000);
-    CHECK(d1.stats.packets.lost == 3 && d1.stats.packets.restarts == 1 && d1.stats.bytes_skipped == 1);
-    CHECK(a.foc[1000].packet == 999 && a.offsets[1] == 77);
+    CHECK(a.n == 1000 && d1.stats.checksum_failures == 1);
+    CHECK(d1.stats.info_frames == 1 && d1.stats.packets.count == 999);
+    CHECK(d1.stats.packets.lost == 4 && d1.stats.packets.restarts == 1 && d1.stats.bytes_skipped == 25);
+    CHECK(a.foc[999].packet == 999 && a.foc[801].throttle_in_raw == 1024 && a.offsets[1] == 77);
     feed_foc(stream, n, 2, &b, &d2);
     CHECK(b.n == a.n && memcmp(&d1.stats, &d2.stats, sizeof d1.stats) == 0);
     CHECK(memcmp(a.foc, b.foc, sizeof a.foc) == 0);
@@ -206,7 +232,8 @@ static void test_hw5(void) {
     size_t n = 0, i;
     memset(&f, 0, sizeof f);
     for (i = 0; i < 300; i++) {
-        f.throttle = (uint8_t)i;
+        f.throttle = (uint8_t)(i == 250 ? HWFOC_HW5_THROTTLE_MAX_PCT + 1u : i % 101u);
+        f.voltage_raw = (uint16_t)(i == 200 ? HWFOC_HW5_VOLTAGE_MAX_RAW + 1u : HWFOC_HW5_VOLTAGE_MAX_RAW);
         f.erpm_raw = (uint16_t)rnd();
         f.fault = (uint8_t)rnd();
         hwfoc_hw5_encode(&f, stream + n);
@@ -214,8 +241,9 @@ static void test_hw5(void) {
         n += HWFOC_HW5_TELEMETRY_LEN;
     }
     feed_hw5(stream, n, 1, &a, &d1);
-    CHECK(a.n == 299 && d1.stats.crc_failures == 1 && d1.stats.frames[HWFOC_HW5_TELEMETRY] == 299);
-    CHECK(a.hw5[298].throttle == (uint8_t)299);
+    CHECK(a.n == 297 && d1.stats.crc_failures == 1 && d1.stats.frames[HWFOC_HW5_TELEMETRY] == 297);
+    CHECK(d1.stats.out_of_range == 2 && d1.stats.bytes_skipped == 3u * HWFOC_HW5_TELEMETRY_LEN);
+    CHECK(a.hw5[296].throttle == 299 % 101 && a.hw5[296].voltage_raw == HWFOC_HW5_VOLTAGE_MAX_RAW);
     feed_hw5(stream, n, 2, &b, &d2);
     CHECK(b.n == a.n && memcmp(&d1.stats, &d2.stats, sizeof d1.stats) == 0);
     CHECK(strcmp(hwfoc_hw5_fault_name(0), "motor_locked") == 0);
@@ -476,6 +504,7 @@ static int test_vectors(const char *path) {
 int main(int argc, char **argv) {
     int values;
     test_crcs();
+    test_sequence();
     test_foc();
     test_dl();
     test_v3();

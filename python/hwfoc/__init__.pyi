@@ -224,14 +224,17 @@ class Decoder:
         """``esc``: the ``esc`` column of the records; ``baud``: the line's rate, for the time of
         each byte (by default that of ``protocol``, else 19200); ``protocol``: a name of
         :data:`PROTOCOLS` to decode that protocol only (None: every one, from the bytes).
-        Raises ValueError for another name."""
+        Raises ValueError for another name, for ``esc`` outside 0 to 255 or ``baud`` below 1;
+        SettingsError for ``pole_pairs`` outside 1 to 65535."""
 
     def feed(
         self, data: Union[bytes, bytearray, memoryview], t: Optional[float] = None
     ) -> pa.RecordBatch:
         """Decodes the next bytes; ``t``: Unix time (s) the first was received (the others
         follow at the baud rate), or None for no ``t_s``. Returns the records of the data
-        frames completed (``.to_pylist()`` gives dicts)."""
+        frames completed (``.to_pylist()`` gives dicts). Raises ValueError for ``t`` outside 0
+        to 18446744073 (1970 to 2554); InputError when the first bytes fed are a candump log
+        (decode its frames with :class:`CanDecoder`, or read the log with :func:`read`)."""
 
     def finish(self) -> pa.RecordBatch:
         """Ends the stream: records of frames still held (a frame cut off is dropped)."""
@@ -240,7 +243,8 @@ class Decoder:
     def stats(self) -> Dict[str, Any]:
         """Link statistics: ``bytes``, ``bytes_skipped``, ``frames``, ``info_frames``,
         ``checksum_failures``, ``lost_packets``, ``duplicate_packets``, ``restarts``,
-        ``last_packet``, ``delivery_ratio``."""
+        ``last_packet``, ``delivery_ratio``. ``frames`` counts the data frames of every format
+        the stream carried (the rows given); the other figures are of its current format."""
 
     @property
     def schema(self) -> pa.Schema:

@@ -116,11 +116,11 @@ fn frame_of(item: &Bound<'_, PyAny>) -> PyResult<(f64, CanFrame)> {
 #[pymethods]
 impl CanDecoder {
     #[new]
-    #[pyo3(signature = (*, esc=0, current_scale=CURRENT_SCALE, pole_pairs=POLE_PAIRS, gear_ratio=GEAR_RATIO, v4_volts_per_step=V4_VOLTS_PER_STEP), text_signature = "(*, esc=0, current_scale=DEFAULT_CURRENT_SCALE, pole_pairs=DEFAULT_POLE_PAIRS, gear_ratio=DEFAULT_GEAR_RATIO, v4_volts_per_step=DEFAULT_V4_VOLTS_PER_STEP)")]
+    #[pyo3(signature = (*, esc=crate::args::Esc(0), current_scale=CURRENT_SCALE, pole_pairs=crate::args::PolePairs(POLE_PAIRS), gear_ratio=GEAR_RATIO, v4_volts_per_step=V4_VOLTS_PER_STEP), text_signature = "(*, esc=0, current_scale=DEFAULT_CURRENT_SCALE, pole_pairs=DEFAULT_POLE_PAIRS, gear_ratio=DEFAULT_GEAR_RATIO, v4_volts_per_step=DEFAULT_V4_VOLTS_PER_STEP)")]
     fn new(
-        esc: u8,
+        esc: crate::args::Esc,
         current_scale: f32,
-        pole_pairs: u16,
+        pole_pairs: crate::args::PolePairs,
         gear_ratio: f32,
         v4_volts_per_step: &str,
     ) -> PyResult<Self> {
@@ -132,7 +132,7 @@ impl CanDecoder {
                 bytes: Vec::new(),
                 times: Vec::new(),
             }),
-            esc,
+            esc: esc.0,
             settings,
             schema: live_schema(settings, Vec::new()),
         })

@@ -41,8 +41,12 @@ create_exception!(
 );
 
 /// The Python exception of an input error: a port's is a `PortError`, as the command tells
-/// them apart.
+/// them apart; a `KeyboardInterrupt` (any `BaseException` not an `Exception`) raised inside a
+/// file object's `read()` is raised again as itself.
 pub fn input(e: hwfoc_io::InputError) -> PyErr {
+    if let Some(raised) = raised_in_read(&e) {
+        return raised;
+    }
     match e {
         hwfoc_io::InputError::Port(e) => port(e),
         hwfoc_io::InputError::NoTiming { input } => InputError::new_err(format!(
@@ -51,6 +55,23 @@ pub fn input(e: hwfoc_io::InputError) -> PyErr {
         )),
         e => InputError::new_err(e.to_string()),
     }
+}
+
+/// The exception a file object's `read()` raised that is not an `Exception`, if `e` carries
+/// one (see [`crate::source::Raised`]).
+fn raised_in_read(e: &hwfoc_io::InputError) -> Option<PyErr> {
+    let mut next: Option<&(dyn std::error::Error + 'static)> = Some(e);
+    while let Some(err) = next {
+        let inner = err
+            .downcast_ref::<std::io::Error>()
+            .and_then(|io| io.get_ref())
+            .and_then(|inner| inner.downcast_ref::<crate::source::Raised>());
+        if let Some(crate::source::Raised(raised)) = inner {
+            return Some(pyo3::Python::attach(|py| raised.clone_ref(py)));
+        }
+        next = err.source();
+    }
+    None
 }
 
 /// The Python exception of a port error.

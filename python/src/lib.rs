@@ -4,8 +4,10 @@
 //! per row. Decoding runs with the interpreter's lock released; every error becomes an
 //! exception of `hwfoc` (see `errors.rs`) whose message is the one the `hwfoc` command prints.
 
+mod args;
 mod can;
 mod errors;
+mod interrupt;
 mod live;
 mod records;
 mod scan;
@@ -27,6 +29,7 @@ use hwfoc_io::write::arrow::schema;
 use hwfoc_io::write::metadata::escs_json;
 use hwfoc_io::{Input, InputError};
 use hwfoc_io::{Selection, Window, filter_text};
+use interrupt::Interruptible;
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
 
@@ -74,8 +77,8 @@ impl Options {
         settings: Settings,
     ) -> PyResult<Options> {
         let escs = escs_arg(esc)?;
-        let from = time_arg(start)?;
-        let to = time_arg(end)?;
+        let from = time_arg("start", start)?;
+        let to = time_arg("end", end)?;
         let window = Window::new(from, to).map_err(errors::window)?;
         Ok(Options {
             settings,
@@ -115,12 +118,12 @@ impl Options {
 /// `ValueError` naming the argument.
 pub(crate) fn settings_arg(
     current_scale: f32,
-    pole_pairs: u16,
+    pole_pairs: crate::args::PolePairs,
     gear_ratio: f32,
     v4_volts_per_step: &str,
 ) -> PyResult<Settings> {
     let settings =
-        Settings::new(current_scale, pole_pairs, gear_ratio).map_err(errors::settings)?;
+        Settings::new(current_scale, pole_pairs.0, gear_ratio).map_err(errors::settings)?;
     let v4_volts_per_step = v4_volts_per_step.parse::<VoltsPerStep>().map_err(|e| {
         PyValueError::new_err(format!("v4_volts_per_step: {v4_volts_per_step:?}: {e}"))
     })?;
@@ -170,15 +173,11 @@ pub(crate) fn protocol_arg(name: Option<&str>) -> PyResult<Option<Protocol>> {
 }
 
 /// `baud=`: the baud rate given, else that of the serial protocol forced, else the default, as
-/// the command's `--baud`; 0 is a `ValueError`.
-pub(crate) fn baud_arg(baud: Option<u32>, protocol: Option<Protocol>) -> PyResult<u32> {
-    let baud = baud
+/// the command's `--baud` (0 is refused as [`args::Baud`] is converted).
+pub(crate) fn baud_arg(baud: Option<args::Baud>, protocol: Option<Protocol>) -> u32 {
+    baud.map(|b| b.0)
         .or(protocol.and_then(Protocol::serial_baud_rate))
-        .unwrap_or(hwfoc_io::serial::DEFAULT_BAUD);
-    if baud == 0 {
-        return Err(PyValueError::new_err("baud must be at least 1"));
-    }
-    Ok(baud)
+        .unwrap_or(hwfoc_io::serial::DEFAULT_BAUD)
 }
 
 /// The inputs read with `settings`, of `protocol` only when one is forced, the recordings
@@ -199,7 +198,9 @@ pub(crate) fn sources(
 }
 
 /// `start=`/`end=`: seconds as `t_s` has them (a number), or a `datetime` (its Unix time).
-fn time_arg(t: Option<&Bound<'_, PyAny>>) -> PyResult<Option<f64>> {
+/// A `datetime` whose Unix time Python cannot compute (`datetime.min` in a time zone east of
+/// UTC) is a `ValueError` naming the argument.
+fn time_arg(name: &str, t: Option<&Bound<'_, PyAny>>) -> PyResult<Option<f64>> {
     let Some(t) = t.filter(|t| !t.is_none()) else {
         return Ok(None);
     };
@@ -207,7 +208,16 @@ fn time_arg(t: Option<&Bound<'_, PyAny>>) -> PyResult<Option<f64>> {
         return Ok(Some(s));
     }
     if t.hasattr("timestamp")? {
-        return Ok(Some(t.call_method0("timestamp")?.extract::<f64>()?));
+        return t
+            .call_method0("timestamp")
+            .and_then(|s| s.extract::<f64>())
+            .map(Some)
+            .map_err(|e| {
+                PyValueError::new_err(format!(
+                    "{name}: {t} has no Unix time ({e}): give a datetime between the years 1 \
+                     and 9999 that Python can convert, or seconds"
+                ))
+            });
     }
     Err(PyTypeError::new_err(
         "start/end: give seconds (a number, as in t_s) or a datetime",
@@ -335,14 +345,17 @@ fn decode_all(specs: Vec<Spec>, options: &Options, notes: &Notes) -> Result<Deco
             });
         }
         let mut next = 0;
-        let mut collect = Collect::new(options.selection.clone(), READ_ROWS, |frames| {
+        let collect = Collect::new(options.selection.clone(), READ_ROWS, |frames| {
             tx.send((next, frames)).map_err(|_| Stop::Abandoned)?;
             next += 1;
             Ok(())
         })
         .reuse(spare_rx);
-        let result = sources.run(&mut collect).and_then(|()| collect.flush());
-        let empty = empty_window(&collect, options, &sources);
+        let mut collect = Interruptible::new(collect);
+        let result = sources
+            .run(&mut collect)
+            .and_then(|()| collect.inner.flush());
+        let empty = empty_window(&collect.inner, options, &sources);
         drop(collect);
         drop(tx);
         result.map(|()| empty)
@@ -381,7 +394,7 @@ pub(crate) fn stop_error(stop: Stop) -> PyErr {
 /// SelectionError, SettingsError, ValueError for an unknown protocol; warns HwfocWarning for
 /// inputs without frames and for damage or notes in a recording.
 #[pyfunction]
-#[pyo3(signature = (source, *, esc=None, start=None, end=None, current_scale=CURRENT_SCALE, pole_pairs=POLE_PAIRS, gear_ratio=GEAR_RATIO, v4_volts_per_step=V4_VOLTS_PER_STEP, protocol=None, join=false), text_signature = "(source, *, esc=None, start=None, end=None, current_scale=DEFAULT_CURRENT_SCALE, pole_pairs=DEFAULT_POLE_PAIRS, gear_ratio=DEFAULT_GEAR_RATIO, v4_volts_per_step=DEFAULT_V4_VOLTS_PER_STEP, protocol=None, join=False)")]
+#[pyo3(signature = (source, *, esc=None, start=None, end=None, current_scale=CURRENT_SCALE, pole_pairs=crate::args::PolePairs(POLE_PAIRS), gear_ratio=GEAR_RATIO, v4_volts_per_step=V4_VOLTS_PER_STEP, protocol=None, join=false), text_signature = "(source, *, esc=None, start=None, end=None, current_scale=DEFAULT_CURRENT_SCALE, pole_pairs=DEFAULT_POLE_PAIRS, gear_ratio=DEFAULT_GEAR_RATIO, v4_volts_per_step=DEFAULT_V4_VOLTS_PER_STEP, protocol=None, join=False)")]
 #[allow(clippy::too_many_arguments)]
 fn read<'py>(
     py: Python<'py>,
@@ -390,7 +403,7 @@ fn read<'py>(
     start: Option<&Bound<'py, PyAny>>,
     end: Option<&Bound<'py, PyAny>>,
     current_scale: f32,
-    pole_pairs: u16,
+    pole_pairs: crate::args::PolePairs,
     gear_ratio: f32,
     v4_volts_per_step: &str,
     protocol: Option<&str>,
@@ -430,22 +443,22 @@ fn summary_json(
     notes: &Notes,
 ) -> Result<String, InputError> {
     let mut sources = sources(open_all(specs, notes)?, settings, (protocol, join));
-    let mut summary = Summary::new();
+    let mut summary = Interruptible::new(Summary::new());
     sources.run(&mut summary)?;
-    Ok(summary.report(&sources).json().to_string())
+    Ok(summary.inner.report(&sources).json().to_string())
 }
 
 /// What `hwfoc summary --json` prints for `source` (as `read` takes it), as Python objects:
 /// settings, inputs, and per ESC its link statistics, field ranges, faults and fault episodes;
 /// `protocol` and `join` as `read`'s. Raises InputError, ValueError for an unknown protocol.
 #[pyfunction]
-#[pyo3(signature = (source, *, current_scale=CURRENT_SCALE, pole_pairs=POLE_PAIRS, gear_ratio=GEAR_RATIO, v4_volts_per_step=V4_VOLTS_PER_STEP, protocol=None, join=false), text_signature = "(source, *, current_scale=DEFAULT_CURRENT_SCALE, pole_pairs=DEFAULT_POLE_PAIRS, gear_ratio=DEFAULT_GEAR_RATIO, v4_volts_per_step=DEFAULT_V4_VOLTS_PER_STEP, protocol=None, join=False)")]
+#[pyo3(signature = (source, *, current_scale=CURRENT_SCALE, pole_pairs=crate::args::PolePairs(POLE_PAIRS), gear_ratio=GEAR_RATIO, v4_volts_per_step=V4_VOLTS_PER_STEP, protocol=None, join=false), text_signature = "(source, *, current_scale=DEFAULT_CURRENT_SCALE, pole_pairs=DEFAULT_POLE_PAIRS, gear_ratio=DEFAULT_GEAR_RATIO, v4_volts_per_step=DEFAULT_V4_VOLTS_PER_STEP, protocol=None, join=False)")]
 #[allow(clippy::too_many_arguments)]
 fn summary<'py>(
     py: Python<'py>,
     source: &Bound<'py, PyAny>,
     current_scale: f32,
-    pole_pairs: u16,
+    pole_pairs: crate::args::PolePairs,
     gear_ratio: f32,
     v4_volts_per_step: &str,
     protocol: Option<&str>,
@@ -464,11 +477,11 @@ fn summary<'py>(
 /// The Arrow schema of the records (names, types, nullability, units in the fields' metadata),
 /// with the settings in its metadata.
 #[pyfunction]
-#[pyo3(signature = (*, current_scale=CURRENT_SCALE, pole_pairs=POLE_PAIRS, gear_ratio=GEAR_RATIO, v4_volts_per_step=V4_VOLTS_PER_STEP), text_signature = "(*, current_scale=DEFAULT_CURRENT_SCALE, pole_pairs=DEFAULT_POLE_PAIRS, gear_ratio=DEFAULT_GEAR_RATIO, v4_volts_per_step=DEFAULT_V4_VOLTS_PER_STEP)")]
+#[pyo3(signature = (*, current_scale=CURRENT_SCALE, pole_pairs=crate::args::PolePairs(POLE_PAIRS), gear_ratio=GEAR_RATIO, v4_volts_per_step=V4_VOLTS_PER_STEP), text_signature = "(*, current_scale=DEFAULT_CURRENT_SCALE, pole_pairs=DEFAULT_POLE_PAIRS, gear_ratio=DEFAULT_GEAR_RATIO, v4_volts_per_step=DEFAULT_V4_VOLTS_PER_STEP)")]
 fn record_schema<'py>(
     py: Python<'py>,
     current_scale: f32,
-    pole_pairs: u16,
+    pole_pairs: crate::args::PolePairs,
     gear_ratio: f32,
     v4_volts_per_step: &str,
 ) -> PyResult<Bound<'py, PyAny>> {

@@ -31,6 +31,25 @@ use hwfoc_io::write::Provenance;
 /// How long a wait for port events lasts before looking for Ctrl-C.
 const POLL: Duration = Duration::from_millis(100);
 
+/// The latest receive time `Decoder.feed` takes, s: the last Unix nanosecond a `u64` holds.
+const MAX_T_S: f64 = u64::MAX as f64 / 1e9;
+
+/// Why `Decoder.feed` refused its bytes.
+enum Refused {
+    /// A time given with some feeds and not others.
+    MixedTiming,
+    /// The first bytes are a candump log.
+    CanLog,
+}
+
+/// Whether `bytes`, a stream's first, are a candump log: a first line that parses as one.
+fn is_candump(bytes: &[u8]) -> bool {
+    use hwfoc_io::can::candump;
+    let line = bytes.split(|&b| b == b'\n').next().unwrap_or_default();
+    candump::looks_like_line(line)
+        && std::str::from_utf8(line).is_ok_and(|line| candump::parse_line(line, 1).is_ok())
+}
+
 /// A handler gathering the data frames it is given.
 #[derive(Default)]
 struct Gather(Frames);
@@ -90,6 +109,9 @@ struct DecoderState {
     /// Whether the bytes fed so far came with times (`None` before the first feed): a stream
     /// is timed throughout or not at all (a frame's time is its first byte's).
     timed: Option<bool>,
+    /// Data frames given so far, of every format the stream carried (the stream's own
+    /// statistics are of its current format).
+    data_frames: u64,
 }
 
 /// A streaming decoder of one ESC's bytes: see `hwfoc.Decoder`.
@@ -120,12 +142,12 @@ impl Decoder {
 #[pymethods]
 impl Decoder {
     #[new]
-    #[pyo3(signature = (*, esc=0, baud=None, current_scale=CURRENT_SCALE, pole_pairs=POLE_PAIRS, gear_ratio=GEAR_RATIO, v4_volts_per_step=V4_VOLTS_PER_STEP, protocol=None), text_signature = "(*, esc=0, baud=None, current_scale=DEFAULT_CURRENT_SCALE, pole_pairs=DEFAULT_POLE_PAIRS, gear_ratio=DEFAULT_GEAR_RATIO, v4_volts_per_step=DEFAULT_V4_VOLTS_PER_STEP, protocol=None)")]
+    #[pyo3(signature = (*, esc=crate::args::Esc(0), baud=None, current_scale=CURRENT_SCALE, pole_pairs=crate::args::PolePairs(POLE_PAIRS), gear_ratio=GEAR_RATIO, v4_volts_per_step=V4_VOLTS_PER_STEP, protocol=None), text_signature = "(*, esc=0, baud=None, current_scale=DEFAULT_CURRENT_SCALE, pole_pairs=DEFAULT_POLE_PAIRS, gear_ratio=DEFAULT_GEAR_RATIO, v4_volts_per_step=DEFAULT_V4_VOLTS_PER_STEP, protocol=None)")]
     fn new(
-        esc: u8,
-        baud: Option<u32>,
+        esc: crate::args::Esc,
+        baud: Option<crate::args::Baud>,
         current_scale: f32,
-        pole_pairs: u16,
+        pole_pairs: crate::args::PolePairs,
         gear_ratio: f32,
         v4_volts_per_step: &str,
         protocol: Option<&str>,
@@ -133,14 +155,15 @@ impl Decoder {
         let settings =
             crate::settings_arg(current_scale, pole_pairs, gear_ratio, v4_volts_per_step)?;
         let protocol = crate::protocol_arg(protocol)?;
-        let baud = crate::baud_arg(baud, protocol)?;
+        let baud = crate::baud_arg(baud, protocol);
         Ok(Decoder {
             state: Mutex::new(DecoderState {
                 stream: Stream::forced(protocol),
                 times: Vec::new(),
                 timed: None,
+                data_frames: 0,
             }),
-            esc,
+            esc: esc.0,
             settings,
             per_byte_ns: hwfoc::wire::byte_ns(baud),
             schema: live_schema(settings, Vec::new()),
@@ -150,14 +173,18 @@ impl Decoder {
     /// Decodes `data`, the next bytes of the stream; `t`: Unix time (s) the first of them was
     /// received, the others following at the baud rate's byte time. Returns the records of
     /// the data frames completed, as a `pyarrow.RecordBatch`.
+    /// `t` outside 0 to 18446744073 (1970 to 2554) is a `ValueError`; first bytes that are a
+    /// candump log are an `InputError` (decode its frames with `hwfoc.CanDecoder`).
     #[pyo3(signature = (data, t=None))]
     fn feed(&self, py: Python<'_>, data: &Bound<'_, PyAny>, t: Option<f64>) -> PyResult<Py<PyAny>> {
         let bytes = bytes_of(data)?;
         if let Some(t) = t
-            && !(t.is_finite() && t >= 0.0)
+            && !(t.is_finite() && (0.0..=MAX_T_S).contains(&t))
         {
             return Err(PyValueError::new_err(format!(
-                "t: {t} is not a time in seconds since 1970"
+                "t: {t} is not a time in seconds since 1970: give 0 to {:.0} (the year \
+                 2554, the last nanosecond the clocks hold)",
+                MAX_T_S.floor()
             )));
         }
         let esc = self.esc;
@@ -168,9 +195,13 @@ impl Decoder {
                 stream,
                 times,
                 timed,
+                data_frames,
             } = &mut *state;
             if *timed.get_or_insert(t.is_some()) != t.is_some() {
-                return Some(Err(()));
+                return Some(Err(Refused::MixedTiming));
+            }
+            if stream.stats().bytes() == 0 && is_candump(&bytes) {
+                return Some(Err(Refused::CanLog));
             }
             let mut gather = Gather::default();
             times.clear();
@@ -190,15 +221,20 @@ impl Decoder {
                         .push(t, channel.map_or(esc, |c| esc.saturating_add(c)), f);
                 }
             });
+            *data_frames += gather.0.len() as u64;
             Some(Ok(gather.0))
         });
         let frames = frames
             .ok_or_else(|| errors::HwfocError::new_err("the decoder failed earlier"))?
-            .map_err(|()| {
-                PyValueError::new_err(
+            .map_err(|refused| match refused {
+                Refused::MixedTiming => PyValueError::new_err(
                     "t: give a receive time with every feed() or with none (a stream is timed \
                      throughout or not at all)",
-                )
+                ),
+                Refused::CanLog => errors::InputError::new_err(
+                    "the bytes fed are a candump log (text of CAN frames), not a serial wire's \
+                     bytes: feed its frames to hwfoc.CanDecoder, or read the log with hwfoc.read",
+                ),
             })?;
         self.batch(py, &frames)
     }
@@ -208,22 +244,28 @@ impl Decoder {
     fn finish(&self, py: Python<'_>) -> PyResult<Py<PyAny>> {
         let mut gather = Gather::default();
         let esc = self.esc;
-        self.lock()?.stream.finish(|t, channel, d| {
+        let mut state = self.lock()?;
+        state.stream.finish(|t, channel, d| {
             if let Frame::Data(f) = d {
                 gather
                     .0
                     .push(t, channel.map_or(esc, |c| esc.saturating_add(c)), f);
             }
         });
+        state.data_frames += gather.0.len() as u64;
+        drop(state);
         self.batch(py, &gather.0)
     }
 
     /// The link statistics so far (bytes, frames, checksum failures, lost packets,
-    /// duplicates, restarts...).
+    /// duplicates, restarts...). `frames` counts the data frames of every format the stream
+    /// carried (the rows given); the other figures are of its current format.
     #[getter]
     fn stats<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
-        let stats = self.lock()?.stream.stats();
-        stats_dict(py, &stats)
+        let state = self.lock()?;
+        let d = stats_dict(py, &state.stream.stats())?;
+        d.set_item("frames", state.data_frames)?;
+        Ok(d)
     }
 
     /// The Arrow schema of the batches `feed` returns.
@@ -251,13 +293,13 @@ pub struct Ports {
 /// Opens serial ports: see `hwfoc.open_ports`.
 #[pyfunction]
 #[allow(clippy::too_many_arguments)]
-#[pyo3(signature = (ports, *, baud=None, current_scale=CURRENT_SCALE, pole_pairs=POLE_PAIRS, gear_ratio=GEAR_RATIO, v4_volts_per_step=V4_VOLTS_PER_STEP, protocol=None), text_signature = "(ports, *, baud=None, current_scale=DEFAULT_CURRENT_SCALE, pole_pairs=DEFAULT_POLE_PAIRS, gear_ratio=DEFAULT_GEAR_RATIO, v4_volts_per_step=DEFAULT_V4_VOLTS_PER_STEP, protocol=None)")]
+#[pyo3(signature = (ports, *, baud=None, current_scale=CURRENT_SCALE, pole_pairs=crate::args::PolePairs(POLE_PAIRS), gear_ratio=GEAR_RATIO, v4_volts_per_step=V4_VOLTS_PER_STEP, protocol=None), text_signature = "(ports, *, baud=None, current_scale=DEFAULT_CURRENT_SCALE, pole_pairs=DEFAULT_POLE_PAIRS, gear_ratio=DEFAULT_GEAR_RATIO, v4_volts_per_step=DEFAULT_V4_VOLTS_PER_STEP, protocol=None)")]
 pub fn open_ports(
     py: Python<'_>,
     ports: Vec<String>,
-    baud: Option<u32>,
+    baud: Option<crate::args::Baud>,
     current_scale: f32,
-    pole_pairs: u16,
+    pole_pairs: crate::args::PolePairs,
     gear_ratio: f32,
     v4_volts_per_step: &str,
     protocol: Option<&str>,
@@ -277,7 +319,7 @@ pub fn open_ports(
             )));
         }
     }
-    let baud = crate::baud_arg(baud, protocol)?;
+    let baud = crate::baud_arg(baud, protocol);
     let set = py
         .detach(|| PortSet::open(&ports, baud))
         .map_err(errors::port)?;
@@ -310,9 +352,9 @@ impl Ports {
             if let Some(event) = &event {
                 state.streams.feed(event, &mut gather);
             }
-            Some((event, gather.0))
+            Some((event, gather.0, state.streams.take_notices()))
         });
-        let Some((event, frames)) = got else {
+        let Some((event, frames, notices)) = got else {
             return Ok(false);
         };
         if !frames.is_empty() {
@@ -332,9 +374,12 @@ impl Ports {
         {
             crate::warn_notice(py, notice)?;
         }
-        if event.is_none() {
-            py.check_signals()?;
+        // What the streams found (ESCs past number 255 left out, two CAN ESCs on one channel).
+        for notice in notices {
+            crate::warn_notice(py, notice)?;
         }
+        // Ctrl-C, whether the ports are busy or quiet.
+        py.check_signals()?;
         Ok(true)
     }
 

@@ -10,7 +10,6 @@ use std::time::Duration;
 
 use arrow_array::RecordBatch;
 use arrow_pyarrow::ToPyArrow;
-use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
 use crate::records::{Collect, Stop};
@@ -106,25 +105,23 @@ fn produce(
 /// batches ahead. Errors opening the inputs are raised at once, later ones by the iterator after
 /// the batches before them.
 #[pyfunction]
-#[pyo3(signature = (sources, *, batch_rows=65536, esc=None, start=None, end=None, current_scale=CURRENT_SCALE, pole_pairs=POLE_PAIRS, gear_ratio=GEAR_RATIO, v4_volts_per_step=V4_VOLTS_PER_STEP, protocol=None, join=false), text_signature = "(sources, *, batch_rows=65536, esc=None, start=None, end=None, current_scale=DEFAULT_CURRENT_SCALE, pole_pairs=DEFAULT_POLE_PAIRS, gear_ratio=DEFAULT_GEAR_RATIO, v4_volts_per_step=DEFAULT_V4_VOLTS_PER_STEP, protocol=None, join=False)")]
+#[pyo3(signature = (sources, *, batch_rows=crate::args::Rows(65536), esc=None, start=None, end=None, current_scale=CURRENT_SCALE, pole_pairs=crate::args::PolePairs(POLE_PAIRS), gear_ratio=GEAR_RATIO, v4_volts_per_step=V4_VOLTS_PER_STEP, protocol=None, join=false), text_signature = "(sources, *, batch_rows=65536, esc=None, start=None, end=None, current_scale=DEFAULT_CURRENT_SCALE, pole_pairs=DEFAULT_POLE_PAIRS, gear_ratio=DEFAULT_GEAR_RATIO, v4_volts_per_step=DEFAULT_V4_VOLTS_PER_STEP, protocol=None, join=False)")]
 #[allow(clippy::too_many_arguments)]
 pub fn scan(
     py: Python<'_>,
     sources: &Bound<'_, PyAny>,
-    batch_rows: usize,
+    batch_rows: crate::args::Rows,
     esc: Option<&Bound<'_, PyAny>>,
     start: Option<&Bound<'_, PyAny>>,
     end: Option<&Bound<'_, PyAny>>,
     current_scale: f32,
-    pole_pairs: u16,
+    pole_pairs: crate::args::PolePairs,
     gear_ratio: f32,
     v4_volts_per_step: &str,
     protocol: Option<&str>,
     join: bool,
 ) -> PyResult<Scan> {
-    if batch_rows == 0 {
-        return Err(PyValueError::new_err("batch_rows must be at least 1"));
-    }
+    let batch_rows = batch_rows.0;
     let settings = crate::settings_arg(current_scale, pole_pairs, gear_ratio, v4_volts_per_step)?;
     let options = Options::new(esc, start, end, settings)?
         .forced(protocol)?

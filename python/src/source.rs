@@ -140,7 +140,7 @@ impl Read for PyReader {
                 .obj
                 .bind(py)
                 .call_method1("read", (buf.len(),))
-                .map_err(|e| io::Error::other(e.to_string()))?;
+                .map_err(|e| raised(py, e))?;
             if data.is_none() {
                 // A non-blocking stream with nothing yet: no bytes now is the end for a file.
                 return Ok(0);
@@ -160,5 +160,29 @@ impl Read for PyReader {
             buf[..data.len()].copy_from_slice(&data);
             Ok(data.len())
         })
+    }
+}
+
+/// A `BaseException` that is not an `Exception` (`KeyboardInterrupt`, `SystemExit`) raised
+/// inside a file object's `read()`, carried through the reading as an `io::Error` to be raised
+/// again as itself (see [`crate::errors::input`]).
+#[derive(Debug)]
+pub struct Raised(pub PyErr);
+
+impl std::fmt::Display for Raised {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        self.0.fmt(f)
+    }
+}
+
+impl std::error::Error for Raised {}
+
+/// The `io::Error` of an exception raised by a file object's `read()`: an `Exception` becomes
+/// its text (an input error naming the input), anything else is kept to be raised again.
+fn raised(py: Python<'_>, e: PyErr) -> io::Error {
+    if e.is_instance_of::<pyo3::exceptions::PyException>(py) {
+        io::Error::other(e.to_string())
+    } else {
+        io::Error::other(Raised(e))
     }
 }

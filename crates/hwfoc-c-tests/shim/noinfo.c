@@ -122,7 +122,7 @@ long noinfo_stats(noinfo *s, const uint64_t **out) {
     const hwfoc_sequence *q = &t->packets;
     s->o.len = 0;
     put(s, t->bytes); put(s, t->bytes_skipped); put(s, t->checksum_failures);
-    put(s, q->count); put(s, q->lost); put(s, q->duplicates); put(s, q->restarts);
+    put(s, q->count); put(s, q->lost); put(s, q->duplicates); put(s, q->restarts); put(s, q->reordered);
     put(s, q->count ? q->last : UINT64_MAX);
     return noinfo_take_frames(s, out);
 }

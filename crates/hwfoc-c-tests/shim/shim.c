@@ -25,7 +25,7 @@ static void put(shim *s, uint64_t v) {
 }
 
 static void put_seq(shim *s, const hwfoc_sequence *q, uint64_t none) {
-    put(s, q->count); put(s, q->lost); put(s, q->duplicates); put(s, q->restarts);
+    put(s, q->count); put(s, q->lost); put(s, q->duplicates); put(s, q->restarts); put(s, q->reordered);
     put(s, q->count ? q->last : none);
 }
 
@@ -200,7 +200,7 @@ long shim_stats(shim *s, const uint64_t **out) {
         const hwfoc_hw5_stats *t = &s->d.hw5.stats;
         put(s, t->bytes); put(s, t->bytes_skipped);
         for (i = 0; i < HWFOC_HW5_KINDS; i++) put(s, t->frames[i]);
-        put(s, t->crc_failures); put(s, t->bad_headers); put(s, t->unknown_types);
+        put(s, t->crc_failures); put(s, t->bad_headers); put(s, t->unknown_types); put(s, t->out_of_range);
         break;
     }
     }

@@ -28,7 +28,16 @@ fn opt(v: Option<impl Into<u64>>) -> u64 {
 }
 
 fn sequence<W: Width>(s: &Sequence<W>, out: &mut Vec<u64>) {
-    out.extend([s.count(), s.lost(), s.duplicates(), s.restarts()].map(u64::from));
+    out.extend(
+        [
+            s.count(),
+            s.lost(),
+            s.duplicates(),
+            s.restarts(),
+            s.reordered(),
+        ]
+        .map(u64::from),
+    );
     out.push(s.last().map_or(NONE, |n| u64::from(n.into())));
 }
 
@@ -216,7 +225,15 @@ impl Flat for hw5::Scanner {
     fn stats(s: &hw5::Stats, out: &mut Vec<u64>) {
         out.extend([s.bytes(), s.bytes_skipped()]);
         out.extend(s.frames_by_kind().map(u64::from));
-        out.extend([s.crc_failures(), s.bad_headers(), s.unknown_types()].map(u64::from));
+        out.extend(
+            [
+                s.crc_failures(),
+                s.bad_headers(),
+                s.unknown_types(),
+                s.out_of_range(),
+            ]
+            .map(u64::from),
+        );
     }
     fn encode(item: &hw5::Decoded) -> Vec<u8> {
         item.frame.encode().to_vec()

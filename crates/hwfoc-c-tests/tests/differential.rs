@@ -107,12 +107,15 @@ fn foc_stream(rng: &mut Rng, frames: usize) -> Vec<u8> {
     out
 }
 
-/// A counter's next step: mostly 1, sometimes a repeat, a gap, or a restart.
+/// A counter's next step: mostly 1, sometimes a repeat, a gap, a restart, or one back (after a
+/// gap of one: two adjacent frames swapped).
 fn step(rng: &mut Rng) -> u32 {
     match rng.below(30) {
         0 => 0,
         1 => 2 + rng.below(5) as u32,
         2 => rng.bits() as u32,
+        3 => 2,
+        4 => u32::MAX,
         _ => 1,
     }
 }
@@ -230,11 +233,12 @@ fn hw5_stream(rng: &mut Rng, frames: usize) -> Vec<u8> {
     let mut out = Vec::new();
     for _ in 0..frames {
         let f = hw5::TelemetryFrame {
-            throttle: rng.bits() as u8,
+            // Mostly in range, a few over (rejected as out of range by both decoders).
+            throttle: rng.below(110) as u8,
             unknown: [rng.bits() as u8, rng.bits() as u8],
             fault: hw5::FaultCode(rng.bits() as u8),
             erpm_raw: rng.bits() as u16,
-            voltage_raw: rng.bits() as u16,
+            voltage_raw: rng.below(1100) as u16,
             current_raw: rng.bits() as u16,
             esc_temp: rng.bits() as u8,
             bec_temp: rng.bits() as u8,

@@ -309,22 +309,14 @@ fn run_toml(text: &str, dir: &Path) -> Result<(), String> {
     }
 }
 
-/// Whether a block can run here (tshark is installed by CI, perhaps not elsewhere).
-fn can_run(block: &Block) -> bool {
-    if !block.text.contains("tshark") {
-        return true;
-    }
-    let found = common::tshark()
-        .arg("--version")
-        .stdout(Stdio::null())
-        .stderr(Stdio::null())
-        .status()
-        .is_ok_and(|s| s.success());
-    common::can_check(found, &format!("{}: tshark", block.place))
+/// Whether a block needs tshark (run only by [`every_example_that_needs_tshark_runs`]).
+fn needs_tshark(block: &Block) -> bool {
+    block.text.contains("tshark")
 }
 
-/// Runs a document's blocks in order in a fresh directory; the failures, one per block.
-fn run_document(path: &Path, setup: &[Block]) -> Vec<String> {
+/// Runs a document's blocks in order in a fresh directory (those that need tshark only
+/// `with_tshark`); the failures, one per block.
+fn run_document(path: &Path, setup: &[Block], with_tshark: bool) -> Vec<String> {
     let dir = common::Dir::new();
     std::os::unix::fs::symlink(root().join("testdata"), dir.path("testdata")).unwrap();
     let is_readme = path.ends_with("README.md") && path.parent() == Some(&root());
@@ -338,7 +330,7 @@ fn run_document(path: &Path, setup: &[Block]) -> Vec<String> {
         }
     }
     for block in blocks(path) {
-        if !can_run(&block) {
+        if needs_tshark(&block) && !with_tshark {
             continue;
         }
         let result = match block.info.as_str() {
@@ -376,14 +368,21 @@ fn every_block_has_a_known_language() {
     );
 }
 
-/// Every shell example, transcript and configuration file of the documents runs as written.
-#[test]
-fn every_example_runs() {
+/// The README's ```sh setup blocks, run before each other document's blocks.
+fn setup_blocks() -> Vec<Block> {
     let setup: Vec<Block> = blocks(&root().join("README.md"))
         .into_iter()
         .filter(|b| b.info == "sh setup")
         .collect();
     assert!(!setup.is_empty(), "README.md: no ```sh setup block");
+    setup
+}
+
+/// Every shell example, transcript and configuration file of the documents runs as written
+/// (but those that need tshark: [`every_example_that_needs_tshark_runs`]).
+#[test]
+fn every_example_runs() {
+    let setup = setup_blocks();
     let mut failures = Vec::new();
     let mut ran = Vec::new();
     for doc in documents() {
@@ -397,9 +396,27 @@ fn every_example_runs() {
             .display()
             .to_string();
         ran.push(format!("{name} ({count} blocks)"));
-        failures.extend(run_document(&doc, &setup));
+        failures.extend(run_document(&doc, &setup, false));
     }
     eprintln!("ran the examples of: {}", ran.join(", "));
+    assert!(failures.is_empty(), "{}", failures.join("\n\n"));
+}
+
+/// The documents with an example that needs tshark run as written, those examples included.
+#[test]
+#[ignore = "needs tshark: .ci/run installs it and runs these with --ignored"]
+fn every_example_that_needs_tshark_runs() {
+    common::need_tshark();
+    let setup = setup_blocks();
+    let mut failures = Vec::new();
+    let mut ran = 0;
+    for doc in documents() {
+        if blocks(&doc).iter().any(needs_tshark) {
+            ran += 1;
+            failures.extend(run_document(&doc, &setup, true));
+        }
+    }
+    assert!(ran > 0, "no document has an example that needs tshark");
     assert!(failures.is_empty(), "{}", failures.join("\n\n"));
 }
 

@@ -17,7 +17,7 @@ mod python;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-use common::{hwfoc, run};
+use common::{hwfoc, need_tshark, run};
 use hwfoc::foc::{DataFrame, Frame, InfoFrame};
 use hwfoc_io::pcapng;
 use serde_json::Value;
@@ -28,28 +28,6 @@ fn dissector() -> PathBuf {
 
 fn old_recording() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../../testdata/recordings/chunked-2esc.pcapng")
-}
-
-fn tshark_found() -> bool {
-    let found = common::tshark()
-        .arg("--version")
-        .output()
-        .is_ok_and(|o| o.status.success());
-    common::can_check(found, "tshark (running the Wireshark dissector)")
-}
-
-/// tshark, for a test that is tshark and nothing else (listed as ignored by a plain `cargo
-/// test`; `.ci/run` installs tshark and runs them with `--ignored`): a missing tshark fails
-/// it, saying so.
-fn need_tshark() {
-    let found = common::tshark()
-        .arg("--version")
-        .output()
-        .is_ok_and(|o| o.status.success());
-    assert!(
-        found,
-        "needs tshark: install it (Debian: apt-get install tshark), as .ci/run does"
-    );
 }
 
 const FIELDS: [&str; 22] = [
@@ -436,7 +414,7 @@ fn a_simulated_recording_dissects_as_decode_reads_it() {
 }
 
 #[test]
-fn the_old_chunked_recording_decodes_as_before_and_dissects_alike() {
+fn the_old_chunked_recording_decodes_as_before() {
     let file = old_recording();
     let golden = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/golden/chunked-2esc.jsonl");
     let out = run(hwfoc().arg("decode").arg(&file));
@@ -447,9 +425,14 @@ fn the_old_chunked_recording_decodes_as_before_and_dissects_alike() {
         "an old recording must decode exactly as before (the same records as the old writer's \
          reader gave, now in time order across its two ports)"
     );
-    if !tshark_found() {
-        return;
-    }
+}
+
+#[test]
+#[ignore = "needs tshark: .ci/run installs it and runs these with --ignored"]
+fn the_old_chunked_recording_dissects_as_it_decodes() {
+    need_tshark();
+    let file = old_recording();
+    let golden = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/golden/chunked-2esc.jsonl");
     let shown = tshark(&file, &[], true);
     let decoded = records(&std::fs::read(&golden).unwrap());
     // Frames cut across packets (reads) are reassembled: every frame is there.
@@ -578,25 +561,6 @@ fn install_path_and_print() {
     assert!(again.status.success());
     assert!(String::from_utf8_lossy(&again.stdout).contains("already"));
 
-    // Wireshark loads it from there: tshark dissects without -X.
-    if tshark_found() {
-        let file = home.join("codes.pcapng");
-        every_code(&file);
-        let out = common::tshark()
-            .env("HOME", home)
-            .arg("-r")
-            .arg(&file)
-            .args(["-T", "fields", "-e", "hwfoc.packet"])
-            .output()
-            .unwrap();
-        let text = String::from_utf8_lossy(&out.stdout);
-        assert_eq!(
-            text.lines().filter(|l| !l.is_empty()).count(),
-            256,
-            "{text}"
-        );
-    }
-
     // A file of one's own is never replaced unasked.
     std::fs::write(&target, "-- my edits\n").unwrap();
     let refused = cmd(&["install"]);
@@ -610,6 +574,33 @@ fn install_path_and_print() {
         .unwrap()
         .collect();
     assert_eq!(left.len(), 1, "a temporary file was left behind");
+}
+
+/// Wireshark loads the dissector `hwfoc wireshark install` put in place: tshark dissects without
+/// -X.
+#[test]
+#[ignore = "needs tshark: .ci/run installs it and runs these with --ignored"]
+fn tshark_loads_the_installed_dissector() {
+    need_tshark();
+    let dir = tempfile::tempdir().unwrap();
+    let home = dir.path();
+    let install = run(hwfoc().args(["wireshark", "install"]).env("HOME", home));
+    assert!(install.status.success());
+    let file = home.join("codes.pcapng");
+    every_code(&file);
+    let out = common::tshark()
+        .env("HOME", home)
+        .arg("-r")
+        .arg(&file)
+        .args(["-T", "fields", "-e", "hwfoc.packet"])
+        .output()
+        .unwrap();
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert_eq!(
+        text.lines().filter(|l| !l.is_empty()).count(),
+        256,
+        "{text}"
+    );
 }
 
 /// Each ESC's valid data frames, as (interface or ESC) -> packet numbers in order.

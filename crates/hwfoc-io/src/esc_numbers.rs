@@ -12,8 +12,9 @@
 //! ahead), so that a bus read alone numbers its ESCs by their place and two ESCs are never one. Numbers stop at [`MAX_ESCS`]: the record's
 //! `esc` column is a `u8`.
 
-/// How many ESCs the record's `esc` column (a `u8`) can number.
-pub(crate) const MAX_ESCS: usize = 256;
+/// How many ESCs the record's `esc` column (a `u8`) can number: the most ESCs any input,
+/// port set or simulated fleet may have.
+pub const MAX_ESCS: usize = 256;
 
 /// The number of a hub's channel past [`MAX_ESCS`]: its frames are not handed on, the `esc`
 /// column could not tell them from another ESC's.

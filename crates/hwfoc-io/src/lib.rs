@@ -142,6 +142,7 @@ mod fixed;
 mod handler;
 mod input;
 mod notice;
+mod port;
 mod select;
 mod settings;
 mod sources;
@@ -171,6 +172,7 @@ pub use input::{Batch, Input, InputError, InputFormat, Looks, read_small_file};
 
 // Decoding: `Sources` reads inputs, merges them in time order and decodes each ESC's bytes
 // with a `Stream` (`PortStreams` for live ports), handing frames to a `Handler`.
+pub use esc_numbers::MAX_ESCS;
 pub use esc_table::{EscEntry, EscKey, EscTable, Place, Recording};
 pub use handler::{Both, Handler, LaterPart};
 pub use sources::{Esc, InputInfo, MAX_QUEUED, Sources};

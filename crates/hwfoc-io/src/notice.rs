@@ -90,6 +90,15 @@ pub enum Notice {
         /// ESCs`).
         message: String,
     },
+    /// A live port's ESCs past the last number records have (255): their frames are left out
+    /// (counted by [`crate::PortStreams::left_out`]), told once per port.
+    PastLastEsc {
+        /// The port or bus, as named.
+        input: String,
+        /// Where the first ESC left out is on the port (`DataLink channel 7`, `place 300 of
+        /// the bus`), if not the port itself.
+        place: Option<String>,
+    },
     /// A damaged place in a recording, skipped.
     Damage {
         /// The input as named.
@@ -178,6 +187,7 @@ impl Notice {
                 | Notice::NotClassicCan { .. }
                 | Notice::LeftOut { .. }
                 | Notice::CanBus { .. }
+                | Notice::PastLastEsc { .. }
                 | Notice::Damage { .. }
                 | Notice::Overlap { .. }
                 | Notice::Duplicate { .. }
@@ -275,6 +285,17 @@ impl fmt::Display for Notice {
                 interface,
                 message,
             } => write!(f, "{}: {}: {message}", Escaped(input), Escaped(interface)),
+            Notice::PastLastEsc { input, place } => write!(
+                f,
+                "{}: ESCs past number {} left out{}: records number ESCs 0 to {} only",
+                Escaped(input),
+                u8::MAX,
+                place
+                    .as_ref()
+                    .map(|p| format!(" (the first: {p})"))
+                    .unwrap_or_default(),
+                u8::MAX
+            ),
             Notice::Damage { input, damage } => write!(f, "{}: {damage}", Escaped(input)),
             Notice::Duplicate { input, earlier } => write!(
                 f,

@@ -1,5 +1,5 @@
-//! Serial ports: telling them from files, opening them with errors that say what to do, and
-//! reading several at once, each in its own thread, surviving a port that is unplugged.
+//! Serial ports: telling them from files, opening them with errors that say what to do ([`open`],
+//! [`PortError`]: `port.rs`, which the CAN buses use too), and reading several at once, each in its own thread, surviving a port that is unplugged.
 //!
 //! A [`PortSet`] owns one reader thread per port. Each thread hands over every chunk of bytes
 //! as soon as a read returns, with the Unix time of its first byte, as a [`PortEvent`] on a
@@ -21,7 +21,6 @@
 //! is; no rate is searched on it.
 
 use std::io::{self, Read};
-use std::path::Path;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc::{self, Receiver, Sender};
@@ -30,18 +29,15 @@ use std::time::{Duration, Instant};
 
 use crate::can::{CanBus, CanError};
 use crate::clock::ReceiveClock;
+use crate::port::READ_TIMEOUT;
+pub use crate::port::{PortError, available_ports, open};
 
 use hwfoc::Protocol;
 use hwfoc::detect;
-use serialport::{ClearBuffer, DataBits, FlowControl, Parity, SerialPort, StopBits};
-
-use std::fmt;
+use serialport::{ClearBuffer, SerialPort};
 
 /// The HW-FOC telemetry rate, the default of every serial input.
 pub const DEFAULT_BAUD: u32 = hwfoc::foc::BAUD_RATE;
-
-/// How long a read waits for bytes before the thread checks whether it should stop.
-const READ_TIMEOUT: Duration = Duration::from_millis(50);
 
 /// How often a lost port is tried again.
 pub const RETRY_EVERY: Duration = Duration::from_millis(500);
@@ -213,78 +209,6 @@ impl Search {
     }
 }
 
-/// Why a serial port could not be opened or read. Each names the port as the user gave it.
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub enum PortError {
-    /// A serial port that does not exist.
-    NoSuchPort {
-        /// The port as named on the command line.
-        port: String,
-        /// The ports the system does have.
-        available: Vec<String>,
-    },
-    /// A serial port we may not open.
-    Permission {
-        /// The port as named on the command line.
-        port: String,
-        /// The group owning the device file, if known.
-        group: Option<String>,
-    },
-    /// A serial port another program has open.
-    Busy {
-        /// The port as named on the command line.
-        port: String,
-    },
-    /// A serial port that could not be opened or set up for another reason.
-    Other {
-        /// The port as named on the command line.
-        port: String,
-        /// Why.
-        message: String,
-    },
-}
-
-impl fmt::Display for PortError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            PortError::NoSuchPort { port, available } => {
-                write!(f, "no such port {port}")?;
-                if available.is_empty() {
-                    write!(f, " (no serial ports found: is the adapter plugged in?)")
-                } else {
-                    write!(f, " (serial ports found: {})", available.join(", "))
-                }
-            }
-            PortError::Permission { port, group } => {
-                // A device of group root is not meant for users: give the usual groups.
-                let group = group.as_deref().filter(|g| *g != "root");
-                let owner = match group {
-                    Some(g) => format!(" (owned by group {g})"),
-                    None => String::new(),
-                };
-                let command = match group {
-                    Some(g) => format!("`sudo usermod -aG {g} $USER`"),
-                    None => "`sudo usermod -aG dialout $USER` on Debian/Ubuntu, `uucp` on Arch"
-                        .to_string(),
-                };
-                write!(
-                    f,
-                    "permission denied on {port}{owner}: join the group that may use serial \
-                     ports ({command}), then log out and in again"
-                )
-            }
-            PortError::Busy { port } => write!(
-                f,
-                "{port} is busy: another program has it open (a serial monitor, another hwfoc, \
-                 ModemManager); close it and try again"
-            ),
-            PortError::Other { port, message } => write!(f, "cannot open port {port}: {message}"),
-        }
-    }
-}
-
-impl std::error::Error for PortError {}
-
 /// Whether `spec`, an input named on the command line, is a serial port rather than a file:
 /// `COM3` (or `\\.\COM12`); a character device that is a terminal; or a path under `/dev` that
 /// looks like a serial device (`/dev/ttyUSB0`, `/dev/ttyACM0`, `/dev/cu.usbserial-1`,
@@ -340,95 +264,6 @@ fn is_terminal(path: &str) -> bool {
         // Not allowed to open it: say so when it is opened as a port.
         Err(e) => e.kind() == io::ErrorKind::PermissionDenied,
     }
-}
-
-/// Opens `port` at `baud`, 8N1, no flow control, for exclusive use.
-pub fn open(port: &str, baud: u32) -> Result<Box<dyn SerialPort>, PortError> {
-    if cfg!(unix) {
-        match std::fs::metadata(port) {
-            Err(_) => return Err(no_such_port(port)),
-            Ok(meta) if meta.is_file() || meta.is_dir() => {
-                return Err(PortError::Other {
-                    port: port.to_string(),
-                    message: format!(
-                        "it is a {}, not a serial port (to read a capture file, use `hwfoc \
-                         decode {port}`)",
-                        if meta.is_dir() { "directory" } else { "file" }
-                    ),
-                });
-            }
-            Ok(_) => {}
-        }
-    }
-    serialport::new(port, baud)
-        .data_bits(DataBits::Eight)
-        .parity(Parity::None)
-        .stop_bits(StopBits::One)
-        .flow_control(FlowControl::None)
-        .timeout(READ_TIMEOUT)
-        .open()
-        .map_err(|e| open_error(port, e))
-}
-
-fn no_such_port(port: &str) -> PortError {
-    PortError::NoSuchPort {
-        port: port.to_string(),
-        available: available_ports(),
-    }
-}
-
-/// The serial ports the system knows of, with the USB adapter's product name where known.
-pub fn available_ports() -> Vec<String> {
-    // The sysfs scan of `serialport` panics when /sys/class/tty is missing (some containers).
-    if cfg!(target_os = "linux") && !Path::new("/sys/class/tty").is_dir() {
-        return Vec::new();
-    }
-    let mut ports: Vec<String> = serialport::available_ports()
-        .unwrap_or_default()
-        .into_iter()
-        .map(|p| match p.port_type {
-            serialport::SerialPortType::UsbPort(usb) => match usb.product {
-                Some(product) => format!("{} ({product})", p.port_name),
-                None => format!("{} (USB {:04x}:{:04x})", p.port_name, usb.vid, usb.pid),
-            },
-            _ => p.port_name,
-        })
-        .collect();
-    ports.sort();
-    ports
-}
-
-fn open_error(port: &str, e: serialport::Error) -> PortError {
-    use serialport::ErrorKind as K;
-    match e.kind() {
-        K::Io(io::ErrorKind::NotFound) => no_such_port(port),
-        K::Io(io::ErrorKind::PermissionDenied) => PortError::Permission {
-            port: port.to_string(),
-            group: owner_group(port),
-        },
-        // EBUSY from TIOCEXCL, or the lock another program holds.
-        K::NoDevice => PortError::Busy {
-            port: port.to_string(),
-        },
-        _ => PortError::Other {
-            port: port.to_string(),
-            message: e.to_string(),
-        },
-    }
-}
-
-/// The name of the group owning the device file, if it can be found.
-#[cfg(unix)]
-fn owner_group(port: &str) -> Option<String> {
-    use std::os::unix::fs::MetadataExt;
-    let gid = std::fs::metadata(port).ok()?.gid();
-    let group = nix::unistd::Group::from_gid(nix::unistd::Gid::from_raw(gid)).ok()??;
-    Some(group.name)
-}
-
-#[cfg(not(unix))]
-fn owner_group(_port: &str) -> Option<String> {
-    None
 }
 
 /// What a port's reader thread reports.
@@ -945,16 +780,6 @@ mod tests {
         ] {
             assert!(!is_port(file), "{file}");
         }
-    }
-
-    #[test]
-    fn missing_port_is_named() {
-        let e = open("/dev/ttyUSB_hwfoc_test_missing", 19200).err().unwrap();
-        assert!(
-            e.to_string()
-                .starts_with("no such port /dev/ttyUSB_hwfoc_test_missing"),
-            "{e}"
-        );
     }
 
     #[test]

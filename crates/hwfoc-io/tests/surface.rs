@@ -12,7 +12,9 @@
 use hwfoc_io::{Batch, Input, InputError, InputFormat, Looks, read_small_file};
 
 // Decoding.
-use hwfoc_io::{Both, Esc, EscLink, Handler, InputInfo, LaterPart, MAX_QUEUED, PortStreams};
+use hwfoc_io::{
+    Both, Esc, EscLink, Handler, InputInfo, LaterPart, MAX_ESCS, MAX_QUEUED, PortStreams,
+};
 use hwfoc_io::{SILENCE_S, Sources, Stream, WireKind};
 
 // Settings.
@@ -81,4 +83,6 @@ fn the_surface_constants_are_those_of_the_specs() {
     assert_eq!(JSON_SCHEMA_VERSION, 1);
     assert_eq!(RECORD_SCHEMA_VERSION, 3);
     assert_eq!(RECORD_SCHEMA_VERSION_KEY, "record_schema_version");
+    // The record's `esc` column is a `u8`: as many ESCs as it can number.
+    assert_eq!(MAX_ESCS, usize::from(u8::MAX) + 1);
 }

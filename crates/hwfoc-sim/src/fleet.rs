@@ -17,8 +17,8 @@ use crate::protocols;
 use crate::schedule::{self, Pace, SimClock};
 use crate::sink::Sink;
 
-/// The most ESCs a fleet can have: a record's ESC number is a byte.
-pub const MAX_ESCS: usize = 256;
+/// The most ESCs a fleet can have: as many as a record can number.
+pub use hwfoc_io::MAX_ESCS;
 
 /// Everything the virtual ESCs of a run are made from, as plain data.
 #[derive(Debug, Clone, PartialEq)]

@@ -1,12 +1,14 @@
 //! The counters both protocols' statistics keep ([`crate::foc::Stats`],
 //! [`crate::datalink::Stats`]): byte counts of 48 bits, and the following of a packet counter.
 //!
-//! A [`PacketSequence`] sorts every step from one number to the next into one of four events:
+//! A [`PacketSequence`] sorts every step from one number to the next into one of five events:
 //! the next number (nothing to count), the same number again (a
 //! [duplicate](PacketSequence::duplicates)), a small gap forward ([lost](PacketSequence::lost):
-//! the numbers in between), or a jump that no lost frames explain: a step backwards, or forwards
-//! by more than [`MAX_PACKET_GAP`] + 1. Such a jump is a [restart](PacketSequence::restarts): the
-//! ESC rebooted (its counter starts again), another simulator took over the port, or two
+//! the numbers in between), the number a gap of one skipped, right after it (two adjacent
+//! frames [swapped](PacketSequence::reordered): the loss that gap counted is taken back), or a
+//! jump that no lost frames explain: a step backwards, or forwards by more than
+//! [`MAX_PACKET_GAP`] + 1. Such a jump is a [restart](PacketSequence::restarts): the ESC
+//! rebooted (its counter starts again), another simulator took over the port, or two
 //! sequences are interleaved. It counts as one restart and no loss, and the sequence continues
 //! from the new number.
 //!
@@ -33,8 +35,8 @@ pub const MAX_PACKET_GAP: u16 = 1000;
 /// The two byte counters of a protocol's statistics ([`foc::Stats`](crate::foc::Stats),
 /// [`datalink::Stats`](crate::datalink::Stats)), of 48 bits each: a `u32` and a `u16`. They take
 /// 12 bytes at an alignment of 4, where two `u64` would take 16 at an alignment of 8: that is
-/// what keeps [`foc::Stats`](crate::foc::Stats), with every event counter a `u32`, at 40 bytes,
-/// and the HW-FOC [`Decoder`] at 120.
+/// what keeps [`foc::Stats`](crate::foc::Stats), with every event counter a `u32`, at 44 bytes,
+/// and the HW-FOC [`Decoder`] at 124.
 ///
 /// 2^48 bytes are 4.6 million years of a 19200-baud wire, or 78 hours of reading a file at
 /// 1 GB/s; past that a count wraps to 0. Saturating instead would cost about 110 bytes of
@@ -95,18 +97,20 @@ impl ByteCounts {
 /// and [`PacketSequence24`] (24 bits) are its two instances.
 ///
 /// Counters are `u32` and saturate; the last number and the gap limit are kept in the width's
-/// own type ([`Width::Number`]), so a [`PacketSequence`] takes 20 bytes and a
-/// [`PacketSequence24`] 24.
+/// own type ([`Width::Number`]), so a [`PacketSequence`] takes 24 bytes and a
+/// [`PacketSequence24`] 28.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
 pub struct Sequence<W: Width> {
     pub(crate) count: u32,
     pub(crate) lost: u32,
     pub(crate) duplicates: u32,
     pub(crate) restarts: u32,
+    pub(crate) reordered: u32,
     pub(crate) last: W::Number,
     /// The largest step to the next number that counts as a loss, as set by
     /// [`Sequence::line_silent`]; 0 (no silence since the last number) means
-    /// `MAX_PACKET_GAP + 1`.
+    /// `MAX_PACKET_GAP + 1`, and [`Width::MAX`] the same after a gap of one number (which the
+    /// next number may fill: a swap).
     pub(crate) gap_limit: W::Number,
 }
 
@@ -166,7 +170,7 @@ impl Width for Bits24 {
 ///
 /// [`foc::Stats`](crate::foc::Stats) keeps one for the data frames' packet numbers;
 /// [`datalink::Stats`](crate::datalink::Stats) one for the hub's frame counter and one per ESC
-/// channel. Counters are `u32` and saturate; 20 bytes.
+/// channel. Counters are `u32` and saturate; 24 bytes.
 pub type PacketSequence = Sequence<Bits16>;
 
 /// The largest value of a 24-bit counter (the packet counters of Hobbywing V3 and V4,
@@ -179,7 +183,7 @@ pub const COUNTER24_MAX: u32 = 0xFF_FFFF;
 /// of more than 2^23.
 ///
 /// A separate instance rather than a wider [`PacketSequence`], so that the HW-FOC and DataLink
-/// statistics keep their sizes. Counters are `u32` and saturate; 24 bytes.
+/// statistics keep their sizes. Counters are `u32` and saturate; 28 bytes.
 ///
 /// ```
 /// use hwfoc::counters::PacketSequence24;
@@ -204,9 +208,15 @@ impl<W: Width> Sequence<W> {
             lost: 0,
             duplicates: 0,
             restarts: 0,
+            reordered: 0,
             last: W::ZERO,
             gap_limit: W::ZERO,
         }
+    }
+
+    /// The gap limit's mark of a gap of one number just counted (a swap may follow).
+    fn swap_mark() -> W::Number {
+        W::number(W::MAX)
     }
 
     /// Numbers seen (frames or records counted).
@@ -225,6 +235,13 @@ impl<W: Width> Sequence<W> {
     /// Numbers equal to the one before (not a loss).
     pub const fn duplicates(&self) -> u32 {
         self.duplicates
+    }
+
+    /// Numbers that came right after the next one: the number a gap of one skipped, right after
+    /// that gap (`5, 7, 6, 8`: two adjacent frames swapped on the way). Not a loss (the gap's
+    /// loss is taken back) and not a restart.
+    pub const fn reordered(&self) -> u32 {
+        self.reordered
     }
 
     /// Numbers that start a new sequence: a step backwards (`d` above half the modulus: 32768,
@@ -258,6 +275,8 @@ impl<W: Width> Sequence<W> {
     pub fn line_silent(&mut self, max_frames: u32) {
         let limit = match self.gap_limit.into() {
             0 => 1,
+            // A silence after a gap of one: the number after it is no swap.
+            limit if limit == W::MAX => 1,
             limit => limit,
         };
         let limit = limit.saturating_add(max_frames);
@@ -278,6 +297,7 @@ impl<W: Width> Sequence<W> {
         self.lost = self.lost.saturating_add(later.lost);
         self.duplicates = self.duplicates.saturating_add(later.duplicates);
         self.restarts = self.restarts.saturating_add(later.restarts);
+        self.reordered = self.reordered.saturating_add(later.reordered);
         self.last = later.last;
         self.gap_limit = later.gap_limit;
     }
@@ -295,20 +315,34 @@ impl<W: Width> Sequence<W> {
             self.last = W::number(number);
             return;
         }
+        let mut mark = W::ZERO;
         if self.count != 0 {
-            let limit = if gap_limit == 0 {
+            let swap = gap_limit == W::MAX;
+            let limit = if gap_limit == 0 || swap {
                 u32::from(MAX_PACKET_GAP) + 1
             } else {
                 gap_limit
             };
             match number.wrapping_sub(last) & W::MAX {
                 0 => self.duplicates = self.duplicates.saturating_add(1),
+                // The number the gap of one before skipped: a swap, the number stays.
+                step if swap && step == W::MAX => {
+                    self.lost = self.lost.saturating_sub(1);
+                    self.reordered = self.reordered.saturating_add(1);
+                    self.gap_limit = W::ZERO;
+                    self.count = self.count.saturating_add(1);
+                    return;
+                }
+                2 if limit >= 2 => {
+                    self.lost = self.lost.saturating_add(1);
+                    mark = Self::swap_mark();
+                }
                 // The next number (a step of 1) loses nothing; the limit is at least 1.
                 step if step <= limit => self.lost = self.lost.saturating_add(step - 1),
                 _ => self.restarts = self.restarts.saturating_add(1),
             }
         }
-        self.gap_limit = W::ZERO;
+        self.gap_limit = mark;
         self.count = self.count.saturating_add(1);
         self.last = W::number(number);
     }
@@ -360,8 +394,46 @@ mod tests {
     }
 
     #[test]
-    fn a_sequence_fits_in_20_bytes() {
-        assert_eq!(size_of::<PacketSequence>(), 20);
+    fn a_sequence_fits_in_24_bytes() {
+        assert_eq!(size_of::<PacketSequence>(), 24);
+    }
+
+    /// Two adjacent frames swapped (`5, 7, 6, 8`) are one reordering: no loss, no restart
+    /// (they counted a restart and two lost packets). A gap of one that stays one is a loss;
+    /// a silence between the gap and the number is no swap.
+    #[test]
+    fn two_adjacent_frames_swapped_are_a_reordering() {
+        let mut s = PacketSequence::new();
+        for n in [4, 5, 7, 6, 8, 9, 11, 12, 13, 65535] {
+            s.next(n);
+        }
+        assert_eq!(
+            (
+                s.count(),
+                s.lost(),
+                s.restarts(),
+                s.duplicates(),
+                s.reordered()
+            ),
+            (10, 1, 1, 0, 1)
+        );
+        assert_eq!(s.delivery_ratio(), Some(10.0 / 11.0));
+        for n in [1, 0, 2] {
+            s.next(n); // across the wrap
+        }
+        assert_eq!((s.lost(), s.restarts(), s.reordered()), (1, 1, 2));
+        assert_eq!(s.last(), Some(2));
+        let mut t = PacketSequence24::new();
+        for n in [0xFF_FFFE, 0, 0xFF_FFFF, 1] {
+            t.next(n);
+        }
+        assert_eq!((t.lost(), t.restarts(), t.reordered()), (0, 0, 1));
+        let mut u = PacketSequence::new();
+        u.next(5);
+        u.next(7);
+        u.line_silent(3);
+        u.next(6);
+        assert_eq!((u.lost(), u.restarts(), u.reordered()), (1, 1, 0));
     }
 
     #[test]
@@ -378,6 +450,6 @@ mod tests {
         s.line_silent(2);
         s.next(12); // step 3: 2 lost
         assert_eq!((s.count(), s.lost(), s.restarts()), (7, 1002, 4));
-        assert_eq!(size_of::<PacketSequence24>(), 24);
+        assert_eq!(size_of::<PacketSequence24>(), 28);
     }
 }

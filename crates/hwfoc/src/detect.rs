@@ -9,7 +9,11 @@
 //! bytes to that format's decoder only, so a stream of one format is read at that decoder's
 //! speed. After a silence of the line ([`Decoder::line_silent_each`]), and at the end of a
 //! block of [`RELOCK_AFTER`] bytes (blocks start at its multiples in the stream) in which the
-//! locked format's decoder handed on no frame, it reads every format again (a stream may change format: an adapter moved from one ESC to another); a decoder that was not given some bytes passes over them
+//! locked format's decoder handed on no frame, it reads every format again (a stream may change format: an adapter moved from one ESC to another). The
+//! other formats' decoders then first read the bytes after the locked decoder's last frame,
+//! kept while locked ([`HISTORY`]), as they do at a silence and at the end of the stream: the
+//! frames of a new format in them are handed on then (late, never lost), and the decoder locks
+//! onto it at once. A decoder that was not given some bytes before those passes over them
 //! ([`StreamDecoder::pass_over`](crate::StreamDecoder::pass_over)): they are its skipped bytes, so every decoder's offsets and
 //! statistics are the stream's.
 //!
@@ -41,6 +45,7 @@
 //! assert_eq!(decoder.locked(), Some(Family::HwV3));
 //! ```
 
+use crate::scan::{self, Scanner, StreamDecoder};
 use crate::{Protocol, hw5, mixed, v3, v4};
 
 /// Bytes per slice while detecting (see the module documentation).
@@ -53,6 +58,14 @@ pub const SLICE: u64 = 64;
 /// stream runs as fast as [`mixed`]'s alone.) A new format is found at most two blocks and a
 /// slice after the change.
 pub const RELOCK_AFTER: u64 = 4096;
+
+/// The bytes kept while locked: two blocks, more than lie between the locked decoder's last
+/// frame and the end of the block at which every format is read again. Those after that
+/// frame are read by every other format's decoder then, so a format that follows another
+/// loses no frame. (8 KiB of each stream's decoder: the price of a change of format without
+/// a silence.) Only the bytes after the locked decoder's last frame are copied into it, so on
+/// a clean locked stream it costs a few bytes' copy per chunk.
+pub const HISTORY: usize = 2 * RELOCK_AFTER as usize;
 
 /// A format the decoder locks onto: HW-FOC and DataLink are read by one decoder ([`mixed`]),
 /// which tells them apart frame by frame.
@@ -135,6 +148,68 @@ fn noting<'a>(
     }
 }
 
+/// The stream's bytes after the locked decoder's last frame (at most the last [`HISTORY`]),
+/// kept while locked so that the formats' decoders that were not given them read them when
+/// detection starts again. A ring indexed by stream offset: bytes before that frame, never
+/// read again, are not written.
+#[derive(Clone)]
+struct History([u8; HISTORY]);
+
+impl Default for History {
+    fn default() -> History {
+        History([0; HISTORY])
+    }
+}
+
+impl core::fmt::Debug for History {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        write!(f, "History({HISTORY} bytes)")
+    }
+}
+
+impl History {
+    /// Keeps `data`, the stream's bytes from offset `at`.
+    #[inline(always)]
+    fn keep(&mut self, at: u64, data: &[u8]) {
+        let skip = data.len().saturating_sub(HISTORY);
+        let (at, data) = (at + skip as u64, &data[skip..]);
+        let start = (at % HISTORY as u64) as usize;
+        let first = data.len().min(HISTORY - start);
+        self.0[start..start + first].copy_from_slice(&data[..first]);
+        self.0[..data.len() - first].copy_from_slice(&data[first..]);
+    }
+
+    /// The bytes of the stream from offset `from` to `to` (at most [`HISTORY`] bytes back from
+    /// the last kept, `to`), in at most two slices.
+    fn between(&self, from: u64, to: u64) -> (&[u8], &[u8]) {
+        let n = (to - from) as usize;
+        let start = (from % HISTORY as u64) as usize;
+        let first = n.min(HISTORY - start);
+        (&self.0[start..start + first], &self.0[..n - first])
+    }
+}
+
+/// Brings `decoder`, if it is behind the stream's end `to`, up to it: it passes over the bytes
+/// before `from` it was not given, then reads those from `from` on out of `history`.
+fn replay_into<S: Scanner>(
+    decoder: &mut StreamDecoder<S>,
+    history: &History,
+    from: u64,
+    to: u64,
+    on_frame: &mut dyn FnMut(S::Item),
+) {
+    let at = scan::Stats::bytes(decoder.stats());
+    if at >= to {
+        return;
+    }
+    if from > at {
+        decoder.pass_over(from.min(to) - at);
+    }
+    let (a, b) = history.between(at.max(from).min(to), to);
+    decoder.feed(a, &mut *on_frame);
+    decoder.feed(b, &mut *on_frame);
+}
+
 /// A decoder of every Hobbywing serial format at once (see the module documentation).
 #[derive(Debug, Clone, Default)]
 pub struct Decoder {
@@ -153,6 +228,10 @@ pub struct Decoder {
     block_start: Option<u64>,
     /// Detecting: which families found a frame in the current slice, and the last one's offset.
     found: [Option<u64>; 4],
+    /// Locked: the offset of the locked decoder's last frame.
+    last_frame: u64,
+    /// The stream's last bytes (kept while locked).
+    history: History,
 }
 
 impl Decoder {
@@ -239,17 +318,26 @@ impl Decoder {
         let to_end = RELOCK_AFTER - self.bytes % RELOCK_AFTER;
         let n = usize::try_from(to_end).map_or(data.len(), |k| k.min(data.len()));
         let piece = &data[..n];
+        let last = &mut self.last_frame;
         match family {
             Family::Mixed => self.mixed.feed(
                 piece,
                 #[inline(always)]
-                |d| on_frame(Decoded::Mixed(d)),
+                |d| {
+                    *last = d.offset();
+                    on_frame(Decoded::Mixed(d))
+                },
             ),
             other => self.feed_slow(other, piece, on_frame),
         }
+        // Only the bytes after the last frame are ever read again (on a clean stream, less
+        // than a frame of each piece): the history is nearly free while frames keep coming.
+        let after = self.last_frame.saturating_add(1).saturating_sub(self.bytes);
+        let skip = usize::try_from(after).map_or(n, |k| k.min(n));
+        self.history.keep(self.bytes + skip as u64, &piece[skip..]);
         self.bytes += n as u64;
         if self.bytes.is_multiple_of(RELOCK_AFTER) {
-            self.end_block(family);
+            self.end_block(family, on_frame);
         }
         n
     }
@@ -272,15 +360,41 @@ impl Decoder {
     }
 
     /// At the end of a block while locked: detection starts again when the locked decoder
-    /// handed on no frame since the block's start.
+    /// handed on no frame since the block's start, every other decoder reading the bytes
+    /// after its last frame first (the frames found there lock at once).
     #[cold]
-    fn end_block(&mut self, family: Family) {
+    fn end_block(&mut self, family: Family, on_frame: &mut dyn FnMut(Decoded)) {
         let now = self.handed_on(family);
         if self.block_start == Some(now) {
             self.locked = None;
             self.found = [None; 4];
+            self.replay(on_frame);
+            self.end_slice();
         }
         self.block_start = Some(now);
+    }
+
+    /// Gives every decoder that is behind the bytes after the locked decoder's last frame
+    /// (kept in the history), after passing over those before them; `on_frame` gets the frames
+    /// they find, noted in `found`.
+    fn replay(&mut self, on_frame: &mut dyn FnMut(Decoded)) {
+        let to = self.bytes;
+        let from = (self.last_frame + 1).max(to.saturating_sub(HISTORY as u64));
+        let (history, found) = (&self.history, &mut self.found);
+        let mut on_frame = on_frame;
+        let mut take = noting(true, found, &mut on_frame);
+        replay_into(&mut self.mixed, history, from, to, &mut |d| {
+            take(Decoded::Mixed(d))
+        });
+        replay_into(&mut self.hw5, history, from, to, &mut |d| {
+            take(Decoded::Hw5(d))
+        });
+        replay_into(&mut self.v4, history, from, to, &mut |d| {
+            take(Decoded::HwV4(d))
+        });
+        replay_into(&mut self.v3, history, from, to, &mut |d| {
+            take(Decoded::HwV3(d))
+        });
     }
 
     /// Gives every decoder the bytes of `data` to the end of the current slice; at its end,
@@ -289,11 +403,15 @@ impl Decoder {
     /// V3, HW5) given `piece`: its frames through a `dyn` callback, so that its scanner is
     /// compiled once, not once per caller (every handler's, which made the binary 10 % larger).
     fn feed_slow(&mut self, family: Family, piece: &[u8], on_frame: &mut dyn FnMut(Decoded)) {
+        let mut take = |d: Decoded| {
+            self.last_frame = d.offset();
+            on_frame(d)
+        };
         match family {
-            Family::HwV4 => self.v4.feed(piece, |d| on_frame(Decoded::HwV4(d))),
-            Family::HwV3 => self.v3.feed(piece, |d| on_frame(Decoded::HwV3(d))),
-            Family::Hw5 => self.hw5.feed(piece, |d| on_frame(Decoded::Hw5(d))),
-            Family::Mixed => self.mixed.feed(piece, |d| on_frame(Decoded::Mixed(d))),
+            Family::HwV4 => self.v4.feed(piece, |d| take(Decoded::HwV4(d))),
+            Family::HwV3 => self.v3.feed(piece, |d| take(Decoded::HwV3(d))),
+            Family::Hw5 => self.hw5.feed(piece, |d| take(Decoded::Hw5(d))),
+            Family::Mixed => self.mixed.feed(piece, |d| take(Decoded::Mixed(d))),
         }
     }
 
@@ -334,6 +452,7 @@ impl Decoder {
             self.locked = Some(family);
             self.last_locked = Some(family);
             self.block_start = None;
+            self.last_frame = self.found[i].unwrap_or(self.bytes);
         }
         self.found = [None; 4];
     }
@@ -362,10 +481,12 @@ impl Decoder {
         }
     }
 
-    /// Tells the decoders being given bytes that the line was silent for a time in which at
-    /// most `esc_frames` HW-FOC frames (24 byte times each) and `hub_frames` DataLink frames
-    /// could have been sent (see [`StreamDecoder::line_silent`](crate::StreamDecoder::line_silent));
-    /// `on_frame` gets the frames still found in the bytes they held.
+    /// Tells the decoders that the line was silent for a time in which at most `esc_frames`
+    /// HW-FOC frames (24 byte times each) and `hub_frames` DataLink frames could have been
+    /// sent (see [`StreamDecoder::line_silent`](crate::StreamDecoder::line_silent)); `on_frame`
+    /// gets the frames still found in the bytes they held. Locked, the other formats' decoders
+    /// first read the bytes after the locked decoder's last frame (another format may have
+    /// begun there). Every format is read again after it.
     pub fn line_silent_each(
         &mut self,
         esc_frames: u32,
@@ -387,61 +508,46 @@ impl Decoder {
         let scaled = |len: u64| {
             u32::try_from((u64::from(esc_frames) * 24).div_ceil(len)).unwrap_or(u32::MAX)
         };
-        let all = self.locked.is_none();
-        let mut take = noting(all, &mut self.found, &mut on_frame);
-        if all || self.locked == Some(Family::Mixed) {
-            self.mixed
-                .line_silent_each(esc_frames, hub_frames, |d| take(Decoded::Mixed(d)));
+        if self.locked.is_some() {
+            self.replay(on_frame);
         }
-        if all || self.locked == Some(Family::Hw5) {
-            self.hw5.line_silent(esc_frames, |d| take(Decoded::Hw5(d)));
-        }
-        if all || self.locked == Some(Family::HwV4) {
-            self.v4.line_silent(scaled(v4::DATA_FRAME_LEN as u64), |d| {
-                take(Decoded::HwV4(d))
-            });
-        }
-        if all || self.locked == Some(Family::HwV3) {
-            self.v3
-                .line_silent(scaled(v3::FRAME_LEN as u64), |d| take(Decoded::HwV3(d)));
-        }
+        let mut take = noting(true, &mut self.found, &mut on_frame);
+        self.mixed
+            .line_silent_each(esc_frames, hub_frames, |d| take(Decoded::Mixed(d)));
+        self.hw5.line_silent(esc_frames, |d| take(Decoded::Hw5(d)));
+        self.v4.line_silent(scaled(v4::DATA_FRAME_LEN as u64), |d| {
+            take(Decoded::HwV4(d))
+        });
+        self.v3
+            .line_silent(scaled(v3::FRAME_LEN as u64), |d| take(Decoded::HwV3(d)));
         drop(take);
-        if all {
-            self.end_slice();
-        }
+        self.end_slice();
         // A silence may be a change of ESC: every format is read again from here.
         self.locked = None;
         self.found = [None; 4];
     }
 
-    /// Ends the stream: the decoders being given bytes decide what they hold (as each
-    /// protocol's `flush`), and every decoder passes over the bytes it was not given, so that
-    /// each one's statistics count the whole stream. A decoder still detecting locks onto
-    /// what the last slice found.
+    /// Ends the stream: every decoder decides what it holds (as each protocol's `flush`),
+    /// those not given the bytes after the locked decoder's last frame having read them first
+    /// (another format may have begun there), and passes over the bytes it was not given, so
+    /// that each one's statistics count the whole stream. A decoder still detecting locks onto
+    /// what the last slice found; a locked one onto a format found in those last bytes.
     pub fn flush(&mut self, mut on_frame: impl FnMut(Decoded)) {
         self.flush_dyn(&mut on_frame);
     }
 
     /// [`Decoder::flush`], compiled once (as [`Decoder::feed_slow`]).
     fn flush_dyn(&mut self, mut on_frame: &mut dyn FnMut(Decoded)) {
-        let all = self.locked.is_none();
-        let mut take = noting(all, &mut self.found, &mut on_frame);
-        if all || self.locked == Some(Family::Mixed) {
-            self.mixed.flush(|d| take(Decoded::Mixed(d)));
+        if self.locked.is_some() {
+            self.replay(on_frame);
         }
-        if all || self.locked == Some(Family::Hw5) {
-            self.hw5.flush(|d| take(Decoded::Hw5(d)));
-        }
-        if all || self.locked == Some(Family::HwV4) {
-            self.v4.flush(|d| take(Decoded::HwV4(d)));
-        }
-        if all || self.locked == Some(Family::HwV3) {
-            self.v3.flush(|d| take(Decoded::HwV3(d)));
-        }
+        let mut take = noting(true, &mut self.found, &mut on_frame);
+        self.mixed.flush(|d| take(Decoded::Mixed(d)));
+        self.hw5.flush(|d| take(Decoded::Hw5(d)));
+        self.v4.flush(|d| take(Decoded::HwV4(d)));
+        self.v3.flush(|d| take(Decoded::HwV3(d)));
         drop(take);
-        if all {
-            self.end_slice();
-        }
+        self.end_slice();
         self.catch_up(true);
     }
 

@@ -299,12 +299,11 @@ fn vectors_telemetry_decode_and_encode_match_the_script() {
     assert_eq!(lines.len(), 52);
     let mut wire = Vec::new();
     let mut expected = Vec::new();
+    let mut out_of_range = 0;
     for w in &lines {
         let bytes = hex(w[1]);
         assert_eq!(bytes.len(), hw5::TELEMETRY_LEN);
         let n = |key: &str| value(w, key).parse::<u32>().unwrap();
-        let f = TelemetryFrame::parse(&bytes).unwrap_or_else(|e| panic!("{}: {e}", w[1]));
-
         // Rust decode == the script's values.
         let script = TelemetryFrame {
             throttle: n("throttle") as u8,
@@ -319,6 +318,24 @@ fn vectors_telemetry_decode_and_encode_match_the_script() {
             bec_voltage_raw: n("bec_voltage_raw") as u8,
             bec_current_raw: n("bec_current_raw") as u8,
         };
+        // Rust encode == the script's bytes (for every vector: the layout).
+        assert_eq!(script.encode().as_slice(), bytes.as_slice());
+        // A vector with a value out of the protocol's range (the script draws any voltage) is
+        // rejected, never decoded.
+        if script.throttle > hw5::THROTTLE_MAX_PCT || script.voltage_raw > hw5::VOLTAGE_MAX_RAW {
+            assert!(
+                matches!(
+                    TelemetryFrame::parse(&bytes),
+                    Err(hw5::Error::OutOfRange { .. })
+                ),
+                "{}",
+                w[1]
+            );
+            out_of_range += 1;
+            wire.extend_from_slice(&bytes);
+            continue;
+        }
+        let f = TelemetryFrame::parse(&bytes).unwrap_or_else(|e| panic!("{}: {e}", w[1]));
         assert_eq!(f, script, "{}", w[1]);
         let float = |key: &str| value(w, key).parse::<f32>().unwrap();
         assert_eq!(f.erpm(), n("erpm"));
@@ -340,8 +357,6 @@ fn vectors_telemetry_decode_and_encode_match_the_script() {
         assert_eq!(crc16_modbus(&bytes[..30]), crc);
         assert_eq!(crc_reference(&bytes[..30]), crc);
 
-        // Rust encode == the script's bytes.
-        assert_eq!(script.encode().as_slice(), bytes.as_slice());
         assert_eq!(identify(&bytes), Ok(Kind::Telemetry));
 
         expected.push(hw5::Decoded {
@@ -352,8 +367,10 @@ fn vectors_telemetry_decode_and_encode_match_the_script() {
     }
     let (decoded, stats) = bulk(&wire);
     assert_eq!(decoded, expected);
-    assert_eq!(stats.telemetry_frames(), 52);
-    assert_eq!(stats.bytes_skipped(), 0);
+    assert_eq!((expected.len(), out_of_range), (12, 40));
+    assert_eq!(stats.telemetry_frames(), 12);
+    assert_eq!(stats.out_of_range(), 40);
+    assert_eq!(stats.bytes_skipped(), 40 * hw5::TELEMETRY_LEN as u64);
     assert_eq!(streamed_bytewise::<hw5::Scanner>(&wire), (decoded, stats));
 }
 
@@ -427,10 +444,11 @@ fn vectors_corrupted_frames_are_rejected() {
 // Generators
 // ---------------------------------------------------------------------------------------------
 
+/// Any telemetry frame in the protocol's ranges (throttle and input voltage).
 fn telemetry() -> impl Strategy<Value = TelemetryFrame> {
     (
-        (any::<u8>(), any::<[u8; 2]>(), any::<u8>()),
-        (any::<u16>(), any::<u16>(), any::<u16>()),
+        (0..=hw5::THROTTLE_MAX_PCT, any::<[u8; 2]>(), any::<u8>()),
+        (any::<u16>(), 0..=hw5::VOLTAGE_MAX_RAW, any::<u16>()),
         (
             any::<u8>(),
             any::<u8>(),

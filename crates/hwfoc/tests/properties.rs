@@ -261,7 +261,10 @@ fn reference_scan(bytes: &[u8], base: u64, s: &mut RefStats, out: &mut Vec<Decod
         // Device-information text is ASCII: this keeps a cut info frame from hiding the frames
         // behind it, which its 8-bit check alone would do once in 256 times.
         let text_ok = len == DATA_FRAME_LEN || f[4..76].is_ascii();
-        if !(sum_ok && f[2] == 0x01 && f[3] == command && text_ok) {
+        // A throttle over 100 % (1024) is out of the protocol's range: no frame.
+        let throttle = |i: usize| u16::from_be_bytes([f[i], f[i + 1]]);
+        let in_range = len != DATA_FRAME_LEN || (throttle(6) <= 1024 && throttle(8) <= 1024);
+        if !(sum_ok && f[2] == 0x01 && f[3] == command && text_ok && in_range) {
             s.checksum_failures += 1;
             s.bytes_skipped += 1;
             i += 1;

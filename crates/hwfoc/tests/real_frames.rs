@@ -826,12 +826,13 @@ fn sync_byte_inside_a_payload_loses_no_frame() {
 
 #[test]
 fn sync_and_header_inside_a_payload_loses_no_frame() {
-    // Packet 0x9B16 and throttle 0x9B4C put both frame headers inside the payload.
+    // Packet 0x9B16 and eRPM 0x9B4C (a throttle cannot be: over 100 %) put both frame headers
+    // inside the payload, the info header's `01 01` after it.
     let inner = DataFrame {
         packet: 0x9B16,
-        throttle_in_raw: 0x9B4C,
-        throttle_out_raw: 0x0101,
-        erpm_raw: 0x9B16,
+        erpm_raw: 0x9B4C,
+        voltage_raw: 0x0101,
+        current_raw: 0x9B16u16 as i16,
         ..Default::default()
     };
     let next = DataFrame {

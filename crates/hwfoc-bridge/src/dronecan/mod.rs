@@ -92,8 +92,9 @@ pub const PRIORITY: u8 = 16;
 pub const NODE_STATUS_EVERY: Duration = Duration::from_secs(1);
 /// The shortest time between the frames of two esc.StatusExtended of one ESC.
 pub const EXTENDED_EVERY: Duration = Duration::from_millis(250);
-/// The most ESCs `esc_index` (uint5) can number.
-pub const MAX_ESCS: usize = 32;
+/// How many ESC numbers DroneCAN's `esc_index` (a `uint5`) holds: ESCs 0 to 31 are bridged.
+/// A limit of the message, not of the toolkit (which numbers up to [`hwfoc_io::MAX_ESCS`]).
+pub const ESC_INDEX_COUNT: usize = 32;
 
 /// The node's settings.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -274,7 +275,7 @@ impl DronecanOutput {
             port,
             opened: now,
             next_node_status: None,
-            escs: vec![Esc::default(); MAX_ESCS],
+            escs: vec![Esc::default(); ESC_INDEX_COUNT],
             esc_transfer_id: 0,
             extended_transfer_id: 0,
             node_transfer_id: 0,
@@ -513,7 +514,7 @@ impl Output for DronecanOutput {
     }
 
     fn carries(&self) -> usize {
-        MAX_ESCS
+        ESC_INDEX_COUNT
     }
 }
 

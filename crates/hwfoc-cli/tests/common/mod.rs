@@ -266,18 +266,28 @@ mod unix {
     }
 }
 
-/// Whether a check that needs `what` (a tool, another user) can run here. Where it cannot: in
-/// CI (the environment variable `CI` is set, and `.ci/run` installs every tool), the test fails
-/// loudly; elsewhere it says on standard error that the check is skipped.
-pub fn can_check(available: bool, what: &str) -> bool {
-    if !available {
-        assert!(
-            std::env::var_os("CI").is_none(),
-            "{what}: required in CI, where .ci/run provides it"
-        );
-        eprintln!("NOTICE: {what}: this check is skipped here");
-    }
-    available
+/// The one skip policy: a test that needs `what` (a tool, another user) is
+/// `#[ignore = "needs …"]`, so that a plain `cargo test` lists it as ignored (never as passed),
+/// and `.ci/run` (or the script its reason names) runs it with `--ignored` where the tool is
+/// installed. Such a test starts with this: where `what` is missing, it fails, saying so.
+pub fn need(available: bool, what: &str) {
+    assert!(
+        available,
+        "needs {what}: install it (as .ci/run does) or leave this ignored test unrun"
+    );
+}
+
+/// Whether tshark runs here.
+pub fn tshark_found() -> bool {
+    tshark()
+        .arg("--version")
+        .output()
+        .is_ok_and(|o| o.status.success())
+}
+
+/// [`need`] tshark (Debian: `apt-get install tshark`).
+pub fn need_tshark() {
+    need(tshark_found(), "tshark");
 }
 
 /// `hwfoc` as the user `nobody` when the tests run as root (root may write and open anything,

@@ -12,7 +12,7 @@ use serialport::SerialPort;
 use super::ask::{AskIds, DEFAULT_SOURCE_NODE};
 use super::slcan::{self, Event, Parser};
 use crate::clock::ReceiveClock;
-use crate::serial::PortError;
+use crate::port::PortError;
 
 /// The serial speed an SLCAN adapter is opened at (USB CDC adapters ignore it).
 pub const SLCAN_BAUD: u32 = 115_200;
@@ -105,7 +105,7 @@ impl std::error::Error for CanError {}
 
 impl CanError {
     /// The error as a port's that could not be opened ([`PortError`]), for a bus opened among
-    /// serial ports ([`crate::serial::PortSet`]).
+    /// serial ports (the port set of `serial.rs`).
     pub fn into_port_error(self) -> PortError {
         let other = |port: String, message: &str| PortError::Other {
             port,
@@ -385,7 +385,7 @@ fn open_slcan(spec: &str, port: &str, bitrate: u32) -> Result<Link, CanError> {
         bus: spec.to_string(),
         reason: format!("no SLCAN code for {bitrate} bit/s"),
     })?;
-    let mut serial = crate::serial::open(port, SLCAN_BAUD).map_err(|e| match e {
+    let mut serial = crate::port::open(port, SLCAN_BAUD).map_err(|e| match e {
         PortError::Permission { .. } => CanError::Permission {
             bus: spec.to_string(),
         },

@@ -636,6 +636,17 @@ fn files_and_ports_number_a_hub_alike_at_the_last_esc_number() {
     assert_eq!(live.0, expected, "ports");
     assert_eq!(streams.channel_of(249, 255), Some(6));
     assert!(streams.settings_of(255).is_some());
+    // Live, the frames of ESC 256 are left out and counted, and told once, naming the port.
+    assert_eq!(streams.left_out(249), 3);
+    let notices: Vec<String> = streams.take_notices().iter().map(|n| n.line()).collect();
+    assert_eq!(
+        notices,
+        [
+            "hwfoc: warning: port249: ESCs past number 255 left out (the first: DataLink channel 7): \
+          records number ESCs 0 to 255 only"
+        ]
+    );
+    assert!(streams.take_notices().is_empty());
 }
 
 /// Every call a handler gets, in order; `RUNS` says whether it takes runs of untimed data

@@ -339,10 +339,14 @@ impl CanWire {
                 None => self.last_expire = Some(t),
             }
         }
-        let Some(received) = self.rx.push(&frame) else {
+        let t_us = t.filter(|t| *t >= 0.0).map(|t| (t * 1e6).round() as u64);
+        let received = match t_us {
+            Some(t_us) => self.rx.push_at(&frame, t_us),
+            None => self.rx.push(&frame),
+        };
+        let Some(received) = received else {
             return;
         };
-        let t_us = t.filter(|t| *t >= 0.0).map(|t| (t * 1e6).round() as u64);
         let Some(data) = self.escs.push(&received, t_us) else {
             return;
         };

@@ -126,8 +126,8 @@ fn emit_other(d: detect::Decoded, emit: &mut impl FnMut(Option<u8>, u64, &Frame)
 }
 
 /// The decoder of a stream: of every protocol at once (the bytes tell which), or of the one
-/// protocol a user forced. (Its arms' sizes differ, a few hundred bytes at most: one per
-/// stream, held inline, so that the decoder of every byte is not behind a pointer.)
+/// protocol a user forced. (Its arms' sizes differ, by the 8 KiB `detect` keeps while locked at
+/// most: one per stream, held inline, so that the decoder of every byte is not behind a pointer.)
 #[derive(Debug)]
 #[allow(clippy::large_enum_variant)]
 enum Wire {
@@ -478,13 +478,14 @@ impl EscLink {
         !matches!(self, EscLink::HwV4(_) | EscLink::HwV3(_))
     }
 
-    /// Frames rejected by their checksum (behind a hub: the hub frames' CRC failures; 0 for a
-    /// format without checksum).
+    /// Frames rejected by their checksum, or whose checksum matched but whose values are out of
+    /// their protocol's range (behind a hub: the hub frames' CRC failures; 0 for a format
+    /// without checksum).
     pub fn checksum_failures(&self) -> u32 {
         match self {
             EscLink::Wire(s) => s.checksum_failures(),
             EscLink::Hub { hub, .. } => hub.crc_failures(),
-            EscLink::Hw5(s) => s.crc_failures(),
+            EscLink::Hw5(s) => s.crc_failures().saturating_add(s.out_of_range()),
             EscLink::Can(c) => c.node_stats.crc_errors(),
             EscLink::HwV4(_) | EscLink::HwV3(_) => 0,
         }
@@ -532,8 +533,22 @@ impl EscLink {
         }
     }
 
-    /// Jumps of the packet numbers that no loss explains.
+    /// Packet numbers that came right after the next one (two adjacent frames swapped): not
+    /// lost, no restart.
+    pub fn reordered_packets(&self) -> u32 {
+        match self.counting() {
+            Some(Counting::Bits16(c)) => c.reordered(),
+            Some(Counting::Bits24(c)) => c.reordered(),
+            None => 0,
+        }
+    }
+
+    /// Jumps of the packet numbers that no loss explains (on a CAN bus: the node's transfers
+    /// after a silence of the whole bus).
     pub fn restarts(&self) -> u32 {
+        if let EscLink::Can(c) = self {
+            return c.node_stats.restarts();
+        }
         match self.counting() {
             Some(Counting::Bits16(c)) => c.restarts(),
             Some(Counting::Bits24(c)) => c.restarts(),
@@ -880,6 +895,10 @@ pub struct PortStreams {
     /// The ESC number of each channel numbered so far of each port found to be a hub or a CAN
     /// bus (`esc_numbers.rs`).
     hubs: Vec<Vec<usize>>,
+    /// Data frames of each port left out, their ESC numbered past 255.
+    left_out: Vec<u64>,
+    /// Notices of ESCs left out, to be taken ([`PortStreams::take_notices`]).
+    past_last: Vec<Notice>,
 }
 
 impl PortStreams {
@@ -915,6 +934,8 @@ impl PortStreams {
                 .map(|n| (!crate::can::is_can_spec(n)).then_some(baud))
                 .collect(),
             discarded: vec![0; names.len()],
+            left_out: vec![0; names.len()],
+            past_last: Vec::new(),
             times: Vec::new(),
             esc_settings: names
                 .iter()
@@ -965,6 +986,8 @@ impl PortStreams {
             map,
             esc_settings,
             hubs,
+            left_out,
+            past_last,
         } = self;
         let stream = streams.get_mut(*port)?;
         times.clear();
@@ -999,6 +1022,20 @@ impl PortStreams {
                 };
                 if let Ok(id) = u8::try_from(esc) {
                     handler.frame(id, t, d, &esc_settings[esc]);
+                } else if matches!(d, Frame::Data(_)) {
+                    if left_out[*port] == 0 {
+                        past_last.push(Notice::PastLastEsc {
+                            input: names[*port].clone(),
+                            place: channel.map(|c| {
+                                if can {
+                                    format!("place {c} of the bus")
+                                } else {
+                                    format!("DataLink channel {c}")
+                                }
+                            }),
+                        });
+                    }
+                    left_out[*port] += 1;
                 }
             },
         );
@@ -1064,9 +1101,10 @@ impl PortStreams {
 
     /// What the ports' streams found since the last call that a person should be told: on a
     /// live CAN bus, two ESCs that claim one throttle channel (each stays an ESC of its own;
-    /// [`Notice::CanBus`] names both nodes).
+    /// [`Notice::CanBus`] names both nodes); ESCs past number 255, left out
+    /// ([`Notice::PastLastEsc`], once per port).
     pub fn take_notices(&mut self) -> Vec<Notice> {
-        let mut notices = Vec::new();
+        let mut notices = std::mem::take(&mut self.past_last);
         for (stream, name) in self.streams.iter_mut().zip(&self.names) {
             for message in stream.take_can_clashes() {
                 notices.push(Notice::CanBus {
@@ -1077,6 +1115,12 @@ impl PortStreams {
             }
         }
         notices
+    }
+
+    /// Data frames of `port` left out because their ESC would be numbered past 255 (told
+    /// once by a [`Notice::PastLastEsc`]).
+    pub fn left_out(&self, port: usize) -> u64 {
+        self.left_out.get(port).copied().unwrap_or(0)
     }
 
     /// The settings the records of ESC `esc` are made under, once it has a number.
@@ -1240,6 +1284,17 @@ mod tests {
         );
         assert_eq!(got, [times[24]]);
         assert_eq!(stream.held_since(), None);
+    }
+
+    /// Two adjacent frames swapped on the way: one reordering, no loss, no restart, every
+    /// frame delivered (they counted a restart and 2 lost packets, 96 %: issue 29).
+    #[test]
+    fn two_swapped_frames_are_a_reordering() {
+        let s = run(&[timed(&[1, 2, 4, 3, 5, 6], 10.0)], 7);
+        assert_eq!(s.frames(), 6);
+        assert_eq!((s.lost_packets(), s.restarts()), (0, 0));
+        assert_eq!(s.reordered_packets(), 1);
+        assert_eq!(s.delivery_ratio(), Some(1.0));
     }
 
     /// An ESC that restarts after a silence counts a restart, not the packets its new numbers

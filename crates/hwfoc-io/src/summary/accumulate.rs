@@ -411,6 +411,22 @@ impl Values {
     }
 }
 
+/// `protocol`'s place in [`Protocol::ALL`]: its discriminant (a search per frame cost the
+/// summary instructions).
+#[inline(always)]
+const fn protocol_index(protocol: Protocol) -> usize {
+    protocol as usize
+}
+
+// [`Protocol::ALL`] lists the protocols in their declaration order.
+const _: () = {
+    let mut i = 0;
+    while i < Protocol::ALL.len() {
+        assert!(Protocol::ALL[i] as usize == i);
+        i += 1;
+    }
+};
+
 /// Whether the summary keeps the raw integers of `protocol`'s frames (HW-FOC, DataLink: one
 /// linear conversion per ESC, the fast path) rather than their values ([`Values`]).
 #[inline(always)]
@@ -477,6 +493,8 @@ pub(super) struct Accumulator {
     pub(super) tally: Tally,
     /// A data frame of the ESC (its first), whose protocol's conversions the report uses.
     pub(super) sample: Option<Data>,
+    /// Data frames by protocol (as [`Protocol::ALL`]): see [`Accumulator::formats`].
+    pub(super) by_protocol: [u64; Protocol::ALL.len()],
     /// Whether the next data frame may take [`Accumulator::add_clean`]: the ESC's sample is
     /// known and no fault episode is open.
     pub(super) fast: bool,
@@ -512,6 +530,7 @@ impl Default for Accumulator {
         Accumulator {
             tally: Tally::default(),
             sample: None,
+            by_protocol: [0; Protocol::ALL.len()],
             fast: false,
             mos_codes: [0; 256],
             cap_codes: [0; 256],
@@ -551,6 +570,7 @@ impl Accumulator {
     #[inline(always)]
     pub(super) fn add_clean(&mut self, t: Option<f64>, f: &Data) {
         debug_assert!(self.fast && self.sample.is_some() && self.episode.is_none());
+        self.by_protocol[protocol_index(f.protocol())] += 1;
         self.count(t, f);
     }
 
@@ -583,6 +603,7 @@ impl Accumulator {
             .position(|f| !f.status.is_ok())
             .unwrap_or(frames.len());
         let run = &frames[..n];
+        self.by_protocol[protocol_index(Protocol::HwFoc)] += n as u64;
         self.tally.add_run(run);
         let codes = |q| run.iter().map(move |f| code(f, q));
         self.count_codes(codes(Quantity::MosTemp), codes(Quantity::CapTemp));
@@ -662,6 +683,7 @@ impl Accumulator {
     #[inline]
     pub(super) fn add_data(&mut self, t: Option<f64>, f: &Data) {
         self.sample.get_or_insert(*f);
+        self.by_protocol[protocol_index(f.protocol())] += 1;
         let index = self.tally.frames;
         self.count(t, f);
         let status = f.fault_word().unwrap_or_default();
@@ -686,6 +708,16 @@ impl Accumulator {
 }
 
 impl Accumulator {
+    /// The protocols of the ESC's data frames with their counts, in the order of
+    /// [`Protocol::ALL`] (a stream that changed format: more than one).
+    pub(super) fn formats(&self) -> Vec<(Protocol, u64)> {
+        Protocol::ALL
+            .into_iter()
+            .zip(self.by_protocol)
+            .filter(|&(_, n)| n > 0)
+            .collect()
+    }
+
     /// Takes what `later` gathered of the frames of the ESC that came right after every frame
     /// this one took, both without receive times (the two halves of a raw file read at once):
     /// afterwards this is what one accumulator given every frame in order would hold. Counts,
@@ -706,6 +738,9 @@ impl Accumulator {
         }
         let base = self.tally.frames;
         self.sample = self.sample.or(later.sample);
+        for (n, m) in self.by_protocol.iter_mut().zip(later.by_protocol) {
+            *n += m;
+        }
         match (&mut self.values, later.values) {
             (Some(v), Some(l)) => v.join(&l),
             (v @ None, l) => *v = l,

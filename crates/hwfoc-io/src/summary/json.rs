@@ -125,12 +125,12 @@ impl EscReport<'_> {
             (st.frames() == 0).then_some(self.no_frames.as_str())
         };
         let counted = st.counts_packets();
-        json!({
+        let mut report = json!({
             "esc": self.index,
             "input": self.input,
             "stream": self.stream,
             "bytes": st.bytes(),
-            "frames": st.frames(),
+            "frames": self.data_frames(),
             "info_frames": st.info_frames(),
             "clock": clock_name(self.clock),
             "first_t_s": self.acc.first_t,
@@ -165,7 +165,18 @@ impl EscReport<'_> {
             "fault_episode_count": self.episode_count,
             "fault_episodes": episodes,
             "warning": warning,
-        })
+        });
+        // A stream that changed format: each format's data frames (the key only then, so that
+        // the report of a stream of one format is unchanged).
+        let formats = self.acc.formats();
+        if let (true, Some(object)) = (formats.len() > 1, report.as_object_mut()) {
+            let counts: serde_json::Map<String, Value> = formats
+                .iter()
+                .map(|(p, n)| (p.name().to_string(), json!(n)))
+                .collect();
+            object.insert("formats".to_string(), Value::Object(counts));
+        }
+        report
     }
 }
 

@@ -231,6 +231,7 @@ impl Handler for Summary {
             && let Some(acc) = self.0.get_mut(esc)
             && acc.fast
             && is_clean(f)
+            && accumulate::keeps_raw(f.protocol())
         {
             acc.add_clean(t, f);
         } else {
@@ -449,6 +450,16 @@ impl EscReport<'_> {
         };
         let across = if back + jumps == 1 { "it" } else { "them" };
         Some(format!("{text}: no time counted across {across}"))
+    }
+
+    /// Data frames of the ESC: its link's, or when its stream changed format, every format's
+    /// (the link counts the format read last).
+    fn data_frames(&self) -> u64 {
+        let formats = self.acc.formats();
+        match formats.len() {
+            0 | 1 => u64::from(self.stats.frames()),
+            _ => formats.iter().map(|(_, n)| n).sum(),
+        }
     }
 
     /// Data frames per second between the first and the last frame.

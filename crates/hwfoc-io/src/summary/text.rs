@@ -111,16 +111,30 @@ impl EscReport<'_> {
             let _ = writeln!(o, "skipped      {} bytes", st.bytes_skipped());
             return;
         }
+        let formats = self.acc.formats();
+        let several = formats.len() > 1;
         let _ = write!(
             o,
             "frames       {} data, {} info",
-            st.frames(),
+            self.data_frames(),
             st.info_frames()
         );
         if let (Some(d), Some(rate)) = (self.duration(), self.frame_rate()) {
             let _ = write!(o, " over {d:.3} s ({rate:.1} data frames/s)");
         }
         o.push('\n');
+        if several {
+            let list: Vec<String> = formats
+                .iter()
+                .map(|(p, n)| format!("{} {n} data frames", p.title()))
+                .collect();
+            let _ = writeln!(
+                o,
+                "formats      {} (the stream changed format; the link figures below are {}'s)",
+                list.join(", "),
+                st.protocol().title()
+            );
+        }
         if let (Some(first), Some(last)) = (self.acc.first_t, self.acc.last_t) {
             if self.clock == Clock::Wall {
                 let _ = writeln!(
@@ -142,8 +156,12 @@ impl EscReport<'_> {
             None => format!("{} checksum failures", st.checksum_failures()),
         };
         let counted = if st.counts_packets() {
+            let reordered = match st.reordered_packets() {
+                0 => String::new(),
+                n => format!(", {n} reordered (adjacent frames swapped)"),
+            };
             format!(
-                "{} lost packets, {} duplicate packets, {} restarts",
+                "{} lost packets, {} duplicate packets, {} restarts{reordered}",
                 st.lost_packets(),
                 st.duplicate_packets(),
                 st.restarts()
@@ -164,7 +182,11 @@ impl EscReport<'_> {
             percent(st.bytes_skipped(), st.bytes())
         );
         if let Some(ratio) = st.delivery_ratio() {
-            let _ = writeln!(o, "delivery     {:.2} % of data frames", ratio * 100.0);
+            let of = match several {
+                true => format!("{} ", st.protocol().title()),
+                false => String::new(),
+            };
+            let _ = writeln!(o, "delivery     {:.2} % of {of}data frames", ratio * 100.0);
         }
         if let crate::stream::EscLink::Can(c) = &st {
             let n = &c.node_stats;

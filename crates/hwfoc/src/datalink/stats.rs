@@ -270,7 +270,7 @@ mod tests {
 
     #[test]
     fn size() {
-        assert_eq!(size_of::<Stats>(), 220);
+        assert_eq!(size_of::<Stats>(), 256);
     }
 
     #[test]

@@ -95,7 +95,7 @@ pub use frame::{
 };
 pub use id::{Header, IdError, MAX_NODE_ID, MAX_PRIORITY, TailByte, TransferType};
 pub use kind::{DataType, Form, Kind, MAX_PAYLOAD_LEN, Message, PayloadError};
-pub use receiver::{DEFAULT_SLOTS, Received, Receiver};
+pub use receiver::{BUS_SILENCE_MS, DEFAULT_SLOTS, Received, Receiver};
 pub use stats::{BusStats, LinkStats, NODES, NodeStats};
 pub use transfer::{FRAME_PAYLOAD, Frames, signature_crc, transfer_crc};
 pub use types::{

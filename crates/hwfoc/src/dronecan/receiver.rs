@@ -3,15 +3,62 @@
 use super::frame::{CanFrame, FrameKind};
 use super::id::{Header, TailByte, TransferType};
 use super::kind::{Form, Kind, MAX_PAYLOAD_LEN, Message};
-use super::stats::LinkStats;
+use super::stats::{Judged, LinkStats, NODES};
 use super::transfer::{FRAME_PAYLOAD, signature_crc};
+use crate::counters::MAX_PACKET_GAP;
 use crate::wire::crc16_ccitt;
 
+/// The known data types whose transfers take more than one frame (a payload over
+/// [`FRAME_PAYLOAD`] bytes): messages all (a test checks it), so a node has one transfer of
+/// each in progress at most.
+const MULTI_FRAME_TYPES: usize = {
+    let mut n = 0;
+    let mut i = 0;
+    while i < Kind::COUNT {
+        if Kind::ALL[i].max_len() > FRAME_PAYLOAD {
+            n += 1;
+        }
+        i += 1;
+    }
+    n
+};
+
 /// Reassembly slots of a [`Receiver`] by default: multi-frame transfers that can be in
-/// progress at once. Single-frame transfers take none; of the known types only
-/// `uavcan.equipment.esc.Status` is multi-frame, so 16 is one per ESC of a 16-ESC bus sending
-/// at the same moment.
-pub const DEFAULT_SLOTS: usize = 16;
+/// progress at once. Single-frame transfers take none; every node id can have one transfer of
+/// each known multi-frame type in progress (only `uavcan.equipment.esc.Status`), so 128 slots
+/// hold every transfer a bus can have in progress (of 40 bytes each: 5 KiB, beside the
+/// statistics' 22 KiB). A smaller receiver ([`Receiver::with_slots`]) counts a transfer that
+/// finds no slot ([`BusStats::no_slot`](super::BusStats::no_slot)).
+pub const DEFAULT_SLOTS: usize = NODES * MULTI_FRAME_TYPES;
+
+/// A silence of the whole bus this long (milliseconds) or longer, between two frames pushed with
+/// their times ([`Receiver::push_at`]), is a power cycle: each node's next transfer of every
+/// message type is a [restart](super::NodeStats::restarts), not a gap. (As a serial line's
+/// silence of a second.)
+pub const BUS_SILENCE_MS: u32 = 1000;
+
+/// When a node's message type last completed a transfer (timed), and its period.
+#[derive(Debug, Clone, Copy)]
+struct Timing {
+    /// Milliseconds (wrapping) of the last transfer.
+    last_ms: u32,
+    /// The mean interval between transfers one id apart, in 1/16 ms (0: not known yet).
+    period: u16,
+    /// [`Timing::KNOWN`], [`Timing::AFTER_SILENCE`].
+    flags: u8,
+}
+
+impl Timing {
+    const NONE: Timing = Timing {
+        last_ms: 0,
+        period: 0,
+        flags: 0,
+    };
+    /// `last_ms` holds a time.
+    const KNOWN: u8 = 1;
+    /// The whole bus was silent since.
+    const AFTER_SILENCE: u8 = 2;
+}
 
 /// A decoded transfer.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -142,6 +189,12 @@ pub struct Receiver<const SLOTS: usize = DEFAULT_SLOTS> {
     slots: [Slot; SLOTS],
     stats: LinkStats,
     clock: u32,
+    /// Each node's message types' last transfers and periods (timed pushes: 7 KiB).
+    timing: [[Timing; Kind::MESSAGES]; NODES],
+    /// The time of the last frame pushed with one, milliseconds (wrapping).
+    last_frame_ms: Option<u32>,
+    /// The time of the frame being pushed, when given.
+    now_ms: Option<u32>,
 }
 
 impl Default for Receiver {
@@ -164,6 +217,9 @@ impl<const SLOTS: usize> Receiver<SLOTS> {
             slots: [Slot::FREE; SLOTS],
             stats: LinkStats::new(),
             clock: 0,
+            timing: [[Timing::NONE; Kind::MESSAGES]; NODES],
+            last_frame_ms: None,
+            now_ms: None,
         }
     }
 
@@ -214,6 +270,77 @@ impl<const SLOTS: usize> Receiver<SLOTS> {
         for node in self.stats.nodes.iter_mut() {
             node.forget_transfer_ids();
         }
+        self.timing = [[Timing::NONE; Kind::MESSAGES]; NODES];
+        self.last_frame_ms = None;
+    }
+
+    /// [`Receiver::push`] of a frame received at `t_us` microseconds (of any clock that does
+    /// not step): a message type's transfer-id gap is then judged by time as well as modulo 32
+    /// (40 transfers lost at 50 Hz are 40, not 8: the count congruent to the ids' step nearest
+    /// to the time since the type's last transfer over its period, the mean interval of
+    /// transfers one id apart), and after a silence of the whole bus of [`BUS_SILENCE_MS`] or
+    /// more (or a gap over [`MAX_PACKET_GAP`] transfers) each node's next transfer of a type
+    /// is a [restart](super::NodeStats::restarts), not a gap. A clock stepping back judges by
+    /// ids alone.
+    pub fn push_at(&mut self, frame: &CanFrame, t_us: u64) -> Option<Received> {
+        let now = (t_us / 1000) as u32;
+        if let Some(last) = self.last_frame_ms {
+            let quiet = now.wrapping_sub(last);
+            if (BUS_SILENCE_MS..1 << 31).contains(&quiet) {
+                for t in self.timing.iter_mut().flatten() {
+                    if t.flags & Timing::KNOWN != 0 {
+                        t.flags |= Timing::AFTER_SILENCE;
+                    }
+                }
+            }
+        }
+        self.last_frame_ms = Some(now);
+        self.now_ms = Some(now);
+        let received = self.push(frame);
+        self.now_ms = None;
+        received
+    }
+
+    /// What the time says of the step to `transfer_id` of `kind` from `node` (a timed push's
+    /// message transfer), the type's timing brought up to it.
+    fn judge(&mut self, node: u8, kind: Kind, transfer_id: u8) -> Judged {
+        let (Some(now), Some(i)) = (self.now_ms, kind.message_index()) else {
+            return Judged::ByIds;
+        };
+        let stats = self.stats.node(node);
+        let step_one = stats
+            .last_transfer_id(kind)
+            .is_some_and(|last| transfer_id.wrapping_sub(last) & 0x1F == 1);
+        let t = &mut self.timing[usize::from(node) % NODES][i];
+        let elapsed = now.wrapping_sub(t.last_ms);
+        let known = t.flags & Timing::KNOWN != 0 && elapsed < 1 << 31;
+        let judged = if t.flags & Timing::AFTER_SILENCE != 0 {
+            Judged::Restart
+        } else if !known || t.period == 0 {
+            Judged::ByIds
+        } else {
+            let period = u64::from(t.period);
+            let expected = ((u64::from(elapsed) * 16 + period / 2) / period).max(1);
+            if expected - 1 > u64::from(MAX_PACKET_GAP) {
+                Judged::Restart
+            } else {
+                Judged::Expected(expected as u32)
+            }
+        };
+        if known && step_one && judged != Judged::Restart {
+            // The mean interval of transfers one id apart (an eighth of each new one).
+            let interval = i64::from(elapsed.min(0xFFF)) * 16;
+            let period = i64::from(t.period);
+            let mean = if period == 0 {
+                interval
+            } else {
+                period + (interval - period) / 8
+            };
+            t.period = u16::try_from(mean.max(1)).unwrap_or(u16::MAX);
+        }
+        t.last_ms = now;
+        t.flags = Timing::KNOWN;
+        judged
     }
 
     /// Frees slot `i`, counting a transfer in progress as cut short.
@@ -238,6 +365,7 @@ impl<const SLOTS: usize> Receiver<SLOTS> {
             Some(i) => i,
             None => {
                 let clock = self.clock;
+                self.stats.bus.no_slot = self.stats.bus.no_slot.saturating_add(1);
                 let (i, _) = self
                     .slots
                     .iter()
@@ -388,8 +516,9 @@ impl<const SLOTS: usize> Receiver<SLOTS> {
         transfer_id: u8,
         payload: &[u8],
     ) -> Option<Received> {
+        let judged = self.judge(header.source_node, kind, transfer_id);
         let node = self.stats.node_mut(header.source_node);
-        if !node.next_transfer_id(kind, transfer_id) {
+        if !node.next_transfer_id_judged(kind, transfer_id, judged) {
             return None;
         }
         match Message::decode(kind, payload) {
@@ -430,6 +559,19 @@ mod tests {
 
     fn frames(m: &Message, node: u8, tid: u8) -> Vec<CanFrame> {
         m.frames(16, node, 0, tid).collect()
+    }
+
+    /// Every known multi-frame type is a message (a node has one transfer of each in progress
+    /// at most, which [`DEFAULT_SLOTS`] counts on), and each slot is small.
+    #[test]
+    fn the_default_slots_hold_every_node_s_transfers() {
+        for k in Kind::ALL {
+            if k.max_len() > FRAME_PAYLOAD {
+                assert_eq!(k.form(), Form::Message, "{k:?}");
+            }
+        }
+        assert_eq!(DEFAULT_SLOTS, 128);
+        assert!(core::mem::size_of::<Slot>() <= 40);
     }
 
     #[test]

@@ -16,6 +16,19 @@ fn bump(n: &mut u32) {
     *n = n.saturating_add(1);
 }
 
+/// What the time since a message type's last transfer from a node says of the step of its
+/// transfer ids ([`Receiver::push_at`](super::Receiver::push_at)).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Judged {
+    /// Nothing: the step modulo 32 (one to 31 ids skipped, or a duplicate).
+    ByIds,
+    /// About this many transfers were sent since the last (the time over the type's period):
+    /// the ids skipped are the count congruent to the step's nearest to it, beyond 31 too.
+    Expected(u32),
+    /// The whole bus was silent since: the node restarted, no id is missed.
+    Restart,
+}
+
 /// What the bus carried that no node is named by: frames that are not DroneCAN. Counters are
 /// `u32` and saturate.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
@@ -27,6 +40,7 @@ pub struct BusStats {
     pub(crate) empty: u32,
     pub(crate) bad_ids: u32,
     pub(crate) anonymous: u32,
+    pub(crate) no_slot: u32,
 }
 
 impl BusStats {
@@ -66,6 +80,13 @@ impl BusStats {
         self.anonymous
     }
 
+    /// Multi-frame transfers dropped for want of a reassembly slot: each also counted as cut
+    /// short by its node. (A [`Receiver`](super::Receiver) of the default size has a slot for
+    /// every node id's transfer of every known multi-frame type, so none.)
+    pub const fn no_slot(&self) -> u32 {
+        self.no_slot
+    }
+
     /// Frames that are not DroneCAN: standard, remote, error, empty frames and bad ids.
     pub const fn not_dronecan(&self) -> u32 {
         self.standard
@@ -100,6 +121,7 @@ pub struct NodeStats {
     cut_short: u32,
     orphan_frames: u32,
     unknown_types: u32,
+    restarts: u32,
     last_transfer_id: [u8; Kind::MESSAGES],
 }
 
@@ -126,6 +148,7 @@ impl NodeStats {
             cut_short: 0,
             orphan_frames: 0,
             unknown_types: 0,
+            restarts: 0,
             last_transfer_id: [NO_TRANSFER_ID; Kind::MESSAGES],
         }
     }
@@ -157,10 +180,19 @@ impl NodeStats {
         self.gaps
     }
 
-    /// Transfers missed in those gaps: the ids skipped (at most 30 a gap; a gap of 32 or more
-    /// cannot be seen).
+    /// Transfers missed in those gaps: the ids skipped. Untimed, at most 30 a gap (a gap of 32
+    /// or more cannot be seen in 5-bit ids); timed
+    /// ([`Receiver::push_at`](super::Receiver::push_at)), the count of the ids skipped modulo
+    /// 32 nearest to the transfers the time since the type's last one held at its period.
     pub const fn missed(&self) -> u32 {
         self.missed
+    }
+
+    /// Message transfers that came after a silence of the whole bus of a second or more (timed,
+    /// [`Receiver::push_at`](super::Receiver::push_at)): the node, powered again, counts its
+    /// transfer ids afresh. Neither a gap nor a duplicate.
+    pub const fn restarts(&self) -> u32 {
+        self.restarts
     }
 
     /// Message transfers with the same transfer id as the previous one of their type (a
@@ -240,7 +272,18 @@ impl NodeStats {
 
     /// A whole message transfer with `transfer_id`: whether it is new (not a duplicate), after
     /// counting a gap if ids were skipped.
+    #[cfg(test)]
     pub(crate) fn next_transfer_id(&mut self, kind: Kind, transfer_id: u8) -> bool {
+        self.next_transfer_id_judged(kind, transfer_id, Judged::ByIds)
+    }
+
+    /// [`NodeStats::next_transfer_id`], with what time says of the step (see [`Judged`]).
+    pub(crate) fn next_transfer_id_judged(
+        &mut self,
+        kind: Kind,
+        transfer_id: u8,
+        judged: Judged,
+    ) -> bool {
         let Some(i) = kind.message_index() else {
             return true;
         };
@@ -249,18 +292,41 @@ impl NodeStats {
         if last == NO_TRANSFER_ID {
             return true;
         }
-        match transfer_id.wrapping_sub(last) & 0x1F {
-            0 => {
-                bump(&mut self.duplicates);
-                false
+        let step = u32::from(transfer_id.wrapping_sub(last) & 0x1F);
+        // The ids skipped modulo 32.
+        let base = step.wrapping_sub(1) & 0x1F;
+        let (duplicate, missed) = match judged {
+            Judged::Restart => {
+                bump(&mut self.restarts);
+                return true;
             }
-            1 => true,
-            step => {
-                bump(&mut self.gaps);
-                self.missed = self.missed.saturating_add(u32::from(step - 1));
-                true
+            Judged::ByIds => (step == 0, base),
+            // The count of ids skipped congruent to `base`, nearest to what the time held; a
+            // step of 0 is a duplicate when fewer than half a round of ids fit in it.
+            Judged::Expected(expected) => {
+                let skipped = expected.saturating_sub(1);
+                let rounds = (skipped + 16).saturating_sub(base) / 32;
+                (
+                    step == 0 && skipped < 16,
+                    base.saturating_add(rounds.saturating_mul(32)),
+                )
             }
+        };
+        if duplicate {
+            bump(&mut self.duplicates);
+            return false;
         }
+        if missed > 0 {
+            bump(&mut self.gaps);
+            self.missed = self.missed.saturating_add(missed);
+        }
+        true
+    }
+
+    /// The transfer id of the last message transfer of `kind` taken, if any.
+    pub(crate) fn last_transfer_id(&self, kind: Kind) -> Option<u8> {
+        let id = self.last_transfer_id[kind.message_index()?];
+        (id != NO_TRANSFER_ID).then_some(id)
     }
 
     /// Every counter to zero, the transfer-id history kept.
@@ -302,7 +368,7 @@ impl NodeStats {
 }
 
 /// Link statistics of a bus: [`BusStats`] and a [`NodeStats`] for every node id 0..=127
-/// (about 21 KiB: a fixed table, no allocation).
+/// (about 22 KiB: a fixed table, no allocation).
 #[derive(Debug, Clone, PartialEq, Eq, Hash)]
 pub struct LinkStats {
     pub(crate) bus: BusStats,
@@ -327,6 +393,7 @@ impl LinkStats {
                 empty: 0,
                 bad_ids: 0,
                 anonymous: 0,
+                no_slot: 0,
             },
             nodes: [NodeStats::new(); NODES],
         }
@@ -394,7 +461,7 @@ impl fmt::Display for BusStats {
         write!(
             f,
             "{} frames, {} not DroneCAN ({} standard, {} remote, {} error, {} empty, {} bad ids), \
-             {} anonymous",
+             {} anonymous, {} transfers without a reassembly slot",
             self.frames,
             self.not_dronecan(),
             self.standard,
@@ -402,7 +469,8 @@ impl fmt::Display for BusStats {
             self.error,
             self.empty,
             self.bad_ids,
-            self.anonymous
+            self.anonymous,
+            self.no_slot
         )
     }
 }
@@ -430,7 +498,7 @@ mod tests {
 
     #[test]
     fn sizes() {
-        assert_eq!(size_of::<NodeStats>(), 4 * (Kind::COUNT + 12) + 8);
-        assert!(size_of::<LinkStats>() <= 21 * 1024);
+        assert_eq!(size_of::<NodeStats>(), 4 * (Kind::COUNT + 13) + 8);
+        assert!(size_of::<LinkStats>() <= 22 * 1024);
     }
 }

@@ -263,7 +263,7 @@ impl scan::Scanner for Scanner {
 /// (the streaming layer's [`StreamDecoder`] over the HW-FOC scanner).
 ///
 /// Its whole state is a 76-byte buffer for a frame still arriving plus the [`Stats`]:
-/// 120 bytes (`size_of::<Decoder>()`, checked by a test), no allocation, no timing.
+/// 124 bytes (`size_of::<Decoder>()`, checked by a test), no allocation, no timing.
 /// Large chunks are scanned in place (the bulk path); only the unfinished tail is copied. One
 /// byte pushed completes at most three frames (when a rejected device-information candidate
 /// turns out to hold data frames).
@@ -404,9 +404,38 @@ pub(crate) mod tests {
         assert_matches_a_plain_search(find_header, &[0x16, 0x4C], near);
     }
 
+    /// A candidate is tried only as the kind whose whole header it carries: one with the data
+    /// frame's length byte but another command, its sum sealed as a data frame's, is rejected
+    /// (and costs one byte), and the frames after it are found.
+    #[test]
+    fn a_candidate_is_tried_as_the_kind_of_its_whole_header() {
+        use crate::foc::InfoFrame;
+        use crate::wire::Checksum;
+        let data = DataFrame::default().encode();
+        let mut fake = data;
+        fake[3] = 0x01; // the info frame's command after the data frame's length byte
+        Checksum::Sum16Le.seal(&mut fake);
+        let info = InfoFrame::new("XR_FOC_ESC", "", "", "").map(|i| i.encode());
+        let info = info.unwrap_or([0; 77]);
+        let mut wire = [0u8; 24 + 77 + 24];
+        wire[..24].copy_from_slice(&fake);
+        wire[24..24 + 77].copy_from_slice(&info);
+        wire[24 + 77..].copy_from_slice(&data);
+        let mut it = frames(&wire);
+        let mut offsets = [0u64; 3];
+        let found = it
+            .by_ref()
+            .zip(&mut offsets)
+            .map(|(d, o)| *o = d.offset)
+            .count();
+        assert_eq!(&offsets[..found], [24, 24 + 77]);
+        assert_eq!(it.stats().checksum_failures(), 1);
+        assert_eq!(it.stats().bytes_skipped(), 24);
+    }
+
     #[test]
     fn state_is_under_128_bytes() {
-        assert_eq!(core::mem::size_of::<Decoder>(), 120);
+        assert_eq!(core::mem::size_of::<Decoder>(), 124);
     }
 
     #[test]

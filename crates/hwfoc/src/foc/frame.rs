@@ -122,8 +122,13 @@ macro_rules! frame_kinds {
                 stats: &mut Stats,
             ) -> Option<(usize, Frame)> {
                 let at = *pos;
+                // One load and one compare per kind: only the kind whose whole header the
+                // candidate carries checks it further (kinds' headers differ), so a fake header
+                // costs no checksum, and a kind's frame none of another kind's checks.
+                let header = data[at..].first_chunk::<4>().map(|h| u32::from_le_bytes(*h));
                 $(
-                    if let Some(frame) = <$kind as FrameKind>::accept(&data[at..]) {
+                    if header == Some(<$kind as FrameKind>::HEADER_WORD) {
+                        let frame = <$kind as FrameKind>::accept(&data[at..])?;
                         frame.count(stats);
                         *pos = at + <$kind as FrameKind>::LEN;
                         return Some((at, Frame::$arm(frame)));
@@ -319,6 +324,17 @@ pub enum FrameError {
         /// Command byte (byte 3).
         command: u8,
     },
+    /// Checksum correct, but a value outside the range the protocol allows (a throttle over
+    /// [`THROTTLE_MAX_RAW`](crate::foc::THROTTLE_MAX_RAW)): a corrupted frame whose weak
+    /// checksum still matches.
+    OutOfRange {
+        /// The field.
+        field: &'static str,
+        /// Its raw value.
+        raw: u16,
+        /// The largest the protocol allows.
+        max: u16,
+    },
     /// A device-information candidate whose text holds a byte that is not ASCII: not a real
     /// frame (typically a cut one with another frame behind it).
     NotText {
@@ -350,6 +366,10 @@ impl fmt::Display for FrameError {
             FrameError::UnknownCommand { version, command } => write!(
                 f,
                 "unknown version 0x{version:02X} / command 0x{command:02X}"
+            ),
+            FrameError::OutOfRange { field, raw, max } => write!(
+                f,
+                "{field} {raw} out of the protocol's range 0..={max}: a corrupted frame whose checksum still matches"
             ),
             FrameError::NotText { offset, found } => write!(
                 f,

@@ -84,6 +84,6 @@ pub const BAUD_RATE: u32 = 19_200;
 pub use decoder::{Decoded, Decoder, Frames, Scanner, frames};
 pub use frame::{Frame, FrameError, MAX_FRAME_LEN, Parsed, parse};
 pub use kinds::FrameKind;
-pub use kinds::data::DataFrame;
+pub use kinds::data::{DataFrame, THROTTLE_MAX_RAW};
 pub use kinds::info::{InfoFieldError, InfoFrame};
 pub use stats::Stats;

@@ -13,7 +13,7 @@ use crate::counters::{ByteCounts, Bytes, PacketSequence};
 ///
 /// Event counters are `u32` and saturate (at the ESC's 20 frames a second a `u32` lasts more than
 /// six years); byte counters hold 48 bits (4.6 million years of the wire; they wrap past 2^48).
-/// That keeps the whole decoder small enough for a microcontroller: 40 bytes here.
+/// That keeps the whole decoder small enough for a microcontroller: 44 bytes here.
 ///
 /// Every byte fed ends up either in an accepted frame or in [`Stats::bytes_skipped`]: after
 /// [`crate::foc::Decoder::flush`], `bytes == 24 * frames + 77 * info_frames + bytes_skipped`.
@@ -65,7 +65,9 @@ impl Stats {
     }
 
     /// Candidate frames (0x9B followed by a known length byte, long enough) that were rejected:
-    /// checksum mismatch, or a correct checksum with an unknown version or command, or a
+    /// checksum mismatch, or a correct checksum with an unknown version or command or a value
+    /// outside the protocol's range (a throttle over 100 %,
+    /// [`THROTTLE_MAX_RAW`](crate::foc::THROTTLE_MAX_RAW): the 16-bit sum is weak), or a
     /// device-information candidate whose text is not ASCII. Corrupted and cut frames, and fake
     /// headers in noise, all count here; a frame cut off by the end of the stream does not.
     pub const fn checksum_failures(&self) -> u32 {
@@ -200,8 +202,8 @@ mod tests {
     }
 
     #[test]
-    fn every_counter_fits_in_40_bytes() {
-        assert_eq!(size_of::<Stats>(), 40);
+    fn every_counter_fits_in_44_bytes() {
+        assert_eq!(size_of::<Stats>(), 44);
     }
 
     /// Two interleaved sequences far apart for a million frames: the loss stays at 0 (it never

@@ -111,6 +111,8 @@ enum Verdict {
     BadHeader,
     UnknownType,
     BadCrc,
+    /// A telemetry frame whose CRC matched with a value out of range.
+    OutOfRange,
     /// More bytes are needed.
     Undecided,
 }
@@ -151,7 +153,15 @@ fn judge(c: &[u8]) -> Verdict {
             return Verdict::Undecided;
         }
         if crc_ok(c, kind.wire_len()) {
-            return Verdict::Frame(kind);
+            return match c.first_chunk::<TELEMETRY_LEN>() {
+                Some(f) if kind == Kind::Telemetry => {
+                    match TelemetryFrame::from_verified(f).out_of_range() {
+                        Some(_) => Verdict::OutOfRange,
+                        None => Verdict::Frame(kind),
+                    }
+                }
+                _ => Verdict::Frame(kind),
+            };
         }
     }
     Verdict::BadCrc
@@ -193,6 +203,10 @@ pub(crate) fn take_candidate(
         }
         Verdict::BadCrc => {
             stats.crc_failure();
+            Candidate::Rejected
+        }
+        Verdict::OutOfRange => {
+            stats.out_of_range_frame();
             Candidate::Rejected
         }
         Verdict::Undecided if !at_end => Candidate::Undecided,
@@ -368,7 +382,7 @@ mod tests {
 
     #[test]
     fn state_size() {
-        assert_eq!(size_of::<Decoder>(), 164);
+        assert_eq!(size_of::<Decoder>(), 168);
     }
 
     /// A frame of `kind` with its CRC.
@@ -378,6 +392,10 @@ mod tests {
         f[3] = 0x03;
         f[4..6].copy_from_slice(&kind.frame_type().to_le_bytes());
         f[6] = 0x17;
+        if kind == Kind::Telemetry {
+            // A voltage in range (50.4 V).
+            f[15..17].copy_from_slice(&504u16.to_le_bytes());
+        }
         CHECKSUM.seal(&mut f[..kind.wire_len()]);
         f
     }

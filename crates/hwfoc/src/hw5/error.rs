@@ -44,6 +44,16 @@ pub enum Error {
         /// The byte found.
         found: u8,
     },
+    /// The CRC matches, but a value is outside the range the protocol allows: a corrupted
+    /// frame whose CRC still matches.
+    OutOfRange {
+        /// The field.
+        field: &'static str,
+        /// Its raw value.
+        raw: u16,
+        /// The largest the protocol allows.
+        max: u16,
+    },
     /// The CRC-16/MODBUS does not match the bytes: the frame was corrupted on the wire.
     Crc {
         /// CRC computed over the bytes before the check bytes.
@@ -83,6 +93,10 @@ impl fmt::Display for Error {
             Error::PayloadLength { found } => write!(
                 f,
                 "HW5 telemetry payload length 0x{found:02X} (expected 0x17)"
+            ),
+            Error::OutOfRange { field, raw, max } => write!(
+                f,
+                "HW5 {field} {raw} out of the protocol's range 0..={max}: a corrupted frame whose CRC still matches"
             ),
             Error::Crc { expected, found } => write!(
                 f,

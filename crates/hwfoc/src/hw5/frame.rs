@@ -206,10 +206,18 @@ pub struct TelemetryFrame {
     pub bec_current_raw: u8,
 }
 
+/// The largest throttle a telemetry frame carries: 100 (percent).
+pub const THROTTLE_MAX_PCT: u8 = 100;
+
+/// The largest input voltage a telemetry frame is believed: 100.0 V (raw, in 0.1 V). HW5 ESCs
+/// are rated up to 14S (61 V charged, LiHV); the margin takes a regenerative-braking spike. A
+/// frame over it is counted as [out of range](super::Stats::out_of_range), never handed on.
+pub const VOLTAGE_MAX_RAW: u16 = 1000;
+
 impl TelemetryFrame {
     /// Decodes a telemetry frame from the first [`TELEMETRY_LEN`] bytes of `bytes` (bytes
     /// after it are ignored), checking in this order: length, envelope (`FE 01 00`), code and
-    /// type (`03`, 0x5C30), payload length (`17`), CRC.
+    /// type (`03`, 0x5C30), payload length (`17`), CRC, the values' ranges.
     pub fn parse(bytes: &[u8]) -> Result<TelemetryFrame, Error> {
         let Some(f) = bytes.first_chunk::<TELEMETRY_LEN>() else {
             return Err(Error::Truncated {
@@ -234,7 +242,26 @@ impl TelemetryFrame {
             });
         }
         check(f)?;
-        Ok(Self::from_verified(f))
+        let frame = Self::from_verified(f);
+        match frame.out_of_range() {
+            Some((field, raw, max)) => Err(Error::OutOfRange { field, raw, max }),
+            None => Ok(frame),
+        }
+    }
+
+    /// The first field outside the range the protocol allows ([`THROTTLE_MAX_PCT`],
+    /// [`VOLTAGE_MAX_RAW`]), with its raw value and the largest allowed, if any.
+    pub(crate) fn out_of_range(&self) -> Option<(&'static str, u16, u16)> {
+        let throttle = (self.throttle > THROTTLE_MAX_PCT).then_some((
+            "throttle",
+            u16::from(self.throttle),
+            u16::from(THROTTLE_MAX_PCT),
+        ));
+        throttle.or((self.voltage_raw > VOLTAGE_MAX_RAW).then_some((
+            "input voltage",
+            self.voltage_raw,
+            VOLTAGE_MAX_RAW,
+        )))
     }
 
     /// Reads the fields of a frame whose header and CRC were already verified.

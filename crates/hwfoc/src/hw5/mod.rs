@@ -95,7 +95,9 @@ mod stats;
 
 pub use decoder::{Decoded, Decoder, Frames, Scanner, frames};
 pub use error::Error;
-pub use frame::{Fault, FaultCode, Faults, TelemetryFrame, identify};
+pub use frame::{
+    Fault, FaultCode, Faults, THROTTLE_MAX_PCT, TelemetryFrame, VOLTAGE_MAX_RAW, identify,
+};
 pub use layout::{
     AMPS, BAUD_RATE, CHECKSUM, CODE_AT, Direction, ERPM, ESC_ADDRESS, ESC_BYTE2, ESC_START,
     FRAME_PERIOD_IDLE, FRAME_PERIOD_RUNNING, HEADER_LEN, Kind, MAX_FRAME_LEN, PAYLOAD_LEN_AT,

@@ -15,8 +15,8 @@ use super::layout::{Direction, Kind};
 /// `bytes == Σ kind.wire_len() * frames(kind) + bytes_skipped` ([`Stats::frame_bytes`] is the sum).
 ///
 /// Every candidate (`FE 01` or `01 FD`) that is not a frame is counted once, as a
-/// [bad header](Stats::bad_headers), an [unknown type](Stats::unknown_types) or a
-/// [CRC failure](Stats::crc_failures), except one cut off by the end of the stream, which is
+/// [bad header](Stats::bad_headers), an [unknown type](Stats::unknown_types), a
+/// [CRC failure](Stats::crc_failures) or [out of range](Stats::out_of_range), except one cut off by the end of the stream, which is
 /// only skipped.
 ///
 /// There is no packet counter on the wire, so no loss is counted here: the layers above judge
@@ -29,6 +29,7 @@ pub struct Stats {
     crc_failures: u32,
     bad_headers: u32,
     unknown_types: u32,
+    out_of_range: u32,
 }
 
 impl Stats {
@@ -40,6 +41,7 @@ impl Stats {
             crc_failures: 0,
             bad_headers: 0,
             unknown_types: 0,
+            out_of_range: 0,
         }
     }
 
@@ -116,11 +118,19 @@ impl Stats {
         self.unknown_types
     }
 
-    /// Candidates rejected: bad headers, unknown types and CRC failures.
+    /// Telemetry frames whose CRC matched but that carry a value outside the range the
+    /// protocol allows ([`THROTTLE_MAX_PCT`](super::THROTTLE_MAX_PCT),
+    /// [`VOLTAGE_MAX_RAW`](super::VOLTAGE_MAX_RAW)): corrupted frames, rejected, never handed on.
+    pub const fn out_of_range(&self) -> u32 {
+        self.out_of_range
+    }
+
+    /// Candidates rejected: bad headers, unknown types, CRC failures and frames out of range.
     pub const fn rejected(&self) -> u32 {
         self.bad_headers
             .saturating_add(self.unknown_types)
             .saturating_add(self.crc_failures)
+            .saturating_add(self.out_of_range)
     }
 
     #[inline]
@@ -142,6 +152,11 @@ impl Stats {
     #[inline]
     pub(crate) fn crc_failure(&mut self) {
         self.crc_failures = self.crc_failures.saturating_add(1);
+    }
+
+    #[inline]
+    pub(crate) fn out_of_range_frame(&mut self) {
+        self.out_of_range = self.out_of_range.saturating_add(1);
     }
 
     #[inline]
@@ -176,8 +191,9 @@ impl fmt::Display for Stats {
         }
         write!(
             f,
-            ", {} CRC failures, {} bad headers, {} unknown types, {} bytes skipped",
+            ", {} CRC failures, {} out of range, {} bad headers, {} unknown types, {} bytes skipped",
             self.crc_failures,
+            self.out_of_range,
             self.bad_headers,
             self.unknown_types,
             self.bytes_skipped(),
@@ -215,6 +231,6 @@ mod tests {
 
     #[test]
     fn size() {
-        assert_eq!(size_of::<Stats>(), 56);
+        assert_eq!(size_of::<Stats>(), 60);
     }
 }

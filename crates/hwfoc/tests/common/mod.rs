@@ -7,10 +7,12 @@ use hwfoc::scan::{Scanner, StreamDecoder};
 use proptest::prelude::*;
 use proptest::sample::Index;
 
-/// Any data frame: every field over its whole range.
+/// Any data frame: every field over its whole range, the throttles over the protocol's
+/// (0..=1024: a frame with a larger one is rejected).
 pub fn data_frame() -> impl Strategy<Value = DataFrame> {
+    let throttle = 0..=hwfoc::foc::THROTTLE_MAX_RAW;
     (
-        (any::<u16>(), any::<u16>(), any::<u16>(), any::<u16>()),
+        (any::<u16>(), throttle.clone(), throttle, any::<u16>()),
         (any::<u16>(), any::<i16>(), any::<i16>()),
         (any::<u8>(), any::<u8>(), any::<u16>()),
     )

@@ -27,6 +27,12 @@ pub const DATA_PAYLOAD_LEN: usize = 18;
 
 const _: () = assert!(DATA_FRAME_LEN == 4 + DATA_PAYLOAD_LEN + 2);
 
+/// The largest input or output throttle a data frame can carry: 1024, 100 % (the protocol's
+/// range is 0..=1024). A frame with a larger one is no frame, whatever its checksum: the
+/// 16-bit sum is weak, and corruption that keeps it is counted as a rejected candidate
+/// ([`Stats::checksum_failures`](crate::foc::Stats::checksum_failures)), never recorded.
+pub const THROTTLE_MAX_RAW: u16 = 1024;
+
 /// One real-time telemetry frame (command 0x02), every field as the raw integer sent on the wire.
 ///
 /// Physical values come from the conversion methods, which take the user's [`Settings`] where a
@@ -89,11 +95,15 @@ impl FrameKind for DataFrame {
         let header = u32::from_le_bytes([d[0], d[1], d[2], d[3]]);
         let sum = u32::from(HEADER_SUM.wrapping_add(sum16(&d[4..22])));
         let found = u32::from(u16::from_le_bytes([d[22], d[23]]));
-        if (sum ^ found) | (header ^ Self::HEADER_WORD) == 0 {
-            Some(Self::from_verified(d))
-        } else {
-            None
+        if (sum ^ found) | (header ^ Self::HEADER_WORD) != 0 {
+            return None;
         }
+        // The throttles' range (bytes 6..10, big-endian) only once the checksum matched: both
+        // high bytes under 4 (0..=1023) at once, else each one exactly.
+        let throttle = |at: usize| u16::from_be_bytes([d[at], d[at + 1]]);
+        let plausible = (d[6] | d[8]) < (THROTTLE_MAX_RAW >> 8) as u8
+            || throttle(6).max(throttle(8)) <= THROTTLE_MAX_RAW;
+        plausible.then(|| Self::from_verified(d))
     }
 }
 
@@ -104,7 +114,7 @@ impl sealed::Sealed for DataFrame {
     #[inline]
     fn read(frame: &[u8]) -> Result<Self, FrameError> {
         match frame.first_chunk::<DATA_FRAME_LEN>() {
-            Some(f) => Ok(Self::from_verified(f)),
+            Some(f) => Self::from_verified(f).plausible(),
             None => Err(FrameError::Truncated {
                 needed: DATA_FRAME_LEN,
                 got: frame.len(),
@@ -130,6 +140,23 @@ impl DataFrame {
     /// header and the checksum. Bytes after the frame are ignored.
     pub fn parse(bytes: &[u8]) -> Result<DataFrame, FrameError> {
         <Self as FrameKind>::parse(bytes)
+    }
+
+    /// The frame, if its values are in the protocol's ranges ([`THROTTLE_MAX_RAW`]).
+    fn plausible(self) -> Result<DataFrame, FrameError> {
+        for (field, raw) in [
+            ("input throttle", self.throttle_in_raw),
+            ("output throttle", self.throttle_out_raw),
+        ] {
+            if raw > THROTTLE_MAX_RAW {
+                return Err(FrameError::OutOfRange {
+                    field,
+                    raw,
+                    max: THROTTLE_MAX_RAW,
+                });
+            }
+        }
+        Ok(self)
     }
 
     /// Reads the fields of a frame whose header and checksum were already verified.
