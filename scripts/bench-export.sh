@@ -17,6 +17,10 @@
 # An output file past its first 16 MiB is written with direct I/O (see
 # crates/hwfoc-cli/src/export/file.rs), so disk figures include the disk's own throughput; compare
 # variants by user + sys CPU time when the load average is not near zero.
+#
+# With BINS="PATH..." (binaries of other builds), each run times every one of them in turn
+# (alternating builds in one sitting: the load changes alike for all) instead of building the
+# release binary; each line names its binary.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 size_mb=${1:-2048}
@@ -24,22 +28,28 @@ runs=${2:-3}
 bench=target/bench
 out_dir=${3:-$bench}
 formats=${FORMATS:-parquet csv jsonl}
+declare -A all
 mkdir -p "$bench"
 [ "$out_dir" = null ] || mkdir -p "$out_dir"
 input=$bench/big-$size_mb.bin
 if [ ! -s "$input" ]; then
   python3 scripts/make-big-input.py "$input" "$size_mb"
 fi
-cargo build --release -p hwfoc-cli --quiet
-bin=target/release/hwfoc
+if [ -n "${BINS:-}" ]; then
+  bins=$BINS
+else
+  cargo build --release -p hwfoc-cli --quiet
+  bins=target/release/hwfoc
+fi
 bytes=$(stat -c %s "$input")
 echo "input: $input, $bytes bytes; $(nproc) cores ($(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2- | sed 's/^ *//')); load average: $(cut -d' ' -f1-3 /proc/loadavg)"
 # Read the input once so that every run finds it in the page cache.
 cat "$input" > /dev/null
 for format in $formats; do
   if [ "$out_dir" = null ]; then out=/dev/null; else out=$out_dir/out.$format; fi
-  all=
+  for bin in $bins; do all[$bin]=; done
   for run in $(seq "$runs"); do
+  for bin in $bins; do
     [ "$out" = /dev/null ] || rm -f "$out"
     log=$(mktemp)
     cpu_before=$(head -1 /proc/stat)
@@ -61,15 +71,18 @@ for format in $formats; do
         for (i = 2; i <= 9; i++) { d[i] = v[2, i] - v[1, i]; t += d[i] }
         printf "idle %.0f %%, stolen %.0f %%", 100 * (d[5] + d[6]) / t, 100 * d[9] / t
       }')
-    printf '%-8s run %d: %6.2f s wall (%s s user, %s s sys; %s), %5s MB/s, peak RSS %d MB, output %s MB\n' \
-      "$format" "$run" "$secs" "$user" "$sys" "$share" "$mbps" $((rss_kb / 1024)) "$out_mb"
-    all="$all $mbps"
+    printf '%-8s run %d: %6.2f s wall (%s s user, %s s sys; %s), %5s MB/s, peak RSS %d MB, output %s MB, %s\n' \
+      "$format" "$run" "$secs" "$user" "$sys" "$share" "$mbps" $((rss_kb / 1024)) "$out_mb" "$bin"
+    all[$bin]="${all[$bin]} $mbps"
   done
-  echo "$format:$all" | awk '{
+  done
+  for bin in $bins; do
+  echo "$format:${all[$bin]}" | awk -v bin="$bin" '{
     n = NF - 1; for (i = 2; i <= NF; i++) v[i - 1] = $i
     for (i = 1; i <= n; i++) for (j = i + 1; j <= n; j++) if (v[j] > v[i]) { t = v[i]; v[i] = v[j]; v[j] = t }
     m = (n % 2) ? v[(n + 1) / 2] : (v[n / 2] + v[n / 2 + 1]) / 2
-    printf "%s best %d MB/s, median %d MB/s (%d runs)\n", $1, v[1], m, n
+    printf "%s best %d MB/s, median %d MB/s (%d runs), %s\n", $1, v[1], m, n, bin
   }'
+  done
   [ "$out" = /dev/null ] || rm -f "$out"
 done

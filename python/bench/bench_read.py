@@ -93,12 +93,20 @@ def main():
     args = ap.parse_args()
     size = os.path.getsize(args.path)
 
+    # The machine may be shared: the load average, and user CPU time beside the wall time (the
+    # user CPU of all of hwfoc.read's threads, which other processes' load does not lengthen
+    # much).
+    print(f"load average: {' '.join(open('/proc/loadavg').read().split()[:3])}")
     t = time.perf_counter()
+    cpu = resource.getrusage(resource.RUSAGE_SELF)
     table = hwfoc.read(args.path)
     rust_s = time.perf_counter() - t
+    after = resource.getrusage(resource.RUSAGE_SELF)
+    user_s, sys_s = after.ru_utime - cpu.ru_utime, after.ru_stime - cpu.ru_stime
     rows = table.num_rows
     del table
-    print(f"hwfoc.read: {size / 1e6:.0f} MB in {rust_s:.2f} s = {size / rust_s / 1e6:.0f} MB/s of input, {rows} rows")
+    print(f"hwfoc.read: {size / 1e6:.0f} MB in {rust_s:.2f} s = {size / rust_s / 1e6:.0f} MB/s of input, {rows} rows;"
+          f" {user_s:.2f} s user ({size / user_s / 1e6:.0f} MB/s of input per user CPU second) + {sys_s:.2f} s system")
 
     with open(args.path, "rb") as f:
         part = f.read(args.python_mib << 20)
@@ -112,7 +120,8 @@ def main():
     py_rate = len(part) / py_s
     print(f"pure Python (struct): {len(part) / 1e6:.0f} MB in {py_s:.2f} s = {py_rate / 1e6:.1f} MB/s"
           f" (whole file at that rate: {size / py_rate:.0f} s)")
-    print(f"hwfoc.read is {size / rust_s / py_rate:.0f}x the pure-Python decoder")
+    print(f"hwfoc.read is {size / rust_s / py_rate:.0f}x the pure-Python decoder"
+          f" ({size / user_s / py_rate:.0f}x by user CPU)")
 
     if args.scan:
         # VmHWM, not ru_maxrss: the latter is carried across exec from this process.

@@ -5,6 +5,7 @@
 use arrow_array::{RecordBatch, new_null_array};
 use arrow_schema::SchemaRef;
 use hwfoc::Settings;
+use hwfoc::foc::DataFrame;
 use hwfoc::telemetry::{Data, Frame};
 use hwfoc_io::Handler;
 use hwfoc_io::InputError;
@@ -46,6 +47,15 @@ impl Frames {
         self.frames.push(*frame);
     }
 
+    /// Adds HW-FOC frames of ESC `esc` without receive times (a raw input's run).
+    #[inline]
+    pub fn extend_untimed(&mut self, esc: u8, frames: &[DataFrame]) {
+        let n = self.len() + frames.len();
+        self.t.resize(n, f64::NAN);
+        self.esc.resize(n, esc);
+        self.frames.extend(frames.iter().map(|&f| Data::HwFoc(f)));
+    }
+
     /// Empties it, keeping its room (a buffer used again is not faulted in again).
     pub fn clear(&mut self) {
         self.t.clear();
@@ -82,6 +92,8 @@ impl Frames {
             frames: &'a Frames,
             rows: std::ops::Range<usize>,
             settings: &'a Settings,
+            /// Whether every frame of `rows` is HW-FOC (looked at once, not per column).
+            hwfoc_only: bool,
             arrays: Vec<arrow_array::ArrayRef>,
         }
         impl Visitor for Arrays<'_> {
@@ -97,15 +109,28 @@ impl Frames {
                     return;
                 }
                 let (t, esc, frames) = (&f.t[rows.clone()], &f.esc[rows.clone()], &f.frames[rows]);
-                let values = t.iter().zip(esc).zip(frames).map(|((&t, &esc), frame)| {
-                    let t = (!t.is_nan()).then_some(t);
-                    C::from_frame(t, esc, frame, s)
-                });
-                self.arrays.push(<C::Value as ArrowValue>::array(values));
+                let rows = t.iter().zip(esc).zip(frames);
+                let array = if self.hwfoc_only {
+                    // HW-FOC frames only (a raw file's): each value read by field, without a
+                    // match on the protocol per value (as the Parquet export reads them).
+                    <C::Value as ArrowValue>::array(rows.map(|((&t, &esc), frame)| {
+                        let frame = Data::HwFoc(frame.to_hwfoc().unwrap_or_default());
+                        C::from_frame((!t.is_nan()).then_some(t), esc, &frame, s)
+                    }))
+                } else {
+                    <C::Value as ArrowValue>::array(rows.map(|((&t, &esc), frame)| {
+                        C::from_frame((!t.is_nan()).then_some(t), esc, frame, s)
+                    }))
+                };
+                self.arrays.push(array);
             }
         }
+        let hwfoc_only = self.frames[rows.clone()]
+            .iter()
+            .all(|f| matches!(f, Data::HwFoc(_)));
         let mut arrays = Arrays {
             frames: self,
+            hwfoc_only,
             rows,
             settings,
             arrays: Vec::with_capacity(columns::COUNT),
@@ -219,6 +244,20 @@ impl<F: FnMut(Frames) -> Result<(), Stop>> Handler for Collect<F> {
                 self.frames.push(t, esc, frame);
                 self.kept += 1;
             }
+        }
+    }
+
+    /// A raw input's HW-FOC frames come a run at a time, as the summary takes them: the
+    /// decoder's bulk path, without a call per frame (issue 31: `hwfoc.read` took each frame
+    /// through [`Handler::frame`], at 23 times the pure-Python decoder's speed).
+    const TAKES_RUNS: bool = true;
+
+    #[inline]
+    fn untimed_data(&mut self, esc: u8, frames: &[DataFrame], _: &Settings) {
+        // No receive time: no span to widen, and the selection is the same for the whole run.
+        if self.selection.contains(esc, None) {
+            self.frames.extend_untimed(esc, frames);
+            self.kept += frames.len() as u64;
         }
     }
 

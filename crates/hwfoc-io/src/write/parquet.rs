@@ -114,6 +114,7 @@ mod encode {
     use std::sync::mpsc::{Receiver, SyncSender};
 
     use bytes::Bytes;
+    use hwfoc::telemetry::Data;
     use hwfoc::{Protocol, Settings, Status};
     use parquet::arrow::{ArrowSchemaConverter, add_encoded_arrow_schema_to_metadata};
     use parquet::basic::Repetition;
@@ -669,6 +670,10 @@ mod encode {
     }
 
     /// [`encode_column`] with the settings of each row's ESC given by `settings`.
+    ///
+    /// Out of line: each column's conversion and encoding is a function of its own, optimised
+    /// on its own, not one body of every column's loops.
+    #[inline(never)]
     fn encode_column_by<'s, C: Column>(
         rows: &Chunk,
         descr: ColumnDescPtr,
@@ -698,14 +703,27 @@ mod encode {
         type Physical<C> = <<C as Column>::Value as ParquetValue>::Physical;
         encode_in::<Physical<C>>(block_rows, descr, props, n, |block, levels| {
             // A receive time where there is one (NaN in the chunk where not).
-            let values = rows.t[block.clone()]
-                .iter()
-                .zip(&rows.esc[block.clone()])
-                .zip(&rows.frames[block])
-                .map(|((&t, &esc), frame)| {
+            let (t, esc, frames) = (
+                &rows.t[block.clone()],
+                &rows.esc[block.clone()],
+                &rows.frames[block],
+            );
+            let rows = t.iter().zip(esc).zip(frames);
+            if frames.iter().all(|f| matches!(f, Data::HwFoc(_))) {
+                // A block of HW-FOC frames (nearly every block of a large file): each frame's
+                // protocol known here, its values read by field without a match on the
+                // protocol per value.
+                let values = rows.map(|((&t, &esc), frame)| {
+                    let frame = Data::HwFoc(frame.to_hwfoc().unwrap_or_default());
+                    C::from_frame((!t.is_nan()).then_some(t), esc, &frame, settings(esc))
+                });
+                <C::Value as ParquetValue>::fill(values, levels);
+            } else {
+                let values = rows.map(|((&t, &esc), frame)| {
                     C::from_frame((!t.is_nan()).then_some(t), esc, frame, settings(esc))
                 });
-            <C::Value as ParquetValue>::fill(values, levels);
+                <C::Value as ParquetValue>::fill(values, levels);
+            }
         })
     }
 
