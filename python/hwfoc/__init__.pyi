@@ -102,8 +102,8 @@ def read(
     ``gear_ratio``, ``v4_volts_per_step``, ``inputs`` and ``escs`` (JSON) and ``filter`` when records were selected;
     each field has its ``unit``.
 
-    Raises InputError (also for a serial port's path: read ports with :func:`open_ports`),
-    SelectionError, SettingsError; TypeError for a source of another type; ValueError for a
+    Raises InputError (also for a serial port's path: read ports with :func:`open_ports`; and,
+    after the warnings, when no input held a data frame, as ``hwfoc decode`` fails), SelectionError, SettingsError; TypeError for a source of another type; ValueError for a
     ``protocol`` not in :data:`PROTOCOLS` or a ``v4_volts_per_step`` that is not a fraction. Warns HwfocWarning
     for inputs without frames and for a recording's damage and notes.
     """

@@ -20,12 +20,15 @@ fn findings_json(
     settings: Settings,
     (config, baseline): (&CheckConfig, Option<&Baseline>),
     notes: &Notes,
-) -> Result<String, InputError> {
+) -> Result<Result<String, String>, InputError> {
     let mut sources = sources(open_all(specs, notes)?, settings, (None, false));
     let mut check = Check::new();
     sources.run(&mut check)?;
+    if let Some(nothing) = crate::nothing_decoded(&sources) {
+        return Ok(Err(nothing));
+    }
     let findings = analyse(&check.series(&sources), config, baseline);
-    Ok(serde_json::to_string(&findings).unwrap_or_default())
+    Ok(Ok(serde_json::to_string(&findings).unwrap_or_default()))
 }
 
 /// A `ValueError` naming the argument `what` whose JSON does not fit.
@@ -35,15 +38,16 @@ fn bad_json(what: &str) -> impl Fn(serde_json::Error) -> PyErr + '_ {
 
 /// The findings of `hwfoc check --json` on `source` (as `read` takes it), as one JSON text
 /// (a list of findings); `config` the `[check]` table and `baseline` a fitted baseline, each
-/// as JSON text. Raises InputError, ValueError.
+/// as JSON text. Raises InputError (also when no input held a data frame, as the command
+/// fails), ValueError.
 #[pyfunction]
-#[pyo3(signature = (source, *, current_scale=CURRENT_SCALE, pole_pairs=POLE_PAIRS, gear_ratio=GEAR_RATIO, v4_volts_per_step=V4_VOLTS_PER_STEP, config=None, baseline=None))]
+#[pyo3(signature = (source, *, current_scale=CURRENT_SCALE, pole_pairs=crate::args::PolePairs(POLE_PAIRS), gear_ratio=GEAR_RATIO, v4_volts_per_step=V4_VOLTS_PER_STEP, config=None, baseline=None))]
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn check_json(
     py: Python<'_>,
     source: &Bound<'_, PyAny>,
     current_scale: f32,
-    pole_pairs: u16,
+    pole_pairs: crate::args::PolePairs,
     gear_ratio: f32,
     v4_volts_per_step: &str,
     config: Option<&str>,
@@ -61,5 +65,6 @@ pub(crate) fn check_json(
     let notes = Notes::default();
     let json = py.detach(|| findings_json(specs, settings, (&config, baseline.as_ref()), &notes));
     warn_notices(py, &notes)?;
-    json.map_err(errors::input)
+    json.map_err(errors::input)?
+        .map_err(errors::InputError::new_err)
 }

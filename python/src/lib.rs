@@ -278,6 +278,8 @@ struct Decoded {
     batches: Vec<RecordBatch>,
     escs: String,
     warnings: Vec<String>,
+    /// The error when no input held a data frame ([`nothing_decoded`]).
+    nothing: Option<String>,
 }
 
 /// The warnings `hwfoc decode` prints: a CAN bus's records of protocols other than the one
@@ -295,6 +297,17 @@ pub(crate) fn no_frames(sources: &Sources) -> Vec<String> {
         })
         .map(|i| format!("{}: {}", esc_label(sources, i), no_frames_text(sources, i)));
     left_out.chain(none).collect()
+}
+
+/// The command's error when no input held a data frame (`hwfoc decode` and `hwfoc summary`
+/// exit 1 with it, after their warnings), raised as `InputError`.
+pub(crate) fn nothing_decoded(sources: &Sources) -> Option<String> {
+    (!sources.any_data_frame()).then(|| {
+        format!(
+            "no data frame in any input ({})",
+            sources.names().join(", ")
+        )
+    })
 }
 
 /// The command's warning for a time window that held no frame, if `collect`'s did not.
@@ -372,6 +385,7 @@ fn decode_all(specs: Vec<Spec>, options: &Options, notes: &Notes) -> Result<Deco
             .into_iter()
             .chain(empty_window)
             .collect(),
+        nothing: nothing_decoded(&sources),
     })
 }
 
@@ -391,9 +405,10 @@ pub(crate) fn stop_error(stop: Stop) -> PyErr {
 /// currents and RPM; `protocol` (a name, as the command's `--protocol`) reads that protocol
 /// only; `join=True` reads the recordings given as one, as the command's `--join` (without it,
 /// each file is ESCs of its own unless it is a file of the same `hwfoc record` run as another).
-/// The schema metadata is that of `hwfoc decode --format parquet`. Raises InputError,
-/// SelectionError, SettingsError, ValueError for an unknown protocol; warns HwfocWarning for
-/// inputs without frames and for damage or notes in a recording.
+/// The schema metadata is that of `hwfoc decode --format parquet`. Raises InputError (also
+/// when no input held a data frame, after the warnings, as the command fails), SelectionError,
+/// SettingsError, ValueError for an unknown protocol; warns HwfocWarning for inputs without
+/// frames and for damage or notes in a recording.
 #[pyfunction]
 #[pyo3(signature = (source, *, esc=None, start=None, end=None, current_scale=CURRENT_SCALE, pole_pairs=crate::args::PolePairs(POLE_PAIRS), gear_ratio=GEAR_RATIO, v4_volts_per_step=V4_VOLTS_PER_STEP, protocol=None, join=false), text_signature = "(source, *, esc=None, start=None, end=None, current_scale=DEFAULT_CURRENT_SCALE, pole_pairs=DEFAULT_POLE_PAIRS, gear_ratio=DEFAULT_GEAR_RATIO, v4_volts_per_step=DEFAULT_V4_VOLTS_PER_STEP, protocol=None, join=False)")]
 #[allow(clippy::too_many_arguments)]
@@ -424,6 +439,9 @@ fn read<'py>(
     for warning in &decoded.warnings {
         errors::warn(py, &py.get_type::<errors::HwfocWarning>(), warning)?;
     }
+    if let Some(nothing) = decoded.nothing {
+        return Err(errors::InputError::new_err(nothing));
+    }
     let schema = provenance.schema(Some(decoded.escs));
     let batches = decoded
         .batches
@@ -442,11 +460,14 @@ fn summary_json(
     settings: Settings,
     (protocol, join): (Option<Protocol>, bool),
     notes: &Notes,
-) -> Result<String, InputError> {
+) -> Result<Result<String, String>, InputError> {
     let mut sources = sources(open_all(specs, notes)?, settings, (protocol, join));
     let mut summary = Interruptible::new(Summary::new());
     sources.run(&mut summary)?;
-    Ok(summary.inner.report(&sources).json().to_string())
+    if let Some(nothing) = nothing_decoded(&sources) {
+        return Ok(Err(nothing));
+    }
+    Ok(Ok(summary.inner.report(&sources).json().to_string()))
 }
 
 /// What `hwfoc summary --json` prints for `source` (as `read` takes it), as Python objects:
@@ -471,7 +492,9 @@ fn summary<'py>(
     let notes = Notes::default();
     let json = py.detach(|| summary_json(specs, settings, (protocol, join), &notes));
     warn_notices(py, &notes)?;
-    let json = json.map_err(errors::input)?;
+    let json = json
+        .map_err(errors::input)?
+        .map_err(errors::InputError::new_err)?;
     py.import("json")?.call_method1("loads", (json,))
 }
 

@@ -32,6 +32,8 @@ enum Msg {
     Failed(Stop),
     /// The inputs are read: the warnings `read` gives too (an ESC whose bytes held no frame).
     Warnings(Vec<String>),
+    /// No input held a data frame: `read`'s error, after the warnings.
+    Nothing(String),
 }
 
 /// An iterator of `pyarrow.RecordBatch`: see `hwfoc.scan`.
@@ -96,6 +98,9 @@ fn produce(
             let mut warnings = crate::no_frames(&sources);
             warnings.extend(empty_window);
             let _ = tx.send(Msg::Warnings(warnings));
+            if let Some(nothing) = crate::nothing_decoded(&sources) {
+                let _ = tx.send(Msg::Nothing(nothing));
+            }
         }
     }
 }
@@ -148,9 +153,11 @@ pub fn scan(
     match msg? {
         Some(Msg::Opened) | None => Ok(scan),
         Some(Msg::Failed(stop)) => Err(stop_error(stop)),
-        Some(Msg::Batch(_) | Msg::Warnings(_)) => Err(errors::HwfocError::new_err(
-            "the decoding thread sent records before opening the inputs",
-        )),
+        Some(Msg::Batch(_) | Msg::Warnings(_) | Msg::Nothing(_)) => {
+            Err(errors::HwfocError::new_err(
+                "the decoding thread sent records before opening the inputs",
+            ))
+        }
     }
 }
 
@@ -202,6 +209,10 @@ impl Scan {
                         errors::warn(py, &py.get_type::<errors::HwfocWarning>(), warning)?;
                     }
                     continue;
+                }
+                Ok(Some(Msg::Nothing(nothing))) => {
+                    self.drop_channel();
+                    return Err(errors::InputError::new_err(nothing));
                 }
                 Ok(Some(Msg::Failed(stop))) => {
                     self.drop_channel();

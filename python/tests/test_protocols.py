@@ -103,8 +103,8 @@ def test_scan_and_the_decoder_read_as_read(capture, protocol):
                          ids=["v4", "v3"])
 def test_the_protocol_forced_reads_that_format_only(capture, protocol, other):
     assert hwfoc.read(capture, protocol=protocol).num_rows > 0
-    with pytest.warns(hwfoc.HwfocWarning):
-        assert hwfoc.read(capture, protocol=other).num_rows == 0
+    with pytest.warns(hwfoc.HwfocWarning), pytest.raises(hwfoc.InputError, match="no data frame"):
+        hwfoc.read(capture, protocol=other)
 
 
 @pytest.mark.parametrize("capture", [V4, V3], ids=["v4", "v3"])
@@ -397,15 +397,18 @@ def test_the_can_protocols_are_listed_and_filter_a_bus():
             table = hwfoc.read(CAN_LOG, protocol=protocol)
         assert table.num_rows == rows
         assert set(table.column("protocol").to_pylist()) == {protocol}
-    with pytest.warns(hwfoc.HwfocWarning, match="39 hw-can records and 19 dronecan records"):
-        assert hwfoc.read(CAN_LOG, protocol="hw5").num_rows == 0
+    with pytest.warns(hwfoc.HwfocWarning, match="39 hw-can records and 19 dronecan records"), \
+            pytest.raises(hwfoc.InputError, match="no data frame"):
+        hwfoc.read(CAN_LOG, protocol="hw5")
 
 
 def test_a_forced_protocol_names_the_format_the_bytes_are():
-    with pytest.warns(hwfoc.HwfocWarning, match="these bytes are hw-v4 frames"):
-        assert hwfoc.read(V4, protocol="hw5").num_rows == 0
-    with pytest.warns(hwfoc.HwfocWarning, match="not CAN frames but hw-v4 frames"):
-        assert hwfoc.read(V4, protocol="hw-can").num_rows == 0
+    with pytest.warns(hwfoc.HwfocWarning, match="these bytes are hw-v4 frames"), \
+            pytest.raises(hwfoc.InputError, match="no data frame"):
+        hwfoc.read(V4, protocol="hw5")
+    with pytest.warns(hwfoc.HwfocWarning, match="not CAN frames but hw-v4 frames"), \
+            pytest.raises(hwfoc.InputError, match="no data frame"):
+        hwfoc.read(V4, protocol="hw-can")
 
 
 def test_a_can_protocol_on_a_serial_port_is_a_value_error():

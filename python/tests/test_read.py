@@ -263,19 +263,29 @@ def test_garbage_and_other_protocols_warn_as_the_command_does(cli, tmp_path):
     # A DataLink-like stream (another protocol): 0x9B headers that never make a HW-FOC frame.
     other = tmp_path / "other.bin"
     other.write_bytes(bytes([0x9B, 0x30, 0x01, 0x22] + list(range(40))) * 200)
-    for path in (garbage, other):
-        with pytest.warns(hwfoc.HwfocWarning) as caught:
-            table = hwfoc.read(path)
-        assert table.num_rows == 0
+    notes = tmp_path / "notes.txt"
+    notes.write_text("Notes of the bench run: motor 2 sounded rough at 60 %.\n" * 50)
+    for path in (garbage, other, notes):
         _, err, code = run_cli(cli, "decode", path, check=False)
         assert code == 1, err
-        # The command then fails (no data frame in any input); its warnings are the same.
+        # The command warns, then fails (no data frame in any input); Python warns alike, then
+        # raises the command's error, never an empty table.
         warned = [line for line in err.splitlines() if line.startswith("hwfoc: warning: ")]
+        failed = err.splitlines()[-1]
+        assert failed.startswith("hwfoc: no data frame in any input"), err
+        with pytest.warns(hwfoc.HwfocWarning) as caught, pytest.raises(hwfoc.InputError) as e:
+            hwfoc.read(path)
         assert [f"hwfoc: warning: {w.message}" for w in caught] == warned
-        # scan warns alike, once its inputs are read.
-        with pytest.warns(hwfoc.HwfocWarning) as scanned:
-            assert sum(b.num_rows for b in hwfoc.scan(path)) == 0
+        assert f"hwfoc: {e.value}" == failed
+        # scan warns alike, once its inputs are read, then raises.
+        with pytest.warns(hwfoc.HwfocWarning) as scanned, pytest.raises(hwfoc.InputError) as e:
+            for _ in hwfoc.scan(path):
+                pass
         assert [str(w.message) for w in scanned] == [str(w.message) for w in caught]
+        assert f"hwfoc: {e.value}" == failed
+        with pytest.raises(hwfoc.InputError) as e:
+            hwfoc.summary(path)
+        assert str(e.value) == cli_error(cli, "summary", path)
 
 
 def test_truncated_recording_reads_what_is_there(cli, sim_dir, tmp_path, capfd):
@@ -428,8 +438,9 @@ def test_a_forced_protocol_that_finds_nothing_warns_with_its_advice(mixed):
     first = mixed[0]
     # Its bytes are HW-FOC frames: the warning says so, not the baud rate and the wiring.
     with pytest.warns(hwfoc.HwfocWarning, match=r"no valid DataLink V2 frames: these bytes are hw-foc frames "
-                                                 r"\(try --protocol hw-foc, or leave --protocol out\)"):
-        assert hwfoc.read(first, protocol="datalink").num_rows == 0
+                                                 r"\(try --protocol hw-foc, or leave --protocol out\)"), \
+            pytest.raises(hwfoc.InputError, match="no data frame in any input"):
+        hwfoc.read(first, protocol="datalink")
 
 
 def test_protocol_names_and_their_defaults():
@@ -443,11 +454,12 @@ def test_protocol_names_and_their_defaults():
                                              r'"datalink", "hw-v4", "hw-v3", "hw5", "hw-can", "dronecan"'):
             call()
     # Every protocol's name is taken (any case), by every function; a CAN protocol's too (it
-    # keeps a bus's records of that protocol; serial bytes give nothing).
+    # keeps a bus's records of that protocol; serial bytes give nothing, which fails as the
+    # command does).
     for name in hwfoc.PROTOCOLS + ("HW5", "Hw-V4", "DroneCAN"):
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", hwfoc.HwfocWarning)
-            assert hwfoc.read(b"\0", protocol=name).num_rows == 0
-            assert list(hwfoc.scan(b"\0", protocol=name)) == []
-            assert hwfoc.summary(b"\0", protocol=name)["escs"][0]["frames"] == 0
+            for call in (hwfoc.read, lambda *a, **k: list(hwfoc.scan(*a, **k)), hwfoc.summary):
+                with pytest.raises(hwfoc.InputError, match="no data frame in any input"):
+                    call(b"\0", protocol=name)
         assert hwfoc.Decoder(protocol=name).finish().num_rows == 0
