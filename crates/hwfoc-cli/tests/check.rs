@@ -532,6 +532,47 @@ fn check_plot_shades_the_windows_of_its_findings() {
     );
 }
 
+#[test]
+fn plot_check_shades_the_same_windows() {
+    let dir = Dir::new();
+    let loose = simulate(&dir, "loose.pcapng", 6, &["--degrade", "1:wire@10=0.5"]);
+    let (plain, shaded) = (dir.arg("plain.svg"), dir.arg("shaded.svg"));
+    let out = run(hwfoc().args(["plot", "--no-config", &loose, "-o", &plain]));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let out = run(hwfoc().args(["plot", "--no-config", &loose, "-o", &shaded, "--check"]));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(
+        !std::fs::read_to_string(&plain)
+            .unwrap()
+            .contains("critical link")
+    );
+    let image = std::fs::read_to_string(&shaded).unwrap();
+    assert!(image.contains("critical link"), "no label of the finding");
+    // A baseline needs --check.
+    let out = run(hwfoc().args([
+        "plot",
+        &loose,
+        "-o",
+        &dir.arg("x.svg"),
+        "--baseline",
+        "b.toml",
+    ]));
+    assert_eq!(
+        out.status.code(),
+        Some(2),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
+
 /// Every recording and capture in `testdata/` that `hwfoc check` reads.
 fn testdata() -> Vec<PathBuf> {
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../testdata");

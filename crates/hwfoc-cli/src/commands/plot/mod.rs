@@ -21,9 +21,10 @@ use hwfoc::telemetry::Info;
 use crate::args::{InputArgs, SelectArgs, SettingsArgs};
 use crate::error::CliError;
 use hwfoc_io::Selection;
+use hwfoc_io::check::{Baseline, Check, analyse};
 use hwfoc_io::record::Record;
 use hwfoc_io::write::WriteError;
-use hwfoc_io::{Handler, Sources};
+use hwfoc_io::{Both, Handler, Sources};
 
 use collect::Collector;
 use target::ImageFile;
@@ -62,6 +63,14 @@ pub struct PlotArgs {
     /// Title on top of the image. Default: the inputs' names.
     #[arg(long, value_name = "TEXT")]
     title: Option<String>,
+    /// Shade the windows of the warnings and critical findings of `hwfoc check` (its analysers,
+    /// with the configuration file's [check] thresholds) in the same reading of the inputs.
+    #[arg(long)]
+    check: bool,
+    /// With --check: judge drift against this baseline (a TOML file written by `hwfoc check
+    /// --fit-baseline`).
+    #[arg(long, value_name = "FILE", requires = "check")]
+    baseline: Option<std::path::PathBuf>,
     #[command(flatten)]
     select: SelectArgs,
     #[command(flatten)]
@@ -90,6 +99,10 @@ pub fn run(args: &PlotArgs) -> Result<(), CliError> {
     // created here is removed again if the plot is not written.
     args.input.refuse_output(&args.output, &config)?;
     let mut target = ImageFile::open(&args.output, args.overwrite)?;
+    let baseline: Option<Baseline> = match &args.baseline {
+        Some(path) => Some(crate::config::read_toml(path)?),
+        None => None,
+    };
     let options = Options {
         width: args.width,
         height: args.height,
@@ -101,10 +114,18 @@ pub fn run(args: &PlotArgs) -> Result<(), CliError> {
         sources.require_timing()?;
         args.select.check_clocks(&sources)?;
     }
+    let mut check = args.check.then(|| Check::selecting(selection.clone()));
     let mut collector = Collector::new(settings, selection, options.width)
         .stop_on(args.input.stop_if_read_to_end(), &args.output);
-    let result = sources.run(&mut collector);
+    let result = match &mut check {
+        Some(check) => sources.run(&mut Both(check, &mut collector)),
+        None => sources.run(&mut collector),
+    };
     crate::args::warn_left_out(&sources);
+    if let Some(check) = check {
+        let series = check.series(&sources);
+        collector.shade(&analyse(&series, &config.file.check, baseline.as_ref()));
+    }
     if let Err(e @ CliError::Write(WriteError::Interrupted { .. })) = result {
         return Err(e);
     }
