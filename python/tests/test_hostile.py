@@ -8,7 +8,7 @@ import datetime
 import pytest
 
 import hwfoc
-from conftest import run_cli
+from conftest import cli_error, run_cli
 
 
 class Interrupting:
@@ -106,11 +106,12 @@ def test_a_candump_log_fed_to_the_byte_decoder_is_refused():
 
 @pytest.mark.parametrize(
     "call",
-    ["hwfoc.read('/dev/zero')", "next(iter(hwfoc.scan('/dev/zero')))", "hwfoc.summary('/dev/zero')"],
+    ["hwfoc.read('/dev/urandom')", "next(iter(hwfoc.scan('/dev/urandom')))",
+     "hwfoc.summary('/dev/urandom')"],
 )
 def test_ctrl_c_stops_reading_an_endless_input(call):
-    """An endless input (/dev/zero) is read until Ctrl-C, which then stops it at once as
-    KeyboardInterrupt (every reading loop looks for signals)."""
+    """An endless input (/dev/urandom: bytes that never make a frame) is read until Ctrl-C,
+    which then stops it at once as KeyboardInterrupt (every reading loop looks for signals)."""
     import signal
     import subprocess
     import sys
@@ -128,3 +129,14 @@ def test_ctrl_c_stops_reading_an_endless_input(call):
             p.kill()
             p.wait()
     assert p.returncode == 42, p.stderr.read().decode()
+
+
+def test_dev_zero_ends_as_the_command_does(cli):
+    """/dev/zero never ends, but nothing but zeros is no telemetry: reading stops after 64 MiB
+    with the command's error, in every reading call."""
+    expected = cli_error(cli, "decode", "/dev/zero")
+    assert expected == "/dev/zero: only zero bytes, not telemetry (the first 64 MiB; reading stopped)"
+    for call in (hwfoc.read, lambda p: list(hwfoc.scan(p)), hwfoc.summary):
+        with pytest.raises(hwfoc.InputError) as e:
+            call("/dev/zero")
+        assert str(e.value) == expected

@@ -169,7 +169,7 @@ pub const RECORD_SCHEMA_VERSION: u32 = 4;
 
 // Inputs: where bytes come from, each opened as an `Input` whose format is detected from its
 // content, read as `Batch`es of bytes with their receive times.
-pub use input::{Batch, Input, InputError, InputFormat, Looks, read_small_file};
+pub use input::{Batch, Input, InputError, InputFormat, Looks, ONLY_ZEROS_LIMIT, read_small_file};
 
 // Decoding: `Sources` reads inputs, merges them in time order and decodes each ESC's bytes
 // with a `Stream` (`PortStreams` for live ports), handing frames to a `Handler`.

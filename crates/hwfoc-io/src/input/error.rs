@@ -73,6 +73,14 @@ pub enum InputError {
         /// The format it has now.
         format: crate::input::InputFormat,
     },
+    /// An input gave nothing but zero bytes for [`ONLY_ZEROS_LIMIT`](crate::ONLY_ZEROS_LIMIT)
+    /// bytes from its start (a device such as `/dev/zero`, which never ends): reading stops.
+    OnlyZeros {
+        /// The input as named on the command line.
+        input: String,
+        /// How many bytes it gave.
+        bytes: u64,
+    },
     /// A serial port could not be opened.
     Port(PortError),
 }
@@ -94,6 +102,11 @@ impl fmt::Display for InputError {
             InputError::Empty { input } => {
                 write!(f, "{input} is empty: there is nothing to decode")
             }
+            InputError::OnlyZeros { input, bytes } => write!(
+                f,
+                "{input}: only zero bytes, not telemetry (the first {} MiB; reading stopped)",
+                bytes >> 20
+            ),
             InputError::Csv {
                 input,
                 line,

@@ -54,6 +54,11 @@ use crate::serial::PortSet;
 use self::csv::{CsvRows, may_be_header};
 pub use self::error::InputError;
 pub use self::looks::Looks;
+
+/// How many bytes of nothing but zeros from its start end the reading of a raw input with
+/// [`InputError::OnlyZeros`]: 64 MiB, over an hour of any format's frames, so no recording
+/// that starts with a zeroed stretch is cut short, while `/dev/zero` ends in a moment.
+pub const ONLY_ZEROS_LIMIT: u64 = 64 << 20;
 use self::ports::Ports;
 use self::raw::RawReader;
 use self::recording::RecordingReader;
@@ -896,6 +901,32 @@ mod tests {
             err.to_string(),
             "cap.csv:5: bad byte value \"nope\" (expected 0x00..0xFF or 0..255)"
         );
+    }
+
+    #[test]
+    fn an_endless_stream_of_zeros_ends_with_an_error() {
+        // `/dev/zero` as a reader: endless zeros stop at the limit, naming the input.
+        let mut input = Input::from_reader("/dev/zero", Box::new(std::io::repeat(0))).unwrap();
+        let err = loop {
+            match input.next_batch() {
+                Ok(Some(_)) => {}
+                Ok(None) => panic!("an endless input ended"),
+                Err(e) => break e,
+            }
+        };
+        assert!(
+            matches!(err, InputError::OnlyZeros { bytes, .. } if bytes >= ONLY_ZEROS_LIMIT),
+            "{err}"
+        );
+        assert_eq!(
+            err.to_string(),
+            "/dev/zero: only zero bytes, not telemetry (the first 64 MiB; reading stopped)"
+        );
+        // One byte that is not zero, and the zeros after it are read to the end.
+        let mut bytes = vec![0u8; (ONLY_ZEROS_LIMIT + (1 << 20)) as usize];
+        bytes[10] = 0x9B;
+        let mut input = Input::from_reader("x", Box::new(std::io::Cursor::new(bytes))).unwrap();
+        while input.next_batch().unwrap().is_some() {}
     }
 
     #[test]

@@ -37,6 +37,8 @@ pub(super) struct RawReader {
     sample: Vec<u8>,
     /// A second handle on a regular file read, for positional reads of a later part.
     file: Option<File>,
+    /// The bytes read so far while every one was zero; `None` once one was not.
+    zeros: Option<u64>,
 }
 
 impl RawReader {
@@ -48,6 +50,7 @@ impl RawReader {
             pending: head,
             sample: Vec::new(),
             file,
+            zeros: Some(0),
         }
     }
 }
@@ -87,6 +90,20 @@ impl Source for RawReader {
                         source,
                     });
                 }
+            }
+        }
+        if let Some(zeros) = &mut self.zeros {
+            if bytes.iter().all(|&b| b == 0) {
+                *zeros += bytes.len() as u64;
+                // An endless device of zeros (`/dev/zero`) would be read for ever.
+                if *zeros >= super::ONLY_ZEROS_LIMIT {
+                    return Err(InputError::OnlyZeros {
+                        input: name.to_string(),
+                        bytes: *zeros,
+                    });
+                }
+            } else {
+                self.zeros = None;
             }
         }
         let room = looks::SAMPLE.saturating_sub(self.sample.len());

@@ -64,7 +64,7 @@ pub struct PlotArgs {
     #[arg(long, value_name = "TEXT")]
     title: Option<String>,
     /// Shade the windows of the warnings and critical findings of `hwfoc check` (its analysers,
-    /// with the configuration file's [check] thresholds) in the same reading of the inputs.
+    /// with the configuration file's check thresholds) in the same reading of the inputs.
     #[arg(long)]
     check: bool,
     /// With --check: judge drift against this baseline (a TOML file written by `hwfoc check
