@@ -115,7 +115,7 @@ echo "V4 decoder state: ${v4_state:?} bytes (size_of::<v4::Decoder>(), owned by 
 hw5_state=$(state_of HW5_DECODER_STATE_BYTES)
 echo "HW5 decoder state: ${hw5_state:?} bytes (size_of::<hw5::Decoder>(), owned by the caller)"
 can_state=$(state_of DRONECAN_RECEIVER_STATE_BYTES)
-echo "DroneCAN receiver state: ${can_state:?} bytes (size_of::<dronecan::Receiver>(): 16 slots," \
+echo "DroneCAN receiver state: ${can_state:?} bytes (size_of::<dronecan::Receiver>(): 128 slots, one per node id," \
     "statistics of 128 node ids; owned by the caller)"
 
 # Symbols the probe objects take from outside (every build).

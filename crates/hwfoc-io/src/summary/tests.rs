@@ -243,6 +243,9 @@ fn a_stream_that_changed_format_names_both() {
         text.contains("delivery     75.00 % of HW-FOC data frames"),
         "{text}"
     );
+    // The HW5 bytes are no bytes skipped: they are outside HW-FOC's frames.
+    assert!(text.contains("bytes outside HW-FOC frames"), "{text}");
+    assert!(!text.contains("bytes skipped"), "{text}");
     let esc = &json["escs"][0];
     assert_eq!(esc["frames"], 661);
     assert_eq!(esc["formats"]["hw5"], 658);

@@ -175,9 +175,15 @@ impl EscReport<'_> {
                 None => "no packet counter (loss not counted)".to_string(),
             }
         };
+        // After a change of format, the bytes the locked format's decoder skipped hold the other
+        // formats' frames: said as what they are, not as bytes no decoder could read.
+        let skipped = match several {
+            true => format!("bytes outside {} frames", st.protocol().title()),
+            false => "bytes skipped".to_string(),
+        };
         let _ = writeln!(
             o,
-            "link         {checks}, {counted}, {} bytes skipped ({:.2} %)",
+            "link         {checks}, {counted}, {} {skipped} ({:.2} %)",
             st.bytes_skipped(),
             percent(st.bytes_skipped(), st.bytes())
         );

@@ -28,29 +28,29 @@
 use hwfoc::foc::Decoder;
 
 /// `size_of::<Decoder>()` on the target; the build fails if it changes (the script reports it).
-pub const DECODER_STATE_BYTES: usize = 120;
+pub const DECODER_STATE_BYTES: usize = 124;
 const _: () = assert!(core::mem::size_of::<Decoder>() == DECODER_STATE_BYTES);
 
 /// `size_of::<hwfoc::datalink::Decoder>()` on the target, checked as [`DECODER_STATE_BYTES`] is.
-pub const DATALINK_DECODER_STATE_BYTES: usize = 380;
+pub const DATALINK_DECODER_STATE_BYTES: usize = 416;
 const _: () =
     assert!(core::mem::size_of::<hwfoc::datalink::Decoder>() == DATALINK_DECODER_STATE_BYTES);
 
 /// `size_of::<hwfoc::v3::Decoder>()` on the target, checked as [`DECODER_STATE_BYTES`] is.
-pub const V3_DECODER_STATE_BYTES: usize = 96;
+pub const V3_DECODER_STATE_BYTES: usize = 104;
 const _: () = assert!(core::mem::size_of::<hwfoc::v3::Decoder>() == V3_DECODER_STATE_BYTES);
 
 /// `size_of::<hwfoc::v4::Decoder>()` on the target, checked as [`DECODER_STATE_BYTES`] is.
-pub const V4_DECODER_STATE_BYTES: usize = 176;
+pub const V4_DECODER_STATE_BYTES: usize = 184;
 const _: () = assert!(core::mem::size_of::<hwfoc::v4::Decoder>() == V4_DECODER_STATE_BYTES);
 
 /// `size_of::<hwfoc::hw5::Decoder>()` on the target, checked as [`DECODER_STATE_BYTES`] is.
-pub const HW5_DECODER_STATE_BYTES: usize = 164;
+pub const HW5_DECODER_STATE_BYTES: usize = 168;
 const _: () = assert!(core::mem::size_of::<hwfoc::hw5::Decoder>() == HW5_DECODER_STATE_BYTES);
 
-/// `size_of::<hwfoc::dronecan::Receiver>()` (16 reassembly slots, statistics of every node id)
+/// `size_of::<hwfoc::dronecan::Receiver>()` (128 reassembly slots, one per node id, and statistics of every node id)
 /// on the target, checked as [`DECODER_STATE_BYTES`] is.
-pub const DRONECAN_RECEIVER_STATE_BYTES: usize = 21600;
+pub const DRONECAN_RECEIVER_STATE_BYTES: usize = 33332;
 const _: () =
     assert!(core::mem::size_of::<hwfoc::dronecan::Receiver>() == DRONECAN_RECEIVER_STATE_BYTES);
 
