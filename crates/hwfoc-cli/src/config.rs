@@ -394,25 +394,34 @@ impl Config {
 
     /// The label of ESC `esc` read from `port`: its `[esc.N]` label, else its port's.
     pub fn label(&self, esc: usize, port: &str) -> Option<&str> {
-        let by_index = match &self.file.esc {
-            EscSection::ByIndex(escs) => u8::try_from(esc)
-                .ok()
-                .and_then(|i| escs.get(&i))
-                .and_then(|e| e.label.as_deref()),
+        self.esc_labels()
+            .into_iter()
+            .find_map(|(n, label)| (n == esc).then_some(label))
+            .or_else(|| self.port_label(port))
+    }
+
+    /// The `[esc.N]` labels, by ESC number.
+    pub fn esc_labels(&self) -> Vec<(usize, &str)> {
+        match &self.file.esc {
+            EscSection::ByIndex(escs) => escs
+                .iter()
+                .filter_map(|(&i, e)| Some((usize::from(i), e.label.as_deref()?)))
+                .collect(),
+            _ => Vec::new(),
+        }
+    }
+
+    /// The label of port `port`: `[port."NAME"]`'s, else that of its `[[esc]]` entry.
+    pub fn port_label(&self, port: &str) -> Option<&str> {
+        let from_table = self.file.port.get(port).and_then(|e| e.label.as_deref());
+        let from_list = match &self.file.esc {
+            EscSection::Ports(list) => list
+                .iter()
+                .filter(|e| e.port == port)
+                .find_map(|e| e.label.as_deref()),
             _ => None,
         };
-        let by_port = || {
-            let from_table = self.file.port.get(port).and_then(|e| e.label.as_deref());
-            let from_list = match &self.file.esc {
-                EscSection::Ports(list) => list
-                    .iter()
-                    .filter(|e| e.port == port)
-                    .find_map(|e| e.label.as_deref()),
-                _ => None,
-            };
-            from_table.or(from_list)
-        };
-        by_index.or_else(by_port)
+        from_table.or(from_list)
     }
 
     /// The ports to watch when none are named: `[monitor] ports`, then those of the older

@@ -902,3 +902,47 @@ fn an_hw5_esc_is_found_at_115200_and_shown_with_its_own_fields() {
     stop.store(true, Ordering::Relaxed);
     esc.join().unwrap();
 }
+
+/// A simulated CAN bus of three Hobbywing ESCs (nodes 10, 11, 12) watched by `monitor
+/// slcan:PTY --json`: the ESCs numbered 0, 1, 2 as `decode` numbers them, and `[esc.1]`'s
+/// label on ESC 1 only.
+#[test]
+fn can_escs_are_numbered_as_decode_does_and_labelled_by_number() {
+    let dir = tempfile::tempdir().unwrap();
+    let config = dir.path().join("monitor.toml");
+    std::fs::write(&config, "[esc.1]\nlabel = \"left\"\n").unwrap();
+    let sim = Running::start(&["simulate", "--protocol", "hw-can", "--escs", "3", "--pty"]);
+    let line = sim.wait_for_stdout("slcan: ", Duration::from_secs(20));
+    let bus = format!("slcan:{}", line.trim_start_matches("slcan: ").trim());
+    let out = hwfoc()
+        .args([
+            "monitor",
+            &bus,
+            "--json",
+            "--interval",
+            "0.5",
+            "--duration",
+            "3",
+        ])
+        .arg("--config")
+        .arg(&config)
+        .output()
+        .expect("spawn");
+    let out = ok(out);
+    // Every status line counts: an ESC never shown under another number, even at first.
+    let mut seen = std::collections::BTreeMap::new();
+    for l in lines(&out.stdout) {
+        let v: Value = serde_json::from_str(&l).unwrap_or_else(|e| panic!("{e}: {l}"));
+        if v["type"] == "status" && v["record"].is_object() {
+            let label = seen
+                .entry(v["esc"].as_u64().unwrap())
+                .or_insert(Value::Null);
+            assert!(label.is_null() || *label == v["label"], "{l}");
+            *label = v["label"].clone();
+        }
+    }
+    let numbers: Vec<u64> = seen.keys().copied().collect();
+    assert_eq!(numbers, [0, 1, 2], "{seen:?}");
+    assert_eq!(seen[&1], "left", "{seen:?}");
+    assert!(seen[&0].is_null() && seen[&2].is_null(), "{seen:?}");
+}

@@ -229,6 +229,16 @@ impl MonitorSetup {
     pub fn label(&self, esc: usize, port: &str) -> Option<&str> {
         self.general.label(esc, port)
     }
+
+    /// The file's `[esc.N]` labels, by ESC number.
+    pub fn esc_labels(&self) -> Vec<(usize, &str)> {
+        self.general.esc_labels()
+    }
+
+    /// The label the file gives port `port` itself, if any.
+    pub fn port_label(&self, port: &str) -> Option<&str> {
+        self.general.port_label(port)
+    }
 }
 
 fn invalid(origin: String, message: impl Into<String>) -> CliError {

@@ -2,7 +2,7 @@
 //! alarms and the alarm log. No terminal here: the dashboard and the headless printers only
 //! read it.
 
-use std::collections::{HashMap, VecDeque};
+use std::collections::{BTreeMap, HashMap, VecDeque};
 
 use hwfoc::Settings;
 use hwfoc::telemetry::Info;
@@ -442,6 +442,10 @@ pub struct Fleet {
     ports: Vec<usize>,
     /// The ESC shown for each channel heard of each port that turned out to be a DataLink hub.
     channels: HashMap<(usize, usize), usize>,
+    /// Labels by ESC number (`[esc.N]`), for a hub's channels and a bus's ESCs.
+    esc_labels: BTreeMap<usize, String>,
+    /// Each port's own label (by flag or port name), for its channels with no label by number.
+    port_labels: Vec<Option<String>>,
 }
 
 impl Fleet {
@@ -500,6 +504,8 @@ impl Fleet {
             streams,
             ports: (0..escs.len()).collect(),
             channels: HashMap::new(),
+            esc_labels: BTreeMap::new(),
+            port_labels: Vec::new(),
             escs,
             log: VecDeque::new(),
             notices: Vec::new(),
@@ -508,6 +514,13 @@ impl Fleet {
             peak_total_w: None,
             limits,
         }
+    }
+
+    /// Labels a hub's channels and a bus's ESCs by their ESC number (`by_esc`), else by their
+    /// port's own label (`by_port`, one per port).
+    pub fn set_labels(&mut self, by_esc: BTreeMap<usize, String>, by_port: Vec<Option<String>>) {
+        self.esc_labels = by_esc;
+        self.port_labels = by_port;
     }
 
     /// Reads protocol `protocol` only, on every port (call it before the first event).
@@ -675,7 +688,6 @@ impl Fleet {
             view.info = None;
             view.alarms = Alarms::default();
             view.recent.clear();
-            view.label = None;
             self.escs.push(view);
             self.ports.push(port);
             self.escs.len() - 1
@@ -683,6 +695,11 @@ impl Fleet {
             port
         };
         // A CAN ESC by its bus and node (named in full from its link: `can_name`).
+        self.escs[i].label = self
+            .esc_labels
+            .get(&usize::from(esc))
+            .or_else(|| self.port_labels.get(port).and_then(Option::as_ref))
+            .cloned();
         self.escs[i].name = match r.node {
             Some(node) => format!("{name} node {node}"),
             None => format!("{name} channel {channel}"),

@@ -235,6 +235,18 @@ impl Session {
                 (ports, feed)
             }
         };
+        // A port's own label: its flag, else the file's for its name (a bus's ESCs and a
+        // hub's channels are labelled by ESC number first).
+        let port_labels: Vec<Option<String>> = names
+            .iter()
+            .enumerate()
+            .map(|(i, name)| {
+                args.labels
+                    .get(i)
+                    .cloned()
+                    .or_else(|| config.port_label(name).map(str::to_string))
+            })
+            .collect();
         let labelled = names
             .iter()
             .enumerate()
@@ -264,6 +276,14 @@ impl Session {
             config.limits.clone(),
             baud,
             now,
+        );
+        fleet.set_labels(
+            config
+                .esc_labels()
+                .into_iter()
+                .map(|(esc, label)| (esc, label.to_string()))
+                .collect(),
+            port_labels,
         );
         if let Some(protocol) = config.protocol {
             fleet.force_protocol(protocol);
