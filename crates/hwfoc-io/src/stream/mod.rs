@@ -6,7 +6,7 @@
 //! becomes the time of each of its bytes.
 
 use hwfoc::counters::{PacketSequence, PacketSequence24};
-use hwfoc::telemetry::{Data, Frame};
+use hwfoc::telemetry::{Data, Frame, Info};
 use hwfoc::{Protocol, Settings, foc};
 use hwfoc::{datalink, detect, hw5, mixed, v3, v4};
 
@@ -229,7 +229,8 @@ impl Wire {
             Wire::HwV4(d) => feed_one(d, data, silent, detect::Decoded::HwV4, &mut emit),
             Wire::HwV3(d) => feed_one(d, data, silent, detect::Decoded::HwV3, &mut emit),
             Wire::Hw5(d) => feed_one(d, data, silent, detect::Decoded::Hw5, &mut emit),
-            _ => {}
+            Wire::Any(_) | Wire::HwFoc(_) | Wire::DataLink(_) | Wire::Can(_) | Wire::NotCan(..) => {
+            }
         }
     }
 
@@ -255,7 +256,8 @@ impl Wire {
             Wire::HwV4(d) => d.flush(|d| emit_any(detect::Decoded::HwV4(d), &mut emit)),
             Wire::HwV3(d) => d.flush(|d| emit_any(detect::Decoded::HwV3(d), &mut emit)),
             Wire::Hw5(d) => d.flush(|d| emit_any(detect::Decoded::Hw5(d), &mut emit)),
-            _ => {}
+            Wire::Any(_) | Wire::HwFoc(_) | Wire::DataLink(_) | Wire::Can(_) | Wire::NotCan(..) => {
+            }
         }
     }
 
@@ -292,7 +294,7 @@ impl Wire {
         match self {
             Wire::Any(d) => Some(&d.mixed_stats().esc),
             Wire::HwFoc(d) | Wire::NotCan(d, _) => Some(d.stats()),
-            _ => None,
+            Wire::DataLink(_) | Wire::HwV4(_) | Wire::HwV3(_) | Wire::Hw5(_) | Wire::Can(_) => None,
         }
     }
 
@@ -301,7 +303,12 @@ impl Wire {
         match self {
             Wire::Any(d) => Some(&d.mixed_stats().hub),
             Wire::DataLink(d) => Some(d.stats()),
-            _ => None,
+            Wire::HwFoc(_)
+            | Wire::HwV4(_)
+            | Wire::HwV3(_)
+            | Wire::Hw5(_)
+            | Wire::Can(_)
+            | Wire::NotCan(..) => None,
         }
     }
 
@@ -455,7 +462,7 @@ impl EscLink {
             EscLink::HwV3(s) => s.frames(),
             EscLink::Hw5(s) => s.telemetry_frames(),
             EscLink::Can(c) => c.records,
-            _ => match self.counting() {
+            EscLink::Wire(_) | EscLink::Hub { .. } => match self.counting() {
                 Some(Counting::Bits16(c)) => c.count(),
                 Some(Counting::Bits24(c)) => c.count(),
                 None => 0,
@@ -497,7 +504,7 @@ impl EscLink {
         match self {
             EscLink::HwV4(s) => Some(s.rejected()),
             EscLink::HwV3(s) => Some(s.rejected()),
-            _ => None,
+            EscLink::Wire(_) | EscLink::Hub { .. } | EscLink::Hw5(_) | EscLink::Can(_) => None,
         }
     }
 
@@ -576,11 +583,16 @@ impl EscLink {
         }
     }
 
-    /// The V4 info frame whose constants were adopted (two identical copies in a row), if any.
-    pub fn adopted_info(&self) -> Option<v4::InfoFrame> {
+    /// The info frame whose constants were adopted (two identical copies in a row), if any: a
+    /// format whose description has [`adopted_info`](hwfoc::format::FormatDescription) (V4).
+    pub fn adopted_info(&self) -> Option<Info> {
         match self {
-            EscLink::HwV4(s) => s.adopted(),
-            _ => None,
+            EscLink::HwV4(s) => s.adopted().map(Info::HwV4),
+            EscLink::Wire(_)
+            | EscLink::Hub { .. }
+            | EscLink::HwV3(_)
+            | EscLink::Hw5(_)
+            | EscLink::Can(_) => None,
         }
     }
 }
@@ -642,7 +654,13 @@ impl Stream {
     pub fn left_out(&self) -> Vec<(Protocol, u64)> {
         match &self.wire {
             Wire::Can(c) => c.left_out(),
-            _ => Vec::new(),
+            Wire::Any(_)
+            | Wire::HwFoc(_)
+            | Wire::DataLink(_)
+            | Wire::HwV4(_)
+            | Wire::HwV3(_)
+            | Wire::Hw5(_)
+            | Wire::NotCan(..) => Vec::new(),
         }
     }
 
@@ -663,7 +681,13 @@ impl Stream {
                 .iter()
                 .map(|c| c.to_string())
                 .collect(),
-            _ => Vec::new(),
+            Wire::Any(_)
+            | Wire::HwFoc(_)
+            | Wire::DataLink(_)
+            | Wire::HwV4(_)
+            | Wire::HwV3(_)
+            | Wire::Hw5(_)
+            | Wire::NotCan(..) => Vec::new(),
         }
     }
 
@@ -778,7 +802,17 @@ impl Stream {
             // summary of an HW5 file does not need two cores).
             (Wire::HwFoc(a), Wire::HwFoc(b)) => a.then(b, first_packet),
             (Wire::DataLink(a), Wire::DataLink(b)) => a.then(b, first_packet),
-            _ => false,
+            (
+                Wire::Any(_)
+                | Wire::HwFoc(_)
+                | Wire::DataLink(_)
+                | Wire::HwV4(_)
+                | Wire::HwV3(_)
+                | Wire::Hw5(_)
+                | Wire::Can(_)
+                | Wire::NotCan(..),
+                _,
+            ) => false,
         }
     }
 
