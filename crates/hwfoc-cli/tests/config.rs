@@ -776,7 +776,7 @@ fn set_key_value_sets_the_formats_own_settings_by_their_descriptions_keys() {
     };
     let hv = comment(&["--v4-volts-per-step", "hv"]);
     assert!(hv.contains(" v4_volts_per_step=11/650 "), "{hv}");
-    for setting in hwfoc::format::SettingDescription::all() {
+    for setting in hwfoc::Protocol::settings() {
         let key = setting.key;
         assert_eq!(comment(&["--set", &format!("{key}=hv")]), hv);
         assert_eq!(

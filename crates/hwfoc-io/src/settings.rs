@@ -23,7 +23,8 @@
 use std::collections::BTreeMap;
 use std::fmt;
 
-use hwfoc::format::{SettingDescription, SettingError};
+use hwfoc::Protocol;
+use hwfoc::protocol::SettingError;
 use hwfoc::v4::VoltsPerStep;
 use hwfoc::{Settings, SettingsError};
 
@@ -139,7 +140,7 @@ impl SettingsPatch {
     }
 
     /// The patch that sets a format's own setting, `key` (a key of a format's description:
-    /// [`SettingDescription`], `-` and `_` alike) to `value`: what `--set KEY=VALUE` gives.
+    /// [`SettingDescription`](hwfoc::format::SettingDescription), `-` and `_` alike) to `value`: what `--set KEY=VALUE` gives.
     ///
     /// ```
     /// use hwfoc::v4::VoltsPerStep;
@@ -149,12 +150,12 @@ impl SettingsPatch {
     /// assert_eq!(patch.v4_volts_per_step, Some(VoltsPerStep::HIGH_VOLTAGE));
     /// assert!(SettingsPatch::format_setting("v4_volts_per_step", "8/0").is_err());
     /// assert!(SettingsPatch::format_setting("no_such_key", "1").is_err());
-    /// # Ok::<(), hwfoc::format::SettingError>(())
+    /// # Ok::<(), hwfoc::protocol::SettingError>(())
     /// ```
     pub fn format_setting(key: &str, value: &str) -> Result<SettingsPatch, SettingError> {
+        let setting = Protocol::setting(key).ok_or(SettingError::UnknownKey)?;
         let mut settings = Settings::DEFAULT;
-        SettingDescription::set(&mut settings, key, value)?;
-        let setting = SettingDescription::find(key).ok_or(SettingError::UnknownKey)?;
+        Protocol::apply_setting(&mut settings, setting.key, value)?;
         let mut patch = SettingsPatch::default();
         let (_, field) = FORMAT_FIELDS
             .iter()
@@ -195,7 +196,7 @@ impl SettingsPatch {
 type SetField = fn(&Settings, &mut SettingsPatch);
 
 /// The patch's field of each format setting, by the setting's key
-/// ([`SettingDescription::key`]): what [`SettingsPatch::format_setting`] sets from the
+/// ([`SettingDescription::key`](hwfoc::format::SettingDescription::key)): what [`SettingsPatch::format_setting`] sets from the
 /// [`Settings`] the description's `apply` wrote (a test checks that every format setting has
 /// one).
 const FORMAT_FIELDS: [(&str, SetField); 1] = [("v4_volts_per_step", |s, p| {
@@ -291,9 +292,9 @@ impl SettingsMap {
 mod tests {
     #[test]
     fn every_format_setting_has_a_patch_field_and_its_default() {
-        let keys: Vec<&str> = SettingDescription::all().map(|s| s.key).collect();
+        let keys: Vec<&str> = Protocol::settings().map(|s| s.key).collect();
         assert!(!keys.is_empty());
-        for setting in SettingDescription::all() {
+        for setting in Protocol::settings() {
             let patch = SettingsPatch::format_setting(setting.key, setting.default)
                 .unwrap_or_else(|e| panic!("{}: {e}", setting.key));
             assert!(!patch.is_empty(), "{}", setting.key);

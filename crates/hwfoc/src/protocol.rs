@@ -4,9 +4,9 @@
 
 use core::fmt;
 
-use crate::format::FormatDescription;
+use crate::format::{FormatDescription, SettingDescription};
 use crate::status::Status;
-use crate::units::Quantity;
+use crate::units::{Quantity, Settings};
 
 /// Declares [`Protocol`] from the list of formats, one line each (its arm, documentation and
 /// [`FormatDescription`]), with [`Protocol::ALL`] and [`Protocol::description`]: adding a
@@ -234,6 +234,86 @@ impl Protocol {
             .find(|p| p.name().eq_ignore_ascii_case(name))
     }
 }
+
+impl Protocol {
+    /// Every format's own settings, in the order of [`Protocol::ALL`].
+    pub fn settings() -> impl Iterator<Item = &'static SettingDescription> {
+        Protocol::ALL
+            .into_iter()
+            .flat_map(|p| p.description().settings.iter())
+    }
+
+    /// The format setting whose key is `key` (`-` and `_` alike, any case).
+    pub fn setting(key: &str) -> Option<&'static SettingDescription> {
+        let norm = |c: u8| {
+            if c == b'-' {
+                b'_'
+            } else {
+                c.to_ascii_lowercase()
+            }
+        };
+        let same = |a: &str| {
+            a.len() == key.len() && a.bytes().zip(key.bytes()).all(|(x, y)| norm(x) == norm(y))
+        };
+        Self::settings().find(|s| same(s.key))
+    }
+
+    /// Sets the format setting `key` to `value` in `settings`.
+    ///
+    /// ```
+    /// use hwfoc::{Protocol, Settings};
+    /// use hwfoc::v4::VoltsPerStep;
+    ///
+    /// let mut s = Settings::default();
+    /// Protocol::apply_setting(&mut s, "v4-volts-per-step", "hv")?;
+    /// assert_eq!(s.v4_volts_per_step, VoltsPerStep::HIGH_VOLTAGE);
+    /// assert!(Protocol::apply_setting(&mut s, "v4_volts_per_step", "8/0").is_err());
+    /// assert!(Protocol::apply_setting(&mut s, "nope", "1").is_err());
+    /// # Ok::<(), hwfoc::protocol::SettingError>(())
+    /// ```
+    pub fn apply_setting(
+        settings: &mut Settings,
+        key: &str,
+        value: &str,
+    ) -> Result<(), SettingError> {
+        let setting = Self::setting(key).ok_or(SettingError::UnknownKey)?;
+        (setting.apply)(settings, value).map_err(|reason| SettingError::Value {
+            key: setting.key,
+            reason,
+        })
+    }
+}
+
+/// Why a format setting was not set.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SettingError {
+    /// No format has a setting of that key.
+    UnknownKey,
+    /// The value is not one the setting takes.
+    Value {
+        /// The setting's key.
+        key: &'static str,
+        /// Why, in words.
+        reason: &'static str,
+    },
+}
+
+impl core::fmt::Display for SettingError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match self {
+            SettingError::UnknownKey => {
+                f.write_str("no format has this setting; the settings are:")?;
+                for s in Protocol::settings() {
+                    write!(f, " {}", s.key)?;
+                }
+                Ok(())
+            }
+            SettingError::Value { key, reason } => write!(f, "{key}: {reason}"),
+        }
+    }
+}
+
+impl core::error::Error for SettingError {}
 
 impl fmt::Display for Protocol {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
