@@ -674,21 +674,14 @@ impl Stream {
     /// A CAN bus's ESCs heard since the last call that claim a throttle channel another holds,
     /// in words (none for any other stream).
     pub(crate) fn take_can_clashes(&mut self) -> Vec<String> {
-        match &mut self.wire {
-            Wire::Can(c) => c
-                .wire
-                .take_clashes()
-                .iter()
-                .map(|c| c.to_string())
-                .collect(),
-            Wire::Any(_)
-            | Wire::HwFoc(_)
-            | Wire::DataLink(_)
-            | Wire::HwV4(_)
-            | Wire::HwV3(_)
-            | Wire::Hw5(_)
-            | Wire::NotCan(..) => Vec::new(),
-        }
+        let Wire::Can(c) = &mut self.wire else {
+            return Vec::new();
+        };
+        c.wire
+            .take_clashes()
+            .iter()
+            .map(|c| c.to_string())
+            .collect()
     }
 
     /// Of a serial stream forced to read one protocol: the protocol of the first frame found
