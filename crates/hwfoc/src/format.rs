@@ -33,6 +33,9 @@ pub struct FormatDescription {
     pub baud_rate: u32,
     /// What sends it: one ESC, a hub of several, or a bus.
     pub link: LinkKind,
+    /// The length in bytes of a data frame on its wire (of a CAN format: a CAN frame's 16-byte
+    /// record): how many frames a silence of the line can have hidden.
+    pub data_frame_len: usize,
     /// The width of its packet counter in bits, or `None` where it sends none.
     pub counter_bits: Option<u32>,
     /// How its frames are checked.

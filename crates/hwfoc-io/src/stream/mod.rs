@@ -43,15 +43,8 @@ pub const SILENCE_S: f64 = crate::clock::MAX_STEP_S;
 /// length of byte times at its baud rate, the fastest the line carries them (real ESCs send
 /// far fewer).
 fn frames_in_of(protocol: Protocol, seconds: f64) -> u32 {
-    let len = match protocol {
-        Protocol::HwFoc => foc::kinds::data::DATA_FRAME_LEN,
-        Protocol::DataLink => datalink::FRAME_LEN,
-        Protocol::HwV4 => v4::DATA_FRAME_LEN,
-        Protocol::HwV3 => v3::FRAME_LEN,
-        Protocol::Hw5 => hw5::TELEMETRY_LEN,
-        // Not read from a serial line (a bus's stream is not told of silences).
-        Protocol::HwCan | Protocol::DroneCan => hwfoc::dronecan::SOCKETCAN_RECORD_LEN,
-    };
+    // (A bus's stream is not told of silences: its record length is never asked here.)
+    let len = protocol.description().data_frame_len;
     let frame_s = len as f64 * hwfoc::wire::byte_ns(protocol.baud_rate()) * 1e-9;
     (seconds / frame_s).ceil().min(f64::from(u32::MAX)) as u32
 }

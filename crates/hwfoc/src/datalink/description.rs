@@ -13,6 +13,7 @@ pub const DESCRIPTION: FormatDescription = FormatDescription {
     link: LinkKind::Hub {
         channels: super::CHANNELS as u8,
     },
+    data_frame_len: super::FRAME_LEN,
     check: Check::Checksum(Checksum::Crc16Xmodem),
     adopted_info: None,
     info_keys: &[],

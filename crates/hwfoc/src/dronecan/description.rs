@@ -11,6 +11,7 @@ pub const HW_CAN: FormatDescription = FormatDescription {
     title: "Hobbywing DroneCAN",
     baud_rate: super::HOBBYWING_BITRATE,
     link: LinkKind::Bus,
+    data_frame_len: super::SOCKETCAN_RECORD_LEN,
     counter_bits: None,
     check: Check::CanTransfer,
     frame_period: None,

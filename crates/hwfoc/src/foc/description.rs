@@ -14,6 +14,7 @@ pub const DESCRIPTION: FormatDescription = FormatDescription {
     title: "HW-FOC",
     baud_rate: super::BAUD_RATE,
     link: LinkKind::OneEsc,
+    data_frame_len: super::kinds::data::DATA_FRAME_LEN,
     counter_bits: Some(16),
     check: Check::Checksum(Checksum::Sum16Le),
     frame_period: Some(Duration::from_millis(50)),

@@ -12,6 +12,7 @@ pub const DESCRIPTION: FormatDescription = FormatDescription {
     title: "HW5",
     baud_rate: super::BAUD_RATE,
     link: LinkKind::OneEsc,
+    data_frame_len: super::TELEMETRY_LEN,
     counter_bits: None,
     check: Check::Checksum(Checksum::Crc16Modbus),
     frame_period: Some(super::FRAME_PERIOD_RUNNING),

@@ -12,6 +12,7 @@ pub const DESCRIPTION: FormatDescription = FormatDescription {
     title: "Hobbywing V3",
     baud_rate: super::BAUD_RATE,
     link: LinkKind::OneEsc,
+    data_frame_len: super::FRAME_LEN,
     counter_bits: Some(24),
     check: Check::None,
     frame_period: Some(Duration::from_micros(19_500)),

@@ -17,6 +17,7 @@ pub const DESCRIPTION: FormatDescription = FormatDescription {
     title: "Hobbywing V4",
     baud_rate: super::BAUD_RATE,
     link: LinkKind::OneEsc,
+    data_frame_len: super::DATA_FRAME_LEN,
     counter_bits: Some(24),
     check: Check::None,
     frame_period: Some(Duration::from_millis(51)),
