@@ -345,4 +345,25 @@ mod tests {
         assert_eq!(Protocol::HwV3.packets_between(0xFF_FFFF, 0), Some(1));
         assert_eq!(Protocol::Hw5.packets_between(1, 2), None);
     }
+
+    #[test]
+    fn the_list_makes_the_serial_protocols_and_each_description_is_its_own() {
+        use Protocol as P;
+        assert_eq!(
+            Protocol::SERIAL,
+            [P::HwFoc, P::DataLink, P::HwV4, P::HwV3, P::Hw5]
+        );
+        for p in Protocol::ALL {
+            let d = p.description();
+            assert_eq!(d.is_can(), !Protocol::SERIAL.contains(&p));
+            // A format with fault bits names each of them once.
+            assert!(d.faults.len() <= 16);
+            for (bit, f) in d.faults.iter().enumerate() {
+                assert_eq!(p.fault_name(bit as u8), Some(f.name));
+                assert_eq!(d.faults.iter().filter(|g| g.name == f.name).count(), 1);
+            }
+            // Frames of a serial format are timed at its period; a bus's come with times.
+            assert_eq!(d.frame_period.is_some(), !d.is_can(), "{p}");
+        }
+    }
 }
