@@ -955,15 +955,16 @@ mod tests {
 
     #[test]
     fn a_v4_device_line_is_its_info_fields_by_their_description() {
+        // The Platinum V4 capture's info frame (the fields not given are 0).
+        let (v1, v2, i2, t) = (8, 91, 1, 0x21);
         let v4 = hwfoc::v4::InfoFrame {
             full_scale: 1000,
-            v1: 8,
-            v2: 91,
-            i1: 0,
-            i2: 1,
-            i3: 0,
-            t1: 0x21,
-            t2: 0x21,
+            v1,
+            v2,
+            i2,
+            t1: t,
+            t2: t,
+            ..Default::default()
         };
         assert_eq!(
             adopted_info_line(&Info::HwV4(v4), true),
