@@ -472,10 +472,11 @@ impl EscLink {
         }
     }
 
-    /// Whether the link's frames carry a checksum (V3 and V4 do not: their frames are
-    /// recognised by plausibility and chaining, see [`EscLink::rejected_frames`]).
+    /// Whether the link's frames are checked (its format's description: V3 and V4 are not,
+    /// their frames are recognised by plausibility and chaining, see
+    /// [`EscLink::rejected_frames`]).
     pub fn has_checksum(&self) -> bool {
-        !matches!(self, EscLink::HwV4(_) | EscLink::HwV3(_))
+        self.protocol().description().check != hwfoc::format::Check::None
     }
 
     /// Frames rejected by their checksum, or whose checksum matched but whose values are out of
