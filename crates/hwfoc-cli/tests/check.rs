@@ -8,13 +8,12 @@ use std::path::{Path, PathBuf};
 
 use common::{Dir, hwfoc, run};
 
-use hwfoc::{Protocol, Settings};
+use hwfoc::Settings;
 use hwfoc_io::Record;
 use hwfoc_io::check::{
     Analyser, Baseline, CheckConfig, EscId, EscSeries, Finding, Sample, Severity, analyse,
 };
 use hwfoc_sim::degrade::{DegradeKind, DegradeSpec};
-use hwfoc_sim::faults::LinkRates;
 use hwfoc_sim::fleet::FleetSpec;
 use hwfoc_sim::model::ModelConfig;
 use hwfoc_sim::profile::{ProfileSpec, Shape};
@@ -46,21 +45,17 @@ fn healthy(i: u64) -> FleetSpec {
     let levels: Vec<f64> = (0..5)
         .map(|_| (d.between(0.0, 100.0) / 5.0).round() * 5.0)
         .collect();
-    FleetSpec {
-        n: 3 + (i % 6) as usize,
-        seed: 1000 + i,
-        protocol: Protocol::HwFoc,
-        baud: 19200,
-        start_packet: None,
-        profile,
-        shape: Shape {
+    let mut spec = FleetSpec::steps(
+        3 + (i % 6) as usize,
+        1000 + i,
+        Shape {
             lead_in_s: d.between(0.5, 3.0),
             levels: [vec![0.0], levels, vec![0.0]].concat(),
             hold_s: d.between(1.0, 5.0),
             period_s: d.between(4.0, 15.0),
             max_pct: d.between(40.0, 100.0),
         },
-        model: ModelConfig {
+        ModelConfig {
             kv: d.between(300.0, 1500.0),
             pole_pairs: 7,
             full_current_a: d.between(15.0, 90.0),
@@ -70,10 +65,10 @@ fn healthy(i: u64) -> FleetSpec {
             ambient_c: d.between(5.0, 40.0),
             current_scale: 64.0,
         },
-        faults: Vec::new(),
-        link: LinkRates::default(),
-        degradations: Vec::new(),
-    }
+        Vec::new(),
+    );
+    spec.profile = profile;
+    spec
 }
 
 /// The ESCs' series of `spec` flown for `seconds`, generated in-process: each intact data frame
@@ -154,14 +149,10 @@ fn two_hundred_healthy_simulated_flights_raise_no_warning() {
 /// The airframe of the degradation tests: four ESCs on a staircase of throttle levels held 4 s
 /// each, `degradations` applied, seed `seed`.
 fn airframe(seed: u64, ambient_c: f64, degradations: Vec<DegradeSpec>) -> FleetSpec {
-    FleetSpec {
-        n: 4,
+    FleetSpec::steps(
+        4,
         seed,
-        protocol: Protocol::HwFoc,
-        baud: 19200,
-        start_packet: None,
-        profile: ProfileSpec::Steps,
-        shape: Shape {
+        Shape {
             lead_in_s: 1.0,
             levels: vec![
                 0.0, 30.0, 50.0, 70.0, 40.0, 60.0, 80.0, 50.0, 30.0, 60.0, 45.0, 0.0,
@@ -170,7 +161,7 @@ fn airframe(seed: u64, ambient_c: f64, degradations: Vec<DegradeSpec>) -> FleetS
             period_s: 10.0,
             max_pct: 80.0,
         },
-        model: ModelConfig {
+        ModelConfig {
             kv: 500.0,
             pole_pairs: 7,
             full_current_a: 60.0,
@@ -180,10 +171,8 @@ fn airframe(seed: u64, ambient_c: f64, degradations: Vec<DegradeSpec>) -> FleetS
             ambient_c,
             current_scale: 64.0,
         },
-        faults: Vec::new(),
-        link: LinkRates::default(),
         degradations,
-    }
+    )
 }
 
 /// ESC `esc` degraded by `kind` from `start_s` at `severity`.
