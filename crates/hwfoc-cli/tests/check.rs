@@ -214,11 +214,18 @@ fn found(
     baseline: Option<&Baseline>,
     analyser: Analyser,
 ) -> Vec<Finding> {
-    let series = fly(
-        airframe(AIRFRAME, ambient_c, degradations),
-        seconds,
-        "degraded",
-    );
+    let spec = airframe(AIRFRAME, ambient_c, degradations);
+    found_in(spec, seconds, baseline, analyser)
+}
+
+/// The warnings and critical findings of `analyser` on the flight of `spec`.
+fn found_in(
+    spec: FleetSpec,
+    seconds: f64,
+    baseline: Option<&Baseline>,
+    analyser: Analyser,
+) -> Vec<Finding> {
+    let series = fly(spec, seconds, "degraded");
     let findings = analyse(&series, &CheckConfig::default(), baseline);
     let all: Vec<Finding> = findings
         .into_iter()
@@ -273,6 +280,25 @@ fn a_damaged_prop_is_found_as_imbalance_and_as_drift_on_its_esc_from_when_it_sta
             .iter()
             .all(|f| f.threshold.as_ref().unwrap().name == "rpm_per_throttle")
     );
+}
+
+/// [`airframe`] [`AIRFRAME`] flying a sine of throttle (8 s a cycle, up to 80 %): the throttle
+/// never holds, as in a real flight.
+fn sine(degradations: Vec<DegradeSpec>) -> FleetSpec {
+    let mut spec = airframe(AIRFRAME, 25.0, degradations);
+    spec.profile = ProfileSpec::Sine;
+    spec.shape.period_s = 8.0;
+    spec
+}
+
+#[test]
+fn a_damaged_prop_is_found_as_imbalance_while_the_throttle_moves() {
+    let prop = degrade(1, DegradeKind::Prop, 15.0, 1.0);
+    let imbalance = found_in(sine(prop), 50.0, None, Analyser::Imbalance);
+    on_esc_in_window(&imbalance, 1, 15.0, 5.0, 45.0);
+    // Healthy, the same moving flight is balanced.
+    let healthy = found_in(sine(Vec::new()), 50.0, None, Analyser::Imbalance);
+    assert!(healthy.is_empty(), "{healthy:#?}");
 }
 
 #[test]
