@@ -103,6 +103,7 @@ fn fly(spec: FleetSpec, seconds: f64, recording: &str) -> Vec<EscSeries> {
                 protocol: esc.protocol(),
                 timed: true,
                 link: None,
+                maintenance_min: None,
                 samples,
             }
         })
