@@ -643,3 +643,63 @@ fn the_real_captures_give_no_finding_the_capture_does_not_show() {
     }
     assert!(read >= 8, "only {read} captures read");
 }
+
+#[test]
+fn a_can_esc_s_maintenance_answer_in_its_recording_is_judged_against_the_service_interval() {
+    use hwfoc::dronecan::{GetMaintenanceInformationResponse, Message};
+    let dir = Dir::new();
+    let path = dir.arg("bus.log");
+    let out = run(hwfoc().args([
+        "simulate",
+        "--protocol",
+        "hw-can",
+        "--escs",
+        "4",
+        "--duration",
+        "10",
+        "-q",
+        "-o",
+        &path,
+    ]));
+    assert!(out.status.success(), "{}", common::stdout(&out));
+    // Node 11 (ESC 1) answers a GetMaintenanceInformation request, as on a bus where `hwfoc
+    // can list` asked: 150 h turned, 55 h (3300 min) since its last maintenance.
+    let mut log = std::fs::read_to_string(&path).unwrap();
+    let last: f64 = log.lines().last().unwrap()[1..18].parse().unwrap();
+    let answer = Message::from(GetMaintenanceInformationResponse {
+        total_rotation_time_min: 9000,
+        time_since_maintenance_min: 3300,
+    });
+    for frame in answer.frames(24, 11, 127, 0) {
+        hwfoc_io::can::candump::push_line(&mut log, last + 0.001, "can0", &frame);
+    }
+    std::fs::write(&path, log).unwrap();
+    let (code, report) = check_json(&[&path]);
+    assert_eq!(code, 1, "{report:#}");
+    assert_eq!(raised_in(&report), [("runtime".to_string(), 1)]);
+    let runtime: Vec<&Value> = report["findings"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|f| f["analyser"] == "runtime")
+        .collect();
+    assert_eq!(runtime.len(), 4, "{report:#}");
+    let f = runtime.iter().find(|f| f["severity"] == "warning").unwrap();
+    assert!(
+        f["esc"]["label"].as_str().unwrap().contains("node 11"),
+        "{f:#}"
+    );
+    let value = |name: &str| {
+        f["values"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|v| v["name"] == name)
+            .unwrap_or_else(|| panic!("{name}: {f:#}"))["value"]
+            .as_f64()
+            .unwrap()
+    };
+    assert_eq!(value("hours_since_service"), 55.0);
+    assert_eq!(value("esc_total_rotation"), 150.0);
+    assert_eq!(f["threshold"]["value"], 50.0, "{f:#}");
+}

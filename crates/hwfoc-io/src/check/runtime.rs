@@ -37,11 +37,11 @@ pub(super) fn analyse(series: &EscSeries, config: &RuntimeConfig, out: &mut Vec<
         f = f.value("esc_total_rotation", total_h, "h");
     }
     let mut f = f.judged(
-            severity,
-            "hours_since_service",
-            limits.crossed(severity),
-            "h",
-        );
+        severity,
+        "hours_since_service",
+        limits.crossed(severity),
+        "h",
+    );
     let source = match counted {
         Some((total_h, _)) => format!(
             " by the ESC's own counter ({total_h:.2} h turned in all; GetMaintenanceInformation)"
@@ -124,14 +124,22 @@ mod tests {
         };
         let mut out = Vec::new();
         // 55 h since maintenance (3300 min) of 100 h turned: over the 50 h interval.
-        analyse(&idle(Some((6000, 3300))), &RuntimeConfig::default(), &mut out);
+        analyse(
+            &idle(Some((6000, 3300))),
+            &RuntimeConfig::default(),
+            &mut out,
+        );
         // Just serviced (0 min): ok, whatever `hours_before` says.
         analyse(&idle(Some((6000, 0))), &config, &mut out);
         assert_eq!(out[0].severity, Severity::Warning, "{out:?}");
         assert_eq!(out[0].values[1].value, 55.0);
         assert_eq!(out[0].values[2].name, "esc_total_rotation");
         assert_eq!(out[0].values[2].value, 100.0);
-        assert!(out[0].message.contains("ESC's own counter"), "{}", out[0].message);
+        assert!(
+            out[0].message.contains("ESC's own counter"),
+            "{}",
+            out[0].message
+        );
         assert_eq!(out[1].severity, Severity::Ok, "{out:?}");
         // 76 h: past 1.5 times the interval.
         analyse(&idle(Some((6000, 76 * 60))), &config, &mut out);
