@@ -20,7 +20,7 @@ mod column;
 pub mod columns;
 mod text;
 
-pub use column::{Column, FaultList, UtcTime, Value, Visitor};
+pub use column::{Column, Cons, FaultList, Nil, UtcTime, Value, Visitor};
 pub use columns::{COLUMNS, Record, TEXT_COLUMNS, UNITS};
 pub use text::TextEncoder;
 
