@@ -7,7 +7,7 @@ pub use hwfoc_records::record::*;
 pub use crate::write::stored::{StoredColumn as Column, Visitor};
 
 /// The columns of the schema ([`hwfoc_records::record::columns`]), walked by this crate's
-/// writers with [`visit`].
+/// writers with [`visit`](columns::visit).
 pub mod columns {
     pub use crate::write::stored::visit;
     pub use hwfoc_records::record::columns::*;

@@ -50,7 +50,7 @@ pub trait Column: 'static {
 /// A type a column's values may have: `f32`, `Option<f32>`, `Option<f64>`, `u8`, `u16`, `u32`,
 /// [`Status`] (an unsigned 16-bit word) and [`FaultList`].
 ///
-/// Each format says how it stores such a value: text (JSON and CSV, [`TextValue`]), and the
+/// Each format says how it stores such a value: text (JSON and CSV, `TextValue`), and the
 /// binary writers of `hwfoc-io` (Arrow: type, arrays; Parquet: physical type, levels), which
 /// implement their own traits for these types. A new value type implements them all; a new
 /// column of an existing value type needs none of it.
