@@ -1780,3 +1780,68 @@ fn garbage_can_frames_do_not_make_the_dissector_fail() {
         random.len()
     );
 }
+
+/// 24 nodes sending `esc.Status` at once (issue 29): each round the first frames of all 24
+/// transfers, then their second frames, then their third, 20 rounds. `decode` gives all 480
+/// records, node by node as the dissector reassembles them (all 480 transfers, each CRC ok).
+#[test]
+#[ignore = "needs tshark: .ci/run installs it and runs these with --ignored"]
+fn twenty_four_nodes_sending_esc_status_at_once_decode_as_they_dissect() {
+    use hwfoc::dronecan::{EscStatus, Message};
+    use std::collections::BTreeMap;
+    need_tshark();
+    const NODES: u8 = 24;
+    const ROUNDS: u8 = 20;
+    let mut records: Vec<Vec<u8>> = Vec::new();
+    for round in 0..ROUNDS {
+        let transfers: Vec<Vec<_>> = (1..=NODES)
+            .map(|node| {
+                let status = EscStatus {
+                    error_count: 0,
+                    voltage: 24.0,
+                    current: 1.5,
+                    temperature: 300.0,
+                    rpm: 1000 + i32::from(round),
+                    power_rating_pct: 10,
+                    esc_index: node - 1,
+                };
+                Message::from(status)
+                    .frames(16, node, 0, round % 32)
+                    .collect()
+            })
+            .collect();
+        assert!(
+            transfers[0].len() > 1,
+            "esc.Status is a multi-frame transfer"
+        );
+        for k in 0..transfers[0].len() {
+            for t in &transfers {
+                records.push(t[k].to_socketcan_record().to_vec());
+            }
+        }
+    }
+    let dir = common::Dir::new();
+    let file = dir.path("24-nodes.pcapng");
+    can_pcapng(&file, &records);
+    let mut decoded: BTreeMap<u64, usize> = BTreeMap::new();
+    for r in decode(&file, &[]) {
+        *decoded.entry(r["node"].as_u64().unwrap()).or_default() += 1;
+    }
+    let fields = [
+        "dronecan.source",
+        "dronecan.esc.status.esc_index",
+        "dronecan.crc.status",
+    ];
+    let (rows, _) = tshark_can(&file, &fields);
+    assert_eq!(rows.len(), records.len());
+    let mut shown: BTreeMap<u64, usize> = BTreeMap::new();
+    for row in rows.iter().filter(|r| !r[1].is_empty()) {
+        assert_eq!(row[2], "1", "CRC of a reassembled transfer: {row:?}");
+        *shown.entry(row[0].parse().unwrap()).or_default() += 1;
+    }
+    let all: BTreeMap<u64, usize> = (1..=u64::from(NODES))
+        .map(|n| (n, usize::from(ROUNDS)))
+        .collect();
+    assert_eq!(shown, all, "the dissector's transfers by node");
+    assert_eq!(decoded, all, "decode's records by node");
+}
