@@ -1845,3 +1845,69 @@ fn twenty_four_nodes_sending_esc_status_at_once_decode_as_they_dissect() {
     assert_eq!(shown, all, "the dissector's transfers by node");
     assert_eq!(decoded, all, "decode's records by node");
 }
+
+/// A frame whose checksum matches but whose value is past its protocol's range (an HW-FOC
+/// input throttle of raw 16890, 1649 %; an HW5 input voltage of 506.1 V) is shown rejected, with
+/// the value named, as `decode` rejects it; the frames around it are shown and decoded.
+#[test]
+#[ignore = "needs tshark: .ci/run installs it and runs these with --ignored"]
+fn a_frame_past_its_range_is_rejected_as_decode_rejects_it() {
+    need_tshark();
+    let dir = common::Dir::new();
+    let foc: Vec<u8> = (0..20u16)
+        .flat_map(|packet| {
+            DataFrame {
+                packet,
+                throttle_in_raw: if packet == 10 { 16890 } else { 300 },
+                voltage_raw: 247,
+                ..Default::default()
+            }
+            .encode()
+        })
+        .collect();
+    let hw5: Vec<u8> = (0..20u16)
+        .flat_map(|n| {
+            hwfoc::hw5::TelemetryFrame {
+                throttle: 20,
+                erpm_raw: 1000 + n,
+                voltage_raw: if n == 10 { 5061 } else { 504 },
+                ..Default::default()
+            }
+            .encode()
+        })
+        .collect();
+    for (name, baud, bytes) in [("foc.pcapng", 19200, foc), ("hw5.pcapng", 115200, hw5)] {
+        let file = dir.path(name);
+        let timed: Vec<(f64, u8)> = bytes
+            .iter()
+            .enumerate()
+            .map(|(i, &b)| (i as f64 * 1e-4, b))
+            .collect();
+        record_reads(&file, baud, 1_700_000_000_000_000_000, &timed, 7);
+        assert_eq!(decode(&file, &[]).len(), 19, "{name}: decoded");
+        let mut cmd = common::tshark();
+        cmd.arg("-X")
+            .arg(format!("lua_script:{}", dissector().display()))
+            .arg("-r")
+            .arg(&file)
+            .arg("-V");
+        let out = cmd.output().expect("tshark");
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let text = String::from_utf8(out.stdout).unwrap();
+        let invalid = text.matches("[invalid, not decoded by hwfoc]").count();
+        assert_eq!(invalid, 1, "{name}: {text}");
+        let named = if baud == 19200 {
+            "input throttle 16890 over 1024"
+        } else {
+            "input voltage 5061 over 1000"
+        };
+        assert!(
+            text.contains(&format!("Out of range: {named}")),
+            "{name}: {text}"
+        );
+    }
+}
