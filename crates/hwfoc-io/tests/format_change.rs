@@ -11,7 +11,7 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 use hwfoc::Settings;
 use hwfoc::Telemetry;
 use hwfoc::telemetry::Frame;
-use hwfoc_io::{Handler, Input, InputError, Sources};
+use hwfoc_io::{Handler, Input, InputError, OpenInput, Sources};
 use proptest::prelude::*;
 
 /// The serial formats.
