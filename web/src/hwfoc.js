@@ -89,6 +89,16 @@ export function openFile(name, bytes) {
 }
 
 /**
+ * The names of a status word's set fault bits, in bit order, as a record's `faults` gives them.
+ * @param {string} protocol as `--protocol` names it (a record's `protocols[protocol]`)
+ * @param {number} status the record's `status`
+ * @returns {string[]}
+ */
+export function faultNames(protocol, status) {
+  return Array.from(wasm.faultNames(protocol, status));
+}
+
+/**
  * A recording of a port's bytes with their receive times, as `hwfoc record` writes it.
  */
 export class Recorder {

@@ -78,3 +78,14 @@ impl WasmSession {
         Ok(out)
     }
 }
+
+/// The names of the set fault bits of `status` in bit order, by `protocol` (a name
+/// `--protocol` takes), as a record's `faults` gives them; empty for an unknown protocol.
+#[wasm_bindgen(js_name = faultNames)]
+pub fn fault_names(protocol: &str, status: u16) -> Array {
+    hwfoc::Protocol::from_name(protocol)
+        .into_iter()
+        .flat_map(|p| p.fault_names(hwfoc::Status(status)))
+        .map(JsValue::from_str)
+        .collect()
+}
