@@ -71,7 +71,7 @@ test('float32Text gives the shortest decimal of a float32', () => {
 });
 
 import { View } from '../src/files/view.js';
-import { formatTick } from '../src/files/chart.js';
+import { formatTick, niceTicks } from '../src/files/chart.js';
 
 test('View zooms about a point and stays inside the recording', () => {
   const v = new View(0, 100);
@@ -87,4 +87,10 @@ test('formatTick', () => {
   assert.equal(formatTick(12.34567), '12.35');
   assert.equal(formatTick(NaN), '');
   assert.equal(formatTick(2e7), '2.00e+7');
+});
+
+test('niceTicks', () => {
+  assert.deepEqual(niceTicks(0, 10, 5), [0, 2, 4, 6, 8, 10]);
+  assert.deepEqual(niceTicks(23.4, 24.9, 3), [23.5, 24, 24.5]);
+  assert.deepEqual(niceTicks(1, 1, 3), []);
 });
