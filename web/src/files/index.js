@@ -42,17 +42,15 @@ export function mountFiles(root, api) {
   const input = root.querySelector('input[type=file]');
   const drop = root.querySelector('.drop');
   const state = { recordings: [], current: null };
+  const opener = makeOpener(api);
 
   const open = async (files) => {
     for (const file of files) {
       const bytes = new Uint8Array(await file.arrayBuffer());
       const started = performance.now();
-      let opened;
-      try {
-        opened = api.openFile(file.name, bytes);
-      } catch (e) {
-        opened = { error: `${file.name}: ${e.message ?? e}` };
-      }
+      drop.setAttribute('aria-busy', 'true');
+      const opened = await opener(file.name, bytes);
+      drop.removeAttribute('aria-busy');
       const recording = prepare(file.name, opened, performance.now() - started);
       state.recordings.push(recording);
       show(recording);
@@ -109,6 +107,51 @@ export function mountFiles(root, api) {
     plot.hidden = recording.error !== undefined || recording.records.count === 0;
     if (!plot.hidden) mountPlot(plot, recording, api);
   }
+}
+
+/**
+ * Opens a recording: in a worker where the browser has module workers (the page stays
+ * responsive while a large file is decoded), else on the page's thread.
+ * @param {typeof import('../hwfoc.js')} api
+ * @returns {(name: string, bytes: Uint8Array) => Promise<object>} openFile's answer, or {error}
+ */
+function makeOpener(api) {
+  const direct = async (name, bytes) => {
+    try {
+      return api.openFile(name, bytes);
+    } catch (e) {
+      return { error: `${name}: ${e?.message ?? e}` };
+    }
+  };
+  let worker;
+  try {
+    worker = new Worker(new URL('./worker.js', import.meta.url), { type: 'module' });
+  } catch {
+    return direct;
+  }
+  const waiting = new Map();
+  let next = 0;
+  worker.onmessage = ({ data }) => {
+    waiting.get(data.id)?.(data.error ? { error: data.error } : data.opened);
+    waiting.delete(data.id);
+  };
+  worker.onerror = (e) => {
+    // A worker that cannot start (no module workers): every open goes on the page's thread.
+    e.preventDefault?.();
+    worker = null;
+    for (const [id, done] of waiting) done(null);
+    waiting.clear();
+  };
+  return async (name, bytes) => {
+    if (!worker) return direct(name, bytes);
+    const id = next++;
+    const answer = await new Promise((done) => {
+      waiting.set(id, done);
+      // Copied, not transferred: the page keeps the bytes should the worker fail.
+      worker.postMessage({ id, name, bytes });
+    });
+    return answer ?? direct(name, bytes);
+  };
 }
 
 /**
