@@ -3,7 +3,7 @@
 
 import { Chart, COLOURS } from './chart.js';
 import { csvColumns, toCsv } from './csv.js';
-import { gather, nearest, splitByEsc, timed } from './series.js';
+import { blocks, gather, nearest, splitByEsc, timed } from './series.js';
 import { escSummary } from './summary.js';
 import { View } from './view.js';
 
@@ -195,13 +195,17 @@ function prepare(name, opened, openMs) {
 }
 
 /**
- * An ESC's values of one column, gathered once.
+ * An ESC's values of one column and their blocks' extremes, made once.
  * @param {object} recording
  * @param {object} esc
  * @param {string} name
+ * @returns {{ys: ArrayLike<number>, blocked: {min: Float32Array, max: Float32Array}}}
  */
-function ys(recording, esc, name) {
-  if (!esc.ys.has(name)) esc.ys.set(name, gather(recording.records.columns[name], esc.index));
+function series(recording, esc, name) {
+  if (!esc.ys.has(name)) {
+    const ys = gather(recording.records.columns[name], esc.index);
+    esc.ys.set(name, { ys, blocked: blocks(ys) });
+  }
   return esc.ys.get(name);
 }
 
@@ -274,7 +278,7 @@ function mountPlot(plot, recording, api) {
         const lines = recording.escs
           .map((e, k) => ({ e, colour: COLOURS[k % COLOURS.length] }))
           .filter(({ e }) => e.chosen)
-          .map(({ e, colour }) => ({ xs: e.xs, ys: ys(recording, e, q), colour }));
+          .map(({ e, colour }) => ({ xs: e.xs, ...series(recording, e, q), colour }));
         chart.draw(recording.view, lines, shaded, cursor);
       }
       showReadout();
@@ -290,7 +294,7 @@ function mountPlot(plot, recording, api) {
     for (const e of recording.escs.filter((x) => x.chosen)) {
       const k = nearest(e.xs, cursor);
       if (k < 0) continue;
-      const values = charts.map(({ q }) => `${q} ${fmt(ys(recording, e, q)[k])}`);
+      const values = charts.map(({ q }) => `${q} ${fmt(series(recording, e, q).ys[k])}`);
       parts.push(`ESC ${e.esc}: ${values.join(', ')}`);
     }
     readout.textContent = parts.join(' | ');
