@@ -86,23 +86,19 @@ pub fn open(name: &str, bytes: Vec<u8>) -> Opened {
         name: name.to_owned(),
         bytes: bytes.into(),
     };
-    let file = match memory.open() {
-        Ok(file) => file,
-        Err(e) => {
-            return Opened {
-                columns,
-                summary: "null".to_owned(),
-                notices: vec![format!("hwfoc: {name}: {e}")],
-            };
-        }
-    };
-    let mut input = match Input::from_file(name, Box::new(memory), file) {
+    let opened = memory
+        .open()
+        .map_err(|e| format!("hwfoc: {name}: {e}"))
+        .and_then(|file| {
+            Input::from_file(name, Box::new(memory), file).map_err(|e| format!("hwfoc: {e}"))
+        });
+    let mut input = match opened {
         Ok(input) => input,
-        Err(e) => {
+        Err(line) => {
             return Opened {
                 columns,
                 summary: "null".to_owned(),
-                notices: vec![format!("hwfoc: {e}")],
+                notices: vec![line],
             };
         }
     };
