@@ -1,0 +1,69 @@
+// The live mode's defaults equal the command's: the alarm levels `hwfoc monitor --help`
+// documents, and the port search and SLCAN constants of the Rust sources.
+import { test } from 'node:test';
+import assert from 'node:assert/strict';
+import { execFileSync } from 'node:child_process';
+import { existsSync, readFileSync } from 'node:fs';
+import { fileURLToPath } from 'node:url';
+import * as limits from '../../src/live/limits.js';
+
+const repo = fileURLToPath(new URL('../../../', import.meta.url));
+
+/** The hwfoc binary: $HWFOC_BIN, else the workspace's debug build. */
+export function hwfocBin() {
+  const candidates = [process.env.HWFOC_BIN, `${repo}target/debug/hwfoc`, `${repo}target/release/hwfoc`];
+  return candidates.find((p) => p && existsSync(p)) ?? null;
+}
+
+test('alarm defaults equal hwfoc monitor --help', { skip: hwfocBin() ? false : 'needs hwfoc (cargo build, or HWFOC_BIN)' }, () => {
+  const help = execFileSync(hwfocBin(), ['monitor', '--help'], { encoding: 'utf8' });
+  const documented = {};
+  for (const m of help.matchAll(/--([a-z-]+) <[A-Z]+>\s*\n\s+[^[]*?\[default: ([0-9.]+)\]/g)) {
+    documented[m[1].replaceAll('-', '_')] = Number(m[2]);
+  }
+  for (const [key, value] of Object.entries(limits.ALARM_DEFAULTS)) {
+    assert.equal(documented[key], value, `--${key.replaceAll('_', '-')}`);
+  }
+  assert.equal(Object.keys(limits.ALARM_DEFAULTS).length, 10);
+});
+
+function rust(path) {
+  return readFileSync(`${repo}${path}`, 'utf8');
+}
+
+test('port search constants equal hwfoc-io serial.rs', () => {
+  const src = rust('crates/hwfoc-io/src/serial.rs');
+  const rates = src.match(/pub const SEARCH_RATES: \[u32; \d+\] = \[([^\]]+)\]/)[1].split(',').map((s) => Number(s.trim().replaceAll('_', '')));
+  assert.deepEqual([...limits.SEARCH_RATES], rates);
+  const ms = (name) => Number(src.match(new RegExp(`pub const ${name}: Duration = Duration::from_millis\\((\\d+)\\)`))[1]);
+  assert.equal(limits.SEARCH_BYTES_FOR_MS, ms('SEARCH_BYTES_FOR'));
+  assert.equal(limits.SEARCH_SILENT_FOR_MS, ms('SEARCH_SILENT_FOR'));
+  assert.equal(limits.RETRY_EVERY_MS, ms('RETRY_EVERY'));
+  assert.equal(limits.SEARCH_LOCK_FRAMES, Number(src.match(/pub const SEARCH_LOCK_FRAMES: u32 = (\d+);/)[1]));
+});
+
+test('SLCAN constants equal hwfoc-io can/', () => {
+  const slcan = rust('crates/hwfoc-io/src/can/slcan.rs');
+  const rates = slcan.match(/pub const BITRATES: \[u32; 9\] = \[([^\]]+)\]/)[1].split(',').filter((s) => s.trim()).map((s) => Number(s.trim().replaceAll('_', '')));
+  assert.deepEqual([...limits.SLCAN_BITRATES], rates);
+  const bus = rust('crates/hwfoc-io/src/can/bus.rs');
+  assert.equal(limits.SLCAN_SERIAL_BAUD, Number(bus.match(/pub const SLCAN_BAUD: u32 = ([\d_]+);/)[1].replaceAll('_', '')));
+  assert.equal(limits.DEFAULT_CAN_BITRATE, Number(bus.match(/pub const DEFAULT_BITRATE: u32 = ([\d_]+);/)[1].replaceAll('_', '')));
+});
+
+test('cell detection and fault levels equal the monitor', () => {
+  const fleet = rust('crates/hwfoc-cli/src/commands/monitor/fleet.rs');
+  assert.equal(limits.FULL_CELL_V, Number(fleet.match(/const FULL_CELL_V: f64 = ([\d.]+);/)[1]));
+  // The warning faults of monitor/alarms.rs `fault_level`, by their codec names.
+  const alarms = rust('crates/hwfoc-cli/src/commands/monitor/alarms.rs');
+  const body = alarms.slice(alarms.indexOf('pub fn fault_level'), alarms.indexOf('/// What happened to an alarm.'));
+  const snake = (s) => s.replace(/([a-z])([A-Z0-9])/g, '$1_$2').toLowerCase();
+  const hw5Part = body.slice(body.indexOf('Protocol::Hw5'), body.indexOf('_ => match'));
+  const focPart = body.slice(body.indexOf('_ => match'));
+  const variants = (part, prefix) => [...part.matchAll(new RegExp(`${prefix}::([A-Za-z0-9]+)`, 'g'))].map((m) => m[1]).filter((v) => v !== 'from');
+  assert.deepEqual(limits.WARNING_FAULTS.hw5, variants(hw5Part, 'Hw5').map(snake));
+  assert.deepEqual(limits.WARNING_FAULTS['hw-foc'], variants(focPart, 'Fault').map(snake));
+  assert.equal(limits.faultLevel('hw-foc', 'mos_overheat'), 'critical');
+  assert.equal(limits.faultLevel('datalink', 'throttle_signal_lost'), 'warning');
+  assert.equal(limits.faultLevel('hw5', 'motor_locked'), 'critical');
+});
