@@ -1,0 +1,107 @@
+//! The records decoded so far, held column by column as the page reads them: one typed array
+//! per column of the record schema (`docs/RECORD-SCHEMA.md`), a null float as NaN.
+
+use hwfoc::telemetry::{Data, Telemetry};
+use hwfoc::{Protocol, Quantity, Settings};
+use js_sys::{Array, Float32Array, Float64Array, Object, Reflect, Uint8Array};
+use wasm_bindgen::JsValue;
+
+/// The columns given as Float64Array: unsigned integers that may be null (NaN).
+const NULLABLE_INTEGERS: [&str; 6] = [
+    "packet",
+    "erpm",
+    "status",
+    "node",
+    "msg2_age_ms",
+    "msg3_age_ms",
+];
+
+/// Records column by column, emptied by [`Columns::take`].
+#[derive(Default)]
+pub struct Columns {
+    t_s: Vec<f64>,
+    esc: Vec<u8>,
+    protocol: Vec<u8>,
+    /// `NULLABLE_INTEGERS`' columns, in that order.
+    integers: [Vec<f64>; 6],
+    /// Every float quantity of [`Quantity::ALL`] but `erpm`, in that order.
+    floats: Vec<Vec<f32>>,
+}
+
+/// The float32 quantities: every quantity but eRPM, which is an integer.
+fn float_quantities() -> impl Iterator<Item = Quantity> {
+    Quantity::ALL.into_iter().filter(|q| *q != Quantity::Erpm)
+}
+
+/// The code of `protocol` in the `protocol` column: its place in [`Protocol::ALL`].
+fn protocol_code(protocol: Protocol) -> u8 {
+    Protocol::ALL
+        .iter()
+        .position(|p| *p == protocol)
+        .map_or(u8::MAX, |i| i as u8)
+}
+
+impl Columns {
+    /// The number of records held.
+    pub fn len(&self) -> usize {
+        self.esc.len()
+    }
+
+    /// Whether no record is held.
+    pub fn is_empty(&self) -> bool {
+        self.esc.is_empty()
+    }
+
+    /// Adds the record of `data` from ESC `esc` received at `t_s` (seconds, or None).
+    pub fn push(&mut self, t_s: Option<f64>, esc: u8, data: &Data, settings: &Settings) {
+        if self.floats.is_empty() {
+            self.floats = float_quantities().map(|_| Vec::new()).collect();
+        }
+        let nan = f64::NAN;
+        self.t_s.push(t_s.unwrap_or(nan));
+        self.esc.push(esc);
+        self.protocol.push(protocol_code(data.protocol()));
+        let erpm = data.value(Quantity::Erpm, settings).map(f64::from);
+        let integers = [
+            data.packet().map(f64::from),
+            erpm,
+            data.status().map(|s| f64::from(s.0)),
+            data.node().map(f64::from),
+            data.msg2_age_ms().map(f64::from),
+            data.msg3_age_ms().map(f64::from),
+        ];
+        for (column, value) in self.integers.iter_mut().zip(integers) {
+            column.push(value.unwrap_or(nan));
+        }
+        for (column, quantity) in self.floats.iter_mut().zip(float_quantities()) {
+            column.push(data.value(quantity, settings).unwrap_or(f32::NAN));
+        }
+    }
+
+    /// The records held as `{count, columns: {name: TypedArray}, protocols}`, emptying the
+    /// columns. `protocol` is a Uint8Array of places in `protocols` (the names `--protocol`
+    /// takes); every other column is the schema's, a null as NaN.
+    pub fn take(&mut self) -> Result<Object, JsValue> {
+        let taken = core::mem::take(self);
+        let columns = Object::new();
+        let set = |name: &str, value: JsValue| Reflect::set(&columns, &name.into(), &value);
+        set("t_s", Float64Array::from(&taken.t_s[..]).into())?;
+        set("esc", Uint8Array::from(&taken.esc[..]).into())?;
+        set("protocol", Uint8Array::from(&taken.protocol[..]).into())?;
+        for (name, column) in NULLABLE_INTEGERS.iter().zip(&taken.integers) {
+            set(name, Float64Array::from(&column[..]).into())?;
+        }
+        for (quantity, column) in float_quantities().zip(&taken.floats) {
+            set(quantity.name(), Float32Array::from(&column[..]).into())?;
+        }
+        let protocols: Array = Protocol::ALL
+            .iter()
+            .map(|p| JsValue::from_str(p.name()))
+            .collect();
+        let out = Object::new();
+        Reflect::set(&out, &"count".into(), &(taken.len() as u32).into())?;
+        Reflect::set(&out, &"columns".into(), &columns)?;
+        Reflect::set(&out, &"protocols".into(), &protocols)?;
+        Ok(out)
+    }
+}

@@ -1,0 +1,74 @@
+//! The browser app's decoding: the workspace's codec (and readers) compiled to WebAssembly.
+//!
+//! `web/build.sh` builds this crate for `wasm32-unknown-unknown` and runs `wasm-bindgen` on it;
+//! `web/src/hwfoc.js` wraps the classes exported here into the page's one API (`Session`,
+//! `openFile`, `Recorder`). Nothing here is rewritten in JavaScript: the page reads bytes as the
+//! command does.
+
+#![warn(missing_docs)]
+
+pub mod columns;
+pub mod session;
+
+use js_sys::{Array, Object, Reflect};
+use wasm_bindgen::prelude::*;
+
+/// A session as JavaScript holds it (`web/src/hwfoc.js`'s `Session` wraps it).
+#[wasm_bindgen(js_name = WasmSession)]
+pub struct WasmSession {
+    inner: session::Session,
+}
+
+#[wasm_bindgen(js_class = WasmSession)]
+impl WasmSession {
+    /// A session reading every serial format, or only `protocol` (a name `--protocol` takes).
+    #[wasm_bindgen(constructor)]
+    pub fn new(protocol: Option<String>) -> Result<WasmSession, JsError> {
+        let inner =
+            session::Session::new(protocol.as_deref()).map_err(|e| JsError::new(&e.to_string()))?;
+        Ok(WasmSession { inner })
+    }
+
+    /// Decodes `bytes`, the chunk whose last byte came at `t_micros` (Unix microseconds), or
+    /// without a time (a file).
+    pub fn feed(&mut self, bytes: &[u8], t_micros: Option<f64>) {
+        self.inner.feed(bytes, t_micros.map(|t| t / 1e6));
+    }
+
+    /// Ends the stream.
+    pub fn finish(&mut self) {
+        self.inner.finish();
+    }
+
+    /// The records decoded since the last call: `{count, columns, protocols}`
+    /// ([`columns::Columns::take`]).
+    #[wasm_bindgen(js_name = takeRecords)]
+    pub fn take_records(&mut self) -> Result<Object, JsValue> {
+        self.inner.columns().take()
+    }
+
+    /// The notices so far, as the command's stderr lines.
+    pub fn notices(&self) -> Array {
+        self.inner
+            .notices()
+            .iter()
+            .map(|n| JsValue::from_str(n))
+            .collect()
+    }
+
+    /// Per ESC: `{esc, frames, info_frames, info}`.
+    pub fn summary(&self) -> Result<Object, JsValue> {
+        let escs = Array::new();
+        for (esc, frames, info_frames, info) in self.inner.escs() {
+            let o = Object::new();
+            Reflect::set(&o, &"esc".into(), &(esc as u32).into())?;
+            Reflect::set(&o, &"frames".into(), &(frames as f64).into())?;
+            Reflect::set(&o, &"info_frames".into(), &(info_frames as f64).into())?;
+            Reflect::set(&o, &"info".into(), &info.map_or(JsValue::NULL, Into::into))?;
+            escs.push(&o);
+        }
+        let out = Object::new();
+        Reflect::set(&out, &"escs".into(), &escs)?;
+        Ok(out)
+    }
+}
