@@ -110,3 +110,14 @@ export class Recorder {
     return this.inner.finish();
   }
 }
+
+/**
+ * The names of the fault bits set in a record's `status` for a frame of `protocol` (a name of
+ * `protocols`), in bit order: the record schema's `faults`.
+ * @param {string} protocol
+ * @param {number} status
+ * @returns {string[]}
+ */
+export function faultNames(protocol, status) {
+  return Array.from(wasm.faultNames(protocol, status));
+}
