@@ -9,7 +9,7 @@ export const DEMO_URL = new URL('./demo.pcapng', import.meta.url);
 export function slice(records, from, to) {
   const columns = {};
   for (const [name, c] of Object.entries(records.columns)) columns[name] = c.slice(from, to);
-  return { count: to - from, columns };
+  return { count: to - from, columns, protocols: records.protocols };
 }
 
 /**

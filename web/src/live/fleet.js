@@ -89,8 +89,13 @@ class Esc {
 
 /** Every ESC of every port, and the alarm log. */
 export class Fleet {
-  constructor(limits = limitsFrom(), { onLog } = {}) {
+  /**
+   * `faultNames(protocol, status)`: the names of a status word's bits (the WebAssembly API's),
+   * for records that carry `status` but no `faults` column.
+   */
+  constructor(limits = limitsFrom(), { onLog, faultNames } = {}) {
     this.limits = limits;
+    this.faultNames = faultNames;
     this.escs = new Map();
     this.log = [];
     this.onLog = onLog;
@@ -125,7 +130,7 @@ export class Fleet {
    * Takes the records a port's session decoded (`{count, columns}`), received at `now` (Unix
    * seconds: the time of records without `t_s`).
    */
-  addRecords(port, { count, columns }, now) {
+  addRecords(port, { count, columns, protocols }, now) {
     const col = (name, i) => {
       const c = columns[name];
       if (!c) return null;
@@ -135,7 +140,8 @@ export class Fleet {
     for (let i = 0; i < count; i++) {
       const e = this.#esc(port, col('esc', i) ?? 0);
       const t = col('t_s', i) ?? now;
-      e.protocol = columns.protocol?.[i] ?? e.protocol;
+      const protocol = columns.protocol?.[i];
+      e.protocol = (protocols && protocol !== undefined ? protocols[protocol] : protocol) ?? e.protocol;
       e.frames += 1;
       e.lastT = t;
       e.times.push(t);
@@ -151,7 +157,9 @@ export class Fleet {
       }
       e.history.push(sample);
       while (e.history.length > HISTORY_MAX || (e.history.length && e.history[0].t < t - CHART_SECONDS)) e.history.shift();
-      e.faults = faultsOf(columns.faults?.[i]);
+      const status = col('status', i);
+      if (columns.faults) e.faults = faultsOf(columns.faults[i]);
+      else e.faults = status && this.faultNames ? this.faultNames(e.protocol, status) : [];
       this.#judge(e, t);
     }
   }

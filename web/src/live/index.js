@@ -31,7 +31,7 @@ export function mountLive(element, api, { serial = globalThis.navigator?.serial 
   if (!document.querySelector('link[data-live-css]')) {
     document.head.append(el('link', { rel: 'stylesheet', href: new URL('./live.css', import.meta.url).href, 'data-live-css': '' }));
   }
-  const fleet = new Fleet(limitsFrom());
+  const fleet = new Fleet(limitsFrom(), { faultNames: api.faultNames });
   const ports = [];
   const sessions = new Map();
   let recording = null;
@@ -47,7 +47,7 @@ export function mountLive(element, api, { serial = globalThis.navigator?.serial 
   const addPort = el('button', { type: 'button', 'data-testid': 'add-port' }, 'Add port');
   const addCan = el('button', { type: 'button', 'data-testid': 'add-slcan' }, 'Add SLCAN adapter');
   const demo = el('button', { type: 'button', 'data-testid': 'demo' }, 'Demo');
-  const record = el('button', { type: 'button', 'data-testid': 'record', disabled: true }, 'Record');
+  const record = el('button', { type: 'button', 'data-testid': 'record' }, 'Record');
   const board = el('div', { class: 'live-board' });
   const dashboard = new Dashboard(board, { onResetPeaks: () => fleet.resetPeaks() });
   const bar = el('div', { class: 'live-bar' });
@@ -96,9 +96,7 @@ export function mountLive(element, api, { serial = globalThis.navigator?.serial 
     });
     ports.push(live);
     showPorts();
-    if (await live.start()) {
-      record.disabled = false;
-    } else {
+    if (!(await live.start())) {
       ports.pop();
       showPorts();
     }
@@ -135,7 +133,12 @@ export function mountLive(element, api, { serial = globalThis.navigator?.serial 
       downloadAll(files);
       say(`Recording saved: ${files.map((f) => f.name).join(', ')}.`);
     } else {
-      recording = startRecording(api);
+      try {
+        recording = startRecording(api);
+      } catch (e) {
+        say(`Recording is not available: ${e?.message ?? e}.`);
+        return;
+      }
       record.textContent = '● Stop and download';
       say('Recording what the ports send.');
     }

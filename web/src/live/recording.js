@@ -4,6 +4,8 @@
 /** A recording of every port from now: `add(...)` each chunk, `finish()` the files. */
 export function startRecording(api, stamp = new Date()) {
   const recorders = new Map();
+  // A build without the recorder fails here, before any port's bytes are taken.
+  new api.Recorder({ port: 'check', baud: 0 }).finish();
   const name = stamp.toISOString().replace(/[:.]/g, '-').replace(/-\d+Z$/, 'Z');
   return {
     add(index, port, baud, bytes, tMicros) {

@@ -3,17 +3,12 @@
 import { test } from 'node:test';
 import assert from 'node:assert/strict';
 import { execFileSync } from 'node:child_process';
-import { existsSync, readFileSync } from 'node:fs';
+import { readFileSync } from 'node:fs';
 import { fileURLToPath } from 'node:url';
 import * as limits from '../../src/live/limits.js';
+import { hwfocBin } from '../live/hwfoc-bin.js';
 
 const repo = fileURLToPath(new URL('../../../', import.meta.url));
-
-/** The hwfoc binary: $HWFOC_BIN, else the workspace's debug build. */
-export function hwfocBin() {
-  const candidates = [process.env.HWFOC_BIN, `${repo}target/debug/hwfoc`, `${repo}target/release/hwfoc`];
-  return candidates.find((p) => p && existsSync(p)) ?? null;
-}
 
 test('alarm defaults equal hwfoc monitor --help', { skip: hwfocBin() ? false : 'needs hwfoc (cargo build, or HWFOC_BIN)' }, () => {
   const help = execFileSync(hwfocBin(), ['monitor', '--help'], { encoding: 'utf8' });

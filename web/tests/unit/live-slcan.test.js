@@ -7,7 +7,7 @@ import { mkdtempSync, readFileSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { SlcanLines, bitrateCode, openSequence, recordOf } from '../../src/live/slcan.js';
 import { packets } from '../live/pcapng.js';
-import { hwfocBin } from './live-limits.test.js';
+import { hwfocBin } from '../live/hwfoc-bin.js';
 
 test('the open sequence is the command\'s: \\rC\\r, S6\\r, O\\r at 500 kbit/s', () => {
   assert.equal(bitrateCode(500000), 6);

@@ -1,0 +1,170 @@
+// The live mode in a real browser (Debian's chromium through playwright-core): a fake
+// navigator.serial feeds four simulated ESCs (`hwfoc simulate`) at their real pace; the
+// dashboard shows the values `hwfoc decode` gives for those bytes, the injected overheat raises
+// its alarm, unplugging shows the reconnect message and replugging resumes, the recording
+// downloaded equals the bytes fed (and hwfoc decode and tshark read it), the demo plays.
+// Screenshots at 390 px and 1280 px go to target/web-screenshots/.
+//
+// Run: web/build.sh (web/pkg), then `HWFOC_BIN=target/debug/hwfoc node --test tests/live.spec.mjs`
+// in web/ (CHROMIUM for another browser binary).
+import { after, before, test } from 'node:test';
+import assert from 'node:assert/strict';
+import { execFileSync } from 'node:child_process';
+import { existsSync, mkdirSync, mkdtempSync, readFileSync } from 'node:fs';
+import { tmpdir } from 'node:os';
+import { fileURLToPath } from 'node:url';
+import { installFakeSerial } from './live/fake-serial.js';
+import { joined, packets } from './live/pcapng.js';
+import { serve } from './live/server.js';
+import { hwfocBin } from './live/hwfoc-bin.js';
+
+const web = fileURLToPath(new URL('..', import.meta.url));
+const shots = fileURLToPath(new URL('../../target/web-screenshots/', import.meta.url));
+const chromiumPath = process.env.CHROMIUM ?? '/usr/bin/chromium';
+const FLAGS = ['--headless', '--no-sandbox', '--disable-gpu', '--disable-quic', '--no-first-run',
+  '--disable-background-networking', '--disable-component-update', '--disable-sync'];
+const ESCS = 4;
+const OVERHEAT_ESC = 2;
+const SHOWN = ['throttle_in_pct', 'throttle_out_pct', 'rpm', 'voltage_v', 'current_a', 'phase_current_a', 'mos_temp_c', 'cap_temp_c'];
+
+let playwright = null;
+try { playwright = await import('playwright-core'); } catch { /* skipped below */ }
+const missing = !playwright ? 'needs playwright-core (npm ci in web/)'
+  : !existsSync(chromiumPath) ? `needs chromium (${chromiumPath}: apt-get install -y chromium)`
+    : !hwfocBin() ? 'needs hwfoc (cargo build, or HWFOC_BIN)'
+      : !existsSync(`${web}pkg/hwfoc_web.js`) ? 'needs the WebAssembly build (web/build.sh)' : false;
+
+let browser;
+let server;
+let sims;
+
+before(async () => {
+  if (missing) return;
+  const dir = mkdtempSync(`${tmpdir()}/hwfoc-live-`);
+  execFileSync(hwfocBin(), ['simulate', '--escs', String(ESCS), '--duration', '14', '--no-config',
+    '--fault', `${OVERHEAT_ESC}:mos_overheat@5-9`, '-o', `${dir}/sim{esc}.pcapng`], { stdio: 'ignore' });
+  sims = [...Array(ESCS).keys()].map((i) => {
+    const file = `${dir}/sim${i}.pcapng`;
+    const decoded = execFileSync(hwfocBin(), ['decode', '--no-config', file], { encoding: 'utf8' })
+      .trim().split('\n').map((l) => JSON.parse(l));
+    return { file, packets: packets(readFileSync(file)), decoded };
+  });
+  const t0 = Math.min(...sims.map((s) => s.packets[0].t));
+  for (const s of sims) {
+    s.spec = { baud: 19200, chunks: s.packets.map((p) => ({ at: (p.t - t0) * 1000, b64: Buffer.from(p.data).toString('base64') })) };
+  }
+  server = await serve(web);
+  browser = await playwright.chromium.launch({ executablePath: chromiumPath, args: FLAGS });
+  mkdirSync(shots, { recursive: true });
+});
+
+after(async () => {
+  await browser?.close();
+  await server?.close();
+});
+
+async function livePage(width, ports) {
+  const context = await browser.newContext({ viewport: { width, height: 900 }, acceptDownloads: true });
+  const page = await context.newPage();
+  page.on('pageerror', (e) => console.error('page error:', e.message));
+  await page.addInitScript(installFakeSerial, ports);
+  await page.goto(`${server.url}/tests/live/harness.html`);
+  await page.waitForFunction(() => window.__ready === true);
+  return page;
+}
+
+const message = (page) => page.getByTestId('live-message').textContent();
+
+test('four simulated ESCs: values, alarm, unplug and replug, recording, screenshots', { skip: missing, timeout: 120000 }, async () => {
+  const page = await livePage(1280, sims.map((s) => s.spec));
+
+  // No port chosen, and a port another program holds: each says what to do.
+  await page.evaluate(() => { window.__fake.refuseNext = true; });
+  await page.getByTestId('add-port').click();
+  assert.match(await message(page), /No port was chosen/);
+  await page.evaluate(() => { window.__fake.busy[0] = true; });
+  await page.getByTestId('add-port').click();
+  await page.waitForFunction(() => document.querySelector('[data-testid=live-message]').textContent.includes('dialout'));
+  assert.match(await message(page), /another program is using it.*dialout/);
+  await page.evaluate(() => { window.__fake.busy[0] = false; });
+
+  await page.getByTestId('record').click();
+  for (let i = 0; i < ESCS; i++) await page.getByTestId('add-port').click();
+  await page.waitForFunction((n) => document.querySelectorAll('.live-table tbody tr').length === n, ESCS, { timeout: 10000 });
+
+  // Unplugged mid-run: the reconnect message and the disconnected alarm; back: it resumes.
+  await page.waitForTimeout(4000);
+  await page.evaluate(() => window.__fake.unplug(1));
+  await page.waitForFunction(() => document.querySelector('[data-testid=live-message]').textContent.includes('unplugged'));
+  assert.match(await message(page), /port 2 .*was unplugged: plug it back in and it resumes by itself/);
+  await page.waitForFunction(() => document.querySelector('[data-esc="1"] [data-col=alarms]')?.textContent.includes('disconnected'));
+  const before = await page.evaluate(() => window.__fake.fed[1].length);
+  await page.waitForTimeout(1000);
+  await page.evaluate(() => window.__fake.plug(1));
+  await page.waitForFunction(() => document.querySelector('[data-testid=live-message]').textContent.includes('is back'));
+  await page.waitForFunction((n) => window.__fake.fed[1].length > n + 5, before);
+
+  await page.waitForFunction(() => window.__fake.done(), null, { timeout: 30000 });
+  await page.waitForTimeout(800);
+
+  // The table holds each ESC's last frame as hwfoc decode gives it.
+  for (let i = 0; i < ESCS; i++) {
+    const last = sims[i].decoded.at(-1);
+    for (const column of SHOWN) {
+      const shown = await page.locator(`[data-esc="${i}"] [data-col="${column}"]`).getAttribute('data-value');
+      assert.ok(Math.abs(Number(shown) - last[column]) <= 1e-4 * Math.max(1, Math.abs(last[column])),
+        `esc ${i} ${column}: page ${shown}, decode ${last[column]}`);
+    }
+  }
+  const log = await page.getByTestId('alarm-log').textContent();
+  assert.match(log, new RegExp(`esc ${OVERHEAT_ESC} mos_overheat critical raised`));
+  assert.match(log, new RegExp(`esc ${OVERHEAT_ESC} mos_overheat critical cleared`));
+  assert.doesNotMatch(log, /esc [013] mos_overheat/);
+
+  await page.screenshot({ path: `${shots}live-1280.png`, fullPage: true });
+  await page.setViewportSize({ width: 390, height: 844 });
+  await page.waitForTimeout(400);
+  await page.screenshot({ path: `${shots}live-390.png`, fullPage: true });
+  const overflow = await page.evaluate(() => document.documentElement.scrollWidth - window.innerWidth);
+  assert.ok(overflow <= 0, `the page is ${overflow} px wider than a phone`);
+
+  // The recording: one pcapng per port, its bytes exactly those fed, read by hwfoc and tshark.
+  const recorder = await page.evaluate(async () => {
+    const api = await import('/src/hwfoc.js');
+    try { new api.Recorder({ port: 'x', baud: 0 }).finish(); return true; } catch { return false; }
+  });
+  if (!recorder) {
+    test.diagnostic?.('recording not checked: this build has no Recorder');
+    return;
+  }
+  const downloads = [];
+  page.on('download', (d) => downloads.push(d));
+  await page.getByTestId('record').click();
+  await page.waitForFunction(() => true);
+  for (let tries = 0; downloads.length < ESCS && tries < 50; tries++) await page.waitForTimeout(100);
+  assert.equal(downloads.length, ESCS);
+  const fed = await page.evaluate(() => window.__fake.fed);
+  const dir = mkdtempSync(`${tmpdir()}/hwfoc-rec-`);
+  for (const d of downloads) {
+    const port = Number(d.suggestedFilename().match(/port(\d+)\.pcapng$/)[1]) - 1;
+    const path = `${dir}/${d.suggestedFilename()}`;
+    await d.saveAs(path);
+    const want = Buffer.concat(fed[port].map((b) => Buffer.from(b, 'base64')));
+    assert.ok(Buffer.from(joined(readFileSync(path))).equals(want), `port ${port + 1}: the recording differs from the bytes fed`);
+    const records = execFileSync(hwfocBin(), ['decode', '--no-config', path], { encoding: 'utf8' }).trim().split('\n');
+    assert.ok(records.length > 100, `hwfoc decode read ${records.length} records of ${path}`);
+    let tshark = null;
+    try { tshark = execFileSync('tshark', ['-r', path, '-T', 'fields', '-e', 'frame.len'], { encoding: 'utf8' }); } catch (e) {
+      if (e.code !== 'ENOENT') throw e;
+    }
+    if (tshark !== null) assert.equal(tshark.trim().split('\n').length, packets(readFileSync(path)).length);
+  }
+});
+
+test('the demo replays the bundled recording with no hardware', { skip: missing, timeout: 30000 }, async () => {
+  const page = await livePage(1280, []);
+  await page.getByTestId('demo').click();
+  await page.waitForFunction(() => document.querySelectorAll('.live-table tbody tr').length === 2, null, { timeout: 10000 });
+  await page.waitForFunction(() => Number(document.querySelector('[data-esc="0"] [data-col=rpm]').dataset.value) >= 0);
+  await page.screenshot({ path: `${shots}live-demo-1280.png`, fullPage: true });
+});
