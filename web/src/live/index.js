@@ -149,7 +149,8 @@ export function mountLive(element, api, { serial = globalThis.navigator?.serial 
     try {
       await api.init?.();
       const bytes = new Uint8Array(await (await fetch(DEMO_URL)).arrayBuffer());
-      const { records } = api.openFile('demo.pcapng', bytes);
+      const { records, notices } = api.openFile('demo.pcapng', bytes);
+      if (!records.count) throw new Error(`the bundled recording gave no frame (${notices.join('; ')})`);
       // The demo is a virtual port after the real ones.
       const index = MAX_PORTS;
       stopDemo = replay(records, (set, now) => fleet.addRecords(index, set, now));
