@@ -79,20 +79,31 @@ impl Columns {
     }
 
     /// The records held as `{count, columns: {name: TypedArray}, protocols}`, emptying the
-    /// columns. `protocol` is a Uint8Array of places in `protocols` (the names `--protocol`
-    /// takes); every other column is the schema's, a null as NaN.
+    /// columns, in the record schema's order. `protocol` is a Uint8Array of places in
+    /// `protocols` (the names `--protocol` takes); every other column is the schema's, a null as
+    /// NaN (`faults` is left out: it is `status` named by `protocol`).
     pub fn take(&mut self) -> Result<Object, JsValue> {
         let taken = core::mem::take(self);
         let columns = Object::new();
         let set = |name: &str, value: JsValue| Reflect::set(&columns, &name.into(), &value);
+        let integer = |name: &str| {
+            let at = NULLABLE_INTEGERS.iter().position(|n| *n == name);
+            JsValue::from(Float64Array::from(&taken.integers[at.unwrap_or(0)][..]))
+        };
         set("t_s", Float64Array::from(&taken.t_s[..]).into())?;
         set("esc", Uint8Array::from(&taken.esc[..]).into())?;
         set("protocol", Uint8Array::from(&taken.protocol[..]).into())?;
-        for (name, column) in NULLABLE_INTEGERS.iter().zip(&taken.integers) {
-            set(name, Float64Array::from(&column[..]).into())?;
+        set("packet", integer("packet"))?;
+        let mut floats = float_quantities().zip(&taken.floats);
+        for quantity in Quantity::ALL {
+            if quantity == Quantity::Erpm {
+                set("erpm", integer("erpm"))?;
+            } else if let Some((q, column)) = floats.next() {
+                set(q.name(), Float32Array::from(&column[..]).into())?;
+            }
         }
-        for (quantity, column) in float_quantities().zip(&taken.floats) {
-            set(quantity.name(), Float32Array::from(&column[..]).into())?;
+        for name in &NULLABLE_INTEGERS[2..] {
+            set(name, integer(name))?;
         }
         let protocols: Array = Protocol::ALL
             .iter()
