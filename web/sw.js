@@ -8,6 +8,8 @@ const CACHE = 'hwfoc-web-v1';
 /** Files cached at install, relative to this worker (one missing does not stop the install). */
 const AHEAD = [
   './', './index.html', './style.css', './src/main.js', './src/hwfoc.js',
+  './pkg/hwfoc_web.js', './pkg/hwfoc_web_bg.wasm',
+  './src/files/chart.js', './src/files/csv.js', './src/files/index.js', './src/files/series.js', './src/files/summary.js', './src/files/view.js',
   './src/live/index.js', './src/live/alarms.js', './src/live/baud.js', './src/live/dashboard.js',
   './src/live/demo.js', './src/live/errors.js', './src/live/fleet.js', './src/live/limits.js',
   './src/live/ports.js', './src/live/recording.js', './src/live/slcan.js', './src/live/live.css',
