@@ -180,3 +180,40 @@ test('the demo replays the bundled recording with no hardware', { skip: missing,
   await page.waitForFunction(() => Number(document.querySelector('[data-esc="0"] [data-col=rpm]').dataset.value) >= 0);
   await page.screenshot({ path: `${shots}live-demo-1280.png`, fullPage: true });
 });
+
+test('a browser without Web Serial gets the files mode and a note naming the browsers that have it', { skip: missing, timeout: 30000 }, async () => {
+  const context = await browser.newContext({ viewport: { width: 390, height: 844 } });
+  const page = await context.newPage();
+  await page.addInitScript(() => {
+    delete Navigator.prototype.serial;
+    Object.defineProperty(navigator, 'serial', { value: undefined });
+  });
+  await page.goto(`${server.url}/index.html`);
+  await page.locator('[data-tab=live]').click();
+  const note = page.getByTestId('live-message');
+  await note.waitFor();
+  assert.match(await note.textContent(), /Chrome, Edge or Firefox 151 and later.*Files tab/);
+  assert.equal(await page.getByTestId('add-port').count(), 0);
+  await page.screenshot({ path: `${shots}live-no-serial-390.png`, fullPage: true });
+  await context.close();
+});
+
+test('once loaded, the page and its live mode open offline (the service worker)', { skip: missing, timeout: 30000 }, async () => {
+  const context = await browser.newContext({ viewport: { width: 1280, height: 800 } });
+  const page = await context.newPage();
+  await page.goto(`${server.url}/index.html`);
+  await page.evaluate(async () => {
+    await navigator.serviceWorker.ready;
+    // Every file fetched ahead is in the cache.
+    for (;;) {
+      const keys = await (await caches.open('hwfoc-web-v1')).keys();
+      if (keys.some((k) => k.url.endsWith('/src/live/slcan.js')) && keys.some((k) => k.url.endsWith('.wasm'))) return;
+      await new Promise((r) => setTimeout(r, 100));
+    }
+  });
+  await context.setOffline(true);
+  await page.reload();
+  await page.locator('[data-tab=live]').click();
+  await page.getByTestId('demo').waitFor();
+  await context.close();
+});
