@@ -217,3 +217,20 @@ test('once loaded, the page and its live mode open offline (the service worker)'
   await page.getByTestId('demo').waitFor();
   await context.close();
 });
+
+test('the first decoded frame is on the dashboard within 1 s of the port opening (baud searched)', { skip: missing, timeout: 30000 }, async (t) => {
+  const page = await livePage(1280, [sims[0].spec]);
+  await page.evaluate(() => {
+    new MutationObserver((_, observer) => {
+      if (document.querySelector('.live-table tbody tr')) {
+        window.__firstRowAt = performance.now();
+        observer.disconnect();
+      }
+    }).observe(document.body, { childList: true, subtree: true });
+  });
+  await page.getByTestId('add-port').click();
+  await page.waitForFunction(() => window.__firstRowAt !== undefined);
+  const ms = await page.evaluate(() => window.__firstRowAt - window.__fake.opened[0].at);
+  t.diagnostic(`first frame shown ${ms.toFixed(0)} ms after the port opened`);
+  assert.ok(ms < 1000, `${ms} ms`);
+});

@@ -74,14 +74,23 @@ export class BaudSearch {
   }
 }
 
-/** A decoder for the search over the WebAssembly API: counts the records a fresh Session decodes. */
+/**
+ * A decoder for the search over the WebAssembly API: a fresh Session, whose frames (data and
+ * device information, as the command's search counts every frame the detector gives) are read
+ * from its summary.
+ */
 export function sessionJudge(api) {
   return () => {
     const session = new api.Session({});
+    let seen = 0;
     return {
       feed(bytes) {
         session.feed(bytes, undefined);
-        return session.takeRecords().count;
+        session.takeRecords();
+        const now = (session.summary()?.escs ?? []).reduce((n, e) => n + (e.frames ?? 0) + (e.info_frames ?? 0), 0);
+        const found = now - seen;
+        seen = now;
+        return found;
       },
     };
   };

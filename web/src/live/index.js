@@ -81,7 +81,10 @@ export function mountLive(element, api, { serial = globalThis.navigator?.serial 
       slcan: slcanBitrate ?? null,
       newDecoder: sessionJudge(api),
       onData: (bytes, tMicros, rate) => {
+        const fresh = !sessions.has(index);
         sessionOf(index, slcanBitrate ? 'hw-can' : undefined, rate).feed(bytes, tMicros);
+        // A port's first frames are shown at once, not at the next redraw.
+        if (fresh) setTimeout(refresh, 0);
         // An SLCAN adapter's frames are not serial bytes: a CAN bus is recorded by `hwfoc record slcan:PORT`.
         if (!slcanBitrate) recording?.add(index, live.name, rate, bytes, tMicros);
       },
@@ -161,14 +164,16 @@ export function mountLive(element, api, { serial = globalThis.navigator?.serial 
     }
   });
 
+  function refresh() {
+    const now = Date.now() / 1000;
+    for (const [index, s] of sessions) fleet.addRecords(index, s.takeRecords(), now);
+    fleet.tick(now);
+    for (const e of fleet.escs.values()) e.state = ports[e.port]?.state;
+    dashboard.render(fleet, now);
+  }
+
   const timers = [
-    setInterval(() => {
-      const now = Date.now() / 1000;
-      for (const [index, s] of sessions) fleet.addRecords(index, s.takeRecords(), now);
-      fleet.tick(now);
-      for (const e of fleet.escs.values()) e.state = ports[e.port]?.state;
-      dashboard.render(fleet, now);
-    }, RENDER_EVERY_MS),
+    setInterval(refresh, RENDER_EVERY_MS),
     setInterval(() => {
       for (const [index, s] of sessions) fleet.setSummary(index, s.summary());
     }, SUMMARY_EVERY_MS),

@@ -37,7 +37,7 @@ export function installFakeSerial(ports) {
     async open({ baudRate }) {
       if (this.readable) throw new DOMException('The port is already open.', 'InvalidStateError');
       if (!this.present || fake.busy[this.index]) throw new DOMException('Failed to open serial port.', 'NetworkError');
-      fake.opened.push({ port: this.index, baudRate });
+      fake.opened.push({ port: this.index, baudRate, at: performance.now() });
       this.granted = true;
       const right = baudRate === this.spec.baud;
       // The feed's clock: chunk times from where the feed stands, at the real pace.
