@@ -3,7 +3,8 @@
 import { test } from 'node:test';
 import assert from 'node:assert/strict';
 import { execFileSync } from 'node:child_process';
-import { mkdtempSync, readFileSync } from 'node:fs';
+import { existsSync, mkdtempSync, readFileSync } from 'node:fs';
+import { fileURLToPath } from 'node:url';
 import { tmpdir } from 'node:os';
 import { SlcanLines, bitrateCode, openSequence, recordOf } from '../../src/live/slcan.js';
 import { packets } from '../live/pcapng.js';
@@ -48,4 +49,31 @@ test('a simulated bus as an adapter sends it gives the pcapng records of the sam
     assert.ok(lines.length > 600, String(lines.length));
     assert.equal(got.length, want.length);
     assert.deepEqual(got, want);
+  });
+
+const wasmPath = fileURLToPath(new URL('../../pkg/hwfoc_web_bg.wasm', import.meta.url));
+
+test('an SLCAN adapter\'s lines of a simulated bus decode to the records hwfoc decode gives',
+  { skip: !hwfocBin() ? 'needs hwfoc (cargo build, or HWFOC_BIN)' : !existsSync(wasmPath) ? 'needs web/build.sh' : false }, async (t) => {
+    const api = await import('../../src/hwfoc.js');
+    await api.init(readFileSync(wasmPath));
+    const dir = mkdtempSync(`${tmpdir()}/slcan-`);
+    execFileSync(hwfocBin(), ['simulate', '--protocol', 'hw-can', '--escs', '2', '--duration', '3', '--no-config', '-o', `${dir}/bus.log`], { stdio: 'ignore' });
+    const want = execFileSync(hwfocBin(), ['decode', '--no-config', `${dir}/bus.log`], { encoding: 'utf8' }).trim().split('\n').map((l) => JSON.parse(l));
+    const lines = readFileSync(`${dir}/bus.log`, 'utf8').trim().split('\n');
+    const session = new api.Session({ protocol: 'hw-can', name: 'slcan' });
+    const p = new SlcanLines();
+    for (const l of lines) {
+      const [time, , frame] = l.split(' ');
+      const [id, data] = frame.split('#');
+      const records = p.push(new TextEncoder().encode(`T${id}${data.length / 2}${data}\r`));
+      session.feed(records, Math.round(Number(time.slice(1, -1)) * 1e6));
+    }
+    const got = session.takeRecords();
+    if (got.count === 0) {
+      t.todo('needs a WebAssembly Session that decodes a CAN stream (protocol hw-can)');
+      return;
+    }
+    assert.equal(got.count, want.length);
+    assert.ok(Math.abs(got.columns.voltage_v.at(-1) - want.at(-1).voltage_v) < 1e-4);
   });
