@@ -234,3 +234,36 @@ test('the first decoded frame is on the dashboard within 1 s of the port opening
   t.diagnostic(`first frame shown ${ms.toFixed(0)} ms after the port opened`);
   assert.ok(ms < 1000, `${ms} ms`);
 });
+
+test('sixteen ESCs at their frame rates, the page responsive', { skip: missing, timeout: 60000 }, async (t) => {
+  const dir = mkdtempSync(`${tmpdir()}/hwfoc-16-`);
+  execFileSync(hwfocBin(), ['simulate', '--escs', '16', '--duration', '10', '--lead-in', '0', '--no-config', '-o', `${dir}/sim{esc}.pcapng`], { stdio: 'ignore' });
+  const all = [...Array(16).keys()].map((i) => packets(readFileSync(`${dir}/sim${i}.pcapng`)));
+  const t0 = Math.min(...all.map((p) => p[0].t));
+  const specs = all.map((p) => ({ baud: 19200, chunks: p.map((k) => ({ at: (k.t - t0) * 1000, b64: Buffer.from(k.data).toString('base64') })) }));
+  const page = await livePage(1280, specs);
+  await page.evaluate(() => {
+    window.__long = [];
+    new PerformanceObserver((list) => window.__long.push(...list.getEntries().map((e) => e.duration))).observe({ type: 'longtask', buffered: true });
+  });
+  await page.selectOption('[aria-label="Baud rate"]', '19200');
+  for (let i = 0; i < 16; i++) await page.getByTestId('add-port').click();
+  await page.waitForFunction(() => document.querySelectorAll('.live-table tbody tr').length === 16, null, { timeout: 10000 });
+  await page.waitForTimeout(4000);
+  // Responsive while all sixteen stream: a click is answered within 100 ms.
+  const started = Date.now();
+  await page.selectOption('[aria-label="Quantity charted"]', 'voltage_v');
+  const answer = Date.now() - started;
+  // Every ESC kept up with: all its frames, as hwfoc decode counts them, are on the dashboard.
+  await page.waitForFunction(() => window.__fake.done(), null, { timeout: 30000 });
+  await page.waitForTimeout(600);
+  const frames = await page.$$eval('.live-table tbody tr', (rows) => rows.map((r) => Number(r.dataset.frames)));
+  const want = [...Array(16).keys()].map((i) => execFileSync(hwfocBin(), ['decode', '--no-config', `${dir}/sim${i}.pcapng`], { encoding: 'utf8' }).trim().split('\n').length);
+  assert.deepEqual(frames, want);
+  // Responsive: a click is answered within 100 ms, and no task held the page for 200 ms.
+  const long = await page.evaluate(() => window.__long);
+  t.diagnostic(`16 ESCs: ${want.reduce((a, b) => a + b)} frames all shown, input answered in ${answer} ms, longest task ${Math.max(0, ...long).toFixed(0)} ms (${long.length} over 50 ms)`);
+  assert.ok(answer < 100, `${answer} ms`);
+  assert.ok(Math.max(0, ...long) < 200, `longest task ${Math.max(...long)} ms`);
+  await page.screenshot({ path: `${shots}live-16-1280.png`, fullPage: true });
+});

@@ -2,22 +2,13 @@
 // alarms), the totals (power, peak, mAh, Wh), the alarm log and the last minute charted.
 
 import { CHART_SECONDS } from './limits.js';
+import { el } from './dom.js';
 import { SHOWN, powerOf } from './fleet.js';
 
 const DIGITS = { rpm: 0, throttle_in_pct: 1, throttle_out_pct: 1 };
 const COLOURS = ['#2a7ab0', '#d0452f', '#3a9a3a', '#9b59b6', '#e08e0b', '#16a2a2', '#7f6a00', '#c2185b',
   '#455a64', '#8d6e63', '#00897b', '#5c6bc0', '#f4511e', '#6d4c41', '#43a047', '#1e88e5'];
 
-function el(tag, attrs = {}, ...children) {
-  const node = document.createElement(tag);
-  for (const [k, v] of Object.entries(attrs)) {
-    if (k === 'class') node.className = v;
-    else if (k.startsWith('data-')) node.setAttribute(k, v);
-    else node[k] = v;
-  }
-  node.append(...children);
-  return node;
-}
 
 /** A value as the table shows it. */
 export function format(column, value) {
@@ -93,6 +84,7 @@ export class Dashboard {
     );
     row.className = lost ? 'lost' : '';
     row.dataset.esc = String(e.number);
+    row.dataset.frames = String(e.frames);
     row.replaceChildren(...cells);
   }
 

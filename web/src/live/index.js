@@ -2,6 +2,7 @@
 // WebAssembly session, shown on the monitor's dashboard; recording to pcapng; the demo.
 
 import { Dashboard } from './dashboard.js';
+import { el } from './dom.js';
 import { DEMO_URL, replay } from './demo.js';
 import { explain, hasWebSerial, noSerialNote } from './errors.js';
 import { Fleet, limitsFrom } from './fleet.js';
@@ -15,16 +16,6 @@ const RENDER_EVERY_MS = 250;
 /** How often each session's summary (link counters, energy) is read, ms. */
 const SUMMARY_EVERY_MS = 1000;
 
-function el(tag, attrs = {}, ...children) {
-  const node = document.createElement(tag);
-  for (const [k, v] of Object.entries(attrs)) {
-    if (k === 'class') node.className = v;
-    else if (k.startsWith('data-') || k.startsWith('aria-')) node.setAttribute(k, v);
-    else node[k] = v;
-  }
-  node.append(...children);
-  return node;
-}
 
 /** Mounts the live mode in `element`; `api` is web/src/hwfoc.js. Returns `unmount()`. */
 export function mountLive(element, api, { serial = globalThis.navigator?.serial } = {}) {
