@@ -26,7 +26,7 @@ wasm-bindgen --target web --no-typescript --out-dir "$web/pkg" \
 
 rm -rf "$web/dist"
 mkdir -p "$web/dist"
-cp -R "$web/index.html" "$web/style.css" "$web/src" "$web/pkg" "$web/dist/"
+cp -RL "$web/index.html" "$web/style.css" "$web/src" "$web/pkg" "$web/dist/"
 [ -f "$web/sw.js" ] && cp "$web/sw.js" "$web/dist/"
 
 size=0
