@@ -68,8 +68,9 @@ async function livePage(width, ports) {
   const page = await context.newPage();
   page.on('pageerror', (e) => console.error('page error:', e.message));
   await page.addInitScript(installFakeSerial, ports);
-  await page.goto(`${server.url}/tests/live/harness.html`);
-  await page.waitForFunction(() => window.__ready === true);
+  await page.goto(`${server.url}/index.html`);
+  await page.locator('[data-tab=live]').click();
+  await page.getByTestId('demo').waitFor();
   return page;
 }
 
