@@ -1,11 +1,14 @@
 //! Puts the git commit and its date into `hwfoc --version` (`HWFOC_VERSION`, see
-//! `build_info.rs`), and falls back to the package version alone outside a git checkout.
+//! `build_info.rs`), and falls back to the package version alone outside a git checkout; builds
+//! the browser app that `hwfoc web` serves (`build_web.rs`).
 
 use std::path::Path;
 use std::process::Command;
 
 #[path = "build_info.rs"]
 mod build_info;
+#[path = "build_web.rs"]
+mod build_web;
 
 /// Runs git in the package's directory: its trimmed output, or `None` if it failed.
 fn git(args: &[&str]) -> Option<String> {
@@ -23,6 +26,8 @@ fn main() {
     println!("cargo:rustc-env=HWFOC_VERSION={version}");
     println!("cargo:rerun-if-changed=build.rs");
     println!("cargo:rerun-if-changed=build_info.rs");
+    println!("cargo:rerun-if-changed=build_web.rs");
+    build_web::embed();
     // A new commit moves the branch's ref (a file, or a line of packed-refs); a checkout of
     // another branch or commit changes HEAD. `--git-path` finds them in a worktree too.
     let mut watched = vec!["HEAD".to_string(), "packed-refs".to_string()];

@@ -83,6 +83,13 @@ pub enum CliError {
         /// What is missing, and where.
         message: String,
     },
+    /// `hwfoc web`: the address could not be listened on.
+    Listen {
+        /// The address, as given.
+        listen: String,
+        /// Why.
+        message: String,
+    },
     /// `hwfoc plot`: the image could not be drawn.
     Render {
         /// The image file.
@@ -218,6 +225,9 @@ impl fmt::Display for CliError {
             }
             CliError::NothingToPlot { message } => write!(f, "nothing to plot: {message}"),
             CliError::Render { output, message } => write!(f, "cannot draw {output}: {message}"),
+            CliError::Listen { listen, message } => {
+                write!(f, "cannot listen on {listen}: {message}")
+            }
         }
     }
 }

@@ -19,7 +19,7 @@ use std::process::ExitCode;
 use clap::{CommandFactory, Parser, Subcommand};
 
 use crate::commands::{
-    bridge, can, check, completions, decode, man, monitor, plot, record, simulate, summary,
+    bridge, can, check, completions, decode, man, monitor, plot, record, simulate, summary, web,
 };
 use crate::error::CliError;
 
@@ -59,6 +59,8 @@ enum Command {
     Can(can::CanArgs),
     /// The Wireshark dissector for recordings: install it, print where it goes, or print it.
     Wireshark(commands::wireshark::WiresharkArgs),
+    /// The browser app: serve it on this computer (files and live ports in the browser).
+    Web(web::WebArgs),
     /// Print the completion script for a shell (bash, zsh, fish, powershell, elvish).
     Completions(completions::CompletionsArgs),
     /// Write the manual pages (hwfoc.1 and one per subcommand), or print hwfoc.1.
@@ -80,6 +82,7 @@ fn main() -> ExitCode {
         Command::Bridge(args) => bridge::run(args),
         Command::Can(args) => can::run(args),
         Command::Wireshark(args) => commands::wireshark::run(args),
+        Command::Web(args) => web::run(args),
         Command::Completions(args) => completions::run(args, Cli::command()),
         Command::Man(args) => man::run(args, Cli::command()),
     };

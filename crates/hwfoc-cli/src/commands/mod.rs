@@ -11,4 +11,5 @@ pub mod plot;
 pub mod record;
 pub mod simulate;
 pub mod summary;
+pub mod web;
 pub mod wireshark;

@@ -1,0 +1,106 @@
+// Every recording in testdata/ opened in the page: its per-ESC figures equal `hwfoc summary
+// --json`'s; screenshots at a phone's and a laptop's width.
+
+import { test, before, after } from 'node:test';
+import assert from 'node:assert/strict';
+import { readdirSync, statSync } from 'node:fs';
+import { join, relative } from 'node:path';
+import { ROOT, hwfoc, launch, screenshotsDir, serve } from './harness.mjs';
+
+/** The recordings of testdata/ (every file but the READMEs and the test vectors). */
+function recordings() {
+  const out = [];
+  const walk = (dir) => {
+    for (const name of readdirSync(dir).sort()) {
+      const path = join(dir, name);
+      if (statSync(path).isDirectory()) walk(path);
+      else if (!/README|vectors/.test(name)) out.push(relative(ROOT, path));
+    }
+  };
+  walk(join(ROOT, 'testdata'));
+  return out;
+}
+
+/** The value at a dotted key. */
+function at(object, key) {
+  return key.split('.').reduce((o, part) => (o == null ? undefined : o[part]), object);
+}
+
+let server;
+let browser;
+before(async () => {
+  server = await serve();
+  browser = await launch();
+});
+after(async () => {
+  await browser?.close();
+  server?.close();
+});
+
+/** Opens `files` in a fresh page of width `width`; returns the page once the summaries show. */
+async function openInPage(files, width) {
+  const page = await browser.newPage({ viewport: { width, height: 900 } });
+  const errors = [];
+  page.on('pageerror', (e) => errors.push(e.message));
+  await page.goto(server.url);
+  await page.waitForSelector('body[data-ready=true]');
+  await page.setInputFiles('#files input[type=file]', files.map((f) => join(ROOT, f)));
+  await page.waitForFunction(
+    (n) => document.querySelectorAll('.recordings button').length === n,
+    files.length,
+  );
+  assert.deepEqual(errors, []);
+  return page;
+}
+
+for (const file of recordings()) {
+  test(`${file}: the page's figures are hwfoc summary --json's`, async () => {
+    const expected = JSON.parse(hwfoc('summary', '--json', file));
+    const page = await openInPage([file], 1280);
+    try {
+      const shown = await page.$$eval('.esc-summary', (sections) =>
+        sections.map((s) => ({
+          esc: Number(s.dataset.esc),
+          cells: Array.from(s.querySelectorAll('[data-key]'), (c) => [c.dataset.key, c.dataset.value]),
+        })),
+      );
+      assert.deepEqual(
+        shown.map((s) => s.esc),
+        expected.escs.map((e) => e.esc),
+        'the ESCs',
+      );
+      for (const { esc, cells } of shown) {
+        const want = expected.escs.find((e) => e.esc === esc);
+        assert.ok(cells.length >= 10, `ESC ${esc}: figures shown`);
+        for (const [key, value] of cells) {
+          assert.deepEqual(JSON.parse(value), at(want, key) ?? null, `ESC ${esc} ${key}`);
+        }
+      }
+    } finally {
+      await page.close();
+    }
+  });
+}
+
+test('screenshots at 390 px and 1280 px', async () => {
+  const dir = screenshotsDir();
+  const files = ['testdata/captures/xrotor-v4-pro-hv-80A.csv', 'testdata/dronecan/can-bus.candump.txt'];
+  for (const width of [390, 1280]) {
+    const page = await openInPage(files, width);
+    try {
+      await page.waitForSelector('canvas.chart');
+      await page.waitForTimeout(100);
+      const canvas = page.locator('canvas.chart').first();
+      const box = await canvas.boundingBox();
+      await page.mouse.move(box.x + box.width / 2, box.y + box.height / 2);
+      await page.waitForTimeout(50);
+      const readout = await page.textContent('.readout');
+      assert.match(readout, /ESC \d+: /, 'the cursor readout');
+      await page.screenshot({ path: join(dir, `files-${width}.png`), fullPage: true });
+      const overflow = await page.evaluate(() => document.documentElement.scrollWidth - window.innerWidth);
+      assert.ok(overflow <= 0, `no sideways scrolling at ${width} px (${overflow} px too wide)`);
+    } finally {
+      await page.close();
+    }
+  }
+});
