@@ -5,38 +5,36 @@
 // downloaded equals the bytes fed (and hwfoc decode and tshark read it), the demo plays.
 // Screenshots at 390 px and 1280 px go to target/web-screenshots/.
 //
-// Run: web/build.sh (web/pkg), then `HWFOC_BIN=target/debug/hwfoc node --test tests/live.spec.mjs`
-// in web/ (CHROMIUM for another browser binary).
+// Run: web/build.sh, then `node --test tests/live.spec.mjs` in web/ (HWFOC for another hwfoc
+// binary than target/debug/hwfoc, CHROMIUM for another browser).
 import { after, before, test } from 'node:test';
 import assert from 'node:assert/strict';
 import { execFileSync } from 'node:child_process';
-import { existsSync, mkdirSync, mkdtempSync, readFileSync } from 'node:fs';
+import { existsSync, mkdtempSync, readFileSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { fileURLToPath } from 'node:url';
 import { installFakeSerial } from './live/fake-serial.js';
 import { joined, packets } from './live/pcapng.js';
-import { serve } from './live/server.js';
 import { hwfocBin } from './live/hwfoc-bin.js';
 
-const web = fileURLToPath(new URL('..', import.meta.url));
-const shots = fileURLToPath(new URL('../../target/web-screenshots/', import.meta.url));
+const dist = fileURLToPath(new URL('../dist/', import.meta.url));
 const chromiumPath = process.env.CHROMIUM ?? '/usr/bin/chromium';
-const FLAGS = ['--headless', '--no-sandbox', '--disable-gpu', '--disable-quic', '--no-first-run',
-  '--disable-background-networking', '--disable-component-update', '--disable-sync'];
 const ESCS = 4;
 const OVERHEAT_ESC = 2;
 const SHOWN = ['throttle_in_pct', 'throttle_out_pct', 'rpm', 'voltage_v', 'current_a', 'phase_current_a', 'mos_temp_c', 'cap_temp_c'];
 
-let playwright = null;
-try { playwright = await import('playwright-core'); } catch { /* skipped below */ }
-const missing = !playwright ? 'needs playwright-core (npm ci in web/)'
+// The project's browser harness (web/e2e/harness.mjs: web/dist served, chromium launched).
+let harness = null;
+try { harness = await import('../e2e/harness.mjs'); } catch { /* skipped below */ }
+const missing = !harness ? 'needs playwright-core (npm ci in web/)'
   : !existsSync(chromiumPath) ? `needs chromium (${chromiumPath}: apt-get install -y chromium)`
-    : !hwfocBin() ? 'needs hwfoc (cargo build, or HWFOC_BIN)'
-      : !existsSync(`${web}pkg/hwfoc_web.js`) ? 'needs the WebAssembly build (web/build.sh)' : false;
+    : !hwfocBin() ? 'needs hwfoc (cargo build, or HWFOC)'
+      : !existsSync(`${dist}index.html`) ? 'needs the page built (web/build.sh)' : false;
 
 let browser;
 let server;
 let sims;
+let shots;
 
 before(async () => {
   if (missing) return;
@@ -53,9 +51,9 @@ before(async () => {
   for (const s of sims) {
     s.spec = { baud: 19200, chunks: s.packets.map((p) => ({ at: (p.t - t0) * 1000, b64: Buffer.from(p.data).toString('base64') })) };
   }
-  server = await serve(web);
-  browser = await playwright.chromium.launch({ executablePath: chromiumPath, args: FLAGS });
-  mkdirSync(shots, { recursive: true });
+  server = await harness.serve();
+  browser = await harness.launch();
+  shots = `${harness.screenshotsDir()}/`;
 });
 
 after(async () => {
@@ -68,7 +66,7 @@ async function livePage(width, ports) {
   const page = await context.newPage();
   page.on('pageerror', (e) => console.error('page error:', e.message));
   await page.addInitScript(installFakeSerial, ports);
-  await page.goto(`${server.url}/index.html`);
+  await page.goto(`${server.url}index.html`);
   await page.locator('[data-tab=live]').click();
   await page.getByTestId('demo').waitFor();
   return page;
@@ -131,7 +129,7 @@ test('four simulated ESCs: values, alarm, unplug and replug, recording, screensh
 
   // The recording: one pcapng per port, its bytes exactly those fed, read by hwfoc and tshark.
   const recorder = await page.evaluate(async () => {
-    const api = await import('/src/hwfoc.js');
+    const api = await import('./src/hwfoc.js');
     try { new api.Recorder({ port: 'x', baud: 0 }).finish(); return true; } catch { return false; }
   });
   if (!recorder) {
@@ -165,8 +163,8 @@ test('four simulated ESCs: values, alarm, unplug and replug, recording, screensh
 test('the demo replays the bundled recording with no hardware', { skip: missing, timeout: 30000 }, async (t) => {
   const page = await livePage(1280, []);
   const frames = await page.evaluate(async () => {
-    const api = await import('/src/hwfoc.js');
-    const bytes = new Uint8Array(await (await fetch('/src/live/demo.pcapng')).arrayBuffer());
+    const api = await import('./src/hwfoc.js');
+    const bytes = new Uint8Array(await (await fetch('src/live/demo.pcapng')).arrayBuffer());
     return api.openFile('demo.pcapng', bytes).records.count;
   });
   if (frames === 0) {
@@ -189,7 +187,7 @@ test('a browser without Web Serial gets the files mode and a note naming the bro
     delete Navigator.prototype.serial;
     Object.defineProperty(navigator, 'serial', { value: undefined });
   });
-  await page.goto(`${server.url}/index.html`);
+  await page.goto(`${server.url}index.html`);
   await page.locator('[data-tab=live]').click();
   const note = page.getByTestId('live-message');
   await note.waitFor();
@@ -202,7 +200,7 @@ test('a browser without Web Serial gets the files mode and a note naming the bro
 test('once loaded, the page and its live mode open offline (the service worker)', { skip: missing, timeout: 30000 }, async () => {
   const context = await browser.newContext({ viewport: { width: 1280, height: 800 } });
   const page = await context.newPage();
-  await page.goto(`${server.url}/index.html`);
+  await page.goto(`${server.url}index.html`);
   await page.evaluate(async () => {
     await navigator.serviceWorker.ready;
     // Every file fetched ahead is in the cache.

@@ -4,8 +4,8 @@ import { fileURLToPath } from 'node:url';
 
 const repo = fileURLToPath(new URL('../../../', import.meta.url));
 
-/** The hwfoc binary: $HWFOC_BIN, else the workspace's debug or release build; null if none. */
+/** The hwfoc binary: $HWFOC (as web/e2e/harness.mjs), else the workspace's debug build; null if none. */
 export function hwfocBin() {
-  const candidates = [process.env.HWFOC_BIN, `${repo}target/debug/hwfoc`, `${repo}target/release/hwfoc`];
-  return candidates.find((p) => p && existsSync(p)) ?? null;
+  const bin = process.env.HWFOC ?? `${repo}target/debug/hwfoc`;
+  return existsSync(bin) ? bin : null;
 }

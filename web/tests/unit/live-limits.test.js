@@ -10,7 +10,7 @@ import { hwfocBin } from '../live/hwfoc-bin.js';
 
 const repo = fileURLToPath(new URL('../../../', import.meta.url));
 
-test('alarm defaults equal hwfoc monitor --help', { skip: hwfocBin() ? false : 'needs hwfoc (cargo build, or HWFOC_BIN)' }, () => {
+test('alarm defaults equal hwfoc monitor --help', { skip: hwfocBin() ? false : 'needs hwfoc (cargo build, or HWFOC)' }, () => {
   const help = execFileSync(hwfocBin(), ['monitor', '--help'], { encoding: 'utf8' });
   const documented = {};
   for (const m of help.matchAll(/--([a-z-]+) <[A-Z]+>\s*\n\s+[^[]*?\[default: ([0-9.]+)\]/g)) {

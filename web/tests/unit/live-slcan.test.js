@@ -31,7 +31,7 @@ test('lines that are not frames give no record; a split line is read whole', () 
 });
 
 test('a simulated bus as an adapter sends it gives the pcapng records of the same bus',
-  { skip: hwfocBin() ? false : 'needs hwfoc (cargo build, or HWFOC_BIN)' }, () => {
+  { skip: hwfocBin() ? false : 'needs hwfoc (cargo build, or HWFOC)' }, () => {
     const dir = mkdtempSync(`${tmpdir()}/slcan-`);
     const args = ['simulate', '--protocol', 'hw-can', '--escs', '2', '--duration', '3', '--no-config'];
     execFileSync(hwfocBin(), [...args, '-o', `${dir}/bus.log`], { stdio: 'ignore' });
@@ -51,11 +51,12 @@ test('a simulated bus as an adapter sends it gives the pcapng records of the sam
     assert.deepEqual(got, want);
   });
 
-const wasmPath = fileURLToPath(new URL('../../pkg/hwfoc_web_bg.wasm', import.meta.url));
+// The page as web/build.sh builds it (its src/hwfoc.js beside the WebAssembly glue in pkg/).
+const wasmPath = fileURLToPath(new URL('../../dist/pkg/hwfoc_web_bg.wasm', import.meta.url));
 
 test('an SLCAN adapter\'s lines of a simulated bus decode to the records hwfoc decode gives',
-  { skip: !hwfocBin() ? 'needs hwfoc (cargo build, or HWFOC_BIN)' : !existsSync(wasmPath) ? 'needs web/build.sh' : false }, async (t) => {
-    const api = await import('../../src/hwfoc.js');
+  { skip: !hwfocBin() ? 'needs hwfoc (cargo build, or HWFOC)' : !existsSync(wasmPath) ? 'needs web/build.sh' : false }, async (t) => {
+    const api = await import('../../dist/src/hwfoc.js');
     await api.init(readFileSync(wasmPath));
     const dir = mkdtempSync(`${tmpdir()}/slcan-`);
     execFileSync(hwfocBin(), ['simulate', '--protocol', 'hw-can', '--escs', '2', '--duration', '3', '--no-config', '-o', `${dir}/bus.log`], { stdio: 'ignore' });
