@@ -67,7 +67,11 @@ pub fn build(root: &Path, target_dir: &Path, out: &Path) -> Result<Vec<PathBuf>,
     wasm_bindgen_cli_support::Bindgen::new()
         .input_path(&wasm)
         .web(true)
-        .and_then(|b| b.typescript(false).generate(&pkg))
+        .and_then(|b| {
+            b.typescript(false)
+                .omit_default_module_path(false)
+                .generate(&pkg)
+        })
         .map_err(|e| BuildError::Bindgen(format!("{e:#}")))?;
     let web = root.join("web");
     for name in PAGE {

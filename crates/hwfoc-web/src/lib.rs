@@ -64,7 +64,13 @@ impl WasmSession {
             Reflect::set(&o, &"esc".into(), &(esc as u32).into())?;
             Reflect::set(&o, &"frames".into(), &(frames as f64).into())?;
             Reflect::set(&o, &"info_frames".into(), &(info_frames as f64).into())?;
-            Reflect::set(&o, &"info".into(), &info.map_or(JsValue::NULL, Into::into))?;
+            let infos = Array::new();
+            if let Some(text) = info {
+                let i = Object::new();
+                Reflect::set(&i, &"text".into(), &text.into())?;
+                infos.push(&i);
+            }
+            Reflect::set(&o, &"info".into(), &infos)?;
             escs.push(&o);
         }
         let out = Object::new();
