@@ -5,7 +5,7 @@
 // downloaded equals the bytes fed (and hwfoc decode and tshark read it), the demo plays.
 // Screenshots at 390 px and 1280 px go to target/web-screenshots/.
 //
-// Run: web/build.sh, then `node --test tests/live.spec.mjs` in web/ (HWFOC for another hwfoc
+// Run: web/build.sh, then `node --test web/e2e/live.test.mjs` (HWFOC for another hwfoc
 // binary than target/debug/hwfoc, CHROMIUM for another browser).
 import { after, before, test } from 'node:test';
 import assert from 'node:assert/strict';
@@ -25,7 +25,7 @@ const SHOWN = ['throttle_in_pct', 'throttle_out_pct', 'rpm', 'voltage_v', 'curre
 
 // The project's browser harness (web/e2e/harness.mjs: web/dist served, chromium launched).
 let harness = null;
-try { harness = await import('../e2e/harness.mjs'); } catch { /* skipped below */ }
+try { harness = await import('./harness.mjs'); } catch { /* skipped below */ }
 const missing = !harness ? 'needs playwright-core (npm ci in web/)'
   : !existsSync(chromiumPath) ? `needs chromium (${chromiumPath}: apt-get install -y chromium)`
     : !hwfocBin() ? 'needs hwfoc (cargo build, or HWFOC)'

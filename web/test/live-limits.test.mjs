@@ -5,10 +5,10 @@ import assert from 'node:assert/strict';
 import { execFileSync } from 'node:child_process';
 import { readFileSync } from 'node:fs';
 import { fileURLToPath } from 'node:url';
-import * as limits from '../../src/live/limits.js';
-import { hwfocBin } from '../live/hwfoc-bin.js';
+import * as limits from '../src/live/limits.js';
+import { hwfocBin } from '../e2e/live/hwfoc-bin.js';
 
-const repo = fileURLToPath(new URL('../../../', import.meta.url));
+const repo = fileURLToPath(new URL('../../', import.meta.url));
 
 test('alarm defaults equal hwfoc monitor --help', { skip: hwfocBin() ? false : 'needs hwfoc (cargo build, or HWFOC)' }, () => {
   const help = execFileSync(hwfocBin(), ['monitor', '--help'], { encoding: 'utf8' });

@@ -6,9 +6,9 @@ import { execFileSync } from 'node:child_process';
 import { existsSync, mkdtempSync, readFileSync } from 'node:fs';
 import { fileURLToPath } from 'node:url';
 import { tmpdir } from 'node:os';
-import { SlcanLines, bitrateCode, openSequence, recordOf } from '../../src/live/slcan.js';
-import { packets } from '../live/pcapng.js';
-import { hwfocBin } from '../live/hwfoc-bin.js';
+import { SlcanLines, bitrateCode, openSequence, recordOf } from '../src/live/slcan.js';
+import { packets } from '../e2e/live/pcapng.js';
+import { hwfocBin } from '../e2e/live/hwfoc-bin.js';
 
 test('the open sequence is the command\'s: \\rC\\r, S6\\r, O\\r at 500 kbit/s', () => {
   assert.equal(bitrateCode(500000), 6);
@@ -52,11 +52,11 @@ test('a simulated bus as an adapter sends it gives the pcapng records of the sam
   });
 
 // The page as web/build.sh builds it (its src/hwfoc.js beside the WebAssembly glue in pkg/).
-const wasmPath = fileURLToPath(new URL('../../dist/pkg/hwfoc_web_bg.wasm', import.meta.url));
+const wasmPath = fileURLToPath(new URL('../dist/pkg/hwfoc_web_bg.wasm', import.meta.url));
 
 test('an SLCAN adapter\'s lines of a simulated bus decode to the records hwfoc decode gives',
   { skip: !hwfocBin() ? 'needs hwfoc (cargo build, or HWFOC)' : !existsSync(wasmPath) ? 'needs web/build.sh' : false }, async (t) => {
-    const api = await import('../../dist/src/hwfoc.js');
+    const api = await import('../dist/src/hwfoc.js');
     await api.init(readFileSync(wasmPath));
     const dir = mkdtempSync(`${tmpdir()}/slcan-`);
     execFileSync(hwfocBin(), ['simulate', '--protocol', 'hw-can', '--escs', '2', '--duration', '3', '--no-config', '-o', `${dir}/bus.log`], { stdio: 'ignore' });

@@ -4,7 +4,7 @@ import assert from 'node:assert/strict';
 import { readFileSync, readdirSync } from 'node:fs';
 import { fileURLToPath } from 'node:url';
 
-const web = fileURLToPath(new URL('../../', import.meta.url));
+const web = fileURLToPath(new URL('../', import.meta.url));
 
 function filesUnder(dir) {
   return readdirSync(`${web}${dir}`, { withFileTypes: true }).flatMap((d) =>

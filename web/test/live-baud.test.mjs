@@ -1,7 +1,7 @@
 // The port search tries 19200 then 115200 as serial.rs `Search` does.
 import { test } from 'node:test';
 import assert from 'node:assert/strict';
-import { BaudSearch } from '../../src/live/baud.js';
+import { BaudSearch } from '../src/live/baud.js';
 
 /** A decoder that finds a frame in every chunk starting with 0xAA. */
 const fake = () => ({ feed: (bytes) => (bytes[0] === 0xaa ? 1 : 0) });

@@ -2,8 +2,8 @@
 // only past the hysteresis, escalated once, bits held off for the hold time.
 import { test } from 'node:test';
 import assert from 'node:assert/strict';
-import { Latch, Threshold, describeChange } from '../../src/live/alarms.js';
-import { Fleet, limitsFrom } from '../../src/live/fleet.js';
+import { Latch, Threshold, describeChange } from '../src/live/alarms.js';
+import { Fleet, limitsFrom } from '../src/live/fleet.js';
 
 test('a temperature warning is raised at 90 and cleared at 85, not before', () => {
   const th = new Threshold(90, 105, 5);
