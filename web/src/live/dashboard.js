@@ -49,8 +49,9 @@ export class Dashboard {
     while (this.body.rows.length > escs.length) this.body.deleteRow(-1);
     escs.forEach((e, i) => this.#row(this.body.rows[i] ?? this.body.insertRow(), e, now));
     const t = fleet.totals();
+    const fixed = (v, digits) => (v === null ? '–' : v.toFixed(digits));
     this.totals.textContent = `All ESCs: ${t.powerW.toFixed(0)} W now, peak ${t.peakPowerW.toFixed(0)} W, ` +
-      `${t.mah.toFixed(0)} mAh, ${t.wh.toFixed(2)} Wh`;
+      `${fixed(t.mah, 0)} mAh, ${fixed(t.wh, 2)} Wh`;
     this.#log(fleet.log);
     this.#chart(escs, now);
   }
@@ -76,8 +77,8 @@ export class Dashboard {
       el('td', { 'data-col': 'power_w' }, power === null ? '–' : power.toFixed(0)),
       el('td', { 'data-col': 'rate' }, e.rate(now).toFixed(1)),
       el('td', { 'data-col': 'link' }, link ? `${link.lost_packets ?? 0}/${link.duplicate_packets ?? 0}/${link.checksum_failures ?? 0}` : '–'),
-      el('td', { 'data-col': 'mah' }, used.mah.toFixed(0)),
-      el('td', { 'data-col': 'wh' }, used.wh.toFixed(2)),
+      el('td', { 'data-col': 'mah' }, used ? used.mah.toFixed(0) : '–'),
+      el('td', { 'data-col': 'wh' }, used ? used.wh.toFixed(2) : '–'),
       el('td', { 'data-col': 'age' }, e.lastT === null ? '–' : Math.max(0, now - e.lastT).toFixed(1)),
       el('td', { 'data-col': 'alarms' }, ...alarms.map((a) => el('span', { class: `alarm ${a.level}` }, a.name, ' ')),
         ...e.faults.filter((f) => !alarms.some((a) => a.name === f)).map((f) => el('span', { class: 'fault' }, f, ' '))),

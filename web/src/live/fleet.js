@@ -79,9 +79,9 @@ class Esc {
     return recent.length / RATE_WINDOW_S;
   }
 
-  /** Charge (mAh) and energy (Wh) since the last reset, from the session's summary. */
+  /** Charge (mAh) and energy (Wh) since the last reset, from the session's summary; null without one. */
   used() {
-    if (!this.energy) return { mah: 0, wh: 0 };
+    if (!this.energy) return null;
     const b = this.energyBase ?? { charge_mah: 0, energy_wh: 0 };
     return { mah: this.energy.charge_mah - b.charge_mah, wh: this.energy.energy_wh - b.energy_wh };
   }
@@ -229,18 +229,20 @@ export class Fleet {
     }
   }
 
-  /** All ESCs together: power now (W, the sum of their latest frames), its peak, mAh, Wh. */
+  /** All ESCs together: power now (W, the sum of their latest frames), its peak, mAh, Wh (null where no summary gives them). */
   totals() {
     let power = 0;
-    let mah = 0;
-    let wh = 0;
+    let mah = null;
+    let wh = null;
     for (const e of this.escs.values()) {
       const p = powerOf(e.values);
       if (p !== null) power += p;
       e.peakPowerW = Math.max(e.peakPowerW ?? 0, p ?? 0);
       const used = e.used();
-      mah += used.mah;
-      wh += used.wh;
+      if (used) {
+        mah = (mah ?? 0) + used.mah;
+        wh = (wh ?? 0) + used.wh;
+      }
     }
     this.peakPowerW = Math.max(this.peakPowerW ?? 0, power);
     return { powerW: power, peakPowerW: this.peakPowerW, mah, wh };
