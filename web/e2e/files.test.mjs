@@ -82,6 +82,25 @@ for (const file of recordings()) {
   });
 }
 
+test('the CSV of the whole recording is hwfoc decode --format csv', async () => {
+  for (const file of ['testdata/captures/xrotor-v4-pro-hv-80A.csv', 'testdata/captures/platinum-v4.csv']) {
+    const page = await openInPage([file], 1280);
+    try {
+      const [download] = await Promise.all([page.waitForEvent('download'), page.click('button.export')]);
+      const csv = await (await download.createReadStream()).toArray();
+      const shown = Buffer.concat(csv).toString();
+      const expected = hwfoc('decode', '--format', 'csv', file);
+      const a = shown.split('\n');
+      const b = expected.split('\n');
+      for (let i = 0; i < Math.max(a.length, b.length); i++) {
+        assert.equal(a[i], b[i], `${file}: line ${i + 1}`);
+      }
+    } finally {
+      await page.close();
+    }
+  }
+});
+
 test('screenshots at 390 px and 1280 px', async () => {
   const dir = screenshotsDir();
   const files = ['testdata/captures/xrotor-v4-pro-hv-80A.csv', 'testdata/dronecan/can-bus.candump.txt'];

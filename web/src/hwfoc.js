@@ -89,6 +89,16 @@ export function openFile(name, bytes) {
 }
 
 /**
+ * The names of a status word's set fault bits, in bit order, as a record's `faults` gives them.
+ * @param {string} protocol as `--protocol` names it (a record's `protocols[protocol]`)
+ * @param {number} status the record's `status`
+ * @returns {string[]}
+ */
+export function faultNames(protocol, status) {
+  return Array.from(wasm.faultNames(protocol, status));
+}
+
+/**
  * A recording of a port's bytes with their receive times, as `hwfoc record` writes it.
  */
 export class Recorder {
@@ -109,15 +119,4 @@ export class Recorder {
   finish() {
     return this.inner.finish();
   }
-}
-
-/**
- * The names of the fault bits set in a record's `status` for a frame of `protocol` (a name of
- * `protocols`), in bit order: the record schema's `faults`.
- * @param {string} protocol
- * @param {number} status
- * @returns {string[]}
- */
-export function faultNames(protocol, status) {
-  return Array.from(wasm.faultNames(protocol, status));
 }

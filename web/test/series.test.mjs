@@ -1,7 +1,7 @@
 import { test } from 'node:test';
 import assert from 'node:assert/strict';
 import { envelope, lowerBound, nearest, range, splitByEsc, timed, gather } from '../src/files/series.js';
-import { toCsv, float32Text } from '../src/files/csv.js';
+import { toCsv, float32Text, csvColumns } from '../src/files/csv.js';
 
 test('envelope keeps each pixel column first, min, max and last', () => {
   const xs = [0, 0.1, 0.2, 0.3, 1.0, 1.5];
@@ -45,12 +45,23 @@ test('splitByEsc and timed', () => {
   assert.deepEqual(Array.from(gather(Float32Array.of(9, 8, 7, 6, 5), escs[1].index)), [8, 6]);
 });
 
-test('toCsv writes nulls as empty cells and protocols by name', () => {
+test('toCsv writes nulls as empty cells, protocols by name, faults from the status', () => {
   const records = {
     protocols: ['hw-foc', 'datalink'],
-    columns: { t_s: Float64Array.of(0.5, NaN), protocol: Uint8Array.of(0, 1), voltage_v: Float32Array.of(24.7, NaN) },
+    columns: {
+      t_s: Float64Array.of(0.5, NaN),
+      protocol: Uint8Array.of(0, 1),
+      voltage_v: Float32Array.of(24.7, NaN),
+      status: Float64Array.of(5, NaN),
+    },
   };
-  assert.equal(toCsv(records, ['t_s', 'protocol', 'voltage_v'], [0, 1]), 't_s,protocol,voltage_v\n0.5,hw-foc,24.7\n,datalink,\n');
+  const names = csvColumns(records);
+  assert.deepEqual(names, ['t_s', 'protocol', 'voltage_v', 'status', 'faults']);
+  const faultNames = (p, s) => (p === 'hw-foc' && s === 5 ? ['a', 'c'] : ['?']);
+  assert.equal(
+    toCsv(records, names, [0, 1], faultNames),
+    't_s,protocol,voltage_v,status,faults\n0.5,hw-foc,24.7,5,a|c\n,datalink,,,\n',
+  );
 });
 
 test('float32Text gives the shortest decimal of a float32', () => {
@@ -60,7 +71,7 @@ test('float32Text gives the shortest decimal of a float32', () => {
 });
 
 import { View } from '../src/files/view.js';
-import { formatTick } from '../src/files/chart.js';
+import { formatTick, niceTicks } from '../src/files/chart.js';
 
 test('View zooms about a point and stays inside the recording', () => {
   const v = new View(0, 100);
@@ -76,4 +87,10 @@ test('formatTick', () => {
   assert.equal(formatTick(12.34567), '12.35');
   assert.equal(formatTick(NaN), '');
   assert.equal(formatTick(2e7), '2.00e+7');
+});
+
+test('niceTicks', () => {
+  assert.deepEqual(niceTicks(0, 10, 5), [0, 2, 4, 6, 8, 10]);
+  assert.deepEqual(niceTicks(23.4, 24.9, 3), [23.5, 24, 24.5]);
+  assert.deepEqual(niceTicks(1, 1, 3), []);
 });

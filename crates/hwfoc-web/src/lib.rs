@@ -79,16 +79,13 @@ impl WasmSession {
     }
 }
 
-/// The names of the fault bits set in `status` (a record's `status`) for a frame of `protocol`
-/// (as `--protocol` names it), in bit order: the record's `faults` column. None for a protocol
-/// whose word has no known fault bit, or an unknown name.
+/// The names of the set fault bits of `status` in bit order, by `protocol` (a name
+/// `--protocol` takes), as a record's `faults` gives them; empty for an unknown protocol.
 #[wasm_bindgen(js_name = faultNames)]
 pub fn fault_names(protocol: &str, status: u16) -> Array {
     hwfoc::Protocol::from_name(protocol)
-        .map(|p| {
-            p.fault_names(hwfoc::Status(status))
-                .map(JsValue::from_str)
-                .collect()
-        })
-        .unwrap_or_default()
+        .into_iter()
+        .flat_map(|p| p.fault_names(hwfoc::Status(status)))
+        .map(JsValue::from_str)
+        .collect()
 }

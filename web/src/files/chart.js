@@ -77,19 +77,32 @@ export class Chart {
       if (b >= a) ctx.fillRect(left + a, top, Math.max(1, b - a), height);
     }
 
-    ctx.strokeStyle = '#bbb';
     ctx.lineWidth = 1;
-    ctx.strokeRect(left + 0.5, top + 0.5, width - 1, height - 1);
-    ctx.fillStyle = '#444';
     ctx.font = '11px system-ui, sans-serif';
+    ctx.fillStyle = '#444';
+    ctx.strokeStyle = '#eee';
     ctx.textAlign = 'right';
-    ctx.fillText(formatTick(hi), left - 4, top + 8);
-    ctx.fillText(formatTick(lo), left - 4, top + height);
+    for (const v of niceTicks(lo, hi, Math.max(2, Math.floor(height / 35)))) {
+      const y = Math.round(yOf(v)) + 0.5;
+      ctx.beginPath();
+      ctx.moveTo(left, y);
+      ctx.lineTo(left + width, y);
+      ctx.stroke();
+      ctx.fillText(formatTick(v), left - 4, y + 4);
+    }
+    ctx.textAlign = 'center';
+    for (const v of niceTicks(view.x0, view.x1, Math.max(2, Math.floor(width / 90)))) {
+      const x = Math.round(left + (v - view.x0) * xScale) + 0.5;
+      ctx.beginPath();
+      ctx.moveTo(x, top);
+      ctx.lineTo(x, top + height);
+      ctx.stroke();
+      ctx.fillText(formatTick(v), x, top + height + 13);
+    }
+    ctx.strokeStyle = '#bbb';
+    ctx.strokeRect(left + 0.5, top + 0.5, width - 1, height - 1);
     ctx.textAlign = 'left';
     ctx.fillText(this.title, left + 4, top - 3);
-    ctx.fillText(formatTick(view.x0), left, top + height + 13);
-    ctx.textAlign = 'right';
-    ctx.fillText(formatTick(view.x1), left + width, top + height + 13);
 
     envs.forEach((env, k) => {
       ctx.strokeStyle = lines[k].colour;
@@ -118,6 +131,25 @@ export class Chart {
       ctx.stroke();
     }
   }
+}
+
+/**
+ * Round values between `lo` and `hi` for about `count` ticks (steps of 1, 2 or 5 times a power
+ * of ten).
+ * @param {number} lo
+ * @param {number} hi
+ * @param {number} count
+ */
+export function niceTicks(lo, hi, count) {
+  if (!(hi > lo) || count < 1) return [];
+  const raw = (hi - lo) / count;
+  const power = 10 ** Math.floor(Math.log10(raw));
+  const step = [1, 2, 5, 10].map((m) => m * power).find((s) => s >= raw) ?? 10 * power;
+  const ticks = [];
+  for (let v = Math.ceil(lo / step) * step; v <= hi + step * 1e-9; v += step) {
+    ticks.push(Number(v.toPrecision(12)));
+  }
+  return ticks;
 }
 
 /**

@@ -25,19 +25,37 @@ function cell(v, f32) {
 }
 
 /**
- * The CSV text of the records at `rows` (places in the columns, in order).
+ * The column names of a CSV of `records`: theirs, with `faults` after `status` as the
+ * command's CSV has it.
+ * @param {{columns: object}} records
+ */
+export function csvColumns(records) {
+  return Object.keys(records.columns).flatMap((n) => (n === 'status' ? ['status', 'faults'] : [n]));
+}
+
+/**
+ * The CSV text of the records at `rows` (places in the columns, in order). `faults` is made from
+ * `status` and `protocol` by `faultNames(protocol, status)`, `|`-joined.
  * @param {{columns: Object<string, ArrayLike<number>>, protocols: string[]}} records
  * @param {string[]} names the columns to write, in order
  * @param {ArrayLike<number>} rows
+ * @param {(protocol: string, status: number) => string[]} [faultNames]
  */
-export function toCsv(records, names, rows) {
+export function toCsv(records, names, rows, faultNames = () => []) {
   const lines = [names.join(',')];
+  const { status, protocol } = records.columns;
+  const faults = (i) =>
+    Number.isNaN(status[i]) ? '' : faultNames(records.protocols[protocol[i]], status[i]).join('|');
   const columns = names.map((n) => records.columns[n]);
   const f32 = columns.map((c) => c instanceof Float32Array);
   for (let k = 0; k < rows.length; k++) {
     const i = rows[k];
     const cells = names.map((n, c) =>
-      n === 'protocol' ? records.protocols[columns[c][i]] : cell(columns[c][i], f32[c]),
+      n === 'protocol'
+        ? records.protocols[columns[c][i]]
+        : n === 'faults'
+          ? faults(i)
+          : cell(columns[c][i], f32[c]),
     );
     lines.push(cells.join(','));
   }

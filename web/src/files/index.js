@@ -2,7 +2,7 @@
 // (api.openFile), summarised per ESC, and charted with zoom, pan and a cursor readout.
 
 import { Chart, COLOURS } from './chart.js';
-import { toCsv } from './csv.js';
+import { csvColumns, toCsv } from './csv.js';
 import { gather, nearest, splitByEsc, timed } from './series.js';
 import { escSummary } from './summary.js';
 import { View } from './view.js';
@@ -107,7 +107,7 @@ export function mountFiles(root, api) {
     summaries.replaceChildren(...escs.map((esc, k) => escSummary(doc, esc, COLOURS[k % COLOURS.length])));
     const plot = root.querySelector('.plot');
     plot.hidden = recording.error !== undefined || recording.records.count === 0;
-    if (!plot.hidden) mountPlot(plot, recording);
+    if (!plot.hidden) mountPlot(plot, recording, api);
   }
 }
 
@@ -178,8 +178,9 @@ function episodes(recording, escNumber) {
  * Builds the controls and charts of `recording` in `plot`.
  * @param {HTMLElement} plot
  * @param {object} recording
+ * @param {typeof import('../hwfoc.js')} api
  */
-function mountPlot(plot, recording) {
+function mountPlot(plot, recording, api) {
   const doc = plot.ownerDocument;
   const unit = recording.timed ? 's' : 'frame';
   const escBox = plot.querySelector('.escs');
@@ -297,7 +298,8 @@ function mountPlot(plot, recording) {
     redraw();
   };
   plot.querySelector('.export').onclick = () => {
-    const csv = toCsv(recording.records, Object.keys(recording.records.columns), rowsInView(recording));
+    const { records } = recording;
+    const csv = toCsv(records, csvColumns(records), rowsInView(recording), api.faultNames);
     const a = doc.createElement('a');
     a.href = URL.createObjectURL(new Blob([csv], { type: 'text/csv' }));
     a.download = `${recording.name.replace(/\.[^.]*$/, '')}-view.csv`;
