@@ -280,3 +280,12 @@ test('sixteen ESCs at their frame rates, the page responsive', { skip: missing, 
   assert.ok(longest < 200, `longest task ${longest} ms`);
   await page.screenshot({ path: `${shots}live-16-1280.png`, fullPage: true });
 });
+
+test('an SLCAN adapter is opened at 115200 baud with the command\'s sequence at the bitrate chosen', { skip: missing, timeout: 30000 }, async () => {
+  const page = await livePage(1280, [{ baud: 115200, chunks: [] }]);
+  await page.selectOption('[aria-label="CAN bitrate"]', '1000000');
+  await page.getByTestId('add-slcan').click();
+  await page.waitForFunction(() => window.__fake.written[0].includes('O\r'));
+  assert.equal(await page.evaluate(() => window.__fake.written[0]), '\rC\rS8\rO\r');
+  assert.deepEqual(await page.evaluate(() => window.__fake.opened.map((o) => o.baudRate)), [115200]);
+});

@@ -1,7 +1,7 @@
 // A fake `navigator.serial` for the browser tests, injected with `page.addInitScript`: each
 // port feeds its chunks (`{at: ms from the first, b64}`) at their real pace once opened at
 // its baud rate, and keeps what it fed in `window.__fake.fed[i]` (base64 per chunk) so a test
-// compares it with a recording. `__fake.unplug(i)` / `plug(i)` act as pulling the adapter out
+// compares it with a recording, and what the page wrote to it in `__fake.written[i]`. `__fake.unplug(i)` / `plug(i)` act as pulling the adapter out
 // and putting it back (the feed goes on from where it was); `__fake.refuseNext` makes the next
 // requestPort fail as a user who chose nothing; `__fake.busy[i]` makes open fail as a port
 // another program holds.
@@ -10,7 +10,7 @@
 export function installFakeSerial(ports) {
   const decode = (b64) => Uint8Array.from(atob(b64), (c) => c.charCodeAt(0));
   const serial = new EventTarget();
-  const fake = { fed: ports.map(() => []), busy: ports.map(() => false), refuseNext: false, opened: [] };
+  const fake = { fed: ports.map(() => []), written: ports.map(() => ''), busy: ports.map(() => false), refuseNext: false, opened: [] };
   const fire = (type, port) => {
     const event = new Event(type);
     Object.defineProperty(event, 'target', { value: port });
@@ -59,7 +59,9 @@ export function installFakeSerial(ports) {
         cancel: () => clearInterval(timer),
       });
       this.stopFeed = () => clearInterval(timer);
-      this.writable = new WritableStream({ write: () => {} });
+      this.writable = new WritableStream({
+        write: (chunk) => { fake.written[this.index] += new TextDecoder().decode(chunk); },
+      });
     }
 
     async close() {

@@ -80,7 +80,9 @@ export class Dashboard {
       el('td', { 'data-col': 'mah' }, used ? used.mah.toFixed(0) : '–'),
       el('td', { 'data-col': 'wh' }, used ? used.wh.toFixed(2) : '–'),
       el('td', { 'data-col': 'age' }, e.lastT === null ? '–' : Math.max(0, now - e.lastT).toFixed(1)),
-      el('td', { 'data-col': 'alarms' }, ...alarms.map((a) => el('span', { class: `alarm ${a.level}` }, a.name, ' ')),
+      el('td', { 'data-col': 'alarms' }, ...alarms.map((a) => el('span', { class: `alarm ${a.level}` },
+        // A port that is gone reads as the monitor's does: `disconnected 12 s`.
+        a.name === 'disconnected' ? `disconnected ${Math.max(0, now - e.latch('disconnected').since).toFixed(0)} s` : a.name, ' ')),
         ...e.faults.filter((f) => !alarms.some((a) => a.name === f)).map((f) => el('span', { class: 'fault' }, f, ' '))),
     );
     row.className = lost ? 'lost' : '';
