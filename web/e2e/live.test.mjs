@@ -289,3 +289,27 @@ test('an SLCAN adapter is opened at 115200 baud with the command\'s sequence at 
   assert.equal(await page.evaluate(() => window.__fake.written[0]), '\rC\rS8\rO\r');
   assert.deepEqual(await page.evaluate(() => window.__fake.opened.map((o) => o.baudRate)), [115200]);
 });
+
+test('the port search finds an HW5 ESC at 115200 baud after the bytes at 19200 gave no frame', { skip: missing, timeout: 60000 }, async () => {
+  const dir = mkdtempSync(`${tmpdir()}/hwfoc-hw5-`);
+  execFileSync(hwfocBin(), ['simulate', '--protocol', 'hw5', '--escs', '1', '--duration', '8', '--no-config', '-o', `${dir}/hw5.pcapng`], { stdio: 'ignore' });
+  const p = packets(readFileSync(`${dir}/hw5.pcapng`));
+  const spec = { baud: 115200, chunks: p.map((k) => ({ at: (k.t - p[0].t) * 1000, b64: Buffer.from(k.data).toString('base64') })) };
+  const page = await livePage(1280, [spec]);
+  await page.getByTestId('add-port').click();
+  await page.waitForFunction(() => document.querySelector('[data-testid=port-status]').textContent.includes('found at 115200 baud'), null, { timeout: 10000 });
+  const opened = await page.evaluate(() => window.__fake.opened.map((o) => [o.baudRate, Math.round(o.at)]));
+  assert.deepEqual(opened.map((o) => o[0]), [19200, 115200]);
+  // Left after 1.5 s of bytes without a frame (the command's SEARCH_BYTES_FOR), not before.
+  const ms = opened[1][1] - opened[0][1];
+  assert.ok(ms >= 1500 && ms < 2500, `${ms} ms at 19200 baud`);
+  await page.waitForFunction(() => window.__fake.done(), null, { timeout: 20000 });
+  await page.waitForTimeout(600);
+  // Nothing read at 19200 reached the decoder: the frames shown are the file's.
+  const decoded = execFileSync(hwfocBin(), ['decode', '--no-config', `${dir}/hw5.pcapng`], { encoding: 'utf8' }).trim().split('\n').map((l) => JSON.parse(l));
+  const fed = await page.evaluate(() => window.__fake.fed[0].length);
+  const frames = Number(await page.locator('[data-esc="0"]').getAttribute('data-frames'));
+  assert.ok(frames > 0 && frames <= decoded.length, `${frames} frames of ${decoded.length} (${fed} chunks fed at 115200)`);
+  const last = decoded.at(-1);
+  assert.ok(Math.abs(Number(await page.locator('[data-esc="0"] [data-col=voltage_v]').getAttribute('data-value')) - last.voltage_v) < 1e-4);
+});

@@ -1,6 +1,6 @@
 // A fake `navigator.serial` for the browser tests, injected with `page.addInitScript`: each
-// port feeds its chunks (`{at: ms from the first, b64}`) at their real pace once opened at
-// its baud rate, and keeps what it fed in `window.__fake.fed[i]` (base64 per chunk) so a test
+// port feeds its chunks (`{at: ms from the first, b64}`) at their real pace once opened (as
+// random bytes when opened at another rate than its `baud`), and keeps what it fed in `window.__fake.fed[i]` (base64 per chunk) so a test
 // compares it with a recording, and what the page wrote to it in `__fake.written[i]`. `__fake.unplug(i)` / `plug(i)` act as pulling the adapter out
 // and putting it back (the feed goes on from where it was); `__fake.refuseNext` makes the next
 // requestPort fail as a user who chose nothing; `__fake.busy[i]` makes open fail as a port
@@ -47,12 +47,16 @@ export function installFakeSerial(ports) {
         start: (controller) => {
           this.controller = controller;
           timer = setInterval(() => {
-            if (!right) return;
             const now = performance.now() - base;
             while (this.next < this.chunks.length && this.chunks[this.next].at <= now) {
               const bytes = this.chunks[this.next++].bytes;
-              fake.fed[this.index].push(btoa(String.fromCharCode(...bytes)));
-              controller.enqueue(bytes.slice());
+              if (right) {
+                fake.fed[this.index].push(btoa(String.fromCharCode(...bytes)));
+                controller.enqueue(bytes.slice());
+              } else {
+                // Read at another rate, a UART makes line noise of the wire's edges.
+                controller.enqueue(bytes.map(() => Math.floor(Math.random() * 256)));
+              }
             }
           }, 5);
         },
