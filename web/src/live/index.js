@@ -114,7 +114,13 @@ export function mountLive(element, api, { serial = globalThis.navigator?.serial 
     await open(port, slcanBitrate);
   }
 
-  const onConnect = (event) => ports.forEach((p) => p.connected(event.target ?? event.port));
+  // A device plugged back in resumes the lost port that is the same object, else the first lost
+  // one with its USB ids (Web Serial gives no serial number to tell two alike adapters apart).
+  const onConnect = (event) => {
+    const port = event.target ?? event.port;
+    const lost = ports.find((p) => p.awaits(port) && p.port === port) ?? ports.find((p) => p.awaits(port));
+    lost?.connected(port);
+  };
   const onDisconnect = (event) => ports.forEach((p) => p.disconnected(event.target ?? event.port));
   serial?.addEventListener?.('connect', onConnect);
   serial?.addEventListener?.('disconnect', onDisconnect);

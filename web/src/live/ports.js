@@ -112,7 +112,8 @@ export class LivePort {
     }
     const slcan = this.options.slcan ? new SlcanLines() : null;
     try {
-      while (this.port.readable && !this.stopped && outcome !== 'next') {
+      this.unplugged = false;
+      while (this.port.readable && !this.stopped && !this.unplugged && outcome !== 'next') {
         this.reader = this.port.readable.getReader();
         try {
           for (;;) {
@@ -175,18 +176,24 @@ export class LivePort {
     });
   }
 
-  /** The browser says `port` was plugged in: if it is this one, reading resumes. */
+  /** Whether this port is lost and waiting for `port` (itself, or a device with its USB ids). */
+  awaits(port) {
+    return this.state === 'lost' && samePort(this.port, port);
+  }
+
+  /** The browser says `port`, this port's device, was plugged in: reading resumes. */
   connected(port) {
-    if (this.state !== 'lost' || !samePort(this.port, port)) return;
+    if (this.state !== 'lost') return;
     this.port = port;
     const resolve = this.replugged;
     this.replugged = null;
     resolve?.();
   }
 
-  /** The browser says `port` was unplugged: if it is this one, the read ends as lost. */
+  /** The browser says `port` was unplugged: if it is this very port, the read ends as lost. */
   disconnected(port) {
-    if (!samePort(this.port, port)) return;
+    if (this.port !== port) return;
+    this.unplugged = true;
     this.reader?.cancel().catch(() => {});
   }
 
