@@ -6,7 +6,7 @@ export const SERIAL_BROWSERS = 'Chrome, Edge or Firefox 151 and later';
 /** The note a browser without Web Serial shows in place of the live mode. */
 export function noSerialNote() {
   return `This browser cannot open serial ports (Web Serial). Live mode needs ${SERIAL_BROWSERS} ` +
-    'on a desktop computer; the Files tab works here: open a recording made with `hwfoc record`.';
+    'on a desktop computer; the Files tab works here: open a recording made with hwfoc record.';
 }
 
 /** Whether the page can open serial ports. */
@@ -16,7 +16,7 @@ export function hasWebSerial(nav = globalThis.navigator) {
 
 /** Linux's group whose members may open serial devices, and the fix. */
 const DIALOUT = 'on Linux your user must be in the dialout group: ' +
-  '`sudo usermod -aG dialout $USER`, then log out and in again';
+  'sudo usermod -aG dialout $USER, then log out and in again';
 
 /**
  * The line a person reads for an error of `requestPort` or `open` (`what`: 'choose' or

@@ -39,7 +39,8 @@ export function mountLive(element, api, { serial = globalThis.navigator?.serial 
   const addCan = el('button', { type: 'button', 'data-testid': 'add-slcan' }, 'Add SLCAN adapter');
   const demo = el('button', { type: 'button', 'data-testid': 'demo' }, 'Demo');
   const record = el('button', { type: 'button', 'data-testid': 'record' }, 'Record');
-  const board = el('div', { class: 'live-board' });
+  // The dashboard shows once there is an ESC to show.
+  const board = el('div', { class: 'live-board', hidden: true });
   const dashboard = new Dashboard(board, { onResetPeaks: () => fleet.resetPeaks() });
   const bar = el('div', { class: 'live-bar' });
   element.replaceChildren(bar, message, portList, board);
@@ -166,7 +167,8 @@ export function mountLive(element, api, { serial = globalThis.navigator?.serial 
     for (const [index, s] of sessions) fleet.addRecords(index, s.takeRecords(), now);
     fleet.tick(now);
     for (const e of fleet.escs.values()) e.state = ports[e.port]?.state;
-    dashboard.render(fleet, now);
+    board.hidden = fleet.escs.size === 0;
+    if (!board.hidden) dashboard.render(fleet, now);
   }
 
   const timers = [
