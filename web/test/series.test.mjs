@@ -1,6 +1,6 @@
 import { test } from 'node:test';
 import assert from 'node:assert/strict';
-import { envelope, lowerBound, nearest, range, splitByEsc, timed, gather } from '../src/files/series.js';
+import { envelope, blocks, lowerBound, nearest, range, splitByEsc, timed, gather } from '../src/files/series.js';
 import { toCsv, float32Text, csvColumns } from '../src/files/csv.js';
 
 test('envelope keeps each pixel column first, min, max and last', () => {
@@ -24,6 +24,24 @@ test('envelope of a million samples keeps the extremes', () => {
   ys[123_456] = 50;
   ys[654_321] = -50;
   assert.deepEqual(range(envelope(xs, ys, 0, n, 800)), [-50, 50]);
+});
+
+test('the envelope from blocks keeps the extremes and the columns of the samples', () => {
+  const n = 1_000_000;
+  const xs = new Float64Array(n).map((_, i) => i);
+  const ys = new Float32Array(n).map((_, i) => (i % 1000) / 10);
+  ys[123_457] = 500;
+  ys[654_321] = NaN;
+  ys[654_322] = -500;
+  const exact = envelope(xs, ys, 0, n, 100);
+  const fast = envelope(xs, ys, 0, n, 100, blocks(ys));
+  assert.deepEqual(range(fast), [-500, 500]);
+  assert.deepEqual(Array.from(fast), Array.from(exact));
+  // Zoomed in, too few samples per column for blocks: sample by sample.
+  assert.deepEqual(
+    Array.from(envelope(xs, ys, 1000, 2000, 100, blocks(ys))),
+    Array.from(envelope(xs, ys, 1000, 2000, 100)),
+  );
 });
 
 test('lowerBound and nearest', () => {

@@ -32,7 +32,7 @@ export class Chart {
   /**
    * Draws the lines.
    * @param {{x0: number, x1: number}} view
-   * @param {{xs: ArrayLike<number>, ys: ArrayLike<number>, colour: string}[]} lines
+   * @param {{xs: ArrayLike<number>, ys: ArrayLike<number>, blocked?: object, colour: string}[]} lines
    * @param {{from: number, to: number}[]} shaded fault episodes, in x
    * @param {number | null} cursor the cursor's x, or null
    */
@@ -52,7 +52,7 @@ export class Chart {
     const top = 14;
     const height = Math.max(1, cssH - top - MARGIN_BOTTOM);
     const px = Math.max(1, Math.floor(width));
-    const envs = lines.map((l) => envelope(l.xs, l.ys, view.x0, view.x1, px));
+    const envs = lines.map((l) => envelope(l.xs, l.ys, view.x0, view.x1, px, l.blocked));
     let lo = Infinity;
     let hi = -Infinity;
     for (const env of envs) {

@@ -3,7 +3,7 @@
 
 import { Chart, COLOURS } from './chart.js';
 import { csvColumns, toCsv } from './csv.js';
-import { gather, nearest, splitByEsc, timed } from './series.js';
+import { blocks, gather, nearest, splitByEsc, timed } from './series.js';
 import { escSummary } from './summary.js';
 import { View } from './view.js';
 
@@ -42,17 +42,15 @@ export function mountFiles(root, api) {
   const input = root.querySelector('input[type=file]');
   const drop = root.querySelector('.drop');
   const state = { recordings: [], current: null };
+  const opener = makeOpener(api);
 
   const open = async (files) => {
     for (const file of files) {
       const bytes = new Uint8Array(await file.arrayBuffer());
       const started = performance.now();
-      let opened;
-      try {
-        opened = api.openFile(file.name, bytes);
-      } catch (e) {
-        opened = { error: `${file.name}: ${e.message ?? e}` };
-      }
+      drop.setAttribute('aria-busy', 'true');
+      const opened = await opener(file.name, bytes);
+      drop.removeAttribute('aria-busy');
       const recording = prepare(file.name, opened, performance.now() - started);
       state.recordings.push(recording);
       show(recording);
@@ -112,6 +110,51 @@ export function mountFiles(root, api) {
 }
 
 /**
+ * Opens a recording: in a worker where the browser has module workers (the page stays
+ * responsive while a large file is decoded), else on the page's thread.
+ * @param {typeof import('../hwfoc.js')} api
+ * @returns {(name: string, bytes: Uint8Array) => Promise<object>} openFile's answer, or {error}
+ */
+function makeOpener(api) {
+  const direct = async (name, bytes) => {
+    try {
+      return api.openFile(name, bytes);
+    } catch (e) {
+      return { error: `${name}: ${e?.message ?? e}` };
+    }
+  };
+  let worker;
+  try {
+    worker = new Worker(new URL('./worker.js', import.meta.url), { type: 'module' });
+  } catch {
+    return direct;
+  }
+  const waiting = new Map();
+  let next = 0;
+  worker.onmessage = ({ data }) => {
+    waiting.get(data.id)?.(data.error ? { error: data.error } : data.opened);
+    waiting.delete(data.id);
+  };
+  worker.onerror = (e) => {
+    // A worker that cannot start (no module workers): every open goes on the page's thread.
+    e.preventDefault?.();
+    worker = null;
+    for (const [id, done] of waiting) done(null);
+    waiting.clear();
+  };
+  return async (name, bytes) => {
+    if (!worker) return direct(name, bytes);
+    const id = next++;
+    const answer = await new Promise((done) => {
+      waiting.set(id, done);
+      // Copied, not transferred: the page keeps the bytes should the worker fail.
+      worker.postMessage({ id, name, bytes });
+    });
+    return answer ?? direct(name, bytes);
+  };
+}
+
+/**
  * A recording as the page holds it: what openFile gave, split by ESC, with each ESC's x.
  * @param {string} name
  * @param {{records?: object, summary?: object, notices?: string[], error?: string}} opened
@@ -152,13 +195,17 @@ function prepare(name, opened, openMs) {
 }
 
 /**
- * An ESC's values of one column, gathered once.
+ * An ESC's values of one column and their blocks' extremes, made once.
  * @param {object} recording
  * @param {object} esc
  * @param {string} name
+ * @returns {{ys: ArrayLike<number>, blocked: {min: Float32Array, max: Float32Array}}}
  */
-function ys(recording, esc, name) {
-  if (!esc.ys.has(name)) esc.ys.set(name, gather(recording.records.columns[name], esc.index));
+function series(recording, esc, name) {
+  if (!esc.ys.has(name)) {
+    const ys = gather(recording.records.columns[name], esc.index);
+    esc.ys.set(name, { ys, blocked: blocks(ys) });
+  }
   return esc.ys.get(name);
 }
 
@@ -231,7 +278,7 @@ function mountPlot(plot, recording, api) {
         const lines = recording.escs
           .map((e, k) => ({ e, colour: COLOURS[k % COLOURS.length] }))
           .filter(({ e }) => e.chosen)
-          .map(({ e, colour }) => ({ xs: e.xs, ys: ys(recording, e, q), colour }));
+          .map(({ e, colour }) => ({ xs: e.xs, ...series(recording, e, q), colour }));
         chart.draw(recording.view, lines, shaded, cursor);
       }
       showReadout();
@@ -247,7 +294,7 @@ function mountPlot(plot, recording, api) {
     for (const e of recording.escs.filter((x) => x.chosen)) {
       const k = nearest(e.xs, cursor);
       if (k < 0) continue;
-      const values = charts.map(({ q }) => `${q} ${fmt(ys(recording, e, q)[k])}`);
+      const values = charts.map(({ q }) => `${q} ${fmt(series(recording, e, q).ys[k])}`);
       parts.push(`ESC ${e.esc}: ${values.join(', ')}`);
     }
     readout.textContent = parts.join(' | ');
