@@ -9,7 +9,7 @@ const CACHE = 'hwfoc-web-v1';
 const AHEAD = [
   './', './index.html', './style.css', './src/main.js', './src/hwfoc.js',
   './pkg/hwfoc_web.js', './pkg/hwfoc_web_bg.wasm',
-  './src/files/chart.js', './src/files/csv.js', './src/files/index.js', './src/files/series.js', './src/files/summary.js', './src/files/view.js',
+  './src/files/chart.js', './src/files/csv.js', './src/files/index.js', './src/files/series.js', './src/files/summary.js', './src/files/view.js', './src/files/worker.js',
   './src/live/index.js', './src/live/alarms.js', './src/live/baud.js', './src/live/dashboard.js', './src/live/dom.js',
   './src/live/demo.js', './src/live/errors.js', './src/live/fleet.js', './src/live/limits.js',
   './src/live/ports.js', './src/live/recording.js', './src/live/slcan.js', './src/live/live.css',
