@@ -3,7 +3,7 @@
 
 import { createServer } from 'node:http';
 import { readFile } from 'node:fs/promises';
-import { existsSync, mkdirSync } from 'node:fs';
+import { existsSync, mkdirSync, readFileSync } from 'node:fs';
 import { extname, join, normalize, dirname } from 'node:path';
 import { fileURLToPath } from 'node:url';
 import { execFileSync } from 'node:child_process';
@@ -64,6 +64,18 @@ export function launch() {
 export function hwfoc(...args) {
   const bin = process.env.HWFOC ?? join(ROOT, 'target', 'debug', 'hwfoc');
   return execFileSync(bin, args, { cwd: ROOT, maxBuffer: 1 << 28 }).toString();
+}
+
+/**
+ * Why the tests of files other than raw bytes are skipped, or false: the WebAssembly build
+ * reads analyser CSV, pcapng and CAN logs, and summarises, once crates/hwfoc-records (the
+ * command's OS-free readers) is in the workspace; its glue then exports `openFile`.
+ */
+export function needsReaders() {
+  const glue = readFileSync(join(DIST, 'pkg', 'hwfoc_web.js'), 'utf8');
+  return /export function openFile/.test(glue)
+    ? false
+    : 'needs the command\'s readers in the WebAssembly build (crates/hwfoc-records)';
 }
 
 /** Makes the screenshots' folder. */

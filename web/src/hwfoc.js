@@ -104,6 +104,9 @@ export function faultNames(protocol, status) {
 export class Recorder {
   /** @param {{port?: string, baud?: number}} [options] */
   constructor({ port, baud } = {}) {
+    if (typeof wasm.WasmRecorder !== 'function') {
+      throw new Error("this build cannot record: the pcapng writer comes with the command's readers (crates/hwfoc-records)");
+    }
     this.inner = new wasm.WasmRecorder(port ?? 'port', baud ?? 0);
   }
 

@@ -52,7 +52,12 @@ pub fn hub_record(data: &Data, settings: &Settings, packet: u16) -> DataFrame {
     let amps = settings.amps_linear();
     let status = match data {
         Data::Hw5(frame) => frame.fault.hwfoc_status(),
-        _ => Status::OK,
+        Data::HwFoc(_)
+        | Data::DataLink(_)
+        | Data::HwV4(_)
+        | Data::HwV3(_)
+        | Data::HwCan(_)
+        | Data::DroneCan(_) => Status::OK,
     };
     DataFrame {
         packet: data.packet().map_or(packet, |p| p as u16),

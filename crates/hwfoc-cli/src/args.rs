@@ -225,6 +225,12 @@ pub struct SettingsArgs {
     /// models) [default: from the configuration file, else 8/910].
     #[arg(long, value_name = "N/D", help_heading = "Settings")]
     pub v4_volts_per_step: Option<VoltsPerStep>,
+    /// A format's own setting, for every ESC (repeat for several): KEY=VALUE, the keys those of
+    /// the formats' descriptions (v4_volts_per_step=N/D, low or hv; its flag
+    /// --v4-volts-per-step, which wins, is an alias) [default: from the configuration file, else
+    /// the format's].
+    #[arg(long = "set", value_name = "KEY=VALUE", value_parser = format_setting, help_heading = "Settings")]
+    pub set: Vec<SettingsPatch>,
     /// Configuration file (TOML) [default: $HWFOC_CONFIG, else hwfoc/config.toml in the user's
     /// configuration directory, if it exists].
     #[arg(long, value_name = "FILE", help_heading = "Settings", long_help = SETTINGS_HELP)]
@@ -237,13 +243,27 @@ pub struct SettingsArgs {
 impl SettingsArgs {
     /// The settings set by flags.
     pub fn patch(&self) -> SettingsPatch {
-        SettingsPatch {
+        let flags = SettingsPatch {
             current_scale: self.current_scale,
             pole_pairs: self.pole_pairs,
             gear_ratio: self.gear_ratio,
             v4_volts_per_step: self.v4_volts_per_step,
-        }
+        };
+        // The last --set of a key wins; a flag of its own wins over --set.
+        let set = self
+            .set
+            .iter()
+            .fold(SettingsPatch::default(), |under, set| set.over(&under));
+        flags.over(&set)
     }
+}
+
+/// `--set KEY=VALUE`: a format's own setting ([`SettingsPatch::format_setting`]).
+fn format_setting(text: &str) -> Result<SettingsPatch, String> {
+    let (key, value) = text
+        .split_once('=')
+        .ok_or_else(|| format!("{text:?} is not KEY=VALUE"))?;
+    SettingsPatch::format_setting(key.trim(), value.trim()).map_err(|e| e.to_string())
 }
 
 /// The selection options that `decode` and `plot` share.

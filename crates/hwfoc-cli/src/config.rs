@@ -668,6 +668,7 @@ mod tests {
             pole_pairs: None,
             gear_ratio: None,
             v4_volts_per_step: None,
+            set: Vec::new(),
             config: config.map(Path::to_path_buf),
             no_config: config.is_none(),
         }

@@ -755,3 +755,83 @@ fn a_configuration_that_is_not_a_regular_file_is_an_error_naming_it() {
         "--no-config",
     ])));
 }
+
+/// `--set KEY=VALUE` sets a format's own setting by its description's key (`-` or `_`), as its
+/// flag does (`--v4-volts-per-step`, an alias that wins); each key is a configuration key too;
+/// an unknown key or a bad value is a usage error naming the keys or the value's form.
+#[test]
+fn set_key_value_sets_the_formats_own_settings_by_their_descriptions_keys() {
+    let dir = Dir::new();
+    let input = recording(&dir);
+    let home = dir.path("none");
+    let comment = |args: &[&str]| {
+        let out = ok(clean(&home)
+            .args(["decode", "--format", "csv", "--settings-comment"])
+            .args(args)
+            .arg(&input)
+            .output()
+            .expect("spawn"));
+        let text = String::from_utf8(out.stdout).unwrap();
+        text.lines().next().unwrap().to_string()
+    };
+    let hv = comment(&["--v4-volts-per-step", "hv"]);
+    assert!(hv.contains(" v4_volts_per_step=11/650 "), "{hv}");
+    for setting in hwfoc::Protocol::settings() {
+        let key = setting.key;
+        assert_eq!(comment(&["--set", &format!("{key}=hv")]), hv);
+        assert_eq!(
+            comment(&["--set", &format!("{}=hv", key.replace('_', "-"))]),
+            hv
+        );
+        // The flag wins over --set; the last --set wins.
+        let both = [
+            "--set",
+            &format!("{key}=8/900"),
+            "--v4-volts-per-step",
+            "hv",
+        ];
+        assert_eq!(comment(&both), hv);
+        let twice = [
+            "--set",
+            &format!("{key}=8/900"),
+            "--set",
+            &format!("{key}=hv"),
+        ];
+        assert_eq!(comment(&twice), hv);
+        // A configuration key of the same name, its description's default a value it takes.
+        let configured = user_config(&dir, &format!("[settings]\n{key} = \"hv\"\n"));
+        let out = ok(clean(&configured)
+            .args(["decode", "--format", "csv", "--settings-comment", &input])
+            .output()
+            .expect("spawn"));
+        let first = String::from_utf8(out.stdout).unwrap();
+        assert_eq!(first.lines().next(), Some(hv.as_str()));
+        let default = user_config(
+            &dir,
+            &format!("[settings]\n{key} = \"{}\"\n", setting.default),
+        );
+        ok(clean(&default)
+            .args(["decode", &input])
+            .output()
+            .expect("spawn"));
+    }
+    let bad = |set: &str, needle: &str| {
+        let out = clean(&home)
+            .args(["decode", "--set", set, &input])
+            .output()
+            .expect("spawn");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{err}");
+        assert!(err.contains(needle), "{needle:?} not in {err}");
+        assert!(!err.contains("panicked"), "{err}");
+    };
+    bad(
+        "nope=1",
+        "no format has this setting; the settings are: v4_volts_per_step",
+    );
+    bad(
+        "v4_volts_per_step=8/0",
+        "v4_volts_per_step: volts per step must be N/D",
+    );
+    bad("v4_volts_per_step", "is not KEY=VALUE");
+}

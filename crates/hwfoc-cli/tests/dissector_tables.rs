@@ -1,6 +1,8 @@
 //! The tables and formulas the Wireshark dissector (`wireshark/hwfoc.lua`) copies from the codec,
 //! read from the Lua source and compared with the codec's own: the fault names of HW-FOC's
-//! status word (with the fault table of `docs/PROTOCOL-NOTES.md`) and of HW5's fault byte, the ADC table of HW-FOC's temperatures, and the constants of V4's NTC
+//! status word (with the fault table of `docs/PROTOCOL-NOTES.md`) and of HW5's fault byte, a
+//! table for every format whose description has faults (names, and titles that say what the
+//! description says), the ADC table of HW-FOC's temperatures, and the constants of V4's NTC
 //! formula. The codec is the one source: a change there fails here until the copies follow.
 //! (How the dissector shows what these tables give is checked through tshark in `wireshark.rs`.)
 
@@ -99,6 +101,83 @@ fn the_dissectors_hw5_fault_bits_are_the_codecs_fault_names() {
     let codec = codec_fault_names(Protocol::Hw5);
     assert_eq!(codec.len(), 8);
     assert_eq!(lua_fault_names(&dissector(), "HW5_FAULTS"), codec);
+}
+
+/// Each `{ "name", "title" }` entry of a Lua table of faults, in order.
+fn lua_faults(lua: &str, table: &str) -> Vec<(String, String)> {
+    lua_table(lua, table)
+        .lines()
+        .filter_map(|line| line.trim().strip_prefix("{ \""))
+        .map(|rest| {
+            let mut quoted = rest.split('"').step_by(2);
+            let name = quoted.next().unwrap().to_string();
+            (name, quoted.next().unwrap_or_default().to_string())
+        })
+        .collect()
+}
+
+/// The words of `text`, in lower case (a hyphenated word is one: `start-up`).
+fn words(text: &str) -> Vec<String> {
+    text.split(|c: char| !c.is_alphanumeric() && c != '-')
+        .filter(|w| !w.is_empty())
+        .map(str::to_lowercase)
+        .collect()
+}
+
+/// Whether the dissector's title of a fault says what the codec's description does: each of its
+/// words is one of the description's (the title's `Reserved` is the description's `not
+/// assigned`), so a title may drop a description's filler words but add or change none.
+fn title_says(title: &str, description: &str) -> bool {
+    let description = words(description);
+    words(title)
+        .iter()
+        .flat_map(|w| match w.as_str() {
+            "reserved" => vec!["not".to_string(), "assigned".to_string()],
+            _ => vec![w.clone()],
+        })
+        .all(|w| description.contains(&w))
+}
+
+#[test]
+fn every_described_fault_word_has_a_dissector_table_saying_its_descriptions() {
+    let lua = dissector();
+    let tables = ["FAULTS", "HW5_FAULTS"].map(|t| (t, lua_faults(&lua, t)));
+    let mut with_faults = 0;
+    for p in Protocol::ALL {
+        let faults = p.description().faults;
+        if faults.is_empty() {
+            continue;
+        }
+        with_faults += 1;
+        let names: Vec<&str> = faults.iter().map(|f| f.name).collect();
+        let (table, entries) = tables
+            .iter()
+            .find(|(_, t)| t.iter().map(|(n, _)| n.as_str()).eq(names.iter().copied()))
+            .unwrap_or_else(|| panic!("hwfoc.lua has no fault table of {p}'s bits {names:?}"));
+        for ((name, title), fault) in entries.iter().zip(faults) {
+            assert!(
+                title_says(title, fault.description),
+                "hwfoc.lua {table} {name}: {title:?} does not say the codec's {:?}",
+                fault.description
+            );
+        }
+    }
+    // HW-FOC, DataLink (its hub records carry HW-FOC's status word) and HW5.
+    assert_eq!(with_faults, 3);
+}
+
+#[test]
+fn a_changed_description_fails_the_title_check() {
+    assert!(title_says(
+        "Input voltage too high",
+        "input voltage is too high"
+    ));
+    assert!(title_says("Reserved (bit 3)", "not assigned (bit 3)"));
+    assert!(!title_says(
+        "Input voltage too high",
+        "input voltage is too low"
+    ));
+    assert!(!title_says("Motor blocked", "motor locked"));
 }
 
 /// The integers of a Lua table of numbers.

@@ -23,6 +23,8 @@
 use std::collections::BTreeMap;
 use std::fmt;
 
+use hwfoc::Protocol;
+use hwfoc::protocol::SettingError;
 use hwfoc::v4::VoltsPerStep;
 use hwfoc::{Settings, SettingsError};
 
@@ -137,6 +139,32 @@ impl SettingsPatch {
         })
     }
 
+    /// The patch that sets a format's own setting, `key` (a key of a format's description:
+    /// [`SettingDescription`](hwfoc::format::SettingDescription), `-` and `_` alike) to `value`: what `--set KEY=VALUE` gives.
+    ///
+    /// ```
+    /// use hwfoc::v4::VoltsPerStep;
+    /// use hwfoc_io::SettingsPatch;
+    ///
+    /// let patch = SettingsPatch::format_setting("v4-volts-per-step", "hv")?;
+    /// assert_eq!(patch.v4_volts_per_step, Some(VoltsPerStep::HIGH_VOLTAGE));
+    /// assert!(SettingsPatch::format_setting("v4_volts_per_step", "8/0").is_err());
+    /// assert!(SettingsPatch::format_setting("no_such_key", "1").is_err());
+    /// # Ok::<(), hwfoc::protocol::SettingError>(())
+    /// ```
+    pub fn format_setting(key: &str, value: &str) -> Result<SettingsPatch, SettingError> {
+        let setting = Protocol::setting(key).ok_or(SettingError::UnknownKey)?;
+        let mut settings = Settings::DEFAULT;
+        Protocol::apply_setting(&mut settings, setting.key, value)?;
+        let mut patch = SettingsPatch::default();
+        let (_, field) = FORMAT_FIELDS
+            .iter()
+            .find(|(k, _)| *k == setting.key)
+            .ok_or(SettingError::UnknownKey)?;
+        field(&settings, &mut patch);
+        Ok(patch)
+    }
+
     /// Whether no field is set.
     pub fn is_empty(&self) -> bool {
         *self == SettingsPatch::default()
@@ -163,6 +191,17 @@ impl SettingsPatch {
             .filter_map(|(field, given)| given.then_some(field))
     }
 }
+
+/// Sets a patch's field from [`Settings`].
+type SetField = fn(&Settings, &mut SettingsPatch);
+
+/// The patch's field of each format setting, by the setting's key
+/// ([`SettingDescription::key`](hwfoc::format::SettingDescription::key)): what [`SettingsPatch::format_setting`] sets from the
+/// [`Settings`] the description's `apply` wrote (a test checks that every format setting has
+/// one).
+const FORMAT_FIELDS: [(&str, SetField); 1] = [("v4_volts_per_step", |s, p| {
+    p.v4_volts_per_step = Some(s.v4_volts_per_step)
+})];
 
 /// The settings of every ESC: defaults, and patches by port name and by ESC index.
 #[derive(Debug, Clone, PartialEq)]
@@ -251,6 +290,23 @@ impl SettingsMap {
 
 #[cfg(test)]
 mod tests {
+    #[test]
+    fn every_format_setting_has_a_patch_field_and_its_default() {
+        let keys: Vec<&str> = Protocol::settings().map(|s| s.key).collect();
+        assert!(!keys.is_empty());
+        for setting in Protocol::settings() {
+            let patch = SettingsPatch::format_setting(setting.key, setting.default)
+                .unwrap_or_else(|e| panic!("{}: {e}", setting.key));
+            assert!(!patch.is_empty(), "{}", setting.key);
+            // The description's default is the settings' default, named as every output does.
+            let applied = patch.apply(&Settings::DEFAULT).unwrap();
+            assert_eq!(applied, Settings::DEFAULT, "{}", setting.key);
+            let (name, _) = patch.fields().next().unwrap();
+            assert_eq!(name, setting.key);
+        }
+        assert_eq!(FORMAT_FIELDS.len(), keys.len());
+    }
+
     use super::*;
 
     fn patch(scale: Option<f32>, pairs: Option<u16>, ratio: Option<f32>) -> SettingsPatch {

@@ -232,7 +232,9 @@ impl VirtualEsc {
                 },
                 phase % protocols::HW5_RUN_NS,
             ),
-            _ => (Other::None, phase),
+            Protocol::HwFoc | Protocol::DataLink | Protocol::HwCan | Protocol::DroneCan => {
+                (Other::None, phase)
+            }
         };
         VirtualEsc {
             byte_ns: hwfoc::wire::byte_ns(setup.baud),

@@ -164,12 +164,16 @@ impl Session {
             realtime,
             duration_ns,
         } = self;
-        // Only HW-FOC's device information names the ESC.
+        // The ESC's id, where its format's device information has one (HW-FOC's).
         let ids: Vec<String> = escs
             .iter()
-            .map(|e| match e.protocol() {
-                hwfoc::Protocol::HwFoc => e.info().id().to_string(),
-                _ => String::new(),
+            .map(|e| {
+                let has_id = e.protocol().description().info_keys.contains(&"id");
+                if has_id {
+                    e.info().id().to_string()
+                } else {
+                    String::new()
+                }
             })
             .collect();
         let clock = SimClock {

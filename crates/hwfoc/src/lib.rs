@@ -9,6 +9,7 @@ pub mod datalink;
 pub mod detect;
 pub mod dronecan;
 pub mod foc;
+pub mod format;
 pub mod hw5;
 pub mod mixed;
 pub mod protocol;

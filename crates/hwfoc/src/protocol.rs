@@ -4,107 +4,116 @@
 
 use core::fmt;
 
+use crate::format::{FormatDescription, SettingDescription};
 use crate::status::Status;
-use crate::units::Quantity;
+use crate::units::{Quantity, Settings};
 
-/// A wire protocol the codec reads.
-///
-/// ```
-/// use hwfoc::Protocol;
-///
-/// assert_eq!(Protocol::from_name("datalink"), Some(Protocol::DataLink));
-/// assert_eq!(Protocol::HwFoc.to_string(), "hw-foc");
-/// assert_eq!(Protocol::HwFoc.baud_rate(), hwfoc::foc::BAUD_RATE);
-/// ```
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-pub enum Protocol {
-    /// HW-FOC: an ESC's own wire ([`crate::foc`]).
-    HwFoc,
-    /// DataLink V2: a Hobbywing hub's frames of up to eight ESCs ([`crate::datalink`]).
-    DataLink,
-    /// Platinum V4 (and Platinum Pro V4, FlyFun V5): `9B` data and info frames without checksum
-    /// ([`crate::v4`]).
-    HwV4,
-    /// Platinum V3 (and Platinum Pro V3): 10-byte `9B` frames without checksum ([`crate::v3`]).
-    HwV3,
-    /// HW5 (Platinum V5, VBAR firmware): `FE` frames with a CRC-16/MODBUS at 115200 baud
-    /// ([`crate::hw5`]).
-    Hw5,
-    /// Hobbywing's DroneCAN ESCs (XRotor X6/X8/X9 and H-series "CAN" versions):
-    /// `com.hobbywing.esc.StatusMsg1/2/3` on a CAN bus (`hw-can`).
-    HwCan,
-    /// Standard DroneCAN ESCs: `uavcan.equipment.esc.Status` and `StatusExtended` on a CAN
-    /// bus (`dronecan`).
-    DroneCan,
+/// Declares [`Protocol`] from the list of formats, one line each (its arm, documentation and
+/// [`FormatDescription`]), with [`Protocol::ALL`] and [`Protocol::description`]: adding a
+/// format is its module and one line of the list in this file.
+macro_rules! formats {
+    ($( $(#[$doc:meta])* $arm:ident => $description:path, )+) => {
+        /// A wire protocol the codec reads.
+        ///
+        /// ```
+        /// use hwfoc::Protocol;
+        ///
+        /// assert_eq!(Protocol::from_name("datalink"), Some(Protocol::DataLink));
+        /// assert_eq!(Protocol::HwFoc.to_string(), "hw-foc");
+        /// assert_eq!(Protocol::HwFoc.baud_rate(), hwfoc::foc::BAUD_RATE);
+        /// ```
+        #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+        pub enum Protocol {
+            $( $(#[$doc])* $arm, )+
+        }
+
+        impl Protocol {
+            /// Every protocol, in the order they are listed to a user.
+            pub const ALL: [Protocol; [$(Protocol::$arm),+].len()] = [$(Protocol::$arm),+];
+
+            /// What the protocol says of itself: its module's `DESCRIPTION`.
+            #[inline(always)]
+            pub const fn description(self) -> &'static FormatDescription {
+                match self {
+                    $( Protocol::$arm => &$description, )+
+                }
+            }
+        }
+    };
 }
 
-impl Protocol {
-    /// Every protocol, in the order they are listed to a user.
-    pub const ALL: [Protocol; 7] = [
-        Protocol::HwFoc,
-        Protocol::DataLink,
-        Protocol::HwV4,
-        Protocol::HwV3,
-        Protocol::Hw5,
-        Protocol::HwCan,
-        Protocol::DroneCan,
-    ];
+formats! {
+    /// HW-FOC: an ESC's own wire ([`crate::foc`]).
+    HwFoc => crate::foc::DESCRIPTION,
+    /// DataLink V2: a Hobbywing hub's frames of up to eight ESCs ([`crate::datalink`]).
+    DataLink => crate::datalink::DESCRIPTION,
+    /// Platinum V4 (and Platinum Pro V4, FlyFun V5): `9B` data and info frames without checksum
+    /// ([`crate::v4`]).
+    HwV4 => crate::v4::DESCRIPTION,
+    /// Platinum V3 (and Platinum Pro V3): 10-byte `9B` frames without checksum ([`crate::v3`]).
+    HwV3 => crate::v3::DESCRIPTION,
+    /// HW5 (Platinum V5, VBAR firmware): `FE` frames with a CRC-16/MODBUS at 115200 baud
+    /// ([`crate::hw5`]).
+    Hw5 => crate::hw5::DESCRIPTION,
+    /// Hobbywing's DroneCAN ESCs (XRotor X6/X8/X9 and H-series "CAN" versions):
+    /// `com.hobbywing.esc.StatusMsg1/2/3` on a CAN bus (`hw-can`).
+    HwCan => crate::dronecan::HW_CAN,
+    /// Standard DroneCAN ESCs: `uavcan.equipment.esc.Status` and `StatusExtended` on a CAN
+    /// bus (`dronecan`).
+    DroneCan => crate::dronecan::DRONECAN,
+}
 
+/// How many of [`Protocol::ALL`] are serial.
+const SERIAL_COUNT: usize = {
+    let mut n = 0;
+    let mut i = 0;
+    while i < Protocol::ALL.len() {
+        if !Protocol::ALL[i].is_can() {
+            n += 1;
+        }
+        i += 1;
+    }
+    n
+};
+
+impl Protocol {
     /// The protocols of a serial line: all but the CAN protocols. (`--protocol` forces any of
     /// [`Protocol::ALL`]: a serial stream then reads that protocol only, a CAN bus keeps that
     /// protocol's records only.)
-    pub const SERIAL: [Protocol; 5] = [
-        Protocol::HwFoc,
-        Protocol::DataLink,
-        Protocol::HwV4,
-        Protocol::HwV3,
-        Protocol::Hw5,
-    ];
+    pub const SERIAL: [Protocol; SERIAL_COUNT] = {
+        let mut out = [Protocol::ALL[0]; SERIAL_COUNT];
+        let (mut i, mut n) = (0, 0);
+        while i < Protocol::ALL.len() {
+            if !Protocol::ALL[i].is_can() {
+                out[n] = Protocol::ALL[i];
+                n += 1;
+            }
+            i += 1;
+        }
+        out
+    };
 
     /// Whether the protocol is carried on a CAN bus (`hw-can`, `dronecan`), not a serial line.
     pub const fn is_can(self) -> bool {
-        matches!(self, Protocol::HwCan | Protocol::DroneCan)
+        self.description().is_can()
     }
 
     /// The protocol's name as users give it and outputs show it: `hw-foc`, `datalink`, `hw-v4`,
     /// `hw-v3`, `hw5`.
     pub const fn name(self) -> &'static str {
-        match self {
-            Protocol::HwFoc => "hw-foc",
-            Protocol::DataLink => "datalink",
-            Protocol::HwV4 => "hw-v4",
-            Protocol::HwV3 => "hw-v3",
-            Protocol::Hw5 => "hw5",
-            Protocol::HwCan => "hw-can",
-            Protocol::DroneCan => "dronecan",
-        }
+        self.description().name
     }
 
     /// The protocol's name in prose: `HW-FOC`, `DataLink V2`, `Hobbywing V4`, `Hobbywing V3`,
     /// `HW5`.
     pub const fn title(self) -> &'static str {
-        match self {
-            Protocol::HwFoc => "HW-FOC",
-            Protocol::DataLink => "DataLink V2",
-            Protocol::HwV4 => "Hobbywing V4",
-            Protocol::HwV3 => "Hobbywing V3",
-            Protocol::Hw5 => "HW5",
-            Protocol::HwCan => "Hobbywing DroneCAN",
-            Protocol::DroneCan => "DroneCAN ESC",
-        }
+        self.description().title
     }
 
     /// The baud rate its senders use (8N1); for a CAN protocol, the bus's bit rate as
     /// Hobbywing's ESCs leave the factory ([`HOBBYWING_BITRATE`](crate::dronecan::HOBBYWING_BITRATE)).
     pub const fn baud_rate(self) -> u32 {
-        match self {
-            Protocol::HwFoc => crate::foc::BAUD_RATE,
-            Protocol::DataLink => crate::datalink::BAUD_RATE,
-            Protocol::HwV4 => crate::v4::BAUD_RATE,
-            Protocol::HwV3 => crate::v3::BAUD_RATE,
-            Protocol::Hw5 => crate::hw5::BAUD_RATE,
-            Protocol::HwCan | Protocol::DroneCan => crate::dronecan::HOBBYWING_BITRATE,
-        }
+        self.description().baud_rate
     }
 
     /// The baud rate of a serial line carrying it ([`Protocol::baud_rate`]), or `None` for a
@@ -136,25 +145,14 @@ impl Protocol {
     /// assert_eq!(Protocol::HwV3.frame_period(), Some(Duration::from_micros(19_500)));
     /// ```
     pub const fn frame_period(self) -> Option<core::time::Duration> {
-        use core::time::Duration;
-        match self {
-            Protocol::HwFoc | Protocol::DataLink => Some(Duration::from_millis(50)),
-            Protocol::HwV4 => Some(Duration::from_millis(51)),
-            Protocol::HwV3 => Some(Duration::from_micros(19_500)),
-            Protocol::Hw5 => Some(crate::hw5::FRAME_PERIOD_RUNNING),
-            Protocol::HwCan | Protocol::DroneCan => None,
-        }
+        self.description().frame_period
     }
 
     /// The width of its packet counter in bits (which it wraps at), or `None` for a protocol
     /// that sends no counter: 16 for HW-FOC and DataLink, 24 for V3 and V4, none for HW5 and the
     /// CAN protocols (a transfer id is the transport's: its gaps are counted per node).
     pub const fn packet_bits(self) -> Option<u32> {
-        match self {
-            Protocol::HwFoc | Protocol::DataLink => Some(16),
-            Protocol::HwV4 | Protocol::HwV3 => Some(24),
-            Protocol::Hw5 | Protocol::HwCan | Protocol::DroneCan => None,
-        }
+        self.description().counter_bits
     }
 
     /// How far a packet counter of this protocol advanced from `from` to `to`, wrapping at its
@@ -184,39 +182,7 @@ impl Protocol {
     /// assert!(Protocol::Hw5.carries(Quantity::BecVoltage));
     /// ```
     pub const fn carries(self, quantity: Quantity) -> bool {
-        use Quantity as Q;
-        match self {
-            Protocol::HwFoc | Protocol::DataLink => !matches!(
-                quantity,
-                Q::MotorTemp | Q::BecTemp | Q::BecVoltage | Q::BecCurrent
-            ),
-            Protocol::HwV4 => !matches!(
-                quantity,
-                Q::PhaseCurrent | Q::MotorTemp | Q::BecTemp | Q::BecVoltage | Q::BecCurrent
-            ),
-            Protocol::HwV3 => matches!(quantity, Q::ThrottleIn | Q::ThrottleOut | Q::Erpm | Q::Rpm),
-            Protocol::Hw5 => !matches!(quantity, Q::ThrottleOut | Q::PhaseCurrent | Q::CapTemp),
-            Protocol::HwCan => matches!(
-                quantity,
-                Q::ThrottleOut
-                    | Q::Rpm
-                    | Q::Voltage
-                    | Q::Current
-                    | Q::MosTemp
-                    | Q::CapTemp
-                    | Q::MotorTemp
-            ),
-            Protocol::DroneCan => matches!(
-                quantity,
-                Q::ThrottleIn
-                    | Q::ThrottleOut
-                    | Q::Rpm
-                    | Q::Voltage
-                    | Q::Current
-                    | Q::MosTemp
-                    | Q::MotorTemp
-            ),
-        }
+        self.description().carries.contains(quantity)
     }
 
     /// Whether this protocol's data frames carry a fault word (a record's `status` and
@@ -224,7 +190,7 @@ impl Protocol {
     /// Hobbywing CAN ESC's `status` word is kept raw, but its only known bit is the direction:
     /// no fault bits.)
     pub const fn has_faults(self) -> bool {
-        matches!(self, Protocol::HwFoc | Protocol::DataLink | Protocol::Hw5)
+        !self.description().faults.is_empty()
     }
 
     /// The name of bit `bit` of this protocol's fault word ([`Status`] holds it), as every
@@ -238,23 +204,19 @@ impl Protocol {
     /// assert_eq!(Protocol::Hw5.fault_name(3), Some("throttle_signal_lost"));
     /// assert_eq!(Protocol::Hw5.fault_name(8), None);
     /// ```
-    pub fn fault_name(self, bit: u8) -> Option<&'static str> {
-        match self {
-            Protocol::HwFoc | Protocol::DataLink => crate::Fault::from_bit(bit).map(|f| f.name()),
-            Protocol::Hw5 => crate::hw5::Fault::from_bit(bit).map(|f| f.name()),
-            Protocol::HwV4 | Protocol::HwV3 | Protocol::HwCan | Protocol::DroneCan => None,
+    pub const fn fault_name(self, bit: u8) -> Option<&'static str> {
+        match self.description().fault(bit) {
+            Some(f) => Some(f.name),
+            None => None,
         }
     }
 
     /// A short English description of bit `bit` of this protocol's fault word (see
     /// [`Protocol::fault_name`]).
-    pub fn fault_description(self, bit: u8) -> Option<&'static str> {
-        match self {
-            Protocol::HwFoc | Protocol::DataLink => {
-                crate::Fault::from_bit(bit).map(|f| f.description())
-            }
-            Protocol::Hw5 => crate::hw5::Fault::from_bit(bit).map(|f| f.description()),
-            Protocol::HwV4 | Protocol::HwV3 | Protocol::HwCan | Protocol::DroneCan => None,
+    pub const fn fault_description(self, bit: u8) -> Option<&'static str> {
+        match self.description().fault(bit) {
+            Some(f) => Some(f.description),
+            None => None,
         }
     }
 
@@ -272,6 +234,86 @@ impl Protocol {
             .find(|p| p.name().eq_ignore_ascii_case(name))
     }
 }
+
+impl Protocol {
+    /// Every format's own settings, in the order of [`Protocol::ALL`].
+    pub fn settings() -> impl Iterator<Item = &'static SettingDescription> {
+        Protocol::ALL
+            .into_iter()
+            .flat_map(|p| p.description().settings.iter())
+    }
+
+    /// The format setting whose key is `key` (`-` and `_` alike, any case).
+    pub fn setting(key: &str) -> Option<&'static SettingDescription> {
+        let norm = |c: u8| {
+            if c == b'-' {
+                b'_'
+            } else {
+                c.to_ascii_lowercase()
+            }
+        };
+        let same = |a: &str| {
+            a.len() == key.len() && a.bytes().zip(key.bytes()).all(|(x, y)| norm(x) == norm(y))
+        };
+        Self::settings().find(|s| same(s.key))
+    }
+
+    /// Sets the format setting `key` to `value` in `settings`.
+    ///
+    /// ```
+    /// use hwfoc::{Protocol, Settings};
+    /// use hwfoc::v4::VoltsPerStep;
+    ///
+    /// let mut s = Settings::default();
+    /// Protocol::apply_setting(&mut s, "v4-volts-per-step", "hv")?;
+    /// assert_eq!(s.v4_volts_per_step, VoltsPerStep::HIGH_VOLTAGE);
+    /// assert!(Protocol::apply_setting(&mut s, "v4_volts_per_step", "8/0").is_err());
+    /// assert!(Protocol::apply_setting(&mut s, "nope", "1").is_err());
+    /// # Ok::<(), hwfoc::protocol::SettingError>(())
+    /// ```
+    pub fn apply_setting(
+        settings: &mut Settings,
+        key: &str,
+        value: &str,
+    ) -> Result<(), SettingError> {
+        let setting = Self::setting(key).ok_or(SettingError::UnknownKey)?;
+        (setting.apply)(settings, value).map_err(|reason| SettingError::Value {
+            key: setting.key,
+            reason,
+        })
+    }
+}
+
+/// Why a format setting was not set.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SettingError {
+    /// No format has a setting of that key.
+    UnknownKey,
+    /// The value is not one the setting takes.
+    Value {
+        /// The setting's key.
+        key: &'static str,
+        /// Why, in words.
+        reason: &'static str,
+    },
+}
+
+impl core::fmt::Display for SettingError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match self {
+            SettingError::UnknownKey => {
+                f.write_str("no format has this setting; the settings are:")?;
+                for s in Protocol::settings() {
+                    write!(f, " {}", s.key)?;
+                }
+                Ok(())
+            }
+            SettingError::Value { key, reason } => write!(f, "{key}: {reason}"),
+        }
+    }
+}
+
+impl core::error::Error for SettingError {}
 
 impl fmt::Display for Protocol {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
@@ -302,5 +344,26 @@ mod tests {
         assert_eq!(Protocol::HwV4.baud_rate(), 19_200);
         assert_eq!(Protocol::HwV3.packets_between(0xFF_FFFF, 0), Some(1));
         assert_eq!(Protocol::Hw5.packets_between(1, 2), None);
+    }
+
+    #[test]
+    fn the_list_makes_the_serial_protocols_and_each_description_is_its_own() {
+        use Protocol as P;
+        assert_eq!(
+            Protocol::SERIAL,
+            [P::HwFoc, P::DataLink, P::HwV4, P::HwV3, P::Hw5]
+        );
+        for p in Protocol::ALL {
+            let d = p.description();
+            assert_eq!(d.is_can(), !Protocol::SERIAL.contains(&p));
+            // A format with fault bits names each of them once.
+            assert!(d.faults.len() <= 16);
+            for (bit, f) in d.faults.iter().enumerate() {
+                assert_eq!(p.fault_name(bit as u8), Some(f.name));
+                assert_eq!(d.faults.iter().filter(|g| g.name == f.name).count(), 1);
+            }
+            // Frames of a serial format are timed at its period; a bus's come with times.
+            assert_eq!(d.frame_period.is_some(), !d.is_can(), "{p}");
+        }
     }
 }

@@ -4,6 +4,9 @@
 //! byte, bit 8 of the high byte. Names are those of `docs/PROTOCOL-NOTES.md` and are stable across every
 //! output of the project.
 
+use crate::format::FaultDescription;
+use crate::format::Severity::{Critical, Warning};
+
 /// One bit of the status word.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
 #[repr(u8)]
@@ -65,48 +68,64 @@ impl Fault {
 
     /// The stable machine name used in every output, e.g. `mos_overheat`.
     pub const fn name(self) -> &'static str {
-        match self {
-            Fault::InputVoltageHigh => "input_voltage_high",
-            Fault::InputVoltageLow => "input_voltage_low",
-            Fault::OverCurrent => "over_current",
-            Fault::Reserved3 => "reserved_3",
-            Fault::ThrottleSignalLost => "throttle_signal_lost",
-            Fault::ThrottleNotZeroed => "throttle_not_zeroed",
-            Fault::MosOverheat => "mos_overheat",
-            Fault::CapOverheat => "cap_overheat",
-            Fault::MotorBlocked => "motor_blocked",
-            Fault::UpperBridgeOpen => "upper_bridge_open",
-            Fault::MosShort => "mos_short",
-            Fault::LowerBridgeOpen => "lower_bridge_open",
-            Fault::OpampPhaseC => "opamp_phase_c",
-            Fault::OpampPhaseB => "opamp_phase_b",
-            Fault::OpampPhaseA => "opamp_phase_a",
-            Fault::Reserved15 => "reserved_15",
-        }
+        FAULTS[self as usize].name
     }
 
     /// A short English description, e.g. "MOSFET overheat".
     pub const fn description(self) -> &'static str {
-        match self {
-            Fault::InputVoltageHigh => "input voltage is too high",
-            Fault::InputVoltageLow => "input voltage is too low",
-            Fault::OverCurrent => "over current",
-            Fault::Reserved3 => "not assigned (bit 3)",
-            Fault::ThrottleSignalLost => "the throttle signal is lost",
-            Fault::ThrottleNotZeroed => "the throttle is not returned to zero",
-            Fault::MosOverheat => "MOSFET overheat",
-            Fault::CapOverheat => "capacitor overheat",
-            Fault::MotorBlocked => "motor is blocked",
-            Fault::UpperBridgeOpen => "open circuit of upper bridge (MOSFET)",
-            Fault::MosShort => "MOSFET short circuit",
-            Fault::LowerBridgeOpen => "open circuit of lower bridge (MOSFET)",
-            Fault::OpampPhaseC => "operational amplifier abnormal, phase C",
-            Fault::OpampPhaseB => "operational amplifier abnormal, phase B",
-            Fault::OpampPhaseA => "operational amplifier abnormal, phase A",
-            Fault::Reserved15 => "not assigned (bit 15)",
-        }
+        FAULTS[self as usize].description
     }
 }
+
+/// The sixteen bits of HW-FOC's status word, bit 0 first: each [`Fault`]'s name, description and
+/// severity (faults that damage hardware or stop the motor are critical; voltage limits,
+/// throttle-signal problems and unassigned bits are warnings).
+pub const FAULTS: [FaultDescription; 16] = [
+    FaultDescription::new("input_voltage_high", "input voltage is too high", Warning),
+    FaultDescription::new("input_voltage_low", "input voltage is too low", Warning),
+    FaultDescription::new("over_current", "over current", Critical),
+    FaultDescription::new("reserved_3", "not assigned (bit 3)", Warning),
+    FaultDescription::new(
+        "throttle_signal_lost",
+        "the throttle signal is lost",
+        Warning,
+    ),
+    FaultDescription::new(
+        "throttle_not_zeroed",
+        "the throttle is not returned to zero",
+        Warning,
+    ),
+    FaultDescription::new("mos_overheat", "MOSFET overheat", Critical),
+    FaultDescription::new("cap_overheat", "capacitor overheat", Critical),
+    FaultDescription::new("motor_blocked", "motor is blocked", Critical),
+    FaultDescription::new(
+        "upper_bridge_open",
+        "open circuit of upper bridge (MOSFET)",
+        Critical,
+    ),
+    FaultDescription::new("mos_short", "MOSFET short circuit", Critical),
+    FaultDescription::new(
+        "lower_bridge_open",
+        "open circuit of lower bridge (MOSFET)",
+        Critical,
+    ),
+    FaultDescription::new(
+        "opamp_phase_c",
+        "operational amplifier abnormal, phase C",
+        Critical,
+    ),
+    FaultDescription::new(
+        "opamp_phase_b",
+        "operational amplifier abnormal, phase B",
+        Critical,
+    ),
+    FaultDescription::new(
+        "opamp_phase_a",
+        "operational amplifier abnormal, phase A",
+        Critical,
+    ),
+    FaultDescription::new("reserved_15", "not assigned (bit 15)", Warning),
+];
 
 /// The raw status word with named access to its flags.
 ///

@@ -27,6 +27,7 @@
 
 use crate::foc::kinds::data::DataFrame;
 use crate::foc::kinds::info::InfoFrame;
+use crate::format::InfoValue;
 use crate::protocol::Protocol;
 use crate::status::Status;
 use crate::units::{Linear, Quantity, Settings, Temperature};
@@ -414,6 +415,39 @@ per_protocol! {
 }
 
 impl Info {
+    /// The protocol the frame was received in.
+    #[inline]
+    pub const fn protocol(&self) -> Protocol {
+        match self {
+            Info::HwFoc(_) => Protocol::HwFoc,
+            Info::HwV4(_) => Protocol::HwV4,
+        }
+    }
+
+    /// What the frame says of the device, as key/value pairs: the keys of its protocol's
+    /// description ([`FormatDescription::info_keys`](crate::format::FormatDescription)) with
+    /// this frame's values.
+    ///
+    /// ```
+    /// use hwfoc::format::InfoValue;
+    /// use hwfoc::telemetry::Info;
+    /// use hwfoc::v4::InfoFrame;
+    ///
+    /// let v4 = InfoFrame { full_scale: 1000, v1: 8, v2: 91, i1: 0, i2: 1, i3: 0, t1: 0x21, t2: 0x21 };
+    /// let info = Info::HwV4(v4);
+    /// let fields: Vec<_> = info.fields().collect();
+    /// assert_eq!(fields[0], ("full_scale", InfoValue::Number(1000)));
+    /// assert_eq!(fields.len(), 8);
+    /// ```
+    pub fn fields(&self) -> impl Iterator<Item = (&'static str, InfoValue<'_>)> {
+        let keys = self.protocol().description().info_keys.iter().copied();
+        let values: [Option<InfoValue<'_>>; 8] = match self {
+            Info::HwFoc(i) => padded(crate::foc::description::info_values(i)),
+            Info::HwV4(i) => padded(crate::v4::description::info_values(i)),
+        };
+        keys.zip(values.into_iter().flatten())
+    }
+
     /// The product name, e.g. `X6`.
     pub fn product(&self) -> &str {
         match self {
@@ -456,6 +490,15 @@ impl core::fmt::Display for Info {
             Info::HwV4(i) => i.fmt(f),
         }
     }
+}
+
+/// `values` in an array of the largest number of information fields (8), the rest `None`.
+fn padded<'a, const N: usize>(values: [InfoValue<'a>; N]) -> [Option<InfoValue<'a>>; 8] {
+    let mut out = [None; 8];
+    for (slot, v) in out.iter_mut().zip(values) {
+        *slot = Some(v);
+    }
+    out
 }
 
 /// A frame of any supported protocol as the layers above the codec take it: data, or device

@@ -49,7 +49,9 @@ impl EscKey {
                 node: r.node,
                 index: Some(r.esc_index),
             }),
-            _ => None,
+            Data::HwFoc(_) | Data::DataLink(_) | Data::HwV4(_) | Data::HwV3(_) | Data::Hw5(_) => {
+                None
+            }
         }
     }
 }

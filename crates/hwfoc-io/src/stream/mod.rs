@@ -6,7 +6,7 @@
 //! becomes the time of each of its bytes.
 
 use hwfoc::counters::{PacketSequence, PacketSequence24};
-use hwfoc::telemetry::{Data, Frame};
+use hwfoc::telemetry::{Data, Frame, Info};
 use hwfoc::{Protocol, Settings, foc};
 use hwfoc::{datalink, detect, hw5, mixed, v3, v4};
 
@@ -43,15 +43,8 @@ pub const SILENCE_S: f64 = crate::clock::MAX_STEP_S;
 /// length of byte times at its baud rate, the fastest the line carries them (real ESCs send
 /// far fewer).
 fn frames_in_of(protocol: Protocol, seconds: f64) -> u32 {
-    let len = match protocol {
-        Protocol::HwFoc => foc::kinds::data::DATA_FRAME_LEN,
-        Protocol::DataLink => datalink::FRAME_LEN,
-        Protocol::HwV4 => v4::DATA_FRAME_LEN,
-        Protocol::HwV3 => v3::FRAME_LEN,
-        Protocol::Hw5 => hw5::TELEMETRY_LEN,
-        // Not read from a serial line (a bus's stream is not told of silences).
-        Protocol::HwCan | Protocol::DroneCan => hwfoc::dronecan::SOCKETCAN_RECORD_LEN,
-    };
+    // (A bus's stream is not told of silences: its record length is never asked here.)
+    let len = protocol.description().data_frame_len;
     let frame_s = len as f64 * hwfoc::wire::byte_ns(protocol.baud_rate()) * 1e-9;
     (seconds / frame_s).ceil().min(f64::from(u32::MAX)) as u32
 }
@@ -229,7 +222,8 @@ impl Wire {
             Wire::HwV4(d) => feed_one(d, data, silent, detect::Decoded::HwV4, &mut emit),
             Wire::HwV3(d) => feed_one(d, data, silent, detect::Decoded::HwV3, &mut emit),
             Wire::Hw5(d) => feed_one(d, data, silent, detect::Decoded::Hw5, &mut emit),
-            _ => {}
+            Wire::Any(_) | Wire::HwFoc(_) | Wire::DataLink(_) | Wire::Can(_) | Wire::NotCan(..) => {
+            }
         }
     }
 
@@ -255,7 +249,8 @@ impl Wire {
             Wire::HwV4(d) => d.flush(|d| emit_any(detect::Decoded::HwV4(d), &mut emit)),
             Wire::HwV3(d) => d.flush(|d| emit_any(detect::Decoded::HwV3(d), &mut emit)),
             Wire::Hw5(d) => d.flush(|d| emit_any(detect::Decoded::Hw5(d), &mut emit)),
-            _ => {}
+            Wire::Any(_) | Wire::HwFoc(_) | Wire::DataLink(_) | Wire::Can(_) | Wire::NotCan(..) => {
+            }
         }
     }
 
@@ -292,7 +287,7 @@ impl Wire {
         match self {
             Wire::Any(d) => Some(&d.mixed_stats().esc),
             Wire::HwFoc(d) | Wire::NotCan(d, _) => Some(d.stats()),
-            _ => None,
+            Wire::DataLink(_) | Wire::HwV4(_) | Wire::HwV3(_) | Wire::Hw5(_) | Wire::Can(_) => None,
         }
     }
 
@@ -301,7 +296,12 @@ impl Wire {
         match self {
             Wire::Any(d) => Some(&d.mixed_stats().hub),
             Wire::DataLink(d) => Some(d.stats()),
-            _ => None,
+            Wire::HwFoc(_)
+            | Wire::HwV4(_)
+            | Wire::HwV3(_)
+            | Wire::Hw5(_)
+            | Wire::Can(_)
+            | Wire::NotCan(..) => None,
         }
     }
 
@@ -455,7 +455,7 @@ impl EscLink {
             EscLink::HwV3(s) => s.frames(),
             EscLink::Hw5(s) => s.telemetry_frames(),
             EscLink::Can(c) => c.records,
-            _ => match self.counting() {
+            EscLink::Wire(_) | EscLink::Hub { .. } => match self.counting() {
                 Some(Counting::Bits16(c)) => c.count(),
                 Some(Counting::Bits24(c)) => c.count(),
                 None => 0,
@@ -472,10 +472,11 @@ impl EscLink {
         }
     }
 
-    /// Whether the link's frames carry a checksum (V3 and V4 do not: their frames are
-    /// recognised by plausibility and chaining, see [`EscLink::rejected_frames`]).
+    /// Whether the link's frames are checked (its format's description: V3 and V4 are not,
+    /// their frames are recognised by plausibility and chaining, see
+    /// [`EscLink::rejected_frames`]).
     pub fn has_checksum(&self) -> bool {
-        !matches!(self, EscLink::HwV4(_) | EscLink::HwV3(_))
+        self.protocol().description().check != hwfoc::format::Check::None
     }
 
     /// Frames rejected by their checksum, or whose checksum matched but whose values are out of
@@ -497,7 +498,7 @@ impl EscLink {
         match self {
             EscLink::HwV4(s) => Some(s.rejected()),
             EscLink::HwV3(s) => Some(s.rejected()),
-            _ => None,
+            EscLink::Wire(_) | EscLink::Hub { .. } | EscLink::Hw5(_) | EscLink::Can(_) => None,
         }
     }
 
@@ -576,11 +577,16 @@ impl EscLink {
         }
     }
 
-    /// The V4 info frame whose constants were adopted (two identical copies in a row), if any.
-    pub fn adopted_info(&self) -> Option<v4::InfoFrame> {
+    /// The info frame whose constants were adopted (two identical copies in a row), if any: a
+    /// format whose description has [`adopted_info`](hwfoc::format::FormatDescription) (V4).
+    pub fn adopted_info(&self) -> Option<Info> {
         match self {
-            EscLink::HwV4(s) => s.adopted(),
-            _ => None,
+            EscLink::HwV4(s) => s.adopted().map(Info::HwV4),
+            EscLink::Wire(_)
+            | EscLink::Hub { .. }
+            | EscLink::HwV3(_)
+            | EscLink::Hw5(_)
+            | EscLink::Can(_) => None,
         }
     }
 }
@@ -642,7 +648,13 @@ impl Stream {
     pub fn left_out(&self) -> Vec<(Protocol, u64)> {
         match &self.wire {
             Wire::Can(c) => c.left_out(),
-            _ => Vec::new(),
+            Wire::Any(_)
+            | Wire::HwFoc(_)
+            | Wire::DataLink(_)
+            | Wire::HwV4(_)
+            | Wire::HwV3(_)
+            | Wire::Hw5(_)
+            | Wire::NotCan(..) => Vec::new(),
         }
     }
 
@@ -656,15 +668,14 @@ impl Stream {
     /// A CAN bus's ESCs heard since the last call that claim a throttle channel another holds,
     /// in words (none for any other stream).
     pub(crate) fn take_can_clashes(&mut self) -> Vec<String> {
-        match &mut self.wire {
-            Wire::Can(c) => c
-                .wire
-                .take_clashes()
-                .iter()
-                .map(|c| c.to_string())
-                .collect(),
-            _ => Vec::new(),
-        }
+        let Wire::Can(c) = &mut self.wire else {
+            return Vec::new();
+        };
+        c.wire
+            .take_clashes()
+            .iter()
+            .map(|c| c.to_string())
+            .collect()
     }
 
     /// Of a serial stream forced to read one protocol: the protocol of the first frame found
@@ -778,7 +789,17 @@ impl Stream {
             // summary of an HW5 file does not need two cores).
             (Wire::HwFoc(a), Wire::HwFoc(b)) => a.then(b, first_packet),
             (Wire::DataLink(a), Wire::DataLink(b)) => a.then(b, first_packet),
-            _ => false,
+            (
+                Wire::Any(_)
+                | Wire::HwFoc(_)
+                | Wire::DataLink(_)
+                | Wire::HwV4(_)
+                | Wire::HwV3(_)
+                | Wire::Hw5(_)
+                | Wire::Can(_)
+                | Wire::NotCan(..),
+                _,
+            ) => false,
         }
     }
 

@@ -3,6 +3,7 @@
 //! per-frame cost of `hwfoc summary`.
 
 use hwfoc::foc::DataFrame;
+use hwfoc::format::FormatDescription;
 use hwfoc::telemetry::{Conversion, Data, Frame, Info, Telemetry};
 use hwfoc::units::ADC_NO_VALUE;
 use hwfoc::{Protocol, Quantity, Settings, Status, Temperature};
@@ -319,17 +320,22 @@ pub(super) struct TimedLoss {
 }
 
 impl TimedLoss {
-    /// The frame received at `t`, whose motor turned or not.
-    fn add(&mut self, t: f64, turning: bool) {
+    /// The frame of a format described by `format` received at `t`, whose motor turned or
+    /// not: judged against the format's frame periods, running and idle (a format without
+    /// one, whose frames are not periodic, is not judged).
+    fn add(&mut self, format: &FormatDescription, t: f64, turning: bool) {
+        let Some(running) = format.frame_period else {
+            return;
+        };
         if let Some((last, was_turning)) = self.last {
             let dt = t - last;
             if dt > crate::clock::MAX_STEP_S {
                 self.unjudged += 1;
             } else if dt > 0.0 {
                 let period = if turning && was_turning {
-                    hwfoc::hw5::FRAME_PERIOD_RUNNING
+                    running
                 } else {
-                    hwfoc::hw5::FRAME_PERIOD_IDLE
+                    format.idle_frame_period.unwrap_or(running)
                 }
                 .as_secs_f64();
                 if dt > 1.5 * period {
@@ -670,7 +676,7 @@ impl Accumulator {
             let turning = [Quantity::Erpm, Quantity::ThrottleIn]
                 .into_iter()
                 .any(|q| f.raw(q).is_some_and(|raw| raw > 0));
-            values.loss.add(t, turning);
+            values.loss.add(f.protocol().description(), t, turning);
         }
         if let (Some(t), Some((volts, amps))) = (t, powered) {
             values.energy.add(Some(t), volts, amps);

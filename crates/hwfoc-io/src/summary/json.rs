@@ -1,6 +1,7 @@
 //! The summary as JSON (`hwfoc summary --json`).
 
 use super::*;
+use hwfoc::format::InfoValue;
 
 impl Report<'_> {
     /// The summary as one JSON object, as `hwfoc summary --json` prints it.
@@ -106,8 +107,8 @@ impl EscReport<'_> {
                 let mut info = device_json(i);
                 info.insert("text".to_string(), json!(i.to_string()));
                 info.insert("frames".to_string(), json!(n));
-                if let Info::HwV4(v4) = i {
-                    let adopted = st.adopted_info() == Some(*v4);
+                if i.protocol().description().adopted_info.is_some() {
+                    let adopted = st.adopted_info() == Some(*i);
                     info.insert("adopted".to_string(), json!(adopted));
                 }
                 Value::Object(info)
@@ -229,28 +230,14 @@ fn clock_name(clock: Clock) -> &'static str {
 /// What an information frame says of the device, as every JSON output names it (`summary
 /// --json`, `monitor --json`): `{"product": ..., "hardware": ..., "firmware": ..., "id": ...}`.
 pub fn device_json(info: &Info) -> serde_json::Map<String, Value> {
-    let pairs: Vec<(&str, Value)> = match info {
-        Info::HwFoc(_) => vec![
-            ("product", json!(info.product())),
-            ("hardware", json!(info.hardware())),
-            ("firmware", json!(info.firmware())),
-            ("id", json!(info.id())),
-        ],
-        // A V4 info frame carries constants, no names (docs/OLDER-PROTOCOLS.md).
-        Info::HwV4(i) => vec![
-            ("full_scale", json!(i.full_scale)),
-            ("v1", json!(i.v1)),
-            ("v2", json!(i.v2)),
-            ("i1", json!(i.i1)),
-            ("i2", json!(i.i2)),
-            ("i3", json!(i.i3)),
-            ("t1", json!(i.t1)),
-            ("t2", json!(i.t2)),
-        ],
-    };
-    pairs
-        .into_iter()
-        .map(|(name, value)| (name.to_string(), value))
+    info.fields()
+        .map(|(key, value)| {
+            let value = match value {
+                InfoValue::Text(text) => json!(text),
+                InfoValue::Number(n) => json!(n),
+            };
+            (key.to_string(), value)
+        })
         .collect()
 }
 

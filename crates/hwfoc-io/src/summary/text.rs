@@ -220,9 +220,10 @@ impl EscReport<'_> {
         }
         let adopted = st.adopted_info();
         for (info, n) in &self.acc.infos {
-            let adopted = match info {
-                hwfoc::telemetry::Info::HwV4(i) if Some(*i) == adopted => ", adopted",
-                _ => "",
+            let adopted = if Some(*info) == adopted {
+                ", adopted"
+            } else {
+                ""
             };
             let _ = writeln!(
                 o,

@@ -115,11 +115,14 @@ pub fn escs_json(sources: &Sources) -> String {
                 "stream": esc.key.port,
                 "protocol": framed.then(|| link.protocol().name()),
             });
-            if framed && link.protocol() == hwfoc::Protocol::HwV4 {
-                let info = link
-                    .adopted_info()
-                    .map(|i| crate::summary::device_json(&hwfoc::telemetry::Info::HwV4(i)));
-                entry["v4_info"] = serde_json::json!(info);
+            if let Some(key) = link
+                .protocol()
+                .description()
+                .adopted_info
+                .filter(|_| framed)
+            {
+                let info = link.adopted_info().map(|i| crate::summary::device_json(&i));
+                entry[key] = serde_json::json!(info);
             }
             entry
         })

@@ -42,12 +42,14 @@
 //! ```
 
 pub(crate) mod decoder;
+mod description;
 mod error;
 mod frame;
 mod layout;
 mod stats;
 
 pub use decoder::{Decoded, Decoder, Frames, Scanner, frames};
+pub use description::DESCRIPTION;
 pub use error::Error;
 pub use frame::{Frame, FrameReport};
 pub use layout::{

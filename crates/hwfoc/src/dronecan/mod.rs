@@ -78,6 +78,7 @@
 pub const HOBBYWING_BITRATE: u32 = 500_000;
 
 mod bits;
+mod description;
 mod escs;
 mod frame;
 mod id;
@@ -88,6 +89,7 @@ mod transfer;
 mod types;
 
 pub use bits::{F16_MAX, f16_from_f32, f32_from_f16, saturate_f16};
+pub use description::{DRONECAN, HW_CAN};
 pub use escs::{DroneCanEsc, Escs, Extended, HwCanEsc, Power, Temperatures};
 pub use frame::{
     CanFrame, FrameKind, MAX_EXTENDED_ID, MAX_STANDARD_ID, SOCKETCAN_EFF_FLAG, SOCKETCAN_ERR_FLAG,

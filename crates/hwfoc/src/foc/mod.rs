@@ -74,6 +74,7 @@
 //!   would sit above both scanners.
 
 pub(crate) mod decoder;
+pub(crate) mod description;
 pub(crate) mod frame;
 pub mod kinds;
 mod stats;
@@ -82,6 +83,7 @@ mod stats;
 pub const BAUD_RATE: u32 = 19_200;
 
 pub use decoder::{Decoded, Decoder, Frames, Scanner, frames};
+pub use description::DESCRIPTION;
 pub use frame::{Frame, FrameError, MAX_FRAME_LEN, Parsed, parse};
 pub use kinds::FrameKind;
 pub use kinds::data::{DataFrame, THROTTLE_MAX_RAW};

@@ -8,6 +8,8 @@
 //! ```
 
 use crate::foc::FrameError;
+use crate::format::FaultDescription;
+use crate::format::Severity::{Critical, Warning};
 use crate::status::Status;
 use crate::telemetry::{Reading, Telemetry};
 use crate::units::{Linear, Quantity, Settings};
@@ -56,32 +58,31 @@ impl Fault {
 
     /// The stable machine name, e.g. `throttle_signal_lost`.
     pub const fn name(self) -> &'static str {
-        match self {
-            Fault::MotorLocked => "motor_locked",
-            Fault::OverTemperature => "over_temperature",
-            Fault::ThrottleNotZeroAtStart => "throttle_not_zero_at_start",
-            Fault::ThrottleSignalLost => "throttle_signal_lost",
-            Fault::OverCurrent => "over_current",
-            Fault::LowVoltage => "low_voltage",
-            Fault::InputVoltageError => "input_voltage_error",
-            Fault::MotorConnectionError => "motor_connection_error",
-        }
+        FAULTS[self as usize].name
     }
 
     /// A short English description, e.g. "throttle signal lost".
     pub const fn description(self) -> &'static str {
-        match self {
-            Fault::MotorLocked => "motor locked",
-            Fault::OverTemperature => "over-temperature",
-            Fault::ThrottleNotZeroAtStart => "throttle not at zero at start-up",
-            Fault::ThrottleSignalLost => "throttle signal lost",
-            Fault::OverCurrent => "over-current",
-            Fault::LowVoltage => "low voltage",
-            Fault::InputVoltageError => "input voltage error",
-            Fault::MotorConnectionError => "motor connection error",
-        }
+        FAULTS[self as usize].description
     }
 }
+
+/// The eight bits of HW5's fault byte, bit 0 first: each [`Fault`]'s name, description and
+/// severity (throttle-signal and voltage problems are warnings, the rest critical).
+pub const FAULTS: [FaultDescription; 8] = [
+    FaultDescription::new("motor_locked", "motor locked", Critical),
+    FaultDescription::new("over_temperature", "over-temperature", Critical),
+    FaultDescription::new(
+        "throttle_not_zero_at_start",
+        "throttle not at zero at start-up",
+        Warning,
+    ),
+    FaultDescription::new("throttle_signal_lost", "throttle signal lost", Warning),
+    FaultDescription::new("over_current", "over-current", Critical),
+    FaultDescription::new("low_voltage", "low voltage", Warning),
+    FaultDescription::new("input_voltage_error", "input voltage error", Warning),
+    FaultDescription::new("motor_connection_error", "motor connection error", Critical),
+];
 
 /// The raw fault byte with named access to its flags.
 ///

@@ -88,15 +88,17 @@
 //! ```
 
 pub(crate) mod decoder;
+mod description;
 mod error;
 mod frame;
 mod layout;
 mod stats;
 
 pub use decoder::{Decoded, Decoder, Frames, Scanner, frames};
+pub use description::DESCRIPTION;
 pub use error::Error;
 pub use frame::{
-    Fault, FaultCode, Faults, THROTTLE_MAX_PCT, TelemetryFrame, VOLTAGE_MAX_RAW, identify,
+    FAULTS, Fault, FaultCode, Faults, THROTTLE_MAX_PCT, TelemetryFrame, VOLTAGE_MAX_RAW, identify,
 };
 pub use layout::{
     AMPS, BAUD_RATE, CHECKSUM, CODE_AT, Direction, ERPM, ESC_ADDRESS, ESC_BYTE2, ESC_START,

@@ -67,6 +67,7 @@
 //! ```
 
 pub(crate) mod decoder;
+mod description;
 mod frame;
 mod stats;
 
@@ -75,6 +76,7 @@ pub const BAUD_RATE: u32 = crate::foc::BAUD_RATE;
 
 pub use crate::chain::MAX_CHAINED_GAP;
 pub use decoder::{CHAIN_TO_LOCK, Decoded, Decoder, Frames, Scanner, frames};
+pub use description::DESCRIPTION;
 pub use frame::{
     COUNTER_AT, FRAME_LEN, FULL_SCALE, Frame, PLACEHOLDER_PERIOD_US, US_PER_MINUTE, erpm_of_period,
 };

@@ -196,6 +196,10 @@ impl core::fmt::Display for VoltsPerStep {
     }
 }
 
+/// What a [`VoltsPerStep`] is written as, in words (its error's message).
+pub(crate) const VOLTS_PER_STEP_FORM: &str = "volts per step must be N/D with whole numbers from 1 \
+     to 65535 (8/910 for low-voltage models, 11/650 for HV), or low or hv";
+
 /// Why a text is not a [`VoltsPerStep`].
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum VoltsPerStepError {
@@ -205,10 +209,7 @@ pub enum VoltsPerStepError {
 
 impl core::fmt::Display for VoltsPerStepError {
     fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
-        f.write_str(
-            "volts per step must be N/D with whole numbers from 1 to 65535 (8/910 for \
-             low-voltage models, 11/650 for HV), or low or hv",
-        )
+        f.write_str(VOLTS_PER_STEP_FORM)
     }
 }
 

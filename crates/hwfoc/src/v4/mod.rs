@@ -90,6 +90,7 @@
 
 pub(crate) mod data;
 pub(crate) mod decoder;
+pub(crate) mod description;
 pub(crate) mod info;
 mod layout;
 mod stats;
@@ -101,6 +102,7 @@ pub const BAUD_RATE: u32 = crate::foc::BAUD_RATE;
 pub use crate::chain::MAX_CHAINED_GAP;
 pub use data::{Data, DataFrame};
 pub use decoder::{CHAIN_TO_LOCK, Decoded, Decoder, Frame, Frames, Scanner, frames};
+pub use description::DESCRIPTION;
 pub use info::{CurrentScale, InfoFrame, VoltsPerStep, VoltsPerStepError, throttle_linear};
 pub use layout::{
     ADC_LIMIT, COUNTER_AT, DATA_FRAME_LEN, DEFAULT_FULL_SCALE, INFO_FRAME_LEN, INFO_MARK,

@@ -14,7 +14,8 @@
 
 use std::fmt;
 
-use hwfoc::{Fault, Protocol};
+use hwfoc::Protocol;
+use hwfoc::format::Severity;
 
 /// A fault bit of a protocol's fault word (HW-FOC's sixteen status bits, HW5's eight fault
 /// bits: [`Protocol::fault_name`]): the same bit means another fault in another protocol.
@@ -84,33 +85,17 @@ impl Kind {
         }
     }
 
-    /// The level of a fault-bit alarm: faults that damage hardware or stop the motor are
-    /// critical; voltage limits, throttle-signal problems and unassigned bits are warnings.
+    /// The level of a fault-bit alarm: the severity its protocol's description gives the bit
+    /// ([`hwfoc::format::FaultDescription::severity`]); a bit it does not define is a warning.
     pub fn fault_level(f: FaultBit) -> Level {
-        use hwfoc::hw5::Fault as Hw5;
-        match f.protocol {
-            Protocol::Hw5 => match Hw5::from_bit(f.bit) {
-                Some(
-                    Hw5::ThrottleNotZeroAtStart
-                    | Hw5::ThrottleSignalLost
-                    | Hw5::LowVoltage
-                    | Hw5::InputVoltageError,
-                )
-                | None => Level::Warning,
-                Some(_) => Level::Critical,
-            },
-            _ => match Fault::from_bit(f.bit) {
-                Some(
-                    Fault::InputVoltageHigh
-                    | Fault::InputVoltageLow
-                    | Fault::Reserved3
-                    | Fault::ThrottleSignalLost
-                    | Fault::ThrottleNotZeroed
-                    | Fault::Reserved15,
-                )
-                | None => Level::Warning,
-                Some(_) => Level::Critical,
-            },
+        let severity = f
+            .protocol
+            .description()
+            .fault(f.bit)
+            .map_or(Severity::UNKNOWN, |d| d.severity);
+        match severity {
+            Severity::Warning => Level::Warning,
+            Severity::Critical => Level::Critical,
         }
     }
 }
@@ -289,6 +274,7 @@ impl Latch {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use hwfoc::Fault;
 
     fn run(latch: &mut Latch, th: &Threshold, values: &[f64]) -> Vec<(usize, Change)> {
         values

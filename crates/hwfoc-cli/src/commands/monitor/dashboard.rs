@@ -30,6 +30,7 @@ use super::{Session, number, reading};
 use crate::error::CliError;
 use crate::shown::{Measure, Shown};
 use hwfoc::Quantity;
+use hwfoc::format::InfoValue;
 use hwfoc::telemetry::Info;
 use hwfoc_io::Escaped;
 use hwfoc_io::Fixed;
@@ -445,27 +446,37 @@ fn alarm_cell(esc: &EscView) -> Cell<'static> {
     Cell::from(names.join(" ")).style(level_style(worst))
 }
 
+/// The device line of a format whose info frame is adopted (V4's scales): its format, its
+/// fields as its description names them, and whether they were taken (two identical copies).
+fn adopted_info_line(info: &Info, adopted: bool) -> String {
+    let fields: Vec<String> = info
+        .fields()
+        .map(|(key, value)| match value {
+            InfoValue::Text(text) => format!("{key} {}", Escaped(text)),
+            InfoValue::Number(n) => format!("{key} {n}"),
+        })
+        .collect();
+    let state = if adopted {
+        "adopted"
+    } else {
+        "not adopted yet (two identical copies needed)"
+    };
+    format!(
+        "{} info: {} · {state}",
+        info.protocol().title(),
+        fields.join(" · ")
+    )
+}
+
 fn draw_detail(frame: &mut Frame, area: Rect, index: usize, esc: &EscView, now: f64) {
     let hw5 = esc.protocol() == Some(hwfoc::Protocol::Hw5);
     let can = esc.protocol().is_some_and(hwfoc::Protocol::is_can);
     let info = match &esc.info {
-        // V4: the scales of its info frame, and whether they were taken (two identical copies).
-        Some(Info::HwV4(i)) => format!(
-            "V4 constants: full scale {} · v {} {} · i {} {} {} · t {} {} · {}",
-            i.full_scale,
-            i.v1,
-            i.v2,
-            i.i1,
-            i.i2,
-            i.i3,
-            i.t1,
-            i.t2,
-            if esc.stats.adopted_info().is_some() {
-                "adopted"
-            } else {
-                "not adopted yet (two identical copies needed)"
-            }
-        ),
+        // A format whose info frame is adopted (V4's scales): its fields, and whether they were
+        // taken (two identical copies).
+        Some(info) if info.protocol().description().adopted_info.is_some() => {
+            adopted_info_line(info, esc.stats.adopted_info().is_some())
+        }
         // HW5 sends no device information: its BEC and motor instead.
         None if hw5 => {
             let r = esc.last.as_ref();
@@ -941,6 +952,30 @@ fn draw_help(frame: &mut Frame, session: &Session) {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_v4_device_line_is_its_info_fields_by_their_description() {
+        // The Platinum V4 capture's info frame (the fields not given are 0).
+        let (v1, v2, i2, t) = (8, 91, 1, 0x21);
+        let v4 = hwfoc::v4::InfoFrame {
+            full_scale: 1000,
+            v1,
+            v2,
+            i2,
+            t1: t,
+            t2: t,
+            ..Default::default()
+        };
+        assert_eq!(
+            adopted_info_line(&Info::HwV4(v4), true),
+            "Hobbywing V4 info: full_scale 1000 · v1 8 · v2 91 · i1 0 · i2 1 · i3 0 · t1 33 · \
+             t2 33 · adopted"
+        );
+        assert!(
+            adopted_info_line(&Info::HwV4(v4), false)
+                .ends_with("· not adopted yet (two identical copies needed)")
+        );
+    }
 
     #[test]
     fn the_charts_and_their_lines() {

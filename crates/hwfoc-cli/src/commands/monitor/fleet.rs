@@ -250,7 +250,11 @@ impl EscView {
         if self.can.is_some() {
             let bus = match &self.stats {
                 EscLink::Can(c) => c.bus,
-                _ => Default::default(),
+                EscLink::Wire(_)
+                | EscLink::Hub { .. }
+                | EscLink::HwV4(_)
+                | EscLink::HwV3(_)
+                | EscLink::Hw5(_) => Default::default(),
             };
             return match (bus.frames(), bus.error_frames()) {
                 (0, _) => "no CAN frame yet: bit rate? ESCs powered?",

@@ -13,7 +13,6 @@ use super::{Session, number, reading};
 use crate::error::CliError;
 use crate::shown::Shown;
 use hwfoc::Quantity;
-use hwfoc::telemetry::Info;
 use hwfoc_io::Escaped;
 use hwfoc_io::Fixed;
 use hwfoc_io::energy::Energy;
@@ -306,7 +305,7 @@ pub(super) fn status_json(esc: &EscView, now: f64) -> Value {
         "bytes": esc.stats.bytes(),
         "bytes_skipped": esc.stats.bytes_skipped(),
         "bytes_at_other_rates": esc.discarded,
-        "info_adopted": esc.stats.adopted_info().map(|i| hwfoc_io::summary::device_json(&Info::HwV4(i))),
+        "info_adopted": esc.stats.adopted_info().map(|i| hwfoc_io::summary::device_json(&i)),
         "record": record,
         "peaks": {
             "rpm": p.rpm,

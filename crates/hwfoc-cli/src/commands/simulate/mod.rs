@@ -417,7 +417,7 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
                  simulates Hobbywing's DroneCAN ESCs",
             ));
         }
-        _ => {}
+        Protocol::HwFoc | Protocol::DataLink | Protocol::HwV4 | Protocol::HwV3 | Protocol::Hw5 => {}
     }
     if args.factory {
         return Err(usage("--factory", "only for --protocol hw-can"));
