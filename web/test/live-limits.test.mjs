@@ -49,15 +49,12 @@ test('SLCAN constants equal hwfoc-io can/', () => {
 test('cell detection and fault levels equal the monitor', () => {
   const fleet = rust('crates/hwfoc-cli/src/commands/monitor/fleet.rs');
   assert.equal(limits.FULL_CELL_V, Number(fleet.match(/const FULL_CELL_V: f64 = ([\d.]+);/)[1]));
-  // The warning faults of monitor/alarms.rs `fault_level`, by their codec names.
-  const alarms = rust('crates/hwfoc-cli/src/commands/monitor/alarms.rs');
-  const body = alarms.slice(alarms.indexOf('pub fn fault_level'), alarms.indexOf('/// What happened to an alarm.'));
-  const snake = (s) => s.replace(/([a-z])([A-Z0-9])/g, '$1_$2').toLowerCase();
-  const hw5Part = body.slice(body.indexOf('Protocol::Hw5'), body.indexOf('_ => match'));
-  const focPart = body.slice(body.indexOf('_ => match'));
-  const variants = (part, prefix) => [...part.matchAll(new RegExp(`${prefix}::([A-Za-z0-9]+)`, 'g'))].map((m) => m[1]).filter((v) => v !== 'from');
-  assert.deepEqual(limits.WARNING_FAULTS.hw5, variants(hw5Part, 'Hw5').map(snake));
-  assert.deepEqual(limits.WARNING_FAULTS['hw-foc'], variants(focPart, 'Fault').map(snake));
+  // The monitor's fault levels are the codec's fault descriptions' severities (format.rs).
+  const warnings = (path) => [...rust(path).matchAll(/FaultDescription::new\(\s*"([a-z0-9_]+)",\s*"[^"]*",\s*(Warning|Critical),?\s*\)/g)]
+    .filter((m) => m[2] === 'Warning').map((m) => m[1]);
+  assert.deepEqual(limits.WARNING_FAULTS['hw-foc'], warnings('crates/hwfoc/src/status.rs'));
+  assert.deepEqual(limits.WARNING_FAULTS.hw5, warnings('crates/hwfoc/src/hw5/frame.rs'));
+  assert.match(rust('crates/hwfoc/src/format.rs'), /pub const UNKNOWN: Severity = Severity::Warning;/);
   assert.equal(limits.faultLevel('hw-foc', 'mos_overheat'), 'critical');
   assert.equal(limits.faultLevel('datalink', 'throttle_signal_lost'), 'warning');
   assert.equal(limits.faultLevel('hw5', 'motor_locked'), 'critical');

@@ -1,6 +1,6 @@
 // The monitor's defaults, in one place: alarm levels (as `hwfoc monitor --help` documents them,
-// crates/hwfoc-cli/src/commands/monitor/config.rs), the level of each fault bit
-// (monitor/alarms.rs `fault_level`), the cell detection (monitor/fleet.rs) and the port search
+// crates/hwfoc-cli/src/commands/monitor/config.rs), the level of each fault bit (the severity
+// of the codec's fault descriptions, crates/hwfoc/src/status.rs and hw5/frame.rs), the cell detection (monitor/fleet.rs) and the port search
 // (crates/hwfoc-io/src/serial.rs). tests/unit/live-limits.test.js compares them with the command.
 
 /** Alarm levels, by the name of their `hwfoc monitor` flag (`--mos-warning-c` is `mos_warning_c`). */
