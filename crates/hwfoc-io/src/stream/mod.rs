@@ -479,6 +479,16 @@ impl EscLink {
         self.protocol().description().check != hwfoc::format::Check::None
     }
 
+    /// A Hobbywing CAN ESC's own maintenance counters, minutes (total rotation time, time since
+    /// maintenance), where its bus's recording holds its answer to GetMaintenanceInformation;
+    /// `None` otherwise.
+    pub fn maintenance_min(&self) -> Option<(u32, u32)> {
+        match self {
+            EscLink::Can(c) => c.maintenance_min,
+            _ => None,
+        }
+    }
+
     /// Frames rejected by their checksum, or whose checksum matched but whose values are out of
     /// their protocol's range (behind a hub: the hub frames' CRC failures; 0 for a format
     /// without checksum).
