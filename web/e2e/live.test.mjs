@@ -87,7 +87,11 @@ test('four simulated ESCs: values, alarm, unplug and replug, recording, screensh
   assert.match(await message(page), /another program is using it.*dialout/);
   await page.evaluate(() => { window.__fake.busy[0] = false; });
 
+  // (The recording is checked once the WebAssembly build exports its recorder; until then the
+  // page says it cannot record.)
+  const recorder = await page.evaluate(async () => typeof (await import('./pkg/hwfoc_web.js')).WasmRecorder === 'function');
   await page.getByTestId('record').click();
+  if (!recorder) assert.match(await message(page), /^Recording is not available: /);
   for (let i = 0; i < ESCS; i++) await page.getByTestId('add-port').click();
   await page.waitForFunction((n) => document.querySelectorAll('.live-table tbody tr').length === n, ESCS, { timeout: 10000 });
 
@@ -140,8 +144,6 @@ test('four simulated ESCs: values, alarm, unplug and replug, recording, screensh
   assert.ok(overflow <= 0, `the page is ${overflow} px wider than a phone`);
 
   // The recording: one pcapng per port, its bytes exactly those fed, read by hwfoc and tshark.
-  // (Checked once the WebAssembly build exports its recorder; a recorder that fails then fails here.)
-  const recorder = await page.evaluate(async () => typeof (await import('./pkg/hwfoc_web.js')).WasmRecorder === 'function');
   if (!recorder) {
     t.diagnostic('recording not checked: this build has no WebAssembly Recorder yet');
     return;
