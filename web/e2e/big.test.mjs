@@ -2,39 +2,25 @@
 // opens, summarised and charted, in under 3 s, and a zoom redraws every chart in well under a
 // second.
 
-import { test, before, after } from 'node:test';
+import { test } from 'node:test';
 import assert from 'node:assert/strict';
-import { mkdtempSync, rmSync } from 'node:fs';
-import { tmpdir } from 'node:os';
 import { join } from 'node:path';
-import { hwfoc, launch, needsReaders, serve } from './harness.mjs';
+import { hwfoc, needsReaders, useBrowser } from './harness.mjs';
 
-let server;
-let browser;
-let dir;
-before(async () => {
-  server = await serve();
-  browser = await launch();
-  dir = mkdtempSync(join(tmpdir(), 'hwfoc-web-big-'));
-});
-after(async () => {
-  await browser?.close();
-  server?.close();
-  if (dir) rmSync(dir, { recursive: true, force: true });
-});
+const ctx = useBrowser('big');
 
 /** Waits for the page to have drawn (two animation frames). */
 const drawn = (page) =>
   page.evaluate(() => new Promise((r) => requestAnimationFrame(() => requestAnimationFrame(r))));
 
 test('a 2-hour recording of 8 ESCs opens in under 3 s', { skip: needsReaders() }, async () => {
-  const file = join(dir, 'two-hours.pcapng');
+  const file = join(ctx.dir, 'two-hours.pcapng');
   // 8 ESCs for 9000 s at the simulator's 16 frames a second: 1.15 million data frames, as many
   // as 2 hours at 20 frames a second.
   hwfoc('simulate', '--escs', '8', '--duration', '9000', '-o', file);
-  const page = await browser.newPage({ viewport: { width: 1280, height: 900 } });
+  const page = await ctx.browser.newPage({ viewport: { width: 1280, height: 900 } });
   try {
-    await page.goto(server.url);
+    await page.goto(ctx.server.url);
     await page.waitForSelector('body[data-ready=true]');
     const started = Date.now();
     await page.setInputFiles('#files input[type=file]', file);

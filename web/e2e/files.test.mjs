@@ -1,13 +1,11 @@
 // Every recording in testdata/ opened in the page: its per-ESC figures equal `hwfoc summary
 // --json`'s; screenshots at a phone's and a laptop's width.
 
-import { test, before, after } from 'node:test';
+import { test } from 'node:test';
 import assert from 'node:assert/strict';
 import { readdirSync, statSync } from 'node:fs';
 import { join, relative, resolve } from 'node:path';
-import { ROOT, hwfoc, launch, needsReaders, screenshotsDir, serve } from './harness.mjs';
-import { mkdtempSync, rmSync } from 'node:fs';
-import { tmpdir } from 'node:os';
+import { ROOT, hwfoc, needsReaders, screenshotsDir, useBrowser } from './harness.mjs';
 
 /** The recordings of testdata/ (every file but the READMEs and the test vectors). */
 function recordings() {
@@ -28,28 +26,16 @@ function at(object, key) {
   return key.split('.').reduce((o, part) => (o == null ? undefined : o[part]), object);
 }
 
-let server;
-let browser;
-let dir;
-before(async () => {
-  server = await serve();
-  browser = await launch();
-  dir = mkdtempSync(join(tmpdir(), 'hwfoc-web-files-'));
-});
-after(async () => {
-  await browser?.close();
-  server?.close();
-  if (dir) rmSync(dir, { recursive: true, force: true });
-});
+const ctx = useBrowser('files');
 
 const skip = needsReaders();
 
 /** Opens `files` in a fresh page of width `width`; returns the page once the summaries show. */
 async function openInPage(files, width) {
-  const page = await browser.newPage({ viewport: { width, height: 900 } });
+  const page = await ctx.browser.newPage({ viewport: { width, height: 900 } });
   const errors = [];
   page.on('pageerror', (e) => errors.push(e.message));
-  await page.goto(server.url);
+  await page.goto(ctx.server.url);
   await page.waitForSelector('body[data-ready=true]');
   await page.setInputFiles('#files input[type=file]', files.map((f) => resolve(ROOT, f)));
   await page.waitForFunction(
@@ -112,7 +98,7 @@ test('screenshots at 390 px and 1280 px', async () => {
   const shots = screenshotsDir();
   // A minute of a virtual ESC's raw bytes (with a fault episode: --demo's run), and, where the
   // page reads them, a capture and a CAN bus.
-  const sim = join(dir, 'sim.bin');
+  const sim = join(ctx.dir, 'sim.bin');
   hwfoc('simulate', '--duration', '60', '-o', sim);
   const files = [sim];
   if (!skip) files.push('testdata/captures/xrotor-v4-pro-hv-80A.csv', 'testdata/dronecan/can-bus.candump.txt');

@@ -3,7 +3,9 @@
 
 import { createServer } from 'node:http';
 import { readFile } from 'node:fs/promises';
-import { existsSync, mkdirSync, readFileSync } from 'node:fs';
+import { existsSync, mkdirSync, mkdtempSync, readFileSync, rmSync } from 'node:fs';
+import { tmpdir } from 'node:os';
+import { before, after } from 'node:test';
 import { extname, join, normalize, dirname } from 'node:path';
 import { fileURLToPath } from 'node:url';
 import { execFileSync } from 'node:child_process';
@@ -82,4 +84,25 @@ export function needsReaders() {
 export function screenshotsDir() {
   mkdirSync(SCREENSHOTS, { recursive: true });
   return SCREENSHOTS;
+}
+
+/**
+ * For a test file: web/dist served, chromium launched and a temporary folder made before its
+ * tests, all three gone after. The fields of the object returned are set once `before` ran.
+ * @param {string} name the temporary folder's prefix
+ * @returns {{server: {url: string}, browser: import('playwright-core').Browser, dir: string}}
+ */
+export function useBrowser(name) {
+  const context = {};
+  before(async () => {
+    context.server = await serve();
+    context.browser = await launch();
+    context.dir = mkdtempSync(join(tmpdir(), `hwfoc-web-${name}-`));
+  });
+  after(async () => {
+    await context.browser?.close();
+    context.server?.close();
+    if (context.dir) rmSync(context.dir, { recursive: true, force: true });
+  });
+  return context;
 }

@@ -897,7 +897,7 @@ impl Stream {
 }
 
 /// A [`Stream`] per port, fed by [`PortEvent`]s: the path from live bytes to timed frames of
-/// `monitor`, `record` and the bridges (and of [`crate::Input::open_ports`], through
+/// `monitor`, `record` and the bridges (and of `hwfoc-io`'s `Input::open_ports`, through
 /// [`byte_times`]).
 ///
 /// ESC numbers are those [`crate::Sources`] gives a recording of the same ports: port
@@ -1103,7 +1103,7 @@ impl PortStreams {
         self.bauds[port] = Some(baud);
     }
 
-    /// Every port's rate is to be found ([`crate::serial::Baud::Auto`]): unknown until its
+    /// Every port's rate is to be found (`hwfoc-io`'s `serial::Baud::Auto`): unknown until its
     /// [`PortEvent::Found`].
     pub fn auto_baud(&mut self) {
         self.bauds.fill(None);

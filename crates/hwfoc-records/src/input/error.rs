@@ -65,7 +65,7 @@ pub enum InputError {
         /// The input as named on the command line.
         input: String,
     },
-    /// A file read in two goes (closed meanwhile: see [`Input::open`](crate::Input::open))
+    /// A file read in two goes (closed meanwhile: see [`Input::from_file`](crate::Input::from_file))
     /// was no longer of the format it was first.
     Changed {
         /// The input as named on the command line.
