@@ -3,7 +3,7 @@
 import { test } from 'node:test';
 import assert from 'node:assert/strict';
 import { execFileSync } from 'node:child_process';
-import { readFileSync } from 'node:fs';
+import { existsSync, readFileSync } from 'node:fs';
 import { fileURLToPath } from 'node:url';
 import * as limits from '../src/live/limits.js';
 import { hwfocBin } from '../e2e/live/hwfoc-bin.js';
@@ -26,8 +26,17 @@ function rust(path) {
   return readFileSync(`${repo}${path}`, 'utf8');
 }
 
-test('port search constants equal hwfoc-io serial.rs', () => {
-  const src = rust('crates/hwfoc-io/src/serial.rs');
+/** The text of those of `paths` that exist, joined (the I/O crates' modules move between crates). */
+function sources(...paths) {
+  return paths.filter((p) => existsSync(`${repo}${p}`)).map(rust).join('\n');
+}
+
+const SERIAL = ['crates/hwfoc-io/src/serial.rs', 'crates/hwfoc-records/src/serial.rs', 'crates/hwfoc-ports/src/serial.rs'];
+const CAN = ['crates/hwfoc-io/src/can/bus.rs', 'crates/hwfoc-io/src/can/slcan.rs', 'crates/hwfoc-records/src/can/mod.rs',
+  'crates/hwfoc-ports/src/can/bus.rs', 'crates/hwfoc-ports/src/can/slcan.rs', 'crates/hwfoc-ports/src/slcan.rs'];
+
+test('port search constants equal the command\'s (serial.rs)', () => {
+  const src = sources(...SERIAL);
   const rates = src.match(/pub const SEARCH_RATES: \[u32; \d+\] = \[([^\]]+)\]/)[1].split(',').map((s) => Number(s.trim().replaceAll('_', '')));
   assert.deepEqual([...limits.SEARCH_RATES], rates);
   const ms = (name) => Number(src.match(new RegExp(`pub const ${name}: Duration = Duration::from_millis\\((\\d+)\\)`))[1]);
@@ -37,11 +46,11 @@ test('port search constants equal hwfoc-io serial.rs', () => {
   assert.equal(limits.SEARCH_LOCK_FRAMES, Number(src.match(/pub const SEARCH_LOCK_FRAMES: u32 = (\d+);/)[1]));
 });
 
-test('SLCAN constants equal hwfoc-io can/', () => {
-  const slcan = rust('crates/hwfoc-io/src/can/slcan.rs');
+test('SLCAN constants equal the command\'s (can/)', () => {
+  const slcan = sources(...CAN);
   const rates = slcan.match(/pub const BITRATES: \[u32; 9\] = \[([^\]]+)\]/)[1].split(',').filter((s) => s.trim()).map((s) => Number(s.trim().replaceAll('_', '')));
   assert.deepEqual([...limits.SLCAN_BITRATES], rates);
-  const bus = rust('crates/hwfoc-io/src/can/bus.rs');
+  const bus = slcan;
   assert.equal(limits.SLCAN_SERIAL_BAUD, Number(bus.match(/pub const SLCAN_BAUD: u32 = ([\d_]+);/)[1].replaceAll('_', '')));
   assert.equal(limits.DEFAULT_CAN_BITRATE, Number(bus.match(/pub const DEFAULT_BITRATE: u32 = ([\d_]+);/)[1].replaceAll('_', '')));
 });
