@@ -36,6 +36,7 @@ pub fn embed() {
         "web/src",
         "crates/hwfoc-web",
         "crates/hwfoc/src",
+        "crates/hwfoc-records/src",
         "Cargo.lock",
     ] {
         println!("cargo:rerun-if-changed={}", root.join(watched).display());

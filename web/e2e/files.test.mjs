@@ -100,8 +100,8 @@ test('screenshots at 390 px and 1280 px', async () => {
   // page reads them, a capture and a CAN bus.
   const sim = join(ctx.dir, 'sim.bin');
   hwfoc('simulate', '--duration', '60', '-o', sim);
-  const files = [sim];
-  if (!skip) files.push('testdata/captures/xrotor-v4-pro-hv-80A.csv', 'testdata/dronecan/can-bus.candump.txt');
+  const files = skip ? [] : ['testdata/captures/xrotor-v4-pro-hv-80A.csv', 'testdata/dronecan/can-bus.candump.txt'];
+  files.push(sim);
   for (const width of [390, 1280]) {
     const page = await openInPage(files, width);
     try {

@@ -78,14 +78,8 @@ export class Session {
  * @returns {{records: object, summary: object, notices: string[]}}
  */
 export function openFile(name, bytes) {
-  const session = new Session({ name });
-  try {
-    session.feed(bytes);
-    session.finish();
-    return { records: session.takeRecords(), summary: session.summary(), notices: session.notices() };
-  } finally {
-    session.free();
-  }
+  const opened = wasm.openFile(name, bytes);
+  return { records: opened.records, summary: opened.summary, notices: Array.from(opened.notices) };
 }
 
 /**
@@ -104,9 +98,6 @@ export function faultNames(protocol, status) {
 export class Recorder {
   /** @param {{port?: string, baud?: number}} [options] */
   constructor({ port, baud } = {}) {
-    if (typeof wasm.WasmRecorder !== 'function') {
-      throw new Error("this build cannot record: the pcapng writer comes with the command's readers (crates/hwfoc-records)");
-    }
     this.inner = new wasm.WasmRecorder(port ?? 'port', baud ?? 0);
   }
 

@@ -70,15 +70,16 @@ test('toCsv writes nulls as empty cells, protocols by name, faults from the stat
       t_s: Float64Array.of(0.5, NaN),
       protocol: Uint8Array.of(0, 1),
       voltage_v: Float32Array.of(24.7, NaN),
+      mos_temp_c: Float32Array.of(28, NaN),
       status: Float64Array.of(5, NaN),
     },
   };
   const names = csvColumns(records);
-  assert.deepEqual(names, ['t_s', 'protocol', 'voltage_v', 'status', 'faults']);
+  assert.deepEqual(names, ['t_s', 'protocol', 'voltage_v', 'mos_temp_c', 'status', 'faults']);
   const faultNames = (p, s) => (p === 'hw-foc' && s === 5 ? ['a', 'c'] : ['?']);
   assert.equal(
     toCsv(records, names, [0, 1], faultNames),
-    't_s,protocol,voltage_v,status,faults\n0.5,hw-foc,24.7,5,a|c\n,datalink,,,\n',
+    't_s,protocol,voltage_v,mos_temp_c,status,faults\n0.5,hw-foc,24.7,28.0,5,a|c\n,datalink,,,,\n',
   );
 });
 
@@ -86,6 +87,9 @@ test('float32Text gives the shortest decimal of a float32', () => {
   assert.equal(float32Text(Math.fround(24.7)), '24.7');
   assert.equal(float32Text(Math.fround(-0.015625)), '-0.015625');
   assert.equal(float32Text(Math.fround(11428.5712890625)), '11428.571');
+  // 61.9140625 exactly: a tie between 61.914062 and 61.914063, the even digit taken (as ryu).
+  assert.equal(float32Text(Math.fround(61.9140625)), '61.914062');
+  assert.equal(float32Text(0), '0');
 });
 
 import { View } from '../src/files/view.js';

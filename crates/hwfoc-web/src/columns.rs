@@ -3,6 +3,7 @@
 
 use hwfoc::telemetry::{Data, Telemetry};
 use hwfoc::{Protocol, Quantity, Settings};
+use hwfoc_records::Record;
 use js_sys::{Array, Float32Array, Float64Array, Object, Reflect, Uint8Array};
 use wasm_bindgen::JsValue;
 
@@ -50,6 +51,46 @@ impl Columns {
     /// Whether no record is held.
     pub fn is_empty(&self) -> bool {
         self.esc.is_empty()
+    }
+
+    /// Adds a record as the command makes it (`hwfoc_records::Record`).
+    pub fn push_record(&mut self, r: &Record) {
+        if self.floats.is_empty() {
+            self.floats = float_quantities().map(|_| Vec::new()).collect();
+        }
+        let nan = f64::NAN;
+        self.t_s.push(r.t_s.unwrap_or(nan));
+        self.esc.push(r.esc);
+        self.protocol.push(protocol_code(r.protocol));
+        let integers = [
+            r.packet.map(f64::from),
+            r.erpm.map(f64::from),
+            r.status.map(|s| f64::from(s.0)),
+            r.node.map(f64::from),
+            r.msg2_age_ms.map(f64::from),
+            r.msg3_age_ms.map(f64::from),
+        ];
+        for (column, value) in self.integers.iter_mut().zip(integers) {
+            column.push(value.unwrap_or(nan));
+        }
+        // In the order of `float_quantities`: Quantity::ALL but eRPM.
+        let floats = [
+            r.throttle_in_pct,
+            r.throttle_out_pct,
+            r.rpm,
+            r.voltage_v,
+            r.current_a,
+            r.phase_current_a,
+            r.mos_temp_c,
+            r.cap_temp_c,
+            r.motor_temp_c,
+            r.bec_temp_c,
+            r.bec_voltage_v,
+            r.bec_current_a,
+        ];
+        for (column, value) in self.floats.iter_mut().zip(floats) {
+            column.push(value.unwrap_or(f32::NAN));
+        }
     }
 
     /// Adds the record of `data` from ESC `esc` received at `t_s` (seconds, or None).

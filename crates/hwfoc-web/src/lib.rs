@@ -8,6 +8,7 @@
 #![warn(missing_docs)]
 
 pub mod columns;
+pub mod file;
 pub mod session;
 
 use js_sys::{Array, Object, Reflect};
@@ -88,4 +89,85 @@ pub fn fault_names(protocol: &str, status: u16) -> Array {
         .flat_map(|p| p.fault_names(hwfoc::Status(status)))
         .map(JsValue::from_str)
         .collect()
+}
+
+/// A recording's records, summary and notices (`file::open`): `{records, summary, notices}`,
+/// `records` as [`WasmSession::take_records`] gives them, `summary` the object of
+/// `hwfoc summary --json` (null when the file could not be read).
+#[wasm_bindgen(js_name = openFile)]
+pub fn open_file(name: &str, bytes: Vec<u8>) -> Result<Object, JsValue> {
+    let mut opened = file::open(name, bytes);
+    let out = Object::new();
+    Reflect::set(&out, &"records".into(), &opened.columns.take()?.into())?;
+    Reflect::set(
+        &out,
+        &"summary".into(),
+        &js_sys::JSON::parse(&opened.summary)?,
+    )?;
+    let notices: Array = opened
+        .notices
+        .iter()
+        .map(|n| JsValue::from_str(n))
+        .collect();
+    Reflect::set(&out, &"notices".into(), &notices)?;
+    Ok(out)
+}
+
+/// A recording of one port's bytes with their receive times, written as `hwfoc record` writes
+/// it (`hwfoc_records::pcapng::Writer`): the port is declared at its first bytes.
+#[wasm_bindgen(js_name = WasmRecorder)]
+pub struct WasmRecorder {
+    writer: Option<hwfoc_records::pcapng::Writer<Vec<u8>>>,
+    port: String,
+    baud: u32,
+    declared: bool,
+}
+
+#[wasm_bindgen(js_class = WasmRecorder)]
+impl WasmRecorder {
+    /// A recording of the port named `port`, read at `baud` (8N1).
+    #[wasm_bindgen(constructor)]
+    pub fn new(port: String, baud: u32) -> Result<WasmRecorder, JsError> {
+        let writer = hwfoc_records::pcapng::Writer::new(Vec::new())
+            .map_err(|e| JsError::new(&format!("{port}: {e}")))?;
+        Ok(WasmRecorder {
+            writer: Some(writer),
+            port,
+            baud,
+            declared: false,
+        })
+    }
+
+    /// Adds a chunk as the port gave it, its last byte received at `t_micros` (Unix
+    /// microseconds).
+    pub fn add(&mut self, bytes: &[u8], t_micros: f64) -> Result<(), JsError> {
+        let port = self.port.clone();
+        let err = |e: std::io::Error| JsError::new(&format!("{port}: {e}"));
+        let Some(writer) = self.writer.as_mut() else {
+            return Err(JsError::new(&format!("{port}: the recording is finished")));
+        };
+        if !self.declared {
+            writer.add_interface(&self.port, self.baud).map_err(err)?;
+            self.declared = true;
+        }
+        // The time of the chunk's first byte: the last's less the wire time of the others.
+        let per_byte = hwfoc::wire::byte_ns(self.baud);
+        let last_ns = (t_micros.max(0.0) * 1000.0) as u64;
+        let before = (bytes.len().saturating_sub(1) as f64 * per_byte) as u64;
+        writer
+            .write(0, last_ns.saturating_sub(before), bytes)
+            .map_err(err)
+    }
+
+    /// The pcapng file.
+    pub fn finish(&mut self) -> Result<Vec<u8>, JsError> {
+        let port = self.port.clone();
+        let writer = self
+            .writer
+            .take()
+            .ok_or_else(|| JsError::new(&format!("{port}: the recording is finished")))?;
+        writer
+            .into_inner()
+            .map_err(|e| JsError::new(&format!("{port}: {e}")))
+    }
 }

@@ -7,22 +7,44 @@
  * @param {number} v
  */
 export function float32Text(v) {
-  for (let p = 1; p < 9; p++) {
-    const text = v.toPrecision(p);
-    if (Math.fround(Number(text)) === v) return String(Number(text));
+  for (let p = 1; p < 10; p++) {
+    // The p-digit decimals next to v; of those that read back as v, the nearest (on a tie, the
+    // one with an even last digit), as the command's float formatting (ryu) chooses.
+    const [mantissa, exponent] = v.toExponential(p - 1).split('e');
+    const m = Math.round(Number(mantissa.replace('.', '').replace('-', '')));
+    const sign = v < 0 ? '-' : '';
+    const scale = Number(exponent) - (p - 1);
+    let best = null;
+    for (const k of [m - 1, m, m + 1]) {
+      if (k <= 0 && m > 0) continue;
+      const text = `${sign}${k}e${scale}`;
+      const value = Number(text);
+      if (Math.fround(value) !== v) continue;
+      const distance = Math.abs(value - v);
+      if (best === null || distance < best.distance || (distance === best.distance && k % 2 === 0)) {
+        best = { value, distance };
+      }
+    }
+    if (best !== null) return String(best.value);
   }
   return String(v);
 }
 
 /**
- * One cell: a null (NaN) empty; a float32 column's value by `float32Text`.
+ * One cell: a null (NaN) empty; a float column's value as the command writes a float (`28.0`,
+ * not `28`), a float32 by `float32Text`; an integer column's as an integer.
  * @param {number} v
- * @param {boolean} f32
+ * @param {'f32' | 'f64' | 'int'} kind
  */
-function cell(v, f32) {
+function cell(v, kind) {
   if (Number.isNaN(v)) return '';
-  return f32 ? float32Text(v) : String(v);
+  if (kind === 'int') return String(v);
+  const text = kind === 'f32' ? float32Text(v) : String(v);
+  return /[.e]/.test(text) ? text : `${text}.0`;
 }
+
+/** The one float64 column of the records; the other Float64Arrays hold integers. */
+const FLOAT64 = new Set(['t_s']);
 
 /**
  * The column names of a CSV of `records`: theirs, with `faults` after `status` as the
@@ -47,7 +69,9 @@ export function toCsv(records, names, rows, faultNames = () => []) {
   const faults = (i) =>
     Number.isNaN(status[i]) ? '' : faultNames(records.protocols[protocol[i]], status[i]).join('|');
   const columns = names.map((n) => records.columns[n]);
-  const f32 = columns.map((c) => c instanceof Float32Array);
+  const kinds = names.map((n, c) =>
+    columns[c] instanceof Float32Array ? 'f32' : FLOAT64.has(n) ? 'f64' : 'int',
+  );
   for (let k = 0; k < rows.length; k++) {
     const i = rows[k];
     const cells = names.map((n, c) =>
@@ -55,7 +79,7 @@ export function toCsv(records, names, rows, faultNames = () => []) {
         ? records.protocols[columns[c][i]]
         : n === 'faults'
           ? faults(i)
-          : cell(columns[c][i], f32[c]),
+          : cell(columns[c][i], kinds[c]),
     );
     lines.push(cells.join(','));
   }

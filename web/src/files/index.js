@@ -394,7 +394,8 @@ function checkbox(doc, text, checked, colour, onChange) {
   return label;
 }
 
-/** A number for the readout. */
+/** A number for the readout (a Unix time to the millisecond). */
 function fmt(v) {
-  return Number.isFinite(v) ? String(Number(v.toPrecision(6))) : '-';
+  if (!Number.isFinite(v)) return '-';
+  return Math.abs(v) >= 1e5 ? v.toFixed(3) : String(Number(v.toPrecision(6)));
 }
