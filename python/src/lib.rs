@@ -308,14 +308,9 @@ pub(crate) fn no_frames(sources: &Sources) -> Vec<String> {
 }
 
 /// The command's error when no input held a data frame (`hwfoc decode` and `hwfoc summary`
-/// exit 1 with it, after their warnings), raised as `InputError`.
+/// exit 1 with it, after their warnings), raised as `InputError`: its text.
 pub(crate) fn nothing_decoded(sources: &Sources) -> Option<String> {
-    (!sources.any_data_frame()).then(|| {
-        format!(
-            "no data frame in any input ({})",
-            sources.names().join(", ")
-        )
-    })
+    sources.nothing_decoded().map(|e| e.to_string())
 }
 
 /// The command's warning for a time window that held no frame, if `collect`'s did not.

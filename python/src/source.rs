@@ -5,7 +5,7 @@
 
 use std::io::{self, Read};
 
-use hwfoc_io::{Input, InputError};
+use hwfoc_io::{Input, InputError, OpenInput};
 use pyo3::exceptions::PyTypeError;
 use pyo3::prelude::*;
 use pyo3::types::{PyByteArray, PyBytes, PyList, PyMemoryView, PyString, PyTuple};

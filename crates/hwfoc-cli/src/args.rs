@@ -10,7 +10,7 @@ use hwfoc::v4::VoltsPerStep;
 use hwfoc_io::Sources;
 use hwfoc_io::serial;
 use hwfoc_io::time::{Clock, Time, TimeError};
-use hwfoc_io::{Input, InputError};
+use hwfoc_io::{Input, InputError, OpenInput};
 use hwfoc_io::{Selection, Window};
 use hwfoc_io::{SettingsMap, SettingsPatch};
 

@@ -72,12 +72,6 @@ pub enum CliError {
         /// Why.
         source: io::Error,
     },
-    /// `hwfoc decode`, `hwfoc summary`: no input gave a data frame (why, input by input, was
-    /// said before).
-    NoDataFrames {
-        /// The inputs, as named.
-        inputs: String,
-    },
     /// `hwfoc plot`: the inputs hold nothing to plot.
     NothingToPlot {
         /// What is missing, and where.
@@ -213,9 +207,6 @@ impl fmt::Display for CliError {
                 message,
             } => write!(f, "{path}: {message}"),
             CliError::Terminal { source } => write!(f, "terminal: {source}"),
-            CliError::NoDataFrames { inputs } => {
-                write!(f, "no data frame in any input ({inputs})")
-            }
             CliError::NothingToPlot { message } => write!(f, "nothing to plot: {message}"),
             CliError::Render { output, message } => write!(f, "cannot draw {output}: {message}"),
         }

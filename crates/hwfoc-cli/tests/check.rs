@@ -8,13 +8,12 @@ use std::path::{Path, PathBuf};
 
 use common::{Dir, hwfoc, run};
 
-use hwfoc::{Protocol, Settings};
+use hwfoc::Settings;
 use hwfoc_io::Record;
 use hwfoc_io::check::{
     Analyser, Baseline, CheckConfig, EscId, EscSeries, Finding, Sample, Severity, analyse,
 };
 use hwfoc_sim::degrade::{DegradeKind, DegradeSpec};
-use hwfoc_sim::faults::LinkRates;
 use hwfoc_sim::fleet::FleetSpec;
 use hwfoc_sim::model::ModelConfig;
 use hwfoc_sim::profile::{ProfileSpec, Shape};
@@ -46,21 +45,17 @@ fn healthy(i: u64) -> FleetSpec {
     let levels: Vec<f64> = (0..5)
         .map(|_| (d.between(0.0, 100.0) / 5.0).round() * 5.0)
         .collect();
-    FleetSpec {
-        n: 3 + (i % 6) as usize,
-        seed: 1000 + i,
-        protocol: Protocol::HwFoc,
-        baud: 19200,
-        start_packet: None,
-        profile,
-        shape: Shape {
+    let mut spec = FleetSpec::steps(
+        3 + (i % 6) as usize,
+        1000 + i,
+        Shape {
             lead_in_s: d.between(0.5, 3.0),
             levels: [vec![0.0], levels, vec![0.0]].concat(),
             hold_s: d.between(1.0, 5.0),
             period_s: d.between(4.0, 15.0),
             max_pct: d.between(40.0, 100.0),
         },
-        model: ModelConfig {
+        ModelConfig {
             kv: d.between(300.0, 1500.0),
             pole_pairs: 7,
             full_current_a: d.between(15.0, 90.0),
@@ -70,10 +65,10 @@ fn healthy(i: u64) -> FleetSpec {
             ambient_c: d.between(5.0, 40.0),
             current_scale: 64.0,
         },
-        faults: Vec::new(),
-        link: LinkRates::default(),
-        degradations: Vec::new(),
-    }
+        Vec::new(),
+    );
+    spec.profile = profile;
+    spec
 }
 
 /// The ESCs' series of `spec` flown for `seconds`, generated in-process: each intact data frame
@@ -108,6 +103,7 @@ fn fly(spec: FleetSpec, seconds: f64, recording: &str) -> Vec<EscSeries> {
                 protocol: esc.protocol(),
                 timed: true,
                 link: None,
+                maintenance_min: None,
                 samples,
             }
         })
@@ -154,14 +150,10 @@ fn two_hundred_healthy_simulated_flights_raise_no_warning() {
 /// The airframe of the degradation tests: four ESCs on a staircase of throttle levels held 4 s
 /// each, `degradations` applied, seed `seed`.
 fn airframe(seed: u64, ambient_c: f64, degradations: Vec<DegradeSpec>) -> FleetSpec {
-    FleetSpec {
-        n: 4,
+    FleetSpec::steps(
+        4,
         seed,
-        protocol: Protocol::HwFoc,
-        baud: 19200,
-        start_packet: None,
-        profile: ProfileSpec::Steps,
-        shape: Shape {
+        Shape {
             lead_in_s: 1.0,
             levels: vec![
                 0.0, 30.0, 50.0, 70.0, 40.0, 60.0, 80.0, 50.0, 30.0, 60.0, 45.0, 0.0,
@@ -170,7 +162,7 @@ fn airframe(seed: u64, ambient_c: f64, degradations: Vec<DegradeSpec>) -> FleetS
             period_s: 10.0,
             max_pct: 80.0,
         },
-        model: ModelConfig {
+        ModelConfig {
             kv: 500.0,
             pole_pairs: 7,
             full_current_a: 60.0,
@@ -180,10 +172,8 @@ fn airframe(seed: u64, ambient_c: f64, degradations: Vec<DegradeSpec>) -> FleetS
             ambient_c,
             current_scale: 64.0,
         },
-        faults: Vec::new(),
-        link: LinkRates::default(),
         degradations,
-    }
+    )
 }
 
 /// ESC `esc` degraded by `kind` from `start_s` at `severity`.
@@ -225,11 +215,18 @@ fn found(
     baseline: Option<&Baseline>,
     analyser: Analyser,
 ) -> Vec<Finding> {
-    let series = fly(
-        airframe(AIRFRAME, ambient_c, degradations),
-        seconds,
-        "degraded",
-    );
+    let spec = airframe(AIRFRAME, ambient_c, degradations);
+    found_in(spec, seconds, baseline, analyser)
+}
+
+/// The warnings and critical findings of `analyser` on the flight of `spec`.
+fn found_in(
+    spec: FleetSpec,
+    seconds: f64,
+    baseline: Option<&Baseline>,
+    analyser: Analyser,
+) -> Vec<Finding> {
+    let series = fly(spec, seconds, "degraded");
     let findings = analyse(&series, &CheckConfig::default(), baseline);
     let all: Vec<Finding> = findings
         .into_iter()
@@ -286,6 +283,25 @@ fn a_damaged_prop_is_found_as_imbalance_and_as_drift_on_its_esc_from_when_it_sta
     );
 }
 
+/// [`airframe`] [`AIRFRAME`] flying a sine of throttle (8 s a cycle, up to 80 %): the throttle
+/// never holds, as in a real flight.
+fn sine(degradations: Vec<DegradeSpec>) -> FleetSpec {
+    let mut spec = airframe(AIRFRAME, 25.0, degradations);
+    spec.profile = ProfileSpec::Sine;
+    spec.shape.period_s = 8.0;
+    spec
+}
+
+#[test]
+fn a_damaged_prop_is_found_as_imbalance_while_the_throttle_moves() {
+    let prop = degrade(1, DegradeKind::Prop, 15.0, 1.0);
+    let imbalance = found_in(sine(prop), 50.0, None, Analyser::Imbalance);
+    on_esc_in_window(&imbalance, 1, 15.0, 5.0, 45.0);
+    // Healthy, the same moving flight is balanced.
+    let healthy = found_in(sine(Vec::new()), 50.0, None, Analyser::Imbalance);
+    assert!(healthy.is_empty(), "{healthy:#?}");
+}
+
 #[test]
 fn a_weak_battery_is_found_against_the_baseline_on_its_esc() {
     let baseline = baseline();
@@ -330,8 +346,8 @@ fn a_slow_heat_build_up_is_found_on_its_esc_when_it_crosses_the_limit() {
     }
 }
 
-/// Simulates four ESCs of seed `seed` for 40 s into `dir/name` (a pcapng), with `more`
-/// options (`--degrade`).
+/// Simulates four ESCs of seed `seed` for 40 s into `dir/name` (a pcapng, or a candump log:
+/// `.log`), with `more` options (`--degrade`, `--protocol`).
 fn simulate(dir: &Dir, name: &str, seed: u64, more: &[&str]) -> String {
     let path = dir.arg(name);
     let seed = seed.to_string();
@@ -626,4 +642,52 @@ fn the_real_captures_give_no_finding_the_capture_does_not_show() {
         }
     }
     assert!(read >= 8, "only {read} captures read");
+}
+
+#[test]
+fn a_can_esc_s_maintenance_answer_in_its_recording_is_judged_against_the_service_interval() {
+    use hwfoc::dronecan::{GetMaintenanceInformationResponse, Message};
+    let dir = Dir::new();
+    let path = simulate(&dir, "bus.log", 1, &["--protocol", "hw-can"]);
+    // Node 11 (ESC 1) answers a GetMaintenanceInformation request, as on a bus where `hwfoc
+    // can list` asked: 150 h turned, 55 h (3300 min) since its last maintenance.
+    let mut log = std::fs::read_to_string(&path).unwrap();
+    let last_line = log.lines().last().unwrap();
+    let last: f64 = last_line[1..last_line.find(')').unwrap()].parse().unwrap();
+    let answer = Message::from(GetMaintenanceInformationResponse {
+        total_rotation_time_min: 9000,
+        time_since_maintenance_min: 3300,
+    });
+    for frame in answer.frames(24, 11, 127, 0) {
+        hwfoc_io::can::candump::push_line(&mut log, last + 0.001, "can0", &frame);
+    }
+    std::fs::write(&path, log).unwrap();
+    let (code, report) = check_json(&[&path]);
+    assert_eq!(code, 1, "{report:#}");
+    assert_eq!(raised_in(&report), [("runtime".to_string(), 1)]);
+    let runtime: Vec<&Value> = report["findings"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|f| f["analyser"] == "runtime")
+        .collect();
+    assert_eq!(runtime.len(), 4, "{report:#}");
+    let f = runtime.iter().find(|f| f["severity"] == "warning").unwrap();
+    assert!(
+        f["esc"]["label"].as_str().unwrap().contains("node 11"),
+        "{f:#}"
+    );
+    let value = |name: &str| {
+        f["values"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|v| v["name"] == name)
+            .unwrap_or_else(|| panic!("{name}: {f:#}"))["value"]
+            .as_f64()
+            .unwrap()
+    };
+    assert_eq!(value("hours_since_service"), 55.0);
+    assert_eq!(value("esc_total_rotation"), 150.0);
+    assert_eq!(f["threshold"]["value"], 50.0, "{f:#}");
 }

@@ -807,7 +807,7 @@ fn records_an_slcan_bus_as_can_frames() {
     );
     assert_eq!(reader.interfaces()[0].name, bus);
     assert_eq!(reader.interfaces()[0].baud, Some(500_000));
-    let mut input = hwfoc_io::Input::open(out.to_str().unwrap()).unwrap();
+    let mut input = <hwfoc_io::Input as hwfoc_io::OpenInput>::open(out.to_str().unwrap()).unwrap();
     let mut records = 0;
     while let Some(b) = input.next_batch().unwrap() {
         records += b.bytes.len() / 16;

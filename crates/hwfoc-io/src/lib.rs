@@ -1,13 +1,16 @@
 //! Everything between the bytes on an ESC's telemetry wire and the records every output shows.
 //!
 //! The codec (`hwfoc`) turns bytes into frames; this library does what lies around it, for every
-//! front end alike (the `hwfoc` command, bridges, bindings). Its surface, by role (the items
-//! at the crate root, the rest in the public modules named):
+//! front end alike (the `hwfoc` command, bridges, bindings). What needs no operating system
+//! (formats, streams, ESC numbering, the record, the summary, the checks) is `hwfoc-records`,
+//! re-exported here at the same paths; this crate adds files, standard input, serial ports, CAN
+//! adapters and the writers' threads. Its surface, by role (the items at the crate root, the
+//! rest in the public modules named):
 //!
 //! - inputs: where bytes come from (raw files, logic-analyser CSV exports, pcapng recordings,
 //!   serial ports, standard input), an [`Input`] whose [`InputFormat`] is detected from the
 //!   content, read as [`Batch`]es of bytes with their receive times where the source has a
-//!   clock;
+//!   clock; files, standard input and ports are opened through [`OpenInput`];
 //! - decoding: [`Sources`] and [`Stream`] ([`PortStreams`] for live ports), the one path from
 //!   timed bytes to frames, a decoding stream per ESC, each converted under its own settings
 //!   ([`SettingsMap`]); the [`Handler`] seam through which records reach a front end;
@@ -124,74 +127,72 @@
 // Modules whose names are a namespace for their items (`time::parse`, `serial::open`,
 // `pcapng::Reader`, `write::arrow::schema`): public, each exporting only its public items.
 pub mod can;
-pub mod check;
-pub mod clock;
-pub mod energy;
-pub mod pcapng;
 pub mod record;
 pub mod serial;
-pub mod summary;
-pub mod time;
 pub mod write;
+pub use hwfoc_records::{check, energy, pcapng, summary, time};
+
+/// Receive times: the clock that stamps what is received (`ReceiveClock`, reading the system's
+/// clocks) and `hwfoc-records`' timing of a chunk's bytes and steps between frames.
+pub mod clock {
+    pub use crate::receive::{ReceiveClock, unix_now_ns};
+    pub use hwfoc_records::clock::*;
+}
 
 // Modules whose public items are re-exported below, by role.
-mod episode;
-mod esc_numbers;
-mod esc_table;
-mod escape;
-mod fixed;
-mod handler;
 mod input;
-mod notice;
 mod port;
-mod select;
-mod settings;
-mod sources;
-mod stream;
+mod receive;
 
-/// The version of the layout of the JSON objects the project prints (`hwfoc summary --json`,
-/// the status and alarm lines of `hwfoc monitor --json`), as their `"schema_version"` key: it
-/// goes up when a key is renamed or removed or its meaning or unit changes, not when a key is
-/// added. The records of `docs/RECORD-SCHEMA.md` (JSON Lines) carry no such key: they have exactly
-/// the schema's keys.
-pub const JSON_SCHEMA_VERSION: u32 = 1;
+// `hwfoc-records`' modules as this crate's own modules name them.
+mod handler {
+    pub use hwfoc_records::Handler;
+}
+mod select {
+    pub use hwfoc_records::Selection;
+    #[cfg(test)]
+    pub use hwfoc_records::Window;
+}
+mod settings {
+    #[cfg(test)]
+    pub use hwfoc_records::SettingsMap;
+    pub use hwfoc_records::{SettingsPatch, settings_fields as fields, settings_json};
+}
+mod sources {
+    pub use hwfoc_records::Sources;
+}
 
-/// The version of the record schema of `docs/RECORD-SCHEMA.md` (its columns, their types and
-/// nullability), recorded with the outputs that carry metadata: the Parquet export's key-value
-/// metadata and the Python package's Arrow schema, key `record_schema_version`. Version 2 added
-/// `protocol`, the BEC and motor columns, a 32-bit nullable `packet` and null for what a format
-/// does not carry; version 3 the CAN bus's `node`, `msg2_age_ms` and `msg3_age_ms` (the
-/// document's "Changes").
-pub const RECORD_SCHEMA_VERSION: u32 = 4;
+/// The versions of the JSON objects' layout and of the record schema (`hwfoc-records`').
+pub use hwfoc_records::{JSON_SCHEMA_VERSION, RECORD_SCHEMA_VERSION};
 
 // The crate-root items, by role (a comment, not a doc comment: rustdoc would prepend a doc
 // comment on a re-export to the docs of each item it names).
 
 // Inputs: where bytes come from, each opened as an `Input` whose format is detected from its
-// content, read as `Batch`es of bytes with their receive times.
-pub use input::{Batch, Input, InputError, InputFormat, Looks, ONLY_ZEROS_LIMIT, read_small_file};
+// content, read as `Batch`es of bytes with their receive times; files, standard input and
+// ports opened by `OpenInput`.
+pub use hwfoc_records::{Batch, Input, InputError, InputFormat, Looks, ONLY_ZEROS_LIMIT};
+pub use input::{OpenInput, read_small_file};
 
 // Decoding: `Sources` reads inputs, merges them in time order and decodes each ESC's bytes
 // with a `Stream` (`PortStreams` for live ports), handing frames to a `Handler`.
-pub use esc_numbers::MAX_ESCS;
-pub use esc_table::{EscEntry, EscKey, EscTable, Place, Recording};
-pub use handler::{Both, Handler, LaterPart};
-pub use sources::{Esc, InputInfo, MAX_QUEUED, Sources};
-pub use stream::{EscLink, PortStreams, SILENCE_S, Stream, WireKind};
+pub use hwfoc_records::{
+    Both, Esc, EscEntry, EscKey, EscLink, EscTable, Handler, InputInfo, LaterPart, MAX_ESCS,
+    MAX_QUEUED, Place, PortStreams, Recording, SILENCE_S, Sources, Stream, WireKind,
+};
 
 // Settings: each ESC's conversion settings (`hwfoc::Settings`), as given per ESC and shown.
-pub use settings::{SettingValue, SettingsMap, SettingsPatch, settings_json};
+pub use hwfoc_records::{SettingValue, SettingsMap, SettingsPatch, settings_json};
 
 // Records: the record of `docs/RECORD-SCHEMA.md` (`record` has its columns and text
 // encodings).
-pub use record::Record;
+pub use hwfoc_records::Record;
 
 // Selection of records by ESC and time window.
-pub use select::{EmptyWindow, Selection, Window, filter_text, no_frame_in_window};
+pub use hwfoc_records::{EmptyWindow, Selection, Window, filter_text, no_frame_in_window};
 
 // What an input tells a person while it is read (a port unplugged, a damaged recording).
-pub use notice::Notice;
+pub use hwfoc_records::Notice;
 
 // Text helpers: a name shown safely (`Escaped`), a number with fixed decimals (`Fixed`).
-pub use escape::Escaped;
-pub use fixed::Fixed;
+pub use hwfoc_records::{Escaped, Fixed};

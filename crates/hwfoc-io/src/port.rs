@@ -3,87 +3,15 @@
 //! ([`available_ports`]). Beneath both the port set ([`crate::serial`]) and the CAN buses on an
 //! SLCAN adapter ([`crate::can`]), which depend on it and not on each other's modules.
 
-use std::fmt;
 use std::io;
 use std::path::Path;
 use std::time::Duration;
 
+pub use hwfoc_records::serial::PortError;
 use serialport::{DataBits, FlowControl, Parity, SerialPort, StopBits};
 
 /// How long a read waits for bytes before the thread checks whether it should stop.
 pub(crate) const READ_TIMEOUT: Duration = Duration::from_millis(50);
-
-/// Why a serial port could not be opened or read. Each names the port as the user gave it.
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub enum PortError {
-    /// A serial port that does not exist.
-    NoSuchPort {
-        /// The port as named on the command line.
-        port: String,
-        /// The ports the system does have.
-        available: Vec<String>,
-    },
-    /// A serial port we may not open.
-    Permission {
-        /// The port as named on the command line.
-        port: String,
-        /// The group owning the device file, if known.
-        group: Option<String>,
-    },
-    /// A serial port another program has open.
-    Busy {
-        /// The port as named on the command line.
-        port: String,
-    },
-    /// A serial port that could not be opened or set up for another reason.
-    Other {
-        /// The port as named on the command line.
-        port: String,
-        /// Why.
-        message: String,
-    },
-}
-
-impl fmt::Display for PortError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            PortError::NoSuchPort { port, available } => {
-                write!(f, "no such port {port}")?;
-                if available.is_empty() {
-                    write!(f, " (no serial ports found: is the adapter plugged in?)")
-                } else {
-                    write!(f, " (serial ports found: {})", available.join(", "))
-                }
-            }
-            PortError::Permission { port, group } => {
-                // A device of group root is not meant for users: give the usual groups.
-                let group = group.as_deref().filter(|g| *g != "root");
-                let owner = match group {
-                    Some(g) => format!(" (owned by group {g})"),
-                    None => String::new(),
-                };
-                let command = match group {
-                    Some(g) => format!("`sudo usermod -aG {g} $USER`"),
-                    None => "`sudo usermod -aG dialout $USER` on Debian/Ubuntu, `uucp` on Arch"
-                        .to_string(),
-                };
-                write!(
-                    f,
-                    "permission denied on {port}{owner}: join the group that may use serial \
-                     ports ({command}), then log out and in again"
-                )
-            }
-            PortError::Busy { port } => write!(
-                f,
-                "{port} is busy: another program has it open (a serial monitor, another hwfoc, \
-                 ModemManager); close it and try again"
-            ),
-            PortError::Other { port, message } => write!(f, "cannot open port {port}: {message}"),
-        }
-    }
-}
-
-impl std::error::Error for PortError {}
 
 /// Opens `port` at `baud`, 8N1, no flow control, for exclusive use.
 pub fn open(port: &str, baud: u32) -> Result<Box<dyn SerialPort>, PortError> {

@@ -31,16 +31,11 @@ use crate::can::{CanBus, CanError};
 use crate::clock::ReceiveClock;
 use crate::port::READ_TIMEOUT;
 pub use crate::port::{PortError, available_ports, open};
+pub use hwfoc_records::serial::{DEFAULT_BAUD, PortEvent, RETRY_EVERY};
 
 use hwfoc::Protocol;
 use hwfoc::detect;
 use serialport::{ClearBuffer, SerialPort};
-
-/// The HW-FOC telemetry rate, the default of every serial input.
-pub const DEFAULT_BAUD: u32 = hwfoc::foc::BAUD_RATE;
-
-/// How often a lost port is tried again.
-pub const RETRY_EVERY: Duration = Duration::from_millis(500);
 
 /// Bytes asked for per read (at 19200 baud a read rarely returns more than a frame).
 const READ_SIZE: usize = 4096;
@@ -263,76 +258,6 @@ fn is_terminal(path: &str) -> bool {
         Ok(file) => file.is_terminal(),
         // Not allowed to open it: say so when it is opened as a port.
         Err(e) => e.kind() == io::ErrorKind::PermissionDenied,
-    }
-}
-
-/// What a port's reader thread reports.
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub enum PortEvent {
-    /// Bytes received.
-    Data {
-        /// Index of the port in the set.
-        port: usize,
-        /// Unix time in nanoseconds of the first byte: the time the read returned less the
-        /// wire time of the bytes after the first, never earlier than just after the previous
-        /// chunk's last byte.
-        t_ns: u64,
-        /// The bytes.
-        bytes: Vec<u8>,
-    },
-    /// The port failed mid-read (unplugged); the thread now tries to reopen it.
-    Lost {
-        /// Index of the port in the set.
-        port: usize,
-        /// Unix time in nanoseconds when the failure was seen.
-        t_ns: u64,
-        /// What the operating system said.
-        reason: String,
-    },
-    /// A lost port was reopened.
-    Back {
-        /// Index of the port in the set.
-        port: usize,
-        /// Unix time in nanoseconds when it was reopened.
-        t_ns: u64,
-    },
-    /// Auto-baud ([`Baud::Auto`]): the port is now read at `baud`, the next rate tried. The
-    /// bytes read at the rate before gave no frame and were not handed on.
-    Searching {
-        /// Index of the port in the set.
-        port: usize,
-        /// Unix time in nanoseconds of the change.
-        t_ns: u64,
-        /// The rate now tried.
-        baud: u32,
-        /// How many bytes the rate before gave (read at a wrong rate: not the wire's bytes).
-        discarded: u64,
-    },
-    /// Auto-baud ([`Baud::Auto`]): the bytes read at `baud` gave frames of `protocol`, and the
-    /// port stays at that rate. The bytes read at it since it was tried follow as
-    /// [`PortEvent::Data`] (with their own times), then every later byte.
-    Found {
-        /// Index of the port in the set.
-        port: usize,
-        /// Unix time in nanoseconds of the lock.
-        t_ns: u64,
-        /// The port's rate.
-        baud: u32,
-        /// The protocol of the first frame found.
-        protocol: Protocol,
-    },
-}
-
-impl PortEvent {
-    /// The index of the port that reported it.
-    pub fn port(&self) -> usize {
-        match self {
-            PortEvent::Data { port, .. }
-            | PortEvent::Lost { port, .. }
-            | PortEvent::Back { port, .. }
-            | PortEvent::Searching { port, .. }
-            | PortEvent::Found { port, .. } => *port,
-        }
     }
 }
 

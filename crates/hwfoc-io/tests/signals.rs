@@ -8,7 +8,7 @@ use std::os::fd::AsFd;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 
-use hwfoc_io::Input;
+use hwfoc_io::{Input, OpenInput};
 
 /// Whether `signal`'s action is still the default one.
 fn is_default(signal: libc::c_int) -> bool {

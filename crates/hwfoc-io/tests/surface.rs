@@ -9,7 +9,7 @@
 #![allow(unused_imports)]
 
 // Inputs.
-use hwfoc_io::{Batch, Input, InputError, InputFormat, Looks, read_small_file};
+use hwfoc_io::{Batch, Input, InputError, InputFormat, Looks, OpenInput, read_small_file};
 
 // Decoding.
 use hwfoc_io::{

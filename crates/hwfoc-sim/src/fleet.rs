@@ -50,6 +50,32 @@ pub struct FleetSpec {
 }
 
 impl FleetSpec {
+    /// `n` HW-FOC ESCs at 19200 baud of seed `seed` (random first packet numbers) flying a
+    /// staircase of `shape` on `model`, with no fault, no link error and `degradations`: the
+    /// flight the tests of the degradations and of `hwfoc check` start from (set `profile` or
+    /// the rest after).
+    pub fn steps(
+        n: usize,
+        seed: u64,
+        shape: Shape,
+        model: ModelConfig,
+        degradations: Vec<DegradeSpec>,
+    ) -> FleetSpec {
+        FleetSpec {
+            n,
+            seed,
+            protocol: Protocol::HwFoc,
+            baud: 19200,
+            start_packet: None,
+            profile: ProfileSpec::Steps,
+            shape,
+            model,
+            faults: Vec::new(),
+            link: LinkRates::default(),
+            degradations,
+        }
+    }
+
     /// The fleet, checked (at most [`MAX_ESCS`] ESCs, every fault's ESC exists, the protocol is
     /// one a virtual ESC speaks, link faults only on HW-FOC, every fault has a flag in an HW5
     /// fault byte when speaking HW5) and its profile loaded (a CSV file read), but not started.

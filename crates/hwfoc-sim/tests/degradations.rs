@@ -6,34 +6,27 @@ use hwfoc::foc::DataFrame;
 use hwfoc::{Protocol, Temperature};
 use hwfoc_sim::FleetSpec;
 use hwfoc_sim::degrade::DegradeSpec;
-use hwfoc_sim::faults::LinkRates;
 use hwfoc_sim::model::ModelConfig;
-use hwfoc_sim::profile::{ProfileSpec, Shape};
+use hwfoc_sim::profile::Shape;
 
 /// Two ESCs, throttle stepping between 30 % and 70 % every 3 s after a 1 s lead-in.
 fn spec(degradations: &[&str]) -> FleetSpec {
-    FleetSpec {
-        n: 2,
-        seed: 11,
-        protocol: Protocol::HwFoc,
-        baud: 19200,
-        start_packet: None,
-        profile: ProfileSpec::Steps,
-        shape: Shape {
+    FleetSpec::steps(
+        2,
+        11,
+        Shape {
             lead_in_s: 1.0,
             levels: vec![30.0, 70.0],
             hold_s: 3.0,
             period_s: 10.0,
             max_pct: 80.0,
         },
-        model: ModelConfig {
+        ModelConfig {
             capacity_mah: 50_000.0,
             ..ModelConfig::SIMULATE
         },
-        faults: Vec::new(),
-        link: LinkRates::default(),
-        degradations: degradations.iter().map(|d| d.parse().unwrap()).collect(),
-    }
+        degradations.iter().map(|d| d.parse().unwrap()).collect(),
+    )
 }
 
 /// The frames each ESC delivers intact in `seconds`, with their times (s).

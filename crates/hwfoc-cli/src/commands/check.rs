@@ -6,10 +6,10 @@
 use std::path::PathBuf;
 
 use clap::Args;
+use hwfoc_io::Sources;
 use hwfoc_io::check::{Baseline, Check, EscSeries, Finding, Severity};
 use hwfoc_io::time::{self, Clock};
 use hwfoc_io::write::{WriteError, create_file};
-use hwfoc_io::{Both, Sources};
 use serde_json::json;
 
 use super::plot;
@@ -60,10 +60,7 @@ pub fn run(args: &CheckArgs) -> Result<Severity, CliError> {
     let (config, settings_map) = args.settings.settings_map()?;
     let settings = *settings_map.default_settings();
     let selection = args.select.selection()?;
-    let baseline: Option<Baseline> = match &args.baseline {
-        Some(path) => Some(crate::config::read_toml(path)?),
-        None => None,
-    };
+    let baseline = plot::read_baseline(args.baseline.as_deref())?;
     // The output files are opened first: a wrong name is reported before the inputs are read.
     let mut out = match &args.output {
         Some(path) => {
@@ -88,15 +85,9 @@ pub fn run(args: &CheckArgs) -> Result<Severity, CliError> {
         args.select.check_clocks(&sources)?;
     }
     let mut check = Check::selecting(selection);
-    match &mut plot {
-        Some(plot) => sources.run(&mut Both(&mut check, plot))?,
-        None => sources.run(&mut check)?,
-    }
-    crate::args::warn_left_out(&sources);
-    if !sources.any_data_frame() {
-        return Err(CliError::NoDataFrames {
-            inputs: sources.names().join(", "),
-        });
+    plot::read_checked(&mut sources, Some(&mut check), plot.as_mut())?;
+    if let Some(nothing) = sources.nothing_decoded() {
+        return Err(nothing.into());
     }
     let series = check.series(&sources);
     let check_config = &config.file.check;

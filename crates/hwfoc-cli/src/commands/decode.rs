@@ -122,13 +122,13 @@ pub fn run(args: &DecodeArgs) -> Result<(), CliError> {
         export = export.stop_on(stop);
     }
     let result = sources.run(&mut export);
-    if result.is_ok() && !sources.any_data_frame() {
+    if result.is_ok()
+        && let Some(nothing) = sources.nothing_decoded()
+    {
         // Nothing decoded: no output is written (a file of that name stays as it was).
         drop(export);
         warn(&sources, &args.select.esc);
-        return Err(CliError::NoDataFrames {
-            inputs: sources.names().join(", "),
-        });
+        return Err(nothing.into());
     }
     let (kept, span) = (export.kept(), export.span());
     if let Some((first, _)) = span {

@@ -64,11 +64,11 @@ pub fn run(args: &SummaryArgs) -> Result<(), CliError> {
         // Stopped by a signal: the plot is not drawn (its temporary file goes away).
         return Err(e);
     }
-    if result.is_ok() && !sources.any_data_frame() {
+    if result.is_ok()
+        && let Some(nothing) = sources.nothing_decoded()
+    {
         // The report says why, ESC by ESC; the exit says it failed, as decode and plot do.
-        return Err(CliError::NoDataFrames {
-            inputs: sources.names().join(", "),
-        });
+        return Err(nothing.into());
     }
     if let Some(plot) = plot {
         plot.finish(&sources)?;

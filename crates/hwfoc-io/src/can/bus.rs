@@ -13,19 +13,12 @@ use super::ask::{AskIds, DEFAULT_SOURCE_NODE};
 use super::slcan::{self, Event, Parser};
 use crate::clock::ReceiveClock;
 use crate::port::PortError;
+pub use hwfoc_records::can::{DEFAULT_BITRATE, is_can_spec};
 
 /// The serial speed an SLCAN adapter is opened at (USB CDC adapters ignore it).
 pub const SLCAN_BAUD: u32 = 115_200;
-/// The CAN bit rate of an `slcan:` bus unless given: 500 kbit/s, the factory rate of
-/// Hobbywing's DroneCAN ESCs.
-pub const DEFAULT_BITRATE: u32 = 500_000;
 /// How long an adapter is given to answer a setup command.
 const ANSWER_WITHIN: Duration = Duration::from_millis(300);
-
-/// Whether `spec` names a CAN bus (`slcan:...`, `can:...`) rather than a serial port or a file.
-pub fn is_can_spec(spec: &str) -> bool {
-    spec.starts_with("slcan:") || spec.starts_with("can:")
-}
 
 /// Why a CAN bus could not be opened or read. Each names the bus as given.
 #[derive(Debug)]

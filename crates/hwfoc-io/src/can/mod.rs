@@ -11,7 +11,7 @@
 
 mod ask;
 mod bus;
-pub mod candump;
+pub use hwfoc_records::can::candump;
 pub mod setup;
 pub mod slcan;
 #[cfg(target_os = "linux")]
@@ -19,12 +19,5 @@ mod socketcan;
 
 pub use ask::{ASK_EVERY, ASK_PRIORITY, AskIds, DEFAULT_SOURCE_NODE};
 
-/// The record that stands for a frame that is no classic CAN frame (a CAN FD frame of a
-/// `candump` log or a pcapng): a length byte of 255, which no classic frame has, so that a
-/// bus's stream counts it (`CanLink::bad_records`) and decodes nothing of it.
-pub const NOT_CLASSIC_RECORD: [u8; hwfoc::dronecan::SOCKETCAN_RECORD_LEN] = {
-    let mut record = [0u8; hwfoc::dronecan::SOCKETCAN_RECORD_LEN];
-    record[4] = 255;
-    record
-};
 pub use bus::{CanBus, CanError, CanSpec, DEFAULT_BITRATE, SLCAN_BAUD, is_can_spec};
+pub use hwfoc_records::can::NOT_CLASSIC_RECORD;

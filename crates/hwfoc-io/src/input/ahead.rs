@@ -12,7 +12,7 @@ use std::io;
 use std::sync::mpsc::{Receiver, SyncSender, TryRecvError, sync_channel};
 use std::thread::JoinHandle;
 
-use super::{BATCH, read_some};
+use hwfoc_records::{BATCH, BlockRead, read_some};
 
 /// Blocks read ahead at most (each [`BATCH`] bytes).
 const AHEAD: usize = 3;
@@ -51,10 +51,12 @@ impl ReadAhead {
             Err(_) => Err(back),
         }
     }
+}
 
+impl BlockRead for ReadAhead {
     /// Puts the next block in `bytes` (its old buffer is given back to be read into again):
     /// its length, 0 at the end of the file.
-    pub(super) fn read(&mut self, bytes: &mut Vec<u8>) -> io::Result<usize> {
+    fn read(&mut self, bytes: &mut Vec<u8>) -> io::Result<usize> {
         let next = match (&self.full, self.done) {
             (Some(full), false) => full.recv(),
             _ => {
@@ -126,7 +128,8 @@ mod tests {
     use std::io::Write;
 
     use super::*;
-    use crate::input::Input;
+    use crate::input::OpenInput;
+    use hwfoc_records::Input;
 
     /// A file of `len` bytes counting 0, 1, 2, … (modulo 251, so that no block repeats the one
     /// before it).

@@ -4,12 +4,10 @@ use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Duration;
 
-use crate::clock::byte_times;
-use crate::notice::Notice;
-use crate::serial::{PortEvent, PortSet};
-use crate::time::Clock;
+use hwfoc_records::clock::byte_times;
+use hwfoc_records::{InputError, InputFormat, Looks, Notice, Source};
 
-use super::{InputError, InputFormat, Looks, Source};
+use crate::serial::{PortEvent, PortSet};
 
 /// How long a serial input waits for bytes before checking for Ctrl-C.
 const PORT_POLL: Duration = Duration::from_millis(100);
@@ -77,18 +75,6 @@ impl Ports {
         }
         0
     }
-}
-
-impl InputFormat {
-    /// Live serial ports: one stream per port, times of reception (Unix seconds), read as the
-    /// bytes arrive.
-    pub const SERIAL: InputFormat = InputFormat {
-        name: "serial port",
-        short_name: "serial",
-        clock: Clock::Wall,
-        live: true,
-        recorded_ports: false,
-    };
 }
 
 impl Source for Ports {

@@ -35,6 +35,7 @@ pub mod metadata;
 pub(crate) mod parquet;
 mod safety;
 mod staging;
+pub(crate) mod stored;
 mod text;
 
 pub use error::{ExportError, WriteError};

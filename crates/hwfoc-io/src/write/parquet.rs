@@ -700,7 +700,7 @@ mod encode {
             } else {
                 BLOCK
             };
-        type Physical<C> = <<C as Column>::Value as ParquetValue>::Physical;
+        type Physical<C> = <<C as hwfoc_records::record::Column>::Value as ParquetValue>::Physical;
         encode_in::<Physical<C>>(block_rows, descr, props, n, |block, levels| {
             // A receive time where there is one (NaN in the chunk where not).
             let (t, esc, frames) = (
@@ -1649,7 +1649,7 @@ mod encode {
             struct Expected(Vec<(String, PhysicalType, i16, i16)>);
             impl Visitor for Expected {
                 fn column<C: Column>(&mut self) {
-                    type V<C> = <C as Column>::Value;
+                    type V<C> = <C as hwfoc_records::record::Column>::Value;
                     self.0.push((
                         C::NAME.to_string(),
                         <<V<C> as ParquetValue>::Physical as ParquetType>::get_physical_type(),

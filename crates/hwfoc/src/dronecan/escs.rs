@@ -8,7 +8,10 @@
 //! - the latest `StatusMsg2` (voltage, current, ESC temperature) and `StatusMsg3` (MOSFET,
 //!   capacitor, motor temperatures) of a Hobbywing ESC, and the latest
 //!   `uavcan.equipment.esc.StatusExtended` of a standard DroneCAN ESC, each with its time;
-//! - whether its motor turns (the last `StatusMsg1`'s rpm or pwm, or `Status`'s rpm, above 0).
+//! - whether its motor turns (the last `StatusMsg1`'s rpm or pwm, or `Status`'s rpm, above 0);
+//! - its maintenance counters from the last `com.hobbywing.esc.GetMaintenanceInformation`
+//!   answer it sent (total rotation time, time since maintenance: [`Escs::maintenance_min`]),
+//!   where the bus's recording holds one (`hwfoc can list`, a DataLink or a GCS asked).
 //!
 //! Each `StatusMsg1` is a [`HwCanEsc`] record (protocol `hw-can`) and each
 //! `uavcan.equipment.esc.Status` a [`DroneCanEsc`] record (protocol `dronecan`), with the slower
@@ -259,6 +262,9 @@ struct Node {
     temperatures: Option<(Temperatures, Option<u64>)>,
     extended: Option<(Extended, Option<u64>)>,
     turning: bool,
+    /// The last GetMaintenanceInformation answer's counters, minutes: (total rotation time,
+    /// time since maintenance).
+    maintenance_min: Option<(u32, u32)>,
 }
 
 impl Node {
@@ -268,6 +274,7 @@ impl Node {
         temperatures: None,
         extended: None,
         turning: false,
+        maintenance_min: None,
     };
 }
 
@@ -353,6 +360,11 @@ impl Escs {
                 }
                 None
             }
+            Message::GetMaintenanceInformationResponse(m) => {
+                node.maintenance_min =
+                    Some((m.total_rotation_time_min, m.time_since_maintenance_min));
+                None
+            }
             Message::EscStatusExtended(m) => {
                 let e = Extended {
                     input_pct: m.input_pct,
@@ -391,6 +403,12 @@ impl Escs {
     pub fn channel(&self, node: u8) -> Option<u8> {
         let c = self.nodes.get(usize::from(node))?.channel;
         (c > 0).then_some(c)
+    }
+
+    /// The maintenance counters `node` last answered a GetMaintenanceInformation request with,
+    /// minutes: (total rotation time, time since maintenance); `None` before an answer.
+    pub fn maintenance_min(&self, node: u8) -> Option<(u32, u32)> {
+        self.nodes.get(usize::from(node))?.maintenance_min
     }
 
     /// Whether any node's last status said its motor turns (rpm or throttle above 0).
@@ -500,6 +518,39 @@ mod tests {
         assert_eq!(escs.channel(5), Some(1));
         escs.reset();
         assert_eq!(escs.channel(5), None);
+    }
+
+    #[test]
+    fn a_maintenance_answer_is_kept_for_its_node_and_a_request_is_not_one() {
+        use super::super::{GetMaintenanceInformationRequest, GetMaintenanceInformationResponse};
+        let (mut rx, mut escs) = (Receiver::new(), Escs::new());
+        // A service's half goes from one node to another: `from` to `to`.
+        let mut send = |m: Message, from: u8, to: u8| {
+            for f in m.frames(24, from, to, 0) {
+                if let Some(got) = rx.push(&f) {
+                    assert!(escs.push(&got, None).is_none());
+                }
+            }
+        };
+        let ask = GetMaintenanceInformationRequest { option: 0 };
+        send(ask.into(), 127, 5);
+        // The answer of docs/HOBBYWING-CAN.md's example, the widest counters: 18F17DFF,
+        // FF FF FF FF 1A FC C2 (uint32, then uint24, little-endian as DSDL packs them).
+        let answer = GetMaintenanceInformationResponse {
+            total_rotation_time_min: 4_294_967_295,
+            time_since_maintenance_min: 12_778_522,
+        };
+        let m = Message::from(answer);
+        let mut frames = m.frames(24, 5, 127, 0);
+        let only = frames.next().unwrap();
+        assert!(frames.next().is_none());
+        assert_eq!(only.data()[..7], [0xFF, 0xFF, 0xFF, 0xFF, 0x1A, 0xFC, 0xC2]);
+        send(m, 5, 127);
+        assert_eq!(escs.maintenance_min(127), None);
+        assert_eq!(escs.maintenance_min(5), Some((4_294_967_295, 12_778_522)));
+        assert_eq!(escs.maintenance_min(6), None);
+        escs.reset();
+        assert_eq!(escs.maintenance_min(5), None);
     }
 
     #[test]

@@ -20,6 +20,7 @@ use hwfoc_bridge::fanout::Fanout;
 use hwfoc_bridge::mavlink::{self, MavlinkOptions, MavlinkOutput, MavlinkTarget};
 use hwfoc_bridge::replay::{POLL, Replay, ReplayError};
 use hwfoc_io::Notice;
+use hwfoc_io::OpenInput;
 use hwfoc_io::PortStreams;
 use hwfoc_io::SettingsMap;
 use hwfoc_io::Sources;

@@ -12,6 +12,7 @@ mod draw;
 mod target;
 mod text;
 
+use std::path::Path;
 use std::sync::Arc;
 use std::sync::atomic::AtomicBool;
 
@@ -99,10 +100,7 @@ pub fn run(args: &PlotArgs) -> Result<(), CliError> {
     // created here is removed again if the plot is not written.
     args.input.refuse_output(&args.output, &config)?;
     let mut target = ImageFile::open(&args.output, args.overwrite)?;
-    let baseline: Option<Baseline> = match &args.baseline {
-        Some(path) => Some(crate::config::read_toml(path)?),
-        None => None,
-    };
+    let baseline = read_baseline(args.baseline.as_deref())?;
     let options = Options {
         width: args.width,
         height: args.height,
@@ -117,11 +115,7 @@ pub fn run(args: &PlotArgs) -> Result<(), CliError> {
     let mut check = args.check.then(|| Check::selecting(selection.clone()));
     let mut collector = Collector::new(settings, selection, options.width)
         .stop_on(args.input.stop_if_read_to_end(), &args.output);
-    let result = match &mut check {
-        Some(check) => sources.run(&mut Both(check, &mut collector)),
-        None => sources.run(&mut collector),
-    };
-    crate::args::warn_left_out(&sources);
+    let result = read_checked(&mut sources, check.as_mut(), Some(&mut collector));
     if let Some(check) = check {
         let series = check.series(&sources);
         collector.shade(&analyse(&series, &config.file.check, baseline.as_ref()));
@@ -133,6 +127,28 @@ pub fn run(args: &PlotArgs) -> Result<(), CliError> {
     let written = collector.write(&sources, &options, &mut target);
     result?;
     written
+}
+
+/// The baseline TOML file of `--baseline` (`hwfoc check`, `hwfoc plot --check`), if given.
+pub(crate) fn read_baseline(path: Option<&Path>) -> Result<Option<Baseline>, CliError> {
+    path.map(crate::config::read_toml).transpose()
+}
+
+/// Reads `sources` in one go into `check` and `other`, each where given (`hwfoc check --plot`,
+/// `hwfoc plot --check`), then warns of the records left out; the reading's error, if any.
+pub(crate) fn read_checked<H: Handler<Error = CliError>>(
+    sources: &mut Sources,
+    check: Option<&mut Check>,
+    other: Option<&mut H>,
+) -> Result<(), CliError> {
+    let result = match (check, other) {
+        (Some(check), Some(other)) => sources.run(&mut Both(check, other)),
+        (Some(check), None) => sources.run(check).map_err(CliError::from),
+        (None, Some(other)) => sources.run(other),
+        (None, None) => Ok(()),
+    };
+    crate::args::warn_left_out(sources);
+    result
 }
 
 /// `hwfoc summary --plot FILE`: a plot with the defaults of `hwfoc plot`, of the frames the

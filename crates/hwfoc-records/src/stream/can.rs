@@ -388,6 +388,7 @@ impl CanWire {
         CanLink {
             node,
             channel: node.and_then(|n| self.escs.channel(n)),
+            maintenance_min: node.and_then(|n| self.escs.maintenance_min(n)),
             protocol: node
                 .and_then(|n| self.protocol[usize::from(n) % NODES])
                 .unwrap_or(Protocol::HwCan),
@@ -408,6 +409,9 @@ pub struct CanLink {
     pub node: Option<u8>,
     /// Its node's throttle channel (1-based) from a GetEscID answer, if one came.
     pub channel: Option<u8>,
+    /// Its node's maintenance counters from the last GetMaintenanceInformation answer on the
+    /// bus, if one came, minutes: (total rotation time, time since maintenance).
+    pub maintenance_min: Option<(u32, u32)>,
     /// The protocol of its records: `hw-can` or `dronecan`.
     pub protocol: Protocol,
     /// The ESC's records (StatusMsg1 or Status transfers decoded).

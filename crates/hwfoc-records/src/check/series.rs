@@ -96,6 +96,10 @@ pub struct EscSeries {
     pub timed: bool,
     /// Its link's figures; `None` where there are none (built from records alone).
     pub link: Option<LinkFigures>,
+    /// A Hobbywing CAN ESC's own maintenance counters, minutes (total rotation time, time since
+    /// maintenance), where its recording holds its answer to GetMaintenanceInformation
+    /// ([`EscLink::maintenance_min`]).
+    pub maintenance_min: Option<(u32, u32)>,
     /// Its data frames.
     pub samples: Vec<Sample>,
 }

@@ -301,6 +301,14 @@ impl Sources {
         (0..self.escs.len()).any(|esc| self.link(esc).frames() > 0)
     }
 
+    /// The error of a run in which no input held a data frame ([`InputError::NoDataFrames`],
+    /// naming the inputs); `None` when one did.
+    pub fn nothing_decoded(&self) -> Option<InputError> {
+        (!self.any_data_frame()).then(|| InputError::NoDataFrames {
+            inputs: self.names().join(", "),
+        })
+    }
+
     /// How many raw files were read in two halves at once, their halves joined (`split.rs`).
     #[cfg(test)]
     pub(crate) fn joined_halves(&self) -> u32 {

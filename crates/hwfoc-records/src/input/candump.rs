@@ -165,10 +165,8 @@ mod tests {
 
     #[test]
     fn a_closed_file_keeps_which_streams_are_can() {
-        let dir = tempfile::tempdir().unwrap();
-        let path = dir.path().join("bus.log");
-        std::fs::write(&path, LOG).unwrap();
-        let mut input = Input::open(path.to_str().unwrap()).unwrap();
+        let file = crate::input::file::memory::MemoryFile::new("bus.log", LOG.as_bytes().to_vec());
+        let mut input = file.input().unwrap();
         input.set_notices(|_| {});
         while input.next_batch().unwrap().is_some() {}
         assert!(input.is_can(1) && !input.is_can(2));

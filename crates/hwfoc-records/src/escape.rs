@@ -9,7 +9,7 @@
 //! string, escaped by their own format's rules.
 //!
 //! ```
-//! use hwfoc_io::Escaped;
+//! use hwfoc_records::Escaped;
 //!
 //! let name = "tail\r\x1b[2Jfront";
 //! assert_eq!(Escaped(name).to_string(), "tail\\r\\x1b[2Jfront");

@@ -5,7 +5,7 @@
 //! numbers mean: Unix seconds for pcapng recordings and serial ports ([`Clock::Wall`]), seconds
 //! from the start of the capture for a logic-analyser CSV export ([`Clock::Capture`]), nothing for
 //! raw bytes ([`Clock::None`]). Only wall-clock times are shown as dates. (The clock that stamps
-//! what is received is [`crate::clock::ReceiveClock`].)
+//! what is received is `hwfoc-io`'s `clock::ReceiveClock`.)
 //!
 //! # The grammar of a time ([`parse`])
 //!

@@ -93,6 +93,7 @@ impl Check {
                     protocol: link.protocol(),
                     timed,
                     link: Some(LinkFigures::of(&link)),
+                    maintenance_min: link.maintenance_min(),
                     samples,
                 })
             })
@@ -193,6 +194,7 @@ pub(crate) mod tests {
                 has_checksum: true,
                 ..LinkFigures::default()
             }),
+            maintenance_min: None,
             samples,
         }
     }

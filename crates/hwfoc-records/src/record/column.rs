@@ -7,8 +7,6 @@ use hwfoc::{Protocol, Settings, Status};
 
 use super::Record;
 use super::text::TextValue;
-use crate::write::arrow::ArrowValue;
-use crate::write::parquet::ParquetValue;
 
 /// One column of the record schema: a zero-sized type per column, made by the table in
 /// [`columns`](super::columns). Everything here is known at compile time, so a writer generic
@@ -22,7 +20,7 @@ pub trait Column: 'static {
     /// Its position in the schema, from 0.
     const INDEX: usize;
     /// Whether its values may be null (they are `Option`s).
-    const NULLABLE: bool = <Self::Value as ArrowValue>::NULLABLE;
+    const NULLABLE: bool = <Self::Value as Value>::NULLABLE;
     /// `,"NAME":`, the text before its value in a JSON object (the first column's comma becomes
     /// the opening brace).
     const JSON_KEY: &'static str;
@@ -52,18 +50,37 @@ pub trait Column: 'static {
 /// A type a column's values may have: `f32`, `Option<f32>`, `Option<f64>`, `u8`, `u16`, `u32`,
 /// [`Status`] (an unsigned 16-bit word) and [`FaultList`].
 ///
-/// Each format says how it stores such a value: text (JSON and CSV), Arrow (type, nullability,
-/// arrays: [`ArrowValue`]) and Parquet (physical type, levels). A new value type implements
-/// the three; a new column of an existing value type needs none of it.
-pub trait Value:
-    Copy + PartialEq + std::fmt::Debug + TextValue + ArrowValue + ParquetValue
-{
+/// Each format says how it stores such a value: text (JSON and CSV, `TextValue`), and the
+/// binary writers of `hwfoc-io` (Arrow: type, arrays; Parquet: physical type, levels), which
+/// implement their own traits for these types. A new value type implements them all; a new
+/// column of an existing value type needs none of it.
+pub trait Value: Copy + PartialEq + std::fmt::Debug + TextValue {
+    /// Whether a value may be null (an `Option`).
+    const NULLABLE: bool;
 }
 
-impl<T> Value for T where
-    T: Copy + PartialEq + std::fmt::Debug + TextValue + ArrowValue + ParquetValue
-{
+/// Value types that are never null.
+macro_rules! not_null {
+    ($($t:ty),*) => {
+        $(impl Value for $t {
+            const NULLABLE: bool = false;
+        })*
+    };
 }
+
+not_null!(f32, f64, u8, u16, u32, Status, Protocol, FaultList, UtcTime);
+
+impl<T: Value> Value for Option<T> {
+    const NULLABLE: bool = true;
+}
+
+/// A list of column types, in schema order ([`columns::List`](super::columns::List)): its first
+/// column and the rest. A writer outside this crate walks it with bounds of its own on the
+/// columns' value types (its traits for storing them), where [`Visitor`] knows only [`Value`].
+pub struct Cons<C, Rest>(std::marker::PhantomData<(C, Rest)>);
+
+/// The end of a [`Cons`] list.
+pub struct Nil;
 
 /// The `time` column's value: a receive time as whole microseconds since the Unix epoch, UTC
 /// (an Arrow `Timestamp(Microsecond, "UTC")`, a Parquet `TIMESTAMP(MICROS, UTC)`).
@@ -214,8 +231,16 @@ macro_rules! columns {
             $(visitor.column::<$name>();)*
         }
 
+        /// The column types in schema order, as a [`Cons`](crate::record::Cons) list.
+        pub type List = columns!(@list $($name)*);
+
         columns!(@record (t_s, esc, frame, settings) [] []
             $([$(#[doc = $doc])*] $name: $value [$(|$r| $get)?];)*);
+    };
+
+    (@list) => { $crate::record::Nil };
+    (@list $head:ident $($rest:ident)*) => {
+        $crate::record::Cons<$head, columns!(@list $($rest)*)>
     };
 
     (@cached) => { false };

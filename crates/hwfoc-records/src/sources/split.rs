@@ -20,7 +20,6 @@
 //! [`Handler::fork`]: crate::Handler::fork
 //! [`Handler::join`]: crate::Handler::join
 
-use std::fs::File;
 use std::io;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -32,7 +31,7 @@ use hwfoc::{Protocol, Settings};
 
 use super::{HELD, Held, Takes, feed_runs};
 use crate::handler::LaterPart;
-use crate::input::{BATCH, Batch};
+use crate::input::{BATCH, Batch, ReadAt};
 use crate::stream::Stream;
 
 /// The smallest raw file read in two halves: below it, starting a thread is not worth it.
@@ -73,7 +72,7 @@ impl Later {
     /// under `settings`. `None` where no thread can be started or the platform has no
     /// positional reads.
     pub(super) fn start(
-        file: File,
+        file: Box<dyn ReadAt>,
         len: u64,
         forced: Option<Protocol>,
         part: Box<dyn LaterPart>,
@@ -143,7 +142,7 @@ impl Drop for Later {
 
 /// The later half's reader.
 struct Reader {
-    file: File,
+    file: Box<dyn ReadAt>,
     forced: Option<Protocol>,
     esc: u8,
     settings: Settings,
@@ -234,7 +233,7 @@ impl Reader {
             return None;
         }
         loop {
-            match read_at(&self.file, block, pos) {
+            match self.file.read_at(block, pos) {
                 Err(e) if e.kind() == io::ErrorKind::Interrupted => continue,
                 read => return read.ok(),
             }
@@ -289,25 +288,12 @@ impl Takes for ToPart<'_> {
     }
 }
 
-/// Reads bytes at `pos` of `file`, whatever its current offset (which is not moved).
-#[cfg(unix)]
-fn read_at(file: &File, block: &mut [u8], pos: u64) -> io::Result<usize> {
-    std::os::unix::fs::FileExt::read_at(file, block, pos)
-}
-
-#[cfg(not(unix))]
-fn read_at(_: &File, _: &mut [u8], _: u64) -> io::Result<usize> {
-    Err(io::Error::from(io::ErrorKind::Unsupported))
-}
-
 #[cfg(test)]
 mod tests {
-    use std::io::Write;
-
     use hwfoc::foc::{DataFrame, InfoFrame};
     use hwfoc::{Protocol, Settings, Status};
 
-    use crate::input::Input;
+    use crate::input::file::memory::MemoryFile;
     use crate::sources::Sources;
     use crate::sources::tests::hub_wire;
     use crate::stream::EscLink;
@@ -324,8 +310,8 @@ mod tests {
     /// Summarises the raw file `path`, in two halves at once when `split` (whatever its
     /// size), else in one; with protocol `forced` only when given. What it read, and whether
     /// the halves were joined.
-    fn summarise(path: &str, split: bool, forced: Option<Protocol>) -> (Read, bool) {
-        let input = Input::open(path).unwrap();
+    fn summarise(file: &MemoryFile, split: bool, forced: Option<Protocol>) -> (Read, bool) {
+        let input = file.input().unwrap();
         let mut sources = Sources::new(vec![input], Settings::DEFAULT);
         sources.split_at_least(if split { 1 } else { u64::MAX });
         if let Some(p) = forced {
@@ -346,15 +332,9 @@ mod tests {
     /// at once, and whether the halves were joined (`joined`, unless `None`).
     #[track_caller]
     fn assert_alike(bytes: &[u8], forced: Option<Protocol>, joined: Option<bool>, case: &str) {
-        let dir = tempfile::tempdir().unwrap();
-        let path = dir.path().join("raw.bin");
-        std::fs::File::create(&path)
-            .unwrap()
-            .write_all(bytes)
-            .unwrap();
-        let path = path.to_str().unwrap();
-        let (one, _) = summarise(path, false, forced);
-        let (two, was_joined) = summarise(path, true, forced);
+        let file = MemoryFile::new("raw.bin", bytes.to_vec());
+        let (one, _) = summarise(&file, false, forced);
+        let (two, was_joined) = summarise(&file, true, forced);
         assert!(
             one == two,
             "{case}: one reading\n{one:?}\ntwo halves\n{two:?}"

@@ -10,7 +10,7 @@
 //!
 //! ```
 //! use hwfoc::Settings;
-//! use hwfoc_io::{SettingsMap, SettingsPatch};
+//! use hwfoc_records::{SettingsMap, SettingsPatch};
 //!
 //! let mut map = SettingsMap::from(Settings::DEFAULT);
 //! map.set_port("/dev/ttyUSB1", SettingsPatch { current_scale: Some(100.0), ..Default::default() });
@@ -64,7 +64,7 @@ impl From<SettingValue> for serde_json::Value {
 /// The fields of `settings` by their name in every output (Parquet metadata, the CSV comment,
 /// the JSON of `summary` and `monitor`, the Python package's keyword arguments), in that
 /// order: `current_scale`, `pole_pairs`, `gear_ratio`, `v4_volts_per_step`.
-pub(crate) fn fields(settings: &Settings) -> [(&'static str, SettingValue); 4] {
+pub fn fields(settings: &Settings) -> [(&'static str, SettingValue); 4] {
     [
         ("current_scale", SettingValue::Real(settings.current_scale)),
         ("pole_pairs", SettingValue::Count(settings.pole_pairs)),

@@ -8,7 +8,7 @@ use std::fmt;
 /// text output (summary, monitor, plot labels) writes a measured number.
 ///
 /// ```
-/// use hwfoc_io::Fixed;
+/// use hwfoc_records::Fixed;
 /// assert_eq!(Fixed(-0.389, 0).to_string(), "0");
 /// assert_eq!(Fixed(-0.0079, 1).to_string(), "0.0");
 /// assert_eq!(Fixed(-0.05, 1).to_string(), "-0.1");

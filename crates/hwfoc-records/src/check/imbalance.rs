@@ -1,19 +1,26 @@
 //! Imbalance between motors: at equal throttle, one ESC's current or rpm far from its
 //! siblings' (the other ESCs of its recording). In each window of time, each ESC's medians per
 //! throttle bin (5 %) are compared with the median of its siblings' curves at the same
-//! throttle (between their points), so that
-//! motors that lag each other are compared alike, and only at a steady throttle (rpm lags a
-//! moving throttle, current spikes as a motor speeds up);
-//! the window's deviation is the median over its bins, and it must hold in two windows in a row.
+//! throttle (between their points), so that motors that lag each other are compared alike.
+//! The throttle need not hold: a flight's throttle moves all the time, and its siblings see the
+//! same throttle at the same moment; only the samples just after a jump or in a fast sweep are
+//! left out ([`SLOW_PCT`]: there rpm lags, and current spikes as a motor speeds up, by how fast
+//! each motor follows). The window's deviation is the median over its bins, and it must hold
+//! in two windows in a row.
 
 use std::collections::BTreeMap;
 
 use super::baseline::THROTTLE_BIN_PCT;
-use super::stats::{curve, held_finding, median, steady, windows};
+use super::stats::{curve, held_finding, held_within, median, windows};
 use super::{Analyser, Curve, EscSeries, Finding, ImbalanceConfig, Limits, Sample, Span};
 
 /// Siblings needed to tell which motor is off: with two, either could be.
 const MIN_ESCS: usize = 3;
+
+/// How far the throttle may have moved over the 0.6 s before a sample compared, %: siblings
+/// are compared while the throttle moves, but not just after a jump, nor where it sweeps so
+/// fast that how quickly each motor follows (its load, its prop) decides its rpm.
+const SLOW_PCT: f32 = 10.0;
 
 /// Samples a bin of a window needs.
 const MIN_BIN_SAMPLES: usize = 5;
@@ -86,7 +93,7 @@ pub(super) fn analyse(series: &[EscSeries], config: &ImbalanceConfig, out: &mut 
 /// The curves of `get` against throttle of `series`, window by window (above the least
 /// throttle compared).
 fn curves(series: &EscSeries, get: fn(&Sample) -> Option<f32>, config: &ImbalanceConfig) -> Curves {
-    windows(&steady(&series.samples), config.window_s)
+    windows(&held_within(&series.samples, SLOW_PCT), config.window_s)
         .map(|(span, samples)| {
             let c = curve(
                 samples.iter().filter_map(|s| {

@@ -1,6 +1,5 @@
-//! Receive times: Unix time in nanoseconds, from the wall clock and a monotonic one.
-
-use std::time::{Instant, SystemTime, UNIX_EPOCH};
+//! Receive times: a chunk's bytes timed from its receive time, and the steps between frames
+//! (the clock that stamps what is received, reading the system's clocks, is `hwfoc-io`'s).
 
 /// Receive time in Unix seconds of byte `i` of a chunk whose first byte arrived at `t_ns`, the
 /// bytes `per_byte_ns` apart. The one conversion from receive timestamps to `t_s`: the
@@ -15,45 +14,6 @@ pub fn byte_time_s(t_ns: u64, i: usize, per_byte_ns: f64) -> f64 {
 /// time becomes the time of each of its bytes.
 pub fn byte_times(t_ns: u64, per_byte_ns: f64, n: usize, times: &mut Vec<f64>) {
     times.extend((0..n).map(|i| byte_time_s(t_ns, i, per_byte_ns)));
-}
-
-/// The wall clock now, Unix time in nanoseconds (0 for a clock set before 1970).
-pub fn unix_now_ns() -> u64 {
-    SystemTime::now()
-        .duration_since(UNIX_EPOCH)
-        .map_or(0, |d| d.as_nanos() as u64)
-}
-
-/// The clock that stamps what is received (ports, the simulator, recordings): Unix time in
-/// nanoseconds that never goes backwards, the wall clock when the clock was made advanced by a
-/// monotonic clock (so that a clock step during a recording does not reorder it). Not to be
-/// confused with [`crate::time::Clock`], which says what a source's times mean.
-#[derive(Debug, Clone, Copy)]
-pub struct ReceiveClock {
-    wall_ns: u64,
-    start: Instant,
-}
-
-impl ReceiveClock {
-    /// A clock anchored at the wall-clock time now.
-    pub fn new() -> ReceiveClock {
-        let wall_ns = unix_now_ns();
-        ReceiveClock {
-            wall_ns,
-            start: Instant::now(),
-        }
-    }
-
-    /// Unix time now, in nanoseconds.
-    pub fn now_ns(&self) -> u64 {
-        self.wall_ns + self.start.elapsed().as_nanos() as u64
-    }
-}
-
-impl Default for ReceiveClock {
-    fn default() -> Self {
-        ReceiveClock::new()
-    }
 }
 
 /// The longest step between two frames of one ESC that is always time passing at the frame

@@ -1,10 +1,8 @@
 //! Raw bytes as they came off the wire: no timing, one stream.
 
-use std::fs::File;
 use std::io::Read;
 
-use super::ahead::ReadAhead;
-use super::{BATCH, InputError, InputFormat, Looks, Source, looks, read_some};
+use super::{BATCH, BlockRead, InputError, InputFormat, Looks, ReadAt, Source, looks, read_some};
 use crate::notice::Notice;
 use crate::time::Clock;
 
@@ -24,7 +22,7 @@ pub(super) enum Reader {
     /// Any reader, read in turn.
     Plain(Box<dyn Read>),
     /// A regular file read ahead.
-    Ahead(ReadAhead),
+    Ahead(Box<dyn BlockRead>),
 }
 
 /// A raw input being read.
@@ -36,7 +34,7 @@ pub(super) struct RawReader {
     /// frame.
     sample: Vec<u8>,
     /// A second handle on a regular file read, for positional reads of a later part.
-    file: Option<File>,
+    file: Option<Box<dyn ReadAt>>,
     /// The bytes read so far while every one was zero; `None` once one was not.
     zeros: Option<u64>,
 }
@@ -44,7 +42,7 @@ pub(super) struct RawReader {
 impl RawReader {
     /// Reads `reader` (a regular file when `file`, a second handle on it, is given), after
     /// `head`, the bytes format detection read of it.
-    pub(super) fn new(reader: Reader, file: Option<File>, head: Vec<u8>) -> RawReader {
+    pub(super) fn new(reader: Reader, file: Option<Box<dyn ReadAt>>, head: Vec<u8>) -> RawReader {
         RawReader {
             reader,
             pending: head,
@@ -129,7 +127,7 @@ impl Source for RawReader {
         Looks::of(&self.sample)
     }
 
-    fn file(&self) -> Option<&File> {
-        self.file.as_ref()
+    fn file(&self) -> Option<&dyn ReadAt> {
+        self.file.as_deref()
     }
 }

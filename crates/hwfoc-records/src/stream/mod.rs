@@ -479,6 +479,16 @@ impl EscLink {
         self.protocol().description().check != hwfoc::format::Check::None
     }
 
+    /// A Hobbywing CAN ESC's own maintenance counters, minutes (total rotation time, time since
+    /// maintenance), where its bus's recording holds its answer to GetMaintenanceInformation;
+    /// `None` otherwise.
+    pub fn maintenance_min(&self) -> Option<(u32, u32)> {
+        match self {
+            EscLink::Can(c) => c.maintenance_min,
+            _ => None,
+        }
+    }
+
     /// Frames rejected by their checksum, or whose checksum matched but whose values are out of
     /// their protocol's range (behind a hub: the hub frames' CRC failures; 0 for a format
     /// without checksum).
@@ -887,7 +897,7 @@ impl Stream {
 }
 
 /// A [`Stream`] per port, fed by [`PortEvent`]s: the path from live bytes to timed frames of
-/// `monitor`, `record` and the bridges (and of [`crate::Input::open_ports`], through
+/// `monitor`, `record` and the bridges (and of `hwfoc-io`'s `Input::open_ports`, through
 /// [`byte_times`]).
 ///
 /// ESC numbers are those [`crate::Sources`] gives a recording of the same ports: port
@@ -1093,7 +1103,7 @@ impl PortStreams {
         self.bauds[port] = Some(baud);
     }
 
-    /// Every port's rate is to be found ([`crate::serial::Baud::Auto`]): unknown until its
+    /// Every port's rate is to be found (`hwfoc-io`'s `serial::Baud::Auto`): unknown until its
     /// [`PortEvent::Found`].
     pub fn auto_baud(&mut self) {
         self.bauds.fill(None);

@@ -8,6 +8,7 @@ use proptest::prelude::*;
 use super::tests::ByEsc;
 use super::*;
 use crate::esc_table::Recording;
+use crate::input::file::memory::MemoryFile;
 use crate::notice::Notice;
 use crate::pcapng::{self, RecordingId};
 
@@ -73,17 +74,16 @@ fn foreign(mut bytes: Vec<u8>) -> Vec<u8> {
     bytes
 }
 
-/// Reads `files` (written into `dir` as `f-K.pcapng`, so that copies are found) together:
+/// Reads `files` (files named `f-K.pcapng`, so that copies are found) together:
 /// the records by ESC, the notices, and the sources.
-fn read(dir: &std::path::Path, files: &[Vec<u8>], join: bool) -> (ByEsc, Vec<Notice>, Sources) {
+fn read(files: &[Vec<u8>], join: bool) -> (ByEsc, Vec<Notice>, Sources) {
     let seen = Arc::new(Mutex::new(Vec::new()));
     let inputs = files
         .iter()
         .enumerate()
         .map(|(k, bytes)| {
-            let path = dir.join(format!("f-{k}.pcapng"));
-            std::fs::write(&path, bytes).unwrap();
-            let mut input = Input::open(path.to_str().unwrap()).unwrap();
+            let file = MemoryFile::new(&format!("f-{k}.pcapng"), bytes.clone());
+            let mut input = file.input().unwrap();
             let sink = Arc::clone(&seen);
             input.set_notices(move |n| sink.lock().unwrap().push(n));
             input
@@ -101,8 +101,7 @@ fn read(dir: &std::path::Path, files: &[Vec<u8>], join: bool) -> (ByEsc, Vec<Not
 
 /// The records of each port of a recording read alone, in port order.
 fn alone(ports: &[Port]) -> Vec<Vec<(u16, f64)>> {
-    let dir = tempfile::tempdir().unwrap();
-    let (got, _, sources) = read(dir.path(), &[file(None, ports, 0, u64::MAX)], false);
+    let (got, _, sources) = read(&[file(None, ports, 0, u64::MAX)], false);
     assert_eq!(sources.escs().len(), ports.len());
     got.0
 }
@@ -121,7 +120,6 @@ fn port(name: &'static str, first: u16, frames: u16, t0: u64) -> Port {
 /// drone naming the earlier one.
 #[test]
 fn drones_recorded_at_the_same_time_are_other_escs() {
-    let dir = tempfile::tempdir().unwrap();
     let drones: Vec<Vec<Port>> = (0..3u16)
         .map(|d| {
             vec![
@@ -134,7 +132,7 @@ fn drones_recorded_at_the_same_time_are_other_escs() {
         .iter()
         .map(|ports| file(Some(RecordingId::new()), ports, 0, u64::MAX))
         .collect();
-    let (got, notices, sources) = read(dir.path(), &files, false);
+    let (got, notices, sources) = read(&files, false);
     assert_eq!(sources.escs().len(), 6);
     for (d, ports) in drones.iter().enumerate() {
         assert_eq!(sources.inputs()[d].escs, [2 * d, 2 * d + 1]);
@@ -167,7 +165,7 @@ fn drones_recorded_at_the_same_time_are_other_escs() {
     assert!(notes[1].0.ends_with("f-2.pcapng") && notes[1].1.ends_with("f-0.pcapng"));
     assert_eq!(notices.len(), 2, "{notices:?}");
     // With --join they are one recording again, as the user asked: one ESC per port name.
-    let (_, _, joined) = read(dir.path(), &files, true);
+    let (_, _, joined) = read(&files, true);
     assert_eq!(joined.escs().len(), 2);
 }
 
@@ -175,12 +173,11 @@ fn drones_recorded_at_the_same_time_are_other_escs() {
 /// other ESCs, with a note suggesting `--join` since the times line up; joined, one stream.
 #[test]
 fn files_naming_no_recording_are_joined_only_when_asked() {
-    let dir = tempfile::tempdir().unwrap();
     let ports = [port("/dev/ttyUSB0", 0, 400, T0)];
     let cut = ports[0].time(200);
     let first = file(None, &ports, 0, cut);
     let second = file(None, &ports, cut, u64::MAX);
-    let (got, notices, sources) = read(dir.path(), &[first.clone(), second.clone()], false);
+    let (got, notices, sources) = read(&[first.clone(), second.clone()], false);
     assert_eq!(sources.escs().len(), 2);
     assert_eq!((got.0[0].len(), got.0[1].len()), (200, 200));
     assert!(matches!(
@@ -200,7 +197,7 @@ fn files_naming_no_recording_are_joined_only_when_asked() {
     assert!(*gap > 0.03 && *gap < 0.05, "{gap}");
     let line = notices[0].line();
     assert!(line.contains("--join"), "{line}");
-    let (got, notices, sources) = read(dir.path(), &[second, first], true);
+    let (got, notices, sources) = read(&[second, first], true);
     assert_eq!(sources.escs().len(), 1);
     assert_eq!(got.0[0], alone(&ports)[0]);
     assert!(notices.is_empty(), "{notices:?}");
@@ -211,11 +208,10 @@ fn files_naming_no_recording_are_joined_only_when_asked() {
 /// summary's inputs say which it copies.
 #[test]
 fn a_file_given_twice_is_read_once() {
-    let dir = tempfile::tempdir().unwrap();
     let ports = [port("esc-0", 0, 100, T0), port("esc-1", 0, 100, T0)];
     let rec = file(Some(RecordingId::new()), &ports, 0, u64::MAX);
     let other = file(Some(RecordingId::new()), &ports, 0, u64::MAX);
-    let (got, notices, sources) = read(dir.path(), &[rec.clone(), other, rec], false);
+    let (got, notices, sources) = read(&[rec.clone(), other, rec], false);
     assert_eq!(sources.escs().len(), 4);
     assert_eq!(got.0.iter().map(Vec::len).sum::<usize>(), 400);
     assert_eq!(sources.inputs()[2].duplicate_of, Some(0));
@@ -303,7 +299,6 @@ proptest! {
     /// once, and nothing else joins, whatever the port names and times.
     #[test]
     fn a_fleet_read_together_is_each_recording_read_alone(f in fleet()) {
-        let dir = tempfile::tempdir().unwrap();
         // Every file, with the recording and the port names it holds.
         let mut files: Vec<(usize, Vec<u8>)> = Vec::new();
         for (r, (ours, ports, cuts)) in f.recordings.iter().enumerate() {
@@ -320,7 +315,7 @@ proptest! {
             files.push(copy);
         }
         let given: Vec<Vec<u8>> = f.order.iter().map(|&k| files[k].1.clone()).collect();
-        let (got, _, sources) = read(dir.path(), &given, false);
+        let (got, _, sources) = read(&given, false);
         let table = sources.esc_table();
         let mut seen = 0;
         for (r, (_, ports, _)) in f.recordings.iter().enumerate() {

@@ -87,6 +87,12 @@ const STEADY_PCT: f32 = 2.5;
 /// the 0.6 s before. Where a throttle moves, rpm and current depend on how fast it moved, which
 /// differs from motor to motor and flight to flight; at a steady throttle they do not.
 pub(super) fn steady(samples: &[super::Sample]) -> Vec<super::Sample> {
+    held_within(samples, STEADY_PCT)
+}
+
+/// The samples of `samples` (in time order) whose throttle stayed within `pct` % of theirs
+/// over the 0.6 s before ([`steady`] with a bound of its own).
+pub(super) fn held_within(samples: &[super::Sample], pct: f32) -> Vec<super::Sample> {
     let mut start = 0;
     let mut out = Vec::new();
     for (i, s) in samples.iter().enumerate() {
@@ -97,10 +103,9 @@ pub(super) fn steady(samples: &[super::Sample]) -> Vec<super::Sample> {
             start += 1;
         }
         let held = s.t - samples[start].t >= STEADY_S * 0.75
-            && samples[start..i].iter().all(|x| {
-                x.throttle_pct
-                    .is_some_and(|p| (p - throttle).abs() <= STEADY_PCT)
-            });
+            && samples[start..i]
+                .iter()
+                .all(|x| x.throttle_pct.is_some_and(|p| (p - throttle).abs() <= pct));
         if held {
             out.push(*s);
         }

@@ -10,7 +10,7 @@
 //!   a [`Visitor`] with each column's type in schema order: writers are generic over the
 //!   column, monomorphised and inlined, with no dispatch per row;
 //! - the text encodings (JSON Lines and CSV, [`TextEncoder`]), the Arrow schema and record
-//!   batches ([`crate::write::arrow`]), the Parquet columns (the `parquet` feature): each
+//!   batches (`hwfoc-io`'s `write::arrow`), the Parquet columns (the `parquet` feature): each
 //!   format stores a column as its [`Value`] type says.
 //!
 //! How to add a column: see [`columns`].
@@ -20,7 +20,7 @@ mod column;
 pub mod columns;
 mod text;
 
-pub use column::{Column, FaultList, UtcTime, Value, Visitor};
+pub use column::{Column, Cons, FaultList, Nil, UtcTime, Value, Visitor};
 pub use columns::{COLUMNS, Record, TEXT_COLUMNS, UNITS};
 pub use text::TextEncoder;
 

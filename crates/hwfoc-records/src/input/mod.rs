@@ -15,17 +15,17 @@
 //!   or decimal), whose times become `t_s`;
 //! - otherwise raw bytes as they came off the wire (no timing).
 //!
-//! Serial ports are opened with [`Input::open_ports`]: one input with one stream per port,
-//! times being the Unix time each byte was received.
+//! Files, standard input and serial ports are opened by `hwfoc-io` (`OpenInput::open`,
+//! `OpenInput::open_ports`): a regular file through [`Reopen`] and [`RegularFile`], open only
+//! while it is read; live ports as a [`Source`] of their own ([`Input::from_source`]).
 //!
 //! Each kind of input is a module (`raw.rs`, `csv.rs`, `recording.rs`, `candump.rs`, `asc.rs`,
-//! `blf.rs`, `trc.rs`, `can_csv.rs`, `candump_text.rs`, `ports.rs`) declaring
+//! `blf.rs`, `trc.rs`, `can_csv.rs`, `candump_text.rs`; `hwfoc-io`'s `ports.rs`) declaring
 //! its [`InputFormat`] (names, clock, whether live, whether its streams are recorded ports:
 //! what [`crate::Sources`] and the summary ask of a format) and implementing `Source`
 //! (its reading, its streams, its flagged bytes). Standard input and files are read as their
 //! content says.
 
-mod ahead;
 mod asc;
 mod blf;
 mod can_csv;
@@ -35,31 +35,27 @@ mod candump_text;
 mod csv;
 mod end;
 mod error;
+pub(crate) mod file;
 mod looks;
-mod ports;
 mod raw;
 mod recording;
 mod trc;
 
 use std::fmt;
-use std::fs::File;
 use std::io::{self, BufReader, Cursor, Read};
-use std::sync::Arc;
-use std::sync::atomic::AtomicBool;
 
 use crate::notice::{self, Notice, NoticeSink};
 use crate::pcapng;
-use crate::serial::PortSet;
 
 use self::csv::{CsvRows, may_be_header};
 pub use self::error::InputError;
+pub use self::file::{BlockRead, ReadAt, RegularFile, Reopen};
 pub use self::looks::Looks;
 
 /// How many bytes of nothing but zeros from its start end the reading of a raw input with
 /// [`InputError::OnlyZeros`]: 64 MiB, over an hour of any format's frames, so no recording
 /// that starts with a zeroed stretch is cut short, while `/dev/zero` ends in a moment.
 pub const ONLY_ZEROS_LIMIT: u64 = 64 << 20;
-use self::ports::Ports;
 use self::raw::RawReader;
 use self::recording::RecordingReader;
 use crate::time::Clock;
@@ -67,7 +63,7 @@ use crate::time::Clock;
 /// How many bytes a raw read asks for: small enough that what the kernel copies in is still in
 /// the L2 cache when the decoder reads it (1 MiB reads made `summary` 1.6x slower), large enough
 /// that system calls cost nothing. Also the read buffer of a CSV input.
-pub(crate) const BATCH: usize = 64 << 10;
+pub const BATCH: usize = 64 << 10;
 /// The magic numbers of a classic libpcap file, as its first four bytes: microsecond and
 /// nanosecond timestamps, either byte order.
 const CLASSIC_PCAP: [[u8; 4]; 4] = [
@@ -151,9 +147,22 @@ impl fmt::Display for InputFormat {
     }
 }
 
+impl InputFormat {
+    /// Live serial ports: one stream per port, times of reception (Unix seconds), read as the
+    /// bytes arrive.
+    pub const SERIAL: InputFormat = InputFormat {
+        name: "serial port",
+        short_name: "serial",
+        clock: Clock::Wall,
+        live: true,
+        recorded_ports: false,
+    };
+}
+
 /// The reader of one input kind, behind [`Input`]: each kind's module implements it, holding
-/// its own policy (its [`InputFormat`], its streams, its flagged bytes).
-trait Source {
+/// its own policy (its [`InputFormat`], its streams, its flagged bytes); live ports' is
+/// `hwfoc-io`'s ([`Input::from_source`]).
+pub trait Source {
     /// The format read.
     fn format(&self) -> InputFormat;
 
@@ -190,8 +199,8 @@ trait Source {
     fn looks(&self) -> Option<Looks>;
 
     /// A second handle on the regular file being read, for positional reads of a later part
-    /// ([`Input::later_half`]): raw bytes only.
-    fn file(&self) -> Option<&File> {
+    /// (`Input::later_half`): raw bytes only.
+    fn file(&self) -> Option<&dyn ReadAt> {
         None
     }
 
@@ -262,8 +271,9 @@ pub struct Input {
     deferred: Option<InputError>,
     /// Where notices go ([`crate::notice`]).
     notices: NoticeSink,
-    /// A regular file opened by its path: open only while it is read (see [`Input::open`]).
-    path: Option<String>,
+    /// A regular file opened by its path: open only while it is read (see
+    /// [`Input::from_file`]).
+    path: Option<Box<dyn Reopen>>,
     /// Notices given since the file was opened, and how many of them a reading before a
     /// rewind already gave (those are not given again).
     told: usize,
@@ -274,33 +284,20 @@ pub struct Input {
 }
 
 impl Input {
-    /// Opens a file, or standard input for `-`, and detects its format. A regular file is
-    /// closed again once its format is known: it is open only while it is read, from its first
-    /// [`Input::next_batch`] to its end, so that any number of inputs can be given together.
-    pub fn open(spec: &str) -> Result<Input, InputError> {
-        if spec == "-" {
-            return Input::from_reader("standard input", Box::new(io::stdin().lock()));
-        }
-        let file = File::open(spec).map_err(|source| InputError::Open {
-            input: spec.to_string(),
-            source,
-        })?;
-        let meta = file.metadata().map_err(|source| InputError::Open {
-            input: spec.to_string(),
-            source,
-        })?;
-        if meta.is_dir() {
-            return Err(InputError::IsDirectory {
-                input: spec.to_string(),
-            });
-        }
-        let mut input = Input::from_reader(spec, Box::new(file))?;
-        if meta.is_file() {
-            // Closed until read: a year of rotated recordings is thousands of inputs, more
-            // than a process may hold open. (A pipe or a device cannot be opened again.)
-            input.path = Some(spec.to_string());
-            input.close();
-        }
+    /// The input of a regular file opened by its path (`hwfoc-io` opens it: `file`, read from
+    /// its start), its format detected. It is closed again once its format is known: it is
+    /// open only while it is read, from its first [`Input::next_batch`] to its end (`path`
+    /// opens it again), so that any number of inputs can be given together.
+    pub fn from_file(
+        name: &str,
+        path: Box<dyn Reopen>,
+        file: Box<dyn RegularFile>,
+    ) -> Result<Input, InputError> {
+        let mut input = Input::read_file(name, file, false)?;
+        // Closed until read: a year of rotated recordings is thousands of inputs, more than a
+        // process may hold open. (A pipe or a device cannot be opened again.)
+        input.path = Some(path);
+        input.close();
         Ok(input)
     }
 
@@ -310,11 +307,11 @@ impl Input {
         let Some(path) = &self.path else {
             return Ok(());
         };
-        let file = File::open(path).map_err(|source| InputError::Open {
+        let file = path.open().map_err(|source| InputError::Open {
             input: self.name.clone(),
             source,
         })?;
-        let fresh = Input::from_file(&self.name, file, self.ahead)?;
+        let fresh = Input::read_file(&self.name, file, self.ahead)?;
         if fresh.format != self.format {
             return Err(InputError::Changed {
                 input: self.name.clone(),
@@ -363,7 +360,7 @@ impl Input {
 
     /// The length of a regular file opened by its path, as it is now.
     pub(crate) fn file_len(&self) -> Option<u64> {
-        std::fs::metadata(self.path.as_ref()?).ok().map(|m| m.len())
+        self.path.as_ref()?.file_len()
     }
 
     /// Whether this input and `other` are regular files holding the same bytes (the same
@@ -373,29 +370,12 @@ impl Input {
         let (Some(a), Some(b)) = (&self.path, &other.path) else {
             return false;
         };
-        same_file_bytes(a, b).unwrap_or(false)
+        a.same_bytes_as(&**b)
     }
 
     /// Hands `notice` to the input's notice sink.
     pub(crate) fn tell(&mut self, notice: Notice) {
         (self.notices)(notice);
-    }
-
-    /// Opens serial ports at `baud` (8N1; at [`crate::serial::Baud::Auto`] each port finds its
-    /// rate, told as a notice) as one input with one stream per port, in the order given.
-    /// Reading ends once `stop` is set (the `hwfoc` command sets it on Ctrl-C or SIGTERM; the
-    /// library installs no signal handler); a port that is unplugged is waited for, with a
-    /// warning.
-    pub fn open_ports(
-        names: &[String],
-        baud: impl Into<crate::serial::Baud>,
-        stop: Arc<AtomicBool>,
-    ) -> Result<Input, InputError> {
-        let set = PortSet::open(names, baud)?;
-        Ok(Input::new(
-            &names.join(", "),
-            Box::new(Ports::new(set, stop)),
-        ))
     }
 
     /// An input over bytes already in memory (the built-in demo stream).
@@ -410,9 +390,13 @@ impl Input {
         Input::with_head(name, head, Opened::Reader(reader))
     }
 
-    /// [`Input::from_reader`] of a regular file: raw bytes are read ahead on a thread of their
-    /// own (see `ahead.rs`) when `ahead`.
-    fn from_file(name: &str, mut file: File, ahead: bool) -> Result<Input, InputError> {
+    /// [`Input::from_reader`] of a regular file: raw bytes are read ahead
+    /// ([`RegularFile::read_ahead`]) when `ahead`.
+    fn read_file(
+        name: &str,
+        mut file: Box<dyn RegularFile>,
+        ahead: bool,
+    ) -> Result<Input, InputError> {
         let head = read_head(name, &mut file)?;
         let opened = Opened::File { file, ahead };
         Input::with_head(name, head, opened)
@@ -434,10 +418,10 @@ impl Input {
 
     /// A raw input that is a regular file, being read: a second handle on it, for positional
     /// reads of a later part, and its length now.
-    pub(crate) fn later_half(&self) -> Option<(File, u64)> {
+    pub(crate) fn later_half(&self) -> Option<(Box<dyn ReadAt>, u64)> {
         let file = self.source.as_ref()?.file()?;
-        let len = file.metadata().ok()?.len();
-        Some((file.try_clone().ok()?, len))
+        let len = file.file_len()?;
+        Some((file.try_clone()?, len))
     }
 
     /// The input whose first bytes, `head`, were read of `opened`.
@@ -459,7 +443,7 @@ impl Input {
             let (reader, file) = opened.raw();
             Box::new(RawReader::new(reader, file, head))
         };
-        Ok(Input::new(name, source))
+        Ok(Input::from_source(name, source))
     }
 
     /// What a raw input's first bytes look like when they are not telemetry (text, zeros, a
@@ -468,7 +452,8 @@ impl Input {
         self.source.as_ref().map_or(self.kept.looks, |s| s.looks())
     }
 
-    fn new(name: &str, source: Box<dyn Source>) -> Input {
+    /// The input read by `source` (live ports: `hwfoc-io`'s), named `name`.
+    pub fn from_source(name: &str, source: Box<dyn Source>) -> Input {
         Input {
             name: name.to_string(),
             format: source.format(),
@@ -618,84 +603,6 @@ impl Input {
     }
 }
 
-/// Whether files `a` and `b` hold the same bytes: their lengths first, then their contents in
-/// blocks up to the first that differs.
-fn same_file_bytes(a: &str, b: &str) -> io::Result<bool> {
-    let (fa, fb) = (File::open(a)?, File::open(b)?);
-    if fa.metadata()?.len() != fb.metadata()?.len() {
-        return Ok(false);
-    }
-    let (mut fa, mut fb) = (BufReader::new(fa), BufReader::new(fb));
-    let (mut ba, mut bb) = (vec![0u8; 1 << 16], vec![0u8; 1 << 16]);
-    loop {
-        // `take(..).read_to_end` reads a block whole (a plain `read` may stop short).
-        ba.clear();
-        bb.clear();
-        let n = (&mut fa).take(1 << 16).read_to_end(&mut ba)?;
-        let m = (&mut fb).take(1 << 16).read_to_end(&mut bb)?;
-        if ba != bb {
-            return Ok(false);
-        }
-        if n == 0 && m == 0 {
-            return Ok(true);
-        }
-    }
-}
-
-/// Reads a small file whole (a configuration file, a throttle profile): at most `limit` bytes;
-/// a larger file (or an endless one such as `/dev/zero`) is an error of kind `InvalidData`
-/// saying so, rather than memory for whatever it holds. Anything but a regular file (a FIFO, a
-/// device, a directory) is an error of kind `InvalidInput` naming what it is: opening a FIFO
-/// waits for a writer, so it is opened without waiting and refused.
-pub fn read_small_file(path: impl AsRef<std::path::Path>, limit: u64) -> io::Result<Vec<u8>> {
-    let mut options = std::fs::OpenOptions::new();
-    options.read(true);
-    // O_NONBLOCK: the open of a FIFO returns at once; reads of a regular file never wait anyway.
-    #[cfg(unix)]
-    std::os::unix::fs::OpenOptionsExt::custom_flags(&mut options, libc::O_NONBLOCK);
-    let file = options.open(path)?;
-    let kind = file.metadata()?.file_type();
-    if !kind.is_file() {
-        return Err(io::Error::new(
-            io::ErrorKind::InvalidInput,
-            match file_kind(&kind) {
-                Some(what) => format!("it is {what}, not a regular file"),
-                None => "it is not a regular file".to_string(),
-            },
-        ));
-    }
-    let mut bytes = Vec::new();
-    file.take(limit + 1).read_to_end(&mut bytes)?;
-    if bytes.len() as u64 > limit {
-        return Err(io::Error::new(
-            io::ErrorKind::InvalidData,
-            format!(
-                "it is larger than {} KiB, more than such a file holds",
-                limit >> 10
-            ),
-        ));
-    }
-    Ok(bytes)
-}
-
-/// What a file that is not a regular file is, for an error: "a FIFO", "a directory".
-fn file_kind(kind: &std::fs::FileType) -> Option<&'static str> {
-    #[cfg(unix)]
-    {
-        use std::os::unix::fs::FileTypeExt;
-        if kind.is_fifo() {
-            return Some("a FIFO");
-        }
-        if kind.is_char_device() || kind.is_block_device() {
-            return Some("a device");
-        }
-        if kind.is_socket() {
-            return Some("a socket");
-        }
-    }
-    kind.is_dir().then_some("a directory")
-}
-
 /// The first bytes of an input, as many as detecting its format takes; an empty input is an
 /// error naming it.
 fn read_head(name: &str, reader: &mut dyn Read) -> Result<Vec<u8>, InputError> {
@@ -751,30 +658,33 @@ enum Opened {
     /// Any reader.
     Reader(Box<dyn Read>),
     /// A regular file: raw bytes of it are read ahead when `ahead`.
-    File { file: File, ahead: bool },
+    File {
+        file: Box<dyn RegularFile>,
+        ahead: bool,
+    },
 }
 
 impl Opened {
     fn reader(self) -> Box<dyn Read> {
         match self {
             Opened::Reader(reader) => reader,
-            Opened::File { file, .. } => Box::new(file),
+            Opened::File { file, .. } => file,
         }
     }
 
     /// The reader of raw bytes, and a second handle on a regular file (for positional reads
     /// of a later part: [`Input::later_half`]).
-    fn raw(self) -> (raw::Reader, Option<File>) {
+    fn raw(self) -> (raw::Reader, Option<Box<dyn ReadAt>>) {
         match self {
             Opened::Reader(reader) => (raw::Reader::Plain(reader), None),
             Opened::File { file, ahead } => {
-                let second = file.try_clone().ok();
+                let second = file.second();
                 let reader = match ahead {
-                    true => match ahead::ReadAhead::start(file) {
+                    true => match file.read_ahead() {
                         Ok(ahead) => raw::Reader::Ahead(ahead),
-                        Err(file) => raw::Reader::Plain(Box::new(file)),
+                        Err(file) => raw::Reader::Plain(file),
                     },
-                    false => raw::Reader::Plain(Box::new(file)),
+                    false => raw::Reader::Plain(file),
                 };
                 (reader, second)
             }
@@ -783,7 +693,7 @@ impl Opened {
 }
 
 /// `read` that retries when interrupted by a signal.
-fn read_some(reader: &mut dyn Read, buf: &mut [u8]) -> io::Result<usize> {
+pub fn read_some(reader: &mut dyn Read, buf: &mut [u8]) -> io::Result<usize> {
     loop {
         match reader.read(buf) {
             Err(e) if e.kind() == io::ErrorKind::Interrupted => continue,
@@ -1082,42 +992,6 @@ mod tests {
         assert_eq!(read_all(&mut input), (raw, None));
     }
 
-    #[cfg(unix)]
-    #[test]
-    fn serial_ports_give_a_stream_per_port_with_receive_times() {
-        use std::io::Write;
-        use std::os::fd::AsFd;
-        let ptys: Vec<_> = (0..2)
-            .map(|_| nix::pty::openpty(None, None).unwrap())
-            .collect();
-        let names: Vec<String> = ptys
-            .iter()
-            .map(|p| {
-                let name = nix::unistd::ttyname(p.slave.as_fd()).unwrap();
-                name.to_string_lossy().into_owned()
-            })
-            .collect();
-        let stop = Arc::new(AtomicBool::new(false));
-        let mut input = Input::open_ports(&names, 19200, stop).unwrap();
-        assert_eq!(input.format(), InputFormat::SERIAL);
-        assert_eq!(input.streams(), 2);
-        assert_eq!(input.stream_name(1), names[1]);
-        let mut master = std::fs::File::from(ptys[1].master.try_clone().unwrap());
-        let sent = crate::clock::ReceiveClock::new().now_ns() as f64 * 1e-9;
-        master.write_all(&[0x9B, 0x16, 0x01]).unwrap();
-        let mut got = Vec::new();
-        let mut times = Vec::new();
-        while got.len() < 3 {
-            let b = input.next_batch().unwrap().unwrap();
-            assert_eq!(b.stream, 1);
-            got.extend_from_slice(b.bytes);
-            times.extend_from_slice(b.times.unwrap());
-        }
-        assert_eq!(got, [0x9B, 0x16, 0x01]);
-        assert!((times[0] - sent).abs() < 0.5, "{times:?} vs {sent}");
-        assert!(times.windows(2).all(|w| w[1] > w[0]));
-    }
-
     /// The first error of reading `input` to its end.
     fn first_error(mut input: Input) -> InputError {
         loop {
@@ -1235,15 +1109,13 @@ mod tests {
     /// opened again is an error naming it.
     #[test]
     fn files_are_opened_when_read_and_can_be_read_again() {
-        let dir = tempfile::tempdir().unwrap();
-        let path = dir.path().join("r.pcapng");
         let mut w = pcapng::Writer::new(Vec::new()).unwrap();
         w.add_interface("/dev/ttyUSB0", 19200).unwrap();
         w.comment(0, 1, "a note").unwrap();
         w.write(0, 2, &[7, 8]).unwrap();
-        std::fs::write(&path, w.into_inner().unwrap()).unwrap();
-        let name = path.to_str().unwrap();
-        let mut input = Input::open(name).unwrap();
+        let name = "r.pcapng";
+        let file = file::memory::MemoryFile::new(name, w.into_inner().unwrap());
+        let mut input = file.input().unwrap();
         assert!(input.source.is_none());
         let seen = std::sync::Arc::new(std::sync::Mutex::new(0));
         let count = std::sync::Arc::clone(&seen);
@@ -1256,7 +1128,7 @@ mod tests {
         assert_eq!(input.stream_name(0), "/dev/ttyUSB0");
         assert_eq!(*seen.lock().unwrap(), 1);
         assert!(input.rewind());
-        std::fs::write(&path, b"raw bytes now").unwrap();
+        *file.bytes.lock().unwrap() = std::sync::Arc::new(b"raw bytes now".to_vec());
         let e = input.next_batch().err().unwrap();
         assert_eq!(
             e.to_string(),

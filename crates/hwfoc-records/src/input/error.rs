@@ -65,7 +65,7 @@ pub enum InputError {
         /// The input as named on the command line.
         input: String,
     },
-    /// A file read in two goes (closed meanwhile: see [`Input::open`](crate::Input::open))
+    /// A file read in two goes (closed meanwhile: see [`Input::from_file`](crate::Input::from_file))
     /// was no longer of the format it was first.
     Changed {
         /// The input as named on the command line.
@@ -80,6 +80,12 @@ pub enum InputError {
         input: String,
         /// How many bytes it gave.
         bytes: u64,
+    },
+    /// No input gave a data frame (`decode`, `summary`, `check` and Python fail with this; why,
+    /// input by input, is said before): see [`Sources::nothing_decoded`](crate::Sources::nothing_decoded).
+    NoDataFrames {
+        /// The inputs, as named, joined by `, `.
+        inputs: String,
     },
     /// A serial port could not be opened.
     Port(PortError),
@@ -142,6 +148,9 @@ impl fmt::Display for InputError {
                 f,
                 "{input} changed while it was being read: it is now {format}"
             ),
+            InputError::NoDataFrames { inputs } => {
+                write!(f, "no data frame in any input ({inputs})")
+            }
             InputError::Port(e) => e.fmt(f),
         }
     }

@@ -1,0 +1,14 @@
+//! The record of `docs/RECORD-SCHEMA.md` ([`hwfoc_records::record`]), its columns seen by this
+//! crate's writers: [`Column`] and [`Visitor`] here know how every writer stores each column's
+//! values (`write/stored.rs`).
+
+pub use hwfoc_records::record::*;
+
+pub use crate::write::stored::{StoredColumn as Column, Visitor};
+
+/// The columns of the schema ([`hwfoc_records::record::columns`]), walked by this crate's
+/// writers with [`visit`](columns::visit).
+pub mod columns {
+    pub use crate::write::stored::visit;
+    pub use hwfoc_records::record::columns::*;
+}
