@@ -16,10 +16,11 @@ DEFAULT_CURRENT_SCALE: float
 DEFAULT_POLE_PAIRS: int
 #: The default of every ``gear_ratio`` argument: motor turns per output shaft turn.
 DEFAULT_GEAR_RATIO: float
-#: The default of every ``v4_volts_per_step`` argument, ``"8/910"``: volts per voltage ADC step
-#: of a Platinum V4 ESC until its info frame is adopted (the ``hwfoc`` command's
-#: ``--v4-volts-per-step``; ``"low"`` is 8/910, ``"hv"`` 11/650 for HV models).
-DEFAULT_V4_VOLTS_PER_STEP: str
+#: The formats' own settings, each key of every ``settings`` argument with its default, from the
+#: formats' descriptions (the ``hwfoc`` command's ``--set KEY=VALUE``):
+#: ``{"v4_volts_per_step": "8/910"}``, volts per voltage ADC step of a Platinum V4 ESC until its
+#: info frame is adopted (``"N/D"``, ``"low"``: 8/910, or ``"hv"``: 11/650 for HV models).
+DEFAULT_SETTINGS: Dict[str, str]
 #: The names every ``protocol`` argument takes (``"hw-foc"``: an ESC's own wire, 19200 baud;
 #: ``"datalink"``: a DataLink V2 hub, 115200 baud; ``"hw-v4"`` and ``"hw-v3"``: Platinum V4 and
 #: V3, 19200 baud; ``"hw5"``: HW5, 115200 baud; ``"hw-can"`` and ``"dronecan"``: Hobbywing's
@@ -70,7 +71,7 @@ def read(
     current_scale: float = ...,
     pole_pairs: int = ...,
     gear_ratio: float = ...,
-    v4_volts_per_step: str = ...,
+    settings: Optional[Mapping[str, str]] = None,
     protocol: Optional[str] = None,
     join: bool = False,
 ) -> pa.Table:
@@ -83,9 +84,10 @@ def read(
     own, however their ports are named, unless ``join=True`` reads them as one recording, as the
     command's ``--join``; a file given twice is read once). ``esc``, ``start`` and ``end`` select as the
     command's ``--esc``, ``--from`` (inclusive) and ``--to`` (exclusive); a time window needs
-    inputs with receive times. The settings convert currents and RPM; ``v4_volts_per_step``
-    (``"N/D"``, ``"low"`` or ``"hv"``, as the command's ``--v4-volts-per-step``) converts a
-    Platinum V4 ESC's voltage until its info frame is adopted. ``protocol``: a name of
+    inputs with receive times. The settings convert currents and RPM; ``settings`` sets the formats' own
+    settings by the keys of :data:`DEFAULT_SETTINGS`, each value as the command's ``--set
+    KEY=VALUE`` takes it (``{"v4_volts_per_step": "hv"}`` converts a Platinum V4 ESC's voltage
+    until its info frame is adopted). ``protocol``: a name of
     :data:`PROTOCOLS`, to read that protocol's frames only (the bytes of any other are skipped
     bytes), as the command's ``--protocol``; None reads every protocol.
 
@@ -99,12 +101,13 @@ def read(
 
     The schema's metadata holds what ``hwfoc decode --format parquet`` writes in its file:
     ``hwfoc_version``, ``record_schema_version`` (``4``), ``current_scale``, ``pole_pairs``,
-    ``gear_ratio``, ``v4_volts_per_step``, ``inputs`` and ``escs`` (JSON) and ``filter`` when records were selected;
+    ``gear_ratio``, each key of :data:`DEFAULT_SETTINGS`, ``inputs`` and ``escs`` (JSON) and ``filter`` when records were selected;
     each field has its ``unit``.
 
     Raises InputError (also for a serial port's path: read ports with :func:`open_ports`; and,
-    after the warnings, when no input held a data frame, as ``hwfoc decode`` fails), SelectionError, SettingsError; TypeError for a source of another type; ValueError for a
-    ``protocol`` not in :data:`PROTOCOLS` or a ``v4_volts_per_step`` that is not a fraction. Warns HwfocWarning
+    after the warnings, when no input held a data frame, as ``hwfoc decode`` fails), SelectionError, SettingsError (also for a ``settings`` key no format has: the message lists
+    the keys); TypeError for a source of another type; ValueError for a
+    ``protocol`` not in :data:`PROTOCOLS` or a ``settings`` value the setting does not take. Warns HwfocWarning
     for inputs without frames and for a recording's damage and notes.
     """
 
@@ -118,7 +121,7 @@ def scan(
     current_scale: float = ...,
     pole_pairs: int = ...,
     gear_ratio: float = ...,
-    v4_volts_per_step: str = ...,
+    settings: Optional[Mapping[str, str]] = None,
     protocol: Optional[str] = None,
     join: bool = False,
 ) -> "Scan":
@@ -151,7 +154,7 @@ def check(
     current_scale: float = ...,
     pole_pairs: int = ...,
     gear_ratio: float = ...,
-    v4_volts_per_step: str = ...,
+    settings: Optional[Mapping[str, str]] = None,
 ) -> pa.Table:
     """The findings of ``hwfoc check --json`` on ``source`` as a table of
     :data:`FINDINGS_SCHEMA` (docs/CHECKS.md, "Python")."""
@@ -163,7 +166,7 @@ def summary(
     current_scale: float = ...,
     pole_pairs: int = ...,
     gear_ratio: float = ...,
-    v4_volts_per_step: str = ...,
+    settings: Optional[Mapping[str, str]] = None,
     protocol: Optional[str] = None,
     join: bool = False,
 ) -> Dict[str, Any]:
@@ -177,7 +180,7 @@ def record_schema(
     current_scale: float = ...,
     pole_pairs: int = ...,
     gear_ratio: float = ...,
-    v4_volts_per_step: str = ...,
+    settings: Optional[Mapping[str, str]] = None,
 ) -> pa.Schema:
     """The Arrow schema of the records (units in the fields' metadata, settings in the
     schema's)."""
@@ -197,7 +200,7 @@ class CanDecoder:
         current_scale: float = ...,
         pole_pairs: int = ...,
         gear_ratio: float = ...,
-        v4_volts_per_step: str = ...,
+        settings: Optional[Mapping[str, str]] = None,
     ) -> None: ...
     def feed(
         self,
@@ -234,7 +237,7 @@ class Decoder:
         current_scale: float = ...,
         pole_pairs: int = ...,
         gear_ratio: float = ...,
-        v4_volts_per_step: str = ...,
+        settings: Optional[Mapping[str, str]] = None,
         protocol: Optional[str] = None,
     ) -> None:
         """``esc``: the ``esc`` column of the records; ``baud``: the line's rate, for the time of
@@ -273,7 +276,7 @@ def open_ports(
     current_scale: float = ...,
     pole_pairs: int = ...,
     gear_ratio: float = ...,
-    v4_volts_per_step: str = ...,
+    settings: Optional[Mapping[str, str]] = None,
     protocol: Optional[str] = None,
 ) -> "Ports":
     """Opens serial ports (8N1) at ``baud`` (by default that of ``protocol``, else 19200), one

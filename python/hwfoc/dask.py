@@ -92,7 +92,7 @@ def read(
     import dask.dataframe as dd
 
     files = paths(paths_or_glob)
-    settings = {k: options[k] for k in ("current_scale", "pole_pairs", "gear_ratio", "v4_volts_per_step") if k in options}
+    settings = {k: options[k] for k in ("current_scale", "pole_pairs", "gear_ratio", "settings") if k in options}
     empty = hwfoc.record_schema(**settings).empty_table()
     meta = to_pandas(add_columns(empty, None, path_column, frame_column))
     return dd.from_map(

@@ -83,7 +83,7 @@ def check(source: Any, *, config: Toml = None, baseline: Toml = None, **settings
     configuration file (its ``[check]`` table is taken); the documented defaults without it.
     ``baseline``: a baseline ``hwfoc check --fit-baseline`` wrote (a path, or the table
     parsed), for the drift analyser. ``settings``: ``current_scale``, ``pole_pairs``,
-    ``gear_ratio``, ``v4_volts_per_step`` as :func:`hwfoc.read`'s. Raises
+    ``gear_ratio``, ``settings`` as :func:`hwfoc.read`'s. Raises
     :class:`hwfoc.InputError` as :func:`hwfoc.read` does, ``ValueError`` for a config or
     baseline that does not fit."""
     text = check_json(source, config=_toml(config, "config"), baseline=_toml(baseline, "baseline"), **settings)

@@ -82,7 +82,7 @@ def _records(batches: Iterator[pa.RecordBatch], column: str, name_column: str, p
 
 
 def _settings(options: dict) -> dict:
-    return {k: options[k] for k in ("current_scale", "pole_pairs", "gear_ratio", "v4_volts_per_step") if k in options}
+    return {k: options[k] for k in ("current_scale", "pole_pairs", "gear_ratio", "settings") if k in options}
 
 
 def read(

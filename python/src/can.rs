@@ -19,7 +19,7 @@ use pyo3::types::{PyDict, PyTuple};
 use crate::errors;
 use crate::live::{bytes_of, live_schema, stats_dict};
 use crate::records::Frames;
-use crate::{CURRENT_SCALE, GEAR_RATIO, POLE_PAIRS, V4_VOLTS_PER_STEP};
+use crate::{CURRENT_SCALE, GEAR_RATIO, POLE_PAIRS};
 
 /// The latest time taken, Unix seconds: past it, nanoseconds overflow 64 bits (2554).
 const MAX_T_S: f64 = 18_446_744_073.0;
@@ -116,16 +116,16 @@ fn frame_of(item: &Bound<'_, PyAny>) -> PyResult<(f64, CanFrame)> {
 #[pymethods]
 impl CanDecoder {
     #[new]
-    #[pyo3(signature = (*, esc=crate::args::Esc(0), current_scale=CURRENT_SCALE, pole_pairs=crate::args::PolePairs(POLE_PAIRS), gear_ratio=GEAR_RATIO, v4_volts_per_step=V4_VOLTS_PER_STEP), text_signature = "(*, esc=0, current_scale=DEFAULT_CURRENT_SCALE, pole_pairs=DEFAULT_POLE_PAIRS, gear_ratio=DEFAULT_GEAR_RATIO, v4_volts_per_step=DEFAULT_V4_VOLTS_PER_STEP)")]
+    #[pyo3(signature = (*, esc=crate::args::Esc(0), current_scale=CURRENT_SCALE, pole_pairs=crate::args::PolePairs(POLE_PAIRS), gear_ratio=GEAR_RATIO, settings=None), text_signature = "(*, esc=0, current_scale=DEFAULT_CURRENT_SCALE, pole_pairs=DEFAULT_POLE_PAIRS, gear_ratio=DEFAULT_GEAR_RATIO, settings=None)")]
     fn new(
         esc: crate::args::Esc,
         current_scale: f32,
         pole_pairs: crate::args::PolePairs,
         gear_ratio: f32,
-        v4_volts_per_step: &str,
+        settings: Option<crate::FormatSettings<'_>>,
     ) -> PyResult<Self> {
         let settings =
-            crate::settings_arg(current_scale, pole_pairs, gear_ratio, v4_volts_per_step)?;
+            crate::settings_arg(current_scale, pole_pairs, gear_ratio, settings)?;
         Ok(CanDecoder {
             state: Mutex::new(CanState {
                 stream: Stream::can(),

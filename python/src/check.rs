@@ -10,7 +10,7 @@ use pyo3::prelude::*;
 
 use crate::source::{self, Spec};
 use crate::{
-    CURRENT_SCALE, GEAR_RATIO, Notes, POLE_PAIRS, V4_VOLTS_PER_STEP, errors, open_all,
+    CURRENT_SCALE, GEAR_RATIO, Notes, POLE_PAIRS, errors, open_all,
     settings_arg, sources, warn_notices,
 };
 
@@ -41,7 +41,7 @@ fn bad_json(what: &str) -> impl Fn(serde_json::Error) -> PyErr + '_ {
 /// as JSON text. Raises InputError (also when no input held a data frame, as the command
 /// fails), ValueError.
 #[pyfunction]
-#[pyo3(signature = (source, *, current_scale=CURRENT_SCALE, pole_pairs=crate::args::PolePairs(POLE_PAIRS), gear_ratio=GEAR_RATIO, v4_volts_per_step=V4_VOLTS_PER_STEP, config=None, baseline=None))]
+#[pyo3(signature = (source, *, current_scale=CURRENT_SCALE, pole_pairs=crate::args::PolePairs(POLE_PAIRS), gear_ratio=GEAR_RATIO, settings=None, config=None, baseline=None))]
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn check_json(
     py: Python<'_>,
@@ -49,11 +49,11 @@ pub(crate) fn check_json(
     current_scale: f32,
     pole_pairs: crate::args::PolePairs,
     gear_ratio: f32,
-    v4_volts_per_step: &str,
+    settings: Option<crate::FormatSettings<'_>>,
     config: Option<&str>,
     baseline: Option<&str>,
 ) -> PyResult<String> {
-    let settings = settings_arg(current_scale, pole_pairs, gear_ratio, v4_volts_per_step)?;
+    let settings = settings_arg(current_scale, pole_pairs, gear_ratio, settings)?;
     let config: CheckConfig = match config {
         Some(text) => serde_json::from_str(text).map_err(bad_json("config"))?,
         None => CheckConfig::default(),

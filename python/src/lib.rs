@@ -14,12 +14,13 @@ mod records;
 mod scan;
 mod source;
 
+use std::collections::BTreeMap;
 use std::sync::mpsc::{self, sync_channel};
 use std::sync::{Arc, Mutex};
 
 use arrow_array::RecordBatch;
 use arrow_pyarrow::{IntoPyArrow, Table};
-use hwfoc::v4::VoltsPerStep;
+use hwfoc::protocol::SettingError;
 use hwfoc::{Protocol, Settings};
 use hwfoc_io::Notice;
 use hwfoc_io::Sources;
@@ -37,18 +38,20 @@ use pyo3::prelude::*;
 use records::{Collect, Frames, Stop};
 use source::Spec;
 
-/// The defaults of every function's settings arguments (`current_scale`, `pole_pairs`,
-/// `gear_ratio`, `v4_volts_per_step`), those of the library: Python has them as
-/// `hwfoc.DEFAULT_CURRENT_SCALE`, `DEFAULT_POLE_PAIRS`, `DEFAULT_GEAR_RATIO` and
-/// `DEFAULT_V4_VOLTS_PER_STEP`.
+/// The defaults of every function's common settings arguments (`current_scale`, `pole_pairs`,
+/// `gear_ratio`), those of the library: Python has them as `hwfoc.DEFAULT_CURRENT_SCALE`,
+/// `DEFAULT_POLE_PAIRS` and `DEFAULT_GEAR_RATIO` (and the formats' own settings' defaults as
+/// `DEFAULT_SETTINGS`, from their descriptions).
 pub(crate) const CURRENT_SCALE: f32 = Settings::DEFAULT.current_scale;
 /// See [`CURRENT_SCALE`].
 pub(crate) const POLE_PAIRS: u16 = Settings::DEFAULT.pole_pairs;
 /// See [`CURRENT_SCALE`].
 pub(crate) const GEAR_RATIO: f32 = Settings::DEFAULT.gear_ratio;
-/// See [`CURRENT_SCALE`]: the text of [`VoltsPerStep::DEFAULT`] (the module's
-/// `DEFAULT_V4_VOLTS_PER_STEP` is made from the library's value, and a test checks they agree).
-pub(crate) const V4_VOLTS_PER_STEP: &str = "8/910";
+
+/// `settings=`: the formats' own settings, by the keys of their descriptions
+/// ([`Protocol::settings`]), each value as the command's `--set KEY=VALUE` takes it (a value
+/// that is not a `str` by its `str()`).
+pub(crate) type FormatSettings<'py> = BTreeMap<String, Bound<'py, PyAny>>;
 
 /// Rows per record batch of `read`'s table: blocks converted side by side on the workers. A
 /// block of frames this size (under 2 MiB: 29 bytes a frame) stays in a core's L2 cache while
@@ -114,24 +117,29 @@ impl Options {
 }
 
 /// The conversion settings of a call, checked: `current_scale`, `pole_pairs` and `gear_ratio`
-/// out of range are a `SettingsError` worded as the command's; `v4_volts_per_step` (`"N/D"`,
-/// `"low"` or `"hv"`, as the command's `--v4-volts-per-step`) that is none of these is a
-/// `ValueError` naming the argument.
+/// out of range are a `SettingsError` worded as the command's; in `settings` (see
+/// [`FormatSettings`]), a key no format's description has is a `SettingsError` listing the
+/// keys, and a value the setting does not take a `ValueError` naming the key.
 pub(crate) fn settings_arg(
     current_scale: f32,
     pole_pairs: crate::args::PolePairs,
     gear_ratio: f32,
-    v4_volts_per_step: &str,
+    formats: Option<FormatSettings<'_>>,
 ) -> PyResult<Settings> {
-    let settings =
+    let mut settings =
         Settings::new(current_scale, pole_pairs.0, gear_ratio).map_err(errors::settings)?;
-    let v4_volts_per_step = v4_volts_per_step.parse::<VoltsPerStep>().map_err(|e| {
-        PyValueError::new_err(format!("v4_volts_per_step: {v4_volts_per_step:?}: {e}"))
-    })?;
-    Ok(Settings {
-        v4_volts_per_step,
-        ..settings
-    })
+    for (key, value) in formats.unwrap_or_default() {
+        let value = value.str()?.to_string();
+        Protocol::apply_setting(&mut settings, &key, &value).map_err(|e| match e {
+            SettingError::UnknownKey => {
+                errors::SettingsError::new_err(format!("settings: {key:?}: {e}"))
+            }
+            SettingError::Value { key, reason } => {
+                PyValueError::new_err(format!("{key}: {value:?}: {reason}"))
+            }
+        })?;
+    }
+    Ok(settings)
 }
 
 /// `esc=`: an ESC index or a list of them.
@@ -405,7 +413,7 @@ pub(crate) fn stop_error(stop: Stop) -> PyErr {
 /// SettingsError, ValueError for an unknown protocol; warns HwfocWarning for inputs without
 /// frames and for damage or notes in a recording.
 #[pyfunction]
-#[pyo3(signature = (source, *, esc=None, start=None, end=None, current_scale=CURRENT_SCALE, pole_pairs=crate::args::PolePairs(POLE_PAIRS), gear_ratio=GEAR_RATIO, v4_volts_per_step=V4_VOLTS_PER_STEP, protocol=None, join=false), text_signature = "(source, *, esc=None, start=None, end=None, current_scale=DEFAULT_CURRENT_SCALE, pole_pairs=DEFAULT_POLE_PAIRS, gear_ratio=DEFAULT_GEAR_RATIO, v4_volts_per_step=DEFAULT_V4_VOLTS_PER_STEP, protocol=None, join=False)")]
+#[pyo3(signature = (source, *, esc=None, start=None, end=None, current_scale=CURRENT_SCALE, pole_pairs=crate::args::PolePairs(POLE_PAIRS), gear_ratio=GEAR_RATIO, settings=None, protocol=None, join=false), text_signature = "(source, *, esc=None, start=None, end=None, current_scale=DEFAULT_CURRENT_SCALE, pole_pairs=DEFAULT_POLE_PAIRS, gear_ratio=DEFAULT_GEAR_RATIO, settings=None, protocol=None, join=False)")]
 #[allow(clippy::too_many_arguments)]
 fn read<'py>(
     py: Python<'py>,
@@ -416,11 +424,11 @@ fn read<'py>(
     current_scale: f32,
     pole_pairs: crate::args::PolePairs,
     gear_ratio: f32,
-    v4_volts_per_step: &str,
+    settings: Option<FormatSettings<'_>>,
     protocol: Option<&str>,
     join: bool,
 ) -> PyResult<Bound<'py, PyAny>> {
-    let settings = settings_arg(current_scale, pole_pairs, gear_ratio, v4_volts_per_step)?;
+    let settings = settings_arg(current_scale, pole_pairs, gear_ratio, settings)?;
     let options = Options::new(esc, start, end, settings)?
         .forced(protocol)?
         .joined(join);
@@ -469,7 +477,7 @@ fn summary_json(
 /// settings, inputs, and per ESC its link statistics, field ranges, faults and fault episodes;
 /// `protocol` and `join` as `read`'s. Raises InputError, ValueError for an unknown protocol.
 #[pyfunction]
-#[pyo3(signature = (source, *, current_scale=CURRENT_SCALE, pole_pairs=crate::args::PolePairs(POLE_PAIRS), gear_ratio=GEAR_RATIO, v4_volts_per_step=V4_VOLTS_PER_STEP, protocol=None, join=false), text_signature = "(source, *, current_scale=DEFAULT_CURRENT_SCALE, pole_pairs=DEFAULT_POLE_PAIRS, gear_ratio=DEFAULT_GEAR_RATIO, v4_volts_per_step=DEFAULT_V4_VOLTS_PER_STEP, protocol=None, join=False)")]
+#[pyo3(signature = (source, *, current_scale=CURRENT_SCALE, pole_pairs=crate::args::PolePairs(POLE_PAIRS), gear_ratio=GEAR_RATIO, settings=None, protocol=None, join=false), text_signature = "(source, *, current_scale=DEFAULT_CURRENT_SCALE, pole_pairs=DEFAULT_POLE_PAIRS, gear_ratio=DEFAULT_GEAR_RATIO, settings=None, protocol=None, join=False)")]
 #[allow(clippy::too_many_arguments)]
 fn summary<'py>(
     py: Python<'py>,
@@ -477,11 +485,11 @@ fn summary<'py>(
     current_scale: f32,
     pole_pairs: crate::args::PolePairs,
     gear_ratio: f32,
-    v4_volts_per_step: &str,
+    settings: Option<FormatSettings<'_>>,
     protocol: Option<&str>,
     join: bool,
 ) -> PyResult<Bound<'py, PyAny>> {
-    let settings = settings_arg(current_scale, pole_pairs, gear_ratio, v4_volts_per_step)?;
+    let settings = settings_arg(current_scale, pole_pairs, gear_ratio, settings)?;
     let protocol = protocol_arg(protocol)?;
     let specs = source::specs(source)?;
     let notes = Notes::default();
@@ -496,15 +504,15 @@ fn summary<'py>(
 /// The Arrow schema of the records (names, types, nullability, units in the fields' metadata),
 /// with the settings in its metadata.
 #[pyfunction]
-#[pyo3(signature = (*, current_scale=CURRENT_SCALE, pole_pairs=crate::args::PolePairs(POLE_PAIRS), gear_ratio=GEAR_RATIO, v4_volts_per_step=V4_VOLTS_PER_STEP), text_signature = "(*, current_scale=DEFAULT_CURRENT_SCALE, pole_pairs=DEFAULT_POLE_PAIRS, gear_ratio=DEFAULT_GEAR_RATIO, v4_volts_per_step=DEFAULT_V4_VOLTS_PER_STEP)")]
+#[pyo3(signature = (*, current_scale=CURRENT_SCALE, pole_pairs=crate::args::PolePairs(POLE_PAIRS), gear_ratio=GEAR_RATIO, settings=None), text_signature = "(*, current_scale=DEFAULT_CURRENT_SCALE, pole_pairs=DEFAULT_POLE_PAIRS, gear_ratio=DEFAULT_GEAR_RATIO, settings=None)")]
 fn record_schema<'py>(
     py: Python<'py>,
     current_scale: f32,
     pole_pairs: crate::args::PolePairs,
     gear_ratio: f32,
-    v4_volts_per_step: &str,
+    settings: Option<FormatSettings<'_>>,
 ) -> PyResult<Bound<'py, PyAny>> {
-    let settings = settings_arg(current_scale, pole_pairs, gear_ratio, v4_volts_per_step)?;
+    let settings = settings_arg(current_scale, pole_pairs, gear_ratio, settings)?;
     let provenance = Provenance::new(settings, Vec::new(), String::new());
     let schema = provenance.schema(None);
     arrow_pyarrow::ToPyArrow::to_pyarrow(schema.as_ref(), py)
@@ -535,10 +543,11 @@ fn _hwfoc(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("DEFAULT_CURRENT_SCALE", CURRENT_SCALE)?;
     m.add("DEFAULT_POLE_PAIRS", POLE_PAIRS)?;
     m.add("DEFAULT_GEAR_RATIO", GEAR_RATIO)?;
-    m.add(
-        "DEFAULT_V4_VOLTS_PER_STEP",
-        Settings::DEFAULT.v4_volts_per_step.to_string(),
-    )?;
+    let defaults = pyo3::types::PyDict::new(py);
+    for setting in Protocol::settings() {
+        defaults.set_item(setting.key, setting.default)?;
+    }
+    m.add("DEFAULT_SETTINGS", defaults)?;
     let protocols: Vec<&str> = Protocol::ALL.iter().map(|p| p.name()).collect();
     m.add("PROTOCOLS", pyo3::types::PyTuple::new(py, protocols)?)?;
     Ok(())

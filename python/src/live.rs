@@ -2,7 +2,7 @@
 //! serial ports read as `hwfoc monitor` reads them (`PortSet`: a reader thread per port that
 //! survives unplugging; `PortStreams`: a timed decoding stream per port).
 
-use crate::{CURRENT_SCALE, GEAR_RATIO, POLE_PAIRS, V4_VOLTS_PER_STEP};
+use crate::{CURRENT_SCALE, GEAR_RATIO, POLE_PAIRS};
 use std::collections::VecDeque;
 use std::sync::Mutex;
 use std::time::Duration;
@@ -142,18 +142,18 @@ impl Decoder {
 #[pymethods]
 impl Decoder {
     #[new]
-    #[pyo3(signature = (*, esc=crate::args::Esc(0), baud=None, current_scale=CURRENT_SCALE, pole_pairs=crate::args::PolePairs(POLE_PAIRS), gear_ratio=GEAR_RATIO, v4_volts_per_step=V4_VOLTS_PER_STEP, protocol=None), text_signature = "(*, esc=0, baud=None, current_scale=DEFAULT_CURRENT_SCALE, pole_pairs=DEFAULT_POLE_PAIRS, gear_ratio=DEFAULT_GEAR_RATIO, v4_volts_per_step=DEFAULT_V4_VOLTS_PER_STEP, protocol=None)")]
+    #[pyo3(signature = (*, esc=crate::args::Esc(0), baud=None, current_scale=CURRENT_SCALE, pole_pairs=crate::args::PolePairs(POLE_PAIRS), gear_ratio=GEAR_RATIO, settings=None, protocol=None), text_signature = "(*, esc=0, baud=None, current_scale=DEFAULT_CURRENT_SCALE, pole_pairs=DEFAULT_POLE_PAIRS, gear_ratio=DEFAULT_GEAR_RATIO, settings=None, protocol=None)")]
     fn new(
         esc: crate::args::Esc,
         baud: Option<crate::args::Baud>,
         current_scale: f32,
         pole_pairs: crate::args::PolePairs,
         gear_ratio: f32,
-        v4_volts_per_step: &str,
+        settings: Option<crate::FormatSettings<'_>>,
         protocol: Option<&str>,
     ) -> PyResult<Self> {
         let settings =
-            crate::settings_arg(current_scale, pole_pairs, gear_ratio, v4_volts_per_step)?;
+            crate::settings_arg(current_scale, pole_pairs, gear_ratio, settings)?;
         let protocol = crate::protocol_arg(protocol)?;
         let baud = crate::baud_arg(baud, protocol);
         Ok(Decoder {
@@ -293,7 +293,7 @@ pub struct Ports {
 /// Opens serial ports: see `hwfoc.open_ports`.
 #[pyfunction]
 #[allow(clippy::too_many_arguments)]
-#[pyo3(signature = (ports, *, baud=None, current_scale=CURRENT_SCALE, pole_pairs=crate::args::PolePairs(POLE_PAIRS), gear_ratio=GEAR_RATIO, v4_volts_per_step=V4_VOLTS_PER_STEP, protocol=None), text_signature = "(ports, *, baud=None, current_scale=DEFAULT_CURRENT_SCALE, pole_pairs=DEFAULT_POLE_PAIRS, gear_ratio=DEFAULT_GEAR_RATIO, v4_volts_per_step=DEFAULT_V4_VOLTS_PER_STEP, protocol=None)")]
+#[pyo3(signature = (ports, *, baud=None, current_scale=CURRENT_SCALE, pole_pairs=crate::args::PolePairs(POLE_PAIRS), gear_ratio=GEAR_RATIO, settings=None, protocol=None), text_signature = "(ports, *, baud=None, current_scale=DEFAULT_CURRENT_SCALE, pole_pairs=DEFAULT_POLE_PAIRS, gear_ratio=DEFAULT_GEAR_RATIO, settings=None, protocol=None)")]
 pub fn open_ports(
     py: Python<'_>,
     ports: Vec<String>,
@@ -301,10 +301,10 @@ pub fn open_ports(
     current_scale: f32,
     pole_pairs: crate::args::PolePairs,
     gear_ratio: f32,
-    v4_volts_per_step: &str,
+    settings: Option<crate::FormatSettings<'_>>,
     protocol: Option<&str>,
 ) -> PyResult<Ports> {
-    let settings = crate::settings_arg(current_scale, pole_pairs, gear_ratio, v4_volts_per_step)?;
+    let settings = crate::settings_arg(current_scale, pole_pairs, gear_ratio, settings)?;
     if ports.is_empty() {
         return Err(PyValueError::new_err("no port given"));
     }

@@ -3,7 +3,7 @@
 //! and converts each block of frames into a record batch, handing them over a channel of
 //! `QUEUE` batches; the iterator waits for the next with the interpreter's lock released.
 
-use crate::{CURRENT_SCALE, GEAR_RATIO, POLE_PAIRS, V4_VOLTS_PER_STEP};
+use crate::{CURRENT_SCALE, GEAR_RATIO, POLE_PAIRS};
 use std::sync::Mutex;
 use std::sync::mpsc::{Receiver, RecvTimeoutError, sync_channel};
 use std::time::Duration;
@@ -110,7 +110,7 @@ fn produce(
 /// batches ahead. Errors opening the inputs are raised at once, later ones by the iterator after
 /// the batches before them.
 #[pyfunction]
-#[pyo3(signature = (sources, *, batch_rows=crate::args::Rows(65536), esc=None, start=None, end=None, current_scale=CURRENT_SCALE, pole_pairs=crate::args::PolePairs(POLE_PAIRS), gear_ratio=GEAR_RATIO, v4_volts_per_step=V4_VOLTS_PER_STEP, protocol=None, join=false), text_signature = "(sources, *, batch_rows=65536, esc=None, start=None, end=None, current_scale=DEFAULT_CURRENT_SCALE, pole_pairs=DEFAULT_POLE_PAIRS, gear_ratio=DEFAULT_GEAR_RATIO, v4_volts_per_step=DEFAULT_V4_VOLTS_PER_STEP, protocol=None, join=False)")]
+#[pyo3(signature = (sources, *, batch_rows=crate::args::Rows(65536), esc=None, start=None, end=None, current_scale=CURRENT_SCALE, pole_pairs=crate::args::PolePairs(POLE_PAIRS), gear_ratio=GEAR_RATIO, settings=None, protocol=None, join=false), text_signature = "(sources, *, batch_rows=65536, esc=None, start=None, end=None, current_scale=DEFAULT_CURRENT_SCALE, pole_pairs=DEFAULT_POLE_PAIRS, gear_ratio=DEFAULT_GEAR_RATIO, settings=None, protocol=None, join=False)")]
 #[allow(clippy::too_many_arguments)]
 pub fn scan(
     py: Python<'_>,
@@ -122,12 +122,12 @@ pub fn scan(
     current_scale: f32,
     pole_pairs: crate::args::PolePairs,
     gear_ratio: f32,
-    v4_volts_per_step: &str,
+    settings: Option<crate::FormatSettings<'_>>,
     protocol: Option<&str>,
     join: bool,
 ) -> PyResult<Scan> {
     let batch_rows = batch_rows.0;
-    let settings = crate::settings_arg(current_scale, pole_pairs, gear_ratio, v4_volts_per_step)?;
+    let settings = crate::settings_arg(current_scale, pole_pairs, gear_ratio, settings)?;
     let options = Options::new(esc, start, end, settings)?
         .forced(protocol)?
         .joined(join);

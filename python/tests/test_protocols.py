@@ -128,7 +128,7 @@ def test_the_captures_summary_is_the_commands(cli, capture):
 
 def test_v4_volts_per_step_converts_v4_voltages_until_the_info_frame(cli, tmp_path):
     default = hwfoc.read(V4)
-    hv = hwfoc.read(V4, v4_volts_per_step="hv")
+    hv = hwfoc.read(V4, settings={"v4_volts_per_step": "hv"})
     assert_same_records(hv, cli_records(cli, V4, "--v4-volts-per-step", "hv"))
     assert hv.schema.metadata[b"v4_volts_per_step"] == b"11/650"
     assert default.schema.metadata[b"v4_volts_per_step"] == b"8/910"
@@ -141,10 +141,10 @@ def test_v4_volts_per_step_converts_v4_voltages_until_the_info_frame(cli, tmp_pa
     for i in changed:
         assert after[i] == pytest.approx(before[i] * (11 / 650) / (8 / 910), rel=1e-6)
     # "N/D" as the command takes it; "low" is the default.
-    assert hwfoc.read(V4, v4_volts_per_step="11/650").equals(hv)
-    assert hwfoc.read(V4, v4_volts_per_step="low").equals(default)
+    assert hwfoc.read(V4, settings={"v4_volts_per_step": "11/650"}).equals(hv)
+    assert hwfoc.read(V4, settings={"v4_volts_per_step": "low"}).equals(default)
     # Other formats are not changed by it, but their metadata says it.
-    assert hwfoc.read(V3, v4_volts_per_step="hv").drop_columns([]).column("rpm").equals(
+    assert hwfoc.read(V3, settings={"v4_volts_per_step": "hv"}).drop_columns([]).column("rpm").equals(
         hwfoc.read(V3).column("rpm"))
     # In the Parquet metadata of the command's export, and the summary's settings.
     out = tmp_path / "v4.parquet"
@@ -152,11 +152,11 @@ def test_v4_volts_per_step_converts_v4_voltages_until_the_info_frame(cli, tmp_pa
     assert pq.read_metadata(out).metadata[b"v4_volts_per_step"] == b"11/650"
     file_meta = {k: v for k, v in pq.read_metadata(out).metadata.items() if k != b"ARROW:schema"}
     assert hv.schema.metadata == file_meta
-    assert hwfoc.summary(V4, v4_volts_per_step="hv")["settings"]["v4_volts_per_step"] == "11/650"
-    scanned = next(iter(hwfoc.scan(V4, v4_volts_per_step="hv")))
+    assert hwfoc.summary(V4, settings={"v4_volts_per_step": "hv"})["settings"]["v4_volts_per_step"] == "11/650"
+    scanned = next(iter(hwfoc.scan(V4, settings={"v4_volts_per_step": "hv"})))
     assert scanned.schema.metadata[b"v4_volts_per_step"] == b"11/650"
-    assert hwfoc.record_schema(v4_volts_per_step="9/700").metadata[b"v4_volts_per_step"] == b"9/700"
-    decoder = hwfoc.Decoder(v4_volts_per_step="hv")
+    assert hwfoc.record_schema(settings={"v4_volts_per_step": "9/700"}).metadata[b"v4_volts_per_step"] == b"9/700"
+    decoder = hwfoc.Decoder(settings={"v4_volts_per_step": "hv"})
     assert decoder.schema.metadata[b"v4_volts_per_step"] == b"11/650"
     data, _ = _capture_bytes(V4)
     fed = pa.Table.from_batches([decoder.feed(data), decoder.finish()])
@@ -165,21 +165,45 @@ def test_v4_volts_per_step_converts_v4_voltages_until_the_info_frame(cli, tmp_pa
 
 @pytest.mark.parametrize("bad", ["9/0", "0/910", "8", "x", "", "8/910/1", "70000/1"])
 def test_a_bad_v4_volts_per_step_is_a_value_error_naming_it(bad):
-    for call in (lambda: hwfoc.read(V4, v4_volts_per_step=bad),
-                 lambda: hwfoc.scan(V4, v4_volts_per_step=bad),
-                 lambda: hwfoc.summary(V4, v4_volts_per_step=bad),
-                 lambda: hwfoc.record_schema(v4_volts_per_step=bad),
-                 lambda: hwfoc.Decoder(v4_volts_per_step=bad),
-                 lambda: hwfoc.open_ports(["/dev/null"], v4_volts_per_step=bad)):
+    for call in (lambda: hwfoc.read(V4, settings={"v4_volts_per_step": bad}),
+                 lambda: hwfoc.scan(V4, settings={"v4_volts_per_step": bad}),
+                 lambda: hwfoc.summary(V4, settings={"v4_volts_per_step": bad}),
+                 lambda: hwfoc.record_schema(settings={"v4_volts_per_step": bad}),
+                 lambda: hwfoc.Decoder(settings={"v4_volts_per_step": bad}),
+                 lambda: hwfoc.open_ports(["/dev/null"], settings={"v4_volts_per_step": bad})):
         with pytest.raises(ValueError, match=r"^v4_volts_per_step: .*volts per step must be N/D"):
             call()
 
 
 def test_the_default_v4_volts_per_step_is_the_librarys():
-    assert hwfoc.DEFAULT_V4_VOLTS_PER_STEP == "8/910"
+    assert hwfoc.DEFAULT_SETTINGS == {"v4_volts_per_step": "8/910"}
     assert hwfoc.record_schema().metadata[b"v4_volts_per_step"] == b"8/910"
     for f in (hwfoc.read, hwfoc.scan, hwfoc.summary, hwfoc.record_schema, hwfoc.Decoder, hwfoc.open_ports):
-        assert inspect.signature(f).parameters["v4_volts_per_step"].default == hwfoc.DEFAULT_V4_VOLTS_PER_STEP, f
+        params = inspect.signature(f).parameters
+        assert params["settings"].default is None, f
+        # The formats' settings are keys of `settings=`, not arguments of their own.
+        assert not set(params) & set(hwfoc.DEFAULT_SETTINGS), f
+
+
+def test_format_settings_are_read_by_their_descriptions_keys():
+    # Every key of the descriptions, at its default, changes nothing; `-` and `_` alike.
+    assert hwfoc.read(V4, settings=dict(hwfoc.DEFAULT_SETTINGS)).equals(hwfoc.read(V4))
+    hv = hwfoc.read(V4, settings={"v4_volts_per_step": "hv"})
+    assert hwfoc.read(V4, settings={"v4-volts-per-step": "hv"}).equals(hv)
+
+
+def test_an_unknown_format_setting_is_a_settings_error_listing_the_keys():
+    keys = " ".join(hwfoc.DEFAULT_SETTINGS)
+    for call in (lambda s: hwfoc.read(V4, settings=s),
+                 lambda s: hwfoc.scan(V4, settings=s),
+                 lambda s: hwfoc.summary(V4, settings=s),
+                 lambda s: hwfoc.record_schema(settings=s),
+                 lambda s: hwfoc.Decoder(settings=s),
+                 lambda s: hwfoc.CanDecoder(settings=s),
+                 lambda s: hwfoc.open_ports(["/dev/null"], settings=s)):
+        with pytest.raises(hwfoc.SettingsError) as e:
+            call({"v4_volts": "hv"})
+        assert str(e.value) == f'settings: "v4_volts": no format has this setting; the settings are: {keys}'
 
 
 # ---- HW5 -------------------------------------------------------------------------------------
@@ -314,7 +338,7 @@ def test_dask_reads_every_format(tmp_path, hw5_stream):
 
     paths = _fleet_of_formats(tmp_path, hw5_stream)
     ddf = hwfoc.dask.read(paths, path_column="recording", frame_column="frame",
-                          v4_volts_per_step="hv")
+                          settings={"v4_volts_per_step": "hv"})
     df = ddf.compute()
     counts = df.groupby("recording")["esc"].size().to_dict()
     assert counts == {paths[0]: 297, paths[1]: 699, paths[2]: 40}
@@ -357,7 +381,7 @@ def test_spark_reads_every_format(spark, tmp_path, hw5_stream):
 
     paths = _fleet_of_formats(tmp_path, hw5_stream)
     df = hwfoc.spark.read(spark, paths, path_column="recording", frame_column="frame",
-                          v4_volts_per_step="hv")
+                          settings={"v4_volts_per_step": "hv"})
     rows = df.collect()
     by_file = {}
     for r in rows:
@@ -375,7 +399,7 @@ def test_spark_reads_every_format(spark, tmp_path, hw5_stream):
     hw5 = sorted(by_file[paths[2]], key=lambda r: r["frame"])
     assert all(r["packet"] is None and r["bec_voltage_v"] is not None for r in hw5)
     assert list(hw5[2]["faults"]) == ["throttle_signal_lost", "low_voltage"]
-    schema = hwfoc.spark.spark_schema("recording", "frame", v4_volts_per_step="hv")
+    schema = hwfoc.spark.spark_schema("recording", "frame", settings={"v4_volts_per_step": "hv"})
     assert df.schema == schema
     # `time` (record schema 4): a Spark timestamp, null exactly where `t_s` is.
     from pyspark.sql import types as T

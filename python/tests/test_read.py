@@ -115,19 +115,20 @@ def test_settings_change_values_and_metadata(cli, sim_dir):
 
 def test_the_default_settings_are_the_librarys(sim_dir):
     # docs/RECORD-SCHEMA.md: current scale 64, 7 pole pairs, gear ratio 1, 8/910 V per V4 step.
-    defaults = (hwfoc.DEFAULT_CURRENT_SCALE, hwfoc.DEFAULT_POLE_PAIRS, hwfoc.DEFAULT_GEAR_RATIO,
-                hwfoc.DEFAULT_V4_VOLTS_PER_STEP)
-    assert defaults == (64.0, 7, 1.0, "8/910")
+    defaults = (hwfoc.DEFAULT_CURRENT_SCALE, hwfoc.DEFAULT_POLE_PAIRS, hwfoc.DEFAULT_GEAR_RATIO)
+    assert defaults == (64.0, 7, 1.0)
+    assert hwfoc.DEFAULT_SETTINGS == {"v4_volts_per_step": "8/910"}
     assert isinstance(hwfoc.DEFAULT_POLE_PAIRS, int)
     meta = hwfoc.record_schema().metadata
-    names = ("current_scale", "pole_pairs", "gear_ratio", "v4_volts_per_step")
-    assert tuple(meta[name.encode()] for name in names) == (b"64", b"7", b"1", b"8/910")
+    names = ("current_scale", "pole_pairs", "gear_ratio")
+    assert tuple(meta[name.encode()] for name in names) == (b"64", b"7", b"1")
+    assert {k: meta[k.encode()].decode() for k in hwfoc.DEFAULT_SETTINGS} == hwfoc.DEFAULT_SETTINGS
     for f in (hwfoc.read, hwfoc.scan, hwfoc.summary, hwfoc.record_schema, hwfoc.Decoder, hwfoc.open_ports):
         params = inspect.signature(f).parameters
         got = tuple(params[name].default for name in names)
         assert got == defaults, f
     path = sim_dir / "one.bin"
-    given = hwfoc.read(path, **dict(zip(names, defaults)))
+    given = hwfoc.read(path, **dict(zip(names, defaults)), settings=hwfoc.DEFAULT_SETTINGS)
     assert given.equals(hwfoc.read(path))
 
 

@@ -41,7 +41,6 @@ use std::collections::BTreeMap;
 use std::fmt;
 use std::path::{Path, PathBuf};
 
-use hwfoc::v4::VoltsPerStep;
 use hwfoc::{Protocol, Settings};
 use hwfoc_io::InputError;
 use hwfoc_io::read_small_file;
@@ -50,6 +49,10 @@ use serde::Deserialize;
 use serde::de::{self, Deserializer, MapAccess, SeqAccess, Visitor};
 use toml::Spanned;
 use toml::de::{DeString, DeTable, DeValue};
+
+mod entry;
+
+use entry::{Entry, PortEntry};
 
 use crate::args::SettingsArgs;
 use crate::error::CliError;
@@ -89,64 +92,6 @@ pub struct File {
     pole_pairs: Option<u16>,
     gear_ratio: Option<f32>,
     record_dir: Option<PathBuf>,
-}
-
-/// Settings of every ESC, of a port's or of one ESC.
-#[derive(Debug, Default, Clone, Deserialize)]
-#[serde(deny_unknown_fields)]
-struct Entry {
-    current_scale: Option<f32>,
-    pole_pairs: Option<u16>,
-    gear_ratio: Option<f32>,
-    /// `"8/910"`, `"11/650"`, `"low"` or `"hv"`.
-    #[serde(default, deserialize_with = "volts_per_step")]
-    v4_volts_per_step: Option<VoltsPerStep>,
-    /// A name shown by the monitor (not in `[settings]`).
-    label: Option<String>,
-}
-
-/// A V4 volts-per-step setting, written as `"8/910"` (or `"low"`, `"hv"`).
-fn volts_per_step<'de, D: serde::Deserializer<'de>>(
-    d: D,
-) -> Result<Option<VoltsPerStep>, D::Error> {
-    let text = String::deserialize(d)?;
-    text.parse().map(Some).map_err(serde::de::Error::custom)
-}
-
-impl Entry {
-    fn patch(&self) -> SettingsPatch {
-        SettingsPatch {
-            current_scale: self.current_scale,
-            pole_pairs: self.pole_pairs,
-            gear_ratio: self.gear_ratio,
-            v4_volts_per_step: self.v4_volts_per_step,
-        }
-    }
-}
-
-/// An entry of the older `[[esc]]` list: a port, and settings for it.
-#[derive(Debug, Clone, Deserialize)]
-#[serde(deny_unknown_fields)]
-struct PortEntry {
-    port: String,
-    current_scale: Option<f32>,
-    pole_pairs: Option<u16>,
-    gear_ratio: Option<f32>,
-    #[serde(default, deserialize_with = "volts_per_step")]
-    v4_volts_per_step: Option<VoltsPerStep>,
-    label: Option<String>,
-}
-
-impl PortEntry {
-    fn entry(&self) -> Entry {
-        Entry {
-            current_scale: self.current_scale,
-            pole_pairs: self.pole_pairs,
-            gear_ratio: self.gear_ratio,
-            v4_volts_per_step: self.v4_volts_per_step,
-            label: self.label.clone(),
-        }
-    }
 }
 
 /// `esc`: a table of ESC indices (`[esc.3]`), or the older list of ports (`[[esc]]`).
@@ -388,7 +333,7 @@ impl Config {
             .port
             .iter()
             .map(|(p, e)| (p.as_str(), e.clone()))
-            .chain(list.iter().map(|e| (e.port.as_str(), e.entry())))
+            .chain(list.iter().map(|e| (e.port.as_str(), e.entry.clone())))
             .collect()
     }
 
@@ -418,7 +363,7 @@ impl Config {
             EscSection::Ports(list) => list
                 .iter()
                 .filter(|e| e.port == port)
-                .find_map(|e| e.label.as_deref()),
+                .find_map(|e| e.entry.label.as_deref()),
             _ => None,
         };
         from_table.or(from_list)
@@ -917,6 +862,37 @@ mod tests {
         let err = config.unwrap_err().to_string();
         assert!(err.contains("config.toml line 2"), "{err}");
         assert!(err.contains("volts per step must be N/D"), "{err}");
+    }
+
+    /// Every format's own setting is a key of every settings table, by its description's key;
+    /// an unknown key's error lists them.
+    #[test]
+    fn the_formats_settings_are_keys_of_every_table() {
+        for setting in Protocol::settings() {
+            let (key, value) = (setting.key, setting.default);
+            let text = format!(
+                "[settings]\n{key} = \"{value}\"\n[port.\"p\"]\n{key} = \"{value}\"\n\
+                 [esc.1]\n{key} = \"{value}\"\n"
+            );
+            let (_dir, config) = load(&text);
+            let map = config.unwrap().settings_map(&flags(None)).unwrap();
+            assert_eq!(map.get(1, "p"), Settings::DEFAULT, "{key}");
+            let (_dir, config) = load(&format!("[[esc]]\nport = \"p\"\n{key} = \"{value}\"\n"));
+            let map = config.unwrap().settings_map(&flags(None)).unwrap();
+            assert_eq!(map.get(0, "p"), Settings::DEFAULT, "{key}");
+        }
+        let (_dir, config) = load("[esc.1]\nv4_volts = \"hv\"\n");
+        let err = config.unwrap_err().to_string();
+        assert!(
+            err.contains("config.toml line 2: unknown field `v4_volts`"),
+            "{err}"
+        );
+        for setting in Protocol::settings() {
+            assert!(err.contains(&format!("`{}`", setting.key)), "{err}");
+        }
+        let (_dir, config) = load("[[esc]]\nv4_volts_per_step = \"hv\"\n");
+        let err = config.unwrap_err().to_string();
+        assert!(err.contains("missing field `port`"), "{err}");
     }
 
     #[test]
