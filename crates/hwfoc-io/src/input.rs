@@ -11,7 +11,7 @@ use std::io::{self, BufReader, Read};
 use std::sync::Arc;
 use std::sync::atomic::AtomicBool;
 
-use hwfoc_records::{BlockRead, ReadAt, RegularFile, Reopen};
+use hwfoc_records::{Beside, BlockRead, ReadAt, RegularFile, Reopen};
 pub(crate) use hwfoc_records::{Input, InputError};
 
 use crate::serial::PortSet;
@@ -143,6 +143,26 @@ impl ReadAt for Second {
 
     fn try_clone(&self) -> Option<Box<dyn ReadAt>> {
         Some(Box::new(Second(self.0.try_clone().ok()?)))
+    }
+
+    fn read_beside(
+        self: Box<Self>,
+        work: Box<dyn FnOnce(Box<dyn ReadAt>) + Send>,
+    ) -> Option<Box<dyn Beside>> {
+        let thread = std::thread::Builder::new()
+            .name("hwfoc-later-half".into())
+            .spawn(move || work(self))
+            .ok()?;
+        Some(Box::new(Thread(thread)))
+    }
+}
+
+/// A thread reading a later half.
+struct Thread(std::thread::JoinHandle<()>);
+
+impl Beside for Thread {
+    fn join(self: Box<Self>) {
+        let _ = self.0.join();
     }
 }
 
