@@ -4,7 +4,6 @@
 //! positions for a later half; serial ports are read by `ports.rs`.
 
 mod ahead;
-mod ports;
 
 use std::fs::File;
 use std::io::{self, BufReader, Read};
@@ -17,7 +16,7 @@ pub(crate) use hwfoc_records::{Input, InputError};
 use crate::serial::PortSet;
 
 use self::ahead::ReadAhead;
-use self::ports::Ports;
+use hwfoc_ports::Ports;
 
 /// Opening an [`Input`] of a file, standard input or serial ports.
 pub trait OpenInput: Sized {
