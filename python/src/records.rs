@@ -2,8 +2,10 @@
 //! nullability, units of docs/RECORD-SCHEMA.md, from the column table), each column's array made at
 //! once from a block of frames.
 
-use arrow_array::{RecordBatch, new_null_array};
-use arrow_schema::SchemaRef;
+use arrow_array::{ArrayRef, RecordBatch, make_array, new_null_array};
+use arrow_buffer::{Buffer, NullBuffer};
+use arrow_data::ArrayData;
+use arrow_schema::{DataType, SchemaRef};
 use hwfoc::Settings;
 use hwfoc::foc::DataFrame;
 use hwfoc::telemetry::{Data, Frame};
@@ -14,64 +16,84 @@ use hwfoc_io::record::{Column, Visitor, columns};
 use hwfoc_io::write::arrow::ArrowValue;
 
 /// Data frames as received, column by column: what a batch is made from.
+///
+/// A raw input's frames are HW-FOC frames without receive times: while every frame of the
+/// block is, the frames are kept as the codec's (`hwfoc`, a copy of the decoder's runs) and no
+/// time is stored, so that each column is converted straight from the fields (issue 31).
 #[derive(Debug, Default)]
 pub struct Frames {
-    /// Receive time of each frame's first byte; NaN where the input has no times (a receive
-    /// time is never NaN).
-    pub t: Vec<f64>,
-    /// Whether any frame has a time.
-    pub timed: bool,
+    /// Receive time of each frame's first byte, NaN where the frame has none (a receive time
+    /// is never NaN); empty while no frame has a time.
+    t: Vec<f64>,
     /// ESC of each frame.
-    pub esc: Vec<u8>,
-    /// The frames.
-    pub frames: Vec<Data>,
+    esc: Vec<u8>,
+    /// The frames while all are HW-FOC (then `frames` is empty).
+    hwfoc: Vec<DataFrame>,
+    /// The frames once one is not HW-FOC (then `hwfoc` is empty).
+    frames: Vec<Data>,
 }
 
 impl Frames {
-    /// Room for `n` frames.
+    /// Room for `n` frames (of HW-FOC without times: other frames' room is made when they come).
     pub fn with_capacity(n: usize) -> Frames {
         Frames {
-            t: Vec::with_capacity(n),
-            timed: false,
             esc: Vec::with_capacity(n),
-            frames: Vec::with_capacity(n),
+            hwfoc: Vec::with_capacity(n),
+            ..Frames::default()
         }
     }
 
     /// Adds a frame.
     #[inline]
     pub fn push(&mut self, t: Option<f64>, esc: u8, frame: &Data) {
-        self.timed |= t.is_some();
-        self.t.push(t.unwrap_or(f64::NAN));
+        if let Some(t) = t {
+            // The frames before had no time.
+            self.t.resize(self.len(), f64::NAN);
+            self.t.push(t);
+        } else if !self.t.is_empty() {
+            self.t.push(f64::NAN);
+        }
         self.esc.push(esc);
-        self.frames.push(*frame);
+        match frame {
+            Data::HwFoc(f) if self.frames.is_empty() => self.hwfoc.push(*f),
+            _ => {
+                self.frames.extend(self.hwfoc.drain(..).map(Data::HwFoc));
+                self.frames.push(*frame);
+            }
+        }
     }
 
     /// Adds HW-FOC frames of ESC `esc` without receive times (a raw input's run).
     #[inline]
     pub fn extend_untimed(&mut self, esc: u8, frames: &[DataFrame]) {
         let n = self.len() + frames.len();
-        self.t.resize(n, f64::NAN);
+        if !self.t.is_empty() {
+            self.t.resize(n, f64::NAN);
+        }
         self.esc.resize(n, esc);
-        self.frames.extend(frames.iter().map(|&f| Data::HwFoc(f)));
+        if self.frames.is_empty() {
+            self.hwfoc.extend_from_slice(frames);
+        } else {
+            self.frames.extend(frames.iter().map(|&f| Data::HwFoc(f)));
+        }
     }
 
     /// Empties it, keeping its room (a buffer used again is not faulted in again).
     pub fn clear(&mut self) {
         self.t.clear();
         self.esc.clear();
+        self.hwfoc.clear();
         self.frames.clear();
-        self.timed = false;
     }
 
     /// Number of frames.
     pub fn len(&self) -> usize {
-        self.frames.len()
+        self.esc.len()
     }
 
     /// Whether there are none.
     pub fn is_empty(&self) -> bool {
-        self.frames.is_empty()
+        self.esc.is_empty()
     }
 
     /// The record batch of these frames under `settings`, with schema `schema` (the record
@@ -88,57 +110,125 @@ impl Frames {
         schema: SchemaRef,
         settings: &Settings,
     ) -> RecordBatch {
-        struct Arrays<'a> {
-            frames: &'a Frames,
-            rows: std::ops::Range<usize>,
-            settings: &'a Settings,
-            /// Whether every frame of `rows` is HW-FOC (looked at once, not per column).
-            hwfoc_only: bool,
-            arrays: Vec<arrow_array::ArrayRef>,
-        }
-        impl Visitor for Arrays<'_> {
-            fn column<C: Column>(&mut self) {
-                let f = self.frames;
-                let s = self.settings;
-                let rows = self.rows.clone();
-                // Without times `t_s` is all null: an array of nulls is zeroed memory the
-                // allocator hands out untouched, not a value written per row.
-                if C::NAME == "t_s" && !f.timed {
-                    let nulls = new_null_array(&<C::Value as ArrowValue>::data_type(), rows.len());
-                    self.arrays.push(nulls);
-                    return;
-                }
-                let (t, esc, frames) = (&f.t[rows.clone()], &f.esc[rows.clone()], &f.frames[rows]);
-                let rows = t.iter().zip(esc).zip(frames);
-                let array = if self.hwfoc_only {
-                    // HW-FOC frames only (a raw file's): each value read by field, without a
-                    // match on the protocol per value (as the Parquet export reads them).
-                    <C::Value as ArrowValue>::array(rows.map(|((&t, &esc), frame)| {
-                        let frame = Data::HwFoc(frame.to_hwfoc().unwrap_or_default());
-                        C::from_frame((!t.is_nan()).then_some(t), esc, &frame, s)
-                    }))
-                } else {
-                    <C::Value as ArrowValue>::array(rows.map(|((&t, &esc), frame)| {
-                        C::from_frame((!t.is_nan()).then_some(t), esc, frame, s)
-                    }))
-                };
-                self.arrays.push(array);
-            }
-        }
-        let hwfoc_only = self.frames[rows.clone()]
-            .iter()
-            .all(|f| matches!(f, Data::HwFoc(_)));
+        let esc = &self.esc[rows.clone()];
+        let times = (!self.t.is_empty()).then(|| &self.t[rows.clone()]);
         let mut arrays = Arrays {
-            frames: self,
-            hwfoc_only,
-            rows,
             settings,
             arrays: Vec::with_capacity(columns::COUNT),
         };
-        columns::visit(&mut arrays);
+        // HW-FOC frames (a raw file's) are converted as such: each value read by field, without
+        // a match on the protocol per value (as the Parquet export reads them).
+        if self.frames.is_empty() {
+            let frames = self.hwfoc[rows].iter().map(|&f| Data::HwFoc(f));
+            match times {
+                None => arrays.visit(Untimed(esc.len()), esc, frames),
+                Some(t) => arrays.visit(Timed(t), esc, frames),
+            }
+        } else {
+            let frames = self.frames[rows].iter().copied();
+            match times {
+                None => arrays.visit(Untimed(esc.len()), esc, frames),
+                Some(t) => arrays.visit(Timed(t), esc, frames),
+            }
+        }
         // Each array has its field's type and nullability (both come from the column's value
         // type, as in `hwfoc_io::write::arrow`), and all have the same length.
         RecordBatch::try_new(schema, arrays.arrays).expect("the arrays follow the schema")
+    }
+}
+
+/// The receive times of a block's rows, as an iterator of them.
+trait Times: Copy {
+    /// The times, `None` where a frame has none.
+    fn times(self) -> impl ExactSizeIterator<Item = Option<f64>> + Clone;
+}
+
+/// Rows without times (that many).
+#[derive(Clone, Copy)]
+struct Untimed(usize);
+
+impl Times for Untimed {
+    #[inline(always)]
+    fn times(self) -> impl ExactSizeIterator<Item = Option<f64>> + Clone {
+        std::iter::repeat_n(None, self.0)
+    }
+}
+
+/// Rows with the times of a slice (NaN: none).
+#[derive(Clone, Copy)]
+struct Timed<'a>(&'a [f64]);
+
+impl Times for Timed<'_> {
+    #[inline(always)]
+    fn times(self) -> impl ExactSizeIterator<Item = Option<f64>> + Clone {
+        self.0.iter().map(|&t| (!t.is_nan()).then_some(t))
+    }
+}
+
+/// An array of `len` nulls of type `data_type` whose values are zeroed memory the allocator hands
+/// out untouched (fresh pages, not faulted in unless read): `new_null_array` writes its zeros,
+/// since a buffer aligned to 64 bytes is not `calloc`'s (half a table of HW-FOC frames is such
+/// columns: the system time of its fresh pages).
+fn null_array(data_type: &DataType, len: usize) -> ArrayRef {
+    let Some(width) = data_type.primitive_width() else {
+        return new_null_array(data_type, len);
+    };
+    // Words of 8 bytes: aligned for every primitive type, and within `calloc`'s alignment.
+    let values = Buffer::from_vec(vec![0u64; (len * width).div_ceil(8)]);
+    let data = ArrayData::builder(data_type.clone())
+        .len(len)
+        .add_buffer(values)
+        .nulls(Some(NullBuffer::new_null(len)))
+        .build()
+        .expect("zeroed values of the type's width, all null");
+    make_array(data)
+}
+
+/// The arrays of a batch, made a column at a time.
+struct Arrays<'a> {
+    settings: &'a Settings,
+    arrays: Vec<ArrayRef>,
+}
+
+impl Arrays<'_> {
+    /// Every column's array of rows of times `t`, ESCs `esc` and frames `frames`.
+    fn visit<T, F>(&mut self, t: T, esc: &[u8], frames: F)
+    where
+        T: Times,
+        F: ExactSizeIterator<Item = Data> + Clone,
+    {
+        struct Columns<'a, 'b, T, F> {
+            arrays: &'a mut Arrays<'b>,
+            t: T,
+            esc: &'a [u8],
+            frames: F,
+        }
+        impl<T: Times, F: ExactSizeIterator<Item = Data> + Clone> Visitor for Columns<'_, '_, T, F> {
+            fn column<C: Column>(&mut self) {
+                let s = self.arrays.settings;
+                let values = self
+                    .t
+                    .times()
+                    .zip(self.esc)
+                    .zip(self.frames.clone())
+                    .map(|((t, &esc), frame)| C::from_frame(t, esc, &frame, s));
+                // A column null in every row (`t_s` of a raw file, HW5's quantities in HW-FOC)
+                // is made without a value written per row. Where the frames cannot carry the
+                // value, this check is no work at all.
+                let array = if C::NULLABLE && values.clone().all(|v| v.is_null()) {
+                    null_array(&<C::Value as ArrowValue>::data_type(), values.len())
+                } else {
+                    <C::Value as ArrowValue>::array(values)
+                };
+                self.arrays.arrays.push(array);
+            }
+        }
+        columns::visit(&mut Columns {
+            arrays: self,
+            t,
+            esc,
+            frames,
+        });
     }
 }
 

@@ -434,6 +434,21 @@ def test_a_forced_protocol_reads_its_frames_only(mixed):
     assert decoder.stats["bytes_skipped"] == len(first) + len(last)
 
 
+def test_esc_frames_then_hub_frames_in_one_block_are_the_commands(cli, mixed, tmp_path):
+    # A raw ESC input's frames are kept as HW-FOC frames until another protocol's frame comes
+    # into the same block of rows: then all of the block is converted frame by frame.
+    first, hub, last, whole = mixed
+    files = [tmp_path / "a.bin", tmp_path / "hub.bin", tmp_path / "b.bin"]
+    for path, data in zip(files, (first, hub, last)):
+        path.write_bytes(data)
+    table = hwfoc.read(files)
+    assert set(table.column("protocol").to_pylist()) == {"hw-foc", "datalink"}
+    assert_same_records(table, cli_records(cli, *files))
+    # The same in one input: ESC frames, then the hub's, then ESC frames again.
+    (tmp_path / "whole.bin").write_bytes(whole)
+    assert_same_records(hwfoc.read(whole), cli_records(cli, tmp_path / "whole.bin"))
+
+
 def test_a_forced_protocol_that_finds_nothing_warns_with_its_advice(mixed):
     first = mixed[0]
     # Its bytes are HW-FOC frames: the warning says so, not the baud rate and the wiring.

@@ -515,10 +515,10 @@ fn a_late_get_esc_id_answer_numbers_its_node_for_the_whole_file() {
     let escs: Vec<u64> = got.iter().map(|r| r["esc"].as_u64().unwrap()).collect();
     assert_eq!(escs, [3, 3, 3]);
     assert!(got.iter().all(|r| r["node"] == 7));
-    // Not read ahead (standard input, as live): the node keeps the number it was first heard
-    // at, its node id.
+    // Not read ahead (standard input, as live): the node's records are held until its answer
+    // (within 1 s), so they get the file's number too.
     let (pairs, ..) = decode_stdin(&text);
-    assert_eq!(pairs, [(7, 7); 3]);
+    assert_eq!(pairs, [(7, 3); 3]);
 }
 
 /// A candump log line of `frame` at `t` seconds on `interface`.

@@ -229,3 +229,34 @@ fn the_dissectors_ntc_formula_has_the_codecs_constants() {
     let t = hwfoc::v4::ntc_celsius(3377).unwrap();
     assert!((t - 25.0).abs() < 0.05, "{t}");
 }
+
+/// The value of the Lua constant `local NAME = VALUE` (an integer).
+fn lua_constant(lua: &str, name: &str) -> u64 {
+    let start = lua
+        .find(&format!("local {name} = "))
+        .unwrap_or_else(|| panic!("hwfoc.lua has no constant {name}"));
+    let rest = &lua[start + format!("local {name} = ").len()..];
+    let value = rest.split_whitespace().next().unwrap();
+    value
+        .parse()
+        .unwrap_or_else(|e| panic!("hwfoc.lua: {name} = {value}: {e}"))
+}
+
+/// The physical ranges past which the codec rejects a frame whose checksum matched (issue 29):
+/// the dissector rejects the same frames by the same limits.
+#[test]
+fn the_plausibility_ranges_are_the_codecs() {
+    let lua = dissector();
+    assert_eq!(
+        lua_constant(&lua, "FOC_THROTTLE_MAX_RAW"),
+        u64::from(hwfoc::foc::THROTTLE_MAX_RAW)
+    );
+    assert_eq!(
+        lua_constant(&lua, "HW5_THROTTLE_MAX_PCT"),
+        u64::from(hwfoc::hw5::THROTTLE_MAX_PCT)
+    );
+    assert_eq!(
+        lua_constant(&lua, "HW5_VOLTAGE_MAX_RAW"),
+        u64::from(hwfoc::hw5::VOLTAGE_MAX_RAW)
+    );
+}

@@ -904,15 +904,14 @@ fn an_hw5_esc_is_found_at_115200_and_shown_with_its_own_fields() {
 }
 
 /// A simulated CAN bus of three Hobbywing ESCs (nodes 10, 11, 12 on throttle channels 1, 2, 3)
-/// watched by `monitor slcan:PTY --json`: node 11, ESC 1 (or ESC 11 when first heard before
-/// its GetEscID answer: numbered by its node id live), wears the label of its number and no
-/// other ESC does, whichever node was heard first.
+/// watched by `monitor slcan:PTY --json`: every status line, from the first, numbers node n as
+/// ESC n - 10, as `decode` of the bus recorded does (a node heard before its GetEscID answer is
+/// held until it answers), and `[esc.1]`'s label is on ESC 1 only.
 #[test]
-fn can_escs_are_labelled_by_their_esc_number() {
+fn live_can_escs_are_numbered_as_decode_numbers_them_and_labelled_by_number() {
     let dir = tempfile::tempdir().unwrap();
     let config = dir.path().join("monitor.toml");
-    let labels = "[esc.1]\nlabel = \"left\"\n\n[esc.11]\nlabel = \"left\"\n";
-    std::fs::write(&config, labels).unwrap();
+    std::fs::write(&config, "[esc.1]\nlabel = \"left\"\n").unwrap();
     let sim = Running::start(&["simulate", "--protocol", "hw-can", "--escs", "3", "--pty"]);
     let line = sim.wait_for_stdout("slcan: ", Duration::from_secs(20));
     let bus = format!("slcan:{}", line.trim_start_matches("slcan: ").trim());
@@ -936,6 +935,7 @@ fn can_escs_are_labelled_by_their_esc_number() {
         let v: Value = serde_json::from_str(&l).unwrap_or_else(|e| panic!("{e}: {l}"));
         if v["type"] == "status" && v["record"].is_object() {
             let node = v["record"]["node"].as_u64().unwrap();
+            assert_eq!(v["esc"].as_u64(), Some(node - 10), "{l}");
             let expected = if node == 11 {
                 "left".into()
             } else {
@@ -945,5 +945,5 @@ fn can_escs_are_labelled_by_their_esc_number() {
             nodes.insert(node);
         }
     }
-    assert!(nodes.contains(&11), "node 11 unheard: {nodes:?}");
+    assert_eq!(nodes.into_iter().collect::<Vec<_>>(), [10, 11, 12]);
 }

@@ -1780,3 +1780,134 @@ fn garbage_can_frames_do_not_make_the_dissector_fail() {
         random.len()
     );
 }
+
+/// 24 nodes sending `esc.Status` at once (issue 29): each round the first frames of all 24
+/// transfers, then their second frames, then their third, 20 rounds. `decode` gives all 480
+/// records, node by node as the dissector reassembles them (all 480 transfers, each CRC ok).
+#[test]
+#[ignore = "needs tshark: .ci/run installs it and runs these with --ignored"]
+fn twenty_four_nodes_sending_esc_status_at_once_decode_as_they_dissect() {
+    use hwfoc::dronecan::{EscStatus, Message};
+    use std::collections::BTreeMap;
+    need_tshark();
+    const NODES: u8 = 24;
+    const ROUNDS: u8 = 20;
+    let mut records: Vec<Vec<u8>> = Vec::new();
+    for round in 0..ROUNDS {
+        let transfers: Vec<Vec<_>> = (1..=NODES)
+            .map(|node| {
+                let status = EscStatus {
+                    error_count: 0,
+                    voltage: 24.0,
+                    current: 1.5,
+                    temperature: 300.0,
+                    rpm: 1000 + i32::from(round),
+                    power_rating_pct: 10,
+                    esc_index: node - 1,
+                };
+                Message::from(status)
+                    .frames(16, node, 0, round % 32)
+                    .collect()
+            })
+            .collect();
+        assert!(
+            transfers[0].len() > 1,
+            "esc.Status is a multi-frame transfer"
+        );
+        for k in 0..transfers[0].len() {
+            for t in &transfers {
+                records.push(t[k].to_socketcan_record().to_vec());
+            }
+        }
+    }
+    let dir = common::Dir::new();
+    let file = dir.path("24-nodes.pcapng");
+    can_pcapng(&file, &records);
+    let mut decoded: BTreeMap<u64, usize> = BTreeMap::new();
+    for r in decode(&file, &[]) {
+        *decoded.entry(r["node"].as_u64().unwrap()).or_default() += 1;
+    }
+    let fields = [
+        "dronecan.source",
+        "dronecan.esc.status.esc_index",
+        "dronecan.crc.status",
+    ];
+    let (rows, _) = tshark_can(&file, &fields);
+    assert_eq!(rows.len(), records.len());
+    let mut shown: BTreeMap<u64, usize> = BTreeMap::new();
+    for row in rows.iter().filter(|r| !r[1].is_empty()) {
+        assert_eq!(row[2], "1", "CRC of a reassembled transfer: {row:?}");
+        *shown.entry(row[0].parse().unwrap()).or_default() += 1;
+    }
+    let all: BTreeMap<u64, usize> = (1..=u64::from(NODES))
+        .map(|n| (n, usize::from(ROUNDS)))
+        .collect();
+    assert_eq!(shown, all, "the dissector's transfers by node");
+    assert_eq!(decoded, all, "decode's records by node");
+}
+
+/// A frame whose checksum matches but whose value is past its protocol's range (an HW-FOC
+/// input throttle of raw 16890, 1649 %; an HW5 input voltage of 506.1 V) is shown rejected, with
+/// the value named, as `decode` rejects it; the frames around it are shown and decoded.
+#[test]
+#[ignore = "needs tshark: .ci/run installs it and runs these with --ignored"]
+fn a_frame_past_its_range_is_rejected_as_decode_rejects_it() {
+    need_tshark();
+    let dir = common::Dir::new();
+    let foc: Vec<u8> = (0..20u16)
+        .flat_map(|packet| {
+            DataFrame {
+                packet,
+                throttle_in_raw: if packet == 10 { 16890 } else { 300 },
+                voltage_raw: 247,
+                ..Default::default()
+            }
+            .encode()
+        })
+        .collect();
+    let hw5: Vec<u8> = (0..20u16)
+        .flat_map(|n| {
+            hwfoc::hw5::TelemetryFrame {
+                throttle: 20,
+                erpm_raw: 1000 + n,
+                voltage_raw: if n == 10 { 5061 } else { 504 },
+                ..Default::default()
+            }
+            .encode()
+        })
+        .collect();
+    for (name, baud, bytes) in [("foc.pcapng", 19200, foc), ("hw5.pcapng", 115200, hw5)] {
+        let file = dir.path(name);
+        let timed: Vec<(f64, u8)> = bytes
+            .iter()
+            .enumerate()
+            .map(|(i, &b)| (i as f64 * 1e-4, b))
+            .collect();
+        record_reads(&file, baud, 1_700_000_000_000_000_000, &timed, 7);
+        assert_eq!(decode(&file, &[]).len(), 19, "{name}: decoded");
+        let mut cmd = common::tshark();
+        cmd.arg("-X")
+            .arg(format!("lua_script:{}", dissector().display()))
+            .arg("-r")
+            .arg(&file)
+            .arg("-V");
+        let out = cmd.output().expect("tshark");
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let text = String::from_utf8(out.stdout).unwrap();
+        let invalid = text.matches("[invalid, not decoded by hwfoc]").count();
+        assert_eq!(invalid, 1, "{name}: {text}");
+        let named = if baud == 19200 {
+            "input throttle 16890 over 1024"
+        } else {
+            "input voltage 5061 over 1000"
+        };
+        assert!(
+            text.contains(&format!("Out of range: {named}")),
+            "{name}: {text}"
+        );
+    }
+}

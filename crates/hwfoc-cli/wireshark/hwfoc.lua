@@ -94,6 +94,13 @@ local V4_TRAILER = { len = 1, name = "Platinum V4 data frame trailer", proto = "
 local V3_DATA = { len = 10, name = "Platinum V3 frame", proto = "hw-v3", kind = "data" }
 local HW5_TELEMETRY = { len = 32, name = "HW5 telemetry frame", proto = "hw5", kind = "data" }
 local HW5_HEADER = { 0xFE, 0x01, 0x00, 0x03, 0x30, 0x5C, 0x17 }
+-- The physical ranges the codec allows (a frame whose checksum matches with a value past them is
+-- rejected, as a bad checksum is: the codec's hwfoc::foc::THROTTLE_MAX_RAW,
+-- hwfoc::hw5::THROTTLE_MAX_PCT and hwfoc::hw5::VOLTAGE_MAX_RAW; tests/dissector_tables.rs keeps
+-- them equal).
+local FOC_THROTTLE_MAX_RAW = 1024
+local HW5_THROTTLE_MAX_PCT = 100
+local HW5_VOLTAGE_MAX_RAW = 1000
 local TITLES = { ["hw-foc"] = "HW-FOC", ["hw-v4"] = "HW-V4", ["hw-v3"] = "HW-V3", hw5 = "HW5" }
 
 -- Status bits, bit 0 = least significant bit of the low byte (docs/PROTOCOL-NOTES.md).
@@ -259,6 +266,9 @@ local ef = {
         expert.group.MALFORMED, expert.severity.ERROR),
     temp_range = ProtoExpert.new("hwfoc.temp.out_of_range", "Temperature out of the ADC table",
         expert.group.SEQUENCE, expert.severity.NOTE),
+    out_of_range = ProtoExpert.new("hwfoc.value.out_of_range",
+        "Value past the protocol's range: rejected by hwfoc", expert.group.MALFORMED,
+        expert.severity.ERROR),
     noise = ProtoExpert.new("hwfoc.noise.expert", "Line noise", expert.group.SEQUENCE,
         expert.severity.NOTE),
     partial = ProtoExpert.new("hwfoc.partial.expert", "Frame cut by the end of the packet",
@@ -270,7 +280,7 @@ local ef = {
         expert.severity.CHAT),
 }
 hwfoc.experts = { ef.fault, ef.bad_checksum, ef.bad_header, ef.not_ascii, ef.temp_range, ef.noise,
-    ef.partial, ef.cut, ef.reassembled }
+    ef.partial, ef.cut, ef.reassembled, ef.out_of_range }
 
 hwfoc.prefs.pole_pairs = Pref.uint("Pole pairs", 7, "Motor pole pairs (magnets / 2), for RPM")
 hwfoc.prefs.gear_ratio = Pref.string("Gear ratio", "1",
@@ -315,6 +325,32 @@ local function sum(s, from, to) -- bytes from..to-1 (0-based)
     return total
 end
 
+-- The first value of the HW-FOC data frame at `i` (whole) past its range, as "name raw max",
+-- or nil: the throttles (big-endian, bytes 6 and 8) up to FOC_THROTTLE_MAX_RAW.
+local function foc_out_of_range(s, i)
+    for _, t in ipairs({ { 6, "input throttle" }, { 8, "output throttle" } }) do
+        local raw = s:byte(i + t[1] + 1) * 256 + s:byte(i + t[1] + 2)
+        if raw > FOC_THROTTLE_MAX_RAW then
+            return string.format("%s %d over %d", t[2], raw, FOC_THROTTLE_MAX_RAW)
+        end
+    end
+    return nil
+end
+
+-- The first value of the HW5 telemetry frame at `i` (whole) past its range, or nil: the
+-- throttle (byte 9, percent) and the input voltage (bytes 15-16, 0.1 V), as the codec checks.
+local function hw5_out_of_range(s, i)
+    local throttle = s:byte(i + 10)
+    if throttle > HW5_THROTTLE_MAX_PCT then
+        return string.format("throttle %d over %d", throttle, HW5_THROTTLE_MAX_PCT)
+    end
+    local volts = s:byte(i + 16) + s:byte(i + 17) * 256
+    if volts > HW5_VOLTAGE_MAX_RAW then
+        return string.format("input voltage %d over %d", volts, HW5_VOLTAGE_MAX_RAW)
+    end
+    return nil
+end
+
 -- Whether a frame may start at `i` of `s` (n bytes): returns the kind and "good" or "bad" once
 -- its bytes decide, "undecided" while the bytes there begin a frame the bytes still to come may
 -- complete, or nil when no frame starts there. The rule is the hwfoc decoder's: a sync byte, a
@@ -344,6 +380,7 @@ local function candidate(s, n, i)
     local good
     if kind.len == DATA_LEN then
         good = sum(s, i, i + 22) % 65536 == s:byte(i + 23) + s:byte(i + 24) * 256
+            and foc_out_of_range(s, i) == nil
     else
         good = sum(s, i, i + 76) % 256 == s:byte(i + 77)
     end
@@ -389,6 +426,7 @@ local function hw5_candidate(s, n, i)
     end
     if n - i < HW5_TELEMETRY.len then return HW5_TELEMETRY, "undecided" end
     local good = crc16_modbus(s, i, i + 30) == s:byte(i + 31) + s:byte(i + 32) * 256
+        and hw5_out_of_range(s, i) == nil
     return HW5_TELEMETRY, good and "good" or "bad"
 end
 
@@ -850,6 +888,11 @@ local function other_frame(item, r, tree, when)
                 "Bad CRC: 0x%X carried, 0x%X computed", carried, computed))
         else
             check:append_text(" [correct]")
+            local range = hw5_out_of_range(r:raw(), 0)
+            if range then
+                subtree:add_proto_expert_info(ef.out_of_range, "Out of range: " .. range ..
+                    " (rejected by hwfoc, CRC notwithstanding)")
+            end
         end
     else
         subtree:add(f.no_checksum, r, "none (" .. TITLES[kind.proto] .. " frames carry none: " ..
@@ -911,6 +954,11 @@ local function frame(item, r, tree, pinfo, when)
             "Bad checksum: 0x%X carried, 0x%X computed", carried, computed))
     else
         check:append_text(" [correct]")
+        local range = len == DATA_LEN and foc_out_of_range(r:raw(), 0)
+        if range then
+            subtree:add_proto_expert_info(ef.out_of_range, "Out of range: " .. range ..
+                " (rejected by hwfoc, checksum notwithstanding)")
+        end
     end
     if good then
         subtree:append_text(": " .. summary)

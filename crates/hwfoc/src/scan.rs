@@ -535,6 +535,119 @@ impl<S: Scanner> Iterator for Scan<'_, S> {
     fn next(&mut self) -> Option<S::Item> {
         S::scan_next(self.data, &mut self.pos, &mut self.stats)
     }
+
+    /// The rest of the stream in one run of the scanner, as [`StreamDecoder`] runs it: the
+    /// position and statistics stay in registers from frame to frame, where [`Iterator::next`]
+    /// stores them in the iterator after each frame. So `fold` and what is built on it
+    /// (`for_each`, `count`, `sum`, `last`...) decode faster than a `for` loop: the same
+    /// frames, the same statistics (the scan stops after a frame, every byte before it decided,
+    /// as a streaming decoder fed the rest in one chunk and flushed would).
+    #[inline]
+    fn fold<B, F: FnMut(B, S::Item) -> B>(mut self, init: B, mut f: F) -> B {
+        let rest = self.data.get(self.pos..).unwrap_or_default();
+        let mut acc = Some(init);
+        S::scan_all::<true>(rest, self.pos as u64, &mut self.stats, &mut |item| {
+            acc = acc.take().map(|a| f(a, item));
+        });
+        // Taken and put back for each frame: never left empty.
+        acc.unwrap_or_else(|| unreachable!("the fold's accumulator is put back after each frame"))
+    }
 }
 
 impl<S: Scanner> core::iter::FusedIterator for Scan<'_, S> {}
+
+#[cfg(test)]
+mod tests {
+    extern crate std;
+    use std::vec::Vec;
+
+    use crate::foc::{DataFrame, InfoFrame};
+    use crate::scan::{Scan, Scanner};
+    use crate::wire::SYNC;
+    use crate::{datalink, foc, v3};
+
+    /// A stream of `frame(i)`s among garbage dense in sync bytes, `header`s, flipped bits and
+    /// cut frames, from the seed `x`.
+    fn noisy(mut x: u64, header: &[u8], frame: impl Fn(u32) -> Vec<u8>) -> Vec<u8> {
+        let mut next = || {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            x
+        };
+        let mut out = Vec::new();
+        for i in 0..300 {
+            for _ in 0..next() % 4 * (next() % 9) {
+                match next() % 6 {
+                    0 => out.push(SYNC),
+                    1 => out.extend_from_slice(header),
+                    _ => out.push(next() as u8),
+                }
+            }
+            let mut f = frame(i);
+            match next() % 12 {
+                0 => f.truncate(1 + next() as usize % (f.len() - 1)),
+                1 => {
+                    let bit = next() as usize % (f.len() * 8);
+                    f[bit / 8] ^= 1 << (bit % 8);
+                }
+                _ => {}
+            }
+            out.extend_from_slice(&f);
+        }
+        out
+    }
+
+    /// `fold` over the rest of a scan, after `k` frames taken by `next`, gives the frames that
+    /// `next` gives, for every `k`.
+    fn assert_fold_is_next<S: Scanner>(stream: &[u8])
+    where
+        S::Item: PartialEq + core::fmt::Debug,
+    {
+        let items: Vec<S::Item> = Scan::<S>::new(stream).collect();
+        assert!(items.len() > 50, "{} frames", items.len());
+        for k in [0, 1, 2, items.len() / 3, items.len() - 1, items.len()] {
+            let mut scan = Scan::<S>::new(stream);
+            let head: Vec<S::Item> = scan.by_ref().take(k).collect();
+            let folded = scan.fold(head, |mut v, item| {
+                v.push(item);
+                v
+            });
+            assert_eq!(folded, items, "after {k} frames");
+        }
+    }
+
+    #[test]
+    fn fold_gives_what_next_gives() {
+        let info = InfoFrame::new("XR_FOC_ESC", "HW1", "FW2", "ID").map(|i| i.encode().to_vec());
+        let info = info.unwrap_or_default();
+        let foc_stream = noisy(0x9B16_0102, &[SYNC, 0x16, 0x01, 0x02], |i| {
+            if i % 20 == 19 {
+                info.clone()
+            } else {
+                let packet = i as u16;
+                DataFrame {
+                    packet,
+                    ..Default::default()
+                }
+                .encode()
+                .to_vec()
+            }
+        });
+        assert_fold_is_next::<foc::Scanner>(&foc_stream);
+        let hub = noisy(0x9B9E_0102, &[SYNC, 0x9E, 0x01, 0x02], |i| {
+            datalink::Frame::new(i as u16).encode().to_vec()
+        });
+        assert_fold_is_next::<datalink::Scanner>(&hub);
+        let older = noisy(0x9B00_0003, &[SYNC], |i| {
+            let counter = i + 7;
+            v3::Frame {
+                counter,
+                ..Default::default()
+            }
+            .encode()
+            .to_vec()
+        });
+        assert_fold_is_next::<v3::Scanner>(&older);
+    }
+}

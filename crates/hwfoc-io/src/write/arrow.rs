@@ -14,7 +14,7 @@ use arrow_array::types::{
     Float32Type, Float64Type, Int8Type, TimestampMicrosecondType, UInt8Type, UInt16Type, UInt32Type,
 };
 use arrow_array::{ArrayRef, DictionaryArray, ListArray, PrimitiveArray, RecordBatch, StringArray};
-use arrow_buffer::NullBuffer;
+use arrow_buffer::NullBufferBuilder;
 use arrow_schema::{DataType, Field, FieldRef, Schema, SchemaRef, TimeUnit};
 use hwfoc::telemetry::Data;
 use hwfoc::{Protocol, Settings, Status};
@@ -36,6 +36,13 @@ pub trait ArrowValue: Sized {
 
     /// An array of `values`, of type [`ArrowValue::data_type`].
     fn array(values: impl ExactSizeIterator<Item = Self>) -> ArrayRef;
+
+    /// Whether the value is null (`None`): a column whose values all are is made as an array
+    /// of nulls (`arrow_array::new_null_array`: zeroed memory, no value written).
+    #[inline(always)]
+    fn is_null(&self) -> bool {
+        false
+    }
 }
 
 /// Value types stored as an Arrow primitive, never null, and as one, nullable, in an `Option`.
@@ -62,6 +69,11 @@ macro_rules! primitive {
 
             fn array(values: impl ExactSizeIterator<Item = Self>) -> ArrayRef {
                 Arc::new(values.collect::<PrimitiveArray<$arrow>>())
+            }
+
+            #[inline(always)]
+            fn is_null(&self) -> bool {
+                self.is_none()
             }
         }
     )*};
@@ -97,6 +109,11 @@ impl ArrowValue for Option<Status> {
     fn array(values: impl ExactSizeIterator<Item = Self>) -> ArrayRef {
         Option::<u16>::array(values.map(|s| s.map(|s| s.0)))
     }
+
+    #[inline(always)]
+    fn is_null(&self) -> bool {
+        self.is_none()
+    }
 }
 
 /// The zone of the `time` column: a UTC instant, which engines show as a time with zone
@@ -115,26 +132,31 @@ impl ArrowValue for Option<UtcTime> {
             values.map(|t| t.map(|t| t.0)).collect();
         Arc::new(times.with_timezone(TIME_ZONE))
     }
+
+    #[inline(always)]
+    fn is_null(&self) -> bool {
+        self.is_none()
+    }
 }
 
 /// The fault lists of `values` (`None`: a null list), as one list array.
 ///
 /// The offsets of the lists and the names' offsets and bytes go straight into their buffers,
 /// without a builder call per row: most rows have no fault, an empty list, which is only its
-/// offset repeated; a null buffer is made only where a list is null.
+/// offset repeated; a null buffer is made only where a list is null (from the first).
 fn fault_lists(values: impl ExactSizeIterator<Item = Option<FaultList>>) -> ArrayRef {
     let mut lists = OffsetBufferBuilder::<i32>::new(values.len());
     let mut names = OffsetBufferBuilder::<i32>::new(0);
     let mut bytes: Vec<u8> = Vec::new();
-    let mut valid: Vec<bool> = Vec::new();
-    let mut any_null = false;
+    // Its bitmap is made at the first null list only.
+    let mut nulls = NullBufferBuilder::new(values.len());
     for faults in values {
-        valid.push(faults.is_some());
         let Some(faults) = faults else {
-            any_null = true;
+            nulls.append_null();
             lists.push_length(0);
             continue;
         };
+        nulls.append_non_null();
         let count = faults.0.0.count_ones() as usize;
         if count != 0 {
             for name in faults.names() {
@@ -145,12 +167,11 @@ fn fault_lists(values: impl ExactSizeIterator<Item = Option<FaultList>>) -> Arra
         lists.push_length(count);
     }
     let names = StringArray::new(names.finish(), bytes.into(), None);
-    let nulls = any_null.then(|| NullBuffer::from(valid));
     Arc::new(ListArray::new(
         fault_item(),
         lists.finish(),
         Arc::new(names),
-        nulls,
+        nulls.finish(),
     ))
 }
 
@@ -176,6 +197,11 @@ impl ArrowValue for Option<FaultList> {
     fn array(values: impl ExactSizeIterator<Item = Self>) -> ArrayRef {
         fault_lists(values)
     }
+
+    #[inline(always)]
+    fn is_null(&self) -> bool {
+        self.is_none()
+    }
 }
 
 /// The Arrow type of the `protocol` column's dictionary keys.
@@ -191,12 +217,13 @@ impl ArrowValue for Protocol {
     }
 
     fn array(values: impl ExactSizeIterator<Item = Self>) -> ArrayRef {
-        let keys = PrimitiveArray::<ProtocolKey>::from_iter_values(values.map(|p| {
-            Protocol::ALL
-                .iter()
-                .position(|&q| q == p)
-                .expect("every protocol is in Protocol::ALL") as i8
-        }));
+        // Each protocol's key (its place in `Protocol::ALL`) by its discriminant: a load per
+        // row, not a search.
+        let mut key = [0i8; Protocol::ALL.len()];
+        for (i, &p) in Protocol::ALL.iter().enumerate() {
+            key[p as usize] = i as i8;
+        }
+        let keys = PrimitiveArray::<ProtocolKey>::from_iter_values(values.map(|p| key[p as usize]));
         let names = StringArray::from_iter_values(Protocol::ALL.map(Protocol::name));
         Arc::new(
             DictionaryArray::<ProtocolKey>::try_new(keys, Arc::new(names))

@@ -15,8 +15,12 @@
 //! already, then the next after the highest slot given (two ESCs that claim one throttle
 //! channel stay two). A file's bus is read ahead ([`BusPlan`], `sources/can_plan.rs`), so that
 //! each ESC's slot is that of its place at the end of the file: a node that answers GetEscID
-//! late keeps one slot for the whole file. Live, a node keeps the slot it got first; the
-//! channel it learns later is in its records.
+//! late keeps one slot for the whole file. Live, a Hobbywing node heard before its GetEscID
+//! answer is held (its records kept back) until the answer comes, up to [`HOLD_S`] of the bus's
+//! clock ([`HOLD_FRAMES`] CAN frames without receive times, [`HOLD_RECORDS`] records at most),
+//! then its records are handed on under the slot of its channel: the slot read ahead gives it.
+//! A node that does not answer within the hold is placed by its node id, as read ahead when no
+//! answer ever comes; one that answers after that keeps the slot it got.
 
 use hwfoc::Protocol;
 use hwfoc::dronecan::{BusStats, CanFrame, Escs, NodeStats, Receiver, SOCKETCAN_RECORD_LEN};
@@ -169,6 +173,11 @@ impl BusPlan {
             .unwrap_or(0)
     }
 
+    /// Whether `key` has a slot.
+    fn has(&self, key: EscKey) -> bool {
+        self.slots.iter().any(|(c, _)| c.key == key)
+    }
+
     /// Whether no ESC was heard.
     pub(crate) fn is_empty(&self) -> bool {
         self.slots.is_empty()
@@ -184,8 +193,11 @@ pub(crate) struct BusLearner {
 
 impl BusLearner {
     pub(crate) fn new() -> BusLearner {
+        let mut wire = CanWire::new();
+        // Each record's place as it comes: nothing to wait for.
+        wire.hold = false;
         BusLearner {
-            wire: CanWire::new(),
+            wire,
             last: Vec::new(),
         }
     }
@@ -248,6 +260,26 @@ const NODES: usize = hwfoc::dronecan::NODES;
 /// stream's clock (DroneCAN's transfer timeout is 2 s).
 const EXPIRE_EVERY_S: f64 = 1.0;
 
+/// Live, how long a Hobbywing node heard before its GetEscID answer has its records held,
+/// waiting for the answer that gives its slot, seconds of the bus's clock.
+pub(crate) const HOLD_S: f64 = 1.0;
+
+/// The hold without receive times: CAN frames of the bus.
+pub(crate) const HOLD_FRAMES: u64 = 1000;
+
+/// The most records held of one node.
+pub(crate) const HOLD_RECORDS: usize = 1024;
+
+/// The records of a node waiting for its GetEscID answer, and when the wait began (the bus's
+/// clock, and its count of CAN frames).
+#[derive(Debug)]
+struct Held {
+    key: EscKey,
+    since: Option<f64>,
+    since_frame: u64,
+    records: Vec<(Option<f64>, Data)>,
+}
+
 /// Where a bus's records go: `emit(t, place, frame)`.
 pub(crate) type Emit<'a> = dyn FnMut(Option<f64>, Option<u8>, &Frame) + 'a;
 
@@ -274,6 +306,11 @@ pub(crate) struct CanWire {
     records: [u32; BUS_PLACES],
     protocol: [Option<Protocol>; NODES],
     last_expire: Option<f64>,
+    /// Whether records wait for their GetEscID answer (not when read ahead), the nodes whose
+    /// records wait, and the CAN frames heard.
+    hold: bool,
+    waiting: Vec<Held>,
+    frames: u64,
 }
 
 impl CanWire {
@@ -292,6 +329,9 @@ impl CanWire {
             records: [0; BUS_PLACES],
             protocol: [None; NODES],
             last_expire: None,
+            hold: true,
+            waiting: Vec::new(),
+            frames: 0,
         }
     }
 
@@ -331,6 +371,8 @@ impl CanWire {
             self.bad_records += 1;
             return;
         };
+        self.frames += 1;
+        self.release_expired(t, emit);
         if let Some(t) = t {
             match self.last_expire {
                 Some(last) if t - last < EXPIRE_EVERY_S && t >= last => {}
@@ -357,18 +399,84 @@ impl CanWire {
         let (Some(claim), Some(place)) = (Claim::of(&data), data.bus_index()) else {
             return;
         };
+        let waiting = self.waiting.iter().position(|h| h.key == claim.key);
+        if self.hold && claim.by_node_id && !self.plan.has(claim.key) {
+            // No slot yet, no answer yet: held until one comes or the hold runs out.
+            let i = waiting.unwrap_or_else(|| {
+                self.waiting.push(Held {
+                    key: claim.key,
+                    since: t,
+                    since_frame: self.frames,
+                    records: Vec::new(),
+                });
+                self.waiting.len() - 1
+            });
+            self.waiting[i].records.push((t, data));
+            if self.waiting[i].records.len() >= HOLD_RECORDS {
+                self.release(i, emit);
+            }
+            return;
+        }
+        if let Some(i) = waiting {
+            // The answer came in time: the records held go to its channel's slot.
+            for (t, d) in std::mem::take(&mut self.waiting.remove(i).records) {
+                self.place(claim, place, t, d, emit);
+            }
+        }
+        self.place(claim, place, t, data, emit);
+    }
+
+    /// Hands on a record of ESC `claim` at `place` under its slot.
+    fn place(&mut self, claim: Claim, place: u8, t: Option<f64>, data: Data, emit: &mut Emit<'_>) {
         let Some(slot) = self.plan.slot(claim, place) else {
             return;
         };
-        self.place_node[usize::from(slot)] = Some(node);
+        self.place_node[usize::from(slot)] = Some(claim.key.node);
         self.records[usize::from(slot)] += 1;
         emit(t, Some(slot), &Frame::Data(data));
     }
 
-    /// Ends the stream: a record cut off is counted.
-    pub(crate) fn finish(&mut self) {
+    /// Hands on the records held of the node `i` of those waiting, placed by its node id (no
+    /// answer came in time).
+    fn release(&mut self, i: usize, emit: &mut Emit<'_>) {
+        let held = self.waiting.remove(i);
+        let claim = Claim {
+            key: held.key,
+            by_node_id: true,
+        };
+        for (t, d) in held.records {
+            if let Some(place) = d.bus_index() {
+                self.place(claim, place, t, d, emit);
+            }
+        }
+    }
+
+    /// Releases the nodes whose hold ran out by the frame at `t` (or by the frames heard,
+    /// without times; a clock that stepped back ends every hold).
+    fn release_expired(&mut self, t: Option<f64>, emit: &mut Emit<'_>) {
+        let mut i = 0;
+        while i < self.waiting.len() {
+            let h = &self.waiting[i];
+            let over = match h.since.zip(t) {
+                Some((since, t)) => t - since >= HOLD_S || t < since,
+                None => self.frames - h.since_frame >= HOLD_FRAMES,
+            };
+            if over {
+                self.release(i, emit);
+            } else {
+                i += 1;
+            }
+        }
+    }
+
+    /// Ends the stream: a record cut off is counted; the records held are handed on, placed
+    /// by their node ids.
+    pub(crate) fn finish(&mut self, emit: &mut Emit<'_>) {
         self.cut_bytes += self.held_len as u64;
         self.held_len = 0;
+        while !self.waiting.is_empty() {
+            self.release(0, emit);
+        }
     }
 
     /// Every byte fed.
@@ -473,6 +581,11 @@ pub(crate) fn decode_all(bytes: &[u8], times: Option<&[f64]>) -> Vec<(Option<f64
             out.push((t, place.unwrap_or(0), *d));
         }
     });
+    wire.finish(&mut |t, place, f| {
+        if let Frame::Data(d) = f {
+            out.push((t, place.unwrap_or(0), *d));
+        }
+    });
     out
 }
 
@@ -491,11 +604,11 @@ mod tests {
         out
     }
 
-    /// Live (no plan), a node keeps the slot it was first heard at (its node id) when a
-    /// GetEscID answer maps it later (it moved to its channel's slot, a second ESC); the
-    /// channel learned is in its records.
+    /// Live (no plan), a node heard before its GetEscID answer is held until the answer maps
+    /// it: all its records go to its channel's slot; the channel learned is in its records
+    /// after the answer.
     #[test]
-    fn records_come_with_their_frame_times_and_first_slots_whatever_the_chunking() {
+    fn records_come_with_their_frame_times_and_answered_slots_whatever_the_chunking() {
         let m1 = StatusMsg1 {
             rpm: 100,
             pwm: 200,
@@ -515,8 +628,8 @@ mod tests {
         let times: Vec<f64> = (0..bytes.len()).map(|i| (i / 16) as f64 * 0.01).collect();
         let whole = decode_all(&bytes, Some(&times));
         assert_eq!(whole.len(), 2);
-        assert_eq!((whole[0].0, whole[0].1), (Some(0.01), 3));
-        assert_eq!((whole[1].0, whole[1].1), (Some(0.03), 3));
+        assert_eq!((whole[0].0, whole[0].1), (Some(0.01), 1));
+        assert_eq!((whole[1].0, whole[1].1), (Some(0.03), 1));
         let Data::HwCan(r) = whole[1].2 else { panic!() };
         assert_eq!((r.node, r.channel, r.msg2_age_ms), (3, Some(2), Some(30)));
         for chunk in [1, 5, 16, 17] {
@@ -530,12 +643,12 @@ mod tests {
                 });
             }
             assert_eq!(got, whole, "chunks of {chunk}");
-            let link = wire.link(3);
+            let link = wire.link(1);
             assert_eq!(
                 (link.node, link.channel, link.records, link.protocol),
                 (Some(3), Some(2), 2, Protocol::HwCan)
             );
-            assert_eq!(wire.link(1).records, 0);
+            assert_eq!(wire.link(3).records, 0);
         }
     }
 
@@ -619,6 +732,70 @@ mod tests {
         assert_eq!(slots, [0, 3, 0, 2]);
     }
 
+    /// Live, a node heard before its GetEscID answer is held until it answers (within
+    /// [`HOLD_S`]): every record gets the slot the file's read-ahead plan gives it; a node that
+    /// never answers is placed by its node id once the hold runs out, as read ahead.
+    #[test]
+    fn live_slots_equal_the_read_ahead_ones_when_a_node_answers_late() {
+        let m1 = StatusMsg1 {
+            rpm: 1,
+            pwm: 1,
+            status: 0,
+        };
+        let answer = |node, channel| GetEscId::new(&[node, channel]).unwrap().into();
+        let mut messages = vec![
+            (m1.into(), 10, 0),
+            (m1.into(), 10, 1),
+            (answer(11, 2), 11, 0),
+            (m1.into(), 11, 1),
+            (answer(12, 3), 12, 0),
+            (m1.into(), 12, 1),
+            (m1.into(), 40, 0),
+            (answer(10, 1), 10, 2),
+        ];
+        for k in 0..150u8 {
+            for node in [10, 11, 12, 40] {
+                messages.push((m1.into(), node, (k + 3) % 32));
+            }
+        }
+        let bytes = records(&messages);
+        // 10 ms a transfer: the answer of node 10 comes in time, node 40 never answers.
+        let times: Vec<f64> = (0..bytes.len()).map(|i| (i / 16) as f64 * 0.01).collect();
+        let mut learner = BusLearner::new();
+        learner.feed(&bytes, Some(&times));
+        let plan = learner.plan();
+        let by_record = |mut wire: CanWire, chunk: usize| {
+            let mut got = Vec::new();
+            for (b, t) in bytes.chunks(chunk).zip(times.chunks(chunk)) {
+                wire.feed(b, Some(t), &mut |t, slot, f| {
+                    if let Frame::Data(Data::HwCan(r)) = f {
+                        got.push((t.map(|t| (t * 1e3).round() as u64), r.node, slot.unwrap()));
+                    }
+                });
+            }
+            wire.finish(&mut |t, slot, f| {
+                if let Frame::Data(Data::HwCan(r)) = f {
+                    got.push((t.map(|t| (t * 1e3).round() as u64), r.node, slot.unwrap()));
+                }
+            });
+            got.sort();
+            got
+        };
+        let mut planned = CanWire::new();
+        planned.set_plan(&plan);
+        let read_ahead = by_record(planned, bytes.len());
+        assert_eq!(read_ahead.len(), 5 + 150 * 4);
+        for chunk in [1, 16, 100] {
+            assert_eq!(
+                by_record(CanWire::new(), chunk),
+                read_ahead,
+                "chunks of {chunk}"
+            );
+        }
+        let slot_of = |node| read_ahead.iter().find(|r| r.1 == node).unwrap().2;
+        assert_eq!([10, 11, 12, 40].map(slot_of), [0, 1, 2, 40]);
+    }
+
     #[test]
     fn bad_records_and_cut_ones_are_counted_not_decoded() {
         let mut bytes = records(&[(
@@ -646,7 +823,7 @@ mod tests {
             assert_eq!(t, None);
             n += 1
         });
-        wire.finish();
+        wire.finish(&mut |_, _, _| n += 1);
         assert_eq!(n, 1);
         let link = wire.link(1);
         assert_eq!((link.bad_records, link.bus.standard_frames()), (1, 1));

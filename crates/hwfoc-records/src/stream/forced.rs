@@ -40,6 +40,28 @@ impl Probe {
     }
 }
 
+/// Hands a bus's record on unless another protocol than its own is forced (then counts it).
+fn keep(
+    forced: Option<Protocol>,
+    left_out: &mut [u64; Protocol::ALL.len()],
+    t: Option<f64>,
+    place: Option<u8>,
+    frame: &Frame,
+    emit: &mut Emit<'_>,
+) {
+    let protocol = match frame {
+        Frame::Data(d) => Some(d.protocol()),
+        Frame::Info(_) => None,
+    };
+    match forced.zip(protocol) {
+        Some((forced, p)) if p != forced => {
+            let i = Protocol::ALL.iter().position(|&q| q == p).unwrap_or(0);
+            left_out[i] += 1;
+        }
+        _ => emit(t, place, frame),
+    }
+}
+
 /// A CAN bus's stream, its records of protocols other than the one forced (if one is) left
 /// out and counted by protocol.
 #[derive(Debug)]
@@ -63,18 +85,15 @@ impl Bus {
     pub(crate) fn feed(&mut self, bytes: &[u8], times: Option<&[f64]>, emit: &mut Emit<'_>) {
         let (forced, left_out) = (self.forced, &mut self.left_out);
         self.wire.feed(bytes, times, &mut |t, place, frame| {
-            let protocol = match frame {
-                Frame::Data(d) => Some(d.protocol()),
-                Frame::Info(_) => None,
-            };
-            match forced.zip(protocol) {
-                Some((forced, p)) if p != forced => {
-                    let i = Protocol::ALL.iter().position(|&q| q == p).unwrap_or(0);
-                    left_out[i] += 1;
-                }
-                _ => emit(t, place, frame),
-            }
+            keep(forced, left_out, t, place, frame, emit)
         });
+    }
+
+    /// Ends the stream as [`CanWire::finish`] does, handing on the records kept.
+    pub(crate) fn finish(&mut self, emit: &mut Emit<'_>) {
+        let (forced, left_out) = (self.forced, &mut self.left_out);
+        self.wire
+            .finish(&mut |t, place, frame| keep(forced, left_out, t, place, frame, emit));
     }
 
     /// The link of the ESC at `place`: no record where its protocol is not the one forced.
@@ -161,11 +180,14 @@ mod tests {
         ] {
             let mut bus = Bus::new(forced);
             let mut n = 0;
-            bus.feed(&bytes, None, &mut |_, _, f| {
+            let mut count = |_, _, f: &Frame| {
                 let Frame::Data(d) = f else { return };
                 assert!(forced.is_none_or(|p| p == d.protocol()));
                 n += 1;
-            });
+            };
+            bus.feed(&bytes, None, &mut count);
+            // (The Hobbywing ESC, which never answers GetEscID, is held to the end.)
+            bus.finish(&mut count);
             assert_eq!((n, bus.left_out()), (kept, left_out), "{forced:?}");
         }
     }

@@ -238,7 +238,8 @@ impl Wire {
                 d.flush(|d| emit_any(detect::Decoded::Mixed(mixed::Decoded::Hub(d)), emit))
             }
             Wire::HwV4(_) | Wire::HwV3(_) | Wire::Hw5(_) => self.flush_slow(emit),
-            Wire::Can(c) => c.wire.finish(),
+            // Ended by `Stream::finish`, with the times of the records it held.
+            Wire::Can(_) => {}
             Wire::NotCan(..) => {}
         }
     }
@@ -815,6 +816,9 @@ impl Stream {
 
     /// Ends the stream: a frame cut off at the end is dropped, frames inside it are still found.
     pub fn finish(&mut self, mut on_frame: impl FnMut(Option<f64>, Option<u8>, &Frame)) {
+        if let Wire::Can(c) = &mut self.wire {
+            return c.finish(&mut on_frame);
+        }
         let end = self.wire.bytes();
         let history = &self.history;
         let timed = !history.is_empty();

@@ -2,7 +2,8 @@
 //! bytes in one chunk, one byte at a time, and through `decode_all`.
 //!
 //! Checked: the whole-stream invariants of `check_stream`, the iterator staying exhausted, and
-//! exact equality (frames and statistics) of all four ways of decoding.
+//! exact equality (frames and statistics) of all four ways of decoding, and the frames of the
+//! iterator's `fold` (one run of the scanner) against its `next`.
 
 #![no_main]
 
@@ -40,4 +41,19 @@ fuzz_target!(|data: &[u8]| {
     all.decode_all(data, |d| got.push(d));
     assert_eq!(got, bulk, "decode_all and frames() disagree");
     assert_eq!(*all.stats(), stats);
+
+    // `fold` (one run of the scanner over the rest), from the start and after a few frames
+    // taken by `next`.
+    for k in [0, 1, bulk.len() / 2] {
+        let mut it = frames(data);
+        let head: Vec<_> = it.by_ref().take(k).collect();
+        let folded = it.fold(head, |mut v, d| {
+            v.push(d);
+            v
+        });
+        assert_eq!(
+            folded, bulk,
+            "frames().fold and next() disagree after {k} frames"
+        );
+    }
 });

@@ -221,7 +221,7 @@ fn scan_next(
                 stats.accept_data(at, &frame, synced);
                 let data = Data {
                     frame,
-                    info: stats.adopted(),
+                    info: stats.in_use(),
                 };
                 (DATA_FRAME_LEN, Frame::Data(data))
             }
@@ -320,6 +320,7 @@ pub type Frames<'a> = Scan<'a, Scanner>;
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::v4::info::VoltsPerStep;
 
     fn data(counter: u32) -> DataFrame {
         DataFrame {
@@ -444,12 +445,39 @@ mod tests {
             }
         }
         assert_eq!(n, 6);
-        assert_eq!(
-            scales,
-            [None, None, None, Some(1000), Some(1000), Some(2000)]
-        );
+        assert_eq!(scales, [None, None, None, Some(1000), None, Some(2000)]);
         let s = it.stats();
         assert_eq!((s.info_adoptions(), s.info_disagreements()), (2, 3));
         assert_eq!(s.adopted(), Some(other));
+    }
+
+    /// A 6S ESC swapped for a 12S one (slow mode: info and data frames alternate; the new ESC's
+    /// counter starts again): no data frame after the first info frame of the new ESC is scaled
+    /// by the old ESC's volts per step; those before its constants are adopted (two identical
+    /// copies) are scaled as before any info frame.
+    #[test]
+    fn a_swapped_esc_frame_never_uses_the_old_scale() {
+        let hv = InfoFrame {
+            v1: 11,
+            v2: 65,
+            ..INFO
+        };
+        let mut w = [0u8; 7 * 33];
+        for (k, info) in [INFO, INFO, INFO, hv, hv, hv, hv].iter().enumerate() {
+            let counter = if k < 3 { 100 + k as u32 } else { k as u32 - 3 };
+            w[33 * k..33 * k + 13].copy_from_slice(&info.encode());
+            w[33 * k + 13..33 * k + 33].copy_from_slice(&data(counter).encode_with_trailer());
+        }
+        let mut scales: [Option<VoltsPerStep>; 7] = [Some(VoltsPerStep::DEFAULT); 7];
+        let mut n = 0;
+        for d in frames(&w) {
+            if let Frame::Data(d) = d.frame {
+                scales[n] = d.info.map(|i| i.volts_per_step());
+                n += 1;
+            }
+        }
+        assert_eq!(n, 7);
+        let (lv, hv) = (Some(INFO.volts_per_step()), Some(hv.volts_per_step()));
+        assert_eq!(scales, [None, lv, lv, None, hv, hv, hv]);
     }
 }

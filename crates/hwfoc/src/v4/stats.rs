@@ -116,6 +116,18 @@ impl Stats {
         self.adopted
     }
 
+    /// The info frame a data frame is decoded under now: the adopted one, unless the last info
+    /// frame accepted differs from it (another ESC's constants not yet confirmed by a second
+    /// copy, as after a swap, or a corrupted copy): then none, as before any info frame, so that
+    /// no frame of a new ESC is scaled by the old one's constants.
+    #[inline]
+    pub fn in_use(&self) -> Option<InfoFrame> {
+        match self.last_info {
+            Some(last) if self.adopted.is_some_and(|a| a != last) => None,
+            _ => self.adopted,
+        }
+    }
+
     /// The last info frame accepted, adopted or not.
     pub const fn last_info(&self) -> Option<InfoFrame> {
         self.last_info
