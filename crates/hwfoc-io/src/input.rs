@@ -4,20 +4,19 @@
 //! positions for a later half; serial ports are read by `ports.rs`.
 
 mod ahead;
-mod ports;
 
 use std::fs::File;
 use std::io::{self, BufReader, Read};
 use std::sync::Arc;
 use std::sync::atomic::AtomicBool;
 
-use hwfoc_records::{BlockRead, ReadAt, RegularFile, Reopen};
+use hwfoc_records::{Beside, BlockRead, ReadAt, RegularFile, Reopen};
 pub(crate) use hwfoc_records::{Input, InputError};
 
 use crate::serial::PortSet;
 
 use self::ahead::ReadAhead;
-use self::ports::Ports;
+use hwfoc_ports::Ports;
 
 /// Opening an [`Input`] of a file, standard input or serial ports.
 pub trait OpenInput: Sized {
@@ -143,6 +142,26 @@ impl ReadAt for Second {
 
     fn try_clone(&self) -> Option<Box<dyn ReadAt>> {
         Some(Box::new(Second(self.0.try_clone().ok()?)))
+    }
+
+    fn read_beside(
+        self: Box<Self>,
+        work: Box<dyn FnOnce(Box<dyn ReadAt>) + Send>,
+    ) -> Option<Box<dyn Beside>> {
+        let thread = std::thread::Builder::new()
+            .name("hwfoc-later-half".into())
+            .spawn(move || work(self))
+            .ok()?;
+        Some(Box::new(Thread(thread)))
+    }
+}
+
+/// A thread reading a later half.
+struct Thread(std::thread::JoinHandle<()>);
+
+impl Beside for Thread {
+    fn join(self: Box<Self>) {
+        let _ = self.0.join();
     }
 }
 

@@ -128,21 +128,12 @@
 // `pcapng::Reader`, `write::arrow::schema`): public, each exporting only its public items.
 pub mod can;
 pub mod record;
-pub mod serial;
 pub mod write;
+pub use hwfoc_ports::{clock, serial};
 pub use hwfoc_records::{check, energy, pcapng, summary, time};
-
-/// Receive times: the clock that stamps what is received (`ReceiveClock`, reading the system's
-/// clocks) and `hwfoc-records`' timing of a chunk's bytes and steps between frames.
-pub mod clock {
-    pub use crate::receive::{ReceiveClock, unix_now_ns};
-    pub use hwfoc_records::clock::*;
-}
 
 // Modules whose public items are re-exported below, by role.
 mod input;
-mod port;
-mod receive;
 
 // `hwfoc-records`' modules as this crate's own modules name them.
 mod handler {

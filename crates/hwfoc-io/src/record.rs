@@ -4,11 +4,4 @@
 
 pub use hwfoc_records::record::*;
 
-pub use crate::write::stored::{StoredColumn as Column, Visitor};
-
-/// The columns of the schema ([`hwfoc_records::record::columns`]), walked by this crate's
-/// writers with [`visit`](columns::visit).
-pub mod columns {
-    pub use crate::write::stored::visit;
-    pub use hwfoc_records::record::columns::*;
-}
+pub use crate::write::stored::{Column, Visitor, columns};

@@ -114,8 +114,8 @@ pub const RECORD_SCHEMA_VERSION: u32 = 4;
 // Inputs: where bytes come from, each opened as an `Input` whose format is detected from its
 // content, read as `Batch`es of bytes with their receive times.
 pub use input::{
-    BATCH, Batch, BlockRead, Input, InputError, InputFormat, Looks, ONLY_ZEROS_LIMIT, ReadAt,
-    RegularFile, Reopen, Source, read_some,
+    BATCH, Batch, Beside, BlockRead, Input, InputError, InputFormat, Looks, ONLY_ZEROS_LIMIT,
+    ReadAt, RegularFile, Reopen, Source, read_some,
 };
 
 // Decoding: `Sources` reads inputs, merges them in time order and decodes each ESC's bytes

@@ -144,7 +144,7 @@ impl SettingsPatch {
     ///
     /// ```
     /// use hwfoc::v4::VoltsPerStep;
-    /// use hwfoc_io::SettingsPatch;
+    /// use hwfoc_records::SettingsPatch;
     ///
     /// let patch = SettingsPatch::format_setting("v4-volts-per-step", "hv")?;
     /// assert_eq!(patch.v4_volts_per_step, Some(VoltsPerStep::HIGH_VOLTAGE));

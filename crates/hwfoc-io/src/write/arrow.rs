@@ -19,7 +19,8 @@ use arrow_schema::{DataType, Field, FieldRef, Schema, SchemaRef, TimeUnit};
 use hwfoc::telemetry::Data;
 use hwfoc::{Protocol, Settings, Status};
 
-use crate::record::{Column, FaultList, Record, UtcTime, Visitor, columns};
+use super::stored::{Column, Visitor, columns};
+use hwfoc_records::record::{FaultList, Record, UtcTime};
 
 /// Name of the `faults` list's item field (Arrow's default).
 pub(crate) const ITEM: &str = "item";

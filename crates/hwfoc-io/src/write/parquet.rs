@@ -139,9 +139,10 @@ mod encode {
 
     use super::super::arrow::schema;
     use super::super::metadata::schema_with;
+    use super::super::stored::columns::{COLUMNS, COUNT, visit};
+    use super::super::stored::{Column, Visitor};
     use super::super::{Chunk, Provenance, Sink, ToWriter, WriteError};
-    use crate::record::columns::{COLUMNS, COUNT, visit};
-    use crate::record::{Column, FaultList, UtcTime, Visitor};
+    use hwfoc_records::record::{FaultList, UtcTime};
 
     /// Values handed to a column writer at a time (the crate's default, 1024, spends more time
     /// per value and makes pages of 1 MB at most).

@@ -4,7 +4,7 @@
 //! [`Visitor`](hwfoc_records::record::Visitor) knows only the text encodings: the binary
 //! writers' traits live here, above the record.
 
-use hwfoc_records::record::{Column, Cons, Nil, Value, columns};
+use hwfoc_records::record::{Cons, Nil, Value};
 
 use super::arrow::ArrowValue;
 use super::parquet::ParquetValue;
@@ -14,16 +14,17 @@ pub trait StoredValue: Value + ArrowValue + ParquetValue {}
 
 impl<T: Value + ArrowValue + ParquetValue> StoredValue for T {}
 
-/// A column whose values every writer stores: each column of the record schema.
-pub trait StoredColumn: Column<Value: StoredValue> {}
+/// A column whose values every writer stores: each column of the record schema
+/// ([`hwfoc_records::record::Column`]).
+pub trait Column: hwfoc_records::record::Column<Value: StoredValue> {}
 
-impl<C: Column<Value: StoredValue>> StoredColumn for C {}
+impl<C: hwfoc_records::record::Column<Value: StoredValue>> Column for C {}
 
 /// Something a writer does for each column, in schema order: [`visit`] calls
 /// [`Visitor::column`] once per column, with the column's type, monomorphised and inlined.
 pub trait Visitor {
     /// Called for column `C`.
-    fn column<C: StoredColumn>(&mut self);
+    fn column<C: Column>(&mut self);
 }
 
 /// A list of columns walked in order.
@@ -37,7 +38,7 @@ impl Walk for Nil {
     fn walk<V: Visitor>(_: &mut V) {}
 }
 
-impl<C: StoredColumn, Rest: Walk> Walk for Cons<C, Rest> {
+impl<C: Column, Rest: Walk> Walk for Cons<C, Rest> {
     #[inline(always)]
     fn walk<V: Visitor>(visitor: &mut V) {
         visitor.column::<C>();
@@ -49,4 +50,11 @@ impl<C: StoredColumn, Rest: Walk> Walk for Cons<C, Rest> {
 #[inline(always)]
 pub fn visit<V: Visitor>(visitor: &mut V) {
     <columns::List as Walk>::walk(visitor);
+}
+
+/// The columns of the schema ([`hwfoc_records::record::columns`]), walked by this crate's
+/// writers with [`visit`](columns::visit).
+pub mod columns {
+    pub use super::visit;
+    pub use hwfoc_records::record::columns::*;
 }

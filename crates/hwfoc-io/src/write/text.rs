@@ -11,8 +11,8 @@ use std::sync::mpsc::{Receiver, SyncSender, sync_channel};
 use hwfoc::Settings;
 use hwfoc::telemetry::Data;
 
-use crate::record::{Record, TextEncoder};
 use crate::settings;
+use hwfoc_records::record::{Record, TextEncoder};
 
 use super::{Chunk, EscTable, Provenance, Sink, ToWriter, WriteError};
 

@@ -1,6 +1,7 @@
 //! What an input asks of a regular file, which the crate above opens (`hwfoc-io`: this crate
 //! opens no file): to be opened again from its start ([`Reopen`]), read in turn, read ahead
-//! ([`BlockRead`]) or read at a position ([`ReadAt`]) ([`RegularFile`]).
+//! ([`BlockRead`]) or read at a position ([`ReadAt`]) ([`RegularFile`]), the later half of it
+//! beside the caller ([`Beside`]).
 
 use std::io::{self, Read};
 
@@ -50,6 +51,19 @@ pub trait ReadAt: Send {
 
     /// Another handle on the same file.
     fn try_clone(&self) -> Option<Box<dyn ReadAt>>;
+
+    /// Reads the file beside the caller: `work` runs with it on a thread of its own (the crate
+    /// above starts it); `None`, and `work` is dropped, where none can be started.
+    fn read_beside(
+        self: Box<Self>,
+        work: Box<dyn FnOnce(Box<dyn ReadAt>) + Send>,
+    ) -> Option<Box<dyn Beside>>;
+}
+
+/// Work running beside the caller ([`ReadAt::read_beside`]).
+pub trait Beside {
+    /// Waits for the work to end.
+    fn join(self: Box<Self>);
 }
 
 /// Files held in memory, for the tests of what reads files: each reading sees the bytes the
@@ -59,7 +73,7 @@ pub(crate) mod memory {
     use std::io::{self, Read};
     use std::sync::{Arc, Mutex};
 
-    use super::{BlockRead, ReadAt, RegularFile, Reopen};
+    use super::{Beside, BlockRead, ReadAt, RegularFile, Reopen};
     use crate::input::{Input, InputError};
 
     /// A file's path and its bytes, which a test may replace.
@@ -146,6 +160,19 @@ pub(crate) mod memory {
 
         fn try_clone(&self) -> Option<Box<dyn ReadAt>> {
             Some(Box::new(Arc::clone(self)))
+        }
+
+        fn read_beside(
+            self: Box<Self>,
+            work: Box<dyn FnOnce(Box<dyn ReadAt>) + Send>,
+        ) -> Option<Box<dyn Beside>> {
+            Some(Box::new(std::thread::spawn(move || work(self))))
+        }
+    }
+
+    impl Beside for std::thread::JoinHandle<()> {
+        fn join(self: Box<Self>) {
+            let _ = std::thread::JoinHandle::join(*self);
         }
     }
 }

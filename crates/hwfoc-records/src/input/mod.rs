@@ -49,7 +49,7 @@ use crate::pcapng;
 
 use self::csv::{CsvRows, may_be_header};
 pub use self::error::InputError;
-pub use self::file::{BlockRead, ReadAt, RegularFile, Reopen};
+pub use self::file::{Beside, BlockRead, ReadAt, RegularFile, Reopen};
 pub use self::looks::Looks;
 
 /// How many bytes of nothing but zeros from its start end the reading of a raw input with

@@ -24,14 +24,13 @@ use std::io;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc::{Receiver, SyncSender, sync_channel};
-use std::thread::JoinHandle;
 
 use hwfoc::telemetry::{Data, Frame, Telemetry};
 use hwfoc::{Protocol, Settings};
 
 use super::{HELD, Held, Takes, feed_runs};
 use crate::handler::LaterPart;
-use crate::input::{BATCH, Batch, ReadAt};
+use crate::input::{BATCH, Batch, Beside, ReadAt};
 use crate::stream::Stream;
 
 /// The smallest raw file read in two halves: below it, starting a thread is not worth it.
@@ -51,7 +50,10 @@ pub(super) struct Later {
     found: Option<Option<u64>>,
     /// Asks the reader to stop (the later half's work is not wanted).
     stop: Arc<AtomicBool>,
-    thread: Option<JoinHandle<Option<Done>>>,
+    /// What the reader did, once it ended.
+    done: Receiver<Option<Done>>,
+    /// The reader, running beside ([`ReadAt::read_beside`]) until it is joined.
+    thread: Option<Box<dyn Beside>>,
 }
 
 /// What the later half's reader did, from the seam to the end of the file.
@@ -86,22 +88,23 @@ impl Later {
         let (seam_tx, seam) = sync_channel(1);
         let stop = Arc::new(AtomicBool::new(false));
         let asked = Arc::clone(&stop);
-        let reader = Reader {
-            file,
-            forced,
-            esc,
-            settings,
-            stop: asked,
-        };
-        let thread = std::thread::Builder::new()
-            .name("hwfoc-later-half".into())
-            .spawn(move || reader.run(start, part, &seam_tx))
-            .ok()?;
+        let (done_tx, done) = sync_channel(1);
+        let thread = file.read_beside(Box::new(move |file| {
+            let reader = Reader {
+                file,
+                forced,
+                esc,
+                settings,
+                stop: asked,
+            };
+            let _ = done_tx.send(reader.run(start, part, &seam_tx));
+        }))?;
         Some(Later {
             start,
             seam,
             found: None,
             stop,
+            done,
             thread: Some(thread),
         })
     }
@@ -125,7 +128,8 @@ impl Later {
     /// Waits for the later half's reader to end: what it did, or `None` where it could not be
     /// joined (a read error, hub frames, no frame).
     pub(super) fn finish(mut self) -> Option<Done> {
-        self.thread.take()?.join().ok().flatten()
+        self.thread.take()?.join();
+        self.done.try_recv().ok().flatten()
     }
 }
 
@@ -135,7 +139,7 @@ impl Drop for Later {
     fn drop(&mut self) {
         self.stop.store(true, Ordering::Relaxed);
         if let Some(thread) = self.thread.take() {
-            let _ = thread.join();
+            thread.join();
         }
     }
 }

@@ -13,7 +13,7 @@ use crate::serial::{PortEvent, PortSet};
 const PORT_POLL: Duration = Duration::from_millis(100);
 
 /// Live serial ports.
-pub(super) struct Ports {
+pub struct Ports {
     set: PortSet,
     /// Each port's byte time, ns: of the rate given, or found ([`PortEvent::Found`]).
     per_byte_ns: Vec<f64>,
@@ -23,7 +23,7 @@ pub(super) struct Ports {
 
 impl Ports {
     /// Reads `set` until `interrupted` is set.
-    pub(super) fn new(set: PortSet, interrupted: Arc<AtomicBool>) -> Ports {
+    pub fn new(set: PortSet, interrupted: Arc<AtomicBool>) -> Ports {
         let per_byte = hwfoc::wire::byte_ns(set.baud().initial());
         Ports {
             // A CAN bus's bytes all have their frame's time.
