@@ -1197,8 +1197,12 @@ static void hwfoc__v4_accept(hwfoc_v4_stats *s, hwfoc_v4_frame *f, int synced) {
         s->chain_has_next = 1;
         s->chain_next = (f->data.counter + 1u) & HWFOC_COUNTER24_MAX;
         s->chain_trailer = 1;
-        f->has_info = s->has_adopted;
-        if (s->has_adopted) f->info = s->adopted;
+        /* The constants in use: the adopted ones, unless the last info frame differs from them
+         * (another ESC's, not yet confirmed by a second copy, as after a swap): then none, as
+         * before any info frame (Rust: v4::Stats::in_use). */
+        f->has_info = s->has_adopted &&
+                      !(s->has_last_info && !hwfoc__v4_info_eq(&s->adopted, &s->last_info));
+        if (f->has_info) f->info = s->adopted;
         else memset(&f->info, 0, sizeof f->info);
     } else {
         int same = s->has_last_info && hwfoc__v4_info_eq(&s->last_info, &f->info);
