@@ -1095,15 +1095,17 @@ mod tests {
         );
         let bytes = |m: Message, tid: u8| can_bytes(m, 10, tid);
         let m1 = status1();
+        // No GetEscID answer within the hold (1 s of the bus's clock): placed by its node id.
         f.on_event(&data(0, 1000.0, bytes(m1.into(), 0)));
+        f.on_event(&data(0, 1001.1, bytes(m1.into(), 1)));
         let esc = f.escs[0].last.unwrap().esc;
         assert_eq!(f.escs[0].name, "vcan0 node 10");
         f.on_event(&data(
             0,
-            1000.1,
-            bytes(GetEscId::new(&[10, 2]).unwrap().into(), 1),
+            1001.2,
+            bytes(GetEscId::new(&[10, 2]).unwrap().into(), 2),
         ));
-        f.on_event(&data(0, 1000.2, bytes(m1.into(), 2)));
+        f.on_event(&data(0, 1001.3, bytes(m1.into(), 3)));
         let views: Vec<&str> = f.escs.iter().map(|e| e.name.as_str()).collect();
         assert_eq!(views, ["vcan0 node 10 ch 2", "slcan:/dev/ttyACM0:1M"]);
         assert_eq!(f.escs[0].last.unwrap().esc, esc);
@@ -1146,6 +1148,9 @@ mod tests {
         f.set_labels(by_esc, vec![Some("bus".to_string())]);
         f.on_event(&data(0, 1000.0, can_bytes(status1().into(), 13, 0)));
         f.on_event(&data(0, 1000.1, can_bytes(status1().into(), 11, 0)));
+        // Neither answers a GetEscID within the hold (1 s): each is placed by its node id.
+        f.on_event(&data(0, 1001.2, can_bytes(status1().into(), 13, 1)));
+        f.on_event(&data(0, 1001.3, can_bytes(status1().into(), 11, 1)));
         let got: Vec<(usize, Option<&str>)> = f
             .escs
             .iter()
@@ -1161,6 +1166,9 @@ mod tests {
         let mut f = fleet_of(vec!["can:vcan0".to_string()]);
         f.on_event(&data(0, 1000.0, can_bytes(status1().into(), 13, 0)));
         f.on_event(&data(0, 1000.1, can_bytes(status1().into(), 11, 0)));
+        // Neither answers a GetEscID within the hold (1 s): each is placed by its node id.
+        f.on_event(&data(0, 1001.2, can_bytes(status1().into(), 13, 1)));
+        f.on_event(&data(0, 1001.3, can_bytes(status1().into(), 11, 1)));
         let got: Vec<(usize, u8)> = f
             .escs
             .iter()
@@ -1168,9 +1176,9 @@ mod tests {
             .collect();
         assert_eq!(got, [(13, 13), (11, 11)]);
         // --json and --plain say so.
-        let json = super::super::headless::status_json(&f.escs[1], 1000.2);
+        let json = super::super::headless::status_json(&f.escs[1], 1001.4);
         assert_eq!(json["esc"], 11, "{json}");
-        let line = super::super::headless::status_line(&f.escs[1], 1000.2);
+        let line = super::super::headless::status_line(&f.escs[1], 1001.4);
         assert!(line.contains(" esc11 "), "{line}");
         // `[esc.11]` applies to node 11's view, whatever order the ESCs were heard in.
         let mut settings = hwfoc_io::SettingsMap::new(Settings::DEFAULT);
@@ -1184,6 +1192,9 @@ mod tests {
         let mut f = Fleet::new(names, settings, limits, Baud::Fixed(19_200), 1000.0);
         f.on_event(&data(0, 1000.0, can_bytes(status1().into(), 13, 0)));
         f.on_event(&data(0, 1000.1, can_bytes(status1().into(), 11, 0)));
+        // Neither answers a GetEscID within the hold (1 s): each is placed by its node id.
+        f.on_event(&data(0, 1001.2, can_bytes(status1().into(), 13, 1)));
+        f.on_event(&data(0, 1001.3, can_bytes(status1().into(), 11, 1)));
         let pole_pairs: Vec<(usize, u16)> = f
             .escs
             .iter()
