@@ -186,6 +186,16 @@ fn reference_scan(
             }
             let crc = u16::from_le_bytes([rest[len - 2], rest[len - 1]]);
             if crc_reference(&rest[..len - 2]) == crc {
+                if kind == Kind::Telemetry {
+                    // A value past the protocol's range (THROTTLE_MAX_PCT, VOLTAGE_MAX_RAW):
+                    // a corrupted frame whose CRC still matches, rejected as one byte.
+                    let f = reference_fields(rest);
+                    if f.throttle > hw5::THROTTLE_MAX_PCT || f.voltage_raw > hw5::VOLTAGE_MAX_RAW {
+                        s.bytes_skipped += 1;
+                        i += 1;
+                        continue 'scan;
+                    }
+                }
                 s.frames[kind as usize] += 1;
                 if kind == Kind::Telemetry {
                     out.push(hw5::Decoded {
