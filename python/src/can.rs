@@ -124,8 +124,7 @@ impl CanDecoder {
         gear_ratio: f32,
         settings: Option<crate::FormatSettings<'_>>,
     ) -> PyResult<Self> {
-        let settings =
-            crate::settings_arg(current_scale, pole_pairs, gear_ratio, settings)?;
+        let settings = crate::settings_arg(current_scale, pole_pairs, gear_ratio, settings)?;
         Ok(CanDecoder {
             state: Mutex::new(CanState {
                 stream: Stream::can(),

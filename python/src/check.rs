@@ -10,8 +10,8 @@ use pyo3::prelude::*;
 
 use crate::source::{self, Spec};
 use crate::{
-    CURRENT_SCALE, GEAR_RATIO, Notes, POLE_PAIRS, errors, open_all,
-    settings_arg, sources, warn_notices,
+    CURRENT_SCALE, GEAR_RATIO, Notes, POLE_PAIRS, errors, open_all, settings_arg, sources,
+    warn_notices,
 };
 
 /// The findings on `specs` as JSON, under `config`, drift judged against `baseline`.

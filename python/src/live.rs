@@ -152,8 +152,7 @@ impl Decoder {
         settings: Option<crate::FormatSettings<'_>>,
         protocol: Option<&str>,
     ) -> PyResult<Self> {
-        let settings =
-            crate::settings_arg(current_scale, pole_pairs, gear_ratio, settings)?;
+        let settings = crate::settings_arg(current_scale, pole_pairs, gear_ratio, settings)?;
         let protocol = crate::protocol_arg(protocol)?;
         let baud = crate::baud_arg(baud, protocol);
         Ok(Decoder {
