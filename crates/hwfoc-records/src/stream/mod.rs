@@ -486,7 +486,11 @@ impl EscLink {
     pub fn maintenance_min(&self) -> Option<(u32, u32)> {
         match self {
             EscLink::Can(c) => c.maintenance_min,
-            _ => None,
+            EscLink::Wire(_)
+            | EscLink::Hub { .. }
+            | EscLink::HwV4(_)
+            | EscLink::HwV3(_)
+            | EscLink::Hw5(_) => None,
         }
     }
 
