@@ -1,7 +1,7 @@
 //! The records decoded so far, held column by column as the page reads them: one typed array
 //! per column of the record schema (`docs/RECORD-SCHEMA.md`), a null float as NaN.
 
-use hwfoc::telemetry::{Data, Telemetry};
+use hwfoc::telemetry::Data;
 use hwfoc::{Protocol, Quantity, Settings};
 use hwfoc_records::Record;
 use js_sys::{Array, Float32Array, Float64Array, Object, Reflect, Uint8Array};
@@ -93,30 +93,10 @@ impl Columns {
         }
     }
 
-    /// Adds the record of `data` from ESC `esc` received at `t_s` (seconds, or None).
+    /// Adds the record of `data` from ESC `esc` received at `t_s` (seconds, or None), converted
+    /// as the command converts it ([`Record::new`]).
     pub fn push(&mut self, t_s: Option<f64>, esc: u8, data: &Data, settings: &Settings) {
-        if self.floats.is_empty() {
-            self.floats = float_quantities().map(|_| Vec::new()).collect();
-        }
-        let nan = f64::NAN;
-        self.t_s.push(t_s.unwrap_or(nan));
-        self.esc.push(esc);
-        self.protocol.push(protocol_code(data.protocol()));
-        let erpm = data.value(Quantity::Erpm, settings).map(f64::from);
-        let integers = [
-            data.packet().map(f64::from),
-            erpm,
-            data.status().map(|s| f64::from(s.0)),
-            data.node().map(f64::from),
-            data.msg2_age_ms().map(f64::from),
-            data.msg3_age_ms().map(f64::from),
-        ];
-        for (column, value) in self.integers.iter_mut().zip(integers) {
-            column.push(value.unwrap_or(nan));
-        }
-        for (column, quantity) in self.floats.iter_mut().zip(float_quantities()) {
-            column.push(data.value(quantity, settings).unwrap_or(f32::NAN));
-        }
+        self.push_record(&Record::new(t_s, esc, data, settings));
     }
 
     /// The records held as `{count, columns: {name: TypedArray}, protocols}`, emptying the
