@@ -214,7 +214,13 @@ class CanDecoder:
         ``Message`` objects (duck-typed: ``timestamp``, ``arbitration_id``, ``data``,
         ``is_extended_id``) or tuples ``(timestamp, arbitration_id, data, is_extended)``, or
         one of them. ``timestamp``: Unix seconds. Raises ValueError for a frame that is no
-        classic CAN data frame. Returns the records of the ESC statuses completed."""
+        classic CAN data frame. Returns the records of the ESC statuses completed; a Hobbywing
+        node heard before its GetEscID answer has its records held (up to 1 s of the bus's
+        clock) until the answer places it."""
+
+    def finish(self) -> pa.RecordBatch:
+        """Ends the bus's stream: the records still held, a node that never answered placed by
+        its node id, as ``hwfoc decode -`` gives them."""
 
     @property
     def stats(self) -> Dict[str, Any]:

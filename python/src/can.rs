@@ -113,6 +113,25 @@ fn frame_of(item: &Bound<'_, PyAny>) -> PyResult<(f64, CanFrame)> {
     Ok((t, frame))
 }
 
+/// Gathers the data frames a bus's stream hands on, an ESC at slot `s` as ESC `esc + s`.
+fn gathering(gather: &mut Frames, esc: u8) -> impl FnMut(Option<f64>, Option<u8>, &Frame) + '_ {
+    move |t, slot, d| {
+        if let Frame::Data(f) = d {
+            gather.push(t, slot.map_or(esc, |s| esc.saturating_add(s)), f);
+        }
+    }
+}
+
+impl CanDecoder {
+    /// The records gathered, as a `pyarrow.RecordBatch` of the decoder's schema.
+    fn batch(&self, py: Python<'_>, gather: Frames) -> PyResult<Py<PyAny>> {
+        Ok(gather
+            .to_batch(self.schema.clone(), &self.settings)
+            .to_pyarrow(py)?
+            .unbind())
+    }
+}
+
 #[pymethods]
 impl CanDecoder {
     #[new]
@@ -182,17 +201,24 @@ impl CanDecoder {
                 times: Some(times),
                 stream: 0,
             };
-            stream.feed(batch, |t, slot, d| {
-                if let Frame::Data(f) = d {
-                    gather.push(t, slot.map_or(esc, |s| esc.saturating_add(s)), f);
-                }
-            });
+            stream.feed(batch, gathering(&mut gather, esc));
         });
         drop(state);
-        Ok(gather
-            .to_batch(self.schema.clone(), &self.settings)
-            .to_pyarrow(py)?
-            .unbind())
+        self.batch(py, gather)
+    }
+
+    /// Ends the bus's stream: the records still held, as a `pyarrow.RecordBatch`. Live, a
+    /// Hobbywing node heard before its GetEscID answer has its records held (up to 1 s of the
+    /// bus's clock) until the answer places it; at the end they are given, the node placed by
+    /// its node id, as `hwfoc decode -` gives them.
+    fn finish(&self, py: Python<'_>) -> PyResult<Py<PyAny>> {
+        let mut gather = Frames::default();
+        self.state
+            .lock()
+            .map_err(|_| errors::HwfocError::new_err("the decoder failed earlier"))?
+            .stream
+            .finish(gathering(&mut gather, self.esc));
+        self.batch(py, gather)
     }
 
     /// The bus's statistics so far (bytes, frames, ...), as `Decoder.stats`.
