@@ -173,21 +173,19 @@ def age_ms(now, then):
     return None if then is None else (now - then) // 1000
 
 
-def expected_records(transfers, ahead):
+def expected_records(transfers):
     """The records of docs/RECORD-SCHEMA.md hwfoc must make of the transfers. An ESC's number is
-    its place on the bus: a file is read ahead (`ahead`), so a Hobbywing node has for the whole
-    file the throttle channel - 1 it is answered with, its node id if never; live, a node keeps
-    the place it had when first heard (its node id: the answers come at 0.2 s)."""
-    channel = {}
-    number = {}
+    its place on the bus: a Hobbywing node has, for the whole bus, the throttle channel - 1 it is
+    answered with, its node id if never. A file is read ahead; live, hwfoc holds a node's records
+    until its answer for up to 1 s of bus time, and the answers here come at 0.2 s, so the
+    numbers are the same (live, held records come out when their node is placed)."""
     msg2, msg3, ext = {}, {}, {}
     records = []
     for t, name, v, src, ok in transfers:
         if not ok:
             continue
-        if name == HW + "GetEscID" and len(v["payload"]) == 2:
-            node, ch = v["payload"]
-            channel[node] = ch
+        if name == HW + "GetEscID":
+            continue
         elif name == HW + "StatusMsg2":
             msg2[src] = (v, t)
         elif name == HW + "StatusMsg3":
@@ -198,12 +196,8 @@ def expected_records(transfers, ahead):
             m2, t2 = msg2.get(src, (None, None))
             m3, t3 = msg3.get(src, (None, None))
             mos = m3["MOS_T"] if m3 else (m2["temperature"] if m2 else None)
-            ch = channel.get(src)
-            if ahead:
-                final = HW_NODES[src]
-                esc = final - 1 if final else src
-            else:
-                esc = number.setdefault(src, ch - 1 if ch else src)
+            final = HW_NODES[src]
+            esc = final - 1 if final else src
             records.append(record(
                 t, esc, "hw-can", src,
                 throttle_out_pct=f32(v["pwm"] / 10), rpm=float(v["rpm"]),
@@ -256,7 +250,7 @@ def slcan_line(can_id, data):
 def main():
     mode = sys.argv[1] if len(sys.argv) > 1 else ""
     frames, transfers = bus()
-    expected = expected_records(transfers, ahead=mode == "log")
+    expected = expected_records(transfers)
     if mode == "log" and len(sys.argv) == 4:
         for r in expected:
             r["t_s"] = (T0_US + round(r["t_s"] * 1e6)) / 1e6
