@@ -721,7 +721,6 @@ const MEASURED: [(Analyser, &str, bool, usize); 8] = [
 ];
 
 #[test]
-#[ignore = "a measurement: 320 simulated flights and 60 baselines, 20 s in a debug build"]
 fn detection_over_twenty_airframes() {
     let mut rows = Vec::new();
     let mut failed = false;
