@@ -3,7 +3,7 @@
 
 usage: scripts/protocol-arms.py [--list]   (from the checkout to count)
 
-Reads the non-test Rust code of hwfoc-records, hwfoc-ports, hwfoc-io, hwfoc-web, hwfoc-cli, hwfoc-sim, hwfoc-bridge and python/src
+Reads the non-test Rust code of hwfoc-records, hwfoc-ports, hwfoc-io, hwfoc-can-setup, hwfoc-web, hwfoc-cli, hwfoc-sim, hwfoc-bridge and python/src
 (a file's `#[cfg(test)]` module, `tests.rs` files and `tests/` folders are left out) and finds each `match`
 whose arms name an arm of a per-protocol enum (`Protocol`, `Data`, `Info`, `Wire`, `EscLink`,
 `Decoded`, `Family`, `Conversion`). It prints the number of such arms and of wildcard arms
@@ -17,7 +17,7 @@ import sys
 
 ROOT = pathlib.Path.cwd()
 DIRS = ["crates/hwfoc-records/src", "crates/hwfoc-ports/src", "crates/hwfoc-io/src",
-        "crates/hwfoc-web/src", "crates/hwfoc-cli/src", "crates/hwfoc-sim/src",
+        "crates/hwfoc-can-setup/src", "crates/hwfoc-web/src", "crates/hwfoc-cli/src", "crates/hwfoc-sim/src",
         "crates/hwfoc-bridge/src", "python/src"]
 ENUMS = "Protocol|Data|Info|Wire|EscLink|Decoded|Family|Conversion"
 ARM = re.compile(r"(?<![\w:])(?:[\w]+::)*(?:" + ENUMS + r")::[A-Z]\w*")

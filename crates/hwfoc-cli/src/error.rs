@@ -27,7 +27,7 @@ pub enum CliError {
     /// A bridge output could not be opened.
     Output(hwfoc_bridge::OutputError),
     /// A CAN bus could not be used, or an ESC on it did not do what was asked (`hwfoc can`).
-    Can(hwfoc_io::can::setup::SetupError),
+    Can(hwfoc_can_setup::SetupError),
     /// The user did not confirm a change (`hwfoc can`).
     Declined,
     /// The virtual ESCs could not be set up or run (`hwfoc simulate`, `hwfoc monitor --sim`).
@@ -119,8 +119,8 @@ impl From<ExportError> for CliError {
     }
 }
 
-impl From<hwfoc_io::can::setup::SetupError> for CliError {
-    fn from(e: hwfoc_io::can::setup::SetupError) -> Self {
+impl From<hwfoc_can_setup::SetupError> for CliError {
+    fn from(e: hwfoc_can_setup::SetupError) -> Self {
         CliError::Can(e)
     }
 }

@@ -63,11 +63,6 @@ use hwfoc_io::can::slcan::{BEL, BITRATES, CLOSE, Counts, Event, MAX_LINE, Parser
 use hwfoc_io::can::slcan::{bitrate_code, push_extended, push_frame, setup};
 use hwfoc_io::can::{ASK_EVERY, ASK_PRIORITY, AskIds, DEFAULT_SOURCE_NODE};
 use hwfoc_io::can::{CanBus, CanError, CanSpec, DEFAULT_BITRATE, SLCAN_BAUD, is_can_spec};
-// Setting Hobbywing's CAN ESCs up.
-use hwfoc_io::can::setup::{Change, Client, EscSurvey, Heard, Link, NodeHeard, SetupError, Survey};
-use hwfoc_io::can::setup::{Direction, LED_BLINKS, LED_COLORS, Led, StatusMessage, ThrottleSource};
-use hwfoc_io::can::setup::{Made, Motion, rate_text, short_name};
-use hwfoc_io::can::setup::{REQUEST_PRIORITY, baud_code, parse_rate, rate_code, rate_hz};
 
 // Times, clocks and energy.
 use hwfoc_io::clock::{MAX_FRAME_SPACING_S, MAX_STEP_S, ReceiveClock, Step};

@@ -6,6 +6,7 @@ use crate::error::SimError;
 use crate::pty::{self, PtyLinks};
 use crate::schedule::Pace;
 use crate::sink::{self, PcapngSink, PortSink, RawSink, Sink};
+use crate::template;
 
 /// Duration of one piece written to a pseudo-terminal or a pipe in real time, seconds.
 const PIECE_S: f64 = 0.004;
@@ -106,7 +107,7 @@ impl Destination {
     pub fn files(&self, n: usize) -> Vec<String> {
         match self {
             Destination::File { path, .. } if path.contains("{esc}") => {
-                (0..n).map(|i| sink::expand(path, i)).collect()
+                (0..n).map(|i| template::expand(path, i)).collect()
             }
             Destination::File { path, .. } => vec![path.clone()],
             Destination::Stdout(_) => vec!["-".to_string()],

@@ -39,12 +39,16 @@ pub enum SimError {
     TooManyEscs {
         /// How many were asked for.
         n: usize,
+        /// The most there may be.
+        max: usize,
     },
     /// More ESCs on a simulated CAN bus than it can have
     /// ([`MAX_CAN_ESCS`](crate::can::MAX_CAN_ESCS)).
     TooManyCanEscs {
         /// How many were asked for.
         n: usize,
+        /// The most there may be.
+        max: usize,
     },
     /// Link faults (bit errors, drops, cuts, garbage) asked of a CAN bus.
     CanLinkFaults,
@@ -147,15 +151,12 @@ impl fmt::Display for SimError {
                 line,
                 message,
             } => write!(f, "{file}:{line}: {message}"),
-            SimError::TooManyEscs { n } => write!(
+            SimError::TooManyEscs { n, max } => {
+                write!(f, "{n} ESCs: at most {max} (an ESC's number is a byte)")
+            }
+            SimError::TooManyCanEscs { n, max } => write!(
                 f,
-                "{n} ESCs: at most {} (an ESC's number is a byte)",
-                crate::fleet::MAX_ESCS
-            ),
-            SimError::TooManyCanEscs { n } => write!(
-                f,
-                "{n} ESCs on a CAN bus: at most {} (a throttle channel has 6 bits)",
-                crate::can::MAX_CAN_ESCS
+                "{n} ESCs on a CAN bus: at most {max} (a throttle channel has 6 bits)"
             ),
             SimError::CanLinkFaults => f.write_str(
                 "link faults (bit errors, drops, cuts, garbage) are simulated for HW-FOC only, \

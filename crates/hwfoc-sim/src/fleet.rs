@@ -81,7 +81,10 @@ impl FleetSpec {
     /// fault byte when speaking HW5) and its profile loaded (a CSV file read), but not started.
     pub fn build(self) -> Result<VirtualFleet, SimError> {
         if self.n > MAX_ESCS {
-            return Err(SimError::TooManyEscs { n: self.n });
+            return Err(SimError::TooManyEscs {
+                n: self.n,
+                max: MAX_ESCS,
+            });
         }
         if !protocols::simulated(self.protocol) {
             return Err(SimError::Protocol {
@@ -226,7 +229,10 @@ pub(crate) mod tests {
         );
         assert!(matches!(
             spec(MAX_ESCS + 1).build(),
-            Err(SimError::TooManyEscs { n: 257 })
+            Err(SimError::TooManyEscs {
+                n: 257,
+                max: MAX_ESCS
+            })
         ));
         let fleet = spec(3).build().unwrap();
         assert_eq!(fleet.profile().natural_length_s(), 2.5);

@@ -6,9 +6,9 @@
 //! Each ESC runs a small physical model ([`model`]) driven by a throttle profile ([`profile`]),
 //! sends its frames on the real schedule ([`esc`]) through a link that can misbehave
 //! ([`faults`]), into pseudo-terminals, serial ports, files or standard output ([`destination`],
-//! [`sink`], `pty` on Unix), paced in real time or as fast as possible ([`schedule`]). Every
-//! random choice comes from the seed ([`rng`]): the same seed and description give the same
-//! bytes.
+//! [`sink`], `pty` on Unix; [`template`]: one name for every ESC), paced in real time or as
+//! fast as possible ([`schedule`]). Every random choice comes from the seed ([`rng`]): the same
+//! seed and description give the same bytes.
 //!
 //! A run is described in plain data: the ESCs by a [`FleetSpec`], built (checked, its profile
 //! loaded) into a [`VirtualFleet`]; where and how they run by a [`Plan`]. A [`Session`] opens
@@ -36,6 +36,7 @@ pub mod rng;
 pub mod schedule;
 pub mod session;
 pub mod sink;
+pub mod template;
 
 pub use destination::{Destination, FileFormat};
 pub use error::SimError;

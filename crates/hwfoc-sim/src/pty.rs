@@ -28,7 +28,7 @@ use nix::poll::{PollFd, PollFlags, PollTimeout, poll};
 use nix::sys::termios::{SetArg, cfmakeraw, tcgetattr, tcsetattr};
 
 use crate::error::SimError;
-use crate::sink::expand;
+use crate::template::expand;
 
 /// A pseudo-terminal pair in raw mode, both sides close-on-exec from the moment they exist.
 ///

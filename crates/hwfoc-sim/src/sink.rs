@@ -54,11 +54,6 @@ pub fn check_new<'a>(
     }
 }
 
-/// `template` with `{esc}` replaced by the ESC's index.
-pub fn expand(template: &str, esc: usize) -> String {
-    template.replace("{esc}", &esc.to_string())
-}
-
 fn write_error(name: &str) -> impl FnOnce(io::Error) -> WriteError + '_ {
     move |source| WriteError::Write {
         output: name.to_string(),

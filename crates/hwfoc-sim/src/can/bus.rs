@@ -75,7 +75,10 @@ impl CanBus {
     /// 500 kbit/s.
     pub fn build(spec: &FleetSpec, factory: bool) -> Result<CanBus, SimError> {
         if spec.n > MAX_CAN_ESCS {
-            return Err(SimError::TooManyCanEscs { n: spec.n });
+            return Err(SimError::TooManyCanEscs {
+                n: spec.n,
+                max: MAX_CAN_ESCS,
+            });
         }
         if spec.link != LinkRates::default() {
             return Err(SimError::CanLinkFaults);

@@ -68,6 +68,7 @@
 //! | `bits` | DSDL bit packing, float16 ([`f16_from_f32`], [`f32_from_f16`]) |
 //! | `kind` | [`Kind`], [`Form`], [`Message`], [`DataType`], [`PayloadError`], [`MAX_PAYLOAD_LEN`] |
 //! | `types` | the data types' structs |
+//! | `setup_codes` | the codes in Hobbywing's set-up requests (`SetDirectionRequest::QUERY`, ...) |
 //! | `transfer` | [`transfer_crc`], [`signature_crc`], [`Frames`] |
 //! | `receiver` | [`Receiver`], [`Received`], [`DEFAULT_SLOTS`] |
 //! | `stats` | [`LinkStats`], [`BusStats`], [`NodeStats`] |
@@ -84,6 +85,7 @@ mod frame;
 mod id;
 mod kind;
 mod receiver;
+mod setup_codes;
 mod stats;
 mod transfer;
 mod types;

@@ -5,7 +5,7 @@ use std::io::{BufRead, IsTerminal, Write};
 
 use clap::Args;
 use hwfoc::dronecan::{Message, SelfTestRequest};
-use hwfoc_io::can::setup::{
+use hwfoc_can_setup::{
     Change, Client, Direction, Led, SetupError, ThrottleSource, baud_code, parse_rate,
 };
 

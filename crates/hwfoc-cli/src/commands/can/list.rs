@@ -3,7 +3,7 @@
 use std::time::Duration;
 
 use clap::Args;
-use hwfoc_io::can::setup::{EscSurvey, LED_COLORS, Survey, rate_hz};
+use hwfoc_can_setup::{EscSurvey, LED_COLORS, Survey, rate_hz};
 use hwfoc_sim::can::MAX_CHANNEL;
 use serde_json::{Value, json};
 
@@ -310,7 +310,7 @@ fn json(bus: &str, s: &Survey) -> Value {
 mod tests {
     use super::*;
     use hwfoc::dronecan::{GetEscId, Message, StatusMsg1};
-    use hwfoc_io::can::setup::Heard;
+    use hwfoc_can_setup::Heard;
 
     /// The survey of nodes that each sent a StatusMsg1 and answered GetEscID `[node, channel]`.
     fn survey(answers: &[(u8, u8)]) -> Survey {

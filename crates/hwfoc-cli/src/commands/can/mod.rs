@@ -2,7 +2,7 @@
 //! versions) in the open, as the DataLink's CAN tab does: list them (`list`), give one a node
 //! id and throttle channel (`set-id`), change its direction, throttle source, LED, reporting
 //! rates or bit rate (`set`), run its self test (`self-test`). The protocol is
-//! [`hwfoc_io::can::setup`]'s [`Client`]; this module holds the options, the confirmation and
+//! [`hwfoc_can_setup`]'s [`Client`]; this module holds the options, the confirmation and
 //! the presentation (`list`: the table and the JSON; `change`: the other subcommands).
 
 mod change;
@@ -12,8 +12,8 @@ use std::sync::Arc;
 use std::time::Duration;
 
 use clap::{Args, Subcommand};
+use hwfoc_can_setup::Client;
 use hwfoc_io::can::CanBus;
-use hwfoc_io::can::setup::Client;
 
 use crate::error::CliError;
 

@@ -26,7 +26,7 @@ use hwfoc_sim::profile::{ProfileSpec, Shape};
 use hwfoc_sim::protocols::SIMULATED;
 #[cfg(unix)]
 use hwfoc_sim::pty::PtyLinks;
-use hwfoc_sim::sink::expand;
+use hwfoc_sim::template::expand;
 use hwfoc_sim::{
     Destination, EscReport, FileFormat, FleetSpec, Plan, Session, SimError, VirtualFleet,
 };

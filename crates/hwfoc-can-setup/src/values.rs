@@ -12,17 +12,15 @@ use hwfoc::dronecan::{
 
 /// Which way the motor turns (`SetDirection`: 0 clockwise, 1 counter-clockwise).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[repr(u8)]
 pub enum Direction {
     /// Clockwise (`cw`).
-    Cw,
+    Cw = SetDirectionRequest::CW,
     /// Counter-clockwise (`ccw`).
-    Ccw,
+    Ccw = SetDirectionRequest::CCW,
 }
 
 impl Direction {
-    /// `SetDirection`'s `direction` that asks without changing anything.
-    pub const QUERY: u8 = 255;
-
     /// From the wire's code (0 or 1; `GetMajorConfig`'s `direction` bit).
     pub fn from_ccw(ccw: bool) -> Direction {
         if ccw { Direction::Ccw } else { Direction::Cw }
@@ -55,11 +53,12 @@ impl FromStr for Direction {
 
 /// Where the ESC takes its throttle from (`SetThrottleSource`: 0 CAN, 1 PWM).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[repr(u8)]
 pub enum ThrottleSource {
     /// DroneCAN's `RawCommand` (`can`).
-    Can,
+    Can = SetThrottleSourceRequest::CAN,
     /// The PWM signal wire (`pwm`).
-    Pwm,
+    Pwm = SetThrottleSourceRequest::PWM,
 }
 
 impl ThrottleSource {
@@ -96,15 +95,13 @@ impl FromStr for ThrottleSource {
 pub const LED_COLORS: [&str; 8] = [
     "off", "blue", "green", "cyan", "red", "magenta", "yellow", "white",
 ];
-/// The LED blink codes `SetLED` takes: 0 steady, else the rate in Hz.
-pub const LED_BLINKS: [u8; 4] = [0, 1, 2, 5];
 
 /// An LED setting: colour, blink, and whether the ESC keeps it (`SetLED`'s option 1).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Led {
     /// Colour code 0..=7 ([`LED_COLORS`]).
     pub color: u8,
-    /// Blink code ([`LED_BLINKS`]): 0 steady, 1, 2 or 5 Hz.
+    /// Blink code ([`SetLedRequest::BLINKS`]): 0 steady, 1, 2 or 5 Hz.
     pub blink: u8,
     /// Saved by the ESC (not read back: `GetMajorConfig` does not say).
     pub save: bool,
@@ -133,7 +130,7 @@ impl FromStr for Led {
                         .trim_end_matches("Hz")
                         .parse::<u8>()
                         .ok()
-                        .filter(|b| LED_BLINKS.contains(b))
+                        .filter(|b| SetLedRequest::BLINKS.contains(b))
                         .ok_or_else(|| {
                             format!("{s:?}: expected COLOR[,BLINK][,save], BLINK 0, 1, 2 or 5 (Hz)")
                         })?
@@ -170,6 +167,13 @@ pub enum StatusMessage {
 }
 
 impl StatusMessage {
+    /// The three, in order.
+    pub const ALL: [StatusMessage; 3] = [
+        StatusMessage::Msg1,
+        StatusMessage::Msg2,
+        StatusMessage::Msg3,
+    ];
+
     /// Its data type: `SetReportingFrequency`'s `MSG_ID` is its id.
     pub fn kind(self) -> Kind {
         match self {
@@ -193,10 +197,14 @@ impl FromStr for StatusMessage {
     type Err = String;
     fn from_str(s: &str) -> Result<StatusMessage, String> {
         match s.to_ascii_lowercase().as_str() {
-            "msg1" | "statusmsg1" | "20050" => Ok(StatusMessage::Msg1),
-            "msg2" | "statusmsg2" | "20051" => Ok(StatusMessage::Msg2),
-            "msg3" | "statusmsg3" | "20052" => Ok(StatusMessage::Msg3),
-            _ => Err(format!("{s:?}: expected msg1, msg2 or msg3")),
+            "msg1" | "statusmsg1" => Ok(StatusMessage::Msg1),
+            "msg2" | "statusmsg2" => Ok(StatusMessage::Msg2),
+            "msg3" | "statusmsg3" => Ok(StatusMessage::Msg3),
+            // Or its data type id (20050-20052).
+            id => StatusMessage::ALL
+                .into_iter()
+                .find(|m| id.parse() == Ok(m.kind().data_type_id()))
+                .ok_or_else(|| format!("{s:?}: expected msg1, msg2 or msg3")),
         }
     }
 }
@@ -249,7 +257,7 @@ pub fn baud_code(bitrate: u32) -> Option<u8> {
 }
 
 /// One setting a setup service changes, with its value. Also what the ESC says it has (read
-/// back: [`Client::read`](super::Client::read)).
+/// back: [`Client::read`](crate::Client::read)).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Change {
     /// Node id and throttle channel (`SetID`).
@@ -292,13 +300,13 @@ impl Change {
             .into(),
             Change::ThrottleSource(s) => SetThrottleSourceRequest { source: s as u8 }.into(),
             Change::Led(l) => SetLedRequest {
-                option: u8::from(l.save),
+                option: if l.save { SetLedRequest::SAVE } else { 0 },
                 color: l.color,
                 blink: l.blink,
             }
             .into(),
             Change::Rate { message, code } => SetReportingFrequencyRequest {
-                option: 1,
+                option: SetReportingFrequencyRequest::WRITE,
                 msg_id: message.kind().data_type_id(),
                 rate: code,
             }
@@ -370,6 +378,11 @@ mod tests {
     #[test]
     fn names_parse_and_print() {
         assert_eq!("CCW".parse(), Ok(Direction::Ccw));
+        assert_eq!("StatusMsg2".parse(), Ok(StatusMessage::Msg2));
+        assert_eq!("20052".parse(), Ok(StatusMessage::Msg3));
+        assert!("20053".parse::<StatusMessage>().is_err());
+        assert_eq!(Direction::Ccw.code(), 1);
+        assert_eq!(ThrottleSource::Pwm as u8, 1);
         assert!("left".parse::<Direction>().is_err());
         assert_eq!("pwm".parse(), Ok(ThrottleSource::Pwm));
         let led: Led = "red,2,save".parse().unwrap();

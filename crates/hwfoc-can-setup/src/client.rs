@@ -11,10 +11,10 @@ use hwfoc::dronecan::{
     SetReportingFrequencyRequest, TransferType,
 };
 
-use super::SetupError;
-use super::heard::{Heard, NodeHeard};
-use super::values::{Change, Direction, Led, StatusMessage, ThrottleSource};
-use crate::can::{ASK_EVERY, ASK_PRIORITY, CanBus, CanError};
+use crate::SetupError;
+use crate::heard::{Heard, NodeHeard};
+use crate::values::{Change, Direction, Led, StatusMessage, ThrottleSource};
+use hwfoc_ports::can::{ASK_EVERY, ASK_PRIORITY, CanBus, CanError};
 
 /// Priority of hwfoc's service requests: 16, DroneCAN's "medium" (pydronecan's and
 /// ArduPilot's default).
@@ -378,10 +378,12 @@ impl<L: Link> Client<L> {
     /// The direction (`SetDirection` 255, which only asks).
     pub fn direction(&mut self, node: u8, timeout: Duration) -> Result<Direction, SetupError> {
         let r = SetDirectionRequest {
-            direction: Direction::QUERY,
+            direction: SetDirectionRequest::QUERY,
         };
         self.ask(node, r, timeout, |m| match m {
-            Message::SetDirectionResponse(r) => Some(Direction::from_ccw(r.direction == 1)),
+            Message::SetDirectionResponse(r) => {
+                Some(Direction::from_ccw(r.direction == SetDirectionRequest::CCW))
+            }
             _ => None,
         })
     }
@@ -409,7 +411,9 @@ impl<L: Link> Client<L> {
         node: u8,
         timeout: Duration,
     ) -> Result<GetMaintenanceInformationResponse, SetupError> {
-        let r = GetMaintenanceInformationRequest { option: 0 };
+        let r = GetMaintenanceInformationRequest {
+            option: GetMaintenanceInformationRequest::READ,
+        };
         self.ask(node, r, timeout, |m| match m {
             Message::GetMaintenanceInformationResponse(r) => Some(r),
             _ => None,
@@ -424,7 +428,7 @@ impl<L: Link> Client<L> {
         timeout: Duration,
     ) -> Result<u8, SetupError> {
         let r = SetReportingFrequencyRequest {
-            option: 0,
+            option: SetReportingFrequencyRequest::READ,
             msg_id: message.kind().data_type_id(),
             rate: 0,
         };

@@ -16,6 +16,9 @@
 //! | `heard` | [`Heard`], [`NodeHeard`]: what each node sent; [`Motion`]: what says a motor turns |
 //! | `values` | [`Change`] and its values by name |
 
+#![forbid(unsafe_op_in_unsafe_fn)]
+#![warn(missing_docs)]
+
 mod client;
 mod heard;
 mod values;
@@ -28,11 +31,11 @@ use hwfoc::dronecan::Kind;
 pub use client::{Client, EscSurvey, Link, Made, REQUEST_PRIORITY, Survey};
 pub use heard::{Heard, Motion, NodeHeard};
 pub use values::{
-    Change, Direction, LED_BLINKS, LED_COLORS, Led, StatusMessage, ThrottleSource, baud_code,
-    parse_rate, rate_code, rate_hz, rate_text,
+    Change, Direction, LED_COLORS, Led, StatusMessage, ThrottleSource, baud_code, parse_rate,
+    rate_code, rate_hz, rate_text,
 };
 
-use super::CanError;
+use hwfoc_ports::can::CanError;
 
 /// Why a setup step failed. Each names the bus, and the node where there is one.
 #[derive(Debug)]
