@@ -45,6 +45,7 @@
 //! assert_eq!(decoder.locked(), Some(Family::HwV3));
 //! ```
 
+use crate::protocol::FoundFrame;
 use crate::scan::{self, Scanner, StreamDecoder};
 use crate::{Protocol, hw5, mixed, v3, v4};
 
@@ -67,76 +68,88 @@ pub const RELOCK_AFTER: u64 = 4096;
 /// a clean locked stream it costs a few bytes' copy per chunk.
 pub const HISTORY: usize = 2 * RELOCK_AFTER as usize;
 
-/// A format the decoder locks onto: HW-FOC and DataLink are read by one decoder ([`mixed`]),
-/// which tells them apart frame by frame.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-pub enum Family {
-    /// HW-FOC or DataLink V2 ([`mixed`]).
-    Mixed,
-    /// HW5 ([`hw5`]).
-    Hw5,
-    /// Hobbywing V4 ([`v4`]).
-    HwV4,
-    /// Hobbywing V3 ([`v3`]).
-    HwV3,
-}
-
-impl Family {
-    /// Every family, in the order they are preferred when two find frames in one slice.
-    pub const ALL: [Family; 4] = [Family::Mixed, Family::Hw5, Family::HwV4, Family::HwV3];
-}
-
-/// A frame of any format, with its stream offset.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-pub enum Decoded {
-    /// An HW-FOC or DataLink V2 frame.
-    Mixed(mixed::Decoded),
-    /// A Hobbywing V4 frame (data or info).
-    HwV4(v4::Decoded),
-    /// A Hobbywing V3 frame.
-    HwV3(v3::Decoded),
-    /// An HW5 telemetry frame.
-    Hw5(hw5::Decoded),
-}
-
-impl Decoded {
-    /// Offset of the frame's first byte in the stream.
-    pub fn offset(&self) -> u64 {
-        match self {
-            Decoded::Mixed(d) => d.offset(),
-            Decoded::HwV4(d) => d.offset,
-            Decoded::HwV3(d) => d.offset,
-            Decoded::Hw5(d) => d.offset,
+/// Declares [`Family`] and [`Decoded`] from the list of formats (`formats!` in `lib.rs`): one
+/// arm for each format there with a `family`.
+macro_rules! declare_families {
+    ($( $(#[$doc:meta])* $arm:ident => $description:path, $kind:ident $data:ty
+        $(, info $info:ty)? $(, family $family:ident($decoded:ty) rank $rank:literal)?; )+) => {
+        /// A format the decoder locks onto: HW-FOC and DataLink are read by one decoder
+        /// ([`mixed`]), which tells them apart frame by frame.
+        #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+        pub enum Family {
+            $($(
+                #[doc = concat!("The format(s) whose frames are [`", stringify!($decoded), "`].")]
+                $family,
+            )?)+
         }
-    }
 
-    /// The protocol the frame came in.
-    pub fn protocol(&self) -> Protocol {
-        match self {
-            Decoded::Mixed(mixed::Decoded::Esc(_)) => Protocol::HwFoc,
-            Decoded::Mixed(mixed::Decoded::Hub(_)) => Protocol::DataLink,
-            Decoded::HwV4(_) => Protocol::HwV4,
-            Decoded::HwV3(_) => Protocol::HwV3,
-            Decoded::Hw5(_) => Protocol::Hw5,
+        impl Family {
+            /// Every family, in the order they are preferred when two find frames in one slice
+            /// (their rank in the list of formats).
+            pub const ALL: [Family; [$($(Family::$family,)?)+].len()] = {
+                let mut ranked = [$($((Family::$family, $rank),)?)+];
+                let mut i = 1;
+                while i < ranked.len() {
+                    let mut j = i;
+                    while j > 0 && ranked[j - 1].1 > ranked[j].1 {
+                        let t = ranked[j];
+                        ranked[j] = ranked[j - 1];
+                        ranked[j - 1] = t;
+                        j -= 1;
+                    }
+                    i += 1;
+                }
+                let mut all = [ranked[0].0; [$($(Family::$family,)?)+].len()];
+                let mut k = 0;
+                while k < ranked.len() {
+                    all[k] = ranked[k].0;
+                    k += 1;
+                }
+                all
+            };
         }
-    }
 
-    /// The family of its format.
-    pub fn family(&self) -> Family {
-        match self {
-            Decoded::Mixed(_) => Family::Mixed,
-            Decoded::HwV4(_) => Family::HwV4,
-            Decoded::HwV3(_) => Family::HwV3,
-            Decoded::Hw5(_) => Family::Hw5,
+        /// A frame of any format, with its stream offset.
+        #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+        pub enum Decoded {
+            $($(
+                #[doc = concat!("A frame of [`Family::", stringify!($family), "`].")]
+                $family($decoded),
+            )?)+
         }
-    }
+
+        impl Decoded {
+            /// Offset of the frame's first byte in the stream.
+            pub fn offset(&self) -> u64 {
+                match self {
+                    $($( Decoded::$family(d) => FoundFrame::offset(d), )?)+
+                }
+            }
+
+            /// The protocol the frame came in.
+            pub fn protocol(&self) -> Protocol {
+                match self {
+                    $($( Decoded::$family(d) => FoundFrame::protocol(d), )?)+
+                }
+            }
+
+            /// The family of its format.
+            pub fn family(&self) -> Family {
+                match self {
+                    $($( Decoded::$family(_) => Family::$family, )?)+
+                }
+            }
+        }
+    };
 }
+
+formats!(declare_families);
 
 /// `on_frame`, noting in `found` the family of each frame while detecting (`all`): for the
 /// frames a silence or the end of the stream settles.
 fn noting<'a>(
     all: bool,
-    found: &'a mut [Option<u64>; 4],
+    found: &'a mut [Option<u64>; Family::ALL.len()],
     on_frame: &'a mut impl FnMut(Decoded),
 ) -> impl FnMut(Decoded) + 'a {
     move |d: Decoded| {
@@ -227,7 +240,7 @@ pub struct Decoder {
     /// `None` for the block it locked in (not judged: it is only partly locked).
     block_start: Option<u64>,
     /// Detecting: which families found a frame in the current slice, and the last one's offset.
-    found: [Option<u64>; 4],
+    found: [Option<u64>; Family::ALL.len()],
     /// Locked: the offset of the locked decoder's last frame.
     last_frame: u64,
     /// The stream's last bytes (kept while locked).
@@ -367,7 +380,7 @@ impl Decoder {
         let now = self.handed_on(family);
         if self.block_start == Some(now) {
             self.locked = None;
-            self.found = [None; 4];
+            self.found = [None; Family::ALL.len()];
             self.replay(on_frame);
             self.end_slice();
         }
@@ -454,7 +467,7 @@ impl Decoder {
             self.block_start = None;
             self.last_frame = self.found[i].unwrap_or(self.bytes);
         }
-        self.found = [None; 4];
+        self.found = [None; Family::ALL.len()];
     }
 
     /// Brings every decoder to the stream's end: each passes over the bytes it was not given.
@@ -524,7 +537,7 @@ impl Decoder {
         self.end_slice();
         // A silence may be a change of ESC: every format is read again from here.
         self.locked = None;
-        self.found = [None; 4];
+        self.found = [None; Family::ALL.len()];
     }
 
     /// Ends the stream: every decoder decides what it holds (as each protocol's `flush`),
@@ -590,5 +603,18 @@ impl Decoder {
         self.block_start = None;
         self.found = later.found.map(|at| at.map(|at| at + base));
         true
+    }
+}
+
+#[cfg(test)]
+mod family_tests {
+    use super::*;
+
+    #[test]
+    fn families_are_preferred_checksummed_first() {
+        assert_eq!(
+            Family::ALL,
+            [Family::Mixed, Family::Hw5, Family::HwV4, Family::HwV3]
+        );
     }
 }

@@ -51,6 +51,21 @@ impl Decoded {
     }
 }
 
+impl crate::protocol::FoundFrame for Decoded {
+    #[inline]
+    fn offset(&self) -> u64 {
+        Decoded::offset(self)
+    }
+
+    #[inline]
+    fn protocol(&self) -> crate::Protocol {
+        match self {
+            Decoded::Esc(_) => crate::Protocol::HwFoc,
+            Decoded::Hub(_) => crate::Protocol::DataLink,
+        }
+    }
+}
+
 /// The statistics of a stream read by the [`Decoder`]: each protocol's.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Stats {

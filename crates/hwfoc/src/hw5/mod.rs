@@ -107,3 +107,5 @@ pub use layout::{
     TYPE_PARAMETERS, TYPE_PING, TYPE_RESET, TYPE_TELEMETRY, VOLTS, envelope, kinds_of,
 };
 pub use stats::Stats;
+
+crate::protocol::found_frame!(Decoded, Hw5);

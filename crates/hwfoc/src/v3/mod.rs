@@ -81,3 +81,5 @@ pub use frame::{
     COUNTER_AT, FRAME_LEN, FULL_SCALE, Frame, PLACEHOLDER_PERIOD_US, US_PER_MINUTE, erpm_of_period,
 };
 pub use stats::Stats;
+
+crate::protocol::found_frame!(Decoded, HwV3);
