@@ -5,6 +5,7 @@
 use core::fmt;
 
 use crate::format::{FormatDescription, SettingDescription};
+use crate::scan::{Scanner, StreamDecoder};
 use crate::status::Status;
 use crate::units::{Quantity, Settings};
 
@@ -12,7 +13,7 @@ use crate::units::{Quantity, Settings};
 /// [`Protocol::ALL`] and [`Protocol::description`].
 macro_rules! declare_protocol {
     ($( $(#[$doc:meta])* $arm:ident => $description:path, $kind:ident $data:ty
-        $(, info $info:ty)? $(, family $family:ident($decoded:ty) rank $rank:literal)?; )+) => {
+        $(, info $info:ty)? $(, family $family:ident($scanner:ty) rank $rank:literal)?; )+) => {
         /// A wire protocol the codec reads.
         ///
         /// ```
@@ -324,6 +325,37 @@ pub trait FoundFrame {
     fn offset(&self) -> u64;
     /// The protocol the frame came in.
     fn protocol(&self) -> Protocol;
+}
+
+/// The scanner of a serial family that [`detect::Decoder`](crate::detect::Decoder) reads
+/// (its line of the list of formats names it): what differs between the families' decoders.
+pub trait FamilyScanner: Scanner<Item: FoundFrame> + Sized {
+    /// The frames (data and information) a decoder with statistics `stats` has handed on.
+    fn handed_on(stats: &Self::Stats) -> u64;
+
+    /// The length of the frames whose count a silence is told in (HW-FOC's 24 bytes unless the
+    /// family's frames are shorter).
+    const SILENCE_FRAME_LEN: usize = 24;
+
+    /// Tells `decoder` that the line was silent for a time in which at most `esc_frames`
+    /// HW-FOC frames (24 byte times each) and `hub_frames` DataLink frames could have been sent:
+    /// as many of its frames of [`FamilyScanner::SILENCE_FRAME_LEN`] as fit in that time.
+    fn line_silent(
+        decoder: &mut StreamDecoder<Self>,
+        esc_frames: u32,
+        hub_frames: u32,
+        on_frame: &mut dyn FnMut(Self::Item),
+    ) {
+        let _ = hub_frames;
+        let n = frames_in_silence(esc_frames, Self::SILENCE_FRAME_LEN);
+        decoder.line_silent(n, on_frame);
+    }
+}
+
+/// As many frames of `len` bytes as fit in the time of `esc_frames` HW-FOC frames (24 byte
+/// times each).
+pub fn frames_in_silence(esc_frames: u32, len: usize) -> u32 {
+    u32::try_from((u64::from(esc_frames) * 24).div_ceil(len as u64)).unwrap_or(u32::MAX)
 }
 
 /// `impl FoundFrame for $decoded`, a decoder's frame with its `offset` field, all of protocol

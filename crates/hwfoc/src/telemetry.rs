@@ -166,7 +166,7 @@ macro_rules! data_from {
 /// `From` conversions, its [`Telemetry`] and [`Data::protocol`].
 macro_rules! declare_data {
     ($( $(#[$doc:meta])* $arm:ident => $description:path, $kind:ident $data:ty
-        $(, info $info:ty)? $(, family $family:ident($decoded:ty) rank $rank:literal)?; )+) => {
+        $(, info $info:ty)? $(, family $family:ident($scanner:ty) rank $rank:literal)?; )+) => {
         /// A data frame of any supported protocol: one arm per protocol (its data frame, as
         /// the list of formats names it), so that what a record says of its source
         /// ([`Data::protocol`]) is a property of the frame, as its readings are.
@@ -285,7 +285,7 @@ impl Data {
 /// [`DeviceInfo`].
 macro_rules! declare_info {
     ($( $(#[$doc:meta])* $arm:ident => $description:path, $kind:ident $data:ty
-        $(, info $info:ty)? $(, family $family:ident($decoded:ty) rank $rank:literal)?; )+) => {
+        $(, info $info:ty)? $(, family $family:ident($scanner:ty) rank $rank:literal)?; )+) => {
         /// A device-information frame of any supported protocol.
         #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
         pub enum Info {

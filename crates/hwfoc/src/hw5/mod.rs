@@ -109,3 +109,9 @@ pub use layout::{
 pub use stats::Stats;
 
 crate::protocol::found_frame!(Decoded, Hw5);
+
+impl crate::protocol::FamilyScanner for Scanner {
+    fn handed_on(s: &Stats) -> u64 {
+        u64::from(s.telemetry_frames())
+    }
+}

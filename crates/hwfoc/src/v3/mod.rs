@@ -83,3 +83,11 @@ pub use frame::{
 pub use stats::Stats;
 
 crate::protocol::found_frame!(Decoded, HwV3);
+
+impl crate::protocol::FamilyScanner for Scanner {
+    fn handed_on(s: &Stats) -> u64 {
+        u64::from(s.frames())
+    }
+
+    const SILENCE_FRAME_LEN: usize = FRAME_LEN;
+}

@@ -121,3 +121,11 @@ impl From<Frame> for crate::telemetry::Frame {
         }
     }
 }
+
+impl crate::protocol::FamilyScanner for Scanner {
+    fn handed_on(s: &Stats) -> u64 {
+        u64::from(s.frames()) + u64::from(s.info_frames())
+    }
+
+    const SILENCE_FRAME_LEN: usize = DATA_FRAME_LEN;
+}
