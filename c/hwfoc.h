@@ -1139,10 +1139,19 @@ static int hwfoc__v4_found_at(const uint8_t *c, size_t n, size_t at, unsigned fu
                ? HWFOC__V4_DATA : HWFOC__V4_NOTHING;
 }
 
+/* Whether data frames are decoded under the adopted constants now: adopted, unless the last
+ * info frame differs from them (another ESC's, not yet confirmed by a second copy, as after a
+ * swap): then none, as before any info frame (Rust: v4::Stats::in_use). */
+HWFOC__OUT_OF_LINE static int hwfoc__v4_in_use(const hwfoc_v4_stats *s) {
+    return s->has_adopted && !(s->has_last_info && !hwfoc__v4_info_eq(&s->adopted, &s->last_info));
+}
+
 /* Judges the candidate at stream offset `at`; a frame's kind and fields go to *f. */
 static int hwfoc__v4_judge(const hwfoc_v4_stats *s, const uint8_t *c, size_t n, uint64_t at,
                            hwfoc_v4_frame *f, int *synced) {
-    unsigned full_scale = s->has_adopted ? s->adopted.full_scale : HWFOC_V4_DEFAULT_FULL_SCALE;
+    /* Judged by the scale it would be decoded under: the constants in use (Rust:
+     * v4::Stats::full_scale), none while the last info frame differs from the adopted one. */
+    unsigned full_scale = hwfoc__v4_in_use(s) ? s->adopted.full_scale : HWFOC_V4_DEFAULT_FULL_SCALE;
     hwfoc_v4_data next_data;
     hwfoc_v4_info next_info;
     int chained = s->has_chain && s->chain_end == at;
@@ -1197,11 +1206,7 @@ static void hwfoc__v4_accept(hwfoc_v4_stats *s, hwfoc_v4_frame *f, int synced) {
         s->chain_has_next = 1;
         s->chain_next = (f->data.counter + 1u) & HWFOC_COUNTER24_MAX;
         s->chain_trailer = 1;
-        /* The constants in use: the adopted ones, unless the last info frame differs from them
-         * (another ESC's, not yet confirmed by a second copy, as after a swap): then none, as
-         * before any info frame (Rust: v4::Stats::in_use). */
-        f->has_info = s->has_adopted &&
-                      !(s->has_last_info && !hwfoc__v4_info_eq(&s->adopted, &s->last_info));
+        f->has_info = hwfoc__v4_in_use(s);
         if (f->has_info) f->info = s->adopted;
         else memset(&f->info, 0, sizeof f->info);
     } else {

@@ -193,11 +193,16 @@ const AIRFRAME: u64 = 11;
 /// The baseline of three healthy flights of [`airframe`] [`AIRFRAME`], flown other ways than
 /// the flights checked (a sine, a ramp, other levels).
 fn baseline() -> Baseline {
+    baseline_of(AIRFRAME)
+}
+
+/// The baseline of three healthy flights of [`airframe`] `seed` ([`baseline`]'s).
+fn baseline_of(seed: u64) -> Baseline {
     let series: Vec<EscSeries> = [ProfileSpec::Sine, ProfileSpec::Ramp, ProfileSpec::Steps]
         .into_iter()
         .enumerate()
         .flat_map(|(i, profile)| {
-            let mut spec = airframe(AIRFRAME, 25.0, Vec::new());
+            let mut spec = airframe(seed, 25.0, Vec::new());
             spec.profile = profile;
             spec.shape.levels = vec![0.0, 35.0, 55.0, 75.0, 45.0, 65.0, 85.0, 25.0, 0.0];
             spec.shape.period_s = 8.0;
@@ -690,4 +695,73 @@ fn a_can_esc_s_maintenance_answer_in_its_recording_is_judged_against_the_service
     assert_eq!(value("hours_since_service"), 55.0);
     assert_eq!(value("esc_total_rotation"), 150.0);
     assert_eq!(f["threshold"]["value"], 50.0, "{f:#}");
+}
+
+#[test]
+fn a_damaged_prop_flags_its_esc_alone_not_a_healthy_sibling_beside_it() {
+    // Airframe 15: ESC 1's damaged prop draws less current, and with ESC 1 in the siblings'
+    // median ESC 3's healthy current looked 41 % above its siblings'.
+    let spec = airframe(15, 25.0, degrade(1, DegradeKind::Prop, 15.0, 1.0));
+    let imbalance = found_in(spec, 50.0, None, Analyser::Imbalance);
+    on_esc_in_window(&imbalance, 1, 15.0, 5.0, 45.0);
+}
+
+/// The rows of docs/CHECKS.md's detection table: the analyser, the degradation, whether the
+/// flight is a sine of throttle (8 s a cycle) rather than the staircase, and the airframes (of
+/// 20) it is found on.
+const MEASURED: [(Analyser, &str, bool, usize); 8] = [
+    (Analyser::Imbalance, "2:bearing@20=0.5", false, 13),
+    (Analyser::Imbalance, "1:prop@15=1", false, 20),
+    (Analyser::Imbalance, "1:prop@15=1", true, 20),
+    (Analyser::Imbalance, "2:bearing@15=0.5", true, 12),
+    (Analyser::Drift, "2:bearing@20=0.5", false, 20),
+    (Analyser::Drift, "1:prop@15=1", false, 20),
+    (Analyser::Battery, "3:battery@0=0.5", false, 17),
+    (Analyser::Link, "0:wire@25=0.5", false, 20),
+];
+
+#[test]
+fn detection_over_twenty_airframes() {
+    let mut rows = Vec::new();
+    let mut failed = false;
+    for (analyser, degradation, sine, documented) in MEASURED {
+        let spec: DegradeSpec = degradation.parse().unwrap();
+        let (mut found, mut missed, mut other, mut trips) = (0, Vec::new(), Vec::new(), 0);
+        for seed in 1..=20 {
+            let flight = |degradations: Vec<DegradeSpec>| {
+                let mut flight = airframe(seed, 25.0, degradations);
+                if sine {
+                    flight.profile = ProfileSpec::Sine;
+                    flight.shape.period_s = 8.0;
+                }
+                flight
+            };
+            let base =
+                matches!(analyser, Analyser::Drift | Analyser::Battery).then(|| baseline_of(seed));
+            let raised = found_in(flight(vec![spec]), 50.0, base.as_ref(), analyser);
+            let number = |f: &Finding| f.esc.as_ref().unwrap().number;
+            if raised.iter().any(|f| number(f) == spec.esc) {
+                found += 1;
+            } else {
+                missed.push(seed);
+            }
+            other.extend(
+                raised
+                    .iter()
+                    .filter(|f| number(f) != spec.esc)
+                    .map(|f| format!("airframe {seed} ESC {}: {}", number(f), f.message)),
+            );
+            if !found_in(flight(Vec::new()), 50.0, base.as_ref(), analyser).is_empty() {
+                trips += 1;
+            }
+        }
+        failed |= found < documented || !other.is_empty() || trips > 0;
+        rows.push(format!(
+            "{analyser} {degradation} {}: found {found}/20 (missed {missed:?}), \
+             other ESC {other:?}, healthy trips {trips}/20",
+            if sine { "sine" } else { "steps" }
+        ));
+    }
+    println!("{}", rows.join("\n"));
+    assert!(!failed, "{}", rows.join("\n"));
 }

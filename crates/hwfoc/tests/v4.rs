@@ -469,6 +469,45 @@ fn the_adopted_full_scale_is_the_plausibility_limit() {
     assert_eq!(stats.implausible(), 1);
 }
 
+/// Found by the v4 fuzz target: after the constants of another ESC appear (one copy, not yet
+/// adopted), a data frame is decoded as before any info frame (full scale 1000), so it must be
+/// judged by that scale too, not by the adopted one; else a frame of 1500 steps was accepted
+/// and read as 150 %.
+#[test]
+fn a_candidate_is_judged_by_the_scale_it_would_be_decoded_under() {
+    let wide = InfoFrame {
+        full_scale: 2000,
+        ..InfoFrame::parse(&CAPTURE_INFO).unwrap()
+    };
+    let other = InfoFrame {
+        full_scale: 1000,
+        ..wide
+    };
+    let high = |c| DataFrame {
+        throttle_in_raw: 1500,
+        ..data(c)
+    };
+    let mut wire = Vec::new();
+    for c in 0..2 {
+        wire.extend_from_slice(&wide.encode());
+        wire.extend_from_slice(&data(c).encode_with_trailer());
+    }
+    wire.extend_from_slice(&high(2).encode()); // 75 % under the adopted constants
+    wire.extend_from_slice(&other.encode());
+    wire.extend_from_slice(&high(3).encode_with_trailer()); // above 1000 under none: rejected
+    let (decoded, stats) = bulk::<Scanner>(&wire);
+    for (at, d) in data_of(&decoded) {
+        assert!(
+            d.frame.is_plausible(d.full_scale()),
+            "data frame at {at} accepted at {} %",
+            d.throttle_in_pct()
+        );
+    }
+    assert_eq!(counters(&decoded), [0, 1, 2]);
+    assert_eq!(data_of(&decoded)[2].1.throttle_in_pct(), 75.0);
+    assert_eq!(stats.implausible(), 1);
+}
+
 // ---------------------------------------------------------------------------------------------
 // Properties
 // ---------------------------------------------------------------------------------------------

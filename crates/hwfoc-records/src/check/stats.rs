@@ -17,6 +17,18 @@ pub(super) fn median(values: &mut [f64]) -> Option<f64> {
     percentile(values, 50.0)
 }
 
+/// The median of `values` as the middle value, or the mean of the two middle values of an
+/// even count (where [`median`] takes the lower): a reference drawn from two or four ESCs lies
+/// between them, not on the lowest; `None` when empty.
+pub(super) fn centre(values: &mut [f64]) -> Option<f64> {
+    if values.is_empty() {
+        return None;
+    }
+    values.sort_by(f64::total_cmp);
+    let n = values.len();
+    Some((values[(n - 1) / 2] + values[n / 2]) / 2.0)
+}
+
 /// The curve of `points` `(x, y)`: in each bin of `x` of width `width` holding at least `min`
 /// points, the median `x` and the median `y`, by `x`.
 pub(super) fn curve(points: impl Iterator<Item = (f64, f64)>, width: f64, min: usize) -> Curve {
@@ -252,6 +264,13 @@ mod tests {
         let mut points: Vec<(f64, f64)> = (0..100).map(|i| (i as f64 * 0.1, 1.0)).collect();
         points[50].1 = 100.0;
         assert!(rolling_median(&points, 1.0).iter().all(|m| m.2 == 1.0));
+    }
+
+    #[test]
+    fn a_centre_of_an_even_count_lies_between_the_two_middle_values() {
+        assert_eq!(centre(&mut [4.0, 1.0, 3.0, 2.0]), Some(2.5));
+        assert_eq!(centre(&mut [3.0, 1.0, 2.0]), Some(2.0));
+        assert_eq!(centre(&mut []), None);
     }
 
     #[test]

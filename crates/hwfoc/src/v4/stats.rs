@@ -133,10 +133,13 @@ impl Stats {
         self.last_info
     }
 
-    /// Full scale of throttle and PWM in use (for the plausibility test too): the adopted info
-    /// frame's, else 1000.
-    pub const fn full_scale(&self) -> u16 {
-        match self.adopted {
+    /// Full scale of throttle and PWM in use (for the plausibility test too): that of the info
+    /// frame data frames are decoded under now ([`Stats::in_use`]), else 1000. A candidate is
+    /// judged by the scale it would be decoded under, so an accepted frame is never above 100 %
+    /// (after a swap, a frame above 1000 before the new constants are confirmed is rejected).
+    #[inline]
+    pub fn full_scale(&self) -> u16 {
+        match self.in_use() {
             Some(info) => info.full_scale,
             None => DEFAULT_FULL_SCALE,
         }
