@@ -36,10 +36,7 @@ fn float_quantities() -> impl Iterator<Item = Quantity> {
 
 /// The code of `protocol` in the `protocol` column: its place in [`Protocol::ALL`].
 fn protocol_code(protocol: Protocol) -> u8 {
-    Protocol::ALL
-        .iter()
-        .position(|p| *p == protocol)
-        .map_or(u8::MAX, |i| i as u8)
+    protocol.index() as u8
 }
 
 impl Columns {

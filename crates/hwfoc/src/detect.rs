@@ -45,6 +45,7 @@
 //! assert_eq!(decoder.locked(), Some(Family::HwV3));
 //! ```
 
+use crate::protocol::{FamilyScanner, FoundFrame};
 use crate::scan::{self, Scanner, StreamDecoder};
 use crate::{Protocol, hw5, mixed, v3, v4};
 
@@ -67,76 +68,181 @@ pub const RELOCK_AFTER: u64 = 4096;
 /// a clean locked stream it costs a few bytes' copy per chunk.
 pub const HISTORY: usize = 2 * RELOCK_AFTER as usize;
 
-/// A format the decoder locks onto: HW-FOC and DataLink are read by one decoder ([`mixed`]),
-/// which tells them apart frame by frame.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-pub enum Family {
-    /// HW-FOC or DataLink V2 ([`mixed`]).
-    Mixed,
-    /// HW5 ([`hw5`]).
-    Hw5,
-    /// Hobbywing V4 ([`v4`]).
-    HwV4,
-    /// Hobbywing V3 ([`v3`]).
-    HwV3,
-}
-
-impl Family {
-    /// Every family, in the order they are preferred when two find frames in one slice.
-    pub const ALL: [Family; 4] = [Family::Mixed, Family::Hw5, Family::HwV4, Family::HwV3];
-}
-
-/// A frame of any format, with its stream offset.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-pub enum Decoded {
-    /// An HW-FOC or DataLink V2 frame.
-    Mixed(mixed::Decoded),
-    /// A Hobbywing V4 frame (data or info).
-    HwV4(v4::Decoded),
-    /// A Hobbywing V3 frame.
-    HwV3(v3::Decoded),
-    /// An HW5 telemetry frame.
-    Hw5(hw5::Decoded),
-}
-
-impl Decoded {
-    /// Offset of the frame's first byte in the stream.
-    pub fn offset(&self) -> u64 {
-        match self {
-            Decoded::Mixed(d) => d.offset(),
-            Decoded::HwV4(d) => d.offset,
-            Decoded::HwV3(d) => d.offset,
-            Decoded::Hw5(d) => d.offset,
+/// Declares [`Family`] and [`Decoded`] from the list of formats (`formats!` in `lib.rs`): one
+/// arm for each format there with a `family`.
+macro_rules! declare_families {
+    ($( $(#[$doc:meta])* $arm:ident => $description:path, $kind:ident $data:ty
+        $(, info $info:ty)? $(, family $family:ident($scanner:ty) rank $rank:literal)?; )+) => {
+        /// A format the decoder locks onto: HW-FOC and DataLink are read by one decoder
+        /// ([`mixed`]), which tells them apart frame by frame.
+        #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+        pub enum Family {
+            $($(
+                #[doc = concat!("The format(s) read by [`", stringify!($scanner), "`].")]
+                $family,
+            )?)+
         }
-    }
 
-    /// The protocol the frame came in.
-    pub fn protocol(&self) -> Protocol {
-        match self {
-            Decoded::Mixed(mixed::Decoded::Esc(_)) => Protocol::HwFoc,
-            Decoded::Mixed(mixed::Decoded::Hub(_)) => Protocol::DataLink,
-            Decoded::HwV4(_) => Protocol::HwV4,
-            Decoded::HwV3(_) => Protocol::HwV3,
-            Decoded::Hw5(_) => Protocol::Hw5,
+        impl Family {
+            /// Every family, in the order they are preferred when two find frames in one slice
+            /// (their rank in the list of formats).
+            pub const ALL: [Family; [$($(Family::$family,)?)+].len()] = {
+                let mut ranked = [$($((Family::$family, $rank),)?)+];
+                let mut i = 1;
+                while i < ranked.len() {
+                    let mut j = i;
+                    while j > 0 && ranked[j - 1].1 > ranked[j].1 {
+                        let t = ranked[j];
+                        ranked[j] = ranked[j - 1];
+                        ranked[j - 1] = t;
+                        j -= 1;
+                    }
+                    i += 1;
+                }
+                let mut all = [ranked[0].0; [$($(Family::$family,)?)+].len()];
+                let mut k = 0;
+                while k < ranked.len() {
+                    all[k] = ranked[k].0;
+                    k += 1;
+                }
+                all
+            };
         }
-    }
 
-    /// The family of its format.
-    pub fn family(&self) -> Family {
-        match self {
-            Decoded::Mixed(_) => Family::Mixed,
-            Decoded::HwV4(_) => Family::HwV4,
-            Decoded::HwV3(_) => Family::HwV3,
-            Decoded::Hw5(_) => Family::Hw5,
+        /// A frame of any format, with its stream offset.
+        #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+        pub enum Decoded {
+            $($(
+                #[doc = concat!("A frame of [`Family::", stringify!($family), "`].")]
+                $family(<$scanner as Scanner>::Item),
+            )?)+
         }
-    }
+
+        impl Decoded {
+            /// Offset of the frame's first byte in the stream.
+            pub fn offset(&self) -> u64 {
+                match self {
+                    $($( Decoded::$family(d) => FoundFrame::offset(d), )?)+
+                }
+            }
+
+            /// The protocol the frame came in.
+            pub fn protocol(&self) -> Protocol {
+                match self {
+                    $($( Decoded::$family(d) => FoundFrame::protocol(d), )?)+
+                }
+            }
+
+            /// The family of its format.
+            pub fn family(&self) -> Family {
+                match self {
+                    $($( Decoded::$family(_) => Family::$family, )?)+
+                }
+            }
+        }
+
+        /// Each family's decoder, a field named as its family.
+        #[allow(non_snake_case)]
+        #[derive(Debug, Clone, Default)]
+        struct Decoders {
+            $($( $family: StreamDecoder<$scanner>, )?)+
+        }
+
+        impl Decoders {
+            /// Bytes `family`'s decoder holds for a frame still arriving.
+            fn buffered(&self, family: Family) -> usize {
+                match family {
+                    $($( Family::$family => self.$family.buffered(), )?)+
+                }
+            }
+
+            /// Every byte `family`'s decoder was given or passed over.
+            fn bytes(&self, family: Family) -> u64 {
+                match family {
+                    $($( Family::$family => scan::Stats::bytes(self.$family.stats()), )?)+
+                }
+            }
+
+            /// The frames `family`'s decoder has handed on so far (data and information).
+            fn handed_on(&self, family: Family) -> u64 {
+                match family {
+                    $($( Family::$family => {
+                        <$scanner as FamilyScanner>::handed_on(self.$family.stats())
+                    } )?)+
+                }
+            }
+
+            /// `family`'s decoder passes over `n` bytes.
+            fn pass_over(&mut self, family: Family, n: u64) {
+                match family {
+                    $($( Family::$family => self.$family.pass_over(n), )?)+
+                }
+            }
+
+            /// Gives `family`'s decoder `piece`.
+            fn feed(&mut self, family: Family, piece: &[u8], on_frame: &mut dyn FnMut(Decoded)) {
+                match family {
+                    $($( Family::$family => {
+                        self.$family.feed(piece, |d| on_frame(Decoded::$family(d)))
+                    } )?)+
+                }
+            }
+
+            /// `family`'s decoder decides what it holds.
+            fn flush(&mut self, family: Family, on_frame: &mut dyn FnMut(Decoded)) {
+                match family {
+                    $($( Family::$family => self.$family.flush(|d| on_frame(Decoded::$family(d))), )?)+
+                }
+            }
+
+            /// Tells `family`'s decoder of a silence ([`FamilyScanner::line_silent`]).
+            fn line_silent(
+                &mut self,
+                family: Family,
+                esc_frames: u32,
+                hub_frames: u32,
+                on_frame: &mut dyn FnMut(Decoded),
+            ) {
+                match family {
+                    $($( Family::$family => <$scanner as FamilyScanner>::line_silent(
+                        &mut self.$family,
+                        esc_frames,
+                        hub_frames,
+                        &mut |d| on_frame(Decoded::$family(d)),
+                    ), )?)+
+                }
+            }
+
+            /// Brings `family`'s decoder up to `to` ([`replay_into`]).
+            fn replay(
+                &mut self,
+                family: Family,
+                history: &History,
+                from: u64,
+                to: u64,
+                on_frame: &mut dyn FnMut(Decoded),
+            ) {
+                match family {
+                    $($( Family::$family => replay_into(
+                        &mut self.$family,
+                        history,
+                        from,
+                        to,
+                        &mut |d| on_frame(Decoded::$family(d)),
+                    ), )?)+
+                }
+            }
+        }
+    };
 }
+
+formats!(declare_families);
 
 /// `on_frame`, noting in `found` the family of each frame while detecting (`all`): for the
 /// frames a silence or the end of the stream settles.
 fn noting<'a>(
     all: bool,
-    found: &'a mut [Option<u64>; 4],
+    found: &'a mut [Option<u64>; Family::ALL.len()],
     on_frame: &'a mut impl FnMut(Decoded),
 ) -> impl FnMut(Decoded) + 'a {
     move |d: Decoded| {
@@ -213,10 +319,8 @@ fn replay_into<S: Scanner>(
 /// A decoder of every Hobbywing serial format at once (see the module documentation).
 #[derive(Debug, Clone, Default)]
 pub struct Decoder {
-    mixed: mixed::Decoder,
-    v4: v4::Decoder,
-    v3: v3::Decoder,
-    hw5: hw5::Decoder,
+    /// Each family's decoder.
+    decoders: Decoders,
     /// Every byte given so far.
     bytes: u64,
     /// The format locked onto, if any.
@@ -227,7 +331,7 @@ pub struct Decoder {
     /// `None` for the block it locked in (not judged: it is only partly locked).
     block_start: Option<u64>,
     /// Detecting: which families found a frame in the current slice, and the last one's offset.
-    found: [Option<u64>; 4],
+    found: [Option<u64>; Family::ALL.len()],
     /// Locked: the offset of the locked decoder's last frame.
     last_frame: u64,
     /// The stream's last bytes (kept while locked).
@@ -259,38 +363,34 @@ impl Decoder {
     /// most any decoder holds.
     pub fn buffered(&self) -> usize {
         match self.locked {
-            Some(Family::Mixed) => self.mixed.buffered(),
-            Some(Family::HwV4) => self.v4.buffered(),
-            Some(Family::HwV3) => self.v3.buffered(),
-            Some(Family::Hw5) => self.hw5.buffered(),
-            None => self
-                .mixed
-                .buffered()
-                .max(self.v4.buffered())
-                .max(self.v3.buffered())
-                .max(self.hw5.buffered()),
+            Some(family) => self.decoders.buffered(family),
+            None => Family::ALL
+                .iter()
+                .map(|&f| self.decoders.buffered(f))
+                .max()
+                .unwrap_or(0),
         }
     }
 
     /// HW-FOC's and DataLink's statistics (of the bytes given to their decoder so far: all
     /// of them after [`Decoder::flush`]).
     pub fn mixed_stats(&self) -> &mixed::Stats {
-        self.mixed.stats()
+        self.decoders.Mixed.stats()
     }
 
     /// V4's statistics (see [`Decoder::mixed_stats`]).
     pub fn v4_stats(&self) -> &v4::Stats {
-        self.v4.stats()
+        self.decoders.HwV4.stats()
     }
 
     /// V3's statistics (see [`Decoder::mixed_stats`]).
     pub fn v3_stats(&self) -> &v3::Stats {
-        self.v3.stats()
+        self.decoders.HwV3.stats()
     }
 
     /// HW5's statistics (see [`Decoder::mixed_stats`]).
     pub fn hw5_stats(&self) -> &hw5::Stats {
-        self.hw5.stats()
+        self.decoders.Hw5.stats()
     }
 
     /// Feeds a chunk of bytes; `on_frame` gets each frame found.
@@ -320,7 +420,7 @@ impl Decoder {
         let piece = &data[..n];
         let last = &mut self.last_frame;
         match family {
-            Family::Mixed => self.mixed.feed(
+            Family::Mixed => self.decoders.Mixed.feed(
                 piece,
                 #[inline(always)]
                 |d| {
@@ -342,32 +442,15 @@ impl Decoder {
         n
     }
 
-    /// The frames `family`'s decoder has handed on so far (data and information frames).
-    fn handed_on(&self, family: Family) -> u64 {
-        match family {
-            Family::Mixed => {
-                let s = self.mixed.stats();
-                u64::from(s.esc.packets().count())
-                    + u64::from(s.esc.info_frames())
-                    + u64::from(s.hub.frames())
-            }
-            Family::HwV4 => {
-                u64::from(self.v4.stats().frames()) + u64::from(self.v4.stats().info_frames())
-            }
-            Family::HwV3 => u64::from(self.v3.stats().frames()),
-            Family::Hw5 => u64::from(self.hw5.stats().telemetry_frames()),
-        }
-    }
-
     /// At the end of a block while locked: detection starts again when the locked decoder
     /// handed on no frame since the block's start, every other decoder reading the bytes
     /// after its last frame first (the frames found there lock at once).
     #[cold]
     fn end_block(&mut self, family: Family, on_frame: &mut dyn FnMut(Decoded)) {
-        let now = self.handed_on(family);
+        let now = self.decoders.handed_on(family);
         if self.block_start == Some(now) {
             self.locked = None;
-            self.found = [None; 4];
+            self.found = [None; Family::ALL.len()];
             self.replay(on_frame);
             self.end_slice();
         }
@@ -383,18 +466,10 @@ impl Decoder {
         let (history, found) = (&self.history, &mut self.found);
         let mut on_frame = on_frame;
         let mut take = noting(true, found, &mut on_frame);
-        replay_into(&mut self.mixed, history, from, to, &mut |d| {
-            take(Decoded::Mixed(d))
-        });
-        replay_into(&mut self.hw5, history, from, to, &mut |d| {
-            take(Decoded::Hw5(d))
-        });
-        replay_into(&mut self.v4, history, from, to, &mut |d| {
-            take(Decoded::HwV4(d))
-        });
-        replay_into(&mut self.v3, history, from, to, &mut |d| {
-            take(Decoded::HwV3(d))
-        });
+        for family in Family::ALL {
+            self.decoders
+                .replay(family, history, from, to, &mut |d| take(d));
+        }
     }
 
     /// Gives every decoder the bytes of `data` to the end of the current slice; at its end,
@@ -403,16 +478,11 @@ impl Decoder {
     /// V3, HW5) given `piece`: its frames through a `dyn` callback, so that its scanner is
     /// compiled once, not once per caller (every handler's, which made the binary 10 % larger).
     fn feed_slow(&mut self, family: Family, piece: &[u8], on_frame: &mut dyn FnMut(Decoded)) {
-        let mut take = |d: Decoded| {
-            self.last_frame = d.offset();
+        let last = &mut self.last_frame;
+        self.decoders.feed(family, piece, &mut |d: Decoded| {
+            *last = d.offset();
             on_frame(d)
-        };
-        match family {
-            Family::HwV4 => self.v4.feed(piece, |d| take(Decoded::HwV4(d))),
-            Family::HwV3 => self.v3.feed(piece, |d| take(Decoded::HwV3(d))),
-            Family::Hw5 => self.hw5.feed(piece, |d| take(Decoded::Hw5(d))),
-            Family::Mixed => self.mixed.feed(piece, |d| take(Decoded::Mixed(d))),
-        }
+        });
     }
 
     /// (Through a `dyn` callback, as [`Decoder::feed_slow`]: detection reads a few slices.)
@@ -421,23 +491,13 @@ impl Decoder {
         let to_end = SLICE - self.bytes % SLICE;
         let n = usize::try_from(to_end).map_or(data.len(), |k| k.min(data.len()));
         let piece = &data[..n];
-        let found = &mut self.found;
-        self.mixed.feed(piece, |d| {
-            found[0] = Some(d.offset());
-            on_frame(Decoded::Mixed(d))
-        });
-        self.hw5.feed(piece, |d| {
-            found[1] = Some(d.offset);
-            on_frame(Decoded::Hw5(d))
-        });
-        self.v4.feed(piece, |d| {
-            found[2] = Some(d.offset);
-            on_frame(Decoded::HwV4(d))
-        });
-        self.v3.feed(piece, |d| {
-            found[3] = Some(d.offset);
-            on_frame(Decoded::HwV3(d))
-        });
+        for (i, family) in Family::ALL.into_iter().enumerate() {
+            let found = &mut self.found[i];
+            self.decoders.feed(family, piece, &mut |d| {
+                *found = Some(d.offset());
+                on_frame(d)
+            });
+        }
         self.bytes += n as u64;
         if self.bytes.is_multiple_of(SLICE) {
             self.end_slice();
@@ -454,7 +514,7 @@ impl Decoder {
             self.block_start = None;
             self.last_frame = self.found[i].unwrap_or(self.bytes);
         }
-        self.found = [None; 4];
+        self.found = [None; Family::ALL.len()];
     }
 
     /// Brings every decoder to the stream's end: each passes over the bytes it was not given.
@@ -467,17 +527,11 @@ impl Decoder {
             let n = bytes - b;
             (n > 0 || (settle && held > 0)).then_some(n)
         };
-        if let Some(n) = behind(self.mixed.stats().bytes(), self.mixed.buffered()) {
-            self.mixed.pass_over(n);
-        }
-        if let Some(n) = behind(self.v4.stats().bytes(), self.v4.buffered()) {
-            self.v4.pass_over(n);
-        }
-        if let Some(n) = behind(self.v3.stats().bytes(), self.v3.buffered()) {
-            self.v3.pass_over(n);
-        }
-        if let Some(n) = behind(self.hw5.stats().bytes(), self.hw5.buffered()) {
-            self.hw5.pass_over(n);
+        for family in Family::ALL {
+            let held = self.decoders.buffered(family);
+            if let Some(n) = behind(self.decoders.bytes(family), held) {
+                self.decoders.pass_over(family, n);
+            }
         }
     }
 
@@ -503,28 +557,19 @@ impl Decoder {
         hub_frames: u32,
         mut on_frame: &mut dyn FnMut(Decoded),
     ) {
-        // As many frames of the shorter formats fit in the same time: 24 byte times against
-        // V3's 10 and V4's 19.
-        let scaled = |len: u64| {
-            u32::try_from((u64::from(esc_frames) * 24).div_ceil(len)).unwrap_or(u32::MAX)
-        };
         if self.locked.is_some() {
             self.replay(on_frame);
         }
         let mut take = noting(true, &mut self.found, &mut on_frame);
-        self.mixed
-            .line_silent_each(esc_frames, hub_frames, |d| take(Decoded::Mixed(d)));
-        self.hw5.line_silent(esc_frames, |d| take(Decoded::Hw5(d)));
-        self.v4.line_silent(scaled(v4::DATA_FRAME_LEN as u64), |d| {
-            take(Decoded::HwV4(d))
-        });
-        self.v3
-            .line_silent(scaled(v3::FRAME_LEN as u64), |d| take(Decoded::HwV3(d)));
+        for family in Family::ALL {
+            self.decoders
+                .line_silent(family, esc_frames, hub_frames, &mut take);
+        }
         drop(take);
         self.end_slice();
         // A silence may be a change of ESC: every format is read again from here.
         self.locked = None;
-        self.found = [None; 4];
+        self.found = [None; Family::ALL.len()];
     }
 
     /// Ends the stream: every decoder decides what it holds (as each protocol's `flush`),
@@ -542,10 +587,9 @@ impl Decoder {
             self.replay(on_frame);
         }
         let mut take = noting(true, &mut self.found, &mut on_frame);
-        self.mixed.flush(|d| take(Decoded::Mixed(d)));
-        self.hw5.flush(|d| take(Decoded::Hw5(d)));
-        self.v4.flush(|d| take(Decoded::HwV4(d)));
-        self.v3.flush(|d| take(Decoded::HwV3(d)));
+        for family in Family::ALL {
+            self.decoders.flush(family, &mut take);
+        }
         drop(take);
         self.end_slice();
         self.catch_up(true);
@@ -566,22 +610,27 @@ impl Decoder {
     pub fn then(&mut self, later: &Decoder, first_packet: Option<u16>) -> bool {
         let only_mixed = |d: &Decoder| {
             d.last_locked.is_none_or(|f| f == Family::Mixed)
-                && d.v4.stats().frames() == 0
-                && d.v4.stats().info_frames() == 0
-                && d.v3.stats().frames() == 0
-                && d.hw5.stats().telemetry_frames() == 0
+                && Family::ALL
+                    .iter()
+                    .all(|&f| f == Family::Mixed || d.decoders.handed_on(f) == 0)
         };
         if self.buffered() != 0 || !only_mixed(self) || !only_mixed(later) {
             return false;
         }
         self.catch_up(false);
-        if !self.mixed.then(&later.mixed, first_packet) {
+        if !self
+            .decoders
+            .Mixed
+            .then(&later.decoders.Mixed, first_packet)
+        {
             return false;
         }
         let n = later.bytes;
-        self.v4.pass_over(n);
-        self.v3.pass_over(n);
-        self.hw5.pass_over(n);
+        for family in Family::ALL {
+            if family != Family::Mixed {
+                self.decoders.pass_over(family, n);
+            }
+        }
         self.bytes += n;
         self.locked = later.locked;
         self.last_locked = later.last_locked.or(self.last_locked);
@@ -590,5 +639,18 @@ impl Decoder {
         self.block_start = None;
         self.found = later.found.map(|at| at.map(|at| at + base));
         true
+    }
+}
+
+#[cfg(test)]
+mod family_tests {
+    use super::*;
+
+    #[test]
+    fn families_are_preferred_checksummed_first() {
+        assert_eq!(
+            Family::ALL,
+            [Family::Mixed, Family::Hw5, Family::HwV4, Family::HwV3]
+        );
     }
 }

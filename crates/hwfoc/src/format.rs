@@ -181,6 +181,49 @@ pub enum InfoValue<'a> {
     Number(u32),
 }
 
+/// What a format's device-information frame says of the device, as
+/// [`Info`](crate::telemetry::Info) asks it of each format's frame: implemented in each format's
+/// module that sends one.
+pub trait DeviceInfo: core::fmt::Display {
+    /// The values of its fields, in the order of its description's
+    /// [`info_keys`](FormatDescription::info_keys), the rest `None`.
+    fn values(&self) -> [Option<InfoValue<'_>>; MAX_INFO_FIELDS];
+
+    /// The product name, e.g. `X6` (empty where the frame names none).
+    fn product(&self) -> &str {
+        ""
+    }
+
+    /// The hardware version (empty where the frame names none).
+    fn hardware(&self) -> &str {
+        ""
+    }
+
+    /// The firmware version (empty where the frame names none).
+    fn firmware(&self) -> &str {
+        ""
+    }
+
+    /// The device's identifier (empty where the frame names none).
+    fn id(&self) -> &str {
+        ""
+    }
+}
+
+/// The largest number of device-information fields of any format (V4's eight constants).
+pub const MAX_INFO_FIELDS: usize = 8;
+
+/// `values` in an array of [`MAX_INFO_FIELDS`], the rest `None`.
+pub(crate) fn padded<'a, const N: usize>(
+    values: [InfoValue<'a>; N],
+) -> [Option<InfoValue<'a>>; MAX_INFO_FIELDS] {
+    let mut out = [None; MAX_INFO_FIELDS];
+    for (slot, v) in out.iter_mut().zip(values) {
+        *slot = Some(v);
+    }
+    out
+}
+
 /// A format's own setting: what `--set KEY=VALUE`, a configuration key and Python's
 /// `settings={...}` take.
 #[derive(Debug, Clone, Copy)]

@@ -51,6 +51,21 @@ impl Decoded {
     }
 }
 
+impl crate::protocol::FoundFrame for Decoded {
+    #[inline]
+    fn offset(&self) -> u64 {
+        Decoded::offset(self)
+    }
+
+    #[inline]
+    fn protocol(&self) -> crate::Protocol {
+        match self {
+            Decoded::Esc(_) => crate::Protocol::HwFoc,
+            Decoded::Hub(_) => crate::Protocol::DataLink,
+        }
+    }
+}
+
 /// The statistics of a stream read by the [`Decoder`]: each protocol's.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Stats {
@@ -340,6 +355,23 @@ pub fn frames(data: &[u8]) -> Frames<'_> {
 
 /// Iterator returned by [`frames`].
 pub type Frames<'a> = Scan<'a, Scanner>;
+
+impl crate::protocol::FamilyScanner for Scanner {
+    fn handed_on(s: &Stats) -> u64 {
+        u64::from(s.esc.packets().count())
+            + u64::from(s.esc.info_frames())
+            + u64::from(s.hub.frames())
+    }
+
+    fn line_silent(
+        decoder: &mut Decoder,
+        esc_frames: u32,
+        hub_frames: u32,
+        on_frame: &mut dyn FnMut(Decoded),
+    ) {
+        decoder.line_silent_each(esc_frames, hub_frames, on_frame);
+    }
+}
 
 #[cfg(test)]
 mod tests {

@@ -5,14 +5,15 @@
 use core::fmt;
 
 use crate::format::{FormatDescription, SettingDescription};
+use crate::scan::{Scanner, StreamDecoder};
 use crate::status::Status;
 use crate::units::{Quantity, Settings};
 
-/// Declares [`Protocol`] from the list of formats, one line each (its arm, documentation and
-/// [`FormatDescription`]), with [`Protocol::ALL`] and [`Protocol::description`]: adding a
-/// format is its module and one line of the list in this file.
-macro_rules! formats {
-    ($( $(#[$doc:meta])* $arm:ident => $description:path, )+) => {
+/// Declares [`Protocol`] from the list of formats (`formats!` in `lib.rs`), with
+/// [`Protocol::ALL`] and [`Protocol::description`].
+macro_rules! declare_protocol {
+    ($( $(#[$doc:meta])* $arm:ident => $description:path, $kind:ident $data:ty
+        $(, info $info:ty)? $(, family $family:ident($scanner:ty) rank $rank:literal)?; )+) => {
         /// A wire protocol the codec reads.
         ///
         /// ```
@@ -42,26 +43,7 @@ macro_rules! formats {
     };
 }
 
-formats! {
-    /// HW-FOC: an ESC's own wire ([`crate::foc`]).
-    HwFoc => crate::foc::DESCRIPTION,
-    /// DataLink V2: a Hobbywing hub's frames of up to eight ESCs ([`crate::datalink`]).
-    DataLink => crate::datalink::DESCRIPTION,
-    /// Platinum V4 (and Platinum Pro V4, FlyFun V5): `9B` data and info frames without checksum
-    /// ([`crate::v4`]).
-    HwV4 => crate::v4::DESCRIPTION,
-    /// Platinum V3 (and Platinum Pro V3): 10-byte `9B` frames without checksum ([`crate::v3`]).
-    HwV3 => crate::v3::DESCRIPTION,
-    /// HW5 (Platinum V5, VBAR firmware): `FE` frames with a CRC-16/MODBUS at 115200 baud
-    /// ([`crate::hw5`]).
-    Hw5 => crate::hw5::DESCRIPTION,
-    /// Hobbywing's DroneCAN ESCs (XRotor X6/X8/X9 and H-series "CAN" versions):
-    /// `com.hobbywing.esc.StatusMsg1/2/3` on a CAN bus (`hw-can`).
-    HwCan => crate::dronecan::HW_CAN,
-    /// Standard DroneCAN ESCs: `uavcan.equipment.esc.Status` and `StatusExtended` on a CAN
-    /// bus (`dronecan`).
-    DroneCan => crate::dronecan::DRONECAN,
-}
+formats!(declare_protocol);
 
 /// How many of [`Protocol::ALL`] are serial.
 const SERIAL_COUNT: usize = {
@@ -92,6 +74,21 @@ impl Protocol {
         }
         out
     };
+
+    /// Its place in [`Protocol::ALL`] (the list of formats), `0..Protocol::ALL.len()`: the
+    /// `protocol` column's dictionary key.
+    ///
+    /// ```
+    /// use hwfoc::Protocol;
+    ///
+    /// for (i, p) in Protocol::ALL.into_iter().enumerate() {
+    ///     assert_eq!(p.index(), i);
+    /// }
+    /// ```
+    #[inline(always)]
+    pub const fn index(self) -> usize {
+        self as usize
+    }
 
     /// Whether the protocol is carried on a CAN bus (`hw-can`, `dronecan`), not a serial line.
     pub const fn is_can(self) -> bool {
@@ -320,6 +317,65 @@ impl fmt::Display for Protocol {
         f.write_str(self.name())
     }
 }
+
+/// A frame a serial format's decoder found: where it starts in the stream and which protocol
+/// it came in (what [`Decoded`](crate::detect::Decoded) asks each family's frames).
+pub trait FoundFrame {
+    /// Offset of the frame's first byte in the stream.
+    fn offset(&self) -> u64;
+    /// The protocol the frame came in.
+    fn protocol(&self) -> Protocol;
+}
+
+/// The scanner of a serial family that [`detect::Decoder`](crate::detect::Decoder) reads
+/// (its line of the list of formats names it): what differs between the families' decoders.
+pub trait FamilyScanner: Scanner<Item: FoundFrame> + Sized {
+    /// The frames (data and information) a decoder with statistics `stats` has handed on.
+    fn handed_on(stats: &Self::Stats) -> u64;
+
+    /// The length of the frames whose count a silence is told in (HW-FOC's 24 bytes unless the
+    /// family's frames are shorter).
+    const SILENCE_FRAME_LEN: usize = 24;
+
+    /// Tells `decoder` that the line was silent for a time in which at most `esc_frames`
+    /// HW-FOC frames (24 byte times each) and `hub_frames` DataLink frames could have been sent:
+    /// as many of its frames of [`FamilyScanner::SILENCE_FRAME_LEN`] as fit in that time.
+    fn line_silent(
+        decoder: &mut StreamDecoder<Self>,
+        esc_frames: u32,
+        hub_frames: u32,
+        on_frame: &mut dyn FnMut(Self::Item),
+    ) {
+        let _ = hub_frames;
+        let n = frames_in_silence(esc_frames, Self::SILENCE_FRAME_LEN);
+        decoder.line_silent(n, on_frame);
+    }
+}
+
+/// As many frames of `len` bytes as fit in the time of `esc_frames` HW-FOC frames (24 byte
+/// times each).
+pub fn frames_in_silence(esc_frames: u32, len: usize) -> u32 {
+    u32::try_from((u64::from(esc_frames) * 24).div_ceil(len as u64)).unwrap_or(u32::MAX)
+}
+
+/// `impl FoundFrame for $decoded`, a decoder's frame with its `offset` field, all of protocol
+/// `$protocol`.
+macro_rules! found_frame {
+    ($decoded:ty, $protocol:ident) => {
+        impl $crate::protocol::FoundFrame for $decoded {
+            #[inline]
+            fn offset(&self) -> u64 {
+                self.offset
+            }
+
+            #[inline]
+            fn protocol(&self) -> $crate::Protocol {
+                $crate::Protocol::$protocol
+            }
+        }
+    };
+}
+pub(crate) use found_frame;
 
 #[cfg(test)]
 mod tests {

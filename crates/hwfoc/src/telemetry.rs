@@ -7,8 +7,10 @@
 //!
 //! [`Data`] is a data frame of any supported protocol and [`Info`] a device-information frame of
 //! any, each an enum with one arm per protocol; [`Frame`] is either, as decoders hand them to the
-//! layers above. A new protocol adds its arm to each (the compiler names every `match` that
-//! must learn it; none exists outside this module).
+//! layers above. Both are declared from the list of formats (`formats!` in `lib.rs`): a new
+//! protocol's line there gives it its `Data` arm (and `Info` arm, where it sends an information
+//! frame, through [`DeviceInfo`]); its own module implements
+//! [`Telemetry`] for its data frame. This module names no protocol's module.
 //!
 //! ```
 //! use hwfoc::telemetry::{Data, Telemetry};
@@ -25,9 +27,7 @@
 //! # Ok::<(), hwfoc::foc::FrameError>(())
 //! ```
 
-use crate::foc::kinds::data::DataFrame;
-use crate::foc::kinds::info::InfoFrame;
-use crate::format::InfoValue;
+use crate::format::{DeviceInfo, InfoValue};
 use crate::protocol::Protocol;
 use crate::status::Status;
 use crate::units::{Linear, Quantity, Settings, Temperature};
@@ -37,7 +37,7 @@ const KELVIN_AT_0_C: f32 = 273.15;
 
 /// The value of a float16's bits; `None` for NaN (DroneCAN's "unknown").
 fn half(raw: i32) -> Option<f32> {
-    let v = crate::dronecan::f32_from_f16(u16::try_from(raw).ok()?);
+    let v = crate::wire::f32_from_f16(u16::try_from(raw).ok()?);
     (!v.is_nan()).then_some(v)
 }
 
@@ -54,7 +54,7 @@ pub enum Conversion {
     Ntc,
     /// A Hobbywing V4 current ADC code through its info frame's constants,
     /// `adc * I1 / I2 - I3`, not below 0 ([`crate::v4::CurrentScale`]).
-    V4Current(crate::v4::CurrentScale),
+    V4Current(crate::units::CurrentScale),
     /// A float16's bits (DroneCAN's `float16`), the value in its unit.
     Half,
     /// A float16's bits holding kelvins, the value in degC (`- 273.15`).
@@ -71,7 +71,7 @@ impl Conversion {
             Conversion::AdcTable => u8::try_from(raw)
                 .ok()
                 .and_then(|code| Temperature::from_adc(code).celsius()),
-            Conversion::Ntc => u16::try_from(raw).ok().and_then(crate::v4::ntc_celsius),
+            Conversion::Ntc => u16::try_from(raw).ok().and_then(crate::ntc::ntc_celsius),
             Conversion::V4Current(scale) => u16::try_from(raw).ok().map(|adc| scale.amps(adc)),
             Conversion::Half => half(raw),
             Conversion::HalfKelvin => half(raw).map(|k| k - KELVIN_AT_0_C),
@@ -148,207 +148,83 @@ pub trait Telemetry {
     }
 }
 
-impl Telemetry for DataFrame {
-    #[inline(always)]
-    fn packet(&self) -> Option<u32> {
-        Some(u32::from(self.packet))
-    }
-
-    #[inline(always)]
-    fn status(&self) -> Option<Status> {
-        Some(self.status)
-    }
-
-    #[inline(always)]
-    fn reading(&self, quantity: Quantity, settings: &Settings) -> Option<Reading> {
-        let linear = Reading::linear;
-        let adc = |code: u8| Reading {
-            raw: i32::from(code),
-            conversion: Conversion::AdcTable,
-        };
-        Some(match quantity {
-            Quantity::ThrottleIn => linear(self.throttle_in_raw.into(), Linear::THROTTLE_PCT),
-            Quantity::ThrottleOut => linear(self.throttle_out_raw.into(), Linear::THROTTLE_PCT),
-            Quantity::Erpm => linear(self.erpm_raw.into(), Linear::ERPM),
-            Quantity::Rpm => linear(self.erpm_raw.into(), settings.rpm_linear()),
-            Quantity::Voltage => linear(self.voltage_raw.into(), Linear::VOLTS),
-            Quantity::Current => linear(self.current_raw.into(), settings.amps_linear()),
-            Quantity::PhaseCurrent => linear(self.phase_current_raw.into(), settings.amps_linear()),
-            Quantity::MosTemp => adc(self.mos_adc),
-            Quantity::CapTemp => adc(self.cap_adc),
-            Quantity::MotorTemp
-            | Quantity::BecTemp
-            | Quantity::BecVoltage
-            | Quantity::BecCurrent => return None,
-        })
-    }
+/// `From<$data> for Data`, for a format whose data frame is its own (`data`), not one it
+/// shares with a format listed before it (`shares`).
+macro_rules! data_from {
+    (data, $arm:ident, $data:ty) => {
+        impl From<$data> for Data {
+            #[inline]
+            fn from(frame: $data) -> Data {
+                Data::$arm(frame)
+            }
+        }
+    };
+    (shares, $arm:ident, $data:ty) => {};
 }
 
-/// Declares an enum with one arm per protocol and its `From` conversions.
-macro_rules! per_protocol {
-    (
-        $(#[$attr:meta])* pub enum $name:ident {
-            $( $(#[$arm_attr:meta])* $arm:ident($inner:ty), )+
-        }
-    ) => {
-        $(#[$attr])*
+/// Declares [`Data`] from the list of formats (`formats!` in `lib.rs`): its arms, their
+/// `From` conversions, its [`Telemetry`] and [`Data::protocol`].
+macro_rules! declare_data {
+    ($( $(#[$doc:meta])* $arm:ident => $description:path, $kind:ident $data:ty
+        $(, info $info:ty)? $(, family $family:ident($scanner:ty) rank $rank:literal)?; )+) => {
+        /// A data frame of any supported protocol: one arm per protocol (its data frame, as
+        /// the list of formats names it), so that what a record says of its source
+        /// ([`Data::protocol`]) is a property of the frame, as its readings are.
+        ///
+        /// `From<foc::DataFrame>` gives the HW-FOC arm (an ESC's own wire); a DataLink V2
+        /// hub's record, which carries the same payload, is made as `Data::DataLink(frame)`.
         #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-        pub enum $name {
-            $( $(#[$arm_attr])* $arm($inner), )+
+        pub enum Data {
+            $( $(#[$doc])* $arm($data), )+
         }
 
-        $(
-            impl From<$inner> for $name {
-                #[inline]
-                fn from(inner: $inner) -> $name {
-                    $name::$arm(inner)
+        $( data_from!($kind, $arm, $data); )+
+
+        impl Telemetry for Data {
+            #[inline(always)]
+            fn packet(&self) -> Option<u32> {
+                match self {
+                    $( Data::$arm(f) => Telemetry::packet(f), )+
                 }
             }
-        )+
+
+            #[inline(always)]
+            fn status(&self) -> Option<Status> {
+                match self {
+                    $( Data::$arm(f) => Telemetry::status(f), )+
+                }
+            }
+
+            #[inline(always)]
+            fn reading(&self, quantity: Quantity, settings: &Settings) -> Option<Reading> {
+                match self {
+                    $( Data::$arm(f) => f.reading(quantity, settings), )+
+                }
+            }
+        }
+
+        impl Data {
+            /// The protocol the frame was received in (the record's `protocol` column).
+            ///
+            /// ```
+            /// use hwfoc::Protocol;
+            /// use hwfoc::foc::DataFrame;
+            /// use hwfoc::telemetry::Data;
+            ///
+            /// assert_eq!(Data::from(DataFrame::default()).protocol(), Protocol::HwFoc);
+            /// assert_eq!(Data::DataLink(DataFrame::default()).protocol(), Protocol::DataLink);
+            /// ```
+            #[inline(always)]
+            pub const fn protocol(&self) -> Protocol {
+                match self {
+                    $( Data::$arm(_) => Protocol::$arm, )+
+                }
+            }
+        }
     };
 }
 
-/// A data frame of any supported protocol: one arm per protocol, so that what a record says
-/// of its source ([`Data::protocol`]) is a property of the frame, as its readings are.
-///
-/// `From<foc::DataFrame>` gives the HW-FOC arm (an ESC's own wire); a DataLink V2 hub's record,
-/// which carries the same payload, is made as `Data::DataLink(frame)`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-pub enum Data {
-    /// An HW-FOC data frame, from an ESC's own wire.
-    HwFoc(DataFrame),
-    /// A DataLink V2 hub's record of one ESC channel: the HW-FOC payload the hub forwards.
-    DataLink(DataFrame),
-    /// A Hobbywing V4 data frame, with the info frame adopted when it was decoded.
-    HwV4(crate::v4::Data),
-    /// A Hobbywing V3 frame.
-    HwV3(crate::v3::Frame),
-    /// An HW5 telemetry frame.
-    Hw5(crate::hw5::TelemetryFrame),
-    /// A Hobbywing CAN ESC's record at a `StatusMsg1` (with its node's slower messages).
-    HwCan(crate::dronecan::HwCanEsc),
-    /// A standard DroneCAN ESC's record at a `uavcan.equipment.esc.Status`.
-    DroneCan(crate::dronecan::DroneCanEsc),
-}
-
-impl From<crate::dronecan::HwCanEsc> for Data {
-    #[inline]
-    fn from(esc: crate::dronecan::HwCanEsc) -> Data {
-        Data::HwCan(esc)
-    }
-}
-
-impl From<crate::dronecan::DroneCanEsc> for Data {
-    #[inline]
-    fn from(esc: crate::dronecan::DroneCanEsc) -> Data {
-        Data::DroneCan(esc)
-    }
-}
-
-impl From<crate::v4::Data> for Data {
-    #[inline]
-    fn from(data: crate::v4::Data) -> Data {
-        Data::HwV4(data)
-    }
-}
-
-impl From<crate::v3::Frame> for Data {
-    #[inline]
-    fn from(frame: crate::v3::Frame) -> Data {
-        Data::HwV3(frame)
-    }
-}
-
-impl From<crate::hw5::TelemetryFrame> for Data {
-    #[inline]
-    fn from(frame: crate::hw5::TelemetryFrame) -> Data {
-        Data::Hw5(frame)
-    }
-}
-
-impl From<DataFrame> for Data {
-    /// The HW-FOC arm: a frame from an ESC's own wire.
-    #[inline]
-    fn from(frame: DataFrame) -> Data {
-        Data::HwFoc(frame)
-    }
-}
-
-impl Telemetry for Data {
-    #[inline(always)]
-    fn packet(&self) -> Option<u32> {
-        match self {
-            Data::HwFoc(f) | Data::DataLink(f) => f.packet(),
-            Data::HwV4(f) => Telemetry::packet(f),
-            Data::HwV3(f) => Telemetry::packet(f),
-            Data::Hw5(f) => Telemetry::packet(f),
-            Data::HwCan(f) => Telemetry::packet(f),
-            Data::DroneCan(f) => Telemetry::packet(f),
-        }
-    }
-
-    #[inline(always)]
-    fn status(&self) -> Option<Status> {
-        match self {
-            Data::HwFoc(f) | Data::DataLink(f) => Telemetry::status(f),
-            Data::HwV4(f) => Telemetry::status(f),
-            Data::HwV3(f) => Telemetry::status(f),
-            Data::Hw5(f) => Telemetry::status(f),
-            Data::HwCan(f) => Telemetry::status(f),
-            Data::DroneCan(f) => Telemetry::status(f),
-        }
-    }
-
-    #[inline(always)]
-    fn reading(&self, quantity: Quantity, settings: &Settings) -> Option<Reading> {
-        match self {
-            Data::HwFoc(f) | Data::DataLink(f) => f.reading(quantity, settings),
-            Data::HwV4(f) => f.reading(quantity, settings),
-            Data::HwV3(f) => f.reading(quantity, settings),
-            Data::Hw5(f) => f.reading(quantity, settings),
-            Data::HwCan(f) => f.reading(quantity, settings),
-            Data::DroneCan(f) => f.reading(quantity, settings),
-        }
-    }
-}
-
-impl Data {
-    /// The protocol the frame was received in (the record's `protocol` column).
-    ///
-    /// ```
-    /// use hwfoc::Protocol;
-    /// use hwfoc::foc::DataFrame;
-    /// use hwfoc::telemetry::Data;
-    ///
-    /// assert_eq!(Data::from(DataFrame::default()).protocol(), Protocol::HwFoc);
-    /// assert_eq!(Data::DataLink(DataFrame::default()).protocol(), Protocol::DataLink);
-    /// ```
-    #[inline(always)]
-    pub const fn protocol(&self) -> Protocol {
-        match self {
-            Data::HwFoc(_) => Protocol::HwFoc,
-            Data::DataLink(_) => Protocol::DataLink,
-            Data::HwV4(_) => Protocol::HwV4,
-            Data::HwV3(_) => Protocol::HwV3,
-            Data::Hw5(_) => Protocol::Hw5,
-            Data::HwCan(_) => Protocol::HwCan,
-            Data::DroneCan(_) => Protocol::DroneCan,
-        }
-    }
-
-    /// The HW-FOC data frame this frame is, for outputs that speak HW-FOC: an HW-FOC frame
-    /// itself, or what a DataLink V2 hub record holds (the hub forwards HW-FOC payloads);
-    /// `None` for another protocol's frame, whose fields HW-FOC's do not hold as sent.
-    #[inline]
-    pub fn to_hwfoc(&self) -> Option<DataFrame> {
-        match self {
-            Data::HwFoc(f) | Data::DataLink(f) => Some(*f),
-            Data::HwV4(_) | Data::HwV3(_) | Data::Hw5(_) | Data::HwCan(_) | Data::DroneCan(_) => {
-                None
-            }
-        }
-    }
-}
+formats!(declare_data);
 
 impl Data {
     /// The frame's fault word: its [`Telemetry::status`] where its protocol has fault bits
@@ -404,26 +280,53 @@ impl Data {
     }
 }
 
-per_protocol! {
-    /// A device-information frame of any supported protocol.
-    pub enum Info {
-        /// An HW-FOC device-information frame.
-        HwFoc(InfoFrame),
-        /// A Hobbywing V4 info frame: the ESC's scales, no names.
-        HwV4(crate::v4::InfoFrame),
-    }
+/// Declares [`Info`] from the list of formats (`formats!` in `lib.rs`): one arm for each
+/// format there with an `info` frame, its `From` conversions and its dispatch to
+/// [`DeviceInfo`].
+macro_rules! declare_info {
+    ($( $(#[$doc:meta])* $arm:ident => $description:path, $kind:ident $data:ty
+        $(, info $info:ty)? $(, family $family:ident($scanner:ty) rank $rank:literal)?; )+) => {
+        /// A device-information frame of any supported protocol.
+        #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+        pub enum Info {
+            $($(
+                #[doc = concat!("A device-information frame of [`Protocol::", stringify!($arm), "`].")]
+                $arm($info),
+            )?)+
+        }
+
+        $($(
+            impl From<$info> for Info {
+                #[inline]
+                fn from(info: $info) -> Info {
+                    Info::$arm(info)
+                }
+            }
+        )?)+
+
+        impl Info {
+            /// The protocol the frame was received in.
+            #[inline]
+            pub const fn protocol(&self) -> Protocol {
+                match self {
+                    $($( Info::$arm(i) => { let _: &$info = i; Protocol::$arm } )?)+
+                }
+            }
+
+            /// The frame's [`DeviceInfo`].
+            #[inline]
+            fn device(&self) -> &dyn DeviceInfo {
+                match self {
+                    $($( Info::$arm(i) => { let i: &$info = i; i } )?)+
+                }
+            }
+        }
+    };
 }
 
-impl Info {
-    /// The protocol the frame was received in.
-    #[inline]
-    pub const fn protocol(&self) -> Protocol {
-        match self {
-            Info::HwFoc(_) => Protocol::HwFoc,
-            Info::HwV4(_) => Protocol::HwV4,
-        }
-    }
+formats!(declare_info);
 
+impl Info {
     /// What the frame says of the device, as key/value pairs: the keys of its protocol's
     /// description ([`FormatDescription::info_keys`](crate::format::FormatDescription)) with
     /// this frame's values.
@@ -441,43 +344,27 @@ impl Info {
     /// ```
     pub fn fields(&self) -> impl Iterator<Item = (&'static str, InfoValue<'_>)> {
         let keys = self.protocol().description().info_keys.iter().copied();
-        let values: [Option<InfoValue<'_>>; 8] = match self {
-            Info::HwFoc(i) => padded(crate::foc::description::info_values(i)),
-            Info::HwV4(i) => padded(crate::v4::description::info_values(i)),
-        };
-        keys.zip(values.into_iter().flatten())
+        keys.zip(self.device().values().into_iter().flatten())
     }
 
     /// The product name, e.g. `X6`.
     pub fn product(&self) -> &str {
-        match self {
-            Info::HwFoc(i) => i.product(),
-            Info::HwV4(_) => "",
-        }
+        self.device().product()
     }
 
     /// The hardware version.
     pub fn hardware(&self) -> &str {
-        match self {
-            Info::HwFoc(i) => i.hardware(),
-            Info::HwV4(_) => "",
-        }
+        self.device().hardware()
     }
 
     /// The firmware version.
     pub fn firmware(&self) -> &str {
-        match self {
-            Info::HwFoc(i) => i.firmware(),
-            Info::HwV4(_) => "",
-        }
+        self.device().firmware()
     }
 
     /// The device's identifier.
     pub fn id(&self) -> &str {
-        match self {
-            Info::HwFoc(i) => i.id(),
-            Info::HwV4(_) => "",
-        }
+        self.device().id()
     }
 }
 
@@ -485,20 +372,8 @@ impl core::fmt::Display for Info {
     /// The device's text as each protocol shows it (HW-FOC: its words joined by single spaces;
     /// V4: its constants).
     fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
-        match self {
-            Info::HwFoc(i) => i.fmt(f),
-            Info::HwV4(i) => i.fmt(f),
-        }
+        self.device().fmt(f)
     }
-}
-
-/// `values` in an array of the largest number of information fields (8), the rest `None`.
-fn padded<'a, const N: usize>(values: [InfoValue<'a>; N]) -> [Option<InfoValue<'a>>; 8] {
-    let mut out = [None; 8];
-    for (slot, v) in out.iter_mut().zip(values) {
-        *slot = Some(v);
-    }
-    out
 }
 
 /// A frame of any supported protocol as the layers above the codec take it: data, or device
@@ -509,24 +384,4 @@ pub enum Frame {
     Data(Data),
     /// A device-information frame.
     Info(Info),
-}
-
-impl From<crate::v4::Frame> for Frame {
-    #[inline(always)]
-    fn from(frame: crate::v4::Frame) -> Frame {
-        match frame {
-            crate::v4::Frame::Data(d) => Frame::Data(Data::HwV4(d)),
-            crate::v4::Frame::Info(i) => Frame::Info(Info::HwV4(i)),
-        }
-    }
-}
-
-impl From<crate::foc::frame::Frame> for Frame {
-    #[inline(always)]
-    fn from(frame: crate::foc::frame::Frame) -> Frame {
-        match frame {
-            crate::foc::frame::Frame::Data(f) => Frame::Data(Data::HwFoc(f)),
-            crate::foc::frame::Frame::Info(i) => Frame::Info(Info::HwFoc(i)),
-        }
-    }
 }

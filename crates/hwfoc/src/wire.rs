@@ -17,8 +17,6 @@
 //! kinds apart; version and command are then checked against the kind (see
 //! `docs/PROTOCOL-NOTES.md`).
 
-use crate::foc::FrameError;
-
 /// Bits on the wire per byte on an 8N1 line: start bit, 8 data bits, stop bit.
 pub const BITS_PER_BYTE: u32 = 10;
 
@@ -231,10 +229,10 @@ impl Checksum {
     /// Checks the check bytes at the end of `frame` (a whole frame, nothing after it).
     ///
     /// The error carries the value computed over the bytes (`expected`) and the one the frame
-    /// carries (`found`); a slice shorter than the check bytes is [`FrameError::Truncated`].
+    /// carries (`found`); a slice shorter than the check bytes is [`CheckError::Truncated`] (a format's frame error is made `From` it).
     #[inline(always)]
-    pub fn verify(self, frame: &[u8]) -> Result<(), FrameError> {
-        let truncated = FrameError::Truncated {
+    pub fn verify(self, frame: &[u8]) -> Result<(), CheckError> {
+        let truncated = CheckError::Truncated {
             needed: self.width(),
             got: frame.len(),
         };
@@ -248,7 +246,7 @@ impl Checksum {
         let expected = self.compute(covered);
         let found = self.carried(check).ok_or(truncated)?;
         if expected != found {
-            return Err(FrameError::Checksum { expected, found });
+            return Err(CheckError::Checksum { expected, found });
         }
         Ok(())
     }
@@ -269,6 +267,56 @@ impl Checksum {
         }
     }
 }
+
+/// The value of IEEE binary16 bits (exact), as libuavcan and pydronecan convert
+/// (`f32_from_f16`).
+pub fn f32_from_f16(h: u16) -> f32 {
+    let magic = f32::from_bits((254 - 15) << 23);
+    let was_inf_nan = f32::from_bits((127 + 16) << 23);
+    let mut out = f32::from_bits(u32::from(h & 0x7FFF) << 13) * magic;
+    let mut u = out.to_bits();
+    if out >= was_inf_nan {
+        u |= 255 << 23;
+    }
+    u |= u32::from(h & 0x8000) << 16;
+    out = f32::from_bits(u);
+    out
+}
+
+/// Why a frame's check bytes do not hold ([`Checksum::verify`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum CheckError {
+    /// Fewer bytes than the check bytes.
+    Truncated {
+        /// Bytes the check bytes take.
+        needed: usize,
+        /// Bytes given.
+        got: usize,
+    },
+    /// The check bytes do not match the bytes: the frame was corrupted on the wire.
+    Checksum {
+        /// Check value computed over the received bytes.
+        expected: u16,
+        /// Check value carried by the frame.
+        found: u16,
+    },
+}
+
+impl core::fmt::Display for CheckError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match *self {
+            CheckError::Truncated { needed, got } => {
+                write!(f, "truncated: {got} bytes, the check bytes need {needed}")
+            }
+            CheckError::Checksum { expected, found } => write!(
+                f,
+                "check bytes {found:#06X} do not match the bytes' {expected:#06X}"
+            ),
+        }
+    }
+}
+
+impl core::error::Error for CheckError {}
 
 #[cfg(test)]
 mod tests {
@@ -343,7 +391,7 @@ mod tests {
         frame[0] ^= 0x80;
         assert_eq!(
             Checksum::Crc16Xmodem.verify(&frame),
-            Err(FrameError::Checksum {
+            Err(CheckError::Checksum {
                 expected: crc16_xmodem(&frame[..9]),
                 found: 0x31C3
             })
@@ -407,7 +455,7 @@ mod tests {
         frame[8] ^= 0x01;
         assert_eq!(
             Checksum::Crc16Modbus.verify(&frame),
-            Err(FrameError::Checksum {
+            Err(CheckError::Checksum {
                 expected: crc16_modbus(&frame[..9]),
                 found: 0x4B37
             })
@@ -426,7 +474,7 @@ mod tests {
         frame[5] ^= 1;
         assert_eq!(
             Checksum::Sum16Le.verify(&frame),
-            Err(FrameError::Checksum {
+            Err(CheckError::Checksum {
                 expected: sum - 1,
                 found: sum
             })
@@ -437,11 +485,11 @@ mod tests {
         assert_eq!(Checksum::Sum8.verify(&short), Ok(()));
         assert_eq!(
             Checksum::Sum16Le.verify(&[1]),
-            Err(FrameError::Truncated { needed: 2, got: 1 })
+            Err(CheckError::Truncated { needed: 2, got: 1 })
         );
         assert_eq!(
             Checksum::Sum8.verify(&[]),
-            Err(FrameError::Truncated { needed: 1, got: 0 })
+            Err(CheckError::Truncated { needed: 1, got: 0 })
         );
     }
 }

@@ -217,13 +217,8 @@ impl ArrowValue for Protocol {
     }
 
     fn array(values: impl ExactSizeIterator<Item = Self>) -> ArrayRef {
-        // Each protocol's key (its place in `Protocol::ALL`) by its discriminant: a load per
-        // row, not a search.
-        let mut key = [0i8; Protocol::ALL.len()];
-        for (i, &p) in Protocol::ALL.iter().enumerate() {
-            key[p as usize] = i as i8;
-        }
-        let keys = PrimitiveArray::<ProtocolKey>::from_iter_values(values.map(|p| key[p as usize]));
+        // Each protocol's key: its place in `Protocol::ALL`.
+        let keys = PrimitiveArray::<ProtocolKey>::from_iter_values(values.map(|p| p.index() as i8));
         let names = StringArray::from_iter_values(Protocol::ALL.map(Protocol::name));
         Arc::new(
             DictionaryArray::<ProtocolKey>::try_new(keys, Arc::new(names))

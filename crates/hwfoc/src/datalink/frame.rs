@@ -1,7 +1,7 @@
 //! The DataLink V2 frame: a frame counter and up to eight ESCs' data, read and written.
 
-use crate::foc::FrameError;
 use crate::foc::kinds::data::{DATA_PAYLOAD_LEN, DataFrame};
+use crate::wire::CheckError;
 use crate::wire::SYNC;
 
 use super::error::Error;
@@ -124,7 +124,7 @@ impl Frame {
         }
         match CHECKSUM.verify(f) {
             Ok(()) => Ok(Self::read(f, length_byte)),
-            Err(FrameError::Checksum { expected, found }) => Err(Error::Crc { expected, found }),
+            Err(CheckError::Checksum { expected, found }) => Err(Error::Crc { expected, found }),
             // A 160-byte frame always holds its check bytes.
             Err(_) => Err(Error::Truncated { got: bytes.len() }),
         }

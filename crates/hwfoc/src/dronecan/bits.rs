@@ -206,20 +206,7 @@ pub fn f16_from_f32(v: f32) -> u16 {
     (out | (sign >> 16)) as u16
 }
 
-/// The value of IEEE binary16 bits (exact), as libuavcan and pydronecan convert
-/// (`f32_from_f16`).
-pub fn f32_from_f16(h: u16) -> f32 {
-    let magic = f32::from_bits((254 - 15) << 23);
-    let was_inf_nan = f32::from_bits((127 + 16) << 23);
-    let mut out = f32::from_bits(u32::from(h & 0x7FFF) << 13) * magic;
-    let mut u = out.to_bits();
-    if out >= was_inf_nan {
-        u |= 255 << 23;
-    }
-    u |= u32::from(h & 0x8000) << 16;
-    out = f32::from_bits(u);
-    out
-}
+pub use crate::wire::f32_from_f16;
 
 #[cfg(test)]
 mod tests {

@@ -89,3 +89,41 @@ pub use kinds::FrameKind;
 pub use kinds::data::{DataFrame, THROTTLE_MAX_RAW};
 pub use kinds::info::{InfoFieldError, InfoFrame};
 pub use stats::Stats;
+
+impl From<crate::wire::CheckError> for FrameError {
+    /// The frame error of check bytes that do not hold.
+    #[inline(always)]
+    fn from(e: crate::wire::CheckError) -> FrameError {
+        match e {
+            crate::wire::CheckError::Truncated { needed, got } => {
+                FrameError::Truncated { needed, got }
+            }
+            crate::wire::CheckError::Checksum { expected, found } => {
+                FrameError::Checksum { expected, found }
+            }
+        }
+    }
+}
+
+impl From<Frame> for crate::telemetry::Frame {
+    #[inline(always)]
+    fn from(frame: Frame) -> crate::telemetry::Frame {
+        match frame {
+            Frame::Data(f) => crate::telemetry::Frame::Data(crate::telemetry::Data::HwFoc(f)),
+            Frame::Info(i) => crate::telemetry::Frame::Info(crate::telemetry::Info::HwFoc(i)),
+        }
+    }
+}
+
+impl crate::telemetry::Data {
+    /// The HW-FOC data frame this frame is, for outputs that speak HW-FOC: an HW-FOC frame
+    /// itself, or what a DataLink V2 hub record holds (the hub forwards HW-FOC payloads);
+    /// `None` for another protocol's frame, whose fields HW-FOC's do not hold as sent.
+    #[inline]
+    pub fn to_hwfoc(&self) -> Option<DataFrame> {
+        match self {
+            crate::telemetry::Data::HwFoc(f) | crate::telemetry::Data::DataLink(f) => Some(*f),
+            _ => None,
+        }
+    }
+}

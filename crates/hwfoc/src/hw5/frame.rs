@@ -7,12 +7,12 @@
 //!                                                    (LE)    (LE)    (LE)    degC degC degC  *10    *10
 //! ```
 
-use crate::foc::FrameError;
 use crate::format::FaultDescription;
 use crate::format::Severity::{Critical, Warning};
 use crate::status::Status;
 use crate::telemetry::{Reading, Telemetry};
 use crate::units::{Linear, Quantity, Settings};
+use crate::wire::CheckError;
 
 use super::error::Error;
 use super::layout::{
@@ -404,7 +404,7 @@ impl Telemetry for TelemetryFrame {
 fn check(frame: &[u8]) -> Result<(), Error> {
     match CHECKSUM.verify(frame) {
         Ok(()) => Ok(()),
-        Err(FrameError::Checksum { expected, found }) => Err(Error::Crc { expected, found }),
+        Err(CheckError::Checksum { expected, found }) => Err(Error::Crc { expected, found }),
         Err(_) => Err(Error::Truncated {
             needed: 2,
             got: frame.len(),

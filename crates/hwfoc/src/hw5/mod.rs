@@ -107,3 +107,11 @@ pub use layout::{
     TYPE_PARAMETERS, TYPE_PING, TYPE_RESET, TYPE_TELEMETRY, VOLTS, envelope, kinds_of,
 };
 pub use stats::Stats;
+
+crate::protocol::found_frame!(Decoded, Hw5);
+
+impl crate::protocol::FamilyScanner for Scanner {
+    fn handed_on(s: &Stats) -> u64 {
+        u64::from(s.telemetry_frames())
+    }
+}

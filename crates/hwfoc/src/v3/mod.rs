@@ -81,3 +81,13 @@ pub use frame::{
     COUNTER_AT, FRAME_LEN, FULL_SCALE, Frame, PLACEHOLDER_PERIOD_US, US_PER_MINUTE, erpm_of_period,
 };
 pub use stats::Stats;
+
+crate::protocol::found_frame!(Decoded, HwV3);
+
+impl crate::protocol::FamilyScanner for Scanner {
+    fn handed_on(s: &Stats) -> u64 {
+        u64::from(s.frames())
+    }
+
+    const SILENCE_FRAME_LEN: usize = FRAME_LEN;
+}

@@ -8,7 +8,7 @@ use crate::wire::SYNC;
 
 use super::info::{InfoFrame, VoltsPerStep, throttle_linear};
 use super::layout::{ADC_LIMIT, DATA_FRAME_LEN, DEFAULT_FULL_SCALE, SLOW_DATA_FRAME_LEN, TRAILER};
-use super::temperature::ntc_celsius;
+use crate::ntc::ntc_celsius;
 
 /// One V4 data frame, every field as the raw integer sent.
 ///

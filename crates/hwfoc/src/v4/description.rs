@@ -3,7 +3,8 @@
 use core::time::Duration;
 
 use crate::format::{
-    Check, FormatDescription, InfoValue, LinkKind, Quantities, SettingDescription,
+    Check, DeviceInfo, FormatDescription, InfoValue, LinkKind, MAX_INFO_FIELDS, Quantities,
+    SettingDescription, padded,
 };
 use crate::units::{Quantity as Q, Settings};
 
@@ -43,7 +44,7 @@ pub const DESCRIPTION: FormatDescription = FormatDescription {
 };
 
 /// The values of an info frame's constants, in the order of [`DESCRIPTION`]'s `info_keys`.
-pub(crate) fn info_values(i: &InfoFrame) -> [InfoValue<'static>; 8] {
+fn info_values(i: &InfoFrame) -> [InfoValue<'static>; 8] {
     [
         i.full_scale,
         i.v1.into(),
@@ -55,6 +56,12 @@ pub(crate) fn info_values(i: &InfoFrame) -> [InfoValue<'static>; 8] {
         i.t2.into(),
     ]
     .map(|v: u16| InfoValue::Number(v.into()))
+}
+
+impl DeviceInfo for InfoFrame {
+    fn values(&self) -> [Option<InfoValue<'_>>; MAX_INFO_FIELDS] {
+        padded(info_values(self))
+    }
 }
 
 /// The setting `v4_volts_per_step` from its text.

@@ -26,5 +26,4 @@ pub const INFO_MARK: u8 = 0x01;
 pub const COUNTER_AT: usize = 1;
 /// Full scale of throttle and PWM until an info frame is adopted.
 pub const DEFAULT_FULL_SCALE: u16 = 1000;
-/// ADC fields are 12 bits: a data frame with one at this value or above is implausible.
-pub const ADC_LIMIT: u16 = 4096;
+pub use crate::ntc::ADC_LIMIT;

@@ -94,12 +94,12 @@ pub(crate) mod description;
 pub(crate) mod info;
 mod layout;
 mod stats;
-mod temperature;
 
 /// Baud rate of the V4 telemetry wire (8N1), as HW-FOC's.
 pub const BAUD_RATE: u32 = crate::foc::BAUD_RATE;
 
 pub use crate::chain::MAX_CHAINED_GAP;
+pub use crate::ntc::{NTC_BETA, NTC_R25_OVER_REFERENCE, ntc_celsius};
 pub use data::{Data, DataFrame};
 pub use decoder::{CHAIN_TO_LOCK, Decoded, Decoder, Frame, Frames, Scanner, frames};
 pub use description::DESCRIPTION;
@@ -109,4 +109,23 @@ pub use layout::{
     SLOW_DATA_FRAME_LEN, TRAILER,
 };
 pub use stats::Stats;
-pub use temperature::{NTC_BETA, NTC_R25_OVER_REFERENCE, ntc_celsius};
+
+crate::protocol::found_frame!(Decoded, HwV4);
+
+impl From<Frame> for crate::telemetry::Frame {
+    #[inline(always)]
+    fn from(frame: Frame) -> crate::telemetry::Frame {
+        match frame {
+            Frame::Data(d) => crate::telemetry::Frame::Data(crate::telemetry::Data::HwV4(d)),
+            Frame::Info(i) => crate::telemetry::Frame::Info(crate::telemetry::Info::HwV4(i)),
+        }
+    }
+}
+
+impl crate::protocol::FamilyScanner for Scanner {
+    fn handed_on(s: &Stats) -> u64 {
+        u64::from(s.frames()) + u64::from(s.info_frames())
+    }
+
+    const SILENCE_FRAME_LEN: usize = DATA_FRAME_LEN;
+}

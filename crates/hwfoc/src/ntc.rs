@@ -1,10 +1,13 @@
-//! The V4 temperature conversion: an NTC thermistor read by a 12-bit ADC.
+//! The V4 temperature conversion: an NTC thermistor read by a 12-bit ADC. Here, not in
+//! [`crate::v4`], because the neutral [`Conversion::Ntc`](crate::Conversion) computes it;
+//! [`crate::v4`] re-exports it.
 //!
 //! Beta 3950, 47 kOhm at 25 degC, against a 10 kOhm reference (every source agrees):
 //! `T = 1 / (ln(adc / (4096 - adc) * 10 / 47) / 3950 + 1 / 298.15) - 273.15` degC. An ADC
 //! value of 0 is no reading. `core` has no logarithm, so the one this needs is here.
 
-use super::layout::ADC_LIMIT;
+/// One more than the largest code of a 12-bit ADC (V4's voltage, current and temperature codes).
+pub const ADC_LIMIT: u16 = 4096;
 
 /// Beta of the NTC thermistor, in kelvin.
 pub const NTC_BETA: f64 = 3950.0;

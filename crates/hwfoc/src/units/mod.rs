@@ -24,7 +24,10 @@
 
 use core::fmt;
 
-use crate::v4::VoltsPerStep;
+mod adc_scale;
+
+pub(crate) use adc_scale::VOLTS_PER_STEP_FORM;
+pub use adc_scale::{CurrentScale, VoltsPerStep, VoltsPerStepError};
 
 /// Electrical RPM per unit of a data frame's raw eRPM field.
 pub const ERPM_PER_RAW: u16 = 10;
