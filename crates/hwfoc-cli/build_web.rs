@@ -7,7 +7,9 @@ use std::path::{Path, PathBuf};
 
 /// Builds the app and writes the list of its files; tells cargo what to watch.
 pub fn embed() {
-    let manifest = Path::new(env!("CARGO_MANIFEST_DIR"));
+    // Read when the script runs, not when it was compiled: a target folder moved to another
+    // checkout (CI's clone) reuses the compiled script, which must build that checkout's app.
+    let manifest = PathBuf::from(std::env::var_os("CARGO_MANIFEST_DIR").expect("cargo sets it"));
     let root = manifest
         .parent()
         .and_then(Path::parent)
