@@ -3,7 +3,10 @@
 //! under made errors.
 
 fn main() {
-    let header_dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../../c");
+    // Read when the script runs, not when it was compiled: a target folder reused by another
+    // checkout must compile that checkout's header.
+    let manifest = std::env::var("CARGO_MANIFEST_DIR").expect("cargo sets CARGO_MANIFEST_DIR");
+    let header_dir = format!("{manifest}/../../c");
     println!("cargo:rerun-if-changed=shim/shim.c");
     println!("cargo:rerun-if-changed=shim/noinfo.c");
     println!("cargo:rerun-if-changed=shim/flat_out.h");
@@ -11,7 +14,7 @@ fn main() {
     cc::Build::new()
         .file("shim/shim.c")
         .file("shim/noinfo.c")
-        .include(header_dir)
+        .include(&header_dir)
         .std("c99")
         .flag_if_supported("-Wall")
         .flag_if_supported("-Wextra")

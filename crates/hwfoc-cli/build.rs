@@ -14,7 +14,8 @@ mod build_web;
 fn git(args: &[&str]) -> Option<String> {
     let out = Command::new("git")
         .args(args)
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        // Read when the script runs (a target folder may be reused by another checkout).
+        .current_dir(std::env::var_os("CARGO_MANIFEST_DIR").expect("cargo sets it"))
         .output()
         .ok()?;
     let text = String::from_utf8(out.stdout).ok()?;
