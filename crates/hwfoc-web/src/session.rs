@@ -146,12 +146,18 @@ impl Session {
         }
     }
 
-    /// Ends the stream: nothing more is decoded; a session that found no frame says so.
+    /// Ends the stream: the frames held at its end (a CAN node's records awaiting its GetEscID
+    /// answer) are handed on, nothing more is decoded; a session that found no frame says so.
     pub fn finish(&mut self) {
         if self.finished {
             return;
         }
         self.finished = true;
+        let mut take = Take {
+            columns: &mut self.columns,
+            escs: &mut self.escs,
+        };
+        self.streams.finish(&mut take);
         if self.escs.iter().all(|e| e.frames == 0) {
             self.notices
                 .push(format!("no telemetry frame found in {} bytes", self.bytes));

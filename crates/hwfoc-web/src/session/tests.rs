@@ -75,3 +75,68 @@ fn a_port_fed_in_chunks_gives_the_summary_figures_of_its_recording() {
         e["energy_wh"]
     );
 }
+
+/// A CAN bus log's frames as an SLCAN port's session is fed them: (SocketCAN record, Unix µs).
+fn bus_records(log: &str) -> Vec<([u8; 16], f64)> {
+    use hwfoc_records::can::candump::{Logged, parse_line};
+    log.lines()
+        .enumerate()
+        .filter_map(|(i, l)| match parse_line(l, i as u64 + 1).unwrap().frame {
+            Logged::Classic(f) => {
+                Some((f.to_socketcan_record(), parse_line(l, 1).unwrap().t_s * 1e6))
+            }
+            Logged::Fd => None,
+        })
+        .collect()
+}
+
+#[test]
+fn an_slcan_bus_gives_the_summary_figures_of_its_log() {
+    let log = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../testdata/dronecan/can-bus.log"
+    ))
+    .unwrap();
+    let want: Value =
+        serde_json::from_str(&crate::file::open("bus.log", log.clone().into_bytes()).summary)
+            .unwrap();
+    let mut session = Session::new(None, "slcan:bus", None).unwrap();
+    for (record, t) in bus_records(&log) {
+        session.feed(&record, Some(t));
+    }
+    session.finish();
+    let got: Vec<_> = session.escs().filter(|(_, f, _)| f.frames > 0).collect();
+    let want: Vec<_> = want["escs"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|e| e["frames"].as_u64() > Some(0))
+        .collect();
+    let figs: Vec<_> = got
+        .iter()
+        .map(|(e, f, l)| (*e, f.frames, l.lost_packets()))
+        .collect();
+    let wants: Vec<_> = want
+        .iter()
+        .map(|w| {
+            (
+                w["esc"].clone(),
+                w["frames"].clone(),
+                w["link"]["lost_packets"].clone(),
+            )
+        })
+        .collect();
+    assert_eq!(got.len(), want.len(), "{figs:?} vs {wants:?}");
+    for ((esc, figures, link), w) in got.iter().zip(&want) {
+        assert_eq!(Some(*esc as u64), w["esc"].as_u64());
+        assert_eq!(Some(figures.frames), w["frames"].as_u64(), "esc {esc}");
+        let lost = link
+            .counts_packets()
+            .then(|| u64::from(link.lost_packets()));
+        assert_eq!(
+            lost,
+            w["link"]["lost_packets"].as_u64(),
+            "esc {esc}'s lost packets"
+        );
+    }
+}
