@@ -15,6 +15,10 @@ use crate::columns::Columns;
 /// The rate a port is taken to be read at when the page names none (HW-FOC's).
 const DEFAULT_BAUD: u32 = hwfoc_records::serial::DEFAULT_BAUD;
 
+/// The characters of an adapter's line of an extended frame of 8 bytes (`T`, 8 id digits,
+/// length, 16 data digits, CR): a frame's wire time on the adapter's serial port.
+const SLCAN_LINE: usize = 27;
+
 /// What a session knows of one ESC, by number.
 #[derive(Default, Clone)]
 pub struct EscFigures {
@@ -117,33 +121,45 @@ impl Session {
         if bytes.is_empty() || self.finished {
             return;
         }
-        // A bus's frames all came at the chunk's time, each its own event (as a bus's reader
-        // hands them on); a port's bytes back to back before its last.
-        let t_ns = match (t_micros, self.can) {
-            (Some(t), true) => first_byte_ns(t, 1, self.baud),
-            (Some(t), false) => first_byte_ns(t, bytes.len(), self.baud),
-            (None, _) => self.last_ns + (hwfoc::wire::byte_ns(self.baud) * 64.0) as u64,
-        }
-        .max(self.last_ns);
-        self.last_ns = t_ns;
         self.bytes += bytes.len() as u64;
         let mut take = Take {
             columns: &mut self.columns,
             escs: &mut self.escs,
         };
-        let size = if self.can {
-            hwfoc::dronecan::SOCKETCAN_RECORD_LEN
-        } else {
-            bytes.len()
-        };
-        for piece in bytes.chunks(size) {
-            let event = PortEvent::Data {
-                port: 0,
-                t_ns,
-                bytes: piece.to_vec(),
-            };
-            self.streams.feed(&event, &mut take);
+        if self.can {
+            // A bus's frames, each its own event (as a bus's reader hands them on): their
+            // adapter's lines came back to back at the port's rate before the chunk's time.
+            let records = bytes.chunks(hwfoc::dronecan::SOCKETCAN_RECORD_LEN);
+            let n = records.len();
+            for (k, record) in records.enumerate() {
+                let t_ns = match t_micros {
+                    Some(t) => first_byte_ns(t, 1 + (n - 1 - k) * SLCAN_LINE, self.baud),
+                    None => self.last_ns + (hwfoc::wire::byte_ns(self.baud) * 64.0) as u64,
+                }
+                .max(self.last_ns);
+                self.last_ns = t_ns;
+                let event = PortEvent::Data {
+                    port: 0,
+                    t_ns,
+                    bytes: record.to_vec(),
+                };
+                self.streams.feed(&event, &mut take);
+            }
+            return;
         }
+        // A port's bytes back to back before its last.
+        let t_ns = match t_micros {
+            Some(t) => first_byte_ns(t, bytes.len(), self.baud),
+            None => self.last_ns + (hwfoc::wire::byte_ns(self.baud) * 64.0) as u64,
+        }
+        .max(self.last_ns);
+        self.last_ns = t_ns;
+        let event = PortEvent::Data {
+            port: 0,
+            t_ns,
+            bytes: bytes.to_vec(),
+        };
+        self.streams.feed(&event, &mut take);
     }
 
     /// Ends the stream: the frames held at its end (a CAN node's records awaiting its GetEscID

@@ -92,6 +92,10 @@ fn bus_records(log: &str) -> Vec<([u8; 16], f64)> {
 
 #[test]
 fn an_slcan_bus_gives_the_summary_figures_of_its_log() {
+    slcan_bus_read(1);
+}
+
+fn slcan_bus_read(lines: usize) {
     let log = std::fs::read_to_string(concat!(
         env!("CARGO_MANIFEST_DIR"),
         "/../../testdata/dronecan/can-bus.log"
@@ -101,8 +105,9 @@ fn an_slcan_bus_gives_the_summary_figures_of_its_log() {
         serde_json::from_str(&crate::file::open("bus.log", log.clone().into_bytes()).summary)
             .unwrap();
     let mut session = Session::new(None, "slcan:bus", None).unwrap();
-    for (record, t) in bus_records(&log) {
-        session.feed(&record, Some(t));
+    for group in bus_records(&log).chunks(lines) {
+        let bytes: Vec<u8> = group.iter().flat_map(|(r, _)| r.to_vec()).collect();
+        session.feed(&bytes, group.last().map(|(_, t)| *t));
     }
     session.finish();
     let got: Vec<_> = session.escs().filter(|(_, f, _)| f.frames > 0).collect();
