@@ -126,40 +126,34 @@ impl Session {
             columns: &mut self.columns,
             escs: &mut self.escs,
         };
-        if self.can {
-            // A bus's frames, each its own event (as a bus's reader hands them on): their
-            // adapter's lines came back to back at the port's rate before the chunk's time.
-            let records = bytes.chunks(hwfoc::dronecan::SOCKETCAN_RECORD_LEN);
-            let n = records.len();
-            for (k, record) in records.enumerate() {
-                let t_ns = match t_micros {
-                    Some(t) => first_byte_ns(t, 1 + (n - 1 - k) * SLCAN_LINE, self.baud),
-                    None => self.last_ns + (hwfoc::wire::byte_ns(self.baud) * 64.0) as u64,
-                }
-                .max(self.last_ns);
-                self.last_ns = t_ns;
-                let event = PortEvent::Data {
-                    port: 0,
-                    t_ns,
-                    bytes: record.to_vec(),
-                };
-                self.streams.feed(&event, &mut take);
-            }
-            return;
-        }
-        // A port's bytes back to back before its last.
-        let t_ns = match t_micros {
-            Some(t) => first_byte_ns(t, bytes.len(), self.baud),
-            None => self.last_ns + (hwfoc::wire::byte_ns(self.baud) * 64.0) as u64,
-        }
-        .max(self.last_ns);
-        self.last_ns = t_ns;
-        let event = PortEvent::Data {
-            port: 0,
-            t_ns,
-            bytes: bytes.to_vec(),
+        // A bus's frames go each as its own event (as a bus's reader hands them on), their
+        // adapter's lines back to back at the port's rate before the chunk's time; a port's
+        // bytes as one event, back to back before its last.
+        let size = if self.can {
+            hwfoc::dronecan::SOCKETCAN_RECORD_LEN
+        } else {
+            bytes.len()
         };
-        self.streams.feed(&event, &mut take);
+        let n = bytes.len().div_ceil(size);
+        for (k, piece) in bytes.chunks(size).enumerate() {
+            let after = if self.can {
+                (n - 1 - k) * SLCAN_LINE
+            } else {
+                piece.len() - 1
+            };
+            let t_ns = match t_micros {
+                Some(t) => first_byte_ns(t, 1 + after, self.baud),
+                None => self.last_ns + (hwfoc::wire::byte_ns(self.baud) * 64.0) as u64,
+            }
+            .max(self.last_ns);
+            self.last_ns = t_ns;
+            let event = PortEvent::Data {
+                port: 0,
+                t_ns,
+                bytes: piece.to_vec(),
+            };
+            self.streams.feed(&event, &mut take);
+        }
     }
 
     /// Ends the stream: the frames held at its end (a CAN node's records awaiting its GetEscID

@@ -1087,32 +1087,9 @@ impl PortStreams {
             }
             PortEvent::Lost { .. } | PortEvent::Back { .. } => return None,
         };
-        let PortStreams {
-            streams,
-            per_byte_ns,
-            bauds: _,
-            discarded: _,
-            times,
-            names,
-            map,
-            esc_settings,
-            hubs,
-            left_out,
-            past_last,
-        } = self;
-        let stream = streams.get_mut(*port)?;
+        let (stream, mut numbering, times, per_byte_ns) = self.port(*port)?;
         times.clear();
-        byte_times(*t_ns, per_byte_ns[*port], bytes.len(), times);
-        let mut numbering = Numbering {
-            port: *port,
-            can: stream.is_can(),
-            hub: &mut hubs[*port],
-            esc_settings,
-            names,
-            map,
-            left_out,
-            past_last,
-        };
+        byte_times(*t_ns, per_byte_ns, bytes.len(), times);
         stream.feed(
             Batch {
                 bytes,
@@ -1124,31 +1101,41 @@ impl PortStreams {
         Some(stream.stats())
     }
 
+    /// The stream of `port`, its numbering, the byte times' buffer and its byte time (ns).
+    fn port(&mut self, port: usize) -> Option<(&mut Stream, Numbering<'_>, &mut Vec<f64>, f64)> {
+        let PortStreams {
+            streams,
+            per_byte_ns,
+            times,
+            names,
+            map,
+            esc_settings,
+            hubs,
+            left_out,
+            past_last,
+            ..
+        } = self;
+        let stream = streams.get_mut(port)?;
+        let numbering = Numbering {
+            port,
+            can: stream.is_can(),
+            hub: &mut hubs[port],
+            esc_settings,
+            names,
+            map,
+            left_out,
+            past_last,
+        };
+        Some((stream, numbering, times, per_byte_ns[port]))
+    }
+
     /// Ends every port's stream, handing on to `handler` the frames it held (a frame cut off at
     /// the end is dropped; a CAN node's records held for its GetEscID answer come out,
     /// numbered as a recording of the same bytes numbers them).
     pub fn finish<H: Handler>(&mut self, handler: &mut H) {
         for port in 0..self.streams.len() {
-            let PortStreams {
-                streams,
-                names,
-                map,
-                esc_settings,
-                hubs,
-                left_out,
-                past_last,
-                ..
-            } = self;
-            let stream = &mut streams[port];
-            let mut numbering = Numbering {
-                port,
-                can: stream.is_can(),
-                hub: &mut hubs[port],
-                esc_settings,
-                names,
-                map,
-                left_out,
-                past_last,
+            let Some((stream, mut numbering, ..)) = self.port(port) else {
+                continue;
             };
             stream.finish(|t, channel, d| numbering.hand_on(t, channel, d, handler));
         }
