@@ -315,3 +315,40 @@ test('the port search finds an HW5 ESC at 115200 baud after the bytes at 19200 g
   const last = decoded.at(-1);
   assert.ok(Math.abs(Number(await page.locator('[data-esc="0"] [data-col=voltage_v]').getAttribute('data-value')) - last.voltage_v) < 1e-4);
 });
+
+test('an SLCAN adapter\'s bus of two Hobbywing CAN ESCs shows the values hwfoc decode gives', { skip: missing, timeout: 60000 }, async () => {
+  const dir = mkdtempSync(`${tmpdir()}/hwfoc-slcan-`);
+  execFileSync(hwfocBin(), ['simulate', '--protocol', 'hw-can', '--escs', '2', '--duration', '4', '--no-config', '-o', `${dir}/bus.log`], { stdio: 'ignore' });
+  const decoded = execFileSync(hwfocBin(), ['decode', '--no-config', `${dir}/bus.log`], { encoding: 'utf8' })
+    .trim().split('\n').map((l) => JSON.parse(l));
+  // candump's `(time) iface ID#DATA` lines as the adapter sends them: T, 8 id digits, length, data.
+  const lines = readFileSync(`${dir}/bus.log`, 'utf8').trim().split('\n').map((l) => {
+    const [time, , frame] = l.split(' ');
+    const [id, data] = frame.split('#');
+    return { t: Number(time.slice(1, -1)), text: `T${id}${data.length / 2}${data}\r` };
+  });
+  const chunks = lines.map((l) => ({ at: (l.t - lines[0].t) * 1000, b64: Buffer.from(l.text).toString('base64') }));
+  const page = await livePage(1280, [{ baud: 115200, chunks }]);
+  await page.getByTestId('add-slcan').click();
+  await page.waitForFunction(() => window.__fake.done(), null, { timeout: 20000 });
+  await page.waitForTimeout(800);
+  const escs = [...new Set(decoded.map((r) => r.esc))].sort();
+  assert.equal(await page.locator('.live-table tbody tr').count(), escs.length);
+  for (const esc of escs) {
+    const mine = decoded.filter((r) => r.esc === esc);
+    const row = page.locator(`[data-esc="${esc}"]`);
+    assert.equal(Number(await row.getAttribute('data-frames')), mine.length, `esc ${esc}'s frames`);
+    const v = Number(await row.locator('[data-col=voltage_v]').getAttribute('data-value'));
+    assert.ok(Math.abs(v - mine.at(-1).voltage_v) < 1e-4, `esc ${esc}: ${v} V, decode ${mine.at(-1).voltage_v} V`);
+  }
+  // The session's summary reaches the dashboard: mAh and Wh as hwfoc summary gives them, not –.
+  const summary = JSON.parse(execFileSync(hwfocBin(), ['summary', '--json', '--no-config', `${dir}/bus.log`], { encoding: 'utf8' }));
+  for (const e of summary.escs) {
+    const row = page.locator(`[data-esc="${e.esc}"]`);
+    assert.equal(await row.locator('[data-col=mah]').textContent(), e.energy.charge_mah.toFixed(0));
+    assert.equal(await row.locator('[data-col=wh]').textContent(), e.energy.energy_wh.toFixed(2));
+    // (Hobbywing CAN's lost packets are judged from the frames' times, which the page's timers
+    // shift under load: web/test/live-slcan.test.mjs compares them on exact times.)
+  }
+  await page.screenshot({ path: `${shots}live-slcan-1280.png`, fullPage: true });
+});

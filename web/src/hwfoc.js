@@ -28,7 +28,7 @@ export class Session {
   constructor({ protocol, baud, name } = {}) {
     this.name = name ?? 'stream';
     this.baud = baud;
-    this.inner = new wasm.WasmSession(protocol ?? undefined);
+    this.inner = new wasm.WasmSession(protocol ?? undefined, this.name, baud ?? undefined);
   }
 
   /**

@@ -1,6 +1,6 @@
 import { test } from 'node:test';
 import assert from 'node:assert/strict';
-import { envelope, blocks, lowerBound, nearest, range, splitByEsc, timed, gather } from '../src/files/series.js';
+import { envelope, blocks, lowerBound, nearest, range, splitByEsc, timed, gather, hasValue } from '../src/files/series.js';
 import { toCsv, float32Text, csvColumns } from '../src/files/csv.js';
 
 test('envelope keeps each pixel column first, min, max and last', () => {
@@ -115,4 +115,11 @@ test('niceTicks', () => {
   assert.deepEqual(niceTicks(0, 10, 5), [0, 2, 4, 6, 8, 10]);
   assert.deepEqual(niceTicks(23.4, 24.9, 3), [23.5, 24, 24.5]);
   assert.deepEqual(niceTicks(1, 1, 3), []);
+});
+
+test('a column has a value unless every entry is NaN', () => {
+  assert.equal(hasValue(new Float32Array([NaN, NaN, NaN])), false);
+  assert.equal(hasValue(new Float64Array(0)), false);
+  assert.equal(hasValue(new Float32Array([NaN, NaN, 0])), true);
+  assert.equal(hasValue(new Uint8Array([0])), true);
 });

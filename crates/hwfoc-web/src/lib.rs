@@ -22,18 +22,25 @@ pub struct WasmSession {
 
 #[wasm_bindgen(js_class = WasmSession)]
 impl WasmSession {
-    /// A session reading every serial format, or only `protocol` (a name `--protocol` takes).
+    /// A session reading port `name` at `baud` (HW-FOC's 19200 when not given), every
+    /// format or only `protocol` (a name `--protocol` takes); a CAN bus (`slcan:` name, or a
+    /// CAN protocol) is fed SocketCAN records ([`session::Session::new`]).
     #[wasm_bindgen(constructor)]
-    pub fn new(protocol: Option<String>) -> Result<WasmSession, JsError> {
-        let inner =
-            session::Session::new(protocol.as_deref()).map_err(|e| JsError::new(&e.to_string()))?;
+    pub fn new(
+        protocol: Option<String>,
+        name: Option<String>,
+        baud: Option<u32>,
+    ) -> Result<WasmSession, JsError> {
+        let name = name.unwrap_or_else(|| "port".to_owned());
+        let inner = session::Session::new(protocol.as_deref(), &name, baud)
+            .map_err(|e| JsError::new(&e.to_string()))?;
         Ok(WasmSession { inner })
     }
 
     /// Decodes `bytes`, the chunk whose last byte came at `t_micros` (Unix microseconds), or
-    /// without a time (a file).
+    /// without a time.
     pub fn feed(&mut self, bytes: &[u8], t_micros: Option<f64>) {
-        self.inner.feed(bytes, t_micros.map(|t| t / 1e6));
+        self.inner.feed(bytes, t_micros);
     }
 
     /// Ends the stream.
@@ -57,27 +64,64 @@ impl WasmSession {
             .collect()
     }
 
-    /// Per ESC: `{esc, frames, info_frames, info}`.
+    /// Per ESC, the figures of `hwfoc summary --json`'s object that a live port gives:
+    /// `{esc, frames, info_frames, info, link, energy}` (`link`: checksum failures, lost and
+    /// duplicate packets, restarts, bytes skipped, delivery ratio, null where the protocol
+    /// has none; `energy`: charge, energy, peak and mean power, seconds, or null).
     pub fn summary(&self) -> Result<Object, JsValue> {
         let escs = Array::new();
-        for (esc, frames, info_frames, info) in self.inner.escs() {
+        for (esc, figures, link) in self.inner.escs() {
             let o = Object::new();
-            Reflect::set(&o, &"esc".into(), &(esc as u32).into())?;
-            Reflect::set(&o, &"frames".into(), &(frames as f64).into())?;
-            Reflect::set(&o, &"info_frames".into(), &(info_frames as f64).into())?;
+            set(&o, "esc", esc as f64)?;
+            set(&o, "frames", figures.frames as f64)?;
+            set(&o, "info_frames", figures.info_frames as f64)?;
             let infos = Array::new();
-            if let Some(text) = info {
+            if let Some(text) = &figures.info {
                 let i = Object::new();
                 Reflect::set(&i, &"text".into(), &text.into())?;
                 infos.push(&i);
             }
             Reflect::set(&o, &"info".into(), &infos)?;
+            let counted = link.counts_packets();
+            let l = Object::new();
+            let checksum = link.has_checksum().then(|| link.checksum_failures());
+            set(&l, "checksum_failures", checksum.map(f64::from))?;
+            set(
+                &l,
+                "lost_packets",
+                counted.then(|| f64::from(link.lost_packets())),
+            )?;
+            let duplicates = counted.then(|| f64::from(link.duplicate_packets()));
+            set(&l, "duplicate_packets", duplicates)?;
+            set(&l, "restarts", counted.then(|| f64::from(link.restarts())))?;
+            set(&l, "bytes_skipped", link.bytes_skipped() as f64)?;
+            set(&l, "delivery_ratio", link.delivery_ratio())?;
+            Reflect::set(&o, &"link".into(), &l)?;
+            let energy = if figures.powered {
+                let e = &figures.energy;
+                let j = Object::new();
+                set(&j, "charge_mah", e.charge_mah())?;
+                set(&j, "energy_wh", e.energy_wh())?;
+                set(&j, "peak_power_w", e.peak_w())?;
+                set(&j, "mean_power_w", e.mean_w())?;
+                set(&j, "seconds", e.seconds())?;
+                JsValue::from(j)
+            } else {
+                JsValue::NULL
+            };
+            Reflect::set(&o, &"energy".into(), &energy)?;
             escs.push(&o);
         }
         let out = Object::new();
         Reflect::set(&out, &"escs".into(), &escs)?;
         Ok(out)
     }
+}
+
+/// Sets `key` of `o` to a number (null for `None`).
+fn set(o: &Object, key: &str, value: impl Into<Option<f64>>) -> Result<(), JsValue> {
+    let value = value.into().map_or(JsValue::NULL, JsValue::from);
+    Reflect::set(o, &key.into(), &value).map(|_| ())
 }
 
 /// The names of the set fault bits of `status` in bit order, by `protocol` (a name
@@ -150,13 +194,8 @@ impl WasmRecorder {
             writer.add_interface(&self.port, self.baud).map_err(err)?;
             self.declared = true;
         }
-        // The time of the chunk's first byte: the last's less the wire time of the others.
-        let per_byte = hwfoc::wire::byte_ns(self.baud);
-        let last_ns = (t_micros.max(0.0) * 1000.0) as u64;
-        let before = (bytes.len().saturating_sub(1) as f64 * per_byte) as u64;
-        writer
-            .write(0, last_ns.saturating_sub(before), bytes)
-            .map_err(err)
+        let first_ns = session::first_byte_ns(t_micros, bytes.len(), self.baud);
+        writer.write(0, first_ns, bytes).map_err(err)
     }
 
     /// The pcapng file.

@@ -3,7 +3,7 @@
 
 import { Chart, COLOURS } from './chart.js';
 import { csvColumns, toCsv } from './csv.js';
-import { blocks, gather, nearest, splitByEsc, timed } from './series.js';
+import { blocks, gather, hasValue, nearest, splitByEsc, timed } from './series.js';
 import { escSummary } from './summary.js';
 import { View } from './view.js';
 
@@ -171,7 +171,7 @@ function prepare(name, opened, openMs) {
     e.chosen = true;
   }
   const quantities = Object.keys(records.columns).filter(
-    (name) => !NOT_CHARTED.has(name) && records.columns[name].some((v) => !Number.isNaN(v)),
+    (name) => !NOT_CHARTED.has(name) && hasValue(records.columns[name]),
   );
   let min = Infinity;
   let max = -Infinity;

@@ -47,6 +47,19 @@ export function timed(t, escs) {
 }
 
 /**
+ * Whether `column` holds a value (not all NaN): a plain loop, since a column of a quantity the
+ * protocol does not send is read to its end (a closure per element cost 0.4 s on 1.15 million
+ * records of 14 columns).
+ * @param {ArrayLike<number>} column
+ */
+export function hasValue(column) {
+  for (let i = 0; i < column.length; i++) {
+    if (column[i] === column[i]) return true;
+  }
+  return false;
+}
+
+/**
  * One column's values at the places `index`, in an array of the column's type.
  * @param {Float32Array | Float64Array | Uint8Array} column
  * @param {Uint32Array} index

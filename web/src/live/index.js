@@ -52,8 +52,10 @@ export function mountLive(element, api, { serial = globalThis.navigator?.serial 
     say(noSerialNote());
   }
 
-  function sessionOf(index, protocol, rate) {
-    if (!sessions.has(index)) sessions.set(index, new api.Session({ protocol, baud: rate, name: ports[index].name }));
+  // An SLCAN adapter's bus is read as `hwfoc decode slcan:PORT` reads it: every CAN protocol.
+  function sessionOf(index, slcanBitrate, rate) {
+    const name = slcanBitrate ? `slcan:${ports[index].name}` : ports[index].name;
+    if (!sessions.has(index)) sessions.set(index, new api.Session({ baud: rate, name }));
     return sessions.get(index);
   }
 
@@ -74,7 +76,7 @@ export function mountLive(element, api, { serial = globalThis.navigator?.serial 
       newDecoder: sessionJudge(api),
       onData: (bytes, tMicros, rate) => {
         const fresh = !sessions.has(index);
-        sessionOf(index, slcanBitrate ? 'hw-can' : undefined, rate).feed(bytes, tMicros);
+        sessionOf(index, slcanBitrate, rate).feed(bytes, tMicros);
         // A port's first frames are shown at once, not at the next redraw.
         if (fresh) setTimeout(refresh, 0);
         // An SLCAN adapter's frames are not serial bytes: a CAN bus is recorded by `hwfoc record slcan:PORT`.

@@ -904,6 +904,78 @@ impl Stream {
     }
 }
 
+/// What numbers a port's frames into ESCs ([`PortStreams`]): the port's own ESC, a hub's
+/// channels and a bus's places after every port's.
+struct Numbering<'a> {
+    port: usize,
+    can: bool,
+    hub: &'a mut Vec<usize>,
+    esc_settings: &'a mut Vec<Settings>,
+    names: &'a [String],
+    map: &'a SettingsMap,
+    left_out: &'a mut [u64],
+    past_last: &'a mut Vec<Notice>,
+}
+
+impl Numbering<'_> {
+    /// Hands `d` (of the port's `channel`, at `t`) to `handler` with its ESC number.
+    fn hand_on<H: Handler>(
+        &mut self,
+        t: Option<f64>,
+        channel: Option<u8>,
+        d: &Frame,
+        handler: &mut H,
+    ) {
+        let Numbering {
+            port,
+            can,
+            hub,
+            esc_settings,
+            names,
+            map,
+            left_out,
+            past_last,
+        } = self;
+        let can = *can;
+        let esc = match channel {
+            None => *port,
+            Some(c) => {
+                // A hub's channels all at once, a bus's places up to the one heard.
+                let places = if can {
+                    usize::from(c) + 1
+                } else {
+                    datalink::CHANNELS
+                };
+                while hub.len() < places {
+                    let n = channel_number(*port, esc_settings.len(), hub.len());
+                    if n != UNNUMBERED && n != *port {
+                        esc_settings.push(map.get(n, &names[*port]));
+                    }
+                    hub.push(n);
+                }
+                hub[usize::from(c)]
+            }
+        };
+        if let Ok(id) = u8::try_from(esc) {
+            handler.frame(id, t, d, &esc_settings[esc]);
+        } else if matches!(d, Frame::Data(_)) {
+            if left_out[*port] == 0 {
+                past_last.push(Notice::PastLastEsc {
+                    input: names[*port].clone(),
+                    place: channel.map(|c| {
+                        if can {
+                            format!("place {c} of the bus")
+                        } else {
+                            format!("DataLink channel {c}")
+                        }
+                    }),
+                });
+            }
+            left_out[*port] += 1;
+        }
+    }
+}
+
 /// A [`Stream`] per port, fed by [`PortEvent`]s: the path from live bytes to timed frames of
 /// `monitor`, `record` and the bridges (and of `hwfoc-io`'s `Input::open_ports`, through
 /// [`byte_times`]).
@@ -1015,11 +1087,25 @@ impl PortStreams {
             }
             PortEvent::Lost { .. } | PortEvent::Back { .. } => return None,
         };
+        let (stream, mut numbering, times, per_byte_ns) = self.port(*port)?;
+        times.clear();
+        byte_times(*t_ns, per_byte_ns, bytes.len(), times);
+        stream.feed(
+            Batch {
+                bytes,
+                times: Some(&times[..]),
+                stream: *port,
+            },
+            |t, channel, d| numbering.hand_on(t, channel, d, handler),
+        );
+        Some(stream.stats())
+    }
+
+    /// The stream of `port`, its numbering, the byte times' buffer and its byte time (ns).
+    fn port(&mut self, port: usize) -> Option<(&mut Stream, Numbering<'_>, &mut Vec<f64>, f64)> {
         let PortStreams {
             streams,
             per_byte_ns,
-            bauds: _,
-            discarded: _,
             times,
             names,
             map,
@@ -1027,58 +1113,32 @@ impl PortStreams {
             hubs,
             left_out,
             past_last,
+            ..
         } = self;
-        let stream = streams.get_mut(*port)?;
-        times.clear();
-        byte_times(*t_ns, per_byte_ns[*port], bytes.len(), times);
-        let hub = &mut hubs[*port];
-        let can = stream.is_can();
-        stream.feed(
-            Batch {
-                bytes,
-                times: Some(&times[..]),
-                stream: *port,
-            },
-            |t, channel, d| {
-                let esc = match channel {
-                    None => *port,
-                    Some(c) => {
-                        // A hub's channels all at once, a bus's places up to the one heard.
-                        let places = if can {
-                            usize::from(c) + 1
-                        } else {
-                            datalink::CHANNELS
-                        };
-                        while hub.len() < places {
-                            let n = channel_number(*port, esc_settings.len(), hub.len());
-                            if n != UNNUMBERED && n != *port {
-                                esc_settings.push(map.get(n, &names[*port]));
-                            }
-                            hub.push(n);
-                        }
-                        hub[usize::from(c)]
-                    }
-                };
-                if let Ok(id) = u8::try_from(esc) {
-                    handler.frame(id, t, d, &esc_settings[esc]);
-                } else if matches!(d, Frame::Data(_)) {
-                    if left_out[*port] == 0 {
-                        past_last.push(Notice::PastLastEsc {
-                            input: names[*port].clone(),
-                            place: channel.map(|c| {
-                                if can {
-                                    format!("place {c} of the bus")
-                                } else {
-                                    format!("DataLink channel {c}")
-                                }
-                            }),
-                        });
-                    }
-                    left_out[*port] += 1;
-                }
-            },
-        );
-        Some(stream.stats())
+        let stream = streams.get_mut(port)?;
+        let numbering = Numbering {
+            port,
+            can: stream.is_can(),
+            hub: &mut hubs[port],
+            esc_settings,
+            names,
+            map,
+            left_out,
+            past_last,
+        };
+        Some((stream, numbering, times, per_byte_ns[port]))
+    }
+
+    /// Ends every port's stream, handing on to `handler` the frames it held (a frame cut off at
+    /// the end is dropped; a CAN node's records held for its GetEscID answer come out,
+    /// numbered as a recording of the same bytes numbers them).
+    pub fn finish<H: Handler>(&mut self, handler: &mut H) {
+        for port in 0..self.streams.len() {
+            let Some((stream, mut numbering, ..)) = self.port(port) else {
+                continue;
+            };
+            stream.finish(|t, channel, d| numbering.hand_on(t, channel, d, handler));
+        }
     }
 
     /// Makes every port's stream read protocol `protocol` only (see [`Stream::forced`]; a
