@@ -116,6 +116,17 @@ test('screenshots at 390 px and 1280 px', async () => {
       assert.match(readout, /ESC \d+: /, 'the cursor readout');
       await page.evaluate(() => window.scrollTo(0, 0));
       await page.screenshot({ path: join(shots, `files-${width}.png`), fullPage: true });
+      // The readout names the shown recording's range (the last file's: frames), also after a
+      // resize, when the tabs shown before once drew theirs into it.
+      // (The shown plot's redraw is queued first, by the pointer leaving, as a screenshot's
+      // resize found it after the cursor readout.)
+      await page.mouse.move(0, 0);
+      await page.evaluate(() => {
+        document.querySelector('canvas.chart').dispatchEvent(new Event('pointerleave'));
+        window.dispatchEvent(new Event('resize'));
+      });
+      await page.waitForTimeout(100);
+      assert.match(await page.textContent('.readout'), / frame$/, 'the range of the recording shown');
       const overflow = await page.evaluate(() => document.documentElement.scrollWidth - window.innerWidth);
       assert.ok(overflow <= 0, `no sideways scrolling at ${width} px (${overflow} px too wide)`);
     } finally {

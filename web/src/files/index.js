@@ -227,7 +227,15 @@ function episodes(recording, escNumber) {
  * @param {object} recording
  * @param {typeof import('../hwfoc.js')} api
  */
+/** The listeners of the recording each plot element shows, dropped when another is mounted. */
+const mounts = new WeakMap();
+
 function mountPlot(plot, recording, api) {
+  // The plot element is shared by the recordings' tabs: the one shown before must stop drawing
+  // into it (its window resize listener wrote its own time range into the readout).
+  mounts.get(plot)?.abort();
+  const mounted = new AbortController();
+  mounts.set(plot, mounted);
   const doc = plot.ownerDocument;
   const unit = recording.timed ? 's' : 'frame';
   const escBox = plot.querySelector('.escs');
@@ -273,6 +281,7 @@ function mountPlot(plot, recording, api) {
     pending = true;
     requestAnimationFrame(() => {
       pending = false;
+      if (mounted.signal.aborted) return;
       const shaded = recording.escs.filter((e) => e.chosen).flatMap((e) => episodes(recording, e.esc));
       for (const { q, chart } of charts) {
         const lines = recording.escs
@@ -353,7 +362,7 @@ function mountPlot(plot, recording, api) {
     a.click();
     setTimeout(() => URL.revokeObjectURL(a.href), 10_000);
   };
-  globalThis.addEventListener?.('resize', redraw);
+  globalThis.addEventListener?.('resize', redraw, { signal: mounted.signal });
   build();
 }
 
