@@ -425,6 +425,10 @@ struct Tmux {
     socket: String,
 }
 
+/// How long the pane may take to show a key's effect: generous, as CI machines run many tests
+/// at once (a wait, not a speed test: it returns as soon as the pane shows it).
+const PANE_WAIT: Duration = Duration::from_secs(15);
+
 impl Tmux {
     fn start(width: u16, height: u16) -> Tmux {
         // A server per test: tests run in parallel.
@@ -565,11 +569,11 @@ fn the_dashboard_in_tmux() {
 
     // Selecting the next ESC changes the detail pane.
     tmux.keys(&["Down"]);
-    tmux.wait("esc1's detail pane", Duration::from_secs(3), |p| {
+    tmux.wait("esc1's detail pane", PANE_WAIT, |p| {
         p.contains("┌ esc1 sim:esc1")
     });
     tmux.keys(&["3"]);
-    tmux.wait("esc3's detail pane", Duration::from_secs(3), |p| {
+    tmux.wait("esc3's detail pane", PANE_WAIT, |p| {
         p.contains("┌ esc3 sim:esc3")
     });
 
@@ -582,22 +586,18 @@ fn the_dashboard_in_tmux() {
 
     // Pause freezes the display; the peaks can be reset.
     tmux.keys(&["p"]);
-    tmux.wait("PAUSED", Duration::from_secs(3), |p| p.contains("PAUSED"));
+    tmux.wait("PAUSED", PANE_WAIT, |p| p.contains("PAUSED"));
     tmux.keys(&["p"]);
-    tmux.wait("live again", Duration::from_secs(3), |p| {
-        !p.contains("PAUSED")
-    });
+    tmux.wait("live again", PANE_WAIT, |p| !p.contains("PAUSED"));
     tmux.keys(&["c"]);
-    tmux.wait("the peaks reset", Duration::from_secs(3), |p| {
-        p.contains("peaks reset")
-    });
+    tmux.wait("the peaks reset", PANE_WAIT, |p| p.contains("peaks reset"));
 
     // r starts a recording in --record-dir and stops it; it decodes.
     tmux.keys(&["r"]);
-    tmux.wait("recording", Duration::from_secs(3), |p| p.contains("● REC"));
+    tmux.wait("recording", PANE_WAIT, |p| p.contains("● REC"));
     thread::sleep(Duration::from_millis(1500));
     tmux.keys(&["r"]);
-    tmux.wait("recorded", Duration::from_secs(3), |p| {
+    tmux.wait("recorded", PANE_WAIT, |p| {
         p.contains("recorded to") && !p.contains("● REC")
     });
     let files: Vec<_> = std::fs::read_dir(dir.path())
@@ -629,7 +629,7 @@ fn the_dashboard_in_tmux() {
         .status()
         .unwrap();
     assert!(ok.success());
-    tmux.wait("the table at 110 columns", Duration::from_secs(3), |p| {
+    tmux.wait("the table at 110 columns", PANE_WAIT, |p| {
         p.lines().all(|l| l.chars().count() <= 110)
             && (0..4).all(|i| row(p, i).is_some())
             && p.lines().count() <= 30
@@ -638,11 +638,9 @@ fn the_dashboard_in_tmux() {
 
     // Help opens and closes.
     tmux.keys(&["?"]);
-    tmux.wait("the help", Duration::from_secs(3), |p| {
-        p.contains("reset the peaks")
-    });
+    tmux.wait("the help", PANE_WAIT, |p| p.contains("reset the peaks"));
     tmux.keys(&["Escape"]);
-    tmux.wait("the help closed", Duration::from_secs(3), |p| {
+    tmux.wait("the help closed", PANE_WAIT, |p| {
         !p.contains("reset the peaks") && p.contains("sim:esc0")
     });
 
@@ -723,12 +721,10 @@ fn the_dashboard_at_80_by_24_is_readable() {
 
     // r records into the data directory, made private, and says where.
     tmux.keys(&["r"]);
-    tmux.wait("recording", Duration::from_secs(3), |p| p.contains("● REC"));
+    tmux.wait("recording", PANE_WAIT, |p| p.contains("● REC"));
     thread::sleep(Duration::from_millis(800));
     tmux.keys(&["r"]);
-    tmux.wait("recorded", Duration::from_secs(3), |p| {
-        p.contains("recorded to")
-    });
+    tmux.wait("recorded", PANE_WAIT, |p| p.contains("recorded to"));
     let recordings = data.join("hwfoc/recordings");
     let files: Vec<_> = std::fs::read_dir(&recordings).unwrap().collect();
     assert_eq!(files.len(), 1);
