@@ -320,6 +320,10 @@ typedef struct hwfoc_v4_stats {
     uint32_t disagreements;
     uint32_t trailers;
     uint8_t has_chain, chain_has_next, chain_trailer, has_last_info, has_adopted;
+    /* Data frames are decoded (and judged) under `adopted`: adopted, and the last info frame is
+     * it (else another ESC's, not yet confirmed by a second copy, as after a swap: none, as
+     * before any info frame; Rust: v4::Stats::in_use). Set where an info frame is accepted. */
+    uint8_t in_use;
     uint32_t chain_next;
     uint64_t chain_end;
     hwfoc_v4_info last_info;
@@ -1139,19 +1143,11 @@ static int hwfoc__v4_found_at(const uint8_t *c, size_t n, size_t at, unsigned fu
                ? HWFOC__V4_DATA : HWFOC__V4_NOTHING;
 }
 
-/* Whether data frames are decoded under the adopted constants now: adopted, unless the last
- * info frame differs from them (another ESC's, not yet confirmed by a second copy, as after a
- * swap): then none, as before any info frame (Rust: v4::Stats::in_use). */
-HWFOC__OUT_OF_LINE static int hwfoc__v4_in_use(const hwfoc_v4_stats *s) {
-    return s->has_adopted && !(s->has_last_info && !hwfoc__v4_info_eq(&s->adopted, &s->last_info));
-}
-
 /* Judges the candidate at stream offset `at`; a frame's kind and fields go to *f. */
 static int hwfoc__v4_judge(const hwfoc_v4_stats *s, const uint8_t *c, size_t n, uint64_t at,
                            hwfoc_v4_frame *f, int *synced) {
-    /* Judged by the scale it would be decoded under: the constants in use (Rust:
-     * v4::Stats::full_scale), none while the last info frame differs from the adopted one. */
-    unsigned full_scale = hwfoc__v4_in_use(s) ? s->adopted.full_scale : HWFOC_V4_DEFAULT_FULL_SCALE;
+    /* Judged by the scale it would be decoded under (Rust: v4::Stats::full_scale). */
+    unsigned full_scale = s->in_use ? s->adopted.full_scale : HWFOC_V4_DEFAULT_FULL_SCALE;
     hwfoc_v4_data next_data;
     hwfoc_v4_info next_info;
     int chained = s->has_chain && s->chain_end == at;
@@ -1206,7 +1202,7 @@ static void hwfoc__v4_accept(hwfoc_v4_stats *s, hwfoc_v4_frame *f, int synced) {
         s->chain_has_next = 1;
         s->chain_next = (f->data.counter + 1u) & HWFOC_COUNTER24_MAX;
         s->chain_trailer = 1;
-        f->has_info = hwfoc__v4_in_use(s);
+        f->has_info = s->in_use;
         if (f->has_info) f->info = s->adopted;
         else memset(&f->info, 0, sizeof f->info);
     } else {
@@ -1221,6 +1217,7 @@ static void hwfoc__v4_accept(hwfoc_v4_stats *s, hwfoc_v4_frame *f, int synced) {
         }
         s->last_info = f->info;
         s->has_last_info = 1;
+        s->in_use = s->has_adopted && hwfoc__v4_info_eq(&s->adopted, &f->info);
         if (!(s->has_chain && !synced)) s->chain_has_next = 0;
         s->has_chain = 1;
         s->chain_end = f->offset + HWFOC_V4_INFO_LEN;
