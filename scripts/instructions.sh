@@ -59,6 +59,11 @@ declare -A got
 got[summary]=$(count -- "$bin" summary "$big")
 got[parquet]=$(count -- "$bin" decode --format parquet "$small" -o "$work/out.parquet")
 rm -f "$work/out.parquet"
+# The interpreter's counts are repeatable only with these two: numpy's OpenBLAS (imported with
+# pyarrow) starts a thread per core whose busy waiting varied `import hwfoc` alone from 578 to
+# 638 M instructions (and hwfoc.read's difference by +-10 %, which failed CI's fresh machine at
+# +43.6 %); Python's string hashes, randomised per run, move the rest by some 0.05 %.
+export OPENBLAS_NUM_THREADS=1 PYTHONHASHSEED=0
 if why=$("$python" -c 'import hwfoc' 2>&1); then
   read_all=$(count -- "$python" -c 'import sys, hwfoc; hwfoc.read(sys.argv[1])' "$small")
   import_only=$(count -- "$python" -c 'import sys, hwfoc' "$small")
