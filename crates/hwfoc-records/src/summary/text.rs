@@ -151,7 +151,7 @@ impl EscReport<'_> {
                 let _ = writeln!(o, "clock        {text}");
             }
         }
-        let checks = match st.rejected_frames() {
+        let checks = match st.rejected_candidates() {
             Some(n) => format!("{n} rejected candidates (no checksum)"),
             None => format!("{} checksum failures", st.checksum_failures()),
         };
@@ -204,10 +204,10 @@ impl EscReport<'_> {
                 "can          {node}: {} transfers, {} gaps in transfer ids ({} missed), {} duplicates, {} toggle errors, {} CRC errors, {} cut short, {} of unknown types; bus: {} frames, {} not DroneCAN ({} error frames)",
                 n.total_transfers(),
                 n.gaps(),
-                n.missed(),
+                n.lost_packets(),
                 n.duplicates(),
                 n.toggle_errors(),
-                n.crc_errors(),
+                n.checksum_failures(),
                 n.cut_short(),
                 n.unknown_types(),
                 c.bus.frames(),

@@ -509,7 +509,7 @@ impl<const SLOTS: usize> Receiver<SLOTS> {
         }
         slot.state = State::Free;
         if slot.crc != slot.carried_crc {
-            node.crc_error();
+            node.checksum_failure();
             return None;
         }
         let (buf, len) = (slot.buf, slot.len);

@@ -315,7 +315,7 @@ impl EscView {
                 s.duplicate_packets()
             ));
         }
-        match s.rejected_frames() {
+        match s.rejected_candidates() {
             Some(rejected) => parts.push(format!("rejected {rejected}")),
             None => parts.push(format!("crc {}", s.checksum_failures())),
         }
