@@ -17,8 +17,8 @@ use hwfoc_io::EscLink;
 use hwfoc_io::Handler;
 use hwfoc_io::InputError;
 use hwfoc_io::Notice;
-use hwfoc_io::clock::byte_times;
-use hwfoc_io::serial::PortSet;
+use hwfoc_ports::clock::byte_times;
+use hwfoc_ports::serial::PortSet;
 use hwfoc_io::{PortStreams, Stream};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
@@ -44,7 +44,7 @@ enum Refused {
 
 /// Whether `bytes`, a stream's first, are a candump log: a first line that parses as one.
 fn is_candump(bytes: &[u8]) -> bool {
-    use hwfoc_io::can::candump;
+    use hwfoc_ports::can::candump;
     let line = bytes.split(|&b| b == b'\n').next().unwrap_or_default();
     candump::looks_like_line(line)
         && std::str::from_utf8(line).is_ok_and(|line| candump::parse_line(line, 1).is_ok())
@@ -313,7 +313,7 @@ pub fn open_ports(
     }
     let protocol = crate::protocol_arg(protocol)?;
     if let Some(p) = protocol.filter(|p| p.is_can()) {
-        let serial = ports.iter().find(|n| !hwfoc_io::can::is_can_spec(n));
+        let serial = ports.iter().find(|n| !hwfoc_ports::can::is_can_spec(n));
         if let Some(port) = serial {
             return Err(PyValueError::new_err(format!(
                 "protocol: {:?} reads CAN buses (slcan:PORT, can:INTERFACE), not the serial port \
