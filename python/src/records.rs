@@ -12,7 +12,7 @@ use hwfoc::telemetry::{Data, Frame};
 use hwfoc_io::Handler;
 use hwfoc_io::InputError;
 use hwfoc_io::Selection;
-use hwfoc_io::record::{Column, Visitor, columns};
+use hwfoc_io::record::{Column, DataFrames, FrameSlice, Visitor, columns};
 use hwfoc_io::write::arrow::ArrowValue;
 
 /// Data frames as received, column by column: what a batch is made from.
@@ -27,10 +27,8 @@ pub struct Frames {
     t: Vec<f64>,
     /// ESC of each frame.
     esc: Vec<u8>,
-    /// The frames while all are HW-FOC (then `frames` is empty).
-    hwfoc: Vec<DataFrame>,
-    /// The frames once one is not HW-FOC (then `hwfoc` is empty).
-    frames: Vec<Data>,
+    /// The frames (HW-FOC's as the codec's while all are).
+    frames: DataFrames,
 }
 
 impl Frames {
@@ -38,7 +36,7 @@ impl Frames {
     pub fn with_capacity(n: usize) -> Frames {
         Frames {
             esc: Vec::with_capacity(n),
-            hwfoc: Vec::with_capacity(n),
+            frames: DataFrames::with_capacity(n),
             ..Frames::default()
         }
     }
@@ -54,16 +52,7 @@ impl Frames {
             self.t.push(f64::NAN);
         }
         self.esc.push(esc);
-        // HW-FOC frames while every frame is one go to their own column (the fast path);
-        // the first frame of another protocol moves them all to the general one.
-        if let Data::HwFoc(f) = frame
-            && self.frames.is_empty()
-        {
-            self.hwfoc.push(*f);
-        } else {
-            self.frames.extend(self.hwfoc.drain(..).map(Data::HwFoc));
-            self.frames.push(*frame);
-        }
+        self.frames.push(frame);
     }
 
     /// Adds HW-FOC frames of ESC `esc` without receive times (a raw input's run).
@@ -74,18 +63,13 @@ impl Frames {
             self.t.resize(n, f64::NAN);
         }
         self.esc.resize(n, esc);
-        if self.frames.is_empty() {
-            self.hwfoc.extend_from_slice(frames);
-        } else {
-            self.frames.extend(frames.iter().map(|&f| Data::HwFoc(f)));
-        }
+        self.frames.extend_hwfoc(frames);
     }
 
     /// Empties it, keeping its room (a buffer used again is not faulted in again).
     pub fn clear(&mut self) {
         self.t.clear();
         self.esc.clear();
-        self.hwfoc.clear();
         self.frames.clear();
     }
 
@@ -121,17 +105,20 @@ impl Frames {
         };
         // HW-FOC frames (a raw file's) are converted as such: each value read by field, without
         // a match on the protocol per value (as the Parquet export reads them).
-        if self.frames.is_empty() {
-            let frames = self.hwfoc[rows].iter().map(|&f| Data::HwFoc(f));
-            match times {
-                None => arrays.visit(Untimed(esc.len()), esc, frames),
-                Some(t) => arrays.visit(Timed(t), esc, frames),
+        match self.frames.slice(rows) {
+            FrameSlice::HwFoc(frames) => {
+                let frames = frames.iter().map(|&f| Data::HwFoc(f));
+                match times {
+                    None => arrays.visit(Untimed(esc.len()), esc, frames),
+                    Some(t) => arrays.visit(Timed(t), esc, frames),
+                }
             }
-        } else {
-            let frames = self.frames[rows].iter().copied();
-            match times {
-                None => arrays.visit(Untimed(esc.len()), esc, frames),
-                Some(t) => arrays.visit(Timed(t), esc, frames),
+            FrameSlice::Any(frames) => {
+                let frames = frames.iter().copied();
+                match times {
+                    None => arrays.visit(Untimed(esc.len()), esc, frames),
+                    Some(t) => arrays.visit(Timed(t), esc, frames),
+                }
             }
         }
         // Each array has its field's type and nullability (both come from the column's value

@@ -12,8 +12,10 @@ use std::thread::JoinHandle;
 use std::ops::Range;
 
 use hwfoc::Settings;
-use hwfoc::foc::DataFrame;
 use hwfoc::telemetry::{Data, Frame};
+use hwfoc_records::record::DataFrames;
+#[cfg(feature = "parquet")]
+use hwfoc_records::record::FrameSlice;
 
 use super::{
     ExportError, OutputFormat, Provenance, Staging, WriteError, esc_settings_json, file, parquet,
@@ -43,12 +45,9 @@ pub(crate) struct Chunk {
     pub t: Vec<f64>,
     /// ESC index of each frame.
     pub esc: Vec<u8>,
-    /// The frames while every one is an HW-FOC frame (a raw file's, nearly every chunk): 18
-    /// bytes a row where a [`Data`] takes 44. Each Parquet column reads a row group's frames
-    /// again, so their size is memory traffic: this halved the export's cache misses.
-    hwfoc: Vec<DataFrame>,
-    /// The frames, once one is of another protocol (`hwfoc` is then empty).
-    frames: Vec<Data>,
+    /// The frames (HW-FOC's kept as the codec's while every frame is one: each Parquet column
+    /// reads a row group's frames again).
+    frames: DataFrames,
     /// Whether the writer should push everything to the operating system after this chunk
     /// (live input: records appear as frames arrive).
     pub flush: bool,
@@ -66,8 +65,7 @@ impl Chunk {
         Chunk {
             t: Vec::with_capacity(n),
             esc: Vec::with_capacity(n),
-            hwfoc: Vec::with_capacity(n),
-            frames: Vec::new(),
+            frames: DataFrames::with_capacity(n),
             flush: false,
             settings: None,
         }
@@ -75,7 +73,7 @@ impl Chunk {
 
     /// Number of rows.
     pub fn len(&self) -> usize {
-        self.hwfoc.len() + self.frames.len()
+        self.frames.len()
     }
 
     /// Whether there are no rows.
@@ -88,46 +86,28 @@ impl Chunk {
     pub(super) fn push(&mut self, esc: u8, t: Option<f64>, frame: &Data) {
         self.t.push(t.unwrap_or(f64::NAN));
         self.esc.push(esc);
-        if let Data::HwFoc(f) = frame
-            && self.frames.is_empty()
-        {
-            self.hwfoc.push(*f);
-        } else {
-            self.frames.extend(self.hwfoc.drain(..).map(Data::HwFoc));
-            self.frames.push(*frame);
-        }
+        self.frames.push(frame);
     }
 
-    /// The frames of the rows in `rows`.
+    /// The frames of the rows in `rows` (the Parquet writer's: by column, a block at a time).
+    #[cfg(feature = "parquet")]
     #[inline]
-    pub(super) fn frames(&self, rows: Range<usize>) -> Frames<'_> {
-        if self.frames.is_empty() {
-            Frames::HwFoc(&self.hwfoc[rows])
-        } else {
-            Frames::Any(&self.frames[rows])
-        }
+    pub(super) fn frames(&self, rows: Range<usize>) -> FrameSlice<'_> {
+        self.frames.slice(rows)
     }
 
     /// The frame of row `i`.
     #[inline]
     pub(super) fn frame(&self, i: usize) -> Data {
-        match self.frames(i..i + 1) {
-            Frames::HwFoc(f) => Data::HwFoc(f[0]),
-            Frames::Any(f) => f[0],
-        }
+        self.frames.get(i)
     }
 
     /// The rows in `rows`, as a chunk of their own (with the same settings).
     pub(super) fn slice(&self, rows: Range<usize>, flush: bool) -> Chunk {
-        let (hwfoc, frames) = match self.frames(rows.clone()) {
-            Frames::HwFoc(f) => (f.to_vec(), Vec::new()),
-            Frames::Any(f) => (Vec::new(), f.to_vec()),
-        };
         Chunk {
             t: self.t[rows.clone()].to_vec(),
-            esc: self.esc[rows].to_vec(),
-            hwfoc,
-            frames,
+            esc: self.esc[rows.clone()].to_vec(),
+            frames: self.frames.to_owned_range(rows),
             flush,
             settings: self.settings.clone(),
         }
@@ -136,19 +116,10 @@ impl Chunk {
     pub(super) fn clear(&mut self) {
         self.t.clear();
         self.esc.clear();
-        self.hwfoc.clear();
         self.frames.clear();
         self.flush = false;
         self.settings = None;
     }
-}
-
-/// The frames of some rows of a [`Chunk`].
-pub(crate) enum Frames<'a> {
-    /// Every one an HW-FOC frame.
-    HwFoc(&'a [DataFrame]),
-    /// Of any protocol.
-    Any(&'a [Data]),
 }
 
 /// A message to the writer thread.
@@ -592,6 +563,7 @@ mod tests {
     use crate::settings::SettingsPatch;
     use crate::sources::Sources;
     use hwfoc::foc::DataFrame;
+    use hwfoc_records::record::FrameSlice;
     use std::path::PathBuf;
 
     #[test]
@@ -608,10 +580,10 @@ mod tests {
         chunk.push(0, None, &pushed[0]);
         chunk.push(1, Some(2.5), &pushed[1]);
         // HW-FOC frames only so far: held as such.
-        assert!(matches!(chunk.frames(0..2), Frames::HwFoc(f) if f.len() == 2));
+        assert!(matches!(chunk.frames.slice(0..2), FrameSlice::HwFoc(f) if f.len() == 2));
         chunk.push(2, None, &pushed[2]);
         chunk.push(3, None, &pushed[3]);
-        assert!(matches!(chunk.frames(0..4), Frames::Any(f) if f == pushed));
+        assert!(matches!(chunk.frames.slice(0..4), FrameSlice::Any(f) if f == pushed));
         assert_eq!(chunk.len(), 4);
         assert_eq!((0..4).map(|i| chunk.frame(i)).collect::<Vec<_>>(), pushed);
         assert_eq!(chunk.esc, [0, 1, 2, 3]);

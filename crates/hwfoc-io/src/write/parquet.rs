@@ -141,7 +141,8 @@ mod encode {
     use super::super::metadata::schema_with;
     use super::super::stored::columns::{COLUMNS, COUNT, visit};
     use super::super::stored::{Column, Visitor};
-    use super::super::{Chunk, Frames, Provenance, Sink, ToWriter, WriteError};
+    use super::super::{Chunk, Provenance, Sink, ToWriter, WriteError};
+    use hwfoc_records::record::FrameSlice;
     use hwfoc_records::record::{FaultList, UtcTime};
 
     /// Values handed to a column writer at a time (the crate's default, 1024, spends more time
@@ -710,14 +711,14 @@ mod encode {
                 // HW-FOC frames (nearly every block of a large file): each frame's protocol
                 // known here, its values read by field without a match on the protocol per
                 // value.
-                Frames::HwFoc(frames) => {
+                FrameSlice::HwFoc(frames) => {
                     let values = rows_in.zip(frames).map(|((&t, &esc), frame)| {
                         let frame = Data::HwFoc(*frame);
                         C::from_frame((!t.is_nan()).then_some(t), esc, &frame, settings(esc))
                     });
                     <C::Value as ParquetValue>::fill(values, levels);
                 }
-                Frames::Any(frames) => {
+                FrameSlice::Any(frames) => {
                     let values = rows_in.zip(frames).map(|((&t, &esc), frame)| {
                         C::from_frame((!t.is_nan()).then_some(t), esc, frame, settings(esc))
                     });

@@ -18,10 +18,12 @@
 #[macro_use]
 mod column;
 pub mod columns;
+mod frames;
 mod text;
 
 pub use column::{Column, Cons, FaultList, Nil, UtcTime, Value, Visitor};
 pub use columns::{COLUMNS, Record, TEXT_COLUMNS, UNITS};
+pub use frames::{DataFrames, FrameSlice};
 pub use text::TextEncoder;
 
 impl Record {
