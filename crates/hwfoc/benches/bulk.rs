@@ -22,9 +22,12 @@
 //!   checksum: they lock on chains of frames, so after each break the frames until a new chain
 //!   is confirmed are lost (the share found is printed before measuring).
 //!
-//! Each stream is measured three ways: the `frames` iterator over the whole buffer, a `Decoder`
-//! fed 64 KiB chunks then flushed, and a `Decoder` pushed one byte at a time (the
-//! microcontroller path; on a 256 KiB slice only, as it is much slower).
+//! Each stream is measured four ways: the `frames` iterator over the whole buffer in a `for`
+//! loop (`frames`: `Iterator::next` per frame), the same iterator consumed by `fold`
+//! (`frames_fold`: the scanner's whole-buffer loop, what `scripts/instructions.sh` counts and
+//! what `collect`, `for_each` and `sum` run), a `Decoder` fed 64 KiB chunks then flushed, and a
+//! `Decoder` pushed one byte at a time (the microcontroller path; on a 256 KiB slice only, as it
+//! is much slower).
 //!
 //! Run: `cargo bench -p hwfoc --bench bulk` (about 30 s for the HW-FOC and DataLink streams,
 //! 70 s more for V3, V4 and HW5, once built on a 2-core machine; add a filter such as
@@ -312,9 +315,11 @@ fn check(name: &str, buf: &[u8], e: &Expected) {
     );
 }
 
-/// The three decoding paths of scanner `S` over `buf`, each decoded frame folded by `fold` (so
-/// that nothing is optimised away): `frames` (bulk), `feed_64k` (the streaming decoder fed
-/// 64 KiB chunks) and `push_256k` (a byte at a time, over the first 256 KiB).
+/// The decoding paths of scanner `S` over `buf`, each decoded frame folded by `fold` (so that
+/// nothing is optimised away): `frames` (bulk, a `for` loop: `Iterator::next`), `frames_fold`
+/// (bulk, `Iterator::fold`: the loop [`decode_once`] runs for the instruction guard),
+/// `feed_64k` (the streaming decoder fed 64 KiB chunks) and `push_256k` (a byte at a time, over
+/// the first 256 KiB).
 fn bench_decoder<S: Scanner>(
     g: &mut BenchmarkGroup<'_, criterion::measurement::WallTime>,
     buf: &[u8],
@@ -329,6 +334,9 @@ fn bench_decoder<S: Scanner>(
             }
             black_box(acc)
         })
+    });
+    g.bench_function("frames_fold", |b| {
+        b.iter(|| black_box(Scan::<S>::new(black_box(buf)).fold(0u64, |acc, d| fold(acc, &d))))
     });
     g.bench_function("feed_64k", |b| {
         b.iter(|| {
@@ -755,7 +763,8 @@ fn bulk(c: &mut Criterion) {
     }
 }
 
-/// One bulk decode of `buf` (the function whose instructions `scripts/instructions.sh` counts).
+/// One bulk decode of `buf` (the function whose instructions `scripts/instructions.sh` counts):
+/// `Iterator::fold`, the loop the criterion bench's `frames_fold` measurement times.
 #[inline(never)]
 fn decode_once(buf: &[u8]) -> u64 {
     frames(black_box(buf)).fold(0, |acc, d| fold(acc, &d))
