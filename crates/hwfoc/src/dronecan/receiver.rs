@@ -327,7 +327,9 @@ impl<const SLOTS: usize> Receiver<SLOTS> {
                 Judged::Expected(expected as u32)
             }
         };
-        if known && step_one && judged != Judged::Restart {
+        // Transfers one id apart in the same millisecond came in one read (bunched): their
+        // interval says nothing of the period.
+        if known && step_one && elapsed > 0 && judged != Judged::Restart {
             // The mean interval of transfers one id apart (an eighth of each new one).
             let interval = i64::from(elapsed.min(0xFFF)) * 16;
             let period = i64::from(t.period);
