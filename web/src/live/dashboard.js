@@ -21,9 +21,11 @@ export class Dashboard {
   constructor(root, { onResetPeaks } = {}) {
     this.root = root;
     this.chartColumn = 'rpm';
-    const head = el('tr', {}, el('th', {}, 'ESC'), ...SHOWN.map((q) => el('th', {}, `${q.title} ${q.unit}`)),
-      el('th', {}, 'Power W'), el('th', {}, 'Rate Hz'), el('th', {}, 'Lost/dup/CRC'), el('th', {}, 'mAh'),
-      el('th', {}, 'Wh'), el('th', {}, 'Age s'), el('th', {}, 'Faults and alarms'));
+    // The columns' titles: the table's header, and each cell's label where a phone shows an ESC
+    // as a card (live.css).
+    this.titles = ['ESC', ...SHOWN.map((q) => `${q.title} ${q.unit}`), 'Power W', 'Rate Hz', 'Lost/dup/CRC', 'mAh',
+      'Wh', 'Age s', 'Faults and alarms'];
+    const head = el('tr', {}, ...this.titles.map((title) => el('th', {}, title)));
     this.body = el('tbody');
     this.table = el('table', { class: 'live-table' }, el('thead', {}, head), this.body);
     this.totals = el('p', { class: 'live-totals', 'data-testid': 'totals' });
@@ -88,6 +90,7 @@ export class Dashboard {
     row.className = lost ? 'lost' : '';
     row.dataset.esc = String(e.number);
     row.dataset.frames = String(e.frames);
+    cells.forEach((td, i) => { td.dataset.label = this.titles[i]; });
     row.replaceChildren(...cells);
   }
 
