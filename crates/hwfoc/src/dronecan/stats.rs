@@ -302,14 +302,15 @@ impl NodeStats {
             }
             Judged::ByIds => (step == 0, base),
             // The count of ids skipped congruent to `base`, nearest to what the time held, if
-            // the time agrees with it (within 2 and a sixteenth): a transfer delivered late
-            // (bunched reads) is a time that agrees with no whole round, not rounds lost. A
-            // step of 0 is a duplicate when fewer than half a round of ids fit in it.
+            // the time agrees with it (within 2 and a sixteenth) and an id was skipped: the
+            // next id after a long time is a transfer delivered late (bunched reads), not
+            // whole rounds lost. A step of 0 is a duplicate when fewer than half a round of
+            // ids fit in it.
             Judged::Expected(expected) => {
                 let skipped = expected.saturating_sub(1);
                 let rounds = (skipped + 16).saturating_sub(base) / 32;
                 let nearest = base.saturating_add(rounds.saturating_mul(32));
-                let agrees = skipped.abs_diff(nearest) <= 2 + nearest / 16;
+                let agrees = base > 0 && skipped.abs_diff(nearest) <= 2 + nearest / 16;
                 (
                     step == 0 && skipped < 16,
                     if agrees { nearest } else { base },
