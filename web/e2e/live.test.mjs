@@ -144,12 +144,11 @@ test('four simulated ESCs: values, alarm, unplug and replug, recording, screensh
   // the voltage: issue 34).
   const headers = await page.locator('.live-table thead th').allTextContents();
   assert.ok(headers.length >= 15, headers.join(', '));
-  for (const [i, title] of headers.entries()) {
-    const cell = page.locator('[data-esc="0"] td').nth(i);
-    assert.equal(await cell.getAttribute('data-label'), title);
-    const box = await cell.boundingBox();
-    assert.ok(box && box.x >= 0 && box.x + box.width <= 390 && box.width > 0, `${title}: ${JSON.stringify(box)}`);
-  }
+  // (Read in one go: the row is redrawn as records come.)
+  const cells = await page.evaluate(() => [...document.querySelectorAll('[data-esc="0"] td')]
+    .map((td) => { const r = td.getBoundingClientRect(); return { label: td.dataset.label, x: r.x, width: r.width }; }));
+  assert.deepEqual(cells.map((c) => c.label), headers);
+  for (const c of cells) assert.ok(c.x >= 0 && c.x + c.width <= 390 && c.width > 0, `${c.label}: ${JSON.stringify(c)}`);
   const overflow = await page.evaluate(() => document.documentElement.scrollWidth - window.innerWidth);
   assert.ok(overflow <= 0, `the page is ${overflow} px wider than a phone`);
 

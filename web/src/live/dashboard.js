@@ -13,7 +13,8 @@ const COLOURS = ['#2a7ab0', '#d0452f', '#3a9a3a', '#9b59b6', '#e08e0b', '#16a2a2
 /** A value as the table shows it. */
 export function format(column, value) {
   if (value === null || value === undefined || Number.isNaN(value)) return '–';
-  return value.toFixed(DIGITS[column] ?? 1);
+  // A small negative reading rounds to 0, not "-0.0" (the demo's idle current showed it).
+  return value.toFixed(DIGITS[column] ?? 1).replace(/^-(0\.?0*)$/, '$1');
 }
 
 /** The dashboard inside `root`; `render(fleet, now)` redraws it. */
