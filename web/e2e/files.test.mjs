@@ -116,6 +116,16 @@ test('screenshots at 390 px and 1280 px', async () => {
       assert.match(readout, /ESC \d+: /, 'the cursor readout');
       await page.evaluate(() => window.scrollTo(0, 0));
       await page.screenshot({ path: join(shots, `files-${width}.png`), fullPage: true });
+      // Every column of each ESC's summary can be brought onto the screen (issue 34).
+      const heads = page.locator('.esc-summary table.fields tr:first-child th');
+      assert.ok(await heads.count() >= 5);
+      for (let i = 0; i < await heads.count(); i++) {
+        const th = heads.nth(i);
+        await th.scrollIntoViewIfNeeded();
+        const box = await th.boundingBox();
+        assert.ok(box && box.x >= 0 && box.x + box.width <= width, `${await th.textContent()}: ${JSON.stringify(box)}`);
+      }
+      await page.evaluate(() => window.scrollTo(0, 0));
       // The readout names the shown recording's range (the last file's: frames), also after a
       // resize, when the tabs shown before once drew theirs into it.
       // (The shown plot's redraw is queued first, by the pointer leaving, as a screenshot's

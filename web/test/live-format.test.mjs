@@ -1,14 +1,14 @@
-// The dashboard's numbers: a value that rounds to zero is shown without a sign.
+// The live table's numbers: a small negative reading is 0, never "-0.0" (issue 34's screenshots).
 import { test } from 'node:test';
 import assert from 'node:assert/strict';
 import { fixed, format } from '../src/live/dashboard.js';
 
-test('a value that rounds to zero has no sign; others keep theirs', () => {
-  assert.equal(format('current_a', -0.0), '0.0');
-  assert.equal(format('current_a', -0.04), '0.0');
-  assert.equal(format('current_a', -0.06), '-0.1');
+test('a reading that rounds to zero shows 0, a negative one keeps its sign', () => {
+  assert.equal(format('current_a', -0.01), '0.0');
+  assert.equal(format('current_a', -1.5), '-1.5');
+  assert.equal(format('current_a', null), '–');
   assert.equal(format('rpm', -0.4), '0');
+  // Power and the totals too.
   assert.equal(fixed(-0.3, 0), '0');
-  assert.equal(fixed(12.345, 2), '12.35');
-  assert.equal(format('voltage_v', null), '–');
+  assert.equal(fixed(12.5, 1), '12.5');
 });

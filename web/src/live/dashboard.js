@@ -10,10 +10,10 @@ const COLOURS = ['#2a7ab0', '#d0452f', '#3a9a3a', '#9b59b6', '#e08e0b', '#16a2a2
   '#455a64', '#8d6e63', '#00897b', '#5c6bc0', '#f4511e', '#6d4c41', '#43a047', '#1e88e5'];
 
 
-/** `value` with `digits` decimals, without the sign of a value that rounds to zero ("-0.0"). */
+/** `value` with `digits` decimals; a small negative value rounds to 0, not "-0.0" (the demo's
+ * idle current showed it). */
 export function fixed(value, digits) {
-  const text = value.toFixed(digits);
-  return Number(text) === 0 ? text.replace('-', '') : text;
+  return value.toFixed(digits).replace(/^-(0\.?0*)$/, '$1');
 }
 
 /** A value as the table shows it. */
@@ -27,9 +27,11 @@ export class Dashboard {
   constructor(root, { onResetPeaks } = {}) {
     this.root = root;
     this.chartColumn = 'rpm';
-    const head = el('tr', {}, el('th', {}, 'ESC'), ...SHOWN.map((q) => el('th', {}, `${q.title} ${q.unit}`)),
-      el('th', {}, 'Power W'), el('th', {}, 'Rate Hz'), el('th', {}, 'Lost/dup/CRC'), el('th', {}, 'mAh'),
-      el('th', {}, 'Wh'), el('th', {}, 'Age s'), el('th', {}, 'Faults and alarms'));
+    // The columns' titles: the table's header, and each cell's label where a phone shows an ESC
+    // as a card (live.css).
+    this.titles = ['ESC', ...SHOWN.map((q) => `${q.title} ${q.unit}`), 'Power W', 'Rate Hz', 'Lost/dup/CRC', 'mAh',
+      'Wh', 'Age s', 'Faults and alarms'];
+    const head = el('tr', {}, ...this.titles.map((title) => el('th', {}, title)));
     this.body = el('tbody');
     this.table = el('table', { class: 'live-table' }, el('thead', {}, head), this.body);
     this.totals = el('p', { class: 'live-totals', 'data-testid': 'totals' });
@@ -94,6 +96,7 @@ export class Dashboard {
     row.className = lost ? 'lost' : '';
     row.dataset.esc = String(e.number);
     row.dataset.frames = String(e.frames);
+    cells.forEach((td, i) => { td.dataset.label = this.titles[i]; });
     row.replaceChildren(...cells);
   }
 
