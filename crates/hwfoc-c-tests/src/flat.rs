@@ -128,7 +128,7 @@ impl Flat for datalink::Scanner {
         out.extend([s.bytes(), s.bytes_skipped()]);
         out.extend(
             [
-                s.crc_failures(),
+                s.checksum_failures(),
                 s.bad_headers(),
                 s.frames_with_length_byte(Covered),
                 s.frames_with_length_byte(Total),
@@ -227,7 +227,7 @@ impl Flat for hw5::Scanner {
         out.extend(s.frames_by_kind().map(u64::from));
         out.extend(
             [
-                s.crc_failures(),
+                s.checksum_failures(),
                 s.bad_headers(),
                 s.unknown_types(),
                 s.out_of_range(),

@@ -467,9 +467,9 @@ mod tests {
             let s = d.stats();
             assert_eq!((s.esc.bytes_skipped(), s.hub.bytes_skipped()), (111, 111));
             assert_eq!((s.esc.checksum_failures(), s.esc.lost_packets()), (1, 0));
-            assert_eq!((s.hub.crc_failures(), s.hub.bad_headers()), (1, 0));
+            assert_eq!((s.hub.checksum_failures(), s.hub.bad_headers()), (1, 0));
             assert_eq!((s.esc.packets().count(), s.hub.frames()), (80, 6));
-            assert_eq!(s.hub.lost_frames(), 0);
+            assert_eq!(s.hub.lost_packets(), 0);
         }
         // Each protocol's own decoder sees only its own frames in the same bytes.
         let mut own = foc::Decoder::new();

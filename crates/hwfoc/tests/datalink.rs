@@ -243,7 +243,7 @@ impl RefSequence {
 #[derive(Debug, Default)]
 struct RefStats {
     bytes_skipped: u64,
-    crc_failures: u32,
+    checksum_failures: u32,
     bad_headers: u32,
     length_bytes: [u32; 2],
     empty: u32,
@@ -301,7 +301,7 @@ fn reference_scan(bytes: &[u8], at_end: bool) -> (Vec<datalink::Decoded>, RefSta
                 i += FRAME_LEN;
                 continue;
             }
-            s.crc_failures += 1;
+            s.checksum_failures += 1;
         }
         s.bytes_skipped += 1;
         i += 1;
@@ -364,7 +364,7 @@ fn reference_read(f: &[u8], s: &mut RefStats) -> (datalink::Frame, FrameReport) 
 fn assert_stats(bytes: &[u8], stats: &datalink::Stats, r: &RefStats) {
     assert_eq!(stats.bytes(), bytes.len() as u64);
     assert_eq!(stats.bytes_skipped(), r.bytes_skipped);
-    assert_eq!(stats.crc_failures(), r.crc_failures);
+    assert_eq!(stats.checksum_failures(), r.checksum_failures);
     assert_eq!(stats.bad_headers(), r.bad_headers);
     assert_eq!(
         stats.frames_with_length_byte(LengthByte::Covered),
@@ -379,7 +379,7 @@ fn assert_stats(bytes: &[u8], stats: &datalink::Stats, r: &RefStats) {
     assert_eq!(stats.duplicate_channels(), r.duplicate_channels);
     assert!(r.counter.matches(stats.counter()), "{stats}");
     assert_eq!(
-        (stats.frames(), stats.lost_frames(), stats.last_counter()),
+        (stats.frames(), stats.lost_packets(), stats.last_counter()),
         (r.counter.count, r.counter.lost, r.counter.last)
     );
     for ch in 0..CHANNELS {
@@ -686,8 +686,8 @@ proptest! {
         let (decoded, stats) = decode_checked(&bytes, &picks);
         prop_assert_eq!(decoded.len() as u32, sent);
         prop_assert_eq!(stats.frames(), sent);
-        prop_assert_eq!(stats.crc_failures(), dropped_inside);
-        prop_assert_eq!(stats.lost_frames(), dropped_inside);
+        prop_assert_eq!(stats.checksum_failures(), dropped_inside);
+        prop_assert_eq!(stats.lost_packets(), dropped_inside);
         prop_assert_eq!((stats.restarts(), stats.duplicate_frames()), (0, 0));
         for ch in 0..CHANNELS {
             let s = stats.channel(ch).unwrap();
@@ -753,7 +753,7 @@ fn both_length_bytes_are_counted() {
     assert_eq!(stats.frames_with_length_byte(LengthByte::Covered), 2);
     assert_eq!(stats.frames_with_length_byte(LengthByte::Total), 3);
     assert_eq!(decoded[1].report.length_byte, LengthByte::Total);
-    assert_eq!(stats.lost_frames(), 0);
+    assert_eq!(stats.lost_packets(), 0);
 }
 
 /// A record is empty only when all 18 bytes after its channel byte are zero: one non-zero byte
@@ -785,7 +785,7 @@ fn other_length_bytes_are_not_frames() {
         );
         let (decoded, stats) = decode_checked(&b, &[]);
         assert!(decoded.is_empty());
-        assert_eq!((stats.crc_failures(), stats.bad_headers()), (0, 0));
+        assert_eq!((stats.checksum_failures(), stats.bad_headers()), (0, 0));
     }
 }
 
@@ -832,7 +832,7 @@ fn cut_frames() {
     assert_eq!(decoded.len(), 1);
     assert_eq!(decoded[0].offset, 100);
     assert_eq!(decoded[0].frame.slots[4].map(|e| e.packet), Some(9));
-    assert_eq!(stats.crc_failures(), 1);
+    assert_eq!(stats.checksum_failures(), 1);
     assert_eq!(stats.bytes_skipped(), 250);
     let mut d = datalink::Decoder::new();
     d.feed(&wire, |_| {});
@@ -918,7 +918,7 @@ fn line_silent_limits_counter_and_channels() {
     assert_eq!(datalink::esc_frames_in(8), 9);
     d.feed(&frame(20, 510), |_| n += 1);
     let s = d.stats();
-    assert_eq!((s.restarts(), s.lost_frames()), (1, 0));
+    assert_eq!((s.restarts(), s.lost_packets()), (1, 0));
     let ch = s.channel(6).unwrap();
     assert_eq!((ch.lost(), ch.restarts()), (9, 0));
     assert_eq!(s.bytes_skipped(), 90);

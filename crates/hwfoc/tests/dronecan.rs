@@ -624,7 +624,7 @@ proptest! {
         match fault {
             Fault::WrongToggle(_) => prop_assert_eq!((s.toggle_errors(), a_arrived), (1, false)),
             Fault::MissingMiddle => prop_assert_eq!((s.toggle_errors(), a_arrived), (1, false)),
-            Fault::FlippedCrcBit(_) => prop_assert_eq!((s.crc_errors(), a_arrived), (1, false)),
+            Fault::FlippedCrcBit(_) => prop_assert_eq!((s.checksum_failures(), a_arrived), (1, false)),
             Fault::Repeated(0) => prop_assert_eq!((s.cut_short(), a_arrived), (1, true)),
             Fault::Repeated(1) => prop_assert_eq!((s.toggle_errors(), a_arrived), (1, false)),
             Fault::Repeated(_) => prop_assert_eq!((s.orphan_frames(), a_arrived), (1, true)),
@@ -660,7 +660,7 @@ proptest! {
             prop_assert!(again.is_none());
             prop_assert_eq!(s.duplicates(), 1);
             prop_assert!(after_skip.is_some());
-            prop_assert_eq!((s.gaps(), s.missed()), (1, u32::from(skip) - 1));
+            prop_assert_eq!((s.gaps(), s.lost_packets()), (1, u32::from(skip) - 1));
         } else {
             // services are not checked for continuity: a response carries its request's id
             prop_assert!(again.is_some() && after_skip.is_some());
@@ -880,14 +880,14 @@ fn a_transfer_id_gap_is_judged_by_time() {
     let n = rx.stats().node(5);
     assert_eq!(got, 150);
     assert_eq!(
-        (n.gaps(), n.missed(), n.duplicates(), n.restarts()),
+        (n.gaps(), n.lost_packets(), n.duplicates(), n.restarts()),
         (1, 40, 0, 0)
     );
     let mut untimed = Receiver::new();
     for (_, f) in before.iter().chain(&after) {
         untimed.push(f);
     }
-    assert_eq!(untimed.stats().node(5).missed(), 8);
+    assert_eq!(untimed.stats().node(5).lost_packets(), 8);
     // A repeated frame a millisecond later is still a duplicate.
     let mut rx = Receiver::new();
     push_timed(&mut rx, &before);
@@ -906,12 +906,12 @@ fn a_bus_that_went_silent_and_came_back_is_a_restart() {
     let got = push_timed(&mut rx, &before) + push_timed(&mut rx, &after);
     let n = rx.stats().node(5);
     assert_eq!(got, 200);
-    assert_eq!((n.gaps(), n.missed(), n.restarts()), (0, 0, 1));
+    assert_eq!((n.gaps(), n.lost_packets(), n.restarts()), (0, 0, 1));
     // A silence under a second is no restart: what it hid is missed.
     let after = timed_msg1(130, 10, 130 * 20_000, 20_000, false);
     let mut rx = Receiver::new();
     push_timed(&mut rx, &before);
     push_timed(&mut rx, &after);
     let n = rx.stats().node(5);
-    assert_eq!((n.missed(), n.restarts()), (30, 0));
+    assert_eq!((n.lost_packets(), n.restarts()), (30, 0));
 }

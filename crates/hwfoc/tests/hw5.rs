@@ -74,7 +74,7 @@ struct RefStats {
     bytes: u64,
     bytes_skipped: u64,
     frames: [u32; 8],
-    crc_failures: u32,
+    checksum_failures: u32,
     bad_headers: u32,
     unknown_types: u32,
 }
@@ -85,7 +85,7 @@ impl From<&hw5::Stats> for RefStats {
             bytes: s.bytes(),
             bytes_skipped: s.bytes_skipped(),
             frames: *s.frames_by_kind(),
-            crc_failures: s.crc_failures(),
+            checksum_failures: s.checksum_failures(),
             bad_headers: s.bad_headers(),
             unknown_types: s.unknown_types(),
         }
@@ -207,7 +207,7 @@ fn reference_scan(
                 continue 'scan;
             }
         }
-        s.crc_failures += 1;
+        s.checksum_failures += 1;
         s.bytes_skipped += 1;
         i += 1;
     }
@@ -937,7 +937,7 @@ fn random_bytes_rich_in_headers_never_make_a_frame() {
     assert_eq!(stats.frames_by_kind(), &[0; Kind::COUNT], "{stats}");
     assert_eq!(stats.bytes_skipped(), bytes.len() as u64);
     assert!(headers > 2_500);
-    assert!(stats.crc_failures() > 1_500, "{stats}");
+    assert!(stats.checksum_failures() > 1_500, "{stats}");
     assert!(
         stats.bad_headers() > 0 && stats.unknown_types() > 0,
         "{stats}"

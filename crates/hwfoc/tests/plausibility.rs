@@ -86,7 +86,7 @@ fn an_hw5_value_out_of_range_is_rejected() {
         assert_eq!(got, [504, VOLTAGE_MAX_RAW], "{throttle} {voltage}");
         let s = d.stats();
         assert_eq!(
-            (s.out_of_range(), s.rejected(), s.crc_failures()),
+            (s.out_of_range(), s.rejected(), s.checksum_failures()),
             (1, 1, 0)
         );
         assert_eq!(s.bytes_skipped(), hw5::TELEMETRY_LEN as u64);

@@ -148,7 +148,7 @@ fn an_esc_restart_starts_a_new_chain() {
     let (decoded, stats) = bulk::<Scanner>(&wire);
     assert_eq!(decoded.len(), 15);
     assert_eq!(
-        (stats.restarts(), stats.lost_frames(), stats.syncs()),
+        (stats.restarts(), stats.lost_packets(), stats.syncs()),
         (1, 0, 2)
     );
     assert_eq!(stats.bytes_skipped(), 0);
@@ -161,7 +161,7 @@ fn lost_frames_are_counted_across_a_gap() {
     wire.extend(encode_all(7..10)); // 5 and 6 never sent
     let (decoded, stats) = bulk::<Scanner>(&wire);
     assert_eq!(counters(&decoded), [0, 1, 2, 3, 7, 8, 9]);
-    assert_eq!((stats.lost_frames(), stats.bytes_skipped()), (3, 6));
+    assert_eq!((stats.lost_packets(), stats.bytes_skipped()), (3, 6));
 }
 
 #[test]
@@ -171,7 +171,7 @@ fn a_corrupted_counter_costs_that_frame() {
     let (decoded, stats) = bulk::<Scanner>(&wire);
     assert_eq!(counters(&decoded), [0, 1, 2, 3, 5, 6, 7]);
     assert_eq!(
-        (stats.unconfirmed(), stats.lost_frames(), stats.syncs()),
+        (stats.unconfirmed(), stats.lost_packets(), stats.syncs()),
         (1, 1, 2)
     );
 }
@@ -182,7 +182,7 @@ fn a_frame_between_two_cut_frames_continues_the_chain_up_to_the_bound() {
     // chain ends with its counter advanced by two.
     let (decoded, stats) = bulk::<Scanner>(&encode_all([0, 1, 2, 4, 6]));
     assert_eq!(counters(&decoded), [0, 1, 2, 4, 6]);
-    assert_eq!((stats.lost_frames(), stats.syncs()), (2, 1));
+    assert_eq!((stats.lost_packets(), stats.syncs()), (2, 1));
     // Up to MAX_CHAINED_GAP frames missing; one more, and the frame needs a chain of three.
     let last = 2 + v3::MAX_CHAINED_GAP + 1;
     let (decoded, _) = bulk::<Scanner>(&encode_all([0, 1, 2, last, last + 2]));
@@ -207,7 +207,7 @@ fn a_counter_flipped_forward_within_the_gap_passes_for_cut_frames() {
     let (decoded, stats) = bulk::<Scanner>(&wire);
     assert_eq!(counters(&decoded), [0, 1, 2, 3, 6, 5, 6, 7]);
     assert_eq!(
-        (stats.lost_frames(), stats.restarts(), stats.syncs()),
+        (stats.lost_packets(), stats.restarts(), stats.syncs()),
         (2, 1, 2)
     );
 }
@@ -225,7 +225,7 @@ fn a_cut_frame_that_stays_plausible_is_taken() {
     assert_eq!(got, [0, 1, 2, 3, 5, 6, 7, 8, 9]);
     // Frame "3" took the first two bytes of frame 4 as its period.
     assert_eq!(decoded[3].frame.period_us, 0x9B00);
-    assert_eq!(stats.lost_frames(), 1);
+    assert_eq!(stats.lost_packets(), 1);
 }
 
 /// The stream for V3: 120 s of a V3 ESC as `hwfoc simulate --protocol hw-v3

@@ -260,7 +260,7 @@ fn a_plausible_running_stream_with_a_restart_and_a_gap() {
     assert_eq!(counters(&decoded).len(), 12);
     // The restart starts a new chain; the gap of three frames (3 to 7) continues it.
     assert_eq!(
-        (stats.restarts(), stats.lost_frames(), stats.syncs()),
+        (stats.restarts(), stats.lost_packets(), stats.syncs()),
         (1, 3, 2)
     );
     assert_eq!((stats.bytes_skipped(), stats.trailers()), (0, 0));
@@ -274,7 +274,7 @@ fn a_frame_between_two_cut_frames_continues_the_chain_up_to_the_bound() {
     // chain ends with its counter advanced by two.
     let (decoded, stats) = bulk::<Scanner>(&wire(&[0, 1, 2, 4, 6]));
     assert_eq!(counters(&decoded), [0, 1, 2, 4, 6]);
-    assert_eq!((stats.lost_frames(), stats.syncs()), (2, 1));
+    assert_eq!((stats.lost_packets(), stats.syncs()), (2, 1));
     // Up to MAX_CHAINED_GAP frames missing; one more, and the frame needs a chain of three.
     let last = 2 + v4::MAX_CHAINED_GAP + 1;
     let (decoded, _) = bulk::<Scanner>(&wire(&[0, 1, 2, last, last + 2]));
@@ -296,7 +296,7 @@ fn a_frame_between_two_cut_frames_continues_the_chain_up_to_the_bound() {
     assert_eq!(counters(&decoded), [0, 3, 4]);
     assert_eq!(infos_of(&decoded).len(), 3);
     assert_eq!(
-        (stats.lost_frames(), stats.syncs(), stats.bytes_skipped()),
+        (stats.lost_packets(), stats.syncs(), stats.bytes_skipped()),
         (2, 1, 0)
     );
 }

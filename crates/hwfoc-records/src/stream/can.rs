@@ -566,7 +566,7 @@ impl CanLink {
     /// Transfers of the node received over those sent, from the gaps in its transfer ids.
     pub fn delivery_ratio(&self) -> Option<f64> {
         let got = self.node_stats.total_transfers();
-        let sent = got + u64::from(self.node_stats.missed());
+        let sent = got + u64::from(self.node_stats.lost_packets());
         (sent > 0).then(|| got as f64 / sent as f64)
     }
 }

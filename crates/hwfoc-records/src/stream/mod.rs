@@ -500,9 +500,9 @@ impl EscLink {
     pub fn checksum_failures(&self) -> u32 {
         match self {
             EscLink::Wire(s) => s.checksum_failures(),
-            EscLink::Hub { hub, .. } => hub.crc_failures(),
-            EscLink::Hw5(s) => s.crc_failures().saturating_add(s.out_of_range()),
-            EscLink::Can(c) => c.node_stats.crc_errors(),
+            EscLink::Hub { hub, .. } => hub.checksum_failures(),
+            EscLink::Hw5(s) => s.checksum_failures().saturating_add(s.out_of_range()),
+            EscLink::Can(c) => c.node_stats.checksum_failures(),
             EscLink::HwV4(_) | EscLink::HwV3(_) => 0,
         }
     }
@@ -528,7 +528,7 @@ impl EscLink {
     /// their transfer ids).
     pub fn lost_packets(&self) -> u32 {
         if let EscLink::Can(c) = self {
-            return c.node_stats.missed();
+            return c.node_stats.lost_packets();
         }
         match self.counting() {
             Some(Counting::Bits16(c)) => c.lost(),
@@ -1550,7 +1550,7 @@ mod mixed_tests {
             );
             let hub = stream.hub().unwrap();
             assert_eq!(
-                (hub.frames(), hub.lost_frames(), hub.crc_failures()),
+                (hub.frames(), hub.lost_packets(), hub.checksum_failures()),
                 (200, 0, 0)
             );
             assert_eq!(s.checksum_failures(), 0);

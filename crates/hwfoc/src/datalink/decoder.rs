@@ -4,7 +4,7 @@
 //! The scanner is content-based: a candidate is a `9B` followed by a length byte 0x9E or 0xA0.
 //! It is rejected as soon as its version and command bytes are not `01 02` (a
 //! [bad header](Stats::bad_headers)), or once its 160 bytes are there and the CRC does
-//! not match (a [CRC failure](Stats::crc_failures)); a rejected candidate costs one
+//! not match (a [CRC failure](Stats::checksum_failures)); a rejected candidate costs one
 //! byte: scanning resumes at the byte after its `9B`, so a lone `9B`, a fake header, a cut frame
 //! or garbage never hides a following intact frame. A verified frame is taken whole. Both
 //! decoders run the same scanner, so they give the same frames and statistics for the same
@@ -286,7 +286,7 @@ impl scan::Scanner for Scanner {
 /// decoder.feed(&Frame::new(1200).encode(), |_| {}); // the hub restarted
 /// decoder.feed(&Frame::new(1203).encode(), |_| {}); // 2 frames lost
 /// assert_eq!(decoder.stats().restarts(), 1);
-/// assert_eq!(decoder.stats().lost_frames(), 2);
+/// assert_eq!(decoder.stats().lost_packets(), 2);
 /// ```
 pub type Decoder = StreamDecoder<Scanner>;
 
@@ -307,8 +307,8 @@ pub type Decoder = StreamDecoder<Scanner>;
 /// let mut it = datalink::frames(&wire);
 /// let counters: Vec<u16> = it.by_ref().map(|d| d.frame.counter).collect();
 /// assert_eq!(counters, [0, 2]);
-/// assert_eq!(it.stats().crc_failures(), 1);
-/// assert_eq!(it.stats().lost_frames(), 1);
+/// assert_eq!(it.stats().checksum_failures(), 1);
+/// assert_eq!(it.stats().lost_packets(), 1);
 /// ```
 pub fn frames(data: &[u8]) -> Frames<'_> {
     Scan::new(data)

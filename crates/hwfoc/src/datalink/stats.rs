@@ -25,7 +25,7 @@ use super::layout::{BAUD_RATE, CHANNELS, FRAME_LEN, LengthByte};
 /// `8 * frames == records + empty_slots + bad_channels + duplicate_channels`.
 ///
 /// The hub's frame counter is followed exactly as [`foc::Stats`](crate::foc::Stats) follows an
-/// ESC's packet numbers (a [`PacketSequence`]: [lost frames](Stats::lost_frames),
+/// ESC's packet numbers (a [`PacketSequence`]: [lost frames](Stats::lost_packets),
 /// [duplicates](Stats::duplicate_frames), [restarts](Stats::restarts)), and so
 /// is each channel's packet number, record after record. A channel's lost packets are the
 /// numbers the stream did not carry, whether the ESC's own wire lost them or the hub forwarded
@@ -33,7 +33,7 @@ use super::layout::{BAUD_RATE, CHANNELS, FRAME_LEN, LengthByte};
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
 pub struct Stats {
     bytes: ByteCounts,
-    crc_failures: u32,
+    checksum_failures: u32,
     bad_headers: u32,
     length_bytes: [u32; 2],
     bad_channels: u32,
@@ -48,7 +48,7 @@ impl Stats {
     pub const fn new() -> Self {
         Stats {
             bytes: ByteCounts::new(),
-            crc_failures: 0,
+            checksum_failures: 0,
             bad_headers: 0,
             length_bytes: [0; 2],
             bad_channels: 0,
@@ -83,8 +83,8 @@ impl Stats {
     /// Whole candidates (`9B`, a length byte 0x9E or 0xA0, `01 02`, 160 bytes) whose CRC did not
     /// match: corrupted frames, frames cut short and followed by other bytes. A frame cut off by
     /// the end of the stream is not counted.
-    pub const fn crc_failures(&self) -> u32 {
-        self.crc_failures
+    pub const fn checksum_failures(&self) -> u32 {
+        self.checksum_failures
     }
 
     /// Candidates (`9B` and a length byte 0x9E or 0xA0) whose version and command bytes are not
@@ -117,7 +117,7 @@ impl Stats {
 
     /// Frame-counter values missing between consecutive frames (as
     /// [`foc::Stats::lost_packets`](crate::foc::Stats::lost_packets)).
-    pub const fn lost_frames(&self) -> u32 {
+    pub const fn lost_packets(&self) -> u32 {
         self.counter.lost()
     }
 
@@ -172,14 +172,16 @@ impl Stats {
             return false;
         }
         self.bytes.then(&later.bytes);
-        self.crc_failures = self.crc_failures.saturating_add(later.crc_failures);
+        self.checksum_failures = self
+            .checksum_failures
+            .saturating_add(later.checksum_failures);
         self.bad_headers = self.bad_headers.saturating_add(later.bad_headers);
         true
     }
 
     #[inline]
     pub(crate) fn crc_failure(&mut self) {
-        self.crc_failures = self.crc_failures.saturating_add(1);
+        self.checksum_failures = self.checksum_failures.saturating_add(1);
     }
 
     #[inline]
@@ -240,10 +242,10 @@ impl fmt::Display for Stats {
             self.frames(),
             self.frames_with_length_byte(LengthByte::Covered),
             self.frames_with_length_byte(LengthByte::Total),
-            self.crc_failures,
+            self.checksum_failures,
             self.bad_headers,
             self.bytes_skipped(),
-            self.lost_frames(),
+            self.lost_packets(),
             self.duplicate_frames(),
             self.restarts(),
             self.records(),
@@ -294,13 +296,13 @@ mod tests {
         s.line_silent(9);
         // Counter step 10 (<= 9 + 1): 9 lost; packet step 11 (<= 10 + 1): 10 lost.
         s.frame(&frame(110, 1011), &report);
-        assert_eq!((s.lost_frames(), s.restarts()), (9, 0));
+        assert_eq!((s.lost_packets(), s.restarts()), (9, 0));
         let ch = s.channel(3).unwrap();
         assert_eq!((ch.count(), ch.lost(), ch.restarts()), (2, 10, 0));
         s.line_silent(9);
         // Counter step 11 and packet step 12: both restarts.
         s.frame(&frame(121, 1023), &report);
-        assert_eq!((s.lost_frames(), s.restarts()), (9, 1));
+        assert_eq!((s.lost_packets(), s.restarts()), (9, 1));
         assert_eq!(s.channel(3).unwrap().restarts(), 1);
         assert_eq!(s.frames_with_length_byte(LengthByte::Total), 3);
         assert_eq!(s.empty_slots(), 21);

@@ -102,7 +102,7 @@ impl BusStats {
 /// Every DroneCAN frame a node sends is counted in [`NodeStats::frames`]; every transfer it
 /// starts ends in exactly one of: decoded ([`NodeStats::transfers`]), a
 /// [duplicate](NodeStats::duplicates), a [toggle error](NodeStats::toggle_errors), a
-/// [CRC error](NodeStats::crc_errors), [too long](NodeStats::too_long), a
+/// [CRC error](NodeStats::checksum_failures), [too long](NodeStats::too_long), a
 /// [short frame](NodeStats::short_frames), a [bad payload](NodeStats::bad_payloads),
 /// [cut short](NodeStats::cut_short), or an [unknown type](NodeStats::unknown_types); a
 /// transfer still being received is none of them yet.
@@ -111,10 +111,10 @@ pub struct NodeStats {
     frames: u32,
     transfers: [u32; Kind::COUNT],
     gaps: u32,
-    missed: u32,
+    lost_packets: u32,
     duplicates: u32,
     toggle_errors: u32,
-    crc_errors: u32,
+    checksum_failures: u32,
     too_long: u32,
     short_frames: u32,
     bad_payloads: u32,
@@ -138,10 +138,10 @@ impl NodeStats {
             frames: 0,
             transfers: [0; Kind::COUNT],
             gaps: 0,
-            missed: 0,
+            lost_packets: 0,
             duplicates: 0,
             toggle_errors: 0,
-            crc_errors: 0,
+            checksum_failures: 0,
             too_long: 0,
             short_frames: 0,
             bad_payloads: 0,
@@ -184,8 +184,8 @@ impl NodeStats {
     /// or more cannot be seen in 5-bit ids); timed
     /// ([`Receiver::push_at`](super::Receiver::push_at)), the count of the ids skipped modulo
     /// 32 nearest to the transfers the time since the type's last one held at its period.
-    pub const fn missed(&self) -> u32 {
-        self.missed
+    pub const fn lost_packets(&self) -> u32 {
+        self.lost_packets
     }
 
     /// Message transfers that came after a silence of the whole bus of a second or more (timed,
@@ -208,8 +208,8 @@ impl NodeStats {
     }
 
     /// Multi-frame transfers whose CRC did not match.
-    pub const fn crc_errors(&self) -> u32 {
-        self.crc_errors
+    pub const fn checksum_failures(&self) -> u32 {
+        self.checksum_failures
     }
 
     /// Multi-frame transfers longer than their data type can be (more than
@@ -250,7 +250,7 @@ impl NodeStats {
     /// Transfers lost to errors: toggle, CRC, too long, short frames, bad payloads, cut short.
     pub const fn errors(&self) -> u32 {
         self.toggle_errors
-            .saturating_add(self.crc_errors)
+            .saturating_add(self.checksum_failures)
             .saturating_add(self.too_long)
             .saturating_add(self.short_frames)
             .saturating_add(self.bad_payloads)
@@ -318,7 +318,7 @@ impl NodeStats {
         }
         if missed > 0 {
             bump(&mut self.gaps);
-            self.missed = self.missed.saturating_add(missed);
+            self.lost_packets = self.lost_packets.saturating_add(missed);
         }
         true
     }
@@ -345,7 +345,7 @@ impl NodeStats {
         bump(&mut self.toggle_errors);
     }
     pub(crate) fn crc_error(&mut self) {
-        bump(&mut self.crc_errors);
+        bump(&mut self.checksum_failures);
     }
     pub(crate) fn too_long_transfer(&mut self) {
         bump(&mut self.too_long);
@@ -442,10 +442,10 @@ impl fmt::Display for NodeStats {
             "; {} gaps ({} missed), {} duplicates, {} toggle errors, {} CRC errors, {} too long, \
              {} short frames, {} bad payloads, {} cut short, {} orphan frames, {} unknown types",
             self.gaps,
-            self.missed,
+            self.lost_packets,
             self.duplicates,
             self.toggle_errors,
-            self.crc_errors,
+            self.checksum_failures,
             self.too_long,
             self.short_frames,
             self.bad_payloads,
@@ -490,7 +490,7 @@ mod tests {
         assert!(n.next_transfer_id(Kind::StatusMsg2, 9)); // another type: its own ids
         assert!(n.next_transfer_id(Kind::SetIdRequest, 9));
         assert!(n.next_transfer_id(Kind::SetIdRequest, 9)); // services: not checked
-        assert_eq!((n.gaps(), n.missed(), n.duplicates()), (1, 3, 1));
+        assert_eq!((n.gaps(), n.lost_packets(), n.duplicates()), (1, 3, 1));
         n.forget_transfer_ids();
         assert!(n.next_transfer_id(Kind::StatusMsg1, 20));
         assert_eq!(n.gaps(), 1);

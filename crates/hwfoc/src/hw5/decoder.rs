@@ -11,7 +11,7 @@
 //!    is an [unknown type](Stats::unknown_types) (its length cannot be known);
 //! 3. for telemetry, its payload length byte (byte 6) `17`, else a bad header;
 //! 4. the CRC over each allowed length in turn: the first that matches makes it a frame of that
-//!    kind; none is a [CRC failure](Stats::crc_failures).
+//!    kind; none is a [CRC failure](Stats::checksum_failures).
 //!
 //! A rejected candidate costs one byte: scanning resumes at the byte after its start, so a
 //! fake header, a cut or unknown frame or garbage never hides a following intact frame. A
@@ -326,7 +326,7 @@ pub type Decoder = StreamDecoder<Scanner>;
 /// let mut it = hw5::frames(&wire);
 /// let throttles: Vec<u8> = it.by_ref().map(|d| d.frame.throttle).collect();
 /// assert_eq!(throttles, [0, 2]);
-/// assert_eq!(it.stats().crc_failures(), 1);
+/// assert_eq!(it.stats().checksum_failures(), 1);
 /// assert_eq!(it.stats().bytes_skipped(), 32);
 /// ```
 pub fn frames(data: &[u8]) -> Frames<'_> {

@@ -56,7 +56,7 @@
 //!
 //! Any other candidate (an `FE 01` or `01 FD` whose third byte, type or CRC does not fit)
 //! costs one byte and is counted ([`Stats::bad_headers`], [`Stats::unknown_types`],
-//! [`Stats::crc_failures`]); the scan goes on at the next byte, so nothing hides a following
+//! [`Stats::checksum_failures`]); the scan goes on at the next byte, so nothing hides a following
 //! intact frame.
 //!
 //! | module | holds |

@@ -16,7 +16,7 @@ use super::layout::{Direction, Kind};
 ///
 /// Every candidate (`FE 01` or `01 FD`) that is not a frame is counted once, as a
 /// [bad header](Stats::bad_headers), an [unknown type](Stats::unknown_types), a
-/// [CRC failure](Stats::crc_failures) or [out of range](Stats::out_of_range), except one cut off by the end of the stream, which is
+/// [CRC failure](Stats::checksum_failures) or [out of range](Stats::out_of_range), except one cut off by the end of the stream, which is
 /// only skipped.
 ///
 /// There is no packet counter on the wire, so no loss is counted here: the layers above judge
@@ -26,7 +26,7 @@ use super::layout::{Direction, Kind};
 pub struct Stats {
     bytes: ByteCounts,
     frames: [u32; Kind::COUNT],
-    crc_failures: u32,
+    checksum_failures: u32,
     bad_headers: u32,
     unknown_types: u32,
     out_of_range: u32,
@@ -38,7 +38,7 @@ impl Stats {
         Stats {
             bytes: ByteCounts::new(),
             frames: [0; Kind::COUNT],
-            crc_failures: 0,
+            checksum_failures: 0,
             bad_headers: 0,
             unknown_types: 0,
             out_of_range: 0,
@@ -100,8 +100,8 @@ impl Stats {
     /// Whole candidates of a known kind whose CRC did not match (for a type with several
     /// lengths, none of them): corrupted frames, frames cut short and followed by other bytes.
     /// A frame cut off by the end of the stream is not counted.
-    pub const fn crc_failures(&self) -> u32 {
-        self.crc_failures
+    pub const fn checksum_failures(&self) -> u32 {
+        self.checksum_failures
     }
 
     /// Candidates whose third byte is not that of their envelope (`00` after `FE 01`, `03` after
@@ -129,7 +129,7 @@ impl Stats {
     pub const fn rejected(&self) -> u32 {
         self.bad_headers
             .saturating_add(self.unknown_types)
-            .saturating_add(self.crc_failures)
+            .saturating_add(self.checksum_failures)
             .saturating_add(self.out_of_range)
     }
 
@@ -151,7 +151,7 @@ impl Stats {
 
     #[inline]
     pub(crate) fn crc_failure(&mut self) {
-        self.crc_failures = self.crc_failures.saturating_add(1);
+        self.checksum_failures = self.checksum_failures.saturating_add(1);
     }
 
     #[inline]
@@ -192,7 +192,7 @@ impl fmt::Display for Stats {
         write!(
             f,
             ", {} CRC failures, {} out of range, {} bad headers, {} unknown types, {} bytes skipped",
-            self.crc_failures,
+            self.checksum_failures,
             self.out_of_range,
             self.bad_headers,
             self.unknown_types,

@@ -9,14 +9,14 @@
 //! 2. **Chained**: it starts exactly where the last accepted frame ended
 //!    ([`Stats::chain_end`]) and its counter is that frame's + 1, or skips at most
 //!    [`MAX_CHAINED_GAP`](super::MAX_CHAINED_GAP) counters (frames cut out whole, counted
-//!    [lost](Stats::lost_frames)): accepted on its own, decided on its tenth byte. So a frame
+//!    [lost](Stats::lost_packets)): accepted on its own, decided on its tenth byte. So a frame
 //!    between two cut frames, with no consecutive neighbour, is not lost.
 //! 3. **Confirmed**: otherwise (the first frame of a stream, after garbage, a cut or corrupted
 //!    frame, a counter that jumped further) it is accepted only as the first of three chained
 //!    plausible frames with counters +1: decided on at most 30 bytes, each byte looked at once
 //!    more. The frames after it are then accepted as chained, so a chain loses none of its
 //!    frames; its first counter's step from the last accepted one counts
-//!    [lost frames](Stats::lost_frames), a [duplicate](Stats::duplicate_frames) or a
+//!    [lost frames](Stats::lost_packets), a [duplicate](Stats::duplicate_frames) or a
 //!    [restart](Stats::restarts).
 //! 4. Otherwise it is rejected ([unconfirmed](Stats::unconfirmed)) and costs one byte: scanning
 //!    resumes at the byte after its `9B`.
@@ -253,7 +253,7 @@ mod tests {
         let (w, n) = wire([0xFF_FFFE, 0xFF_FFFF, 0, 1]);
         let mut it = frames(&w[..n]);
         assert_eq!(it.by_ref().count(), 4);
-        assert_eq!((it.stats().lost_frames(), it.stats().restarts()), (0, 0));
+        assert_eq!((it.stats().lost_packets(), it.stats().restarts()), (0, 0));
     }
 
     #[test]
@@ -263,7 +263,7 @@ mod tests {
         let mut it = frames(&w[..n]);
         assert_eq!(it.by_ref().count(), 6);
         let s = it.stats();
-        assert_eq!((s.lost_frames(), s.syncs(), s.unconfirmed()), (7, 2, 0));
+        assert_eq!((s.lost_packets(), s.syncs(), s.unconfirmed()), (7, 2, 0));
         // 0 1 2 | 10 11 at the end of the stream: no chain of three after the jump, both
         // dropped (cut off by the end, not counted as rejected).
         let (w, n) = wire([0, 1, 2, 10, 11]);
@@ -280,7 +280,7 @@ mod tests {
         assert_eq!(it.by_ref().count(), 6);
         let s = it.stats();
         assert_eq!(
-            (s.unconfirmed(), s.bytes_skipped(), s.lost_frames()),
+            (s.unconfirmed(), s.bytes_skipped(), s.lost_packets()),
             (2, 20, 17)
         );
     }

@@ -23,7 +23,7 @@ use super::frame::{FRAME_LEN, Frame};
 ///
 /// The counter of accepted frames is followed as [`foc::Stats`](crate::foc::Stats) follows an
 /// ESC's packet numbers, in 24 bits ([`PacketSequence24`]): the step to the first frame of each
-/// new chain tells [lost frames](Stats::lost_frames), a [duplicate](Stats::duplicate_frames) or
+/// new chain tells [lost frames](Stats::lost_packets), a [duplicate](Stats::duplicate_frames) or
 /// a [restart](Stats::restarts).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
 pub struct Stats {
@@ -83,7 +83,7 @@ impl Stats {
 
     /// Counter values missing between accepted frames (as
     /// [`foc::Stats::lost_packets`](crate::foc::Stats::lost_packets), in 24 bits).
-    pub const fn lost_frames(&self) -> u32 {
+    pub const fn lost_packets(&self) -> u32 {
         self.counts.counter.lost()
     }
 

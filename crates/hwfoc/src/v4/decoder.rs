@@ -17,7 +17,7 @@
 //! 4. **A chained data frame**: it starts exactly where the last accepted frame (with its
 //!    trailer, if one came) ended ([`Stats::chain_end`]) and carries the counter after the last
 //!    data frame's, or one at most [`MAX_CHAINED_GAP`](super::MAX_CHAINED_GAP) further (frames
-//!    cut out whole, counted [lost](Stats::lost_frames); any counter right after an info frame
+//!    cut out whole, counted [lost](Stats::lost_packets); any counter right after an info frame
 //!    that started a chain): accepted on its own, on its 19th byte. So a frame between two cut
 //!    frames, with no consecutive neighbour, is not lost.
 //! 5. **A confirmed data frame**: otherwise (the first frame of a stream, after garbage or a cut
@@ -26,7 +26,7 @@
 //!    it or after the next data frame (slow mode, where they alternate). At most 59 bytes decide
 //!    it. The frames after it are then accepted as chained, so a chain loses none of its
 //!    frames; its first counter's step from the last accepted one counts
-//!    [lost frames](Stats::lost_frames), a [duplicate](Stats::duplicate_frames) or a
+//!    [lost frames](Stats::lost_packets), a [duplicate](Stats::duplicate_frames) or a
 //!    [restart](Stats::restarts).
 //! 6. Otherwise it is rejected ([unconfirmed](Stats::unconfirmed)) and costs one byte: scanning
 //!    resumes at the byte after its `9B`.

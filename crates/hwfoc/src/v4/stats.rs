@@ -38,7 +38,7 @@ struct Chain {
 /// not counted).
 ///
 /// The data frames' counter is followed in 24 bits ([`PacketSequence24`]): the step to the
-/// first frame of each new chain tells [lost frames](Stats::lost_frames), a
+/// first frame of each new chain tells [lost frames](Stats::lost_packets), a
 /// [duplicate](Stats::duplicate_frames) or a [restart](Stats::restarts).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub struct Stats {
@@ -170,7 +170,7 @@ impl Stats {
     }
 
     /// Counter values missing between accepted data frames (in 24 bits).
-    pub const fn lost_frames(&self) -> u32 {
+    pub const fn lost_packets(&self) -> u32 {
         self.counts.counter.lost()
     }
 
