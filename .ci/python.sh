@@ -36,6 +36,11 @@ step install "$venv/bin/pip" install -q "./python[test]"
 step python-can "$venv/bin/pip" install -q 'python-can>=4,<5'
 # pytest exits non-zero when no test ran, as when any failed.
 step pytest "$venv/bin/python" -m pytest -q -p no:cacheprovider -rs python/tests 2>&1 | tee "${TMPDIR:-/tmp}/hwfoc-ci-pytest.log"
+# The benchmark of docs/PERFORMANCE.md runs (on 16 MiB: a check that it works, not a figure).
+bench_input=${TMPDIR:-/tmp}/hwfoc-ci-bench-16.bin
+step bench-input python3 scripts/make-big-input.py "$bench_input" 16
+step bench-read "$venv/bin/python" python/bench/bench_read.py "$bench_input" --python-mib 1 --scan
+rm -f "$bench_input"
 # Every test ran: what a test needs (python-can, polars, DuckDB) is installed here, and pytest -rs
 # lists what was skipped, with the reason.
 if grep -q "SKIPPED" "${TMPDIR:-/tmp}/hwfoc-ci-pytest.log"; then

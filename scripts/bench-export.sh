@@ -15,7 +15,7 @@
 # by the hypervisor during it, and the best and median run per format. Other heavy processes on the
 # machine skew the figures: the script prints the load average first; run it on a quiet machine.
 # An output file past its first 16 MiB is written with direct I/O (see
-# crates/hwfoc-cli/src/export/file.rs), so disk figures include the disk's own throughput; compare
+# crates/hwfoc-io/src/write/file.rs), so disk figures include the disk's own throughput; compare
 # variants by user + sys CPU time when the load average is not near zero.
 #
 # With BINS="PATH..." (binaries of other builds), each run times every one of them in turn

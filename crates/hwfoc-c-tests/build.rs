@@ -10,7 +10,8 @@ fn main() {
     println!("cargo:rerun-if-changed=shim/shim.c");
     println!("cargo:rerun-if-changed=shim/noinfo.c");
     println!("cargo:rerun-if-changed=shim/flat_out.h");
-    println!("cargo:rerun-if-changed={header_dir}/hwfoc.h");
+    // Relative to this crate, as cargo takes it: the watch follows the checkout.
+    println!("cargo:rerun-if-changed=../../c/hwfoc.h");
     cc::Build::new()
         .file("shim/shim.c")
         .file("shim/noinfo.c")

@@ -19,13 +19,15 @@ pub fn embed() {
     let files = hwfoc_web_build::build(root, &hwfoc_web_build::target_dir(root), &dist)
         .unwrap_or_else(|e| panic!("the browser app for `hwfoc web`: {e}"));
     let mut list = String::from("&[\n");
+    // Each file named from `OUT_DIR` when the crate compiles, not by the path it had here: a
+    // target folder moved to another checkout (CI's clone) keeps this list without running
+    // the script again.
     for file in &files {
         let name = file.to_string_lossy().replace('\\', "/");
-        let path = dist.join(file);
         writeln!(
             list,
-            "    ({name:?}, include_bytes!({:?})),",
-            path.display()
+            "    ({name:?}, include_bytes!(concat!(env!(\"OUT_DIR\"), {:?}))),",
+            format!("/web/{name}")
         )
         .unwrap();
     }
@@ -41,6 +43,8 @@ pub fn embed() {
         "crates/hwfoc-records/src",
         "Cargo.lock",
     ] {
-        println!("cargo:rerun-if-changed={}", root.join(watched).display());
+        // Relative to this crate (cargo joins them to the package root): the watch follows the
+        // checkout the target folder is used from.
+        println!("cargo:rerun-if-changed=../../{watched}");
     }
 }

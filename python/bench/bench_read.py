@@ -28,8 +28,8 @@ HEADER_SUM = sum(HEADER)
 
 
 def celsius_table():
-    """Index: ADC code; value: degC or None, as the codec's table (crates/hwfoc/src/units.rs)."""
-    text = (ROOT / "crates/hwfoc/src/units.rs").read_text()
+    """Index: ADC code; value: degC or None, as the codec's table (crates/hwfoc/src/units/mod.rs)."""
+    text = (ROOT / "crates/hwfoc/src/units/mod.rs").read_text()
     body = re.search(r"pub const ADC_TABLE: \[u8; 130\] = \[(.*?)\];", text, re.S).group(1)
     codes = [int(x) for x in re.findall(r"\b\d+\b", re.sub(r"//.*", "", body))]
     table = [None] * 256

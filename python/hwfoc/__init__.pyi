@@ -308,7 +308,8 @@ class Ports(Iterator[Dict[str, Any]]):
         """Each port's link statistics so far (as :attr:`Decoder.stats`)."""
 
     def close(self) -> None:
-        """Stops reading and closes the ports; the iterator then ends."""
+        """Stops reading and closes the ports; the iterator then gives the records the streams
+        held (a CAN node's, awaiting its GetEscID answer) and ends."""
 
     def __enter__(self) -> "Ports": ...
     def __exit__(

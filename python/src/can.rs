@@ -10,7 +10,7 @@ use arrow_schema::SchemaRef;
 use hwfoc::Settings;
 use hwfoc::dronecan::CanFrame;
 use hwfoc::telemetry::Frame;
-use hwfoc_io::clock::byte_times;
+use hwfoc_ports::clock::byte_times;
 use hwfoc_io::{Batch, Stream};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;

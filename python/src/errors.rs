@@ -75,7 +75,7 @@ fn raised_in_read(e: &hwfoc_io::InputError) -> Option<PyErr> {
 }
 
 /// The Python exception of a port error.
-pub fn port(e: hwfoc_io::serial::PortError) -> PyErr {
+pub fn port(e: hwfoc_ports::serial::PortError) -> PyErr {
     PortError::new_err(e.to_string())
 }
 

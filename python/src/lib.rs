@@ -186,7 +186,7 @@ pub(crate) fn protocol_arg(name: Option<&str>) -> PyResult<Option<Protocol>> {
 pub(crate) fn baud_arg(baud: Option<args::Baud>, protocol: Option<Protocol>) -> u32 {
     baud.map(|b| b.0)
         .or(protocol.and_then(Protocol::serial_baud_rate))
-        .unwrap_or(hwfoc_io::serial::DEFAULT_BAUD)
+        .unwrap_or(hwfoc_ports::serial::DEFAULT_BAUD)
 }
 
 /// The inputs read with `settings`, of `protocol` only when one is forced, the recordings

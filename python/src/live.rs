@@ -17,8 +17,8 @@ use hwfoc_io::EscLink;
 use hwfoc_io::Handler;
 use hwfoc_io::InputError;
 use hwfoc_io::Notice;
-use hwfoc_io::clock::byte_times;
-use hwfoc_io::serial::PortSet;
+use hwfoc_ports::clock::byte_times;
+use hwfoc_ports::serial::PortSet;
 use hwfoc_io::{PortStreams, Stream};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
@@ -44,7 +44,7 @@ enum Refused {
 
 /// Whether `bytes`, a stream's first, are a candump log: a first line that parses as one.
 fn is_candump(bytes: &[u8]) -> bool {
-    use hwfoc_io::can::candump;
+    use hwfoc_ports::can::candump;
     let line = bytes.split(|&b| b == b'\n').next().unwrap_or_default();
     candump::looks_like_line(line)
         && std::str::from_utf8(line).is_ok_and(|line| candump::parse_line(line, 1).is_ok())
@@ -283,6 +283,10 @@ struct PortsState {
 #[pyclass(module = "hwfoc")]
 pub struct Ports {
     state: Mutex<Option<PortsState>>,
+    /// The records the streams held when the ports were closed (a CAN node's awaiting its
+    /// GetEscID answer), set in the same hold of `state` that closes them, so that whoever
+    /// finds the ports closed finds these too; handed on as records before the iterator ends.
+    held: Mutex<Option<Frames>>,
     pending: Mutex<VecDeque<Py<PyAny>>>,
     names: Vec<String>,
     settings: Settings,
@@ -309,7 +313,7 @@ pub fn open_ports(
     }
     let protocol = crate::protocol_arg(protocol)?;
     if let Some(p) = protocol.filter(|p| p.is_can()) {
-        let serial = ports.iter().find(|n| !hwfoc_io::can::is_can_spec(n));
+        let serial = ports.iter().find(|n| !hwfoc_ports::can::is_can_spec(n));
         if let Some(port) = serial {
             return Err(PyValueError::new_err(format!(
                 "protocol: {:?} reads CAN buses (slcan:PORT, can:INTERFACE), not the serial port \
@@ -328,6 +332,7 @@ pub fn open_ports(
     }
     Ok(Ports {
         state: Mutex::new(Some(PortsState { set, streams })),
+        held: Mutex::new(None),
         pending: Mutex::new(VecDeque::new()),
         schema: live_schema(settings, ports.clone()),
         names: ports,
@@ -356,17 +361,7 @@ impl Ports {
         let Some((event, frames, notices)) = got else {
             return Ok(false);
         };
-        if !frames.is_empty() {
-            let batch: RecordBatch = frames.to_batch(self.schema.clone(), &self.settings);
-            let rows = batch.to_pyarrow(py)?.call_method0("to_pylist")?;
-            let mut pending = self
-                .pending
-                .lock()
-                .map_err(|_| errors::HwfocError::new_err("the ports failed earlier"))?;
-            for row in rows.try_iter()? {
-                pending.push_back(row?.unbind());
-            }
-        }
+        self.push_pending(py, &frames)?;
         if let Some(notice) = event
             .as_ref()
             .and_then(|e| Notice::of_port_event(e, &self.names))
@@ -382,10 +377,45 @@ impl Ports {
         Ok(true)
     }
 
+    /// `frames` as pending records (dicts).
+    fn push_pending(&self, py: Python<'_>, frames: &Frames) -> PyResult<()> {
+        if frames.is_empty() {
+            return Ok(());
+        }
+        let batch: RecordBatch = frames.to_batch(self.schema.clone(), &self.settings);
+        let rows = batch.to_pyarrow(py)?.call_method0("to_pylist")?;
+        let mut pending = self
+            .pending
+            .lock()
+            .map_err(|_| errors::HwfocError::new_err("the ports failed earlier"))?;
+        for row in rows.try_iter()? {
+            pending.push_back(row?.unbind());
+        }
+        Ok(())
+    }
+
+    /// The records held at closing, as pending records: true if there were any.
+    fn take_held(&self, py: Python<'_>) -> PyResult<bool> {
+        let held = self.held.lock().ok().and_then(|mut h| h.take());
+        match held {
+            Some(frames) if !frames.is_empty() => self.push_pending(py, &frames).map(|()| true),
+            _ => Ok(false),
+        }
+    }
+
+    /// Closes the ports: the streams end, handing on what they held (kept for the iterator).
     fn shut(&self, py: Python<'_>) {
         // Joining the reader threads takes up to a read timeout: without the lock.
         py.detach(|| {
-            let state = self.state.lock().ok().and_then(|mut s| s.take());
+            let state = self.state.lock().ok().and_then(|mut s| {
+                let mut state = s.take()?;
+                let mut gather = Gather::default();
+                state.streams.finish(&mut gather);
+                if let Ok(mut held) = self.held.lock() {
+                    *held = Some(gather.0);
+                }
+                Some(state)
+            });
             drop(state);
         });
     }
@@ -404,6 +434,8 @@ impl Ports {
             }
             match self.step(py) {
                 Ok(true) => {}
+                // Closed: the records held at closing, then the end.
+                Ok(false) if self.take_held(py)? => {}
                 Ok(false) => return Ok(None),
                 Err(e) => {
                     // Ctrl-C (or a warning made an error): the ports are closed.
@@ -434,7 +466,8 @@ impl Ports {
         all.iter().map(|s| stats_dict(py, s)).collect()
     }
 
-    /// Stops reading and closes the ports; the iterator then ends.
+    /// Stops reading and closes the ports; the iterator then gives the records the streams
+    /// held (a CAN node's, awaiting its GetEscID answer) and ends.
     fn close(&self, py: Python<'_>) {
         self.shut(py);
     }

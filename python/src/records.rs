@@ -54,12 +54,15 @@ impl Frames {
             self.t.push(f64::NAN);
         }
         self.esc.push(esc);
-        match frame {
-            Data::HwFoc(f) if self.frames.is_empty() => self.hwfoc.push(*f),
-            _ => {
-                self.frames.extend(self.hwfoc.drain(..).map(Data::HwFoc));
-                self.frames.push(*frame);
-            }
+        // HW-FOC frames while every frame is one go to their own column (the fast path);
+        // the first frame of another protocol moves them all to the general one.
+        if let Data::HwFoc(f) = frame
+            && self.frames.is_empty()
+        {
+            self.hwfoc.push(*f);
+        } else {
+            self.frames.extend(self.hwfoc.drain(..).map(Data::HwFoc));
+            self.frames.push(*frame);
         }
     }
 

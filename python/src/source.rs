@@ -70,7 +70,7 @@ pub fn specs(source: &Bound<'_, PyAny>) -> PyResult<Vec<Spec>> {
 /// A path, unless it names a serial port: reading one as a file would wait for its bytes
 /// forever, without receive times.
 fn path_spec(path: String) -> PyResult<Spec> {
-    if hwfoc_io::serial::is_port(&path) {
+    if hwfoc_ports::serial::is_port(&path) {
         return Err(crate::errors::InputError::new_err(format!(
             "{path} is a serial port: read it live with hwfoc.open_ports([\"{path}\"])"
         )));

@@ -12,7 +12,7 @@ import warnings
 import pytest
 
 import hwfoc
-from conftest import cli_error
+from conftest import cli_error, run_cli
 
 
 def _pty():
@@ -142,3 +142,42 @@ def test_reading_a_port_as_a_file_is_refused():
     finally:
         os.close(master)
         os.close(slave)
+
+
+def _slcan_lines(candump: str) -> bytes:
+    """The frames of a candump log (`(t) can0 ID#DATA` lines, extended ids) as the lines an
+    SLCAN adapter sends: `T` + eight hex digits of the id + the length + the data."""
+    out = []
+    for line in candump.splitlines():
+        frame = line.split()[2]
+        ident, data = frame.split("#")
+        assert len(ident) == 8, line
+        out.append(f"T{ident}{len(data) // 2}{data}\r")
+    return "".join(out).encode()
+
+
+def test_closing_hands_on_the_can_records_held(cli, tmp_path):
+    # ESCs that never answer GetEscID: their records are held until the stream places the
+    # nodes by their ids (a second after they are heard), or until it ends. Closed before
+    # that, the ports still give every record, as a recording of the same frames does.
+    log = tmp_path / "bus.log"
+    run_cli(cli, "simulate", "--protocol", "hw-can", "--escs", "2", "--duration", "0.3",
+            "--no-ask-ids", "-o", str(log))
+    expected = hwfoc.read(str(log)).to_pylist()
+    assert len(expected) > 20
+    m, s, name = _pty()
+    try:
+        ports = hwfoc.open_ports([f"slcan:{name}"])
+        os.write(m, _slcan_lines(log.read_text()))
+        # Read until closed, 0.5 s after the frames were written: the iterator gives what the
+        # stream held, then ends.
+        _close_after(ports, 0.5)
+        got = list(ports)
+        assert len(got) == len(expected)
+        assert sorted((r["esc"], r["packet"]) for r in got) == sorted(
+            (r["esc"], r["packet"]) for r in expected)
+        # Closed: the iterator ends.
+        assert list(ports) == []
+    finally:
+        os.close(m)
+        os.close(s)

@@ -10,12 +10,12 @@
 import { after, before, test } from 'node:test';
 import assert from 'node:assert/strict';
 import { execFileSync } from 'node:child_process';
-import { existsSync, mkdtempSync, readFileSync } from 'node:fs';
-import { tmpdir } from 'node:os';
+import { existsSync, readFileSync } from 'node:fs';
 import { fileURLToPath } from 'node:url';
 import { installFakeSerial } from './live/fake-serial.js';
 import { joined, packets } from './live/pcapng.js';
 import { hwfocBin } from './live/hwfoc-bin.js';
+import { tempDir } from './live/temp-dir.js';
 
 const dist = fileURLToPath(new URL('../dist/', import.meta.url));
 const chromiumPath = process.env.CHROMIUM ?? '/usr/bin/chromium';
@@ -38,7 +38,7 @@ let shots;
 
 before(async () => {
   if (missing) return;
-  const dir = mkdtempSync(`${tmpdir()}/hwfoc-live-`);
+  const dir = tempDir('hwfoc-live-');
   execFileSync(hwfocBin(), ['simulate', '--escs', String(ESCS), '--duration', '14', '--no-config',
     '--fault', `${OVERHEAT_ESC}:mos_overheat@5-9`, '-o', `${dir}/sim{esc}.pcapng`], { stdio: 'ignore' });
   sims = [...Array(ESCS).keys()].map((i) => {
@@ -142,6 +142,27 @@ test('four simulated ESCs: values, alarm, unplug and replug, recording, screensh
   await page.screenshot({ path: `${shots}live-390.png`, fullPage: true });
   const overflow = await page.evaluate(() => document.documentElement.scrollWidth - window.innerWidth);
   assert.ok(overflow <= 0, `the page is ${overflow} px wider than a phone`);
+  // Every column can be brought into view on a phone: the table scrolls sideways under the
+  // ESC column, which stays in view (it was cut after the voltage column).
+  const unreachable = await page.evaluate(() => {
+    const scroller = document.querySelector('.live-scroll');
+    const bad = [];
+    for (const th of document.querySelectorAll('.live-table thead th')) {
+      th.scrollIntoView({ inline: 'nearest', block: 'nearest' });
+      const esc = document.querySelector('.live-table tbody td[data-col=esc]').getBoundingClientRect();
+      const box = th.getBoundingClientRect();
+      const inView = box.left >= (th.cellIndex === 0 ? 0 : esc.right - 1) && box.right <= window.innerWidth + 1;
+      if (!inView || esc.left < 0) bad.push(`${th.textContent} at ${box.left.toFixed(0)}-${box.right.toFixed(0)} px, ESC column ${esc.left.toFixed(0)}-${esc.right.toFixed(0)} px`);
+    }
+    const scrolled = scroller.scrollLeft;
+    scroller.scrollLeft = 0;
+    return scrolled > 0 ? bad : ['the table never scrolled', ...bad];
+  });
+  assert.deepEqual(unreachable, []);
+  await page.getByTestId('totals').scrollIntoViewIfNeeded();
+  await page.locator('.live-scroll').evaluate((s) => { s.scrollLeft = s.scrollWidth; });
+  await page.evaluate(() => window.scrollTo(0, 0));
+  await page.screenshot({ path: `${shots}live-390-scrolled.png`, fullPage: true });
 
   // The recording: one pcapng per port, its bytes exactly those fed, read by hwfoc and tshark.
   if (!recorder) {
@@ -155,7 +176,7 @@ test('four simulated ESCs: values, alarm, unplug and replug, recording, screensh
   for (let tries = 0; downloads.length < ESCS && tries < 50; tries++) await page.waitForTimeout(100);
   assert.equal(downloads.length, ESCS);
   const fed = await page.evaluate(() => window.__fake.fed);
-  const dir = mkdtempSync(`${tmpdir()}/hwfoc-rec-`);
+  const dir = tempDir('hwfoc-rec-');
   for (const d of downloads) {
     const port = Number(d.suggestedFilename().match(/port(\d+)\.pcapng$/)[1]) - 1;
     const path = `${dir}/${d.suggestedFilename()}`;
@@ -247,7 +268,7 @@ test('the first decoded frame is on the dashboard within 1 s of the port opening
 });
 
 test('sixteen ESCs at their frame rates, the page responsive', { skip: missing, timeout: 60000 }, async (t) => {
-  const dir = mkdtempSync(`${tmpdir()}/hwfoc-16-`);
+  const dir = tempDir('hwfoc-16-');
   execFileSync(hwfocBin(), ['simulate', '--escs', '16', '--duration', '10', '--lead-in', '0', '--no-config', '-o', `${dir}/sim{esc}.pcapng`], { stdio: 'ignore' });
   const all = [...Array(16).keys()].map((i) => packets(readFileSync(`${dir}/sim${i}.pcapng`)));
   const t0 = Math.min(...all.map((p) => p[0].t));
@@ -293,7 +314,7 @@ test('an SLCAN adapter is opened at 115200 baud with the command\'s sequence at 
 });
 
 test('the port search finds an HW5 ESC at 115200 baud after the bytes at 19200 gave no frame', { skip: missing, timeout: 60000 }, async () => {
-  const dir = mkdtempSync(`${tmpdir()}/hwfoc-hw5-`);
+  const dir = tempDir('hwfoc-hw5-');
   execFileSync(hwfocBin(), ['simulate', '--protocol', 'hw5', '--escs', '1', '--duration', '8', '--no-config', '-o', `${dir}/hw5.pcapng`], { stdio: 'ignore' });
   const p = packets(readFileSync(`${dir}/hw5.pcapng`));
   const spec = { baud: 115200, chunks: p.map((k) => ({ at: (k.t - p[0].t) * 1000, b64: Buffer.from(k.data).toString('base64') })) };
@@ -317,7 +338,7 @@ test('the port search finds an HW5 ESC at 115200 baud after the bytes at 19200 g
 });
 
 test('an SLCAN adapter\'s bus of two Hobbywing CAN ESCs shows the values hwfoc decode gives', { skip: missing, timeout: 60000 }, async () => {
-  const dir = mkdtempSync(`${tmpdir()}/hwfoc-slcan-`);
+  const dir = tempDir('hwfoc-slcan-');
   execFileSync(hwfocBin(), ['simulate', '--protocol', 'hw-can', '--escs', '2', '--duration', '4', '--no-config', '-o', `${dir}/bus.log`], { stdio: 'ignore' });
   const decoded = execFileSync(hwfocBin(), ['decode', '--no-config', `${dir}/bus.log`], { encoding: 'utf8' })
     .trim().split('\n').map((l) => JSON.parse(l));
@@ -347,8 +368,10 @@ test('an SLCAN adapter\'s bus of two Hobbywing CAN ESCs shows the values hwfoc d
     const row = page.locator(`[data-esc="${e.esc}"]`);
     assert.equal(await row.locator('[data-col=mah]').textContent(), e.energy.charge_mah.toFixed(0));
     assert.equal(await row.locator('[data-col=wh]').textContent(), e.energy.energy_wh.toFixed(2));
-    // (Hobbywing CAN's lost packets are judged from the frames' times, which the page's timers
-    // shift under load: web/test/live-slcan.test.mjs compares them on exact times.)
+    // Nothing was lost: none is counted, though the page's timers deliver the lines late and
+    // bunched under load (a transfer id one after the last is never a loss: 288 and 384 were
+    // shown before).
+    assert.equal(await row.locator('[data-col=link]').textContent(), '0/0/0', `esc ${e.esc}'s lost/dup/CRC`);
   }
   await page.screenshot({ path: `${shots}live-slcan-1280.png`, fullPage: true });
 });

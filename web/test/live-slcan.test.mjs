@@ -3,12 +3,12 @@
 import { test } from 'node:test';
 import assert from 'node:assert/strict';
 import { execFileSync } from 'node:child_process';
-import { existsSync, mkdtempSync, readFileSync } from 'node:fs';
+import { existsSync, readFileSync } from 'node:fs';
 import { fileURLToPath } from 'node:url';
-import { tmpdir } from 'node:os';
 import { SlcanLines, bitrateCode, openSequence, recordOf } from '../src/live/slcan.js';
 import { packets } from '../e2e/live/pcapng.js';
 import { hwfocBin } from '../e2e/live/hwfoc-bin.js';
+import { tempDir } from '../e2e/live/temp-dir.js';
 
 test('the open sequence is the command\'s: \\rC\\r, S6\\r, O\\r at 500 kbit/s', () => {
   assert.equal(bitrateCode(500000), 6);
@@ -32,7 +32,7 @@ test('lines that are not frames give no record; a split line is read whole', () 
 
 test('a simulated bus as an adapter sends it gives the pcapng records of the same bus',
   { skip: hwfocBin() ? false : 'needs hwfoc (cargo build, or HWFOC)' }, () => {
-    const dir = mkdtempSync(`${tmpdir()}/slcan-`);
+    const dir = tempDir('slcan-');
     const args = ['simulate', '--protocol', 'hw-can', '--escs', '2', '--duration', '3', '--no-config'];
     execFileSync(hwfocBin(), [...args, '-o', `${dir}/bus.log`], { stdio: 'ignore' });
     execFileSync(hwfocBin(), [...args, '-o', `${dir}/bus.pcapng`], { stdio: 'ignore' });
@@ -58,7 +58,7 @@ test('an SLCAN adapter\'s lines of a simulated bus decode to the records hwfoc d
   { skip: !hwfocBin() ? 'needs hwfoc (cargo build, or HWFOC)' : !existsSync(wasmPath) ? 'needs web/build.sh' : false }, async () => {
     const api = await import('../dist/src/hwfoc.js');
     await api.init(readFileSync(wasmPath));
-    const dir = mkdtempSync(`${tmpdir()}/slcan-`);
+    const dir = tempDir('slcan-');
     execFileSync(hwfocBin(), ['simulate', '--protocol', 'hw-can', '--escs', '2', '--duration', '3', '--no-config', '-o', `${dir}/bus.log`], { stdio: 'ignore' });
     const want = execFileSync(hwfocBin(), ['decode', '--no-config', `${dir}/bus.log`], { encoding: 'utf8' }).trim().split('\n').map((l) => JSON.parse(l));
     const lines = readFileSync(`${dir}/bus.log`, 'utf8').trim().split('\n');
@@ -79,7 +79,7 @@ test('an SLCAN adapter\'s lines read ten at a time give the link figures hwfoc s
   { skip: !hwfocBin() ? 'needs hwfoc (cargo build, or HWFOC)' : !existsSync(wasmPath) ? 'needs web/build.sh' : false }, async () => {
     const api = await import('../dist/src/hwfoc.js');
     await api.init(readFileSync(wasmPath));
-    const dir = mkdtempSync(`${tmpdir()}/slcan-`);
+    const dir = tempDir('slcan-');
     execFileSync(hwfocBin(), ['simulate', '--protocol', 'hw-can', '--escs', '2', '--duration', '4', '--no-config', '-o', `${dir}/bus.log`], { stdio: 'ignore' });
     const want = JSON.parse(execFileSync(hwfocBin(), ['summary', '--json', '--no-config', `${dir}/bus.log`], { encoding: 'utf8' }));
     const lines = readFileSync(`${dir}/bus.log`, 'utf8').trim().split('\n');

@@ -127,7 +127,7 @@ impl std::fmt::Debug for ReopeningPort {
 }
 
 impl ReopeningPort {
-    /// Opens `path` at `baud` (8N1, [`hwfoc_io::serial::open`], whose timeout bounds each
+    /// Opens `path` at `baud` (8N1, [`hwfoc_ports::serial::open`], whose timeout bounds each
     /// write) and sets it up as `options` say; the error says why it cannot be used now.
     pub fn open(path: &str, baud: u32, options: PortOptions) -> Result<ReopeningPort, String> {
         let port = open_set_up(path, baud, options.setup.as_ref())?;
@@ -227,7 +227,7 @@ fn open_set_up(
     baud: u32,
     setup: Option<&Setup>,
 ) -> Result<Box<dyn SerialPort>, String> {
-    let mut port = hwfoc_io::serial::open(path, baud).map_err(|e| e.to_string())?;
+    let mut port = hwfoc_ports::serial::open(path, baud).map_err(|e| e.to_string())?;
     if let Some(setup) = setup {
         setup(port.as_mut())?;
     }

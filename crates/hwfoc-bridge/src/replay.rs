@@ -17,9 +17,9 @@ use std::time::{Duration, Instant};
 
 use hwfoc::telemetry::{Frame, Telemetry};
 use hwfoc::{Protocol, Settings};
-use hwfoc_io::clock::Step;
 use hwfoc_io::energy::nominal_period_s;
 use hwfoc_io::{Handler, InputError};
+use hwfoc_ports::clock::Step;
 
 use crate::fanout::Fanout;
 use crate::output::OutputError;
@@ -83,7 +83,7 @@ pub struct Replay<'a, E> {
     /// after another, never holds the other ESCs back by the step.
     last: Vec<Option<Timed>>,
     /// The last timed frame of any ESC: what an ESC's first frame is measured from (without a
-    /// packet number in common, a step over [`hwfoc_io::clock::MAX_STEP_S`] is a jump).
+    /// packet number in common, a step over [`hwfoc_ports::clock::MAX_STEP_S`] is a jump).
     latest: Option<Timed>,
     /// When the replay started, for untimed frames.
     start: Instant,

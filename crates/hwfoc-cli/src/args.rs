@@ -8,11 +8,11 @@ use clap::builder::{PossibleValue, PossibleValuesParser, TypedValueParser};
 use hwfoc::Protocol;
 use hwfoc::v4::VoltsPerStep;
 use hwfoc_io::Sources;
-use hwfoc_io::serial;
 use hwfoc_io::time::{Clock, Time, TimeError};
 use hwfoc_io::{Input, InputError, OpenInput};
 use hwfoc_io::{Selection, Window};
 use hwfoc_io::{SettingsMap, SettingsPatch};
+use hwfoc_ports::serial;
 
 use crate::demo;
 use crate::error::CliError;
@@ -96,7 +96,10 @@ impl ProtocolArgs {
         let Some(protocol) = self.protocol.filter(|p| p.is_can()) else {
             return Ok(());
         };
-        match ports.into_iter().find(|p| !hwfoc_io::can::is_can_spec(p)) {
+        match ports
+            .into_iter()
+            .find(|p| !hwfoc_ports::can::is_can_spec(p))
+        {
             Some(port) => Err(CliError::Usage {
                 option: format!("--protocol {protocol}"),
                 message: format!(

@@ -11,8 +11,8 @@ use std::io;
 
 use hwfoc_io::EmptyWindow;
 use hwfoc_io::InputError;
-use hwfoc_io::serial::PortError;
 use hwfoc_io::write::{ExportError, WriteError};
+use hwfoc_ports::serial::PortError;
 use hwfoc_sim::SimError;
 
 /// Everything that makes a command fail. Printed once, by `main`, as `hwfoc: <message>`.
@@ -125,8 +125,8 @@ impl From<hwfoc_can_setup::SetupError> for CliError {
     }
 }
 
-impl From<hwfoc_io::can::CanError> for CliError {
-    fn from(e: hwfoc_io::can::CanError) -> Self {
+impl From<hwfoc_ports::can::CanError> for CliError {
+    fn from(e: hwfoc_ports::can::CanError) -> Self {
         CliError::Can(e.into())
     }
 }

@@ -664,7 +664,7 @@ fn a_can_esc_s_maintenance_answer_in_its_recording_is_judged_against_the_service
         time_since_maintenance_min: 3300,
     });
     for frame in answer.frames(24, 11, 127, 0) {
-        hwfoc_io::can::candump::push_line(&mut log, last + 0.001, "can0", &frame);
+        hwfoc_ports::can::candump::push_line(&mut log, last + 0.001, "can0", &frame);
     }
     std::fs::write(&path, log).unwrap();
     let (code, report) = check_json(&[&path]);

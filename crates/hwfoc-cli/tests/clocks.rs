@@ -1,6 +1,6 @@
 //! Recordings whose receive clock steps back (NTP) or jumps forward (a computer that booted
 //! in 1970 and then synced): `summary`, `plot` and the bridge's replay treat each as a
-//! discontinuity (`hwfoc_io::clock::Step`), never as a negative or a centuries-long span.
+//! discontinuity (`hwfoc_ports::clock::Step`), never as a negative or a centuries-long span.
 
 mod common;
 

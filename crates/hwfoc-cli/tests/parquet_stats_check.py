@@ -276,8 +276,17 @@ def main():
     if len(sys.argv) not in (2, 3):
         sys.exit(__doc__.split("\n\n")[1])
     hwfoc = sys.argv[1]
-    work = sys.argv[2] if len(sys.argv) == 3 else tempfile.mkdtemp(prefix="hwfoc-stats-")
-    os.makedirs(work, exist_ok=True)
+    if len(sys.argv) == 3:
+        os.makedirs(sys.argv[2], exist_ok=True)
+        checks(hwfoc, sys.argv[2])
+    else:
+        # Removed afterwards, whether the checks pass or not.
+        with tempfile.TemporaryDirectory(prefix="hwfoc-stats-") as work:
+            checks(hwfoc, work)
+
+
+def checks(hwfoc, work):
+    """The checks, with their files in `work`."""
     path = export(hwfoc, work)
     groups = check_pyarrow_statistics(path)
     with_names = sum(1 for g in groups if g["faults.list.item"][0] is not None)

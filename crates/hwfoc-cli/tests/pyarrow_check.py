@@ -86,8 +86,17 @@ def main():
     if len(sys.argv) not in (2, 3):
         sys.exit(__doc__.split("\n\n")[1])
     hwfoc = sys.argv[1]
-    work = sys.argv[2] if len(sys.argv) == 3 else tempfile.mkdtemp(prefix="hwfoc-pyarrow-")
-    os.makedirs(work, exist_ok=True)
+    if len(sys.argv) == 3:
+        os.makedirs(sys.argv[2], exist_ok=True)
+        checks(hwfoc, sys.argv[2])
+    else:
+        # Removed afterwards, whether the checks pass or not.
+        with tempfile.TemporaryDirectory(prefix="hwfoc-pyarrow-") as work:
+            checks(hwfoc, work)
+
+
+def checks(hwfoc, work):
+    """The checks, with their files in `work`."""
     parquet_path = os.path.join(work, "demo.parquet")
     settings = [arg for k, v in SETTINGS.items() for arg in (f"--{k.replace('_', '-')}", v)]
     base = [hwfoc, "decode", "--demo", *settings]

@@ -13,7 +13,7 @@ use std::sync::atomic::AtomicBool;
 use hwfoc_records::{Beside, BlockRead, ReadAt, RegularFile, Reopen};
 pub(crate) use hwfoc_records::{Input, InputError};
 
-use crate::serial::PortSet;
+use hwfoc_ports::serial::PortSet;
 
 use self::ahead::ReadAhead;
 use hwfoc_ports::Ports;
@@ -25,14 +25,14 @@ pub trait OpenInput: Sized {
     /// [`Input::next_batch`] to its end, so that any number of inputs can be given together.
     fn open(spec: &str) -> Result<Self, InputError>;
 
-    /// Opens serial ports at `baud` (8N1; at [`crate::serial::Baud::Auto`] each port finds its
+    /// Opens serial ports at `baud` (8N1; at [`hwfoc_ports::serial::Baud::Auto`] each port finds its
     /// rate, told as a notice) as one input with one stream per port, in the order given.
     /// Reading ends once `stop` is set (the `hwfoc` command sets it on Ctrl-C or SIGTERM; the
     /// library installs no signal handler); a port that is unplugged is waited for, with a
     /// warning.
     fn open_ports(
         names: &[String],
-        baud: impl Into<crate::serial::Baud>,
+        baud: impl Into<hwfoc_ports::serial::Baud>,
         stop: Arc<AtomicBool>,
     ) -> Result<Self, InputError>;
 }
@@ -63,7 +63,7 @@ impl OpenInput for Input {
 
     fn open_ports(
         names: &[String],
-        baud: impl Into<crate::serial::Baud>,
+        baud: impl Into<hwfoc_ports::serial::Baud>,
         stop: Arc<AtomicBool>,
     ) -> Result<Input, InputError> {
         let set = PortSet::open(names, baud)?;
@@ -273,7 +273,7 @@ mod tests {
         assert_eq!(input.streams(), 2);
         assert_eq!(input.stream_name(1), names[1]);
         let mut master = std::fs::File::from(ptys[1].master.try_clone().unwrap());
-        let sent = crate::clock::ReceiveClock::new().now_ns() as f64 * 1e-9;
+        let sent = hwfoc_ports::clock::ReceiveClock::new().now_ns() as f64 * 1e-9;
         master.write_all(&[0x9B, 0x16, 0x01]).unwrap();
         let mut got = Vec::new();
         let mut times = Vec::new();

@@ -3,9 +3,10 @@
 //! The codec (`hwfoc`) turns bytes into frames; this library does what lies around it, for every
 //! front end alike (the `hwfoc` command, bridges, bindings). What needs no operating system
 //! (formats, streams, ESC numbering, the record, the summary, the checks) is `hwfoc-records`,
-//! re-exported here at the same paths; this crate adds files, standard input, serial ports, CAN
-//! adapters and the writers' threads. Its surface, by role (the items at the crate root, the
-//! rest in the public modules named):
+//! re-exported here at the same paths; this crate adds files, standard input, live ports (read
+//! through `hwfoc-ports`, whose serial ports, CAN adapters and clocks are named from that
+//! crate) and the writers' threads. Its surface, by role (the items at the crate root, the rest
+//! in the public modules named):
 //!
 //! - inputs: where bytes come from (raw files, logic-analyser CSV exports, pcapng recordings,
 //!   serial ports, standard input), an [`Input`] whose [`InputFormat`] is detected from the
@@ -23,9 +24,7 @@
 //! - [`pcapng`]: the recording format (writer and truncation-tolerant reader);
 //! - [`time`]: times as people write them (`--from +5`, ISO 8601) and dates shown where the
 //!   source has a wall clock; [`energy`]: charge and energy integrated over frame times;
-//! - [`can`]: CAN frames in and out (SLCAN adapters, `candump` logs);
-//! - [`serial`]: serial ports that survive being unplugged; [`clock`]: receive times;
-//!   every loop that waits (a port input, an export's [`stop_on`](write::Export::stop_on))
+//! - every loop that waits (a port input, an export's [`stop_on`](write::Export::stop_on))
 //!   ends when a stop flag its caller passes in (an `Arc<AtomicBool>`) is set: the library
 //!   installs no signal handler, so that a program embedding it keeps its own (the `hwfoc`
 //!   command sets the flag on Ctrl-C and SIGTERM; the Python package's own loops check for
@@ -124,12 +123,10 @@
 #![forbid(unsafe_op_in_unsafe_fn)]
 #![warn(missing_docs)]
 
-// Modules whose names are a namespace for their items (`time::parse`, `serial::open`,
+// Modules whose names are a namespace for their items (`time::parse`, `summary::Summary`,
 // `pcapng::Reader`, `write::arrow::schema`): public, each exporting only its public items.
-pub mod can;
 pub mod record;
 pub mod write;
-pub use hwfoc_ports::{clock, serial};
 pub use hwfoc_records::{check, energy, pcapng, summary, time};
 
 // Modules whose public items are re-exported below, by role.

@@ -10,8 +10,8 @@ use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
 use hwfoc::dronecan::CanFrame;
-use hwfoc_io::clock::unix_now_ns;
-use hwfoc_io::serial::{PortEvent, PortSet};
+use hwfoc_ports::clock::unix_now_ns;
+use hwfoc_ports::serial::{PortEvent, PortSet};
 
 /// The records of the first `n` data events within 5 s, with their times.
 fn frames(set: &PortSet, n: usize) -> Vec<(u64, CanFrame)> {
@@ -98,7 +98,7 @@ fn a_refused_bit_rate_is_an_error_naming_the_adapter() {
             }
         }
     });
-    let e = hwfoc_io::can::CanBus::open(&spec, false).unwrap_err();
+    let e = hwfoc_ports::can::CanBus::open(&spec, false).unwrap_err();
     assert_eq!(
         e.to_string(),
         format!("{spec}: the adapter refused the bit rate 250000 bit/s")
@@ -114,7 +114,7 @@ fn a_vcan_interface_is_a_can_port() {
     let names = vec!["can:vcan0".to_string()];
     let set = PortSet::open(&names, 19200).unwrap();
     assert!(set.is_can(0));
-    let mut other = hwfoc_io::can::CanBus::open("can:vcan0", false).unwrap();
+    let mut other = hwfoc_ports::can::CanBus::open("can:vcan0", false).unwrap();
     let frame = CanFrame::extended(0x104E_5201, &[1, 2, 3, 0xC0]).unwrap();
     other.send(&frame).unwrap();
     let got = frames(&set, 1);

@@ -52,21 +52,8 @@ use hwfoc_io::summary::{device_json, esc_label, no_frames};
 use hwfoc_io::pcapng::LINKTYPE_CAN_SOCKETCAN;
 use hwfoc_io::pcapng::{Damage, Interface, LINKTYPE, MAGIC, MAX_CHUNK, Packet, Reader, Writer};
 
-// Serial ports.
-use hwfoc_io::serial::{Baud, SEARCH_BYTES_FOR, SEARCH_RATES, SEARCH_SILENT_FOR, Search, Verdict};
-use hwfoc_io::serial::{DEFAULT_BAUD, PortError, PortEvent, PortSet, RETRY_EVERY, Readers};
-use hwfoc_io::serial::{available_ports, is_port, open};
-
-// CAN frames: SLCAN adapters, candump logs.
-use hwfoc_io::can::candump::{Line, LineError, Logged, looks_like_line, parse_line, push_line};
-use hwfoc_io::can::slcan::{BEL, BITRATES, CLOSE, Counts, Event, MAX_LINE, Parser};
-use hwfoc_io::can::slcan::{bitrate_code, push_extended, push_frame, setup};
-use hwfoc_io::can::{ASK_EVERY, ASK_PRIORITY, AskIds, DEFAULT_SOURCE_NODE};
-use hwfoc_io::can::{CanBus, CanError, CanSpec, DEFAULT_BITRATE, SLCAN_BAUD, is_can_spec};
-
-// Times, clocks and energy.
-use hwfoc_io::clock::{MAX_FRAME_SPACING_S, MAX_STEP_S, ReceiveClock, Step};
-use hwfoc_io::clock::{byte_time_s, byte_times, unix_now_ns};
+// Times and energy (the live devices, their clocks included, are hwfoc-ports': its own
+// surface test).
 use hwfoc_io::energy::{Energy, drawn_w, nominal_period_s, power_w};
 use hwfoc_io::time::{Clock, Time, TimeError, iso8601, iso8601_local, parse, span_text};
 
@@ -81,7 +68,6 @@ fn the_surface_constants_are_those_of_the_specs() {
     assert_eq!(MAGIC, [0x0A, 0x0D, 0x0D, 0x0A]);
     assert_eq!(LINKTYPE, 147);
     assert_eq!(LINKTYPE_CAN_SOCKETCAN, 227);
-    assert_eq!(DEFAULT_BAUD, 19_200);
     assert_eq!(nominal_period_s(None), 0.05);
     assert_eq!(JSON_SCHEMA_VERSION, 1);
     assert_eq!(RECORD_SCHEMA_VERSION, 4);

@@ -9,8 +9,8 @@
 use std::fmt;
 use std::io;
 
-use hwfoc_io::serial::PortError;
 use hwfoc_io::write::WriteError;
+use hwfoc_ports::serial::PortError;
 
 /// Everything that makes a simulation fail to start or stop early.
 #[derive(Debug)]

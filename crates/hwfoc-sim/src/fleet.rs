@@ -6,7 +6,7 @@ use std::sync::atomic::AtomicBool;
 use std::time::Instant;
 
 use hwfoc::Protocol;
-use hwfoc_io::clock::unix_now_ns;
+use hwfoc_ports::clock::unix_now_ns;
 
 use crate::degrade::{DegradeKind, DegradeSpec};
 use crate::error::SimError;

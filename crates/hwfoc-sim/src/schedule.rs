@@ -215,7 +215,7 @@ pub fn run(
             // Seconds exactly as the recording's reader computes them for a packet's first
             // byte, so that decoding a recording gives the same `t_s`.
             let t_ns = clock.origin_ns + lane.burst.t_ns;
-            truth.record_data(hwfoc_io::clock::byte_time_s(t_ns, 0, 0.0), index, &data)?;
+            truth.record_data(hwfoc_ports::clock::byte_time_s(t_ns, 0, 0.0), index, &data)?;
         }
         lane.burst = lane.esc.next_burst();
         lane.written = 0;

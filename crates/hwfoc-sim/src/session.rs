@@ -15,7 +15,7 @@ use std::sync::atomic::AtomicBool;
 use std::time::{Duration, Instant};
 
 use hwfoc::Settings;
-use hwfoc_io::clock::unix_now_ns;
+use hwfoc_ports::clock::unix_now_ns;
 
 use crate::destination::{Destination, FileFormat, Opened};
 use crate::error::SimError;

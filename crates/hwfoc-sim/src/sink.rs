@@ -8,8 +8,8 @@ use hwfoc::telemetry::Data;
 
 use hwfoc_io::pcapng;
 use hwfoc_io::record::Record;
-use hwfoc_io::serial::PortError;
 use hwfoc_io::write::{self, WriteError};
+use hwfoc_ports::serial::PortError;
 
 /// The outputs of a simulation, one stream per ESC.
 pub trait Sink {
@@ -164,7 +164,7 @@ impl PortSink {
     pub fn open(names: &[String], baud: u32) -> Result<PortSink, PortError> {
         let mut ports = Vec::with_capacity(names.len());
         for name in names {
-            let mut port = hwfoc_io::serial::open(name, baud)?;
+            let mut port = hwfoc_ports::serial::open(name, baud)?;
             // A write waits at most this long for room in the driver's buffer.
             port.set_timeout(std::time::Duration::from_millis(500))
                 .map_err(|e| PortError::Other {

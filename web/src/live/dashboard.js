@@ -10,10 +10,16 @@ const COLOURS = ['#2a7ab0', '#d0452f', '#3a9a3a', '#9b59b6', '#e08e0b', '#16a2a2
   '#455a64', '#8d6e63', '#00897b', '#5c6bc0', '#f4511e', '#6d4c41', '#43a047', '#1e88e5'];
 
 
+/** `value` with `digits` decimals, without the sign of a value that rounds to zero ("-0.0"). */
+export function fixed(value, digits) {
+  const text = value.toFixed(digits);
+  return Number(text) === 0 ? text.replace('-', '') : text;
+}
+
 /** A value as the table shows it. */
 export function format(column, value) {
   if (value === null || value === undefined || Number.isNaN(value)) return '–';
-  return value.toFixed(DIGITS[column] ?? 1);
+  return fixed(value, DIGITS[column] ?? 1);
 }
 
 /** The dashboard inside `root`; `render(fleet, now)` redraws it. */
@@ -49,9 +55,9 @@ export class Dashboard {
     while (this.body.rows.length > escs.length) this.body.deleteRow(-1);
     escs.forEach((e, i) => this.#row(this.body.rows[i] ?? this.body.insertRow(), e, now));
     const t = fleet.totals();
-    const fixed = (v, digits) => (v === null ? '–' : v.toFixed(digits));
-    this.totals.textContent = `All ESCs: ${t.powerW.toFixed(0)} W now, peak ${t.peakPowerW.toFixed(0)} W, ` +
-      `${fixed(t.mah, 0)} mAh, ${fixed(t.wh, 2)} Wh`;
+    const shown = (v, digits) => (v === null ? '–' : fixed(v, digits));
+    this.totals.textContent = `All ESCs: ${shown(t.powerW, 0)} W now, peak ${shown(t.peakPowerW, 0)} W, ` +
+      `${shown(t.mah, 0)} mAh, ${shown(t.wh, 2)} Wh`;
     this.#log(fleet.log);
     this.#chart(escs, now);
   }
@@ -74,7 +80,7 @@ export class Dashboard {
     const used = e.used();
     const lost = e.state === 'lost';
     cells.push(
-      el('td', { 'data-col': 'power_w' }, power === null ? '–' : power.toFixed(0)),
+      el('td', { 'data-col': 'power_w' }, power === null ? '–' : fixed(power, 0)),
       el('td', { 'data-col': 'rate' }, e.rate(now).toFixed(1)),
       el('td', { 'data-col': 'link' }, link ? `${link.lost_packets ?? 0}/${link.duplicate_packets ?? 0}/${link.checksum_failures ?? 0}` : '–'),
       el('td', { 'data-col': 'mah' }, used ? used.mah.toFixed(0) : '–'),

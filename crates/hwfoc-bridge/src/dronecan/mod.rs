@@ -38,7 +38,7 @@
 //!
 //! # The adapter
 //!
-//! Opened with [`hwfoc_io::serial::open`] (ptys too) at [`DronecanOptions::baud`] (default
+//! Opened with [`hwfoc_ports::serial::open`] (ptys too) at [`DronecanOptions::baud`] (default
 //! [`DEFAULT_BAUD`]; adapters on USB CDC such as CANable ignore it, an adapter on a real UART
 //! needs its own: at 115200 baud a link carries about 140 esc.Status a second), then set up
 //! with `C`, `S<code>`, `O` (see [`slcan`]). What the adapter answers is read and ignored
@@ -67,7 +67,7 @@
 //! [`slcan::push_extended`] does. `canadensis` is Cyphal (UAVCAN v1), another transport.
 
 pub mod dsdl;
-pub use hwfoc_io::can::slcan;
+pub use hwfoc_ports::can::slcan;
 
 use std::time::{Duration, Instant};
 

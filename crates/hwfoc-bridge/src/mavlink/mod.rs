@@ -62,7 +62,7 @@
 //! Sending never stops the output: an unreachable UDP destination (a refused port, reported by
 //! ICMP on our connected socket; a network without a route) is an [`OutputError::Send`], counted
 //! in [`OutputStats::errors`], and the next poll sends again; a serial port that disappears is an
-//! [`OutputError::Lost`], reopened every [`hwfoc_io::serial::RETRY_EVERY`] from later polls (what
+//! [`OutputError::Lost`], reopened every [`hwfoc_ports::serial::RETRY_EVERY`] from later polls (what
 //! would have been sent meanwhile is dropped, not counted). Nothing blocks for long: the UDP
 //! socket is non-blocking, a serial write waits at most 50 ms, and after a write that found the
 //! link full or timed out the rest of that poll's messages are dropped (each counted as an error).
@@ -168,7 +168,7 @@ pub enum MavlinkTarget {
     Udp(SocketAddr),
     /// A serial port (a telemetry radio, a flight controller's telemetry port).
     Serial {
-        /// The port, as `hwfoc_io::serial::open` takes it (`/dev/ttyUSB0`, `COM3`).
+        /// The port, as `hwfoc_ports::serial::open` takes it (`/dev/ttyUSB0`, `COM3`).
         port: String,
         /// Its baud rate.
         baud: u32,

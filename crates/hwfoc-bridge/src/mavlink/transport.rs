@@ -62,7 +62,7 @@ impl Link {
         })
     }
 
-    /// The serial port `port` at `baud` (8N1; `hwfoc_io::serial::open`, whose timeout of 50 ms
+    /// The serial port `port` at `baud` (8N1; `hwfoc_ports::serial::open`, whose timeout of 50 ms
     /// bounds each write).
     pub(crate) fn serial(port: &str, baud: u32) -> Result<Link, String> {
         Ok(Link::Serial(ReopeningPort::open(

@@ -19,7 +19,7 @@
 //! no valid frame (a wrong baud rate or swapped wires) or nothing at all.
 //!
 //! Without `--baud` (or `--protocol`, which gives its rate) each port finds its rate from the
-//! bytes ([`hwfoc_io::serial::Baud::Auto`]), and the recording says the rate each port was
+//! bytes ([`hwfoc_ports::serial::Baud::Auto`]), and the recording says the rate each port was
 //! read at: the file's interfaces are declared, each with its port's rate, once every port has
 //! found it. Until then, what the ports found bytes give is held in memory (a port's bytes
 //! reach the recorder only once its rate is found: bytes read at a rate that gave no frame
@@ -48,8 +48,8 @@ use hwfoc_io::Escaped;
 use hwfoc_io::Notice;
 use hwfoc_io::PortStreams;
 use hwfoc_io::pcapng;
-use hwfoc_io::serial::{Baud, DEFAULT_BAUD, PortEvent, PortSet, SEARCH_BYTES_FOR, SEARCH_RATES};
 use hwfoc_io::write::WriteError;
+use hwfoc_ports::serial::{Baud, DEFAULT_BAUD, PortEvent, PortSet, SEARCH_BYTES_FOR, SEARCH_RATES};
 
 /// Longest time a received byte stays in this process before it is written to the file.
 pub const FLUSH_EVERY: Duration = Duration::from_millis(50);
@@ -186,11 +186,11 @@ struct PortState {
 
 /// Whether port `name` is a CAN bus, and its bit rate where its name gives it.
 fn can_bus(name: &str) -> Option<Option<u32>> {
-    if !hwfoc_io::can::is_can_spec(name) {
+    if !hwfoc_ports::can::is_can_spec(name) {
         return None;
     }
-    match hwfoc_io::can::CanSpec::parse(name) {
-        Ok(hwfoc_io::can::CanSpec::Slcan { bitrate, .. }) => Some(Some(bitrate)),
+    match hwfoc_ports::can::CanSpec::parse(name) {
+        Ok(hwfoc_ports::can::CanSpec::Slcan { bitrate, .. }) => Some(Some(bitrate)),
         _ => Some(None),
     }
 }
@@ -252,7 +252,7 @@ pub struct Recorder {
     last_flush: Instant,
     last_sync: Instant,
     /// The clock of the ports' timestamps.
-    clock: hwfoc_io::clock::ReceiveClock,
+    clock: hwfoc_ports::clock::ReceiveClock,
     ports: Vec<PortState>,
     /// The ports' decoding streams (frames are counted, not kept).
     streams: PortStreams,
@@ -326,7 +326,7 @@ impl Recorder {
     pub fn new(
         plan: Plan,
         ports: &[String],
-        clock: hwfoc_io::clock::ReceiveClock,
+        clock: hwfoc_ports::clock::ReceiveClock,
     ) -> Result<Recorder, CliError> {
         let rotating = plan.rotate_size.is_some() || plan.rotate_time.is_some();
         let first = if rotating {

@@ -40,6 +40,8 @@ mod text;
 
 pub use error::{ExportError, WriteError};
 pub use export::Export;
+#[cfg(feature = "parquet")]
+pub(crate) use export::Frames;
 pub(crate) use export::{Chunk, EscTable, Sink, ToWriter};
 pub(crate) use metadata::esc_settings_json;
 pub use safety::{FileId, create_file, same_file};

@@ -141,7 +141,7 @@ mod encode {
     use super::super::metadata::schema_with;
     use super::super::stored::columns::{COLUMNS, COUNT, visit};
     use super::super::stored::{Column, Visitor};
-    use super::super::{Chunk, Provenance, Sink, ToWriter, WriteError};
+    use super::super::{Chunk, Frames, Provenance, Sink, ToWriter, WriteError};
     use hwfoc_records::record::{FaultList, UtcTime};
 
     /// Values handed to a column writer at a time (the crate's default, 1024, spends more time
@@ -688,7 +688,7 @@ mod encode {
             C::from_frame(
                 (!t.is_nan()).then_some(t),
                 esc,
-                &rows.frames[i],
+                &rows.frame(i),
                 settings(esc),
             )
         };
@@ -704,26 +704,25 @@ mod encode {
         type Physical<C> = <<C as hwfoc_records::record::Column>::Value as ParquetValue>::Physical;
         encode_in::<Physical<C>>(block_rows, descr, props, n, |block, levels| {
             // A receive time where there is one (NaN in the chunk where not).
-            let (t, esc, frames) = (
-                &rows.t[block.clone()],
-                &rows.esc[block.clone()],
-                &rows.frames[block],
-            );
-            let rows = t.iter().zip(esc).zip(frames);
-            if frames.iter().all(|f| matches!(f, Data::HwFoc(_))) {
-                // A block of HW-FOC frames (nearly every block of a large file): each frame's
-                // protocol known here, its values read by field without a match on the
-                // protocol per value.
-                let values = rows.map(|((&t, &esc), frame)| {
-                    let frame = Data::HwFoc(frame.to_hwfoc().unwrap_or_default());
-                    C::from_frame((!t.is_nan()).then_some(t), esc, &frame, settings(esc))
-                });
-                <C::Value as ParquetValue>::fill(values, levels);
-            } else {
-                let values = rows.map(|((&t, &esc), frame)| {
-                    C::from_frame((!t.is_nan()).then_some(t), esc, frame, settings(esc))
-                });
-                <C::Value as ParquetValue>::fill(values, levels);
+            let (t, esc) = (&rows.t[block.clone()], &rows.esc[block.clone()]);
+            let rows_in = t.iter().zip(esc);
+            match rows.frames(block) {
+                // HW-FOC frames (nearly every block of a large file): each frame's protocol
+                // known here, its values read by field without a match on the protocol per
+                // value.
+                Frames::HwFoc(frames) => {
+                    let values = rows_in.zip(frames).map(|((&t, &esc), frame)| {
+                        let frame = Data::HwFoc(*frame);
+                        C::from_frame((!t.is_nan()).then_some(t), esc, &frame, settings(esc))
+                    });
+                    <C::Value as ParquetValue>::fill(values, levels);
+                }
+                Frames::Any(frames) => {
+                    let values = rows_in.zip(frames).map(|((&t, &esc), frame)| {
+                        C::from_frame((!t.is_nan()).then_some(t), esc, frame, settings(esc))
+                    });
+                    <C::Value as ParquetValue>::fill(values, levels);
+                }
             }
         })
     }

@@ -56,13 +56,17 @@ pub(super) fn write(
                 let mut by_settings: Option<Encoders> = None;
                 for slice in slice_rx {
                     let mut text = Vec::with_capacity(slice.len() * if csv { 110 } else { 260 });
-                    let rows = slice.t.iter().zip(&slice.esc).zip(&slice.frames);
+                    let rows = slice
+                        .t
+                        .iter()
+                        .zip(&slice.esc)
+                        .zip((0..slice.len()).map(|i| slice.frame(i)));
                     match slice.settings.as_deref() {
                         None => {
                             for ((&t, &esc), frame) in rows {
                                 let t = (!t.is_nan()).then_some(t);
-                                let record = Record::new(t, esc, frame, &settings);
-                                encode(&mut encoder, (csv, iso), &record, frame, &mut text);
+                                let record = Record::new(t, esc, &frame, &settings);
+                                encode(&mut encoder, (csv, iso), &record, &frame, &mut text);
                             }
                         }
                         Some(table) => {
@@ -71,9 +75,9 @@ pub(super) fn write(
                             for ((&t, &esc), frame) in rows {
                                 let t = (!t.is_nan()).then_some(t);
                                 let settings = &table[usize::from(esc)];
-                                let record = Record::new(t, esc, frame, settings);
+                                let record = Record::new(t, esc, &frame, settings);
                                 let encoder = encoders.get(slots[usize::from(esc)]);
-                                encode(encoder, (csv, iso), &record, frame, &mut text);
+                                encode(encoder, (csv, iso), &record, &frame, &mut text);
                             }
                         }
                     }
@@ -96,13 +100,7 @@ pub(super) fn write(
             let mut start = 0;
             while start < n || (n == 0 && chunk.flush) {
                 let end = n.min(start + SLICE_ROWS);
-                let slice = Chunk {
-                    t: chunk.t[start..end].to_vec(),
-                    esc: chunk.esc[start..end].to_vec(),
-                    frames: chunk.frames[start..end].to_vec(),
-                    flush: chunk.flush && end == n,
-                    settings: chunk.settings.clone(),
-                };
+                let slice = chunk.slice(start..end, chunk.flush && end == n);
                 if slices[turn].send(slice).is_err() {
                     break 'rows;
                 }

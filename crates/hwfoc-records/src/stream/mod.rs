@@ -475,7 +475,7 @@ impl EscLink {
 
     /// Whether the link's frames are checked (its format's description: V3 and V4 are not,
     /// their frames are recognised by plausibility and chaining, see
-    /// [`EscLink::rejected_frames`]).
+    /// [`EscLink::rejected_candidates`]).
     pub fn has_checksum(&self) -> bool {
         self.protocol().description().check != hwfoc::format::Check::None
     }
@@ -509,7 +509,7 @@ impl EscLink {
 
     /// Candidates of a format without checksum that were not taken: implausible, or not
     /// confirmed by a chain (`None` for a checksummed format).
-    pub fn rejected_frames(&self) -> Option<u32> {
+    pub fn rejected_candidates(&self) -> Option<u32> {
         match self {
             EscLink::HwV4(s) => Some(s.rejected()),
             EscLink::HwV3(s) => Some(s.rejected()),

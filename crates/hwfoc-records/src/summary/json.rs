@@ -145,7 +145,7 @@ impl EscReport<'_> {
             "protocol": self.protocol().map(Protocol::name),
             "link": {
                 "checksum_failures": st.has_checksum().then(|| st.checksum_failures()),
-                "rejected_candidates": st.rejected_frames(),
+                "rejected_candidates": st.rejected_candidates(),
                 "lost_packets": counted.then(|| st.lost_packets()),
                 "duplicate_packets": counted.then(|| st.duplicate_packets()),
                 "restarts": counted.then(|| st.restarts()),

@@ -151,7 +151,7 @@ impl EscReport<'_> {
                 let _ = writeln!(o, "clock        {text}");
             }
         }
-        let checks = match st.rejected_frames() {
+        let checks = match st.rejected_candidates() {
             Some(n) => format!("{n} rejected candidates (no checksum)"),
             None => format!("{} checksum failures", st.checksum_failures()),
         };

@@ -14,10 +14,10 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 
 use hwfoc::dronecan::{CanFrame, Form, Message};
-use hwfoc_io::can::{AskIds, DEFAULT_SOURCE_NODE, candump};
-use hwfoc_io::clock::unix_now_ns;
 use hwfoc_io::pcapng;
 use hwfoc_io::write::WriteError;
+use hwfoc_ports::can::{AskIds, DEFAULT_SOURCE_NODE, candump};
+use hwfoc_ports::clock::unix_now_ns;
 
 use super::bus::{CanBus, Sent};
 use super::slcan::Adapter;

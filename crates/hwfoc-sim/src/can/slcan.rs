@@ -11,15 +11,15 @@
 //! open, without timestamps.
 //!
 //! Written here because no crate of the workspace speaks the adapter's side of SLCAN: the io
-//! crate's [`hwfoc_io::can::slcan`] speaks the host's. Its [`Parser`] reads the frames of the
+//! crate's [`hwfoc_ports::can::slcan`] speaks the host's. Its [`Parser`] reads the frames of the
 //! `T`/`t`/`R`/`r` commands (a host's send command has the layout of an adapter's received
 //! frame) and its [`push_frame`] writes the frames handed on; the commands `C`, `S0`..`S8`,
 //! `O`, `F`, `V`, `v`, `N`, `Z`, `M`, `m`, `X`, `W` are handled here, as that parser, made for
 //! an adapter's output, does not know them.
 
 use hwfoc::dronecan::CanFrame;
-pub use hwfoc_io::can::slcan::{BEL, BITRATES, push_frame};
-use hwfoc_io::can::slcan::{Event, Parser};
+pub use hwfoc_ports::can::slcan::{BEL, BITRATES, push_frame};
+use hwfoc_ports::can::slcan::{Event, Parser};
 
 /// The longest command kept; a longer line is refused whole (BEL).
 pub const MAX_LINE: usize = 64;

@@ -569,7 +569,7 @@ fn the_virtual_controller_asks_for_ids_while_no_motor_turns() {
     // the motors start, and an ESC that turns stops the requests.
     let (report, frames) = run("ask.log", true, 2.5);
     let asked: Vec<usize> = (0..frames.len())
-        .filter(|&i| kind(&frames[i]).0 == hwfoc_io::can::DEFAULT_SOURCE_NODE)
+        .filter(|&i| kind(&frames[i]).0 == hwfoc_ports::can::DEFAULT_SOURCE_NODE)
         .collect();
     assert_eq!(report.received, asked.len() as u64);
     assert_eq!(asked.len(), 2, "{asked:?}");

@@ -328,15 +328,23 @@ impl<const SLOTS: usize> Receiver<SLOTS> {
             }
         };
         if known && step_one && judged != Judged::Restart {
-            // The mean interval of transfers one id apart (an eighth of each new one).
+            // The mean interval of transfers one id apart (an eighth of each new one). One
+            // under half the mean is left out, and one over twice the mean counts as twice:
+            // frames bunched after a receiver's stall (intervals near 0) say nothing of the
+            // sender's period, and the stall itself moves it an eighth at most. A sender that
+            // slows down is followed at an eighth a transfer; one that more than doubles its
+            // rate at once is not (its gaps are then judged long, never more than 16 ids).
             let interval = i64::from(elapsed.min(0xFFF)) * 16;
             let period = i64::from(t.period);
             let mean = if period == 0 {
                 interval
+            } else if interval < period / 2 {
+                period
             } else {
-                period + (interval - period) / 8
+                period + (interval.min(period * 2) - period) / 8
             };
-            t.period = u16::try_from(mean.max(1)).unwrap_or(u16::MAX);
+            // 0 (a first interval under a millisecond) stays unknown.
+            t.period = u16::try_from(mean).unwrap_or(u16::MAX);
         }
         t.last_ms = now;
         t.flags = Timing::KNOWN;
@@ -501,7 +509,7 @@ impl<const SLOTS: usize> Receiver<SLOTS> {
         }
         slot.state = State::Free;
         if slot.crc != slot.carried_crc {
-            node.crc_error();
+            node.checksum_failure();
             return None;
         }
         let (buf, len) = (slot.buf, slot.len);

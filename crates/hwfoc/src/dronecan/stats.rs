@@ -302,10 +302,17 @@ impl NodeStats {
             }
             Judged::ByIds => (step == 0, base),
             // The count of ids skipped congruent to `base`, nearest to what the time held; a
-            // step of 0 is a duplicate when fewer than half a round of ids fit in it.
+            // step of 0 is a duplicate when fewer than half a round of ids fit in it. A step
+            // of 1 (the next id) skipped none, however long it took: a receiver that stalled
+            // and got the frames late and bunched, or a sender that slowed down, is far more
+            // likely than exactly 32, 64, ... transfers lost, which it would then not count.
             Judged::Expected(expected) => {
                 let skipped = expected.saturating_sub(1);
-                let rounds = (skipped + 16).saturating_sub(base) / 32;
+                let rounds = if step == 1 {
+                    0
+                } else {
+                    (skipped + 16).saturating_sub(base) / 32
+                };
                 (
                     step == 0 && skipped < 16,
                     base.saturating_add(rounds.saturating_mul(32)),
@@ -344,7 +351,7 @@ impl NodeStats {
     pub(crate) fn toggle_error(&mut self) {
         bump(&mut self.toggle_errors);
     }
-    pub(crate) fn crc_error(&mut self) {
+    pub(crate) fn checksum_failure(&mut self) {
         bump(&mut self.checksum_failures);
     }
     pub(crate) fn too_long_transfer(&mut self) {

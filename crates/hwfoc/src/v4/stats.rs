@@ -50,6 +50,10 @@ pub struct Stats {
     chain: Option<Chain>,
     last_info: Option<InfoFrame>,
     adopted: Option<InfoFrame>,
+    /// Whether the last info frame differs from the adopted one (not yet confirmed): then no
+    /// constants are in use ([`Stats::in_use`]). Set where an info frame is accepted, the only
+    /// place the two above change, since every candidate reads it (as the C header's flag).
+    unconfirmed_info: bool,
 }
 
 impl Default for Stats {
@@ -70,6 +74,7 @@ impl Stats {
             chain: None,
             last_info: None,
             adopted: None,
+            unconfirmed_info: false,
         }
     }
 
@@ -121,10 +126,11 @@ impl Stats {
     /// copy, as after a swap, or a corrupted copy): then none, as before any info frame, so that
     /// no frame of a new ESC is scaled by the old one's constants.
     #[inline]
-    pub fn in_use(&self) -> Option<InfoFrame> {
-        match self.last_info {
-            Some(last) if self.adopted.is_some_and(|a| a != last) => None,
-            _ => self.adopted,
+    pub const fn in_use(&self) -> Option<InfoFrame> {
+        if self.unconfirmed_info {
+            None
+        } else {
+            self.adopted
         }
     }
 
@@ -138,7 +144,7 @@ impl Stats {
     /// judged by the scale it would be decoded under, so an accepted frame is never above 100 %
     /// (after a swap, a frame above 1000 before the new constants are confirmed is rejected).
     #[inline]
-    pub fn full_scale(&self) -> u16 {
+    pub const fn full_scale(&self) -> u16 {
         match self.in_use() {
             Some(info) => info.full_scale,
             None => DEFAULT_FULL_SCALE,
@@ -266,6 +272,7 @@ impl Stats {
             self.disagreements = self.disagreements.saturating_add(1);
         }
         self.last_info = Some(*info);
+        self.unconfirmed_info = self.adopted.is_some_and(|adopted| adopted != *info);
         // A chained info frame keeps the counter the chain expects next; one that starts a
         // chain (confirmed by the data frame after it) lets that frame bring any counter.
         let next = match self.chain {

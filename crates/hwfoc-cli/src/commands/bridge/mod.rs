@@ -24,7 +24,7 @@ use hwfoc_io::OpenInput;
 use hwfoc_io::PortStreams;
 use hwfoc_io::SettingsMap;
 use hwfoc_io::Sources;
-use hwfoc_io::serial::{self, PortEvent};
+use hwfoc_ports::serial::{self, PortEvent};
 
 use crate::args::{ProtocolArgs, SettingsArgs, seconds};
 use crate::commands::monitor::feed::{Feed, Msg};
@@ -195,7 +195,7 @@ pub fn run(args: &BridgeArgs) -> Result<(), CliError> {
         if let Some(protocol) = protocol {
             streams.force_protocol(protocol);
         }
-        if baud == hwfoc_io::serial::Baud::Auto && args.sim.is_none() {
+        if baud == hwfoc_ports::serial::Baud::Auto && args.sim.is_none() {
             streams.auto_baud();
         }
         let per_byte_ns = hwfoc::wire::byte_ns(baud.initial());
@@ -288,7 +288,7 @@ fn live(
     errors: &mut Errors,
 ) -> Result<(), CliError> {
     let stop = crate::stop::interrupted();
-    let clock = hwfoc_io::clock::ReceiveClock::new();
+    let clock = hwfoc_ports::clock::ReceiveClock::new();
     while !stop.load(Ordering::Relaxed) && deadline.is_none_or(|d| Instant::now() < d) {
         let mut msg = match rx.recv_timeout(POLL) {
             Ok(msg) => Some(msg),
@@ -315,7 +315,7 @@ fn take(
     names: &[String],
     streams: &mut PortStreams,
     per_byte_ns: f64,
-    clock: &hwfoc_io::clock::ReceiveClock,
+    clock: &hwfoc_ports::clock::ReceiveClock,
     fanout: &mut Fanout,
 ) {
     match event {

@@ -13,7 +13,7 @@ use std::time::Duration;
 
 use clap::{Args, Subcommand};
 use hwfoc_can_setup::Client;
-use hwfoc_io::can::CanBus;
+use hwfoc_ports::can::CanBus;
 
 use crate::error::CliError;
 
@@ -58,7 +58,7 @@ struct BusArgs {
     #[arg(value_name = "BUS")]
     bus: String,
     /// The node id hwfoc sends from.
-    #[arg(long, value_name = "N", default_value_t = hwfoc_io::can::DEFAULT_SOURCE_NODE,
+    #[arg(long, value_name = "N", default_value_t = hwfoc_ports::can::DEFAULT_SOURCE_NODE,
           value_parser = clap::value_parser!(u8).range(1..=127))]
     source: u8,
     /// How long to wait for each answer of an ESC, seconds.
@@ -87,9 +87,9 @@ impl BusArgs {
 
     /// The bit rate the bus was opened at, where known (an `slcan:` bus's).
     fn bitrate(&self) -> Option<u32> {
-        match hwfoc_io::can::CanSpec::parse(&self.bus).ok()? {
-            hwfoc_io::can::CanSpec::Slcan { bitrate, .. } => Some(bitrate),
-            hwfoc_io::can::CanSpec::SocketCan { .. } => None,
+        match hwfoc_ports::can::CanSpec::parse(&self.bus).ok()? {
+            hwfoc_ports::can::CanSpec::Slcan { bitrate, .. } => Some(bitrate),
+            hwfoc_ports::can::CanSpec::SocketCan { .. } => None,
         }
     }
 

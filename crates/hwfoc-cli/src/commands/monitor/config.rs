@@ -33,7 +33,7 @@ use std::path::PathBuf;
 
 use hwfoc::Protocol;
 use hwfoc_io::SettingsMap;
-use hwfoc_io::serial;
+use hwfoc_ports::serial;
 
 use super::alarms::Threshold;
 use crate::args::SettingsArgs;
@@ -252,7 +252,7 @@ fn invalid(origin: String, message: impl Into<String>) -> CliError {
 mod tests {
     use super::*;
     use hwfoc::Settings;
-    use hwfoc_io::serial::Baud;
+    use hwfoc_ports::serial::Baud;
 
     fn parse(text: &str) -> Result<MonitorSetup, CliError> {
         let dir = tempfile::tempdir().unwrap();
@@ -282,7 +282,7 @@ mod tests {
         let six = config.limits.voltage(6);
         assert_eq!((six.warning, six.hysteresis), (3.5 * 6.0, 0.1 * 6.0));
         assert!((six.critical - 19.8).abs() < 1e-9 && six.low_is_bad);
-        assert_eq!(config.baud, hwfoc_io::serial::Baud::Auto);
+        assert_eq!(config.baud, hwfoc_ports::serial::Baud::Auto);
         assert_eq!(config.settings, SettingsMap::from(Settings::DEFAULT));
         assert!(config.ports.is_empty());
         assert_eq!(config.record_dir, default_record_dir());

@@ -13,8 +13,8 @@ use hwfoc::Settings;
 
 use crate::commands::simulate::ModelArgs;
 use crate::error::CliError;
-use hwfoc_io::serial::{Baud, PortEvent, Readers};
 use hwfoc_io::write::WriteError;
+use hwfoc_ports::serial::{Baud, PortEvent, Readers};
 use hwfoc_sim::{Sink, VirtualFleet};
 
 /// What the monitor's loop receives.

@@ -6,8 +6,8 @@ use std::collections::{BTreeMap, HashMap, VecDeque};
 
 use hwfoc::Settings;
 use hwfoc::telemetry::Info;
-use hwfoc_io::can::{CanSpec, is_can_spec};
 use hwfoc_io::{EscLink, WireKind};
+use hwfoc_ports::can::{CanSpec, is_can_spec};
 
 use super::alarms::{Change, FaultBit, Kind, Latch, Level, Threshold};
 use super::config::Limits;
@@ -18,7 +18,7 @@ use hwfoc_io::PortStreams;
 use hwfoc_io::SettingsMap;
 use hwfoc_io::energy::Energy;
 use hwfoc_io::record::Record;
-use hwfoc_io::serial::{Baud, PortEvent};
+use hwfoc_ports::serial::{Baud, PortEvent};
 
 /// Seconds of history kept for the charts.
 pub const HISTORY_S: f64 = 60.0;
@@ -315,7 +315,7 @@ impl EscView {
                 s.duplicate_packets()
             ));
         }
-        match s.rejected_frames() {
+        match s.rejected_candidates() {
             Some(rejected) => parts.push(format!("rejected {rejected}")),
             None => parts.push(format!("crc {}", s.checksum_failures())),
         }

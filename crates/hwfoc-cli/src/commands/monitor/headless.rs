@@ -301,7 +301,7 @@ pub(super) fn status_json(esc: &EscView, now: f64) -> Value {
         "duplicates": counted.then(|| esc.stats.duplicate_packets()),
         "restarts": counted.then(|| esc.stats.restarts()),
         "checksum_failures": esc.stats.has_checksum().then(|| esc.stats.checksum_failures()),
-        "rejected_frames": esc.stats.rejected_frames(),
+        "rejected_frames": esc.stats.rejected_candidates(),
         "bytes": esc.stats.bytes(),
         "bytes_skipped": esc.stats.bytes_skipped(),
         "bytes_at_other_rates": esc.discarded,

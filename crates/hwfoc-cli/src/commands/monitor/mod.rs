@@ -29,7 +29,7 @@ use super::record::{self, Recorder};
 use crate::args::{ProtocolArgs, SettingsArgs};
 use crate::commands::simulate::ModelArgs;
 use crate::error::CliError;
-use hwfoc_io::serial::{Baud, PortEvent};
+use hwfoc_ports::serial::{Baud, PortEvent};
 
 /// The most virtual ESCs `--sim` runs.
 const MAX_SIM: u16 = 64;
@@ -177,7 +177,7 @@ pub struct Session {
     rx: Receiver<Msg>,
     tx: mpsc::Sender<Msg>,
     feed: Option<Feed>,
-    clock: hwfoc_io::clock::ReceiveClock,
+    clock: hwfoc_ports::clock::ReceiveClock,
     names: Vec<String>,
     baud: Baud,
     /// The ports' rates found from their bytes (and what the streams found to tell, such as two
@@ -262,7 +262,7 @@ impl Session {
         // The ports' own clock, so that ages and recordings agree with their timestamps.
         let clock = match &feed {
             Feed::Ports(readers) => readers.clock(),
-            Feed::Simulated { .. } => hwfoc_io::clock::ReceiveClock::new(),
+            Feed::Simulated { .. } => hwfoc_ports::clock::ReceiveClock::new(),
         };
         let now = clock.now_ns() as f64 / 1e9;
         // Virtual ESCs send at the rate they are given: nothing to find.

@@ -26,12 +26,12 @@ use hwfoc::{Settings, Status};
 use crate::error::CliError;
 use crate::shown::{COUNT, Shown, Values, values};
 use hwfoc_io::Handler;
-use hwfoc_io::clock::Step;
 use hwfoc_io::energy::{self, Energy};
 use hwfoc_io::record::Record;
 use hwfoc_io::summary::{Episode, Mark};
 use hwfoc_io::write::WriteError;
 use hwfoc_io::{Selection, Window};
+use hwfoc_ports::clock::Step;
 
 /// A pause longer than this between two data frames of an ESC (idle frames come every
 /// ~364 ms) is a gap in the recording: lines are not drawn across it.
