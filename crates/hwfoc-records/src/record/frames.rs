@@ -87,9 +87,10 @@ impl DataFrames {
     /// Frame `i` (within `0..len()`).
     #[inline]
     pub fn get(&self, i: usize) -> Data {
-        match self.slice(i..i + 1) {
-            FrameSlice::HwFoc(f) => Data::HwFoc(f[0]),
-            FrameSlice::Any(f) => f[0],
+        if self.any.is_empty() {
+            Data::HwFoc(self.hwfoc[i])
+        } else {
+            self.any[i]
         }
     }
 

@@ -4,7 +4,7 @@
 //! The scanner is content-based: a candidate is a `9B` followed by a length byte 0x9E or 0xA0.
 //! It is rejected as soon as its version and command bytes are not `01 02` (a
 //! [bad header](Stats::bad_headers)), or once its 160 bytes are there and the CRC does
-//! not match (a [CRC failure](Stats::checksum_failures)); a rejected candidate costs one
+//! not match (a [checksum failure](Stats::checksum_failures)); a rejected candidate costs one
 //! byte: scanning resumes at the byte after its `9B`, so a lone `9B`, a fake header, a cut frame
 //! or garbage never hides a following intact frame. A verified frame is taken whole. Both
 //! decoders run the same scanner, so they give the same frames and statistics for the same

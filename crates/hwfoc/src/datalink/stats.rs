@@ -25,7 +25,7 @@ use super::layout::{BAUD_RATE, CHANNELS, FRAME_LEN, LengthByte};
 /// `8 * frames == records + empty_slots + bad_channels + duplicate_channels`.
 ///
 /// The hub's frame counter is followed exactly as [`foc::Stats`](crate::foc::Stats) follows an
-/// ESC's packet numbers (a [`PacketSequence`]: [lost frames](Stats::lost_packets),
+/// ESC's packet numbers (a [`PacketSequence`]: [lost packets](Stats::lost_packets),
 /// [duplicates](Stats::duplicate_frames), [restarts](Stats::restarts)), and so
 /// is each channel's packet number, record after record. A channel's lost packets are the
 /// numbers the stream did not carry, whether the ESC's own wire lost them or the hub forwarded

@@ -333,7 +333,8 @@ impl<const SLOTS: usize> Receiver<SLOTS> {
             // frames bunched after a receiver's stall (intervals near 0) say nothing of the
             // sender's period, and the stall itself moves it an eighth at most. A sender that
             // slows down is followed at an eighth a transfer; one that more than doubles its
-            // rate at once is not (its gaps are then judged long, never more than 16 ids).
+            // rate at once is not (its period stays long, and a gap's time over it then counts
+            // fewer transfers than the gap held).
             let interval = i64::from(elapsed.min(0xFFF)) * 16;
             let period = i64::from(t.period);
             let mean = if period == 0 {

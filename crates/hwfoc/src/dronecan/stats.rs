@@ -102,7 +102,7 @@ impl BusStats {
 /// Every DroneCAN frame a node sends is counted in [`NodeStats::frames`]; every transfer it
 /// starts ends in exactly one of: decoded ([`NodeStats::transfers`]), a
 /// [duplicate](NodeStats::duplicates), a [toggle error](NodeStats::toggle_errors), a
-/// [CRC error](NodeStats::checksum_failures), [too long](NodeStats::too_long), a
+/// [checksum failure](NodeStats::checksum_failures) (a CRC that did not match), [too long](NodeStats::too_long), a
 /// [short frame](NodeStats::short_frames), a [bad payload](NodeStats::bad_payloads),
 /// [cut short](NodeStats::cut_short), or an [unknown type](NodeStats::unknown_types); a
 /// transfer still being received is none of them yet.

@@ -11,7 +11,7 @@
 //!    is an [unknown type](Stats::unknown_types) (its length cannot be known);
 //! 3. for telemetry, its payload length byte (byte 6) `17`, else a bad header;
 //! 4. the CRC over each allowed length in turn: the first that matches makes it a frame of that
-//!    kind; none is a [CRC failure](Stats::checksum_failures).
+//!    kind; none is a [checksum failure](Stats::checksum_failures).
 //!
 //! A rejected candidate costs one byte: scanning resumes at the byte after its start, so a
 //! fake header, a cut or unknown frame or garbage never hides a following intact frame. A

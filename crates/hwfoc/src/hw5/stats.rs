@@ -16,7 +16,7 @@ use super::layout::{Direction, Kind};
 ///
 /// Every candidate (`FE 01` or `01 FD`) that is not a frame is counted once, as a
 /// [bad header](Stats::bad_headers), an [unknown type](Stats::unknown_types), a
-/// [CRC failure](Stats::checksum_failures) or [out of range](Stats::out_of_range), except one cut off by the end of the stream, which is
+/// [checksum failure](Stats::checksum_failures) or [out of range](Stats::out_of_range), except one cut off by the end of the stream, which is
 /// only skipped.
 ///
 /// There is no packet counter on the wire, so no loss is counted here: the layers above judge

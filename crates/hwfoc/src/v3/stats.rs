@@ -23,7 +23,7 @@ use super::frame::{FRAME_LEN, Frame};
 ///
 /// The counter of accepted frames is followed as [`foc::Stats`](crate::foc::Stats) follows an
 /// ESC's packet numbers, in 24 bits ([`PacketSequence24`]): the step to the first frame of each
-/// new chain tells [lost frames](Stats::lost_packets), a [duplicate](Stats::duplicate_frames) or
+/// new chain tells [lost packets](Stats::lost_packets), a [duplicate](Stats::duplicate_frames) or
 /// a [restart](Stats::restarts).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
 pub struct Stats {

@@ -38,7 +38,7 @@ struct Chain {
 /// not counted).
 ///
 /// The data frames' counter is followed in 24 bits ([`PacketSequence24`]): the step to the
-/// first frame of each new chain tells [lost frames](Stats::lost_packets), a
+/// first frame of each new chain tells [lost packets](Stats::lost_packets), a
 /// [duplicate](Stats::duplicate_frames) or a [restart](Stats::restarts).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub struct Stats {
