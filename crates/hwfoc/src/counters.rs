@@ -315,6 +315,7 @@ impl<W: Width> Sequence<W> {
             self.last = W::number(number);
             return;
         }
+        rare();
         let mut mark = W::ZERO;
         if self.count != 0 {
             let swap = gap_limit == W::MAX;
@@ -347,6 +348,14 @@ impl<W: Width> Sequence<W> {
         self.last = W::number(number);
     }
 }
+
+/// Marks the path that calls it as rare (what `core::hint::cold_path` does from Rust 1.95,
+/// above the codec's minimum Rust version): the usual step of [`Sequence::next`] then
+/// stays the straight path through a decoder's loop however the code around it is laid out,
+/// which keeps the clean stream's decoding speed from hanging on the scanner's other paths.
+#[cold]
+#[inline(always)]
+fn rare() {}
 
 #[cfg(test)]
 mod tests {

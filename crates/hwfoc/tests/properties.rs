@@ -66,7 +66,8 @@ enum Piece {
     Garbage(Vec<u8>),
     /// The first `n` bytes of a frame (`1 <= n < wire_len`).
     Cut(Frame, usize),
-    /// A header with nothing of its frame after it: `9B 16`, `9B 4C` or a lone `9B`.
+    /// A header with nothing of its frame after it: `9B 16`, `9B 4C`, a lone `9B`, or a kind's
+    /// whole header (which the scanner's search windows must verify and reject).
     Fake(&'static [u8]),
 }
 
@@ -80,6 +81,8 @@ fn piece() -> impl Strategy<Value = Piece> {
             Just(&[0x9B, 0x16][..]),
             Just(&[0x9B, 0x4C][..]),
             Just(&[0x9B][..]),
+            Just(&[0x9B, 0x16, 0x01, 0x02][..]),
+            Just(&[0x9B, 0x4C, 0x01, 0x01][..]),
         ]
         .prop_map(Piece::Fake),
     ]

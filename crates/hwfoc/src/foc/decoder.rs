@@ -9,6 +9,14 @@
 //! byte: scanning resumes at the byte after the rejected `0x9B`, so a lone `0x9B`, a fake header,
 //! a cut frame or a run of garbage never hides a following intact frame.
 //!
+//! How it looks for the next frame after one it took: first a frame of the first kind right
+//! there (back-to-back frames), then of any kind; else, while a window of 64 positions and a
+//! whole frame's bytes are left, [`crate::foc::window`] finds every candidate and header of the
+//! window at once, and the first header whose frame verifies is taken, every candidate before it
+//! counted rejected (so line noise and fake headers cost no branch each); near the end of the
+//! bytes, a word-at-a-time search for the next candidate decides them one by one, as a
+//! [`Decoder`] must when a candidate may still be arriving. Both ways count the same.
+//!
 //! The scanner names no frame kind: it asks the list of kinds in [`crate::foc::frame`] whether a
 //! frame starts at a candidate, and how long a candidate with a given length byte is. Those calls
 //! are inlined with every kind's constants: no dynamic dispatch, no function pointer, and no loop
@@ -16,6 +24,7 @@
 
 use crate::foc::frame::{Frame, MAX_FRAME_LEN, candidate_len, or_length_bytes, wire_len_of};
 use crate::foc::stats::Stats;
+use crate::foc::window::{WINDOW, WINDOW_BYTES, Window, window};
 use crate::scan::{self, Candidate, Scan, StreamDecoder};
 use crate::wire::SYNC;
 
@@ -111,6 +120,21 @@ fn scan_next(
     if first_guess && let Some(found) = Frame::take_first(data, pos, stats) {
         return Some(found);
     }
+    // A frame of any kind right here (a device-information frame among data frames).
+    if let Some(found) = Frame::take(data, pos, stats) {
+        return Some(found);
+    }
+    // Then whole windows, counted here from what the search found.
+    let searched = search_windows(data, *pos);
+    stats.checksum_failures_n(searched.rejected);
+    stats.skip(searched.skipped);
+    *pos += searched.skipped;
+    if searched.found
+        && let Some(found) = Frame::take(data, pos, stats)
+    {
+        return Some(found);
+    }
+    // The last bytes, one candidate at a time.
     loop {
         let Some(k) = find_header(&data[*pos..]) else {
             stats.skip(data.len() - *pos);
@@ -127,6 +151,61 @@ fn scan_next(
         }
         stats.skip(1);
         *pos = i + 1;
+    }
+}
+
+/// What [`search_windows`] found.
+struct Searched {
+    /// Bytes passed over, to the frame found or the end of the last window.
+    skipped: usize,
+    /// Candidates among them, each a checksum failure.
+    rejected: u32,
+    /// Whether a frame starts after the bytes passed over.
+    found: bool,
+}
+
+/// Searches `data` from `from` a window at a time, where the target has one
+/// ([`crate::foc::window`]), while a whole frame's bytes follow the window's last position:
+/// then every candidate in it is complete, and its candidates are decided together, the first
+/// header that verifies a frame, every candidate before it rejected.
+///
+/// Out of line, and it counts nothing itself (no statistics pass through it): the loop over
+/// back-to-back frames that calls it keeps its counts in registers.
+#[inline(never)]
+fn search_windows(data: &[u8], from: usize) -> Searched {
+    let mut searched = Searched {
+        skipped: 0,
+        rejected: 0,
+        found: false,
+    };
+    loop {
+        let start = from + searched.skipped;
+        let Some(w) = data
+            .get(start..start + WINDOW + MAX_FRAME_LEN)
+            .and_then(|w| w.first_chunk::<WINDOW_BYTES>())
+        else {
+            return searched;
+        };
+        let Some(Window {
+            candidates,
+            mut headers,
+        }) = window(w)
+        else {
+            return searched;
+        };
+        while headers != 0 {
+            let k = headers.trailing_zeros() as usize;
+            if Frame::verifies(data, start + k) {
+                let before = candidates & ((1 << k) - 1);
+                searched.rejected = searched.rejected.saturating_add(before.count_ones());
+                searched.skipped += k;
+                searched.found = true;
+                return searched;
+            }
+            headers &= headers - 1;
+        }
+        searched.rejected = searched.rejected.saturating_add(candidates.count_ones());
+        searched.skipped += WINDOW;
     }
 }
 

@@ -40,7 +40,15 @@ macro_rules! frame_kinds {
         const KINDS: &[Kind] = &[$(Kind::of::<$kind>()),+];
 
         /// The length byte of every kind, in list order.
-        const LENGTH_BYTES: [u8; KINDS.len()] = [$(<$kind as FrameKind>::LENGTH_BYTE),+];
+        pub(crate) const LENGTH_BYTES: [u8; KINDS.len()] =
+            [$(<$kind as FrameKind>::LENGTH_BYTE),+];
+
+        /// The header of every kind, in list order (for the search window, on x86_64).
+        #[cfg_attr(
+            not(all(target_arch = "x86_64", target_feature = "sse2")),
+            allow(dead_code)
+        )]
+        pub(crate) const HEADERS: [[u8; 4]; KINDS.len()] = [$(<$kind as FrameKind>::HEADER),+];
 
         /// `f` of every kind's length byte, ORed: one expression with constants, never a loop
         /// (which LLVM does not always unroll).
@@ -135,6 +143,19 @@ macro_rules! frame_kinds {
                     }
                 )+
                 None
+            }
+
+            /// Whether a frame of some kind starts at `data[at..]` ([`Frame::take`] without
+            /// counting it or building it).
+            #[inline(always)]
+            pub(crate) fn verifies(data: &[u8], at: usize) -> bool {
+                let header = data[at..].first_chunk::<4>().map(|h| u32::from_le_bytes(*h));
+                $(
+                    if header == Some(<$kind as FrameKind>::HEADER_WORD) {
+                        return <$kind as FrameKind>::accept(&data[at..]).is_some();
+                    }
+                )+
+                false
             }
 
             /// Checks and decodes `candidate`, at least as long as the kinds with its length

@@ -10,6 +10,7 @@
 //! | `frame` | the list of kinds: [`Frame`], [`MAX_FRAME_LEN`], [`parse`], [`Parsed`], [`FrameError`] |
 //! | `stats` | the link statistics: [`Stats`] |
 //! | `decoder` | the scanner: [`Decoder`], [`frames`], [`Decoded`], under the streaming layer of [`crate::scan`] |
+//! | `window` | the scanner's search window: 64 positions' candidates and headers at once |
 //!
 //! Beside this module, [`crate::datalink`] holds the DataLink V2 hub's frame, scanner and
 //! statistics, built on [`crate::wire`], [`DataFrame`]'s payload and the scanner's sync-pair
@@ -78,6 +79,7 @@ pub(crate) mod description;
 pub(crate) mod frame;
 pub mod kinds;
 mod stats;
+pub(crate) mod window;
 
 /// Baud rate of the HW-FOC telemetry wire (8 data bits, no parity, 1 stop bit: 8N1).
 pub const BAUD_RATE: u32 = 19_200;

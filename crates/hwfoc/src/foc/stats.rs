@@ -153,6 +153,12 @@ impl Stats {
         self.checksum_failures = self.checksum_failures.saturating_add(1);
     }
 
+    /// Counts `n` checksum failures at once (the rejected candidates of a search window).
+    #[inline]
+    pub(crate) fn checksum_failures_n(&mut self, n: u32) {
+        self.checksum_failures = self.checksum_failures.saturating_add(n);
+    }
+
     #[inline]
     pub(crate) fn info_frame(&mut self) {
         self.info_frames = self.info_frames.saturating_add(1);
