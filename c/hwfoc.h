@@ -1126,8 +1126,10 @@ static int hwfoc__v4_found_at(const uint8_t *c, size_t n, size_t at, unsigned fu
         info->full_scale = hwfoc__be16(b + 2);
         info->v1 = b[5]; info->v2 = b[6]; info->i1 = b[7]; info->i2 = b[8]; info->i3 = b[9];
         info->t1 = b[10]; info->t2 = b[11];
-        return info->full_scale != 0 && info->v2 != 0 && (info->i1 == 0 || info->i2 != 0)
-                   ? HWFOC__V4_INFO : HWFOC__V4_NOTHING;
+        if (info->full_scale != 0 && info->v2 != 0 && (info->i1 == 0 || info->i2 != 0))
+            return HWFOC__V4_INFO;
+        /* Not an info frame, but maybe a data frame with the same bytes there: a counter
+         * 0x9Bxxxx, an input throttle of 256 to 511, a voltage reading whose low byte is B9. */
     }
     if (n - at < HWFOC_V4_DATA_LEN) return HWFOC__V4_UNDECIDED;
     data->counter = hwfoc__be24(b + 1);

@@ -82,6 +82,29 @@ fn the_real_captures_decode_alike() {
     }
 }
 
+/// A V4 chain whose third data frame carries an info frame's fixed bytes (counter 0x9B0100, an
+/// input throttle of 256, a voltage reading of 0x05B9) but no plausible info frame's constants:
+/// both decoders read it as data, and all three frames are found.
+#[test]
+fn a_v4_data_frame_with_an_info_frames_fixed_bytes_decodes_alike() {
+    let mut bytes = vec![0x00];
+    for (counter, throttle_in_raw, voltage_adc) in [
+        (0x9B_00FE, 0, 0),
+        (0x9B_00FF, 0, 0),
+        (0x9B_0100, 256, 0x05B9),
+    ] {
+        let frame = v4::DataFrame {
+            counter,
+            throttle_in_raw,
+            voltage_adc,
+            ..Default::default()
+        };
+        bytes.extend_from_slice(&frame.encode());
+    }
+    let counts = all_formats(&[Op::Feed(bytes), Op::Flush]);
+    assert_eq!(counts[Format::V4 as usize], 3);
+}
+
 /// Random HW-FOC data and info frames, some dropped, duplicated, cut or corrupted, with noise.
 fn foc_stream(rng: &mut Rng, frames: usize) -> Vec<u8> {
     let mut out = Vec::new();

@@ -198,6 +198,47 @@ fn rich_random_bytes_hold_info_shapes_that_are_not_taken() {
     assert_eq!(v4::frames(&bytes).count(), 0);
 }
 
+/// A data frame can carry an info frame's fixed bytes (`9B 9B` at 0, `01` at 4, `B9` at 12):
+/// counter 0x9B0100, an input throttle of 256 and a voltage reading of 0x05B9. Where those
+/// bytes' constants are not a plausible info frame, it is read as the data frame it is, and
+/// the chain it confirms is not lost (found by `chains_decode_exactly`: before, none of the
+/// three frames was decoded).
+#[test]
+fn a_data_frame_with_an_info_frames_fixed_bytes_is_data() {
+    let frames = [
+        DataFrame {
+            counter: 0x9B_00FE,
+            ..Default::default()
+        },
+        DataFrame {
+            counter: 0x9B_00FF,
+            ..Default::default()
+        },
+        DataFrame {
+            counter: 0x9B_0100,
+            throttle_in_raw: 256,
+            voltage_adc: 0x05B9,
+            ..Default::default()
+        },
+    ];
+    let third = frames[2].encode();
+    assert_eq!(
+        [third[0], third[1], third[4], third[12]],
+        [0x9B, 0x9B, 0x01, 0xB9]
+    );
+    let mut wire = vec![0x00];
+    for f in &frames {
+        wire.extend_from_slice(&f.encode());
+    }
+    let (decoded, stats) = bulk::<Scanner>(&wire);
+    let counters: Vec<u32> = data_of(&decoded)
+        .iter()
+        .map(|(_, d)| d.frame.counter)
+        .collect();
+    assert_eq!(counters, [0x9B_00FE, 0x9B_00FF, 0x9B_0100]);
+    assert_eq!(stats.bytes_skipped(), 1);
+}
+
 #[test]
 fn temperature_matches_the_formula() {
     for adc in 1u16..4096 {

@@ -5,7 +5,8 @@
 //! fields and by the frames around it, in this order:
 //!
 //! 1. **Kind**: an info frame if it has the info frame's fixed bytes (`9B 9B` at 0, `01` at 4,
-//!    `B9` at 12), else a data frame.
+//!    `B9` at 12) and plausible constants, else a data frame (whose counter, throttle and voltage
+//!    may put the same bytes there).
 //! 2. **Plausible** ([`DataFrame::is_plausible`] under the full scale in use,
 //!    [`InfoFrame::is_plausible`]); otherwise rejected ([implausible](Stats::implausible)).
 //! 3. **An info frame** is accepted when a plausible data frame (any counter) starts right
@@ -108,11 +109,11 @@ fn found_at(c: &[u8], at: usize, full_scale: u16) -> Found {
     };
     if InfoFrame::has_fixed_bytes(head) {
         let info = InfoFrame::read(head);
-        return if info.is_plausible() {
-            Found::Info(info)
-        } else {
-            Found::Nothing
-        };
+        if info.is_plausible() {
+            return Found::Info(info);
+        }
+        // Not an info frame, but maybe a data frame with the same bytes there: a counter
+        // 0x9Bxxxx, an input throttle of 256 to 511 and a voltage reading whose low byte is B9.
     }
     let Some(bytes) = rest.first_chunk::<DATA_FRAME_LEN>() else {
         return Found::Undecided;
