@@ -14,7 +14,7 @@ use arrow_array::types::{
     Float32Type, Float64Type, Int8Type, TimestampMicrosecondType, UInt8Type, UInt16Type, UInt32Type,
 };
 use arrow_array::{ArrayRef, DictionaryArray, ListArray, PrimitiveArray, RecordBatch, StringArray};
-use arrow_buffer::NullBufferBuilder;
+use arrow_buffer::{NullBufferBuilder, OffsetBuffer, ScalarBuffer};
 use arrow_schema::{DataType, Field, FieldRef, Schema, SchemaRef, TimeUnit};
 use hwfoc::telemetry::Data;
 use hwfoc::{Protocol, Settings, Status};
@@ -141,35 +141,39 @@ impl ArrowValue for Option<UtcTime> {
 
 /// The fault lists of `values` (`None`: a null list), as one list array.
 ///
-/// The offsets of the lists and the names' offsets and bytes go straight into their buffers,
-/// without a builder call per row: most rows have no fault, an empty list, which is only its
-/// offset repeated; a null buffer is made only where a list is null (from the first).
+/// Most rows have no fault: an empty list, which is only its offset repeated. So the lists'
+/// offsets are written by one `extend` (no capacity check or overflow check per row, as
+/// `OffsetBufferBuilder::push_length` makes), a row's names looked up only where its fault word
+/// is not 0, and a null buffer made only where a list is null (from the first).
 fn fault_lists(values: impl ExactSizeIterator<Item = Option<FaultList>>) -> ArrayRef {
-    let mut lists = OffsetBufferBuilder::<i32>::new(values.len());
+    let mut offsets: Vec<i32> = Vec::with_capacity(values.len() + 1);
+    offsets.push(0);
     let mut names = OffsetBufferBuilder::<i32>::new(0);
     let mut bytes: Vec<u8> = Vec::new();
     // Its bitmap is made at the first null list only.
     let mut nulls = NullBufferBuilder::new(values.len());
-    for faults in values {
-        let Some(faults) = faults else {
-            nulls.append_null();
-            lists.push_length(0);
-            continue;
-        };
-        nulls.append_non_null();
-        let count = faults.0.0.count_ones() as usize;
-        if count != 0 {
-            for name in faults.names() {
-                bytes.extend_from_slice(name.as_bytes());
-                names.push_length(name.len());
+    let mut count: usize = 0;
+    offsets.extend(values.map(|faults| {
+        match faults {
+            None => nulls.append_null(),
+            Some(faults) => {
+                nulls.append_non_null();
+                if faults.0.0 != 0 {
+                    for name in faults.names() {
+                        bytes.extend_from_slice(name.as_bytes());
+                        names.push_length(name.len());
+                        count += 1;
+                    }
+                }
             }
         }
-        lists.push_length(count);
-    }
+        // At most 16 names a row, in a block of rows held in memory.
+        i32::try_from(count).expect("fewer than 2^31 fault names in a block")
+    }));
     let names = StringArray::new(names.finish(), bytes.into(), None);
     Arc::new(ListArray::new(
         fault_item(),
-        lists.finish(),
+        OffsetBuffer::new(ScalarBuffer::from(offsets)),
         Arc::new(names),
         nulls.finish(),
     ))
