@@ -1122,14 +1122,15 @@ static int hwfoc__v4_found_at(const uint8_t *c, size_t n, size_t at, unsigned fu
     if (at >= n) return HWFOC__V4_UNDECIDED;
     if (b[0] != HWFOC_SYNC) return HWFOC__V4_NOTHING;
     if (n - at < HWFOC_V4_INFO_LEN) return HWFOC__V4_UNDECIDED;
-    if (b[1] == HWFOC_SYNC && b[4] == HWFOC_V4_INFO_MARK && b[12] == HWFOC_V4_TRAILER) {
+    /* An info frame: its fixed bytes and plausible constants (full scale, V2 not 0; I2 not 0
+     * where I1 is not). Otherwise a data frame, which may carry the same fixed bytes: a counter
+     * 0x9Bxxxx, an input throttle of 256 to 511, a voltage reading whose low byte is B9. */
+    if (b[1] == HWFOC_SYNC && b[4] == HWFOC_V4_INFO_MARK && b[12] == HWFOC_V4_TRAILER &&
+        (b[2] | b[3]) != 0 && b[6] != 0 && (b[7] == 0 || b[8] != 0)) {
         info->full_scale = hwfoc__be16(b + 2);
         info->v1 = b[5]; info->v2 = b[6]; info->i1 = b[7]; info->i2 = b[8]; info->i3 = b[9];
         info->t1 = b[10]; info->t2 = b[11];
-        if (info->full_scale != 0 && info->v2 != 0 && (info->i1 == 0 || info->i2 != 0))
-            return HWFOC__V4_INFO;
-        /* Not an info frame, but maybe a data frame with the same bytes there: a counter
-         * 0x9Bxxxx, an input throttle of 256 to 511, a voltage reading whose low byte is B9. */
+        return HWFOC__V4_INFO;
     }
     if (n - at < HWFOC_V4_DATA_LEN) return HWFOC__V4_UNDECIDED;
     data->counter = hwfoc__be24(b + 1);
