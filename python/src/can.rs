@@ -9,7 +9,7 @@ use arrow_pyarrow::ToPyArrow;
 use arrow_schema::SchemaRef;
 use hwfoc::Settings;
 use hwfoc::dronecan::CanFrame;
-use hwfoc::telemetry::Frame;
+use hwfoc::telemetry::AnyFrame;
 use hwfoc_io::{Batch, Stream};
 use hwfoc_ports::clock::byte_times;
 use pyo3::exceptions::PyValueError;
@@ -114,9 +114,9 @@ fn frame_of(item: &Bound<'_, PyAny>) -> PyResult<(f64, CanFrame)> {
 }
 
 /// Gathers the data frames a bus's stream hands on, an ESC at slot `s` as ESC `esc + s`.
-fn gathering(gather: &mut Frames, esc: u8) -> impl FnMut(Option<f64>, Option<u8>, &Frame) + '_ {
+fn gathering(gather: &mut Frames, esc: u8) -> impl FnMut(Option<f64>, Option<u8>, &AnyFrame) + '_ {
     move |t, slot, d| {
-        if let Frame::Data(f) = d {
+        if let AnyFrame::Data(f) = d {
             gather.push(t, slot.map_or(esc, |s| esc.saturating_add(s)), f);
         }
     }

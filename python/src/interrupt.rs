@@ -6,7 +6,7 @@ use std::time::{Duration, Instant};
 
 use hwfoc::Settings;
 use hwfoc::foc::DataFrame;
-use hwfoc::telemetry::Frame;
+use hwfoc::telemetry::AnyFrame;
 use hwfoc_io::{Handler, InputError, LaterPart, Record};
 use pyo3::Python;
 
@@ -48,7 +48,7 @@ impl<H: Handler> Handler for Interruptible<H> {
     }
 
     #[inline]
-    fn frame(&mut self, esc: u8, t: Option<f64>, frame: &Frame, settings: &Settings) {
+    fn frame(&mut self, esc: u8, t: Option<f64>, frame: &AnyFrame, settings: &Settings) {
         self.inner.frame(esc, t, frame, settings);
     }
 

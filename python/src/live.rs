@@ -11,7 +11,7 @@ use arrow_array::RecordBatch;
 use arrow_pyarrow::ToPyArrow;
 use arrow_schema::SchemaRef;
 use hwfoc::Settings;
-use hwfoc::telemetry::Frame;
+use hwfoc::telemetry::AnyFrame;
 use hwfoc_io::Batch;
 use hwfoc_io::EscLink;
 use hwfoc_io::Handler;
@@ -57,8 +57,8 @@ struct Gather(Frames);
 impl Handler for Gather {
     type Error = InputError;
 
-    fn frame(&mut self, esc: u8, t: Option<f64>, frame: &Frame, _: &Settings) {
-        if let Frame::Data(f) = frame {
+    fn frame(&mut self, esc: u8, t: Option<f64>, frame: &AnyFrame, _: &Settings) {
+        if let AnyFrame::Data(f) = frame {
             self.0.push(t, esc, f);
         }
     }
@@ -214,7 +214,7 @@ impl Decoder {
             };
             // From a DataLink hub, channel `c` is ESC `esc + c`.
             stream.feed(batch, |t, channel, d| {
-                if let Frame::Data(f) = d {
+                if let AnyFrame::Data(f) = d {
                     gather
                         .0
                         .push(t, channel.map_or(esc, |c| esc.saturating_add(c)), f);
@@ -245,7 +245,7 @@ impl Decoder {
         let esc = self.esc;
         let mut state = self.lock()?;
         state.stream.finish(|t, channel, d| {
-            if let Frame::Data(f) = d {
+            if let AnyFrame::Data(f) = d {
                 gather
                     .0
                     .push(t, channel.map_or(esc, |c| esc.saturating_add(c)), f);

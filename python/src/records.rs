@@ -8,7 +8,7 @@ use arrow_data::ArrayData;
 use arrow_schema::{DataType, SchemaRef};
 use hwfoc::Settings;
 use hwfoc::foc::DataFrame;
-use hwfoc::telemetry::{Data, Frame};
+use hwfoc::telemetry::{Data, AnyFrame};
 use hwfoc_io::Handler;
 use hwfoc_io::InputError;
 use hwfoc_io::Selection;
@@ -315,8 +315,8 @@ impl<F: FnMut(Frames) -> Result<(), Stop>> Handler for Collect<F> {
     type Error = Stop;
 
     #[inline]
-    fn frame(&mut self, esc: u8, t: Option<f64>, frame: &Frame, _: &Settings) {
-        if let Frame::Data(frame) = frame {
+    fn frame(&mut self, esc: u8, t: Option<f64>, frame: &AnyFrame, _: &Settings) {
+        if let AnyFrame::Data(frame) = frame {
             if let Some(t) = t.filter(|_| self.selection.esc(esc)) {
                 let (first, last) = self.span.get_or_insert((t, t));
                 *first = first.min(t);

@@ -142,7 +142,7 @@ impl DatalinkOutput {
         // is lost, as on a real line, and the next one carries the next frames.
         let carried: [Option<Slot>; datalink::CHANNELS] =
             std::array::from_fn(|i| self.slots[i].pop_front());
-        let frame = datalink::Frame {
+        let frame = datalink::HubFrame {
             counter: self.counter,
             slots: carried.map(|slot| slot.map(|s| s.frame)),
         };

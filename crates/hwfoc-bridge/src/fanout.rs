@@ -4,7 +4,7 @@ use std::collections::BTreeSet;
 use std::time::Instant;
 
 use hwfoc::Settings;
-use hwfoc::telemetry::Frame;
+use hwfoc::telemetry::AnyFrame;
 use hwfoc_io::{Handler, InputError, Record};
 
 use crate::output::{Output, OutputError, Update};
@@ -64,8 +64,8 @@ impl Fanout {
 impl Handler for Fanout {
     type Error = InputError;
 
-    fn frame(&mut self, esc: u8, t: Option<f64>, frame: &Frame, settings: &Settings) {
-        let Frame::Data(frame) = frame else {
+    fn frame(&mut self, esc: u8, t: Option<f64>, frame: &AnyFrame, settings: &Settings) {
+        let AnyFrame::Data(frame) = frame else {
             return;
         };
         let record = Record::new(t, esc, frame, settings);

@@ -15,7 +15,7 @@ use std::fmt;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 
-use hwfoc::telemetry::{Frame, Telemetry};
+use hwfoc::telemetry::{AnyFrame, Telemetry};
 use hwfoc::{Protocol, Settings};
 use hwfoc_io::energy::nominal_period_s;
 use hwfoc_io::{Handler, InputError};
@@ -211,13 +211,13 @@ impl<'a, E: FnMut(OutputError)> Replay<'a, E> {
 impl<E: FnMut(OutputError)> Handler for Replay<'_, E> {
     type Error = ReplayError;
 
-    fn frame(&mut self, esc: u8, t: Option<f64>, frame: &Frame, settings: &Settings) {
+    fn frame(&mut self, esc: u8, t: Option<f64>, frame: &AnyFrame, settings: &Settings) {
         if self.stop.load(Ordering::Relaxed) {
             return;
         }
         let (protocol, packet) = match frame {
-            Frame::Data(f) => (Some(f.protocol()), f.packet()),
-            Frame::Info(_) => (None, None),
+            AnyFrame::Data(f) => (Some(f.protocol()), f.packet()),
+            AnyFrame::Info(_) => (None, None),
         };
         let due = self.due(esc, t, protocol, packet);
         let now = self.wait(due);

@@ -77,7 +77,7 @@ fn crc_xmodem(bytes: &[u8]) -> u16 {
     crc
 }
 
-fn frames_written(shared: &Shared) -> Vec<datalink::Frame> {
+fn frames_written(shared: &Shared) -> Vec<datalink::HubFrame> {
     let bytes = shared.bytes.lock().unwrap().clone();
     assert_eq!(bytes.len() % datalink::FRAME_LEN, 0);
     for chunk in bytes.chunks(datalink::FRAME_LEN) {

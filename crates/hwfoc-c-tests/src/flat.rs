@@ -87,11 +87,11 @@ impl Flat for foc::Scanner {
     fn frame(item: &foc::Decoded, out: &mut Vec<u64>) {
         out.push(item.offset);
         match &item.frame {
-            foc::Frame::Data(d) => {
+            foc::FocFrame::Data(d) => {
                 out.push(0);
                 foc_data(d, out);
             }
-            foc::Frame::Info(i) => {
+            foc::FocFrame::Info(i) => {
                 out.push(1);
                 out.extend(i.text().iter().map(|&b| u64::from(b)));
             }
@@ -168,7 +168,7 @@ impl Flat for v4::Scanner {
     fn frame(item: &v4::Decoded, out: &mut Vec<u64>) {
         out.push(item.offset);
         match &item.frame {
-            v4::Frame::Data(d) => {
+            v4::V4Frame::Data(d) => {
                 let f = &d.frame;
                 out.extend([0, f.counter.into()]);
                 out.extend([f.throttle_in_raw, f.throttle_out_raw].map(u64::from));
@@ -176,7 +176,7 @@ impl Flat for v4::Scanner {
                 out.extend([f.voltage_adc, f.current_adc, f.temp_adc, f.temp2_adc].map(u64::from));
                 opt_v4_info(d.info, out);
             }
-            v4::Frame::Info(i) => {
+            v4::V4Frame::Info(i) => {
                 out.push(1);
                 v4_info(i, out);
             }
@@ -198,8 +198,8 @@ impl Flat for v4::Scanner {
     }
     fn encode(item: &v4::Decoded) -> Vec<u8> {
         match &item.frame {
-            v4::Frame::Data(d) => d.frame.encode().to_vec(),
-            v4::Frame::Info(i) => i.encode().to_vec(),
+            v4::V4Frame::Data(d) => d.frame.encode().to_vec(),
+            v4::V4Frame::Info(i) => i.encode().to_vec(),
         }
     }
 }

@@ -148,7 +148,7 @@ fn datalink_stream(rng: &mut Rng, frames: usize) -> Vec<u8> {
     let mut counter = rng.bits() as u16;
     let mut packets = [0u16; 8];
     for _ in 0..frames {
-        let mut f = datalink::Frame::new(counter);
+        let mut f = datalink::HubFrame::new(counter);
         for (ch, slot) in f.slots.iter_mut().enumerate() {
             if rng.below(4) != 0 {
                 packets[ch] = packets[ch].wrapping_add(step(rng) as u16);
@@ -180,7 +180,7 @@ fn v3_stream(rng: &mut Rng, frames: usize) -> Vec<u8> {
     let mut out = Vec::new();
     let mut counter = rng.bits() as u32 & 0xFF_FFFF;
     for _ in 0..frames {
-        let f = v3::Frame {
+        let f = v3::V3Frame {
             counter,
             throttle_in_raw: rng.below(270) as u16,
             pwm_out_raw: rng.below(270) as u16,

@@ -23,7 +23,7 @@ fn run(ops: &[Op], mut check: impl FnMut(usize, &[u64], &[u64], &[u64], &[u64]))
     for (i, op) in ops.iter().enumerate() {
         let mut frames = Vec::new();
         apply(op, &mut rust, &mut c, |item: foc::Decoded| {
-            if let foc::Frame::Data(_) = item.frame {
+            if let foc::FocFrame::Data(_) = item.frame {
                 foc::Scanner::frame(&item, &mut frames);
             }
         });

@@ -52,8 +52,8 @@ fn foc_data(d: &foc::DataFrame, key: &str) -> Option<Value> {
 
 fn lookup_foc(item: &foc::Decoded, key: &str) -> Option<Value> {
     match &item.frame {
-        foc::Frame::Data(d) => foc_data(d, key),
-        foc::Frame::Info(i) => Some(Value::Text(
+        foc::FocFrame::Data(d) => foc_data(d, key),
+        foc::FocFrame::Info(i) => Some(Value::Text(
             match key {
                 "product" => i.product(),
                 "hardware" => i.hardware(),
@@ -108,8 +108,8 @@ fn v4_info(i: &v4::InfoFrame, key: &str) -> Option<Value> {
 
 fn lookup_v4(item: &v4::Decoded, key: &str) -> Option<Value> {
     let d = match &item.frame {
-        v4::Frame::Info(i) => return v4_info(i, key),
-        v4::Frame::Data(d) => d,
+        v4::V4Frame::Info(i) => return v4_info(i, key),
+        v4::V4Frame::Data(d) => d,
     };
     let f = &d.frame;
     Some(match key {

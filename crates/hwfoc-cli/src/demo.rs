@@ -100,7 +100,7 @@ pub fn capture_csv() -> Vec<u8> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use hwfoc::telemetry::Frame;
+    use hwfoc::telemetry::AnyFrame;
     use hwfoc::{Quantity, Telemetry};
     use hwfoc_io::Input;
     use hwfoc_io::Stream;
@@ -110,16 +110,16 @@ mod tests {
         let mut input = Input::from_memory("demo", capture_csv()).unwrap();
         let mut stream = Stream::new();
         let (mut data, mut info, mut faulted, mut braking) = (0, 0, 0, 0);
-        let mut on_frame = |t: Option<f64>, _channel: Option<u8>, frame: &Frame| {
+        let mut on_frame = |t: Option<f64>, _channel: Option<u8>, frame: &AnyFrame| {
             assert!(t.is_some());
             match frame {
-                Frame::Data(f) => {
+                AnyFrame::Data(f) => {
                     data += 1;
                     let status = f.status().unwrap();
                     faulted += usize::from(status.contains(Fault::ThrottleSignalLost));
                     braking += usize::from(f.raw(Quantity::Current).unwrap() < 0);
                 }
-                Frame::Info(i) => {
+                AnyFrame::Info(i) => {
                     assert_eq!(i.product(), "XR_FOC_ESC");
                     info += 1;
                 }

@@ -193,7 +193,7 @@ fn hub_bytes() -> Vec<u8> {
     };
     let mut bytes = Vec::new();
     for k in 0..10u16 {
-        let mut frame = datalink::Frame::new(k);
+        let mut frame = datalink::HubFrame::new(k);
         for channel in 0..3 {
             frame.slots[usize::from(channel)] = Some(esc(channel, k));
         }
@@ -372,7 +372,7 @@ fn the_monitor_shows_a_datalink_port_as_its_escs() {
     thread::spawn(move || {
         let mut k = 0u16;
         while !writing.load(Ordering::Relaxed) {
-            let mut frame = datalink::Frame::new(k);
+            let mut frame = datalink::HubFrame::new(k);
             for channel in [0usize, 1, 5] {
                 frame.slots[channel] = Some(DataFrame {
                     packet: k,

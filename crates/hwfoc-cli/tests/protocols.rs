@@ -34,7 +34,7 @@ fn esc(packets: std::ops::Range<u16>) -> Vec<u8> {
 fn hub(id: u16, counters: std::ops::Range<u16>, channels: &[usize]) -> Vec<u8> {
     counters
         .flat_map(|counter| {
-            let mut frame = datalink::Frame::new(counter);
+            let mut frame = datalink::HubFrame::new(counter);
             for &c in channels {
                 frame.slots[c] = Some(DataFrame {
                     packet: 1000 + 100 * id + c as u16,

@@ -14,7 +14,7 @@ use std::time::{Duration, Instant};
 
 use common::{Dir, assert_fails_with, hwfoc, ok};
 
-use hwfoc::foc::{Decoder, Frame};
+use hwfoc::foc::{Decoder, FocFrame};
 use serde_json::Value;
 
 fn run(args: &[&str]) -> Output {
@@ -215,7 +215,7 @@ fn frame_timing_from_a_recording() {
     let bytes = std::fs::read(dir.path("t.pcapng")).unwrap();
     let mut info = 0;
     Decoder::new().decode_all(&bytes, |d| {
-        if matches!(d.frame, Frame::Info(_)) {
+        if matches!(d.frame, FocFrame::Info(_)) {
             info += 1;
         }
     });
@@ -356,7 +356,7 @@ fn pseudo_terminals_carry_the_frames_in_real_time() {
     for (esc, got) in [got0, got1].iter().enumerate() {
         let mut frames = Vec::new();
         Decoder::new().decode_all(got, |d| {
-            if let Frame::Data(f) = d.frame {
+            if let FocFrame::Data(f) = d.frame {
                 frames.push(f);
             }
         });

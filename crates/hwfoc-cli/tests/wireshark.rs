@@ -18,7 +18,7 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 
 use common::{hwfoc, need_tshark, run};
-use hwfoc::foc::{DataFrame, Frame, InfoFrame};
+use hwfoc::foc::{DataFrame, FocFrame, InfoFrame};
 use hwfoc_io::pcapng;
 use serde_json::Value;
 
@@ -284,7 +284,7 @@ fn info_frames(file: &Path) -> Vec<(u32, InfoFrame)> {
     let mut out = Vec::new();
     for (i, s) in streams.iter().enumerate() {
         hwfoc::foc::Decoder::new().decode_all(s, |d| {
-            if let Frame::Info(info) = d.frame {
+            if let FocFrame::Info(info) = d.frame {
                 out.push((i as u32, info));
             }
         });

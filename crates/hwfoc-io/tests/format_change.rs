@@ -10,7 +10,7 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 
 use hwfoc::Settings;
 use hwfoc::Telemetry;
-use hwfoc::telemetry::Frame;
+use hwfoc::telemetry::AnyFrame;
 use hwfoc_io::{Handler, Input, InputError, OpenInput, Sources};
 use proptest::prelude::*;
 
@@ -46,13 +46,13 @@ impl Format {
         match self {
             Format::HwFoc => foc(n as u16).encode().to_vec(),
             Format::DataLink => {
-                let mut frame = hwfoc::datalink::Frame::new(n as u16);
+                let mut frame = hwfoc::datalink::HubFrame::new(n as u16);
                 for c in HUB_CHANNELS {
                     frame.slots[c] = Some(foc(1000 + c as u16 + n as u16));
                 }
                 frame.encode().to_vec()
             }
-            Format::V3 => hwfoc::v3::Frame {
+            Format::V3 => hwfoc::v3::V3Frame {
                 counter: n & 0xFF_FFFF,
                 throttle_in_raw: 51,
                 pwm_out_raw: 51,
@@ -99,8 +99,8 @@ struct Records(Vec<(u8, String, Option<u32>)>);
 impl Handler for Records {
     type Error = InputError;
 
-    fn frame(&mut self, esc: u8, _: Option<f64>, frame: &Frame, _: &Settings) {
-        if let Frame::Data(d) = frame {
+    fn frame(&mut self, esc: u8, _: Option<f64>, frame: &AnyFrame, _: &Settings) {
+        if let AnyFrame::Data(d) = frame {
             self.0
                 .push((esc, format!("{:?}", d.protocol()), Telemetry::packet(d)));
         }

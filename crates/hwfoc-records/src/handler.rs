@@ -5,7 +5,7 @@
 //! A front end (a command, a bridge, a binding) implements [`Handler::record`] and
 //! [`Handler::info`]: it sees records in physical units, the same whatever protocol the bytes
 //! were in, never the codec's frames. The library's own handlers (the writers, the summary)
-//! take the frames through [`Handler::frame`], as the protocol-neutral [`Frame`] read through
+//! take the frames through [`Handler::frame`], as the protocol-neutral [`AnyFrame`] read through
 //! [`hwfoc::Telemetry`], to convert a block at a time on their own threads or to keep raw
 //! integers for exact means; none of them names a protocol's frame type.
 
@@ -13,7 +13,7 @@ use std::any::Any;
 
 use hwfoc::Settings;
 use hwfoc::foc::DataFrame;
-use hwfoc::telemetry::{Data, Frame, Info};
+use hwfoc::telemetry::{AnyFrame, Data, Info};
 
 use crate::input::InputError;
 use crate::record::Record;
@@ -43,10 +43,10 @@ pub trait Handler {
     /// input has one. The default converts a data frame under `settings` and hands it to
     /// [`Handler::record`], and a device-information frame to [`Handler::info`].
     #[inline]
-    fn frame(&mut self, esc: u8, t: Option<f64>, frame: &Frame, settings: &Settings) {
+    fn frame(&mut self, esc: u8, t: Option<f64>, frame: &AnyFrame, settings: &Settings) {
         match frame {
-            Frame::Data(f) => self.record(&Record::new(t, esc, f, settings)),
-            Frame::Info(info) => self.info(esc, t, info),
+            AnyFrame::Data(f) => self.record(&Record::new(t, esc, f, settings)),
+            AnyFrame::Info(info) => self.info(esc, t, info),
         }
     }
 
@@ -67,7 +67,7 @@ pub trait Handler {
     #[inline]
     fn untimed_data(&mut self, esc: u8, frames: &[DataFrame], settings: &Settings) {
         for f in frames {
-            self.frame(esc, None, &Frame::Data(Data::HwFoc(*f)), settings);
+            self.frame(esc, None, &AnyFrame::Data(Data::HwFoc(*f)), settings);
         }
     }
 
@@ -100,7 +100,7 @@ pub trait Handler {
 /// input (which have no receive times) on a thread of its own.
 pub trait LaterPart: Send {
     /// A frame of ESC `esc`, as [`Handler::frame`] takes it (no receive time).
-    fn frame(&mut self, esc: u8, frame: &Frame, settings: &Settings);
+    fn frame(&mut self, esc: u8, frame: &AnyFrame, settings: &Settings);
 
     /// Data frames of ESC `esc`, as [`Handler::untimed_data`] takes them.
     fn untimed_data(&mut self, esc: u8, frames: &[DataFrame], settings: &Settings);
@@ -114,7 +114,7 @@ impl Handler for () {
     type Error = InputError;
 
     #[inline]
-    fn frame(&mut self, _: u8, _: Option<f64>, _: &Frame, _: &Settings) {}
+    fn frame(&mut self, _: u8, _: Option<f64>, _: &AnyFrame, _: &Settings) {}
 }
 
 /// Hands every frame to two handlers, each taking it its own way (as decoded, or as a record):
@@ -131,7 +131,7 @@ where
     const TAKES_RUNS: bool = A::TAKES_RUNS && B::TAKES_RUNS;
 
     #[inline]
-    fn frame(&mut self, esc: u8, t: Option<f64>, frame: &Frame, settings: &Settings) {
+    fn frame(&mut self, esc: u8, t: Option<f64>, frame: &AnyFrame, settings: &Settings) {
         self.0.frame(esc, t, frame, settings);
         self.1.frame(esc, t, frame, settings);
     }

@@ -27,7 +27,7 @@
 use std::collections::VecDeque;
 use std::rc::Rc;
 
-use hwfoc::foc::{DataFrame, Decoder, Frame, InfoFrame};
+use hwfoc::foc::{DataFrame, Decoder, FocFrame, InfoFrame};
 use hwfoc::telemetry::Data;
 use hwfoc::{Fault, Protocol, v4};
 
@@ -490,7 +490,7 @@ impl VirtualEsc {
                     expected.push_back(frame);
                 }
                 monitor.feed(part, |d| {
-                    if let Frame::Data(f) = d.frame {
+                    if let FocFrame::Data(f) = d.frame {
                         if expected.front() == Some(&f) {
                             expected.pop_front();
                         } else {
@@ -794,7 +794,7 @@ pub(crate) mod tests {
     pub(crate) fn decode(wire: &[u8]) -> Vec<DataFrame> {
         let mut out = Vec::new();
         Decoder::new().decode_all(wire, |d| {
-            if let Frame::Data(f) = d.frame {
+            if let FocFrame::Data(f) = d.frame {
                 out.push(f);
             }
         });
@@ -936,8 +936,8 @@ pub(crate) mod tests {
         let wire: Vec<u8> = all.iter().flat_map(|b| b.bytes.clone()).collect();
         let decoded: Vec<v4::Data> = v4::frames(&wire)
             .filter_map(|f| match f.frame {
-                v4::Frame::Data(d) => Some(d),
-                v4::Frame::Info(_) => None,
+                v4::V4Frame::Data(d) => Some(d),
+                v4::V4Frame::Info(_) => None,
             })
             .collect();
         assert_eq!(decoded.len(), data.len());

@@ -113,7 +113,7 @@ pub fn v4_frame(counter: u32, m: &Measured, info: &v4::InfoFrame, slow: bool) ->
 }
 
 /// A V3 frame of the measurements `m`.
-pub fn v3_frame(counter: u32, m: &Measured) -> v3::Frame {
+pub fn v3_frame(counter: u32, m: &Measured) -> v3::V3Frame {
     let throttle = |pct: f64| {
         (pct * f64::from(v3::FULL_SCALE) / 100.0)
             .round()
@@ -129,7 +129,7 @@ pub fn v3_frame(counter: u32, m: &Measured) -> v3::Frame {
     } else {
         v3::PLACEHOLDER_PERIOD_US
     };
-    v3::Frame {
+    v3::V3Frame {
         counter: counter & 0xFF_FFFF,
         throttle_in_raw: throttle(m.throttle_in_pct),
         pwm_out_raw: throttle(m.throttle_out_pct),

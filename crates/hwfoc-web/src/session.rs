@@ -5,7 +5,7 @@
 
 use hwfoc::Protocol;
 use hwfoc::Settings;
-use hwfoc::telemetry::{Data, Frame, Info};
+use hwfoc::telemetry::{AnyFrame, Data, Info};
 use hwfoc_records::energy::Energy;
 use hwfoc_records::serial::PortEvent;
 use hwfoc_records::{EscLink, Handler, InputError, PortStreams, Record};
@@ -225,10 +225,10 @@ impl Handler for Take<'_> {
         e.info = Some(info.to_string());
     }
 
-    fn frame(&mut self, esc: u8, t: Option<f64>, frame: &Frame, settings: &Settings) {
+    fn frame(&mut self, esc: u8, t: Option<f64>, frame: &AnyFrame, settings: &Settings) {
         match frame {
-            Frame::Data(data) => self.data(esc, t, data, settings),
-            Frame::Info(info) => self.info(esc, t, info),
+            AnyFrame::Data(data) => self.data(esc, t, data, settings),
+            AnyFrame::Info(info) => self.info(esc, t, info),
         }
     }
 }

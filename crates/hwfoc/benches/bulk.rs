@@ -47,7 +47,7 @@ use criterion::{BenchmarkGroup, Criterion, Throughput, criterion_group};
 use hwfoc::Status;
 use hwfoc::datalink::{self, FRAME_LEN};
 use hwfoc::foc;
-use hwfoc::foc::{DataFrame, Decoded, Decoder, Frame, InfoFrame, frames};
+use hwfoc::foc::{DataFrame, Decoded, Decoder, FocFrame, InfoFrame, frames};
 use hwfoc::scan::{Scan, Scanner, StreamDecoder};
 use hwfoc::wire::Checksum;
 use hwfoc::{hw5, v3, v4};
@@ -258,8 +258,8 @@ fn noisy_stream(hostile: bool) -> (Vec<u8>, Expected) {
 #[inline(always)]
 fn fold(acc: u64, d: &Decoded) -> u64 {
     let v = match d.frame {
-        Frame::Data(f) => u64::from(f.packet) ^ u64::from(f.status.0) << 16,
-        Frame::Info(i) => u64::from(i.text()[16]),
+        FocFrame::Data(f) => u64::from(f.packet) ^ u64::from(f.status.0) << 16,
+        FocFrame::Info(i) => u64::from(i.text()[16]),
     };
     acc.wrapping_mul(31).wrapping_add(v ^ d.offset)
 }
@@ -379,7 +379,7 @@ fn datalink_stream(noisy: bool) -> (Vec<u8>, Expected) {
         if noisy && rng.chance(350) {
             e.garbage_bytes += garbage(&mut rng, &mut buf, false);
         }
-        let mut frame = datalink::Frame::new(counter);
+        let mut frame = datalink::HubFrame::new(counter);
         counter = counter.wrapping_add(1);
         for (slot, esc) in frame.slots.iter_mut().zip(&mut escs) {
             *slot = Some(esc.next_data());
@@ -502,7 +502,7 @@ fn v3_stream(noisy: bool) -> (Vec<u8>, Expected) {
     stream_of(noisy, 0x0BAD_5EED_0000_0003, move |out| {
         let f = t.next_data();
         let erpm = u32::from(f.erpm_raw) * 10;
-        let frame = v3::Frame {
+        let frame = v3::V3Frame {
             counter,
             throttle_in_raw: (u32::from(f.throttle_in_raw) * 255 / 1024) as u16,
             pwm_out_raw: (u32::from(f.throttle_out_raw) * 255 / 1024) as u16,
@@ -701,8 +701,8 @@ fn fold_v3(acc: u64, d: &v3::Decoded) -> u64 {
 #[inline(always)]
 fn fold_v4(acc: u64, d: &v4::Decoded) -> u64 {
     let v = match d.frame {
-        v4::Frame::Data(f) => u64::from(f.frame.counter) ^ u64::from(f.frame.voltage_adc) << 24,
-        v4::Frame::Info(i) => u64::from(i.full_scale),
+        v4::V4Frame::Data(f) => u64::from(f.frame.counter) ^ u64::from(f.frame.voltage_adc) << 24,
+        v4::V4Frame::Info(i) => u64::from(i.full_scale),
     };
     acc.wrapping_mul(31).wrapping_add(v ^ d.offset)
 }

@@ -34,7 +34,7 @@
 //!
 //! let mut wire = Vec::new();
 //! for counter in 0..5 {
-//!     let frame = v3::Frame { counter, throttle_in_raw: 51, pwm_out_raw: 51, period_us: 1500 };
+//!     let frame = v3::V3Frame { counter, throttle_in_raw: 51, pwm_out_raw: 51, period_us: 1500 };
 //!     wire.extend_from_slice(&frame.encode());
 //! }
 //! let mut decoder = Decoder::new();

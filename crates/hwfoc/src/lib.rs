@@ -31,7 +31,7 @@ macro_rules! formats {
                 family HwV4(crate::v4::Scanner) rank 2;
             /// Platinum V3 (and Platinum Pro V3): 10-byte `9B` frames without checksum
             /// ([`crate::v3`]).
-            HwV3 => crate::v3::DESCRIPTION, data crate::v3::Frame,
+            HwV3 => crate::v3::DESCRIPTION, data crate::v3::V3Frame,
                 family HwV3(crate::v3::Scanner) rank 3;
             /// HW5 (Platinum V5, VBAR firmware): `FE` frames with a CRC-16/MODBUS at 115200 baud
             /// ([`crate::hw5`]).

@@ -187,7 +187,7 @@ fn scan_next(
     at_end: bool,
     first_guess: bool,
 ) -> Option<(usize, Found)> {
-    if first_guess && let Some((at, frame)) = foc::Frame::take_first(data, pos, &mut stats.esc) {
+    if first_guess && let Some((at, frame)) = foc::FocFrame::take_first(data, pos, &mut stats.esc) {
         return Some((at, Found::Esc(frame)));
     }
     loop {
@@ -231,7 +231,7 @@ fn scan_next(
 
 /// A frame found, its offset given apart.
 enum Found {
-    Esc(foc::Frame),
+    Esc(foc::FocFrame),
     Hub(datalink::Decoded),
 }
 
@@ -280,7 +280,8 @@ impl scan::Scanner for Scanner {
         let mut pos = 0;
         loop {
             // Back-to-back ESC data frames: the HW-FOC scanner's first guess.
-            while let Some((at, frame)) = foc::Frame::take_first(data, &mut pos, &mut stats.esc) {
+            while let Some((at, frame)) = foc::FocFrame::take_first(data, &mut pos, &mut stats.esc)
+            {
                 on_frame(Decoded::Esc(foc::Decoded {
                     offset: base + at as u64,
                     frame,
@@ -309,7 +310,7 @@ impl scan::Scanner for Scanner {
 ///
 /// // An adapter on an ESC, then moved to a hub.
 /// let mut wire = DataFrame { packet: 7, ..Default::default() }.encode().to_vec();
-/// wire.extend_from_slice(&datalink::Frame::new(1).encode());
+/// wire.extend_from_slice(&datalink::HubFrame::new(1).encode());
 /// let mut decoder = Decoder::new();
 /// let mut got = Vec::new();
 /// for chunk in wire.chunks(5) {
@@ -394,7 +395,7 @@ mod tests {
 
     fn hub(counters: core::ops::Range<u16>, out: &mut [u8], at: &mut usize) {
         for counter in counters {
-            let mut frame = datalink::Frame::new(counter);
+            let mut frame = datalink::HubFrame::new(counter);
             for (c, slot) in frame.slots.iter_mut().enumerate() {
                 *slot = Some(DataFrame {
                     packet: 1000 + counter * 8 + c as u16,

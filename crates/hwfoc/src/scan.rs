@@ -636,12 +636,12 @@ mod tests {
         });
         assert_fold_is_next::<foc::Scanner>(&foc_stream);
         let hub = noisy(0x9B9E_0102, &[SYNC, 0x9E, 0x01, 0x02], |i| {
-            datalink::Frame::new(i as u16).encode().to_vec()
+            datalink::HubFrame::new(i as u16).encode().to_vec()
         });
         assert_fold_is_next::<datalink::Scanner>(&hub);
         let older = noisy(0x9B00_0003, &[SYNC], |i| {
             let counter = i + 7;
-            v3::Frame {
+            v3::V3Frame {
                 counter,
                 ..Default::default()
             }

@@ -6,7 +6,7 @@
 //! integers and converted once (exact means); records convert each value.
 //!
 //! [`Data`] is a data frame of any supported protocol and [`Info`] a device-information frame of
-//! any, each an enum with one arm per protocol; [`Frame`] is either, as decoders hand them to the
+//! any, each an enum with one arm per protocol; [`AnyFrame`] is either, as decoders hand them to the
 //! layers above. Both are declared from the list of formats (`formats!` in `lib.rs`): a new
 //! protocol's line there gives it its `Data` arm (and `Info` arm, where it sends an information
 //! frame, through [`DeviceInfo`]); its own module implements
@@ -379,7 +379,7 @@ impl core::fmt::Display for Info {
 /// A frame of any supported protocol as the layers above the codec take it: data, or device
 /// information.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-pub enum Frame {
+pub enum AnyFrame {
     /// A data frame.
     Data(Data),
     /// A device-information frame.

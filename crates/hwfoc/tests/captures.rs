@@ -2,7 +2,7 @@
 //! `shared/captures/`, kept in the repository so that a clone alone passes; see
 //! `testdata/README.md` for their source).
 
-use hwfoc::foc::{DataFrame, Decoded, Decoder, Frame, InfoFrame};
+use hwfoc::foc::{DataFrame, Decoded, Decoder, FocFrame, InfoFrame};
 use hwfoc::{Settings, foc};
 
 use older::{PLATINUM_PRO_V3, PLATINUM_V4, XROTOR};
@@ -43,8 +43,8 @@ fn data(decoded: &[Decoded]) -> Vec<(u64, DataFrame)> {
     decoded
         .iter()
         .filter_map(|d| match d.frame {
-            Frame::Data(f) => Some((d.offset, f)),
-            Frame::Info(_) => None,
+            FocFrame::Data(f) => Some((d.offset, f)),
+            FocFrame::Info(_) => None,
         })
         .collect()
 }
@@ -53,8 +53,8 @@ fn infos(decoded: &[Decoded]) -> Vec<(u64, InfoFrame)> {
     decoded
         .iter()
         .filter_map(|d| match d.frame {
-            Frame::Info(f) => Some((d.offset, f)),
-            Frame::Data(_) => None,
+            FocFrame::Info(f) => Some((d.offset, f)),
+            FocFrame::Data(_) => None,
         })
         .collect()
 }
@@ -178,7 +178,7 @@ fn xrotor_lone_sync_byte_before_a_silence() {
     assert!((0.54..0.545).contains(&gap), "{gap}");
     let next = decoded.iter().find(|d| d.offset > 909).unwrap();
     assert_eq!(next.offset, 910);
-    assert!(matches!(next.frame, Frame::Data(f) if f.packet == 1483));
+    assert!(matches!(next.frame, FocFrame::Data(f) if f.packet == 1483));
 }
 
 #[test]

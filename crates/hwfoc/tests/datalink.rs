@@ -29,7 +29,7 @@ fn slot() -> impl Strategy<Value = Option<DataFrame>> {
     ]
 }
 
-fn datalink_frame() -> impl Strategy<Value = datalink::Frame> {
+fn datalink_frame() -> impl Strategy<Value = datalink::HubFrame> {
     (
         any::<u16>(),
         [
@@ -43,7 +43,7 @@ fn datalink_frame() -> impl Strategy<Value = datalink::Frame> {
             slot(),
         ],
     )
-        .prop_map(|(counter, slots)| datalink::Frame { counter, slots })
+        .prop_map(|(counter, slots)| datalink::HubFrame { counter, slots })
 }
 
 /// An ESC whose record is never empty on the wire.
@@ -59,7 +59,7 @@ fn length_byte() -> impl Strategy<Value = LengthByte> {
 }
 
 /// What a frame reads back as: an all-zero ESC is an empty slot.
-fn normalized(f: &datalink::Frame) -> datalink::Frame {
+fn normalized(f: &datalink::HubFrame) -> datalink::HubFrame {
     let mut f = *f;
     for slot in &mut f.slots {
         if *slot == Some(DataFrame::default()) {
@@ -86,13 +86,13 @@ fn noisy_byte() -> impl Strategy<Value = u8> {
 #[derive(Debug, Clone)]
 enum Piece {
     /// A whole, valid frame.
-    Intact(datalink::Frame, LengthByte),
+    Intact(datalink::HubFrame, LengthByte),
     /// Noise.
     Garbage(Vec<u8>),
     /// The first `n` bytes of a frame (`1 <= n < 160`).
-    Cut(datalink::Frame, LengthByte, usize),
+    Cut(datalink::HubFrame, LengthByte, usize),
     /// A frame with one bit flipped.
-    Flipped(datalink::Frame, LengthByte, usize),
+    Flipped(datalink::HubFrame, LengthByte, usize),
     /// A header with nothing of its frame after it.
     Fake(&'static [u8]),
 }
@@ -124,7 +124,7 @@ fn pieces(max: usize) -> impl Strategy<Value = Vec<Piece>> {
 /// A wire and the intact frames put into it, with their offsets and length bytes.
 struct Wire {
     bytes: Vec<u8>,
-    intact: Vec<(u64, datalink::Frame, LengthByte)>,
+    intact: Vec<(u64, datalink::HubFrame, LengthByte)>,
 }
 
 fn build(pieces: &[Piece]) -> Wire {
@@ -155,7 +155,7 @@ fn build(pieces: &[Piece]) -> Wire {
 /// Whether a valid frame, formed by chance, starts outside the intact frames and overlaps one:
 /// a CRC matching by chance (about 1 in 65536 per candidate running into an intact frame). The
 /// CRC cannot settle such a wire; the tests that need every intact frame found discard it.
-fn ambiguous(bytes: &[u8], intact: &[(u64, datalink::Frame, LengthByte)]) -> bool {
+fn ambiguous(bytes: &[u8], intact: &[(u64, datalink::HubFrame, LengthByte)]) -> bool {
     let spans: Vec<(usize, usize)> = intact
         .iter()
         .map(|(o, _, _)| (*o as usize, *o as usize + FRAME_LEN))
@@ -163,7 +163,7 @@ fn ambiguous(bytes: &[u8], intact: &[(u64, datalink::Frame, LengthByte)]) -> boo
     (0..bytes.len())
         .filter(|&p| !spans.iter().any(|&(s, e)| (s..e).contains(&p)))
         .any(|p| {
-            datalink::Frame::parse(&bytes[p..]).is_ok()
+            datalink::HubFrame::parse(&bytes[p..]).is_ok()
                 && spans.iter().any(|&(s, e)| p < e && s < p + FRAME_LEN)
         })
 }
@@ -309,7 +309,7 @@ fn reference_scan(bytes: &[u8], at_end: bool) -> (Vec<datalink::Decoded>, RefSta
     (out, s, 0)
 }
 
-fn reference_read(f: &[u8], s: &mut RefStats) -> (datalink::Frame, FrameReport) {
+fn reference_read(f: &[u8], s: &mut RefStats) -> (datalink::HubFrame, FrameReport) {
     let length_byte = if f[1] == 0x9E {
         LengthByte::Covered
     } else {
@@ -318,7 +318,7 @@ fn reference_read(f: &[u8], s: &mut RefStats) -> (datalink::Frame, FrameReport) 
     s.length_bytes[usize::from(f[1] == 0xA0)] += 1;
     let counter = u16::from_be_bytes([f[4], f[5]]);
     s.counter.next(counter);
-    let mut frame = datalink::Frame::new(counter);
+    let mut frame = datalink::HubFrame::new(counter);
     let mut report = FrameReport {
         length_byte,
         empty_slots: 0,
@@ -430,7 +430,7 @@ fn decode_checked(bytes: &[u8], picks: &[Index]) -> (Vec<datalink::Decoded>, dat
     for d in &frames {
         let at = d.offset as usize;
         assert_eq!(
-            datalink::Frame::parse_with_report(&bytes[at..]),
+            datalink::HubFrame::parse_with_report(&bytes[at..]),
             Ok((d.frame, d.report))
         );
     }
@@ -464,7 +464,7 @@ proptest! {
         let back = normalized(&f);
         let empties = back.slots.iter().filter(|s| s.is_none()).count() as u8;
         prop_assert_eq!(
-            datalink::Frame::parse_with_report(&bytes),
+            datalink::HubFrame::parse_with_report(&bytes),
             Ok((back, FrameReport {
                 length_byte: l,
                 empty_slots: empties,
@@ -502,7 +502,7 @@ proptest! {
         expected.slots[which] = None;
         let empties = f.slots.iter().filter(|s| s.is_none()).count() as u8;
         prop_assert_eq!(
-            datalink::Frame::parse_with_report(&bytes),
+            datalink::HubFrame::parse_with_report(&bytes),
             Ok((expected, FrameReport {
                 length_byte: l,
                 empty_slots: empties,
@@ -536,7 +536,7 @@ proptest! {
         Checksum::Crc16Xmodem.seal(&mut bytes);
         let mut expected = f;
         expected.slots[second] = None;
-        let (frame, report) = datalink::Frame::parse_with_report(&bytes).unwrap();
+        let (frame, report) = datalink::HubFrame::parse_with_report(&bytes).unwrap();
         prop_assert_eq!(frame, expected);
         prop_assert_eq!((report.duplicate_channels, report.bad_channels), (1, 0));
         // And the other way round: the earlier record claims the later one's channel, which
@@ -562,7 +562,7 @@ proptest! {
     ) {
         let mut bytes = f.encode_as(l);
         bytes[bit / 8] ^= 1 << (bit % 8);
-        prop_assert!(datalink::Frame::parse(&bytes).is_err());
+        prop_assert!(datalink::HubFrame::parse(&bytes).is_err());
         let (decoded, stats) = decode_checked(&bytes, &[]);
         prop_assert!(decoded.is_empty());
         prop_assert_eq!(stats.bytes_skipped(), 160);
@@ -572,7 +572,7 @@ proptest! {
 /// Every single-bit flip of a few frames, exhaustively (1280 flips each).
 #[test]
 fn every_single_bit_flip_is_rejected() {
-    let mut full = datalink::Frame::new(0xFFFF);
+    let mut full = datalink::HubFrame::new(0xFFFF);
     for (ch, slot) in full.slots.iter_mut().enumerate() {
         *slot = Some(DataFrame {
             packet: 100 * ch as u16,
@@ -582,13 +582,13 @@ fn every_single_bit_flip_is_rejected() {
             ..Default::default()
         });
     }
-    for frame in [datalink::Frame::new(0), full] {
+    for frame in [datalink::HubFrame::new(0), full] {
         for l in LengthByte::ALL {
             let good = frame.encode_as(l);
             for bit in 0..FRAME_LEN * 8 {
                 let mut bytes = good;
                 bytes[bit / 8] ^= 1 << (bit % 8);
-                assert!(datalink::Frame::parse(&bytes).is_err(), "bit {bit}");
+                assert!(datalink::HubFrame::parse(&bytes).is_err(), "bit {bit}");
                 let (decoded, _) = bulk(&bytes);
                 assert!(decoded.is_empty(), "bit {bit}");
             }
@@ -639,7 +639,7 @@ proptest! {
         let wire = build(&ps);
         prop_assume!(!ambiguous(&wire.bytes, &wire.intact));
         let (decoded, stats) = decode_checked(&wire.bytes, &[]);
-        let found: Vec<(u64, datalink::Frame, LengthByte)> = decoded
+        let found: Vec<(u64, datalink::HubFrame, LengthByte)> = decoded
             .iter()
             .filter(|d| wire.intact.iter().any(|(o, _, _)| *o == d.offset))
             .map(|d| (d.offset, d.frame, d.report.length_byte))
@@ -670,7 +670,7 @@ proptest! {
         let mut sent = 0u32;
         let mut dropped_inside = 0u32;
         for (i, &corrupt) in corrupt.iter().enumerate().take(n) {
-            let mut f = datalink::Frame::new(start.wrapping_add(i as u16));
+            let mut f = datalink::HubFrame::new(start.wrapping_add(i as u16));
             for (ch, &p) in packets.iter().enumerate() {
                 f.slots[2 * ch] = Some(DataFrame { packet: p.wrapping_add(i as u16), voltage_raw: 1, ..Default::default() });
             }
@@ -716,7 +716,7 @@ fn encoder_matches_an_independent_crc() {
         0xCE, 0xD1, 0x00, 0x00, 0x0D, 0x08,
     ])
     .unwrap();
-    let mut f = datalink::Frame::new(1);
+    let mut f = datalink::HubFrame::new(1);
     f.slots[0] = Some(esc);
     let b = f.encode();
     assert_eq!(b[..7], [0x9B, 0x9E, 0x01, 0x02, 0x00, 0x01, 0x00]);
@@ -746,7 +746,7 @@ fn both_length_bytes_are_counted() {
     .into_iter()
     .enumerate()
     {
-        wire.extend_from_slice(&datalink::Frame::new(i as u16).encode_as(l));
+        wire.extend_from_slice(&datalink::HubFrame::new(i as u16).encode_as(l));
     }
     let (decoded, stats) = decode_checked(&wire, &[]);
     assert_eq!(decoded.len(), 5);
@@ -761,10 +761,10 @@ fn both_length_bytes_are_counted() {
 #[test]
 fn one_non_zero_byte_makes_a_record() {
     for at in 0..18 {
-        let mut b = datalink::Frame::new(5).encode();
+        let mut b = datalink::HubFrame::new(5).encode();
         b[RECORDS_AT + 2 * RECORD_LEN + 1 + at] = 0x80;
         Checksum::Crc16Xmodem.seal(&mut b);
-        let (frame, report) = datalink::Frame::parse_with_report(&b).unwrap();
+        let (frame, report) = datalink::HubFrame::parse_with_report(&b).unwrap();
         assert!(frame.slots[2].is_some(), "{at}");
         assert_eq!(frame.escs().count(), 1);
         assert_eq!(report.empty_slots, 7);
@@ -776,11 +776,11 @@ fn one_non_zero_byte_makes_a_record() {
 #[test]
 fn other_length_bytes_are_not_frames() {
     for length in [0x9D, 0x9F, 0xA1, 0x16, 0x4C] {
-        let mut b = datalink::Frame::new(5).encode();
+        let mut b = datalink::HubFrame::new(5).encode();
         b[1] = length;
         Checksum::Crc16Xmodem.seal(&mut b);
         assert_eq!(
-            datalink::Frame::parse(&b),
+            datalink::HubFrame::parse(&b),
             Err(datalink::Error::UnknownLength { found: length })
         );
         let (decoded, stats) = decode_checked(&b, &[]);
@@ -793,12 +793,12 @@ fn other_length_bytes_are_not_frames() {
 /// byte: the frame right behind the fake header's `9B` is still found.
 #[test]
 fn bad_header_costs_one_byte() {
-    let good = datalink::Frame::new(77).encode();
+    let good = datalink::HubFrame::new(77).encode();
     let mut bad = good;
     bad[3] = 0x01;
     Checksum::Crc16Xmodem.seal(&mut bad);
     assert_eq!(
-        datalink::Frame::parse(&bad),
+        datalink::HubFrame::parse(&bad),
         Err(datalink::Error::UnknownCommand {
             version: 1,
             command: 1
@@ -818,8 +818,8 @@ fn bad_header_costs_one_byte() {
 /// as a CRC failure; a frame cut by the end of the stream is skipped and not counted.
 #[test]
 fn cut_frames() {
-    let a = datalink::Frame::new(1).encode();
-    let mut b = datalink::Frame::new(2);
+    let a = datalink::HubFrame::new(1).encode();
+    let mut b = datalink::HubFrame::new(2);
     b.slots[4] = Some(DataFrame {
         packet: 9,
         ..Default::default()
@@ -845,7 +845,7 @@ fn cut_frames() {
 /// (a field of 0x9B9E), never hide or split a frame.
 #[test]
 fn sync_bytes_inside_records() {
-    let mut f = datalink::Frame::new(0x9B9E);
+    let mut f = datalink::HubFrame::new(0x9B9E);
     for slot in &mut f.slots {
         *slot = Some(DataFrame {
             packet: 0x9BA0,
@@ -873,7 +873,7 @@ fn sync_bytes_inside_records() {
 /// an ESC's stream: each wire's bytes are all skipped by the other.
 #[test]
 fn the_two_decoders_do_not_see_each_others_frames() {
-    let mut f = datalink::Frame::new(1);
+    let mut f = datalink::HubFrame::new(1);
     f.slots[0] = Some(DataFrame {
         packet: 5,
         voltage_raw: 252,
@@ -901,7 +901,7 @@ fn the_two_decoders_do_not_see_each_others_frames() {
 #[test]
 fn line_silent_limits_counter_and_channels() {
     let frame = |counter: u16, packet: u16| {
-        let mut f = datalink::Frame::new(counter);
+        let mut f = datalink::HubFrame::new(counter);
         f.slots[6] = Some(DataFrame {
             packet,
             ..Default::default()
@@ -959,7 +959,7 @@ fn error_messages() {
 
 #[test]
 fn stats_display_names_every_counter() {
-    let (_, stats) = bulk(&datalink::Frame::new(1).encode_as(LengthByte::Total));
+    let (_, stats) = bulk(&datalink::HubFrame::new(1).encode_as(LengthByte::Total));
     assert_eq!(
         stats.to_string(),
         "160 bytes, 1 frames (0 with length byte 0x9E, 1 with 0xA0), 0 CRC failures, \

@@ -134,7 +134,7 @@ fn shifted(frame: Decoded, by: u64) -> Decoded {
 fn without_info(frame: Decoded) -> Decoded {
     match frame {
         Decoded::HwV4(mut d) => {
-            if let v4::Frame::Data(x) = &mut d.frame {
+            if let v4::V4Frame::Data(x) = &mut d.frame {
                 x.info = None;
             }
             Decoded::HwV4(d)
@@ -226,7 +226,7 @@ fn foc_stream(packets: std::ops::Range<u16>) -> Vec<u8> {
 fn datalink_stream(counters: std::ops::Range<u16>) -> Vec<u8> {
     counters
         .flat_map(|counter| {
-            let mut frame = datalink::Frame::new(counter);
+            let mut frame = datalink::HubFrame::new(counter);
             for (c, slot) in frame.slots.iter_mut().enumerate().take(4) {
                 *slot = Some(DataFrame {
                     packet: counter.wrapping_mul(4) + c as u16,
@@ -242,7 +242,7 @@ fn datalink_stream(counters: std::ops::Range<u16>) -> Vec<u8> {
 fn v3_stream(counters: std::ops::Range<u32>) -> Vec<u8> {
     counters
         .flat_map(|counter| {
-            v3::Frame {
+            v3::V3Frame {
                 counter: counter & 0xFF_FFFF,
                 throttle_in_raw: (counter % 200) as u16,
                 pwm_out_raw: (counter % 180) as u16,
@@ -464,11 +464,11 @@ fn platinum_v4_capture_as_the_v4_decoder() {
     for d in &frames {
         match d {
             Decoded::HwV4(v4::Decoded {
-                frame: v4::Frame::Data(x),
+                frame: v4::V4Frame::Data(x),
                 ..
             }) => counters.push(x.packet()),
             Decoded::HwV4(v4::Decoded {
-                frame: v4::Frame::Info(_),
+                frame: v4::V4Frame::Info(_),
                 ..
             }) => infos += 1,
             other => panic!("{other:?}"),

@@ -21,7 +21,7 @@ fn foc_decoded(bytes: &[u8]) -> (Vec<u16>, foc::Stats) {
     let mut d = foc::Decoder::new();
     let mut packets = Vec::new();
     d.decode_all(bytes, |x| {
-        if let foc::Frame::Data(f) = x.frame {
+        if let foc::FocFrame::Data(f) = x.frame {
             packets.push(f.packet);
         }
     });

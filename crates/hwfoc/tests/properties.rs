@@ -11,7 +11,7 @@ use hwfoc::counters::MAX_PACKET_GAP;
 use hwfoc::foc::kinds::data::DATA_FRAME_LEN;
 use hwfoc::foc::kinds::info::INFO_FRAME_LEN;
 use hwfoc::foc::{
-    DataFrame, Decoded, Decoder, Frame, FrameError, InfoFrame, Parsed, frames, parse,
+    DataFrame, Decoded, Decoder, FocFrame, FrameError, InfoFrame, Parsed, frames, parse,
 };
 use hwfoc::{Status, foc};
 use proptest::collection::vec;
@@ -38,10 +38,10 @@ fn info_frame() -> impl Strategy<Value = InfoFrame> {
     ]
 }
 
-fn frame() -> impl Strategy<Value = Frame> {
+fn frame() -> impl Strategy<Value = FocFrame> {
     prop_oneof![
-        3 => data_frame().prop_map(Frame::Data),
-        1 => info_frame().prop_map(Frame::Info),
+        3 => data_frame().prop_map(FocFrame::Data),
+        1 => info_frame().prop_map(FocFrame::Info),
     ]
 }
 
@@ -61,11 +61,11 @@ fn noisy_byte() -> impl Strategy<Value = u8> {
 #[derive(Debug, Clone)]
 enum Piece {
     /// A whole, valid frame.
-    Intact(Frame),
+    Intact(FocFrame),
     /// Noise.
     Garbage(Vec<u8>),
     /// The first `n` bytes of a frame (`1 <= n < wire_len`).
-    Cut(Frame, usize),
+    Cut(FocFrame, usize),
     /// A header with nothing of its frame after it: `9B 16`, `9B 4C`, a lone `9B`, or a kind's
     /// whole header (which the scanner's search windows must verify and reject).
     Fake(&'static [u8]),
@@ -92,17 +92,17 @@ fn pieces(max: usize) -> impl Strategy<Value = Vec<Piece>> {
     vec(piece(), 0..max)
 }
 
-fn encode(frame: &Frame) -> Vec<u8> {
+fn encode(frame: &FocFrame) -> Vec<u8> {
     match frame {
-        Frame::Data(d) => d.encode().to_vec(),
-        Frame::Info(i) => i.encode().to_vec(),
+        FocFrame::Data(d) => d.encode().to_vec(),
+        FocFrame::Info(i) => i.encode().to_vec(),
     }
 }
 
 /// A wire and the intact frames put into it, with their offsets.
 struct Wire {
     bytes: Vec<u8>,
-    intact: Vec<(u64, Frame)>,
+    intact: Vec<(u64, FocFrame)>,
 }
 
 fn build(pieces: &[Piece]) -> Wire {
@@ -287,10 +287,10 @@ fn reference_scan(bytes: &[u8], base: u64, s: &mut RefStats, out: &mut Vec<Decod
                 status: Status(u16::from_be_bytes([f[20], f[21]])),
             };
             s.packet(d.packet);
-            Frame::Data(d)
+            FocFrame::Data(d)
         } else {
             s.info_frames += 1;
-            Frame::Info(InfoFrame::from_text(f[4..76].try_into().unwrap()).unwrap())
+            FocFrame::Info(InfoFrame::from_text(f[4..76].try_into().unwrap()).unwrap())
         };
         out.push(Decoded {
             offset: base + i as u64,
@@ -330,7 +330,7 @@ fn reference_held(bytes: &[u8]) -> usize {
 /// Whether some candidate that is not an intact frame's own start is itself a valid frame
 /// overlapping an intact frame. Such a wire is ambiguous: the checksums cannot tell the
 /// candidate from the intact frame, and a decoder that trusts them takes the first one.
-fn ambiguous(bytes: &[u8], intact: &[(u64, Frame)]) -> bool {
+fn ambiguous(bytes: &[u8], intact: &[(u64, FocFrame)]) -> bool {
     let spans: Vec<(usize, usize)> = intact
         .iter()
         .map(|(o, f)| (*o as usize, *o as usize + f.wire_len()))
@@ -360,9 +360,9 @@ proptest! {
         let sum: u32 = bytes[..22].iter().map(|&b| u32::from(b)).sum();
         prop_assert_eq!(u16::from_le_bytes([bytes[22], bytes[23]]), sum as u16);
         prop_assert_eq!(DataFrame::parse(&bytes), Ok(f));
-        prop_assert_eq!(parse(&bytes), Ok(Parsed::Complete(Frame::Data(f), 24)));
+        prop_assert_eq!(parse(&bytes), Ok(Parsed::Complete(FocFrame::Data(f), 24)));
         let (decoded, stats) = bulk(&bytes);
-        prop_assert_eq!(decoded, vec![Decoded { offset: 0, frame: Frame::Data(f) }]);
+        prop_assert_eq!(decoded, vec![Decoded { offset: 0, frame: FocFrame::Data(f) }]);
         prop_assert_eq!(stats.bytes_skipped(), 0);
         prop_assert_eq!(stats.last_packet(), Some(f.packet));
     }
@@ -378,9 +378,9 @@ proptest! {
         let back = InfoFrame::parse(&bytes).unwrap();
         prop_assert_eq!(back, info);
         prop_assert_eq!(back.text(), &text);
-        prop_assert_eq!(parse(&bytes), Ok(Parsed::Complete(Frame::Info(info), 77)));
+        prop_assert_eq!(parse(&bytes), Ok(Parsed::Complete(FocFrame::Info(info), 77)));
         let (decoded, stats) = bulk(&bytes);
-        prop_assert_eq!(decoded, vec![Decoded { offset: 0, frame: Frame::Info(info) }]);
+        prop_assert_eq!(decoded, vec![Decoded { offset: 0, frame: FocFrame::Info(info) }]);
         prop_assert_eq!(stats.info_frames(), 1);
         prop_assert_eq!(stats.checksum_failures(), 0);
     }
@@ -483,7 +483,7 @@ proptest! {
         prop_assume!(!ambiguous(&wire.bytes, &wire.intact));
         let (decoded, stats) = bulk(&wire.bytes);
 
-        let found: Vec<(u64, Frame)> = decoded
+        let found: Vec<(u64, FocFrame)> = decoded
             .iter()
             .filter(|d| wire.intact.iter().any(|(o, _)| *o == d.offset))
             .map(|d| (d.offset, d.frame))
@@ -499,7 +499,7 @@ proptest! {
                 );
             }
         }
-        let intact_data = wire.intact.iter().filter(|(_, f)| matches!(f, Frame::Data(_))).count();
+        let intact_data = wire.intact.iter().filter(|(_, f)| matches!(f, FocFrame::Data(_))).count();
         prop_assert!(stats.frames() as usize >= intact_data);
         prop_assert!(stats.info_frames() as usize >= wire.intact.len() - intact_data);
         prop_assert_eq!(
@@ -536,8 +536,8 @@ proptest! {
         };
         prop_assert_eq!(parse(&bytes), Err(expected));
         match f {
-            Frame::Data(_) => prop_assert!(DataFrame::parse(&bytes).is_err()),
-            Frame::Info(_) => prop_assert!(InfoFrame::parse(&bytes).is_err()),
+            FocFrame::Data(_) => prop_assert!(DataFrame::parse(&bytes).is_err()),
+            FocFrame::Info(_) => prop_assert!(InfoFrame::parse(&bytes).is_err()),
         }
 
         let head = build(&before).bytes;
@@ -777,9 +777,9 @@ proptest! {
                 .iter()
                 .cloned()
                 .map(|p| match p {
-                    Piece::Intact(Frame::Data(d)) => {
+                    Piece::Intact(FocFrame::Data(d)) => {
                         packet = packet.wrapping_add(*steps.next().unwrap());
-                        Piece::Intact(Frame::Data(DataFrame { packet, ..d }))
+                        Piece::Intact(FocFrame::Data(DataFrame { packet, ..d }))
                     }
                     p => p,
                 })

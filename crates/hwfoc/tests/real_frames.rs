@@ -9,7 +9,7 @@ use hwfoc::counters::MAX_PACKET_GAP;
 use hwfoc::foc::kinds::data::DATA_FRAME_LEN;
 use hwfoc::foc::kinds::info::INFO_FRAME_LEN;
 use hwfoc::foc::{
-    DataFrame, Decoded, Decoder, Frame, FrameError, InfoFieldError, InfoFrame, Parsed, frames,
+    DataFrame, Decoded, Decoder, FocFrame, FrameError, InfoFieldError, InfoFrame, Parsed, frames,
     parse,
 };
 use hwfoc::units::{ADC_MAX, ADC_MIN, ADC_TABLE};
@@ -264,8 +264,8 @@ fn data_frames(decoded: &[Decoded]) -> Vec<(u64, u16)> {
     decoded
         .iter()
         .filter_map(|d| match d.frame {
-            Frame::Data(f) => Some((d.offset, f.packet)),
-            Frame::Info(_) => None,
+            FocFrame::Data(f) => Some((d.offset, f.packet)),
+            FocFrame::Info(_) => None,
         })
         .collect()
 }
@@ -352,20 +352,23 @@ fn example_frame_reencodes_byte_for_byte() {
     let f = DataFrame::parse(&EXAMPLE).unwrap();
     assert_eq!(f.encode(), EXAMPLE);
     let mut out = [0xAAu8; 30];
-    assert_eq!(Frame::Data(f).encode_into(&mut out), Some(DATA_FRAME_LEN));
+    assert_eq!(
+        FocFrame::Data(f).encode_into(&mut out),
+        Some(DATA_FRAME_LEN)
+    );
     assert_eq!(out[..24], EXAMPLE);
     assert_eq!(out[24..], [0xAA; 6]);
-    assert_eq!(Frame::Data(f).encode_into(&mut [0u8; 23]), None);
-    assert_eq!(Frame::Data(f).wire_len(), 24);
+    assert_eq!(FocFrame::Data(f).encode_into(&mut [0u8; 23]), None);
+    assert_eq!(FocFrame::Data(f).wire_len(), 24);
 }
 
 #[test]
 fn example_frame_through_parse() {
     let f = DataFrame::parse(&EXAMPLE).unwrap();
-    assert_eq!(parse(&EXAMPLE), Ok(Parsed::Complete(Frame::Data(f), 24)));
+    assert_eq!(parse(&EXAMPLE), Ok(Parsed::Complete(FocFrame::Data(f), 24)));
     // Bytes after the frame are ignored.
     let longer = cat(&[&EXAMPLE, &[0x9B, 0x16, 0x00]]);
-    assert_eq!(parse(&longer), Ok(Parsed::Complete(Frame::Data(f), 24)));
+    assert_eq!(parse(&longer), Ok(Parsed::Complete(FocFrame::Data(f), 24)));
     assert_eq!(DataFrame::parse(&longer), Ok(f));
     // Every prefix is a valid beginning.
     assert_eq!(parse(&[]), Ok(Parsed::Partial(1)));
@@ -394,7 +397,7 @@ fn example_frame_alone_on_the_wire() {
         decoded,
         [Decoded {
             offset: 0,
-            frame: Frame::Data(DataFrame::parse(&EXAMPLE).unwrap())
+            frame: FocFrame::Data(DataFrame::parse(&EXAMPLE).unwrap())
         }]
     );
     assert_eq!(stats.frames(), 1);
@@ -595,15 +598,18 @@ fn real_info_frame_check_byte_and_reencoding() {
     let built = InfoFrame::new("XR_FOC_ESC", "HW577_KZ1_V1.1", "XR-01.0.00", "01040443").unwrap();
     assert_eq!(built, info);
     assert_eq!(built.encode(), bytes);
-    assert_eq!(parse(&bytes), Ok(Parsed::Complete(Frame::Info(info), 77)));
+    assert_eq!(
+        parse(&bytes),
+        Ok(Parsed::Complete(FocFrame::Info(info), 77))
+    );
     let mut out = [0u8; 80];
     assert_eq!(
-        Frame::Info(info).encode_into(&mut out),
+        FocFrame::Info(info).encode_into(&mut out),
         Some(INFO_FRAME_LEN)
     );
     assert_eq!(out[..77], bytes);
-    assert_eq!(Frame::Info(info).encode_into(&mut [0u8; 76]), None);
-    assert_eq!(Frame::Info(info).wire_len(), 77);
+    assert_eq!(FocFrame::Info(info).encode_into(&mut [0u8; 76]), None);
+    assert_eq!(FocFrame::Info(info).wire_len(), 77);
 }
 
 #[test]
@@ -847,10 +853,10 @@ fn sync_and_header_inside_a_payload_loses_no_frame() {
     ]);
     let (decoded, stats) = decode(&stream);
     assert_eq!(decoded.len(), 4);
-    assert_eq!(decoded[0].frame, Frame::Data(inner));
-    assert_eq!(decoded[1].frame, Frame::Data(next));
+    assert_eq!(decoded[0].frame, FocFrame::Data(inner));
+    assert_eq!(decoded[1].frame, FocFrame::Data(next));
     assert_eq!(decoded[2].offset, 48);
-    assert!(matches!(decoded[2].frame, Frame::Info(_)));
+    assert!(matches!(decoded[2].frame, FocFrame::Info(_)));
     assert_eq!(decoded[3].offset, 125);
     assert_eq!(stats.bytes_skipped(), 0);
     assert_eq!(stats.checksum_failures(), 0);
@@ -923,7 +929,7 @@ fn info_frame_immediately_followed_by_a_data_frame() {
     assert_eq!(data_frames(&decoded), [(0, 1474), (101, 1475), (202, 1476)]);
     assert_eq!(
         decoded[1].frame,
-        Frame::Info(InfoFrame::parse(&info).unwrap())
+        FocFrame::Info(InfoFrame::parse(&info).unwrap())
     );
     assert_eq!(stats.frames(), 3);
     assert_eq!(stats.info_frames(), 2);
@@ -1001,7 +1007,7 @@ fn cut_info_frame_of_67_bytes_does_not_swallow_the_next_data_frame() {
     assert!(
         !decoded
             .iter()
-            .any(|d| d.offset == 24 && matches!(d.frame, Frame::Info(_))),
+            .any(|d| d.offset == 24 && matches!(d.frame, FocFrame::Info(_))),
         "bogus info frame at offset 24"
     );
 }
@@ -1646,7 +1652,7 @@ fn header_and_sum_differing_by_the_same_bits_are_refused() {
             // ... and right after a frame, where the scanner tries a data frame first.
             let (decoded, _) = decode(&cat(&[&EXAMPLE, &candidate]));
             assert_eq!(decoded.len(), 1, "{candidate:02X?}");
-            assert_eq!(decoded[0].frame, Frame::Data(frame));
+            assert_eq!(decoded[0].frame, FocFrame::Data(frame));
         }
     }
 }

@@ -8,7 +8,7 @@ mod older;
 
 use common::{cut_points, streamed_bytewise};
 use hwfoc::counters::PacketSequence24;
-use hwfoc::v3::{self, Decoded, Decoder, FRAME_LEN, Frame, Scanner};
+use hwfoc::v3::{self, Decoded, Decoder, FRAME_LEN, Scanner, V3Frame};
 use older::{Figures, PLATINUM_PRO_V3, PLATINUM_V4, RANDOM_LEN, Rng, XROTOR, bulk, load};
 use proptest::collection::vec;
 use proptest::prelude::*;
@@ -43,10 +43,10 @@ fn capture_decodes_completely() {
 #[test]
 fn capture_values() {
     let (decoded, _) = bulk::<Scanner>(&load(PLATINUM_PRO_V3));
-    let frames: Vec<Frame> = decoded.iter().map(|d| d.frame).collect();
+    let frames: Vec<V3Frame> = decoded.iter().map(|d| d.frame).collect();
     assert_eq!(
         frames[0],
-        Frame {
+        V3Frame {
             counter: 0,
             throttle_in_raw: 107,
             pwm_out_raw: 10,
@@ -56,9 +56,9 @@ fn capture_values() {
     // 28 frames hold the start-up placeholder: no speed.
     let no_speed = frames.iter().filter(|f| f.erpm().is_none()).count();
     assert_eq!(no_speed, 28);
-    let max_erpm = frames.iter().filter_map(Frame::erpm).max();
+    let max_erpm = frames.iter().filter_map(V3Frame::erpm).max();
     assert_eq!(max_erpm, Some(60_000_000 / 1538));
-    let throttle = |f: &Frame| f.throttle_in_raw;
+    let throttle = |f: &V3Frame| f.throttle_in_raw;
     assert_eq!(frames.iter().map(throttle).min(), Some(10));
     assert_eq!(frames.iter().map(throttle).max(), Some(107));
     assert!(frames.iter().all(|f| f.pwm_out_raw <= 116));
@@ -111,8 +111,8 @@ fn two_million_random_bytes_give_no_frame() {
 // The lock rule's edges
 // ---------------------------------------------------------------------------------------------
 
-fn frame(counter: u32) -> Frame {
-    Frame {
+fn frame(counter: u32) -> V3Frame {
+    V3Frame {
         counter,
         throttle_in_raw: 120,
         pwm_out_raw: 60,
@@ -223,7 +223,7 @@ fn a_cut_frame_that_stays_plausible_is_taken() {
     let (decoded, stats) = bulk::<Scanner>(&wire);
     let got = counters(&decoded);
     assert_eq!(got, [0, 1, 2, 3, 5, 6, 7, 8, 9]);
-    // Frame "3" took the first two bytes of frame 4 as its period.
+    // V3Frame "3" took the first two bytes of frame 4 as its period.
     assert_eq!(decoded[3].frame.period_us, 0x9B00);
     assert_eq!(stats.lost_packets(), 1);
 }
@@ -235,8 +235,8 @@ fn a_cut_frame_that_stays_plausible_is_taken() {
 #[test]
 fn no_intact_frame_is_lost_between_frames_cut_out_whole() {
     let mut rng = Rng(0x5EED_0120);
-    let sent: Vec<Frame> = (0..6154u32)
-        .map(|k| Frame {
+    let sent: Vec<V3Frame> = (0..6154u32)
+        .map(|k| V3Frame {
             counter: 0xAB_0000 + k,
             throttle_in_raw: (rng.next() % 256) as u16,
             pwm_out_raw: (rng.next() % 256) as u16,
@@ -282,8 +282,8 @@ fn a_silence_decides_the_held_bytes() {
 // Properties
 // ---------------------------------------------------------------------------------------------
 
-fn any_frame() -> impl Strategy<Value = Frame> {
-    (0u32..1 << 24, any::<u16>(), any::<u16>(), any::<u16>()).prop_map(|(c, t, p, e)| Frame {
+fn any_frame() -> impl Strategy<Value = V3Frame> {
+    (0u32..1 << 24, any::<u16>(), any::<u16>(), any::<u16>()).prop_map(|(c, t, p, e)| V3Frame {
         counter: c,
         throttle_in_raw: t,
         pwm_out_raw: p,
@@ -310,13 +310,13 @@ enum Piece {
     Chain(u32, Vec<(u16, u16, u16)>),
     Garbage(Vec<u8>),
     /// The first `n` bytes (1..10) of a frame.
-    Cut(Frame, usize),
+    Cut(V3Frame, usize),
 }
 
 /// A wire, and what a decoder must find in it.
 struct Wire {
     bytes: Vec<u8>,
-    frames: Vec<(u64, Frame)>,
+    frames: Vec<(u64, V3Frame)>,
     skipped: u64,
     syncs: u32,
     sequence: PacketSequence24,
@@ -341,7 +341,7 @@ fn build(pieces: &[Piece]) -> Wire {
                 }
                 let mut counter = *start;
                 for &(t, p, e) in fields {
-                    let f = Frame {
+                    let f = V3Frame {
                         counter,
                         throttle_in_raw: t,
                         pwm_out_raw: p,
@@ -369,7 +369,7 @@ fn build(pieces: &[Piece]) -> Wire {
 
 fn assert_finds_exactly(w: &Wire) -> Result<(), TestCaseError> {
     let (decoded, stats) = bulk::<Scanner>(&w.bytes);
-    let got: Vec<(u64, Frame)> = decoded.iter().map(|d| (d.offset, d.frame)).collect();
+    let got: Vec<(u64, V3Frame)> = decoded.iter().map(|d| (d.offset, d.frame)).collect();
     prop_assert_eq!(&got, &w.frames);
     prop_assert_eq!(stats.bytes_skipped(), w.skipped);
     prop_assert_eq!(stats.bytes(), w.bytes.len() as u64);
@@ -385,7 +385,7 @@ proptest! {
     fn encode_decode_identity(f in any_frame()) {
         let bytes = f.encode();
         prop_assert_eq!(bytes[0], 0x9B);
-        prop_assert_eq!(Frame::parse(&bytes), Some(f));
+        prop_assert_eq!(V3Frame::parse(&bytes), Some(f));
         prop_assert_eq!(f.is_plausible(), f.throttle_in_raw <= 255 && f.pwm_out_raw <= 255);
     }
 
@@ -453,7 +453,7 @@ proptest! {
         let mut wire = Vec::new();
         let mut want = Vec::new();
         for (k, &(t, p, e)) in fields.iter().enumerate() {
-            let f = Frame {
+            let f = V3Frame {
                 counter: (start + k as u32) & 0xFF_FFFF,
                 throttle_in_raw: t,
                 pwm_out_raw: p,
@@ -465,7 +465,7 @@ proptest! {
             }
         }
         let (decoded, stats) = bulk::<Scanner>(&wire);
-        let got: Vec<(u64, Frame)> = decoded.iter().map(|d| (d.offset, d.frame)).collect();
+        let got: Vec<(u64, V3Frame)> = decoded.iter().map(|d| (d.offset, d.frame)).collect();
         prop_assert_eq!(got, want);
         prop_assert_eq!(figures(&stats), Figures::after_cuts(sent.iter().filter(|&&s| !s).count()));
         prop_assert_eq!(streamed_bytewise::<Scanner>(&wire), (decoded, stats));

@@ -9,7 +9,7 @@ mod older;
 use common::{cut_points, streamed_bytewise};
 use hwfoc::counters::PacketSequence24;
 use hwfoc::v4::{
-    self, DATA_FRAME_LEN, Data, DataFrame, Decoded, Frame, INFO_FRAME_LEN, InfoFrame, Scanner,
+    self, DATA_FRAME_LEN, Data, DataFrame, Decoded, INFO_FRAME_LEN, InfoFrame, Scanner, V4Frame,
     VoltsPerStep,
 };
 use hwfoc::{foc, v3};
@@ -27,8 +27,8 @@ fn data_of(decoded: &[Decoded]) -> Vec<(u64, Data)> {
     decoded
         .iter()
         .filter_map(|d| match d.frame {
-            Frame::Data(x) => Some((d.offset, x)),
-            Frame::Info(_) => None,
+            V4Frame::Data(x) => Some((d.offset, x)),
+            V4Frame::Info(_) => None,
         })
         .collect()
 }
@@ -37,8 +37,8 @@ fn infos_of(decoded: &[Decoded]) -> Vec<(u64, InfoFrame)> {
     decoded
         .iter()
         .filter_map(|d| match d.frame {
-            Frame::Info(i) => Some((d.offset, i)),
-            Frame::Data(_) => None,
+            V4Frame::Info(i) => Some((d.offset, i)),
+            V4Frame::Data(_) => None,
         })
         .collect()
 }
@@ -478,7 +478,7 @@ fn implausible_fields_are_rejected() {
             wire.extend_from_slice(&f.encode());
         }
         let (decoded, stats) = bulk::<Scanner>(&wire);
-        // Frame 3 is rejected; 4 and 5 cannot form a chain of three before the end.
+        // V4Frame 3 is rejected; 4 and 5 cannot form a chain of three before the end.
         assert_eq!(counters(&decoded), [0, 1, 2]);
         assert_eq!(stats.implausible(), 1);
     }
@@ -666,7 +666,7 @@ fn gap() -> impl Strategy<Value = Piece> {
 #[derive(Debug)]
 struct Wire {
     bytes: Vec<u8>,
-    frames: Vec<(u64, Frame)>,
+    frames: Vec<(u64, V4Frame)>,
     /// Where the info frames really are (any other info-shaped bytes are a fake).
     info_at: Vec<usize>,
     skipped: u64,
@@ -726,7 +726,7 @@ fn build(pieces: &[Piece]) -> Wire {
                     }
                     last_info = Some(*info);
                     w.info_at.push(w.bytes.len());
-                    w.frames.push((w.bytes.len() as u64, Frame::Info(*info)));
+                    w.frames.push((w.bytes.len() as u64, V4Frame::Info(*info)));
                     w.bytes.extend_from_slice(&info.encode());
                     let f = push_data(&mut w, &mut counter, f, in_use(adopted, last_info));
                     w.bytes.extend_from_slice(&f.encode_with_trailer());
@@ -763,7 +763,7 @@ fn push_data(
     };
     w.frames.push((
         w.bytes.len() as u64,
-        Frame::Data(Data {
+        V4Frame::Data(Data {
             frame: f,
             info: adopted,
         }),
@@ -792,7 +792,7 @@ fn fake_info_outside(bytes: &[u8], info_at: &[usize]) -> bool {
 
 fn assert_finds_exactly(w: &Wire) -> Result<(), TestCaseError> {
     let (decoded, stats) = bulk::<Scanner>(&w.bytes);
-    let got: Vec<(u64, Frame)> = decoded.iter().map(|d| (d.offset, d.frame)).collect();
+    let got: Vec<(u64, V4Frame)> = decoded.iter().map(|d| (d.offset, d.frame)).collect();
     prop_assert_eq!(&got, &w.frames);
     prop_assert_eq!(stats.bytes_skipped(), w.skipped);
     prop_assert_eq!(stats.trailers(), w.trailers);
@@ -951,7 +951,7 @@ proptest! {
         let mut bytes = Vec::new();
         let mut v3_frames = Vec::new();
         for (k, &(t, p, e)) in v3_fields.iter().enumerate() {
-            let f = v3::Frame {
+            let f = v3::V3Frame {
                 counter: (v3_start + k as u32) & 0xFF_FFFF,
                 throttle_in_raw: t,
                 pwm_out_raw: p,
@@ -965,10 +965,10 @@ proptest! {
         let base = bytes.len() as u64;
         bytes.extend_from_slice(&v4_part.bytes);
 
-        let got3: Vec<(u64, v3::Frame)> = v3::frames(&bytes).map(|d| (d.offset, d.frame)).collect();
+        let got3: Vec<(u64, v3::V3Frame)> = v3::frames(&bytes).map(|d| (d.offset, d.frame)).collect();
         prop_assert_eq!(got3, v3_frames);
-        let got4: Vec<(u64, Frame)> = v4::frames(&bytes).map(|d| (d.offset, d.frame)).collect();
-        let want4: Vec<(u64, Frame)> = v4_part.frames.iter().map(|(at, f)| (at + base, *f)).collect();
+        let got4: Vec<(u64, V4Frame)> = v4::frames(&bytes).map(|d| (d.offset, d.frame)).collect();
+        let want4: Vec<(u64, V4Frame)> = v4_part.frames.iter().map(|(at, f)| (at + base, *f)).collect();
         prop_assert_eq!(got4, want4);
     }
 }

@@ -12,7 +12,7 @@ use std::thread::JoinHandle;
 use std::ops::Range;
 
 use hwfoc::Settings;
-use hwfoc::telemetry::{Data, Frame};
+use hwfoc::telemetry::{AnyFrame, Data};
 use hwfoc_records::record::DataFrames;
 #[cfg(feature = "parquet")]
 use hwfoc_records::record::FrameSlice;
@@ -509,8 +509,8 @@ impl Handler for Export {
     type Error = ExportError;
 
     #[inline]
-    fn frame(&mut self, esc: u8, t: Option<f64>, frame: &Frame, settings: &Settings) {
-        if let Frame::Data(frame) = *frame {
+    fn frame(&mut self, esc: u8, t: Option<f64>, frame: &AnyFrame, settings: &Settings) {
+        if let AnyFrame::Data(frame) = *frame {
             // The first frame of any ESC resolves a window given after the first frame.
             self.selection.window.observe(t);
             let state = self.escs[usize::from(esc)];
@@ -574,7 +574,7 @@ mod tests {
                 ..Default::default()
             })
         };
-        let v3 = Data::HwV3(hwfoc::v3::Frame::default());
+        let v3 = Data::HwV3(hwfoc::v3::V3Frame::default());
         let pushed = [foc(1), foc(2), v3, foc(3)];
         let mut chunk = Chunk::with_capacity(4);
         chunk.push(0, None, &pushed[0]);

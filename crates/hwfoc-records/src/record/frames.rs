@@ -127,7 +127,7 @@ mod tests {
                 ..Default::default()
             })
         };
-        let v3 = Data::HwV3(hwfoc::v3::Frame::default());
+        let v3 = Data::HwV3(hwfoc::v3::V3Frame::default());
         let mut frames = DataFrames::with_capacity(4);
         frames.push(&foc(1));
         frames.extend_hwfoc(&[DataFrame {

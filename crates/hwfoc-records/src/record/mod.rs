@@ -150,7 +150,7 @@ mod tests {
             temp2_adc: 3244,
             ..Default::default()
         };
-        let v3 = hwfoc::v3::Frame {
+        let v3 = hwfoc::v3::V3Frame {
             counter: 3,
             throttle_in_raw: 51,
             pwm_out_raw: 51,
@@ -300,7 +300,7 @@ mod tests {
             v["voltage_v"].as_f64().map(|x| (x * 100.0).round()),
             Some(1200.0)
         );
-        let placeholder = Data::from(hwfoc::v3::Frame {
+        let placeholder = Data::from(hwfoc::v3::V3Frame {
             period_us: hwfoc::v3::PLACEHOLDER_PERIOD_US,
             ..v3
         });

@@ -17,7 +17,7 @@
 use std::cmp::Ordering;
 use std::collections::{BTreeMap, BinaryHeap, VecDeque};
 
-use hwfoc::telemetry::Frame;
+use hwfoc::telemetry::AnyFrame;
 
 use super::numbering::{Deliver, route};
 use super::{Handler, LIVE_BATCH, Sources};
@@ -385,7 +385,7 @@ impl Sources {
 /// stream's order) and a heap of their first frames.
 #[derive(Default)]
 pub(super) struct Queue {
-    escs: Vec<VecDeque<(Option<f64>, Frame)>>,
+    escs: Vec<VecDeque<(Option<f64>, AnyFrame)>>,
     fronts: BinaryHeap<Earliest>,
     len: usize,
     pub(super) peak: usize,
@@ -421,7 +421,7 @@ fn key(t: Option<f64>) -> f64 {
 }
 
 impl Queue {
-    pub(super) fn push(&mut self, esc: usize, t: Option<f64>, d: &Frame) {
+    pub(super) fn push(&mut self, esc: usize, t: Option<f64>, d: &AnyFrame) {
         if self.escs.len() <= esc {
             self.escs.resize_with(esc + 1, VecDeque::new);
         }
@@ -435,7 +435,7 @@ impl Queue {
     }
 
     /// The earliest frame, if it is earlier than `bound` or the queue is over its bound.
-    pub(super) fn pop_before(&mut self, bound: f64) -> Option<(usize, Option<f64>, Frame)> {
+    pub(super) fn pop_before(&mut self, bound: f64) -> Option<(usize, Option<f64>, AnyFrame)> {
         let front = self.fronts.peek()?;
         if front.t >= bound && self.len <= MAX_QUEUED {
             return None;

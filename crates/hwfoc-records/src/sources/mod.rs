@@ -41,7 +41,7 @@ use std::collections::{HashMap, VecDeque};
 
 use hwfoc::datalink;
 use hwfoc::foc::DataFrame;
-use hwfoc::telemetry::{Data, Frame};
+use hwfoc::telemetry::{AnyFrame, Data};
 use hwfoc::{Protocol, Settings};
 
 use crate::esc_table::{EscTable, Recording};
@@ -631,7 +631,7 @@ trait Takes {
     /// Data frames of the stream's own ESC without receive times, one after another.
     fn run(&mut self, frames: &[DataFrame]);
     /// Any other frame (with a receive time, of a hub's channel, or device information).
-    fn other(&mut self, t: Option<f64>, channel: Option<u8>, frame: &Frame);
+    fn other(&mut self, t: Option<f64>, channel: Option<u8>, frame: &AnyFrame);
 }
 
 /// Decodes `batch` with `stream`: for a handler that takes runs ([`Takes::RUNS`]), the
@@ -647,7 +647,7 @@ fn feed_runs<T: Takes>(stream: &mut Stream, batch: Batch<'_>, held: &mut Held, t
         batch,
         #[inline(always)]
         |t, channel, d| {
-            if let (true, None, None, Frame::Data(Data::HwFoc(f))) = (T::RUNS, t, channel, d) {
+            if let (true, None, None, AnyFrame::Data(Data::HwFoc(f))) = (T::RUNS, t, channel, d) {
                 if n == HELD {
                     to.run(held);
                     n = 0;
@@ -688,7 +688,7 @@ impl<H: Handler> Takes for ToHandler<'_, '_, H> {
     fn run(&mut self, frames: &[DataFrame]) {
         // After a hub frame waiting for its channel's number: in order, behind it.
         if !self.pending.is_empty() {
-            let frames = frames.iter().map(|f| Frame::Data(Data::HwFoc(*f)));
+            let frames = frames.iter().map(|f| AnyFrame::Data(Data::HwFoc(*f)));
             self.pending.extend(frames.map(|f| (None, None, f)));
             return;
         }
@@ -696,7 +696,7 @@ impl<H: Handler> Takes for ToHandler<'_, '_, H> {
     }
 
     #[inline(always)]
-    fn other(&mut self, t: Option<f64>, channel: Option<u8>, d: &Frame) {
+    fn other(&mut self, t: Option<f64>, channel: Option<u8>, d: &AnyFrame) {
         // After a hub frame waiting for its channel's number: in order, behind it (a file read
         // in one batch gave the hub's frames after every later ESC frame of the batch).
         if !self.pending.is_empty() {

@@ -6,7 +6,7 @@ use std::collections::VecDeque;
 
 use hwfoc::Settings;
 use hwfoc::datalink::CHANNELS;
-use hwfoc::telemetry::Frame;
+use hwfoc::telemetry::AnyFrame;
 
 use super::{Esc, Handler, Sources};
 use crate::esc_numbers::{MAX_ESCS, UNNUMBERED, channel_number};
@@ -240,7 +240,7 @@ pub(super) struct Hub {
 
 /// A frame of a channel that has no ESC yet (its time, channel and frame), or of the stream's
 /// own ESC (channel `None`) that came after one in its batch, kept in its place.
-pub(super) type Pending = (Option<f64>, Option<u8>, Frame);
+pub(super) type Pending = (Option<f64>, Option<u8>, AnyFrame);
 
 /// The ESC a frame of the stream of ESC `own` belongs to: `own` on its own wire; behind a hub
 /// whose channels are numbered (`hub`), its channel's ESC with that ESC's settings; `None` for a
@@ -252,7 +252,7 @@ pub(super) fn route<'h>(
     hub: Option<&'h Hub>,
     t: Option<f64>,
     channel: Option<u8>,
-    d: &Frame,
+    d: &AnyFrame,
     pending: &mut Vec<Pending>,
 ) -> Option<(usize, Option<&'h Settings>)> {
     match (channel, hub) {

@@ -25,7 +25,7 @@ use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc::{Receiver, SyncSender, sync_channel};
 
-use hwfoc::telemetry::{Data, Frame, Telemetry};
+use hwfoc::telemetry::{AnyFrame, Data, Telemetry};
 use hwfoc::{Protocol, Settings};
 
 use super::{HELD, Held, Takes, feed_runs};
@@ -279,11 +279,11 @@ impl Takes for ToPart<'_> {
         self.part.untimed_data(self.esc, frames, self.settings);
     }
 
-    fn other(&mut self, _: Option<f64>, channel: Option<u8>, frame: &Frame) {
+    fn other(&mut self, _: Option<f64>, channel: Option<u8>, frame: &AnyFrame) {
         match (channel, frame) {
             (Some(_), _) => self.hub = true,
             (None, frame) => {
-                if let Frame::Data(f) = frame {
+                if let AnyFrame::Data(f) = frame {
                     self.data(f);
                 }
                 self.part.frame(self.esc, frame, self.settings);

@@ -6,7 +6,7 @@ use crate::pcapng;
 use crate::record::Record;
 use hwfoc::datalink::CHANNELS;
 use hwfoc::foc::DataFrame;
-use hwfoc::telemetry::Frame;
+use hwfoc::telemetry::AnyFrame;
 
 /// Collects the records (packet number and time), by ESC.
 #[derive(Default)]
@@ -388,7 +388,7 @@ fn hubs_and_escs_together_number_every_esc_once_live_and_recorded() {
     let hub = |port: u16| -> Vec<u8> {
         (0..3)
             .flat_map(|counter| {
-                let mut frame = hwfoc::datalink::Frame {
+                let mut frame = hwfoc::datalink::HubFrame {
                     counter,
                     slots: [None; CHANNELS],
                 };
@@ -431,7 +431,7 @@ fn hubs_and_escs_together_number_every_esc_once_live_and_recorded() {
         fn record(&mut self, r: &Record) {
             self.0.push((r.esc, packet(r)));
         }
-        fn frame(&mut self, esc: u8, t: Option<f64>, d: &Frame, settings: &Settings) {
+        fn frame(&mut self, esc: u8, t: Option<f64>, d: &AnyFrame, settings: &Settings) {
             // ESC 12 (port 0's channel 2) has settings of its own; port 2's channels
             // follow the port's.
             let poles = match esc {
@@ -444,7 +444,7 @@ fn hubs_and_escs_together_number_every_esc_once_live_and_recorded() {
                 (settings.pole_pairs, settings.current_scale),
                 (poles, scale)
             );
-            if let Frame::Data(f) = d {
+            if let AnyFrame::Data(f) = d {
                 self.record(&Record::new(t, esc, f, settings));
             }
         }
@@ -498,7 +498,7 @@ fn hubs_and_escs_together_number_every_esc_once_live_and_recorded() {
 pub(crate) fn hub_wire(id: u16, counters: std::ops::Range<u16>, channels: &[usize]) -> Vec<u8> {
     counters
         .flat_map(|counter| {
-            let mut frame = hwfoc::datalink::Frame::new(counter);
+            let mut frame = hwfoc::datalink::HubFrame::new(counter);
             for &c in channels {
                 frame.slots[c] = Some(DataFrame {
                     packet: 1000 + 100 * id + c as u16,
@@ -659,10 +659,10 @@ impl<const RUNS: bool> Handler for Calls<RUNS> {
 
     const TAKES_RUNS: bool = RUNS;
 
-    fn frame(&mut self, esc: u8, t: Option<f64>, frame: &Frame, _: &Settings) {
+    fn frame(&mut self, esc: u8, t: Option<f64>, frame: &AnyFrame, _: &Settings) {
         let what = match frame {
-            Frame::Data(d) => format!("{}", hwfoc::Telemetry::packet(d).unwrap_or_default()),
-            Frame::Info(_) => "info".to_string(),
+            AnyFrame::Data(d) => format!("{}", hwfoc::Telemetry::packet(d).unwrap_or_default()),
+            AnyFrame::Info(_) => "info".to_string(),
         };
         self.0.push(format!("{esc} {t:?} {what}"));
     }

@@ -24,7 +24,7 @@
 
 use hwfoc::Protocol;
 use hwfoc::dronecan::{BusStats, CanFrame, Escs, NodeStats, Receiver, SOCKETCAN_RECORD_LEN};
-use hwfoc::telemetry::{Data, Frame};
+use hwfoc::telemetry::{AnyFrame, Data};
 
 /// Slots on a bus: places (node ids 0-127 before a node is mapped to its throttle channel, then
 /// its channel - 1, a byte; a standard ESC's `esc_index`), and those after the highest place
@@ -206,7 +206,7 @@ impl BusLearner {
     pub(crate) fn feed(&mut self, bytes: &[u8], times: Option<&[f64]>) {
         let last = &mut self.last;
         self.wire.feed(bytes, times, &mut |_, _, f| {
-            let Frame::Data(d) = f else { return };
+            let AnyFrame::Data(d) = f else { return };
             let (Some(claim), Some(place)) = (Claim::of(d), d.bus_index()) else {
                 return;
             };
@@ -281,7 +281,7 @@ struct Held {
 }
 
 /// Where a bus's records go: `emit(t, place, frame)`.
-pub(crate) type Emit<'a> = dyn FnMut(Option<f64>, Option<u8>, &Frame) + 'a;
+pub(crate) type Emit<'a> = dyn FnMut(Option<f64>, Option<u8>, &AnyFrame) + 'a;
 
 /// The decoding state of a CAN bus's stream.
 #[derive(Debug)]
@@ -433,7 +433,7 @@ impl CanWire {
         };
         self.place_node[usize::from(slot)] = Some(claim.key.node);
         self.records[usize::from(slot)] += 1;
-        emit(t, Some(slot), &Frame::Data(data));
+        emit(t, Some(slot), &AnyFrame::Data(data));
     }
 
     /// Hands on the records held of the node `i` of those waiting, placed by its node id (no
@@ -577,12 +577,12 @@ pub(crate) fn decode_all(bytes: &[u8], times: Option<&[f64]>) -> Vec<(Option<f64
     let mut wire = CanWire::new();
     let mut out = Vec::new();
     wire.feed(bytes, times, &mut |t, place, f| {
-        if let Frame::Data(d) = f {
+        if let AnyFrame::Data(d) = f {
             out.push((t, place.unwrap_or(0), *d));
         }
     });
     wire.finish(&mut |t, place, f| {
-        if let Frame::Data(d) = f {
+        if let AnyFrame::Data(d) = f {
             out.push((t, place.unwrap_or(0), *d));
         }
     });
@@ -637,7 +637,7 @@ mod tests {
             let mut got = Vec::new();
             for (b, t) in bytes.chunks(chunk).zip(times.chunks(chunk)) {
                 wire.feed(b, Some(t), &mut |t, p, f| {
-                    if let Frame::Data(d) = f {
+                    if let AnyFrame::Data(d) = f {
                         got.push((t, p.unwrap(), *d));
                     }
                 });
@@ -768,13 +768,13 @@ mod tests {
             let mut got = Vec::new();
             for (b, t) in bytes.chunks(chunk).zip(times.chunks(chunk)) {
                 wire.feed(b, Some(t), &mut |t, slot, f| {
-                    if let Frame::Data(Data::HwCan(r)) = f {
+                    if let AnyFrame::Data(Data::HwCan(r)) = f {
                         got.push((t.map(|t| (t * 1e3).round() as u64), r.node, slot.unwrap()));
                     }
                 });
             }
             wire.finish(&mut |t, slot, f| {
-                if let Frame::Data(Data::HwCan(r)) = f {
+                if let AnyFrame::Data(Data::HwCan(r)) = f {
                     got.push((t.map(|t| (t * 1e3).round() as u64), r.node, slot.unwrap()));
                 }
             });

@@ -2,7 +2,7 @@
 //! bus's records of the other protocols left out and counted ([`Bus`]), and what the bytes of
 //! a serial stream are when the protocol forced finds none of its frames ([`Probe`]).
 
-use hwfoc::telemetry::Frame;
+use hwfoc::telemetry::AnyFrame;
 use hwfoc::{Protocol, detect};
 
 use super::can::{CanLink, CanWire, Emit};
@@ -46,12 +46,12 @@ fn keep(
     left_out: &mut [u64; Protocol::ALL.len()],
     t: Option<f64>,
     place: Option<u8>,
-    frame: &Frame,
+    frame: &AnyFrame,
     emit: &mut Emit<'_>,
 ) {
     let protocol = match frame {
-        Frame::Data(d) => Some(d.protocol()),
-        Frame::Info(_) => None,
+        AnyFrame::Data(d) => Some(d.protocol()),
+        AnyFrame::Info(_) => None,
     };
     match forced.zip(protocol) {
         Some((forced, p)) if p != forced => {
@@ -180,8 +180,8 @@ mod tests {
         ] {
             let mut bus = Bus::new(forced);
             let mut n = 0;
-            let mut count = |_, _, f: &Frame| {
-                let Frame::Data(d) = f else { return };
+            let mut count = |_, _, f: &AnyFrame| {
+                let AnyFrame::Data(d) = f else { return };
                 assert!(forced.is_none_or(|p| p == d.protocol()));
                 n += 1;
             };

@@ -6,7 +6,7 @@
 //! becomes the time of each of its bytes.
 
 use hwfoc::counters::{PacketSequence, PacketSequence24};
-use hwfoc::telemetry::{Data, Frame, Info};
+use hwfoc::telemetry::{AnyFrame, Data, Info};
 use hwfoc::{Protocol, Settings, foc};
 use hwfoc::{datalink, detect, hw5, mixed, v3, v4};
 
@@ -77,25 +77,25 @@ pub enum WireKind {
 /// Hands each ESC frame of a hub frame on as `(channel, offset, frame)`, at the hub frame's
 /// offset.
 #[inline]
-fn hub_records(d: &datalink::Decoded, emit: &mut impl FnMut(Option<u8>, u64, &Frame)) {
+fn hub_records(d: &datalink::Decoded, emit: &mut impl FnMut(Option<u8>, u64, &AnyFrame)) {
     for (channel, frame) in d.frame.escs() {
         emit(
             Some(channel as u8),
             d.offset,
-            &Frame::Data(Data::DataLink(*frame)),
+            &AnyFrame::Data(Data::DataLink(*frame)),
         );
     }
 }
 
-/// Hands on a frame of any protocol as the protocol-neutral [`Frame`]: `emit(channel, offset,
+/// Hands on a frame of any protocol as the protocol-neutral [`AnyFrame`]: `emit(channel, offset,
 /// frame)` gets each ESC frame with its DataLink channel (`None` on an ESC's own wire) and the
 /// stream offset of its first byte. The one place where the codec's protocol frames become
 /// neutral frames.
 #[inline(always)]
-fn emit_any(d: detect::Decoded, emit: &mut impl FnMut(Option<u8>, u64, &Frame)) {
+fn emit_any(d: detect::Decoded, emit: &mut impl FnMut(Option<u8>, u64, &AnyFrame)) {
     match d {
         detect::Decoded::Mixed(mixed::Decoded::Esc(d)) => {
-            emit(None, d.offset, &Frame::from(d.frame))
+            emit(None, d.offset, &AnyFrame::from(d.frame))
         }
         detect::Decoded::Mixed(mixed::Decoded::Hub(d)) => hub_records(&d, emit),
         other => emit_other(other, emit),
@@ -106,13 +106,13 @@ fn emit_any(d: detect::Decoded, emit: &mut impl FnMut(Option<u8>, u64, &Frame)) 
 /// HW5): out of line, so that the loop of an HW-FOC stream holds none of it.
 #[cold]
 #[inline(never)]
-fn emit_other(d: detect::Decoded, emit: &mut impl FnMut(Option<u8>, u64, &Frame)) {
+fn emit_other(d: detect::Decoded, emit: &mut impl FnMut(Option<u8>, u64, &AnyFrame)) {
     match d {
-        detect::Decoded::HwV4(d) => emit(None, d.offset, &Frame::from(d.frame)),
-        detect::Decoded::HwV3(d) => emit(None, d.offset, &Frame::Data(Data::HwV3(d.frame))),
-        detect::Decoded::Hw5(d) => emit(None, d.offset, &Frame::Data(Data::Hw5(d.frame))),
+        detect::Decoded::HwV4(d) => emit(None, d.offset, &AnyFrame::from(d.frame)),
+        detect::Decoded::HwV3(d) => emit(None, d.offset, &AnyFrame::Data(Data::HwV3(d.frame))),
+        detect::Decoded::Hw5(d) => emit(None, d.offset, &AnyFrame::Data(Data::Hw5(d.frame))),
         detect::Decoded::Mixed(d) => match d {
-            mixed::Decoded::Esc(d) => emit(None, d.offset, &Frame::from(d.frame)),
+            mixed::Decoded::Esc(d) => emit(None, d.offset, &AnyFrame::from(d.frame)),
             mixed::Decoded::Hub(d) => hub_records(&d, emit),
         },
     }
@@ -166,7 +166,7 @@ impl Wire {
         &mut self,
         data: &[u8],
         silence_s: Option<f64>,
-        mut emit: impl FnMut(Option<u8>, u64, &Frame),
+        mut emit: impl FnMut(Option<u8>, u64, &AnyFrame),
     ) {
         let emit = &mut emit;
         let silent = |p: Protocol| silence_s.map(|s| frames_in_of(p, s));
@@ -214,7 +214,7 @@ impl Wire {
         &mut self,
         data: &[u8],
         silence_s: Option<f64>,
-        mut emit: &mut dyn FnMut(Option<u8>, u64, &Frame),
+        mut emit: &mut dyn FnMut(Option<u8>, u64, &AnyFrame),
     ) {
         let forced = self.forced();
         let silent = silence_s.zip(forced).map(|(s, p)| frames_in_of(p, s));
@@ -228,7 +228,7 @@ impl Wire {
     }
 
     /// Ends the stream, handing on what the held bytes still hold.
-    fn flush(&mut self, emit: &mut impl FnMut(Option<u8>, u64, &Frame)) {
+    fn flush(&mut self, emit: &mut impl FnMut(Option<u8>, u64, &AnyFrame)) {
         match self {
             Wire::Any(d) => d.flush(|d| emit_any(d, emit)),
             Wire::HwFoc(d) => {
@@ -245,7 +245,7 @@ impl Wire {
     }
 
     /// [`Wire::flush`] of a forced V4, V3 or HW5 decoder (see [`Wire::feed_slow`]).
-    fn flush_slow(&mut self, mut emit: &mut dyn FnMut(Option<u8>, u64, &Frame)) {
+    fn flush_slow(&mut self, mut emit: &mut dyn FnMut(Option<u8>, u64, &AnyFrame)) {
         match self {
             Wire::HwV4(d) => d.flush(|d| emit_any(detect::Decoded::HwV4(d), &mut emit)),
             Wire::HwV3(d) => d.flush(|d| emit_any(detect::Decoded::HwV3(d), &mut emit)),
@@ -348,7 +348,7 @@ fn feed_one<S: hwfoc::scan::Scanner>(
     data: &[u8],
     silent: Option<u32>,
     wrap: impl Fn(S::Item) -> detect::Decoded,
-    emit: &mut impl FnMut(Option<u8>, u64, &Frame),
+    emit: &mut impl FnMut(Option<u8>, u64, &AnyFrame),
 ) {
     decoder.feed(
         data,
@@ -717,7 +717,7 @@ impl Stream {
     pub fn feed(
         &mut self,
         batch: Batch<'_>,
-        mut on_frame: impl FnMut(Option<f64>, Option<u8>, &Frame),
+        mut on_frame: impl FnMut(Option<f64>, Option<u8>, &AnyFrame),
     ) {
         if let Wire::Can(c) = &mut self.wire {
             return c.feed(batch.bytes, batch.times, &mut on_frame);
@@ -738,7 +738,7 @@ impl Stream {
             }
             Some(times) => {
                 let history = &self.history;
-                let mut emit = |channel: Option<u8>, offset: u64, f: &Frame| {
+                let mut emit = |channel: Option<u8>, offset: u64, f: &AnyFrame| {
                     on_frame(Some(time_at(history, times, start, offset)), channel, f)
                 };
                 // The batch in pieces at each silence of the line: the decoder is told how many
@@ -773,7 +773,7 @@ impl Stream {
     pub(crate) fn feed_untimed(
         &mut self,
         bytes: &[u8],
-        on_frame: impl FnMut(Option<u8>, u64, &Frame),
+        on_frame: impl FnMut(Option<u8>, u64, &AnyFrame),
     ) {
         self.history.clear();
         if let Some(probe) = &mut self.probe {
@@ -819,14 +819,14 @@ impl Stream {
     }
 
     /// Ends the stream: a frame cut off at the end is dropped, frames inside it are still found.
-    pub fn finish(&mut self, mut on_frame: impl FnMut(Option<f64>, Option<u8>, &Frame)) {
+    pub fn finish(&mut self, mut on_frame: impl FnMut(Option<f64>, Option<u8>, &AnyFrame)) {
         if let Wire::Can(c) = &mut self.wire {
             return c.finish(&mut on_frame);
         }
         let end = self.wire.bytes();
         let history = &self.history;
         let timed = !history.is_empty();
-        let mut emit = |channel: Option<u8>, offset: u64, f: &Frame| {
+        let mut emit = |channel: Option<u8>, offset: u64, f: &AnyFrame| {
             let t = timed.then(|| time_at(history, &[], end, offset));
             on_frame(t, channel, f)
         };
@@ -923,7 +923,7 @@ impl Numbering<'_> {
         &mut self,
         t: Option<f64>,
         channel: Option<u8>,
-        d: &Frame,
+        d: &AnyFrame,
         handler: &mut H,
     ) {
         let Numbering {
@@ -958,7 +958,7 @@ impl Numbering<'_> {
         };
         if let Ok(id) = u8::try_from(esc) {
             handler.frame(id, t, d, &esc_settings[esc]);
-        } else if matches!(d, Frame::Data(_)) {
+        } else if matches!(d, AnyFrame::Data(_)) {
             if left_out[*port] == 0 {
                 past_last.push(Notice::PastLastEsc {
                     input: names[*port].clone(),
@@ -1488,8 +1488,8 @@ mod mixed_tests {
     ) -> (Vec<(Option<u8>, u16)>, Stream) {
         let mut stream = Stream::forced(forced);
         let mut got = Vec::new();
-        let mut on = |_: Option<f64>, channel: Option<u8>, frame: &Frame| {
-            if let Frame::Data(f) = frame {
+        let mut on = |_: Option<f64>, channel: Option<u8>, frame: &AnyFrame| {
+            if let AnyFrame::Data(f) = frame {
                 got.push((
                     channel,
                     hwfoc::Telemetry::packet(f).unwrap_or_default() as u16,

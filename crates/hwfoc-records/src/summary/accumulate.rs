@@ -4,7 +4,7 @@
 
 use hwfoc::foc::DataFrame;
 use hwfoc::format::FormatDescription;
-use hwfoc::telemetry::{Conversion, Data, Frame, Info, Telemetry};
+use hwfoc::telemetry::{AnyFrame, Conversion, Data, Info, Telemetry};
 use hwfoc::units::ADC_NO_VALUE;
 use hwfoc::{Protocol, Quantity, Settings, Status, Temperature};
 
@@ -560,11 +560,11 @@ impl Default for Accumulator {
 
 impl Accumulator {
     #[inline]
-    pub(super) fn add(&mut self, t: Option<f64>, frame: &Frame, settings: &Settings) {
+    pub(super) fn add(&mut self, t: Option<f64>, frame: &AnyFrame, settings: &Settings) {
         match frame {
-            Frame::Data(f) if !keeps_raw(f.protocol()) => self.add_values(t, f, settings),
-            Frame::Data(f) => self.add_data(t, f),
-            Frame::Info(info) => match self.infos.iter_mut().find(|(i, _)| i == info) {
+            AnyFrame::Data(f) if !keeps_raw(f.protocol()) => self.add_values(t, f, settings),
+            AnyFrame::Data(f) => self.add_data(t, f),
+            AnyFrame::Info(info) => match self.infos.iter_mut().find(|(i, _)| i == info) {
                 Some((_, n)) => *n += 1,
                 None => self.infos.push((*info, 1)),
             },

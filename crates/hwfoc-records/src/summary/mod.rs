@@ -28,7 +28,7 @@
 use std::any::Any;
 
 use hwfoc::foc::DataFrame;
-use hwfoc::telemetry::{Conversion, Data, Frame, Info, Telemetry};
+use hwfoc::telemetry::{AnyFrame, Conversion, Data, Info, Telemetry};
 use hwfoc::units::Linear;
 use hwfoc::{Protocol, Quantity, Settings, Status};
 use serde_json::{Value, json};
@@ -225,9 +225,9 @@ impl Handler for Summary {
     /// to the accumulator, not through a `Decoded` in memory); every other frame is taken out of
     /// line.
     #[inline(always)]
-    fn frame(&mut self, esc: u8, t: Option<f64>, frame: &Frame, settings: &Settings) {
+    fn frame(&mut self, esc: u8, t: Option<f64>, frame: &AnyFrame, settings: &Settings) {
         let esc = usize::from(esc);
-        if let Frame::Data(f) = frame
+        if let AnyFrame::Data(f) = frame
             && let Some(acc) = self.0.get_mut(esc)
             && acc.fast
             && is_clean(f)
@@ -252,7 +252,7 @@ impl Handler for Summary {
                 i += acc.add_clean_run(&frames[i..]);
             }
             if let Some(f) = frames.get(i) {
-                self.add(esc, None, &Frame::Data(Data::HwFoc(*f)), settings);
+                self.add(esc, None, &AnyFrame::Data(Data::HwFoc(*f)), settings);
                 i += 1;
             }
         }
@@ -282,7 +282,7 @@ impl Handler for Summary {
 struct Part(Summary);
 
 impl LaterPart for Part {
-    fn frame(&mut self, esc: u8, frame: &Frame, settings: &Settings) {
+    fn frame(&mut self, esc: u8, frame: &AnyFrame, settings: &Settings) {
         self.0.frame(esc, None, frame, settings);
     }
 
@@ -299,7 +299,7 @@ impl Summary {
     /// Any frame of ESC `esc`.
     #[cold]
     #[inline(never)]
-    fn add(&mut self, esc: usize, t: Option<f64>, frame: &Frame, settings: &Settings) {
+    fn add(&mut self, esc: usize, t: Option<f64>, frame: &AnyFrame, settings: &Settings) {
         if self.0.len() <= esc {
             self.0.resize_with(esc + 1, Accumulator::default);
         }

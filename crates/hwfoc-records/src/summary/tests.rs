@@ -63,7 +63,7 @@ fn episodes_are_maximal_runs_of_faulty_frames() {
         };
         acc.add(
             Some(i as f64 * 0.05),
-            &Frame::Data(frame.into()),
+            &AnyFrame::Data(frame.into()),
             &Settings::DEFAULT,
         );
     }
@@ -117,7 +117,7 @@ fn frames_handed_on_together_are_summarised_as_one_at_a_time() {
     let settings = Settings::DEFAULT;
     let mut one_at_a_time = Summary::new();
     for f in &frames {
-        one_at_a_time.frame(0, None, &Frame::Data(Data::HwFoc(*f)), &settings);
+        one_at_a_time.frame(0, None, &AnyFrame::Data(Data::HwFoc(*f)), &settings);
     }
     for run in [1, 2, 7, 512, 3000] {
         let mut together = Summary::new();
@@ -184,7 +184,7 @@ fn summarised(name: &str, bytes: Vec<u8>) -> (String, Value) {
 #[test]
 fn hw5_loss_is_judged_from_time() {
     let frame = |erpm_raw: u16| {
-        Frame::Data(Data::Hw5(hwfoc::hw5::TelemetryFrame {
+        AnyFrame::Data(Data::Hw5(hwfoc::hw5::TelemetryFrame {
             throttle: if erpm_raw > 0 { 30 } else { 0 },
             erpm_raw,
             voltage_raw: 504,
@@ -293,7 +293,7 @@ impl Wire {
     fn frame(self, n: u32) -> Vec<u8> {
         match self {
             Wire::HwFoc => foc_frames([n as u16]),
-            Wire::V3 => hwfoc::v3::Frame {
+            Wire::V3 => hwfoc::v3::V3Frame {
                 counter: n & 0xFF_FFFF,
                 throttle_in_raw: 51,
                 pwm_out_raw: 51,

@@ -3,7 +3,7 @@
 use std::fmt;
 
 use hwfoc::datalink::LengthByte;
-use hwfoc::foc::{Decoded, Frame, Parsed, parse};
+use hwfoc::foc::{Decoded, FocFrame, Parsed, parse};
 use hwfoc::scan::{Scan, Scanner, Stats as _, StreamDecoder};
 use hwfoc::{datalink, detect, foc, hw5, mixed, v3, v4};
 
@@ -26,7 +26,7 @@ pub fn check_stream(input: &[u8], decoded: &[Decoded], stats: &foc::Stats) {
     );
     let data = decoded
         .iter()
-        .filter(|d| matches!(d.frame, Frame::Data(_)))
+        .filter(|d| matches!(d.frame, FocFrame::Data(_)))
         .count();
     assert_eq!(data as u64, u64::from(stats.frames()), "data frames");
     assert_eq!(
@@ -81,7 +81,7 @@ pub fn check_stream(input: &[u8], decoded: &[Decoded], stats: &foc::Stats) {
 /// - every record of every frame counted once (a channel's, empty, bad or duplicate channel),
 ///   and each channel's record count matches the frames given;
 /// - offsets strictly increase and frames never overlap;
-/// - `datalink::Frame::parse_with_report` reads the same frame and report at each offset, and
+/// - `datalink::HubFrame::parse_with_report` reads the same frame and report at each offset, and
 ///   the frame re-encodes to the input bytes when nothing of it was dropped (no bad or
 ///   duplicate channel, the length byte 0x9E, every channel byte its position).
 pub fn check_datalink_stream(input: &[u8], decoded: &[datalink::Decoded], stats: &datalink::Stats) {
@@ -128,7 +128,7 @@ pub fn check_datalink_stream(input: &[u8], decoded: &[datalink::Decoded], stats:
         let end = start + 160;
         assert!(end <= input.len(), "frame at {start} runs past the input");
         assert_eq!(
-            datalink::Frame::parse_with_report(&input[start..]),
+            datalink::HubFrame::parse_with_report(&input[start..]),
             Ok((d.frame, d.report)),
             "parse disagrees at {start}"
         );
@@ -373,7 +373,7 @@ pub fn check_v3_stream(input: &[u8], decoded: &[v3::Decoded], stats: &v3::Stats)
         let start = d.offset as usize;
         assert!(d.frame.is_plausible(), "implausible frame at {start}");
         assert_eq!(
-            v3::Frame::parse(&input[start..]),
+            v3::V3Frame::parse(&input[start..]),
             Some(d.frame),
             "parse at {start}"
         );
@@ -402,7 +402,7 @@ pub fn check_v4_stream(input: &[u8], decoded: &[v4::Decoded], stats: &v4::Stats)
     );
     let data = decoded
         .iter()
-        .filter(|d| matches!(d.frame, v4::Frame::Data(_)))
+        .filter(|d| matches!(d.frame, v4::V4Frame::Data(_)))
         .count();
     assert_eq!(data as u64, u64::from(stats.frames()), "data frames");
     assert_eq!(
@@ -412,15 +412,15 @@ pub fn check_v4_stream(input: &[u8], decoded: &[v4::Decoded], stats: &v4::Stats)
     );
     assert!(stats.trailers() <= stats.frames(), "trailers: {stats}");
     let len_of = |d: &v4::Decoded| match d.frame {
-        v4::Frame::Data(_) => v4::DATA_FRAME_LEN,
-        v4::Frame::Info(_) => v4::INFO_FRAME_LEN,
+        v4::V4Frame::Data(_) => v4::DATA_FRAME_LEN,
+        v4::V4Frame::Info(_) => v4::INFO_FRAME_LEN,
     };
     assert_disjoint(input.len(), decoded.iter().map(|d| (d.offset, len_of(d))));
     let mut infos_seen: Vec<v4::InfoFrame> = Vec::new();
     for d in decoded {
         let start = d.offset as usize;
         match d.frame {
-            v4::Frame::Data(data) => {
+            v4::V4Frame::Data(data) => {
                 assert!(
                     data.frame.is_plausible(data.full_scale()),
                     "implausible data frame at {start}"
@@ -437,7 +437,7 @@ pub fn check_v4_stream(input: &[u8], decoded: &[v4::Decoded], stats: &v4::Stats)
                     );
                 }
             }
-            v4::Frame::Info(info) => {
+            v4::V4Frame::Info(info) => {
                 assert!(info.is_plausible(), "implausible info frame at {start}");
                 assert_eq!(v4::InfoFrame::parse(&input[start..]), Some(info));
                 assert_eq!(

@@ -83,7 +83,7 @@ pub use esc::*;
 
 #[cfg(feature = "esc")]
 mod esc {
-    use hwfoc::foc::{Decoder, Frame};
+    use hwfoc::foc::{Decoder, FocFrame};
 
     use crate::ProbeFrame;
 
@@ -98,7 +98,7 @@ mod esc {
     ) -> bool {
         let mut got = false;
         state.push(byte, |d| {
-            if let Frame::Data(f) = d.frame {
+            if let FocFrame::Data(f) = d.frame {
                 *out = ProbeFrame {
                     offset: d.offset,
                     packet: f.packet,
@@ -354,7 +354,7 @@ mod v4 {
     ) -> bool {
         let mut got = false;
         state.push(byte, |d| {
-            if let v4::Frame::Data(data) = d.frame {
+            if let v4::V4Frame::Data(data) = d.frame {
                 let f = data.frame;
                 *out = ProbeV4 {
                     offset: d.offset,

@@ -13,7 +13,7 @@
 use crate::foc::decoder::{bytes_equal, find_sync_then};
 use crate::scan::{self, Candidate, Scan, StreamDecoder};
 
-use super::frame::{Frame, FrameReport};
+use super::frame::{FrameReport, HubFrame};
 use super::layout::{FRAME_LEN, LengthByte, is_version_and_command};
 use super::stats::Stats;
 
@@ -24,7 +24,7 @@ pub struct Decoded {
     /// created (or, for [`frames`], from the start of the slice).
     pub offset: u64,
     /// The frame.
-    pub frame: Frame,
+    pub frame: HubFrame,
     /// Its length byte, and its empty, bad-channel and duplicate-channel records.
     pub report: FrameReport,
 }
@@ -56,7 +56,7 @@ pub(crate) fn candidate_len(held: usize) -> usize {
 
 /// What a candidate (a `9B` and a length byte, or a `9B` alone at the end) is.
 enum Verdict {
-    Frame(Frame, FrameReport),
+    Frame(HubFrame, FrameReport),
     BadHeader,
     BadCrc,
     /// More bytes are needed.
@@ -76,12 +76,12 @@ fn judge(candidate: &[u8]) -> Verdict {
     let Some(frame) = candidate.first_chunk::<FRAME_LEN>() else {
         return Verdict::Undecided;
     };
-    if !Frame::crc_ok(frame) {
+    if !HubFrame::crc_ok(frame) {
         return Verdict::BadCrc;
     }
     match LengthByte::from_byte(length_byte) {
         Some(length_byte) => {
-            let (frame, report) = Frame::read(frame, length_byte);
+            let (frame, report) = HubFrame::read(frame, length_byte);
             Verdict::Frame(frame, report)
         }
         // `find_header` stops at no other length byte.
@@ -100,7 +100,7 @@ fn scan_next(
     pos: &mut usize,
     stats: &mut Stats,
     at_end: bool,
-) -> Option<(usize, Frame, FrameReport)> {
+) -> Option<(usize, HubFrame, FrameReport)> {
     loop {
         let Some(k) = find_header(&data[*pos..]) else {
             stats.skip(data.len() - *pos);
@@ -129,7 +129,7 @@ pub(crate) fn take_candidate(
     pos: &mut usize,
     stats: &mut Stats,
     at_end: bool,
-) -> Candidate<(usize, Frame, FrameReport)> {
+) -> Candidate<(usize, HubFrame, FrameReport)> {
     let i = *pos;
     match judge(&data[i..]) {
         Verdict::Frame(frame, report) => {
@@ -240,10 +240,10 @@ impl scan::Scanner for Scanner {
 /// completes at most one frame.
 ///
 /// ```
-/// use hwfoc::datalink::{Decoder, Frame, LengthByte};
+/// use hwfoc::datalink::{Decoder, HubFrame, LengthByte};
 /// use hwfoc::foc::DataFrame;
 ///
-/// let mut frame = Frame::new(7);
+/// let mut frame = HubFrame::new(7);
 /// frame.slots[1] = Some(DataFrame { packet: 300, voltage_raw: 252, ..Default::default() });
 /// let mut wire = vec![0x00, 0x9B, 0x9E]; // noise and a fake header
 /// wire.extend_from_slice(&frame.encode_as(LengthByte::Total));
@@ -274,17 +274,17 @@ impl scan::Scanner for Scanner {
 /// sent on its own 19200-baud wire in that time.
 ///
 /// ```
-/// use hwfoc::datalink::{BAUD_RATE, Decoder, Frame, FRAME_LEN};
+/// use hwfoc::datalink::{BAUD_RATE, Decoder, HubFrame, FRAME_LEN};
 /// use hwfoc::wire::byte_ns;
 ///
 /// let mut decoder = Decoder::new();
-/// decoder.feed(&Frame::new(1000).encode(), |_| {});
+/// decoder.feed(&HubFrame::new(1000).encode(), |_| {});
 /// // 1 s without a byte: at most 1 s / 160 byte times = 72 frames could have been sent.
 /// let max_frames = (1e9 / (FRAME_LEN as f64 * byte_ns(BAUD_RATE))) as u32;
 /// assert_eq!(max_frames, 72);
 /// decoder.line_silent(max_frames, |_| {});
-/// decoder.feed(&Frame::new(1200).encode(), |_| {}); // the hub restarted
-/// decoder.feed(&Frame::new(1203).encode(), |_| {}); // 2 frames lost
+/// decoder.feed(&HubFrame::new(1200).encode(), |_| {}); // the hub restarted
+/// decoder.feed(&HubFrame::new(1203).encode(), |_| {}); // 2 frames lost
 /// assert_eq!(decoder.stats().restarts(), 1);
 /// assert_eq!(decoder.stats().lost_packets(), 2);
 /// ```
@@ -297,11 +297,11 @@ pub type Decoder = StreamDecoder<Scanner>;
 /// flushed would, with the same statistics.
 ///
 /// ```
-/// use hwfoc::datalink::{self, Frame};
+/// use hwfoc::datalink::{self, HubFrame};
 ///
 /// let mut wire = Vec::new();
 /// for counter in 0..3u16 {
-///     wire.extend_from_slice(&Frame::new(counter).encode());
+///     wire.extend_from_slice(&HubFrame::new(counter).encode());
 /// }
 /// wire[200] ^= 0x04; // corrupt the second frame
 /// let mut it = datalink::frames(&wire);
@@ -336,7 +336,7 @@ mod tests {
 
     #[test]
     fn held_candidate_resolves_across_calls() {
-        let f = Frame::new(9).encode();
+        let f = HubFrame::new(9).encode();
         let mut d = Decoder::new();
         let mut n = 0;
         for (i, chunk) in [&f[..1], &f[1..3], &f[3..4], &f[4..159]].iter().enumerate() {

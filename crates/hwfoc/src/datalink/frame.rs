@@ -18,20 +18,20 @@ use super::layout::{
 /// every field is zero encodes as an empty slot and parses back as `None`.
 ///
 /// ```
-/// use hwfoc::datalink::{Frame, FRAME_LEN};
+/// use hwfoc::datalink::{HubFrame, FRAME_LEN};
 /// use hwfoc::foc::DataFrame;
 ///
-/// let mut frame = Frame::new(41);
+/// let mut frame = HubFrame::new(41);
 /// frame.slots[2] = Some(DataFrame { packet: 7, voltage_raw: 252, ..Default::default() });
 /// let bytes = frame.encode();
 /// assert_eq!(bytes.len(), FRAME_LEN);
 /// assert_eq!(&bytes[..6], &[0x9B, 0x9E, 0x01, 0x02, 0x00, 41]);
 /// assert_eq!(bytes[6 + 2 * 19], 2); // the channel byte of slot 2's record
-/// assert_eq!(Frame::parse(&bytes)?, frame);
+/// assert_eq!(HubFrame::parse(&bytes)?, frame);
 /// # Ok::<(), hwfoc::datalink::Error>(())
 /// ```
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
-pub struct Frame {
+pub struct HubFrame {
     /// The hub's frame counter (bytes 4..6, big-endian).
     pub counter: u16,
     /// The ESC records by channel; `None` for an empty slot.
@@ -58,10 +58,10 @@ pub struct FrameReport {
     pub duplicate_channels: u8,
 }
 
-impl Frame {
+impl HubFrame {
     /// A frame with counter `counter` and every slot empty.
     pub const fn new(counter: u16) -> Self {
-        Frame {
+        HubFrame {
             counter,
             slots: [None; CHANNELS],
         }
@@ -101,12 +101,12 @@ impl Frame {
     /// ignored), checking in this order: length, sync byte, length byte (0x9E or 0xA0), version
     /// and command (`01 02`), CRC. The records are read as the decoder reads them (see
     /// [`FrameReport`]): a bad or duplicate channel drops that record, not the frame.
-    pub fn parse(bytes: &[u8]) -> Result<Frame, Error> {
+    pub fn parse(bytes: &[u8]) -> Result<HubFrame, Error> {
         Self::parse_with_report(bytes).map(|(frame, _)| frame)
     }
 
     /// [`Self::parse`], with what reading the records found.
-    pub fn parse_with_report(bytes: &[u8]) -> Result<(Frame, FrameReport), Error> {
+    pub fn parse_with_report(bytes: &[u8]) -> Result<(HubFrame, FrameReport), Error> {
         let Some(f) = bytes.first_chunk::<FRAME_LEN>() else {
             return Err(Error::Truncated { got: bytes.len() });
         };
@@ -138,8 +138,8 @@ impl Frame {
 
     /// Reads the counter and records of a frame whose header and CRC are verified.
     #[inline]
-    pub(crate) fn read(f: &[u8; FRAME_LEN], length_byte: LengthByte) -> (Frame, FrameReport) {
-        let mut frame = Frame::new(u16::from_be_bytes([f[COUNTER_AT], f[COUNTER_AT + 1]]));
+    pub(crate) fn read(f: &[u8; FRAME_LEN], length_byte: LengthByte) -> (HubFrame, FrameReport) {
+        let mut frame = HubFrame::new(u16::from_be_bytes([f[COUNTER_AT], f[COUNTER_AT + 1]]));
         let mut report = FrameReport {
             length_byte,
             empty_slots: 0,
@@ -199,7 +199,7 @@ mod tests {
     /// and its CRC against Python's `binascii.crc_hqx(bytes[:158], 0)` (CRC-16/XMODEM).
     #[test]
     fn encode_writes_the_documented_layout() {
-        let mut frame = Frame::new(0x1234);
+        let mut frame = HubFrame::new(0x1234);
         frame.slots[0] = Some(esc(0xABCD));
         frame.slots[7] = Some(esc(1));
         let b = frame.encode();
@@ -226,7 +226,7 @@ mod tests {
 
     #[test]
     fn records_by_channel_byte_not_position() {
-        let mut b = Frame::new(3).encode();
+        let mut b = HubFrame::new(3).encode();
         // Record 0 for channel 5, record 1 for channel 9, record 2 again for channel 5,
         // record 3 empty with a channel byte of 200.
         let r = |i: usize| 6 + 19 * i;
@@ -238,7 +238,7 @@ mod tests {
         b[r(2) + 2] = 3;
         b[r(3)] = 200;
         CHECKSUM.seal(&mut b);
-        let (frame, report) = Frame::parse_with_report(&b).unwrap();
+        let (frame, report) = HubFrame::parse_with_report(&b).unwrap();
         assert_eq!(frame.slots[5].map(|e| e.packet), Some(1));
         assert_eq!(frame.escs().count(), 1);
         assert_eq!(
@@ -254,21 +254,24 @@ mod tests {
 
     #[test]
     fn parse_errors_in_order() {
-        let good = Frame::new(1).encode();
+        let good = HubFrame::new(1).encode();
         assert_eq!(
-            Frame::parse(&good[..159]),
+            HubFrame::parse(&good[..159]),
             Err(Error::Truncated { got: 159 })
         );
         let mut b = good;
         b[0] = 0x9C;
         b[1] = 0x16;
-        assert_eq!(Frame::parse(&b), Err(Error::NoSync { found: 0x9C }));
+        assert_eq!(HubFrame::parse(&b), Err(Error::NoSync { found: 0x9C }));
         b[0] = 0x9B;
-        assert_eq!(Frame::parse(&b), Err(Error::UnknownLength { found: 0x16 }));
+        assert_eq!(
+            HubFrame::parse(&b),
+            Err(Error::UnknownLength { found: 0x16 })
+        );
         b[1] = 0xA0;
         b[3] = 0x01;
         assert_eq!(
-            Frame::parse(&b),
+            HubFrame::parse(&b),
             Err(Error::UnknownCommand {
                 version: 1,
                 command: 1
@@ -276,7 +279,7 @@ mod tests {
         );
         b[3] = 0x02;
         let carried = u16::from_le_bytes([b[158], b[159]]);
-        let Err(Error::Crc { expected, found }) = Frame::parse(&b) else {
+        let Err(Error::Crc { expected, found }) = HubFrame::parse(&b) else {
             panic!("a changed length byte breaks the CRC");
         };
         assert_eq!(
@@ -286,7 +289,7 @@ mod tests {
         assert_ne!(expected, found);
         let mut longer = [0u8; 200];
         longer[..160].copy_from_slice(&good);
-        assert_eq!(Frame::parse(&longer), Ok(Frame::new(1)));
+        assert_eq!(HubFrame::parse(&longer), Ok(HubFrame::new(1)));
     }
 
     #[test]

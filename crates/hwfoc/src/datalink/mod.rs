@@ -2,7 +2,7 @@
 //! 160-byte frame (`docs/PROTOCOL-NOTES.md`, "The DataLink side").
 //!
 //! A family of its own beside the HW-FOC decoder ([`crate::foc`]), not a kind of
-//! [`crate::foc::Frame`]: a hub's wire carries only these frames, an ESC's wire never does, so
+//! [`crate::foc::FocFrame`]: a hub's wire carries only these frames, an ESC's wire never does, so
 //! neither decoder pays for the other (the HW-FOC [`Decoder`](crate::foc::Decoder) keeps its
 //! 76-byte buffer; this one holds up to 159 bytes). What the two share is not copied:
 //!
@@ -19,16 +19,16 @@
 //! | module | holds |
 //! |---|---|
 //! | `layout` | [`BAUD_RATE`], [`FRAME_LEN`], [`RECORD_LEN`], [`CHANNELS`], offsets, [`LengthByte`] |
-//! | `frame` | [`Frame`] (encode, parse), [`FrameReport`] |
+//! | `frame` | [`HubFrame`] (encode, parse), [`FrameReport`] |
 //! | `error` | [`Error`] |
 //! | `stats` | [`Stats`], [`esc_frames_in`] |
 //! | `decoder` | the scanner: [`Decoder`], [`frames`], [`Decoded`] |
 //!
 //! ```
-//! use hwfoc::datalink::{self, Frame};
+//! use hwfoc::datalink::{self, HubFrame};
 //! use hwfoc::foc::DataFrame;
 //!
-//! let mut frame = Frame::new(1);
+//! let mut frame = HubFrame::new(1);
 //! frame.slots[0] = Some(DataFrame { packet: 10, erpm_raw: 900, ..Default::default() });
 //! frame.slots[3] = Some(DataFrame { packet: 20, erpm_raw: 950, ..Default::default() });
 //! let mut wire = b"noise".to_vec();
@@ -51,7 +51,7 @@ mod stats;
 pub use decoder::{Decoded, Decoder, Frames, Scanner, frames};
 pub use description::DESCRIPTION;
 pub use error::Error;
-pub use frame::{Frame, FrameReport};
+pub use frame::{FrameReport, HubFrame};
 pub use layout::{
     BAUD_RATE, CHANNELS, CHECK_AT, CHECKSUM, COMMAND, COUNTER_AT, FRAME_LEN, LengthByte,
     RECORD_LEN, RECORDS_AT, header,

@@ -6,7 +6,7 @@ use core::fmt;
 use crate::counters::{ByteCounts, Bytes, PacketSequence};
 use crate::foc::kinds::data::DATA_FRAME_LEN;
 
-use super::frame::{Frame, FrameReport};
+use super::frame::{FrameReport, HubFrame};
 use super::layout::{BAUD_RATE, CHANNELS, FRAME_LEN, LengthByte};
 
 /// Counters kept per stream by [`Decoder`](super::Decoder) and
@@ -191,7 +191,7 @@ impl Stats {
 
     /// Counts an accepted frame.
     #[inline]
-    pub(crate) fn frame(&mut self, frame: &Frame, report: &FrameReport) {
+    pub(crate) fn frame(&mut self, frame: &HubFrame, report: &FrameReport) {
         self.counter.next(frame.counter);
         let n = &mut self.length_bytes[report.length_byte as usize];
         *n = n.saturating_add(1);
@@ -285,7 +285,7 @@ mod tests {
             duplicate_channels: 0,
         };
         let frame = |counter: u16, packet: u16| {
-            let mut f = Frame::new(counter);
+            let mut f = HubFrame::new(counter);
             f.slots[3] = Some(DataFrame {
                 packet,
                 ..Default::default()

@@ -22,7 +22,7 @@
 //! are inlined with every kind's constants: no dynamic dispatch, no function pointer, and no loop
 //! over the kinds is left in the scanner.
 
-use crate::foc::frame::{Frame, MAX_FRAME_LEN, candidate_len, or_length_bytes, wire_len_of};
+use crate::foc::frame::{FocFrame, MAX_FRAME_LEN, candidate_len, or_length_bytes, wire_len_of};
 use crate::foc::stats::Stats;
 use crate::foc::window::{WINDOW, WINDOW_BYTES, Window, window};
 use crate::scan::{self, Candidate, Scan, StreamDecoder};
@@ -35,7 +35,7 @@ pub struct Decoded {
     /// created (or, for [`frames`], from the start of the slice).
     pub offset: u64,
     /// The frame.
-    pub frame: Frame,
+    pub frame: FocFrame,
 }
 
 /// Whether `b` is the length byte of a known frame kind.
@@ -115,13 +115,13 @@ fn scan_next(
     stats: &mut Stats,
     at_end: bool,
     first_guess: bool,
-) -> Option<(usize, Frame)> {
+) -> Option<(usize, FocFrame)> {
     // Back-to-back frames, the usual case: a frame of the most frequent kind starts right here.
-    if first_guess && let Some(found) = Frame::take_first(data, pos, stats) {
+    if first_guess && let Some(found) = FocFrame::take_first(data, pos, stats) {
         return Some(found);
     }
     // A frame of any kind right here (a device-information frame among data frames).
-    if let Some(found) = Frame::take(data, pos, stats) {
+    if let Some(found) = FocFrame::take(data, pos, stats) {
         return Some(found);
     }
     // Then whole windows, counted here from what the search found.
@@ -130,7 +130,7 @@ fn scan_next(
     stats.skip(searched.skipped);
     *pos += searched.skipped;
     if searched.found
-        && let Some(found) = Frame::take(data, pos, stats)
+        && let Some(found) = FocFrame::take(data, pos, stats)
     {
         return Some(found);
     }
@@ -195,7 +195,7 @@ fn search_windows(data: &[u8], from: usize) -> Searched {
         };
         while headers != 0 {
             let k = headers.trailing_zeros() as usize;
-            if Frame::verifies(data, start + k) {
+            if FocFrame::verifies(data, start + k) {
                 let before = candidates & ((1 << k) - 1);
                 searched.rejected = searched.rejected.saturating_add(before.count_ones());
                 searched.skipped += k;
@@ -219,11 +219,11 @@ pub(crate) fn take_candidate(
     pos: &mut usize,
     stats: &mut Stats,
     at_end: bool,
-) -> Candidate<(usize, Frame)> {
+) -> Candidate<(usize, FocFrame)> {
     let i = *pos;
     // Each kind decides "valid frame of mine" with as few, as predictable, branches as it can
     // (false all through line noise, true all through a run of frames).
-    if let Some(found) = Frame::take(data, pos, stats) {
+    if let Some(found) = FocFrame::take(data, pos, stats) {
         return Candidate::Frame(found);
     }
     let rest = &data[i..];
@@ -313,7 +313,7 @@ impl scan::Scanner for Scanner {
             // Back-to-back frames of the first kind have a call site of their own, where the frame
             // built is known to be of that kind: only its fields are written, not the bytes of the
             // largest kind that a merged call site would copy for every frame.
-            while let Some((at, frame)) = Frame::take_first(data, &mut pos, stats) {
+            while let Some((at, frame)) = FocFrame::take_first(data, &mut pos, stats) {
                 on_frame(Decoded {
                     offset: base + at as u64,
                     frame,
@@ -348,7 +348,7 @@ impl scan::Scanner for Scanner {
 /// turns out to hold data frames).
 ///
 /// ```
-/// use hwfoc::foc::{DataFrame, Decoder, Frame};
+/// use hwfoc::foc::{DataFrame, Decoder, FocFrame};
 ///
 /// let frame = DataFrame { packet: 7, voltage_raw: 252, ..Default::default() };
 /// let mut wire = vec![0x00, 0x9B, 0x13]; // noise and a lone sync byte
@@ -363,7 +363,7 @@ impl scan::Scanner for Scanner {
 /// decoder.flush(|d| got.push(d));
 /// assert_eq!(got.len(), 1);
 /// assert_eq!(got[0].offset, 3);
-/// assert_eq!(got[0].frame, Frame::Data(frame));
+/// assert_eq!(got[0].frame, FocFrame::Data(frame));
 /// assert_eq!(decoder.stats().bytes_skipped(), 3);
 /// ```
 ///
@@ -415,7 +415,7 @@ pub type Decoder = StreamDecoder<Scanner>;
 /// would, with the same statistics.
 ///
 /// ```
-/// use hwfoc::foc::{DataFrame, Frame, frames};
+/// use hwfoc::foc::{DataFrame, FocFrame, frames};
 ///
 /// let mut wire = Vec::new();
 /// for packet in 0..3u16 {
@@ -425,7 +425,7 @@ pub type Decoder = StreamDecoder<Scanner>;
 /// let mut it = frames(&wire);
 /// let packets: Vec<u16> = it
 ///     .by_ref()
-///     .filter_map(|d| match d.frame { Frame::Data(f) => Some(f.packet), _ => None })
+///     .filter_map(|d| match d.frame { FocFrame::Data(f) => Some(f.packet), _ => None })
 ///     .collect();
 /// assert_eq!(packets, [0, 2]);
 /// assert_eq!(it.stats().checksum_failures(), 1);

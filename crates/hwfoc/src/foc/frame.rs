@@ -1,4 +1,4 @@
-//! The list of frame kinds, and what is built from it: [`Frame`] (one arm per kind),
+//! The list of frame kinds, and what is built from it: [`FocFrame`] (one arm per kind),
 //! [`MAX_FRAME_LEN`], [`parse`] and the dispatch the scanner of [`crate::foc::decoder`] uses.
 
 use core::fmt;
@@ -23,15 +23,15 @@ macro_rules! frame_kinds {
     (@expand $first_arm:ident($first_kind:ty); $([$(#[$attr:meta])* $arm:ident($kind:ty)])+) => {
         /// A frame of any kind found on the telemetry wire: one arm per [`FrameKind`].
         #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-        pub enum Frame {
+        pub enum FocFrame {
             $( $(#[$attr])* $arm($kind), )+
         }
 
         $(
-            impl From<$kind> for Frame {
+            impl From<$kind> for FocFrame {
                 #[inline]
-                fn from(frame: $kind) -> Frame {
-                    Frame::$arm(frame)
+                fn from(frame: $kind) -> FocFrame {
+                    FocFrame::$arm(frame)
                 }
             }
         )+
@@ -89,19 +89,19 @@ macro_rules! frame_kinds {
             MAX_FRAME_LEN
         }
 
-        impl Frame {
+        impl FocFrame {
             /// The frame's length on the wire.
             pub fn wire_len(&self) -> usize {
                 match self {
-                    $( Frame::$arm(_) => <$kind as FrameKind>::LEN, )+
+                    $( FocFrame::$arm(_) => <$kind as FrameKind>::LEN, )+
                 }
             }
 
             /// Encodes the frame into the start of `out` and returns the number of bytes written,
-            /// or `None` when `out` is shorter than [`Frame::wire_len`].
+            /// or `None` when `out` is shorter than [`FocFrame::wire_len`].
             pub fn encode_into(&self, out: &mut [u8]) -> Option<usize> {
                 match self {
-                    $( Frame::$arm(frame) => frame.encode_into(out), )+
+                    $( FocFrame::$arm(frame) => frame.encode_into(out), )+
                 }
             }
 
@@ -113,22 +113,22 @@ macro_rules! frame_kinds {
                 data: &[u8],
                 pos: &mut usize,
                 stats: &mut Stats,
-            ) -> Option<(usize, Frame)> {
+            ) -> Option<(usize, FocFrame)> {
                 let at = *pos;
                 let frame = <$first_kind as FrameKind>::accept(&data[at..])?;
                 frame.count(stats);
                 *pos = at + <$first_kind as FrameKind>::LEN;
-                Some((at, Frame::$first_arm(frame)))
+                Some((at, FocFrame::$first_arm(frame)))
             }
 
             /// The frame at `data[*pos..]` (a sync byte and a known length byte), if a kind
-            /// accepts it: counted and returned as by [`Frame::take_first`].
+            /// accepts it: counted and returned as by [`FocFrame::take_first`].
             #[inline(always)]
             pub(crate) fn take(
                 data: &[u8],
                 pos: &mut usize,
                 stats: &mut Stats,
-            ) -> Option<(usize, Frame)> {
+            ) -> Option<(usize, FocFrame)> {
                 let at = *pos;
                 // One load and one compare per kind: only the kind whose whole header the
                 // candidate carries checks it further (kinds' headers differ), so a fake header
@@ -139,13 +139,13 @@ macro_rules! frame_kinds {
                         let frame = <$kind as FrameKind>::accept(&data[at..])?;
                         frame.count(stats);
                         *pos = at + <$kind as FrameKind>::LEN;
-                        return Some((at, Frame::$arm(frame)));
+                        return Some((at, FocFrame::$arm(frame)));
                     }
                 )+
                 None
             }
 
-            /// Whether a frame of some kind starts at `data[at..]` ([`Frame::take`] without
+            /// Whether a frame of some kind starts at `data[at..]` ([`FocFrame::take`] without
             /// counting it or building it).
             #[inline(always)]
             pub(crate) fn verifies(data: &[u8], at: usize) -> bool {
@@ -161,16 +161,16 @@ macro_rules! frame_kinds {
             /// Checks and decodes `candidate`, at least as long as the kinds with its length
             /// byte `length_byte`: as the kind whose header it carries, else as the first kind
             /// with that length byte (whose error then says what is wrong).
-            fn verify(candidate: &[u8], length_byte: u8) -> Result<Frame, FrameError> {
+            fn verify(candidate: &[u8], length_byte: u8) -> Result<FocFrame, FrameError> {
                 let header = candidate.first_chunk::<4>();
                 $(
                     if header == Some(&<$kind as FrameKind>::HEADER) {
-                        return <$kind as FrameKind>::verify(candidate).map(Frame::$arm);
+                        return <$kind as FrameKind>::verify(candidate).map(FocFrame::$arm);
                     }
                 )+
                 $(
                     if length_byte == <$kind as FrameKind>::LENGTH_BYTE {
-                        return <$kind as FrameKind>::verify(candidate).map(Frame::$arm);
+                        return <$kind as FrameKind>::verify(candidate).map(FocFrame::$arm);
                     }
                 )+
                 Err(FrameError::UnknownLength { found: length_byte })
@@ -272,7 +272,7 @@ fn write_length_bytes(f: &mut fmt::Formatter<'_>) -> fmt::Result {
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Parsed {
     /// A verified frame and the number of bytes it occupies at the start of the input.
-    Complete(Frame, usize),
+    Complete(FocFrame, usize),
     /// The input is a valid beginning of a frame; at least this many bytes in total are needed.
     Partial(usize),
 }
@@ -305,7 +305,7 @@ pub fn parse(bytes: &[u8]) -> Result<Parsed, FrameError> {
     if bytes.len() < len {
         return Ok(Parsed::Partial(len));
     }
-    Ok(Parsed::Complete(Frame::verify(bytes, length_byte)?, len))
+    Ok(Parsed::Complete(FocFrame::verify(bytes, length_byte)?, len))
 }
 
 /// Why bytes are not a valid frame.

@@ -7,7 +7,7 @@
 //! | module | holds |
 //! |---|---|
 //! | [`kinds`] | the [`FrameKind`] trait; one module per kind: [`DataFrame`], [`InfoFrame`] |
-//! | `frame` | the list of kinds: [`Frame`], [`MAX_FRAME_LEN`], [`parse`], [`Parsed`], [`FrameError`] |
+//! | `frame` | the list of kinds: [`FocFrame`], [`MAX_FRAME_LEN`], [`parse`], [`Parsed`], [`FrameError`] |
 //! | `stats` | the link statistics: [`Stats`] |
 //! | `decoder` | the scanner: [`Decoder`], [`frames`], [`Decoded`], under the streaming layer of [`crate::scan`] |
 //! | `window` | the scanner's search window: 64 positions' candidates and headers at once |
@@ -34,8 +34,8 @@
 //!    [`FrameKind::accept`]) and `impl Sealed` (read the payload of a verified frame, write it,
 //!    count the frame in [`Stats`]).
 //! 2. **One arm** in the `frame_kinds!` list of `frame.rs`: `Name(Type)` with its doc comment. That
-//!    arm makes the [`Frame`] variant, a `From` conversion, its place in [`Frame::wire_len`],
-//!    [`Frame::encode_into`], [`parse`], the scanner's dispatch, the known length bytes of
+//!    arm makes the [`FocFrame`] variant, a `From` conversion, its place in [`FocFrame::wire_len`],
+//!    [`FocFrame::encode_into`], [`parse`], the scanner's dispatch, the known length bytes of
 //!    [`FrameError::UnknownLength`] and [`MAX_FRAME_LEN`]. Arms are tried in order, and only the
 //!    first is tried right after a frame: keep the most frequent kind first.
 //! 3. If the kind should be counted apart, a counter in [`Stats`]
@@ -45,7 +45,7 @@
 //! check bytes, two kinds with the same header, and two kinds sharing a length byte but not a
 //! length (two kinds *may* share a length byte: the `9B 16 03` frame would share the data frame's).
 //! A kind longer than 77 bytes raises [`MAX_FRAME_LEN`], and with it the [`Decoder`]'s
-//! state (`MAX_FRAME_LEN - 1` bytes of buffer) and the size of [`Frame`]: the decoder's
+//! state (`MAX_FRAME_LEN - 1` bytes of buffer) and the size of [`FocFrame`]: the decoder's
 //! `state_is_under_128_bytes` test and the size probe's `DECODER_STATE_BYTES` check catch it.
 //!
 //! # Another protocol
@@ -57,7 +57,7 @@
 //!   ([`datalink::Decoder`](crate::datalink::Decoder),
 //!   [`datalink::frames`](crate::datalink::frames)) and statistics
 //!   ([`datalink::Stats`](crate::datalink::Stats)): as a kind it would have made [`MAX_FRAME_LEN`]
-//!   160, every [`Decoder`] 200 bytes instead of 120 and [`Frame`] the size of 8 records, also in
+//!   160, every [`Decoder`] 200 bytes instead of 120 and [`FocFrame`] the size of 8 records, also in
 //!   firmware that reads one ESC's own wire, where a hub frame never comes; and its two length
 //!   bytes for one length break this list's rule that the length byte is the length minus the check
 //!   bytes. What it shares is shared, not copied: the
@@ -86,7 +86,7 @@ pub const BAUD_RATE: u32 = 19_200;
 
 pub use decoder::{Decoded, Decoder, Frames, Scanner, frames};
 pub use description::DESCRIPTION;
-pub use frame::{Frame, FrameError, MAX_FRAME_LEN, Parsed, parse};
+pub use frame::{FocFrame, FrameError, MAX_FRAME_LEN, Parsed, parse};
 pub use kinds::FrameKind;
 pub use kinds::data::{DataFrame, THROTTLE_MAX_RAW};
 pub use kinds::info::{InfoFieldError, InfoFrame};
@@ -107,12 +107,12 @@ impl From<crate::wire::CheckError> for FrameError {
     }
 }
 
-impl From<Frame> for crate::telemetry::Frame {
+impl From<FocFrame> for crate::telemetry::AnyFrame {
     #[inline(always)]
-    fn from(frame: Frame) -> crate::telemetry::Frame {
+    fn from(frame: FocFrame) -> crate::telemetry::AnyFrame {
         match frame {
-            Frame::Data(f) => crate::telemetry::Frame::Data(crate::telemetry::Data::HwFoc(f)),
-            Frame::Info(i) => crate::telemetry::Frame::Info(crate::telemetry::Info::HwFoc(i)),
+            FocFrame::Data(f) => crate::telemetry::AnyFrame::Data(crate::telemetry::Data::HwFoc(f)),
+            FocFrame::Info(i) => crate::telemetry::AnyFrame::Info(crate::telemetry::Info::HwFoc(i)),
         }
     }
 }

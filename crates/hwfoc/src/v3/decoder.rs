@@ -4,7 +4,7 @@
 //! With no checksum, a candidate (a `9B` not inside an accepted frame) is judged by its own
 //! fields and by the frames around it, in this order:
 //!
-//! 1. **Plausible**: throttle and PWM at most 255 ([`Frame::is_plausible`]); otherwise it is
+//! 1. **Plausible**: throttle and PWM at most 255 ([`V3Frame::is_plausible`]); otherwise it is
 //!    rejected ([implausible](Stats::implausible)).
 //! 2. **Chained**: it starts exactly where the last accepted frame ended
 //!    ([`Stats::chain_end`]) and its counter is that frame's + 1, or skips at most
@@ -32,7 +32,7 @@ use crate::counters::COUNTER24_MAX;
 use crate::scan::{Scan, StreamDecoder, impl_scanner};
 use crate::wire::SYNC;
 
-use super::frame::{FRAME_LEN, Frame};
+use super::frame::{FRAME_LEN, V3Frame};
 use super::stats::Stats;
 
 /// How many chained frames lock the decoder onto a stream.
@@ -48,17 +48,17 @@ pub struct Decoded {
     /// created (or, for [`frames`], from the start of the slice).
     pub offset: u64,
     /// The frame.
-    pub frame: Frame,
+    pub frame: V3Frame,
 }
 
 /// Judges the candidate at the start of `c` (a `9B` at stream offset `at`) from the bytes
 /// there; decided by at most [`MAX_LEN`] bytes.
 #[inline(always)]
-fn judge(c: &[u8], at: u64, stats: &Stats) -> Verdict<Frame> {
+fn judge(c: &[u8], at: u64, stats: &Stats) -> Verdict<V3Frame> {
     let Some(first) = c.first_chunk::<FRAME_LEN>() else {
         return Verdict::Undecided;
     };
-    let frame = Frame::read(first);
+    let frame = V3Frame::read(first);
     if !frame.is_plausible() {
         return Verdict::Implausible;
     }
@@ -76,7 +76,7 @@ fn judge(c: &[u8], at: u64, stats: &Stats) -> Verdict<Frame> {
         let Some(next) = rest.first_chunk::<FRAME_LEN>() else {
             return Verdict::Undecided;
         };
-        let next = Frame::read(next);
+        let next = V3Frame::read(next);
         counter = (counter + 1) & COUNTER24_MAX;
         if !next.is_plausible() || next.counter != counter {
             return Verdict::Unconfirmed;
@@ -107,7 +107,7 @@ fn scan_next(
     base: u64,
     stats: &mut Stats,
     at_end: bool,
-) -> Option<(usize, Frame)> {
+) -> Option<(usize, V3Frame)> {
     chain::scan_next(
         data,
         pos,
@@ -145,11 +145,11 @@ impl_scanner!(
 /// frame of a stream (or after a break) once two more have confirmed it.
 ///
 /// ```
-/// use hwfoc::v3::{Decoder, Frame};
+/// use hwfoc::v3::{Decoder, V3Frame};
 ///
 /// let mut wire = vec![0x00, 0x9B, 0x13]; // noise and a lone sync byte
 /// for counter in 5..9 {
-///     wire.extend_from_slice(&Frame { counter, pwm_out_raw: 10, ..Default::default() }.encode());
+///     wire.extend_from_slice(&V3Frame { counter, pwm_out_raw: 10, ..Default::default() }.encode());
 /// }
 /// let mut decoder = Decoder::new();
 /// let mut got = Vec::new();
@@ -177,11 +177,11 @@ pub type Decoder = StreamDecoder<Scanner>;
 /// fed the same bytes and then flushed would, with the same statistics.
 ///
 /// ```
-/// use hwfoc::v3::{self, Frame};
+/// use hwfoc::v3::{self, V3Frame};
 ///
 /// let mut wire = Vec::new();
 /// for counter in 0..6 {
-///     wire.extend_from_slice(&Frame { counter, ..Default::default() }.encode());
+///     wire.extend_from_slice(&V3Frame { counter, ..Default::default() }.encode());
 /// }
 /// wire[34] = 0x01; // frame 3's throttle becomes 256: implausible
 /// let mut it = v3::frames(&wire);
@@ -206,7 +206,7 @@ mod tests {
         let mut out = [0u8; 200];
         let mut n = 0;
         for counter in counters {
-            let f = Frame {
+            let f = V3Frame {
                 counter,
                 throttle_in_raw: 100,
                 pwm_out_raw: 10,

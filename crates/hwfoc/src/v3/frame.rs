@@ -28,19 +28,19 @@ pub const COUNTER_AT: usize = 1;
 /// period; **not** voltage, current, temperatures or a status word.
 ///
 /// ```
-/// use hwfoc::v3::Frame;
+/// use hwfoc::v3::V3Frame;
 ///
 /// // The first frame of the Platinum Pro V3 capture.
 /// let bytes = [0x9B, 0x00, 0x00, 0x00, 0x00, 0x6B, 0x00, 0x0A, 0x89, 0xF2];
-/// let frame = Frame::parse(&bytes).unwrap();
+/// let frame = V3Frame::parse(&bytes).unwrap();
 /// assert_eq!((frame.counter, frame.throttle_in_raw, frame.pwm_out_raw), (0, 107, 10));
 /// assert_eq!(frame.erpm(), None); // 35314 us: the ESC's placeholder before the motor turns
 /// assert_eq!(frame.encode(), bytes);
-/// let turning = Frame { period_us: 1554, ..frame };
+/// let turning = V3Frame { period_us: 1554, ..frame };
 /// assert_eq!(turning.erpm(), Some(38_610));
 /// ```
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
-pub struct Frame {
+pub struct V3Frame {
     /// Packet counter, +1 per frame from 0 at power-up; 24 bits (the top byte of the `u32` is 0
     /// in a decoded frame; the encoder writes the low 24 bits).
     pub counter: u32,
@@ -53,18 +53,18 @@ pub struct Frame {
     pub period_us: u16,
 }
 
-impl Frame {
+impl V3Frame {
     /// The frame in `bytes` (its first [`FRAME_LEN`] bytes), if they start with `9B`; every
-    /// field value is read as sent, plausible or not ([`Frame::is_plausible`]).
-    pub fn parse(bytes: &[u8]) -> Option<Frame> {
+    /// field value is read as sent, plausible or not ([`V3Frame::is_plausible`]).
+    pub fn parse(bytes: &[u8]) -> Option<V3Frame> {
         let b = bytes.first_chunk::<FRAME_LEN>()?;
-        (b[0] == SYNC).then(|| Frame::read(b))
+        (b[0] == SYNC).then(|| V3Frame::read(b))
     }
 
     /// Reads the fields of a frame's bytes (the first is not checked).
     #[inline(always)]
-    pub(crate) fn read(b: &[u8; FRAME_LEN]) -> Frame {
-        Frame {
+    pub(crate) fn read(b: &[u8; FRAME_LEN]) -> V3Frame {
+        V3Frame {
             counter: u32::from_be_bytes([0, b[1], b[2], b[3]]),
             throttle_in_raw: u16::from_be_bytes([b[4], b[5]]),
             pwm_out_raw: u16::from_be_bytes([b[6], b[7]]),
@@ -94,7 +94,7 @@ impl Frame {
         self.counter
     }
 
-    /// Input throttle in percent: raw * 100 / 255 ([`Frame::THROTTLE_PCT`]).
+    /// Input throttle in percent: raw * 100 / 255 ([`V3Frame::THROTTLE_PCT`]).
     pub fn throttle_in_pct(&self) -> f32 {
         Self::THROTTLE_PCT.to_f32(f32::from(self.throttle_in_raw))
     }
@@ -114,7 +114,7 @@ impl Frame {
     }
 }
 
-impl Telemetry for Frame {
+impl Telemetry for V3Frame {
     #[inline]
     fn packet(&self) -> Option<u32> {
         Some(self.counter)
@@ -127,7 +127,7 @@ impl Telemetry for Frame {
     }
 
     /// Throttle and PWM in 255ths; eRPM (and RPM) from the period, its raw integer the eRPM
-    /// rounded down ([`Frame::erpm`]), not carried by the start-up placeholder or a period of
+    /// rounded down ([`V3Frame::erpm`]), not carried by the start-up placeholder or a period of
     /// 0. V3 carries nothing else.
     #[inline]
     fn reading(&self, quantity: Quantity, settings: &Settings) -> Option<Reading> {
@@ -158,7 +158,7 @@ mod tests {
 
     #[test]
     fn fields_are_big_endian_and_encode_inverts_parse() {
-        let f = Frame {
+        let f = V3Frame {
             counter: 0x12_3456,
             throttle_in_raw: 0x00FE,
             pwm_out_raw: 0x0001,
@@ -169,13 +169,13 @@ mod tests {
             b,
             [0x9B, 0x12, 0x34, 0x56, 0x00, 0xFE, 0x00, 0x01, 0xA1, 0xB2]
         );
-        assert_eq!(Frame::parse(&b), Some(f));
-        assert_eq!(Frame::parse(&b[..9]), None);
+        assert_eq!(V3Frame::parse(&b), Some(f));
+        assert_eq!(V3Frame::parse(&b[..9]), None);
         let mut not_sync = b;
         not_sync[0] = 0x9C;
-        assert_eq!(Frame::parse(&not_sync), None);
+        assert_eq!(V3Frame::parse(&not_sync), None);
         // The encoder writes the low 24 bits of the counter.
-        let wide = Frame {
+        let wide = V3Frame {
             counter: 0xAB12_3456,
             ..f
         };
@@ -184,21 +184,21 @@ mod tests {
 
     #[test]
     fn plausibility_is_throttle_and_pwm_at_most_255() {
-        let ok = Frame {
+        let ok = V3Frame {
             throttle_in_raw: 255,
             pwm_out_raw: 255,
             ..Default::default()
         };
         assert!(ok.is_plausible());
         assert!(
-            !Frame {
+            !V3Frame {
                 throttle_in_raw: 256,
                 ..ok
             }
             .is_plausible()
         );
         assert!(
-            !Frame {
+            !V3Frame {
                 pwm_out_raw: 256,
                 ..ok
             }
@@ -213,7 +213,7 @@ mod tests {
         assert_eq!(erpm_of_period(35_313), Some(1699));
         assert_eq!(erpm_of_period(1), Some(60_000_000));
         assert_eq!(erpm_of_period(40_843), Some(1469));
-        let f = Frame {
+        let f = V3Frame {
             throttle_in_raw: 255,
             pwm_out_raw: 51,
             ..Default::default()

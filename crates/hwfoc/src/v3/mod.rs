@@ -5,10 +5,10 @@
 //!
 //! | quantity | field | conversion |
 //! |---|---|---|
-//! | packet | [`Frame::counter`], u24 | [`Frame::packet`] (`u32`) |
-//! | input throttle | [`Frame::throttle_in_raw`], 0..=255 | % = raw * 100 / 255 ([`Frame::throttle_in_pct`], [`Frame::THROTTLE_PCT`]) |
-//! | output throttle (PWM) | [`Frame::pwm_out_raw`], 0..=255 | % = raw * 100 / 255 ([`Frame::throttle_out_pct`]) |
-//! | eRPM | [`Frame::period_us`], us per electrical revolution | 60 000 000 / period ([`Frame::erpm`]); `None` for the start-up placeholder 35314 and for 0 |
+//! | packet | [`V3Frame::counter`], u24 | [`V3Frame::packet`] (`u32`) |
+//! | input throttle | [`V3Frame::throttle_in_raw`], 0..=255 | % = raw * 100 / 255 ([`V3Frame::throttle_in_pct`], [`V3Frame::THROTTLE_PCT`]) |
+//! | output throttle (PWM) | [`V3Frame::pwm_out_raw`], 0..=255 | % = raw * 100 / 255 ([`V3Frame::throttle_out_pct`]) |
+//! | eRPM | [`V3Frame::period_us`], us per electrical revolution | 60 000 000 / period ([`V3Frame::erpm`]); `None` for the start-up placeholder 35314 and for 0 |
 //!
 //! It does **not** carry voltage, current, phase current, temperatures or a status word, and
 //! there is no device-information frame. RPM is eRPM / pole pairs (/ gear ratio), as for HW-FOC.
@@ -47,16 +47,16 @@
 //!
 //! | module | holds |
 //! |---|---|
-//! | `frame` | [`Frame`] (parse, encode, plausibility, conversions), [`FRAME_LEN`], [`FULL_SCALE`], [`PLACEHOLDER_PERIOD_US`], [`erpm_of_period`] |
+//! | `frame` | [`V3Frame`] (parse, encode, plausibility, conversions), [`FRAME_LEN`], [`FULL_SCALE`], [`PLACEHOLDER_PERIOD_US`], [`erpm_of_period`] |
 //! | `stats` | [`Stats`] (and the chain's end: the scanner's state) |
 //! | `decoder` | the scanner: [`Decoder`], [`frames`], [`Decoded`], [`Scanner`] |
 //!
 //! ```
-//! use hwfoc::v3::{self, Frame};
+//! use hwfoc::v3::{self, V3Frame};
 //!
 //! let mut wire = b"noise".to_vec();
 //! for counter in 100..104 {
-//!     let frame = Frame { counter, throttle_in_raw: 51, pwm_out_raw: 51, period_us: 1500 };
+//!     let frame = V3Frame { counter, throttle_in_raw: 51, pwm_out_raw: 51, period_us: 1500 };
 //!     wire.extend_from_slice(&frame.encode());
 //! }
 //! let decoded: Vec<_> = v3::frames(&wire).collect();
@@ -78,7 +78,8 @@ pub use crate::chain::MAX_CHAINED_GAP;
 pub use decoder::{CHAIN_TO_LOCK, Decoded, Decoder, Frames, Scanner, frames};
 pub use description::DESCRIPTION;
 pub use frame::{
-    COUNTER_AT, FRAME_LEN, FULL_SCALE, Frame, PLACEHOLDER_PERIOD_US, US_PER_MINUTE, erpm_of_period,
+    COUNTER_AT, FRAME_LEN, FULL_SCALE, PLACEHOLDER_PERIOD_US, US_PER_MINUTE, V3Frame,
+    erpm_of_period,
 };
 pub use stats::Stats;
 

@@ -7,7 +7,7 @@ use crate::chain::{self, ChainStats, Counts};
 use crate::counters::{COUNTER24_MAX, PacketSequence24};
 use crate::scan::SkipBytes;
 
-use super::frame::{FRAME_LEN, Frame};
+use super::frame::{FRAME_LEN, V3Frame};
 
 /// Counters kept per stream by [`Decoder`](super::Decoder) and [`Frames`](super::Frames), and
 /// where the last accepted frame ended (the scanner's lock). Event counters are `u32` and
@@ -133,7 +133,7 @@ impl Stats {
 
     /// Counts a frame accepted at stream offset `at`; `synced`: by a chain of three.
     #[inline]
-    pub(crate) fn accept(&mut self, at: u64, frame: &Frame, synced: bool) {
+    pub(crate) fn accept(&mut self, at: u64, frame: &V3Frame, synced: bool) {
         self.counts.sync(synced);
         self.counts.counter.next(frame.counter);
         self.chain_end = Some(at + FRAME_LEN as u64);

@@ -60,7 +60,7 @@ const MAX_LEN: usize = CHAIN_TO_LOCK * SLOW_DATA_FRAME_LEN;
 
 /// A V4 frame as the decoder emits it.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-pub enum Frame {
+pub enum V4Frame {
     /// A data frame, with the info frame adopted when it was decoded.
     Data(Data),
     /// An info frame (each copy, adopted or not: see [`Stats::adopted`]).
@@ -74,7 +74,7 @@ pub struct Decoded {
     /// created (or, for [`frames`], from the start of the slice).
     pub offset: u64,
     /// The frame.
-    pub frame: Frame,
+    pub frame: V4Frame,
 }
 
 /// The frame a candidate is found to be (in a [`Verdict`]).
@@ -205,7 +205,7 @@ fn scan_next(
     base: u64,
     stats: &mut Stats,
     at_end: bool,
-) -> Option<(usize, Frame)> {
+) -> Option<(usize, V4Frame)> {
     if data.get(*pos) == Some(&TRAILER) && stats.trailer_at(base + *pos as u64) {
         stats.take_trailer();
         *pos += 1;
@@ -224,11 +224,11 @@ fn scan_next(
                     frame,
                     info: stats.in_use(),
                 };
-                (DATA_FRAME_LEN, Frame::Data(data))
+                (DATA_FRAME_LEN, V4Frame::Data(data))
             }
             Judged::Info(info) => {
                 stats.accept_info(at, &info, synced);
-                (INFO_FRAME_LEN, Frame::Info(info))
+                (INFO_FRAME_LEN, V4Frame::Info(info))
             }
         },
     )
@@ -256,7 +256,7 @@ impl_scanner!(
 /// (`size_of::<Decoder>()`, checked by a test), no allocation, no timing.
 ///
 /// ```
-/// use hwfoc::v4::{Decoder, DataFrame, Frame, InfoFrame};
+/// use hwfoc::v4::{Decoder, DataFrame, V4Frame, InfoFrame};
 ///
 /// let info = InfoFrame { full_scale: 1000, v1: 8, v2: 91, ..Default::default() };
 /// let data = |counter| DataFrame { counter, voltage_adc: 1365, ..Default::default() };
@@ -276,7 +276,7 @@ impl_scanner!(
 /// // Constants adopted from the second copy on.
 /// let adopted: Vec<bool> = got
 ///     .iter()
-///     .filter_map(|f| match f { Frame::Data(d) => Some(d.info.is_some()), _ => None })
+///     .filter_map(|f| match f { V4Frame::Data(d) => Some(d.info.is_some()), _ => None })
 ///     .collect();
 /// assert_eq!(adopted, [false, true, true]);
 /// let stats = decoder.stats();
@@ -297,7 +297,7 @@ pub type Decoder = StreamDecoder<Scanner>;
 /// fed the same bytes and then flushed would, with the same statistics.
 ///
 /// ```
-/// use hwfoc::v4::{self, DataFrame, Frame};
+/// use hwfoc::v4::{self, DataFrame, V4Frame};
 ///
 /// let mut wire = Vec::new();
 /// for counter in 40..44 {
@@ -306,7 +306,7 @@ pub type Decoder = StreamDecoder<Scanner>;
 /// let mut it = v4::frames(&wire);
 /// let counters: Vec<u32> = it
 ///     .by_ref()
-///     .filter_map(|d| match d.frame { Frame::Data(d) => Some(d.packet()), _ => None })
+///     .filter_map(|d| match d.frame { V4Frame::Data(d) => Some(d.packet()), _ => None })
 ///     .collect();
 /// assert_eq!(counters, [40, 41, 42, 43]);
 /// assert_eq!(it.stats().bytes_skipped(), 0);
@@ -440,7 +440,7 @@ mod tests {
         let mut scales = [Some(0); 6];
         let mut n = 0;
         for d in it.by_ref() {
-            if let Frame::Data(d) = d.frame {
+            if let V4Frame::Data(d) = d.frame {
                 scales[n] = d.info.map(|i| i.full_scale);
                 n += 1;
             }
@@ -472,7 +472,7 @@ mod tests {
         let mut scales: [Option<VoltsPerStep>; 7] = [Some(VoltsPerStep::DEFAULT); 7];
         let mut n = 0;
         for d in frames(&w) {
-            if let Frame::Data(d) = d.frame {
+            if let V4Frame::Data(d) = d.frame {
                 scales[n] = d.info.map(|i| i.volts_per_step());
                 n += 1;
             }

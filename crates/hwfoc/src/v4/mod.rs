@@ -68,10 +68,10 @@
 //! | `info` | [`InfoFrame`] (parse, encode, constants), [`VoltsPerStep`], [`CurrentScale`] |
 //! | `temperature` | [`ntc_celsius`] |
 //! | `stats` | [`Stats`] (and the scanner's state) |
-//! | `decoder` | the scanner: [`Decoder`], [`frames`], [`Decoded`], [`Frame`], [`Scanner`] |
+//! | `decoder` | the scanner: [`Decoder`], [`frames`], [`Decoded`], [`V4Frame`], [`Scanner`] |
 //!
 //! ```
-//! use hwfoc::v4::{self, DataFrame, Frame, InfoFrame, VoltsPerStep};
+//! use hwfoc::v4::{self, DataFrame, V4Frame, InfoFrame, VoltsPerStep};
 //!
 //! let info = InfoFrame { full_scale: 1000, v1: 8, v2: 91, i1: 0, i2: 1, i3: 0, t1: 0x21, t2: 0x21 };
 //! let mut wire = Vec::new();
@@ -81,7 +81,7 @@
 //!     wire.extend_from_slice(&frame.encode_with_trailer());
 //! }
 //! let last = v4::frames(&wire).last().unwrap();
-//! let Frame::Data(data) = last.frame else { panic!() };
+//! let V4Frame::Data(data) = last.frame else { panic!() };
 //! assert_eq!(data.info, Some(info));
 //! assert_eq!(data.throttle_in_pct(), 25.0);
 //! assert_eq!(data.voltage_v(VoltsPerStep::DEFAULT), 12.0);
@@ -101,7 +101,7 @@ pub const BAUD_RATE: u32 = crate::foc::BAUD_RATE;
 pub use crate::chain::MAX_CHAINED_GAP;
 pub use crate::ntc::{NTC_BETA, NTC_R25_OVER_REFERENCE, ntc_celsius};
 pub use data::{Data, DataFrame};
-pub use decoder::{CHAIN_TO_LOCK, Decoded, Decoder, Frame, Frames, Scanner, frames};
+pub use decoder::{CHAIN_TO_LOCK, Decoded, Decoder, Frames, Scanner, V4Frame, frames};
 pub use description::DESCRIPTION;
 pub use info::{CurrentScale, InfoFrame, VoltsPerStep, VoltsPerStepError, throttle_linear};
 pub use layout::{
@@ -112,12 +112,12 @@ pub use stats::Stats;
 
 crate::protocol::found_frame!(Decoded, HwV4);
 
-impl From<Frame> for crate::telemetry::Frame {
+impl From<V4Frame> for crate::telemetry::AnyFrame {
     #[inline(always)]
-    fn from(frame: Frame) -> crate::telemetry::Frame {
+    fn from(frame: V4Frame) -> crate::telemetry::AnyFrame {
         match frame {
-            Frame::Data(d) => crate::telemetry::Frame::Data(crate::telemetry::Data::HwV4(d)),
-            Frame::Info(i) => crate::telemetry::Frame::Info(crate::telemetry::Info::HwV4(i)),
+            V4Frame::Data(d) => crate::telemetry::AnyFrame::Data(crate::telemetry::Data::HwV4(d)),
+            V4Frame::Info(i) => crate::telemetry::AnyFrame::Info(crate::telemetry::Info::HwV4(i)),
         }
     }
 }

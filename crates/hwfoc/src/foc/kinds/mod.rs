@@ -1,5 +1,5 @@
 //! One module per frame kind, each a type implementing [`FrameKind`] with one
-//! arm in [`Frame`](crate::foc::Frame).
+//! arm in [`FocFrame`](crate::foc::FocFrame).
 //!
 //! | module | type | header | length | check bytes |
 //! |---|---|---|---|---|
@@ -19,12 +19,12 @@ use crate::wire::{Checksum, SYNC};
 /// A kind of frame: its header, length, check bytes and payload layout.
 ///
 /// Each kind lives in its own module under [`crate::foc::kinds`] and has one arm in
-/// [`crate::foc::Frame`]; the scanner and [`crate::foc::parse`] reach it only through this trait,
+/// [`crate::foc::FocFrame`]; the scanner and [`crate::foc::parse`] reach it only through this trait,
 /// with every constant known at compile time (no `dyn`, no function pointers: after inlining, the
 /// code is what a hand-written check of that one kind would be). See [`crate::foc`] for how to add
 /// a kind.
 ///
-/// The trait is sealed: a kind is only useful with its arm in [`crate::foc::Frame`], so it is
+/// The trait is sealed: a kind is only useful with its arm in [`crate::foc::FocFrame`], so it is
 /// implemented inside this crate. Its constants and provided methods are for everyone.
 ///
 /// ```
