@@ -4,7 +4,7 @@ use core::fmt;
 
 use super::layout::{FRAME_LEN, LengthByte};
 
-/// Why [`HubFrame::parse`](super::Frame::parse) refused bytes, in the order it
+/// Why [`HubFrame::parse`](super::HubFrame::parse) refused bytes, in the order it
 /// checks them (the streaming decoder rejects candidates in the same order).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum Error {
