@@ -8,7 +8,7 @@ use arrow_data::ArrayData;
 use arrow_schema::{DataType, SchemaRef};
 use hwfoc::Settings;
 use hwfoc::foc::DataFrame;
-use hwfoc::telemetry::{Data, AnyFrame};
+use hwfoc::telemetry::{AnyFrame, Data};
 use hwfoc_io::Handler;
 use hwfoc_io::InputError;
 use hwfoc_io::Selection;
