@@ -5,7 +5,7 @@ usage: scripts/protocol-arms.py [--list]   (from the checkout to count)
 
 Reads the non-test Rust code of hwfoc-records, hwfoc-ports, hwfoc-io, hwfoc-can-setup, hwfoc-web, hwfoc-cli, hwfoc-sim, hwfoc-bridge and python/src
 (a file's `#[cfg(test)]` module, `tests.rs` files and `tests/` folders are left out) and finds each `match`
-whose arms name an arm of a per-protocol enum (`Protocol`, `Data`, `Info`, `Wire`, `EscLink`,
+whose arms name an arm of a per-protocol enum (`Protocol`, `Data`, `Info`, `Wire`, `Fast`, `EscLink`,
 `Decoded`, `Family`, `Conversion`). It prints the number of such arms and of wildcard arms
 (`_ =>`) in those matches: a wildcard absorbs a new protocol, so the compiler no longer names
 the place. With --list, each wildcard's file and line.
@@ -19,7 +19,7 @@ ROOT = pathlib.Path.cwd()
 DIRS = ["crates/hwfoc-records/src", "crates/hwfoc-ports/src", "crates/hwfoc-io/src",
         "crates/hwfoc-can-setup/src", "crates/hwfoc-web/src", "crates/hwfoc-cli/src", "crates/hwfoc-sim/src",
         "crates/hwfoc-bridge/src", "python/src"]
-ENUMS = "Protocol|Data|Info|Wire|EscLink|Decoded|Family|Conversion"
+ENUMS = "Protocol|Data|Info|Wire|Fast|EscLink|Decoded|Family|Conversion"
 ARM = re.compile(r"(?<![\w:])(?:[\w]+::)*(?:" + ENUMS + r")::[A-Z]\w*")
 
 

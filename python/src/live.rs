@@ -13,9 +13,9 @@ use arrow_schema::SchemaRef;
 use hwfoc::Settings;
 use hwfoc::telemetry::AnyFrame;
 use hwfoc_io::Batch;
-use hwfoc_io::EscLink;
 use hwfoc_io::Handler;
 use hwfoc_io::InputError;
+use hwfoc_io::LinkStats;
 use hwfoc_io::Notice;
 use hwfoc_io::{PortStreams, Stream};
 use hwfoc_ports::clock::byte_times;
@@ -65,7 +65,7 @@ impl Handler for Gather {
 }
 
 /// The link statistics as a dict.
-pub(crate) fn stats_dict<'py>(py: Python<'py>, s: &EscLink) -> PyResult<Bound<'py, PyDict>> {
+pub(crate) fn stats_dict<'py>(py: Python<'py>, s: &LinkStats) -> PyResult<Bound<'py, PyDict>> {
     let d = PyDict::new(py);
     d.set_item("bytes", s.bytes())?;
     d.set_item("bytes_skipped", s.bytes_skipped())?;
@@ -457,7 +457,7 @@ impl Ports {
     /// The link statistics of each port so far, in port order.
     #[getter]
     fn stats<'py>(&self, py: Python<'py>) -> PyResult<Vec<Bound<'py, PyDict>>> {
-        let all: Vec<EscLink> = match self.state.lock().ok().as_ref().and_then(|s| s.as_ref()) {
+        let all: Vec<LinkStats> = match self.state.lock().ok().as_ref().and_then(|s| s.as_ref()) {
             Some(state) => (0..self.names.len())
                 .filter_map(|p| state.streams.stats(p))
                 .collect(),

@@ -199,7 +199,7 @@ fn hobbywing_can_records_go_out_with_erpm_from_rpm_and_the_settings() {
         .map(|k| {
             Data::from(HwCanEsc {
                 node: 3,
-                channel: Some(1),
+                throttle_channel: Some(1),
                 transfer_id: k as u8,
                 rpm: 911 * k,
                 pwm: 83 * k,

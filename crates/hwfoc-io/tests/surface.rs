@@ -13,7 +13,7 @@ use hwfoc_io::{Batch, Input, InputError, InputFormat, Looks, OpenInput, read_sma
 
 // Decoding.
 use hwfoc_io::{
-    Both, Esc, EscLink, Handler, InputInfo, LaterPart, MAX_ESCS, MAX_QUEUED, PortStreams,
+    Both, Esc, Handler, InputInfo, LaterPart, LinkStats, MAX_ESCS, MAX_QUEUED, PortStreams,
 };
 use hwfoc_io::{SILENCE_S, Sources, Stream, WireKind};
 

@@ -21,7 +21,7 @@ pub const MAX_ESCS: usize = 256;
 pub(crate) const UNNUMBERED: usize = usize::MAX;
 
 /// The ESC number of channel `channel` of the stream of ESC `own` (a DataLink hub's channel, a
-/// CAN bus's slot: its ESC's place, [`hwfoc::telemetry::Data::bus_index`], unless another ESC
+/// CAN bus's slot: its ESC's place, [`hwfoc::telemetry::Data::bus_place`], unless another ESC
 /// holds it) numbered when `next` numbers have been given, the channels before it numbered
 /// already: `own` for channel 0, else `next` ([`UNNUMBERED`] from [`MAX_ESCS`] on). A CAN bus's
 /// slots are numbered up to the highest one heard, so that a bus read alone numbers its ESCs by

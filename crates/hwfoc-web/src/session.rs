@@ -8,7 +8,7 @@ use hwfoc::Settings;
 use hwfoc::telemetry::{AnyFrame, Data, Info};
 use hwfoc_records::energy::Energy;
 use hwfoc_records::serial::PortEvent;
-use hwfoc_records::{EscLink, Handler, InputError, PortStreams, Record};
+use hwfoc_records::{Handler, InputError, LinkStats, PortStreams, Record};
 
 use crate::columns::Columns;
 
@@ -186,7 +186,7 @@ impl Session {
 
     /// Per ESC (by number): its figures and its link statistics (as `hwfoc summary` counts
     /// them: its channel's on a hub or a bus, else the port's).
-    pub fn escs(&self) -> impl Iterator<Item = (usize, &EscFigures, EscLink)> {
+    pub fn escs(&self) -> impl Iterator<Item = (usize, &EscFigures, LinkStats)> {
         self.escs.iter().enumerate().map(|(esc, figures)| {
             let link = u8::try_from(esc)
                 .ok()

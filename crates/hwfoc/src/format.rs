@@ -92,6 +92,25 @@ pub enum LinkKind {
     Bus,
 }
 
+impl LinkKind {
+    /// How many of a stream's channels are numbered once its channel `heard` is heard: a hub's
+    /// all at once, a bus's slots up to the one heard (one ESC's wire has no channel but its
+    /// own: up to the one heard as well).
+    ///
+    /// ```
+    /// use hwfoc::format::LinkKind;
+    ///
+    /// assert_eq!(LinkKind::Hub { channels: 8 }.channels_numbered(2), 8);
+    /// assert_eq!(LinkKind::Bus.channels_numbered(2), 3);
+    /// ```
+    pub const fn channels_numbered(self, heard: u8) -> usize {
+        match self {
+            LinkKind::Hub { channels } => channels as usize,
+            LinkKind::OneEsc | LinkKind::Bus => heard as usize + 1,
+        }
+    }
+}
+
 /// How a format's frames are checked.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Check {

@@ -249,10 +249,10 @@ impl Data {
     /// answer mapped its node, until then its node id; a standard ESC's `esc_index`. `None` for
     /// a serial format.
     #[inline]
-    pub fn bus_index(&self) -> Option<u8> {
+    pub fn bus_place(&self) -> Option<u8> {
         match self {
-            Data::HwCan(e) => Some(e.bus_index()),
-            Data::DroneCan(e) => Some(e.bus_index()),
+            Data::HwCan(e) => Some(e.bus_place()),
+            Data::DroneCan(e) => Some(e.bus_place()),
             _ => None,
         }
     }

@@ -249,7 +249,7 @@ mod tests {
         use hwfoc::dronecan::HwCanEsc;
         let data = hwfoc::telemetry::Data::from(HwCanEsc {
             node: 3,
-            channel: Some(1),
+            throttle_channel: Some(1),
             transfer_id: 0,
             rpm: 1200,
             pwm: 300,

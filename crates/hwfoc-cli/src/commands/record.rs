@@ -40,7 +40,7 @@ use std::time::{Duration, Instant};
 
 use hwfoc::Protocol;
 use hwfoc::dronecan::{CanFrame, Header, SOCKETCAN_RECORD_LEN};
-use hwfoc_io::EscLink;
+use hwfoc_io::LinkStats;
 
 use crate::args::ProtocolArgs;
 use crate::error::CliError;
@@ -196,7 +196,7 @@ fn can_bus(name: &str) -> Option<Option<u32>> {
 }
 
 /// Frames of either kind a port's stream has decoded.
-fn frames(stats: EscLink) -> u64 {
+fn frames(stats: LinkStats) -> u64 {
     u64::from(stats.frames()) + u64::from(stats.info_frames())
 }
 

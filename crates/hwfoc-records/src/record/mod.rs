@@ -173,7 +173,7 @@ mod tests {
             Data::from(hw5),
             Data::from(hwfoc::dronecan::HwCanEsc {
                 node: 7,
-                channel: Some(2),
+                throttle_channel: Some(2),
                 transfer_id: 3,
                 rpm: 1200,
                 pwm: 300,

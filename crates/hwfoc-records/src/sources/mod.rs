@@ -41,6 +41,7 @@ use std::collections::{HashMap, VecDeque};
 
 use hwfoc::datalink;
 use hwfoc::foc::DataFrame;
+use hwfoc::format::LinkKind;
 use hwfoc::telemetry::{AnyFrame, Data};
 use hwfoc::{Protocol, Settings};
 
@@ -50,7 +51,7 @@ use crate::handler::LaterPart;
 use crate::input::{Batch, Input, InputError, InputFormat};
 use crate::notice::Notice;
 use crate::settings::SettingsMap;
-use crate::stream::{BusPlan, EscLink, Stream};
+use crate::stream::{BusPlan, LinkStats, Stream};
 use crate::time::Clock;
 
 pub use self::merge::MAX_QUEUED;
@@ -288,7 +289,7 @@ impl Sources {
 
     /// The link statistics of ESC `esc` (behind a DataLink hub, its channel's and the hub
     /// link's).
-    pub fn link(&self, esc: usize) -> EscLink {
+    pub fn link(&self, esc: usize) -> LinkStats {
         match self.escs[esc].hub {
             Some((owner, channel)) => self.escs[owner].stream.link(channel),
             None => self.escs[esc].stream.stats(),
@@ -378,7 +379,7 @@ impl Sources {
             if self.escs[esc].hub.is_some() && frames {
                 read.escs.push(esc);
                 read.escs.sort_unstable();
-            } else if self.escs[esc].stream.is_can() && !frames {
+            } else if self.escs[esc].stream.layout() == LinkKind::Bus && !frames {
                 read.escs.retain(|&e| e != esc);
             }
         }

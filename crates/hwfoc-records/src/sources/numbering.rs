@@ -5,7 +5,7 @@
 use std::collections::VecDeque;
 
 use hwfoc::Settings;
-use hwfoc::datalink::CHANNELS;
+use hwfoc::format::LinkKind;
 use hwfoc::telemetry::AnyFrame;
 
 use super::{Esc, Handler, Sources};
@@ -29,16 +29,9 @@ impl Sources {
         if pending.is_empty() {
             return;
         }
-        let places = if self.escs[esc].stream.is_can() {
-            pending
-                .iter()
-                .filter_map(|p| p.1)
-                .map(|c| usize::from(c) + 1)
-                .max()
-                .unwrap_or(0)
-        } else {
-            CHANNELS
-        };
+        let layout = self.escs[esc].stream.layout();
+        let heard = pending.iter().filter_map(|p| p.1).max();
+        let places = layout.channels_numbered(heard.unwrap_or(0));
         self.grow_hub(esc, places);
         let own = self.esc_settings(esc);
         let hub = &self.hubs[&esc];
@@ -104,9 +97,9 @@ impl Sources {
     /// (`can_plan.rs`) has its ESCs' slots fixed and numbered at once, so that its ESCs'
     /// numbers follow each other whatever is heard on other buses meanwhile.
     fn push_esc(&mut self, mut esc: Esc, key: EscKey, input: usize) {
-        let plan = match esc.stream.is_can() {
-            true => self.buses.get(&(key.recording, key.port.clone())).cloned(),
-            false => None,
+        let plan = match esc.stream.layout() {
+            LinkKind::Bus => self.buses.get(&(key.recording, key.port.clone())).cloned(),
+            LinkKind::OneEsc | LinkKind::Hub { .. } => None,
         };
         if let Some(plan) = &plan {
             esc.stream.plan_can(plan);

@@ -300,14 +300,14 @@ mod tests {
     use crate::input::file::memory::MemoryFile;
     use crate::sources::Sources;
     use crate::sources::tests::hub_wire;
-    use crate::stream::EscLink;
+    use crate::stream::LinkStats;
     use crate::summary::Summary;
 
     /// What a summary of a raw file shows, and the links and bytes it was made of.
     #[derive(Debug, PartialEq)]
     struct Read {
         report: serde_json::Value,
-        links: Vec<EscLink>,
+        links: Vec<LinkStats>,
         bytes: Vec<u64>,
     }
 

@@ -9,7 +9,7 @@
 //! (`esc_numbers.rs`).
 //!
 //! An ESC on a bus is its node (a standard DroneCAN ESC: its node and `esc_index`: an
-//! [`EscKey`]); its place ([`Data::bus_index`]: throttle channel - 1 once a GetEscID answer
+//! [`EscKey`]); its place ([`Data::bus_place`]: throttle channel - 1 once a GetEscID answer
 //! mapped it, else its node id; a standard ESC's `esc_index`) only orders the slots. The slot
 //! of an ESC is fixed when it is first heard: its place, unless another ESC holds that slot
 //! already, then the next after the highest slot given (two ESCs that claim one throttle
@@ -25,6 +25,8 @@
 use hwfoc::Protocol;
 use hwfoc::dronecan::{BusStats, CanFrame, Escs, NodeStats, Receiver, SOCKETCAN_RECORD_LEN};
 use hwfoc::telemetry::{AnyFrame, Data};
+
+use super::decoder::Emit;
 
 /// Slots on a bus: places (node ids 0-127 before a node is mapped to its throttle channel, then
 /// its channel - 1, a byte; a standard ESC's `esc_index`), and those after the highest place
@@ -83,7 +85,7 @@ impl Claim {
     fn of(data: &Data) -> Option<Claim> {
         Some(Claim {
             key: EscKey::of(data)?,
-            by_node_id: matches!(data, Data::HwCan(r) if r.channel.is_none()),
+            by_node_id: matches!(data, Data::HwCan(r) if r.throttle_channel.is_none()),
         })
     }
 }
@@ -207,7 +209,7 @@ impl BusLearner {
         let last = &mut self.last;
         self.wire.feed(bytes, times, &mut |_, _, f| {
             let AnyFrame::Data(d) = f else { return };
-            let (Some(claim), Some(place)) = (Claim::of(d), d.bus_index()) else {
+            let (Some(claim), Some(place)) = (Claim::of(d), d.bus_place()) else {
                 return;
             };
             match last.iter_mut().find(|(c, _)| c.key == claim.key) {
@@ -279,9 +281,6 @@ struct Held {
     since_frame: u64,
     records: Vec<(Option<f64>, Data)>,
 }
-
-/// Where a bus's records go: `emit(t, place, frame)`.
-pub(crate) type Emit<'a> = dyn FnMut(Option<f64>, Option<u8>, &AnyFrame) + 'a;
 
 /// The decoding state of a CAN bus's stream.
 #[derive(Debug)]
@@ -396,7 +395,7 @@ impl CanWire {
         };
         let node = received.header.source_node;
         self.protocol[usize::from(node) % NODES] = Some(data.protocol());
-        let (Some(claim), Some(place)) = (Claim::of(&data), data.bus_index()) else {
+        let (Some(claim), Some(place)) = (Claim::of(&data), data.bus_place()) else {
             return;
         };
         let waiting = self.waiting.iter().position(|h| h.key == claim.key);
@@ -445,7 +444,7 @@ impl CanWire {
             by_node_id: true,
         };
         for (t, d) in held.records {
-            if let Some(place) = d.bus_index() {
+            if let Some(place) = d.bus_place() {
                 self.place(claim, place, t, d, emit);
             }
         }
@@ -495,7 +494,7 @@ impl CanWire {
         let stats = self.rx.stats();
         CanLink {
             node,
-            channel: node.and_then(|n| self.escs.channel(n)),
+            throttle_channel: node.and_then(|n| self.escs.throttle_channel(n)),
             maintenance_min: node.and_then(|n| self.escs.maintenance_min(n)),
             protocol: node
                 .and_then(|n| self.protocol[usize::from(n) % NODES])
@@ -516,7 +515,7 @@ pub struct CanLink {
     /// The node of the ESC's slot on the bus (`None` before any record).
     pub node: Option<u8>,
     /// Its node's throttle channel (1-based) from a GetEscID answer, if one came.
-    pub channel: Option<u8>,
+    pub throttle_channel: Option<u8>,
     /// Its node's maintenance counters from the last GetMaintenanceInformation answer on the
     /// bus, if one came, minutes: (total rotation time, time since maintenance).
     pub maintenance_min: Option<(u32, u32)>,
@@ -631,7 +630,10 @@ mod tests {
         assert_eq!((whole[0].0, whole[0].1), (Some(0.01), 1));
         assert_eq!((whole[1].0, whole[1].1), (Some(0.03), 1));
         let Data::HwCan(r) = whole[1].2 else { panic!() };
-        assert_eq!((r.node, r.channel, r.msg2_age_ms), (3, Some(2), Some(30)));
+        assert_eq!(
+            (r.node, r.throttle_channel, r.msg2_age_ms),
+            (3, Some(2), Some(30))
+        );
         for chunk in [1, 5, 16, 17] {
             let mut wire = CanWire::new();
             let mut got = Vec::new();
@@ -645,7 +647,12 @@ mod tests {
             assert_eq!(got, whole, "chunks of {chunk}");
             let link = wire.link(1);
             assert_eq!(
-                (link.node, link.channel, link.records, link.protocol),
+                (
+                    link.node,
+                    link.throttle_channel,
+                    link.records,
+                    link.protocol
+                ),
                 (Some(3), Some(2), 2, Protocol::HwCan)
             );
             assert_eq!(wire.link(3).records, 0);

@@ -2,10 +2,15 @@
 //! bus's records of the other protocols left out and counted ([`Bus`]), and what the bytes of
 //! a serial stream are when the protocol forced finds none of its frames ([`Probe`]).
 
+use hwfoc::format::LinkKind;
 use hwfoc::telemetry::AnyFrame;
 use hwfoc::{Protocol, detect};
 
-use super::can::{CanLink, CanWire, Emit};
+use super::WireKind;
+use super::can::{BusPlan, CanLink, CanWire};
+use super::decoder::{Emit, LinkDecoder};
+use super::link::LinkStats;
+use crate::input::Batch;
 
 /// How many of a forced stream's first bytes are also read by every format at once, to say
 /// what they are when the protocol forced finds nothing in them.
@@ -82,7 +87,7 @@ impl Bus {
     }
 
     /// Decodes `bytes` as [`CanWire::feed`] does, handing on the records kept.
-    pub(crate) fn feed(&mut self, bytes: &[u8], times: Option<&[f64]>, emit: &mut Emit<'_>) {
+    pub(crate) fn decode(&mut self, bytes: &[u8], times: Option<&[f64]>, emit: &mut Emit<'_>) {
         let (forced, left_out) = (self.forced, &mut self.left_out);
         self.wire.feed(bytes, times, &mut |t, place, frame| {
             keep(forced, left_out, t, place, frame, emit)
@@ -90,34 +95,87 @@ impl Bus {
     }
 
     /// Ends the stream as [`CanWire::finish`] does, handing on the records kept.
-    pub(crate) fn finish(&mut self, emit: &mut Emit<'_>) {
+    pub(crate) fn end(&mut self, emit: &mut Emit<'_>) {
         let (forced, left_out) = (self.forced, &mut self.left_out);
         self.wire
             .finish(&mut |t, place, frame| keep(forced, left_out, t, place, frame, emit));
     }
 
-    /// The link of the ESC at `place`: no record where its protocol is not the one forced.
-    pub(crate) fn link(&self, place: u8) -> CanLink {
-        let mut link = self.wire.link(place);
+    /// The link of the ESC in `slot`: no record where its protocol is not the one forced.
+    pub(crate) fn can_link(&self, slot: u8) -> CanLink {
+        let mut link = self.wire.link(slot);
         if self.forced.is_some_and(|p| p != link.protocol) {
             link.records = 0;
         }
         link
     }
+}
 
-    /// The protocol forced, if one is.
-    pub(crate) fn forced(&self) -> Option<Protocol> {
+impl LinkDecoder for Bus {
+    fn feed(&mut self, batch: Batch<'_>, on_frame: &mut Emit<'_>) {
+        self.decode(batch.bytes, batch.times, on_frame);
+    }
+
+    /// Each record at the offset of the bytes fed before it was handed on.
+    fn feed_untimed(&mut self, bytes: &[u8], on_frame: &mut dyn FnMut(Option<u8>, u64, &AnyFrame)) {
+        let at = self.wire.bytes();
+        self.decode(bytes, None, &mut |_, slot, f| on_frame(slot, at, f));
+    }
+
+    fn finish(&mut self, on_frame: &mut Emit<'_>) {
+        self.end(on_frame);
+    }
+
+    fn layout(&self) -> LinkKind {
+        LinkKind::Bus
+    }
+
+    fn forced(&self) -> Option<Protocol> {
         self.forced
+    }
+
+    fn bytes(&self) -> u64 {
+        self.wire.bytes()
+    }
+
+    fn buffered(&self) -> usize {
+        self.wire.buffered()
+    }
+
+    /// None: a record held for its node's GetEscID answer has its own time.
+    fn held_since(&self) -> Option<f64> {
+        None
+    }
+
+    fn kind(&self) -> WireKind {
+        let link = self.can_link(0);
+        match link.records {
+            0 => WireKind::Unknown,
+            _ => WireKind::Other(link.protocol),
+        }
+    }
+
+    fn link(&self, slot: u8) -> LinkStats {
+        LinkStats::bus(self.can_link(slot))
     }
 
     /// The records left out, by protocol (those of which some were), in
     /// [`Protocol::ALL`]'s order.
-    pub(crate) fn left_out(&self) -> Vec<(Protocol, u64)> {
+    fn left_out(&self) -> Vec<(Protocol, u64)> {
         Protocol::ALL
             .into_iter()
             .zip(self.left_out)
             .filter(|&(_, n)| n > 0)
             .collect()
+    }
+
+    fn plan(&mut self, plan: &BusPlan) {
+        self.wire.set_plan(plan);
+    }
+
+    fn take_clashes(&mut self) -> Vec<String> {
+        let clashes = self.wire.take_clashes();
+        clashes.iter().map(|c| c.to_string()).collect()
     }
 }
 
@@ -185,9 +243,9 @@ mod tests {
                 assert!(forced.is_none_or(|p| p == d.protocol()));
                 n += 1;
             };
-            bus.feed(&bytes, None, &mut count);
+            bus.decode(&bytes, None, &mut count);
             // (The Hobbywing ESC, which never answers GetEscID, is held to the end.)
-            bus.finish(&mut count);
+            bus.end(&mut count);
             assert_eq!((n, bus.left_out()), (kept, left_out), "{forced:?}");
         }
     }

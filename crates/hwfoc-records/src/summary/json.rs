@@ -182,8 +182,8 @@ impl EscReport<'_> {
 }
 
 /// An ESC's node and bus figures on a CAN bus (null elsewhere).
-fn can_json(st: &crate::stream::EscLink) -> Value {
-    let crate::stream::EscLink::Can(c) = st else {
+fn can_json(st: &crate::stream::LinkStats) -> Value {
+    let Some(c) = st.can() else {
         return Value::Null;
     };
     let n = &c.node_stats;

@@ -41,7 +41,7 @@ use crate::handler::LaterPart;
 use crate::input::InputError;
 use crate::settings::{self, settings_json};
 use crate::sources::{Handler, Sources};
-use crate::stream::EscLink;
+use crate::stream::LinkStats;
 use crate::time::{self, Clock};
 use hwfoc::datalink::LengthByte;
 
@@ -108,12 +108,12 @@ pub fn no_frames(sources: &Sources, esc: usize) -> String {
     if let Some(looks) = looks.filter(|l| l.is_other_than_telemetry()) {
         return looks.to_string();
     }
-    if let EscLink::Can(c) = sources.link(esc) {
+    if let Some(c) = sources.link(esc).can() {
         return c.no_status();
     }
     if let Some(protocol) = sources.forced_protocol() {
         let stream = sources.escs().get(esc).map(|e| &e.stream);
-        if stream.is_some_and(|s| s.is_can()) {
+        if stream.is_some_and(|s| s.layout() == hwfoc::format::LinkKind::Bus) {
             return format!(
                 "no {} records on this CAN bus (its records of other protocols left out)",
                 protocol.title()
@@ -155,7 +155,7 @@ const TEXT_EPISODES: usize = 20;
 
 /// Where an ESC is on a CAN bus, as its label says it.
 fn can_place(c: &crate::stream::CanLink) -> String {
-    match (c.node, c.channel, c.protocol) {
+    match (c.node, c.throttle_channel, c.protocol) {
         (Some(node), Some(channel), _) => format!(" throttle channel {channel}, node {node}"),
         (Some(node), None, Protocol::HwCan) => {
             format!(" node {node} (no GetEscID answer: numbered by node id)")
@@ -174,8 +174,8 @@ pub fn esc_label(sources: &Sources, esc: usize) -> String {
         .inputs()
         .get(e.input)
         .is_none_or(|info| info.escs.len() == 1);
-    let channel = match (sources.link(esc), sources.escs()[esc].hub) {
-        (crate::stream::EscLink::Can(c), _) => can_place(&c),
+    let channel = match (sources.link(esc).can(), sources.escs()[esc].hub) {
+        (Some(c), _) => can_place(c),
         (_, Some((_, channel))) => format!(" channel {channel}"),
         _ if sources.is_hub(esc) => " channel 0".to_string(),
         _ => String::new(),
@@ -325,7 +325,7 @@ struct EscReport<'a> {
     label: String,
     stream: &'a str,
     input: &'a str,
-    stats: EscLink,
+    stats: LinkStats,
     settings: Settings,
     acc: &'a Accumulator,
     /// The episode still open at the end, closed for the report.

@@ -194,7 +194,7 @@ impl EscReport<'_> {
             };
             let _ = writeln!(o, "delivery     {:.2} % of {of}data frames", ratio * 100.0);
         }
-        if let crate::stream::EscLink::Can(c) = &st {
+        if let Some(c) = st.can() {
             let n = &c.node_stats;
             let node = c
                 .node

@@ -90,9 +90,9 @@ impl Bus {
         match data {
             Data::HwCan(r) => {
                 assert_eq!(r.node, node);
-                assert_eq!(r.channel, self.escs.channel(node));
-                let place = r.channel.map_or(node, |c| c.saturating_sub(1));
-                assert_eq!(r.bus_index(), place);
+                assert_eq!(r.throttle_channel, self.escs.throttle_channel(node));
+                let place = r.throttle_channel.map_or(node, |c| c.saturating_sub(1));
+                assert_eq!(r.bus_place(), place);
                 assert!(age_ok(r.msg2_age_ms, r.power.is_some()), "{r:?}");
                 assert!(age_ok(r.msg3_age_ms, r.temperatures.is_some()), "{r:?}");
                 if r.rpm > 0 || r.pwm > 0 {
@@ -101,7 +101,7 @@ impl Bus {
             }
             Data::DroneCan(r) => {
                 assert_eq!(r.node, node);
-                assert!(r.esc_index < 32 && r.bus_index() == r.esc_index);
+                assert!(r.esc_index < 32 && r.bus_place() == r.esc_index);
                 assert!(age_ok(r.ext_age_ms, r.extended.is_some()), "{r:?}");
                 if r.rpm != 0 {
                     assert!(self.escs.any_turning());

@@ -39,7 +39,7 @@
 //! assert!(feed(Message::from(GetEscId::new(&[7, 3]).unwrap()), 7, 2_000).is_none());
 //! let m1 = StatusMsg1 { rpm: 4200, pwm: 350, status: StatusMsg1::STATUS_CCW };
 //! let Some(Data::HwCan(r)) = feed(Message::from(m1), 7, 21_000) else { panic!() };
-//! assert_eq!((r.node, r.channel, r.bus_index(), r.ccw()), (7, Some(3), 2, true));
+//! assert_eq!((r.node, r.throttle_channel, r.bus_place(), r.ccw()), (7, Some(3), 2, true));
 //! assert_eq!(r.msg2_age_ms, Some(20));
 //! let s = Settings::default();
 //! assert_eq!(r.value(Quantity::Voltage, &s), Some(25.2));
@@ -95,7 +95,7 @@ pub struct HwCanEsc {
     /// The sending node.
     pub node: u8,
     /// Its throttle channel (1-based) from a GetEscID answer, if one came.
-    pub channel: Option<u8>,
+    pub throttle_channel: Option<u8>,
     /// The StatusMsg1 transfer's id.
     pub transfer_id: u8,
     /// StatusMsg1 `rpm`.
@@ -121,9 +121,10 @@ impl HwCanEsc {
     }
 
     /// Where the ESC is on its bus: its throttle channel - 1 once a GetEscID answer mapped it,
-    /// until then its node id ([`HwCanEsc::channel`] says which).
-    pub fn bus_index(&self) -> u8 {
-        self.channel.map_or(self.node, |c| c.saturating_sub(1))
+    /// until then its node id ([`HwCanEsc::throttle_channel`] says which).
+    pub fn bus_place(&self) -> u8 {
+        self.throttle_channel
+            .map_or(self.node, |c| c.saturating_sub(1))
     }
 }
 
@@ -210,7 +211,7 @@ pub struct DroneCanEsc {
 
 impl DroneCanEsc {
     /// Where the ESC is on its bus: its `esc_index`.
-    pub const fn bus_index(&self) -> u8 {
+    pub const fn bus_place(&self) -> u8 {
         self.esc_index
     }
 }
@@ -321,7 +322,7 @@ impl Escs {
                 Some(
                     HwCanEsc {
                         node: source,
-                        channel: (node.channel > 0).then_some(node.channel),
+                        throttle_channel: (node.channel > 0).then_some(node.channel),
                         transfer_id: rx.transfer_id,
                         rpm: m.rpm,
                         pwm: m.pwm,
@@ -400,7 +401,7 @@ impl Escs {
     }
 
     /// The throttle channel (1-based) a GetEscID answer gave `node`.
-    pub fn channel(&self, node: u8) -> Option<u8> {
+    pub fn throttle_channel(&self, node: u8) -> Option<u8> {
         let c = self.nodes.get(usize::from(node))?.channel;
         (c > 0).then_some(c)
     }
@@ -467,10 +468,10 @@ mod tests {
             panic!()
         };
         assert_eq!(
-            (r.power, r.temperatures, r.msg2_age_ms, r.channel),
+            (r.power, r.temperatures, r.msg2_age_ms, r.throttle_channel),
             (None, None, None, None)
         );
-        assert_eq!(r.bus_index(), 5);
+        assert_eq!(r.bus_place(), 5);
         let s = Settings::default();
         assert_eq!(r.value(Quantity::Voltage, &s), None);
         assert_eq!(r.value(Quantity::ThrottleOut, &s), Some(0.0));
@@ -507,7 +508,7 @@ mod tests {
             127,
             None,
         );
-        assert_eq!(escs.channel(0), None);
+        assert_eq!(escs.throttle_channel(0), None);
         feed(
             &mut rx,
             &mut escs,
@@ -515,9 +516,9 @@ mod tests {
             5,
             None,
         );
-        assert_eq!(escs.channel(5), Some(1));
+        assert_eq!(escs.throttle_channel(5), Some(1));
         escs.reset();
-        assert_eq!(escs.channel(5), None);
+        assert_eq!(escs.throttle_channel(5), None);
     }
 
     #[test]
@@ -579,7 +580,7 @@ mod tests {
         };
         let s = Settings::default();
         assert_eq!(
-            (r.bus_index(), r.ext_age_ms, r.error_count),
+            (r.bus_place(), r.ext_age_ms, r.error_count),
             (2, Some(50), 7)
         );
         assert_eq!(r.value(Quantity::Voltage, &s), Some(24.5));

@@ -5,8 +5,9 @@
 use std::collections::{BTreeMap, HashMap, VecDeque};
 
 use hwfoc::Settings;
+use hwfoc::format::LinkKind;
 use hwfoc::telemetry::Info;
-use hwfoc_io::{EscLink, WireKind};
+use hwfoc_io::{LinkStats, WireKind};
 use hwfoc_ports::can::{CanSpec, is_can_spec};
 
 use super::alarms::{Change, FaultBit, Kind, Latch, Level, Threshold};
@@ -194,7 +195,7 @@ pub struct EscView {
     /// The latest device-information frame.
     pub info: Option<Info>,
     /// Link statistics of its decoder.
-    pub stats: EscLink,
+    pub stats: LinkStats,
     /// Its port's baud rate: given, or found from the bytes; `None` while it is being found
     /// (and on a CAN bus).
     pub baud: Option<u32>,
@@ -248,14 +249,7 @@ impl EscView {
     /// no ESC status yet.
     pub fn waiting(&self) -> &'static str {
         if self.can.is_some() {
-            let bus = match &self.stats {
-                EscLink::Can(c) => c.bus,
-                EscLink::Wire(_)
-                | EscLink::Hub { .. }
-                | EscLink::HwV4(_)
-                | EscLink::HwV3(_)
-                | EscLink::Hw5(_) => Default::default(),
-            };
+            let bus = self.stats.can().map(|c| c.bus).unwrap_or_default();
             return match (bus.frames(), bus.error_frames()) {
                 (0, _) => "no CAN frame yet: bit rate? ESCs powered?",
                 (_, 1..) => "error frames, no ESC status: the bus's bit rate?",
@@ -492,7 +486,7 @@ impl Fleet {
                 energy: Energy::new(),
                 history: VecDeque::new(),
                 info: None,
-                stats: EscLink::default(),
+                stats: LinkStats::default(),
                 baud: baud.fixed(),
                 trying: (baud == Baud::Auto).then_some(baud.initial()),
                 discarded: 0,
@@ -555,7 +549,8 @@ impl Fleet {
                 self.notices.extend(self.streams.take_notices());
                 // A hub's channels and a CAN bus's ESCs each have a view of their own.
                 let hub = self.streams.stream(port).is_some_and(|s| {
-                    s.is_can() || matches!(s.kind(), WireKind::Hub | WireKind::Mixed)
+                    s.layout() == LinkKind::Bus
+                        || matches!(s.kind(), WireKind::Hub | WireKind::Mixed)
                 });
                 let mut data = 0;
                 for item in got.0 {
@@ -584,8 +579,8 @@ impl Fleet {
                             if p == port {
                                 let view = &mut self.escs[i];
                                 view.stats = stream.link(channel as u8);
-                                if let (Some(spec), EscLink::Can(c)) = (&view.can, &view.stats) {
-                                    view.name = can_name(spec, c.node, c.channel);
+                                if let (Some(spec), Some(c)) = (&view.can, view.stats.can()) {
+                                    view.name = can_name(spec, c.node, c.throttle_channel);
                                 }
                             }
                         }

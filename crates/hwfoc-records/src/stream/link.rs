@@ -1,0 +1,280 @@
+//! One ESC's link figures, whatever carries it ([`LinkStats`]): its own serial wire, a channel of
+//! a DataLink hub or a slot of a CAN bus. Each decoder of a stream gives them for each of its
+//! channels ([`super::decoder::Link::link`]); every front end reads them here, under one set of
+//! names.
+
+use hwfoc::counters::{Sequence, Width};
+use hwfoc::format::Check;
+use hwfoc::telemetry::Info;
+use hwfoc::{Protocol, datalink, foc, hw5, v3, v4};
+
+use super::can::CanLink;
+
+/// The packet counts of a link whose frames are numbered (by a packet counter, or on a CAN bus
+/// by each node's transfer ids).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+struct Packets {
+    /// Numbers received (a bus: the node's transfers).
+    received: u64,
+    lost: u32,
+    duplicates: u32,
+    reordered: u32,
+    restarts: u32,
+    last: Option<u32>,
+}
+
+impl Packets {
+    /// The counts of a packet counter's numbers.
+    fn of<W: Width>(s: &Sequence<W>) -> Packets {
+        Packets {
+            received: u64::from(s.count()),
+            lost: s.lost(),
+            duplicates: s.duplicates(),
+            reordered: s.reordered(),
+            restarts: s.restarts(),
+            last: s.last().map(Into::into),
+        }
+    }
+}
+
+/// The link figures of one ESC: those of its own wire, of its channel of a DataLink hub (whose
+/// bytes, skipped bytes and checksum failures are the hub link's, shared by its channels), or of
+/// its node on a CAN bus (with its place there: [`LinkStats::can`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct LinkStats {
+    protocol: Protocol,
+    bytes: u64,
+    bytes_skipped: u64,
+    frames: u32,
+    info_frames: u32,
+    checksum_failures: u32,
+    rejected_candidates: Option<u32>,
+    /// `None` where frames carry no packet number (HW5).
+    packets: Option<Packets>,
+    adopted_info: Option<Info>,
+    can: Option<CanLink>,
+}
+
+impl Default for LinkStats {
+    fn default() -> Self {
+        LinkStats::wire(&foc::Stats::new())
+    }
+}
+
+impl LinkStats {
+    /// The figures of an ESC on its own HW-FOC wire (or of a stream whose protocol is not known
+    /// yet).
+    pub(crate) fn wire(s: &foc::Stats) -> LinkStats {
+        let packets = Packets::of(s.packets());
+        LinkStats {
+            protocol: Protocol::HwFoc,
+            bytes: s.bytes(),
+            bytes_skipped: s.bytes_skipped(),
+            frames: s.packets().count(),
+            info_frames: s.info_frames(),
+            checksum_failures: s.checksum_failures(),
+            rejected_candidates: None,
+            packets: Some(packets),
+            adopted_info: None,
+            can: None,
+        }
+    }
+
+    /// The figures of channel `channel` of a DataLink hub whose link's statistics are `hub`.
+    pub(crate) fn hub(hub: &datalink::Stats, channel: u8) -> LinkStats {
+        let packets = hub.channel(usize::from(channel)).map(Packets::of);
+        LinkStats {
+            protocol: Protocol::DataLink,
+            bytes: hub.bytes(),
+            bytes_skipped: hub.bytes_skipped(),
+            frames: packets.map_or(0, |p| p.received as u32),
+            info_frames: 0,
+            checksum_failures: hub.checksum_failures(),
+            rejected_candidates: None,
+            packets: Some(packets.unwrap_or_default()),
+            adopted_info: None,
+            can: None,
+        }
+    }
+
+    /// The figures of a Hobbywing V4 ESC's wire.
+    pub(crate) fn v4(s: &v4::Stats) -> LinkStats {
+        LinkStats {
+            protocol: Protocol::HwV4,
+            bytes: s.bytes(),
+            bytes_skipped: s.bytes_skipped(),
+            frames: s.frames(),
+            info_frames: s.info_frames(),
+            checksum_failures: 0,
+            rejected_candidates: Some(s.rejected()),
+            packets: Some(Packets::of(s.counter())),
+            adopted_info: s.adopted().map(Info::HwV4),
+            can: None,
+        }
+    }
+
+    /// The figures of a Hobbywing V3 ESC's wire.
+    pub(crate) fn v3(s: &v3::Stats) -> LinkStats {
+        LinkStats {
+            protocol: Protocol::HwV3,
+            bytes: s.bytes(),
+            bytes_skipped: s.bytes_skipped(),
+            frames: s.frames(),
+            info_frames: 0,
+            checksum_failures: 0,
+            rejected_candidates: Some(s.rejected()),
+            packets: Some(Packets::of(s.counter())),
+            adopted_info: None,
+            can: None,
+        }
+    }
+
+    /// The figures of an HW5 ESC's wire (its frames carry no packet number).
+    pub(crate) fn hw5(s: &hw5::Stats) -> LinkStats {
+        LinkStats {
+            protocol: Protocol::Hw5,
+            bytes: s.bytes(),
+            bytes_skipped: s.bytes_skipped(),
+            frames: s.telemetry_frames(),
+            info_frames: 0,
+            checksum_failures: s.checksum_failures().saturating_add(s.out_of_range()),
+            rejected_candidates: None,
+            packets: None,
+            adopted_info: None,
+            can: None,
+        }
+    }
+
+    /// The figures of an ESC on a CAN bus: its node's transfers, counted from their transfer
+    /// ids.
+    pub(crate) fn bus(c: CanLink) -> LinkStats {
+        let node = &c.node_stats;
+        LinkStats {
+            protocol: c.protocol,
+            bytes: c.bytes,
+            bytes_skipped: c.bytes_skipped(),
+            frames: c.records,
+            info_frames: 0,
+            checksum_failures: node.checksum_failures(),
+            rejected_candidates: None,
+            packets: Some(Packets {
+                received: node.total_transfers(),
+                lost: node.lost_packets(),
+                duplicates: node.duplicates(),
+                reordered: 0,
+                restarts: node.restarts(),
+                last: None,
+            }),
+            adopted_info: None,
+            can: Some(c),
+        }
+    }
+
+    /// The protocol of the link's frames.
+    pub fn protocol(&self) -> Protocol {
+        self.protocol
+    }
+
+    /// Bytes of the stream the ESC's frames came in.
+    pub fn bytes(&self) -> u64 {
+        self.bytes
+    }
+
+    /// Bytes of that stream that were in no accepted frame (of the link's protocol; an HW5
+    /// wire's other frame kinds, requests and answers, are not skipped).
+    pub fn bytes_skipped(&self) -> u64 {
+        self.bytes_skipped
+    }
+
+    /// Data frames of the ESC (records of its channel, behind a hub; of its node, on a bus).
+    pub fn frames(&self) -> u32 {
+        self.frames
+    }
+
+    /// Device-information frames (V4: info frames; a hub forwards none).
+    pub fn info_frames(&self) -> u32 {
+        self.info_frames
+    }
+
+    /// Whether the link's frames are checked (its format's description: V3 and V4 are not,
+    /// their frames are recognised by plausibility and chaining, see
+    /// [`LinkStats::rejected_candidates`]).
+    pub fn has_checksum(&self) -> bool {
+        self.protocol.description().check != Check::None
+    }
+
+    /// Frames rejected by their checksum, or whose checksum matched but whose values are out of
+    /// their protocol's range (behind a hub: the hub frames' CRC failures; 0 for a format
+    /// without checksum).
+    pub fn checksum_failures(&self) -> u32 {
+        self.checksum_failures
+    }
+
+    /// Candidates of a format without checksum that were not taken: implausible, or not
+    /// confirmed by a chain (`None` for a checksummed format).
+    pub fn rejected_candidates(&self) -> Option<u32> {
+        self.rejected_candidates
+    }
+
+    /// Whether the link's frames carry a packet counter, from which loss is counted (HW5's
+    /// do not: its lost, duplicate and restart counts are 0 and say nothing). On a CAN bus,
+    /// the transfer ids of every transfer of the ESC's node are counted.
+    pub fn counts_packets(&self) -> bool {
+        self.packets.is_some()
+    }
+
+    /// Packet numbers skipped (on a CAN bus: transfers of the node missed, from the gaps in
+    /// their transfer ids).
+    pub fn lost_packets(&self) -> u32 {
+        self.packets.map_or(0, |p| p.lost)
+    }
+
+    /// Packet numbers received twice in a row (on a CAN bus: transfers of the node).
+    pub fn duplicate_packets(&self) -> u32 {
+        self.packets.map_or(0, |p| p.duplicates)
+    }
+
+    /// Packet numbers that came right after the next one (two adjacent frames swapped): not
+    /// lost, no restart.
+    pub fn reordered_packets(&self) -> u32 {
+        self.packets.map_or(0, |p| p.reordered)
+    }
+
+    /// Jumps of the packet numbers that no loss explains (on a CAN bus: the node's transfers
+    /// after a silence of the whole bus).
+    pub fn restarts(&self) -> u32 {
+        self.packets.map_or(0, |p| p.restarts)
+    }
+
+    /// The last packet number received.
+    pub fn last_packet(&self) -> Option<u32> {
+        self.packets?.last
+    }
+
+    /// Frames received over frames sent, from the packet numbers (on a CAN bus: the node's
+    /// transfers, from their transfer ids).
+    pub fn delivery_ratio(&self) -> Option<f64> {
+        let p = self.packets?;
+        let received = p.received as f64;
+        (p.received > 0).then(|| received / (received + f64::from(p.lost)))
+    }
+
+    /// The info frame whose constants were adopted (two identical copies in a row), if any: a
+    /// format whose description has [`adopted_info`](hwfoc::format::FormatDescription) (V4).
+    pub fn adopted_info(&self) -> Option<Info> {
+        self.adopted_info
+    }
+
+    /// Of an ESC on a CAN bus: its node, throttle channel, maintenance counters and its bus's
+    /// frame statistics; `None` for a serial link.
+    pub fn can(&self) -> Option<&CanLink> {
+        self.can.as_ref()
+    }
+
+    /// A Hobbywing CAN ESC's own maintenance counters, minutes (total rotation time, time since
+    /// maintenance), where its bus's recording holds its answer to GetMaintenanceInformation;
+    /// `None` otherwise.
+    pub fn maintenance_min(&self) -> Option<(u32, u32)> {
+        self.can?.maintenance_min
+    }
+}
