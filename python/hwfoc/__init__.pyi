@@ -266,10 +266,13 @@ class Decoder:
 
     @property
     def stats(self) -> Dict[str, Any]:
-        """Link statistics: ``bytes``, ``bytes_skipped``, ``frames``, ``info_frames``,
-        ``checksum_failures``, ``lost_packets``, ``duplicate_packets``, ``restarts``,
-        ``last_packet``, ``delivery_ratio``. ``frames`` counts the data frames of every format
-        the stream carried (the rows given); the other figures are of its current format."""
+        """Link statistics: ``bytes``, ``frames``, ``info_frames``, then the link figures under
+        the names of :func:`summary`'s ``link`` (``checksum_failures``, ``rejected_candidates``,
+        ``lost_packets``, ``duplicate_packets``, ``restarts``, ``bytes_skipped``,
+        ``delivery_ratio``: ``None`` where the format does not count one, as for HW5's packets
+        or a checksum V3 and V4 do not have), and ``last_packet``. ``frames`` counts the data
+        frames of every format the stream carried (the rows given); the other figures are of its
+        current format."""
 
     @property
     def schema(self) -> pa.Schema:

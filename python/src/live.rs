@@ -15,8 +15,8 @@ use hwfoc::telemetry::AnyFrame;
 use hwfoc_io::Batch;
 use hwfoc_io::Handler;
 use hwfoc_io::InputError;
-use hwfoc_io::LinkStats;
 use hwfoc_io::Notice;
+use hwfoc_io::{Figure, LinkStats};
 use hwfoc_io::{PortStreams, Stream};
 use hwfoc_ports::clock::byte_times;
 use hwfoc_ports::serial::PortSet;
@@ -71,12 +71,14 @@ pub(crate) fn stats_dict<'py>(py: Python<'py>, s: &LinkStats) -> PyResult<Bound<
     d.set_item("bytes_skipped", s.bytes_skipped())?;
     d.set_item("frames", s.frames())?;
     d.set_item("info_frames", s.info_frames())?;
-    d.set_item("checksum_failures", s.checksum_failures())?;
-    d.set_item("lost_packets", s.lost_packets())?;
-    d.set_item("duplicate_packets", s.duplicate_packets())?;
-    d.set_item("restarts", s.restarts())?;
+    for (name, value) in s.figures() {
+        match value {
+            Some(Figure::Count(n)) => d.set_item(name, n)?,
+            Some(Figure::Ratio(r)) => d.set_item(name, r)?,
+            None => d.set_item(name, py.None())?,
+        }
+    }
     d.set_item("last_packet", s.last_packet())?;
-    d.set_item("delivery_ratio", s.delivery_ratio())?;
     Ok(d)
 }
 

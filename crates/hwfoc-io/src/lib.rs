@@ -165,8 +165,9 @@ pub use input::{OpenInput, read_small_file};
 // Decoding: `Sources` reads inputs, merges them in time order and decodes each ESC's bytes
 // with a `Stream` (`PortStreams` for live ports), handing frames to a `Handler`.
 pub use hwfoc_records::{
-    Both, CanLink, Esc, EscEntry, EscKey, EscTable, Handler, InputInfo, LaterPart, LinkStats,
-    MAX_ESCS, MAX_QUEUED, Place, PortStreams, Recording, SILENCE_S, Sources, Stream, WireKind,
+    Both, CanLink, Esc, EscEntry, EscKey, EscTable, Figure, Handler, InputInfo, LaterPart,
+    LinkStats, MAX_ESCS, MAX_QUEUED, Place, PortStreams, Recording, SILENCE_S, Sources, Stream,
+    WireKind,
 };
 
 // Settings: each ESC's conversion settings (`hwfoc::Settings`), as given per ESC and shown.

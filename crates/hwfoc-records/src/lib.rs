@@ -124,7 +124,9 @@ pub use esc_numbers::MAX_ESCS;
 pub use esc_table::{EscEntry, EscKey, EscTable, Place, Recording};
 pub use handler::{Both, Handler, LaterPart};
 pub use sources::{Esc, InputInfo, MAX_QUEUED, Sources};
-pub use stream::{CanLink, LinkStats, PortStreams, SILENCE_S, Stream, WireKind};
+pub use stream::{
+    CanLink, FIGURES, FRAME_FIGURES, Figure, LinkStats, PortStreams, SILENCE_S, Stream, WireKind,
+};
 
 // Settings: each ESC's conversion settings (`hwfoc::Settings`), as given per ESC and shown.
 pub use settings::{

@@ -11,6 +11,7 @@ pub mod columns;
 pub mod file;
 pub mod session;
 
+use hwfoc_records::Figure;
 use js_sys::{Array, Object, Reflect};
 use wasm_bindgen::prelude::*;
 
@@ -82,20 +83,10 @@ impl WasmSession {
                 infos.push(&i);
             }
             Reflect::set(&o, &"info".into(), &infos)?;
-            let counted = link.counts_packets();
             let l = Object::new();
-            let checksum = link.has_checksum().then(|| link.checksum_failures());
-            set(&l, "checksum_failures", checksum.map(f64::from))?;
-            set(
-                &l,
-                "lost_packets",
-                counted.then(|| f64::from(link.lost_packets())),
-            )?;
-            let duplicates = counted.then(|| f64::from(link.duplicate_packets()));
-            set(&l, "duplicate_packets", duplicates)?;
-            set(&l, "restarts", counted.then(|| f64::from(link.restarts())))?;
-            set(&l, "bytes_skipped", link.bytes_skipped() as f64)?;
-            set(&l, "delivery_ratio", link.delivery_ratio())?;
+            for (name, value) in link.figures() {
+                set(&l, name, value.map(Figure::as_f64))?;
+            }
             Reflect::set(&o, &"link".into(), &l)?;
             let energy = if figures.powered {
                 let e = &figures.energy;

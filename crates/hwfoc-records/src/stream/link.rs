@@ -37,6 +37,31 @@ impl Packets {
     }
 }
 
+/// A link figure's value ([`LinkStats::figures`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Figure {
+    /// A count: frames, packets, bytes.
+    Count(u64),
+    /// A ratio, 0 to 1.
+    Ratio(f64),
+}
+
+impl Figure {
+    /// The value as a number.
+    pub fn as_f64(self) -> f64 {
+        match self {
+            Figure::Count(n) => n as f64,
+            Figure::Ratio(r) => r,
+        }
+    }
+}
+
+/// How many figures [`LinkStats::figures`] gives, and how many of them, first, are its frames'
+/// and packets' (the rest are its stream's).
+pub const FIGURES: usize = 7;
+/// See [`FIGURES`].
+pub const FRAME_FIGURES: usize = 5;
+
 /// The link figures of one ESC: those of its own wire, of its channel of a DataLink hub (whose
 /// bytes, skipped bytes and checksum failures are the hub link's, shared by its channels), or of
 /// its node on a CAN bus (with its place there: [`LinkStats::can`]).
@@ -168,6 +193,39 @@ impl LinkStats {
             adopted_info: None,
             can: Some(c),
         }
+    }
+
+    /// The link's figures under their one set of names, as every output gives them (the
+    /// summary's `link` object, the browser's summary, Python's `stats`): `None` where the link
+    /// does not count the figure (checksum failures without a checksum, rejected candidates
+    /// with one, packets without a packet counter, a ratio of nothing). Its frames' and
+    /// packets' figures first ([`FRAME_FIGURES`] of them), then its stream's.
+    pub fn figures(&self) -> [(&'static str, Option<Figure>); FIGURES] {
+        let count = |n: u32| Some(Figure::Count(u64::from(n)));
+        let packets = |n: u32| {
+            if self.counts_packets() {
+                count(n)
+            } else {
+                None
+            }
+        };
+        [
+            (
+                "checksum_failures",
+                self.has_checksum()
+                    .then_some(self.checksum_failures)
+                    .and_then(count),
+            ),
+            (
+                "rejected_candidates",
+                self.rejected_candidates.and_then(count),
+            ),
+            ("lost_packets", packets(self.lost_packets())),
+            ("duplicate_packets", packets(self.duplicate_packets())),
+            ("restarts", packets(self.restarts())),
+            ("bytes_skipped", Some(Figure::Count(self.bytes_skipped))),
+            ("delivery_ratio", self.delivery_ratio().map(Figure::Ratio)),
+        ]
     }
 
     /// The protocol of the link's frames.

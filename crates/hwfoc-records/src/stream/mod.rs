@@ -22,7 +22,7 @@ pub use self::can::CanLink;
 pub(crate) use self::can::{BusLearner, BusPlan, no_status};
 use self::decoder::LinkDecoder;
 use self::forced::Bus;
-pub use self::link::LinkStats;
+pub use self::link::{FIGURES, FRAME_FIGURES, Figure, LinkStats};
 use self::serial::{Fast, OneEsc, PassOver, Serial};
 use crate::clock::byte_times;
 use crate::esc_numbers::{UNNUMBERED, channel_number};

@@ -109,7 +109,7 @@ pub(super) trait SerialDecoder: std::fmt::Debug + Send {
         &mut self,
         data: &[u8],
         silence_s: Option<f64>,
-        emit: &mut impl FnMut(Option<u8>, u64, &AnyFrame),
+        emit: impl FnMut(Option<u8>, u64, &AnyFrame),
     );
     /// Ends the stream, handing on what the held bytes still hold.
     fn flush(&mut self, emit: &mut impl FnMut(Option<u8>, u64, &AnyFrame));
@@ -151,8 +151,9 @@ impl SerialDecoder for Fast {
         &mut self,
         data: &[u8],
         silence_s: Option<f64>,
-        emit: &mut impl FnMut(Option<u8>, u64, &AnyFrame),
+        mut emit: impl FnMut(Option<u8>, u64, &AnyFrame),
     ) {
+        let emit = &mut emit;
         let silent = |p: Protocol| silence_s.map(|s| frames_in(p, s));
         match self {
             // The closures inlined into the scanner's loop, so that the handler may be too: a
@@ -331,10 +332,10 @@ where
         &mut self,
         data: &[u8],
         silence_s: Option<f64>,
-        emit: &mut impl FnMut(Option<u8>, u64, &AnyFrame),
+        mut emit: impl FnMut(Option<u8>, u64, &AnyFrame),
     ) {
         let silent = silence_s.map(|s| frames_in(self.protocol, s));
-        feed_one(&mut self.decoder, data, silent, self.wrap, emit);
+        feed_one(&mut self.decoder, data, silent, self.wrap, &mut emit);
     }
 
     fn flush(&mut self, emit: &mut impl FnMut(Option<u8>, u64, &AnyFrame)) {
@@ -390,12 +391,7 @@ impl PassOver {
 }
 
 impl SerialDecoder for PassOver {
-    fn feed(
-        &mut self,
-        data: &[u8],
-        _: Option<f64>,
-        _: &mut impl FnMut(Option<u8>, u64, &AnyFrame),
-    ) {
+    fn feed(&mut self, data: &[u8], _: Option<f64>, _: impl FnMut(Option<u8>, u64, &AnyFrame)) {
         self.decoder.pass_over(data.len() as u64);
     }
 
@@ -467,9 +463,12 @@ impl<D: SerialDecoder> Serial<D> {
         match batch.times {
             None => {
                 self.history.clear();
-                self.decoder.feed(batch.bytes, None, &mut |channel, _, f| {
-                    on_frame(None, channel, f)
-                });
+                self.decoder.feed(
+                    batch.bytes,
+                    None,
+                    #[inline(always)]
+                    |channel, _, f| on_frame(None, channel, f),
+                );
             }
             Some(times) => {
                 let history = &self.history;
@@ -507,13 +506,13 @@ impl<D: SerialDecoder> Serial<D> {
     pub(super) fn feed_offsets(
         &mut self,
         bytes: &[u8],
-        mut on_frame: impl FnMut(Option<u8>, u64, &AnyFrame),
+        on_frame: impl FnMut(Option<u8>, u64, &AnyFrame),
     ) {
         self.history.clear();
         if let Some(probe) = &mut self.probe {
             probe.feed(bytes);
         }
-        self.decoder.feed(bytes, None, &mut on_frame);
+        self.decoder.feed(bytes, None, on_frame);
     }
 
     /// Ends the stream: a frame cut off at the end is dropped, frames inside it are still

@@ -1,7 +1,9 @@
 //! The summary as JSON (`hwfoc summary --json`).
 
 use super::*;
+use crate::stream::{FRAME_FIGURES, Figure};
 use hwfoc::format::InfoValue;
+use serde_json::Map;
 
 impl Report<'_> {
     /// The summary as one JSON object, as `hwfoc summary --json` prints it.
@@ -125,7 +127,21 @@ impl EscReport<'_> {
         } else {
             (st.frames() == 0).then_some(self.no_frames.as_str())
         };
-        let counted = st.counts_packets();
+        // The link's figures (their one set of names), with the loss judged from time after
+        // its frames' and packets'.
+        let figures = st.figures();
+        let (frames, stream) = figures.split_at(FRAME_FIGURES);
+        let mut link: Map<String, Value> = frames.iter().map(figure_json).collect();
+        link.insert(
+            "lost_frames_from_time".into(),
+            json!(self.timed_loss().map(|l| l.lost)),
+        );
+        link.insert(
+            "silences_not_judged".into(),
+            json!(self.timed_loss().map(|l| l.unjudged)),
+        );
+        link.extend(stream.iter().map(figure_json));
+        link.insert("can".into(), can_json(&st));
         let mut report = json!({
             "esc": self.index,
             "input": self.input,
@@ -143,18 +159,7 @@ impl EscReport<'_> {
             "clock_jumps": self.acc.jumps,
             "frame_rate_hz": self.frame_rate(),
             "protocol": self.protocol().map(Protocol::name),
-            "link": {
-                "checksum_failures": st.has_checksum().then(|| st.checksum_failures()),
-                "rejected_candidates": st.rejected_candidates(),
-                "lost_packets": counted.then(|| st.lost_packets()),
-                "duplicate_packets": counted.then(|| st.duplicate_packets()),
-                "restarts": counted.then(|| st.restarts()),
-                "lost_frames_from_time": self.timed_loss().map(|l| l.lost),
-                "silences_not_judged": self.timed_loss().map(|l| l.unjudged),
-                "bytes_skipped": st.bytes_skipped(),
-                "delivery_ratio": st.delivery_ratio(),
-                "can": can_json(&st),
-            },
+            "link": Value::Object(link),
             "info": infos,
             "fields": fields,
             "temperature_out_of_range": {
@@ -179,6 +184,17 @@ impl EscReport<'_> {
         }
         report
     }
+}
+
+/// A link figure as a JSON member: a count as an integer, a ratio as a number, null where not
+/// counted.
+fn figure_json(&(name, value): &(&str, Option<Figure>)) -> (String, Value) {
+    let value = match value {
+        Some(Figure::Count(n)) => json!(n),
+        Some(Figure::Ratio(r)) => json!(r),
+        None => Value::Null,
+    };
+    (name.to_string(), value)
 }
 
 /// An ESC's node and bus figures on a CAN bus (null elsewhere).
