@@ -5,8 +5,10 @@ usage: scripts/protocol-arms.py [--list]   (from the checkout to count)
 
 Reads the non-test Rust code of hwfoc-records, hwfoc-ports, hwfoc-io, hwfoc-can-setup, hwfoc-web, hwfoc-cli, hwfoc-sim, hwfoc-bridge and python/src
 (a file's `#[cfg(test)]` module, `tests.rs` files and `tests/` folders are left out) and finds each `match`
-whose arms name an arm of a per-protocol enum (`Protocol`, `Data`, `Info`, `Wire`, `Fast`, `EscLink`,
-`Decoded`, `Family`, `Conversion`). It prints the number of such arms and of wildcard arms
+whose arms name an arm of a per-protocol enum (`Protocol`, `Data`, `Info`, `Fast`, `Decoded`,
+`Family`, `Conversion`; until 2026-11-29 also the stream's `Wire` and `EscLink`, which were
+per-protocol then: `Wire` is now a serial line's fast decoder or a `dyn LinkDecoder`, and
+`LinkStats` a struct). It prints the number of such arms and of wildcard arms
 (`_ =>`) in those matches: a wildcard absorbs a new protocol, so the compiler no longer names
 the place. With --list, each wildcard's file and line.
 """
@@ -19,7 +21,7 @@ ROOT = pathlib.Path.cwd()
 DIRS = ["crates/hwfoc-records/src", "crates/hwfoc-ports/src", "crates/hwfoc-io/src",
         "crates/hwfoc-can-setup/src", "crates/hwfoc-web/src", "crates/hwfoc-cli/src", "crates/hwfoc-sim/src",
         "crates/hwfoc-bridge/src", "python/src"]
-ENUMS = "Protocol|Data|Info|Wire|Fast|EscLink|Decoded|Family|Conversion"
+ENUMS = "Protocol|Data|Info|Fast|Decoded|Family|Conversion"
 ARM = re.compile(r"(?<![\w:])(?:[\w]+::)*(?:" + ENUMS + r")::[A-Z]\w*")
 
 

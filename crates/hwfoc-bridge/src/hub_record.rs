@@ -27,7 +27,7 @@
 use hwfoc::foc::DataFrame;
 use hwfoc::telemetry::{Data, Telemetry};
 use hwfoc::units::{ADC_NO_VALUE, Linear};
-use hwfoc::{Quantity, Settings, Status, Temperature};
+use hwfoc::{Quantity, Settings, Temperature};
 
 /// The largest raw throttle of an HW-FOC frame (100 %).
 const THROTTLE_MAX: u16 = 1024;
@@ -50,15 +50,7 @@ pub fn hub_record(data: &Data, settings: &Settings, packet: u16) -> DataFrame {
     };
     let adc = |q: Quantity| value(q).map_or(ADC_NO_VALUE, Temperature::adc_of);
     let amps = settings.amps_linear();
-    let status = match data {
-        Data::Hw5(frame) => frame.fault.hwfoc_status(),
-        Data::HwFoc(_)
-        | Data::DataLink(_)
-        | Data::HwV4(_)
-        | Data::HwV3(_)
-        | Data::HwCan(_)
-        | Data::DroneCan(_) => Status::OK,
-    };
+    let status = data.hwfoc_status();
     DataFrame {
         packet: data.packet().map_or(packet, |p| p as u16),
         throttle_in_raw: throttle(Quantity::ThrottleIn),

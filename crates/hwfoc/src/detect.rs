@@ -45,6 +45,7 @@
 //! assert_eq!(decoder.locked(), Some(Family::HwV3));
 //! ```
 
+use crate::family::{Emit, FamilyLink, LinkFigures};
 use crate::protocol::{FamilyScanner, FoundFrame};
 use crate::scan::{self, Scanner, StreamDecoder};
 use crate::{Protocol, hw5, mixed, v3, v4};
@@ -70,6 +71,16 @@ pub const HISTORY: usize = 2 * RELOCK_AFTER as usize;
 
 /// Declares [`Family`] and [`Decoded`] from the list of formats (`formats!` in `lib.rs`): one
 /// arm for each format there with a `family`.
+/// `Some(Family::$family)`, or `None` for a format without a family of its own.
+macro_rules! family_of {
+    () => {
+        None
+    };
+    ($family:ident) => {
+        Some(Family::$family)
+    };
+}
+
 macro_rules! declare_families {
     ($( $(#[$doc:meta])* $arm:ident => $description:path, $kind:ident $data:ty
         $(, info $info:ty)? $(, family $family:ident($scanner:ty) rank $rank:literal)?; )+) => {
@@ -141,6 +152,99 @@ macro_rules! declare_families {
             }
         }
 
+        impl Family {
+            /// The family a format's own line of the format list declares: HW-FOC's is
+            /// [`Family::Mixed`] (which reads DataLink too); `None` for DataLink and the CAN
+            /// formats.
+            pub fn of(protocol: Protocol) -> Option<Family> {
+                match protocol {
+                    $( Protocol::$arm => family_of!($($family)?), )+
+                }
+            }
+        }
+
+        impl Decoded {
+            /// Hands the frame on as the ESC frames it holds ([`FamilyLink::hand_on`]):
+            /// `emit(channel, offset, frame)`.
+            pub fn hand_on(&self, emit: &mut Emit<'_>) {
+                match self {
+                    $($( Decoded::$family(d) => <$scanner as FamilyLink>::hand_on(d, emit), )?)+
+                }
+            }
+        }
+
+        /// One family's decoder alone, detecting nothing: a format read as the only one (a
+        /// protocol forced), its frames as [`Decoded`] and its link's figures in neutral terms.
+        #[derive(Debug, Clone)]
+        #[allow(clippy::large_enum_variant)]
+        pub enum OneFamily {
+            $($(
+                #[doc = concat!("[`Family::", stringify!($family), "`]'s decoder.")]
+                $family(StreamDecoder<$scanner>),
+            )?)+
+        }
+
+        impl OneFamily {
+            /// `family`'s decoder, nothing seen.
+            pub fn new(family: Family) -> OneFamily {
+                match family {
+                    $($( Family::$family => OneFamily::$family(StreamDecoder::default()), )?)+
+                }
+            }
+
+            /// Its family.
+            pub fn family(&self) -> Family {
+                match self {
+                    $($( OneFamily::$family(_) => Family::$family, )?)+
+                }
+            }
+
+            /// Feeds a chunk of bytes; `on_frame` gets each frame found.
+            pub fn feed(&mut self, data: &[u8], on_frame: &mut dyn FnMut(Decoded)) {
+                match self {
+                    $($( OneFamily::$family(d) => d.feed(data, |f| on_frame(Decoded::$family(f))), )?)+
+                }
+            }
+
+            /// The line was silent for a time in which at most `max_frames` of the family's
+            /// frames could have been sent ([`StreamDecoder::line_silent`]).
+            pub fn line_silent(&mut self, max_frames: u32, on_frame: &mut dyn FnMut(Decoded)) {
+                match self {
+                    $($( OneFamily::$family(d) => {
+                        d.line_silent(max_frames, |f| on_frame(Decoded::$family(f)))
+                    } )?)+
+                }
+            }
+
+            /// Ends the stream, handing on what the held bytes still hold.
+            pub fn flush(&mut self, on_frame: &mut dyn FnMut(Decoded)) {
+                match self {
+                    $($( OneFamily::$family(d) => d.flush(|f| on_frame(Decoded::$family(f))), )?)+
+                }
+            }
+
+            /// Every byte given or passed over so far.
+            pub fn bytes(&self) -> u64 {
+                match self {
+                    $($( OneFamily::$family(d) => scan::Stats::bytes(d.stats()), )?)+
+                }
+            }
+
+            /// Bytes held for a frame still arriving.
+            pub fn buffered(&self) -> usize {
+                match self {
+                    $($( OneFamily::$family(d) => d.buffered(), )?)+
+                }
+            }
+
+            /// The link's figures ([`FamilyLink::figures`]).
+            pub fn figures(&self) -> Option<LinkFigures> {
+                match self {
+                    $($( OneFamily::$family(d) => <$scanner as FamilyLink>::figures(d.stats()), )?)+
+                }
+            }
+        }
+
         /// Each family's decoder, a field named as its family.
         #[allow(non_snake_case)]
         #[derive(Debug, Clone, Default)]
@@ -149,6 +253,13 @@ macro_rules! declare_families {
         }
 
         impl Decoders {
+            /// The link's figures of `family`'s decoder ([`FamilyLink::figures`]).
+            fn figures(&self, family: Family) -> Option<LinkFigures> {
+                match family {
+                    $($( Family::$family => <$scanner as FamilyLink>::figures(self.$family.stats()), )?)+
+                }
+            }
+
             /// Bytes `family`'s decoder holds for a frame still arriving.
             fn buffered(&self, family: Family) -> usize {
                 match family {
@@ -391,6 +502,13 @@ impl Decoder {
     /// HW5's statistics (see [`Decoder::mixed_stats`]).
     pub fn hw5_stats(&self) -> &hw5::Stats {
         self.decoders.Hw5.stats()
+    }
+
+    /// The link's figures of the format it last locked onto, in neutral terms
+    /// ([`FamilyLink::figures`]): `None` before any lock, and for HW-FOC and DataLink, whose
+    /// figures are per channel ([`Decoder::mixed_stats`]).
+    pub fn last_locked_figures(&self) -> Option<LinkFigures> {
+        self.decoders.figures(self.last_locked?)
     }
 
     /// Feeds a chunk of bytes; `on_frame` gets each frame found.

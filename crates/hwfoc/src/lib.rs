@@ -52,6 +52,7 @@ pub mod counters;
 pub mod datalink;
 pub mod detect;
 pub mod dronecan;
+pub mod family;
 pub mod foc;
 pub mod format;
 pub mod hw5;

@@ -374,6 +374,28 @@ impl crate::protocol::FamilyScanner for Scanner {
     }
 }
 
+impl crate::family::FamilyLink for Scanner {
+    /// An ESC's frame, or each of a hub frame's ESC frames with its channel, at the hub frame's
+    /// offset.
+    fn hand_on(d: &Decoded, emit: &mut crate::family::Emit<'_>) {
+        match d {
+            Decoded::Esc(d) => emit(None, d.offset, &crate::telemetry::AnyFrame::from(d.frame)),
+            Decoded::Hub(d) => {
+                for (channel, frame) in d.frame.escs() {
+                    let frame = crate::telemetry::Data::DataLink(*frame);
+                    let frame = crate::telemetry::AnyFrame::Data(frame);
+                    emit(Some(channel as u8), d.offset, &frame);
+                }
+            }
+        }
+    }
+
+    /// None: an ESC's wire and each of a hub's channels has figures of its own.
+    fn figures(_: &Stats) -> Option<crate::family::LinkFigures> {
+        None
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -129,6 +129,14 @@ pub trait Telemetry {
     /// The frame's status word (sixteen fault bits, [`Status`]), where the protocol sends one.
     fn status(&self) -> Option<Status>;
 
+    /// The frame's faults as HW-FOC's sixteen status bits, for a frame sent on in HW-FOC's
+    /// layout (a DataLink hub's record): HW-FOC's own word; another format's faults mapped to
+    /// the HW-FOC bit of the same fault where one clearly is (HW5); [`Status::OK`] where a
+    /// format's flags have no HW-FOC meaning (the default).
+    fn hwfoc_status(&self) -> Status {
+        Status::OK
+    }
+
     /// `quantity` as this frame carries it under `settings` (which only conversions that depend
     /// on the user's setup read: pole pairs, gear ratio, current scale), or `None` when the
     /// frame's protocol does not carry it.
@@ -195,6 +203,12 @@ macro_rules! declare_data {
                 }
             }
 
+            fn hwfoc_status(&self) -> Status {
+                match self {
+                    $( Data::$arm(f) => Telemetry::hwfoc_status(f), )+
+                }
+            }
+
             #[inline(always)]
             fn reading(&self, quantity: Quantity, settings: &Settings) -> Option<Reading> {
                 match self {
@@ -241,6 +255,16 @@ impl Data {
         match self {
             Data::HwCan(e) => Some(e.node),
             Data::DroneCan(e) => Some(e.node),
+            _ => None,
+        }
+    }
+
+    /// A standard DroneCAN ESC's `esc_index` (which of its node's ESCs it is); `None` for a
+    /// Hobbywing CAN ESC (one per node) and a serial format.
+    #[inline]
+    pub const fn esc_index(&self) -> Option<u8> {
+        match self {
+            Data::DroneCan(e) => Some(e.esc_index),
             _ => None,
         }
     }

@@ -46,19 +46,10 @@ pub(crate) struct EscKey {
 impl EscKey {
     /// The ESC a record is of.
     pub(crate) fn of(data: &Data) -> Option<EscKey> {
-        match data {
-            Data::HwCan(r) => Some(EscKey {
-                node: r.node,
-                index: None,
-            }),
-            Data::DroneCan(r) => Some(EscKey {
-                node: r.node,
-                index: Some(r.esc_index),
-            }),
-            Data::HwFoc(_) | Data::DataLink(_) | Data::HwV4(_) | Data::HwV3(_) | Data::Hw5(_) => {
-                None
-            }
-        }
+        Some(EscKey {
+            node: data.node()?,
+            index: data.esc_index(),
+        })
     }
 }
 

@@ -3,39 +3,12 @@
 //! channels ([`super::decoder::Link::link`]); every front end reads them here, under one set of
 //! names.
 
-use hwfoc::counters::{Sequence, Width};
+use hwfoc::family::{LinkFigures, PacketCounts};
 use hwfoc::format::Check;
 use hwfoc::telemetry::Info;
-use hwfoc::{Protocol, datalink, foc, hw5, v3, v4};
+use hwfoc::{Protocol, datalink, foc};
 
 use super::can::CanLink;
-
-/// The packet counts of a link whose frames are numbered (by a packet counter, or on a CAN bus
-/// by each node's transfer ids).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-struct Packets {
-    /// Numbers received (a bus: the node's transfers).
-    received: u64,
-    lost: u32,
-    duplicates: u32,
-    reordered: u32,
-    restarts: u32,
-    last: Option<u32>,
-}
-
-impl Packets {
-    /// The counts of a packet counter's numbers.
-    fn of<W: Width>(s: &Sequence<W>) -> Packets {
-        Packets {
-            received: u64::from(s.count()),
-            lost: s.lost(),
-            duplicates: s.duplicates(),
-            reordered: s.reordered(),
-            restarts: s.restarts(),
-            last: s.last().map(Into::into),
-        }
-    }
-}
 
 /// A link figure's value ([`LinkStats::figures`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -75,7 +48,7 @@ pub struct LinkStats {
     checksum_failures: u32,
     rejected_candidates: Option<u32>,
     /// `None` where frames carry no packet number (HW5).
-    packets: Option<Packets>,
+    packets: Option<PacketCounts>,
     adopted_info: Option<Info>,
     can: Option<CanLink>,
 }
@@ -90,7 +63,7 @@ impl LinkStats {
     /// The figures of an ESC on its own HW-FOC wire (or of a stream whose protocol is not known
     /// yet).
     pub(crate) fn wire(s: &foc::Stats) -> LinkStats {
-        let packets = Packets::of(s.packets());
+        let packets = PacketCounts::of(s.packets());
         LinkStats {
             protocol: Protocol::HwFoc,
             bytes: s.bytes(),
@@ -107,7 +80,7 @@ impl LinkStats {
 
     /// The figures of channel `channel` of a DataLink hub whose link's statistics are `hub`.
     pub(crate) fn hub(hub: &datalink::Stats, channel: u8) -> LinkStats {
-        let packets = hub.channel(usize::from(channel)).map(Packets::of);
+        let packets = hub.channel(usize::from(channel)).map(PacketCounts::of);
         LinkStats {
             protocol: Protocol::DataLink,
             bytes: hub.bytes(),
@@ -122,50 +95,18 @@ impl LinkStats {
         }
     }
 
-    /// The figures of a Hobbywing V4 ESC's wire.
-    pub(crate) fn v4(s: &v4::Stats) -> LinkStats {
+    /// The figures of another format's wire (V4, V3, HW5), as the codec gives them.
+    pub(crate) fn of(f: LinkFigures) -> LinkStats {
         LinkStats {
-            protocol: Protocol::HwV4,
-            bytes: s.bytes(),
-            bytes_skipped: s.bytes_skipped(),
-            frames: s.frames(),
-            info_frames: s.info_frames(),
-            checksum_failures: 0,
-            rejected_candidates: Some(s.rejected()),
-            packets: Some(Packets::of(s.counter())),
-            adopted_info: s.adopted().map(Info::HwV4),
-            can: None,
-        }
-    }
-
-    /// The figures of a Hobbywing V3 ESC's wire.
-    pub(crate) fn v3(s: &v3::Stats) -> LinkStats {
-        LinkStats {
-            protocol: Protocol::HwV3,
-            bytes: s.bytes(),
-            bytes_skipped: s.bytes_skipped(),
-            frames: s.frames(),
-            info_frames: 0,
-            checksum_failures: 0,
-            rejected_candidates: Some(s.rejected()),
-            packets: Some(Packets::of(s.counter())),
-            adopted_info: None,
-            can: None,
-        }
-    }
-
-    /// The figures of an HW5 ESC's wire (its frames carry no packet number).
-    pub(crate) fn hw5(s: &hw5::Stats) -> LinkStats {
-        LinkStats {
-            protocol: Protocol::Hw5,
-            bytes: s.bytes(),
-            bytes_skipped: s.bytes_skipped(),
-            frames: s.telemetry_frames(),
-            info_frames: 0,
-            checksum_failures: s.checksum_failures().saturating_add(s.out_of_range()),
-            rejected_candidates: None,
-            packets: None,
-            adopted_info: None,
+            protocol: f.protocol,
+            bytes: f.bytes,
+            bytes_skipped: f.bytes_skipped,
+            frames: f.frames,
+            info_frames: f.info_frames,
+            checksum_failures: f.checksum_failures,
+            rejected_candidates: f.rejected_candidates,
+            packets: f.packets,
+            adopted_info: f.adopted_info,
             can: None,
         }
     }
@@ -182,7 +123,7 @@ impl LinkStats {
             info_frames: 0,
             checksum_failures: node.checksum_failures(),
             rejected_candidates: None,
-            packets: Some(Packets {
+            packets: Some(PacketCounts {
                 received: node.total_transfers(),
                 lost: node.lost_packets(),
                 duplicates: node.duplicates(),

@@ -10,7 +10,7 @@
 
 use hwfoc::format::LinkKind;
 use hwfoc::telemetry::AnyFrame;
-use hwfoc::{Protocol, Settings, datalink, detect, hw5, v3, v4};
+use hwfoc::{Protocol, Settings, datalink, detect};
 
 mod can;
 mod decoder;
@@ -82,26 +82,14 @@ impl Wire {
     }
 }
 
-/// The decoder of a serial line forced to read a format of a slow ESC (V4, V3, HW5), or a CAN
-/// protocol (which no serial line carries: every byte is skipped).
+/// The decoder of a serial line forced to read a format of a slow ESC (V4, V3, HW5: its
+/// family's decoder alone), or a CAN protocol (which no serial line carries: every byte is
+/// skipped).
 fn slow_serial(p: Protocol) -> Box<dyn LinkDecoder> {
     let forced = Some(p);
-    match p {
-        Protocol::HwV4 => Box::new(Serial::new(
-            OneEsc::<v4::Scanner>::new(p, detect::Decoded::HwV4, LinkStats::v4),
-            forced,
-        )),
-        Protocol::HwV3 => Box::new(Serial::new(
-            OneEsc::<v3::Scanner>::new(p, detect::Decoded::HwV3, LinkStats::v3),
-            forced,
-        )),
-        Protocol::Hw5 => Box::new(Serial::new(
-            OneEsc::<hw5::Scanner>::new(p, detect::Decoded::Hw5, LinkStats::hw5),
-            forced,
-        )),
-        Protocol::HwFoc | Protocol::DataLink | Protocol::HwCan | Protocol::DroneCan => {
-            Box::new(Serial::new(PassOver::new(p), forced))
-        }
+    match detect::Family::of(p).filter(|&f| f != detect::Family::Mixed) {
+        Some(family) => Box::new(Serial::new(OneEsc::new(family, p), forced)),
+        None => Box::new(Serial::new(PassOver::new(p), forced)),
     }
 }
 
@@ -815,7 +803,7 @@ mod port_tests {
         assert_eq!(streams.feed(&found, &mut ()), None);
         assert_eq!((streams.baud(0), streams.baud(1)), (None, Some(115_200)));
         let bytes: Vec<u8> = (0..3)
-            .flat_map(|_| hw5::TelemetryFrame::default().encode())
+            .flat_map(|_| hwfoc::hw5::TelemetryFrame::default().encode())
             .collect();
         let data = PortEvent::Data {
             port: 1,

@@ -7,7 +7,7 @@
 //! CAN protocol).
 
 use hwfoc::format::LinkKind;
-use hwfoc::scan::{Scanner, Stats as _};
+use hwfoc::scan::Scanner;
 use hwfoc::telemetry::{AnyFrame, Data};
 use hwfoc::{Protocol, StreamDecoder, datalink, detect, foc, mixed};
 
@@ -64,19 +64,12 @@ fn emit_any(d: detect::Decoded, emit: &mut impl FnMut(Option<u8>, u64, &AnyFrame
 }
 
 /// [`emit_any`] for the formats of ESCs that send at most about 50 frames a second (V4, V3,
-/// HW5): out of line, so that the loop of an HW-FOC stream holds none of it.
+/// HW5): out of line, so that the loop of an HW-FOC stream holds none of it, each format's
+/// frames made neutral frames by its own module ([`detect::Decoded::hand_on`]).
 #[cold]
 #[inline(never)]
 fn emit_other(d: detect::Decoded, emit: &mut impl FnMut(Option<u8>, u64, &AnyFrame)) {
-    match d {
-        detect::Decoded::HwV4(d) => emit(None, d.offset, &AnyFrame::from(d.frame)),
-        detect::Decoded::HwV3(d) => emit(None, d.offset, &AnyFrame::Data(Data::HwV3(d.frame))),
-        detect::Decoded::Hw5(d) => emit(None, d.offset, &AnyFrame::Data(Data::Hw5(d.frame))),
-        detect::Decoded::Mixed(d) => match d {
-            mixed::Decoded::Esc(d) => emit(None, d.offset, &AnyFrame::from(d.frame)),
-            mixed::Decoded::Hub(d) => hub_records(&d, emit),
-        },
-    }
+    d.hand_on(&mut |channel, offset, frame| emit(channel, offset, frame));
 }
 
 /// Decodes `data` with one protocol's decoder (ending with a silence of the line in which at
@@ -233,12 +226,7 @@ impl SerialDecoder for Fast {
 
     fn other(&self) -> Option<LinkStats> {
         let Fast::Any(d) = self else { return None };
-        Some(match d.last_locked()? {
-            detect::Family::Mixed => return None,
-            detect::Family::HwV4 => LinkStats::v4(d.v4_stats()),
-            detect::Family::HwV3 => LinkStats::v3(d.v3_stats()),
-            detect::Family::Hw5 => LinkStats::hw5(d.hw5_stats()),
-        })
+        d.last_locked_figures().map(LinkStats::of)
     }
 
     fn forced(&self) -> Option<Protocol> {
@@ -282,69 +270,45 @@ impl Fast {
 }
 
 /// One format of an ESC that sends at most about 50 frames a second (V4, V3, HW5), forced:
-/// behind [`LinkDecoder`]'s `dyn`, so that its scanner is compiled once, not once per handler.
-pub(super) struct OneEsc<S: Scanner> {
-    decoder: StreamDecoder<S>,
+/// its family's decoder alone ([`detect::OneFamily`]), behind [`LinkDecoder`]'s `dyn`, so that
+/// its scanner is compiled once, not once per handler.
+#[derive(Debug)]
+pub(super) struct OneEsc {
+    decoder: detect::OneFamily,
     protocol: Protocol,
-    /// Its frames as the detecting decoder gives them.
-    wrap: fn(S::Item) -> detect::Decoded,
-    /// Its link figures.
-    figures: fn(&S::Stats) -> LinkStats,
 }
 
-impl<S: Scanner> std::fmt::Debug for OneEsc<S>
-where
-    StreamDecoder<S>: std::fmt::Debug,
-{
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.debug_struct("OneEsc")
-            .field("decoder", &self.decoder)
-            .field("protocol", &self.protocol)
-            .finish()
-    }
-}
-
-impl<S: Scanner> OneEsc<S> {
-    /// A decoder of `protocol`, its frames made [`detect::Decoded`] by `wrap`, its figures
-    /// by `figures`.
-    pub(super) fn new(
-        protocol: Protocol,
-        wrap: fn(S::Item) -> detect::Decoded,
-        figures: fn(&S::Stats) -> LinkStats,
-    ) -> OneEsc<S>
-    where
-        StreamDecoder<S>: Default,
-    {
+impl OneEsc {
+    /// The decoder of `protocol`, read by `family` alone.
+    pub(super) fn new(family: detect::Family, protocol: Protocol) -> OneEsc {
         OneEsc {
-            decoder: StreamDecoder::default(),
+            decoder: detect::OneFamily::new(family),
             protocol,
-            wrap,
-            figures,
         }
     }
 }
 
-impl<S: Scanner> SerialDecoder for OneEsc<S>
-where
-    StreamDecoder<S>: std::fmt::Debug + Send,
-{
+impl SerialDecoder for OneEsc {
     fn feed(
         &mut self,
         data: &[u8],
         silence_s: Option<f64>,
         mut emit: impl FnMut(Option<u8>, u64, &AnyFrame),
     ) {
-        let silent = silence_s.map(|s| frames_in(self.protocol, s));
-        feed_one(&mut self.decoder, data, silent, self.wrap, &mut emit);
+        let emit = &mut emit;
+        self.decoder.feed(data, &mut |d| emit_any(d, emit));
+        if let Some(s) = silence_s {
+            let frames = frames_in(self.protocol, s);
+            self.decoder.line_silent(frames, &mut |d| emit_any(d, emit));
+        }
     }
 
     fn flush(&mut self, emit: &mut impl FnMut(Option<u8>, u64, &AnyFrame)) {
-        let wrap = self.wrap;
-        self.decoder.flush(|d| emit_any(wrap(d), emit));
+        self.decoder.flush(&mut |d| emit_any(d, emit));
     }
 
     fn bytes(&self) -> u64 {
-        self.decoder.stats().bytes()
+        self.decoder.bytes()
     }
 
     fn buffered(&self) -> usize {
@@ -360,7 +324,7 @@ where
     }
 
     fn other(&self) -> Option<LinkStats> {
-        Some((self.figures)(self.decoder.stats()))
+        self.decoder.figures().map(LinkStats::of)
     }
 
     fn forced(&self) -> Option<Protocol> {

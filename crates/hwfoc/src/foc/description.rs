@@ -68,6 +68,10 @@ impl Telemetry for super::DataFrame {
         Some(self.status)
     }
 
+    fn hwfoc_status(&self) -> Status {
+        self.status
+    }
+
     #[inline(always)]
     fn reading(&self, quantity: Quantity, settings: &Settings) -> Option<Reading> {
         let linear = Reading::linear;

@@ -378,6 +378,11 @@ impl Telemetry for TelemetryFrame {
         Some(Status(u16::from(self.fault.0)))
     }
 
+    /// Its faults mapped to HW-FOC's bits ([`Fault::hwfoc_status`]).
+    fn hwfoc_status(&self) -> Status {
+        self.fault.hwfoc_status()
+    }
+
     /// Throttle (one value: the input throttle's column) in percent as sent, eRPM / 10,
     /// voltages and currents in tenths, temperatures in degC; no output throttle, phase current
     /// or capacitor temperature. Current is the wire's (see [`TelemetryFrame::current_raw`]).

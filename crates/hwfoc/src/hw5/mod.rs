@@ -115,3 +115,26 @@ impl crate::protocol::FamilyScanner for Scanner {
         u64::from(s.telemetry_frames())
     }
 }
+
+impl crate::family::FamilyLink for Scanner {
+    fn hand_on(d: &Decoded, emit: &mut crate::family::Emit<'_>) {
+        let frame = crate::telemetry::Data::Hw5(d.frame);
+        emit(None, d.offset, &crate::telemetry::AnyFrame::Data(frame));
+    }
+
+    /// Its frames carry no packet number: no packet counts. Values out of range count as
+    /// checksum failures.
+    fn figures(s: &Stats) -> Option<crate::family::LinkFigures> {
+        Some(crate::family::LinkFigures {
+            protocol: crate::Protocol::Hw5,
+            bytes: crate::scan::Stats::bytes(s),
+            bytes_skipped: s.bytes_skipped(),
+            frames: s.telemetry_frames(),
+            info_frames: 0,
+            checksum_failures: s.checksum_failures().saturating_add(s.out_of_range()),
+            rejected_candidates: None,
+            packets: None,
+            adopted_info: None,
+        })
+    }
+}

@@ -92,3 +92,24 @@ impl crate::protocol::FamilyScanner for Scanner {
 
     const SILENCE_FRAME_LEN: usize = FRAME_LEN;
 }
+
+impl crate::family::FamilyLink for Scanner {
+    fn hand_on(d: &Decoded, emit: &mut crate::family::Emit<'_>) {
+        let frame = crate::telemetry::Data::HwV3(d.frame);
+        emit(None, d.offset, &crate::telemetry::AnyFrame::Data(frame));
+    }
+
+    fn figures(s: &Stats) -> Option<crate::family::LinkFigures> {
+        Some(crate::family::LinkFigures {
+            protocol: crate::Protocol::HwV3,
+            bytes: crate::scan::Stats::bytes(s),
+            bytes_skipped: s.bytes_skipped(),
+            frames: s.frames(),
+            info_frames: 0,
+            checksum_failures: 0,
+            rejected_candidates: Some(s.rejected()),
+            packets: Some(crate::family::PacketCounts::of(s.counter())),
+            adopted_info: None,
+        })
+    }
+}

@@ -129,3 +129,23 @@ impl crate::protocol::FamilyScanner for Scanner {
 
     const SILENCE_FRAME_LEN: usize = DATA_FRAME_LEN;
 }
+
+impl crate::family::FamilyLink for Scanner {
+    fn hand_on(d: &Decoded, emit: &mut crate::family::Emit<'_>) {
+        emit(None, d.offset, &crate::telemetry::AnyFrame::from(d.frame));
+    }
+
+    fn figures(s: &Stats) -> Option<crate::family::LinkFigures> {
+        Some(crate::family::LinkFigures {
+            protocol: crate::Protocol::HwV4,
+            bytes: crate::scan::Stats::bytes(s),
+            bytes_skipped: s.bytes_skipped(),
+            frames: s.frames(),
+            info_frames: s.info_frames(),
+            checksum_failures: 0,
+            rejected_candidates: Some(s.rejected()),
+            packets: Some(crate::family::PacketCounts::of(s.counter())),
+            adopted_info: s.adopted().map(crate::telemetry::Info::HwV4),
+        })
+    }
+}

@@ -408,16 +408,17 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
     let config = args.settings.config()?;
     let settings = config.settings(&args.settings)?;
     let protocol = args.protocol.unwrap_or(Protocol::HwFoc);
-    match protocol {
-        Protocol::HwCan => return can::run(args, &config, settings),
-        Protocol::DroneCan => {
-            return Err(usage(
-                "--protocol",
-                "standard DroneCAN ESCs (dronecan) are not simulated: --protocol hw-can \
-                 simulates Hobbywing's DroneCAN ESCs",
-            ));
-        }
-        Protocol::HwFoc | Protocol::DataLink | Protocol::HwV4 | Protocol::HwV3 | Protocol::Hw5 => {}
+    // The serial formats are simulated alike (`hwfoc-sim`'s protocols); of the CAN formats,
+    // Hobbywing's only.
+    if protocol == Protocol::HwCan {
+        return can::run(args, &config, settings);
+    }
+    if protocol == Protocol::DroneCan {
+        return Err(usage(
+            "--protocol",
+            "standard DroneCAN ESCs (dronecan) are not simulated: --protocol hw-can \
+             simulates Hobbywing's DroneCAN ESCs",
+        ));
     }
     if args.factory {
         return Err(usage("--factory", "only for --protocol hw-can"));
