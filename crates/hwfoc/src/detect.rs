@@ -1,11 +1,11 @@
-//! Streams of any Hobbywing serial format, told from their bytes: the [`Decoder`] reads HW-FOC
-//! and DataLink V2 ([`mixed`]), Hobbywing V4 ([`v4`]), V3 ([`v3`]) and HW5 ([`hw5`]) and locks
-//! onto the format it finds.
+//! Streams of any Hobbywing serial format, told from their bytes: the [`Decoder`] reads every
+//! serial format of the format list (HW-FOC and DataLink V2 in one family, [`mixed`], and each
+//! other serial format in a family of its own: [`Family`]) and locks onto the format it finds.
 //!
 //! Until it has locked, every format's decoder is given every byte, in slices of [`SLICE`]
 //! bytes that start at multiples of [`SLICE`] in the stream; at the end of a slice in which
-//! one or more of them found a frame, it locks onto the first of those in the order HW-FOC and
-//! DataLink, HW5, V4, V3 (checksummed formats before the chained ones). Locked, it gives the
+//! one or more of them found a frame, it locks onto the first of those in their rank in the
+//! format list ([`Family::ALL`]: checksummed formats before the chained ones). Locked, it gives the
 //! bytes to that format's decoder only, so a stream of one format is read at that decoder's
 //! speed. After a silence of the line ([`Decoder::line_silent_each`]), and at the end of a
 //! block of [`RELOCK_AFTER`] bytes (blocks start at its multiples in the stream) in which the
@@ -24,31 +24,27 @@
 //! gives them format by format, bytes given one at a time give them in the order they were
 //! decided. HW-FOC and DataLink frames always come in byte order ([`mixed`]).
 //!
-//! How soon it locks: on the first checksummed frame (an HW-FOC or HW5 frame), on three
-//! chained V3 frames (about 60 ms of a V3 ESC's wire) or V4 frames (150 ms running), or a V4
-//! data and info frame chained (idle), each within a slice more.
+//! How soon it locks: on the first checksummed frame (an HW-FOC or HW5 frame), on a chain of
+//! a chained format's frames (as its module says), each within a slice more.
 //!
 //! ```
 //! use hwfoc::detect::{Decoder, Decoded, Family};
-//! use hwfoc::v3;
+//! use hwfoc::hw5;
 //!
-//! let mut wire = Vec::new();
-//! for counter in 0..5 {
-//!     let frame = v3::V3Frame { counter, throttle_in_raw: 51, pwm_out_raw: 51, period_us: 1500 };
-//!     wire.extend_from_slice(&frame.encode());
-//! }
+//! let wire: Vec<u8> = (0..5).flat_map(|_| hw5::TelemetryFrame::default().encode()).collect();
 //! let mut decoder = Decoder::new();
 //! let mut found = Vec::new();
 //! decoder.decode_all(&wire, |d| found.push(d));
 //! assert_eq!(found.len(), 5);
-//! assert!(matches!(found[0], Decoded::HwV3(_)));
-//! assert_eq!(decoder.locked(), Some(Family::HwV3));
+//! assert!(matches!(found[0], Decoded::Hw5(_)));
+//! assert_eq!(decoder.locked(), Some(Family::Hw5));
+//! assert_eq!(decoder.stats::<hw5::Scanner>().telemetry_frames(), 5);
 //! ```
 
 use crate::family::{Emit, FamilyLink, LinkFigures};
 use crate::protocol::{FamilyScanner, FoundFrame};
 use crate::scan::{self, Scanner, StreamDecoder};
-use crate::{Protocol, hw5, mixed, v3, v4};
+use crate::{Protocol, mixed};
 
 /// Bytes per slice while detecting (see the module documentation).
 pub const SLICE: u64 = 64;
@@ -71,6 +67,14 @@ pub const HISTORY: usize = 2 * RELOCK_AFTER as usize;
 
 /// Declares [`Family`] and [`Decoded`] from the list of formats (`formats!` in `lib.rs`): one
 /// arm for each format there with a `family`.
+mod sealed {
+    /// A family's scanner: where its decoder's statistics are in a [`super::Decoder`].
+    pub trait Family: super::FamilyScanner {
+        /// The statistics of this family's decoder in `decoder`.
+        fn stats_in(decoder: &super::Decoder) -> &Self::Stats;
+    }
+}
+
 /// `Some(Family::$family)`, or `None` for a format without a family of its own.
 macro_rules! family_of {
     () => {
@@ -244,6 +248,14 @@ macro_rules! declare_families {
                 }
             }
         }
+
+        $($(
+            impl sealed::Family for $scanner {
+                fn stats_in(decoder: &Decoder) -> &<$scanner as Scanner>::Stats {
+                    decoder.decoders.$family.stats()
+                }
+            }
+        )?)+
 
         /// Each family's decoder, a field named as its family.
         #[allow(non_snake_case)]
@@ -489,19 +501,10 @@ impl Decoder {
         self.decoders.Mixed.stats()
     }
 
-    /// V4's statistics (see [`Decoder::mixed_stats`]).
-    pub fn v4_stats(&self) -> &v4::Stats {
-        self.decoders.HwV4.stats()
-    }
-
-    /// V3's statistics (see [`Decoder::mixed_stats`]).
-    pub fn v3_stats(&self) -> &v3::Stats {
-        self.decoders.HwV3.stats()
-    }
-
-    /// HW5's statistics (see [`Decoder::mixed_stats`]).
-    pub fn hw5_stats(&self) -> &hw5::Stats {
-        self.decoders.Hw5.stats()
+    /// The statistics of the family whose scanner is `S` (of the bytes given to its decoder so
+    /// far: all of them after [`Decoder::flush`]): `decoder.stats::<hwfoc::v4::Scanner>()`.
+    pub fn stats<S: sealed::Family>(&self) -> &S::Stats {
+        S::stats_in(self)
     }
 
     /// The link's figures of the format it last locked onto, in neutral terms

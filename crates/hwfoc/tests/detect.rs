@@ -43,9 +43,9 @@ fn state(d: &Decoder) -> State {
         bytes: d.bytes(),
         buffered: d.buffered(),
         mixed: *d.mixed_stats(),
-        hw5: *d.hw5_stats(),
-        v4: *d.v4_stats(),
-        v3: *d.v3_stats(),
+        hw5: *d.stats::<hwfoc::hw5::Scanner>(),
+        v4: *d.stats::<hwfoc::v4::Scanner>(),
+        v3: *d.stats::<hwfoc::v3::Scanner>(),
     }
 }
 
@@ -445,7 +445,7 @@ fn platinum_pro_v3_capture_as_the_v3_decoder() {
     }
     let mut detect = Decoder::new();
     detect.decode_all(&bytes, |_| {});
-    let s = detect.v3_stats();
+    let s = detect.stats::<hwfoc::v3::Scanner>();
     assert_eq!((s.frames(), s.bytes(), s.bytes_skipped()), (699, 6990, 0));
     assert_eq!(
         (s.syncs(), s.rejected(), s.last_counter()),
@@ -478,7 +478,7 @@ fn platinum_v4_capture_as_the_v4_decoder() {
     assert_eq!(infos, 26);
     let mut detect = Decoder::new();
     detect.decode_all(&bytes, |_| {});
-    let s = detect.v4_stats();
+    let s = detect.stats::<hwfoc::v4::Scanner>();
     assert_eq!((s.frames(), s.info_frames(), s.trailers()), (297, 26, 26));
     assert_eq!((s.bytes(), s.bytes_skipped(), s.syncs()), (6007, 0, 1));
     let c = s.counter();
@@ -493,7 +493,7 @@ fn hw5_stream_as_the_hw5_decoder() {
     assert_eq!(frames.len(), 40 + 12);
     let mut detect = Decoder::new();
     detect.decode_all(&bytes, |_| {});
-    let s = detect.hw5_stats();
+    let s = detect.stats::<hwfoc::hw5::Scanner>();
     assert_eq!((s.telemetry_frames(), s.other_frames()), (52, 22));
     let rejected = 40 * hw5::TELEMETRY_LEN as u64;
     assert_eq!((s.bytes_skipped(), s.rejected()), (rejected, 40));
@@ -665,7 +665,7 @@ fn a_flush_when_locked_counts_every_byte_of_every_format() {
     let mut n = 0;
     d.decode_all(&foc_stream(4..6), |_| n += 1);
     assert_eq!((n, d.locked()), (2, Some(Family::Mixed)));
-    assert_eq!(d.v3_stats().bytes_skipped(), SLICE + 48);
+    assert_eq!(d.stats::<hwfoc::v3::Scanner>().bytes_skipped(), SLICE + 48);
 }
 
 /// Frames of two formats in one slice while detecting: format by format in a chunk holding
@@ -966,9 +966,13 @@ fn random_bytes_never_lock() {
         let n = LEN as u64;
         assert_eq!(d.mixed_stats().esc.bytes_skipped(), n, "{kind}");
         assert_eq!(d.mixed_stats().hub.bytes_skipped(), n, "{kind}");
-        assert_eq!(d.hw5_stats().bytes_skipped(), n, "{kind}");
-        assert_eq!(d.v4_stats().bytes_skipped(), n, "{kind}");
-        assert_eq!(d.v3_stats().bytes_skipped(), n, "{kind}");
+        assert_eq!(
+            d.stats::<hwfoc::hw5::Scanner>().bytes_skipped(),
+            n,
+            "{kind}"
+        );
+        assert_eq!(d.stats::<hwfoc::v4::Scanner>().bytes_skipped(), n, "{kind}");
+        assert_eq!(d.stats::<hwfoc::v3::Scanner>().bytes_skipped(), n, "{kind}");
     }
 }
 

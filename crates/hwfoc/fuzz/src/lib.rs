@@ -503,9 +503,9 @@ pub fn detect_state(d: &detect::Decoder) -> DetectState {
         bytes: d.bytes(),
         stats: (
             *d.mixed_stats(),
-            *d.hw5_stats(),
-            *d.v4_stats(),
-            *d.v3_stats(),
+            *d.stats::<hwfoc::hw5::Scanner>(),
+            *d.stats::<hwfoc::v4::Scanner>(),
+            *d.stats::<hwfoc::v3::Scanner>(),
         ),
     }
 }
@@ -549,9 +549,9 @@ pub fn check_detected(input: &[u8], decoded: &[detect::Decoded], d: &detect::Dec
     if esc.is_empty() {
         check_datalink_stream(input, &hub, &m.hub);
     }
-    check_hw5_stream(input, &five, d.hw5_stats());
-    check_v4_stream(input, &four, d.v4_stats());
-    check_v3_stream(input, &three, d.v3_stats());
+    check_hw5_stream(input, &five, d.stats::<hwfoc::hw5::Scanner>());
+    check_v4_stream(input, &four, d.stats::<hwfoc::v4::Scanner>());
+    check_v3_stream(input, &three, d.stats::<hwfoc::v3::Scanner>());
 }
 
 /// The whole check of the `detect` target: `decode_all` (checked by [`check_detected`]), a
