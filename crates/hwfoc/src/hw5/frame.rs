@@ -378,7 +378,7 @@ impl Telemetry for TelemetryFrame {
         Some(Status(u16::from(self.fault.0)))
     }
 
-    /// Its faults mapped to HW-FOC's bits ([`Fault::hwfoc_status`]).
+    /// Its faults mapped to HW-FOC's bits ([`FaultCode::hwfoc_status`]).
     fn hwfoc_status(&self) -> Status {
         self.fault.hwfoc_status()
     }
