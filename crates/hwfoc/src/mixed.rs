@@ -374,20 +374,26 @@ impl crate::protocol::FamilyScanner for Scanner {
     }
 }
 
-impl crate::family::FamilyLink for Scanner {
-    /// An ESC's frame, or each of a hub frame's ESC frames with its channel, at the hub frame's
-    /// offset.
-    fn hand_on(d: &Decoded, emit: &mut crate::family::Emit<'_>) {
-        match d {
+impl Decoded {
+    /// Hands the frame on as the ESC frames it holds: `emit(channel, offset, frame)` gets an ESC's
+    /// frame (channel `None`), or each of a hub frame's ESC frames with its channel, at the hub
+    /// frame's offset. Generic, so that a caller's loop over HW-FOC frames keeps it inline
+    /// ([`crate::family::FamilyLink::hand_on`] is it behind `dyn`).
+    #[inline(always)]
+    pub fn each_esc_frame(
+        &self,
+        mut emit: impl FnMut(Option<u8>, u64, &crate::telemetry::AnyFrame),
+    ) {
+        match self {
             Decoded::Esc(d) => emit(None, d.offset, &crate::telemetry::AnyFrame::from(d.frame)),
-            Decoded::Hub(d) => {
-                for (channel, frame) in d.frame.escs() {
-                    let frame = crate::telemetry::Data::DataLink(*frame);
-                    let frame = crate::telemetry::AnyFrame::Data(frame);
-                    emit(Some(channel as u8), d.offset, &frame);
-                }
-            }
+            Decoded::Hub(d) => d.each_esc_frame(emit),
         }
+    }
+}
+
+impl crate::family::FamilyLink for Scanner {
+    fn hand_on(d: &Decoded, emit: &mut crate::family::Emit<'_>) {
+        d.each_esc_frame(emit);
     }
 
     /// None: an ESC's wire and each of a hub's channels has figures of its own.

@@ -1,7 +1,7 @@
 //! One ESC's link figures, whatever carries it ([`LinkStats`]): its own serial wire, a channel of
 //! a DataLink hub or a slot of a CAN bus. Each decoder of a stream gives them for each of its
-//! channels ([`super::decoder::Link::link`]); every front end reads them here, under one set of
-//! names.
+//! channels ([`super::decoder::LinkDecoder::link`]); every front end reads them here, under one
+//! set of names ([`LinkStats::figures`]).
 
 use hwfoc::family::{LinkFigures, PacketCounts};
 use hwfoc::format::Check;

@@ -29,6 +29,22 @@ pub struct Decoded {
     pub report: FrameReport,
 }
 
+impl Decoded {
+    /// Hands on each of the frame's ESC frames: `emit(channel, offset, frame)` with its
+    /// channel, at the hub frame's offset. (Not forced inline: in a loop over HW-FOC frames, the
+    /// hub's eight records would crowd the usual path.)
+    #[inline]
+    pub fn each_esc_frame(
+        &self,
+        mut emit: impl FnMut(Option<u8>, u64, &crate::telemetry::AnyFrame),
+    ) {
+        for (channel, frame) in self.frame.escs() {
+            let frame = crate::telemetry::AnyFrame::Data(crate::telemetry::Data::DataLink(*frame));
+            emit(Some(channel as u8), self.offset, &frame);
+        }
+    }
+}
+
 /// Offset of the first candidate in `hay`: a `9B` followed by 0x9E or 0xA0, or a `9B` that is
 /// the last byte of `hay`.
 #[inline]
