@@ -438,3 +438,42 @@ def test_a_forced_protocol_names_the_format_the_bytes_are():
 def test_a_can_protocol_on_a_serial_port_is_a_value_error():
     with pytest.raises(ValueError, match="reads CAN buses"):
         hwfoc.open_ports(["/dev/ttyUSB_hwfoc_missing"], protocol="dronecan")
+
+
+# ---- link figures ------------------------------------------------------------------------------
+
+# The link figures under their one set of names (hwfoc-records' LinkStats::figures): a decoder's
+# stats and the summary's `link` give the same, None where the format does not count one.
+FIGURES = ("checksum_failures", "rejected_candidates", "lost_packets", "duplicate_packets",
+           "restarts", "bytes_skipped", "delivery_ratio")
+
+
+@pytest.mark.parametrize("capture,protocol", [(V4, "hw-v4"), (V3, "hw-v3")], ids=["v4", "v3"])
+def test_a_decoders_link_figures_are_the_summarys(capture, protocol, tmp_path):
+    data, _ = _capture_bytes(capture)
+    path = tmp_path / "raw.bin"
+    path.write_bytes(data)
+    link = hwfoc.summary(path)["escs"][0]["link"]
+    # No checksum: its rejected candidates are counted instead, and its packets are numbered.
+    assert link["checksum_failures"] is None and link["rejected_candidates"] == 0
+    assert link["lost_packets"] is not None and link["delivery_ratio"] == 1.0
+    for forced in (None, protocol):
+        decoder = hwfoc.Decoder(protocol=forced)
+        for i in range(0, len(data), 37):
+            decoder.feed(data[i:i + 37])
+        decoder.finish()
+        assert {k: decoder.stats[k] for k in FIGURES} == {k: link[k] for k in FIGURES}, forced
+
+
+def test_an_hw5_decoders_link_figures_are_the_summarys(hw5_stream, tmp_path):
+    path = tmp_path / "hw5.bin"
+    path.write_bytes(hw5_stream)
+    link = hwfoc.summary(path)["escs"][0]["link"]
+    decoder = hwfoc.Decoder(protocol="hw5")
+    decoder.feed(hw5_stream)
+    decoder.finish()
+    got = {k: decoder.stats[k] for k in FIGURES}
+    assert got == {k: link[k] for k in FIGURES}
+    # No packet counter: its packet figures are not counted (None, not 0).
+    assert [got[k] for k in ("lost_packets", "duplicate_packets", "restarts", "delivery_ratio")] == [None] * 4
+    assert (got["checksum_failures"], got["rejected_candidates"]) == (1, None)
