@@ -5,7 +5,7 @@ use hwfoc::{Protocol, Status};
 use serde::{Deserialize, Serialize};
 
 use super::EscId;
-use crate::LinkStats as Link;
+use crate::LinkStats;
 use crate::record::Record;
 
 /// One data frame of an ESC, as the analysers read it (a record's columns they use).
@@ -72,7 +72,7 @@ pub struct LinkFigures {
 
 impl LinkFigures {
     /// The figures of `link`.
-    pub fn of(link: &Link) -> LinkFigures {
+    pub fn of(link: &LinkStats) -> LinkFigures {
         LinkFigures {
             frames: u64::from(link.frames()),
             counts_packets: link.counts_packets(),
@@ -98,7 +98,7 @@ pub struct EscSeries {
     pub link: Option<LinkFigures>,
     /// A Hobbywing CAN ESC's own maintenance counters, minutes (total rotation time, time since
     /// maintenance), where its recording holds its answer to GetMaintenanceInformation
-    /// ([`Link::maintenance_min`]).
+    /// ([`LinkStats::maintenance_min`]).
     pub maintenance_min: Option<(u32, u32)>,
     /// Its data frames.
     pub samples: Vec<Sample>,

@@ -40,16 +40,10 @@ pub const FRAME_FIGURES: usize = 5;
 /// its node on a CAN bus (with its place there: [`LinkStats::can`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct LinkStats {
-    protocol: Protocol,
-    bytes: u64,
-    bytes_skipped: u64,
-    frames: u32,
-    info_frames: u32,
-    checksum_failures: u32,
-    rejected_candidates: Option<u32>,
-    /// `None` where frames carry no packet number (HW5).
-    packets: Option<PacketCounts>,
-    adopted_info: Option<Info>,
+    /// The figures, in the codec's neutral terms (its `packets` `None` where frames carry no
+    /// packet number: HW5).
+    figures: LinkFigures,
+    /// Of an ESC on a CAN bus: its place there.
     can: Option<CanLink>,
 }
 
@@ -63,8 +57,7 @@ impl LinkStats {
     /// The figures of an ESC on its own HW-FOC wire (or of a stream whose protocol is not known
     /// yet).
     pub(crate) fn wire(s: &foc::Stats) -> LinkStats {
-        let packets = PacketCounts::of(s.packets());
-        LinkStats {
+        LinkStats::of(LinkFigures {
             protocol: Protocol::HwFoc,
             bytes: s.bytes(),
             bytes_skipped: s.bytes_skipped(),
@@ -72,16 +65,15 @@ impl LinkStats {
             info_frames: s.info_frames(),
             checksum_failures: s.checksum_failures(),
             rejected_candidates: None,
-            packets: Some(packets),
+            packets: Some(PacketCounts::of(s.packets())),
             adopted_info: None,
-            can: None,
-        }
+        })
     }
 
     /// The figures of channel `channel` of a DataLink hub whose link's statistics are `hub`.
     pub(crate) fn hub(hub: &datalink::Stats, channel: u8) -> LinkStats {
         let packets = hub.channel(usize::from(channel)).map(PacketCounts::of);
-        LinkStats {
+        LinkStats::of(LinkFigures {
             protocol: Protocol::DataLink,
             bytes: hub.bytes(),
             bytes_skipped: hub.bytes_skipped(),
@@ -91,31 +83,20 @@ impl LinkStats {
             rejected_candidates: None,
             packets: Some(packets.unwrap_or_default()),
             adopted_info: None,
-            can: None,
-        }
+        })
     }
 
-    /// The figures of another format's wire (V4, V3, HW5), as the codec gives them.
-    pub(crate) fn of(f: LinkFigures) -> LinkStats {
-        LinkStats {
-            protocol: f.protocol,
-            bytes: f.bytes,
-            bytes_skipped: f.bytes_skipped,
-            frames: f.frames,
-            info_frames: f.info_frames,
-            checksum_failures: f.checksum_failures,
-            rejected_candidates: f.rejected_candidates,
-            packets: f.packets,
-            adopted_info: f.adopted_info,
-            can: None,
-        }
+    /// The figures of a serial link as the codec gives them (V4, V3 and HW5 through their
+    /// [`hwfoc::family::FamilyLink`]).
+    pub(crate) fn of(figures: LinkFigures) -> LinkStats {
+        LinkStats { figures, can: None }
     }
 
     /// The figures of an ESC on a CAN bus: its node's transfers, counted from their transfer
     /// ids.
     pub(crate) fn bus(c: CanLink) -> LinkStats {
         let node = &c.node_stats;
-        LinkStats {
+        let figures = LinkFigures {
             protocol: c.protocol,
             bytes: c.bytes,
             bytes_skipped: c.bytes_skipped(),
@@ -132,6 +113,9 @@ impl LinkStats {
                 last: None,
             }),
             adopted_info: None,
+        };
+        LinkStats {
+            figures,
             can: Some(c),
         }
     }
@@ -154,106 +138,109 @@ impl LinkStats {
             (
                 "checksum_failures",
                 self.has_checksum()
-                    .then_some(self.checksum_failures)
+                    .then_some(self.figures.checksum_failures)
                     .and_then(count),
             ),
             (
                 "rejected_candidates",
-                self.rejected_candidates.and_then(count),
+                self.figures.rejected_candidates.and_then(count),
             ),
             ("lost_packets", packets(self.lost_packets())),
             ("duplicate_packets", packets(self.duplicate_packets())),
             ("restarts", packets(self.restarts())),
-            ("bytes_skipped", Some(Figure::Count(self.bytes_skipped))),
+            (
+                "bytes_skipped",
+                Some(Figure::Count(self.figures.bytes_skipped)),
+            ),
             ("delivery_ratio", self.delivery_ratio().map(Figure::Ratio)),
         ]
     }
 
     /// The protocol of the link's frames.
     pub fn protocol(&self) -> Protocol {
-        self.protocol
+        self.figures.protocol
     }
 
     /// Bytes of the stream the ESC's frames came in.
     pub fn bytes(&self) -> u64 {
-        self.bytes
+        self.figures.bytes
     }
 
     /// Bytes of that stream that were in no accepted frame (of the link's protocol; an HW5
     /// wire's other frame kinds, requests and answers, are not skipped).
     pub fn bytes_skipped(&self) -> u64 {
-        self.bytes_skipped
+        self.figures.bytes_skipped
     }
 
     /// Data frames of the ESC (records of its channel, behind a hub; of its node, on a bus).
     pub fn frames(&self) -> u32 {
-        self.frames
+        self.figures.frames
     }
 
     /// Device-information frames (V4: info frames; a hub forwards none).
     pub fn info_frames(&self) -> u32 {
-        self.info_frames
+        self.figures.info_frames
     }
 
     /// Whether the link's frames are checked (its format's description: V3 and V4 are not,
     /// their frames are recognised by plausibility and chaining, see
     /// [`LinkStats::rejected_candidates`]).
     pub fn has_checksum(&self) -> bool {
-        self.protocol.description().check != Check::None
+        self.figures.protocol.description().check != Check::None
     }
 
     /// Frames rejected by their checksum, or whose checksum matched but whose values are out of
     /// their protocol's range (behind a hub: the hub frames' CRC failures; 0 for a format
     /// without checksum).
     pub fn checksum_failures(&self) -> u32 {
-        self.checksum_failures
+        self.figures.checksum_failures
     }
 
     /// Candidates of a format without checksum that were not taken: implausible, or not
     /// confirmed by a chain (`None` for a checksummed format).
     pub fn rejected_candidates(&self) -> Option<u32> {
-        self.rejected_candidates
+        self.figures.rejected_candidates
     }
 
     /// Whether the link's frames carry a packet counter, from which loss is counted (HW5's
     /// do not: its lost, duplicate and restart counts are 0 and say nothing). On a CAN bus,
     /// the transfer ids of every transfer of the ESC's node are counted.
     pub fn counts_packets(&self) -> bool {
-        self.packets.is_some()
+        self.figures.packets.is_some()
     }
 
     /// Packet numbers skipped (on a CAN bus: transfers of the node missed, from the gaps in
     /// their transfer ids).
     pub fn lost_packets(&self) -> u32 {
-        self.packets.map_or(0, |p| p.lost)
+        self.figures.packets.map_or(0, |p| p.lost)
     }
 
     /// Packet numbers received twice in a row (on a CAN bus: transfers of the node).
     pub fn duplicate_packets(&self) -> u32 {
-        self.packets.map_or(0, |p| p.duplicates)
+        self.figures.packets.map_or(0, |p| p.duplicates)
     }
 
     /// Packet numbers that came right after the next one (two adjacent frames swapped): not
     /// lost, no restart.
     pub fn reordered_packets(&self) -> u32 {
-        self.packets.map_or(0, |p| p.reordered)
+        self.figures.packets.map_or(0, |p| p.reordered)
     }
 
     /// Jumps of the packet numbers that no loss explains (on a CAN bus: the node's transfers
     /// after a silence of the whole bus).
     pub fn restarts(&self) -> u32 {
-        self.packets.map_or(0, |p| p.restarts)
+        self.figures.packets.map_or(0, |p| p.restarts)
     }
 
     /// The last packet number received.
     pub fn last_packet(&self) -> Option<u32> {
-        self.packets?.last
+        self.figures.packets?.last
     }
 
     /// Frames received over frames sent, from the packet numbers (on a CAN bus: the node's
     /// transfers, from their transfer ids).
     pub fn delivery_ratio(&self) -> Option<f64> {
-        let p = self.packets?;
+        let p = self.figures.packets?;
         let received = p.received as f64;
         (p.received > 0).then(|| received / (received + f64::from(p.lost)))
     }
@@ -261,7 +248,7 @@ impl LinkStats {
     /// The info frame whose constants were adopted (two identical copies in a row), if any: a
     /// format whose description has [`adopted_info`](hwfoc::format::FormatDescription) (V4).
     pub fn adopted_info(&self) -> Option<Info> {
-        self.adopted_info
+        self.figures.adopted_info
     }
 
     /// Of an ESC on a CAN bus: its node, throttle channel, maintenance counters and its bus's
