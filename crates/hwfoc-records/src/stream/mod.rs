@@ -10,7 +10,7 @@
 
 use hwfoc::format::LinkKind;
 use hwfoc::telemetry::AnyFrame;
-use hwfoc::{Protocol, Settings, datalink, detect};
+use hwfoc::{Protocol, Settings, datalink};
 
 mod can;
 mod decoder;
@@ -86,10 +86,9 @@ impl Wire {
 /// family's decoder alone), or a CAN protocol (which no serial line carries: every byte is
 /// skipped).
 fn slow_serial(p: Protocol) -> Box<dyn LinkDecoder> {
-    let forced = Some(p);
-    match detect::Family::of(p).filter(|&f| f != detect::Family::Mixed) {
-        Some(family) => Box::new(Serial::new(OneEsc::new(family, p), forced)),
-        None => Box::new(Serial::new(PassOver::new(p), forced)),
+    match OneEsc::of(p) {
+        Some(one) => Box::new(Serial::new(one)),
+        None => Box::new(Serial::new(PassOver::new(p))),
     }
 }
 
@@ -125,8 +124,8 @@ impl Stream {
     /// format ([`Stream::found_instead`]).
     pub fn forced(forced: Option<Protocol>) -> Stream {
         let wire = match Fast::of(forced) {
-            Some(fast) => Wire::Fast(Serial::new(fast, forced)),
-            None => Wire::Other(slow_serial(forced.unwrap_or(Protocol::HwFoc))),
+            Ok(fast) => Wire::Fast(Serial::new(fast)),
+            Err(slow) => Wire::Other(slow_serial(slow)),
         };
         Stream { wire }
     }

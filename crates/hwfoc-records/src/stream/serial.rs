@@ -237,12 +237,12 @@ impl SerialDecoder for Fast {
 
 impl Fast {
     /// The fast decoder of `forced` (every format when `None`), if it has one.
-    pub(super) fn of(forced: Option<Protocol>) -> Option<Fast> {
+    pub(super) fn of(forced: Option<Protocol>) -> Result<Fast, Protocol> {
         match forced {
-            None => Some(Fast::Any(detect::Decoder::new())),
-            Some(Protocol::HwFoc) => Some(Fast::HwFoc(foc::Decoder::new())),
-            Some(Protocol::DataLink) => Some(Fast::DataLink(datalink::Decoder::new())),
-            Some(_) => None,
+            None => Ok(Fast::Any(detect::Decoder::new())),
+            Some(Protocol::HwFoc) => Ok(Fast::HwFoc(foc::Decoder::new())),
+            Some(Protocol::DataLink) => Ok(Fast::DataLink(datalink::Decoder::new())),
+            Some(slow) => Err(slow),
         }
     }
 
@@ -269,12 +269,14 @@ pub(super) struct OneEsc {
 }
 
 impl OneEsc {
-    /// The decoder of `protocol`, read by `family` alone.
-    pub(super) fn new(family: detect::Family, protocol: Protocol) -> OneEsc {
-        OneEsc {
+    /// The decoder of `protocol`, read by its own family alone; `None` for a protocol without
+    /// a family of its own, or read with DataLink's ([`detect::Family::Mixed`]).
+    pub(super) fn of(protocol: Protocol) -> Option<OneEsc> {
+        let family = detect::Family::of(protocol).filter(|&f| f != detect::Family::Mixed)?;
+        Some(OneEsc {
             decoder: detect::OneFamily::new(family),
             protocol,
-        }
+        })
     }
 }
 
@@ -392,13 +394,13 @@ pub(super) struct Serial<D> {
 }
 
 impl<D: SerialDecoder> Serial<D> {
-    /// The stream of `decoder`, which reads protocol `forced` only (every protocol when
-    /// `None`).
-    pub(super) fn new(decoder: D, forced: Option<Protocol>) -> Serial<D> {
+    /// The stream of `decoder`; when it reads one protocol only, every format is read over
+    /// its first bytes too.
+    pub(super) fn new(decoder: D) -> Serial<D> {
         Serial {
+            probe: decoder.forced().map(|_| Box::default()),
             decoder,
             history: Vec::new(),
-            probe: forced.map(|_| Box::default()),
         }
     }
 
