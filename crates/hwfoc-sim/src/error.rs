@@ -89,8 +89,10 @@ pub enum SimError {
         /// The protocol.
         protocol: hwfoc::Protocol,
     },
-    /// A fault injected on ESCs speaking HW5, whose fault byte has no flag for it.
-    NoHw5Fault {
+    /// A fault injected on ESCs speaking a format whose fault word has no flag for it.
+    NoFaultFlag {
+        /// The protocol.
+        protocol: hwfoc::Protocol,
         /// The fault.
         fault: hwfoc::Fault,
     },
@@ -192,7 +194,7 @@ impl fmt::Display for SimError {
                 f,
                 "virtual ESCs do not speak {} ({protocol}): they speak {}",
                 protocol.title(),
-                crate::protocols::SIMULATED.map(|p| p.name()).join(", ")
+                crate::formats::SIMULATED.map(|p| p.name()).join(", ")
             ),
             SimError::LinkFaults { protocol } => write!(
                 f,
@@ -200,12 +202,23 @@ impl fmt::Display for SimError {
                  not for {} ({protocol})",
                 protocol.title()
             ),
-            SimError::NoHw5Fault { fault } => write!(
-                f,
-                "the fault {} has no flag in HW5's fault byte; HW5 carries {}",
-                fault.name(),
-                hw5_carried().join(", ")
-            ),
+            SimError::NoFaultFlag { protocol, fault } => {
+                let title = protocol.title();
+                let word = crate::formats::format(*protocol).and_then(|f| f.fault_word.as_ref());
+                let carried: Vec<String> = word.map_or_else(Vec::new, |word| {
+                    hwfoc::Fault::ALL
+                        .iter()
+                        .filter_map(|f| (word.flag)(*f).map(|h| format!("{} (as {h})", f.name())))
+                        .collect()
+                });
+                write!(
+                    f,
+                    "the fault {} has no flag in {title}'s {}; {title} carries {}",
+                    fault.name(),
+                    word.map_or("fault word", |w| w.name),
+                    carried.join(", ")
+                )
+            }
             SimError::LinkCount { links, n } => write!(
                 f,
                 "{links} links to pseudo-terminals for {n} ESCs: give one per ESC, or one with \
@@ -227,16 +240,6 @@ impl fmt::Display for SimError {
             SimError::Link { path, source } => write!(f, "cannot create the link {path}: {source}"),
         }
     }
-}
-
-/// The simulator's fault names that HW5 carries (each with the flag it is sent as).
-fn hw5_carried() -> Vec<String> {
-    hwfoc::Fault::ALL
-        .iter()
-        .filter_map(|f| {
-            crate::protocols::hw5_fault(*f).map(|h| format!("{} (as {})", f.name(), h.name()))
-        })
-        .collect()
 }
 
 impl std::error::Error for SimError {

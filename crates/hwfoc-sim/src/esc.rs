@@ -12,10 +12,8 @@
 //! The ESC's output is an endless series of [`Burst`]s, bytes sent back to back, in time
 //! order: frames, and the garbage and glitches the link adds between them.
 //!
-//! The other protocols' schedules (V4's fast and slow modes, V3's steady 19.5 ms, HW5's 50 Hz
-//! and 2.5 Hz) are described in [`crate::protocols`]; they run over the same model and wire, but
-//! without link faults (the fleet refuses them: with no checksum, V3 and V4 cannot tell every
-//! corruption, so the ground truth could not stay exact).
+//! The other formats' schedules are their modules' in [`crate::formats`]; they run over the
+//! same model and wire, but without link faults (the fleet refuses them: see there).
 //!
 //! Ground truth stays exact under link faults: the ESC runs a reference decoder over its own
 //! wire, and if a fault would make the decoder see a frame that was never sent (a corruption the
@@ -29,13 +27,13 @@ use std::rc::Rc;
 
 use hwfoc::foc::{DataFrame, Decoder, FocFrame, InfoFrame};
 use hwfoc::telemetry::Data;
-use hwfoc::{Fault, Protocol, v4};
+use hwfoc::{Fault, Protocol};
 
 use crate::degrade::{DegradeSpec, ModelDegradations, WireLoss};
 use crate::faults::{Fate, FaultSchedule, LineFaults, LinkRates};
+use crate::formats::{self, Speaker, Start};
 use crate::model::{Model, ModelConfig};
 use crate::profile::Profile;
-use crate::protocols::{self, Hw5Current};
 use crate::rng::{Purpose, Rng};
 
 /// Data frame interval while the motor turns, ns.
@@ -119,7 +117,7 @@ pub struct Setup {
     pub index: usize,
     /// The run's seed.
     pub seed: u64,
-    /// The protocol it speaks (every one of [`protocols::SIMULATED`]).
+    /// The protocol it speaks (every one of [`formats::SIMULATED`]).
     pub protocol: Protocol,
     /// Line rate, bits per second (10 bits per byte, 8N1).
     pub baud: u32,
@@ -168,30 +166,9 @@ pub struct VirtualEsc {
     /// The reference decoder over everything sent, and the intact frames it has not seen yet.
     monitor: Decoder,
     expected: VecDeque<DataFrame>,
-    /// The state of another protocol's schedule.
-    other: Other,
-}
-
-/// Where the schedule of a protocol other than HW-FOC is.
-#[derive(Debug, Clone)]
-enum Other {
-    /// HW-FOC: nothing more.
-    None,
-    /// V4: fast or slow mode.
-    V4 {
-        counter: u32,
-        info: v4::InfoFrame,
-        fast: bool,
-        /// Last time (fast mode) the throttle was above 0 or the motor turned.
-        active_ns: u64,
-        /// Slow mode: the next slot, and whether it is an info frame's.
-        slot_ns: u64,
-        info_next: bool,
-    },
-    /// V3: a counter.
-    V3 { counter: u32 },
-    /// HW5: the current it repeats.
-    Hw5 { current: Hw5Current },
+    /// The schedule of a format other than HW-FOC ([`crate::formats`]), which then sends
+    /// everything.
+    speaker: Option<Box<dyn Speaker>>,
 }
 
 impl VirtualEsc {
@@ -209,32 +186,17 @@ impl VirtualEsc {
         // Fixed ASCII fields within their lengths: cannot fail.
         let info = InfoFrame::new(PRODUCT, HARDWARE, FIRMWARE, &format!("{id:08}"))
             .expect("valid device information");
-        let start = setup.start_packet.map_or(0, u32::from);
-        let (other, next_tick_ns) = match setup.protocol {
-            Protocol::HwV4 => (
-                Other::V4 {
-                    counter: start,
-                    info: protocols::v4_info(setup.model.cells),
-                    fast: false,
-                    active_ns: 0,
-                    slot_ns: phase,
-                    info_next: false,
-                },
-                phase,
-            ),
-            Protocol::HwV3 => (
-                Other::V3 { counter: start },
-                phase % protocols::V3_INTERVAL_NS,
-            ),
-            Protocol::Hw5 => (
-                Other::Hw5 {
-                    current: Hw5Current::default(),
-                },
-                phase % protocols::HW5_RUN_NS,
-            ),
-            Protocol::HwFoc | Protocol::DataLink | Protocol::HwCan | Protocol::DroneCan => {
-                (Other::None, phase)
+        let (speaker, next_tick_ns) = match formats::format(setup.protocol) {
+            Some(format) => {
+                let start = Start {
+                    counter: setup.start_packet.map_or(0, u32::from),
+                    cells: setup.model.cells,
+                    phase_ns: phase,
+                };
+                let (speaker, first) = (format.start)(&start);
+                (Some(speaker), first)
             }
+            None => (None, phase),
         };
         VirtualEsc {
             byte_ns: hwfoc::wire::byte_ns(setup.baud),
@@ -259,7 +221,7 @@ impl VirtualEsc {
             queue: VecDeque::new(),
             monitor: Decoder::new(),
             expected: VecDeque::new(),
-            other,
+            speaker,
             setup,
         }
     }
@@ -291,7 +253,7 @@ impl VirtualEsc {
             if let Some(burst) = self.queue.pop_front() {
                 return burst;
             }
-            if !matches!(self.other, Other::None) {
+            if self.speaker.is_some() {
                 self.other_tick();
                 continue;
             }
@@ -330,101 +292,20 @@ impl VirtualEsc {
         };
     }
 
-    /// The next check of another protocol's schedule: what it sends at that moment, and when
-    /// it looks again (see [`crate::protocols`]).
+    /// The next look of another format's schedule: what it sends at that moment, and when it
+    /// looks again (see [`crate::formats`]).
     fn other_tick(&mut self) {
         let t = self.next_tick_ns;
         self.advance_to(t);
         let injected = self.setup.faults.status_at(seconds(t));
         let m = self.model.measure(injected, &mut self.noise);
-        match &mut self.other {
-            Other::None => unreachable!("HW-FOC has its own schedule"),
-            Other::V3 { counter } => {
-                let frame = protocols::v3_frame(*counter, &m);
-                *counter = (*counter + 1) & 0xFF_FFFF;
-                self.next_tick_ns = t + protocols::V3_INTERVAL_NS;
-                let data = Data::HwV3(frame);
-                self.send_plain(t, frame.encode().to_vec(), What::Telemetry { data });
-            }
-            Other::Hw5 { current } => {
-                let idle_due = self
-                    .last_data_ns
-                    .is_none_or(|last| t >= last + protocols::HW5_IDLE_NS);
-                if m.spinning || idle_due {
-                    let raw = current.raw(&m);
-                    let frame = protocols::hw5_frame(&m, raw, self.noise.noise(1.0));
-                    self.last_data_ns = Some(t);
-                    let data = Data::Hw5(frame);
-                    self.send_plain(t, frame.encode().to_vec(), What::Telemetry { data });
-                }
-                let last = self.last_data_ns.unwrap_or(t);
-                self.next_tick_ns = if m.spinning {
-                    t + protocols::HW5_RUN_NS
-                } else {
-                    (t + protocols::HW5_RUN_NS).min(last + protocols::HW5_IDLE_NS)
-                };
-            }
-            Other::V4 {
-                counter,
-                info,
-                fast,
-                active_ns,
-                slot_ns,
-                info_next,
-            } => {
-                let info = *info;
-                let throttle = m.throttle_in_pct * f64::from(info.full_scale) / 100.0;
-                let active = throttle.round() >= 1.0 || m.spinning;
-                if *fast && !active && t >= *active_ns + protocols::V4_SLOW_AFTER_NS {
-                    // Back to slow mode: its first slot now, a data frame.
-                    *fast = false;
-                    *slot_ns = t;
-                    *info_next = false;
-                } else if !*fast && throttle.round() >= 1.0 {
-                    *fast = true;
-                }
-                if active {
-                    *active_ns = t;
-                }
-                let what;
-                let bytes;
-                if *fast {
-                    let frame = protocols::v4_frame(*counter, &m, &info, false);
-                    *counter = (*counter + 1) & 0xFF_FFFF;
-                    bytes = frame.encode().to_vec();
-                    what = What::Telemetry {
-                        data: Data::HwV4(v4::Data {
-                            frame,
-                            info: Some(info),
-                        }),
-                    };
-                    self.next_tick_ns = t + protocols::V4_FAST_NS;
-                } else if t >= *slot_ns {
-                    if *info_next {
-                        bytes = info.encode().to_vec();
-                        what = What::Info { fate: Fate::Intact };
-                    } else {
-                        let frame = protocols::v4_frame(*counter, &m, &info, true);
-                        *counter = (*counter + 1) & 0xFF_FFFF;
-                        bytes = frame.encode_with_trailer().to_vec();
-                        what = What::Telemetry {
-                            data: Data::HwV4(v4::Data {
-                                frame,
-                                info: Some(info),
-                            }),
-                        };
-                    }
-                    *info_next = !*info_next;
-                    *slot_ns = t + protocols::V4_SLOW_SLOT_NS;
-                    // The ESC looks at the throttle between slots, as often as it sends in
-                    // fast mode.
-                    self.next_tick_ns = (t + protocols::V4_FAST_NS).min(*slot_ns);
-                } else {
-                    self.next_tick_ns = (t + protocols::V4_FAST_NS).min(*slot_ns);
-                    return;
-                }
-                self.send_plain(t, bytes, what);
-            }
+        let Some(speaker) = self.speaker.as_mut() else {
+            return;
+        };
+        let look = speaker.look(t, &m, &mut self.noise);
+        self.next_tick_ns = look.next_ns;
+        if let Some((bytes, what)) = look.send {
+            self.send_plain(t, bytes, what);
         }
     }
 
@@ -894,7 +775,7 @@ pub(crate) mod tests {
 
     /// The bursts of 8 s of `idle_run_idle` on ESC 0 speaking `protocol` at its baud rate,
     /// with the times of its data frames.
-    fn other_run(protocol: Protocol, faults: &[&str]) -> (Vec<Burst>, Vec<(f64, Data)>) {
+    pub(crate) fn other_run(protocol: Protocol, faults: &[&str]) -> (Vec<Burst>, Vec<(f64, Data)>) {
         let mut s = setup(idle_run_idle(), LinkRates::default());
         s.protocol = protocol;
         s.baud = protocol.baud_rate();
@@ -915,135 +796,12 @@ pub(crate) mod tests {
     }
 
     /// Gaps between successive data frames, ms, with whether the later one is running.
-    fn gaps(data: &[(f64, Data)], running: impl Fn(&Data) -> bool) -> Vec<(f64, bool, f64)> {
+    pub(crate) fn gaps(
+        data: &[(f64, Data)],
+        running: impl Fn(&Data) -> bool,
+    ) -> Vec<(f64, bool, f64)> {
         data.windows(2)
             .map(|w| ((w[1].0 - w[0].0) * 1e3, running(&w[1].1), w[1].0))
             .collect()
-    }
-
-    #[test]
-    fn v4_fast_and_slow_modes() {
-        let (all, data) = other_run(Protocol::HwV4, &[]);
-        let v4 = |d: &Data| match d {
-            Data::HwV4(d) => *d,
-            _ => panic!("{d:?}"),
-        };
-        // Counters from 0, +1 per data frame; the wire decodes to the same frames, the info
-        // frame adopted.
-        for (k, (_, d)) in data.iter().enumerate() {
-            assert_eq!(v4(d).frame.counter, k as u32);
-        }
-        let wire: Vec<u8> = all.iter().flat_map(|b| b.bytes.clone()).collect();
-        let decoded: Vec<v4::Data> = v4::frames(&wire)
-            .filter_map(|f| match f.frame {
-                v4::V4Frame::Data(d) => Some(d),
-                v4::V4Frame::Info(_) => None,
-            })
-            .collect();
-        assert_eq!(decoded.len(), data.len());
-        assert_eq!(decoded.last().unwrap(), &v4(&data.last().unwrap().1));
-        let fast = |d: &Data| v4(d).frame.temp2_adc != 0;
-        let (mut fast_gaps, mut slow_gaps) = (0, 0);
-        for (gap, running, t) in gaps(&data, fast) {
-            if running {
-                assert!((gap - 51.0).abs() < 1e-3 || t < 2.1, "{gap} at {t}");
-                fast_gaps += 1;
-            } else {
-                // A data frame every 400 ms: an info frame between.
-                assert!((gap - 400.0).abs() < 1e-3 || t > 5.0, "{gap} at {t}");
-                slow_gaps += 1;
-            }
-        }
-        assert!(fast_gaps > 60 && slow_gaps > 8, "{fast_gaps} {slow_gaps}");
-        // Fast from the first frame with throttle (2 s), slow 1.5 s after the motor stopped
-        // (spun down by about 4.8 s).
-        let first_fast = data.iter().find(|d| fast(&d.1)).unwrap().0;
-        assert!((2.0..2.06).contains(&first_fast), "{first_fast}");
-        let last_fast = data.iter().rev().find(|d| fast(&d.1)).unwrap().0;
-        assert!((5.7..6.5).contains(&last_fast), "{last_fast}");
-        // Slow data frames have the trailer, and info frames come 200 ms after each.
-        for (i, b) in all.iter().enumerate() {
-            match &b.what {
-                What::Info { .. } => {
-                    assert_eq!(b.bytes.len(), 13);
-                    let prev = &all[i - 1];
-                    assert_eq!(prev.bytes.len(), 20);
-                    assert_eq!(b.t_ns - prev.t_ns, protocols::V4_SLOW_SLOT_NS);
-                }
-                What::Telemetry { data } if fast(data) => assert_eq!(b.bytes.len(), 19),
-                What::Telemetry { .. } => assert_eq!(b.bytes.len(), 20),
-                other => panic!("{other:?}"),
-            }
-        }
-        // Values: throttle in 1000ths, current while running.
-        let mid = data.iter().find(|d| d.0 > 3.5).unwrap().1;
-        let mid = v4(&mid);
-        assert!((39.0..41.0).contains(&mid.throttle_in_pct()));
-        assert!(mid.current_a().unwrap() > 3.0);
-        assert!((24.0..25.5).contains(&mid.voltage_v(v4::VoltsPerStep::DEFAULT)));
-        assert!((15.0..40.0).contains(&mid.temp_c().unwrap()));
-    }
-
-    #[test]
-    fn v3_steady_frames_and_the_placeholder() {
-        let (all, data) = other_run(Protocol::HwV3, &[]);
-        assert!(all.iter().all(|b| b.bytes.len() == 10));
-        let v3 = |d: &Data| match d {
-            Data::HwV3(f) => *f,
-            _ => panic!("{d:?}"),
-        };
-        for (k, (_, d)) in data.iter().enumerate() {
-            assert_eq!(v3(d).counter, k as u32);
-        }
-        for (gap, _, _) in gaps(&data, |_| true) {
-            assert!((gap - 19.5).abs() < 1e-3, "{gap}");
-        }
-        assert!((400..412).contains(&data.len()), "{}", data.len());
-        for (t, d) in &data {
-            let f = v3(d);
-            if *t < 2.0 || *t > 5.5 {
-                assert_eq!(f.period_us, hwfoc::v3::PLACEHOLDER_PERIOD_US, "at {t}");
-            }
-            if (2.5..4.0).contains(t) {
-                assert!(f.erpm().unwrap() > 10_000, "at {t}");
-                assert!((100..105).contains(&f.throttle_in_raw));
-            }
-        }
-        let wire: Vec<u8> = all.iter().flat_map(|b| b.bytes.clone()).collect();
-        assert_eq!(hwfoc::v3::frames(&wire).count(), data.len());
-    }
-
-    #[test]
-    fn hw5_rates_and_faults() {
-        let (all, data) = other_run(Protocol::Hw5, &["motor_blocked@3-3.5", "over_current@6"]);
-        assert!(all.iter().all(|b| b.bytes.len() == 32));
-        let hw5 = |d: &Data| match d {
-            Data::Hw5(f) => *f,
-            _ => panic!("{d:?}"),
-        };
-        let (mut run, mut idle) = (0, 0);
-        for (gap, running, t) in gaps(&data, |d| hw5(d).erpm_raw > 0) {
-            if running {
-                assert!((gap - 20.0).abs() < 1e-3 || t < 2.1, "{gap} at {t}");
-                run += 1;
-            } else {
-                // Idle, and the first frame once the motor has stopped: 400 ms.
-                assert!((gap - 400.0).abs() < 1e-3, "{gap} at {t}");
-                idle += 1;
-            }
-        }
-        assert!(run > 100 && idle > 6, "{run} {idle}");
-        for (t, d) in &data {
-            let f = hw5(d);
-            let names: Vec<&str> = f.fault.faults().map(|f| f.name()).collect();
-            let want: &[&str] = match t {
-                t if (3.0..3.5).contains(t) => &["motor_locked"],
-                t if *t >= 6.0 => &["over_current"],
-                _ => &[],
-            };
-            assert_eq!(names, want, "at {t}");
-        }
-        let wire: Vec<u8> = all.iter().flat_map(|b| b.bytes.clone()).collect();
-        assert_eq!(hwfoc::hw5::frames(&wire).count(), data.len());
     }
 }

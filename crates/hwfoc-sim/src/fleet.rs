@@ -12,9 +12,9 @@ use crate::degrade::{DegradeKind, DegradeSpec};
 use crate::error::SimError;
 use crate::esc::{Setup, VirtualEsc, spread};
 use crate::faults::{FaultSchedule, FaultSpec, LinkRates};
+use crate::formats;
 use crate::model::ModelConfig;
 use crate::profile::{Profile, ProfileSpec, Shape};
-use crate::protocols;
 use crate::schedule::{self, Pace, SimClock};
 use crate::sink::Sink;
 
@@ -28,7 +28,7 @@ pub struct FleetSpec {
     pub n: usize,
     /// Seed of every random choice: the same seed and description give the same bytes.
     pub seed: u64,
-    /// The protocol every ESC speaks (one of [`protocols::SIMULATED`]).
+    /// The protocol every ESC speaks (one of [`formats::SIMULATED`]).
     pub protocol: Protocol,
     /// Line rate, baud (8N1).
     pub baud: u32,
@@ -77,8 +77,8 @@ impl FleetSpec {
     }
 
     /// The fleet, checked (at most [`MAX_ESCS`] ESCs, every fault's ESC exists, the protocol is
-    /// one a virtual ESC speaks, link faults only on HW-FOC, every fault has a flag in an HW5
-    /// fault byte when speaking HW5) and its profile loaded (a CSV file read), but not started.
+    /// one a virtual ESC speaks, link faults only on HW-FOC, every fault has a flag in the
+    /// format's fault word where it has one) and its profile loaded (a CSV file read), but not started.
     pub fn build(self) -> Result<VirtualFleet, SimError> {
         if self.n > MAX_ESCS {
             return Err(SimError::TooManyEscs {
@@ -86,7 +86,7 @@ impl FleetSpec {
                 max: MAX_ESCS,
             });
         }
-        if !protocols::simulated(self.protocol) {
+        if !formats::simulated(self.protocol) {
             return Err(SimError::Protocol {
                 protocol: self.protocol,
             });
@@ -112,13 +112,14 @@ impl FleetSpec {
                 n: self.n,
             });
         }
-        if self.protocol == Protocol::Hw5
-            && let Some(f) = self
-                .faults
-                .iter()
-                .find(|f| protocols::hw5_fault(f.fault).is_none())
+        let fault_word = formats::format(self.protocol).and_then(|f| f.fault_word.as_ref());
+        if let Some(word) = fault_word
+            && let Some(f) = self.faults.iter().find(|f| (word.flag)(f.fault).is_none())
         {
-            return Err(SimError::NoHw5Fault { fault: f.fault });
+            return Err(SimError::NoFaultFlag {
+                protocol: self.protocol,
+                fault: f.fault,
+            });
         }
         if let Some(esc) = self
             .faults
@@ -251,15 +252,30 @@ pub(crate) mod tests {
         };
         assert_eq!(
             with(Protocol::DataLink).build().unwrap_err().to_string(),
-            "virtual ESCs do not speak DataLink V2 (datalink): they speak hw-foc, hw-v4, hw-v3, hw5"
+            format!(
+                "virtual ESCs do not speak DataLink V2 (datalink): they speak {}",
+                formats::SIMULATED.map(|p| p.name()).join(", ")
+            )
         );
-        let mut s = with(Protocol::HwV3);
-        s.link.drop = 0.1;
-        assert_eq!(
-            s.build().unwrap_err().to_string(),
-            "link faults (bit errors, drops, cuts, garbage) are simulated for HW-FOC only, not \
-             for Hobbywing V3 (hw-v3)"
-        );
+        for format in formats::FORMATS.iter().copied() {
+            let mut s = with(format.protocol);
+            s.link.drop = 0.1;
+            assert_eq!(
+                s.build().unwrap_err().to_string(),
+                format!(
+                    "link faults (bit errors, drops, cuts, garbage) are simulated for HW-FOC \
+                     only, not for {} ({})",
+                    format.protocol.title(),
+                    format.protocol
+                )
+            );
+            // Without a fault word, faults act on the model only.
+            if format.fault_word.is_none() {
+                let mut s = with(format.protocol);
+                s.faults = vec!["mos_short@2".parse().unwrap()];
+                assert!(s.build().is_ok());
+            }
+        }
         let mut s = with(Protocol::Hw5);
         s.faults = vec!["over_current@1".parse().unwrap()];
         assert!(s.clone().build().is_ok());
@@ -272,9 +288,5 @@ pub(crate) mod tests {
             ),
             "{e}"
         );
-        // V3 and V4 carry no fault word: faults act on the model only.
-        let mut s = with(Protocol::HwV4);
-        s.faults = vec!["mos_short@2".parse().unwrap()];
-        assert!(s.build().is_ok());
     }
 }

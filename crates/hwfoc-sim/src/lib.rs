@@ -1,5 +1,5 @@
-//! Virtual Hobbywing ESCs that speak their protocol as real ones do (HW-FOC, and Platinum V4, V3
-//! and HW5: [`protocols`]), for every front end alike (the
+//! Virtual Hobbywing ESCs that speak their protocol as real ones do (HW-FOC, and the formats of
+//! [`formats`]), for every front end alike (the
 //! `hwfoc simulate` command, `hwfoc monitor --sim`, bridges, bindings, tests that need
 //! recordings).
 //!
@@ -27,9 +27,9 @@ pub mod error;
 pub mod esc;
 pub mod faults;
 pub mod fleet;
+pub mod formats;
 pub mod model;
 pub mod profile;
-pub mod protocols;
 #[cfg(unix)]
 pub mod pty;
 pub mod rng;

@@ -21,9 +21,9 @@ use hwfoc_io::write::WriteError;
 use hwfoc_sim::degrade::DegradeSpec;
 use hwfoc_sim::faults::{FaultSpec, LinkRates};
 use hwfoc_sim::fleet::MAX_ESCS;
+use hwfoc_sim::formats::SIMULATED;
 use hwfoc_sim::model::ModelConfig;
 use hwfoc_sim::profile::{ProfileSpec, Shape};
-use hwfoc_sim::protocols::SIMULATED;
 #[cfg(unix)]
 use hwfoc_sim::pty::PtyLinks;
 use hwfoc_sim::template::expand;
@@ -444,7 +444,7 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
         ..args.model.spec(n, baud, &settings)
     };
     let fleet = spec.build().map_err(|e| match e {
-        e @ SimError::NoHw5Fault { .. } => usage("--fault", e.to_string()),
+        e @ SimError::NoFaultFlag { .. } => usage("--fault", e.to_string()),
         e @ (SimError::NoSuchDegradedEsc { .. } | SimError::WireDegradation { .. }) => {
             usage("--degrade", e.to_string())
         }
