@@ -39,7 +39,7 @@ use hwfoc_io::write::{FileId, Staging, create_file, same_file};
 // Check.
 use hwfoc_io::check::{Analyser, EscId, Finding, Severity, Span, Threshold, Value as CheckValue};
 use hwfoc_io::check::{
-    Baseline, Check, EscBaseline, EscSeries, LinkFigures, Sample, analyse, check,
+    Baseline, Check, EscBaseline, EscSeries, LinkTotals, Sample, analyse, check,
 };
 use hwfoc_io::check::{BatteryConfig, CheckConfig, DriftConfig, EscOverride, FaultsConfig};
 use hwfoc_io::check::{HeatConfig, ImbalanceConfig, Limits, LinkConfig, RuntimeConfig};

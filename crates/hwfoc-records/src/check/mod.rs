@@ -37,7 +37,7 @@ pub use config::{
     ImbalanceConfig, Limits, LinkConfig, RuntimeConfig,
 };
 pub use finding::{Analyser, EscId, Finding, Severity, Span, Threshold, Value};
-pub use series::{EscSeries, LinkFigures, Sample};
+pub use series::{EscSeries, LinkTotals, Sample};
 
 /// What the check gathers from the records: each ESC's series of samples.
 #[derive(Debug, Default)]
@@ -92,7 +92,7 @@ impl Check {
                     recording: recording_name(sources, entry),
                     protocol: link.protocol(),
                     timed,
-                    link: Some(LinkFigures::of(&link)),
+                    link: Some(LinkTotals::of(&link)),
                     maintenance_min: link.maintenance_min(),
                     samples,
                 })
@@ -188,11 +188,11 @@ pub(crate) mod tests {
             recording: "flight".to_string(),
             protocol: Protocol::HwFoc,
             timed: true,
-            link: Some(LinkFigures {
+            link: Some(LinkTotals {
                 frames: samples.len() as u64,
                 counts_packets: true,
                 has_checksum: true,
-                ..LinkFigures::default()
+                ..LinkTotals::default()
             }),
             maintenance_min: None,
             samples,

@@ -57,7 +57,7 @@ impl Sample {
 
 /// The link figures the link analyser judges (the summary's).
 #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
-pub struct LinkFigures {
+pub struct LinkTotals {
     /// Data and information frames decoded.
     pub frames: u64,
     /// Whether its protocol numbers its packets (else no loss is counted).
@@ -70,10 +70,10 @@ pub struct LinkFigures {
     pub checksum_failures: u64,
 }
 
-impl LinkFigures {
+impl LinkTotals {
     /// The figures of `link`.
-    pub fn of(link: &LinkStats) -> LinkFigures {
-        LinkFigures {
+    pub fn of(link: &LinkStats) -> LinkTotals {
+        LinkTotals {
             frames: u64::from(link.frames()),
             counts_packets: link.counts_packets(),
             lost_packets: u64::from(link.lost_packets()),
@@ -95,7 +95,7 @@ pub struct EscSeries {
     /// Whether its times are receive times (else the nominal period times the frame index).
     pub timed: bool,
     /// Its link's figures; `None` where there are none (built from records alone).
-    pub link: Option<LinkFigures>,
+    pub link: Option<LinkTotals>,
     /// A Hobbywing CAN ESC's own maintenance counters, minutes (total rotation time, time since
     /// maintenance), where its recording holds its answer to GetMaintenanceInformation
     /// ([`LinkStats::maintenance_min`]).

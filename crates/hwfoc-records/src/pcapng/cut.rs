@@ -67,7 +67,7 @@ impl Cutter {
     /// decided, in order, as (first byte's time, bytes).
     pub(crate) fn feed<E>(&mut self, t_ns: u64, data: &[u8], emit: &mut E) -> Result<(), E::Error>
     where
-        E: Emit,
+        E: PieceSink,
     {
         if data.is_empty() {
             return Ok(());
@@ -87,7 +87,7 @@ impl Cutter {
 
     /// Decides the held bytes now, as at the end of the stream (a frame cut short is given out
     /// as bytes between frames), and gives them all out.
-    pub(crate) fn settle<E: Emit>(&mut self, emit: &mut E) -> Result<(), E::Error> {
+    pub(crate) fn settle<E: PieceSink>(&mut self, emit: &mut E) -> Result<(), E::Error> {
         let mut frames = Vec::new();
         self.decoder
             .flush(|d| frames.push((d.offset, d.frame.wire_len())));
@@ -96,7 +96,11 @@ impl Cutter {
 
     /// Gives out `frames` (stream offset, length) and the bytes before them, then every byte
     /// the decoder has decided.
-    fn give_out<E: Emit>(&mut self, frames: &[(u64, usize)], emit: &mut E) -> Result<(), E::Error> {
+    fn give_out<E: PieceSink>(
+        &mut self,
+        frames: &[(u64, usize)],
+        emit: &mut E,
+    ) -> Result<(), E::Error> {
         let mut done = 0; // index in `held` of the first byte not yet given out
         for &(offset, len) in frames {
             let at = (offset - self.held_from) as usize;
@@ -113,7 +117,7 @@ impl Cutter {
     }
 
     /// Gives out `held[from..to]`, bytes between frames: a piece per read they come from.
-    fn between<E: Emit>(&self, from: usize, to: usize, emit: &mut E) -> Result<(), E::Error> {
+    fn between<E: PieceSink>(&self, from: usize, to: usize, emit: &mut E) -> Result<(), E::Error> {
         let mut at = from;
         while at < to {
             let next = self
@@ -174,7 +178,7 @@ impl Cutter {
 }
 
 /// Where a [`Cutter`]'s pieces go.
-pub(crate) trait Emit {
+pub(crate) trait PieceSink {
     /// The error of writing a piece.
     type Error;
     /// A piece: bytes to write as one packet (or several, if longer than a packet may be),
@@ -189,7 +193,7 @@ mod tests {
 
     struct Pieces(Vec<(u64, Vec<u8>)>);
 
-    impl Emit for Pieces {
+    impl PieceSink for Pieces {
         type Error = ();
         fn piece(&mut self, t_ns: u64, bytes: &[u8]) -> Result<(), ()> {
             self.0.push((t_ns, bytes.to_vec()));

@@ -4,7 +4,7 @@ use std::io::{self, Write};
 
 use hwfoc::dronecan::SOCKETCAN_RECORD_LEN;
 
-use super::cut::{Cutter, Emit};
+use super::cut::{Cutter, PieceSink};
 use super::{
     BYTE_ORDER_MAGIC, EPB, IDB, IF_DESCRIPTION, IF_NAME, IF_SPEED, IF_TSRESOL, LINKTYPE,
     LINKTYPE_CAN_SOCKETCAN, MAX_CHUNK, OPT_COMMENT, OPT_END, RecordingId, SHB, SHB_OS,
@@ -41,7 +41,7 @@ struct Packets<'a, W: Write> {
     iface: u32,
 }
 
-impl<W: Write> Emit for Packets<'_, W> {
+impl<W: Write> PieceSink for Packets<'_, W> {
     type Error = io::Error;
     fn piece(&mut self, t_ns: u64, bytes: &[u8]) -> io::Result<()> {
         self.writer.chunk(self.iface, t_ns, bytes)
@@ -51,7 +51,7 @@ impl<W: Write> Emit for Packets<'_, W> {
 /// The pieces of a cutter counted as file bytes.
 struct Cost(u64);
 
-impl Emit for Cost {
+impl PieceSink for Cost {
     type Error = std::convert::Infallible;
     fn piece(&mut self, _: u64, bytes: &[u8]) -> Result<(), Self::Error> {
         let whole = (bytes.len() / MAX_CHUNK) as u64 * epb_size(MAX_CHUNK);

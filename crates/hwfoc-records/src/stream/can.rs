@@ -26,7 +26,7 @@ use hwfoc::Protocol;
 use hwfoc::dronecan::{BusStats, CanFrame, Escs, NodeStats, Receiver, SOCKETCAN_RECORD_LEN};
 use hwfoc::telemetry::{AnyFrame, Data};
 
-use super::decoder::Emit;
+use super::decoder::OnFrame;
 
 /// Slots on a bus: places (node ids 0-127 before a node is mapped to its throttle channel, then
 /// its channel - 1, a byte; a standard ESC's `esc_index`), and those after the highest place
@@ -340,7 +340,7 @@ impl CanWire {
 
     /// Decodes `bytes` (with each byte's receive time, or none): `emit(t, slot, frame)` gets
     /// each record with the time of its CAN frame and its ESC's slot on the bus.
-    pub(crate) fn feed(&mut self, bytes: &[u8], times: Option<&[f64]>, emit: &mut Emit<'_>) {
+    pub(crate) fn feed(&mut self, bytes: &[u8], times: Option<&[f64]>, emit: &mut OnFrame<'_>) {
         self.bytes += bytes.len() as u64;
         for (i, &b) in bytes.iter().enumerate() {
             if self.held_len == 0 {
@@ -356,7 +356,12 @@ impl CanWire {
         }
     }
 
-    fn frame(&mut self, record: &[u8; SOCKETCAN_RECORD_LEN], t: Option<f64>, emit: &mut Emit<'_>) {
+    fn frame(
+        &mut self,
+        record: &[u8; SOCKETCAN_RECORD_LEN],
+        t: Option<f64>,
+        emit: &mut OnFrame<'_>,
+    ) {
         let Some(frame) = CanFrame::from_socketcan_record(record) else {
             self.bad_records += 1;
             return;
@@ -417,7 +422,14 @@ impl CanWire {
     }
 
     /// Hands on a record of ESC `claim` at `place` under its slot.
-    fn place(&mut self, claim: Claim, place: u8, t: Option<f64>, data: Data, emit: &mut Emit<'_>) {
+    fn place(
+        &mut self,
+        claim: Claim,
+        place: u8,
+        t: Option<f64>,
+        data: Data,
+        emit: &mut OnFrame<'_>,
+    ) {
         let Some(slot) = self.plan.slot(claim, place) else {
             return;
         };
@@ -428,7 +440,7 @@ impl CanWire {
 
     /// Hands on the records held of the node `i` of those waiting, placed by its node id (no
     /// answer came in time).
-    fn release(&mut self, i: usize, emit: &mut Emit<'_>) {
+    fn release(&mut self, i: usize, emit: &mut OnFrame<'_>) {
         let held = self.waiting.remove(i);
         let claim = Claim {
             key: held.key,
@@ -443,7 +455,7 @@ impl CanWire {
 
     /// Releases the nodes whose hold ran out by the frame at `t` (or by the frames heard,
     /// without times; a clock that stepped back ends every hold).
-    fn release_expired(&mut self, t: Option<f64>, emit: &mut Emit<'_>) {
+    fn release_expired(&mut self, t: Option<f64>, emit: &mut OnFrame<'_>) {
         let mut i = 0;
         while i < self.waiting.len() {
             let h = &self.waiting[i];
@@ -461,7 +473,7 @@ impl CanWire {
 
     /// Ends the stream: a record cut off is counted; the records held are handed on, placed
     /// by their node ids.
-    pub(crate) fn finish(&mut self, emit: &mut Emit<'_>) {
+    pub(crate) fn finish(&mut self, emit: &mut OnFrame<'_>) {
         self.cut_bytes += self.held_len as u64;
         self.held_len = 0;
         while !self.waiting.is_empty() {

@@ -18,17 +18,17 @@ use crate::input::Batch;
 
 /// Where a stream's frames go: `emit(t, channel, frame)`, each with its receive time (`None`
 /// without timing) and its channel (`None`: the stream's own ESC).
-pub(crate) type Emit<'a> = dyn FnMut(Option<f64>, Option<u8>, &AnyFrame) + 'a;
+pub(crate) type OnFrame<'a> = dyn FnMut(Option<f64>, Option<u8>, &AnyFrame) + 'a;
 
 /// The decoder of one input stream.
 pub(crate) trait LinkDecoder: std::fmt::Debug + Send {
     /// Decodes a batch: `on_frame(t, channel, frame)` gets each frame completed.
-    fn feed(&mut self, batch: Batch<'_>, on_frame: &mut Emit<'_>);
+    fn feed(&mut self, batch: Batch<'_>, on_frame: &mut OnFrame<'_>);
     /// Decodes bytes without receive times: `on_frame(channel, offset, frame)` gets each frame
     /// with the stream offset where it was handed on.
     fn feed_untimed(&mut self, bytes: &[u8], on_frame: &mut dyn FnMut(Option<u8>, u64, &AnyFrame));
     /// Ends the stream, handing on what it held.
-    fn finish(&mut self, on_frame: &mut Emit<'_>);
+    fn finish(&mut self, on_frame: &mut OnFrame<'_>);
     /// How its channels are laid out: one ESC, a hub's channels, a bus's slots.
     fn layout(&self) -> LinkKind;
     /// The protocol it was made to read only, if any.

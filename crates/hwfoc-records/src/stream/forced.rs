@@ -8,7 +8,7 @@ use hwfoc::{Protocol, detect};
 
 use super::WireKind;
 use super::can::{BusPlan, CanLink, CanWire};
-use super::decoder::{Emit, LinkDecoder};
+use super::decoder::{LinkDecoder, OnFrame};
 use super::link::LinkStats;
 use crate::input::Batch;
 
@@ -52,7 +52,7 @@ fn keep(
     t: Option<f64>,
     place: Option<u8>,
     frame: &AnyFrame,
-    emit: &mut Emit<'_>,
+    emit: &mut OnFrame<'_>,
 ) {
     let protocol = match frame {
         AnyFrame::Data(d) => Some(d.protocol()),
@@ -87,7 +87,7 @@ impl Bus {
     }
 
     /// Decodes `bytes` as [`CanWire::feed`] does, handing on the records kept.
-    pub(crate) fn decode(&mut self, bytes: &[u8], times: Option<&[f64]>, emit: &mut Emit<'_>) {
+    pub(crate) fn decode(&mut self, bytes: &[u8], times: Option<&[f64]>, emit: &mut OnFrame<'_>) {
         let (forced, left_out) = (self.forced, &mut self.left_out);
         self.wire.feed(bytes, times, &mut |t, place, frame| {
             keep(forced, left_out, t, place, frame, emit)
@@ -95,7 +95,7 @@ impl Bus {
     }
 
     /// Ends the stream as [`CanWire::finish`] does, handing on the records kept.
-    pub(crate) fn end(&mut self, emit: &mut Emit<'_>) {
+    pub(crate) fn end(&mut self, emit: &mut OnFrame<'_>) {
         let (forced, left_out) = (self.forced, &mut self.left_out);
         self.wire
             .finish(&mut |t, place, frame| keep(forced, left_out, t, place, frame, emit));
@@ -112,7 +112,7 @@ impl Bus {
 }
 
 impl LinkDecoder for Bus {
-    fn feed(&mut self, batch: Batch<'_>, on_frame: &mut Emit<'_>) {
+    fn feed(&mut self, batch: Batch<'_>, on_frame: &mut OnFrame<'_>) {
         self.decode(batch.bytes, batch.times, on_frame);
     }
 
@@ -122,7 +122,7 @@ impl LinkDecoder for Bus {
         self.decode(bytes, None, &mut |_, slot, f| on_frame(slot, at, f));
     }
 
-    fn finish(&mut self, on_frame: &mut Emit<'_>) {
+    fn finish(&mut self, on_frame: &mut OnFrame<'_>) {
         self.end(on_frame);
     }
 

@@ -11,7 +11,7 @@ use hwfoc::scan::Scanner;
 use hwfoc::telemetry::AnyFrame;
 use hwfoc::{Protocol, StreamDecoder, datalink, detect, foc, mixed};
 
-use super::decoder::{Emit, LinkDecoder};
+use super::decoder::{LinkDecoder, OnFrame};
 use super::forced::Probe;
 use super::link::LinkStats;
 use super::{SILENCE_S, WireKind};
@@ -510,7 +510,7 @@ impl Serial<Fast> {
 }
 
 impl<D: SerialDecoder> LinkDecoder for Serial<D> {
-    fn feed(&mut self, batch: Batch<'_>, on_frame: &mut Emit<'_>) {
+    fn feed(&mut self, batch: Batch<'_>, on_frame: &mut OnFrame<'_>) {
         self.feed_timed(batch, on_frame)
     }
 
@@ -518,7 +518,7 @@ impl<D: SerialDecoder> LinkDecoder for Serial<D> {
         self.feed_offsets(bytes, on_frame)
     }
 
-    fn finish(&mut self, on_frame: &mut Emit<'_>) {
+    fn finish(&mut self, on_frame: &mut OnFrame<'_>) {
         self.finish_timed(on_frame)
     }
 
