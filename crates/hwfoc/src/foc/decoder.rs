@@ -11,11 +11,13 @@
 //!
 //! How it looks for the next frame after one it took: first a frame of the first kind right
 //! there (back-to-back frames), then of any kind; else, while a window of 64 positions and a
-//! whole frame's bytes are left, [`crate::foc::window`] finds every candidate and header of the
-//! window at once, and the first header whose frame verifies is taken, every candidate before it
-//! counted rejected (so line noise and fake headers cost no branch each); near the end of the
-//! bytes, a word-at-a-time search for the next candidate decides them one by one, as a
-//! [`Decoder`] must when a candidate may still be arriving. Both ways count the same.
+//! whole frame's bytes are left, a frame at one of the first sync bytes of the window (after a
+//! run of line noise, the usual place: one compare per 16 positions finds them), while that has
+//! been right lately ([`Guess`]); else [`crate::foc::window`] finds every candidate and header
+//! of the window at once, and the first header whose frame verifies is taken, every candidate
+//! before it counted rejected (so line noise and fake headers cost no branch each); near the end
+//! of the bytes, a word-at-a-time search for the next candidate decides them one by one, as a
+//! [`Decoder`] must when a candidate may still be arriving. Every way counts the same.
 //!
 //! The scanner names no frame kind: it asks the list of kinds in [`crate::foc::frame`] whether a
 //! frame starts at a candidate, and how long a candidate with a given length byte is. Those calls
@@ -24,7 +26,7 @@
 
 use crate::foc::frame::{FocFrame, MAX_FRAME_LEN, candidate_len, or_length_bytes, wire_len_of};
 use crate::foc::stats::Stats;
-use crate::foc::window::{WINDOW, WINDOW_BYTES, Window, window};
+use crate::foc::window::{WINDOW, WINDOW_BYTES, Window, syncs, window};
 use crate::scan::{self, Candidate, Scan, StreamDecoder};
 use crate::wire::SYNC;
 
@@ -103,7 +105,8 @@ pub(crate) fn find_sync_then(
 
 /// Finds the next frame in `data` from `*pos`, counting what it passes over in `stats`.
 /// Unless `first_guess` is false (the caller has just tried it), it first tries a frame of the
-/// first kind right at `*pos`.
+/// first kind right at `*pos`. `guess` is the caller's, kept from one call to the next (see
+/// [`Guess`]).
 ///
 /// Returns the frame and its start offset, with `*pos` just after it. Returns `None` when no
 /// further frame can be decided: `*pos` is then `data.len()`, or, unless `at_end`, the start of
@@ -113,8 +116,8 @@ fn scan_next(
     data: &[u8],
     pos: &mut usize,
     stats: &mut Stats,
-    at_end: bool,
-    first_guess: bool,
+    (at_end, first_guess): (bool, bool),
+    guess: &mut Guess,
 ) -> Option<(usize, FocFrame)> {
     // Back-to-back frames, the usual case: a frame of the most frequent kind starts right here.
     if first_guess && let Some(found) = FocFrame::take_first(data, pos, stats) {
@@ -124,8 +127,22 @@ fn scan_next(
     if let Some(found) = FocFrame::take(data, pos, stats) {
         return Some(found);
     }
+    // After a run of line noise: a frame at one of its first sync bytes, while that is what
+    // the noise has been giving.
+    let guessed = guess.holds();
+    if guessed && let Some(found) = take_after_noise(data, pos, stats) {
+        guess.right();
+        return Some(found);
+    }
     // Then whole windows, counted here from what the search found.
     let searched = search_windows(data, *pos);
+    if searched.found {
+        if !guessed && searched.at_first_sync {
+            guess.right();
+        } else {
+            guess.wrong();
+        }
+    }
     stats.checksum_failures_n(searched.rejected);
     stats.skip(searched.skipped);
     *pos += searched.skipped;
@@ -154,6 +171,75 @@ fn scan_next(
     }
 }
 
+/// Whether the frame after a run of line noise starts at one of the run's first sync bytes:
+/// a 2-bit counter kept by the caller of [`scan_next`] from one call to the next.
+///
+/// In line noise a sync byte comes once in 256 bytes, so the next frame usually starts at the
+/// run's first or second, and [`take_after_noise`] finds it with one compare per 16 positions
+/// and no search; in noise full of sync bytes (fake headers), it hardly ever does, and trying
+/// would only add to each search. So it is tried while it has been right more often than not
+/// lately: right counts up, wrong (tried and failed, or not tried and a search found the frame
+/// elsewhere) counts down. It changes what is looked at first, never what is found or counted.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Guess(u8);
+
+impl Guess {
+    /// A guess that holds, as at the start of a stream.
+    pub(crate) const NEW: Guess = Guess(3);
+
+    #[inline(always)]
+    fn holds(self) -> bool {
+        self.0 >= 2
+    }
+
+    #[inline(always)]
+    fn right(&mut self) {
+        self.0 = (self.0 + 1).min(3);
+    }
+
+    #[inline(always)]
+    fn wrong(&mut self) {
+        self.0 = self.0.saturating_sub(1);
+    }
+}
+
+/// Sync bytes [`take_after_noise`] tries a frame at.
+const TRIES: usize = 2;
+
+/// The frame at one of the first [`TRIES`] sync bytes after `*pos` within the next 64
+/// positions (or just after them, when they hold fewer), taken as [`FocFrame::take`] does, the
+/// bytes before it skipped and the candidates among them counted as checksum failures. The
+/// byte at `*pos` is known to start no frame. `None`, with nothing counted and `*pos` unmoved,
+/// when there is no such frame, or fewer than a window and a frame's bytes are left, or the
+/// target has no vector unit [`crate::foc::window`] uses.
+#[inline(always)]
+fn take_after_noise(data: &[u8], pos: &mut usize, stats: &mut Stats) -> Option<(usize, FocFrame)> {
+    let w = data.get(*pos..*pos + WINDOW + MAX_FRAME_LEN)?;
+    let mut syncs = syncs(w.first_chunk::<WINDOW>()?)?;
+    // Every position of the window and the frame after it are in `data`.
+    let mut rejected = 0;
+    if syncs & 1 != 0 {
+        rejected += u32::from(is_length_byte(w[1]));
+        syncs &= !1;
+    }
+    for _ in 0..TRIES {
+        let k = syncs.trailing_zeros() as usize;
+        let mut at = *pos + k;
+        if let Some(found) = FocFrame::take(data, &mut at, stats) {
+            stats.checksum_failures_n(rejected);
+            stats.skip(k);
+            *pos = at;
+            return Some(found);
+        }
+        if k == WINDOW {
+            return None;
+        }
+        rejected += u32::from(is_length_byte(w[k + 1]));
+        syncs &= syncs - 1;
+    }
+    None
+}
+
 /// What [`search_windows`] found.
 struct Searched {
     /// Bytes passed over, to the frame found or the end of the last window.
@@ -162,6 +248,8 @@ struct Searched {
     rejected: u32,
     /// Whether a frame starts after the bytes passed over.
     found: bool,
+    /// Whether it starts at the first sync byte passed over.
+    at_first_sync: bool,
 }
 
 /// Searches `data` from `from` a window at a time, where the target has one
@@ -177,6 +265,7 @@ fn search_windows(data: &[u8], from: usize) -> Searched {
         skipped: 0,
         rejected: 0,
         found: false,
+        at_first_sync: true,
     };
     loop {
         let start = from + searched.skipped;
@@ -187,6 +276,7 @@ fn search_windows(data: &[u8], from: usize) -> Searched {
             return searched;
         };
         let Some(Window {
+            syncs,
             candidates,
             mut headers,
         }) = window(w)
@@ -196,8 +286,11 @@ fn search_windows(data: &[u8], from: usize) -> Searched {
         while headers != 0 {
             let k = headers.trailing_zeros() as usize;
             if FocFrame::verifies(data, start + k) {
-                let before = candidates & ((1 << k) - 1);
-                searched.rejected = searched.rejected.saturating_add(before.count_ones());
+                let before = (1 << k) - 1;
+                searched.rejected = searched
+                    .rejected
+                    .saturating_add((candidates & before).count_ones());
+                searched.at_first_sync &= syncs & before == 0;
                 searched.skipped += k;
                 searched.found = true;
                 return searched;
@@ -205,6 +298,7 @@ fn search_windows(data: &[u8], from: usize) -> Searched {
             headers &= headers - 1;
         }
         searched.rejected = searched.rejected.saturating_add(candidates.count_ones());
+        searched.at_first_sync &= syncs == 0;
         searched.skipped += WINDOW;
     }
 }
@@ -309,6 +403,7 @@ impl scan::Scanner for Scanner {
         on_frame: &mut impl FnMut(Decoded),
     ) -> usize {
         let mut pos = 0;
+        let mut guess = Guess::NEW;
         loop {
             // Back-to-back frames of the first kind have a call site of their own, where the frame
             // built is known to be of that kind: only its fields are written, not the bytes of the
@@ -319,7 +414,8 @@ impl scan::Scanner for Scanner {
                     frame,
                 });
             }
-            let Some((at, frame)) = scan_next(data, &mut pos, stats, AT_END, false) else {
+            let Some((at, frame)) = scan_next(data, &mut pos, stats, (AT_END, false), &mut guess)
+            else {
                 return pos;
             };
             on_frame(Decoded {
@@ -331,7 +427,9 @@ impl scan::Scanner for Scanner {
 
     #[inline(always)]
     fn scan_next(data: &[u8], pos: &mut usize, stats: &mut Stats) -> Option<Decoded> {
-        scan_next(data, pos, stats, true, true).map(|(at, frame)| Decoded {
+        // One frame at a time (a byte pushed, a held candidate): no noise to learn from.
+        let mut guess = Guess::NEW;
+        scan_next(data, pos, stats, (true, true), &mut guess).map(|(at, frame)| Decoded {
             offset: at as u64,
             frame,
         })

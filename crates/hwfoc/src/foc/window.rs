@@ -7,6 +7,8 @@
 //! noise full of fake headers (`9B 16` with no frame behind it) it also counts them together
 //! instead of one stop each.
 //!
+//! [`syncs`] is the scanner's first look after a run of noise, the window's sync bytes alone.
+//!
 //! The window is four SSE2 compares per byte value and a movemask per 16 positions, on x86_64
 //! (which always has SSE2). Elsewhere there is none ([`window`] gives `None`) and the scanner
 //! searches a word at a time: a window computed a byte at a time would cost a microcontroller
@@ -27,6 +29,8 @@ pub(crate) const WINDOW_BYTES: usize = WINDOW + 3;
 /// What a window holds, bit `i` for position `i`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(crate) struct Window {
+    /// A sync byte.
+    pub(crate) syncs: u64,
     /// A sync byte followed by a known length byte: where the scanner tries a frame, and,
     /// when none is there and its bytes are all in, a checksum failure.
     pub(crate) candidates: u64,
@@ -55,6 +59,26 @@ pub(crate) fn window(w: &[u8; WINDOW_BYTES]) -> Option<Window> {
     }
 }
 
+/// The sync bytes of `w`, bit `i` for position `i`, where the target has a vector unit this
+/// module uses (SSE2): `None` elsewhere. One compare and one movemask per 16 positions: the
+/// scanner's first look after a run of garbage, whose frame usually starts at the run's first
+/// sync byte.
+#[inline(always)]
+pub(crate) fn syncs(w: &[u8; WINDOW]) -> Option<u64> {
+    #[cfg(all(target_arch = "x86_64", target_feature = "sse2"))]
+    {
+        // SAFETY: as in `window`: SSE2 is enabled in this build.
+        #[allow(unsafe_code)]
+        let syncs = unsafe { sse2::syncs(w) };
+        Some(syncs)
+    }
+    #[cfg(not(all(target_arch = "x86_64", target_feature = "sse2")))]
+    {
+        let _ = w;
+        None
+    }
+}
+
 #[cfg(all(target_arch = "x86_64", target_feature = "sse2"))]
 mod sse2 {
     use core::arch::x86_64::{
@@ -64,12 +88,39 @@ mod sse2 {
 
     use super::{HEADERS, LENGTH_BYTES, SYNC, WINDOW, WINDOW_BYTES, Window};
 
+    /// Sixteen bytes of `w` from `at` (two little-endian words: a plain unaligned load once
+    /// compiled, with no pointer).
+    #[target_feature(enable = "sse2")]
+    #[inline]
+    fn sixteen<const N: usize>(w: &[u8; N], at: usize) -> __m128i {
+        let word = |from: usize| {
+            let mut b = [0; 8];
+            b.copy_from_slice(&w[from..from + 8]);
+            i64::from_le_bytes(b)
+        };
+        _mm_set_epi64x(word(at + 8), word(at))
+    }
+
+    /// [`super::syncs`] with SSE2.
+    #[target_feature(enable = "sse2")]
+    #[inline]
+    pub(super) fn syncs(w: &[u8; WINDOW]) -> u64 {
+        let sync = _mm_set1_epi8(SYNC as i8);
+        let mut syncs = 0;
+        for at in (0..WINDOW).step_by(16) {
+            let mask = _mm_movemask_epi8(_mm_cmpeq_epi8(sixteen(w, at), sync));
+            syncs |= u64::from(mask as u16) << at;
+        }
+        syncs
+    }
+
     /// [`super::window`] with SSE2: per 16 positions, the bytes at offsets 0 to 3 of each
     /// position compared with the sync byte, the length bytes and the kinds' headers, and a
     /// movemask of each result.
     #[target_feature(enable = "sse2")]
     #[inline]
     pub(super) fn window(w: &[u8; WINDOW_BYTES]) -> Window {
+        let mut syncs = 0;
         let mut candidates = 0;
         let mut headers = 0;
         for at in (0..WINDOW).step_by(16) {
@@ -97,10 +148,12 @@ mod sse2 {
                 header = _mm_or_si128(header, _mm_and_si128(first, last));
             }
             let mask = |v: __m128i| u64::from(_mm_movemask_epi8(v) as u16);
+            syncs |= mask(sync) << at;
             candidates |= mask(_mm_and_si128(sync, length_byte)) << at;
             headers |= mask(header) << at;
         }
         Window {
+            syncs,
             candidates,
             headers,
         }
@@ -147,10 +200,14 @@ mod tests {
                 i += 1;
             }
             let mut plain = Window {
+                syncs: 0,
                 candidates: 0,
                 headers: 0,
             };
             for i in 0..WINDOW {
+                if w[i] == SYNC {
+                    plain.syncs |= 1 << i;
+                }
                 if w[i] == SYNC && LENGTH_BYTES.contains(&w[i + 1]) {
                     plain.candidates |= 1 << i;
                 }
@@ -159,6 +216,8 @@ mod tests {
                 }
             }
             assert_eq!(window(&w), Some(plain), "{w:02X?}");
+            let first: &[u8; WINDOW] = w.first_chunk().unwrap();
+            assert_eq!(syncs(first), Some(plain.syncs));
         }
     }
 }
