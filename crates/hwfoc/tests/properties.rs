@@ -863,3 +863,65 @@ fn streamed_with_silences(
     d.flush(|x| out.push(x));
     (out, *d.stats())
 }
+
+/// The bulk scanner's first look after a run of noise (a frame at one of the run's first sync
+/// bytes, tried while that has been right lately) changes what it looks at first, never what
+/// it finds or counts: over phases of plain line noise (where that look is right), noise full
+/// of sync bytes, fake headers and whole fake frames (where it is wrong, and stops being
+/// tried), then plain noise again, with runs up to 200 bytes (past a 64-position window), cut
+/// and flipped frames, and info frames, it gives what the streaming decoder gives a byte at a
+/// time, which never looks that way.
+#[test]
+fn the_first_look_after_noise_finds_and_counts_as_a_byte_at_a_time() {
+    let mut x = 0x2545_F491_4F6C_DD1Du64;
+    let mut next = move || {
+        x ^= x << 13;
+        x ^= x >> 7;
+        x ^= x << 17;
+        x
+    };
+    let info = InfoFrame::new("XR_FOC_ESC", "HW577", "01.0.00", "12345678")
+        .unwrap()
+        .encode();
+    let mut wire = Vec::new();
+    let mut packet = 0u16;
+    for phase in 0..6 {
+        let hostile = phase % 2 == 1;
+        for _ in 0..400 {
+            let r = next();
+            if r % 3 == 0 {
+                let len = (next() % if r % 7 == 0 { 200 } else { 64 }) as usize + 1;
+                for _ in 0..len {
+                    let b = next();
+                    match (hostile, b % 12) {
+                        (true, 0) => wire.push(0x9B),
+                        (true, 1) => wire.extend_from_slice(&[0x9B, 0x16]),
+                        (true, 2) => wire.extend_from_slice(&[0x9B, 0x16, 0x01, 0x02]),
+                        (true, 3) => wire.extend_from_slice(&[0x9B, 0x4C]),
+                        _ => wire.push((b >> 8) as u8),
+                    }
+                }
+            }
+            let mut frame = DataFrame {
+                packet,
+                ..Default::default()
+            }
+            .encode();
+            packet = packet.wrapping_add(1);
+            match next() % 25 {
+                0 => frame[(next() % 24) as usize] ^= 1 << (next() % 8),
+                1 => {
+                    wire.extend_from_slice(&frame[..(next() % 23) as usize + 1]);
+                    continue;
+                }
+                2 => wire.extend_from_slice(&info),
+                _ => {}
+            }
+            wire.extend_from_slice(&frame);
+        }
+    }
+    let (found, stats) = bulk(&wire);
+    assert!(found.len() > 2000, "{}", found.len());
+    assert!(stats.checksum_failures() > 100, "{stats:?}");
+    assert_eq!((found, stats), streamed_bytewise::<foc::Scanner>(&wire));
+}

@@ -137,11 +137,7 @@ fn scan_next(
     // Then whole windows, counted here from what the search found.
     let searched = search_windows(data, *pos);
     if searched.found {
-        if !guessed && searched.at_first_sync {
-            guess.right();
-        } else {
-            guess.wrong();
-        }
+        guess.judged(!guessed && searched.rejected == 0);
     }
     stats.checksum_failures_n(searched.rejected);
     stats.skip(searched.skipped);
@@ -178,8 +174,8 @@ fn scan_next(
 /// run's first or second, and [`take_after_noise`] finds it with one compare per 16 positions
 /// and no search; in noise full of sync bytes (fake headers), it hardly ever does, and trying
 /// would only add to each search. So it is tried while it has been right more often than not
-/// lately: right counts up, wrong (tried and failed, or not tried and a search found the frame
-/// elsewhere) counts down. It changes what is looked at first, never what is found or counted.
+/// lately: right counts up, wrong (tried and failed, or not tried and the search found the
+/// frame after a candidate, as fake headers make it) counts down. It changes what is looked at first, never what is found or counted.
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct Guess(u8);
 
@@ -197,9 +193,12 @@ impl Guess {
         self.0 = (self.0 + 1).min(3);
     }
 
+    /// Right or wrong, without a branch.
     #[inline(always)]
-    fn wrong(&mut self) {
-        self.0 = self.0.saturating_sub(1);
+    fn judged(&mut self, right: bool) {
+        let up = (self.0 + 1).min(3);
+        let down = self.0.saturating_sub(1);
+        self.0 = if right { up } else { down };
     }
 }
 
@@ -248,8 +247,6 @@ struct Searched {
     rejected: u32,
     /// Whether a frame starts after the bytes passed over.
     found: bool,
-    /// Whether it starts at the first sync byte passed over.
-    at_first_sync: bool,
 }
 
 /// Searches `data` from `from` a window at a time, where the target has one
@@ -265,7 +262,6 @@ fn search_windows(data: &[u8], from: usize) -> Searched {
         skipped: 0,
         rejected: 0,
         found: false,
-        at_first_sync: true,
     };
     loop {
         let start = from + searched.skipped;
@@ -276,7 +272,6 @@ fn search_windows(data: &[u8], from: usize) -> Searched {
             return searched;
         };
         let Some(Window {
-            syncs,
             candidates,
             mut headers,
         }) = window(w)
@@ -286,11 +281,8 @@ fn search_windows(data: &[u8], from: usize) -> Searched {
         while headers != 0 {
             let k = headers.trailing_zeros() as usize;
             if FocFrame::verifies(data, start + k) {
-                let before = (1 << k) - 1;
-                searched.rejected = searched
-                    .rejected
-                    .saturating_add((candidates & before).count_ones());
-                searched.at_first_sync &= syncs & before == 0;
+                let before = candidates & ((1 << k) - 1);
+                searched.rejected = searched.rejected.saturating_add(before.count_ones());
                 searched.skipped += k;
                 searched.found = true;
                 return searched;
@@ -298,7 +290,6 @@ fn search_windows(data: &[u8], from: usize) -> Searched {
             headers &= headers - 1;
         }
         searched.rejected = searched.rejected.saturating_add(candidates.count_ones());
-        searched.at_first_sync &= syncs == 0;
         searched.skipped += WINDOW;
     }
 }

@@ -29,8 +29,6 @@ pub(crate) const WINDOW_BYTES: usize = WINDOW + 3;
 /// What a window holds, bit `i` for position `i`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(crate) struct Window {
-    /// A sync byte.
-    pub(crate) syncs: u64,
     /// A sync byte followed by a known length byte: where the scanner tries a frame, and,
     /// when none is there and its bytes are all in, a checksum failure.
     pub(crate) candidates: u64,
@@ -120,7 +118,6 @@ mod sse2 {
     #[target_feature(enable = "sse2")]
     #[inline]
     pub(super) fn window(w: &[u8; WINDOW_BYTES]) -> Window {
-        let mut syncs = 0;
         let mut candidates = 0;
         let mut headers = 0;
         for at in (0..WINDOW).step_by(16) {
@@ -148,12 +145,10 @@ mod sse2 {
                 header = _mm_or_si128(header, _mm_and_si128(first, last));
             }
             let mask = |v: __m128i| u64::from(_mm_movemask_epi8(v) as u16);
-            syncs |= mask(sync) << at;
             candidates |= mask(_mm_and_si128(sync, length_byte)) << at;
             headers |= mask(header) << at;
         }
         Window {
-            syncs,
             candidates,
             headers,
         }
@@ -200,13 +195,13 @@ mod tests {
                 i += 1;
             }
             let mut plain = Window {
-                syncs: 0,
                 candidates: 0,
                 headers: 0,
             };
+            let mut plain_syncs = 0;
             for i in 0..WINDOW {
                 if w[i] == SYNC {
-                    plain.syncs |= 1 << i;
+                    plain_syncs |= 1 << i;
                 }
                 if w[i] == SYNC && LENGTH_BYTES.contains(&w[i + 1]) {
                     plain.candidates |= 1 << i;
@@ -217,7 +212,7 @@ mod tests {
             }
             assert_eq!(window(&w), Some(plain), "{w:02X?}");
             let first: &[u8; WINDOW] = w.first_chunk().unwrap();
-            assert_eq!(syncs(first), Some(plain.syncs));
+            assert_eq!(syncs(first), Some(plain_syncs));
         }
     }
 }
