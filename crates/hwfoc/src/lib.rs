@@ -1,7 +1,8 @@
 #![doc = include_str!("../README.md")]
 #![no_std]
-// No `unsafe` but one call, in `foc/window.rs`: the SSE2 search window, whose compare and
-// movemask `core::arch` gives only to a function with the target feature (x86_64 always has it).
+// No `unsafe` but two calls, in `foc/window.rs`: the SSE2 search window and sync mask, whose
+// compare and movemask `core::arch` gives only to a function with the target feature (x86_64
+// always has it).
 #![deny(unsafe_code)]
 #![warn(missing_docs)]
 

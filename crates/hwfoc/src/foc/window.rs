@@ -44,7 +44,7 @@ pub(crate) fn window(w: &[u8; WINDOW_BYTES]) -> Option<Window> {
     #[cfg(all(target_arch = "x86_64", target_feature = "sse2"))]
     {
         // SAFETY: the function needs SSE2, which this build enables (the `cfg` above; x86_64
-        // always has it). It is the codec's only `unsafe`: `core::arch`'s compare and
+        // always has it). With `syncs`, the codec's only `unsafe`: `core::arch`'s compare and
         // movemask need a target feature, and LLVM makes neither from portable code.
         #[allow(unsafe_code)]
         let window = unsafe { sse2::window(w) };
