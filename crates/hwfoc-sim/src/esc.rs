@@ -26,9 +26,9 @@ use std::collections::VecDeque;
 use std::rc::Rc;
 
 use hwfoc::foc::{DataFrame, Decoder, FocFrame, InfoFrame};
-use hwfoc::telemetry::Data;
 use hwfoc::{Fault, Protocol};
 
+pub use crate::burst::{Burst, What};
 use crate::degrade::{DegradeSpec, ModelDegradations, WireLoss};
 use crate::faults::{Fate, FaultSchedule, LineFaults, LinkRates};
 use crate::formats::{self, Speaker, Start};
@@ -51,64 +51,6 @@ const MAX_GLITCH: usize = 8;
 const PRODUCT: &str = "XR_FOC_ESC";
 const HARDWARE: &str = "HW577_KZ1_V1.1";
 const FIRMWARE: &str = "XR-01.0.00";
-
-/// What a burst is.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub enum What {
-    /// A data frame, and what the link did to it (dropped: no bytes).
-    Data {
-        /// The frame as the ESC meant it.
-        frame: DataFrame,
-        /// What the link did to it.
-        fate: Fate,
-    },
-    /// A data frame of another protocol than HW-FOC (always intact: no link faults there).
-    Telemetry {
-        /// The frame as the ESC meant it (a V4 frame with the ESC's own info frame).
-        data: Data,
-    },
-    /// A device-information frame (HW-FOC's, or V4's info frame).
-    Info {
-        /// What the link did to it.
-        fate: Fate,
-    },
-    /// Line noise between frames.
-    Garbage,
-    /// Zero bytes put before a frame so that a fault stays detectable (see the module doc).
-    Glitch,
-}
-
-/// Bytes sent back to back on one ESC's wire.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Burst {
-    /// Simulated time of the start of the first byte, ns since the start of the run.
-    pub t_ns: u64,
-    /// The bytes (none for a dropped frame).
-    pub bytes: Vec<u8>,
-    /// What they are.
-    pub what: What,
-}
-
-impl Burst {
-    /// The data frame it carries intact, if any: what the ground truth records.
-    pub fn intact_frame(&self) -> Option<&DataFrame> {
-        match &self.what {
-            What::Data {
-                frame,
-                fate: Fate::Intact,
-            } => Some(frame),
-            _ => None,
-        }
-    }
-
-    /// The data frame of any protocol it carries intact, if any: what the ground truth records.
-    pub fn intact_data(&self) -> Option<Data> {
-        match &self.what {
-            What::Telemetry { data } => Some(*data),
-            _ => self.intact_frame().map(|f| Data::HwFoc(*f)),
-        }
-    }
-}
 
 /// Everything one virtual ESC is made from.
 #[derive(Debug, Clone)]
@@ -474,6 +416,8 @@ pub(crate) fn seconds(t_ns: u64) -> f64 {
 
 #[cfg(test)]
 pub(crate) mod tests {
+    use hwfoc::telemetry::Data;
+
     use super::*;
     use crate::model::tests::config;
     use hwfoc::Status;

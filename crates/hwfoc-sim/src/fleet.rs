@@ -5,7 +5,7 @@ use std::rc::Rc;
 use std::sync::atomic::AtomicBool;
 use std::time::Instant;
 
-use hwfoc::Protocol;
+use hwfoc::{Fault, Protocol};
 use hwfoc_ports::clock::unix_now_ns;
 
 use crate::degrade::{DegradeKind, DegradeSpec};
@@ -89,6 +89,7 @@ impl FleetSpec {
         if !formats::simulated(self.protocol) {
             return Err(SimError::Protocol {
                 protocol: self.protocol,
+                simulated: &formats::SIMULATED,
             });
         }
         if self.protocol != Protocol::HwFoc && self.link != LinkRates::default() {
@@ -119,6 +120,11 @@ impl FleetSpec {
             return Err(SimError::NoFaultFlag {
                 protocol: self.protocol,
                 fault: f.fault,
+                word: word.name,
+                carried: Fault::ALL
+                    .into_iter()
+                    .filter_map(|f| (word.flag)(f).map(|flag| (f, flag)))
+                    .collect(),
             });
         }
         if let Some(esc) = self

@@ -20,6 +20,7 @@
 #![forbid(unsafe_op_in_unsafe_fn)]
 #![warn(missing_docs)]
 
+pub mod burst;
 pub mod can;
 pub mod degrade;
 pub mod destination;

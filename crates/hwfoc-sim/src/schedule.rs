@@ -9,7 +9,8 @@
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 
-use crate::esc::{Burst, VirtualEsc, What};
+use crate::burst::{Burst, What};
+use crate::esc::VirtualEsc;
 use crate::faults::Fate;
 use crate::sink::{Sink, Truth};
 use hwfoc_io::write::WriteError;

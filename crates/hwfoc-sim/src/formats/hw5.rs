@@ -13,7 +13,7 @@ use hwfoc::telemetry::Data;
 use hwfoc::{Fault, Protocol, Status};
 
 use super::{FaultWord, Look, SimulatedFormat, Speaker, Start};
-use crate::esc::What;
+use crate::burst::What;
 use crate::model::Measured;
 use crate::rng::Rng;
 

@@ -11,7 +11,7 @@
 
 use hwfoc::{Fault, Protocol};
 
-use crate::esc::What;
+use crate::burst::What;
 use crate::model::Measured;
 use crate::rng::Rng;
 

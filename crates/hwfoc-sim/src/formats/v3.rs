@@ -9,7 +9,7 @@ use hwfoc::telemetry::Data;
 use hwfoc::{Protocol, v3};
 
 use super::{Look, SimulatedFormat, Speaker, Start};
-use crate::esc::What;
+use crate::burst::What;
 use crate::model::Measured;
 use crate::rng::Rng;
 

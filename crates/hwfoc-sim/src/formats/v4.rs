@@ -20,7 +20,7 @@ use hwfoc::telemetry::Data;
 use hwfoc::{Protocol, v4};
 
 use super::{Look, SimulatedFormat, Speaker, Start};
-use crate::esc::What;
+use crate::burst::What;
 use crate::faults::Fate;
 use crate::model::Measured;
 use crate::rng::Rng;
