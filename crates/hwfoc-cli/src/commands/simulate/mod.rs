@@ -1,5 +1,5 @@
 //! `hwfoc simulate`: virtual ESCs that speak their protocol as real ones do (HW-FOC by default;
-//! `--protocol hw-v4`, `hw-v3` or `hw5`: [`hwfoc_sim::protocols`]; `--protocol hw-can`: a CAN
+//! `--protocol hw-v4`, `hw-v3` or `hw5`: [`hwfoc_sim::formats`]; `--protocol hw-can`: a CAN
 //! bus of Hobbywing DroneCAN ESCs, [`hwfoc_sim::can`], run by the `can` module).
 //!
 //! The simulator is the `hwfoc_sim` library; this command turns its options into the library's
