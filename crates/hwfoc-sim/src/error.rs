@@ -83,8 +83,6 @@ pub enum SimError {
     Protocol {
         /// The protocol asked for.
         protocol: hwfoc::Protocol,
-        /// The protocols virtual ESCs speak.
-        simulated: &'static [hwfoc::Protocol],
     },
     /// Link faults (bit errors, drops, cuts, garbage) asked of a protocol other than HW-FOC.
     LinkFaults {
@@ -97,10 +95,6 @@ pub enum SimError {
         protocol: hwfoc::Protocol,
         /// The fault.
         fault: hwfoc::Fault,
-        /// What the format calls its fault word ("fault byte").
-        word: &'static str,
-        /// The faults it carries, each with the name of the flag it is sent as.
-        carried: Vec<(hwfoc::Fault, &'static str)>,
     },
     /// Symlinks to pseudo-terminals, neither one per ESC nor one template.
     LinkCount {
@@ -196,39 +190,32 @@ impl fmt::Display for SimError {
                 "raw bytes of {n} ESCs cannot share one output: give each its own file \
                  ({{esc}} in the name) or write a recording (pcapng)"
             ),
-            SimError::Protocol {
-                protocol,
-                simulated,
-            } => {
-                let names: Vec<&str> = simulated.iter().map(|p| p.name()).collect();
-                write!(
-                    f,
-                    "virtual ESCs do not speak {} ({protocol}): they speak {}",
-                    protocol.title(),
-                    names.join(", ")
-                )
-            }
+            SimError::Protocol { protocol } => write!(
+                f,
+                "virtual ESCs do not speak {} ({protocol}): they speak {}",
+                protocol.title(),
+                crate::formats::SIMULATED.map(|p| p.name()).join(", ")
+            ),
             SimError::LinkFaults { protocol } => write!(
                 f,
                 "link faults (bit errors, drops, cuts, garbage) are simulated for HW-FOC only, \
                  not for {} ({protocol})",
                 protocol.title()
             ),
-            SimError::NoFaultFlag {
-                protocol,
-                fault,
-                word,
-                carried,
-            } => {
+            SimError::NoFaultFlag { protocol, fault } => {
                 let title = protocol.title();
-                let carried: Vec<String> = carried
-                    .iter()
-                    .map(|(f, flag)| format!("{} (as {flag})", f.name()))
-                    .collect();
+                let word = crate::formats::format(*protocol).and_then(|f| f.fault_word.as_ref());
+                let carried: Vec<String> = word.map_or_else(Vec::new, |word| {
+                    hwfoc::Fault::ALL
+                        .iter()
+                        .filter_map(|f| (word.flag)(*f).map(|h| format!("{} (as {h})", f.name())))
+                        .collect()
+                });
                 write!(
                     f,
-                    "the fault {} has no flag in {title}'s {word}; {title} carries {}",
+                    "the fault {} has no flag in {title}'s {}; {title} carries {}",
                     fault.name(),
+                    word.map_or("fault word", |w| w.name),
                     carried.join(", ")
                 )
             }

@@ -5,7 +5,7 @@ use std::rc::Rc;
 use std::sync::atomic::AtomicBool;
 use std::time::Instant;
 
-use hwfoc::{Fault, Protocol};
+use hwfoc::Protocol;
 use hwfoc_ports::clock::unix_now_ns;
 
 use crate::degrade::{DegradeKind, DegradeSpec};
@@ -89,7 +89,6 @@ impl FleetSpec {
         if !formats::simulated(self.protocol) {
             return Err(SimError::Protocol {
                 protocol: self.protocol,
-                simulated: &formats::SIMULATED,
             });
         }
         if self.protocol != Protocol::HwFoc && self.link != LinkRates::default() {
@@ -120,11 +119,6 @@ impl FleetSpec {
             return Err(SimError::NoFaultFlag {
                 protocol: self.protocol,
                 fault: f.fault,
-                word: word.name,
-                carried: Fault::ALL
-                    .into_iter()
-                    .filter_map(|f| (word.flag)(f).map(|flag| (f, flag)))
-                    .collect(),
             });
         }
         if let Some(esc) = self
@@ -258,11 +252,20 @@ pub(crate) mod tests {
         };
         assert_eq!(
             with(Protocol::DataLink).build().unwrap_err().to_string(),
-            format!(
-                "virtual ESCs do not speak DataLink V2 (datalink): they speak {}",
-                formats::SIMULATED.map(|p| p.name()).join(", ")
-            )
+            "virtual ESCs do not speak DataLink V2 (datalink): they speak hw-foc, hw-v4, hw-v3, hw5"
         );
+        let mut s = with(Protocol::HwV3);
+        s.link.drop = 0.1;
+        assert_eq!(
+            s.build().unwrap_err().to_string(),
+            "link faults (bit errors, drops, cuts, garbage) are simulated for HW-FOC only, not \
+             for Hobbywing V3 (hw-v3)"
+        );
+        // V3 and V4 carry no fault word: faults act on the model only.
+        let mut s = with(Protocol::HwV4);
+        s.faults = vec!["mos_short@2".parse().unwrap()];
+        assert!(s.build().is_ok());
+        // Every format: the same, from its own description.
         for format in formats::FORMATS.iter().copied() {
             let mut s = with(format.protocol);
             s.link.drop = 0.1;
