@@ -175,7 +175,8 @@ fn scan_next(
 /// and no search; in noise full of sync bytes (fake headers), it hardly ever does, and trying
 /// would only add to each search. So it is tried while it has been right more often than not
 /// lately: right counts up, wrong (tried and failed, or not tried and the search found the
-/// frame after a candidate, as fake headers make it) counts down. It changes what is looked at first, never what is found or counted.
+/// frame after a candidate, as fake headers make it) counts down. It changes what is looked at
+/// first, never what is found or counted.
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct Guess(u8);
 
@@ -188,17 +189,22 @@ impl Guess {
         self.0 >= 2
     }
 
+    /// The counter after a right guess.
+    #[inline(always)]
+    fn up(self) -> u8 {
+        (self.0 + 1).min(3)
+    }
+
     #[inline(always)]
     fn right(&mut self) {
-        self.0 = (self.0 + 1).min(3);
+        self.0 = self.up();
     }
 
     /// Right or wrong, without a branch.
     #[inline(always)]
     fn judged(&mut self, right: bool) {
-        let up = (self.0 + 1).min(3);
         let down = self.0.saturating_sub(1);
-        self.0 = if right { up } else { down };
+        self.0 = if right { self.up() } else { down };
     }
 }
 
