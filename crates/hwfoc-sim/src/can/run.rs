@@ -126,8 +126,12 @@ impl CanSession {
         );
         let realtime = plan.realtime || live;
         let mut files: Vec<String> = plan.truth.iter().cloned().collect();
-        if let CanDestination::Candump(path) | CanDestination::Pcapng(path) = &plan.destination {
-            files.push(path.clone());
+        match &plan.destination {
+            CanDestination::Candump(path) | CanDestination::Pcapng(path) => {
+                files.push(path.clone())
+            }
+            #[cfg(unix)]
+            CanDestination::Pty(_) => {}
         }
         sink::check_new(files.iter().map(String::as_str), plan.overwrite)?;
         let truth = match &plan.truth {
@@ -200,6 +204,8 @@ impl CanSession {
     /// Runs to the end of the duration, or until `stop` is set.
     pub fn run(mut self, stop: &AtomicBool) -> Result<CanReport, SimError> {
         let start = Instant::now();
+        // Fed only by a pty's controller (a pty is Unix's).
+        #[cfg_attr(not(unix), allow(unused_mut))]
         let mut adapter = Adapter::new();
         let mut t_ns = 0u64;
         // What the pty's controller sends and is answered (a pty is Unix's).
