@@ -35,10 +35,15 @@
 //! decoded once and checked: every intact frame found (of the noisy V3 and V4 streams, the share
 //! found is shown), `Decoder` and `frames` in agreement.
 //!
+//! Each HW-FOC and DataLink stream is also read the default way (`detect_clean`, ...,
+//! `detect_datalink_noisy`): a `detect::Decoder` fed the whole buffer, as every reader does
+//! unless a protocol is forced, which locks both onto the mixed scanner ([`detect_once`]).
+//!
 //! With `HWFOC_BULK_ONCE=clean` (or `noisy`, `hostile`) in the environment, the bench instead
 //! makes that stream, checks it, decodes it once with `frames` in [`decode_once`] and exits
 //! (with `HWFOC_BULK_DECODES=N`, N times, 0 included): what `scripts/instructions.sh` counts the
-//! instructions of (cachegrind: a run with one decode less one with none).
+//! instructions of (cachegrind: a run with one decode less one with none). With `detect_`
+//! before the stream's name (`HWFOC_BULK_ONCE=detect_noisy`), the decode is [`detect_once`]'s.
 
 use std::hint::black_box;
 use std::time::Duration;
@@ -50,7 +55,7 @@ use hwfoc::foc;
 use hwfoc::foc::{DataFrame, Decoded, Decoder, FocFrame, InfoFrame, frames};
 use hwfoc::scan::{Scan, Scanner, StreamDecoder};
 use hwfoc::wire::Checksum;
-use hwfoc::{hw5, v3, v4};
+use hwfoc::{detect, hw5, mixed, v3, v4};
 
 /// Size of each generated stream.
 const STREAM_LEN: usize = 8 << 20;
@@ -742,6 +747,46 @@ fn older(c: &mut Criterion) {
     }
 }
 
+/// Something from every frame `detect` hands on (an ESC's or a hub's, as [`fold`] and
+/// [`fold_datalink`] take them), so that no decoding work can be optimised away.
+#[inline(always)]
+fn fold_detected(acc: u64, d: &detect::Decoded) -> u64 {
+    match d {
+        detect::Decoded::Mixed(mixed::Decoded::Esc(d)) => fold(acc, d),
+        detect::Decoded::Mixed(mixed::Decoded::Hub(d)) => fold_datalink(acc, d),
+        other => acc.wrapping_mul(31).wrapping_add(other.offset()),
+    }
+}
+
+/// One decode of `buf` by a `detect::Decoder` fed the whole buffer: the default path.
+#[inline(never)]
+fn detect_once(buf: &[u8]) -> u64 {
+    let mut acc = 0;
+    let mut d = detect::Decoder::new();
+    d.feed(black_box(buf), |x| acc = fold_detected(acc, &x));
+    d.flush(|x| acc = fold_detected(acc, &x));
+    acc
+}
+
+/// The default path over `buf` as group `name`: a `detect::Decoder` fed the whole buffer, as
+/// every reader does unless a protocol is forced (HW-FOC and DataLink locked onto
+/// [`mixed`]'s scanner), once checked to find the frames at `offsets` (the format's own
+/// decoder's).
+fn bench_detect(c: &mut Criterion, name: &str, buf: &[u8], offsets: &[u64]) {
+    let mut found = Vec::with_capacity(offsets.len());
+    let mut d = detect::Decoder::new();
+    d.feed(buf, |x| found.push(x.offset()));
+    d.flush(|x| found.push(x.offset()));
+    assert_eq!(
+        found, offsets,
+        "{name}: detect and the format's own decoder disagree"
+    );
+    let mut g = c.benchmark_group(name);
+    g.throughput(Throughput::Bytes(buf.len() as u64));
+    g.bench_function("feed", |b| b.iter(|| black_box(detect_once(buf))));
+    g.finish();
+}
+
 fn bulk(c: &mut Criterion) {
     for (name, noisy) in [("datalink_clean", false), ("datalink_noisy", true)] {
         let (buf, expected) = datalink_stream(noisy);
@@ -749,6 +794,8 @@ fn bulk(c: &mut Criterion) {
         let mut g = c.benchmark_group(name);
         bench_decoder::<datalink::Scanner>(&mut g, &buf, fold_datalink);
         g.finish();
+        let offsets: Vec<u64> = datalink::frames(&buf).map(|d| d.offset).collect();
+        bench_detect(c, &format!("detect_{name}"), &buf, &offsets);
     }
     let streams = [
         ("clean", clean_stream()),
@@ -760,6 +807,8 @@ fn bulk(c: &mut Criterion) {
         let mut g = c.benchmark_group(name);
         bench_decoder::<foc::Scanner>(&mut g, &buf, fold);
         g.finish();
+        let offsets: Vec<u64> = frames(&buf).map(|d| d.offset).collect();
+        bench_detect(c, &format!("detect_{name}"), &buf, &offsets);
     }
 }
 
@@ -772,12 +821,19 @@ fn decode_once(buf: &[u8]) -> u64 {
 
 /// The `HWFOC_BULK_ONCE` mode (see the module's documentation): one stream decoded once.
 fn once(name: &str) {
-    let (buf, expected) = match name {
+    let (stream, detected) = match name.strip_prefix("detect_") {
+        Some(stream) => (stream, true),
+        None => (name, false),
+    };
+    let (buf, expected) = match stream {
         "clean" => clean_stream(),
         "noisy" => noisy_stream(false),
         "hostile" => noisy_stream(true),
-        other => {
-            eprintln!("HWFOC_BULK_ONCE={other}: not a stream (clean, noisy, hostile)");
+        _ => {
+            eprintln!(
+                "HWFOC_BULK_ONCE={name}: not a stream (clean, noisy, hostile, each also with \
+                 detect_ before it)"
+            );
             std::process::exit(2);
         }
     };
@@ -791,7 +847,12 @@ fn once(name: &str) {
         }
     };
     for _ in 0..decodes {
-        println!("{name}: {} bytes, fold {:x}", buf.len(), decode_once(&buf));
+        let fold = if detected {
+            detect_once(&buf)
+        } else {
+            decode_once(&buf)
+        };
+        println!("{name}: {} bytes, fold {fold:x}", buf.len());
     }
 }
 

@@ -130,12 +130,14 @@ fn scan_next(
     // After a run of line noise: a frame at one of its first sync bytes, while that is what
     // the noise has been giving.
     let guessed = guess.holds();
-    if guessed && let Some(found) = take_after_noise(data, pos, stats) {
+    if guessed && let Some(looked) = take_after_noise::<NoStops>(data, pos, stats) {
         guess.right();
-        return Some(found);
+        stats.checksum_failures_n(looked.rejected);
+        stats.skip(looked.skipped);
+        return Some(looked.found);
     }
     // Then whole windows, counted here from what the search found.
-    let searched = search_windows(data, *pos);
+    let searched = search_windows::<NoStops>(data, *pos);
     if searched.found {
         guess.judged(!guessed && searched.rejected == 0);
     }
@@ -185,7 +187,7 @@ impl Guess {
     pub(crate) const NEW: Guess = Guess(3);
 
     #[inline(always)]
-    fn holds(self) -> bool {
+    pub(crate) fn holds(self) -> bool {
         self.0 >= 2
     }
 
@@ -196,13 +198,13 @@ impl Guess {
     }
 
     #[inline(always)]
-    fn right(&mut self) {
+    pub(crate) fn right(&mut self) {
         self.0 = self.up();
     }
 
     /// Right or wrong, without a branch.
     #[inline(always)]
-    fn judged(&mut self, right: bool) {
+    pub(crate) fn judged(&mut self, right: bool) {
         let down = self.0.saturating_sub(1);
         self.0 = if right { self.up() } else { down };
     }
@@ -211,14 +213,51 @@ impl Guess {
 /// Sync bytes [`take_after_noise`] tries a frame at.
 const TRIES: usize = 2;
 
+/// Where the searches after noise stop undecided: a sync byte followed by one of
+/// [`Stops::SECONDS`], another protocol's candidate, which a scanner reading both protocols
+/// decides itself ([`crate::mixed`]: DataLink's). The HW-FOC scanner has none ([`NoStops`]),
+/// and then nothing of them is computed.
+pub(crate) trait Stops {
+    /// The second bytes of the other protocol's candidates.
+    const SECONDS: &'static [u8];
+
+    /// Whether a sync byte followed by `second` is a stop.
+    #[inline(always)]
+    fn at(second: u8) -> bool {
+        Self::SECONDS.contains(&second)
+    }
+}
+
+/// No stops: the HW-FOC scanner's searches.
+pub(crate) struct NoStops;
+
+impl Stops for NoStops {
+    const SECONDS: &'static [u8] = &[];
+}
+
+/// What [`take_after_noise`] found.
+pub(crate) struct Looked {
+    /// Bytes passed over before the frame.
+    pub(crate) skipped: usize,
+    /// Candidates among them, each a checksum failure.
+    pub(crate) rejected: u32,
+    /// The frame and its start offset.
+    pub(crate) found: (usize, FocFrame),
+}
+
 /// The frame at one of the first [`TRIES`] sync bytes after `*pos` within the next 64
-/// positions (or just after them, when they hold fewer), taken as [`FocFrame::take`] does, the
-/// bytes before it skipped and the candidates among them counted as checksum failures. The
-/// byte at `*pos` is known to start no frame. `None`, with nothing counted and `*pos` unmoved,
-/// when there is no such frame, or fewer than a window and a frame's bytes are left, or the
-/// target has no vector unit [`crate::foc::window`] uses.
+/// positions (or just after them, when they hold fewer), taken and counted as
+/// [`FocFrame::take`] does, `*pos` just after it. What it passed over is the caller's to
+/// count ([`Looked`]). The byte at `*pos` is known to start no frame, and to be no stop.
+/// `None`, with nothing counted and `*pos` unmoved, when there is no such frame,
+/// or a stop comes first, or fewer than a window and a frame's bytes are left, or the target
+/// has no vector unit [`crate::foc::window`] uses.
 #[inline(always)]
-fn take_after_noise(data: &[u8], pos: &mut usize, stats: &mut Stats) -> Option<(usize, FocFrame)> {
+pub(crate) fn take_after_noise<S: Stops>(
+    data: &[u8],
+    pos: &mut usize,
+    stats: &mut Stats,
+) -> Option<Looked> {
     let w = data.get(*pos..*pos + WINDOW + MAX_FRAME_LEN)?;
     let mut syncs = syncs(w.first_chunk::<WINDOW>()?)?;
     // Every position of the window and the frame after it are in `data`.
@@ -231,12 +270,14 @@ fn take_after_noise(data: &[u8], pos: &mut usize, stats: &mut Stats) -> Option<(
         let k = syncs.trailing_zeros() as usize;
         let mut at = *pos + k;
         if let Some(found) = FocFrame::take(data, &mut at, stats) {
-            stats.checksum_failures_n(rejected);
-            stats.skip(k);
             *pos = at;
-            return Some(found);
+            return Some(Looked {
+                skipped: k,
+                rejected,
+                found,
+            });
         }
-        if k == WINDOW {
+        if k == WINDOW || S::at(w[k + 1]) {
             return None;
         }
         rejected += u32::from(is_length_byte(w[k + 1]));
@@ -246,24 +287,26 @@ fn take_after_noise(data: &[u8], pos: &mut usize, stats: &mut Stats) -> Option<(
 }
 
 /// What [`search_windows`] found.
-struct Searched {
-    /// Bytes passed over, to the frame found or the end of the last window.
-    skipped: usize,
+pub(crate) struct Searched {
+    /// Bytes passed over, to the frame found, the first stop or the end of the last window.
+    pub(crate) skipped: usize,
     /// Candidates among them, each a checksum failure.
-    rejected: u32,
-    /// Whether a frame starts after the bytes passed over.
-    found: bool,
+    pub(crate) rejected: u32,
+    /// Whether a frame starts after the bytes passed over (if not, a stop may: the caller
+    /// decides what is there).
+    pub(crate) found: bool,
 }
 
 /// Searches `data` from `from` a window at a time, where the target has one
 /// ([`crate::foc::window`]), while a whole frame's bytes follow the window's last position:
 /// then every candidate in it is complete, and its candidates are decided together, the first
-/// header that verifies a frame, every candidate before it rejected.
+/// header that verifies a frame, every candidate before it rejected. It stops at the first
+/// stop ([`Stops`]) that comes before such a frame, every candidate before it rejected.
 ///
 /// Out of line, and it counts nothing itself (no statistics pass through it): the loop over
 /// back-to-back frames that calls it keeps its counts in registers.
 #[inline(never)]
-fn search_windows(data: &[u8], from: usize) -> Searched {
+pub(crate) fn search_windows<S: Stops>(data: &[u8], from: usize) -> Searched {
     let mut searched = Searched {
         skipped: 0,
         rejected: 0,
@@ -280,10 +323,15 @@ fn search_windows(data: &[u8], from: usize) -> Searched {
         let Some(Window {
             candidates,
             mut headers,
-        }) = window(w)
+            stops,
+        }) = window(w, S::SECONDS)
         else {
             return searched;
         };
+        // Only the headers before the first stop are this search's to decide (with no stops,
+        // all of them).
+        let before_stop = (stops & stops.wrapping_neg()).wrapping_sub(1);
+        headers &= before_stop;
         while headers != 0 {
             let k = headers.trailing_zeros() as usize;
             if FocFrame::verifies(data, start + k) {
@@ -294,6 +342,12 @@ fn search_windows(data: &[u8], from: usize) -> Searched {
                 return searched;
             }
             headers &= headers - 1;
+        }
+        if stops != 0 {
+            let before = candidates & before_stop;
+            searched.rejected = searched.rejected.saturating_add(before.count_ones());
+            searched.skipped += stops.trailing_zeros() as usize;
+            return searched;
         }
         searched.rejected = searched.rejected.saturating_add(candidates.count_ones());
         searched.skipped += WINDOW;

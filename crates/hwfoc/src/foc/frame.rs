@@ -43,11 +43,8 @@ macro_rules! frame_kinds {
         pub(crate) const LENGTH_BYTES: [u8; KINDS.len()] =
             [$(<$kind as FrameKind>::LENGTH_BYTE),+];
 
-        /// The header of every kind, in list order (for the search window, on x86_64).
-        #[cfg_attr(
-            not(all(target_arch = "x86_64", target_feature = "sse2")),
-            allow(dead_code)
-        )]
+        /// The header of every kind, in list order: for the search window (on x86_64), and
+        /// where the mixed scanner starts a run of ESC frames.
         pub(crate) const HEADERS: [[u8; 4]; KINDS.len()] = [$(<$kind as FrameKind>::HEADER),+];
 
         /// `f` of every kind's length byte, ORed: one expression with constants, never a loop

@@ -8,6 +8,9 @@
 //! instead of one stop each.
 //!
 //! [`syncs`] is the scanner's first look after a run of noise, the window's sync bytes alone.
+//! A scanner that reads another protocol too ([`crate::mixed`]) names that protocol's second
+//! bytes, and the window marks where its candidates are (`stops`), for the scanner to stop
+//! there.
 //!
 //! The window is four SSE2 compares per byte value and a movemask per 16 positions, on x86_64
 //! (which always has SSE2). Elsewhere there is none ([`window`] gives `None`) and the scanner
@@ -35,24 +38,29 @@ pub(crate) struct Window {
     /// A kind's whole header (sync, length byte, version, command): the candidates that can
     /// be frames.
     pub(crate) headers: u64,
+    /// A sync byte followed by one of the second bytes the caller names: another protocol's
+    /// candidates, where a scanner that reads both must stop (the mixed scanner's DataLink
+    /// candidates; none for the HW-FOC scanner).
+    pub(crate) stops: u64,
 }
 
-/// The window of `w`'s first [`WINDOW`] positions, where the target has a vector unit this
-/// module uses (SSE2): `None` elsewhere.
+/// The window of `w`'s first [`WINDOW`] positions, its stops a sync byte followed by one of
+/// `stops` (a constant of the caller's; with none, nothing of them is computed), where the
+/// target has a vector unit this module uses (SSE2): `None` elsewhere.
 #[inline(always)]
-pub(crate) fn window(w: &[u8; WINDOW_BYTES]) -> Option<Window> {
+pub(crate) fn window(w: &[u8; WINDOW_BYTES], stops: &[u8]) -> Option<Window> {
     #[cfg(all(target_arch = "x86_64", target_feature = "sse2"))]
     {
         // SAFETY: the function needs SSE2, which this build enables (the `cfg` above; x86_64
         // always has it). With `syncs`, the codec's only `unsafe`: `core::arch`'s compare and
         // movemask need a target feature, and LLVM makes neither from portable code.
         #[allow(unsafe_code)]
-        let window = unsafe { sse2::window(w) };
+        let window = unsafe { sse2::window(w, stops) };
         Some(window)
     }
     #[cfg(not(all(target_arch = "x86_64", target_feature = "sse2")))]
     {
-        let _ = w;
+        let _ = (w, stops);
         None
     }
 }
@@ -117,9 +125,10 @@ mod sse2 {
     /// movemask of each result.
     #[target_feature(enable = "sse2")]
     #[inline]
-    pub(super) fn window(w: &[u8; WINDOW_BYTES]) -> Window {
+    pub(super) fn window(w: &[u8; WINDOW_BYTES], stops: &[u8]) -> Window {
         let mut candidates = 0;
         let mut headers = 0;
+        let mut stopped = 0;
         for at in (0..WINDOW).step_by(16) {
             // Sixteen bytes from `at + k` (two little-endian words: a plain unaligned load
             // once compiled, with no pointer).
@@ -147,10 +156,18 @@ mod sse2 {
             let mask = |v: __m128i| u64::from(_mm_movemask_epi8(v) as u16);
             candidates |= mask(_mm_and_si128(sync, length_byte)) << at;
             headers |= mask(header) << at;
+            if !stops.is_empty() {
+                let mut second = _mm_setzero_si128();
+                for &l in stops {
+                    second = _mm_or_si128(second, equal(b[1], l));
+                }
+                stopped |= mask(_mm_and_si128(sync, second)) << at;
+            }
         }
         Window {
             candidates,
             headers,
+            stops: stopped,
         }
     }
 }
@@ -167,6 +184,8 @@ mod tests {
         ignore = "needs x86_64 (the window is SSE2; other targets search a word at a time)"
     )]
     fn window_matches_a_plain_search() {
+        // Stops as the mixed scanner's (DataLink's length bytes) and one that is not.
+        const STOPS: [u8; 3] = [0x9E, 0xA0, 0x17];
         let mut x = 0x9E37_79B9_7F4A_7C15u64;
         let mut w = [0u8; WINDOW_BYTES];
         for round in 0..50_000 {
@@ -190,6 +209,7 @@ mod tests {
                     }
                     1 => w[i] = SYNC,
                     2 => w[i] = LENGTH_BYTES[(x >> 30) as usize % LENGTH_BYTES.len()],
+                    3 => w[i] = STOPS[(x >> 30) as usize % STOPS.len()],
                     _ => w[i] = x as u8,
                 }
                 i += 1;
@@ -197,7 +217,9 @@ mod tests {
             let mut plain = Window {
                 candidates: 0,
                 headers: 0,
+                stops: 0,
             };
+            let mut plain_stops = 0;
             let mut plain_syncs = 0;
             for i in 0..WINDOW {
                 if w[i] == SYNC {
@@ -209,8 +231,16 @@ mod tests {
                 if HEADERS.iter().any(|h| w[i..i + 4] == h[..]) {
                     plain.headers |= 1 << i;
                 }
+                if w[i] == SYNC && STOPS.contains(&w[i + 1]) {
+                    plain_stops |= 1 << i;
+                }
             }
-            assert_eq!(window(&w), Some(plain), "{w:02X?}");
+            assert_eq!(window(&w, &[]), Some(plain), "{w:02X?}");
+            let with_stops = Window {
+                stops: plain_stops,
+                ..plain
+            };
+            assert_eq!(window(&w, &STOPS), Some(with_stops), "{w:02X?}");
             let first: &[u8; WINDOW] = w.first_chunk().unwrap();
             assert_eq!(syncs(first), Some(plain_syncs));
         }
