@@ -203,7 +203,8 @@ fn candidate_len(held: &[u8]) -> usize {
 /// Returns as the HW-FOC scanner's `scan_next` does, and looks for the next frame as it does
 /// (a frame right here, the first look after noise while `guess` holds, then whole windows),
 /// with this difference: each of those ways stops at a DataLink candidate, which DataLink then
-/// decides (back-to-back hub frames are decided first, with no window).
+/// decides (back-to-back hub frames are decided first, with no window). After a hub frame
+/// (`after_hub`) it searches one candidate at a time.
 #[inline(always)]
 fn scan_next(
     data: &[u8],
