@@ -89,7 +89,8 @@ def test_summary_of_a_can_bus_is_the_commands(cli):
         assert g["link"]["can"] == w["link"]["can"]
     by_esc = {e["esc"]: e for e in got["escs"]}
     assert by_esc[0]["link"]["can"]["node"] == 11
-    assert by_esc[4]["link"]["can"]["crc_errors"] == 1
+    assert by_esc[4]["link"]["checksum_failures"] == 1
+    assert "crc_errors" not in by_esc[4]["link"]["can"]
     assert by_esc[0]["link"]["can"]["unknown_types"] == 1
 
 

@@ -249,9 +249,9 @@ fn datalink_inputs_with_bad_frames_are_counted_and_the_other_escs_kept() {
     assert_eq!(hub["frames"], 8);
     assert_eq!(hub["frames_length_byte_158"], 7);
     assert_eq!(hub["frames_length_byte_160"], 1);
-    assert_eq!(hub["crc_failures"], 1);
+    assert_eq!(hub["checksum_failures"], 1);
     assert_eq!(hub["bad_channels"], 1);
-    assert_eq!(hub["lost_frames"], 2);
+    assert_eq!(hub["lost_packets"], 2);
     assert_eq!(hub["bytes_skipped"], 320);
     let escs = summary["escs"].as_array().unwrap();
     assert_eq!(escs.len(), 3, "only the channels that carried an ESC");
@@ -259,7 +259,7 @@ fn datalink_inputs_with_bad_frames_are_counted_and_the_other_escs_kept() {
     assert_eq!(escs[2]["link"]["lost_packets"], 3, "{}", escs[2]);
     let text = String::from_utf8(ok(run(hwfoc().arg("summary").arg(&input))).stdout).unwrap();
     assert!(
-        text.contains("DataLink V2") && text.contains("1 CRC failures"),
+        text.contains("DataLink V2") && text.contains("1 checksum failures"),
         "{text}"
     );
 }

@@ -256,7 +256,9 @@ fn can_bus_log_decodes_and_summarises_as_the_golden_files() {
     assert_eq!(esc(3)["protocol"], "dronecan");
     assert_eq!(esc(0)["link"]["can"]["node"], 11);
     assert_eq!(esc(0)["link"]["can"]["unknown_types"], 1);
-    assert_eq!(esc(4)["link"]["can"]["crc_errors"], 1);
+    // The transfer whose CRC failed is the link's checksum failure, named once.
+    assert_eq!(esc(4)["link"]["checksum_failures"], 1);
+    assert_eq!(esc(4)["link"]["can"]["crc_errors"], Value::Null);
     assert_eq!(esc(4)["frames"], 9);
     let portable = out.replace(
         &serde_json::to_string(path).unwrap(),
@@ -401,17 +403,21 @@ fn a_candump_log_of_broken_transfers_and_foreign_frames_is_counted() {
     assert!(!String::from_utf8_lossy(&out.stderr).contains("panicked"));
     let v: Value = serde_json::from_str(&stdout(&out)).unwrap();
     let escs = v["escs"].as_array().unwrap();
-    let can = |n: u64| escs.iter().find(|e| e["esc"] == n).unwrap()["link"]["can"].clone();
+    let link = |n: u64| escs.iter().find(|e| e["esc"] == n).unwrap()["link"].clone();
+    let can = |n: u64| link(n)["can"].clone();
     let (hw, std) = (can(5), can(1));
     assert_eq!(std["node"], 9);
     assert_eq!(std["cut_short"], 1, "{std}");
     assert_eq!(std["toggle_errors"], 1, "{std}");
-    assert_eq!(std["crc_errors"], 1, "{std}");
+    assert_eq!(link(1)["checksum_failures"], 1, "{std}");
     assert_eq!(std["unknown_types"], 1, "{std}");
     assert_eq!(hw["node"], 5);
     assert_eq!(hw["unknown_types"], 1, "{hw}");
     assert_eq!(
-        (hw["toggle_errors"].as_u64(), hw["crc_errors"].as_u64()),
+        (
+            hw["toggle_errors"].as_u64(),
+            link(5)["checksum_failures"].as_u64()
+        ),
         (Some(0), Some(0)),
         "{hw}"
     );

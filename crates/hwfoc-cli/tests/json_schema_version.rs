@@ -28,8 +28,8 @@ fn summary_json_starts_with_the_schema_version() {
             .unwrap(),
     );
     let v: Value = serde_json::from_str(&out).unwrap();
-    assert_eq!(hwfoc_io::JSON_SCHEMA_VERSION, 1);
-    assert_eq!(first(&v), ("schema_version", &Value::from(1)));
+    assert_eq!(hwfoc_io::JSON_SCHEMA_VERSION, 2);
+    assert_eq!(first(&v), ("schema_version", &Value::from(2)));
 }
 
 #[test]
@@ -61,7 +61,7 @@ fn monitor_json_status_alarm_and_total_lines_carry_the_schema_version() {
         "{kinds:?}"
     );
     for v in &lines {
-        assert_eq!(first(v), ("schema_version", &Value::from(1)), "{v}");
+        assert_eq!(first(v), ("schema_version", &Value::from(2)), "{v}");
         // The record inside a status line is the schema's, without a version of its own.
         if let Some(record) = v["record"].as_object() {
             let keys: Vec<&str> = record.keys().map(String::as_str).collect();

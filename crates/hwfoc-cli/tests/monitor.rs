@@ -882,10 +882,11 @@ fn an_hw5_esc_is_found_at_115200_and_shown_with_its_own_fields() {
     let v: serde_json::Value = serde_json::from_str(&status).unwrap();
     assert_eq!(v["protocol"], "hw5", "{status}");
     assert_eq!(v["baud"], 115_200);
-    assert_eq!(v["lost"], serde_json::Value::Null);
+    assert_eq!(v["lost_packets"], serde_json::Value::Null);
     assert_eq!(v["restarts"], serde_json::Value::Null);
     assert_eq!(v["checksum_failures"], 0);
-    assert_eq!(v["rejected_frames"], serde_json::Value::Null);
+    assert_eq!(v["rejected_candidates"], serde_json::Value::Null);
+    assert!(v.get("delivery_ratio").is_some(), "{status}");
     assert!(v["bytes_at_other_rates"].as_u64().unwrap() > 0, "{status}");
     assert_eq!(v["record"]["phase_current_a"], serde_json::Value::Null);
     monitor.signal(Signal::SIGTERM);

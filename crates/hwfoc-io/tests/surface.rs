@@ -69,7 +69,7 @@ fn the_surface_constants_are_those_of_the_specs() {
     assert_eq!(LINKTYPE, 147);
     assert_eq!(LINKTYPE_CAN_SOCKETCAN, 227);
     assert_eq!(nominal_period_s(None), 0.05);
-    assert_eq!(JSON_SCHEMA_VERSION, 1);
+    assert_eq!(JSON_SCHEMA_VERSION, 2);
     assert_eq!(RECORD_SCHEMA_VERSION, 4);
     assert_eq!(RECORD_SCHEMA_VERSION_KEY, "record_schema_version");
     // The record's `esc` column is a `u8`: as many ESCs as it can number.

@@ -98,7 +98,14 @@ mod stream;
 /// goes up when a key is renamed or removed or its meaning or unit changes, not when a key is
 /// added. The records of `docs/RECORD-SCHEMA.md` (JSON Lines) carry no such key: they have exactly
 /// the schema's keys.
-pub const JSON_SCHEMA_VERSION: u32 = 1;
+///
+/// Version 2 gave a link's figures one set of names everywhere (`checksum_failures`,
+/// `lost_packets`, `duplicate_packets`, `rejected_candidates`): the summary's `hubs` had
+/// `crc_failures`, `lost_frames` and `duplicate_frames`; its `link.can` repeated the link's
+/// figures as `missed_transfers`, `duplicates` and `crc_errors` (gone); a status line of
+/// `monitor --json` had `lost`, `duplicates` and `rejected_frames`, and now has every figure of
+/// the summary's `link` object.
+pub const JSON_SCHEMA_VERSION: u32 = 2;
 
 /// The version of the record schema of `docs/RECORD-SCHEMA.md` (its columns, their types and
 /// nullability), recorded with the outputs that carry metadata: the Parquet export's key-value

@@ -120,7 +120,7 @@ impl fmt::Display for Counts {
         write!(
             f,
             "{} bytes skipped, {} implausible and {} unconfirmed candidates, {} syncs, {} lost \
-             frames, {} duplicate frames, {} restarts",
+             packets, {} duplicate packets, {} restarts",
             self.bytes_skipped(),
             self.implausible,
             self.unconfirmed,

@@ -688,7 +688,7 @@ proptest! {
         prop_assert_eq!(stats.frames(), sent);
         prop_assert_eq!(stats.checksum_failures(), dropped_inside);
         prop_assert_eq!(stats.lost_packets(), dropped_inside);
-        prop_assert_eq!((stats.restarts(), stats.duplicate_frames()), (0, 0));
+        prop_assert_eq!((stats.restarts(), stats.duplicate_packets()), (0, 0));
         for ch in 0..CHANNELS {
             let s = stats.channel(ch).unwrap();
             if ch % 2 == 0 && ch < 6 {
@@ -864,7 +864,7 @@ fn sync_bytes_inside_records() {
         decoded.iter().map(|d| d.offset).collect::<Vec<_>>(),
         [1, 161, 321]
     );
-    assert_eq!(stats.duplicate_frames(), 2);
+    assert_eq!(stats.duplicate_packets(), 2);
     assert_eq!(stats.channel(7).unwrap().duplicates(), 2);
     assert_eq!(stats.bytes_skipped(), 1);
 }
@@ -962,8 +962,8 @@ fn stats_display_names_every_counter() {
     let (_, stats) = bulk(&datalink::HubFrame::new(1).encode_as(LengthByte::Total));
     assert_eq!(
         stats.to_string(),
-        "160 bytes, 1 frames (0 with length byte 0x9E, 1 with 0xA0), 0 CRC failures, \
-         0 bad headers, 0 bytes skipped, 0 lost frames, 0 duplicate frames, 0 restarts, \
+        "160 bytes, 1 frames (0 with length byte 0x9E, 1 with 0xA0), 0 checksum \
+         failures, 0 bad headers, 0 bytes skipped, 0 lost packets, 0 duplicate packets, 0 restarts, \
          0 records, 8 empty slots, 0 bad channels, 0 duplicate channels"
     );
 }

@@ -570,7 +570,7 @@ proptest! {
                 prop_assert!(same(&r.message, m));
             }
             let s = rx.stats().node(node);
-            prop_assert_eq!(s.errors() + s.gaps() + s.duplicates() + s.orphan_frames(), 0);
+            prop_assert_eq!(s.errors() + s.gaps() + s.duplicate_packets() + s.orphan_frames(), 0);
         }
         prop_assert_eq!(rx.in_progress(), 0);
     }
@@ -632,7 +632,7 @@ proptest! {
             Fault::Truncated(_) => prop_assert_eq!((s.cut_short(), a_arrived), (1, false)),
         }
         // exactly one thing went wrong
-        let counted = s.errors() + s.orphan_frames() + s.unknown_types() + s.duplicates() + s.gaps();
+        let counted = s.errors() + s.orphan_frames() + s.unknown_types() + s.duplicate_packets() + s.gaps();
         prop_assert_eq!(counted, 1, "{}", s);
         prop_assert_eq!(rx.in_progress(), 0);
     }
@@ -658,13 +658,13 @@ proptest! {
         let s = rx.stats().node(node);
         if kind.form() == Form::Message {
             prop_assert!(again.is_none());
-            prop_assert_eq!(s.duplicates(), 1);
+            prop_assert_eq!(s.duplicate_packets(), 1);
             prop_assert!(after_skip.is_some());
             prop_assert_eq!((s.gaps(), s.lost_packets()), (1, u32::from(skip) - 1));
         } else {
             // services are not checked for continuity: a response carries its request's id
             prop_assert!(again.is_some() && after_skip.is_some());
-            prop_assert_eq!(s.duplicates() + s.gaps(), 0);
+            prop_assert_eq!(s.duplicate_packets() + s.gaps(), 0);
         }
     }
 
@@ -880,7 +880,12 @@ fn a_transfer_id_gap_is_judged_by_time() {
     let n = rx.stats().node(5);
     assert_eq!(got, 150);
     assert_eq!(
-        (n.gaps(), n.lost_packets(), n.duplicates(), n.restarts()),
+        (
+            n.gaps(),
+            n.lost_packets(),
+            n.duplicate_packets(),
+            n.restarts()
+        ),
         (1, 40, 0, 0)
     );
     let mut untimed = Receiver::new();
@@ -893,7 +898,7 @@ fn a_transfer_id_gap_is_judged_by_time() {
     push_timed(&mut rx, &before);
     let (t, f) = before[99];
     assert!(rx.push_at(&f, t + 1000).is_none());
-    assert_eq!(rx.stats().node(5).duplicates(), 1);
+    assert_eq!(rx.stats().node(5).duplicate_packets(), 1);
 }
 
 /// Frames delivered late and bunched (a receiver that stalled, as a busy browser tab or host
@@ -918,7 +923,12 @@ fn frames_delivered_late_and_bunched_lose_nothing() {
     let n = rx.stats().node(5);
     assert_eq!(got, 240);
     assert_eq!(
-        (n.gaps(), n.lost_packets(), n.duplicates(), n.restarts()),
+        (
+            n.gaps(),
+            n.lost_packets(),
+            n.duplicate_packets(),
+            n.restarts()
+        ),
         (0, 0, 0, 0)
     );
     // Transfers 140..143 lost right after the bunch: 3, judged at the sender's period (the
@@ -930,7 +940,12 @@ fn frames_delivered_late_and_bunched_lose_nothing() {
     push_timed(&mut rx, &after);
     let n = rx.stats().node(5);
     assert_eq!(
-        (n.gaps(), n.lost_packets(), n.duplicates(), n.restarts()),
+        (
+            n.gaps(),
+            n.lost_packets(),
+            n.duplicate_packets(),
+            n.restarts()
+        ),
         (1, 3, 0, 0)
     );
     // Stalls again and again (a tab under load), then a real gap at the sender's pace:
@@ -997,7 +1012,12 @@ fn bunched_late_delivery_invents_no_loss() {
     let n = rx.stats().node(5);
     assert_eq!(got, 2000);
     assert_eq!(
-        (n.gaps(), n.lost_packets(), n.duplicates(), n.restarts()),
+        (
+            n.gaps(),
+            n.lost_packets(),
+            n.duplicate_packets(),
+            n.restarts()
+        ),
         (0, 0, 0, 0)
     );
 }

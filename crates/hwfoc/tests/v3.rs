@@ -525,6 +525,6 @@ fn stats_display_names_every_counter() {
     assert_eq!(
         stats.to_string(),
         "30 bytes, 3 frames, 0 bytes skipped, 0 implausible and 0 unconfirmed candidates, \
-         1 syncs, 0 lost frames, 0 duplicate frames, 0 restarts"
+         1 syncs, 0 lost packets, 0 duplicate packets, 0 restarts"
     );
 }

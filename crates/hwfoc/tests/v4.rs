@@ -993,7 +993,7 @@ fn stats_display_names_every_counter() {
     assert_eq!(
         stats.to_string(),
         "60 bytes, 3 data frames (3 with trailer), 0 info frames (0 adoptions, 0 disagreeing), \
-         0 bytes skipped, 0 implausible and 0 unconfirmed candidates, 1 syncs, 0 lost frames, \
-         0 duplicate frames, 0 restarts"
+         0 bytes skipped, 0 implausible and 0 unconfirmed candidates, 1 syncs, 0 lost packets, \
+         0 duplicate packets, 0 restarts"
     );
 }

@@ -107,7 +107,7 @@ impl LinkStats {
             packets: Some(PacketCounts {
                 received: node.total_transfers(),
                 lost: node.lost_packets(),
-                duplicates: node.duplicates(),
+                duplicates: node.duplicate_packets(),
                 reordered: 0,
                 restarts: node.restarts(),
                 last: None,

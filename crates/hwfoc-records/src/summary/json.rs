@@ -52,10 +52,10 @@ impl Report<'_> {
                     "frames": h.frames(),
                     "frames_length_byte_158": h.frames_with_length_byte(LengthByte::Covered),
                     "frames_length_byte_160": h.frames_with_length_byte(LengthByte::Total),
-                    "crc_failures": h.checksum_failures(),
+                    "checksum_failures": h.checksum_failures(),
                     "bad_headers": h.bad_headers(),
-                    "lost_frames": h.lost_packets(),
-                    "duplicate_frames": h.duplicate_frames(),
+                    "lost_packets": h.lost_packets(),
+                    "duplicate_packets": h.duplicate_packets(),
                     "restarts": h.restarts(),
                     "empty_slots": h.empty_slots(),
                     "bad_channels": h.bad_channels(),
@@ -186,6 +186,13 @@ impl EscReport<'_> {
     }
 }
 
+/// A link's figures as JSON members, under their one set of names
+/// ([`LinkStats::figures`](crate::stream::LinkStats::figures)): the form every JSON output gives
+/// them in (the summary's `link` object, the status lines of `hwfoc monitor --json`).
+pub fn link_json(st: &crate::stream::LinkStats) -> Map<String, Value> {
+    st.figures().iter().map(figure_json).collect()
+}
+
 /// A link figure as a JSON member: a count as an integer, a ratio as a number, null where not
 /// counted.
 fn figure_json(&(name, value): &(&str, Option<Figure>)) -> (String, Value) {
@@ -197,7 +204,9 @@ fn figure_json(&(name, value): &(&str, Option<Figure>)) -> (String, Value) {
     (name.to_string(), value)
 }
 
-/// An ESC's node and bus figures on a CAN bus (null elsewhere).
+/// An ESC's node and bus figures on a CAN bus (null elsewhere). The node's lost and duplicate
+/// transfers and its transfers' CRC failures are not repeated here: they are the link's
+/// `lost_packets`, `duplicate_packets` and `checksum_failures`.
 fn can_json(st: &crate::stream::LinkStats) -> Value {
     let Some(c) = st.can() else {
         return Value::Null;
@@ -207,10 +216,7 @@ fn can_json(st: &crate::stream::LinkStats) -> Value {
         "node": c.node,
         "transfers": n.total_transfers(),
         "gaps": n.gaps(),
-        "missed_transfers": n.lost_packets(),
-        "duplicates": n.duplicates(),
         "toggle_errors": n.toggle_errors(),
-        "crc_errors": n.checksum_failures(),
         "cut_short": n.cut_short(),
         "orphan_frames": n.orphan_frames(),
         "bad_payloads": n.bad_payloads(),

@@ -52,7 +52,7 @@ mod tests;
 mod text;
 
 use accumulate::{Accumulator, TempStats, is_clean, lane, temp_stats};
-pub use json::device_json;
+pub use json::{device_json, link_json};
 
 /// What to tell a user whose wire gave bytes but no frame of any format: the formats, their
 /// baud rates and the wiring.

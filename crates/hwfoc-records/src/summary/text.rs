@@ -201,13 +201,10 @@ impl EscReport<'_> {
                 .map_or("no node yet".to_string(), |n| format!("node {n}"));
             let _ = writeln!(
                 o,
-                "can          {node}: {} transfers, {} gaps in transfer ids ({} missed), {} duplicates, {} toggle errors, {} CRC errors, {} cut short, {} of unknown types; bus: {} frames, {} not DroneCAN ({} error frames)",
+                "can          {node}: {} transfers, {} gaps in transfer ids, {} toggle errors, {} cut short, {} of unknown types; bus: {} frames, {} not DroneCAN ({} error frames)",
                 n.total_transfers(),
                 n.gaps(),
-                n.lost_packets(),
-                n.duplicates(),
                 n.toggle_errors(),
-                n.checksum_failures(),
                 n.cut_short(),
                 n.unknown_types(),
                 c.bus.frames(),

@@ -26,7 +26,7 @@ use super::layout::{BAUD_RATE, CHANNELS, FRAME_LEN, LengthByte};
 ///
 /// The hub's frame counter is followed exactly as [`foc::Stats`](crate::foc::Stats) follows an
 /// ESC's packet numbers (a [`PacketSequence`]: [lost packets](Stats::lost_packets),
-/// [duplicates](Stats::duplicate_frames), [restarts](Stats::restarts)), and so
+/// [duplicates](Stats::duplicate_packets), [restarts](Stats::restarts)), and so
 /// is each channel's packet number, record after record. A channel's lost packets are the
 /// numbers the stream did not carry, whether the ESC's own wire lost them or the hub forwarded
 /// its records less often than the ESC sent frames.
@@ -122,7 +122,7 @@ impl Stats {
     }
 
     /// Frames whose counter equals the previous frame's.
-    pub const fn duplicate_frames(&self) -> u32 {
+    pub const fn duplicate_packets(&self) -> u32 {
         self.counter.duplicates()
     }
 
@@ -235,8 +235,9 @@ impl fmt::Display for Stats {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         write!(
             f,
-            "{} bytes, {} frames ({} with length byte 0x9E, {} with 0xA0), {} CRC failures, \
-             {} bad headers, {} bytes skipped, {} lost frames, {} duplicate frames, {} restarts, \
+            "{} bytes, {} frames ({} with length byte 0x9E, {} with 0xA0), {} checksum \
+             failures, {} bad headers, {} bytes skipped, {} lost packets, {} duplicate packets, \
+             {} restarts, \
              {} records, {} empty slots, {} bad channels, {} duplicate channels",
             self.bytes(),
             self.frames(),
@@ -246,7 +247,7 @@ impl fmt::Display for Stats {
             self.bad_headers,
             self.bytes_skipped(),
             self.lost_packets(),
-            self.duplicate_frames(),
+            self.duplicate_packets(),
             self.restarts(),
             self.records(),
             self.empty_slots,

@@ -643,7 +643,7 @@ mod tests {
         rx.reset();
         assert_eq!(rx.stats().node(5).cut_short(), 2);
         assert!(rx.push(&one[0]).is_some(), "history forgotten");
-        assert_eq!(rx.stats().node(5).duplicates(), 1);
+        assert_eq!(rx.stats().node(5).duplicate_packets(), 1);
         rx.reset_stats();
         assert_eq!(rx.stats().node(5).frames(), 0);
         assert!(rx.push(&one[0]).is_none(), "history kept by reset_stats");

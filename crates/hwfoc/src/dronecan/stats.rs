@@ -101,7 +101,7 @@ impl BusStats {
 ///
 /// Every DroneCAN frame a node sends is counted in [`NodeStats::frames`]; every transfer it
 /// starts ends in exactly one of: decoded ([`NodeStats::transfers`]), a
-/// [duplicate](NodeStats::duplicates), a [toggle error](NodeStats::toggle_errors), a
+/// [duplicate](NodeStats::duplicate_packets), a [toggle error](NodeStats::toggle_errors), a
 /// [checksum failure](NodeStats::checksum_failures) (a CRC that did not match), [too long](NodeStats::too_long), a
 /// [short frame](NodeStats::short_frames), a [bad payload](NodeStats::bad_payloads),
 /// [cut short](NodeStats::cut_short), or an [unknown type](NodeStats::unknown_types); a
@@ -197,7 +197,7 @@ impl NodeStats {
 
     /// Message transfers with the same transfer id as the previous one of their type (a
     /// repeated frame or transfer): not handed on.
-    pub const fn duplicates(&self) -> u32 {
+    pub const fn duplicate_packets(&self) -> u32 {
         self.duplicates
     }
 
@@ -497,7 +497,10 @@ mod tests {
         assert!(n.next_transfer_id(Kind::StatusMsg2, 9)); // another type: its own ids
         assert!(n.next_transfer_id(Kind::SetIdRequest, 9));
         assert!(n.next_transfer_id(Kind::SetIdRequest, 9)); // services: not checked
-        assert_eq!((n.gaps(), n.lost_packets(), n.duplicates()), (1, 3, 1));
+        assert_eq!(
+            (n.gaps(), n.lost_packets(), n.duplicate_packets()),
+            (1, 3, 1)
+        );
         n.forget_transfer_ids();
         assert!(n.next_transfer_id(Kind::StatusMsg1, 20));
         assert_eq!(n.gaps(), 1);

@@ -16,7 +16,7 @@
 //!    plausible frames with counters +1: decided on at most 30 bytes, each byte looked at once
 //!    more. The frames after it are then accepted as chained, so a chain loses none of its
 //!    frames; its first counter's step from the last accepted one counts
-//!    [lost packets](Stats::lost_packets), a [duplicate](Stats::duplicate_frames) or a
+//!    [lost packets](Stats::lost_packets), a [duplicate](Stats::duplicate_packets) or a
 //!    [restart](Stats::restarts).
 //! 4. Otherwise it is rejected ([unconfirmed](Stats::unconfirmed)) and costs one byte: scanning
 //!    resumes at the byte after its `9B`.

@@ -23,7 +23,7 @@ use super::frame::{FRAME_LEN, V3Frame};
 ///
 /// The counter of accepted frames is followed as [`foc::Stats`](crate::foc::Stats) follows an
 /// ESC's packet numbers, in 24 bits ([`PacketSequence24`]): the step to the first frame of each
-/// new chain tells [lost packets](Stats::lost_packets), a [duplicate](Stats::duplicate_frames) or
+/// new chain tells [lost packets](Stats::lost_packets), a [duplicate](Stats::duplicate_packets) or
 /// a [restart](Stats::restarts).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
 pub struct Stats {
@@ -88,7 +88,7 @@ impl Stats {
     }
 
     /// Accepted frames whose counter equals the previous one's.
-    pub const fn duplicate_frames(&self) -> u32 {
+    pub const fn duplicate_packets(&self) -> u32 {
         self.counts.counter.duplicates()
     }
 

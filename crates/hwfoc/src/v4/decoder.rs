@@ -27,7 +27,7 @@
 //!    it or after the next data frame (slow mode, where they alternate). At most 59 bytes decide
 //!    it. The frames after it are then accepted as chained, so a chain loses none of its
 //!    frames; its first counter's step from the last accepted one counts
-//!    [lost packets](Stats::lost_packets), a [duplicate](Stats::duplicate_frames) or a
+//!    [lost packets](Stats::lost_packets), a [duplicate](Stats::duplicate_packets) or a
 //!    [restart](Stats::restarts).
 //! 6. Otherwise it is rejected ([unconfirmed](Stats::unconfirmed)) and costs one byte: scanning
 //!    resumes at the byte after its `9B`.

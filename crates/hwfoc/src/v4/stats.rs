@@ -39,7 +39,7 @@ struct Chain {
 ///
 /// The data frames' counter is followed in 24 bits ([`PacketSequence24`]): the step to the
 /// first frame of each new chain tells [lost packets](Stats::lost_packets), a
-/// [duplicate](Stats::duplicate_frames) or a [restart](Stats::restarts).
+/// [duplicate](Stats::duplicate_packets) or a [restart](Stats::restarts).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub struct Stats {
     counts: Counts,
@@ -181,7 +181,7 @@ impl Stats {
     }
 
     /// Accepted data frames whose counter equals the previous one's.
-    pub const fn duplicate_frames(&self) -> u32 {
+    pub const fn duplicate_packets(&self) -> u32 {
         self.counts.counter.duplicates()
     }
 

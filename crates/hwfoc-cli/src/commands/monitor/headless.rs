@@ -266,7 +266,6 @@ fn alarm_json(entry: &LogEntry, esc: &EscView) -> Value {
 }
 
 pub(super) fn status_json(esc: &EscView, now: f64) -> Value {
-    let counted = esc.stats.counts_packets();
     let record = esc.last.as_ref().map(record_json);
     let (link, down_since, reason) = match &esc.link {
         Link::Up => ("up", None, None),
@@ -279,7 +278,7 @@ pub(super) fn status_json(esc: &EscView, now: f64) -> Value {
         .into_iter()
         .map(|(kind, level)| json!({"alarm": kind.name(), "level": level.name()}))
         .collect();
-    json!({
+    let mut status = json!({
         "schema_version": hwfoc_io::JSON_SCHEMA_VERSION,
         "type": "status",
         "time": timestamp(now),
@@ -295,15 +294,12 @@ pub(super) fn status_json(esc: &EscView, now: f64) -> Value {
         "protocol": esc.protocol().map(hwfoc::Protocol::name),
         "baud": esc.baud,
         "frames": esc.stats.frames(),
-        // Null where the format has no such figure (HW5 numbers no packet, V3 and V4 frames
-        // carry no checksum), never 0.
-        "lost": counted.then(|| esc.stats.lost_packets()),
-        "duplicates": counted.then(|| esc.stats.duplicate_packets()),
-        "restarts": counted.then(|| esc.stats.restarts()),
-        "checksum_failures": esc.stats.has_checksum().then(|| esc.stats.checksum_failures()),
-        "rejected_frames": esc.stats.rejected_candidates(),
         "bytes": esc.stats.bytes(),
-        "bytes_skipped": esc.stats.bytes_skipped(),
+    });
+    // The link's figures as the summary gives them: null where the format has no such figure
+    // (HW5 numbers no packet, V3 and V4 frames carry no checksum), never 0.
+    let link_figures = hwfoc_io::summary::link_json(&esc.stats);
+    let rest = json!({
         "bytes_at_other_rates": esc.discarded,
         "info_adopted": esc.stats.adopted_info().map(|i| hwfoc_io::summary::device_json(&i)),
         "record": record,
@@ -320,7 +316,12 @@ pub(super) fn status_json(esc: &EscView, now: f64) -> Value {
         "info": esc.info.as_ref().map(hwfoc_io::summary::device_json),
         "alarms": alarms,
         "settings": hwfoc_io::settings_json(&esc.settings),
-    })
+    });
+    if let (Some(object), Value::Object(rest)) = (status.as_object_mut(), rest) {
+        object.extend(link_figures);
+        object.extend(rest);
+    }
+    status
 }
 
 /// The record exactly as `hwfoc decode` writes it (docs/RECORD-SCHEMA.md).
