@@ -26,8 +26,7 @@
 
 use crate::datalink::{self, FRAME_LEN, LengthByte};
 use crate::foc::decoder::{
-    Guess, Stops, bytes_equal, find_sync_then, is_length_byte, search_windows, take_after_noise,
-    take_candidate,
+    Guess, Stops, bytes_equal, find_sync_then, is_length_byte, search_after_noise, take_candidate,
 };
 use crate::foc::frame::{HEADERS, or_length_bytes};
 use crate::foc::{self, MAX_FRAME_LEN};
@@ -224,28 +223,11 @@ fn scan_next(
         if let Some((at, frame)) = foc::FocFrame::take(data, pos, &mut stats.esc) {
             return Some((at, Found::Esc(frame)));
         }
-        let guessed = guess.holds();
-        if guessed
-            && let Some(looked) = take_after_noise::<HubCandidates>(data, pos, &mut stats.esc)
-        {
-            guess.right();
-            stats.esc.checksum_failures_n(looked.rejected);
-            stats.skip(looked.skipped);
-            let (at, frame) = looked.found;
-            return Some((at, Found::Esc(frame)));
-        }
-        let searched = search_windows::<HubCandidates>(data, *pos);
-        if searched.found {
-            guess.judged(!guessed && searched.rejected == 0);
-        }
-        stats.esc.checksum_failures_n(searched.rejected);
-        stats.skip(searched.skipped);
-        *pos += searched.skipped;
-        if searched.found
-            && let Some((at, frame)) = foc::FocFrame::take(data, pos, &mut stats.esc)
-        {
-            return Some((at, Found::Esc(frame)));
-        }
+        search_after_noise!(
+            HubCandidates, data, pos, stats, guess,
+            esc: &mut stats.esc,
+            found: |f| (f.0, Found::Esc(f.1))
+        );
     }
     // A hub candidate, where the search stopped, and the last bytes: one candidate at a time.
     // (After a hub candidate that is no frame, the rest of a run of noise is searched so too:
