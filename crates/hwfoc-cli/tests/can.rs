@@ -20,7 +20,7 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
 use std::time::Duration;
 
-use common::{Dir, assert_fails_with, hwfoc, ok, records, stdout};
+use common::{Dir, assert_fails_with, check_golden, hwfoc, ok, records, stdout};
 use hwfoc::dronecan::{
     CanFrame, EscStatus, GetEscId, Message, SOCKETCAN_ERR_FLAG, StatusMsg1, StatusMsg2,
 };
@@ -38,29 +38,8 @@ fn frames_pcapng() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../../testdata/dronecan/pydronecan-frames.pcapng")
 }
 
-fn golden(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("tests/golden")
-        .join(name)
-}
-
 fn run(args: &[&str]) -> Output {
     hwfoc().args(args).output().expect("run hwfoc")
-}
-
-/// Compares with a golden file; `UPDATE_GOLDEN=1` rewrites it instead (as in tests/cli.rs).
-fn check_golden(name: &str, actual: &str) {
-    let path = golden(name);
-    if std::env::var_os("UPDATE_GOLDEN").is_some() {
-        std::fs::write(&path, actual).unwrap();
-    }
-    let expected = std::fs::read_to_string(&path)
-        .unwrap_or_else(|e| panic!("{}: {e} (run with UPDATE_GOLDEN=1)", path.display()));
-    assert!(
-        expected == actual,
-        "{name} differs from the golden file {}",
-        path.display()
-    );
 }
 
 fn python() -> String {

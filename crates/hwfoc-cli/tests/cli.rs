@@ -3,19 +3,13 @@
 mod common;
 
 use std::io::{Read, Write};
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::{Output, Stdio};
 
-use common::{TEXT_SCHEMA, XROTOR, assert_fails_with, capture, hwfoc, stdout};
+use common::{TEXT_SCHEMA, XROTOR, assert_fails_with, capture, check_golden, hwfoc, stdout};
 use hwfoc::foc::{DataFrame, InfoFrame};
 use hwfoc::{Fault, Status};
 use serde_json::Value;
-
-fn golden(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("tests/golden")
-        .join(name)
-}
 
 fn run(args: &[&str]) -> Output {
     hwfoc().args(args).output().expect("run hwfoc")
@@ -42,22 +36,6 @@ fn run_stdin(args: &[&str], stdin: &[u8]) -> Output {
     let out = child.wait_with_output().expect("wait hwfoc");
     writer.join().unwrap();
     out
-}
-
-/// Compares with a golden file; `UPDATE_GOLDEN=1` rewrites it instead.
-fn check_golden(name: &str, actual: &str) {
-    let path = golden(name);
-    if std::env::var_os("UPDATE_GOLDEN").is_some() {
-        std::fs::create_dir_all(path.parent().unwrap()).unwrap();
-        std::fs::write(&path, actual).unwrap();
-    }
-    let expected = std::fs::read_to_string(&path)
-        .unwrap_or_else(|e| panic!("{}: {e} (run with UPDATE_GOLDEN=1)", path.display()));
-    assert!(
-        expected == actual,
-        "{name} differs from the golden file {}",
-        path.display()
-    );
 }
 
 /// The bytes of a logic-analyser CSV, as a raw capture would hold them.
