@@ -15,7 +15,7 @@
 /// slice, 0 first).
 ///
 /// `formats!(callback)` hands the list to `callback`, which declares from it
-/// [`Protocol`](protocol::Protocol), [`Data`](telemetry::Data), [`Info`](telemetry::Info),
+/// [`Protocol`], [`Data`](telemetry::Data), [`Info`](telemetry::Info),
 /// [`Family`](detect::Family) and [`Decoded`](detect::Decoded): adding a format is its module,
 /// one line here and its `pub mod` line.
 macro_rules! formats {

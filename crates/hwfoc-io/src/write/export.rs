@@ -454,7 +454,7 @@ impl Export {
 
     /// Writes the remaining rows and ends the output: flushes text, closes a Parquet file (adding
     /// `metadata` to its key-value metadata, and `esc_settings` when some ESC's rows were converted
-    /// under settings of their own: see [`esc_settings_json`](super::metadata::esc_settings_json)),
+    /// under settings of their own: see [`esc_settings_json`]),
     /// and renames a file written under its temporary name into place. On a write error, or when
     /// the export was asked to stop ([`Export::stop_on`]), the temporary file is removed instead.
     pub fn finish(mut self, mut metadata: Vec<(String, String)>) -> Result<(), WriteError> {

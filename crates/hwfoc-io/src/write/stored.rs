@@ -53,7 +53,7 @@ pub fn visit<V: Visitor>(visitor: &mut V) {
 }
 
 /// The columns of the schema ([`hwfoc_records::record::columns`]), walked by this crate's
-/// writers with [`visit`](columns::visit).
+/// writers with [`visit`].
 pub mod columns {
     pub use super::visit;
     pub use hwfoc_records::record::columns::*;

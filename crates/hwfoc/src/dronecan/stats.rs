@@ -277,7 +277,8 @@ impl NodeStats {
         self.next_transfer_id_judged(kind, transfer_id, Judged::ByIds)
     }
 
-    /// [`NodeStats::next_transfer_id`], with what time says of the step (see [`Judged`]).
+    /// A whole message transfer with `transfer_id`: whether it is new (not a duplicate), after
+    /// counting a gap if ids were skipped, with what time says of the step (see [`Judged`]).
     pub(crate) fn next_transfer_id_judged(
         &mut self,
         kind: Kind,
