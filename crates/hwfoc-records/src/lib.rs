@@ -104,7 +104,8 @@ mod stream;
 /// `crc_failures`, `lost_frames` and `duplicate_frames`; its `link.can` repeated the link's
 /// figures as `missed_transfers`, `duplicates` and `crc_errors` (gone); a status line of
 /// `monitor --json` had `lost`, `duplicates` and `rejected_frames`, and now has every figure of
-/// the summary's `link` object.
+/// the summary's `link` object; the link finding of `hwfoc check --json` gives its share of
+/// packets lost (%) as `lost_packets`, not `lost`.
 pub const JSON_SCHEMA_VERSION: u32 = 2;
 
 /// The version of the record schema of `docs/RECORD-SCHEMA.md` (its columns, their types and

@@ -25,10 +25,10 @@ pub(super) fn analyse(series: &EscSeries, config: &LinkConfig, out: &mut Vec<Fin
     if let Some(link) = series.link {
         if link.counts_packets {
             let lost = percent(link.lost_packets, link.frames + link.lost_packets);
-            f = f.value("lost", lost, "%");
+            f = f.value("lost_packets", lost, "%");
             judged.push((
                 config.lost_pct.judge(lost),
-                "lost",
+                "lost_packets",
                 lost,
                 config.lost_pct,
                 "%",
@@ -69,7 +69,7 @@ pub(super) fn analyse(series: &EscSeries, config: &LinkConfig, out: &mut Vec<Fin
     f = f.judged(severity, name, limit, unit);
     f.window = window.filter(|_| severity > Severity::Ok);
     let words = match name {
-        "lost" => "packets lost",
+        "lost_packets" => "packets lost",
         "checksum_failures" => "frames failing their checksum",
         "burst" => "packets lost in the worst window",
         _ => "longest dropout while the motor turned",
@@ -218,6 +218,20 @@ mod tests {
             w.start_s < 31.0 && w.end_s > 34.0 && w.end_s < 41.0,
             "{w:?}"
         );
+    }
+
+    #[test]
+    fn loss_spread_over_the_flight_is_judged_under_the_summary_s_name() {
+        // Every 20th frame lost: 5 % (a warning from 2 %), never 20 % in a window.
+        let f = link(&flight(|i| i % 20 == 7));
+        assert_eq!(f.severity, Severity::Warning, "{f:?}");
+        let threshold = f.threshold.as_ref().unwrap();
+        assert_eq!(
+            (threshold.name.as_str(), threshold.value),
+            ("lost_packets", 2.0)
+        );
+        let lost = f.values.iter().find(|v| v.name == "lost_packets").unwrap();
+        assert!((lost.value - 5.0).abs() < 1e-9 && lost.unit == "%", "{f:?}");
     }
 
     #[test]
