@@ -541,8 +541,9 @@ mod tests {
     /// The searches that stop at hub candidates (the first look after noise and whole
     /// windows) find and count what a search one candidate at a time finds, over phases of
     /// plain noise (with a hub candidate now and then), of noise full of sync bytes, fake ESC
-    /// headers and hub candidates, and of plain noise again, with runs of up to 200 bytes (past a window), ESC data and info
-    /// frames and hub frames, whole, cut short or with one bit flipped.
+    /// headers and hub candidates, and of plain noise again, with runs of up to 200 bytes
+    /// (past a window), ESC data and info frames and hub frames, whole, cut short or with one
+    /// bit flipped.
     #[test]
     fn the_searches_after_noise_find_and_count_as_one_candidate_at_a_time() {
         let mut x = 0x9E37_79B9_7F4A_7C15u64;

@@ -237,8 +237,7 @@ impl fmt::Display for Stats {
             f,
             "{} bytes, {} frames ({} with length byte 0x9E, {} with 0xA0), {} checksum \
              failures, {} bad headers, {} bytes skipped, {} lost packets, {} duplicate packets, \
-             {} restarts, \
-             {} records, {} empty slots, {} bad channels, {} duplicate channels",
+             {} restarts, {} records, {} empty slots, {} bad channels, {} duplicate channels",
             self.bytes(),
             self.frames(),
             self.frames_with_length_byte(LengthByte::Covered),
