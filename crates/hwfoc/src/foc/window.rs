@@ -86,7 +86,7 @@ pub(crate) fn syncs(w: &[u8; WINDOW]) -> Option<u64> {
 }
 
 #[cfg(all(target_arch = "x86_64", target_feature = "sse2"))]
-mod sse2 {
+pub(crate) mod sse2 {
     use core::arch::x86_64::{
         __m128i, _mm_and_si128, _mm_cmpeq_epi8, _mm_movemask_epi8, _mm_or_si128, _mm_set_epi64x,
         _mm_set1_epi8, _mm_setzero_si128,
@@ -95,10 +95,10 @@ mod sse2 {
     use super::{HEADERS, LENGTH_BYTES, SYNC, WINDOW, WINDOW_BYTES, Window};
 
     /// Sixteen bytes of `w` from `at` (two little-endian words: a plain unaligned load once
-    /// compiled, with no pointer).
+    /// compiled, with no pointer). The candidate map's SSE2 code takes them here too.
     #[target_feature(enable = "sse2")]
     #[inline]
-    fn sixteen<const N: usize>(w: &[u8; N], at: usize) -> __m128i {
+    pub(crate) fn sixteen<const N: usize>(w: &[u8; N], at: usize) -> __m128i {
         let word = |from: usize| {
             let mut b = [0; 8];
             b.copy_from_slice(&w[from..from + 8]);
