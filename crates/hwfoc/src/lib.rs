@@ -1,8 +1,10 @@
 #![doc = include_str!("../README.md")]
 #![no_std]
-// No `unsafe` but two calls, in `foc/window.rs`: the SSE2 search window and sync mask, whose
-// compare and movemask `core::arch` gives only to a function with the target feature (x86_64
-// always has it).
+// No `unsafe` but calls of `core::arch` functions that need a target feature (compares and
+// movemasks) or are `unsafe` themselves: in `foc/window.rs` the SSE2 search window and sync
+// mask (x86_64 always has SSE2), in `foc/map.rs` the candidate map, with AVX2 where `cpuid`
+// and `xgetbv` (asked once, also there) say the processor and operating system have it, else
+// SSE2.
 #![deny(unsafe_code)]
 #![warn(missing_docs)]
 

@@ -557,7 +557,7 @@ impl<S: Scanner> Iterator for Scan<'_, S> {
 impl<S: Scanner> core::iter::FusedIterator for Scan<'_, S> {}
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     extern crate std;
     use std::vec::Vec;
 
@@ -566,9 +566,14 @@ mod tests {
     use crate::wire::SYNC;
     use crate::{datalink, foc, v3};
 
-    /// A stream of `frame(i)`s among garbage dense in sync bytes, `header`s, flipped bits and
-    /// cut frames, from the seed `x`.
-    fn noisy(mut x: u64, header: &[u8], frame: impl Fn(u32) -> Vec<u8>) -> Vec<u8> {
+    /// A stream of `frames` `frame(i)`s among garbage dense in sync bytes and `header`s, one
+    /// frame in `dirt` cut and one in `dirt` with a flipped bit, from the seed `x`.
+    pub(crate) fn noisy(
+        mut x: u64,
+        (frames, dirt): (u32, u64),
+        header: &[u8],
+        frame: impl Fn(u32) -> Vec<u8>,
+    ) -> Vec<u8> {
         let mut next = || {
             x ^= x << 13;
             x ^= x >> 7;
@@ -576,7 +581,7 @@ mod tests {
             x
         };
         let mut out = Vec::new();
-        for i in 0..300 {
+        for i in 0..frames {
             for _ in 0..next() % 4 * (next() % 9) {
                 match next() % 6 {
                     0 => out.push(SYNC),
@@ -585,7 +590,7 @@ mod tests {
                 }
             }
             let mut f = frame(i);
-            match next() % 12 {
+            match next() % dirt {
                 0 => f.truncate(1 + next() as usize % (f.len() - 1)),
                 1 => {
                     let bit = next() as usize % (f.len() * 8);
@@ -617,29 +622,32 @@ mod tests {
         }
     }
 
+    /// HW-FOC frame `i`: a data frame with packet number `i`, every 20th a device-information
+    /// frame instead.
+    pub(crate) fn foc_frame(i: u32) -> Vec<u8> {
+        if i % 20 == 19 {
+            let info = InfoFrame::new("XR_FOC_ESC", "HW1", "FW2", "ID").map(|i| i.encode());
+            info.unwrap_or([0; 77]).to_vec()
+        } else {
+            let packet = i as u16;
+            DataFrame {
+                packet,
+                ..Default::default()
+            }
+            .encode()
+            .to_vec()
+        }
+    }
+
     #[test]
     fn fold_gives_what_next_gives() {
-        let info = InfoFrame::new("XR_FOC_ESC", "HW1", "FW2", "ID").map(|i| i.encode().to_vec());
-        let info = info.unwrap_or_default();
-        let foc_stream = noisy(0x9B16_0102, &[SYNC, 0x16, 0x01, 0x02], |i| {
-            if i % 20 == 19 {
-                info.clone()
-            } else {
-                let packet = i as u16;
-                DataFrame {
-                    packet,
-                    ..Default::default()
-                }
-                .encode()
-                .to_vec()
-            }
-        });
+        let foc_stream = noisy(0x9B16_0102, (300, 12), &[SYNC, 0x16, 0x01, 0x02], foc_frame);
         assert_fold_is_next::<foc::Scanner>(&foc_stream);
-        let hub = noisy(0x9B9E_0102, &[SYNC, 0x9E, 0x01, 0x02], |i| {
+        let hub = noisy(0x9B9E_0102, (300, 12), &[SYNC, 0x9E, 0x01, 0x02], |i| {
             datalink::HubFrame::new(i as u16).encode().to_vec()
         });
         assert_fold_is_next::<datalink::Scanner>(&hub);
-        let older = noisy(0x9B00_0003, &[SYNC], |i| {
+        let older = noisy(0x9B00_0003, (300, 12), &[SYNC], |i| {
             let counter = i + 7;
             v3::V3Frame {
                 counter,

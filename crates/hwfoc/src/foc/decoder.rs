@@ -19,11 +19,18 @@
 //! of the bytes, a word-at-a-time search for the next candidate decides them one by one, as a
 //! [`Decoder`] must when a candidate may still be arriving. Every way counts the same.
 //!
+//! The bulk scanner (`scan_all`: [`frames`]' `fold`, `for_each` and `sum`, and every
+//! [`Decoder::feed`](StreamDecoder::feed)) goes further after a run of line noise: it follows
+//! [`crate::foc::follow`]'s candidate maps, from each frame straight to the next candidate,
+//! while the noise lasts and holds few fake headers.
+//!
 //! The scanner names no frame kind: it asks the list of kinds in [`crate::foc::frame`] whether a
 //! frame starts at a candidate, and how long a candidate with a given length byte is. Those calls
 //! are inlined with every kind's constants: no dynamic dispatch, no function pointer, and no loop
 //! over the kinds is left in the scanner.
 
+#[cfg(target_arch = "x86_64")]
+use crate::foc::follow::{Follow, follow_maps};
 use crate::foc::frame::{FocFrame, MAX_FRAME_LEN, candidate_len, or_length_bytes, wire_len_of};
 use crate::foc::stats::Stats;
 use crate::foc::window::{WINDOW, WINDOW_BYTES, Window, syncs, window};
@@ -481,6 +488,8 @@ impl scan::Scanner for Scanner {
     ) -> usize {
         let mut pos = 0;
         let mut guess = Guess::NEW;
+        #[cfg(target_arch = "x86_64")]
+        let mut follow = Follow::NEW;
         loop {
             // Back-to-back frames of the first kind have a call site of their own, where the frame
             // built is known to be of that kind: only its fields are written, not the bytes of the
@@ -491,6 +500,7 @@ impl scan::Scanner for Scanner {
                     frame,
                 });
             }
+            let (before, failures) = (pos, stats.checksum_failures());
             let Some((at, frame)) = scan_next(data, &mut pos, stats, (AT_END, false), &mut guess)
             else {
                 return pos;
@@ -499,6 +509,21 @@ impl scan::Scanner for Scanner {
                 offset: base + at as u64,
                 frame,
             });
+            // After line noise (bytes passed over, no candidate among them: fake headers are
+            // better decided by the search windows), follow the candidate maps while it lasts,
+            // unless following has lately met too many rejected candidates (x86_64 only).
+            #[cfg(target_arch = "x86_64")]
+            if !follow.waits() && at != before && stats.checksum_failures() == failures {
+                let on_frame = &mut *on_frame;
+                follow_maps(data, &mut pos, stats, &mut follow, &mut move |at, frame| {
+                    on_frame(Decoded {
+                        offset: base + at as u64,
+                        frame,
+                    });
+                });
+            }
+            #[cfg(not(target_arch = "x86_64"))]
+            let _ = (before, failures);
         }
     }
 

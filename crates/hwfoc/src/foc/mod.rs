@@ -11,6 +11,8 @@
 //! | `stats` | the link statistics: [`Stats`] |
 //! | `decoder` | the scanner: [`Decoder`], [`frames`], [`Decoded`], under the streaming layer of [`crate::scan`] |
 //! | `window` | the scanner's search window: 64 positions' candidates and headers at once |
+//! | `map` | the candidate map: 4096 positions' candidates at once, with AVX2 or SSE2 (x86_64) |
+//! | `follow` | the bulk scanner after line noise: from a frame to the next candidate of the map (x86_64) |
 //!
 //! Beside this module, [`crate::datalink`] holds the DataLink V2 hub's frame, scanner and
 //! statistics, built on [`crate::wire`], [`DataFrame`]'s payload and the scanner's sync-pair
@@ -76,9 +78,13 @@
 
 pub(crate) mod decoder;
 pub(crate) mod description;
+#[cfg(target_arch = "x86_64")]
+pub(crate) mod follow;
 pub(crate) mod frame;
 pub mod kinds;
-mod stats;
+#[cfg(target_arch = "x86_64")]
+pub(crate) mod map;
+pub(crate) mod stats;
 pub(crate) mod window;
 
 /// Baud rate of the HW-FOC telemetry wire (8 data bits, no parity, 1 stop bit: 8N1).
