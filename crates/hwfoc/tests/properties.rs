@@ -88,6 +88,19 @@ fn piece() -> impl Strategy<Value = Piece> {
     ]
 }
 
+/// A stretch of a wire with line noise as it comes: runs of random bytes (up to 150, longer
+/// than the 57 positions the bulk scanner's candidate map gives at once) between frames, few
+/// cut frames, a rare fake header.
+fn line_noise_piece() -> impl Strategy<Value = Piece> {
+    prop_oneof![
+        12 => frame().prop_map(Piece::Intact),
+        4 => vec(any::<u8>(), 1..150).prop_map(Piece::Garbage),
+        1 => (frame(), any::<Index>())
+            .prop_map(|(f, i)| Piece::Cut(f, 1 + i.index(f.wire_len() - 1))),
+        1 => Just(Piece::Fake(&[0x9B, 0x16, 0x01, 0x02][..])),
+    ]
+}
+
 fn pieces(max: usize) -> impl Strategy<Value = Vec<Piece>> {
     vec(piece(), 0..max)
 }
@@ -924,4 +937,37 @@ fn the_first_look_after_noise_finds_and_counts_as_a_byte_at_a_time() {
     assert!(found.len() > 2000, "{}", found.len());
     assert!(stats.checksum_failures() > 100, "{stats:?}");
     assert_eq!((found, stats), streamed_bytewise::<foc::Scanner>(&wire));
+}
+
+proptest! {
+    // Each case is a wire of about 60 kB, checked against the byte-by-byte reference.
+    #![proptest_config(ProptestConfig::with_cases(48))]
+
+    /// (e) The same on wires long enough for the bulk scanner's candidate maps (a block of
+    /// 4096 positions and a frame's bytes after it, `foc::follow`): line noise, a run of frames
+    /// long enough to stop following, noise full of fake headers (which stops it too), line
+    /// noise again.
+    #[test]
+    fn bulk_equals_streaming_and_the_reference_on_long_noisy_wires(
+        line in vec(line_noise_piece(), 300..600),
+        quiet in vec(frame(), 300..400),
+        fakes in vec(piece(), 400..800),
+        again in vec(line_noise_piece(), 300..600),
+        picks in vec(any::<Index>(), 0..8),
+    ) {
+        let ps: Vec<Piece> = line
+            .into_iter()
+            .chain(quiet.into_iter().map(Piece::Intact))
+            .chain(fakes)
+            .chain(again)
+            .collect();
+        let wire = build(&ps);
+        let whole = streamed_at(&wire.bytes, &[0, wire.bytes.len()]);
+        let cuts = cut_points(wire.bytes.len(), &picks);
+        prop_assert_eq!(&streamed_at(&wire.bytes, &cuts), &whole);
+        prop_assert_eq!(&bulk(&wire.bytes), &whole);
+        let (ref_decoded, ref_stats) = reference(&wire.bytes);
+        prop_assert_eq!(&whole.0, &ref_decoded);
+        prop_assert_eq!(RefStats::from(&whole.1), ref_stats);
+    }
 }

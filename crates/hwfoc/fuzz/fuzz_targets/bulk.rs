@@ -3,7 +3,9 @@
 //!
 //! Checked: the whole-stream invariants of `check_stream`, the iterator staying exhausted, and
 //! exact equality (frames and statistics) of all four ways of decoding, and the frames of the
-//! iterator's `fold` (one run of the scanner) against its `next`.
+//! iterator's `fold` (one run of the scanner) against its `next`. Then the same of the input
+//! repeated to 24 kB: the scanner's whole-buffer run follows candidate maps where a map's
+//! block and a frame's bytes are left (over 4 kB), which `next` never does.
 
 #![no_main]
 
@@ -55,5 +57,17 @@ fuzz_target!(|data: &[u8]| {
             folded, bulk,
             "frames().fold and next() disagree after {k} frames"
         );
+    }
+
+    // Long enough for the candidate maps of the whole-buffer run (`foc::follow`).
+    if !data.is_empty() {
+        let long: Vec<u8> = data.iter().copied().cycle().take(24 * 1024).collect();
+        let mut it = frames(&long);
+        let one_at_a_time: Vec<_> = it.by_ref().collect();
+        let mut whole = Decoder::new();
+        got.clear();
+        whole.decode_all(&long, |d| got.push(d));
+        assert_eq!(got, one_at_a_time, "repeated input: decode_all and next() disagree");
+        assert_eq!(whole.stats(), it.stats(), "repeated input: statistics disagree");
     }
 });
