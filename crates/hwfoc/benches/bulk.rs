@@ -25,7 +25,8 @@
 //! Each stream is measured four ways: the `frames` iterator over the whole buffer in a `for`
 //! loop (`frames`: `Iterator::next` per frame), the same iterator consumed by `fold`
 //! (`frames_fold`: the scanner's whole-buffer loop, what `scripts/instructions.sh` counts and
-//! what `collect`, `for_each` and `sum` run), a `Decoder` fed 64 KiB chunks then flushed, and a
+//! what `for_each`, `sum` and `count` run; `collect` into a `Vec` takes `next`), a `Decoder`
+//! fed 64 KiB chunks then flushed, and a
 //! `Decoder` pushed one byte at a time (the microcontroller path; on a 256 KiB slice only, as it
 //! is much slower).
 //!
