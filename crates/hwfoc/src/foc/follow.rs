@@ -23,7 +23,7 @@ use crate::foc::stats::Stats;
 /// run of line noise in which the search found no candidate (fake headers are better decided
 /// by the search windows, many at once), and follows them until a block without noise, or
 /// until it meets more than [`Follow::MAX_REJECTED`] rejected candidates in a block (noise full
-/// of fake headers); then it lets 16 frames that the search after noise finds pass before
+/// of fake headers); then it lets 256 frames that the search after noise finds pass before
 /// trying again, twice as many each time in a row (at most 4096). It changes how the next
 /// frame is looked for, never what is found or counted.
 #[derive(Debug, Clone, Copy)]
@@ -42,9 +42,9 @@ impl Follow {
         backoff: Self::FIRST_BACKOFF,
     };
 
-    /// Rejected candidates in a block after which following stops: one per 128 positions,
-    /// which corrupted frames do not reach (a link losing one frame in ten gives about 34)
-    /// but fake headers do.
+    /// Rejected candidates in a block after which following stops: one per 256 positions,
+    /// which corrupted frames seldom reach (a link losing one frame in ten gives about 14 in a
+    /// block of data frames; the bench's noisy stream about 4) but fake headers soon do.
     pub(crate) const MAX_REJECTED: u32 = 16;
 
     /// Frames to wait after the first block with too many rejected candidates.
